@@ -1,0 +1,25 @@
+# make demo: the seed's torus example (curvatures, a picture, a summary)
+# make test: the test suite
+# Both create a local virtual environment (.venv) on first use.
+
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: demo test bench-accuracy bench-speed clean
+
+$(STAMP): pyproject.toml
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "meshcurv needs Python 3.11 or newer: make PYTHON=python3.11 ...")'
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[plot,test]'
+	@touch $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/python -m meshcurv demo demo-output/torus_gaussian.png
+
+test: $(STAMP)
+	$(BIN)/python -m pytest
+
+clean:
+	rm -rf $(VENV) demo-output

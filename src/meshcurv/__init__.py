@@ -1,0 +1,50 @@
+"""meshcurv: curvature of triangle meshes.
+
+Principal curvatures and directions, mean and Gaussian curvature and normals at
+every vertex, in 1/length, with matGeom's ``meshCurvatures`` reproduced exactly
+as ``method="matgeom"``.
+
+>>> import meshcurv
+>>> torus = meshcurv.shapes.torus()
+>>> r = meshcurv.principal_curvatures(torus.vertices, torus.faces)
+>>> r.k_min.shape, r.dir_max.shape
+((3600,), (3600, 3))
+"""
+
+from . import errors, geometry, shapes, topology
+from .curvature import METHODS, principal_curvatures
+from .diagnosis import MeshDiagnosis, diagnose
+from .errors import (
+    InvalidMeshError,
+    InvalidOptionError,
+    MeshcurvWarning,
+    MeshFileError,
+    MeshQualityWarning,
+    TriangulationWarning,
+)
+from .result import CurvatureResult
+from .smoothing import smooth_vertex_field
+from .topology import MeshTopology, triangulate_faces
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "principal_curvatures",
+    "METHODS",
+    "CurvatureResult",
+    "MeshTopology",
+    "MeshDiagnosis",
+    "diagnose",
+    "triangulate_faces",
+    "smooth_vertex_field",
+    "shapes",
+    "geometry",
+    "topology",
+    "errors",
+    "InvalidMeshError",
+    "InvalidOptionError",
+    "MeshFileError",
+    "MeshcurvWarning",
+    "MeshQualityWarning",
+    "TriangulationWarning",
+]

@@ -1,0 +1,195 @@
+"""The one place where user input is checked and coerced.
+
+Every public entry point passes its arrays through :func:`as_vertices` and
+:func:`as_faces`; the core then trusts them (float64 (V, 3) finite vertices,
+int64 (F, 3) triangles with indices in range).
+"""
+
+from __future__ import annotations
+
+import operator
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+
+from .errors import InvalidMeshError, InvalidOptionError, TriangulationWarning
+
+__all__ = ["as_vertices", "as_faces", "as_polygons", "check_int_option", "check_choice"]
+
+
+def _shape_text(array) -> str:
+    return str(tuple(np.shape(array)))
+
+
+def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
+    """Return ``vertices`` as a new C-contiguous float64 array of shape (V, 3).
+
+    Raises
+    ------
+    InvalidMeshError
+        Wrong shape or dtype, no vertices, NaN or infinite coordinates.
+    """
+    try:
+        array = np.asarray(vertices)
+    except (ValueError, TypeError) as exc:  # ragged nested lists
+        raise InvalidMeshError(
+            f"`{name}` must be an array of shape (V, 3); it could not be converted to an array ({exc})"
+        ) from None
+    if array.dtype == object or not (
+        np.issubdtype(array.dtype, np.floating) or np.issubdtype(array.dtype, np.integer)
+    ):
+        raise InvalidMeshError(
+            f"`{name}` must hold real numbers (float or int); got dtype {array.dtype}"
+        )
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise InvalidMeshError(f"`{name}` must have shape (V, 3); got {_shape_text(array)}")
+    if array.shape[0] == 0:
+        raise InvalidMeshError(f"`{name}` is empty: the mesh has no vertices")
+    out = np.array(array, dtype=np.float64, order="C", copy=True)
+    finite = np.isfinite(out).all(axis=1)
+    if not finite.all():
+        bad = np.flatnonzero(~finite)
+        raise InvalidMeshError(
+            f"`{name}` has NaN or infinite coordinates at {bad.size} vertices "
+            f"(first at index {bad[0]})"
+        )
+    return out
+
+
+def _integer_faces(array: np.ndarray, name: str) -> np.ndarray:
+    """Coerce a numeric face array to int64, refusing non-integral values."""
+    if array.dtype == bool or not (
+        np.issubdtype(array.dtype, np.integer) or np.issubdtype(array.dtype, np.floating)
+    ):
+        raise InvalidMeshError(f"`{name}` must hold integer vertex indices; got dtype {array.dtype}")
+    if np.issubdtype(array.dtype, np.floating):
+        if not np.isfinite(array).all():
+            raise InvalidMeshError(f"`{name}` has NaN or infinite values; indices must be integers")
+        if not np.array_equal(array, np.round(array)):
+            raise InvalidMeshError(
+                f"`{name}` has non-integer values; vertex indices must be whole numbers"
+            )
+    if np.issubdtype(array.dtype, np.unsignedinteger) and array.size and array.max() > np.iinfo(np.int64).max:
+        raise InvalidMeshError(f"`{name}` has indices too large for int64")
+    return array.astype(np.int64, copy=True)
+
+
+def as_polygons(faces, *, name: str = "faces") -> list[np.ndarray] | np.ndarray:
+    """Return ``faces`` as an int64 (F, k) array, or a list of int64 index arrays when ragged."""
+    if isinstance(faces, np.ndarray) or not isinstance(faces, Sequence):
+        try:
+            array = np.asarray(faces)
+        except (ValueError, TypeError) as exc:
+            raise InvalidMeshError(
+                f"`{name}` must be an array of shape (F, 3) or (F, k), or a list of index lists ({exc})"
+            ) from None
+    else:
+        lengths = set()
+        for face in faces:
+            lengths.add(len(face) if isinstance(face, (Sequence, np.ndarray)) else -1)
+        if -1 in lengths:
+            raise InvalidMeshError(
+                f"`{name}` must be an array of shape (F, 3) or (F, k), or a list of index lists; "
+                "got a list whose items are not sequences"
+            )
+        if len(lengths) > 1:
+            polygons = [_integer_faces(np.asarray(face), name) for face in faces]
+            if min(p.size for p in polygons) < 3:
+                raise InvalidMeshError(
+                    f"`{name}` has a face with fewer than 3 vertices; every face needs at least 3"
+                )
+            return polygons
+        array = np.asarray(faces)
+    if array.ndim != 2:
+        raise InvalidMeshError(
+            f"`{name}` must have shape (F, 3) or (F, k) with k >= 3; got {_shape_text(array)}"
+        )
+    if array.shape[0] == 0:
+        raise InvalidMeshError(f"`{name}` is empty: the mesh has no faces")
+    if array.shape[1] < 3:
+        raise InvalidMeshError(
+            f"`{name}` must have at least 3 columns (one vertex index per corner); got {_shape_text(array)}"
+        )
+    return _integer_faces(array, name)
+
+
+def _check_range(triangles: np.ndarray, n_vertices: int, name: str) -> None:
+    low = int(triangles.min())
+    high = int(triangles.max())
+    if low < 0:
+        raise InvalidMeshError(
+            f"`{name}` has negative vertex indices (smallest {low}); indices are 0-based and >= 0"
+        )
+    if high >= n_vertices:
+        if high == n_vertices and low >= 1:
+            raise InvalidMeshError(
+                f"`{name}` look 1-based: indices run from {low} to {high} with {n_vertices} vertices; "
+                "meshcurv uses 0-based indices, pass `faces - 1`"
+            )
+        raise InvalidMeshError(
+            f"`{name}` has vertex index {high} out of range for {n_vertices} vertices "
+            f"(valid: 0 to {n_vertices - 1})"
+        )
+
+
+def as_faces(faces, n_vertices: int, *, name: str = "faces", stacklevel: int = 3) -> np.ndarray:
+    """Return ``faces`` as a new int64 (F, 3) triangle array with indices checked.
+
+    Polygons ((F, k) arrays with k > 3, or lists of index lists of varying length)
+    are fan-triangulated with :func:`meshcurv.topology.triangulate_faces`, with a
+    :class:`TriangulationWarning`, as matGeom's meshCurvatures does.
+
+    Raises
+    ------
+    InvalidMeshError
+        Wrong shape or dtype, non-integer values, empty, fewer than 3 corners,
+        negative or out-of-range indices (with a hint when they look 1-based).
+    """
+    from .topology import triangulate_faces
+
+    polygons = as_polygons(faces, name=name)
+    flat = np.concatenate(polygons) if isinstance(polygons, list) else polygons
+    _check_range(flat, n_vertices, name)
+    if isinstance(polygons, list) or polygons.shape[1] != 3:
+        warnings.warn(
+            "requires triangle mesh, forces triangulation: polygonal faces were fan-triangulated",
+            TriangulationWarning,
+            stacklevel=stacklevel,
+        )
+        return triangulate_faces(polygons)
+    return np.ascontiguousarray(polygons)
+
+
+def check_int_option(value, name: str, *, minimum: int = 0) -> int:
+    """Return ``value`` as an int >= ``minimum`` or raise :class:`InvalidOptionError`."""
+    if isinstance(value, (bool, np.bool_)):
+        raise InvalidOptionError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
+    try:
+        number = operator.index(value)
+    except TypeError:
+        raise InvalidOptionError(f"`{name}` must be an integer >= {minimum}; got {value!r}") from None
+    if number < minimum:
+        raise InvalidOptionError(f"`{name}` must be an integer >= {minimum}; got {number}")
+    return int(number)
+
+
+def check_positive_float(value, name: str) -> float:
+    """Return ``value`` as a finite float > 0 or raise :class:`InvalidOptionError`."""
+    if isinstance(value, (bool, np.bool_)):
+        raise InvalidOptionError(f"`{name}` must be a positive number; got {value!r}")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InvalidOptionError(f"`{name}` must be a positive number; got {value!r}") from None
+    if not np.isfinite(number) or number <= 0:
+        raise InvalidOptionError(f"`{name}` must be a positive finite number; got {value!r}")
+    return number
+
+
+def check_choice(value, name: str, choices) -> str:
+    """Return ``value`` if it is one of ``choices`` or raise :class:`InvalidOptionError`."""
+    if not isinstance(value, str) or value not in choices:
+        listed = ", ".join(repr(c) for c in choices)
+        raise InvalidOptionError(f"unknown {name} {value!r}; choose one of {listed}")
+    return value

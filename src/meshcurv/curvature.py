@@ -1,0 +1,121 @@
+"""The public entry point: :func:`principal_curvatures`."""
+
+from __future__ import annotations
+
+import warnings
+
+from ._validation import as_faces, as_vertices, check_choice, check_int_option
+from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
+from .estimators import ESTIMATORS
+from .estimators._common import ProgressCallback, Stages
+from .result import CurvatureResult
+from .topology import MeshTopology
+
+__all__ = ["principal_curvatures", "METHODS"]
+
+#: The names accepted by ``method=``.
+METHODS = tuple(ESTIMATORS)
+
+
+def principal_curvatures(
+    vertices,
+    faces,
+    *,
+    method: str = "normal_cycle",
+    smoothing_steps: int | None = None,
+    progress: ProgressCallback | None = None,
+) -> CurvatureResult:
+    """Principal curvatures, their directions, and the normal at every vertex.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+        Vertex coordinates (any real dtype; computed in float64).
+    faces : array_like of shape (F, 3) or (F, k), list of index lists, or MeshTopology
+        0-based vertex indices. Polygons (k > 3, or lists of varying length) are
+        fan-triangulated as matGeom's ``triangulateFaces`` does, with a
+        :class:`~meshcurv.errors.TriangulationWarning`. A :class:`MeshTopology`
+        built once with :meth:`MeshTopology.from_faces` skips the topology step.
+    method : {'normal_cycle', 'matgeom'}, default: 'normal_cycle'
+        - ``'normal_cycle'``: the normal-cycle tensor of Cohen-Steiner and Morvan
+          over barycentric cells, in 1/length, correct on open meshes.
+        - ``'matgeom'``: matGeom's ``meshCurvatures`` reproduced number for
+          number (dimensionless values; see the README).
+    smoothing_steps : int, default: 3
+        Passes of the 1-ring mean over the tensor field (0 = none).
+    progress : callable, optional
+        Called as ``progress(stage, index, total)`` when each stage starts (matGeom's
+        ShowProgress, per stage). Stage messages also go to the ``meshcurv``
+        logger at INFO level (matGeom's Verbose).
+
+    Returns
+    -------
+    CurvatureResult
+        ``k_min, k_max, dir_min, dir_max, normals, valid`` and the derived
+        ``mean`` and ``gaussian``; ``as_matgeom()`` gives matGeom's seven outputs.
+
+    Raises
+    ------
+    InvalidMeshError
+        Vertices or faces of the wrong shape or dtype, NaN or infinite
+        coordinates, empty mesh, negative, out-of-range or 1-based indices.
+    InvalidOptionError
+        Unknown method, or an option value it cannot use.
+
+    Warns
+    -----
+    MeshQualityWarning
+        Once per call, when the mesh has boundaries, non-manifold or
+        inconsistently oriented edges, zero-area faces or unreferenced vertices,
+        with the counts; the affected vertices have ``valid=False``.
+
+    Examples
+    --------
+    A sphere of radius 2 has curvature 1/2 everywhere:
+
+    >>> import numpy as np, meshcurv
+    >>> sphere = meshcurv.shapes.icosphere(subdivisions=16, radius=2.0)
+    >>> r = meshcurv.principal_curvatures(sphere.vertices, sphere.faces)
+    >>> print(f"{np.median(r.k_min):.2f} {np.median(r.k_max):.2f}")
+    0.50 0.50
+
+    matGeom's seven outputs, its numbers:
+
+    >>> C1, C2, U1, U2, H, K, N = meshcurv.principal_curvatures(
+    ...     sphere.vertices, sphere.faces, method="matgeom").as_matgeom()
+    >>> print(f"{np.mean(C1):.4f}")  # dimensionless, not 1/2: see the README
+    0.0215
+    """
+    estimator = ESTIMATORS.get(method) if isinstance(method, str) else None
+    if estimator is None:
+        check_choice(method, "method", METHODS)
+    given = {"smoothing_steps": smoothing_steps}
+    options = dict(estimator.options)
+    for name, value in given.items():
+        if value is None:
+            continue
+        if name not in estimator.options:
+            raise InvalidOptionError(f"method {method!r} does not take the option `{name}`")
+        options[name] = value
+    if "smoothing_steps" in options:
+        options["smoothing_steps"] = check_int_option(options["smoothing_steps"], "smoothing_steps")
+
+    points = as_vertices(vertices)
+    topology = _as_topology(faces, points.shape[0])
+    result, problems = estimator.function(
+        points, topology, stages=Stages(estimator.stages, progress), **options
+    )
+    if problems:
+        warnings.warn(f"{method}: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
+    return result
+
+
+def _as_topology(faces, n_vertices: int) -> MeshTopology:
+    if isinstance(faces, MeshTopology):
+        if faces.n_vertices != n_vertices:
+            raise InvalidMeshError(
+                f"`faces` is a MeshTopology of {faces.n_vertices} vertices but `vertices` has "
+                f"{n_vertices} rows"
+            )
+        return faces
+    return MeshTopology._build(as_faces(faces, n_vertices, stacklevel=4), n_vertices)

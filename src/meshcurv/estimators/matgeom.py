@@ -1,0 +1,199 @@
+"""matGeom's ``meshCurvatures``, reproduced number for number.
+
+This is the compatibility mode. It follows the MATLAB code of matGeom
+(github.com/mattools/matGeom, ``meshes3d/meshCurvatures.m``, D. Legland, 2021),
+itself adapted from G. Peyre's toolbox_graph ``compute_curvature``:
+
+1. pair every edge with two faces through a sparse matrix of summed 1-based face
+   ids, enumerated twice (the pairing is exact on closed, consistently oriented
+   meshes and drifts on open ones; reproduced literally);
+2. edge lengths divided by their mean; unit edge vectors;
+3. signed angle between the two face normals,
+   ``beta = arccos(n1 . n2) * sign((n1 x n2) . e)``;
+4. edge tensor ``T_e = d_e * beta_e * e e^T``;
+5. vertex tensor = sum of the tensors of its edges divided by their number;
+6. ``smoothing_steps`` passes of a plain 1-ring mean of every tensor component;
+7. eigen-decomposition; eigenpairs sorted by absolute eigenvalue; the two
+   largest are the curvatures, the smallest one's vector is the "normal";
+   swapped so that ``C1 <= C2``.
+
+The outputs are dimensionless (see the README: not curvatures in 1/length).
+
+References
+----------
+D. Cohen-Steiner and J.-M. Morvan (2003). Restricted Delaunay triangulations and
+normal cycle. Proc. 19th ACM Symposium on Computational Geometry, 312-321.
+https://doi.org/10.1145/777792.777839
+
+P. Alliez, D. Cohen-Steiner, O. Devillers, B. Levy, M. Desbrun (2003).
+Anisotropic polygonal remeshing. ACM Trans. Graph. 22(3), 485-493.
+https://doi.org/10.1145/882262.882296
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..result import CurvatureResult
+from ..smoothing import smooth_vertex_field
+from ..topology import MeshTopology
+from .._tensors import outer6
+from ._common import Stages
+from ._eigen import sorted_by_magnitude
+
+STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
+
+
+def matgeom_pairing(faces: np.ndarray, n_vertices: int):
+    """matGeom's edge/face pairing (its step 1), literally.
+
+    Returns
+    -------
+    ev1, ev2 : ndarray of shape (E,)
+        Kept edges, ``ev1 < ev2``.
+    ef1, ef2 : ndarray of shape (E,)
+        0-based face indices as matGeom uses them (the sum of the 1-based ids of
+        the faces sharing a directed side, minus 1: may be out of range, or a face
+        that does not contain the edge, on open or non-manifold meshes).
+    """
+    n_faces = faces.shape[0]
+    tail = faces.T.ravel()  # matGeom concatenates the columns
+    head = np.roll(faces, -1, axis=1).T.ravel()
+    ids = np.tile(np.arange(1, n_faces + 1, dtype=np.int64), 3)
+    keys, inverse = np.unique(tail * n_vertices + head, return_inverse=True)
+    sums = np.bincount(inverse.ravel(), weights=ids).astype(np.int64)
+    rows, cols = np.divmod(keys, n_vertices)  # keys sorted by (row, column)
+    by_column = np.lexsort((rows, cols))
+    ef1 = sums[by_column]
+    ev1, ev2, ef2 = cols, rows, sums
+    keep = ev1 < ev2
+    return ev1[keep], ev2[keep], ef1[keep] - 1, ef2[keep] - 1
+
+
+def _row_dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``sum(a .* b, 2)`` summed left to right, as Octave does."""
+    return (a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]) + a[:, 2] * b[:, 2]
+
+
+def _row_norms(a: np.ndarray) -> np.ndarray:
+    return np.sqrt(_row_dots(a, a))
+
+
+def _matgeom_face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """matGeom's meshFaceNormals: cross product of the sides from corner 1, normalised."""
+    a = vertices[faces[:, 0]]
+    cross = np.cross(vertices[faces[:, 1]] - a, vertices[faces[:, 2]] - a)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return cross / _row_norms(cross)[:, None]
+
+
+def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_steps: int,
+                    stages: Stages | None = None):
+    """matGeom's smoothed vertex tensors (steps 1 to 6).
+
+    Returns
+    -------
+    tensors : ndarray of shape (V, 6)
+        ``(xx, yy, zz, xy, xz, yz)``; NaN where matGeom's arithmetic gives NaN or
+        where it stops with an index error.
+    n_kept_edges, n_wrong_face, n_out_of_range : int
+        How matGeom's pairing went: edges kept, edges paired with a face that
+        does not contain them, face-id sums beyond the number of faces.
+    """
+    stages = stages or Stages(STAGES)
+    faces = topology.faces
+    n_vertices = vertices.shape[0]
+    n_faces = faces.shape[0]
+
+    stages.start("compute adjacencies")
+    ev1, ev2, ef1, ef2 = matgeom_pairing(faces, n_vertices)
+    out_of_range = (ef1 >= n_faces) | (ef2 >= n_faces)
+    ef1_safe = np.where(out_of_range, 0, ef1)
+    ef2_safe = np.where(out_of_range, 0, ef2)
+    # a face "contains" the edge when both ends are among its corners
+    f1 = faces[ef1_safe]
+    wrong_face = ~out_of_range & ~(((f1 == ev1[:, None]).any(1)) & ((f1 == ev2[:, None]).any(1)))
+
+    stages.start("compute edge tensors")
+    # Operations in matGeom's order: arccos is ill-conditioned near 1, so the
+    # dot products of nearly parallel normals must match bit for bit.
+    edge_vectors = vertices[ev2] - vertices[ev1]
+    lengths = _row_norms(edge_vectors)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        edge_vectors = edge_vectors / lengths[:, None]
+        lengths = lengths / lengths.mean()
+    normals = _matgeom_face_normals(vertices, faces)
+    n1 = normals[ef1_safe]
+    n2 = normals[ef2_safe]
+    with np.errstate(invalid="ignore"):
+        beta = np.arccos(np.clip(_row_dots(n1, n2), -1.0, 1.0))
+        beta *= np.sign(_row_dots(np.cross(n1, n2), edge_vectors))
+    weight = lengths * beta
+    weight[out_of_range] = np.nan  # where matGeom stops with an index error
+    edge_tensors = outer6(edge_vectors, weight)
+
+    ends = np.concatenate([ev1, ev2])
+    counts = np.bincount(ends, minlength=n_vertices).astype(np.float64)
+    counts[counts < np.finfo(float).eps] = 1.0
+    tensors = np.stack(
+        [np.bincount(ends, weights=np.tile(edge_tensors[:, k], 2), minlength=n_vertices) for k in range(6)],
+        axis=1,
+    ) / counts[:, None]
+
+    stages.start("average vertex tensors")
+    tensors = smooth_vertex_field(tensors, topology, smoothing_steps)
+    return tensors, ev1.size, int(wrong_face.sum()), int(out_of_range.sum())
+
+
+def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
+    """Run matGeom's algorithm. Returns ``(result, problems)``."""
+    tensors, n_kept, n_wrong_face, n_out_of_range = matgeom_tensors(
+        vertices, topology, smoothing_steps, stages
+    )
+    problems: list[str] = []
+
+    stages.start("retrieve curvatures")
+    values, vectors = sorted_by_magnitude(tensors)
+    c1, c2 = values[:, 1].copy(), values[:, 2].copy()
+    u1, u2, normal = vectors[:, :, 2].copy(), vectors[:, :, 1].copy(), vectors[:, :, 0].copy()
+    swap = c1 > c2
+    c1[swap], c2[swap] = c2[swap], c1[swap]
+    u1[swap], u2[swap] = u2[swap], u1[swap]
+
+    finite = np.isfinite(tensors).all(axis=1)
+    valid = topology.referenced_vertices & finite
+
+    n_boundary = int(topology.boundary_edges.sum())
+    if n_boundary:
+        n_dropped = topology.n_edges - n_kept
+        problems.append(
+            f"open mesh ({n_boundary} boundary edges): matGeom's edge/face pairing drops "
+            f"{n_dropped} edges and pairs {n_wrong_face} edges with a face that does not "
+            "contain them, so values near the boundary are wrong (reproduced as matGeom computes them)"
+        )
+    n_bad_edges = int((topology.nonmanifold_edges | topology.inconsistent_edges).sum())
+    if n_bad_edges:
+        problems.append(
+            f"{n_bad_edges} non-manifold or inconsistently oriented edges: matGeom sums the ids of "
+            f"their faces ({n_out_of_range} sums out of range, where matGeom stops with an "
+            "index error: NaN there)"
+        )
+    n_nan_vertices = int((topology.referenced_vertices & ~finite).sum())
+    if n_nan_vertices:
+        problems.append(
+            f"{n_nan_vertices} vertices have undefined tensors (zero-area faces, zero-length edges "
+            "or the index errors above; matGeom stops with 'EIG: matrix contains Inf or NaN values'): "
+            "they are NaN and valid=False"
+        )
+    n_unreferenced = int((~topology.referenced_vertices).sum())
+    if n_unreferenced:
+        problems.append(
+            f"{n_unreferenced} unreferenced vertices: matGeom's zeros, valid=False"
+        )
+    if problems:
+        problems.append("method='normal_cycle' handles such meshes correctly")
+    result = CurvatureResult(
+        k_min=c1, k_max=c2, dir_min=u1, dir_max=u2, normals=normal, valid=valid,
+        method="matgeom", parameters={"smoothing_steps": smoothing_steps},
+    )
+    return result, problems

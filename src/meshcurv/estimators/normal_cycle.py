@@ -1,0 +1,129 @@
+"""The normal-cycle curvature tensor (Cohen-Steiner and Morvan 2003), in true units.
+
+For a region ``A(v)`` around vertex ``v``,
+
+.. math::
+
+    T(v) = \\frac{1}{|A(v)|} \\sum_{e} \\beta(e)\\, |e \\cap A(v)|\\, \\bar e \\bar e^T
+
+where ``beta(e)`` is the signed angle between the normals of the two faces of
+edge ``e`` (positive where the surface bends away from the normals) and ``ē`` the
+unit edge vector. Here ``A(v)`` is the barycentric cell of ``v`` (a third of each
+incident face), which contains half of every edge at ``v`` and no other edge, so
+the sum runs over the edges at ``v`` with half their length. The numerator is an
+integral (the anisotropic curvature measure of the cell) and the denominator an
+area, so ``T`` is in 1/length.
+
+``smoothing_steps`` passes of matGeom's 1-ring mean are applied to the measure
+and to the area alike before the division: the result is the same formula over
+the larger region those passes cover (a 1-ring mean of the measures, divided by
+the 1-ring mean of the areas).
+
+The eigenvector of ``T`` with eigenvalue ``k`` lies along the curvature
+direction of the *other* principal curvature (an edge bends the surface across
+itself); the tensor is restricted to the plane orthogonal to the vertex normal
+(area-weighted mean of the face normals) and its 2x2 eigen-problem solved in
+closed form. The mean of the two curvatures is half the trace of the full 3x3
+tensor (the normal cycle's mean-curvature measure, independent of any frame),
+their difference comes from the tangent restriction.
+
+Boundary edges have no dihedral angle: the cells of boundary vertices miss
+part of their measure, so boundary vertices are ``valid=False`` (NaN) and do not
+enter the smoothing of their neighbours. The same holds for vertices on
+non-manifold or inconsistently oriented edges and for vertices of zero-area faces.
+
+References
+----------
+D. Cohen-Steiner and J.-M. Morvan (2003). Restricted Delaunay triangulations and
+normal cycle. Proc. 19th ACM Symposium on Computational Geometry, 312-321.
+https://doi.org/10.1145/777792.777839
+
+P. Alliez, D. Cohen-Steiner, O. Devillers, B. Levy, M. Desbrun (2003).
+Anisotropic polygonal remeshing. ACM Trans. Graph. 22(3), 485-493.
+https://doi.org/10.1145/882262.882296
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._tensors import outer6, principal_from_shape_operator
+from ..diagnosis import degenerate_faces
+from ..geometry import face_cross_products, vertex_normals
+from ..result import CurvatureResult
+from ..smoothing import smooth_vertex_field
+from ..topology import MeshTopology
+from ._common import Stages, nan_where
+from ._defects import mesh_defects
+
+STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
+
+
+def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_normals: np.ndarray,
+                         usable_edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Signed angle between the two face normals of each usable edge.
+
+    Returns ``(beta, lengths, unit_edges)`` of shapes (E,), (E,), (E, 3); ``beta``
+    is 0 on edges that are not usable (boundary, non-manifold, degenerate).
+    """
+    edges = topology.edges
+    vectors = vertices[edges[:, 1]] - vertices[edges[:, 0]]
+    lengths = np.linalg.norm(vectors, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(lengths[:, None] > 0, vectors / lengths[:, None], 0.0)
+    beta = np.zeros(edges.shape[0])
+    faces = topology.edge_faces[usable_edges]
+    n1 = unit_normals[faces[:, 0]]
+    n2 = unit_normals[faces[:, 1]]
+    sine = np.einsum("ij,ij->i", np.cross(n1, n2), unit[usable_edges])
+    cosine = np.einsum("ij,ij->i", n1, n2)
+    beta[usable_edges] = np.arctan2(sine, cosine)
+    return beta, lengths, unit
+
+
+def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
+    """Normal-cycle tensor in true units. Returns ``(result, problems)``."""
+    stages.start("compute adjacencies")
+    n_vertices = vertices.shape[0]
+    faces = topology.faces
+    cross = face_cross_products(vertices, faces)
+    double_areas = np.linalg.norm(cross, axis=1)
+    degenerate = degenerate_faces(vertices, topology, cross=cross)
+    defects = mesh_defects(topology, degenerate)
+
+    stages.start("compute edge tensors")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit_normals = cross / double_areas[:, None]
+    usable = topology.interior_edges & ~degenerate[np.maximum(topology.edge_faces, 0)].any(axis=1)
+    beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
+    edge_measures = outer6(unit, 0.5 * beta * lengths)
+    ends = topology.edges.T.ravel()
+    measures = np.stack(
+        [np.bincount(ends, weights=np.tile(edge_measures[:, k], 2), minlength=n_vertices) for k in range(6)],
+        axis=1,
+    )
+    face_area_thirds = np.where(degenerate, 0.0, double_areas / 6.0)
+    areas = np.bincount(faces.ravel(), weights=np.repeat(face_area_thirds, 3), minlength=n_vertices)
+
+    stages.start("average vertex tensors")
+    valid = ~defects.invalid_vertices
+    weights = valid.astype(np.float64)
+    pooled = smooth_vertex_field(
+        np.column_stack([measures * weights[:, None], areas * weights]), topology, smoothing_steps
+    )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tensors = pooled[:, :6] / pooled[:, 6:7]
+
+    stages.start("retrieve curvatures")
+    normals = vertex_normals(vertices, faces[~degenerate])
+    valid &= np.isfinite(normals).all(axis=1) & (pooled[:, 6] > 0)
+    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
+        np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
+        rotate=True, mean_from_trace=True,
+    )
+    nan_where(~valid, k_min, k_max, dir_min, dir_max)
+    result = CurvatureResult(
+        k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
+        method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},
+    )
+    return result, defects.messages()

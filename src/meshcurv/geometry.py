@@ -1,0 +1,98 @@
+"""Geometric quantities of triangle meshes, as pure functions over arrays.
+
+Inputs are float64 ``vertices`` of shape (V, 3) and int64 ``faces`` of shape
+(F, 3) (0-based); outputs are new float64 arrays. Nothing here validates its
+input: the public entry points do that once (:mod:`meshcurv._validation`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "face_cross_products",
+    "face_areas",
+    "face_normals",
+    "signed_volume",
+    "vertex_areas",
+    "vertex_normals",
+    "mean_edge_length",
+    "degenerate_face_mask",
+]
+
+#: Faces with area below this fraction of (mean edge length)^2 count as degenerate.
+DEGENERATE_AREA_RATIO = 1e-12
+
+
+def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) ``cross(b - a, c - a)`` for every face ``(a, b, c)``: twice the area times the unit normal."""
+    a = vertices[faces[:, 0]]
+    return np.cross(vertices[faces[:, 1]] - a, vertices[faces[:, 2]] - a)
+
+
+def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F,) area of every face."""
+    return 0.5 * np.linalg.norm(face_cross_products(vertices, faces), axis=1)
+
+
+def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) unit normal of every face, by the right-hand rule on its vertex order.
+
+    A face with zero area has no normal: its row is NaN.
+    """
+    cross = face_cross_products(vertices, faces)
+    norm = np.linalg.norm(cross, axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(norm > 0, cross / norm, np.nan)
+
+
+def signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """Signed volume enclosed by the faces (positive for a closed, outward-wound mesh).
+
+    Computed relative to the centroid of the vertices, which reduces rounding and
+    makes the value independent of translation on closed meshes.
+    """
+    centred = vertices - vertices.mean(axis=0)
+    a, b, c = (centred[faces[:, k]] for k in range(3))
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def vertex_areas(vertices: np.ndarray, faces: np.ndarray, *, areas: np.ndarray | None = None) -> np.ndarray:
+    """(V,) barycentric vertex areas: a third of the area of every incident face.
+
+    They sum to the total area of the mesh; an unreferenced vertex gets 0.
+    """
+    if areas is None:
+        areas = face_areas(vertices, faces)
+    return np.bincount(faces.ravel(), weights=np.repeat(areas / 3.0, 3), minlength=vertices.shape[0])
+
+
+def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray | None = None) -> np.ndarray:
+    """(V, 3) unit vertex normals, the area-weighted mean of the incident face normals.
+
+    Oriented like the faces (outward on an outward-wound closed mesh). A vertex
+    with no incident face of non-zero area, or whose face normals cancel, is NaN.
+    """
+    if cross is None:
+        cross = face_cross_products(vertices, faces)
+    n = vertices.shape[0]
+    flat = faces.ravel()
+    summed = np.stack(
+        [np.bincount(flat, weights=np.repeat(cross[:, k], 3), minlength=n) for k in range(3)], axis=1
+    )
+    norm = np.linalg.norm(summed, axis=1, keepdims=True)
+    scale = np.abs(summed).max(axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(norm > 1e-12 * np.maximum(scale, np.finfo(float).tiny), summed / norm, np.nan)
+
+
+def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
+    """Mean length of the given (E, 2) edges."""
+    if edges.shape[0] == 0:
+        return 0.0
+    return float(np.linalg.norm(vertices[edges[:, 1]] - vertices[edges[:, 0]], axis=1).mean())
+
+
+def degenerate_face_mask(areas: np.ndarray, length_scale: float) -> np.ndarray:
+    """(F,) bool: faces whose area is negligible relative to ``length_scale ** 2``."""
+    return areas <= DEGENERATE_AREA_RATIO * length_scale**2

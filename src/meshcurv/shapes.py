@@ -1,0 +1,265 @@
+"""Analytic surfaces as triangle meshes, with their exact curvatures at the vertices.
+
+Shared by tests, documentation and benchmarks. Every function returns an
+:class:`AnalyticMesh` whose faces are wound counter-clockwise seen from outside
+(normals outward; for height fields, upward), so that the exact curvatures follow
+meshcurv's sign convention: positive where the surface bends away from its normal.
+
+Examples
+--------
+>>> from meshcurv import shapes
+>>> torus = shapes.torus()          # matGeom's torusMesh default: R 30, r 10, 60 x 60
+>>> torus.vertices.shape, torus.faces.shape
+((3600, 3), (7200, 3))
+>>> float(torus.k_max.max())        # the tube: 1 / r
+0.1
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._tensors import principal_from_shape_operator
+from ._validation import check_int_option
+
+__all__ = ["AnalyticMesh", "icosphere", "uv_sphere", "torus", "ellipsoid", "cylinder", "saddle"]
+
+
+@dataclass(frozen=True, eq=False)
+class AnalyticMesh:
+    """A triangle mesh sampled from a surface with known curvatures.
+
+    Attributes
+    ----------
+    name : str
+    vertices : ndarray of shape (V, 3), float64
+    faces : ndarray of shape (F, 3), int64
+    k_min, k_max : ndarray of shape (V,)
+        Exact principal curvatures at the vertices (1/length).
+    dir_min, dir_max : ndarray of shape (V, 3)
+        Exact principal directions; NaN at umbilics, where they are undefined.
+    normals : ndarray of shape (V, 3)
+        Exact unit normals, on the side the faces are wound towards.
+    quads : ndarray of shape (Q, 4) or None
+        The quad faces the triangles were split from, when the mesh is a quad grid.
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    k_min: np.ndarray
+    k_max: np.ndarray
+    dir_min: np.ndarray
+    dir_max: np.ndarray
+    normals: np.ndarray
+    quads: np.ndarray | None = None
+
+    @property
+    def mean(self) -> np.ndarray:
+        return (self.k_min + self.k_max) / 2
+
+    @property
+    def gaussian(self) -> np.ndarray:
+        return self.k_min * self.k_max
+
+
+def _make(name, vertices, faces, k_min, k_max, dir_min, dir_max, normals, quads=None) -> AnalyticMesh:
+    k_min = np.broadcast_to(np.asarray(k_min, dtype=float), vertices.shape[:1]).copy()
+    k_max = np.broadcast_to(np.asarray(k_max, dtype=float), vertices.shape[:1]).copy()
+    scale = np.maximum(np.abs(k_min), np.abs(k_max))
+    umbilic = np.abs(k_max - k_min) <= 1e-9 * np.maximum(scale, np.finfo(float).tiny)
+    dir_min = np.array(np.broadcast_to(dir_min, vertices.shape), dtype=float)
+    dir_max = np.array(np.broadcast_to(dir_max, vertices.shape), dtype=float)
+    dir_min[umbilic] = np.nan
+    dir_max[umbilic] = np.nan
+    return AnalyticMesh(
+        name=name, vertices=vertices, faces=np.ascontiguousarray(faces, dtype=np.int64),
+        k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max,
+        normals=np.asarray(normals, dtype=float), quads=quads,
+    )
+
+
+def _implicit(points: np.ndarray, gradient: np.ndarray, hessian6: np.ndarray):
+    """Curvatures of the level set of F through ``points``, normal along grad F.
+
+    Normal curvature along a unit tangent ``t`` is ``t^T Hess(F) t / |grad F|``.
+    """
+    norm = np.linalg.norm(gradient, axis=1)
+    normals = gradient / norm[:, None]
+    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(hessian6 / norm[:, None], normals)
+    return k_min, k_max, dir_min, dir_max, normals
+
+
+def _quads_to_triangles(quads: np.ndarray) -> np.ndarray:
+    """Split quads ``a, b, c, d`` into ``(a, b, c), (a, c, d)``, as matGeom's triangulateFaces."""
+    return np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1).reshape(-1, 3)
+
+
+def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
+    phi = (1 + 5**0.5) / 2
+    v = np.array(
+        [[-1, phi, 0], [1, phi, 0], [-1, -phi, 0], [1, -phi, 0],
+         [0, -1, phi], [0, 1, phi], [0, -1, -phi], [0, 1, -phi],
+         [phi, 0, -1], [phi, 0, 1], [-phi, 0, -1], [-phi, 0, 1]], dtype=float)
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    f = np.array(
+        [[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11],
+         [1, 5, 9], [5, 11, 4], [11, 10, 2], [10, 7, 6], [7, 1, 8],
+         [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9],
+         [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]])
+    return v, f
+
+
+def _subdivided_sphere(subdivisions: int) -> tuple[np.ndarray, np.ndarray]:
+    """Unit icosphere: every icosahedron edge split into ``subdivisions`` parts, projected."""
+    n = check_int_option(subdivisions, "subdivisions", minimum=1)
+    corners, ico_faces = _icosahedron()
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij"))
+    inside = i + j <= n
+    i, j = i[inside], j[inside]
+    local = np.full((n + 1, n + 1), -1)
+    local[i, j] = np.arange(i.size)
+    weights = np.stack([n - i - j, i, j], axis=1)  # on corners A, B, C
+    # a key per grid point that is the same from every face sharing it
+    ids = np.where(weights[None] > 0, ico_faces[:, None, :], 12)  # (20, m, 3); 12 = no corner
+    w = np.broadcast_to(weights, ids.shape)
+    order = np.argsort(ids, axis=2)
+    ids = np.take_along_axis(ids, order, axis=2)
+    w = np.take_along_axis(w, order, axis=2)
+    key = ((ids[..., 0] * 13 + ids[..., 1]) * 13 + ids[..., 2]) * (n + 1) ** 2 + w[..., 0] * (n + 1) + w[..., 1]
+    unique_keys, first, inverse = np.unique(key.ravel(), return_index=True, return_inverse=True)
+    inverse = inverse.reshape(20, -1)
+    a, b, c = (corners[ico_faces[:, k]] for k in range(3))
+    points = (a[:, None, :] * weights[None, :, 0:1] + b[:, None, :] * weights[None, :, 1:2]
+              + c[:, None, :] * weights[None, :, 2:3]) / n
+    vertices = points.reshape(-1, 3)[first]
+    vertices /= np.linalg.norm(vertices, axis=1, keepdims=True)
+    up = i + j <= n - 1
+    down = i + j <= n - 2
+    tri_local = np.concatenate([
+        np.stack([local[i[up], j[up]], local[i[up] + 1, j[up]], local[i[up], j[up] + 1]], axis=1),
+        np.stack([local[i[down] + 1, j[down]], local[i[down] + 1, j[down] + 1], local[i[down], j[down] + 1]], axis=1),
+    ])
+    faces = inverse[:, tri_local].reshape(-1, 3)
+    return vertices, faces
+
+
+def icosphere(subdivisions: int = 16, radius: float = 1.0, center=(0.0, 0.0, 0.0)) -> AnalyticMesh:
+    """Sphere from a regular icosahedron whose edges are split into ``subdivisions`` parts.
+
+    ``10 * subdivisions**2 + 2`` vertices (2562 for 16), as matGeom's
+    ``subdivideMesh(createIcosahedron, n)`` projected on the sphere. Exact
+    curvature ``1 / radius`` everywhere (every point is umbilic).
+    """
+    unit, faces = _subdivided_sphere(subdivisions)
+    vertices = unit * radius + np.asarray(center, dtype=float)
+    return _make(f"icosphere({subdivisions})", vertices, faces, 1 / radius, 1 / radius,
+                 np.nan, np.nan, unit)
+
+
+def uv_sphere(n_longitude: int = 32, n_latitude: int = 16, radius: float = 1.0) -> AnalyticMesh:
+    """Latitude-longitude sphere with single pole vertices (matGeom's sphereMesh, poles merged).
+
+    ``n_longitude * (n_latitude - 1) + 2`` vertices; triangles at the poles, split
+    quads elsewhere.
+    """
+    theta = np.pi * np.arange(1, n_latitude) / n_latitude  # colatitude of the rings
+    phi = 2 * np.pi * np.arange(n_longitude) / n_longitude
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    ring = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1).reshape(-1, 3)
+    unit = np.vstack([[0.0, 0.0, 1.0], ring, [0.0, 0.0, -1.0]])
+    north, south = 0, unit.shape[0] - 1
+    idx = 1 + np.arange((n_latitude - 1) * n_longitude).reshape(n_latitude - 1, n_longitude)
+    nxt = np.roll(idx, -1, axis=1)
+    quads = np.stack([idx[:-1], idx[1:], nxt[1:], nxt[:-1]], axis=-1).reshape(-1, 4)
+    caps = np.concatenate([
+        np.stack([np.full(n_longitude, north), idx[0], nxt[0]], axis=1),
+        np.stack([np.full(n_longitude, south), nxt[-1], idx[-1]], axis=1),
+    ])
+    faces = np.concatenate([caps[:n_longitude], _quads_to_triangles(quads), caps[n_longitude:]])
+    return _make(f"uv_sphere({n_longitude}x{n_latitude})", unit * radius, faces,
+                 1 / radius, 1 / radius, np.nan, np.nan, unit)
+
+
+def torus(major_radius: float = 30.0, minor_radius: float = 10.0, n_major: int = 60,
+          n_minor: int = 60) -> AnalyticMesh:
+    """Torus around the z axis, laid out as matGeom's ``torusMesh``.
+
+    Vertex ``i * n_minor + j`` sits at ring angle ``2 pi i / n_major`` and tube
+    angle ``2 pi j / n_minor`` (0 on the outer equator). The quads
+    ``(i, j), (i+1, j), (i+1, j+1), (i, j+1)`` are kept in ``quads`` and split as
+    matGeom's ``triangulateFaces`` does. Defaults: matGeom's torusMesh (R 30,
+    r 10, 60 x 60: 3600 vertices).
+
+    Exact curvatures: ``1 / r`` along the tube circle (``k_max``), and
+    ``cos(phi) / (R + r cos(phi))`` along the ring (``k_min``).
+    """
+    R, r = float(major_radius), float(minor_radius)
+    theta = 2 * np.pi * np.arange(n_major) / n_major
+    phi = 2 * np.pi * np.arange(n_minor) / n_minor
+    t, p = (a.ravel() for a in np.meshgrid(theta, phi, indexing="ij"))
+    normals = np.stack([np.cos(p) * np.cos(t), np.cos(p) * np.sin(t), np.sin(p)], axis=1)
+    vertices = np.stack([(R + r * np.cos(p)) * np.cos(t), (R + r * np.cos(p)) * np.sin(t), r * np.sin(p)], axis=1)
+    tube_direction = np.stack([-np.sin(p) * np.cos(t), -np.sin(p) * np.sin(t), np.cos(p)], axis=1)
+    ring_direction = np.stack([-np.sin(t), np.cos(t), np.zeros_like(t)], axis=1)
+    idx = np.arange(n_major * n_minor).reshape(n_major, n_minor)
+    i_next = np.roll(idx, -1, axis=0)
+    quads = np.stack([idx, i_next, np.roll(i_next, -1, axis=1), np.roll(idx, -1, axis=1)], axis=-1).reshape(-1, 4)
+    k_ring = np.cos(p) / (R + r * np.cos(p))
+    return _make(f"torus(R={R:g}, r={r:g})", vertices, _quads_to_triangles(quads), k_ring, 1 / r,
+                 ring_direction, tube_direction, normals, quads=quads)
+
+
+def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh:
+    """Unit icosphere scaled by ``semi_axes`` (matGeom reference ``ellipsoid_321``)."""
+    a = np.asarray(semi_axes, dtype=float)
+    unit, faces = _subdivided_sphere(subdivisions)
+    vertices = unit * a
+    inv2 = 1.0 / a**2
+    gradient = 2 * vertices * inv2
+    hessian = np.zeros((vertices.shape[0], 6))
+    hessian[:, :3] = 2 * inv2
+    k_min, k_max, dir_min, dir_max, normals = _implicit(vertices, gradient, hessian)
+    return _make(f"ellipsoid{tuple(a.tolist())}", vertices, faces, k_min, k_max, dir_min, dir_max, normals)
+
+
+def cylinder(radius: float = 1.0, height: float = 2.0, n_around: int = 32, n_along: int = 16) -> AnalyticMesh:
+    """Open cylinder around the z axis (two boundary rings), split quads.
+
+    Exact curvatures: ``k_max = 1 / radius`` around, ``k_min = 0`` along the axis.
+    """
+    phi = 2 * np.pi * np.arange(n_around) / n_around
+    z = np.linspace(-height / 2, height / 2, n_along + 1)
+    zz, pp = (a.ravel() for a in np.meshgrid(z, phi, indexing="ij"))
+    normals = np.stack([np.cos(pp), np.sin(pp), np.zeros_like(pp)], axis=1)
+    vertices = normals * radius + np.stack([0 * zz, 0 * zz, zz], axis=1)
+    around = np.stack([-np.sin(pp), np.cos(pp), np.zeros_like(pp)], axis=1)
+    axis = np.broadcast_to([0.0, 0.0, 1.0], vertices.shape)
+    idx = np.arange(vertices.shape[0]).reshape(n_along + 1, n_around)
+    nxt = np.roll(idx, -1, axis=1)
+    quads = np.stack([idx[:-1], nxt[:-1], nxt[1:], idx[1:]], axis=-1).reshape(-1, 4)
+    return _make(f"cylinder(r={radius:g})", vertices, _quads_to_triangles(quads), 0.0, 1 / radius,
+                 axis, around, normals, quads=quads)
+
+
+def saddle(half_width: float = 1.0, spacing: float = 0.025) -> AnalyticMesh:
+    """Open height field ``z = x**2 - y**2`` on a square grid over ``[-w, w]^2``, normals up.
+
+    At the centre the exact curvatures are ``-2`` (along x: the surface bends
+    towards its upward normal) and ``+2`` (along y). Each grid square is split
+    along the same diagonal.
+    """
+    n = int(round(2 * half_width / spacing)) + 1
+    x = np.linspace(-half_width, half_width, n)
+    yy, xx = (a.ravel() for a in np.meshgrid(x, x, indexing="ij"))
+    vertices = np.stack([xx, yy, xx**2 - yy**2], axis=1)
+    gradient = np.stack([-2 * xx, 2 * yy, np.ones_like(xx)], axis=1)  # of F = z - x^2 + y^2
+    hessian = np.zeros((vertices.shape[0], 6))
+    hessian[:, 0], hessian[:, 1] = -2.0, 2.0
+    k_min, k_max, dir_min, dir_max, normals = _implicit(vertices, gradient, hessian)
+    idx = np.arange(n * n).reshape(n, n)  # idx[row = y, column = x]
+    quads = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], axis=-1).reshape(-1, 4)
+    return _make(f"saddle(spacing={spacing:g})", vertices, _quads_to_triangles(quads), k_min, k_max,
+                 dir_min, dir_max, normals, quads=quads)

@@ -1,0 +1,285 @@
+"""Connectivity of triangle meshes: edges, their faces, rings, boundary, manifoldness.
+
+Everything here depends on the faces only (never on coordinates), so a
+:class:`MeshTopology` built once serves every later computation on meshes with the
+same connectivity, whatever the vertex positions and whatever the method.
+
+Conventions
+-----------
+- Vertex and face indices are 0-based.
+- Side ``k`` of face ``f`` runs from ``faces[f, k]`` to ``faces[f, (k + 1) % 3]``.
+- An edge is an unordered pair ``(p, q)`` with ``p < q``; ``edges`` is sorted
+  lexicographically.
+- ``edge_faces[e, 0]`` is a face that traverses edge ``e`` from ``p`` to ``q``,
+  ``edge_faces[e, 1]`` one that traverses it from ``q`` to ``p`` (on a consistently
+  oriented manifold mesh); -1 where there is none (boundary).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+__all__ = ["triangulate_faces", "MeshTopology"]
+
+
+def triangulate_faces(polygons) -> np.ndarray:
+    """Fan-triangulate polygonal faces exactly as matGeom's ``triangulateFaces``.
+
+    Parameters
+    ----------
+    polygons : array_like of shape (F, k), or list of index sequences
+        Faces with ``k >= 3`` corners each (0-based vertex indices). A list may
+        hold faces of different lengths.
+
+    Returns
+    -------
+    triangles : ndarray of shape (T, 3), int64
+        Face ``(f0, f1, ..., f(k-1))`` gives the triangles ``(f0, f(j-1), f(j))``
+        for ``j = 2 .. k-1``, kept next to each other in the order of the faces:
+        a quad ``a, b, c, d`` gives ``(a, b, c)`` then ``(a, c, d)``. No check of
+        convexity or planarity is made (matGeom makes none).
+
+    Examples
+    --------
+    >>> triangulate_faces([[0, 1, 2, 3]]).tolist()
+    [[0, 1, 2], [0, 2, 3]]
+    """
+    if isinstance(polygons, np.ndarray) and polygons.ndim == 2:
+        groups = [polygons]
+    else:
+        groups = [np.asarray(face, dtype=np.int64)[None, :] for face in polygons]
+    pieces = []
+    for group in groups:
+        group = np.asarray(group, dtype=np.int64)
+        k = group.shape[1]
+        j = np.arange(2, k)
+        # (F, k-2, 3): for every face, its fan triangles in order
+        fan = np.stack(
+            [np.repeat(group[:, :1], k - 2, axis=1), group[:, j - 1], group[:, j]], axis=2
+        )
+        pieces.append(fan.reshape(-1, 3))
+    return np.ascontiguousarray(np.concatenate(pieces)) if pieces else np.zeros((0, 3), np.int64)
+
+
+@dataclass(frozen=True, eq=False)
+class MeshTopology:
+    """The connectivity of a triangle mesh, computed once and reused.
+
+    Build it with :meth:`from_faces`; pass it as ``faces`` to
+    :func:`meshcurv.principal_curvatures` to skip the topology step on later calls.
+
+    Attributes
+    ----------
+    faces : ndarray of shape (F, 3), int64
+        The triangles.
+    n_vertices : int
+        Number of vertices (unreferenced ones included).
+    edges : ndarray of shape (E, 2), int64
+        Unique undirected edges ``(p, q)`` with ``p < q``, sorted.
+    face_edges : ndarray of shape (F, 3), int64
+        Edge of side ``k`` of each face (``faces[f, k] -> faces[f, (k+1) % 3]``);
+        -1 for a side whose two ends are the same vertex.
+    edge_faces : ndarray of shape (E, 2), int64
+        Two faces of each edge: column 0 one that runs ``p -> q``, column 1 one
+        that runs ``q -> p`` where the mesh is consistently oriented; -1 = none.
+        On a non-manifold edge these are two of its faces.
+    edge_face_counts : ndarray of shape (E,), int64
+        Number of faces of each edge (1 = boundary, 2 = interior, 3+ = non-manifold).
+    """
+
+    faces: np.ndarray
+    n_vertices: int
+    edges: np.ndarray
+    face_edges: np.ndarray
+    edge_faces: np.ndarray
+    edge_face_counts: np.ndarray
+    _edge_forward_counts: np.ndarray = field(repr=False)
+
+    @classmethod
+    def from_faces(cls, faces, n_vertices: int | None = None) -> "MeshTopology":
+        """Compute the topology of ``faces``.
+
+        Parameters
+        ----------
+        faces : array_like of shape (F, 3) or (F, k), or list of index lists
+            0-based vertex indices; polygons are fan-triangulated (with a warning).
+        n_vertices : int, optional
+            Number of vertices; default ``faces.max() + 1``.
+        """
+        from ._validation import as_faces, as_polygons
+
+        if n_vertices is None:
+            polygons = as_polygons(faces)
+            flat = np.concatenate(polygons) if isinstance(polygons, list) else polygons
+            n_vertices = int(flat.max()) + 1
+        triangles = as_faces(faces, n_vertices)
+        return cls._build(triangles, int(n_vertices))
+
+    @classmethod
+    def _build(cls, faces: np.ndarray, n_vertices: int) -> "MeshTopology":
+        """Build from already validated int64 (F, 3) triangles."""
+        n_faces = faces.shape[0]
+        tail = faces.ravel()
+        head = np.roll(faces, -1, axis=1).ravel()
+        low = np.minimum(tail, head)
+        high = np.maximum(tail, head)
+        backward = (tail > head).astype(np.int64)
+        proper = tail != head
+        # one sort of the sides, by edge and then direction (p -> q first)
+        key = (low * n_vertices + high) * 2 + backward
+        side_ids = np.flatnonzero(proper)
+        order = side_ids[np.argsort(key[side_ids], kind="stable")]
+        edge_key = key[order] >> 1
+        starts = np.ones(order.size, dtype=bool)
+        starts[1:] = edge_key[1:] != edge_key[:-1]
+        edge_of_sorted = np.cumsum(starts) - 1
+        n_edges = int(edge_of_sorted[-1]) + 1 if order.size else 0
+        face_edges = np.full(3 * n_faces, -1, dtype=np.int64)
+        face_edges[order] = edge_of_sorted
+        first = np.flatnonzero(starts)
+        counts = np.diff(np.append(first, order.size))
+        edges = np.stack([low[order[first]], high[order[first]]], axis=1)
+        side_face = order // 3
+        edge_faces = np.full((n_edges, 2), -1, dtype=np.int64)
+        first_backward = backward[order[first]].astype(bool)
+        # first side of each edge: p -> q unless the edge has no forward side
+        edge_faces[~first_backward, 0] = side_face[first[~first_backward]]
+        edge_faces[first_backward, 1] = side_face[first[first_backward]]
+        has_second = counts >= 2
+        second = first[has_second] + 1
+        column = np.where(edge_faces[has_second, 1] == -1, 1, 0)
+        rows = np.flatnonzero(has_second)
+        edge_faces[rows, column] = side_face[second]
+        forward_counts = np.bincount(
+            edge_of_sorted, weights=1 - backward[order], minlength=n_edges
+        ).astype(np.int64)
+        return cls(
+            faces=_readonly(faces),
+            n_vertices=n_vertices,
+            edges=_readonly(edges),
+            face_edges=_readonly(face_edges.reshape(n_faces, 3)),
+            edge_faces=_readonly(edge_faces),
+            edge_face_counts=_readonly(counts.astype(np.int64)),
+            _edge_forward_counts=_readonly(forward_counts),
+        )
+
+    # -- sizes ------------------------------------------------------------------
+    @property
+    def n_faces(self) -> int:
+        return int(self.faces.shape[0])
+
+    @property
+    def n_edges(self) -> int:
+        return int(self.edges.shape[0])
+
+    # -- edge classes -----------------------------------------------------------
+    @cached_property
+    def boundary_edges(self) -> np.ndarray:
+        """(E,) bool: edges with exactly one face."""
+        return _readonly(self.edge_face_counts == 1)
+
+    @cached_property
+    def nonmanifold_edges(self) -> np.ndarray:
+        """(E,) bool: edges with three or more faces."""
+        return _readonly(self.edge_face_counts > 2)
+
+    @cached_property
+    def inconsistent_edges(self) -> np.ndarray:
+        """(E,) bool: two-face edges whose faces run it in the same direction."""
+        two = self.edge_face_counts == 2
+        return _readonly(two & (self._edge_forward_counts != 1))
+
+    @cached_property
+    def interior_edges(self) -> np.ndarray:
+        """(E,) bool: manifold edges with two consistently oriented faces."""
+        return _readonly((self.edge_face_counts == 2) & (self._edge_forward_counts == 1))
+
+    # -- vertex classes ---------------------------------------------------------
+    @cached_property
+    def referenced_vertices(self) -> np.ndarray:
+        """(V,) bool: vertices used by at least one face."""
+        used = np.zeros(self.n_vertices, dtype=bool)
+        used[self.faces.ravel()] = True
+        return _readonly(used)
+
+    def edge_vertices(self, edge_mask: np.ndarray) -> np.ndarray:
+        """(V,) bool: vertices that are an end of an edge selected by ``edge_mask``."""
+        marked = np.zeros(self.n_vertices, dtype=bool)
+        marked[self.edges[edge_mask].ravel()] = True
+        return marked
+
+    @cached_property
+    def boundary_vertices(self) -> np.ndarray:
+        """(V,) bool: vertices on a boundary edge."""
+        return _readonly(self.edge_vertices(self.boundary_edges))
+
+    @cached_property
+    def degenerate_faces(self) -> np.ndarray:
+        """(F,) bool: faces that repeat a vertex index (no area whatever the positions)."""
+        f = self.faces
+        return _readonly((f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0]))
+
+    # -- adjacency --------------------------------------------------------------
+    @cached_property
+    def adjacency(self) -> sp.csr_matrix:
+        """(V, V) sparse symmetric 0/1 matrix: ``i ~ j`` when they share an edge."""
+        n = self.n_vertices
+        rows = np.concatenate([self.edges[:, 0], self.edges[:, 1]])
+        cols = np.concatenate([self.edges[:, 1], self.edges[:, 0]])
+        data = np.ones(rows.size, dtype=np.float64)
+        matrix = sp.csr_matrix((data, (rows, cols)), shape=(n, n))
+        matrix.sum_duplicates()
+        return matrix
+
+    @cached_property
+    def vertex_degrees(self) -> np.ndarray:
+        """(V,) int64: number of edges at each vertex."""
+        return _readonly(np.bincount(self.edges.ravel(), minlength=self.n_vertices).astype(np.int64))
+
+    @cached_property
+    def face_components(self) -> tuple[int, np.ndarray]:
+        """Connected components of the faces (through shared vertices).
+
+        Returns ``(n_components, labels)`` with ``labels`` of shape (F,).
+        """
+        n_faces = self.n_faces
+        rows = np.repeat(np.arange(n_faces), 3)
+        incidence = sp.csr_matrix(
+            (np.ones(rows.size), (rows, self.faces.ravel())), shape=(n_faces, self.n_vertices)
+        )
+        graph = incidence @ incidence.T
+        count, labels = connected_components(graph, directed=False)
+        return count, _readonly(labels)
+
+    @property
+    def n_components(self) -> int:
+        """Number of connected components of the faces."""
+        return int(self.face_components[0])
+
+    @cached_property
+    def euler_characteristic(self) -> int:
+        """V - E + F over the referenced vertices."""
+        return int(self.referenced_vertices.sum()) - self.n_edges + self.n_faces
+
+    @cached_property
+    def n_boundary_loops(self) -> int:
+        """Number of boundary loops (connected sets of boundary edges)."""
+        boundary = self.edges[self.boundary_edges]
+        if boundary.size == 0:
+            return 0
+        n = self.n_vertices
+        graph = sp.csr_matrix(
+            (np.ones(boundary.shape[0]), (boundary[:, 0], boundary[:, 1])), shape=(n, n)
+        )
+        count, labels = connected_components(graph, directed=False)
+        return int(np.unique(labels[boundary[:, 0]]).size)
+
+
+def _readonly(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array

@@ -1,0 +1,46 @@
+import numpy as np
+
+from meshcurv import geometry, shapes
+from meshcurv.topology import MeshTopology
+
+
+def test_sphere_area_and_volume_approach_the_exact_ones():
+    sphere = shapes.icosphere(32, radius=2.0)
+    area = geometry.face_areas(sphere.vertices, sphere.faces).sum()
+    volume = geometry.signed_volume(sphere.vertices, sphere.faces)
+    assert abs(area / (16 * np.pi) - 1) < 2e-3
+    assert abs(volume / (32 * np.pi / 3) - 1) < 3e-3
+    np.testing.assert_allclose(geometry.signed_volume(sphere.vertices, sphere.faces[:, ::-1]), -volume, rtol=1e-14)
+
+
+def test_vertex_areas_sum_to_the_total_area():
+    torus = shapes.torus()
+    areas = geometry.face_areas(torus.vertices, torus.faces)
+    np.testing.assert_allclose(geometry.vertex_areas(torus.vertices, torus.faces).sum(), areas.sum())
+    # exact area of a torus: 4 pi^2 R r
+    assert abs(areas.sum() / (4 * np.pi**2 * 300) - 1) < 5e-3
+
+
+def test_face_normals_are_unit_outward_and_nan_without_area():
+    sphere = shapes.icosphere(4)
+    normals = geometry.face_normals(sphere.vertices, sphere.faces)
+    centres = sphere.vertices[sphere.faces].mean(axis=1)
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1)
+    assert (np.sum(normals * centres, axis=1) > 0).all()
+    flat = geometry.face_normals(np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.0]]), np.array([[0, 1, 2]]))
+    assert np.isnan(flat).all()
+
+
+def test_vertex_normals_match_the_exact_ones():
+    torus = shapes.torus()
+    normals = geometry.vertex_normals(torus.vertices, torus.faces)
+    assert np.sum(normals * torus.normals, axis=1).min() > 0.999
+
+
+def test_mean_edge_length_of_a_unit_grid():
+    saddle = shapes.saddle(half_width=1.0, spacing=0.5)
+    top = MeshTopology.from_faces(saddle.faces)
+    flat = saddle.vertices * [1, 1, 0]
+    # 5 x 5 points: 20 + 20 axis-aligned edges of 0.5, 16 diagonals of 0.5 sqrt(2)
+    expected = (40 * 0.5 + 16 * 0.5 * np.sqrt(2)) / 56
+    assert abs(geometry.mean_edge_length(flat, top.edges) - expected) < 1e-12

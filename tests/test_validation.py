@@ -1,0 +1,103 @@
+"""Every error path of the public entry point, with its message."""
+
+import numpy as np
+import pytest
+
+import meshcurv
+from meshcurv import shapes
+from meshcurv.errors import InvalidMeshError, InvalidOptionError
+
+TRI = np.array([[0, 1, 2], [0, 2, 3]])
+QUAD_VERTICES = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]])
+
+
+def call(vertices=QUAD_VERTICES, faces=TRI, **options):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", meshcurv.MeshQualityWarning)
+        return meshcurv.principal_curvatures(vertices, faces, **options)
+
+
+@pytest.mark.parametrize(
+    "vertices, match",
+    [
+        (np.zeros((4, 2)), r"`vertices` must have shape \(V, 3\); got \(4, 2\)"),
+        (np.zeros(12), r"`vertices` must have shape \(V, 3\); got \(12,\)"),
+        (np.zeros((0, 3)), "`vertices` is empty"),
+        (np.array([["a", "b", "c"]] * 4), "must hold real numbers"),
+        (np.zeros((4, 3), dtype=complex), "must hold real numbers"),
+        ([[0, 0, 0], [1, 0], [1, 1, 0], [0, 1, 0]], "could not be converted"),
+        (np.where(np.arange(12).reshape(4, 3) == 4, np.nan, 0.0), r"NaN or infinite coordinates at 1 vertices \(first at index 1\)"),
+        (np.where(np.arange(12).reshape(4, 3) == 11, np.inf, 0.0), "NaN or infinite"),
+    ],
+)
+def test_bad_vertices(vertices, match):
+    with pytest.raises(InvalidMeshError, match=match):
+        call(vertices=vertices)
+
+
+@pytest.mark.parametrize(
+    "faces, match",
+    [
+        (np.array([0, 1, 2]), r"`faces` must have shape \(F, 3\) or \(F, k\) with k >= 3; got \(3,\)"),
+        (np.zeros((0, 3), dtype=int), "`faces` is empty"),
+        (np.array([[0, 1], [1, 2]]), "at least 3 columns"),
+        (np.array([[0, 1, 2], [0, 2, -1]]), r"negative vertex indices \(smallest -1\)"),
+        (np.array([[0, 1, 2], [0, 2, 7]]), "vertex index 7 out of range for 4 vertices"),
+        (TRI + 1, "look 1-based: indices run from 1 to 4 with 4 vertices.*faces - 1"),
+        (np.array([[0, 1, 2.5]]), "non-integer values"),
+        (np.array([[0, 1, np.nan]]), "NaN or infinite values"),
+        (np.array([[True, False, True]]), "must hold integer vertex indices; got dtype bool"),
+        (np.array([["0", "1", "2"]]), "must hold integer vertex indices"),
+        ([[0, 1, 2], [0, 2]], "fewer than 3 vertices"),
+        ([[0, 1, 2], 5], "items are not sequences"),
+    ],
+)
+def test_bad_faces(faces, match):
+    with pytest.raises(InvalidMeshError, match=match):
+        call(faces=faces)
+
+
+def test_integral_float_faces_are_accepted():
+    r = call(faces=TRI.astype(float))
+    assert r.n_vertices == 4
+
+
+@pytest.mark.parametrize(
+    "options, match",
+    [
+        ({"method": "rusinkiewicz_typo"}, "unknown method 'rusinkiewicz_typo'; choose one of 'normal_cycle', 'matgeom'"),
+        ({"method": None}, "unknown method None"),
+        ({"smoothing_steps": -1}, "`smoothing_steps` must be an integer >= 0; got -1"),
+        ({"smoothing_steps": 2.5}, r"`smoothing_steps` must be an integer >= 0; got 2.5"),
+        ({"smoothing_steps": True}, "`smoothing_steps` must be an integer"),
+    ],
+)
+def test_bad_options(options, match):
+    with pytest.raises(InvalidOptionError, match=match):
+        call(**options)
+
+
+def test_errors_are_value_errors():
+    assert issubclass(InvalidMeshError, ValueError) and issubclass(InvalidOptionError, ValueError)
+
+
+def test_topology_must_match_the_vertices():
+    top = meshcurv.MeshTopology.from_faces(TRI, n_vertices=5)
+    with pytest.raises(InvalidMeshError, match="MeshTopology of 5 vertices but `vertices` has 4 rows"):
+        call(faces=top)
+
+
+def test_inputs_are_never_modified():
+    torus = shapes.torus(n_major=12, n_minor=8)
+    vertices, faces = torus.vertices.copy(), torus.faces.copy()
+    meshcurv.principal_curvatures(vertices, faces)
+    meshcurv.principal_curvatures(vertices, faces, method="matgeom")
+    np.testing.assert_array_equal(vertices, torus.vertices)
+    np.testing.assert_array_equal(faces, torus.faces)
+
+
+def test_shape_generator_options_are_checked():
+    with pytest.raises(InvalidOptionError, match="`subdivisions` must be an integer >= 1; got 0"):
+        shapes.icosphere(0)
