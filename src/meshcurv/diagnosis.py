@@ -1,15 +1,24 @@
-"""What a mesh is, and what is questionable about it."""
+"""What a mesh is, and what is questionable about it.
+
+:func:`diagnose` gathers the facts ``meshcurv info`` prints and that
+:func:`meshcurv.principal_curvatures` attaches to its result. It reuses what the
+:class:`~meshcurv.topology.MeshTopology` has already computed (edge classes, the
+vertex adjacency the smoothing uses) and makes one pass over the face geometry.
+"""
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import asdict, dataclass
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
-from .geometry import degenerate_face_mask, face_cross_products, mean_edge_length, signed_volume
+from .geometry import DEGENERATE_AREA_RATIO
 from .topology import MeshTopology
 
-__all__ = ["MeshDiagnosis", "diagnose", "degenerate_faces"]
+__all__ = ["MeshDiagnosis", "diagnose", "degenerate_faces", "bowtie_vertices"]
 
 
 @dataclass(frozen=True)
@@ -20,7 +29,7 @@ class MeshDiagnosis:
     ----------
     n_vertices, n_faces, n_edges : int
     n_components : int
-        Connected components of the faces.
+        Connected components of the faces (faces sharing a vertex are connected).
     n_boundary_edges, n_boundary_loops : int
     n_nonmanifold_edges : int
         Edges with three or more faces.
@@ -38,7 +47,15 @@ class MeshDiagnosis:
         Signed enclosed volume for closed meshes; None when there is a boundary.
     mean_edge_length : float
     bounding_box : tuple of two 3-tuples
-        Smallest and largest coordinates.
+        Smallest and largest coordinates of the referenced vertices.
+    n_bowtie_vertices : int
+        Vertices where two or more fans of faces meet at a single point (no
+        non-manifold edge there): the neighbourhood is not a disc.
+    n_zero_length_edges : int
+        Edges whose two ends coincide (length below ``1e-6`` x the mean edge length).
+    n_flipped_faces : int
+        Faces reversed by ``orient=`` before the computation (0 when nothing was
+        reversed, and for :func:`diagnose` itself).
     """
 
     n_vertices: int
@@ -57,6 +74,9 @@ class MeshDiagnosis:
     volume: float | None
     mean_edge_length: float
     bounding_box: tuple
+    n_bowtie_vertices: int = 0
+    n_zero_length_edges: int = 0
+    n_flipped_faces: int = 0
 
     @property
     def is_closed(self) -> bool:
@@ -70,6 +90,7 @@ class MeshDiagnosis:
             or self.n_inconsistent_edges
             or self.n_degenerate_faces
             or self.n_unreferenced_vertices
+            or self.n_bowtie_vertices
         )
 
     def problems(self) -> list[str]:
@@ -79,10 +100,14 @@ class MeshDiagnosis:
             found.append(f"{self.n_boundary_edges} boundary edges in {self.n_boundary_loops} loops")
         if self.n_nonmanifold_edges:
             found.append(f"{self.n_nonmanifold_edges} non-manifold edges (3+ faces)")
+        if self.n_bowtie_vertices:
+            found.append(f"{self.n_bowtie_vertices} bow-tie vertices (fans meeting at a point)")
         if self.n_inconsistent_edges:
             found.append(f"{self.n_inconsistent_edges} edges between inconsistently oriented faces")
         if self.n_degenerate_faces:
             found.append(f"{self.n_degenerate_faces} zero-area faces")
+        if self.n_zero_length_edges:
+            found.append(f"{self.n_zero_length_edges} zero-length edges")
         if self.n_unreferenced_vertices:
             found.append(f"{self.n_unreferenced_vertices} unreferenced vertices")
         return found
@@ -91,36 +116,153 @@ class MeshDiagnosis:
         return asdict(self)
 
 
-def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.ndarray | None = None) -> np.ndarray:
-    """(F,) bool: faces with a repeated corner or an area below 1e-12 x (mean edge length)^2."""
+def _cross(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) ``cross(b - a, c - a)``, written out (faster than :func:`numpy.cross`)."""
+    a = vertices[faces[:, 0]]
+    u = vertices[faces[:, 1]] - a
+    w = vertices[faces[:, 2]] - a
+    return np.stack(
+        [u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1], u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2],
+         u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]],
+        axis=1,
+    )
+
+
+def _edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
+    return np.sqrt(np.einsum("ij,ij->i", d, d))
+
+
+def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.ndarray | None = None,
+                     mean_edge_length: float | None = None) -> np.ndarray:
+    """(F,) bool: faces with a repeated corner or an area below 1e-12 x (mean edge length)^2.
+
+    The threshold is relative to the mesh's own length scale, so the same mesh
+    gives the same answer at any scale (coordinates around 1e-9 or 1e9 alike).
+    """
     if cross is None:
-        cross = face_cross_products(vertices, topology.faces)
-    areas = 0.5 * np.linalg.norm(cross, axis=1)
-    scale = mean_edge_length(vertices, topology.edges)
-    return degenerate_face_mask(areas, scale) | topology.degenerate_faces
+        cross = _cross(vertices, topology.faces)
+    if mean_edge_length is None:
+        lengths = _edge_lengths(vertices, topology.edges)
+        mean_edge_length = float(lengths.mean()) if lengths.size else 0.0
+    double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
+    return (0.5 * double_areas <= DEGENERATE_AREA_RATIO * mean_edge_length**2) | topology.degenerate_faces
 
 
-def diagnose(vertices: np.ndarray, topology: MeshTopology) -> MeshDiagnosis:
+def bowtie_vertices(topology: MeshTopology) -> np.ndarray:
+    """(V,) bool: vertices whose faces form more than one fan.
+
+    Two faces at a vertex are in the same fan when a chain of faces at that
+    vertex joins them, each sharing with the next a manifold edge (exactly two
+    faces) at the vertex. A manifold vertex has one fan (a disc, or a half-disc
+    on the boundary); two cones touching at their tips, or two sheets glued at a
+    corner, give two. Faces with a repeated corner are left out. Vertices on
+    non-manifold edges usually have several fans too and are included.
+
+    Notes
+    -----
+    One :func:`~scipy.sparse.csgraph.connected_components` call over the
+    ``3 F`` face corners, linked across every manifold edge; a vertex is a
+    bow-tie when its corners fall in more than one component. The answer
+    depends on the connectivity only and is remembered for the lifetime of the
+    (immutable) ``topology``, so the estimators and :func:`diagnose` share it.
+    """
+    cached = _BOWTIES.get(topology)
+    if cached is None:
+        cached = _bowtie_vertices(topology)
+        cached.flags.writeable = False
+        _BOWTIES[topology] = cached
+    return cached
+
+
+_BOWTIES: "weakref.WeakKeyDictionary[MeshTopology, np.ndarray]" = weakref.WeakKeyDictionary()
+
+
+def _bowtie_vertices(topology: MeshTopology) -> np.ndarray:
+    faces = topology.faces
+    n_corners = 3 * faces.shape[0]
+    proper = np.repeat(~topology.degenerate_faces, 3)
+    pairs = topology.edge_faces
+    linked = (topology.edge_face_counts == 2) & (pairs[:, 0] != pairs[:, 1])
+    side_edge = topology.face_edges.ravel()
+    sides = np.flatnonzero(proper & (side_edge >= 0))
+    sides = sides[linked[side_edge[sides]]]
+    # the two sides of every linked edge, by two scatters (no sort, no search)
+    first = np.full(topology.n_edges, -1, dtype=np.int64)
+    first[side_edge[sides]] = sides
+    second = sides[first[side_edge[sides]] != sides]
+    one = first[side_edge[second]]
+    tail = faces.ravel()
+    position = np.arange(n_corners) % 3
+    head_corner = np.arange(n_corners) - position + (position + 1) % 3
+    # side s runs from corner s to corner head_corner[s]; join the corners at the same vertex
+    same = tail[one] == tail[second]
+    rows = np.concatenate([one, head_corner[one]])
+    cols = np.concatenate([np.where(same, second, head_corner[second]),
+                           np.where(same, head_corner[second], second)])
+    graph = sp.csr_matrix(
+        (np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n_corners, n_corners)
+    )
+    _, labels = connected_components(graph, directed=False)
+    first_label = np.full(topology.n_vertices, -1, dtype=np.int64)
+    first_label[tail[proper]] = labels[proper]
+    several = np.zeros(topology.n_vertices, dtype=bool)
+    several[tail[proper & (labels != first_label[tail])]] = True
+    return several
+
+
+def _n_components(topology: MeshTopology) -> int:
+    """Connected components of the faces, from the vertex adjacency (cached, shared with smoothing)."""
+    used = topology.referenced_vertices
+    if not used.any():
+        return 0
+    _, labels = connected_components(topology.adjacency, directed=False)
+    return int(np.unique(labels[used]).size)
+
+
+def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: int = 0) -> MeshDiagnosis:
     """Describe a mesh: its sizes, topology and defects.
 
     Parameters
     ----------
     vertices : ndarray of shape (V, 3), float64
     topology : MeshTopology
+    n_flipped_faces : int, default: 0
+        Recorded as is (faces reversed by ``orient=`` before the computation).
 
     Returns
     -------
     MeshDiagnosis
+
+    Examples
+    --------
+    >>> from meshcurv import shapes, MeshTopology, diagnose
+    >>> sphere = shapes.icosphere(4)
+    >>> d = diagnose(sphere.vertices, MeshTopology.from_faces(sphere.faces))
+    >>> d.n_components, d.genus, d.is_clean, d.problems()
+    (1, 0, True, [])
     """
-    cross = face_cross_products(vertices, topology.faces)
-    degenerate = degenerate_faces(vertices, topology, cross=cross)
+    faces = topology.faces
+    cross = _cross(vertices, faces)
+    lengths = _edge_lengths(vertices, topology.edges)
+    scale = float(lengths.mean()) if lengths.size else 0.0
+    degenerate = degenerate_faces(vertices, topology, cross=cross, mean_edge_length=scale)
     n_boundary = int(topology.boundary_edges.sum())
-    n_nonmanifold = int(topology.nonmanifold_edges.sum())
+    nonmanifold = topology.nonmanifold_edges
+    n_nonmanifold = int(nonmanifold.sum())
     chi = topology.euler_characteristic
-    n_components = topology.n_components
+    n_components = _n_components(topology)
     closed = n_boundary == 0
     genus = (2 - chi) // 2 if closed and n_components == 1 and n_nonmanifold == 0 else None
-    used = vertices[topology.referenced_vertices] if topology.referenced_vertices.any() else vertices
+    referenced = topology.referenced_vertices
+    n_unreferenced = int(topology.n_vertices - referenced.sum())
+    used = vertices if n_unreferenced == 0 else vertices[referenced]
+    volume = None
+    if closed and faces.shape[0]:
+        # the cross products are translation-invariant: a . (b x c) = (a - o) . cross(b - a, c - a)
+        centred = vertices[faces[:, 0]] - used.mean(axis=0)
+        volume = float(np.einsum("ij,ij->i", centred, cross).sum() / 6.0)
+    bowties = bowtie_vertices(topology) & ~topology.edge_vertices(nonmanifold)
     return MeshDiagnosis(
         n_vertices=topology.n_vertices,
         n_faces=topology.n_faces,
@@ -131,11 +273,35 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology) -> MeshDiagnosis:
         n_nonmanifold_edges=n_nonmanifold,
         n_inconsistent_edges=int(topology.inconsistent_edges.sum()),
         n_degenerate_faces=int(degenerate.sum()),
-        n_unreferenced_vertices=int((~topology.referenced_vertices).sum()),
+        n_unreferenced_vertices=n_unreferenced,
         euler_characteristic=chi,
         genus=genus,
-        area=float(0.5 * np.linalg.norm(cross, axis=1).sum()),
-        volume=signed_volume(vertices, topology.faces) if closed else None,
-        mean_edge_length=mean_edge_length(vertices, topology.edges),
+        area=float(0.5 * np.sqrt(np.einsum("ij,ij->i", cross, cross)).sum()),
+        volume=volume,
+        mean_edge_length=scale,
         bounding_box=(tuple(used.min(axis=0).tolist()), tuple(used.max(axis=0).tolist())),
+        n_bowtie_vertices=int(bowties.sum()),
+        n_zero_length_edges=int((lengths <= 1e-6 * scale).sum()) if lengths.size else 0,
+        n_flipped_faces=int(n_flipped_faces),
     )
+
+
+def quality_message(method: str, problems: list[str], diagnosis: MeshDiagnosis | None) -> str | None:
+    """The text of the one :class:`~meshcurv.errors.MeshQualityWarning` of a call, or None.
+
+    ``problems`` are the estimator's own phrases (what it did about the
+    defects); the diagnosis adds what it found that they do not mention and
+    the number of faces ``orient=`` reversed.
+    """
+    parts = list(problems)
+    if diagnosis is not None:
+        if not parts:
+            parts = diagnosis.problems()
+        elif diagnosis.n_bowtie_vertices and not any("bow-tie" in p for p in parts):
+            parts.insert(0, f"{diagnosis.n_bowtie_vertices} bow-tie vertices (fans meeting at a point)")
+        if diagnosis.n_flipped_faces:
+            parts.append(f"orient reversed {diagnosis.n_flipped_faces} faces before the computation")
+    if not parts:
+        return None
+    suffix = " (details: result.diagnosis)" if diagnosis is not None else ""
+    return f"{method}: " + "; ".join(parts) + suffix

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..diagnosis import bowtie_vertices
 from ..topology import MeshTopology
 
 
@@ -15,7 +16,9 @@ class VertexDefects:
 
     A vertex is invalid when it is unreferenced, on a boundary edge (no dihedral
     angle there), on a non-manifold or inconsistently oriented edge (no
-    well-defined pair of faces), or a corner of a zero-area face (no normal).
+    well-defined pair of faces), a bow-tie vertex (two or more fans of faces
+    meeting at a point: no single tangent plane), or a corner of a zero-area
+    face (no normal; zero-length edges make zero-area faces).
     """
 
     invalid_vertices: np.ndarray
@@ -26,6 +29,7 @@ class VertexDefects:
         labels = [
             ("boundary_edges", "boundary edges (their vertices have no complete neighbourhood)"),
             ("nonmanifold_edges", "non-manifold edges (3+ faces)"),
+            ("bowtie_vertices", "bow-tie vertices (fans meeting at a point)"),
             ("inconsistent_edges", "edges between inconsistently oriented faces"),
             ("degenerate_faces", "zero-area faces"),
             ("unreferenced_vertices", "unreferenced vertices"),
@@ -40,11 +44,14 @@ def mesh_defects(topology: MeshTopology, degenerate_faces: np.ndarray) -> Vertex
     """Find the vertices an edge-based estimator must leave undefined."""
     bad_edges = topology.boundary_edges | topology.nonmanifold_edges | topology.inconsistent_edges
     invalid = topology.edge_vertices(bad_edges)
+    bowties = bowtie_vertices(topology) & ~topology.edge_vertices(topology.nonmanifold_edges)
+    invalid |= bowties
     invalid[topology.faces[degenerate_faces].ravel()] = True
     invalid |= ~topology.referenced_vertices
     counts = {
         "boundary_edges": int(topology.boundary_edges.sum()),
         "nonmanifold_edges": int(topology.nonmanifold_edges.sum()),
+        "bowtie_vertices": int(bowties.sum()),
         "inconsistent_edges": int(topology.inconsistent_edges.sum()),
         "degenerate_faces": int(degenerate_faces.sum()),
         "unreferenced_vertices": int((~topology.referenced_vertices).sum()),
