@@ -3,12 +3,14 @@
 Tolerances and masks: tests/data/matgeom/README.md.
 """
 
+import importlib.util
 import warnings
 
 import numpy as np
 import pytest
 
 import meshcurv
+from meshcurv._backend import use_backend
 from meshcurv.errors import MeshQualityWarning, TriangulationWarning
 from meshcurv.estimators._eigen import sorted_by_magnitude
 from meshcurv.estimators.matgeom import matgeom_tensors
@@ -48,10 +50,15 @@ def test_all_reference_cases_are_present():
     assert len(CASES) == 17
 
 
+BACKENDS = ["numpy"] + (["numba"] if importlib.util.find_spec("numba") else [])
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("name", CASES)
-def test_matgeom_parity(name):
+def test_matgeom_parity(name, backend):
     case = load(name)
-    result = run_matgeom(case)
+    with use_backend(backend):
+        result = run_matgeom(case)
     C1, C2, U1, U2, H, K, N = result.as_matgeom()
     scale = max(np.abs(case["C1"]).max(), np.abs(case["C2"]).max())
 
@@ -66,7 +73,8 @@ def test_matgeom_parity(name):
         MeshTopology._build(meshcurv.triangulate_faces(case["faces"]), case["vertices"].shape[0]),
         int(case["smoothing_steps"]),
     )
-    values, _ = sorted_by_magnitude(tensors)
+    with use_backend(backend):
+        values, _ = sorted_by_magnitude(tensors)
     flat = np.abs(values[:, 1]) - np.abs(values[:, 0]) <= 1e-8 * scale
     assert misalignment(U1, case["U1"])[~umbilic].max(initial=0) <= 1e-8
     assert misalignment(U2, case["U2"])[~(umbilic | flat)].max(initial=0) <= 1e-8

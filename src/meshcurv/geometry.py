@@ -18,6 +18,9 @@ __all__ = [
     "vertex_normals",
     "mean_edge_length",
     "degenerate_face_mask",
+    "corner_cotangents",
+    "corner_angles",
+    "mixed_voronoi_corner_areas",
 ]
 
 #: Faces with area below this fraction of (mean edge length)^2 count as degenerate.
@@ -80,6 +83,11 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
     summed = np.stack(
         [np.bincount(flat, weights=np.repeat(cross[:, k], 3), minlength=n) for k in range(3)], axis=1
     )
+    return normalize_normal_sums(summed)
+
+
+def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
+    """Unit vectors from (V, 3) sums of face cross products; NaN where they (nearly) cancel."""
     norm = np.linalg.norm(summed, axis=1, keepdims=True)
     scale = np.abs(summed).max(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -96,3 +104,57 @@ def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
 def degenerate_face_mask(areas: np.ndarray, length_scale: float) -> np.ndarray:
     """(F,) bool: faces whose area is negligible relative to ``length_scale ** 2``."""
     return areas <= DEGENERATE_AREA_RATIO * length_scale**2
+
+
+def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) cotangent of the angle at each corner of every face.
+
+    ``cot = (a . b) / |a x b|`` for the two edge vectors ``a, b`` leaving the
+    corner; NaN on zero-area faces.
+    """
+    out = np.zeros(faces.shape, dtype=np.float64)
+    for k in range(3):
+        p = vertices[faces[:, k]]
+        a = vertices[faces[:, (k + 1) % 3]] - p
+        b = vertices[faces[:, (k + 2) % 3]] - p
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[:, k] = np.einsum("ij,ij->i", a, b) / np.linalg.norm(np.cross(a, b), axis=1)
+    return out
+
+
+def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) interior angle at each corner of every face, in radians (0 on zero-area faces)."""
+    out = np.zeros(faces.shape, dtype=np.float64)
+    for k in range(3):
+        p = vertices[faces[:, k]]
+        a = vertices[faces[:, (k + 1) % 3]] - p
+        b = vertices[faces[:, (k + 2) % 3]] - p
+        out[:, k] = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+    return out
+
+
+def mixed_voronoi_corner_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) the share of each face in the mixed Voronoi area of each of its corners.
+
+    Meyer, Desbrun, Schroeder and Barr (2003), Fig. 4: on a non-obtuse triangle
+    the Voronoi region of corner ``i``, ``(|e_ij|^2 cot k + |e_ik|^2 cot j) / 8``;
+    on an obtuse one, half the area for the obtuse corner and a quarter for the
+    other two. The shares of a face sum to its area; summed per vertex
+    (``np.bincount(faces.ravel(), shares.ravel())``) they tile the surface.
+    https://doi.org/10.1007/978-3-662-05105-4_2
+    """
+    cot = corner_cotangents(vertices, faces)
+    area = face_areas(vertices, faces)
+    squared = np.zeros(faces.shape, dtype=np.float64)  # squared length of the side opposite corner k
+    for k in range(3):
+        d = vertices[faces[:, (k + 2) % 3]] - vertices[faces[:, (k + 1) % 3]]
+        squared[:, k] = np.einsum("ij,ij->i", d, d)
+    voronoi = np.zeros(faces.shape, dtype=np.float64)
+    for k in range(3):
+        j, m = (k + 1) % 3, (k + 2) % 3
+        # sides at corner k: k-j (opposite m) and k-m (opposite j)
+        voronoi[:, k] = (squared[:, m] * cot[:, m] + squared[:, j] * cot[:, j]) / 8.0
+    obtuse_corner = cot < 0
+    obtuse = obtuse_corner.any(axis=1)
+    mixed = np.where(obtuse[:, None], np.where(obtuse_corner, area[:, None] / 2, area[:, None] / 4), voronoi)
+    return np.where(np.isfinite(mixed), mixed, 0.0)

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
+from ._backend import numba_kernels
 from .topology import MeshTopology
 
 __all__ = ["smooth_vertex_field"]
@@ -39,14 +39,14 @@ def smooth_vertex_field(values, topology: MeshTopology, steps: int) -> np.ndarra
     field = np.array(values, dtype=np.float64, copy=True)
     if steps <= 0:
         return field
-    operator = _averaging_operator(topology)
+    kernels = numba_kernels()
+    if kernels is not None:
+        flat = field.reshape(field.shape[0], -1)
+        return kernels.smooth_over_edges(flat, topology.edges, topology.n_vertices, steps).reshape(field.shape)
+    adjacency = topology.adjacency
+    scale = 1.0 / (topology.vertex_degrees + 1.0)
+    if field.ndim == 2:
+        scale = scale[:, None]
     for _ in range(steps):
-        field = operator @ field
+        field = (adjacency @ field + field) * scale
     return field
-
-
-def _averaging_operator(topology: MeshTopology) -> sp.csr_matrix:
-    """(V, V) row-stochastic sparse matrix ``D^-1 (A + I)``."""
-    matrix = (topology.adjacency + sp.identity(topology.n_vertices, format="csr")).tocsr()
-    row_sums = np.asarray(matrix.sum(axis=1)).ravel()
-    return sp.diags(1.0 / row_sums) @ matrix

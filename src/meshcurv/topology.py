@@ -24,6 +24,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from ._backend import numba_kernels
+
 __all__ = ["triangulate_faces", "MeshTopology"]
 
 
@@ -123,48 +125,18 @@ class MeshTopology:
     @classmethod
     def _build(cls, faces: np.ndarray, n_vertices: int) -> "MeshTopology":
         """Build from already validated int64 (F, 3) triangles."""
-        n_faces = faces.shape[0]
-        tail = faces.ravel()
-        head = np.roll(faces, -1, axis=1).ravel()
-        low = np.minimum(tail, head)
-        high = np.maximum(tail, head)
-        backward = (tail > head).astype(np.int64)
-        proper = tail != head
-        # one sort of the sides, by edge and then direction (p -> q first)
-        key = (low * n_vertices + high) * 2 + backward
-        side_ids = np.flatnonzero(proper)
-        order = side_ids[np.argsort(key[side_ids], kind="stable")]
-        edge_key = key[order] >> 1
-        starts = np.ones(order.size, dtype=bool)
-        starts[1:] = edge_key[1:] != edge_key[:-1]
-        edge_of_sorted = np.cumsum(starts) - 1
-        n_edges = int(edge_of_sorted[-1]) + 1 if order.size else 0
-        face_edges = np.full(3 * n_faces, -1, dtype=np.int64)
-        face_edges[order] = edge_of_sorted
-        first = np.flatnonzero(starts)
-        counts = np.diff(np.append(first, order.size))
-        edges = np.stack([low[order[first]], high[order[first]]], axis=1)
-        side_face = order // 3
-        edge_faces = np.full((n_edges, 2), -1, dtype=np.int64)
-        first_backward = backward[order[first]].astype(bool)
-        # first side of each edge: p -> q unless the edge has no forward side
-        edge_faces[~first_backward, 0] = side_face[first[~first_backward]]
-        edge_faces[first_backward, 1] = side_face[first[first_backward]]
-        has_second = counts >= 2
-        second = first[has_second] + 1
-        column = np.where(edge_faces[has_second, 1] == -1, 1, 0)
-        rows = np.flatnonzero(has_second)
-        edge_faces[rows, column] = side_face[second]
-        forward_counts = np.bincount(
-            edge_of_sorted, weights=1 - backward[order], minlength=n_edges
-        ).astype(np.int64)
+        kernels = numba_kernels()
+        if kernels is not None:
+            edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(faces, n_vertices)
+        else:
+            edges, face_edges, edge_faces, counts, forward_counts = _build_edges(faces, n_vertices)
         return cls(
             faces=_readonly(faces),
             n_vertices=n_vertices,
             edges=_readonly(edges),
-            face_edges=_readonly(face_edges.reshape(n_faces, 3)),
+            face_edges=_readonly(face_edges),
             edge_faces=_readonly(edge_faces),
-            edge_face_counts=_readonly(counts.astype(np.int64)),
+            edge_face_counts=_readonly(counts),
             _edge_forward_counts=_readonly(forward_counts),
         )
 
@@ -232,9 +204,8 @@ class MeshTopology:
         rows = np.concatenate([self.edges[:, 0], self.edges[:, 1]])
         cols = np.concatenate([self.edges[:, 1], self.edges[:, 0]])
         data = np.ones(rows.size, dtype=np.float64)
-        matrix = sp.csr_matrix((data, (rows, cols)), shape=(n, n))
-        matrix.sum_duplicates()
-        return matrix
+        # edges are unique, so no duplicate entries: convert without summing
+        return sp.coo_matrix((data, (rows, cols)), shape=(n, n)).tocsr()
 
     @cached_property
     def vertex_degrees(self) -> np.ndarray:
@@ -278,6 +249,46 @@ class MeshTopology:
         )
         count, labels = connected_components(graph, directed=False)
         return int(np.unique(labels[boundary[:, 0]]).size)
+
+
+def _build_edges(faces: np.ndarray, n_vertices: int):
+    """NumPy path of :meth:`MeshTopology._build`: one sort of the sides by (edge, direction)."""
+    n_faces = faces.shape[0]
+    tail = faces.ravel()
+    head = np.roll(faces, -1, axis=1).ravel()
+    low = np.minimum(tail, head)
+    high = np.maximum(tail, head)
+    backward = (tail > head).astype(np.int64)
+    proper = tail != head
+    # one sort of the sides, by edge and then direction (p -> q first)
+    key = (low * n_vertices + high) * 2 + backward
+    side_ids = np.flatnonzero(proper)
+    order = side_ids[np.argsort(key[side_ids], kind="stable")]
+    edge_key = key[order] >> 1
+    starts = np.ones(order.size, dtype=bool)
+    starts[1:] = edge_key[1:] != edge_key[:-1]
+    edge_of_sorted = np.cumsum(starts) - 1
+    n_edges = int(edge_of_sorted[-1]) + 1 if order.size else 0
+    face_edges = np.full(3 * n_faces, -1, dtype=np.int64)
+    face_edges[order] = edge_of_sorted
+    first = np.flatnonzero(starts)
+    counts = np.diff(np.append(first, order.size))
+    edges = np.stack([low[order[first]], high[order[first]]], axis=1)
+    side_face = order // 3
+    edge_faces = np.full((n_edges, 2), -1, dtype=np.int64)
+    first_backward = backward[order[first]].astype(bool)
+    # first side of each edge: p -> q unless the edge has no forward side
+    edge_faces[~first_backward, 0] = side_face[first[~first_backward]]
+    edge_faces[first_backward, 1] = side_face[first[first_backward]]
+    has_second = counts >= 2
+    second = first[has_second] + 1
+    column = np.where(edge_faces[has_second, 1] == -1, 1, 0)
+    rows = np.flatnonzero(has_second)
+    edge_faces[rows, column] = side_face[second]
+    forward_counts = np.bincount(
+        edge_of_sorted, weights=1 - backward[order], minlength=n_edges
+    ).astype(np.int64)
+    return edges, face_edges.reshape(n_faces, 3), edge_faces, counts.astype(np.int64), forward_counts
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:

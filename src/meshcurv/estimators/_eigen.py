@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._backend import numba_kernels
+
 _ROWS = np.array([0, 3, 4, 3, 1, 5, 4, 5, 2])  # (xx, yy, zz, xy, xz, yz) -> 3x3, row-major
 
 
@@ -15,6 +17,9 @@ def sorted_by_magnitude(tensors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     The sort is stable over LAPACK's ascending order, as matGeom's ``sort(abs(d))``
     over Octave's ``eig``. Rows with a non-finite component are NaN.
     """
+    kernels = numba_kernels()
+    if kernels is not None:
+        return kernels.eigen_by_magnitude(np.ascontiguousarray(tensors))
     n = tensors.shape[0]
     values = np.full((n, 3), np.nan)
     vectors = np.full((n, 3, 3), np.nan)

@@ -49,7 +49,8 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from ..diagnosis import degenerate_faces
-from ..geometry import face_cross_products, vertex_normals
+from .._backend import numba_kernels
+from ..geometry import face_cross_products, normalize_normal_sums, vertex_normals
 from ..result import CurvatureResult
 from ..smoothing import smooth_vertex_field
 from ..topology import MeshTopology
@@ -95,15 +96,23 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
     with np.errstate(invalid="ignore", divide="ignore"):
         unit_normals = cross / double_areas[:, None]
     usable = topology.interior_edges & ~degenerate[np.maximum(topology.edge_faces, 0)].any(axis=1)
-    beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
-    edge_measures = outer6(unit, 0.5 * beta * lengths)
-    ends = topology.edges.T.ravel()
-    measures = np.stack(
-        [np.bincount(ends, weights=np.tile(edge_measures[:, k], 2), minlength=n_vertices) for k in range(6)],
-        axis=1,
-    )
-    face_area_thirds = np.where(degenerate, 0.0, double_areas / 6.0)
-    areas = np.bincount(faces.ravel(), weights=np.repeat(face_area_thirds, 3), minlength=n_vertices)
+    kernels = numba_kernels()
+    if kernels is not None:
+        sums = kernels.normal_cycle_sums(vertices, faces, topology.edges, topology.edge_faces, usable,
+                                         degenerate, unit_normals)
+        measures, areas, normals = sums[:, :6], sums[:, 6], normalize_normal_sums(sums[:, 7:])
+    else:
+        beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
+        edge_measures = outer6(unit, 0.5 * beta * lengths)
+        ends = topology.edges.T.ravel()
+        measures = np.stack(
+            [np.bincount(ends, weights=np.tile(edge_measures[:, k], 2), minlength=n_vertices)
+             for k in range(6)],
+            axis=1,
+        )
+        face_area_thirds = np.where(degenerate, 0.0, double_areas / 6.0)
+        areas = np.bincount(faces.ravel(), weights=np.repeat(face_area_thirds, 3), minlength=n_vertices)
+        normals = vertex_normals(vertices, faces[~degenerate], cross=cross[~degenerate])
 
     stages.start("average vertex tensors")
     valid = ~defects.invalid_vertices
@@ -115,13 +124,16 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
         tensors = pooled[:, :6] / pooled[:, 6:7]
 
     stages.start("retrieve curvatures")
-    normals = vertex_normals(vertices, faces[~degenerate])
     valid &= np.isfinite(normals).all(axis=1) & (pooled[:, 6] > 0)
-    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-        np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
-        rotate=True, mean_from_trace=True,
-    )
-    nan_where(~valid, k_min, k_max, dir_min, dir_max)
+    if kernels is not None:
+        out = kernels.tangent_principal(tensors, normals, valid, True, True)
+        k_min, k_max, dir_min, dir_max = out[:, 0], out[:, 1], out[:, 2:5], out[:, 5:8]
+    else:
+        k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
+            np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
+            rotate=True, mean_from_trace=True,
+        )
+        nan_where(~valid, k_min, k_max, dir_min, dir_max)
     result = CurvatureResult(
         k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
         method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},

@@ -1,0 +1,85 @@
+"""The compiled kernels compute what the NumPy paths compute.
+
+The rest of the suite runs with whatever backend is installed; these tests run
+both on the same meshes (skipped when numba is not installed). CI installs
+numba, so both paths are exercised there; MESHCURV_BACKEND=numpy forces the
+NumPy path for a whole run.
+"""
+
+import warnings
+
+import numpy as np
+import pytest
+
+import meshcurv
+from meshcurv import shapes
+from meshcurv._backend import use_backend
+from meshcurv.errors import InvalidOptionError, MeshQualityWarning
+from meshcurv.topology import MeshTopology
+
+pytest.importorskip("numba")
+
+
+def meshes():
+    sphere = shapes.icosphere(6)
+    v, f = sphere.vertices.copy(), sphere.faces
+    v[f[0, 2]] = v[f[0, 0]]  # two zero-area faces
+    fin = np.vstack([f, [f[50, 0], f[50, 1], 0], [f[7, 1], f[7, 1], f[9, 2]]])
+    saddle = shapes.saddle(spacing=0.1)
+    torus = shapes.torus(n_major=20, n_minor=12)
+    flipped = torus.faces.copy()
+    flipped[::7] = flipped[::7, ::-1]
+    return {
+        "torus": (torus.vertices, torus.faces),
+        "saddle": (saddle.vertices, saddle.faces),
+        "defects": (v, fin),
+        "flipped_faces": (torus.vertices, flipped),
+        "unreferenced": (np.vstack([torus.vertices, [[1.0, 2.0, 3.0]]]), torus.faces),
+    }
+
+
+MESHES = meshes()
+
+
+def run(name, method, backend):
+    vertices, faces = MESHES[name]
+    with use_backend(backend), warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        return meshcurv.principal_curvatures(vertices, faces, method=method)
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_topology_is_identical(name):
+    vertices, faces = MESHES[name]
+    with use_backend("numpy"):
+        a = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
+    with use_backend("numba"):
+        b = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
+    for field in ("edges", "face_edges", "edge_faces", "edge_face_counts", "_edge_forward_counts"):
+        np.testing.assert_array_equal(getattr(a, field), getattr(b, field), err_msg=field)
+
+
+@pytest.mark.parametrize("method", ["normal_cycle", "matgeom"])
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_curvatures_agree(name, method):
+    a = run(name, method, "numpy")
+    b = run(name, method, "numba")
+    np.testing.assert_array_equal(a.valid, b.valid)
+    scale = np.nanmax(np.abs(a.k_max))
+    for field in ("k_min", "k_max", "mean", "gaussian"):
+        np.testing.assert_allclose(getattr(b, field), getattr(a, field), rtol=0, atol=1e-11 * scale * max(scale, 1),
+                                   err_msg=field)
+    separated = a.valid & (np.abs(a.k_max - a.k_min) > 1e-6 * scale)
+    for field in ("dir_min", "dir_max"):
+        dots = np.abs(np.sum(getattr(a, field) * getattr(b, field), axis=1))[separated]
+        assert (1 - dots).max(initial=0) < 1e-9, field
+
+
+def test_unknown_backend_is_refused(monkeypatch):
+    with pytest.raises(InvalidOptionError, match="unknown backend 'gpu'"):
+        with use_backend("gpu"):
+            pass
+    monkeypatch.setenv("MESHCURV_BACKEND", "fortran")
+    torus = shapes.torus(n_major=8, n_minor=6)
+    with pytest.raises(InvalidOptionError, match=r"unknown backend 'fortran' \(MESHCURV_BACKEND\)"):
+        meshcurv.principal_curvatures(torus.vertices, torus.faces)
