@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
-from . import matgeom, normal_cycle
+from . import icc, matgeom, meyer, normal_cycle, normal_cycle_ball, quadric, rusinkiewicz
 
 __all__ = ["Estimator", "ESTIMATORS"]
 
@@ -21,7 +21,8 @@ class Estimator:
     function : callable
         ``function(vertices, topology, *, stages, **options) -> (CurvatureResult, problems)``.
     options : dict
-        The options it takes, with their defaults.
+        The options it takes, with their defaults (``radius=None``: the mesh's
+        default, :func:`meshcurv.neighborhoods.default_radius`).
     summary : str
         One line for ``meshcurv methods``.
     stages : tuple of str
@@ -49,5 +50,40 @@ ESTIMATORS: dict[str, Estimator] = {
         options={"smoothing_steps": 3},
         summary="matGeom's meshCurvatures reproduced exactly (dimensionless values, compatibility mode)",
         stages=matgeom.STAGES,
+    ),
+    "icc": Estimator(
+        name="icc",
+        function=icc.estimate,
+        options={"radius": None},
+        summary="interpolated corrected curvature measures over a ball (Lachaud et al. 2020), in 1/length",
+        stages=icc.STAGES,
+    ),
+    "quadric": Estimator(
+        name="quadric",
+        function=quadric.estimate,
+        options={"radius": None},
+        summary="least-squares quadric (jet) fit over a ball (Cazals & Pouget 2005; Panozzo et al. 2010)",
+        stages=quadric.STAGES,
+    ),
+    "rusinkiewicz": Estimator(
+        name="rusinkiewicz",
+        function=rusinkiewicz.estimate,
+        options={},
+        summary="per-face curvature tensors from normal differences, Voronoi-weighted (Rusinkiewicz 2004)",
+        stages=rusinkiewicz.STAGES,
+    ),
+    "normal_cycle_ball": Estimator(
+        name="normal_cycle_ball",
+        function=normal_cycle_ball.estimate,
+        options={"radius": None},
+        summary="normal-cycle tensor over a ball (Cohen-Steiner & Morvan 2003), in 1/length",
+        stages=normal_cycle_ball.STAGES,
+    ),
+    "meyer": Estimator(
+        name="meyer",
+        function=meyer.estimate,
+        options={},
+        summary="cotangent mean and angle-defect Gaussian curvature (Meyer et al. 2003), no directions",
+        stages=meyer.STAGES,
     ),
 }

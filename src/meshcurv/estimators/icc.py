@@ -1,0 +1,101 @@
+"""Interpolated corrected curvature measures over a ball (Lachaud, Romon, Thibert, Coeurjolly 2020).
+
+The vertex normals ``u_i`` (area-weighted mean of the face normals) are
+interpolated linearly over each triangle ``(x_i, x_j, x_k)``; the curvature
+measures of the corrected normal current then have closed forms per face, with
+``ū = (u_i + u_j + u_k) / 3``:
+
+.. math::
+
+    \\mu_0 &= \\tfrac12 \\langle ū \\mid (x_j - x_i) \\times (x_k - x_i) \\rangle
+    \\quad\\text{(corrected area)}\\\\
+    \\mu_1 &= \\tfrac12 \\langle ū \\mid (u_k - u_j) \\times x_i + (u_i - u_k) \\times x_j
+    + (u_j - u_i) \\times x_k \\rangle \\quad (2H\\,dA)\\\\
+    \\mu_2 &= \\tfrac12 \\langle u_i \\mid u_j \\times u_k \\rangle \\quad (K\\,dA)\\\\
+    \\mu^{X,Y} &= \\tfrac12 \\langle ū \\mid \\langle Y \\mid u_k - u_i \\rangle X \\times (x_j - x_i)
+    - \\langle Y \\mid u_j - u_i \\rangle X \\times (x_k - x_i) \\rangle
+
+Each measure is summed over the ball ``B(x_v, r)`` (every face weighted by its
+approximate share inside the ball, see :func:`meshcurv.neighborhoods.face_in_ball_ratios`)
+and divided by the corrected area ``mu_0(B)``: ``H = mu_1 / (2 mu_0)``,
+``K = mu_2 / mu_0``, and the shape operator is ``-sym(mu^{X,Y}) / mu_0``
+restricted to the tangent plane of ``u_v``; its eigenvectors are the principal
+directions. The principal curvatures are taken from the two scalar measures,
+whose convergence the paper proves, ``k = H -/+ sqrt(max(H^2 - K, 0))``: the
+eigenvalues of the ball-summed tensor carry a bias of order ``(r k)^2`` (the
+tangent planes turn inside the ball), several times larger than that of
+``mu_1`` and ``mu_2`` (on a torus with 2.5 edge lengths: 5% against 0.5%).
+
+Boundaries need no special case: the measures and the corrected area both stop
+at the boundary, so boundary vertices are valid.
+
+References
+----------
+J.-O. Lachaud, P. Romon, B. Thibert, D. Coeurjolly (2020). Interpolated
+corrected curvature measures for polygonal surfaces. Computer Graphics Forum
+39(5), 41-54. https://doi.org/10.1111/cgf.14067
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._tensors import principal_from_shape_operator
+from ..neighborhoods import ball_face_sums, resolve_radius
+from ..topology import MeshTopology
+from ._common import Stages
+from ._support import finish, prepare
+
+STAGES = ("compute normals", "compute face measures", "sum over balls", "retrieve curvatures")
+
+
+def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(F, 9) per-face ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` (xx, yy, zz, xy, xz, yz).
+
+    Written relative to the first corner, so that a translation of the mesh
+    changes nothing (the sum ``(u_k - u_j) + (u_i - u_k) + (u_j - u_i)`` is 0).
+    """
+    x0, x1, x2 = (vertices[faces[:, k]] for k in range(3))
+    u0, u1, u2 = (normals[faces[:, k]] for k in range(3))
+    x01, x02 = x1 - x0, x2 - x0
+    u01, u02 = u1 - u0, u2 - u0
+    um = (u0 + u1 + u2) / 3
+    mu0 = 0.5 * np.einsum("ij,ij->i", um, np.cross(x01, x02))
+    mu1 = 0.5 * np.einsum("ij,ij->i", um, np.cross(u0 - u2, x01) + np.cross(u1 - u0, x02))
+    mu2 = 0.5 * np.einsum("ij,ij->i", u0, np.cross(u1, u2))
+    # mu^{X,Y} = X^T M Y with M = 1/2 [ (x01 x um) (u02)^T - (x02 x um) (u01)^T ]
+    a, b = np.cross(x01, um), np.cross(x02, um)
+    m = 0.5 * (a[:, :, None] * u02[:, None, :] - b[:, :, None] * u01[:, None, :])
+    sym = np.stack([m[:, 0, 0], m[:, 1, 1], m[:, 2, 2], 0.5 * (m[:, 0, 1] + m[:, 1, 0]),
+                    0.5 * (m[:, 0, 2] + m[:, 2, 0]), 0.5 * (m[:, 1, 2] + m[:, 2, 1])], axis=1)
+    return np.column_stack([mu0, mu1, mu2, sym])
+
+
+def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
+    """Interpolated corrected curvature measures over balls. Returns ``(result, problems)``."""
+    stages.start("compute normals")
+    radius = resolve_radius(radius, vertices, topology)
+    _, degenerate, defects, normals, valid = prepare(vertices, topology)
+
+    stages.start("compute face measures")
+    faces = topology.faces
+    usable = ~degenerate & np.isfinite(normals[faces]).all(axis=(1, 2))
+    measures = face_measures(vertices, faces[usable], normals)
+
+    stages.start("sum over balls")
+    summed = ball_face_sums(vertices, faces[usable], radius, measures)
+
+    stages.start("retrieve curvatures")
+    area = summed[:, 0]
+    valid &= area > 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = summed[:, 1] / (2 * area)
+        shape_operator = -summed[:, 3:] / area[:, None]
+    frame_normals = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
+    _, _, dir_min, dir_max = principal_from_shape_operator(
+        np.where(valid[:, None], shape_operator, 0.0), frame_normals)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        gaussian = summed[:, 2] / area
+    half_difference = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
+    k_min, k_max = mean - half_difference, mean + half_difference
+    return finish("icc", {"radius": radius}, valid, normals, k_min, k_max, dir_min, dir_max, defects)

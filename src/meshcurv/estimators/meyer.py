@@ -1,0 +1,76 @@
+"""Cotangent mean curvature and angle-defect Gaussian curvature (Meyer, Desbrun, Schröder, Barr 2003).
+
+At vertex ``i`` with mixed Voronoi area ``A_i``
+(:func:`meshcurv.geometry.mixed_voronoi_corner_areas`):
+
+.. math::
+
+    \\mathbf K(x_i) = \\frac{1}{2 A_i} \\sum_{j \\in N(i)} (\\cot \\alpha_{ij} + \\cot \\beta_{ij})
+    (x_j - x_i) = -2 H n_i, \\qquad
+    K = \\frac{2\\pi - \\sum_f \\theta_f}{A_i}
+
+``alpha_ij, beta_ij`` are the angles opposite edge ``ij`` and ``theta_f`` the
+angles at ``i``. ``H = -<K(x_i), n_i> / 2`` with ``n_i`` the area-weighted vertex
+normal, so that an outward-wound sphere gives ``+1/r``. The principal curvatures
+follow as ``H -/+ sqrt(max(H^2 - K, 0))``. The method gives no principal
+directions: ``dir_min`` and ``dir_max`` are NaN.
+
+A 1-ring method: it does not converge pointwise on irregular meshes, and on a
+boundary the angle defect is the geodesic curvature of the boundary, not ``K``;
+boundary vertices are NaN with ``valid=False``.
+
+References
+----------
+M. Meyer, M. Desbrun, P. Schröder, A. H. Barr (2003). Discrete
+differential-geometry operators for triangulated 2-manifolds. Visualization and
+Mathematics III, 35-57. https://doi.org/10.1007/978-3-662-05105-4_2
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..diagnosis import degenerate_faces
+from ..geometry import corner_angles, corner_cotangents, face_cross_products, mixed_voronoi_corner_areas, vertex_normals
+from ..topology import MeshTopology
+from ._common import Stages
+from ._defects import mesh_defects
+from ._support import finish
+
+STAGES = ("compute angles", "compute cotangent Laplacian", "retrieve curvatures")
+
+
+def estimate(vertices: np.ndarray, topology: MeshTopology, *, stages: Stages):
+    """Meyer et al. mean and Gaussian curvature. Returns ``(result, problems)``."""
+    stages.start("compute angles")
+    n = vertices.shape[0]
+    faces = topology.faces
+    cross = face_cross_products(vertices, faces)
+    degenerate = degenerate_faces(vertices, topology, cross=cross)
+    defects = mesh_defects(topology, degenerate)
+    good = faces[~degenerate]
+    cot = corner_cotangents(vertices, good)
+    angles = corner_angles(vertices, good)
+    shares = mixed_voronoi_corner_areas(vertices, good)
+    areas = np.bincount(good.ravel(), weights=shares.ravel(), minlength=n)
+
+    stages.start("compute cotangent Laplacian")
+    laplace = np.zeros((n, 3))
+    for k in range(3):  # edge (j, m) opposite corner k, weighted by cot at k
+        j, m = good[:, (k + 1) % 3], good[:, (k + 2) % 3]
+        d = (vertices[m] - vertices[j]) * cot[:, k, None]
+        for axis in range(3):
+            laplace[:, axis] += np.bincount(j, weights=d[:, axis], minlength=n)
+            laplace[:, axis] -= np.bincount(m, weights=d[:, axis], minlength=n)
+    defect = 2 * np.pi - np.bincount(good.ravel(), weights=angles.ravel(), minlength=n)
+
+    stages.start("retrieve curvatures")
+    normals = vertex_normals(vertices, good)
+    valid = ~defects.invalid_vertices & np.isfinite(normals).all(axis=1) & (areas > 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = -np.einsum("ij,ij->i", laplace, normals) / (4 * areas)
+        gaussian = defect / areas
+    half_difference = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
+    directions = np.full((n, 3), np.nan)
+    return finish("meyer", {}, valid, normals, mean - half_difference, mean + half_difference,
+                  directions, directions.copy(), defects)

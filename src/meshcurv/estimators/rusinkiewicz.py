@@ -1,0 +1,121 @@
+"""Per-face second fundamental form from normal differences (Rusinkiewicz 2004).
+
+On each face with orthonormal frame ``(e_u, e_v)`` in its plane, the second
+fundamental form ``II = [[L, M], [M, N]]`` is fitted by least squares to the
+three edges ``e`` and the differences ``Δn`` of the vertex normals at their ends:
+
+.. math::
+
+    II \\begin{pmatrix} e \\cdot e_u \\\\ e \\cdot e_v \\end{pmatrix}
+    = \\begin{pmatrix} \\Delta n \\cdot e_u \\\\ \\Delta n \\cdot e_v \\end{pmatrix}
+
+(six equations, three unknowns; with normals pointing outward ``dn = S dx``, so
+a sphere of radius ``r`` gives ``II = I / r``). Each face tensor is turned
+into the tangent plane of each of its corners (the rotation that takes the face
+normal to the vertex normal) and averaged with the corner's mixed Voronoi area
+as weight; the eigen-decomposition of the average in the vertex tangent plane
+gives the principal curvatures and directions. The vertex normals are the
+area-weighted means of the face normals.
+
+Boundary vertices are kept (their average runs over the faces they have).
+
+References
+----------
+S. Rusinkiewicz (2004). Estimating curvatures and their derivatives on triangle
+meshes. Proc. 2nd International Symposium on 3D Data Processing, Visualization
+and Transmission (3DPVT), 486-493. https://doi.org/10.1109/TDPVT.2004.1335277
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._tensors import principal_from_shape_operator
+from ..geometry import mixed_voronoi_corner_areas
+from ..topology import MeshTopology
+from ._common import Stages
+from ._support import finish, prepare
+
+STAGES = ("compute normals", "fit face tensors", "average vertex tensors", "retrieve curvatures")
+
+_SIX = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))  # 3x3 -> (xx, yy, zz, xy, xz, yz)
+
+
+def face_second_fundamental_forms(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray,
+                                  face_unit_normals: np.ndarray) -> np.ndarray:
+    """(F, 3, 3) least-squares shape operator of every face, as a 3D tensor in its plane."""
+    x = [vertices[faces[:, k]] for k in range(3)]
+    u = [normals[faces[:, k]] for k in range(3)]
+    e_u = x[1] - x[0]
+    e_u /= np.linalg.norm(e_u, axis=1, keepdims=True)
+    e_v = np.cross(face_unit_normals, e_u)
+    lhs = np.zeros((faces.shape[0], 3, 3))
+    rhs = np.zeros((faces.shape[0], 3))
+    for k in range(3):
+        edge = x[(k + 2) % 3] - x[(k + 1) % 3]
+        dn = u[(k + 2) % 3] - u[(k + 1) % 3]
+        a, b = np.einsum("ij,ij->i", edge, e_u), np.einsum("ij,ij->i", edge, e_v)
+        p, q = np.einsum("ij,ij->i", dn, e_u), np.einsum("ij,ij->i", dn, e_v)
+        # rows (a, b, 0) . (L, M, N) = p and (0, a, b) . (L, M, N) = q
+        lhs[:, 0, 0] += a * a
+        lhs[:, 0, 1] += a * b
+        lhs[:, 1, 1] += b * b + a * a
+        lhs[:, 1, 2] += a * b
+        lhs[:, 2, 2] += b * b
+        rhs[:, 0] += a * p
+        rhs[:, 1] += b * p + a * q
+        rhs[:, 2] += b * q
+    lhs[:, 1, 0], lhs[:, 2, 1] = lhs[:, 0, 1], lhs[:, 1, 2]
+    lmn = np.linalg.solve(lhs, rhs[:, :, None])[:, :, 0]
+    uu = e_u[:, :, None] * e_u[:, None, :]
+    vv = e_v[:, :, None] * e_v[:, None, :]
+    uv = e_u[:, :, None] * e_v[:, None, :]
+    return lmn[:, 0, None, None] * uu + lmn[:, 1, None, None] * (uv + uv.transpose(0, 2, 1)) + lmn[:, 2, None, None] * vv
+
+
+def rotations_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(N, 3, 3) the smallest rotations taking unit vectors ``a`` to ``b`` (Rodrigues).
+
+    Antiparallel pairs (no unique smallest rotation) get the identity.
+    """
+    axis = np.cross(a, b)
+    cos = np.einsum("ij,ij->i", a, b)
+    skew = np.zeros((a.shape[0], 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
+    skew -= skew.transpose(0, 2, 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        factor = np.where(cos > -1 + 1e-12, 1.0 / (1.0 + cos), 0.0)
+    return np.eye(3) + skew + factor[:, None, None] * (skew @ skew)
+
+
+def estimate(vertices: np.ndarray, topology: MeshTopology, *, stages: Stages):
+    """Rusinkiewicz's per-face curvature tensors averaged on vertices. Returns ``(result, problems)``."""
+    stages.start("compute normals")
+    n = vertices.shape[0]
+    cross, degenerate, defects, normals, valid = prepare(vertices, topology)
+    usable = ~degenerate & np.isfinite(normals[topology.faces]).all(axis=(1, 2))
+    faces = topology.faces[usable]
+    face_unit_normals = cross[usable] / np.linalg.norm(cross[usable], axis=1, keepdims=True)
+
+    stages.start("fit face tensors")
+    tensors = face_second_fundamental_forms(vertices, faces, normals, face_unit_normals)
+
+    stages.start("average vertex tensors")
+    weights = mixed_voronoi_corner_areas(vertices, faces)
+    summed = np.zeros((n, 6))
+    total = np.bincount(faces.ravel(), weights=weights.ravel(), minlength=n)
+    for k in range(3):
+        corner = faces[:, k]
+        rotation = rotations_between(face_unit_normals, normals[corner])
+        turned = rotation @ tensors @ rotation.transpose(0, 2, 1)
+        six = turned[:, _SIX[0], _SIX[1]] * weights[:, k, None]
+        for c in range(6):
+            summed[:, c] += np.bincount(corner, weights=six[:, c], minlength=n)
+
+    stages.start("retrieve curvatures")
+    valid &= total > 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        shape_operator = summed / total[:, None]
+    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
+        np.where(valid[:, None], shape_operator, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]))
+    return finish("rusinkiewicz", {}, valid, normals, k_min, k_max, dir_min, dir_max, defects)
