@@ -93,10 +93,17 @@ class MeshDiagnosis:
             or self.n_bowtie_vertices
         )
 
-    def problems(self) -> list[str]:
-        """One short phrase per kind of defect found."""
+    def problems(self, *, boundary: bool = True) -> list[str]:
+        """One short phrase per kind of defect found.
+
+        Parameters
+        ----------
+        boundary : bool, default: True
+            Include the boundary edges (a boundary is a defect for some methods
+            only).
+        """
         found = []
-        if self.n_boundary_edges:
+        if self.n_boundary_edges and boundary:
             found.append(f"{self.n_boundary_edges} boundary edges in {self.n_boundary_loops} loops")
         if self.n_nonmanifold_edges:
             found.append(f"{self.n_nonmanifold_edges} non-manifold edges (3+ faces)")
@@ -290,13 +297,14 @@ def quality_message(method: str, problems: list[str], diagnosis: MeshDiagnosis |
     """The text of the one :class:`~meshcurv.errors.MeshQualityWarning` of a call, or None.
 
     ``problems`` are the estimator's own phrases (what it did about the
-    defects); the diagnosis adds what it found that they do not mention and
-    the number of faces ``orient=`` reversed.
+    defects); the diagnosis adds the defects they do not mention (bow-tie
+    vertices; all its defects but boundaries when the estimator reported none)
+    and the number of faces ``orient=`` reversed.
     """
     parts = list(problems)
     if diagnosis is not None:
-        if not parts:
-            parts = diagnosis.problems()
+        if not parts:  # the method handled everything it met; say what else was found
+            parts = diagnosis.problems(boundary=False)
         elif diagnosis.n_bowtie_vertices and not any("bow-tie" in p for p in parts):
             parts.insert(0, f"{diagnosis.n_bowtie_vertices} bow-tie vertices (fans meeting at a point)")
         if diagnosis.n_flipped_faces:

@@ -23,11 +23,14 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._validation import as_faces, as_vertices
+from ._validation import as_faces, as_vertices, check_choice
 from .errors import InvalidMeshError
 from .topology import MeshTopology
 
-__all__ = ["orient_faces"]
+__all__ = ["orient_faces", "ORIENT_CHOICES"]
+
+#: The values of ``orient=`` in :func:`meshcurv.principal_curvatures`.
+ORIENT_CHOICES = ("keep", "consistent", "outward")
 
 
 def orient_faces(vertices, faces, *, outward: bool = True) -> tuple[np.ndarray, int]:
@@ -128,7 +131,7 @@ def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = 
     if outward:
         invert = _outward(vertices, topology, patch, flip, invert, n_labels)
     flip ^= invert[patch] & orientable
-    return flip
+    return flip & proper
 
 
 def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
@@ -152,3 +155,21 @@ def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
     magnitude = np.bincount(patch, weights=np.abs(volume6), minlength=n_labels)
     decided = ~open_patch & (np.abs(signed) > 1e-9 * magnitude)
     return np.where(decided, signed < 0, invert)
+
+
+def oriented_topology(vertices: np.ndarray, topology: MeshTopology, orient: str) -> tuple[MeshTopology, int]:
+    """Apply ``orient=`` of :func:`meshcurv.principal_curvatures`: ``(topology, n_flipped)``.
+
+    ``'keep'`` returns ``topology`` untouched; otherwise the reversed faces get
+    a new topology (the given one is returned when nothing had to change).
+    """
+    check_choice(orient, "orient", ORIENT_CHOICES)
+    if orient == "keep":
+        return topology, 0
+    flip = face_flips(vertices, topology, outward=orient == "outward")
+    n_flipped = int(flip.sum())
+    if n_flipped == 0:
+        return topology, 0
+    faces = np.array(topology.faces, dtype=np.int64, copy=True)
+    faces[flip] = faces[flip][:, [0, 2, 1]]
+    return MeshTopology._build(faces, topology.n_vertices), n_flipped
