@@ -22,6 +22,7 @@ from .errors import (
     MeshQualityWarning,
     TriangulationWarning,
 )
+from .io import read_mesh, write_mesh
 from .result import CurvatureResult
 from .smoothing import smooth_vertex_field
 from .topology import MeshTopology, triangulate_faces
@@ -30,6 +31,8 @@ __version__ = "0.1.0"
 
 __all__ = [
     "principal_curvatures",
+    "read_mesh",
+    "write_mesh",
     "METHODS",
     "CurvatureResult",
     "MeshTopology",

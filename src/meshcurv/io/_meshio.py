@@ -1,0 +1,117 @@
+"""PLY, STL and VTK (legacy .vtk, XML .vtu) through meshio, an optional extra.
+
+OFF is done in :mod:`._off` (meshio's OFF reader takes triangles only and its
+writer keeps 12 significant digits).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import logging
+
+import numpy as np
+
+from ..errors import MeshFileError, MissingDependencyError
+
+__all__ = ["read_with_meshio", "write_with_meshio"]
+
+logger = logging.getLogger(__name__)
+
+_SURFACE_CELLS = ("triangle", "quad", "polygon")
+
+
+def _meshio():
+    try:
+        import meshio
+    except ImportError:
+        raise MissingDependencyError(
+            "reading and writing PLY, STL, VTK and VTU files needs meshio: pip install 'meshcurv[io]'"
+        ) from None
+    return meshio
+
+
+@contextlib.contextmanager
+def _to_log():
+    """Send what meshio prints on stderr (its warnings) to this module's logger instead."""
+    captured = io.StringIO()
+    try:
+        with contextlib.redirect_stderr(captured):
+            yield
+    finally:
+        for line in captured.getvalue().splitlines():
+            if line.strip():
+                logger.warning("meshio: %s", line.strip())
+
+
+def check_stl(path) -> None:
+    """Refuse what is neither a binary STL (its size matches its triangle count) nor starts with ``solid``.
+
+    meshio's ASCII STL reader takes the last three numbers of any line, so an
+    OBJ file named .stl would otherwise be read as nonsense.
+    """
+    with open(path, "rb") as handle:
+        head = handle.read(84)
+    size = path.stat().st_size
+    if len(head) == 84 and 84 + 50 * int.from_bytes(head[80:84], "little") == size:
+        return
+    if not head.lstrip().startswith(b"solid"):
+        raise MeshFileError(
+            f"{path}: not an STL file (not a binary STL: its size does not match its triangle count; "
+            "not an ASCII STL: it does not start with 'solid')"
+        )
+
+
+def read_with_meshio(path, file_format: str):
+    """Read the vertices and the surface faces (triangles, quads, polygons) of a mesh file.
+
+    Calls the format's own reader (``meshio.ply.read``, ...): ``meshio.read``
+    prints and calls ``sys.exit(1)`` when a reader fails.
+    """
+    reader = getattr(_meshio(), file_format).read
+    try:
+        # errstate: meshio's STL reader tests for binary by multiplying a uint32 header count
+        with _to_log(), np.errstate(over="ignore"):
+            mesh = reader(str(path))
+    except Exception as exc:  # any parser failure becomes one readable error naming the file
+        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise MeshFileError(f"{path}: cannot be read as {file_format.upper()} ({reason})") from exc
+    blocks = [np.asarray(block.data, dtype=np.int64) for block in mesh.cells if block.type in _SURFACE_CELLS]
+    points = np.asarray(mesh.points, dtype=np.float64)
+    if not blocks or sum(len(b) for b in blocks) == 0:
+        found = sorted({block.type for block in mesh.cells}) or ["none"]
+        raise MeshFileError(
+            f"{path}: the file has no surface faces (triangles or polygons); cells found: {', '.join(found)}"
+        )
+    if points.ndim != 2 or points.shape[1] not in (2, 3):
+        raise MeshFileError(f"{path}: vertices must have 3 coordinates; got shape {points.shape}")
+    if points.shape[1] == 2:
+        points = np.column_stack([points, np.zeros(points.shape[0])])
+    if len({b.shape[1] for b in blocks}) == 1:
+        return points, np.concatenate(blocks)
+    return points, [face for block in blocks for face in block]
+
+
+def _cells(faces):
+    """meshio cell blocks for an (F, k) array or a list of index arrays, grouped by size."""
+    if isinstance(faces, np.ndarray):
+        groups = {faces.shape[1]: faces}
+    else:
+        sizes = np.array([len(face) for face in faces])
+        groups = {int(k): np.array([faces[i] for i in np.flatnonzero(sizes == k)]) for k in np.unique(sizes)}
+    names = {3: "triangle", 4: "quad"}
+    return [(names.get(k, "polygon"), block.astype(np.int32)) for k, block in groups.items()]
+
+
+def write_with_meshio(path, vertices, faces, point_data: dict, *, file_format: str, binary: bool) -> None:
+    """Write a mesh and its per-vertex fields (already flattened for PLY by the caller)."""
+    meshio = _meshio()
+    options = {"binary": binary}
+    if file_format == "vtk":
+        options["fmt_version"] = "4.2"  # the legacy layout every VTK and ParaView version reads
+    mesh = meshio.Mesh(vertices, _cells(faces), point_data=point_data)
+    try:
+        with _to_log():
+            getattr(meshio, file_format).write(str(path), mesh, **options)
+    except Exception as exc:
+        raise MeshFileError(f"{path}: cannot be written as {file_format.upper()} ({exc})") from exc

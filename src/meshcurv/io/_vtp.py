@@ -1,0 +1,151 @@
+"""VTK XML PolyData (.vtp), ParaView's own surface format, with the standard library.
+
+meshio reads and writes .vtu but not .vtp. This module writes inline base64
+binary arrays (UInt64 headers, little-endian) and reads inline arrays in the
+``ascii`` and ``binary`` encodings, compressed with zlib or not, with UInt32 or
+UInt64 headers: what ParaView and VTK write by default except appended data,
+which is refused with a message.
+"""
+
+from __future__ import annotations
+
+import base64
+import xml.etree.ElementTree as ElementTree
+import zlib
+
+import numpy as np
+
+from ..errors import MeshFileError
+
+__all__ = ["read_vtp", "write_vtp"]
+
+_TYPES = {
+    "Int8": "i1", "UInt8": "u1", "Int16": "i2", "UInt16": "u2", "Int32": "i4", "UInt32": "u4",
+    "Int64": "i8", "UInt64": "u8", "Float32": "f4", "Float64": "f8",
+}
+_NAMES = {np.dtype(code).newbyteorder("<"): name for name, code in _TYPES.items()}
+
+
+def _encode(array: np.ndarray) -> str:
+    data = np.ascontiguousarray(array).astype(array.dtype.newbyteorder("<"), copy=False).tobytes()
+    header = np.array([len(data)], dtype="<u8").tobytes()
+    return (base64.b64encode(header) + base64.b64encode(data)).decode("ascii")
+
+
+def _data_array(parent, array: np.ndarray, name: str | None = None) -> None:
+    if array.dtype == bool:
+        array = array.astype(np.uint8)
+    attributes = {"type": _NAMES[array.dtype.newbyteorder("<")], "format": "binary"}
+    if name is not None:
+        attributes["Name"] = name
+    if array.ndim == 2:
+        attributes["NumberOfComponents"] = str(array.shape[1])
+    element = ElementTree.SubElement(parent, "DataArray", attributes)
+    element.text = _encode(array)
+
+
+def write_vtp(path, vertices: np.ndarray, faces, point_data: dict) -> None:
+    """Write a surface and its per-vertex fields (scalars and 3-vectors) as VTK XML PolyData."""
+    if isinstance(faces, np.ndarray):
+        connectivity = faces.reshape(-1)
+        offsets = np.arange(1, faces.shape[0] + 1) * faces.shape[1]
+    else:
+        connectivity = np.concatenate(faces)
+        offsets = np.cumsum([len(face) for face in faces])
+    root = ElementTree.Element(
+        "VTKFile", {"type": "PolyData", "version": "1.0", "byte_order": "LittleEndian", "header_type": "UInt64"}
+    )
+    piece = ElementTree.SubElement(
+        ElementTree.SubElement(root, "PolyData"),
+        "Piece",
+        {"NumberOfPoints": str(vertices.shape[0]), "NumberOfVerts": "0", "NumberOfLines": "0",
+         "NumberOfStrips": "0", "NumberOfPolys": str(len(offsets))},
+    )
+    scalars = [name for name, value in point_data.items() if np.ndim(value) == 1]
+    vectors = [name for name, value in point_data.items() if np.ndim(value) == 2]
+    attributes = {}
+    if scalars:
+        attributes["Scalars"] = scalars[0]
+    if vectors:
+        attributes["Normals" if "normals" in vectors else "Vectors"] = "normals" if "normals" in vectors else vectors[0]
+    fields = ElementTree.SubElement(piece, "PointData", attributes)
+    for name, value in point_data.items():
+        _data_array(fields, np.asarray(value), name)
+    _data_array(ElementTree.SubElement(piece, "Points"), np.asarray(vertices, dtype=np.float64))
+    polys = ElementTree.SubElement(piece, "Polys")
+    _data_array(polys, np.asarray(connectivity, dtype=np.int64), "connectivity")
+    _data_array(polys, np.asarray(offsets, dtype=np.int64), "offsets")
+    ElementTree.indent(root)
+    ElementTree.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+
+
+def _decode(element, path, *, header: str, order: str, compressed: bool) -> np.ndarray:
+    kind = element.get("type")
+    if kind not in _TYPES:
+        raise MeshFileError(f"{path}: unsupported DataArray type {kind!r}")
+    dtype = np.dtype(order + _TYPES[kind])
+    encoding = element.get("format", "ascii")
+    text = (element.text or "").strip()
+    if encoding == "ascii":
+        values = np.array(text.split(), dtype=np.float64).astype(dtype)
+    elif encoding == "binary":
+        header_type = np.dtype(order + ("u8" if header == "UInt64" else "u4"))
+        if compressed:
+            # header: number of blocks, block size, last block size, compressed size of each block
+            head_chars = 4 * -(-3 * header_type.itemsize // 3)
+            n_blocks = int(np.frombuffer(base64.b64decode(text[:head_chars]), header_type)[0])
+            head_chars = 4 * -(-(3 + n_blocks) * header_type.itemsize // 3)
+            sizes = np.frombuffer(base64.b64decode(text[:head_chars]), header_type)[3:3 + n_blocks]
+            raw = base64.b64decode(text[head_chars:])
+            ends = np.cumsum(sizes)
+            data = b"".join(zlib.decompress(raw[end - size:end]) for size, end in zip(sizes, ends))
+        else:
+            head_chars = 4 * -(-header_type.itemsize // 3)
+            n_bytes = int(np.frombuffer(base64.b64decode(text[:head_chars]), header_type)[0])
+            data = base64.b64decode(text[head_chars:])[:n_bytes]
+        values = np.frombuffer(data, dtype=dtype)
+    else:
+        raise MeshFileError(
+            f"{path}: DataArray format {encoding!r} is not supported (only inline 'ascii' and 'binary'); "
+            "resave it from ParaView with appended data off, or as .vtu"
+        )
+    components = int(element.get("NumberOfComponents", "1"))
+    return values.reshape(-1, components) if components > 1 else values
+
+
+def read_vtp(path):
+    """Read the points and polygons of a VTK XML PolyData file."""
+    try:
+        root = ElementTree.parse(path).getroot()
+    except ElementTree.ParseError as exc:
+        raise MeshFileError(f"{path}: not a VTK XML file ({exc})") from None
+    if root.tag != "VTKFile" or root.get("type") != "PolyData":
+        raise MeshFileError(f"{path}: not a VTK PolyData file (root <{root.tag} type={root.get('type')!r}>)")
+    compressed = root.get("compressor") is not None
+    options = {"header": root.get("header_type", "UInt32"),
+               "order": "<" if root.get("byte_order", "LittleEndian") == "LittleEndian" else ">",
+               "compressed": compressed}
+    piece = root.find("PolyData/Piece")
+    points = piece.find("Points/DataArray") if piece is not None else None
+    polys = piece.find("Polys") if piece is not None else None
+    if points is None or polys is None:
+        raise MeshFileError(f"{path}: the PolyData has no points or no polygons")
+    arrays = {element.get("Name"): element for element in polys.findall("DataArray")}
+    if "connectivity" not in arrays or "offsets" not in arrays:
+        raise MeshFileError(f"{path}: the polygons lack a connectivity or an offsets array")
+    try:
+        vertices = _decode(points, path, **options).astype(np.float64).reshape(-1, 3)
+        connectivity = _decode(arrays["connectivity"], path, **options).astype(np.int64)
+        offsets = _decode(arrays["offsets"], path, **options).astype(np.int64)
+    except MeshFileError:
+        raise
+    except (ValueError, zlib.error, base64.binascii.Error) as exc:
+        raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
+    if vertices.shape[0] == 0 or offsets.size == 0:
+        raise MeshFileError(f"{path}: the PolyData has no points or no polygons")
+    sizes = np.diff(offsets, prepend=0)
+    if offsets[-1] != connectivity.size or (sizes < 3).any():
+        raise MeshFileError(f"{path}: the polygon offsets do not match the connectivity")
+    if (sizes == sizes[0]).all():
+        return vertices, connectivity.reshape(-1, int(sizes[0]))
+    return vertices, np.split(connectivity, offsets[:-1])

@@ -1,0 +1,130 @@
+"""Per-vertex fields of a curvature result, named as they are written to files."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InvalidOptionError
+
+__all__ = ["FIELDS", "curvature_fields", "shape_index", "curvedness"]
+
+#: The fields :func:`curvature_fields` can produce, in file order, with what they are.
+FIELDS = {
+    "k_min": "smaller principal curvature (1/length)",
+    "k_max": "larger principal curvature (1/length)",
+    "mean": "mean curvature (k_min + k_max) / 2 (1/length)",
+    "gaussian": "Gaussian curvature k_min * k_max (1/length²)",
+    "shape_index": "Koenderink's shape index in [-1, 1]: -1 cup, 0 saddle, +1 cap (no unit)",
+    "curvedness": "Koenderink's curvedness sqrt((k_min² + k_max²) / 2) (1/length)",
+    "dir_min": "unit direction of k_min (3-vector)",
+    "dir_max": "unit direction of k_max (3-vector)",
+    "normals": "unit vertex normal (3-vector)",
+    "valid": "1 where the estimate is defined, 0 where it is not",
+}
+
+
+def shape_index(k_min, k_max) -> np.ndarray:
+    """Koenderink and van Doorn's shape index, from the principal curvatures.
+
+    Parameters
+    ----------
+    k_min, k_max : array_like of shape (V,)
+        Principal curvatures, ``k_min <= k_max``.
+
+    Returns
+    -------
+    ndarray of shape (V,)
+        ``S = (2 / pi) * arctan((k_max + k_min) / (k_max - k_min))`` in [-1, 1]:
+        +1 on a spherical cap (bending away from the normal, as an outward
+        sphere), +0.5 on a ridge (cylinder), 0 on a symmetric saddle, -1 on a
+        cup. Undefined (NaN) on flat points, where both curvatures are 0.
+
+    References
+    ----------
+    J. J. Koenderink and A. J. van Doorn (1992). Surface shape and curvature
+    scales. Image and Vision Computing 10(8), 557-564.
+    https://doi.org/10.1016/0262-8856(92)90076-F
+
+    Examples
+    --------
+    >>> from meshcurv.io.fields import shape_index
+    >>> shape_index([1.0, 0.0, -1.0], [1.0, 1.0, 1.0]).tolist()
+    [1.0, 0.5, 0.0]
+    """
+    k_min = np.asarray(k_min, dtype=np.float64)
+    k_max = np.asarray(k_max, dtype=np.float64)
+    index = (2 / np.pi) * np.arctan2(k_max + k_min, k_max - k_min)
+    return np.where((k_min == 0) & (k_max == 0), np.nan, index)
+
+
+def curvedness(k_min, k_max) -> np.ndarray:
+    """Koenderink and van Doorn's curvedness ``sqrt((k_min² + k_max²) / 2)``, in 1/length.
+
+    Examples
+    --------
+    >>> from meshcurv.io.fields import curvedness
+    >>> curvedness([0.5], [0.5]).tolist()      # a sphere of radius 2
+    [0.5]
+    """
+    k_min = np.asarray(k_min, dtype=np.float64)
+    k_max = np.asarray(k_max, dtype=np.float64)
+    return np.sqrt((k_min**2 + k_max**2) / 2)
+
+
+def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> dict[str, np.ndarray]:
+    """The per-vertex arrays of a curvature result, ready for :func:`meshcurv.write_mesh`.
+
+    Parameters
+    ----------
+    result : CurvatureResult
+    fields : sequence of str, optional
+        Which of :data:`FIELDS` to include, in that order; all by default.
+    quality : str or None, default: 'mean'
+        A scalar field copied as ``quality``, the vertex property MeshLab
+        colours by; None leaves it out.
+
+    Returns
+    -------
+    dict of str to ndarray
+        (V,) float64 scalars, (V, 3) float64 vectors and ``valid`` as (V,) uint8.
+
+    Raises
+    ------
+    InvalidOptionError
+        An unknown field name, or a ``quality`` that is not a scalar field.
+
+    Examples
+    --------
+    >>> import meshcurv
+    >>> from meshcurv.io.fields import curvature_fields
+    >>> sphere = meshcurv.shapes.icosphere(subdivisions=4)
+    >>> r = meshcurv.principal_curvatures(sphere.vertices, sphere.faces)
+    >>> sorted(curvature_fields(r, fields=["mean", "normals"]))
+    ['mean', 'normals', 'quality']
+    """
+    names = list(FIELDS) if fields is None else list(fields)
+    unknown = [name for name in names if name not in FIELDS]
+    if unknown:
+        raise InvalidOptionError(
+            f"unknown field {unknown[0]!r}; choose from {', '.join(FIELDS)}"
+        )
+    if quality is not None and (quality not in FIELDS or quality in _NOT_FOR_QUALITY):
+        scalars = [name for name in FIELDS if name not in _NOT_FOR_QUALITY]
+        raise InvalidOptionError(f"`quality` must be a scalar field ({', '.join(scalars)}); got {quality!r}")
+    wanted = names + ([quality] if quality is not None and quality not in names else [])
+    values = {name: _field(result, name) for name in wanted}
+    out = {name: values[name] for name in names}
+    if quality is not None:
+        out["quality"] = values[quality]
+    return out
+
+
+_NOT_FOR_QUALITY = ("dir_min", "dir_max", "normals", "valid")
+
+
+def _field(result, name: str) -> np.ndarray:
+    if name == "valid":
+        return result.valid.astype(np.uint8)
+    if name in ("shape_index", "curvedness") and not hasattr(result, name):
+        return (shape_index if name == "shape_index" else curvedness)(result.k_min, result.k_max)
+    return np.array(getattr(result, name), dtype=np.float64)
