@@ -13,7 +13,7 @@ import math
 import numba as nb
 import numpy as np
 
-_JIT = dict(cache=True, nogil=True, fastmath=False)
+_JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 
 # -- topology -------------------------------------------------------------------
@@ -199,7 +199,7 @@ def _tangent_frame(nx, ny, nz):
     return tx, ty, tz, ny * tz - nz * ty, nz * tx - nx * tz, nx * ty - ny * tx
 
 
-@nb.njit(**_JIT)
+@nb.njit(parallel=True, **_JIT)
 def tangent_principal(tensors, normals, valid, rotate, mean_from_trace):
     """Per-vertex closed-form version of ``_tensors.principal_from_shape_operator``.
 
@@ -208,7 +208,7 @@ def tangent_principal(tensors, normals, valid, rotate, mean_from_trace):
     """
     n = tensors.shape[0]
     out = np.full((n, 8), np.nan)
-    for i in range(n):
+    for i in nb.prange(n):
         if not valid[i]:
             continue
         xx, yy, zz, xy, xz, yz = (tensors[i, 0], tensors[i, 1], tensors[i, 2],
@@ -240,45 +240,76 @@ def tangent_principal(tensors, normals, valid, rotate, mean_from_trace):
 
 
 # -- symmetric 3x3 eigen-decomposition -----------------------------------------
+@nb.njit(inline="always", **_JIT)
+def _rotation(app, aqq, apq, sweep):
+    """Jacobi rotation zeroing ``apq`` (Numerical Recipes, ``jacobi``).
+
+    Returns ``(t, s, tau, apply)``; ``apply`` is False when ``apq`` is too small
+    to change the diagonal (it is then simply set to zero by the caller).
+    """
+    g = 100.0 * abs(apq)
+    if apq == 0.0 or (sweep > 2 and abs(app) + g == abs(app) and abs(aqq) + g == abs(aqq)):
+        return 0.0, 0.0, 0.0, False
+    h = aqq - app
+    if abs(h) + g == abs(h):
+        t = apq / h
+    else:
+        theta = 0.5 * h / apq
+        t = 1.0 / (abs(theta) + math.sqrt(1.0 + theta * theta))
+        if theta < 0.0:
+            t = -t
+    c = 1.0 / math.sqrt(t * t + 1.0)
+    s = t * c
+    return t, s, s / (1.0 + c), True
+
+
 @nb.njit(**_JIT)
-def _jacobi3(a, v):
-    """Cyclic Jacobi on a symmetric 3x3 ``a`` (overwritten); eigenvectors into ``v``."""
-    for i in range(3):
-        for j in range(3):
-            v[i, j] = 1.0 if i == j else 0.0
-    for _ in range(50):
-        off = a[0, 1] * a[0, 1] + a[0, 2] * a[0, 2] + a[1, 2] * a[1, 2]
-        diag = a[0, 0] * a[0, 0] + a[1, 1] * a[1, 1] + a[2, 2] * a[2, 2]
-        if off <= 1e-36 * diag or off == 0.0:
+def _jacobi3(a00, a11, a22, a01, a02, a12):
+    """Eigen-decomposition of a symmetric 3x3 by cyclic Jacobi rotations, on scalars.
+
+    Returns the three eigenvalues and the nine entries of the eigenvector
+    matrix (row-major, column k goes with eigenvalue k).
+    """
+    v00, v01, v02 = 1.0, 0.0, 0.0
+    v10, v11, v12 = 0.0, 1.0, 0.0
+    v20, v21, v22 = 0.0, 0.0, 1.0
+    for sweep in range(50):
+        if a01 == 0.0 and a02 == 0.0 and a12 == 0.0:
             break
-        for p, q in ((0, 1), (0, 2), (1, 2)):
-            apq = a[p, q]
-            if apq == 0.0:
-                continue
-            theta = (a[q, q] - a[p, p]) / (2.0 * apq)
-            t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
-            if theta < 0.0:
-                t = -t
-            c = 1.0 / math.sqrt(t * t + 1.0)
-            s = t * c
-            for k in range(3):  # columns p, q of a
-                akp = a[k, p]
-                akq = a[k, q]
-                a[k, p] = c * akp - s * akq
-                a[k, q] = s * akp + c * akq
-            for k in range(3):  # rows p, q of a
-                apk = a[p, k]
-                aqk = a[q, k]
-                a[p, k] = c * apk - s * aqk
-                a[q, k] = s * apk + c * aqk
-            for k in range(3):
-                vkp = v[k, p]
-                vkq = v[k, q]
-                v[k, p] = c * vkp - s * vkq
-                v[k, q] = s * vkp + c * vkq
+        # (p, q, r) = (0, 1, 2)
+        t, s, tau, apply = _rotation(a00, a11, a01, sweep)
+        if apply:
+            a00 -= t * a01
+            a11 += t * a01
+            a02, a12 = a02 - s * (a12 + tau * a02), a12 + s * (a02 - tau * a12)
+            v00, v01 = v00 - s * (v01 + tau * v00), v01 + s * (v00 - tau * v01)
+            v10, v11 = v10 - s * (v11 + tau * v10), v11 + s * (v10 - tau * v11)
+            v20, v21 = v20 - s * (v21 + tau * v20), v21 + s * (v20 - tau * v21)
+        a01 = 0.0
+        # (p, q, r) = (0, 2, 1)
+        t, s, tau, apply = _rotation(a00, a22, a02, sweep)
+        if apply:
+            a00 -= t * a02
+            a22 += t * a02
+            a01, a12 = a01 - s * (a12 + tau * a01), a12 + s * (a01 - tau * a12)
+            v00, v02 = v00 - s * (v02 + tau * v00), v02 + s * (v00 - tau * v02)
+            v10, v12 = v10 - s * (v12 + tau * v10), v12 + s * (v10 - tau * v12)
+            v20, v22 = v20 - s * (v22 + tau * v20), v22 + s * (v20 - tau * v22)
+        a02 = 0.0
+        # (p, q, r) = (1, 2, 0)
+        t, s, tau, apply = _rotation(a11, a22, a12, sweep)
+        if apply:
+            a11 -= t * a12
+            a22 += t * a12
+            a01, a02 = a01 - s * (a02 + tau * a01), a02 + s * (a01 - tau * a02)
+            v01, v02 = v01 - s * (v02 + tau * v01), v02 + s * (v01 - tau * v02)
+            v11, v12 = v11 - s * (v12 + tau * v11), v12 + s * (v11 - tau * v12)
+            v21, v22 = v21 - s * (v22 + tau * v21), v22 + s * (v21 - tau * v22)
+        a12 = 0.0
+    return a00, a11, a22, v00, v01, v02, v10, v11, v12, v20, v21, v22
 
 
-@nb.njit(**_JIT)
+@nb.njit(parallel=True, **_JIT)
 def eigen_by_magnitude(tensors):
     """Eigenpairs of (N, 6) symmetric tensors ordered by |eigenvalue| (see _eigen.py).
 
@@ -288,39 +319,114 @@ def eigen_by_magnitude(tensors):
     n = tensors.shape[0]
     values = np.full((n, 3), np.nan)
     vectors = np.full((n, 3, 3), np.nan)
-    a = np.empty((3, 3))
-    v = np.empty((3, 3))
-    w = np.empty(3)
-    order = np.empty(3, np.int64)
-    for i in range(n):
+    for i in nb.prange(n):
         finite = True
         for k in range(6):
             if not math.isfinite(tensors[i, k]):
                 finite = False
         if not finite:
             continue
-        a[0, 0], a[1, 1], a[2, 2] = tensors[i, 0], tensors[i, 1], tensors[i, 2]
-        a[0, 1] = a[1, 0] = tensors[i, 3]
-        a[0, 2] = a[2, 0] = tensors[i, 4]
-        a[1, 2] = a[2, 1] = tensors[i, 5]
-        _jacobi3(a, v)
-        for k in range(3):
-            w[k] = a[k, k]
-            order[k] = k
-        # ascending order, stable
-        for x in range(1, 3):
-            y = x
-            while y > 0 and w[order[y - 1]] > w[order[y]]:
-                order[y - 1], order[y] = order[y], order[y - 1]
-                y -= 1
-        # then by magnitude, stable
-        for x in range(1, 3):
-            y = x
-            while y > 0 and abs(w[order[y - 1]]) > abs(w[order[y]]):
-                order[y - 1], order[y] = order[y], order[y - 1]
-                y -= 1
-        for k in range(3):
-            values[i, k] = w[order[k]]
-            for r in range(3):
-                vectors[i, r, k] = v[r, order[k]]
+        w0, w1, w2, v00, v01, v02, v10, v11, v12, v20, v21, v22 = _jacobi3(
+            tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4], tensors[i, 5]
+        )
+        # order: ascending value (stable), then ascending magnitude (stable)
+        o0, o1, o2 = 0, 1, 2
+        w = (w0, w1, w2)
+        if w[o0] > w[o1]:
+            o0, o1 = o1, o0
+        if w[o1] > w[o2]:
+            o1, o2 = o2, o1
+            if w[o0] > w[o1]:
+                o0, o1 = o1, o0
+        if abs(w[o0]) > abs(w[o1]):
+            o0, o1 = o1, o0
+        if abs(w[o1]) > abs(w[o2]):
+            o1, o2 = o2, o1
+            if abs(w[o0]) > abs(w[o1]):
+                o0, o1 = o1, o0
+        columns = ((v00, v10, v20), (v01, v11, v21), (v02, v12, v22))
+        for k, o in enumerate((o0, o1, o2)):
+            values[i, k] = w[o]
+            column = columns[o]
+            vectors[i, 0, k] = column[0]
+            vectors[i, 1, k] = column[1]
+            vectors[i, 2, k] = column[2]
     return values, vectors
+
+# -- matGeom's edge tensors -----------------------------------------------------
+@nb.njit(**_JIT)
+def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2):
+    """Steps 2 to 5 of matGeom's meshCurvatures (see estimators/matgeom.py).
+
+    Same operations in the same order as Octave (sums of three products left
+    to right), so that ``arccos`` of nearly parallel normals gets the same input.
+    Face ids beyond the face count give NaN (matGeom stops with an index error).
+    """
+    n_vertices = vertices.shape[0]
+    n_faces = faces.shape[0]
+    n_edges = ev1.shape[0]
+    normals = np.empty((n_faces, 3))
+    for f in range(n_faces):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        ux = vertices[b, 0] - vertices[a, 0]
+        uy = vertices[b, 1] - vertices[a, 1]
+        uz = vertices[b, 2] - vertices[a, 2]
+        vx = vertices[c, 0] - vertices[a, 0]
+        vy = vertices[c, 1] - vertices[a, 1]
+        vz = vertices[c, 2] - vertices[a, 2]
+        nx = uy * vz - uz * vy
+        ny = uz * vx - ux * vz
+        nz = ux * vy - uy * vx
+        norm = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        normals[f, 0] = nx / norm if norm > 0 else np.nan
+        normals[f, 1] = ny / norm if norm > 0 else np.nan
+        normals[f, 2] = nz / norm if norm > 0 else np.nan
+    lengths = np.empty(n_edges)
+    total = 0.0
+    for e in range(n_edges):
+        p, q = ev1[e], ev2[e]
+        x = vertices[q, 0] - vertices[p, 0]
+        y = vertices[q, 1] - vertices[p, 1]
+        z = vertices[q, 2] - vertices[p, 2]
+        lengths[e] = math.sqrt((x * x + y * y) + z * z)
+        total += lengths[e]
+    mean = total / n_edges
+    sums = np.zeros((n_vertices, 6))
+    counts = np.zeros(n_vertices)
+    for e in range(n_edges):
+        p, q = ev1[e], ev2[e]
+        counts[p] += 1.0
+        counts[q] += 1.0
+        d = lengths[e]
+        ex = (vertices[q, 0] - vertices[p, 0]) / d
+        ey = (vertices[q, 1] - vertices[p, 1]) / d
+        ez = (vertices[q, 2] - vertices[p, 2]) / d
+        f1, f2 = ef1[e], ef2[e]
+        if f1 >= n_faces or f2 >= n_faces:
+            weight = np.nan
+        else:
+            ax, ay, az = normals[f1, 0], normals[f1, 1], normals[f1, 2]
+            bx, by, bz = normals[f2, 0], normals[f2, 1], normals[f2, 2]
+            dot = (ax * bx + ay * by) + az * bz
+            beta = math.acos(min(max(dot, -1.0), 1.0)) if math.isfinite(dot) else np.nan
+            side = ((ay * bz - by * az) * ex + (az * bx - bz * ax) * ey) + (ax * by - bx * ay) * ez
+            if side > 0:
+                weight = (d / mean) * beta
+            elif side < 0:
+                weight = (d / mean) * -beta
+            elif side == 0:
+                weight = 0.0 * beta
+            else:
+                weight = np.nan
+        for v in (p, q):
+            sums[v, 0] += (ex * ex) * weight
+            sums[v, 1] += (ey * ey) * weight
+            sums[v, 2] += (ez * ez) * weight
+            sums[v, 3] += (ex * ey) * weight
+            sums[v, 4] += (ex * ez) * weight
+            sums[v, 5] += (ey * ez) * weight
+    for i in range(n_vertices):
+        if counts[i] > 0:
+            for k in range(6):
+                sums[i, k] /= counts[i]
+    return sums

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..result import CurvatureResult
 from ..smoothing import smooth_vertex_field
+from .._backend import numba_kernels
 from ..topology import MeshTopology
 from .._tensors import outer6
 from ._common import Stages
@@ -87,6 +88,34 @@ def _matgeom_face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray
         return cross / _row_norms(cross)[:, None]
 
 
+def _vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, out_of_range):
+    """NumPy path of matGeom's steps 2 to 5: edge tensors pooled on vertices."""
+    n_vertices = vertices.shape[0]
+    # Operations in matGeom's order: arccos is ill-conditioned near 1, so the
+    # dot products of nearly parallel normals must match bit for bit.
+    edge_vectors = vertices[ev2] - vertices[ev1]
+    lengths = _row_norms(edge_vectors)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        edge_vectors = edge_vectors / lengths[:, None]
+        lengths = lengths / lengths.mean()
+    normals = _matgeom_face_normals(vertices, faces)
+    n1 = normals[ef1]
+    n2 = normals[ef2]
+    with np.errstate(invalid="ignore"):
+        beta = np.arccos(np.clip(_row_dots(n1, n2), -1.0, 1.0))
+        beta *= np.sign(_row_dots(np.cross(n1, n2), edge_vectors))
+    weight = lengths * beta
+    weight[out_of_range] = np.nan  # where matGeom stops with an index error
+    edge_tensors = outer6(edge_vectors, weight)
+    ends = np.concatenate([ev1, ev2])
+    counts = np.bincount(ends, minlength=n_vertices).astype(np.float64)
+    counts[counts < np.finfo(float).eps] = 1.0
+    return np.stack(
+        [np.bincount(ends, weights=np.tile(edge_tensors[:, k], 2), minlength=n_vertices) for k in range(6)],
+        axis=1,
+    ) / counts[:, None]
+
+
 def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_steps: int,
                     stages: Stages | None = None):
     """matGeom's smoothed vertex tensors (steps 1 to 6).
@@ -106,43 +135,34 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
     n_faces = faces.shape[0]
 
     stages.start("compute adjacencies")
-    ev1, ev2, ef1, ef2 = matgeom_pairing(faces, n_vertices)
-    out_of_range = (ef1 >= n_faces) | (ef2 >= n_faces)
-    ef1_safe = np.where(out_of_range, 0, ef1)
-    ef2_safe = np.where(out_of_range, 0, ef2)
-    # a face "contains" the edge when both ends are among its corners
-    f1 = faces[ef1_safe]
-    wrong_face = ~out_of_range & ~(((f1 == ev1[:, None]).any(1)) & ((f1 == ev2[:, None]).any(1)))
+    if topology.interior_edges.all() and not topology.degenerate_faces.any():
+        # closed, consistently oriented, manifold: the pairing is each edge
+        # p < q with the face running p -> q and the one running q -> p
+        ev1, ev2 = topology.edges[:, 0], topology.edges[:, 1]
+        ef1, ef2 = topology.edge_faces[:, 0], topology.edge_faces[:, 1]
+        out_of_range = np.zeros(ev1.size, dtype=bool)
+        n_wrong_face = 0
+    else:
+        ev1, ev2, ef1, ef2 = matgeom_pairing(faces, n_vertices)
+        out_of_range = (ef1 >= n_faces) | (ef2 >= n_faces)
+        # a face "contains" the edge when both ends are among its corners
+        f1 = faces[np.where(out_of_range, 0, ef1)]
+        contains = (f1 == ev1[:, None]).any(1) & (f1 == ev2[:, None]).any(1)
+        n_wrong_face = int((~out_of_range & ~contains).sum())
 
     stages.start("compute edge tensors")
-    # Operations in matGeom's order: arccos is ill-conditioned near 1, so the
-    # dot products of nearly parallel normals must match bit for bit.
-    edge_vectors = vertices[ev2] - vertices[ev1]
-    lengths = _row_norms(edge_vectors)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        edge_vectors = edge_vectors / lengths[:, None]
-        lengths = lengths / lengths.mean()
-    normals = _matgeom_face_normals(vertices, faces)
-    n1 = normals[ef1_safe]
-    n2 = normals[ef2_safe]
-    with np.errstate(invalid="ignore"):
-        beta = np.arccos(np.clip(_row_dots(n1, n2), -1.0, 1.0))
-        beta *= np.sign(_row_dots(np.cross(n1, n2), edge_vectors))
-    weight = lengths * beta
-    weight[out_of_range] = np.nan  # where matGeom stops with an index error
-    edge_tensors = outer6(edge_vectors, weight)
-
-    ends = np.concatenate([ev1, ev2])
-    counts = np.bincount(ends, minlength=n_vertices).astype(np.float64)
-    counts[counts < np.finfo(float).eps] = 1.0
-    tensors = np.stack(
-        [np.bincount(ends, weights=np.tile(edge_tensors[:, k], 2), minlength=n_vertices) for k in range(6)],
-        axis=1,
-    ) / counts[:, None]
+    kernels = numba_kernels()
+    if kernels is not None:
+        tensors = kernels.matgeom_vertex_tensors(vertices, faces, np.ascontiguousarray(ev1),
+                                                 np.ascontiguousarray(ev2), np.ascontiguousarray(ef1),
+                                                 np.ascontiguousarray(ef2))
+    else:
+        tensors = _vertex_tensors(vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1),
+                                  np.where(out_of_range, 0, ef2), out_of_range)
 
     stages.start("average vertex tensors")
     tensors = smooth_vertex_field(tensors, topology, smoothing_steps)
-    return tensors, ev1.size, int(wrong_face.sum()), int(out_of_range.sum())
+    return tensors, ev1.size, n_wrong_face, int(out_of_range.sum())
 
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
