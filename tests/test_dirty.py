@@ -1,12 +1,13 @@
 """Dirty meshes through every method: a defined answer, the doubtful vertices marked, one warning.
 
-The corpus (tests/dirty_meshes.py) puts one defect at one place of a clean
+The corpus (tests/test_dirty_corpus.py) puts one defect at one place of a clean
 torus. Expectations come from the construction: the vertices the defect
 touches are ``valid=False`` (NaN), every valid vertex is finite, vertices far
 from the defect keep the values of the clean torus, and the call gives exactly
 one MeshQualityWarning whose text names the defect.
 """
 
+import functools
 import warnings
 
 import numpy as np
@@ -19,7 +20,7 @@ from meshcurv.errors import MeshQualityWarning, TriangulationWarning
 from meshcurv.estimators import ESTIMATORS
 from meshcurv.topology import MeshTopology
 
-from dirty_meshes import EDGE, TORUS, cases
+from test_dirty_corpus import EDGE, TORUS, cases
 
 METHODS = sorted(ESTIMATORS)
 CASES = {case.name: case for case in cases()}
@@ -54,6 +55,7 @@ def clean():
             for m in METHODS}
 
 
+@functools.cache
 def keeps_boundary(method):
     """Methods built on balls or fits keep boundary vertices valid (their documented choice)."""
     saddle = shapes.saddle(spacing=0.125)

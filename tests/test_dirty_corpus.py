@@ -3,7 +3,7 @@
 Every case knows, by construction, which vertices the defect touches
 (``core``: vertices whose neighbourhood is not a clean disc) and what the
 clean mesh was, so tests can check the valid mask and that vertices far
-from the defect keep their clean values. Shared by tests/test_dirty*.py.
+from the defect keep their clean values. Shared by tests/test_dirty*.py (this module holds no tests).
 """
 
 from __future__ import annotations
