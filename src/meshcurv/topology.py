@@ -21,8 +21,6 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ._backend import numba_kernels
 
@@ -198,13 +196,15 @@ class MeshTopology:
 
     # -- adjacency --------------------------------------------------------------
     @cached_property
-    def adjacency(self) -> sp.csr_matrix:
+    def adjacency(self) -> "scipy.sparse.csr_matrix":
         """(V, V) sparse symmetric 0/1 matrix: ``i ~ j`` when they share an edge."""
         n = self.n_vertices
         rows = np.concatenate([self.edges[:, 0], self.edges[:, 1]])
         cols = np.concatenate([self.edges[:, 1], self.edges[:, 0]])
         data = np.ones(rows.size, dtype=np.float64)
         # edges are unique, so no duplicate entries: convert without summing
+        import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
+
         return sp.coo_matrix((data, (rows, cols)), shape=(n, n)).tocsr()
 
     @cached_property
@@ -218,14 +218,12 @@ class MeshTopology:
 
         Returns ``(n_components, labels)`` with ``labels`` of shape (F,).
         """
-        n_faces = self.n_faces
-        rows = np.repeat(np.arange(n_faces), 3)
-        incidence = sp.csr_matrix(
-            (np.ones(rows.size), (rows, self.faces.ravel())), shape=(n_faces, self.n_vertices)
-        )
-        graph = incidence @ incidence.T
-        count, labels = connected_components(graph, directed=False)
-        return count, _readonly(labels)
+        from scipy.sparse.csgraph import connected_components
+
+        # faces sharing a vertex are joined by edges: label the vertex graph
+        _, vertex_labels = connected_components(self.adjacency, directed=False)
+        used, labels = np.unique(vertex_labels[self.faces[:, 0]], return_inverse=True)
+        return int(used.size), _readonly(labels.astype(np.int64))
 
     @property
     def n_components(self) -> int:
@@ -244,6 +242,9 @@ class MeshTopology:
         if boundary.size == 0:
             return 0
         n = self.n_vertices
+        import scipy.sparse as sp
+        from scipy.sparse.csgraph import connected_components
+
         graph = sp.csr_matrix(
             (np.ones(boundary.shape[0]), (boundary[:, 0], boundary[:, 1])), shape=(n, n)
         )
