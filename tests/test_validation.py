@@ -101,3 +101,32 @@ def test_inputs_are_never_modified():
 def test_shape_generator_options_are_checked():
     with pytest.raises(InvalidOptionError, match="`subdivisions` must be an integer >= 1; got 0"):
         shapes.icosphere(0)
+
+
+@pytest.mark.parametrize(
+    "vertices, faces, match",
+    [
+        (QUAD_VERTICES * 1e120, TRI, r"coordinates as large as 1e\+120.*rescale the mesh"),
+        (np.ones((4, 3), dtype=np.longdouble) * np.finfo(np.longdouble).max, TRI, "NaN or infinite coordinates"),
+        (QUAD_VERTICES, np.array([[0, 1, 2], [0, 2, 2.0**63]]), "indices too large for int64"),
+        (QUAD_VERTICES, [[0, 1, 2], [[0], 1, 2, 3]], "could not be converted|nested lists"),
+        (QUAD_VERTICES, [[0, 1, 2, 3], [[0, 1], 2, 3]], "could not be converted|nested lists"),
+        (QUAD_VERTICES, [[], [0, 1, 2]], "fewer than 3 vertices"),
+        (QUAD_VERTICES, "0 1 2", "got a str"),
+        (QUAD_VERTICES, ["012", "023"], "items are not sequences"),
+    ],
+)
+def test_bad_input_found_by_fuzzing(vertices, faces, match):
+    with pytest.raises(InvalidMeshError, match=match):
+        call(vertices=vertices, faces=faces)
+
+
+def test_every_entry_point_checks_its_input():
+    from meshcurv.orient import orient_faces
+
+    with pytest.raises(InvalidMeshError, match="look 1-based"):
+        meshcurv.MeshTopology.from_faces(TRI + 1, n_vertices=4)
+    with pytest.raises(InvalidMeshError, match=r"`vertices` must have shape \(V, 3\)"):
+        orient_faces(np.zeros((4, 2)), TRI)
+    with pytest.raises(InvalidMeshError, match="negative vertex indices"):
+        orient_faces(QUAD_VERTICES, -TRI)

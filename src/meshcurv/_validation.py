@@ -46,7 +46,8 @@ def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
         raise InvalidMeshError(f"`{name}` must have shape (V, 3); got {_shape_text(array)}")
     if array.shape[0] == 0:
         raise InvalidMeshError(f"`{name}` is empty: the mesh has no vertices")
-    out = np.array(array, dtype=np.float64, order="C", copy=True)
+    with np.errstate(over="ignore"):  # float128 beyond float64: caught as infinite below
+        out = np.array(array, dtype=np.float64, order="C", copy=True)
     finite = np.isfinite(out).all(axis=1)
     if not finite.all():
         bad = np.flatnonzero(~finite)
@@ -54,7 +55,17 @@ def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
             f"`{name}` has NaN or infinite coordinates at {bad.size} vertices "
             f"(first at index {bad[0]})"
         )
+    largest = float(np.abs(out).max())
+    if largest > MAX_COORDINATE:
+        raise InvalidMeshError(
+            f"`{name}` has coordinates as large as {largest:.3g}; products of lengths would overflow "
+            f"float64 beyond {MAX_COORDINATE:.0e}: rescale the mesh"
+        )
     return out
+
+
+#: Largest coordinate accepted: areas and squared lengths stay far from float64 overflow.
+MAX_COORDINATE = 1e100
 
 
 def _integer_faces(array: np.ndarray, name: str) -> np.ndarray:
@@ -70,37 +81,52 @@ def _integer_faces(array: np.ndarray, name: str) -> np.ndarray:
             raise InvalidMeshError(
                 f"`{name}` has non-integer values; vertex indices must be whole numbers"
             )
+        if array.size and np.abs(array).max() >= 2.0**62:
+            raise InvalidMeshError(f"`{name}` has indices too large for int64")
     if np.issubdtype(array.dtype, np.unsignedinteger) and array.size and array.max() > np.iinfo(np.int64).max:
         raise InvalidMeshError(f"`{name}` has indices too large for int64")
     return array.astype(np.int64, copy=True)
 
 
+def _as_array(value, name: str) -> np.ndarray:
+    """``np.asarray`` with numpy's conversion errors (ragged, mixed types) as InvalidMeshError."""
+    try:
+        return np.asarray(value)
+    except (ValueError, TypeError, OverflowError) as exc:
+        raise InvalidMeshError(
+            f"`{name}` must be an array of shape (F, 3) or (F, k), or a list of index lists; "
+            f"it could not be converted to an array ({exc})"
+        ) from None
+
+
 def as_polygons(faces, *, name: str = "faces") -> list[np.ndarray] | np.ndarray:
     """Return ``faces`` as an int64 (F, k) array, or a list of int64 index arrays when ragged."""
+    if isinstance(faces, (str, bytes)):
+        raise InvalidMeshError(f"`{name}` must be an array of vertex indices; got a {type(faces).__name__}")
     if isinstance(faces, np.ndarray) or not isinstance(faces, Sequence):
-        try:
-            array = np.asarray(faces)
-        except (ValueError, TypeError) as exc:
-            raise InvalidMeshError(
-                f"`{name}` must be an array of shape (F, 3) or (F, k), or a list of index lists ({exc})"
-            ) from None
+        array = _as_array(faces, name)
     else:
         lengths = set()
         for face in faces:
-            lengths.add(len(face) if isinstance(face, (Sequence, np.ndarray)) else -1)
+            is_sequence = isinstance(face, (Sequence, np.ndarray)) and not isinstance(face, (str, bytes))
+            lengths.add(len(face) if is_sequence else -1)
         if -1 in lengths:
             raise InvalidMeshError(
                 f"`{name}` must be an array of shape (F, 3) or (F, k), or a list of index lists; "
                 "got a list whose items are not sequences"
             )
         if len(lengths) > 1:
-            polygons = [_integer_faces(np.asarray(face), name) for face in faces]
-            if min(p.size for p in polygons) < 3:
+            if min(lengths) < 3:
                 raise InvalidMeshError(
                     f"`{name}` has a face with fewer than 3 vertices; every face needs at least 3"
                 )
-            return polygons
-        array = np.asarray(faces)
+            polygons = [_as_array(face, name) for face in faces]
+            if any(p.ndim != 1 for p in polygons):
+                raise InvalidMeshError(
+                    f"`{name}` must be a list of flat index lists; a face holds nested lists"
+                )
+            return [_integer_faces(p, name) for p in polygons]
+        array = _as_array(faces, name)
     if array.ndim != 2:
         raise InvalidMeshError(
             f"`{name}` must have shape (F, 3) or (F, k) with k >= 3; got {_shape_text(array)}"
