@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
-from ._validation import as_faces, as_vertices, check_choice, check_int_option
+from ._validation import as_faces, as_vertices, check_choice, check_int_option, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .estimators import ESTIMATORS
 from .estimators._common import ProgressCallback, Stages
+from .diagnosis import diagnose, quality_message
+from .orient import oriented_topology
 from .result import CurvatureResult
 from .topology import MeshTopology
 
@@ -23,6 +26,8 @@ def principal_curvatures(
     *,
     method: str = "normal_cycle",
     smoothing_steps: int | None = None,
+    radius: float | None = None,
+    orient: str = "keep",
     progress: ProgressCallback | None = None,
 ) -> CurvatureResult:
     """Principal curvatures, their directions, and the normal at every vertex.
@@ -36,13 +41,40 @@ def principal_curvatures(
         fan-triangulated as matGeom's ``triangulateFaces`` does, with a
         :class:`~meshcurv.errors.TriangulationWarning`. A :class:`MeshTopology`
         built once with :meth:`MeshTopology.from_faces` skips the topology step.
-    method : {'normal_cycle', 'matgeom'}, default: 'normal_cycle'
+    method : {'normal_cycle', 'matgeom', 'icc', 'quadric', 'rusinkiewicz', 'normal_cycle_ball', 'meyer'}, default: 'normal_cycle'
         - ``'normal_cycle'``: the normal-cycle tensor of Cohen-Steiner and Morvan
           over barycentric cells, in 1/length, correct on open meshes.
         - ``'matgeom'``: matGeom's ``meshCurvatures`` reproduced number for
           number (dimensionless values; see the README).
+        - ``'icc'``: interpolated corrected curvature measures over a ball
+          (Lachaud et al. 2020); takes ``radius``; boundary vertices are kept.
+        - ``'quadric'``: least-squares quadric (jet) fit over a ball (Cazals and
+          Pouget 2005; Panozzo et al. 2010); takes ``radius``.
+        - ``'rusinkiewicz'``: per-face tensors from normal differences averaged
+          with Voronoi weights (Rusinkiewicz 2004).
+        - ``'normal_cycle_ball'``: the normal-cycle tensor over a ball; takes
+          ``radius``.
+        - ``'meyer'``: cotangent mean and angle-defect Gaussian curvature (Meyer
+          et al. 2003); no directions (``dir_min``, ``dir_max`` NaN), boundary
+          vertices invalid.
     smoothing_steps : int, default: 3
-        Passes of the 1-ring mean over the tensor field (0 = none).
+        Passes of the 1-ring mean over the tensor field (0 = none); only
+        ``'normal_cycle'`` and ``'matgeom'``.
+    radius : float, optional
+        Radius of the Euclidean ball around each vertex over which ``'icc'``,
+        ``'quadric'`` and ``'normal_cycle_ball'`` gather the mesh, in the units of
+        ``vertices`` (the same meaning for all three). Default: 2.5 times the
+        mean edge length (:func:`meshcurv.neighborhoods.default_radius`). Pass
+        the same value for meshes of one object at different resolutions to
+        get the same estimate. Refused by the other methods.
+    orient : {'keep', 'consistent', 'outward'}, default: 'keep'
+        Face orientation before the computation (:func:`meshcurv.orient.orient_faces`):
+        ``'keep'`` uses the faces as given (vertices on inconsistently oriented
+        edges are then ``valid=False``); ``'consistent'`` reverses the fewest faces
+        that make each patch (faces joined by manifold edges) consistently
+        oriented; ``'outward'`` does the same and turns every closed patch
+        outward (positive volume). The number of faces reversed is
+        ``result.diagnosis.n_flipped_faces`` and is given in the warning.
     progress : callable, optional
         Called as ``progress(stage, index, total)`` when each stage starts (matGeom's
         ShowProgress, per stage). Stage messages also go to the ``meshcurv``
@@ -89,7 +121,7 @@ def principal_curvatures(
     estimator = ESTIMATORS.get(method) if isinstance(method, str) else None
     if estimator is None:
         check_choice(method, "method", METHODS)
-    given = {"smoothing_steps": smoothing_steps}
+    given = {"smoothing_steps": smoothing_steps, "radius": radius}
     options = dict(estimator.options)
     for name, value in given.items():
         if value is None:
@@ -99,14 +131,19 @@ def principal_curvatures(
         options[name] = value
     if "smoothing_steps" in options:
         options["smoothing_steps"] = check_int_option(options["smoothing_steps"], "smoothing_steps")
+    if options.get("radius") is not None:
+        options["radius"] = check_positive_float(options["radius"], "radius")
 
     points = as_vertices(vertices)
     topology = _as_topology(faces, points.shape[0])
+    topology, n_flipped = oriented_topology(points, topology, orient)
     result, problems = estimator.function(
         points, topology, stages=Stages(estimator.stages, progress), **options
     )
-    if problems:
-        warnings.warn(f"{method}: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
+    result = dataclasses.replace(result, diagnosis=diagnose(points, topology, n_flipped_faces=n_flipped))
+    message = quality_message(method, problems, result.diagnosis)
+    if message:
+        warnings.warn(message, MeshQualityWarning, stacklevel=2)
     return result
 
 

@@ -5,9 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .diagnosis import MeshDiagnosis
 
 __all__ = ["CurvatureResult"]
 
@@ -48,6 +51,10 @@ class CurvatureResult:
         The estimator that produced the result.
     parameters : mapping
         The options the estimator used (defaults filled in).
+    diagnosis : MeshDiagnosis or None
+        What :func:`meshcurv.diagnose` found in the mesh the curvatures were
+        computed on (after ``orient=``), with the number of faces ``orient=``
+        reversed; None when the result was built directly.
     """
 
     k_min: np.ndarray
@@ -58,6 +65,7 @@ class CurvatureResult:
     valid: np.ndarray
     method: str
     parameters: Mapping[str, Any] = field(default_factory=dict)
+    diagnosis: "MeshDiagnosis | None" = None
 
     def __post_init__(self):
         for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid"):
@@ -81,6 +89,30 @@ class CurvatureResult:
     def gaussian(self) -> np.ndarray:
         """(V,) Gaussian curvature ``k_min * k_max``."""
         return _readonly(self.k_min * self.k_max)
+
+    @cached_property
+    def shape_index(self) -> np.ndarray:
+        """(V,) shape index of Koenderink and van Doorn (1992), in [-1, 1].
+
+        ``S = (2 / pi) * arctan((k_max + k_min) / (k_max - k_min))``, computed as
+        ``arctan2`` so that umbilics give +-1. With meshcurv's signs (convex
+        outward = positive curvature): +1 a cap (sphere seen from outside),
+        +1/2 a ridge (cylinder), 0 a symmetric saddle, -1/2 a rut, -1 a cup.
+        Flipping the faces negates it. NaN where the surface is flat
+        (``curvedness == 0``) or the estimate is invalid.
+
+        J. J. Koenderink and A. J. van Doorn (1992). Surface shape and curvature
+        scales. Image and Vision Computing 10(8), 557-564.
+        https://doi.org/10.1016/0262-8856(92)90076-F
+        """
+        with np.errstate(invalid="ignore"):
+            index = (2 / np.pi) * np.arctan2(self.k_max + self.k_min, self.k_max - self.k_min)
+        return _readonly(np.where(self.curvedness > 0, index, np.nan))
+
+    @cached_property
+    def curvedness(self) -> np.ndarray:
+        """(V,) curvedness ``sqrt((k_min**2 + k_max**2) / 2)`` (Koenderink and van Doorn 1992), in 1/length."""
+        return _readonly(np.sqrt((self.k_min**2 + self.k_max**2) / 2))
 
     def as_matgeom(self) -> tuple[np.ndarray, ...]:
         """The seven outputs of matGeom's ``meshCurvatures``, in its order.

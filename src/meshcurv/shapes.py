@@ -23,8 +23,12 @@ import numpy as np
 
 from ._tensors import principal_from_shape_operator
 from ._validation import check_int_option
+from .errors import InvalidOptionError
 
-__all__ = ["AnalyticMesh", "icosphere", "uv_sphere", "torus", "ellipsoid", "cylinder", "saddle"]
+__all__ = [
+    "AnalyticMesh", "icosphere", "uv_sphere", "torus", "ellipsoid", "cylinder", "saddle",
+    "random_sphere", "random_ellipsoid", "hemisphere", "with_normal_noise",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,9 +96,27 @@ def _implicit(points: np.ndarray, gradient: np.ndarray, hessian6: np.ndarray):
     return k_min, k_max, dir_min, dir_max, normals
 
 
-def _quads_to_triangles(quads: np.ndarray) -> np.ndarray:
-    """Split quads ``a, b, c, d`` into ``(a, b, c), (a, c, d)``, as matGeom's triangulateFaces."""
-    return np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1).reshape(-1, 3)
+def _quads_to_triangles(quads: np.ndarray, rng: np.random.Generator | None = None) -> np.ndarray:
+    """Split quads ``a, b, c, d`` into ``(a, b, c), (a, c, d)``, as matGeom's triangulateFaces.
+
+    With a generator, each quad is split along a random diagonal instead
+    (``(a, b, d), (b, c, d)`` half of the time).
+    """
+    first = np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1)
+    if rng is not None:
+        other = np.stack([quads[:, [0, 1, 3]], quads[:, [1, 2, 3]]], axis=1)
+        first = np.where(rng.random(quads.shape[0])[:, None, None] < 0.5, first, other)
+    return first.reshape(-1, 3)
+
+
+def _jitter(values: np.ndarray, step: float, jitter: float, rng, fixed=None) -> np.ndarray:
+    """``values`` plus uniform noise in ``[-jitter * step, jitter * step]`` (none where ``fixed``)."""
+    if not 0 <= jitter < 0.5:
+        raise InvalidOptionError(f"`jitter` must be in [0, 0.5) (a fraction of the grid spacing); got {jitter!r}")
+    noise = rng.uniform(-jitter * step, jitter * step, size=values.shape)
+    if fixed is not None:
+        noise[fixed] = 0.0
+    return values + noise
 
 
 def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
@@ -184,7 +206,7 @@ def uv_sphere(n_longitude: int = 32, n_latitude: int = 16, radius: float = 1.0) 
 
 
 def torus(major_radius: float = 30.0, minor_radius: float = 10.0, n_major: int = 60,
-          n_minor: int = 60) -> AnalyticMesh:
+          n_minor: int = 60, *, jitter: float = 0.0, seed: int = 0) -> AnalyticMesh:
     """Torus around the z axis, laid out as matGeom's ``torusMesh``.
 
     Vertex ``i * n_minor + j`` sits at ring angle ``2 pi i / n_major`` and tube
@@ -195,11 +217,21 @@ def torus(major_radius: float = 30.0, minor_radius: float = 10.0, n_major: int =
 
     Exact curvatures: ``1 / r`` along the tube circle (``k_max``), and
     ``cos(phi) / (R + r cos(phi))`` along the ring (``k_min``).
+
+    ``jitter > 0`` gives an irregular mesh of the same surface: both angles of
+    every vertex move by a uniform random fraction (up to ``jitter``, below 0.5)
+    of the grid step, and each quad is split along a random diagonal
+    (generator seeded with ``seed``); the exact values are those of the moved
+    points.
     """
     R, r = float(major_radius), float(minor_radius)
     theta = 2 * np.pi * np.arange(n_major) / n_major
     phi = 2 * np.pi * np.arange(n_minor) / n_minor
     t, p = (a.ravel() for a in np.meshgrid(theta, phi, indexing="ij"))
+    rng = np.random.default_rng(seed) if jitter else None
+    if rng is not None:
+        t = _jitter(t, 2 * np.pi / n_major, jitter, rng)
+        p = _jitter(p, 2 * np.pi / n_minor, jitter, rng)
     normals = np.stack([np.cos(p) * np.cos(t), np.cos(p) * np.sin(t), np.sin(p)], axis=1)
     vertices = np.stack([(R + r * np.cos(p)) * np.cos(t), (R + r * np.cos(p)) * np.sin(t), r * np.sin(p)], axis=1)
     tube_direction = np.stack([-np.sin(p) * np.cos(t), -np.sin(p) * np.sin(t), np.cos(p)], axis=1)
@@ -208,7 +240,8 @@ def torus(major_radius: float = 30.0, minor_radius: float = 10.0, n_major: int =
     i_next = np.roll(idx, -1, axis=0)
     quads = np.stack([idx, i_next, np.roll(i_next, -1, axis=1), np.roll(idx, -1, axis=1)], axis=-1).reshape(-1, 4)
     k_ring = np.cos(p) / (R + r * np.cos(p))
-    return _make(f"torus(R={R:g}, r={r:g})", vertices, _quads_to_triangles(quads), k_ring, 1 / r,
+    name = f"torus(R={R:g}, r={r:g})" + (f", jitter {jitter:g}" if jitter else "")
+    return _make(name, vertices, _quads_to_triangles(quads, rng), k_ring, 1 / r,
                  ring_direction, tube_direction, normals, quads=quads)
 
 
@@ -225,14 +258,20 @@ def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh
     return _make(f"ellipsoid{tuple(a.tolist())}", vertices, faces, k_min, k_max, dir_min, dir_max, normals)
 
 
-def cylinder(radius: float = 1.0, height: float = 2.0, n_around: int = 32, n_along: int = 16) -> AnalyticMesh:
+def cylinder(radius: float = 1.0, height: float = 2.0, n_around: int = 32, n_along: int = 16, *,
+             jitter: float = 0.0, seed: int = 0) -> AnalyticMesh:
     """Open cylinder around the z axis (two boundary rings), split quads.
 
     Exact curvatures: ``k_max = 1 / radius`` around, ``k_min = 0`` along the axis.
+    ``jitter`` and ``seed``: as for :func:`torus` (the boundary rings stay flat).
     """
     phi = 2 * np.pi * np.arange(n_around) / n_around
     z = np.linspace(-height / 2, height / 2, n_along + 1)
     zz, pp = (a.ravel() for a in np.meshgrid(z, phi, indexing="ij"))
+    rng = np.random.default_rng(seed) if jitter else None
+    if rng is not None:
+        pp = _jitter(pp, 2 * np.pi / n_around, jitter, rng)
+        zz = _jitter(zz, height / n_along, jitter, rng, fixed=np.abs(zz) >= height / 2)
     normals = np.stack([np.cos(pp), np.sin(pp), np.zeros_like(pp)], axis=1)
     vertices = normals * radius + np.stack([0 * zz, 0 * zz, zz], axis=1)
     around = np.stack([-np.sin(pp), np.cos(pp), np.zeros_like(pp)], axis=1)
@@ -240,20 +279,27 @@ def cylinder(radius: float = 1.0, height: float = 2.0, n_around: int = 32, n_alo
     idx = np.arange(vertices.shape[0]).reshape(n_along + 1, n_around)
     nxt = np.roll(idx, -1, axis=1)
     quads = np.stack([idx[:-1], nxt[:-1], nxt[1:], idx[1:]], axis=-1).reshape(-1, 4)
-    return _make(f"cylinder(r={radius:g})", vertices, _quads_to_triangles(quads), 0.0, 1 / radius,
+    name = f"cylinder(r={radius:g})" + (f", jitter {jitter:g}" if jitter else "")
+    return _make(name, vertices, _quads_to_triangles(quads, rng), 0.0, 1 / radius,
                  axis, around, normals, quads=quads)
 
 
-def saddle(half_width: float = 1.0, spacing: float = 0.025) -> AnalyticMesh:
+def saddle(half_width: float = 1.0, spacing: float = 0.025, *, jitter: float = 0.0, seed: int = 0) -> AnalyticMesh:
     """Open height field ``z = x**2 - y**2`` on a square grid over ``[-w, w]^2``, normals up.
 
     At the centre the exact curvatures are ``-2`` (along x: the surface bends
     towards its upward normal) and ``+2`` (along y). Each grid square is split
-    along the same diagonal.
+    along the same diagonal. ``jitter`` and ``seed``: as for :func:`torus`
+    (boundary vertices move along the boundary only).
     """
     n = int(round(2 * half_width / spacing)) + 1
     x = np.linspace(-half_width, half_width, n)
     yy, xx = (a.ravel() for a in np.meshgrid(x, x, indexing="ij"))
+    rng = np.random.default_rng(seed) if jitter else None
+    if rng is not None:
+        step = x[1] - x[0]
+        xx = _jitter(xx, step, jitter, rng, fixed=np.abs(xx) >= half_width)
+        yy = _jitter(yy, step, jitter, rng, fixed=np.abs(yy) >= half_width)
     vertices = np.stack([xx, yy, xx**2 - yy**2], axis=1)
     gradient = np.stack([-2 * xx, 2 * yy, np.ones_like(xx)], axis=1)  # of F = z - x^2 + y^2
     hessian = np.zeros((vertices.shape[0], 6))
@@ -261,5 +307,87 @@ def saddle(half_width: float = 1.0, spacing: float = 0.025) -> AnalyticMesh:
     k_min, k_max, dir_min, dir_max, normals = _implicit(vertices, gradient, hessian)
     idx = np.arange(n * n).reshape(n, n)  # idx[row = y, column = x]
     quads = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], axis=-1).reshape(-1, 4)
-    return _make(f"saddle(spacing={spacing:g})", vertices, _quads_to_triangles(quads), k_min, k_max,
+    name = f"saddle(spacing={spacing:g})" + (f", jitter {jitter:g}" if jitter else "")
+    return _make(name, vertices, _quads_to_triangles(quads, rng), k_min, k_max,
                  dir_min, dir_max, normals, quads=quads)
+
+
+def _random_unit_sphere(n_vertices: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Uniform random points on the unit sphere and their Delaunay triangulation (convex hull), outward."""
+    from scipy.spatial import ConvexHull
+
+    n = check_int_option(n_vertices, "n_vertices", minimum=4)
+    rng = np.random.default_rng(seed)
+    points = rng.normal(size=(n, 3))
+    points /= np.linalg.norm(points, axis=1, keepdims=True)
+    faces = ConvexHull(points).simplices.astype(np.int64)
+    a, b, c = (points[faces[:, k]] for k in range(3))
+    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a + b + c) < 0
+    faces[inward] = faces[inward][:, ::-1]
+    return points, faces
+
+
+def random_sphere(n_vertices: int = 2562, radius: float = 1.0, *, seed: int = 0) -> AnalyticMesh:
+    """Sphere through ``n_vertices`` uniform random points: an irregular Delaunay mesh.
+
+    The points are drawn with ``numpy.random.default_rng(seed)`` and triangulated
+    by their convex hull (the Delaunay triangulation on the sphere), faces wound
+    outward. Valences and angles vary freely (slivers included), the test that
+    1-ring estimators fail. Exact curvature ``1 / radius``.
+    """
+    unit, faces = _random_unit_sphere(n_vertices, seed)
+    return _make(f"random_sphere({n_vertices}, seed {seed})", unit * radius, faces, 1 / radius, 1 / radius,
+                 np.nan, np.nan, unit)
+
+
+def random_ellipsoid(semi_axes=(3.0, 2.0, 1.0), n_vertices: int = 2562, *, seed: int = 0) -> AnalyticMesh:
+    """:func:`random_sphere` (unit radius) scaled by ``semi_axes``: an irregular ellipsoid mesh."""
+    a = np.asarray(semi_axes, dtype=float)
+    unit, faces = _random_unit_sphere(n_vertices, seed)
+    vertices = unit * a
+    inv2 = 1.0 / a**2
+    hessian = np.zeros((vertices.shape[0], 6))
+    hessian[:, :3] = 2 * inv2
+    k_min, k_max, dir_min, dir_max, normals = _implicit(vertices, 2 * vertices * inv2, hessian)
+    return _make(f"random_ellipsoid{tuple(a.tolist())}", vertices, faces, k_min, k_max, dir_min, dir_max, normals)
+
+
+def hemisphere(subdivisions: int = 16, radius: float = 1.0, *, irregular: bool = False, seed: int = 0) -> AnalyticMesh:
+    """Open upper half (z > 0) of :func:`icosphere` (or of :func:`random_sphere` with ``irregular=True``).
+
+    The faces whose centroid lies above the equator are kept and the vertices
+    re-indexed: one boundary loop near ``z = 0``. Exact curvature ``1 / radius``.
+    """
+    if irregular:
+        whole = random_sphere(10 * check_int_option(subdivisions, "subdivisions", minimum=1) ** 2 + 2, radius,
+                              seed=seed)
+    else:
+        whole = icosphere(subdivisions, radius)
+    keep = whole.vertices[whole.faces].mean(axis=1)[:, 2] > 0
+    used, faces = np.unique(whole.faces[keep], return_inverse=True)
+    return _make(f"hemisphere({whole.name})", whole.vertices[used], faces.reshape(-1, 3), 1 / radius, 1 / radius,
+                 np.nan, np.nan, whole.normals[used])
+
+
+def with_normal_noise(mesh: AnalyticMesh, level: float, *, seed: int = 0) -> AnalyticMesh:
+    """The mesh with every vertex moved along its exact normal by uniform noise.
+
+    Each vertex moves by ``t * n`` with ``t`` uniform in ``[-a, a]``,
+    ``a = level * mean edge length`` (``level`` 0.1 and 0.3 in the accuracy
+    benchmark), drawn with ``numpy.random.default_rng(seed)``. The exact
+    curvatures, directions and normals stay those of the unperturbed surface
+    at the original points: what an estimator should recover.
+    """
+    from .geometry import mean_edge_length
+    from .topology import MeshTopology
+
+    if not (isinstance(level, (int, float)) and np.isfinite(level) and level >= 0):
+        raise InvalidOptionError(f"`level` must be a number >= 0 (a fraction of the mean edge length); got {level!r}")
+    edges = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).edges
+    amplitude = level * mean_edge_length(mesh.vertices, edges)
+    t = np.random.default_rng(seed).uniform(-amplitude, amplitude, size=mesh.vertices.shape[0])
+    return AnalyticMesh(
+        name=f"{mesh.name} + noise {level:g}h", vertices=mesh.vertices + t[:, None] * mesh.normals,
+        faces=mesh.faces, k_min=mesh.k_min, k_max=mesh.k_max, dir_min=mesh.dir_min, dir_max=mesh.dir_max,
+        normals=mesh.normals, quads=mesh.quads,
+    )

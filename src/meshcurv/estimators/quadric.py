@@ -65,6 +65,7 @@ def fit_coefficients(vertices: np.ndarray, normals: np.ndarray, t1: np.ndarray, 
                      radius: float) -> tuple[np.ndarray, np.ndarray]:
     """(V, 6) coefficients ``c0, d, e, a, b, c`` (in units of ``radius``) and (V,) point counts."""
     n = vertices.shape[0]
+    radius = radius if radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
     normal_matrix = np.zeros((n, 6, 6))
     right = np.zeros((n, 6))
     counts = np.zeros(n)
@@ -110,7 +111,8 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
 
     stages.start("retrieve curvatures")
     _, p, q, a, b, c = coefficients.T
-    a, b, c = a / radius, b / radius, c / radius  # back from units of radius
+    unit = radius if radius > 0 else 1.0
+    a, b, c = a / unit, b / unit, c / unit  # back from units of radius
     width = np.sqrt(1 + p * p + q * q)
     first = np.stack([1 + p * p, p * q, 1 + q * q], axis=1)
     second = -np.stack([2 * a, b, 2 * c], axis=1) / width[:, None]

@@ -1,0 +1,327 @@
+"""Accuracy of every meshcurv method and of the peers, on the same analytic meshes.
+
+Run from the repository root (peers: ``pip install 'meshcurv[bench]'``; those not
+installed are listed as such in the table)::
+
+    python benchmarks/accuracy.py            # writes benchmarks/accuracy.md
+    python benchmarks/accuracy.py --quick    # the two coarser resolutions only
+
+Surfaces (``meshcurv.shapes``): sphere (r 1), torus (R 3, r 1), ellipsoid
+(3, 2, 1), open cylinder (r 1, height 4), saddle ``z = x^2 - y^2`` on [-1, 1]^2,
+and an open hemisphere for the boundary target; each regular, irregular
+(random points on the sphere and ellipsoid, Delaunay; jittered grids with random
+diagonals elsewhere) and noisy (regular mesh, every vertex moved along its normal
+by uniform noise of amplitude 0.1 and 0.3 x mean edge length), at three
+resolutions. Errors are against the exact values at the unperturbed points.
+
+Error of a quantity at a vertex: ``|estimate - exact| / s`` with ``s`` the
+largest exact principal curvature magnitude at that vertex (``s^2`` for K): the
+usual relative error on a sphere, and still defined where a curvature crosses
+zero (cylinder, torus, saddle). Directions: share of vertices, among those where
+the exact curvatures differ by more than 10% of ``s``, whose ``dir_max`` is
+within 8 degrees of the exact one. Statistics are over the vertices the method
+reports (``valid``); ``cover`` is the share it reports. Vertices on a boundary
+are reported in rows of their own.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import datetime
+import importlib.metadata
+import io
+import os
+import sys
+import time
+import warnings
+
+import numpy as np
+
+import meshcurv
+from meshcurv import shapes
+from meshcurv.estimators import ESTIMATORS
+from meshcurv.neighborhoods import default_radius
+
+OUTPUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy.md")
+
+
+# -- meshes -----------------------------------------------------------------------
+
+def surfaces(levels):
+    """Yield ``(surface, variant, level, mesh)``."""
+    sphere_n = [8, 16, 32]
+    torus_n = [(48, 16), (96, 32), (192, 64)]
+    cylinder_n = [(24, 16), (48, 32), (96, 64)]
+    saddle_h = [0.1, 0.05, 0.025]
+    for level in levels:
+        n = sphere_n[level]
+        regular = {
+            "sphere": shapes.icosphere(n),
+            "torus": shapes.torus(3.0, 1.0, *torus_n[level]),
+            "ellipsoid": shapes.ellipsoid((3.0, 2.0, 1.0), n),
+            "cylinder": shapes.cylinder(1.0, 4.0, *cylinder_n[level]),
+            "saddle": shapes.saddle(1.0, saddle_h[level]),
+            "hemisphere": shapes.hemisphere(n),
+        }
+        irregular = {
+            "sphere": shapes.random_sphere(10 * n * n + 2, seed=level),
+            "torus": shapes.torus(3.0, 1.0, *torus_n[level], jitter=0.35, seed=level),
+            "ellipsoid": shapes.random_ellipsoid((3.0, 2.0, 1.0), 10 * n * n + 2, seed=level),
+            "cylinder": shapes.cylinder(1.0, 4.0, *cylinder_n[level], jitter=0.35, seed=level),
+            "saddle": shapes.saddle(1.0, saddle_h[level], jitter=0.35, seed=level),
+            "hemisphere": shapes.hemisphere(n, irregular=True, seed=level),
+        }
+        for name, mesh in regular.items():
+            yield name, "regular", level, mesh
+            yield name, "irregular", level, irregular[name]
+            if name != "hemisphere":
+                for noise in (0.1, 0.3):
+                    yield name, f"noise {noise}h", level, shapes.with_normal_noise(mesh, noise, seed=level)
+
+
+# -- peers ------------------------------------------------------------------------
+
+def _from_mean_gaussian(mean, gaussian):
+    half = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
+    nan = np.full((mean.size, 3), np.nan)
+    return mean - half, mean + half, nan, nan
+
+
+def peer_libigl(v, f):
+    import igl
+
+    pd1, pd2, pv1, pv2, bad = igl.principal_curvature(v, f)  # default: 5-ring quadric fit
+    # libigl's sign: checked on an outward sphere (positive, as meshcurv)
+    k_max, k_min = np.maximum(pv1, pv2), np.minimum(pv1, pv2)
+    dir_max = np.where((pv1 >= pv2)[:, None], pd1, pd2)
+    return k_min, k_max, np.full_like(dir_max, np.nan), dir_max
+
+
+def _vtk_polydata(v, f):
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+    points = vtk.vtkPoints()
+    points.SetData(numpy_to_vtk(np.ascontiguousarray(v), deep=True))
+    cells = vtk.vtkCellArray()
+    cells.SetData(numpy_to_vtkIdTypeArray(np.arange(0, 3 * len(f) + 1, 3, dtype=np.int64), deep=True),
+                  numpy_to_vtkIdTypeArray(np.ascontiguousarray(f.ravel(), dtype=np.int64), deep=True))
+    data = vtk.vtkPolyData()
+    data.SetPoints(points)
+    data.SetPolys(cells)
+    return data
+
+
+def peer_vtk(v, f):
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    values = []
+    for kind in ("Mean", "Gaussian"):
+        filt = vtk.vtkCurvatures()
+        filt.SetInputData(_vtk_polydata(v, f))
+        getattr(filt, f"SetCurvatureTypeTo{kind}")()
+        filt.Update()
+        values.append(vtk_to_numpy(filt.GetOutput().GetPointData().GetScalars()).astype(float))
+    return _from_mean_gaussian(*values)
+
+
+def peer_trimesh(v, f, radius):
+    import trimesh
+
+    mesh = trimesh.Trimesh(v, f, process=False)
+    area = np.pi * radius**2  # integrated measures over the ball, per unit area
+    mean = trimesh.curvature.discrete_mean_curvature_measure(mesh, v, radius) / area
+    gaussian = trimesh.curvature.discrete_gaussian_curvature_measure(mesh, v, radius) / area
+    return _from_mean_gaussian(mean, gaussian)
+
+
+def peer_meshlab(v, f, method):
+    """MeshLab in a child process: pymeshlab aborts the process on some open meshes."""
+    import concurrent.futures
+    import multiprocessing
+
+    with concurrent.futures.ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:
+        return pool.submit(_meshlab, v, f, method).result()
+
+
+def _meshlab(v, f, method):
+    import pymeshlab
+
+    scalars = []
+    for label in ("Min Curvature", "Max Curvature"):
+        ms = pymeshlab.MeshSet()
+        ms.add_mesh(pymeshlab.Mesh(v, f))
+        with contextlib.redirect_stdout(io.StringIO()):
+            ms.compute_curvature_principal_directions_per_vertex(method=method, curvcolormethod=label,
+                                                                 autoclean=False)
+        mesh = ms.current_mesh()
+        scalars.append(mesh.vertex_scalar_array().astype(float))
+        dir1 = mesh.vertex_curvature_principal_dir1_matrix()
+    # MeshLab's "Min" scalar goes with dir1 and is the larger on an outward torus (checked)
+    a, b = scalars
+    dir1 = dir1 / np.linalg.norm(dir1, axis=1, keepdims=True)
+    nan = np.full_like(dir1, np.nan)
+    dir_max = np.where((a >= b)[:, None], dir1, nan)
+    return np.minimum(a, b), np.maximum(a, b), nan, dir_max
+
+
+def peers():
+    """name -> (function(v, f, radius), package) for the peers that import."""
+    found, missing = {}, {}
+    candidates = [
+        ("libigl principal_curvature (5-ring quadric)", "igl", "libigl", lambda v, f, r: peer_libigl(v, f)),
+        ("VTK vtkCurvatures (1-ring)", "vtk", "vtk", lambda v, f, r: peer_vtk(v, f)),
+        ("trimesh ball measures (r = default radius)", "trimesh", "trimesh", peer_trimesh),
+        ("MeshLab quadric fitting", "pymeshlab", "pymeshlab",
+         lambda v, f, r: peer_meshlab(v, f, "Quadric Fitting")),
+        ("MeshLab scale-dependent quadric", "pymeshlab", "pymeshlab",
+         lambda v, f, r: peer_meshlab(v, f, "Scale Dependent Quadric Fitting")),
+        ("MeshLab Taubin", "pymeshlab", "pymeshlab", lambda v, f, r: peer_meshlab(v, f, "Taubin approximation")),
+    ]
+    for name, module, dist, function in candidates:
+        try:
+            __import__(module)
+            found[name] = (function, f"{dist} {importlib.metadata.version(dist)}")
+        except Exception as exc:  # noqa: BLE001 - any import failure means "not installed"
+            missing[name] = f"{dist}: not installed ({type(exc).__name__})"
+    return found, missing
+
+
+# -- errors -----------------------------------------------------------------------
+
+def errors(mesh, k_min, k_max, dir_max, mask):
+    scale = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))[mask]
+    out = {}
+    est_mean, est_gauss = (k_min + k_max) / 2, k_min * k_max
+    for key, est, exact, s in (("k_min", k_min, mesh.k_min, scale), ("k_max", k_max, mesh.k_max, scale),
+                               ("H", est_mean, mesh.mean, scale), ("K", est_gauss, mesh.gaussian, scale**2)):
+        e = np.abs(est[mask] - exact[mask]) / s
+        out[key] = (np.median(e), np.percentile(e, 95)) if e.size else (np.nan, np.nan)
+    distinct = (np.abs(mesh.k_max - mesh.k_min)[mask] > 0.1 * scale) & np.isfinite(mesh.dir_max[mask]).all(axis=1)
+    if distinct.any() and np.isfinite(dir_max[mask][distinct]).all():
+        cos = np.abs(np.sum(dir_max[mask][distinct] * mesh.dir_max[mask][distinct], axis=1))
+        out["dir"] = float(np.mean(cos >= np.cos(np.radians(8))))
+    else:
+        out["dir"] = np.nan
+    return out
+
+
+def run(levels):
+    found, missing = peers()
+    methods = {f"meshcurv {name}": None for name in ESTIMATORS}
+    rows = []
+    timings = {}
+    for surface, variant, level, mesh in surfaces(levels):
+        topology = meshcurv.MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0])
+        boundary = topology.boundary_vertices
+        radius = default_radius(mesh.vertices, topology)
+        results = {}
+        for label in methods:
+            t0 = time.perf_counter()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                r = meshcurv.principal_curvatures(mesh.vertices, topology, method=label.split()[1])
+            timings[label] = timings.get(label, 0.0) + time.perf_counter() - t0
+            results[label] = (r.k_min, r.k_max, r.dir_max, r.valid)
+        for label, (function, _) in found.items():
+            t0 = time.perf_counter()
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    k_min, k_max, _, dir_max = function(mesh.vertices, mesh.faces, radius)
+            except Exception as exc:  # noqa: BLE001 - a peer failing on a mesh is a result
+                print(f"  {label} failed on {mesh.name}: {exc}", file=sys.stderr)
+                continue
+            timings[label] = timings.get(label, 0.0) + time.perf_counter() - t0
+            valid = np.isfinite(k_min) & np.isfinite(k_max)
+            results[label] = (k_min, k_max, dir_max, valid)
+        for label, (k_min, k_max, dir_max, valid) in results.items():
+            for where, region in (("interior", ~boundary), ("boundary", boundary)):
+                if not region.any():
+                    continue
+                mask = region & valid
+                rows.append({"surface": surface, "variant": variant, "level": level,
+                             "n": mesh.vertices.shape[0], "where": where, "method": label,
+                             "cover": mask.sum() / region.sum(), **errors(mesh, k_min, k_max, dir_max, mask)})
+        print(f"{surface:10s} {variant:10s} level {level} ({mesh.vertices.shape[0]} vertices) done", file=sys.stderr)
+    return rows, found, missing, timings
+
+
+# -- report -----------------------------------------------------------------------
+
+def _pct(x):
+    return "—" if not np.isfinite(x) else (f"{100 * x:.2g}%" if x < 0.1 else f"{100 * x:.0f}%")
+
+
+def markdown(rows, found, missing, timings, levels):
+    lines = [
+        "# Accuracy of curvature estimators on analytic meshes",
+        "",
+        f"Generated {datetime.date.today().isoformat()} by `python benchmarks/accuracy.py` "
+        f"(meshcurv {meshcurv.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}).",
+        "",
+        "Peers: " + "; ".join(sorted({pkg for _, pkg in found.values()})) + ".",
+    ]
+    if missing:
+        lines.append("Not installed (not run): " + "; ".join(f"{k} ({v})" for k, v in missing.items()) + ".")
+    lines += [
+        "",
+        "Error = |estimate - exact| / s with s the largest exact |principal curvature| at the vertex (s² for K);",
+        "cells are median / 95th percentile over the vertices the method reports; `cover` = share reported;",
+        "`dir` = share of vertices (exact curvatures differing by > 10% of s) with dir_max within 8°.",
+        "meshcurv's `radius` methods use the default radius (2.5 x mean edge length); trimesh gets the same radius.",
+        "Meshes: sphere r 1, torus R 3 r 1, ellipsoid (3, 2, 1), cylinder r 1 h 4, saddle z = x² - y², hemisphere;",
+        "irregular = random points (sphere, ellipsoid, hemisphere) or jittered grid with random diagonals;",
+        "noise = regular mesh with uniform normal displacement of amplitude 0.1 h or 0.3 h (h = mean edge length).",
+        "",
+    ]
+    # summary: median H and K error per family, averaged over the resolutions
+    lines += ["## Summary: median error of H / K (interior), mean over resolutions", ""]
+    families = []
+    for r in rows:
+        key = (r["surface"], r["variant"])
+        if key not in families:
+            families.append(key)
+    methods = list(dict.fromkeys(r["method"] for r in rows))
+    lines.append("| method | " + " | ".join(f"{s} {v}" for s, v in families) + " |")
+    lines.append("|---" * (len(families) + 1) + "|")
+    for m in methods:
+        cells = []
+        for s, v in families:
+            sel = [r for r in rows if r["method"] == m and r["surface"] == s and r["variant"] == v
+                   and r["where"] == "interior"]
+            h = np.mean([r["H"][0] for r in sel]) if sel else np.nan
+            k = np.mean([r["K"][0] for r in sel]) if sel else np.nan
+            cells.append(f"{_pct(h)} / {_pct(k)}")
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    lines += ["", "## Time (s, all meshes)", "", "| method | seconds |", "|---|---|"]
+    lines += [f"| {m} | {t:.1f} |" for m, t in timings.items()]
+    lines += ["", "## All results", "",
+              "| surface | variant | V | where | method | cover | k_min | k_max | H | K | dir < 8° |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        cells = [f"{_pct(r[q][0])} / {_pct(r[q][1])}" for q in ("k_min", "k_max", "H", "K")]
+        lines.append(f"| {r['surface']} | {r['variant']} | {r['n']} | {r['where']} | {r['method']} | "
+                     f"{_pct(r['cover'])} | " + " | ".join(cells) + f" | {_pct(r['dir'])} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="the two coarser resolutions only")
+    parser.add_argument("--levels", type=int, nargs="+", help="resolutions to run (0, 1, 2)")
+    parser.add_argument("--output", default=OUTPUT, help="markdown file to write (default: %(default)s)")
+    args = parser.parse_args(argv)
+    levels = args.levels or ([0, 1] if args.quick else [0, 1, 2])
+    rows, found, missing, timings = run(levels)
+    text = markdown(rows, found, missing, timings, levels)
+    with open(args.output, "w") as handle:
+        handle.write(text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
