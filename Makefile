@@ -12,11 +12,11 @@ STAMP := $(VENV)/.installed
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "meshcurv needs Python 3.11 or newer: make PYTHON=python3.11 ...")'
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[plot,test,fast]'
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[all,test]'
 	@touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/python -m meshcurv demo demo-output/torus_gaussian.png
+	$(BIN)/meshcurv demo --overwrite demo-output/torus_gaussian.png
 
 test: $(STAMP)
 	$(BIN)/python -m pytest

@@ -1,18 +1,8 @@
-"""``python -m meshcurv demo``: the seed's torus example."""
+"""``python -m meshcurv ...``: the same as the ``meshcurv`` command (see :mod:`meshcurv.cli`)."""
 
 import sys
 
-from .demo import run_demo
-
-
-def main(argv=None) -> int:
-    args = sys.argv[1:] if argv is None else list(argv)
-    if args[:1] != ["demo"]:
-        print("usage: python -m meshcurv demo [OUTPUT.png]", file=sys.stderr)
-        return 2
-    print(run_demo(*args[1:2]))
-    return 0
-
+from .cli import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import os
 import pathlib
-import tempfile
 
 import numpy as np
 
@@ -22,28 +21,25 @@ from .curvature import principal_curvatures
 __all__ = ["run_demo"]
 
 
-def run_demo(output: str | os.PathLike = "torus_gaussian.png") -> str:
+def run_demo(output: str | os.PathLike = "torus_gaussian.png", *, overwrite: bool = False) -> str:
     """Compute the curvatures of matGeom's default torus and draw its Gaussian curvature.
 
-    Writes the picture to ``output`` (atomically) and returns a short summary
+    Writes the picture to ``output`` (atomically; an existing file only with
+    ``overwrite=True``), creating its folder, and returns a short summary
     comparing the estimate to the exact curvatures of the torus.
     """
-    from .plotting import plot_field
+    from .plotting import plot_field, save_figure
 
     torus = shapes.torus()
     result = principal_curvatures(torus.vertices, torus.faces)
     compat = principal_curvatures(torus.vertices, torus.faces, method="matgeom")
 
-    fig = plot_field(torus.vertices, torus.faces, result.gaussian, label="Gaussian curvature K (1/length²)",
-                     title="matGeom's torusMesh (R 30, r 10): K = k_min · k_max")
     output = pathlib.Path(output)
     output.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.NamedTemporaryFile(dir=output.parent, suffix=".png", delete=False) as tmp:
-        fig.savefig(tmp, format="png")
-    os.replace(tmp.name, output)
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
+    fig = plot_field(torus.vertices, torus.faces, result.gaussian, view=["iso", "top"],
+                     label="Gaussian curvature K (1/length²)",
+                     title="matGeom's torusMesh (R 30, r 10): K = k_min · k_max")
+    save_figure(fig, output, overwrite=overwrite)
 
     rows = [
         ("k_min", result.k_min, torus.k_min),

@@ -41,7 +41,7 @@ def _to_log():
     finally:
         for line in captured.getvalue().splitlines():
             if line.strip():
-                logger.warning("meshio: %s", line.strip())
+                logger.info("meshio: %s", line.strip())
 
 
 def check_stl(path) -> None:

@@ -1,0 +1,432 @@
+"""The commands of ``meshcurv`` (click). Run them through :func:`meshcurv.cli.main`."""
+
+from __future__ import annotations
+
+import inspect
+import logging
+import pathlib
+import re
+import sys
+import warnings
+
+import click
+import numpy as np
+
+from . import __version__
+from ._validation import as_faces
+from .curvature import principal_curvatures
+from .diagnosis import diagnose
+from .errors import MeshFileError
+from .estimators import ESTIMATORS
+from .io import FORMATS, read_mesh, write_curvatures
+from .io._files import check_output
+from .io.fields import FIELDS, curvature_fields
+from .topology import MeshTopology
+
+__all__ = ["meshcurv", "Session"]
+
+SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid")]
+_LEVELS = {-2: logging.CRITICAL, -1: logging.ERROR, 0: logging.WARNING, 1: logging.INFO, 2: logging.DEBUG}
+
+
+class Session:
+    """What one run of the command configures: logging level, warnings, progress; undone on exit."""
+
+    def __init__(self):
+        self.verbose = 0
+        self.quiet = 0
+        self.debug = False
+        self.progress = None
+        self._logger = logging.getLogger("meshcurv")
+        self._handler = None
+        self._warnings = None
+        self._level = None
+
+    def __enter__(self):
+        self._level = self._logger.level
+        self._handler = logging.StreamHandler(sys.stderr)
+        self._handler.setFormatter(logging.Formatter("meshcurv: %(message)s"))
+        self._logger.addHandler(self._handler)
+        self._warnings = warnings.catch_warnings()
+        self._warnings.__enter__()
+        warnings.simplefilter("always")
+        warnings.showwarning = self._show_warning
+        self.update()
+        return self
+
+    def __exit__(self, *exc_info):
+        self._warnings.__exit__(*exc_info)
+        self._logger.removeHandler(self._handler)
+        self._logger.setLevel(self._level)
+        return False
+
+    def update(self) -> None:
+        level = _LEVELS[max(-2, min(2, self.verbose - self.quiet))]
+        self._logger.setLevel(level)
+        if level <= logging.DEBUG:
+            self._handler.setFormatter(logging.Formatter("meshcurv: %(name)s: %(message)s"))
+
+    def _show_warning(self, message, category, filename, lineno, file=None, line=None):
+        if self.verbose - self.quiet >= 0:
+            click.echo(f"meshcurv: warning: {message}", err=True)
+
+    def info(self, text: str) -> None:
+        """A line on stderr unless -q."""
+        if self.verbose - self.quiet >= 0:
+            click.echo(f"meshcurv: {text}", err=True)
+
+    def bar(self, stages):
+        """A :class:`StageBar` for these stages, or a silent one (not a terminal, or --no-progress)."""
+        stream = sys.stderr
+        show = self.progress if self.progress is not None else stream.isatty()
+        return StageBar(stages, stream if show else None, tty=stream.isatty())
+
+
+class StageBar:
+    """A progress bar over named stages, on stderr: redrawn in place on a terminal, one line per stage otherwise."""
+
+    def __init__(self, stages, stream, *, tty: bool, width: int = 24):
+        self.stages = list(stages)
+        self.stream = stream
+        self.tty = tty
+        self.width = width
+        self.done = 0
+
+    def __call__(self, stage: str, index: int | None = None, total: int | None = None, *, offset: int = 0):
+        if self.stream is None:
+            return
+        position = offset + (index if index is not None else self.stages.index(stage) + 1)
+        count = len(self.stages)
+        filled = round(self.width * (position - 1) / count)
+        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {position}/{count} {stage}"
+        if self.tty:
+            self.stream.write(f"\r\033[K{text}")
+        else:
+            self.stream.write(f"meshcurv: {text}\n")
+        self.stream.flush()
+        self.done = position
+
+    def close(self) -> None:
+        if self.stream is not None and self.tty and self.done:
+            self.stream.write("\r\033[K")
+            self.stream.flush()
+
+
+def _store(ctx, param, value):
+    session = ctx.find_object(Session)
+    if param.name in ("verbose", "quiet"):
+        setattr(session, param.name, getattr(session, param.name) + value)
+    elif param.name == "debug":
+        session.debug = session.debug or value
+    elif value is not None:
+        session.progress = value
+    if session._handler is not None:
+        session.update()
+    return value
+
+
+def common_options(function):
+    """-v/-q/--debug/--progress, accepted before or after the command name."""
+    options = [
+        click.option("-v", "--verbose", count=True, expose_value=False, callback=_store,
+                     help="More messages on stderr (-v: stages, -vv: debug)."),
+        click.option("-q", "--quiet", count=True, expose_value=False, callback=_store,
+                     help="Fewer messages: no warnings (-q), only errors."),
+        click.option("--debug", is_flag=True, expose_value=False, callback=_store,
+                     help="Show the traceback when something fails."),
+        click.option("--progress/--no-progress", default=None, expose_value=False, callback=_store,
+                     help="Progress bar on stderr (default: only when stderr is a terminal)."),
+    ]
+    for option in reversed(options):
+        function = option(function)
+    return function
+
+
+class MethodChoice(click.Choice):
+    """The names of :data:`meshcurv.estimators.ESTIMATORS`, read when used (methods can be added)."""
+
+    def __init__(self):
+        super().__init__(list(ESTIMATORS))
+
+    @property
+    def choices(self):
+        return tuple(ESTIMATORS)
+
+    @choices.setter
+    def choices(self, value):
+        pass
+
+
+def _default_method() -> str:
+    return inspect.signature(principal_curvatures).parameters["method"].default
+
+
+def method_options(function):
+    """--method and the estimator options, passed on only when given."""
+    options = [
+        click.option("-m", "--method", type=MethodChoice(), default=_default_method(), show_default=True,
+                     help="Curvature estimator (see `meshcurv methods`)."),
+        click.option("--smoothing-steps", type=click.IntRange(min=0), default=None,
+                     help="Passes of 1-ring smoothing (normal_cycle, matgeom; default 3)."),
+        click.option("--radius", type=click.FloatRange(min=0, min_open=True), default=None,
+                     help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
+                          "default 2.5 x mean edge length)."),
+        click.option("--orient", type=click.Choice(["keep", "consistent", "outward"]), default=None,
+                     help="Reorient the faces first (default: keep)."),
+    ]
+    for option in reversed(options):
+        function = option(function)
+    return function
+
+
+def _estimate(vertices, faces, method, options, bar, *, offset):
+    given = {name: value for name, value in options.items() if value is not None}
+    takes = ESTIMATORS[method].options
+    for name in given:
+        if name != "orient" and name not in takes:
+            accepted = ", ".join(f"--{option.replace('_', '-')}" for option in takes) or "none"
+            raise click.UsageError(f"method {method!r} does not take --{name.replace('_', '-')} "
+                                   f"(its options: {accepted})")
+    return principal_curvatures(vertices, faces, method=method, **given,
+                                progress=lambda stage, index, total: bar(stage, index, total, offset=offset))
+
+
+def _fields(ctx, param, value):
+    if value is None:
+        return None
+    names = [name.strip() for name in value.split(",") if name.strip()]
+    unknown = [name for name in names if name not in FIELDS]
+    if unknown or not names:
+        raise click.BadParameter(f"unknown field {unknown[0] if unknown else value!r}; choose from "
+                                 f"{', '.join(FIELDS)} (separated by commas)")
+    return names
+
+
+def _check_output(path: pathlib.Path, *, overwrite: bool, source, needs_fields: bool) -> None:
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise MeshFileError(f"{path}: unknown output extension {path.suffix!r}; known: {', '.join(FORMATS)}")
+    if needs_fields and FORMATS[suffix].fields == "none":
+        raise MeshFileError(f"{path}: {FORMATS[suffix].name} files cannot hold per-vertex fields; "
+                            "write .ply, .vtk, .vtu, .vtp, .csv or .npz")
+    check_output(path, overwrite=overwrite, source=source)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="meshcurv")
+@common_options
+def meshcurv():
+    """Curvature of triangle meshes: principal curvatures and directions, mean and Gaussian curvature.
+
+    \b
+    meshcurv info mesh.obj                 what the mesh is
+    meshcurv compute mesh.obj              summary table of the curvatures
+    meshcurv compute mesh.obj -o out.ply   per-vertex fields for MeshLab, ParaView, pandas
+    meshcurv plot mesh.obj --field mean    a picture
+    meshcurv methods                       the estimators and their options
+    """
+
+
+@meshcurv.command()
+@click.argument("mesh", type=click.Path(path_type=pathlib.Path))
+@click.option("-o", "--output", type=click.Path(path_type=pathlib.Path), default=None,
+              help="Write the fields to .ply, .vtk, .vtu, .vtp, .csv or .npz (default: print a summary).")
+@method_options
+@click.option("--fields", callback=_fields, default=None, metavar="NAME,...",
+              help=f"Fields to write or summarise (default: all): {', '.join(FIELDS)}.")
+@click.option("--quality", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
+              help="Field copied as `quality`, the vertex property MeshLab colours by.")
+@click.option("--ascii", "ascii_", is_flag=True, help="ASCII rather than binary PLY, STL or VTK.")
+@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
+@common_options
+def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite):
+    """Compute the curvatures of MESH; write them with -o, or print a summary table."""
+    session = click.get_current_context().find_object(Session)
+    if output is not None:
+        _check_output(output, overwrite=overwrite, source=mesh, needs_fields=True)
+    stages = ["read", *ESTIMATORS[method].stages, "write" if output is not None else "summary"]
+    bar = session.bar(stages)
+    try:
+        bar("read")
+        vertices, faces = read_mesh(mesh)
+        options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
+        result = _estimate(vertices, faces, method, options, bar, offset=1)
+        bar(stages[-1], len(stages))
+        if output is not None:
+            write_curvatures(output, vertices, faces, result, fields=fields, quality=quality, overwrite=overwrite,
+                             source=mesh, binary=not ascii_)
+    finally:
+        bar.close()
+    if output is not None:
+        written = fields or list(FIELDS)
+        session.info(f"wrote {output}: {len(vertices)} vertices, fields {', '.join(written)} (quality = {quality})")
+        return
+    click.echo(_summary(mesh, vertices, faces, result, fields))
+
+
+def _summary(path, vertices, faces, result, fields) -> str:
+    parameters = ", ".join(f"{key}={value}" for key, value in result.parameters.items())
+    lines = [f"{path}: {len(vertices)} vertices, {len(faces)} faces; method {result.method}"
+             + (f" ({parameters})" if parameters else "")]
+    columns = ["min", "p5", "p25", "median", "p75", "p95", "max", "mean"]
+    lines.append(f"{'field':<12}" + "".join(f"{name:>11}" for name in columns))
+    values = curvature_fields(result, fields=[f for f in (fields or SCALAR_FIELDS) if f in SCALAR_FIELDS],
+                              quality=None)
+    for name, field in values.items():
+        finite = field[np.isfinite(field)]
+        if finite.size == 0:
+            lines.append(f"{name:<12}" + f"{'(no finite value)':>22}")
+            continue
+        row = [finite.min(), *np.percentile(finite, [5, 25, 50, 75, 95]), finite.max(), finite.mean()]
+        lines.append(f"{name:<12}" + "".join(f"{value:>11.4g}" for value in row))
+    n_invalid = int((~result.valid).sum())
+    lines.append(f"invalid vertices (estimate undefined, fields NaN): {n_invalid} of {len(vertices)}")
+    return "\n".join(lines)
+
+
+def _views(ctx, param, values):
+    views = []
+    for value in values:
+        if re.fullmatch(r"\s*-?\d+(\.\d*)?\s*,\s*-?\d+(\.\d*)?\s*", value):
+            views.append(tuple(float(x) for x in value.split(",")))
+            continue
+        for name in filter(None, (part.strip() for part in value.split(","))):
+            if name != "auto" and name not in _plotting_views():
+                raise click.BadParameter(f"unknown view {name!r}; choose auto, {', '.join(_plotting_views())}, "
+                                         "or ELEVATION,AZIMUTH in degrees")
+            views.append(name)
+    return views or ["auto"]
+
+
+def _plotting_views():
+    from .plotting import VIEWS
+
+    return list(VIEWS)
+
+
+def _percentiles(ctx, param, value):
+    try:
+        low, high = (float(part) for part in value.split(","))
+    except ValueError:
+        raise click.BadParameter(f"give two percentiles as LOW,HIGH (e.g. 2,98); got {value!r}") from None
+    if not 0 <= low < high <= 100:
+        raise click.BadParameter(f"need 0 <= LOW < HIGH <= 100; got {value!r}")
+    return low, high
+
+
+@meshcurv.command()
+@click.argument("mesh", type=click.Path(path_type=pathlib.Path))
+@click.option("-o", "--output", type=click.Path(path_type=pathlib.Path), default=None,
+              help="The PNG to write (default: MESH-NAME_FIELD.png in the current folder).")
+@click.option("-f", "--field", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
+              help="The field that colours the mesh.")
+@method_options
+@click.option("--view", "views", multiple=True, callback=_views, metavar="VIEW",
+              help="auto (several views of a closed mesh, one of an open one), names separated by commas "
+                   "(iso, front, back, left, right, top, bottom, iso-back) or ELEVATION,AZIMUTH; repeatable.")
+@click.option("--up", type=click.Choice(["y", "z", "x"]), default="y", show_default=True,
+              help="The axis drawn upwards (y for most OBJ and PLY files).")
+@click.option("--directions", type=click.Choice(["none", "max", "min", "both"]), default="none",
+              show_default=True, help="Strokes along the principal directions.")
+@click.option("--percentiles", callback=_percentiles, default="2,98", show_default=True, metavar="LOW,HIGH",
+              help="Colour limits as percentiles of the field.")
+@click.option("--pixels", type=click.IntRange(min=16), default=700, show_default=True,
+              help="Size of each view's image.")
+@click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
+@common_options
+def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up, directions, percentiles,
+         pixels, overwrite):
+    """Draw MESH coloured by a curvature field, with a colour bar."""
+    from .plotting import _pyplot, plot_field, save_figure
+
+    _pyplot()  # fail early, before computing, when matplotlib is missing
+    session = click.get_current_context().find_object(Session)
+    output = output if output is not None else pathlib.Path(f"{mesh.stem}_{field}.png")
+    if output.suffix.lower() != ".png":
+        raise click.BadParameter(f"the picture is a PNG; got {output.name!r}", param_hint="'-o'")
+    check_output(output, overwrite=overwrite, source=mesh)
+    stages = ["read", *ESTIMATORS[method].stages, "draw"]
+    bar = session.bar(stages)
+    try:
+        bar("read")
+        vertices, faces = read_mesh(mesh)
+        triangles = as_faces(faces, len(vertices))
+        options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
+        result = _estimate(vertices, triangles, method, options, bar, offset=1)
+        bar("draw", len(stages))
+        if "auto" in views:
+            closed = not MeshTopology.from_faces(triangles, len(vertices)).boundary_edges.any()
+            auto = ["front", "left", "back"] if closed else ["iso"]
+            views = [view for name in views for view in (auto if name == "auto" else [name])]
+        strokes = {"max": {"k_max": result.dir_max}, "min": {"k_min": result.dir_min},
+                   "both": {"k_max": result.dir_max, "k_min": result.dir_min}}.get(directions)
+        values = curvature_fields(result, fields=[field], quality=None)[field]
+        figure = plot_field(vertices, triangles, values, view=views, up=up, percentiles=percentiles,
+                            label=f"{field}: {FIELDS[field]}", directions=strokes, pixels=pixels,
+                            title=f"{mesh.name}, method {result.method}")
+        save_figure(figure, output, overwrite=overwrite)
+    finally:
+        bar.close()
+    session.info(f"wrote {output}")
+
+
+@meshcurv.command()
+@click.argument("mesh", type=click.Path(path_type=pathlib.Path))
+@common_options
+def info(mesh):
+    """What MESH is: sizes, topology, defects, bounding box, edge length."""
+    vertices, faces = read_mesh(mesh)
+    n_polygons = len(faces)
+    triangles = as_faces(faces, len(vertices))
+    facts = diagnose(vertices, MeshTopology.from_faces(triangles, len(vertices))).as_dict()
+    lines = [f"file                   {mesh} ({FORMATS[mesh.suffix.lower()].name}, {mesh.stat().st_size} bytes)"]
+    if n_polygons != len(triangles):
+        lines.append(f"{'polygons':<22} {n_polygons} (fan-triangulated into {len(triangles)} triangles)")
+    for key, value in facts.items():
+        name = key[2:] if key.startswith("n_") else key
+        name = name.replace("_", " ")
+        if key == "bounding_box":
+            low, high = (np.asarray(corner, dtype=float) for corner in value)
+            value = f"{_point(low)} to {_point(high)} (size {_point(high - low)})"
+        elif isinstance(value, float):
+            value = f"{value:.6g}"
+        elif value is None:
+            value = "-"
+        lines.append(f"{name:<22} {value}")
+    click.echo("\n".join(lines))
+
+
+def _point(values) -> str:
+    return "(" + ", ".join(f"{value:.6g}" for value in values) + ")"
+
+
+@meshcurv.command()
+@common_options
+def methods():
+    """The curvature estimators, one line each, and their options."""
+    default = _default_method()
+    width = max(map(len, ESTIMATORS)) + 2
+    lines = []
+    for name, estimator in ESTIMATORS.items():
+        marker = " (default)" if name == default else ""
+        lines.append(f"{name:<{width}}{estimator.summary}{marker}")
+        options = [f"--{option.replace('_', '-')} "
+                   + (f"(default {value})" if value is not None else "(default: from the mesh)")
+                   for option, value in estimator.options.items()]
+        lines.append(" " * width + "options: " + (", ".join(options) if options else "none"))
+    click.echo("\n".join(lines))
+
+
+@meshcurv.command()
+@click.argument("output", type=click.Path(path_type=pathlib.Path), default="torus_gaussian.png")
+@click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
+@common_options
+def demo(output, overwrite):
+    """The seed's example: matGeom's torus, its curvatures against the exact ones, a picture (OUTPUT)."""
+    from .demo import run_demo
+    from .plotting import _pyplot
+
+    _pyplot()
+    if output.exists() and not overwrite:
+        check_output(output, overwrite=False)
+    click.echo(run_demo(output, overwrite=overwrite))
