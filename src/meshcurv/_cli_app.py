@@ -206,10 +206,10 @@ def _check_output(path: pathlib.Path, *, overwrite: bool, source, needs_fields: 
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise MeshFileError(f"{path}: unknown output extension {path.suffix!r}; known: {', '.join(FORMATS)}")
+    check_output(path, overwrite=overwrite, source=source)
     if needs_fields and FORMATS[suffix].fields == "none":
         raise MeshFileError(f"{path}: {FORMATS[suffix].name} files cannot hold per-vertex fields; "
                             "write .ply, .vtk, .vtu, .vtp, .csv or .npz")
-    check_output(path, overwrite=overwrite, source=source)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})

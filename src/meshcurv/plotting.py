@@ -60,7 +60,7 @@ def _pyplot():
 def _as_views(view) -> list[tuple[str, tuple[float, float]]]:
     """``view`` as a list of (title, (elevation, azimuth))."""
     single = isinstance(view, str) or (
-        np.ndim(view) == 1 and len(view) == 2 and all(isinstance(v, (int, float, np.number)) for v in view)
+        len(view) == 2 and all(isinstance(v, (int, float, np.number)) for v in view)
     )
     views = []
     for item in [view] if single else list(view):

@@ -1,0 +1,309 @@
+"""The ``meshcurv`` command, run in-process through ``main(argv)`` (and once as a real process)."""
+
+import builtins
+import logging
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import meshcurv
+from meshcurv.estimators import ESTIMATORS, Estimator
+
+click = pytest.importorskip("click")
+from meshcurv.cli import main  # noqa: E402
+
+
+@pytest.fixture
+def torus_file(tmp_path):
+    torus = meshcurv.shapes.torus()  # R 30, r 10: k_max = 1/r = 0.1 everywhere
+    return meshcurv.write_mesh(tmp_path / "torus.obj", torus.vertices, torus.faces)
+
+
+@pytest.fixture
+def small_torus_file(tmp_path):
+    torus = meshcurv.shapes.torus(n_major=24, n_minor=16)
+    return meshcurv.write_mesh(tmp_path / "small.obj", torus.vertices, torus.faces)
+
+
+@pytest.fixture
+def saddle_file(tmp_path):
+    saddle = meshcurv.shapes.saddle(spacing=0.1)  # open: boundary vertices are invalid, with a warning
+    return meshcurv.write_mesh(tmp_path / "saddle.obj", saddle.vertices, saddle.faces)
+
+
+def run(capsys, *argv):
+    code = main([str(arg) for arg in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def one_error_line(err):
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    return lines[0]
+
+
+# ---------------------------------------------------------------- methods, info
+
+
+def test_methods_lists_the_registry_as_it_is_now(capsys, monkeypatch):
+    code, out, _ = run(capsys, "methods")
+    assert code == 0
+    for name, estimator in ESTIMATORS.items():
+        assert f"{name} " in out and estimator.summary in out
+    assert "(default)" in out.splitlines()[0] or "(default)" in out
+    extra = Estimator(name="made_up", function=None, options={"radius": None, "width": 2},
+                      summary="an estimator added later", stages=())
+    monkeypatch.setitem(ESTIMATORS, "made_up", extra)
+    code, out, _ = run(capsys, "methods")
+    assert "made_up" in out and "an estimator added later" in out
+    assert "options: --radius (default: from the mesh), --width (default 2)" in out
+
+
+def test_info_describes_a_torus(capsys, torus_file):
+    code, out, err = run(capsys, "info", torus_file)
+    assert code == 0 and err == ""
+    facts = dict(line.split(None, 1) if not line.startswith(("boundary", "mean", "euler", "bounding"))
+                 else (" ".join(line.split()[:2]), " ".join(line.split()[2:])) for line in out.splitlines())
+    assert facts["vertices"] == "3600" and facts["faces"] == "7200" and facts["genus"] == "1"
+    assert facts["boundary loops"] == "0" and facts["euler characteristic"] == "0"
+    assert facts["bounding box"].startswith("(-40, -40, -10) to (40, 40, 10)")
+
+
+def test_info_counts_polygons(capsys, tmp_path):
+    torus = meshcurv.shapes.torus(n_major=12, n_minor=8)
+    path = meshcurv.write_mesh(tmp_path / "quads.off", torus.vertices, torus.quads)
+    code, out, err = run(capsys, "info", path)
+    assert code == 0
+    assert "polygons               96 (fan-triangulated into 192 triangles)" in out
+    assert "fan-triangulated" in err  # the TriangulationWarning, as one line
+
+
+# ---------------------------------------------------------------- compute
+
+
+def test_compute_prints_a_summary_table(capsys, torus_file):
+    code, out, err = run(capsys, "compute", torus_file)
+    assert code == 0 and err == ""
+    lines = out.splitlines()
+    assert "3600 vertices, 7200 faces; method normal_cycle (smoothing_steps=3)" in lines[0]
+    assert lines[1].split() == ["field", "min", "p5", "p25", "median", "p75", "p95", "max", "mean"]
+    rows = {line.split()[0]: [float(x) for x in line.split()[1:]] for line in lines[2:-1]}
+    assert list(rows) == ["k_min", "k_max", "mean", "gaussian", "shape_index", "curvedness"]
+    assert rows["k_max"][3] == pytest.approx(0.1, rel=0.02)  # median of k_max: 1/r
+    assert lines[-1] == "invalid vertices (estimate undefined, fields NaN): 0 of 3600"
+
+
+@pytest.mark.parametrize("extension", [".ply", ".vtp", ".npz"])
+def test_compute_writes_the_fields(capsys, torus_file, tmp_path, extension):
+    if extension == ".ply":
+        pytest.importorskip("meshio")
+    output = tmp_path / f"torus{extension}"
+    code, _, err = run(capsys, "compute", torus_file, "-o", output, "--fields", "k_min,normals", "--quality",
+                       "gaussian")
+    assert code == 0
+    assert err.strip() == f"meshcurv: wrote {output}: 3600 vertices, fields k_min, normals (quality = gaussian)"
+    vertices, faces = meshcurv.read_mesh(output)
+    expected = meshcurv.principal_curvatures(vertices, faces)
+    if extension == ".npz":
+        stored = np.load(output)
+        np.testing.assert_array_equal(stored["k_min"], expected.k_min)
+        np.testing.assert_array_equal(stored["quality"], expected.gaussian)
+        assert sorted(stored.files) == ["faces", "k_min", "normals", "quality", "vertices"]
+    else:
+        assert output.stat().st_size > 0
+
+
+def test_compute_method_options(capsys, torus_file, tmp_path):
+    code, out, _ = run(capsys, "compute", torus_file, "--method", "matgeom", "--smoothing-steps", "0")
+    assert code == 0 and "method matgeom (smoothing_steps=0)" in out
+    code, _, err = run(capsys, "compute", torus_file, "--radius", "3")
+    assert code == 2
+    assert "method 'normal_cycle' does not take --radius (its options: --smoothing-steps)" in err
+    code, _, err = run(capsys, "compute", torus_file, "--method", "nope")
+    assert code == 2 and "'nope' is not one of 'normal_cycle'" in err
+    code, _, err = run(capsys, "compute", torus_file, "--smoothing-steps", "-1")
+    assert code == 2 and "--smoothing-steps" in err
+    code, _, err = run(capsys, "compute", torus_file, "--fields", "k_min,curvature")
+    assert code == 2 and "unknown field 'curvature'" in err
+
+
+def test_compute_refuses_to_overwrite_unless_asked(capsys, torus_file, tmp_path):
+    output = tmp_path / "out.vtp"
+    output.write_text("keep")
+    code, _, err = run(capsys, "compute", torus_file, "-o", output)
+    assert code == 1
+    assert one_error_line(err) == f"meshcurv: error: {output}: already exists; pass overwrite=True (--overwrite) " \
+                                  "to replace it"
+    assert output.read_text() == "keep"
+    code, _, _ = run(capsys, "compute", torus_file, "-o", output, "--overwrite")
+    assert code == 0 and meshcurv.read_mesh(output).vertices.shape == (3600, 3)
+
+
+def test_compute_refuses_bad_outputs(capsys, torus_file, tmp_path):
+    code, _, err = run(capsys, "compute", torus_file, "-o", torus_file, "--overwrite")
+    assert code == 1 and "the output would replace the input file" in one_error_line(err)
+    code, _, err = run(capsys, "compute", torus_file, "-o", tmp_path / "t.stl")
+    assert code == 1 and "STL files cannot hold per-vertex fields" in one_error_line(err)
+    code, _, err = run(capsys, "compute", torus_file, "-o", tmp_path / "t.xyz")
+    assert code == 1 and "unknown output extension '.xyz'" in one_error_line(err)
+
+
+def test_unreadable_mesh_is_one_line_and_debug_shows_the_traceback(capsys, tmp_path):
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nf 1 2 3\n")
+    code, out, err = run(capsys, "compute", bad)
+    assert code == 1 and out == ""
+    assert one_error_line(err) == f"meshcurv: error: {bad}: a face uses vertex 3 but the file has 2 vertices"
+    code, _, err = run(capsys, "compute", bad, "--debug")
+    assert code == 1 and "Traceback" in err and err.strip().endswith("the file has 2 vertices")
+    code, _, err = run(capsys, "info", tmp_path / "missing.ply")
+    assert code == 1 and one_error_line(err).endswith("missing.ply: no such file")
+
+
+def test_library_option_errors_are_usage_errors_and_bugs_are_one_line(capsys, torus_file, monkeypatch):
+    def refuses(*args, **kwargs):
+        raise meshcurv.InvalidOptionError("`radius` must be a positive finite number; got inf")
+
+    monkeypatch.setattr("meshcurv._cli_app.principal_curvatures", refuses)
+    code, _, err = run(capsys, "compute", torus_file)
+    assert code == 2 and one_error_line(err) == "meshcurv: error: `radius` must be a positive finite number; got inf"
+
+    def breaks(*args, **kwargs):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr("meshcurv._cli_app.principal_curvatures", breaks)
+    code, _, err = run(capsys, "compute", torus_file)
+    assert code == 1
+    assert one_error_line(err) == "meshcurv: error: unexpected RuntimeError: boom (run with --debug for the traceback)"
+
+
+def test_usage_errors_exit_2(capsys):
+    assert run(capsys, "frobnicate")[0] == 2
+    code, out, err = run(capsys)
+    assert code == 2 and "Usage: meshcurv" in out + err
+    code, out, _ = run(capsys, "--help")
+    assert code == 0 and "compute" in out and "methods" in out
+    code, out, _ = run(capsys, "--version")
+    assert code == 0 and meshcurv.__version__ in out
+
+
+# ---------------------------------------------------------------- messages: warnings, logging, progress
+
+
+def test_warnings_are_one_line_and_quiet_hides_them(capsys, saddle_file):
+    code, out, err = run(capsys, "compute", saddle_file)
+    assert code == 0 and "invalid vertices" in out
+    warning_lines = [line for line in err.splitlines() if line.startswith("meshcurv: warning: ")]
+    assert len(warning_lines) == 1 and "boundary" in warning_lines[0]
+    code, _, err = run(capsys, "compute", saddle_file, "-q")
+    assert code == 0 and err == ""
+
+
+def test_verbose_logs_the_stages_and_the_logger_is_restored(capsys, torus_file):
+    logger = logging.getLogger("meshcurv")
+    level, handlers = logger.level, list(logger.handlers)
+    code, _, err = run(capsys, "-v", "compute", torus_file)
+    assert code == 0
+    assert f"meshcurv: read {torus_file}: 3600 vertices, 7200 faces" in err
+    assert "compute edge tensors (2/4)" in err
+    assert logger.level == level and logger.handlers == handlers
+    code, _, err = run(capsys, "compute", torus_file, "-vv")
+    assert "meshcurv: meshcurv.io: read" in err
+
+
+def test_progress_only_when_asked_or_on_a_terminal(capsys, torus_file, monkeypatch):
+    code, _, err = run(capsys, "compute", torus_file)
+    assert err == ""
+    code, _, err = run(capsys, "compute", torus_file, "--progress")
+    lines = err.splitlines()
+    assert lines[0] == "meshcurv: [........................] 1/6 read"
+    assert lines[-1].endswith("6/6 summary") and len(lines) == 6
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    code, _, err = run(capsys, "compute", torus_file)
+    assert "\r\x1b[K[" in err and "6/6 summary" in err and err.endswith("\r\x1b[K")
+    code, _, err = run(capsys, "compute", torus_file, "--no-progress")
+    assert err == ""
+
+
+# ---------------------------------------------------------------- plot, demo
+
+
+def test_plot_writes_a_png_named_after_the_mesh(capsys, small_torus_file, tmp_path, monkeypatch):
+    pytest.importorskip("matplotlib")
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(capsys, "plot", small_torus_file, "--field", "gaussian", "--directions", "both",
+                       "--up", "z", "--pixels", "200")
+    assert code == 0 and err.strip() == "meshcurv: wrote small_gaussian.png"
+    assert (tmp_path / "small_gaussian.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    code, _, err = run(capsys, "plot", small_torus_file, "--field", "gaussian")
+    assert code == 1 and "small_gaussian.png: already exists" in one_error_line(err)
+    code, _, _ = run(capsys, "plot", small_torus_file, "-o", tmp_path / "two.png", "--view", "iso,top",
+                     "--view", "20,45", "--percentiles", "5,95", "--pixels", "120")
+    assert code == 0 and (tmp_path / "two.png").exists()
+
+
+def test_plot_bad_options(capsys, small_torus_file, tmp_path):
+    pytest.importorskip("matplotlib")
+    for options, message in [
+        (["--view", "sideways"], "unknown view 'sideways'"),
+        (["--percentiles", "98,2"], "need 0 <= LOW < HIGH <= 100"),
+        (["--percentiles", "lots"], "give two percentiles as LOW,HIGH"),
+        (["-o", tmp_path / "x.jpg"], "the picture is a PNG; got 'x.jpg'"),
+        (["--field", "normals"], "'normals' is not one of"),
+    ]:
+        code, _, err = run(capsys, "plot", small_torus_file, *options)
+        assert code == 2 and message in err, (options, err)
+
+
+def test_plot_an_open_mesh(capsys, saddle_file, tmp_path):
+    pytest.importorskip("matplotlib")
+    code, _, _ = run(capsys, "plot", saddle_file, "-o", tmp_path / "saddle.png", "--up", "z", "-q",
+                     "--pixels", "120")
+    assert code == 0 and (tmp_path / "saddle.png").exists()
+
+
+def test_demo_command(capsys, tmp_path):
+    pytest.importorskip("matplotlib")
+    output = tmp_path / "demo" / "torus.png"
+    code, out, _ = run(capsys, "demo", output)
+    assert code == 0 and "3600 vertices" in out and output.exists()
+    code, _, err = run(capsys, "demo", output)
+    assert code == 1 and "already exists" in one_error_line(err)
+    assert run(capsys, "demo", output, "--overwrite")[0] == 0
+
+
+def test_missing_click_names_the_extra(capsys, monkeypatch):
+    real_import = builtins.__import__
+
+    def no_click(name, *args, **kwargs):
+        if name == "click" or name.startswith("click."):
+            raise ImportError(name, name="click")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.delitem(sys.modules, "meshcurv._cli_app")
+    monkeypatch.delattr(meshcurv, "_cli_app")
+    monkeypatch.setattr(builtins, "__import__", no_click)
+    code, _, err = run(capsys, "methods")
+    assert code == 1 and one_error_line(err) == ("meshcurv: error: the command line needs click: "
+                                                 "pip install 'meshcurv[cli]'")
+
+
+# ---------------------------------------------------------------- real processes
+
+
+def test_installed_entry_point_runs_as_a_process(torus_file):
+    script = pathlib.Path(sys.executable).parent / "meshcurv"
+    if not script.exists():
+        pytest.skip("meshcurv is not installed as a script in this environment")
+    done = subprocess.run([script, "info", torus_file], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and "genus                  1" in done.stdout
+    done = subprocess.run([script, "compute", torus_file.with_name("none.obj")], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 1 and done.stderr.strip().endswith("none.obj: no such file")
+    done = subprocess.run([sys.executable, "-m", "meshcurv", "--version"], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0 and meshcurv.__version__ in done.stdout
