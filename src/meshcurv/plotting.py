@@ -2,7 +2,7 @@
 
 The mesh is rasterised here, with numpy, into an image per view (orthographic
 camera, z-buffer, vertex values interpolated across each triangle as matGeom's
-``drawMesh(v, f, 'VertexColor', c)`` does, smooth shading, 2x supersampling),
+``drawMesh(v, f, 'VertexColor', c)`` does, Gouraud shading),
 and matplotlib lays out the images, the colour bar and the direction strokes.
 matplotlib's own 3D axes sort whole polygons by depth (wrong where a
 non-convex surface hides itself) and took about 30 s for the 268k triangles of
@@ -99,8 +99,7 @@ class _Raster:
     """One view of a mesh rasterised with a z-buffer.
 
     Attributes ``face`` (-1 for background), ``weights`` (barycentric, (H, W, 3))
-    and ``depth`` are per pixel of the supersampled grid; ``to_pixels`` maps
-    points to that grid.
+    and ``depth`` are per pixel; ``to_pixels`` maps points to the pixel grid.
     """
 
     def __init__(self, vertices, faces, camera, *, pixels: int, chunk: int = 2**22):
@@ -109,12 +108,10 @@ class _Raster:
         span = np.maximum(high - low, 1e-12 * max(float((high - low).max()), 1e-300))
         # no supersampling: the image has about twice the resolution of its panel in the figure,
         # and matplotlib's antialiased resampling smooths the edges when it is drawn
-        supersample = 1
-        scale = (pixels - 2) * supersample / span.max()  # one pixel of margin each side
-        self.width, self.height = (np.ceil(span * scale).astype(int) + 2 * supersample)
-        self.offset = low - supersample / scale
+        scale = (pixels - 2) / span.max()  # one pixel of margin each side
+        self.width, self.height = (np.ceil(span * scale).astype(int) + 2)
+        self.offset = low - 1 / scale
         self.scale = scale
-        self.supersample = supersample
         self.extent = (self.offset[0], self.offset[0] + self.width / scale,
                        self.offset[1], self.offset[1] + self.height / scale)
         points = self.to_pixels(screen)
@@ -189,11 +186,6 @@ class _Raster:
         weights = self.weights[covered].reshape((-1, 3) + (1,) * (vertex_values.ndim - 1))
         out[covered] = (weights * corners).sum(axis=1)
         return out
-
-    def downsample(self, image: np.ndarray) -> np.ndarray:
-        s = self.supersample
-        height, width = image.shape[0] // s, image.shape[1] // s
-        return image[: height * s, : width * s].reshape(height, s, width, s, -1).mean(axis=(1, 3))
 
 
 def _colour_limits(values, percentiles, signed_hint=None):
@@ -352,17 +344,14 @@ def _draw_view(axis, points, triangles, values, normals, camera, colormap, norm,
 
     raster = _Raster(points, triangles, camera, pixels=pixels)
     covered = raster.face >= 0
-    field = raster.interpolate(triangles, values)
-    colours = colormap(norm(np.ma.masked_invalid(field)))
-    normal = raster.interpolate(triangles, normals)[covered]
+    # Gouraud shading: the light is computed at the vertices and interpolated with the values
     light = camera[2] + 0.45 * camera[1] - 0.3 * camera[0]
     light /= np.linalg.norm(light)
-    lit = np.abs(normal @ light) / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)
-    colours[covered, :3] *= (0.45 + 0.55 * lit)[:, None]
+    both = raster.interpolate(triangles, np.column_stack([values, np.abs(normals @ light)]))
+    colours = colormap(norm(np.ma.masked_invalid(both[..., 0])))
+    colours[covered, :3] *= (0.45 + 0.55 * both[covered, 1])[:, None]
     colours[~covered] = 0.0
-    image = raster.downsample(colours)
-    rgb = image[..., :3] / np.maximum(image[..., 3:], 1e-12)  # un-premultiply the edges
-    axis.imshow(np.dstack([rgb, image[..., 3]]).clip(0, 1), origin="lower", extent=raster.extent,
+    axis.imshow(colours.clip(0, 1), origin="lower", extent=raster.extent,
                 interpolation="antialiased")
     for (name, field), colour in zip(strokes.items(), _STROKE_COLOURS):
         segments = _strokes(raster, points, field, camera, normals)
