@@ -1,0 +1,108 @@
+"""``meshcurv batch``: the command over :func:`meshcurv.batch.run`.
+
+It is added to the ``meshcurv`` group by :mod:`meshcurv._cli_app` and uses its
+options; import :mod:`meshcurv._cli_app` (or run :func:`meshcurv.cli.main`),
+not this module, first.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import sys
+
+import click
+
+from ._cli_app import Session, common_options, method_options
+from .batch import OUTPUT_FORMATS, run
+
+__all__ = ["batch", "BatchBar"]
+
+_SHOWN_FAILURES = 10
+
+
+class BatchBar:
+    """Progress over the meshes of a batch on stderr: ``[####....] 12/200 meshes, 1 failed``.
+
+    Redrawn in place on a terminal; otherwise one line per percent at most.
+    """
+
+    def __init__(self, stream, *, tty: bool, width: int = 24):
+        self.stream = stream
+        self.tty = tty
+        self.width = width
+        self._shown = None
+
+    def __call__(self, done: int, total: int, failed: int) -> None:
+        if self.stream is None:
+            return
+        step = (done * 100 // total if total else 100, failed)
+        if not self.tty and step == self._shown:
+            return
+        self._shown = step
+        filled = round(self.width * done / total) if total else self.width
+        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} meshes, {failed} failed"
+        if self.tty:
+            self.stream.write(f"\r\033[K{text}")
+        else:
+            self.stream.write(f"meshcurv: {text}\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.stream is not None and self.tty and self._shown is not None:
+            self.stream.write("\r\033[K")
+            self.stream.flush()
+
+
+@click.command()
+@click.argument("inputs", nargs=-1, required=True)
+@click.option("-o", "--output-dir", "out_dir", required=True, type=click.Path(path_type=pathlib.Path),
+              help="Folder of the results and of summary.parquet / summary.csv (created if needed).")
+@method_options
+@click.option("--format", "output_format", type=click.Choice(OUTPUT_FORMATS), default="ply", show_default=True,
+              help="Format of the result files.")
+@click.option("--workers", type=click.IntRange(min=1), default=None,
+              help="Worker processes of the local cluster (default: one per core).")
+@click.option("--scheduler", metavar="ADDRESS", default=None,
+              help="Run on an existing Dask cluster, e.g. tcp://host:8786, instead of a local one.")
+@click.option("--overwrite", is_flag=True, help="Compute again the meshes whose results exist.")
+@common_options
+def batch(inputs, out_dir, method, smoothing_steps, radius, orient, output_format, workers, scheduler, overwrite):
+    """Curvatures of many meshes on Dask: INPUTS are files, folders and glob patterns.
+
+    \b
+    meshcurv batch scans/ -o results/                    a local cluster, one worker per core
+    meshcurv batch 'scans/**/*.ply' -o results/ --workers 4
+    meshcurv batch scans/ -o results/ --scheduler tcp://host:8786
+
+    Writes one result file per mesh to OUTDIR and a summary, one row per mesh,
+    to OUTDIR/summary.parquet and OUTDIR/summary.csv. A second run skips the
+    meshes whose results exist (--overwrite computes them again). Inputs and
+    OUTDIR must be on storage that every worker sees under the same paths.
+    Exits with 1 when a mesh failed (the summary has its error).
+    """
+    if workers is not None and scheduler is not None:
+        raise click.UsageError("--workers sizes the local cluster; leave it out with --scheduler "
+                               "(the cluster's own workers are used)")
+    session = click.get_current_context().find_object(Session)
+    stream = sys.stderr
+    show = session.progress if session.progress is not None else stream.isatty()
+    bar = BatchBar(stream if show else None, tty=stream.isatty())
+    try:
+        summary = run(list(inputs), out_dir, method=method, smoothing_steps=smoothing_steps, radius=radius,
+                      orient=orient, output_format=output_format, workers=workers, scheduler=scheduler,
+                      overwrite=overwrite, progress=bar)
+    finally:
+        bar.close()
+    counts = summary["status"].value_counts()
+    failures = summary[summary["status"] == "failed"]
+    session.info(f"{len(summary)} meshes: {counts.get('computed', 0)} computed, {counts.get('skipped', 0)} skipped "
+                 f"(done before), {len(failures)} failed; summary in {out_dir / 'summary.parquet'} and "
+                 f"{out_dir / 'summary.csv'}")
+    if failures.empty:
+        return 0
+    for path, error in zip(failures["path"][:_SHOWN_FAILURES], failures["error"][:_SHOWN_FAILURES]):
+        click.echo(f"meshcurv: failed: {path}: {error}", err=True)
+    if len(failures) > _SHOWN_FAILURES:
+        click.echo(f"meshcurv: ... and {len(failures) - _SHOWN_FAILURES} more (see the summary)", err=True)
+    click.echo(f"meshcurv: error: {len(failures)} of {len(summary)} meshes failed", err=True)
+    return 1

@@ -1,0 +1,584 @@
+"""Curvature of whole datasets: many mesh files at once, on a Dask cluster.
+
+:func:`run` expands files, folders and glob patterns into a list of meshes,
+computes the curvatures of each on a Dask cluster (a local one by default,
+started and closed by the call, or an existing one given by its scheduler
+address or a :class:`distributed.Client`), writes one result file per mesh
+and returns a summary table, one row per mesh, that it also writes to
+``OUT_DIR/summary.parquet`` and ``OUT_DIR/summary.csv``.
+
+Paths travel to the workers, not arrays: each worker reads its own file and
+writes its own result, so the inputs and ``OUT_DIR`` must be on storage that
+the machine calling :func:`run` and every worker see under the same paths
+(a local disk for a local cluster, a shared file system for a cluster).
+
+Needs ``pip install 'meshcurv[batch]'`` (dask.distributed, pandas, pyarrow).
+
+What is written (``OUT_DIR`` is created if needed):
+
+- one result file per mesh, ``OUT_DIR/<name>.<output_format>``, holding the
+  mesh and its curvature fields (:func:`meshcurv.io.write_curvatures`); inputs
+  in several folders keep their folders below the deepest folder they share;
+- a record per result in ``OUT_DIR/.meshcurv-batch/`` (its summary row, in
+  JSON), so that a later run can skip the mesh and still report it;
+- ``summary.parquet`` and ``summary.csv``, ordered by input path.
+
+Every file is written under a temporary name and renamed when complete: a
+result file that exists is complete, and a run that is interrupted or whose
+worker dies leaves no partial file (see :func:`run`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import glob
+import json
+import logging
+import os
+import pathlib
+import re
+import time
+import warnings
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ._validation import check_choice, check_int_option
+from .errors import InvalidOptionError, MeshFileError, MissingDependencyError
+
+__all__ = ["run", "process_mesh", "expand_inputs", "COLUMNS", "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS"]
+
+logger = logging.getLogger(__name__)
+
+#: The per-vertex fields summarised in each row (attributes of :class:`~meshcurv.CurvatureResult`).
+SUMMARY_FIELDS = ("k_min", "k_max", "mean", "gaussian", "shape_index", "curvedness")
+
+#: The statistics of each summarised field, over the valid vertices with a finite value.
+STATISTICS = ("mean", "median", "p5", "p95")
+
+#: The result file formats: those of :data:`meshcurv.io.FORMATS` that hold per-vertex fields.
+OUTPUT_FORMATS = ("ply", "npz", "vtp", "vtu", "vtk", "csv")
+
+#: The folder of ``OUT_DIR`` that holds one record (the summary row) per result file.
+RECORDS = ".meshcurv-batch"
+
+_SUMMARY_NAME = "summary"
+
+#: The columns of the summary, in order, with their pandas dtypes.
+COLUMNS = {
+    "path": "str",
+    "status": "str",
+    "n_vertices": "Int64",
+    "n_faces": "Int64",
+    "area": "float64",
+    "volume": "float64",
+    "euler_characteristic": "Int64",
+    "n_components": "Int64",
+    "n_boundary_loops": "Int64",
+    **{f"{field}_{statistic}": "float64" for field in SUMMARY_FIELDS for statistic in STATISTICS},
+    "n_invalid": "Int64",
+    "seconds": "float64",
+    "error": "str",
+    "warnings": "str",
+    "method": "str",
+    "output": "str",
+}
+
+#: Environment of the worker processes of the local cluster: one thread each for
+#: BLAS, OpenMP and numba, so that N workers use N cores and not N x N threads.
+WORKER_ENVIRONMENT = {
+    "OMP_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+    "NUMBA_NUM_THREADS": "1",
+}
+
+_GLOB_CHARACTERS = re.compile(r"[*?\[]")
+
+
+def _readable_extensions() -> set[str]:
+    from .io import FORMATS
+
+    return {extension for extension, fmt in FORMATS.items() if fmt.read is not None}
+
+
+def expand_inputs(inputs, *, exclude=None) -> list[pathlib.Path]:
+    """The mesh files named by files, folders and glob patterns, sorted by path.
+
+    Parameters
+    ----------
+    inputs : str, os.PathLike or sequence of them
+        Files (kept whatever their extension: a file that cannot be read
+        gets its error in the summary), folders (their mesh files, by the
+        extensions of :data:`meshcurv.io.FORMATS` that can be read, not
+        recursive, hidden files left out) and glob patterns (``*``, ``?``,
+        ``[...]``; ``**`` crosses folders; mesh files only).
+    exclude : str or os.PathLike, optional
+        A folder whose files are never inputs (the output folder).
+
+    Returns
+    -------
+    list of pathlib.Path
+        Each file once, sorted by its path as a string.
+
+    Raises
+    ------
+    MeshFileError
+        An input that is neither a file, a folder nor a pattern that matches
+        something; or nothing found at all.
+
+    Examples
+    --------
+    >>> import meshcurv, pathlib, tempfile
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> for name in ("b.obj", "a.off", "notes.txt"):
+    ...     _ = (folder / name).write_text("")
+    >>> [path.name for path in expand_inputs([folder])]
+    ['a.off', 'b.obj']
+    """
+    if isinstance(inputs, (str, os.PathLike)):
+        inputs = [inputs]
+    extensions = _readable_extensions()
+    excluded = os.path.abspath(exclude) if exclude is not None else None
+    found: dict[str, pathlib.Path] = {}
+
+    def add(path: pathlib.Path) -> None:
+        absolute = os.path.abspath(path)
+        if excluded is not None and (absolute == excluded or absolute.startswith(excluded + os.sep)):
+            return
+        found.setdefault(absolute, path)
+
+    for item in inputs:
+        text = os.fspath(item)
+        path = pathlib.Path(text)
+        if path.is_dir():
+            for child in sorted(path.iterdir()):
+                if child.is_file() and not child.name.startswith(".") and child.suffix.lower() in extensions:
+                    add(child)
+        elif path.is_file():
+            add(path)
+        elif _GLOB_CHARACTERS.search(text):
+            matches = [pathlib.Path(match) for match in glob.glob(text, recursive=True)]
+            matches = [match for match in matches if match.is_file() and match.suffix.lower() in extensions]
+            if not matches:
+                raise MeshFileError(f"{text}: the pattern matches no mesh file")
+            for match in matches:
+                add(match)
+        else:
+            raise MeshFileError(f"{text}: no such file or folder")
+    if not found:
+        listed = ", ".join(os.fspath(item) for item in inputs) or "(none)"
+        raise MeshFileError(f"no mesh file found in {listed} (mesh files end in {', '.join(sorted(extensions))})")
+    return sorted(found.values(), key=os.fspath)
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One mesh of a batch: where it is read, written and recorded (absolute paths)."""
+
+    path: pathlib.Path
+    source: str
+    output: str
+    record: str
+
+
+def _plan(paths: list[pathlib.Path], out_dir: pathlib.Path, suffix: str) -> list[_Job]:
+    absolute = [pathlib.Path(os.path.abspath(path)) for path in paths]
+    root = pathlib.Path(os.path.commonpath([path.parent for path in absolute]))
+    out_dir = pathlib.Path(os.path.abspath(out_dir))
+    jobs, claimed = [], {}
+    reserved = {out_dir / f"{_SUMMARY_NAME}.csv": "the summary", out_dir / f"{_SUMMARY_NAME}.parquet": "the summary"}
+    for path, source in zip(paths, absolute):
+        relative = source.relative_to(root).with_suffix(suffix)
+        output = out_dir / relative
+        if output in reserved or output in claimed:
+            other = reserved.get(output) or claimed[output]
+            raise InvalidOptionError(
+                f"{path} and {other} would both be written to {output}; "
+                "give them different names or process them in separate runs"
+            )
+        if output == source:
+            raise InvalidOptionError(f"{path}: its result would replace it; choose another output folder")
+        claimed[output] = path
+        record = out_dir / RECORDS / relative.with_name(relative.name + ".json")
+        jobs.append(_Job(path, os.fspath(source), os.fspath(output), os.fspath(record)))
+    return jobs
+
+
+def _options(method, smoothing_steps, radius, orient) -> dict:
+    """The options given, validated by a computation on a small mesh (the errors of principal_curvatures)."""
+    from . import shapes
+    from .curvature import METHODS, principal_curvatures
+    from .estimators import ESTIMATORS
+
+    check_choice(method, "method", METHODS)
+    given = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
+    given = {name: value for name, value in given.items() if value is not None}
+    probe = shapes.icosphere(2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = principal_curvatures(probe.vertices, probe.faces, method=method, **given)
+    # the same computation is asked the same way whatever the spelling: defaults left out, plain types
+    defaults = {**ESTIMATORS[method].options, "orient": "keep"}
+    options = {"method": method}
+    for name, value in given.items():
+        value = result.parameters.get(name, value) if name != "radius" else float(value)
+        if value != defaults.get(name):
+            options[name] = value.item() if isinstance(value, np.generic) else value
+    return options
+
+
+def _statistics(result) -> dict:
+    row = {}
+    for name in SUMMARY_FIELDS:
+        values = np.asarray(getattr(result, name))[result.valid]
+        values = values[np.isfinite(values)]
+        if values.size:
+            p5, median, p95 = np.percentile(values, [5, 50, 95])
+            figures = {"mean": values.mean(), "median": median, "p5": p5, "p95": p95}
+        else:
+            figures = dict.fromkeys(STATISTICS, np.nan)
+        row.update({f"{name}_{statistic}": float(figures[statistic]) for statistic in STATISTICS})
+    return row
+
+
+def _stale_temporaries(output: pathlib.Path) -> list[pathlib.Path]:
+    """Temporary files left beside ``output`` by writes that never finished (a killed process).
+
+    :func:`meshcurv.io._files.atomic_output` names them ``.<name>.<random><suffix>``
+    in the folder of ``<name>``; a temporary of a temporary starts with ``..<name>.``.
+    """
+    if not output.parent.is_dir():
+        return []
+    pattern = glob.escape(f".{output.name}.") + "*" + glob.escape(output.suffix)
+    nested = glob.escape(f"..{output.name}.") + "*" + glob.escape(output.suffix)
+    return sorted({*output.parent.glob(pattern), *output.parent.glob(nested)})
+
+
+def _write_record(path: pathlib.Path, record: dict) -> None:
+    from .io._files import atomic_output
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_output(path) as temporary:
+        temporary.write_text(json.dumps(record, allow_nan=True))
+
+
+def _read_record(path: pathlib.Path) -> dict | None:
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def process_mesh(source, output, record, *, method: str = "normal_cycle", smoothing_steps: int | None = None,
+                 radius: float | None = None, orient: str | None = None) -> dict:
+    """Compute the curvatures of one mesh file, write the result and its record, return its summary row.
+
+    The task :func:`run` sends to the workers; it never raises for a bad mesh.
+    The result file is written under a temporary name; the record is written
+    before the result is renamed into place, so a result that exists always
+    has its record. An older result at ``output`` is replaced.
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        The mesh file (any format :func:`meshcurv.read_mesh` reads).
+    output : str or os.PathLike
+        The result file; its extension picks the format (one of
+        :data:`OUTPUT_FORMATS`). Its folder is created if needed.
+    record : str or os.PathLike
+        The JSON file that keeps the row, for later runs.
+    method, smoothing_steps, radius, orient
+        As in :func:`meshcurv.principal_curvatures`.
+
+    Returns
+    -------
+    dict
+        The summary row (the keys of :data:`COLUMNS` but ``path``), with
+        ``status`` ``'computed'``, or ``'failed'`` and the ``error`` (its type
+        and message) when the mesh could not be read, computed or written.
+    """
+    from .curvature import principal_curvatures
+    from .io import read_mesh, write_curvatures
+    from .io._files import atomic_output
+
+    start = time.perf_counter()
+    source, output, record = pathlib.Path(source), pathlib.Path(output), pathlib.Path(record)
+    options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
+    options = {name: value for name, value in options.items() if value is not None}
+    row = {"status": "computed", "error": "", "warnings": "", "method": method, "output": os.fspath(output)}
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            vertices, faces = read_mesh(source)
+            result = principal_curvatures(vertices, faces, method=method, **options)
+        facts = result.diagnosis
+        row.update(
+            n_vertices=facts.n_vertices, n_faces=facts.n_faces, area=facts.area,
+            volume=np.nan if facts.volume is None else facts.volume,
+            euler_characteristic=facts.euler_characteristic, n_components=facts.n_components,
+            n_boundary_loops=facts.n_boundary_loops, n_invalid=int((~result.valid).sum()),
+            warnings="; ".join(dict.fromkeys(str(warning.message) for warning in caught)),
+        )
+        row.update(_statistics(result))
+        output.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_output(output) as temporary:
+            write_curvatures(temporary, vertices, faces, result, overwrite=True, source=source)
+            output.unlink(missing_ok=True)  # an older result must not outlive a newer record
+            row["seconds"] = time.perf_counter() - start
+            _write_record(record, {"row": row, "options": {"method": method, **options}})
+    except Exception as exc:  # one bad mesh never sinks the batch: its row says what went wrong
+        row = {"status": "failed", "error": f"{type(exc).__name__}: {exc}", "warnings": "", "method": method,
+               "output": "", "seconds": time.perf_counter() - start}
+        logger.info("%s failed: %s", source, row["error"])
+    return row
+
+
+def _dependencies():
+    try:
+        import distributed
+        import pandas
+        import pyarrow  # noqa: F401 (the Parquet writer of pandas)
+    except ImportError as exc:
+        raise MissingDependencyError(
+            f"meshcurv.batch needs {exc.name or 'dask.distributed, pandas and pyarrow'}: "
+            "pip install 'meshcurv[batch]'"
+        ) from None
+    return distributed, pandas
+
+
+@contextlib.contextmanager
+def _cluster(distributed, *, client, scheduler, workers):
+    """Yield ``(client, owned)``: the given client, one connected to ``scheduler``, or a new local cluster's."""
+    if client is not None:
+        yield client, False
+    elif scheduler is not None:
+        with distributed.Client(scheduler) as connected:
+            yield connected, False
+    else:
+        from dask.system import CPU_COUNT
+
+        n_workers = workers if workers is not None else CPU_COUNT
+        with distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                      host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                                      env=dict(WORKER_ENVIRONMENT)) as cluster, \
+                distributed.Client(cluster) as local:
+            yield local, True
+
+
+def _dashboard(client) -> str | None:
+    try:
+        return client.dashboard_link if "dashboard" in client.scheduler_info().get("services", {}) else None
+    except Exception:  # no dashboard is not a reason to stop
+        return None
+
+
+def run(paths, out_dir, *, method: str = "normal_cycle", smoothing_steps: int | None = None,
+        radius: float | None = None, orient: str | None = None, output_format: str = "ply", client=None,
+        scheduler: str | None = None, workers: int | None = None, overwrite: bool = False,
+        progress: Callable[[int, int, int], None] | None = None):
+    """Compute the curvatures of many mesh files on a Dask cluster and summarise them.
+
+    Parameters
+    ----------
+    paths : str, os.PathLike or sequence of them
+        Mesh files, folders and glob patterns (see :func:`expand_inputs`).
+        Files inside ``out_dir`` are never inputs.
+    out_dir : str or os.PathLike
+        The folder of the results and the summary; created if needed.
+    method : str, default: 'normal_cycle'
+        Any of :data:`meshcurv.METHODS`.
+    smoothing_steps, radius, orient : optional
+        As in :func:`meshcurv.principal_curvatures` (checked before anything runs).
+    output_format : {'ply', 'npz', 'vtp', 'vtu', 'vtk', 'csv'}, default: 'ply'
+        The format of the result files (PLY, VTK and VTU need
+        ``meshcurv[io]``, which the ``batch`` extra includes).
+    client : distributed.Client, optional
+        Run on the cluster of this client (left open).
+    scheduler : str, optional
+        The address of a running Dask scheduler (``'tcp://host:8786'``) to
+        connect to, for the duration of the call.
+    workers : int, optional
+        The number of worker processes of the local cluster started when
+        neither ``client`` nor ``scheduler`` is given (default: one per core),
+        each with one thread (and ``OMP_NUM_THREADS``, ``NUMBA_NUM_THREADS``
+        ... set to 1).
+    overwrite : bool, default: False
+        Compute every mesh again. By default a mesh whose result file exists
+        (with its record) is skipped: its row is the one recorded then.
+    progress : callable, optional
+        Called as ``progress(done, total, failed)`` once before the first mesh
+        (``done`` counts the skipped ones) and after each mesh.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per mesh, ordered by path, with the columns of
+        :data:`COLUMNS`: ``path`` (as expanded from ``paths``), ``status``
+        (``'computed'``, ``'skipped'`` or ``'failed'``), vertex and face
+        counts, area, volume (closed meshes; NaN otherwise), Euler
+        characteristic, components, boundary loops; for each of
+        :data:`SUMMARY_FIELDS` the mean, median, 5th and 95th percentiles over
+        the valid vertices (``mean_median`` is the median of the mean
+        curvature H); the number of invalid vertices; the seconds the mesh
+        took; the error (its type and message) of a failed mesh, the warnings
+        of the computation, the method and the result file. The same table is
+        written to ``out_dir/summary.parquet`` and ``out_dir/summary.csv``
+        (replaced at each run, written atomically).
+
+    Raises
+    ------
+    MeshFileError
+        An input that does not exist or matches nothing; a result file that
+        exists but was not written by a batch (no record) without ``overwrite``.
+    InvalidOptionError
+        Bad options; two inputs that would write the same result; results of
+        another method or options in ``out_dir`` without ``overwrite``.
+    MissingDependencyError
+        dask.distributed, pandas or pyarrow is not installed.
+
+    Notes
+    -----
+    One bad file never stops the batch: its row has status ``'failed'`` and
+    the error. When a worker process dies (killed, out of memory), Dask runs
+    its task again on another worker; a mesh whose task has killed
+    ``distributed.scheduler.allowed-failures`` + 1 workers (3 + 1 by default)
+    is reported as failed. Files are written under temporary names and renamed
+    when complete; temporaries left by a killed worker are removed when the
+    batch ends. An interrupted call (KeyboardInterrupt) writes no summary; the
+    next call resumes where it stopped.
+
+    Examples
+    --------
+    Not run as a doctest (it starts a cluster)::
+
+        import meshcurv, meshcurv.batch
+
+        summary = meshcurv.batch.run("scans/*.ply", "results", workers=4)
+        summary[["path", "area", "mean_median", "error"]]
+
+        # the same meshes on a running cluster (dask scheduler / dask worker, SLURM, Kubernetes)
+        summary = meshcurv.batch.run("scans/*.ply", "results", scheduler="tcp://head-node:8786")
+    """
+    distributed, pandas = _dependencies()
+    check_choice(output_format, "output_format", OUTPUT_FORMATS)
+    if client is not None and scheduler is not None:
+        raise InvalidOptionError("give `client` or `scheduler`, not both")
+    if workers is not None:
+        if client is not None or scheduler is not None:
+            raise InvalidOptionError("`workers` sizes the local cluster; it cannot be used with `client` or `scheduler`")
+        workers = check_int_option(workers, "workers", minimum=1)
+    options = _options(method, smoothing_steps, radius, orient)
+    out_dir = pathlib.Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise MeshFileError(f"{out_dir}: is a file; the output must be a folder")
+    jobs = _plan(expand_inputs(paths, exclude=out_dir), out_dir, "." + output_format)
+    out_dir.mkdir(parents=True, exist_ok=True)
+
+    rows: dict[int, dict] = {}
+    todo = []
+    for index, job in enumerate(jobs):
+        stored = _completed(job, options, overwrite=overwrite)
+        if stored is None:
+            todo.append(index)
+        else:
+            rows[index] = {**stored, "status": "skipped"}
+    failed = 0
+    if progress is not None:
+        progress(len(rows), len(jobs), failed)
+    logger.info("%d meshes: %d to compute, %d already done", len(jobs), len(todo), len(rows))
+
+    if todo:
+        owned = False
+        try:
+            with _cluster(distributed, client=client, scheduler=scheduler, workers=workers) as (active, owned):
+                logger.info("Dask dashboard: %s", _dashboard(active) or "none (pip install bokeh to have one)")
+                futures = active.map(process_mesh, [jobs[index].source for index in todo],
+                                     [jobs[index].output for index in todo],
+                                     [jobs[index].record for index in todo], pure=False, **options)
+                positions = {future.key: index for future, index in zip(futures, todo)}
+                try:
+                    for future, outcome in distributed.as_completed(futures, with_results=True,
+                                                                    raise_errors=False):
+                        index = positions[future.key]
+                        rows[index] = _lost(outcome, distributed) if isinstance(outcome, BaseException) else outcome
+                        failed += rows[index]["status"] == "failed"
+                        future.release()
+                        if progress is not None:
+                            progress(len(rows), len(jobs), failed)
+                except BaseException:
+                    active.cancel(futures)
+                    raise
+                if not owned:  # every task has ended: what a dead worker left half-written can go
+                    _remove_temporaries(jobs, todo)
+        finally:
+            if owned:  # the local workers are gone (also after an interruption)
+                _remove_temporaries(jobs, todo)
+
+    summary = _summary(pandas, jobs, rows)
+    _write_summary(summary, out_dir)
+    return summary
+
+
+def _completed(job: _Job, options: dict, *, overwrite: bool) -> dict | None:
+    """The recorded row of a mesh whose result exists, or None when it is to be computed."""
+    output, record = pathlib.Path(job.output), pathlib.Path(job.record)
+    if overwrite or not output.exists():
+        return None
+    stored = _read_record(record)
+    if stored is None:
+        raise MeshFileError(
+            f"{output}: exists but was not written by meshcurv batch (no record in {record.parent}); "
+            "pass overwrite=True (--overwrite) to replace it, or choose another output folder"
+        )
+    if stored.get("options") != options:
+        raise InvalidOptionError(
+            f"{output}: holds results computed with {_describe(stored.get('options'))}, not "
+            f"{_describe(options)}; pass overwrite=True (--overwrite) to recompute, or choose another output folder"
+        )
+    return stored["row"]
+
+
+def _describe(options) -> str:
+    return ", ".join(f"{name}={value!r}" for name, value in (options or {}).items()) or "unknown options"
+
+
+def _lost(exc: BaseException, distributed) -> dict:
+    if isinstance(exc, distributed.KilledWorker):
+        error = f"KilledWorker: every worker that ran this mesh died ({exc})"
+    else:
+        error = f"{type(exc).__name__}: {exc}"
+    return {"status": "failed", "error": error, "warnings": "", "output": ""}
+
+
+def _remove_temporaries(jobs: list[_Job], indices: list[int]) -> None:
+    for index in indices:
+        for target in (pathlib.Path(jobs[index].output), pathlib.Path(jobs[index].record)):
+            for temporary in _stale_temporaries(target):
+                logger.info("removing %s, left by an interrupted write", temporary)
+                temporary.unlink(missing_ok=True)
+
+
+def _summary(pandas, jobs: list[_Job], rows: dict[int, dict]):
+    records = [{**rows[index], "path": os.fspath(job.path)} for index, job in enumerate(jobs)]
+    frame = pandas.DataFrame.from_records(records, columns=list(COLUMNS))
+    for name, dtype in COLUMNS.items():
+        if dtype == "str":
+            frame[name] = frame[name].fillna("").astype(str)
+        else:
+            frame[name] = frame[name].astype(dtype)
+    return frame
+
+
+def _write_summary(summary, out_dir: pathlib.Path) -> None:
+    from .io._files import atomic_output
+
+    for suffix in (".parquet", ".csv"):
+        path = out_dir / f"{_SUMMARY_NAME}{suffix}"
+        with atomic_output(path) as temporary:
+            if suffix == ".parquet":
+                summary.to_parquet(temporary, index=False)
+            else:
+                summary.to_csv(temporary, index=False)
+        logger.info("wrote %s", path)
