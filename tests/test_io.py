@@ -12,7 +12,7 @@ import pytest
 import meshcurv
 from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshFileError, MissingDependencyError
 from meshcurv.io import FORMATS, Mesh, write_curvatures
-from meshcurv.io.fields import curvature_fields, curvedness, shape_index
+from meshcurv.io.fields import curvature_fields
 
 MESHES = pathlib.Path("/work/shared/meshes")
 MESH_FORMATS = [".obj", ".ply", ".stl", ".off", ".vtk", ".vtu", ".vtp", ".npz"]
@@ -487,15 +487,6 @@ def test_failed_backend_write_is_a_mesh_file_error(tmp_path, torus, monkeypatch)
 
 
 # ---------------------------------------------------------------- fields
-
-
-def test_shape_index_and_curvedness_on_analytic_surfaces():
-    cylinder = meshcurv.shapes.cylinder(radius=2.0)  # k = 0 and 1/2: a ridge
-    np.testing.assert_allclose(shape_index(cylinder.k_min, cylinder.k_max), 0.5)
-    np.testing.assert_allclose(curvedness(cylinder.k_min, cylinder.k_max), np.sqrt(0.125))
-    np.testing.assert_allclose(shape_index([-0.5], [-0.5]), [-1.0])  # a cup
-    np.testing.assert_allclose(shape_index([-2.0], [2.0]), [0.0])  # a symmetric saddle
-    assert np.isnan(shape_index([0.0], [0.0])).all()  # flat: undefined
 
 
 def test_curvature_fields_errors(torus):

@@ -427,6 +427,4 @@ def demo(output, overwrite):
     from .plotting import _pyplot
 
     _pyplot()
-    if output.exists() and not overwrite:
-        check_output(output, overwrite=False)
     click.echo(run_demo(output, overwrite=overwrite))

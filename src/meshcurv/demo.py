@@ -28,14 +28,16 @@ def run_demo(output: str | os.PathLike = "torus_gaussian.png", *, overwrite: boo
     ``overwrite=True``), creating its folder, and returns a short summary
     comparing the estimate to the exact curvatures of the torus.
     """
+    from .io._files import check_output
     from .plotting import plot_field, save_figure
 
+    output = pathlib.Path(output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    check_output(output, overwrite=overwrite)  # before the work, not after
     torus = shapes.torus()
     result = principal_curvatures(torus.vertices, torus.faces)
     compat = principal_curvatures(torus.vertices, torus.faces, method="matgeom")
 
-    output = pathlib.Path(output)
-    output.parent.mkdir(parents=True, exist_ok=True)
     fig = plot_field(torus.vertices, torus.faces, result.gaussian, view=["iso", "top"],
                      label="Gaussian curvature K (1/length²)",
                      title="matGeom's torusMesh (R 30, r 10): K = k_min · k_max")

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..errors import InvalidOptionError
 
-__all__ = ["FIELDS", "curvature_fields", "shape_index", "curvedness"]
+__all__ = ["FIELDS", "curvature_fields"]
 
 #: The fields :func:`curvature_fields` can produce, in file order, with what they are.
 FIELDS = {
@@ -21,54 +21,6 @@ FIELDS = {
     "normals": "unit vertex normal (3-vector)",
     "valid": "1 where the estimate is defined, 0 where it is not",
 }
-
-
-def shape_index(k_min, k_max) -> np.ndarray:
-    """Koenderink and van Doorn's shape index, from the principal curvatures.
-
-    Parameters
-    ----------
-    k_min, k_max : array_like of shape (V,)
-        Principal curvatures, ``k_min <= k_max``.
-
-    Returns
-    -------
-    ndarray of shape (V,)
-        ``S = (2 / pi) * arctan((k_max + k_min) / (k_max - k_min))`` in [-1, 1]:
-        +1 on a spherical cap (bending away from the normal, as an outward
-        sphere), +0.5 on a ridge (cylinder), 0 on a symmetric saddle, -1 on a
-        cup. Undefined (NaN) on flat points, where both curvatures are 0.
-
-    References
-    ----------
-    J. J. Koenderink and A. J. van Doorn (1992). Surface shape and curvature
-    scales. Image and Vision Computing 10(8), 557-564.
-    https://doi.org/10.1016/0262-8856(92)90076-F
-
-    Examples
-    --------
-    >>> from meshcurv.io.fields import shape_index
-    >>> shape_index([1.0, 0.0, -1.0], [1.0, 1.0, 1.0]).tolist()
-    [1.0, 0.5, 0.0]
-    """
-    k_min = np.asarray(k_min, dtype=np.float64)
-    k_max = np.asarray(k_max, dtype=np.float64)
-    index = (2 / np.pi) * np.arctan2(k_max + k_min, k_max - k_min)
-    return np.where((k_min == 0) & (k_max == 0), np.nan, index)
-
-
-def curvedness(k_min, k_max) -> np.ndarray:
-    """Koenderink and van Doorn's curvedness ``sqrt((k_min² + k_max²) / 2)``, in 1/length.
-
-    Examples
-    --------
-    >>> from meshcurv.io.fields import curvedness
-    >>> curvedness([0.5], [0.5]).tolist()      # a sphere of radius 2
-    [0.5]
-    """
-    k_min = np.asarray(k_min, dtype=np.float64)
-    k_max = np.asarray(k_max, dtype=np.float64)
-    return np.sqrt((k_min**2 + k_max**2) / 2)
 
 
 def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> dict[str, np.ndarray]:
@@ -125,6 +77,4 @@ _NOT_FOR_QUALITY = ("dir_min", "dir_max", "normals", "valid")
 def _field(result, name: str) -> np.ndarray:
     if name == "valid":
         return result.valid.astype(np.uint8)
-    if name in ("shape_index", "curvedness") and not hasattr(result, name):
-        return (shape_index if name == "shape_index" else curvedness)(result.k_min, result.k_max)
     return np.array(getattr(result, name), dtype=np.float64)
