@@ -5,6 +5,8 @@ installed are listed as such in the table)::
 
     python benchmarks/accuracy.py            # writes benchmarks/accuracy.md
     python benchmarks/accuracy.py --quick    # the two coarser resolutions only
+    python benchmarks/accuracy.py --families sphere:irregular torus --resolutions 0 1 \
+        --methods icc quadric MeshLab --output /tmp/subset.md   # a subset (never overwrite the table)
 
 Surfaces (``meshcurv.shapes``): sphere (r 1), torus (R 3, r 1), ellipsoid
 (3, 2, 1), open cylinder (r 1, height 4), saddle ``z = x^2 - y^2`` on [-1, 1]^2,
@@ -48,8 +50,19 @@ OUTPUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy.md")
 
 # -- meshes -----------------------------------------------------------------------
 
-def surfaces(levels):
-    """Yield ``(surface, variant, level, mesh)``."""
+def _selected(families, surface, variant):
+    """True when ``surface variant`` matches one of ``families`` (``"torus"`` or ``"torus:noise 0.1h"``)."""
+    if not families:
+        return True
+    for family in families:
+        name, _, kind = family.partition(":")
+        if name == surface and (not kind or kind == variant):
+            return True
+    return False
+
+
+def surfaces(levels, families=None):
+    """Yield ``(surface, variant, level, mesh)`` (only the selected ``families``, built lazily)."""
     sphere_n = [8, 16, 32]
     torus_n = [(48, 16), (96, 32), (192, 64)]
     cylinder_n = [(24, 16), (48, 32), (96, 64)]
@@ -57,27 +70,34 @@ def surfaces(levels):
     for level in levels:
         n = sphere_n[level]
         regular = {
-            "sphere": shapes.icosphere(n),
-            "torus": shapes.torus(3.0, 1.0, *torus_n[level]),
-            "ellipsoid": shapes.ellipsoid((3.0, 2.0, 1.0), n),
-            "cylinder": shapes.cylinder(1.0, 4.0, *cylinder_n[level]),
-            "saddle": shapes.saddle(1.0, saddle_h[level]),
-            "hemisphere": shapes.hemisphere(n),
+            "sphere": lambda: shapes.icosphere(n),
+            "torus": lambda: shapes.torus(3.0, 1.0, *torus_n[level]),
+            "ellipsoid": lambda: shapes.ellipsoid((3.0, 2.0, 1.0), n),
+            "cylinder": lambda: shapes.cylinder(1.0, 4.0, *cylinder_n[level]),
+            "saddle": lambda: shapes.saddle(1.0, saddle_h[level]),
+            "hemisphere": lambda: shapes.hemisphere(n),
         }
         irregular = {
-            "sphere": shapes.random_sphere(10 * n * n + 2, seed=level),
-            "torus": shapes.torus(3.0, 1.0, *torus_n[level], jitter=0.35, seed=level),
-            "ellipsoid": shapes.random_ellipsoid((3.0, 2.0, 1.0), 10 * n * n + 2, seed=level),
-            "cylinder": shapes.cylinder(1.0, 4.0, *cylinder_n[level], jitter=0.35, seed=level),
-            "saddle": shapes.saddle(1.0, saddle_h[level], jitter=0.35, seed=level),
-            "hemisphere": shapes.hemisphere(n, irregular=True, seed=level),
+            "sphere": lambda: shapes.random_sphere(10 * n * n + 2, seed=level),
+            "torus": lambda: shapes.torus(3.0, 1.0, *torus_n[level], jitter=0.35, seed=level),
+            "ellipsoid": lambda: shapes.random_ellipsoid((3.0, 2.0, 1.0), 10 * n * n + 2, seed=level),
+            "cylinder": lambda: shapes.cylinder(1.0, 4.0, *cylinder_n[level], jitter=0.35, seed=level),
+            "saddle": lambda: shapes.saddle(1.0, saddle_h[level], jitter=0.35, seed=level),
+            "hemisphere": lambda: shapes.hemisphere(n, irregular=True, seed=level),
         }
-        for name, mesh in regular.items():
-            yield name, "regular", level, mesh
-            yield name, "irregular", level, irregular[name]
-            if name != "hemisphere":
-                for noise in (0.1, 0.3):
-                    yield name, f"noise {noise}h", level, shapes.with_normal_noise(mesh, noise, seed=level)
+        for name, build in regular.items():
+            variants = ["regular", "irregular"] + ([] if name == "hemisphere" else ["noise 0.1h", "noise 0.3h"])
+            if not any(_selected(families, name, v) for v in variants):
+                continue
+            mesh = build()
+            if _selected(families, name, "regular"):
+                yield name, "regular", level, mesh
+            if _selected(families, name, "irregular"):
+                yield name, "irregular", level, irregular[name]()
+            for noise in (0.1, 0.3):
+                variant = f"noise {noise}h"
+                if variant in variants and _selected(families, name, variant):
+                    yield name, variant, level, shapes.with_normal_noise(mesh, noise, seed=level)
 
 
 # -- peers ------------------------------------------------------------------------
@@ -167,8 +187,13 @@ def _meshlab(v, f, method):
     return np.minimum(a, b), np.maximum(a, b), nan, dir_max
 
 
-def peers():
-    """name -> (function(v, f, radius), package) for the peers that import."""
+def _wanted(label, methods):
+    """True when ``label`` contains one of ``methods`` (case-insensitive), or no filter."""
+    return not methods or any(m.lower() in label.lower() for m in methods)
+
+
+def peers(methods=None):
+    """name -> (function(v, f, radius), package) for the peers that import (and are selected)."""
     found, missing = {}, {}
     candidates = [
         ("libigl principal_curvature (5-ring quadric)", "igl", "libigl", lambda v, f, r: peer_libigl(v, f)),
@@ -181,6 +206,8 @@ def peers():
         ("MeshLab Taubin", "pymeshlab", "pymeshlab", lambda v, f, r: peer_meshlab(v, f, "Taubin approximation")),
     ]
     for name, module, dist, function in candidates:
+        if not _wanted(name, methods):
+            continue
         try:
             __import__(module)
             found[name] = (function, f"{dist} {importlib.metadata.version(dist)}")
@@ -208,12 +235,12 @@ def errors(mesh, k_min, k_max, dir_max, mask):
     return out
 
 
-def run(levels):
-    found, missing = peers()
-    methods = {f"meshcurv {name}": None for name in ESTIMATORS}
+def run(levels, families=None, methods=None):
+    found, missing = peers(methods)
+    methods = {label: None for label in (f"meshcurv {name}" for name in ESTIMATORS) if _wanted(label, methods)}
     rows = []
     timings = {}
-    for surface, variant, level, mesh in surfaces(levels):
+    for surface, variant, level, mesh in surfaces(levels, families):
         topology = meshcurv.MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0])
         boundary = topology.boundary_vertices
         radius = default_radius(mesh.vertices, topology)
@@ -311,11 +338,16 @@ def markdown(rows, found, missing, timings, levels):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the two coarser resolutions only")
-    parser.add_argument("--levels", type=int, nargs="+", help="resolutions to run (0, 1, 2)")
+    parser.add_argument("--levels", "--resolutions", type=int, nargs="+", dest="levels",
+                        help="resolutions to run (0, 1, 2)")
+    parser.add_argument("--families", nargs="+", metavar="SURFACE[:VARIANT]",
+                        help="surfaces or surface:variant pairs to run, e.g. torus 'sphere:noise 0.1h' (default: all)")
+    parser.add_argument("--methods", nargs="+", metavar="NAME",
+                        help="methods whose label contains one of these (case-insensitive), e.g. icc MeshLab")
     parser.add_argument("--output", default=OUTPUT, help="markdown file to write (default: %(default)s)")
     args = parser.parse_args(argv)
     levels = args.levels or ([0, 1] if args.quick else [0, 1, 2])
-    rows, found, missing, timings = run(levels)
+    rows, found, missing, timings = run(levels, args.families, args.methods)
     text = markdown(rows, found, missing, timings, levels)
     with open(args.output, "w") as handle:
         handle.write(text)

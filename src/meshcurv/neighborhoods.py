@@ -15,8 +15,6 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from ._validation import check_positive_float
 from .geometry import mean_edge_length
@@ -58,25 +56,30 @@ def resolve_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> floa
     return check_positive_float(radius, "radius")
 
 
-def _chunks(n: int) -> Iterator[slice]:
-    for start in range(0, n, CHUNK):
-        yield slice(start, min(n, start + CHUNK))
+def _chunks(n: int, size: int = CHUNK) -> Iterator[slice]:
+    for start in range(0, n, size):
+        yield slice(start, min(n, start + size))
 
 
-def _pairs(tree: cKDTree, centers: np.ndarray, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
-    """(i, j): centre ``i`` and tree point ``j`` no farther apart than ``cutoff``."""
+def _pairs(tree, centers: np.ndarray, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
+    """(i, j): centre ``i`` and point ``j`` of ``tree`` (a ``cKDTree``) no farther apart than ``cutoff``."""
+    from scipy.spatial import cKDTree  # imported on use: scipy.spatial costs import time
+
     found = cKDTree(centers).sparse_distance_matrix(tree, cutoff, output_type="ndarray")
     return found["i"].astype(np.int64), found["j"].astype(np.int64)
 
 
-def vertex_pairs_in_ball(points: np.ndarray, radius: float) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+def vertex_pairs_in_ball(points: np.ndarray, radius: float, *, chunk_size: int = CHUNK
+                         ) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """Yield ``(chunk, centre, neighbour)``: every point within ``radius`` of each centre.
 
-    ``centre`` indexes all points (absolute), grouped by chunk of centres;
-    ``neighbour`` is the point within the ball (the centre itself included).
+    ``centre`` indexes all points (absolute), grouped by chunk of ``chunk_size``
+    centres; ``neighbour`` is the point within the ball (the centre itself included).
     """
+    from scipy.spatial import cKDTree
+
     tree = cKDTree(points)
-    for chunk in _chunks(points.shape[0]):
+    for chunk in _chunks(points.shape[0], chunk_size):
         i, j = _pairs(tree, points[chunk], radius)
         yield chunk, i + chunk.start, j
 
@@ -117,6 +120,9 @@ def segment_in_ball_lengths(starts: np.ndarray, ends: np.ndarray, centers: np.nd
 def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: np.ndarray,
                usable: np.ndarray | None, weight) -> np.ndarray:
     """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices."""
+    import scipy.sparse as sp
+    from scipy.spatial import cKDTree
+
     if usable is not None:
         keep = np.flatnonzero(usable)
         cells, values = cells[keep], values[keep]

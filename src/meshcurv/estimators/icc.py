@@ -1,7 +1,15 @@
 """Interpolated corrected curvature measures over a ball (Lachaud, Romon, Thibert, Coeurjolly 2020).
 
-The vertex normals ``u_i`` (area-weighted mean of the face normals) are
-interpolated linearly over each triangle ``(x_i, x_j, x_k)``; the curvature
+The vertex normals ``u_i`` are those of a weighted degree-2 jet fitted over the
+same ball ``B(x_i, r)`` with one normal re-estimation
+(:func:`meshcurv.estimators.quadric.fit_jets`; Cazals and Pouget 2005), not the
+area-weighted mean of the face normals: the corrected measures are only as
+good as the normals they interpolate, and the mean of the face normals has an
+error of order ``h`` on an irregular triangulation (a median error of H of 2%
+on a random sphere, against 0.01% with the fitted normals) and is one-sided at
+a boundary, where the fit extrapolates (a degree-2 fit needs six points with
+non-zero weight; where it fails, the mean of the face normals is kept). The
+normals ``u_i`` are interpolated linearly over each triangle ``(x_i, x_j, x_k)``; the curvature
 measures of the corrected normal current then have closed forms per face, with
 ``ū = (u_i + u_j + u_k) / 3``:
 
@@ -26,11 +34,15 @@ eigenvalues of the ball-summed tensor carry a bias of order ``(r k)^2`` (the
 tangent planes turn inside the ball), several times larger than that of
 ``mu_1`` and ``mu_2`` (on a torus with 2.5 edge lengths: 5% against 0.5%).
 
-Boundaries need no special case: the measures and the corrected area both stop
-at the boundary, so boundary vertices are valid.
+Boundaries need no special case beyond the fitted normals: the measures and
+the corrected area both stop at the boundary, so boundary vertices are valid.
 
 References
 ----------
+F. Cazals and M. Pouget (2005). Estimating differential quantities using
+polynomial fitting of osculating jets. Computer Aided Geometric Design 22(2),
+121-146. https://doi.org/10.1016/j.cagd.2004.09.004
+
 J.-O. Lachaud, P. Romon, B. Thibert, D. Coeurjolly (2020). Interpolated
 corrected curvature measures for polygonal surfaces. Computer Graphics Forum
 39(5), 41-54. https://doi.org/10.1111/cgf.14067
@@ -45,8 +57,12 @@ from ..neighborhoods import ball_face_sums, resolve_radius
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
+from .quadric import fit_jets, shape_operators
 
-STAGES = ("compute normals", "compute face measures", "sum over balls", "retrieve curvatures")
+#: Degree of the jet whose normals the measures interpolate (2: least sensitive to noise).
+NORMAL_DEGREE = 2
+
+STAGES = ("compute normals", "fit normals", "compute face measures", "sum over balls", "retrieve curvatures")
 
 
 def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -71,11 +87,25 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
     return np.column_stack([mu0, mu1, mu2, sym])
 
 
+def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, radius: float) -> np.ndarray:
+    """(V, 3) normals of weighted degree-2 jets over balls of ``radius`` (``normals`` where no fit)."""
+    if not radius > 0:
+        return normals
+    start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
+    coefficients, frame, _ = fit_jets(vertices, start, radius, degree=NORMAL_DEGREE)
+    _, fitted = shape_operators(coefficients, frame, radius)
+    usable = valid & np.isfinite(fitted).all(axis=1)
+    return np.where(usable[:, None], fitted, normals)
+
+
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
     """Interpolated corrected curvature measures over balls. Returns ``(result, problems)``."""
     stages.start("compute normals")
     radius = resolve_radius(radius, vertices, topology)
     _, degenerate, defects, normals, valid = prepare(vertices, topology)
+
+    stages.start("fit normals")
+    normals = fitted_normals(vertices, normals, valid, radius)
 
     stages.start("compute face measures")
     faces = topology.faces

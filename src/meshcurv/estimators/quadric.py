@@ -1,35 +1,51 @@
-"""Least-squares quadric (osculating jet) fit in the local tangent frame (Cazals and Pouget 2005; Panozzo et al. 2010).
+"""Weighted osculating jet fit with normal re-estimation (Cazals and Pouget 2005; Panozzo et al. 2010).
 
-For vertex ``v`` with area-weighted normal ``n`` and tangent frame ``(t_1, t_2)``,
-every vertex ``x_j`` in the ball ``B(x_v, r)`` (the vertex itself included) gives
-local coordinates ``(u, v, w) = ((x_j - x_v) . t_1, (x_j - x_v) . t_2, (x_j - x_v) . n)``
-and the height function
+For vertex ``v`` with a frame ``(t_1, t_2, n)``, every vertex ``x_j`` in the ball
+``B(x_v, r)`` (the vertex itself included) gives local coordinates
+``(u_j, v_j, w_j) = ((x_j - x_v) . t_1, (x_j - x_v) . t_2, (x_j - x_v) . n)``, and the
+height function is fitted by weighted least squares as a polynomial (a *jet*) of
+degree ``d``:
 
 .. math::
 
-    w(u, v) = c_0 + d\\,u + e\\,v + a\\,u^2 + b\\,uv + c\\,v^2
+    w(u, v) = \\sum_{i + k \\le d} c_{ik}\\, u^i v^k, \\qquad
+    \\min_c \\sum_j \\omega_j \\big(w_j - w(u_j, v_j)\\big)^2, \\qquad
+    \\omega_j = \\big(1 - |x_j - x_v|^2 / r^2\\big)^2 .
 
-is fitted by least squares (a degree-2 jet: Cazals and Pouget's
-osculating jet of order 2; the quadric of Panozzo et al., with the ball of
-radius ``r`` instead of a number of rings). The constant and linear terms let
-the fit find its own point and tangent plane, which matters on noisy meshes.
-With ``p = d``, ``q = e``, ``W = sqrt(1 + p^2 + q^2)``, the first and second
-fundamental forms of the graph at ``(0, 0)`` are
+The degree is :data:`DEGREE` (4) where the ball holds enough points for a
+well-conditioned fit, else 3, else 2 (Cazals and Pouget: a degree-``d`` jet
+gives the curvatures with an error of order ``r^{d-1}`` on a smooth surface,
+against ``r`` or ``r^2`` for the quadric, the bias that grows as
+``(r k)^2``). The constant term is free (on a noisy mesh the vertex is not on
+the surface), and so are the linear terms.
+
+Normal re-estimation: the first fit runs in the frame of the area-weighted
+vertex normal; the fitted surface's normal ``(n - c_{10} t_1 - c_{01} t_2) /
+sqrt(1 + c_{10}^2 + c_{01}^2)`` (Cazals and Pouget's Monge basis) becomes the
+frame of a second fit, :data:`ITERATIONS` fits in all, so that the final fit is
+a height function over (almost) its own tangent plane, where the quadric
+coefficients are the second fundamental form (Panozzo et al. fit in the frame of
+an estimated normal the same way). From the last fit, with ``p = c_{10}``,
+``q = c_{01}`` and ``W = sqrt(1 + p^2 + q^2)``:
 
 .. math::
 
     I = \\begin{pmatrix} 1 + p^2 & pq \\\\ pq & 1 + q^2 \\end{pmatrix}, \\qquad
-    II = \\frac{1}{W} \\begin{pmatrix} 2a & b \\\\ b & 2c \\end{pmatrix}
+    II = \\frac{1}{W} \\begin{pmatrix} 2 c_{20} & c_{11} \\\\ c_{11} & 2 c_{02} \\end{pmatrix}
 
 and the shape operator in meshcurv's sign (positive where the surface bends
-away from its normal) is ``-I^{-1} II``; it is turned into a symmetric 3D
-tensor ``J I^{-1} (-II) I^{-1} J^T`` with ``J = [t_1 + p n, t_2 + q n]`` and
-solved in the plane of the fitted normal ``(n - p t_1 - q t_2) / W``, which is
-the normal reported.
+away from its normal) is ``-I^{-1} II``, turned into a symmetric 3D tensor
+``J I^{-1} (-II) I^{-1} J^T`` with ``J = [t_1 + p n, t_2 + q n]`` and solved in
+the plane of the fitted normal, which is the normal reported.
 
-A fit needs at least six points: vertices with fewer inside their ball are
-NaN with ``valid=False`` (use a larger ``radius``). Boundary vertices are fitted
-on their one-sided neighbourhood and kept.
+The fit uses only vertex positions, not the triangles: it is indifferent to
+the quality of the triangulation (irregular meshes), and the ball, unlike a
+number of rings, keeps its size in length units across resolutions.
+
+A fit needs at least six points with non-zero weight: vertices with fewer (or
+a degenerate set, for example collinear points) are NaN with ``valid=False``
+(use a larger ``radius``). Boundary vertices are fitted on their one-sided
+neighbourhood and kept.
 
 References
 ----------
@@ -38,14 +54,13 @@ polynomial fitting of osculating jets. Computer Aided Geometric Design 22(2),
 121-146. https://doi.org/10.1016/j.cagd.2004.09.004
 
 D. Panozzo, E. Puppo, L. Rocca (2010). Efficient multi-scale curvature and
-crease estimation. Proc. Computer Graphics, Computer Vision and Mathematics
-(GraVisMa), 9-16.
+crease estimation. Computer Graphics Forum 29(5) / GraVisMa 2010, 9-16.
+https://doi.org/10.1111/j.1467-8659.2010.01797.x
 """
 
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
 from .._tensors import principal_from_shape_operator, tangent_basis
 from ..neighborhoods import resolve_radius, vertex_pairs_in_ball
@@ -53,66 +68,152 @@ from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
 
-STAGES = ("compute normals", "fit quadrics", "retrieve curvatures")
+STAGES = ("compute normals", "fit jets", "retrieve curvatures")
 
-#: Fewest points a fit takes (six coefficients).
+#: Highest degree of the jet (lowered to 3, then 2, where the ball holds too few points).
+DEGREE = 4
+
+#: Fits per vertex: the first in the frame of the vertex normal, each next one in
+#: the frame of the normal of the previous fit.
+ITERATIONS = 2
+
+#: Fewest points (with non-zero weight) a fit takes: the six coefficients of a quadric.
 MIN_POINTS = 6
 
-_UPPER = np.triu_indices(6)
+#: Largest condition number of a (diagonally scaled) normal matrix that is solved.
+MAX_CONDITION = 1e5
+
+#: Centres per chunk of pair queries (bounds the memory of the per-pair arrays).
+CHUNK_SIZE = 4096
 
 
-def fit_coefficients(vertices: np.ndarray, normals: np.ndarray, t1: np.ndarray, t2: np.ndarray,
-                     radius: float) -> tuple[np.ndarray, np.ndarray]:
-    """(V, 6) coefficients ``c0, d, e, a, b, c`` (in units of ``radius``) and (V,) point counts."""
+def _exponents(degree: int) -> np.ndarray:
+    """(m, 2) exponents ``(i, k)`` of the monomials ``u^i v^k``, by total degree."""
+    return np.array([(total - k, k) for total in range(degree + 1) for k in range(total + 1)])
+
+
+def _n_terms(degree: int) -> int:
+    return (degree + 1) * (degree + 2) // 2
+
+
+def _fit_chunk(offsets: np.ndarray, rows: np.ndarray, size: int, frame: tuple, weights: np.ndarray,
+               degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Weighted normal equations of the jets of one chunk of centres, in units of the radius.
+
+    ``offsets`` (P, 3) are ``(x_j - x_v) / r``, ``rows`` (P,) the centre of each
+    pair within the chunk and ``frame`` the (size, 3) vectors ``t1, t2, n`` of
+    the centres. Returns the (size, m, m) matrices and the (size, m) right-hand sides.
+    """
+    t1, t2, normal = frame
+    u = np.einsum("ij,ij->i", offsets, t1[rows])
+    v = np.einsum("ij,ij->i", offsets, t2[rows])
+    w = np.einsum("ij,ij->i", offsets, normal[rows])
+    exponents = _exponents(degree)
+    m = exponents.shape[0]
+    # the products of two monomials are monomials of degree <= 2d: sum each once
+    u_powers = [np.ones_like(u)]
+    v_powers = [np.ones_like(v)]
+    for _ in range(2 * degree):
+        u_powers.append(u_powers[-1] * u)
+        v_powers.append(v_powers[-1] * v)
+    moments = {}
+    for total in range(2 * degree + 1):
+        for k in range(total + 1):
+            moments[total - k, k] = np.bincount(rows, weights=weights * u_powers[total - k] * v_powers[k],
+                                                minlength=size)
+    matrix = np.zeros((size, m, m))
+    for a in range(m):
+        for b in range(a, m):
+            matrix[:, a, b] = matrix[:, b, a] = moments[tuple(exponents[a] + exponents[b])]
+    right = np.stack([np.bincount(rows, weights=weights * w * u_powers[i] * v_powers[k], minlength=size)
+                      for i, k in exponents], axis=1)
+    return matrix, right
+
+
+def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: int) -> np.ndarray:
+    """(N, 6) the constant, linear and quadratic coefficients of the highest solvable degree (NaN: none).
+
+    The monomials are ordered by degree, so the normal equations of a lower
+    degree are the leading block of those of ``degree``.
+    """
+    out = np.full((matrix.shape[0], 6), np.nan)
+    todo = np.ones(matrix.shape[0], dtype=bool)
+    for d in range(degree, 1, -1):
+        m = _n_terms(d)
+        candidates = np.flatnonzero(todo & (counts >= m))
+        if candidates.size == 0:
+            continue
+        block = matrix[candidates, :m, :m]
+        scale = np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
+        scaled = block / scale[:, :, None] / scale[:, None, :]
+        eigen = np.linalg.eigvalsh(scaled)
+        ok = eigen[:, 0] > eigen[:, -1] / MAX_CONDITION
+        chosen = candidates[ok]
+        if chosen.size:
+            solution = np.linalg.solve(scaled[ok], (right[chosen, :m] / scale[ok])[:, :, None])[:, :, 0]
+            out[chosen] = (solution / scale[ok])[:, :6]
+            todo[chosen] = False
+    return out
+
+
+def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
+             iterations: int = ITERATIONS, chunk_size: int = CHUNK_SIZE):
+    """Fit a weighted jet at every vertex, re-estimating its frame from each fit.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+    normals : ndarray of shape (V, 3)
+        Unit normals of the first frame (finite everywhere).
+    radius : float
+        Radius of the ball of each fit (> 0).
+    degree : int, default: DEGREE
+    iterations : int, default: ITERATIONS
+
+    Returns
+    -------
+    coefficients : ndarray of shape (V, 6)
+        ``c00, c10, c01, c20, c11, c02`` of the last fit, in units of ``radius``
+        (NaN where no fit was possible).
+    frame : tuple of three ndarrays of shape (V, 3)
+        ``t1, t2, n``: the frame of the last fit.
+    counts : ndarray of shape (V,)
+        Points with non-zero weight in each ball.
+    """
     n = vertices.shape[0]
-    radius = radius if radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
-    normal_matrix = np.zeros((n, 6, 6))
-    right = np.zeros((n, 6))
-    counts = np.zeros(n)
-    for chunk, centre, neighbour in vertex_pairs_in_ball(vertices, radius):
-        offset = (vertices[neighbour] - vertices[centre]) / radius
-        u = np.einsum("ij,ij->i", offset, t1[centre])
-        v = np.einsum("ij,ij->i", offset, t2[centre])
-        w = np.einsum("ij,ij->i", offset, normals[centre])
-        monomials = np.stack([np.ones_like(u), u, v, u * u, u * v, v * v], axis=1)
-        products = monomials[:, _UPPER[0]] * monomials[:, _UPPER[1]]
-        columns = np.column_stack([products, monomials * w[:, None], np.ones_like(u)])
-        rows = centre - chunk.start
-        size = chunk.stop - chunk.start
-        gather = sp.csr_matrix((np.ones_like(u), (rows, np.arange(u.size))), shape=(size, u.size))
-        sums = np.asarray(gather @ columns)
-        block = np.zeros((size, 6, 6))
-        block[:, _UPPER[0], _UPPER[1]] = sums[:, :21]
-        block[:, _UPPER[1], _UPPER[0]] = sums[:, :21]
-        normal_matrix[chunk] = block
-        right[chunk] = sums[:, 21:27]
-        counts[chunk] = sums[:, 27]
+    t1, t2 = tangent_basis(normals)
+    frame = [t1, t2, normals.copy()]
     coefficients = np.full((n, 6), np.nan)
-    enough = counts >= MIN_POINTS
-    if enough.any():
-        matrices = normal_matrix[enough]
-        singular = np.linalg.cond(matrices) > 1e12
-        solvable = np.flatnonzero(enough)[~singular]
-        if solvable.size:
-            coefficients[solvable] = np.linalg.solve(normal_matrix[solvable], right[solvable][:, :, None])[:, :, 0]
-    return coefficients, counts
+    counts = np.zeros(n)
+    for chunk, centre, neighbour in vertex_pairs_in_ball(vertices, radius, chunk_size=chunk_size):
+        size = chunk.stop - chunk.start
+        rows = centre - chunk.start
+        offsets = (vertices[neighbour] - vertices[centre]) / radius
+        weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
+        count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
+        local = [f[chunk] for f in frame]
+        for step in range(iterations):
+            matrix, right = _fit_chunk(offsets, rows, size, local, weights, degree)
+            fitted = _solve(matrix, right, count, degree)
+            if step + 1 < iterations:
+                p, q = fitted[:, 1:2], fitted[:, 2:3]
+                tilted = local[2] - p * local[0] - q * local[1]
+                tilted /= np.linalg.norm(tilted, axis=1, keepdims=True)
+                keep = np.isfinite(tilted).all(axis=1, keepdims=True)
+                new_normal = np.where(keep, tilted, local[2])
+                local = [*tangent_basis(new_normal), new_normal]
+        for f, part in zip(frame, local):
+            f[chunk] = part
+        coefficients[chunk] = fitted
+        counts[chunk] = count
+    return coefficients, tuple(frame), counts
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
-    """Quadric fit over balls of radius ``radius``. Returns ``(result, problems)``."""
-    stages.start("compute normals")
-    radius = resolve_radius(radius, vertices, topology)
-    _, _, defects, normals, valid = prepare(vertices, topology)
-    frame = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
-    t1, t2 = tangent_basis(frame)
-
-    stages.start("fit quadrics")
-    coefficients, counts = fit_coefficients(vertices, frame, t1, t2, radius)
-
-    stages.start("retrieve curvatures")
+def shape_operators(coefficients: np.ndarray, frame: tuple, radius: float):
+    """(V, 6) shape operators (meshcurv's sign) and (V, 3) unit normals of the fitted jets."""
+    t1, t2, normal = frame
     _, p, q, a, b, c = coefficients.T
-    unit = radius if radius > 0 else 1.0
-    a, b, c = a / unit, b / unit, c / unit  # back from units of radius
+    a, b, c = a / radius, b / radius, c / radius  # back from units of radius
     width = np.sqrt(1 + p * p + q * q)
     first = np.stack([1 + p * p, p * q, 1 + q * q], axis=1)
     second = -np.stack([2 * a, b, 2 * c], axis=1) / width[:, None]
@@ -123,15 +224,31 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         return np.stack([np.stack([s[:, 0], s[:, 1]], axis=1), np.stack([s[:, 1], s[:, 2]], axis=1)], axis=1)
 
     middle = as2x2(inverse) @ as2x2(second) @ as2x2(inverse)
-    jacobian = np.stack([t1 + p[:, None] * frame, t2 + q[:, None] * frame], axis=2)  # (V, 3, 2)
+    jacobian = np.stack([t1 + p[:, None] * normal, t2 + q[:, None] * normal], axis=2)  # (V, 3, 2)
     tensor = jacobian @ middle @ jacobian.transpose(0, 2, 1)
     six = tensor[:, [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]
-    fitted = (frame - p[:, None] * t1 - q[:, None] * t2) / width[:, None]
+    fitted = (normal - p[:, None] * t1 - q[:, None] * t2) / width[:, None]
+    return six, fitted
+
+
+def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
+    """Weighted jet fits over balls of radius ``radius``. Returns ``(result, problems)``."""
+    stages.start("compute normals")
+    radius = resolve_radius(radius, vertices, topology)
+    _, _, defects, normals, valid = prepare(vertices, topology)
+    start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
+    unit = radius if radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
+
+    stages.start("fit jets")
+    coefficients, frame, counts = fit_jets(vertices, start, unit)
+
+    stages.start("retrieve curvatures")
+    six, fitted = shape_operators(coefficients, frame, unit)
     fitted = np.where(np.isfinite(fitted).all(axis=1, keepdims=True), fitted, normals)
     valid &= np.isfinite(coefficients).all(axis=1)
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
         np.where(valid[:, None], six, 0.0), np.where(valid[:, None], fitted, [0.0, 0.0, 1.0]))
-    few = int((valid & (counts < MIN_POINTS)).sum() + (~valid & ~defects.invalid_vertices).sum())
+    few = int((~valid & ~defects.invalid_vertices).sum())
     extra = (f"{few} vertices have fewer than {MIN_POINTS} vertices (or a degenerate set) within "
              f"radius {radius:g}; pass a larger `radius`",) if few else ()
     normals_out = np.where(valid[:, None], fitted, normals)
