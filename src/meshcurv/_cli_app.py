@@ -428,3 +428,8 @@ def demo(output, overwrite):
 
     _pyplot()
     click.echo(run_demo(output, overwrite=overwrite))
+
+
+from ._batch_cli import batch  # noqa: E402  (meshcurv batch; it builds on the options above)
+
+meshcurv.add_command(batch)

@@ -44,7 +44,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import check_choice, check_int_option
+from ._validation import check_choice, check_int_option, check_positive_float
 from .errors import InvalidOptionError, MeshFileError, MissingDependencyError
 
 __all__ = ["run", "process_mesh", "expand_inputs", "COLUMNS", "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS"]
@@ -207,25 +207,28 @@ def _plan(paths: list[pathlib.Path], out_dir: pathlib.Path, suffix: str) -> list
 
 
 def _options(method, smoothing_steps, radius, orient) -> dict:
-    """The options given, validated by a computation on a small mesh (the errors of principal_curvatures)."""
-    from . import shapes
-    from .curvature import METHODS, principal_curvatures
+    """The options given, checked as :func:`meshcurv.principal_curvatures` checks them, defaults left out.
+
+    The same computation is then recorded the same way however it was asked
+    (``smoothing_steps=3`` or nothing), and a bad option fails before any work.
+    """
+    from .curvature import METHODS
     from .estimators import ESTIMATORS
+    from .orient import ORIENT_CHOICES
 
     check_choice(method, "method", METHODS)
-    given = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
-    given = {name: value for name, value in given.items() if value is not None}
-    probe = shapes.icosphere(2)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        result = principal_curvatures(probe.vertices, probe.faces, method=method, **given)
-    # the same computation is asked the same way whatever the spelling: defaults left out, plain types
-    defaults = {**ESTIMATORS[method].options, "orient": "keep"}
+    defaults = ESTIMATORS[method].options
     options = {"method": method}
-    for name, value in given.items():
-        value = result.parameters.get(name, value) if name != "radius" else float(value)
-        if value != defaults.get(name):
-            options[name] = value.item() if isinstance(value, np.generic) else value
+    for name, value in (("smoothing_steps", smoothing_steps), ("radius", radius)):
+        if value is None:
+            continue
+        if name not in defaults:
+            raise InvalidOptionError(f"method {method!r} does not take the option `{name}`")
+        value = check_int_option(value, name) if name == "smoothing_steps" else check_positive_float(value, name)
+        if value != defaults[name]:
+            options[name] = value
+    if orient is not None and check_choice(orient, "orient", ORIENT_CHOICES) != "keep":
+        options["orient"] = orient
     return options
 
 
@@ -362,7 +365,8 @@ def _cluster(distributed, *, client, scheduler, workers):
         n_workers = workers if workers is not None else CPU_COUNT
         with distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                                       host="127.0.0.1", dashboard_address="127.0.0.1:0",
-                                      env=dict(WORKER_ENVIRONMENT)) as cluster, \
+                                      env=dict(WORKER_ENVIRONMENT), preload=["meshcurv._batch_worker"],
+                                      silence_logs=logging.ERROR) as cluster, \
                 distributed.Client(cluster) as local:
             yield local, True
 
