@@ -113,9 +113,12 @@ def test_far_from_the_defect_nothing_changes(name, method, clean):
     index = case.clean_index[far]
     np.testing.assert_array_equal(r.valid[far], reference.valid[index])
     scale = np.nanmax(np.abs(reference.k_max))
+    # rounding only; quadric solves normal equations (condition number squared), whose
+    # chunked sums change with the number of vertices: it keeps about 6 digits
+    tolerance = 1e-5 if method == "quadric" else 1e-9
     for field in ("k_min", "k_max", "mean", "gaussian"):
         np.testing.assert_allclose(getattr(r, field)[far], getattr(reference, field)[index],
-                                   rtol=1e-9, atol=1e-9 * scale, err_msg=field)
+                                   rtol=tolerance, atol=tolerance * scale, err_msg=field)
 
 
 @pytest.mark.parametrize("method", METHODS)

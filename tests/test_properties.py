@@ -143,10 +143,7 @@ VERTICES = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0], [1, 1, 1.0]])
 TETRA = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
 
 
-# quadric divides by a zero default radius when every edge has zero length (reported)
-KNOWN = {"quadric": pytest.mark.xfail(raises=RuntimeWarning, strict=False,
-                                      reason="quadric: zero default radius on an all-coincident mesh")}
-METHOD_PARAMS = [pytest.param(m, marks=KNOWN[m]) if m in KNOWN else m for m in METHODS]
+METHOD_PARAMS = METHODS
 
 
 @pytest.mark.parametrize("method", METHOD_PARAMS)
