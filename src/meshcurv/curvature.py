@@ -47,9 +47,13 @@ def principal_curvatures(
         - ``'matgeom'``: matGeom's ``meshCurvatures`` reproduced number for
           number (dimensionless values; see the README).
         - ``'icc'``: interpolated corrected curvature measures over a ball
-          (Lachaud et al. 2020); takes ``radius``; boundary vertices are kept.
-        - ``'quadric'``: least-squares quadric (jet) fit over a ball (Cazals and
-          Pouget 2005; Panozzo et al. 2010); takes ``radius``.
+          (Lachaud et al. 2020) of normals from fitted jets; takes ``radius``;
+          boundary vertices are kept. The most robust to noise and irregular
+          sampling.
+        - ``'quadric'``: weighted degree-4 jet fit over a ball with normal
+          re-estimation (Cazals and Pouget 2005; Panozzo et al. 2010); takes
+          ``radius``. The most accurate on clean (noise-free) meshes, regular
+          or not; not for noisy ones.
         - ``'rusinkiewicz'``: per-face tensors from normal differences averaged
           with Voronoi weights (Rusinkiewicz 2004).
         - ``'normal_cycle_ball'``: the normal-cycle tensor over a ball; takes

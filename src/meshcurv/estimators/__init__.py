@@ -55,14 +55,14 @@ ESTIMATORS: dict[str, Estimator] = {
         name="icc",
         function=icc.estimate,
         options={"radius": None},
-        summary="interpolated corrected curvature measures over a ball (Lachaud et al. 2020), in 1/length",
+        summary="interpolated corrected curvature measures over a ball, normals from jets (Lachaud et al. 2020), in 1/length",
         stages=icc.STAGES,
     ),
     "quadric": Estimator(
         name="quadric",
         function=quadric.estimate,
         options={"radius": None},
-        summary="least-squares quadric (jet) fit over a ball (Cazals & Pouget 2005; Panozzo et al. 2010)",
+        summary="weighted degree-4 jet fit over a ball, normal re-estimated (Cazals & Pouget 2005; Panozzo et al. 2010)",
         stages=quadric.STAGES,
     ),
     "rusinkiewicz": Estimator(
