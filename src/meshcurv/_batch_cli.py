@@ -1,8 +1,8 @@
 """``meshcurv batch``: the command over :func:`meshcurv.batch.run`.
 
-It is added to the ``meshcurv`` group by :mod:`meshcurv._cli_app` and uses its
-options; import :mod:`meshcurv._cli_app` (or run :func:`meshcurv.cli.main`),
-not this module, first.
+:mod:`meshcurv._cli_app` adds it to the ``meshcurv`` group with
+``meshcurv.add_command(batch_command())``; the command is built there, with the
+group's options, so that neither module imports the other at import time.
 """
 
 from __future__ import annotations
@@ -12,10 +12,9 @@ import sys
 
 import click
 
-from ._cli_app import Session, common_options, method_options
 from .batch import OUTPUT_FORMATS, run
 
-__all__ = ["batch", "BatchBar"]
+__all__ = ["batch_command", "BatchBar"]
 
 _SHOWN_FAILURES = 10
 
@@ -53,56 +52,62 @@ class BatchBar:
             self.stream.flush()
 
 
-@click.command()
-@click.argument("inputs", nargs=-1, required=True)
-@click.option("-o", "--output-dir", "out_dir", required=True, type=click.Path(path_type=pathlib.Path),
-              help="Folder of the results and of summary.parquet / summary.csv (created if needed).")
-@method_options
-@click.option("--format", "output_format", type=click.Choice(OUTPUT_FORMATS), default="ply", show_default=True,
-              help="Format of the result files.")
-@click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Worker processes of the local cluster (default: one per core).")
-@click.option("--scheduler", metavar="ADDRESS", default=None,
-              help="Run on an existing Dask cluster, e.g. tcp://host:8786, instead of a local one.")
-@click.option("--overwrite", is_flag=True, help="Compute again the meshes whose results exist.")
-@common_options
-def batch(inputs, out_dir, method, smoothing_steps, radius, orient, output_format, workers, scheduler, overwrite):
-    """Curvatures of many meshes on Dask: INPUTS are files, folders and glob patterns.
+def batch_command() -> click.Command:
+    """The ``meshcurv batch`` command, with the options of the ``meshcurv`` group (:mod:`meshcurv._cli_app`)."""
+    from ._cli_app import Session, common_options, method_options
 
-    \b
-    meshcurv batch scans/ -o results/                    a local cluster, one worker per core
-    meshcurv batch 'scans/**/*.ply' -o results/ --workers 4
-    meshcurv batch scans/ -o results/ --scheduler tcp://host:8786
+    @click.command()
+    @click.argument("inputs", nargs=-1, required=True)
+    @click.option("-o", "--output-dir", "out_dir", required=True, type=click.Path(path_type=pathlib.Path),
+                  help="Folder of the results and of summary.parquet / summary.csv (created if needed).")
+    @method_options
+    @click.option("--format", "output_format", type=click.Choice(OUTPUT_FORMATS), default="ply", show_default=True,
+                  help="Format of the result files.")
+    @click.option("--workers", type=click.IntRange(min=1), default=None,
+                  help="Worker processes of the local cluster (default: one per core).")
+    @click.option("--scheduler", metavar="ADDRESS", default=None,
+                  help="Run on an existing Dask cluster, e.g. tcp://host:8786, instead of a local one.")
+    @click.option("--overwrite", is_flag=True, help="Compute again the meshes whose results exist.")
+    @common_options
+    def batch(inputs, out_dir, method, smoothing_steps, radius, orient, output_format, workers, scheduler, overwrite):
+        """Curvatures of many meshes on Dask: INPUTS are files, folders and glob patterns.
 
-    Writes one result file per mesh to OUTDIR and a summary, one row per mesh,
-    to OUTDIR/summary.parquet and OUTDIR/summary.csv. A second run skips the
-    meshes whose results exist (--overwrite computes them again). Inputs and
-    OUTDIR must be on storage that every worker sees under the same paths.
-    Exits with 1 when a mesh failed (the summary has its error).
-    """
-    if workers is not None and scheduler is not None:
-        raise click.UsageError("--workers sizes the local cluster; leave it out with --scheduler "
-                               "(the cluster's own workers are used)")
-    session = click.get_current_context().find_object(Session)
-    stream = sys.stderr
-    show = session.progress if session.progress is not None else stream.isatty()
-    bar = BatchBar(stream if show else None, tty=stream.isatty())
-    try:
-        summary = run(list(inputs), out_dir, method=method, smoothing_steps=smoothing_steps, radius=radius,
-                      orient=orient, output_format=output_format, workers=workers, scheduler=scheduler,
-                      overwrite=overwrite, progress=bar)
-    finally:
-        bar.close()
-    counts = summary["status"].value_counts()
-    failures = summary[summary["status"] == "failed"]
-    session.info(f"{len(summary)} meshes: {counts.get('computed', 0)} computed, {counts.get('skipped', 0)} skipped "
-                 f"(done before), {len(failures)} failed; summary in {out_dir / 'summary.parquet'} and "
-                 f"{out_dir / 'summary.csv'}")
-    if failures.empty:
-        return 0
-    for path, error in zip(failures["path"][:_SHOWN_FAILURES], failures["error"][:_SHOWN_FAILURES]):
-        click.echo(f"meshcurv: failed: {path}: {error}", err=True)
-    if len(failures) > _SHOWN_FAILURES:
-        click.echo(f"meshcurv: ... and {len(failures) - _SHOWN_FAILURES} more (see the summary)", err=True)
-    click.echo(f"meshcurv: error: {len(failures)} of {len(summary)} meshes failed", err=True)
-    return 1
+        \b
+        meshcurv batch scans/ -o results/                    a local cluster, one worker per core
+        meshcurv batch 'scans/**/*.ply' -o results/ --workers 4
+        meshcurv batch scans/ -o results/ --scheduler tcp://host:8786
+
+        Writes one result file per mesh to OUTDIR and a summary, one row per mesh,
+        to OUTDIR/summary.parquet and OUTDIR/summary.csv. A second run skips the
+        meshes whose results exist (--overwrite computes them again). Inputs and
+        OUTDIR must be on storage that every worker sees under the same paths.
+        Exits with 1 when a mesh failed (the summary has its error).
+        """
+        if workers is not None and scheduler is not None:
+            raise click.UsageError("--workers sizes the local cluster; leave it out with --scheduler "
+                                   "(the cluster's own workers are used)")
+        session = click.get_current_context().find_object(Session)
+        stream = sys.stderr
+        show = session.progress if session.progress is not None else stream.isatty()
+        bar = BatchBar(stream if show else None, tty=stream.isatty())
+        try:
+            summary = run(list(inputs), out_dir, method=method, smoothing_steps=smoothing_steps, radius=radius,
+                          orient=orient, output_format=output_format, workers=workers, scheduler=scheduler,
+                          overwrite=overwrite, progress=bar)
+        finally:
+            bar.close()
+        counts = summary["status"].value_counts()
+        failures = summary[summary["status"] == "failed"]
+        session.info(f"{len(summary)} meshes: {counts.get('computed', 0)} computed, {counts.get('skipped', 0)} skipped "
+                     f"(done before), {len(failures)} failed; summary in {out_dir / 'summary.parquet'} and "
+                     f"{out_dir / 'summary.csv'}")
+        if failures.empty:
+            return 0
+        for path, error in zip(failures["path"][:_SHOWN_FAILURES], failures["error"][:_SHOWN_FAILURES]):
+            click.echo(f"meshcurv: failed: {path}: {error}", err=True)
+        if len(failures) > _SHOWN_FAILURES:
+            click.echo(f"meshcurv: ... and {len(failures) - _SHOWN_FAILURES} more (see the summary)", err=True)
+        click.echo(f"meshcurv: error: {len(failures)} of {len(summary)} meshes failed", err=True)
+        return 1
+
+    return batch

@@ -430,6 +430,6 @@ def demo(output, overwrite):
     click.echo(run_demo(output, overwrite=overwrite))
 
 
-from ._batch_cli import batch  # noqa: E402  (meshcurv batch; it builds on the options above)
+from ._batch_cli import batch_command  # noqa: E402  (meshcurv batch, built with the options above)
 
-meshcurv.add_command(batch)
+meshcurv.add_command(batch_command())

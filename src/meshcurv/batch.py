@@ -195,11 +195,9 @@ def _plan(paths: list[pathlib.Path], out_dir: pathlib.Path, suffix: str) -> list
         if output in reserved or output in claimed:
             other = reserved.get(output) or claimed[output]
             raise InvalidOptionError(
-                f"{path} and {other} would both be written to {output}; "
+                f"{other} and {path} would both be written to {output}; "
                 "give them different names or process them in separate runs"
             )
-        if output == source:
-            raise InvalidOptionError(f"{path}: its result would replace it; choose another output folder")
         claimed[output] = path
         record = out_dir / RECORDS / relative.with_name(relative.name + ".json")
         jobs.append(_Job(path, os.fspath(source), os.fspath(output), os.fspath(record)))
