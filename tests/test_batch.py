@@ -126,13 +126,12 @@ def assert_complete_npz(path: pathlib.Path, n_vertices: int):
 
 @pytest.fixture(scope="module")
 def client():
-    """A real local cluster of two worker processes on 127.0.0.1 (as run() would start, without dashboard)."""
-    import logging
-
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host=LOOPBACK,
-                                  dashboard_address=None, env=dict(batch.WORKER_ENVIRONMENT),
-                                  silence_logs=logging.ERROR) as cluster, distributed.Client(cluster) as client:
+    """The local cluster run() starts (two worker processes on 127.0.0.1), without its dashboard."""
+    before = dict(os.environ)
+    with batch.local_cluster(workers=2, dashboard=False) as client:
+        client.environment_before = before
         yield client
+    assert dict(os.environ) == before  # what Dask wrote there to start the workers is put back
 
 
 @pytest.fixture(scope="module")
@@ -277,6 +276,17 @@ def test_missing_dask_names_the_extra(tmp_path, monkeypatch):
 
 
 # ---------------------------------------------------------------------------------------------- a local cluster
+
+
+def test_local_cluster_workers_keep_to_one_thread_and_fast_memory(client):
+    names = ("OMP_NUM_THREADS", "NUMBA_NUM_THREADS", "MALLOC_TRIM_THRESHOLD_")
+    found = client.run(lambda: [os.environ.get(name) for name in names])
+    assert len(found) == 2
+    for values in found.values():
+        # one thread each; glibc's trimming as in this process (unset here unless the environment sets it)
+        assert values == ["1", "1", client.environment_before.get("MALLOC_TRIM_THRESHOLD_")]
+    assert [info["nthreads"] for info in client.scheduler_info()["workers"].values()] == [1, 1]
+    assert all(address.startswith(f"tcp://{LOOPBACK}:") for address in client.scheduler_info()["workers"])
 
 
 def test_every_good_mesh_has_its_result_and_row_and_the_corrupt_one_its_error(first_run, dozen):

@@ -47,7 +47,7 @@ import numpy as np
 from ._validation import check_choice, check_int_option, check_positive_float
 from .errors import InvalidOptionError, MeshFileError, MissingDependencyError
 
-__all__ = ["run", "process_mesh", "expand_inputs", "COLUMNS", "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS"]
+__all__ = ["run", "local_cluster", "process_mesh", "expand_inputs", "COLUMNS", "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS"]
 
 logger = logging.getLogger(__name__)
 
@@ -350,6 +350,74 @@ def _dependencies():
 
 
 @contextlib.contextmanager
+def local_cluster(*, workers: int | None = None, dashboard: bool = True):
+    """Start the local Dask cluster :func:`run` starts, and close it at the end of the block.
+
+    Pass its client to several :func:`run` calls to start the workers once
+    (in a notebook, say).
+
+    Parameters
+    ----------
+    workers : int, optional
+        The number of worker processes (default: one per core), each with one
+        thread.
+    dashboard : bool, default: True
+        Serve the Dask dashboard on 127.0.0.1 and a free port
+        (``client.dashboard_link``).
+
+    Yields
+    ------
+    distributed.Client
+        A client of the cluster, listening on 127.0.0.1 only.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``workers`` is not a positive integer.
+    MissingDependencyError
+        dask.distributed, pandas or pyarrow is not installed.
+
+    Notes
+    -----
+    The worker processes get ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS``,
+    ``OPENBLAS_NUM_THREADS`` and ``NUMBA_NUM_THREADS`` set to 1, so that N
+    workers keep to N cores; they ignore Ctrl-C (the caller closes them). Dask
+    normally starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536``, which
+    makes glibc hand every large array back to the system when freed: meshcurv
+    allocates many, and each mesh then takes about twice as long; this cluster
+    leaves the variable unset (glibc's own adaptive threshold), unless it is
+    set in the environment. The variables Dask writes into ``os.environ`` of
+    this process to start the workers are put back as they were on closing.
+
+    Examples
+    --------
+    Not run as a doctest (it starts a cluster)::
+
+        with meshcurv.batch.local_cluster(workers=2) as client:
+            first = meshcurv.batch.run("scans/a/*.ply", "results/a", client=client)
+            second = meshcurv.batch.run("scans/b/*.ply", "results/b", client=client)
+    """
+    distributed, _ = _dependencies()
+    import dask
+    from dask.system import CPU_COUNT
+
+    n_workers = CPU_COUNT if workers is None else check_int_option(workers, "workers", minimum=1)
+    saved = dict(os.environ)
+    try:
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}), \
+                distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                         host="127.0.0.1", dashboard_address="127.0.0.1:0" if dashboard else None,
+                                         env=dict(WORKER_ENVIRONMENT), preload=["meshcurv._batch_worker"],
+                                         silence_logs=logging.ERROR) as cluster, \
+                distributed.Client(cluster) as client:
+            yield client
+    finally:
+        for name in set(os.environ) - set(saved):
+            del os.environ[name]
+        os.environ.update({name: value for name, value in saved.items() if os.environ.get(name) != value})
+
+
+@contextlib.contextmanager
 def _cluster(distributed, *, client, scheduler, workers):
     """Yield ``(client, owned)``: the given client, one connected to ``scheduler``, or a new local cluster's."""
     if client is not None:
@@ -358,14 +426,7 @@ def _cluster(distributed, *, client, scheduler, workers):
         with distributed.Client(scheduler) as connected:
             yield connected, False
     else:
-        from dask.system import CPU_COUNT
-
-        n_workers = workers if workers is not None else CPU_COUNT
-        with distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                      host="127.0.0.1", dashboard_address="127.0.0.1:0",
-                                      env=dict(WORKER_ENVIRONMENT), preload=["meshcurv._batch_worker"],
-                                      silence_logs=logging.ERROR) as cluster, \
-                distributed.Client(cluster) as local:
+        with local_cluster(workers=workers) as local:
             yield local, True
 
 
@@ -485,7 +546,7 @@ def run(paths, out_dir, *, method: str = "normal_cycle", smoothing_steps: int | 
         if stored is None:
             todo.append(index)
         else:
-            rows[index] = {**stored, "status": "skipped"}
+            rows[index] = {**stored, "status": "skipped", "output": job.output}
     failed = 0
     if progress is not None:
         progress(len(rows), len(jobs), failed)
