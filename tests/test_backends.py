@@ -29,7 +29,16 @@ def meshes():
     torus = shapes.torus(n_major=20, n_minor=12)
     flipped = torus.faces.copy()
     flipped[::7] = flipped[::7, ::-1]
+    # two spheres touching at one shared vertex: a bow-tie
+    a = shapes.icosphere(3)
+    top = np.argmax(a.vertices[:, 2])
+    bottom = np.argmin(a.vertices[:, 2])
+    b_vertices = a.vertices + (a.vertices[top] - a.vertices[bottom])
+    b_faces = a.faces + a.vertices.shape[0]
+    b_faces[b_faces == bottom + a.vertices.shape[0]] = top
+    bowtie = (np.vstack([a.vertices, b_vertices]), np.vstack([a.faces, b_faces]))
     return {
+        "bowtie": bowtie,
         "torus": (torus.vertices, torus.faces),
         "saddle": (saddle.vertices, saddle.faces),
         "defects": (v, fin),
@@ -57,6 +66,12 @@ def test_topology_is_identical(name):
         b = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
     for field in ("edges", "face_edges", "edge_faces", "edge_face_counts", "_edge_forward_counts"):
         np.testing.assert_array_equal(getattr(a, field), getattr(b, field), err_msg=field)
+    with use_backend("numpy"):
+        expected = a.bowtie_vertices
+    with use_backend("numba"):
+        np.testing.assert_array_equal(b.bowtie_vertices, expected)
+    if name == "bowtie":
+        assert expected.sum() == 1
 
 
 @pytest.mark.parametrize("method", ["normal_cycle", "matgeom"])

@@ -35,7 +35,7 @@ NAMED = {"boundary": "boundary", "nonmanifold": "non-manifold", "bowtie": "bow-t
 # matGeom's compatibility mode reproduces matGeom, which neither stops nor
 # gives NaN on these defects; its values there are matGeom's (wrong) numbers and
 # the vertices stay valid=True. Reported; strict so that a fix is noticed.
-MATGEOM_KEEPS_VALID = {"bowtie", "flipped", "collinear"}
+MATGEOM_KEEPS_VALID: set = set()
 
 
 def options(method):

@@ -23,6 +23,7 @@ from .errors import (
     TriangulationWarning,
 )
 from .io import read_mesh, write_mesh
+from .orient import orient_faces
 from .result import CurvatureResult
 from .smoothing import smooth_vertex_field
 from .topology import MeshTopology, triangulate_faces
@@ -38,6 +39,7 @@ __all__ = [
     "MeshTopology",
     "MeshDiagnosis",
     "diagnose",
+    "orient_faces",
     "triangulate_faces",
     "smooth_vertex_field",
     "shapes",

@@ -430,3 +430,60 @@ def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2):
             for k in range(6):
                 sums[i, k] /= counts[i]
     return sums
+
+
+# -- bow-tie vertices -----------------------------------------------------------
+@nb.njit(inline="always", **_JIT)
+def _find(parent, x):
+    while parent[x] != x:
+        parent[x] = parent[parent[x]]
+        x = parent[x]
+    return x
+
+
+@nb.njit(**_JIT)
+def bowtie_vertices(faces, face_edges, linked, proper, n_vertices, n_edges):
+    """Vertices whose face corners fall in more than one fan (see MeshTopology.bowtie_vertices).
+
+    Union-find over the ``3 F`` corners: the corners at each end of a linked
+    edge (two faces, both without a repeated vertex) are joined.
+    """
+    n_corners = 3 * faces.shape[0]
+    parent = np.arange(n_corners)
+    first = np.full(n_edges, -1, np.int64)
+    for f in range(faces.shape[0]):
+        if not proper[f]:
+            continue
+        for k in range(3):
+            e = face_edges[f, k]
+            if e < 0 or not linked[e]:
+                continue
+            side = 3 * f + k
+            if first[e] < 0:
+                first[e] = side
+                continue
+            one = first[e]
+            head_one = one - one % 3 + (one % 3 + 1) % 3
+            head_two = side - k + (k + 1) % 3
+            if faces[one // 3, one % 3] == faces[f, k]:  # same direction
+                pairs = ((one, side), (head_one, head_two))
+            else:
+                pairs = ((one, head_two), (head_one, side))
+            for a, b in pairs:
+                ra = _find(parent, a)
+                rb = _find(parent, b)
+                if ra != rb:
+                    parent[max(ra, rb)] = min(ra, rb)
+    root_of = np.full(n_vertices, -1, np.int64)
+    several = np.zeros(n_vertices, np.bool_)
+    for f in range(faces.shape[0]):
+        if not proper[f]:
+            continue
+        for k in range(3):
+            v = faces[f, k]
+            r = _find(parent, 3 * f + k)
+            if root_of[v] < 0:
+                root_of[v] = r
+            elif root_of[v] != r:
+                several[v] = True
+    return several

@@ -8,12 +8,9 @@ vertex adjacency the smoothing uses) and makes one pass over the face geometry.
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import asdict, dataclass
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from .geometry import DEGENERATE_AREA_RATIO
 from .topology import MeshTopology
@@ -157,74 +154,8 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
 
 
 def bowtie_vertices(topology: MeshTopology) -> np.ndarray:
-    """(V,) bool: vertices whose faces form more than one fan.
-
-    Two faces at a vertex are in the same fan when a chain of faces at that
-    vertex joins them, each sharing with the next a manifold edge (exactly two
-    faces) at the vertex. A manifold vertex has one fan (a disc, or a half-disc
-    on the boundary); two cones touching at their tips, or two sheets glued at a
-    corner, give two. Faces with a repeated corner are left out. Vertices on
-    non-manifold edges usually have several fans too and are included.
-
-    Notes
-    -----
-    One :func:`~scipy.sparse.csgraph.connected_components` call over the
-    ``3 F`` face corners, linked across every manifold edge; a vertex is a
-    bow-tie when its corners fall in more than one component. The answer
-    depends on the connectivity only and is remembered for the lifetime of the
-    (immutable) ``topology``, so the estimators and :func:`diagnose` share it.
-    """
-    cached = _BOWTIES.get(topology)
-    if cached is None:
-        cached = _bowtie_vertices(topology)
-        cached.flags.writeable = False
-        _BOWTIES[topology] = cached
-    return cached
-
-
-_BOWTIES: "weakref.WeakKeyDictionary[MeshTopology, np.ndarray]" = weakref.WeakKeyDictionary()
-
-
-def _bowtie_vertices(topology: MeshTopology) -> np.ndarray:
-    faces = topology.faces
-    n_corners = 3 * faces.shape[0]
-    proper = np.repeat(~topology.degenerate_faces, 3)
-    pairs = topology.edge_faces
-    linked = (topology.edge_face_counts == 2) & (pairs[:, 0] != pairs[:, 1])
-    side_edge = topology.face_edges.ravel()
-    sides = np.flatnonzero(proper & (side_edge >= 0))
-    sides = sides[linked[side_edge[sides]]]
-    # the two sides of every linked edge, by two scatters (no sort, no search)
-    first = np.full(topology.n_edges, -1, dtype=np.int64)
-    first[side_edge[sides]] = sides
-    second = sides[first[side_edge[sides]] != sides]
-    one = first[side_edge[second]]
-    tail = faces.ravel()
-    position = np.arange(n_corners) % 3
-    head_corner = np.arange(n_corners) - position + (position + 1) % 3
-    # side s runs from corner s to corner head_corner[s]; join the corners at the same vertex
-    same = tail[one] == tail[second]
-    rows = np.concatenate([one, head_corner[one]])
-    cols = np.concatenate([np.where(same, second, head_corner[second]),
-                           np.where(same, head_corner[second], second)])
-    graph = sp.csr_matrix(
-        (np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n_corners, n_corners)
-    )
-    _, labels = connected_components(graph, directed=False)
-    first_label = np.full(topology.n_vertices, -1, dtype=np.int64)
-    first_label[tail[proper]] = labels[proper]
-    several = np.zeros(topology.n_vertices, dtype=bool)
-    several[tail[proper & (labels != first_label[tail])]] = True
-    return several
-
-
-def _n_components(topology: MeshTopology) -> int:
-    """Connected components of the faces, from the vertex adjacency (cached, shared with smoothing)."""
-    used = topology.referenced_vertices
-    if not used.any():
-        return 0
-    _, labels = connected_components(topology.adjacency, directed=False)
-    return int(np.unique(labels[used]).size)
+    """(V,) bool: vertices whose faces form more than one fan (:attr:`MeshTopology.bowtie_vertices`)."""
+    return topology.bowtie_vertices
 
 
 def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: int = 0) -> MeshDiagnosis:
@@ -258,7 +189,7 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     nonmanifold = topology.nonmanifold_edges
     n_nonmanifold = int(nonmanifold.sum())
     chi = topology.euler_characteristic
-    n_components = _n_components(topology)
+    n_components = topology.n_components
     closed = n_boundary == 0
     genus = (2 - chi) // 2 if closed and n_components == 1 and n_nonmanifold == 0 else None
     referenced = topology.referenced_vertices

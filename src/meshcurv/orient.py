@@ -20,8 +20,6 @@ mirror components, one of which is chosen per patch; a non-orientable patch
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ._validation import as_faces, as_vertices, check_choice
 from .errors import InvalidMeshError
@@ -115,6 +113,9 @@ def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = 
     # (f, s) is node f + s * F; a consistent edge keeps s, an inconsistent one swaps it
     rows = np.concatenate([f, f + n_faces])
     cols = np.concatenate([g + crossed * n_faces, g + (1 - crossed) * n_faces])
+    import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
+    from scipy.sparse.csgraph import connected_components
+
     graph = sp.csr_matrix(
         (np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(2 * n_faces, 2 * n_faces)
     )

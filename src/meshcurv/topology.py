@@ -189,6 +189,25 @@ class MeshTopology:
         return _readonly(self.edge_vertices(self.boundary_edges))
 
     @cached_property
+    def bowtie_vertices(self) -> np.ndarray:
+        """(V,) bool: vertices whose faces form more than one fan.
+
+        Two faces at a vertex are in the same fan when a chain of faces at that
+        vertex joins them, each sharing with the next a manifold edge (exactly
+        two faces) at the vertex. A manifold vertex has one fan (a disc, or a
+        half-disc on the boundary); two cones touching at their tips, or two
+        sheets glued at a corner, give two. Faces with a repeated corner are
+        left out. Vertices on non-manifold edges usually have several fans too
+        and are included.
+        """
+        kernels = numba_kernels()
+        if kernels is None:
+            return _readonly(_bowtie_vertices(self))
+        linked = (self.edge_face_counts == 2) & (self.edge_faces[:, 0] != self.edge_faces[:, 1])
+        return _readonly(kernels.bowtie_vertices(self.faces, self.face_edges, linked, ~self.degenerate_faces,
+                                                 self.n_vertices, self.n_edges))
+
+    @cached_property
     def degenerate_faces(self) -> np.ndarray:
         """(F,) bool: faces that repeat a vertex index (no area whatever the positions)."""
         f = self.faces
@@ -290,6 +309,43 @@ def _build_edges(faces: np.ndarray, n_vertices: int):
         edge_of_sorted, weights=1 - backward[order], minlength=n_edges
     ).astype(np.int64)
     return edges, face_edges.reshape(n_faces, 3), edge_faces, counts.astype(np.int64), forward_counts
+
+
+def _bowtie_vertices(topology: "MeshTopology") -> np.ndarray:
+    """NumPy path of :attr:`MeshTopology.bowtie_vertices`: components of the corner graph."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+
+    faces = topology.faces
+    n_corners = 3 * faces.shape[0]
+    proper = np.repeat(~topology.degenerate_faces, 3)
+    pairs = topology.edge_faces
+    linked = (topology.edge_face_counts == 2) & (pairs[:, 0] != pairs[:, 1])
+    side_edge = topology.face_edges.ravel()
+    sides = np.flatnonzero(proper & (side_edge >= 0))
+    sides = sides[linked[side_edge[sides]]]
+    # the two sides of every linked edge, by two scatters (no sort, no search)
+    first = np.full(topology.n_edges, -1, dtype=np.int64)
+    first[side_edge[sides]] = sides
+    second = sides[first[side_edge[sides]] != sides]
+    one = first[side_edge[second]]
+    tail = faces.ravel()
+    position = np.arange(n_corners) % 3
+    head_corner = np.arange(n_corners) - position + (position + 1) % 3
+    # side s runs from corner s to corner head_corner[s]; join the corners at the same vertex
+    same = tail[one] == tail[second]
+    rows = np.concatenate([one, head_corner[one]])
+    cols = np.concatenate([np.where(same, second, head_corner[second]),
+                           np.where(same, head_corner[second], second)])
+    graph = sp.csr_matrix(
+        (np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n_corners, n_corners)
+    )
+    _, labels = connected_components(graph, directed=False)
+    first_label = np.full(topology.n_vertices, -1, dtype=np.int64)
+    first_label[tail[proper]] = labels[proper]
+    several = np.zeros(topology.n_vertices, dtype=bool)
+    several[tail[proper & (labels != first_label[tail])]] = True
+    return several
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:

@@ -6,7 +6,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..diagnosis import bowtie_vertices
 from ..topology import MeshTopology
 
 
@@ -44,7 +43,7 @@ def mesh_defects(topology: MeshTopology, degenerate_faces: np.ndarray) -> Vertex
     """Find the vertices an edge-based estimator must leave undefined."""
     bad_edges = topology.boundary_edges | topology.nonmanifold_edges | topology.inconsistent_edges
     invalid = topology.edge_vertices(bad_edges)
-    bowties = bowtie_vertices(topology) & ~topology.edge_vertices(topology.nonmanifold_edges)
+    bowties = topology.bowtie_vertices & ~topology.edge_vertices(topology.nonmanifold_edges)
     invalid |= bowties
     invalid[topology.faces[degenerate_faces].ravel()] = True
     invalid |= ~topology.referenced_vertices

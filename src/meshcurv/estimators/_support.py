@@ -20,7 +20,8 @@ def defects_without_boundary(topology: MeshTopology, degenerate: np.ndarray) -> 
     zero-area faces, ...) except that boundary vertices stay valid.
     """
     full = mesh_defects(topology, degenerate)
-    invalid = full.invalid_vertices & ~topology.boundary_vertices
+    # boundary vertices stay valid, unless they are bow-ties (two fans touching at the rim)
+    invalid = full.invalid_vertices & ~(topology.boundary_vertices & ~topology.bowtie_vertices)
     invalid |= topology.edge_vertices(topology.nonmanifold_edges | topology.inconsistent_edges)
     invalid[topology.faces[degenerate].ravel()] = True
     invalid |= ~topology.referenced_vertices

@@ -37,7 +37,9 @@ import numpy as np
 from ..result import CurvatureResult
 from ..smoothing import smooth_vertex_field
 from .._backend import numba_kernels
+from ..diagnosis import degenerate_faces
 from ..topology import MeshTopology
+from ._defects import mesh_defects
 from .._tensors import outer6
 from ._common import Stages
 from ._eigen import sorted_by_magnitude
@@ -128,6 +130,8 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
     n_kept_edges, n_wrong_face, n_out_of_range : int
         How matGeom's pairing went: edges kept, edges paired with a face that
         does not contain them, face-id sums beyond the number of faces.
+    mispaired : ndarray of shape (V,), bool
+        Ends of the edges paired with a face that does not contain them.
     """
     stages = stages or Stages(STAGES)
     faces = topology.faces
@@ -141,14 +145,14 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
         ev1, ev2 = topology.edges[:, 0], topology.edges[:, 1]
         ef1, ef2 = topology.edge_faces[:, 0], topology.edge_faces[:, 1]
         out_of_range = np.zeros(ev1.size, dtype=bool)
-        n_wrong_face = 0
+        wrong_face = out_of_range
     else:
         ev1, ev2, ef1, ef2 = matgeom_pairing(faces, n_vertices)
         out_of_range = (ef1 >= n_faces) | (ef2 >= n_faces)
         # a face "contains" the edge when both ends are among its corners
         f1 = faces[np.where(out_of_range, 0, ef1)]
         contains = (f1 == ev1[:, None]).any(1) & (f1 == ev2[:, None]).any(1)
-        n_wrong_face = int((~out_of_range & ~contains).sum())
+        wrong_face = ~out_of_range & ~contains
 
     stages.start("compute edge tensors")
     kernels = numba_kernels()
@@ -162,12 +166,15 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
 
     stages.start("average vertex tensors")
     tensors = smooth_vertex_field(tensors, topology, smoothing_steps)
-    return tensors, ev1.size, n_wrong_face, int(out_of_range.sum())
+    mispaired = np.zeros(n_vertices, dtype=bool)
+    mispaired[ev1[wrong_face]] = True
+    mispaired[ev2[wrong_face]] = True
+    return tensors, ev1.size, int(wrong_face.sum()), int(out_of_range.sum()), mispaired
 
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
     """Run matGeom's algorithm. Returns ``(result, problems)``."""
-    tensors, n_kept, n_wrong_face, n_out_of_range = matgeom_tensors(
+    tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = matgeom_tensors(
         vertices, topology, smoothing_steps, stages
     )
     problems: list[str] = []
@@ -181,7 +188,16 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
     u1[swap], u2[swap] = u2[swap], u1[swap]
 
     finite = np.isfinite(tensors).all(axis=1)
-    valid = topology.referenced_vertices & finite
+    # matGeom's numbers are kept everywhere it computes them; valid=False marks
+    # where they are not an estimate: vertices whose tensor drew on a defect
+    # (boundary, non-manifold, bow-tie, flipped or zero-area neighbourhood, or an
+    # edge paired with a wrong face), spread over the smoothing rings as the
+    # smoothing spreads it
+    doubtful = mesh_defects(topology, degenerate_faces(vertices, topology)).invalid_vertices | mispaired
+    doubtful &= topology.referenced_vertices
+    if doubtful.any() and smoothing_steps:
+        doubtful = smooth_vertex_field(doubtful.astype(np.float64), topology, smoothing_steps) > 0
+    valid = topology.referenced_vertices & finite & ~doubtful
 
     n_boundary = int(topology.boundary_edges.sum())
     if n_boundary:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import zipfile
+import zlib
 
 import numpy as np
 
@@ -53,10 +54,10 @@ def write_npz(path, vertices: np.ndarray, faces, point_data: dict) -> None:
 def read_npz(path):
     """Read ``vertices`` and ``faces`` back from an NPZ file written by :func:`write_npz`."""
     try:
-        with np.load(path, allow_pickle=False) as archive:
+        with open(path, "rb") as handle, np.load(handle, allow_pickle=False) as archive:
             names = sorted(archive.files)
             arrays = {name: archive[name] for name in names if name.startswith(("vertices", "face"))}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile, zlib.error, EOFError) as exc:
         raise MeshFileError(f"{path}: cannot be read as NPZ ({exc})") from exc
     if "vertices" not in arrays or not ({"faces"} <= set(arrays) or {"face_corners", "face_sizes"} <= set(arrays)):
         raise MeshFileError(f"{path}: an NPZ mesh needs arrays named 'vertices' and 'faces'; found {names}")
