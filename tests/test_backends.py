@@ -98,3 +98,18 @@ def test_unknown_backend_is_refused(monkeypatch):
     torus = shapes.torus(n_major=8, n_minor=6)
     with pytest.raises(InvalidOptionError, match=r"unknown backend 'fortran' \(MESHCURV_BACKEND\)"):
         meshcurv.principal_curvatures(torus.vertices, torus.faces)
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_diagnosis_agrees(name):
+    vertices, faces = MESHES[name]
+    facts = {}
+    for backend in ("numpy", "numba"):
+        with use_backend(backend):
+            top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
+            facts[backend] = meshcurv.diagnose(vertices, top).as_dict()
+    for key, value in facts["numpy"].items():
+        if isinstance(value, float):
+            assert facts["numba"][key] == pytest.approx(value, rel=1e-12, abs=1e-12), key
+        else:
+            assert facts["numba"][key] == value, key

@@ -487,3 +487,55 @@ def bowtie_vertices(faces, face_edges, linked, proper, n_vertices, n_edges):
             elif root_of[v] != r:
                 several[v] = True
     return several
+
+
+# -- mesh facts -------------------------------------------------------------------
+@nb.njit(**_JIT)
+def count_components(edges, referenced, n_vertices):
+    """Connected components of the vertex graph among the referenced vertices (union-find)."""
+    parent = np.arange(n_vertices)
+    for e in range(edges.shape[0]):
+        a = _find(parent, edges[e, 0])
+        b = _find(parent, edges[e, 1])
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    count = 0
+    for v in range(n_vertices):
+        if referenced[v] and _find(parent, v) == v:
+            count += 1
+    return count
+
+
+@nb.njit(**_JIT)
+def mesh_measures(vertices, faces, edges, centre):
+    """One pass over edges and faces: the facts :func:`meshcurv.diagnose` needs.
+
+    Returns ``(edge_lengths (E,), double_areas (F,), area, six_volume)`` where
+    ``six_volume`` is the sum over faces of ``(a - centre) . cross(b - a, c - a)``.
+    """
+    lengths = np.empty(edges.shape[0])
+    for e in range(edges.shape[0]):
+        p, q = edges[e, 0], edges[e, 1]
+        x = vertices[q, 0] - vertices[p, 0]
+        y = vertices[q, 1] - vertices[p, 1]
+        z = vertices[q, 2] - vertices[p, 2]
+        lengths[e] = math.sqrt(x * x + y * y + z * z)
+    double_areas = np.empty(faces.shape[0])
+    area = 0.0
+    six_volume = 0.0
+    for f in range(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        ux = vertices[b, 0] - vertices[a, 0]
+        uy = vertices[b, 1] - vertices[a, 1]
+        uz = vertices[b, 2] - vertices[a, 2]
+        wx = vertices[c, 0] - vertices[a, 0]
+        wy = vertices[c, 1] - vertices[a, 1]
+        wz = vertices[c, 2] - vertices[a, 2]
+        nx = uy * wz - uz * wy
+        ny = uz * wx - ux * wz
+        nz = ux * wy - uy * wx
+        double_areas[f] = math.sqrt(nx * nx + ny * ny + nz * nz)
+        area += 0.5 * double_areas[f]
+        six_volume += ((vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny
+                       + (vertices[a, 2] - centre[2]) * nz)
+    return lengths, double_areas, area, six_volume

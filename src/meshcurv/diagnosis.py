@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ._backend import numba_kernels
 from .geometry import DEGENERATE_AREA_RATIO
 from .topology import MeshTopology
 
@@ -150,7 +151,12 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
         lengths = _edge_lengths(vertices, topology.edges)
         mean_edge_length = float(lengths.mean()) if lengths.size else 0.0
     double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
-    return (0.5 * double_areas <= DEGENERATE_AREA_RATIO * mean_edge_length**2) | topology.degenerate_faces
+    return _negligible(double_areas, mean_edge_length) | topology.degenerate_faces
+
+
+def _negligible(double_areas: np.ndarray, mean_edge_length: float) -> np.ndarray:
+    """(F,) bool: areas below 1e-12 x (mean edge length)^2."""
+    return 0.5 * double_areas <= DEGENERATE_AREA_RATIO * mean_edge_length**2
 
 
 def bowtie_vertices(topology: MeshTopology) -> np.ndarray:
@@ -181,10 +187,22 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     (1, 0, True, [])
     """
     faces = topology.faces
-    cross = _cross(vertices, faces)
-    lengths = _edge_lengths(vertices, topology.edges)
+    referenced = topology.referenced_vertices
+    n_unreferenced = int(topology.n_vertices - referenced.sum())
+    used = vertices if n_unreferenced == 0 else vertices[referenced]
+    centre = used.mean(axis=0)
+    kernels = numba_kernels()
+    if kernels is not None:
+        lengths, double_areas, area, six_volume = kernels.mesh_measures(vertices, faces, topology.edges, centre)
+    else:
+        cross = _cross(vertices, faces)
+        lengths = _edge_lengths(vertices, topology.edges)
+        double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
+        area = float(0.5 * double_areas.sum())
+        # the cross products are translation-invariant: a . (b x c) = (a - o) . cross(b - a, c - a)
+        six_volume = float(np.einsum("ij,ij->i", vertices[faces[:, 0]] - centre, cross).sum())
     scale = float(lengths.mean()) if lengths.size else 0.0
-    degenerate = degenerate_faces(vertices, topology, cross=cross, mean_edge_length=scale)
+    degenerate = _negligible(double_areas, scale) | topology.degenerate_faces
     n_boundary = int(topology.boundary_edges.sum())
     nonmanifold = topology.nonmanifold_edges
     n_nonmanifold = int(nonmanifold.sum())
@@ -192,14 +210,7 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     n_components = topology.n_components
     closed = n_boundary == 0
     genus = (2 - chi) // 2 if closed and n_components == 1 and n_nonmanifold == 0 else None
-    referenced = topology.referenced_vertices
-    n_unreferenced = int(topology.n_vertices - referenced.sum())
-    used = vertices if n_unreferenced == 0 else vertices[referenced]
-    volume = None
-    if closed and faces.shape[0]:
-        # the cross products are translation-invariant: a . (b x c) = (a - o) . cross(b - a, c - a)
-        centred = vertices[faces[:, 0]] - used.mean(axis=0)
-        volume = float(np.einsum("ij,ij->i", centred, cross).sum() / 6.0)
+    volume = six_volume / 6.0 if closed and faces.shape[0] else None
     bowties = bowtie_vertices(topology) & ~topology.edge_vertices(nonmanifold)
     return MeshDiagnosis(
         n_vertices=topology.n_vertices,
@@ -214,7 +225,7 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
         n_unreferenced_vertices=n_unreferenced,
         euler_characteristic=chi,
         genus=genus,
-        area=float(0.5 * np.sqrt(np.einsum("ij,ij->i", cross, cross)).sum()),
+        area=float(area),
         volume=volume,
         mean_edge_length=scale,
         bounding_box=(tuple(used.min(axis=0).tolist()), tuple(used.max(axis=0).tolist())),

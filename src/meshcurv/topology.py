@@ -244,10 +244,13 @@ class MeshTopology:
         used, labels = np.unique(vertex_labels[self.faces[:, 0]], return_inverse=True)
         return int(used.size), _readonly(labels.astype(np.int64))
 
-    @property
+    @cached_property
     def n_components(self) -> int:
         """Number of connected components of the faces."""
-        return int(self.face_components[0])
+        kernels = numba_kernels()
+        if kernels is None:
+            return int(self.face_components[0])
+        return int(kernels.count_components(self.edges, self.referenced_vertices, self.n_vertices))
 
     @cached_property
     def euler_characteristic(self) -> int:
