@@ -125,7 +125,7 @@ def smooth_over_edges(values, edges, n_vertices, steps):
 
 # -- normal cycle ---------------------------------------------------------------
 @nb.njit(**_JIT)
-def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate, unit_normals):
+def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate):
     """Per-vertex measures (6 tensor components), barycentric areas and normal sums.
 
     Returns ``sums`` of shape (V, 10): columns 0-5 the anisotropic measure
@@ -134,6 +134,7 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate, un
     """
     n_vertices = vertices.shape[0]
     sums = np.zeros((n_vertices, 10))
+    unit_normals = np.zeros((faces.shape[0], 3))
     for f in range(faces.shape[0]):
         if degenerate[f]:
             continue
@@ -147,7 +148,11 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate, un
         nx = uy * vz - uz * vy
         ny = uz * vx - ux * vz
         nz = ux * vy - uy * vx
-        third = math.sqrt(nx * nx + ny * ny + nz * nz) / 6.0
+        double_area = math.sqrt(nx * nx + ny * ny + nz * nz)
+        unit_normals[f, 0] = nx / double_area
+        unit_normals[f, 1] = ny / double_area
+        unit_normals[f, 2] = nz / double_area
+        third = double_area / 6.0
         for corner in (a, b, c):
             sums[corner, 6] += third
             sums[corner, 7] += nx

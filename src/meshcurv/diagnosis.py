@@ -139,18 +139,19 @@ def _edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
 
 
 def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.ndarray | None = None,
-                     mean_edge_length: float | None = None) -> np.ndarray:
+                     mean_edge_length: float | None = None, double_areas: np.ndarray | None = None) -> np.ndarray:
     """(F,) bool: faces with a repeated corner or an area below 1e-12 x (mean edge length)^2.
 
     The threshold is relative to the mesh's own length scale, so the same mesh
     gives the same answer at any scale (coordinates around 1e-9 or 1e9 alike).
     """
-    if cross is None:
-        cross = _cross(vertices, topology.faces)
     if mean_edge_length is None:
         lengths = _edge_lengths(vertices, topology.edges)
         mean_edge_length = float(lengths.mean()) if lengths.size else 0.0
-    double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
+    if double_areas is None:
+        if cross is None:
+            cross = _cross(vertices, topology.faces)
+        double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
     return _negligible(double_areas, mean_edge_length) | topology.degenerate_faces
 
 

@@ -87,21 +87,25 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
     stages.start("compute adjacencies")
     n_vertices = vertices.shape[0]
     faces = topology.faces
-    cross = face_cross_products(vertices, faces)
-    double_areas = np.linalg.norm(cross, axis=1)
-    degenerate = degenerate_faces(vertices, topology, cross=cross)
+    kernels = numba_kernels()
+    if kernels is not None:
+        lengths, double_areas, _, _ = kernels.mesh_measures(vertices, faces, topology.edges, np.zeros(3))
+        degenerate = degenerate_faces(vertices, topology, double_areas=double_areas,
+                                      mean_edge_length=float(lengths.mean()) if lengths.size else 0.0)
+    else:
+        cross = face_cross_products(vertices, faces)
+        double_areas = np.linalg.norm(cross, axis=1)
+        degenerate = degenerate_faces(vertices, topology, cross=cross)
     defects = mesh_defects(topology, degenerate)
 
     stages.start("compute edge tensors")
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit_normals = cross / double_areas[:, None]
     usable = topology.interior_edges & ~degenerate[np.maximum(topology.edge_faces, 0)].any(axis=1)
-    kernels = numba_kernels()
     if kernels is not None:
-        sums = kernels.normal_cycle_sums(vertices, faces, topology.edges, topology.edge_faces, usable,
-                                         degenerate, unit_normals)
+        sums = kernels.normal_cycle_sums(vertices, faces, topology.edges, topology.edge_faces, usable, degenerate)
         measures, areas, normals = sums[:, :6], sums[:, 6], normalize_normal_sums(sums[:, 7:])
     else:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            unit_normals = cross / double_areas[:, None]
         beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
         edge_measures = outer6(unit, 0.5 * beta * lengths)
         ends = topology.edges.T.ravel()
