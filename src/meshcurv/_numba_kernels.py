@@ -96,33 +96,6 @@ def build_edges(faces, n_vertices):
             counts[:n_edges].copy(), forward[:n_edges].copy())
 
 
-# -- smoothing ------------------------------------------------------------------
-@nb.njit(**_JIT)
-def smooth_over_edges(values, edges, n_vertices, steps):
-    """``steps`` passes of the 1-ring mean (self + neighbours) / (degree + 1)."""
-    n_columns = values.shape[1]
-    degree = np.zeros(n_vertices, np.float64)
-    for e in range(edges.shape[0]):
-        degree[edges[e, 0]] += 1.0
-        degree[edges[e, 1]] += 1.0
-    current = values.copy()
-    following = np.empty_like(current)
-    for _ in range(steps):
-        following[:] = current
-        for e in range(edges.shape[0]):
-            p = edges[e, 0]
-            q = edges[e, 1]
-            for c in range(n_columns):
-                following[p, c] += current[q, c]
-                following[q, c] += current[p, c]
-        for i in range(n_vertices):
-            scale = 1.0 / (degree[i] + 1.0)
-            for c in range(n_columns):
-                following[i, c] *= scale
-        current, following = following, current
-    return current
-
-
 # -- normal cycle ---------------------------------------------------------------
 @nb.njit(**_JIT)
 def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate):
@@ -544,3 +517,43 @@ def mesh_measures(vertices, faces, edges, centre):
         six_volume += ((vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny
                        + (vertices[a, 2] - centre[2]) * nz)
     return lengths, double_areas, area, six_volume
+
+
+# -- smoothing ------------------------------------------------------------------
+@nb.njit(**_JIT)
+def neighbour_lists(edges, n_vertices):
+    """CSR lists of the edge neighbours of every vertex: ``(indptr, indices)``."""
+    indptr = np.zeros(n_vertices + 1, np.int64)
+    for e in range(edges.shape[0]):
+        indptr[edges[e, 0] + 1] += 1
+        indptr[edges[e, 1] + 1] += 1
+    for v in range(n_vertices):
+        indptr[v + 1] += indptr[v]
+    fill = indptr[:-1].copy()
+    indices = np.empty(indptr[n_vertices], np.int64)
+    for e in range(edges.shape[0]):
+        p, q = edges[e, 0], edges[e, 1]
+        indices[fill[p]] = q
+        fill[p] += 1
+        indices[fill[q]] = p
+        fill[q] += 1
+    return indptr, indices
+
+
+@nb.njit(parallel=True, **_JIT)
+def smooth_over_neighbours(values, indptr, indices, steps):
+    """``steps`` passes of the 1-ring mean (self + neighbours) / (degree + 1), by gathering."""
+    n_vertices, n_columns = values.shape
+    current = values.copy()
+    following = np.empty_like(current)
+    for _ in range(steps):
+        for i in nb.prange(n_vertices):
+            start, stop = indptr[i], indptr[i + 1]
+            scale = 1.0 / (stop - start + 1.0)
+            for c in range(n_columns):
+                total = current[i, c]
+                for j in range(start, stop):
+                    total += current[indices[j], c]
+                following[i, c] = total * scale
+        current, following = following, current
+    return current

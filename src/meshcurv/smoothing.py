@@ -41,8 +41,9 @@ def smooth_vertex_field(values, topology: MeshTopology, steps: int) -> np.ndarra
         return field
     kernels = numba_kernels()
     if kernels is not None:
-        flat = field.reshape(field.shape[0], -1)
-        return kernels.smooth_over_edges(flat, topology.edges, topology.n_vertices, steps).reshape(field.shape)
+        flat = np.ascontiguousarray(field.reshape(field.shape[0], -1))
+        indptr, indices = topology.neighbour_lists
+        return kernels.smooth_over_neighbours(flat, indptr, indices, steps).reshape(field.shape)
     adjacency = topology.adjacency
     scale = 1.0 / (topology.vertex_degrees + 1.0)
     if field.ndim == 2:

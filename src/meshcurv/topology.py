@@ -227,6 +227,20 @@ class MeshTopology:
         return sp.coo_matrix((data, (rows, cols)), shape=(n, n)).tocsr()
 
     @cached_property
+    def neighbour_lists(self) -> tuple[np.ndarray, np.ndarray]:
+        """Edge neighbours of every vertex in CSR form: ``(indptr, indices)``.
+
+        The neighbours of vertex ``v`` are ``indices[indptr[v]:indptr[v + 1]]``.
+        """
+        kernels = numba_kernels()
+        if kernels is not None:
+            indptr, indices = kernels.neighbour_lists(self.edges, self.n_vertices)
+        else:
+            adjacency = self.adjacency
+            indptr, indices = adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64)
+        return _readonly(indptr), _readonly(indices)
+
+    @cached_property
     def vertex_degrees(self) -> np.ndarray:
         """(V,) int64: number of edges at each vertex."""
         return _readonly(np.bincount(self.edges.ravel(), minlength=self.n_vertices).astype(np.int64))
