@@ -712,7 +712,7 @@ def markdown(bench) -> str:
         f"- Load average (1, 5, 15 min) at start {tuple(round(x, 1) for x in info['load_start'])}, "
         f"at end {tuple(round(x, 1) for x in info.get('load_end', (0, 0, 0)))}"
         + (" — **shared machine: other jobs were running, timings are noisy**"
-           if max(info["load_start"][0], info.get("load_end", (0,))[0]) > 0.5 * info["cores"] else ""),
+           if info["load_start"][0] > 0.5 * info["cores"] else " (the load at the end is the benchmark's own)"),
         f"- Python {info['python']}, numpy {v.get('numpy', '—')}, scipy {v.get('scipy', '—')}, "
         f"numba {v.get('numba', 'not installed')} (llvmlite {v.get('llvmlite', '—')}); "
         f"meshcurv {v.get('meshcurv', '—')} at commit {info['commit'] or '?'}",
