@@ -132,13 +132,23 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
         return out
     corners = vertices[cells]
     centres = corners.mean(axis=1)
-    reach = np.linalg.norm(corners - centres[:, None, :], axis=2).max()
-    tree = cKDTree(centres)
-    for chunk in _chunks(n):
-        i, c = _pairs(tree, vertices[chunk], radius + reach)
-        weights = weight(corners[c], vertices[chunk][i], radius)
-        gather = sp.csr_matrix((weights, (i, c)), shape=(chunk.stop - chunk.start, values.shape[0]))
-        out[chunk] = np.asarray(gather @ values)
+    reach = np.linalg.norm(corners - centres[:, None, :], axis=2).max(axis=1)
+    # Cells are searched by their centres within radius + their own reach. One
+    # search radius for all would be set by the largest cell: on a mesh with a
+    # few long edges (a scan with a coarse patch) every ball would then gather
+    # thousands of small cells. So cells are grouped by size (powers of two of
+    # their reach), each group searched with its own largest reach.
+    _, exponent = np.frexp(np.maximum(reach, np.finfo(float).tiny))
+    for level in np.unique(exponent):
+        group = np.flatnonzero(exponent == level)
+        tree = cKDTree(centres[group])
+        cutoff = radius + reach[group].max()
+        for chunk in _chunks(n):
+            i, c = _pairs(tree, vertices[chunk], cutoff)
+            c = group[c]
+            weights = weight(corners[c], vertices[chunk][i], radius)
+            gather = sp.csr_matrix((weights, (i, c)), shape=(chunk.stop - chunk.start, values.shape[0]))
+            out[chunk] += np.asarray(gather @ values)
     return out
 
 
