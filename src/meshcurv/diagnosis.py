@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ._backend import numba_kernels
-from .geometry import DEGENERATE_AREA_RATIO
+from .geometry import degenerate_face_mask, edge_lengths, face_cross_products
 from .topology import MeshTopology
 
 __all__ = ["MeshDiagnosis", "diagnose", "degenerate_faces", "bowtie_vertices"]
@@ -121,23 +121,6 @@ class MeshDiagnosis:
         return asdict(self)
 
 
-def _cross(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F, 3) ``cross(b - a, c - a)``, written out (faster than :func:`numpy.cross`)."""
-    a = vertices[faces[:, 0]]
-    u = vertices[faces[:, 1]] - a
-    w = vertices[faces[:, 2]] - a
-    return np.stack(
-        [u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1], u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2],
-         u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]],
-        axis=1,
-    )
-
-
-def _edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
-    return np.sqrt(np.einsum("ij,ij->i", d, d))
-
-
 def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.ndarray | None = None,
                      mean_edge_length: float | None = None, double_areas: np.ndarray | None = None) -> np.ndarray:
     """(F,) bool: faces with a repeated corner or an area below 1e-12 x (mean edge length)^2.
@@ -146,18 +129,13 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
     gives the same answer at any scale (coordinates around 1e-9 or 1e9 alike).
     """
     if mean_edge_length is None:
-        lengths = _edge_lengths(vertices, topology.edges)
+        lengths = edge_lengths(vertices, topology.edges)
         mean_edge_length = float(lengths.mean()) if lengths.size else 0.0
     if double_areas is None:
         if cross is None:
-            cross = _cross(vertices, topology.faces)
+            cross = face_cross_products(vertices, topology.faces)
         double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
-    return _negligible(double_areas, mean_edge_length) | topology.degenerate_faces
-
-
-def _negligible(double_areas: np.ndarray, mean_edge_length: float) -> np.ndarray:
-    """(F,) bool: areas below 1e-12 x (mean edge length)^2."""
-    return 0.5 * double_areas <= DEGENERATE_AREA_RATIO * mean_edge_length**2
+    return degenerate_face_mask(0.5 * double_areas, mean_edge_length) | topology.degenerate_faces
 
 
 def bowtie_vertices(topology: MeshTopology) -> np.ndarray:
@@ -196,14 +174,14 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     if kernels is not None:
         lengths, double_areas, area, six_volume = kernels.mesh_measures(vertices, faces, topology.edges, centre)
     else:
-        cross = _cross(vertices, faces)
-        lengths = _edge_lengths(vertices, topology.edges)
+        cross = face_cross_products(vertices, faces)
+        lengths = edge_lengths(vertices, topology.edges)
         double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
         area = float(0.5 * double_areas.sum())
         # the cross products are translation-invariant: a . (b x c) = (a - o) . cross(b - a, c - a)
         six_volume = float(np.einsum("ij,ij->i", vertices[faces[:, 0]] - centre, cross).sum())
     scale = float(lengths.mean()) if lengths.size else 0.0
-    degenerate = _negligible(double_areas, scale) | topology.degenerate_faces
+    degenerate = degenerate_face_mask(0.5 * double_areas, scale) | topology.degenerate_faces
     n_boundary = int(topology.boundary_edges.sum())
     nonmanifold = topology.nonmanifold_edges
     n_nonmanifold = int(nonmanifold.sum())

@@ -16,6 +16,7 @@ __all__ = [
     "signed_volume",
     "vertex_areas",
     "vertex_normals",
+    "edge_lengths",
     "mean_edge_length",
     "degenerate_face_mask",
     "corner_cotangents",
@@ -28,9 +29,18 @@ DEGENERATE_AREA_RATIO = 1e-12
 
 
 def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F, 3) ``cross(b - a, c - a)`` for every face ``(a, b, c)``: twice the area times the unit normal."""
+    """(F, 3) ``cross(b - a, c - a)`` for every face ``(a, b, c)``: twice the area times the unit normal.
+
+    Written out component by component (faster than :func:`numpy.cross`, same values).
+    """
     a = vertices[faces[:, 0]]
-    return np.cross(vertices[faces[:, 1]] - a, vertices[faces[:, 2]] - a)
+    u = vertices[faces[:, 1]] - a
+    w = vertices[faces[:, 2]] - a
+    return np.stack(
+        [u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1], u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2],
+         u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]],
+        axis=1,
+    )
 
 
 def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -94,11 +104,17 @@ def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
         return np.where(norm > 1e-12 * np.maximum(scale, np.finfo(float).tiny), summed / norm, np.nan)
 
 
+def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(E,) length of each of the given (E, 2) edges."""
+    d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
+    return np.sqrt(np.einsum("ij,ij->i", d, d))
+
+
 def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
-    """Mean length of the given (E, 2) edges."""
+    """Mean length of the given (E, 2) edges (0 when there are none)."""
     if edges.shape[0] == 0:
         return 0.0
-    return float(np.linalg.norm(vertices[edges[:, 1]] - vertices[edges[:, 0]], axis=1).mean())
+    return float(edge_lengths(vertices, edges).mean())
 
 
 def degenerate_face_mask(areas: np.ndarray, length_scale: float) -> np.ndarray:
