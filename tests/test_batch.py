@@ -279,12 +279,13 @@ def test_missing_dask_names_the_extra(tmp_path, monkeypatch):
 
 
 def test_local_cluster_workers_keep_to_one_thread_and_fast_memory(client):
-    names = ("OMP_NUM_THREADS", "NUMBA_NUM_THREADS", "MALLOC_TRIM_THRESHOLD_")
+    names = ("OMP_NUM_THREADS", "NUMBA_NUM_THREADS", "MALLOC_TRIM_THRESHOLD_", "MALLOC_ARENA_MAX")
     found = client.run(lambda: [os.environ.get(name) for name in names])
     assert len(found) == 2
     for values in found.values():
         # one thread each; glibc's trimming as in this process (unset here unless the environment sets it)
-        assert values == ["1", "1", client.environment_before.get("MALLOC_TRIM_THRESHOLD_")]
+        assert values == ["1", "1", client.environment_before.get("MALLOC_TRIM_THRESHOLD_"), "1"]
+    assert not any(client.run(lambda: __import__("dask").config.get("distributed.worker.profile.enabled")).values())
     assert [info["nthreads"] for info in client.scheduler_info()["workers"].values()] == [1, 1]
     assert all(address.startswith(f"tcp://{LOOPBACK}:") for address in client.scheduler_info()["workers"])
 
@@ -406,7 +407,7 @@ def test_a_worker_killed_mid_run_has_its_meshes_run_again(tmp_path, client):
     killed = []
 
     def kill_a_busy_worker(done, total, failed):
-        if done == 1 and not killed:
+        if done >= 1 and not killed:
             busy = [address for address, keys in client.processing().items() if keys]
             pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
             os.kill(pid, signal.SIGKILL)
@@ -420,6 +421,48 @@ def test_a_worker_killed_mid_run_has_its_meshes_run_again(tmp_path, client):
     assert leftovers(out_dir) == []
     client.wait_for_workers(2, timeout=60)  # the nanny has started a new worker in its place
     assert killed[0][1] not in client.run(os.getpid).values()
+
+
+def test_small_meshes_travel_in_chunks_in_path_order(tmp_path, monkeypatch):
+    paths = write_spheres(tmp_path / "in", 40, 4)
+    jobs = batch._plan(paths, tmp_path / "out", ".npz")
+    chunks = batch._chunks(jobs, list(range(40)), workers=2)
+    assert [index for chunk in chunks for index in chunk] == list(range(40))
+    assert len(chunks) == 2 * batch.CHUNKS_PER_WORKER and {len(chunk) for chunk in chunks} == {2, 3}
+    assert batch._chunks(jobs, [5, 7, 9], workers=2) == [[5], [7], [9]]  # fewer meshes than tasks
+    # the byte budget: two files fit, not three; a file larger than the budget is a task of its own
+    size = os.path.getsize(paths[0])
+    monkeypatch.setattr(batch, "CHUNK_BYTES", 2 * size)
+    assert batch._chunks(jobs, list(range(5)), workers=0.125) == [[0, 1], [2, 3], [4]]
+    monkeypatch.setattr(batch, "CHUNK_BYTES", size // 2)
+    assert batch._chunks(jobs, list(range(3)), workers=0.125) == [[0], [1], [2]]
+
+
+def test_a_task_lost_with_its_workers_is_split_into_single_meshes(tmp_path, caplog):
+    """With no retry allowed, killing a worker fails its task at once: its meshes are run again one by one."""
+    import dask
+
+    paths = write_spheres(tmp_path / "in", 24, 16)  # 2562 vertices; 2 workers -> tasks of 2 meshes
+    out_dir = tmp_path / "out"
+    killed = []
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
+            batch.local_cluster(workers=2, dashboard=False) as client:
+
+        def kill_a_busy_worker(done, total, failed):
+            busy = [address for address, keys in client.processing().items() if keys]
+            if done and busy and not killed:
+                pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
+                os.kill(pid, signal.SIGKILL)
+                killed.append(pid)
+
+        with caplog.at_level("INFO", logger="meshcurv.batch"):
+            summary = batch.run(paths, out_dir, client=client, output_format="npz", progress=kill_a_busy_worker)
+    assert killed, "no worker was busy"
+    assert "a task of 2 meshes killed its workers; running them one by one" in caplog.text
+    assert (summary["status"] == "computed").all(), summary["error"].tolist()
+    for path in paths:
+        assert_complete_npz(out_dir / (path.stem + ".npz"), 2562)
+    assert leftovers(out_dir) == []
 
 
 # ---------------------------------------------------------------------------------------------- the command

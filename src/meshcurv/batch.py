@@ -47,7 +47,7 @@ import numpy as np
 from ._validation import check_choice, check_int_option, check_positive_float
 from .errors import InvalidOptionError, MeshFileError, MissingDependencyError
 
-__all__ = ["run", "local_cluster", "process_mesh", "expand_inputs", "COLUMNS", "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS"]
+__all__ = ["run", "local_cluster", "process_mesh", "process_meshes", "expand_inputs", "COLUMNS", "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS"]
 
 logger = logging.getLogger(__name__)
 
@@ -64,6 +64,15 @@ OUTPUT_FORMATS = ("ply", "npz", "vtp", "vtu", "vtk", "csv")
 RECORDS = ".meshcurv-batch"
 
 _SUMMARY_NAME = "summary"
+
+#: The most bytes of input files sent to a worker as one task (a single larger mesh is a task of its
+#: own). Dask costs a few milliseconds per task, and the process that schedules competes with the
+#: workers for the cores: with a task per mesh of 10k vertices (30 ms of work), two workers on two
+#: cores ran 1.1x as fast as one; in tasks of about 4 MiB (a few hundred milliseconds) the cost is shared.
+CHUNK_BYTES = 4 * 2**20
+
+#: The fewest tasks per worker when there are enough meshes, so that no worker waits for another's long task.
+CHUNKS_PER_WORKER = 8
 
 #: The columns of the summary, in order, with their pandas dtypes.
 COLUMNS = {
@@ -92,6 +101,17 @@ WORKER_ENVIRONMENT = {
     "MKL_NUM_THREADS": "1",
     "OPENBLAS_NUM_THREADS": "1",
     "NUMBA_NUM_THREADS": "1",
+}
+
+#: Dask settings of the local cluster (see :func:`local_cluster`); on a cluster of one's own, a Dask
+#: configuration file on the workers can hold the same.
+WORKER_CONFIG = {
+    # glibc variables, read when a process starts: Dask's MALLOC_TRIM_THRESHOLD_=65536 unset (glibc's
+    # adaptive threshold), and one malloc arena, so that the task thread allocates as a main thread does
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    "distributed.nanny.pre-spawn-environ.MALLOC_ARENA_MAX": 1,
+    # the statistical profiler samples the task thread's stack every 10 ms: not needed for meshes
+    "distributed.worker.profile.enabled": False,
 }
 
 _GLOB_CHARACTERS = re.compile(r"[*?\[]")
@@ -244,17 +264,27 @@ def _statistics(result) -> dict:
     return row
 
 
-def _stale_temporaries(output: pathlib.Path) -> list[pathlib.Path]:
-    """Temporary files left beside ``output`` by writes that never finished (a killed process).
+def _stale_temporaries(targets) -> list[pathlib.Path]:
+    """Temporary files left beside ``targets`` by writes that never finished (a killed process).
 
     :func:`meshcurv.io._files.atomic_output` names them ``.<name>.<random><suffix>``
-    in the folder of ``<name>``; a temporary of a temporary starts with ``..<name>.``.
+    in the folder of ``<name>``; a temporary of a temporary starts with
+    ``..<name>.``. Each folder is listed once, however many targets it holds.
     """
-    if not output.parent.is_dir():
-        return []
-    pattern = glob.escape(f".{output.name}.") + "*" + glob.escape(output.suffix)
-    nested = glob.escape(f"..{output.name}.") + "*" + glob.escape(output.suffix)
-    return sorted({*output.parent.glob(pattern), *output.parent.glob(nested)})
+    by_folder: dict[pathlib.Path, list[pathlib.Path]] = {}
+    for target in targets:
+        by_folder.setdefault(target.parent, []).append(target)
+    found = []
+    for folder, names in by_folder.items():
+        try:
+            hidden = [entry.name for entry in os.scandir(folder) if entry.name.startswith(".")]
+        except (FileNotFoundError, NotADirectoryError):
+            continue
+        for target in names:
+            prefixes = (f".{target.name}.", f"..{target.name}.")
+            found.extend(folder / name for name in hidden
+                         if name.startswith(prefixes) and name.endswith(target.suffix))
+    return sorted(set(found))
 
 
 def _write_record(path: pathlib.Path, record: dict) -> None:
@@ -336,6 +366,12 @@ def process_mesh(source, output, record, *, method: str = "normal_cycle", smooth
     return row
 
 
+def process_meshes(sources, outputs, records, **options) -> list[dict]:
+    """:func:`process_mesh` on several meshes in turn (one Dask task); their rows, in order."""
+    return [process_mesh(source, output, record, **options)
+            for source, output, record in zip(sources, outputs, records, strict=True)]
+
+
 def _dependencies():
     try:
         import distributed
@@ -363,7 +399,9 @@ def local_cluster(*, workers: int | None = None, dashboard: bool = True):
         thread.
     dashboard : bool, default: True
         Serve the Dask dashboard on 127.0.0.1 and a free port
-        (``client.dashboard_link``).
+        (``client.dashboard_link``). The scheduler's HTTP server (health
+        checks) listens there in any case; without ``dashboard`` it does not
+        serve the dashboard's pages.
 
     Yields
     ------
@@ -386,7 +424,10 @@ def local_cluster(*, workers: int | None = None, dashboard: bool = True):
     makes glibc hand every large array back to the system when freed: meshcurv
     allocates many, and each mesh then takes about twice as long; this cluster
     leaves the variable unset (glibc's own adaptive threshold), unless it is
-    set in the environment. The variables Dask writes into ``os.environ`` of
+    set in the environment. It sets ``MALLOC_ARENA_MAX=1``: the task runs in a
+    thread of its worker, and glibc's per-thread arenas made each mesh about 7%
+    slower there than in a main thread. It turns Dask's statistical profiler
+    off (:data:`WORKER_CONFIG`). The variables Dask writes into ``os.environ`` of
     this process to start the workers are put back as they were on closing.
 
     Examples
@@ -404,9 +445,10 @@ def local_cluster(*, workers: int | None = None, dashboard: bool = True):
     n_workers = CPU_COUNT if workers is None else check_int_option(workers, "workers", minimum=1)
     saved = dict(os.environ)
     try:
-        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}), \
+        with dask.config.set(WORKER_CONFIG), \
                 distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                         host="127.0.0.1", dashboard_address="127.0.0.1:0" if dashboard else None,
+                                         host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                                         scheduler_kwargs={"dashboard": dashboard},
                                          env=dict(WORKER_ENVIRONMENT), preload=["meshcurv._batch_worker"],
                                          silence_logs=logging.ERROR) as cluster, \
                 distributed.Client(cluster) as client:
@@ -472,7 +514,9 @@ def run(paths, out_dir, *, method: str = "normal_cycle", smoothing_steps: int | 
         (with its record) is skipped: its row is the one recorded then.
     progress : callable, optional
         Called as ``progress(done, total, failed)`` once before the first mesh
-        (``done`` counts the skipped ones) and after each mesh.
+        (``done`` counts the skipped ones) and after each task: small meshes
+        travel to the workers a few at a time (see :data:`CHUNK_BYTES`), so
+        ``done`` may grow by more than one.
 
     Returns
     -------
@@ -505,9 +549,10 @@ def run(paths, out_dir, *, method: str = "normal_cycle", smoothing_steps: int | 
     -----
     One bad file never stops the batch: its row has status ``'failed'`` and
     the error. When a worker process dies (killed, out of memory), Dask runs
-    its task again on another worker; a mesh whose task has killed
+    its task again on another worker. A task that has killed
     ``distributed.scheduler.allowed-failures`` + 1 workers (3 + 1 by default)
-    is reported as failed. Files are written under temporary names and renamed
+    is split into one task per mesh, and a mesh whose own task kills that many
+    workers is reported as failed: the meshes that shared its task are not. Files are written under temporary names and renamed
     when complete; temporaries left by a killed worker are removed when the
     batch ends. An interrupted call (KeyboardInterrupt) writes no summary; the
     next call resumes where it stopped.
@@ -557,21 +602,32 @@ def run(paths, out_dir, *, method: str = "normal_cycle", smoothing_steps: int | 
         try:
             with _cluster(distributed, client=client, scheduler=scheduler, workers=workers) as (active, owned):
                 logger.info("Dask dashboard: %s", _dashboard(active) or "none (pip install bokeh to have one)")
-                futures = active.map(process_mesh, [jobs[index].source for index in todo],
-                                     [jobs[index].output for index in todo],
-                                     [jobs[index].record for index in todo], pure=False, **options)
-                positions = {future.key: index for future, index in zip(futures, todo)}
+                chunks = _chunks(jobs, todo, workers=_worker_count(active))
+                logger.info("%d meshes in %d tasks", len(todo), len(chunks))
+                pending = _submit(active, jobs, chunks, options)
                 try:
-                    for future, outcome in distributed.as_completed(futures, with_results=True,
-                                                                    raise_errors=False):
-                        index = positions[future.key]
-                        rows[index] = _lost(outcome, distributed) if isinstance(outcome, BaseException) else outcome
-                        failed += rows[index]["status"] == "failed"
-                        future.release()
-                        if progress is not None:
-                            progress(len(rows), len(jobs), failed)
+                    while pending:
+                        outcomes = distributed.as_completed(list(pending), with_results=True, raise_errors=False)
+                        retry = []
+                        for future, outcome in outcomes:
+                            chunk = pending.pop(future)
+                            if future.status == "error":  # Dask gives (type, exception, traceback)
+                                outcome = outcome[1]
+                            future.release()
+                            if isinstance(outcome, distributed.KilledWorker) and len(chunk) > 1:
+                                # a mesh of the chunk kills its workers: run each alone, so that only it fails
+                                logger.info("a task of %d meshes killed its workers; running them one by one",
+                                            len(chunk))
+                                retry.extend([index] for index in chunk)
+                                continue
+                            for index, row in zip(chunk, _rows(outcome, chunk, distributed)):
+                                rows[index] = row
+                                failed += row["status"] == "failed"
+                            if progress is not None:
+                                progress(len(rows), len(jobs), failed)
+                        pending = _submit(active, jobs, retry, options)
                 except BaseException:
-                    active.cancel(futures)
+                    active.cancel(list(pending))
                     raise
                 if not owned:  # every task has ended: what a dead worker left half-written can go
                     _remove_temporaries(jobs, todo)
@@ -607,20 +663,65 @@ def _describe(options) -> str:
     return ", ".join(f"{name}={value!r}" for name, value in (options or {}).items()) or "unknown options"
 
 
-def _lost(exc: BaseException, distributed) -> dict:
-    if isinstance(exc, distributed.KilledWorker):
-        error = f"KilledWorker: every worker that ran this mesh died ({exc})"
+def _worker_count(client) -> int:
+    try:
+        return max(1, len(client.scheduler_info().get("workers", {})))
+    except Exception:  # an unusual scheduler: chunk as for one worker
+        return 1
+
+
+def _chunks(jobs: list[_Job], indices: list[int], *, workers: int) -> list[list[int]]:
+    """The meshes ``indices`` cut into tasks: runs of consecutive meshes, in path order.
+
+    The meshes are first shared out evenly into :data:`CHUNKS_PER_WORKER`
+    runs per worker (fewer when there are fewer meshes), so that the workers
+    finish together; a run is then cut where its input files pass
+    :data:`CHUNK_BYTES` (one mesh at least per task), so that large meshes go
+    one by one.
+    """
+    runs = np.array_split(np.asarray(indices, dtype=np.int64), min(len(indices), CHUNKS_PER_WORKER * workers))
+    chunks = []
+    for run in runs:
+        size = CHUNK_BYTES + 1
+        for index in run.tolist():
+            try:
+                nbytes = os.path.getsize(jobs[index].source)
+            except OSError:  # its task says what is wrong with it
+                nbytes = 0
+            if size + nbytes > CHUNK_BYTES:
+                chunks.append([])
+                size = 0
+            chunks[-1].append(index)
+            size += nbytes
+    return chunks
+
+
+def _submit(client, jobs: list[_Job], chunks: list[list[int]], options: dict) -> dict:
+    """Send each chunk to the cluster as one task; the futures, mapped to their chunks."""
+    if not chunks:
+        return {}
+    futures = client.map(process_meshes, [[jobs[index].source for index in chunk] for chunk in chunks],
+                         [[jobs[index].output for index in chunk] for chunk in chunks],
+                         [[jobs[index].record for index in chunk] for chunk in chunks], pure=False, **options)
+    return dict(zip(futures, chunks))
+
+
+def _rows(outcome, chunk: list[int], distributed) -> list[dict]:
+    """The rows of a finished task: its own, or one failed row per mesh when the task itself was lost."""
+    if not isinstance(outcome, BaseException):
+        return outcome
+    if isinstance(outcome, distributed.KilledWorker):
+        error = f"KilledWorker: every worker that ran this mesh died ({outcome})"
     else:
-        error = f"{type(exc).__name__}: {exc}"
-    return {"status": "failed", "error": error, "warnings": "", "output": ""}
+        error = f"{type(outcome).__name__}: {outcome}"
+    return [{"status": "failed", "error": error, "warnings": "", "output": ""} for _ in chunk]
 
 
 def _remove_temporaries(jobs: list[_Job], indices: list[int]) -> None:
-    for index in indices:
-        for target in (pathlib.Path(jobs[index].output), pathlib.Path(jobs[index].record)):
-            for temporary in _stale_temporaries(target):
-                logger.info("removing %s, left by an interrupted write", temporary)
-                temporary.unlink(missing_ok=True)
+    targets = [pathlib.Path(path) for index in indices for path in (jobs[index].output, jobs[index].record)]
+    for temporary in _stale_temporaries(targets):
+        logger.info("removing %s, left by an interrupted write", temporary)
+        temporary.unlink(missing_ok=True)
 
 
 def _summary(pandas, jobs: list[_Job], rows: dict[int, dict]):
