@@ -98,19 +98,32 @@ def build_edges(faces, n_vertices):
 
 # -- normal cycle ---------------------------------------------------------------
 @nb.njit(**_JIT)
-def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate):
-    """Per-vertex measures (6 tensor components), barycentric areas and normal sums.
+def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_ratio):
+    """Per-vertex measures, barycentric areas and normal sums; the zero-area faces.
 
-    Returns ``sums`` of shape (V, 10): columns 0-5 the anisotropic measure
+    A face is degenerate when it repeats a vertex or its area is at most
+    ``area_ratio`` x (mean edge length)^2 (``diagnosis.degenerate_faces``); an
+    edge contributes when it has two consistently oriented faces (``counts == 2``,
+    ``forward == 1``), neither degenerate. Returns ``(sums, degenerate)``: ``sums``
+    of shape (V, 10), columns 0-5 the anisotropic measure
     ``sum beta |e| / 2 e e^T`` (xx, yy, zz, xy, xz, yz), 6 the area, 7-9 the
-    area-weighted face-normal sum.
+    area-weighted face-normal sum; ``degenerate`` of shape (F,).
     """
     n_vertices = vertices.shape[0]
+    n_faces = faces.shape[0]
+    total = 0.0
+    for e in range(edges.shape[0]):
+        p, q = edges[e, 0], edges[e, 1]
+        x = vertices[q, 0] - vertices[p, 0]
+        y = vertices[q, 1] - vertices[p, 1]
+        z = vertices[q, 2] - vertices[p, 2]
+        total += math.sqrt(x * x + y * y + z * z)
+    mean = total / edges.shape[0] if edges.shape[0] else 0.0
+    threshold = area_ratio * mean * mean
     sums = np.zeros((n_vertices, 10))
-    unit_normals = np.zeros((faces.shape[0], 3))
-    for f in range(faces.shape[0]):
-        if degenerate[f]:
-            continue
+    degenerate = np.zeros(n_faces, np.bool_)
+    unit_normals = np.empty((n_faces, 3))
+    for f in range(n_faces):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         ux = vertices[b, 0] - vertices[a, 0]
         uy = vertices[b, 1] - vertices[a, 1]
@@ -122,6 +135,9 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate):
         ny = uz * vx - ux * vz
         nz = ux * vy - uy * vx
         double_area = math.sqrt(nx * nx + ny * ny + nz * nz)
+        if a == b or b == c or c == a or 0.5 * double_area <= threshold:
+            degenerate[f] = True
+            continue
         unit_normals[f, 0] = nx / double_area
         unit_normals[f, 1] = ny / double_area
         unit_normals[f, 2] = nz / double_area
@@ -132,10 +148,12 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate):
             sums[corner, 8] += ny
             sums[corner, 9] += nz
     for e in range(edges.shape[0]):
-        if not usable[e]:
+        if counts[e] != 2 or forward[e] != 1:
+            continue
+        f1, f2 = edge_faces[e, 0], edge_faces[e, 1]
+        if degenerate[f1] or degenerate[f2]:
             continue
         p, q = edges[e, 0], edges[e, 1]
-        f1, f2 = edge_faces[e, 0], edge_faces[e, 1]
         ex = vertices[q, 0] - vertices[p, 0]
         ey = vertices[q, 1] - vertices[p, 1]
         ez = vertices[q, 2] - vertices[p, 2]
@@ -157,7 +175,62 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, usable, degenerate):
             sums[v, 3] += weight * ex * ey
             sums[v, 4] += weight * ex * ez
             sums[v, 5] += weight * ey * ez
-    return sums
+    return sums, degenerate
+
+
+@nb.njit(parallel=True, **_JIT)
+def normal_cycle_finish(sums, invalid, indptr, indices, steps):
+    """From :func:`normal_cycle_sums` to the curvatures, in one kernel.
+
+    The measures and areas of valid vertices (invalid ones count as zero) are
+    smoothed ``steps`` times over 1-rings (``smoothing.smooth_vertex_field``),
+    divided, restricted to the tangent plane of the unit normal and solved in
+    closed form (``tangent_principal`` with ``rotate`` and ``mean_from_trace``).
+    Returns ``(k_min, k_max, dir_min, dir_max, normals, valid)``, NaN where not valid.
+    """
+    n = sums.shape[0]
+    current = np.empty((n, 7))
+    for i in nb.prange(n):
+        weight = 0.0 if invalid[i] else 1.0
+        for c in range(7):
+            current[i, c] = sums[i, c] * weight
+    if steps > 0:
+        following = np.empty((n, 7))
+        for _ in range(steps):
+            for i in nb.prange(n):
+                start, stop = indptr[i], indptr[i + 1]
+                scale = 1.0 / (stop - start + 1.0)
+                for c in range(7):
+                    total = current[i, c]
+                    for j in range(start, stop):
+                        total += current[indices[j], c]
+                    following[i, c] = total * scale
+            current, following = following, current
+    k_min = np.full(n, np.nan)
+    k_max = np.full(n, np.nan)
+    dir_min = np.full((n, 3), np.nan)
+    dir_max = np.full((n, 3), np.nan)
+    normals = np.full((n, 3), np.nan)
+    valid = np.zeros(n, np.bool_)
+    tiny = np.finfo(np.float64).tiny
+    for i in nb.prange(n):
+        sx, sy, sz = sums[i, 7], sums[i, 8], sums[i, 9]
+        norm = math.sqrt(sx * sx + sy * sy + sz * sz)
+        if not norm > 1e-12 * max(max(abs(sx), abs(sy), abs(sz)), tiny):  # geometry.normalize_normal_sums
+            continue
+        nx, ny, nz = sx / norm, sy / norm, sz / norm
+        normals[i, 0], normals[i, 1], normals[i, 2] = nx, ny, nz
+        area = current[i, 6]
+        if invalid[i] or not area > 0:
+            continue
+        valid[i] = True
+        lo, hi, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
+            current[i, 0] / area, current[i, 1] / area, current[i, 2] / area, current[i, 3] / area,
+            current[i, 4] / area, current[i, 5] / area, nx, ny, nz, True, True)
+        k_min[i], k_max[i] = lo, hi
+        dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
+        dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5
+    return k_min, k_max, dir_min, dir_max, normals, valid
 
 
 @nb.njit(**_JIT)
@@ -177,44 +250,29 @@ def _tangent_frame(nx, ny, nz):
     return tx, ty, tz, ny * tz - nz * ty, nz * tx - nx * tz, nx * ty - ny * tx
 
 
-@nb.njit(parallel=True, **_JIT)
-def tangent_principal(tensors, normals, valid, rotate, mean_from_trace):
-    """Per-vertex closed-form version of ``_tensors.principal_from_shape_operator``.
-
-    Returns ``out`` of shape (V, 8): k_min, k_max, dir_min (3), dir_max (3); NaN
-    where ``valid`` is False.
-    """
-    n = tensors.shape[0]
-    out = np.full((n, 8), np.nan)
-    for i in nb.prange(n):
-        if not valid[i]:
-            continue
-        xx, yy, zz, xy, xz, yz = (tensors[i, 0], tensors[i, 1], tensors[i, 2],
-                                  tensors[i, 3], tensors[i, 4], tensors[i, 5])
-        t1x, t1y, t1z, t2x, t2y, t2z = _tangent_frame(normals[i, 0], normals[i, 1], normals[i, 2])
-        s1x = xx * t1x + xy * t1y + xz * t1z
-        s1y = xy * t1x + yy * t1y + yz * t1z
-        s1z = xz * t1x + yz * t1y + zz * t1z
-        a = t1x * s1x + t1y * s1y + t1z * s1z
-        b = t2x * s1x + t2y * s1y + t2z * s1z
-        c = (t2x * (xx * t2x + xy * t2y + xz * t2z) + t2y * (xy * t2x + yy * t2y + yz * t2z)
-             + t2z * (xz * t2x + yz * t2y + zz * t2z))
-        half_sum = 0.5 * (a + c)
-        if mean_from_trace:
-            half_sum = 0.5 * (xx + yy + zz)
-        half_diff = 0.5 * (a - c)
-        radius = math.hypot(half_diff, b)
-        theta = 0.5 * math.atan2(b, half_diff)
-        co, si = math.cos(theta), math.sin(theta)
-        alx, aly, alz = co * t1x + si * t2x, co * t1y + si * t2y, co * t1z + si * t2z
-        acx, acy, acz = -si * t1x + co * t2x, -si * t1y + co * t2y, -si * t1z + co * t2z
-        if rotate:
-            alx, aly, alz, acx, acy, acz = acx, acy, acz, alx, aly, alz
-        out[i, 0] = half_sum - radius
-        out[i, 1] = half_sum + radius
-        out[i, 2], out[i, 3], out[i, 4] = acx, acy, acz
-        out[i, 5], out[i, 6], out[i, 7] = alx, aly, alz
-    return out
+@nb.njit(inline="always", **_JIT)
+def _tangent_eigen(xx, yy, zz, xy, xz, yz, nx, ny, nz, rotate, mean_from_trace):
+    """k_min, k_max, dir_min (3), dir_max (3) of one tensor restricted to the plane normal to n."""
+    t1x, t1y, t1z, t2x, t2y, t2z = _tangent_frame(nx, ny, nz)
+    s1x = xx * t1x + xy * t1y + xz * t1z
+    s1y = xy * t1x + yy * t1y + yz * t1z
+    s1z = xz * t1x + yz * t1y + zz * t1z
+    a = t1x * s1x + t1y * s1y + t1z * s1z
+    b = t2x * s1x + t2y * s1y + t2z * s1z
+    c = (t2x * (xx * t2x + xy * t2y + xz * t2z) + t2y * (xy * t2x + yy * t2y + yz * t2z)
+         + t2z * (xz * t2x + yz * t2y + zz * t2z))
+    half_sum = 0.5 * (a + c)
+    if mean_from_trace:
+        half_sum = 0.5 * (xx + yy + zz)
+    half_diff = 0.5 * (a - c)
+    radius = math.hypot(half_diff, b)
+    theta = 0.5 * math.atan2(b, half_diff)
+    co, si = math.cos(theta), math.sin(theta)
+    alx, aly, alz = co * t1x + si * t2x, co * t1y + si * t2y, co * t1z + si * t2z
+    acx, acy, acz = -si * t1x + co * t2x, -si * t1y + co * t2y, -si * t1z + co * t2z
+    if rotate:
+        alx, aly, alz, acx, acy, acz = acx, acy, acz, alx, aly, alz
+    return half_sum - radius, half_sum + radius, acx, acy, acz, alx, aly, alz
 
 
 # -- symmetric 3x3 eigen-decomposition -----------------------------------------
@@ -485,22 +543,50 @@ def count_components(edges, referenced, n_vertices):
 
 
 @nb.njit(**_JIT)
-def mesh_measures(vertices, faces, edges, centre):
-    """One pass over edges and faces: the facts :func:`meshcurv.diagnose` needs.
+def mesh_facts(vertices, faces, edges, referenced, area_ratio, zero_length_ratio):
+    """The measured facts of :func:`meshcurv.diagnose`, in one pass over vertices, faces and edges.
 
-    Returns ``(edge_lengths (E,), double_areas (F,), area, six_volume)`` where
-    ``six_volume`` is the sum over faces of ``(a - centre) . cross(b - a, c - a)``.
+    Returns ``(lower, upper, area, six_volume, mean_length, n_degenerate, n_zero_length)``:
+    the bounding box of the referenced vertices, the total area, the sum over
+    faces of ``(a - centre) . cross(b - a, c - a)`` (``centre`` the mean of the
+    referenced vertices), the mean edge length, the faces that repeat a vertex or
+    whose area is at most ``area_ratio`` x mean length^2, the edges no longer
+    than ``zero_length_ratio`` x mean length.
     """
-    lengths = np.empty(edges.shape[0])
-    for e in range(edges.shape[0]):
+    lower = np.full(3, np.inf)
+    upper = np.full(3, -np.inf)
+    centre = np.zeros(3)
+    used = 0
+    for v in range(vertices.shape[0]):
+        if not referenced[v]:
+            continue
+        used += 1
+        for k in range(3):
+            x = vertices[v, k]
+            centre[k] += x
+            lower[k] = min(lower[k], x)
+            upper[k] = max(upper[k], x)
+    if used:
+        centre /= used
+    n_edges = edges.shape[0]
+    lengths = np.empty(n_edges)
+    total = 0.0
+    for e in range(n_edges):
         p, q = edges[e, 0], edges[e, 1]
         x = vertices[q, 0] - vertices[p, 0]
         y = vertices[q, 1] - vertices[p, 1]
         z = vertices[q, 2] - vertices[p, 2]
         lengths[e] = math.sqrt(x * x + y * y + z * z)
-    double_areas = np.empty(faces.shape[0])
+        total += lengths[e]
+    mean = total / n_edges if n_edges else 0.0
+    n_zero_length = 0
+    for e in range(n_edges):
+        if lengths[e] <= zero_length_ratio * mean:
+            n_zero_length += 1
+    threshold = area_ratio * mean * mean
     area = 0.0
     six_volume = 0.0
+    n_degenerate = 0
     for f in range(faces.shape[0]):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         ux = vertices[b, 0] - vertices[a, 0]
@@ -512,11 +598,13 @@ def mesh_measures(vertices, faces, edges, centre):
         nx = uy * wz - uz * wy
         ny = uz * wx - ux * wz
         nz = ux * wy - uy * wx
-        double_areas[f] = math.sqrt(nx * nx + ny * ny + nz * nz)
-        area += 0.5 * double_areas[f]
+        half = 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz)
+        area += half
+        if a == b or b == c or c == a or half <= threshold:
+            n_degenerate += 1
         six_volume += ((vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny
                        + (vertices[a, 2] - centre[2]) * nz)
-    return lengths, double_areas, area, six_volume
+    return lower, upper, area, six_volume, mean, n_degenerate, n_zero_length
 
 
 # -- smoothing ------------------------------------------------------------------

@@ -13,8 +13,11 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ._backend import numba_kernels
-from .geometry import degenerate_face_mask, edge_lengths, face_cross_products
+from .geometry import DEGENERATE_AREA_RATIO, degenerate_face_mask, edge_lengths, face_cross_products
 from .topology import MeshTopology
+
+#: Edges no longer than this times the mean edge length count as zero-length.
+ZERO_LENGTH_RATIO = 1e-6
 
 __all__ = ["MeshDiagnosis", "diagnose", "degenerate_faces", "bowtie_vertices"]
 
@@ -168,20 +171,23 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     faces = topology.faces
     referenced = topology.referenced_vertices
     n_unreferenced = int(topology.n_vertices - referenced.sum())
-    used = vertices if n_unreferenced == 0 else vertices[referenced]
-    centre = used.mean(axis=0)
     kernels = numba_kernels()
     if kernels is not None:
-        lengths, double_areas, area, six_volume = kernels.mesh_measures(vertices, faces, topology.edges, centre)
+        lower, upper, area, six_volume, scale, n_degenerate, n_zero_length = kernels.mesh_facts(
+            vertices, faces, topology.edges, referenced, DEGENERATE_AREA_RATIO, ZERO_LENGTH_RATIO)
     else:
+        used = vertices if n_unreferenced == 0 else vertices[referenced]
+        centre = used.mean(axis=0)
         cross = face_cross_products(vertices, faces)
         lengths = edge_lengths(vertices, topology.edges)
         double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
         area = float(0.5 * double_areas.sum())
         # the cross products are translation-invariant: a . (b x c) = (a - o) . cross(b - a, c - a)
         six_volume = float(np.einsum("ij,ij->i", vertices[faces[:, 0]] - centre, cross).sum())
-    scale = float(lengths.mean()) if lengths.size else 0.0
-    degenerate = degenerate_face_mask(0.5 * double_areas, scale) | topology.degenerate_faces
+        scale = float(lengths.mean()) if lengths.size else 0.0
+        n_degenerate = int((degenerate_face_mask(0.5 * double_areas, scale) | topology.degenerate_faces).sum())
+        n_zero_length = int((lengths <= ZERO_LENGTH_RATIO * scale).sum())
+        lower, upper = used.min(axis=0), used.max(axis=0)
     n_boundary = int(topology.boundary_edges.sum())
     nonmanifold = topology.nonmanifold_edges
     n_nonmanifold = int(nonmanifold.sum())
@@ -189,8 +195,10 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     n_components = topology.n_components
     closed = n_boundary == 0
     genus = (2 - chi) // 2 if closed and n_components == 1 and n_nonmanifold == 0 else None
-    volume = six_volume / 6.0 if closed and faces.shape[0] else None
-    bowties = bowtie_vertices(topology) & ~topology.edge_vertices(nonmanifold)
+    volume = float(six_volume) / 6.0 if closed and faces.shape[0] else None
+    bowties = bowtie_vertices(topology)
+    if n_nonmanifold:
+        bowties = bowties & ~topology.edge_vertices(nonmanifold)
     return MeshDiagnosis(
         n_vertices=topology.n_vertices,
         n_faces=topology.n_faces,
@@ -200,16 +208,16 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
         n_boundary_loops=topology.n_boundary_loops,
         n_nonmanifold_edges=n_nonmanifold,
         n_inconsistent_edges=int(topology.inconsistent_edges.sum()),
-        n_degenerate_faces=int(degenerate.sum()),
+        n_degenerate_faces=int(n_degenerate),
         n_unreferenced_vertices=n_unreferenced,
         euler_characteristic=chi,
         genus=genus,
         area=float(area),
         volume=volume,
-        mean_edge_length=scale,
-        bounding_box=(tuple(used.min(axis=0).tolist()), tuple(used.max(axis=0).tolist())),
+        mean_edge_length=float(scale),
+        bounding_box=(tuple(lower.tolist()), tuple(upper.tolist())),
         n_bowtie_vertices=int(bowties.sum()),
-        n_zero_length_edges=int((lengths <= 1e-6 * scale).sum()) if lengths.size else 0,
+        n_zero_length_edges=int(n_zero_length),
         n_flipped_faces=int(n_flipped_faces),
     )
 

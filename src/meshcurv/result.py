@@ -68,13 +68,29 @@ class CurvatureResult:
     diagnosis: "MeshDiagnosis | None" = None
 
     def __post_init__(self):
-        for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid"):
+        for name in _ARRAY_FIELDS:
             value = getattr(self, name)
-            dtype = bool if name == "valid" else np.float64
-            array = np.array(value, dtype=dtype, copy=True)
+            if isinstance(value, np.ndarray) and not value.flags.writeable and _keepable(value, name):
+                continue  # read-only, owns its data: cannot change under the result (see _of_arrays)
+            array = np.array(value, dtype=bool if name == "valid" else np.float64, copy=True)
             array.flags.writeable = False
             object.__setattr__(self, name, array)
         object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
+
+    @classmethod
+    def _of_arrays(cls, **fields) -> "CurvatureResult":
+        """A result that takes the estimator's own arrays without copying them.
+
+        The arrays are made read-only here and kept by :meth:`__post_init__`
+        (float64, or bool for ``valid``, C-contiguous, owning their data);
+        others are copied as by the constructor. Only for arrays that nobody
+        else holds.
+        """
+        for name in _ARRAY_FIELDS:
+            value = fields[name]
+            if isinstance(value, np.ndarray) and _keepable(value, name):
+                value.flags.writeable = False
+        return cls(**fields)
 
     @property
     def n_vertices(self) -> int:
@@ -131,6 +147,14 @@ class CurvatureResult:
             f"CurvatureResult(method={self.method!r}, n_vertices={self.n_vertices}, "
             f"valid={n_valid}, parameters={dict(self.parameters)})"
         )
+
+
+_ARRAY_FIELDS = ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid")
+
+
+def _keepable(array: np.ndarray, name: str) -> bool:
+    dtype = np.bool_ if name == "valid" else np.float64
+    return array.dtype == dtype and array.flags.owndata and array.flags.c_contiguous
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:

@@ -50,7 +50,7 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from ..diagnosis import degenerate_faces
 from .._backend import numba_kernels
-from ..geometry import face_cross_products, normalize_normal_sums, vertex_normals
+from ..geometry import DEGENERATE_AREA_RATIO, face_cross_products, vertex_normals
 from ..result import CurvatureResult
 from ..smoothing import smooth_vertex_field
 from ..topology import MeshTopology
@@ -84,39 +84,31 @@ def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_norm
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
     """Normal-cycle tensor in true units. Returns ``(result, problems)``."""
+    kernels = numba_kernels()
+    if kernels is not None:
+        return _estimate_compiled(kernels, vertices, topology, smoothing_steps, stages)
     stages.start("compute adjacencies")
     n_vertices = vertices.shape[0]
     faces = topology.faces
-    kernels = numba_kernels()
-    if kernels is not None:
-        lengths, double_areas, _, _ = kernels.mesh_measures(vertices, faces, topology.edges, np.zeros(3))
-        degenerate = degenerate_faces(vertices, topology, double_areas=double_areas,
-                                      mean_edge_length=float(lengths.mean()) if lengths.size else 0.0)
-    else:
-        cross = face_cross_products(vertices, faces)
-        double_areas = np.linalg.norm(cross, axis=1)
-        degenerate = degenerate_faces(vertices, topology, cross=cross)
+    cross = face_cross_products(vertices, faces)
+    double_areas = np.linalg.norm(cross, axis=1)
+    degenerate = degenerate_faces(vertices, topology, cross=cross)
     defects = mesh_defects(topology, degenerate)
 
     stages.start("compute edge tensors")
     usable = topology.interior_edges & ~degenerate[np.maximum(topology.edge_faces, 0)].any(axis=1)
-    if kernels is not None:
-        sums = kernels.normal_cycle_sums(vertices, faces, topology.edges, topology.edge_faces, usable, degenerate)
-        measures, areas, normals = sums[:, :6], sums[:, 6], normalize_normal_sums(sums[:, 7:])
-    else:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            unit_normals = cross / double_areas[:, None]
-        beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
-        edge_measures = outer6(unit, 0.5 * beta * lengths)
-        ends = topology.edges.T.ravel()
-        measures = np.stack(
-            [np.bincount(ends, weights=np.tile(edge_measures[:, k], 2), minlength=n_vertices)
-             for k in range(6)],
-            axis=1,
-        )
-        face_area_thirds = np.where(degenerate, 0.0, double_areas / 6.0)
-        areas = np.bincount(faces.ravel(), weights=np.repeat(face_area_thirds, 3), minlength=n_vertices)
-        normals = vertex_normals(vertices, faces[~degenerate], cross=cross[~degenerate])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit_normals = cross / double_areas[:, None]
+    beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
+    edge_measures = outer6(unit, 0.5 * beta * lengths)
+    ends = topology.edges.T.ravel()
+    measures = np.stack(
+        [np.bincount(ends, weights=np.tile(edge_measures[:, k], 2), minlength=n_vertices) for k in range(6)],
+        axis=1,
+    )
+    face_area_thirds = np.where(degenerate, 0.0, double_areas / 6.0)
+    areas = np.bincount(faces.ravel(), weights=np.repeat(face_area_thirds, 3), minlength=n_vertices)
+    normals = vertex_normals(vertices, faces[~degenerate], cross=cross[~degenerate])
 
     stages.start("average vertex tensors")
     valid = ~defects.invalid_vertices
@@ -129,16 +121,35 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
 
     stages.start("retrieve curvatures")
     valid &= np.isfinite(normals).all(axis=1) & (pooled[:, 6] > 0)
-    if kernels is not None:
-        out = kernels.tangent_principal(tensors, normals, valid, True, True)
-        k_min, k_max, dir_min, dir_max = out[:, 0], out[:, 1], out[:, 2:5], out[:, 5:8]
-    else:
-        k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-            np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
-            rotate=True, mean_from_trace=True,
-        )
-        nan_where(~valid, k_min, k_max, dir_min, dir_max)
-    result = CurvatureResult(
+    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
+        np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
+        rotate=True, mean_from_trace=True,
+    )
+    nan_where(~valid, k_min, k_max, dir_min, dir_max)
+    result = CurvatureResult._of_arrays(
+        k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
+        method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},
+    )
+    return result, defects.messages()
+
+
+def _estimate_compiled(kernels, vertices: np.ndarray, topology: MeshTopology, smoothing_steps: int,
+                       stages: Stages):
+    """The same with the compiled kernels: one pass for the sums, one kernel from sums to curvatures."""
+    stages.start("compute adjacencies")
+    indptr, indices = topology.neighbour_lists if smoothing_steps > 0 else (None, None)
+    stages.start("compute edge tensors")
+    sums, degenerate = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
+                                                 topology.edge_face_counts, topology._edge_forward_counts,
+                                                 DEGENERATE_AREA_RATIO)
+    defects = mesh_defects(topology, degenerate)
+    stages.start("average vertex tensors")
+    if indptr is None:
+        indptr, indices = np.zeros(vertices.shape[0] + 1, np.int64), np.zeros(0, np.int64)
+    stages.start("retrieve curvatures")
+    k_min, k_max, dir_min, dir_max, normals, valid = kernels.normal_cycle_finish(
+        sums, defects.invalid_vertices, indptr, indices, smoothing_steps)
+    result = CurvatureResult._of_arrays(
         k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
         method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},
     )
