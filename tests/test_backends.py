@@ -74,6 +74,19 @@ def test_topology_is_identical(name):
         assert expected.sum() == 1
 
 
+@pytest.mark.parametrize("chunks", [1, 3, 7])
+def test_topology_does_not_depend_on_the_number_of_threads(chunks):
+    """The compiled build splits the vertices into one range per thread: any split gives the same edges."""
+    from meshcurv import _numba_kernels
+    from meshcurv.topology import _build_edges
+
+    vertices, faces = MESHES["defects"]
+    faces = np.asarray(faces, np.int64)
+    expected = _build_edges(faces, vertices.shape[0])
+    for got, want in zip(_numba_kernels.build_edges(faces, vertices.shape[0], chunks), expected, strict=True):
+        np.testing.assert_array_equal(got, want)
+
+
 @pytest.mark.parametrize("method", ["normal_cycle", "matgeom"])
 @pytest.mark.parametrize("name", sorted(MESHES))
 def test_curvatures_agree(name, method):

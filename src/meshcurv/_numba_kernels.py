@@ -17,56 +17,84 @@ _JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 
 # -- topology -------------------------------------------------------------------
-@nb.njit(**_JIT)
-def build_edges(faces, n_vertices):
+def threads() -> int:
+    """The threads numba's parallel kernels use (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``)."""
+    return nb.get_num_threads()
+
+
+@nb.njit(parallel=True, **_JIT)
+def build_edges(faces, n_vertices, n_chunks):
     """Edges of the triangles, their faces and counts (see MeshTopology._build).
 
     Sides are bucketed by their smaller vertex (counting sort), each bucket is
     sorted by (larger vertex, direction) with a stable insertion sort, so the
     edges come out in lexicographic order, as ``np.unique`` would give them.
+    Each thread buckets the sides of its own range of vertices (scanning all
+    faces), then sorts and numbers the buckets of its vertices; the edge numbers
+    come from a prefix sum of the edges per vertex. ``n_chunks``: the number of
+    vertex ranges (one per thread, :func:`threads`).
     """
     n_faces = faces.shape[0]
+    n_chunks = max(1, min(n_chunks, n_vertices))
+    bounds = np.empty(n_chunks + 1, np.int64)
+    for c in range(n_chunks + 1):
+        bounds[c] = (n_vertices * c) // n_chunks
     bucket_start = np.zeros(n_vertices + 1, np.int64)
-    for f in range(n_faces):
-        for k in range(3):
-            a = faces[f, k]
-            b = faces[f, (k + 1) % 3]
-            if a != b:
-                bucket_start[min(a, b) + 1] += 1
+    for c in nb.prange(n_chunks):
+        first, last = bounds[c], bounds[c + 1]
+        for f in range(n_faces):
+            for k in range(3):
+                a = faces[f, k]
+                b = faces[f, (k + 1) % 3]
+                low = min(a, b)
+                if a != b and first <= low < last:
+                    bucket_start[low + 1] += 1
     for i in range(n_vertices):
         bucket_start[i + 1] += bucket_start[i]
     n_sides = bucket_start[n_vertices]
-    fill = bucket_start[:-1].copy()
     sort_key = np.empty(n_sides, np.int64)  # 2 * larger vertex + backward
     side_of = np.empty(n_sides, np.int64)
-    for f in range(n_faces):
-        for k in range(3):
-            a = faces[f, k]
-            b = faces[f, (k + 1) % 3]
-            if a != b:
+    fill = bucket_start[:-1].copy()
+    for c in nb.prange(n_chunks):
+        first, last = bounds[c], bounds[c + 1]
+        for f in range(n_faces):
+            for k in range(3):
+                a = faces[f, k]
+                b = faces[f, (k + 1) % 3]
                 low = min(a, b)
-                slot = fill[low]
-                fill[low] += 1
-                sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
-                side_of[slot] = 3 * f + k
-    for v in range(n_vertices):  # stable insertion sort of each (small) bucket
-        for i in range(bucket_start[v] + 1, bucket_start[v + 1]):
+                if a != b and first <= low < last:
+                    slot = fill[low]
+                    fill[low] += 1
+                    sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
+                    side_of[slot] = 3 * f + k
+    edges_before = np.zeros(n_vertices + 1, np.int64)
+    for v in nb.prange(n_vertices):  # stable insertion sort of each (small) bucket; count its edges
+        start, stop = bucket_start[v], bucket_start[v + 1]
+        for i in range(start + 1, stop):
             key = sort_key[i]
             side = side_of[i]
             j = i - 1
-            while j >= bucket_start[v] and sort_key[j] > key:
+            while j >= start and sort_key[j] > key:
                 sort_key[j + 1] = sort_key[j]
                 side_of[j + 1] = side_of[j]
                 j -= 1
             sort_key[j + 1] = key
             side_of[j + 1] = side
-    edges = np.empty((n_sides, 2), np.int64)
-    edge_faces = np.full((n_sides, 2), -1, np.int64)
-    counts = np.zeros(n_sides, np.int64)
-    forward = np.zeros(n_sides, np.int64)
-    face_edges = np.full(3 * n_faces, -1, np.int64)
-    e = -1
+        distinct = 0
+        for i in range(start, stop):
+            if i == start or (sort_key[i] >> 1) != (sort_key[i - 1] >> 1):
+                distinct += 1
+        edges_before[v + 1] = distinct
     for v in range(n_vertices):
+        edges_before[v + 1] += edges_before[v]
+    n_edges = edges_before[n_vertices]
+    edges = np.empty((n_edges, 2), np.int64)
+    edge_faces = np.full((n_edges, 2), -1, np.int64)
+    counts = np.zeros(n_edges, np.int64)
+    forward = np.zeros(n_edges, np.int64)
+    face_edges = np.full(3 * n_faces, -1, np.int64)
+    for v in nb.prange(n_vertices):
+        e = edges_before[v] - 1
         previous_high = -1
         for i in range(bucket_start[v], bucket_start[v + 1]):
             high = sort_key[i] >> 1
@@ -91,9 +119,7 @@ def build_edges(faces, n_vertices):
             if not backward:
                 forward[e] += 1
             face_edges[side] = e
-    n_edges = e + 1
-    return (edges[:n_edges].copy(), face_edges.reshape(n_faces, 3), edge_faces[:n_edges].copy(),
-            counts[:n_edges].copy(), forward[:n_edges].copy())
+    return edges, face_edges.reshape(n_faces, 3), edge_faces, counts, forward
 
 
 # -- normal cycle ---------------------------------------------------------------
@@ -345,6 +371,26 @@ def _jacobi3(a00, a11, a22, a01, a02, a12):
     return a00, a11, a22, v00, v01, v02, v10, v11, v12, v20, v21, v22
 
 
+@nb.njit(inline="always", **_JIT)
+def _magnitude_order(w0, w1, w2):
+    """Positions of three eigenvalues in ascending value (stable), then ascending magnitude (stable)."""
+    o0, o1, o2 = 0, 1, 2
+    w = (w0, w1, w2)
+    if w[o0] > w[o1]:
+        o0, o1 = o1, o0
+    if w[o1] > w[o2]:
+        o1, o2 = o2, o1
+        if w[o0] > w[o1]:
+            o0, o1 = o1, o0
+    if abs(w[o0]) > abs(w[o1]):
+        o0, o1 = o1, o0
+    if abs(w[o1]) > abs(w[o2]):
+        o1, o2 = o2, o1
+        if abs(w[o0]) > abs(w[o1]):
+            o0, o1 = o1, o0
+    return o0, o1, o2
+
+
 @nb.njit(parallel=True, **_JIT)
 def eigen_by_magnitude(tensors):
     """Eigenpairs of (N, 6) symmetric tensors ordered by |eigenvalue| (see _eigen.py).
@@ -365,21 +411,8 @@ def eigen_by_magnitude(tensors):
         w0, w1, w2, v00, v01, v02, v10, v11, v12, v20, v21, v22 = _jacobi3(
             tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4], tensors[i, 5]
         )
-        # order: ascending value (stable), then ascending magnitude (stable)
-        o0, o1, o2 = 0, 1, 2
+        o0, o1, o2 = _magnitude_order(w0, w1, w2)
         w = (w0, w1, w2)
-        if w[o0] > w[o1]:
-            o0, o1 = o1, o0
-        if w[o1] > w[o2]:
-            o1, o2 = o2, o1
-            if w[o0] > w[o1]:
-                o0, o1 = o1, o0
-        if abs(w[o0]) > abs(w[o1]):
-            o0, o1 = o1, o0
-        if abs(w[o1]) > abs(w[o2]):
-            o1, o2 = o2, o1
-            if abs(w[o0]) > abs(w[o1]):
-                o0, o1 = o1, o0
         columns = ((v00, v10, v20), (v01, v11, v21), (v02, v12, v22))
         for k, o in enumerate((o0, o1, o2)):
             values[i, k] = w[o]
@@ -388,6 +421,50 @@ def eigen_by_magnitude(tensors):
             vectors[i, 1, k] = column[1]
             vectors[i, 2, k] = column[2]
     return values, vectors
+
+@nb.njit(parallel=True, **_JIT)
+def matgeom_principal(tensors):
+    """matGeom's step 7 per vertex: eigenpairs by magnitude, the two largest as curvatures, swapped so c1 <= c2.
+
+    Returns ``(c1, c2, u1, u2, normal)``: the eigenvalues of middle and largest
+    magnitude (ordered), their eigenvectors (the curvature directions) and the
+    eigenvector of the smallest magnitude (the normal); NaN rows where a
+    component is not finite. As :func:`eigen_by_magnitude` and the swap of
+    ``estimators.matgeom.estimate``.
+    """
+    n = tensors.shape[0]
+    c1 = np.full(n, np.nan)
+    c2 = np.full(n, np.nan)
+    u1 = np.full((n, 3), np.nan)
+    u2 = np.full((n, 3), np.nan)
+    normal = np.full((n, 3), np.nan)
+    for i in nb.prange(n):
+        finite = True
+        for k in range(6):
+            if not math.isfinite(tensors[i, k]):
+                finite = False
+        if not finite:
+            continue
+        w0, w1, w2, v00, v01, v02, v10, v11, v12, v20, v21, v22 = _jacobi3(
+            tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4], tensors[i, 5]
+        )
+        o0, o1, o2 = _magnitude_order(w0, w1, w2)
+        w = (w0, w1, w2)
+        columns = ((v00, v10, v20), (v01, v11, v21), (v02, v12, v22))
+        small, middle, large = columns[o0], columns[o1], columns[o2]
+        a, b = w[o1], w[o2]
+        if a > b:  # matGeom's swap: c1 <= c2, u1 with c1
+            c1[i], c2[i] = b, a
+            first, second = middle, large
+        else:
+            c1[i], c2[i] = a, b
+            first, second = large, middle
+        for k in range(3):
+            u1[i, k] = first[k]
+            u2[i, k] = second[k]
+            normal[i, k] = small[k]
+    return c1, c2, u1, u2, normal
+
 
 # -- matGeom's edge tensors -----------------------------------------------------
 @nb.njit(**_JIT)
@@ -540,6 +617,34 @@ def count_components(edges, referenced, n_vertices):
         if referenced[v] and _find(parent, v) == v:
             count += 1
     return count
+
+
+@nb.njit(parallel=True, **_JIT)
+def degenerate_faces(vertices, faces, edges, area_ratio):
+    """(F,) bool: faces that repeat a vertex or whose area is at most ``area_ratio`` x (mean edge length)^2."""
+    total = 0.0
+    for e in nb.prange(edges.shape[0]):
+        p, q = edges[e, 0], edges[e, 1]
+        x = vertices[q, 0] - vertices[p, 0]
+        y = vertices[q, 1] - vertices[p, 1]
+        z = vertices[q, 2] - vertices[p, 2]
+        total += math.sqrt(x * x + y * y + z * z)
+    mean = total / edges.shape[0] if edges.shape[0] else 0.0
+    threshold = area_ratio * mean * mean
+    out = np.empty(faces.shape[0], np.bool_)
+    for f in nb.prange(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        ux = vertices[b, 0] - vertices[a, 0]
+        uy = vertices[b, 1] - vertices[a, 1]
+        uz = vertices[b, 2] - vertices[a, 2]
+        wx = vertices[c, 0] - vertices[a, 0]
+        wy = vertices[c, 1] - vertices[a, 1]
+        wz = vertices[c, 2] - vertices[a, 2]
+        nx = uy * wz - uz * wy
+        ny = uz * wx - ux * wz
+        nz = ux * wy - uy * wx
+        out[f] = a == b or b == c or c == a or 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz) <= threshold
+    return out
 
 
 @nb.njit(**_JIT)

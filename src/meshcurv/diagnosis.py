@@ -131,6 +131,9 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
     The threshold is relative to the mesh's own length scale, so the same mesh
     gives the same answer at any scale (coordinates around 1e-9 or 1e9 alike).
     """
+    kernels = numba_kernels()
+    if kernels is not None and mean_edge_length is None and double_areas is None and cross is None:
+        return kernels.degenerate_faces(vertices, topology.faces, topology.edges, DEGENERATE_AREA_RATIO)
     if mean_edge_length is None:
         lengths = edge_lengths(vertices, topology.edges)
         mean_edge_length = float(lengths.mean()) if lengths.size else 0.0

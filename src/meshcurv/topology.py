@@ -125,7 +125,7 @@ class MeshTopology:
         """Build from already validated int64 (F, 3) triangles."""
         kernels = numba_kernels()
         if kernels is not None:
-            edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(faces, n_vertices)
+            edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(faces, n_vertices, kernels.threads())
         else:
             edges, face_edges, edge_faces, counts, forward_counts = _build_edges(faces, n_vertices)
         return cls(

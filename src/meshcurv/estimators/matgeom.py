@@ -180,12 +180,16 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
     problems: list[str] = []
 
     stages.start("retrieve curvatures")
-    values, vectors = sorted_by_magnitude(tensors)
-    c1, c2 = values[:, 1].copy(), values[:, 2].copy()
-    u1, u2, normal = vectors[:, :, 2].copy(), vectors[:, :, 1].copy(), vectors[:, :, 0].copy()
-    swap = c1 > c2
-    c1[swap], c2[swap] = c2[swap], c1[swap]
-    u1[swap], u2[swap] = u2[swap], u1[swap]
+    kernels = numba_kernels()
+    if kernels is not None:
+        c1, c2, u1, u2, normal = kernels.matgeom_principal(np.ascontiguousarray(tensors))
+    else:
+        values, vectors = sorted_by_magnitude(tensors)
+        c1, c2 = values[:, 1].copy(), values[:, 2].copy()
+        u1, u2, normal = vectors[:, :, 2].copy(), vectors[:, :, 1].copy(), vectors[:, :, 0].copy()
+        swap = c1 > c2
+        c1[swap], c2[swap] = c2[swap], c1[swap]
+        u1[swap], u2[swap] = u2[swap], u1[swap]
 
     finite = np.isfinite(tensors).all(axis=1)
     # matGeom's numbers are kept everywhere it computes them; valid=False marks
@@ -228,7 +232,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
         )
     if problems:
         problems.append("method='normal_cycle' handles such meshes correctly")
-    result = CurvatureResult(
+    result = CurvatureResult._of_arrays(
         k_min=c1, k_max=c2, dir_min=u1, dir_max=u2, normals=normal, valid=valid,
         method="matgeom", parameters={"smoothing_steps": smoothing_steps},
     )
