@@ -392,45 +392,14 @@ def _magnitude_order(w0, w1, w2):
 
 
 @nb.njit(parallel=True, **_JIT)
-def eigen_by_magnitude(tensors):
-    """Eigenpairs of (N, 6) symmetric tensors ordered by |eigenvalue| (see _eigen.py).
-
-    Eigenvalues are first put in ascending order (as LAPACK returns them), then
-    stably re-ordered by magnitude. Rows with a non-finite component are NaN.
-    """
-    n = tensors.shape[0]
-    values = np.full((n, 3), np.nan)
-    vectors = np.full((n, 3, 3), np.nan)
-    for i in nb.prange(n):
-        finite = True
-        for k in range(6):
-            if not math.isfinite(tensors[i, k]):
-                finite = False
-        if not finite:
-            continue
-        w0, w1, w2, v00, v01, v02, v10, v11, v12, v20, v21, v22 = _jacobi3(
-            tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4], tensors[i, 5]
-        )
-        o0, o1, o2 = _magnitude_order(w0, w1, w2)
-        w = (w0, w1, w2)
-        columns = ((v00, v10, v20), (v01, v11, v21), (v02, v12, v22))
-        for k, o in enumerate((o0, o1, o2)):
-            values[i, k] = w[o]
-            column = columns[o]
-            vectors[i, 0, k] = column[0]
-            vectors[i, 1, k] = column[1]
-            vectors[i, 2, k] = column[2]
-    return values, vectors
-
-@nb.njit(parallel=True, **_JIT)
 def matgeom_principal(tensors):
     """matGeom's step 7 per vertex: eigenpairs by magnitude, the two largest as curvatures, swapped so c1 <= c2.
 
     Returns ``(c1, c2, u1, u2, normal)``: the eigenvalues of middle and largest
     magnitude (ordered), their eigenvectors (the curvature directions) and the
     eigenvector of the smallest magnitude (the normal); NaN rows where a
-    component is not finite. As :func:`eigen_by_magnitude` and the swap of
-    ``estimators.matgeom.estimate``.
+    component is not finite. As ``estimators._eigen.sorted_by_magnitude`` and the
+    swap of ``estimators.matgeom.estimate``.
     """
     n = tensors.shape[0]
     c1 = np.full(n, np.nan)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._backend import numba_kernels
 
 _ROWS = np.array([0, 3, 4, 3, 1, 5, 4, 5, 2])  # (xx, yy, zz, xy, xz, yz) -> 3x3, row-major
 
@@ -15,11 +14,10 @@ def sorted_by_magnitude(tensors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Returns ``values`` (N, 3) and ``vectors`` (N, 3, 3) (``vectors[i, :, k]`` goes
     with ``values[i, k]``), with ``|values[:, 0]| <= |values[:, 1]| <= |values[:, 2]|``.
     The sort is stable over LAPACK's ascending order, as matGeom's ``sort(abs(d))``
-    over Octave's ``eig``. Rows with a non-finite component are NaN.
+    over Octave's ``eig``. Rows with a non-finite component are NaN. (The
+    compiled path of matGeom's estimator does the same per vertex in
+    ``_numba_kernels.matgeom_principal``.)
     """
-    kernels = numba_kernels()
-    if kernels is not None:
-        return kernels.eigen_by_magnitude(np.ascontiguousarray(tensors))
     n = tensors.shape[0]
     values = np.full((n, 3), np.nan)
     vectors = np.full((n, 3, 3), np.nan)
