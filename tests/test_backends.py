@@ -87,6 +87,24 @@ def test_topology_does_not_depend_on_the_number_of_threads(chunks):
         np.testing.assert_array_equal(got, want)
 
 
+@pytest.mark.parametrize("name", ["defects", "flipped_faces"])
+def test_normal_cycle_sums_do_not_depend_on_the_number_of_threads(name):
+    """Each thread adds what falls on its own range of vertices, in the same order: the sums are identical."""
+    from meshcurv import _numba_kernels
+    from meshcurv.geometry import DEGENERATE_AREA_RATIO
+
+    vertices, faces = MESHES[name]
+    top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
+    arguments = (vertices, top.faces, top.edges, top.edge_faces, top.edge_face_counts, top._edge_forward_counts,
+                 DEGENERATE_AREA_RATIO)
+    sums, degenerate = _numba_kernels.normal_cycle_sums(*arguments, 1)
+    for chunks in (2, 5):
+        other_sums, other_degenerate = _numba_kernels.normal_cycle_sums(*arguments, chunks)
+        np.testing.assert_array_equal(other_sums, sums)
+        np.testing.assert_array_equal(other_degenerate, degenerate)
+    assert np.abs(sums[:, :6]).sum() > 0 and (name != "defects" or degenerate.sum() == 3)
+
+
 @pytest.mark.parametrize("method", ["normal_cycle", "matgeom"])
 @pytest.mark.parametrize("name", sorted(MESHES))
 def test_curvatures_agree(name, method):

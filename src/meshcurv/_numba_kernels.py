@@ -123,8 +123,8 @@ def build_edges(faces, n_vertices, n_chunks):
 
 
 # -- normal cycle ---------------------------------------------------------------
-@nb.njit(**_JIT)
-def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_ratio):
+@nb.njit(parallel=True, **_JIT)
+def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_ratio, n_chunks):
     """Per-vertex measures, barycentric areas and normal sums; the zero-area faces.
 
     A face is degenerate when it repeats a vertex or its area is at most
@@ -134,11 +134,16 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_
     of shape (V, 10), columns 0-5 the anisotropic measure
     ``sum beta |e| / 2 e e^T`` (xx, yy, zz, xy, xz, yz), 6 the area, 7-9 the
     area-weighted face-normal sum; ``degenerate`` of shape (F,).
+
+    The face normals are computed in parallel over faces; the sums in
+    ``n_chunks`` vertex ranges, each thread adding what falls on its own
+    vertices (a face or an edge across two ranges is visited by both), so no
+    two threads write the same row.
     """
     n_vertices = vertices.shape[0]
     n_faces = faces.shape[0]
     total = 0.0
-    for e in range(edges.shape[0]):
+    for e in nb.prange(edges.shape[0]):
         p, q = edges[e, 0], edges[e, 1]
         x = vertices[q, 0] - vertices[p, 0]
         y = vertices[q, 1] - vertices[p, 1]
@@ -146,10 +151,9 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_
         total += math.sqrt(x * x + y * y + z * z)
     mean = total / edges.shape[0] if edges.shape[0] else 0.0
     threshold = area_ratio * mean * mean
-    sums = np.zeros((n_vertices, 10))
     degenerate = np.zeros(n_faces, np.bool_)
-    unit_normals = np.empty((n_faces, 3))
-    for f in range(n_faces):
+    face_normals = np.empty((n_faces, 4))  # the cross product and its norm (twice the area)
+    for f in nb.prange(n_faces):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         ux = vertices[b, 0] - vertices[a, 0]
         uy = vertices[b, 1] - vertices[a, 1]
@@ -161,46 +165,56 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_
         ny = uz * vx - ux * vz
         nz = ux * vy - uy * vx
         double_area = math.sqrt(nx * nx + ny * ny + nz * nz)
-        if a == b or b == c or c == a or 0.5 * double_area <= threshold:
-            degenerate[f] = True
-            continue
-        unit_normals[f, 0] = nx / double_area
-        unit_normals[f, 1] = ny / double_area
-        unit_normals[f, 2] = nz / double_area
-        third = double_area / 6.0
-        for corner in (a, b, c):
-            sums[corner, 6] += third
-            sums[corner, 7] += nx
-            sums[corner, 8] += ny
-            sums[corner, 9] += nz
-    for e in range(edges.shape[0]):
-        if counts[e] != 2 or forward[e] != 1:
-            continue
-        f1, f2 = edge_faces[e, 0], edge_faces[e, 1]
-        if degenerate[f1] or degenerate[f2]:
-            continue
-        p, q = edges[e, 0], edges[e, 1]
-        ex = vertices[q, 0] - vertices[p, 0]
-        ey = vertices[q, 1] - vertices[p, 1]
-        ez = vertices[q, 2] - vertices[p, 2]
-        length = math.sqrt(ex * ex + ey * ey + ez * ez)
-        if length == 0.0:
-            continue
-        ex /= length
-        ey /= length
-        ez /= length
-        ax, ay, az = unit_normals[f1, 0], unit_normals[f1, 1], unit_normals[f1, 2]
-        bx, by, bz = unit_normals[f2, 0], unit_normals[f2, 1], unit_normals[f2, 2]
-        sine = (ay * bz - az * by) * ex + (az * bx - ax * bz) * ey + (ax * by - ay * bx) * ez
-        cosine = ax * bx + ay * by + az * bz
-        weight = 0.5 * math.atan2(sine, cosine) * length
-        for v in (p, q):
-            sums[v, 0] += weight * ex * ex
-            sums[v, 1] += weight * ey * ey
-            sums[v, 2] += weight * ez * ez
-            sums[v, 3] += weight * ex * ey
-            sums[v, 4] += weight * ex * ez
-            sums[v, 5] += weight * ey * ez
+        face_normals[f, 0], face_normals[f, 1], face_normals[f, 2], face_normals[f, 3] = nx, ny, nz, double_area
+        degenerate[f] = a == b or b == c or c == a or 0.5 * double_area <= threshold
+    n_chunks = max(1, min(n_chunks, n_vertices))
+    sums = np.zeros((n_vertices, 10))
+    for chunk in nb.prange(n_chunks):
+        first = (n_vertices * chunk) // n_chunks
+        last = (n_vertices * (chunk + 1)) // n_chunks
+        for f in range(n_faces):
+            if degenerate[f]:
+                continue
+            third = face_normals[f, 3] / 6.0
+            for k in range(3):
+                corner = faces[f, k]
+                if first <= corner < last:
+                    sums[corner, 6] += third
+                    sums[corner, 7] += face_normals[f, 0]
+                    sums[corner, 8] += face_normals[f, 1]
+                    sums[corner, 9] += face_normals[f, 2]
+        for e in range(edges.shape[0]):
+            p, q = edges[e, 0], edges[e, 1]
+            p_here = first <= p < last
+            q_here = first <= q < last
+            if not (p_here or q_here) or counts[e] != 2 or forward[e] != 1:
+                continue
+            f1, f2 = edge_faces[e, 0], edge_faces[e, 1]
+            if degenerate[f1] or degenerate[f2]:
+                continue
+            ex = vertices[q, 0] - vertices[p, 0]
+            ey = vertices[q, 1] - vertices[p, 1]
+            ez = vertices[q, 2] - vertices[p, 2]
+            length = math.sqrt(ex * ex + ey * ey + ez * ez)
+            if length == 0.0:
+                continue
+            ex /= length
+            ey /= length
+            ez /= length
+            d1, d2 = face_normals[f1, 3], face_normals[f2, 3]
+            ax, ay, az = face_normals[f1, 0] / d1, face_normals[f1, 1] / d1, face_normals[f1, 2] / d1
+            bx, by, bz = face_normals[f2, 0] / d2, face_normals[f2, 1] / d2, face_normals[f2, 2] / d2
+            sine = (ay * bz - az * by) * ex + (az * bx - ax * bz) * ey + (ax * by - ay * bx) * ez
+            cosine = ax * bx + ay * by + az * bz
+            weight = 0.5 * math.atan2(sine, cosine) * length
+            for v in (p, q):
+                if first <= v < last:
+                    sums[v, 0] += weight * ex * ex
+                    sums[v, 1] += weight * ey * ey
+                    sums[v, 2] += weight * ez * ez
+                    sums[v, 3] += weight * ex * ey
+                    sums[v, 4] += weight * ex * ez
+                    sums[v, 5] += weight * ey * ez
     return sums, degenerate
 
 
@@ -226,11 +240,20 @@ def normal_cycle_finish(sums, invalid, indptr, indices, steps):
             for i in nb.prange(n):
                 start, stop = indptr[i], indptr[i + 1]
                 scale = 1.0 / (stop - start + 1.0)
-                for c in range(7):
-                    total = current[i, c]
-                    for j in range(start, stop):
-                        total += current[indices[j], c]
-                    following[i, c] = total * scale
+                t0, t1, t2, t3 = current[i, 0], current[i, 1], current[i, 2], current[i, 3]
+                t4, t5, t6 = current[i, 4], current[i, 5], current[i, 6]
+                for j in range(start, stop):  # one pass over the neighbours, seven sums in registers
+                    w = indices[j]
+                    t0 += current[w, 0]
+                    t1 += current[w, 1]
+                    t2 += current[w, 2]
+                    t3 += current[w, 3]
+                    t4 += current[w, 4]
+                    t5 += current[w, 5]
+                    t6 += current[w, 6]
+                following[i, 0], following[i, 1], following[i, 2] = t0 * scale, t1 * scale, t2 * scale
+                following[i, 3], following[i, 4], following[i, 5] = t3 * scale, t4 * scale, t5 * scale
+                following[i, 6] = t6 * scale
             current, following = following, current
     k_min = np.full(n, np.nan)
     k_max = np.full(n, np.nan)

@@ -141,7 +141,7 @@ def _estimate_compiled(kernels, vertices: np.ndarray, topology: MeshTopology, sm
     stages.start("compute edge tensors")
     sums, degenerate = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
                                                  topology.edge_face_counts, topology._edge_forward_counts,
-                                                 DEGENERATE_AREA_RATIO)
+                                                 DEGENERATE_AREA_RATIO, kernels.threads())
     defects = mesh_defects(topology, degenerate)
     stages.start("average vertex tensors")
     if indptr is None:
