@@ -487,11 +487,14 @@ def test_command_on_a_running_dask_cluster(dask_cluster, dozen, tmp_path):
 
 
 def test_an_interrupted_command_leaves_no_partial_result_and_resumes(tmp_path, client):
-    paths = write_spheres(tmp_path / "in", 40, 16, extension=".obj")  # 2562 vertices each
+    # 5762 vertices each: about a second of work left when the first result appears
+    paths = write_spheres(tmp_path / "in", 80, 24, extension=".obj")
     out_dir = tmp_path / "out"
     process = subprocess.Popen([*MESHCURV, "batch", os.fspath(tmp_path / "in"), "-o", os.fspath(out_dir),
                                 "--workers", "2", "--format", "npz"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               # a shell starts background jobs with SIGINT ignored, and children inherit it
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + 90
         while not list(out_dir.glob("*.npz")) and time.monotonic() < deadline and process.poll() is None:
@@ -504,14 +507,14 @@ def test_an_interrupted_command_leaves_no_partial_result_and_resumes(tmp_path, c
     present = sorted(out_dir.glob("*.npz"))
     assert 0 < len(present) < len(paths)
     for path in present:
-        assert_complete_npz(path, 2562)
+        assert_complete_npz(path, 5762)
     assert leftovers(out_dir) == []
     assert not (out_dir / "summary.parquet").exists() and not (out_dir / "summary.csv").exists()
     resumed = batch.run(tmp_path / "in", out_dir, client=client, output_format="npz")
     assert (resumed["status"] == "skipped").sum() == len(present)
     assert (resumed["status"] == "computed").sum() == len(paths) - len(present)
     for path in paths:
-        assert_complete_npz(out_dir / (path.stem + ".npz"), 2562)
+        assert_complete_npz(out_dir / (path.stem + ".npz"), 5762)
 
 
 def test_command_usage_errors(tmp_path, capsys):

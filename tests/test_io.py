@@ -323,6 +323,94 @@ def test_binary_ply_under_an_obj_name(tmp_path, torus):
         meshcurv.read_mesh(tmp_path / "t.obj")
 
 
+def _ply_bytes(order, vertex_fields, vertex_rows, face_fields, face_rows, *, extra=""):
+    """A binary PLY built by hand: header lines and numpy records of the given fields."""
+    vertex_type = np.dtype([(name, order + kind) for name, kind, _ in vertex_fields])
+    face_type = np.dtype([(name, order + kind, shape) if shape else (name, order + kind)
+                          for name, kind, shape in face_fields])
+    names = {"f8": "double", "f4": "float", "u1": "uchar", "i4": "int", "u4": "uint", "i2": "short"}
+    header = ["ply", f"format binary_{'little' if order == '<' else 'big'}_endian 1.0", "comment by hand",
+              f"element vertex {len(vertex_rows)}"]
+    header += [f"property {names[kind]} {name}" for name, kind, _ in vertex_fields]
+    header += [f"element face {len(face_rows)}"]
+    for name, kind, shape in face_fields:
+        if name == "count":
+            continue
+        if name == "corners":
+            header.append(f"property list uchar {names[kind]} vertex_indices")
+        else:
+            header.append(f"property {names[kind]} {name}")
+    header += [line for line in extra.splitlines() if line] + ["end_header", ""]
+    return ("\n".join(header).encode() + np.array(vertex_rows, vertex_type).tobytes()
+            + np.array(face_rows, face_type).tobytes())
+
+
+def test_binary_ply_fast_path_reads_other_tools_layouts(tmp_path):
+    """Big-endian, float32 coordinates among colour properties, face properties around uint corners."""
+    from meshcurv.io import _ply
+
+    quad = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.5], [1.0, 1.0, 0.25], [0.0, 1.0, 0.125]])
+    vertex_fields = [("red", "u1", None), ("x", "f4", None), ("y", "f4", None), ("z", "f4", None),
+                     ("nx", "f4", None)]
+    vertex_rows = [(200, *point, 1.0) for point in quad]
+    face_fields = [("flags", "i2", None), ("count", "u1", None), ("corners", "u4", (3,)), ("quality", "f4", None)]
+    triangles = [[0, 1, 2], [0, 2, 3]]
+    for order in "<>":
+        path = tmp_path / f"hand{order == '>'}.ply"
+        path.write_bytes(_ply_bytes(order, vertex_fields, vertex_rows, face_fields,
+                                    [(7, 3, corners, 0.5) for corners in triangles],
+                                    extra="element edge 0\nproperty int vertex1"))
+        vertices, faces = _ply.read_binary_ply(path)
+        np.testing.assert_array_equal(vertices, quad)  # these coordinates are exact in float32
+        assert faces.dtype == np.int64 and faces.tolist() == triangles
+        mesh = meshcurv.read_mesh(path)
+        np.testing.assert_array_equal(mesh.vertices, quad)
+        assert mesh.faces.tolist() == triangles
+    # quads stay quads, as meshio gives them
+    path = tmp_path / "quad.ply"
+    path.write_bytes(_ply_bytes("<", vertex_fields, vertex_rows, [("count", "u1", None), ("corners", "i4", (4,))],
+                                [(4, [0, 1, 2, 3])]))
+    assert _ply.read_binary_ply(path)[1].tolist() == [[0, 1, 2, 3]]
+
+
+def test_binary_ply_fast_path_agrees_with_meshio_and_steps_aside_for_the_rest(tmp_path, torus):
+    meshio = pytest.importorskip("meshio")
+    from meshcurv.io import _ply
+
+    path = meshcurv.write_mesh(tmp_path / "t.ply", torus.vertices, torus.faces,
+                               point_data={"k": np.arange(len(torus.vertices), dtype=float)})
+    vertices, faces = _ply.read_binary_ply(path)
+    reference = meshio.ply.read(str(path))
+    np.testing.assert_array_equal(vertices, reference.points)
+    np.testing.assert_array_equal(faces, reference.cells_dict["triangle"])
+    np.testing.assert_array_equal(faces, torus.faces)
+    # ASCII, faces of mixed sizes, truncated files: not the fast path's (None); meshio reads or refuses them
+    ascii_path = meshcurv.write_mesh(tmp_path / "a.ply", torus.vertices, torus.faces, binary=False)
+    mixed = meshcurv.write_mesh(tmp_path / "m.ply", torus.vertices, [[0, 1, 2, 3], *torus.faces[2:].tolist()])
+    truncated = tmp_path / "cut.ply"
+    truncated.write_bytes(path.read_bytes()[:-100])
+    for other in (ascii_path, mixed, truncated):
+        assert _ply.read_binary_ply(other) is None, other.name
+    assert len(meshcurv.read_mesh(mixed).faces) == len(torus.faces) - 1
+    with pytest.raises(MeshFileError, match=r"cut\.ply: "):
+        meshcurv.read_mesh(truncated)
+
+
+def test_binary_ply_needs_no_meshio(tmp_path, monkeypatch, torus):
+    pytest.importorskip("meshio")
+    path = meshcurv.write_mesh(tmp_path / "t.ply", torus.vertices, torus.faces)
+    real_import = builtins.__import__
+
+    def no_meshio(name, *args, **kwargs):
+        if name == "meshio":
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_meshio)
+    vertices, faces = meshcurv.read_mesh(path)
+    np.testing.assert_array_equal(faces, torus.faces)
+
+
 def test_volume_cells_only_is_an_error(tmp_path):
     meshio = pytest.importorskip("meshio")
     points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
