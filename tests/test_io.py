@@ -323,6 +323,18 @@ def test_binary_ply_under_an_obj_name(tmp_path, torus):
         meshcurv.read_mesh(tmp_path / "t.obj")
 
 
+def without_meshio(monkeypatch):
+    """Make ``import meshio`` fail for the rest of the test."""
+    real_import = builtins.__import__
+
+    def no_meshio(name, *args, **kwargs):
+        if name == "meshio":
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_meshio)
+
+
 def _ply_bytes(order, vertex_fields, vertex_rows, face_fields, face_rows, *, extra=""):
     """A binary PLY built by hand: header lines and numpy records of the given fields."""
     vertex_type = np.dtype([(name, order + kind) for name, kind, _ in vertex_fields])
@@ -399,14 +411,7 @@ def test_binary_ply_fast_path_agrees_with_meshio_and_steps_aside_for_the_rest(tm
 def test_binary_ply_needs_no_meshio(tmp_path, monkeypatch, torus):
     pytest.importorskip("meshio")
     path = meshcurv.write_mesh(tmp_path / "t.ply", torus.vertices, torus.faces)
-    real_import = builtins.__import__
-
-    def no_meshio(name, *args, **kwargs):
-        if name == "meshio":
-            raise ImportError(name)
-        return real_import(name, *args, **kwargs)
-
-    monkeypatch.setattr(builtins, "__import__", no_meshio)
+    without_meshio(monkeypatch)
     vertices, faces = meshcurv.read_mesh(path)
     np.testing.assert_array_equal(faces, torus.faces)
 
@@ -439,14 +444,7 @@ def test_meshio_messages_go_to_the_log_not_the_terminal(tmp_path, torus, caplog,
 
 
 def test_missing_meshio_names_the_extra(tmp_path, monkeypatch, torus):
-    real_import = builtins.__import__
-
-    def no_meshio(name, *args, **kwargs):
-        if name == "meshio":
-            raise ImportError(name)
-        return real_import(name, *args, **kwargs)
-
-    monkeypatch.setattr(builtins, "__import__", no_meshio)
+    without_meshio(monkeypatch)
     with pytest.raises(MissingDependencyError, match=r"pip install 'meshcurv\[io\]'"):
         meshcurv.write_mesh(tmp_path / "t.ply", torus.vertices, torus.faces)
 
