@@ -105,6 +105,20 @@ def test_normal_cycle_sums_do_not_depend_on_the_number_of_threads(name):
     assert np.abs(sums[:, :6]).sum() > 0 and (name != "defects" or degenerate.sum() == 3)
 
 
+@pytest.mark.parametrize("name", ["defects", "torus"])
+def test_matgeom_sums_do_not_depend_on_the_number_of_threads(name):
+    from meshcurv import _numba_kernels
+
+    vertices, faces = MESHES[name]
+    top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
+    arguments = (vertices, top.faces, top.edges[:, 0].copy(), top.edges[:, 1].copy(),
+                 np.maximum(top.edge_faces[:, 0], 0), np.maximum(top.edge_faces[:, 1], 0))
+    sums = _numba_kernels.matgeom_vertex_tensors(*arguments, 1)
+    assert np.isfinite(sums).any()
+    for chunks in (2, 5):
+        np.testing.assert_array_equal(_numba_kernels.matgeom_vertex_tensors(*arguments, chunks), sums)
+
+
 @pytest.mark.parametrize("method", ["normal_cycle", "matgeom"])
 @pytest.mark.parametrize("name", sorted(MESHES))
 def test_curvatures_agree(name, method):

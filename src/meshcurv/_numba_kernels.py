@@ -459,19 +459,22 @@ def matgeom_principal(tensors):
 
 
 # -- matGeom's edge tensors -----------------------------------------------------
-@nb.njit(**_JIT)
-def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2):
+@nb.njit(parallel=True, **_JIT)
+def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, n_chunks):
     """Steps 2 to 5 of matGeom's meshCurvatures (see estimators/matgeom.py).
 
     Same operations in the same order as Octave (sums of three products left
     to right), so that ``arccos`` of nearly parallel normals gets the same input.
     Face ids beyond the face count give NaN (matGeom stops with an index error).
+    Face normals and edge lengths are computed in parallel (the lengths summed
+    in order); the vertex sums in ``n_chunks`` vertex ranges, each thread adding
+    the edges in order onto its own vertices.
     """
     n_vertices = vertices.shape[0]
     n_faces = faces.shape[0]
     n_edges = ev1.shape[0]
     normals = np.empty((n_faces, 3))
-    for f in range(n_faces):
+    for f in nb.prange(n_faces):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         ux = vertices[b, 0] - vertices[a, 0]
         uy = vertices[b, 1] - vertices[a, 1]
@@ -487,50 +490,59 @@ def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2):
         normals[f, 1] = ny / norm if norm > 0 else np.nan
         normals[f, 2] = nz / norm if norm > 0 else np.nan
     lengths = np.empty(n_edges)
-    total = 0.0
-    for e in range(n_edges):
+    for e in nb.prange(n_edges):
         p, q = ev1[e], ev2[e]
         x = vertices[q, 0] - vertices[p, 0]
         y = vertices[q, 1] - vertices[p, 1]
         z = vertices[q, 2] - vertices[p, 2]
         lengths[e] = math.sqrt((x * x + y * y) + z * z)
+    total = 0.0
+    for e in range(n_edges):
         total += lengths[e]
     mean = total / n_edges
+    n_chunks = max(1, min(n_chunks, n_vertices))
     sums = np.zeros((n_vertices, 6))
     counts = np.zeros(n_vertices)
-    for e in range(n_edges):
-        p, q = ev1[e], ev2[e]
-        counts[p] += 1.0
-        counts[q] += 1.0
-        d = lengths[e]
-        ex = (vertices[q, 0] - vertices[p, 0]) / d
-        ey = (vertices[q, 1] - vertices[p, 1]) / d
-        ez = (vertices[q, 2] - vertices[p, 2]) / d
-        f1, f2 = ef1[e], ef2[e]
-        if f1 >= n_faces or f2 >= n_faces:
-            weight = np.nan
-        else:
-            ax, ay, az = normals[f1, 0], normals[f1, 1], normals[f1, 2]
-            bx, by, bz = normals[f2, 0], normals[f2, 1], normals[f2, 2]
-            dot = (ax * bx + ay * by) + az * bz
-            beta = math.acos(min(max(dot, -1.0), 1.0)) if math.isfinite(dot) else np.nan
-            side = ((ay * bz - by * az) * ex + (az * bx - bz * ax) * ey) + (ax * by - bx * ay) * ez
-            if side > 0:
-                weight = (d / mean) * beta
-            elif side < 0:
-                weight = (d / mean) * -beta
-            elif side == 0:
-                weight = 0.0 * beta
-            else:
+    for chunk in nb.prange(n_chunks):
+        first = (n_vertices * chunk) // n_chunks
+        last = (n_vertices * (chunk + 1)) // n_chunks
+        for e in range(n_edges):
+            p, q = ev1[e], ev2[e]
+            p_here = first <= p < last
+            q_here = first <= q < last
+            if not (p_here or q_here):
+                continue
+            d = lengths[e]
+            ex = (vertices[q, 0] - vertices[p, 0]) / d
+            ey = (vertices[q, 1] - vertices[p, 1]) / d
+            ez = (vertices[q, 2] - vertices[p, 2]) / d
+            f1, f2 = ef1[e], ef2[e]
+            if f1 >= n_faces or f2 >= n_faces:
                 weight = np.nan
-        for v in (p, q):
-            sums[v, 0] += (ex * ex) * weight
-            sums[v, 1] += (ey * ey) * weight
-            sums[v, 2] += (ez * ez) * weight
-            sums[v, 3] += (ex * ey) * weight
-            sums[v, 4] += (ex * ez) * weight
-            sums[v, 5] += (ey * ez) * weight
-    for i in range(n_vertices):
+            else:
+                ax, ay, az = normals[f1, 0], normals[f1, 1], normals[f1, 2]
+                bx, by, bz = normals[f2, 0], normals[f2, 1], normals[f2, 2]
+                dot = (ax * bx + ay * by) + az * bz
+                beta = math.acos(min(max(dot, -1.0), 1.0)) if math.isfinite(dot) else np.nan
+                side = ((ay * bz - by * az) * ex + (az * bx - bz * ax) * ey) + (ax * by - bx * ay) * ez
+                if side > 0:
+                    weight = (d / mean) * beta
+                elif side < 0:
+                    weight = (d / mean) * -beta
+                elif side == 0:
+                    weight = 0.0 * beta
+                else:
+                    weight = np.nan
+            for v in (p, q):
+                if first <= v < last:
+                    counts[v] += 1.0
+                    sums[v, 0] += (ex * ex) * weight
+                    sums[v, 1] += (ey * ey) * weight
+                    sums[v, 2] += (ez * ez) * weight
+                    sums[v, 3] += (ex * ey) * weight
+                    sums[v, 4] += (ex * ez) * weight
+                    sums[v, 5] += (ey * ez) * weight
+    for i in nb.prange(n_vertices):
         if counts[i] > 0:
             for k in range(6):
                 sums[i, k] /= counts[i]
@@ -736,9 +748,12 @@ def smooth_over_neighbours(values, indptr, indices, steps):
             start, stop = indptr[i], indptr[i + 1]
             scale = 1.0 / (stop - start + 1.0)
             for c in range(n_columns):
-                total = current[i, c]
-                for j in range(start, stop):
-                    total += current[indices[j], c]
-                following[i, c] = total * scale
+                following[i, c] = current[i, c]
+            for j in range(start, stop):  # neighbours outside, columns inside: each row read once
+                w = indices[j]
+                for c in range(n_columns):
+                    following[i, c] += current[w, c]
+            for c in range(n_columns):
+                following[i, c] *= scale
         current, following = following, current
     return current

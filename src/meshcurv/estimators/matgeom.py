@@ -159,7 +159,7 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
     if kernels is not None:
         tensors = kernels.matgeom_vertex_tensors(vertices, faces, np.ascontiguousarray(ev1),
                                                  np.ascontiguousarray(ev2), np.ascontiguousarray(ef1),
-                                                 np.ascontiguousarray(ef2))
+                                                 np.ascontiguousarray(ef2), kernels.threads())
     else:
         tensors = _vertex_tensors(vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1),
                                   np.where(out_of_range, 0, ef2), out_of_range)
