@@ -87,6 +87,20 @@ def test_topology_does_not_depend_on_the_number_of_threads(chunks):
         np.testing.assert_array_equal(got, want)
 
 
+@pytest.mark.parametrize("chunks", [1, 3])
+def test_bowtie_vertices_do_not_depend_on_the_number_of_threads(chunks):
+    from meshcurv import _numba_kernels
+    from meshcurv.topology import _bowtie_vertices
+
+    vertices, faces = MESHES["bowtie"]
+    top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
+    linked = (top.edge_face_counts == 2) & (top.edge_faces[:, 0] != top.edge_faces[:, 1])
+    found = _numba_kernels.bowtie_vertices(top.faces, top.edges, top.edge_faces, linked, ~top.degenerate_faces,
+                                           top.n_vertices, chunks)
+    np.testing.assert_array_equal(found, _bowtie_vertices(top))
+    assert found.sum() == 1
+
+
 @pytest.mark.parametrize("name", ["defects", "flipped_faces"])
 def test_normal_cycle_sums_do_not_depend_on_the_number_of_threads(name):
     """Each thread adds what falls on its own range of vertices, in the same order: the sums are identical."""

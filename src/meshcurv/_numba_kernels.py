@@ -558,51 +558,59 @@ def _find(parent, x):
     return x
 
 
-@nb.njit(**_JIT)
-def bowtie_vertices(faces, face_edges, linked, proper, n_vertices, n_edges):
+@nb.njit(inline="always", **_JIT)
+def _corner_at(faces, f, v):
+    """The corner (3 f + k) of face ``f`` at vertex ``v``."""
+    if faces[f, 0] == v:
+        return 3 * f
+    if faces[f, 1] == v:
+        return 3 * f + 1
+    return 3 * f + 2
+
+
+@nb.njit(parallel=True, **_JIT)
+def bowtie_vertices(faces, edges, edge_faces, linked, proper, n_vertices, n_chunks):
     """Vertices whose face corners fall in more than one fan (see MeshTopology.bowtie_vertices).
 
-    Union-find over the ``3 F`` corners: the corners at each end of a linked
-    edge (two faces, both without a repeated vertex) are joined.
+    Union-find over the ``3 F`` corners: at each end of a linked edge (two
+    faces, both without a repeated vertex) the corners of its two faces are
+    joined. Corners are only ever joined to corners at the same vertex, so each
+    of ``n_chunks`` threads does the joins and the finds at its own range of
+    vertices.
     """
     n_corners = 3 * faces.shape[0]
-    parent = np.arange(n_corners)
-    first = np.full(n_edges, -1, np.int64)
-    for f in range(faces.shape[0]):
-        if not proper[f]:
-            continue
-        for k in range(3):
-            e = face_edges[f, k]
-            if e < 0 or not linked[e]:
-                continue
-            side = 3 * f + k
-            if first[e] < 0:
-                first[e] = side
-                continue
-            one = first[e]
-            head_one = one - one % 3 + (one % 3 + 1) % 3
-            head_two = side - k + (k + 1) % 3
-            if faces[one // 3, one % 3] == faces[f, k]:  # same direction
-                pairs = ((one, side), (head_one, head_two))
-            else:
-                pairs = ((one, head_two), (head_one, side))
-            for a, b in pairs:
-                ra = _find(parent, a)
-                rb = _find(parent, b)
-                if ra != rb:
-                    parent[max(ra, rb)] = min(ra, rb)
+    parent = np.empty(n_corners, np.int64)
+    for c in nb.prange(n_corners):
+        parent[c] = c
+    n_chunks = max(1, min(n_chunks, n_vertices))
     root_of = np.full(n_vertices, -1, np.int64)
     several = np.zeros(n_vertices, np.bool_)
-    for f in range(faces.shape[0]):
-        if not proper[f]:
-            continue
-        for k in range(3):
-            v = faces[f, k]
-            r = _find(parent, 3 * f + k)
-            if root_of[v] < 0:
-                root_of[v] = r
-            elif root_of[v] != r:
-                several[v] = True
+    for chunk in nb.prange(n_chunks):
+        first = (n_vertices * chunk) // n_chunks
+        last = (n_vertices * (chunk + 1)) // n_chunks
+        for e in range(edges.shape[0]):
+            if not linked[e]:
+                continue
+            f1, f2 = edge_faces[e, 0], edge_faces[e, 1]
+            if not (proper[f1] and proper[f2]):
+                continue
+            for v in (edges[e, 0], edges[e, 1]):
+                if first <= v < last:
+                    ra = _find(parent, _corner_at(faces, f1, v))
+                    rb = _find(parent, _corner_at(faces, f2, v))
+                    if ra != rb:
+                        parent[max(ra, rb)] = min(ra, rb)
+        for f in range(faces.shape[0]):
+            if not proper[f]:
+                continue
+            for k in range(3):
+                v = faces[f, k]
+                if first <= v < last:
+                    r = _find(parent, 3 * f + k)
+                    if root_of[v] < 0:
+                        root_of[v] = r
+                    elif root_of[v] != r:
+                        several[v] = True
     return several
 
 

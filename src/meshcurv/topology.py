@@ -204,8 +204,8 @@ class MeshTopology:
         if kernels is None:
             return _readonly(_bowtie_vertices(self))
         linked = (self.edge_face_counts == 2) & (self.edge_faces[:, 0] != self.edge_faces[:, 1])
-        return _readonly(kernels.bowtie_vertices(self.faces, self.face_edges, linked, ~self.degenerate_faces,
-                                                 self.n_vertices, self.n_edges))
+        return _readonly(kernels.bowtie_vertices(self.faces, self.edges, self.edge_faces, linked,
+                                                 ~self.degenerate_faces, self.n_vertices, kernels.threads()))
 
     @cached_property
     def degenerate_faces(self) -> np.ndarray:
