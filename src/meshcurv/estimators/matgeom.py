@@ -157,9 +157,8 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
     stages.start("compute edge tensors")
     kernels = numba_kernels()
     if kernels is not None:
-        tensors = kernels.matgeom_vertex_tensors(vertices, faces, np.ascontiguousarray(ev1),
-                                                 np.ascontiguousarray(ev2), np.ascontiguousarray(ef1),
-                                                 np.ascontiguousarray(ef2), kernels.threads())
+        # columns of the topology's arrays as they are (strided views): numba reads them without a copy
+        tensors = kernels.matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, kernels.threads())
     else:
         tensors = _vertex_tensors(vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1),
                                   np.where(out_of_range, 0, ef2), out_of_range)
