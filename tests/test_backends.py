@@ -87,6 +87,23 @@ def test_topology_does_not_depend_on_the_number_of_threads(chunks):
         np.testing.assert_array_equal(got, want)
 
 
+def test_neighbour_lists_do_not_depend_on_the_number_of_threads():
+    from meshcurv import _numba_kernels
+
+    vertices, faces = MESHES["defects"]
+    top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
+    indptr, indices = _numba_kernels.neighbour_lists(top.edges, top.n_vertices, 1)
+    for chunks in (2, 7):
+        other = _numba_kernels.neighbour_lists(top.edges, top.n_vertices, chunks)
+        np.testing.assert_array_equal(other[0], indptr)
+        np.testing.assert_array_equal(other[1], indices)
+    with use_backend("numpy"):  # the same neighbours as the adjacency matrix, in edge order
+        adjacency = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0]).adjacency
+    for v in range(top.n_vertices):
+        assert sorted(indices[indptr[v]:indptr[v + 1]]) == sorted(adjacency.indices[adjacency.indptr[v]:
+                                                                                    adjacency.indptr[v + 1]])
+
+
 @pytest.mark.parametrize("chunks", [1, 3])
 def test_bowtie_vertices_do_not_depend_on_the_number_of_threads(chunks):
     from meshcurv import _numba_kernels

@@ -48,14 +48,16 @@ def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
         raise InvalidMeshError(f"`{name}` is empty: the mesh has no vertices")
     with np.errstate(over="ignore"):  # float128 beyond float64: caught as infinite below
         out = np.array(array, dtype=np.float64, order="C", copy=True)
-    finite = np.isfinite(out).all(axis=1)
-    if not finite.all():
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = out.sum()  # finite unless a coordinate is NaN or infinite (or the sum overflows)
+    finite = np.isfinite(out).all(axis=1) if not np.isfinite(total) else None
+    if finite is not None and not finite.all():
         bad = np.flatnonzero(~finite)
         raise InvalidMeshError(
             f"`{name}` has NaN or infinite coordinates at {bad.size} vertices "
             f"(first at index {bad[0]})"
         )
-    largest = float(np.abs(out).max())
+    largest = max(float(out.max()), -float(out.min()))
     if largest > MAX_COORDINATE:
         raise InvalidMeshError(
             f"`{name}` has coordinates as large as {largest:.3g}; products of lengths would overflow "

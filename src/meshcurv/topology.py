@@ -234,7 +234,7 @@ class MeshTopology:
         """
         kernels = numba_kernels()
         if kernels is not None:
-            indptr, indices = kernels.neighbour_lists(self.edges, self.n_vertices)
+            indptr, indices = kernels.neighbour_lists(self.edges, self.n_vertices, kernels.threads())
         else:
             adjacency = self.adjacency
             indptr, indices = adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64)
