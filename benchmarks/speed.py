@@ -334,6 +334,23 @@ def peak_rss() -> int:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # KiB on Linux
 
 
+def prefault(nbytes: int) -> None:
+    """Touch ``nbytes`` of fresh memory once and free it.
+
+    This machine is a Firecracker VM with a balloon device that reports free
+    memory back to the host: the first touch of a page the host has taken back
+    costs about 2.5 s per GiB (against 0.1 s per GiB for a page already
+    backed), and freed memory is handed back after a few seconds. Without this
+    step, the time of an implementation depends on how much memory the process
+    held just before it (up to 3x at 4M vertices). Touching enough memory
+    immediately before each measurement puts every implementation, peers
+    included, on backed memory, as on an ordinary computer.
+    """
+    if nbytes > 0:
+        block = np.ones(nbytes // 8)
+        del block
+
+
 def time_calls(call, repeats: int, long: float, budget: float) -> list:
     times = []
     spent = 0.0
@@ -520,8 +537,10 @@ class Bench:
             self.rates[key] = predicted / n
             log(f"  {row['label']}: skipped ({row['skipped']})")
             return row
+        touch = int(args.prefault * n)
         if key in SUBPROCESS_PEERS:
             timeout = budget if key == "trimesh" else max(600.0, 10 * budget)
+            prefault(touch)
             res = run_child(key, mesh_dir, repeats, args.long, budget, timeout)
             if "timeout" in res:
                 row["skipped"] = f"> {budget:.0f} s (stopped)"
@@ -536,6 +555,7 @@ class Bench:
             return row
         try:
             call = make_call(key, v, f)
+            prefault(touch)
             times = time_calls(call, repeats, args.long, budget * max(repeats, 1))
             del call
         except Exception as exc:  # noqa: BLE001 - a failing implementation is a result
@@ -545,6 +565,7 @@ class Bench:
         row.update(times=times, where="in-process")
         self.record(key, n, min(times))
         if memory and args.memory:
+            prefault(touch)
             res = run_child(key, mesh_dir, 1, args.long, budget, timeout=max(600.0, 20 * max(times) + 120))
             if "peak_rss" in res:
                 row.update(first_fresh=res["first"], peak_rss=res["peak_rss"], base_rss=res["base_rss"])
@@ -734,6 +755,15 @@ def markdown(bench) -> str:
         "backend); `libigl ÷`, `VTK ÷` = their time / this time (how many times faster than them). "
         f"Budget: {args.budget:.0f} s per call (trimesh {args.trimesh_budget:.0f} s); 'est.' = linear "
         "extrapolation from the previous size, not run.",
+        "",
+        (f"Memory warm-up: {args.prefault:.0f} bytes per vertex of memory are touched and freed just before "
+         "each measurement (`--prefault`). This machine is a Firecracker VM whose balloon device hands free "
+         "memory back to the host after a few seconds; touching a page the host has taken back costs about "
+         "2.5 s per GiB (0.1 s per GiB for a backed page), so without the warm-up a time depends on what ran "
+         "before it (up to 3x at 4M vertices). The warm-up applies to every row, peers included."
+         if args.prefault > 0 else
+         "No memory warm-up (`--prefault 0`): on this VM, the first touch of memory the host has taken back "
+         "costs about 2.5 s per GiB, and times at 4M vertices depend on what ran before."),
         "",
     ]
 
@@ -939,6 +969,9 @@ def main(argv=None):
                         help="cProfile one normal_cycle and matgeom call (default: yes)")
     parser.add_argument("--profile-size", default="1M", help="mesh of the profile (default: %(default)s)")
     parser.add_argument("--profile-top", type=int, default=15)
+    parser.add_argument("--prefault", type=float, default=2000.0,
+                        help="bytes per vertex of memory touched just before each measurement (0: none); "
+                             "see prefault() (default: %(default)s)")
     parser.add_argument("--json", help="also write the raw measurements to this JSON file")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--impl", help=argparse.SUPPRESS)
