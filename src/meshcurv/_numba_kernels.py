@@ -359,7 +359,9 @@ def _jacobi3(a00, a11, a22, a01, a02, a12):
     v10, v11, v12 = 0.0, 1.0, 0.0
     v20, v21, v22 = 0.0, 0.0, 1.0
     for sweep in range(50):
-        if a01 == 0.0 and a02 == 0.0 and a12 == 0.0:
+        # converged: the off-diagonal is below what a rotation could still change (NR's test, per element)
+        off = abs(a01) + abs(a02) + abs(a12)
+        if off == 0.0 or (sweep > 0 and 1e-18 * (abs(a00) + abs(a11) + abs(a22)) >= off):
             break
         # (p, q, r) = (0, 1, 2)
         t, s, tau, apply = _rotation(a00, a11, a01, sweep)
@@ -425,17 +427,20 @@ def matgeom_principal(tensors):
     swap of ``estimators.matgeom.estimate``.
     """
     n = tensors.shape[0]
-    c1 = np.full(n, np.nan)
-    c2 = np.full(n, np.nan)
-    u1 = np.full((n, 3), np.nan)
-    u2 = np.full((n, 3), np.nan)
-    normal = np.full((n, 3), np.nan)
+    c1 = np.empty(n)
+    c2 = np.empty(n)
+    u1 = np.empty((n, 3))
+    u2 = np.empty((n, 3))
+    normal = np.empty((n, 3))
     for i in nb.prange(n):
         finite = True
         for k in range(6):
             if not math.isfinite(tensors[i, k]):
                 finite = False
         if not finite:
+            c1[i] = c2[i] = np.nan
+            for k in range(3):
+                u1[i, k] = u2[i, k] = normal[i, k] = np.nan
             continue
         w0, w1, w2, v00, v01, v02, v10, v11, v12, v20, v21, v22 = _jacobi3(
             tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4], tensors[i, 5]

@@ -190,7 +190,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
         c1[swap], c2[swap] = c2[swap], c1[swap]
         u1[swap], u2[swap] = u2[swap], u1[swap]
 
-    finite = np.isfinite(tensors).all(axis=1)
+    finite = ~np.isnan(c1)  # NaN exactly where a tensor component is not finite
     # matGeom's numbers are kept everywhere it computes them; valid=False marks
     # where they are not an estimate: vertices whose tensor drew on a defect
     # (boundary, non-manifold, bow-tie, flipped or zero-area neighbourhood, or an
