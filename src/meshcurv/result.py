@@ -71,7 +71,7 @@ class CurvatureResult:
         for name in _ARRAY_FIELDS:
             value = getattr(self, name)
             if isinstance(value, np.ndarray) and not value.flags.writeable and _keepable(value, name):
-                continue  # read-only, owns its data: cannot change under the result (see _of_arrays)
+                continue  # read-only and owning its data: taken as it is, not copied (see _of_arrays)
             array = np.array(value, dtype=bool if name == "valid" else np.float64, copy=True)
             array.flags.writeable = False
             object.__setattr__(self, name, array)
