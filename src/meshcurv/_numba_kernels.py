@@ -16,6 +16,42 @@ import numpy as np
 _JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 
+# -- shared pieces ----------------------------------------------------------------
+@nb.njit(inline="always", **_JIT)
+def _edge_length(vertices, p, q):
+    x = vertices[q, 0] - vertices[p, 0]
+    y = vertices[q, 1] - vertices[p, 1]
+    z = vertices[q, 2] - vertices[p, 2]
+    return math.sqrt(x * x + y * y + z * z)
+
+
+@nb.njit(inline="always", **_JIT)
+def _face_cross(vertices, a, b, c):
+    """cross(b - a, c - a): the face normal times twice its area."""
+    ux = vertices[b, 0] - vertices[a, 0]
+    uy = vertices[b, 1] - vertices[a, 1]
+    uz = vertices[b, 2] - vertices[a, 2]
+    wx = vertices[c, 0] - vertices[a, 0]
+    wy = vertices[c, 1] - vertices[a, 1]
+    wz = vertices[c, 2] - vertices[a, 2]
+    return uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+
+
+@nb.njit(inline="always", **_JIT)
+def _degenerate(a, b, c, half_area, threshold):
+    """A face that repeats a vertex or whose area is at most ``threshold`` (``diagnosis.degenerate_faces``)."""
+    return a == b or b == c or c == a or half_area <= threshold
+
+
+@nb.njit(parallel=True, **_JIT)
+def _mean_edge_length(vertices, edges):
+    """Mean length of the edges (0 when there are none), a parallel reduction."""
+    total = 0.0
+    for e in nb.prange(edges.shape[0]):
+        total += _edge_length(vertices, edges[e, 0], edges[e, 1])
+    return total / edges.shape[0] if edges.shape[0] else 0.0
+
+
 # -- topology -------------------------------------------------------------------
 def threads() -> int:
     """The threads numba's parallel kernels use (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``)."""
@@ -142,31 +178,16 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_
     """
     n_vertices = vertices.shape[0]
     n_faces = faces.shape[0]
-    total = 0.0
-    for e in nb.prange(edges.shape[0]):
-        p, q = edges[e, 0], edges[e, 1]
-        x = vertices[q, 0] - vertices[p, 0]
-        y = vertices[q, 1] - vertices[p, 1]
-        z = vertices[q, 2] - vertices[p, 2]
-        total += math.sqrt(x * x + y * y + z * z)
-    mean = total / edges.shape[0] if edges.shape[0] else 0.0
+    mean = _mean_edge_length(vertices, edges)
     threshold = area_ratio * mean * mean
     degenerate = np.zeros(n_faces, np.bool_)
     face_normals = np.empty((n_faces, 4))  # the cross product and its norm (twice the area)
     for f in nb.prange(n_faces):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-        ux = vertices[b, 0] - vertices[a, 0]
-        uy = vertices[b, 1] - vertices[a, 1]
-        uz = vertices[b, 2] - vertices[a, 2]
-        vx = vertices[c, 0] - vertices[a, 0]
-        vy = vertices[c, 1] - vertices[a, 1]
-        vz = vertices[c, 2] - vertices[a, 2]
-        nx = uy * vz - uz * vy
-        ny = uz * vx - ux * vz
-        nz = ux * vy - uy * vx
+        nx, ny, nz = _face_cross(vertices, a, b, c)
         double_area = math.sqrt(nx * nx + ny * ny + nz * nz)
         face_normals[f, 0], face_normals[f, 1], face_normals[f, 2], face_normals[f, 3] = nx, ny, nz, double_area
-        degenerate[f] = a == b or b == c or c == a or 0.5 * double_area <= threshold
+        degenerate[f] = _degenerate(a, b, c, 0.5 * double_area, threshold)
     n_chunks = max(1, min(n_chunks, n_vertices))
     sums = np.zeros((n_vertices, 10))
     for chunk in nb.prange(n_chunks):
@@ -480,16 +501,7 @@ def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, n_chunks):
     n_edges = ev1.shape[0]
     normals = np.empty((n_faces, 3))
     for f in nb.prange(n_faces):
-        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-        ux = vertices[b, 0] - vertices[a, 0]
-        uy = vertices[b, 1] - vertices[a, 1]
-        uz = vertices[b, 2] - vertices[a, 2]
-        vx = vertices[c, 0] - vertices[a, 0]
-        vy = vertices[c, 1] - vertices[a, 1]
-        vz = vertices[c, 2] - vertices[a, 2]
-        nx = uy * vz - uz * vy
-        ny = uz * vx - ux * vz
-        nz = ux * vy - uy * vx
+        nx, ny, nz = _face_cross(vertices, faces[f, 0], faces[f, 1], faces[f, 2])  # Octave's cross
         norm = math.sqrt((nx * nx + ny * ny) + nz * nz)
         normals[f, 0] = nx / norm if norm > 0 else np.nan
         normals[f, 1] = ny / norm if norm > 0 else np.nan
@@ -639,28 +651,13 @@ def count_components(edges, referenced, n_vertices):
 @nb.njit(parallel=True, **_JIT)
 def degenerate_faces(vertices, faces, edges, area_ratio):
     """(F,) bool: faces that repeat a vertex or whose area is at most ``area_ratio`` x (mean edge length)^2."""
-    total = 0.0
-    for e in nb.prange(edges.shape[0]):
-        p, q = edges[e, 0], edges[e, 1]
-        x = vertices[q, 0] - vertices[p, 0]
-        y = vertices[q, 1] - vertices[p, 1]
-        z = vertices[q, 2] - vertices[p, 2]
-        total += math.sqrt(x * x + y * y + z * z)
-    mean = total / edges.shape[0] if edges.shape[0] else 0.0
+    mean = _mean_edge_length(vertices, edges)
     threshold = area_ratio * mean * mean
     out = np.empty(faces.shape[0], np.bool_)
     for f in nb.prange(faces.shape[0]):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-        ux = vertices[b, 0] - vertices[a, 0]
-        uy = vertices[b, 1] - vertices[a, 1]
-        uz = vertices[b, 2] - vertices[a, 2]
-        wx = vertices[c, 0] - vertices[a, 0]
-        wy = vertices[c, 1] - vertices[a, 1]
-        wz = vertices[c, 2] - vertices[a, 2]
-        nx = uy * wz - uz * wy
-        ny = uz * wx - ux * wz
-        nz = ux * wy - uy * wx
-        out[f] = a == b or b == c or c == a or 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz) <= threshold
+        nx, ny, nz = _face_cross(vertices, a, b, c)
+        out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
     return out
 
 
@@ -695,11 +692,7 @@ def mesh_facts(vertices, faces, edges, referenced, area_ratio, zero_length_ratio
     lengths = np.empty(n_edges)
     total = 0.0
     for e in nb.prange(n_edges):
-        p, q = edges[e, 0], edges[e, 1]
-        x = vertices[q, 0] - vertices[p, 0]
-        y = vertices[q, 1] - vertices[p, 1]
-        z = vertices[q, 2] - vertices[p, 2]
-        lengths[e] = math.sqrt(x * x + y * y + z * z)
+        lengths[e] = _edge_length(vertices, edges[e, 0], edges[e, 1])
         total += lengths[e]
     mean = total / n_edges if n_edges else 0.0
     n_zero_length = 0
@@ -711,18 +704,10 @@ def mesh_facts(vertices, faces, edges, referenced, area_ratio, zero_length_ratio
     n_degenerate = 0
     for f in nb.prange(faces.shape[0]):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-        ux = vertices[b, 0] - vertices[a, 0]
-        uy = vertices[b, 1] - vertices[a, 1]
-        uz = vertices[b, 2] - vertices[a, 2]
-        wx = vertices[c, 0] - vertices[a, 0]
-        wy = vertices[c, 1] - vertices[a, 1]
-        wz = vertices[c, 2] - vertices[a, 2]
-        nx = uy * wz - uz * wy
-        ny = uz * wx - ux * wz
-        nz = ux * wy - uy * wx
+        nx, ny, nz = _face_cross(vertices, a, b, c)
         half = 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz)
         area += half
-        n_degenerate += 1 if a == b or b == c or c == a or half <= threshold else 0
+        n_degenerate += 1 if _degenerate(a, b, c, half, threshold) else 0
         six_volume += ((vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny
                        + (vertices[a, 2] - centre[2]) * nz)
     return lower, upper, area, six_volume, mean, n_degenerate, n_zero_length

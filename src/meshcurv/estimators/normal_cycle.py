@@ -137,15 +137,16 @@ def _estimate_compiled(kernels, vertices: np.ndarray, topology: MeshTopology, sm
                        stages: Stages):
     """The same with the compiled kernels: one pass for the sums, one kernel from sums to curvatures."""
     stages.start("compute adjacencies")
-    indptr, indices = topology.neighbour_lists if smoothing_steps > 0 else (None, None)
+    if smoothing_steps > 0:
+        indptr, indices = topology.neighbour_lists
+    else:  # no smoothing: no neighbour lists to build
+        indptr, indices = np.zeros(vertices.shape[0] + 1, np.int64), np.zeros(0, np.int64)
     stages.start("compute edge tensors")
     sums, degenerate = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
                                                  topology.edge_face_counts, topology._edge_forward_counts,
                                                  DEGENERATE_AREA_RATIO, kernels.threads())
     defects = mesh_defects(topology, degenerate)
     stages.start("average vertex tensors")
-    if indptr is None:
-        indptr, indices = np.zeros(vertices.shape[0] + 1, np.int64), np.zeros(0, np.int64)
     stages.start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max, normals, valid = kernels.normal_cycle_finish(
         sums, defects.invalid_vertices, indptr, indices, smoothing_steps)
