@@ -166,6 +166,34 @@ def test_curvatures_agree(name, method):
         assert (1 - dots).max(initial=0) < 1e-9, field
 
 
+@pytest.mark.parametrize("method", ["icc", "quadric"])
+@pytest.mark.parametrize("name", ["torus", "saddle", "defects", "noisy", "coincident"])
+def test_ball_methods_agree(name, method):
+    # the compiled ball queries, jet fits and face sums against the cKDTree / NumPy path;
+    # summation order differs (grid cells against k-d tree pairs), hence the tolerance
+    if name == "noisy":
+        mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.3, seed=5)
+        vertices, faces = mesh.vertices, mesh.faces
+    elif name == "coincident":  # a second copy of the torus: every ball holds each point twice
+        torus = shapes.torus(n_major=20, n_minor=12)
+        vertices = np.vstack([torus.vertices, torus.vertices])
+        faces = np.vstack([torus.faces, torus.faces + torus.vertices.shape[0]])
+    else:
+        vertices, faces = MESHES[name]
+    results = []
+    for backend in ("numpy", "numba"):
+        with use_backend(backend), warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshQualityWarning)
+            results.append(meshcurv.principal_curvatures(vertices, faces, method=method))
+    a, b = results
+    np.testing.assert_array_equal(a.valid, b.valid)
+    assert a.parameters == pytest.approx(b.parameters, rel=1e-9)
+    scale = np.nanmax(np.abs(a.k_max))
+    for field in ("k_min", "k_max", "normals"):
+        np.testing.assert_allclose(getattr(b, field), getattr(a, field), rtol=0, atol=1e-8 * max(scale, 1),
+                                   err_msg=field)
+
+
 def test_unknown_backend_is_refused(monkeypatch):
     with pytest.raises(InvalidOptionError, match="unknown backend 'gpu'"):
         with use_backend("gpu"):

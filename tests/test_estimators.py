@@ -14,7 +14,7 @@ import pytest
 import meshcurv
 from meshcurv import shapes
 from meshcurv.errors import InvalidOptionError, MeshQualityWarning
-from meshcurv.estimators import ESTIMATORS
+from meshcurv.estimators import ESTIMATORS, icc
 from meshcurv.neighborhoods import DEFAULT_RADIUS_FACTOR, face_in_ball_ratios, segment_in_ball_lengths
 
 from conftest import relative_error
@@ -162,10 +162,36 @@ def test_icc_is_accurate_under_noise():
 def test_radius_is_recorded_and_has_a_mesh_default(method, sphere):
     r = curvatures(sphere, method)
     h = meshcurv.geometry.mean_edge_length(sphere.vertices, meshcurv.MeshTopology.from_faces(sphere.faces).edges)
-    assert r.parameters["radius"] == pytest.approx(DEFAULT_RADIUS_FACTOR * h)
+    # icc: one edge length on a clean mesh (its default follows the noise, tested below)
+    assert r.parameters["radius"] == pytest.approx((1.0 if method == "icc" else DEFAULT_RADIUS_FACTOR) * h)
     wider = curvatures(sphere, method, radius=0.8)
     assert wider.parameters["radius"] == 0.8
     assert np.median(relative_error(wider.mean, 0.5)) < 0.05
+
+
+@pytest.mark.parametrize("amplitude", [0.1, 0.3])
+def test_icc_noise_level_follows_the_noise(amplitude):
+    # uniform normal noise of amplitude a x h: the distance to the fitted jets is about 0.23 a
+    # (the fit absorbs part of it); a clean mesh stays below the floor
+    sphere = shapes.icosphere(16)
+    noisy = shapes.with_normal_noise(sphere, amplitude, seed=3)
+    clean, rough = curvatures(sphere, "icc"), curvatures(noisy, "icc")
+    assert clean.parameters["noise"] < icc.NOISE_FLOOR
+    assert 0.15 * amplitude < rough.parameters["noise"] < 0.35 * amplitude
+    h = meshcurv.geometry.mean_edge_length(noisy.vertices, meshcurv.MeshTopology.from_faces(noisy.faces).edges)
+    expected = h * (1 + icc.NOISE_GAIN * np.sqrt(rough.parameters["noise"] - icc.NOISE_FLOOR))
+    assert rough.parameters["radius"] == pytest.approx(expected)
+    assert rough.parameters["normal_radius"] == pytest.approx(icc.NORMAL_RADIUS_RATIO * expected)
+
+
+def test_icc_noise_level_is_scale_free():
+    # measured in edge lengths: scaling the mesh changes neither the level nor the radius in edge lengths
+    noisy = shapes.with_normal_noise(shapes.icosphere(12), 0.1, seed=4)
+    small = meshcurv.principal_curvatures(noisy.vertices, noisy.faces, method="icc")
+    large = meshcurv.principal_curvatures(noisy.vertices * 1000.0, noisy.faces, method="icc")
+    assert large.parameters["noise"] == pytest.approx(small.parameters["noise"], rel=1e-9)
+    assert large.parameters["radius"] == pytest.approx(1000.0 * small.parameters["radius"], rel=1e-9)
+    np.testing.assert_allclose(large.mean * 1000.0, small.mean, rtol=1e-8, atol=1e-10)
 
 
 @pytest.mark.parametrize("method", WITH_RADIUS)

@@ -768,3 +768,334 @@ def smooth_over_neighbours(values, indptr, indices, steps):
                 following[i, c] *= scale
         current, following = following, current
     return current
+
+
+# -- balls and jets -----------------------------------------------------------------
+#: Cells per axis of a ball grid stay below 2**21, so three cell indices pack into one int64.
+_GRID_BITS = 21
+
+
+@nb.njit(**_JIT)
+def _grid(points, cell):
+    """Sorted cell keys of the points (cells of side ``cell``), their order, and the grid origin."""
+    n = points.shape[0]
+    lo = np.empty(3)
+    for a in range(3):
+        lo[a] = points[:, a].min() if n else 0.0
+    keys = np.empty(n, np.int64)
+    for i in range(n):
+        ix = np.int64((points[i, 0] - lo[0]) / cell)
+        iy = np.int64((points[i, 1] - lo[1]) / cell)
+        iz = np.int64((points[i, 2] - lo[2]) / cell)
+        keys[i] = (ix << (2 * _GRID_BITS)) | (iy << _GRID_BITS) | iz
+    order = np.argsort(keys, kind="mergesort")
+    return keys[order], order, lo
+
+
+@nb.njit(inline="always", **_JIT)
+def _lower_bound(keys, key):
+    lo, hi = 0, keys.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if keys[mid] < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@nb.njit(**_JIT)
+def _ball_members(points, keys, order, lo, cell, cx, cy, cz, cutoff, out):
+    """Indices of the points within ``cutoff`` of ``(cx, cy, cz)`` written to ``out`` (grown when full).
+
+    Returns ``(out, count)``.
+    """
+    limit = (np.int64(1) << _GRID_BITS) - 1
+    bx = np.int64((cx - lo[0]) / cell)
+    by = np.int64((cy - lo[1]) / cell)
+    bz = np.int64((cz - lo[2]) / cell)
+    cutoff2 = cutoff * cutoff
+    count = 0
+    for ix in range(bx - 1, bx + 2):
+        if ix < 0 or ix > limit:
+            continue
+        for iy in range(by - 1, by + 2):
+            if iy < 0 or iy > limit:
+                continue
+            # the three cells (ix, iy, bz - 1 .. bz + 1) are consecutive keys: one search per column
+            column = (ix << (2 * _GRID_BITS)) | (iy << _GRID_BITS)
+            first = column | max(bz - 1, 0)
+            last = column | min(bz + 1, limit)
+            if bz + 1 < 0 or bz - 1 > limit:
+                continue
+            k = _lower_bound(keys, first)
+            while k < keys.shape[0] and keys[k] <= last:
+                j = order[k]
+                dx = points[j, 0] - cx
+                dy = points[j, 1] - cy
+                dz = points[j, 2] - cz
+                if dx * dx + dy * dy + dz * dz <= cutoff2:
+                    if count == out.shape[0]:
+                        grown = np.empty(2 * out.shape[0], np.int64)
+                        grown[:count] = out[:count]
+                        out = grown
+                    out[count] = j
+                    count += 1
+                k += 1
+    return out, count
+
+
+@nb.njit(**_JIT)
+def _cholesky_solve(a, b, low, m, min_pivot):
+    """Solve ``a[:m, :m] x = b[:m]`` (symmetric, unit diagonal) in place of ``b``; False if a pivot <= min_pivot.
+
+    The same operations in the same order as ``quadric._cholesky_solve``; ``low`` is scratch.
+    """
+    for k in range(m):
+        d = a[k, k]
+        for j in range(k):
+            d -= low[k, j] * low[k, j]
+        if not d > min_pivot:
+            return False
+        root = math.sqrt(d)
+        low[k, k] = root
+        for i in range(k + 1, m):
+            s = a[i, k]
+            for j in range(k):
+                s -= low[i, j] * low[k, j]
+            low[i, k] = s / root
+    for i in range(m):
+        s = b[i]
+        for j in range(i):
+            s -= low[i, j] * b[j]
+        b[i] = s / low[i, i]
+    for i in range(m - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, m):
+            s -= low[j, i] * b[j]
+        b[i] = s / low[i, i]
+    return True
+
+
+@nb.njit(parallel=True, **_JIT)
+def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_points, min_pivot, cell, n_chunks):
+    """``quadric.fit_jets``: weighted jets over the balls of ``radius``, frame re-estimated from each fit.
+
+    Returns ``(coefficients (V, 6), t1, t2, n, counts)``; the neighbours of each
+    vertex are found on a grid of cells of side ``cell`` (>= radius).
+    """
+    n = vertices.shape[0]
+    keys, order, lo = _grid(vertices, cell)
+    coefficients = np.full((n, 6), np.nan)
+    t1s = np.empty((n, 3))
+    t2s = np.empty((n, 3))
+    ns = np.empty((n, 3))
+    counts = np.zeros(n)
+    n_terms = exponents.shape[0]
+    top = 2 * degree
+    n_chunks = max(min(n, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        # buffers once per chunk of vertices, not per vertex
+        members = np.empty(64, np.int64)
+        ox = np.empty(64)
+        oy = np.empty(64)
+        oz = np.empty(64)
+        weight = np.empty(64)
+        moments = np.zeros((top + 1, top + 1))
+        right = np.zeros(n_terms)
+        up = np.empty(top + 1)
+        vp = np.empty(top + 1)
+        matrix = np.empty((n_terms, n_terms))
+        low = np.empty((n_terms, n_terms))
+        scale = np.empty(n_terms)
+        solution = np.empty(n_terms)
+        for rank in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
+            v = order[rank]  # centres in grid order: consecutive balls share cells (cache)
+            members, ox, oy, oz, weight = _fit_one(
+                vertices, normals, radius, degree, iterations, exponents, min_pivot, cell, keys, order, lo, v,
+                members, ox, oy, oz, weight, moments, right, up, vp, matrix, low, scale, solution,
+                coefficients, t1s, t2s, ns, counts)
+    return coefficients, t1s, t2s, ns, counts
+
+
+@nb.njit(**_JIT)
+def _fit_one(vertices, normals, radius, degree, iterations, exponents, min_pivot, cell, keys, order, lo, v,
+             members, ox, oy, oz, weight, moments, right, up, vp, matrix, low, scale, solution,
+             coefficients, t1s, t2s, ns, counts):
+    """One vertex of :func:`fit_jets` in the caller's buffers; returns the buffers that may have grown."""
+    n_terms = exponents.shape[0]
+    top = 2 * degree
+    members, size = _ball_members(vertices, keys, order, lo, cell, vertices[v, 0], vertices[v, 1],
+                                  vertices[v, 2], radius, members)
+    if size > ox.shape[0]:
+        ox = np.empty(members.shape[0])
+        oy = np.empty(members.shape[0])
+        oz = np.empty(members.shape[0])
+        weight = np.empty(members.shape[0])
+    count = 0.0
+    for a in range(size):
+        j = members[a]
+        x = (vertices[j, 0] - vertices[v, 0]) / radius
+        y = (vertices[j, 1] - vertices[v, 1]) / radius
+        z = (vertices[j, 2] - vertices[v, 2]) / radius
+        ox[a], oy[a], oz[a] = x, y, z
+        w = max(1.0 - (x * x + y * y + z * z), 0.0)
+        weight[a] = w * w
+        if weight[a] > 0:
+            count += 1.0
+    counts[v] = count
+    nx, ny, nz = normals[v, 0], normals[v, 1], normals[v, 2]
+    ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
+    fitted = False
+    for step in range(iterations):
+        moments[:] = 0.0
+        right[:] = 0.0
+        for a in range(size):
+            u = ox[a] * ax + oy[a] * ay + oz[a] * az
+            w2 = ox[a] * bx + oy[a] * by + oz[a] * bz
+            h = ox[a] * nx + oy[a] * ny + oz[a] * nz
+            up[0] = 1.0
+            vp[0] = 1.0
+            for p in range(1, top + 1):
+                up[p] = up[p - 1] * u
+                vp[p] = vp[p - 1] * w2
+            wt = weight[a]
+            for total in range(top + 1):
+                for k in range(total + 1):
+                    moments[total - k, k] += wt * up[total - k] * vp[k]
+            for t in range(n_terms):
+                right[t] += wt * h * up[exponents[t, 0]] * vp[exponents[t, 1]]
+        fitted = False
+        for d in range(degree, 1, -1):
+            m = (d + 1) * (d + 2) // 2
+            if count < m:
+                continue
+            for r in range(m):
+                for c in range(m):
+                    matrix[r, c] = moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
+            for r in range(m):
+                scale[r] = math.sqrt(max(matrix[r, r], 2.2250738585072014e-308))
+            for r in range(m):
+                for c in range(m):
+                    matrix[r, c] = matrix[r, c] / scale[r] / scale[c]
+                solution[r] = right[r] / scale[r]
+            if _cholesky_solve(matrix, solution, low, m, min_pivot):
+                for r in range(6):
+                    solution[r] = solution[r] / scale[r]
+                fitted = True
+                break
+        if step + 1 < iterations and fitted:
+            p, q = solution[1], solution[2]
+            tx = nx - p * ax - q * bx
+            ty = ny - p * ay - q * by
+            tz = nz - p * az - q * bz
+            norm = math.sqrt(tx * tx + ty * ty + tz * tz)
+            tx, ty, tz = tx / norm, ty / norm, tz / norm
+            if math.isfinite(tx) and math.isfinite(ty) and math.isfinite(tz):
+                nx, ny, nz = tx, ty, tz
+                ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
+    if fitted:
+        for r in range(6):
+            coefficients[v, r] = solution[r]
+    t1s[v, 0], t1s[v, 1], t1s[v, 2] = ax, ay, az
+    t2s[v, 0], t2s[v, 1], t2s[v, 2] = bx, by, bz
+    ns[v, 0], ns[v, 1], ns[v, 2] = nx, ny, nz
+    return members, ox, oy, oz, weight
+
+
+@nb.njit(parallel=True, **_JIT)
+def ball_face_sums(vertices, faces, values, radius, cutoff, cell, n_chunks):
+    """``neighborhoods.ball_face_sums`` for one group of faces: (V, k) sums of ``ratio * values``.
+
+    Faces are found by their centroids within ``cutoff`` (radius + the group's
+    largest reach) on a grid of cells of side ``cell`` (>= cutoff).
+    """
+    n = vertices.shape[0]
+    n_faces = faces.shape[0]
+    n_values = values.shape[1]
+    centroids = np.empty((n_faces, 3))
+    for f in nb.prange(n_faces):
+        for a in range(3):
+            centroids[f, a] = (vertices[faces[f, 0], a] + vertices[faces[f, 1], a] + vertices[faces[f, 2], a]) / 3
+    keys, order, lo = _grid(centroids, cell)
+    out = np.zeros((n, n_values))
+    _, centres, _ = _grid(vertices, cell)  # centres in grid order: consecutive balls share cells (cache)
+    n_chunks = max(min(n, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        members = np.empty(64, np.int64)
+        for rank in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
+            v = centres[rank]
+            members = _face_ratio_sums(vertices, faces, values, radius, cutoff, cell, centroids, keys, order, lo,
+                                       v, members, out)
+    return out
+
+
+@nb.njit(**_JIT)
+def _face_ratio_sums(vertices, faces, values, radius, cutoff, cell, centroids, keys, order, lo, v, members, out):
+    """One vertex of :func:`ball_face_sums`; returns the (possibly grown) member buffer."""
+    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+    members, size = _ball_members(centroids, keys, order, lo, cell, cx, cy, cz, cutoff, members)
+    for a in range(size):
+        f = members[a]
+        low = np.inf
+        high = -np.inf
+        for corner in range(4):
+            if corner < 3:
+                px = vertices[faces[f, corner], 0]
+                py = vertices[faces[f, corner], 1]
+                pz = vertices[faces[f, corner], 2]
+            else:
+                px, py, pz = centroids[f, 0], centroids[f, 1], centroids[f, 2]
+            dx, dy, dz = px - cx, py - cy, pz - cz
+            dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+            low = min(low, dist)
+            high = max(high, dist)
+        if high <= radius:
+            ratio = 1.0
+        elif low >= radius:
+            continue
+        else:
+            ratio = (radius - low) / (high - low)
+        for k in range(values.shape[1]):
+            out[v, k] += ratio * values[f, k]
+    return members
+
+
+@nb.njit(parallel=True, **_JIT)
+def icc_face_measures(vertices, faces, normals):
+    """``icc.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
+    out = np.empty((faces.shape[0], 9))
+    for f in nb.prange(faces.shape[0]):
+        i, j, k = faces[f, 0], faces[f, 1], faces[f, 2]
+        ax, ay, az = vertices[j, 0] - vertices[i, 0], vertices[j, 1] - vertices[i, 1], vertices[j, 2] - vertices[i, 2]
+        bx, by, bz = vertices[k, 0] - vertices[i, 0], vertices[k, 1] - vertices[i, 1], vertices[k, 2] - vertices[i, 2]
+        u0x, u0y, u0z = normals[i, 0], normals[i, 1], normals[i, 2]
+        u1x, u1y, u1z = normals[j, 0], normals[j, 1], normals[j, 2]
+        u2x, u2y, u2z = normals[k, 0], normals[k, 1], normals[k, 2]
+        mx, my, mz = (u0x + u1x + u2x) / 3, (u0y + u1y + u2y) / 3, (u0z + u1z + u2z) / 3
+        cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        out[f, 0] = 0.5 * (mx * cx + my * cy + mz * cz)
+        # (u0 - u2) x a + (u1 - u0) x b
+        px, py, pz = u0x - u2x, u0y - u2y, u0z - u2z
+        qx, qy, qz = u1x - u0x, u1y - u0y, u1z - u0z
+        sx = (py * az - pz * ay) + (qy * bz - qz * by)
+        sy = (pz * ax - px * az) + (qz * bx - qx * bz)
+        sz = (px * ay - py * ax) + (qx * by - qy * bx)
+        out[f, 1] = 0.5 * (mx * sx + my * sy + mz * sz)
+        out[f, 2] = 0.5 * (u0x * (u1y * u2z - u1z * u2y) + u0y * (u1z * u2x - u1x * u2z) + u0z * (u1x * u2y - u1y * u2x))
+        # M = 1/2 [ (a x m) (u2 - u0)^T - (b x m) (u1 - u0)^T ]
+        gx, gy, gz = ay * mz - az * my, az * mx - ax * mz, ax * my - ay * mx
+        hx, hy, hz = by * mz - bz * my, bz * mx - bx * mz, bx * my - by * mx
+        ex, ey, ez = u2x - u0x, u2y - u0y, u2z - u0z
+        m00 = 0.5 * (gx * ex - hx * qx)
+        m11 = 0.5 * (gy * ey - hy * qy)
+        m22 = 0.5 * (gz * ez - hz * qz)
+        m01 = 0.5 * (gx * ey - hx * qy)
+        m10 = 0.5 * (gy * ex - hy * qx)
+        m02 = 0.5 * (gx * ez - hx * qz)
+        m20 = 0.5 * (gz * ex - hz * qx)
+        m12 = 0.5 * (gy * ez - hy * qz)
+        m21 = 0.5 * (gz * ey - hz * qy)
+        out[f, 3], out[f, 4], out[f, 5] = m00, m11, m22
+        out[f, 6], out[f, 7], out[f, 8] = 0.5 * (m01 + m10), 0.5 * (m02 + m20), 0.5 * (m12 + m21)
+    return out

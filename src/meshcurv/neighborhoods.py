@@ -16,6 +16,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from ._backend import numba_kernels
 from ._validation import check_positive_float
 from .geometry import mean_edge_length
 from .topology import MeshTopology
@@ -118,7 +119,7 @@ def segment_in_ball_lengths(starts: np.ndarray, ends: np.ndarray, centers: np.nd
 
 
 def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: np.ndarray,
-               usable: np.ndarray | None, weight) -> np.ndarray:
+               usable: np.ndarray | None, weight, compiled: str | None = None) -> np.ndarray:
     """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices."""
     import scipy.sparse as sp
     from scipy.spatial import cKDTree
@@ -139,8 +140,15 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     # thousands of small cells. So cells are grouped by size (powers of two of
     # their reach), each group searched with its own largest reach.
     _, exponent = np.frexp(np.maximum(reach, np.finfo(float).tiny))
+    kernels = numba_kernels() if compiled is not None else None
     for level in np.unique(exponent):
         group = np.flatnonzero(exponent == level)
+        if kernels is not None:
+            cutoff = radius + reach[group].max()
+            extent = float(np.ptp(vertices, axis=0).max())
+            out += getattr(kernels, compiled)(vertices, cells[group], np.ascontiguousarray(values[group]), radius,
+                                              cutoff, max(cutoff, extent / 2.0**20), 64 * kernels.threads())
+            continue
         tree = cKDTree(centres[group])
         cutoff = radius + reach[group].max()
         for chunk in _chunks(n):
@@ -159,7 +167,7 @@ def ball_face_sums(vertices: np.ndarray, faces: np.ndarray, radius: float, value
     ``values`` is (F, k); ``ratio`` is :func:`face_in_ball_ratios`. Faces not
     ``usable`` (F,) bool are left out.
     """
-    return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios)
+    return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, "ball_face_sums")
 
 
 def ball_edge_sums(vertices: np.ndarray, edges: np.ndarray, radius: float, values: np.ndarray,

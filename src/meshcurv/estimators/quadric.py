@@ -62,6 +62,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._backend import numba_kernels
 from .._tensors import principal_from_shape_operator, tangent_basis
 from ..neighborhoods import resolve_radius, vertex_pairs_in_ball
 from ..topology import MeshTopology
@@ -80,8 +81,9 @@ ITERATIONS = 2
 #: Fewest points (with non-zero weight) a fit takes: the six coefficients of a quadric.
 MIN_POINTS = 6
 
-#: Largest condition number of a (diagonally scaled) normal matrix that is solved.
-MAX_CONDITION = 1e5
+#: Smallest Cholesky pivot of a diagonally scaled normal matrix (unit diagonal) that is
+#: solved: a smaller one means a nearly degenerate set of points (for example collinear).
+MIN_PIVOT = 1e-5
 
 #: Centres per chunk of pair queries (bounds the memory of the per-pair arrays).
 CHUNK_SIZE = 4096
@@ -130,6 +132,41 @@ def _fit_chunk(offsets: np.ndarray, rows: np.ndarray, size: int, frame: tuple, w
     return matrix, right
 
 
+def _cholesky_solve(matrix: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Solve the (N, m, m) symmetric systems of unit diagonal by Cholesky.
+
+    Returns the (N, m) solutions and (N,) whether every pivot exceeded
+    :data:`MIN_PIVOT` (the solutions of the others are meaningless). A loop over
+    the m <= 15 columns, vectorized over the systems; the compiled kernel does
+    the same operations in the same order.
+    """
+    n, m = right.shape
+    low = np.zeros_like(matrix)
+    ok = np.ones(n, dtype=bool)
+    for k in range(m):
+        d = matrix[:, k, k].copy()
+        for j in range(k):
+            d -= low[:, k, j] * low[:, k, j]
+        ok &= d > MIN_PIVOT
+        root = np.sqrt(np.where(ok, d, 1.0))
+        low[:, k, k] = root
+        for i in range(k + 1, m):
+            t = matrix[:, i, k].copy()
+            for j in range(k):
+                t -= low[:, i, j] * low[:, k, j]
+            low[:, i, k] = t / root
+    x = right.copy()
+    for i in range(m):
+        for j in range(i):
+            x[:, i] -= low[:, i, j] * x[:, j]
+        x[:, i] /= low[:, i, i]
+    for i in range(m - 1, -1, -1):
+        for j in range(i + 1, m):
+            x[:, i] -= low[:, j, i] * x[:, j]
+        x[:, i] /= low[:, i, i]
+    return x, ok
+
+
 def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: int) -> np.ndarray:
     """(N, 6) the constant, linear and quadratic coefficients of the highest solvable degree (NaN: none).
 
@@ -146,12 +183,10 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
         block = matrix[candidates, :m, :m]
         scale = np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
         scaled = block / scale[:, :, None] / scale[:, None, :]
-        eigen = np.linalg.eigvalsh(scaled)
-        ok = eigen[:, 0] > eigen[:, -1] / MAX_CONDITION
+        solution, ok = _cholesky_solve(scaled, right[candidates, :m] / scale)
         chosen = candidates[ok]
         if chosen.size:
-            solution = np.linalg.solve(scaled[ok], (right[chosen, :m] / scale[ok])[:, :, None])[:, :, 0]
-            out[chosen] = (solution / scale[ok])[:, :6]
+            out[chosen] = (solution[ok] / scale[ok])[:, :6]
             todo[chosen] = False
     return out
 
@@ -180,6 +215,13 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     counts : ndarray of shape (V,)
         Points with non-zero weight in each ball.
     """
+    kernels = numba_kernels()
+    if kernels is not None and vertices.shape[0]:
+        cell = max(radius, float(np.ptp(vertices, axis=0).max()) / 2.0**20)
+        coefficients, t1, t2, n, counts = kernels.fit_jets(
+            vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_POINTS, MIN_PIVOT, cell,
+            64 * kernels.threads())
+        return coefficients, (t1, t2, n), counts
     n = vertices.shape[0]
     t1, t2 = tangent_basis(normals)
     frame = [t1, t2, normals.copy()]
