@@ -25,7 +25,7 @@ from test_dirty_corpus import EDGE, TORUS, cases
 METHODS = sorted(ESTIMATORS)
 CASES = {case.name: case for case in cases()}
 RADIUS = 2.5 * EDGE  # fixed ball radius: the default follows the global mean edge length
-FAR_RINGS = 8  # more rings than any method's neighbourhood (smoothing 3 + 1, ball ~3 rings)
+FAR_RINGS = 12  # more rings than any method's neighbourhood (smoothing 3 + 1, icc's jets and ball ~11 rings)
 
 # What the warning must name, per kind of defect.
 NAMED = {"boundary": "boundary", "nonmanifold": "non-manifold", "bowtie": "bow-tie",
@@ -105,7 +105,8 @@ def test_far_from_the_defect_nothing_changes(name, method, clean):
     if case.core.size:
         rings = shortest_path(top.adjacency, unweighted=True, indices=case.core).min(axis=0)
         distance = np.linalg.norm(case.vertices[:, None] - case.vertices[case.core][None], axis=2).min(axis=1)
-        far = old & (rings >= FAR_RINGS) & (distance > 4 * RADIUS)
+        # icc's normals come from jets over 3 x RADIUS, its measures from RADIUS further on
+        far = old & (rings >= FAR_RINGS) & (distance > 5 * RADIUS)
     else:
         far = old
     assert far.sum() > 200

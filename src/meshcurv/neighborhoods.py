@@ -7,7 +7,10 @@ each vertex position, in the units of the coordinates. The default radius is
 
 Queries run on :class:`scipy.spatial.cKDTree` pair searches, in chunks of
 centres so that memory stays bounded on large meshes; all per-pair work is
-vectorized (no Python loop over vertices, edges or faces).
+vectorized (no Python loop over vertices, edges or faces). With numba, the
+face sums (and the jet fits of :mod:`meshcurv.estimators.quadric`) run on a
+grid of cells at least as wide as the ball instead, in compiled kernels that
+find the same points (tests/test_backends.py compares the two).
 """
 
 from __future__ import annotations
