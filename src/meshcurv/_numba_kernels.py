@@ -776,12 +776,21 @@ _GRID_BITS = 21
 
 
 @nb.njit(**_JIT)
-def _grid(points, cell):
-    """Sorted cell keys of the points (cells of side ``cell``), their order, and the grid origin."""
+def _grid(points, reach):
+    """Sorted cell keys of the points, their order, the grid origin and the cell side.
+
+    The side is at least ``reach`` (a ball of that radius spans at most three
+    cells per axis) and wide enough that the cells per axis fit in ``_GRID_BITS``.
+    """
     n = points.shape[0]
     lo = np.empty(3)
+    extent = 0.0
     for a in range(3):
         lo[a] = points[:, a].min() if n else 0.0
+        extent = max(extent, points[:, a].max() - lo[a] if n else 0.0)
+    cell = max(reach, extent / 2.0 ** (_GRID_BITS - 1))
+    if not cell > 0:  # every point in one place and a zero reach: one cell
+        cell = 1.0
     keys = np.empty(n, np.int64)
     for i in range(n):
         ix = np.int64((points[i, 0] - lo[0]) / cell)
@@ -789,7 +798,7 @@ def _grid(points, cell):
         iz = np.int64((points[i, 2] - lo[2]) / cell)
         keys[i] = (ix << (2 * _GRID_BITS)) | (iy << _GRID_BITS) | iz
     order = np.argsort(keys, kind="mergesort")
-    return keys[order], order, lo
+    return keys[order], order, lo, cell
 
 
 @nb.njit(inline="always", **_JIT)
@@ -816,6 +825,8 @@ def _ball_members(points, keys, order, lo, cell, cx, cy, cz, cutoff, out):
     bz = np.int64((cz - lo[2]) / cell)
     cutoff2 = cutoff * cutoff
     count = 0
+    if bz + 1 < 0 or bz - 1 > limit:
+        return out, count
     for ix in range(bx - 1, bx + 2):
         if ix < 0 or ix > limit:
             continue
@@ -826,8 +837,6 @@ def _ball_members(points, keys, order, lo, cell, cx, cy, cz, cutoff, out):
             column = (ix << (2 * _GRID_BITS)) | (iy << _GRID_BITS)
             first = column | max(bz - 1, 0)
             last = column | min(bz + 1, limit)
-            if bz + 1 < 0 or bz - 1 > limit:
-                continue
             k = _lower_bound(keys, first)
             while k < keys.shape[0] and keys[k] <= last:
                 j = order[k]
@@ -878,14 +887,14 @@ def _cholesky_solve(a, b, low, m, min_pivot):
 
 
 @nb.njit(parallel=True, **_JIT)
-def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_points, min_pivot, cell, n_chunks):
+def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot, n_chunks):
     """``quadric.fit_jets``: weighted jets over the balls of ``radius``, frame re-estimated from each fit.
 
     Returns ``(coefficients (V, 6), t1, t2, n, counts)``; the neighbours of each
-    vertex are found on a grid of cells of side ``cell`` (>= radius).
+    vertex are found on a grid of cells (:func:`_grid`).
     """
     n = vertices.shape[0]
-    keys, order, lo = _grid(vertices, cell)
+    keys, order, lo, cell = _grid(vertices, radius)
     coefficients = np.full((n, 6), np.nan)
     t1s = np.empty((n, 3))
     t2s = np.empty((n, 3))
@@ -1004,22 +1013,17 @@ def _fit_one(vertices, normals, radius, degree, iterations, exponents, min_pivot
 
 
 @nb.njit(parallel=True, **_JIT)
-def ball_face_sums(vertices, faces, values, radius, cutoff, cell, n_chunks):
+def ball_face_sums(vertices, faces, centroids, values, radius, cutoff, n_chunks):
     """``neighborhoods.ball_face_sums`` for one group of faces: (V, k) sums of ``ratio * values``.
 
-    Faces are found by their centroids within ``cutoff`` (radius + the group's
-    largest reach) on a grid of cells of side ``cell`` (>= cutoff).
+    Faces are found by their ``centroids`` within ``cutoff`` (radius + the
+    group's largest reach) on a grid of cells (:func:`_grid`).
     """
     n = vertices.shape[0]
-    n_faces = faces.shape[0]
     n_values = values.shape[1]
-    centroids = np.empty((n_faces, 3))
-    for f in nb.prange(n_faces):
-        for a in range(3):
-            centroids[f, a] = (vertices[faces[f, 0], a] + vertices[faces[f, 1], a] + vertices[faces[f, 2], a]) / 3
-    keys, order, lo = _grid(centroids, cell)
+    keys, order, lo, cell = _grid(centroids, cutoff)
     out = np.zeros((n, n_values))
-    _, centres, _ = _grid(vertices, cell)  # centres in grid order: consecutive balls share cells (cache)
+    _, centres, _, _ = _grid(vertices, cell)  # centres in grid order: consecutive balls share cells (cache)
     n_chunks = max(min(n, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         members = np.empty(64, np.int64)

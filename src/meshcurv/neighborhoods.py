@@ -147,10 +147,9 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     for level in np.unique(exponent):
         group = np.flatnonzero(exponent == level)
         if kernels is not None:
-            cutoff = radius + reach[group].max()
-            extent = float(np.ptp(vertices, axis=0).max())
-            out += getattr(kernels, compiled)(vertices, cells[group], np.ascontiguousarray(values[group]), radius,
-                                              cutoff, max(cutoff, extent / 2.0**20), 64 * kernels.threads())
+            out += getattr(kernels, compiled)(vertices, cells[group], centres[group],
+                                              np.ascontiguousarray(values[group]), radius,
+                                              radius + reach[group].max(), 64 * kernels.threads())
             continue
         tree = cKDTree(centres[group])
         cutoff = radius + reach[group].max()

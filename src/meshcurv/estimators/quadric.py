@@ -217,9 +217,8 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     """
     kernels = numba_kernels()
     if kernels is not None and vertices.shape[0]:
-        cell = max(radius, float(np.ptp(vertices, axis=0).max()) / 2.0**20)
         coefficients, t1, t2, n, counts = kernels.fit_jets(
-            vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_POINTS, MIN_PIVOT, cell,
+            vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT,
             64 * kernels.threads())
         return coefficients, (t1, t2, n), counts
     n = vertices.shape[0]
