@@ -194,6 +194,42 @@ def test_ball_methods_agree(name, method):
                                    err_msg=field)
 
 
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_jets_fitted_at_chosen_centres(backend):
+    # fitting a subset of the vertices gives their rows of the full fit; the other rows are NaN
+    from meshcurv.estimators.quadric import fit_jets
+
+    mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=2)
+    normals = mesh.vertices / np.linalg.norm(mesh.vertices, axis=1, keepdims=True)
+    centres = np.arange(3, mesh.vertices.shape[0], 7)
+    with use_backend(backend):
+        full, full_frame, full_counts = fit_jets(mesh.vertices, normals, 0.4, degree=3)
+        some, frame, counts = fit_jets(mesh.vertices, normals, 0.4, degree=3, centres=centres)
+    others = np.setdiff1d(np.arange(mesh.vertices.shape[0]), centres)
+    assert np.isnan(some[others]).all() and np.isnan(frame[2][others]).all() and (counts[others] == 0).all()
+    np.testing.assert_allclose(some[centres], full[centres], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(frame[2][centres], full_frame[2][centres], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(counts[centres], full_counts[centres])
+
+
+def test_ball_grid_finds_every_neighbour_of_a_sparse_flat_cloud():
+    # 50 clusters of 40 points scattered over a 1000 x 1000 square, radius 5: cells of side 5
+    # would make 20 columns per point, so the kernel widens its cells; every ball must still
+    # hold every point within the radius (brute force)
+    from meshcurv.estimators.quadric import fit_jets
+
+    rng = np.random.default_rng(4)
+    clusters = rng.uniform(0, 1000, (50, 2)).repeat(40, axis=0)
+    points = np.column_stack([clusters + rng.uniform(-5, 5, (2000, 2)), rng.normal(0, 1, 2000)])
+    normals = np.tile([0.0, 0.0, 1.0], (2000, 1))
+    with use_backend("numba"):
+        _, _, counts = fit_jets(points, normals, 5.0, degree=2)
+    distances = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2)
+    inside = (distances < 5.0).sum(axis=1)
+    assert inside.mean() > 10
+    np.testing.assert_array_equal(counts, inside)
+
+
 def test_unknown_backend_is_refused(monkeypatch):
     with pytest.raises(InvalidOptionError, match="unknown backend 'gpu'"):
         with use_backend("gpu"):

@@ -194,6 +194,18 @@ def test_icc_noise_level_is_scale_free():
     np.testing.assert_allclose(large.mean * 1000.0, small.mean, rtol=1e-8, atol=1e-10)
 
 
+def test_icc_noise_level_on_a_sample(monkeypatch):
+    # above NOISE_SAMPLE valid vertices the median is taken over evenly spaced vertices:
+    # the level stays close to that of all vertices, and a run gives the same level again
+    noisy = shapes.with_normal_noise(shapes.icosphere(16), 0.1, seed=6)
+    full = curvatures(noisy, "icc").parameters["noise"]
+    monkeypatch.setattr(icc, "NOISE_SAMPLE", 500)
+    sampled = curvatures(noisy, "icc").parameters["noise"]
+    assert sampled != full
+    assert sampled == pytest.approx(full, rel=0.1)
+    assert curvatures(noisy, "icc").parameters["noise"] == sampled
+
+
 @pytest.mark.parametrize("method", WITH_RADIUS)
 def test_same_radius_same_answer_across_resolutions(method):
     # radius in length units: two resolutions of one sphere agree (to the discretization error)

@@ -14,6 +14,8 @@ import numba as nb
 import numpy as np
 
 _JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+#: Sums that may be reassociated (vectorized); no other fast-math assumption (NaN and inf stay meaningful).
+_JIT_REASSOC = {**_JIT, "fastmath": {"reassoc", "contract"}}
 
 
 # -- shared pieces ----------------------------------------------------------------
@@ -771,84 +773,115 @@ def smooth_over_neighbours(values, indptr, indices, steps):
 
 
 # -- balls and jets -----------------------------------------------------------------
-#: Cells per axis of a ball grid stay below 2**21, so three cell indices pack into one int64.
-_GRID_BITS = 21
+#: A ball grid has at most this many columns of cells per point (and at least 4096 in all).
+_GRID_COLUMNS_PER_POINT = 4
 
 
 @nb.njit(**_JIT)
 def _grid(points, reach):
-    """Sorted cell keys of the points, their order, the grid origin and the cell side.
+    """Points sorted into a grid of cubic cells: ``(order, starts, levels, lo, cell, nx, ny)``.
 
-    The side is at least ``reach`` (a ball of that radius spans at most three
-    cells per axis) and wide enough that the cells per axis fit in ``_GRID_BITS``.
+    The cells have a side ``cell`` of at least ``reach`` (a ball of that radius
+    spans at most three cells per axis) from the origin ``lo``. ``order`` lists
+    the points column by column (``x`` cell, then ``y`` cell), and within a
+    column by ``z`` cell: a stable counting sort, so ties keep their index
+    order. The points of column ``ix * ny + iy`` are ranks
+    ``starts[c]:starts[c + 1]`` of ``order``, their ``z`` cells ``levels[rank]``.
+    The cell is widened when the columns would outnumber
+    ``_GRID_COLUMNS_PER_POINT`` per point (a sparse or very flat cloud).
     """
     n = points.shape[0]
-    lo = np.empty(3)
-    extent = 0.0
+    lo = np.zeros(3)
+    hi = np.zeros(3)
     for a in range(3):
-        lo[a] = points[:, a].min() if n else 0.0
-        extent = max(extent, points[:, a].max() - lo[a] if n else 0.0)
-    cell = max(reach, extent / 2.0 ** (_GRID_BITS - 1))
-    if not cell > 0:  # every point in one place and a zero reach: one cell
+        if n:
+            lo[a] = points[:, a].min()
+            hi[a] = points[:, a].max()
+    extent = max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2])
+    cell = max(reach, extent / 2.0**60)  # z cells fit in an int64
+    if not cell > 0:  # every point in one place and a zero reach: any side
         cell = 1.0
-    keys = np.empty(n, np.int64)
+    limit = max(_GRID_COLUMNS_PER_POINT * n, 4096)
+    while ((hi[0] - lo[0]) / cell + 1) * ((hi[1] - lo[1]) / cell + 1) > limit:
+        cell *= 2.0
+    nx = np.int64((hi[0] - lo[0]) / cell) + 1
+    ny = np.int64((hi[1] - lo[1]) / cell) + 1
+    column = np.empty(n, np.int64)
+    starts = np.zeros(nx * ny + 1, np.int64)
     for i in range(n):
-        ix = np.int64((points[i, 0] - lo[0]) / cell)
-        iy = np.int64((points[i, 1] - lo[1]) / cell)
-        iz = np.int64((points[i, 2] - lo[2]) / cell)
-        keys[i] = (ix << (2 * _GRID_BITS)) | (iy << _GRID_BITS) | iz
-    order = np.argsort(keys, kind="mergesort")
-    return keys[order], order, lo, cell
-
-
-@nb.njit(inline="always", **_JIT)
-def _lower_bound(keys, key):
-    lo, hi = 0, keys.shape[0]
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if keys[mid] < key:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
+        c = np.int64((points[i, 0] - lo[0]) / cell) * ny + np.int64((points[i, 1] - lo[1]) / cell)
+        column[i] = c
+        starts[c + 1] += 1
+    for c in range(nx * ny):
+        starts[c + 1] += starts[c]
+    order = np.empty(n, np.int64)
+    filled = starts[:-1].copy()
+    for i in range(n):
+        order[filled[column[i]]] = i
+        filled[column[i]] += 1
+    levels = np.empty(n, np.int64)
+    for i in range(n):
+        levels[i] = np.int64((points[order[i], 2] - lo[2]) / cell)
+    for c in range(nx * ny):  # within a column, by z cell (stable)
+        first, last = starts[c], starts[c + 1]
+        if last - first > 32:
+            by_level = np.argsort(levels[first:last], kind="mergesort")
+            order[first:last] = order[first:last][by_level]
+            levels[first:last] = levels[first:last][by_level]
+            continue
+        for i in range(first + 1, last):  # insertion sort of a short column
+            level, point = levels[i], order[i]
+            j = i
+            while j > first and levels[j - 1] > level:
+                levels[j] = levels[j - 1]
+                order[j] = order[j - 1]
+                j -= 1
+            levels[j] = level
+            order[j] = point
+    return order, starts, levels, lo, cell, nx, ny
 
 
 @nb.njit(**_JIT)
-def _ball_members(points, keys, order, lo, cell, cx, cy, cz, cutoff, out):
-    """Indices of the points within ``cutoff`` of ``(cx, cy, cz)`` written to ``out`` (grown when full).
+def _ball_members(points, grid, cx, cy, cz, cutoff, out):
+    """Ranks of the points within ``cutoff`` of ``(cx, cy, cz)`` written to ``out`` (grown when full).
 
-    Returns ``(out, count)``.
+    ``points`` are in the order of ``grid`` (:func:`_grid`, ``cutoff`` at
+    most its cell side), so that the three cells of a column around the centre
+    are one contiguous run of memory. Returns ``(out, count)``.
     """
-    limit = (np.int64(1) << _GRID_BITS) - 1
-    bx = np.int64((cx - lo[0]) / cell)
-    by = np.int64((cy - lo[1]) / cell)
-    bz = np.int64((cz - lo[2]) / cell)
+    _, starts, levels, lo, cell, nx, ny = grid
+    fx = (cx - lo[0]) / cell
+    fy = (cy - lo[1]) / cell
+    fz = (cz - lo[2]) / cell
     cutoff2 = cutoff * cutoff
     count = 0
-    if bz + 1 < 0 or bz - 1 > limit:
+    if not (fx > -2 and fy > -2 and fz > -2 and fx < nx + 1 and fy < ny + 1 and fz < 2.0**61):
         return out, count
-    for ix in range(bx - 1, bx + 2):
-        if ix < 0 or ix > limit:
-            continue
-        for iy in range(by - 1, by + 2):
-            if iy < 0 or iy > limit:
-                continue
-            # the three cells (ix, iy, bz - 1 .. bz + 1) are consecutive keys: one search per column
-            column = (ix << (2 * _GRID_BITS)) | (iy << _GRID_BITS)
-            first = column | max(bz - 1, 0)
-            last = column | min(bz + 1, limit)
-            k = _lower_bound(keys, first)
-            while k < keys.shape[0] and keys[k] <= last:
-                j = order[k]
-                dx = points[j, 0] - cx
-                dy = points[j, 1] - cy
-                dz = points[j, 2] - cz
+    bx = np.int64(math.floor(fx))
+    by = np.int64(math.floor(fy))
+    bz = np.int64(math.floor(fz))
+    for ix in range(max(bx - 1, 0), min(bx + 2, nx)):
+        for iy in range(max(by - 1, 0), min(by + 2, ny)):
+            c = ix * ny + iy
+            k = starts[c]
+            last = starts[c + 1]
+            high = last
+            while k < high:  # first rank of the column at z cell bz - 1 or above
+                middle = (k + high) // 2
+                if levels[middle] < bz - 1:
+                    k = middle + 1
+                else:
+                    high = middle
+            while k < last and levels[k] <= bz + 1:
+                dx = points[k, 0] - cx
+                dy = points[k, 1] - cy
+                dz = points[k, 2] - cz
                 if dx * dx + dy * dy + dz * dz <= cutoff2:
                     if count == out.shape[0]:
                         grown = np.empty(2 * out.shape[0], np.int64)
                         grown[:count] = out[:count]
                         out = grown
-                    out[count] = j
+                    out[count] = k
                     count += 1
                 k += 1
     return out, count
@@ -887,93 +920,109 @@ def _cholesky_solve(a, b, low, m, min_pivot):
 
 
 @nb.njit(parallel=True, **_JIT)
-def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot, n_chunks):
+def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks):
     """``quadric.fit_jets``: weighted jets over the balls of ``radius``, frame re-estimated from each fit.
 
-    Returns ``(coefficients (V, 6), t1, t2, n, counts)``; the neighbours of each
-    vertex are found on a grid of cells (:func:`_grid`).
+    Fits the jets of the vertices ``centres`` (the other rows of the outputs
+    stay NaN). Returns ``(coefficients (V, 6), t1, t2, n, counts)``; the
+    neighbours of each vertex are found on a grid of cells (:func:`_grid`).
     """
     n = vertices.shape[0]
-    keys, order, lo, cell = _grid(vertices, radius)
+    grid = _grid(vertices, radius)
+    order = grid[0]
+    points = np.empty((n, 3))
+    for k in range(n):
+        points[k] = vertices[order[k]]
+    # centres in grid order: consecutive balls share cells (cache)
+    chosen = np.zeros(n, np.bool_)
+    chosen[centres] = True
+    centres = order[chosen[order]]
     coefficients = np.full((n, 6), np.nan)
-    t1s = np.empty((n, 3))
-    t2s = np.empty((n, 3))
-    ns = np.empty((n, 3))
+    t1s = np.full((n, 3), np.nan)
+    t2s = np.full((n, 3), np.nan)
+    ns = np.full((n, 3), np.nan)
     counts = np.zeros(n)
     n_terms = exponents.shape[0]
-    top = 2 * degree
-    n_chunks = max(min(n, n_chunks), 1)
+    m = centres.shape[0]
+    n_chunks = max(min(m, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         # buffers once per chunk of vertices, not per vertex
         members = np.empty(64, np.int64)
-        ox = np.empty(64)
-        oy = np.empty(64)
-        oz = np.empty(64)
-        weight = np.empty(64)
-        moments = np.zeros((top + 1, top + 1))
-        right = np.zeros(n_terms)
-        up = np.empty(top + 1)
-        vp = np.empty(top + 1)
+        work = np.empty((_JET_ROWS + 2 * (2 * degree + 1), 64))
+        moments = np.empty((2 * degree + 1, 2 * degree + 1))
+        right = np.empty(n_terms)
         matrix = np.empty((n_terms, n_terms))
         low = np.empty((n_terms, n_terms))
         scale = np.empty(n_terms)
         solution = np.empty(n_terms)
-        for rank in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
-            v = order[rank]  # centres in grid order: consecutive balls share cells (cache)
-            members, ox, oy, oz, weight = _fit_one(
-                vertices, normals, radius, degree, iterations, exponents, min_pivot, cell, keys, order, lo, v,
-                members, ox, oy, oz, weight, moments, right, up, vp, matrix, low, scale, solution,
-                coefficients, t1s, t2s, ns, counts)
+        for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
+            members, work = _fit_one(vertices, points, grid, normals, radius, degree, iterations, exponents,
+                                     min_pivot, centres[i], members, work, moments, right, matrix, low, scale,
+                                     solution, coefficients, t1s, t2s, ns, counts)
     return coefficients, t1s, t2s, ns, counts
 
 
+#: Rows of a jet fit's scratch before the powers of u and v: the offsets x, y, z, the weight, weight * height.
+_JET_ROWS = 5
+
+
+@nb.njit(**_JIT_REASSOC)
+def _weighted_dot(a, b, c, size):
+    """``sum_i a[i] b[i] c[i]`` over the first ``size`` entries, reassociated (vectorized)."""
+    total = 0.0
+    for i in range(size):
+        total += a[i] * b[i] * c[i]
+    return total
+
+
 @nb.njit(**_JIT)
-def _fit_one(vertices, normals, radius, degree, iterations, exponents, min_pivot, cell, keys, order, lo, v,
-             members, ox, oy, oz, weight, moments, right, up, vp, matrix, low, scale, solution,
-             coefficients, t1s, t2s, ns, counts):
-    """One vertex of :func:`fit_jets` in the caller's buffers; returns the buffers that may have grown."""
+def _fit_one(vertices, points, grid, normals, radius, degree, iterations, exponents, min_pivot, v, members, work, moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts):
+    """One vertex of :func:`fit_jets` in the caller's buffers; returns the buffers that may have grown.
+
+    ``work`` holds one column per ball member: its offset from the centre in
+    units of the radius, its weight, its weighted height and the powers
+    ``u^0..u^2d`` and ``v^0..v^2d`` of its tangent coordinates, so that each
+    moment of the normal equations is one vectorized dot product.
+    """
     n_terms = exponents.shape[0]
     top = 2 * degree
-    members, size = _ball_members(vertices, keys, order, lo, cell, vertices[v, 0], vertices[v, 1],
-                                  vertices[v, 2], radius, members)
-    if size > ox.shape[0]:
-        ox = np.empty(members.shape[0])
-        oy = np.empty(members.shape[0])
-        oz = np.empty(members.shape[0])
-        weight = np.empty(members.shape[0])
+    members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius, members)
+    if size > work.shape[1]:
+        work = np.empty((work.shape[0], members.shape[0]))
+    ox, oy, oz, weight, lift = work[0], work[1], work[2], work[3], work[4]
+    inverse = 1.0 / radius
+    pu = work[_JET_ROWS:_JET_ROWS + top + 1]
+    pv = work[_JET_ROWS + top + 1:]
     count = 0.0
     for a in range(size):
-        j = members[a]
-        x = (vertices[j, 0] - vertices[v, 0]) / radius
-        y = (vertices[j, 1] - vertices[v, 1]) / radius
-        z = (vertices[j, 2] - vertices[v, 2]) / radius
+        k = members[a]
+        x = (points[k, 0] - vertices[v, 0]) * inverse
+        y = (points[k, 1] - vertices[v, 1]) * inverse
+        z = (points[k, 2] - vertices[v, 2]) * inverse
         ox[a], oy[a], oz[a] = x, y, z
         w = max(1.0 - (x * x + y * y + z * z), 0.0)
         weight[a] = w * w
         if weight[a] > 0:
             count += 1.0
+        pu[0, a] = 1.0
+        pv[0, a] = 1.0
     counts[v] = count
     nx, ny, nz = normals[v, 0], normals[v, 1], normals[v, 2]
     ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
     fitted = False
     for step in range(iterations):
-        moments[:] = 0.0
-        right[:] = 0.0
         for a in range(size):
             u = ox[a] * ax + oy[a] * ay + oz[a] * az
             w2 = ox[a] * bx + oy[a] * by + oz[a] * bz
-            h = ox[a] * nx + oy[a] * ny + oz[a] * nz
-            up[0] = 1.0
-            vp[0] = 1.0
+            lift[a] = weight[a] * (ox[a] * nx + oy[a] * ny + oz[a] * nz)
             for p in range(1, top + 1):
-                up[p] = up[p - 1] * u
-                vp[p] = vp[p - 1] * w2
-            wt = weight[a]
-            for total in range(top + 1):
-                for k in range(total + 1):
-                    moments[total - k, k] += wt * up[total - k] * vp[k]
-            for t in range(n_terms):
-                right[t] += wt * h * up[exponents[t, 0]] * vp[exponents[t, 1]]
+                pu[p, a] = pu[p - 1, a] * u
+                pv[p, a] = pv[p - 1, a] * w2
+        for total in range(top + 1):
+            for k in range(total + 1):
+                moments[total - k, k] = _weighted_dot(weight, pu[total - k], pv[k], size)
+        for t in range(n_terms):
+            right[t] = _weighted_dot(lift, pu[exponents[t, 0]], pv[exponents[t, 1]], size)
         fitted = False
         for d in range(degree, 1, -1):
             m = (d + 1) * (d + 2) // 2
@@ -983,14 +1032,14 @@ def _fit_one(vertices, normals, radius, degree, iterations, exponents, min_pivot
                 for c in range(m):
                     matrix[r, c] = moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
             for r in range(m):
-                scale[r] = math.sqrt(max(matrix[r, r], 2.2250738585072014e-308))
+                scale[r] = 1.0 / math.sqrt(max(matrix[r, r], 2.2250738585072014e-308))
             for r in range(m):
                 for c in range(m):
-                    matrix[r, c] = matrix[r, c] / scale[r] / scale[c]
-                solution[r] = right[r] / scale[r]
+                    matrix[r, c] = matrix[r, c] * scale[r] * scale[c]
+                solution[r] = right[r] * scale[r]
             if _cholesky_solve(matrix, solution, low, m, min_pivot):
                 for r in range(6):
-                    solution[r] = solution[r] / scale[r]
+                    solution[r] = solution[r] * scale[r]
                 fitted = True
                 break
         if step + 1 < iterations and fitted:
@@ -1009,7 +1058,30 @@ def _fit_one(vertices, normals, radius, degree, iterations, exponents, min_pivot
     t1s[v, 0], t1s[v, 1], t1s[v, 2] = ax, ay, az
     t2s[v, 0], t2s[v, 1], t2s[v, 2] = bx, by, bz
     ns[v, 0], ns[v, 1], ns[v, 2] = nx, ny, nz
-    return members, ox, oy, oz, weight
+    return members, work
+
+
+@nb.njit(parallel=True, **_JIT)
+def cell_centres(vertices, cells):
+    """``neighborhoods._ball_sums``'s (C, 3) centroids of cells (faces or edges) and (C,) their reach.
+
+    The reach is the largest distance from the centroid to a corner.
+    """
+    n, corners = cells.shape
+    centres = np.zeros((n, 3))
+    reach = np.zeros(n)
+    for c in nb.prange(n):
+        for k in range(corners):
+            for a in range(3):
+                centres[c, a] += vertices[cells[c, k], a]
+        for a in range(3):
+            centres[c, a] /= corners
+        for k in range(corners):
+            d = 0.0
+            for a in range(3):
+                d += (vertices[cells[c, k], a] - centres[c, a]) ** 2
+            reach[c] = max(reach[c], math.sqrt(d))
+    return centres, reach
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -1017,40 +1089,47 @@ def ball_face_sums(vertices, faces, centroids, values, radius, cutoff, n_chunks)
     """``neighborhoods.ball_face_sums`` for one group of faces: (V, k) sums of ``ratio * values``.
 
     Faces are found by their ``centroids`` within ``cutoff`` (radius + the
-    group's largest reach) on a grid of cells (:func:`_grid`).
+    group's largest reach) on a grid of cells (:func:`_grid`); their corners,
+    centroids and values are copied in grid order first, so that a ball reads
+    contiguous memory.
     """
     n = vertices.shape[0]
+    n_faces = faces.shape[0]
     n_values = values.shape[1]
-    keys, order, lo, cell = _grid(centroids, cutoff)
+    grid = _grid(centroids, cutoff)
+    order = grid[0]
+    points = np.empty((n_faces, 4, 3))  # the three corners and the centroid
+    sorted_values = np.empty((n_faces, n_values))
+    for k in nb.prange(n_faces):
+        f = order[k]
+        for corner in range(3):
+            points[k, corner] = vertices[faces[f, corner]]
+        points[k, 3] = centroids[f]
+        sorted_values[k] = values[f]
     out = np.zeros((n, n_values))
-    _, centres, _, _ = _grid(vertices, cell)  # centres in grid order: consecutive balls share cells (cache)
+    centres = _grid(vertices, grid[4])[0]  # centres in grid order: consecutive balls share cells (cache)
     n_chunks = max(min(n, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         members = np.empty(64, np.int64)
         for rank in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
-            v = centres[rank]
-            members = _face_ratio_sums(vertices, faces, values, radius, cutoff, cell, centroids, keys, order, lo,
-                                       v, members, out)
+            members = _face_ratio_sums(vertices, points, grid, sorted_values, radius, cutoff, centres[rank],
+                                       members, out)
     return out
 
 
 @nb.njit(**_JIT)
-def _face_ratio_sums(vertices, faces, values, radius, cutoff, cell, centroids, keys, order, lo, v, members, out):
+def _face_ratio_sums(vertices, points, grid, values, radius, cutoff, v, members, out):
     """One vertex of :func:`ball_face_sums`; returns the (possibly grown) member buffer."""
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
-    members, size = _ball_members(centroids, keys, order, lo, cell, cx, cy, cz, cutoff, members)
+    members, size = _ball_members(points[:, 3], grid, cx, cy, cz, cutoff, members)
     for a in range(size):
         f = members[a]
         low = np.inf
         high = -np.inf
         for corner in range(4):
-            if corner < 3:
-                px = vertices[faces[f, corner], 0]
-                py = vertices[faces[f, corner], 1]
-                pz = vertices[faces[f, corner], 2]
-            else:
-                px, py, pz = centroids[f, 0], centroids[f, 1], centroids[f, 2]
-            dx, dy, dz = px - cx, py - cy, pz - cz
+            dx = points[f, corner, 0] - cx
+            dy = points[f, corner, 1] - cy
+            dz = points[f, corner, 2] - cz
             dist = math.sqrt(dx * dx + dy * dy + dz * dz)
             low = min(low, dist)
             high = max(high, dist)

@@ -41,6 +41,10 @@ DEFAULT_RADIUS_FACTOR = 2.5
 #: Centres per chunk of a ball query (bounds the memory of the pair lists).
 CHUNK = 32768
 
+#: Cells of different sizes share one search while its radius (radius + largest reach) grows
+#: by at most this factor over that of their smallest size class.
+GROUP_GROWTH = 1.5
+
 
 def default_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
     """``DEFAULT_RADIUS_FACTOR`` times the mean edge length (0 for a mesh without edges)."""
@@ -73,18 +77,20 @@ def _pairs(tree, centers: np.ndarray, cutoff: float) -> tuple[np.ndarray, np.nda
     return found["i"].astype(np.int64), found["j"].astype(np.int64)
 
 
-def vertex_pairs_in_ball(points: np.ndarray, radius: float, *, chunk_size: int = CHUNK
-                         ) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+def vertex_pairs_in_ball(points: np.ndarray, radius: float, *, centres: np.ndarray | None = None,
+                         chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """Yield ``(chunk, centre, neighbour)``: every point within ``radius`` of each centre.
 
-    ``centre`` indexes all points (absolute), grouped by chunk of ``chunk_size``
-    centres; ``neighbour`` is the point within the ball (the centre itself included).
+    The centres are the points ``centres`` (default: all), taken by chunk of
+    ``chunk_size``; ``centre`` indexes them (absolute: ``chunk.start`` and up),
+    ``neighbour`` indexes ``points``: the point within the ball (the centre itself included).
     """
     from scipy.spatial import cKDTree
 
     tree = cKDTree(points)
-    for chunk in _chunks(points.shape[0], chunk_size):
-        i, j = _pairs(tree, points[chunk], radius)
+    centres = np.arange(points.shape[0]) if centres is None else centres
+    for chunk in _chunks(centres.shape[0], chunk_size):
+        i, j = _pairs(tree, points[centres[chunk]], radius)
         yield chunk, i + chunk.start, j
 
 
@@ -121,6 +127,27 @@ def segment_in_ball_lengths(starts: np.ndarray, ends: np.ndarray, centers: np.nd
     return inside * np.sqrt(a)
 
 
+def _size_groups(reach: np.ndarray, radius: float) -> list[np.ndarray | slice]:
+    """The cells by group of similar ``reach``, smallest first (see :func:`_ball_sums`).
+
+    A group is an index array, or ``slice(None)`` when all cells form one.
+    """
+    _, exponent = np.frexp(np.maximum(reach, np.finfo(float).tiny))
+    level = exponent - exponent.min()
+    largest = np.zeros(level.max() + 1)
+    np.maximum.at(largest, level, reach)
+    label = np.zeros(largest.size, dtype=np.int64)
+    first = 0
+    for k in np.flatnonzero(largest):
+        if radius + largest[k] > GROUP_GROWTH * (radius + largest[first]):
+            first = k
+        label[k] = first
+    firsts = np.unique(label[largest > 0])
+    if firsts.size == 1:
+        return [slice(None)]
+    return [np.flatnonzero(label[level] == first) for first in firsts]
+
+
 def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: np.ndarray,
                usable: np.ndarray | None, weight, compiled: str | None = None) -> np.ndarray:
     """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices."""
@@ -134,18 +161,20 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     out = np.zeros((n, values.shape[1]))
     if cells.shape[0] == 0:
         return out
-    corners = vertices[cells]
-    centres = corners.mean(axis=1)
-    reach = np.linalg.norm(corners - centres[:, None, :], axis=2).max(axis=1)
+    kernels = numba_kernels() if compiled is not None else None
+    if kernels is not None:
+        centres, reach = kernels.cell_centres(vertices, cells)
+    else:
+        corners = vertices[cells]
+        centres = corners.mean(axis=1)
+        reach = np.linalg.norm(corners - centres[:, None, :], axis=2).max(axis=1)
     # Cells are searched by their centres within radius + their own reach. One
     # search radius for all would be set by the largest cell: on a mesh with a
     # few long edges (a scan with a coarse patch) every ball would then gather
-    # thousands of small cells. So cells are grouped by size (powers of two of
-    # their reach), each group searched with its own largest reach.
-    _, exponent = np.frexp(np.maximum(reach, np.finfo(float).tiny))
-    kernels = numba_kernels() if compiled is not None else None
-    for level in np.unique(exponent):
-        group = np.flatnonzero(exponent == level)
+    # thousands of small cells. So cells are grouped by size: each group is
+    # searched with its own largest reach, and a group takes the next power of
+    # two of reach as long as its search radius grows by at most GROUP_GROWTH.
+    for group in _size_groups(reach, radius):
         if kernels is not None:
             out += getattr(kernels, compiled)(vertices, cells[group], centres[group],
                                               np.ascontiguousarray(values[group]), radius,
@@ -155,8 +184,8 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
         cutoff = radius + reach[group].max()
         for chunk in _chunks(n):
             i, c = _pairs(tree, vertices[chunk], cutoff)
-            c = group[c]
-            weights = weight(corners[c], vertices[chunk][i], radius)
+            c = np.arange(cells.shape[0])[group][c]
+            weights = weight(vertices[cells[c]], vertices[chunk][i], radius)
             gather = sp.csr_matrix((weights, (i, c)), shape=(chunk.stop - chunk.start, values.shape[0]))
             out[chunk] += np.asarray(gather @ values)
     return out

@@ -181,29 +181,32 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
         if candidates.size == 0:
             continue
         block = matrix[candidates, :m, :m]
-        scale = np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
-        scaled = block / scale[:, :, None] / scale[:, None, :]
-        solution, ok = _cholesky_solve(scaled, right[candidates, :m] / scale)
+        scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
+        scaled = block * scale[:, :, None] * scale[:, None, :]
+        solution, ok = _cholesky_solve(scaled, right[candidates, :m] * scale)
         chosen = candidates[ok]
         if chosen.size:
-            out[chosen] = (solution[ok] / scale[ok])[:, :6]
+            out[chosen] = (solution[ok] * scale[ok])[:, :6]
             todo[chosen] = False
     return out
 
 
 def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
-             iterations: int = ITERATIONS, chunk_size: int = CHUNK_SIZE):
-    """Fit a weighted jet at every vertex, re-estimating its frame from each fit.
+             iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE):
+    """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
     Parameters
     ----------
     vertices : ndarray of shape (V, 3)
     normals : ndarray of shape (V, 3)
-        Unit normals of the first frame (finite everywhere).
+        Unit normals of the first frame (finite at the centres).
     radius : float
         Radius of the ball of each fit (> 0).
     degree : int, default: DEGREE
     iterations : int, default: ITERATIONS
+    centres : ndarray of int, optional
+        The vertices to fit (default: all). The rows of the others are NaN
+        (counts 0); every vertex still takes part in the fits around it.
 
     Returns
     -------
@@ -215,24 +218,25 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     counts : ndarray of shape (V,)
         Points with non-zero weight in each ball.
     """
-    kernels = numba_kernels()
-    if kernels is not None and vertices.shape[0]:
-        coefficients, t1, t2, n, counts = kernels.fit_jets(
-            vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT,
-            64 * kernels.threads())
-        return coefficients, (t1, t2, n), counts
     n = vertices.shape[0]
-    t1, t2 = tangent_basis(normals)
-    frame = [t1, t2, normals.copy()]
+    centres = np.arange(n) if centres is None else np.asarray(centres, dtype=np.int64)
+    kernels = numba_kernels()
+    if kernels is not None and n:
+        coefficients, t1, t2, normal, counts = kernels.fit_jets(
+            vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, centres,
+            64 * kernels.threads())
+        return coefficients, (t1, t2, normal), counts
+    frame = [np.full((n, 3), np.nan) for _ in range(3)]
     coefficients = np.full((n, 6), np.nan)
     counts = np.zeros(n)
-    for chunk, centre, neighbour in vertex_pairs_in_ball(vertices, radius, chunk_size=chunk_size):
-        size = chunk.stop - chunk.start
+    for chunk, centre, neighbour in vertex_pairs_in_ball(vertices, radius, centres=centres, chunk_size=chunk_size):
+        index = centres[chunk]
+        size = index.size
         rows = centre - chunk.start
-        offsets = (vertices[neighbour] - vertices[centre]) / radius
+        offsets = (vertices[neighbour] - vertices[index[rows]]) * (1.0 / radius)
         weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
-        local = [f[chunk] for f in frame]
+        local = [*tangent_basis(normals[index]), normals[index]]
         for step in range(iterations):
             matrix, right = _fit_chunk(offsets, rows, size, local, weights, degree)
             fitted = _solve(matrix, right, count, degree)
@@ -244,10 +248,17 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
                 new_normal = np.where(keep, tilted, local[2])
                 local = [*tangent_basis(new_normal), new_normal]
         for f, part in zip(frame, local):
-            f[chunk] = part
-        coefficients[chunk] = fitted
-        counts[chunk] = count
+            f[index] = part
+        coefficients[index] = fitted
+        counts[index] = count
     return coefficients, tuple(frame), counts
+
+
+def jet_normals(coefficients: np.ndarray, frame: tuple) -> np.ndarray:
+    """(V, 3) unit normals of the fitted jets, ``(n - c10 t1 - c01 t2) / sqrt(1 + c10^2 + c01^2)``."""
+    t1, t2, normal = frame
+    p, q = coefficients[:, 1:2], coefficients[:, 2:3]
+    return (normal - p * t1 - q * t2) / np.sqrt(1 + p * p + q * q)
 
 
 def shape_operators(coefficients: np.ndarray, frame: tuple, radius: float):
@@ -268,8 +279,7 @@ def shape_operators(coefficients: np.ndarray, frame: tuple, radius: float):
     jacobian = np.stack([t1 + p[:, None] * normal, t2 + q[:, None] * normal], axis=2)  # (V, 3, 2)
     tensor = jacobian @ middle @ jacobian.transpose(0, 2, 1)
     six = tensor[:, [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]
-    fitted = (normal - p[:, None] * t1 - q[:, None] * t2) / width[:, None]
-    return six, fitted
+    return six, jet_normals(coefficients, frame)
 
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
