@@ -54,6 +54,32 @@ def _mean_edge_length(vertices, edges):
     return total / edges.shape[0] if edges.shape[0] else 0.0
 
 
+@nb.njit(parallel=True, **_JIT)
+def face_cross_products(vertices, faces):
+    """``geometry.face_cross_products``: (F, 3) ``cross(b - a, c - a)`` of every face."""
+    out = np.empty((faces.shape[0], 3))
+    for f in nb.prange(faces.shape[0]):
+        out[f, 0], out[f, 1], out[f, 2] = _face_cross(vertices, faces[f, 0], faces[f, 1], faces[f, 2])
+    return out
+
+
+@nb.njit(**_JIT)
+def vertex_normal_sums(cross, faces, n_vertices):
+    """(V, 3) sums of the face cross products over the faces of each vertex, in face order (as ``np.bincount``)."""
+    out = np.zeros((n_vertices, 3))
+    for f in range(faces.shape[0]):
+        for k in range(3):
+            v = faces[f, k]
+            for a in range(3):
+                out[v, a] += cross[f, a]
+    return out
+
+
+def mean_edge_length(vertices, edges):
+    """``geometry.mean_edge_length``."""
+    return _mean_edge_length(vertices, edges)
+
+
 # -- topology -------------------------------------------------------------------
 def threads() -> int:
     """The threads numba's parallel kernels use (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``)."""
@@ -345,6 +371,24 @@ def _tangent_eigen(xx, yy, zz, xy, xz, yz, nx, ny, nz, rotate, mean_from_trace):
     if rotate:
         alx, aly, alz, acx, acy, acz = acx, acy, acz, alx, aly, alz
     return half_sum - radius, half_sum + radius, acx, acy, acz, alx, aly, alz
+
+
+@nb.njit(parallel=True, **_JIT)
+def principal_from_shape_operator(tensor, normals, rotate, mean_from_trace):
+    """``_tensors.principal_from_shape_operator``: (N,) k_min, k_max and (N, 3) dir_min, dir_max."""
+    n = tensor.shape[0]
+    k_min = np.empty(n)
+    k_max = np.empty(n)
+    dir_min = np.empty((n, 3))
+    dir_max = np.empty((n, 3))
+    for i in nb.prange(n):
+        lo, hi, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
+            tensor[i, 0], tensor[i, 1], tensor[i, 2], tensor[i, 3], tensor[i, 4], tensor[i, 5],
+            normals[i, 0], normals[i, 1], normals[i, 2], rotate, mean_from_trace)
+        k_min[i], k_max[i] = lo, hi
+        dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
+        dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5
+    return k_min, k_max, dir_min, dir_max
 
 
 # -- symmetric 3x3 eigen-decomposition -----------------------------------------

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._backend import numba_kernels
+
 __all__ = ["outer6", "apply6", "tangent_basis", "principal_from_shape_operator"]
 
 
@@ -70,6 +72,9 @@ def principal_from_shape_operator(tensor: np.ndarray, normals: np.ndarray, *, ro
     k_min, k_max : ndarray of shape (N,)
     dir_min, dir_max : ndarray of shape (N, 3)
     """
+    kernels = numba_kernels()
+    if kernels is not None:
+        return kernels.principal_from_shape_operator(tensor, normals, rotate, mean_from_trace)
     t1, t2 = tangent_basis(normals)
     s1 = apply6(tensor, t1)
     a = np.einsum("ij,ij->i", t1, s1)

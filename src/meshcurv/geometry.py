@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._backend import numba_kernels
+
 __all__ = [
     "face_cross_products",
     "face_areas",
@@ -33,6 +35,9 @@ def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
     Written out component by component (faster than :func:`numpy.cross`, same values).
     """
+    kernels = numba_kernels()
+    if kernels is not None:
+        return kernels.face_cross_products(vertices, faces)
     a = vertices[faces[:, 0]]
     u = vertices[faces[:, 1]] - a
     w = vertices[faces[:, 2]] - a
@@ -89,6 +94,9 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
     if cross is None:
         cross = face_cross_products(vertices, faces)
     n = vertices.shape[0]
+    kernels = numba_kernels()
+    if kernels is not None:
+        return normalize_normal_sums(kernels.vertex_normal_sums(cross, faces, n))
     flat = faces.ravel()
     summed = np.stack(
         [np.bincount(flat, weights=np.repeat(cross[:, k], 3), minlength=n) for k in range(3)], axis=1
@@ -114,6 +122,9 @@ def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     """Mean length of the given (E, 2) edges (0 when there are none)."""
     if edges.shape[0] == 0:
         return 0.0
+    kernels = numba_kernels()
+    if kernels is not None:
+        return float(kernels.mean_edge_length(vertices, edges))
     return float(edge_lengths(vertices, edges).mean())
 
 

@@ -35,9 +35,10 @@ def prepare(vertices: np.ndarray, topology: MeshTopology):
     the defects and vertices without a normal.
     """
     cross = face_cross_products(vertices, topology.faces)
-    degenerate = degenerate_faces(vertices, topology, cross=cross)
+    degenerate = degenerate_faces(vertices, topology)
     defects = defects_without_boundary(topology, degenerate)
-    normals = vertex_normals(vertices, topology.faces[~degenerate])
+    kept = ~degenerate
+    normals = vertex_normals(vertices, topology.faces[kept], cross=cross[kept])
     valid = ~defects.invalid_vertices & np.isfinite(normals).all(axis=1)
     return cross, degenerate, defects, normals, valid
 

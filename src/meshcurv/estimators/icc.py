@@ -79,6 +79,9 @@ NORMAL_DEGREE = 3
 #: The normals are fitted over balls this many times the measure radius.
 NORMAL_RADIUS_RATIO = 3.0
 
+#: Fits per normal: the first in the frame of the mean of the face normals, the next in that of the first fit.
+NORMAL_ITERATIONS = 2
+
 #: The noise level is measured with degree-2 jets over balls of this many mean edge lengths.
 NOISE_FIT_RADIUS = 2.0
 
@@ -124,7 +127,7 @@ def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray,
     ``normals`` (the first frames) is kept where no jet could be fitted.
     """
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
-    coefficients, frame, _ = fit_jets(vertices, start, radius, degree=NORMAL_DEGREE)
+    coefficients, frame, _ = fit_jets(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS)
     fitted = jet_normals(coefficients, frame)
     usable = valid & np.isfinite(fitted).all(axis=1)
     return np.where(usable[:, None], fitted, normals)
@@ -179,13 +182,13 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
 
     stages.start("compute face measures")
     faces = topology.faces
-    usable = ~degenerate & np.isfinite(normals[faces]).all(axis=(1, 2))
+    faces = faces[~degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)]
     kernels = numba_kernels()
     measure = kernels.icc_face_measures if kernels is not None else face_measures
-    measures = measure(vertices, faces[usable], normals)
+    measures = measure(vertices, faces, normals)
 
     stages.start("sum over balls")
-    summed = ball_face_sums(vertices, faces[usable], radius, measures)
+    summed = ball_face_sums(vertices, faces, radius, measures)
 
     stages.start("retrieve curvatures")
     area = summed[:, 0]

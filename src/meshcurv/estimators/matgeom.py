@@ -99,7 +99,7 @@ def _vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, out_of_range):
     lengths = _row_norms(edge_vectors)
     with np.errstate(invalid="ignore", divide="ignore"):
         edge_vectors = edge_vectors / lengths[:, None]
-        lengths = lengths / lengths.mean()
+        lengths = lengths / (lengths.mean() if lengths.size else 1.0)  # no edges: nothing to scale
     normals = _matgeom_face_normals(vertices, faces)
     n1 = normals[ef1]
     n2 = normals[ef2]
