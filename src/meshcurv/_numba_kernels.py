@@ -889,9 +889,9 @@ def _grid(points, reach):
 def _ball_members(points, grid, cx, cy, cz, cutoff, out):
     """Ranks of the points within ``cutoff`` of ``(cx, cy, cz)`` written to ``out`` (grown when full).
 
-    ``points`` are in the order of ``grid`` (:func:`_grid`, ``cutoff`` at
-    most its cell side), so that the three cells of a column around the centre
-    are one contiguous run of memory. Returns ``(out, count)``.
+    ``points`` are in the order of ``grid`` (:func:`_grid`), so that the
+    cells of a column around the centre (``ceil(cutoff / cell)`` each way) are
+    one contiguous run of memory. Returns ``(out, count)``.
     """
     _, starts, levels, lo, cell, nx, ny = grid
     fx = (cx - lo[0]) / cell
@@ -899,42 +899,46 @@ def _ball_members(points, grid, cx, cy, cz, cutoff, out):
     fz = (cz - lo[2]) / cell
     cutoff2 = cutoff * cutoff
     count = 0
-    if not (fx > -2 and fy > -2 and fz > -2 and fx < nx + 1 and fy < ny + 1 and fz < 2.0**61):
+    span = np.int64(math.ceil(cutoff / cell))  # cells each way from the centre's
+    if not (fx > -1 - span and fy > -1 - span and fz > -1 - span and fx < nx + span and fy < ny + span
+            and fz < 2.0**61):
         return out, count
     bx = np.int64(math.floor(fx))
     by = np.int64(math.floor(fy))
     bz = np.int64(math.floor(fz))
-    for ix in range(max(bx - 1, 0), min(bx + 2, nx)):
-        for iy in range(max(by - 1, 0), min(by + 2, ny)):
+    for ix in range(max(bx - span, 0), min(bx + span + 1, nx)):
+        for iy in range(max(by - span, 0), min(by + span + 1, ny)):
             c = ix * ny + iy
             k = starts[c]
             last = starts[c + 1]
             high = last
-            while k < high:  # first rank of the column at z cell bz - 1 or above
+            while k < high:  # first rank of the column at z cell bz - span or above
                 middle = (k + high) // 2
-                if levels[middle] < bz - 1:
+                if levels[middle] < bz - span:
                     k = middle + 1
                 else:
                     high = middle
-            while k < last and levels[k] <= bz + 1:
-                dx = points[k, 0] - cx
-                dy = points[k, 1] - cy
-                dz = points[k, 2] - cz
-                if dx * dx + dy * dy + dz * dz <= cutoff2:
-                    if count == out.shape[0]:
-                        grown = np.empty(2 * out.shape[0], np.int64)
-                        grown[:count] = out[:count]
-                        out = grown
-                    out[count] = k
-                    count += 1
-                k += 1
+            end = k
+            while end < last and levels[end] <= bz + span:
+                end += 1
+            if count + end - k > out.shape[0]:
+                grown = np.empty(2 * (count + end - k), np.int64)
+                grown[:count] = out[:count]
+                out = grown
+            for j in range(k, end):  # branch-free: every candidate is written, the inside ones kept
+                dx = points[j, 0] - cx
+                dy = points[j, 1] - cy
+                dz = points[j, 2] - cz
+                out[count] = j
+                count += dx * dx + dy * dy + dz * dz <= cutoff2
     return out, count
 
 
 @nb.njit(**_JIT)
 def _cholesky_solve(a, b, low, m, min_pivot):
-    """Solve ``a[:m, :m] x = b[:m]`` (symmetric, unit diagonal) in place of ``b``; False if a pivot <= min_pivot.
+    """Solve ``a[:m, :m] x = b[:m]`` in place of ``b``; False if a pivot <= min_pivot.
 
+    ``a`` is symmetric with a unit diagonal; only its lower triangle is read.
     The same operations in the same order as ``quadric._cholesky_solve``; ``low`` is scratch.
     """
     for k in range(m):
@@ -1046,8 +1050,7 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
         ox[a], oy[a], oz[a] = x, y, z
         w = max(1.0 - (x * x + y * y + z * z), 0.0)
         weight[a] = w * w
-        if weight[a] > 0:
-            count += 1.0
+        count += weight[a] > 0
         pu[0, a] = 1.0
         pv[0, a] = 1.0
     counts[v] = count
@@ -1056,12 +1059,13 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
     fitted = False
     for step in range(iterations):
         for a in range(size):
-            u = ox[a] * ax + oy[a] * ay + oz[a] * az
-            w2 = ox[a] * bx + oy[a] * by + oz[a] * bz
+            pu[1, a] = ox[a] * ax + oy[a] * ay + oz[a] * az
+            pv[1, a] = ox[a] * bx + oy[a] * by + oz[a] * bz
             lift[a] = weight[a] * (ox[a] * nx + oy[a] * ny + oz[a] * nz)
-            for p in range(1, top + 1):
-                pu[p, a] = pu[p - 1, a] * u
-                pv[p, a] = pv[p - 1, a] * w2
+        for p in range(2, top + 1):  # power by power over all members (no chain of products per member)
+            for a in range(size):
+                pu[p, a] = pu[p - 1, a] * pu[1, a]
+                pv[p, a] = pv[p - 1, a] * pv[1, a]
         for total in range(top + 1):
             for k in range(total + 1):
                 moments[total - k, k] = _weighted_dot(weight, pu[total - k], pv[k], size)
@@ -1073,13 +1077,12 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
             if count < m:
                 continue
             for r in range(m):
-                for c in range(m):
-                    matrix[r, c] = moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
-            for r in range(m):
-                scale[r] = 1.0 / math.sqrt(max(matrix[r, r], 2.2250738585072014e-308))
-            for r in range(m):
-                for c in range(m):
-                    matrix[r, c] = matrix[r, c] * scale[r] * scale[c]
+                scale[r] = 1.0 / math.sqrt(max(moments[2 * exponents[r, 0], 2 * exponents[r, 1]],
+                                               2.2250738585072014e-308))
+            for r in range(m):  # the lower triangle: all the Cholesky factorization reads
+                for c in range(r + 1):
+                    matrix[r, c] = (moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
+                                    * scale[r] * scale[c])
                 solution[r] = right[r] * scale[r]
             if _cholesky_solve(matrix, solution, low, m, min_pivot):
                 for r in range(6):
@@ -1165,24 +1168,26 @@ def ball_face_sums(vertices, faces, centroids, values, radius, cutoff, n_chunks)
 def _face_ratio_sums(vertices, points, grid, values, radius, cutoff, v, members, out):
     """One vertex of :func:`ball_face_sums`; returns the (possibly grown) member buffer."""
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+    radius2 = radius * radius
     members, size = _ball_members(points[:, 3], grid, cx, cy, cz, cutoff, members)
     for a in range(size):
         f = members[a]
-        low = np.inf
+        low = np.inf  # squared distances: the square roots only for faces the sphere cuts
         high = -np.inf
         for corner in range(4):
             dx = points[f, corner, 0] - cx
             dy = points[f, corner, 1] - cy
             dz = points[f, corner, 2] - cz
-            dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+            dist = dx * dx + dy * dy + dz * dz
             low = min(low, dist)
             high = max(high, dist)
-        if high <= radius:
+        if high <= radius2:
             ratio = 1.0
-        elif low >= radius:
+        elif low >= radius2:
             continue
         else:
-            ratio = (radius - low) / (high - low)
+            low = math.sqrt(low)
+            ratio = (radius - low) / (math.sqrt(high) - low)
         for k in range(values.shape[1]):
             out[v, k] += ratio * values[f, k]
     return members
