@@ -53,13 +53,6 @@ def enclosed_volume(vertices, faces):
     return np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum() / 6
 
 
-def boundary_vertices(faces):
-    """Vertices on an edge that belongs to one face only, counted from the faces."""
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
-    return np.unique(unique[counts == 1]).size
-
-
 def two_spheres():
     first, second = shapes.icosphere(4, radius=1.0), shapes.icosphere(4, radius=1.0, center=(5, 0, 0))
     vertices = np.concatenate([first.vertices, second.vertices])
@@ -76,7 +69,7 @@ def write_dozen(folder: pathlib.Path) -> dict:
         meshcurv.write_mesh(folder / name, vertices, faces)
         expected[name] = dict(n_vertices=len(vertices), n_faces=len(faces), area=triangle_area(vertices, faces),
                               volume=enclosed_volume(vertices, faces) if facts["n_boundary_loops"] == 0 else None,
-                              n_invalid=boundary_vertices(np.asarray(faces)), **facts)
+                              n_invalid=0, **facts)  # icc keeps the boundary vertices of the open ones
 
     for radius, extension in zip(RADII, (".obj", ".off", ".ply", ".npz")):
         sphere = shapes.icosphere(8, radius=radius)
@@ -232,9 +225,11 @@ def test_run_refuses_bad_options_before_any_work(tmp_path):
     with pytest.raises(InvalidOptionError, match="unknown method 'gauss'"):
         batch.run(folder, out_dir, scheduler=dead, method="gauss")
     with pytest.raises(InvalidOptionError, match="method 'normal_cycle' does not take the option `radius`"):
-        batch.run(folder, out_dir, scheduler=dead, radius=0.1)
+        batch.run(folder, out_dir, scheduler=dead, method="normal_cycle", radius=0.1)
+    with pytest.raises(InvalidOptionError, match="method 'icc' does not take the option `smoothing_steps`"):
+        batch.run(folder, out_dir, scheduler=dead, smoothing_steps=2)
     with pytest.raises(InvalidOptionError, match="`radius` must be a positive finite number"):
-        batch.run(folder, out_dir, scheduler=dead, method="icc", radius=-1.0)
+        batch.run(folder, out_dir, scheduler=dead, radius=-1.0)
     with pytest.raises(InvalidOptionError, match="unknown orient 'inward'"):
         batch.run(folder, out_dir, scheduler=dead, orient="inward")
     with pytest.raises(InvalidOptionError, match="unknown output_format 'obj'"):
@@ -381,24 +376,24 @@ def test_a_second_run_does_no_work(first_run, dozen, client):
 def test_overwrite_and_results_of_other_options(tmp_path, client):
     paths = write_spheres(tmp_path / "in", 2, 4)
     out_dir = tmp_path / "out"
-    batch.run(paths, out_dir, client=client, smoothing_steps=3)  # the default, spelt out
+    batch.run(paths, out_dir, client=client, method="icc")  # the default, spelt out
     first = (out_dir / "sphere_000.ply").stat()
     # the same computation asked without the default: skipped
     assert (batch.run(paths, out_dir, client=client)["status"] == "skipped").all()
-    with pytest.raises(InvalidOptionError, match=r"holds results computed with method='normal_cycle', not "
-                                                 r"method='normal_cycle', smoothing_steps=1; pass overwrite=True"):
-        batch.run(paths, out_dir, client=client, smoothing_steps=1)
-    redone = batch.run(paths, out_dir, client=client, smoothing_steps=1, overwrite=True)
+    with pytest.raises(InvalidOptionError, match=r"holds results computed with method='icc', not "
+                                                 r"method='icc', radius=0.3; pass overwrite=True"):
+        batch.run(paths, out_dir, client=client, radius=0.3)
+    redone = batch.run(paths, out_dir, client=client, radius=0.3, overwrite=True)
     assert (redone["status"] == "computed").all()
     assert (out_dir / "sphere_000.ply").stat().st_ino != first.st_ino
     record = json.loads((out_dir / batch.RECORDS / "sphere_000.ply.json").read_text())
-    assert record["options"] == {"method": "normal_cycle", "smoothing_steps": 1}
+    assert record["options"] == {"method": "icc", "radius": 0.3}
     # a file of the same name that no batch wrote is not replaced silently
     small = shapes.icosphere(2)
     meshcurv.write_mesh(tmp_path / "in" / "sphere_002.ply", small.vertices, small.faces)
     meshcurv.write_mesh(out_dir / "sphere_002.ply", small.vertices, small.faces)
     with pytest.raises(MeshFileError, match=r"sphere_002\.ply: exists but was not written by meshcurv batch"):
-        batch.run(tmp_path / "in", out_dir, client=client, smoothing_steps=1)
+        batch.run(tmp_path / "in", out_dir, client=client, radius=0.3)
 
 
 def test_a_worker_killed_mid_run_has_its_meshes_run_again(tmp_path, client):

@@ -173,8 +173,10 @@ def test_a_vertex_of_valence_1000(method):
     assert r.valid[n] and r.valid[n + 1]
 
 
-def test_every_defect_at_once():
-    # the hole, the fin and a collinear face together, far apart on the torus
+@pytest.mark.parametrize("method", ["normal_cycle", "icc"])
+def test_every_defect_at_once(method):
+    # the hole, the fin and a collinear face together, far apart on the torus; icc keeps
+    # the rim of the hole (a boundary is no defect to it), normal_cycle marks it
     V, F = TORUS.vertices.copy(), TORUS.faces
     n = V.shape[0]
     hole_faces = np.flatnonzero((F == 0).any(axis=1))
@@ -187,11 +189,12 @@ def test_every_defect_at_once():
     vertices = np.vstack([V, V[fin[0][0]] + [0, 0, 5.0]])
     faces = np.vstack([F[keep], fin])
     with pytest.warns(MeshQualityWarning) as record:
-        r = meshcurv.principal_curvatures(vertices, faces)
+        r = meshcurv.principal_curvatures(vertices, faces, method=method)
     assert len(record) == 1
     message = str(record[0].message)
-    for word in ("boundary", "non-manifold", "zero-area", "unreferenced"):
+    for word in ("non-manifold", "zero-area", "unreferenced"):
         assert word in message
+    assert ("boundary" in message) == (method == "normal_cycle")
     d = r.diagnosis
     assert d.n_nonmanifold_edges == 1 and d.n_degenerate_faces == 1 and d.n_unreferenced_vertices == 1
     assert d.n_boundary_edges == 6 + 2 and d.n_boundary_loops == 2

@@ -69,9 +69,11 @@ def test_integral_float_faces_are_accepted():
     [
         ({"method": "rusinkiewicz_typo"}, "unknown method 'rusinkiewicz_typo'; choose one of 'normal_cycle', 'matgeom'"),
         ({"method": None}, "unknown method None"),
-        ({"smoothing_steps": -1}, "`smoothing_steps` must be an integer >= 0; got -1"),
-        ({"smoothing_steps": 2.5}, r"`smoothing_steps` must be an integer >= 0; got 2.5"),
-        ({"smoothing_steps": True}, "`smoothing_steps` must be an integer"),
+        ({"method": "normal_cycle", "smoothing_steps": -1}, "`smoothing_steps` must be an integer >= 0; got -1"),
+        ({"method": "normal_cycle", "smoothing_steps": 2.5},
+         r"`smoothing_steps` must be an integer >= 0; got 2.5"),
+        ({"method": "matgeom", "smoothing_steps": True}, "`smoothing_steps` must be an integer"),
+        ({"smoothing_steps": 2}, "method 'icc' does not take the option `smoothing_steps`"),
     ],
 )
 def test_bad_options(options, match):

@@ -170,7 +170,7 @@ def method_options(function):
                      help="Passes of 1-ring smoothing (normal_cycle, matgeom; default 3)."),
         click.option("--radius", type=click.FloatRange(min=0, min_open=True), default=None,
                      help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
-                          "default 2.5 x mean edge length)."),
+                          "default from the mesh: see `meshcurv methods`)."),
         click.option("--orient", type=click.Choice(["keep", "consistent", "outward"]), default=None,
                      help="Reorient the faces first (default: keep)."),
     ]
@@ -265,7 +265,8 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
 
 
 def _summary(path, vertices, faces, result, fields) -> str:
-    parameters = ", ".join(f"{key}={value}" for key, value in result.parameters.items())
+    parameters = ", ".join(f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
+                           for key, value in result.parameters.items())
     lines = [f"{path}: {len(vertices)} vertices, {len(faces)} faces; method {result.method}"
              + (f" ({parameters})" if parameters else "")]
     columns = ["min", "p5", "p25", "median", "p75", "p95", "max", "mean"]

@@ -46,6 +46,7 @@ import numpy as np
 
 from ._validation import check_choice, check_int_option, check_positive_float
 from .errors import InvalidOptionError, MeshFileError, MissingDependencyError
+from .estimators import DEFAULT_METHOD
 
 __all__ = ["run", "local_cluster", "process_mesh", "process_meshes", "expand_inputs", "COLUMNS", "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS"]
 
@@ -302,7 +303,7 @@ def _read_record(path: pathlib.Path) -> dict | None:
         return None
 
 
-def process_mesh(source, output, record, *, method: str = "normal_cycle", smoothing_steps: int | None = None,
+def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smoothing_steps: int | None = None,
                  radius: float | None = None, orient: str | None = None) -> dict:
     """Compute the curvatures of one mesh file, write the result and its record, return its summary row.
 
@@ -479,7 +480,7 @@ def _dashboard(client) -> str | None:
         return None
 
 
-def run(paths, out_dir, *, method: str = "normal_cycle", smoothing_steps: int | None = None,
+def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | None = None,
         radius: float | None = None, orient: str | None = None, output_format: str = "ply", client=None,
         scheduler: str | None = None, workers: int | None = None, overwrite: bool = False,
         progress: Callable[[int, int, int], None] | None = None):
@@ -492,7 +493,7 @@ def run(paths, out_dir, *, method: str = "normal_cycle", smoothing_steps: int | 
         Files inside ``out_dir`` are never inputs.
     out_dir : str or os.PathLike
         The folder of the results and the summary; created if needed.
-    method : str, default: 'normal_cycle'
+    method : str, default: 'icc'
         Any of :data:`meshcurv.METHODS`.
     smoothing_steps, radius, orient : optional
         As in :func:`meshcurv.principal_curvatures` (checked before anything runs).

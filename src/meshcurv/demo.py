@@ -50,7 +50,7 @@ def run_demo(output: str | os.PathLike = "torus_gaussian.png", *, overwrite: boo
         ("Gaussian K", result.gaussian, torus.gaussian),
     ]
     lines = [
-        f"torus R=30 r=10, {torus.vertices.shape[0]} vertices, {torus.faces.shape[0]} triangles",
+        f"torus R=30 r=10, {torus.vertices.shape[0]} vertices, {torus.faces.shape[0]} triangles, method {result.method}",
         f"{'field':<11} {'min':>10} {'max':>10} {'exact min':>10} {'exact max':>10} {'max |error|':>12}",
     ]
     for name, estimate, exact in rows:

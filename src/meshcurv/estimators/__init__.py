@@ -7,7 +7,11 @@ from typing import Callable
 
 from . import icc, matgeom, meyer, normal_cycle, normal_cycle_ball, quadric, rusinkiewicz
 
-__all__ = ["Estimator", "ESTIMATORS"]
+__all__ = ["Estimator", "ESTIMATORS", "DEFAULT_METHOD"]
+
+#: The method of :func:`meshcurv.principal_curvatures`, the CLI and batch runs when none is given: the
+#: lowest error on irregular and noisy meshes of the accuracy benchmark (see the README).
+DEFAULT_METHOD = "icc"
 
 
 @dataclass(frozen=True)
