@@ -72,7 +72,7 @@ MESHLAB_METHODS = ("Quadric Fitting", "Taubin approximation", "Normal Cycles")
 RADIUS_FACTORS = (1.0, 2.0, 4.0)
 
 TARGETS = {
-    "time_1m": 1.0,          # s at 1M, normal_cycle and matgeom
+    "time_1m": 1.0,          # s at 1M, the default method and matgeom
     "vs_libigl": 20.0,       # libigl / meshcurv at 1M
     "vs_vtk": 1.0,           # VTK / meshcurv at 1M (> 1)
     "vs_lower": 10.0,        # meshcurv / lower bound at 1M
@@ -598,7 +598,10 @@ class Bench:
 
         self.info = machine_info()
         self.default_backend = default_backend()
-        self.default_key = f"meshcurv/normal_cycle/{self.default_backend}"
+        from meshcurv.estimators import DEFAULT_METHOD
+
+        self.default_method = DEFAULT_METHOD
+        self.default_key = f"meshcurv/{DEFAULT_METHOD}/{self.default_backend}"
         found, missing = peers_installed() if args.peers else ({}, {})
         self.found, self.missing = found, missing
         keys = ["lower_bound"] + meshcurv_keys() + list(found)
@@ -666,7 +669,7 @@ class Bench:
                                                                     memory=False)
 
     def profile(self, v, f):
-        for method in ("normal_cycle", "matgeom"):
+        for method in dict.fromkeys((self.default_method, "normal_cycle", "matgeom")):
             key = f"meshcurv/{method}/{self.default_backend}"
             call = make_call(key, v, f)
             prof = cProfile.Profile()
@@ -738,7 +741,7 @@ def markdown(bench) -> str:
         f"numba {v.get('numba', 'not installed')} (llvmlite {v.get('llvmlite', '—')}); "
         f"meshcurv {v.get('meshcurv', '—')} at commit {info['commit'] or '?'}",
         f"- Peers: {peer_versions}" + (f" (rtree {v['rtree']})" if "rtree" in v else ""),
-        f"- meshcurv default backend: {bench.default_backend}; default method: normal_cycle "
+        f"- meshcurv default backend: {bench.default_backend}; default method: {bench.default_method} "
         f"(`{label_of(bench.default_key)}` is the reference of the ratios)",
     ]
     if bench.missing:
@@ -751,8 +754,8 @@ def markdown(bench) -> str:
         "process (numba rows: kernels loaded from the numba cache). Peak RSS: the high-water mark (`VmHWM`, "
         "what `ru_maxrss` reports without the value Linux carries over from the parent process) of that fresh "
         "process after the call (interpreter, libraries and the input arrays included); bytes/vertex = peak "
-        "RSS / V. `÷ lower` = time / lower bound; `÷ default` = time / meshcurv normal_cycle (default "
-        "backend); `libigl ÷`, `VTK ÷` = their time / this time (how many times faster than them). "
+        "RSS / V. `÷ lower` = time / lower bound; `÷ default` = time / meshcurv's default method "
+        f"({bench.default_method}, default backend); `libigl ÷`, `VTK ÷` = their time / this time (how many times faster than them). "
         f"Budget: {args.budget:.0f} s per call (trimesh {args.trimesh_budget:.0f} s); 'est.' = linear "
         "extrapolation from the previous size, not run.",
         "",
@@ -788,7 +791,8 @@ def markdown(bench) -> str:
     lines += ["## Targets", "", "| target | measured | |", "|---|---|---|"]
     if one_m:
         lb = t(one_m, "lower_bound")
-        for method in ("normal_cycle", "matgeom"):
+        # the targets are the default method's and matgeom's; normal_cycle (the fastest) for comparison
+        for method in dict.fromkeys((bench.default_method, "matgeom", "normal_cycle")):
             key = f"meshcurv/{method}/{db}"
             tm = t(one_m, key)
             lines.append(f"| {method} at 1M vertices <= 1 s | {fmt_s(tm)} s | "
@@ -811,8 +815,9 @@ def markdown(bench) -> str:
             lines.append(f"| {method}: t(4M) / t(1M) <= 4.5 | {fmt_ratio(r)} | "
                          f"{met(None if r is None else r <= TARGETS['growth'])} |")
     if four_m:
-        for key in (f"meshcurv/normal_cycle/{db}", f"meshcurv/matgeom/{db}", "meshcurv/normal_cycle/numpy",
-                    "meshcurv/matgeom/numpy"):
+        for key in dict.fromkeys((f"meshcurv/{bench.default_method}/{db}", f"meshcurv/normal_cycle/{db}",
+                                  f"meshcurv/matgeom/{db}", f"meshcurv/{bench.default_method}/numpy",
+                                  "meshcurv/normal_cycle/numpy", "meshcurv/matgeom/numpy")):
             row = find(four_m, key)
             if row and "peak_rss" in row:
                 n = next(m[2] for m in bench.meshes if m[0] == four_m)
@@ -877,9 +882,11 @@ def markdown(bench) -> str:
     # radius
     if bench.radius:
         lines += ["## Radius-based methods: time as the radius grows", "",
-                  f"Default backend ({db}); radius in mean edge lengths; the default radius is 2.5. "
+                  f"Default backend ({db}); radius in mean edge lengths `h`. The default radius is 2.5 h for "
+                  "quadric and normal_cycle_ball, and for icc follows the measured noise: 1 h on these clean "
+                  "icospheres (its normals are fitted over 3 r). "
                   "`÷ 1-ring` = time / normal_cycle time on the same mesh.", "",
-                  "| mesh | method | r = 1 | r = 2 | r = 2.5 (default) | r = 4 | default ÷ 1-ring |",
+                  "| mesh | method | r = 1 | r = 2 | default r | r = 4 | default ÷ 1-ring |",
                   "|---|---|--:|--:|--:|--:|--:|"]
         for label in [m[0] for m in bench.meshes]:
             ring = t(label, f"meshcurv/normal_cycle/{db}")
