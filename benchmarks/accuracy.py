@@ -298,7 +298,9 @@ def markdown(rows, found, missing, timings, levels):
         "Error = |estimate - exact| / s with s the largest exact |principal curvature| at the vertex (s² for K);",
         "cells are median / 95th percentile over the vertices the method reports; `cover` = share reported;",
         "`dir` = share of vertices (exact curvatures differing by > 10% of s) with dir_max within 8°.",
-        "meshcurv's `radius` methods use the default radius (2.5 x mean edge length); trimesh gets the same radius.",
+        "meshcurv's `radius` methods use their default radius (icc: from the measured noise, 1 x mean edge "
+        "length on a clean mesh; quadric and normal_cycle_ball: 2.5 x mean edge length); trimesh gets 2.5 x mean "
+        "edge length.",
         "Meshes: sphere r 1, torus R 3 r 1, ellipsoid (3, 2, 1), cylinder r 1 h 4, saddle z = x² - y², hemisphere;",
         "irregular = random points (sphere, ellipsoid, hemisphere) or jittered grid with random diagonals;",
         "noise = regular mesh with uniform normal displacement of amplitude 0.1 h or 0.3 h (h = mean edge length).",
