@@ -166,10 +166,10 @@ def test_curvatures_agree(name, method):
         assert (1 - dots).max(initial=0) < 1e-9, field
 
 
-@pytest.mark.parametrize("method", ["icc", "quadric"])
+@pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
 @pytest.mark.parametrize("name", ["torus", "saddle", "defects", "noisy", "coincident"])
 def test_ball_methods_agree(name, method):
-    # the compiled ball queries, jet fits and face sums against the cKDTree / NumPy path;
+    # the compiled ball queries, jet fits, face and edge sums against the cKDTree / NumPy path;
     # summation order differs (grid cells against k-d tree pairs), hence the tolerance
     if name == "noisy":
         mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.3, seed=5)

@@ -1024,7 +1024,8 @@ def _weighted_dot(a, b, c, size):
 
 
 @nb.njit(**_JIT)
-def _fit_one(vertices, points, grid, normals, radius, degree, iterations, exponents, min_pivot, v, members, work, moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts):
+def _fit_one(vertices, points, grid, normals, radius, degree, iterations, exponents, min_pivot, v, members, work,
+             moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts):
     """One vertex of :func:`fit_jets` in the caller's buffers; returns the buffers that may have grown.
 
     ``work`` holds one column per ball member: its offset from the centre in
@@ -1132,64 +1133,100 @@ def cell_centres(vertices, cells):
 
 
 @nb.njit(parallel=True, **_JIT)
-def ball_face_sums(vertices, faces, centroids, values, radius, cutoff, n_chunks):
-    """``neighborhoods.ball_face_sums`` for one group of faces: (V, k) sums of ``ratio * values``.
+def ball_cell_sums(vertices, cells, centroids, values, radius, cutoff, n_chunks):
+    """``neighborhoods._ball_sums`` for one group of cells: (V, k) sums of ``weight * values``.
 
-    Faces are found by their ``centroids`` within ``cutoff`` (radius + the
+    Cells are faces (three corners; weight: the share of the face inside the
+    ball, ``neighborhoods.face_in_ball_ratios``) or edges (two corners; weight:
+    the length of the edge inside the ball, ``neighborhoods.segment_in_ball_lengths``).
+    They are found by their ``centroids`` within ``cutoff`` (radius + the
     group's largest reach) on a grid of cells (:func:`_grid`); their corners,
     centroids and values are copied in grid order first, so that a ball reads
     contiguous memory.
     """
     n = vertices.shape[0]
-    n_faces = faces.shape[0]
+    n_cells, corners = cells.shape
     n_values = values.shape[1]
     grid = _grid(centroids, cutoff)
     order = grid[0]
-    points = np.empty((n_faces, 4, 3))  # the three corners and the centroid
-    sorted_values = np.empty((n_faces, n_values))
-    for k in nb.prange(n_faces):
-        f = order[k]
-        for corner in range(3):
-            points[k, corner] = vertices[faces[f, corner]]
-        points[k, 3] = centroids[f]
-        sorted_values[k] = values[f]
+    points = np.empty((n_cells, corners + 1, 3))  # the corners, then the centroid
+    sorted_values = np.empty((n_cells, n_values))
+    for k in nb.prange(n_cells):
+        c = order[k]
+        for corner in range(corners):
+            points[k, corner] = vertices[cells[c, corner]]
+        points[k, corners] = centroids[c]
+        sorted_values[k] = values[c]
     out = np.zeros((n, n_values))
     centres = _grid(vertices, grid[4])[0]  # centres in grid order: consecutive balls share cells (cache)
     n_chunks = max(min(n, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         members = np.empty(64, np.int64)
         for rank in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
-            members = _face_ratio_sums(vertices, points, grid, sorted_values, radius, cutoff, centres[rank],
-                                       members, out)
+            members = _cell_weight_sums(vertices, points, grid, sorted_values, radius, cutoff, centres[rank],
+                                        members, out)
     return out
 
 
+@nb.njit(inline="always", **_JIT)
+def _face_share(points, f, cx, cy, cz, radius, radius2):
+    """``face_in_ball_ratios`` of face ``f`` (corners and centroid in ``points[f]``); squared
+    distances, the square roots only for faces the sphere cuts."""
+    low = np.inf
+    high = -np.inf
+    for corner in range(4):
+        dx = points[f, corner, 0] - cx
+        dy = points[f, corner, 1] - cy
+        dz = points[f, corner, 2] - cz
+        dist = dx * dx + dy * dy + dz * dz
+        low = min(low, dist)
+        high = max(high, dist)
+    if high <= radius2:
+        return 1.0
+    if low >= radius2:
+        return 0.0
+    low = math.sqrt(low)
+    return (radius - low) / (math.sqrt(high) - low)
+
+
+@nb.njit(inline="always", **_JIT)
+def _segment_length(points, e, cx, cy, cz, radius2):
+    """``segment_in_ball_lengths`` of edge ``e`` (its ends in ``points[e, :2]``)."""
+    dx = points[e, 1, 0] - points[e, 0, 0]
+    dy = points[e, 1, 1] - points[e, 0, 1]
+    dz = points[e, 1, 2] - points[e, 0, 2]
+    fx = points[e, 0, 0] - cx
+    fy = points[e, 0, 1] - cy
+    fz = points[e, 0, 2] - cz
+    a = dx * dx + dy * dy + dz * dz
+    b = 2 * (dx * fx + dy * fy + dz * fz)
+    c = fx * fx + fy * fy + fz * fz - radius2
+    disc = b * b - 4 * a * c
+    if not (disc > 0 and a > 0):
+        return 0.0
+    root = math.sqrt(disc)
+    t0 = min(max((-b - root) / (2 * a), 0.0), 1.0)
+    t1 = min(max((-b + root) / (2 * a), 0.0), 1.0)
+    return (t1 - t0) * math.sqrt(a)
+
+
 @nb.njit(**_JIT)
-def _face_ratio_sums(vertices, points, grid, values, radius, cutoff, v, members, out):
-    """One vertex of :func:`ball_face_sums`; returns the (possibly grown) member buffer."""
+def _cell_weight_sums(vertices, points, grid, values, radius, cutoff, v, members, out):
+    """One vertex of :func:`ball_cell_sums`; returns the (possibly grown) member buffer."""
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
     radius2 = radius * radius
-    members, size = _ball_members(points[:, 3], grid, cx, cy, cz, cutoff, members)
+    corners = points.shape[1] - 1
+    members, size = _ball_members(points[:, corners], grid, cx, cy, cz, cutoff, members)
     for a in range(size):
-        f = members[a]
-        low = np.inf  # squared distances: the square roots only for faces the sphere cuts
-        high = -np.inf
-        for corner in range(4):
-            dx = points[f, corner, 0] - cx
-            dy = points[f, corner, 1] - cy
-            dz = points[f, corner, 2] - cz
-            dist = dx * dx + dy * dy + dz * dz
-            low = min(low, dist)
-            high = max(high, dist)
-        if high <= radius2:
-            ratio = 1.0
-        elif low >= radius2:
-            continue
+        c = members[a]
+        if corners == 3:
+            weight = _face_share(points, c, cx, cy, cz, radius, radius2)
         else:
-            low = math.sqrt(low)
-            ratio = (radius - low) / (math.sqrt(high) - low)
+            weight = _segment_length(points, c, cx, cy, cz, radius2)
+        if weight == 0.0:
+            continue
         for k in range(values.shape[1]):
-            out[v, k] += ratio * values[f, k]
+            out[v, k] += weight * values[c, k]
     return members
 
 

@@ -8,9 +8,9 @@ each vertex position, in the units of the coordinates. The default radius is
 Queries run on :class:`scipy.spatial.cKDTree` pair searches, in chunks of
 centres so that memory stays bounded on large meshes; all per-pair work is
 vectorized (no Python loop over vertices, edges or faces). With numba, the
-face sums (and the jet fits of :mod:`meshcurv.estimators.quadric`) run on a
-grid of cells at least as wide as the ball instead, in compiled kernels that
-find the same points (tests/test_backends.py compares the two).
+face and edge sums (and the jet fits of :mod:`meshcurv.estimators.quadric`)
+run on a grid of cells at least as wide as the ball instead, in compiled
+kernels that find the same points (tests/test_backends.py compares the two).
 """
 
 from __future__ import annotations
@@ -149,7 +149,7 @@ def _size_groups(reach: np.ndarray, radius: float) -> list[np.ndarray | slice]:
 
 
 def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: np.ndarray,
-               usable: np.ndarray | None, weight, compiled: str | None = None) -> np.ndarray:
+               usable: np.ndarray | None, weight) -> np.ndarray:
     """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices."""
     import scipy.sparse as sp
     from scipy.spatial import cKDTree
@@ -161,7 +161,7 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     out = np.zeros((n, values.shape[1]))
     if cells.shape[0] == 0:
         return out
-    kernels = numba_kernels() if compiled is not None else None
+    kernels = numba_kernels()
     if kernels is not None:
         centres, reach = kernels.cell_centres(vertices, cells)
     else:
@@ -176,7 +176,7 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     # two of reach as long as its search radius grows by at most GROUP_GROWTH.
     for group in _size_groups(reach, radius):
         if kernels is not None:
-            out += getattr(kernels, compiled)(vertices, cells[group], centres[group],
+            out += kernels.ball_cell_sums(vertices, cells[group], centres[group],
                                               np.ascontiguousarray(values[group]), radius,
                                               radius + reach[group].max(), 64 * kernels.threads())
             continue
@@ -198,7 +198,7 @@ def ball_face_sums(vertices: np.ndarray, faces: np.ndarray, radius: float, value
     ``values`` is (F, k); ``ratio`` is :func:`face_in_ball_ratios`. Faces not
     ``usable`` (F,) bool are left out.
     """
-    return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, "ball_face_sums")
+    return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios)
 
 
 def ball_edge_sums(vertices: np.ndarray, edges: np.ndarray, radius: float, values: np.ndarray,
