@@ -174,6 +174,8 @@ def main(argv=None) -> int:
         shutil.rmtree(work, ignore_errors=True)
     load_after = os.getloadavg()
 
+    from meshcurv.estimators import DEFAULT_METHOD
+
     serial_total = figures["serial_1"]["per_mesh"] * n  # the loop over n meshes, kernels loaded
     serial_default_total = figures["serial_default"]["per_mesh"] * n
     overhead = (figures["warm_1"]["meshes"] - serial_total) / n
@@ -201,7 +203,7 @@ def main(argv=None) -> int:
         "",
         f"Produced by `python benchmarks/batch.py --meshes {n}` on {datetime.date.today().isoformat()}: "
         f"{n} meshes of 10242 vertices / 20480 faces (`icosphere(32)`, radii 1 to 5, normal noise 0 to 0.2 "
-        "mean edge lengths), PLY in, PLY results out, method `normal_cycle`.",
+        f"mean edge lengths), PLY in, PLY results out, method `{DEFAULT_METHOD}` (the default).",
         "",
         f"Machine: {platform.machine()}, {os.cpu_count()} cores, {platform.platform()}. "
         f"Load average (1 min) {load_before[0]:.1f} before, {load_after[0]:.1f} after.",
