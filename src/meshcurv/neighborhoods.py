@@ -135,7 +135,8 @@ def _size_groups(reach: np.ndarray, radius: float) -> list[np.ndarray | slice]:
     _, exponent = np.frexp(np.maximum(reach, np.finfo(float).tiny))
     level = exponent - exponent.min()
     largest = np.zeros(level.max() + 1)
-    np.maximum.at(largest, level, reach)
+    for k in np.flatnonzero(np.bincount(level)):  # a few size classes: one pass each
+        largest[k] = reach[level == k].max()
     label = np.zeros(largest.size, dtype=np.int64)
     first = 0
     for k in np.flatnonzero(largest):
@@ -176,9 +177,11 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     # two of reach as long as its search radius grows by at most GROUP_GROWTH.
     for group in _size_groups(reach, radius):
         if kernels is not None:
-            out += kernels.ball_cell_sums(vertices, cells[group], centres[group],
-                                              np.ascontiguousarray(values[group]), radius,
-                                              radius + reach[group].max(), 64 * kernels.threads())
+            sums = kernels.ball_cell_sums(vertices, cells[group], centres[group], np.ascontiguousarray(values[group]),
+                                          radius, radius + reach[group].max(), 64 * kernels.threads())
+            if isinstance(group, slice):  # one group: its sums are the result
+                return sums
+            out += sums
             continue
         tree = cKDTree(centres[group])
         cutoff = radius + reach[group].max()
