@@ -43,6 +43,7 @@ import numpy as np
 import meshcurv
 from meshcurv import shapes
 from meshcurv.estimators import ESTIMATORS
+from meshcurv.estimators import DEFAULT_METHOD
 from meshcurv.neighborhoods import default_radius
 
 OUTPUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy.md")
@@ -290,6 +291,7 @@ def markdown(rows, found, missing, timings, levels):
         f"(meshcurv {meshcurv.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}).",
         "",
         "Peers: " + "; ".join(sorted({pkg for _, pkg in found.values()})) + ".",
+        f"meshcurv's default method: `{DEFAULT_METHOD}`.",
     ]
     if missing:
         lines.append("Not installed (not run): " + "; ".join(f"{k} ({v})" for k, v in missing.items()) + ".")
