@@ -42,8 +42,7 @@ import numpy as np
 
 import meshcurv
 from meshcurv import shapes
-from meshcurv.estimators import ESTIMATORS
-from meshcurv.estimators import DEFAULT_METHOD
+from meshcurv.estimators import DEFAULT_METHOD, ESTIMATORS
 from meshcurv.neighborhoods import default_radius
 
 OUTPUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy.md")
