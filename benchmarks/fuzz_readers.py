@@ -19,7 +19,6 @@ import tempfile
 import traceback
 import warnings
 
-import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

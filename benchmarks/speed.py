@@ -938,8 +938,8 @@ def markdown(bench) -> str:
     elif comp:
         lines += [f"numba compile measurement failed: {comp}", ""]
     if bench.warm:
-        lines += [f"Warm-up of this process (first call of each implementation on icosphere(8), "
-                  f"642 vertices; numba kernels from the default cache): "
+        lines += ["Warm-up of this process (first call of each implementation on icosphere(8), "
+                  "642 vertices; numba kernels from the default cache): "
                   + ", ".join(f"{label_of(k)} {s:.2f} s" for k, s in bench.warm.items() if s > 0.05) + ".", ""]
 
     # profile

@@ -1,7 +1,5 @@
 """method="normal_cycle": analytic surfaces first, then invariances."""
 
-import warnings
-
 import numpy as np
 import pytest
 
