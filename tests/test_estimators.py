@@ -194,6 +194,23 @@ def test_icc_noise_level_is_scale_free():
     np.testing.assert_allclose(large.mean * 1000.0, small.mean, rtol=1e-8, atol=1e-10)
 
 
+def test_icc_noise_level_is_measured_at_the_local_resolution():
+    # a fine sphere (radius 0.05, h 0.0037) beside a coarse one (radius 10, h 5): at the mean edge
+    # length (0.18) a jet cannot follow the small sphere, which would read as noise 0.26 and a radius
+    # of 5.5 h; measured in each vertex's own edge length, the clean mesh stays below the floor
+    small = shapes.icosphere(16, radius=0.05)
+    big = shapes.icosphere(4, radius=10.0, center=(30, 0, 0))
+    vertices = np.vstack([small.vertices, big.vertices])
+    faces = np.vstack([small.faces, big.faces + small.vertices.shape[0]])
+    r = meshcurv.principal_curvatures(vertices, faces, method="icc")
+    h = meshcurv.geometry.mean_edge_length(vertices, meshcurv.MeshTopology.from_faces(faces).edges)
+    assert r.parameters["noise"] < icc.NOISE_FLOOR
+    assert r.parameters["radius"] == pytest.approx(h)
+    n = small.vertices.shape[0]
+    assert np.median(relative_error(r.mean[:n], 20.0)) < 0.01
+    assert np.median(relative_error(r.mean[n:], 0.1)) < 0.05
+
+
 def test_icc_noise_level_on_a_sample(monkeypatch):
     # above NOISE_SAMPLE valid vertices the median is taken over evenly spaced vertices:
     # the level stays close to that of all vertices, and a run gives the same level again

@@ -14,7 +14,8 @@ have an error of order ``r^3`` where those of a degree-2 jet have ``r^2``
 (on a regular ellipsoid, 0.5% against 1.8% in H).
 
 The default radius follows the noise of the mesh (:func:`noise_level`, ``nu``
-in units of the mean edge length ``h``): ``r = h (1 + 9 sqrt(max(nu - 0.005, 0)))``,
+in units of the local edge length) and its mean edge length ``h``:
+``r = h (1 + 9 sqrt(max(nu - 0.005, 0)))``,
 one edge length on a clean mesh, where the smallest ball has the smallest bias,
 about 2.2 h under normal noise of amplitude 0.1 h and 3.3 h under 0.3 h, where
 a larger ball averages the noise out. The constants come from a sweep of both
@@ -66,7 +67,7 @@ import numpy as np
 from .._tensors import principal_from_shape_operator
 from .._backend import numba_kernels
 from .._validation import check_positive_float
-from ..geometry import mean_edge_length
+from ..geometry import edge_lengths, mean_edge_length
 from ..neighborhoods import ball_face_sums
 from ..topology import MeshTopology
 from ._common import Stages
@@ -82,7 +83,7 @@ NORMAL_RADIUS_RATIO = 3.0
 #: Fits per normal: the first in the frame of the mean of the face normals, the next in that of the first fit.
 NORMAL_ITERATIONS = 2
 
-#: The noise level is measured with degree-2 jets over balls of this many mean edge lengths.
+#: The noise level is measured with degree-2 jets over balls of this many local edge lengths.
 NOISE_FIT_RADIUS = 2.0
 
 #: Noise levels (in mean edge lengths) up to this count as a clean mesh: the
@@ -133,26 +134,46 @@ def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray,
     return np.where(usable[:, None], fitted, normals)
 
 
-def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, edge_length: float) -> float:
-    """Median distance of the vertices to degree-2 jets fitted around them, in mean edge lengths.
+def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, edges: np.ndarray) -> float:
+    """Median distance of the vertices to degree-2 jets fitted around them, in local edge lengths.
 
-    Each jet is fitted over the ball of :data:`NOISE_FIT_RADIUS` edge lengths
-    around its vertex, the vertex included. On a smooth, clean mesh the distance is the
-    fit's bias (below :data:`NOISE_FLOOR`); under normal noise of uniform
-    amplitude ``a h`` it is about ``0.23 a`` (0.1 h: 0.020-0.028). On a mesh of
-    more than :data:`NOISE_SAMPLE` valid vertices, the median is taken over that
-    many of them, evenly spaced in index order (the median of 65536 draws is
-    within about 1% of that of all vertices; a re-indexing then changes the
-    level, and the default radius, by that much). 0 when no jet could be fitted.
+    The local edge length ``h_v`` of a vertex is the mean length of its edges.
+    The vertices are taken by class of ``h_v`` (powers of two around the
+    median, so that a mesh of even resolution is one class), and each jet is
+    fitted over the ball of :data:`NOISE_FIT_RADIUS` times the mean ``h_v`` of
+    its class, the vertex included; its distance is measured in that mean. On a
+    smooth, clean mesh the distance is the fit's bias (below
+    :data:`NOISE_FLOOR`); under normal noise of uniform amplitude ``a h`` it is
+    about ``0.23 a`` (0.1 h: 0.020-0.028). Local classes keep a mesh whose
+    resolution varies (a decimated model, 40x between its shortest and longest
+    edges) from reading its fine detail as noise at the scale of its mean edge.
+    On a mesh of more than :data:`NOISE_SAMPLE` valid vertices, the median is
+    taken over that many of them, evenly spaced in index order (the median of
+    65536 draws is within about 1% of that of all vertices; a re-indexing then
+    changes the level, and the default radius, by that much). 0 when no jet
+    could be fitted.
     """
-    centres = np.flatnonzero(valid)
+    n = vertices.shape[0]
+    lengths = edge_lengths(vertices, edges)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        local = (np.bincount(edges.ravel(), weights=np.repeat(lengths, 2), minlength=n)
+                 / np.bincount(edges.ravel(), minlength=n))
+    centres = np.flatnonzero(valid & (local > 0))
     if centres.size > NOISE_SAMPLE:
         centres = centres[np.linspace(0, centres.size - 1, NOISE_SAMPLE).round().astype(np.int64)]
-    radius = NOISE_FIT_RADIUS * edge_length
-    coefficients, _, _ = fit_jets(vertices, normals, radius, degree=2, centres=centres)
-    heights = np.abs(coefficients[centres, 0]) * radius
-    heights = heights[np.isfinite(heights)]
-    return float(np.median(heights)) / edge_length if heights.size else 0.0
+    if centres.size == 0:
+        return 0.0
+    scale = local[centres]
+    level = np.round(np.log2(scale / np.median(scale))).astype(np.int64)
+    distances = np.full(centres.size, np.nan)
+    for k in np.unique(level):
+        members = np.flatnonzero(level == k)
+        unit = scale[members].mean()
+        radius = NOISE_FIT_RADIUS * unit
+        coefficients, _, _ = fit_jets(vertices, normals, radius, degree=2, centres=centres[members])
+        distances[members] = np.abs(coefficients[centres[members], 0]) * radius / unit
+    distances = distances[np.isfinite(distances)]
+    return float(np.median(distances)) if distances.size else 0.0
 
 
 def default_radius(noise: float, edge_length: float) -> float:
@@ -169,7 +190,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     noise = {}
     if radius is None:
         edge_length = mean_edge_length(vertices, topology.edges)
-        level = noise_level(vertices, normals, valid, edge_length) if edge_length > 0 else 0.0
+        level = noise_level(vertices, normals, valid, topology.edges) if edge_length > 0 else 0.0
         radius = float(default_radius(level, edge_length))
         noise = {"noise": level}
     else:
