@@ -75,6 +75,22 @@ def vertex_normal_sums(cross, faces, n_vertices):
     return out
 
 
+@nb.njit(**_JIT)
+def vertex_edge_lengths(vertices, edges, n_vertices):
+    """``geometry.vertex_edge_lengths``: (V,) mean length of the edges at each vertex (NaN where none)."""
+    total = np.zeros(n_vertices)
+    count = np.zeros(n_vertices)
+    for e in range(edges.shape[0]):
+        length = _edge_length(vertices, edges[e, 0], edges[e, 1])
+        for k in range(2):
+            total[edges[e, k]] += length
+            count[edges[e, k]] += 1.0
+    out = np.empty(n_vertices)
+    for v in range(n_vertices):
+        out[v] = total[v] / count[v] if count[v] > 0 else np.nan
+    return out
+
+
 def mean_edge_length(vertices, edges):
     """``geometry.mean_edge_length``."""
     return _mean_edge_length(vertices, edges)

@@ -19,6 +19,7 @@ __all__ = [
     "vertex_areas",
     "vertex_normals",
     "edge_lengths",
+    "vertex_edge_lengths",
     "mean_edge_length",
     "degenerate_face_mask",
     "corner_cotangents",
@@ -116,6 +117,18 @@ def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """(E,) length of each of the given (E, 2) edges."""
     d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
     return np.sqrt(np.einsum("ij,ij->i", d, d))
+
+
+def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(V,) mean length of the given (E, 2) edges at each vertex: the local resolution (NaN where none)."""
+    n = vertices.shape[0]
+    kernels = numba_kernels()
+    if kernels is not None:
+        return kernels.vertex_edge_lengths(vertices, edges, n)
+    flat = edges.ravel()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (np.bincount(flat, weights=np.repeat(edge_lengths(vertices, edges), 2), minlength=n)
+                / np.bincount(flat, minlength=n))
 
 
 def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:

@@ -67,7 +67,7 @@ import numpy as np
 from .._tensors import principal_from_shape_operator
 from .._backend import numba_kernels
 from .._validation import check_positive_float
-from ..geometry import edge_lengths, mean_edge_length
+from ..geometry import mean_edge_length, vertex_edge_lengths
 from ..neighborhoods import ball_face_sums
 from ..topology import MeshTopology
 from ._common import Stages
@@ -153,11 +153,7 @@ def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, ed
     changes the level, and the default radius, by that much). 0 when no jet
     could be fitted.
     """
-    n = vertices.shape[0]
-    lengths = edge_lengths(vertices, edges)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        local = (np.bincount(edges.ravel(), weights=np.repeat(lengths, 2), minlength=n)
-                 / np.bincount(edges.ravel(), minlength=n))
+    local = vertex_edge_lengths(vertices, edges)
     centres = np.flatnonzero(valid & (local > 0))
     if centres.size > NOISE_SAMPLE:
         centres = centres[np.linspace(0, centres.size - 1, NOISE_SAMPLE).round().astype(np.int64)]
