@@ -132,7 +132,8 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
     gives the same answer at any scale (coordinates around 1e-9 or 1e9 alike).
     """
     kernels = numba_kernels()
-    if kernels is not None and mean_edge_length is None and double_areas is None and cross is None:
+    if kernels is not None and mean_edge_length is None and double_areas is None:
+        # the kernel computes the cross products inline: ``cross`` only spares the NumPy path that work
         return kernels.degenerate_faces(vertices, topology.faces, topology.edges, DEGENERATE_AREA_RATIO)
     if mean_edge_length is None:
         lengths = edge_lengths(vertices, topology.edges)

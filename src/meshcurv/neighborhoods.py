@@ -185,9 +185,10 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
             continue
         tree = cKDTree(centres[group])
         cutoff = radius + reach[group].max()
+        index = np.arange(cells.shape[0])[group]  # group position -> cell
         for chunk in _chunks(n):
             i, c = _pairs(tree, vertices[chunk], cutoff)
-            c = np.arange(cells.shape[0])[group][c]
+            c = index[c]
             weights = weight(vertices[cells[c]], vertices[chunk][i], radius)
             gather = sp.csr_matrix((weights, (i, c)), shape=(chunk.stop - chunk.start, values.shape[0]))
             out[chunk] += np.asarray(gather @ values)

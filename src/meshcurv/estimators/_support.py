@@ -35,7 +35,7 @@ def prepare(vertices: np.ndarray, topology: MeshTopology):
     the defects and vertices without a normal.
     """
     cross = face_cross_products(vertices, topology.faces)
-    degenerate = degenerate_faces(vertices, topology)
+    degenerate = degenerate_faces(vertices, topology, cross=cross)
     defects = defects_without_boundary(topology, degenerate)
     kept = ~degenerate
     normals = vertex_normals(vertices, topology.faces[kept], cross=cross[kept])

@@ -164,10 +164,10 @@ def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, ed
     distances = np.full(centres.size, np.nan)
     for k in np.unique(level):
         members = np.flatnonzero(level == k)
-        unit = scale[members].mean()
-        radius = NOISE_FIT_RADIUS * unit
+        radius = NOISE_FIT_RADIUS * scale[members].mean()
         coefficients, _, _ = fit_jets(vertices, normals, radius, degree=2, centres=centres[members])
-        distances[members] = np.abs(coefficients[centres[members], 0]) * radius / unit
+        # the constant term is in units of the radius: NOISE_FIT_RADIUS class mean edge lengths
+        distances[members] = np.abs(coefficients[centres[members], 0]) * NOISE_FIT_RADIUS
     distances = distances[np.isfinite(distances)]
     return float(np.median(distances)) if distances.size else 0.0
 
