@@ -50,7 +50,7 @@ def principal_curvatures(
           3.5 s for a million vertices on 2 cores.
         - ``'normal_cycle'``: the normal-cycle tensor of Cohen-Steiner and Morvan
           over barycentric cells, in 1/length, correct on open meshes; the
-          fastest (a million vertices in under half a second), exact to second
+          fastest (a million vertices in about 0.6 s), exact to second
           order on regular meshes, less accurate on irregular or noisy ones.
         - ``'matgeom'``: matGeom's ``meshCurvatures`` reproduced number for
           number (dimensionless values; see the README).
