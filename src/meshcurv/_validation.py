@@ -7,6 +7,7 @@ int64 (F, 3) triangles with indices in range).
 
 from __future__ import annotations
 
+import numbers
 import operator
 import warnings
 from collections.abc import Sequence
@@ -15,7 +16,14 @@ import numpy as np
 
 from .errors import InvalidMeshError, InvalidOptionError, TriangulationWarning
 
-__all__ = ["as_vertices", "as_faces", "as_polygons", "check_int_option", "check_choice"]
+__all__ = ["as_vertices", "as_faces", "as_polygons", "check_int_option", "check_positive_float", "check_choice",
+           "checked_mesh", "checked_points", "checked_indices"]
+
+
+def _short_repr(value, limit: int = 40) -> str:
+    """``repr(value)``, cut to ``limit`` characters (an option of 400 digits stays readable)."""
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[:limit - 12]}... ({len(text)} chars)"
 
 
 def _shape_text(array) -> str:
@@ -30,9 +38,10 @@ def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
     InvalidMeshError
         Wrong shape or dtype, no vertices, NaN or infinite coordinates.
     """
+    _refuse_masked(vertices, name)
     try:
         array = np.asarray(vertices)
-    except (ValueError, TypeError) as exc:  # ragged nested lists
+    except (ValueError, TypeError, OverflowError) as exc:  # ragged nested lists, ints beyond float
         raise InvalidMeshError(
             f"`{name}` must be an array of shape (V, 3); it could not be converted to an array ({exc})"
         ) from None
@@ -47,7 +56,10 @@ def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
     if array.shape[0] == 0:
         raise InvalidMeshError(f"`{name}` is empty: the mesh has no vertices")
     with np.errstate(over="ignore"):  # float128 beyond float64: caught as infinite below
-        out = np.array(array, dtype=np.float64, order="C", copy=True)
+        try:
+            out = np.array(array, dtype=np.float64, order="C", copy=True)
+        except OverflowError:  # Python ints beyond float64 in an object-free int array cannot occur; be safe
+            raise InvalidMeshError(f"`{name}` has coordinates beyond the float64 range") from None
     with np.errstate(over="ignore", invalid="ignore"):
         total = out.sum()  # finite unless a coordinate is NaN or infinite (or the sum overflows)
     finite = np.isfinite(out).all(axis=1) if not np.isfinite(total) else None
@@ -60,14 +72,41 @@ def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
     largest = max(float(out.max()), -float(out.min()))
     if largest > MAX_COORDINATE:
         raise InvalidMeshError(
-            f"`{name}` has coordinates as large as {largest:.3g}; products of lengths would overflow "
-            f"float64 beyond {MAX_COORDINATE:.0e}: rescale the mesh"
+            f"`{name}` has coordinates as large as {largest:.3g}; products of four lengths (squared "
+            f"areas) would overflow float64 beyond {MAX_COORDINATE:.0e}: rescale the mesh"
+        )
+    if 0.0 < largest < MIN_COORDINATE:
+        raise InvalidMeshError(
+            f"`{name}` has no coordinate larger than {largest:.3g}; products of four lengths (squared "
+            f"areas) would underflow float64 below {MIN_COORDINATE:.0e}: rescale the mesh"
         )
     return out
 
 
-#: Largest coordinate accepted: areas and squared lengths stay far from float64 overflow.
-MAX_COORDINATE = 1e100
+#: Largest coordinate magnitude accepted. The estimators form products of up to four
+#: lengths (squared face areas, ``b^2 - 4ac`` of a segment-ball intersection, the
+#: squared norms of cross products); a length is at most ``2 sqrt(3)`` times the largest
+#: coordinate, so with 1e75 such a product stays below ``(3.5e75)^4 = 1.5e302``, inside
+#: float64's 1.8e308, with a margin for sums of a few dozen terms.
+MAX_COORDINATE = 1e75
+
+#: Smallest largest-coordinate magnitude accepted (a mesh of coordinates all below this
+#: is refused): products of four lengths of 1e-75 are 1e-300, above float64's smallest
+#: normal number 2.2e-308; below, squared areas underflow to 0 and every face would be
+#: read as zero-area. A mesh whose coordinates are all exactly 0 passes (its faces are
+#: all degenerate, which the estimators report).
+MIN_COORDINATE = 1e-75
+
+
+def _refuse_masked(value, name: str) -> None:
+    """Refuse a :class:`numpy.ma.MaskedArray` with masked entries (its mask would be ignored)."""
+    if isinstance(value, np.ma.MaskedArray):
+        n_masked = int(np.ma.count_masked(value))
+        if n_masked:
+            raise InvalidMeshError(
+                f"`{name}` is a masked array with {n_masked} masked values; meshcurv does not guess "
+                "them: remove the masked rows (or fill them) first"
+            )
 
 
 def _integer_faces(array: np.ndarray, name: str) -> np.ndarray:
@@ -105,6 +144,7 @@ def as_polygons(faces, *, name: str = "faces") -> list[np.ndarray] | np.ndarray:
     """Return ``faces`` as an int64 (F, k) array, or a list of int64 index arrays when ragged."""
     if isinstance(faces, (str, bytes)):
         raise InvalidMeshError(f"`{name}` must be an array of vertex indices; got a {type(faces).__name__}")
+    _refuse_masked(faces, name)
     if isinstance(faces, np.ndarray) or not isinstance(faces, Sequence):
         array = _as_array(faces, name)
     else:
@@ -189,29 +229,47 @@ def as_faces(faces, n_vertices: int, *, name: str = "faces", stacklevel: int = 3
     return np.ascontiguousarray(polygons)
 
 
-def check_int_option(value, name: str, *, minimum: int = 0) -> int:
-    """Return ``value`` as an int >= ``minimum`` or raise :class:`InvalidOptionError`."""
+def check_int_option(value, name: str, *, minimum: int = 0, maximum: int | None = None) -> int:
+    """Return ``value`` as an int in ``[minimum, maximum]`` or raise :class:`InvalidOptionError`.
+
+    ``maximum`` defaults to the largest int64 (the compiled kernels take int64):
+    ``2**63`` is refused here, not by an OverflowError deep inside.
+    """
+    top = INT64_MAX if maximum is None else min(maximum, INT64_MAX)
+    expected = f"an integer between {minimum} and {top}"
     if isinstance(value, (bool, np.bool_)):
-        raise InvalidOptionError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
+        raise InvalidOptionError(f"`{name}` must be {expected}; got {_short_repr(value)}")
     try:
         number = operator.index(value)
     except TypeError:
-        raise InvalidOptionError(f"`{name}` must be an integer >= {minimum}; got {value!r}") from None
-    if number < minimum:
-        raise InvalidOptionError(f"`{name}` must be an integer >= {minimum}; got {number}")
+        raise InvalidOptionError(f"`{name}` must be {expected}; got {_short_repr(value)}") from None
+    if number < minimum or number > top:
+        raise InvalidOptionError(f"`{name}` must be {expected}; got {_short_repr(number)}")
     return int(number)
 
 
+#: Largest value of an integer option (the compiled kernels take int64).
+INT64_MAX = int(np.iinfo(np.int64).max)
+
+
 def check_positive_float(value, name: str) -> float:
-    """Return ``value`` as a finite float > 0 or raise :class:`InvalidOptionError`."""
-    if isinstance(value, (bool, np.bool_)):
-        raise InvalidOptionError(f"`{name}` must be a positive number; got {value!r}")
+    """Return ``value`` as a finite float > 0 or raise :class:`InvalidOptionError`.
+
+    Only real numbers are accepted (int, float and their NumPy scalars, 0-d
+    arrays): a string such as ``"0.5"`` is refused rather than parsed, and an
+    integer beyond the float64 range (``10**400``) is refused, not overflowed.
+    """
+    if isinstance(value, (bool, np.bool_, str, bytes)) or not isinstance(value, (numbers.Real, np.ndarray)):
+        raise InvalidOptionError(f"`{name}` must be a positive number; got {_short_repr(value)}")
+    if isinstance(value, np.ndarray) and (value.ndim != 0 or not np.issubdtype(value.dtype, np.number)
+                                          or np.issubdtype(value.dtype, np.complexfloating)):
+        raise InvalidOptionError(f"`{name}` must be a positive number; got {_short_repr(value)}")
     try:
         number = float(value)
-    except (TypeError, ValueError):
-        raise InvalidOptionError(f"`{name}` must be a positive number; got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidOptionError(f"`{name}` must be a positive finite number; got {_short_repr(value)}") from None
     if not np.isfinite(number) or number <= 0:
-        raise InvalidOptionError(f"`{name}` must be a positive finite number; got {value!r}")
+        raise InvalidOptionError(f"`{name}` must be a positive finite number; got {_short_repr(value)}")
     return number
 
 
@@ -221,3 +279,53 @@ def check_choice(value, name: str, choices) -> str:
         listed = ", ".join(repr(c) for c in choices)
         raise InvalidOptionError(f"unknown {name} {value!r}; choose one of {listed}")
     return value
+
+
+# -- cheap checks at the public helpers (geometry, neighborhoods, smoothing, diagnose) --------------
+def checked_points(vertices, *, name: str = "vertices") -> np.ndarray:
+    """``vertices`` as a C-contiguous float64 (V, 3) array, checked finite.
+
+    The public helpers of the core call this on every input: an array that is
+    already float64 (V, 3) is not copied and costs one summation (NaN or
+    infinite coordinates would send the compiled grid searches out of bounds);
+    anything else goes through :func:`as_vertices`.
+    """
+    if not (isinstance(vertices, np.ndarray) and type(vertices) is np.ndarray and vertices.dtype == np.float64
+            and vertices.ndim == 2 and vertices.shape[1] == 3 and vertices.shape[0] > 0):
+        return as_vertices(vertices, name=name)
+    with np.errstate(over="ignore", invalid="ignore"):
+        finite = np.isfinite(vertices.sum())
+    if not finite:
+        return as_vertices(vertices, name=name)  # raises, naming the vertices (or the overflow)
+    return np.ascontiguousarray(vertices)
+
+
+def checked_indices(indices, n_vertices: int, *, columns: int = 3, name: str = "faces") -> np.ndarray:
+    """``indices`` as a C-contiguous int64 (N, columns) array of 0-based vertex indices, checked in range.
+
+    Unlike :func:`as_faces`, no polygon is triangulated and an empty array is
+    accepted: this is the check of the helpers that take faces (or edges) the
+    caller has built. An int64 array is not copied; the check is one pass of
+    ``min`` and ``max``.
+
+    Raises
+    ------
+    InvalidMeshError
+        Wrong shape or dtype, non-integer values, indices out of range (with the
+        1-based hint of :func:`as_faces`).
+    """
+    _refuse_masked(indices, name)
+    array = indices if isinstance(indices, np.ndarray) else _as_array(indices, name)
+    if array.ndim != 2 or array.shape[1] != columns:
+        raise InvalidMeshError(f"`{name}` must have shape (N, {columns}); got {_shape_text(array)}")
+    if array.dtype != np.int64:
+        array = _integer_faces(array, name)
+    if array.size:
+        _check_range(array, n_vertices, name)
+    return np.ascontiguousarray(array)
+
+
+def checked_mesh(vertices, faces, *, columns: int = 3, name: str = "faces") -> tuple[np.ndarray, np.ndarray]:
+    """``(checked_points(vertices), checked_indices(faces, V))``."""
+    points = checked_points(vertices)
+    return points, checked_indices(faces, points.shape[0], columns=columns, name=name)
