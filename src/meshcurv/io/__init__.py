@@ -38,8 +38,8 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .._validation import _check_range, as_polygons, as_vertices
-from ..errors import InvalidMeshError, InvalidOptionError, MeshFileError
-from . import _meshio, _obj, _off, _ply, _tables, _vtp
+from ..errors import InvalidMeshError, InvalidOptionError, MeshFileError, MissingDependencyError
+from . import _meshio, _obj, _off, _ply, _tables, _vtk, _vtp
 from ._files import atomic_output, check_input, check_output
 from .fields import FIELDS, curvature_fields
 
@@ -87,9 +87,9 @@ def _meshio_format(file_format: str):
         if file_format == "stl":
             _meshio.check_stl(path)
         if file_format == "ply":
-            fast = _ply.read_binary_ply(path)  # the common binary layout in one pass, without meshio
-            if fast is not None:
-                return fast
+            return _ply.read_ply(path)  # our own bounded reader: meshio's loops on a header cut short
+        if file_format == "vtk" and _vtk.is_polydata(path):
+            return _vtk.read_vtk_polydata(path)  # meshio reads only UNSTRUCTURED_GRID legacy files
         return _meshio.read_with_meshio(path, file_format)
 
     def write(path, vertices, faces, point_data, binary):
@@ -181,8 +181,14 @@ def read_mesh(path, *, file_format: str | None = None) -> Mesh:
     path = check_input(path)
     try:
         vertices, faces = fmt.read(path)
+    except (MeshFileError, MissingDependencyError, MemoryError):
+        raise  # ours already name the file; a MemoryError is a real lack of memory (sizes are bounded)
     except OSError as exc:
         raise MeshFileError(f"{path}: {exc.strerror or exc}") from exc
+    except Exception as exc:  # any other parser failure: one readable error naming the file
+        reason = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
+        raise MeshFileError(f"{path}: cannot be read as {fmt.name} ({type(exc).__name__}"
+                            + (f": {reason})" if reason else ")")) from exc
     try:
         vertices = as_vertices(vertices)
         polygons = as_polygons(faces)
@@ -263,7 +269,7 @@ def write_mesh(path, vertices, faces, *, point_data=None, overwrite: bool = Fals
             "write .ply, .vtk, .vtu, .vtp, .csv or .npz"
         )
     path = check_output(path, overwrite=overwrite, source=source)
-    with atomic_output(path) as temporary:
+    with atomic_output(path, overwrite=overwrite) as temporary:
         try:
             fmt.write(temporary, points, polygons, data, binary)
         except OSError as exc:

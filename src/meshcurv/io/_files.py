@@ -27,10 +27,19 @@ def check_input(path) -> pathlib.Path:
 
 
 def _same_file(a: pathlib.Path, b: pathlib.Path) -> bool:
+    """Whether ``a`` and ``b`` are one file: same device and inode, or the same real path.
+
+    Symbolic links, ``..``, hard links and bind mounts of one file are all
+    the same file; when ``a`` does not exist yet, its real path (symbolic
+    links of its folders resolved) is compared.
+    """
     try:
-        return a.samefile(b)
-    except OSError:
-        return a.resolve() == b.resolve()
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        try:
+            return os.path.normcase(os.path.realpath(a)) == os.path.normcase(os.path.realpath(b))
+        except (OSError, ValueError):
+            return False
 
 
 def check_output(path, *, overwrite: bool = False, source=None) -> pathlib.Path:
@@ -55,22 +64,63 @@ def check_output(path, *, overwrite: bool = False, source=None) -> pathlib.Path:
 
 
 @contextlib.contextmanager
-def atomic_output(path: pathlib.Path):
-    """Yield a temporary path beside ``path``; move it onto ``path`` only if the block succeeds.
+def atomic_output(path: pathlib.Path, *, overwrite: bool = True):
+    """Yield a temporary path beside ``path``; publish it as ``path`` only if the block succeeds.
 
-    The temporary file lives in the same folder (so :func:`os.replace` is an
-    atomic rename) and keeps the suffix of ``path``; it is removed on failure.
+    The temporary file lives in the same folder and keeps the suffix of
+    ``path``; it is removed on failure. With ``overwrite=True`` it is moved
+    with :func:`os.replace` (an atomic rename onto any existing file). With
+    ``overwrite=False`` it is published without replacement: a hard link to
+    ``path`` (which fails if ``path`` exists, atomically), or where the file
+    system has no hard links, an exclusive creation (``O_EXCL``) of ``path``
+    before the rename. Of two writers started together, the second gets a
+    MeshFileError instead of silently replacing the first one's file.
+
+    Raises
+    ------
+    MeshFileError
+        The folder cannot take the temporary file (read-only, missing, full),
+        or ``path`` appeared meanwhile and ``overwrite`` is False. The message
+        names ``path``, never the temporary.
     """
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    path = pathlib.Path(path)
+    try:
+        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    except OSError as exc:
+        raise MeshFileError(f"{path}: cannot be written ({exc.strerror or exc})") from exc
     os.close(handle)
     temporary = pathlib.Path(temporary)
     try:
         yield temporary
-        os.chmod(temporary, 0o666 & ~_umask())
-        os.replace(temporary, path)
-    except BaseException:
+        try:
+            os.chmod(temporary, 0o666 & ~_umask())
+            if overwrite:
+                os.replace(temporary, path)
+            else:
+                _publish_exclusive(temporary, path)
+        except FileExistsError as exc:
+            raise MeshFileError(
+                f"{path}: already exists (another writer created it meanwhile); "
+                "pass overwrite=True (--overwrite) to replace it"
+            ) from exc
+        except OSError as exc:
+            raise MeshFileError(f"{path}: cannot be written ({exc.strerror or exc})") from exc
+    finally:
         temporary.unlink(missing_ok=True)
+
+
+def _publish_exclusive(temporary: pathlib.Path, path: pathlib.Path) -> None:
+    """Give the finished ``temporary`` the name ``path``, failing with FileExistsError if it is taken."""
+    try:
+        os.link(temporary, path)
+        return
+    except FileExistsError:
         raise
+    except OSError:  # no hard links here (FAT, some network and FUSE file systems)
+        pass
+    descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    os.close(descriptor)
+    os.replace(temporary, path)
 
 
 def _umask() -> int:
