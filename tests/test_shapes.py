@@ -1,9 +1,12 @@
 """The analytic meshes and their exact curvatures, checked against closed forms."""
 
+import sys
+
 import numpy as np
 import pytest
 
 from meshcurv import geometry, shapes
+from meshcurv.errors import InvalidOptionError
 from meshcurv.topology import MeshTopology
 
 from conftest import DATA
@@ -74,3 +77,112 @@ def test_torus_and_cylinder_closed_forms():
     c = shapes.cylinder(radius=2.0)
     assert (c.k_max == 0.5).all() and (c.k_min == 0).all()
     assert np.isnan(shapes.icosphere(2).dir_min).all()  # umbilic everywhere
+
+
+# -- marching-cubes meshes of voxelised solids (the `volume` extra) -------------------
+
+@pytest.fixture
+def skimage():
+    return pytest.importorskip("skimage")
+
+
+@pytest.mark.parametrize("spacing", [(1.0, 1.0, 1.0), (2.0, 1.0, 1.0), (0.3, 0.4, 0.5)])
+def test_voxel_sphere_vertices_within_half_a_voxel_and_exact_curvature(skimage, spacing):
+    m = shapes.voxel_sphere(6.0, spacing, seed=3)
+    distance = np.linalg.norm(m.vertices - m.center, axis=1)
+    # a vertex is the midpoint of a grid edge joining a voxel centre inside (<= r) and one outside (> r)
+    assert np.abs(distance - 6.0).max() <= max(spacing) / 2 + 1e-12
+    np.testing.assert_allclose(np.linalg.norm(m.closest_points - m.center, axis=1), 6.0, rtol=1e-12)
+    np.testing.assert_allclose(m.mean, 1 / 6.0, rtol=1e-12)
+    np.testing.assert_allclose(m.gaussian, 1 / 36.0, rtol=1e-12)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", m.normals, m.vertices - m.center), distance, rtol=1e-12)
+    assert m.spacing == spacing
+
+
+def test_voxel_sphere_is_closed_inward_and_has_the_balls_volume(skimage):
+    m = shapes.voxel_sphere(10.0, seed=1)
+    top = MeshTopology.from_faces(m.faces, m.vertices.shape[0])
+    assert top.interior_edges.all() and top.euler_characteristic == 2
+    volume = geometry.signed_volume(m.vertices, m.faces)
+    # inward as marching cubes returns it; the voxel count of a radius-10 ball is within 1% of 4/3 pi r^3
+    assert volume < 0
+    assert -volume == pytest.approx(4 / 3 * np.pi * 1000, rel=0.01)
+    normals = geometry.vertex_normals(m.vertices, m.faces)
+    assert np.median(np.einsum("ij,ij->i", normals, m.normals)) < -0.9  # faces wound against the exact normals
+
+
+def test_voxel_shapes_centre_is_a_seeded_sub_voxel_offset(skimage):
+    a, b, c = (shapes.voxel_sphere(3.0, (0.5, 0.5, 0.5), seed=s) for s in (0, 0, 1))
+    np.testing.assert_array_equal(a.vertices, b.vertices)
+    assert not np.allclose(a.center, c.center)
+    assert np.abs(a.center - c.center).max() < 0.5  # both within half a voxel of the grid's middle
+
+
+def test_ellipsoid_closest_points_are_on_the_surface_and_along_the_normal():
+    axes = np.array([5.0, 3.0, 2.0])
+    rng = np.random.default_rng(0)
+    directions = rng.normal(size=(500, 3))
+    surface = directions / np.linalg.norm(directions / axes, axis=1, keepdims=True)
+    points = surface * rng.uniform(0.8, 1.3, size=(500, 1))  # inside and outside, near the surface
+    closest = shapes.ellipsoid_closest_points(points, axes)
+    np.testing.assert_allclose(np.sum((closest / axes) ** 2, axis=1), 1.0, rtol=1e-12)
+    gradient = closest / axes**2  # the normality condition: y - x parallel to the normal at x
+    residual = np.cross(points - closest, gradient / np.linalg.norm(gradient, axis=1, keepdims=True))
+    assert np.abs(residual).max() < 1e-10
+    # no point of a dense sample of the surface is closer
+    u, v = np.meshgrid(np.linspace(0, np.pi, 120), np.linspace(0, 2 * np.pi, 240), indexing="ij")
+    sample = np.stack([np.sin(u) * np.cos(v), np.sin(u) * np.sin(v), np.cos(u)], axis=-1).reshape(-1, 3) * axes
+    from scipy.spatial import cKDTree
+
+    brute, _ = cKDTree(sample).query(points)
+    assert (np.linalg.norm(points - closest, axis=1) <= brute + 1e-12).all()
+
+
+def test_voxel_ellipsoid_exact_values_match_the_closed_forms(skimage):
+    a, b, c = 6.0, 4.0, 3.0
+    m = shapes.voxel_ellipsoid((a, b, c), (1.0, 0.5, 0.5), seed=2)
+    x, y, z = (m.closest_points - m.center).T
+    np.testing.assert_allclose(x**2 / a**2 + y**2 / b**2 + z**2 / c**2, 1.0, rtol=1e-12)
+    s = x**2 / a**4 + y**2 / b**4 + z**2 / c**4
+    np.testing.assert_allclose(m.gaussian, 1 / (a * b * c) ** 2 / s**2, rtol=1e-9)
+    mean = (x**2 + y**2 + z**2 - a * a - b * b - c * c) / (2 * (a * b * c) ** 2 * s**1.5)
+    np.testing.assert_allclose(m.mean, -mean, rtol=1e-9)
+    assert np.abs(np.cross(m.vertices - m.closest_points, m.normals)).max() < 1e-10
+    assert np.linalg.norm(m.vertices - m.closest_points, axis=1).max() <= np.linalg.norm(m.spacing) / 2
+    assert geometry.signed_volume(m.vertices, m.faces) == pytest.approx(-4 / 3 * np.pi * a * b * c, rel=0.03)
+
+
+def test_voxel_torus_exact_values(skimage):
+    R, r = 8.0, 3.0
+    m = shapes.voxel_torus(R, r, (0.5, 0.5, 0.5), seed=4)
+    p = m.closest_points - m.center
+    np.testing.assert_allclose(p[:, 0] ** 2 + (np.hypot(p[:, 1], p[:, 2]) - R) ** 2, r * r, rtol=1e-12)
+    assert (m.k_max == 1 / r).all()
+    rho = np.hypot(p[:, 1], p[:, 2])
+    np.testing.assert_allclose(m.k_min, (rho - R) / r / rho, rtol=1e-9, atol=1e-15)  # cos(phi) / (R + r cos(phi))
+    assert m.k_min.min() == pytest.approx(-1 / (R - r), rel=0.01) and m.k_max.max() == 1 / r
+    top = MeshTopology.from_faces(m.faces, m.vertices.shape[0])
+    assert top.euler_characteristic == 0
+    assert geometry.signed_volume(m.vertices, m.faces) == pytest.approx(-2 * np.pi**2 * R * r * r, rel=0.02)
+    assert np.abs(np.einsum("ij,ij->i", m.dir_max, m.normals)).max() < 1e-12
+
+
+def test_voxel_shapes_reject_bad_options():
+    with pytest.raises(InvalidOptionError, match=r"`spacing` must be 3 positive numbers.*got \(1, 1\)"):
+        shapes.voxel_sphere(5.0, (1, 1))
+    with pytest.raises(InvalidOptionError, match=r"`minor_radius` must be below `major_radius`"):
+        shapes.voxel_torus(3.0, 4.0)
+    with pytest.raises(InvalidOptionError, match=r"`semi_axes` must be 3 positive number"):
+        shapes.voxel_ellipsoid((1.0, -1.0, 2.0))
+
+
+def test_voxel_shapes_refuse_a_huge_grid(skimage):
+    with pytest.raises(InvalidOptionError, match=r"the voxel grid would have .* voxels; use a larger `spacing`"):
+        shapes.voxel_sphere(100.0, (0.1, 0.1, 0.1))
+
+
+def test_voxel_shapes_name_the_extra_without_scikit_image(monkeypatch):
+    monkeypatch.setitem(sys.modules, "skimage.measure", None)
+    monkeypatch.setitem(sys.modules, "skimage", None)
+    with pytest.raises(ImportError, match=r"pip install 'meshcurv\[volume\]'"):
+        shapes.voxel_sphere(5.0)

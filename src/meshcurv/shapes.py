@@ -4,6 +4,9 @@ Shared by tests, documentation and benchmarks. Every function returns an
 :class:`AnalyticMesh` whose faces are wound counter-clockwise seen from outside
 (normals outward; for height fields, upward), so that the exact curvatures follow
 meshcurv's sign convention: positive where the surface bends away from its normal.
+The exception is the marching-cubes meshes of voxelised solids (:func:`voxel_sphere`,
+:func:`voxel_ellipsoid`, :func:`voxel_torus`; they need scikit-image): their faces are
+wound inward as marching cubes returns them, while their exact values are outward.
 
 Examples
 --------
@@ -28,6 +31,7 @@ from .errors import InvalidOptionError
 __all__ = [
     "AnalyticMesh", "icosphere", "uv_sphere", "torus", "ellipsoid", "cylinder", "saddle",
     "random_sphere", "random_ellipsoid", "hemisphere", "with_normal_noise",
+    "VoxelMesh", "voxel_sphere", "voxel_ellipsoid", "voxel_torus", "ellipsoid_closest_points",
 ]
 
 
