@@ -230,7 +230,7 @@ f -4 -2 -1
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ("v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n", "a `v` line has fewer than 3 coordinates"),
+        ("v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n", "line 2: a `v` line has fewer than 3 coordinates"),
         ("v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n", "a vertex coordinate is not a number"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\n", r"no faces \(`f` lines\) found"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3.5\n", "a face index is not an integer"),

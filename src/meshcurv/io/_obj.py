@@ -16,6 +16,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError
+from ._text import numbers_per_line
 
 __all__ = ["read_obj", "write_obj"]
 
@@ -41,16 +42,22 @@ def read_obj(path):
     vertex_lines = _VERTEX.findall(data)
     if not vertex_lines:
         raise MeshFileError(f"{path}: no vertices (`v` lines) found; is it an OBJ file?")
-    tokens = b" ".join(vertex_lines).split()
-    if len(tokens) != 3 * len(vertex_lines):  # some lines carry w or colours: keep x y z
-        rows = [line.split() for line in vertex_lines]
-        if min(map(len, rows)) < 3:
-            raise MeshFileError(f"{path}: a `v` line has fewer than 3 coordinates")
-        tokens = [value for row in rows for value in row[:3]]
-    try:
-        vertices = np.array(tokens, dtype=np.float64).reshape(-1, 3)
-    except ValueError as exc:
-        raise MeshFileError(f"{path}: a vertex coordinate is not a number ({exc})") from None
+    parsed = numbers_per_line(vertex_lines)
+    if parsed is None:
+        raise MeshFileError(f"{path}: a vertex coordinate is not a number")
+    values, counts = parsed
+    if (counts == 3).all():
+        vertices = values.reshape(-1, 3)
+    else:  # per line: `v x y z w` and `v x y z r g b` keep x y z; the next lines do not shift
+        short = int(np.flatnonzero(counts < 3)[0]) if (counts < 3).any() else None
+        if short is not None:
+            match = next(m for i, m in enumerate(_VERTEX.finditer(data)) if i == short)
+            line = data.count(b"\n", 0, match.start()) + 1
+            raise MeshFileError(
+                f"{path}: line {line}: a `v` line has fewer than 3 coordinates ({int(counts[short])})"
+            )
+        first = np.cumsum(counts) - counts
+        vertices = values[first[:, None] + np.arange(3)]
 
     face_lines = _FACE.findall(data)
     n_face_lines = sum(data.count(b"\nf" + blank) + data.startswith(b"f" + blank) for blank in (b" ", b"\t"))

@@ -11,6 +11,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError
+from ._text import numbers_per_line
 
 __all__ = ["read_off", "write_off"]
 
@@ -18,32 +19,62 @@ _COMMENT = re.compile(rb"#[^\n]*")
 
 
 def read_off(path):
-    """Read an OFF file: ``OFF``, ``V F E``, V lines of x y z, F lines of ``k i j ...`` (0-based)."""
+    """Read an OFF file: ``OFF``, ``V F E``, V lines of x y z, F lines of ``k i j ...`` (0-based).
+
+    Read line by line (in numpy): what follows the coordinates of a vertex or
+    the ``k`` indices of a face on its line (a colour, as the format allows)
+    is ignored. The declared counts are checked against the lines the file
+    holds before anything is allocated for them.
+    """
     with open(path, "rb") as handle:
         data = _COMMENT.sub(b"", handle.read())
-    tokens = data.split()
-    if not tokens or tokens[0] != b"OFF":
-        found = tokens[0][:20].decode("ascii", "replace") if tokens else ""
+    lines = [line for line in data.split(b"\n") if line.strip()]
+    words = lines[0].split() if lines else []
+    if not words or words[0] != b"OFF":
+        found = words[0][:20].decode("ascii", "replace") if words else ""
         raise MeshFileError(f"{path}: not an OFF file (it should start with 'OFF'; starts with {found!r})")
+    counts_line = words[1:] if len(words) > 1 else (lines[1].split() if len(lines) > 1 else [])
+    body = lines[1:] if len(words) > 1 else lines[2:]
     try:
-        n_vertices, n_faces = int(tokens[1]), int(tokens[2])
-        end = 4 + 3 * n_vertices
-        vertices = np.array(tokens[4:end], dtype=np.float64).reshape(-1, 3)
-        corners = np.array(tokens[end:], dtype=np.int64)
+        n_vertices, n_faces = int(counts_line[0]), int(counts_line[1])
     except (IndexError, ValueError) as exc:
         raise MeshFileError(f"{path}: the OFF counts, vertices or faces cannot be read ({exc})") from None
-    if vertices.shape[0] != n_vertices:
-        raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; the file has {vertices.shape[0]}")
-    if corners.size == 4 * n_faces and (corners[::4] == 3).all():
-        return vertices, corners.reshape(-1, 4)[:, 1:]
-    faces, position = [], 0
-    for _ in range(n_faces):  # polygons (or face colours): the sizes decide where each face starts
-        size = int(corners[position]) if position < corners.size else 0
-        if size < 3 or position + 1 + size > corners.size:
-            raise MeshFileError(f"{path}: face {len(faces)} is truncated or has fewer than 3 corners")
-        faces.append(corners[position + 1:position + 1 + size])
-        position += 1 + size
-    return vertices, faces
+    if n_vertices < 0 or n_faces < 0:
+        raise MeshFileError(f"{path}: the OFF counts must not be negative; got {n_vertices} and {n_faces}")
+    if n_vertices > len(body):
+        raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; the file has {min(len(body), n_vertices)}")
+    if n_vertices + n_faces > len(body):
+        raise MeshFileError(
+            f"{path}: the header declares {n_vertices} vertices and {n_faces} faces but the file holds only "
+            f"{len(body)} lines for them; face {len(body) - n_vertices} is missing (the file is cut short)"
+        )
+    parsed = numbers_per_line(body[:n_vertices])
+    if parsed is None:
+        raise MeshFileError(f"{path}: the OFF counts, vertices or faces cannot be read (a coordinate is not a number)")
+    values, counts = parsed
+    if (counts < 3).any():
+        bad = int(np.flatnonzero(counts < 3)[0])
+        raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; vertex {bad} has "
+                            f"{int(counts[bad])} coordinates")
+    vertices = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
+    parsed = numbers_per_line(body[n_vertices:n_vertices + n_faces])
+    if parsed is None:
+        raise MeshFileError(f"{path}: the OFF counts, vertices or faces cannot be read (a face index is not a number)")
+    values, counts = parsed
+    first = np.cumsum(counts) - counts
+    sizes = np.where(counts > 0, values[np.minimum(first, max(values.size - 1, 0))] if values.size else 0, 0)
+    bad = (counts == 0) | (sizes != np.floor(sizes)) | (sizes < 3) | (sizes > counts - 1)
+    if bad.any():
+        face = int(np.flatnonzero(bad)[0])
+        raise MeshFileError(f"{path}: face {face} is truncated or has fewer than 3 corners")
+    sizes = sizes.astype(np.int64)
+    corners = values[np.repeat(first + 1 - (np.cumsum(sizes) - sizes), sizes) + np.arange(sizes.sum())]
+    if not (corners == np.floor(corners)).all() or (np.abs(corners) > 2.0 ** 53).any():
+        raise MeshFileError(f"{path}: a face index is not an integer")
+    corners = corners.astype(np.int64)
+    if sizes.size and (sizes == sizes[0]).all():
+        return vertices, corners.reshape(sizes.size, int(sizes[0]))
+    return vertices, np.split(corners, np.cumsum(sizes)[:-1])
 
 
 def write_off(path, vertices: np.ndarray, faces, point_data: dict) -> None:
