@@ -220,7 +220,7 @@ def test_run_refuses_bad_options_before_any_work(tmp_path):
         batch.run(folder, out_dir, client=object(), scheduler=dead)
     with pytest.raises(InvalidOptionError, match="`workers` sizes the local cluster"):
         batch.run(folder, out_dir, scheduler=dead, workers=2)
-    with pytest.raises(InvalidOptionError, match="`workers` must be an integer >= 1; got 0"):
+    with pytest.raises(InvalidOptionError, match=r"`workers` must be an integer between 1 and 1024; got 0"):
         batch.run(folder, out_dir, workers=0)
     with pytest.raises(InvalidOptionError, match="unknown method 'gauss'"):
         batch.run(folder, out_dir, scheduler=dead, method="gauss")

@@ -31,13 +31,18 @@ worker dies leaves no partial file (see :func:`run`).
 from __future__ import annotations
 
 import contextlib
+import faulthandler
 import glob
+import hashlib
 import json
 import logging
 import os
 import pathlib
 import re
+import tempfile
+import threading
 import time
+import uuid
 import warnings
 from dataclasses import dataclass
 from typing import Callable
@@ -45,10 +50,11 @@ from typing import Callable
 import numpy as np
 
 from ._validation import check_choice, check_int_option, check_positive_float
-from .errors import InvalidOptionError, MeshFileError, MissingDependencyError
+from .errors import InvalidOptionError, MeshcurvWarning, MeshFileError, MissingDependencyError
 from .estimators import DEFAULT_METHOD
 
-__all__ = ["run", "local_cluster", "process_mesh", "process_meshes", "expand_inputs", "COLUMNS", "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS"]
+__all__ = ["run", "local_cluster", "process_mesh", "process_meshes", "expand_inputs", "fingerprint", "COLUMNS",
+           "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS", "DEFAULT_TIMEOUT", "NoWorkerError"]
 
 logger = logging.getLogger(__name__)
 
@@ -65,6 +71,35 @@ OUTPUT_FORMATS = ("ply", "npz", "vtp", "vtu", "vtk", "csv")
 RECORDS = ".meshcurv-batch"
 
 _SUMMARY_NAME = "summary"
+
+#: The most worker processes of a local cluster (each a Python process of about 100 MB, before any mesh).
+MAX_WORKERS = 1024
+
+#: The default time limit of one mesh, in seconds (``timeout`` of :func:`run`, ``--timeout``): a hundred
+#: times what icc takes on a mesh of ten million vertices, so only a mesh that never ends reaches it.
+DEFAULT_TIMEOUT = 3600.0
+
+#: The most times the worker computing a mesh may die (killed: out of memory, a flaky node) before
+#: the mesh is reported as failed; below Dask's ``allowed-failures`` (3), so that the meshes that
+#: share its task are not lost with it.
+MAX_WORKER_DEATHS = 2
+
+#: Seconds without any worker after which :func:`run` gives up (:class:`NoWorkerError`): on the local
+#: cluster, whose nannies restart a dead worker within seconds, and on a cluster of one's own (whose
+#: workers may wait in a queue of the batch system).
+NO_WORKER_SECONDS = {"local": 60.0, "remote": 600.0}
+
+#: Files up to this size are hashed whole for their fingerprint; of larger ones, the first and last
+#: :data:`HASH_PART_BYTES` (with the size and mtime): see :func:`fingerprint`.
+HASH_WHOLE_BYTES = 256 * 2**20
+HASH_PART_BYTES = 16 * 2**20
+
+#: How often :func:`run` looks at the cluster while it waits for results, in seconds.
+_POLL_SECONDS = 1.0
+
+
+class NoWorkerError(TimeoutError):
+    """The cluster has had no worker for too long (they died and none could be started)."""
 
 #: The most bytes of input files sent to a worker as one task (a single larger mesh is a task of its
 #: own). Dask costs a few milliseconds per task, and the process that schedules competes with the
@@ -124,6 +159,41 @@ def _readable_extensions() -> set[str]:
     return {extension for extension, fmt in FORMATS.items() if fmt.read is not None}
 
 
+def _identity(path) -> tuple[int, int] | None:
+    """The real identity of a file or folder, ``(st_dev, st_ino)`` (links followed), or None if it is not there."""
+    try:
+        stat = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return stat.st_dev, stat.st_ino
+
+
+class _Folder:
+    """A folder known by its real identity: whether a path lies in it, whatever the path's spelling.
+
+    Symbolic links, ``.`` and ``..``, bind mounts and other aliases of the
+    folder (or of the folders above a path) all compare equal: each folder
+    above the path's real location is compared by ``(st_dev, st_ino)``.
+    """
+
+    def __init__(self, path):
+        self.path = path
+        self.identity = _identity(path)
+        self._seen: dict[str, bool] = {}
+
+    def holds(self, path) -> bool:
+        """True when ``path`` is this folder or lies below it."""
+        if self.identity is None:
+            return False
+        return self._below(os.path.realpath(path))
+
+    def _below(self, real: str) -> bool:
+        if real not in self._seen:
+            parent = os.path.dirname(real)
+            self._seen[real] = _identity(real) == self.identity or (parent != real and self._below(parent))
+        return self._seen[real]
+
+
 def expand_inputs(inputs, *, exclude=None) -> list[pathlib.Path]:
     """The mesh files named by files, folders and glob patterns, sorted by path.
 
@@ -136,7 +206,10 @@ def expand_inputs(inputs, *, exclude=None) -> list[pathlib.Path]:
         recursive, hidden files left out) and glob patterns (``*``, ``?``,
         ``[...]``; ``**`` crosses folders; mesh files only).
     exclude : str or os.PathLike, optional
-        A folder whose files are never inputs (the output folder).
+        A folder whose files are never inputs (the output folder), compared
+        by real identity (symbolic links, ``..``, bind mounts resolved): the
+        files of folders and patterns that lie in it are left out; a file or
+        folder named explicitly that lies in it is an error.
 
     Returns
     -------
@@ -147,7 +220,8 @@ def expand_inputs(inputs, *, exclude=None) -> list[pathlib.Path]:
     ------
     MeshFileError
         An input that is neither a file, a folder nor a pattern that matches
-        something; or nothing found at all.
+        something; a file or folder named explicitly inside ``exclude``; or
+        nothing found at all.
 
     Examples
     --------
@@ -161,23 +235,34 @@ def expand_inputs(inputs, *, exclude=None) -> list[pathlib.Path]:
     if isinstance(inputs, (str, os.PathLike)):
         inputs = [inputs]
     extensions = _readable_extensions()
-    excluded = os.path.abspath(exclude) if exclude is not None else None
+    excluded = _Folder(exclude) if exclude is not None else None
     found: dict[str, pathlib.Path] = {}
+    left_out = []
 
     def add(path: pathlib.Path) -> None:
-        absolute = os.path.abspath(path)
-        if excluded is not None and (absolute == excluded or absolute.startswith(excluded + os.sep)):
+        if excluded is not None and excluded.holds(path):
+            left_out.append(path)
             return
-        found.setdefault(absolute, path)
+        found.setdefault(os.path.abspath(path), path)
+
+    def refuse_inside(text: str, path: pathlib.Path) -> None:
+        if excluded is not None and excluded.holds(path):
+            raise MeshFileError(
+                f"{text}: is in the output folder {os.fspath(exclude)} (the same folder, under another name "
+                "or not); the results would replace or mix with the inputs: choose an output folder "
+                "apart from the inputs"
+            )
 
     for item in inputs:
         text = os.fspath(item)
         path = pathlib.Path(text)
         if path.is_dir():
+            refuse_inside(text, path)
             for child in sorted(path.iterdir()):
                 if child.is_file() and not child.name.startswith(".") and child.suffix.lower() in extensions:
                     add(child)
         elif path.is_file():
+            refuse_inside(text, path)
             add(path)
         elif _GLOB_CHARACTERS.search(text):
             matches = [pathlib.Path(match) for match in glob.glob(text, recursive=True)]
@@ -186,10 +271,15 @@ def expand_inputs(inputs, *, exclude=None) -> list[pathlib.Path]:
                 raise MeshFileError(f"{text}: the pattern matches no mesh file")
             for match in matches:
                 add(match)
+        elif path.exists() or os.path.lexists(path):
+            raise MeshFileError(f"{text}: neither a file nor a folder (a broken link, a device?)")
         else:
             raise MeshFileError(f"{text}: no such file or folder")
     if not found:
         listed = ", ".join(os.fspath(item) for item in inputs) or "(none)"
+        if left_out:
+            raise MeshFileError(f"no mesh file found in {listed} but in the output folder {os.fspath(exclude)} "
+                                f"({len(left_out)} files: results are never inputs)")
         raise MeshFileError(f"no mesh file found in {listed} (mesh files end in {', '.join(sorted(extensions))})")
     return sorted(found.values(), key=os.fspath)
 
@@ -222,7 +312,22 @@ def _plan(paths: list[pathlib.Path], out_dir: pathlib.Path, suffix: str) -> list
         claimed[output] = path
         record = out_dir / RECORDS / relative.with_name(relative.name + ".json")
         jobs.append(_Job(path, os.fspath(source), os.fspath(output), os.fspath(record)))
+    inputs = {_identity(job.source): job.path for job in jobs}
+    inputs.pop(None, None)
+    for target in [*reserved, *(pathlib.Path(path) for job in jobs for path in (job.output, job.record))]:
+        _refuse_input(target, inputs)
     return jobs
+
+
+def _refuse_input(target, inputs: dict) -> None:
+    """Raise MeshFileError when the file ``target`` is one of ``inputs`` (keyed by real identity)."""
+    identity = _identity(target)
+    if identity is not None and identity in inputs:
+        raise MeshFileError(
+            f"{os.fspath(target)}: is the input file {os.fspath(inputs[identity])} under another name (a link, "
+            "an alias of its folder); writing it would replace the input: choose an output folder apart "
+            "from the inputs"
+        )
 
 
 def _options(method, smoothing_steps, radius, orient) -> dict:
@@ -288,6 +393,60 @@ def _stale_temporaries(targets) -> list[pathlib.Path]:
     return sorted(set(found))
 
 
+def fingerprint(path) -> dict:
+    """What identifies the content of an input file: its size, mtime (ns) and a BLAKE2b hash.
+
+    A batch records it with each result; a later run computes the mesh again
+    when the size or mtime differ, or else when the hash differs (a file
+    replaced by another of the same size with its mtime kept: ``cp -p``,
+    ``rsync -t``, an archive unpacked).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    dict
+        ``{"size": int, "mtime_ns": int, "blake2b": str}``. Files up to
+        :data:`HASH_WHOLE_BYTES` (256 MiB) are hashed whole; of a larger file,
+        the first and the last :data:`HASH_PART_BYTES` (16 MiB) are hashed:
+        every format keeps its header (and so the counts) at the start and
+        ends with the last faces, so a mesh of another size or shape changes
+        them, while hashing a 10 GB scan whole would cost a resume tens of
+        seconds for each file.
+
+    Raises
+    ------
+    OSError
+        The file cannot be read.
+    """
+    with open(path, "rb") as stream:
+        stat = os.fstat(stream.fileno())
+        digest = hashlib.blake2b(digest_size=16)
+        if stat.st_size <= HASH_WHOLE_BYTES:
+            for block in iter(lambda: stream.read(2**20), b""):
+                digest.update(block)
+        else:
+            digest.update(stream.read(HASH_PART_BYTES))
+            stream.seek(-HASH_PART_BYTES, os.SEEK_END)
+            digest.update(stream.read(HASH_PART_BYTES))
+    return {"size": stat.st_size, "mtime_ns": stat.st_mtime_ns, "blake2b": digest.hexdigest()}
+
+
+def _unchanged(path, stored) -> bool:
+    """Whether ``path`` still has the fingerprint ``stored`` (the hash is read only when size and mtime agree)."""
+    if not isinstance(stored, dict):
+        return False
+    try:
+        stat = os.stat(path)
+        if (stat.st_size, stat.st_mtime_ns) != (stored.get("size"), stored.get("mtime_ns")):
+            return False
+        return fingerprint(path) == stored
+    except OSError:
+        return False
+
+
 def _write_record(path: pathlib.Path, record: dict) -> None:
     from .io._files import atomic_output
 
@@ -296,21 +455,113 @@ def _write_record(path: pathlib.Path, record: dict) -> None:
         temporary.write_text(json.dumps(record, allow_nan=True))
 
 
+class _Unreadable(Exception):
+    """A record that exists but cannot be used (cut short, corrupt, not a record)."""
+
+
 def _read_record(path: pathlib.Path) -> dict | None:
+    """The record at ``path``; None when there is none; :class:`_Unreadable` when it is damaged."""
     try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
+        record = json.loads(pathlib.Path(path).read_text())
+    except FileNotFoundError:
         return None
+    except (OSError, ValueError) as exc:  # UnicodeDecodeError and JSONDecodeError are ValueErrors
+        raise _Unreadable(f"{type(exc).__name__}: {exc}") from None
+    if not (isinstance(record, dict) and isinstance(record.get("row"), dict)
+            and isinstance(record["row"].get("status"), str)):
+        raise _Unreadable("not a meshcurv batch record")
+    return record
+
+
+def _attempt_path(record: pathlib.Path) -> pathlib.Path:
+    """Where a worker notes the mesh it is computing (beside its record), until its record is written."""
+    return record.with_name(record.name.removesuffix(".json") + ".attempt")
+
+
+# ------------------------------------------------------------------------------------- time limits
+# A mesh over its time limit is stopped by ending its worker process: a reader looping in Python, a
+# compiled kernel holding the GIL or a C library cannot be interrupted from another thread. The
+# timer is faulthandler's, a C thread that needs no GIL; the nanny starts a new worker, Dask runs the
+# task again, and that attempt finds the mesh's attempt note with its deadline passed: the mesh is
+# failed ("timed out") and recorded, the meshes after it in the task are computed.
+
+_DEADLINES: dict[object, float] = {}
+_DEADLINES_LOCK = threading.Lock()
+_DEVNULL = None
+
+
+def _can_be_ended() -> bool:
+    """True in a Dask worker process that a nanny restarts (the local cluster's, ``dask worker``'s)."""
+    try:
+        from distributed import get_worker
+
+        return get_worker().nanny is not None
+    except (ImportError, ValueError, AttributeError):
+        return False
+
+
+def _arm_locked() -> None:
+    global _DEVNULL
+    if not _DEADLINES:
+        faulthandler.cancel_dump_traceback_later()
+        return
+    if _DEVNULL is None:
+        _DEVNULL = open(os.devnull, "w")  # noqa: SIM115 (kept open: faulthandler writes to it on expiry)
+    remaining = max(min(_DEADLINES.values()) - time.monotonic(), 0.001)
+    faulthandler.dump_traceback_later(remaining, exit=True, file=_DEVNULL)
+
+
+@contextlib.contextmanager
+def _time_limit(seconds: float | None):
+    """End this worker process if the block runs longer than ``seconds`` (no limit: None, or not in a worker)."""
+    if seconds is None or not _can_be_ended():
+        yield
+        return
+    token = object()
+    with _DEADLINES_LOCK:
+        _DEADLINES[token] = time.monotonic() + seconds
+        _arm_locked()
+    try:
+        yield
+    finally:
+        with _DEADLINES_LOCK:
+            del _DEADLINES[token]
+            _arm_locked()
+
+
+def _seconds(value: float) -> str:
+    return f"{value:g} s"
+
+
+def _previous_attempt(attempt: pathlib.Path, run_id: str | None, timeout: float | None) -> tuple[int, str | None]:
+    """The worker deaths of this run while computing the mesh, and the error to report instead of trying again."""
+    if run_id is None:
+        return 0, None
+    try:
+        noted = json.loads(attempt.read_text())
+    except (OSError, ValueError):
+        return 0, None
+    if not isinstance(noted, dict) or noted.get("run") != run_id:
+        return 0, None  # a note of an earlier run, interrupted: try again
+    deaths = int(noted.get("deaths", 0)) + 1
+    if timeout is not None and time.time() >= float(noted.get("deadline", np.inf)):
+        return deaths, f"TimeoutError: timed out after {_seconds(timeout)} (the time limit of a mesh: --timeout)"
+    if deaths >= MAX_WORKER_DEATHS:
+        return deaths, (f"WorkerDied: the worker computing this mesh died {deaths} times (killed by the system: "
+                        "out of memory?)")
+    return deaths, None
 
 
 def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smoothing_steps: int | None = None,
-                 radius: float | None = None, orient: str | None = None) -> dict:
+                 radius: float | None = None, orient: str | None = None, timeout: float | None = None,
+                 run_id: str | None = None) -> dict:
     """Compute the curvatures of one mesh file, write the result and its record, return its summary row.
 
     The task :func:`run` sends to the workers; it never raises for a bad mesh.
     The result file is written under a temporary name; the record is written
     before the result is renamed into place, so a result that exists always
-    has its record. An older result at ``output`` is replaced.
+    has its record. An older result at ``output`` is replaced; ``output``
+    is never the input file itself (checked before the rename).
 
     Parameters
     ----------
@@ -320,16 +571,27 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
         The result file; its extension picks the format (one of
         :data:`OUTPUT_FORMATS`). Its folder is created if needed.
     record : str or os.PathLike
-        The JSON file that keeps the row, for later runs.
+        The JSON file that keeps the row and the input's :func:`fingerprint`,
+        for later runs; a failure is recorded too.
     method, smoothing_steps, radius, orient
         As in :func:`meshcurv.principal_curvatures`.
+    timeout : float, optional
+        The time limit in seconds. Enforced only in a Dask worker that has a
+        nanny (the local cluster's, ``dask worker``'s): past it, the worker
+        process is ended, and the next attempt of the task (``run_id`` given)
+        reports the mesh as timed out.
+    run_id : str, optional
+        The batch run: with it, the mesh being computed is noted beside its
+        record, so that an attempt after its worker died knows it (see
+        :data:`MAX_WORKER_DEATHS`).
 
     Returns
     -------
     dict
         The summary row (the keys of :data:`COLUMNS` but ``path``), with
         ``status`` ``'computed'``, or ``'failed'`` and the ``error`` (its type
-        and message) when the mesh could not be read, computed or written.
+        and message) when the mesh could not be read, computed or written,
+        took longer than ``timeout`` or killed its workers.
     """
     from .curvature import principal_curvatures
     from .io import read_mesh, write_curvatures
@@ -339,32 +601,65 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
     source, output, record = pathlib.Path(source), pathlib.Path(output), pathlib.Path(record)
     options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
     options = {name: value for name, value in options.items() if value is not None}
+    stored_options = {"method": method, **options}
     row = {"status": "computed", "error": "", "warnings": "", "method": method, "output": os.fspath(output)}
+    attempt = _attempt_path(record)
+    deaths, error = _previous_attempt(attempt, run_id, timeout)
+    facts = None
     try:
-        with warnings.catch_warnings(record=True) as caught:
+        facts = fingerprint(source)
+    except OSError:
+        pass  # read_mesh says what is wrong with it
+    if error is not None:
+        row = {"status": "failed", "error": error, "warnings": "", "method": method, "output": "",
+               "seconds": timeout if error.startswith("TimeoutError") else np.nan}
+        logger.info("%s failed: %s", source, error)
+        _record_failure(record, row, stored_options, facts, timeout)
+        attempt.unlink(missing_ok=True)
+        return row
+    try:
+        if run_id is not None:
+            deadline = time.time() + timeout if timeout is not None else None
+            _write_record(attempt, {"run": run_id, "deaths": deaths, "deadline": deadline})
+        with _time_limit(timeout), warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             vertices, faces = read_mesh(source)
             result = principal_curvatures(vertices, faces, method=method, **options)
-        facts = result.diagnosis
+        facts_of = result.diagnosis
         row.update(
-            n_vertices=facts.n_vertices, n_faces=facts.n_faces, area=facts.area,
-            volume=np.nan if facts.volume is None else facts.volume,
-            euler_characteristic=facts.euler_characteristic, n_components=facts.n_components,
-            n_boundary_loops=facts.n_boundary_loops, n_invalid=int((~result.valid).sum()),
+            n_vertices=facts_of.n_vertices, n_faces=facts_of.n_faces, area=facts_of.area,
+            volume=np.nan if facts_of.volume is None else facts_of.volume,
+            euler_characteristic=facts_of.euler_characteristic, n_components=facts_of.n_components,
+            n_boundary_loops=facts_of.n_boundary_loops, n_invalid=int((~result.valid).sum()),
             warnings="; ".join(dict.fromkeys(str(warning.message) for warning in caught)),
         )
         row.update(_statistics(result))
         output.parent.mkdir(parents=True, exist_ok=True)
         with atomic_output(output) as temporary:
             write_curvatures(temporary, vertices, faces, result, overwrite=True, source=source)
+            inputs = {_identity(source): source}
+            _refuse_input(output, inputs)  # the output folder may have become an alias of the input's
+            _refuse_input(record, inputs)
             output.unlink(missing_ok=True)  # an older result must not outlive a newer record
             row["seconds"] = time.perf_counter() - start
-            _write_record(record, {"row": row, "options": {"method": method, **options}})
+            _write_record(record, {"row": row, "options": stored_options, "input": facts})
     except Exception as exc:  # one bad mesh never sinks the batch: its row says what went wrong
         row = {"status": "failed", "error": f"{type(exc).__name__}: {exc}", "warnings": "", "method": method,
                "output": "", "seconds": time.perf_counter() - start}
         logger.info("%s failed: %s", source, row["error"])
+        _record_failure(record, row, stored_options, facts, timeout)
+    attempt.unlink(missing_ok=True)
     return row
+
+
+def _record_failure(record: pathlib.Path, row: dict, options: dict, facts: dict | None, timeout) -> None:
+    """Record a failed mesh, so that a later run reports it without trying again (unless its input changes)."""
+    if facts is None:  # the input cannot be read: nothing identifies it; a later run tries again
+        return
+    try:
+        _write_record(record, {"row": row, "options": options, "input": facts, "timeout": timeout})
+    except OSError as exc:  # the row still reaches the summary
+        logger.info("%s: cannot record the failure: %s", record, exc)
 
 
 def process_meshes(sources, outputs, records, **options) -> list[dict]:
@@ -443,7 +738,7 @@ def local_cluster(*, workers: int | None = None, dashboard: bool = True):
     import dask
     from dask.system import CPU_COUNT
 
-    n_workers = CPU_COUNT if workers is None else check_int_option(workers, "workers", minimum=1)
+    n_workers = CPU_COUNT if workers is None else check_int_option(workers, "workers", minimum=1, maximum=MAX_WORKERS)
     saved = dict(os.environ)
     try:
         with dask.config.set(WORKER_CONFIG), \
@@ -483,6 +778,7 @@ def _dashboard(client) -> str | None:
 def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | None = None,
         radius: float | None = None, orient: str | None = None, output_format: str = "ply", client=None,
         scheduler: str | None = None, workers: int | None = None, overwrite: bool = False,
+        timeout: float | None = DEFAULT_TIMEOUT, retry_failed: bool = False,
         progress: Callable[[int, int, int], None] | None = None):
     """Compute the curvatures of many mesh files on a Dask cluster and summarise them.
 
@@ -490,9 +786,13 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
     ----------
     paths : str, os.PathLike or sequence of them
         Mesh files, folders and glob patterns (see :func:`expand_inputs`).
-        Files inside ``out_dir`` are never inputs.
+        Files inside ``out_dir`` are never inputs: those of folders and
+        patterns are left out, a file or folder named there is an error;
+        ``out_dir`` is compared by real identity (a symbolic link to an input
+        folder, ``IN/.``, a bind mount are the same folder).
     out_dir : str or os.PathLike
-        The folder of the results and the summary; created if needed.
+        The folder of the results and the summary; created if needed, and
+        checked writable (a file created and removed) before any work.
     method : str, default: 'icc'
         Any of :data:`meshcurv.METHODS`.
     smoothing_steps, radius, orient : optional
@@ -512,7 +812,23 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
         ... set to 1).
     overwrite : bool, default: False
         Compute every mesh again. By default a mesh whose result file exists
-        (with its record) is skipped: its row is the one recorded then.
+        (with its record) is skipped: its row is the one recorded then,
+        unless the input has changed since (its size, mtime or content hash:
+        :func:`fingerprint`). Whatever ``overwrite``, no result ever replaces
+        an input file (checked by real identity: links, hard links, aliases).
+    timeout : float or None, default: :data:`DEFAULT_TIMEOUT` (3600)
+        The time limit of one mesh, in seconds (None: none). A mesh over it
+        fails with the error ``timed out after N s``: its worker process is
+        ended (nothing else can stop a reader or kernel that never returns)
+        and started again by its nanny. Enforced on workers with a nanny (the
+        local cluster's, ``dask worker``'s).
+    retry_failed : bool, default: False
+        Compute again the meshes that failed in an earlier run. By default a
+        recorded failure is reported again (status ``'failed'``, its error)
+        and not retried, so that a file that hangs or kills its workers costs
+        one time limit, not one per run; a failed mesh whose input has
+        changed since, or that timed out under a shorter ``timeout``, is
+        always retried.
     progress : callable, optional
         Called as ``progress(done, total, failed)`` once before the first mesh
         (``done`` counts the skipped ones) and after each task: small meshes
@@ -538,22 +854,36 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
     Raises
     ------
     MeshFileError
-        An input that does not exist or matches nothing; a result file that
-        exists but was not written by a batch (no record) without ``overwrite``.
+        An input that does not exist or matches nothing; an input inside
+        ``out_dir``; a result or record that would be an input file; an
+        ``out_dir`` that cannot be written; a result file that exists but was
+        not written by a batch (no record) without ``overwrite``.
     InvalidOptionError
         Bad options; two inputs that would write the same result; results of
         another method or options in ``out_dir`` without ``overwrite``.
+    NoWorkerError
+        The cluster had no worker for :data:`NO_WORKER_SECONDS` (60 s on the
+        local cluster, 600 s on another): the workers died and none could be
+        started. What was computed is kept and recorded; the next run resumes.
     MissingDependencyError
         dask.distributed, pandas or pyarrow is not installed.
 
     Notes
     -----
     One bad file never stops the batch: its row has status ``'failed'`` and
-    the error. When a worker process dies (killed, out of memory), Dask runs
-    its task again on another worker. A task that has killed
-    ``distributed.scheduler.allowed-failures`` + 1 workers (3 + 1 by default)
-    is split into one task per mesh, and a mesh whose own task kills that many
-    workers is reported as failed: the meshes that shared its task are not. Files are written under temporary names and renamed
+    the error, and it is recorded (a later run reports it without trying
+    again, see ``retry_failed``). When a worker process dies (killed, out of
+    memory), Dask runs its task again on another worker; a mesh whose worker
+    has died :data:`MAX_WORKER_DEATHS` (2) times while computing it fails
+    with ``WorkerDied``, and the meshes that shared its task are computed. A
+    task that has killed ``distributed.scheduler.allowed-failures`` + 1
+    workers nonetheless (a lower setting) is split into one task per mesh,
+    and a mesh whose own task kills that many workers is reported as failed
+    (``KilledWorker``). A damaged record in ``out_dir/.meshcurv-batch`` (a
+    run cut short, a full disk) is ignored with one warning, and its mesh
+    computed again. When the summary files cannot be written at the end,
+    the table is still returned (with a warning; its
+    ``attrs["not_written"]`` says why). Files are written under temporary names and renamed
     when complete; temporaries left by a killed worker are removed when the
     batch ends. An interrupted call (KeyboardInterrupt) writes no summary; the
     next call resumes where it stopped.
@@ -577,43 +907,50 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
     if workers is not None:
         if client is not None or scheduler is not None:
             raise InvalidOptionError("`workers` sizes the local cluster; it cannot be used with `client` or `scheduler`")
-        workers = check_int_option(workers, "workers", minimum=1)
+        workers = check_int_option(workers, "workers", minimum=1, maximum=MAX_WORKERS)
+    if timeout is not None:
+        timeout = check_positive_float(timeout, "timeout")
     options = _options(method, smoothing_steps, radius, orient)
     out_dir = pathlib.Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise MeshFileError(f"{out_dir}: is a file; the output must be a folder")
     jobs = _plan(expand_inputs(paths, exclude=out_dir), out_dir, "." + output_format)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    _check_writable(out_dir)
 
     rows: dict[int, dict] = {}
-    todo = []
+    todo, damaged = [], []
     for index, job in enumerate(jobs):
-        stored = _completed(job, options, overwrite=overwrite)
+        stored = _completed(job, options, overwrite=overwrite, retry_failed=retry_failed, timeout=timeout,
+                            damaged=damaged)
         if stored is None:
             todo.append(index)
         else:
-            rows[index] = {**stored, "status": "skipped", "output": job.output}
-    failed = 0
+            rows[index] = stored
+    if damaged:
+        warnings.warn(f"{len(damaged)} records in {out_dir / RECORDS} cannot be read (cut short or corrupt: "
+                      f"{damaged[0][0].name}: {damaged[0][1]}); their meshes are computed again",
+                      MeshcurvWarning, stacklevel=2)
+    failed = sum(row["status"] == "failed" for row in rows.values())
     if progress is not None:
         progress(len(rows), len(jobs), failed)
     logger.info("%d meshes: %d to compute, %d already done", len(jobs), len(todo), len(rows))
 
     if todo:
         owned = False
+        task_options = {**options, "timeout": timeout, "run_id": uuid.uuid4().hex}
         try:
             with _cluster(distributed, client=client, scheduler=scheduler, workers=workers) as (active, owned):
                 logger.info("Dask dashboard: %s", _dashboard(active) or "none (pip install bokeh to have one)")
                 chunks = _chunks(jobs, todo, workers=_worker_count(active))
                 logger.info("%d meshes in %d tasks", len(todo), len(chunks))
-                pending = _submit(active, jobs, chunks, options)
+                pending = _submit(active, jobs, chunks, task_options)
+                watch = _WorkerWatch(active, NO_WORKER_SECONDS["local" if owned else "remote"])
                 try:
                     while pending:
-                        outcomes = distributed.as_completed(list(pending), with_results=True, raise_errors=False)
                         retry = []
-                        for future, outcome in outcomes:
+                        for future in _finished(distributed, list(pending), watch):
                             chunk = pending.pop(future)
-                            if future.status == "error":  # Dask gives (type, exception, traceback)
-                                outcome = outcome[1]
+                            outcome = _outcome(future)
                             future.release()
                             if isinstance(outcome, distributed.KilledWorker) and len(chunk) > 1:
                                 # a mesh of the chunk kills its workers: run each alone, so that only it fails
@@ -624,9 +961,11 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
                             for index, row in zip(chunk, _rows(outcome, chunk, distributed)):
                                 rows[index] = row
                                 failed += row["status"] == "failed"
+                                if isinstance(outcome, distributed.KilledWorker):
+                                    _record_lost(jobs[index], row, options, timeout)
                             if progress is not None:
                                 progress(len(rows), len(jobs), failed)
-                        pending = _submit(active, jobs, retry, options)
+                        pending.update(_submit(active, jobs, retry, task_options))
                 except BaseException:
                     active.cancel(list(pending))
                     raise
@@ -637,27 +976,139 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
                 _remove_temporaries(jobs, todo)
 
     summary = _summary(pandas, jobs, rows)
-    _write_summary(summary, out_dir)
+    try:
+        _write_summary(summary, out_dir)
+    except OSError as exc:  # the rows are not lost with the files: the caller has them
+        message = f"{out_dir}: the summary could not be written ({type(exc).__name__}: {exc})"
+        summary.attrs["not_written"] = message
+        warnings.warn(message, MeshcurvWarning, stacklevel=2)
     return summary
 
 
-def _completed(job: _Job, options: dict, *, overwrite: bool) -> dict | None:
-    """The recorded row of a mesh whose result exists, or None when it is to be computed."""
+def _check_writable(out_dir: pathlib.Path) -> None:
+    """Create ``out_dir`` and its records folder, and a file in each (removed): fail before any work."""
+    for folder in (out_dir, out_dir / RECORDS):
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            handle, probe = tempfile.mkstemp(dir=folder, prefix=".meshcurv-probe.")
+            os.close(handle)
+            os.unlink(probe)
+        except OSError as exc:
+            raise MeshFileError(f"{folder}: cannot write the results there ({exc.strerror or exc}); "
+                                "nothing was computed") from None
+
+
+class _WorkerWatch:
+    """Notices a cluster left without workers, and says so after ``patience`` seconds of it."""
+
+    def __init__(self, client, patience: float):
+        self.client = client
+        self.patience = patience
+        self.since = None
+
+    def check(self) -> None:
+        try:
+            count = len(self.client.nthreads())
+        except Exception:  # the scheduler does not answer: as bad as no worker
+            count = 0
+        if count:
+            self.since = None
+            return
+        now = time.monotonic()
+        if self.since is None:
+            self.since = now
+            logger.warning("the cluster has no worker (they died?); waiting up to %s for one",
+                           _seconds(self.patience))
+        elif now - self.since >= self.patience:
+            raise NoWorkerError(
+                f"the cluster has had no worker for {_seconds(self.patience)}: the workers died and none could be "
+                "started (out of memory? see the worker logs); the meshes computed so far are kept, run again "
+                "to resume"
+            )
+
+
+def _finished(distributed, futures: list, watch: _WorkerWatch) -> list:
+    """The futures that have ended, waiting for at least one while watching the cluster's workers."""
+    while True:
+        done, _ = _wait_some(distributed, futures)
+        if done:
+            return list(done)
+        watch.check()
+
+
+def _wait_some(distributed, futures: list):
+    try:
+        return distributed.wait(futures, timeout=_POLL_SECONDS, return_when="FIRST_COMPLETED")
+    except TimeoutError:
+        return set(), set(futures)
+
+
+def _outcome(future):
+    """The result of a finished future, or the exception it ended with (errors and cancellations alike)."""
+    try:
+        return future.result()
+    except Exception as exc:  # noqa: BLE001 (a task's error is its row, not ours)
+        return exc
+
+
+def _record_lost(job: _Job, row: dict, options: dict, timeout) -> None:
+    """Record a mesh whose task was lost (its workers killed), so that a later run does not retry it forever."""
+    try:
+        facts = fingerprint(job.source)
+    except OSError:
+        return
+    _record_failure(pathlib.Path(job.record), row, options, facts, timeout)
+
+
+def _completed(job: _Job, options: dict, *, overwrite: bool, retry_failed: bool, timeout: float | None,
+               damaged: list) -> dict | None:
+    """The recorded row of a mesh that needs no work (status as recorded), or None when it is to be computed.
+
+    A record that cannot be read is added to ``damaged`` (the mesh is computed
+    again); a record whose input has changed since (:func:`fingerprint`) is
+    ignored; a failure is reported again, not retried, unless ``retry_failed``
+    or, for a mesh that timed out, a longer ``timeout``.
+    """
     output, record = pathlib.Path(job.output), pathlib.Path(job.record)
-    if overwrite or not output.exists():
+    if overwrite:
         return None
-    stored = _read_record(record)
+    try:
+        stored = _read_record(record)
+    except _Unreadable as exc:
+        damaged.append((record, str(exc)))
+        return None
     if stored is None:
-        raise MeshFileError(
-            f"{output}: exists but was not written by meshcurv batch (no record in {record.parent}); "
-            "pass overwrite=True (--overwrite) to replace it, or choose another output folder"
-        )
-    if stored.get("options") != options:
+        if output.exists():
+            raise MeshFileError(
+                f"{output}: exists but was not written by meshcurv batch (no record in {record.parent}); "
+                "pass overwrite=True (--overwrite) to replace it, or choose another output folder"
+            )
+        return None
+    row = stored["row"]
+    if row["status"] != "failed" and stored.get("options") != options and output.exists():
         raise InvalidOptionError(
             f"{output}: holds results computed with {_describe(stored.get('options'))}, not "
             f"{_describe(options)}; pass overwrite=True (--overwrite) to recompute, or choose another output folder"
         )
-    return stored["row"]
+    if not _unchanged(job.source, stored.get("input")):
+        logger.info("%s: changed since its result was recorded (or no fingerprint): computed again", job.path)
+        return None
+    if row["status"] == "failed":
+        if retry_failed or stored.get("options") != options:
+            return None
+        if row.get("error", "").startswith("TimeoutError") and _longer(timeout, stored.get("timeout")):
+            return None
+        return {**row, "output": ""}
+    if not output.exists():
+        return None
+    return {**row, "status": "skipped", "output": job.output}
+
+
+def _longer(timeout, before) -> bool:
+    """Whether the time limit ``timeout`` (None: none) is longer than ``before``."""
+    if timeout is None:
+        return before is not None
+    return before is not None and timeout > before
 
 
 def _describe(options) -> str:
@@ -712,14 +1163,19 @@ def _rows(outcome, chunk: list[int], distributed) -> list[dict]:
     if not isinstance(outcome, BaseException):
         return outcome
     if isinstance(outcome, distributed.KilledWorker):
-        error = f"KilledWorker: every worker that ran this mesh died ({outcome})"
+        error = (f"KilledWorker: every worker that ran this mesh died (killed by the system: out of memory?) "
+                 f"({outcome})")
     else:
         error = f"{type(outcome).__name__}: {outcome}"
     return [{"status": "failed", "error": error, "warnings": "", "output": ""} for _ in chunk]
 
 
 def _remove_temporaries(jobs: list[_Job], indices: list[int]) -> None:
-    targets = [pathlib.Path(path) for index in indices for path in (jobs[index].output, jobs[index].record)]
+    records = [pathlib.Path(jobs[index].record) for index in indices]
+    targets = [pathlib.Path(jobs[index].output) for index in indices] + records
+    for attempt in map(_attempt_path, records):  # notes of meshes whose task ended without them
+        attempt.unlink(missing_ok=True)
+        targets.append(attempt)
     for temporary in _stale_temporaries(targets):
         logger.info("removing %s, left by an interrupted write", temporary)
         temporary.unlink(missing_ok=True)
