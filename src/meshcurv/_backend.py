@@ -7,12 +7,24 @@ without temporaries. They are used when numba is installed
 the environment. numba is imported on first use, never by ``import meshcurv``;
 compiled kernels are cached on disk, so only the first process pays the
 compilation.
+
+Thread safety: numba's ``workqueue`` threading layer (the one numba falls back
+to where neither TBB nor OpenMP is installed) aborts the process when two
+threads launch parallel kernels at once. :func:`numba_kernels` therefore hands
+out the kernels behind :class:`_SerialisedKernels`: every kernel call takes a
+process-wide lock while the layer is unknown (the first call decides it) and
+whenever it is ``workqueue``; under ``tbb`` and ``omp`` (both thread-safe) the
+calls go straight through. The cost is one attribute lookup and one function
+call per kernel call (about a microsecond) on the other layers; under
+``workqueue``, concurrent calls run one after the other instead of aborting.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
+import threading
 
 from .errors import InvalidOptionError, MissingDependencyError
 
@@ -42,7 +54,69 @@ def numba_kernels():
                 "the numba backend needs numba: pip install 'meshcurv[fast]'"
             ) from None
         return None
-    return _numba_kernels
+    return _serialised(_numba_kernels)
+
+
+#: Serialises kernel calls where the threading layer is not thread-safe (see the module's doc).
+_KERNEL_LOCK = threading.RLock()
+
+#: The threading layer numba chose, once a parallel kernel has run (None before).
+_layer: str | None = None
+
+#: Threading layers that may be entered by several threads at once.
+THREAD_SAFE_LAYERS = ("tbb", "omp")
+
+
+def _threading_layer() -> str | None:
+    """numba's threading layer, or None before the first parallel kernel has run."""
+    import numba
+
+    try:
+        return numba.threading_layer()
+    except ValueError:  # no parallel kernel has run yet
+        return None
+
+
+class _SerialisedKernels:
+    """The kernels module, with each call under :data:`_KERNEL_LOCK` unless the layer is thread-safe."""
+
+    def __init__(self, module):
+        self._module = module
+        self._wrapped: dict = {}
+
+    def __getattr__(self, name):
+        value = getattr(self._module, name)
+        if not callable(value) or isinstance(value, type):
+            return value
+        wrapped = self._wrapped.get(name)
+        if wrapped is None:
+            wrapped = self._wrapped[name] = _locked(value)
+        return wrapped
+
+
+def _locked(function):
+    @functools.wraps(function)
+    def call(*args, **kwargs):
+        global _layer
+        if _layer in THREAD_SAFE_LAYERS:
+            return function(*args, **kwargs)
+        with _KERNEL_LOCK:
+            result = function(*args, **kwargs)
+            if _layer is None:
+                _layer = _threading_layer()
+            return result
+
+    return call
+
+
+_proxies: dict = {}
+
+
+def _serialised(module) -> _SerialisedKernels:
+    proxy = _proxies.get(id(module))
+    if proxy is None:
+        proxy = _proxies[id(module)] = _SerialisedKernels(module)
+    return proxy
 
 
 @contextlib.contextmanager
