@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import zipfile
-import zlib
 
 import numpy as np
 
@@ -51,16 +50,60 @@ def write_npz(path, vertices: np.ndarray, faces, point_data: dict) -> None:
     np.savez_compressed(path, vertices=vertices, **arrays, **point_data)
 
 
+#: deflate expands at most about 1032 times; a member declaring more is corrupt (or a zip bomb)
+_DEFLATE_RATIO = 1100
+
+
+def _check_members(path, archive: zipfile.ZipFile) -> None:
+    """Refuse mesh arrays whose declared shape needs more bytes than their zip member holds.
+
+    numpy allocates the declared shape before it reads a member, so a header
+    claiming a huge shape would be a MemoryError (or take all memory): the
+    header is read first and checked against the member's size, and that
+    size against what its compressed bytes can expand to.
+    """
+    readers = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
+    for info in archive.infolist():
+        key = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
+        if not key.startswith(("vertices", "face")):
+            continue
+        if info.file_size > _DEFLATE_RATIO * info.compress_size + 4096:
+            raise MeshFileError(f"{path}: the NPZ member {key!r} claims {info.file_size} bytes from "
+                                f"{info.compress_size} compressed ones; the archive is corrupt")
+        with archive.open(info) as member:
+            version = np.lib.format.read_magic(member)
+            if version not in readers:
+                raise MeshFileError(f"{path}: the NPZ member {key!r} has an unsupported .npy version {version}")
+            shape, _, dtype = readers[version](member)
+        need = int(np.prod(shape, dtype=object)) * dtype.itemsize
+        if dtype.hasobject or need > info.file_size:
+            raise MeshFileError(
+                f"{path}: the NPZ array {key!r} declares shape {shape} of {dtype} ({need} bytes) but the "
+                f"archive holds only {info.file_size} bytes for it"
+            )
+
+
 def read_npz(path):
     """Read ``vertices`` and ``faces`` back from an NPZ file written by :func:`write_npz`."""
     try:
-        with open(path, "rb") as handle, np.load(handle, allow_pickle=False) as archive:
-            names = sorted(archive.files)
-            arrays = {name: archive[name] for name in names if name.startswith(("vertices", "face"))}
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile, zlib.error, EOFError) as exc:
-        raise MeshFileError(f"{path}: cannot be read as NPZ ({exc})") from exc
+        with open(path, "rb") as handle:
+            with zipfile.ZipFile(handle) as archive:
+                _check_members(path, archive)
+            handle.seek(0)
+            with np.load(handle, allow_pickle=False) as archive:
+                names = sorted(archive.files)
+                arrays = {name: archive[name] for name in names if name.startswith(("vertices", "face"))}
+    except (MeshFileError, MemoryError):
+        raise
+    except Exception as exc:  # zip, zlib, npy header, tokenizer errors: all one kind for the caller
+        reason = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else type(exc).__name__
+        raise MeshFileError(f"{path}: cannot be read as NPZ ({reason})") from exc
     if "vertices" not in arrays or not ({"faces"} <= set(arrays) or {"face_corners", "face_sizes"} <= set(arrays)):
         raise MeshFileError(f"{path}: an NPZ mesh needs arrays named 'vertices' and 'faces'; found {names}")
     if "faces" in arrays:
         return arrays["vertices"], arrays["faces"]
-    return arrays["vertices"], np.split(arrays["face_corners"], np.cumsum(arrays["face_sizes"])[:-1])
+    corners, sizes = arrays["face_corners"], arrays["face_sizes"]
+    if corners.ndim != 1 or sizes.ndim != 1 or sizes.dtype.kind not in "iu" or (sizes < 0).any() \
+            or int(sizes.sum(dtype=np.int64)) != corners.size:
+        raise MeshFileError(f"{path}: the NPZ 'face_sizes' do not add up to the {corners.size} 'face_corners'")
+    return arrays["vertices"], np.split(corners, np.cumsum(sizes)[:-1])

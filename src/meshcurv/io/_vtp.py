@@ -16,6 +16,7 @@ import zlib
 import numpy as np
 
 from ..errors import MeshFileError
+from ._text import numbers
 
 __all__ = ["read_vtp", "write_vtp"]
 
@@ -87,23 +88,17 @@ def _decode(element, path, *, header: str, order: str, compressed: bool) -> np.n
     encoding = element.get("format", "ascii")
     text = (element.text or "").strip()
     if encoding == "ascii":
-        values = np.array(text.split(), dtype=np.float64).astype(dtype)
+        values = _numbers(text, path)
+        if dtype.kind in "iu":
+            bad = ~(np.abs(values) <= 2.0 ** 53) | (values != np.floor(values))
+            if bad.any():
+                raise MeshFileError(f"{path}: a DataArray of type {kind} holds a value that is not an integer "
+                                    f"({values[bad][0]!r}); indices must be whole numbers")
+        with np.errstate(over="ignore", invalid="ignore"):  # beyond Float32: inf, refused later
+            values = values.astype(dtype)
     elif encoding == "binary":
-        header_type = np.dtype(order + ("u8" if header == "UInt64" else "u4"))
-        if compressed:
-            # header: number of blocks, block size, last block size, compressed size of each block
-            head_chars = 4 * -(-3 * header_type.itemsize // 3)
-            n_blocks = int(np.frombuffer(base64.b64decode(text[:head_chars]), header_type)[0])
-            head_chars = 4 * -(-(3 + n_blocks) * header_type.itemsize // 3)
-            sizes = np.frombuffer(base64.b64decode(text[:head_chars]), header_type)[3:3 + n_blocks]
-            raw = base64.b64decode(text[head_chars:])
-            ends = np.cumsum(sizes)
-            data = b"".join(zlib.decompress(raw[end - size:end]) for size, end in zip(sizes, ends))
-        else:
-            head_chars = 4 * -(-header_type.itemsize // 3)
-            n_bytes = int(np.frombuffer(base64.b64decode(text[:head_chars]), header_type)[0])
-            data = base64.b64decode(text[head_chars:])[:n_bytes]
-        values = np.frombuffer(data, dtype=dtype)
+        values = np.frombuffer(_binary(text, path, np.dtype(order + ("u8" if header == "UInt64" else "u4")),
+                                       compressed), dtype=dtype)
     else:
         raise MeshFileError(
             f"{path}: DataArray format {encoding!r} is not supported (only inline 'ascii' and 'binary'); "
@@ -111,6 +106,51 @@ def _decode(element, path, *, header: str, order: str, compressed: bool) -> np.n
         )
     components = int(element.get("NumberOfComponents", "1"))
     return values.reshape(-1, components) if components > 1 else values
+
+
+def _numbers(text: str, path) -> np.ndarray:
+    values = numbers(text.encode("ascii", "replace"))
+    if values is None:
+        raise MeshFileError(f"{path}: a data array cannot be decoded (an ascii DataArray holds a word that is not a number)")
+    return values
+
+
+def _header_values(text: str, count: int, header_type: np.dtype, path) -> np.ndarray:
+    """The first ``count`` header integers of a base64 binary DataArray, or a MeshFileError."""
+    chars = 4 * -(-count * header_type.itemsize // 3)
+    raw = base64.b64decode(text[:chars])
+    if len(raw) < count * header_type.itemsize:
+        raise MeshFileError(f"{path}: a binary DataArray is empty or cut short (no complete header)")
+    return np.frombuffer(raw, header_type, count=count)
+
+
+def _binary(text: str, path, header_type: np.dtype, compressed: bool) -> bytes:
+    """The bytes of a base64 binary DataArray; declared sizes checked before anything is allocated."""
+    if not compressed:
+        n_bytes = int(_header_values(text, 1, header_type, path)[0])
+        data = base64.b64decode(text[4 * -(-header_type.itemsize // 3):])
+        if len(data) < n_bytes:
+            raise MeshFileError(f"{path}: a binary DataArray declares {n_bytes} bytes but holds {len(data)}")
+        return data[:n_bytes]
+    # header: number of blocks, block size, last block size, compressed size of each block
+    n_blocks = int(_header_values(text, 3, header_type, path)[0])
+    if n_blocks * header_type.itemsize > len(text):
+        raise MeshFileError(f"{path}: a compressed DataArray declares {n_blocks} blocks; the file holds far fewer")
+    head = _header_values(text, 3 + n_blocks, header_type, path)
+    block_size, last_size, sizes = int(head[1]), int(head[2]), head[3:].astype(np.int64)
+    raw = base64.b64decode(text[4 * -(-(3 + n_blocks) * header_type.itemsize // 3):])
+    if int(sizes.sum()) > len(raw):
+        raise MeshFileError(f"{path}: a compressed DataArray declares {int(sizes.sum())} bytes but holds {len(raw)}")
+    blocks, start = [], 0
+    for i, size in enumerate(sizes.tolist()):
+        expected = last_size if i == n_blocks - 1 and last_size else block_size
+        inflater = zlib.decompressobj()
+        block = inflater.decompress(raw[start:start + size], expected + 1)  # never more than declared
+        if len(block) != expected or not inflater.eof:
+            raise MeshFileError(f"{path}: a compressed DataArray block does not hold its declared {expected} bytes")
+        blocks.append(block)
+        start += size
+    return b"".join(blocks)
 
 
 def read_vtp(path):
@@ -141,6 +181,9 @@ def read_vtp(path):
         raise
     except (ValueError, zlib.error, base64.binascii.Error) as exc:
         raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
+    declared = piece.get("NumberOfPoints")
+    if declared is not None and declared.strip() != str(vertices.shape[0]):
+        raise MeshFileError(f"{path}: the PolyData declares {declared.strip()[:20]} points but holds {vertices.shape[0]}")
     if vertices.shape[0] == 0 or offsets.size == 0:
         raise MeshFileError(f"{path}: the PolyData has no points or no polygons")
     sizes = np.diff(offsets, prepend=0)
