@@ -38,8 +38,9 @@ def close_directions(a, b, atol):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_reversing_every_face_flips_signs_and_keeps_gaussian(method, mesh):
-    base = run(mesh.vertices, mesh.faces, method)
-    flipped = run(mesh.vertices, mesh.faces[:, ::-1], method)
+    # orient="keep": the literal convention (the default would turn the faces back outward)
+    base = run(mesh.vertices, mesh.faces, method, orient="keep")
+    flipped = run(mesh.vertices, mesh.faces[:, ::-1], method, orient="keep")
     np.testing.assert_allclose(flipped.k_min, -base.k_max, atol=1e-10)
     np.testing.assert_allclose(flipped.k_max, -base.k_min, atol=1e-10)
     np.testing.assert_allclose(flipped.gaussian, base.gaussian, atol=1e-10)

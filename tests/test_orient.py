@@ -11,6 +11,7 @@ import pytest
 
 import meshcurv
 from meshcurv import shapes
+from meshcurv.result import INVALID_REASONS
 from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from meshcurv.estimators import ESTIMATORS
 from meshcurv.orient import orient_faces
@@ -68,7 +69,7 @@ def test_inconsistent_faces_make_curvature_invalid_unless_oriented():
     faces = reverse(torus.faces, np.arange(torus.faces.shape[0]) % 7 == 0)
     clean = meshcurv.principal_curvatures(torus.vertices, torus.faces)
     for method in ESTIMATORS:
-        with pytest.warns(MeshQualityWarning, match="orient reversed") as record:
+        with pytest.warns(MeshQualityWarning, match="orient='outward' reversed 110 of 768 faces") as record:
             r = meshcurv.principal_curvatures(torus.vertices, faces, method=method, orient="outward")
         assert len(record) == 1
         assert r.diagnosis.n_flipped_faces == (np.arange(torus.faces.shape[0]) % 7 == 0).sum()
@@ -77,20 +78,29 @@ def test_inconsistent_faces_make_curvature_invalid_unless_oriented():
         np.testing.assert_array_equal(r.valid, reference.valid)
         np.testing.assert_allclose(r.k_max, reference.k_max, rtol=1e-12, atol=1e-12 * np.nanmax(np.abs(reference.k_max)))
     with pytest.warns(MeshQualityWarning, match="inconsistently oriented"):
-        kept = meshcurv.principal_curvatures(torus.vertices, faces)
+        kept = meshcurv.principal_curvatures(torus.vertices, faces, orient="keep")
     assert not kept.valid.all() and kept.diagnosis.n_flipped_faces == 0
+    assert (kept.invalid_reason[~kept.valid] == INVALID_REASONS.index(
+        "on an edge between inconsistently oriented faces")).all()
     assert clean.valid.all()
+    # the default orients: the same numbers as the clean mesh, with one warning that says what was done
+    with pytest.warns(MeshQualityWarning, match="reversed 110 of 768 faces before the computation: to orient"):
+        default = meshcurv.principal_curvatures(torus.vertices, faces)
+    np.testing.assert_allclose(default.k_max, clean.k_max, rtol=1e-12, atol=1e-12)
 
 
 def test_orient_keeps_the_sign_convention_of_an_outward_mesh():
     # flipping every face flips the signs, unless orient='outward' undoes it
     sphere = shapes.icosphere(8, radius=2.0)
     inward = sphere.faces[:, ::-1]
-    r = meshcurv.principal_curvatures(sphere.vertices, inward)
+    r = meshcurv.principal_curvatures(sphere.vertices, inward, orient="keep")
     assert np.median(r.mean) == pytest.approx(-0.5, rel=0.01)
-    with pytest.warns(MeshQualityWarning, match=f"orient reversed {sphere.faces.shape[0]} faces"):
-        r = meshcurv.principal_curvatures(sphere.vertices, inward, orient="outward")
-    assert np.median(r.mean) == pytest.approx(0.5, rel=0.01)
+    n = sphere.faces.shape[0]
+    for orient in ("outward", "auto"):  # 'auto' is 'outward' for every method but matgeom
+        with pytest.warns(MeshQualityWarning, match=f"reversed {n} of {n} faces .*: the mesh was wound inward"):
+            r = meshcurv.principal_curvatures(sphere.vertices, inward, orient=orient)
+        assert np.median(r.mean) == pytest.approx(0.5, rel=0.01)
+        assert r.parameters["orient"] == "outward" and r.diagnosis.n_flipped_faces == n
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         r = meshcurv.principal_curvatures(sphere.vertices, inward, orient="consistent")
@@ -141,7 +151,7 @@ def test_inputs_are_not_modified():
 
 def test_bad_orient_values_and_inputs_are_refused():
     sphere = shapes.icosphere(2)
-    with pytest.raises(InvalidOptionError, match="unknown orient 'inward'; choose one of 'keep', 'consistent', 'outward'"):
+    with pytest.raises(InvalidOptionError, match="unknown orient 'inward'; choose one of 'auto', 'outward', 'consistent', 'keep'"):
         meshcurv.principal_curvatures(sphere.vertices, sphere.faces, orient="inward")
     with pytest.raises(InvalidOptionError, match="unknown orient True"):
         meshcurv.principal_curvatures(sphere.vertices, sphere.faces, orient=True)

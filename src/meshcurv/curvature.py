@@ -5,14 +5,17 @@ from __future__ import annotations
 import dataclasses
 import warnings
 
+import numpy as np
+
 from ._validation import as_faces, as_vertices, check_choice, check_int_option, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._common import ProgressCallback, Stages
-from .diagnosis import diagnose, quality_message
-from .orient import oriented_topology
-from .result import CurvatureResult
+from .diagnosis import degenerate_faces, diagnose, quality_message
+from .orient import ORIENT_CHOICES, oriented_topology
+from .result import INVALID_REASONS, CurvatureResult
 from .topology import MeshTopology
+from .weld import weld_vertices
 
 __all__ = ["principal_curvatures", "METHODS"]
 
@@ -27,7 +30,8 @@ def principal_curvatures(
     method: str = DEFAULT_METHOD,
     smoothing_steps: int | None = None,
     radius: float | None = None,
-    orient: str = "keep",
+    orient: str = "auto",
+    weld: bool | None = None,
     progress: ProgressCallback | None = None,
 ) -> CurvatureResult:
     """Principal curvatures, their directions, and the normal at every vertex.
@@ -79,14 +83,29 @@ def principal_curvatures(
         lengths (:func:`meshcurv.neighborhoods.default_radius`). Pass the same
         value for meshes of one object at different resolutions to get the
         same estimate. Refused by the other methods.
-    orient : {'keep', 'consistent', 'outward'}, default: 'keep'
+    orient : {'auto', 'outward', 'consistent', 'keep'}, default: 'auto'
         Face orientation before the computation (:func:`meshcurv.orient.orient_faces`):
-        ``'keep'`` uses the faces as given (vertices on inconsistently oriented
-        edges are then ``valid=False``); ``'consistent'`` reverses the fewest faces
-        that make each patch (faces joined by manifold edges) consistently
-        oriented; ``'outward'`` does the same and turns every closed patch
-        outward (positive volume). The number of faces reversed is
-        ``result.diagnosis.n_flipped_faces`` and is given in the warning.
+        ``'outward'`` reverses the fewest faces that make each patch (faces
+        joined by manifold edges) consistently oriented, and turns every closed
+        patch outward (positive volume), so that a convex solid gets positive
+        curvature however its faces were wound (marching cubes winds them
+        inward); ``'consistent'`` does the same but keeps the majority
+        orientation of closed patches too; ``'keep'`` uses the faces as given
+        (vertices on inconsistently oriented edges are then ``valid=False``,
+        and an inward-wound sphere gets negative curvature). ``'auto'``:
+        ``'keep'`` for ``method='matgeom'`` (matGeom's numbers), ``'outward'``
+        for every other method. The number of faces reversed is
+        ``result.diagnosis.n_flipped_faces`` and is given, with the reason, in
+        the warning.
+    weld : bool, optional
+        Merge coincident vertices on boundary edges before the computation
+        (:func:`meshcurv.weld.weld_vertices`: triangle soups such as STL files,
+        meshes split at texture or normal seams), within ``1e-5`` times the
+        median edge length. The result still has one row per input vertex: the
+        copies of a welded vertex get the same values. Default: True for every
+        method but ``'matgeom'`` (matGeom's numbers); the number of vertices
+        welded is ``result.parameters["n_welded_vertices"]`` and is given in
+        the warning.
     progress : callable, optional
         Called as ``progress(stage, index, total)`` when each stage starts (matGeom's
         ShowProgress, per stage). Stage messages also go to the ``meshcurv``
@@ -111,7 +130,9 @@ def principal_curvatures(
     MeshQualityWarning
         Once per call, when the mesh has boundaries, non-manifold or
         inconsistently oriented edges, zero-area faces or unreferenced vertices,
-        with the counts; the affected vertices have ``valid=False``.
+        when vertices were welded or faces reversed, with the counts; the
+        affected vertices have ``valid=False`` and ``result.invalid_reason``
+        says why for each.
 
     Examples
     --------
@@ -148,15 +169,84 @@ def principal_curvatures(
 
     points = as_vertices(vertices)
     topology = _as_topology(faces, points.shape[0])
+    check_choice(orient, "orient", ORIENT_CHOICES)
+    if orient == "auto":
+        orient = "keep" if method == "matgeom" else "outward"
+    if weld is None:
+        weld = method != "matgeom"
+    elif not isinstance(weld, (bool, np.bool_)):
+        raise InvalidOptionError(f"`weld` must be True or False; got {weld!r}")
+    welding = weld_vertices(points, topology) if weld else None
+    if welding is not None and welding.n_welded:
+        points, topology = welding.vertices, welding.topology
     topology, n_flipped = oriented_topology(points, topology, orient)
     result, problems = estimator.function(
         points, topology, stages=Stages(estimator.stages, progress), **options
     )
-    result = dataclasses.replace(result, diagnosis=diagnose(points, topology, n_flipped_faces=n_flipped))
-    message = quality_message(method, problems, result.diagnosis)
+    diagnosis = diagnose(points, topology, n_flipped_faces=n_flipped)
+    reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
+    parameters = {**result.parameters, "orient": orient,
+                  "n_welded_vertices": welding.n_welded if welding is not None else 0}
+    result = dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons, parameters=parameters)
+    if welding is not None and welding.n_welded:
+        result = _expanded(result, welding.index)
+        problems = [f"welded {welding.n_welded} coincident vertices (a triangle soup or split seams) "
+                    "before the computation; copies share their values"] + list(problems)
+    if n_flipped:
+        problems = list(problems) + [_flip_reason(diagnosis, orient)]
+    message = quality_message(method, problems, dataclasses.replace(diagnosis, n_flipped_faces=0))
     if message:
+        counts = result.invalid_counts()
+        if counts:
+            message += "; invalid vertices by reason: " + ", ".join(f"{n} {why}" for why, n in counts.items())
         warnings.warn(message, MeshQualityWarning, stacklevel=2)
     return result
+
+
+#: Methods whose boundary vertices are valid (the others leave them undefined).
+_BOUNDARY_METHODS = frozenset({"icc", "quadric", "normal_cycle_ball", "rusinkiewicz", "matgeom"})
+
+
+def invalid_reasons(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray, *,
+                    boundary_valid: bool) -> np.ndarray:
+    """(V,) int8 codes of :data:`~meshcurv.result.INVALID_REASONS`: why each invalid vertex is.
+
+    Each invalid vertex gets the first reason that applies to it, in the
+    order of :data:`~meshcurv.result.INVALID_REASONS`; an invalid vertex
+    with no defect of the mesh gets the last one (the estimate itself was
+    undefined). 0 where ``valid``.
+    """
+    reasons = np.zeros(valid.shape[0], dtype=np.int8)
+    invalid = ~valid
+    if not invalid.any():
+        return reasons
+    degenerate = degenerate_faces(vertices, topology)
+    corners = np.zeros(valid.shape[0], dtype=bool)
+    corners[topology.faces[degenerate].ravel()] = True
+    bowties = topology.bowtie_vertices & ~topology.edge_vertices(topology.nonmanifold_edges)
+    boundary = np.zeros_like(valid) if boundary_valid else topology.boundary_vertices
+    classes = [~topology.referenced_vertices, topology.edge_vertices(topology.nonmanifold_edges), bowties,
+               topology.edge_vertices(topology.inconsistent_edges), corners, boundary]
+    for code, members in enumerate(classes, start=1):
+        reasons[invalid & members & (reasons == 0)] = code
+    reasons[invalid & (reasons == 0)] = len(INVALID_REASONS) - 1
+    return reasons
+
+
+def _flip_reason(diagnosis, orient: str) -> str:
+    n = diagnosis.n_flipped_faces
+    if orient == "consistent" or diagnosis.n_faces == 0 or n < diagnosis.n_faces:
+        why = "to orient every patch consistently" + (" and outward" if orient == "outward" else "")
+    else:
+        why = "the mesh was wound inward (negative volume; marching cubes winds its faces so)"
+    return f"orient={orient!r} reversed {n} of {diagnosis.n_faces} faces before the computation: {why}"
+
+
+def _expanded(result: CurvatureResult, index: np.ndarray) -> CurvatureResult:
+    """The result of a welded mesh on the input's vertices: row ``i`` is the welded vertex ``index[i]``."""
+    fields = {name: getattr(result, name)[index]
+              for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason")}
+    return dataclasses.replace(result, **fields)
 
 
 def _as_topology(faces, n_vertices: int) -> MeshTopology:

@@ -28,7 +28,7 @@ from .topology import MeshTopology
 __all__ = ["orient_faces", "ORIENT_CHOICES"]
 
 #: The values of ``orient=`` in :func:`meshcurv.principal_curvatures`.
-ORIENT_CHOICES = ("keep", "consistent", "outward")
+ORIENT_CHOICES = ("auto", "outward", "consistent", "keep")
 
 
 def orient_faces(vertices, faces, *, outward: bool = True) -> tuple[np.ndarray, int]:
@@ -106,6 +106,8 @@ def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = 
     counts = topology.edge_face_counts
     pairs = topology.edge_faces
     proper = ~topology.degenerate_faces
+    if not proper.any():  # every face has a repeated corner: nothing to orient
+        return proper
     linked = (counts == 2) & (pairs[:, 0] != pairs[:, 1])
     linked &= proper[np.maximum(pairs[:, 0], 0)] & proper[np.maximum(pairs[:, 1], 0)]
     f, g = pairs[linked, 0], pairs[linked, 1]
@@ -165,7 +167,7 @@ def oriented_topology(vertices: np.ndarray, topology: MeshTopology, orient: str)
     a new topology (the given one is returned when nothing had to change).
     """
     check_choice(orient, "orient", ORIENT_CHOICES)
-    if orient == "keep":
+    if orient in ("keep", "auto"):  # 'auto' is resolved by the caller, which knows the method
         return topology, 0
     flip = face_flips(vertices, topology, outward=orient == "outward")
     n_flipped = int(flip.sum())

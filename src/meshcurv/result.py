@@ -12,7 +12,20 @@ import numpy as np
 if TYPE_CHECKING:
     from .diagnosis import MeshDiagnosis
 
-__all__ = ["CurvatureResult"]
+__all__ = ["CurvatureResult", "INVALID_REASONS"]
+
+#: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``. A vertex
+#: gets the first code that applies, in this order.
+INVALID_REASONS = (
+    "valid",
+    "unreferenced vertex (in no face)",
+    "on a non-manifold edge (3+ faces)",
+    "bow-tie vertex (fans of faces meeting at a point)",
+    "on an edge between inconsistently oriented faces",
+    "corner of a zero-area face",
+    "on a boundary edge (this method needs a closed neighbourhood)",
+    "estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)",
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,8 +66,12 @@ class CurvatureResult:
         The options the estimator used (defaults filled in).
     diagnosis : MeshDiagnosis or None
         What :func:`meshcurv.diagnose` found in the mesh the curvatures were
-        computed on (after ``orient=``), with the number of faces ``orient=``
-        reversed; None when the result was built directly.
+        computed on (after welding and ``orient=``), with the number of faces
+        ``orient=`` reversed; None when the result was built directly.
+    invalid_reason : ndarray of shape (V,), int8, or None
+        Why each vertex is invalid: an index into :data:`INVALID_REASONS`
+        (0 where ``valid``); set by :func:`meshcurv.principal_curvatures`,
+        None when the result was built directly.
     """
 
     k_min: np.ndarray
@@ -66,6 +83,7 @@ class CurvatureResult:
     method: str
     parameters: Mapping[str, Any] = field(default_factory=dict)
     diagnosis: "MeshDiagnosis | None" = None
+    invalid_reason: np.ndarray | None = None
 
     def __post_init__(self):
         for name in _ARRAY_FIELDS:
@@ -76,6 +94,21 @@ class CurvatureResult:
             array.flags.writeable = False
             object.__setattr__(self, name, array)
         object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
+        if self.invalid_reason is not None:
+            object.__setattr__(self, "invalid_reason", _readonly(np.array(self.invalid_reason, dtype=np.int8)))
+
+    def invalid_counts(self) -> dict[str, int]:
+        """How many vertices are invalid for each reason (:data:`INVALID_REASONS`), largest first.
+
+        Empty when every vertex is valid; ``{"unknown": n}`` when the result
+        carries no ``invalid_reason``.
+        """
+        if self.invalid_reason is None:
+            n_invalid = int((~self.valid).sum())
+            return {"unknown": n_invalid} if n_invalid else {}
+        counts = np.bincount(self.invalid_reason, minlength=len(INVALID_REASONS))
+        order = np.argsort(-counts[1:], kind="stable") + 1
+        return {INVALID_REASONS[c]: int(counts[c]) for c in order if counts[c]}
 
     @classmethod
     def _of_arrays(cls, **fields) -> "CurvatureResult":

@@ -1,0 +1,121 @@
+"""Recognising meshes of voxel images: the grid their vertices lie on.
+
+A mesh extracted from a 3D image by marching cubes (scikit-image's
+``measure.marching_cubes``, VTK's ``vtkMarchingCubes`` / flying edges,
+ITK, ...) has every vertex on an edge of the voxel grid: two of its three
+coordinates are grid coordinates ``origin + i * spacing``, the third is
+interpolated. A blocky (cuberille) surface built from voxel faces has all three
+on the grid. Such surfaces carry a staircase of the grid's size that a
+curvature estimator must average out over a few voxels; :func:`voxel_grid`
+finds the grid so that the default radius can take it into account.
+
+The test is exact, not statistical: grid coordinates come from the same
+``i * spacing`` (plus the same offset) for every vertex on a grid plane, so they
+repeat bit for bit, while interpolated coordinates are almost all distinct.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+__all__ = ["VoxelGrid", "voxel_grid", "GRID_FRACTION"]
+
+#: Share of the vertices that must have at least two coordinates on the grid.
+GRID_FRACTION = 0.95
+
+#: A coordinate value counts as a grid plane when this many vertices share it.
+_PLANE_MULTIPLICITY = 3
+
+#: Grid coordinates within this fraction of the spacing of a plane of the lattice lie on it.
+_ON_GRID = 1e-6
+
+
+class VoxelGrid(NamedTuple):
+    """The grid found by :func:`voxel_grid`.
+
+    Attributes
+    ----------
+    spacing : ndarray of shape (3,)
+        Distance between grid planes along x, y and z (the vertices' own axes).
+    origin : ndarray of shape (3,)
+        One grid coordinate per axis.
+    fraction : float
+        Share of the vertices with at least two coordinates on the grid.
+    """
+
+    spacing: np.ndarray
+    origin: np.ndarray
+    fraction: float
+
+
+def _axis_lattice(values: np.ndarray):
+    """``(spacing, origin, on_grid)`` of one coordinate axis, or None when its repeated values form no lattice."""
+    planes, counts = np.unique(values, return_counts=True)
+    planes = planes[counts >= _PLANE_MULTIPLICITY]
+    if planes.size < 3:
+        return None
+    gaps = np.diff(planes)
+    gaps = gaps[gaps > 0]
+    if gaps.size == 0:
+        return None
+    # the smallest gap that is common among the planes is the spacing; wider gaps are multiples of it
+    smallest = float(np.min(gaps))
+    near = gaps[gaps < 1.5 * smallest]
+    if near.size < 0.5 * gaps.size:
+        return None
+    spacing = float(np.median(near))
+    origin = float(planes[0])
+    steps = (planes - origin) / spacing
+    if np.abs(steps - np.round(steps)).max() > 1e3 * _ON_GRID:
+        return None  # the repeated values are not evenly spaced: not a grid (a symmetric height field, say)
+    steps = (values - origin) / spacing
+    whole = np.round(steps)
+    on_grid = np.abs(steps - whole) <= _ON_GRID * max(1.0, np.abs(steps).max() * 1e-9)
+    return spacing, origin, on_grid, whole.astype(np.int64) % 2
+
+
+def voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
+    """The voxel grid a mesh's vertices lie on, or None.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+        Vertex coordinates (of the referenced vertices).
+
+    Returns
+    -------
+    VoxelGrid or None
+        The spacing and origin of the grid when at least :data:`GRID_FRACTION`
+        of the vertices have two or more coordinates on it along every axis
+        (marching cubes: exactly two; voxel faces: three); None otherwise.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from meshcurv.lattice import voxel_grid
+    >>> voxel_grid(np.random.default_rng(0).normal(size=(500, 3))) is None
+    True
+    """
+    if vertices.shape[0] < 16:
+        return None
+    found = [_axis_lattice(vertices[:, k]) for k in range(3)]
+    if any(axis is None for axis in found):
+        return None
+    on_grid = np.column_stack([axis[2] for axis in found])
+    fraction = float((on_grid.sum(axis=1) >= 2).mean())
+    if fraction < GRID_FRACTION:
+        return None
+    spacing = np.array([axis[0] for axis in found])
+    origin = np.array([axis[1] for axis in found])
+    # a binary mask cut at 0.5 puts the interpolated coordinate at the middle of its grid edge: every
+    # coordinate is then on the half grid, and the voxel grid is every other plane of it along each axis,
+    # the choice of planes (one of eight) that puts two coordinates of every vertex on the grid
+    parity = np.column_stack([axis[3] for axis in found])
+    for pattern in np.ndindex(2, 2, 2):
+        on_voxel_grid = on_grid & (parity == np.array(pattern))
+        voxel_fraction = float((on_voxel_grid.sum(axis=1) >= 2).mean())
+        if voxel_fraction >= GRID_FRACTION:
+            return VoxelGrid(2 * spacing, origin + np.array(pattern) * spacing, voxel_fraction)
+    return VoxelGrid(spacing, origin, fraction)
