@@ -5,9 +5,34 @@ from __future__ import annotations
 import numpy as np
 
 from ._backend import numba_kernels
+from ._validation import check_int_option
+from .errors import InvalidMeshError, InvalidOptionError
 from .topology import MeshTopology
 
-__all__ = ["smooth_vertex_field"]
+__all__ = ["smooth_vertex_field", "MAX_SMOOTHING_STEPS", "check_smoothing_steps"]
+
+#: Most passes accepted. Each pass spreads every value one ring further, and the
+#: spread after ``s`` passes is about ``sqrt(s)`` rings (a diffusion): 10000 passes
+#: average each value over some 100 rings, far beyond any local curvature estimate,
+#: and on a million-vertex mesh they already take minutes. Larger values (a typo,
+#: 10**9 would run for days) are refused.
+MAX_SMOOTHING_STEPS = 10_000
+
+#: Passes per compiled kernel call: between calls Python gets control back, so that
+#: Ctrl-C (KeyboardInterrupt) stops a long smoothing.
+STEPS_PER_CALL = 64
+
+
+def check_smoothing_steps(steps) -> int:
+    """``steps`` as an int in ``[0, MAX_SMOOTHING_STEPS]`` or :class:`InvalidOptionError`."""
+    number = check_int_option(steps, "smoothing_steps", maximum=None)
+    if number > MAX_SMOOTHING_STEPS:
+        raise InvalidOptionError(
+            f"`smoothing_steps` must be at most {MAX_SMOOTHING_STEPS}; got {number} (each pass averages over "
+            f"one more ring: {MAX_SMOOTHING_STEPS} passes already spread every value over about "
+            f"{int(MAX_SMOOTHING_STEPS ** 0.5)} rings)"
+        )
+    return number
 
 
 def smooth_vertex_field(values, topology: MeshTopology, steps: int) -> np.ndarray:
@@ -25,25 +50,46 @@ def smooth_vertex_field(values, topology: MeshTopology, steps: int) -> np.ndarra
     topology : MeshTopology
         The mesh connectivity (its ``adjacency``).
     steps : int
-        Number of passes; 0 returns a copy.
+        Number of passes, 0 to :data:`MAX_SMOOTHING_STEPS`; 0 returns a copy.
 
     Returns
     -------
     ndarray of the same shape as ``values``, float64.
 
+    Raises
+    ------
+    InvalidMeshError
+        ``values`` has not one row per vertex of ``topology``, or is not real.
+    InvalidOptionError
+        ``steps`` is not an integer in ``[0, MAX_SMOOTHING_STEPS]``.
+
     Notes
     -----
     NaN spreads one ring per pass, as in matGeom (the sparse product only
-    touches neighbours).
+    touches neighbours). The compiled path runs :data:`STEPS_PER_CALL` passes per
+    kernel call, so that a long smoothing can be interrupted.
     """
-    field = np.array(values, dtype=np.float64, copy=True)
+    steps = check_smoothing_steps(steps)
+    if not isinstance(topology, MeshTopology):
+        raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}")
+    try:
+        field = np.array(values, dtype=np.float64, copy=True)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InvalidMeshError(f"`values` must be a real array of shape (V,) or (V, k) ({exc})") from None
+    if field.ndim not in (1, 2) or field.shape[0] != topology.n_vertices:
+        raise InvalidMeshError(
+            f"`values` must have shape (V,) or (V, k) with V = {topology.n_vertices} (the topology's "
+            f"vertices); got {tuple(field.shape)}"
+        )
     if steps <= 0:
         return field
     kernels = numba_kernels()
     if kernels is not None:
         flat = np.ascontiguousarray(field.reshape(field.shape[0], -1))
         indptr, indices = topology.neighbour_lists
-        return kernels.smooth_over_neighbours(flat, indptr, indices, steps).reshape(field.shape)
+        for done in range(0, steps, STEPS_PER_CALL):
+            flat = kernels.smooth_over_neighbours(flat, indptr, indices, min(STEPS_PER_CALL, steps - done))
+        return flat.reshape(field.shape)
     adjacency = topology.adjacency
     scale = 1.0 / (topology.vertex_degrees + 1.0)
     if field.ndim == 2:

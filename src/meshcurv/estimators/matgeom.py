@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..result import CurvatureResult
-from ..smoothing import smooth_vertex_field
+from ..smoothing import check_smoothing_steps, smooth_vertex_field
 from .._backend import numba_kernels
 from ..diagnosis import degenerate_faces
 from ..topology import MeshTopology
@@ -173,6 +173,7 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
     """Run matGeom's algorithm. Returns ``(result, problems)``."""
+    smoothing_steps = check_smoothing_steps(smoothing_steps)
     tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = matgeom_tensors(
         vertices, topology, smoothing_steps, stages
     )

@@ -52,7 +52,7 @@ from ..diagnosis import degenerate_faces
 from .._backend import numba_kernels
 from ..geometry import DEGENERATE_AREA_RATIO, face_cross_products, vertex_normals
 from ..result import CurvatureResult
-from ..smoothing import smooth_vertex_field
+from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from ..topology import MeshTopology
 from ._common import Stages, nan_where
 from ._defects import mesh_defects
@@ -84,6 +84,7 @@ def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_norm
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
     """Normal-cycle tensor in true units. Returns ``(result, problems)``."""
+    smoothing_steps = check_smoothing_steps(smoothing_steps)
     kernels = numba_kernels()
     if kernels is not None:
         return _estimate_compiled(kernels, vertices, topology, smoothing_steps, stages)
@@ -148,8 +149,16 @@ def _estimate_compiled(kernels, vertices: np.ndarray, topology: MeshTopology, sm
     defects = mesh_defects(topology, degenerate)
     stages.start("average vertex tensors")
     stages.start("retrieve curvatures")
+    if smoothing_steps > STEPS_PER_CALL:
+        # a long smoothing in interruptible calls (smooth_vertex_field), the same passes the kernel makes
+        sums = sums.copy()
+        sums[defects.invalid_vertices, :7] = 0.0
+        sums[:, :7] = smooth_vertex_field(sums[:, :7], topology, smoothing_steps)
+        smoothing_left = 0
+    else:
+        smoothing_left = smoothing_steps
     k_min, k_max, dir_min, dir_max, normals, valid = kernels.normal_cycle_finish(
-        sums, defects.invalid_vertices, indptr, indices, smoothing_steps)
+        sums, defects.invalid_vertices, indptr, indices, smoothing_left)
     result = CurvatureResult._of_arrays(
         k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
         method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},
