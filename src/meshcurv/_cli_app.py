@@ -21,11 +21,19 @@ from .estimators import ESTIMATORS
 from .io import FORMATS, read_mesh, write_curvatures
 from .io._files import check_output
 from .io.fields import FIELDS, curvature_fields
+from .plotting import MAX_PIXELS
 from .topology import MeshTopology
 
 __all__ = ["meshcurv", "Session"]
 
 SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid")]
+
+#: The most smoothing passes the command takes: each pass averages over the 1-ring, so a few hundred
+#: already flatten any field; beyond this, a typo (or 10**20) would run for days.
+MAX_SMOOTHING_STEPS = 10_000
+
+#: The largest finite float: an option value that parses to infinity (``1e400``) is beyond it.
+_FLOAT_MAX = sys.float_info.max
 _LEVELS = {-2: logging.CRITICAL, -1: logging.ERROR, 0: logging.WARNING, 1: logging.INFO, 2: logging.DEBUG}
 
 
@@ -166,9 +174,10 @@ def method_options(function):
     options = [
         click.option("-m", "--method", type=MethodChoice(), default=_default_method(), show_default=True,
                      help="Curvature estimator (see `meshcurv methods`)."),
-        click.option("--smoothing-steps", type=click.IntRange(min=0), default=None,
-                     help="Passes of 1-ring smoothing (normal_cycle, matgeom; default 3)."),
-        click.option("--radius", type=click.FloatRange(min=0, min_open=True), default=None,
+        click.option("--smoothing-steps", type=click.IntRange(min=0, max=MAX_SMOOTHING_STEPS), default=None,
+                     help=f"Passes of 1-ring smoothing (normal_cycle, matgeom; default 3; at most "
+                          f"{MAX_SMOOTHING_STEPS})."),
+        click.option("--radius", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
                      help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
                           "default from the mesh: see `meshcurv methods`)."),
         click.option("--orient", type=click.Choice(["keep", "consistent", "outward"]), default=None,
@@ -228,8 +237,8 @@ def meshcurv():
 
 
 @meshcurv.command()
-@click.argument("mesh", type=click.Path(path_type=pathlib.Path))
-@click.option("-o", "--output", type=click.Path(path_type=pathlib.Path), default=None,
+@click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
+@click.option("-o", "--output", type=click.Path(readable=False, path_type=pathlib.Path), default=None,
               help="Write the fields to .ply, .vtk, .vtu, .vtp, .csv or .npz (default: print a summary).")
 @method_options
 @click.option("--fields", callback=_fields, default=None, metavar="NAME,...",
@@ -316,8 +325,8 @@ def _percentiles(ctx, param, value):
 
 
 @meshcurv.command()
-@click.argument("mesh", type=click.Path(path_type=pathlib.Path))
-@click.option("-o", "--output", type=click.Path(path_type=pathlib.Path), default=None,
+@click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
+@click.option("-o", "--output", type=click.Path(readable=False, path_type=pathlib.Path), default=None,
               help="The PNG to write (default: MESH-NAME_FIELD.png in the current folder).")
 @click.option("-f", "--field", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
               help="The field that colours the mesh.")
@@ -331,8 +340,8 @@ def _percentiles(ctx, param, value):
               show_default=True, help="Strokes along the principal directions.")
 @click.option("--percentiles", callback=_percentiles, default="2,98", show_default=True, metavar="LOW,HIGH",
               help="Colour limits as percentiles of the field.")
-@click.option("--pixels", type=click.IntRange(min=16), default=700, show_default=True,
-              help="Size of each view's image.")
+@click.option("--pixels", type=click.IntRange(min=16, max=MAX_PIXELS), default=700, show_default=True,
+              help=f"Size of each view's image (at most {MAX_PIXELS}).")
 @click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
 @common_options
 def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up, directions, percentiles,
@@ -372,7 +381,7 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
 
 
 @meshcurv.command()
-@click.argument("mesh", type=click.Path(path_type=pathlib.Path))
+@click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
 @common_options
 def info(mesh):
     """What MESH is: sizes, topology, defects, bounding box, edge length."""
@@ -419,7 +428,7 @@ def methods():
 
 
 @meshcurv.command()
-@click.argument("output", type=click.Path(path_type=pathlib.Path), default="torus_gaussian.png")
+@click.argument("output", type=click.Path(readable=False, path_type=pathlib.Path), default="torus_gaussian.png")
 @click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
 @common_options
 def demo(output, overwrite):

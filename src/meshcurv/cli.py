@@ -7,7 +7,8 @@ exit code and one line on stderr:
 - 0: done;
 - 1: the mesh cannot be processed (unreadable file, unusable mesh, existing
   output, missing optional dependency);
-- 2: bad usage (unknown option or command, bad option value).
+- 2: bad usage (unknown option or command, bad option value, an option
+  beyond its bounds): one line too, naming the option and the help to read.
 
 ``--debug`` adds the traceback.
 """
@@ -59,8 +60,13 @@ def main(argv=None) -> int:
         return code if isinstance(code, int) else 0
     except click.exceptions.Exit as exc:  # --help, --version
         return exc.exit_code
-    except click.UsageError as exc:
+    except click.exceptions.NoArgsIsHelpError as exc:  # `meshcurv` alone: the help
         exc.show()
+        return 2
+    except click.UsageError as exc:  # one line, as every other error, and where to find the help
+        message = " ".join(exc.format_message().split())
+        hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+        print(f"meshcurv: error: {message}{hint}", file=sys.stderr)
         return 2
     except click.Abort:
         print("meshcurv: aborted", file=sys.stderr)

@@ -18,7 +18,20 @@ import numpy as np
 from ._validation import as_faces, as_vertices
 from .errors import InvalidOptionError, MissingDependencyError
 
-__all__ = ["plot_field", "save_figure", "VIEWS"]
+__all__ = ["plot_field", "save_figure", "VIEWS", "MAX_PIXELS", "MAX_DPI"]
+
+#: The largest side of a view's image, in pixels: a panel of the figure is about 330 points wide, so
+#: even a print at 1200 dpi (:data:`MAX_DPI`) needs fewer; 8192 x 8192 already takes gigabytes.
+MAX_PIXELS = 8192
+
+#: The highest resolution :func:`save_figure` writes (the figure is about 11 x 4 inches).
+MAX_DPI = 1200
+
+#: The memory a view takes while it is drawn: bytes per pixel (z-buffer, face and barycentric weights,
+#: interpolated values, RGBA colours) and the rasteriser's chunks of pixel-face pairs. Measured with
+#: tracemalloc (one view of a 2562-vertex sphere): a peak of 1.07 GB at 2000 pixels, 1.46 GB at 3000.
+_BYTES_PER_PIXEL = 80
+_BYTES_FIXED = 2**30
 
 #: Named views as (elevation, azimuth) in degrees, matplotlib's convention:
 #: the camera looks at the mesh from ``(cos e cos a, cos e sin a, sin e)``.
@@ -243,7 +256,9 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
         OBJ and PLY files are made with y up). With ``'y'``, ``'front'`` looks
         from +z.
     pixels : int, default: 700
-        Size of the longer side of each view's image, in pixels.
+        Size of the longer side of each view's image, in pixels, from 16 to
+        :data:`MAX_PIXELS` (8192), and within the memory available (about
+        80 bytes a pixel and 1 GiB while a view is drawn).
 
     Returns
     -------
@@ -254,7 +269,8 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     InvalidOptionError
         ``values`` or ``directions`` without one row per vertex, more than two
         direction fields, an unknown view or ``up``, several views with
-        ``ax``, or ``pixels`` below 16.
+        ``ax``, ``pixels`` below 16, above :data:`MAX_PIXELS` or beyond the
+        memory available.
     InvalidMeshError
         Unusable vertices or faces.
     MissingDependencyError
@@ -280,8 +296,7 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     views = _as_views(view)
     if ax is not None and len(views) > 1:
         raise InvalidOptionError(f"`ax` takes one view; got {len(views)} (leave `ax` out for several panels)")
-    if int(pixels) < 16:
-        raise InvalidOptionError(f"`pixels` must be at least 16; got {pixels!r}")
+    pixels = _check_pixels(pixels)
     if up not in _UP:
         raise InvalidOptionError(f"`up` must be one of 'z', 'y', 'x'; got {up!r}")
     rotation = _UP[up]
@@ -302,7 +317,7 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
         fig, axes = ax.figure, [ax]
     for axis, (name, angles) in zip(axes, views):
         _draw_view(axis, points - center, triangles, values, normals, _camera(*angles), colormap, norm,
-                   strokes, pixels=int(pixels))
+                   strokes, pixels=pixels)
         if len(views) > 1:
             axis.set_title(name, fontsize=9)
     mappable = plt.cm.ScalarMappable(norm=norm, cmap=colormap)
@@ -320,6 +335,31 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+def _check_pixels(pixels) -> int:
+    """``pixels`` as an int in [16, :data:`MAX_PIXELS`] whose image fits in the memory available."""
+    from ._validation import check_int_option
+
+    pixels = check_int_option(pixels, "pixels", minimum=16, maximum=MAX_PIXELS)
+    needed = pixels * pixels * _BYTES_PER_PIXEL + _BYTES_FIXED
+    available = _available_memory()
+    if available is not None and needed > available:
+        raise InvalidOptionError(f"`pixels`={pixels} needs about {needed / 2**30:.1f} GiB for each view; "
+                                 f"{available / 2**30:.1f} GiB of memory is available: give fewer pixels")
+    return pixels
+
+
+def _available_memory() -> int | None:
+    """The bytes of memory available (Linux: MemAvailable), or None where it cannot be known."""
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
 
 
 def _as_directions(directions, n_vertices: int) -> dict[str, np.ndarray]:
@@ -392,6 +432,8 @@ def save_figure(fig, path, *, overwrite: bool = False, dpi: int | None = None):
     overwrite : bool, default: False
         Replace an existing file.
     dpi : int, optional
+        Dots per inch, from 10 to :data:`MAX_DPI` (1200); matplotlib's
+        default (100) when not given.
 
     Returns
     -------
@@ -402,10 +444,15 @@ def save_figure(fig, path, *, overwrite: bool = False, dpi: int | None = None):
     MeshFileError
         ``path`` exists (without ``overwrite``), is a directory, or its folder
         does not exist.
+    InvalidOptionError
+        ``dpi`` outside 10 to :data:`MAX_DPI`.
     """
+    from ._validation import check_int_option
     from .io._files import atomic_output, check_output
 
     plt = _pyplot()
+    if dpi is not None:
+        dpi = check_int_option(dpi, "dpi", minimum=10, maximum=MAX_DPI)
     path = check_output(os.fspath(path), overwrite=overwrite)
     try:
         with atomic_output(path) as temporary:
