@@ -73,7 +73,7 @@ class _Element:
 
 def _header(data: bytes, path):
     """``(format, [_Element], offset of the body)``; every malformed header is a MeshFileError."""
-    if not data.startswith(b"ply") or data[3:4] not in (b"\n", b"\r"):
+    if not data.startswith(b"ply") or data[3:4] not in (b"\n", b"\r", b""):
         raise MeshFileError(f"{path}: not a PLY file (it should start with a line 'ply'; starts with {data[:20]!r})")
     match = _END_HEADER.search(data, 0, HEADER_LIMIT + 16)
     if match is None or match.start() > HEADER_LIMIT:
