@@ -7,6 +7,19 @@ installed are listed as such in the table)::
     python benchmarks/accuracy.py --quick    # the two coarser resolutions only
     python benchmarks/accuracy.py --families sphere:irregular torus --resolutions 0 1 \
         --methods icc quadric MeshLab --output /tmp/subset.md   # a subset (never overwrite the table)
+    python benchmarks/accuracy.py --voxel        # marching-cubes family: writes benchmarks/accuracy_voxel.md
+    python benchmarks/accuracy.py --voxel-sweep  # icc's error vs radius there: accuracy_voxel_sweep.md
+
+The marching-cubes family (needs ``pip install 'meshcurv[volume]'``): spheres,
+ellipsoids and tori voxelised on isotropic grids (10 to 40 voxels per radius)
+and on grids 2x and 4x coarser along image axis 0, meshed by
+``skimage.measure.marching_cubes`` and given to every method and peer as it
+returns them (faces wound inward); meshcurv is called with no option. Errors are
+relative to the exact H and K at each vertex's closest point on the analytic
+surface (see ``meshcurv.shapes.voxel_sphere``). A held-out set (other radii,
+aspect ratios, a 3:1 voxel) is marked "not tuned on". ``--voxel-sweep`` runs
+icc with the faces reversed to outward over radii in multiples of the voxel size
+and of sqrt(voxel x radius of curvature), for choosing a default radius.
 
 Surfaces (``meshcurv.shapes``): sphere (r 1), torus (R 3, r 1), ellipsoid
 (3, 2, 1), open cylinder (r 1, height 4), saddle ``z = x^2 - y^2`` on [-1, 1]^2,
@@ -331,13 +344,37 @@ def voxel_errors(mesh, mean, gaussian, valid):
             "sign": sign, "cover": np.mean(valid)}
 
 
-def _child_call(function, *args):
-    """``function(*args)`` in a child process (pymeshlab double-frees on marching-cubes meshes)."""
-    import concurrent.futures
+def _child_call(function, *args, timeout=900):
+    """``function(*args)`` in a forked child process: a peer that crashes (pymeshlab double-frees on
+    marching-cubes meshes) or hangs is reported as failed instead of taking the benchmark down."""
     import multiprocessing
 
-    with concurrent.futures.ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:
-        return pool.submit(function, *args).result(timeout=600)
+    context = multiprocessing.get_context("fork")  # fork: ``function`` may be a closure, never pickled
+    receive, send = context.Pipe(duplex=False)
+
+    def target():
+        try:
+            send.send(("ok", function(*args)))
+        except BaseException as exc:  # noqa: BLE001 - reported to the parent
+            send.send(("error", f"{type(exc).__name__}: {exc}"))
+
+    process = context.Process(target=target)  # not daemonic: the MeshLab peer starts its own child
+    process.start()
+    send.close()
+    try:
+        if not receive.poll(timeout):
+            raise TimeoutError(f"no answer within {timeout} s")
+        status, value = receive.recv()
+    except EOFError:
+        process.join(10)
+        raise RuntimeError(f"the process died (exit code {process.exitcode})") from None
+    finally:
+        if process.is_alive():
+            process.kill()
+        process.join(10)
+    if status != "ok":
+        raise RuntimeError(value)
+    return value
 
 
 def _voxel_label(mesh, held_out):
