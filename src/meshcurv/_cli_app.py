@@ -21,16 +21,13 @@ from .estimators import ESTIMATORS
 from .io import FORMATS, read_mesh, write_curvatures
 from .io._files import check_output
 from .io.fields import FIELDS, curvature_fields
+from .smoothing import MAX_SMOOTHING_STEPS
 from .plotting import MAX_PIXELS
 from .topology import MeshTopology
 
 __all__ = ["meshcurv", "Session"]
 
 SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid")]
-
-#: The most smoothing passes the command takes: each pass averages over the 1-ring, so a few hundred
-#: already flatten any field; beyond this, a typo (or 10**20) would run for days.
-MAX_SMOOTHING_STEPS = 10_000
 
 #: The largest finite float: an option value that parses to infinity (``1e400``) is beyond it.
 _FLOAT_MAX = sys.float_info.max
