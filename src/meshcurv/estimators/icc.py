@@ -68,6 +68,7 @@ from .._tensors import principal_from_shape_operator
 from .._backend import numba_kernels
 from .._validation import check_positive_float
 from ..geometry import mean_edge_length, vertex_edge_lengths
+from ..lattice import voxel_grid
 from ..neighborhoods import ball_face_sums
 from ..topology import MeshTopology
 from ._common import Stages
@@ -85,6 +86,9 @@ NORMAL_ITERATIONS = 2
 
 #: The noise level is measured with degree-2 jets over balls of this many local edge lengths.
 NOISE_FIT_RADIUS = 2.0
+
+#: A fitted normal is kept where its cosine with the mean of the face normals exceeds this (60 degrees).
+NORMAL_AGREEMENT = 0.5
 
 #: Noise levels (in mean edge lengths) up to this count as a clean mesh: the
 #: fit's own bias on smooth surfaces sampled with 8 or more edges per radius of curvature.
@@ -125,12 +129,17 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
 def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, radius: float) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
-    ``normals`` (the first frames) is kept where no jet could be fitted.
+    ``normals`` (the first frames) is kept where no jet could be fitted, and
+    where the fitted normal turns more than 60 degrees (:data:`NORMAL_AGREEMENT`)
+    from it: the ball then reached another sheet of the surface (the far side
+    of a part thinner than the ball, a voxel surface's tip) and the fit
+    describes neither.
     """
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     coefficients, frame, _ = fit_jets(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS)
     fitted = jet_normals(coefficients, frame)
-    usable = valid & np.isfinite(fitted).all(axis=1)
+    with np.errstate(invalid="ignore"):
+        usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     return np.where(usable[:, None], fitted, normals)
 
 
@@ -177,37 +186,72 @@ def default_radius(noise: float, edge_length: float) -> float:
     return edge_length * (1.0 + NOISE_GAIN * np.sqrt(max(noise - NOISE_FLOOR, 0.0)))
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
-    """Interpolated corrected curvature measures over balls. Returns ``(result, problems)``."""
-    stages.start("compute normals")
-    _, degenerate, defects, normals, valid = prepare(vertices, topology)
+def voxel_radius(spacing: np.ndarray, curvature_radius: float) -> float:
+    """The default measure radius of a voxel surface: ``min(1.5 sqrt(h R), R / 2)``, at least ``h``.
 
-    stages.start("measure noise")
-    noise = {}
-    if radius is None:
-        edge_length = mean_edge_length(vertices, topology.edges)
-        level = noise_level(vertices, normals, valid, topology.edges) if edge_length > 0 else 0.0
-        radius = float(default_radius(level, edge_length))
-        noise = {"noise": level}
-    else:
-        radius = check_positive_float(radius, "radius")
-    parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius, **noise}
+    ``h`` is the largest voxel size, ``R`` the typical radius of curvature of
+    the surface. The staircase of the voxels is noise of amplitude ``h`` that
+    a ball of radius ``r`` averages down as ``h / r``, while the ball's own
+    bias grows as ``(r / R)^2``: the error is smallest for ``r`` of order
+    ``sqrt(h R)`` (Lachaud et al. 2020, digitised surfaces). The factor 1.5
+    and the cap ``R / 2`` (beyond it the normals, fitted over three radii,
+    reach round the shape) come from a sweep over the marching-cubes meshes of
+    ``benchmarks/accuracy.py`` (spheres, ellipsoids and tori, voxels 1:1:1 to
+    4:1:1, ``python benchmarks/accuracy.py --voxel-sweep``).
+    """
+    h = float(np.max(spacing))
+    return float(max(h, min(VOXEL_GAIN * np.sqrt(h * curvature_radius), VOXEL_CAP * curvature_radius)))
 
-    stages.start("fit normals")
+
+#: The voxel radius rule ``min(VOXEL_GAIN sqrt(h R), VOXEL_CAP R)`` (see :func:`voxel_radius`).
+VOXEL_GAIN = 1.5
+VOXEL_CAP = 0.5
+
+#: The typical radius of curvature of a voxel surface is measured with a first pass at this many voxels.
+VOXEL_PILOT = 2.0
+
+
+def _default_radius(vertices, topology, degenerate, normals, valid) -> tuple[float, dict]:
+    """The default radius and what it was derived from (``result.parameters``)."""
+    grid = voxel_grid(vertices[topology.referenced_vertices])
+    if grid is not None:
+        pilot = VOXEL_PILOT * float(np.max(grid.spacing))
+        k_min, k_max, *_ = _curvatures(vertices, topology.faces, degenerate, normals, valid.copy(), pilot)
+        curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
+        curvedness = curvedness[np.isfinite(curvedness) & (curvedness > 0)]
+        if curvedness.size:
+            curvature_radius = 1.0 / float(np.median(curvedness))
+            return voxel_radius(grid.spacing, curvature_radius), {
+                "surface": "voxel", "voxel_spacing": tuple(float(x) for x in grid.spacing),
+                "curvature_radius": curvature_radius}
+    edge_length = mean_edge_length(vertices, topology.edges)
+    level = noise_level(vertices, normals, valid, topology.edges) if edge_length > 0 else 0.0
+    return float(default_radius(level, edge_length)), {"surface": "smooth", "noise": level}
+
+
+def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Stages | None = None):
+    """``k_min, k_max, dir_min, dir_max, normals, valid`` of the measures over balls of ``radius``.
+
+    ``valid`` is updated in place (vertices whose ball has no corrected area).
+    """
+    def start(stage):
+        if stages is not None:
+            stages.start(stage)
+
+    start("fit normals")
     if radius > 0:
         normals = fitted_normals(vertices, normals, valid, NORMAL_RADIUS_RATIO * radius)
 
-    stages.start("compute face measures")
-    faces = topology.faces
+    start("compute face measures")
     faces = faces[~degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)]
     kernels = numba_kernels()
     measure = kernels.icc_face_measures if kernels is not None else face_measures
     measures = measure(vertices, faces, normals)
 
-    stages.start("sum over balls")
+    start("sum over balls")
     summed = ball_face_sums(vertices, faces, radius, measures)
 
-    stages.start("retrieve curvatures")
+    start("retrieve curvatures")
     area = summed[:, 0]
     valid &= area > 0
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -219,5 +263,20 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     with np.errstate(invalid="ignore", divide="ignore"):
         gaussian = summed[:, 2] / area
     half_difference = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
-    k_min, k_max = mean - half_difference, mean + half_difference
+    return mean - half_difference, mean + half_difference, dir_min, dir_max, normals, valid
+
+
+def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
+    """Interpolated corrected curvature measures over balls. Returns ``(result, problems)``."""
+    stages.start("compute normals")
+    _, degenerate, defects, normals, valid = prepare(vertices, topology)
+
+    stages.start("measure noise")
+    if radius is None:
+        radius, found = _default_radius(vertices, topology, degenerate, normals, valid)
+    else:
+        radius, found = check_positive_float(radius, "radius"), {}
+    parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius, **found}
+    k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
+        vertices, topology.faces, degenerate, normals, valid, radius, stages)
     return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects)
