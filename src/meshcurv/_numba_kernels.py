@@ -96,6 +96,15 @@ def mean_edge_length(vertices, edges):
     return _mean_edge_length(vertices, edges)
 
 
+@nb.njit(parallel=True, **_JIT)
+def edge_lengths(vertices, edges):
+    """``geometry.edge_lengths``: (E,) length of each edge."""
+    out = np.empty(edges.shape[0])
+    for e in nb.prange(edges.shape[0]):
+        out[e] = _edge_length(vertices, edges[e, 0], edges[e, 1])
+    return out
+
+
 # -- topology -------------------------------------------------------------------
 def threads() -> int:
     """The threads numba's parallel kernels use (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``)."""
@@ -204,11 +213,11 @@ def build_edges(faces, n_vertices, n_chunks):
 
 # -- normal cycle ---------------------------------------------------------------
 @nb.njit(parallel=True, **_JIT)
-def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_ratio, n_chunks):
+def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, scales, area_ratio, n_chunks):
     """Per-vertex measures, barycentric areas and normal sums; the zero-area faces.
 
     A face is degenerate when it repeats a vertex or its area is at most
-    ``area_ratio`` x (mean edge length)^2 (``diagnosis.degenerate_faces``); an
+    ``area_ratio`` x ``scales[a]^2`` (``diagnosis.degenerate_faces``); an
     edge contributes when it has two consistently oriented faces (``counts == 2``,
     ``forward == 1``), neither degenerate. Returns ``(sums, degenerate)``: ``sums``
     of shape (V, 10), columns 0-5 the anisotropic measure
@@ -222,8 +231,6 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_
     """
     n_vertices = vertices.shape[0]
     n_faces = faces.shape[0]
-    mean = _mean_edge_length(vertices, edges)
-    threshold = area_ratio * mean * mean
     degenerate = np.zeros(n_faces, np.bool_)
     face_normals = np.empty((n_faces, 4))  # the cross product and its norm (twice the area)
     for f in nb.prange(n_faces):
@@ -231,7 +238,7 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, area_
         nx, ny, nz = _face_cross(vertices, a, b, c)
         double_area = math.sqrt(nx * nx + ny * ny + nz * nz)
         face_normals[f, 0], face_normals[f, 1], face_normals[f, 2], face_normals[f, 3] = nx, ny, nz, double_area
-        degenerate[f] = _degenerate(a, b, c, 0.5 * double_area, threshold)
+        degenerate[f] = _degenerate(a, b, c, 0.5 * double_area, area_ratio * scales[a] * scales[a])
     n_chunks = max(1, min(n_chunks, n_vertices))
     sums = np.zeros((n_vertices, 10))
     for chunk in nb.prange(n_chunks):
@@ -710,29 +717,55 @@ def count_components(edges, referenced, n_vertices):
     return count
 
 
+@nb.njit(**_JIT)
+def component_labels(edges, referenced, n_vertices):
+    """(V,) component of each vertex of the edge graph (0, 1, ... by first vertex; -1: unreferenced) and the count."""
+    parent = np.arange(n_vertices)
+    for e in range(edges.shape[0]):
+        a = _find(parent, edges[e, 0])
+        b = _find(parent, edges[e, 1])
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    labels = np.full(n_vertices, -1, np.int64)
+    count = 0
+    for v in range(n_vertices):
+        if not referenced[v]:
+            continue
+        root = _find(parent, v)
+        if labels[root] < 0:
+            labels[root] = count
+            count += 1
+        labels[v] = labels[root]
+    return labels, count
+
+
 @nb.njit(parallel=True, **_JIT)
-def degenerate_faces(vertices, faces, edges, area_ratio):
-    """(F,) bool: faces that repeat a vertex or whose area is at most ``area_ratio`` x (mean edge length)^2."""
-    mean = _mean_edge_length(vertices, edges)
-    threshold = area_ratio * mean * mean
+def degenerate_faces(vertices, faces, scales, area_ratio):
+    """(F,) bool: faces that repeat a vertex or whose area is at most ``area_ratio`` x ``scales[a]^2``.
+
+    ``scales`` (V,) is the length scale at each vertex (``geometry.vertex_length_scales``),
+    read at the first corner ``a`` (the corners of a face share their component).
+    """
     out = np.empty(faces.shape[0], np.bool_)
     for f in nb.prange(faces.shape[0]):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         nx, ny, nz = _face_cross(vertices, a, b, c)
+        threshold = area_ratio * scales[a] * scales[a]
         out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
     return out
 
 
 @nb.njit(parallel=True, **_JIT)
-def mesh_facts(vertices, faces, edges, referenced, area_ratio, zero_length_ratio):
+def mesh_facts(vertices, faces, edges, referenced, scales, area_ratio, zero_length_ratio):
     """The measured facts of :func:`meshcurv.diagnose`, in one pass over vertices, faces and edges.
 
     Returns ``(lower, upper, area, six_volume, mean_length, n_degenerate, n_zero_length)``:
     the bounding box of the referenced vertices, the total area, the sum over
     faces of ``(a - centre) . cross(b - a, c - a)`` (``centre`` the mean of the
     referenced vertices), the mean edge length, the faces that repeat a vertex or
-    whose area is at most ``area_ratio`` x mean length^2, the edges no longer
-    than ``zero_length_ratio`` x mean length. The passes over edges and faces
+    whose area is at most ``area_ratio`` x ``scales[a]^2``, the edges no longer
+    than ``zero_length_ratio`` x ``scales`` at their first end (``scales``: the
+    length scale of each vertex, ``geometry.vertex_length_scales``). The passes over edges and faces
     are parallel reductions (sums in another order than a loop: equal to ~1e-16).
     """
     lower = np.full(3, np.inf)
@@ -759,8 +792,7 @@ def mesh_facts(vertices, faces, edges, referenced, area_ratio, zero_length_ratio
     mean = total / n_edges if n_edges else 0.0
     n_zero_length = 0
     for e in nb.prange(n_edges):
-        n_zero_length += 1 if lengths[e] <= zero_length_ratio * mean else 0
-    threshold = area_ratio * mean * mean
+        n_zero_length += 1 if lengths[e] <= zero_length_ratio * scales[edges[e, 0]] else 0
     area = 0.0
     six_volume = 0.0
     n_degenerate = 0
@@ -769,7 +801,7 @@ def mesh_facts(vertices, faces, edges, referenced, area_ratio, zero_length_ratio
         nx, ny, nz = _face_cross(vertices, a, b, c)
         half = 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz)
         area += half
-        n_degenerate += 1 if _degenerate(a, b, c, half, threshold) else 0
+        n_degenerate += 1 if _degenerate(a, b, c, half, area_ratio * scales[a] * scales[a]) else 0
         six_volume += ((vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny
                        + (vertices[a, 2] - centre[2]) * nz)
     return lower, upper, area, six_volume, mean, n_degenerate, n_zero_length

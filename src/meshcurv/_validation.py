@@ -236,15 +236,17 @@ def check_int_option(value, name: str, *, minimum: int = 0, maximum: int | None 
     ``2**63`` is refused here, not by an OverflowError deep inside.
     """
     top = INT64_MAX if maximum is None else min(maximum, INT64_MAX)
-    expected = f"an integer between {minimum} and {top}"
+    expected = f"an integer >= {minimum}" if maximum is None else f"an integer between {minimum} and {top}"
     if isinstance(value, (bool, np.bool_)):
         raise InvalidOptionError(f"`{name}` must be {expected}; got {_short_repr(value)}")
     try:
         number = operator.index(value)
     except TypeError:
         raise InvalidOptionError(f"`{name}` must be {expected}; got {_short_repr(value)}") from None
-    if number < minimum or number > top:
+    if number < minimum:
         raise InvalidOptionError(f"`{name}` must be {expected}; got {_short_repr(number)}")
+    if number > top:
+        raise InvalidOptionError(f"`{name}` must be {expected} and at most {top}; got {_short_repr(number)}")
     return int(number)
 
 

@@ -13,10 +13,14 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ._backend import numba_kernels
-from .geometry import DEGENERATE_AREA_RATIO, degenerate_face_mask, edge_lengths, face_cross_products
+from ._validation import checked_points
+from .errors import InvalidMeshError
+from .geometry import (DEGENERATE_AREA_RATIO, degenerate_face_mask, edge_lengths, face_cross_products,
+                       vertex_length_scales)
 from .topology import MeshTopology
 
-#: Edges no longer than this times the mean edge length count as zero-length.
+#: Edges no longer than this times the length scale of their component (its median
+#: edge length, :func:`meshcurv.geometry.vertex_length_scales`) count as zero-length.
 ZERO_LENGTH_RATIO = 1e-6
 
 __all__ = ["MeshDiagnosis", "diagnose", "degenerate_faces", "bowtie_vertices"]
@@ -37,7 +41,8 @@ class MeshDiagnosis:
     n_inconsistent_edges : int
         Two-face edges whose faces run them in the same direction (orientation flips).
     n_degenerate_faces : int
-        Faces of (near) zero area, repeated corners included.
+        Faces of (near) zero area, repeated corners included: area below ``1e-12``
+        x the squared median edge length of their connected component.
     n_unreferenced_vertices : int
     euler_characteristic : int
         V - E + F over the referenced vertices.
@@ -53,7 +58,8 @@ class MeshDiagnosis:
         Vertices where two or more fans of faces meet at a single point (no
         non-manifold edge there): the neighbourhood is not a disc.
     n_zero_length_edges : int
-        Edges whose two ends coincide (length below ``1e-6`` x the mean edge length).
+        Edges whose two ends coincide (length below ``1e-6`` x the median edge
+        length of their connected component).
     n_flipped_faces : int
         Faces reversed by ``orient=`` before the computation (0 when nothing was
         reversed, and for :func:`diagnose` itself).
@@ -125,24 +131,46 @@ class MeshDiagnosis:
 
 
 def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.ndarray | None = None,
-                     mean_edge_length: float | None = None, double_areas: np.ndarray | None = None) -> np.ndarray:
-    """(F,) bool: faces with a repeated corner or an area below 1e-12 x (mean edge length)^2.
+                     mean_edge_length: float | None = None, double_areas: np.ndarray | None = None,
+                     scales: np.ndarray | None = None) -> np.ndarray:
+    """(F,) bool: faces with a repeated corner or an area below 1e-12 x (length scale)^2.
 
-    The threshold is relative to the mesh's own length scale, so the same mesh
-    gives the same answer at any scale (coordinates around 1e-9 or 1e9 alike).
+    The length scale of a face is the median edge length of its connected
+    component (:func:`meshcurv.geometry.vertex_length_scales`; ``scales`` passes
+    them when already computed), or ``mean_edge_length`` when given (one scale
+    for all). Relative to the mesh's own scale, the same mesh gives the same
+    answer at any scale (coordinates around 1e-9 or 1e9 alike); a median, it is
+    not moved by a few outlier vertices (a spike at 1e10 leaves the other faces
+    alone); per component, a part at 1e-3 and a part at 1e3 are each measured
+    against their own edges.
     """
+    vertices = _checked(vertices, topology)
     kernels = numba_kernels()
-    if kernels is not None and mean_edge_length is None and double_areas is None:
+    if scales is None and mean_edge_length is None:
+        scales = vertex_length_scales(vertices, topology)
+    if kernels is not None and double_areas is None:
         # the kernel computes the cross products inline: ``cross`` only spares the NumPy path that work
-        return kernels.degenerate_faces(vertices, topology.faces, topology.edges, DEGENERATE_AREA_RATIO)
-    if mean_edge_length is None:
-        lengths = edge_lengths(vertices, topology.edges)
-        mean_edge_length = float(lengths.mean()) if lengths.size else 0.0
+        if scales is None:
+            scales = np.full(topology.n_vertices, float(mean_edge_length))
+        return kernels.degenerate_faces(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)
+    face_scale = scales[topology.faces[:, 0]] if scales is not None else mean_edge_length
     if double_areas is None:
         if cross is None:
             cross = face_cross_products(vertices, topology.faces)
         double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
-    return degenerate_face_mask(0.5 * double_areas, mean_edge_length) | topology.degenerate_faces
+    return degenerate_face_mask(0.5 * double_areas, face_scale) | topology.degenerate_faces
+
+
+def _checked(vertices, topology) -> np.ndarray:
+    """``vertices`` checked (:func:`~meshcurv._validation.checked_points`) against ``topology``."""
+    if not isinstance(topology, MeshTopology):
+        raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}")
+    vertices = checked_points(vertices)
+    if vertices.shape[0] != topology.n_vertices:
+        raise InvalidMeshError(
+            f"`vertices` has {vertices.shape[0]} rows but the topology has {topology.n_vertices} vertices"
+        )
+    return vertices
 
 
 def bowtie_vertices(topology: MeshTopology) -> np.ndarray:
@@ -172,13 +200,15 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     >>> d.n_components, d.genus, d.is_clean, d.problems()
     (1, 0, True, [])
     """
+    vertices = _checked(vertices, topology)
     faces = topology.faces
     referenced = topology.referenced_vertices
     n_unreferenced = int(topology.n_vertices - referenced.sum())
+    scales = vertex_length_scales(vertices, topology)
     kernels = numba_kernels()
     if kernels is not None:
         lower, upper, area, six_volume, scale, n_degenerate, n_zero_length = kernels.mesh_facts(
-            vertices, faces, topology.edges, referenced, DEGENERATE_AREA_RATIO, ZERO_LENGTH_RATIO)
+            vertices, faces, topology.edges, referenced, scales, DEGENERATE_AREA_RATIO, ZERO_LENGTH_RATIO)
     else:
         used = vertices if n_unreferenced == 0 else vertices[referenced]
         centre = used.mean(axis=0)
@@ -189,8 +219,9 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
         # the cross products are translation-invariant: a . (b x c) = (a - o) . cross(b - a, c - a)
         six_volume = float(np.einsum("ij,ij->i", vertices[faces[:, 0]] - centre, cross).sum())
         scale = float(lengths.mean()) if lengths.size else 0.0
-        n_degenerate = int((degenerate_face_mask(0.5 * double_areas, scale) | topology.degenerate_faces).sum())
-        n_zero_length = int((lengths <= ZERO_LENGTH_RATIO * scale).sum())
+        n_degenerate = int((degenerate_face_mask(0.5 * double_areas, scales[faces[:, 0]])
+                            | topology.degenerate_faces).sum())
+        n_zero_length = int((lengths <= ZERO_LENGTH_RATIO * scales[topology.edges[:, 0]]).sum())
         lower, upper = used.min(axis=0), used.max(axis=0)
     n_boundary = int(topology.boundary_edges.sum())
     nonmanifold = topology.nonmanifold_edges

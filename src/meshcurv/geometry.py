@@ -1,8 +1,17 @@
 """Geometric quantities of triangle meshes, as pure functions over arrays.
 
-Inputs are float64 ``vertices`` of shape (V, 3) and int64 ``faces`` of shape
-(F, 3) (0-based); outputs are new float64 arrays. Nothing here validates its
-input: the public entry points do that once (:mod:`meshcurv._validation`).
+Inputs are ``vertices`` of shape (V, 3) and ``faces`` of shape (F, 3)
+(0-based); outputs are new float64 arrays. Each function checks its arrays
+cheaply (:func:`meshcurv._validation.checked_mesh`: dtype, shape, finite
+coordinates, indices in range; no copy of arrays that are already float64 and
+int64), so that the compiled kernels never read out of bounds.
+
+Length scales: every tolerance of the core is relative to a *robust* length
+scale, the median edge length of the vertex's connected component
+(:func:`vertex_length_scales`), never to the mean over the whole mesh: one
+vertex at 1e10 (a scanner's sentinel) moves the mean edge length of a mesh by
+orders of magnitude but not its median, and a mesh made of a part at 1e-3 and a
+part at 1e3 has a scale for each.
 """
 
 from __future__ import annotations
@@ -10,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 
 from ._backend import numba_kernels
+from ._validation import checked_indices, checked_mesh, checked_points
+from .errors import InvalidMeshError
 
 __all__ = [
     "face_cross_products",
@@ -21,14 +32,25 @@ __all__ = [
     "edge_lengths",
     "vertex_edge_lengths",
     "mean_edge_length",
+    "median_edge_length",
+    "robust_mean_edge_length",
+    "vertex_length_scales",
     "degenerate_face_mask",
     "corner_cotangents",
     "corner_angles",
     "mixed_voronoi_corner_areas",
 ]
 
-#: Faces with area below this fraction of (mean edge length)^2 count as degenerate.
+#: Faces with area below this fraction of the squared length scale of their component
+#: (:func:`vertex_length_scales`, the median edge length) count as degenerate.
 DEGENERATE_AREA_RATIO = 1e-12
+
+#: :func:`robust_mean_edge_length` leaves out edges longer than this many median edge lengths.
+OUTLIER_EDGE_RATIO = 1000.0
+
+#: Components whose typical edge (geometric mean) is within this factor of the mesh's median
+#: edge length share that median as their scale (one pass, no sort); others get their own.
+COMPONENT_SCALE_SPREAD = 16.0
 
 
 def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -36,6 +58,7 @@ def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
     Written out component by component (faster than :func:`numpy.cross`, same values).
     """
+    vertices, faces = checked_mesh(vertices, faces)
     kernels = numba_kernels()
     if kernels is not None:
         return kernels.face_cross_products(vertices, faces)
@@ -71,6 +94,7 @@ def signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
     Computed relative to the centroid of the vertices, which reduces rounding and
     makes the value independent of translation on closed meshes.
     """
+    vertices, faces = checked_mesh(vertices, faces)
     centred = vertices - vertices.mean(axis=0)
     a, b, c = (centred[faces[:, k]] for k in range(3))
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
@@ -81,6 +105,7 @@ def vertex_areas(vertices: np.ndarray, faces: np.ndarray, *, areas: np.ndarray |
 
     They sum to the total area of the mesh; an unreferenced vertex gets 0.
     """
+    vertices, faces = checked_mesh(vertices, faces)
     if areas is None:
         areas = face_areas(vertices, faces)
     return np.bincount(faces.ravel(), weights=np.repeat(areas / 3.0, 3), minlength=vertices.shape[0])
@@ -92,6 +117,11 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
     Oriented like the faces (outward on an outward-wound closed mesh). A vertex
     with no incident face of non-zero area, or whose face normals cancel, is NaN.
     """
+    vertices, faces = checked_mesh(vertices, faces)
+    if cross is not None:
+        cross = np.ascontiguousarray(cross, dtype=np.float64)
+        if cross.shape != faces.shape:
+            raise InvalidMeshError(f"`cross` must have shape {faces.shape} (one row per face); got {cross.shape}")
     if cross is None:
         cross = face_cross_products(vertices, faces)
     n = vertices.shape[0]
@@ -115,12 +145,17 @@ def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
 
 def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """(E,) length of each of the given (E, 2) edges."""
+    vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
+    kernels = numba_kernels()
+    if kernels is not None:
+        return kernels.edge_lengths(vertices, edges)
     d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
     return np.sqrt(np.einsum("ij,ij->i", d, d))
 
 
 def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """(V,) mean length of the given (E, 2) edges at each vertex: the local resolution (NaN where none)."""
+    vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
     n = vertices.shape[0]
     kernels = numba_kernels()
     if kernels is not None:
@@ -132,7 +167,13 @@ def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
 
 
 def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
-    """Mean length of the given (E, 2) edges (0 when there are none)."""
+    """Mean length of the given (E, 2) edges (0 when there are none).
+
+    Not robust: one edge to a vertex at 1e10 sets it. Tolerances and default
+    radii use :func:`median_edge_length`, :func:`robust_mean_edge_length` or
+    :func:`vertex_length_scales` instead.
+    """
+    vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
     if edges.shape[0] == 0:
         return 0.0
     kernels = numba_kernels()
@@ -141,9 +182,82 @@ def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     return float(edge_lengths(vertices, edges).mean())
 
 
-def degenerate_face_mask(areas: np.ndarray, length_scale: float) -> np.ndarray:
-    """(F,) bool: faces whose area is negligible relative to ``length_scale ** 2``."""
-    return areas <= DEGENERATE_AREA_RATIO * length_scale**2
+def median_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
+    """Median length of the given (E, 2) edges (0 when there are none): a scale no outlier moves."""
+    lengths = edge_lengths(vertices, edges)
+    return float(np.median(lengths)) if lengths.size else 0.0
+
+
+def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
+    """Mean length of the given (E, 2) edges, leaving out those beyond ``OUTLIER_EDGE_RATIO`` medians.
+
+    Equal to :func:`mean_edge_length` on any mesh whose longest edge is within
+    :data:`OUTLIER_EDGE_RATIO` (1000) times its median (a decimated model has
+    some 40 between its shortest and longest edges), so default radii keep their
+    values there; an edge to a spike vertex (a scanner's sentinel at 1e10) is left
+    out instead of multiplying the mean. 0 when there are no edges.
+    """
+    lengths = edge_lengths(vertices, edges)
+    if lengths.size == 0:
+        return 0.0
+    median = float(np.median(lengths))
+    longest = float(lengths.max())
+    if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean (one pass)
+        return float(lengths.mean())
+    kept = lengths[lengths <= OUTLIER_EDGE_RATIO * median]
+    return float(kept.mean())
+
+
+def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
+    """(V,) the length scale at each vertex: the median edge length of its connected component.
+
+    The scale of every tolerance in the core (zero-area faces, zero-length
+    edges). On a mesh whose components are of one scale (each component's
+    geometric-mean edge within :data:`COMPONENT_SCALE_SPREAD` of the mesh's
+    median edge) it is the mesh's median edge length everywhere, found in one
+    pass; otherwise each component gets its own median (a sort of the edges by
+    component). Unreferenced vertices get 0.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    topology : MeshTopology
+
+    Returns
+    -------
+    ndarray of shape (V,), float64
+    """
+    edges = topology.edges
+    lengths = edge_lengths(vertices, edges)
+    n = topology.n_vertices
+    if lengths.size == 0:
+        return np.zeros(n)
+    overall = float(np.median(lengths))
+    referenced = topology.referenced_vertices
+    n_components, labels = topology.vertex_components
+    if n_components <= 1:
+        return np.where(referenced, overall, 0.0)
+    edge_label = labels[edges[:, 0]]
+    positive = lengths > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_sums = np.bincount(edge_label[positive], weights=np.log2(lengths[positive]), minlength=n_components)
+        typical = log_sums / np.bincount(edge_label[positive], minlength=n_components)
+    spread = np.abs(typical[np.isfinite(typical)] - np.log2(overall)) if overall > 0 else np.array([np.inf])
+    if spread.size and spread.max() <= np.log2(COMPONENT_SCALE_SPREAD):
+        return np.where(referenced, overall, 0.0)
+    order = np.lexsort((lengths, edge_label))
+    counts = np.bincount(edge_label, minlength=n_components)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    ranked = lengths[order]
+    low = ranked[starts + np.maximum(counts - 1, 0) // 2]
+    high = ranked[starts + np.minimum(counts // 2, np.maximum(counts - 1, 0))]
+    medians = np.where(counts > 0, 0.5 * (low + high), 0.0)
+    return np.where(referenced, medians[np.maximum(labels, 0)], 0.0)
+
+
+def degenerate_face_mask(areas: np.ndarray, length_scale) -> np.ndarray:
+    """(F,) bool: faces whose area is negligible relative to ``length_scale ** 2`` (a float or (F,) scales)."""
+    return areas <= DEGENERATE_AREA_RATIO * np.asarray(length_scale, dtype=np.float64) ** 2
 
 
 def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -152,6 +266,7 @@ def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     ``cot = (a . b) / |a x b|`` for the two edge vectors ``a, b`` leaving the
     corner; NaN on zero-area faces.
     """
+    vertices, faces = checked_mesh(vertices, faces)
     out = np.zeros(faces.shape, dtype=np.float64)
     for k in range(3):
         p = vertices[faces[:, k]]
@@ -164,6 +279,7 @@ def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(F, 3) interior angle at each corner of every face, in radians (0 on zero-area faces)."""
+    vertices, faces = checked_mesh(vertices, faces)
     out = np.zeros(faces.shape, dtype=np.float64)
     for k in range(3):
         p = vertices[faces[:, k]]
@@ -183,6 +299,7 @@ def mixed_voronoi_corner_areas(vertices: np.ndarray, faces: np.ndarray) -> np.nd
     (``np.bincount(faces.ravel(), shares.ravel())``) they tile the surface.
     https://doi.org/10.1007/978-3-662-05105-4_2
     """
+    vertices, faces = checked_mesh(vertices, faces)
     cot = corner_cotangents(vertices, faces)
     area = face_areas(vertices, faces)
     squared = np.zeros(faces.shape, dtype=np.float64)  # squared length of the side opposite corner k

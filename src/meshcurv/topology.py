@@ -259,6 +259,30 @@ class MeshTopology:
         return int(used.size), _readonly(labels.astype(np.int64))
 
     @cached_property
+    def vertex_components(self) -> tuple[int, np.ndarray]:
+        """Connected components of the referenced vertices (through edges).
+
+        Returns ``(n_components, labels)`` with ``labels`` of shape (V,): 0, 1, ...
+        numbered in the order of each component's first vertex, -1 for an
+        unreferenced vertex.
+        """
+        kernels = numba_kernels()
+        referenced = self.referenced_vertices
+        if kernels is not None:
+            labels, count = kernels.component_labels(self.edges, referenced, self.n_vertices)
+            return int(count), _readonly(labels)
+        from scipy.sparse.csgraph import connected_components
+
+        _, raw = connected_components(self.adjacency, directed=False)
+        raw = np.where(referenced, raw, -1)
+        used, first = np.unique(raw[referenced], return_index=True)
+        rank = np.empty(used.size, dtype=np.int64)
+        rank[np.argsort(first, kind="stable")] = np.arange(used.size)
+        labels = np.full(self.n_vertices, -1, dtype=np.int64)
+        labels[referenced] = rank[np.searchsorted(used, raw[referenced])]
+        return int(used.size), _readonly(labels)
+
+    @cached_property
     def n_components(self) -> int:
         """Number of connected components of the faces."""
         kernels = numba_kernels()

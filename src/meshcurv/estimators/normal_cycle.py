@@ -50,7 +50,7 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from ..diagnosis import degenerate_faces
 from .._backend import numba_kernels
-from ..geometry import DEGENERATE_AREA_RATIO, face_cross_products, vertex_normals
+from ..geometry import DEGENERATE_AREA_RATIO, face_cross_products, vertex_length_scales, vertex_normals
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from ..topology import MeshTopology
@@ -145,7 +145,8 @@ def _estimate_compiled(kernels, vertices: np.ndarray, topology: MeshTopology, sm
     stages.start("compute edge tensors")
     sums, degenerate = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
                                                  topology.edge_face_counts, topology._edge_forward_counts,
-                                                 DEGENERATE_AREA_RATIO, kernels.threads())
+                                                 vertex_length_scales(vertices, topology), DEGENERATE_AREA_RATIO,
+                                                 kernels.threads())
     defects = mesh_defects(topology, degenerate)
     stages.start("average vertex tensors")
     stages.start("retrieve curvatures")
