@@ -455,7 +455,7 @@ def test_pixels_beyond_the_bound_or_the_memory_are_refused_before_allocating(mon
 
     torus = shapes.torus(12, 4, 8, 4)
     values = torus.vertices[:, 0]
-    with pytest.raises(InvalidOptionError, match=r"`pixels` must be an integer between 16 and 8192; got 100000"):
+    with pytest.raises(InvalidOptionError, match=r"`pixels` must be an integer between 16 and 8192.*; got 100000"):
         plotting.plot_field(torus.vertices, torus.faces, values, pixels=100_000)
     with pytest.raises(InvalidOptionError, match=r"`pixels` must be an integer between 16 and 8192"):
         plotting.plot_field(torus.vertices, torus.faces, values, pixels=2**64)
@@ -464,7 +464,7 @@ def test_pixels_beyond_the_bound_or_the_memory_are_refused_before_allocating(mon
                                                  r"memory is available"):
         plotting.plot_field(torus.vertices, torus.faces, values, pixels=8192)
     figure = plotting.plot_field(torus.vertices, torus.faces, values, pixels=64)
-    with pytest.raises(InvalidOptionError, match=r"`dpi` must be an integer between 10 and 1200; got 100000"):
+    with pytest.raises(InvalidOptionError, match=r"`dpi` must be an integer between 10 and 1200.*; got 100000"):
         plotting.save_figure(figure, "never.png", dpi=100_000)
     assert not os.path.exists("never.png")
 
@@ -480,14 +480,35 @@ def test_two_commands_writing_the_same_file_do_not_both_succeed(tmp_path):
     processes = [subprocess.Popen([*MESHCURV, "compute", mesh, "-o", output], stdout=subprocess.PIPE,
                                   stderr=subprocess.PIPE, text=True) for _ in range(2)]
     try:
-        outcomes = [(process.wait(timeout=120), process.stderr.read()) for process in processes]
+        outcomes = [(process.returncode, process.communicate(timeout=120)[1]) for process in processes]
+        outcomes = [(process.returncode, err) for process, (_, err) in zip(processes, outcomes)]
     finally:
         for process in processes:
-            process.kill()
-            process.wait()
+            if process.poll() is None:
+                process.kill()
+                process.communicate()
     codes = sorted(code for code, _ in outcomes)
     assert codes == [0, 1], outcomes
     refused = next(err for code, err in outcomes if code == 1)
     assert "same.ply: already exists" in refused
     assert meshcurv.read_mesh(output).vertices.shape == (len(sphere.vertices), 3)
 
+
+
+def test_a_picture_written_meanwhile_by_another_process_is_not_replaced(tmp_path):
+    pytest.importorskip("matplotlib")
+    from meshcurv import plotting
+
+    torus = shapes.torus(12, 4, 8, 4)
+    figure = plotting.plot_field(torus.vertices, torus.faces, torus.vertices[:, 0], pixels=32)
+    path = tmp_path / "t.png"
+    savefig = figure.savefig
+
+    def racing(*args, **kwargs):  # another `meshcurv plot -o t.png` publishes first
+        path.write_bytes(b"the other one")
+        return savefig(*args, **kwargs)
+
+    figure.savefig = racing
+    with pytest.raises(MeshFileError, match=r"t\.png: already exists"):
+        plotting.save_figure(figure, path)
+    assert path.read_bytes() == b"the other one"

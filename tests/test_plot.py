@@ -105,7 +105,7 @@ def test_save_figure_is_atomic_and_refuses_to_overwrite(tmp_path):
         ({"view": []}, "`view` is empty"),
         ({"view": ["iso", "top"], "ax": "given"}, "`ax` takes one view; got 2"),
         ({"pixels": 8}, "`pixels` must be an integer between 16 and 8192; got 8"),
-        ({"pixels": 100_000}, "`pixels` must be an integer between 16 and 8192; got 100000"),
+        ({"pixels": 100_000}, "`pixels` must be an integer between 16 and 8192"),
         ({"up": "w"}, "`up` must be one of 'z', 'y', 'x'; got 'w'"),
     ],
 )

@@ -442,8 +442,9 @@ def save_figure(fig, path, *, overwrite: bool = False, dpi: int | None = None):
     Raises
     ------
     MeshFileError
-        ``path`` exists (without ``overwrite``), is a directory, or its folder
-        does not exist.
+        ``path`` exists (without ``overwrite``; also when another process
+        wrote it while the figure was being saved), is a directory, or its
+        folder does not exist.
     InvalidOptionError
         ``dpi`` outside 10 to :data:`MAX_DPI`.
     """
@@ -455,7 +456,7 @@ def save_figure(fig, path, *, overwrite: bool = False, dpi: int | None = None):
         dpi = check_int_option(dpi, "dpi", minimum=10, maximum=MAX_DPI)
     path = check_output(os.fspath(path), overwrite=overwrite)
     try:
-        with atomic_output(path) as temporary:
+        with atomic_output(path, overwrite=overwrite) as temporary:  # no silent replacement of a file made meanwhile
             fig.savefig(temporary, format="png", dpi=dpi)
     finally:
         plt.close(fig)
