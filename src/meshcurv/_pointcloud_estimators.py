@@ -1,0 +1,144 @@
+"""The curvature estimators of :func:`meshcurv.pointcloud.point_cloud_curvatures`.
+
+Both take trusted arrays (float64 points, unit oriented normals) and return
+``k_min, k_max, dir_min, dir_max, normals`` (NaN where undefined).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._backend import numba_kernels
+from ._tensors import principal_from_shape_operator
+from .estimators.icc import face_measures
+from .estimators.quadric import fit_jets, jet_normals, shape_operators
+
+#: Degree of the jets of ``method="jets"`` (Cazals and Pouget 2005: error of order ``r^(d-1)``).
+JET_DEGREE = 3
+
+#: Fits per point of the jets: the first in the frame of the point's normal, the next in the fitted one's.
+JET_ITERATIONS = 2
+
+#: Random triangles per point of ``method="corrected_measures"``.
+TRIANGLES = 48
+
+#: Most points of a ball that ``corrected_measures`` draws its triangles from (the nearest ones).
+MAX_BALL_POINTS = 96
+
+#: Fewest points of a ball for ``corrected_measures`` (three corners and some choice).
+MIN_BALL_POINTS = 6
+
+#: The normals of ``corrected_measures`` (when not given) are those of degree-3 jets over this many radii.
+NORMAL_RADIUS_RATIO = 2.0
+
+#: Centres per chunk of ``corrected_measures`` (bounds memory: chunk x TRIANGLES triangles).
+CHUNK = 32768
+
+
+def jets(points, normals, radius, centres, usable):
+    """Principal curvatures of jets fitted over balls of ``radius`` around ``centres``.
+
+    Returns ``(k_min, k_max, dir_min, dir_max, normals)`` at every point, NaN
+    where the fit failed and at points not in ``centres``; ``normals`` are those
+    of the fitted jets (the given ones where the fit failed).
+    """
+    coefficients, frame, _ = fit_jets(points, normals, radius, degree=JET_DEGREE, iterations=JET_ITERATIONS,
+                                      centres=centres, neighbours=usable)
+    six, fitted = shape_operators(coefficients, frame, radius)
+    ok = np.isfinite(coefficients).all(axis=1) & np.isfinite(fitted).all(axis=1)
+    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
+        np.where(ok[:, None], six, 0.0), np.where(ok[:, None], fitted, [0.0, 0.0, 1.0]))
+    out_normals = np.where(ok[:, None], fitted, normals)
+    for array in (k_min, k_max, dir_min, dir_max):
+        array[~ok] = np.nan
+    return k_min, k_max, dir_min, dir_max, out_normals
+
+
+def fitted_normals(points, normals, radius, centres, usable):
+    """(N, 3) normals of degree-3 jets over balls of ``radius`` (``normals`` kept where a fit fails)."""
+    coefficients, frame, _ = fit_jets(points, normals, radius, degree=3, iterations=2, centres=centres,
+                                      neighbours=usable)
+    fitted = jet_normals(coefficients, frame)
+    ok = np.isfinite(fitted).all(axis=1)
+    return np.where(ok[:, None], fitted, normals)
+
+
+def _rank_pattern(n_triangles: int) -> np.ndarray:
+    """(T, 3) fixed uniform numbers in [0, 1): the same random pattern of ranks for every point."""
+    return np.random.default_rng(20230517).random((n_triangles, 3))
+
+
+def _distinct_ranks(pattern: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """(M, T, 3) three distinct ranks below ``counts`` (>= 3) per triangle, uniform over the triples."""
+    c = counts[:, None].astype(float)
+    a = np.floor(pattern[None, :, 0] * c).astype(np.int64)
+    b = np.floor(pattern[None, :, 1] * (c - 1)).astype(np.int64)
+    b += b >= a
+    z = np.floor(pattern[None, :, 2] * (c - 2)).astype(np.int64)
+    low, high = np.minimum(a, b), np.maximum(a, b)
+    z += z >= low
+    z += z >= high
+    return np.stack([a, b, z], axis=2)
+
+
+def corrected_measures(tree, points, normals, radius, centres, usable, *, n_triangles: int = TRIANGLES):
+    """Randomized corrected curvature measures over balls of ``radius`` (Lachaud et al. 2023).
+
+    For every centre, ``n_triangles`` triangles with corners drawn at random
+    among the (at most :data:`MAX_BALL_POINTS` nearest) usable points of its
+    ball, each turned so that its corrected area is positive; the
+    interpolated corrected measures of :func:`meshcurv.estimators.icc.face_measures`
+    of these triangles with the point normals, summed: ``H = mu_1 / (2 mu_0)``,
+    ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``, the directions
+    those of ``-sym(mu^{X,Y}) / mu_0`` in the tangent plane of the centre's
+    normal. The draws are ranks in the ball's distance order from one fixed
+    pattern: the result does not depend on the order of the points, and moves
+    with them under rigid motions and scaling.
+    """
+    n = points.shape[0]
+    out = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)]
+    pattern = _rank_pattern(n_triangles)
+    kernels = numba_kernels()
+    measure = kernels.icc_face_measures if kernels is not None else face_measures
+    for start in range(0, centres.size, CHUNK):
+        chunk = centres[start:start + CHUNK]
+        distance, index = tree.query(points[chunk], k=min(MAX_BALL_POINTS, n), distance_upper_bound=radius,
+                                     workers=-1)
+        index = index.reshape(chunk.size, -1)
+        inside = index < n
+        inside[inside] = usable[index[inside]]
+        # usable points first, in distance order (a stable sort keeps the order within each group)
+        order = np.argsort(~inside, axis=1, kind="stable")
+        index = np.take_along_axis(index, order, axis=1)
+        counts = inside.sum(axis=1)
+        ok = counts >= MIN_BALL_POINTS
+        rows = np.flatnonzero(ok)
+        if rows.size == 0:
+            continue
+        ranks = _distinct_ranks(pattern, counts[rows])
+        triangles = np.take_along_axis(index[rows][:, None, :], ranks.reshape(rows.size, 1, -1), axis=2)
+        triangles = triangles.reshape(rows.size, n_triangles, 3)
+        # turn each triangle so that its normal agrees with the mean of its corners' normals
+        x0, x1, x2 = (points[triangles[..., j]] for j in range(3))
+        facing = np.einsum("mtj,mtj->mt", np.cross(x1 - x0, x2 - x0),
+                           normals[triangles].sum(axis=2))
+        flip = facing < 0
+        triangles[flip, 1], triangles[flip, 2] = triangles[flip, 2], triangles[flip, 1].copy()
+        measures = measure(points, np.ascontiguousarray(triangles.reshape(-1, 3)), normals)
+        summed = measures.reshape(rows.size, n_triangles, 9).sum(axis=1)
+        area = summed[:, 0]
+        good = area > 0
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = summed[:, 1] / (2 * area)
+            gaussian = summed[:, 2] / area
+            shape_operator = -summed[:, 3:] / area[:, None]
+        centre_normals = normals[chunk[rows]]
+        _, _, dir_min, dir_max = principal_from_shape_operator(
+            np.where(good[:, None], shape_operator, 0.0), centre_normals)
+        half = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
+        target = chunk[rows[good]]
+        out[0][target] = (mean - half)[good]
+        out[1][target] = (mean + half)[good]
+        out[2][target] = dir_min[good]
+        out[3][target] = dir_max[good]
+    return (*out, normals)

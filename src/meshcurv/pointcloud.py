@@ -1,0 +1,350 @@
+"""Principal curvatures of point clouds, without a mesh.
+
+:func:`point_cloud_curvatures` gives, at every point, the principal curvatures
+``k_min <= k_max`` (1/length), their directions, the normal and a ``valid``
+mask, in the same :class:`~meshcurv.result.CurvatureResult` as
+:func:`meshcurv.principal_curvatures`, with the same sign convention:
+curvatures are positive where the surface bends away from the normal (points
+sampled on a sphere of radius ``r`` with outward normals give ``+1/r``).
+
+Pipeline (all vectorised, neighbours from :class:`scipy.spatial.cKDTree`
+queries in chunks, no O(N^2) memory):
+
+1. checks: shape, NaN, at least :data:`MIN_POINTS` points, not all on a line;
+   duplicate points are computed once and copied; points whose neighbours are
+   all far (outliers) stay out of every neighbourhood and are NaN;
+2. the local spacing ``s_i`` (:func:`meshcurv._pointcloud_normals.local_spacing`,
+   the analogue of a mesh's edge length) and its median ``s``;
+3. normals: the given ones (made unit), or PCA of the 10 nearest neighbours;
+   oriented consistently along a minimum spanning tree of the neighbour graph
+   (Hoppe et al. 1992) unless the given ones already are, and, when estimated,
+   outward on each connected component;
+4. the noise level ``nu``: the median distance of the points to degree-2 jets
+   fitted over :data:`NOISE_FIT_RADIUS` spacings, in spacings;
+5. the radius: ``s (a + b sqrt(max(nu - 0.005, 0)))`` (constants per method,
+   from ``benchmarks/pointcloud.py``); when the density varies by more than
+   a factor 2 across the cloud, each class of local spacing (powers of two)
+   gets its own radius;
+6. the estimator (``method``):
+
+   - ``"jets"`` (default): weighted degree-3 jets over the ball, refitted in
+     the frame of their own normal (Cazals and Pouget 2005), curvatures from
+     the jet's second fundamental form
+     (:func:`meshcurv.estimators.quadric.shape_operators`);
+   - ``"corrected_measures"``: randomized corrected curvature measures
+     (Lachaud, Coeurjolly, Labart, Romon, Thibert 2023): random triangles
+     among the points of the ball, their interpolated corrected measures with
+     the point normals (:func:`meshcurv.estimators.icc.face_measures`)
+     summed, ``H = mu_1 / 2 mu_0``, ``K = mu_2 / mu_0``.
+
+References
+----------
+F. Cazals and M. Pouget (2005). Estimating differential quantities using
+polynomial fitting of osculating jets. Computer Aided Geometric Design 22(2),
+121-146. https://doi.org/10.1016/j.cagd.2004.09.004
+
+H. Hoppe, T. DeRose, T. Duchamp, J. McDonald, W. Stuetzle (1992). Surface
+reconstruction from unorganized points. SIGGRAPH '92, 71-78.
+https://doi.org/10.1145/133994.134011
+
+J.-O. Lachaud, D. Coeurjolly, C. Labart, P. Romon, B. Thibert (2023).
+Lightweight curvature estimation on point clouds with randomized corrected
+curvature measures. Computer Graphics Forum 42(5), e14910.
+https://doi.org/10.1111/cgf.14910
+"""
+
+from __future__ import annotations
+
+import logging
+import warnings
+
+import numpy as np
+
+from . import _pointcloud_estimators as _estimators
+from . import _pointcloud_normals as _normals
+from ._validation import as_vertices, check_choice, check_positive_float
+from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
+from .estimators.quadric import fit_jets
+from .result import INVALID_REASONS, CurvatureResult
+
+__all__ = ["point_cloud_curvatures", "POINT_CLOUD_METHODS", "MIN_POINTS"]
+
+logger = logging.getLogger(__name__)
+
+#: The estimators of :func:`point_cloud_curvatures`; the first is the default.
+POINT_CLOUD_METHODS = ("jets", "corrected_measures")
+
+#: Fewest points accepted.
+MIN_POINTS = 10
+
+#: The default radius ``s (a + b sqrt(max(nu - NOISE_FLOOR, 0)))`` per method: ``(a, b)``.
+RADIUS_RULES = {"jets": (3.0, 12.0), "corrected_measures": (3.0, 12.0)}
+
+#: Noise levels (in spacings) up to this count as clean samples: the fit's own bias.
+NOISE_FLOOR = 0.005
+
+#: The noise level is measured with degree-2 jets over balls of this many spacings.
+NOISE_FIT_RADIUS = 3.0
+
+#: The noise level is measured on at most this many points, evenly spaced in index order.
+NOISE_SAMPLE = 16384
+
+#: A point whose local spacing exceeds this many times the median is an outlier.
+OUTLIER_FACTOR = 10.0
+
+#: The density counts as uneven (and each class of spacing gets its own radius) when the 95th
+#: percentile of the (neighbour-averaged) local spacing exceeds this many times the 5th.
+UNEVEN_DENSITY = 2.0
+
+#: Code of :data:`meshcurv.result.INVALID_REASONS` for points without an estimate.
+_UNDEFINED = len(INVALID_REASONS) - 1
+
+
+def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | None = None) -> CurvatureResult:
+    """Principal curvatures, directions and normals at every point of a point cloud.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 3)
+        Samples of a surface (N >= 10), not all on one line.
+    normals : array_like of shape (N, 3), optional
+        Normals at the points, of any length (not zero) and any signs. Used
+        when given: made unit; if their signs are not consistent they are
+        oriented along a minimum spanning tree of the neighbour graph, each
+        connected part keeping the side most of its given normals point to.
+        The curvature signs follow them. Default: estimated (PCA of the 10
+        nearest neighbours), oriented consistently and outward on closed
+        shapes.
+    radius : float, optional
+        Radius of the Euclidean ball of each estimate, in the units of the
+        points. Default: from the data, ``s (3 + 12 sqrt(max(nu - 0.005, 0)))``
+        with ``s`` the median local spacing and ``nu`` the noise level in
+        spacings (see the module doc); per class of density when it varies by
+        more than a factor 2.
+    method : {"jets", "corrected_measures"}, default: "jets"
+        ``"jets"``: osculating jets of degree 3 (Cazals and Pouget 2005).
+        ``"corrected_measures"``: randomized corrected curvature measures
+        (Lachaud et al. 2023).
+
+    Returns
+    -------
+    CurvatureResult
+        ``k_min, k_max, dir_min, dir_max, normals, valid`` per point and
+        ``invalid_reason``; ``parameters`` holds ``radius`` (or ``radii`` per
+        density class), ``spacing``, ``noise`` and ``normals`` (``"given"``,
+        ``"given, reoriented"`` or ``"estimated"``). ``normals`` are those
+        the curvatures refer to: the fitted jets' (``"jets"``), or the
+        oriented ones used by the measures (``"corrected_measures"``).
+
+    Raises
+    ------
+    InvalidMeshError
+        ``points`` or ``normals`` of the wrong shape, NaN or infinite values,
+        fewer than :data:`MIN_POINTS` distinct points, all points on a line,
+        zero normals.
+    InvalidOptionError
+        Unknown ``method``, ``radius`` not a positive number or larger than
+        the cloud.
+
+    Warns
+    -----
+    MeshQualityWarning
+        Once per call, listing what was found and done: duplicate points
+        (computed once, copied), outliers (NaN), very uneven density (one
+        radius per class of density), points without an estimate.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from meshcurv.pointcloud import point_cloud_curvatures
+    >>> rng = np.random.default_rng(0)
+    >>> p = rng.normal(size=(5000, 3))
+    >>> p = 2.0 * p / np.linalg.norm(p, axis=1, keepdims=True)    # sphere of radius 2
+    >>> r = point_cloud_curvatures(p)
+    >>> print(f"{np.median(r.mean):.3f}", r.parameters["normals"])
+    0.500 estimated
+    """
+    method = POINT_CLOUD_METHODS[0] if method is None else check_choice(method, "method", POINT_CLOUD_METHODS)
+    points = as_vertices(points, name="points")
+    given = None if normals is None else _checked_normals(normals, points.shape)
+    if radius is not None:
+        radius = check_positive_float(radius, "radius")
+    n_all = points.shape[0]
+    if n_all < MIN_POINTS:
+        raise InvalidMeshError(f"`points` holds {n_all} points; at least {MIN_POINTS} are needed")
+    problems: list[str] = []
+
+    # duplicates: computed once on the first of each group of coincident points, copied to the others
+    representative = _representatives(points)
+    unique = np.flatnonzero(representative == np.arange(n_all))
+    if unique.size < n_all:
+        problems.append(f"{n_all - unique.size} points coincide with others (duplicates): computed once and copied")
+    if unique.size < MIN_POINTS:
+        raise InvalidMeshError(f"`points` holds {unique.size} distinct points; at least {MIN_POINTS} are needed")
+    cloud = points[unique]
+    _check_spread(cloud)
+    if radius is not None:
+        diagonal = float(np.linalg.norm(cloud.max(axis=0) - cloud.min(axis=0)))
+        if radius > diagonal:
+            raise InvalidOptionError(
+                f"`radius` {radius:g} is larger than the point cloud itself (bounding-box diagonal {diagonal:g}): "
+                "every ball would hold every point; pass a radius of a few point spacings, in the units of the points")
+
+    k_min, k_max, dir_min, dir_max, out_normals, valid, parameters, found = _compute(
+        cloud, None if given is None else given[unique], radius, method)
+    problems.extend(found)
+
+    # back to all points: each duplicate takes its representative's values
+    position = np.zeros(n_all, dtype=np.int64)
+    position[unique] = np.arange(unique.size)
+    take = position[representative]
+    fields = [a[take] for a in (k_min, k_max, dir_min, dir_max, out_normals, valid)]
+    k_min, k_max, dir_min, dir_max, out_normals, valid = fields
+    valid = valid & np.isfinite(k_min) & np.isfinite(k_max)
+    for array in (k_min, k_max, dir_min, dir_max):
+        array[~valid] = np.nan
+    n_invalid = int((~valid).sum())
+    if n_invalid:
+        problems.append(f"{n_invalid} points are NaN with valid=False")
+    if problems:
+        warnings.warn("point cloud: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
+    reason = np.where(valid, 0, _UNDEFINED).astype(np.int8)
+    return CurvatureResult._of_arrays(k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max,
+                                      normals=out_normals, valid=valid, method=method, parameters=parameters,
+                                      invalid_reason=reason)
+
+
+def _checked_normals(normals, shape) -> np.ndarray:
+    """The given normals as unit float64 (N, 3) vectors."""
+    array = as_vertices(normals, name="normals")
+    if array.shape != shape:
+        raise InvalidMeshError(f"`normals` must have the shape of `points` {shape}; got {array.shape}")
+    length = np.linalg.norm(array, axis=1)
+    zero = np.flatnonzero(~(length > 0))
+    if zero.size:
+        raise InvalidMeshError(f"`normals` has zero length at {zero.size} points (first at index {zero[0]})")
+    return array / length[:, None]
+
+
+def _representatives(points: np.ndarray) -> np.ndarray:
+    """(N,) the index of the first point with the same coordinates as each point (itself when unique)."""
+    order = np.lexsort(points.T[::-1])
+    ordered = points[order]
+    new = np.ones(points.shape[0], dtype=bool)
+    new[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
+    if new.all():
+        return np.arange(points.shape[0])
+    group = np.cumsum(new) - 1
+    first = np.full(group[-1] + 1, points.shape[0], dtype=np.int64)
+    np.minimum.at(first, group, order)
+    out = np.empty(points.shape[0], dtype=np.int64)
+    out[order] = first[group]
+    return out
+
+
+def _check_spread(cloud: np.ndarray) -> None:
+    """Refuse a cloud whose points all lie on one line (no surface through them)."""
+    sample = cloud[np.linspace(0, cloud.shape[0] - 1, min(cloud.shape[0], 100_000)).round().astype(np.int64)]
+    centred = sample - sample.mean(axis=0)
+    singular = np.linalg.svd(centred, compute_uv=False)
+    if singular[1] <= 1e-9 * singular[0]:
+        raise InvalidMeshError(
+            f"all {cloud.shape[0]} distinct points lie on one line (extent {singular[0]:.3g} along it, "
+            f"{singular[1]:.3g} across): no surface to measure")
+
+
+def _compute(points, given, radius, method):
+    """The pipeline on distinct points. Returns the fields, ``valid``, ``parameters`` and the problems."""
+    from scipy.spatial import cKDTree
+
+    n = points.shape[0]
+    problems = []
+    tree = cKDTree(points)
+    logger.info("point cloud: %d points: neighbours", n)
+    distances, indices = _normals.knn(tree, points)
+    spacing = _normals.local_spacing(distances)
+    median = float(np.median(spacing))
+    usable = spacing <= OUTLIER_FACTOR * median
+    if not usable.all():
+        problems.append(f"{int((~usable).sum())} points are outliers (their {_normals.SPACING_NEIGHBOUR}th "
+                        f"neighbour is beyond {OUTLIER_FACTOR:g} times the median spacing): left out, NaN")
+    centres = np.flatnonzero(usable)
+
+    logger.info("point cloud: normals")
+    if given is None:
+        start = _normals.pca_normals(points, indices)
+        signs, labels = _normals.orientation_signs(start, indices, usable)
+        start = start * signs[:, None]
+        start = start * _normals.outward_signs(points, start, labels, np.where(usable, spacing**2, 0.0))[:, None]
+        how = "estimated"
+    else:
+        signs, labels = _normals.orientation_signs(given, indices, usable)
+        # each component keeps the side most of its given normals point to
+        majority = np.bincount(labels, weights=signs, minlength=int(labels.max()) + 1)
+        signs = signs * np.where(majority[labels] < 0, -1.0, 1.0)
+        reoriented = bool((signs < 0).any())
+        start = given * signs[:, None]
+        how = "given, reoriented" if reoriented else "given"
+
+    logger.info("point cloud: noise level")
+    noise = _noise_level(points, start, median, centres, usable)
+    groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems)
+
+    k_min, k_max = np.full(n, np.nan), np.full(n, np.nan)
+    dir_min, dir_max = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
+    out_normals = start.copy()
+    logger.info("point cloud: %s over %d radius class(es)", method, len(groups))
+    for group_radius, members in groups:
+        if method == "jets":
+            found = _estimators.jets(points, start, group_radius, members, usable)
+        else:
+            normals = start if given is not None else _estimators.fitted_normals(
+                points, start, _estimators.NORMAL_RADIUS_RATIO * group_radius, members, usable)
+            found = _estimators.corrected_measures(tree, points, normals, group_radius, members, usable)
+        for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
+            whole[members] = part[members]
+    valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
+    parameters = {"radius": groups[0][0], "spacing": median, "noise": noise, "normals": how}
+    if len(groups) > 1:
+        parameters["radii"] = tuple(r for r, _ in groups)
+    return k_min, k_max, dir_min, dir_max, out_normals, valid, parameters, problems
+
+
+def _noise_level(points, normals, spacing, centres, usable) -> float:
+    """Median distance of the points to degree-2 jets over :data:`NOISE_FIT_RADIUS` spacings, in spacings."""
+    sample = centres[np.linspace(0, centres.size - 1, min(centres.size, NOISE_SAMPLE)).round().astype(np.int64)]
+    if spacing <= 0 or sample.size == 0:
+        return 0.0
+    radius = NOISE_FIT_RADIUS * spacing
+    coefficients, _, _ = fit_jets(points, normals, radius, degree=2, iterations=1, centres=sample,
+                                  neighbours=usable)
+    heights = np.abs(coefficients[sample, 0]) * NOISE_FIT_RADIUS  # c00 is in units of the radius
+    heights = heights[np.isfinite(heights)]
+    return float(np.median(heights)) if heights.size else 0.0
+
+
+def default_radius(spacing: float, noise: float, method: str = POINT_CLOUD_METHODS[0]) -> float:
+    """The default radius for points of this median ``spacing`` and ``noise`` level (in spacings)."""
+    a, b = RADIUS_RULES[method]
+    return float(spacing * (a + b * np.sqrt(max(noise - NOISE_FLOOR, 0.0))))
+
+
+def _radius_groups(spacing, indices, usable, median, noise, radius, method, problems):
+    """``[(radius, centres), ...]``: one radius, or one per class of density when it is uneven."""
+    centres = np.flatnonzero(usable)
+    if radius is not None:
+        return [(radius, centres)]
+    # the spacing averaged over the neighbours: one class per region, not per random gap
+    smooth = np.where(usable, spacing, np.nan)
+    smooth = np.nanmean(np.concatenate([smooth[:, None], smooth[indices]], axis=1), axis=1)[centres]
+    low, high = np.percentile(smooth, [5, 95])
+    if high <= UNEVEN_DENSITY * low:
+        return [(default_radius(median, noise, method), centres)]
+    level = np.round(np.log2(smooth / median)).astype(np.int64)
+    groups = []
+    for k in np.unique(level):
+        members = centres[level == k]
+        groups.append((default_radius(median * 2.0**k, noise, method), members))
+    problems.append(f"the density of the points is very uneven (local spacing from {low:.3g} to {high:.3g}, "
+                    f"5th to 95th percentile): each of {len(groups)} classes of spacing got its own radius")
+    return groups
