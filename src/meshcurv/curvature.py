@@ -7,6 +7,7 @@ import warnings
 
 import numpy as np
 
+from ._adapters import mesh_arrays
 from ._validation import as_faces, as_vertices, check_choice, check_int_option, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
@@ -25,7 +26,7 @@ METHODS = tuple(ESTIMATORS)
 
 def principal_curvatures(
     vertices,
-    faces,
+    faces=None,
     *,
     method: str = DEFAULT_METHOD,
     smoothing_steps: int | None = None,
@@ -38,8 +39,12 @@ def principal_curvatures(
 
     Parameters
     ----------
-    vertices : array_like of shape (V, 3)
-        Vertex coordinates (any real dtype; computed in float64).
+    vertices : array_like of shape (V, 3), or a mesh object
+        Vertex coordinates (any real dtype; computed in float64). Or, with
+        ``faces`` left out, a mesh object of trimesh (``Trimesh``), PyVista
+        (``PolyData``), meshio (``Mesh``) or Open3D (``TriangleMesh``), whose
+        vertices and faces are taken (none of these libraries is needed
+        otherwise).
     faces : array_like of shape (F, 3) or (F, k), list of index lists, or MeshTopology
         0-based vertex indices. Polygons (k > 3, or lists of varying length) are
         fan-triangulated as matGeom's ``triangulateFaces`` does, with a
@@ -167,6 +172,8 @@ def principal_curvatures(
     if options.get("radius") is not None:
         options["radius"] = check_positive_float(options["radius"], "radius")
 
+    if faces is None:
+        vertices, faces = mesh_arrays(vertices)
     points = as_vertices(vertices)
     topology = _as_topology(faces, points.shape[0])
     check_choice(orient, "orient", ORIENT_CHOICES)
