@@ -120,6 +120,9 @@ def batch_command() -> click.Command:
             click.echo(f"meshcurv: failed: {path}: {error}", err=True)
         if len(failures) > _SHOWN_FAILURES:
             click.echo(f"meshcurv: ... and {len(failures) - _SHOWN_FAILURES} more (see the summary)", err=True)
+        if not failures.empty and not retry_failed:
+            session.info("meshes that failed before are reported, not tried again, until their file changes "
+                         "(--retry-failed tries them)")
         if not failures.empty:
             click.echo(f"meshcurv: error: {len(failures)} of {len(summary)} meshes failed", err=True)
         if not_written:

@@ -19,9 +19,18 @@ What is written (``OUT_DIR`` is created if needed):
 - one result file per mesh, ``OUT_DIR/<name>.<output_format>``, holding the
   mesh and its curvature fields (:func:`meshcurv.io.write_curvatures`); inputs
   in several folders keep their folders below the deepest folder they share;
-- a record per result in ``OUT_DIR/.meshcurv-batch/`` (its summary row, in
-  JSON), so that a later run can skip the mesh and still report it;
+- a record per mesh in ``OUT_DIR/.meshcurv-batch/`` (its summary row, the
+  options and the input's :func:`fingerprint`, in JSON), so that a later run
+  can skip the mesh and still report it, and notice an input changed since;
+  failures are recorded too (a later run reports them without trying again,
+  unless asked); a damaged record is ignored (its mesh computed again);
 - ``summary.parquet`` and ``summary.csv``, ordered by input path.
+
+``OUT_DIR`` is kept apart from the inputs: an input in it (under any name:
+links, ``..``, bind mounts) is refused or, matched by a folder or pattern,
+left out, and no result or record is ever written over an input file. Each
+mesh has a time limit (``timeout``, one hour by default), and a mesh whose
+workers keep dying fails alone (see :func:`run`).
 
 Every file is written under a temporary name and renamed when complete: a
 result file that exists is complete, and a run that is interrupted or whose
