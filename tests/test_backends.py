@@ -156,7 +156,8 @@ def test_curvatures_agree(name, method):
     a = run(name, method, "numpy")
     b = run(name, method, "numba")
     np.testing.assert_array_equal(a.valid, b.valid)
-    scale = np.nanmax(np.abs(a.k_max))
+    finite = np.abs(a.k_max[np.isfinite(a.k_max)])
+    scale = finite.max() if finite.size else 1.0  # quadric on the coarse torus: every ball holds the tube's far side
     for field in ("k_min", "k_max", "mean", "gaussian"):
         np.testing.assert_allclose(getattr(b, field), getattr(a, field), rtol=0, atol=1e-11 * scale * max(scale, 1),
                                    err_msg=field)
@@ -191,7 +192,8 @@ def test_ball_methods_agree(name, method):
     assert {k: a.parameters[k] for k in numeric} == pytest.approx({k: b.parameters[k] for k in numeric}, rel=1e-9)
     assert {k: v for k, v in a.parameters.items() if k not in numeric} == {
         k: v for k, v in b.parameters.items() if k not in numeric}
-    scale = np.nanmax(np.abs(a.k_max))
+    finite = np.abs(a.k_max[np.isfinite(a.k_max)])
+    scale = finite.max() if finite.size else 1.0  # quadric on the coarse torus: every ball holds the tube's far side
     for field in ("k_min", "k_max", "normals"):
         np.testing.assert_allclose(getattr(b, field), getattr(a, field), rtol=0, atol=1e-8 * max(scale, 1),
                                    err_msg=field)

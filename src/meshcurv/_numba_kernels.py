@@ -1016,30 +1016,55 @@ def _cholesky_solve(a, b, low, m, min_pivot):
 
 
 @nb.njit(parallel=True, **_JIT)
-def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks):
+def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks, pool, facing,
+             check_facing, away_fraction):
     """``quadric.fit_jets``: weighted jets over the balls of ``radius``, frame re-estimated from each fit.
 
     Fits the jets of the vertices ``centres`` (the other rows of the outputs
-    stay NaN). Returns ``(coefficients (V, 6), t1, t2, n, counts)``; the
-    neighbours of each vertex are found on a grid of cells (:func:`_grid`).
+    stay NaN). Only the vertices ``pool`` (int64 ids) enter the balls. With
+    ``check_facing``, a fit whose ball holds more than ``away_fraction`` of its
+    points (of non-zero weight) with a ``facing`` normal opposite to the centre's
+    (``n_j . n_v < 0``; NaN normals are not counted) is not a height function over
+    the tangent plane and is left NaN. Returns ``(coefficients (V, 6), t1, t2,
+    n, counts, away)``, ``away`` the share of points facing away (NaN
+    unless checked); the neighbours of each vertex are found on a grid of cells
+    (:func:`_grid`).
     """
     n = vertices.shape[0]
-    grid = _grid(vertices, radius)
+    n_pool = pool.shape[0]
+    pooled = np.empty((n_pool, 3))
+    for k in range(n_pool):
+        pooled[k] = vertices[pool[k]]
+    grid = _grid(pooled, radius)
     order = grid[0]
-    points = np.empty((n, 3))
-    for k in range(n):
-        points[k] = vertices[order[k]]
-    # centres in grid order: consecutive balls share cells (cache)
+    points = np.empty((n_pool, 3))
+    ids = np.empty(n_pool, np.int64)
+    for k in range(n_pool):
+        points[k] = pooled[order[k]]
+        ids[k] = pool[order[k]]
+    # centres in grid order: consecutive balls share cells (cache); centres outside the pool last
     chosen = np.zeros(n, np.bool_)
     chosen[centres] = True
-    centres = order[chosen[order]]
+    sorted_centres = np.empty(centres.shape[0], np.int64)
+    m = 0
+    for k in range(n_pool):
+        if chosen[ids[k]]:
+            sorted_centres[m] = ids[k]
+            chosen[ids[k]] = False
+            m += 1
+    for k in range(centres.shape[0]):
+        if chosen[centres[k]]:
+            sorted_centres[m] = centres[k]
+            chosen[centres[k]] = False
+            m += 1
+    centres = sorted_centres[:m]
     coefficients = np.full((n, 6), np.nan)
     t1s = np.full((n, 3), np.nan)
     t2s = np.full((n, 3), np.nan)
     ns = np.full((n, 3), np.nan)
     counts = np.zeros(n)
+    away = np.full(n, np.nan)
     n_terms = exponents.shape[0]
-    m = centres.shape[0]
     n_chunks = max(min(m, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         # buffers once per chunk of vertices, not per vertex
@@ -1054,8 +1079,9 @@ def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot
         for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
             members, work = _fit_one(vertices, points, grid, normals, radius, degree, iterations, exponents,
                                      min_pivot, centres[i], members, work, moments, right, matrix, low, scale,
-                                     solution, coefficients, t1s, t2s, ns, counts)
-    return coefficients, t1s, t2s, ns, counts
+                                     solution, coefficients, t1s, t2s, ns, counts, ids, facing, check_facing,
+                                     away_fraction, away)
+    return coefficients, t1s, t2s, ns, counts, away
 
 
 #: Rows of a jet fit's scratch before the powers of u and v: the offsets x, y, z, the weight, weight * height.
@@ -1073,7 +1099,8 @@ def _weighted_dot(a, b, c, size):
 
 @nb.njit(**_JIT)
 def _fit_one(vertices, points, grid, normals, radius, degree, iterations, exponents, min_pivot, v, members, work,
-             moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts):
+             moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing,
+             check_facing, away_fraction, away_out):
     """One vertex of :func:`fit_jets` in the caller's buffers; returns the buffers that may have grown.
 
     ``work`` holds one column per ball member: its offset from the centre in
@@ -1103,6 +1130,20 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
         pu[0, a] = 1.0
         pv[0, a] = 1.0
     counts[v] = count
+    graph = True
+    if check_facing:  # the ball must not hold the other side of the surface (a height function over the plane)
+        fx, fy, fz = facing[v, 0], facing[v, 1], facing[v, 2]
+        total = 0.0
+        away = 0.0
+        for a in range(size):
+            if not weight[a] > 0:
+                continue
+            k = ids[members[a]]
+            total += 1.0
+            if fx * facing[k, 0] + fy * facing[k, 1] + fz * facing[k, 2] < 0.0:
+                away += 1.0
+        away_out[v] = away / total if total > 0 else 0.0
+        graph = not away > away_fraction * total
     nx, ny, nz = normals[v, 0], normals[v, 1], normals[v, 2]
     ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
     fitted = False
@@ -1148,7 +1189,7 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
             if math.isfinite(tx) and math.isfinite(ty) and math.isfinite(tz):
                 nx, ny, nz = tx, ty, tz
                 ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
-    if fitted:
+    if fitted and graph:
         for r in range(6):
             coefficients[v, r] = solution[r]
     t1s[v, 0], t1s[v, 1], t1s[v, 2] = ax, ay, az
@@ -1181,7 +1222,7 @@ def cell_centres(vertices, cells):
 
 
 @nb.njit(parallel=True, **_JIT)
-def ball_cell_sums(vertices, cells, centroids, values, radius, cutoff, n_chunks):
+def ball_cell_sums(vertices, cells, centroids, values, radius, cutoff, n_chunks, start, stop):
     """``neighborhoods._ball_sums`` for one group of cells: (V, k) sums of ``weight * values``.
 
     Cells are faces (three corners; weight: the share of the face inside the
@@ -1190,7 +1231,9 @@ def ball_cell_sums(vertices, cells, centroids, values, radius, cutoff, n_chunks)
     They are found by their ``centroids`` within ``cutoff`` (radius + the
     group's largest reach) on a grid of cells (:func:`_grid`); their corners,
     centroids and values are copied in grid order first, so that a ball reads
-    contiguous memory.
+    contiguous memory. Only the balls of ranks ``start`` to ``stop`` of the
+    vertices in grid order are summed (the caller splits a long computation
+    into calls; the other rows are 0).
     """
     n = vertices.shape[0]
     n_cells, corners = cells.shape
@@ -1207,10 +1250,12 @@ def ball_cell_sums(vertices, cells, centroids, values, radius, cutoff, n_chunks)
         sorted_values[k] = values[c]
     out = np.zeros((n, n_values))
     centres = _grid(vertices, grid[4])[0]  # centres in grid order: consecutive balls share cells (cache)
-    n_chunks = max(min(n, n_chunks), 1)
+    start = max(min(start, n), 0)
+    m = max(min(stop, n), start) - start
+    n_chunks = max(min(m, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         members = np.empty(64, np.int64)
-        for rank in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
+        for rank in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
             members = _cell_weight_sums(vertices, points, grid, sorted_values, radius, cutoff, centres[rank],
                                         members, out)
     return out

@@ -3,7 +3,19 @@
 Every estimator that takes ``radius=`` uses it through this module, so the
 option has one meaning: the closed Euclidean ball ``B(x_v, radius)`` around
 each vertex position, in the units of the coordinates. The default radius is
-:data:`DEFAULT_RADIUS_FACTOR` times the mean edge length of the mesh.
+:data:`DEFAULT_RADIUS_FACTOR` times the mean edge length of the mesh, leaving
+out outlier edges (:func:`meshcurv.geometry.robust_mean_edge_length`: one spike
+vertex does not blow it up); on a mesh whose components differ in scale, each
+component of its own scale gets its own default (:func:`default_radii`).
+
+Bounds: a radius given beyond the extent of the mesh (the diagonal of the
+bounding box of its referenced vertices) is refused (:func:`check_radius`: a
+unit mistake, every ball would hold every vertex). Before any ball search, the
+number of (centre, point) pairs is estimated from a sample
+(:func:`estimate_ball_pairs`); beyond :data:`MAX_BALL_PAIRS` the radius is
+refused, and the work is split so that memory stays bounded (NumPy path:
+chunks of at most about :data:`PAIRS_PER_CHUNK` pairs) and Ctrl-C gets
+through (compiled path: calls of about :data:`PAIRS_PER_CALL` pairs).
 
 Queries run on :class:`scipy.spatial.cKDTree` pair searches, in chunks of
 centres so that memory stays bounded on large meshes; all per-pair work is
@@ -20,14 +32,20 @@ from collections.abc import Iterator
 import numpy as np
 
 from ._backend import numba_kernels
-from ._validation import check_positive_float
-from .geometry import mean_edge_length
+from ._validation import check_positive_float, checked_indices, checked_points
+from .errors import InvalidMeshError, InvalidOptionError
+from .geometry import median_edge_length, robust_mean_edge_length, vertex_length_scales
 from .topology import MeshTopology
 
 __all__ = [
     "DEFAULT_RADIUS_FACTOR",
+    "MAX_BALL_PAIRS",
     "default_radius",
+    "default_radii",
     "resolve_radius",
+    "check_radius",
+    "estimate_ball_pairs",
+    "check_ball_work",
     "vertex_pairs_in_ball",
     "ball_face_sums",
     "ball_edge_sums",
@@ -41,26 +59,159 @@ DEFAULT_RADIUS_FACTOR = 2.5
 #: Centres per chunk of a ball query (bounds the memory of the pair lists).
 CHUNK = 32768
 
+#: Most (centre, point) pairs a ball computation may take: about a minute of jet fits on two
+#: cores (a million vertices with 2000 points per ball). More is refused (a radius far too
+#: large for the mesh's resolution) instead of running for hours.
+MAX_BALL_PAIRS = 2_000_000_000
+
+#: (Centre, point) pairs per chunk of the NumPy path's ball searches (bounds their memory).
+PAIRS_PER_CHUNK = 1 << 20
+
+#: (Centre, point) pairs per call of a compiled ball kernel: between calls Python gets control
+#: back (Ctrl-C); a default radius on a million vertices is one call.
+PAIRS_PER_CALL = 100_000_000
+
+#: Centres and points of the sample that estimates the pairs of a ball computation.
+SAMPLE_CENTRES = 32
+SAMPLE_POINTS = 8192
+
 #: Cells of different sizes share one search while its radius (radius + largest reach) grows
 #: by at most this factor over that of their smallest size class.
 GROUP_GROWTH = 1.5
 
 
 def default_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
-    """``DEFAULT_RADIUS_FACTOR`` times the mean edge length (0 for a mesh without edges)."""
-    return DEFAULT_RADIUS_FACTOR * mean_edge_length(vertices, topology.edges)
+    """``DEFAULT_RADIUS_FACTOR`` times the robust mean edge length (0 for a mesh without edges).
+
+    :func:`meshcurv.geometry.robust_mean_edge_length`: the mean edge length
+    without edges beyond 1000 median edge lengths (equal to the mean on any
+    ordinary mesh; one spike vertex at 1e10 does not multiply it).
+    """
+    vertices = checked_points(vertices)
+    return DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, topology.edges)
 
 
-def resolve_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
-    """The radius to use: ``radius`` checked, or the mesh's default when None.
+def default_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[float, np.ndarray | None]]:
+    """The default radius of each group of components of one scale: ``[(radius, vertices), ...]``.
+
+    ``vertices`` is None when the whole mesh is one group (every component within
+    a factor :data:`meshcurv.geometry.COMPONENT_SCALE_SPREAD` of the median edge
+    length: the usual case, one radius, :func:`default_radius`). Otherwise the
+    components are grouped by the power of two of their median edge length
+    (:func:`meshcurv.geometry.vertex_length_scales`) and each group gets
+    ``DEFAULT_RADIUS_FACTOR`` times the robust mean edge length of its own edges,
+    with the int64 ids of its vertices: a part at 1e-3 and one at 1e3 are each
+    fitted at their own scale.
+    """
+    vertices = checked_points(vertices)
+    scales = vertex_length_scales(vertices, topology)
+    referenced = topology.referenced_vertices
+    used = scales[referenced & (scales > 0)]
+    if used.size == 0 or used.min() == used.max():
+        return [(default_radius(vertices, topology), None)]
+    level = np.full(scales.shape, np.iinfo(np.int64).min)
+    positive = referenced & (scales > 0)
+    level[positive] = np.round(np.log2(scales[positive])).astype(np.int64)
+    groups = []
+    for k in np.unique(level[positive]):
+        members = np.flatnonzero(level == k)
+        inside = np.zeros(scales.shape, dtype=bool)
+        inside[members] = True
+        edges = topology.edges[inside[topology.edges[:, 0]]]
+        groups.append((DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, edges), members))
+    return groups
+
+
+def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
+    """``radius`` checked: a positive finite number no larger than the extent of the mesh.
 
     Raises
     ------
     InvalidOptionError
-        ``radius`` is not a positive finite number.
+        ``radius`` is not a positive finite real number (strings are refused),
+        or it exceeds the diagonal of the bounding box of the referenced
+        vertices: every ball would hold the whole mesh (a unit mistake: mm for m).
+    """
+    radius = check_positive_float(radius, "radius")
+    vertices = checked_points(vertices)
+    used = vertices[topology.referenced_vertices] if topology.n_faces else vertices
+    if used.shape[0] == 0:
+        return radius
+    diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    if radius > diagonal:
+        median = median_edge_length(vertices, topology.edges)
+        raise InvalidOptionError(
+            f"`radius` {radius:g} is larger than the mesh itself (bounding-box diagonal {diagonal:g}, median "
+            f"edge length {median:g}): every ball would hold the whole mesh; pass a radius of a few edge "
+            f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
+        )
+    return radius
+
+
+def resolve_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
+    """The radius to use: ``radius`` checked (:func:`check_radius`), or the mesh's default when None.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``radius`` is not a positive finite number, or larger than the mesh.
     """
     if radius is None:
         return default_radius(vertices, topology)
+    return check_radius(radius, vertices, topology)
+
+
+def _sample(n: int, size: int) -> np.ndarray:
+    """``size`` indices evenly spread over ``range(n)`` (all of them when n <= size): deterministic."""
+    if n <= size:
+        return np.arange(n)
+    return np.linspace(0, n - 1, size).round().astype(np.int64)
+
+
+def estimate_ball_pairs(points: np.ndarray, radius: float, centres: np.ndarray | None = None) -> tuple[float, float]:
+    """Estimated points of ``points`` within ``radius`` of each centre: ``(mean, largest)`` per centre.
+
+    From :data:`SAMPLE_CENTRES` centres (default: the points themselves) against
+    :data:`SAMPLE_POINTS` points, both evenly spaced in index order and scaled to
+    the whole cloud: some 0.3 million distances, about a millisecond, whatever
+    the radius (the balls themselves are never searched). Exact when the cloud
+    and the centres are no larger than the sample.
+    """
+    points = checked_points(points, name="points")
+    centres = points if centres is None else centres
+    if centres.shape[0] == 0:
+        return 0.0, 0.0
+    sub = points[_sample(points.shape[0], SAMPLE_POINTS)]
+    probe = centres[_sample(centres.shape[0], SAMPLE_CENTRES)]
+    d2 = np.einsum("cij,cij->ci", sub[None, :, :] - probe[:, None, :], sub[None, :, :] - probe[:, None, :])
+    inside = (d2 <= radius * radius).sum(axis=1) * (points.shape[0] / sub.shape[0])
+    return float(inside.mean()), float(inside.max())
+
+
+def check_ball_work(points: np.ndarray, radius: float, n_centres: int, *,
+                    centres: np.ndarray | None = None) -> tuple[float, float]:
+    """Refuse a ball computation beyond :data:`MAX_BALL_PAIRS`; return :func:`estimate_ball_pairs`.
+
+    Raises
+    ------
+    InvalidOptionError
+        The balls of ``radius`` around ``n_centres`` centres would hold more than
+        :data:`MAX_BALL_PAIRS` (centre, point) pairs in all.
+    """
+    mean, largest = estimate_ball_pairs(points, radius, centres)
+    if mean * n_centres > MAX_BALL_PAIRS:
+        raise InvalidOptionError(
+            f"`radius` {radius:g} is far too large for the mesh's resolution: each ball would hold about "
+            f"{mean:.3g} of its {points.shape[0]} points ({mean * n_centres:.3g} pairs in all, more than "
+            f"{MAX_BALL_PAIRS:.1g}: hours of work); pass a radius of a few edge lengths"
+        )
+    return mean, largest
+
+
+def _checked_radius_value(radius) -> float:
+    """A radius passed to the helpers: a finite real number >= 0 (0: a mesh of coincident points)."""
+    if radius == 0 and not isinstance(radius, (str, bytes, bool)):
+        return 0.0
     return check_positive_float(radius, "radius")
 
 
@@ -82,16 +233,41 @@ def vertex_pairs_in_ball(points: np.ndarray, radius: float, *, centres: np.ndarr
     """Yield ``(chunk, centre, neighbour)``: every point within ``radius`` of each centre.
 
     The centres are the points ``centres`` (default: all), taken by chunk of
-    ``chunk_size``; ``centre`` indexes them (absolute: ``chunk.start`` and up),
-    ``neighbour`` indexes ``points``: the point within the ball (the centre itself included).
+    at most ``chunk_size`` (fewer when the balls are large, so that a chunk holds
+    about :data:`PAIRS_PER_CHUNK` pairs); ``centre`` indexes them (absolute:
+    ``chunk.start`` and up), ``neighbour`` indexes ``points``: the point within
+    the ball (the centre itself included).
+
+    Raises
+    ------
+    InvalidOptionError
+        More than :data:`MAX_BALL_PAIRS` pairs in all (:func:`check_ball_work`).
     """
+    points = checked_points(points, name="points")
+    radius = _checked_radius_value(radius)
+    centres = np.arange(points.shape[0]) if centres is None else _checked_ids(centres, points.shape[0])
+    yield from _ball_pairs(points, points[centres], radius, chunk_size)
+
+
+def _ball_pairs(points: np.ndarray, centre_points: np.ndarray, radius: float,
+                chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+    """:func:`vertex_pairs_in_ball` around arbitrary ``centre_points`` (trusted arrays)."""
     from scipy.spatial import cKDTree
 
+    _, largest = check_ball_work(points, radius, centre_points.shape[0], centres=centre_points)
+    chunk_size = max(1, min(int(chunk_size), int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
     tree = cKDTree(points)
-    centres = np.arange(points.shape[0]) if centres is None else centres
-    for chunk in _chunks(centres.shape[0], chunk_size):
-        i, j = _pairs(tree, points[centres[chunk]], radius)
+    for chunk in _chunks(centre_points.shape[0], chunk_size):
+        i, j = _pairs(tree, centre_points[chunk], radius)
         yield chunk, i + chunk.start, j
+
+
+def _checked_ids(ids, n: int, name: str = "centres") -> np.ndarray:
+    """(N,) int64 vertex ids in ``range(n)``."""
+    array = np.asarray(ids)
+    if array.ndim != 1:
+        raise InvalidMeshError(f"`{name}` must be a 1-d array of vertex indices; got shape {array.shape}")
+    return checked_indices(array[:, None], n, columns=1, name=name)[:, 0]
 
 
 def face_in_ball_ratios(corners: np.ndarray, centers: np.ndarray, radius: float) -> np.ndarray:
@@ -155,7 +331,16 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     import scipy.sparse as sp
     from scipy.spatial import cKDTree
 
+    vertices, cells = _checked_cells(vertices, cells)
+    radius = _checked_radius_value(radius)
+    values = np.asarray(values, dtype=np.float64)
+    if values.ndim != 2 or values.shape[0] != cells.shape[0]:
+        raise InvalidMeshError(
+            f"`values` must have shape ({cells.shape[0]}, k): one row per cell; got {values.shape}")
     if usable is not None:
+        usable = np.asarray(usable, dtype=bool)
+        if usable.shape != (cells.shape[0],):
+            raise InvalidMeshError(f"`usable` must have shape ({cells.shape[0]},); got {usable.shape}")
         keep = np.flatnonzero(usable)
         cells, values = cells[keep], values[keep]
     n = vertices.shape[0]
@@ -176,23 +361,38 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     # searched with its own largest reach, and a group takes the next power of
     # two of reach as long as its search radius grows by at most GROUP_GROWTH.
     for group in _size_groups(reach, radius):
+        cutoff = radius + reach[group].max()
+        mean, largest = check_ball_work(centres[group], cutoff, n, centres=vertices)
         if kernels is not None:
-            sums = kernels.ball_cell_sums(vertices, cells[group], centres[group], np.ascontiguousarray(values[group]),
-                                          radius, radius + reach[group].max(), 64 * kernels.threads())
-            if isinstance(group, slice):  # one group: its sums are the result
-                return sums
-            out += sums
+            n_calls = max(1, int(np.ceil(mean * n / PAIRS_PER_CALL)))
+            for call in range(n_calls):  # Python between calls: Ctrl-C gets through
+                sums = kernels.ball_cell_sums(vertices, cells[group], centres[group],
+                                              np.ascontiguousarray(values[group]), radius, cutoff,
+                                              64 * kernels.threads(), call * n // n_calls,
+                                              (call + 1) * n // n_calls)
+                if isinstance(group, slice) and n_calls == 1:  # one group, one call: its sums are the result
+                    return sums
+                out += sums
             continue
         tree = cKDTree(centres[group])
-        cutoff = radius + reach[group].max()
         index = np.arange(cells.shape[0])[group]  # group position -> cell
-        for chunk in _chunks(n):
+        chunk_size = max(1, min(CHUNK, int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
+        for chunk in _chunks(n, chunk_size):
             i, c = _pairs(tree, vertices[chunk], cutoff)
             c = index[c]
             weights = weight(vertices[cells[c]], vertices[chunk][i], radius)
             gather = sp.csr_matrix((weights, (i, c)), shape=(chunk.stop - chunk.start, values.shape[0]))
             out[chunk] += np.asarray(gather @ values)
     return out
+
+
+def _checked_cells(vertices, cells) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and (C, 3) faces or (C, 2) edges, checked (indices in range)."""
+    vertices = checked_points(vertices)
+    shape = np.shape(cells)
+    columns = shape[1] if len(shape) == 2 and shape[1] in (2, 3) else 3
+    return vertices, checked_indices(cells, vertices.shape[0], columns=columns,
+                                     name="edges" if columns == 2 else "faces")
 
 
 def ball_face_sums(vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,

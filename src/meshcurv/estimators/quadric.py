@@ -64,7 +64,9 @@ import numpy as np
 
 from .._backend import numba_kernels
 from .._tensors import principal_from_shape_operator, tangent_basis
-from ..neighborhoods import resolve_radius, vertex_pairs_in_ball
+from .._validation import checked_points
+from ..errors import InvalidMeshError
+from ..neighborhoods import PAIRS_PER_CALL, _ball_pairs, check_ball_work, default_radii, resolve_radius
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -85,8 +87,19 @@ MIN_POINTS = 6
 #: solved: a smaller one means a nearly degenerate set of points (for example collinear).
 MIN_PIVOT = 1e-5
 
-#: Centres per chunk of pair queries (bounds the memory of the per-pair arrays).
+#: Centres per chunk of pair queries (bounds the memory of the per-pair arrays; fewer
+#: where the balls are large, see :data:`meshcurv.neighborhoods.PAIRS_PER_CHUNK`).
 CHUNK_SIZE = 4096
+
+#: A fit whose ball holds more than this share of its points whose normal faces away from
+#: the centre's (``n_j . n_v < 0``) is refused (:func:`fit_jets`, ``facing``): the ball
+#: reaches past the part's silhouette to its other side. On a smooth surface sampled finer
+#: than its thickness the share is 0; a ball across a needle thinner than the ball holds
+#: about half; on a sphere of radius R a ball of radius 1.5 R holds 11% (2.5 R: 50%), and
+#: from sqrt(2) R (where the share starts) the jet of degree 4 is far off anyway (k R = 0.5
+#: for 1 at 1.5 R). Noisy normals of a clean surface rarely turn beyond 90 degrees: 5%
+#: leaves room for a few that do.
+AWAY_FRACTION = 0.05
 
 
 def _exponents(degree: int) -> np.ndarray:
@@ -192,7 +205,9 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
 
 
 def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
-             iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE):
+             iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
+             neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
+             details: dict | None = None):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
     Parameters
@@ -206,7 +221,23 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     iterations : int, default: ITERATIONS
     centres : ndarray of int, optional
         The vertices to fit (default: all). The rows of the others are NaN
-        (counts 0); every vertex still takes part in the fits around it.
+        (counts 0).
+    neighbours : ndarray of bool of shape (V,), optional
+        The vertices that may enter the balls (default: all). Pass
+        ``topology.referenced_vertices`` so that points stored with the mesh but
+        in no face (a point cloud, scanner leftovers) stay out of every fit: the
+        fits of the referenced vertices are then those of the mesh without them.
+    facing : ndarray of shape (V, 3), optional
+        Normals for the check that each ball is a height function over the
+        tangent plane: a fit whose ball holds more than :data:`AWAY_FRACTION` of
+        its points (of non-zero weight) whose ``facing`` normal is opposite to the centre's
+        (``n_j . n_v < 0``; rows of NaN are not counted) is left NaN. Such a ball
+        holds the other side of a thin part (a needle thinner than the ball) or
+        of the whole closed surface (a ball larger than the part): its jet is
+        a fit through both sides, not the surface. Default: no check.
+    details : dict, optional
+        Receives ``"away"``: (V,) the share of the ball's points facing away at
+        each fitted centre (NaN unless ``facing`` is given).
 
     Returns
     -------
@@ -217,22 +248,63 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
         ``t1, t2, n``: the frame of the last fit.
     counts : ndarray of shape (V,)
         Points with non-zero weight in each ball.
+
+    Raises
+    ------
+    InvalidOptionError
+        The balls would hold more than :data:`meshcurv.neighborhoods.MAX_BALL_PAIRS`
+        pairs in all (a radius far too large for the mesh).
     """
+    vertices = checked_points(vertices)
     n = vertices.shape[0]
-    centres = np.arange(n) if centres is None else np.asarray(centres, dtype=np.int64)
+    normals = np.ascontiguousarray(normals, dtype=np.float64)
+    if normals.shape != vertices.shape:
+        raise InvalidMeshError(f"`normals` must have shape {vertices.shape}; got {normals.shape}")
+    centres = np.arange(n) if centres is None else np.asarray(centres, dtype=np.int64).ravel()
+    if centres.size and (centres.min() < 0 or centres.max() >= n):
+        raise InvalidMeshError(f"`centres` must be vertex indices in 0..{n - 1}")
+    if neighbours is None:
+        pool = np.arange(n)
+    else:
+        neighbours = np.asarray(neighbours, dtype=bool)
+        if neighbours.shape != (n,):
+            raise InvalidMeshError(f"`neighbours` must have shape ({n},); got {neighbours.shape}")
+        pool = np.flatnonzero(neighbours)
+    check = facing is not None
+    if check:
+        facing = np.ascontiguousarray(facing, dtype=np.float64)
+        if facing.shape != vertices.shape:
+            raise InvalidMeshError(f"`facing` must have shape {vertices.shape}; got {facing.shape}")
+    pool_points = vertices[pool]
+    mean, _ = check_ball_work(pool_points, radius, centres.size, centres=vertices[centres])
     kernels = numba_kernels()
     if kernels is not None and n:
-        coefficients, t1, t2, normal, counts = kernels.fit_jets(
-            vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, centres,
-            64 * kernels.threads())
+        outputs = [np.full((n, 6), np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan),
+                   np.full((n, 3), np.nan), np.zeros(n), np.full(n, np.nan)]
+        n_calls = max(1, min(centres.size, int(np.ceil(mean * centres.size / PAIRS_PER_CALL))))
+        for call in range(n_calls):  # Python between calls: Ctrl-C gets through
+            part = centres[call * centres.size // n_calls:(call + 1) * centres.size // n_calls]
+            found = kernels.fit_jets(
+                vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
+                64 * kernels.threads(), pool, facing if check else vertices, check, AWAY_FRACTION)
+            if n_calls == 1:
+                outputs = list(found)
+                break
+            for whole, piece in zip(outputs, found):
+                whole[part] = piece[part]
+        coefficients, t1, t2, normal, counts, away = outputs
+        if details is not None:
+            details["away"] = away
         return coefficients, (t1, t2, normal), counts
     frame = [np.full((n, 3), np.nan) for _ in range(3)]
     coefficients = np.full((n, 6), np.nan)
     counts = np.zeros(n)
-    for chunk, centre, neighbour in vertex_pairs_in_ball(vertices, radius, centres=centres, chunk_size=chunk_size):
+    away = np.full(n, np.nan)
+    for chunk, centre, neighbour in _ball_pairs(pool_points, vertices[centres], radius, chunk_size):
         index = centres[chunk]
         size = index.size
         rows = centre - chunk.start
+        neighbour = pool[neighbour]
         offsets = (vertices[neighbour] - vertices[index[rows]]) * (1.0 / radius)
         weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
@@ -247,10 +319,20 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
                 keep = np.isfinite(tilted).all(axis=1, keepdims=True)
                 new_normal = np.where(keep, tilted, local[2])
                 local = [*tangent_basis(new_normal), new_normal]
+        if check:
+            opposite = np.einsum("ij,ij->i", facing[neighbour], facing[index[rows]]) < 0
+            inside = weights > 0
+            total = np.bincount(rows, weights=inside.astype(float), minlength=size)
+            against = np.bincount(rows, weights=(inside & opposite).astype(float), minlength=size)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                away[index] = np.where(total > 0, against / total, 0.0)
+            fitted[against > AWAY_FRACTION * total] = np.nan
         for f, part in zip(frame, local):
             f[index] = part
         coefficients[index] = fitted
         counts[index] = count
+    if details is not None:
+        details["away"] = away
     return coefficients, tuple(frame), counts
 
 
@@ -283,25 +365,56 @@ def shape_operators(coefficients: np.ndarray, frame: tuple, radius: float):
 
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
-    """Weighted jet fits over balls of radius ``radius``. Returns ``(result, problems)``."""
+    """Weighted jet fits over balls of radius ``radius``. Returns ``(result, problems)``.
+
+    Only referenced vertices enter the balls. A fit whose ball holds the other
+    side of the surface (``facing`` of :func:`fit_jets`: a ball across a needle,
+    or over a whole small closed part) is NaN with ``valid=False`` and counted
+    in the warning. With the default radius, each group of components of one
+    scale gets its own (:func:`meshcurv.neighborhoods.default_radii`).
+    """
     stages.start("compute normals")
-    radius = resolve_radius(radius, vertices, topology)
+    if radius is None:
+        groups = default_radii(vertices, topology)
+    else:
+        groups = [(resolve_radius(radius, vertices, topology), None)]
     _, _, defects, normals, valid = prepare(vertices, topology)
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
-    unit = radius if radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
+    facing = np.where(valid[:, None], normals, np.nan)
+    referenced = topology.referenced_vertices
 
     stages.start("fit jets")
-    coefficients, frame, counts = fit_jets(vertices, start, unit)
+    n = vertices.shape[0]
+    six = np.full((n, 6), np.nan)
+    fitted = np.full((n, 3), np.nan)
+    coefficients = np.full((n, 6), np.nan)
+    away = np.zeros(n)
+    for group_radius, members in groups:
+        unit = group_radius if group_radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
+        details: dict = {}
+        found, frame, _ = fit_jets(vertices, start, unit, centres=members, neighbours=referenced, facing=facing,
+                                   details=details)
+        part_six, part_fitted = shape_operators(found, frame, unit)
+        rows = slice(None) if members is None else members
+        six[rows], fitted[rows], coefficients[rows] = part_six[rows], part_fitted[rows], found[rows]
+        away[rows] = np.nan_to_num(details["away"][rows])
 
     stages.start("retrieve curvatures")
-    six, fitted = shape_operators(coefficients, frame, unit)
     fitted = np.where(np.isfinite(fitted).all(axis=1, keepdims=True), fitted, normals)
     valid &= np.isfinite(coefficients).all(axis=1)
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
         np.where(valid[:, None], six, 0.0), np.where(valid[:, None], fitted, [0.0, 0.0, 1.0]))
-    few = int((~valid & ~defects.invalid_vertices).sum())
-    extra = (f"{few} vertices have fewer than {MIN_POINTS} vertices (or a degenerate set) within "
-             f"radius {radius:g}; pass a larger `radius`",) if few else ()
+    failed = ~valid & ~defects.invalid_vertices
+    two_sided = int((failed & (away > AWAY_FRACTION)).sum())
+    few = int(failed.sum()) - two_sided
+    shown = ", ".join(f"{r:g}" for r, _ in groups)
+    extra = ((f"{few} vertices have fewer than {MIN_POINTS} vertices (or a degenerate set) within "
+              f"radius {shown}; pass a larger `radius`") if few else "",
+             (f"{two_sided} vertices have a ball of radius {shown} that holds the other side of the surface "
+              "(a part thinner than the ball, or a ball over a whole closed part): no height function to fit; "
+              "pass a smaller `radius`") if two_sided else "")
     normals_out = np.where(valid[:, None], fitted, normals)
-    return finish("quadric", {"radius": radius}, valid, normals_out, k_min, k_max, dir_min, dir_max,
-                  defects, extra)
+    parameters = {"radius": groups[0][0]}
+    if len(groups) > 1:
+        parameters["radii"] = tuple(r for r, _ in groups)
+    return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects, extra)
