@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
-from ..neighborhoods import ball_edge_sums, ball_face_sums, resolve_radius
+from ..neighborhoods import ball_edge_sums, ball_face_sums, default_radii, resolve_radius
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -50,7 +50,10 @@ STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
     """Normal-cycle tensor over balls of radius ``radius``. Returns ``(result, problems)``."""
     stages.start("compute normals")
-    radius = resolve_radius(radius, vertices, topology)
+    if radius is None:  # each group of components of one scale at its own default
+        groups = default_radii(vertices, topology)
+    else:
+        groups = [(resolve_radius(radius, vertices, topology), None)]
     cross, degenerate, defects, normals, valid = prepare(vertices, topology)
 
     stages.start("compute edge tensors")
@@ -61,8 +64,13 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     beta, _, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
 
     stages.start("sum over balls")
-    measures = ball_edge_sums(vertices, topology.edges, radius, outer6(unit, beta), usable=usable)
-    areas = ball_face_sums(vertices, topology.faces, radius, (double_areas / 2)[:, None], usable=~degenerate)[:, 0]
+    edge_values, face_values = outer6(unit, beta), (double_areas / 2)[:, None]
+    measures = np.zeros((vertices.shape[0], 6))
+    areas = np.zeros(vertices.shape[0])
+    for group_radius, members in groups:
+        rows = slice(None) if members is None else members
+        measures[rows] = ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=usable)[rows]
+        areas[rows] = ball_face_sums(vertices, topology.faces, group_radius, face_values, usable=~degenerate)[rows, 0]
 
     stages.start("retrieve curvatures")
     valid &= areas > 0
@@ -72,5 +80,8 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
         rotate=True, mean_from_trace=True,
     )
-    return finish("normal_cycle_ball", {"radius": radius}, valid, normals, k_min, k_max, dir_min, dir_max,
+    parameters = {"radius": groups[0][0]}
+    if len(groups) > 1:
+        parameters["radii"] = tuple(r for r, _ in groups)
+    return finish("normal_cycle_ball", parameters, valid, normals, k_min, k_max, dir_min, dir_max,
                   defects)
