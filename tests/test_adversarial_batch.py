@@ -168,22 +168,27 @@ def rows(summary):
 """
 
 
-@pytest.mark.slow
-def test_a_mesh_that_never_ends_times_out_and_a_resume_does_not_wait_for_it_again(tmp_path):
-    result = run_child(FAULTS + f"""
+def run_twice(tmp_path, names, options: str) -> dict:
+    """A batch of ``names`` on a local cluster of one worker with the faults, then its resume (a child process)."""
+    return run_child(FAULTS + f"""
 folder, out_dir = pathlib.Path({os.fspath(tmp_path)!r}) / "in", pathlib.Path({os.fspath(tmp_path)!r}) / "out"
-write(folder, ["a.obj", "hang.obj", "z.obj"])
+write(folder, {names!r})
 with batch.local_cluster(workers=1, dashboard=False) as client:
     client.register_plugin(Faults())
     start = time.monotonic()
-    first = batch.run(folder, out_dir, client=client, timeout=2, output_format="npz")
+    first = batch.run(folder, out_dir, client=client, output_format="npz", {options})
     first_seconds = time.monotonic() - start
     start = time.monotonic()
-    again = batch.run(folder, out_dir, client=client, timeout=2, output_format="npz")
+    again = batch.run(folder, out_dir, client=client, output_format="npz", {options})
     again_seconds = time.monotonic() - start
 print(json.dumps({{"first": rows(first), "again": rows(again), "first_seconds": first_seconds,
                   "again_seconds": again_seconds}}))
 """, timeout=120)
+
+
+@pytest.mark.slow
+def test_a_mesh_that_never_ends_times_out_and_a_resume_does_not_wait_for_it_again(tmp_path):
+    result = run_twice(tmp_path, ["a.obj", "hang.obj", "z.obj"], "timeout=2")
     first, again = result["first"], result["again"]
     assert first["a.obj"] == ["computed", ""] and first["z.obj"] == ["computed", ""]
     assert first["hang.obj"][0] == "failed"
@@ -197,17 +202,7 @@ print(json.dumps({{"first": rows(first), "again": rows(again), "first_seconds": 
 
 @pytest.mark.slow
 def test_a_mesh_that_keeps_killing_its_workers_fails_alone_and_is_not_retried(tmp_path):
-    result = run_child(FAULTS + f"""
-folder, out_dir = pathlib.Path({os.fspath(tmp_path)!r}) / "in", pathlib.Path({os.fspath(tmp_path)!r}) / "out"
-write(folder, ["a.obj", "crash.obj", "z.obj"])
-with batch.local_cluster(workers=1, dashboard=False) as client:
-    client.register_plugin(Faults())
-    first = batch.run(folder, out_dir, client=client, output_format="npz")
-    start = time.monotonic()
-    again = batch.run(folder, out_dir, client=client, output_format="npz")
-    again_seconds = time.monotonic() - start
-print(json.dumps({{"first": rows(first), "again": rows(again), "again_seconds": again_seconds}}))
-""", timeout=120)
+    result = run_twice(tmp_path, ["a.obj", "crash.obj", "z.obj"], "retry_failed=False")
     first, again = result["first"], result["again"]
     assert first["a.obj"] == ["computed", ""] and first["z.obj"] == ["computed", ""]
     assert first["crash.obj"][0] == "failed"
