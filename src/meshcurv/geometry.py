@@ -202,8 +202,8 @@ def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
         return 0.0
     median = float(np.median(lengths))
     longest = float(lengths.max())
-    if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean (one pass)
-        return float(lengths.mean())
+    if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean, to the last bit
+        return mean_edge_length(vertices, edges)
     kept = lengths[lengths <= OUTLIER_EDGE_RATIO * median]
     return float(kept.mean())
 
