@@ -421,7 +421,8 @@ def run_voxel(methods=None):
                 results[label] = ((k_min + k_max) / 2, k_min * k_max, valid)
             for label, result in results.items():
                 row = {"mesh": _voxel_label(mesh, held_out), "n": mesh.vertices.shape[0], "method": label,
-                       "winding": winding, "peer": not label.startswith("meshcurv")}
+                       "winding": winding, "peer": not label.startswith("meshcurv"),
+                       "aspect": max(mesh.spacing) / min(mesh.spacing)}
                 if result is None:
                     row.update(H=np.nan, K=np.nan, sign=np.nan, cover=np.nan, failed=True)
                 else:
@@ -518,6 +519,7 @@ def voxel_markdown(rows, found, missing):
         "K <= 12%; sign right.",
         "",
     ]
+    lines += _voxel_targets(rows, meshes)
     for winding in WINDINGS:
         lines += [f"# Faces {winding}" + (" (marching cubes' own winding: inward)" if winding == "as returned"
                                            else " (outward)"), ""]
@@ -539,6 +541,32 @@ def voxel_markdown(rows, found, missing):
                 lines.append(f"| {mesh} | " + " | ".join(cells) + " |")
             lines.append("")
     return "\n".join(lines)
+
+
+#: Issue 14's targets for the default call: (largest voxel aspect ratio, median H error, median K error).
+VOXEL_TARGETS = [(1.0, 0.03, 0.06), (4.0, 0.06, 0.12)]
+
+
+def _voxel_targets(rows, meshes):
+    """The default call on the faces as returned, against the targets and against the best peer."""
+    lines = ["## The default call against issue 14's targets (faces as returned)", "",
+             "| mesh | voxel aspect | H | K | right H sign | target H / K | met | best peer H / K (either winding) "
+             "| ahead of every peer |", "|---" * 9 + "|"]
+    for mesh in meshes:
+        default = [r for r in rows if r["mesh"] == mesh and r["method"] == "meshcurv default"
+                   and r["winding"] == "as returned"]
+        if not default:
+            continue
+        row = default[0]
+        target = next(((h, k) for aspect, h, k in VOXEL_TARGETS if row["aspect"] <= aspect * (1 + 1e-9)), None)
+        peers_ok = [r for r in rows if r["mesh"] == mesh and r["peer"] and not r["failed"]]
+        best = [min((r[q] for r in peers_ok), default=np.nan) for q in ("H", "K")]
+        met = "—" if target is None else ("yes" if row["H"] <= target[0] and row["K"] <= target[1] else "**no**")
+        ahead = "yes" if all(row[q] < b for q, b in zip(("H", "K"), best) if np.isfinite(b)) else "**no**"
+        lines.append(f"| {mesh} | {row['aspect']:.3g} | {_pct(row['H'])} | {_pct(row['K'])} | {_pct(row['sign'])} | "
+                     + (f"{_pct(target[0])} / {_pct(target[1])}" if target else "—")
+                     + f" | {met} | {_pct(best[0])} / {_pct(best[1])} | {ahead} |")
+    return lines + [""]
 
 
 def _git_head():
