@@ -449,6 +449,11 @@ def sweep_voxel():
         radii = [(f"{m:g}h", m * h) for m in SWEEP_VOXELS]
         radii += [(f"{c:g}√(hR)", c * np.sqrt(h * curvature_radius)) for c in SWEEP_SQRT]
         cells = {}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = meshcurv.principal_curvatures(mesh.vertices, mesh.faces)  # the default call, faces as returned
+        default = r.parameters.get("radius", np.nan)
+        cells["default"] = (voxel_errors(mesh, r.mean, r.gaussian, r.valid), default / h, np.nan)
         for name, radius in radii:
             t0 = time.perf_counter()
             with warnings.catch_warnings():
@@ -469,7 +474,8 @@ def sweep_markdown(rows):
         f"Generated {datetime.date.today().isoformat()} by `python benchmarks/accuracy.py --voxel-sweep` "
         f"(meshcurv {meshcurv.__version__}, git {_git_head()}).",
         "",
-        "Faces reversed to outward; `principal_curvatures(vertices, faces, method='icc', radius=r)`.",
+        "Faces reversed to outward; `principal_curvatures(vertices, faces, method='icc', radius=r)`; column",
+        "`default`: `principal_curvatures(vertices, faces)` on the faces as returned (its radius / h in the last table).",
         "h = largest voxel size; R = median exact radius of curvature 1/|k_max| of the mesh.",
         "Cells: median |H - H_exact| / |H_exact| / median |K - K_exact| / |K_exact| over the valid vertices",
         "(exact values at each vertex's closest point on the analytic surface).",
@@ -481,12 +487,12 @@ def sweep_markdown(rows):
         cells = [f"{_pct(e['H'])} / {_pct(e['K'])}" + ("" if e["cover"] == 1 else f" ({_pct(e['cover'])} valid)")
                  for e, _, _ in row["cells"].values()]
         lines.append(f"| {row['mesh']} | {row['n']} | {row['R'] / row['h']:.3g} | " + " | ".join(cells) + " |")
-    lines += ["", "Radius in voxels (r / h) of the √(hR) columns:", "",
-              "| mesh | " + " | ".join(n for n in names if "√" in n) + " |",
-              "|---" * (1 + sum("√" in n for n in names)) + "|"]
+    lines += ["", "Radius in voxels (r / h) of the default and of the √(hR) columns:", "",
+              "| mesh | " + " | ".join(n for n in names if "√" in n or n == "default") + " |",
+              "|---" * (1 + sum("√" in n or n == "default" for n in names)) + "|"]
     for row in rows:
-        lines.append(f"| {row['mesh']} | " + " | ".join(f"{v[1]:.2g}" for n, v in row["cells"].items() if "√" in n)
-                     + " |")
+        lines.append(f"| {row['mesh']} | " + " | ".join(f"{v[1]:.2g}" for n, v in row["cells"].items()
+                                                         if "√" in n or n == "default") + " |")
     return "\n".join(lines) + "\n"
 
 
