@@ -20,7 +20,7 @@ JET_DEGREE = 3
 JET_ITERATIONS = 2
 
 #: Random triangles per point of ``method="corrected_measures"``.
-TRIANGLES = 48
+TRIANGLES = 32
 
 #: Most points of a ball that ``corrected_measures`` draws its triangles from (the nearest ones).
 MAX_BALL_POINTS = 96
@@ -28,8 +28,9 @@ MAX_BALL_POINTS = 96
 #: Fewest points of a ball for ``corrected_measures`` (three corners and some choice).
 MIN_BALL_POINTS = 6
 
-#: The normals of ``corrected_measures`` (when not given) are those of degree-3 jets over this many radii.
-NORMAL_RADIUS_RATIO = 2.0
+#: The normals of ``corrected_measures`` (when not given) are those of degree-3 jets over balls of
+#: ``s (a + b sqrt(max(nu - 0.005, 0)))`` (``s`` the spacing, ``nu`` the noise level): ``(a, b)``.
+NORMAL_RULE = (6.0, 45.0)
 
 #: Centres per chunk of ``corrected_measures`` (bounds memory: chunk x TRIANGLES triangles).
 CHUNK = 32768
@@ -81,7 +82,28 @@ def _distinct_ranks(pattern: np.ndarray, counts: np.ndarray) -> np.ndarray:
     return np.stack([a, b, z], axis=2)
 
 
-def corrected_measures(tree, points, normals, radius, centres, usable, *, n_triangles: int = TRIANGLES):
+def _triangle_sums(points, normals, index, counts, pattern):
+    """(M, 9) summed measures of the triangles of each ball: the NumPy path of the compiled kernel."""
+    m, n_triangles = index.shape[0], pattern.shape[0]
+    ranks = _distinct_ranks(pattern, counts)
+    triangles = np.take_along_axis(index[:, None, :], ranks.reshape(m, 1, -1), axis=2).reshape(m, n_triangles, 3)
+    # turn each triangle so that its normal agrees with the mean of its corners' normals
+    x0, x1, x2 = (points[triangles[..., j]] for j in range(3))
+    facing = np.einsum("mtj,mtj->mt", np.cross(x1 - x0, x2 - x0), normals[triangles].sum(axis=2))
+    flip = facing < 0
+    triangles[flip, 1], triangles[flip, 2] = triangles[flip, 2], triangles[flip, 1]
+    measures = face_measures(points, triangles.reshape(-1, 3), normals)
+    return measures.reshape(m, n_triangles, 9).sum(axis=1)
+
+
+def ball_size(radius: float, spacing: float) -> int:
+    """Neighbours to query for balls of ``radius`` at this spacing: twice the expected count, capped."""
+    expected = np.pi * (radius / spacing) ** 2 if spacing > 0 else MAX_BALL_POINTS
+    return int(min(MAX_BALL_POINTS, max(2 * MIN_BALL_POINTS, np.ceil(2 * expected))))
+
+
+def corrected_measures(tree, points, normals, radius, centres, usable, *, spacing: float = 0.0,
+                       n_triangles: int | None = None):
     """Randomized corrected curvature measures over balls of ``radius`` (Lachaud et al. 2023).
 
     For every centre, ``n_triangles`` triangles with corners drawn at random
@@ -97,44 +119,37 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, n_tria
     """
     n = points.shape[0]
     out = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)]
-    pattern = _rank_pattern(n_triangles)
-    kernels = numba_kernels()
-    measure = kernels.icc_face_measures if kernels is not None else face_measures
+    pattern = _rank_pattern(TRIANGLES if n_triangles is None else n_triangles)
+    compiled = None
+    if numba_kernels() is not None:
+        from ._pointcloud_kernels import ball_triangle_sums as compiled
+    k = min(ball_size(radius, spacing), n)
     for start in range(0, centres.size, CHUNK):
         chunk = centres[start:start + CHUNK]
-        distance, index = tree.query(points[chunk], k=min(MAX_BALL_POINTS, n), distance_upper_bound=radius,
-                                     workers=-1)
+        _, index = tree.query(points[chunk], k=k, distance_upper_bound=radius, workers=-1)
         index = index.reshape(chunk.size, -1)
         inside = index < n
         inside[inside] = usable[index[inside]]
         # usable points first, in distance order (a stable sort keeps the order within each group)
         order = np.argsort(~inside, axis=1, kind="stable")
-        index = np.take_along_axis(index, order, axis=1)
+        index = np.ascontiguousarray(np.take_along_axis(index, order, axis=1))
         counts = inside.sum(axis=1)
-        ok = counts >= MIN_BALL_POINTS
-        rows = np.flatnonzero(ok)
+        rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
         if rows.size == 0:
             continue
-        ranks = _distinct_ranks(pattern, counts[rows])
-        triangles = np.take_along_axis(index[rows][:, None, :], ranks.reshape(rows.size, 1, -1), axis=2)
-        triangles = triangles.reshape(rows.size, n_triangles, 3)
-        # turn each triangle so that its normal agrees with the mean of its corners' normals
-        x0, x1, x2 = (points[triangles[..., j]] for j in range(3))
-        facing = np.einsum("mtj,mtj->mt", np.cross(x1 - x0, x2 - x0),
-                           normals[triangles].sum(axis=2))
-        flip = facing < 0
-        triangles[flip, 1], triangles[flip, 2] = triangles[flip, 2], triangles[flip, 1].copy()
-        measures = measure(points, np.ascontiguousarray(triangles.reshape(-1, 3)), normals)
-        summed = measures.reshape(rows.size, n_triangles, 9).sum(axis=1)
+        index, counts = index[rows], counts[rows]
+        if compiled is not None:
+            summed = compiled(points, normals, index, counts.astype(np.int64), pattern)
+        else:
+            summed = _triangle_sums(points, normals, index, counts, pattern)
         area = summed[:, 0]
         good = area > 0
         with np.errstate(invalid="ignore", divide="ignore"):
             mean = summed[:, 1] / (2 * area)
             gaussian = summed[:, 2] / area
             shape_operator = -summed[:, 3:] / area[:, None]
-        centre_normals = normals[chunk[rows]]
         _, _, dir_min, dir_max = principal_from_shape_operator(
-            np.where(good[:, None], shape_operator, 0.0), centre_normals)
+            np.where(good[:, None], shape_operator, 0.0), normals[chunk[rows]])
         half = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
         target = chunk[rows[good]]
         out[0][target] = (mean - half)[good]

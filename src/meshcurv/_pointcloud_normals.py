@@ -32,6 +32,9 @@ NEIGHBOURS = 10
 #: The local spacing is measured at this neighbour (see :func:`local_spacing`).
 SPACING_NEIGHBOUR = 8
 
+#: Neighbours per point in the graph of the orientation (the nearest of the query's).
+GRAPH_NEIGHBOURS = 6
+
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
 
@@ -93,7 +96,8 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
     normals : ndarray of shape (N, 3)
         Unit normals, any signs.
     indices : ndarray of shape (N, k)
-        The nearest neighbours of each point (:func:`knn`).
+        The nearest neighbours of each point (:func:`knn`); the first
+        :data:`GRAPH_NEIGHBOURS` are the graph's edges.
     usable : ndarray of shape (N,), bool
         Points that enter the graph (outliers do not; each is its own component).
 
@@ -108,6 +112,7 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
 
+    indices = indices[:, :GRAPH_NEIGHBOURS]
     n, k = indices.shape
     rows = np.repeat(np.arange(n), k)
     cols = indices.ravel()
@@ -117,7 +122,7 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
     # weight 1 - |cos|, plus a floor so that parallel pairs stay edges of the sparse graph
     weights = 1.0 - np.abs(cosine) + 1e-6
     graph = coo_matrix((weights, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
-    graph = graph.maximum(graph.T)  # symmetric: an edge whenever one is among the other's neighbours
+    # both searches treat the graph as undirected: (i, j) is an edge when either is among the other's neighbours
     n_components, labels = connected_components(graph[:n, :n], directed=False)
     # one virtual node n joined to the first point of each component: one tree for every component
     roots = np.zeros(n_components, dtype=np.int64)
@@ -126,8 +131,7 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
     tree = minimum_spanning_tree(graph + hub + hub.T)
     _, parent = breadth_first_order(tree, n, directed=False, return_predecessors=True)
     parent = parent[:n].astype(np.int64)
-    parent[parent == n] = -1
-    parent[parent < 0] = -1
+    parent[(parent == n) | (parent < 0)] = -1  # the roots (children of the hub) and the hub
     # relative sign of each point to its parent, then products along the paths by pointer jumping
     has_parent = parent >= 0
     signs = np.ones(n)

@@ -72,13 +72,13 @@ __all__ = ["point_cloud_curvatures", "POINT_CLOUD_METHODS", "MIN_POINTS"]
 logger = logging.getLogger(__name__)
 
 #: The estimators of :func:`point_cloud_curvatures`; the first is the default.
-POINT_CLOUD_METHODS = ("jets", "corrected_measures")
+POINT_CLOUD_METHODS = ("corrected_measures", "jets")
 
 #: Fewest points accepted.
 MIN_POINTS = 10
 
 #: The default radius ``s (a + b sqrt(max(nu - NOISE_FLOOR, 0)))`` per method: ``(a, b)``.
-RADIUS_RULES = {"jets": (3.0, 12.0), "corrected_measures": (3.0, 12.0)}
+RADIUS_RULES = {"corrected_measures": (3.0, 11.0), "jets": (3.0, 22.0)}
 
 #: Noise levels (in spacings) up to this count as clean samples: the fit's own bias.
 NOISE_FLOOR = 0.005
@@ -294,19 +294,24 @@ def _compute(points, given, radius, method):
     dir_min, dir_max = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
     out_normals = start.copy()
     logger.info("point cloud: %s over %d radius class(es)", method, len(groups))
-    for group_radius, members in groups:
+    parameters = {"radius": groups[0][0], "spacing": median, "noise": noise, "normals": how}
+    for group_radius, group_spacing, members in groups:
         if method == "jets":
             found = _estimators.jets(points, start, group_radius, members, usable)
         else:
-            normals = start if given is not None else _estimators.fitted_normals(
-                points, start, _estimators.NORMAL_RADIUS_RATIO * group_radius, members, usable)
-            found = _estimators.corrected_measures(tree, points, normals, group_radius, members, usable)
+            if given is None:
+                normal_radius = _rule(_estimators.NORMAL_RULE, group_spacing, noise)
+                normals = _estimators.fitted_normals(points, start, normal_radius, members, usable)
+                parameters["normal_radius"] = normal_radius
+            else:
+                normals = start
+            found = _estimators.corrected_measures(tree, points, normals, group_radius, members, usable,
+                                                   spacing=group_spacing)
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
             whole[members] = part[members]
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
-    parameters = {"radius": groups[0][0], "spacing": median, "noise": noise, "normals": how}
     if len(groups) > 1:
-        parameters["radii"] = tuple(r for r, _ in groups)
+        parameters["radii"] = tuple(r for r, _, _ in groups)
     return k_min, k_max, dir_min, dir_max, out_normals, valid, parameters, problems
 
 
@@ -323,28 +328,33 @@ def _noise_level(points, normals, spacing, centres, usable) -> float:
     return float(np.median(heights)) if heights.size else 0.0
 
 
-def default_radius(spacing: float, noise: float, method: str = POINT_CLOUD_METHODS[0]) -> float:
-    """The default radius for points of this median ``spacing`` and ``noise`` level (in spacings)."""
-    a, b = RADIUS_RULES[method]
+def _rule(rule, spacing: float, noise: float) -> float:
+    """``spacing (a + b sqrt(max(noise - NOISE_FLOOR, 0)))`` for ``rule = (a, b)``."""
+    a, b = rule
     return float(spacing * (a + b * np.sqrt(max(noise - NOISE_FLOOR, 0.0))))
 
 
+def default_radius(spacing: float, noise: float, method: str = POINT_CLOUD_METHODS[0]) -> float:
+    """The default radius for points of this median ``spacing`` and ``noise`` level (in spacings)."""
+    return _rule(RADIUS_RULES[method], spacing, noise)
+
+
 def _radius_groups(spacing, indices, usable, median, noise, radius, method, problems):
-    """``[(radius, centres), ...]``: one radius, or one per class of density when it is uneven."""
+    """``[(radius, spacing, centres), ...]``: one radius, or one per class of density when it is uneven."""
     centres = np.flatnonzero(usable)
     if radius is not None:
-        return [(radius, centres)]
+        return [(radius, median, centres)]
     # the spacing averaged over the neighbours: one class per region, not per random gap
     smooth = np.where(usable, spacing, np.nan)
     smooth = np.nanmean(np.concatenate([smooth[:, None], smooth[indices]], axis=1), axis=1)[centres]
     low, high = np.percentile(smooth, [5, 95])
     if high <= UNEVEN_DENSITY * low:
-        return [(default_radius(median, noise, method), centres)]
+        return [(default_radius(median, noise, method), median, centres)]
     level = np.round(np.log2(smooth / median)).astype(np.int64)
     groups = []
     for k in np.unique(level):
         members = centres[level == k]
-        groups.append((default_radius(median * 2.0**k, noise, method), members))
+        groups.append((default_radius(median * 2.0**k, noise, method), median * 2.0**k, members))
     problems.append(f"the density of the points is very uneven (local spacing from {low:.3g} to {high:.3g}, "
                     f"5th to 95th percentile): each of {len(groups)} classes of spacing got its own radius")
     return groups
