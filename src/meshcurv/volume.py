@@ -493,7 +493,8 @@ def label_curvatures(labels, *, spacing=(1.0, 1.0, 1.0), labels_to_use=None, met
 
     Examples
     --------
-    >>> import numpy as np
+    >>> import numpy as np, pytest
+    >>> _ = pytest.importorskip("skimage"), pytest.importorskip("pandas")  # the volume extra
     >>> from meshcurv.volume import label_curvatures
     >>> z, y, x = np.ogrid[:40, :40, :40]
     >>> ball = (z - 19.6) ** 2 + (y - 20.3) ** 2 + (x - 19.8) ** 2 <= 12 ** 2
