@@ -1,0 +1,427 @@
+"""Point-cloud files: PLY (vertices only), XYZ / CSV text, PCD and LAS / LAZ.
+
+:func:`read_points` returns ``(points, normals)`` (normals None when the file
+has none) and :func:`write_points` writes points, normals and per-point fields.
+Every failure is a :class:`~meshcurv.errors.MeshFileError` that names the file.
+Readers are bounded: the declared counts are checked against the size of the
+file before anything is allocated, and a file cut short is an error, not a
+smaller cloud.
+
+=========================  ==================  ==========================================================
+extension                  format              normals read from
+=========================  ==================  ==========================================================
+``.ply``                   PLY ascii / binary  ``nx ny nz`` (or ``normal_x ...``); faces, if any, ignored
+``.xyz .txt .pts .csv``    text rows           header names ``nx ny nz``; without a header, columns 4-6
+                                               when they are unit vectors
+``.pcd``                   PCD ascii / binary  ``normal_x normal_y normal_z``; NaN points (organised
+                                               clouds' missing measurements) are left out
+``.las .laz``              LAS / LAZ (laspy)   extra dimensions ``normal_x`` ... or ``nx`` ...
+=========================  ==================  ==========================================================
+
+LAS and LAZ need the ``points`` extra (``pip install 'meshcurv[points]'``:
+laspy with the lazrs backend). LAS stores integer coordinates: written files
+keep about nine significant digits of the extent (scale = extent / 2^30).
+"""
+
+from __future__ import annotations
+
+import pathlib
+import re
+import warnings
+
+import numpy as np
+
+from ..errors import MeshFileError, MeshQualityWarning, MissingDependencyError
+from ._files import atomic_output, check_input, check_output
+from ._ply import _ORDERS, _header
+
+__all__ = ["read_points", "write_points", "POINT_EXTENSIONS"]
+
+_TEXT = (".xyz", ".txt", ".pts", ".csv")
+
+#: The extensions :func:`read_points` and :func:`write_points` know.
+POINT_EXTENSIONS = (".ply", *_TEXT, ".pcd", ".las", ".laz")
+
+_NORMAL_NAMES = (("nx", "ny", "nz"), ("normal_x", "normal_y", "normal_z"), ("normalx", "normaly", "normalz"))
+
+
+def read_points(path, *, file_format: str | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """Read a point cloud: ``(points, normals)``.
+
+    Parameters
+    ----------
+    path : str or path-like
+    file_format : str, optional
+        An extension (``"ply"``, ``".xyz"``, ...) overriding that of ``path``.
+
+    Returns
+    -------
+    points : ndarray of shape (N, 3), float64
+    normals : ndarray of shape (N, 3), float64, or None
+        None when the file holds no normals.
+
+    Raises
+    ------
+    MeshFileError
+        Missing or empty file, unknown extension, malformed content, declared
+        counts beyond the file's size, a file cut short.
+    MissingDependencyError
+        A LAS / LAZ file without laspy installed.
+    """
+    path = check_input(path)
+    suffix = _suffix(path, file_format)
+    if suffix in (".las", ".laz"):
+        return _read_las(path)
+    data = path.read_bytes()
+    if suffix == ".ply":
+        return _read_ply(data, path)
+    if suffix == ".pcd":
+        return _read_pcd(data, path)
+    return _read_text(data, path)
+
+
+def _suffix(path: pathlib.Path, file_format: str | None) -> str:
+    key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
+    key = (key or path.suffix).lower()
+    if key not in POINT_EXTENSIONS:
+        what = f"format {file_format!r}" if file_format else f"extension {path.suffix!r}" if path.suffix else "no extension"
+        raise MeshFileError(f"{path}: unknown point-cloud file {what}; known formats: {', '.join(POINT_EXTENSIONS)}")
+    return key
+
+
+def _split(columns: dict, path, where: str) -> tuple[np.ndarray, np.ndarray | None]:
+    """``(points, normals)`` from named float columns (lower-case names)."""
+    if not {"x", "y", "z"} <= set(columns):
+        raise MeshFileError(f"{path}: {where} has no x, y and z")
+    points = np.column_stack([columns[a] for a in "xyz"]).astype(np.float64)
+    normals = None
+    for names in _NORMAL_NAMES:
+        if set(names) <= set(columns):
+            normals = np.column_stack([columns[a] for a in names]).astype(np.float64)
+            break
+    return points, normals
+
+
+# -- PLY ----------------------------------------------------------------------------
+
+def _read_ply(data: bytes, path):
+    file_format, elements, offset = _header(data, path)
+    vertex = next((e for e in elements if e.name == "vertex"), None)
+    if vertex is None:
+        raise MeshFileError(f"{path}: the PLY header has no 'vertex' element")
+    if any(p.count_kind is not None for p in vertex.properties):
+        raise MeshFileError(f"{path}: the PLY 'vertex' element has a list property; not supported")
+    before = elements[:elements.index(vertex)]
+    if any(p.count_kind is not None for e in before for p in e.properties):
+        raise MeshFileError(f"{path}: the PLY file has a list element before its vertices; not supported")
+    names = [p.name.lower() for p in vertex.properties]
+    if file_format == "ascii":
+        width = len(vertex.properties)
+        skip = sum(e.count * len(e.properties) for e in before)
+        body = data[offset:]
+        # each value takes at least two bytes (a digit and a separator): bound the count first
+        if (skip + vertex.count * width) * 2 > len(body) + 1:
+            raise _short(path, vertex.count, "vertices", len(body))
+        lines = body.split(b"\n", skip + vertex.count)
+        rows = lines[sum(e.count for e in before):][:vertex.count]
+        if len(rows) < vertex.count:
+            raise _short(path, vertex.count, "vertices", len(body))
+        values = _floats(b" ".join(rows), path, "the ASCII PLY body")
+        if values.size != vertex.count * width:
+            raise MeshFileError(f"{path}: the ASCII PLY vertices do not all have {width} values "
+                                f"({values.size} values on {vertex.count} lines)")
+        table = values.reshape(vertex.count, width)
+        return _split({n: table[:, i] for i, n in enumerate(names)}, path, "the PLY 'vertex' element")
+    order = _ORDERS[file_format]
+    position = offset
+    for element in before:
+        position += element.count * np.dtype([(p.name, order + p.kind) for p in element.properties]).itemsize
+    record = np.dtype([(p.name, order + p.kind) for p in vertex.properties])
+    need = vertex.count * record.itemsize
+    if position + need > len(data):
+        raise _short(path, vertex.count, "vertices", max(len(data) - position, 0), need)
+    table = np.frombuffer(data, record, count=vertex.count, offset=position)
+    return _split({p.name.lower(): table[p.name] for p in vertex.properties}, path, "the PLY 'vertex' element")
+
+
+def _short(path, count, what, available, need=None) -> MeshFileError:
+    needed = f" ({need} needed)" if need is not None else ""
+    return MeshFileError(f"{path}: the header declares {count} {what} but the file holds only {available} bytes "
+                         f"for them{needed}; the file is cut short or its header is wrong")
+
+
+def _floats(body: bytes, path, what: str) -> np.ndarray:
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            return np.fromstring(body, dtype=np.float64, sep=" ")
+    except (ValueError, DeprecationWarning):
+        raise MeshFileError(f"{path}: {what} holds something that is not a number") from None
+
+
+# -- text ---------------------------------------------------------------------------
+
+_SEPARATORS = re.compile(rb"[,;\t ]+")
+
+
+def _read_text(data: bytes, path):
+    """Rows of numbers separated by spaces, tabs, commas or semicolons; ``#`` and ``//`` lines are comments."""
+    lines = [line.strip() for line in data.splitlines()]
+    lines = [line for line in lines if line and not line.startswith((b"#", b"//"))]
+    if not lines:
+        raise MeshFileError(f"{path}: no points in the file")
+    names = None
+    first = _SEPARATORS.split(lines[0])
+    try:
+        [float(word) for word in first]
+    except ValueError:
+        names = [word.decode("utf-8", "replace").strip().strip('"').lower() for word in first]
+        lines = lines[1:]
+        if not lines:
+            raise MeshFileError(f"{path}: a header line and no points") from None
+    width = len(names) if names else len(_SEPARATORS.split(lines[0]))
+    values = _floats(_SEPARATORS.sub(b" ", b"\n".join(lines)), path, "the text")
+    if values.size != width * len(lines):
+        widths = [len(_SEPARATORS.split(line)) for line in lines]
+        bad = next(i for i, w in enumerate(widths) if w != width)
+        raise MeshFileError(f"{path}: data line {bad + 1} has {widths[bad]} values where the first has {width}")
+    table = values.reshape(len(lines), width)
+    if names is None:
+        if width < 3:
+            raise MeshFileError(f"{path}: rows of {width} numbers; a point needs x, y and z")
+        names = ["x", "y", "z"]
+        if width >= 6:
+            length = np.linalg.norm(table[:, 3:6], axis=1)
+            if np.median(np.abs(length - 1.0)) < 1e-3:  # unit vectors: normals (not colours)
+                names += ["nx", "ny", "nz"]
+        names += [f"column{i}" for i in range(len(names), width)]
+    return _split({n: table[:, i] for i, n in enumerate(names)}, path, "the header")
+
+
+# -- PCD ----------------------------------------------------------------------------
+
+_PCD_TYPES = {("F", 4): "f4", ("F", 8): "f8", ("I", 1): "i1", ("I", 2): "i2", ("I", 4): "i4", ("I", 8): "i8",
+              ("U", 1): "u1", ("U", 2): "u2", ("U", 4): "u4", ("U", 8): "u8"}
+
+
+def _read_pcd(data: bytes, path):
+    header, position = {}, 0
+    for _ in range(64):
+        end = data.find(b"\n", position)
+        if end < 0:
+            raise MeshFileError(f"{path}: the PCD header ends before its DATA line (the file is cut short)")
+        line = data[position:end].decode("ascii", "replace").strip()
+        position = end + 1
+        if not line or line.startswith("#"):
+            continue
+        key, *words = line.split()
+        header[key.upper()] = words
+        if key.upper() == "DATA":
+            break
+    else:
+        raise MeshFileError(f"{path}: no DATA line in the first 64 lines; not a PCD file")
+    try:
+        fields = [f.lower() for f in header["FIELDS"]]
+        sizes = [int(s) for s in header.get("SIZE", ["4"] * len(fields))]
+        types = [t.upper() for t in header.get("TYPE", ["F"] * len(fields))]
+        counts = [int(c) for c in header.get("COUNT", ["1"] * len(fields))]
+        n = int(header["POINTS"][0]) if "POINTS" in header else int(header["WIDTH"][0]) * int(header["HEIGHT"][0])
+        kind = header["DATA"][0].lower()
+    except (KeyError, ValueError, IndexError) as exc:
+        raise MeshFileError(f"{path}: malformed PCD header ({type(exc).__name__}: {exc})") from None
+    if not len(fields) == len(sizes) == len(types) == len(counts) or n < 0 or min(counts, default=1) < 1:
+        raise MeshFileError(f"{path}: the PCD header's FIELDS, SIZE, TYPE and COUNT do not match")
+    if kind == "binary_compressed":
+        raise MeshFileError(f"{path}: PCD 'binary_compressed' (LZF) is not supported; save it as binary or ascii")
+    if kind == "ascii":
+        width = sum(counts)
+        body = data[position:]
+        if n * width * 2 > len(body) + 1:
+            raise _short(path, n, "points", len(body))
+        values = _floats(body, path, "the PCD body")
+        if values.size != n * width:
+            raise MeshFileError(f"{path}: the PCD body holds {values.size} values; {n} points of {width} need "
+                                f"{n * width}")
+        table = values.reshape(n, width)
+        starts = np.cumsum([0] + counts[:-1])
+        columns = {f: table[:, s] for f, s in zip(fields, starts)}
+    elif kind == "binary":
+        try:
+            record = np.dtype([(f"f{i}", "<" + _PCD_TYPES[t, s], (c,)) for i, (t, s, c) in
+                               enumerate(zip(types, sizes, counts))])
+        except KeyError:
+            raise MeshFileError(f"{path}: a PCD field has an unknown TYPE/SIZE pair") from None
+        need = n * record.itemsize
+        if position + need > len(data):
+            raise _short(path, n, "points", len(data) - position, need)
+        table = np.frombuffer(data, record, count=n, offset=position)
+        columns = {f: table[f"f{i}"][:, 0] for i, f in enumerate(fields)}
+    else:
+        raise MeshFileError(f"{path}: unknown PCD DATA kind {kind!r} (ascii, binary)")
+    points, normals = _split(columns, path, "the PCD FIELDS")
+    finite = np.isfinite(points).all(axis=1)
+    if not finite.all():
+        warnings.warn(f"{path}: {int((~finite).sum())} of {n} points have NaN coordinates (missing measurements): "
+                      "left out", MeshQualityWarning, stacklevel=3)
+        points = points[finite]
+        normals = None if normals is None else normals[finite]
+    return points, normals
+
+
+# -- LAS / LAZ ----------------------------------------------------------------------
+
+def _laspy(path):
+    try:
+        import laspy
+    except ImportError:
+        raise MissingDependencyError(f"{path}: reading or writing LAS / LAZ needs laspy: "
+                                     "pip install 'meshcurv[points]'") from None
+    return laspy
+
+
+def _read_las(path):
+    laspy = _laspy(path)
+    try:
+        with laspy.open(path) as reader:
+            header = reader.header
+            count = int(header.point_count)
+            if path.suffix.lower() != ".laz" and not header.are_points_compressed:
+                need = int(header.offset_to_point_data) + count * int(header.point_format.size)
+                if need > path.stat().st_size:
+                    raise _short(path, count, "points", path.stat().st_size, need)
+            data = reader.read()
+        points = np.column_stack([np.asarray(data.x, dtype=np.float64), np.asarray(data.y, dtype=np.float64),
+                                  np.asarray(data.z, dtype=np.float64)])
+        extra = {name.lower(): name for name in data.point_format.extra_dimension_names}
+        normals = None
+        for names in _NORMAL_NAMES:
+            if set(names) <= set(extra):
+                normals = np.column_stack([np.asarray(data[extra[n]], dtype=np.float64) for n in names])
+                break
+    except MeshFileError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - laspy raises many kinds on a bad file
+        raise MeshFileError(f"{path}: not a readable LAS / LAZ file ({type(exc).__name__}: {exc})") from None
+    if points.shape[0] != count:
+        raise MeshFileError(f"{path}: the header declares {count} points; {points.shape[0]} were read")
+    return points, normals
+
+
+# -- writing ------------------------------------------------------------------------
+
+def _columns(points, normals, point_data) -> dict[str, np.ndarray]:
+    """Named float64 columns: x, y, z, nx, ny, nz, then each field (vectors as ``name_x`` ...)."""
+    columns = {a: points[:, i] for i, a in enumerate("xyz")}
+    if normals is not None:
+        columns.update({a: normals[:, i] for i, a in enumerate(("nx", "ny", "nz"))})
+    for name, value in (point_data or {}).items():
+        value = np.asarray(value, dtype=np.float64)
+        if value.shape == (points.shape[0],):
+            columns[name] = value
+        elif value.shape == (points.shape[0], 3):
+            columns.update({f"{name}_{a}": value[:, i] for i, a in enumerate("xyz")})
+        else:
+            raise MeshFileError(f"field {name!r} must have shape ({points.shape[0]},) or ({points.shape[0]}, 3); "
+                                f"got {value.shape}")
+    return columns
+
+
+def write_points(path, points, normals=None, *, point_data=None, overwrite: bool = False, binary: bool = True,
+                 source=None, file_format: str | None = None) -> pathlib.Path:
+    """Write a point cloud with its normals and per-point fields.
+
+    Parameters
+    ----------
+    path : str or path-like
+    points : array_like of shape (N, 3)
+    normals : array_like of shape (N, 3), optional
+    point_data : dict of str to array_like of shape (N,) or (N, 3), optional
+        Per-point fields (vectors as ``name_x, name_y, name_z``); LAS / LAZ
+        files keep only the points and normals (as extra dimensions).
+    overwrite : bool, default: False
+    binary : bool, default: True
+        PLY and PCD: binary (little endian) or ASCII.
+    source : path-like, optional
+        The input file, which the output may not replace.
+    file_format : str, optional
+        An extension overriding that of ``path``.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    MeshFileError
+        Unknown extension, existing file without ``overwrite``, the input file,
+        a field of the wrong shape, a folder that cannot be written.
+    """
+    from .._validation import as_vertices
+
+    path = check_output(path, overwrite=overwrite, source=source)
+    suffix = _suffix(path, file_format)
+    points = as_vertices(points, name="points")
+    normals = None if normals is None else np.asarray(normals, dtype=np.float64).reshape(points.shape)
+    columns = _columns(points, normals, point_data)
+    with atomic_output(path, overwrite=overwrite) as temporary:
+        if suffix in (".las", ".laz"):
+            _write_las(temporary, path, points, normals)
+        elif suffix == ".ply":
+            _write_ply(temporary, columns, binary)
+        elif suffix == ".pcd":
+            _write_pcd(temporary, columns, binary)
+        else:
+            separator = "," if suffix == ".csv" else " "
+            table = np.column_stack(list(columns.values()))
+            with open(temporary, "w", encoding="ascii") as handle:
+                handle.write(separator.join(columns) + "\n")
+                np.savetxt(handle, table, fmt="%.17g", delimiter=separator)
+    return path
+
+
+def _write_ply(temporary, columns, binary):
+    n = next(iter(columns.values())).shape[0]
+    lines = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0", f"element vertex {n}"]
+    lines += [f"property double {name}" for name in columns] + ["end_header"]
+    with open(temporary, "wb") as handle:
+        handle.write(("\n".join(lines) + "\n").encode("ascii"))
+        table = np.column_stack(list(columns.values()))
+        if binary:
+            handle.write(np.ascontiguousarray(table, dtype="<f8").tobytes())
+        else:
+            np.savetxt(handle, table, fmt="%.17g")
+
+
+def _write_pcd(temporary, columns, binary):
+    n = next(iter(columns.values())).shape[0]
+    names = [{"nx": "normal_x", "ny": "normal_y", "nz": "normal_z"}.get(name, name) for name in columns]
+    lines = ["# .PCD v0.7 - Point Cloud Data file format", "VERSION 0.7", "FIELDS " + " ".join(names),
+             "SIZE " + " ".join(["8"] * len(names)), "TYPE " + " ".join(["F"] * len(names)),
+             "COUNT " + " ".join(["1"] * len(names)), f"WIDTH {n}", "HEIGHT 1", "VIEWPOINT 0 0 0 1 0 0 0",
+             f"POINTS {n}", f"DATA {'binary' if binary else 'ascii'}"]
+    with open(temporary, "wb") as handle:
+        handle.write(("\n".join(lines) + "\n").encode("ascii"))
+        table = np.column_stack(list(columns.values()))
+        if binary:
+            handle.write(np.ascontiguousarray(table, dtype="<f8").tobytes())
+        else:
+            np.savetxt(handle, table, fmt="%.17g")
+
+
+def _write_las(temporary, path, points, normals):
+    laspy = _laspy(path)
+    header = laspy.LasHeader(point_format=3, version="1.4")
+    low, high = points.min(axis=0), points.max(axis=0)
+    header.offsets = low
+    header.scales = np.maximum((high - low) / 2.0**30, 1e-12)
+    if normals is not None:
+        header.add_extra_dims([laspy.ExtraBytesParams(name=n, type=np.float64) for n in ("nx", "ny", "nz")])
+    data = laspy.LasData(header)
+    data.x, data.y, data.z = points[:, 0], points[:, 1], points[:, 2]
+    if normals is not None:
+        data.nx, data.ny, data.nz = normals[:, 0], normals[:, 1], normals[:, 2]
+    try:
+        data.write(str(temporary), do_compress=path.suffix.lower() == ".laz")
+    except Exception as exc:  # noqa: BLE001 - laspy's writer errors
+        raise MeshFileError(f"{path}: cannot be written as LAS / LAZ ({type(exc).__name__}: {exc})") from None
