@@ -1,0 +1,230 @@
+"""meshcurv.pointcloud: curvatures of point clouds against closed forms, invariances, orientation, errors.
+
+Tolerances: clouds of 2000-4000 random samples; the estimators' median errors on
+such clouds are a few tenths of a percent (benchmarks/pointcloud.md), so the
+medians are checked at 2% and the rigid-motion and scaling invariances (the
+same balls, the same random ranks) at 1e-6 relative.
+"""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from meshcurv import _pointcloud_estimators as estimators
+from meshcurv import _pointcloud_normals as normals_module
+from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
+from meshcurv.pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
+from meshcurv.result import INVALID_REASONS
+
+
+def sphere_points(n=3000, radius=2.0, seed=0):
+    u = np.random.default_rng(seed).normal(size=(n, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    return radius * u, u
+
+
+def torus_points(n=4000, major=3.0, minor=1.0, seed=0):
+    rng = np.random.default_rng(seed)
+    t, p = rng.uniform(0, 2 * np.pi, n), rng.uniform(0, 2 * np.pi, n)
+    normals = np.stack([np.cos(p) * np.cos(t), np.cos(p) * np.sin(t), np.sin(p)], axis=1)
+    centre = np.stack([major * np.cos(t), major * np.sin(t), 0 * t], axis=1)
+    return centre + minor * normals, normals, np.cos(p) / (major + minor * np.cos(p))
+
+
+def cylinder_points(n=3000, radius=1.0, height=6.0, seed=0):
+    rng = np.random.default_rng(seed)
+    phi, z = rng.uniform(0, 2 * np.pi, n), rng.uniform(-height / 2, height / 2, n)
+    normals = np.stack([np.cos(phi), np.sin(phi), 0 * z], axis=1)
+    return radius * normals + np.stack([0 * z, 0 * z, z], axis=1), normals
+
+
+def random_rotation(seed=1):
+    q, r = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    q *= np.sign(np.diag(r))
+    return q if np.linalg.det(q) > 0 else -q
+
+
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
+def test_sphere_samples_give_one_over_r_with_outward_normals(method):
+    points, exact = sphere_points()
+    r = point_cloud_curvatures(points, method=method)
+    assert r.valid.all()
+    assert abs(np.median(r.k_min) - 0.5) < 0.01 and abs(np.median(r.k_max) - 0.5) < 0.01
+    assert np.all(r.k_min <= r.k_max)
+    assert (np.einsum("ij,ij->i", r.normals, exact) > 0.99).all()
+    assert r.parameters["normals"] == "estimated"
+    assert r.method == method and r.parameters["radius"] > r.parameters["spacing"] > 0
+    assert (r.invalid_reason == 0).all()
+
+
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
+def test_torus_principal_curvatures(method):
+    points, exact, k_ring = torus_points(8000)  # 9 spacings per tube radius
+    r = point_cloud_curvatures(points, method=method)
+    assert np.median(np.abs(r.k_max - 1.0)) < 0.02  # tube: 1 / r
+    assert np.median(np.abs(r.k_min - k_ring)) < 0.02  # ring: cos(p) / (R + r cos(p)), negative inside
+    assert (np.einsum("ij,ij->i", r.normals, exact) > 0.95).mean() > 0.999
+
+
+def test_cylinder_curvatures_and_directions():
+    points, exact = cylinder_points()
+    r = point_cloud_curvatures(points)
+    interior = np.abs(points[:, 2]) < 2.0  # away from the open rims, where the balls are one-sided
+    assert np.median(np.abs(r.k_max[interior] - 1.0)) < 0.02
+    assert np.median(np.abs(r.k_min[interior])) < 0.02
+    along_axis = np.degrees(np.arccos(np.clip(np.abs(r.dir_min[interior, 2]), 0, 1)))
+    assert np.median(along_axis) < 5.0
+    # directions unit, orthogonal to each other and to the normal
+    assert np.allclose(np.linalg.norm(r.dir_max, axis=1), 1.0)
+    assert np.abs(np.einsum("ij,ij->i", r.dir_min, r.dir_max)).max() < 1e-9
+    assert np.abs(np.einsum("ij,ij->i", r.dir_max, r.normals)).max() < 1e-9
+
+
+def test_flat_points_have_zero_curvature():
+    rng = np.random.default_rng(3)
+    points = np.column_stack([rng.uniform(-1, 1, (2000, 2)), np.zeros(2000)])
+    r = point_cloud_curvatures(points)
+    assert r.valid.mean() > 0.99
+    assert np.nanmax(np.abs(r.k_max)) < 1e-8 and np.nanmax(np.abs(r.k_min)) < 1e-8
+
+
+def test_given_inward_normals_flip_the_signs():
+    points, exact = sphere_points()
+    r = point_cloud_curvatures(points, normals=-3.0 * exact)  # consistent, inward, not unit
+    assert r.parameters["normals"] == "given"
+    assert abs(np.median(r.k_max) + 0.5) < 0.01 and abs(np.median(r.k_min) + 0.5) < 0.01
+    assert (np.einsum("ij,ij->i", r.normals, exact) < -0.99).all()
+
+
+@pytest.mark.parametrize("outward_share, sign", [(0.7, 1.0), (0.3, -1.0)])
+def test_inconsistent_given_normals_are_reoriented_to_their_majority_side(outward_share, sign):
+    points, exact = sphere_points()
+    flips = np.where(np.random.default_rng(5).random(points.shape[0]) < outward_share, 1.0, -1.0)
+    r = point_cloud_curvatures(points, normals=exact * flips[:, None])
+    assert r.parameters["normals"] == "given, reoriented"
+    assert (sign * np.einsum("ij,ij->i", r.normals, exact) > 0.99).all()
+    assert abs(np.median(r.mean) - sign * 0.5) < 0.01
+
+
+def test_orientation_propagation_makes_random_signs_consistent():
+    points, exact, _ = torus_points(3000)
+    flips = np.where(np.random.default_rng(2).random(points.shape[0]) < 0.5, 1.0, -1.0)
+    from scipy.spatial import cKDTree
+
+    _, indices = normals_module.knn(cKDTree(points), points)
+    signs, labels = normals_module.orientation_signs(exact * flips[:, None], indices, np.ones(3000, dtype=bool))
+    oriented = signs * flips
+    assert labels.max() == 0
+    assert np.all(oriented == oriented[0])  # every point on the side of the root
+
+
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
+def test_rigid_motion_scaling_and_permutation_invariance(method):
+    points, _, _ = torus_points(3000)
+    base = point_cloud_curvatures(points, method=method)
+    rotation = random_rotation()
+    moved = point_cloud_curvatures(points @ rotation.T + [5.0, -2.0, 7.0], method=method)
+    np.testing.assert_allclose(moved.k_max, base.k_max, rtol=1e-6, atol=1e-8)
+    np.testing.assert_allclose(moved.k_min, base.k_min, rtol=1e-6, atol=1e-8)
+    np.testing.assert_allclose(moved.normals, base.normals @ rotation.T, atol=1e-6)
+    scaled = point_cloud_curvatures(points * 4.0, method=method)
+    np.testing.assert_allclose(scaled.k_max, base.k_max / 4.0, rtol=1e-6, atol=1e-8)
+    assert scaled.parameters["radius"] == pytest.approx(4.0 * base.parameters["radius"])
+    order = np.random.default_rng(4).permutation(points.shape[0])
+    permuted = point_cloud_curvatures(points[order], method=method)
+    np.testing.assert_allclose(permuted.k_min, base.k_min[order], rtol=1e-6, atol=1e-8)
+    alignment = np.abs(np.einsum("ij,ij->i", permuted.dir_max, base.dir_max[order]))
+    assert np.median(alignment) > 1 - 1e-9  # directions up to sign (arbitrary only at umbilics)
+
+
+def test_duplicates_are_computed_once_and_copied_with_one_warning():
+    points, _ = sphere_points(2000)
+    doubled = np.concatenate([points, points[:50]])
+    with pytest.warns(MeshQualityWarning, match="50 points coincide with others") as record:
+        r = point_cloud_curvatures(doubled)
+    assert len(record) == 1
+    np.testing.assert_array_equal(r.k_max[2000:], r.k_max[:50])
+    clean = point_cloud_curvatures(points)
+    np.testing.assert_allclose(r.k_max[:2000], clean.k_max, rtol=1e-12)
+
+
+def test_an_outlier_is_left_out_and_reported():
+    points, _ = sphere_points(2000)
+    with pytest.warns(MeshQualityWarning, match="1 points are outliers") as record:
+        r = point_cloud_curvatures(np.concatenate([points, [[50.0, 0.0, 0.0]]]))
+    assert len(record) == 1
+    assert not r.valid[-1] and np.isnan(r.k_max[-1])
+    assert INVALID_REASONS[r.invalid_reason[-1]].startswith("estimate undefined")
+    assert r.valid[:-1].all() and abs(np.median(r.k_max[:-1]) - 0.5) < 0.01
+
+
+def test_uneven_density_gets_one_radius_per_class_and_a_warning():
+    points, _ = sphere_points(6000)
+    keep = (points[:, 0] > 0) | (np.arange(6000) % 8 == 0)  # one half 8x sparser
+    with pytest.warns(MeshQualityWarning, match="very uneven"):
+        r = point_cloud_curvatures(points[keep])
+    assert len(r.parameters["radii"]) >= 2
+    assert r.valid.mean() > 0.99 and np.median(np.abs(r.k_max[r.valid] - 0.5)) < 0.01
+
+
+@pytest.mark.parametrize("points, match", [
+    (np.zeros((20, 2)), r"must have shape \(V, 3\)"),
+    (np.full((20, 3), np.nan), "NaN or infinite"),
+    (np.random.default_rng(0).normal(size=(9, 3)), "at least 10 are needed"),
+    (np.repeat(np.random.default_rng(0).normal(size=(5, 3)), 4, axis=0), "5 distinct points; at least 10"),
+    (np.outer(np.arange(30.0), [1.0, 2.0, 3.0]), "lie on one line"),
+])
+def test_bad_points_are_refused(points, match):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        with pytest.raises(InvalidMeshError, match=match):
+            point_cloud_curvatures(points)
+
+
+def test_bad_normals_and_options_are_refused():
+    points, exact = sphere_points(200)
+    with pytest.raises(InvalidMeshError, match=r"`normals` must have the shape of `points` \(200, 3\)"):
+        point_cloud_curvatures(points, normals=exact[:100])
+    zero = exact.copy()
+    zero[7] = 0
+    with pytest.raises(InvalidMeshError, match="zero length at 1 points .first at index 7"):
+        point_cloud_curvatures(points, normals=zero)
+    with pytest.raises(InvalidOptionError, match="method"):
+        point_cloud_curvatures(points, method="apss")
+    with pytest.raises(InvalidOptionError, match="radius"):
+        point_cloud_curvatures(points, radius=-1.0)
+    with pytest.raises(InvalidOptionError, match="larger than the point cloud itself"):
+        point_cloud_curvatures(points, radius=100.0)
+
+
+def test_too_small_radius_gives_nan_and_the_warning():
+    points, _ = sphere_points(500)
+    with pytest.warns(MeshQualityWarning, match="500 points are NaN with valid=False"):
+        r = point_cloud_curvatures(points, radius=1e-6)
+    assert not r.valid.any() and np.isnan(r.k_min).all()
+
+
+def test_compiled_triangle_sums_match_the_numpy_path():
+    pytest.importorskip("numba")
+    from meshcurv._pointcloud_kernels import ball_triangle_sums
+
+    rng = np.random.default_rng(0)
+    points, exact = sphere_points(300)
+    normals = exact + 0.05 * rng.normal(size=exact.shape)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    index = np.argsort(np.linalg.norm(points[:, None] - points[None, :50], axis=2), axis=0)[:40].T.copy()
+    counts = rng.integers(3, 41, size=50)
+    pattern = estimators._rank_pattern(16)
+    expected = estimators._triangle_sums(points, normals, index, counts, pattern)
+    np.testing.assert_allclose(ball_triangle_sums(points, normals, index, counts, pattern), expected,
+                               rtol=1e-10, atol=1e-14)
+    assert (expected[:, 0] > 0).all()  # every triangle turned to a positive corrected area
+
+
+def test_distinct_ranks_are_distinct_and_in_range():
+    counts = np.array([3, 4, 10, 97])
+    ranks = estimators._distinct_ranks(estimators._rank_pattern(500), counts)
+    assert (ranks >= 0).all() and (ranks < counts[:, None, None]).all()
+    assert (np.diff(np.sort(ranks, axis=2), axis=2) > 0).all()
+    assert set(np.unique(ranks[0])) == {0, 1, 2}
