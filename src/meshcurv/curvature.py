@@ -12,6 +12,7 @@ from ._validation import as_faces, as_vertices, check_choice, check_int_option, 
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._common import ProgressCallback, Stages
+from .estimators.icc import voxel_surface_radius
 from .diagnosis import degenerate_faces, diagnose, quality_message
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import INVALID_REASONS, CurvatureResult
@@ -187,12 +188,17 @@ def principal_curvatures(
     if welding is not None and welding.n_welded:
         points, topology = welding.vertices, welding.topology
     topology, n_flipped = oriented_topology(points, topology, orient)
+    found = {}
+    if "radius" in options and options["radius"] is None:
+        voxel = voxel_surface_radius(points, topology)  # a voxel surface: one default for every ball method
+        if voxel is not None:
+            options["radius"], found = voxel
     result, problems = estimator.function(
         points, topology, stages=Stages(estimator.stages, progress), **options
     )
     diagnosis = diagnose(points, topology, n_flipped_faces=n_flipped)
     reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
-    parameters = {**result.parameters, "orient": orient,
+    parameters = {**result.parameters, **found, "orient": orient,
                   "n_welded_vertices": welding.n_welded if welding is not None else 0}
     result = dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons, parameters=parameters)
     if welding is not None and welding.n_welded:
