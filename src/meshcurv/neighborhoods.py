@@ -183,7 +183,10 @@ def estimate_ball_pairs(points: np.ndarray, radius: float, centres: np.ndarray |
         return 0.0, 0.0
     sub = points[_sample(points.shape[0], SAMPLE_POINTS)]
     probe = centres[_sample(centres.shape[0], SAMPLE_CENTRES)]
-    d2 = np.einsum("cij,cij->ci", sub[None, :, :] - probe[:, None, :], sub[None, :, :] - probe[:, None, :])
+    origin = probe.mean(axis=0)  # |p - c|^2 = |p|^2 + |c|^2 - 2 p.c about a nearby origin: one small product
+    sub, probe = sub - origin, probe - origin
+    d2 = (np.einsum("ij,ij->i", probe, probe)[:, None] + np.einsum("ij,ij->i", sub, sub)[None, :]
+          - 2.0 * (probe @ sub.T))
     inside = (d2 <= radius * radius).sum(axis=1) * (points.shape[0] / sub.shape[0])
     return float(inside.mean()), float(inside.max())
 
