@@ -188,7 +188,10 @@ def _apss_child(points, normals, given, send):
         values = {}
         for kind in ("Mean", "Gauss"):
             ms = pymeshlab.MeshSet()
-            ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals if given else None))
+            if given:
+                ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals))
+            else:
+                ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points))
             with contextlib.redirect_stdout(io.StringIO()):
                 if not given:
                     ms.compute_normal_for_point_clouds(k=10)
@@ -260,7 +263,8 @@ def run(surfaces, noise_levels, n, peer=True, methods=POINT_CLOUD_METHODS):
                         if values is None:
                             rows.append((*label, "MeshLab APSS", {"failed": why}, seconds, None))
                         else:
-                            lo, hi = _from_mean_gaussian(values["Mean"], values["Gauss"])
+                            # APSS's "Mean" is k1 + k2 (2.0 on the unit sphere, checked): halved
+                            lo, hi = _from_mean_gaussian(values["Mean"] / 2, values["Gauss"])
                             # APSS's sign convention is checked against the exact normals like ours
                             n_peer = values["normals"]
                             n_peer = n_peer / np.linalg.norm(n_peer, axis=1, keepdims=True)
