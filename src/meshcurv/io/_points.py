@@ -380,17 +380,22 @@ def write_points(path, points, normals=None, *, point_data=None, overwrite: bool
     return path
 
 
-def _write_ply(temporary, columns, binary):
-    n = next(iter(columns.values())).shape[0]
-    lines = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0", f"element vertex {n}"]
-    lines += [f"property double {name}" for name in columns] + ["end_header"]
+def _write_table(temporary, header: list[str], columns: dict, binary: bool) -> None:
+    """The header lines, then the columns as little-endian float64 rows or as text rows."""
+    table = np.column_stack(list(columns.values()))
     with open(temporary, "wb") as handle:
-        handle.write(("\n".join(lines) + "\n").encode("ascii"))
-        table = np.column_stack(list(columns.values()))
+        handle.write(("\n".join(header) + "\n").encode("ascii"))
         if binary:
             handle.write(np.ascontiguousarray(table, dtype="<f8").tobytes())
         else:
             np.savetxt(handle, table, fmt="%.17g")
+
+
+def _write_ply(temporary, columns, binary):
+    n = next(iter(columns.values())).shape[0]
+    lines = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0", f"element vertex {n}"]
+    _write_table(temporary, lines + [f"property double {name}" for name in columns] + ["end_header"], columns,
+                 binary)
 
 
 def _write_pcd(temporary, columns, binary):
@@ -400,13 +405,7 @@ def _write_pcd(temporary, columns, binary):
              "SIZE " + " ".join(["8"] * len(names)), "TYPE " + " ".join(["F"] * len(names)),
              "COUNT " + " ".join(["1"] * len(names)), f"WIDTH {n}", "HEIGHT 1", "VIEWPOINT 0 0 0 1 0 0 0",
              f"POINTS {n}", f"DATA {'binary' if binary else 'ascii'}"]
-    with open(temporary, "wb") as handle:
-        handle.write(("\n".join(lines) + "\n").encode("ascii"))
-        table = np.column_stack(list(columns.values()))
-        if binary:
-            handle.write(np.ascontiguousarray(table, dtype="<f8").tobytes())
-        else:
-            np.savetxt(handle, table, fmt="%.17g")
+    _write_table(temporary, lines, columns, binary)
 
 
 def _write_las(temporary, path, points, normals):
