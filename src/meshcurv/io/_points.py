@@ -70,14 +70,15 @@ def read_points(path, *, file_format: str | None = None) -> tuple[np.ndarray, np
     """
     path = check_input(path)
     suffix = _suffix(path, file_format)
-    if suffix in (".las", ".laz"):
-        return _read_las(path)
-    data = path.read_bytes()
-    if suffix == ".ply":
-        return _read_ply(data, path)
-    if suffix == ".pcd":
-        return _read_pcd(data, path)
-    return _read_text(data, path)
+    reader = {".las": _read_las, ".laz": _read_las, ".ply": _read_ply, ".pcd": _read_pcd}.get(suffix, _read_text)
+    try:
+        return reader(path)
+    except (MeshFileError, MissingDependencyError, MemoryError):
+        raise  # ours name the file; a MemoryError is a real lack of memory (sizes are checked first)
+    except OSError as exc:
+        raise MeshFileError(f"{path}: {exc.strerror or exc}") from exc
+    except Exception as exc:  # noqa: BLE001 - any other failure: one error naming the file
+        raise MeshFileError(f"{path}: cannot be read as a point cloud ({type(exc).__name__}: {exc})") from exc
 
 
 def _suffix(path: pathlib.Path, file_format: str | None) -> str:
@@ -104,7 +105,8 @@ def _split(columns: dict, path, where: str) -> tuple[np.ndarray, np.ndarray | No
 
 # -- PLY ----------------------------------------------------------------------------
 
-def _read_ply(data: bytes, path):
+def _read_ply(path):
+    data = path.read_bytes()
     file_format, elements, offset = _header(data, path)
     vertex = next((e for e in elements if e.name == "vertex"), None)
     if vertex is None:
@@ -164,8 +166,9 @@ def _floats(body: bytes, path, what: str) -> np.ndarray:
 _SEPARATORS = re.compile(rb"[,;\t ]+")
 
 
-def _read_text(data: bytes, path):
+def _read_text(path):
     """Rows of numbers separated by spaces, tabs, commas or semicolons; ``#`` and ``//`` lines are comments."""
+    data = path.read_bytes()
     lines = [line.strip() for line in data.splitlines()]
     lines = [line for line in lines if line and not line.startswith((b"#", b"//"))]
     if not lines:
@@ -204,7 +207,8 @@ _PCD_TYPES = {("F", 4): "f4", ("F", 8): "f8", ("I", 1): "i1", ("I", 2): "i2", ("
               ("U", 1): "u1", ("U", 2): "u2", ("U", 4): "u4", ("U", 8): "u8"}
 
 
-def _read_pcd(data: bytes, path):
+def _read_pcd(path):
+    data = path.read_bytes()
     header, position = {}, 0
     for _ in range(64):
         end = data.find(b"\n", position)
