@@ -4,27 +4,36 @@
 extension     format                 per-vertex fields          needs
 ============  =====================  =========================  ==================
 .obj          Wavefront OBJ          no                         (numpy)
-.ply          PLY, binary or ASCII   float properties           meshcurv[io] [1]_
+.ply          PLY, binary or ASCII   float properties           (numpy) [1]_
 .stl          STL, binary or ASCII   no                         meshcurv[io]
 .off          OFF                    no                         (numpy)
-.vtk          legacy VTK             point data, vectors        meshcurv[io]
+.vtk          legacy VTK             point data, vectors        meshcurv[io] [2]_
 .vtu          VTK XML unstructured   point data, vectors        meshcurv[io]
 .vtp          VTK XML PolyData       point data, vectors        (numpy)
 .csv          table, one row/vertex  columns (write only)       (numpy)
 .npz          numpy archive          arrays                     (numpy)
 ============  =====================  =========================  ==================
 
-.. [1] Reading a binary PLY whose faces all have the same size needs only numpy.
+.. [1] Writing PLY needs meshcurv[io]; reading needs only numpy.
+.. [2] Reading a legacy POLYDATA file (what VTK and ParaView write for
+   surfaces) needs only numpy; UNSTRUCTURED_GRID files and writing need meshio.
 
-PLY, STL, VTK and VTU go through meshio (its STL reader merges the
-repeated corners of each facet into shared vertices), except binary PLY files
-whose faces all have the same number of corners (what scanners and most tools
-write), read here in one numpy pass, without meshio (14 times faster than
-meshio's face-by-face reader: 58 ms against 0.80 s for a 1M-vertex sphere). OFF is read and
-written here (meshio reads only triangles and writes 12 digits). OBJ has its own numpy
+PLY is read here, ASCII and binary, with a bounded header parser and every
+declared count checked against the size of the file before anything is
+allocated (meshio's reader loops forever on a header cut short and allocates
+for what a header declares); faces whose records all have the same size
+(what scanners and most tools write) are read in one numpy pass (about 50 ms
+for a 1M-vertex sphere, against 0.80 s with meshio's face-by-face reader).
+Legacy VTK POLYDATA is read here too (:mod:`._vtk`); STL, UNSTRUCTURED_GRID
+.vtk and .vtu go through meshio (its STL reader merges the repeated corners
+of each facet into shared vertices), and so does writing PLY, STL, VTK and
+VTU. OFF is read and written here (meshio reads only triangles and writes 12
+digits), line by line so that face colours are ignored. OBJ has its own numpy
 reader, faster than meshio's and tolerant of ``f v/vt/vn`` corners whose
 texture coordinates outnumber the vertices; meshio has no .vtp, which has its
-own small XML module. Every failure to read or write is a
+own small XML module. Outputs are written to a temporary file and published
+atomically, without replacing a file that appeared meanwhile unless
+``overwrite=True``. Every failure to read or write is a
 :class:`~meshcurv.errors.MeshFileError` naming the file.
 """
 
@@ -162,7 +171,7 @@ def read_mesh(path, *, file_format: str | None = None) -> Mesh:
         parser cannot read (truncated, another format under this extension),
         no vertices or faces, NaN coordinates or out-of-range indices.
     MissingDependencyError
-        PLY, STL, VTK and VTU need ``pip install 'meshcurv[io]'``.
+        STL, VTU and legacy VTK other than POLYDATA need ``pip install 'meshcurv[io]'``.
 
     Examples
     --------
@@ -250,8 +259,10 @@ def write_mesh(path, vertices, faces, *, point_data=None, overwrite: bool = Fals
     Raises
     ------
     MeshFileError
-        Unknown extension, existing file without ``overwrite``, ``path`` equal
-        to ``source``, a missing folder, fields for a format that holds none.
+        Unknown extension, existing file without ``overwrite`` (also one
+        created by another writer while this one wrote), ``path`` the same
+        file as ``source`` (through any link), a missing folder or one that
+        cannot take the temporary file, fields for a format that holds none.
     InvalidMeshError
         Vertices or faces unusable (see :func:`meshcurv.principal_curvatures`).
     InvalidOptionError
