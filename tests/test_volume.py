@@ -185,6 +185,15 @@ def test_one_failing_label_does_not_sink_the_others(monkeypatch):
     assert table.error[1] == "ValueError: a fault in the estimator"
 
 
+def test_huge_label_values_keep_their_identity():
+    ball = solid((16, 16, 16), (1, 1, 1), (7.6, 7.8, 7.3), (5.0,) * 3)
+    image = np.where(ball, np.uint64(2**63 + 5), np.uint64(2**40))  # no background voxel at all
+    image[0] = 0
+    table = label_curvatures(image, labels_to_use=[2**63 + 5])
+    assert table.label.tolist() == [2**63 + 5] and table.status.tolist() == ["ok"]
+    assert table.n_voxels[0] == ball.sum()
+
+
 def test_boolean_mask_and_progress():
     mask = solid((20, 20, 20), (1, 1, 1), (9.6, 9.9, 10.2), (7.0,) * 3)
     calls = []
@@ -302,6 +311,7 @@ def run_volume(args):
         return click_testing.CliRunner().invoke(volume_command(), [str(arg) for arg in args], obj=session)
 
 
+@pytest.mark.slow  # matplotlib's import and the picture: several seconds
 def test_cli_writes_csv_and_parquet_meshes_and_picture(tmp_path):
     pytest.importorskip("pyarrow")
     pytest.importorskip("matplotlib")
@@ -334,6 +344,8 @@ def test_cli_spacing_from_nifti_and_usage_errors(tmp_path):
     result = run_volume([tmp_path / "m.nii.gz", "-o", tmp_path, "--no-picture"])
     assert result.exit_code == 0, result.output
     assert "voxel size 1 x 0.5 x 0.5 (z y x) from the file" in result.output
-    assert pandas.read_csv(tmp_path / "m_labels.csv").area[0] == pytest.approx(4 * np.pi * 36, rel=0.03)
+    table = pandas.read_parquet(tmp_path / "m_labels.parquet")
+    assert table.area[0] == pytest.approx(4 * np.pi * 36, rel=0.03)
+    assert pandas.read_csv(tmp_path / "m_labels.csv").volume[0] == pytest.approx(table.volume[0], rel=1e-12)
     assert run_volume([tmp_path / "m.nii.gz", "-o", tmp_path / "x", "--spacing", 1, 0, 1]).exit_code == 2
     assert run_volume([tmp_path / "m.nii.gz", "-o", tmp_path / "x", "--labels", "0"]).exit_code == 2

@@ -225,10 +225,11 @@ def _objects(image: np.ndarray, wanted):
         present = {index + 1: box for index, box in enumerate(found) if box is not None}
     else:  # huge label values: number them 1..n first (a full-size index array)
         values, inverse = np.unique(image, return_inverse=True)
-        inverse = inverse.reshape(image.shape)
-        found = ndimage.find_objects(inverse)
-        present = {int(values[index]): box for index, box in enumerate(found)
-                   if box is not None and values[index] != 0}
+        if values[0] != 0:  # code 0 is the background for find_objects: labels from 1 when the image has none
+            values = np.concatenate([np.zeros(1, dtype=values.dtype), values])
+            inverse += 1
+        found = ndimage.find_objects(inverse.reshape(image.shape))
+        present = {int(values[index + 1]): box for index, box in enumerate(found) if box is not None}
     if wanted is None:
         return present
     return {label: present.get(label) for label in wanted}
@@ -412,7 +413,8 @@ def _table(rows):
 
     frame = pandas.DataFrame.from_records(rows, columns=list(COLUMNS))
     for name in _INTEGER_COLUMNS:
-        frame[name] = frame[name].astype(np.int64)
+        huge = name == "label" and len(frame) > 0 and max(map(int, frame[name])) > np.iinfo(np.int64).max
+        frame[name] = frame[name].astype(np.uint64 if huge else np.int64)  # uint64 labels beyond 2**63 kept
     frame["touches_border"] = frame["touches_border"].astype(bool)
     for name in _TEXT_COLUMNS:
         frame[name] = frame[name].fillna("").astype(str)
