@@ -36,6 +36,10 @@ from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
 
+#: Per-face systems whose determinant, with the matrix scaled to a largest entry of 1, is at
+#: most this are not solved (the face's tensor is NaN): a collapsed or sliver face.
+SINGULAR_DETERMINANT = 1e-14
+
 STAGES = ("compute normals", "fit face tensors", "average vertex tensors", "retrieve curvatures")
 
 _SIX = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))  # 3x3 -> (xx, yy, zz, xy, xz, yz)
@@ -66,7 +70,15 @@ def face_second_fundamental_forms(vertices: np.ndarray, faces: np.ndarray, norma
         rhs[:, 1] += b * p + a * q
         rhs[:, 2] += b * q
     lhs[:, 1, 0], lhs[:, 2, 1] = lhs[:, 0, 1], lhs[:, 1, 2]
-    lmn = np.linalg.solve(lhs, rhs[:, :, None])[:, :, 0]
+    # only well-posed systems are solved: a singular one (a collapsed face) or one with a
+    # non-finite entry would make numpy raise LinAlgError for the whole batch; its face is NaN
+    with np.errstate(over="ignore", invalid="ignore"):
+        size = np.abs(lhs).max(axis=(1, 2))
+        unit = lhs / np.where(size > 0, size, 1.0)[:, None, None]
+        solvable = (np.isfinite(lhs).all(axis=(1, 2)) & np.isfinite(rhs).all(axis=1) & (size > 0)
+                    & (np.abs(np.linalg.det(np.where(np.isfinite(unit), unit, 0.0))) > SINGULAR_DETERMINANT))
+    lmn = np.full(rhs.shape, np.nan)
+    lmn[solvable] = np.linalg.solve(lhs[solvable], rhs[solvable][:, :, None])[:, :, 0]
     uu = e_u[:, :, None] * e_u[:, None, :]
     vv = e_v[:, :, None] * e_v[:, None, :]
     uv = e_u[:, :, None] * e_v[:, None, :]
