@@ -67,22 +67,27 @@ def _check_3d(path, array: np.ndarray) -> np.ndarray:
     return array
 
 
+def _npy_header(handle, path, where: str = ""):
+    """``(shape, dtype)`` of the .npy header at ``handle``, checked against :data:`MAX_IMAGE_BYTES`."""
+    version = np.lib.format.read_magic(handle)
+    reader = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+    if reader is None:
+        raise MeshFileError(f"{path}: unsupported .npy version {version}{where}")
+    shape, _, dtype = reader(handle)
+    if dtype.hasobject:
+        raise MeshFileError(f"{path}: the array{where} holds Python objects; an image of numbers is needed")
+    _check_size(path, shape, dtype)
+    return shape, dtype
+
+
 def _npy(path):
     try:
         with open(path, "rb") as handle:
-            version = np.lib.format.read_magic(handle)
-            reader = {(1, 0): np.lib.format.read_array_header_1_0,
-                      (2, 0): np.lib.format.read_array_header_2_0}.get(version)
-            if reader is None:
-                raise MeshFileError(f"{path}: unsupported .npy version {version}")
-            shape, _, dtype = reader(handle)
+            _npy_header(handle, path)
     except MeshFileError:
         raise
     except Exception as exc:
         raise MeshFileError(f"{path}: cannot be read as .npy ({_reason(exc)})") from exc
-    if dtype.hasobject:
-        raise MeshFileError(f"{path}: the array holds Python objects; an image of numbers is needed")
-    _check_size(path, shape, dtype)
     try:
         array = np.load(path, mmap_mode="r", allow_pickle=False)  # a file shorter than its header says fails here
     except Exception as exc:
@@ -107,15 +112,7 @@ def _npz(path):
                 raise MeshFileError(f"{path}: the member {name!r} claims {info.file_size} bytes from "
                                     f"{info.compress_size} compressed ones; the archive is corrupt")
             with archive.open(info) as member:
-                version = np.lib.format.read_magic(member)
-                reader = {(1, 0): np.lib.format.read_array_header_1_0,
-                          (2, 0): np.lib.format.read_array_header_2_0}.get(version)
-                if reader is None:
-                    raise MeshFileError(f"{path}: unsupported .npy version {version} in {name!r}")
-                shape, _, dtype = reader(member)
-            if dtype.hasobject:
-                raise MeshFileError(f"{path}: the array {name!r} holds Python objects; an image of numbers is needed")
-            _check_size(path, shape, dtype)
+                shape, dtype = _npy_header(member, path, f" {name!r}")
             if int(np.prod(shape, dtype=object)) * dtype.itemsize > info.file_size:
                 raise MeshFileError(f"{path}: the array {name!r} declares shape {shape} but the archive holds "
                                     f"only {info.file_size} bytes for it")
