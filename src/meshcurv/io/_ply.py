@@ -28,12 +28,12 @@ from __future__ import annotations
 
 import re
 import struct
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import MeshFileError
+from ._text import numbers
 
 __all__ = ["read_ply", "HEADER_LIMIT"]
 
@@ -280,12 +280,10 @@ def _split(values: np.ndarray, counts: np.ndarray):
 
 
 def _numbers(body: bytes, path) -> np.ndarray:
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            return np.fromstring(body, dtype=np.float64, sep=" ")
-    except (ValueError, DeprecationWarning):
-        raise MeshFileError(f"{path}: the body of the ASCII PLY holds something that is not a number") from None
+    values = numbers(body)
+    if values is None:
+        raise MeshFileError(f"{path}: the body of the ASCII PLY holds something that is not a number")
+    return values
 
 
 def _integers(values: np.ndarray, path, what: str) -> np.ndarray:

@@ -13,11 +13,11 @@ file before anything is allocated for it; triangle strips become triangles.
 from __future__ import annotations
 
 import re
-import warnings
 
 import numpy as np
 
 from ..errors import MeshFileError
+from ._text import numbers
 
 __all__ = ["is_polydata", "read_vtk_polydata"]
 
@@ -92,13 +92,8 @@ class _Cursor:
         if starts.size < n:
             raise MeshFileError(f"{self.path}: the file ends inside its {what} ({starts.size} of {n} numbers)")
         cut = starts[n] if starts.size > n else len(chunk)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("error")
-                values = np.fromstring(chunk[:cut], dtype=np.float64, sep=" ")
-        except (ValueError, DeprecationWarning):
-            raise MeshFileError(f"{self.path}: the {what} hold something that is not a number") from None
-        if values.size != n:
+        values = numbers(chunk[:cut])
+        if values is None or values.size != n:
             raise MeshFileError(f"{self.path}: the {what} hold something that is not a number")
         self.position += cut
         return values
