@@ -194,6 +194,11 @@ def test_huge_label_values_keep_their_identity():
     assert table.n_voxels[0] == ball.sum()
 
 
+def test_no_label_gives_an_empty_table():
+    table = label_curvatures(np.zeros((8, 8, 8), dtype=np.uint8))
+    assert table.empty and list(table.columns) == list(COLUMNS)
+
+
 def test_boolean_mask_and_progress():
     mask = solid((20, 20, 20), (1, 1, 1), (9.6, 9.9, 10.2), (7.0,) * 3)
     calls = []
@@ -279,6 +284,9 @@ def test_reader_errors_name_the_file(tmp_path):
     np.save(tmp_path / "flat.npy", np.zeros((4, 5), dtype=np.uint8))
     with pytest.raises(MeshFileError, match=r"flat.npy: a 3D image .* shape \(4, 5\)"):
         read_image(tmp_path / "flat.npy")
+    np.save(tmp_path / "objects.npy", np.empty((2, 2, 2), dtype=object), allow_pickle=True)
+    with pytest.raises(MeshFileError, match="objects.npy: the array holds Python objects"):
+        read_image(tmp_path / "objects.npy")
     (tmp_path / "a.png").write_bytes(b"\x89PNG....")
     with pytest.raises(MeshFileError, match="a.png: unknown image extension '.png'"):
         read_image(tmp_path / "a.png")
