@@ -30,7 +30,7 @@ MIN_BALL_POINTS = 6
 
 #: The normals of ``corrected_measures`` (when not given) are those of degree-3 jets over balls of
 #: ``s (a + b sqrt(max(nu - 0.005, 0)))`` (``s`` the spacing, ``nu`` the noise level): ``(a, b)``.
-NORMAL_RULE = (6.0, 45.0)
+NORMAL_RULE = (4.0, 55.0)
 
 #: Centres per chunk of ``corrected_measures`` (bounds memory: chunk x TRIANGLES triangles).
 CHUNK = 32768
