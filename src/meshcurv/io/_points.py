@@ -369,18 +369,21 @@ def write_points(path, points, normals=None, *, point_data=None, overwrite: bool
     normals = None if normals is None else np.asarray(normals, dtype=np.float64).reshape(points.shape)
     columns = _columns(points, normals, point_data)
     with atomic_output(path, overwrite=overwrite) as temporary:
-        if suffix in (".las", ".laz"):
-            _write_las(temporary, path, points, normals)
-        elif suffix == ".ply":
-            _write_ply(temporary, columns, binary)
-        elif suffix == ".pcd":
-            _write_pcd(temporary, columns, binary)
-        else:
-            separator = "," if suffix == ".csv" else " "
-            table = np.column_stack(list(columns.values()))
-            with open(temporary, "w", encoding="ascii") as handle:
-                handle.write(separator.join(columns) + "\n")
-                np.savetxt(handle, table, fmt="%.17g", delimiter=separator)
+        try:
+            if suffix in (".las", ".laz"):
+                _write_las(temporary, path, points, normals)
+            elif suffix == ".ply":
+                _write_ply(temporary, columns, binary)
+            elif suffix == ".pcd":
+                _write_pcd(temporary, columns, binary)
+            else:
+                separator = "," if suffix == ".csv" else " "
+                table = np.column_stack(list(columns.values()))
+                with open(temporary, "w", encoding="ascii") as handle:
+                    handle.write(separator.join(columns) + "\n")
+                    np.savetxt(handle, table, fmt="%.17g", delimiter=separator)
+        except OSError as exc:  # name the file asked for, not the temporary
+            raise MeshFileError(f"{path}: cannot be written ({exc.strerror or exc})") from exc
     return path
 
 
