@@ -228,3 +228,17 @@ def test_distinct_ranks_are_distinct_and_in_range():
     assert (ranks >= 0).all() and (ranks < counts[:, None, None]).all()
     assert (np.diff(np.sort(ranks, axis=2), axis=2) > 0).all()
     assert set(np.unique(ranks[0])) == {0, 1, 2}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method, h_limit", [("corrected_measures", 0.02), ("jets", 0.05)])
+def test_noisy_torus_meets_the_noise_targets(method, h_limit):
+    # 20k samples, uniform noise of 0.2 spacings along the normal (issue 16: H <= 5%, K <= 10%)
+    points, exact, k_ring = torus_points(20000, seed=7)
+    spacing = np.sqrt(4 * np.pi**2 * 3.0 / 20000)
+    noisy = points + exact * np.random.default_rng(8).uniform(-0.2, 0.2, (20000, 1)) * spacing
+    r = point_cloud_curvatures(noisy, method=method)
+    assert r.parameters["noise"] > 0.01  # the noise was seen and the radius grew
+    assert r.parameters["radius"] > 4 * r.parameters["spacing"]
+    assert np.median(np.abs(r.mean - (1.0 + k_ring) / 2)) < h_limit
+    assert np.median(np.abs(r.gaussian - k_ring)) < 2 * h_limit
