@@ -172,3 +172,24 @@ def test_paths_are_checked(tmp_path, cloud):
     with pytest.raises(MeshFileError, match=r"field 'k' must have shape \(50,\) or \(50, 3\)"):
         write_points(tmp_path / "other.ply", cloud[0], point_data={"k": np.zeros(3)})
     assert not (tmp_path / "other.ply").exists()
+
+
+def test_is_point_cloud_and_curvature_fields(tmp_path, cloud):
+    from meshcurv.io._points import is_point_cloud, write_point_curvatures
+    from meshcurv.pointcloud import point_cloud_curvatures
+
+    points = np.random.default_rng(1).normal(size=(300, 3))
+    points /= np.linalg.norm(points, axis=1, keepdims=True)
+    write_points(tmp_path / "cloud.ply", points)
+    mesh = tmp_path / "mesh.ply"
+    mesh.write_bytes(b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                     b"property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                     b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    assert is_point_cloud(tmp_path / "cloud.ply") and not is_point_cloud(mesh)
+    assert is_point_cloud(tmp_path / "scan.laz") and not is_point_cloud(tmp_path / "m.obj")
+    result = point_cloud_curvatures(points)
+    write_point_curvatures(tmp_path / "out.csv", points, result, fields=["k_max", "normals"])
+    header = (tmp_path / "out.csv").read_text().splitlines()[0].split(",")
+    assert header == ["x", "y", "z", "k_max", "normals_x", "normals_y", "normals_z", "quality"]
+    table = np.loadtxt(tmp_path / "out.csv", delimiter=",", skiprows=1)
+    np.testing.assert_array_equal(table[:, 3], result.k_max)

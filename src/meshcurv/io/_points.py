@@ -33,9 +33,9 @@ import numpy as np
 
 from ..errors import MeshFileError, MeshQualityWarning, MissingDependencyError
 from ._files import atomic_output, check_input, check_output
-from ._ply import _ORDERS, _header
+from ._ply import _ORDERS, HEADER_LIMIT, _header
 
-__all__ = ["read_points", "write_points", "POINT_EXTENSIONS"]
+__all__ = ["read_points", "write_points", "write_point_curvatures", "is_point_cloud", "POINT_EXTENSIONS"]
 
 _TEXT = (".xyz", ".txt", ".pts", ".csv")
 
@@ -79,6 +79,41 @@ def read_points(path, *, file_format: str | None = None) -> tuple[np.ndarray, np
         raise MeshFileError(f"{path}: {exc.strerror or exc}") from exc
     except Exception as exc:  # noqa: BLE001 - any other failure: one error naming the file
         raise MeshFileError(f"{path}: cannot be read as a point cloud ({type(exc).__name__}: {exc})") from exc
+
+
+def is_point_cloud(path) -> bool:
+    """Whether ``path`` holds a point cloud: a points-only format, or a PLY whose header declares no faces.
+
+    For the command line's choice between :func:`meshcurv.read_mesh` and
+    :func:`read_points`; reads at most the PLY header. False for unknown or
+    unreadable files (the mesh reader then says why).
+    """
+    path = pathlib.Path(path)
+    suffix = path.suffix.lower()
+    if suffix in (".xyz", ".pts", ".pcd", ".las", ".laz"):
+        return True
+    if suffix != ".ply":
+        return False
+    try:
+        with open(path, "rb") as handle:
+            _, elements, _ = _header(handle.read(HEADER_LIMIT + 64), path)
+    except (OSError, MeshFileError):
+        return False
+    return not any(e.name == "face" and e.count > 0 for e in elements)
+
+
+def write_point_curvatures(path, points, result, *, fields=None, quality: str | None = "mean",
+                           overwrite: bool = False, source=None, binary: bool = True) -> pathlib.Path:
+    """Write a point cloud with the fields of a curvature result (those of :func:`meshcurv.io.write_curvatures`).
+
+    ``write_points(path, points, point_data=curvature_fields(result, ...))``:
+    the normals go out as ``normals_x ...`` with the other fields (``nx ...``
+    only when passed to :func:`write_points` directly).
+    """
+    from .fields import curvature_fields
+
+    return write_points(path, points, point_data=curvature_fields(result, fields=fields, quality=quality),
+                        overwrite=overwrite, source=source, binary=binary)
 
 
 def _suffix(path: pathlib.Path, file_format: str | None) -> str:
