@@ -203,7 +203,7 @@ def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     lengths = edge_lengths(vertices, edges)
     if lengths.size == 0:
         return 0.0
-    median = float(np.median(lengths))
+    median = float(np.median(lengths[::max(1, lengths.size // MEDIAN_SAMPLE)]))  # a threshold: a sample will do
     longest = float(lengths.max())
     if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean, to the last bit
         return mean_edge_length(vertices, edges)
