@@ -288,9 +288,11 @@ def markdown(rows, n, command):
              "median angle of dir_max to the exact direction where |k_max - k_min| > s/2, share of normals on the",
              "exact (outward) side, time in seconds (one process, 2 cores). Noise: uniform along the exact normal,",
              "amplitude in mean spacings sqrt(area / N). MeshLab APSS reports mean and Gaussian curvature only",
-             "(principal values from them; no directions); its sign is taken on the side that fits best.", "",
-             "| surface | sampling | noise | normals | method | H | K | dir (deg) | out | cover | time (s) | radius |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "(principal values from them; no directions); its sign is taken on the side that fits best; it runs",
+             "with its default parameters. The given normals are the exact ones at the unperturbed points.", ""]
+    lines += _summary(rows) + ["## All rows", "",
+                               "| surface | sampling | noise | normals | method | H | K | dir (deg) | out | cover "
+                               "| time (s) | radius |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for surface, sampling, level, normals, method, e, seconds, radius in rows:
         if "failed" in e:
             lines.append(f"| {surface} | {sampling} | {level:g} | {normals} | {method} | failed: {e['failed']} "
@@ -301,6 +303,26 @@ def markdown(rows, n, command):
                      f"| {direction} | {e['out']:.3f} | {e['cover']:.3f} | {seconds:.2f} | "
                      f"{'' if radius is None else f'{radius:.4g}'} |")
     return "\n".join(lines) + "\n"
+
+
+def _summary(rows):
+    """Worst median error of H / K over sampling and normals, per surface, noise and method."""
+    worst = {}
+    for surface, _, level, _, method, e, _, _ in rows:
+        if "failed" in e:
+            continue
+        key = (surface, level, method)
+        h, k = worst.get(key, (0.0, 0.0))
+        worst[key] = (max(h, e["H"]), max(k, e["K"]))
+    methods = list(dict.fromkeys(key[2] for key in worst))
+    lines = ["## Summary: worst median error of H / K over sampling (uniform or not) and normals (given or "
+             "estimated)", "", "| surface | noise | " + " | ".join(methods) + " |",
+             "|---|---|" + "---|" * len(methods)]
+    for surface, level in dict.fromkeys((key[0], key[1]) for key in worst):
+        cells = [f"{_pct(worst[surface, level, m][0])} / {_pct(worst[surface, level, m][1])}"
+                 if (surface, level, m) in worst else "-" for m in methods]
+        lines.append(f"| {surface} | {level:g} | " + " | ".join(cells) + " |")
+    return lines + [""]
 
 
 def speed(sizes=(10_000, 100_000, 1_000_000), methods=POINT_CLOUD_METHODS):
@@ -343,7 +365,12 @@ def main(argv=None):
         text = ["", "## Speed (torus samples, normals estimated, end to end)", "",
                 "| points | method | seconds |", "|---|---|---|"]
         text += [f"| {n} | {m} | {s:.2f} |" for n, m, s in rows]
+        text.append(f"\nProduced by `{command.strip()}` (commit {_git_head()}).")
         print("\n".join(text))
+        output = Path(args.output)
+        if output.exists():
+            kept = output.read_text().split("\n## Speed")[0].rstrip("\n")
+            output.write_text(kept + "\n" + "\n".join(text) + "\n")
         return 0
     surfaces = ("ellipsoid", "torus") if args.quick else SURFACES
     rows = run(surfaces, NOISE, args.n, peer=not (args.quick or args.no_peer))
