@@ -56,6 +56,24 @@ def one_line(text: str) -> str:
     return lines[0]
 
 
+def run_bounded(argv, *, timeout: float = 60, memory: int = 8 * 2**30) -> subprocess.CompletedProcess:
+    """Run ``argv`` in its own session with at most ``memory`` bytes of address space; a hang fails the test."""
+    import resource
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+
+    process = subprocess.Popen([os.fspath(arg) for arg in argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, preexec_fn=limit, start_new_session=True)
+    try:
+        out, err = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, 9)  # the command and whatever it started
+        process.communicate()
+        pytest.fail(f"{argv} did not end within {timeout} s")
+    return subprocess.CompletedProcess(argv, process.returncode, out, err)
+
+
 def run_child(code: str, *, timeout: float, cwd=None) -> dict:
     """Run ``code`` in a new Python; it prints one JSON line last, returned. A hang fails the test."""
     try:
@@ -428,8 +446,6 @@ def test_an_input_without_read_permission_is_exit_1_and_one_line(tmp_path):
     (["compute", "{mesh}", "-m", "matgeom", "--smoothing-steps", str(2**63)], "--smoothing-steps"),
     (["compute", "{mesh}", "--radius", "1e400"], "--radius"),
     (["compute", "{mesh}", "--radius", "inf"], "--radius"),
-    (["plot", "{mesh}", "--pixels", "100000"], "--pixels"),
-    (["batch", "{mesh}", "-o", "{out}", "--workers", "99999999999999999999"], "--workers"),
     (["batch", "{mesh}", "-o", "{out}", "--timeout", "1e400"], "--timeout"),
 ])
 def test_option_values_beyond_any_bound_are_one_usage_line(tmp_path, capsys, arguments, option):
@@ -438,30 +454,66 @@ def test_option_values_beyond_any_bound_are_one_usage_line(tmp_path, capsys, arg
     assert main(argv) == 2
     line = one_line(capsys.readouterr().err)
     assert line.startswith(f"meshcurv: error: Invalid value for '{option}'") and "--help" in line
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("arguments, option", [
+    (["plot", "{mesh}", "--pixels", "100000"], "--pixels"),  # was a 75 GiB z-buffer
+    (["batch", "{mesh}", "-o", "{out}", "--workers", "99999999999999999999"], "--workers"),  # was that many processes
+])
+def test_option_values_that_would_take_the_machine_are_refused_first(tmp_path, arguments, option):
+    """In a process of its own with 8 GiB of address space and a timeout: a regression fails, it does not kill."""
+    (mesh,) = write_meshes(tmp_path, ["m.obj"])
+    done = run_bounded([*MESHCURV, *(item.format(mesh=mesh, out=tmp_path / "out") for item in arguments)])
+    assert done.returncode == 2, done.stderr[-2000:]
+    line = one_line(done.stderr)
+    assert line.startswith(f"meshcurv: error: Invalid value for '{option}'") and "--help" in line
     assert not (tmp_path / "out").exists() and not list(tmp_path.glob("*.png"))
 
 
 # ------------------------------------------------------------------------- 8. pictures too large
 
 
-def test_pixels_beyond_the_bound_or_the_memory_are_refused_before_allocating(monkeypatch):
+def test_pixels_beyond_the_bound_or_the_memory_are_refused_before_allocating(tmp_path):
+    """In a child with 8 GiB of address space: the old code's 75 GiB z-buffer is a failure, not the OOM killer."""
     pytest.importorskip("matplotlib")
-    from meshcurv import plotting
+    code = f"""
+import json, os
+from meshcurv import plotting, shapes
+from meshcurv.errors import InvalidOptionError
 
-    torus = shapes.torus(12, 4, 8, 4)
-    values = torus.vertices[:, 0]
-    with pytest.raises(InvalidOptionError, match=r"`pixels` must be an integer between 16 and 8192.*; got 100000"):
-        plotting.plot_field(torus.vertices, torus.faces, values, pixels=100_000)
-    with pytest.raises(InvalidOptionError, match=r"`pixels` must be an integer between 16 and 8192"):
-        plotting.plot_field(torus.vertices, torus.faces, values, pixels=2**64)
-    monkeypatch.setattr(plotting, "_available_memory", lambda: 2 * 2**30)
-    with pytest.raises(InvalidOptionError, match=r"`pixels`=8192 needs about 6\.0 GiB for each view; 2\.0 GiB of "
-                                                 r"memory is available"):
-        plotting.plot_field(torus.vertices, torus.faces, values, pixels=8192)
-    figure = plotting.plot_field(torus.vertices, torus.faces, values, pixels=64)
-    with pytest.raises(InvalidOptionError, match=r"`dpi` must be an integer between 10 and 1200.*; got 100000"):
-        plotting.save_figure(figure, "never.png", dpi=100_000)
-    assert not os.path.exists("never.png")
+torus = shapes.torus(12, 4, 8, 4)
+values = torus.vertices[:, 0]
+messages = []
+
+def refused(call):
+    try:
+        call()
+    except (InvalidOptionError, MemoryError) as exc:
+        messages.append(f"{{type(exc).__name__}}: {{exc}}")
+    else:
+        messages.append(None)
+
+refused(lambda: plotting.plot_field(torus.vertices, torus.faces, values, pixels=100_000))
+refused(lambda: plotting.plot_field(torus.vertices, torus.faces, values, pixels=2**64))
+plotting._available_memory = lambda: 2 * 2**30
+refused(lambda: plotting.plot_field(torus.vertices, torus.faces, values, pixels=8192))
+figure = plotting.plot_field(torus.vertices, torus.faces, values, pixels=64)
+refused(lambda: plotting.save_figure(figure, {os.fspath(tmp_path / "never.png")!r}, dpi=100_000))
+print(json.dumps(messages))
+"""
+    done = run_bounded([sys.executable, "-c", code])
+    assert done.returncode == 0, done.stderr[-2000:]
+    messages = json.loads(done.stdout.splitlines()[-1])
+    assert re.fullmatch(r"InvalidOptionError: `pixels` must be an integer between 16 and 8192.*; got 100000",
+                        messages[0])
+    assert re.fullmatch(r"InvalidOptionError: `pixels` must be an integer between 16 and 8192.*; got \d+",
+                        messages[1])
+    assert messages[2] == ("InvalidOptionError: `pixels`=8192 needs about 6.0 GiB for each view; 2.0 GiB of memory "
+                           "is available: give fewer pixels")
+    assert re.fullmatch(r"InvalidOptionError: `dpi` must be an integer between 10 and 1200.*; got 100000",
+                        messages[3])
+    assert not (tmp_path / "never.png").exists()
 
 
 # ------------------------------------------------------------------------- 9. two commands, one output
