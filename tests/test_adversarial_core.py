@@ -103,12 +103,7 @@ def test_robust_edge_statistics_ignore_the_spike():
 
 
 @pytest.mark.parametrize("scales", [(1e-3, 1e3), (1e-6, 1e6)])
-@pytest.mark.parametrize("method", [
-    *(m for m in CORE_METHODS if m != "icc"),
-    pytest.param("icc", marks=pytest.mark.xfail(strict=True, reason=(
-        "icc takes one default radius for the whole mesh (estimators/icc.py): it needs one per group of "
-        "components of one scale, as neighborhoods.default_radii gives quadric and normal_cycle_ball"))),
-])
+@pytest.mark.parametrize("method", CORE_METHODS)
 def test_components_of_different_scales_each_get_their_curvature(method, scales):
     small, large = scales
     vertices = np.vstack([SPHERE.vertices * small, SPHERE.vertices * large])

@@ -66,10 +66,9 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from .._backend import numba_kernels
-from .._validation import check_positive_float
 from ..geometry import robust_mean_edge_length, vertex_edge_lengths
 from ..lattice import voxel_grid
-from ..neighborhoods import ball_face_sums
+from ..neighborhoods import ball_face_sums, check_radius, default_radii
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -292,14 +291,34 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
 
     stages.start("measure noise")
     referenced = topology.referenced_vertices
-    if radius is None:
-        edge_length = robust_mean_edge_length(vertices, topology.edges)
-        level = (noise_level(vertices, normals, valid, topology.edges, neighbours=referenced)
-                 if edge_length > 0 else 0.0)
-        radius, found = float(default_radius(level, edge_length)), {"surface": "smooth", "noise": level}
+    if radius is None:  # each group of components of one scale (usually the whole mesh) at its own default
+        groups, levels = [], []
+        for group_radius, members in default_radii(vertices, topology):
+            inside = valid if members is None else valid & np.isin(np.arange(vertices.shape[0]), members)
+            edges = topology.edges if members is None else topology.edges[inside[topology.edges[:, 0]]]
+            edge_length = robust_mean_edge_length(vertices, edges)
+            level = (noise_level(vertices, normals, inside, edges, neighbours=referenced)
+                     if edge_length > 0 else 0.0)
+            groups.append((float(default_radius(level, edge_length)), members))
+            levels.append(level)
+        found = {"surface": "smooth", "noise": levels[0] if len(levels) == 1 else levels}
     else:
-        radius, found = check_positive_float(radius, "radius"), {}
-    parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius, **found}
-    k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
-        vertices, topology.faces, degenerate, normals, valid, radius, stages, neighbours=referenced)
+        groups, found = [(check_radius(radius, vertices, topology), None)], {}
+    # one radius; a list of them (one per group of components of one scale) when the scales differ
+    radii = [group_radius for group_radius, _ in groups]
+    parameters = {"radius": radii[0] if len(radii) == 1 else radii,
+                  "normal_radius": NORMAL_RADIUS_RATIO * radii[0] if len(radii) == 1
+                  else [NORMAL_RADIUS_RATIO * r for r in radii], **found}
+    fields = None
+    for group_radius, members in groups:
+        computed = _curvatures(vertices, topology.faces, degenerate, normals, valid, group_radius,
+                               stages if fields is None else None, neighbours=referenced)
+        if members is None:
+            fields = computed
+            continue
+        if fields is None:
+            fields = tuple(np.array(field, copy=True) for field in computed)
+        for field, values in zip(fields, computed):
+            field[members] = values[members]
+    k_min, k_max, dir_min, dir_max, normals, valid = fields
     return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects)
