@@ -1,0 +1,907 @@
+"""Fuzz the public API: ``python benchmarks/fuzz_api.py --minutes N [--seed S] [--timeout T]``.
+
+Adversarial inputs for :func:`meshcurv.principal_curvatures` (every method of
+:data:`meshcurv.METHODS`, every option, garbage option values),
+:func:`meshcurv.pointcloud.point_cloud_curvatures`, :func:`meshcurv.diagnose`,
+:func:`meshcurv.orient_faces`, :meth:`meshcurv.MeshTopology.from_faces`,
+:func:`meshcurv.triangulate_faces`, :func:`meshcurv.smooth_vertex_field` and the
+public functions of :mod:`meshcurv.geometry`. Meshes come from
+:mod:`meshcurv.shapes`, mutated (extreme scales, spikes, NaN, duplicate and
+collapsed vertices, random, degenerate and non-manifold faces, soups, mixed
+component scales, masked arrays, odd dtypes, lists, empty arrays, huge or
+1-based indices, Fortran-ordered, strided and read-only arrays).
+
+Each call runs in a forked child with a wall-clock limit (``--timeout``) and an
+address-space limit (``RLIMIT_AS``: the parent's size plus ``--memory`` MiB
+plus ``--factor`` times the bytes of the input), so a hang or a blow-up is a
+finding, not a stuck run. A finding is:
+
+- an exception other than the documented ones (``InvalidMeshError``,
+  ``InvalidOptionError``, ``MeshFileError``, ``MissingDependencyError``);
+- a child killed by a signal, out of time, or out of memory (``MemoryError``);
+- a successful ``principal_curvatures``/``point_cloud_curvatures`` result
+  that breaks a documented invariant: one row per input vertex, float64
+  read-only arrays, ``k_min <= k_max``, finite curvatures and unit normals and
+  directions where ``valid``, NaN curvatures where not valid (matgeom: zero
+  allowed at unreferenced vertices), ``invalid_reason == 0`` exactly where
+  valid, ``mean``/``gaussian`` consistent, input arrays not modified;
+- a scale mismatch: a clean shape scaled by ``s`` must give the same valid
+  mask and curvatures divided by ``s`` (``matgeom``: unchanged).
+
+Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
+
+numba's default ``omp`` layer (GNU OpenMP) aborts a child forked after a
+parallel region ran, so this script selects the ``workqueue`` layer unless
+``NUMBA_THREADING_LAYER`` is set; a quarter of the cases run with
+``MESHCURV_BACKEND=numpy`` (the NumPy paths).
+
+Output: one JSON line per finding in ``--log`` (default
+``benchmarks/fuzz_api.jsonl``), a summary on stdout. ``--replay I --seed S``
+runs case ``I`` in this process and prints its inputs and traceback.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("NUMBA_THREADING_LAYER", "workqueue")
+
+import argparse  # noqa: E402
+import collections  # noqa: E402
+import fractions  # noqa: E402
+import inspect  # noqa: E402
+import json  # noqa: E402
+import pickle  # noqa: E402
+import resource  # noqa: E402
+import select  # noqa: E402
+import signal  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+import traceback  # noqa: E402
+import warnings  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+import meshcurv  # noqa: E402
+from meshcurv import geometry, shapes  # noqa: E402
+from meshcurv.errors import (  # noqa: E402
+    InvalidMeshError,
+    InvalidOptionError,
+    MeshcurvWarning,
+    MeshFileError,
+    MissingDependencyError,
+)
+
+try:
+    from meshcurv import pointcloud
+except ImportError:  # pragma: no cover
+    pointcloud = None
+
+DOCUMENTED = (InvalidMeshError, InvalidOptionError, MeshFileError, MissingDependencyError)
+METHODS = tuple(meshcurv.METHODS)
+BALL_METHODS = ("icc", "quadric", "normal_cycle_ball")
+SMOOTHING_METHODS = ("normal_cycle", "matgeom")
+
+
+# ----------------------------------------------------------------------------- base meshes
+
+def base_meshes():
+    """Small clean shapes: ``(name, vertices, faces)``."""
+    return [
+        ("icosphere", shapes.icosphere(subdivisions=6)),
+        ("uv_sphere", shapes.uv_sphere(n_longitude=12, n_latitude=8)),
+        ("torus", shapes.torus(n_major=16, n_minor=8)),
+        ("cylinder", shapes.cylinder(n_around=12, n_along=6)),
+        ("saddle", shapes.saddle(spacing=0.2)),
+        ("hemisphere", shapes.hemisphere(subdivisions=6)),
+        ("ellipsoid", shapes.ellipsoid(subdivisions=5)),
+        ("random_sphere", shapes.random_sphere(n_vertices=200)),
+        ("voxel_sphere", shapes.voxel_sphere(radius=4.0)),
+    ]
+
+
+BASES = [(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)) for name, m in base_meshes()]
+
+# ----------------------------------------------------------------------------- garbage values
+
+BIG_INTS = [2**31, 2**31 - 1, 2**32, 2**53 + 1, 2**63 - 1, 2**63, 2**64, 10**400, -(2**63), -1]
+FLOATS = [0.0, -0.0, -1.0, 1e-300, 5e-324, 1e-12, 1e300, 1.7976931348623157e308, float("inf"),
+          float("-inf"), float("nan")]
+
+
+def garbage(rng, kind: str):
+    """A value that a careless or hostile caller could pass for an option."""
+    pool = [None, True, False, "0.5", "abc", "", b"1", [1], (1, 2), {}, object(), np.array(1.5),
+            np.array([1.0, 2.0]), np.float32(0.5), np.float16(2.0), np.int8(3), np.uint64(2**63),
+            np.int64(-5), np.bool_(True), np.longdouble(0.5), 1 + 0j, np.complex128(1.0), fractions.Fraction(1, 3),
+            np.nan, np.ma.masked, 1.5, 2.0]
+    pool += BIG_INTS + FLOATS
+    if kind == "radius":
+        pool += [0.1, 0.5, 2.0, 1e3, 1e6, 1e10, 10**400, np.float64(np.nextafter(0, 1))]
+    elif kind == "steps":
+        pool += [0, 1, 3, 50, 10**4, 10**6, 10**9]
+    return pool[rng.integers(len(pool))]
+
+
+# ----------------------------------------------------------------------------- mesh mutations
+
+def _rows(rng, n, k):
+    return rng.choice(n, size=min(k, n), replace=False) if n else np.zeros(0, np.int64)
+
+
+def m_scale(rng, v, f):
+    e = int(rng.choice([-300, -200, -150, -100, -30, -12, -6, 6, 12, 30, 75, 76, 77, 100, 150, 200, 300]))
+    return v * 10.0**e, f, f"scale 1e{e}"
+
+
+def m_translate(rng, v, f):
+    t = float(rng.choice([1e6, 1e10, 1e15, 1e20, -1e300]))
+    return v + t, f, f"translate {t:g}"
+
+
+def m_spike(rng, v, f):
+    value = float(rng.choice([1e10, -1e10, 1e75, 1e150, 1e300, 1.7e308]))
+    v = v.copy()
+    for i in _rows(rng, len(v), int(rng.integers(1, 4))):
+        v[i, rng.integers(3)] = value
+    return v, f, f"spike {value:g}"
+
+
+def m_nonfinite(rng, v, f):
+    v = v.copy()
+    if len(v):
+        v[rng.integers(len(v)), rng.integers(3)] = rng.choice([np.nan, np.inf, -np.inf])
+    return v, f, "nonfinite vertex"
+
+
+def m_duplicate(rng, v, f):
+    """Copies of some vertices, some faces rewired to them (split seams)."""
+    if not len(v) or not len(f):
+        return v, f, "duplicate(noop)"
+    pick = _rows(rng, len(v), max(1, len(v) // 5))
+    new = np.arange(len(v), len(v) + len(pick))
+    v = np.concatenate([v, v[pick]])
+    remap = np.arange(len(v))
+    remap[pick] = new
+    f = f.copy()
+    rows = _rows(rng, len(f), len(f) // 2)
+    f[rows] = remap[f[rows]]
+    return v, f, "duplicate vertices"
+
+
+def m_soup(rng, v, f):
+    return v[f.ravel()].copy(), np.arange(f.size, dtype=np.int64).reshape(-1, 3), "soup"
+
+
+def m_collapse(rng, v, f):
+    v = v.copy()
+    if len(f):
+        for face in f[_rows(rng, len(f), max(1, len(f) // int(rng.choice([1, 3, 20, 100]))))]:
+            v[face[1]] = v[face[0]]
+    return v, f, "collapsed edges"
+
+
+def m_all_same(rng, v, f):
+    return np.zeros_like(v) + float(rng.choice([0.0, 1.0, 1e300])), f, "all vertices coincide"
+
+
+def m_flat(rng, v, f):
+    v = v.copy()
+    v[:, int(rng.integers(3))] = 0.0
+    return v, f, "flattened"
+
+
+def m_collinear(rng, v, f):
+    t = rng.random(len(v))
+    return np.stack([t, 2 * t, 3 * t], axis=1), f, "collinear"
+
+
+def m_random_faces(rng, v, f):
+    n = max(len(v), 1)
+    return v, rng.integers(0, n, size=(int(rng.integers(0, 3 * n + 1)), 3)), "random faces"
+
+
+def m_degenerate_faces(rng, v, f):
+    if not len(f):
+        return v, f, "degenerate(noop)"
+    f = f.copy()
+    rows = _rows(rng, len(f), max(1, len(f) // 10))
+    f[rows, 1] = f[rows, 0]
+    if rng.random() < 0.5:
+        f[rows, 2] = f[rows, 0]
+    return v, f, "repeated corners"
+
+
+def m_nonmanifold(rng, v, f):
+    if not len(f):
+        return v, f, "nonmanifold(noop)"
+    extra = []
+    for face in f[_rows(rng, len(f), 5)]:
+        apex = int(rng.integers(len(v)))
+        extra += [[face[0], face[1], apex], [face[1], face[0], apex]]
+    if rng.random() < 0.5:  # a fan of faces on one edge
+        a, b = f[0, 0], f[0, 1]
+        extra += [[a, b, int(rng.integers(len(v)))] for _ in range(6)]
+    return v, np.concatenate([f, np.asarray(extra, np.int64)]), "non-manifold edges"
+
+
+def m_bowtie(rng, v, f):
+    """A second copy of the mesh glued at one vertex."""
+    n = len(v)
+    w = v + (v.max(0) - v.min(0)) * 1.0 + 0.0 if n else v
+    g = f + n
+    if n:
+        g[g == n] = 0  # vertex 0 shared
+    return np.concatenate([v, w]), np.concatenate([f, g]), "bow-tie (two copies joined at a vertex)"
+
+
+def m_duplicate_faces(rng, v, f):
+    if not len(f):
+        return v, f, "dupfaces(noop)"
+    rows = _rows(rng, len(f), max(1, len(f) // 4))
+    extra = f[rows][:, [0, 2, 1]] if rng.random() < 0.5 else f[rows]
+    return v, np.concatenate([f, extra]), "duplicate faces"
+
+
+def m_flip(rng, v, f):
+    f = f.copy()
+    rows = _rows(rng, len(f), int(rng.integers(0, len(f) + 1)))
+    f[rows] = f[rows][:, [0, 2, 1]]
+    return v, f, "flipped faces"
+
+
+def m_holes(rng, v, f):
+    keep = rng.random(len(f)) > float(rng.choice([0.1, 0.5, 0.95, 1.0]))
+    return v, f[keep], "faces removed"
+
+
+def m_unreferenced(rng, v, f):
+    n = int(rng.integers(1, 50))
+    extra = rng.normal(size=(n, 3)) * (v.std() if len(v) else 1.0)
+    return np.concatenate([v, extra]), f, "unreferenced vertices"
+
+
+def m_components(rng, v, f):
+    a, b = (10.0 ** float(rng.choice([-12, -6, -3, 0, 3, 6, 12])) for _ in range(2))
+    other = BASES[int(rng.integers(len(BASES)))]
+    w = other[1] * b + 5 * b
+    return np.concatenate([v * a, w]), np.concatenate([f, other[2] + len(v)]), f"components scaled {a:g} and {b:g}"
+
+
+def m_noise(rng, v, f):
+    scale = float(rng.choice([1e-9, 1e-3, 0.1, 1.0, 10.0]))
+    return v + rng.normal(size=v.shape) * scale * (v.std() if len(v) else 1.0), f, f"noise {scale:g}"
+
+
+def m_empty(rng, v, f):
+    choice = int(rng.integers(4))
+    if choice == 0:
+        return v, f[:0], "no faces"
+    if choice == 1:
+        return v[:0], f[:0], "empty mesh"
+    if choice == 2:
+        return v[:3], np.array([[0, 1, 2]]), "one face"
+    return v[:2], np.array([[0, 1, 1]]), "one degenerate face on two vertices"
+
+
+def m_indices(rng, v, f):
+    f = f.copy()
+    choice = int(rng.integers(5))
+    if not len(f):
+        return v, f, "indices(noop)"
+    if choice == 0:
+        return v, f + 1, "1-based faces"
+    if choice == 1:
+        f[rng.integers(len(f)), rng.integers(3)] = int(rng.choice([len(v), 2**31, 2**62, 2**63 - 1]))
+        return v, f, "index out of range"
+    if choice == 2:
+        f[rng.integers(len(f)), rng.integers(3)] = int(rng.choice([-1, -len(v), -(2**63)]))
+        return v, f, "negative index"
+    if choice == 3:
+        return v, f[:, ::-1], "all faces reversed (strided)"
+    perm = rng.permutation(len(v))
+    inverse = np.argsort(perm)
+    return v[perm], inverse[f], "vertices permuted"
+
+
+MUTATIONS = [m_scale, m_translate, m_spike, m_nonfinite, m_duplicate, m_soup, m_collapse, m_all_same, m_flat,
+             m_collinear, m_random_faces, m_degenerate_faces, m_nonmanifold, m_bowtie, m_duplicate_faces, m_flip,
+             m_holes, m_unreferenced, m_components, m_noise, m_empty, m_indices]
+# the rarer, more destructive mutations get lower weight
+WEIGHTS = np.array([3, 1, 2, 1, 2, 2, 2, 0.5, 1, 0.5, 1, 2, 2, 1, 1, 1, 1, 2, 2, 1, 0.5, 1.5])
+WEIGHTS = WEIGHTS / WEIGHTS.sum()
+
+
+# ----------------------------------------------------------------------------- container wrappers
+
+def wrap_vertices(rng, v):
+    choice = int(rng.integers(20))
+    if choice == 0:
+        return v.tolist(), "list"
+    if choice == 1:
+        return np.asfortranarray(v), "fortran"
+    if choice == 2:
+        big = np.zeros((len(v) * 2, 6))
+        big[::2, ::2] = v
+        return big[::2, ::2], "strided"
+    if choice == 3:
+        r = v.copy()
+        r.flags.writeable = False
+        return r, "read-only"
+    if choice == 4:
+        dtype = rng.choice(["float32", "float16", "longdouble", ">f8", "int64", "uint8", "bool", "complex128",
+                            "object"])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return v.astype(str(dtype)), f"dtype {dtype}"
+    if choice == 5:
+        mask = np.zeros(v.shape, bool)
+        if len(v) and rng.random() < 0.7:
+            mask[rng.integers(len(v)), 0] = True
+        return np.ma.masked_array(v, mask=mask), "masked"
+    if choice == 6:
+        return v[:, :2] if rng.random() < 0.5 else np.concatenate([v, v[:, :1]], axis=1), "wrong width"
+    if choice == 7:
+        return v.ravel(), "flat"
+    if choice == 8:
+        return v.astype(str), "strings"
+    return v, "array"
+
+
+def wrap_faces(rng, f):
+    choice = int(rng.integers(24))
+    if choice == 0:
+        return f.tolist(), "list"
+    if choice == 1:
+        return np.asfortranarray(f), "fortran"
+    if choice == 2:
+        return f.astype(rng.choice(["int32", "uint32", "uint64", "int16", "uint8", "int8", ">i8"])), "int dtype"
+    if choice == 3:
+        return f.astype(float) + (0.5 if rng.random() < 0.3 else 0.0), "float faces"
+    if choice == 4:
+        return f.astype(bool), "bool faces"
+    if choice == 5:
+        r = f.copy()
+        r.flags.writeable = False
+        return r, "read-only"
+    if choice == 6:
+        mask = np.zeros(f.shape, bool)
+        if len(f):
+            mask[rng.integers(len(f)), 1] = True
+        return np.ma.masked_array(f, mask=mask), "masked"
+    if choice == 7 and len(f) >= 2:  # quads and a ragged list of polygons
+        quads = np.concatenate([f[:-1], f[1:, :1]], axis=1)
+        return (quads if rng.random() < 0.5 else [list(q) for q in quads] + [list(f[0])]), "polygons"
+    if choice == 8:
+        return f.ravel(), "flat"
+    if choice == 9:
+        return [list(face[: int(rng.integers(0, 4))]) for face in f[:5]], "short polygons"
+    if choice == 10:
+        return f.astype(object), "object"
+    if choice == 11:
+        try:
+            return meshcurv.MeshTopology.from_faces(f, len(f) and int(f.max()) + int(rng.integers(0, 3))), "topology"
+        except Exception:  # noqa: BLE001 - then the plain array
+            return f, "array"
+    return f, "array"
+
+
+# ----------------------------------------------------------------------------- cases
+
+def make_mesh(rng):
+    name, v, f = BASES[int(rng.integers(len(BASES)))]
+    labels = [name]
+    n_mut = int(rng.choice([0, 1, 1, 2, 2, 3]))
+    for mutation in rng.choice(len(MUTATIONS), size=n_mut, p=WEIGHTS):
+        try:
+            with np.errstate(all="ignore"):
+                v, f, label = MUTATIONS[mutation](rng, v, f)
+        except (IndexError, ValueError):  # a mutation that does not apply to what earlier ones left
+            continue
+        labels.append(label)
+    return np.asarray(v, float), np.asarray(f, np.int64), labels
+
+
+def make_case(seed: int, index: int):
+    """``(target, args, kwargs, labels, clean)``, deterministic in ``(seed, index)``.
+
+    ``clean`` is None, or ``(scale, args0, kwargs0)`` for a scale-invariance check.
+    """
+    rng = np.random.default_rng([seed, index])
+    v, f, labels = make_mesh(rng)
+    roll = rng.random()
+    clean = None
+    if roll < 0.55:
+        target = "principal_curvatures"
+        method = METHODS[int(rng.integers(len(METHODS)))] if rng.random() > 0.03 else garbage(rng, "method")
+        kwargs = {"method": method}
+        if rng.random() < 0.5:
+            kwargs["radius"] = garbage(rng, "radius") if rng.random() < 0.5 else float(
+                rng.choice([0.01, 0.1, 0.3, 1.0, 3.0, 30.0, 1e4])) * (float(np.ptp(v)) if v.size else 1.0)
+        if rng.random() < 0.4:
+            kwargs["smoothing_steps"] = garbage(rng, "steps") if rng.random() < 0.5 else int(rng.integers(0, 20))
+        if rng.random() < 0.3:
+            kwargs["orient"] = rng.choice(["auto", "outward", "consistent", "keep", "KEEP", "", "in"]) \
+                if rng.random() < 0.9 else garbage(rng, "orient")
+        if rng.random() < 0.3:
+            kwargs["weld"] = [True, False, None, np.bool_(True), 1, 0, "yes", np.array(True)][int(rng.integers(8))]
+        if isinstance(method, str) and method in METHODS:  # keep most calls well-formed in their options
+            if method not in BALL_METHODS and "radius" in kwargs and rng.random() < 0.8:
+                del kwargs["radius"]
+            if method not in SMOOTHING_METHODS and "smoothing_steps" in kwargs and rng.random() < 0.8:
+                del kwargs["smoothing_steps"]
+        vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
+        ff, flabel = wrap_faces(rng, f) if rng.random() < 0.3 else (f, "array")
+        labels += [f"vertices:{vlabel}", f"faces:{flabel}"]
+        if len(labels) == 3 and vlabel == "array" and flabel == "array" and kwargs.get("radius") is None \
+                and rng.random() < 0.5:  # inside the documented coordinate range (about 1e-70 to 1e70)
+            s = float(rng.choice([2.0**-60, 2.0**40, 1e-30, 1e-8, 1e8, 1e30]))
+            clean = s
+            labels.append(f"scale check x{s:g}")
+        return target, (vv, ff), kwargs, labels, clean
+    if roll < 0.65 and pointcloud is not None:
+        target = "point_cloud_curvatures"
+        kwargs = {}
+        if rng.random() < 0.4:
+            kwargs["radius"] = garbage(rng, "radius") if rng.random() < 0.5 else float(
+                rng.choice([0.05, 0.2, 1.0, 1e3])) * (float(np.ptp(v)) if v.size else 1.0)
+        if rng.random() < 0.3:
+            kwargs["method"] = pointcloud.POINT_CLOUD_METHODS[int(rng.integers(2))] if rng.random() < 0.9 \
+                else garbage(rng, "method")
+        if rng.random() < 0.3 and len(v):
+            normals = rng.normal(size=v.shape)
+            if rng.random() < 0.3:
+                normals[0] = 0.0 if rng.random() < 0.5 else np.nan
+            kwargs["normals"] = normals if rng.random() < 0.8 else normals[:-1]
+        vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
+        labels.append(f"points:{vlabel}")
+        return target, (vv,), kwargs, labels, None
+    vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
+    ff, flabel = wrap_faces(rng, f) if rng.random() < 0.3 else (f, "array")
+    labels += [f"vertices:{vlabel}", f"faces:{flabel}"]
+    target = ["diagnose", "orient_faces", "MeshTopology.from_faces", "triangulate_faces", "smooth_vertex_field",
+              "geometry"][int(rng.integers(6))]
+    if target == "diagnose":
+        topo = ff if isinstance(ff, meshcurv.MeshTopology) else _topology_or_raw(rng, f, len(v))
+        return target, (vv, topo), {}, labels, None
+    if target == "orient_faces":
+        kwargs = {"outward": [True, False, np.bool_(False), 1, "no", None][int(rng.integers(6))]}
+        return target, (vv, ff), kwargs, labels, None
+    if target == "MeshTopology.from_faces":
+        n = [None, len(v), len(v) + 5, 0, -1, 2**63, 2.5, "7", np.int32(len(v))][int(rng.integers(9))]
+        return target, (ff,), ({} if n is None else {"n_vertices": n}), labels, None
+    if target == "triangulate_faces":
+        return target, (ff,), {}, labels, None
+    if target == "smooth_vertex_field":
+        values = [rng.normal(size=len(v)), rng.normal(size=(len(v), 3)), rng.normal(size=len(v) + 1),
+                  np.full(len(v), np.nan), np.zeros((len(v), 0)), "abc", rng.normal(size=(len(v), 2, 2))][
+            int(rng.integers(7))]
+        topo = _topology_or_raw(rng, f, len(v))
+        steps = garbage(rng, "steps") if rng.random() < 0.5 else int(rng.integers(0, 30))
+        return target, (values, topo, steps), {}, labels, None
+    names = list(geometry.__all__)
+    name = names[int(rng.integers(len(names)))]
+    return "geometry." + name, _geometry_args(rng, name, vv, ff, v, f), {}, labels, None
+
+
+def _topology_or_raw(rng, f, n):
+    if rng.random() < 0.15:
+        return f
+    try:
+        return meshcurv.MeshTopology.from_faces(f, max(n, int(f.max()) + 1 if len(f) else n))
+    except Exception:  # noqa: BLE001
+        return f
+
+
+def _geometry_args(rng, name, vv, ff, v, f):
+    params = [p.name for p in inspect.signature(getattr(geometry, name)).parameters.values()
+              if p.kind == p.POSITIONAL_OR_KEYWORD]
+    args = []
+    for p in params:
+        if p == "vertices":
+            args.append(vv)
+        elif p == "faces":
+            args.append(ff)
+        elif p == "edges":
+            edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]) if len(f) else np.zeros((0, 2), int)
+            args.append(edges if rng.random() < 0.8 else garbage(rng, "edges"))
+        elif p == "topology":
+            args.append(_topology_or_raw(rng, f, len(v)))
+        elif p == "areas":
+            args.append(np.abs(rng.normal(size=len(f))) if rng.random() < 0.8 else garbage(rng, "areas"))
+        elif p == "length_scale":
+            args.append(float(rng.choice([1.0, 0.0, np.nan, 1e300])) if rng.random() < 0.8 else garbage(rng, "x"))
+        elif p == "summed":
+            args.append(rng.normal(size=(len(v), 3)) * float(rng.choice([1, 0, 1e300, 1e-320])))
+        elif p in ("cross",):
+            continue
+        else:
+            break
+    return tuple(args)
+
+
+# ----------------------------------------------------------------------------- running one case
+
+def call(target, args, kwargs):
+    if target == "principal_curvatures":
+        return meshcurv.principal_curvatures(*args, **kwargs)
+    if target == "point_cloud_curvatures":
+        return pointcloud.point_cloud_curvatures(*args, **kwargs)
+    if target == "diagnose":
+        return meshcurv.diagnose(*args, **kwargs)
+    if target == "orient_faces":
+        return meshcurv.orient_faces(*args, **kwargs)
+    if target == "MeshTopology.from_faces":
+        return meshcurv.MeshTopology.from_faces(*args, **kwargs)
+    if target == "triangulate_faces":
+        return meshcurv.triangulate_faces(*args, **kwargs)
+    if target == "smooth_vertex_field":
+        return meshcurv.smooth_vertex_field(*args, **kwargs)
+    return getattr(geometry, target.split(".", 1)[1])(*args, **kwargs)
+
+
+def _n_rows(value):
+    try:
+        return len(value)
+    except TypeError:
+        return None
+
+
+def check_result(result, n_vertices, method, referenced):
+    """Documented invariants of a CurvatureResult: a list of broken ones."""
+    broken = []
+    fields = ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "mean", "gaussian")
+    for name in fields:
+        a = getattr(result, name)
+        if not isinstance(a, np.ndarray) or a.shape[:1] != (n_vertices,):
+            broken.append(f"{name} shape {getattr(a, 'shape', None)} for {n_vertices} input vertices")
+            return broken
+        if a.flags.writeable:
+            broken.append(f"{name} writeable")
+        if name != "valid" and a.dtype != np.float64:
+            broken.append(f"{name} dtype {a.dtype}")
+    valid = result.valid
+    k1, k2 = result.k_min, result.k_max
+    with np.errstate(all="ignore"):
+        if not (np.isfinite(k1[valid]).all() and np.isfinite(k2[valid]).all()):
+            broken.append("non-finite curvature at a valid vertex")
+        bad = valid & ~(k1 <= k2 + 1e-9 * np.abs(k2))
+        if bad.any():
+            broken.append(f"k_min > k_max at {int(bad.sum())} valid vertices")
+        norms = np.linalg.norm(result.normals[valid], axis=1)
+        if not (np.abs(norms - 1) < 1e-6).all():
+            broken.append("non-unit normal at a valid vertex")
+        if method != "meyer":
+            for name in ("dir_min", "dir_max"):
+                d = np.linalg.norm(getattr(result, name)[valid], axis=1)
+                if not (np.abs(d - 1) < 1e-6).all():
+                    broken.append(f"non-unit {name} at a valid vertex")
+        invalid = ~valid
+        allowed_zero = invalid & ~referenced if method == "matgeom" else np.zeros_like(invalid)
+        for name, k in (("k_min", k1), ("k_max", k2)):
+            wrong = invalid & ~np.isnan(k) & ~(allowed_zero & (k == 0))
+            if wrong.any():
+                broken.append(f"{name} not NaN at {int(wrong.sum())} invalid vertices")
+        if not np.allclose(result.mean[valid], (k1[valid] + k2[valid]) / 2, rtol=1e-12, atol=0):
+            broken.append("mean != (k_min + k_max) / 2")
+        if not np.allclose(result.gaussian[valid], k1[valid] * k2[valid], rtol=1e-12, atol=0):
+            broken.append("gaussian != k_min * k_max")
+    reason = result.invalid_reason
+    if reason is not None:
+        if reason.shape != (n_vertices,):
+            broken.append(f"invalid_reason shape {reason.shape}")
+        elif ((reason == 0) != valid).any():
+            broken.append("invalid_reason == 0 not exactly where valid")
+    return broken
+
+
+def _snapshot(value):
+    if isinstance(value, np.ma.MaskedArray):
+        return ("masked", np.ma.getdata(value).copy(), np.ma.getmaskarray(value).copy())
+    if isinstance(value, np.ndarray):
+        return ("array", value.copy())
+    if isinstance(value, list):
+        return ("list", pickle.dumps(value))
+    return ("other", None)
+
+
+def _unchanged(value, snap):
+    kind = snap[0]
+    if kind == "masked":
+        return np.array_equal(np.ma.getdata(value), snap[1], equal_nan=True) and np.array_equal(
+            np.ma.getmaskarray(value), snap[2])
+    if kind == "array":
+        try:
+            return np.array_equal(value, snap[1], equal_nan=value.dtype.kind in "fc")
+        except TypeError:
+            return bool((value == snap[1]).all()) if value.size else True
+    if kind == "list":
+        return pickle.dumps(value) == snap[1]
+    return True
+
+
+def _referenced(args, n):
+    faces = args[1] if len(args) > 1 else None
+    ref = np.zeros(n, bool)
+    try:
+        f = faces.faces if isinstance(faces, meshcurv.MeshTopology) else faces
+        if isinstance(f, list):
+            idx = np.concatenate([np.asarray(x, np.int64).ravel() for x in f]) if f else np.zeros(0, np.int64)
+        else:
+            idx = np.asarray(f).astype(np.int64).ravel()
+        ref[idx[(idx >= 0) & (idx < n)]] = True
+    except Exception:  # noqa: BLE001
+        ref[:] = True
+    return ref
+
+
+def run_case(target, args, kwargs, clean):
+    """Run in this process: a dict describing the outcome."""
+    snaps = [_snapshot(a) for a in args]
+    caught = []
+    outcome = {"status": "ok"}
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        try:
+            result = call(target, args, kwargs)
+        except DOCUMENTED as error:
+            outcome = {"status": "documented", "type": type(error).__name__, "message": str(error)[:300]}
+            result = None
+        except BaseException as error:  # noqa: BLE001 - the point of the fuzzer
+            tb = traceback.extract_tb(error.__traceback__)
+            ours = [fr for fr in tb if "meshcurv" in fr.filename and "benchmarks" not in fr.filename]
+            where = ours[-1] if ours else tb[-1]
+            outcome = {"status": "exception", "type": type(error).__name__, "message": str(error)[:300],
+                       "where": f"{os.path.relpath(where.filename, ROOT)}:{where.lineno} ({where.name})",
+                       "inner": f"{os.path.basename(tb[-1].filename)}:{tb[-1].lineno}",
+                       "traceback": "".join(traceback.format_list(tb[-6:]))[-2000:]}
+            result = None
+        for w in seen:
+            caught.append((w.category.__name__, issubclass(w.category, MeshcurvWarning), str(w.message)[:160]))
+    outcome["warnings"] = [c[0] + ": " + c[2] for c in caught if not c[1]]
+    broken = []
+    for a, s in zip(args, snaps):
+        if not _unchanged(a, s):
+            broken.append("an input array was modified")
+    if result is not None and target in ("principal_curvatures", "point_cloud_curvatures"):
+        n = _n_rows(args[0])
+        if isinstance(args[0], np.ndarray) and args[0].ndim != 2:
+            n = None
+        if n is not None:
+            broken += check_result(result, n, getattr(result, "method", ""), _referenced(args, n))
+        if clean is not None:
+            broken += scale_check(args, kwargs, result, clean)
+    if broken:
+        outcome["status"] = "invariant"
+        outcome["broken"] = broken
+    return outcome
+
+
+def scale_check(args, kwargs, result, s):
+    v, f = args
+    kw = dict(kwargs)
+    if kw.get("radius") is not None and isinstance(kw["radius"], float):
+        kw["radius"] = kw["radius"] * s
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            scaled = meshcurv.principal_curvatures(v * s, f, **kw)
+        except DOCUMENTED as error:
+            return [f"scale x{s:g}: {type(error).__name__} where unscaled succeeded: {str(error)[:150]}"]
+    broken = []
+    if not np.array_equal(scaled.valid, result.valid):
+        broken.append(f"scale x{s:g}: valid mask changed ({int(result.valid.sum())} -> {int(scaled.valid.sum())})")
+        return broken
+    factor = 1.0 if result.method == "matgeom" else s
+    both = result.valid
+    size = max(np.abs(result.k_min[both]).max(initial=0), np.abs(result.k_max[both]).max(initial=0), 1e-300)
+    for name in ("k_min", "k_max"):
+        a, b = getattr(result, name)[both], getattr(scaled, name)[both] * factor
+        with np.errstate(all="ignore"):
+            err = np.abs(a - b) / size
+        if a.size and not (err < 1e-6).all():
+            broken.append(f"scale x{s:g}: {name} * s differs by up to {float(np.nanmax(err)):.3g} (relative)")
+    return broken
+
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _nbytes(value):
+    try:
+        return int(np.asarray(value, dtype=object if isinstance(value, list) else None).nbytes)
+    except Exception:  # noqa: BLE001
+        return 0
+
+
+def _vsize() -> int:
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[0]) * resource.getpagesize()
+
+
+def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
+    """Make case ``index`` and run it in a forked child: ``(outcome, elapsed)``.
+
+    The case is built in the child too (building a MeshTopology for a hostile
+    index can itself allocate without bound), under a first cap of the
+    parent's size plus 2 GiB, lowered to the call's own cap before the call.
+    """
+    base = _vsize()
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # child
+        os.close(read_end)
+        code = 0
+        try:
+            resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+            resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, base + 2**31))
+            if numpy_backend:
+                os.environ["MESHCURV_BACKEND"] = "numpy"
+            target, args, kwargs, labels, clean = make_case(seed, index)
+            input_bytes = sum(_nbytes(a) for a in args)
+            limit = base + memory_mib * 2**20 + factor * input_bytes
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+            head = {"target": target, "call": describe(args, kwargs), "mutations": labels,
+                    "method": kwargs.get("method") if isinstance(kwargs.get("method"), str) else None,
+                    "cap_mib": round((limit - base) / 2**20)}
+            data = pickle.dumps(head)
+            os.write(write_end, len(data).to_bytes(8, "little") + data)
+            try:
+                outcome = run_case(target, args, kwargs, clean)
+            except MemoryError:
+                outcome = {"status": "memory", "type": "MemoryError", "message": "checking ran out of memory"}
+            data = pickle.dumps(outcome)
+            with os.fdopen(write_end, "wb") as fh:
+                fh.write(data)
+        except BaseException:  # noqa: BLE001
+            code = 3
+        os._exit(code)
+    os.close(write_end)
+    start = time.monotonic()
+    chunks = []
+    timed_out = False
+    while True:
+        remaining = timeout - (time.monotonic() - start)
+        if remaining <= 0:
+            timed_out = True
+            break
+        ready, _, _ = select.select([read_end], [], [], remaining)
+        if ready:
+            chunk = os.read(read_end, 1 << 20)
+            if not chunk:
+                break
+            chunks.append(chunk)
+    elapsed = time.monotonic() - start
+    if timed_out:
+        os.kill(pid, signal.SIGKILL)
+    _, status = os.waitpid(pid, 0)
+    os.close(read_end)
+    data = b"".join(chunks)
+    head = {"target": "?", "call": "?", "mutations": [], "method": None}
+    if len(data) >= 8:
+        size = int.from_bytes(data[:8], "little")
+        if len(data) >= 8 + size:
+            head = pickle.loads(data[8:8 + size])
+            data = data[8 + size:]
+    if timed_out:
+        outcome = {"status": "timeout", "message": f"no answer within {timeout:g} s"}
+    elif os.WIFSIGNALED(status):
+        outcome = {"status": "crash", "message": f"killed by signal {os.WTERMSIG(status)}"}
+    else:
+        try:
+            outcome = pickle.loads(data)
+        except Exception:  # noqa: BLE001
+            outcome = {"status": "crash" if head["target"] != "?" else "memory",
+                       "message": f"child exit {os.WEXITSTATUS(status)} without an answer"
+                                  + ("" if head["target"] != "?" else " (building the case: over 2 GiB?)")}
+    if outcome.get("type") == "MemoryError":
+        outcome["status"] = "memory"
+        outcome["message"] = f"MemoryError under a cap of {head.get('cap_mib')} MiB above the parent"
+    return head, outcome, elapsed
+
+
+def signature(target, method, outcome):
+    method = method if target == "principal_curvatures" and method in METHODS else None
+    status = outcome["status"]
+    if status == "exception":
+        return f"{target} | {outcome['type']} at {outcome['where']}"
+    if status == "invariant":
+        first = outcome["broken"][0]
+        first = first.split(" at ")[0].split(" by up to")[0].split(" (")[0]
+        return f"{target} [{method}] | {first}"
+    return f"{target} [{method}] | {status}"
+
+
+def describe(args, kwargs):
+    def short(value):
+        if isinstance(value, np.ndarray):
+            return f"ndarray{value.shape} {value.dtype}" + (" masked" if isinstance(value, np.ma.MaskedArray) else "")
+        if isinstance(value, list):
+            return f"list[{len(value)}]"
+        if isinstance(value, meshcurv.MeshTopology):
+            return f"MeshTopology(F={len(value.faces)}, V={value.n_vertices})"
+        text = repr(value)
+        return text if len(text) < 60 else text[:57] + "..."
+    return ", ".join([short(a) for a in args] + [f"{k}={short(v)}" for k, v in kwargs.items()])
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--minutes", type=float, default=5.0)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--timeout", type=float, default=60.0, help="seconds per call")
+    parser.add_argument("--memory", type=int, default=768, help="MiB above the parent's address space")
+    parser.add_argument("--factor", type=int, default=200, help="bytes allowed per byte of input, beyond --memory")
+    parser.add_argument("--start", type=int, default=0, help="first case index")
+    parser.add_argument("--log", default=os.path.join(ROOT, "benchmarks", "fuzz_api.jsonl"))
+    parser.add_argument("--replay", type=int, default=None, help="run case I in this process and show it")
+    options = parser.parse_args(argv)
+
+    if options.replay is not None:
+        guard = _vsize() + 4 * 2**30
+        resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
+        case = make_case(options.seed, options.replay)
+        target, args, kwargs, labels, clean = case
+        print(f"case {options.replay} seed {options.seed}: {target}({describe(args, kwargs)})")
+        print("mutations:", "; ".join(labels))
+        outcome = run_case(target, args, kwargs, clean)
+        for key, value in outcome.items():
+            print(f"{key}: {value}")
+        return 0
+
+    # warm the compiled kernels once so the children fork with them loaded
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        warm = shapes.icosphere(subdivisions=3)
+        for method in METHODS:
+            meshcurv.principal_curvatures(warm.vertices, warm.faces, method=method)
+        if pointcloud is not None:
+            pointcloud.point_cloud_curvatures(shapes.random_sphere(n_vertices=200).vertices)
+
+    guard = _vsize() + 3 * 2**30  # the parent itself never needs more (it builds no case)
+    resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
+    deadline = time.monotonic() + options.minutes * 60
+    counts = collections.Counter()
+    first_seen = {}
+    slowest = []
+    index = options.start
+    with open(options.log, "a") as log:
+        log.write(json.dumps({"run": time.strftime("%Y-%m-%d %H:%M:%S"), "seed": options.seed,
+                              "minutes": options.minutes, "timeout": options.timeout,
+                              "memory": options.memory, "factor": options.factor}) + "\n")
+        while time.monotonic() < deadline:
+            numpy_backend = index % 4 == 3
+            head, outcome, elapsed = run_forked(options.seed, index, options.timeout, options.memory,
+                                                options.factor, numpy_backend)
+            target = head["target"]
+            counts[(target, outcome["status"])] += 1
+            slowest.append((elapsed, index))
+            if outcome["status"] not in ("ok", "documented") or outcome.get("warnings"):
+                key = signature(target, head["method"], outcome) if outcome["status"] not in ("ok", "documented") \
+                    else f"{target} | warning {outcome['warnings'][0][:60]}"
+                record = {"index": index, "seed": options.seed, "key": key,
+                          "backend": "numpy" if numpy_backend else "auto", **head, "elapsed": round(elapsed, 2),
+                          **outcome}
+                log.write(json.dumps(record, default=str) + "\n")
+                log.flush()
+                if key not in first_seen:
+                    first_seen[key] = index
+                    print(f"[{index}] NEW {key}: {outcome.get('message', '')[:120]}", flush=True)
+                counts[("finding", key)] += 1
+            index += 1
+            if index % 500 == 0:
+                print(f"... {index} cases, {len(first_seen)} distinct findings", flush=True)
+    print(f"\n{index - options.start} cases in {options.minutes:g} min (seed {options.seed})")
+    for (target, status), n in sorted(counts.items()):
+        if target != "finding":
+            print(f"  {target:32s} {status:12s} {n}")
+    print(f"\n{len(first_seen)} distinct findings:")
+    for key, first in first_seen.items():
+        print(f"  {counts[('finding', key)]:5d}x  first case {first}: {key}")
+    slowest.sort(reverse=True)
+    print("slowest cases:", ", ".join(f"{i} ({t:.1f}s)" for t, i in slowest[:5]))
+    return 1 if any(not k.split(" | ", 1)[1].startswith("warning") for k in first_seen) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
