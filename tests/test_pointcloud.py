@@ -242,3 +242,10 @@ def test_noisy_torus_meets_the_noise_targets(method, h_limit):
     assert r.parameters["radius"] > 4 * r.parameters["spacing"]
     assert np.median(np.abs(r.mean - (1.0 + k_ring) / 2)) < h_limit
     assert np.median(np.abs(r.gaussian - k_ring)) < 2 * h_limit
+
+
+def test_a_very_sparse_cloud_gets_a_bounded_radius_and_the_warning():
+    points, _ = sphere_points(12)
+    with pytest.warns(MeshQualityWarning, match="too sparse or too noisy for its size"):
+        r = point_cloud_curvatures(points)
+    assert r.parameters["radius"] <= 0.25 * np.linalg.norm(np.ptp(points, axis=0)) + 1e-12

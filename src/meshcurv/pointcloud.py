@@ -103,6 +103,9 @@ OUTLIER_FACTOR = 10.0
 #: percentile of the (neighbour-averaged) local spacing exceeds this many times the 5th.
 UNEVEN_DENSITY = 2.0
 
+#: A default radius is at most this share of the cloud's extent (its bounding-box diagonal).
+EXTENT_CAP = 0.25
+
 #: Code of :data:`meshcurv.result.INVALID_REASONS` for points without an estimate.
 _UNDEFINED = len(INVALID_REASONS) - 1
 
@@ -297,6 +300,14 @@ def _compute(points, given, radius, method):
     logger.info("point cloud: noise level")
     noise = _noise_level(points, start, median, centres, usable)
     groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems)
+    if radius is None:
+        extent = points[usable]
+        largest = EXTENT_CAP * float(np.linalg.norm(extent.max(axis=0) - extent.min(axis=0)))
+        if max(r for r, _, _ in groups) > largest:
+            problems.append(f"the cloud is too sparse or too noisy for its size (default radius "
+                            f"{max(r for r, _, _ in groups):.3g} beyond a quarter of its extent): radius cut to "
+                            f"{largest:.3g}; the curvatures are rough")
+            groups = [(min(r, largest), s, m) for r, s, m in groups]
 
     k_min, k_max = np.full(n, np.nan), np.full(n, np.nan)
     dir_min, dir_max = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
