@@ -1,0 +1,154 @@
+"""Regression tests of the findings of ``benchmarks/fuzz_api.py`` (see ``benchmarks/fuzz_api.md``).
+
+Each test is the smallest input found for one class of finding. Those not yet
+fixed in the core are ``xfail(strict=True)``: they start passing (and so
+failing as XPASS) when the fix lands, and the marker must then be removed.
+"""
+
+import warnings
+
+import numpy as np
+import pytest
+
+import meshcurv
+from meshcurv import geometry, shapes
+from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshcurvWarning
+from meshcurv.pointcloud import point_cloud_curvatures
+
+DOCUMENTED = (InvalidMeshError, InvalidOptionError)
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return shapes.icosphere(subdivisions=2)
+
+
+def _only_documented_warnings():
+    """A context where a numpy RuntimeWarning is an error and meshcurv's own warnings are ignored."""
+    context = warnings.catch_warnings()
+    context.__enter__()
+    warnings.simplefilter("error", RuntimeWarning)
+    warnings.simplefilter("ignore", MeshcurvWarning)
+    return context
+
+
+# --- MeshTopology.from_faces: n_vertices is not checked ---------------------------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: MeshTopology.from_faces does not check n_vertices "
+                   "(TypeError for a string, numba TypingError / OverflowError beyond int64)")
+@pytest.mark.parametrize("n_vertices", ["7", 2**63, 10**400, np.uint64(2**63)], ids=["str", "2**63", "10**400",
+                                                                                    "uint64"])
+def test_from_faces_refuses_an_unusable_vertex_count(sphere, n_vertices):
+    with pytest.raises(DOCUMENTED, match="n_vertices"):
+        meshcurv.MeshTopology.from_faces(sphere.faces, n_vertices)
+
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: MeshTopology.from_faces sizes its arrays from the "
+                   "largest index: one face with index 2**40 is a MemoryError (2**28: 3 GB)")
+def test_from_faces_refuses_an_index_far_beyond_the_faces():
+    with pytest.raises(InvalidMeshError, match="n_vertices"):
+        meshcurv.MeshTopology.from_faces(np.array([[0, 1, 2**40]]))
+
+
+# --- triangulate_faces: no validation at all ---------------------------------------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: triangulate_faces takes anything (TypeError, IndexError, "
+                   "ValueError, OverflowError; too-short faces dropped, float indices truncated, negative kept)")
+@pytest.mark.parametrize("polygons", [
+    pytest.param(np.array([0, 1, 2]), id="flat"),
+    pytest.param(5, id="int"),
+    pytest.param("abc", id="str"),
+    pytest.param([[0, 1]], id="two-corners"),
+    pytest.param([[]], id="empty-face"),
+    pytest.param([[0, 1, 2.5]], id="float-index"),
+    pytest.param([[2**64, 0, 1]], id="beyond-int64"),
+    pytest.param([[-1, 0, 1]], id="negative"),
+])
+def test_triangulate_faces_refuses_what_is_not_polygons(polygons):
+    with pytest.raises(InvalidMeshError, match="faces|polygons"):
+        meshcurv.triangulate_faces(polygons)
+
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: triangulate_faces(MeshTopology) is a TypeError")
+def test_triangulate_faces_of_a_topology(sphere):
+    topology = meshcurv.MeshTopology.from_faces(sphere.faces)
+    try:
+        triangles = meshcurv.triangulate_faces(topology)
+    except InvalidMeshError:
+        return
+    np.testing.assert_array_equal(triangles, sphere.faces)
+
+
+# --- geometry: public functions that do not check their arguments ------------------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: geometry.vertex_length_scales with a face array: "
+                   "AttributeError 'numpy.ndarray' object has no attribute 'edges'")
+def test_vertex_length_scales_refuses_a_face_array(sphere):
+    with pytest.raises(InvalidMeshError, match="topology"):
+        geometry.vertex_length_scales(sphere.vertices, sphere.faces)
+
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: geometry.degenerate_face_mask with a non-number scale: "
+                   "plain ValueError / UFuncTypeError from numpy")
+@pytest.mark.parametrize("length_scale", ["", "abc", None], ids=["empty", "str", "None"])
+def test_degenerate_face_mask_refuses_a_non_number_scale(length_scale):
+    with pytest.raises(DOCUMENTED, match="length_scale"):
+        geometry.degenerate_face_mask(np.ones(4), length_scale)
+
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: geometry functions take coordinates of 1e200 (refused by "
+                   "principal_curvatures beyond 1e75) and return infinite areas without a word")
+@pytest.mark.parametrize("name", ["face_areas", "face_normals", "vertex_normals"])
+def test_geometry_of_huge_coordinates_is_finite_or_refused(sphere, name):
+    try:
+        values = getattr(geometry, name)(sphere.vertices * 1e200, sphere.faces)
+    except InvalidMeshError as error:
+        assert "1e+200" in str(error) or "coordinates" in str(error)
+        return
+    assert np.isfinite(values).all()
+
+
+# --- numpy RuntimeWarnings escaping from the library (errors under -W error) -------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: a 1e40 spike makes lattice._axis_lattice cast inf to "
+                   "int64 (RuntimeWarning: invalid value encountered in cast) for every ball method")
+@pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
+def test_spike_on_an_open_mesh_raises_no_runtime_warning(method):
+    mesh = shapes.hemisphere(subdivisions=4)
+    vertices = mesh.vertices.copy()
+    vertices[5, 0] = 1e40
+    context = _only_documented_warnings()
+    try:
+        result = meshcurv.principal_curvatures(vertices, mesh.faces, method=method)
+    finally:
+        context.__exit__(None, None, None)
+    assert result.k_min.shape == (len(vertices),)
+    assert not result.valid[5]
+
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: meyer multiplies infinite cotangents of a spike's needle "
+                   "triangles (RuntimeWarning: invalid value encountered in multiply, meyer.py)")
+def test_meyer_spike_raises_no_runtime_warning():
+    mesh = shapes.hemisphere(subdivisions=4)
+    vertices = mesh.vertices.copy()
+    vertices[0] = 1e20
+    context = _only_documented_warnings()
+    try:
+        result = meshcurv.principal_curvatures(vertices, mesh.faces, method="meyer")
+    finally:
+        context.__exit__(None, None, None)
+    assert not result.valid[0]
+
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: point_cloud_curvatures on two parts 1000x apart in "
+                   "spacing: nanmean of an all-NaN row (RuntimeWarning: Mean of empty slice, _radius_groups)")
+def test_point_cloud_of_two_scales_raises_no_runtime_warning():
+    small = shapes.uv_sphere(n_longitude=12, n_latitude=8).vertices
+    large = shapes.cylinder(n_around=12, n_along=6).vertices * 1000.0 + 5000.0
+    points = np.concatenate([small, large])
+    context = _only_documented_warnings()
+    try:
+        result = point_cloud_curvatures(points)
+    finally:
+        context.__exit__(None, None, None)
+    assert result.k_min.shape == (len(points),)
