@@ -25,11 +25,12 @@ of 1 x 0.25 x 0.25). The area reported is instead the *corrected area*
 fitted by ``icc`` over a few voxels: it is the area of the smooth surface those
 normals describe (the same spheres: -1.1% to +0.6%). Smoothing the mask with a
 Gaussian of one voxel before marching cubes was measured too and rejected: it
-removes part of the bias (+1 to +2.4% left with 1 x 0.25 x 0.25 voxels), but
-shrinks the objects (volume -2 to -10%, the level set moves inward by about
-``sigma^2 H``), and its vertices are no longer on the half grid, so the voxel
-radius is no longer recognised and K goes wrong (total Gaussian curvature off
-by 5-15%). The raw triangle area stays in the table as ``area_mesh``.
+removes most of the bias (+1 to +2.4% left with 1 x 0.25 x 0.25 voxels), but
+shrinks the objects (volume -0.2% at radius 20 to -10% at radius 6 with cubic
+voxels: the level set moves inward by about ``sigma^2 H``), and its vertices
+are no longer on the half grid, so the voxel radius is no longer recognised
+and K goes wrong (total Gaussian curvature off by up to 15%). The raw
+triangle area stays in the table as ``area_mesh``.
 
 Each vertex carries a third of the corrected area of its faces (the
 barycentric cell, with ``mu_0`` in place of the triangle area); these are the
