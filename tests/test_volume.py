@@ -341,6 +341,11 @@ def test_cli_writes_csv_and_parquet_meshes_and_picture(tmp_path):
     assert (out / "cells_mean.png").stat().st_size > 0
     again = run_volume([tmp_path / "cells.npy", "-o", out, "--no-picture"])
     assert isinstance(again.exception, MeshFileError) and "already exists" in str(again.exception)
+    (out / "cells_labels.csv").unlink()
+    (out / "cells_labels.parquet").unlink()
+    again = run_volume([tmp_path / "cells.npy", "-o", out, "--no-picture", "--meshes", "vtp"])
+    assert isinstance(again.exception, MeshFileError) and "cells_label_2.vtp: already exists" in str(again.exception)
+    assert not (out / "cells_labels.csv").exists()  # refused before computing
     assert run_volume([tmp_path / "cells.npy", "-o", out, "--overwrite", "--no-picture"]).exit_code == 0
 
 

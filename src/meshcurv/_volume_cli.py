@@ -130,6 +130,10 @@ def volume_command() -> click.Command:
         picture_path = out_dir / f"{stem}_{field}.png"
         for path in tables + ([picture_path] if picture else []):
             check_output(path, overwrite=overwrite, source=image)
+        if mesh_format is not None and not overwrite:  # refused before hours of computing, not at the label
+            existing = sorted(out_dir.glob(f"{stem}_label_*.{mesh_format}"))
+            if existing:
+                check_output(existing[0], overwrite=False)
         parquet = _has_pyarrow()
         if not parquet:
             session.info("pyarrow is not installed: the table is written as CSV only (pip install pyarrow)")
