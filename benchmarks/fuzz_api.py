@@ -25,8 +25,11 @@ finding, not a stuck run. A finding is:
   directions where ``valid``, NaN curvatures where not valid (matgeom: zero
   allowed at unreferenced vertices), ``invalid_reason == 0`` exactly where
   valid, ``mean``/``gaussian`` consistent, input arrays not modified;
-- a scale mismatch: a clean shape scaled by ``s`` must give the same valid
-  mask and curvatures divided by ``s`` (``matgeom``: unchanged).
+- a broken relation (:func:`relation_check`): a clean shape scaled by ``s``
+  must give the same valid mask and curvatures divided by ``s`` (``matgeom``:
+  unchanged); translated or with its vertices permuted, the same values; with
+  unreferenced points added near its surface, the same values at every
+  referenced vertex.
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -405,7 +408,7 @@ def make_mesh(rng):
 def make_case(seed: int, index: int):
     """``(target, args, kwargs, labels, clean)``, deterministic in ``(seed, index)``.
 
-    ``clean`` is None, or ``(scale, args0, kwargs0)`` for a scale-invariance check.
+    ``clean`` is None, or ``(relation, value)`` for :func:`relation_check`.
     """
     rng = np.random.default_rng([seed, index])
     v, f, labels = make_mesh(rng)
@@ -433,11 +436,16 @@ def make_case(seed: int, index: int):
         vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
         ff, flabel = wrap_faces(rng, f) if rng.random() < 0.3 else (f, "array")
         labels += [f"vertices:{vlabel}", f"faces:{flabel}"]
-        if len(labels) == 3 and vlabel == "array" and flabel == "array" and kwargs.get("radius") is None \
-                and rng.random() < 0.5:  # inside the documented coordinate range (about 1e-70 to 1e70)
-            s = float(rng.choice([2.0**-60, 2.0**40, 1e-30, 1e-8, 1e8, 1e30]))
-            clean = s
-            labels.append(f"scale check x{s:g}")
+        if vlabel == "array" and flabel == "array" and kwargs.get("radius") is None and rng.random() < 0.5 \
+                and all(label.startswith(("noise", "flipped", "faces removed", "vertices permuted")) for label in labels[1:-2]):
+            relation = ["scale", "scale", "permute", "unreferenced", "translate"][int(rng.integers(5))]
+            if relation == "scale":  # inside the documented coordinate range (about 1e-70 to 1e70)
+                clean = ("scale", float(rng.choice([2.0**-60, 2.0**40, 1e-30, 1e-8, 1e8, 1e30])))
+            elif relation == "translate":
+                clean = ("translate", float(rng.choice([2.0**10, -(2.0**20), 1e3 + 0.1])))
+            else:
+                clean = (relation, int(rng.integers(2**31)))
+            labels.append(f"relation {clean[0]} {clean[1]:g}")
         return target, (vv, ff), kwargs, labels, clean
     if roll < 0.65 and pointcloud is not None:
         target = "point_cloud_curvatures"
@@ -577,9 +585,10 @@ def check_result(result, n_vertices, method, referenced):
                 if not (np.abs(d - 1) < 1e-6).all():
                     broken.append(f"non-unit {name} at a valid vertex")
         invalid = ~valid
-        allowed_zero = invalid & ~referenced if method == "matgeom" else np.zeros_like(invalid)
+        # matgeom keeps matGeom's numbers wherever matGeom computes them (README, "Dirty meshes")
+        allowed = invalid if method == "matgeom" else np.zeros_like(invalid)
         for name, k in (("k_min", k1), ("k_max", k2)):
-            wrong = invalid & ~np.isnan(k) & ~(allowed_zero & (k == 0))
+            wrong = invalid & ~np.isnan(k) & ~allowed
             if wrong.any():
                 broken.append(f"{name} not NaN at {int(wrong.sum())} invalid vertices")
         if not np.allclose(result.mean[valid], (k1[valid] + k2[valid]) / 2, rtol=1e-12, atol=0):
@@ -670,37 +679,62 @@ def run_case(target, args, kwargs, clean):
         if n is not None:
             broken += check_result(result, n, getattr(result, "method", ""), _referenced(args, n))
         if clean is not None:
-            broken += scale_check(args, kwargs, result, clean)
+            broken += relation_check(args, kwargs, result, clean)
     if broken:
         outcome["status"] = "invariant"
         outcome["broken"] = broken
     return outcome
 
 
-def scale_check(args, kwargs, result, s):
+def relation_check(args, kwargs, result, relation):
+    """The same call on a transformed mesh: curvatures must transform as the documentation says.
+
+    ``scale`` s: the same valid mask, curvatures / s (matgeom: unchanged);
+    ``translate``: the same values; ``permute``: the same values, permuted;
+    ``unreferenced``: points added near the surface (in no face) leave every
+    referenced vertex's values and validity unchanged.
+    """
+    kind, value = relation
     v, f = args
-    kw = dict(kwargs)
-    if kw.get("radius") is not None and isinstance(kw["radius"], float):
-        kw["radius"] = kw["radius"] * s
+    n = len(v)
+    factor = 1.0
+    take = np.arange(n)
+    if kind == "scale":
+        v2, f2 = v * value, f
+        factor = 1.0 if result.method == "matgeom" else value
+    elif kind == "translate":
+        v2, f2 = v + value * max(float(np.ptp(v)), 1.0), f
+    elif kind == "permute":
+        perm = np.random.default_rng(value).permutation(n)  # new vertex i is old perm[i]
+        inverse = np.argsort(perm)
+        v2, f2 = v[perm], inverse[f]
+        take = inverse  # old vertex j is new inverse[j]
+    else:
+        rng = np.random.default_rng(value)
+        edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1))) if len(f) else 1.0
+        extra = v[rng.integers(n, size=max(1, n // 10))] + rng.normal(size=(max(1, n // 10), 3)) * 0.3 * edge
+        v2, f2 = np.concatenate([v, extra]), f
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            scaled = meshcurv.principal_curvatures(v * s, f, **kw)
+            other = meshcurv.principal_curvatures(v2, f2, **kwargs)
         except DOCUMENTED as error:
-            return [f"scale x{s:g}: {type(error).__name__} where unscaled succeeded: {str(error)[:150]}"]
-    broken = []
-    if not np.array_equal(scaled.valid, result.valid):
-        broken.append(f"scale x{s:g}: valid mask changed ({int(result.valid.sum())} -> {int(scaled.valid.sum())})")
-        return broken
-    factor = 1.0 if result.method == "matgeom" else s
-    both = result.valid
+            return [f"{kind} {value:g}: {type(error).__name__} where the original succeeded: {str(error)[:150]}"]
+    referenced = _referenced(args, n)
+    old_valid, new_valid = result.valid, other.valid[take]
+    changed = (old_valid != new_valid) & referenced
+    if changed.any():
+        return [f"{kind} {value:g}: valid changed at {int(changed.sum())} vertices "
+                f"({int(old_valid.sum())} -> {int(new_valid.sum())} valid)"]
+    both = old_valid & referenced
     size = max(np.abs(result.k_min[both]).max(initial=0), np.abs(result.k_max[both]).max(initial=0), 1e-300)
+    broken = []
     for name in ("k_min", "k_max"):
-        a, b = getattr(result, name)[both], getattr(scaled, name)[both] * factor
+        a, b = getattr(result, name)[both], getattr(other, name)[take][both] * factor
         with np.errstate(all="ignore"):
             err = np.abs(a - b) / size
         if a.size and not (err < 1e-6).all():
-            broken.append(f"scale x{s:g}: {name} * s differs by up to {float(np.nanmax(err)):.3g} (relative)")
+            broken.append(f"{kind} {value:g}: {name} differs by up to {float(np.nanmax(err)):.3g} (relative)")
     return broken
 
 
@@ -807,6 +841,8 @@ def signature(target, method, outcome):
         return f"{target} | {outcome['type']} at {outcome['where']}"
     if status == "invariant":
         first = outcome["broken"][0]
+        if first.split(" ")[0] in ("scale", "translate", "permute", "unreferenced") and ": " in first:
+            first = first.split(" ")[0] + ": " + first.split(": ", 1)[1]  # without the relation's value
         first = first.split(" at ")[0].split(" by up to")[0].split(" (")[0]
         return f"{target} [{method}] | {first}"
     return f"{target} [{method}] | {status}"
@@ -840,10 +876,12 @@ def main(argv=None) -> int:
     if options.replay is not None:
         guard = _vsize() + 4 * 2**30
         resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
+        if options.replay % 4 == 3:  # as in the run: every fourth case on the NumPy paths
+            os.environ["MESHCURV_BACKEND"] = "numpy"
         case = make_case(options.seed, options.replay)
         target, args, kwargs, labels, clean = case
         print(f"case {options.replay} seed {options.seed}: {target}({describe(args, kwargs)})")
-        print("mutations:", "; ".join(labels))
+        print("mutations:", "; ".join(labels), "| backend:", os.environ.get("MESHCURV_BACKEND", "auto"))
         outcome = run_case(target, args, kwargs, clean)
         for key, value in outcome.items():
             print(f"{key}: {value}")

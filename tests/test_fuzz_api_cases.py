@@ -152,3 +152,59 @@ def test_point_cloud_of_two_scales_raises_no_runtime_warning():
     finally:
         context.__exit__(None, None, None)
     assert result.k_min.shape == (len(points),)
+
+
+# --- unreferenced points change the default radius of voxel surfaces -------------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: icc.voxel_surface_radius takes the median curvedness of its "
+                   "pilot pass over unreferenced vertices too, so points in no face change the default radius "
+                   "(and quadric's k_max by 0.33 on a radius-4 voxel sphere)")
+@pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
+def test_unreferenced_points_leave_a_voxel_surface_unchanged(method):
+    mesh = shapes.voxel_sphere(radius=4.0)
+    n = len(mesh.vertices)
+    extra = mesh.vertices[:30] + np.random.default_rng(0).normal(size=(30, 3)) * 0.3  # near the surface, in no face
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshcurvWarning)
+        alone = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method=method)
+        with_points = meshcurv.principal_curvatures(np.concatenate([mesh.vertices, extra]), mesh.faces, method=method)
+    assert with_points.parameters["radius"] == alone.parameters["radius"]
+    np.testing.assert_array_equal(with_points.valid[:n], alone.valid)
+    np.testing.assert_allclose(with_points.k_max[:n], alone.k_max, rtol=1e-9, atol=1e-12)
+    assert not with_points.valid[n:].any()
+
+
+# --- point clouds: a part at 1e-200 on the NumPy path -----------------------------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: point_cloud_curvatures with a part at scale 1e-200 (NumPy "
+                   "path): ZeroDivisionError in quadric.fit_jets (1.0 / radius with a radius that underflowed to 0)")
+@pytest.mark.parametrize("method", ["jets", "corrected_measures"])
+def test_point_cloud_with_a_vanishing_part_on_the_numpy_path(monkeypatch, method):
+    monkeypatch.setenv("MESHCURV_BACKEND", "numpy")
+    tiny = shapes.hemisphere(subdivisions=6).vertices * 1e-200
+    points = np.concatenate([tiny, shapes.uv_sphere(n_longitude=12, n_latitude=8).vertices])
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshcurvWarning)
+            warnings.simplefilter("ignore", RuntimeWarning)  # the finding of the test above, not this one
+            result = point_cloud_curvatures(points, method=method)
+    except InvalidMeshError:
+        return
+    assert result.k_min.shape == (len(points),)
+    assert not result.valid[: len(tiny)].any() or np.isfinite(result.k_min[: len(tiny)]).all()
+
+
+# --- diagnose: coordinates beyond the documented range ----------------------------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: diagnose takes a 1e300 coordinate (refused by "
+                   "principal_curvatures beyond 1e75) and reports area=inf, mean_edge_length=inf")
+def test_diagnose_of_a_huge_spike_is_finite_or_refused(sphere):
+    vertices = sphere.vertices.copy()
+    vertices[3, 1] = 1e300
+    topology = meshcurv.MeshTopology.from_faces(sphere.faces)
+    try:
+        found = meshcurv.diagnose(vertices, topology)
+    except InvalidMeshError as error:
+        assert "coordinates" in str(error)
+        return
+    assert np.isfinite(found.area) and np.isfinite(found.mean_edge_length)
