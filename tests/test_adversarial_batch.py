@@ -23,7 +23,7 @@ import pytest
 
 import meshcurv
 from meshcurv import shapes
-from meshcurv.errors import InvalidOptionError, MeshcurvWarning, MeshFileError
+from meshcurv.errors import MeshcurvWarning, MeshFileError
 
 pytest.importorskip("distributed")
 pytest.importorskip("pandas")

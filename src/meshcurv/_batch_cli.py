@@ -58,7 +58,8 @@ def batch_command() -> click.Command:
 
     @click.command()
     @click.argument("inputs", nargs=-1, required=True)
-    @click.option("-o", "--output-dir", "out_dir", required=True, type=click.Path(readable=False, path_type=pathlib.Path),
+    @click.option("-o", "--output-dir", "out_dir", required=True,
+                  type=click.Path(readable=False, path_type=pathlib.Path),
                   help="Folder of the results and of summary.parquet / summary.csv (created if needed).")
     @method_options
     @click.option("--format", "output_format", type=click.Choice(OUTPUT_FORMATS), default="ply", show_default=True,

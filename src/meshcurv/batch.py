@@ -917,7 +917,8 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
         raise InvalidOptionError("give `client` or `scheduler`, not both")
     if workers is not None:
         if client is not None or scheduler is not None:
-            raise InvalidOptionError("`workers` sizes the local cluster; it cannot be used with `client` or `scheduler`")
+            raise InvalidOptionError(
+                "`workers` sizes the local cluster; it cannot be used with `client` or `scheduler`")
         workers = check_int_option(workers, "workers", minimum=1, maximum=MAX_WORKERS)
     if timeout is not None:
         timeout = check_positive_float(timeout, "timeout")
