@@ -365,7 +365,9 @@ def main(argv=None):
         text = ["", "## Speed (torus samples, normals estimated, end to end)", "",
                 "| points | method | seconds |", "|---|---|---|"]
         text += [f"| {n} | {m} | {s:.2f} |" for n, m, s in rows]
-        text.append(f"\nProduced by `{command.strip()}` (commit {_git_head()}).")
+        load = ", ".join(f"{x:.1f}" for x in __import__("os").getloadavg())
+        text.append(f"\nProduced by `{command.strip()}` (commit {_git_head()}); load average at the end: {load} "
+                    f"(on {__import__('os').cpu_count()} cores: other processes share the machine).")
         print("\n".join(text))
         output = Path(args.output)
         if output.exists():
