@@ -42,7 +42,6 @@ from pathlib import Path
 
 import numpy as np
 
-from meshcurv import shapes
 from meshcurv._tensors import principal_from_shape_operator
 from meshcurv.pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
 
@@ -158,7 +157,7 @@ def noisy(points, normals, area, level, seed=1):
     return points + t[:, None] * normals
 
 
-def errors(normals, k_min, k_max, dir_max, valid, exact):
+def errors(normals, k_min, k_max, dir_max, valid, exact, dir_min=None):
     """Median relative errors of H and K, median direction angle (degrees), share of exact-side normals."""
     e_normals, e_min, e_max, e_dir = exact
     side = np.sign(np.einsum("ij,ij->i", normals, e_normals))
@@ -172,8 +171,8 @@ def errors(normals, k_min, k_max, dir_max, valid, exact):
            "cover": float(np.mean(m))}
     distinct = m & (np.abs(e_max - e_min) > 0.5 * s)
     if dir_max is not None and distinct.any():
-        d = np.where(side[:, None] > 0, dir_max, np.nan) if False else dir_max
-        # where the signs were flipped, the exact k_max goes with the estimate's k_min direction
+        # where the normal is on the other side, the exact k_max goes with the estimate's k_min direction
+        d = dir_max if dir_min is None else np.where(side[:, None] > 0, dir_max, dir_min)
         cos = np.abs(np.einsum("ij,ij->i", d, e_dir))[distinct]
         out["dir"] = float(np.degrees(np.median(np.arccos(np.clip(cos, 0, 1)))))
     else:
@@ -253,7 +252,7 @@ def run(surfaces, noise_levels, n, peer=True, methods=POINT_CLOUD_METHODS):
                             start = time.perf_counter()
                             r = point_cloud_curvatures(points, normals=normals if given else None, method=method)
                             seconds = time.perf_counter() - start
-                        e = errors(r.normals, r.k_min, r.k_max, r.dir_max, r.valid, exact)
+                        e = errors(r.normals, r.k_min, r.k_max, r.dir_max, r.valid, exact, r.dir_min)
                         rows.append((*label, f"meshcurv {method}", e, seconds, r.parameters.get("radius")))
                         print(rows[-1], flush=True)
                     if has_peer:

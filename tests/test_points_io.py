@@ -163,7 +163,8 @@ def test_paths_are_checked(tmp_path, cloud):
         read_points(tmp_path / "missing.xyz")
     unknown = tmp_path / "cloud.e57"
     unknown.write_text("1 2 3\n")
-    with pytest.raises(MeshFileError, match=r"cloud.e57: unknown point-cloud file extension '.e57'; known formats: .ply"):
+    with pytest.raises(MeshFileError,
+                       match=r"cloud.e57: unknown point-cloud file extension '.e57'; known formats: .ply"):
         read_points(unknown)
     path = tmp_path / "cloud.ply"
     write_points(path, cloud[0])

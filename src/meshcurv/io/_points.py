@@ -120,7 +120,8 @@ def _suffix(path: pathlib.Path, file_format: str | None) -> str:
     key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
     key = (key or path.suffix).lower()
     if key not in POINT_EXTENSIONS:
-        what = f"format {file_format!r}" if file_format else f"extension {path.suffix!r}" if path.suffix else "no extension"
+        what = (f"format {file_format!r}" if file_format
+                else f"extension {path.suffix!r}" if path.suffix else "no extension")
         raise MeshFileError(f"{path}: unknown point-cloud file {what}; known formats: {', '.join(POINT_EXTENSIONS)}")
     return key
 
