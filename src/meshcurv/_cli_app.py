@@ -177,8 +177,8 @@ def method_options(function):
         click.option("--radius", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
                      help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
                           "default from the mesh: see `meshcurv methods`)."),
-        click.option("--orient", type=click.Choice(["keep", "consistent", "outward"]), default=None,
-                     help="Reorient the faces first (default: keep)."),
+        click.option("--orient", type=click.Choice(["auto", "outward", "consistent", "keep"]), default=None,
+                     help="Reorient the faces first (default: auto = outward, keep for matgeom)."),
     ]
     for option in reversed(options):
         function = option(function)

@@ -246,7 +246,7 @@ def check_int_option(value, name: str, *, minimum: int = 0, maximum: int | None 
     if number < minimum:
         raise InvalidOptionError(f"`{name}` must be {expected}; got {_short_repr(number)}")
     if number > top:
-        raise InvalidOptionError(f"`{name}` must be {expected} and at most {top}; got {_short_repr(number)}")
+        raise InvalidOptionError(f"`{name}` must be {expected}; got {_short_repr(number)}")
     return int(number)
 
 

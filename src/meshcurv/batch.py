@@ -360,8 +360,8 @@ def _options(method, smoothing_steps, radius, orient) -> dict:
         value = check_int_option(value, name) if name == "smoothing_steps" else check_positive_float(value, name)
         if value != defaults[name]:
             options[name] = value
-    if orient is not None and check_choice(orient, "orient", ORIENT_CHOICES) != "keep":
-        options["orient"] = orient
+    if orient is not None and check_choice(orient, "orient", ORIENT_CHOICES) != "auto":
+        options["orient"] = orient  # 'auto' is the default: recorded the same as nothing
     return options
 
 
