@@ -1,11 +1,14 @@
 """Speed and memory of every meshcurv method and of the peers, on the same meshes (issue 4).
 
-Run from the repository root (peers: libigl, vtk, trimesh, pymeshlab from PyPI;
-those not installed are listed as such)::
+Run from the repository root (peers: libigl, vtk, trimesh, pymeshlab and trueform
+from PyPI; those not installed are listed as such. trueform's licence is
+non-commercial: it is a benchmark peer only, imported here when installed, never
+a dependency of meshcurv)::
 
     python benchmarks/speed.py                          # 10k, 100k, igea, 1M, 4M; writes benchmarks/speed.md
     python benchmarks/speed.py --sizes 10k,100k         # a quick check
     python benchmarks/speed.py --no-peers --budget 600  # meshcurv only, slow methods allowed 10 min per call
+    python benchmarks/speed.py --sizes 100k,655k,1M --methods icc,normal_cycle,matgeom --backends numba
 
 Meshes: ``meshcurv.shapes.icosphere(n)`` (10 n^2 + 2 vertices: 10k n=32, 100k
 n=100, 1M n=316, 4M n=632) and ``/work/shared/meshes/igea.obj`` (134k vertices)
@@ -16,10 +19,10 @@ How each figure is measured:
 - **time**: median of ``--repeats`` calls (at most 3 from 2M vertices; a single
   call when the first takes more than ``--long`` seconds) in this process, on the
   same in-memory arrays, after a warm-up of every implementation on a small mesh
-  (numba kernels loaded from the cache). meshcurv, libigl and VTK run in this
-  process; trimesh and pymeshlab run in a child process (pymeshlab can abort its
-  process; trimesh is stopped at ``--trimesh-budget``) fed the same arrays
-  through .npy files, the repeats in that child.
+  (numba kernels loaded from the cache). meshcurv runs in this process; every
+  peer (libigl, VTK, trueform, trimesh, pymeshlab) runs in a child process
+  (pymeshlab can abort its process; trimesh is stopped at ``--trimesh-budget``)
+  fed the same arrays through .npy files, the repeats in that child.
 - **first call, fresh process** and **peak RSS**: each implementation once in a
   fresh ``python`` process that loads the arrays from .npy files (its peak RSS,
   ``VmHWM`` of /proc/self/status after the call: the whole process, interpreter,
@@ -75,6 +78,8 @@ TARGETS = {
     "time_1m": 1.0,          # s at 1M, the default method and matgeom
     "vs_libigl": 20.0,       # libigl / meshcurv at 1M
     "vs_vtk": 1.0,           # VTK / meshcurv at 1M (> 1)
+    "vs_trueform": 1.0,      # trueform (k=2, directions) / default method at 1M (issue 15)
+    "vs_trueform_ring": 2.0,  # trueform (k=2, directions) / normal_cycle and matgeom at 1M
     "vs_lower": 10.0,        # meshcurv / lower bound at 1M
     "growth": 4.5,           # t(4M) / t(1M)
     "rss_4m": 6 * GIB,       # peak RSS at 4M
@@ -148,13 +153,18 @@ def default_backend() -> str:
     return "numba" if numba_kernels() is not None else "numpy"
 
 
-def meshcurv_keys() -> list:
+def meshcurv_keys(methods=None, chosen_backends=None) -> list:
+    """Keys of the meshcurv rows: ``methods`` and ``chosen_backends`` (default: all) that exist."""
     from meshcurv.estimators import ESTIMATORS
 
     keys = []
     for backend in backends():
+        if chosen_backends and backend not in chosen_backends:
+            continue
         keys.append(f"topology/{backend}")
         for method in ESTIMATORS:
+            if methods and method not in methods:
+                continue
             keys.append(f"meshcurv/{method}/{backend}")
             if method in ("normal_cycle", "matgeom"):
                 keys.append(f"meshcurv/{method}/{backend}/topo")
@@ -169,14 +179,23 @@ def radius_methods() -> list:
 
 PEERS = {
     # key: (label, import name, distribution, where it runs)
-    "libigl": ("libigl principal_curvature (quadric, radius 5 rings)", "igl", "libigl", "in-process"),
-    "vtk": ("VTK vtkCurvatures mean + Gaussian (1-ring, no directions)", "vtk", "vtk", "in-process"),
+    "libigl": ("libigl principal_curvature (quadric, radius 5 rings)", "igl", "libigl", "child process"),
+    "vtk": ("VTK vtkCurvatures mean + Gaussian (1-ring, no directions)", "vtk", "vtk", "child process"),
+    # trueform: non-commercial licence, a benchmark peer only (never a dependency of meshcurv)
+    "trueform": ("trueform principal_curvatures(k=2) (k-ring quadric, no directions)", "trueform", "trueform",
+                 "child process"),
+    "trueform/directions": ("trueform principal_curvatures(k=2, directions=True)", "trueform", "trueform",
+                            "child process"),
     "trimesh": ("trimesh ball measures, mean + Gaussian (r = 2 mean edges, no directions)", "trimesh",
                 "trimesh", "child process"),
     **{f"meshlab/{m}": (f"pymeshlab principal directions, {m}", "pymeshlab", "pymeshlab", "child process")
        for m in MESHLAB_METHODS},
 }
-SUBPROCESS_PEERS = {"trimesh"} | {f"meshlab/{m}" for m in MESHLAB_METHODS}
+#: Every peer runs in a child process fed the same arrays (its repeats inside it): a peer's threads,
+#: allocator and crashes (pymeshlab can abort) stay out of meshcurv's measurements.
+SUBPROCESS_PEERS = set(PEERS)
+#: The peer with directions that the default method is compared with (issue 15).
+TRUEFORM = "trueform/directions"
 
 
 def peers_installed():
@@ -217,6 +236,11 @@ def make_call(key: str, v: np.ndarray, f: np.ndarray):
         return lambda: igl.principal_curvature(v, f)
     if key == "vtk":
         return lambda: run_vtk(v, f)
+    if key in ("trueform", "trueform/directions"):
+        import trueform
+
+        directions = key.endswith("/directions")
+        return lambda: trueform.principal_curvatures((f, v), k=2, directions=directions)
     if key == "trimesh":
         import trimesh
         from meshcurv.geometry import mean_edge_length
@@ -485,7 +509,7 @@ def machine_info():
                     mem = int(line.split()[1]) * 1024
     versions = {}
     for dist in ("meshcurv", "numpy", "scipy", "numba", "llvmlite", "libigl", "vtk", "trimesh", "rtree",
-                 "pymeshlab"):
+                 "pymeshlab", "trueform"):
         with contextlib.suppress(importlib.metadata.PackageNotFoundError):
             versions[dist] = importlib.metadata.version(dist)
     commit = ""
@@ -604,7 +628,9 @@ class Bench:
         self.default_key = f"meshcurv/{DEFAULT_METHOD}/{self.default_backend}"
         found, missing = peers_installed() if args.peers else ({}, {})
         self.found, self.missing = found, missing
-        keys = ["lower_bound"] + meshcurv_keys() + list(found)
+        methods = [m for m in args.methods.split(",") if m] if args.methods else None
+        chosen = [b for b in args.backends.split(",") if b] if args.backends else None
+        keys = ["lower_bound"] + meshcurv_keys(methods, chosen) + list(found)
         log(f"implementations: {len(keys)}; default: {self.default_key}")
 
         log("import time ...")
@@ -727,7 +753,7 @@ def markdown(bench) -> str:
     v = info["versions"]
     peer_versions = "; ".join(sorted(set(bench.found.values()))) or "none"
     lines = [
-        "# Speed and memory (issue 4)",
+        "# Speed and memory (issues 4 and 15)",
         "",
         f"Generated {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')} by "
         f"`{' '.join(['python benchmarks/speed.py'] + sys.argv[1:])}`",
@@ -749,13 +775,14 @@ def markdown(bench) -> str:
     lines += [
         "",
         "Time: median of the calls in one process on the same in-memory arrays, after a warm-up on a small "
-        "mesh (meshcurv, libigl, VTK in this process; trimesh and pymeshlab in a child process fed the same "
-        "arrays, repeats inside it). `runs`: calls in the median. `fresh`: the same call once in a fresh "
+        "mesh (meshcurv in this process; every peer in a child process fed the same arrays through .npy "
+        "files, its repeats inside it, `fresh` its first call there). `runs`: calls in the median. `fresh`: the same call once in a fresh "
         "process (numba rows: kernels loaded from the numba cache). Peak RSS: the high-water mark (`VmHWM`, "
         "what `ru_maxrss` reports without the value Linux carries over from the parent process) of that fresh "
         "process after the call (interpreter, libraries and the input arrays included); bytes/vertex = peak "
         "RSS / V. `÷ lower` = time / lower bound; `÷ default` = time / meshcurv's default method "
-        f"({bench.default_method}, default backend); `libigl ÷`, `VTK ÷` = their time / this time (how many times faster than them). "
+        f"({bench.default_method}, default backend); `libigl ÷`, `VTK ÷`, `trueform ÷` = their time / this time (how many times "
+        "faster than them; trueform: `principal_curvatures(k=2, directions=True)`). "
         f"Budget: {args.budget:.0f} s per call (trimesh {args.trimesh_budget:.0f} s); 'est.' = linear "
         "extrapolation from the previous size, not run.",
         "",
@@ -803,6 +830,10 @@ def markdown(bench) -> str:
             r = ratio(t(one_m, "vtk"), tm)
             lines.append(f"| {method} faster than VTK (mean/Gaussian only) at 1M | VTK ÷ meshcurv = {fmt_ratio(r)} | "
                          f"{met(None if r is None else r > TARGETS['vs_vtk'])} |")
+            r = ratio(t(one_m, TRUEFORM), tm)
+            need = TARGETS["vs_trueform"] if method == bench.default_method else TARGETS["vs_trueform_ring"]
+            lines.append(f"| {method} >= {need:g}x as fast as trueform (k=2, directions) at 1M | "
+                         f"trueform ÷ meshcurv = {fmt_ratio(r)} | {met(None if r is None else r >= need)} |")
             r = ratio(tm, lb)
             lines.append(f"| {method} within 10x of the lower bound at 1M ({fmt_s(lb)} s) | {fmt_ratio(r)} | "
                          f"{met(None if r is None else r <= TARGETS['vs_lower'])} |")
@@ -844,16 +875,16 @@ def markdown(bench) -> str:
     for label, name, n, n_faces in bench.meshes:
         lb = t(label, "lower_bound")
         ref = t(label, bench.default_key)
-        igl_t, vtk_t = t(label, "libigl"), t(label, "vtk")
+        igl_t, vtk_t, tf_t = t(label, "libigl"), t(label, "vtk"), t(label, TRUEFORM)
         lines += [f"## {label}: {name}, {n:,} vertices, {n_faces:,} faces", "",
                   "| implementation | median s | runs | fresh s | peak RSS MiB | bytes/vertex | ÷ lower | "
-                  "÷ default | libigl ÷ | VTK ÷ |",
-                  "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
+                  "÷ default | libigl ÷ | VTK ÷ | trueform ÷ |",
+                  "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
         for row in bench.rows[label]:
             key = row["key"]
             if "skipped" in row or "error" in row:
                 what = row.get("skipped") or "error: " + row["error"]
-                lines.append(f"| {row['label']} | {what} | | | | | | | | |")
+                lines.append(f"| {row['label']} | {what} | | | | | | | | | |")
                 continue
             tm = median(row)
             peak = row.get("peak_rss")
@@ -864,7 +895,8 @@ def markdown(bench) -> str:
                      fmt_ratio(ratio(tm, lb)) if key != "lower_bound" else "1x",
                      fmt_ratio(ratio(tm, ref)),
                      fmt_ratio(ratio(igl_t, tm)) if is_mc else "",
-                     fmt_ratio(ratio(vtk_t, tm)) if is_mc else ""]
+                     fmt_ratio(ratio(vtk_t, tm)) if is_mc else "",
+                     fmt_ratio(ratio(tf_t, tm)) if is_mc else ""]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
 
@@ -955,6 +987,9 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="10k,100k,1M,4M",
                         help="icosphere sizes (10k, 100k, 1M, 4M or e.g. 250k); default %(default)s")
+    parser.add_argument("--methods", default="",
+                        help="meshcurv methods to time, comma-separated (default: all)")
+    parser.add_argument("--backends", default="", help="numpy, numba or both (default: all installed)")
     parser.add_argument("--repeats", type=int, default=5, help="calls per median (3 at most from 2M vertices)")
     parser.add_argument("--output", default=OUTPUT, help="markdown file to write (default: %(default)s)")
     parser.add_argument("--peers", action=argparse.BooleanOptionalAction, default=True,
