@@ -249,3 +249,18 @@ def test_a_very_sparse_cloud_gets_a_bounded_radius_and_the_warning():
     with pytest.warns(MeshQualityWarning, match="too sparse or too noisy for its size"):
         r = point_cloud_curvatures(points)
     assert r.parameters["radius"] <= 0.25 * np.linalg.norm(np.ptp(points, axis=0)) + 1e-12
+
+
+def test_consistent_given_normals_of_a_thin_plate_are_kept():
+    # two sheets 0.02 apart, spacing about 0.03: each point's nearest neighbours include the other side,
+    # whose normals face the other way; the given (consistent) normals must not be "reoriented"
+    rng = np.random.default_rng(0)
+    sheet = rng.uniform(-1, 1, (6000, 2))
+    points = np.column_stack([sheet, np.where(np.arange(6000) < 3000, 0.01, -0.01)])
+    normals = np.zeros((6000, 3))
+    normals[:, 2] = np.where(np.arange(6000) < 3000, 1.0, -1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)  # the balls hold both sheets
+        r = point_cloud_curvatures(points, normals=normals)
+    assert r.parameters["normals"] == "given"
+    assert (np.einsum("ij,ij->i", r.normals, normals) > 0).all()

@@ -35,6 +35,13 @@ SPACING_NEIGHBOUR = 8
 #: Neighbours per point in the graph of the orientation (the nearest of the query's).
 GRAPH_NEIGHBOURS = 6
 
+#: With given normals, an edge of the orientation graph is steep when an end lies beyond this slope
+#: (15 degrees) of the other's tangent plane (see :func:`orientation_signs`).
+TANGENT_SLOPE = 0.25
+
+#: A point keeps its steep edges (except back-to-back ones) when fewer than this many of its edges are flat.
+MIN_FLAT_EDGES = 3
+
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
 
@@ -88,7 +95,8 @@ def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     return normals
 
 
-def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarray):
+def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarray, *, given: bool = False,
+                      points: np.ndarray | None = None):
     """Signs (+1/-1) that orient ``normals`` consistently, and the component label of each point.
 
     Parameters
@@ -100,6 +108,23 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
         :data:`GRAPH_NEIGHBOURS` are the graph's edges.
     usable : ndarray of shape (N,), bool
         Points that enter the graph (outliers do not; each is its own component).
+    given : bool, default: False
+        The signs carry information (normals given by the user): the edges
+        are weighted ``1 - n_i . n_j`` instead of ``1 - |n_i . n_j|``, so that
+        the tree follows agreeing pairs and crosses to an opposite normal only
+        where no agreeing path exists. Consistent normals on the two sides of
+        a part thinner than the spacing (whose nearest neighbours face the
+        other way) then stay as they are; with ``1 - |n_i . n_j|`` the tree
+        would take those anti-parallel pairs as well and flip one side.
+    points : ndarray of shape (N, 3), optional
+        The positions (given normals): an edge is steep where an end lies
+        beyond :data:`TANGENT_SLOPE` of the other's tangent plane
+        (``|n . d| > 0.25 |d|``). A steep edge is dropped where its point has
+        :data:`MIN_FLAT_EDGES` flat ones, and always when its normals are
+        opposite and both point away from the other point (back to back: the
+        two sides of a part thinner than the neighbourhood, whose consistent
+        normals must not be "corrected" into one direction). A point that
+        noise lifted off its neighbours' planes keeps its other steep edges.
 
     Returns
     -------
@@ -118,9 +143,24 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
     cols = indices.ravel()
     keep = usable[rows] & usable[cols] & (rows != cols)
     rows, cols = rows[keep], cols[keep]
+    if points is not None:
+        offsets = points[cols] - points[rows]
+        reach = TANGENT_SLOPE * np.linalg.norm(offsets, axis=1)
+        along = np.maximum(np.abs(np.einsum("ij,ij->i", offsets, normals[rows])),
+                           np.abs(np.einsum("ij,ij->i", offsets, normals[cols])))
+        flat = along <= reach
+        # a steep edge is dropped only where its point keeps enough flat ones: a point that noise
+        # lifted off its neighbours' planes stays joined to them
+        enough = np.bincount(rows, weights=flat, minlength=n) >= MIN_FLAT_EDGES
+        # opposite normals that both point away from the other point: the two sides of a thin part
+        ahead = np.einsum("ij,ij->i", offsets, normals[rows])
+        behind = np.einsum("ij,ij->i", offsets, normals[cols])
+        back_to_back = (ahead < 0) & (behind > 0) & (np.einsum("ij,ij->i", normals[rows], normals[cols]) < 0)
+        keep = flat | (~enough[rows] & ~back_to_back)
+        rows, cols = rows[keep], cols[keep]
     cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
-    # weight 1 - |cos|, plus a floor so that parallel pairs stay edges of the sparse graph
-    weights = 1.0 - np.abs(cosine) + 1e-6
+    # weight 1 - |cos| (1 - cos for given signs), plus a floor so that parallel pairs stay edges of the sparse graph
+    weights = (1.0 - cosine if given else 1.0 - np.abs(cosine)) + 1e-6
     graph = coo_matrix((weights, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
     # both searches treat the graph as undirected: (i, j) is an edge when either is among the other's neighbours
     n_components, labels = connected_components(graph[:n, :n], directed=False)

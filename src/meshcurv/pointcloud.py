@@ -289,7 +289,7 @@ def _compute(points, given, radius, method):
         start = start * _normals.outward_signs(points, start, labels, np.where(usable, spacing**2, 0.0))[:, None]
         how = "estimated"
     else:
-        signs, labels = _normals.orientation_signs(given, indices, usable)
+        signs, labels = _normals.orientation_signs(given, indices, usable, given=True, points=points)
         # each component keeps the side most of its given normals point to
         majority = np.bincount(labels, weights=signs, minlength=int(labels.max()) + 1)
         signs = signs * np.where(majority[labels] < 0, -1.0, 1.0)
