@@ -121,7 +121,9 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         Normals at the points, of any length (not zero) and any signs. Used
         when given: made unit; if their signs are not consistent they are
         oriented along a minimum spanning tree of the neighbour graph, each
-        connected part keeping the side most of its given normals point to.
+        connected part keeping the side most of its given normals point to
+        (the two sides of a part thinner than the neighbourhood, whose normals
+        point back to back, are not joined, so that both keep their sides).
         The curvature signs follow them. Default: estimated (PCA of the 10
         nearest neighbours), oriented consistently and outward on closed
         shapes.
