@@ -22,7 +22,8 @@ from .errors import (
     MeshQualityWarning,
     TriangulationWarning,
 )
-from .io import read_mesh, write_mesh
+from .io import read_mesh, read_points, write_mesh, write_points
+from .pointcloud import point_cloud_curvatures
 from .orient import orient_faces
 from .result import CurvatureResult
 from .smoothing import smooth_vertex_field
@@ -32,7 +33,10 @@ __version__ = "0.1.0"
 
 __all__ = [
     "principal_curvatures",
+    "point_cloud_curvatures",
     "read_mesh",
+    "read_points",
+    "write_points",
     "write_mesh",
     "METHODS",
     "CurvatureResult",

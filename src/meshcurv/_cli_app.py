@@ -18,7 +18,8 @@ from .curvature import principal_curvatures
 from .diagnosis import diagnose
 from .errors import MeshFileError
 from .estimators import ESTIMATORS
-from .io import FORMATS, read_mesh, write_curvatures
+from .io import FORMATS, is_point_cloud, read_mesh, read_points, write_curvatures, write_point_curvatures
+from .pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
 from .io._files import check_output
 from .io.fields import FIELDS, curvature_fields
 from .smoothing import MAX_SMOOTHING_STEPS
@@ -151,11 +152,11 @@ class MethodChoice(click.Choice):
     """The names of :data:`meshcurv.estimators.ESTIMATORS`, read when used (methods can be added)."""
 
     def __init__(self):
-        super().__init__(list(ESTIMATORS))
+        super().__init__(list(ESTIMATORS) + list(POINT_CLOUD_METHODS))
 
     @property
     def choices(self):
-        return tuple(ESTIMATORS)
+        return tuple(ESTIMATORS) + tuple(POINT_CLOUD_METHODS)
 
     @choices.setter
     def choices(self, value):
@@ -246,10 +247,19 @@ def meshcurv():
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
 @common_options
 def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite):
-    """Compute the curvatures of MESH; write them with -o, or print a summary table."""
-    session = click.get_current_context().find_object(Session)
+    """Compute the curvatures of MESH (a mesh or a point cloud); write them with -o, or print a summary table."""
+    context = click.get_current_context()
+    session = context.find_object(Session)
     if output is not None:
         _check_output(output, overwrite=overwrite, source=mesh, needs_fields=True)
+    given_method = context.get_parameter_source("method") != click.core.ParameterSource.DEFAULT
+    if is_point_cloud(mesh):
+        _compute_points(mesh, output, method if given_method else None, smoothing_steps, radius, orient,
+                        fields, quality, ascii_, overwrite, session)
+        return
+    if method in POINT_CLOUD_METHODS:
+        raise click.UsageError(f"method {method!r} is for point clouds; {mesh} is a mesh (methods: "
+                               f"{', '.join(ESTIMATORS)})")
     stages = ["read", *ESTIMATORS[method].stages, "write" if output is not None else "summary"]
     bar = session.bar(stages)
     try:
@@ -270,10 +280,31 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
     click.echo(_summary(mesh, vertices, faces, result, fields))
 
 
+def _compute_points(path, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite,
+                    session) -> None:
+    """``meshcurv compute`` of a point cloud (a file without faces): :func:`meshcurv.point_cloud_curvatures`."""
+    if method is not None and method not in POINT_CLOUD_METHODS:
+        raise click.UsageError(f"method {method!r} needs faces; {path} is a point cloud (methods: "
+                               f"{', '.join(POINT_CLOUD_METHODS)})")
+    for name, value in (("smoothing-steps", smoothing_steps), ("orient", orient)):
+        if value is not None:
+            raise click.UsageError(f"--{name} is for meshes; {path} is a point cloud")
+    points, normals = read_points(path)
+    result = point_cloud_curvatures(points, normals=normals, radius=radius, method=method)
+    if output is not None:
+        write_point_curvatures(output, points, result, fields=fields, quality=quality, overwrite=overwrite,
+                               source=path, binary=not ascii_)
+        written = fields or list(FIELDS)
+        session.info(f"wrote {output}: {len(points)} points, fields {', '.join(written)} (quality = {quality})")
+        return
+    click.echo(_summary(path, points, np.zeros((0, 3), dtype=np.int64), result, fields))
+
+
 def _summary(path, vertices, faces, result, fields) -> str:
     parameters = ", ".join(f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
                            for key, value in result.parameters.items())
-    lines = [f"{path}: {len(vertices)} vertices, {len(faces)} faces; method {result.method}"
+    size = f"{len(vertices)} vertices, {len(faces)} faces" if len(faces) else f"{len(vertices)} points"
+    lines = [f"{path}: {size}; method {result.method}"
              + (f" ({parameters})" if parameters else "")]
     columns = ["min", "p5", "p25", "median", "p75", "p95", "max", "mean"]
     lines.append(f"{'field':<12}" + "".join(f"{name:>11}" for name in columns))

@@ -163,9 +163,9 @@ _GLOB_CHARACTERS = re.compile(r"[*?\[]")
 
 
 def _readable_extensions() -> set[str]:
-    from .io import FORMATS
+    from .io import FORMATS, POINT_EXTENSIONS
 
-    return {extension for extension, fmt in FORMATS.items() if fmt.read is not None}
+    return {extension for extension, fmt in FORMATS.items() if fmt.read is not None} | set(POINT_EXTENSIONS)
 
 
 def _identity(path) -> tuple[int, int] | None:
@@ -603,8 +603,9 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
         took longer than ``timeout`` or killed its workers.
     """
     from .curvature import principal_curvatures
-    from .io import read_mesh, write_curvatures
+    from .io import is_point_cloud, read_mesh, read_points, write_curvatures, write_point_curvatures
     from .io._files import atomic_output
+    from .pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
 
     start = time.perf_counter()
     source, output, record = pathlib.Path(source), pathlib.Path(output), pathlib.Path(record)
@@ -634,20 +635,33 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
             attempt.write_text(json.dumps({"run": run_id, "deaths": deaths, "deadline": deadline}))
         with _time_limit(timeout), warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            vertices, faces = read_mesh(source)
-            result = principal_curvatures(vertices, faces, method=method, **options)
+            if is_point_cloud(source):  # a file without faces: the point-cloud estimators, their default
+                vertices, normals = read_points(source)
+                faces = None
+                result = point_cloud_curvatures(vertices, normals=normals, radius=options.get("radius"),
+                                                method=method if method in POINT_CLOUD_METHODS else None)
+                row["method"] = result.method
+            else:
+                vertices, faces = read_mesh(source)
+                result = principal_curvatures(vertices, faces, method=method, **options)
         facts_of = result.diagnosis
-        row.update(
-            n_vertices=facts_of.n_vertices, n_faces=facts_of.n_faces, area=facts_of.area,
-            volume=np.nan if facts_of.volume is None else facts_of.volume,
-            euler_characteristic=facts_of.euler_characteristic, n_components=facts_of.n_components,
-            n_boundary_loops=facts_of.n_boundary_loops, n_invalid=int((~result.valid).sum()),
-            warnings="; ".join(dict.fromkeys(str(warning.message) for warning in caught)),
-        )
+        if facts_of is None:  # a point cloud
+            row.update(n_vertices=vertices.shape[0], n_faces=0, area=np.nan, volume=np.nan)
+        else:
+            row.update(
+                n_vertices=facts_of.n_vertices, n_faces=facts_of.n_faces, area=facts_of.area,
+                volume=np.nan if facts_of.volume is None else facts_of.volume,
+                euler_characteristic=facts_of.euler_characteristic, n_components=facts_of.n_components,
+                n_boundary_loops=facts_of.n_boundary_loops)
+        row.update(n_invalid=int((~result.valid).sum()),
+                   warnings="; ".join(dict.fromkeys(str(warning.message) for warning in caught)))
         row.update(_statistics(result))
         output.parent.mkdir(parents=True, exist_ok=True)
         with atomic_output(output) as temporary:
-            write_curvatures(temporary, vertices, faces, result, overwrite=True, source=source)
+            if faces is None:
+                write_point_curvatures(temporary, vertices, result, overwrite=True, source=source)
+            else:
+                write_curvatures(temporary, vertices, faces, result, overwrite=True, source=source)
             inputs = {_identity(source): source}
             _refuse_input(output, inputs)  # the output folder may have become an alias of the input's
             _refuse_input(record, inputs)
