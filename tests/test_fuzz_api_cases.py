@@ -287,3 +287,21 @@ def test_curvatures_with_a_component_without_edges(method):
         result = meshcurv.principal_curvatures(vertices, faces, method=method)
     assert not result.valid[-1]
     assert result.valid[:-1].all()
+
+
+# --- orient_faces and smooth_vertex_field: loosely taken arguments -----------------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: orient_faces takes any truthy `outward` ('no' orients "
+                   "outward, None and [True] are accepted), where principal_curvatures refuses a non-bool `weld`")
+@pytest.mark.parametrize("outward", ["no", None, [True], 1], ids=["str", "None", "list", "int"])
+def test_orient_faces_refuses_a_non_bool_outward(sphere, outward):
+    with pytest.raises(InvalidOptionError, match="outward"):
+        meshcurv.orient_faces(sphere.vertices, sphere.faces, outward=outward)
+
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: smooth_vertex_field drops the imaginary part of complex "
+                   "values with numpy's ComplexWarning instead of refusing them")
+def test_smooth_vertex_field_refuses_complex_values(sphere):
+    topology = meshcurv.MeshTopology.from_faces(sphere.faces)
+    with pytest.raises(InvalidMeshError, match="values"):
+        meshcurv.smooth_vertex_field(np.ones(len(sphere.vertices)) * 1j, topology, 1)
