@@ -258,3 +258,71 @@ def test_diagnosis_agrees(name):
             assert facts["numba"][key] == pytest.approx(value, rel=1e-12, abs=1e-12), key
         else:
             assert facts["numba"][key] == value, key
+
+
+# -- first use: a compilation is announced, a load from the cache is not --------------------
+
+class _Event:
+    """A stand-in for numba.core.event.Event of kind ``numba:compile``."""
+
+    def __init__(self, function, start):
+        self.data = {"dispatcher": type("Dispatcher", (), {"py_func": function})()}
+        self.is_start, self.is_end = start, not start
+
+
+def test_compilation_is_announced_once_on_the_logger(caplog):
+    from meshcurv import _backend
+    from meshcurv._numba_kernels import fit_jets, icc_face_measures
+
+    announcer = _backend._CompileAnnouncer()
+    foreign = _Event(warnings.warn, True)  # a function of another package: never announced
+    with caplog.at_level("INFO", logger="meshcurv"):
+        announcer.on_start(foreign)
+        announcer.on_end(_Event(warnings.warn, False))
+        assert not caplog.records
+        for kernel in (fit_jets.py_func, icc_face_measures.py_func):
+            announcer.on_start(_Event(kernel, True))
+            announcer.on_end(_Event(kernel, False))
+    warned = [r for r in caplog.records if r.levelname == "WARNING"]
+    assert len(warned) == 1 and "compiling meshcurv's numba kernels" in warned[0].getMessage()
+    assert "cached on disk" in warned[0].getMessage()
+    infos = [r.getMessage() for r in caplog.records if r.levelname == "INFO"]
+    assert [m.split()[4] for m in infos] == ["fit_jets", "icc_face_measures"]
+    assert [name for name, _ in announcer.compiled] == ["fit_jets", "icc_face_measures"]
+
+
+def test_nested_compilations_count_once(caplog):
+    from meshcurv import _backend
+    from meshcurv._numba_kernels import _grid, fit_jets
+
+    announcer = _backend._CompileAnnouncer()
+    with caplog.at_level("INFO", logger="meshcurv"):
+        announcer.on_start(_Event(fit_jets.py_func, True))
+        announcer.on_start(_Event(_grid.py_func, True))  # a callee compiled inside its caller
+        announcer.on_end(_Event(_grid.py_func, False))
+        announcer.on_end(_Event(fit_jets.py_func, False))
+    assert [name for name, _ in announcer.compiled] == ["fit_jets"]
+
+
+SNIPPET = """
+import logging, numpy as np
+logging.basicConfig(level=logging.INFO, format="%(levelname)s %(message)s")
+from meshcurv._backend import numba_kernels
+numba_kernels().edge_lengths(np.eye(3), np.array([[0, 1], [1, 2]]))
+"""
+
+
+@pytest.mark.slow
+def test_cold_cache_compiles_and_announces_warm_cache_loads_silently(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), MESHCURV_BACKEND="numba")
+    runs = [subprocess.run([sys.executable, "-c", SNIPPET], capture_output=True, text=True, env=env, timeout=120)
+            for _ in range(2)]
+    cold, warm = (run.stderr for run in runs)
+    assert all(run.returncode == 0 for run in runs), cold + warm
+    assert cold.count("WARNING compiling meshcurv's numba kernels") == 1
+    assert "compiled the numba kernel edge_lengths" in cold
+    assert "compiling" not in warm and "compiled" not in warm

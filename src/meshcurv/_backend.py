@@ -17,19 +17,42 @@ whenever it is ``workqueue``; under ``tbb`` and ``omp`` (both thread-safe) the
 calls go straight through. The cost is one attribute lookup and one function
 call per kernel call (about a microsecond) on the other layers; under
 ``workqueue``, concurrent calls run one after the other instead of aborting.
+
+First use: numba compiles a kernel on its first call (only the kernels a call
+reaches, each once per argument types) and caches the machine code on disk
+(``cache=True``; ``NUMBA_CACHE_DIR`` or numba's default), so a later process
+loads it instead. A compilation, unlike a load from the cache, is announced
+once per process on the ``meshcurv`` logger at WARNING level with its rough
+cost (:data:`COMPILE_MESSAGE`), and each compiled kernel at INFO level with its
+time: a first call that spends half a minute compiling must not look like a
+hang, and WARNING is the lowest level that Python shows without any logging
+configuration (its last-resort handler) and that the CLI shows by default; it
+happens once per installation, so it is no noise. numba's event API
+(:mod:`numba.core.event`, ``numba:compile``, fired on cache misses only) tells
+a compilation from a load.
 """
 
 from __future__ import annotations
 
 import contextlib
 import functools
+import logging
 import os
 import threading
+import time
 
 from .errors import InvalidOptionError, MissingDependencyError
 
 BACKENDS = ("auto", "numpy", "numba")
 _override: str | None = None
+
+logger = logging.getLogger(__name__)
+
+#: Logged once per process (WARNING) when a kernel is compiled rather than loaded from the disk cache.
+COMPILE_MESSAGE = (
+    "compiling meshcurv's numba kernels for first use (once per installation: about 30 s for the default "
+    "method, 60 s for all methods on 2 cores); they are cached on disk for later processes (%s)"
+)
 
 
 def _requested() -> str:
@@ -54,7 +77,68 @@ def numba_kernels():
                 "the numba backend needs numba: pip install 'meshcurv[fast]'"
             ) from None
         return None
+    _announce_compilation()
     return _serialised(_numba_kernels)
+
+
+_announcer = None
+
+
+def _announce_compilation() -> None:
+    """Install (once) the listener that announces the compilation of meshcurv's kernels."""
+    global _announcer
+    if _announcer is not None:
+        return
+    from numba.core import event
+
+    class Announcer(_CompileAnnouncer, event.Listener):
+        pass
+
+    _announcer = Announcer()
+    event.register("numba:compile", _announcer)
+
+
+def _cache_location() -> str:
+    from numba.core import config
+
+    return f"NUMBA_CACHE_DIR={config.CACHE_DIR}" if config.CACHE_DIR else "numba's cache beside the package"
+
+
+class _CompileAnnouncer:
+    """numba event listener: logs the compilation of meshcurv's kernels (not loads from the cache)."""
+
+    def __init__(self):
+        self.announced = False
+        self.depth = 0
+        self.started = 0.0
+        self.compiled: list[tuple[str, float]] = []
+
+    @staticmethod
+    def _ours(event) -> str | None:
+        data = event.data or {}
+        function = getattr(data.get("dispatcher"), "py_func", None)
+        module = getattr(function, "__module__", "") or ""
+        return function.__name__ if module.startswith("meshcurv.") else None
+
+    def on_start(self, event):
+        if self._ours(event) is None:
+            return
+        if self.depth == 0:
+            self.started = time.perf_counter()
+            if not self.announced:
+                self.announced = True
+                logger.warning(COMPILE_MESSAGE, _cache_location())
+        self.depth += 1
+
+    def on_end(self, event):
+        name = self._ours(event)
+        if name is None:
+            return
+        self.depth = max(self.depth - 1, 0)
+        if self.depth == 0:
+            seconds = time.perf_counter() - self.started
+            self.compiled.append((name, seconds))
+            logger.info("compiled the numba kernel %s in %.1f s", name, seconds)
 
 
 #: Serialises kernel calls where the threading layer is not thread-safe (see the module's doc).
