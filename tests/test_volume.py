@@ -13,7 +13,6 @@ total Gaussian curvature within 1.2%. The tests allow 3% (area, H) and 2%
 (volume, total K): the targets of issue 17.
 """
 
-import pathlib
 
 import numpy as np
 import pytest
