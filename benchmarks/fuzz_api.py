@@ -622,6 +622,8 @@ def _unchanged(value, snap):
         return np.array_equal(np.ma.getdata(value), snap[1], equal_nan=True) and np.array_equal(
             np.ma.getmaskarray(value), snap[2])
     if kind == "array":
+        if value.dtype == object:  # NaN objects compare unequal: compare what they pickle to
+            return pickle.dumps(value) == pickle.dumps(snap[1])
         try:
             return np.array_equal(value, snap[1], equal_nan=value.dtype.kind in "fc")
         except TypeError:
