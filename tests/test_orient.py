@@ -162,3 +162,36 @@ def test_bad_orient_values_and_inputs_are_refused():
         orient_faces(sphere.vertices, top)
     with pytest.raises(InvalidMeshError, match="look 1-based"):
         orient_faces(sphere.vertices, sphere.faces + 1)
+
+
+@pytest.mark.parametrize("wound", ["as it should be", "every patch outward", "every face inward"])
+def test_a_cavity_wall_faces_into_the_cavity(wound):
+    # a hollow ball: outward means out of the material, so the inner wall's normals point into the cavity,
+    # whose surface then has H = -1/r seen from the material (concave), the outer H = +1/R
+    outer = shapes.icosphere(16, radius=2.0)
+    inner = shapes.icosphere(8, radius=1.0, center=(0.2, 0.0, 0.0))
+    n = outer.vertices.shape[0]
+    vertices = np.vstack([outer.vertices, inner.vertices])
+    right = np.vstack([outer.faces, inner.faces[:, ::-1] + n])
+    faces = {"as it should be": right, "every patch outward": np.vstack([outer.faces, inner.faces + n]),
+             "every face inward": right[:, ::-1]}[wound]
+    fixed, n_flipped = orient_faces(vertices, faces)
+    np.testing.assert_array_equal(np.sort(fixed, axis=1), np.sort(right, axis=1))
+    assert (meshcurv.geometry.face_normals(vertices, fixed) * meshcurv.geometry.face_normals(vertices, right)).sum(
+        axis=1).min() > 0.99
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        r = meshcurv.principal_curvatures(vertices, faces)
+    assert np.median(r.mean[:n]) == pytest.approx(0.5, rel=1e-3)
+    assert np.median(r.mean[n:]) == pytest.approx(-1.0, rel=1e-2)
+
+
+def test_separate_balls_are_each_outward():
+    a, b = shapes.icosphere(8, radius=1.0), shapes.icosphere(8, radius=1.0, center=(1.5, 0.0, 0.0))
+    vertices = np.vstack([a.vertices, b.vertices])  # their bounding boxes overlap, neither holds the other
+    faces = np.vstack([a.faces[:, ::-1], b.faces + a.vertices.shape[0]])
+    fixed, n_flipped = orient_faces(vertices, faces)
+    assert n_flipped == a.faces.shape[0]
+    centres = np.repeat([[0.0, 0.0, 0.0], [1.5, 0.0, 0.0]], [a.faces.shape[0], b.faces.shape[0]], axis=0)
+    away = vertices[fixed].mean(axis=1) - centres
+    assert (np.einsum("ij,ij->i", meshcurv.geometry.face_normals(vertices, fixed), away) > 0).all()
