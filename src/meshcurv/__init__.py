@@ -24,6 +24,8 @@ from .errors import (
 )
 from .io import read_mesh, read_points, write_mesh, write_points
 from .pointcloud import point_cloud_curvatures
+from . import volume
+from .volume import label_curvatures
 from .orient import orient_faces
 from .result import CurvatureResult
 from .smoothing import smooth_vertex_field
@@ -34,6 +36,8 @@ __version__ = "0.1.0"
 __all__ = [
     "principal_curvatures",
     "point_cloud_curvatures",
+    "label_curvatures",
+    "volume",
     "read_mesh",
     "read_points",
     "write_points",

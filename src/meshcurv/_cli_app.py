@@ -230,6 +230,7 @@ def meshcurv():
     meshcurv compute mesh.obj              summary table of the curvatures
     meshcurv compute mesh.obj -o out.ply   per-vertex fields for MeshLab, ParaView, pandas
     meshcurv plot mesh.obj --field mean    a picture
+    meshcurv volume cells.tif -o out/      per-object table of a label image
     meshcurv methods                       the estimators and their options
     """
 
@@ -471,3 +472,7 @@ def demo(output, overwrite):
 from ._batch_cli import batch_command  # noqa: E402  (meshcurv batch, built with the options above)
 
 meshcurv.add_command(batch_command())
+
+from ._volume_cli import volume_command  # noqa: E402  (meshcurv volume: label images to per-object tables)
+
+meshcurv.add_command(volume_command())
