@@ -305,3 +305,25 @@ def test_smooth_vertex_field_refuses_complex_values(sphere):
     topology = meshcurv.MeshTopology.from_faces(sphere.faces)
     with pytest.raises(InvalidMeshError, match="values"):
         meshcurv.smooth_vertex_field(np.ones(len(sphere.vertices)) * 1j, topology, 1)
+
+
+# --- a radius far below the edge length --------------------------------------------------------
+
+@pytest.mark.xfail(strict=True, reason="fuzz finding: normal_cycle_ball takes radius=1e-100 (valid k_min 0.11, "
+                   "k_max 0.56 on the unit sphere) and on the NumPy path radius=1e-300 (valid zeros); no lower bound "
+                   "on `radius`")
+@pytest.mark.parametrize("radius, backend", [(1e-100, "auto"), (1e-100, "numpy"), (1e-300, "numpy")])
+def test_radius_far_below_the_edges_is_refused_or_invalid(monkeypatch, radius, backend):
+    monkeypatch.setenv("MESHCURV_BACKEND", backend)
+    sphere = shapes.icosphere(subdivisions=4)  # radius 1: k_min = k_max = 1
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshcurvWarning)
+            result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball",
+                                                   radius=radius)
+    except InvalidOptionError as error:
+        assert "radius" in str(error)
+        return
+    valid = result.valid
+    assert np.all(np.abs(result.k_min[valid] - 1.0) < 0.5)
+    assert np.all(np.abs(result.k_max[valid] - 1.0) < 0.5)
