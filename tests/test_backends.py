@@ -326,3 +326,16 @@ def test_cold_cache_compiles_and_announces_warm_cache_loads_silently(tmp_path):
     assert cold.count("WARNING compiling meshcurv's numba kernels") == 1
     assert "compiled the numba kernel edge_lengths" in cold
     assert "compiling" not in warm and "compiled" not in warm
+
+
+def test_normalized_normal_sums_agree():
+    from meshcurv import geometry
+    from meshcurv._backend import numba_kernels
+
+    rng = np.random.default_rng(0)
+    summed = rng.standard_normal((2000, 3)) * 10.0 ** rng.integers(-150, 150, (2000, 1))
+    summed[:5] = 0.0  # cancelled sums: NaN
+    summed[5:10] = [1e-100, 0.0, 0.0]  # tiny but not cancelled: unit
+    expected = geometry.normalize_normal_sums(summed)
+    assert np.isnan(expected[:5]).all() and np.allclose(expected[5:10], [1.0, 0.0, 0.0])
+    np.testing.assert_array_equal(numba_kernels().normalize_normal_sums(summed), expected)

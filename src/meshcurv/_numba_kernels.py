@@ -75,6 +75,22 @@ def vertex_normal_sums(cross, faces, n_vertices):
     return out
 
 
+@nb.njit(parallel=True, **_JIT)
+def normalize_normal_sums(summed):
+    """``geometry.normalize_normal_sums``: unit rows of ``summed``, NaN where they (nearly) cancel."""
+    out = np.empty_like(summed)
+    tiny = np.finfo(np.float64).tiny
+    for v in nb.prange(summed.shape[0]):
+        x, y, z = summed[v, 0], summed[v, 1], summed[v, 2]
+        norm = math.sqrt(x * x + y * y + z * z)
+        scale = max(abs(x), abs(y), abs(z))
+        if norm > 1e-12 * max(scale, tiny):
+            out[v, 0], out[v, 1], out[v, 2] = x / norm, y / norm, z / norm
+        else:
+            out[v, 0] = out[v, 1] = out[v, 2] = np.nan
+    return out
+
+
 @nb.njit(**_JIT)
 def vertex_edge_lengths(vertices, edges, n_vertices):
     """``geometry.vertex_edge_lengths``: (V,) mean length of the edges at each vertex (NaN where none)."""

@@ -130,7 +130,7 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
     n = vertices.shape[0]
     kernels = numba_kernels()
     if kernels is not None:
-        return normalize_normal_sums(kernels.vertex_normal_sums(cross, faces, n))
+        return kernels.normalize_normal_sums(kernels.vertex_normal_sums(cross, faces, n))
     flat = faces.ravel()
     summed = np.stack(
         [np.bincount(flat, weights=np.repeat(cross[:, k], 3), minlength=n) for k in range(3)], axis=1

@@ -261,7 +261,9 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
         normals = fitted_normals(vertices, normals, valid, NORMAL_RADIUS_RATIO * radius, neighbours=neighbours)
 
     start("compute face measures")
-    faces = faces[~degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)]
+    kept = ~degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)
+    if not kept.all():  # a copy only when faces are left out
+        faces = faces[kept]
     kernels = numba_kernels()
     measure = kernels.icc_face_measures if kernels is not None else face_measures
     measures = measure(vertices, faces, normals)

@@ -279,17 +279,16 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     mean, _ = check_ball_work(pool_points, radius, centres.size, centres=vertices[centres])
     kernels = numba_kernels()
     if kernels is not None and n:
-        outputs = [np.full((n, 6), np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan),
-                   np.full((n, 3), np.nan), np.zeros(n), np.full(n, np.nan)]
         n_calls = max(1, min(centres.size, int(np.ceil(mean * centres.size / PAIRS_PER_CALL))))
+        outputs = None  # the first call's outputs (the rows of the others' centres filled in from theirs)
         for call in range(n_calls):  # Python between calls: Ctrl-C gets through
             part = centres[call * centres.size // n_calls:(call + 1) * centres.size // n_calls]
             found = kernels.fit_jets(
                 vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
                 64 * kernels.threads(), pool, facing if check else vertices, check, AWAY_FRACTION)
-            if n_calls == 1:
+            if outputs is None:
                 outputs = list(found)
-                break
+                continue
             for whole, piece in zip(outputs, found):
                 whole[part] = piece[part]
         coefficients, t1, t2, normal, counts, away = outputs
