@@ -103,7 +103,11 @@ def base_meshes():
     ]
 
 
-BASES = [(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)) for name, m in base_meshes()]
+_SHAPES = base_meshes()
+BASES = [(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)) for name, m in _SHAPES]
+#: Exact (k_min, k_max) of the closed analytic shapes, for the "truth" relation.
+TRUTH = {name: (np.asarray(m.k_min, float), np.asarray(m.k_max, float)) for name, m in _SHAPES
+         if name in ("icosphere", "torus", "ellipsoid", "random_sphere")}
 
 # ----------------------------------------------------------------------------- garbage values
 
@@ -436,6 +440,10 @@ def make_case(seed: int, index: int):
         vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
         ff, flabel = wrap_faces(rng, f) if rng.random() < 0.3 else (f, "array")
         labels += [f"vertices:{vlabel}", f"faces:{flabel}"]
+        if vlabel == "array" and flabel == "array" and len(labels) == 3 and labels[0] in TRUTH \
+                and method != "matgeom" and rng.random() < 0.3:  # any option values, garbage radii included
+            labels.append(f"relation truth of {labels[0]}")
+            return target, (vv, ff), kwargs, labels, ("truth", labels[0])
         if vlabel == "array" and flabel == "array" and kwargs.get("radius") is None and rng.random() < 0.5 \
                 and all(label.startswith(("noise", "flipped", "faces removed", "vertices permuted")) for label in labels[1:-2]):
             relation = ["scale", "scale", "permute", "unreferenced", "translate"][int(rng.integers(5))]
@@ -700,6 +708,20 @@ def relation_check(args, kwargs, result, relation):
     """
     kind, value = relation
     v, f = args
+    if kind == "truth":  # valid estimates on a clean closed analytic shape: within half the largest curvature
+        k_min, k_max = TRUTH[value]
+        edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))
+        if kwargs.get("radius") is not None and float(result.parameters.get("radius", 0.0)) > edge:
+            return []  # a large ball averages the curvature (the caller's choice): no pointwise truth
+        scale = float(np.max(np.abs(np.concatenate([k_min, k_max]))))
+        valid = result.valid
+        with np.errstate(all="ignore"):
+            error = np.maximum(np.abs(result.k_min - k_min), np.abs(result.k_max - k_max))[valid] / scale
+        if error.size and not (error < 0.5).all():
+            return [f"truth of {value}: {int((~(error < 0.5)).sum())} of {int(valid.sum())} valid vertices off by more "
+                    f"than half the largest curvature (up to {float(np.nanmax(error)):.3g}; parameters "
+                    f"{dict(result.parameters)})"]
+        return []
     n = len(v)
     factor = 1.0
     take = np.arange(n)
@@ -845,7 +867,7 @@ def signature(target, method, outcome):
         return f"{target} | {outcome['type']} at {outcome['where']}"
     if status == "invariant":
         first = outcome["broken"][0]
-        if first.split(" ")[0] in ("scale", "translate", "permute", "unreferenced") and ": " in first:
+        if first.split(" ")[0] in ("scale", "translate", "permute", "unreferenced", "truth") and ": " in first:
             first = first.split(" ")[0] + ": " + first.split(": ", 1)[1]  # without the relation's value
         first = first.split(" at ")[0].split(" by up to")[0].split(" (")[0]
         return f"{target} [{method}] | {first}"
