@@ -339,3 +339,18 @@ def test_normalized_normal_sums_agree():
     expected = geometry.normalize_normal_sums(summed)
     assert np.isnan(expected[:5]).all() and np.allclose(expected[5:10], [1.0, 0.0, 0.0])
     np.testing.assert_array_equal(numba_kernels().normalize_normal_sums(summed), expected)
+
+
+def test_small_kernels_run_on_one_thread_and_the_count_is_restored():
+    import numba
+
+    from meshcurv import _backend
+
+    threads = numba.get_num_threads()
+    small, large = np.zeros((_backend.SERIAL_ROWS - 1, 3)), np.zeros(_backend.SERIAL_ROWS)
+    assert _backend._run(lambda *arrays: numba.get_num_threads(), (small, 1.0), {}) == 1
+    assert _backend._run(lambda *arrays: numba.get_num_threads(), (small, large), {}) == threads
+    assert numba.get_num_threads() == threads
+    with pytest.raises(ZeroDivisionError):
+        _backend._run(lambda *arrays: 1 / 0, (small,), {})
+    assert numba.get_num_threads() == threads  # restored after a failing kernel too
