@@ -491,6 +491,38 @@ def measure_compile():
     return {"cold": results[0], "warm": results[1], "cache_files": n_files}
 
 
+CLI_MESHES = ("spot.obj", "igea.obj")
+
+
+def measure_cli(n=3):
+    """Wall time of ``python -m meshcurv compute MESH`` (default method, summary printed) in fresh processes.
+
+    The numba cache is the default one, warm after the warm-up of this run: what a user's second
+    and later commands cost. Returns {mesh name: {"runs": [...], "vertices": V} or {"error": ...}}.
+    """
+    import meshcurv
+
+    out = {}
+    for name in CLI_MESHES:
+        path = os.path.join(os.path.dirname(IGEA), name)
+        if not os.path.exists(path):
+            continue
+        v, _ = read_obj(path)
+        runs = []
+        for _ in range(n):
+            t0 = time.perf_counter()
+            proc = subprocess.run([sys.executable, "-m", "meshcurv", "compute", path], capture_output=True,
+                                  text=True, timeout=600)
+            runs.append(time.perf_counter() - t0)
+            if proc.returncode != 0:
+                out[name] = {"error": (proc.stderr.strip().splitlines() or ["?"])[-1][:200]}
+                break
+        else:
+            out[name] = {"runs": runs, "vertices": int(v.shape[0])}
+    del meshcurv
+    return out
+
+
 # -- machine ------------------------------------------------------------------------
 
 def machine_info():
@@ -643,6 +675,8 @@ class Bench:
             self.compile = None
         log("warm-up ...")
         self.warm = self.warm_up(keys)
+        log("meshcurv compute in fresh processes ...")
+        self.cli = measure_cli() if args.cli else {}
 
         labels = [s.strip() for s in args.sizes.split(",") if s.strip()]
         if args.igea and os.path.exists(IGEA) and "igea" not in labels:
@@ -974,6 +1008,21 @@ def markdown(bench) -> str:
                   "642 vertices; numba kernels from the default cache): "
                   + ", ".join(f"{label_of(k)} {s:.2f} s" for k, s in bench.warm.items() if s > 0.05) + ".", ""]
 
+    # the command line, fresh processes
+    if getattr(bench, "cli", None):
+        lines += ["## `meshcurv compute` in a fresh process", "",
+                  "`python -m meshcurv compute MESH` (default method, summary table printed), wall time of the "
+                  "whole process (interpreter start, imports, reading the OBJ, numba kernels loaded from the warm "
+                  "cache, the computation), each run a new process:", "",
+                  "| mesh | vertices | median s | runs |", "|---|--:|--:|---|"]
+        for name, res in bench.cli.items():
+            if "error" in res:
+                lines.append(f"| {name} | | error: {res['error']} | |")
+            else:
+                lines.append(f"| {name} | {res['vertices']:,} | {statistics.median(res['runs']):.2f} | "
+                             + ", ".join(f"{x:.2f}" for x in res["runs"]) + " |")
+        lines.append("")
+
     # profile
     if bench.profiles:
         lines += [f"## Where the time goes ({args.profile_size}, default backend)", ""]
@@ -1014,6 +1063,8 @@ def main(argv=None):
     parser.add_argument("--prefault", type=float, default=2000.0,
                         help="bytes per vertex of memory touched just before each measurement (0: none); "
                              "see prefault() (default: %(default)s)")
+    parser.add_argument("--cli", action=argparse.BooleanOptionalAction, default=True,
+                        help="time `meshcurv compute` on spot.obj and igea.obj in fresh processes (default: yes)")
     parser.add_argument("--json", help="also write the raw measurements to this JSON file")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--impl", help=argparse.SUPPRESS)
