@@ -756,7 +756,8 @@ def relation_check(args, kwargs, result, relation):
         return [f"{kind} {value:g}: valid changed at {int(changed.sum())} vertices "
                 f"({int(old_valid.sum())} -> {int(new_valid.sum())} valid)"]
     both = old_valid & referenced
-    size = max(np.abs(result.k_min[both]).max(initial=0), np.abs(result.k_max[both]).max(initial=0), 1e-300)
+    size = max(np.abs(result.k_min[both]).max(initial=0), np.abs(result.k_max[both]).max(initial=0),
+               1e-6 / max(float(np.ptp(v)) if v.size else 1.0, 1e-300))  # a flat patch: k ~ 1e-17, noise
     broken = []
     for name in ("k_min", "k_max"):
         a, b = getattr(result, name)[both], getattr(other, name)[take][both] * factor
