@@ -165,7 +165,9 @@ _GLOB_CHARACTERS = re.compile(r"[*?\[]")
 def _readable_extensions() -> set[str]:
     from .io import FORMATS, POINT_EXTENSIONS
 
-    return {extension for extension, fmt in FORMATS.items() if fmt.read is not None} | set(POINT_EXTENSIONS)
+    # point clouds too, but for .txt and .csv, which a folder holds for other reasons (notes, tables)
+    points = set(POINT_EXTENSIONS) - {".txt", ".csv"}
+    return {extension for extension, fmt in FORMATS.items() if fmt.read is not None} | points
 
 
 def _identity(path) -> tuple[int, int] | None:
