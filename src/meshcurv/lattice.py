@@ -70,7 +70,10 @@ def _axis_lattice(values: np.ndarray):
     steps = (planes - origin) / spacing
     if np.abs(steps - np.round(steps)).max() > 1e3 * _ON_GRID:
         return None  # the repeated values are not evenly spaced: not a grid (a symmetric height field, say)
-    steps = (values - origin) / spacing
+    with np.errstate(over="ignore", invalid="ignore"):
+        steps = (values - origin) / spacing
+    if not np.isfinite(steps).all() or np.abs(steps).max() > 2.0**52:
+        return None  # a coordinate billions of voxels away (a spike): not a voxel image
     whole = np.round(steps)
     on_grid = np.abs(steps - whole) <= _ON_GRID * max(1.0, np.abs(steps).max() * 1e-9)
     return spacing, origin, on_grid, whole.astype(np.int64) % 2

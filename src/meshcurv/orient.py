@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validation import as_faces, as_vertices, check_choice
-from .errors import InvalidMeshError
+from .errors import InvalidMeshError, InvalidOptionError
 from .topology import MeshTopology
 
 __all__ = ["orient_faces", "ORIENT_CHOICES"]
@@ -88,6 +88,8 @@ def orient_faces(vertices, faces, *, outward: bool = True) -> tuple[np.ndarray, 
     >>> n_flipped, bool((fixed == sphere.faces).all())
     (160, True)
     """
+    if not isinstance(outward, (bool, np.bool_)):
+        raise InvalidOptionError(f"`outward` must be True or False; got {outward!r}")
     if isinstance(faces, MeshTopology):
         topology = faces
         points = as_vertices(vertices)

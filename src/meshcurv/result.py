@@ -46,7 +46,9 @@ class CurvatureResult:
       to the normal, defined up to sign (arbitrary where ``k_min == k_max``);
     - where ``valid`` is False the estimate is undefined and the curvature
       fields are NaN (the one exception is ``method="matgeom"``, which keeps
-      matGeom's own zeros at unreferenced vertices).
+      matGeom's own numbers wherever matGeom computes them, its zeros at
+      unreferenced vertices included, and marks ``valid=False`` where they
+      are not an estimate).
 
     Attributes
     ----------
