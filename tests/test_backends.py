@@ -354,3 +354,11 @@ def test_small_kernels_run_on_one_thread_and_the_count_is_restored():
     with pytest.raises(ZeroDivisionError):
         _backend._run(lambda *arrays: 1 / 0, (small,), {})
     assert numba.get_num_threads() == threads  # restored after a failing kernel too
+
+
+def test_python_helpers_of_the_kernels_module_keep_every_thread():
+    import numba
+
+    from meshcurv._backend import numba_kernels
+
+    assert numba_kernels().threads() == numba.get_num_threads()  # no array argument: not a small kernel

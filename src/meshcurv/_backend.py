@@ -50,8 +50,9 @@ logger = logging.getLogger(__name__)
 
 #: Logged once per process (WARNING) when a kernel is compiled rather than loaded from the disk cache.
 COMPILE_MESSAGE = (
-    "compiling meshcurv's numba kernels for first use (once per installation: about 30 s for the default "
-    "method, 60 s for all methods on 2 cores); they are cached on disk for later processes (%s)"
+    "compiling meshcurv's numba kernels for first use (once per installation: 30 s to a minute for the "
+    "default method, up to 2 minutes for all methods, on 2 cores); they are cached on disk for later "
+    "processes (%s)"
 )
 
 
@@ -215,14 +216,21 @@ def _run(function, args, kwargs):
         numba.set_num_threads(threads)
 
 
+def _direct(function, args, kwargs):
+    return function(*args, **kwargs)
+
+
 def _locked(function):
+    # compiled kernels only: the module's Python helpers (threads(), wrappers) run as they are
+    run = _run if hasattr(function, "py_func") else _direct
+
     @functools.wraps(function)
     def call(*args, **kwargs):
         global _layer
         if _layer in THREAD_SAFE_LAYERS:
-            return _run(function, args, kwargs)
+            return run(function, args, kwargs)
         with _KERNEL_LOCK:
-            result = _run(function, args, kwargs)
+            result = run(function, args, kwargs)
             if _layer is None:
                 _layer = _threading_layer()
             return result
