@@ -122,14 +122,20 @@ def default_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[fl
     return groups
 
 
+#: The smallest radius taken, in median edge lengths: a ball far inside one
+#: face measures nothing (a unit mistake: m for mm), and below about 1e-8 of
+#: the coordinates the ball's geometry is rounding noise.
+MIN_RADIUS_EDGES = 1e-3
+
+
 def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
-    """``radius`` checked: a positive finite number no larger than the extent of the mesh.
+    """``radius`` checked: a positive finite number between a sliver of an edge and the mesh's extent.
 
     Raises
     ------
     InvalidOptionError
         ``radius`` is not a positive finite real number (strings are refused),
-        or it exceeds the diagonal of the bounding box of the referenced
+        it is below :data:`MIN_RADIUS_EDGES` median edge lengths, or it exceeds the diagonal of the bounding box of the referenced
         vertices: every ball would hold the whole mesh (a unit mistake: mm for m).
     """
     radius = check_positive_float(radius, "radius")
@@ -138,6 +144,14 @@ def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
     if used.shape[0] == 0:
         return radius
     diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    if topology.n_faces and radius < MIN_RADIUS_EDGES * diagonal:
+        median = median_edge_length(vertices, topology.edges)
+        if radius < MIN_RADIUS_EDGES * median:
+            raise InvalidOptionError(
+                f"`radius` {radius:g} is below {MIN_RADIUS_EDGES:g} of the median edge length {median:g}: "
+                f"every ball would hold its centre only and give no curvature; pass a radius of a few edge "
+                f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
+            )
     if radius > diagonal:
         median = median_edge_length(vertices, topology.edges)
         raise InvalidOptionError(
