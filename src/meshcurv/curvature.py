@@ -15,7 +15,7 @@ from .estimators._common import ProgressCallback, Stages
 from .estimators.icc import voxel_surface_radius
 from .diagnosis import degenerate_faces, diagnose, quality_message
 from .orient import ORIENT_CHOICES, oriented_topology
-from .result import INVALID_REASONS, CurvatureResult
+from .result import INVALID_REASONS, CurvatureResult, Surface
 from .topology import MeshTopology
 from .weld import weld_vertices
 
@@ -121,7 +121,10 @@ def principal_curvatures(
     -------
     CurvatureResult
         ``k_min, k_max, dir_min, dir_max, normals, valid`` and the derived
-        ``mean`` and ``gaussian``; ``as_matgeom()`` gives matGeom's seven outputs.
+        ``mean`` and ``gaussian``; ``as_matgeom()`` gives matGeom's seven outputs;
+        ``vertex_areas`` and ``integral(field)`` (area, total mean and Gaussian
+        curvature, Willmore energy) from the mesh it keeps (read-only views,
+        computed on first use).
 
     Raises
     ------
@@ -200,7 +203,9 @@ def principal_curvatures(
     reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
     parameters = {**result.parameters, **found, "orient": orient,
                   "n_welded_vertices": welding.n_welded if welding is not None else 0}
-    result = dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons, parameters=parameters)
+    surface = Surface(points, topology.faces, welding.index if welding is not None and welding.n_welded else None)
+    result = dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons, parameters=parameters,
+                                 _surface=surface)
     if welding is not None and welding.n_welded:
         result = _expanded(result, welding.index)
         problems = [f"welded {welding.n_welded} coincident vertices (a triangle soup or split seams) "

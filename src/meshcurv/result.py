@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from functools import cached_property
 from types import MappingProxyType
@@ -13,6 +14,9 @@ if TYPE_CHECKING:
     from .diagnosis import MeshDiagnosis
 
 __all__ = ["CurvatureResult", "INVALID_REASONS"]
+
+#: What :meth:`CurvatureResult.integral` integrates (see :mod:`meshcurv.integrals` for the rules).
+INTEGRALS = ("area", "mean", "gaussian", "willmore")
 
 #: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``. A vertex
 #: gets the first code that applies, in this order.
@@ -74,6 +78,19 @@ class CurvatureResult:
         Why each vertex is invalid: an index into :data:`INVALID_REASONS`
         (0 where ``valid``); set by :func:`meshcurv.principal_curvatures`,
         None when the result was built directly.
+    vertex_areas : ndarray of shape (V,)
+        Barycentric vertex areas (a third of each incident face), in length^2;
+        they sum to the area of the mesh. Where a welded vertex has several
+        rows, the first holds the area and the others 0. NaN when the result
+        has no mesh (point clouds, results built directly).
+
+    Notes
+    -----
+    Integrals over the surface (:meth:`integral`) are sums of per-vertex
+    shares (:meth:`vertex_integrals`) computed from the mesh the curvatures
+    were computed on (kept by :func:`meshcurv.principal_curvatures`) and the
+    result's normals, not from the pointwise fields times an area: see
+    :mod:`meshcurv.integrals`.
     """
 
     k_min: np.ndarray
@@ -86,6 +103,7 @@ class CurvatureResult:
     parameters: Mapping[str, Any] = field(default_factory=dict)
     diagnosis: "MeshDiagnosis | None" = None
     invalid_reason: np.ndarray | None = None
+    _surface: "Surface | None" = field(default=None, repr=False)
 
     def __post_init__(self):
         for name in _ARRAY_FIELDS:
@@ -98,6 +116,12 @@ class CurvatureResult:
         object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
         if self.invalid_reason is not None:
             object.__setattr__(self, "invalid_reason", _readonly(np.array(self.invalid_reason, dtype=np.int8)))
+
+    def __reduce__(self):
+        # the parameters' MappingProxyType does not pickle: rebuilt from a dict
+        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        fields["parameters"] = dict(self.parameters)
+        return (_rebuild, (type(self), fields))
 
     def invalid_counts(self) -> dict[str, int]:
         """How many vertices are invalid for each reason (:data:`INVALID_REASONS`), largest first.
@@ -165,6 +189,108 @@ class CurvatureResult:
         """(V,) curvedness ``sqrt((k_min**2 + k_max**2) / 2)`` (Koenderink and van Doorn 1992), in 1/length."""
         return _readonly(np.sqrt((self.k_min**2 + self.k_max**2) / 2))
 
+    @cached_property
+    def vertex_areas(self) -> np.ndarray:
+        """(V,) barycentric vertex areas, in length^2 (NaN when the result has no mesh)."""
+        if self._surface is None:
+            return _readonly(np.full(self.n_vertices, np.nan))
+        return self.vertex_integrals("area")
+
+    def vertex_integrals(self, field: str) -> np.ndarray:
+        """(V,) the share of each vertex in :meth:`integral` ``(field)``; they add up over any region.
+
+        Parameters
+        ----------
+        field : {'area', 'mean', 'gaussian', 'willmore'}
+            See :meth:`integral`.
+
+        Returns
+        -------
+        ndarray of shape (V,), read-only
+            Where a welded vertex has several rows, the first holds its share
+            and the others 0.
+
+        Raises
+        ------
+        InvalidOptionError
+            Unknown ``field``, or a result with no mesh (point clouds, results built directly).
+        """
+        from ._validation import check_choice
+        from .errors import InvalidOptionError
+
+        check_choice(field, "field", INTEGRALS)
+        cache = self.__dict__.setdefault("_vertex_integrals", {})
+        if field in cache:
+            return cache[field]
+        if self._surface is None:
+            raise InvalidOptionError(
+                f"integrals need the triangles of a mesh; this {self.method!r} result has none (a point "
+                "cloud's, or one built directly): compute it with meshcurv.principal_curvatures on a mesh, "
+                "or use meshcurv.integrals.vertex_integrals(vertices, faces, field, normals=...)"
+            )
+        cache[field] = _readonly(self._surface.shares(field, self))
+        return cache[field]
+
+    def integral(self, field: str, *, where=None) -> float:
+        """The integral of ``field`` over the surface (or over the vertices in ``where``).
+
+        Parameters
+        ----------
+        field : {'area', 'mean', 'gaussian', 'willmore'}
+            - ``'area'``: the area of the mesh (sum of :attr:`vertex_areas`);
+            - ``'mean'``: total mean curvature ``int H dA`` (``4 pi R`` on a
+              sphere of radius ``R``), from the corrected curvature measure
+              ``mu_1 / 2`` of each face with the result's normals;
+            - ``'gaussian'``: total Gaussian curvature ``int K dA``, the signed
+              area of the spherical image of each face under the result's
+              normals: ``2 pi chi`` on a closed mesh (Gauss-Bonnet), whatever
+              the method;
+            - ``'willmore'``: Willmore energy ``int H^2 dA`` (``4 pi`` on a
+              sphere), the pointwise ``mean**2`` times :attr:`vertex_areas`.
+
+            ``'mean'`` and ``'gaussian'`` are defined on every face: they take
+            the area-weighted face normals at invalid vertices, where the
+            result's normal points away from the faces (cosine <= 0), and for
+            ``method='matgeom'`` (unoriented normals).
+        where : array_like of shape (V,), bool, optional
+            Integrate over these vertices only (each stands for a third of
+            its incident faces), e.g. ``result.valid`` for the Willmore
+            energy of a mesh with invalid vertices.
+
+        Returns
+        -------
+        float
+            NaN for ``'willmore'`` when a vertex integrated over is invalid.
+
+        Raises
+        ------
+        InvalidOptionError
+            Unknown ``field``, a ``where`` of the wrong shape, or a result
+            with no mesh (point clouds, results built directly).
+
+        Examples
+        --------
+        >>> import numpy as np, meshcurv
+        >>> sphere = meshcurv.shapes.icosphere(subdivisions=8, radius=2.0)
+        >>> r = meshcurv.principal_curvatures(sphere.vertices, sphere.faces)
+        >>> print(f"{r.integral('gaussian') / np.pi:.4f}")  # 2 pi chi, chi = 2
+        4.0000
+        >>> print(f"{r.integral('willmore') / (4 * np.pi):.2f}")  # 4 pi on any sphere
+        1.00
+        """
+        shares = self.vertex_integrals(field)
+        if where is not None:
+            from .errors import InvalidOptionError
+
+            mask = np.asarray(where)
+            if mask.dtype != bool or mask.shape != shares.shape:
+                raise InvalidOptionError(
+                    f"`where` must be a bool array of shape ({self.n_vertices},); got "
+                    f"{mask.dtype} of shape {mask.shape}"
+                )
+            shares = shares[mask]
+        return float(np.sum(shares))
+
     def as_matgeom(self) -> tuple[np.ndarray, ...]:
         """The seven outputs of matGeom's ``meshCurvatures``, in its order.
 
@@ -182,6 +308,54 @@ class CurvatureResult:
             f"CurvatureResult(method={self.method!r}, n_vertices={self.n_vertices}, "
             f"valid={n_valid}, parameters={dict(self.parameters)})"
         )
+
+
+@dataclass(frozen=True, eq=False)
+class Surface:
+    """The mesh a result was computed on, for its integrals (private to meshcurv).
+
+    ``vertices`` (W, 3) and ``faces`` (F, 3) after welding and orientation;
+    ``index`` (V,) the row of ``vertices`` of each row of the result (None
+    when nothing was welded). Read-only views, never the caller's arrays.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    index: np.ndarray | None = None
+
+    def __post_init__(self):
+        for name in ("vertices", "faces", "index"):
+            value = getattr(self, name)
+            if value is not None:
+                view = value.view()
+                view.flags.writeable = False
+                object.__setattr__(self, name, view)
+
+    def shares(self, field: str, result: CurvatureResult) -> np.ndarray:
+        """(V,) per-row shares of ``field`` (see :func:`meshcurv.integrals.vertex_integrals`)."""
+        from .integrals import vertex_integrals
+
+        rows = slice(None) if self.index is None else _first_rows(self.index, self.vertices.shape[0])
+        normals = None if result.method == "matgeom" else np.where(
+            result.valid[rows, None], result.normals[rows], np.nan)
+        pointwise = result.mean[rows] if field == "willmore" else None
+        shares = vertex_integrals(self.vertices, self.faces, field, normals=normals, pointwise=pointwise)
+        if self.index is None:
+            return shares
+        out = np.zeros(result.n_vertices, dtype=np.float64)
+        out[rows] = shares
+        return out
+
+
+def _rebuild(cls, fields):
+    return cls(**fields)
+
+
+def _first_rows(index: np.ndarray, n_welded: int) -> np.ndarray:
+    """(W,) the first row of the result that stands for each welded vertex."""
+    first = np.full(n_welded, index.shape[0], dtype=np.int64)
+    np.minimum.at(first, index, np.arange(index.shape[0]))
+    return first
 
 
 _ARRAY_FIELDS = ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid")
