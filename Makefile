@@ -7,7 +7,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench-accuracy bench-speed clean
+.PHONY: demo test quick test-minimal lint bench-accuracy bench-speed clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "meshcurv needs Python 3.11 or newer: make PYTHON=python3.11 ...")'
@@ -21,9 +21,24 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest
 
+# the suite without the tests marked slow (under a minute or two on 2 cores)
+quick: $(STAMP)
+	$(BIN)/python -m pytest -q -m "not slow"
+
+# the suite on a minimal install (numpy, scipy and the test tools only: no numba, click, dask, ...):
+# what needs an extra is skipped, the NumPy backend runs
+test-minimal:
+	$(PYTHON) -m venv .venv-minimal
+	.venv-minimal/bin/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
+	.venv-minimal/bin/python -m pytest -q -m "not slow"
+
+lint: $(STAMP)
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check 'ruff>=0.6'
+	$(BIN)/ruff check src tests benchmarks conftest.py
+
 bench-accuracy: $(STAMP)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[bench]'
 	$(BIN)/python benchmarks/accuracy.py
 
 clean:
-	rm -rf $(VENV) demo-output
+	rm -rf $(VENV) .venv-minimal demo-output

@@ -1,0 +1,19 @@
+"""Collection rules for the doctests of ``src/meshcurv`` (``--doctest-modules``).
+
+The modules below import an optional extra at module level (the CLI needs
+click, the compiled kernels numba). On an install without that extra they are
+not collected, so that ``pytest`` on a minimal install (``pip install .[test]``)
+skips what it cannot run instead of failing at collection; the tests that use
+them skip through ``pytest.importorskip``.
+"""
+
+import importlib.util
+
+_NEEDS = {
+    "click": ["src/meshcurv/_cli_app.py", "src/meshcurv/_batch_cli.py", "src/meshcurv/_volume_cli.py",
+              "src/meshcurv/_view_cli.py", "src/meshcurv/cli.py"],
+    "numba": ["src/meshcurv/_numba_kernels.py", "src/meshcurv/_pointcloud_kernels.py"],
+}
+
+collect_ignore = [path for module, paths in _NEEDS.items() if importlib.util.find_spec(module) is None
+                  for path in paths]
