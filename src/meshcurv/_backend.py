@@ -3,10 +3,25 @@
 The NumPy paths are always there and are the reference; the numba kernels
 (:mod:`meshcurv._numba_kernels`) compute the same quantities in single passes
 without temporaries. They are used when numba is installed
-(``pip install 'meshcurv[fast]'``) unless ``MESHCURV_BACKEND=numpy`` is set in
-the environment. numba is imported on first use, never by ``import meshcurv``;
-compiled kernels are cached on disk, so only the first process pays the
-compilation.
+(``pip install 'meshcurv[fast]'``) unless the NumPy paths are asked for.
+
+Decided once per process: the first call that needs a kernel tries to import
+numba (never ``import meshcurv`` itself) and remembers the outcome, so that a
+base install without numba does not retry the failed import (some 11 ms, 10 to
+15 times per call) on every lookup; a lookup then costs an environment read.
+The first decision of each backend is logged once, at INFO on the
+``meshcurv`` logger (``meshcurv -v`` shows it): which backend runs and, when
+numba is missing, that ``pip install 'meshcurv[fast]'`` gives the compiled one.
+
+Which backend runs, highest precedence first: :func:`use_backend` (a context
+manager, for tests and for callers who want one block on one backend), the
+``MESHCURV_BACKEND`` environment variable (``auto``, ``numpy`` or ``numba``,
+read at each call), then ``auto`` (numba when importable).
+
+Interrupts: Ctrl-C while a compiled kernel runs reaches Python when the kernel
+returns, where CPython reports it as a :class:`SystemError` ("returned a
+result with an exception set") whose cause is the :class:`KeyboardInterrupt`;
+every kernel handed out here re-raises the KeyboardInterrupt itself.
 
 Thread safety: numba's ``workqueue`` threading layer (the one numba falls back
 to where neither TBB nor OpenMP is installed) aborts the process when two
@@ -65,21 +80,73 @@ def _requested() -> str:
     return choice
 
 
+#: What the once-per-process import of the kernels gave: ``(module, None)`` or ``(None, ImportError)``;
+#: None before the first call that needs a kernel.
+_imported: tuple | None = None
+
+#: The backend lines already logged (each once per process).
+_logged: set = set()
+
+#: The INFO line when numba cannot be imported.
+MISSING_MESSAGE = ("meshcurv backend: numpy (numba is not installed: %s); pip install 'meshcurv[fast]' gives "
+                   "the compiled kernels, several times faster")
+
+
+def _import_kernels():
+    """The kernels module, imported once per process; None when numba (or the module) cannot be imported."""
+    global _imported
+    if _imported is None:
+        try:
+            from . import _numba_kernels
+        except ImportError as error:
+            _imported = (None, error)
+        else:
+            _imported = (_numba_kernels, None)
+            _announce_compilation()
+    return _imported[0]
+
+
+def _log_once(key: str, message: str, *args) -> None:
+    if key not in _logged:
+        _logged.add(key)
+        logger.info(message, *args)
+
+
+def _forget() -> None:
+    """Forget the decision (for tests that hide or restore numba); the next lookup decides again."""
+    global _imported
+    _imported = None
+    _logged.clear()
+
+
+def backend_name() -> str:
+    """``'numba'`` or ``'numpy'``: the backend the next call will use (see the module's doc)."""
+    return "numpy" if numba_kernels() is None else "numba"
+
+
 def numba_kernels():
     """The numba kernels module, or None when the NumPy paths are to be used."""
     choice = _requested()
     if choice == "numpy":
+        _log_once("numpy", "meshcurv backend: numpy (asked for: MESHCURV_BACKEND or use_backend)")
         return None
-    try:
-        from . import _numba_kernels
-    except ImportError:
+    module = _import_kernels()
+    if module is None:
+        error = _imported[1]
         if choice == "numba":
             raise MissingDependencyError(
-                "the numba backend needs numba: pip install 'meshcurv[fast]'"
+                f"the numba backend needs numba ({error}): pip install 'meshcurv[fast]'"
             ) from None
+        _log_once("missing", MISSING_MESSAGE, error)
         return None
-    _announce_compilation()
-    return _serialised(_numba_kernels)
+    _log_once("numba", "meshcurv backend: numba %s (the fast kernels)", _numba_version())
+    return _serialised(module)
+
+
+def _numba_version() -> str:
+    import numba
+
+    return numba.__version__
 
 
 _announcer = None
@@ -227,15 +294,32 @@ def _locked(function):
     @functools.wraps(function)
     def call(*args, **kwargs):
         global _layer
-        if _layer in THREAD_SAFE_LAYERS:
-            return run(function, args, kwargs)
-        with _KERNEL_LOCK:
-            result = run(function, args, kwargs)
-            if _layer is None:
-                _layer = _threading_layer()
-            return result
+        try:
+            if _layer in THREAD_SAFE_LAYERS:
+                return run(function, args, kwargs)
+            with _KERNEL_LOCK:
+                result = run(function, args, kwargs)
+                if _layer is None:
+                    _layer = _threading_layer()
+                return result
+        except SystemError as error:  # Ctrl-C during the kernel (see the module's doc)
+            interrupt = _interrupt_of(error)
+            if interrupt is None:
+                raise
+            raise interrupt from None
 
     return call
+
+
+def _interrupt_of(error: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt behind a SystemError of a compiled call (its cause or context), or None."""
+    seen = 0
+    while error is not None and seen < 8:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        error = error.__cause__ or error.__context__
+        seen += 1
+    return None
 
 
 _proxies: dict = {}

@@ -11,13 +11,16 @@ import numbers
 import operator
 import warnings
 from collections.abc import Sequence
+from itertools import chain
+from typing import NamedTuple
 
 import numpy as np
 
 from .errors import InvalidMeshError, InvalidOptionError, TriangulationWarning
 
-__all__ = ["as_vertices", "as_faces", "as_polygons", "check_int_option", "check_positive_float", "check_choice",
-           "checked_mesh", "checked_points", "checked_indices"]
+__all__ = ["as_vertices", "as_faces", "as_polygons", "polygon_arrays", "fan_triangles", "checked_triangles", "Ragged",
+           "check_int_option", "check_vertex_count", "check_positive_float", "check_choice", "checked_mesh",
+           "checked_points", "checked_indices", "MAX_VERTICES"]
 
 
 def _short_repr(value, limit: int = 40) -> str:
@@ -114,6 +117,8 @@ def _integer_faces(array: np.ndarray, name: str) -> np.ndarray:
     if array.dtype == bool or not (
         np.issubdtype(array.dtype, np.integer) or np.issubdtype(array.dtype, np.floating)
     ):
+        if array.dtype == object and array.size and all(isinstance(x, numbers.Integral) for x in array.flat):
+            raise InvalidMeshError(f"`{name}` has indices too large for int64")  # Python ints beyond uint64
         raise InvalidMeshError(f"`{name}` must hold integer vertex indices; got dtype {array.dtype}")
     if np.issubdtype(array.dtype, np.floating):
         if not np.isfinite(array).all():
@@ -140,34 +145,60 @@ def _as_array(value, name: str) -> np.ndarray:
         ) from None
 
 
-def as_polygons(faces, *, name: str = "faces") -> list[np.ndarray] | np.ndarray:
-    """Return ``faces`` as an int64 (F, k) array, or a list of int64 index arrays when ragged."""
+class Ragged(NamedTuple):
+    """Faces of varying lengths, flat: face ``f`` is ``flat[starts[f]:starts[f] + lengths[f]]``."""
+
+    flat: np.ndarray
+    lengths: np.ndarray
+
+    @property
+    def starts(self) -> np.ndarray:
+        return np.cumsum(self.lengths) - self.lengths
+
+    def split(self) -> list[np.ndarray]:
+        """One int64 index array per face."""
+        return np.split(self.flat, np.cumsum(self.lengths)[:-1])
+
+
+def _sequence_type(kind: type) -> bool:
+    return (issubclass(kind, (Sequence, np.ndarray))) and not issubclass(kind, (str, bytes))
+
+
+def polygon_arrays(faces, *, name: str = "faces") -> np.ndarray | Ragged:
+    """``faces`` as an int64 (F, k) array (k >= 3), or as :class:`Ragged` when the faces differ in length.
+
+    Vectorised: a list of 100,000 mixed triangles and quads is checked in one
+    conversion of its concatenated indices (no array per face).
+
+    Raises
+    ------
+    InvalidMeshError
+        Not an array or a list of index lists, empty, a face of fewer than 3
+        corners, nested or non-integer values, indices beyond int64.
+    """
     if isinstance(faces, (str, bytes)):
         raise InvalidMeshError(f"`{name}` must be an array of vertex indices; got a {type(faces).__name__}")
     _refuse_masked(faces, name)
     if isinstance(faces, np.ndarray) or not isinstance(faces, Sequence):
         array = _as_array(faces, name)
     else:
-        lengths = set()
-        for face in faces:
-            is_sequence = isinstance(face, (Sequence, np.ndarray)) and not isinstance(face, (str, bytes))
-            lengths.add(len(face) if is_sequence else -1)
-        if -1 in lengths:
+        if not all(_sequence_type(kind) for kind in set(map(type, faces))):
             raise InvalidMeshError(
                 f"`{name}` must be an array of shape (F, 3) or (F, k), or a list of index lists; "
                 "got a list whose items are not sequences"
             )
-        if len(lengths) > 1:
-            if min(lengths) < 3:
+        lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+        if lengths.size and lengths.min() != lengths.max():
+            if lengths.min() < 3:
                 raise InvalidMeshError(
                     f"`{name}` has a face with fewer than 3 vertices; every face needs at least 3"
                 )
-            polygons = [_as_array(face, name) for face in faces]
-            if any(p.ndim != 1 for p in polygons):
+            flat = _as_array(list(chain.from_iterable(faces)), name)
+            if flat.ndim != 1:
                 raise InvalidMeshError(
                     f"`{name}` must be a list of flat index lists; a face holds nested lists"
                 )
-            return [_integer_faces(p, name) for p in polygons]
+            return Ragged(_integer_faces(flat, name), lengths)
         array = _as_array(faces, name)
     if array.ndim != 2:
         raise InvalidMeshError(
@@ -180,6 +211,31 @@ def as_polygons(faces, *, name: str = "faces") -> list[np.ndarray] | np.ndarray:
             f"`{name}` must have at least 3 columns (one vertex index per corner); got {_shape_text(array)}"
         )
     return _integer_faces(array, name)
+
+
+def as_polygons(faces, *, name: str = "faces") -> list[np.ndarray] | np.ndarray:
+    """Return ``faces`` as an int64 (F, k) array, or a list of int64 index arrays when ragged."""
+    shaped = polygon_arrays(faces, name=name)
+    return shaped.split() if isinstance(shaped, Ragged) else shaped
+
+
+def fan_triangles(shaped: np.ndarray | Ragged) -> np.ndarray:
+    """(T, 3) int64 fan triangles of checked polygons (:func:`polygon_arrays`), as matGeom's ``triangulateFaces``.
+
+    Face ``(f0, f1, ..., f(k-1))`` gives ``(f0, f(j-1), f(j))`` for ``j = 2 .. k-1``,
+    the triangles of each face next to each other in the order of the faces.
+    One gather for all faces, whatever their lengths.
+    """
+    if not isinstance(shaped, Ragged):
+        if shaped.shape[1] == 3:
+            return np.ascontiguousarray(shaped)
+        shaped = Ragged(shaped.ravel(), np.full(shaped.shape[0], shaped.shape[1], dtype=np.int64))
+    counts = shaped.lengths - 2  # triangles per face
+    first = np.repeat(shaped.starts, counts)  # position of each triangle's f0 in `flat`
+    # j - 1 for every triangle: 1 .. k-2 within each face
+    offset = np.arange(first.size) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+    flat = shaped.flat
+    return np.stack([flat[first], flat[first + offset], flat[first + offset + 1]], axis=1)
 
 
 def _check_range(triangles: np.ndarray, n_vertices: int, name: str) -> None:
@@ -205,7 +261,8 @@ def as_faces(faces, n_vertices: int, *, name: str = "faces", stacklevel: int = 3
     """Return ``faces`` as a new int64 (F, 3) triangle array with indices checked.
 
     Polygons ((F, k) arrays with k > 3, or lists of index lists of varying length)
-    are fan-triangulated with :func:`meshcurv.topology.triangulate_faces`, with a
+    are fan-triangulated as matGeom's ``triangulateFaces`` does
+    (:func:`fan_triangles`, :func:`meshcurv.topology.triangulate_faces`), with a
     :class:`TriangulationWarning`, as matGeom's meshCurvatures does.
 
     Raises
@@ -214,19 +271,30 @@ def as_faces(faces, n_vertices: int, *, name: str = "faces", stacklevel: int = 3
         Wrong shape or dtype, non-integer values, empty, fewer than 3 corners,
         negative or out-of-range indices (with a hint when they look 1-based).
     """
-    from .topology import triangulate_faces
+    return checked_triangles(polygon_arrays(faces, name=name), n_vertices, name=name, stacklevel=stacklevel + 1)
 
-    polygons = as_polygons(faces, name=name)
-    flat = np.concatenate(polygons) if isinstance(polygons, list) else polygons
-    _check_range(flat, n_vertices, name)
-    if isinstance(polygons, list) or polygons.shape[1] != 3:
+
+def checked_triangles(shaped: np.ndarray | Ragged, n_vertices: int, *, name: str = "faces",
+                      stacklevel: int = 3) -> np.ndarray:
+    """:func:`as_faces` of faces already shaped by :func:`polygon_arrays`."""
+    _check_range(shaped.flat if isinstance(shaped, Ragged) else shaped, n_vertices, name)
+    if isinstance(shaped, Ragged) or shaped.shape[1] != 3:
         warnings.warn(
             "requires triangle mesh, forces triangulation: polygonal faces were fan-triangulated",
             TriangulationWarning,
             stacklevel=stacklevel,
         )
-        return triangulate_faces(polygons)
-    return np.ascontiguousarray(polygons)
+    return fan_triangles(shaped)
+
+
+#: Most vertices a mesh may have: the edges are keyed ``p * V + q`` (times 2, plus a direction
+#: bit) in int64, which holds for ``V < 2**31`` (2.1 billion vertices, 51 GB of coordinates).
+MAX_VERTICES = 2**31 - 1
+
+
+def check_vertex_count(n_vertices, *, name: str = "n_vertices") -> int:
+    """``n_vertices`` as an int in ``[1, MAX_VERTICES]`` or :class:`InvalidOptionError`."""
+    return check_int_option(n_vertices, name, minimum=1, maximum=MAX_VERTICES)
 
 
 def check_int_option(value, name: str, *, minimum: int = 0, maximum: int | None = None) -> int:
@@ -288,17 +356,18 @@ def checked_points(vertices, *, name: str = "vertices") -> np.ndarray:
     """``vertices`` as a C-contiguous float64 (V, 3) array, checked finite.
 
     The public helpers of the core call this on every input: an array that is
-    already float64 (V, 3) is not copied and costs one summation (NaN or
-    infinite coordinates would send the compiled grid searches out of bounds);
-    anything else goes through :func:`as_vertices`.
+    already float64 (V, 3) is not copied and costs a ``min`` and a ``max`` (NaN
+    or infinite coordinates would send the compiled grid searches out of
+    bounds; coordinates beyond :data:`MAX_COORDINATE` overflow squared areas,
+    so they are refused here as by :func:`as_vertices`); anything else goes
+    through :func:`as_vertices`.
     """
     if not (isinstance(vertices, np.ndarray) and type(vertices) is np.ndarray and vertices.dtype == np.float64
             and vertices.ndim == 2 and vertices.shape[1] == 3 and vertices.shape[0] > 0):
         return as_vertices(vertices, name=name)
-    with np.errstate(over="ignore", invalid="ignore"):
-        finite = np.isfinite(vertices.sum())
-    if not finite:
-        return as_vertices(vertices, name=name)  # raises, naming the vertices (or the overflow)
+    largest = max(float(vertices.max()), -float(vertices.min()))  # NaN if any coordinate is NaN
+    if not largest <= MAX_COORDINATE or 0.0 < largest < MIN_COORDINATE:
+        return as_vertices(vertices, name=name)  # raises, naming the vertices and the problem
     return np.ascontiguousarray(vertices)
 
 

@@ -13,10 +13,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ._backend import numba_kernels
-from ._validation import checked_points
+from ._validation import check_int_option
 from .errors import InvalidMeshError
-from .geometry import (DEGENERATE_AREA_RATIO, degenerate_face_mask, edge_lengths, face_cross_products,
-                       vertex_length_scales)
+from .geometry import (DEGENERATE_AREA_RATIO, checked_topology_points, degenerate_face_mask, edge_lengths,
+                       face_cross_products, vertex_length_scales)
 from .topology import MeshTopology
 
 #: Edges no longer than this times the length scale of their component (its median
@@ -143,8 +143,18 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
     not moved by a few outlier vertices (a spike at 1e10 leaves the other faces
     alone); per component, a part at 1e-3 and a part at 1e3 are each measured
     against their own edges.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``topology`` not a MeshTopology, ``vertices`` unusable, or ``cross``
+        (F, 3), ``double_areas`` (F,), ``scales`` (V,) not real arrays of
+        those shapes.
     """
-    vertices = _checked(vertices, topology)
+    vertices = checked_topology_points(vertices, topology)
+    cross = _optional_floats(cross, "cross", topology.faces.shape)
+    double_areas = _optional_floats(double_areas, "double_areas", (topology.n_faces,))
+    scales = _optional_floats(scales, "scales", (topology.n_vertices,))
     kernels = numba_kernels()
     if scales is None and mean_edge_length is None:
         scales = vertex_length_scales(vertices, topology)
@@ -161,16 +171,14 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
     return degenerate_face_mask(0.5 * double_areas, face_scale) | topology.degenerate_faces
 
 
-def _checked(vertices, topology) -> np.ndarray:
-    """``vertices`` checked (:func:`~meshcurv._validation.checked_points`) against ``topology``."""
-    if not isinstance(topology, MeshTopology):
-        raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}")
-    vertices = checked_points(vertices)
-    if vertices.shape[0] != topology.n_vertices:
-        raise InvalidMeshError(
-            f"`vertices` has {vertices.shape[0]} rows but the topology has {topology.n_vertices} vertices"
-        )
-    return vertices
+def _optional_floats(value, name: str, shape: tuple) -> np.ndarray | None:
+    """``value`` as a C-contiguous float64 array of ``shape`` (None stays None)."""
+    if value is None:
+        return None
+    array = np.asarray(value)
+    if array.shape != shape or array.dtype.kind not in "fiu":
+        raise InvalidMeshError(f"`{name}` must be a real array of shape {shape}; got {array.dtype} {array.shape}")
+    return np.ascontiguousarray(array, dtype=np.float64)
 
 
 def bowtie_vertices(topology: MeshTopology) -> np.ndarray:
@@ -186,7 +194,18 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     vertices : ndarray of shape (V, 3), float64
     topology : MeshTopology
     n_flipped_faces : int, default: 0
-        Recorded as is (faces reversed by ``orient=`` before the computation).
+        Recorded as is (faces reversed by ``orient=`` before the computation),
+        0 to the number of faces.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``topology`` not a :class:`~meshcurv.topology.MeshTopology`,
+        ``vertices`` not finite float (V, 3) coordinates within
+        :data:`~meshcurv._validation.MAX_COORDINATE`, or not one row per
+        vertex of the topology.
+    InvalidOptionError
+        ``n_flipped_faces`` not an integer in ``[0, F]``.
 
     Returns
     -------
@@ -200,7 +219,8 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     >>> d.n_components, d.genus, d.is_clean, d.problems()
     (1, 0, True, [])
     """
-    vertices = _checked(vertices, topology)
+    vertices = checked_topology_points(vertices, topology)
+    n_flipped_faces = check_int_option(n_flipped_faces, "n_flipped_faces", maximum=topology.n_faces)
     faces = topology.faces
     referenced = topology.referenced_vertices
     n_unreferenced = int(topology.n_vertices - referenced.sum())

@@ -20,7 +20,8 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._validation import checked_indices, checked_mesh, checked_points
-from .errors import InvalidMeshError
+from .errors import InvalidMeshError, InvalidOptionError
+from .topology import MeshTopology
 
 __all__ = [
     "face_cross_products",
@@ -36,6 +37,7 @@ __all__ = [
     "robust_mean_edge_length",
     "vertex_length_scales",
     "degenerate_face_mask",
+    "checked_topology_points",
     "corner_cotangents",
     "corner_angles",
     "mixed_voronoi_corner_areas",
@@ -222,17 +224,27 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
     geometric-mean edge within :data:`COMPONENT_SCALE_SPREAD` of the mesh's
     median edge) it is the mesh's median edge length everywhere, found in one
     pass; otherwise each component gets its own median (a sort of the edges by
-    component). Unreferenced vertices get 0.
+    component). Unreferenced vertices, and components without an edge (a face
+    ``(a, a, a)``), get 0.
 
     Parameters
     ----------
     vertices : array_like of shape (V, 3)
     topology : MeshTopology
+        The connectivity, with ``topology.n_vertices == V``.
 
     Returns
     -------
     ndarray of shape (V,), float64
+
+    Raises
+    ------
+    InvalidMeshError
+        ``topology`` not a :class:`~meshcurv.topology.MeshTopology` (a face
+        array: build the topology with ``MeshTopology.from_faces``), or
+        ``vertices`` unusable or not one row per vertex of ``topology``.
     """
+    vertices = checked_topology_points(vertices, topology)
     edges = topology.edges
     n = topology.n_vertices
     if edges.shape[0] == 0:
@@ -255,17 +267,87 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
         return np.where(referenced, overall, 0.0)
     order = np.lexsort((lengths, edge_label))
     counts = np.bincount(edge_label, minlength=n_components)
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    starts = np.cumsum(counts) - counts
     ranked = lengths[order]
-    low = ranked[starts + np.maximum(counts - 1, 0) // 2]
-    high = ranked[starts + np.minimum(counts // 2, np.maximum(counts - 1, 0))]
-    medians = np.where(counts > 0, 0.5 * (low + high), 0.0)
+    medians = np.zeros(n_components)
+    some = counts > 0  # a component of faces (a, a, a) only has no edge: scale 0
+    low = ranked[starts[some] + (counts[some] - 1) // 2]
+    high = ranked[starts[some] + counts[some] // 2]
+    medians[some] = 0.5 * (low + high)
     return np.where(referenced, medians[np.maximum(labels, 0)], 0.0)
 
 
+def checked_topology_points(vertices, topology) -> np.ndarray:
+    """``vertices`` checked (:func:`~meshcurv._validation.checked_points`), one row per vertex of ``topology``.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``topology`` not a MeshTopology, ``vertices`` unusable or of another length.
+    """
+    if not isinstance(topology, MeshTopology):
+        hint = (" (a face array: build one with MeshTopology.from_faces(faces, len(vertices)))"
+                if isinstance(topology, (np.ndarray, list, tuple)) else "")
+        raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}{hint}")
+    vertices = checked_points(vertices)
+    if vertices.shape[0] != topology.n_vertices:
+        raise InvalidMeshError(
+            f"`vertices` has {vertices.shape[0]} rows but the topology has {topology.n_vertices} vertices"
+        )
+    return vertices
+
+
 def degenerate_face_mask(areas: np.ndarray, length_scale) -> np.ndarray:
-    """(F,) bool: faces whose area is negligible relative to ``length_scale ** 2`` (a float or (F,) scales)."""
-    return areas <= DEGENERATE_AREA_RATIO * np.asarray(length_scale, dtype=np.float64) ** 2
+    """(F,) bool: faces whose area is negligible relative to ``length_scale ** 2``.
+
+    Parameters
+    ----------
+    areas : array_like of shape (F,)
+        Face areas (:func:`face_areas`).
+    length_scale : float or array_like of shape (F,)
+        The length scale of every face (:func:`vertex_length_scales`), >= 0.
+
+    Returns
+    -------
+    ndarray of shape (F,), bool
+        ``areas <= DEGENERATE_AREA_RATIO * length_scale ** 2``.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``areas`` not a flat array of real numbers.
+    InvalidOptionError
+        ``length_scale`` not a number >= 0 nor an array of them, one per face.
+    """
+    areas = _real_array(areas, "areas")
+    if areas.ndim != 1:
+        raise InvalidMeshError(f"`areas` must have shape (F,); got {areas.shape}")
+    try:
+        scale = _real_array(length_scale, "length_scale")
+    except InvalidMeshError as error:
+        raise InvalidOptionError(str(error)) from None
+    if scale.ndim not in (0, 1) or (scale.ndim == 1 and scale.shape != areas.shape):
+        raise InvalidOptionError(
+            f"`length_scale` must be a number or an array of shape {areas.shape} (one per face); got {scale.shape}"
+        )
+    if not (scale >= 0).all():
+        raise InvalidOptionError("`length_scale` must be >= 0 (not NaN)")
+    return areas <= DEGENERATE_AREA_RATIO * scale**2
+
+
+def _real_array(value, name: str) -> np.ndarray:
+    """``value`` as a float64 array, refusing what is not real numbers (strings, None, complex, objects)."""
+    array = value if isinstance(value, np.ndarray) else None
+    if array is None:
+        if value is None or isinstance(value, (str, bytes)):
+            raise InvalidMeshError(f"`{name}` must hold real numbers; got {type(value).__name__}")
+        try:
+            array = np.asarray(value)
+        except (TypeError, ValueError, OverflowError) as exc:
+            raise InvalidMeshError(f"`{name}` must hold real numbers ({exc})") from None
+    if array.dtype == bool or not (np.issubdtype(array.dtype, np.floating) or np.issubdtype(array.dtype, np.integer)):
+        raise InvalidMeshError(f"`{name}` must hold real numbers; got dtype {array.dtype}")
+    return array.astype(np.float64, copy=False)
 
 
 def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

@@ -106,6 +106,12 @@ UNEVEN_DENSITY = 2.0
 #: A default radius is at most this share of the cloud's extent (its bounding-box diagonal).
 EXTENT_CAP = 0.25
 
+#: Points whose local spacing is at most this are left out (NaN): the k-d tree's squared distances
+#: underflow float64 below about 1.5e-154 (the square root of the smallest normal number, 2.2e-308)
+#: and read as 0, and the fits would divide by a radius of 0. A part of a cloud at 1e-200 beside
+#: a part at 1 cannot be measured in float64; a cloud all at 1e-200 is refused as for meshes.
+MIN_SPACING = 1e-150
+
 #: Code of :data:`meshcurv.result.INVALID_REASONS` for points without an estimate.
 _UNDEFINED = len(INVALID_REASONS) - 1
 
@@ -276,11 +282,20 @@ def _compute(points, given, radius, method):
     logger.info("point cloud: %d points: neighbours", n)
     distances, indices = _normals.knn(tree, points)
     spacing = _normals.local_spacing(distances)
-    median = float(np.median(spacing))
-    usable = spacing <= OUTLIER_FACTOR * median
-    if not usable.all():
-        problems.append(f"{int((~usable).sum())} points are outliers (their {_normals.SPACING_NEIGHBOUR}th "
-                        f"neighbour is beyond {OUTLIER_FACTOR:g} times the median spacing): left out, NaN")
+    measurable = spacing > MIN_SPACING
+    if not measurable.any():
+        raise InvalidMeshError(
+            f"`points` are spaced below {MIN_SPACING:.0e} everywhere: their squared distances underflow "
+            "float64; rescale the points")
+    median = float(np.median(spacing[measurable]))
+    usable = measurable & (spacing <= OUTLIER_FACTOR * median)
+    if not measurable.all():
+        problems.append(f"{int((~measurable).sum())} points are spaced below {MIN_SPACING:.0e} (their squared "
+                        "distances underflow float64): left out, NaN")
+    if not (usable | ~measurable).all():
+        problems.append(f"{int((~usable & measurable).sum())} points are outliers (their "
+                        f"{_normals.SPACING_NEIGHBOUR}th neighbour is beyond {OUTLIER_FACTOR:g} times the median "
+                        "spacing): left out, NaN")
     centres = np.flatnonzero(usable)
 
     logger.info("point cloud: normals")
@@ -366,8 +381,9 @@ def _radius_groups(spacing, indices, usable, median, noise, radius, method, prob
     if radius is not None:
         return [(radius, median, centres)]
     # the spacing averaged over the neighbours: one class per region, not per random gap
+    # (over the usable neighbours of usable points only: a row of outliers alone would have no mean)
     smooth = np.where(usable, spacing, np.nan)
-    smooth = np.nanmean(np.concatenate([smooth[:, None], smooth[indices]], axis=1), axis=1)[centres]
+    smooth = np.nanmean(np.concatenate([smooth[centres, None], smooth[indices[centres]]], axis=1), axis=1)
     low, high = np.percentile(smooth, [5, 95])
     if high <= UNEVEN_DENSITY * low:
         return [(default_radius(median, noise, method), median, centres)]

@@ -73,9 +73,12 @@ def smooth_vertex_field(values, topology: MeshTopology, steps: int) -> np.ndarra
     if not isinstance(topology, MeshTopology):
         raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}")
     try:
-        field = np.array(values, dtype=np.float64, copy=True)
+        array = np.asarray(values)
     except (TypeError, ValueError, OverflowError) as exc:
         raise InvalidMeshError(f"`values` must be a real array of shape (V,) or (V, k) ({exc})") from None
+    if array.dtype.kind not in "biuf":  # complex (its imaginary part would be dropped), strings, objects
+        raise InvalidMeshError(f"`values` must hold real numbers (float, int or bool); got dtype {array.dtype}")
+    field = np.array(array, dtype=np.float64, copy=True)
     if field.ndim not in (1, 2) or field.shape[0] != topology.n_vertices:
         raise InvalidMeshError(
             f"`values` must have shape (V,) or (V, k) with V = {topology.n_vertices} (the topology's "

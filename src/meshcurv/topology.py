@@ -23,8 +23,19 @@ from functools import cached_property
 import numpy as np
 
 from ._backend import numba_kernels
+from ._validation import (MAX_VERTICES, Ragged, check_vertex_count, checked_triangles, fan_triangles,
+                          polygon_arrays)
+from .errors import InvalidMeshError
 
 __all__ = ["triangulate_faces", "MeshTopology"]
+
+#: :meth:`MeshTopology.from_faces` without ``n_vertices`` refuses a largest index beyond this many
+#: vertices per face corner (or :data:`INFERRED_VERTICES_FLOOR`): the count is then read from the
+#: largest index, and every per-vertex array is sized by it.
+INFERRED_VERTICES_PER_CORNER = 64
+
+#: Inferred vertex counts up to this are always accepted (16.7 million: 400 MB of coordinates).
+INFERRED_VERTICES_FLOOR = 2**24
 
 
 def triangulate_faces(polygons) -> np.ndarray:
@@ -32,9 +43,10 @@ def triangulate_faces(polygons) -> np.ndarray:
 
     Parameters
     ----------
-    polygons : array_like of shape (F, k), or list of index sequences
+    polygons : array_like of shape (F, k), list of index sequences, or MeshTopology
         Faces with ``k >= 3`` corners each (0-based vertex indices). A list may
-        hold faces of different lengths.
+        hold faces of different lengths. A :class:`MeshTopology` gives a copy of
+        its triangles.
 
     Returns
     -------
@@ -42,28 +54,33 @@ def triangulate_faces(polygons) -> np.ndarray:
         Face ``(f0, f1, ..., f(k-1))`` gives the triangles ``(f0, f(j-1), f(j))``
         for ``j = 2 .. k-1``, kept next to each other in the order of the faces:
         a quad ``a, b, c, d`` gives ``(a, b, c)`` then ``(a, c, d)``. No check of
-        convexity or planarity is made (matGeom makes none).
+        convexity or planarity is made (matGeom makes none). Computed in one
+        gather over all faces, whatever the mix of lengths.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``polygons`` not an array of shape (F, k) with k >= 3 nor a list of
+        index lists, empty, a face of fewer than 3 corners, non-integer or
+        negative indices, indices beyond int64.
 
     Examples
     --------
     >>> triangulate_faces([[0, 1, 2, 3]]).tolist()
     [[0, 1, 2], [0, 2, 3]]
+    >>> triangulate_faces([[0, 1, 2], [2, 1, 3, 4]]).tolist()
+    [[0, 1, 2], [2, 1, 3], [2, 3, 4]]
     """
-    if isinstance(polygons, np.ndarray) and polygons.ndim == 2:
-        groups = [polygons]
-    else:
-        groups = [np.asarray(face, dtype=np.int64)[None, :] for face in polygons]
-    pieces = []
-    for group in groups:
-        group = np.asarray(group, dtype=np.int64)
-        k = group.shape[1]
-        j = np.arange(2, k)
-        # (F, k-2, 3): for every face, its fan triangles in order
-        fan = np.stack(
-            [np.repeat(group[:, :1], k - 2, axis=1), group[:, j - 1], group[:, j]], axis=2
+    if isinstance(polygons, MeshTopology):
+        return polygons.faces.copy()
+    shaped = polygon_arrays(polygons, name="polygons")
+    flat = shaped.flat if isinstance(shaped, Ragged) else shaped
+    low = int(flat.min())
+    if low < 0:
+        raise InvalidMeshError(
+            f"`polygons` has negative vertex indices (smallest {low}); indices are 0-based and >= 0"
         )
-        pieces.append(fan.reshape(-1, 3))
-    return np.ascontiguousarray(np.concatenate(pieces)) if pieces else np.zeros((0, 3), np.int64)
+    return np.array(fan_triangles(shaped), dtype=np.int64, order="C", copy=True)
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,16 +126,39 @@ class MeshTopology:
         faces : array_like of shape (F, 3) or (F, k), or list of index lists
             0-based vertex indices; polygons are fan-triangulated (with a warning).
         n_vertices : int, optional
-            Number of vertices; default ``faces.max() + 1``.
-        """
-        from ._validation import as_faces, as_polygons
+            Number of vertices, 1 to :data:`~meshcurv._validation.MAX_VERTICES`;
+            default ``faces.max() + 1``, which must then stay within
+            :data:`INFERRED_VERTICES_PER_CORNER` times the number of corners
+            (or :data:`INFERRED_VERTICES_FLOOR`): one stray index of 2**40 must
+            not size every array of the topology.
 
+        Raises
+        ------
+        InvalidMeshError
+            Faces unusable (see :func:`triangulate_faces`), indices out of range
+            for ``n_vertices``, or no ``n_vertices`` with an index far beyond
+            the faces' size.
+        InvalidOptionError
+            ``n_vertices`` not an integer in ``[1, MAX_VERTICES]``.
+        """
+        if n_vertices is not None:
+            n_vertices = check_vertex_count(n_vertices)
+        shaped = polygon_arrays(faces)
         if n_vertices is None:
-            polygons = as_polygons(faces)
-            flat = np.concatenate(polygons) if isinstance(polygons, list) else polygons
-            n_vertices = int(flat.max()) + 1
-        triangles = as_faces(faces, n_vertices)
-        return cls._build(triangles, int(n_vertices))
+            flat = shaped.flat if isinstance(shaped, Ragged) else shaped
+            largest = int(flat.max())
+            limit = min(MAX_VERTICES, max(INFERRED_VERTICES_FLOOR, INFERRED_VERTICES_PER_CORNER * flat.size))
+            if largest >= limit:
+                raise InvalidMeshError(
+                    f"`faces` reference vertex index {largest} but hold only {flat.size} corners: pass "
+                    f"`n_vertices` (the number of vertices) if the mesh really has {largest + 1} of them"
+                    if largest < MAX_VERTICES else
+                    f"`faces` reference vertex index {largest}, beyond the largest mesh meshcurv takes "
+                    f"(n_vertices up to {MAX_VERTICES})"
+                )
+            n_vertices = largest + 1
+        triangles = checked_triangles(shaped, n_vertices, stacklevel=3)
+        return cls._build(triangles, n_vertices)
 
     @classmethod
     def _build(cls, faces: np.ndarray, n_vertices: int) -> "MeshTopology":

@@ -50,6 +50,13 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, stages: Stages):
     defects = mesh_defects(topology, degenerate)
     good = faces[~degenerate]
     cot = corner_cotangents(vertices, good)
+    # a corner whose cross product rounds to zero while its face's area does not (the corner at a vertex
+    # so far from its neighbours that their offsets are absorbed, a spike at 1e20): no cotangent weight
+    needles = ~np.isfinite(cot).all(axis=1)
+    needle_vertices = np.zeros(n, dtype=bool)
+    needle_vertices[good[needles].ravel()] = True
+    if needles.any():
+        good, cot = good[~needles], cot[~needles]
     angles = corner_angles(vertices, good)
     shares = mixed_voronoi_corner_areas(vertices, good)
     areas = np.bincount(good.ravel(), weights=shares.ravel(), minlength=n)
@@ -66,11 +73,13 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, stages: Stages):
 
     stages.start("retrieve curvatures")
     normals = vertex_normals(vertices, good)
-    valid = ~defects.invalid_vertices & np.isfinite(normals).all(axis=1) & (areas > 0)
+    valid = ~defects.invalid_vertices & ~needle_vertices & np.isfinite(normals).all(axis=1) & (areas > 0)
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = -np.einsum("ij,ij->i", laplace, normals) / (4 * areas)
         gaussian = defect / areas
     half_difference = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
     directions = np.full((n, 3), np.nan)
+    extra = (f"{int(needles.sum())} needle faces (a corner angle that rounds to zero: a vertex far from its "
+             "neighbours); their vertices have no cotangent Laplacian",) if needles.any() else ()
     return finish("meyer", {}, valid, normals, mean - half_difference, mean + half_difference,
-                  directions, directions.copy(), defects)
+                  directions, directions.copy(), defects, extra)
