@@ -323,6 +323,10 @@ def test_rows_follow_the_construction_and_the_geometry(first_run, dozen):
         assert row["seconds"] > 0
         for field in batch.SUMMARY_FIELDS:
             assert row[f"{field}_p5"] <= row[f"{field}_median"] <= row[f"{field}_p95"], (name, field)
+            assert row[f"{field}_area_p5"] <= row[f"{field}_area_median"] <= row[f"{field}_area_p95"], (name, field)
+        if facts["volume"] is not None:  # closed: Gauss-Bonnet, exact
+            chi = facts["euler_characteristic"]
+            assert abs(row["total_gaussian"] - 2 * np.pi * chi) < 1e-9 * 4 * np.pi, name
     for radius in RADII:
         row = next(rows.loc[name] for name, facts in expected.items() if facts.get("radius") == radius)
         # an icosphere with 642 vertices: its area and volume are those of the sphere within 1% (0.5% and
@@ -333,6 +337,11 @@ def test_rows_follow_the_construction_and_the_geometry(first_run, dozen):
                              ("gaussian", 1 / radius**2), ("curvedness", 1 / radius), ("shape_index", 1.0)):
             assert row[f"{field}_median"] == pytest.approx(exact, rel=0.01), (radius, field)
             assert row[f"{field}_mean"] == pytest.approx(exact, rel=0.01), (radius, field)
+            assert row[f"{field}_area_median"] == pytest.approx(exact, rel=0.01), (radius, field)
+            assert row[f"{field}_area_mean"] == pytest.approx(exact, rel=0.01), (radius, field)
+        # int H dA = 4 pi R and int H^2 dA = 4 pi, within the inscribed polyhedron's 1% (see test_integrals)
+        assert row["total_mean"] == pytest.approx(4 * np.pi * radius, rel=0.01)
+        assert row["willmore"] == pytest.approx(4 * np.pi, rel=0.01)
     # torus R 30, r 10 of 24 x 12 quads: a 12-gon has sin(30 deg) / (pi / 6) = 95.5% of its circle's area and
     # a 24-gon 98.9%, so the polyhedron's volume is 94% of 2 pi^2 R r^2 and its area 98% of 4 pi^2 R r
     torus = rows.loc["torus.off"]
@@ -371,6 +380,19 @@ def test_a_second_run_does_no_work(first_run, dozen, client):
     # without the corrupt file there is nothing to do: not even a connection (nothing listens on port 9)
     quiet = batch.run(sorted(folder / name for name in expected), out_dir, scheduler=f"tcp://{LOOPBACK}:9")
     assert (quiet["status"] == "skipped").all() and len(quiet) == 11
+
+
+def test_a_record_of_an_older_meshcurv_is_computed_again(tmp_path, client):
+    paths = write_spheres(tmp_path / "in", 2, 3)
+    out_dir = tmp_path / "out"
+    batch.run(paths, out_dir, client=client)
+    path = out_dir / batch.RECORDS / "sphere_000.ply.json"
+    record = json.loads(path.read_text())
+    del record["row"]["total_gaussian"]  # as written before the integrals were in the table
+    path.write_text(json.dumps(record))
+    again = batch.run(paths, out_dir, client=client)
+    assert again["status"].tolist() == ["computed", "skipped"]
+    assert again["total_gaussian"].to_numpy() == pytest.approx([4 * np.pi] * 2, rel=1e-9)
 
 
 def test_overwrite_and_results_of_other_options(tmp_path, client):

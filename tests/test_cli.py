@@ -93,10 +93,27 @@ def test_compute_prints_a_summary_table(capsys, torus_file):
     torus = meshcurv.shapes.torus()
     h = meshcurv.geometry.mean_edge_length(torus.vertices, meshcurv.MeshTopology.from_faces(torus.faces).edges)
     assert f"3600 vertices, 7200 faces; method icc (radius={h:.4g}, normal_radius={3 * h:.4g}, " in lines[0]
-    assert lines[1].split() == ["field", "min", "p5", "p25", "median", "p75", "p95", "max", "mean"]
-    rows = {line.split()[0]: [float(x) for x in line.split()[1:]] for line in lines[2:-1]}
+    assert lines[1].startswith("per vertex")
+    assert lines[2].split() == ["field", "min", "p5", "p25", "median", "p75", "p95", "max", "mean"]
+    rows = {line.split()[0]: [float(x) for x in line.split()[1:]] for line in lines[3:9]}
     assert list(rows) == ["k_min", "k_max", "mean", "gaussian", "shape_index", "curvedness"]
     assert rows["k_max"][3] == pytest.approx(0.1, rel=0.02)  # median of k_max: 1/r
+    # k_min = cos v / (R + r cos v); the vertices are uniform in (u, v), so their mean is
+    # (1 - R / sqrt(R^2 - r^2)) / r = -0.00607, while the area-weighted mean is int k_min dA / A = 0
+    R, r = 30.0, 10.0
+    assert rows["k_min"][7] == pytest.approx((1 - R / np.sqrt(R**2 - r**2)) / r, rel=0.05)
+    assert lines[9].startswith("area-weighted")
+    assert lines[10].split() == ["field", "p5", "p25", "median", "p75", "p95", "mean"]
+    weighted = {line.split()[0]: [float(x) for x in line.split()[1:]] for line in lines[11:17]}
+    assert list(weighted) == list(rows)
+    assert abs(weighted["k_min"][5]) < 0.01 * abs(rows["k_min"][7])
+    assert weighted["k_max"][2] == pytest.approx(0.1, rel=0.02)
+    integrals = lines[17]
+    area = float(integrals.split("area ")[1].split(",")[0])
+    assert area == pytest.approx(4 * np.pi**2 * R * r, rel=0.01)  # inscribed mesh: see test_integrals
+    total_gaussian = float(integrals.split("total Gaussian curvature ")[1].split(" ")[0])
+    assert abs(total_gaussian) < 1e-9  # chi = 0
+    assert "2 pi chi = 0 pi" in integrals
     assert lines[-1] == "invalid vertices (estimate undefined, fields NaN): 0 of 3600"
 
 

@@ -302,15 +302,19 @@ def _compute_points(path, output, method, smoothing_steps, radius, orient, field
 
 
 def _summary(path, vertices, faces, result, fields) -> str:
+    """The summary table of ``meshcurv compute``: per-vertex and area-weighted statistics, then the integrals."""
+    from .integrals import weighted_statistics
+
     parameters = ", ".join(f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
                            for key, value in result.parameters.items())
     size = f"{len(vertices)} vertices, {len(faces)} faces" if len(faces) else f"{len(vertices)} points"
     lines = [f"{path}: {size}; method {result.method}"
              + (f" ({parameters})" if parameters else "")]
-    columns = ["min", "p5", "p25", "median", "p75", "p95", "max", "mean"]
-    lines.append(f"{'field':<12}" + "".join(f"{name:>11}" for name in columns))
     values = curvature_fields(result, fields=[f for f in (fields or SCALAR_FIELDS) if f in SCALAR_FIELDS],
                               quality=None)
+    columns = ["min", "p5", "p25", "median", "p75", "p95", "max", "mean"]
+    lines.append("per vertex (each vertex counts once: depends on the sampling density)")
+    lines.append(f"{'field':<12}" + "".join(f"{name:>11}" for name in columns))
     for name, field in values.items():
         finite = field[np.isfinite(field)]
         if finite.size == 0:
@@ -318,9 +322,30 @@ def _summary(path, vertices, faces, result, fields) -> str:
             continue
         row = [finite.min(), *np.percentile(finite, [5, 25, 50, 75, 95]), finite.max(), finite.mean()]
         lines.append(f"{name:<12}" + "".join(f"{value:>11.4g}" for value in row))
+    if len(faces):
+        weighted = ["p5", "p25", "median", "p75", "p95", "mean"]
+        lines.append("area-weighted (each vertex counts by its area: a third of its faces)")
+        lines.append(f"{'field':<12}" + "".join(f"{name:>11}" for name in weighted))
+        areas = result.vertex_areas
+        for name, field in values.items():
+            figures = weighted_statistics(field, areas)
+            lines.append(f"{name:<12}" + "".join(f"{figures[key]:>11.4g}" for key in weighted))
+        lines.append(_integrals_line(result))
     n_invalid = int((~result.valid).sum())
     lines.append(f"invalid vertices (estimate undefined, fields NaN): {n_invalid} of {len(vertices)}")
     return "\n".join(lines)
+
+
+def _integrals_line(result) -> str:
+    """The integrals over the surface, one line (Gauss-Bonnet's 2 pi chi beside the total of K)."""
+    chi = result.diagnosis.euler_characteristic if result.diagnosis is not None else None
+    closed = result.diagnosis is not None and result.diagnosis.n_boundary_edges == 0
+    gaussian = result.integral("gaussian")
+    check = f" = {gaussian / np.pi:.4f} pi" + (f"; 2 pi chi = {2 * chi} pi" if closed and chi is not None else "")
+    willmore = result.integral("willmore", where=result.valid)
+    partial = "" if result.valid.all() else " over the valid vertices"
+    return (f"integrals: area {result.integral('area'):.6g}, total mean curvature {result.integral('mean'):.6g}, "
+            f"total Gaussian curvature {gaussian:.6g}{check}, Willmore energy{partial} {willmore:.6g}")
 
 
 def _views(ctx, param, values):

@@ -70,8 +70,17 @@ logger = logging.getLogger(__name__)
 #: The per-vertex fields summarised in each row (attributes of :class:`~meshcurv.CurvatureResult`).
 SUMMARY_FIELDS = ("k_min", "k_max", "mean", "gaussian", "shape_index", "curvedness")
 
-#: The statistics of each summarised field, over the valid vertices with a finite value.
+#: The per-vertex statistics of each summarised field, over the valid vertices with a finite value
+#: (each vertex counts once: they depend on the sampling density), as ``<field>_<statistic>``.
 STATISTICS = ("mean", "median", "p5", "p95")
+
+#: The area-weighted statistics of each summarised field (each vertex counts by its vertex area,
+#: :attr:`meshcurv.CurvatureResult.vertex_areas`), as ``<field>_area_<statistic>``; NaN for point clouds.
+AREA_STATISTICS = ("mean", "median", "p5", "p95")
+
+#: The integrals over the surface (:meth:`meshcurv.CurvatureResult.integral`): column -> field.
+#: ``willmore`` is over the valid vertices. NaN for point clouds.
+INTEGRAL_COLUMNS = {"total_mean": "mean", "total_gaussian": "gaussian", "willmore": "willmore"}
 
 #: The result file formats: those of :data:`meshcurv.io.FORMATS` that hold per-vertex fields.
 OUTPUT_FORMATS = ("ply", "npz", "vtp", "vtu", "vtk", "csv")
@@ -131,6 +140,8 @@ COLUMNS = {
     "n_components": "Int64",
     "n_boundary_loops": "Int64",
     **{f"{field}_{statistic}": "float64" for field in SUMMARY_FIELDS for statistic in STATISTICS},
+    **{f"{field}_area_{statistic}": "float64" for field in SUMMARY_FIELDS for statistic in AREA_STATISTICS},
+    **dict.fromkeys(INTEGRAL_COLUMNS, "float64"),
     "n_invalid": "Int64",
     "seconds": "float64",
     "error": "str",
@@ -138,6 +149,10 @@ COLUMNS = {
     "method": "str",
     "output": "str",
 }
+
+#: Columns added since the first records: a record without them is computed again.
+_ADDED_COLUMNS = (*(f"{field}_area_{statistic}" for field in SUMMARY_FIELDS for statistic in AREA_STATISTICS),
+                  *INTEGRAL_COLUMNS)
 
 #: Environment of the worker processes of the local cluster: one thread each for
 #: BLAS, OpenMP and numba, so that N workers use N cores and not N x N threads.
@@ -378,6 +393,18 @@ def _statistics(result) -> dict:
         else:
             figures = dict.fromkeys(STATISTICS, np.nan)
         row.update({f"{name}_{statistic}": float(figures[statistic]) for statistic in STATISTICS})
+    if result._surface is None:  # a point cloud: no areas
+        row.update({f"{name}_area_{statistic}": np.nan for name in SUMMARY_FIELDS for statistic in AREA_STATISTICS})
+        row.update(dict.fromkeys(INTEGRAL_COLUMNS, np.nan))
+        return row
+    from .integrals import weighted_statistics
+
+    areas = np.where(result.valid, result.vertex_areas, 0.0)
+    for name in SUMMARY_FIELDS:
+        figures = weighted_statistics(getattr(result, name), areas)
+        row.update({f"{name}_area_{statistic}": figures[statistic] for statistic in AREA_STATISTICS})
+    for column, field in INTEGRAL_COLUMNS.items():
+        row[column] = result.integral(field, where=result.valid if field == "willmore" else None)
     return row
 
 
@@ -871,8 +898,15 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
         counts, area, volume (closed meshes; NaN otherwise), Euler
         characteristic, components, boundary loops; for each of
         :data:`SUMMARY_FIELDS` the mean, median, 5th and 95th percentiles over
-        the valid vertices (``mean_median`` is the median of the mean
-        curvature H); the number of invalid vertices; the seconds the mesh
+        the valid vertices, each vertex counting once (``mean_median`` is the
+        per-vertex median of the mean curvature H), and the same weighted by
+        the vertex areas (``mean_area_median``; each vertex counts by a third
+        of its faces' area, independent of the sampling density); the integrals
+        over the surface ``total_mean`` (int H dA), ``total_gaussian`` (int K
+        dA, 2 pi chi on a closed mesh) and ``willmore`` (int H^2 dA over the
+        valid vertices; see :meth:`meshcurv.CurvatureResult.integral`); the
+        area-weighted columns and the integrals are NaN for point clouds;
+        the number of invalid vertices; the seconds the mesh
         took; the error (its type and message) of a failed mesh, the warnings
         of the computation, the method and the result file. The same table is
         written to ``out_dir/summary.parquet`` and ``out_dir/summary.csv``
@@ -1120,6 +1154,10 @@ def _completed(job: _Job, options: dict, *, overwrite: bool, retry_failed: bool,
         )
     if not _unchanged(job.source, stored.get("input")):
         logger.info("%s: changed since its result was recorded (or no fingerprint): computed again", job.path)
+        return None
+    missing = [column for column in _ADDED_COLUMNS if column not in row]
+    if row["status"] != "failed" and missing:
+        logger.info("%s: its record has no %s (an older meshcurv): computed again", job.path, ", ".join(missing))
         return None
     if row["status"] == "failed":
         if retry_failed or stored.get("options") != options:

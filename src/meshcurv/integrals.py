@@ -59,7 +59,7 @@ from ._validation import check_choice, checked_mesh
 from .errors import InvalidMeshError
 from .geometry import face_areas, vertex_normals
 
-__all__ = ["INTEGRALS", "vertex_integrals", "face_solid_angles"]
+__all__ = ["INTEGRALS", "vertex_integrals", "face_solid_angles", "weighted_percentiles", "weighted_statistics"]
 
 #: The fields :func:`vertex_integrals` and :meth:`meshcurv.CurvatureResult.integral` integrate.
 INTEGRALS = ("area", "mean", "gaussian", "willmore")
@@ -173,3 +173,47 @@ def vertex_integrals(vertices, faces, field: str, *, normals=None, pointwise=Non
         with np.errstate(invalid="ignore"):
             shares = np.where(shares > 0, pointwise**2 * shares, 0.0)
     return shares
+
+
+def weighted_percentiles(values, weights, percentiles) -> np.ndarray:
+    """Percentiles of ``values`` where each value counts by its weight (e.g. its vertex area).
+
+    Each value stands at the middle of its share of the total weight, and
+    the percentiles are interpolated linearly between those positions (with
+    equal weights, numpy's ``method="hazen"``). Values that are not finite and
+    weights that are not positive are left out; NaN when nothing is left.
+
+    Parameters
+    ----------
+    values, weights : array_like of shape (N,)
+    percentiles : array_like of floats in [0, 100]
+
+    Returns
+    -------
+    ndarray of the shape of ``percentiles``
+    """
+    values = np.asarray(values, dtype=np.float64)
+    weights = np.asarray(weights, dtype=np.float64)
+    if values.shape != weights.shape or values.ndim != 1:
+        raise InvalidMeshError(f"`values` and `weights` must have one shape (N,); got {values.shape} and "
+                               f"{weights.shape}")
+    wanted = np.asarray(percentiles, dtype=np.float64) / 100.0
+    kept = np.isfinite(values) & np.isfinite(weights) & (weights > 0)
+    if not kept.any():
+        return np.full(wanted.shape, np.nan)
+    order = np.argsort(values[kept], kind="stable")
+    ranked, share = values[kept][order], weights[kept][order]
+    running = np.cumsum(share)
+    middles = (running - share / 2) / running[-1]
+    return np.interp(wanted, middles, ranked)
+
+
+def weighted_statistics(values, weights) -> dict[str, float]:
+    """``mean, median, p5, p25, p75, p95`` of ``values`` weighted by ``weights`` (see :func:`weighted_percentiles`)."""
+    values = np.asarray(values, dtype=np.float64)
+    weights = np.asarray(weights, dtype=np.float64)
+    p5, p25, median, p75, p95 = weighted_percentiles(values, weights, [5, 25, 50, 75, 95])
+    kept = np.isfinite(values) & np.isfinite(weights) & (weights > 0)
+    mean = float(np.sum(values[kept] * weights[kept]) / np.sum(weights[kept])) if kept.any() else np.nan
+    return {"mean": mean, "median": float(median), "p5": float(p5), "p25": float(p25), "p75": float(p75),
+            "p95": float(p95)}
