@@ -7,7 +7,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test quick test-minimal lint bench-accuracy bench-speed clean
+.PHONY: demo test quick test-minimal lint docs bench-accuracy bench-speed clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "meshcurv needs Python 3.11 or newer: make PYTHON=python3.11 ...")'
@@ -32,6 +32,11 @@ test-minimal:
 	.venv-minimal/bin/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
 	.venv-minimal/bin/python -m pytest -q -m "not slow"
 
+# the API reference from the docstrings, with the README (docs/_build/html/index.html); warnings are errors
+docs: $(STAMP)
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[docs]'
+	$(BIN)/python -m sphinx -W --keep-going -b html -q docs docs/_build/html
+
 lint: $(STAMP)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check 'ruff>=0.6'
 	$(BIN)/ruff check src tests benchmarks conftest.py
@@ -41,4 +46,4 @@ bench-accuracy: $(STAMP)
 	$(BIN)/python benchmarks/accuracy.py
 
 clean:
-	rm -rf $(VENV) .venv-minimal demo-output
+	rm -rf $(VENV) .venv-minimal demo-output docs/_build docs/api
