@@ -229,3 +229,27 @@ def test_gauss_bonnet_shared_meshes(name, chi):
         warnings.simplefilter("ignore", MeshQualityWarning)
         r = meshcurv.principal_curvatures(mesh.vertices, mesh.faces)
     assert abs(r.integral("gaussian") - 2 * np.pi * chi) < 0.01 * 4 * np.pi
+
+
+def test_weighted_percentiles():
+    from meshcurv.integrals import weighted_percentiles, weighted_statistics
+
+    values = np.random.default_rng(1).normal(size=200)
+    q = [0, 5, 25, 50, 75, 95, 100]
+    np.testing.assert_allclose(weighted_percentiles(values, np.ones(200), q),
+                               np.percentile(values, q, method="inverted_cdf"), rtol=1e-12)
+    # a value that holds more than half of the weight is the median
+    weights = np.ones(200)
+    weights[7] = 300.0
+    assert weighted_percentiles(values, weights, [50])[0] == values[7]
+    # a weight of 2 counts as the value twice
+    weights = np.where(np.arange(200) < 50, 2.0, 1.0)
+    doubled = np.concatenate([values, values[:50]])
+    np.testing.assert_allclose(weighted_percentiles(values, weights, q),
+                               np.percentile(doubled, q, method="inverted_cdf"), rtol=1e-12)
+    # NaN values and zero weights are left out
+    figures = weighted_statistics(np.append(values, [np.nan, 1e9]), np.append(weights, [1.0, 0.0]))
+    assert figures["mean"] == pytest.approx(np.mean(doubled), rel=1e-12)
+    assert np.isnan(weighted_percentiles([np.nan], [1.0], [50])).all()
+    with pytest.raises(InvalidMeshError, match=r"`values` and `weights` must have one shape \(N,\)"):
+        weighted_percentiles(np.ones(3), np.ones(4), [50])

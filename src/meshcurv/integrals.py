@@ -178,10 +178,12 @@ def vertex_integrals(vertices, faces, field: str, *, normals=None, pointwise=Non
 def weighted_percentiles(values, weights, percentiles) -> np.ndarray:
     """Percentiles of ``values`` where each value counts by its weight (e.g. its vertex area).
 
-    Each value stands at the middle of its share of the total weight, and
-    the percentiles are interpolated linearly between those positions (with
-    equal weights, numpy's ``method="hazen"``). Values that are not finite and
-    weights that are not positive are left out; NaN when nothing is left.
+    The ``p``-th percentile is the smallest value whose cumulative weight
+    (values in increasing order) reaches ``p / 100`` of the total: a value of
+    weight 2 counts as the value twice, a value holding more than half the
+    weight is the median, and equal weights give numpy's
+    ``method="inverted_cdf"``. Values that are not finite and weights that
+    are not positive are left out; NaN when nothing is left.
 
     Parameters
     ----------
@@ -204,8 +206,8 @@ def weighted_percentiles(values, weights, percentiles) -> np.ndarray:
     order = np.argsort(values[kept], kind="stable")
     ranked, share = values[kept][order], weights[kept][order]
     running = np.cumsum(share)
-    middles = (running - share / 2) / running[-1]
-    return np.interp(wanted, middles, ranked)
+    reached = np.searchsorted(running, wanted * running[-1] * (1 - 1e-12), side="left")
+    return ranked[np.minimum(reached, ranked.size - 1)]
 
 
 def weighted_statistics(values, weights) -> dict[str, float]:
