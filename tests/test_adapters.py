@@ -62,3 +62,90 @@ def test_open3d_triangle_mesh():
 def test_an_unknown_object_is_refused_with_a_clear_message():
     with pytest.raises(InvalidMeshError, match="`vertices` is a dict, not an array, and not a mesh object"):
         meshcurv.principal_curvatures({"points": 1})
+
+
+# ------------------------------------------------------------------------------------ results out
+
+
+SCALARS = ("k_min", "k_max", "mean", "gaussian", "shape_index", "curvedness")
+
+
+def test_to_pyvista_copies_the_polydata_and_adds_every_field():
+    pv = pytest.importorskip("pyvista")
+    flat = np.c_[np.full(SPHERE.faces.shape[0], 3), SPHERE.faces].ravel()
+    mesh = pv.PolyData(SPHERE.vertices, flat)
+    mesh.point_data["label"] = np.arange(mesh.n_points)
+    r = meshcurv.principal_curvatures(mesh)
+    out = r.to_pyvista(mesh)
+    assert out is not mesh and list(mesh.point_data) == ["label"]  # the input is not changed
+    assert set(out.point_data) == {"label", *SCALARS, "dir_min", "dir_max", "normals", "valid"}
+    for name in SCALARS:
+        np.testing.assert_array_equal(out.point_data[name], getattr(r, name))
+    np.testing.assert_array_equal(out.point_data["dir_max"], r.dir_max)
+    np.testing.assert_array_equal(out.point_data["valid"], r.valid.astype(np.uint8))
+    np.testing.assert_array_equal(out.points, SPHERE.vertices)
+    # the mesh the result keeps, and a (vertices, faces) pair, give the same cells
+    for other in (r.to_pyvista(), r.to_pyvista((SPHERE.vertices, SPHERE.faces), fields=["mean"])):
+        np.testing.assert_array_equal(other.faces, out.faces)
+        np.testing.assert_array_equal(other.point_data["mean"], r.mean)
+
+
+def test_to_pyvista_polygons_and_errors():
+    pv = pytest.importorskip("pyvista")
+    quads = shapes.torus(n_major=12, n_minor=8)
+    quad_faces = np.asarray(quads.quads)
+    r = meshcurv.principal_curvatures(quads.vertices, quads.faces)
+    out = r.to_pyvista((quads.vertices, quad_faces))
+    assert out.n_cells == quad_faces.shape[0] and out.faces[0] == 4
+    mixed = [list(face) for face in quad_faces[:-1]] + [list(quad_faces[-1, :3]), list(quad_faces[-1, [0, 2, 3]])]
+    assert r.to_pyvista((quads.vertices, mixed)).n_cells == quad_faces.shape[0] + 1
+    with pytest.raises(InvalidMeshError, match=r"to_pyvista: the mesh has 3 vertices but the result 96 rows"):
+        r.to_pyvista((np.zeros((3, 3)), [[0, 1, 2]]))
+    soup = SPHERE.vertices[SPHERE.faces].reshape(-1, 3)
+    with pytest.warns(meshcurv.MeshQualityWarning, match="welded"):
+        welded = meshcurv.principal_curvatures(soup, np.arange(soup.shape[0]).reshape(-1, 3))
+    with pytest.raises(InvalidMeshError, match="to_pyvista: pass the mesh the result was computed on; its mesh "
+                                               "was welded"):
+        welded.to_pyvista()
+    assert pv.PolyData  # the module was there: the errors above are meshcurv's
+
+
+def test_to_trimesh_vertex_attributes():
+    trimesh = pytest.importorskip("trimesh")
+    mesh = trimesh.Trimesh(SPHERE.vertices, SPHERE.faces, process=False)
+    r = meshcurv.principal_curvatures(mesh)
+    out = r.to_trimesh(mesh)
+    assert out is not mesh and mesh.vertex_attributes == {}
+    for name in SCALARS:
+        np.testing.assert_array_equal(out.vertex_attributes[name], getattr(r, name))
+    assert out.vertex_attributes["normals"].shape == (SPHERE.vertices.shape[0], 3)
+    built = r.to_trimesh((SPHERE.vertices, SPHERE.faces), fields=["gaussian"])
+    assert list(built.vertex_attributes) == ["gaussian"]
+    np.testing.assert_array_equal(built.vertices, SPHERE.vertices)  # process=False: order kept
+    np.testing.assert_array_equal(built.faces, SPHERE.faces)
+
+
+def test_to_dataframe_one_row_per_vertex():
+    pd = pytest.importorskip("pandas")
+    r = reference()
+    frame = r.to_dataframe()
+    assert isinstance(frame, pd.DataFrame) and len(frame) == SPHERE.vertices.shape[0]
+    assert list(frame.columns) == [*SCALARS, "dir_min_x", "dir_min_y", "dir_min_z", "dir_max_x", "dir_max_y",
+                                   "dir_max_z", "normals_x", "normals_y", "normals_z", "valid", "vertex_area"]
+    assert frame["valid"].dtype == bool
+    np.testing.assert_array_equal(frame["normals_y"], r.normals[:, 1])
+    corners = SPHERE.vertices[SPHERE.faces]
+    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1).sum()
+    assert frame["vertex_area"].sum() == pytest.approx(area, rel=1e-12)
+    assert list(r.to_dataframe(fields=["mean"]).columns) == ["mean"]
+
+
+@pytest.mark.parametrize("method, module", [("to_pyvista", "pyvista"), ("to_trimesh", "trimesh"),
+                                            ("to_dataframe", "pandas")])
+def test_missing_library_names_what_to_install(monkeypatch, method, module):
+    import sys
+
+    r = reference()
+    monkeypatch.setitem(sys.modules, module, None)  # as if not installed: importing it raises ImportError
+    with pytest.raises(meshcurv.errors.MissingDependencyError, match=f"{method} needs {module}: pip install {module}"):
+        getattr(r, method)()

@@ -291,6 +291,32 @@ class CurvatureResult:
             shares = shares[mask]
         return float(np.sum(shares))
 
+    def to_pyvista(self, mesh=None, *, fields=None):
+        """A ``pyvista.PolyData`` with the fields as ``point_data``: :func:`meshcurv._adapters.to_pyvista`.
+
+        ``mesh``: the mesh the result was computed on (a ``PolyData``, copied;
+        another mesh object; or ``(vertices, faces)``); by default the one the
+        result keeps. ``fields``: names of :data:`meshcurv.io.fields.FIELDS`.
+        """
+        from ._adapters import to_pyvista
+
+        return to_pyvista(self, mesh, fields=fields)
+
+    def to_trimesh(self, mesh=None, *, fields=None):
+        """A ``trimesh.Trimesh`` with the fields in ``vertex_attributes``: :func:`meshcurv._adapters.to_trimesh`."""
+        from ._adapters import to_trimesh
+
+        return to_trimesh(self, mesh, fields=fields)
+
+    def to_dataframe(self, *, fields=None):
+        """A ``pandas.DataFrame``, one row per vertex: :func:`meshcurv._adapters.to_dataframe`.
+
+        Vectors as ``<name>_x, _y, _z``; ``vertex_area`` added when ``fields`` is not given.
+        """
+        from ._adapters import to_dataframe
+
+        return to_dataframe(self, fields=fields)
+
     def as_matgeom(self) -> tuple[np.ndarray, ...]:
         """The seven outputs of matGeom's ``meshCurvatures``, in its order.
 
