@@ -24,7 +24,7 @@ from meshcurv import neighborhoods, shapes, smoothing
 from meshcurv._backend import use_backend
 from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from meshcurv.estimators import quadric
-from meshcurv.geometry import (edge_lengths, face_areas, mean_edge_length, median_edge_length,
+from meshcurv.geometry import (degenerate_face_mask, edge_lengths, face_areas, mean_edge_length, median_edge_length,
                                robust_mean_edge_length, vertex_length_scales, vertex_normals)
 from meshcurv.topology import MeshTopology
 
@@ -426,3 +426,85 @@ def test_smoothing_and_diagnose_refuse_mismatched_arrays():
         smoothing.smooth_vertex_field(np.ones(N + 1), top, 2)
     with pytest.raises(InvalidMeshError, match=f"`vertices` has {N - 1} rows but the topology has {N}"):
         meshcurv.diagnose(SPHERE.vertices[:-1], top)
+
+
+def test_geometry_helpers_refuse_what_is_not_a_topology_or_a_scale():
+    top = MeshTopology.from_faces(SPHERE.faces, N)
+    with pytest.raises(InvalidMeshError, match=r"`topology` must be a MeshTopology; got ndarray \(a face array: "
+                                               r"build one with MeshTopology.from_faces"):
+        vertex_length_scales(SPHERE.vertices, SPHERE.faces)
+    with pytest.raises(InvalidMeshError, match=f"`vertices` has {N + 1} rows but the topology has {N}"):
+        vertex_length_scales(np.vstack([SPHERE.vertices, [[0.0, 0.0, 0.0]]]), top)
+    areas = face_areas(SPHERE.vertices, SPHERE.faces)
+    with pytest.raises(InvalidOptionError, match=r"`length_scale` must hold real numbers; got dtype complex128"):
+        degenerate_face_mask(areas, 1j)
+    with pytest.raises(InvalidOptionError, match=r"`length_scale` must be a number or an array of shape \(1280,\)"):
+        degenerate_face_mask(areas, np.ones(3))
+    with pytest.raises(InvalidOptionError, match=r"`length_scale` must be >= 0 \(not NaN\)"):
+        degenerate_face_mask(areas, np.nan)
+    with pytest.raises(InvalidMeshError, match=r"`areas` must have shape \(F,\); got \(1280, 1\)"):
+        degenerate_face_mask(areas[:, None], 1.0)
+    with pytest.raises(InvalidMeshError, match=r"`areas` must hold real numbers; got str"):
+        degenerate_face_mask("1.0", 1.0)
+    # the same scale as a number or one per face: the same faces
+    scales = np.full(areas.shape, 0.1)
+    np.testing.assert_array_equal(degenerate_face_mask(areas, 0.1), degenerate_face_mask(areas, scales))
+    assert not degenerate_face_mask(areas, 0.1).any()  # every face of the unit icosphere is far from 1e-14
+
+
+@pytest.mark.parametrize("scale, word", [(1e200, "overflow"), (1e-200, "underflow")])
+@pytest.mark.parametrize("name", ["face_areas", "face_normals", "vertex_normals", "face_cross_products",
+                                  "corner_angles", "signed_volume"])
+def test_geometry_helpers_refuse_coordinates_beyond_the_float64_range_of_areas(name, scale, word):
+    from meshcurv import geometry
+
+    with pytest.raises(InvalidMeshError, match=f"squared areas\\) would {word} float64"):
+        getattr(geometry, name)(SPHERE.vertices * scale, SPHERE.faces)
+
+
+def test_diagnose_and_degenerate_faces_refuse_bad_arguments():
+    from meshcurv.diagnosis import degenerate_faces
+
+    top = MeshTopology.from_faces(SPHERE.faces, N)
+    spiked = SPHERE.vertices.copy()
+    spiked[3, 1] = 1e300
+    with pytest.raises(InvalidMeshError, match="`vertices` has coordinates as large as 1e\\+300"):
+        meshcurv.diagnose(spiked, top)
+    with pytest.raises(InvalidMeshError, match="`topology` must be a MeshTopology; got list"):
+        meshcurv.diagnose(SPHERE.vertices, SPHERE.faces.tolist())
+    with pytest.raises(InvalidOptionError, match=r"`n_flipped_faces` must be an integer between 0 and 1280"):
+        meshcurv.diagnose(SPHERE.vertices, top, n_flipped_faces=2000)
+    with pytest.raises(InvalidMeshError, match=rf"`scales` must be a real array of shape \({N},\)"):
+        degenerate_faces(SPHERE.vertices, top, scales=np.ones(3))
+    with pytest.raises(InvalidMeshError, match=r"`cross` must be a real array of shape \(1280, 3\)"):
+        degenerate_faces(SPHERE.vertices, top, cross=np.ones((3, 3)))
+    assert meshcurv.diagnose(SPHERE.vertices, top, n_flipped_faces=7).n_flipped_faces == 7
+
+
+@pytest.mark.parametrize("values, dtype", [(np.ones(N) * 1j, "complex128"), (np.array(["a"] * N), "<U1")])
+def test_smooth_vertex_field_refuses_values_that_are_not_real(values, dtype):
+    top = MeshTopology.from_faces(SPHERE.faces, N)
+    with pytest.raises(InvalidMeshError, match=rf"`values` must hold real numbers \(float, int or bool\); "
+                                               rf"got dtype {dtype}"):
+        smoothing.smooth_vertex_field(values, top, 1)
+
+
+def test_meyer_names_the_needle_faces_of_a_far_spike():
+    mesh = shapes.hemisphere(subdivisions=4)
+    vertices = mesh.vertices.copy()
+    vertices[0] = 1e20  # its neighbours' offsets are absorbed: the corner at the spike has no angle
+    with pytest.warns(MeshQualityWarning, match=r"meyer: .*needle faces \(a corner angle that rounds to zero"):
+        result = meshcurv.principal_curvatures(vertices, mesh.faces, method="meyer")
+    ring = np.unique(mesh.faces[(mesh.faces == 0).any(axis=1)])
+    assert not result.valid[ring].any()
+
+
+def test_point_cloud_spaced_below_float64_squares_is_refused():
+    from meshcurv.pointcloud import point_cloud_curvatures
+
+    rng = np.random.default_rng(3)
+    points = np.zeros((40, 3))
+    points[:, 0] = 2.0**-249  # 1.1e-75 shared by all (accepted; a power of two: centred exactly to 0)
+    points[:, 1:] = rng.random((40, 2)) * 1e-200
+    with pytest.raises(InvalidMeshError, match=r"`points` are spaced below 1e-150 everywhere"):
+        point_cloud_curvatures(points)

@@ -2,8 +2,13 @@ import numpy as np
 import pytest
 
 from meshcurv import shapes
-from meshcurv.errors import TriangulationWarning
+from meshcurv.errors import InvalidMeshError, InvalidOptionError, TriangulationWarning
 from meshcurv.topology import MeshTopology, triangulate_faces
+
+
+def _fan_by_definition(polygons):
+    """matGeom's triangulateFaces written out face by face: (f0, f(j-1), f(j)) for j = 2 .. k-1."""
+    return [[face[0], face[j - 1], face[j]] for face in polygons for j in range(2, len(face))]
 
 
 def test_fan_triangulation_follows_matgeom():
@@ -51,7 +56,10 @@ def test_nonmanifold_inconsistent_and_unreferenced_are_found():
     top = MeshTopology.from_faces(faces, n_vertices=8)
     edge = {tuple(e): i for i, e in enumerate(top.edges.tolist())}
     assert top.edge_face_counts[edge[(0, 1)]] == 3 and top.nonmanifold_edges[edge[(0, 1)]]
-    assert top.inconsistent_edges[edge[(1, 2)]] is np.True_ or top.edge_face_counts[edge[(1, 2)]] == 3
+    # (1, 2) has faces 0, 3 and 4: non-manifold, which is not "inconsistent" (a two-face property)
+    assert top.edge_face_counts[edge[(1, 2)]] == 3 and top.nonmanifold_edges[edge[(1, 2)]]
+    assert not top.inconsistent_edges.any()
+    assert top.boundary_edges.sum() == top.n_edges - 2
     assert not top.referenced_vertices[7]
     assert top.n_components == 1
 
@@ -82,3 +90,67 @@ def test_topology_is_read_only():
         top.edges[0, 0] = 5
     with pytest.raises(AttributeError):
         top.n_vertices = 3
+
+
+def test_vectorised_fan_of_mixed_polygons_matches_the_definition():
+    rng = np.random.default_rng(7)
+    polygons = [rng.permutation(50)[:k].tolist() for k in rng.integers(3, 9, size=400)]
+    triangles = triangulate_faces(polygons)
+    assert triangles.dtype == np.int64 and triangles.flags.c_contiguous
+    assert triangles.tolist() == _fan_by_definition(polygons)
+    # the same faces as arrays, and as one (F, k) array when they have one length
+    assert triangulate_faces([np.array(p) for p in polygons]).tolist() == _fan_by_definition(polygons)
+    hexagons = rng.integers(0, 50, size=(30, 6))
+    assert triangulate_faces(hexagons).tolist() == _fan_by_definition(hexagons.tolist())
+    assert triangulate_faces(hexagons.tolist()).tolist() == _fan_by_definition(hexagons.tolist())
+
+
+def test_triangulate_faces_returns_a_new_array():
+    faces = np.array([[0, 1, 2], [2, 1, 3]])
+    triangles = triangulate_faces(faces)
+    triangles[0, 0] = 7
+    assert faces[0, 0] == 0
+    top = MeshTopology.from_faces(faces)
+    assert triangulate_faces(top).tolist() == faces.tolist() and triangulate_faces(top).flags.writeable
+
+
+@pytest.mark.parametrize("polygons, message", [
+    ([[0, 1, 2], [0, 1]], "has a face with fewer than 3 vertices"),
+    ([[[0, 1], [2, 3], [4, 5]], [[0, 1], [2, 3], [4, 5], [6, 7]]], "a face holds nested lists"),
+    ([[0, 1, 2, 3], [[0, 1], [2, 3], [4, 5]]], "could not be converted to an array"),
+    ([[0, 1, 2], 3], "items are not sequences"),
+    ([[0, 1, 2], "abc"], "items are not sequences"),
+    ([[0, 1, 2], [0, 1, 2.5, 3]], "non-integer values"),
+    ([[0, 1, 2], [2**64, 0, 1, 3]], "indices too large for int64"),
+    ([[0, 1, 2], [0, 1, "x", 3]], "must hold integer vertex indices"),
+    ([[0, 1, 2], [0, -4, 1, 3]], r"negative vertex indices \(smallest -4\)"),
+    (np.zeros((0, 3), np.int64), "is empty"),
+    (b"012", "got a bytes"),
+])
+def test_triangulate_faces_names_what_is_wrong(polygons, message):
+    with pytest.raises(InvalidMeshError, match=rf"^`polygons` .*{message}"):
+        triangulate_faces(polygons)
+
+
+@pytest.mark.parametrize("n_vertices", [0, -3, 2.0, True, 2**31], ids=["zero", "negative", "float", "bool", "2**31"])
+def test_from_faces_refuses_an_unusable_vertex_count(n_vertices):
+    with pytest.raises(InvalidOptionError, match=r"`n_vertices` must be an integer between 1 and 2147483647"):
+        MeshTopology.from_faces(np.array([[0, 1, 2]]), n_vertices)
+
+
+def test_from_faces_checks_the_faces_against_the_vertex_count():
+    with pytest.raises(InvalidMeshError, match="vertex index 5 out of range for 4 vertices"):
+        MeshTopology.from_faces(np.array([[0, 1, 5]]), 4)
+    with pytest.raises(InvalidMeshError, match="look 1-based"):
+        MeshTopology.from_faces(np.array([[1, 2, 3]]), 3)
+
+
+def test_from_faces_without_a_count_refuses_a_stray_huge_index():
+    far = 2**24  # the floor of inferred counts: one face may reach it, not beyond
+    with pytest.raises(InvalidMeshError, match=rf"reference vertex index {far} but hold only 3 corners: pass "
+                                               r"`n_vertices`"):
+        MeshTopology.from_faces(np.array([[0, 1, far]]))
+    with pytest.raises(InvalidMeshError, match=r"beyond the largest mesh meshcurv takes \(n_vertices up to"):
+        MeshTopology.from_faces(np.array([[0, 1, 2**31]]))
+    assert MeshTopology.from_faces(np.array([[0, 1, far - 1]])).n_vertices == far
+    assert MeshTopology.from_faces(np.array([[0, 1, far]]), far + 1).n_vertices == far + 1  # when asked for

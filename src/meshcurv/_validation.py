@@ -188,18 +188,16 @@ def polygon_arrays(faces, *, name: str = "faces") -> np.ndarray | Ragged:
                 "got a list whose items are not sequences"
             )
         lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-        if lengths.size and lengths.min() != lengths.max():
-            if lengths.min() < 3:
-                raise InvalidMeshError(
-                    f"`{name}` has a face with fewer than 3 vertices; every face needs at least 3"
-                )
-            flat = _as_array(list(chain.from_iterable(faces)), name)
-            if flat.ndim != 1:
-                raise InvalidMeshError(
-                    f"`{name}` must be a list of flat index lists; a face holds nested lists"
-                )
+        ragged = lengths.size and lengths.min() != lengths.max()
+        if ragged and lengths.min() < 3:
+            raise InvalidMeshError(f"`{name}` has a face with fewer than 3 vertices; every face needs at least 3")
+        # one conversion of the concatenated indices (twice as fast as numpy's nested-list path)
+        flat = _as_array(list(chain.from_iterable(faces)), name)
+        if flat.ndim != 1:
+            raise InvalidMeshError(f"`{name}` must be a list of flat index lists; a face holds nested lists")
+        if ragged:
             return Ragged(_integer_faces(flat, name), lengths)
-        array = _as_array(faces, name)
+        array = flat.reshape(lengths.size, -1) if lengths.size else flat
     if array.ndim != 2:
         raise InvalidMeshError(
             f"`{name}` must have shape (F, 3) or (F, k) with k >= 3; got {_shape_text(array)}"
