@@ -125,7 +125,10 @@ def test_compute_writes_the_fields(capsys, torus_file, tmp_path, extension):
     code, _, err = run(capsys, "compute", torus_file, "-o", output, "--fields", "k_min,normals", "--quality",
                        "gaussian")
     assert code == 0
-    assert err.strip() == f"meshcurv: wrote {output}: 3600 vertices, fields k_min, normals (quality = gaussian)"
+    hint = (" (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
+            if extension == ".ply" else "")
+    assert err.strip() == (f"meshcurv: wrote {output}: 3600 vertices, fields k_min, normals "
+                           f"(quality = gaussian){hint}")
     vertices, faces = meshcurv.read_mesh(output)
     expected = meshcurv.principal_curvatures(vertices, faces)
     if extension == ".npz":
@@ -135,6 +138,19 @@ def test_compute_writes_the_fields(capsys, torus_file, tmp_path, extension):
         assert sorted(stored.files) == ["faces", "k_min", "normals", "quality", "vertices"]
     else:
         assert output.stat().st_size > 0
+
+
+def test_compute_help_names_the_file_for_each_reader(capsys):
+    from meshcurv.io.fields import VIEWERS
+
+    code, out, _ = run(capsys, "compute", "--help")
+    assert code == 0
+    epilog = " ".join(out.split("Which file for which reader")[1].split())
+    for reader, (extensions, keeps) in VIEWERS.items():
+        assert f"{reader}: {', '.join(extensions)}" in epilog
+        assert " ".join(keeps.split()) in epilog
+    code, out, _ = run(capsys, "--help")
+    assert "-o out.vtp   per-vertex fields for ParaView and PyVista" in out
 
 
 def test_compute_method_options(capsys, torus_file, tmp_path):

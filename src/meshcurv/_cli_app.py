@@ -228,17 +228,34 @@ def meshcurv():
     \b
     meshcurv info mesh.obj                 what the mesh is
     meshcurv compute mesh.obj              summary table of the curvatures
-    meshcurv compute mesh.obj -o out.ply   per-vertex fields for MeshLab, ParaView, pandas
+    meshcurv compute mesh.obj -o out.vtp   per-vertex fields for ParaView and PyVista
+    meshcurv compute mesh.obj -o out.ply   ... for MeshLab (--quality), meshio, trimesh
+    meshcurv compute mesh.obj -o out.csv   ... for pandas and spreadsheets
     meshcurv plot mesh.obj --field mean    a picture
     meshcurv volume cells.tif -o out/      per-object table of a label image
     meshcurv methods                       the estimators and their options
     """
 
 
-@meshcurv.command()
+def _viewers_epilog() -> str:
+    """The file to write for each reader (:data:`meshcurv.io.fields.VIEWERS`), for ``compute --help``."""
+    import textwrap
+
+    from .io.fields import VIEWERS
+
+    lines = ["\b", "Which file for which reader (what it keeps of the fields):"]
+    for reader, (extensions, keeps) in VIEWERS.items():
+        lines.append(f"  {reader}: {', '.join(extensions)}")
+        lines.extend(textwrap.wrap(keeps, width=78, initial_indent="      ", subsequent_indent="      ",
+                                   break_on_hyphens=False))
+    return "\n".join(lines)
+
+
+@meshcurv.command(epilog=_viewers_epilog())
 @click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
 @click.option("-o", "--output", type=click.Path(readable=False, path_type=pathlib.Path), default=None,
-              help="Write the fields to .ply, .vtk, .vtu, .vtp, .csv or .npz (default: print a summary).")
+              help="Write the fields to .vtp (ParaView, PyVista), .ply (MeshLab: one field as quality; meshio, "
+                   "trimesh), .vtu/.vtk, .csv (pandas) or .npz (NumPy); see below. Default: print a summary.")
 @method_options
 @click.option("--fields", callback=_fields, default=None, metavar="NAME,...",
               help=f"Fields to write or summarise (default: all): {', '.join(FIELDS)}.")
@@ -276,7 +293,10 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
         bar.close()
     if output is not None:
         written = fields or list(FIELDS)
-        session.info(f"wrote {output}: {len(vertices)} vertices, fields {', '.join(written)} (quality = {quality})")
+        hint = (" (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
+                if output.suffix.lower() == ".ply" else "")
+        session.info(f"wrote {output}: {len(vertices)} vertices, fields {', '.join(written)} "
+                     f"(quality = {quality}){hint}")
         return
     click.echo(_summary(mesh, vertices, faces, result, fields))
 

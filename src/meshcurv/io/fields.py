@@ -6,7 +6,7 @@ import numpy as np
 
 from ..errors import InvalidOptionError
 
-__all__ = ["FIELDS", "curvature_fields"]
+__all__ = ["FIELDS", "VIEWERS", "curvature_fields"]
 
 #: The fields :func:`curvature_fields` can produce, in file order, with what they are.
 FIELDS = {
@@ -72,6 +72,29 @@ def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> di
 
 
 _NOT_FOR_QUALITY = ("dir_min", "dir_max", "normals", "valid")
+
+#: Which file to write for each reader, and what it keeps of the fields, as measured with the readers
+#: themselves (``tests/test_field_roundtrip.py``: VTK 9.7 through PyVista 0.49, trimesh 5.2, meshio 5.3,
+#: pymeshlab 2025): reader -> (extensions, what it keeps).
+VIEWERS = {
+    "ParaView / PyVista (VTK)": (
+        (".vtp", ".vtu", ".vtk"),
+        "every field by name, vectors as 3-component arrays; from .ply only the normals "
+        "(VTK's PLY reader reads no other vertex property)"),
+    "MeshLab / pymeshlab": (
+        (".ply",),
+        "one field, as the vertex quality (--quality; default mean), and the normals; "
+        "no other property of a PLY file (MeshLab reads no .vtk/.vtu/.vtp)"),
+    "meshio": (
+        (".ply", ".vtu", ".vtk"),
+        "every field by name (from .ply, vectors split into _x, _y, _z); meshio has no .vtp reader"),
+    "trimesh": (
+        (".ply",),
+        'every field in mesh.metadata["_ply_raw"]["vertex"]["data"] (load with process=False to keep the '
+        "vertex order); vertex_attributes stay empty with every file: use CurvatureResult.to_trimesh"),
+    "pandas / spreadsheets": ((".csv",), "every field as columns, vectors split into _x, _y, _z"),
+    "NumPy": ((".npz",), "every field as arrays, with the vertices and faces"),
+}
 
 
 def _field(result, name: str) -> np.ndarray:
