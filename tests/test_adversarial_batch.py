@@ -191,6 +191,9 @@ def run_twice(tmp_path, names, options: str) -> dict:
     return run_child(FAULTS + f"""
 folder, out_dir = pathlib.Path({os.fspath(tmp_path)!r}) / "in", pathlib.Path({os.fspath(tmp_path)!r}) / "out"
 write(folder, {names!r})
+# the compiled kernels on disk before the worker starts (a fresh clone compiles them here, once), so
+# that the time limits below measure the batch, not the first compilation
+meshcurv.principal_curvatures(shapes.icosphere(subdivisions=2).vertices, shapes.icosphere(subdivisions=2).faces)
 with batch.local_cluster(workers=1, dashboard=False) as client:
     client.register_plugin(Faults())
     start = time.monotonic()
@@ -201,18 +204,18 @@ with batch.local_cluster(workers=1, dashboard=False) as client:
     again_seconds = time.monotonic() - start
 print(json.dumps({{"first": rows(first), "again": rows(again), "first_seconds": first_seconds,
                   "again_seconds": again_seconds}}))
-""", timeout=120)
+""", timeout=300)
 
 
 @pytest.mark.slow
 def test_a_mesh_that_never_ends_times_out_and_a_resume_does_not_wait_for_it_again(tmp_path):
-    result = run_twice(tmp_path, ["a.obj", "hang.obj", "z.obj"], "timeout=2")
+    result = run_twice(tmp_path, ["a.obj", "hang.obj", "z.obj"], "timeout=10")  # room for a loaded machine
     first, again = result["first"], result["again"]
     assert first["a.obj"] == ["computed", ""] and first["z.obj"] == ["computed", ""]
     assert first["hang.obj"][0] == "failed"
-    assert first["hang.obj"][1].startswith("TimeoutError: timed out after 2 s")
+    assert first["hang.obj"][1].startswith("TimeoutError: timed out after 10 s")
     assert result["first_seconds"] < 60
-    # the resume reports the recorded failure without computing it (nor waiting 2 s for it)
+    # the resume reports the recorded failure without computing it (nor waiting 10 s for it)
     assert again["hang.obj"] == first["hang.obj"]
     assert again["a.obj"][0] == again["z.obj"][0] == "skipped"
     assert result["again_seconds"] < 2
