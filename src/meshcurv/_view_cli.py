@@ -1,0 +1,104 @@
+"""``meshcurv view``: an interactive page of a mesh's curvatures (:func:`meshcurv.viewer.write_html`).
+
+:mod:`meshcurv._cli_app` adds it to the ``meshcurv`` group with
+``meshcurv.add_command(view_command())``, as it does ``meshcurv volume``; the
+command is built there, with the group's options, so that neither module
+imports the other at import time.
+"""
+
+from __future__ import annotations
+
+import pathlib
+
+import click
+
+__all__ = ["view_command"]
+
+
+def view_command() -> click.Command:
+    """The ``meshcurv view`` command, with the options of the ``meshcurv`` group (:mod:`meshcurv._cli_app`)."""
+    from ._cli_app import Session, _estimate, _percentiles, common_options, method_options
+    from .viewer import VIEWER_FIELDS
+
+    @click.command()
+    @click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
+    @click.option("-o", "--output", type=click.Path(readable=False, path_type=pathlib.Path), default=None,
+                  help="The page to write (default: MESH-NAME.html in the current folder).")
+    @click.option("-f", "--field", type=click.Choice(VIEWER_FIELDS), default="mean", show_default=True,
+                  help="The field shown first (the page has a menu of all of them).")
+    @method_options
+    @click.option("--up", type=click.Choice(["y", "z", "x"]), default="y", show_default=True,
+                  help="The axis drawn upwards at first (y for most OBJ and PLY files).")
+    @click.option("--percentiles", callback=_percentiles, default="2,98", show_default=True, metavar="LOW,HIGH",
+                  help="Default colour limits as percentiles of each field (symmetric for signed fields).")
+    @click.option("--directions", "max_directions", type=click.IntRange(min=0, max=10**7), default=20000,
+                  show_default=True, help="Principal directions at most at this many vertices, evenly spread.")
+    @click.option("--unit", "length_unit", default=None, metavar="UNIT",
+                  help="The unit of the coordinates (mm, um, ...) for the colour bar: 1/UNIT.")
+    @click.option("--title", default=None, help="The page's heading (default: the file name).")
+    @click.option("--overwrite", is_flag=True, help="Replace an existing page.")
+    @common_options
+    def view(mesh, output, field, method, smoothing_steps, radius, orient, up, percentiles, max_directions,
+             length_unit, title, overwrite):
+        """Write MESH (a mesh or a point cloud) and its curvatures as one interactive HTML page.
+
+        \b
+        meshcurv view bunny.ply                  bunny.html, open it in a browser
+        meshcurv view scan.obj -o scan.html --field gaussian --unit mm
+        meshcurv view cloud.xyz --radius 0.5     points, curvatures of the cloud
+
+        The page needs no network and no installation (WebGL2 in any current
+        browser): drag to rotate, right drag to pan, the wheel zooms; a menu
+        picks the field, boxes set the colour limits, the value under the
+        cursor is shown, principal directions on demand. Grey: vertices
+        without an estimate. About 28-52 MB per million vertices.
+        """
+        from .estimators import ESTIMATORS
+        from .io import is_point_cloud, read_mesh, read_points
+        from .io._files import check_input, check_output
+        from .pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
+        from ._validation import as_faces
+        from .viewer import write_html
+
+        context = click.get_current_context()
+        session = context.find_object(Session) or Session()
+        output = output if output is not None else pathlib.Path(f"{mesh.stem}.html")
+        if output.suffix.lower() not in (".html", ".htm"):
+            raise click.BadParameter(f"the page is an HTML file (.html); got {output.name!r}", param_hint="'-o'")
+        check_output(output, overwrite=overwrite, source=mesh)
+        check_input(mesh)
+        given_method = context.get_parameter_source("method") != click.core.ParameterSource.DEFAULT
+        if is_point_cloud(mesh):
+            if given_method and method not in POINT_CLOUD_METHODS:
+                raise click.UsageError(f"method {method!r} needs faces; {mesh} is a point cloud (methods: "
+                                       f"{', '.join(POINT_CLOUD_METHODS)})")
+            for name, value in (("smoothing-steps", smoothing_steps), ("orient", orient)):
+                if value is not None:
+                    raise click.UsageError(f"--{name} is for meshes; {mesh} is a point cloud")
+            points, normals = read_points(mesh)
+            vertices, faces = points, None
+            result = point_cloud_curvatures(points, normals=normals, radius=radius,
+                                            method=method if given_method else None)
+        else:
+            if method in POINT_CLOUD_METHODS:
+                raise click.UsageError(f"method {method!r} is for point clouds; {mesh} is a mesh (methods: "
+                                       f"{', '.join(ESTIMATORS)})")
+            stages = ["read", *ESTIMATORS[method].stages, "page"]
+            bar = session.bar(stages)
+            try:
+                bar("read")
+                vertices, polygons = read_mesh(mesh)
+                faces = as_faces(polygons, len(vertices))
+                options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
+                result = _estimate(vertices, faces, method, options, bar, offset=1)
+                bar("page", len(stages))
+            finally:
+                bar.close()
+        write_html(output, vertices, faces, result, field=field, title=title or mesh.name, up=up,
+                   percentiles=percentiles, max_directions=max_directions, length_unit=length_unit,
+                   overwrite=overwrite, source=mesh)
+        size = output.stat().st_size / 1e6
+        session.info(f"wrote {output} ({size:.1f} MB, {len(vertices)} {'points' if faces is None else 'vertices'}); "
+                     "open it in a browser")
+
+    return view
