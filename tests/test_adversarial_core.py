@@ -508,3 +508,25 @@ def test_point_cloud_spaced_below_float64_squares_is_refused():
     points[:, 1:] = rng.random((40, 2)) * 1e-200
     with pytest.raises(InvalidMeshError, match=r"`points` are spaced below 1e-150 everywhere"):
         point_cloud_curvatures(points)
+
+
+def test_helper_arrays_of_the_wrong_shape_are_refused():
+    from meshcurv.diagnosis import bowtie_vertices
+    from meshcurv.geometry import vertex_areas
+
+    top = MeshTopology.from_faces(SPHERE.faces, N)
+    with pytest.raises(InvalidMeshError, match=r"`areas` must have shape \(1280,\) \(one per face\); got \(3,\)"):
+        vertex_areas(SPHERE.vertices, SPHERE.faces, areas=np.ones(3))
+    with pytest.raises(InvalidMeshError, match=r"`cross` must have shape \(1280, 3\) \(one row per face\)"):
+        vertex_normals(SPHERE.vertices, SPHERE.faces, cross=np.ones((3, 3)))
+    with pytest.raises(InvalidMeshError, match=r"`cross` must hold real numbers; got dtype complex128"):
+        vertex_normals(SPHERE.vertices, SPHERE.faces, cross=np.ones((1280, 3)) * 1j)
+    with pytest.raises(InvalidMeshError, match=r"`edge_mask` must be a bool array of shape \(1920,\)"):
+        top.edge_vertices(np.arange(5))
+    with pytest.raises(InvalidMeshError, match="`topology` must be a MeshTopology; got ndarray"):
+        bowtie_vertices(SPHERE.faces)
+    # the barycentric areas given or computed: the same, summing to the total area
+    areas = face_areas(SPHERE.vertices, SPHERE.faces)
+    np.testing.assert_array_equal(vertex_areas(SPHERE.vertices, SPHERE.faces, areas=areas),
+                                  vertex_areas(SPHERE.vertices, SPHERE.faces))
+    assert np.isclose(vertex_areas(SPHERE.vertices, SPHERE.faces).sum(), areas.sum(), rtol=1e-12)

@@ -325,6 +325,15 @@ def _interrupt_of(error: BaseException) -> KeyboardInterrupt | None:
 _proxies: dict = {}
 
 
+def kernels_of(module) -> _SerialisedKernels:
+    """The compiled kernels of ``module`` (one that imports numba) as :func:`numba_kernels` hands them out.
+
+    Each call under the lock of the threading layer, with Ctrl-C as a
+    KeyboardInterrupt and small inputs on one thread (see the module's doc).
+    """
+    return _serialised(module)
+
+
 def _serialised(module) -> _SerialisedKernels:
     proxy = _proxies.get(id(module))
     if proxy is None:

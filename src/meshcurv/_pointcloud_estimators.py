@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import kernels_of, numba_kernels
 from ._tensors import principal_from_shape_operator
 from .estimators.icc import face_measures
 from .estimators.quadric import fit_jets, jet_normals, shape_operators
@@ -127,7 +127,9 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
     pattern = _rank_pattern(TRIANGLES if n_triangles is None else n_triangles)
     compiled = None
     if numba_kernels() is not None:
-        from ._pointcloud_kernels import ball_triangle_sums as compiled
+        from . import _pointcloud_kernels
+
+        compiled = kernels_of(_pointcloud_kernels).ball_triangle_sums  # locked, interruptible
     k = min(ball_size(radius, spacing), n)
     for start in range(0, centres.size, CHUNK):
         chunk = centres[start:start + CHUNK]

@@ -183,6 +183,8 @@ def _optional_floats(value, name: str, shape: tuple) -> np.ndarray | None:
 
 def bowtie_vertices(topology: MeshTopology) -> np.ndarray:
     """(V,) bool: vertices whose faces form more than one fan (:attr:`MeshTopology.bowtie_vertices`)."""
+    if not isinstance(topology, MeshTopology):
+        raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}")
     return topology.bowtie_vertices
 
 

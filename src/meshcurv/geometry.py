@@ -113,6 +113,10 @@ def vertex_areas(vertices: np.ndarray, faces: np.ndarray, *, areas: np.ndarray |
     vertices, faces = checked_mesh(vertices, faces)
     if areas is None:
         areas = face_areas(vertices, faces)
+    else:
+        areas = _real_array(areas, "areas")
+        if areas.shape != faces.shape[:1]:
+            raise InvalidMeshError(f"`areas` must have shape {faces.shape[:1]} (one per face); got {areas.shape}")
     return np.bincount(faces.ravel(), weights=np.repeat(areas / 3.0, 3), minlength=vertices.shape[0])
 
 
@@ -124,7 +128,7 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
     """
     vertices, faces = checked_mesh(vertices, faces)
     if cross is not None:
-        cross = np.ascontiguousarray(cross, dtype=np.float64)
+        cross = np.ascontiguousarray(_real_array(cross, "cross"))
         if cross.shape != faces.shape:
             raise InvalidMeshError(f"`cross` must have shape {faces.shape} (one row per face); got {cross.shape}")
     if cross is None:

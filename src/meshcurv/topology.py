@@ -218,7 +218,13 @@ class MeshTopology:
         return _readonly(used)
 
     def edge_vertices(self, edge_mask: np.ndarray) -> np.ndarray:
-        """(V,) bool: vertices that are an end of an edge selected by ``edge_mask``."""
+        """(V,) bool: vertices that are an end of an edge selected by ``edge_mask``, a (E,) bool array."""
+        edge_mask = np.asarray(edge_mask)
+        if edge_mask.dtype != bool or edge_mask.shape != (self.n_edges,):
+            raise InvalidMeshError(
+                f"`edge_mask` must be a bool array of shape ({self.n_edges},) (one per edge); "
+                f"got {edge_mask.dtype} {edge_mask.shape}"
+            )
         marked = np.zeros(self.n_vertices, dtype=bool)
         marked[self.edges[edge_mask].ravel()] = True
         return marked
