@@ -446,6 +446,8 @@ def test_geometry_helpers_refuse_what_is_not_a_topology_or_a_scale():
         degenerate_face_mask(areas[:, None], 1.0)
     with pytest.raises(InvalidMeshError, match=r"`areas` must hold real numbers; got str"):
         degenerate_face_mask("1.0", 1.0)
+    with pytest.raises(InvalidMeshError, match=r"`areas` must hold real numbers \(setting an array element"):
+        degenerate_face_mask([1.0, [2.0, 3.0]], 1.0)
     # the same scale as a number or one per face: the same faces
     scales = np.full(areas.shape, 0.1)
     np.testing.assert_array_equal(degenerate_face_mask(areas, 0.1), degenerate_face_mask(areas, scales))

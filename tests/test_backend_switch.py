@@ -94,7 +94,7 @@ def test_without_numba_one_info_line_names_the_extra(no_numba, caplog):
     lines = [r.getMessage() for r in caplog.records if r.name.startswith("meshcurv") and "backend" in r.getMessage()]
     assert len(lines) == 1, lines
     assert all(r.levelno == logging.INFO for r in caplog.records if "backend" in r.getMessage())
-    assert lines[0].startswith("meshcurv backend: numpy (numba is not installed")
+    assert lines[0].startswith("meshcurv backend: numpy (numba cannot be imported: No module named 'numba')")
     assert "pip install 'meshcurv[fast]'" in lines[0]
 
 

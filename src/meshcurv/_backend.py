@@ -88,7 +88,7 @@ _imported: tuple | None = None
 _logged: set = set()
 
 #: The INFO line when numba cannot be imported.
-MISSING_MESSAGE = ("meshcurv backend: numpy (numba is not installed: %s); pip install 'meshcurv[fast]' gives "
+MISSING_MESSAGE = ("meshcurv backend: numpy (numba cannot be imported: %s); pip install 'meshcurv[fast]' gives "
                    "the compiled kernels, several times faster")
 
 
@@ -139,7 +139,8 @@ def numba_kernels():
             ) from None
         _log_once("missing", MISSING_MESSAGE, error)
         return None
-    _log_once("numba", "meshcurv backend: numba %s (the fast kernels)", _numba_version())
+    if "numba" not in _logged:
+        _log_once("numba", "meshcurv backend: numba %s (the fast kernels)", _numba_version())
     return _serialised(module)
 
 
