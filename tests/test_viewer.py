@@ -350,11 +350,11 @@ needs_browser = pytest.mark.skipif(CHROMIUM is None, reason="no chromium (apt-ge
 class Chromium:
     """Headless Chromium driven by its DevTools protocol over a pipe (fds 3 and 4, null-terminated JSON)."""
 
-    def __init__(self, width: int = 900, height: int = 700):
+    def __init__(self, width: int = 900, height: int = 700, *, flags=()):
         to_browser, self._writer = os.pipe()
         self._reader, from_browser = os.pipe()
         flags = ["--headless=new", "--remote-debugging-pipe", "--no-first-run", "--hide-scrollbars",
-                 "--enable-unsafe-swiftshader", f"--window-size={width},{height}"]
+                 "--enable-unsafe-swiftshader", f"--window-size={width},{height}", *flags]
         if os.geteuid() == 0:
             flags.append("--no-sandbox")  # Chromium refuses to run as root with its sandbox
 
@@ -524,7 +524,7 @@ def test_browser_hash_sets_field_limits_directions_and_probe(tmp_path, browser, 
 
 @pytest.mark.slow
 @needs_browser
-def test_browser_mouse_rotates_and_zooms(tmp_path, browser, torus):
+def test_browser_mouse_and_controls(tmp_path, browser, torus):
     page = write_html(tmp_path / "torus.html", torus.vertices, torus.faces, exact_result(torus), up="z")
     facts, _ = browser.open(page.as_uri())
     assert facts["state"] == "ok", facts["text"]
@@ -539,6 +539,39 @@ def test_browser_mouse_rotates_and_zooms(tmp_path, browser, torus):
     distance = browser.evaluate("meshcurvViewer.state.distance")
     browser.mouse("mouseWheel", 600, 400, deltaX=0, deltaY=200)
     assert browser.evaluate("meshcurvViewer.state.distance") > distance  # wheel down: farther
+    # the field menu: the colour bar follows, with the field's unit, and the address keeps the choice
+    address = browser.evaluate("(() => { const menu = document.getElementById('field'); menu.value = 'curvedness';"
+                               " menu.dispatchEvent(new Event('change')); return location.hash; })()")
+    assert address.startswith("#field=curvedness&lo=")
+    assert "[1/length]" in browser.evaluate("document.getElementById('bar-label').textContent")
+    limits = [float(part.split("=")[1]) for part in address.split("&")[1:3]]
+    # curvedness sqrt((k_max^2 + k_min^2) / 2) on this torus: k_max = 1/10, k_min from -1/20 to 1/40
+    assert np.sqrt(0.01 / 2) - 1e-6 <= limits[0] < limits[1] <= np.sqrt((0.01 + 0.05**2) / 2) + 1e-6
+    assert browser.evaluate("document.getElementById('status').dataset.state") == "ok"  # no error meanwhile
+
+
+@pytest.mark.slow
+@needs_browser
+def test_browser_reports_a_damaged_page(tmp_path, browser, torus):
+    page = write_html(tmp_path / "torus.html", torus.vertices, torus.faces, exact_result(torus))
+    text = page.read_text(encoding="utf-8")
+    start = text.index('id="array-k_min">') + len('id="array-k_min">')
+    page.write_text(text[:start] + text[start + 400:], encoding="utf-8")  # 300 bytes of k_min gone
+    facts, _ = browser.open(page.as_uri())
+    assert facts["state"] == "error" and "array-k_min" in facts["text"] and "expected 14400" in facts["text"]
+    assert "error" in browser.evaluate("document.title")
+
+
+@pytest.mark.slow
+@needs_browser
+def test_browser_without_webgl_says_so(tmp_path, torus):
+    page = write_html(tmp_path / "torus.html", torus.vertices, torus.faces, exact_result(torus))
+    chromium = Chromium(flags=["--disable-3d-apis"])
+    try:
+        facts, _ = chromium.open(page.as_uri())
+    finally:
+        chromium.close()
+    assert facts["state"] == "error" and "no WebGL2" in facts["text"]
 
 
 @pytest.mark.slow

@@ -3,16 +3,18 @@
 // (base64 of little-endian typed arrays, described by the JSON block "meshcurv-meta").
 // The page's state (field, limits, directions, view, a probe) can be set by the URL hash:
 //   page.html#field=gaussian&lo=-0.01&hi=0.01&directions=both&elevation=20&azimuth=-30&zoom=1.5&probe=400,300
-// document.title and the data-* attributes of #status report "ok" or the error, the time to
-// the first frame and the probe's reading, for people and for headless tests.
+// The data-* attributes of #status report "ok" or the error, the time to the first frame and the
+// probe's reading (for headless tests); an error also shows in the tab's title.
 "use strict";
 
 (function () {
   const statusElement = document.getElementById("status");
   const startedAt = performance.now();
 
-  function report(state, text, data) {
-    document.title = "meshcurv-viewer: " + state + (text ? " | " + text : "");
+  let pageTitle = "meshcurv viewer";
+
+  function report(state, text, data) {  // the tab shows the mesh's name, or what went wrong
+    document.title = state === "ok" ? `${pageTitle} - meshcurv viewer` : `meshcurv viewer: ${state}` + (text ? ` | ${text}` : "");
     statusElement.dataset.state = state;
     statusElement.textContent = text || state;
     for (const [key, value] of Object.entries(data || {})) statusElement.dataset[key] = String(value);
@@ -58,6 +60,11 @@
       for (let i = 1; i < count; i++) array[i] = (array[i] + array[i - 1]) >>> 0;
     }
     return array;
+  }
+
+  function rendererName(gl) {  // the real renderer (SwiftShader, a GPU), where the browser tells it
+    const info = gl.getExtension("WEBGL_debug_renderer_info");
+    return info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);
   }
 
   function littleEndian() {
@@ -445,6 +452,7 @@
       barLabel: document.getElementById("bar-label"),
     };
     document.getElementById("title").textContent = meta.title;
+    pageTitle = meta.title;
     document.getElementById("subtitle").textContent = meta.subtitle;
     document.getElementById("subtitle").title = meta.details;
     for (const name of Object.keys(meta.fields)) {
@@ -714,12 +722,21 @@
       requestDraw();
     });
     window.addEventListener("resize", requestDraw);
-    controls.field.addEventListener("change", () => setField(controls.field.value));
-    controls.low.addEventListener("change", () => setLimits([controls.low.value, state.limits[1]]));
-    controls.high.addEventListener("change", () => setLimits([state.limits[0], controls.high.value]));
-    controls.auto.addEventListener("click", () => setLimits(meta.fields[state.field].limits));
+    // the choices go into the address (#field=...&lo=...), so that a copied address shows the same
+    function keepInAddress() {
+      const hashed = `#field=${state.field}&lo=${state.limits[0]}&hi=${state.limits[1]}&directions=${state.directions}`;
+      history.replaceState(null, "", hashed);
+    }
+    controls.field.addEventListener("change", () => { setField(controls.field.value); keepInAddress(); });
+    controls.low.addEventListener("change", () => { setLimits([controls.low.value, state.limits[1]]); keepInAddress(); });
+    controls.high.addEventListener("change", () => { setLimits([state.limits[0], controls.high.value]); keepInAddress(); });
+    controls.auto.addEventListener("click", () => { setLimits(meta.fields[state.field].limits); keepInAddress(); });
     controls.directions.value = state.directions;
-    controls.directions.addEventListener("change", () => { state.directions = controls.directions.value; requestDraw(); });
+    controls.directions.addEventListener("change", () => {
+      state.directions = controls.directions.value;
+      keepInAddress();
+      requestDraw();
+    });
 
     // ---- first frame, drawn now (not on an animation frame) so that it is there when the page has loaded ----
     const hashLimits = "lo" in hash && "hi" in hash ? [hash.lo, hash.hi] : null;
@@ -738,7 +755,7 @@
       normalsMs: Math.round(normalsAt - decodedAt), uploadMs: Math.round(uploadedAt - normalsAt),
       drawMs: Math.round(drawnAt - uploadedAt),
       field: state.field, low: state.limits[0], high: state.limits[1], directions: state.directions,
-      vertices: nVertices, renderer: gl.getParameter(gl.RENDERER),
+      vertices: nVertices, renderer: rendererName(gl),
     };
     let text = `${nVertices} ${isMesh ? "vertices" : "points"}, first frame at ${facts.openMs} ms`;
     if (hash.probe) {

@@ -352,7 +352,7 @@ def _page_data(points, triangles, result, *, field, percentiles, max_directions,
 
 _STYLE = """
 html, body { margin: 0; height: 100%; overflow: hidden; font: 13px system-ui, sans-serif; color: #222; }
-#view { position: absolute; inset: 0; width: 100%; height: 100%; display: block; cursor: grab; }
+#view { position: absolute; inset: 0; width: 100%; height: 100%; display: block; cursor: grab; touch-action: none; }
 #panel { position: absolute; top: 8px; left: 8px; width: 360px; padding: 8px 10px;
          background: rgba(255, 255, 255, 0.88); border: 1px solid #ccc; border-radius: 4px; }
 #panel h1 { font-size: 14px; margin: 0 0 2px; }
@@ -424,7 +424,7 @@ def _write_page(handle, meta: dict, arrays: dict) -> None:
     head = (f'<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
             f'<meta http-equiv="Content-Security-Policy" content="{_POLICY}">\n'
             f'<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-            f"<title>meshcurv-viewer: loading | {html.escape(meta['title'])}</title>\n"
+            f"<title>{html.escape(meta['title'])} - meshcurv viewer</title>\n"
             f"<style>{_STYLE}</style>\n</head>\n<body>{_BODY}\n"
             f'<script type="application/json" id="meshcurv-meta">{_json_for_script(meta)}</script>\n')
     handle.write(head.encode("utf-8"))
