@@ -291,9 +291,35 @@ def test_plot_writes_a_png_named_after_the_mesh(capsys, small_torus_file, tmp_pa
     assert code == 0 and (tmp_path / "two.png").exists()
 
 
+def png_size(path):
+    data = pathlib.Path(path).read_bytes()
+    return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+
+
+def test_plot_size_colour_map_limits_and_up(capsys, small_torus_file, tmp_path):
+    pytest.importorskip("matplotlib")
+    # --pixels: the width of the PNG, exactly; --dpi: (3.3 n + 1.2) x 4.2 inches for n views
+    code, _, err = run(capsys, "plot", small_torus_file, "-o", tmp_path / "wide.png", "--view", "iso", "--pixels",
+                       "1200", "--up", "z")
+    assert code == 0 and png_size(tmp_path / "wide.png")[0] == 1200
+    code, _, _ = run(capsys, "plot", small_torus_file, "-o", tmp_path / "dpi.png", "--view", "iso,top", "--dpi", "60",
+                     "--cmap", "cividis", "--limits", "-0.01,0.02")
+    assert code == 0 and png_size(tmp_path / "dpi.png") == (round(7.8 * 60), round(4.2 * 60))
+    # the default: 150 dpi; the up axis chosen from the mesh (a torus around z: 0.25 times as tall along z as y)
+    code, _, err = run(capsys, "plot", small_torus_file, "-o", tmp_path / "default.png", "--view", "iso")
+    assert code == 0 and png_size(tmp_path / "default.png") == (round(4.5 * 150), round(4.2 * 150))
+    assert "(up axis y, chosen from the mesh: the mesh is 0.25 times as tall along z as along y" in err
+
+
 def test_plot_bad_options(capsys, small_torus_file, tmp_path):
     pytest.importorskip("matplotlib")
     for options, message in [
+        (["--dpi", "100", "--pixels", "800"], "give --dpi or --pixels, not both"),
+        (["--limits", "-1,1", "--percentiles", "5,95"], "give --limits or --percentiles, not both"),
+        (["--limits", "1,-1"], "need finite LOW < HIGH"),
+        (["--limits", "wide"], "give two numbers as LOW,HIGH"),
+        (["--cmap", "no-such-map"], "unknown colour map 'no-such-map'"),
+        (["--dpi", "5"], "5 is not in the range 10<=x<=1200"),
         (["--view", "sideways"], "unknown view 'sideways'"),
         (["--percentiles", "98,2"], "need 0 <= LOW < HIGH <= 100"),
         (["--percentiles", "lots"], "give two percentiles as LOW,HIGH"),

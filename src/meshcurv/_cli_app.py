@@ -23,7 +23,7 @@ from .pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
 from .io._files import check_output
 from .io.fields import FIELDS, curvature_fields
 from .smoothing import MAX_SMOOTHING_STEPS
-from .plotting import MAX_PIXELS
+from .plotting import MAX_DPI
 from .topology import MeshTopology
 
 __all__ = ["meshcurv", "Session"]
@@ -388,6 +388,22 @@ def _plotting_views():
     return list(VIEWS)
 
 
+#: The resolution of ``meshcurv plot`` pictures when neither --dpi nor --pixels is given.
+DEFAULT_DPI = 150
+
+
+def _limits(ctx, param, value):
+    if value is None:
+        return None
+    try:
+        low, high = (float(part) for part in value.split(","))
+    except ValueError:
+        raise click.BadParameter(f"give two numbers as LOW,HIGH (e.g. -5,5); got {value!r}") from None
+    if not (np.isfinite(low) and np.isfinite(high) and low < high):
+        raise click.BadParameter(f"need finite LOW < HIGH; got {value!r}")
+    return low, high
+
+
 def _percentiles(ctx, param, value):
     try:
         low, high = (float(part) for part in value.split(","))
@@ -408,23 +424,37 @@ def _percentiles(ctx, param, value):
 @click.option("--view", "views", multiple=True, callback=_views, metavar="VIEW",
               help="auto (several views of a closed mesh, one of an open one), names separated by commas "
                    "(iso, front, back, left, right, top, bottom, iso-back) or ELEVATION,AZIMUTH; repeatable.")
-@click.option("--up", type=click.Choice(["y", "z", "x"]), default="y", show_default=True,
-              help="The axis drawn upwards (y for most OBJ and PLY files).")
+@click.option("--up", type=click.Choice(["auto", "y", "z", "x"]), default="auto", show_default=True,
+              help="The axis drawn upwards; auto: z when the mesh is more than 1.2 times as tall along z as "
+                   "along y, else y (most OBJ and PLY files).")
 @click.option("--directions", type=click.Choice(["none", "max", "min", "both"]), default="none",
               show_default=True, help="Strokes along the principal directions.")
 @click.option("--percentiles", callback=_percentiles, default="2,98", show_default=True, metavar="LOW,HIGH",
-              help="Colour limits as percentiles of the field.")
-@click.option("--pixels", type=click.IntRange(min=16, max=MAX_PIXELS), default=700, show_default=True,
-              help=f"Size of each view's image (at most {MAX_PIXELS}).")
+              help="Colour limits as percentiles of the field (symmetric about 0 for a signed field).")
+@click.option("--limits", callback=_limits, default=None, metavar="LOW,HIGH",
+              help="Fixed colour limits (e.g. -5,5), to compare pictures of several meshes; replaces "
+                   "--percentiles.")
+@click.option("--cmap", default=None, metavar="NAME",
+              help="A matplotlib colour map (default: RdBu_r for signed limits, viridis otherwise).")
+@click.option("--dpi", type=click.IntRange(min=10, max=MAX_DPI), default=None,
+              help="Resolution of the PNG (default 150): one view is 4.5 x 4.2 inches, n views "
+                   "(3.3 n + 1.2) x 4.2.")
+@click.option("--pixels", type=click.IntRange(min=100, max=20000), default=None,
+              help="Width of the PNG in pixels (sets the resolution; instead of --dpi).")
 @click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
 @common_options
 def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up, directions, percentiles,
-         pixels, overwrite):
+         limits, cmap, dpi, pixels, overwrite):
     """Draw MESH coloured by a curvature field, with a colour bar."""
-    from .plotting import _pyplot, plot_field, save_figure
+    from .plotting import _PANEL_INCHES, _EXTRA_INCHES, _pyplot, choose_up, plot_field, save_figure
 
     _pyplot()  # fail early, before computing, when matplotlib is missing
-    session = click.get_current_context().find_object(Session)
+    context = click.get_current_context()
+    session = context.find_object(Session)
+    if dpi is not None and pixels is not None:
+        raise click.UsageError("give --dpi or --pixels, not both")
+    if limits is not None and context.get_parameter_source("percentiles") != click.core.ParameterSource.DEFAULT:
+        raise click.UsageError("give --limits or --percentiles, not both")
     output = output if output is not None else pathlib.Path(f"{mesh.stem}_{field}.png")
     if output.suffix.lower() != ".png":
         raise click.BadParameter(f"the picture is a PNG; got {output.name!r}", param_hint="'-o'")
@@ -442,16 +472,26 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
             closed = not MeshTopology.from_faces(triangles, len(vertices)).boundary_edges.any()
             auto = ["front", "left", "back"] if closed else ["iso"]
             views = [view for name in views for view in (auto if name == "auto" else [name])]
+        chosen = ""
+        if up == "auto":
+            up, why = choose_up(vertices)
+            chosen = f" (up axis {up}, chosen from the mesh: {why}; --up to choose)"
+        if pixels is not None:
+            dpi = pixels / (_PANEL_INCHES * len(views) + _EXTRA_INCHES)
+            dpi = max(10, min(MAX_DPI, round(dpi)))
         strokes = {"max": {"k_max": result.dir_max}, "min": {"k_min": result.dir_min},
                    "both": {"k_max": result.dir_max, "k_min": result.dir_min}}.get(directions)
         values = curvature_fields(result, fields=[field], quality=None)[field]
-        figure = plot_field(vertices, triangles, values, view=views, up=up, percentiles=percentiles,
-                            label=f"{field}: {FIELDS[field]}", directions=strokes, pixels=pixels,
-                            title=f"{mesh.name}, method {result.method}")
+        figure = plot_field(vertices, triangles, values, view=views, up=up, percentiles=percentiles, limits=limits,
+                            cmap=cmap, label=f"{field}: {FIELDS[field]}", directions=strokes,
+                            dpi=dpi if dpi is not None else DEFAULT_DPI, title=f"{mesh.name}, method {result.method}")
+        if pixels is not None:  # exactly the width asked: the size in inches follows the rounded dpi
+            width, height = figure.get_size_inches()
+            figure.set_size_inches(pixels / figure.dpi, height * pixels / figure.dpi / width)
         save_figure(figure, output, overwrite=overwrite)
     finally:
         bar.close()
-    session.info(f"wrote {output}")
+    session.info(f"wrote {output}{chosen}")
 
 
 @meshcurv.command()

@@ -18,7 +18,7 @@ import numpy as np
 from ._validation import as_faces, as_vertices
 from .errors import InvalidOptionError, MissingDependencyError
 
-__all__ = ["plot_field", "save_figure", "VIEWS", "MAX_PIXELS", "MAX_DPI"]
+__all__ = ["plot_field", "save_figure", "choose_up", "VIEWS", "MAX_PIXELS", "MAX_DPI", "Z_UP_RATIO"]
 
 #: The largest side of a view's image, in pixels: a panel of the figure is about 330 points wide, so
 #: even a print at 1200 dpi (:data:`MAX_DPI`) needs fewer; 8192 x 8192 already takes gigabytes.
@@ -58,16 +58,40 @@ _UP = {
 
 
 def _pyplot():
+    """The matplotlib module (checked importable); meshcurv never imports pyplot nor changes the backend.
+
+    Figures are :class:`matplotlib.figure.Figure` objects with an Agg canvas of their own, so the
+    user's backend (and any open pyplot windows) are left as they are.
+    """
     try:
         import matplotlib
-
-        matplotlib.use("Agg", force=False)
-        import matplotlib.pyplot as plt
     except ImportError:
         raise MissingDependencyError(
             "pictures need matplotlib: pip install 'meshcurv[plot]'"
         ) from None
-    return plt
+    return matplotlib
+
+
+def choose_up(vertices) -> tuple[str, str]:
+    """The axis drawn upwards when none is given, and why: ``('y' or 'z', reason)``.
+
+    Most OBJ and PLY files are made with y up (trimesh, Blender's OBJ export,
+    the Stanford and Keenan Crane models); CAD, scanners and medical tools
+    often write z up. A mesh is taken as z-up when it is more than
+    :data:`Z_UP_RATIO` times as tall along z as along y (nefertiti.obj: 1.36),
+    else y-up (spot.obj: 1.02, igea.obj: 1.0, ogre.obj: 0.30). x is never
+    chosen.
+    """
+    points = np.asarray(vertices, dtype=float)
+    extent = np.ptp(points, axis=0) if points.size else np.zeros(3)
+    ratio = extent[2] / extent[1] if extent[1] > 0 else np.inf if extent[2] > 0 else 1.0
+    if ratio > Z_UP_RATIO:
+        return "z", f"the mesh is {ratio:.2f} times as tall along z as along y"
+    return "y", f"the mesh is {ratio:.2f} times as tall along z as along y (at most {Z_UP_RATIO:g}: y up)"
+
+
+#: :func:`choose_up` takes z as the up axis beyond this ratio of the z extent to the y extent.
+Z_UP_RATIO = 1.2
 
 
 def _as_views(view) -> list[tuple[str, tuple[float, float]]]:
@@ -201,10 +225,14 @@ class _Raster:
         return out
 
 
-def _colour_limits(values, percentiles, signed_hint=None):
+def _colour_limits(values, percentiles, limits=None):
+    """``(low, high, signed)``: the fixed ``limits``, or the percentiles (symmetric about 0 when signed)."""
+    if limits is not None:
+        low, high = limits
+        return low, high, low < 0 < high
     finite = values[np.isfinite(values)]
     low, high = np.percentile(finite, percentiles) if finite.size else (0.0, 1.0)
-    signed = low < 0 < high if signed_hint is None else signed_hint
+    signed = low < 0 < high
     if signed:
         bound = max(abs(low), abs(high))
         low, high = -bound, bound
@@ -213,17 +241,70 @@ def _colour_limits(values, percentiles, signed_hint=None):
     return float(low), float(high), signed
 
 
+def _check_limits(limits):
+    if limits is None:
+        return None
+    try:
+        low, high = (float(x) for x in limits)
+    except (TypeError, ValueError):
+        raise InvalidOptionError(f"`limits` must be (low, high); got {limits!r}") from None
+    if not (np.isfinite(low) and np.isfinite(high) and low < high):
+        raise InvalidOptionError(f"`limits` must be finite with low < high; got {limits!r}")
+    return low, high
+
+
+def _colormap(matplotlib, cmap, signed: bool):
+    name = cmap or ("RdBu_r" if signed else "viridis")
+    try:
+        colormap = matplotlib.colormaps[name] if isinstance(name, str) else name
+    except KeyError:
+        known = sorted(matplotlib.colormaps)
+        raise InvalidOptionError(f"unknown colour map {name!r}; choose a name of matplotlib.colormaps "
+                                 f"({len(known)} of them, e.g. viridis, cividis, magma, RdBu_r, coolwarm)") from None
+    return colormap.with_extremes(bad="0.6")
+
+
+def _auto_pixels(panel_pixels: float) -> int:
+    """The image side of a view: twice its panel's side in the saved picture, within memory and 3000."""
+    pixels = int(np.clip(round(2 * panel_pixels), 16, _AUTO_MAX_PIXELS))
+    available = _available_memory()
+    if available is not None:
+        fits = int(np.sqrt(max(available - _BYTES_FIXED, 0) / _BYTES_PER_PIXEL))
+        pixels = max(16, min(pixels, fits))
+    return pixels
+
+
+#: The largest image of a view when ``pixels`` is not given (1.7 GiB while drawn).
+_AUTO_MAX_PIXELS = 3000
+
+#: The figure's size: per view, and for the colour bar and margins, in inches.
+_PANEL_INCHES = 3.3
+_EXTRA_INCHES = 1.2
+_HEIGHT_INCHES = 4.2
+
+
+def _fitted_lines(text: str, bar_height_points: float, fontsize: float) -> list[str]:
+    """``text`` in lines no longer than the colour bar (about 0.55 em a character)."""
+    import textwrap
+
+    width = max(12, int(bar_height_points / (0.55 * fontsize)))
+    return [line for paragraph in text.split("\n") for line in textwrap.wrap(paragraph, width)]
+
+
 def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: str | None = None,
-               label: str = "", percentiles: tuple[float, float] = (2.0, 98.0), cmap: str | None = None,
-               directions=None, up: str = "z", pixels: int = 700):
+               label: str = "", percentiles: tuple[float, float] = (2.0, 98.0), limits=None,
+               cmap: str | None = None, directions=None, up: str | None = None, pixels: int | None = None,
+               dpi: int = 100):
     """Draw a triangle mesh coloured by a per-vertex field, with a colour bar.
 
     Vertex values are interpolated across each triangle (matGeom's
     ``drawMesh(v, f, 'VertexColor', c)``), so the seed's example is one call:
     ``plot_field(v, f, c1 * c2)``. Signed fields get a diverging colour map
     centred on zero; the limits are robust (the given percentiles of the
-    finite values, stated on the colour bar), values beyond them take the end
-    colours, and NaN is grey.
+    finite values, stated on the colour bar) unless fixed by ``limits``,
+    values beyond them take the end colours, and NaN is grey. The figure is
+    a :class:`matplotlib.figure.Figure` with its own Agg canvas: pyplot is
+    not imported and the backend is not changed.
 
     Parameters
     ----------
@@ -233,7 +314,8 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     values : array_like of shape (V,)
     ax : matplotlib Axes, optional
         A 2D axes to draw one view into; by default a new figure is made, with
-        one panel per view.
+        one panel per view (3.3 x 4.2 inches each, and 1.2 inches for the
+        colour bar).
     view : str, (elevation, azimuth), or a sequence of them, default: (30, -60)
         A name of :data:`VIEWS` (``'iso'``, ``'front'``, ``'back'``, ``'left'``,
         ``'right'``, ``'top'``, ``'bottom'``, ``'iso-back'``) or angles in
@@ -241,24 +323,34 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     title : str, optional
         Figure title.
     label : str
-        Colour-bar label.
+        Colour-bar label (wrapped to the bar's length).
     percentiles : (float, float), default: (2, 98)
-        Colour limits as percentiles of the finite values.
-    cmap : str, optional
-        Default ``'RdBu_r'`` centred on zero when the limits have opposite
-        signs, ``'viridis'`` otherwise.
+        Colour limits as percentiles of the finite values (symmetric about 0
+        when they have opposite signs).
+    limits : (float, float), optional
+        Fixed colour limits (low < high), instead of ``percentiles``: the same
+        colours mean the same values across pictures.
+    cmap : str or Colormap, optional
+        A name of ``matplotlib.colormaps``. Default ``'RdBu_r'`` when the
+        limits have opposite signs, ``'viridis'`` otherwise.
     directions : (V, 3) array or dict of str to (V, 3) arrays, optional
         Tangent directions drawn as short strokes at evenly spread visible
         vertices (a dict of at most two, e.g. ``{"k_max": r.dir_max, "k_min":
         r.dir_min}``, labelled in a legend). Directions are defined up to sign.
-    up : {'z', 'y', 'x'}, default: 'z'
-        The coordinate axis drawn upwards (matplotlib's convention is z; most
-        OBJ and PLY files are made with y up). With ``'y'``, ``'front'`` looks
-        from +z.
-    pixels : int, default: 700
-        Size of the longer side of each view's image, in pixels, from 16 to
-        :data:`MAX_PIXELS` (8192), and within the memory available (about
-        80 bytes a pixel and 1 GiB while a view is drawn).
+    up : {'z', 'y', 'x'}, optional
+        The coordinate axis drawn upwards. Default: chosen from the mesh by
+        :func:`choose_up` (z when the mesh is more than 1.2 times as tall
+        along z as along y, else y, the convention of most OBJ and PLY
+        files). With ``'y'``, ``'front'`` looks from +z.
+    pixels : int, optional
+        Size of the longer side of each view's image, from 16 to
+        :data:`MAX_PIXELS` (8192), within the memory available (about 80
+        bytes a pixel and 1 GiB while a view is drawn). Default: twice the
+        panel's size in the saved picture (660 at 100 dpi), at most 3000.
+    dpi : int, default: 100
+        Dots per inch of the figure, 10 to :data:`MAX_DPI`, which
+        :func:`save_figure` keeps: a picture of one view is ``4.5 * dpi``
+        pixels wide, of ``n`` views ``(3.3 n + 1.2) * dpi``.
 
     Returns
     -------
@@ -268,9 +360,10 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     ------
     InvalidOptionError
         ``values`` or ``directions`` without one row per vertex, more than two
-        direction fields, an unknown view or ``up``, several views with
-        ``ax``, ``pixels`` below 16, above :data:`MAX_PIXELS` or beyond the
-        memory available.
+        direction fields, an unknown view, colour map or ``up``, several
+        views with ``ax``, ``pixels`` below 16, above :data:`MAX_PIXELS` or
+        beyond the memory available, ``dpi`` out of range, ``limits`` not
+        finite or not increasing.
     InvalidMeshError
         Unusable vertices or faces.
     MissingDependencyError
@@ -285,8 +378,16 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     >>> fig = plot_field(torus.vertices, torus.faces, r.k_min * r.k_max, label="K", view=["iso", "top"])
     >>> len(fig.axes)          # two views and the colour bar
     3
+    >>> [round(x) for x in fig.get_size_inches() * fig.dpi]   # pixels of the saved picture
+    [780, 420]
     """
-    plt = _pyplot()
+    from ._validation import check_int_option
+
+    matplotlib = _pyplot()
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
+
     points = as_vertices(vertices)
     triangles = as_faces(faces, points.shape[0], stacklevel=3)
     values = np.asarray(values, dtype=float)
@@ -296,38 +397,57 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     views = _as_views(view)
     if ax is not None and len(views) > 1:
         raise InvalidOptionError(f"`ax` takes one view; got {len(views)} (leave `ax` out for several panels)")
-    pixels = _check_pixels(pixels)
+    dpi = check_int_option(dpi, "dpi", minimum=10, maximum=MAX_DPI)
+    if pixels is not None:
+        pixels = _check_pixels(pixels)
+    limits = _check_limits(limits)
+    if up is None:
+        up, _ = choose_up(points)
     if up not in _UP:
-        raise InvalidOptionError(f"`up` must be one of 'z', 'y', 'x'; got {up!r}")
+        raise InvalidOptionError(f"`up` must be one of 'z', 'y', 'x'; got {up!r} (or None: chosen from the mesh)")
     rotation = _UP[up]
     points = points @ rotation.T
     strokes = {name: field @ rotation.T for name, field in strokes.items()}
 
-    low, high, signed = _colour_limits(values, percentiles)
-    colormap = plt.get_cmap(cmap or ("RdBu_r" if signed else "viridis")).with_extremes(bad="0.6")
-    norm = plt.Normalize(low, high)
+    low, high, signed = _colour_limits(values, percentiles, limits)
+    colormap = _colormap(matplotlib, cmap, signed)
+    norm = Normalize(low, high)
     normals = _vertex_normals(points, triangles)
     center = (points.min(axis=0) + points.max(axis=0)) / 2
 
     if ax is None:
-        fig, axes = plt.subplots(1, len(views), figsize=(3.3 * len(views) + 1.2, 4.2), dpi=100, squeeze=False,
-                                 layout="constrained")
-        axes = list(axes[0])
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(_PANEL_INCHES * len(views) + _EXTRA_INCHES, _HEIGHT_INCHES), dpi=dpi,
+                     layout="constrained")
+        FigureCanvasAgg(fig)
+        axes = list(fig.subplots(1, len(views), squeeze=False)[0])
+        panel_pixels = _PANEL_INCHES * dpi
     else:
         fig, axes = ax.figure, [ax]
+        box = ax.get_position()
+        width, height = fig.get_size_inches()
+        panel_pixels = max(box.width * width, box.height * height) * fig.dpi
+    if pixels is None:
+        pixels = _auto_pixels(panel_pixels)
     for axis, (name, angles) in zip(axes, views):
         _draw_view(axis, points - center, triangles, values, normals, _camera(*angles), colormap, norm,
                    strokes, pixels=pixels)
         if len(views) > 1:
             axis.set_title(name, fontsize=9)
-    mappable = plt.cm.ScalarMappable(norm=norm, cmap=colormap)
+    mappable = ScalarMappable(norm=norm, cmap=colormap)
     bar = fig.colorbar(mappable, ax=axes, shrink=0.8, pad=0.02, aspect=30)
-    bar.set_label(f"{label}\ncolour limits {low:.3g} to {high:.3g}: percentiles "
-                  f"{percentiles[0]:g}-{percentiles[1]:g}{', centred on 0' if signed else ''}", fontsize=8)
+    how = ("fixed" if limits is not None else
+           f"percentiles {percentiles[0]:g}-{percentiles[1]:g}{', centred on 0' if signed else ''}")
+    bar_points = 0.8 * (fig.get_size_inches()[1] - 0.9) * 72  # the bar's length, titles and margins aside
+    lines = [*_fitted_lines(label, bar_points, 8), f"colour limits {low:.3g} to {high:.3g}:",
+             *_fitted_lines(how, bar_points, 8)]
+    bar.set_label("\n".join(lines), fontsize=8)
     bar.ax.tick_params(labelsize=8)
     if strokes:
-        handles = [plt.Line2D([], [], color=colour, lw=1.2, label=f"{text} direction")
-                   for (text, _), colour in zip(strokes.items(), _STROKE_COLOURS)]
+        handles = [Line2D([], [], color=colour, lw=1.2, label=f"{name} direction")
+                   for (name, _), colour in zip(strokes.items(), _STROKE_COLOURS)]
         if ax is None:
             fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8, frameon=False)
         else:
@@ -432,8 +552,9 @@ def save_figure(fig, path, *, overwrite: bool = False, dpi: int | None = None):
     overwrite : bool, default: False
         Replace an existing file.
     dpi : int, optional
-        Dots per inch, from 10 to :data:`MAX_DPI` (1200); matplotlib's
-        default (100) when not given.
+        Dots per inch, from 10 to :data:`MAX_DPI` (1200); the figure's own
+        (``plot_field(..., dpi=)``) when not given, whatever matplotlib's
+        ``savefig.dpi`` setting.
 
     Returns
     -------
@@ -448,16 +569,19 @@ def save_figure(fig, path, *, overwrite: bool = False, dpi: int | None = None):
     InvalidOptionError
         ``dpi`` outside 10 to :data:`MAX_DPI`.
     """
+    import sys
+
     from ._validation import check_int_option
     from .io._files import atomic_output, check_output
 
-    plt = _pyplot()
-    if dpi is not None:
-        dpi = check_int_option(dpi, "dpi", minimum=10, maximum=MAX_DPI)
+    _pyplot()
+    dpi = fig.dpi if dpi is None else check_int_option(dpi, "dpi", minimum=10, maximum=MAX_DPI)
     path = check_output(os.fspath(path), overwrite=overwrite)
     try:
         with atomic_output(path, overwrite=overwrite) as temporary:  # no silent replacement of a file made meanwhile
             fig.savefig(temporary, format="png", dpi=dpi)
     finally:
-        plt.close(fig)
+        pyplot = sys.modules.get("matplotlib.pyplot")
+        if pyplot is not None:  # a figure of the user's pyplot: closed there (ours are not pyplot's)
+            pyplot.close(fig)
     return path
