@@ -408,6 +408,7 @@ class Chromium:
 
     def open(self, url: str, *, timeout: float = 60) -> tuple[dict, float]:
         """Load ``url`` and wait for the page's status: (its data-* facts, seconds from navigation to "ok")."""
+        self.page("Page.navigate", url="about:blank")  # a new document even when only the #hash differs
         start = time.perf_counter()
         self.page("Page.navigate", url=url)
         while time.perf_counter() - start < timeout:
@@ -520,6 +521,12 @@ def test_browser_hash_sets_field_limits_directions_and_probe(tmp_path, browser, 
     light = (image.min(axis=2) > 200) & (image.max(axis=2) < 250)
     dark = image.max(axis=2) < 60
     assert light.mean() > 0.05 and dark.mean() > 0.002
+    # limits that are not numbers, an unknown field: the defaults, no error
+    facts, _ = browser.open(page.as_uri() + "#field=volume&lo=abc&hi=1&directions=sideways")
+    assert facts["state"] == "ok", facts["text"]
+    meta, _ = read_page_data(page)
+    assert (facts["field"], facts["directions"]) == ("mean", "none")
+    assert [float(facts["low"]), float(facts["high"])] == meta["fields"]["mean"]["limits"]
 
 
 @pytest.mark.slow

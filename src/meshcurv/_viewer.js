@@ -496,7 +496,7 @@
       gl.bufferSubData(gl.ARRAY_BUFFER, 0, invalid);
       state.nInvalid = nInvalid;
       controls.field.value = name;
-      setLimits(limits || meta.fields[name].limits);
+      if (!(limits && setLimits(limits))) setLimits(meta.fields[name].limits);
     }
 
     function setLimits(limits) {
@@ -504,12 +504,13 @@
       const ok = Number.isFinite(low) && Number.isFinite(high) && low < high;
       controls.low.classList.toggle("bad", !ok);
       controls.high.classList.toggle("bad", !ok);
-      if (!ok) return;
+      if (!ok) return false;
       state.limits = [low, high];
       controls.low.value = formatNumber(low);
       controls.high.value = formatNumber(high);
       drawColourBar();
       requestDraw();
+      return true;
     }
 
     function drawColourBar() {
@@ -542,7 +543,10 @@
       }
       view[14] -= d;
       view[15] = 1;
-      const near = Math.max(d - 1.5 * meta.radius, d * 1e-3), far = d + 1.5 * meta.radius;
+      // near and far around the bounding sphere (centred on 0), wherever panning took the camera
+      const centre = Math.hypot(view[12], view[13], view[14]);
+      const near = Math.max(centre - 1.05 * meta.radius, centre * 1e-3, 1e-6 * meta.radius);
+      const far = Math.max(centre + 1.05 * meta.radius, 2 * near);
       const projection = perspective(fovy, width / height, near, far);
       projection[8] = -(panelShift() / canvas.clientWidth);  // the picture moves right, beside the panel
       const rotation = new Float32Array([r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]]);
@@ -696,7 +700,9 @@
     canvas.addEventListener("pointermove", (event) => {
       if (!drag) {
         clearTimeout(hoverTimer);
-        hoverTimer = setTimeout(() => { controls.probe.textContent = describe(pickAt(event.offsetX, event.offsetY)).text; }, 60);
+        // a pick draws the whole mesh once more: wait for the mouse to rest longer where frames are slow
+        hoverTimer = setTimeout(() => { controls.probe.textContent = describe(pickAt(event.offsetX, event.offsetY)).text; },
+                                slowFrames ? 400 : 60);
         return;
       }
       const dx = event.clientX - drag.x, dy = event.clientY - drag.y;
