@@ -589,7 +589,21 @@ def test_browser_point_cloud(tmp_path, browser):
     facts, _ = browser.open(page.as_uri())
     assert facts["state"] == "ok", facts["text"]
     red, _ = colour_fractions(beside_panel(browser, browser.screenshot(tmp_path / "cloud.png")))
-    assert red > 0.02
+    assert red > 0.02  # k_max > 0 everywhere on an ellipsoid
+    # picking a point: in the middle of a sphere's points, the point facing the camera
+    sphere = meshcurv.shapes.icosphere(subdivisions=16, radius=2.0)
+    page = write_html(tmp_path / "sphere.html", sphere.vertices, None, exact_result(sphere))
+    facts, _ = browser.open(page.as_uri())
+    assert facts["state"] == "ok", facts["text"]
+    image = browser.screenshot(tmp_path / "sphere_points.png")
+    drawn = beside_panel(browser, image)
+    rows, columns = np.nonzero((drawn[..., 0] > drawn[..., 2] + 50))
+    x = (columns.min() + columns.max()) / 2 + image.shape[1] - drawn.shape[1]
+    y = (rows.min() + rows.max()) / 2
+    towards_viewer = np.array(browser.evaluate("meshcurvViewer.state.rotation"))[6:9]
+    probe = browser.evaluate(f"meshcurvViewer.describe(meshcurvViewer.pickAt({x}, {y})).data")
+    assert sphere.vertices[int(probe["probeVertex"])] @ towards_viewer / 2.0 > 0.99
+    assert probe["probeValue"] == 0.5
 
 
 @pytest.mark.slow
