@@ -21,6 +21,13 @@ directions are stored for a spatially even subsample of at most
 ``max_directions`` vertices. Everything is base64 (4/3): a page of 1M vertices
 takes 28 MB (ordered) to 52 MB (shuffled). For a point cloud the normals (int8,
 3 bytes) replace the triangles.
+
+The address can set the page's state: ``page.html#field=gaussian&lo=-0.01&hi=0.01&directions=both``
+(also ``elevation``, ``azimuth``, ``zoom``, and ``probe=X,Y``, the vertex under that pixel). The
+element ``#status`` says ``data-state="ok"`` (or ``"error"`` and why), with the time to the
+first frame and the probe's reading, so a page can be checked headless::
+
+    chromium --headless=new --virtual-time-budget=10000 --dump-dom 'file:///.../page.html#probe=600,300'
 """
 
 from __future__ import annotations
