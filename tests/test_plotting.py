@@ -51,7 +51,7 @@ def test_fixed_limits_and_colour_map():
     fig = plot_field(TORUS.vertices, TORUS.faces, TORUS.gaussian, limits=(-0.002, 0.004), cmap="magma")
     bar = fig.axes[-1]
     assert bar.get_ylim() == pytest.approx((-0.002, 0.004))
-    assert "colour limits -0.002 to 0.004:\nfixed" in bar.get_ylabel()
+    assert bar.get_ylabel().endswith("colour limits -0.002 to 0.004 (fixed)")
     image = np.asarray(fig.axes[0].images[0].get_array())
     shown = image[..., :3].reshape(-1, 3)
     shown = shown[shown.sum(axis=1) > 0.05][::25]

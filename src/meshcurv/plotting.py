@@ -438,11 +438,11 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
             axis.set_title(name, fontsize=9)
     mappable = ScalarMappable(norm=norm, cmap=colormap)
     bar = fig.colorbar(mappable, ax=axes, shrink=0.8, pad=0.02, aspect=30)
-    how = ("fixed" if limits is not None else
-           f"percentiles {percentiles[0]:g}-{percentiles[1]:g}{', centred on 0' if signed else ''}")
+    how = f"percentiles {percentiles[0]:g}-{percentiles[1]:g}{', centred on 0' if signed else ''}"
     bar_points = 0.8 * (fig.get_size_inches()[1] - 0.9) * 72  # the bar's length, titles and margins aside
-    lines = [*_fitted_lines(label, bar_points, 8), f"colour limits {low:.3g} to {high:.3g}:",
-             *_fitted_lines(how, bar_points, 8)]
+    limit_lines = ([f"colour limits {low:.3g} to {high:.3g} (fixed)"] if limits is not None
+                   else [f"colour limits {low:.3g} to {high:.3g}:", *_fitted_lines(how, bar_points, 8)])
+    lines = [*_fitted_lines(label, bar_points, 8), *limit_lines]
     bar.set_label("\n".join(lines), fontsize=8)
     bar.ax.tick_params(labelsize=8)
     if strokes:
