@@ -145,6 +145,7 @@ def test_point_cloud_of_two_scales_raises_no_runtime_warning():
 
 @pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
 def test_unreferenced_points_leave_a_voxel_surface_unchanged(method):
+    pytest.importorskip("skimage")
     mesh = shapes.voxel_sphere(radius=4.0)
     n = len(mesh.vertices)
     extra = mesh.vertices[:30] + np.random.default_rng(0).normal(size=(30, 3)) * 0.3  # near the surface, in no face

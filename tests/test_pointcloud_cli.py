@@ -5,9 +5,11 @@ import re
 import numpy as np
 import pytest
 
-import meshcurv
-from meshcurv.batch import process_mesh
-from meshcurv.cli import main
+pytest.importorskip("click")
+
+import meshcurv  # noqa: E402
+from meshcurv.batch import process_mesh  # noqa: E402
+from meshcurv.cli import main  # noqa: E402
 
 RADIUS = 2.0
 

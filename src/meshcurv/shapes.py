@@ -26,7 +26,7 @@ import numpy as np
 
 from ._tensors import principal_from_shape_operator
 from ._validation import check_int_option
-from .errors import InvalidOptionError
+from .errors import InvalidOptionError, MissingDependencyError
 
 __all__ = [
     "AnalyticMesh", "icosphere", "uv_sphere", "torus", "ellipsoid", "cylinder", "saddle",
@@ -449,7 +449,7 @@ def _marching_cubes(inside, extent: np.ndarray, spacing: np.ndarray, seed: int, 
     try:
         from skimage.measure import marching_cubes
     except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise ImportError(f"shapes.{name} needs scikit-image: pip install 'meshcurv[volume]'") from exc
+        raise MissingDependencyError(f"shapes.{name} needs scikit-image: pip install 'meshcurv[volume]'") from exc
     counts = np.ceil(2 * extent / spacing).astype(int) + 5
     if np.prod(counts.astype(float)) > 2e8:
         raise InvalidOptionError(
