@@ -35,17 +35,72 @@ NORMAL_RULE = (4.0, 55.0)
 #: Centres per chunk of ``corrected_measures`` (bounds memory: chunk x TRIANGLES triangles).
 CHUNK = 32768
 
+#: A jet fit whose ball reaches the other side of the surface is redone over a ball this many times
+#: smaller (:func:`one_sided_fits`): sqrt(2) halves the ball's area per step.
+SHRINK = 2.0 ** -0.5
 
-def jets(points, normals, radius, centres, usable):
+
+def one_sided_fits(points, normals, radius, centres, usable, *, smallest: float | None, degree: int = JET_DEGREE,
+                   iterations: int = JET_ITERATIONS):
+    """Jets over the largest ball, from ``radius`` down to ``smallest``, that holds one side of the surface.
+
+    A ball larger than the thickness of a part (a flat ellipsoid's two faces,
+    a thin tube) or than the radius of curvature (a sharp rim) holds points
+    of the other side, whose oriented ``normals`` point the other way: a jet
+    through both sides is not the surface. Such a fit (more than
+    :data:`meshcurv.estimators.quadric.AWAY_FRACTION` of the ball's points
+    facing away, the ``facing`` check of :func:`~meshcurv.estimators.quadric.fit_jets`)
+    is redone over a ball :data:`SHRINK` times smaller, down to ``smallest``.
+    Where the surface is thicker than ``radius`` every fit is the one over
+    ``radius``. ``smallest=None``: one fit over ``radius``, not checked.
+
+    Returns
+    -------
+    coefficients : ndarray of shape (N, 6)
+        In units of each fit's own radius (NaN where even the smallest ball failed).
+    frame : tuple of three ndarrays of shape (N, 3)
+    radii : ndarray of shape (N,)
+        The radius of each point's fit (NaN where none).
+    """
+    n = points.shape[0]
+    if smallest is None:
+        coefficients, frame, _ = fit_jets(points, normals, radius, degree=degree, iterations=iterations,
+                                          centres=centres, neighbours=usable)
+        return coefficients, frame, np.full(n, float(radius))
+    coefficients = np.full((n, 6), np.nan)
+    frame = tuple(np.full((n, 3), np.nan) for _ in range(3))
+    radii = np.full(n, np.nan)
+    todo = np.asarray(centres, dtype=np.int64)
+    current = float(radius)
+    while todo.size:
+        found, local, _ = fit_jets(points, normals, current, degree=degree, iterations=iterations, centres=todo,
+                                   neighbours=usable, facing=normals)
+        done = todo[np.isfinite(found[todo]).all(axis=1)]
+        coefficients[done] = found[done]
+        for whole, part in zip(frame, local):
+            whole[done] = part[done]
+        radii[done] = current
+        todo = np.setdiff1d(todo, done, assume_unique=True)
+        if current <= smallest:
+            break
+        current = max(smallest, current * SHRINK)
+    return coefficients, frame, radii
+
+
+def jets(points, normals, radius, centres, usable, *, smallest: float | None = None):
     """Principal curvatures of jets fitted over balls of ``radius`` around ``centres``.
 
+    Where a ball holds the other side of the surface its fit is redone over a
+    smaller one, down to ``smallest`` (:func:`one_sided_fits`; default: one
+    unchecked fit over ``radius``, as for a radius the user chose).
     Returns ``(k_min, k_max, dir_min, dir_max, normals)`` at every point, NaN
     where the fit failed and at points not in ``centres``; ``normals`` are those
     of the fitted jets (the given ones where the fit failed).
     """
-    coefficients, frame, _ = fit_jets(points, normals, radius, degree=JET_DEGREE, iterations=JET_ITERATIONS,
-                                      centres=centres, neighbours=usable)
-    six, fitted = shape_operators(coefficients, frame, radius)
+    coefficients, frame, radii = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest)
+    six, fitted = shape_operators(coefficients, frame, 1.0)
+    with np.errstate(invalid="ignore"):
+        six = six / radii[:, None]
     ok = np.isfinite(coefficients).all(axis=1) & np.isfinite(fitted).all(axis=1)
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
         np.where(ok[:, None], six, 0.0), np.where(ok[:, None], fitted, [0.0, 0.0, 1.0]))
@@ -55,10 +110,15 @@ def jets(points, normals, radius, centres, usable):
     return k_min, k_max, dir_min, dir_max, out_normals
 
 
-def fitted_normals(points, normals, radius, centres, usable):
-    """(N, 3) normals of degree-3 jets over balls of ``radius`` (``normals`` kept where a fit fails)."""
-    coefficients, frame, _ = fit_jets(points, normals, radius, degree=3, iterations=2, centres=centres,
-                                      neighbours=usable)
+def fitted_normals(points, normals, radius, centres, usable, *, smallest: float):
+    """(N, 3) normals of degree-3 jets over balls of ``radius`` (``normals`` kept where a fit fails).
+
+    Where a ball holds the other side of the surface (a part thinner than the
+    ball) the fit is redone over a smaller one, down to ``smallest``
+    (:func:`one_sided_fits`).
+    """
+    coefficients, frame, _ = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest,
+                                            degree=3, iterations=2)
     fitted = jet_normals(coefficients, frame)
     ok = np.isfinite(fitted).all(axis=1)
     return np.where(ok[:, None], fitted, normals)

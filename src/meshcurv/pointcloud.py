@@ -36,12 +36,18 @@ queries in chunks, no O(N^2) memory):
      measures with the point normals (:func:`meshcurv.estimators.icc.face_measures`)
      summed, ``H = mu_1 / 2 mu_0``, ``K = mu_2 / mu_0``; the normals, when
      not given, are those of degree-3 jets over ``s (4 + 55 sqrt(max(nu -
-     0.005, 0)))``. The default because its error is the lowest under noise
+     0.005, 0)))``, or over the largest smaller ball (down to ``4 s``, steps
+     of ``sqrt(2)``) that holds one side of the surface only (no more than
+     5% of its points with normals facing away): a part thinner than the ball
+     (a flat ellipsoid's two faces, a thin tube) or a rim sharper than it is
+     fitted on its own side. The default because its error is the lowest under noise
      (``benchmarks/pointcloud.md``: noise 0.2 spacings on the ellipsoid, H
      1.8% against 7% for jets) and below 1% on clean samples;
    - ``"jets"``: weighted degree-3 jets over the ball, refitted in the frame
      of their own normal (Cazals and Pouget 2005), curvatures from the jet's
      second fundamental form (:func:`meshcurv.estimators.quadric.shape_operators`);
+     with the default radius, a ball that holds the other side of the surface
+     shrinks as the normal fits' do, down to ``3 s``;
      the lowest error on clean samples (ellipsoid H 0.2%) and the fastest.
 
 References
@@ -333,11 +339,14 @@ def _compute(points, given, radius, method):
     parameters = {"radius": groups[0][0], "spacing": median, "noise": noise, "normals": how}
     for group_radius, group_spacing, members in groups:
         if method == "jets":
-            found = _estimators.jets(points, start, group_radius, members, usable)
+            # a default ball that holds the other side of a thin part shrinks, down to the clean-sample radius
+            smallest = None if radius is not None else min(group_radius, RADIUS_RULES[method][0] * group_spacing)
+            found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest)
         else:
             if given is None:
                 normal_radius = _rule(_estimators.NORMAL_RULE, group_spacing, noise)
-                normals = _estimators.fitted_normals(points, start, normal_radius, members, usable)
+                normals = _estimators.fitted_normals(points, start, normal_radius, members, usable,
+                                                     smallest=_estimators.NORMAL_RULE[0] * group_spacing)
                 parameters["normal_radius"] = normal_radius
             else:
                 normals = start
