@@ -1074,29 +1074,19 @@ def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot
             chosen[centres[k]] = False
             m += 1
     centres = sorted_centres[:m]
-    coefficients = np.full((n, 6), np.nan)
-    t1s = np.full((n, 3), np.nan)
-    t2s = np.full((n, 3), np.nan)
-    ns = np.full((n, 3), np.nan)
-    counts = np.zeros(n)
-    away = np.full(n, np.nan)
+    coefficients, t1s, t2s, ns, counts, away = _jet_outputs(n)
     n_terms = exponents.shape[0]
     n_chunks = max(min(m, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
-        # buffers once per chunk of vertices, not per vertex
         members = np.empty(64, np.int64)
-        work = np.empty((_JET_ROWS + 2 * (2 * degree + 1), 64))
-        moments = np.empty((2 * degree + 1, 2 * degree + 1))
-        right = np.empty(n_terms)
-        matrix = np.empty((n_terms, n_terms))
-        low = np.empty((n_terms, n_terms))
-        scale = np.empty(n_terms)
-        solution = np.empty(n_terms)
+        work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, n_terms)
         for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
-            members, work = _fit_one(vertices, points, grid, normals, radius, degree, iterations, exponents,
-                                     min_pivot, centres[i], members, work, moments, right, matrix, low, scale,
-                                     solution, coefficients, t1s, t2s, ns, counts, ids, facing, check_facing,
-                                     away_fraction, away)
+            v = centres[i]
+            members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius,
+                                          members)
+            work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, v,
+                            members, size, work, moments, right, matrix, low, scale, solution, coefficients, t1s,
+                            t2s, ns, counts, ids, facing, check_facing, away_fraction, away)
     return coefficients, t1s, t2s, ns, counts, away
 
 
@@ -1104,35 +1094,56 @@ def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot
 _JET_ROWS = 5
 
 
+@nb.njit(**_JIT)
+def _jet_outputs(rows):
+    """The outputs of the jet fits, ``coefficients (rows, 6), t1, t2, n (rows, 3), counts, away``: NaN, counts 0."""
+    return (np.full((rows, 6), np.nan), np.full((rows, 3), np.nan), np.full((rows, 3), np.nan),
+            np.full((rows, 3), np.nan), np.zeros(rows), np.full(rows, np.nan))
+
+
+@nb.njit(**_JIT)
+def _jet_scratch(degree, n_terms):
+    """The buffers of :func:`_fit_one` (once per chunk of vertices, not per vertex):
+    ``work, moments, right, matrix, low, scale, solution``."""
+    work = np.empty((_JET_ROWS + 3 * (2 * degree + 1) + degree + 1, 64))
+    return (work, np.empty((2 * degree + 1, 2 * degree + 1)), np.empty(n_terms), np.empty((n_terms, n_terms)),
+            np.empty((n_terms, n_terms)), np.empty(n_terms), np.empty(n_terms))
+
+
 @nb.njit(**_JIT_REASSOC)
-def _weighted_dot(a, b, c, size):
-    """``sum_i a[i] b[i] c[i]`` over the first ``size`` entries, reassociated (vectorized)."""
+def _dot(a, b, size):
+    """``sum_i a[i] b[i]`` over the first ``size`` entries, reassociated (vectorized)."""
     total = 0.0
     for i in range(size):
-        total += a[i] * b[i] * c[i]
+        total += a[i] * b[i]
     return total
 
 
 @nb.njit(**_JIT)
-def _fit_one(vertices, points, grid, normals, radius, degree, iterations, exponents, min_pivot, v, members, work,
+def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, row, members, size, work,
              moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing,
              check_facing, away_fraction, away_out):
-    """One vertex of :func:`fit_jets` in the caller's buffers; returns the buffers that may have grown.
+    """One vertex of :func:`fit_jets` in the caller's buffers; returns ``work`` (grown when too small).
 
-    ``work`` holds one column per ball member: its offset from the centre in
-    units of the radius, its weight, its weighted height and the powers
-    ``u^0..u^2d`` and ``v^0..v^2d`` of its tangent coordinates, so that each
-    moment of the normal equations is one vectorized dot product.
+    The ball's points are ``points[members[:size]]`` (vertex ``ids[members[a]]``);
+    the fit is written to row ``row`` of the outputs. ``work`` holds one column per ball member: its offset from the centre in
+    units of the radius, its weight, its weighted height, the powers
+    ``u^0..u^2d`` and ``v^0..v^2d`` of its tangent coordinates and the products
+    of the weight with ``u^0..u^2d`` and of the weighted height with ``u^0..u^d``
+    (:func:`_jet_scratch`), so that each moment of the normal equations is one
+    vectorized dot product of two rows (the products are those of the three
+    factors in their order: the same numbers).
     """
     n_terms = exponents.shape[0]
     top = 2 * degree
-    members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius, members)
     if size > work.shape[1]:
-        work = np.empty((work.shape[0], members.shape[0]))
+        work = np.empty((work.shape[0], 2 * size))
     ox, oy, oz, weight, lift = work[0], work[1], work[2], work[3], work[4]
     inverse = 1.0 / radius
     pu = work[_JET_ROWS:_JET_ROWS + top + 1]
-    pv = work[_JET_ROWS + top + 1:]
+    pv = work[_JET_ROWS + top + 1:_JET_ROWS + 2 * (top + 1)]
+    wu = work[_JET_ROWS + 2 * (top + 1):_JET_ROWS + 3 * (top + 1)]
+    lu = work[_JET_ROWS + 3 * (top + 1):]
     count = 0.0
     for a in range(size):
         k = members[a]
@@ -1145,7 +1156,7 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
         count += weight[a] > 0
         pu[0, a] = 1.0
         pv[0, a] = 1.0
-    counts[v] = count
+    counts[row] = count
     graph = True
     if check_facing:  # the ball must not hold the other side of the surface (a height function over the plane)
         fx, fy, fz = facing[v, 0], facing[v, 1], facing[v, 2]
@@ -1158,7 +1169,7 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
             total += 1.0
             if fx * facing[k, 0] + fy * facing[k, 1] + fz * facing[k, 2] < 0.0:
                 away += 1.0
-        away_out[v] = away / total if total > 0 else 0.0
+        away_out[row] = away / total if total > 0 else 0.0
         graph = not away > away_fraction * total
     nx, ny, nz = normals[v, 0], normals[v, 1], normals[v, 2]
     ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
@@ -1172,11 +1183,17 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
             for a in range(size):
                 pu[p, a] = pu[p - 1, a] * pu[1, a]
                 pv[p, a] = pv[p - 1, a] * pv[1, a]
+        for p in range(top + 1):  # the weight (and weighted height) times each power of u, once
+            for a in range(size):
+                wu[p, a] = weight[a] * pu[p, a]
+        for p in range(degree + 1):
+            for a in range(size):
+                lu[p, a] = lift[a] * pu[p, a]
         for total in range(top + 1):
             for k in range(total + 1):
-                moments[total - k, k] = _weighted_dot(weight, pu[total - k], pv[k], size)
+                moments[total - k, k] = _dot(wu[total - k], pv[k], size)
         for t in range(n_terms):
-            right[t] = _weighted_dot(lift, pu[exponents[t, 0]], pv[exponents[t, 1]], size)
+            right[t] = _dot(lu[exponents[t, 0]], pv[exponents[t, 1]], size)
         fitted = False
         for d in range(degree, 1, -1):
             m = (d + 1) * (d + 2) // 2
@@ -1207,11 +1224,226 @@ def _fit_one(vertices, points, grid, normals, radius, degree, iterations, expone
                 ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
     if fitted and graph:
         for r in range(6):
-            coefficients[v, r] = solution[r]
-    t1s[v, 0], t1s[v, 1], t1s[v, 2] = ax, ay, az
-    t2s[v, 0], t2s[v, 1], t2s[v, 2] = bx, by, bz
-    ns[v, 0], ns[v, 1], ns[v, 2] = nx, ny, nz
-    return members, work
+            coefficients[row, r] = solution[r]
+    t1s[row, 0], t1s[row, 1], t1s[row, 2] = ax, ay, az
+    t2s[row, 0], t2s[row, 1], t2s[row, 2] = bx, by, bz
+    ns[row, 0], ns[row, 1], ns[row, 2] = nx, ny, nz
+    return work
+
+
+# -- surface-connected balls (breadth-first over the mesh) -----------------------------
+@nb.njit(inline="always", **_JIT)
+def _segment_meets_ball(ax, ay, az, bx, by, bz, radius2):
+    """Whether the segment from ``a`` to ``b`` (relative to the ball's centre) has a point within the ball."""
+    dx, dy, dz = bx - ax, by - ay, bz - az
+    length2 = dx * dx + dy * dy + dz * dz
+    t = 0.0 if not length2 > 0 else min(max(-(ax * dx + ay * dy + az * dz) / length2, 0.0), 1.0)
+    px, py, pz = ax + t * dx, ay + t * dy, az + t * dz
+    return px * px + py * py + pz * pz <= radius2
+
+
+@nb.njit(**_JIT)
+def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, members, queue):
+    """The vertices of the surface-connected piece of the ball ``B(x_v, cutoff)`` written to ``members``.
+
+    Breadth-first from ``v`` over the edges ``indptr, indices`` (CSR) that meet
+    the closed ball (an end inside, or the segment passing through it): every
+    vertex within ``cutoff`` reached so (and ``allowed``) is a member, ``v``
+    first when allowed. When the ball's part of the surface is connected these
+    are exactly the vertices of the Euclidean ball (a path inside it crosses
+    from face to face through edges that meet it, and every edge of a face
+    meets the ball at a corner shared with the next such edge); vertices of
+    another sheet of the surface (the far side of a part thinner than the
+    ball) are left out. ``mark`` (V,) holds, per vertex, the last centre that
+    queued it (no clearing between centres); ``queue`` is scratch. ``members``
+    and ``queue`` hold V entries (a vertex is queued at most once per centre):
+    no buffer is grown, so no array is reassigned in the loop, which keeps
+    numba's reference counting out of it (six times slower with it). Returns
+    the number of members.
+    """
+    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+    cutoff2 = cutoff * cutoff
+    size = 0
+    mark[v] = v
+    queue[0] = v
+    head, tail = 0, 1
+    if allowed[v]:
+        members[0] = v
+        size = 1
+    while head < tail:
+        a = queue[head]
+        head += 1
+        ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
+        a2 = ax * ax + ay * ay + az * az
+        for j in range(indptr[a], indptr[a + 1]):
+            b = indices[j]
+            if mark[b] == v:
+                continue
+            bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
+            b2 = bx * bx + by * by + bz * bz
+            if b2 <= cutoff2:
+                if allowed[b]:
+                    members[size] = b
+                    size += 1
+            elif not a2 <= cutoff2 and not _segment_meets_ball(ax, ay, az, bx, by, bz, cutoff2):
+                continue  # both ends outside, and the segment passes outside too
+            mark[b] = v
+            queue[tail] = b
+            tail += 1
+    return size
+
+
+@nb.njit(parallel=True, **_JIT)
+def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks,
+                       allowed, indptr, indices, facing, check_facing, away_fraction, normals_only):
+    """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
+
+    The same fits, outputs and checks as :func:`fit_jets`, with the points of
+    each ball found breadth-first over the mesh's edges (``indptr, indices``,
+    CSR) instead of on a grid: no search structure over all the points is
+    built, so a fit at a few centres costs only their balls. Only ``allowed``
+    (V,) vertices enter the balls. ``n_chunks``: three (V,) int64 arrays each.
+    With ``normals_only``, returns ``(fitted, ...)``: the (V, 3) unit normals of
+    the fitted jets, ``(n - c10 t1 - c01 t2) / sqrt(1 + c10^2 + c01^2)`` as
+    ``quadric.jet_normals`` computes them (NaN where no fit), and one-row
+    placeholders for the other outputs (136 bytes per vertex never written).
+    """
+    n = vertices.shape[0]
+    m = centres.shape[0]
+    coefficients, t1s, t2s, ns, counts, away = _jet_outputs(1 if normals_only else n)
+    fitted = np.full((n if normals_only else 1, 3), np.nan)
+    ids = np.arange(n)
+    n_terms = exponents.shape[0]
+    n_chunks = max(min(m, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        mark = np.full(n, -1, np.int64)
+        members = np.empty(n, np.int64)
+        queue = np.empty(n, np.int64)
+        work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, n_terms)
+        one = _jet_outputs(1)
+        for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
+            v = centres[i]
+            size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, members, queue)
+            if not normals_only:
+                work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v,
+                                v, members, size, work, moments, right, matrix, low, scale, solution, coefficients,
+                                t1s, t2s, ns, counts, ids, facing, check_facing, away_fraction, away)
+                continue
+            c, a, b, nn = one[0], one[1], one[2], one[3]
+            c[0, :] = np.nan  # a failed fit leaves the row as it finds it
+            work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v, 0,
+                            members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn, one[4],
+                            ids, facing, check_facing, away_fraction, one[5])
+            p, q = c[0, 1], c[0, 2]
+            width = np.sqrt(1 + p * p + q * q)
+            for k in range(3):
+                fitted[v, k] = (nn[0, k] - p * a[0, k] - q * b[0, k]) / width
+    if normals_only:
+        return fitted, t1s, t2s, ns, counts, away
+    return coefficients, t1s, t2s, ns, counts, away
+
+
+@nb.njit(**_JIT)
+def vertex_face_lists(faces, n_vertices):
+    """CSR lists of the faces around every vertex: ``(indptr, indices)``, faces in index order."""
+    indptr = np.zeros(n_vertices + 1, np.int64)
+    for f in range(faces.shape[0]):
+        for k in range(faces.shape[1]):
+            indptr[faces[f, k] + 1] += 1
+    for v in range(n_vertices):
+        indptr[v + 1] += indptr[v]
+    indices = np.empty(indptr[n_vertices], np.int64)
+    fill = indptr[:-1].copy()
+    for f in range(faces.shape[0]):
+        for k in range(faces.shape[1]):
+            indices[fill[faces[f, k]]] = f
+            fill[faces[f, k]] += 1
+    return indptr, indices
+
+
+@nb.njit(parallel=True, **_JIT)
+def connected_face_sums(vertices, faces, usable, values, radius, indptr, indices, n_chunks, start, stop):
+    """(V, k) sums of ``share * values`` over the faces of the surface-connected piece of each ball.
+
+    ``share`` is ``neighborhoods.face_in_ball_ratios`` (1 inside, 0 outside,
+    linear in between by the corners' and centroid's distances). The faces are
+    found breadth-first from the faces around each vertex (``indptr, indices``:
+    :func:`vertex_face_lists`), on through the corners of every face that has a
+    point of an edge, a corner or its centroid in the closed ball ``B(x_v, radius)``:
+    when the ball's part of the surface is connected, every face of the
+    Euclidean ball (a path inside the ball goes from face to face across edges
+    that meet it); another sheet of the surface inside the ball is left out. Faces not ``usable`` (F,) lead the
+    search on but add nothing. Only the balls of the vertices ``start`` to
+    ``stop`` are summed (the other rows are 0). ``n_chunks``: one (V,) and one
+    (F,) mark array each.
+    """
+    n = vertices.shape[0]
+    n_faces = faces.shape[0]
+    n_values = values.shape[1]
+    out = np.zeros((n, n_values))
+    radius2 = radius * radius
+    start = max(min(start, n), 0)
+    m = max(min(stop, n), start) - start
+    n_chunks = max(min(m, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        seen = np.full(n_faces, -1, np.int64)
+        mark = np.full(n, -1, np.int64)
+        queue = np.empty(n, np.int64)  # a vertex is queued at most once per centre: never grown
+        for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
+            cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+            mark[v] = v
+            queue[0] = v
+            head, tail = 0, 1
+            while head < tail:
+                a = queue[head]
+                head += 1
+                for j in range(indptr[a], indptr[a + 1]):
+                    f = indices[j]
+                    if seen[f] == v:
+                        continue
+                    seen[f] = v
+                    low = np.inf
+                    high = -np.inf
+                    gx, gy, gz = 0.0, 0.0, 0.0
+                    for corner in range(3):
+                        c = faces[f, corner]
+                        gx += vertices[c, 0]
+                        gy += vertices[c, 1]
+                        gz += vertices[c, 2]
+                        dx, dy, dz = vertices[c, 0] - cx, vertices[c, 1] - cy, vertices[c, 2] - cz
+                        d = dx * dx + dy * dy + dz * dz
+                        low = min(low, d)
+                        high = max(high, d)
+                    gx, gy, gz = gx / 3, gy / 3, gz / 3
+                    d = (gx - cx) ** 2 + (gy - cy) ** 2 + (gz - cz) ** 2
+                    low = min(low, d)
+                    high = max(high, d)
+                    if high <= radius2:
+                        share = 1.0
+                    elif low >= radius2:  # corners and centroid outside: on through the face if an edge crosses
+                        share = 0.0
+                        crossed = False
+                        for corner in range(3):
+                            p = faces[f, corner]
+                            q = faces[f, (corner + 1) % 3]
+                            crossed = crossed or _segment_meets_ball(
+                                vertices[p, 0] - cx, vertices[p, 1] - cy, vertices[p, 2] - cz,
+                                vertices[q, 0] - cx, vertices[q, 1] - cy, vertices[q, 2] - cz, radius2)
+                        if not crossed:
+                            continue
+                    else:
+                        root = math.sqrt(low)
+                        share = (radius - root) / (math.sqrt(high) - root)
+                    if share != 0.0 and usable[f]:
+                        for k in range(n_values):
+                            out[v, k] += share * values[f, k]
+                    for corner in range(3):
+                        c = faces[f, corner]
+                        if mark[c] != v:
+                            mark[c] = v
+                            queue[tail] = c
+                            tail += 1
+    return out
 
 
 @nb.njit(parallel=True, **_JIT)

@@ -343,8 +343,12 @@ def _size_groups(reach: np.ndarray, radius: float) -> list[np.ndarray | slice]:
 
 
 def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: np.ndarray,
-               usable: np.ndarray | None, weight) -> np.ndarray:
-    """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices."""
+               usable: np.ndarray | None, weight, connected: bool = False) -> np.ndarray:
+    """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices.
+
+    ``connected`` (faces only): with the compiled kernels, the faces of the
+    surface-connected piece of each ball (see :func:`ball_face_sums`).
+    """
     import scipy.sparse as sp
     from scipy.spatial import cKDTree
 
@@ -358,13 +362,16 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
         usable = np.asarray(usable, dtype=bool)
         if usable.shape != (cells.shape[0],):
             raise InvalidMeshError(f"`usable` must have shape ({cells.shape[0]},); got {usable.shape}")
+    kernels = numba_kernels()
+    if connected and kernels is not None and cells.shape[1] == 3 and cells.shape[0]:
+        return _connected_face_sums(kernels, vertices, cells, radius, values, usable)
+    if usable is not None:
         keep = np.flatnonzero(usable)
         cells, values = cells[keep], values[keep]
     n = vertices.shape[0]
     out = np.zeros((n, values.shape[1]))
     if cells.shape[0] == 0:
         return out
-    kernels = numba_kernels()
     if kernels is not None:
         centres, reach = kernels.cell_centres(vertices, cells)
     else:
@@ -403,6 +410,24 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     return out
 
 
+def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,
+                         usable: np.ndarray | None) -> np.ndarray:
+    """:func:`ball_face_sums` over the surface-connected piece of each ball (compiled kernel, breadth-first)."""
+    n = vertices.shape[0]
+    usable = np.ones(faces.shape[0], dtype=bool) if usable is None else usable
+    centres, reach = kernels.cell_centres(vertices, faces)
+    mean, _ = check_ball_work(centres, radius + float(reach.max()), n, centres=vertices)
+    indptr, indices = kernels.vertex_face_lists(faces, n)
+    values = np.ascontiguousarray(values)
+    n_calls = max(1, int(np.ceil(mean * n / PAIRS_PER_CALL)))
+    out = None
+    for call in range(n_calls):  # Python between calls: Ctrl-C gets through
+        sums = kernels.connected_face_sums(vertices, faces, usable, values, radius, indptr, indices,
+                                           kernels.threads(), call * n // n_calls, (call + 1) * n // n_calls)
+        out = sums if out is None else out + sums
+    return out
+
+
 def _checked_cells(vertices, cells) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and (C, 3) faces or (C, 2) edges, checked (indices in range)."""
     vertices = checked_points(vertices)
@@ -413,13 +438,20 @@ def _checked_cells(vertices, cells) -> tuple[np.ndarray, np.ndarray]:
 
 
 def ball_face_sums(vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,
-                   *, usable: np.ndarray | None = None) -> np.ndarray:
+                   *, usable: np.ndarray | None = None, connected: bool = False) -> np.ndarray:
     """(V, k) ``sum_f ratio(f, B(x_v, r)) * values[f]`` over the faces meeting each ball.
 
     ``values`` is (F, k); ``ratio`` is :func:`face_in_ball_ratios`. Faces not
-    ``usable`` (F,) bool are left out.
+    ``usable`` (F,) bool are left out. With ``connected`` and the compiled
+    kernels, the faces are searched breadth-first from those around each
+    vertex, through every face that may meet the ball (a corner or the centroid
+    inside, or the centroid within the radius plus the face's reach; faces not
+    ``usable`` lead the search on): the faces of the ball wherever its part of
+    the surface is connected, without a search structure over the whole mesh;
+    another sheet of the surface inside the ball is left out. The NumPy path
+    takes the whole Euclidean ball.
     """
-    return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios)
+    return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)
 
 
 def ball_edge_sums(vertices: np.ndarray, edges: np.ndarray, radius: float, values: np.ndarray,

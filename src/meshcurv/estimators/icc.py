@@ -72,7 +72,7 @@ from ..neighborhoods import ball_face_sums, check_radius, default_radii
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
-from .quadric import fit_jets, jet_normals
+from .quadric import fit_jet_normals, fit_jets
 
 #: Degree of the jets whose normals the measures interpolate.
 NORMAL_DEGREE = 3
@@ -126,7 +126,7 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
 
 
 def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, radius: float, *,
-                   neighbours: np.ndarray | None = None) -> np.ndarray:
+                   neighbours: np.ndarray | None = None, adjacency: tuple | None = None) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
     Only the ``neighbours`` (V,) bool vertices enter the balls (default: all;
@@ -135,19 +135,19 @@ def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray,
     where the fitted normal turns more than 60 degrees (:data:`NORMAL_AGREEMENT`)
     from it: the ball then reached another sheet of the surface (the far side
     of a part thinner than the ball, a voxel surface's tip) and the fit
-    describes neither.
+    describes neither. ``adjacency``: the mesh's edge lists, so that each ball
+    is its surface-connected piece (:func:`meshcurv.estimators.quadric.fit_jets`).
     """
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
-    coefficients, frame, _ = fit_jets(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS,
-                                      neighbours=neighbours)
-    fitted = jet_normals(coefficients, frame)
+    fitted = fit_jet_normals(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS,
+                             neighbours=neighbours, adjacency=adjacency)
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     return np.where(usable[:, None], fitted, normals)
 
 
 def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, edges: np.ndarray, *,
-                neighbours: np.ndarray | None = None) -> float:
+                neighbours: np.ndarray | None = None, adjacency: tuple | None = None) -> float:
     """Median distance of the vertices to degree-2 jets fitted around them, in local edge lengths.
 
     The local edge length ``h_v`` of a vertex is the mean length of its edges.
@@ -179,7 +179,7 @@ def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, ed
         members = np.flatnonzero(level == k)
         radius = NOISE_FIT_RADIUS * scale[members].mean()
         coefficients, _, _ = fit_jets(vertices, normals, radius, degree=2, centres=centres[members],
-                                      neighbours=neighbours)
+                                      neighbours=neighbours, adjacency=adjacency)
         # the constant term is in units of the radius: NOISE_FIT_RADIUS class mean edge lengths
         distances[members] = np.abs(coefficients[centres[members], 0]) * NOISE_FIT_RADIUS
     distances = distances[np.isfinite(distances)]
@@ -242,7 +242,7 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology) -> tuple[
     _, degenerate, _, normals, valid = prepare(vertices, topology)
     pilot = VOXEL_PILOT * float(np.max(grid.spacing))
     k_min, k_max, *_ = _curvatures(vertices, topology.faces, degenerate, normals, valid, pilot,
-                                   neighbours=referenced)
+                                   neighbours=referenced, adjacency=_adjacency(topology))
     curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
     curvedness = curvedness[referenced & valid & np.isfinite(curvedness) & (curvedness > 0)]
     if curvedness.size == 0:
@@ -253,12 +253,20 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology) -> tuple[
         "curvature_radius": curvature_radius}
 
 
+def _adjacency(topology: MeshTopology) -> tuple | None:
+    """The edge lists the compiled ball searches walk (None on the NumPy path, which does not use them)."""
+    return topology.neighbour_lists if numba_kernels() is not None else None
+
+
 def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Stages | None = None, *,
-                neighbours: np.ndarray | None = None):
+                neighbours: np.ndarray | None = None, adjacency: tuple | None = None):
     """``k_min, k_max, dir_min, dir_max, normals, valid`` of the measures over balls of ``radius``.
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
-    are left out of the one returned.
+    are left out of the one returned. The balls of the normal fits and of the
+    sums are the surface-connected pieces of the Euclidean balls (the same
+    wherever the surface within the ball is connected; compiled kernels only,
+    see :func:`meshcurv.neighborhoods.ball_face_sums`).
     """
     def start(stage):
         if stages is not None:
@@ -266,18 +274,17 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
 
     start("fit normals")
     if radius > 0:
-        normals = fitted_normals(vertices, normals, valid, NORMAL_RADIUS_RATIO * radius, neighbours=neighbours)
+        normals = fitted_normals(vertices, normals, valid, NORMAL_RADIUS_RATIO * radius, neighbours=neighbours,
+                                 adjacency=adjacency)
 
     start("compute face measures")
     kept = ~degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)
-    if not kept.all():  # a copy only when faces are left out
-        faces = faces[kept]
     kernels = numba_kernels()
     measure = kernels.icc_face_measures if kernels is not None else face_measures
-    measures = measure(vertices, faces, normals)
+    measures = measure(vertices, faces, normals)  # rows of the faces left out are not read
 
     start("sum over balls")
-    summed = ball_face_sums(vertices, faces, radius, measures)
+    summed = ball_face_sums(vertices, faces, radius, measures, usable=None if kept.all() else kept, connected=True)
 
     start("retrieve curvatures")
     area = summed[:, 0]
@@ -307,7 +314,8 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
             inside = valid if members is None else valid & np.isin(np.arange(vertices.shape[0]), members)
             edges = topology.edges if members is None else topology.edges[inside[topology.edges[:, 0]]]
             edge_length = robust_mean_edge_length(vertices, edges)
-            level = (noise_level(vertices, normals, inside, edges, neighbours=referenced)
+            level = (noise_level(vertices, normals, inside, edges, neighbours=referenced,
+                                 adjacency=_adjacency(topology))
                      if edge_length > 0 else 0.0)
             groups.append((float(default_radius(level, edge_length)), members))
             levels.append(level)
@@ -322,7 +330,8 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     fields = None
     for group_radius, members in groups:
         computed = _curvatures(vertices, topology.faces, degenerate, normals, valid, group_radius,
-                               stages if fields is None else None, neighbours=referenced)
+                               stages if fields is None else None, neighbours=referenced,
+                               adjacency=_adjacency(topology))
         if members is None:
             fields = computed
             continue

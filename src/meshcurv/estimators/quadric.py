@@ -207,7 +207,7 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
 def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
              iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
              neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
-             details: dict | None = None):
+             details: dict | None = None, adjacency: tuple | None = None):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
     Parameters
@@ -238,6 +238,17 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     details : dict, optional
         Receives ``"away"``: (V,) the share of the ball's points facing away at
         each fitted centre (NaN unless ``facing`` is given).
+    adjacency : tuple of two ndarrays of int, optional
+        ``(indptr, indices)``: the edge neighbours of every vertex in CSR form
+        (:attr:`meshcurv.topology.MeshTopology.neighbour_lists`). With the
+        compiled kernels each ball is then searched breadth-first over the
+        edges that meet it, from its centre, instead of on a grid over all the
+        points: the same points wherever the ball's part of the surface is
+        connected (every ball of a radius below the surface's thickness and
+        reach), and no search structure over the whole mesh (a fit at a few
+        centres costs only their balls). Another sheet of the surface within
+        the ball (the far side of a part thinner than the ball) is left out.
+        The NumPy path takes the whole Euclidean ball.
 
     Returns
     -------
@@ -281,11 +292,22 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     if kernels is not None and n:
         n_calls = max(1, min(centres.size, int(np.ceil(mean * centres.size / PAIRS_PER_CALL))))
         outputs = None  # the first call's outputs (the rows of the others' centres filled in from theirs)
+        if adjacency is not None:
+            allowed = np.ones(n, dtype=bool) if neighbours is None else neighbours
+            indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
+            if indptr.shape != (n + 1,):
+                raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
         for call in range(n_calls):  # Python between calls: Ctrl-C gets through
             part = centres[call * centres.size // n_calls:(call + 1) * centres.size // n_calls]
-            found = kernels.fit_jets(
-                vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
-                64 * kernels.threads(), pool, facing if check else vertices, check, AWAY_FRACTION)
+            if adjacency is not None:
+                found = kernels.fit_jets_connected(
+                    vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
+                    kernels.threads(), allowed, indptr, indices, facing if check else vertices, check, AWAY_FRACTION,
+                    False)
+            else:
+                found = kernels.fit_jets(
+                    vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
+                    64 * kernels.threads(), pool, facing if check else vertices, check, AWAY_FRACTION)
             if outputs is None:
                 outputs = list(found)
                 continue
@@ -333,6 +355,47 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     if details is not None:
         details["away"] = away
     return coefficients, tuple(frame), counts
+
+
+def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
+                    iterations: int = ITERATIONS, neighbours: np.ndarray | None = None,
+                    adjacency: tuple | None = None) -> np.ndarray:
+    """(V, 3) unit normals of the jets of :func:`fit_jets` at every vertex (NaN where no fit was possible).
+
+    ``jet_normals(*fit_jets(...)[:2])`` with the same arguments; with the
+    compiled kernels and ``adjacency``, one pass that writes only the normals
+    (not the coefficients, frames and counts: 136 bytes per vertex).
+    """
+    kernels = numba_kernels()
+    vertices = checked_points(vertices)
+    n = vertices.shape[0]
+    if kernels is None or adjacency is None or n == 0:
+        coefficients, frame, _ = fit_jets(vertices, normals, radius, degree=degree, iterations=iterations,
+                                          neighbours=neighbours, adjacency=adjacency)
+        return jet_normals(coefficients, frame)
+    normals = np.ascontiguousarray(normals, dtype=np.float64)
+    if normals.shape != vertices.shape:
+        raise InvalidMeshError(f"`normals` must have shape {vertices.shape}; got {normals.shape}")
+    allowed = np.ones(n, dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
+    if allowed.shape != (n,):
+        raise InvalidMeshError(f"`neighbours` must have shape ({n},); got {allowed.shape}")
+    indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
+    if indptr.shape != (n + 1,):
+        raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
+    centres = np.arange(n)
+    mean, _ = check_ball_work(vertices[allowed], radius, n, centres=vertices)
+    n_calls = max(1, min(n, int(np.ceil(mean * n / PAIRS_PER_CALL))))
+    fitted = None
+    for call in range(n_calls):  # Python between calls: Ctrl-C gets through
+        part = centres[call * n // n_calls:(call + 1) * n // n_calls]
+        found = kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations, _exponents(degree),
+                                           MIN_PIVOT, part, kernels.threads(), allowed, indptr, indices, vertices,
+                                           False, AWAY_FRACTION, True)[0]
+        if fitted is None:
+            fitted = found
+        else:
+            fitted[part] = found[part]
+    return fitted
 
 
 def jet_normals(coefficients: np.ndarray, frame: tuple) -> np.ndarray:
