@@ -15,9 +15,6 @@ if TYPE_CHECKING:
 
 __all__ = ["CurvatureResult", "INVALID_REASONS"]
 
-#: What :meth:`CurvatureResult.integral` integrates (see :mod:`meshcurv.integrals` for the rules).
-INTEGRALS = ("area", "mean", "gaussian", "willmore")
-
 #: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``. A vertex
 #: gets the first code that applies, in this order.
 INVALID_REASONS = (
@@ -91,6 +88,10 @@ class CurvatureResult:
     were computed on (kept by :func:`meshcurv.principal_curvatures`) and the
     result's normals, not from the pointwise fields times an area: see
     :mod:`meshcurv.integrals`.
+
+    :meth:`to_pyvista`, :meth:`to_trimesh` and :meth:`to_dataframe` put the
+    per-vertex fields onto a ``pyvista.PolyData``, a ``trimesh.Trimesh`` or a
+    ``pandas.DataFrame`` (none of these libraries is needed otherwise).
     """
 
     k_min: np.ndarray
@@ -217,6 +218,7 @@ class CurvatureResult:
         """
         from ._validation import check_choice
         from .errors import InvalidOptionError
+        from .integrals import INTEGRALS
 
         check_choice(field, "field", INTEGRALS)
         cache = self.__dict__.setdefault("_vertex_integrals", {})
