@@ -1362,20 +1362,24 @@ def vertex_face_lists(faces, n_vertices):
 
 
 @nb.njit(parallel=True, **_JIT)
-def connected_face_sums(vertices, faces, usable, values, radius, indptr, indices, n_chunks, start, stop):
+def connected_face_sums(vertices, faces, centroids, reach, usable, values, radius, indptr, indices, n_chunks, start,
+                        stop):
     """(V, k) sums of ``share * values`` over the faces of the surface-connected piece of each ball.
 
     ``share`` is ``neighborhoods.face_in_ball_ratios`` (1 inside, 0 outside,
     linear in between by the corners' and centroid's distances). The faces are
     found breadth-first from the faces around each vertex (``indptr, indices``:
     :func:`vertex_face_lists`), on through the corners of every face that has a
-    point of an edge, a corner or its centroid in the closed ball ``B(x_v, radius)``:
+    point of an edge, a corner or its centroid in the closed ball ``B(x_v, radius)``
+    (``centroids`` and ``reach`` of :func:`cell_centres`: a face whose centroid is
+    farther than ``radius + reach`` is outside, one distance; each vertex's
+    distance is computed once per ball):
     when the ball's part of the surface is connected, every face of the
     Euclidean ball (a path inside the ball goes from face to face across edges
-    that meet it); another sheet of the surface inside the ball is left out. Faces not ``usable`` (F,) lead the
-    search on but add nothing. Only the balls of the vertices ``start`` to
-    ``stop`` are summed (the other rows are 0). ``n_chunks``: one (V,) and one
-    (F,) mark array each.
+    that meet it); another sheet of the surface inside the ball is left out.
+    Faces not ``usable`` (F,) lead the search on but add nothing. Only the
+    balls of the vertices ``start`` to ``stop`` are summed (the other rows are
+    0). ``n_chunks``: four (V,) arrays and one (F,) array each.
     """
     n = vertices.shape[0]
     n_faces = faces.shape[0]
@@ -1387,7 +1391,9 @@ def connected_face_sums(vertices, faces, usable, values, radius, indptr, indices
     n_chunks = max(min(m, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         seen = np.full(n_faces, -1, np.int64)
-        mark = np.full(n, -1, np.int64)
+        mark = np.full(n, -1, np.int64)  # queued for this centre
+        known = np.full(n, -1, np.int64)  # distance to this centre in `squared`
+        squared = np.empty(n)
         queue = np.empty(n, np.int64)  # a vertex is queued at most once per centre: never grown
         for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
             cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
@@ -1402,22 +1408,19 @@ def connected_face_sums(vertices, faces, usable, values, radius, indptr, indices
                     if seen[f] == v:
                         continue
                     seen[f] = v
-                    low = np.inf
-                    high = -np.inf
-                    gx, gy, gz = 0.0, 0.0, 0.0
+                    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
+                    if d > (radius + reach[f]) ** 2:
+                        continue  # every point of the face is outside
+                    low = d
+                    high = d
                     for corner in range(3):
                         c = faces[f, corner]
-                        gx += vertices[c, 0]
-                        gy += vertices[c, 1]
-                        gz += vertices[c, 2]
-                        dx, dy, dz = vertices[c, 0] - cx, vertices[c, 1] - cy, vertices[c, 2] - cz
-                        d = dx * dx + dy * dy + dz * dz
-                        low = min(low, d)
-                        high = max(high, d)
-                    gx, gy, gz = gx / 3, gy / 3, gz / 3
-                    d = (gx - cx) ** 2 + (gy - cy) ** 2 + (gz - cz) ** 2
-                    low = min(low, d)
-                    high = max(high, d)
+                        if known[c] != v:
+                            known[c] = v
+                            squared[c] = ((vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2
+                                          + (vertices[c, 2] - cz) ** 2)
+                        low = min(low, squared[c])
+                        high = max(high, squared[c])
                     if high <= radius2:
                         share = 1.0
                     elif low >= radius2:  # corners and centroid outside: on through the face if an edge crosses

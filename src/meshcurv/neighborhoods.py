@@ -422,7 +422,7 @@ def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radiu
     n_calls = max(1, int(np.ceil(mean * n / PAIRS_PER_CALL)))
     out = None
     for call in range(n_calls):  # Python between calls: Ctrl-C gets through
-        sums = kernels.connected_face_sums(vertices, faces, usable, values, radius, indptr, indices,
+        sums = kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radius, indptr, indices,
                                            kernels.threads(), call * n // n_calls, (call + 1) * n // n_calls)
         out = sums if out is None else out + sums
     return out
