@@ -162,6 +162,41 @@ def test_npz_with_numpy(written):
             np.testing.assert_array_equal(archive[name], getattr(result, name))
 
 
+@pytest.mark.parametrize("name", list(WRITTEN))
+def test_meshcurv_reads_its_own_fields_back(written, name):
+    from meshcurv.io.fields import read_fields
+
+    mesh, result, paths = written
+    fields = read_fields(paths[name])
+    assert set(fields) == set(FIELDS) | {"quality"}
+    assert fields["valid"].dtype == bool and fields["valid"].all()
+    exact = name in ("vtp", "npz", "vtu", "vtk", "vtk-ascii", "csv")  # float64 kept; PLY holds float32
+    for key in SCALARS + VECTORS:
+        truth = np.asarray(getattr(result, key))
+        assert fields[key].shape == truth.shape, key
+        if exact:
+            np.testing.assert_array_equal(fields[key], truth)
+        else:
+            close(fields[key], truth)
+
+
+def test_read_fields_errors(tmp_path):
+    from meshcurv.errors import MeshFileError
+    from meshcurv.io.fields import read_fields
+
+    with pytest.raises(MeshFileError, match=r"no per-vertex fields in a \.obj; read_fields knows \.ply, \.vtp"):
+        read_fields(tmp_path / "mesh.obj")
+    with pytest.raises(MeshFileError, match=r"missing\.ply: no such file"):
+        read_fields(tmp_path / "missing.ply")
+    bad = tmp_path / "bad.csv"
+    bad.write_text("vertex,x,y,z,k_min\n0,1,2,3\n")
+    with pytest.raises(MeshFileError, match=r"bad\.csv: 4 columns under a header of 5 names"):
+        read_fields(bad)
+    bad.write_text("vertex,x,y,z,k_min\n0,1,2,3,high\n")
+    with pytest.raises(MeshFileError, match=r"bad\.csv: cannot be read as a table of numbers"):
+        read_fields(bad)
+
+
 def test_every_recommended_extension_is_written_by_meshcurv():
     from meshcurv.io import FORMATS
 

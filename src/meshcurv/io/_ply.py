@@ -20,8 +20,9 @@ at a time (0.80 s for a 1M-vertex sphere; about 50 ms here). This reader:
 
 Only ``x, y, z`` of the ``vertex`` element and the corner list of the
 ``face`` element (``vertex_indices``, ``vertex_index`` or its only list
-property) are kept; other elements and properties are checked for size and
-skipped.
+property) are kept by :func:`read_ply`; :func:`read_ply_fields` keeps the
+other scalar properties of the vertices too (the curvature fields meshcurv
+writes); other elements and properties are checked for size and skipped.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ import numpy as np
 from ..errors import MeshFileError
 from ._text import numbers
 
-__all__ = ["read_ply", "HEADER_LIMIT"]
+__all__ = ["read_ply", "read_ply_fields", "HEADER_LIMIT"]
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -157,23 +158,39 @@ def read_ply(path):
         A header cut short or malformed, counts larger than the file can
         hold, the end of the file inside an element, float indices.
     """
+    vertices, faces, _ = _read(path, properties=False)
+    return vertices, faces
+
+
+def read_ply_fields(path) -> tuple[np.ndarray, object, dict[str, np.ndarray]]:
+    """``(vertices, faces, properties)``: :func:`read_ply` and the other scalar properties of the vertices.
+
+    ``properties`` maps each property of the ``vertex`` element but ``x, y, z``
+    to a (V,) float64 array, in the order of the header.
+    """
+    return _read(path, properties=True)
+
+
+def _read(path, *, properties: bool):
     with open(path, "rb") as handle:
         data = handle.read()
     file_format, elements, offset = _header(data, path)
     vertex, face, corners = _roles(elements, path)
+    found = {} if properties else None
     if file_format == "ascii":
-        vertices, faces = _read_ascii(data, offset, elements, vertex, face, corners, path)
+        vertices, faces = _read_ascii(data, offset, elements, vertex, face, corners, path, found)
     else:
-        vertices, faces = _read_binary(data, offset, _ORDERS[file_format], elements, vertex, face, corners, path)
+        vertices, faces = _read_binary(data, offset, _ORDERS[file_format], elements, vertex, face, corners, path,
+                                       found)
     if len(faces) == 0:
         raise MeshFileError(f"{path}: the PLY file holds no faces")
-    return vertices, faces
+    return vertices, faces, found
 
 
 # ---------------------------------------------------------------- binary
 
 
-def _read_binary(data, position, order, elements, vertex, face, corners, path):
+def _read_binary(data, position, order, elements, vertex, face, corners, path, found=None):
     vertices = faces = None
     for element in elements:
         available = len(data) - position
@@ -185,6 +202,9 @@ def _read_binary(data, position, order, elements, vertex, face, corners, path):
             if element is vertex:
                 table = np.frombuffer(data, record, count=element.count, offset=position)
                 vertices = np.column_stack([table[axis].astype(np.float64) for axis in "xyz"])
+                if found is not None:
+                    found.update({name: table[name].astype(np.float64) for name in record.names
+                                  if name not in ("x", "y", "z")})
             position += need
             continue
         keep = corners if element is face else None
@@ -293,7 +313,7 @@ def _integers(values: np.ndarray, path, what: str) -> np.ndarray:
     return values.astype(np.int64)
 
 
-def _read_ascii(data, offset, elements, vertex, face, corners, path):
+def _read_ascii(data, offset, elements, vertex, face, corners, path, found=None):
     values = _numbers(data[offset:], path)
     position, vertices, faces = 0, None, None
     for element in elements:
@@ -306,6 +326,9 @@ def _read_ascii(data, offset, elements, vertex, face, corners, path):
             if element is vertex:
                 names = [p.name for p in element.properties]
                 vertices = table[:, [names.index(axis) for axis in "xyz"]]
+                if found is not None:
+                    found.update({name: table[:, k].copy() for k, name in enumerate(names)
+                                  if name not in ("x", "y", "z")})
             position += element.count * width
             continue
         keep = corners if element is face else None

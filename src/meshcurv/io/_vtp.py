@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import MeshFileError
 from ._text import numbers
 
-__all__ = ["read_vtp", "write_vtp"]
+__all__ = ["read_vtp", "read_vtp_point_data", "write_vtp"]
 
 _TYPES = {
     "Int8": "i1", "UInt8": "u1", "Int16": "i2", "UInt16": "u2", "Int32": "i4", "UInt32": "u4",
@@ -153,8 +153,8 @@ def _binary(text: str, path, header_type: np.dtype, compressed: bool) -> bytes:
     return b"".join(blocks)
 
 
-def read_vtp(path):
-    """Read the points and polygons of a VTK XML PolyData file."""
+def _root(path):
+    """``(piece, decoding options)`` of a VTK XML PolyData file."""
     try:
         root = ElementTree.parse(path).getroot()
     except ElementTree.ParseError as exc:
@@ -165,7 +165,27 @@ def read_vtp(path):
     options = {"header": root.get("header_type", "UInt32"),
                "order": "<" if root.get("byte_order", "LittleEndian") == "LittleEndian" else ">",
                "compressed": compressed}
-    piece = root.find("PolyData/Piece")
+    return root.find("PolyData/Piece"), options
+
+
+def read_vtp_point_data(path) -> dict[str, np.ndarray]:
+    """The named point-data arrays of a VTK XML PolyData file: (V,) or (V, k), as stored."""
+    piece, options = _root(path)
+    arrays = piece.findall("PointData/DataArray") if piece is not None else []
+    out = {}
+    for element in arrays:
+        try:
+            out[element.get("Name") or f"array_{len(out)}"] = _decode(element, path, **options)
+        except MeshFileError:
+            raise
+        except (ValueError, zlib.error, base64.binascii.Error) as exc:
+            raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
+    return out
+
+
+def read_vtp(path):
+    """Read the points and polygons of a VTK XML PolyData file."""
+    piece, options = _root(path)
     points = piece.find("Points/DataArray") if piece is not None else None
     polys = piece.find("Polys") if piece is not None else None
     if points is None or polys is None:

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InvalidOptionError
+from ..errors import InvalidOptionError, MeshFileError
 
-__all__ = ["FIELDS", "VIEWERS", "curvature_fields"]
+__all__ = ["FIELDS", "VIEWERS", "curvature_fields", "read_fields"]
 
 #: The fields :func:`curvature_fields` can produce, in file order, with what they are.
 FIELDS = {
@@ -101,3 +101,120 @@ def _field(result, name: str) -> np.ndarray:
     if name == "valid":
         return result.valid.astype(np.uint8)
     return np.array(getattr(result, name), dtype=np.float64)
+
+
+def read_fields(path) -> dict[str, np.ndarray]:
+    """The per-vertex fields of a file written by meshcurv (or any file of these formats), by name.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.ply`` (binary or ASCII: every vertex property but x, y, z),
+        ``.vtp`` (read here), ``.npz``, ``.csv`` (numpy) or ``.vtk``/``.vtu``
+        file (meshio, ``pip install 'meshcurv[io]'``).
+
+    Returns
+    -------
+    dict of str to ndarray
+        (V,) float64 scalars; vectors stored as ``<name>_x, _y, _z`` columns
+        (PLY, CSV) are put back together as (V, 3) arrays, and ``nx, ny, nz``
+        as ``normals``; ``valid`` is bool. The vertices and faces are
+        :func:`meshcurv.read_mesh`'s.
+
+    Raises
+    ------
+    MeshFileError
+        An unknown extension, or a file that cannot be read.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile, meshcurv
+    >>> from meshcurv.io.fields import read_fields
+    >>> sphere = meshcurv.shapes.icosphere(subdivisions=4)
+    >>> r = meshcurv.principal_curvatures(sphere.vertices, sphere.faces)
+    >>> path = meshcurv.io.write_curvatures(pathlib.Path(tempfile.mkdtemp()) / "s.vtp", sphere.vertices,
+    ...                                     sphere.faces, r)
+    >>> fields = read_fields(path)
+    >>> fields["dir_max"].shape, bool((fields["k_max"] == r.k_max).all())
+    ((162, 3), True)
+    """
+    import pathlib
+
+    from ._files import check_input
+
+    path = pathlib.Path(path)
+    suffix = path.suffix.lower()
+    readers = {".ply": _ply_fields, ".vtp": _vtp_fields, ".npz": _npz_fields, ".csv": _csv_fields,
+               ".vtk": _meshio_fields, ".vtu": _meshio_fields}
+    if suffix not in readers:
+        raise MeshFileError(f"{path}: no per-vertex fields in a {suffix or 'file without extension'}; "
+                            f"read_fields knows {', '.join(readers)}")
+    check_input(path)
+    columns = readers[suffix](path)
+    return _regrouped(columns)
+
+
+def _ply_fields(path):
+    from ._ply import read_ply_fields
+
+    return read_ply_fields(path)[2]
+
+
+def _vtp_fields(path):
+    from ._vtp import read_vtp_point_data
+
+    return read_vtp_point_data(path)
+
+
+def _npz_fields(path):
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            return {name: archive[name] for name in archive.files
+                    if name not in ("vertices", "faces", "face_corners", "face_sizes")}
+    except (OSError, ValueError) as exc:
+        raise MeshFileError(f"{path}: cannot be read as NPZ ({exc})") from exc
+
+
+def _csv_fields(path):
+    with open(path, encoding="utf-8") as handle:
+        names = handle.readline().strip().split(",")
+    try:
+        table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as exc:
+        raise MeshFileError(f"{path}: cannot be read as a table of numbers ({exc})") from exc
+    if table.shape[1] != len(names):
+        raise MeshFileError(f"{path}: {table.shape[1]} columns under a header of {len(names)} names")
+    return {name: table[:, k] for k, name in enumerate(names) if name not in ("vertex", "x", "y", "z")}
+
+
+def _meshio_fields(path):
+    from ._meshio import _meshio, _to_log
+
+    meshio = _meshio()
+    try:
+        with _to_log():
+            mesh = meshio.read(str(path))
+    except Exception as exc:  # any parser failure: one readable error naming the file
+        raise MeshFileError(f"{path}: cannot be read ({str(exc).strip()[:200] or type(exc).__name__})") from exc
+    return dict(mesh.point_data)
+
+
+def _regrouped(columns: dict) -> dict[str, np.ndarray]:
+    """``<name>_x, _y, _z`` (and ``nx, ny, nz``) as (V, 3) vectors; scalars as float64, ``valid`` as bool."""
+    out = {}
+    groups = {name[:-2] for name in columns if name.endswith("_x")}
+    groups = {base for base in groups if all(f"{base}_{axis}" in columns for axis in "yz")}
+    for name, values in columns.items():
+        values = np.asarray(values)
+        if name.endswith(("_x", "_y", "_z")) and name[:-2] in groups:
+            if name.endswith("_x"):
+                base = name[:-2]
+                out[base] = np.column_stack([np.asarray(columns[f"{base}_{a}"], dtype=np.float64) for a in "xyz"])
+            continue
+        if name in ("nx", "ny", "nz") and all(key in columns for key in ("nx", "ny", "nz")):
+            if name == "nx":
+                out["normals"] = np.column_stack([np.asarray(columns[key], dtype=np.float64)
+                                                  for key in ("nx", "ny", "nz")])
+            continue
+        out[name] = values.astype(bool) if name == "valid" else values.astype(np.float64)
+    return out
