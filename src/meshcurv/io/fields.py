@@ -94,6 +94,9 @@ VIEWERS = {
         "vertex order); vertex_attributes stay empty with every file: use CurvatureResult.to_trimesh"),
     "pandas / spreadsheets": ((".csv",), "every field as columns, vectors split into _x, _y, _z"),
     "NumPy": ((".npz",), "every field as arrays, with the vertices and faces"),
+    "meshcurv.io.fields.read_fields": (
+        (".ply", ".vtp", ".npz", ".csv", ".vtu", ".vtk"),
+        "every field by name (float32 from .ply, float64 from the others)"),
 }
 
 
