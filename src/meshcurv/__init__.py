@@ -11,7 +11,7 @@ as ``method="matgeom"``.
 ((3600,), (3600, 3))
 """
 
-from . import errors, geometry, shapes, topology
+from . import errors, geometry, integrals, plotting, shapes, topology, viewer
 from .curvature import METHODS, principal_curvatures
 from .diagnosis import MeshDiagnosis, diagnose
 from .errors import (
@@ -52,6 +52,9 @@ __all__ = [
     "smooth_vertex_field",
     "shapes",
     "geometry",
+    "integrals",
+    "plotting",
+    "viewer",
     "topology",
     "errors",
     "InvalidMeshError",

@@ -233,6 +233,7 @@ def meshcurv():
     meshcurv compute mesh.obj -o out.csv   ... for pandas and spreadsheets
     meshcurv plot mesh.obj --field mean    a picture
     meshcurv volume cells.tif -o out/      per-object table of a label image
+    meshcurv view mesh.obj                 an interactive 3D page (HTML, works offline)
     meshcurv methods                       the estimators and their options
     """
 
@@ -561,3 +562,7 @@ meshcurv.add_command(batch_command())
 from ._volume_cli import volume_command  # noqa: E402  (meshcurv volume: label images to per-object tables)
 
 meshcurv.add_command(volume_command())
+
+from ._view_cli import view_command  # noqa: E402  (meshcurv view: an interactive HTML page)
+
+meshcurv.add_command(view_command())

@@ -51,9 +51,9 @@ from ..errors import InvalidMeshError, InvalidOptionError, MeshFileError, Missin
 from . import _meshio, _obj, _off, _ply, _tables, _vtk, _vtp
 from ._files import atomic_output, check_input, check_output
 from ._points import POINT_EXTENSIONS, is_point_cloud, read_points, write_point_curvatures, write_points
-from .fields import FIELDS, curvature_fields
+from .fields import FIELDS, curvature_fields, read_fields
 
-__all__ = ["Mesh", "FileFormat", "FORMATS", "read_mesh", "write_mesh", "write_curvatures",
+__all__ = ["Mesh", "FileFormat", "FORMATS", "read_mesh", "write_mesh", "write_curvatures", "read_fields",
            "curvature_fields", "FIELDS", "read_points", "write_points", "write_point_curvatures",
            "is_point_cloud", "POINT_EXTENSIONS"]
 
