@@ -222,6 +222,84 @@ def test_compiled_triangle_sums_match_the_numpy_path():
     assert (expected[:, 0] > 0).all()  # every triangle turned to a positive corrected area
 
 
+def test_compiled_pca_normals_match_eigh():
+    # a sphere, and a plane far from the origin in a random orientation (an exact zero eigenvalue)
+    pytest.importorskip("numba")
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_kernels import pca_normals
+
+    rng = np.random.default_rng(2)
+    plane = np.column_stack([rng.uniform(-1, 1, (2000, 2)), np.zeros(2000)]) @ random_rotation().T + 1e3
+    for points in (sphere_points(2000)[0], plane):
+        _, indices = normals_module.knn(cKDTree(points), points)
+        compiled = pca_normals(points, indices)
+        expected = normals_module._pca_normals_numpy(points, indices)
+        # the same unit vectors up to their signs (eigenvectors of a simple eigenvalue: 1e-9 after the
+        # 1e3 offset's cancellation, 1e-16 relative, is amplified by 1 / (spectral gap) ~ 1e3)
+        assert np.abs(np.abs(np.einsum("ij,ij->i", compiled, expected)) - 1).max() < 1e-9
+
+
+def test_compiled_ball_search_matches_the_k_d_tree():
+    # the same rows (nearest usable points in distance order, padded with N) and counts
+    pytest.importorskip("numba")
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_kernels import ball_indices
+
+    points, _ = sphere_points(3000)
+    usable = np.random.default_rng(3).random(3000) > 0.05
+    centres = np.flatnonzero(usable)
+    for radius, k in ((0.3, 12), (0.5, 60)):  # spacing 0.13: about 17 and 46 points per ball
+        grid = normals_module.grid_of(points, usable, radius)
+        index, squared, counts = ball_indices(points, centres, radius, k, *grid)
+        expected, expected_counts = estimators._ball_indices(
+            estimators._usable_tree(cKDTree(points), points, usable), points, centres, radius, k)
+        np.testing.assert_array_equal(index, expected)
+        np.testing.assert_array_equal(counts, expected_counts)
+        assert usable[index[index < 3000]].all() and (counts == k).any() and (counts < k).any()
+        inside = np.isfinite(squared)
+        assert np.allclose(squared[inside], np.sum((points[index[inside]] - points[np.repeat(centres, counts)])**2,
+                                                    axis=1))
+
+
+def test_compiled_spanning_signs_orient_as_the_scipy_tree():
+    # random signs on two spheres (two components): both paths make each sphere's normals consistent
+    pytest.importorskip("numba")
+    from scipy.spatial import cKDTree
+
+    from meshcurv._backend import use_backend
+
+    points, exact = sphere_points(2000)
+    points = np.concatenate([points, points + 10.0])
+    exact = np.concatenate([exact, exact])
+    flipped = exact * np.random.default_rng(5).choice([-1.0, 1.0], size=(4000, 1))
+    _, indices = normals_module.knn(cKDTree(points), points)
+    for backend in ("numba", "numpy"):
+        with use_backend(backend):
+            signs, labels = normals_module.orientation_signs(flipped, indices, np.ones(4000, dtype=bool))
+        agree = np.einsum("ij,ij->i", flipped * signs[:, None], exact)
+        assert np.array_equal(labels, np.repeat(labels[[0, 2000]], 2000)) and labels[0] != labels[2000]
+        for part in (slice(0, 2000), slice(2000, 4000)):
+            assert (agree[part] > 0).all() or (agree[part] < 0).all()
+
+
+def test_spatial_order_finds_the_duplicates_as_the_lexicographic_sort():
+    from meshcurv.pointcloud import _representatives, _spatial_order
+
+    points = np.random.default_rng(6).normal(size=(5000, 3))
+    points[100:110] = points[4000:4010]
+    points[7] = points[3]
+    points[8] = -0.0 * points[3] + points[3]  # the same values
+    order, representative = _spatial_order(points)
+    np.testing.assert_array_equal(np.sort(order), np.arange(5000))
+    np.testing.assert_array_equal(representative, _representatives(points))
+    assert representative[8] == representative[7] == 3 and (representative[4000:4010] == np.arange(100, 110)).all()
+    # neighbours in the order are near in space: the mean step is a small share of a random pair's distance
+    steps = np.linalg.norm(np.diff(points[order], axis=0), axis=1)
+    assert steps.mean() < 0.5 * np.linalg.norm(points[1:] - points[:-1], axis=1).mean()
+
+
 def test_distinct_ranks_are_distinct_and_in_range():
     counts = np.array([3, 4, 10, 97])
     ranks = estimators._distinct_ranks(estimators._rank_pattern(500), counts)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._backend import kernels_of, numba_kernels
+from ._pointcloud_normals import grid_of
 from ._tensors import principal_from_shape_operator
 from .estimators.icc import face_measures
 from .estimators.quadric import fit_jets, jet_normals, shape_operators
@@ -167,6 +168,31 @@ def ball_size(radius: float, spacing: float) -> int:
     return int(min(MAX_BALL_POINTS, max(2 * MIN_BALL_POINTS, np.ceil(1.3 * expected))))
 
 
+def _usable_tree(tree, points, usable):
+    """``(tree, pool)``: a k-d tree over the usable points and their indices (``tree`` and None when all are)."""
+    if usable.all():
+        return tree, None
+    from scipy.spatial import cKDTree
+
+    pool = np.flatnonzero(usable)
+    return cKDTree(points[pool]), np.append(pool, points.shape[0])
+
+
+def _ball_indices(search, points, chunk, radius, k):
+    """(M, k) the ``k`` nearest usable points within ``radius`` of each centre of ``chunk`` and (M,) their count.
+
+    The NumPy path of :func:`meshcurv._pointcloud_kernels.ball_indices`: a
+    query of the k-d tree of :func:`_usable_tree` (``search``); rows in
+    distance order, padded with ``N``.
+    """
+    tree, pool = search
+    _, index = tree.query(points[chunk], k=k, distance_upper_bound=radius, workers=-1)
+    index = index.reshape(chunk.size, -1)
+    if pool is not None:
+        index = pool[index]
+    return np.ascontiguousarray(index), (index < points.shape[0]).sum(axis=1)
+
+
 def corrected_measures(tree, points, normals, radius, centres, usable, *, spacing: float = 0.0,
                        n_triangles: int | None = None):
     """Randomized corrected curvature measures over balls of ``radius`` (Lachaud et al. 2023).
@@ -190,17 +216,16 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
         from . import _pointcloud_kernels
 
         compiled = kernels_of(_pointcloud_kernels).ball_triangle_sums  # locked, interruptible
+        find_balls = kernels_of(_pointcloud_kernels).ball_indices
     k = min(ball_size(radius, spacing), n)
+    grid = None if compiled is None else grid_of(points, usable, radius)
+    search = _usable_tree(tree, points, usable) if grid is None else None
     for start in range(0, centres.size, CHUNK):
         chunk = centres[start:start + CHUNK]
-        _, index = tree.query(points[chunk], k=k, distance_upper_bound=radius, workers=-1)
-        index = index.reshape(chunk.size, -1)
-        inside = index < n
-        inside[inside] = usable[index[inside]]
-        # usable points first, in distance order (a stable sort keeps the order within each group)
-        order = np.argsort(~inside, axis=1, kind="stable")
-        index = np.ascontiguousarray(np.take_along_axis(index, order, axis=1))
-        counts = inside.sum(axis=1)
+        if grid is not None:
+            index, _, counts = find_balls(points, chunk, float(radius), k, *grid)
+        else:
+            index, counts = _ball_indices(search, points, chunk, radius, k)
         rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
         if rows.size == 0:
             continue

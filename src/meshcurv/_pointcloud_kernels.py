@@ -68,3 +68,186 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
             out[row, 7] += 0.25 * ((gx * ez - hx * qz) + (gz * ex - hz * qx))
             out[row, 8] += 0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy))
     return out
+
+
+
+@nb.njit(parallel=True, **_JIT)
+def pca_normals(points, indices):
+    """(N, 3) unit least-variance directions of each point with its neighbours ``indices`` (N, k).
+
+    The covariance ``A``'s smallest eigenvalue in closed form (Smith 1961:
+    ``q + 2 p cos(acos(det(B) / 2) / 3 + 2 pi / 3)``, ``q = tr(A) / 3``,
+    ``B = (A - q I) / p``), its eigenvector the longest cross product of two
+    rows of ``A - lambda I``. The NumPy path
+    (:func:`meshcurv._pointcloud_normals.pca_normals`) uses ``numpy.linalg.eigh``:
+    the same vector up to its sign (tests compare the two).
+    """
+    n, k = indices.shape
+    out = np.zeros((n, 3))
+    for i in nb.prange(n):
+        cx, cy, cz = points[i, 0], points[i, 1], points[i, 2]
+        for j in range(k):
+            cx += points[indices[i, j], 0]
+            cy += points[indices[i, j], 1]
+            cz += points[indices[i, j], 2]
+        cx, cy, cz = cx / (k + 1), cy / (k + 1), cz / (k + 1)
+        dx, dy, dz = points[i, 0] - cx, points[i, 1] - cy, points[i, 2] - cz
+        xx, xy, xz, yy, yz, zz = dx * dx, dx * dy, dx * dz, dy * dy, dy * dz, dz * dz
+        for j in range(k):
+            q = indices[i, j]
+            dx, dy, dz = points[q, 0] - cx, points[q, 1] - cy, points[q, 2] - cz
+            xx += dx * dx
+            xy += dx * dy
+            xz += dx * dz
+            yy += dy * dy
+            yz += dy * dz
+            zz += dz * dz
+        off = xy * xy + xz * xz + yz * yz
+        mean = (xx + yy + zz) / 3
+        spread = np.sqrt(((xx - mean) ** 2 + (yy - mean) ** 2 + (zz - mean) ** 2 + 2 * off) / 6)
+        if not spread > 0:  # isotropic (or a single repeated point): every direction is as good
+            out[i, 2] = 1.0
+            continue
+        bxx, byy, bzz = (xx - mean) / spread, (yy - mean) / spread, (zz - mean) / spread
+        bxy, bxz, byz = xy / spread, xz / spread, yz / spread
+        half = 0.5 * (bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz) + bxz * (bxy * byz - byy * bxz))
+        angle = np.arccos(min(1.0, max(-1.0, half))) / 3
+        smallest = mean + 2 * spread * np.cos(angle + 2 * np.pi / 3)
+        r0x, r0y, r0z = xx - smallest, xy, xz
+        r1x, r1y, r1z = xy, yy - smallest, yz
+        r2x, r2y, r2z = xz, yz, zz - smallest
+        ax, ay, az = r0y * r1z - r0z * r1y, r0z * r1x - r0x * r1z, r0x * r1y - r0y * r1x
+        bx, by, bz = r0y * r2z - r0z * r2y, r0z * r2x - r0x * r2z, r0x * r2y - r0y * r2x
+        ex, ey, ez = r1y * r2z - r1z * r2y, r1z * r2x - r1x * r2z, r1x * r2y - r1y * r2x
+        la, lb, le = ax * ax + ay * ay + az * az, bx * bx + by * by + bz * bz, ex * ex + ey * ey + ez * ez
+        if lb > la and lb >= le:
+            ax, ay, az, la = bx, by, bz, lb
+        elif le > la:
+            ax, ay, az, la = ex, ey, ez, le
+        if not la > 0:
+            out[i, 2] = 1.0
+            continue
+        length = np.sqrt(la)
+        out[i, 0], out[i, 1], out[i, 2] = ax / length, ay / length, az / length
+    return out
+
+
+@nb.njit(**_JIT)
+def _first_at_least(keys, key):
+    """Position of the first of the sorted ``keys`` that is ``>= key`` (``keys.size`` when none is)."""
+    lo, hi = 0, keys.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if keys[mid] < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@nb.njit(parallel=True, **_JIT)
+def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool):
+    """(M, k) the ``k`` nearest points of ``pool`` closer than ``radius`` to each centre, (M, k) their
+    squared distances (inf past the count) and (M,) their count.
+
+    The pool's points are sorted by the cell of a grid of side ``radius``
+    (``keys``: the sorted distinct cell numbers ``(x dims_y + y) dims_z + z``,
+    ``starts``: where each cell's run begins in ``pool``, one more entry at the
+    end); each centre looks in the 27 cells around its own (nine runs of
+    three consecutive cells along z, each found by bisection). Rows are in
+    distance order (equal distances: lower index first), padded with
+    ``points.shape[0]`` as :meth:`scipy.spatial.cKDTree.query` does.
+    """
+    n = points.shape[0]
+    m = centres.shape[0]
+    index = np.full((m, k), n, dtype=np.int64)
+    squared = np.full((m, k), np.inf)
+    counts = np.zeros(m, dtype=np.int64)
+    limit = radius * radius
+    for row in nb.prange(m):
+        c = centres[row]
+        px, py, pz = points[c, 0], points[c, 1], points[c, 2]
+        gx = int(np.floor((px - low[0]) / radius))
+        gy = int(np.floor((py - low[1]) / radius))
+        gz = int(np.floor((pz - low[2]) / radius))
+        found = 0
+        for x in range(max(gx - 1, 0), min(gx + 2, dims[0])):
+            for y in range(max(gy - 1, 0), min(gy + 2, dims[1])):
+                # the (up to) three cells along z are consecutive numbers: one run of the pool
+                column = (x * dims[1] + y) * dims[2]
+                first = _first_at_least(keys, column + max(gz - 1, 0))
+                last = _first_at_least(keys, column + min(gz + 1, dims[2] - 1) + 1)
+                for t in range(starts[first], starts[last]):
+                    q = pool[t]
+                    dx, dy, dz = points[q, 0] - px, points[q, 1] - py, points[q, 2] - pz
+                    d = dx * dx + dy * dy + dz * dz
+                    if not d < limit:
+                        continue
+                    if found == k and (d > squared[row, k - 1] or (d == squared[row, k - 1]
+                                                                   and q > index[row, k - 1])):
+                        continue
+                    # insert in order, dropping the last when full
+                    j = found if found < k else k - 1
+                    while j > 0 and (squared[row, j - 1] > d or (squared[row, j - 1] == d
+                                                                 and index[row, j - 1] > q)):
+                        squared[row, j] = squared[row, j - 1]
+                        index[row, j] = index[row, j - 1]
+                        j -= 1
+                    squared[row, j] = d
+                    index[row, j] = q
+                    if found < k:
+                        found += 1
+        counts[row] = found
+    return index, squared, counts
+
+
+@nb.njit(**_JIT)
+def _root(parent, flip, i):
+    """The root of ``i`` in the union-find forest and whether ``i``'s sign is flipped relative to it.
+
+    Halves the paths as it goes (each node then points to its grandparent,
+    its flip relative to it updated).
+    """
+    flipped = 0
+    while parent[i] != i:
+        up = parent[i]
+        if parent[up] != up:
+            flip[i] ^= flip[up]
+            parent[i] = parent[up]
+        flipped ^= flip[i]
+        i = parent[i]
+    return i, flipped
+
+
+@nb.njit(**_JIT)
+def spanning_signs(n, rows, cols, opposite, order):
+    """(N,) +1/-1 and (N,) component roots: signs propagated along the minimum spanning forest.
+
+    Kruskal's algorithm over the edges ``(rows, cols)`` taken in ``order``
+    (increasing weight), with a union-find that keeps each point's flip
+    relative to its root: an edge that joins two trees sets the relative
+    flip of their roots so that its ends differ by ``opposite`` (their normals
+    point apart). The signs are then those of the propagation along the
+    minimum spanning tree (Hoppe et al. 1992), each root +1.
+    """
+    parent = np.arange(n)
+    flip = np.zeros(n, dtype=np.int8)
+    size = np.ones(n, dtype=np.int64)
+    for e in order:
+        a, fa = _root(parent, flip, rows[e])
+        b, fb = _root(parent, flip, cols[e])
+        if a == b:
+            continue
+        if size[a] < size[b]:
+            a, b = b, a
+        parent[b] = a
+        flip[b] = fa ^ fb ^ opposite[e]
+        size[a] += size[b]
+    signs = np.ones(n)
+    roots = np.zeros(n, dtype=np.int64)
+    for i in range(n):
+        r, f = _root(parent, flip, i)
+        roots[i] = r
+        if f:
+            signs[i] = -1.0
+    return signs, roots

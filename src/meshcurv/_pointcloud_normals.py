@@ -8,7 +8,10 @@ the tree follows the pairs of most parallel normals, where the relative sign
 is least ambiguous. The sign of every point relative to its tree's root is the
 product of the signs ``sign(n_i . n_parent(i))`` along its path to the root,
 computed by pointer jumping (``log2(depth)`` vectorised passes over the
-points, no loop over them). Each connected component of the graph is then
+points, no loop over them); with the compiled backend, Kruskal's algorithm
+over the edges in order of weight with a union-find that keeps each point's
+flip relative to its root gives the same signs in one pass
+(:func:`meshcurv._pointcloud_kernels.spanning_signs`). Each connected component of the graph is then
 turned outward: by the divergence theorem ``sum_i a_i n_i . (p_i - c) = 3 V > 0``
 for the outward normals of a closed surface (``a_i`` the area of a point, the
 square of its local spacing; ``c`` any point); on an open surface the sum
@@ -24,6 +27,8 @@ https://doi.org/10.1145/133994.134011
 from __future__ import annotations
 
 import numpy as np
+
+from ._backend import kernels_of, numba_kernels
 
 #: Neighbours (the point itself not counted) of the k-nearest-neighbour query that
 #: gives the spacing, the PCA normals and the orientation graph.
@@ -58,15 +63,44 @@ def knn(tree, points: np.ndarray, k: int = NEIGHBOURS) -> tuple[np.ndarray, np.n
     distances = np.zeros((n, k))
     indices = np.zeros((n, k), dtype=np.int64)
     for start in range(0, n, CHUNK):
-        stop = min(n, start + CHUNK)
-        d, i = tree.query(points[start:stop], k=k + 1, workers=-1)
-        own = i == np.arange(start, stop)[:, None]
-        first = np.where(own.any(axis=1), own.argmax(axis=1), 0)
-        keep = np.ones(d.shape, dtype=bool)
-        keep[np.arange(stop - start), first] = False
-        distances[start:stop] = d[keep].reshape(-1, k)
-        indices[start:stop] = i[keep].reshape(-1, k)
+        rows = np.arange(start, min(n, start + CHUNK))
+        d, i = tree.query(points[rows], k=k + 1, workers=-1)
+        _drop_self(rows, d, i, k, distances, indices)
     return distances, indices
+
+
+def _drop_self(rows, d, i, k, distances, indices) -> None:
+    """Write the (M, k + 1) neighbours ``d, i`` of the points ``rows`` into ``distances, indices`` without themselves."""
+    if (i[:, 0] == rows).all():  # distinct points: each is its own nearest
+        distances[rows], indices[rows] = d[:, 1:], i[:, 1:]
+        return
+    own = i == rows[:, None]
+    first = np.where(own.any(axis=1), own.argmax(axis=1), 0)
+    keep = np.ones(d.shape, dtype=bool)
+    keep[np.arange(rows.size), first] = False
+    distances[rows] = d[keep].reshape(-1, k)
+    indices[rows] = i[keep].reshape(-1, k)
+
+
+def grid_of(points, usable, side):
+    """``(low, dims, keys, starts, pool)``: the usable points sorted by the cell of a grid of ``side``.
+
+    The input of :func:`meshcurv._pointcloud_kernels.ball_indices`. None when
+    the grid's cell numbers would not fit in an int64 (a side below about
+    1e-6 of the cloud's extent): the k-d tree then answers.
+    """
+    pool = np.flatnonzero(usable)
+    low = points[pool].min(axis=0)
+    cells = np.floor((points[pool] - low) / side).astype(np.int64)
+    dims = cells.max(axis=0) + 1
+    if float(np.prod(dims.astype(float))) >= 2.0**62:
+        return None
+    keys = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]
+    order = np.argsort(keys)
+    keys = keys[order]
+    first = np.flatnonzero(np.concatenate([[True], keys[1:] != keys[:-1]]))
+    starts = np.append(first, keys.size).astype(np.int64)
+    return low, dims, keys[first], starts, pool[order]
 
 
 def local_spacing(distances: np.ndarray) -> np.ndarray:
@@ -82,7 +116,21 @@ def local_spacing(distances: np.ndarray) -> np.ndarray:
 
 
 def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
-    """(N, 3) unit normals (unoriented): the least-variance direction of each point and its neighbours."""
+    """(N, 3) unit normals (unoriented): the least-variance direction of each point and its neighbours.
+
+    The compiled kernel (:func:`meshcurv._pointcloud_kernels.pca_normals`, a
+    closed form) when the numba backend is in use, else :func:`numpy.linalg.eigh`
+    on chunks of covariances.
+    """
+    if numba_kernels() is not None:
+        from . import _pointcloud_kernels
+
+        return kernels_of(_pointcloud_kernels).pca_normals(points, np.ascontiguousarray(indices))
+    return _pca_normals_numpy(points, indices)
+
+
+def _pca_normals_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """The NumPy path of :func:`pca_normals`."""
     n = points.shape[0]
     normals = np.zeros((n, 3))
     for start in range(0, n, CHUNK):
@@ -161,6 +209,12 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
     cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
     # weight 1 - |cos| (1 - cos for given signs), plus a floor so that parallel pairs stay edges of the sparse graph
     weights = (1.0 - cosine if given else 1.0 - np.abs(cosine)) + 1e-6
+    if numba_kernels() is not None:
+        from . import _pointcloud_kernels
+
+        signs, roots = kernels_of(_pointcloud_kernels).spanning_signs(
+            n, rows, cols, (cosine < 0).astype(np.int8), np.argsort(weights))
+        return signs, np.unique(roots, return_inverse=True)[1].reshape(-1)
     graph = coo_matrix((weights, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
     # both searches treat the graph as undirected: (i, j) is an edge when either is among the other's neighbours
     n_components, labels = connected_components(graph[:n, :n], directed=False)

@@ -8,11 +8,14 @@ curvatures are positive where the surface bends away from the normal (points
 sampled on a sphere of radius ``r`` with outward normals give ``+1/r``).
 
 Pipeline (all vectorised, neighbours from :class:`scipy.spatial.cKDTree`
-queries in chunks, no O(N^2) memory):
+queries in chunks, or, for the balls of the measures with the compiled
+backend, from a grid of the ball's radius; no O(N^2) memory):
 
 1. checks: shape, NaN, at least :data:`MIN_POINTS` points, not all on a line;
    duplicate points are computed once and copied; points whose neighbours are
-   all far (outliers) stay out of every neighbourhood and are NaN;
+   all far (outliers) stay out of every neighbourhood and are NaN; the
+   distinct points are taken in Morton (Z-curve) order, so that neighbours
+   are near in memory (the results do not depend on the input's order);
 2. the local spacing ``s_i`` (:func:`meshcurv._pointcloud_normals.local_spacing`,
    the analogue of a mesh's edge length) and its median ``s``;
 3. normals: the given ones (made unit), or PCA of the 10 nearest neighbours;
@@ -118,6 +121,9 @@ EXTENT_CAP = 0.25
 #: a part at 1 cannot be measured in float64; a cloud all at 1e-200 is refused as for meshes.
 MIN_SPACING = 1e-150
 
+#: Bits per coordinate of the Morton code that orders the points (3 x 21 bits fill 63 of a uint64).
+MORTON_BITS = 21
+
 #: Code of :data:`meshcurv.result.INVALID_REASONS` for points without an estimate.
 _UNDEFINED = len(INVALID_REASONS) - 1
 
@@ -199,9 +205,10 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         raise InvalidMeshError(f"`points` holds {n_all} points; at least {MIN_POINTS} are needed")
     problems: list[str] = []
 
-    # duplicates: computed once on the first of each group of coincident points, copied to the others
-    representative = _representatives(points)
-    unique = np.flatnonzero(representative == np.arange(n_all))
+    # duplicates: computed once on the first of each group of coincident points, copied to the others;
+    # the distinct points in Morton order (neighbours near in memory: the searches and fits run from cache)
+    order, representative = _spatial_order(points)
+    unique = order[representative[order] == order]
     if unique.size < n_all:
         problems.append(f"{n_all - unique.size} points coincide with others (duplicates): computed once and copied")
     if unique.size < MIN_POINTS:
@@ -249,6 +256,40 @@ def _checked_normals(normals, shape) -> np.ndarray:
     if zero.size:
         raise InvalidMeshError(f"`normals` has zero length at {zero.size} points (first at index {zero[0]})")
     return array / length[:, None]
+
+
+def _spatial_order(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) the points' order along a Morton (Z-order) curve and (N,) their representatives.
+
+    The Morton code interleaves the bits of the coordinates quantized to
+    :data:`MORTON_BITS` bits on the bounding cube: points close in the order
+    are close in space. Coincident points share a code, so duplicates are
+    looked for (:func:`_representatives`) only among the runs of equal codes.
+    """
+    n = points.shape[0]
+    low = points.min(axis=0)
+    extent = float((points.max(axis=0) - low).max())
+    scale = (2.0**MORTON_BITS - 1) / extent if extent > 0 else 0.0
+    cells = np.minimum(((points - low) * scale).astype(np.uint64), np.uint64(2**MORTON_BITS - 1))
+    code = np.zeros(n, dtype=np.uint64)
+    for axis in range(3):
+        spread = cells[:, axis]
+        # spread the 21 bits two apart (bit b goes to bit 3 b)
+        for shift, mask in ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F),
+                            (4, 0x10C30C30C30C30C3), (2, 0x1249249249249249)):
+            spread = (spread | (spread << np.uint64(shift))) & np.uint64(mask)
+        code |= spread << np.uint64(axis)
+    order = np.argsort(code, kind="stable")
+    ordered = code[order]
+    same = ordered[1:] == ordered[:-1]
+    representative = np.arange(n)
+    if same.any():
+        runs = np.zeros(n, dtype=bool)
+        runs[1:] |= same
+        runs[:-1] |= same
+        subset = np.sort(order[runs])
+        representative[subset] = subset[_representatives(points[subset])]
+    return order, representative
 
 
 def _representatives(points: np.ndarray) -> np.ndarray:
