@@ -621,3 +621,14 @@ def test_browser_million_vertices_open_within_10_seconds(tmp_path, browser):
     frame = browser.evaluate("meshcurvViewer.timeFrames(2)")
     print(f"\n1M vertices: {size / 1e6:.1f} MB, open {seconds:.2f} s (first frame at {facts['openMs']} ms in the page), "
           f"{frame:.0f} ms a frame, renderer {facts['renderer']}")
+
+
+@pytest.mark.parametrize("stretch, expected", [((1.0, 1.0, 2.0), "z"), ((1.0, 2.0, 1.0), "y"), ((1.0, 1.0, 1.0), "y")])
+def test_up_axis_is_chosen_from_the_mesh_when_not_given(tmp_path, stretch, expected):
+    sphere = meshcurv.shapes.icosphere(subdivisions=4)
+    vertices = sphere.vertices * np.array(stretch)  # an ellipsoid twice as tall along z (or y) as along the others
+    page = write_html(tmp_path / "e.html", vertices, sphere.faces)
+    meta, _ = read_page_data(page)
+    assert meta["up"] == expected
+    given = write_html(tmp_path / "given.html", vertices, sphere.faces, up="x")
+    assert read_page_data(given)[0]["up"] == "x"

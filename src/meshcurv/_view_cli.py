@@ -27,8 +27,9 @@ def view_command() -> click.Command:
     @click.option("-f", "--field", type=click.Choice(VIEWER_FIELDS), default="mean", show_default=True,
                   help="The field shown first (the page has a menu of all of them).")
     @method_options
-    @click.option("--up", type=click.Choice(["y", "z", "x"]), default="y", show_default=True,
-                  help="The axis drawn upwards at first (y for most OBJ and PLY files).")
+    @click.option("--up", type=click.Choice(["auto", "y", "z", "x"]), default="auto", show_default=True,
+                  help="The axis drawn upwards at first; auto: z when the mesh is clearly taller along z than "
+                       "along y, else y (most OBJ and PLY files).")
     @click.option("--percentiles", callback=_percentiles, default="2,98", show_default=True, metavar="LOW,HIGH",
                   help="Default colour limits as percentiles of each field (symmetric for signed fields).")
     @click.option("--directions", "max_directions", type=click.IntRange(min=0, max=10**7), default=20000,
@@ -94,7 +95,8 @@ def view_command() -> click.Command:
                 bar("page", len(stages))
             finally:
                 bar.close()
-        write_html(output, vertices, faces, result, field=field, title=title or mesh.name, up=up,
+        write_html(output, vertices, faces, result, field=field, title=title or mesh.name,
+                   up=None if up == "auto" else up,
                    percentiles=percentiles, max_directions=max_directions, length_unit=length_unit,
                    overwrite=overwrite, source=mesh)
         size = output.stat().st_size / 1e6

@@ -70,7 +70,7 @@ _UPS = ("y", "z", "x")
 
 
 def write_html(path, vertices, faces=None, result: CurvatureResult | None = None, *, field: str = "mean",
-               title: str | None = None, up: str = "y", elevation: float = 20.0, azimuth: float = -30.0,
+               title: str | None = None, up: str | None = None, elevation: float = 20.0, azimuth: float = -30.0,
                percentiles: tuple[float, float] = (2.0, 98.0), max_directions: int = 20000,
                length_unit: str | None = None, overwrite: bool = False,
                source=None) -> pathlib.Path:
@@ -96,8 +96,10 @@ def write_html(path, vertices, faces=None, result: CurvatureResult | None = None
         The field shown first; the page has a menu of all of them.
     title : str, optional
         The page's heading (default: "meshcurv viewer").
-    up : {'y', 'z', 'x'}, default: 'y'
-        The axis drawn upwards at first.
+    up : {'y', 'z', 'x'}, optional
+        The axis drawn upwards at first; default: chosen from the mesh as for
+        the pictures (:func:`meshcurv.plotting.choose_up`: z when the mesh is
+        clearly taller along z than along y, else y).
     elevation, azimuth : float, default: 20, -30
         The first view, in degrees: the camera above the horizontal plane and
         turned about the up axis.
@@ -147,6 +149,11 @@ def write_html(path, vertices, faces=None, result: CurvatureResult | None = None
         raise MeshFileError(f"{path}: the page must be named .html or .htm; got {path.suffix or 'no extension'!r}")
     check_output(path, overwrite=overwrite, source=source)
     field = check_choice(field, "field", VIEWER_FIELDS)
+    if up is None:
+        from .plotting import choose_up
+
+        up, why = choose_up(checked_points(vertices))
+        logger.info("viewer: up axis %s (%s)", up, why)
     up = check_choice(up, "up", _UPS)
     percentiles = _check_percentiles(percentiles)
     max_directions = _check_count(max_directions, "max_directions")
