@@ -180,9 +180,9 @@ def main(argv=None) -> int:
     serial_default_total = figures["serial_default"]["per_mesh"] * n
     overhead = (figures["warm_1"]["meshes"] - serial_total) / n
     rows = [
-        ("serial loop, NUMBA_NUM_THREADS=1", serial_total, "per mesh {:.1f} ms".format(1000 * serial_total / n)),
+        ("serial loop, NUMBA_NUM_THREADS=1", serial_total, f"per mesh {1000 * serial_total / n:.1f} ms"),
         ("serial loop, numba's default threads", serial_default_total,
-         "per mesh {:.1f} ms".format(1000 * serial_default_total / n)),
+         f"per mesh {1000 * serial_default_total / n:.1f} ms"),
     ]
     # two loops at once, half the meshes each, each timed without its first mesh: what two cores of this
     # machine give without Dask, the best a 2-worker cluster can do

@@ -37,7 +37,8 @@ for f in sorted(glob.glob(str(ROOT / 'tests' / 'data' / 'matgeom' / '*.npz'))):
     vals, _ = sorted_by_magnitude(t)
     flat = np.abs(vals[:,1]) - np.abs(vals[:,0]) <= 1e-8*scale
     def vd(a,b,m):
-        d = 1-np.abs(np.sum(a*b,1)); return d[~m].max() if (~m).any() else 0
+        d = 1-np.abs(np.sum(a*b,1))
+        return d[~m].max() if (~m).any() else 0
     v = max(vd(U1,z['U1'],umb), vd(U2,z['U2'],umb|flat), vd(N,z['N'],flat))
     print(f"| {os.path.basename(f)[:-4]} | {dc:.1e} | {dk:.1e} | {v:.1e} |")
 for radius in (1.0, 1000.0):
@@ -59,7 +60,9 @@ for backend in ("numba", "numpy"):
             meshcurv.principal_curvatures(v, f, method=m)
             ts = []
             for _ in range(5):
-                t = time.perf_counter(); meshcurv.principal_curvatures(v, f, method=m); ts.append(time.perf_counter() - t)
+                t = time.perf_counter()
+                meshcurv.principal_curvatures(v, f, method=m)
+                ts.append(time.perf_counter() - t)
             print(f"igea {backend} {m}: median {np.median(ts):.3f} s (min {min(ts):.3f})")
 v, f = meshcurv.read_mesh(SHARED / 'ogre.obj')
 for m in ("normal_cycle", "matgeom", "meyer", "rusinkiewicz"):

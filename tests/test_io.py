@@ -345,7 +345,7 @@ def _ply_bytes(order, vertex_fields, vertex_rows, face_fields, face_rows, *, ext
               f"element vertex {len(vertex_rows)}"]
     header += [f"property {names[kind]} {name}" for name, kind, _ in vertex_fields]
     header += [f"element face {len(face_rows)}"]
-    for name, kind, shape in face_fields:
+    for name, kind, _shape in face_fields:
         if name == "count":
             continue
         if name == "corners":

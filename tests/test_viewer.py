@@ -33,7 +33,10 @@ def exact_result(shape, *, invalid=()) -> CurvatureResult:
     """The analytic curvatures of a :mod:`meshcurv.shapes` mesh as a result; ``invalid`` vertices NaN and invalid."""
     valid = np.ones(len(shape.vertices), dtype=bool)
     valid[list(invalid)] = False
-    nan_where_invalid = lambda values: np.where(valid.reshape((-1,) + (1,) * (np.ndim(values) - 1)), values, np.nan)
+
+    def nan_where_invalid(values):
+        return np.where(valid.reshape((-1,) + (1,) * (np.ndim(values) - 1)), values, np.nan)
+
     return CurvatureResult(k_min=nan_where_invalid(shape.k_min), k_max=nan_where_invalid(shape.k_max),
                            dir_min=nan_where_invalid(shape.dir_min), dir_max=nan_where_invalid(shape.dir_max),
                            normals=shape.normals, valid=valid, method="exact")
@@ -493,7 +496,7 @@ def test_browser_probe_reads_the_vertex_in_front(tmp_path, browser):
     red, _ = colour_fractions(drawn)
     assert red > 0.05  # mean = +1/2 everywhere: the red half of the map
     # the middle of the drawn sphere: the bounding box of its red pixels
-    rows, columns = np.nonzero((drawn[..., 0] > drawn[..., 2] + 50))
+    rows, columns = np.nonzero(drawn[..., 0] > drawn[..., 2] + 50)
     x = (columns.min() + columns.max()) / 2 + image.shape[1] - drawn.shape[1]
     y = (rows.min() + rows.max()) / 2
     towards_viewer = np.array(browser.evaluate("meshcurvViewer.state.rotation"))[6:9]
@@ -597,7 +600,7 @@ def test_browser_point_cloud(tmp_path, browser):
     assert facts["state"] == "ok", facts["text"]
     image = browser.screenshot(tmp_path / "sphere_points.png")
     drawn = beside_panel(browser, image)
-    rows, columns = np.nonzero((drawn[..., 0] > drawn[..., 2] + 50))
+    rows, columns = np.nonzero(drawn[..., 0] > drawn[..., 2] + 50)
     x = (columns.min() + columns.max()) / 2 + image.shape[1] - drawn.shape[1]
     y = (rows.min() + rows.max()) / 2
     towards_viewer = np.array(browser.evaluate("meshcurvViewer.state.rotation"))[6:9]

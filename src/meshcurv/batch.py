@@ -54,7 +54,7 @@ import time
 import uuid
 import warnings
 from dataclasses import dataclass
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

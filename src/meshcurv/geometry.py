@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._backend import numba_kernels
-from ._validation import checked_indices, checked_mesh, checked_points
+from ._validation import checked_mesh, checked_points
 from .errors import InvalidMeshError, InvalidOptionError
 from .topology import MeshTopology
 

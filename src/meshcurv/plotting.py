@@ -513,7 +513,7 @@ def _draw_view(axis, points, triangles, values, normals, camera, colormap, norm,
     colours[~covered] = 0.0
     axis.imshow(colours.clip(0, 1), origin="lower", extent=raster.extent,
                 interpolation="antialiased")
-    for (name, field), colour in zip(strokes.items(), _STROKE_COLOURS):
+    for field, colour in zip(strokes.values(), _STROKE_COLOURS):
         segments = _strokes(raster, points, field, camera, normals)
         axis.add_collection(LineCollection(segments, colors=colour, linewidths=0.8, capstyle="round"))
     axis.set_xlim(*raster.extent[:2])

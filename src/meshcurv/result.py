@@ -6,7 +6,8 @@ import dataclasses
 from dataclasses import dataclass, field
 from functools import cached_property
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -102,9 +103,9 @@ class CurvatureResult:
     valid: np.ndarray
     method: str
     parameters: Mapping[str, Any] = field(default_factory=dict)
-    diagnosis: "MeshDiagnosis | None" = None
+    diagnosis: MeshDiagnosis | None = None
     invalid_reason: np.ndarray | None = None
-    _surface: "Surface | None" = field(default=None, repr=False)
+    _surface: Surface | None = field(default=None, repr=False)
 
     def __post_init__(self):
         for name in _ARRAY_FIELDS:
@@ -138,7 +139,7 @@ class CurvatureResult:
         return {INVALID_REASONS[c]: int(counts[c]) for c in order if counts[c]}
 
     @classmethod
-    def _of_arrays(cls, **fields) -> "CurvatureResult":
+    def _of_arrays(cls, **fields) -> CurvatureResult:
         """A result that takes the estimator's own arrays without copying them.
 
         The arrays are made read-only here and kept by :meth:`__post_init__`

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,6 +27,9 @@ from ._backend import numba_kernels
 from ._validation import (MAX_VERTICES, Ragged, check_vertex_count, checked_triangles, fan_triangles,
                           polygon_arrays)
 from .errors import InvalidMeshError
+
+if TYPE_CHECKING:
+    import scipy.sparse
 
 __all__ = ["triangulate_faces", "MeshTopology"]
 
@@ -118,7 +122,7 @@ class MeshTopology:
     _edge_forward_counts: np.ndarray = field(repr=False)
 
     @classmethod
-    def from_faces(cls, faces, n_vertices: int | None = None) -> "MeshTopology":
+    def from_faces(cls, faces, n_vertices: int | None = None) -> MeshTopology:
         """Compute the topology of ``faces``.
 
         Parameters
@@ -161,7 +165,7 @@ class MeshTopology:
         return cls._build(triangles, n_vertices)
 
     @classmethod
-    def _build(cls, faces: np.ndarray, n_vertices: int) -> "MeshTopology":
+    def _build(cls, faces: np.ndarray, n_vertices: int) -> MeshTopology:
         """Build from already validated int64 (F, 3) triangles."""
         kernels = numba_kernels()
         if kernels is not None:
@@ -261,7 +265,7 @@ class MeshTopology:
 
     # -- adjacency --------------------------------------------------------------
     @cached_property
-    def adjacency(self) -> "scipy.sparse.csr_matrix":
+    def adjacency(self) -> scipy.sparse.csr_matrix:
         """(V, V) sparse symmetric 0/1 matrix: ``i ~ j`` when they share an edge."""
         n = self.n_vertices
         rows = np.concatenate([self.edges[:, 0], self.edges[:, 1]])
@@ -398,7 +402,7 @@ def _build_edges(faces: np.ndarray, n_vertices: int):
     return edges, face_edges.reshape(n_faces, 3), edge_faces, counts.astype(np.int64), forward_counts
 
 
-def _bowtie_vertices(topology: "MeshTopology") -> np.ndarray:
+def _bowtie_vertices(topology: MeshTopology) -> np.ndarray:
     """NumPy path of :attr:`MeshTopology.bowtie_vertices`: components of the corner graph."""
     import scipy.sparse as sp
     from scipy.sparse.csgraph import connected_components

@@ -446,7 +446,7 @@ def _write_page(handle, meta: dict, arrays: dict) -> None:
         handle.write(f'<script type="application/octet-stream" id="{identifier}">'.encode("ascii"))
         handle.write(encoded)
         handle.write(b"</script>\n")
-    handle.write(f"<script>\n{_script()}\n</script>\n</body>\n</html>\n".encode("utf-8"))
+    handle.write(f"<script>\n{_script()}\n</script>\n</body>\n</html>\n".encode())
 
 
 def read_page_data(path) -> tuple[dict, dict[str, np.ndarray]]:

@@ -114,7 +114,8 @@ from __future__ import annotations
 
 import logging
 import warnings
-from typing import Callable, NamedTuple
+from typing import NamedTuple
+from collections.abc import Callable
 
 import numpy as np
 

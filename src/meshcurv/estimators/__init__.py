@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from collections.abc import Callable
 
 from . import icc, matgeom, meyer, normal_cycle, normal_cycle_ball, quadric, rusinkiewicz
 
