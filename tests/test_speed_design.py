@@ -100,8 +100,20 @@ def test_connected_jets_leave_out_the_other_sheet_and_unlisted_vertices():
     np.testing.assert_array_equal(both, (inside & neighbours[None, :]).sum(axis=1))
 
 
-def test_fit_jet_normals_refuses_adjacency_of_another_mesh():
+@pytest.mark.parametrize("function", [fit_jet_normals, fit_jets])
+def test_adjacency_of_another_mesh_is_refused(function):
     vertices, _, topology, h = _irregular_sphere()
     indptr, indices = topology.neighbour_lists
     with use_backend("numba"), pytest.raises(ValueError, match="`adjacency` must be CSR lists of"):
-        fit_jet_normals(vertices, vertices, 3 * h, adjacency=(indptr[:-1], indices))
+        function(vertices, vertices, 3 * h, adjacency=(indptr[:-1], indices))
+
+
+@pytest.mark.parametrize(("option", "match"), [("normals", "`normals` must have shape"),
+                                               ("neighbours", "`neighbours` must have shape")])
+def test_fit_jet_normals_refuses_arrays_of_another_size(option, match):
+    vertices, _, topology, h = _irregular_sphere()
+    arguments = {"normals": vertices, "neighbours": np.ones(vertices.shape[0], dtype=bool)}
+    arguments[option] = arguments[option][:-1]
+    with use_backend("numba"), pytest.raises(ValueError, match=match):
+        fit_jet_normals(vertices, arguments["normals"], 3 * h, neighbours=arguments["neighbours"],
+                        adjacency=topology.neighbour_lists)

@@ -23,6 +23,12 @@ vectorized (no Python loop over vertices, edges or faces). With numba, the
 face and edge sums (and the jet fits of :mod:`meshcurv.estimators.quadric`)
 run on a grid of cells at least as wide as the ball instead, in compiled
 kernels that find the same points (tests/test_backends.py compares the two).
+A mesh's balls can also be walked breadth-first from their centre over the
+mesh itself (``connected=True`` here, ``adjacency=`` of the jet fits; what
+``icc`` does): no search structure over the whole mesh, and the same ball
+wherever the surface inside it is connected, another sheet of the surface
+within the ball left out (tests/test_speed_design.py). The same walk over a
+k-nearest-neighbour graph would serve point clouds.
 """
 
 from __future__ import annotations

@@ -49,6 +49,15 @@ tangent planes turn inside the ball), several times larger than that of
 Boundaries need no special case beyond the fitted normals: the measures and
 the corrected area both stop at the boundary, so boundary vertices are valid.
 
+With the compiled kernels every ball (of the normal fits and of the sums) is
+the piece of the Euclidean ball connected to its vertex on the mesh, walked
+breadth-first over the edges and faces that meet it (``adjacency=`` of
+:func:`~meshcurv.estimators.quadric.fit_jets`, ``connected=`` of
+:func:`~meshcurv.neighborhoods.ball_face_sums`): the Euclidean ball wherever
+the surface inside it is connected, without a search structure over the whole
+mesh; a ball that reaches another sheet of the surface (the far side of a part
+thinner than the ball) leaves it out. The NumPy path searches Euclidean balls.
+
 References
 ----------
 F. Cazals and M. Pouget (2005). Estimating differential quantities using
