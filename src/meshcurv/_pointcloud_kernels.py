@@ -26,6 +26,8 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
     out = np.zeros((m, 9))
     for row in nb.prange(m):
         c = counts[row]
+        # sums in registers, written once per row
+        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = 0.0
         for t in range(pattern.shape[0]):
             a = int(np.floor(pattern[t, 0] * c))
             b = int(np.floor(pattern[t, 1] * (c - 1)))
@@ -49,24 +51,27 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
                 ax, ay, az, bx, by, bz = bx, by, bz, ax, ay, az
                 u1x, u1y, u1z, u2x, u2y, u2z = u2x, u2y, u2z, u1x, u1y, u1z
                 cx, cy, cz = -cx, -cy, -cz
-            out[row, 0] += 0.5 * (mx * cx + my * cy + mz * cz)
+            s0 += 0.5 * (mx * cx + my * cy + mz * cz)
             px, py, pz = u0x - u2x, u0y - u2y, u0z - u2z
             qx, qy, qz = u1x - u0x, u1y - u0y, u1z - u0z
             sx = (py * az - pz * ay) + (qy * bz - qz * by)
             sy = (pz * ax - px * az) + (qz * bx - qx * bz)
             sz = (px * ay - py * ax) + (qx * by - qy * bx)
-            out[row, 1] += 0.5 * (mx * sx + my * sy + mz * sz)
-            out[row, 2] += 0.5 * (u0x * (u1y * u2z - u1z * u2y) + u0y * (u1z * u2x - u1x * u2z)
+            s1 += 0.5 * (mx * sx + my * sy + mz * sz)
+            s2 += 0.5 * (u0x * (u1y * u2z - u1z * u2y) + u0y * (u1z * u2x - u1x * u2z)
                                   + u0z * (u1x * u2y - u1y * u2x))
             gx, gy, gz = ay * mz - az * my, az * mx - ax * mz, ax * my - ay * mx
             hx, hy, hz = by * mz - bz * my, bz * mx - bx * mz, bx * my - by * mx
             ex, ey, ez = u2x - u0x, u2y - u0y, u2z - u0z
-            out[row, 3] += 0.5 * (gx * ex - hx * qx)
-            out[row, 4] += 0.5 * (gy * ey - hy * qy)
-            out[row, 5] += 0.5 * (gz * ez - hz * qz)
-            out[row, 6] += 0.25 * ((gx * ey - hx * qy) + (gy * ex - hy * qx))
-            out[row, 7] += 0.25 * ((gx * ez - hx * qz) + (gz * ex - hz * qx))
-            out[row, 8] += 0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy))
+            s3 += 0.5 * (gx * ex - hx * qx)
+            s4 += 0.5 * (gy * ey - hy * qy)
+            s5 += 0.5 * (gz * ez - hz * qz)
+            s6 += 0.25 * ((gx * ey - hx * qy) + (gy * ex - hy * qx))
+            s7 += 0.25 * ((gx * ez - hx * qz) + (gz * ex - hz * qx))
+            s8 += 0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy))
+        out[row, 0], out[row, 1], out[row, 2] = s0, s1, s2
+        out[row, 3], out[row, 4], out[row, 5] = s3, s4, s5
+        out[row, 6], out[row, 7], out[row, 8] = s6, s7, s8
     return out
 
 
@@ -146,15 +151,16 @@ def _first_at_least(keys, key):
 
 
 @nb.njit(parallel=True, **_JIT)
-def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool):
+def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool, pool_points):
     """(M, k) the ``k`` nearest points of ``pool`` closer than ``radius`` to each centre, (M, k) their
     squared distances (inf past the count) and (M,) their count.
 
     The pool's points are sorted by the cell of a grid of side ``radius``
     (``keys``: the sorted distinct cell numbers ``(x dims_y + y) dims_z + z``,
     ``starts``: where each cell's run begins in ``pool``, one more entry at the
-    end); each centre looks in the 27 cells around its own (nine runs of
-    three consecutive cells along z, each found by bisection). Rows are in
+    end; ``pool_points``: their coordinates in that order, read in sequence);
+    each centre looks in the 27 cells around its own (nine runs of three
+    consecutive cells along z, each found by bisection). Rows are in
     distance order (equal distances: lower index first), padded with
     ``points.shape[0]`` as :meth:`scipy.spatial.cKDTree.query` does.
     """
@@ -178,11 +184,11 @@ def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool):
                 first = _first_at_least(keys, column + max(gz - 1, 0))
                 last = _first_at_least(keys, column + min(gz + 1, dims[2] - 1) + 1)
                 for t in range(starts[first], starts[last]):
-                    q = pool[t]
-                    dx, dy, dz = points[q, 0] - px, points[q, 1] - py, points[q, 2] - pz
+                    dx, dy, dz = pool_points[t, 0] - px, pool_points[t, 1] - py, pool_points[t, 2] - pz
                     d = dx * dx + dy * dy + dz * dz
                     if not d < limit:
                         continue
+                    q = pool[t]
                     if found == k and (d > squared[row, k - 1] or (d == squared[row, k - 1]
                                                                    and q > index[row, k - 1])):
                         continue

@@ -83,7 +83,7 @@ def _drop_self(rows, d, i, k, distances, indices) -> None:
 
 
 def grid_of(points, usable, side):
-    """``(low, dims, keys, starts, pool)``: the usable points sorted by the cell of a grid of ``side``.
+    """``(low, dims, keys, starts, pool, pool_points)``: the usable points by cell of a grid of ``side``.
 
     The input of :func:`meshcurv._pointcloud_kernels.ball_indices`. None when
     the grid's cell numbers would not fit in an int64 (a side below about
@@ -100,7 +100,8 @@ def grid_of(points, usable, side):
     keys = keys[order]
     first = np.flatnonzero(np.concatenate([[True], keys[1:] != keys[:-1]]))
     starts = np.append(first, keys.size).astype(np.int64)
-    return low, dims, keys[first], starts, pool[order]
+    pool = pool[order]
+    return low, dims, keys[first], starts, pool, np.ascontiguousarray(points[pool])
 
 
 def local_spacing(distances: np.ndarray) -> np.ndarray:
