@@ -91,10 +91,12 @@ def grid_of(points, usable, side):
     """
     pool = np.flatnonzero(usable)
     low = points[pool].min(axis=0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        span = np.floor((points[pool].max(axis=0) - low) / side) + 1
+        if not float(np.prod(span)) < 2.0**62:  # also inf and NaN
+            return None
     cells = np.floor((points[pool] - low) / side).astype(np.int64)
     dims = cells.max(axis=0) + 1
-    if float(np.prod(dims.astype(float))) >= 2.0**62:
-        return None
     keys = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]
     order = np.argsort(keys)
     keys = keys[order]

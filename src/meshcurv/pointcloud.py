@@ -268,8 +268,12 @@ def _spatial_order(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     n = points.shape[0]
     low = points.min(axis=0)
-    extent = float((points.max(axis=0) - low).max())
-    scale = (2.0**MORTON_BITS - 1) / extent if extent > 0 else 0.0
+    with np.errstate(over="ignore"):
+        extent = float((points.max(axis=0) - low).max())
+        scale = (2.0**MORTON_BITS - 1) / extent if extent > 0 else 0.0
+    if not (np.isfinite(extent) and np.isfinite(scale) and scale > 0):
+        # a cloud beyond float64's range or of one point repeated: the input's order, every point compared
+        return np.arange(n), _representatives(points)
     cells = np.minimum(((points - low) * scale).astype(np.uint64), np.uint64(2**MORTON_BITS - 1))
     code = np.zeros(n, dtype=np.uint64)
     for axis in range(3):
