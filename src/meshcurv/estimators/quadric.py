@@ -154,29 +154,29 @@ def _cholesky_solve(matrix: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, 
     the same operations in the same order.
     """
     n, m = right.shape
-    low = np.zeros_like(matrix)
+    low = np.zeros_like(matrix)  # the factor below the diagonal, the inverse of each pivot's root on it
     ok = np.ones(n, dtype=bool)
     for k in range(m):
         d = matrix[:, k, k].copy()
         for j in range(k):
             d -= low[:, k, j] * low[:, k, j]
         ok &= d > MIN_PIVOT
-        root = np.sqrt(np.where(ok, d, 1.0))
-        low[:, k, k] = root
+        inverse = 1.0 / np.sqrt(np.where(ok, d, 1.0))
+        low[:, k, k] = inverse
         for i in range(k + 1, m):
             t = matrix[:, i, k].copy()
             for j in range(k):
                 t -= low[:, i, j] * low[:, k, j]
-            low[:, i, k] = t / root
+            low[:, i, k] = t * inverse
     x = right.copy()
     for i in range(m):
         for j in range(i):
             x[:, i] -= low[:, i, j] * x[:, j]
-        x[:, i] /= low[:, i, i]
+        x[:, i] *= low[:, i, i]
     for i in range(m - 1, -1, -1):
         for j in range(i + 1, m):
             x[:, i] -= low[:, j, i] * x[:, j]
-        x[:, i] /= low[:, i, i]
+        x[:, i] *= low[:, i, i]
     return x, ok
 
 
