@@ -88,7 +88,7 @@ def one_sided_fits(points, normals, radius, centres, usable, *, smallest: float 
     return coefficients, frame, radii
 
 
-def jets(points, normals, radius, centres, usable, *, smallest: float | None = None):
+def jets(points, normals, radius, centres, usable, *, smallest: float | None = None, details: dict | None = None):
     """Principal curvatures of jets fitted over balls of ``radius`` around ``centres``.
 
     Where a ball holds the other side of the surface its fit is redone over a
@@ -96,9 +96,12 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
     unchecked fit over ``radius``, as for a radius the user chose).
     Returns ``(k_min, k_max, dir_min, dir_max, normals)`` at every point, NaN
     where the fit failed and at points not in ``centres``; ``normals`` are those
-    of the fitted jets (the given ones where the fit failed).
+    of the fitted jets (the given ones where the fit failed). ``details``
+    receives ``"radii"``: (N,) the radius of each point's fit.
     """
     coefficients, frame, radii = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest)
+    if details is not None:
+        details["radii"] = radii
     six, fitted = shape_operators(coefficients, frame, 1.0)
     with np.errstate(invalid="ignore"):
         six = six / radii[:, None]
@@ -111,15 +114,18 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
     return k_min, k_max, dir_min, dir_max, out_normals
 
 
-def fitted_normals(points, normals, radius, centres, usable, *, smallest: float):
+def fitted_normals(points, normals, radius, centres, usable, *, smallest: float, details: dict | None = None):
     """(N, 3) normals of degree-3 jets over balls of ``radius`` (``normals`` kept where a fit fails).
 
     Where a ball holds the other side of the surface (a part thinner than the
     ball) the fit is redone over a smaller one, down to ``smallest``
-    (:func:`one_sided_fits`).
+    (:func:`one_sided_fits`); ``details`` receives ``"radii"``, (N,) the
+    radius of each point's fit.
     """
-    coefficients, frame, _ = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest,
-                                            degree=3, iterations=2)
+    coefficients, frame, radii = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest,
+                                                degree=3, iterations=2)
+    if details is not None:
+        details["radii"] = radii
     fitted = jet_normals(coefficients, frame)
     ok = np.isfinite(fitted).all(axis=1)
     return np.where(ok[:, None], fitted, normals)

@@ -162,8 +162,10 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         ``k_min, k_max, dir_min, dir_max, normals, valid`` per point and
         ``invalid_reason``; ``parameters`` holds ``radius`` (and ``radii`` per
         density class), ``spacing``, ``noise``, ``normal_radius`` (measures
-        with estimated normals) and ``normals`` (``"given"``,
-        ``"given, reoriented"`` or ``"estimated"``). ``normals`` are those
+        with estimated normals), ``shrunk`` (the share of points whose jet
+        fit, of the normals or of ``"jets"``, took a smaller ball than asked
+        for because the ball held the other side of a thin part) and
+        ``normals`` (``"given"``, ``"given, reoriented"`` or ``"estimated"``). ``normals`` are those
         the curvatures refer to: the fitted jets' (``"jets"``), or the
         oriented ones used by the measures (``"corrected_measures"``).
 
@@ -382,23 +384,32 @@ def _compute(points, given, radius, method):
     out_normals = start.copy()
     logger.info("point cloud: %s over %d radius class(es)", method, len(groups))
     parameters = {"radius": groups[0][0], "spacing": median, "noise": noise, "normals": how}
+    shrunk = 0  # points whose jet fit took a smaller ball than asked for (its ball held the other side)
     for group_radius, group_spacing, members in groups:
+        details = {}
         if method == "jets":
             # a default ball that holds the other side of a thin part shrinks, down to the clean-sample radius
             smallest = None if radius is not None else min(group_radius, RADIUS_RULES[method][0] * group_spacing)
-            found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest)
+            found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest,
+                                     details=details)
+            asked = group_radius
         else:
             if given is None:
-                normal_radius = _rule(_estimators.NORMAL_RULE, group_spacing, noise)
+                asked = normal_radius = _rule(_estimators.NORMAL_RULE, group_spacing, noise)
                 normals = _estimators.fitted_normals(points, start, normal_radius, members, usable,
-                                                     smallest=_estimators.NORMAL_RULE[0] * group_spacing)
+                                                     smallest=_estimators.NORMAL_RULE[0] * group_spacing,
+                                                     details=details)
                 parameters["normal_radius"] = normal_radius
             else:
                 normals = start
             found = _estimators.corrected_measures(tree, points, normals, group_radius, members, usable,
                                                    spacing=group_spacing)
+        if "radii" in details:
+            shrunk += int((details["radii"][members] < asked).sum())
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
             whole[members] = part[members]
+    if method == "jets" or given is None:
+        parameters["shrunk"] = shrunk / max(centres.size, 1)
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _, _ in groups)
