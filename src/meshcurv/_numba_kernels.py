@@ -1236,12 +1236,16 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
 # -- surface-connected balls (breadth-first over the mesh) -----------------------------
 @nb.njit(inline="always", **_JIT)
 def _segment_meets_ball(ax, ay, az, bx, by, bz, radius2):
-    """Whether the segment from ``a`` to ``b`` (relative to the ball's centre) has a point within the ball."""
+    """Whether the segment from ``a`` to ``b`` (relative to the ball's centre, both ends outside
+    the ball) passes through it: its closest point to the centre is inside, without a division."""
     dx, dy, dz = bx - ax, by - ay, bz - az
+    along = -(ax * dx + ay * dy + az * dz)  # the closest point is a + (along / |d|^2) d, clamped to the segment
+    if not along > 0:
+        return False  # the segment leads away from the centre: a is its closest point
     length2 = dx * dx + dy * dy + dz * dz
-    t = 0.0 if not length2 > 0 else min(max(-(ax * dx + ay * dy + az * dz) / length2, 0.0), 1.0)
-    px, py, pz = ax + t * dx, ay + t * dy, az + t * dz
-    return px * px + py * py + pz * pz <= radius2
+    if not along < length2:
+        return False  # b is its closest point
+    return (ax * ax + ay * ay + az * az) * length2 - along * along <= radius2 * length2
 
 
 @nb.njit(**_JIT)
