@@ -257,3 +257,15 @@ def spanning_signs(n, rows, cols, opposite, order):
         if f:
             signs[i] = -1.0
     return signs, roots
+
+
+@nb.njit(parallel=True, **_JIT)
+def edge_cosines(normals, indices):
+    """(N, k) the cosines ``n_i . n_j`` of each point's normal with its neighbours' (``indices`` (N, k))."""
+    n, k = indices.shape
+    out = np.zeros((n, k))
+    for i in nb.prange(n):
+        for j in range(k):
+            q = indices[i, j]
+            out[i, j] = normals[i, 0] * normals[q, 0] + normals[i, 1] * normals[q, 1] + normals[i, 2] * normals[q, 2]
+    return out

@@ -51,6 +51,13 @@ MIN_FLAT_EDGES = 3
 CHUNK = 131072
 
 
+def _pointcloud_kernels():
+    """The compiled kernels' module (imported only when the numba backend is in use)."""
+    from . import _pointcloud_kernels as module
+
+    return module
+
+
 def knn(tree, points: np.ndarray, k: int = NEIGHBOURS) -> tuple[np.ndarray, np.ndarray]:
     """(N, k) distances and indices of the ``k`` nearest other points of each point (chunked, all cores).
 
@@ -126,9 +133,7 @@ def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     on chunks of covariances.
     """
     if numba_kernels() is not None:
-        from . import _pointcloud_kernels
-
-        return kernels_of(_pointcloud_kernels).pca_normals(points, np.ascontiguousarray(indices))
+        return kernels_of(_pointcloud_kernels()).pca_normals(points, np.ascontiguousarray(indices))
     return _pca_normals_numpy(points, indices)
 
 
@@ -209,13 +214,15 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
         back_to_back = (ahead < 0) & (behind > 0) & (np.einsum("ij,ij->i", normals[rows], normals[cols]) < 0)
         keep = flat | (~enough[rows] & ~back_to_back)
         rows, cols = rows[keep], cols[keep]
-    cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
+    compiled = None if numba_kernels() is None else kernels_of(_pointcloud_kernels())
+    if compiled is not None and points is None:  # every kept edge's cosine without (E, 3) gathers
+        cosine = compiled.edge_cosines(normals, np.ascontiguousarray(indices)).ravel()[keep]
+    else:
+        cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
     # weight 1 - |cos| (1 - cos for given signs), plus a floor so that parallel pairs stay edges of the sparse graph
     weights = (1.0 - cosine if given else 1.0 - np.abs(cosine)) + 1e-6
-    if numba_kernels() is not None:
-        from . import _pointcloud_kernels
-
-        signs, roots = kernels_of(_pointcloud_kernels).spanning_signs(
+    if compiled is not None:
+        signs, roots = compiled.spanning_signs(
             n, rows, cols, (cosine < 0).astype(np.int8), np.argsort(weights))
         return signs, np.unique(roots, return_inverse=True)[1].reshape(-1)
     graph = coo_matrix((weights, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
