@@ -375,13 +375,17 @@ def prefault(nbytes: int) -> None:
         del block
 
 
-def time_calls(call, repeats: int, long: float, budget: float) -> list:
+def time_calls(call, repeats: int, long: float, budget: float, cpu: list | None = None) -> list:
+    """Wall seconds of up to ``repeats`` calls; the CPU seconds of each (all threads) appended to ``cpu``."""
     times = []
     spent = 0.0
     for _ in range(repeats):
+        c0 = time.process_time()
         t0 = time.perf_counter()
         call()
         dt = time.perf_counter() - t0
+        if cpu is not None:
+            cpu.append(time.process_time() - c0)
         times.append(dt)
         spent += dt
         if dt > long or spent > budget:
@@ -398,15 +402,17 @@ def worker(args) -> int:
         import meshcurv  # noqa: F401 - the import is part of a user's process
     call = make_call(args.impl, v, f)
     base_rss, base_peak = current_rss(), peak_rss()
+    c0 = time.process_time()
     t0 = time.perf_counter()
     call()
     first = time.perf_counter() - t0
+    cpu = [time.process_time() - c0]
     peak = peak_rss()
     times = [first]
     if args.repeats > 1 and first <= args.long:
-        times += time_calls(call, args.repeats - 1, args.long, args.budget)
-    print("RESULT " + json.dumps({"first": first, "times": times, "peak_rss": peak, "base_rss": base_rss,
-                                  "base_peak": base_peak}), flush=True)
+        times += time_calls(call, args.repeats - 1, args.long, args.budget, cpu)
+    print("RESULT " + json.dumps({"first": first, "times": times, "cpu": cpu, "peak_rss": peak,
+                                  "base_rss": base_rss, "base_peak": base_peak}), flush=True)
     return 0
 
 
@@ -604,21 +610,22 @@ class Bench:
             elif "error" in res:
                 row["error"] = res["error"]
             else:
-                row.update(times=res["times"], first_fresh=res["first"], peak_rss=res["peak_rss"],
-                           base_rss=res["base_rss"], where="child")
+                row.update(times=res["times"], cpu=res.get("cpu", []), first_fresh=res["first"],
+                           peak_rss=res["peak_rss"], base_rss=res["base_rss"], where="child")
                 self.record(key, n, min(res["times"]))
             log(f"  {row['label']}: {summary(row)}")
             return row
         try:
             call = make_call(key, v, f)
             prefault(touch)
-            times = time_calls(call, repeats, args.long, budget * max(repeats, 1))
+            cpu = []
+            times = time_calls(call, repeats, args.long, budget * max(repeats, 1), cpu)
             del call
         except Exception as exc:  # noqa: BLE001 - a failing implementation is a result
             row["error"] = f"{type(exc).__name__}: {exc}"[:300]
             log(f"  {row['label']}: {row['error']}")
             return row
-        row.update(times=times, where="in-process")
+        row.update(times=times, cpu=cpu, where="in-process")
         self.record(key, n, min(times))
         if memory and args.memory:
             prefault(touch)
@@ -816,7 +823,9 @@ def markdown(bench) -> str:
         "process after the call (interpreter, libraries and the input arrays included); bytes/vertex = peak "
         "RSS / V. `÷ lower` = time / lower bound; `÷ default` = time / meshcurv's default method "
         f"({bench.default_method}, default backend); `libigl ÷`, `VTK ÷`, `trueform ÷` = their time / this time (how many times "
-        "faster than them; trueform: `principal_curvatures(k=2, directions=True)`). "
+        "faster than them; trueform: `principal_curvatures(k=2, directions=True)`). `CPU s`: median of the "
+        "process CPU seconds of the same calls (all threads; the work done, whatever the other jobs on the "
+        "machine take of its cores), `CPU: trueform ÷` = trueform's CPU seconds / this row's. "
         f"Budget: {args.budget:.0f} s per call (trimesh {args.trimesh_budget:.0f} s); 'est.' = linear "
         "extrapolation from the previous size, not run.",
         "",
@@ -868,6 +877,11 @@ def markdown(bench) -> str:
             need = TARGETS["vs_trueform"] if method == bench.default_method else TARGETS["vs_trueform_ring"]
             lines.append(f"| {method} >= {need:g}x as fast as trueform (k=2, directions) at 1M | "
                          f"trueform ÷ meshcurv = {fmt_ratio(r)} | {met(None if r is None else r >= need)} |")
+            mine, theirs = find(one_m, key), find(one_m, TRUEFORM)
+            if mine and theirs and mine.get("cpu") and theirs.get("cpu"):
+                r = ratio(statistics.median(theirs["cpu"]), statistics.median(mine["cpu"]))
+                lines.append(f"| the same in CPU seconds (load-independent) | trueform ÷ meshcurv = {fmt_ratio(r)} | "
+                             f"{met(None if r is None else r >= need)} |")
             r = ratio(tm, lb)
             lines.append(f"| {method} within 10x of the lower bound at 1M ({fmt_s(lb)} s) | {fmt_ratio(r)} | "
                          f"{met(None if r is None else r <= TARGETS['vs_lower'])} |")
@@ -910,27 +924,31 @@ def markdown(bench) -> str:
         lb = t(label, "lower_bound")
         ref = t(label, bench.default_key)
         igl_t, vtk_t, tf_t = t(label, "libigl"), t(label, "vtk"), t(label, TRUEFORM)
+        tf_row = find(label, TRUEFORM)
+        tf_cpu = statistics.median(tf_row["cpu"]) if tf_row and tf_row.get("cpu") else None
         lines += [f"## {label}: {name}, {n:,} vertices, {n_faces:,} faces", "",
-                  "| implementation | median s | runs | fresh s | peak RSS MiB | bytes/vertex | ÷ lower | "
-                  "÷ default | libigl ÷ | VTK ÷ | trueform ÷ |",
-                  "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
+                  "| implementation | median s | CPU s | runs | fresh s | peak RSS MiB | bytes/vertex | ÷ lower | "
+                  "÷ default | libigl ÷ | VTK ÷ | trueform ÷ | CPU: trueform ÷ |",
+                  "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
         for row in bench.rows[label]:
             key = row["key"]
             if "skipped" in row or "error" in row:
                 what = row.get("skipped") or "error: " + row["error"]
-                lines.append(f"| {row['label']} | {what} | | | | | | | | | |")
+                lines.append(f"| {row['label']} | {what} | | | | | | | | | | | |")
                 continue
             tm = median(row)
+            cpu = statistics.median(row["cpu"]) if row.get("cpu") else None
             peak = row.get("peak_rss")
             is_mc = key.startswith("meshcurv/")
             cells = [row["label"] + (" (child process)" if row.get("where") == "child" else ""),
-                     fmt_s(tm), str(len(row["times"])), fmt_s(row.get("first_fresh")),
+                     fmt_s(tm), fmt_s(cpu), str(len(row["times"])), fmt_s(row.get("first_fresh")),
                      f"{peak / MIB:.0f}" if peak else "—", f"{peak / n:.0f}" if peak else "—",
                      fmt_ratio(ratio(tm, lb)) if key != "lower_bound" else "1x",
                      fmt_ratio(ratio(tm, ref)),
                      fmt_ratio(ratio(igl_t, tm)) if is_mc else "",
                      fmt_ratio(ratio(vtk_t, tm)) if is_mc else "",
-                     fmt_ratio(ratio(tf_t, tm)) if is_mc else ""]
+                     fmt_ratio(ratio(tf_t, tm)) if is_mc else "",
+                     fmt_ratio(ratio(tf_cpu, cpu)) if is_mc else ""]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
 
