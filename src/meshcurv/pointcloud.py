@@ -385,6 +385,7 @@ def _compute(points, given, radius, method):
     logger.info("point cloud: %s over %d radius class(es)", method, len(groups))
     parameters = {"radius": groups[0][0], "spacing": median, "noise": noise, "normals": how}
     shrunk = 0  # points whose jet fit took a smaller ball than asked for (its ball held the other side)
+    two_sided = 0  # points whose every ball held the other side (or too few points)
     for group_radius, group_spacing, members in groups:
         details = {}
         if method == "jets":
@@ -405,11 +406,17 @@ def _compute(points, given, radius, method):
             found = _estimators.corrected_measures(tree, points, normals, group_radius, members, usable,
                                                    spacing=group_spacing)
         if "radii" in details:
-            shrunk += int((details["radii"][members] < asked).sum())
+            fitted_radii = details["radii"][members]
+            shrunk += int((fitted_radii < asked).sum())
+            two_sided += int(np.isnan(fitted_radii).sum())
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
             whole[members] = part[members]
     if method == "jets" or given is None:
         parameters["shrunk"] = shrunk / max(centres.size, 1)
+    if two_sided:
+        what = "curvatures NaN" if method == "jets" else "normals from the PCA of 10 neighbours"
+        problems.append(f"{two_sided} points have no one-sided jet fit (every ball down to 3-4 spacings held "
+                        f"points facing the other way: a part thinner than that, or too few points): {what}")
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _, _ in groups)
