@@ -259,6 +259,9 @@ def test_compiled_ball_search_matches_the_k_d_tree():
             estimators._usable_tree(cKDTree(points), points, usable), points, centres, radius, k)
         np.testing.assert_array_equal(index, expected)
         np.testing.assert_array_equal(counts, expected_counts)
+        # without the table of columns (a sparse grid): bisection over all the cells, the same rows
+        unindexed = ball_indices(points, centres, radius, k, *grid[:-1], np.array([0, grid[2].size]))
+        np.testing.assert_array_equal(unindexed[0], expected)
         assert usable[index[index < 3000]].all() and (counts == k).any() and (counts < k).any()
         inside = np.isfinite(squared)
         assert np.allclose(squared[inside], np.sum((points[index[inside]] - points[np.repeat(centres, counts)])**2,

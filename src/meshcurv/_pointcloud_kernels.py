@@ -137,10 +137,15 @@ def pca_normals(points, indices):
     return out
 
 
+#: The nine columns around a cell, nearest first (the points of a ball then arrive roughly in distance
+#: order and most insertions into the sorted row move few entries).
+_AROUND_X = (0, -1, 1, 0, 0, -1, -1, 1, 1)
+_AROUND_Y = (0, 0, 0, -1, 1, -1, 1, -1, 1)
+
+
 @nb.njit(**_JIT)
-def _first_at_least(keys, key):
-    """Position of the first of the sorted ``keys`` that is ``>= key`` (``keys.size`` when none is)."""
-    lo, hi = 0, keys.shape[0]
+def _first_at_least(keys, key, lo, hi):
+    """Position of the first of the sorted ``keys[lo:hi]`` that is ``>= key`` (``hi`` when none is)."""
     while lo < hi:
         mid = (lo + hi) // 2
         if keys[mid] < key:
@@ -151,16 +156,18 @@ def _first_at_least(keys, key):
 
 
 @nb.njit(parallel=True, **_JIT)
-def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool, pool_points):
+def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool, pool_points, columns):
     """(M, k) the ``k`` nearest points of ``pool`` closer than ``radius`` to each centre, (M, k) their
     squared distances (inf past the count) and (M,) their count.
 
     The pool's points are sorted by the cell of a grid of side ``radius``
     (``keys``: the sorted distinct cell numbers ``(x dims_y + y) dims_z + z``,
     ``starts``: where each cell's run begins in ``pool``, one more entry at the
-    end; ``pool_points``: their coordinates in that order, read in sequence);
+    end; ``pool_points``: their coordinates in that order, read in sequence;
+    ``columns``: where the keys of each column ``x dims_y + y`` begin, one
+    more entry at the end, or ``[0, keys.size]`` for one column of all);
     each centre looks in the 27 cells around its own (nine runs of three
-    consecutive cells along z, each found by bisection). Rows are in
+    consecutive cells along z, each found by bisection in its column). Rows are in
     distance order (equal distances: lower index first), padded with
     ``points.shape[0]`` as :meth:`scipy.spatial.cKDTree.query` does.
     """
@@ -177,32 +184,39 @@ def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool, pool
         gy = int(np.floor((py - low[1]) / radius))
         gz = int(np.floor((pz - low[2]) / radius))
         found = 0
-        for x in range(max(gx - 1, 0), min(gx + 2, dims[0])):
-            for y in range(max(gy - 1, 0), min(gy + 2, dims[1])):
-                # the (up to) three cells along z are consecutive numbers: one run of the pool
-                column = (x * dims[1] + y) * dims[2]
-                first = _first_at_least(keys, column + max(gz - 1, 0))
-                last = _first_at_least(keys, column + min(gz + 1, dims[2] - 1) + 1)
-                for t in range(starts[first], starts[last]):
-                    dx, dy, dz = pool_points[t, 0] - px, pool_points[t, 1] - py, pool_points[t, 2] - pz
-                    d = dx * dx + dy * dy + dz * dz
-                    if not d < limit:
-                        continue
-                    q = pool[t]
-                    if found == k and (d > squared[row, k - 1] or (d == squared[row, k - 1]
-                                                                   and q > index[row, k - 1])):
-                        continue
-                    # insert in order, dropping the last when full
-                    j = found if found < k else k - 1
-                    while j > 0 and (squared[row, j - 1] > d or (squared[row, j - 1] == d
-                                                                 and index[row, j - 1] > q)):
-                        squared[row, j] = squared[row, j - 1]
-                        index[row, j] = index[row, j - 1]
-                        j -= 1
-                    squared[row, j] = d
-                    index[row, j] = q
-                    if found < k:
-                        found += 1
+        for step in range(9):  # the centre's column first, then its sides, then its corners
+            x, y = gx + _AROUND_X[step], gy + _AROUND_Y[step]
+            if x < 0 or y < 0 or x >= dims[0] or y >= dims[1]:
+                continue
+            # the (up to) three cells along z are consecutive numbers: one run of the pool
+            column = x * dims[1] + y
+            if columns.shape[0] > 2:
+                lo, hi = columns[column], columns[column + 1]
+            else:
+                lo, hi = columns[0], columns[1]
+            column *= dims[2]
+            first = _first_at_least(keys, column + max(gz - 1, 0), lo, hi)
+            last = _first_at_least(keys, column + min(gz + 1, dims[2] - 1) + 1, first, hi)
+            for t in range(starts[first], starts[last]):
+                dx, dy, dz = pool_points[t, 0] - px, pool_points[t, 1] - py, pool_points[t, 2] - pz
+                d = dx * dx + dy * dy + dz * dz
+                if not d < limit:
+                    continue
+                q = pool[t]
+                if found == k and (d > squared[row, k - 1] or (d == squared[row, k - 1]
+                                                               and q > index[row, k - 1])):
+                    continue
+                # insert in order, dropping the last when full
+                j = found if found < k else k - 1
+                while j > 0 and (squared[row, j - 1] > d or (squared[row, j - 1] == d
+                                                             and index[row, j - 1] > q)):
+                    squared[row, j] = squared[row, j - 1]
+                    index[row, j] = index[row, j - 1]
+                    j -= 1
+                squared[row, j] = d
+                index[row, j] = q
+                if found < k:
+                    found += 1
         counts[row] = found
     return index, squared, counts
 

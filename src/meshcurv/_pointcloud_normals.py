@@ -47,6 +47,10 @@ TANGENT_SLOPE = 0.25
 #: A point keeps its steep edges (except back-to-back ones) when fewer than this many of its edges are flat.
 MIN_FLAT_EDGES = 3
 
+#: The grid of the balls (:func:`grid_of`) indexes its columns (x, y) when they are at most this many times
+#: its occupied cells (a surface's grid has about as many columns as cells; a sparse one far more).
+GRID_COLUMNS = 8
+
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
 
@@ -90,7 +94,7 @@ def _drop_self(rows, d, i, k, distances, indices) -> None:
 
 
 def grid_of(points, usable, side):
-    """``(low, dims, keys, starts, pool, pool_points)``: the usable points by cell of a grid of ``side``.
+    """``(low, dims, keys, starts, pool, pool_points, columns)``: the usable points by cell of a grid.
 
     The input of :func:`meshcurv._pointcloud_kernels.ball_indices`. None when
     the grid's cell numbers would not fit in an int64 (a side below about
@@ -110,7 +114,13 @@ def grid_of(points, usable, side):
     first = np.flatnonzero(np.concatenate([[True], keys[1:] != keys[:-1]]))
     starts = np.append(first, keys.size).astype(np.int64)
     pool = pool[order]
-    return low, dims, keys[first], starts, pool, np.ascontiguousarray(points[pool])
+    keys = keys[first]
+    n_columns = int(dims[0] * dims[1])
+    if n_columns <= GRID_COLUMNS * max(keys.size, 1):
+        columns = np.searchsorted(keys, np.arange(n_columns + 1, dtype=np.int64) * dims[2]).astype(np.int64)
+    else:  # a sparse grid: bisection over all the keys
+        columns = np.array([0, keys.size], dtype=np.int64)
+    return low, dims, keys, starts, pool, np.ascontiguousarray(points[pool]), columns
 
 
 def local_spacing(distances: np.ndarray) -> np.ndarray:
