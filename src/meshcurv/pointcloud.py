@@ -38,8 +38,8 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
      triangles among the points of the ball, their interpolated corrected
      measures with the point normals (:func:`meshcurv.estimators.icc.face_measures`)
      summed, ``H = mu_1 / 2 mu_0``, ``K = mu_2 / mu_0``; the normals, when
-     not given, are those of degree-3 jets over ``s (4 + 55 sqrt(max(nu -
-     0.005, 0)))``, or over the largest smaller ball (down to ``4 s``, steps
+     not given, are those of degree-3 jets (one fit, in the frame of the PCA
+     normal) over ``s (4 + 55 sqrt(max(nu - 0.005, 0)))``, or over the largest smaller ball (down to ``4 s``, steps
      of ``sqrt(2)``) that holds one side of the surface only (no more than
      5% of its points with normals facing away): a part thinner than the ball
      (a flat ellipsoid's two faces, a thin tube) or a rim sharper than it is
