@@ -36,7 +36,7 @@ NORMAL_RULE = (4.0, 55.0)
 #: Fits per point of the normals of ``corrected_measures`` (:func:`fitted_normals`): one, in the frame of
 #: the PCA normal. A second fit in the frame of the first one's normal (as ``"jets"`` does) changed no
 #: median error of ``benchmarks/pointcloud.py`` by more than 0.02 points (ellipsoid, torus, saddle, noise 0
-#: to 0.2 spacings) and took a fifth of the fits' time.
+#: to 0.2 spacings) and cost 7-18% of the fits' time at 1M points (their neighbour search dominates).
 NORMAL_ITERATIONS = 1
 
 #: Centres per chunk of ``corrected_measures`` (bounds memory: chunk x TRIANGLES triangles).

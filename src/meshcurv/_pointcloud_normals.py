@@ -81,7 +81,7 @@ def knn(tree, points: np.ndarray, k: int = NEIGHBOURS) -> tuple[np.ndarray, np.n
 
 
 def _drop_self(rows, d, i, k, distances, indices) -> None:
-    """Write the (M, k + 1) neighbours ``d, i`` of the points ``rows`` into ``distances, indices`` without themselves."""
+    """Write the (M, k + 1) neighbours ``d, i`` of the points ``rows``, less each point itself, into the outputs."""
     if (i[:, 0] == rows).all():  # distinct points: each is its own nearest
         distances[rows], indices[rows] = d[:, 1:], i[:, 1:]
         return
