@@ -5,7 +5,7 @@ import pytest
 
 import meshcurv
 from meshcurv.errors import InvalidOptionError, MeshFileError
-from meshcurv.plotting import VIEWS, _camera, _Raster, plot_field, save_figure
+from meshcurv.plotting import VIEWS, _camera, _point_spacing, _Raster, plot_field, save_figure
 
 pytest.importorskip("matplotlib")
 
@@ -120,3 +120,50 @@ def test_plot_field_errors(options, message):
     with pytest.raises(InvalidOptionError, match=message):
         plot_field(torus.vertices, torus.faces, values, pixels=options.pop("pixels", 40), **options)
     plt.close("all")
+
+
+# --- point clouds: discs of each point's spacing, the nearest point per pixel ------------------------
+
+def grid_points(z, half, n):
+    u = np.linspace(-half, half, n)
+    x, y = np.meshgrid(u, u)
+    return np.column_stack([x.ravel(), y.ravel(), np.full(x.size, z)])
+
+
+def test_the_nearer_points_hide_the_farther_ones():
+    near, far = grid_points(1.0, 1.0, 41), grid_points(0.0, 2.0, 81)  # equal spacing 0.05
+    points = np.vstack([far, near])  # the far ones first: order must not matter
+    spacing = _point_spacing(points)
+    raster = _Raster.of_points(points, _camera(*VIEWS["top"]), pixels=201, spacing=spacing)
+    middle = raster.face[raster.height // 2, raster.width // 2]
+    assert middle >= len(far)  # a point of the near square
+    assert 0 <= raster.face[5, 5] < len(far)  # the corner: only the far square is there
+    from_below = _Raster.of_points(points, _camera(*VIEWS["bottom"]), pixels=201, spacing=spacing)
+    assert 0 <= from_below.face[from_below.height // 2, from_below.width // 2] < len(far)
+
+
+def test_a_sampled_sphere_covers_a_disc_of_its_radius_without_holes():
+    rng = np.random.default_rng(5)
+    points = rng.normal(size=(20000, 3))
+    points *= 2.0 / np.linalg.norm(points, axis=1, keepdims=True)  # random: clusters and holes
+    raster = _Raster.of_points(points, _camera(*VIEWS["iso"]), pixels=200, spacing=_point_spacing(points))
+    covered = raster.face >= 0
+    # the discs reach past the outline by about one spacing: a disc of radius 2 + spacing at most
+    spacing = np.sqrt(4 * np.pi * 4.0 / len(points))
+    area = covered.sum() / raster.scale**2
+    assert np.pi * 2.0**2 * 0.99 < area < np.pi * (2.0 + 2 * spacing) ** 2
+    # no hole inside the outline: every pixel within 0.9 R of the centre is covered
+    rows, columns = np.indices(covered.shape)
+    x = (columns + 0.5) / raster.scale + raster.offset[0]
+    y = (rows + 0.5) / raster.scale + raster.offset[1]
+    assert covered[np.hypot(x, y) < 1.8].all()
+
+
+def test_plot_field_of_a_point_cloud_is_shaded_by_the_given_normals():
+    rng = np.random.default_rng(6)
+    points = rng.normal(size=(3000, 3))
+    points /= np.linalg.norm(points, axis=1, keepdims=True)
+    fig = plot_field(points, None, points[:, 2], normals=points, view=["iso", "top"], label="z")
+    assert len(fig.axes) == 3
+    with pytest.raises(InvalidOptionError, match="normals"):
+        plot_field(points, None, points[:, 2], normals=points[:10])

@@ -50,10 +50,25 @@ def test_compute_writes_the_fields_of_a_point_cloud(sphere_points, tmp_path, cap
     (["-m", "icc"], "method 'icc' needs faces; .* is a point cloud"),
     (["--smoothing-steps", "2"], "--smoothing-steps is for meshes"),
 ])
-def test_mesh_options_are_refused_for_a_point_cloud(sphere_points, capsys, argv, message):
-    code, _, err = run(capsys, "compute", sphere_points, *argv)
+@pytest.mark.parametrize("command", ["compute", "plot"])
+def test_mesh_options_are_refused_for_a_point_cloud(sphere_points, capsys, argv, message, command):
+    code, _, err = run(capsys, command, sphere_points, *argv)
     assert code == 2
     assert re.search(message, err)
+
+
+def test_plot_draws_a_point_cloud(sphere_points, tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    output = tmp_path / "sphere.png"
+    code, _, err = run(capsys, "plot", sphere_points, "-o", output, "--field", "mean", "--view", "iso",
+                       "--pixels", "600")
+    assert code == 0, err
+    from matplotlib.image import imread
+
+    image = imread(output)
+    assert image.shape[1] == 600
+    # the sphere's disc is drawn in colour (the picture is not blank, white or grey)
+    assert (image[..., :3].std(axis=2) > 0.05).mean() > 0.1
 
 
 def test_a_point_cloud_method_is_refused_for_a_mesh(tmp_path, capsys):

@@ -302,15 +302,20 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
     click.echo(_summary(mesh, vertices, faces, result, fields))
 
 
-def _compute_points(path, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite,
-                    session) -> None:
-    """``meshcurv compute`` of a point cloud (a file without faces): :func:`meshcurv.point_cloud_curvatures`."""
+def _check_point_cloud_options(path, method, smoothing_steps, orient) -> None:
+    """Refuse the options of meshes for a point cloud (``method`` None when not given)."""
     if method is not None and method not in POINT_CLOUD_METHODS:
         raise click.UsageError(f"method {method!r} needs faces; {path} is a point cloud (methods: "
                                f"{', '.join(POINT_CLOUD_METHODS)})")
     for name, value in (("smoothing-steps", smoothing_steps), ("orient", orient)):
         if value is not None:
             raise click.UsageError(f"--{name} is for meshes; {path} is a point cloud")
+
+
+def _compute_points(path, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite,
+                    session) -> None:
+    """``meshcurv compute`` of a point cloud (a file without faces): :func:`meshcurv.point_cloud_curvatures`."""
+    _check_point_cloud_options(path, method, smoothing_steps, orient)
     points, normals = read_points(path)
     result = point_cloud_curvatures(points, normals=normals, radius=radius, method=method)
     if output is not None:
@@ -460,17 +465,30 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
     if output.suffix.lower() != ".png":
         raise click.BadParameter(f"the picture is a PNG; got {output.name!r}", param_hint="'-o'")
     check_output(output, overwrite=overwrite, source=mesh)
-    stages = ["read", *ESTIMATORS[method].stages, "draw"]
+    cloud = is_point_cloud(mesh)
+    given_method = context.get_parameter_source("method") != click.core.ParameterSource.DEFAULT
+    if cloud:
+        _check_point_cloud_options(mesh, method if given_method else None, smoothing_steps, orient)
+    elif method in POINT_CLOUD_METHODS:
+        raise click.UsageError(f"method {method!r} is for point clouds; {mesh} is a mesh (methods: "
+                               f"{', '.join(ESTIMATORS)})")
+    stages = ["read", *([] if cloud else ESTIMATORS[method].stages), "draw"]
     bar = session.bar(stages)
     try:
         bar("read")
-        vertices, faces = read_mesh(mesh)
-        triangles = as_faces(faces, len(vertices))
-        options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
-        result = _estimate(vertices, triangles, method, options, bar, offset=1)
+        if cloud:  # drawn as discs of about the spacing, shaded by the estimated normals
+            vertices, given_normals = read_points(mesh)
+            triangles = None
+            result = point_cloud_curvatures(vertices, normals=given_normals, radius=radius,
+                                            method=method if given_method else None)
+        else:
+            vertices, faces = read_mesh(mesh)
+            triangles = as_faces(faces, len(vertices))
+            options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
+            result = _estimate(vertices, triangles, method, options, bar, offset=1)
         bar("draw", len(stages))
         if "auto" in views:
-            closed = not MeshTopology.from_faces(triangles, len(vertices)).boundary_edges.any()
+            closed = cloud or not MeshTopology.from_faces(triangles, len(vertices)).boundary_edges.any()
             auto = ["front", "left", "back"] if closed else ["iso"]
             views = [view for name in views for view in (auto if name == "auto" else [name])]
         chosen = ""
@@ -485,7 +503,8 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
         values = curvature_fields(result, fields=[field], quality=None)[field]
         figure = plot_field(vertices, triangles, values, view=views, up=up, percentiles=percentiles, limits=limits,
                             cmap=cmap, label=f"{field}: {FIELDS[field]}", directions=strokes,
-                            dpi=dpi if dpi is not None else DEFAULT_DPI, title=f"{mesh.name}, method {result.method}")
+                            dpi=dpi if dpi is not None else DEFAULT_DPI, title=f"{mesh.name}, method {result.method}",
+                            normals=result.normals if cloud else None)
         if pixels is not None:  # exactly the width asked: the size in inches follows the rounded dpi
             width, height = figure.get_size_inches()
             figure.set_size_inches(pixels / figure.dpi, height * pixels / figure.dpi / width)

@@ -178,6 +178,58 @@ class _Raster:
         self.weights = self.weights.reshape(self.height, self.width, 3)
         self.depth = self.depth.reshape(self.height, self.width)
 
+    @classmethod
+    def of_points(cls, points, camera, *, pixels: int, spacing: np.ndarray, chunk: int = 2**22) -> _Raster:
+        """One view of a point cloud: each point a disc of its ``spacing``, the nearest one per pixel.
+
+        ``face`` holds the index of the point seen at each pixel (weights ``(1, 0, 0)``), so that
+        :meth:`interpolate` with the faces ``(i, i, i)`` reads the points' values.
+        """
+        raster = cls.__new__(cls)
+        screen = points @ camera.T
+        low, high = screen[:, :2].min(axis=0), screen[:, :2].max(axis=0)
+        span = np.maximum(high - low, 1e-12 * max(float((high - low).max()), 1e-300))
+        scale = (pixels - 2) / span.max()
+        raster.scale, raster.offset = scale, low - 1 / scale
+        raster.width, raster.height = (np.ceil(span * scale).astype(int) + 2)
+        raster.extent = (raster.offset[0], raster.offset[0] + raster.width / scale,
+                         raster.offset[1], raster.offset[1] + raster.height / scale)
+        pixel = raster.to_pixels(screen)
+        raster.depth_low = screen[:, 2].min()
+        raster.depth_step = (2**30 - 1) / max(np.ptp(screen[:, 2]), 1e-300)
+        n_pixels = raster.width * raster.height
+        depth = np.full(n_pixels, -np.inf)
+        face = np.full(n_pixels, -1)
+        centre = np.floor(pixel[:, :2]).astype(np.int64)
+        level = ((screen[:, 2] - raster.depth_low) * raster.depth_step).astype(np.int64).clip(0, 2**30 - 1)
+        radii = np.clip(np.round(2 * spacing * scale) / 2, 0.5, MAX_DISC_PIXELS)  # half-pixel steps
+        for radius in np.unique(radii):  # one disc of pixel offsets per radius class
+            reach = int(np.ceil(radius))
+            dx, dy = np.meshgrid(np.arange(-reach, reach + 1), np.arange(-reach, reach + 1))
+            keep = dx**2 + dy**2 <= radius**2 + 0.25
+            offsets = np.column_stack([dx[keep], dy[keep]])
+            members = np.flatnonzero(radii == radius)
+            step = max(1, chunk // len(offsets))
+            for start in range(0, members.size, step):  # chunks bound the memory and the keys' 23 bits
+                rows = members[start:start + step]
+                x = (centre[rows, 0][:, None] + offsets[:, 0]).ravel()
+                y = (centre[rows, 1][:, None] + offsets[:, 1]).ravel()
+                owner = np.repeat(rows, len(offsets))
+                inside = (x >= 0) & (x < raster.width) & (y >= 0) & (y < raster.height)
+                x, y, owner = x[inside], y[inside], owner[inside]
+                target = y * raster.width + x
+                best = np.full(n_pixels, -1, dtype=np.int64)
+                np.maximum.at(best, target, (level[owner] << 23) | np.arange(owner.size))
+                winner = best[best >= 0] & (2**23 - 1)
+                winner = winner[screen[owner[winner], 2] > depth[target[winner]]]
+                depth[target[winner]] = screen[owner[winner], 2]
+                face[target[winner]] = owner[winner]
+        raster.depth = depth.reshape(raster.height, raster.width)
+        raster.face = face.reshape(raster.height, raster.width)
+        raster.weights = np.zeros((raster.height, raster.width, 3))
+        raster.weights[..., 0] = 1.0
+        return raster
+
     def to_pixels(self, screen: np.ndarray) -> np.ndarray:
         """(n, 3) screen coordinates (right, up, depth) -> (n, 3) pixel x, pixel y, depth."""
         return np.column_stack([(screen[:, :2] - self.offset) * self.scale, screen[:, 2]])
@@ -294,8 +346,8 @@ def _fitted_lines(text: str, bar_height_points: float, fontsize: float) -> list[
 def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: str | None = None,
                label: str = "", percentiles: tuple[float, float] = (2.0, 98.0), limits=None,
                cmap: str | None = None, directions=None, up: str | None = None, pixels: int | None = None,
-               dpi: int = 100):
-    """Draw a triangle mesh coloured by a per-vertex field, with a colour bar.
+               dpi: int = 100, normals=None):
+    """Draw a triangle mesh (or a point cloud) coloured by a per-vertex field, with a colour bar.
 
     Vertex values are interpolated across each triangle (matGeom's
     ``drawMesh(v, f, 'VertexColor', c)``), so the seed's example is one call:
@@ -309,8 +361,10 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     Parameters
     ----------
     vertices : array_like of shape (V, 3)
-    faces : array_like of shape (F, 3) or (F, k)
+    faces : array_like of shape (F, 3) or (F, k), or None
         0-based; polygons are fan-triangulated (with a ``TriangulationWarning``).
+        None draws a point cloud: each point a disc of about its spacing (the
+        median distance to its nearest neighbour), the nearest point per pixel.
     values : array_like of shape (V,)
     ax : matplotlib Axes, optional
         A 2D axes to draw one view into; by default a new figure is made, with
@@ -351,6 +405,10 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
         Dots per inch of the figure, 10 to :data:`MAX_DPI`, which
         :func:`save_figure` keeps: a picture of one view is ``4.5 * dpi``
         pixels wide, of ``n`` views ``(3.3 n + 1.2) * dpi``.
+    normals : array_like of shape (V, 3), optional
+        Unit normals for the shading (e.g. ``result.normals``). Default: the
+        mesh's area-weighted vertex normals; a point cloud without them is
+        drawn unshaded.
 
     Returns
     -------
@@ -389,7 +447,9 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     from matplotlib.lines import Line2D
 
     points = as_vertices(vertices)
-    triangles = as_faces(faces, points.shape[0], stacklevel=3)
+    cloud = faces is None
+    triangles = np.repeat(np.arange(points.shape[0])[:, None], 3, axis=1) if cloud else \
+        as_faces(faces, points.shape[0], stacklevel=3)
     values = np.asarray(values, dtype=float)
     if values.shape != (points.shape[0],):
         raise InvalidOptionError(f"`values` must have shape ({points.shape[0]},), one per vertex; got {values.shape}")
@@ -406,13 +466,20 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     if up not in _UP:
         raise InvalidOptionError(f"`up` must be one of 'z', 'y', 'x'; got {up!r} (or None: chosen from the mesh)")
     rotation = _UP[up]
+    if normals is not None:
+        normals = np.asarray(normals, dtype=float)
+        if normals.shape != points.shape:
+            raise InvalidOptionError(f"`normals` must have shape {points.shape}, one per vertex; got {normals.shape}")
+        normals = np.where(np.isfinite(normals), normals, 0.0) @ rotation.T
     points = points @ rotation.T
     strokes = {name: field @ rotation.T for name, field in strokes.items()}
 
     low, high, signed = _colour_limits(values, percentiles, limits)
     colormap = _colormap(matplotlib, cmap, signed)
     norm = Normalize(low, high)
-    normals = _vertex_normals(points, triangles)
+    if normals is None:
+        normals = _vertex_normals(points, triangles) if not cloud else None
+    spacing = _point_spacing(points) if cloud else None
     center = (points.min(axis=0) + points.max(axis=0)) / 2
 
     if ax is None:
@@ -433,7 +500,7 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
         pixels = _auto_pixels(panel_pixels)
     for axis, (name, angles) in zip(axes, views):
         _draw_view(axis, points - center, triangles, values, normals, _camera(*angles), colormap, norm,
-                   strokes, pixels=pixels)
+                   strokes, pixels=pixels, spacing=spacing)
         if len(views) > 1:
             axis.set_title(name, fontsize=9)
     mappable = ScalarMappable(norm=norm, cmap=colormap)
@@ -499,22 +566,49 @@ def _as_directions(directions, n_vertices: int) -> dict[str, np.ndarray]:
     return out
 
 
-def _draw_view(axis, points, triangles, values, normals, camera, colormap, norm, strokes, *, pixels):
+def _point_spacing(points: np.ndarray) -> np.ndarray:
+    """(N,) the disc radius of each point: the distance to its :data:`DISC_NEIGHBOUR` th nearest neighbour.
+
+    Random samples leave holes between the nearest neighbours; the few next
+    ones close them, where the cloud is dense as where it is sparse.
+    """
+    from scipy.spatial import cKDTree
+
+    distances, _ = cKDTree(points).query(points, k=DISC_NEIGHBOUR + 1)
+    radius = distances[:, -1]
+    finite = radius[np.isfinite(radius) & (radius > 0)]
+    return np.where(np.isfinite(radius), radius, np.median(finite) if finite.size else 0.0)
+
+
+#: The disc of a point in a picture of a point cloud reaches its this-th nearest neighbour.
+DISC_NEIGHBOUR = 5
+
+#: The largest disc of a point, in pixels (a lone point far from the others stays a point).
+MAX_DISC_PIXELS = 12.0
+
+
+def _draw_view(axis, points, triangles, values, normals, camera, colormap, norm, strokes, *, pixels,
+               spacing=None):
     from matplotlib.collections import LineCollection
 
-    raster = _Raster(points, triangles, camera, pixels=pixels)
+    if spacing is None:
+        raster = _Raster(points, triangles, camera, pixels=pixels)
+    else:  # a point cloud: discs of about the spacing
+        raster = _Raster.of_points(points, camera, pixels=pixels, spacing=spacing)
     covered = raster.face >= 0
     # Gouraud shading: the light is computed at the vertices and interpolated with the values
     light = camera[2] + 0.45 * camera[1] - 0.3 * camera[0]
     light /= np.linalg.norm(light)
-    both = raster.interpolate(triangles, np.column_stack([values, np.abs(normals @ light)]))
+    shade = np.abs(normals @ light) if normals is not None else np.ones(len(points))
+    both = raster.interpolate(triangles, np.column_stack([values, shade]))
     colours = colormap(norm(np.ma.masked_invalid(both[..., 0])))
     colours[covered, :3] *= (0.45 + 0.55 * both[covered, 1])[:, None]
     colours[~covered] = 0.0
     axis.imshow(colours.clip(0, 1), origin="lower", extent=raster.extent,
                 interpolation="antialiased")
     for field, colour in zip(strokes.values(), _STROKE_COLOURS):
-        segments = _strokes(raster, points, field, camera, normals)
+        segments = _strokes(raster, points, field, camera,
+                            normals if normals is not None else np.tile(camera[2], (len(points), 1)))
         axis.add_collection(LineCollection(segments, colors=colour, linewidths=0.8, capstyle="round"))
     axis.set_xlim(*raster.extent[:2])
     axis.set_ylim(*raster.extent[2:])
