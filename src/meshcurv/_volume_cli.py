@@ -73,6 +73,7 @@ def _label_list(ctx, param, value):
 def volume_command() -> click.Command:
     """The ``meshcurv volume`` command, with the options of the ``meshcurv`` group (:mod:`meshcurv._cli_app`)."""
     from ._cli_app import SCALAR_FIELDS, MethodChoice, Session, _FLOAT_MAX, common_options
+    from .batch import MAX_WORKERS
 
     @click.command()
     @click.argument("image", type=click.Path(readable=False, path_type=pathlib.Path))
@@ -93,15 +94,20 @@ def volume_command() -> click.Command:
                   help="A picture of all objects coloured by --field (needs matplotlib).")
     @click.option("-f", "--field", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
                   help="The field of the picture.")
+    @click.option("--workers", type=click.IntRange(min=1, max=MAX_WORKERS), default=None,
+                  help="Compute the labels on a local Dask cluster of this many processes (needs "
+                       "meshcurv[batch]; default: one label after the other in this process).")
     @click.option("--overwrite", is_flag=True, help="Replace existing outputs.")
     @common_options
-    def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, picture, field, overwrite):
+    def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, picture, field, workers,
+               overwrite):
         """Curvature of every object of a 3D label image: one table row per label.
 
         \b
         meshcurv volume cells.tif -o results/ --spacing 1 0.25 0.25
         meshcurv volume brain_labels.nii.gz -o results/        spacing from the header
         meshcurv volume mask.npy -o results/ --meshes vtp --field gaussian
+        meshcurv volume cells.tif -o results/ --workers 2      labels on 2 processes
 
         IMAGE is a TIFF stack, .npy, .npz (the array 'labels', or its only array)
         or NIfTI (.nii, .nii.gz) of integer labels (0: background) or a binary
@@ -111,7 +117,9 @@ def volume_command() -> click.Command:
         energy, Euler characteristic, border flag, status), a picture
         OUTDIR/<name>_<field>.png, and with --meshes one file per label
         OUTDIR/<name>_label_<N>.<format>. Nothing is overwritten without
-        --overwrite. Exits with 1 when a label failed (its row says why).
+        --overwrite. Exits with 1 when a label failed (its row says why). With
+        --workers N the labels are computed on N processes (a label whose
+        process dies gets a failed row; the others are computed).
         """
         from . import volume as volume_module
         from .io import write_curvatures
@@ -147,7 +155,9 @@ def volume_command() -> click.Command:
             else:
                 session.info(f"{image}: voxel size {' x '.join(f'{s:g}' for s in spacing)} (z y x) from the file")
         total, labels = volume_module.label_surfaces(read.array, spacing=spacing, labels_to_use=labels_to_use,
-                                                     method=method, radius=radius)
+                                                     method=method, radius=radius,
+                                                     keep_surfaces=mesh_format is not None or picture,
+                                                     workers=workers)
         stream = sys.stderr
         show = session.progress if session.progress is not None else stream.isatty()
         bar = LabelBar(stream if show else None, tty=stream.isatty())

@@ -112,6 +112,9 @@ surface construction algorithm. SIGGRAPH 87. https://doi.org/10.1145/37402.37422
 
 from __future__ import annotations
 
+import collections
+import contextlib
+import functools
 import logging
 import warnings
 from typing import NamedTuple
@@ -119,7 +122,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._validation import check_positive_float
+from ._validation import check_int_option, check_positive_float
 from .curvature import principal_curvatures
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning, MissingDependencyError
 from .estimators.icc import face_measures
@@ -155,6 +158,21 @@ COLUMNS = ("label", "status", "error", "n_voxels", "touches_border", "n_vertices
 
 _INTEGER_COLUMNS = ("label", "n_voxels", "n_vertices", "n_faces", "n_used", "n_invalid", "euler_characteristic")
 _TEXT_COLUMNS = ("status", "error", "surface", "warnings")
+
+#: Voxels of the labels' boxes gathered into one Dask task (``workers``, ``client``): a label of radius 20
+#: voxels (a box of 64k voxels, about a second of work) is a task of its own, many small ones share one.
+TASK_VOXELS = 2**16
+
+#: The fewest tasks per worker when there are enough labels, so that no worker waits for another's long task.
+TASKS_PER_WORKER = 8
+
+#: Tasks sent ahead per worker: the crops held by the cluster at a time are bounded, whatever the image.
+_IN_FLIGHT_PER_WORKER = 3
+
+#: Dask settings of the local cluster of ``workers=N``: a task goes to a worker only when its thread is free
+#: (so that a worker that dies takes only its running task with it), and is tried again once after its
+#: worker died before it is lost (``KilledWorker``: the labels of a group are then run one by one).
+CLUSTER_CONFIG = {"distributed.scheduler.worker-saturation": 1.0, "distributed.scheduler.allowed-failures": 1}
 
 #: Label values up to this are indexed directly by :func:`scipy.ndimage.find_objects` (a list of that length).
 _DIRECT_LABELS = 2**24
@@ -293,21 +311,24 @@ def _empty_row(label: int, status: str, error: str, **facts) -> dict:
     return row
 
 
-def _surface(image: np.ndarray, label: int, box, spacing: np.ndarray):
-    """Vertices (physical), outward faces, voxel count, centroid, border facts of one label's crop."""
-    marching_cubes = _marching_cubes()
-    mask = image[box] == label
-    n_voxels = int(np.count_nonzero(mask))
+def _crop(image: np.ndarray, label: int, box):
+    """The label's mask on its box padded by one voxel of background (bool), and the box's start and stop."""
     starts = np.array([part.start for part in box], dtype=np.int64)
     stops = np.array([part.stop for part in box], dtype=np.int64)
+    return np.pad(image[box] == label, 1), starts, stops
+
+
+def _surface(padded: np.ndarray, starts: np.ndarray, spacing: np.ndarray):
+    """Vertices (in voxels), outward faces, voxel count and centroid of one label's padded crop."""
+    marching_cubes = _marching_cubes()
+    mask = padded[1:-1, 1:-1, 1:-1]
+    n_voxels = int(np.count_nonzero(mask))
     centroid = (np.array([np.mean(axis) for axis in np.nonzero(mask)]) + starts) * spacing
-    padded = np.pad(mask, 1).astype(np.float32)
-    del mask
-    vertices, faces, _, _ = marching_cubes(padded, 0.5, method="lewiner", allow_degenerate=False)
+    vertices, faces, _, _ = marching_cubes(padded.astype(np.float32), 0.5, method="lewiner", allow_degenerate=False)
     # in whole voxels first (exact), then to physical units: grid planes repeat bit for bit (meshcurv.lattice)
     index = vertices.astype(np.float64) + (starts - 1)
     faces = np.ascontiguousarray(faces[:, ::-1], dtype=np.int64)  # marching cubes winds a bright object inward
-    return index, faces, n_voxels, centroid, starts, stops
+    return index, faces, n_voxels, centroid
 
 
 def _divergence_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
@@ -320,8 +341,13 @@ def _one_label(image, label, box, spacing, method, radius):
     """``(row, LabelSurface or None)`` of one label."""
     if box is None:
         return _empty_row(label, "empty", f"label {label} has no voxel in the image"), None
-    index, faces, n_voxels, centroid, starts, stops = _surface(image, label, box, spacing)
-    shape = np.array(image.shape)
+    return _crop_label(label, *_crop(image, label, box), image.shape, spacing, method, radius)
+
+
+def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radius):
+    """``(row, LabelSurface or None)`` of one label from its crop (:func:`_crop`) and the image's shape."""
+    index, faces, n_voxels, centroid = _surface(padded, starts, spacing)
+    shape = np.array(image_shape)
     touching = np.column_stack([starts == 0, stops == shape])  # (3, 2): low and high face of each axis
     facts = {"n_voxels": n_voxels, "touches_border": bool(touching.any()), "n_vertices": int(index.shape[0]),
              "n_faces": int(faces.shape[0]), **{f"centroid_{k}": float(centroid[k]) for k in range(3)}}
@@ -397,20 +423,161 @@ def _plan(labels, spacing, labels_to_use, radius):
     return image, spacing, _objects(image, wanted), radius
 
 
+def _guarded(label, compute, keep_surfaces):
+    """``compute()``, or a ``failed`` row when it raises for this label (not for bad options)."""
+    try:
+        row, surface = compute()
+    except (InvalidOptionError, MissingDependencyError):
+        raise  # the options are wrong for every label: not this label's failure
+    except (ValueError, RuntimeError, ArithmeticError, MemoryError) as exc:
+        logger.debug("label %d failed", label, exc_info=True)
+        row, surface = _empty_row(label, "failed", f"{type(exc).__name__}: {exc}"), None
+    return row, (surface if keep_surfaces else None)
+
+
 def _iterate(image, spacing, objects, method, radius, keep_surfaces):
     for label, box in objects.items():
+        yield _guarded(label, functools.partial(_one_label, image, label, box, spacing, method, radius), keep_surfaces)
+
+
+def _dask():
+    try:
+        import distributed
+    except ImportError:
+        raise MissingDependencyError("label_curvatures with `workers` or `client` runs the labels on Dask: "
+                                     "pip install 'meshcurv[batch]'") from None
+    return distributed
+
+
+def _check_parallel(workers, client):
+    """``(workers, client)`` checked: None, None for the serial path."""
+    if client is not None and workers is not None:
+        raise InvalidOptionError("give `workers` (a local cluster of that many processes) or `client`, not both")
+    if workers is not None:
+        from .batch import MAX_WORKERS
+
+        workers = check_int_option(workers, "workers", minimum=1, maximum=MAX_WORKERS)
+        if workers == 1:
+            workers = None
+    if workers is not None or client is not None:
+        _dask()
+    return workers, client
+
+
+def _crop_task(crops, image_shape, spacing, method, radius, keep_surfaces):
+    """One Dask task: ``(row, surface)`` of each ``(label, padded, starts, stops)`` of ``crops`` (:func:`_crop`)."""
+    return [_guarded(label, functools.partial(_crop_label, label, padded, starts, stops, image_shape, spacing, method,
+                                              radius), keep_surfaces)
+            for label, padded, starts, stops in crops]
+
+
+def _groups(objects, workers: int) -> list[list]:
+    """The labels that have a box, cut into tasks: runs of consecutive labels of about :data:`TASK_VOXELS`.
+
+    The labels are first shared out evenly into :data:`TASKS_PER_WORKER` runs
+    per worker (fewer when there are fewer labels); a run is then cut where
+    the voxels of its boxes pass :data:`TASK_VOXELS` (one label at least per task).
+    """
+    labels = [label for label, box in objects.items() if box is not None]
+    if not labels:
+        return []
+    sizes = [int(np.prod([part.stop - part.start + 2 for part in objects[label]])) for label in labels]
+    groups = []
+    for run in np.array_split(np.arange(len(labels)), min(len(labels), TASKS_PER_WORKER * workers)):
+        total = TASK_VOXELS + 1
+        for position in run.tolist():
+            if total + sizes[position] > TASK_VOXELS:
+                groups.append([])
+                total = 0
+            groups[-1].append(labels[position])
+            total += sizes[position]
+    return groups
+
+
+@contextlib.contextmanager
+def _cluster(client, workers):
+    """Yield ``(client, owned)``: the given client, or that of a new local cluster (:func:`meshcurv.batch.local_cluster`)."""
+    if client is not None:
+        yield client, False
+        return
+    import dask
+
+    from .batch import local_cluster
+
+    with dask.config.set(CLUSTER_CONFIG), local_cluster(workers=workers, dashboard=False) as local:
+        yield local, True
+
+
+def _lost(outcome, distributed) -> str:
+    """The error of a label whose task ended without rows (its worker died, or the task raised)."""
+    if isinstance(outcome, distributed.KilledWorker):
+        return (f"WorkerDied: the worker process computing this label died each time it ran (killed by the system: "
+                f"out of memory? a crash in a compiled library?) ({type(outcome).__name__}: {outcome})")
+    return f"{type(outcome).__name__}: {outcome}"
+
+
+def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers):
+    """As :func:`_iterate` (the same rows, in the same order), each group of labels a task on a Dask cluster.
+
+    Each task gets only its labels' crops (the box padded by one voxel, as a
+    boolean mask), their offsets, the image's shape and the spacing. A task
+    that raises or whose worker dies (:class:`distributed.KilledWorker`) is
+    run again label by label when it held several; a label whose task alone
+    still fails gets a ``failed`` row.
+    """
+    from . import batch
+
+    distributed = _dask()
+    with _cluster(client, workers) as (active, owned):
+        n_workers = batch._worker_count(active)
+        queue = collections.deque(_groups(objects, n_workers))
+        logger.info("%d labels in %d tasks on %d workers", len(objects), len(queue), n_workers)
+        limit = _IN_FLIGHT_PER_WORKER * n_workers
+        watch = batch._WorkerWatch(active, batch.NO_WORKER_SECONDS["local" if owned else "remote"])
+        pending, done = {}, {}
+        labels = list(objects)
+        position = 0
         try:
-            row, surface = _one_label(image, label, box, spacing, method, radius)
-        except (InvalidOptionError, MissingDependencyError):
-            raise  # the options are wrong for every label: not this label's failure
-        except (ValueError, RuntimeError, ArithmeticError, MemoryError) as exc:
-            logger.debug("label %d failed", label, exc_info=True)
-            row, surface = _empty_row(label, "failed", f"{type(exc).__name__}: {exc}"), None
-        yield row, (surface if keep_surfaces else None)
+            while True:
+                while position < len(labels) and (objects[labels[position]] is None or labels[position] in done):
+                    label = labels[position]
+                    if label in done:
+                        yield done.pop(label)
+                    else:
+                        yield _guarded(label, functools.partial(_one_label, image, label, None, spacing, method,
+                                                                radius), keep_surfaces)
+                    position += 1
+                if position == len(labels):
+                    return
+                while queue and len(pending) < limit:
+                    group = queue.popleft()
+                    crops = [(label, *_crop(image, label, objects[label])) for label in group]
+                    future = active.submit(_crop_task, crops, image.shape, spacing, method, radius, keep_surfaces,
+                                           pure=False)
+                    pending[future] = group
+                    del crops
+                for future in batch._finished(distributed, list(pending), watch):
+                    group = pending.pop(future)
+                    outcome = batch._outcome(future)
+                    future.release()
+                    if isinstance(outcome, (InvalidOptionError, MissingDependencyError)):
+                        raise outcome
+                    if not isinstance(outcome, BaseException):
+                        done.update(zip(group, outcome))
+                    elif len(group) > 1:  # one of its labels kills its worker, or raises: each alone, at once
+                        logger.info("a task of %d labels failed (%s); running them one by one", len(group),
+                                    type(outcome).__name__)
+                        queue.extendleft([label] for label in reversed(group))
+                    else:
+                        logger.debug("label %d failed: %r", group[0], outcome)
+                        done[group[0]] = (_empty_row(group[0], "failed", _lost(outcome, distributed)), None)
+        finally:
+            if pending:
+                active.cancel(list(pending))
 
 
 def label_surfaces(labels, *, spacing=(1.0, 1.0, 1.0), labels_to_use=None, method: str | None = None,
-                   radius: float | None = None, keep_surfaces: bool = True):
+                   radius: float | None = None, keep_surfaces: bool = True, workers: int | None = None, client=None):
     """``(total, iterator)``: the number of labels, and ``(row, surface)`` for each, one at a time.
 
     ``row`` is a dict of :data:`COLUMNS` (see :func:`label_curvatures`);
@@ -418,10 +585,15 @@ def label_surfaces(labels, *, spacing=(1.0, 1.0, 1.0), labels_to_use=None, metho
     (``row["status"]`` says why) or when ``keep_surfaces`` is False. Only one
     label's crop and mesh are held at a time: this is what
     :func:`label_curvatures` and ``meshcurv volume`` run. The inputs are
-    checked, and the labels found, before this returns.
+    checked, and the labels found, before this returns. With ``workers`` or
+    ``client`` (as in :func:`label_curvatures`) the labels are computed on a
+    Dask cluster, a few tasks ahead, and yielded in the same order.
     """
+    workers, client = _check_parallel(workers, client)
     image, spacing, objects, radius = _plan(labels, spacing, labels_to_use, radius)
-    return len(objects), _iterate(image, spacing, objects, method, radius, keep_surfaces)
+    if workers is None and client is None:
+        return len(objects), _iterate(image, spacing, objects, method, radius, keep_surfaces)
+    return len(objects), _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers)
 
 
 def _table(rows):
@@ -451,7 +623,8 @@ def _pandas():
 
 def label_curvatures(labels, *, spacing=(1.0, 1.0, 1.0), labels_to_use=None, method: str | None = None,
                      radius: float | None = None, return_meshes: bool = False,
-                     progress: Callable[[int, int, int], None] | None = None):
+                     progress: Callable[[int, int, int], None] | None = None, workers: int | None = None,
+                     client=None):
     """Curvature statistics of every object of a 3D label image, one row per label.
 
     Each label's surface is extracted by marching cubes on its bounding box
@@ -486,6 +659,25 @@ def label_curvatures(labels, *, spacing=(1.0, 1.0, 1.0), labels_to_use=None, met
         areas) of the labels with status ``ok``.
     progress : callable, optional
         Called as ``progress(done, total, label)`` after each label.
+    workers : int, optional
+        Compute the labels on a local Dask cluster of this many worker
+        processes (:func:`meshcurv.batch.local_cluster`, one thread each),
+        started and closed by the call; None or 1: one label after the other
+        in this process.
+    client : distributed.Client, optional
+        Compute the labels on this Dask cluster instead (not with ``workers``).
+
+        On a cluster, a label or a group of small ones (:data:`TASK_VOXELS`
+        voxels of boxes) is one task, which receives only its labels' crops
+        (their boxes padded by one voxel, as boolean masks) with their offsets
+        and the spacing, never the image; a few tasks per worker are sent
+        ahead. The rows are those of the serial run, in the same order (up to
+        the order of floating-point sums). A label whose computation raises
+        gets a ``failed`` row, as serially; a label whose worker process dies
+        (out of memory, a crash in a compiled library) gets a ``failed`` row
+        (``WorkerDied: ...``) after its task was tried again once on the local
+        cluster (``distributed.scheduler.allowed-failures`` times on a
+        ``client``'s), and the other labels are computed.
 
     Returns
     -------
@@ -499,9 +691,11 @@ def label_curvatures(labels, *, spacing=(1.0, 1.0, 1.0), labels_to_use=None, met
         ``labels`` not a 3D integer or boolean array, empty, or with negative labels.
     InvalidOptionError
         ``spacing`` not 3 positive finite numbers; bad ``labels_to_use``,
-        ``method`` or ``radius``.
+        ``method``, ``radius`` or ``workers``; both ``workers`` and ``client``.
     MissingDependencyError
-        Without scikit-image or pandas (``pip install 'meshcurv[volume]'``).
+        Without scikit-image or pandas (``pip install 'meshcurv[volume]'``);
+        ``workers`` or ``client`` without dask.distributed (``pip install
+        'meshcurv[batch]'``).
 
     Warns
     -----
@@ -525,7 +719,8 @@ def label_curvatures(labels, *, spacing=(1.0, 1.0, 1.0), labels_to_use=None, met
     if progress is not None and not callable(progress):
         raise InvalidOptionError(f"`progress` must be a callable progress(done, total, label); got {progress!r}")
     total, surfaces_and_rows = label_surfaces(labels, spacing=spacing, labels_to_use=labels_to_use, method=method,
-                                              radius=radius, keep_surfaces=return_meshes)
+                                              radius=radius, keep_surfaces=return_meshes, workers=workers,
+                                              client=client)
     rows, surfaces = [], {}
     for row, surface in surfaces_and_rows:
         rows.append(row)
