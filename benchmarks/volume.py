@@ -12,16 +12,22 @@ Scale: ``--scale`` builds a label image of ``--scale-shape`` voxels with
 ``--scale-labels`` balls and ellipsoids of radius 6-20 voxels, times the pass
 that finds the labels over the whole image, then processes ``--scale-sample``
 labels of it (label by label, on crops) and extrapolates to all of them;
-peak memory is the process's maximum resident set size.
+peak memory is the process's maximum resident set size. ``--workers N`` runs
+the same labels again on a local Dask cluster of N processes (the cluster's
+start timed apart) and gives both, with the CPU seconds of every process
+(the machine may be shared: wall times alone can mislead).
 
     python benchmarks/volume.py                       # accuracy, 50 labels, 1 x 0.25 x 0.25
     python benchmarks/volume.py --scale               # and the scale run
+    python benchmarks/volume.py --no-accuracy --scale --workers 2    # serial and on 2 processes
     python benchmarks/volume.py --labels 12 --markdown benchmarks/volume.md
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import platform
 import resource
 import sys
@@ -169,8 +175,6 @@ def accuracy(args) -> list[str]:
 def scale(args) -> list[str]:
     from scipy import ndimage
 
-    from meshcurv.volume import label_surfaces
-
     shape = tuple(args.scale_shape)
     rng = np.random.default_rng(args.seed)
     start = time.perf_counter()
@@ -193,27 +197,74 @@ def scale(args) -> list[str]:
     found = time.perf_counter() - start
     present = [index + 1 for index, box in enumerate(boxes) if box is not None]
     sample = present[:: max(1, len(present) // args.scale_sample)][: args.scale_sample]
-    start = time.perf_counter()
-    total, rows = label_surfaces(image, labels_to_use=sample, keep_surfaces=False)
-    statuses = []
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        for row, _ in rows:
-            statuses.append(row["status"])
-    seconds = time.perf_counter() - start
-    per_label = seconds / len(sample)
+    runs = [("serial", *_timed(image, sample, None))]
+    if args.workers and args.workers > 1:
+        runs.append((f"{args.workers} workers", *_timed(image, sample, args.workers)))
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
-    estimate = found + per_label * len(present)
-    return [f"## Scale: {' x '.join(map(str, shape))} voxels (uint16, {image.nbytes / 2**30:.2f} GiB), "
-            f"{len(present)} labels", "",
-            f"- image built in {built:.0f} s; the labels' boxes found (one pass, scipy.ndimage.find_objects) "
-            f"in {found:.1f} s",
-            f"- {len(sample)} labels spread over the label range processed end to end (crop, marching cubes, "
-            f"curvatures, statistics) in {seconds:.0f} s: {per_label:.2f} s per label "
-            f"({statuses.count('ok')} ok)",
-            f"- extrapolated to all {len(present)} labels: {estimate / 60:.1f} min on this machine "
-            f"(the label pass is serial; the curvature kernels use both cores)",
-            f"- peak resident memory of the process: {peak:.2f} GiB (the image itself {image.nbytes / 2**30:.2f} GiB)"]
+    lines = [f"## Scale: {' x '.join(map(str, shape))} voxels (uint16, {image.nbytes / 2**30:.2f} GiB), "
+             f"{len(present)} labels", "",
+             f"- image built in {built:.0f} s; the labels' boxes found (one pass, scipy.ndimage.find_objects) "
+             f"in {found:.1f} s",
+             f"- {len(sample)} labels spread over the label range processed end to end (crop, marching cubes, "
+             f"curvatures, statistics), the same labels in each run; load average before the runs "
+             f"{' '.join(f'{value:.1f}' for value in runs[0][5])} on {os.cpu_count()} cores", "",
+             "| run | wall | per label | CPU seconds (all processes) | extrapolated to all labels | "
+             "peak resident memory | labels ok |", "|---|--:|--:|--:|--:|--:|--:|"]
+    serial_seconds = runs[0][1]
+    for name, seconds, cpu, statuses, extra, _, memory in runs:
+        per_label = seconds / len(sample)
+        estimate = found + extra + per_label * len(present)
+        speedup = "" if name == "serial" else f" ({serial_seconds / seconds:.2f}x)"
+        lines.append(f"| {name} | {seconds:.0f} s{speedup} | {per_label:.2f} s | {cpu:.0f} s | {estimate / 60:.1f} min | "
+                     f"{memory} | {statuses.count('ok')}/{len(sample)} |")
+    lines += ["", f"Extrapolated: the label pass ({found:.1f} s), the cluster's start (workers) and the wall "
+              f"time per label times the {len(present)} labels. Peak resident memory: of this process "
+              f"({peak:.2f} GiB over the whole benchmark, the image itself {image.nbytes / 2**30:.2f} GiB), "
+              "and of each worker process."]
+    return lines
+
+
+def _cpu_seconds() -> float:
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _worker_usage() -> tuple[float, float]:
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 2**20
+
+
+def _timed(image, sample, workers):
+    """``(wall seconds, CPU seconds, statuses, cluster start seconds, load average, peak memory text)``."""
+    from meshcurv.volume import label_surfaces
+
+    load = os.getloadavg()
+    with contextlib.ExitStack() as stack:
+        client, started = None, 0.0
+        if workers:
+            import dask
+
+            from meshcurv import batch, volume
+
+            start = time.perf_counter()
+            client = stack.enter_context(dask.config.set(volume.CLUSTER_CONFIG))
+            client = stack.enter_context(batch.local_cluster(workers=workers, dashboard=False))
+            started = time.perf_counter() - start
+            before = sum(cpu for cpu, _ in client.run(_worker_usage).values())
+        cpu = _cpu_seconds()
+        start = time.perf_counter()
+        total, rows = label_surfaces(image, labels_to_use=sample, keep_surfaces=False, client=client)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            statuses = [row["status"] for row, _ in rows]
+        seconds = time.perf_counter() - start
+        cpu = _cpu_seconds() - cpu
+        memory = f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20:.2f} GiB"
+        if workers:
+            usage = client.run(_worker_usage).values()
+            cpu += sum(seconds for seconds, _ in usage) - before
+            memory += " + " + " + ".join(f"{peak:.2f}" for _, peak in usage) + " GiB (workers)"
+    return seconds, cpu, statuses, started, load, memory
 
 
 def main(argv=None) -> int:
@@ -228,6 +279,8 @@ def main(argv=None) -> int:
     parser.add_argument("--scale-shape", type=int, nargs=3, default=[512, 1024, 1024])
     parser.add_argument("--scale-labels", type=int, default=2000)
     parser.add_argument("--scale-sample", type=int, default=100)
+    parser.add_argument("--workers", type=int, default=None,
+                        help="Also run the scale sample on a local Dask cluster of this many processes.")
     parser.add_argument("--markdown", default=None, help="Also write the tables to this file.")
     args = parser.parse_args(argv)
     lines = ["# Label images: per-label curvature tables (benchmarks/volume.py)", "",
