@@ -115,6 +115,18 @@ def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = 
     proper = ~topology.degenerate_faces
     if not proper.any():  # every face has a repeated corner: nothing to orient
         return proper
+    if proper.all() and not (counts > 2).any() and not topology.inconsistent_edges.any() \
+            and not topology.bowtie_vertices.any():
+        # consistently wound already, and the patches are the components through shared vertices
+        # (faces that share only a vertex would make it a bow-tie): no graph of face sides needed,
+        # only each closed patch's side (a fifth of the time at a million vertices)
+        n_labels, vertex_labels = topology.vertex_components
+        patch = vertex_labels[topology.faces[:, 0]]
+        flip = np.zeros(n_faces, dtype=bool)
+        if not outward:
+            return flip
+        invert = _outward(vertices, topology, patch, flip, np.zeros(n_labels, dtype=bool), n_labels)
+        return invert[patch]
     linked = (counts == 2) & (pairs[:, 0] != pairs[:, 1])
     linked &= proper[np.maximum(pairs[:, 0], 0)] & proper[np.maximum(pairs[:, 1], 0)]
     f, g = pairs[linked, 0], pairs[linked, 1]
@@ -152,20 +164,28 @@ def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
     then it bounds a cavity of the solid around it, and its normals must face
     into the cavity (negative volume), out of the material.
     """
+    from .geometry import face_cross_products
+
     faces = topology.faces
-    on_boundary = topology.boundary_edges[np.maximum(topology.face_edges, 0)] & (topology.face_edges >= 0)
-    open_patch = np.bincount(patch, weights=on_boundary.any(axis=1), minlength=n_labels) > 0
-    corner_patch = np.repeat(patch, 3)
-    corners = faces.ravel()
-    weight = np.bincount(corner_patch, minlength=n_labels).astype(np.float64)
+    if topology.boundary_edges.any():
+        on_boundary = topology.boundary_edges[np.maximum(topology.face_edges, 0)] & (topology.face_edges >= 0)
+        open_patch = np.bincount(patch, weights=on_boundary.any(axis=1), minlength=n_labels) > 0
+    else:
+        open_patch = np.zeros(n_labels, dtype=bool)
+    # each patch's volume from a point near it (its faces' first corners' mean): no cancellation
+    first = vertices[faces[:, 0]]
+    weight = np.bincount(patch, minlength=n_labels).astype(np.float64)
     weight[weight == 0] = 1.0
-    centroid = np.stack(
-        [np.bincount(corner_patch, weights=vertices[corners, k], minlength=n_labels) for k in range(3)], axis=1
-    ) / weight[:, None]
-    a = vertices[faces[:, 0]] - centroid[patch]
-    b = vertices[faces[:, 1]] - centroid[patch]
-    c = vertices[faces[:, 2]] - centroid[patch]
-    volume6 = np.einsum("ij,ij->i", a, np.cross(b, c))
+    centroid = np.stack([np.bincount(patch, weights=first[:, k], minlength=n_labels) for k in range(3)],
+                        axis=1) / weight[:, None]
+    if n_labels == 1:  # one patch: the vertices moved once, the cross products compiled where they can be
+        shifted = vertices - centroid[0]
+        volume6 = np.einsum("ij,ij->i", shifted[faces[:, 0]], face_cross_products(shifted, faces))
+    else:
+        a = first - centroid[patch]
+        b = vertices[faces[:, 1]] - centroid[patch]
+        c = vertices[faces[:, 2]] - centroid[patch]
+        volume6 = np.einsum("ij,ij->i", a, np.cross(b, c))
     sign = np.where(flip, -1.0, 1.0)
     signed = np.bincount(patch, weights=sign * volume6, minlength=n_labels)
     magnitude = np.bincount(patch, weights=np.abs(volume6), minlength=n_labels)
