@@ -11,7 +11,7 @@ a dependency of meshcurv)::
     python benchmarks/speed.py --sizes 100k,655k,1M --methods icc,normal_cycle,matgeom --backends numba
 
 Meshes: ``meshcurv.shapes.icosphere(n)`` (10 n^2 + 2 vertices: 10k n=32, 100k
-n=100, 1M n=316, 4M n=632) and ``/work/shared/meshes/igea.obj`` (134k vertices)
+n=100, 1M n=316, 4M n=632) and ``../shared/meshes/igea.obj`` (beside the repository) (134k vertices)
 when present.
 
 How each figure is measured:
@@ -63,9 +63,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 OUTPUT = os.path.join(HERE, "speed.md")
-IGEA = os.path.join(os.path.dirname(ROOT), "shared", "meshes", "igea.obj")
-if not os.path.exists(IGEA):
-    IGEA = "/work/shared/meshes/igea.obj"
+IGEA = os.path.join(os.path.dirname(ROOT), "shared", "meshes", "igea.obj")  # ../shared beside the repository
 GIB = 1024**3
 MIB = 1024**2
 
@@ -200,7 +198,7 @@ TRUEFORM = "trueform/directions"
 
 def peers_installed():
     found, missing = {}, {}
-    for key, (label, module, dist, _) in PEERS.items():
+    for key, (_label, module, dist, _) in PEERS.items():
         try:
             __import__(module)
             found[key] = f"{dist} {importlib.metadata.version(dist)}"
@@ -695,7 +693,7 @@ class Bench:
         built.sort()
         work = tempfile.mkdtemp(prefix="meshcurv-speed-")
         try:
-            for n_expected, label in built:
+            for _n_expected, label in built:
                 name, v, f = build_mesh(label)
                 n = v.shape[0]
                 self.meshes.append((label, name, n, f.shape[0]))

@@ -319,7 +319,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     referenced = topology.referenced_vertices
     if radius is None:  # each group of components of one scale (usually the whole mesh) at its own default
         groups, levels = [], []
-        for group_radius, members in default_radii(vertices, topology):
+        for _group_radius, members in default_radii(vertices, topology):
             inside = valid if members is None else valid & np.isin(np.arange(vertices.shape[0]), members)
             edges = topology.edges if members is None else topology.edges[inside[topology.edges[:, 0]]]
             edge_length = robust_mean_edge_length(vertices, edges)
