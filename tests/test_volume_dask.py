@@ -147,6 +147,8 @@ def test_a_label_that_raises_or_kills_its_worker_fails_alone(image, serial, faul
     assert failed.error[4].startswith("WorkerDied: the worker process computing this label died")
     others = ~table.label.isin([2, 4])
     assert_same_rows(table[others].reset_index(drop=True), expected[others].reset_index(drop=True))
+    with pytest.raises(InvalidOptionError, match="method"):  # wrong for every label: raised, as serially
+        label_curvatures(image, labels_to_use=[1, 3], method="nope", client=faulty_client)
     # each task received its labels' crops only: the box padded by one voxel, as a boolean mask
     boxes = volume._objects(image, None)
     received = [json.loads(line) for line in faulty_client.calls.read_text().splitlines()]
@@ -193,8 +195,10 @@ def test_groups_share_the_labels_out_by_voxels_in_order():
     ({"workers": 0}, "`workers` must be an integer between 1 and"),
     ({"workers": 2.5}, "`workers` must be an integer"),
     ({"workers": 2, "client": object()}, "not both"),
+    ({"client": object()}, "`client` must be a distributed.Client; got object"),
 ])
 def test_parallel_option_errors(options, message):
+    pytest.importorskip("distributed")
     with pytest.raises(InvalidOptionError, match=message):
         label_curvatures(np.ones((4, 4, 4), dtype=np.uint8), **options)
 

@@ -96,6 +96,20 @@ Koenderink and van Doorn (``shape_index_fraction_cup`` ... ``_cap``) and
   voxels); ``failed`` (anything else: ``error`` says what). One label that
   fails never stops the others.
 
+Many labels on several processes
+--------------------------------
+With ``workers=N`` (a local Dask cluster, :func:`meshcurv.batch.local_cluster`,
+started and closed by the call) or ``client=`` (a cluster of one's own), each
+label, or a group of small ones (:data:`TASK_VOXELS` voxels of boxes), is one
+task. A task receives its labels' crops (the box padded by one voxel, as a
+boolean mask), their offsets, the image's shape and the spacing: never the
+image, which stays in the calling process; a few tasks per worker are sent
+ahead, so the crops in flight are bounded too. The rows are those of the
+serial run, in the same order, up to the order of floating-point sums. A task
+whose worker process dies (out of memory, a crash in a compiled library) or
+that raises is run again label by label; the label that still kills its worker
+gets a ``failed`` row (``WorkerDied: ...``), the others are computed.
+
 References
 ----------
 J.-O. Lachaud, P. Romon, B. Thibert, D. Coeurjolly (2020). Interpolated
@@ -460,7 +474,9 @@ def _check_parallel(workers, client):
         if workers == 1:
             workers = None
     if workers is not None or client is not None:
-        _dask()
+        distributed = _dask()
+        if client is not None and not isinstance(client, distributed.Client):
+            raise InvalidOptionError(f"`client` must be a distributed.Client; got {type(client).__name__}")
     return workers, client
 
 
