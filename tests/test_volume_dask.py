@@ -203,6 +203,18 @@ def test_parallel_option_errors(options, message):
         label_curvatures(np.ones((4, 4, 4), dtype=np.uint8), **options)
 
 
+def test_no_label_to_compute_starts_no_cluster(monkeypatch):
+    pytest.importorskip("distributed")
+
+    def refuse(client, workers):
+        raise AssertionError("a cluster was started")
+
+    monkeypatch.setattr(volume, "_cluster", refuse)
+    with pytest.warns(MeshQualityWarning, match="1 empty"):
+        table = label_curvatures(np.zeros((6, 6, 6), dtype=np.uint8), labels_to_use=[3], workers=2)
+    assert list(table.status) == ["empty"]
+
+
 def test_workers_without_dask_name_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed raises ImportError
     with pytest.raises(MissingDependencyError, match=r"pip install 'meshcurv\[batch\]'"):

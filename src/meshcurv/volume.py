@@ -607,7 +607,7 @@ def label_surfaces(labels, *, spacing=(1.0, 1.0, 1.0), labels_to_use=None, metho
     """
     workers, client = _check_parallel(workers, client)
     image, spacing, objects, radius = _plan(labels, spacing, labels_to_use, radius)
-    if workers is None and client is None:
+    if (workers is None and client is None) or all(box is None for box in objects.values()):
         return len(objects), _iterate(image, spacing, objects, method, radius, keep_surfaces)
     return len(objects), _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers)
 
