@@ -73,6 +73,7 @@ def test_the_image_has_what_the_tests_need(serial):
 
 @pytest.mark.slow  # starts a local cluster of two processes: several seconds
 def test_two_workers_give_the_rows_and_surfaces_of_the_serial_run(image, serial):
+    pytest.importorskip("distributed")
     expected, expected_surfaces = serial
     calls = []
     with pytest.warns(MeshQualityWarning, match="1 empty, 1 too_small"):
@@ -164,6 +165,7 @@ def test_a_label_that_raises_or_kills_its_worker_fails_alone(image, serial, faul
 @pytest.mark.slow  # starts a local cluster: several seconds
 def test_cli_workers_writes_the_serial_table(tmp_path, image, serial):
     pytest.importorskip("pyarrow")
+    pytest.importorskip("distributed")
     from test_volume import run_volume
 
     np.save(tmp_path / "cells.npy", image)
