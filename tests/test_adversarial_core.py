@@ -472,8 +472,12 @@ def test_diagnose_and_degenerate_faces_refuse_bad_arguments():
     spiked[3, 1] = 1e300
     with pytest.raises(InvalidMeshError, match="`vertices` has coordinates as large as 1e\\+300"):
         meshcurv.diagnose(spiked, top)
-    with pytest.raises(InvalidMeshError, match="`topology` must be a MeshTopology; got list"):
-        meshcurv.diagnose(SPHERE.vertices, SPHERE.faces.tolist())
+    with pytest.raises(InvalidMeshError, match="`topology` must be a MeshTopology; got str"):
+        meshcurv.diagnose(SPHERE.vertices, "faces")
+    with pytest.raises(InvalidMeshError, match="`faces`"):  # a face array is checked as faces are
+        meshcurv.diagnose(SPHERE.vertices, SPHERE.faces + N)
+    # faces as a list or an array are the mesh's topology: the same diagnosis
+    assert meshcurv.diagnose(SPHERE.vertices, SPHERE.faces.tolist()) == meshcurv.diagnose(SPHERE.vertices, top)
     with pytest.raises(InvalidOptionError, match=r"`n_flipped_faces` must be an integer between 0 and 1280"):
         meshcurv.diagnose(SPHERE.vertices, top, n_flipped_faces=2000)
     with pytest.raises(InvalidMeshError, match=rf"`scales` must be a real array of shape \({N},\)"):

@@ -194,7 +194,9 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     Parameters
     ----------
     vertices : ndarray of shape (V, 3), float64
-    topology : MeshTopology
+    topology : MeshTopology or array_like of faces
+        The mesh's connectivity; faces ((F, 3) indices, or polygons) are turned
+        into one with :meth:`MeshTopology.from_faces`.
     n_flipped_faces : int, default: 0
         Recorded as is (faces reversed by ``orient=`` before the computation),
         0 to the number of faces.
@@ -220,7 +222,15 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     >>> d = diagnose(sphere.vertices, MeshTopology.from_faces(sphere.faces))
     >>> d.n_components, d.genus, d.is_clean, d.problems()
     (1, 0, True, [])
+    >>> diagnose(sphere.vertices, sphere.faces).n_faces     # faces as they are
+    320
     """
+    if not isinstance(topology, MeshTopology) and not isinstance(topology, (str, bytes)) \
+            and hasattr(topology, "__len__"):  # a face array or polygon list: its topology
+        from ._validation import as_faces, as_vertices
+
+        points = as_vertices(vertices)
+        topology = MeshTopology.from_faces(as_faces(topology, points.shape[0]), points.shape[0])
     vertices = checked_topology_points(vertices, topology)
     n_flipped_faces = check_int_option(n_flipped_faces, "n_flipped_faces", maximum=topology.n_faces)
     faces = topology.faces
