@@ -536,3 +536,15 @@ def test_helper_arrays_of_the_wrong_shape_are_refused():
     np.testing.assert_array_equal(vertex_areas(SPHERE.vertices, SPHERE.faces, areas=areas),
                                   vertex_areas(SPHERE.vertices, SPHERE.faces))
     assert np.isclose(vertex_areas(SPHERE.vertices, SPHERE.faces).sum(), areas.sum(), rtol=1e-12)
+
+
+@pytest.mark.parametrize("function", ["principal_curvatures", "point_cloud_curvatures"])
+def test_a_masked_radius_is_refused_without_numpy_warnings(function):
+    """Found by benchmarks/fuzz_api.py: numpy warned 'converting a masked element to nan' before the refusal."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no warning may escape, the refusal is the whole answer
+        with pytest.raises(InvalidOptionError, match="`radius` must be a positive finite number; got a masked"):
+            if function == "principal_curvatures":
+                meshcurv.principal_curvatures(SPHERE.vertices, SPHERE.faces, radius=np.ma.masked)
+            else:
+                meshcurv.point_cloud_curvatures(SPHERE.vertices, radius=np.ma.masked)

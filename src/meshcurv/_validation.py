@@ -332,6 +332,8 @@ def check_positive_float(value, name: str) -> float:
     if isinstance(value, np.ndarray) and (value.ndim != 0 or not np.issubdtype(value.dtype, np.number)
                                           or np.issubdtype(value.dtype, np.complexfloating)):
         raise InvalidOptionError(f"`{name}` must be a positive number; got {_short_repr(value)}")
+    if isinstance(value, np.ma.MaskedArray) and np.ma.getmaskarray(value).any():  # numpy.ma.masked
+        raise InvalidOptionError(f"`{name}` must be a positive finite number; got a masked value")
     try:
         number = float(value)
     except (TypeError, ValueError, OverflowError):
