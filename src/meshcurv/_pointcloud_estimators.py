@@ -252,12 +252,13 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
             mean = summed[:, 1] / (2 * area)
             gaussian = summed[:, 2] / area
             shape_operator = -summed[:, 3:] / area[:, None]
+            # rows without area (a ball of collinear points) are NaN here and left out below
+            half = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
         _, _, dir_min, dir_max = principal_from_shape_operator(
             np.where(good[:, None], shape_operator, 0.0), normals[chunk[rows]])
-        half = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
         target = chunk[rows[good]]
-        out[0][target] = (mean - half)[good]
-        out[1][target] = (mean + half)[good]
+        out[0][target] = mean[good] - half[good]
+        out[1][target] = mean[good] + half[good]
         out[2][target] = dir_min[good]
         out[3][target] = dir_max[good]
     return (*out, normals)

@@ -336,7 +336,8 @@ def degenerate_face_mask(areas: np.ndarray, length_scale) -> np.ndarray:
         )
     if not (scale >= 0).all():
         raise InvalidOptionError("`length_scale` must be >= 0 (not NaN)")
-    return areas <= DEGENERATE_AREA_RATIO * scale**2
+    with np.errstate(over="ignore"):  # a scale beyond 1e154 squares to inf: every face is below it
+        return areas <= DEGENERATE_AREA_RATIO * scale**2
 
 
 def _real_array(value, name: str) -> np.ndarray:
@@ -401,10 +402,11 @@ def mixed_voronoi_corner_areas(vertices: np.ndarray, faces: np.ndarray) -> np.nd
         d = vertices[faces[:, (k + 2) % 3]] - vertices[faces[:, (k + 1) % 3]]
         squared[:, k] = np.einsum("ij,ij->i", d, d)
     voronoi = np.zeros(faces.shape, dtype=np.float64)
-    for k in range(3):
-        j, m = (k + 1) % 3, (k + 2) % 3
-        # sides at corner k: k-j (opposite m) and k-m (opposite j)
-        voronoi[:, k] = (squared[:, m] * cot[:, m] + squared[:, j] * cot[:, j]) / 8.0
+    with np.errstate(invalid="ignore", over="ignore"):  # the infinite cotangents of zero-area faces: 0 below
+        for k in range(3):
+            j, m = (k + 1) % 3, (k + 2) % 3
+            # sides at corner k: k-j (opposite m) and k-m (opposite j)
+            voronoi[:, k] = (squared[:, m] * cot[:, m] + squared[:, j] * cot[:, j]) / 8.0
     obtuse_corner = cot < 0
     obtuse = obtuse_corner.any(axis=1)
     mixed = np.where(obtuse[:, None], np.where(obtuse_corner, area[:, None] / 2, area[:, None] / 4), voronoi)
