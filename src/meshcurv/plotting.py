@@ -141,19 +141,8 @@ class _Raster:
 
     def __init__(self, vertices, faces, camera, *, pixels: int, chunk: int = 2**22):
         screen = vertices @ camera.T
-        low, high = screen[:, :2].min(axis=0), screen[:, :2].max(axis=0)
-        span = np.maximum(high - low, 1e-12 * max(float((high - low).max()), 1e-300))
-        # no supersampling: the image has about twice the resolution of its panel in the figure,
-        # and matplotlib's antialiased resampling smooths the edges when it is drawn
-        scale = (pixels - 2) / span.max()  # one pixel of margin each side
-        self.width, self.height = (np.ceil(span * scale).astype(int) + 2)
-        self.offset = low - 1 / scale
-        self.scale = scale
-        self.extent = (self.offset[0], self.offset[0] + self.width / scale,
-                       self.offset[1], self.offset[1] + self.height / scale)
+        self._frame(screen, pixels)
         points = self.to_pixels(screen)
-        self.depth_low = screen[:, 2].min()
-        self.depth_step = (2**30 - 1) / max(np.ptp(screen[:, 2]), 1e-300)
         n_pixels = self.width * self.height
         self.depth = np.full(n_pixels, -np.inf)
         self.face = np.full(n_pixels, -1)
@@ -187,16 +176,9 @@ class _Raster:
         """
         raster = cls.__new__(cls)
         screen = points @ camera.T
-        low, high = screen[:, :2].min(axis=0), screen[:, :2].max(axis=0)
-        span = np.maximum(high - low, 1e-12 * max(float((high - low).max()), 1e-300))
-        scale = (pixels - 2) / span.max()
-        raster.scale, raster.offset = scale, low - 1 / scale
-        raster.width, raster.height = (np.ceil(span * scale).astype(int) + 2)
-        raster.extent = (raster.offset[0], raster.offset[0] + raster.width / scale,
-                         raster.offset[1], raster.offset[1] + raster.height / scale)
+        raster._frame(screen, pixels)
+        scale = raster.scale
         pixel = raster.to_pixels(screen)
-        raster.depth_low = screen[:, 2].min()
-        raster.depth_step = (2**30 - 1) / max(np.ptp(screen[:, 2]), 1e-300)
         n_pixels = raster.width * raster.height
         depth = np.full(n_pixels, -np.inf)
         face = np.full(n_pixels, -1)
@@ -229,6 +211,21 @@ class _Raster:
         raster.weights = np.zeros((raster.height, raster.width, 3))
         raster.weights[..., 0] = 1.0
         return raster
+
+    def _frame(self, screen: np.ndarray, pixels: int) -> None:
+        """The image's size, scale and offset for ``screen`` points (right, up, depth), and the depth scale."""
+        low, high = screen[:, :2].min(axis=0), screen[:, :2].max(axis=0)
+        span = np.maximum(high - low, 1e-12 * max(float((high - low).max()), 1e-300))
+        # no supersampling: the image has about twice the resolution of its panel in the figure,
+        # and matplotlib's antialiased resampling smooths the edges when it is drawn
+        scale = (pixels - 2) / span.max()  # one pixel of margin each side
+        self.width, self.height = (np.ceil(span * scale).astype(int) + 2)
+        self.offset = low - 1 / scale
+        self.scale = scale
+        self.extent = (self.offset[0], self.offset[0] + self.width / scale,
+                       self.offset[1], self.offset[1] + self.height / scale)
+        self.depth_low = screen[:, 2].min()
+        self.depth_step = (2**30 - 1) / max(np.ptp(screen[:, 2]), 1e-300)
 
     def to_pixels(self, screen: np.ndarray) -> np.ndarray:
         """(n, 3) screen coordinates (right, up, depth) -> (n, 3) pixel x, pixel y, depth."""
