@@ -57,10 +57,10 @@ def principal_curvatures(
           ``radius`` (default from the mesh's measured noise); boundary vertices
           are kept. The lowest error of all methods and peers on every irregular
           and noisy surface of the accuracy benchmark (see the README); about
-          3.5 s for a million vertices on 2 cores.
+          2.5-3 times the time of ``'normal_cycle'`` (README, Speed).
         - ``'normal_cycle'``: the normal-cycle tensor of Cohen-Steiner and Morvan
-          over barycentric cells, in 1/length, correct on open meshes; the
-          fastest (a million vertices in about 0.6 s), exact to second
+          over barycentric cells, in 1/length, correct on open meshes; fast
+          (a million vertices in a few seconds, topology included), exact to second
           order on regular meshes, less accurate on irregular or noisy ones.
         - ``'matgeom'``: matGeom's ``meshCurvatures`` reproduced number for
           number (dimensionless values; see the README).
