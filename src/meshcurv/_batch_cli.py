@@ -19,11 +19,9 @@ __all__ = ["batch_command", "BatchBar"]
 _SHOWN_FAILURES = 10
 
 
-class BatchBar:
-    """Progress over the meshes of a batch on stderr: ``[####....] 12/200 meshes, 1 failed``.
-
-    Redrawn in place on a terminal; otherwise one line per percent at most.
-    """
+class ProgressBar:
+    """A progress line on stderr, ``[####....] done/total <tail>``: redrawn in place on a terminal,
+    otherwise one line per call; ``close`` clears a terminal's line once something was drawn."""
 
     def __init__(self, stream, *, tty: bool, width: int = 24):
         self.stream = stream
@@ -31,15 +29,9 @@ class BatchBar:
         self.width = width
         self._shown = None
 
-    def __call__(self, done: int, total: int, failed: int) -> None:
-        if self.stream is None:
-            return
-        step = (done * 100 // total if total else 100, failed)
-        if not self.tty and step == self._shown:
-            return
-        self._shown = step
+    def _draw(self, done: int, total: int, tail: str) -> None:
         filled = round(self.width * done / total) if total else self.width
-        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} meshes, {failed} failed"
+        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} {tail}"
         if self.tty:
             self.stream.write(f"\r\033[K{text}")
         else:
@@ -50,6 +42,22 @@ class BatchBar:
         if self.stream is not None and self.tty and self._shown is not None:
             self.stream.write("\r\033[K")
             self.stream.flush()
+
+
+class BatchBar(ProgressBar):
+    """Progress over the meshes of a batch: ``[####....] 12/200 meshes, 1 failed``.
+
+    Redrawn in place on a terminal; otherwise one line per percent at most.
+    """
+
+    def __call__(self, done: int, total: int, failed: int) -> None:
+        if self.stream is None:
+            return
+        step = (done * 100 // total if total else 100, failed)
+        if not self.tty and step == self._shown:
+            return
+        self._shown = step
+        self._draw(done, total, f"meshes, {failed} failed")
 
 
 def batch_command() -> click.Command:

@@ -15,6 +15,8 @@ import warnings
 import click
 import numpy as np
 
+from ._batch_cli import ProgressBar
+
 __all__ = ["volume_command", "LabelBar", "MESH_FORMATS"]
 
 #: Formats of the per-label mesh files (those of :data:`meshcurv.io.FORMATS` that hold per-vertex fields).
@@ -23,34 +25,17 @@ MESH_FORMATS = ("ply", "vtp", "vtu", "vtk", "npz", "csv")
 _SHOWN_FAILURES = 10
 
 
-class LabelBar:
-    """Progress over the labels on stderr: ``[####....] 12/50 labels, label 17 ok``.
+class LabelBar(ProgressBar):
+    """Progress over the labels: ``[####....] 12/50 labels, label 17 ok``.
 
     Redrawn in place on a terminal; otherwise one line per label.
     """
-
-    def __init__(self, stream, *, tty: bool, width: int = 24):
-        self.stream = stream
-        self.tty = tty
-        self.width = width
-        self._shown = False
 
     def __call__(self, done: int, total: int, label: int, status: str) -> None:
         if self.stream is None:
             return
         self._shown = True
-        filled = round(self.width * done / total) if total else self.width
-        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} labels, label {label} {status}"
-        if self.tty:
-            self.stream.write(f"\r\033[K{text}")
-        else:
-            self.stream.write(f"meshcurv: {text}\n")
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.stream is not None and self.tty and self._shown:
-            self.stream.write("\r\033[K")
-            self.stream.flush()
+        self._draw(done, total, f"labels, label {label} {status}")
 
 
 def _stem(path: pathlib.Path) -> str:
