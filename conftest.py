@@ -12,7 +12,7 @@ import importlib.util
 _NEEDS = {
     "click": ["src/meshcurv/_cli_app.py", "src/meshcurv/_batch_cli.py", "src/meshcurv/_volume_cli.py",
               "src/meshcurv/_view_cli.py", "src/meshcurv/cli.py"],
-    "numba": ["src/meshcurv/_numba_kernels.py", "src/meshcurv/_pointcloud_kernels.py"],
+    "numba": ["src/meshcurv/_kernels"],
 }
 
 collect_ignore = [path for module, paths in _NEEDS.items() if importlib.util.find_spec(module) is None

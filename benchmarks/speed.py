@@ -146,9 +146,9 @@ def backends() -> tuple:
 
 
 def default_backend() -> str:
-    from meshcurv._backend import numba_kernels
+    from meshcurv._backend import backend_name
 
-    return "numba" if numba_kernels() is not None else "numpy"
+    return backend_name()
 
 
 def meshcurv_keys(methods=None, chosen_backends=None) -> list:
@@ -445,7 +445,7 @@ t_import = time.perf_counter() - t0
 m = meshcurv.shapes.icosphere(32)
 out = {"import": t_import}
 with use_backend("numba"):
-    t0 = time.perf_counter(); import meshcurv._numba_kernels; out["kernels_import"] = time.perf_counter() - t0
+    t0 = time.perf_counter(); import meshcurv._kernels; out["kernels_import"] = time.perf_counter() - t0
     for name in ESTIMATORS:
         t0 = time.perf_counter(); meshcurv.principal_curvatures(m.vertices, m.faces, method=name)
         first = time.perf_counter() - t0

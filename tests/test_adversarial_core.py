@@ -23,7 +23,7 @@ import meshcurv
 from meshcurv import neighborhoods, shapes, smoothing
 from meshcurv._backend import use_backend
 from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
-from meshcurv.estimators import quadric
+from meshcurv import jets
 from meshcurv.geometry import (degenerate_face_mask, edge_lengths, face_areas, mean_edge_length, median_edge_length,
                                robust_mean_edge_length, vertex_length_scales, vertex_normals)
 from meshcurv.topology import MeshTopology
@@ -152,8 +152,8 @@ def test_fit_jets_only_gathers_the_given_neighbours(backend):
     normals = np.vstack([SPHERE.normals, np.tile([0.0, 0.0, 1.0], (CLOUD.shape[0], 1))])
     mask = np.arange(vertices.shape[0]) < N
     with use_backend(backend):
-        alone, _, alone_counts = quadric.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4, degree=3)
-        mixed, _, counts = quadric.fit_jets(vertices, normals, 0.4, degree=3, neighbours=mask,
+        alone, _, alone_counts = jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4, degree=3)
+        mixed, _, counts = jets.fit_jets(vertices, normals, 0.4, degree=3, neighbours=mask,
                                             centres=np.arange(N))
     np.testing.assert_array_equal(mixed[:N], alone)
     np.testing.assert_array_equal(counts[:N], alone_counts)
@@ -225,19 +225,19 @@ def test_numpy_ball_chunks_are_bounded(monkeypatch):
 @pytest.mark.skipif("numba" not in BACKENDS, reason="needs numba")
 def test_compiled_balls_in_several_calls_give_the_same_sums(monkeypatch):
     monkeypatch.setattr(neighborhoods, "PAIRS_PER_CALL", 2000)
-    monkeypatch.setattr(quadric, "PAIRS_PER_CALL", 2000)
+    monkeypatch.setattr(jets, "PAIRS_PER_CALL", 2000)
     top = MeshTopology.from_faces(SPHERE.faces, N)
     values = np.column_stack([face_areas(SPHERE.vertices, SPHERE.faces), np.arange(top.n_faces, dtype=float)])
     with use_backend("numba"):
         parts = neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values)
-        jets = quadric.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)
+        split = jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)
         monkeypatch.setattr(neighborhoods, "PAIRS_PER_CALL", 10**12)
-        monkeypatch.setattr(quadric, "PAIRS_PER_CALL", 10**12)
+        monkeypatch.setattr(jets, "PAIRS_PER_CALL", 10**12)
         whole = neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values)
-        one = quadric.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)
+        one = jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)
     np.testing.assert_array_equal(parts, whole)
-    np.testing.assert_array_equal(jets[0], one[0])
-    np.testing.assert_array_equal(jets[2], one[2])
+    np.testing.assert_array_equal(split[0], one[0])
+    np.testing.assert_array_equal(split[2], one[2])
 
 
 @pytest.mark.slow

@@ -23,8 +23,8 @@ from meshcurv._backend import backend_name, numba_kernels, use_backend
 from meshcurv.errors import InvalidOptionError, MeshQualityWarning, MissingDependencyError
 
 PYPROJECT = pathlib.Path(__file__).resolve().parents[1] / "pyproject.toml"
-#: The modules that import numba when imported themselves.
-COMPILED = ("meshcurv._numba_kernels", "meshcurv._pointcloud_kernels")
+#: The package whose modules import numba when imported themselves.
+COMPILED = "meshcurv._kernels"
 
 
 class _NoNumba(importlib.abc.MetaPathFinder):
@@ -45,10 +45,10 @@ def no_numba(monkeypatch):
     """numba cannot be imported for the duration of the test; the backend decides afresh before and after."""
     finder = _NoNumba()
     monkeypatch.setattr(sys, "meta_path", [finder, *sys.meta_path])
-    for name in [name for name in sys.modules if name == "numba" or name.startswith("numba.")] + list(COMPILED):
+    for name in [name for name in sys.modules
+                 if name in ("numba", COMPILED) or name.startswith(("numba.", COMPILED + "."))]:
         monkeypatch.delitem(sys.modules, name, raising=False)
-    for name in COMPILED:
-        monkeypatch.delattr(meshcurv, name.rpartition(".")[2], raising=False)
+    monkeypatch.delattr(meshcurv, "_kernels", raising=False)
     monkeypatch.delenv("MESHCURV_BACKEND", raising=False)
     _backend._forget()
     yield finder
@@ -107,16 +107,16 @@ def test_the_extra_named_in_the_message_installs_numba():
 def test_asking_for_numba_without_it_names_the_extra(no_numba, monkeypatch):
     monkeypatch.setenv("MESHCURV_BACKEND", "numba")
     with pytest.raises(MissingDependencyError, match=r"the numba backend needs numba .*pip install 'meshcurv\[fast\]'"):
-        numba_kernels()
+        numba_kernels("geometry")
     with use_backend("numba"), pytest.raises(MissingDependencyError, match=r"meshcurv\[fast\]"):
-        numba_kernels()
+        numba_kernels("geometry")
     assert no_numba.attempts == 1
 
 
 def test_the_numba_backend_is_announced_once(fresh_backend, caplog):
     numba = pytest.importorskip("numba")
     with caplog.at_level(logging.INFO, logger="meshcurv"):
-        first, second = numba_kernels(), numba_kernels()
+        first, second = numba_kernels("geometry"), numba_kernels("geometry")
     assert first is second is not None
     lines = [r.getMessage() for r in caplog.records if r.getMessage().startswith("meshcurv backend:")]
     assert lines == [f"meshcurv backend: numba {numba.__version__} (the fast kernels)"]
@@ -124,13 +124,13 @@ def test_the_numba_backend_is_announced_once(fresh_backend, caplog):
 
 def test_use_backend_overrides_the_environment_and_nests(fresh_backend, monkeypatch):
     monkeypatch.setenv("MESHCURV_BACKEND", "numpy")
-    assert numba_kernels() is None and backend_name() == "numpy"
+    assert numba_kernels("geometry") is None and backend_name() == "numpy"
     with use_backend("auto"):
         assert backend_name() == ("numba" if _importable("numba") else "numpy")
         with use_backend("numpy"):
-            assert numba_kernels() is None
+            assert numba_kernels("geometry") is None
         assert backend_name() == ("numba" if _importable("numba") else "numpy")
-    assert numba_kernels() is None  # the environment again once the block is left
+    assert numba_kernels("geometry") is None  # the environment again once the block is left
 
 
 def test_unknown_backends_are_refused(fresh_backend, monkeypatch):
@@ -139,7 +139,7 @@ def test_unknown_backends_are_refused(fresh_backend, monkeypatch):
             pass
     monkeypatch.setenv("MESHCURV_BACKEND", "cuda")
     with pytest.raises(InvalidOptionError, match=r"unknown backend 'cuda' \(MESHCURV_BACKEND\)"):
-        numba_kernels()
+        numba_kernels("geometry")
 
 
 def _interrupted_kernel(*args):

@@ -77,24 +77,24 @@ def test_topology_is_identical(name):
 @pytest.mark.parametrize("chunks", [1, 3, 7])
 def test_topology_does_not_depend_on_the_number_of_threads(chunks):
     """The compiled build splits the vertices into one range per thread: any split gives the same edges."""
-    from meshcurv import _numba_kernels
+    from meshcurv._kernels import topology as kernels_topology
     from meshcurv.topology import _build_edges
 
     vertices, faces = MESHES["defects"]
     faces = np.asarray(faces, np.int64)
     expected = _build_edges(faces, vertices.shape[0])
-    for got, want in zip(_numba_kernels.build_edges(faces, vertices.shape[0], chunks), expected, strict=True):
+    for got, want in zip(kernels_topology.build_edges(faces, vertices.shape[0], chunks), expected, strict=True):
         np.testing.assert_array_equal(got, want)
 
 
 def test_neighbour_lists_do_not_depend_on_the_number_of_threads():
-    from meshcurv import _numba_kernels
+    from meshcurv._kernels import topology as kernels_topology
 
     vertices, faces = MESHES["defects"]
     top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
-    indptr, indices = _numba_kernels.neighbour_lists(top.edges, top.n_vertices, 1)
+    indptr, indices = kernels_topology.neighbour_lists(top.edges, top.n_vertices, 1)
     for chunks in (2, 7):
-        other = _numba_kernels.neighbour_lists(top.edges, top.n_vertices, chunks)
+        other = kernels_topology.neighbour_lists(top.edges, top.n_vertices, chunks)
         np.testing.assert_array_equal(other[0], indptr)
         np.testing.assert_array_equal(other[1], indices)
     with use_backend("numpy"):  # the same neighbours as the adjacency matrix, in edge order
@@ -106,13 +106,13 @@ def test_neighbour_lists_do_not_depend_on_the_number_of_threads():
 
 @pytest.mark.parametrize("chunks", [1, 3])
 def test_bowtie_vertices_do_not_depend_on_the_number_of_threads(chunks):
-    from meshcurv import _numba_kernels
+    from meshcurv._kernels import topology as kernels_topology
     from meshcurv.topology import _bowtie_vertices
 
     vertices, faces = MESHES["bowtie"]
     top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
     linked = (top.edge_face_counts == 2) & (top.edge_faces[:, 0] != top.edge_faces[:, 1])
-    found = _numba_kernels.bowtie_vertices(top.faces, top.edges, top.edge_faces, linked, ~top.degenerate_faces,
+    found = kernels_topology.bowtie_vertices(top.faces, top.edges, top.edge_faces, linked, ~top.degenerate_faces,
                                            top.n_vertices, chunks)
     np.testing.assert_array_equal(found, _bowtie_vertices(top))
     assert found.sum() == 1
@@ -121,16 +121,16 @@ def test_bowtie_vertices_do_not_depend_on_the_number_of_threads(chunks):
 @pytest.mark.parametrize("name", ["defects", "flipped_faces"])
 def test_normal_cycle_sums_do_not_depend_on_the_number_of_threads(name):
     """Each thread adds what falls on its own range of vertices, in the same order: the sums are identical."""
-    from meshcurv import _numba_kernels
+    from meshcurv._kernels import normal_cycle as kernels_normal_cycle
     from meshcurv.geometry import DEGENERATE_AREA_RATIO, vertex_length_scales
 
     vertices, faces = MESHES[name]
     top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
     arguments = (vertices, top.faces, top.edges, top.edge_faces, top.edge_face_counts, top._edge_forward_counts,
                  vertex_length_scales(vertices, top), DEGENERATE_AREA_RATIO)
-    sums, degenerate = _numba_kernels.normal_cycle_sums(*arguments, 1)
+    sums, degenerate = kernels_normal_cycle.normal_cycle_sums(*arguments, 1)
     for chunks in (2, 5):
-        other_sums, other_degenerate = _numba_kernels.normal_cycle_sums(*arguments, chunks)
+        other_sums, other_degenerate = kernels_normal_cycle.normal_cycle_sums(*arguments, chunks)
         np.testing.assert_array_equal(other_sums, sums)
         np.testing.assert_array_equal(other_degenerate, degenerate)
     assert np.abs(sums[:, :6]).sum() > 0 and (name != "defects" or degenerate.sum() == 3)
@@ -138,16 +138,16 @@ def test_normal_cycle_sums_do_not_depend_on_the_number_of_threads(name):
 
 @pytest.mark.parametrize("name", ["defects", "torus"])
 def test_matgeom_sums_do_not_depend_on_the_number_of_threads(name):
-    from meshcurv import _numba_kernels
+    from meshcurv._kernels import matgeom as kernels_matgeom
 
     vertices, faces = MESHES[name]
     top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
     arguments = (vertices, top.faces, top.edges[:, 0].copy(), top.edges[:, 1].copy(),
                  np.maximum(top.edge_faces[:, 0], 0), np.maximum(top.edge_faces[:, 1], 0))
-    sums = _numba_kernels.matgeom_vertex_tensors(*arguments, 1)
+    sums = kernels_matgeom.matgeom_vertex_tensors(*arguments, 1)
     assert np.isfinite(sums).any()
     for chunks in (2, 5):
-        np.testing.assert_array_equal(_numba_kernels.matgeom_vertex_tensors(*arguments, chunks), sums)
+        np.testing.assert_array_equal(kernels_matgeom.matgeom_vertex_tensors(*arguments, chunks), sums)
 
 
 @pytest.mark.parametrize("method", ["normal_cycle", "matgeom"])
@@ -202,7 +202,7 @@ def test_ball_methods_agree(name, method):
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
 def test_jets_fitted_at_chosen_centres(backend):
     # fitting a subset of the vertices gives their rows of the full fit; the other rows are NaN
-    from meshcurv.estimators.quadric import fit_jets
+    from meshcurv.jets import fit_jets
 
     mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=2)
     normals = mesh.vertices / np.linalg.norm(mesh.vertices, axis=1, keepdims=True)
@@ -221,7 +221,7 @@ def test_ball_grid_finds_every_neighbour_of_a_sparse_flat_cloud():
     # 50 clusters of 40 points scattered over a 1000 x 1000 square, radius 5: cells of side 5
     # would make 20 columns per point, so the kernel widens its cells; every ball must still
     # hold every point within the radius (brute force)
-    from meshcurv.estimators.quadric import fit_jets
+    from meshcurv.jets import fit_jets
 
     rng = np.random.default_rng(4)
     clusters = rng.uniform(0, 1000, (50, 2)).repeat(40, axis=0)
@@ -272,7 +272,8 @@ class _Event:
 
 def test_compilation_is_announced_once_on_the_logger(caplog):
     from meshcurv import _backend
-    from meshcurv._numba_kernels import fit_jets, icc_face_measures
+    from meshcurv._kernels.icc import face_measures
+    from meshcurv._kernels.jets import fit_jets
 
     announcer = _backend._CompileAnnouncer()
     foreign = _Event(warnings.warn, True)  # a function of another package: never announced
@@ -280,20 +281,21 @@ def test_compilation_is_announced_once_on_the_logger(caplog):
         announcer.on_start(foreign)
         announcer.on_end(_Event(warnings.warn, False))
         assert not caplog.records
-        for kernel in (fit_jets.py_func, icc_face_measures.py_func):
+        for kernel in (fit_jets.py_func, face_measures.py_func):
             announcer.on_start(_Event(kernel, True))
             announcer.on_end(_Event(kernel, False))
     warned = [r for r in caplog.records if r.levelname == "WARNING"]
     assert len(warned) == 1 and "compiling meshcurv's numba kernels" in warned[0].getMessage()
     assert "cached on disk" in warned[0].getMessage()
     infos = [r.getMessage() for r in caplog.records if r.levelname == "INFO"]
-    assert [m.split()[4] for m in infos] == ["fit_jets", "icc_face_measures"]
-    assert [name for name, _ in announcer.compiled] == ["fit_jets", "icc_face_measures"]
+    assert [m.split()[4] for m in infos] == ["fit_jets", "face_measures"]
+    assert [name for name, _ in announcer.compiled] == ["fit_jets", "face_measures"]
 
 
 def test_nested_compilations_count_once(caplog):
     from meshcurv import _backend
-    from meshcurv._numba_kernels import _grid, fit_jets
+    from meshcurv._kernels.jets import fit_jets
+    from meshcurv._kernels.neighborhoods import _grid
 
     announcer = _backend._CompileAnnouncer()
     with caplog.at_level("INFO", logger="meshcurv"):
@@ -308,7 +310,7 @@ SNIPPET = """
 import logging, numpy as np
 logging.basicConfig(level=logging.INFO, format="%(levelname)s %(message)s")
 from meshcurv._backend import numba_kernels
-numba_kernels().edge_lengths(np.eye(3), np.array([[0, 1], [1, 2]]))
+numba_kernels("geometry").edge_lengths(np.eye(3), np.array([[0, 1], [1, 2]]))
 """
 
 
@@ -338,7 +340,7 @@ def test_normalized_normal_sums_agree():
     summed[5:10] = [1e-100, 0.0, 0.0]  # tiny but not cancelled: unit
     expected = geometry.normalize_normal_sums(summed)
     assert np.isnan(expected[:5]).all() and np.allclose(expected[5:10], [1.0, 0.0, 0.0])
-    np.testing.assert_array_equal(numba_kernels().normalize_normal_sums(summed), expected)
+    np.testing.assert_array_equal(numba_kernels("geometry").normalize_normal_sums(summed), expected)
 
 
 def test_small_kernels_run_on_one_thread_and_the_count_is_restored():
@@ -356,9 +358,9 @@ def test_small_kernels_run_on_one_thread_and_the_count_is_restored():
     assert numba.get_num_threads() == threads  # restored after a failing kernel too
 
 
-def test_python_helpers_of_the_kernels_module_keep_every_thread():
+def test_kernel_threads_are_numbas_thread_count():
     import numba
 
-    from meshcurv._backend import numba_kernels
+    from meshcurv._backend import kernel_threads
 
-    assert numba_kernels().threads() == numba.get_num_threads()  # no array argument: not a small kernel
+    assert kernel_threads() == numba.get_num_threads()

@@ -209,7 +209,7 @@ def test_too_small_radius_gives_nan_and_the_warning():
 
 def test_compiled_triangle_sums_match_the_numpy_path():
     pytest.importorskip("numba")
-    from meshcurv._pointcloud_kernels import ball_triangle_sums
+    from meshcurv._kernels.pointcloud import ball_triangle_sums
 
     rng = np.random.default_rng(0)
     points, exact = sphere_points(300)
@@ -229,7 +229,7 @@ def test_compiled_pca_normals_match_eigh():
     pytest.importorskip("numba")
     from scipy.spatial import cKDTree
 
-    from meshcurv._pointcloud_kernels import pca_normals
+    from meshcurv._kernels.pointcloud import pca_normals
 
     rng = np.random.default_rng(2)
     plane = np.column_stack([rng.uniform(-1, 1, (2000, 2)), np.zeros(2000)]) @ random_rotation().T + 1e3
@@ -247,7 +247,7 @@ def test_compiled_ball_search_matches_the_k_d_tree():
     pytest.importorskip("numba")
     from scipy.spatial import cKDTree
 
-    from meshcurv._pointcloud_kernels import ball_indices
+    from meshcurv._kernels.pointcloud import ball_indices
 
     points, _ = sphere_points(3000)
     usable = np.random.default_rng(3).random(3000) > 0.05

@@ -14,7 +14,7 @@ import pytest
 
 from meshcurv import shapes
 from meshcurv._backend import use_backend
-from meshcurv.estimators.quadric import fit_jet_normals, fit_jets, jet_normals
+from meshcurv.jets import fit_jet_normals, fit_jets, jet_normals
 from meshcurv.geometry import robust_mean_edge_length
 from meshcurv.neighborhoods import ball_face_sums
 from meshcurv.topology import MeshTopology

@@ -1,8 +1,8 @@
 """Choice between the pure-NumPy code paths and the compiled (numba) kernels.
 
 The NumPy paths are always there and are the reference; the numba kernels
-(:mod:`meshcurv._numba_kernels`) compute the same quantities in single passes
-without temporaries. They are used when numba is installed
+(:mod:`meshcurv._kernels`, one module beside each module of NumPy code) compute
+the same quantities in single passes without temporaries. They are used when numba is installed
 (``pip install 'meshcurv[fast]'``) unless the NumPy paths are asked for.
 
 Decided once per process: the first call that needs a kernel tries to import
@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import importlib
 import logging
 import os
 import threading
@@ -93,15 +94,15 @@ MISSING_MESSAGE = ("meshcurv backend: numpy (numba cannot be imported: %s); pip 
 
 
 def _import_kernels():
-    """The kernels module, imported once per process; None when numba (or the module) cannot be imported."""
+    """The kernels package, imported once per process; None when numba (or the package) cannot be imported."""
     global _imported
     if _imported is None:
         try:
-            from . import _numba_kernels
+            from . import _kernels
         except ImportError as error:
             _imported = (None, error)
         else:
-            _imported = (_numba_kernels, None)
+            _imported = (_kernels, None)
             _announce_compilation()
     return _imported[0]
 
@@ -121,17 +122,17 @@ def _forget() -> None:
 
 def backend_name() -> str:
     """``'numba'`` or ``'numpy'``: the backend the next call will use (see the module's doc)."""
-    return "numpy" if numba_kernels() is None else "numba"
+    return "numpy" if _compiled() is None else "numba"
 
 
-def numba_kernels():
-    """The numba kernels module, or None when the NumPy paths are to be used."""
+def _compiled():
+    """The kernels package when the compiled backend is to be used, else None (and the backend logged once)."""
     choice = _requested()
     if choice == "numpy":
         _log_once("numpy", "meshcurv backend: numpy (asked for: MESHCURV_BACKEND or use_backend)")
         return None
-    module = _import_kernels()
-    if module is None:
+    package = _import_kernels()
+    if package is None:
         error = _imported[1]
         if choice == "numba":
             raise MissingDependencyError(
@@ -141,7 +142,30 @@ def numba_kernels():
         return None
     if "numba" not in _logged:
         _log_once("numba", "meshcurv backend: numba %s (the fast kernels)", _numba_version())
-    return _serialised(module)
+    return package
+
+
+def numba_kernels(module: str):
+    """The compiled kernels of ``meshcurv._kernels.<module>``, or None when the NumPy paths are to be used.
+
+    ``module`` names the module of NumPy code the kernels mirror
+    (``"geometry"``, ``"jets"``, ``"icc"``, ...). The module is imported on
+    first use and handed out behind :class:`_SerialisedKernels`.
+    """
+    package = _compiled()
+    if package is None:
+        return None
+    return _serialised(importlib.import_module(f"{package.__name__}.{module}"))
+
+
+def kernel_threads() -> int:
+    """The threads numba's parallel kernels use (``NUMBA_NUM_THREADS``, ``numba.set_num_threads``).
+
+    For sizing the chunks of a kernel's work; call it only on the compiled path.
+    """
+    import numba
+
+    return numba.get_num_threads()
 
 
 def _numba_version() -> str:
@@ -289,7 +313,7 @@ def _direct(function, args, kwargs):
 
 
 def _locked(function):
-    # compiled kernels only: the module's Python helpers (threads(), wrappers) run as they are
+    # compiled kernels only: a module's Python helpers run as they are
     run = _run if hasattr(function, "py_func") else _direct
 
     @functools.wraps(function)
@@ -324,15 +348,6 @@ def _interrupt_of(error: BaseException) -> KeyboardInterrupt | None:
 
 
 _proxies: dict = {}
-
-
-def kernels_of(module) -> _SerialisedKernels:
-    """The compiled kernels of ``module`` (one that imports numba) as :func:`numba_kernels` hands them out.
-
-    Each call under the lock of the threading layer, with Ctrl-C as a
-    KeyboardInterrupt and small inputs on one thread (see the module's doc).
-    """
-    return _serialised(module)
 
 
 def _serialised(module) -> _SerialisedKernels:

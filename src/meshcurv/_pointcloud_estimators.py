@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import kernels_of, numba_kernels
+from ._backend import numba_kernels
 from ._pointcloud_normals import grid_of
 from ._tensors import principal_from_shape_operator
 from .estimators.icc import face_measures
-from .estimators.quadric import fit_jets, jet_normals, shape_operators
+from .jets import fit_jets, jet_normals, shape_operators
 
 #: Degree of the jets of ``method="jets"`` (Cazals and Pouget 2005: error of order ``r^(d-1)``).
 JET_DEGREE = 3
@@ -55,8 +55,8 @@ def one_sided_fits(points, normals, radius, centres, usable, *, smallest: float 
     a thin tube) or than the radius of curvature (a sharp rim) holds points
     of the other side, whose oriented ``normals`` point the other way: a jet
     through both sides is not the surface. Such a fit (more than
-    :data:`meshcurv.estimators.quadric.AWAY_FRACTION` of the ball's points
-    facing away, the ``facing`` check of :func:`~meshcurv.estimators.quadric.fit_jets`)
+    :data:`meshcurv.jets.AWAY_FRACTION` of the ball's points
+    facing away, the ``facing`` check of :func:`~meshcurv.jets.fit_jets`)
     is redone over a ball :data:`SHRINK` times smaller, down to ``smallest``.
     Where the surface is thicker than ``radius`` every fit is the one over
     ``radius``. ``smallest=None``: one fit over ``radius``, not checked.
@@ -193,7 +193,7 @@ def _usable_tree(tree, points, usable):
 def _ball_indices(search, points, chunk, radius, k):
     """(M, k) the ``k`` nearest usable points within ``radius`` of each centre of ``chunk`` and (M,) their count.
 
-    The NumPy path of :func:`meshcurv._pointcloud_kernels.ball_indices`: a
+    The NumPy path of :func:`meshcurv._kernels.pointcloud.ball_indices`: a
     query of the k-d tree of :func:`_usable_tree` (``search``); rows in
     distance order, padded with ``N``.
     """
@@ -224,11 +224,10 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
     out = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)]
     pattern = _rank_pattern(TRIANGLES if n_triangles is None else n_triangles)
     compiled = None
-    if numba_kernels() is not None:
-        from . import _pointcloud_kernels
-
-        compiled = kernels_of(_pointcloud_kernels).ball_triangle_sums  # locked, interruptible
-        find_balls = kernels_of(_pointcloud_kernels).ball_indices
+    kernels = numba_kernels("pointcloud")
+    if kernels is not None:
+        compiled = kernels.ball_triangle_sums  # locked, interruptible
+        find_balls = kernels.ball_indices
     k = min(ball_size(radius, spacing), n)
     grid = None if compiled is None else grid_of(points, usable, radius)
     search = _usable_tree(tree, points, usable) if grid is None else None

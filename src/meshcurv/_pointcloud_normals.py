@@ -11,7 +11,7 @@ computed by pointer jumping (``log2(depth)`` vectorised passes over the
 points, no loop over them); with the compiled backend, Kruskal's algorithm
 over the edges in order of weight with a union-find that keeps each point's
 flip relative to its root gives the same signs in one pass
-(:func:`meshcurv._pointcloud_kernels.spanning_signs`). Each connected component of the graph is then
+(:func:`meshcurv._kernels.pointcloud.spanning_signs`). Each connected component of the graph is then
 turned outward: by the divergence theorem ``sum_i a_i n_i . (p_i - c) = 3 V > 0``
 for the outward normals of a closed surface (``a_i`` the area of a point, the
 square of its local spacing; ``c`` any point); on an open surface the sum
@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import kernels_of, numba_kernels
+from ._backend import numba_kernels
 
 #: Neighbours (the point itself not counted) of the k-nearest-neighbour query that
 #: gives the spacing, the PCA normals and the orientation graph.
@@ -53,13 +53,6 @@ GRID_COLUMNS = 8
 
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
-
-
-def _pointcloud_kernels():
-    """The compiled kernels' module (imported only when the numba backend is in use)."""
-    from . import _pointcloud_kernels as module
-
-    return module
 
 
 def knn(tree, points: np.ndarray, k: int = NEIGHBOURS) -> tuple[np.ndarray, np.ndarray]:
@@ -96,7 +89,7 @@ def _drop_self(rows, d, i, k, distances, indices) -> None:
 def grid_of(points, usable, side):
     """``(low, dims, keys, starts, pool, pool_points, columns)``: the usable points by cell of a grid.
 
-    The input of :func:`meshcurv._pointcloud_kernels.ball_indices`. None when
+    The input of :func:`meshcurv._kernels.pointcloud.ball_indices`. None when
     the grid's cell numbers would not fit in an int64 (a side below about
     1e-6 of the cloud's extent): the k-d tree then answers.
     """
@@ -138,12 +131,13 @@ def local_spacing(distances: np.ndarray) -> np.ndarray:
 def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """(N, 3) unit normals (unoriented): the least-variance direction of each point and its neighbours.
 
-    The compiled kernel (:func:`meshcurv._pointcloud_kernels.pca_normals`, a
+    The compiled kernel (:func:`meshcurv._kernels.pointcloud.pca_normals`, a
     closed form) when the numba backend is in use, else :func:`numpy.linalg.eigh`
     on chunks of covariances.
     """
-    if numba_kernels() is not None:
-        return kernels_of(_pointcloud_kernels()).pca_normals(points, np.ascontiguousarray(indices))
+    kernels = numba_kernels("pointcloud")
+    if kernels is not None:
+        return kernels.pca_normals(points, np.ascontiguousarray(indices))
     return _pca_normals_numpy(points, indices)
 
 
@@ -224,7 +218,7 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
         back_to_back = (ahead < 0) & (behind > 0) & (np.einsum("ij,ij->i", normals[rows], normals[cols]) < 0)
         keep = flat | (~enough[rows] & ~back_to_back)
         rows, cols = rows[keep], cols[keep]
-    compiled = None if numba_kernels() is None else kernels_of(_pointcloud_kernels())
+    compiled = numba_kernels("pointcloud")
     if compiled is not None and points is None:  # every kept edge's cosine without (E, 3) gathers
         cosine = compiled.edge_cosines(normals, np.ascontiguousarray(indices)).ravel()[keep]
     else:

@@ -72,7 +72,7 @@ def principal_from_shape_operator(tensor: np.ndarray, normals: np.ndarray, *, ro
     k_min, k_max : ndarray of shape (N,)
     dir_min, dir_max : ndarray of shape (N, 3)
     """
-    kernels = numba_kernels()
+    kernels = numba_kernels("tensors")
     if kernels is not None:
         return kernels.principal_from_shape_operator(tensor, normals, rotate, mean_from_trace)
     t1, t2 = tangent_basis(normals)

@@ -155,7 +155,7 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
     cross = _optional_floats(cross, "cross", topology.faces.shape)
     double_areas = _optional_floats(double_areas, "double_areas", (topology.n_faces,))
     scales = _optional_floats(scales, "scales", (topology.n_vertices,))
-    kernels = numba_kernels()
+    kernels = numba_kernels("diagnosis")
     if scales is None and mean_edge_length is None:
         scales = vertex_length_scales(vertices, topology)
     if kernels is not None and double_areas is None:
@@ -237,7 +237,7 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     referenced = topology.referenced_vertices
     n_unreferenced = int(topology.n_vertices - referenced.sum())
     scales = vertex_length_scales(vertices, topology)
-    kernels = numba_kernels()
+    kernels = numba_kernels("diagnosis")
     if kernels is not None:
         lower, upper, area, six_volume, scale, n_degenerate, n_zero_length = kernels.mesh_facts(
             vertices, faces, topology.edges, referenced, scales, DEGENERATE_AREA_RATIO, ZERO_LENGTH_RATIO)

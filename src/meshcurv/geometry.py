@@ -64,7 +64,7 @@ def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     Written out component by component (faster than :func:`numpy.cross`, same values).
     """
     vertices, faces = checked_mesh(vertices, faces)
-    kernels = numba_kernels()
+    kernels = numba_kernels("geometry")
     if kernels is not None:
         return kernels.face_cross_products(vertices, faces)
     a = vertices[faces[:, 0]]
@@ -134,7 +134,7 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
     if cross is None:
         cross = face_cross_products(vertices, faces)
     n = vertices.shape[0]
-    kernels = numba_kernels()
+    kernels = numba_kernels("geometry")
     if kernels is not None:
         return kernels.normalize_normal_sums(kernels.vertex_normal_sums(cross, faces, n))
     flat = faces.ravel()
@@ -155,7 +155,7 @@ def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
 def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """(E,) length of each of the given (E, 2) edges."""
     vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
-    kernels = numba_kernels()
+    kernels = numba_kernels("geometry")
     if kernels is not None:
         return kernels.edge_lengths(vertices, edges)
     d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
@@ -166,7 +166,7 @@ def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """(V,) mean length of the given (E, 2) edges at each vertex: the local resolution (NaN where none)."""
     vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
     n = vertices.shape[0]
-    kernels = numba_kernels()
+    kernels = numba_kernels("geometry")
     if kernels is not None:
         return kernels.vertex_edge_lengths(vertices, edges, n)
     flat = edges.ravel()
@@ -185,7 +185,7 @@ def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
     if edges.shape[0] == 0:
         return 0.0
-    kernels = numba_kernels()
+    kernels = numba_kernels("geometry")
     if kernels is not None:
         return float(kernels.mean_edge_length(vertices, edges))
     return float(edge_lengths(vertices, edges).mean())

@@ -87,8 +87,8 @@ def _face_mean_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.nda
     from ._backend import numba_kernels
     from .estimators.icc import face_measures
 
-    kernels = numba_kernels()
-    measure = getattr(kernels, "icc_face_measures", None) or face_measures
+    kernels = numba_kernels("icc")
+    measure = face_measures if kernels is None else kernels.face_measures
     measures = measure(np.ascontiguousarray(vertices), np.ascontiguousarray(faces, dtype=np.int64),
                        np.ascontiguousarray(normals))[:, 1] / 2
     return np.where(np.isfinite(measures), measures, 0.0)

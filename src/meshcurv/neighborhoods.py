@@ -37,7 +37,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import kernel_threads, numba_kernels
 from ._validation import check_positive_float, checked_indices, checked_points
 from .errors import InvalidMeshError, InvalidOptionError
 from .geometry import median_edge_length, robust_mean_edge_length, vertex_length_scales
@@ -368,7 +368,7 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
         usable = np.asarray(usable, dtype=bool)
         if usable.shape != (cells.shape[0],):
             raise InvalidMeshError(f"`usable` must have shape ({cells.shape[0]},); got {usable.shape}")
-    kernels = numba_kernels()
+    kernels = numba_kernels("neighborhoods")
     if connected and kernels is not None and cells.shape[1] == 3 and cells.shape[0]:
         return _connected_face_sums(kernels, vertices, cells, radius, values, usable)
     if usable is not None:
@@ -398,7 +398,7 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
             for call in range(n_calls):  # Python between calls: Ctrl-C gets through
                 sums = kernels.ball_cell_sums(vertices, cells[group], centres[group],
                                               np.ascontiguousarray(values[group]), radius, cutoff,
-                                              64 * kernels.threads(), call * n // n_calls,
+                                              64 * kernel_threads(), call * n // n_calls,
                                               (call + 1) * n // n_calls)
                 if isinstance(group, slice) and n_calls == 1:  # one group, one call: its sums are the result
                     return sums
@@ -429,7 +429,7 @@ def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radiu
     out = None
     for call in range(n_calls):  # Python between calls: Ctrl-C gets through
         sums = kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radius, indptr, indices,
-                                           kernels.threads(), call * n // n_calls, (call + 1) * n // n_calls)
+                                           kernel_threads(), call * n // n_calls, (call + 1) * n // n_calls)
         out = sums if out is None else out + sums
     return out
 

@@ -48,7 +48,7 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
      1.8% against 7% for jets) and below 1% on clean samples;
    - ``"jets"``: weighted degree-3 jets over the ball, refitted in the frame
      of their own normal (Cazals and Pouget 2005), curvatures from the jet's
-     second fundamental form (:func:`meshcurv.estimators.quadric.shape_operators`);
+     second fundamental form (:func:`meshcurv.jets.shape_operators`);
      with the default radius, a ball that holds the other side of the surface
      shrinks as the normal fits' do, down to ``3 s``;
      the lowest error on clean samples (ellipsoid H 0.2%) and the fastest.
@@ -80,7 +80,7 @@ from . import _pointcloud_estimators as _estimators
 from . import _pointcloud_normals as _normals
 from ._validation import as_vertices, check_choice, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
-from .estimators.quadric import fit_jets
+from .jets import fit_jets
 from .result import INVALID_REASONS, CurvatureResult
 
 __all__ = ["point_cloud_curvatures", "POINT_CLOUD_METHODS", "MIN_POINTS"]

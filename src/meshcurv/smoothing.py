@@ -86,7 +86,7 @@ def smooth_vertex_field(values, topology: MeshTopology, steps: int) -> np.ndarra
         )
     if steps <= 0:
         return field
-    kernels = numba_kernels()
+    kernels = numba_kernels("smoothing")
     if kernels is not None:
         flat = np.ascontiguousarray(field.reshape(field.shape[0], -1))
         indptr, indices = topology.neighbour_lists

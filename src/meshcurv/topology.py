@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import kernel_threads, numba_kernels
 from ._validation import (MAX_VERTICES, Ragged, check_vertex_count, checked_triangles, fan_triangles,
                           polygon_arrays)
 from .errors import InvalidMeshError
@@ -167,9 +167,9 @@ class MeshTopology:
     @classmethod
     def _build(cls, faces: np.ndarray, n_vertices: int) -> MeshTopology:
         """Build from already validated int64 (F, 3) triangles."""
-        kernels = numba_kernels()
+        kernels = numba_kernels("topology")
         if kernels is not None:
-            edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(faces, n_vertices, kernels.threads())
+            edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(faces, n_vertices, kernel_threads())
         else:
             edges, face_edges, edge_faces, counts, forward_counts = _build_edges(faces, n_vertices)
         return cls(
@@ -250,12 +250,12 @@ class MeshTopology:
         left out. Vertices on non-manifold edges usually have several fans too
         and are included.
         """
-        kernels = numba_kernels()
+        kernels = numba_kernels("topology")
         if kernels is None:
             return _readonly(_bowtie_vertices(self))
         linked = (self.edge_face_counts == 2) & (self.edge_faces[:, 0] != self.edge_faces[:, 1])
         return _readonly(kernels.bowtie_vertices(self.faces, self.edges, self.edge_faces, linked,
-                                                 ~self.degenerate_faces, self.n_vertices, kernels.threads()))
+                                                 ~self.degenerate_faces, self.n_vertices, kernel_threads()))
 
     @cached_property
     def degenerate_faces(self) -> np.ndarray:
@@ -282,9 +282,9 @@ class MeshTopology:
 
         The neighbours of vertex ``v`` are ``indices[indptr[v]:indptr[v + 1]]``.
         """
-        kernels = numba_kernels()
+        kernels = numba_kernels("topology")
         if kernels is not None:
-            indptr, indices = kernels.neighbour_lists(self.edges, self.n_vertices, kernels.threads())
+            indptr, indices = kernels.neighbour_lists(self.edges, self.n_vertices, kernel_threads())
         else:
             adjacency = self.adjacency
             indptr, indices = adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64)
@@ -316,7 +316,7 @@ class MeshTopology:
         numbered in the order of each component's first vertex, -1 for an
         unreferenced vertex.
         """
-        kernels = numba_kernels()
+        kernels = numba_kernels("topology")
         referenced = self.referenced_vertices
         if kernels is not None:
             labels, count = kernels.component_labels(self.edges, referenced, self.n_vertices)
@@ -335,7 +335,7 @@ class MeshTopology:
     @cached_property
     def n_components(self) -> int:
         """Number of connected components of the faces."""
-        kernels = numba_kernels()
+        kernels = numba_kernels("topology")
         if kernels is None:
             return int(self.face_components[0])
         return int(kernels.count_components(self.edges, self.referenced_vertices, self.n_vertices))

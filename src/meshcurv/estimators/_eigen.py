@@ -16,7 +16,7 @@ def sorted_by_magnitude(tensors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     The sort is stable over LAPACK's ascending order, as matGeom's ``sort(abs(d))``
     over Octave's ``eig``. Rows with a non-finite component are NaN. (The
     compiled path of matGeom's estimator does the same per vertex in
-    ``_numba_kernels.matgeom_principal``.)
+    ``_kernels.matgeom.matgeom_principal``.)
     """
     n = tensors.shape[0]
     values = np.full((n, 3), np.nan)

@@ -2,7 +2,7 @@
 
 The vertex normals ``u_i`` are those of a weighted degree-3 jet fitted over the
 ball ``B(x_i, 3 r)`` with one normal re-estimation
-(:func:`meshcurv.estimators.quadric.fit_jets`; Cazals and Pouget 2005), not the
+(:func:`meshcurv.jets.fit_jets`; Cazals and Pouget 2005), not the
 area-weighted mean of the face normals: the corrected measures are only as
 good as the normals they interpolate, and the mean of the face normals has an
 error of order ``h`` on an irregular triangulation (a median error of H of 2%
@@ -52,7 +52,7 @@ the corrected area both stop at the boundary, so boundary vertices are valid.
 With the compiled kernels every ball (of the normal fits and of the sums) is
 the piece of the Euclidean ball connected to its vertex on the mesh, walked
 breadth-first over the edges and faces that meet it (``adjacency=`` of
-:func:`~meshcurv.estimators.quadric.fit_jets`, ``connected=`` of
+:func:`~meshcurv.jets.fit_jets`, ``connected=`` of
 :func:`~meshcurv.neighborhoods.ball_face_sums`): the Euclidean ball wherever
 the surface inside it is connected, without a search structure over the whole
 mesh; a ball that reaches another sheet of the surface (the far side of a part
@@ -73,15 +73,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._backend import backend_name, numba_kernels
 from .._tensors import principal_from_shape_operator
-from .._backend import numba_kernels
 from ..geometry import robust_mean_edge_length, vertex_edge_lengths
+from ..jets import fit_jet_normals, fit_jets
 from ..lattice import voxel_grid
 from ..neighborhoods import ball_face_sums, check_radius, default_radii
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
-from .quadric import fit_jet_normals, fit_jets
 
 #: Degree of the jets whose normals the measures interpolate.
 NORMAL_DEGREE = 3
@@ -145,7 +145,7 @@ def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray,
     from it: the ball then reached another sheet of the surface (the far side
     of a part thinner than the ball, a voxel surface's tip) and the fit
     describes neither. ``adjacency``: the mesh's edge lists, so that each ball
-    is its surface-connected piece (:func:`meshcurv.estimators.quadric.fit_jets`).
+    is its surface-connected piece (:func:`meshcurv.jets.fit_jets`).
     """
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     fitted = fit_jet_normals(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS,
@@ -264,7 +264,7 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology) -> tuple[
 
 def _adjacency(topology: MeshTopology) -> tuple | None:
     """The edge lists the compiled ball searches walk (None on the NumPy path, which does not use them)."""
-    return topology.neighbour_lists if numba_kernels() is not None else None
+    return topology.neighbour_lists if backend_name() == "numba" else None
 
 
 def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Stages | None = None, *,
@@ -288,8 +288,8 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
 
     start("compute face measures")
     kept = ~degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)
-    kernels = numba_kernels()
-    measure = kernels.icc_face_measures if kernels is not None else face_measures
+    kernels = numba_kernels("icc")
+    measure = kernels.face_measures if kernels is not None else face_measures
     measures = measure(vertices, faces, normals)  # rows of the faces left out are not read
 
     start("sum over balls")

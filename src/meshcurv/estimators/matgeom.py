@@ -36,7 +36,7 @@ import numpy as np
 
 from ..result import CurvatureResult
 from ..smoothing import check_smoothing_steps, smooth_vertex_field
-from .._backend import numba_kernels
+from .._backend import kernel_threads, numba_kernels
 from ..diagnosis import degenerate_faces
 from ..topology import MeshTopology
 from ._defects import mesh_defects
@@ -155,10 +155,10 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
         wrong_face = ~out_of_range & ~contains
 
     stages.start("compute edge tensors")
-    kernels = numba_kernels()
+    kernels = numba_kernels("matgeom")
     if kernels is not None:
         # columns of the topology's arrays as they are (strided views): numba reads them without a copy
-        tensors = kernels.matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, kernels.threads())
+        tensors = kernels.matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, kernel_threads())
     else:
         tensors = _vertex_tensors(vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1),
                                   np.where(out_of_range, 0, ef2), out_of_range)
@@ -180,7 +180,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
     problems: list[str] = []
 
     stages.start("retrieve curvatures")
-    kernels = numba_kernels()
+    kernels = numba_kernels("matgeom")
     if kernels is not None:
         c1, c2, u1, u2, normal = kernels.matgeom_principal(np.ascontiguousarray(tensors))
     else:

@@ -49,7 +49,7 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from ..diagnosis import degenerate_faces
-from .._backend import numba_kernels
+from .._backend import kernel_threads, numba_kernels
 from ..geometry import DEGENERATE_AREA_RATIO, face_cross_products, vertex_length_scales, vertex_normals
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
@@ -85,7 +85,7 @@ def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_norm
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
     """Normal-cycle tensor in true units. Returns ``(result, problems)``."""
     smoothing_steps = check_smoothing_steps(smoothing_steps)
-    kernels = numba_kernels()
+    kernels = numba_kernels("normal_cycle")
     if kernels is not None:
         return _estimate_compiled(kernels, vertices, topology, smoothing_steps, stages)
     stages.start("compute adjacencies")
@@ -146,7 +146,7 @@ def _estimate_compiled(kernels, vertices: np.ndarray, topology: MeshTopology, sm
     sums, degenerate = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
                                                  topology.edge_face_counts, topology._edge_forward_counts,
                                                  vertex_length_scales(vertices, topology), DEGENERATE_AREA_RATIO,
-                                                 kernels.threads())
+                                                 kernel_threads())
     defects = mesh_defects(topology, degenerate)
     stages.start("average vertex tensors")
     stages.start("retrieve curvatures")

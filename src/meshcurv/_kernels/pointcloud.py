@@ -1,7 +1,6 @@
-"""Compiled kernel (numba) of the randomized corrected measures on points; mirrors the NumPy path.
+"""Compiled twins of the point-cloud code (:mod:`meshcurv._pointcloud_normals` and ``_estimators``).
 
-Imported only when :func:`meshcurv._backend.numba_kernels` says the compiled
-backend is in use. :func:`ball_triangle_sums` does in one pass per centre what
+:func:`ball_triangle_sums` does in one pass per centre what
 :func:`meshcurv._pointcloud_estimators.corrected_measures` does with arrays:
 draw the triangles, turn them, compute the measures of
 :func:`meshcurv.estimators.icc.face_measures` and sum them (tests compare the two).
@@ -12,7 +11,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-_JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+from ._common import _JIT
+from .icc import _triangle_measures
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -26,8 +26,7 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
     out = np.zeros((m, 9))
     for row in nb.prange(m):
         c = counts[row]
-        # sums in registers, written once per row
-        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = 0.0
+        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = 0.0  # sums in registers, written once per row
         for t in range(pattern.shape[0]):
             a = int(np.floor(pattern[t, 0] * c))
             b = int(np.floor(pattern[t, 1] * (c - 1)))
@@ -39,41 +38,14 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
                 z += 1
             if z >= high:
                 z += 1
-            i, j, k = index[row, a], index[row, b], index[row, z]
-            ax, ay, az = points[j, 0] - points[i, 0], points[j, 1] - points[i, 1], points[j, 2] - points[i, 2]
-            bx, by, bz = points[k, 0] - points[i, 0], points[k, 1] - points[i, 1], points[k, 2] - points[i, 2]
-            u0x, u0y, u0z = normals[i, 0], normals[i, 1], normals[i, 2]
-            u1x, u1y, u1z = normals[j, 0], normals[j, 1], normals[j, 2]
-            u2x, u2y, u2z = normals[k, 0], normals[k, 1], normals[k, 2]
-            mx, my, mz = (u0x + u1x + u2x) / 3, (u0y + u1y + u2y) / 3, (u0z + u1z + u2z) / 3
-            cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-            if mx * cx + my * cy + mz * cz < 0:  # turn (i, j, k) into (i, k, j)
-                ax, ay, az, bx, by, bz = bx, by, bz, ax, ay, az
-                u1x, u1y, u1z, u2x, u2y, u2z = u2x, u2y, u2z, u1x, u1y, u1z
-                cx, cy, cz = -cx, -cy, -cz
-            s0 += 0.5 * (mx * cx + my * cy + mz * cz)
-            px, py, pz = u0x - u2x, u0y - u2y, u0z - u2z
-            qx, qy, qz = u1x - u0x, u1y - u0y, u1z - u0z
-            sx = (py * az - pz * ay) + (qy * bz - qz * by)
-            sy = (pz * ax - px * az) + (qz * bx - qx * bz)
-            sz = (px * ay - py * ax) + (qx * by - qy * bx)
-            s1 += 0.5 * (mx * sx + my * sy + mz * sz)
-            s2 += 0.5 * (u0x * (u1y * u2z - u1z * u2y) + u0y * (u1z * u2x - u1x * u2z)
-                                  + u0z * (u1x * u2y - u1y * u2x))
-            gx, gy, gz = ay * mz - az * my, az * mx - ax * mz, ax * my - ay * mx
-            hx, hy, hz = by * mz - bz * my, bz * mx - bx * mz, bx * my - by * mx
-            ex, ey, ez = u2x - u0x, u2y - u0y, u2z - u0z
-            s3 += 0.5 * (gx * ex - hx * qx)
-            s4 += 0.5 * (gy * ey - hy * qy)
-            s5 += 0.5 * (gz * ez - hz * qz)
-            s6 += 0.25 * ((gx * ey - hx * qy) + (gy * ex - hy * qx))
-            s7 += 0.25 * ((gx * ez - hx * qz) + (gz * ex - hz * qx))
-            s8 += 0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy))
+            m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(points, normals, index[row, a], index[row, b],
+                                                                    index[row, z], True)
+            s0, s1, s2, s3, s4, s5 = s0 + m0, s1 + m1, s2 + m2, s3 + m3, s4 + m4, s5 + m5
+            s6, s7, s8 = s6 + m6, s7 + m7, s8 + m8
         out[row, 0], out[row, 1], out[row, 2] = s0, s1, s2
         out[row, 3], out[row, 4], out[row, 5] = s3, s4, s5
         out[row, 6], out[row, 7], out[row, 8] = s6, s7, s8
     return out
-
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -140,6 +112,8 @@ def pca_normals(points, indices):
 #: The nine columns around a cell, nearest first (the points of a ball then arrive roughly in distance
 #: order and most insertions into the sorted row move few entries).
 _AROUND_X = (0, -1, 1, 0, 0, -1, -1, 1, 1)
+
+
 _AROUND_Y = (0, 0, 0, -1, 1, -1, 1, -1, 1)
 
 

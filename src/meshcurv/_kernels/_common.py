@@ -1,0 +1,80 @@
+"""The rules every kernel shares, each in one place: the JIT options, an edge's length, a face's cross
+product, the degenerate-face test, the cancellation of a normal sum, the tangent frame of a normal.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+
+#: The options of every kernel: cached on disk, no GIL, IEEE arithmetic (NaN and inf keep their meaning).
+_JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+
+
+_TINY = np.finfo(np.float64).tiny
+
+
+#: Sums that may be reassociated (vectorized); no other fast-math assumption (NaN and inf stay meaningful).
+_JIT_REASSOC = {**_JIT, "fastmath": {"reassoc", "contract"}}
+
+
+@nb.njit(inline="always", **_JIT)
+def _edge_length(vertices, p, q):
+    x = vertices[q, 0] - vertices[p, 0]
+    y = vertices[q, 1] - vertices[p, 1]
+    z = vertices[q, 2] - vertices[p, 2]
+    return math.sqrt(x * x + y * y + z * z)
+
+
+@nb.njit(inline="always", **_JIT)
+def _face_cross(vertices, a, b, c):
+    """cross(b - a, c - a): the face normal times twice its area."""
+    ux = vertices[b, 0] - vertices[a, 0]
+    uy = vertices[b, 1] - vertices[a, 1]
+    uz = vertices[b, 2] - vertices[a, 2]
+    wx = vertices[c, 0] - vertices[a, 0]
+    wy = vertices[c, 1] - vertices[a, 1]
+    wz = vertices[c, 2] - vertices[a, 2]
+    return uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+
+
+@nb.njit(inline="always", **_JIT)
+def _degenerate(a, b, c, half_area, threshold):
+    """A face that repeats a vertex or whose area is at most ``threshold`` (``diagnosis.degenerate_faces``)."""
+    return a == b or b == c or c == a or half_area <= threshold
+
+
+@nb.njit(inline="always", **_JIT)
+def _unit(x, y, z):
+    """``(x, y, z) / |(x, y, z)|`` and True, or NaNs and False where the sum (nearly) cancels.
+
+    The rule of ``geometry.normalize_normal_sums``: a sum whose norm is at most
+    ``1e-12`` of its largest component (or of the smallest normal float) has
+    no direction.
+    """
+    norm = math.sqrt(x * x + y * y + z * z)
+    if norm > 1e-12 * max(max(abs(x), abs(y), abs(z)), _TINY):
+        return x / norm, y / norm, z / norm, True
+    return np.nan, np.nan, np.nan, False
+
+
+@nb.njit(**_JIT)
+def _tangent_frame(nx, ny, nz):
+    """Unit tangents ``t1, t2`` with ``(t1, t2, n)`` right-handed, ``t1 = cross(n, e)`` for the axis ``e``
+    least aligned with ``n`` (the frame of ``_tensors.tangent_basis``)."""
+    ax, ay, az = abs(nx), abs(ny), abs(nz)
+    # cross(n, axis) with the axis least aligned with n (first minimum, as np.argmin)
+    if ax <= ay and ax <= az:
+        tx, ty, tz = 0.0, nz, -ny
+    elif ay <= az:
+        tx, ty, tz = -nz, 0.0, nx
+    else:
+        tx, ty, tz = ny, -nx, 0.0
+    norm = math.sqrt(tx * tx + ty * ty + tz * tz)
+    tx /= norm
+    ty /= norm
+    tz /= norm
+    return tx, ty, tz, ny * tz - nz * ty, nz * tx - nx * tz, nx * ty - ny * tx

@@ -1,0 +1,79 @@
+"""Compiled twins of :mod:`meshcurv.diagnosis`: degenerate faces and the facts of a mesh in one pass.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ._common import _JIT, _degenerate, _edge_length, _face_cross
+
+
+@nb.njit(parallel=True, **_JIT)
+def degenerate_faces(vertices, faces, scales, area_ratio):
+    """(F,) bool: faces that repeat a vertex or whose area is at most ``area_ratio`` x ``scales[a]^2``.
+
+    ``scales`` (V,) is the length scale at each vertex (``geometry.vertex_length_scales``),
+    read at the first corner ``a`` (the corners of a face share their component).
+    """
+    out = np.empty(faces.shape[0], np.bool_)
+    for f in nb.prange(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        nx, ny, nz = _face_cross(vertices, a, b, c)
+        threshold = area_ratio * scales[a] * scales[a]
+        out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
+    return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def mesh_facts(vertices, faces, edges, referenced, scales, area_ratio, zero_length_ratio):
+    """The measured facts of :func:`meshcurv.diagnose`, in one pass over vertices, faces and edges.
+
+    Returns ``(lower, upper, area, six_volume, mean_length, n_degenerate, n_zero_length)``:
+    the bounding box of the referenced vertices, the total area, the sum over
+    faces of ``(a - centre) . cross(b - a, c - a)`` (``centre`` the mean of the
+    referenced vertices), the mean edge length, the faces that repeat a vertex or
+    whose area is at most ``area_ratio`` x ``scales[a]^2``, the edges no longer
+    than ``zero_length_ratio`` x ``scales`` at their first end (``scales``: the
+    length scale of each vertex, ``geometry.vertex_length_scales``). The passes over edges and faces
+    are parallel reductions (sums in another order than a loop: equal to ~1e-16).
+    """
+    lower = np.full(3, np.inf)
+    upper = np.full(3, -np.inf)
+    centre = np.zeros(3)
+    used = 0
+    for v in range(vertices.shape[0]):
+        if not referenced[v]:
+            continue
+        used += 1
+        for k in range(3):
+            x = vertices[v, k]
+            centre[k] += x
+            lower[k] = min(lower[k], x)
+            upper[k] = max(upper[k], x)
+    if used:
+        centre /= used
+    n_edges = edges.shape[0]
+    lengths = np.empty(n_edges)
+    total = 0.0
+    for e in nb.prange(n_edges):
+        lengths[e] = _edge_length(vertices, edges[e, 0], edges[e, 1])
+        total += lengths[e]
+    mean = total / n_edges if n_edges else 0.0
+    n_zero_length = 0
+    for e in nb.prange(n_edges):
+        n_zero_length += 1 if lengths[e] <= zero_length_ratio * scales[edges[e, 0]] else 0
+    area = 0.0
+    six_volume = 0.0
+    n_degenerate = 0
+    for f in nb.prange(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        nx, ny, nz = _face_cross(vertices, a, b, c)
+        half = 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz)
+        area += half
+        n_degenerate += 1 if _degenerate(a, b, c, half, area_ratio * scales[a] * scales[a]) else 0
+        six_volume += ((vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny
+                       + (vertices[a, 2] - centre[2]) * nz)
+    return lower, upper, area, six_volume, mean, n_degenerate, n_zero_length

@@ -1,0 +1,79 @@
+"""Compiled twins of :mod:`meshcurv.geometry`: face cross products, vertex normals, edge lengths.
+"""
+
+from __future__ import annotations
+
+
+import numba as nb
+import numpy as np
+
+from ._common import _JIT, _edge_length, _face_cross, _unit
+
+
+@nb.njit(parallel=True, **_JIT)
+def _mean_edge_length(vertices, edges):
+    """Mean length of the edges (0 when there are none), a parallel reduction."""
+    total = 0.0
+    for e in nb.prange(edges.shape[0]):
+        total += _edge_length(vertices, edges[e, 0], edges[e, 1])
+    return total / edges.shape[0] if edges.shape[0] else 0.0
+
+
+@nb.njit(parallel=True, **_JIT)
+def face_cross_products(vertices, faces):
+    """``geometry.face_cross_products``: (F, 3) ``cross(b - a, c - a)`` of every face."""
+    out = np.empty((faces.shape[0], 3))
+    for f in nb.prange(faces.shape[0]):
+        out[f, 0], out[f, 1], out[f, 2] = _face_cross(vertices, faces[f, 0], faces[f, 1], faces[f, 2])
+    return out
+
+
+@nb.njit(**_JIT)
+def vertex_normal_sums(cross, faces, n_vertices):
+    """(V, 3) sums of the face cross products over the faces of each vertex, in face order (as ``np.bincount``)."""
+    out = np.zeros((n_vertices, 3))
+    for f in range(faces.shape[0]):
+        for k in range(3):
+            v = faces[f, k]
+            for a in range(3):
+                out[v, a] += cross[f, a]
+    return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def normalize_normal_sums(summed):
+    """``geometry.normalize_normal_sums``: unit rows of ``summed``, NaN where they (nearly) cancel."""
+    out = np.empty_like(summed)
+    for v in nb.prange(summed.shape[0]):
+        out[v, 0], out[v, 1], out[v, 2], _ = _unit(summed[v, 0], summed[v, 1], summed[v, 2])
+    return out
+
+
+@nb.njit(**_JIT)
+def vertex_edge_lengths(vertices, edges, n_vertices):
+    """``geometry.vertex_edge_lengths``: (V,) mean length of the edges at each vertex (NaN where none)."""
+    total = np.zeros(n_vertices)
+    count = np.zeros(n_vertices)
+    for e in range(edges.shape[0]):
+        length = _edge_length(vertices, edges[e, 0], edges[e, 1])
+        for k in range(2):
+            total[edges[e, k]] += length
+            count[edges[e, k]] += 1.0
+    out = np.empty(n_vertices)
+    for v in range(n_vertices):
+        out[v] = total[v] / count[v] if count[v] > 0 else np.nan
+    return out
+
+
+def mean_edge_length(vertices, edges):
+    """``geometry.mean_edge_length``."""
+    return _mean_edge_length(vertices, edges)
+
+
+@nb.njit(parallel=True, **_JIT)
+def edge_lengths(vertices, edges):
+    """``geometry.edge_lengths``: (E,) length of each edge."""
+    out = np.empty(edges.shape[0])
+    for e in nb.prange(edges.shape[0]):
+        out[e] = _edge_length(vertices, edges[e, 0], edges[e, 1])
+    return out

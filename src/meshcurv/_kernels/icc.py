@@ -1,0 +1,60 @@
+"""Compiled twin of :func:`meshcurv.estimators.icc.face_measures`: the corrected curvature measures of
+every face.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+from ._common import _JIT
+
+
+@nb.njit(inline="always", **_JIT)
+def _triangle_measures(points, normals, i, j, k, turn):
+    """``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` (xx, yy, zz, xy, xz, yz) of the triangle ``(i, j, k)``.
+
+    The closed forms of :func:`meshcurv.estimators.icc.face_measures`, relative
+    to the first corner. With ``turn``, a triangle whose corrected area is
+    negative is taken as ``(i, k, j)`` (the random triangles of a point cloud's
+    ball have no orientation of their own).
+    """
+    ax, ay, az = points[j, 0] - points[i, 0], points[j, 1] - points[i, 1], points[j, 2] - points[i, 2]
+    bx, by, bz = points[k, 0] - points[i, 0], points[k, 1] - points[i, 1], points[k, 2] - points[i, 2]
+    u0x, u0y, u0z = normals[i, 0], normals[i, 1], normals[i, 2]
+    u1x, u1y, u1z = normals[j, 0], normals[j, 1], normals[j, 2]
+    u2x, u2y, u2z = normals[k, 0], normals[k, 1], normals[k, 2]
+    mx, my, mz = (u0x + u1x + u2x) / 3, (u0y + u1y + u2y) / 3, (u0z + u1z + u2z) / 3
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    if turn and mx * cx + my * cy + mz * cz < 0:  # (i, j, k) -> (i, k, j)
+        ax, ay, az, bx, by, bz = bx, by, bz, ax, ay, az
+        u1x, u1y, u1z, u2x, u2y, u2z = u2x, u2y, u2z, u1x, u1y, u1z
+        cx, cy, cz = -cx, -cy, -cz
+    mu0 = 0.5 * (mx * cx + my * cy + mz * cz)
+    # (u0 - u2) x a + (u1 - u0) x b
+    px, py, pz = u0x - u2x, u0y - u2y, u0z - u2z
+    qx, qy, qz = u1x - u0x, u1y - u0y, u1z - u0z
+    sx = (py * az - pz * ay) + (qy * bz - qz * by)
+    sy = (pz * ax - px * az) + (qz * bx - qx * bz)
+    sz = (px * ay - py * ax) + (qx * by - qy * bx)
+    mu1 = 0.5 * (mx * sx + my * sy + mz * sz)
+    mu2 = 0.5 * (u0x * (u1y * u2z - u1z * u2y) + u0y * (u1z * u2x - u1x * u2z) + u0z * (u1x * u2y - u1y * u2x))
+    # M = 1/2 [ (a x m) (u2 - u0)^T - (b x m) (u1 - u0)^T ], symmetrized
+    gx, gy, gz = ay * mz - az * my, az * mx - ax * mz, ax * my - ay * mx
+    hx, hy, hz = by * mz - bz * my, bz * mx - bx * mz, bx * my - by * mx
+    ex, ey, ez = u2x - u0x, u2y - u0y, u2z - u0z
+    return (mu0, mu1, mu2, 0.5 * (gx * ex - hx * qx), 0.5 * (gy * ey - hy * qy), 0.5 * (gz * ez - hz * qz),
+            0.25 * ((gx * ey - hx * qy) + (gy * ex - hy * qx)), 0.25 * ((gx * ez - hx * qz) + (gz * ex - hz * qx)),
+            0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy)))
+
+
+@nb.njit(parallel=True, **_JIT)
+def face_measures(vertices, faces, normals):
+    """``icc.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
+    out = np.empty((faces.shape[0], 9))
+    for f in nb.prange(faces.shape[0]):
+        m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(vertices, normals, faces[f, 0], faces[f, 1],
+                                                                faces[f, 2], False)
+        out[f, 0], out[f, 1], out[f, 2], out[f, 3], out[f, 4], out[f, 5] = m0, m1, m2, m3, m4, m5
+        out[f, 6], out[f, 7], out[f, 8] = m6, m7, m8
+    return out

@@ -1,0 +1,297 @@
+"""Compiled twins of :mod:`meshcurv.jets`: weighted jets fitted over Euclidean or surface-connected balls.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ._common import _JIT, _JIT_REASSOC, _tangent_frame
+from .neighborhoods import _ball_members, _connected_members, _grid
+
+
+@nb.njit(**_JIT)
+def _cholesky_solve(a, b, low, m, min_pivot):
+    """Solve ``a[:m, :m] x = b[:m]`` in place of ``b``; False if a pivot <= min_pivot.
+
+    ``a`` is symmetric with a unit diagonal; only its lower triangle is read.
+    The same operations in the same order as ``jets._cholesky_solve``; ``low`` is scratch
+    (the factor below its diagonal, the inverse of each pivot's root on it: m
+    divisions instead of m (m + 3) / 2, the slowest operations of a fit).
+    """
+    for k in range(m):
+        d = a[k, k]
+        for j in range(k):
+            d -= low[k, j] * low[k, j]
+        if not d > min_pivot:
+            return False
+        inverse = 1.0 / math.sqrt(d)
+        low[k, k] = inverse
+        for i in range(k + 1, m):
+            s = a[i, k]
+            for j in range(k):
+                s -= low[i, j] * low[k, j]
+            low[i, k] = s * inverse
+    for i in range(m):
+        s = b[i]
+        for j in range(i):
+            s -= low[i, j] * b[j]
+        b[i] = s * low[i, i]
+    for i in range(m - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, m):
+            s -= low[j, i] * b[j]
+        b[i] = s * low[i, i]
+    return True
+
+
+@nb.njit(parallel=True, **_JIT)
+def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks, pool, facing,
+             check_facing, away_fraction):
+    """``jets.fit_jets``: weighted jets over the balls of ``radius``, frame re-estimated from each fit.
+
+    Fits the jets of the vertices ``centres`` (the other rows of the outputs
+    stay NaN). Only the vertices ``pool`` (int64 ids) enter the balls. With
+    ``check_facing``, a fit whose ball holds more than ``away_fraction`` of its
+    points (of non-zero weight) with a ``facing`` normal opposite to the centre's
+    (``n_j . n_v < 0``; NaN normals are not counted) is not a height function over
+    the tangent plane and is left NaN. Returns ``(coefficients (V, 6), t1, t2,
+    n, counts, away)``, ``away`` the share of points facing away (NaN
+    unless checked); the neighbours of each vertex are found on a grid of cells
+    (:func:`_grid`).
+    """
+    n = vertices.shape[0]
+    n_pool = pool.shape[0]
+    pooled = np.empty((n_pool, 3))
+    for k in range(n_pool):
+        pooled[k] = vertices[pool[k]]
+    grid = _grid(pooled, radius)
+    order = grid[0]
+    points = np.empty((n_pool, 3))
+    ids = np.empty(n_pool, np.int64)
+    for k in range(n_pool):
+        points[k] = pooled[order[k]]
+        ids[k] = pool[order[k]]
+    # centres in grid order: consecutive balls share cells (cache); centres outside the pool last
+    chosen = np.zeros(n, np.bool_)
+    chosen[centres] = True
+    sorted_centres = np.empty(centres.shape[0], np.int64)
+    m = 0
+    for k in range(n_pool):
+        if chosen[ids[k]]:
+            sorted_centres[m] = ids[k]
+            chosen[ids[k]] = False
+            m += 1
+    for k in range(centres.shape[0]):
+        if chosen[centres[k]]:
+            sorted_centres[m] = centres[k]
+            chosen[centres[k]] = False
+            m += 1
+    centres = sorted_centres[:m]
+    coefficients, t1s, t2s, ns, counts, away = _jet_outputs(n)
+    n_terms = exponents.shape[0]
+    n_chunks = max(min(m, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        members = np.empty(64, np.int64)
+        work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, n_terms)
+        for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
+            v = centres[i]
+            members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius,
+                                          members)
+            work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, v,
+                            members, size, work, moments, right, matrix, low, scale, solution, coefficients, t1s,
+                            t2s, ns, counts, ids, facing, check_facing, away_fraction, away)
+    return coefficients, t1s, t2s, ns, counts, away
+
+
+#: Rows of a jet fit's scratch before the powers of u and v: the offsets x, y, z, the weight, weight * height.
+_JET_ROWS = 5
+
+
+@nb.njit(**_JIT)
+def _jet_outputs(rows):
+    """The outputs of the jet fits, ``coefficients (rows, 6), t1, t2, n (rows, 3), counts, away``: NaN, counts 0."""
+    return (np.full((rows, 6), np.nan), np.full((rows, 3), np.nan), np.full((rows, 3), np.nan),
+            np.full((rows, 3), np.nan), np.zeros(rows), np.full(rows, np.nan))
+
+
+@nb.njit(**_JIT)
+def _jet_scratch(degree, n_terms):
+    """The buffers of :func:`_fit_one` (once per chunk of vertices, not per vertex):
+    ``work, moments, right, matrix, low, scale, solution``."""
+    work = np.empty((_JET_ROWS + 3 * (2 * degree + 1) + degree + 1, 64))
+    return (work, np.empty((2 * degree + 1, 2 * degree + 1)), np.empty(n_terms), np.empty((n_terms, n_terms)),
+            np.empty((n_terms, n_terms)), np.empty(n_terms), np.empty(n_terms))
+
+
+@nb.njit(**_JIT_REASSOC)
+def _dot(a, b, size):
+    """``sum_i a[i] b[i]`` over the first ``size`` entries, reassociated (vectorized)."""
+    total = 0.0
+    for i in range(size):
+        total += a[i] * b[i]
+    return total
+
+
+@nb.njit(**_JIT)
+def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, row, members, size, work,
+             moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing,
+             check_facing, away_fraction, away_out):
+    """One vertex of :func:`fit_jets` in the caller's buffers; returns ``work`` (grown when too small).
+
+    The ball's points are ``points[members[:size]]`` (vertex ``ids[members[a]]``);
+    the fit is written to row ``row`` of the outputs. ``work`` holds one column per ball member: its offset from the centre in
+    units of the radius, its weight, its weighted height, the powers
+    ``u^0..u^2d`` and ``v^0..v^2d`` of its tangent coordinates and the products
+    of the weight with ``u^0..u^2d`` and of the weighted height with ``u^0..u^d``
+    (:func:`_jet_scratch`), so that each moment of the normal equations is one
+    vectorized dot product of two rows (the products are those of the three
+    factors in their order: the same numbers).
+    """
+    n_terms = exponents.shape[0]
+    top = 2 * degree
+    if size > work.shape[1]:
+        work = np.empty((work.shape[0], 2 * size))
+    ox, oy, oz, weight, lift = work[0], work[1], work[2], work[3], work[4]
+    inverse = 1.0 / radius
+    pu = work[_JET_ROWS:_JET_ROWS + top + 1]
+    pv = work[_JET_ROWS + top + 1:_JET_ROWS + 2 * (top + 1)]
+    wu = work[_JET_ROWS + 2 * (top + 1):_JET_ROWS + 3 * (top + 1)]
+    lu = work[_JET_ROWS + 3 * (top + 1):]
+    count = 0.0
+    for a in range(size):
+        k = members[a]
+        x = (points[k, 0] - vertices[v, 0]) * inverse
+        y = (points[k, 1] - vertices[v, 1]) * inverse
+        z = (points[k, 2] - vertices[v, 2]) * inverse
+        ox[a], oy[a], oz[a] = x, y, z
+        w = max(1.0 - (x * x + y * y + z * z), 0.0)
+        weight[a] = w * w
+        count += weight[a] > 0
+        pu[0, a] = 1.0
+        pv[0, a] = 1.0
+    counts[row] = count
+    graph = True
+    if check_facing:  # the ball must not hold the other side of the surface (a height function over the plane)
+        fx, fy, fz = facing[v, 0], facing[v, 1], facing[v, 2]
+        total = 0.0
+        away = 0.0
+        for a in range(size):
+            if not weight[a] > 0:
+                continue
+            k = ids[members[a]]
+            total += 1.0
+            if fx * facing[k, 0] + fy * facing[k, 1] + fz * facing[k, 2] < 0.0:
+                away += 1.0
+        away_out[row] = away / total if total > 0 else 0.0
+        graph = not away > away_fraction * total
+    nx, ny, nz = normals[v, 0], normals[v, 1], normals[v, 2]
+    ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
+    fitted = False
+    for step in range(iterations):
+        for a in range(size):
+            pu[1, a] = ox[a] * ax + oy[a] * ay + oz[a] * az
+            pv[1, a] = ox[a] * bx + oy[a] * by + oz[a] * bz
+            lift[a] = weight[a] * (ox[a] * nx + oy[a] * ny + oz[a] * nz)
+        for p in range(2, top + 1):  # power by power over all members (no chain of products per member)
+            for a in range(size):
+                pu[p, a] = pu[p - 1, a] * pu[1, a]
+                pv[p, a] = pv[p - 1, a] * pv[1, a]
+        for p in range(top + 1):  # the weight (and weighted height) times each power of u, once
+            for a in range(size):
+                wu[p, a] = weight[a] * pu[p, a]
+        for p in range(degree + 1):
+            for a in range(size):
+                lu[p, a] = lift[a] * pu[p, a]
+        for total in range(top + 1):
+            for k in range(total + 1):
+                moments[total - k, k] = _dot(wu[total - k], pv[k], size)
+        for t in range(n_terms):
+            right[t] = _dot(lu[exponents[t, 0]], pv[exponents[t, 1]], size)
+        fitted = False
+        for d in range(degree, 1, -1):
+            m = (d + 1) * (d + 2) // 2
+            if count < m:
+                continue
+            for r in range(m):
+                scale[r] = 1.0 / math.sqrt(max(moments[2 * exponents[r, 0], 2 * exponents[r, 1]],
+                                               2.2250738585072014e-308))
+            for r in range(m):  # the lower triangle: all the Cholesky factorization reads
+                for c in range(r + 1):
+                    matrix[r, c] = (moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
+                                    * scale[r] * scale[c])
+                solution[r] = right[r] * scale[r]
+            if _cholesky_solve(matrix, solution, low, m, min_pivot):
+                for r in range(6):
+                    solution[r] = solution[r] * scale[r]
+                fitted = True
+                break
+        if step + 1 < iterations and fitted:
+            p, q = solution[1], solution[2]
+            tx = nx - p * ax - q * bx
+            ty = ny - p * ay - q * by
+            tz = nz - p * az - q * bz
+            norm = math.sqrt(tx * tx + ty * ty + tz * tz)
+            tx, ty, tz = tx / norm, ty / norm, tz / norm
+            if math.isfinite(tx) and math.isfinite(ty) and math.isfinite(tz):
+                nx, ny, nz = tx, ty, tz
+                ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
+    if fitted and graph:
+        for r in range(6):
+            coefficients[row, r] = solution[r]
+    t1s[row, 0], t1s[row, 1], t1s[row, 2] = ax, ay, az
+    t2s[row, 0], t2s[row, 1], t2s[row, 2] = bx, by, bz
+    ns[row, 0], ns[row, 1], ns[row, 2] = nx, ny, nz
+    return work
+
+
+@nb.njit(parallel=True, **_JIT)
+def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks,
+                       allowed, indptr, indices, facing, check_facing, away_fraction, normals_only):
+    """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
+
+    The same fits, outputs and checks as :func:`fit_jets`, with the points of
+    each ball found breadth-first over the mesh's edges (``indptr, indices``,
+    CSR) instead of on a grid: no search structure over all the points is
+    built, so a fit at a few centres costs only their balls. Only ``allowed``
+    (V,) vertices enter the balls. ``n_chunks``: three (V,) int64 arrays each.
+    With ``normals_only``, returns ``(fitted, ...)``: the (V, 3) unit normals of
+    the fitted jets, ``(n - c10 t1 - c01 t2) / sqrt(1 + c10^2 + c01^2)`` as
+    ``jets.jet_normals`` computes them (NaN where no fit), and one-row
+    placeholders for the other outputs (136 bytes per vertex never written).
+    """
+    n = vertices.shape[0]
+    m = centres.shape[0]
+    coefficients, t1s, t2s, ns, counts, away = _jet_outputs(1 if normals_only else n)
+    fitted = np.full((n if normals_only else 1, 3), np.nan)
+    ids = np.arange(n)
+    n_terms = exponents.shape[0]
+    n_chunks = max(min(m, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        mark = np.full(n, -1, np.int64)
+        members = np.empty(n, np.int64)
+        queue = np.empty(n, np.int64)
+        work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, n_terms)
+        one = _jet_outputs(1)
+        for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
+            v = centres[i]
+            size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, members, queue)
+            if not normals_only:
+                work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v,
+                                v, members, size, work, moments, right, matrix, low, scale, solution, coefficients,
+                                t1s, t2s, ns, counts, ids, facing, check_facing, away_fraction, away)
+                continue
+            c, a, b, nn = one[0], one[1], one[2], one[3]
+            c[0, :] = np.nan  # a failed fit leaves the row as it finds it
+            work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v, 0,
+                            members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn, one[4],
+                            ids, facing, check_facing, away_fraction, one[5])
+            p, q = c[0, 1], c[0, 2]
+            width = np.sqrt(1 + p * p + q * q)
+            for k in range(3):
+                fitted[v, k] = (nn[0, k] - p * a[0, k] - q * b[0, k]) / width
+    if normals_only:
+        return fitted, t1s, t2s, ns, counts, away
+    return coefficients, t1s, t2s, ns, counts, away

@@ -1,0 +1,425 @@
+"""Compiled twins of :mod:`meshcurv.neighborhoods`: balls on a grid of cells and surface-connected
+balls walked over the mesh, and the sums of face values over them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ._common import _JIT
+
+
+#: A ball grid has at most this many columns of cells per point (and at least 4096 in all).
+_GRID_COLUMNS_PER_POINT = 4
+
+
+@nb.njit(**_JIT)
+def vertex_face_lists(faces, n_vertices):
+    """CSR lists of the faces around every vertex: ``(indptr, indices)``, faces in index order."""
+    indptr = np.zeros(n_vertices + 1, np.int64)
+    for f in range(faces.shape[0]):
+        for k in range(faces.shape[1]):
+            indptr[faces[f, k] + 1] += 1
+    for v in range(n_vertices):
+        indptr[v + 1] += indptr[v]
+    indices = np.empty(indptr[n_vertices], np.int64)
+    fill = indptr[:-1].copy()
+    for f in range(faces.shape[0]):
+        for k in range(faces.shape[1]):
+            indices[fill[faces[f, k]]] = f
+            fill[faces[f, k]] += 1
+    return indptr, indices
+
+
+@nb.njit(**_JIT)
+def _grid(points, reach):
+    """Points sorted into a grid of cubic cells: ``(order, starts, levels, lo, cell, nx, ny)``.
+
+    The cells have a side ``cell`` of at least ``reach`` (a ball of that radius
+    spans at most three cells per axis) from the origin ``lo``. ``order`` lists
+    the points column by column (``x`` cell, then ``y`` cell), and within a
+    column by ``z`` cell: a stable counting sort, so ties keep their index
+    order. The points of column ``ix * ny + iy`` are ranks
+    ``starts[c]:starts[c + 1]`` of ``order``, their ``z`` cells ``levels[rank]``.
+    The cell is widened when the columns would outnumber
+    ``_GRID_COLUMNS_PER_POINT`` per point (a sparse or very flat cloud).
+    """
+    n = points.shape[0]
+    lo = np.zeros(3)
+    hi = np.zeros(3)
+    for a in range(3):
+        if n:
+            lo[a] = points[:, a].min()
+            hi[a] = points[:, a].max()
+    extent = max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2])
+    cell = max(reach, extent / 2.0**60)  # z cells fit in an int64
+    if not cell > 0:  # every point in one place and a zero reach: any side
+        cell = 1.0
+    limit = max(_GRID_COLUMNS_PER_POINT * n, 4096)
+    while ((hi[0] - lo[0]) / cell + 1) * ((hi[1] - lo[1]) / cell + 1) > limit:
+        cell *= 2.0
+    nx = np.int64((hi[0] - lo[0]) / cell) + 1
+    ny = np.int64((hi[1] - lo[1]) / cell) + 1
+    column = np.empty(n, np.int64)
+    starts = np.zeros(nx * ny + 1, np.int64)
+    for i in range(n):
+        c = np.int64((points[i, 0] - lo[0]) / cell) * ny + np.int64((points[i, 1] - lo[1]) / cell)
+        column[i] = c
+        starts[c + 1] += 1
+    for c in range(nx * ny):
+        starts[c + 1] += starts[c]
+    order = np.empty(n, np.int64)
+    filled = starts[:-1].copy()
+    for i in range(n):
+        order[filled[column[i]]] = i
+        filled[column[i]] += 1
+    levels = np.empty(n, np.int64)
+    for i in range(n):
+        levels[i] = np.int64((points[order[i], 2] - lo[2]) / cell)
+    for c in range(nx * ny):  # within a column, by z cell (stable)
+        first, last = starts[c], starts[c + 1]
+        if last - first > 32:
+            by_level = np.argsort(levels[first:last], kind="mergesort")
+            order[first:last] = order[first:last][by_level]
+            levels[first:last] = levels[first:last][by_level]
+            continue
+        for i in range(first + 1, last):  # insertion sort of a short column
+            level, point = levels[i], order[i]
+            j = i
+            while j > first and levels[j - 1] > level:
+                levels[j] = levels[j - 1]
+                order[j] = order[j - 1]
+                j -= 1
+            levels[j] = level
+            order[j] = point
+    return order, starts, levels, lo, cell, nx, ny
+
+
+@nb.njit(**_JIT)
+def _ball_members(points, grid, cx, cy, cz, cutoff, out):
+    """Ranks of the points within ``cutoff`` of ``(cx, cy, cz)`` written to ``out`` (grown when full).
+
+    ``points`` are in the order of ``grid`` (:func:`_grid`), so that the
+    cells of a column around the centre (``ceil(cutoff / cell)`` each way) are
+    one contiguous run of memory. Returns ``(out, count)``.
+    """
+    _, starts, levels, lo, cell, nx, ny = grid
+    fx = (cx - lo[0]) / cell
+    fy = (cy - lo[1]) / cell
+    fz = (cz - lo[2]) / cell
+    cutoff2 = cutoff * cutoff
+    count = 0
+    span = np.int64(math.ceil(cutoff / cell))  # cells each way from the centre's
+    if not (fx > -1 - span and fy > -1 - span and fz > -1 - span and fx < nx + span and fy < ny + span
+            and fz < 2.0**61):
+        return out, count
+    bx = np.int64(math.floor(fx))
+    by = np.int64(math.floor(fy))
+    bz = np.int64(math.floor(fz))
+    for ix in range(max(bx - span, 0), min(bx + span + 1, nx)):
+        for iy in range(max(by - span, 0), min(by + span + 1, ny)):
+            c = ix * ny + iy
+            k = starts[c]
+            last = starts[c + 1]
+            high = last
+            while k < high:  # first rank of the column at z cell bz - span or above
+                middle = (k + high) // 2
+                if levels[middle] < bz - span:
+                    k = middle + 1
+                else:
+                    high = middle
+            end = k
+            while end < last and levels[end] <= bz + span:
+                end += 1
+            if count + end - k > out.shape[0]:
+                grown = np.empty(2 * (count + end - k), np.int64)
+                grown[:count] = out[:count]
+                out = grown
+            for j in range(k, end):  # branch-free: every candidate is written, the inside ones kept
+                dx = points[j, 0] - cx
+                dy = points[j, 1] - cy
+                dz = points[j, 2] - cz
+                out[count] = j
+                count += dx * dx + dy * dy + dz * dz <= cutoff2
+    return out, count
+
+
+@nb.njit(inline="always", **_JIT)
+def _segment_meets_ball(ax, ay, az, bx, by, bz, radius2):
+    """Whether the segment from ``a`` to ``b`` (relative to the ball's centre, both ends outside
+    the ball) passes through it: its closest point to the centre is inside, without a division."""
+    dx, dy, dz = bx - ax, by - ay, bz - az
+    along = -(ax * dx + ay * dy + az * dz)  # the closest point is a + (along / |d|^2) d, clamped to the segment
+    if not along > 0:
+        return False  # the segment leads away from the centre: a is its closest point
+    length2 = dx * dx + dy * dy + dz * dz
+    if not along < length2:
+        return False  # b is its closest point
+    return (ax * ax + ay * ay + az * az) * length2 - along * along <= radius2 * length2
+
+
+@nb.njit(**_JIT)
+def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, members, queue):
+    """The vertices of the surface-connected piece of the ball ``B(x_v, cutoff)`` written to ``members``.
+
+    Breadth-first from ``v`` over the edges ``indptr, indices`` (CSR) that meet
+    the closed ball (an end inside, or the segment passing through it): every
+    vertex within ``cutoff`` reached so (and ``allowed``) is a member, ``v``
+    first when allowed. When the ball's part of the surface is connected these
+    are exactly the vertices of the Euclidean ball (a path inside it crosses
+    from face to face through edges that meet it, and every edge of a face
+    meets the ball at a corner shared with the next such edge); vertices of
+    another sheet of the surface (the far side of a part thinner than the
+    ball) are left out. ``mark`` (V,) holds, per vertex, the last centre that
+    queued it (no clearing between centres); ``queue`` is scratch. ``members``
+    and ``queue`` hold V entries (a vertex is queued at most once per centre):
+    no buffer is grown, so no array is reassigned in the loop, which keeps
+    numba's reference counting out of it (six times slower with it). Returns
+    the number of members.
+    """
+    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+    cutoff2 = cutoff * cutoff
+    size = 0
+    mark[v] = v
+    queue[0] = v
+    head, tail = 0, 1
+    if allowed[v]:
+        members[0] = v
+        size = 1
+    while head < tail:
+        a = queue[head]
+        head += 1
+        ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
+        a2 = ax * ax + ay * ay + az * az
+        for j in range(indptr[a], indptr[a + 1]):
+            b = indices[j]
+            if mark[b] == v:
+                continue
+            bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
+            b2 = bx * bx + by * by + bz * bz
+            if b2 <= cutoff2:
+                if allowed[b]:
+                    members[size] = b
+                    size += 1
+            elif not a2 <= cutoff2 and not _segment_meets_ball(ax, ay, az, bx, by, bz, cutoff2):
+                continue  # both ends outside, and the segment passes outside too
+            mark[b] = v
+            queue[tail] = b
+            tail += 1
+    return size
+
+
+@nb.njit(parallel=True, **_JIT)
+def connected_face_sums(vertices, faces, centroids, reach, usable, values, radius, indptr, indices, n_chunks, start,
+                        stop):
+    """(V, k) sums of ``share * values`` over the faces of the surface-connected piece of each ball.
+
+    ``share`` is ``neighborhoods.face_in_ball_ratios`` (1 inside, 0 outside,
+    linear in between by the corners' and centroid's distances). The faces are
+    found breadth-first from the faces around each vertex (``indptr, indices``:
+    :func:`vertex_face_lists`), on through the corners of every face that has a
+    point of an edge, a corner or its centroid in the closed ball ``B(x_v, radius)``
+    (``centroids`` and ``reach`` of :func:`cell_centres`: a face whose centroid is
+    farther than ``radius + reach`` is outside, one distance; each vertex's
+    distance is computed once per ball):
+    when the ball's part of the surface is connected, every face of the
+    Euclidean ball (a path inside the ball goes from face to face across edges
+    that meet it); another sheet of the surface inside the ball is left out.
+    Faces not ``usable`` (F,) lead the search on but add nothing. Only the
+    balls of the vertices ``start`` to ``stop`` are summed (the other rows are
+    0). ``n_chunks``: four (V,) arrays and one (F,) array each.
+    """
+    n = vertices.shape[0]
+    n_faces = faces.shape[0]
+    n_values = values.shape[1]
+    out = np.zeros((n, n_values))
+    radius2 = radius * radius
+    start = max(min(start, n), 0)
+    m = max(min(stop, n), start) - start
+    n_chunks = max(min(m, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        seen = np.full(n_faces, -1, np.int64)
+        mark = np.full(n, -1, np.int64)  # queued for this centre
+        known = np.full(n, -1, np.int64)  # distance to this centre in `squared`
+        squared = np.empty(n)
+        queue = np.empty(n, np.int64)  # a vertex is queued at most once per centre: never grown
+        for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
+            cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+            mark[v] = v
+            queue[0] = v
+            head, tail = 0, 1
+            while head < tail:
+                a = queue[head]
+                head += 1
+                for j in range(indptr[a], indptr[a + 1]):
+                    f = indices[j]
+                    if seen[f] == v:
+                        continue
+                    seen[f] = v
+                    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
+                    if d > (radius + reach[f]) ** 2:
+                        continue  # every point of the face is outside
+                    low = d
+                    high = d
+                    for corner in range(3):
+                        c = faces[f, corner]
+                        if known[c] != v:
+                            known[c] = v
+                            squared[c] = ((vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2
+                                          + (vertices[c, 2] - cz) ** 2)
+                        low = min(low, squared[c])
+                        high = max(high, squared[c])
+                    if high <= radius2:
+                        share = 1.0
+                    elif low >= radius2:  # corners and centroid outside: on through the face if an edge crosses
+                        share = 0.0
+                        crossed = False
+                        for corner in range(3):
+                            p = faces[f, corner]
+                            q = faces[f, (corner + 1) % 3]
+                            crossed = crossed or _segment_meets_ball(
+                                vertices[p, 0] - cx, vertices[p, 1] - cy, vertices[p, 2] - cz,
+                                vertices[q, 0] - cx, vertices[q, 1] - cy, vertices[q, 2] - cz, radius2)
+                        if not crossed:
+                            continue
+                    else:
+                        root = math.sqrt(low)
+                        share = (radius - root) / (math.sqrt(high) - root)
+                    if share != 0.0 and usable[f]:
+                        for k in range(n_values):
+                            out[v, k] += share * values[f, k]
+                    for corner in range(3):
+                        c = faces[f, corner]
+                        if mark[c] != v:
+                            mark[c] = v
+                            queue[tail] = c
+                            tail += 1
+    return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def cell_centres(vertices, cells):
+    """``neighborhoods._ball_sums``'s (C, 3) centroids of cells (faces or edges) and (C,) their reach.
+
+    The reach is the largest distance from the centroid to a corner.
+    """
+    n, corners = cells.shape
+    centres = np.zeros((n, 3))
+    reach = np.zeros(n)
+    for c in nb.prange(n):
+        for k in range(corners):
+            for a in range(3):
+                centres[c, a] += vertices[cells[c, k], a]
+        for a in range(3):
+            centres[c, a] /= corners
+        for k in range(corners):
+            d = 0.0
+            for a in range(3):
+                d += (vertices[cells[c, k], a] - centres[c, a]) ** 2
+            reach[c] = max(reach[c], math.sqrt(d))
+    return centres, reach
+
+
+@nb.njit(parallel=True, **_JIT)
+def ball_cell_sums(vertices, cells, centroids, values, radius, cutoff, n_chunks, start, stop):
+    """``neighborhoods._ball_sums`` for one group of cells: (V, k) sums of ``weight * values``.
+
+    Cells are faces (three corners; weight: the share of the face inside the
+    ball, ``neighborhoods.face_in_ball_ratios``) or edges (two corners; weight:
+    the length of the edge inside the ball, ``neighborhoods.segment_in_ball_lengths``).
+    They are found by their ``centroids`` within ``cutoff`` (radius + the
+    group's largest reach) on a grid of cells (:func:`_grid`); their corners,
+    centroids and values are copied in grid order first, so that a ball reads
+    contiguous memory. Only the balls of ranks ``start`` to ``stop`` of the
+    vertices in grid order are summed (the caller splits a long computation
+    into calls; the other rows are 0).
+    """
+    n = vertices.shape[0]
+    n_cells, corners = cells.shape
+    n_values = values.shape[1]
+    grid = _grid(centroids, cutoff)
+    order = grid[0]
+    points = np.empty((n_cells, corners + 1, 3))  # the corners, then the centroid
+    sorted_values = np.empty((n_cells, n_values))
+    for k in nb.prange(n_cells):
+        c = order[k]
+        for corner in range(corners):
+            points[k, corner] = vertices[cells[c, corner]]
+        points[k, corners] = centroids[c]
+        sorted_values[k] = values[c]
+    out = np.zeros((n, n_values))
+    centres = _grid(vertices, grid[4])[0]  # centres in grid order: consecutive balls share cells (cache)
+    start = max(min(start, n), 0)
+    m = max(min(stop, n), start) - start
+    n_chunks = max(min(m, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        members = np.empty(64, np.int64)
+        for rank in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
+            members = _cell_weight_sums(vertices, points, grid, sorted_values, radius, cutoff, centres[rank],
+                                        members, out)
+    return out
+
+
+@nb.njit(inline="always", **_JIT)
+def _face_share(points, f, cx, cy, cz, radius, radius2):
+    """``face_in_ball_ratios`` of face ``f`` (corners and centroid in ``points[f]``); squared
+    distances, the square roots only for faces the sphere cuts."""
+    low = np.inf
+    high = -np.inf
+    for corner in range(4):
+        dx = points[f, corner, 0] - cx
+        dy = points[f, corner, 1] - cy
+        dz = points[f, corner, 2] - cz
+        dist = dx * dx + dy * dy + dz * dz
+        low = min(low, dist)
+        high = max(high, dist)
+    if high <= radius2:
+        return 1.0
+    if low >= radius2:
+        return 0.0
+    low = math.sqrt(low)
+    return (radius - low) / (math.sqrt(high) - low)
+
+
+@nb.njit(inline="always", **_JIT)
+def _segment_length(points, e, cx, cy, cz, radius2):
+    """``segment_in_ball_lengths`` of edge ``e`` (its ends in ``points[e, :2]``)."""
+    dx = points[e, 1, 0] - points[e, 0, 0]
+    dy = points[e, 1, 1] - points[e, 0, 1]
+    dz = points[e, 1, 2] - points[e, 0, 2]
+    fx = points[e, 0, 0] - cx
+    fy = points[e, 0, 1] - cy
+    fz = points[e, 0, 2] - cz
+    a = dx * dx + dy * dy + dz * dz
+    b = 2 * (dx * fx + dy * fy + dz * fz)
+    c = fx * fx + fy * fy + fz * fz - radius2
+    disc = b * b - 4 * a * c
+    if not (disc > 0 and a > 0):
+        return 0.0
+    root = math.sqrt(disc)
+    t0 = min(max((-b - root) / (2 * a), 0.0), 1.0)
+    t1 = min(max((-b + root) / (2 * a), 0.0), 1.0)
+    return (t1 - t0) * math.sqrt(a)
+
+
+@nb.njit(**_JIT)
+def _cell_weight_sums(vertices, points, grid, values, radius, cutoff, v, members, out):
+    """One vertex of :func:`ball_cell_sums`; returns the (possibly grown) member buffer."""
+    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+    radius2 = radius * radius
+    corners = points.shape[1] - 1
+    members, size = _ball_members(points[:, corners], grid, cx, cy, cz, cutoff, members)
+    for a in range(size):
+        c = members[a]
+        if corners == 3:
+            weight = _face_share(points, c, cx, cy, cz, radius, radius2)
+        else:
+            weight = _segment_length(points, c, cx, cy, cz, radius2)
+        if weight == 0.0:
+            continue
+        for k in range(values.shape[1]):
+            out[v, k] += weight * values[c, k]
+    return members

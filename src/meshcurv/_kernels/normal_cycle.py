@@ -1,0 +1,152 @@
+"""Compiled twin of :mod:`meshcurv.estimators.normal_cycle`: the edge sums of the normal-cycle tensor
+and the curvatures from them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ._common import _JIT, _degenerate, _face_cross, _unit
+from .tensors import _tangent_eigen
+
+
+@nb.njit(parallel=True, **_JIT)
+def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, scales, area_ratio, n_chunks):
+    """Per-vertex measures, barycentric areas and normal sums; the zero-area faces.
+
+    A face is degenerate when it repeats a vertex or its area is at most
+    ``area_ratio`` x ``scales[a]^2`` (``diagnosis.degenerate_faces``); an
+    edge contributes when it has two consistently oriented faces (``counts == 2``,
+    ``forward == 1``), neither degenerate. Returns ``(sums, degenerate)``: ``sums``
+    of shape (V, 10), columns 0-5 the anisotropic measure
+    ``sum beta |e| / 2 e e^T`` (xx, yy, zz, xy, xz, yz), 6 the area, 7-9 the
+    area-weighted face-normal sum; ``degenerate`` of shape (F,).
+
+    The face normals are computed in parallel over faces; the sums in
+    ``n_chunks`` vertex ranges, each thread adding what falls on its own
+    vertices (a face or an edge across two ranges is visited by both), so no
+    two threads write the same row.
+    """
+    n_vertices = vertices.shape[0]
+    n_faces = faces.shape[0]
+    degenerate = np.zeros(n_faces, np.bool_)
+    face_normals = np.empty((n_faces, 4))  # the cross product and its norm (twice the area)
+    for f in nb.prange(n_faces):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        nx, ny, nz = _face_cross(vertices, a, b, c)
+        double_area = math.sqrt(nx * nx + ny * ny + nz * nz)
+        face_normals[f, 0], face_normals[f, 1], face_normals[f, 2], face_normals[f, 3] = nx, ny, nz, double_area
+        degenerate[f] = _degenerate(a, b, c, 0.5 * double_area, area_ratio * scales[a] * scales[a])
+    n_chunks = max(1, min(n_chunks, n_vertices))
+    sums = np.zeros((n_vertices, 10))
+    for chunk in nb.prange(n_chunks):
+        first = (n_vertices * chunk) // n_chunks
+        last = (n_vertices * (chunk + 1)) // n_chunks
+        for f in range(n_faces):
+            if degenerate[f]:
+                continue
+            third = face_normals[f, 3] / 6.0
+            for k in range(3):
+                corner = faces[f, k]
+                if first <= corner < last:
+                    sums[corner, 6] += third
+                    sums[corner, 7] += face_normals[f, 0]
+                    sums[corner, 8] += face_normals[f, 1]
+                    sums[corner, 9] += face_normals[f, 2]
+        for e in range(edges.shape[0]):
+            p, q = edges[e, 0], edges[e, 1]
+            p_here = first <= p < last
+            q_here = first <= q < last
+            if not (p_here or q_here) or counts[e] != 2 or forward[e] != 1:
+                continue
+            f1, f2 = edge_faces[e, 0], edge_faces[e, 1]
+            if degenerate[f1] or degenerate[f2]:
+                continue
+            ex = vertices[q, 0] - vertices[p, 0]
+            ey = vertices[q, 1] - vertices[p, 1]
+            ez = vertices[q, 2] - vertices[p, 2]
+            length = math.sqrt(ex * ex + ey * ey + ez * ez)
+            if length == 0.0:
+                continue
+            ex /= length
+            ey /= length
+            ez /= length
+            d1, d2 = face_normals[f1, 3], face_normals[f2, 3]
+            ax, ay, az = face_normals[f1, 0] / d1, face_normals[f1, 1] / d1, face_normals[f1, 2] / d1
+            bx, by, bz = face_normals[f2, 0] / d2, face_normals[f2, 1] / d2, face_normals[f2, 2] / d2
+            sine = (ay * bz - az * by) * ex + (az * bx - ax * bz) * ey + (ax * by - ay * bx) * ez
+            cosine = ax * bx + ay * by + az * bz
+            weight = 0.5 * math.atan2(sine, cosine) * length
+            for v in (p, q):
+                if first <= v < last:
+                    sums[v, 0] += weight * ex * ex
+                    sums[v, 1] += weight * ey * ey
+                    sums[v, 2] += weight * ez * ez
+                    sums[v, 3] += weight * ex * ey
+                    sums[v, 4] += weight * ex * ez
+                    sums[v, 5] += weight * ey * ez
+    return sums, degenerate
+
+
+@nb.njit(parallel=True, **_JIT)
+def normal_cycle_finish(sums, invalid, indptr, indices, steps):
+    """From :func:`normal_cycle_sums` to the curvatures, in one kernel.
+
+    The measures and areas of valid vertices (invalid ones count as zero) are
+    smoothed ``steps`` times over 1-rings (``smoothing.smooth_vertex_field``),
+    divided, restricted to the tangent plane of the unit normal and solved in
+    closed form (``tangent_principal`` with ``rotate`` and ``mean_from_trace``).
+    Returns ``(k_min, k_max, dir_min, dir_max, normals, valid)``, NaN where not valid.
+    """
+    n = sums.shape[0]
+    current = np.empty((n, 7))
+    for i in nb.prange(n):
+        weight = 0.0 if invalid[i] else 1.0
+        for c in range(7):
+            current[i, c] = sums[i, c] * weight
+    if steps > 0:
+        following = np.empty((n, 7))
+        for _ in range(steps):
+            for i in nb.prange(n):
+                start, stop = indptr[i], indptr[i + 1]
+                scale = 1.0 / (stop - start + 1.0)
+                t0, t1, t2, t3 = current[i, 0], current[i, 1], current[i, 2], current[i, 3]
+                t4, t5, t6 = current[i, 4], current[i, 5], current[i, 6]
+                for j in range(start, stop):  # one pass over the neighbours, seven sums in registers
+                    w = indices[j]
+                    t0 += current[w, 0]
+                    t1 += current[w, 1]
+                    t2 += current[w, 2]
+                    t3 += current[w, 3]
+                    t4 += current[w, 4]
+                    t5 += current[w, 5]
+                    t6 += current[w, 6]
+                following[i, 0], following[i, 1], following[i, 2] = t0 * scale, t1 * scale, t2 * scale
+                following[i, 3], following[i, 4], following[i, 5] = t3 * scale, t4 * scale, t5 * scale
+                following[i, 6] = t6 * scale
+            current, following = following, current
+    k_min = np.full(n, np.nan)
+    k_max = np.full(n, np.nan)
+    dir_min = np.full((n, 3), np.nan)
+    dir_max = np.full((n, 3), np.nan)
+    normals = np.full((n, 3), np.nan)
+    valid = np.zeros(n, np.bool_)
+    for i in nb.prange(n):
+        nx, ny, nz, directed = _unit(sums[i, 7], sums[i, 8], sums[i, 9])
+        if not directed:
+            continue
+        normals[i, 0], normals[i, 1], normals[i, 2] = nx, ny, nz
+        area = current[i, 6]
+        if invalid[i] or not area > 0:
+            continue
+        valid[i] = True
+        lo, hi, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
+            current[i, 0] / area, current[i, 1] / area, current[i, 2] / area, current[i, 3] / area,
+            current[i, 4] / area, current[i, 5] / area, nx, ny, nz, True, True)
+        k_min[i], k_max[i] = lo, hi
+        dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
+        dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5
+    return k_min, k_max, dir_min, dir_max, normals, valid

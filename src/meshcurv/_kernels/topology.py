@@ -1,0 +1,248 @@
+"""Compiled twins of :mod:`meshcurv.topology`: edges and their faces, bow-tie vertices, components,
+neighbour lists.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+from ._common import _JIT
+
+
+@nb.njit(parallel=True, **_JIT)
+def build_edges(faces, n_vertices, n_chunks):
+    """Edges of the triangles, their faces and counts (see MeshTopology._build).
+
+    Sides are bucketed by their smaller vertex (counting sort), each bucket is
+    sorted by (larger vertex, direction) with a stable insertion sort, so the
+    edges come out in lexicographic order, as ``np.unique`` would give them.
+    Each thread buckets the sides of its own range of vertices (scanning all
+    faces), then sorts and numbers the buckets of its vertices; the edge numbers
+    come from a prefix sum of the edges per vertex. ``n_chunks``: the number of
+    vertex ranges (one per thread, :func:`threads`).
+    """
+    n_faces = faces.shape[0]
+    n_chunks = max(1, min(n_chunks, n_vertices))
+    bounds = np.empty(n_chunks + 1, np.int64)
+    for c in range(n_chunks + 1):
+        bounds[c] = (n_vertices * c) // n_chunks
+    bucket_start = np.zeros(n_vertices + 1, np.int64)
+    for c in nb.prange(n_chunks):
+        first, last = bounds[c], bounds[c + 1]
+        for f in range(n_faces):
+            for k in range(3):
+                a = faces[f, k]
+                b = faces[f, (k + 1) % 3]
+                low = min(a, b)
+                if a != b and first <= low < last:
+                    bucket_start[low + 1] += 1
+    for i in range(n_vertices):
+        bucket_start[i + 1] += bucket_start[i]
+    n_sides = bucket_start[n_vertices]
+    sort_key = np.empty(n_sides, np.int64)  # 2 * larger vertex + backward
+    side_of = np.empty(n_sides, np.int64)
+    fill = bucket_start[:-1].copy()
+    for c in nb.prange(n_chunks):
+        first, last = bounds[c], bounds[c + 1]
+        for f in range(n_faces):
+            for k in range(3):
+                a = faces[f, k]
+                b = faces[f, (k + 1) % 3]
+                low = min(a, b)
+                if a != b and first <= low < last:
+                    slot = fill[low]
+                    fill[low] += 1
+                    sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
+                    side_of[slot] = 3 * f + k
+    edges_before = np.zeros(n_vertices + 1, np.int64)
+    for v in nb.prange(n_vertices):  # stable insertion sort of each (small) bucket; count its edges
+        start, stop = bucket_start[v], bucket_start[v + 1]
+        for i in range(start + 1, stop):
+            key = sort_key[i]
+            side = side_of[i]
+            j = i - 1
+            while j >= start and sort_key[j] > key:
+                sort_key[j + 1] = sort_key[j]
+                side_of[j + 1] = side_of[j]
+                j -= 1
+            sort_key[j + 1] = key
+            side_of[j + 1] = side
+        distinct = 0
+        for i in range(start, stop):
+            if i == start or (sort_key[i] >> 1) != (sort_key[i - 1] >> 1):
+                distinct += 1
+        edges_before[v + 1] = distinct
+    for v in range(n_vertices):
+        edges_before[v + 1] += edges_before[v]
+    n_edges = edges_before[n_vertices]
+    edges = np.empty((n_edges, 2), np.int64)
+    edge_faces = np.full((n_edges, 2), -1, np.int64)
+    counts = np.zeros(n_edges, np.int64)
+    forward = np.zeros(n_edges, np.int64)
+    face_edges = np.full(3 * n_faces, -1, np.int64)
+    for v in nb.prange(n_vertices):
+        e = edges_before[v] - 1
+        previous_high = -1
+        for i in range(bucket_start[v], bucket_start[v + 1]):
+            high = sort_key[i] >> 1
+            backward = sort_key[i] & 1
+            side = side_of[i]
+            face = side // 3
+            if high != previous_high:
+                e += 1
+                previous_high = high
+                edges[e, 0] = v
+                edges[e, 1] = high
+                if backward:
+                    edge_faces[e, 1] = face
+                else:
+                    edge_faces[e, 0] = face
+            elif counts[e] == 1:
+                if edge_faces[e, 1] == -1:
+                    edge_faces[e, 1] = face
+                else:
+                    edge_faces[e, 0] = face
+            counts[e] += 1
+            if not backward:
+                forward[e] += 1
+            face_edges[side] = e
+    return edges, face_edges.reshape(n_faces, 3), edge_faces, counts, forward
+
+
+@nb.njit(inline="always", **_JIT)
+def _find(parent, x):
+    while parent[x] != x:
+        parent[x] = parent[parent[x]]
+        x = parent[x]
+    return x
+
+
+@nb.njit(inline="always", **_JIT)
+def _corner_at(faces, f, v):
+    """The corner (3 f + k) of face ``f`` at vertex ``v``."""
+    if faces[f, 0] == v:
+        return 3 * f
+    if faces[f, 1] == v:
+        return 3 * f + 1
+    return 3 * f + 2
+
+
+@nb.njit(parallel=True, **_JIT)
+def bowtie_vertices(faces, edges, edge_faces, linked, proper, n_vertices, n_chunks):
+    """Vertices whose face corners fall in more than one fan (see MeshTopology.bowtie_vertices).
+
+    Union-find over the ``3 F`` corners: at each end of a linked edge (two
+    faces, both without a repeated vertex) the corners of its two faces are
+    joined. Corners are only ever joined to corners at the same vertex, so each
+    of ``n_chunks`` threads does the joins and the finds at its own range of
+    vertices.
+    """
+    n_corners = 3 * faces.shape[0]
+    parent = np.empty(n_corners, np.int64)
+    for c in nb.prange(n_corners):
+        parent[c] = c
+    n_chunks = max(1, min(n_chunks, n_vertices))
+    root_of = np.full(n_vertices, -1, np.int64)
+    several = np.zeros(n_vertices, np.bool_)
+    for chunk in nb.prange(n_chunks):
+        first = (n_vertices * chunk) // n_chunks
+        last = (n_vertices * (chunk + 1)) // n_chunks
+        for e in range(edges.shape[0]):
+            if not linked[e]:
+                continue
+            f1, f2 = edge_faces[e, 0], edge_faces[e, 1]
+            if not (proper[f1] and proper[f2]):
+                continue
+            for v in (edges[e, 0], edges[e, 1]):
+                if first <= v < last:
+                    ra = _find(parent, _corner_at(faces, f1, v))
+                    rb = _find(parent, _corner_at(faces, f2, v))
+                    if ra != rb:
+                        parent[max(ra, rb)] = min(ra, rb)
+        for f in range(faces.shape[0]):
+            if not proper[f]:
+                continue
+            for k in range(3):
+                v = faces[f, k]
+                if first <= v < last:
+                    r = _find(parent, 3 * f + k)
+                    if root_of[v] < 0:
+                        root_of[v] = r
+                    elif root_of[v] != r:
+                        several[v] = True
+    return several
+
+
+@nb.njit(**_JIT)
+def _union_edges(edges, n_vertices):
+    """Union-find over the edges: (V,) parents whose roots are each component's smallest vertex."""
+    parent = np.arange(n_vertices)
+    for e in range(edges.shape[0]):
+        a = _find(parent, edges[e, 0])
+        b = _find(parent, edges[e, 1])
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    return parent
+
+
+@nb.njit(**_JIT)
+def count_components(edges, referenced, n_vertices):
+    """Connected components of the vertex graph among the referenced vertices (union-find)."""
+    parent = _union_edges(edges, n_vertices)
+    count = 0
+    for v in range(n_vertices):
+        if referenced[v] and _find(parent, v) == v:
+            count += 1
+    return count
+
+
+@nb.njit(**_JIT)
+def component_labels(edges, referenced, n_vertices):
+    """(V,) component of each vertex of the edge graph (0, 1, ... by first vertex; -1: unreferenced) and the count."""
+    parent = _union_edges(edges, n_vertices)
+    labels = np.full(n_vertices, -1, np.int64)
+    count = 0
+    for v in range(n_vertices):
+        if not referenced[v]:
+            continue
+        root = _find(parent, v)
+        if labels[root] < 0:
+            labels[root] = count
+            count += 1
+        labels[v] = labels[root]
+    return labels, count
+
+
+@nb.njit(parallel=True, **_JIT)
+def neighbour_lists(edges, n_vertices, n_chunks):
+    """CSR lists of the edge neighbours of every vertex: ``(indptr, indices)``.
+
+    Each of ``n_chunks`` threads fills the lists of its own range of vertices,
+    scanning the edges in order: the lists are the same for any number of threads.
+    """
+    n_chunks = max(1, min(n_chunks, n_vertices))
+    indptr = np.zeros(n_vertices + 1, np.int64)
+    for chunk in nb.prange(n_chunks):
+        first = (n_vertices * chunk) // n_chunks
+        last = (n_vertices * (chunk + 1)) // n_chunks
+        for e in range(edges.shape[0]):
+            for v in (edges[e, 0], edges[e, 1]):
+                if first <= v < last:
+                    indptr[v + 1] += 1
+    for v in range(n_vertices):
+        indptr[v + 1] += indptr[v]
+    indices = np.empty(indptr[n_vertices], np.int64)
+    fill = indptr[:-1].copy()
+    for chunk in nb.prange(n_chunks):
+        first = (n_vertices * chunk) // n_chunks
+        last = (n_vertices * (chunk + 1)) // n_chunks
+        for e in range(edges.shape[0]):
+            p, q = edges[e, 0], edges[e, 1]
+            if first <= p < last:
+                indices[fill[p]] = q
+                fill[p] += 1
+            if first <= q < last:
+                indices[fill[q]] = p
+                fill[q] += 1
+    return indptr, indices

@@ -1,0 +1,416 @@
+"""Weighted osculating jets: polynomial height functions fitted over balls (Cazals and Pouget 2005).
+
+For vertex ``v`` with a frame ``(t_1, t_2, n)``, every vertex ``x_j`` in the ball
+``B(x_v, r)`` (the vertex itself included) gives local coordinates
+``(u_j, v_j, w_j) = ((x_j - x_v) . t_1, (x_j - x_v) . t_2, (x_j - x_v) . n)``, and the
+height function is fitted by weighted least squares as a polynomial (a *jet*) of
+degree ``d``:
+
+.. math::
+
+    w(u, v) = \\sum_{i + k \\le d} c_{ik}\\, u^i v^k, \\qquad
+    \\min_c \\sum_j \\omega_j \\big(w_j - w(u_j, v_j)\\big)^2, \\qquad
+    \\omega_j = \\big(1 - |x_j - x_v|^2 / r^2\\big)^2 .
+
+A fit of degree ``d`` falls back to ``d - 1`` (down to 2) where the ball holds
+too few points, or too degenerate a set, for a well-conditioned fit. The
+constant term is free (on a noisy mesh the vertex is not on the surface), and
+so are the linear terms.
+
+Normal re-estimation: the first fit runs in the frame of a given normal (the
+area-weighted vertex normal); the fitted surface's normal ``(n - c_{10} t_1 -
+c_{01} t_2) / sqrt(1 + c_{10}^2 + c_{01}^2)`` (Cazals and Pouget's Monge basis)
+becomes the frame of a second fit, :data:`ITERATIONS` fits in all, so that the
+final fit is a height function over (almost) its own tangent plane, where the
+quadric coefficients are the second fundamental form (Panozzo et al. fit in the
+frame of an estimated normal the same way). From the last fit, with
+``p = c_{10}``, ``q = c_{01}`` and ``W = sqrt(1 + p^2 + q^2)``:
+
+.. math::
+
+    I = \\begin{pmatrix} 1 + p^2 & pq \\\\ pq & 1 + q^2 \\end{pmatrix}, \\qquad
+    II = \\frac{1}{W} \\begin{pmatrix} 2 c_{20} & c_{11} \\\\ c_{11} & 2 c_{02} \\end{pmatrix}
+
+and the shape operator in meshcurv's sign (positive where the surface bends
+away from its normal) is ``-I^{-1} II``, turned into a symmetric 3D tensor
+``J I^{-1} (-II) I^{-1} J^T`` with ``J = [t_1 + p n, t_2 + q n]``
+(:func:`shape_operators`).
+
+The fits serve the ``quadric`` estimator (:mod:`meshcurv.estimators.quadric`,
+curvatures from the jets), the normals of ``icc`` (:mod:`meshcurv.estimators.icc`)
+and the point clouds (:mod:`meshcurv.pointcloud`). With the compiled kernels
+(:mod:`meshcurv._kernels.jets`) a ball can be the surface-connected piece of the
+Euclidean ball (``adjacency=``).
+
+References
+----------
+F. Cazals and M. Pouget (2005). Estimating differential quantities using
+polynomial fitting of osculating jets. Computer Aided Geometric Design 22(2),
+121-146. https://doi.org/10.1016/j.cagd.2004.09.004
+
+D. Panozzo, E. Puppo, L. Rocca (2010). Efficient multi-scale curvature and
+crease estimation. Computer Graphics Forum 29(5) / GraVisMa 2010, 9-16.
+https://doi.org/10.1111/j.1467-8659.2010.01797.x
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._backend import kernel_threads, numba_kernels
+from ._tensors import tangent_basis
+from ._validation import checked_points
+from .errors import InvalidMeshError
+from .neighborhoods import PAIRS_PER_CALL, _ball_pairs, check_ball_work
+
+#: Highest degree of the jet (lowered to 3, then 2, where the ball holds too few points).
+DEGREE = 4
+
+#: Fits per vertex: the first in the frame of the vertex normal, each next one in
+#: the frame of the normal of the previous fit.
+ITERATIONS = 2
+
+#: Fewest points (with non-zero weight) a fit takes: the six coefficients of a quadric.
+MIN_POINTS = 6
+
+#: Smallest Cholesky pivot of a diagonally scaled normal matrix (unit diagonal) that is
+#: solved: a smaller one means a nearly degenerate set of points (for example collinear).
+MIN_PIVOT = 1e-5
+
+#: Centres per chunk of pair queries (bounds the memory of the per-pair arrays; fewer
+#: where the balls are large, see :data:`meshcurv.neighborhoods.PAIRS_PER_CHUNK`).
+CHUNK_SIZE = 4096
+
+#: A fit whose ball holds more than this share of its points whose normal faces away from
+#: the centre's (``n_j . n_v < 0``) is refused (:func:`fit_jets`, ``facing``): the ball
+#: reaches past the part's silhouette to its other side. On a smooth surface sampled finer
+#: than its thickness the share is 0; a ball across a needle thinner than the ball holds
+#: about half; on a sphere of radius R a ball of radius 1.5 R holds 11% (2.5 R: 50%), and
+#: from sqrt(2) R (where the share starts) the jet of degree 4 is far off anyway (k R = 0.5
+#: for 1 at 1.5 R). Noisy normals of a clean surface rarely turn beyond 90 degrees: 5%
+#: leaves room for a few that do.
+AWAY_FRACTION = 0.05
+
+
+def _exponents(degree: int) -> np.ndarray:
+    """(m, 2) exponents ``(i, k)`` of the monomials ``u^i v^k``, by total degree."""
+    return np.array([(total - k, k) for total in range(degree + 1) for k in range(total + 1)])
+
+
+def _n_terms(degree: int) -> int:
+    return (degree + 1) * (degree + 2) // 2
+
+
+def _fit_chunk(offsets: np.ndarray, rows: np.ndarray, size: int, frame: tuple, weights: np.ndarray,
+               degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Weighted normal equations of the jets of one chunk of centres, in units of the radius.
+
+    ``offsets`` (P, 3) are ``(x_j - x_v) / r``, ``rows`` (P,) the centre of each
+    pair within the chunk and ``frame`` the (size, 3) vectors ``t1, t2, n`` of
+    the centres. Returns the (size, m, m) matrices and the (size, m) right-hand sides.
+    """
+    t1, t2, normal = frame
+    u = np.einsum("ij,ij->i", offsets, t1[rows])
+    v = np.einsum("ij,ij->i", offsets, t2[rows])
+    w = np.einsum("ij,ij->i", offsets, normal[rows])
+    exponents = _exponents(degree)
+    m = exponents.shape[0]
+    # the products of two monomials are monomials of degree <= 2d: sum each once
+    u_powers = [np.ones_like(u)]
+    v_powers = [np.ones_like(v)]
+    for _ in range(2 * degree):
+        u_powers.append(u_powers[-1] * u)
+        v_powers.append(v_powers[-1] * v)
+    moments = {}
+    for total in range(2 * degree + 1):
+        for k in range(total + 1):
+            moments[total - k, k] = np.bincount(rows, weights=weights * u_powers[total - k] * v_powers[k],
+                                                minlength=size)
+    matrix = np.zeros((size, m, m))
+    for a in range(m):
+        for b in range(a, m):
+            matrix[:, a, b] = matrix[:, b, a] = moments[tuple(exponents[a] + exponents[b])]
+    right = np.stack([np.bincount(rows, weights=weights * w * u_powers[i] * v_powers[k], minlength=size)
+                      for i, k in exponents], axis=1)
+    return matrix, right
+
+
+def _cholesky_solve(matrix: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Solve the (N, m, m) symmetric systems of unit diagonal by Cholesky.
+
+    Returns the (N, m) solutions and (N,) whether every pivot exceeded
+    :data:`MIN_PIVOT` (the solutions of the others are meaningless). A loop over
+    the m <= 15 columns, vectorized over the systems; the compiled kernel does
+    the same operations in the same order.
+    """
+    n, m = right.shape
+    low = np.zeros_like(matrix)  # the factor below the diagonal, the inverse of each pivot's root on it
+    ok = np.ones(n, dtype=bool)
+    for k in range(m):
+        d = matrix[:, k, k].copy()
+        for j in range(k):
+            d -= low[:, k, j] * low[:, k, j]
+        ok &= d > MIN_PIVOT
+        inverse = 1.0 / np.sqrt(np.where(ok, d, 1.0))
+        low[:, k, k] = inverse
+        for i in range(k + 1, m):
+            t = matrix[:, i, k].copy()
+            for j in range(k):
+                t -= low[:, i, j] * low[:, k, j]
+            low[:, i, k] = t * inverse
+    x = right.copy()
+    for i in range(m):
+        for j in range(i):
+            x[:, i] -= low[:, i, j] * x[:, j]
+        x[:, i] *= low[:, i, i]
+    for i in range(m - 1, -1, -1):
+        for j in range(i + 1, m):
+            x[:, i] -= low[:, j, i] * x[:, j]
+        x[:, i] *= low[:, i, i]
+    return x, ok
+
+
+def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: int) -> np.ndarray:
+    """(N, 6) the constant, linear and quadratic coefficients of the highest solvable degree (NaN: none).
+
+    The monomials are ordered by degree, so the normal equations of a lower
+    degree are the leading block of those of ``degree``.
+    """
+    out = np.full((matrix.shape[0], 6), np.nan)
+    todo = np.ones(matrix.shape[0], dtype=bool)
+    for d in range(degree, 1, -1):
+        m = _n_terms(d)
+        candidates = np.flatnonzero(todo & (counts >= m))
+        if candidates.size == 0:
+            continue
+        block = matrix[candidates, :m, :m]
+        scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
+        scaled = block * scale[:, :, None] * scale[:, None, :]
+        solution, ok = _cholesky_solve(scaled, right[candidates, :m] * scale)
+        chosen = candidates[ok]
+        if chosen.size:
+            out[chosen] = (solution[ok] * scale[ok])[:, :6]
+            todo[chosen] = False
+    return out
+
+
+def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
+             iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
+             neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
+             details: dict | None = None, adjacency: tuple | None = None):
+    """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+    normals : ndarray of shape (V, 3)
+        Unit normals of the first frame (finite at the centres).
+    radius : float
+        Radius of the ball of each fit (> 0).
+    degree : int, default: DEGREE
+    iterations : int, default: ITERATIONS
+    centres : ndarray of int, optional
+        The vertices to fit (default: all). The rows of the others are NaN
+        (counts 0).
+    neighbours : ndarray of bool of shape (V,), optional
+        The vertices that may enter the balls (default: all). Pass
+        ``topology.referenced_vertices`` so that points stored with the mesh but
+        in no face (a point cloud, scanner leftovers) stay out of every fit: the
+        fits of the referenced vertices are then those of the mesh without them.
+    facing : ndarray of shape (V, 3), optional
+        Normals for the check that each ball is a height function over the
+        tangent plane: a fit whose ball holds more than :data:`AWAY_FRACTION` of
+        its points (of non-zero weight) whose ``facing`` normal is opposite to the centre's
+        (``n_j . n_v < 0``; rows of NaN are not counted) is left NaN. Such a ball
+        holds the other side of a thin part (a needle thinner than the ball) or
+        of the whole closed surface (a ball larger than the part): its jet is
+        a fit through both sides, not the surface. Default: no check.
+    details : dict, optional
+        Receives ``"away"``: (V,) the share of the ball's points facing away at
+        each fitted centre (NaN unless ``facing`` is given).
+    adjacency : tuple of two ndarrays of int, optional
+        ``(indptr, indices)``: the edge neighbours of every vertex in CSR form
+        (:attr:`meshcurv.topology.MeshTopology.neighbour_lists`). With the
+        compiled kernels each ball is then searched breadth-first over the
+        edges that meet it, from its centre, instead of on a grid over all the
+        points: the same points wherever the ball's part of the surface is
+        connected (every ball of a radius below the surface's thickness and
+        reach), and no search structure over the whole mesh (a fit at a few
+        centres costs only their balls). Another sheet of the surface within
+        the ball (the far side of a part thinner than the ball) is left out.
+        The NumPy path takes the whole Euclidean ball.
+
+    Returns
+    -------
+    coefficients : ndarray of shape (V, 6)
+        ``c00, c10, c01, c20, c11, c02`` of the last fit, in units of ``radius``
+        (NaN where no fit was possible).
+    frame : tuple of three ndarrays of shape (V, 3)
+        ``t1, t2, n``: the frame of the last fit.
+    counts : ndarray of shape (V,)
+        Points with non-zero weight in each ball.
+
+    Raises
+    ------
+    InvalidOptionError
+        The balls would hold more than :data:`meshcurv.neighborhoods.MAX_BALL_PAIRS`
+        pairs in all (a radius far too large for the mesh).
+    """
+    vertices = checked_points(vertices)
+    n = vertices.shape[0]
+    normals = np.ascontiguousarray(normals, dtype=np.float64)
+    if normals.shape != vertices.shape:
+        raise InvalidMeshError(f"`normals` must have shape {vertices.shape}; got {normals.shape}")
+    centres = np.arange(n) if centres is None else np.asarray(centres, dtype=np.int64).ravel()
+    if centres.size and (centres.min() < 0 or centres.max() >= n):
+        raise InvalidMeshError(f"`centres` must be vertex indices in 0..{n - 1}")
+    if neighbours is None:
+        pool = np.arange(n)
+    else:
+        neighbours = np.asarray(neighbours, dtype=bool)
+        if neighbours.shape != (n,):
+            raise InvalidMeshError(f"`neighbours` must have shape ({n},); got {neighbours.shape}")
+        pool = np.flatnonzero(neighbours)
+    check = facing is not None
+    if check:
+        facing = np.ascontiguousarray(facing, dtype=np.float64)
+        if facing.shape != vertices.shape:
+            raise InvalidMeshError(f"`facing` must have shape {vertices.shape}; got {facing.shape}")
+    pool_points = vertices[pool]
+    mean, _ = check_ball_work(pool_points, radius, centres.size, centres=vertices[centres])
+    kernels = numba_kernels("jets")
+    if kernels is not None and n:
+        n_calls = max(1, min(centres.size, int(np.ceil(mean * centres.size / PAIRS_PER_CALL))))
+        outputs = None  # the first call's outputs (the rows of the others' centres filled in from theirs)
+        if adjacency is not None:
+            allowed = np.ones(n, dtype=bool) if neighbours is None else neighbours
+            indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
+            if indptr.shape != (n + 1,):
+                raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
+        for call in range(n_calls):  # Python between calls: Ctrl-C gets through
+            part = centres[call * centres.size // n_calls:(call + 1) * centres.size // n_calls]
+            if adjacency is not None:
+                found = kernels.fit_jets_connected(
+                    vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
+                    kernel_threads(), allowed, indptr, indices, facing if check else vertices, check, AWAY_FRACTION,
+                    False)
+            else:
+                found = kernels.fit_jets(
+                    vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
+                    64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION)
+            if outputs is None:
+                outputs = list(found)
+                continue
+            for whole, piece in zip(outputs, found):
+                whole[part] = piece[part]
+        coefficients, t1, t2, normal, counts, away = outputs
+        if details is not None:
+            details["away"] = away
+        return coefficients, (t1, t2, normal), counts
+    frame = [np.full((n, 3), np.nan) for _ in range(3)]
+    coefficients = np.full((n, 6), np.nan)
+    counts = np.zeros(n)
+    away = np.full(n, np.nan)
+    for chunk, centre, neighbour in _ball_pairs(pool_points, vertices[centres], radius, chunk_size):
+        index = centres[chunk]
+        size = index.size
+        rows = centre - chunk.start
+        neighbour = pool[neighbour]
+        offsets = (vertices[neighbour] - vertices[index[rows]]) * (1.0 / radius)
+        weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
+        count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
+        local = [*tangent_basis(normals[index]), normals[index]]
+        for step in range(iterations):
+            matrix, right = _fit_chunk(offsets, rows, size, local, weights, degree)
+            fitted = _solve(matrix, right, count, degree)
+            if step + 1 < iterations:
+                p, q = fitted[:, 1:2], fitted[:, 2:3]
+                tilted = local[2] - p * local[0] - q * local[1]
+                tilted /= np.linalg.norm(tilted, axis=1, keepdims=True)
+                keep = np.isfinite(tilted).all(axis=1, keepdims=True)
+                new_normal = np.where(keep, tilted, local[2])
+                local = [*tangent_basis(new_normal), new_normal]
+        if check:
+            opposite = np.einsum("ij,ij->i", facing[neighbour], facing[index[rows]]) < 0
+            inside = weights > 0
+            total = np.bincount(rows, weights=inside.astype(float), minlength=size)
+            against = np.bincount(rows, weights=(inside & opposite).astype(float), minlength=size)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                away[index] = np.where(total > 0, against / total, 0.0)
+            fitted[against > AWAY_FRACTION * total] = np.nan
+        for f, part in zip(frame, local):
+            f[index] = part
+        coefficients[index] = fitted
+        counts[index] = count
+    if details is not None:
+        details["away"] = away
+    return coefficients, tuple(frame), counts
+
+
+def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
+                    iterations: int = ITERATIONS, neighbours: np.ndarray | None = None,
+                    adjacency: tuple | None = None) -> np.ndarray:
+    """(V, 3) unit normals of the jets of :func:`fit_jets` at every vertex (NaN where no fit was possible).
+
+    ``jet_normals(*fit_jets(...)[:2])`` with the same arguments; with the
+    compiled kernels and ``adjacency``, one pass that writes only the normals
+    (not the coefficients, frames and counts: 136 bytes per vertex).
+    """
+    kernels = numba_kernels("jets")
+    vertices = checked_points(vertices)
+    n = vertices.shape[0]
+    if kernels is None or adjacency is None or n == 0:
+        coefficients, frame, _ = fit_jets(vertices, normals, radius, degree=degree, iterations=iterations,
+                                          neighbours=neighbours, adjacency=adjacency)
+        return jet_normals(coefficients, frame)
+    normals = np.ascontiguousarray(normals, dtype=np.float64)
+    if normals.shape != vertices.shape:
+        raise InvalidMeshError(f"`normals` must have shape {vertices.shape}; got {normals.shape}")
+    allowed = np.ones(n, dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
+    if allowed.shape != (n,):
+        raise InvalidMeshError(f"`neighbours` must have shape ({n},); got {allowed.shape}")
+    indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
+    if indptr.shape != (n + 1,):
+        raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
+    centres = np.arange(n)
+    mean, _ = check_ball_work(vertices[allowed], radius, n, centres=vertices)
+    n_calls = max(1, min(n, int(np.ceil(mean * n / PAIRS_PER_CALL))))
+    fitted = None
+    for call in range(n_calls):  # Python between calls: Ctrl-C gets through
+        part = centres[call * n // n_calls:(call + 1) * n // n_calls]
+        found = kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations, _exponents(degree),
+                                           MIN_PIVOT, part, kernel_threads(), allowed, indptr, indices, vertices,
+                                           False, AWAY_FRACTION, True)[0]
+        if fitted is None:
+            fitted = found
+        else:
+            fitted[part] = found[part]
+    return fitted
+
+
+def jet_normals(coefficients: np.ndarray, frame: tuple) -> np.ndarray:
+    """(V, 3) unit normals of the fitted jets, ``(n - c10 t1 - c01 t2) / sqrt(1 + c10^2 + c01^2)``."""
+    t1, t2, normal = frame
+    p, q = coefficients[:, 1:2], coefficients[:, 2:3]
+    return (normal - p * t1 - q * t2) / np.sqrt(1 + p * p + q * q)
+
+
+def shape_operators(coefficients: np.ndarray, frame: tuple, radius: float):
+    """(V, 6) shape operators (meshcurv's sign) and (V, 3) unit normals of the fitted jets."""
+    t1, t2, normal = frame
+    _, p, q, a, b, c = coefficients.T
+    a, b, c = a / radius, b / radius, c / radius  # back from units of radius
+    width = np.sqrt(1 + p * p + q * q)
+    first = np.stack([1 + p * p, p * q, 1 + q * q], axis=1)
+    second = -np.stack([2 * a, b, 2 * c], axis=1) / width[:, None]
+    det = first[:, 0] * first[:, 2] - first[:, 1] ** 2
+    inverse = np.stack([first[:, 2], -first[:, 1], first[:, 0]], axis=1) / det[:, None]
+
+    def as2x2(s):
+        return np.stack([np.stack([s[:, 0], s[:, 1]], axis=1), np.stack([s[:, 1], s[:, 2]], axis=1)], axis=1)
+
+    middle = as2x2(inverse) @ as2x2(second) @ as2x2(inverse)
+    jacobian = np.stack([t1 + p[:, None] * normal, t2 + q[:, None] * normal], axis=2)  # (V, 3, 2)
+    tensor = jacobian @ middle @ jacobian.transpose(0, 2, 1)
+    six = tensor[:, [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]
+    return six, jet_normals(coefficients, frame)
