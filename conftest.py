@@ -10,8 +10,7 @@ them skip through ``pytest.importorskip``.
 import importlib.util
 
 _NEEDS = {
-    "click": ["src/meshcurv/_cli_app.py", "src/meshcurv/_batch_cli.py", "src/meshcurv/_volume_cli.py",
-              "src/meshcurv/_view_cli.py", "src/meshcurv/cli.py"],
+    "click": ["src/meshcurv/cli"],
     "numba": ["src/meshcurv/_kernels"],
 }
 

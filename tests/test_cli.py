@@ -209,14 +209,14 @@ def test_library_option_errors_are_usage_errors_and_bugs_are_one_line(capsys, to
     def refuses(*args, **kwargs):
         raise meshcurv.InvalidOptionError("`radius` must be a positive finite number; got inf")
 
-    monkeypatch.setattr("meshcurv._cli_app.principal_curvatures", refuses)
+    monkeypatch.setattr("meshcurv.cli._common.principal_curvatures", refuses)
     code, _, err = run(capsys, "compute", torus_file)
     assert code == 2 and one_error_line(err) == "meshcurv: error: `radius` must be a positive finite number; got inf"
 
     def breaks(*args, **kwargs):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr("meshcurv._cli_app.principal_curvatures", breaks)
+    monkeypatch.setattr("meshcurv.cli._common.principal_curvatures", breaks)
     code, _, err = run(capsys, "compute", torus_file)
     assert code == 1
     assert one_error_line(err) == "meshcurv: error: unexpected RuntimeError: boom (run with --debug for the traceback)"
@@ -355,8 +355,9 @@ def test_missing_click_names_the_extra(capsys, monkeypatch):
             raise ImportError(name, name="click")
         return real_import(name, *args, **kwargs)
 
-    monkeypatch.delitem(sys.modules, "meshcurv._cli_app")
-    monkeypatch.delattr(meshcurv, "_cli_app")
+    for name in [name for name in sys.modules if name.startswith("meshcurv.cli._")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.delattr(meshcurv.cli, "_app")
     monkeypatch.setattr(builtins, "__import__", no_click)
     code, _, err = run(capsys, "methods")
     assert code == 1 and one_error_line(err) == ("meshcurv: error: the command line needs click: "

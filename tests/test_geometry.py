@@ -1,6 +1,9 @@
 import numpy as np
+import pytest
 
 from meshcurv import geometry, shapes
+from meshcurv.errors import InvalidMeshError
+from meshcurv.geometry import face_normals
 from meshcurv.topology import MeshTopology
 
 
@@ -44,3 +47,34 @@ def test_mean_edge_length_of_a_unit_grid():
     # 5 x 5 points: 20 + 20 axis-aligned edges of 0.5, 16 diagonals of 0.5 sqrt(2)
     expected = (40 * 0.5 + 16 * 0.5 * np.sqrt(2)) / 56
     assert abs(geometry.mean_edge_length(flat, top.edges) - expected) < 1e-12
+
+
+@pytest.mark.parametrize("fold", [0.0, 0.3, np.pi / 2, 2.0])
+def test_edge_dihedral_angles_of_a_folded_pair(fold):
+    # two triangles on the edge (0, 1) along x, the second turned by `fold` about it: their normals differ by it
+    vertices = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -np.cos(fold), np.sin(fold)]])
+    faces = np.array([[0, 1, 2], [1, 0, 3]])
+    top = MeshTopology.from_faces(faces, 4)
+    normals = face_normals(vertices, faces)
+    usable = top.interior_edges.copy()
+    beta, lengths, unit = geometry.edge_dihedral_angles(vertices, top, normals, usable)
+    shared = np.flatnonzero(usable)
+    assert shared.size == 1 and np.allclose(abs(beta[shared]), fold) and (beta[~usable] == 0).all()
+    np.testing.assert_allclose(lengths[shared], 1.0)
+    np.testing.assert_allclose(np.abs(unit[shared]), [[1.0, 0, 0]])
+    mirrored = vertices * [1, 1, -1]  # the fold the other way: the opposite sign
+    other, _, _ = geometry.edge_dihedral_angles(mirrored, top, face_normals(mirrored, faces), usable)
+    np.testing.assert_allclose(other[shared], -beta[shared], atol=1e-15)
+
+
+def test_edge_dihedral_angles_refuse_mismatched_arrays():
+    vertices = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -1, 0]])
+    faces = np.array([[0, 1, 2], [1, 0, 3]])
+    top = MeshTopology.from_faces(faces, 4)
+    normals = face_normals(vertices, faces)
+    with pytest.raises(InvalidMeshError, match=r"`unit_normals` must be a real array of shape \(2, 3\)"):
+        geometry.edge_dihedral_angles(vertices, top, normals[:1], top.interior_edges)
+    with pytest.raises(InvalidMeshError, match=r"`usable_edges` must be a bool array of shape \(5,\)"):
+        geometry.edge_dihedral_angles(vertices, top, normals, np.ones(5))
+    with pytest.raises(InvalidMeshError, match=r"`topology` must be a MeshTopology; got ndarray"):
+        geometry.edge_dihedral_angles(vertices, faces, normals, top.interior_edges)

@@ -282,12 +282,12 @@ def test_array_too_large_for_a_browser(tmp_path, torus, monkeypatch):
 def run_view(args):
     """``meshcurv view ARGS`` in-process (click's CliRunner, the group's Session as meshcurv.cli.main makes it)."""
     click_testing = pytest.importorskip("click.testing")
-    from meshcurv._cli_app import Session
-    from meshcurv._view_cli import view_command
+    from meshcurv.cli._common import Session
+    from meshcurv.cli._view import view
 
     session = Session()
     with session:
-        return click_testing.CliRunner().invoke(view_command(), [str(arg) for arg in args], obj=session)
+        return click_testing.CliRunner().invoke(view, [str(arg) for arg in args], obj=session)
 
 
 @pytest.fixture(scope="module")

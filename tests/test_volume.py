@@ -310,12 +310,12 @@ def test_reader_refuses_huge_declared_sizes(tmp_path, monkeypatch):
 def run_volume(args):
     """``meshcurv volume ARGS`` in-process (click's CliRunner, the group's Session as meshcurv.cli.main makes it)."""
     click_testing = pytest.importorskip("click.testing")
-    from meshcurv._cli_app import Session
-    from meshcurv._volume_cli import volume_command
+    from meshcurv.cli._common import Session
+    from meshcurv.cli._volume import volume
 
     session = Session()
     with session:
-        return click_testing.CliRunner().invoke(volume_command(), [str(arg) for arg in args], obj=session)
+        return click_testing.CliRunner().invoke(volume, [str(arg) for arg in args], obj=session)
 
 
 @pytest.mark.slow  # matplotlib's import and the picture: several seconds

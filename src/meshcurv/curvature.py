@@ -9,11 +9,12 @@ import numpy as np
 
 from ._adapters import mesh_arrays
 from ._validation import as_faces, as_vertices, check_choice, check_int_option, check_positive_float
+from .diagnosis import diagnose, quality_message
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._common import ProgressCallback, Stages
 from .estimators.icc import voxel_surface_radius
-from .diagnosis import degenerate_faces, diagnose, quality_message
+from .geometry import degenerate_faces
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import INVALID_REASONS, CurvatureResult, Surface
 from .topology import MeshTopology

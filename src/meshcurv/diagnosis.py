@@ -15,8 +15,8 @@ import numpy as np
 from ._backend import numba_kernels
 from ._validation import check_int_option
 from .errors import InvalidMeshError
-from .geometry import (DEGENERATE_AREA_RATIO, checked_topology_points, degenerate_face_mask, edge_lengths,
-                       face_cross_products, vertex_length_scales)
+from .geometry import (DEGENERATE_AREA_RATIO, checked_topology_points, degenerate_face_mask, degenerate_faces,
+                       edge_lengths, face_cross_products, vertex_length_scales)
 from .topology import MeshTopology
 
 #: Edges no longer than this times the length scale of their component (its median
@@ -128,57 +128,6 @@ class MeshDiagnosis:
 
     def as_dict(self) -> dict:
         return asdict(self)
-
-
-def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.ndarray | None = None,
-                     mean_edge_length: float | None = None, double_areas: np.ndarray | None = None,
-                     scales: np.ndarray | None = None) -> np.ndarray:
-    """(F,) bool: faces with a repeated corner or an area below 1e-12 x (length scale)^2.
-
-    The length scale of a face is the median edge length of its connected
-    component (:func:`meshcurv.geometry.vertex_length_scales`; ``scales`` passes
-    them when already computed), or ``mean_edge_length`` when given (one scale
-    for all). Relative to the mesh's own scale, the same mesh gives the same
-    answer at any scale (coordinates around 1e-9 or 1e9 alike); a median, it is
-    not moved by a few outlier vertices (a spike at 1e10 leaves the other faces
-    alone); per component, a part at 1e-3 and a part at 1e3 are each measured
-    against their own edges.
-
-    Raises
-    ------
-    InvalidMeshError
-        ``topology`` not a MeshTopology, ``vertices`` unusable, or ``cross``
-        (F, 3), ``double_areas`` (F,), ``scales`` (V,) not real arrays of
-        those shapes.
-    """
-    vertices = checked_topology_points(vertices, topology)
-    cross = _optional_floats(cross, "cross", topology.faces.shape)
-    double_areas = _optional_floats(double_areas, "double_areas", (topology.n_faces,))
-    scales = _optional_floats(scales, "scales", (topology.n_vertices,))
-    kernels = numba_kernels("diagnosis")
-    if scales is None and mean_edge_length is None:
-        scales = vertex_length_scales(vertices, topology)
-    if kernels is not None and double_areas is None:
-        # the kernel computes the cross products inline: ``cross`` only spares the NumPy path that work
-        if scales is None:
-            scales = np.full(topology.n_vertices, float(mean_edge_length))
-        return kernels.degenerate_faces(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)
-    face_scale = scales[topology.faces[:, 0]] if scales is not None else mean_edge_length
-    if double_areas is None:
-        if cross is None:
-            cross = face_cross_products(vertices, topology.faces)
-        double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
-    return degenerate_face_mask(0.5 * double_areas, face_scale) | topology.degenerate_faces
-
-
-def _optional_floats(value, name: str, shape: tuple) -> np.ndarray | None:
-    """``value`` as a C-contiguous float64 array of ``shape`` (None stays None)."""
-    if value is None:
-        return None
-    array = np.asarray(value)
-    if array.shape != shape or array.dtype.kind not in "fiu":
-        raise InvalidMeshError(f"`{name}` must be a real array of shape {shape}; got {array.dtype} {array.shape}")
-    return np.ascontiguousarray(array, dtype=np.float64)
 
 
 def bowtie_vertices(topology: MeshTopology) -> np.ndarray:

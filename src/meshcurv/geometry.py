@@ -24,6 +24,8 @@ from .errors import InvalidMeshError, InvalidOptionError
 from .topology import MeshTopology
 
 __all__ = [
+    "degenerate_faces",
+    "edge_dihedral_angles",
     "face_cross_products",
     "face_areas",
     "face_normals",
@@ -338,6 +340,93 @@ def degenerate_face_mask(areas: np.ndarray, length_scale) -> np.ndarray:
         raise InvalidOptionError("`length_scale` must be >= 0 (not NaN)")
     with np.errstate(over="ignore"):  # a scale beyond 1e154 squares to inf: every face is below it
         return areas <= DEGENERATE_AREA_RATIO * scale**2
+
+
+def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.ndarray | None = None,
+                     mean_edge_length: float | None = None, double_areas: np.ndarray | None = None,
+                     scales: np.ndarray | None = None) -> np.ndarray:
+    """(F,) bool: faces with a repeated corner or an area below 1e-12 x (length scale)^2.
+
+    The length scale of a face is the median edge length of its connected
+    component (:func:`meshcurv.geometry.vertex_length_scales`; ``scales`` passes
+    them when already computed), or ``mean_edge_length`` when given (one scale
+    for all). Relative to the mesh's own scale, the same mesh gives the same
+    answer at any scale (coordinates around 1e-9 or 1e9 alike); a median, it is
+    not moved by a few outlier vertices (a spike at 1e10 leaves the other faces
+    alone); per component, a part at 1e-3 and a part at 1e3 are each measured
+    against their own edges.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``topology`` not a MeshTopology, ``vertices`` unusable, or ``cross``
+        (F, 3), ``double_areas`` (F,), ``scales`` (V,) not real arrays of
+        those shapes.
+    """
+    vertices = checked_topology_points(vertices, topology)
+    cross = _optional_floats(cross, "cross", topology.faces.shape)
+    double_areas = _optional_floats(double_areas, "double_areas", (topology.n_faces,))
+    scales = _optional_floats(scales, "scales", (topology.n_vertices,))
+    kernels = numba_kernels("geometry")
+    if scales is None and mean_edge_length is None:
+        scales = vertex_length_scales(vertices, topology)
+    if kernels is not None and double_areas is None:
+        # the kernel computes the cross products inline: ``cross`` only spares the NumPy path that work
+        if scales is None:
+            scales = np.full(topology.n_vertices, float(mean_edge_length))
+        return kernels.degenerate_faces(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)
+    face_scale = scales[topology.faces[:, 0]] if scales is not None else mean_edge_length
+    if double_areas is None:
+        if cross is None:
+            cross = face_cross_products(vertices, topology.faces)
+        double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
+    return degenerate_face_mask(0.5 * double_areas, face_scale) | topology.degenerate_faces
+
+
+def _optional_floats(value, name: str, shape: tuple) -> np.ndarray | None:
+    """``value`` as a C-contiguous float64 array of ``shape`` (None stays None)."""
+    if value is None:
+        return None
+    array = np.asarray(value)
+    if array.shape != shape or array.dtype.kind not in "fiu":
+        raise InvalidMeshError(f"`{name}` must be a real array of shape {shape}; got {array.dtype} {array.shape}")
+    return np.ascontiguousarray(array, dtype=np.float64)
+
+
+def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_normals: np.ndarray,
+                         usable_edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Signed angle between the two face normals of each usable edge.
+
+    ``unit_normals`` (F, 3): the unit face normals; ``usable_edges`` (E,) bool:
+    the interior manifold edges between proper faces. Returns ``(beta, lengths,
+    unit_edges)`` of shapes (E,), (E,), (E, 3); ``beta`` is 0 on edges that are
+    not usable (boundary, non-manifold, degenerate).
+
+    Raises
+    ------
+    InvalidMeshError
+        ``topology`` not a MeshTopology, ``vertices`` unusable, ``unit_normals``
+        not a real (F, 3) array or ``usable_edges`` not an (E,) bool array.
+    """
+    vertices = checked_topology_points(vertices, topology)
+    unit_normals = _optional_floats(unit_normals, "unit_normals", topology.faces.shape)
+    usable_edges = np.asarray(usable_edges)
+    if usable_edges.shape != (topology.edges.shape[0],) or usable_edges.dtype != bool:
+        raise InvalidMeshError(f"`usable_edges` must be a bool array of shape ({topology.edges.shape[0]},); got "
+                               f"{usable_edges.dtype} {usable_edges.shape}")
+    edges = topology.edges
+    vectors = vertices[edges[:, 1]] - vertices[edges[:, 0]]
+    lengths = np.linalg.norm(vectors, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(lengths[:, None] > 0, vectors / lengths[:, None], 0.0)
+    beta = np.zeros(edges.shape[0])
+    faces = topology.edge_faces[usable_edges]
+    n1 = unit_normals[faces[:, 0]]
+    n2 = unit_normals[faces[:, 1]]
+    sine = np.einsum("ij,ij->i", np.cross(n1, n2), unit[usable_edges])
+    cosine = np.einsum("ij,ij->i", n1, n2)
+    beta[usable_edges] = np.arctan2(sine, cosine)
+    return beta, lengths, unit
 
 
 def _real_array(value, name: str) -> np.ndarray:

@@ -43,7 +43,7 @@ def _face_cross(vertices, a, b, c):
 
 @nb.njit(inline="always", **_JIT)
 def _degenerate(a, b, c, half_area, threshold):
-    """A face that repeats a vertex or whose area is at most ``threshold`` (``diagnosis.degenerate_faces``)."""
+    """A face that repeats a vertex or whose area is at most ``threshold`` (``geometry.degenerate_faces``)."""
     return a == b or b == c or c == a or half_area <= threshold
 
 

@@ -1,4 +1,4 @@
-"""Compiled twins of :mod:`meshcurv.diagnosis`: degenerate faces and the facts of a mesh in one pass.
+"""Compiled twin of :mod:`meshcurv.diagnosis`: the facts of a mesh in one pass.
 """
 
 from __future__ import annotations
@@ -9,22 +9,6 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, _degenerate, _edge_length, _face_cross
-
-
-@nb.njit(parallel=True, **_JIT)
-def degenerate_faces(vertices, faces, scales, area_ratio):
-    """(F,) bool: faces that repeat a vertex or whose area is at most ``area_ratio`` x ``scales[a]^2``.
-
-    ``scales`` (V,) is the length scale at each vertex (``geometry.vertex_length_scales``),
-    read at the first corner ``a`` (the corners of a face share their component).
-    """
-    out = np.empty(faces.shape[0], np.bool_)
-    for f in nb.prange(faces.shape[0]):
-        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-        nx, ny, nz = _face_cross(vertices, a, b, c)
-        threshold = area_ratio * scales[a] * scales[a]
-        out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
-    return out
 
 
 @nb.njit(parallel=True, **_JIT)

@@ -1,13 +1,15 @@
-"""Compiled twins of :mod:`meshcurv.geometry`: face cross products, vertex normals, edge lengths.
+"""Compiled twins of :mod:`meshcurv.geometry`: face cross products, vertex normals, edge lengths,
+degenerate faces.
 """
 
 from __future__ import annotations
 
+import math
 
 import numba as nb
 import numpy as np
 
-from ._common import _JIT, _edge_length, _face_cross, _unit
+from ._common import _JIT, _degenerate, _edge_length, _face_cross, _unit
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -76,4 +78,20 @@ def edge_lengths(vertices, edges):
     out = np.empty(edges.shape[0])
     for e in nb.prange(edges.shape[0]):
         out[e] = _edge_length(vertices, edges[e, 0], edges[e, 1])
+    return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def degenerate_faces(vertices, faces, scales, area_ratio):
+    """(F,) bool: faces that repeat a vertex or whose area is at most ``area_ratio`` x ``scales[a]^2``.
+
+    ``scales`` (V,) is the length scale at each vertex (``geometry.vertex_length_scales``),
+    read at the first corner ``a`` (the corners of a face share their component).
+    """
+    out = np.empty(faces.shape[0], np.bool_)
+    for f in nb.prange(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        nx, ny, nz = _face_cross(vertices, a, b, c)
+        threshold = area_ratio * scales[a] * scales[a]
+        out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
     return out

@@ -18,7 +18,7 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, scale
     """Per-vertex measures, barycentric areas and normal sums; the zero-area faces.
 
     A face is degenerate when it repeats a vertex or its area is at most
-    ``area_ratio`` x ``scales[a]^2`` (``diagnosis.degenerate_faces``); an
+    ``area_ratio`` x ``scales[a]^2`` (``geometry.degenerate_faces``); an
     edge contributes when it has two consistently oriented faces (``counts == 2``,
     ``forward == 1``), neither degenerate. Returns ``(sums, degenerate)``: ``sums``
     of shape (V, 10), columns 0-5 the anisotropic measure

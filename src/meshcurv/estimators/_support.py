@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..diagnosis import degenerate_faces
-from ..geometry import face_cross_products, vertex_normals
+from ..geometry import degenerate_faces, face_cross_products, vertex_normals
 from ..result import CurvatureResult
 from ..topology import MeshTopology
 from ._common import nan_where

@@ -34,13 +34,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._backend import kernel_threads, numba_kernels
+from .._tensors import outer6
+from ..geometry import degenerate_faces
 from ..result import CurvatureResult
 from ..smoothing import check_smoothing_steps, smooth_vertex_field
-from .._backend import kernel_threads, numba_kernels
-from ..diagnosis import degenerate_faces
 from ..topology import MeshTopology
 from ._defects import mesh_defects
-from .._tensors import outer6
 from ._common import Stages
 from ._eigen import sorted_by_magnitude
 

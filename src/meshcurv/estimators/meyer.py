@@ -30,8 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..diagnosis import degenerate_faces
-from ..geometry import corner_angles, corner_cotangents, face_cross_products, mixed_voronoi_corner_areas, vertex_normals
+from ..geometry import corner_angles, corner_cotangents, degenerate_faces, face_cross_products, mixed_voronoi_corner_areas, vertex_normals
 from ..topology import MeshTopology
 from ._common import Stages
 from ._defects import mesh_defects

@@ -48,9 +48,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
-from ..diagnosis import degenerate_faces
 from .._backend import kernel_threads, numba_kernels
-from ..geometry import DEGENERATE_AREA_RATIO, face_cross_products, vertex_length_scales, vertex_normals
+from ..geometry import (DEGENERATE_AREA_RATIO, degenerate_faces, edge_dihedral_angles, face_cross_products,
+                        vertex_length_scales, vertex_normals)
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from ..topology import MeshTopology
@@ -58,28 +58,6 @@ from ._common import Stages, nan_where
 from ._defects import mesh_defects
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
-
-
-def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_normals: np.ndarray,
-                         usable_edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Signed angle between the two face normals of each usable edge.
-
-    Returns ``(beta, lengths, unit_edges)`` of shapes (E,), (E,), (E, 3); ``beta``
-    is 0 on edges that are not usable (boundary, non-manifold, degenerate).
-    """
-    edges = topology.edges
-    vectors = vertices[edges[:, 1]] - vertices[edges[:, 0]]
-    lengths = np.linalg.norm(vectors, axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit = np.where(lengths[:, None] > 0, vectors / lengths[:, None], 0.0)
-    beta = np.zeros(edges.shape[0])
-    faces = topology.edge_faces[usable_edges]
-    n1 = unit_normals[faces[:, 0]]
-    n2 = unit_normals[faces[:, 1]]
-    sine = np.einsum("ij,ij->i", np.cross(n1, n2), unit[usable_edges])
-    cosine = np.einsum("ij,ij->i", n1, n2)
-    beta[usable_edges] = np.arctan2(sine, cosine)
-    return beta, lengths, unit
 
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):

@@ -38,11 +38,11 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
+from ..geometry import edge_dihedral_angles
 from ..neighborhoods import ball_edge_sums, ball_face_sums, default_radii, resolve_radius
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
-from .normal_cycle import edge_dihedral_angles
 
 STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve curvatures")
 

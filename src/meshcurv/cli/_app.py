@@ -1,201 +1,32 @@
-"""The commands of ``meshcurv`` (click). Run them through :func:`meshcurv.cli.main`."""
+"""The ``meshcurv`` group (click) and its commands; ``batch``, ``volume`` and ``view`` come from their modules.
+
+Run them through :func:`meshcurv.cli.main`.
+"""
 
 from __future__ import annotations
 
-import inspect
-import logging
 import pathlib
 import re
-import sys
-import warnings
 
 import click
 import numpy as np
 
-from . import __version__
-from ._validation import as_faces
-from .curvature import principal_curvatures
-from .diagnosis import diagnose
-from .errors import MeshFileError
-from .estimators import ESTIMATORS
-from .io import FORMATS, is_point_cloud, read_mesh, read_points, write_curvatures, write_point_curvatures
-from .pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
-from .io._files import check_output
-from .io.fields import FIELDS, curvature_fields
-from .smoothing import MAX_SMOOTHING_STEPS
-from .plotting import MAX_DPI
-from .topology import MeshTopology
+from .. import __version__
+from .._validation import as_faces
+from ..diagnosis import diagnose
+from ..errors import MeshFileError
+from ..estimators import ESTIMATORS
+from ..io import FORMATS, read_mesh, write_curvatures, write_point_curvatures
+from ..io._files import check_output
+from ..io.fields import FIELDS, curvature_fields
+from ..plotting import MAX_DPI
+from ..topology import MeshTopology
+from ._batch import batch
+from ._common import SCALAR_FIELDS, Session, _default_method, _percentiles, common_options, estimated, method_options
+from ._view import view
+from ._volume import volume
 
 __all__ = ["meshcurv", "Session"]
-
-SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid")]
-
-#: The largest finite float: an option value that parses to infinity (``1e400``) is beyond it.
-_FLOAT_MAX = sys.float_info.max
-_LEVELS = {-2: logging.CRITICAL, -1: logging.ERROR, 0: logging.WARNING, 1: logging.INFO, 2: logging.DEBUG}
-
-
-class Session:
-    """What one run of the command configures: logging level, warnings, progress; undone on exit."""
-
-    def __init__(self):
-        self.verbose = 0
-        self.quiet = 0
-        self.debug = False
-        self.progress = None
-        self._logger = logging.getLogger("meshcurv")
-        self._handler = None
-        self._warnings = None
-        self._level = None
-
-    def __enter__(self):
-        self._level = self._logger.level
-        self._handler = logging.StreamHandler(sys.stderr)
-        self._handler.setFormatter(logging.Formatter("meshcurv: %(message)s"))
-        self._logger.addHandler(self._handler)
-        self._warnings = warnings.catch_warnings()
-        self._warnings.__enter__()
-        warnings.simplefilter("always")
-        warnings.showwarning = self._show_warning
-        self.update()
-        return self
-
-    def __exit__(self, *exc_info):
-        self._warnings.__exit__(*exc_info)
-        self._logger.removeHandler(self._handler)
-        self._logger.setLevel(self._level)
-        return False
-
-    def update(self) -> None:
-        level = _LEVELS[max(-2, min(2, self.verbose - self.quiet))]
-        self._logger.setLevel(level)
-        if level <= logging.DEBUG:
-            self._handler.setFormatter(logging.Formatter("meshcurv: %(name)s: %(message)s"))
-
-    def _show_warning(self, message, category, filename, lineno, file=None, line=None):
-        if self.verbose - self.quiet >= 0:
-            click.echo(f"meshcurv: warning: {message}", err=True)
-
-    def info(self, text: str) -> None:
-        """A line on stderr unless -q."""
-        if self.verbose - self.quiet >= 0:
-            click.echo(f"meshcurv: {text}", err=True)
-
-    def bar(self, stages):
-        """A :class:`StageBar` for these stages, or a silent one (not a terminal, or --no-progress)."""
-        stream = sys.stderr
-        show = self.progress if self.progress is not None else stream.isatty()
-        return StageBar(stages, stream if show else None, tty=stream.isatty())
-
-
-class StageBar:
-    """A progress bar over named stages, on stderr: redrawn in place on a terminal, one line per stage otherwise."""
-
-    def __init__(self, stages, stream, *, tty: bool, width: int = 24):
-        self.stages = list(stages)
-        self.stream = stream
-        self.tty = tty
-        self.width = width
-        self.done = 0
-
-    def __call__(self, stage: str, index: int | None = None, total: int | None = None, *, offset: int = 0):
-        if self.stream is None:
-            return
-        position = offset + (index if index is not None else self.stages.index(stage) + 1)
-        count = len(self.stages)
-        filled = round(self.width * (position - 1) / count)
-        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {position}/{count} {stage}"
-        if self.tty:
-            self.stream.write(f"\r\033[K{text}")
-        else:
-            self.stream.write(f"meshcurv: {text}\n")
-        self.stream.flush()
-        self.done = position
-
-    def close(self) -> None:
-        if self.stream is not None and self.tty and self.done:
-            self.stream.write("\r\033[K")
-            self.stream.flush()
-
-
-def _store(ctx, param, value):
-    session = ctx.find_object(Session)
-    if param.name in ("verbose", "quiet"):
-        setattr(session, param.name, getattr(session, param.name) + value)
-    elif param.name == "debug":
-        session.debug = session.debug or value
-    elif value is not None:
-        session.progress = value
-    if session._handler is not None:
-        session.update()
-    return value
-
-
-def common_options(function):
-    """-v/-q/--debug/--progress, accepted before or after the command name."""
-    options = [
-        click.option("-v", "--verbose", count=True, expose_value=False, callback=_store,
-                     help="More messages on stderr (-v: stages, -vv: debug)."),
-        click.option("-q", "--quiet", count=True, expose_value=False, callback=_store,
-                     help="Fewer messages: no warnings (-q), only errors."),
-        click.option("--debug", is_flag=True, expose_value=False, callback=_store,
-                     help="Show the traceback when something fails."),
-        click.option("--progress/--no-progress", default=None, expose_value=False, callback=_store,
-                     help="Progress bar on stderr (default: only when stderr is a terminal)."),
-    ]
-    for option in reversed(options):
-        function = option(function)
-    return function
-
-
-class MethodChoice(click.Choice):
-    """The names of :data:`meshcurv.estimators.ESTIMATORS`, read when used (methods can be added)."""
-
-    def __init__(self):
-        super().__init__(list(ESTIMATORS) + list(POINT_CLOUD_METHODS))
-
-    @property
-    def choices(self):
-        return tuple(ESTIMATORS) + tuple(POINT_CLOUD_METHODS)
-
-    @choices.setter
-    def choices(self, value):
-        pass
-
-
-def _default_method() -> str:
-    return inspect.signature(principal_curvatures).parameters["method"].default
-
-
-def method_options(function):
-    """--method and the estimator options, passed on only when given."""
-    options = [
-        click.option("-m", "--method", type=MethodChoice(), default=_default_method(), show_default=True,
-                     help="Curvature estimator (see `meshcurv methods`)."),
-        click.option("--smoothing-steps", type=click.IntRange(min=0, max=MAX_SMOOTHING_STEPS), default=None,
-                     help=f"Passes of 1-ring smoothing (normal_cycle, matgeom; default 3; at most "
-                          f"{MAX_SMOOTHING_STEPS})."),
-        click.option("--radius", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
-                     help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
-                          "default from the mesh: see `meshcurv methods`)."),
-        click.option("--orient", type=click.Choice(["auto", "outward", "consistent", "keep"]), default=None,
-                     help="Reorient the faces first (default: auto = outward, keep for matgeom)."),
-    ]
-    for option in reversed(options):
-        function = option(function)
-    return function
-
-
-def _estimate(vertices, faces, method, options, bar, *, offset):
-    given = {name: value for name, value in options.items() if value is not None}
-    takes = ESTIMATORS[method].options
-    for name in given:
-        if name != "orient" and name not in takes:
-            accepted = ", ".join(f"--{option.replace('_', '-')}" for option in takes) or "none"
-            raise click.UsageError(f"method {method!r} does not take --{name.replace('_', '-')} "
-                                   f"(its options: {accepted})")
-    return principal_curvatures(vertices, faces, method=method, **given,
-                                progress=lambda stage, index, total: bar(stage, index, total, offset=offset))
 
 
 def _fields(ctx, param, value):
@@ -242,7 +73,7 @@ def _viewers_epilog() -> str:
     """The file to write for each reader (:data:`meshcurv.io.fields.VIEWERS`), for ``compute --help``."""
     import textwrap
 
-    from .io.fields import VIEWERS
+    from ..io.fields import VIEWERS
 
     lines = ["\b", "Which file for which reader (what it keeps of the fields):"]
     for reader, (extensions, keeps) in VIEWERS.items():
@@ -267,69 +98,31 @@ def _viewers_epilog() -> str:
 @common_options
 def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite):
     """Compute the curvatures of MESH (a mesh or a point cloud); write them with -o, or print a summary table."""
-    context = click.get_current_context()
-    session = context.find_object(Session)
+    session = click.get_current_context().find_object(Session)
     if output is not None:
         _check_output(output, overwrite=overwrite, source=mesh, needs_fields=True)
-    given_method = context.get_parameter_source("method") != click.core.ParameterSource.DEFAULT
-    if is_point_cloud(mesh):
-        _compute_points(mesh, output, method if given_method else None, smoothing_steps, radius, orient,
-                        fields, quality, ascii_, overwrite, session)
+    with estimated(mesh, method, smoothing_steps, radius, orient, session,
+                   "write" if output is not None else "summary") as got:
+        if output is not None and got.cloud:
+            write_point_curvatures(output, got.vertices, got.result, fields=fields, quality=quality,
+                                   overwrite=overwrite, source=mesh, binary=not ascii_)
+        elif output is not None:
+            write_curvatures(output, got.vertices, got.faces, got.result, fields=fields, quality=quality,
+                             overwrite=overwrite, source=mesh, binary=not ascii_)
+    if output is None:
+        faces = np.zeros((0, 3), dtype=np.int64) if got.cloud else got.faces
+        click.echo(_summary(mesh, got.vertices, faces, got.result, fields))
         return
-    if method in POINT_CLOUD_METHODS:
-        raise click.UsageError(f"method {method!r} is for point clouds; {mesh} is a mesh (methods: "
-                               f"{', '.join(ESTIMATORS)})")
-    stages = ["read", *ESTIMATORS[method].stages, "write" if output is not None else "summary"]
-    bar = session.bar(stages)
-    try:
-        bar("read")
-        vertices, faces = read_mesh(mesh)
-        options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
-        result = _estimate(vertices, faces, method, options, bar, offset=1)
-        bar(stages[-1], len(stages))
-        if output is not None:
-            write_curvatures(output, vertices, faces, result, fields=fields, quality=quality, overwrite=overwrite,
-                             source=mesh, binary=not ascii_)
-    finally:
-        bar.close()
-    if output is not None:
-        written = fields or list(FIELDS)
-        hint = (" (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
-                if output.suffix.lower() == ".ply" else "")
-        session.info(f"wrote {output}: {len(vertices)} vertices, fields {', '.join(written)} "
-                     f"(quality = {quality}){hint}")
-        return
-    click.echo(_summary(mesh, vertices, faces, result, fields))
-
-
-def _check_point_cloud_options(path, method, smoothing_steps, orient) -> None:
-    """Refuse the options of meshes for a point cloud (``method`` None when not given)."""
-    if method is not None and method not in POINT_CLOUD_METHODS:
-        raise click.UsageError(f"method {method!r} needs faces; {path} is a point cloud (methods: "
-                               f"{', '.join(POINT_CLOUD_METHODS)})")
-    for name, value in (("smoothing-steps", smoothing_steps), ("orient", orient)):
-        if value is not None:
-            raise click.UsageError(f"--{name} is for meshes; {path} is a point cloud")
-
-
-def _compute_points(path, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite,
-                    session) -> None:
-    """``meshcurv compute`` of a point cloud (a file without faces): :func:`meshcurv.point_cloud_curvatures`."""
-    _check_point_cloud_options(path, method, smoothing_steps, orient)
-    points, normals = read_points(path)
-    result = point_cloud_curvatures(points, normals=normals, radius=radius, method=method)
-    if output is not None:
-        write_point_curvatures(output, points, result, fields=fields, quality=quality, overwrite=overwrite,
-                               source=path, binary=not ascii_)
-        written = fields or list(FIELDS)
-        session.info(f"wrote {output}: {len(points)} points, fields {', '.join(written)} (quality = {quality})")
-        return
-    click.echo(_summary(path, points, np.zeros((0, 3), dtype=np.int64), result, fields))
+    written = fields or list(FIELDS)
+    hint = (" (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
+            if output.suffix.lower() == ".ply" and not got.cloud else "")
+    session.info(f"wrote {output}: {len(got.vertices)} {'points' if got.cloud else 'vertices'}, fields "
+                 f"{', '.join(written)} (quality = {quality}){hint}")
 
 
 def _summary(path, vertices, faces, result, fields) -> str:
     """The summary table of ``meshcurv compute``: per-vertex and area-weighted statistics, then the integrals."""
-    from .integrals import weighted_statistics
+    from ..integrals import weighted_statistics
 
     parameters = ", ".join(f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
                            for key, value in result.parameters.items())
@@ -389,7 +182,7 @@ def _views(ctx, param, values):
 
 
 def _plotting_views():
-    from .plotting import VIEWS
+    from ..plotting import VIEWS
 
     return list(VIEWS)
 
@@ -407,16 +200,6 @@ def _limits(ctx, param, value):
         raise click.BadParameter(f"give two numbers as LOW,HIGH (e.g. -5,5); got {value!r}") from None
     if not (np.isfinite(low) and np.isfinite(high) and low < high):
         raise click.BadParameter(f"need finite LOW < HIGH; got {value!r}")
-    return low, high
-
-
-def _percentiles(ctx, param, value):
-    try:
-        low, high = (float(part) for part in value.split(","))
-    except ValueError:
-        raise click.BadParameter(f"give two percentiles as LOW,HIGH (e.g. 2,98); got {value!r}") from None
-    if not 0 <= low < high <= 100:
-        raise click.BadParameter(f"need 0 <= LOW < HIGH <= 100; got {value!r}")
     return low, high
 
 
@@ -452,7 +235,7 @@ def _percentiles(ctx, param, value):
 def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up, directions, percentiles,
          limits, cmap, dpi, pixels, overwrite):
     """Draw MESH coloured by a curvature field, with a colour bar."""
-    from .plotting import _PANEL_INCHES, _EXTRA_INCHES, _pyplot, choose_up, plot_field, save_figure
+    from ..plotting import _PANEL_INCHES, _EXTRA_INCHES, _pyplot, choose_up, plot_field, save_figure
 
     _pyplot()  # fail early, before computing, when matplotlib is missing
     context = click.get_current_context()
@@ -465,28 +248,8 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
     if output.suffix.lower() != ".png":
         raise click.BadParameter(f"the picture is a PNG; got {output.name!r}", param_hint="'-o'")
     check_output(output, overwrite=overwrite, source=mesh)
-    cloud = is_point_cloud(mesh)
-    given_method = context.get_parameter_source("method") != click.core.ParameterSource.DEFAULT
-    if cloud:
-        _check_point_cloud_options(mesh, method if given_method else None, smoothing_steps, orient)
-    elif method in POINT_CLOUD_METHODS:
-        raise click.UsageError(f"method {method!r} is for point clouds; {mesh} is a mesh (methods: "
-                               f"{', '.join(ESTIMATORS)})")
-    stages = ["read", *([] if cloud else ESTIMATORS[method].stages), "draw"]
-    bar = session.bar(stages)
-    try:
-        bar("read")
-        if cloud:  # drawn as discs of about the spacing, shaded by the estimated normals
-            vertices, given_normals = read_points(mesh)
-            triangles = None
-            result = point_cloud_curvatures(vertices, normals=given_normals, radius=radius,
-                                            method=method if given_method else None)
-        else:
-            vertices, faces = read_mesh(mesh)
-            triangles = as_faces(faces, len(vertices))
-            options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
-            result = _estimate(vertices, triangles, method, options, bar, offset=1)
-        bar("draw", len(stages))
+    with estimated(mesh, method, smoothing_steps, radius, orient, session, "draw") as got:
+        vertices, triangles, result, cloud = got.vertices, got.triangles, got.result, got.cloud
         if "auto" in views:
             closed = cloud or not MeshTopology.from_faces(triangles, len(vertices)).boundary_edges.any()
             auto = ["front", "left", "back"] if closed else ["iso"]
@@ -509,8 +272,6 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
             width, height = figure.get_size_inches()
             figure.set_size_inches(pixels / figure.dpi, height * pixels / figure.dpi / width)
         save_figure(figure, output, overwrite=overwrite)
-    finally:
-        bar.close()
     session.info(f"wrote {output}{chosen}")
 
 
@@ -567,21 +328,13 @@ def methods():
 @common_options
 def demo(output, overwrite):
     """The seed's example: matGeom's torus, its curvatures against the exact ones, a picture (OUTPUT)."""
-    from .demo import run_demo
-    from .plotting import _pyplot
+    from ..demo import run_demo
+    from ..plotting import _pyplot
 
     _pyplot()
     click.echo(run_demo(output, overwrite=overwrite))
 
 
-from ._batch_cli import batch_command  # noqa: E402  (meshcurv batch, built with the options above)
-
-meshcurv.add_command(batch_command())
-
-from ._volume_cli import volume_command  # noqa: E402  (meshcurv volume: label images to per-object tables)
-
-meshcurv.add_command(volume_command())
-
-from ._view_cli import view_command  # noqa: E402  (meshcurv view: an interactive HTML page)
-
-meshcurv.add_command(view_command())
+meshcurv.add_command(batch)
+meshcurv.add_command(volume)
+meshcurv.add_command(view)

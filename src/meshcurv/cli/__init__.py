@@ -1,6 +1,6 @@
 """The ``meshcurv`` command: entry point, exit codes and error messages.
 
-The commands themselves live in :mod:`meshcurv._cli_app` (built on click, an
+The commands themselves live in :mod:`meshcurv.cli._app` (built on click, an
 optional extra); this module only runs them and turns what goes wrong into an
 exit code and one line on stderr:
 
@@ -18,7 +18,7 @@ from __future__ import annotations
 import sys
 import traceback
 
-from .errors import InvalidOptionError, MissingDependencyError
+from ..errors import InvalidOptionError, MissingDependencyError
 
 __all__ = ["main"]
 
@@ -45,7 +45,7 @@ def main(argv=None) -> int:
     args = sys.argv[1:] if argv is None else [str(arg) for arg in argv]
     debug = "--debug" in args
     try:
-        from . import _cli_app
+        from . import _app
     except ImportError as exc:
         if exc.name != "click":
             raise
@@ -53,10 +53,10 @@ def main(argv=None) -> int:
         return 1
     import click
 
-    session = _cli_app.Session()
+    session = _app.Session()
     try:
         with session:
-            code = _cli_app.meshcurv.main(args=args, prog_name="meshcurv", standalone_mode=False, obj=session)
+            code = _app.meshcurv.main(args=args, prog_name="meshcurv", standalone_mode=False, obj=session)
         return code if isinstance(code, int) else 0
     except click.exceptions.Exit as exc:  # --help, --version
         return exc.exit_code

@@ -1,0 +1,296 @@
+"""What the commands of ``meshcurv`` share: the session, the options, progress, reading and estimating.
+
+Every command module of this package (:mod:`._app`, :mod:`._batch`,
+:mod:`._volume`, :mod:`._view`) imports from here and from nothing else of the
+package but the library, so that the dependencies point one way.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import inspect
+import logging
+import sys
+import warnings
+from typing import NamedTuple
+
+import click
+import numpy as np
+
+from .._validation import as_faces
+from ..curvature import principal_curvatures
+from ..estimators import ESTIMATORS
+from ..io import is_point_cloud, read_mesh, read_points
+from ..io.fields import FIELDS
+from ..pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
+from ..smoothing import MAX_SMOOTHING_STEPS
+
+__all__ = ["Session", "common_options", "method_options", "estimated"]
+
+SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid")]
+
+
+#: The largest finite float: an option value that parses to infinity (``1e400``) is beyond it.
+_FLOAT_MAX = sys.float_info.max
+
+
+_LEVELS = {-2: logging.CRITICAL, -1: logging.ERROR, 0: logging.WARNING, 1: logging.INFO, 2: logging.DEBUG}
+
+
+class Session:
+    """What one run of the command configures: logging level, warnings, progress; undone on exit."""
+
+    def __init__(self):
+        self.verbose = 0
+        self.quiet = 0
+        self.debug = False
+        self.progress = None
+        self._logger = logging.getLogger("meshcurv")
+        self._handler = None
+        self._warnings = None
+        self._level = None
+
+    def __enter__(self):
+        self._level = self._logger.level
+        self._handler = logging.StreamHandler(sys.stderr)
+        self._handler.setFormatter(logging.Formatter("meshcurv: %(message)s"))
+        self._logger.addHandler(self._handler)
+        self._warnings = warnings.catch_warnings()
+        self._warnings.__enter__()
+        warnings.simplefilter("always")
+        warnings.showwarning = self._show_warning
+        self.update()
+        return self
+
+    def __exit__(self, *exc_info):
+        self._warnings.__exit__(*exc_info)
+        self._logger.removeHandler(self._handler)
+        self._logger.setLevel(self._level)
+        return False
+
+    def update(self) -> None:
+        level = _LEVELS[max(-2, min(2, self.verbose - self.quiet))]
+        self._logger.setLevel(level)
+        if level <= logging.DEBUG:
+            self._handler.setFormatter(logging.Formatter("meshcurv: %(name)s: %(message)s"))
+
+    def _show_warning(self, message, category, filename, lineno, file=None, line=None):
+        if self.verbose - self.quiet >= 0:
+            click.echo(f"meshcurv: warning: {message}", err=True)
+
+    def info(self, text: str) -> None:
+        """A line on stderr unless -q."""
+        if self.verbose - self.quiet >= 0:
+            click.echo(f"meshcurv: {text}", err=True)
+
+    def bar(self, stages):
+        """A :class:`StageBar` for these stages, or a silent one (not a terminal, or --no-progress)."""
+        stream = sys.stderr
+        show = self.progress if self.progress is not None else stream.isatty()
+        return StageBar(stages, stream if show else None, tty=stream.isatty())
+
+
+class StageBar:
+    """A progress bar over named stages, on stderr: redrawn in place on a terminal, one line per stage otherwise."""
+
+    def __init__(self, stages, stream, *, tty: bool, width: int = 24):
+        self.stages = list(stages)
+        self.stream = stream
+        self.tty = tty
+        self.width = width
+        self.done = 0
+
+    def __call__(self, stage: str, index: int | None = None, total: int | None = None, *, offset: int = 0):
+        if self.stream is None:
+            return
+        position = offset + (index if index is not None else self.stages.index(stage) + 1)
+        count = len(self.stages)
+        filled = round(self.width * (position - 1) / count)
+        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {position}/{count} {stage}"
+        if self.tty:
+            self.stream.write(f"\r\033[K{text}")
+        else:
+            self.stream.write(f"meshcurv: {text}\n")
+        self.stream.flush()
+        self.done = position
+
+    def close(self) -> None:
+        if self.stream is not None and self.tty and self.done:
+            self.stream.write("\r\033[K")
+            self.stream.flush()
+
+
+def _store(ctx, param, value):
+    session = ctx.find_object(Session)
+    if param.name in ("verbose", "quiet"):
+        setattr(session, param.name, getattr(session, param.name) + value)
+    elif param.name == "debug":
+        session.debug = session.debug or value
+    elif value is not None:
+        session.progress = value
+    if session._handler is not None:
+        session.update()
+    return value
+
+
+def common_options(function):
+    """-v/-q/--debug/--progress, accepted before or after the command name."""
+    options = [
+        click.option("-v", "--verbose", count=True, expose_value=False, callback=_store,
+                     help="More messages on stderr (-v: stages, -vv: debug)."),
+        click.option("-q", "--quiet", count=True, expose_value=False, callback=_store,
+                     help="Fewer messages: no warnings (-q), only errors."),
+        click.option("--debug", is_flag=True, expose_value=False, callback=_store,
+                     help="Show the traceback when something fails."),
+        click.option("--progress/--no-progress", default=None, expose_value=False, callback=_store,
+                     help="Progress bar on stderr (default: only when stderr is a terminal)."),
+    ]
+    for option in reversed(options):
+        function = option(function)
+    return function
+
+
+class MethodChoice(click.Choice):
+    """The names of :data:`meshcurv.estimators.ESTIMATORS`, read when used (methods can be added)."""
+
+    def __init__(self):
+        super().__init__(list(ESTIMATORS) + list(POINT_CLOUD_METHODS))
+
+    @property
+    def choices(self):
+        return tuple(ESTIMATORS) + tuple(POINT_CLOUD_METHODS)
+
+    @choices.setter
+    def choices(self, value):
+        pass
+
+
+def _default_method() -> str:
+    return inspect.signature(principal_curvatures).parameters["method"].default
+
+
+def method_options(function):
+    """--method and the estimator options, passed on only when given."""
+    options = [
+        click.option("-m", "--method", type=MethodChoice(), default=_default_method(), show_default=True,
+                     help="Curvature estimator (see `meshcurv methods`)."),
+        click.option("--smoothing-steps", type=click.IntRange(min=0, max=MAX_SMOOTHING_STEPS), default=None,
+                     help=f"Passes of 1-ring smoothing (normal_cycle, matgeom; default 3; at most "
+                          f"{MAX_SMOOTHING_STEPS})."),
+        click.option("--radius", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
+                     help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
+                          "default from the mesh: see `meshcurv methods`)."),
+        click.option("--orient", type=click.Choice(["auto", "outward", "consistent", "keep"]), default=None,
+                     help="Reorient the faces first (default: auto = outward, keep for matgeom)."),
+    ]
+    for option in reversed(options):
+        function = option(function)
+    return function
+
+
+def _estimate(vertices, faces, method, options, bar, *, offset):
+    given = {name: value for name, value in options.items() if value is not None}
+    takes = ESTIMATORS[method].options
+    for name in given:
+        if name != "orient" and name not in takes:
+            accepted = ", ".join(f"--{option.replace('_', '-')}" for option in takes) or "none"
+            raise click.UsageError(f"method {method!r} does not take --{name.replace('_', '-')} "
+                                   f"(its options: {accepted})")
+    return principal_curvatures(vertices, faces, method=method, **given,
+                                progress=lambda stage, index, total: bar(stage, index, total, offset=offset))
+
+
+def _percentiles(ctx, param, value):
+    try:
+        low, high = (float(part) for part in value.split(","))
+    except ValueError:
+        raise click.BadParameter(f"give two percentiles as LOW,HIGH (e.g. 2,98); got {value!r}") from None
+    if not 0 <= low < high <= 100:
+        raise click.BadParameter(f"need 0 <= LOW < HIGH <= 100; got {value!r}")
+    return low, high
+
+
+def _check_point_cloud_options(path, method, smoothing_steps, orient) -> None:
+    """Refuse the options of meshes for a point cloud (``method`` None when not given)."""
+    if method is not None and method not in POINT_CLOUD_METHODS:
+        raise click.UsageError(f"method {method!r} needs faces; {path} is a point cloud (methods: "
+                               f"{', '.join(POINT_CLOUD_METHODS)})")
+    for name, value in (("smoothing-steps", smoothing_steps), ("orient", orient)):
+        if value is not None:
+            raise click.UsageError(f"--{name} is for meshes; {path} is a point cloud")
+
+
+class ProgressBar:
+    """A progress line on stderr, ``[####....] done/total <tail>``: redrawn in place on a terminal,
+    otherwise one line per call; ``close`` clears a terminal's line once something was drawn."""
+
+    def __init__(self, stream, *, tty: bool, width: int = 24):
+        self.stream = stream
+        self.tty = tty
+        self.width = width
+        self._shown = None
+
+    def _draw(self, done: int, total: int, tail: str) -> None:
+        filled = round(self.width * done / total) if total else self.width
+        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} {tail}"
+        if self.tty:
+            self.stream.write(f"\r\033[K{text}")
+        else:
+            self.stream.write(f"meshcurv: {text}\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.stream is not None and self.tty and self._shown is not None:
+            self.stream.write("\r\033[K")
+            self.stream.flush()
+
+
+class Estimated(NamedTuple):
+    """What :func:`estimated` read and computed."""
+
+    vertices: np.ndarray
+    #: The faces as read (polygons kept, for writing them back); None for a point cloud.
+    faces: object
+    #: The faces as triangles (V-indexed (F, 3)); None for a point cloud.
+    triangles: np.ndarray | None
+    result: object
+    cloud: bool
+
+
+@contextlib.contextmanager
+def estimated(path, method, smoothing_steps, radius, orient, session: Session, last_stage: str):
+    """Read ``path`` (a mesh, or a point cloud: a file without faces) and compute its curvatures.
+
+    A progress bar runs over the stages ``read``, the method's own and
+    ``last_stage``, which is the block under the ``with`` (writing, drawing);
+    the bar is cleared when the block ends. The options of meshes are refused
+    for a point cloud, and the methods of each kind for the other; a point
+    cloud takes the method only when it was given (else its own default).
+    Yields an :class:`Estimated`.
+    """
+    context = click.get_current_context()
+    given_method = context.get_parameter_source("method") != click.core.ParameterSource.DEFAULT
+    cloud = is_point_cloud(path)
+    if cloud:
+        _check_point_cloud_options(path, method if given_method else None, smoothing_steps, orient)
+    elif method in POINT_CLOUD_METHODS:
+        raise click.UsageError(f"method {method!r} is for point clouds; {path} is a mesh (methods: "
+                               f"{', '.join(ESTIMATORS)})")
+    stages = ["read", *([] if cloud else ESTIMATORS[method].stages), last_stage]
+    bar = session.bar(stages)
+    try:
+        bar("read")
+        if cloud:
+            vertices, normals = read_points(path)
+            faces = triangles = None
+            result = point_cloud_curvatures(vertices, normals=normals, radius=radius,
+                                            method=method if given_method else None)
+        else:
+            vertices, faces = read_mesh(path)
+            triangles = as_faces(faces, len(vertices))
+            options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
+            result = _estimate(vertices, faces, method, options, bar, offset=1)
+        bar(last_stage, len(stages))
+        yield Estimated(vertices, faces, triangles, result, cloud)
+    finally:
+        bar.close()

@@ -1,0 +1,201 @@
+"""``meshcurv volume``: per-object curvature tables of a 3D label image (:mod:`meshcurv.volume`)."""
+
+from __future__ import annotations
+
+import pathlib
+import sys
+import warnings
+
+import click
+import numpy as np
+
+from ..batch import MAX_WORKERS
+from ._common import _FLOAT_MAX, SCALAR_FIELDS, MethodChoice, ProgressBar, Session, common_options
+
+__all__ = ["volume", "LabelBar", "MESH_FORMATS"]
+
+#: Formats of the per-label mesh files (those of :data:`meshcurv.io.FORMATS` that hold per-vertex fields).
+MESH_FORMATS = ("ply", "vtp", "vtu", "vtk", "npz", "csv")
+
+_SHOWN_FAILURES = 10
+
+
+class LabelBar(ProgressBar):
+    """Progress over the labels: ``[####....] 12/50 labels, label 17 ok``.
+
+    Redrawn in place on a terminal; otherwise one line per label.
+    """
+
+    def __call__(self, done: int, total: int, label: int, status: str) -> None:
+        if self.stream is None:
+            return
+        self._shown = True
+        self._draw(done, total, f"labels, label {label} {status}")
+
+
+def _stem(path: pathlib.Path) -> str:
+    name = path.name
+    return name[: -len(".nii.gz")] if name.lower().endswith(".nii.gz") else path.stem
+
+
+def _label_list(ctx, param, value):
+    if value is None:
+        return None
+    try:
+        labels = [int(part) for part in value.split(",") if part.strip()]
+    except ValueError:
+        raise click.BadParameter(f"labels are whole numbers separated by commas; got {value!r}") from None
+    if not labels or min(labels) < 1:
+        raise click.BadParameter(f"labels are whole numbers >= 1 separated by commas; got {value!r}")
+    return labels
+
+
+@click.command("volume")
+@click.argument("image", type=click.Path(readable=False, path_type=pathlib.Path))
+@click.option("-o", "--output-dir", "out_dir", required=True, type=click.Path(readable=False, path_type=pathlib.Path),
+              help="Folder of the table, pictures and meshes (created if needed).")
+@click.option("--spacing", nargs=3, type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
+              metavar="Z Y X", help="Voxel size along image axes 0, 1, 2 (default: from the file, "
+                                    "else 1 1 1).")
+@click.option("--labels", "labels_to_use", callback=_label_list, default=None, metavar="N,...",
+              help="Only these labels (default: every label in the image).")
+@click.option("-m", "--method", type=MethodChoice(), default=None,
+              help="Curvature estimator (default: icc, with a radius chosen for voxel surfaces).")
+@click.option("--radius", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
+              help="Ball radius in physical units (default: per label, from its voxels and curvature).")
+@click.option("--meshes", "mesh_format", type=click.Choice(MESH_FORMATS), default=None,
+              help="Also write one mesh file per label with its curvature fields, in this format.")
+@click.option("--picture/--no-picture", default=True, show_default=True,
+              help="A picture of all objects coloured by --field (needs matplotlib).")
+@click.option("-f", "--field", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
+              help="The field of the picture.")
+@click.option("--workers", type=click.IntRange(min=1, max=MAX_WORKERS), default=None,
+              help="Compute the labels on a local Dask cluster of this many processes (needs "
+                   "meshcurv[batch]; default: one label after the other in this process).")
+@click.option("--overwrite", is_flag=True, help="Replace existing outputs.")
+@common_options
+def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, picture, field, workers,
+           overwrite):
+    """Curvature of every object of a 3D label image: one table row per label.
+
+    \b
+    meshcurv volume cells.tif -o results/ --spacing 1 0.25 0.25
+    meshcurv volume brain_labels.nii.gz -o results/        spacing from the header
+    meshcurv volume mask.npy -o results/ --meshes vtp --field gaussian
+    meshcurv volume cells.tif -o results/ --workers 2      labels on 2 processes
+
+    IMAGE is a TIFF stack, .npy, .npz (the array 'labels', or its only array)
+    or NIfTI (.nii, .nii.gz) of integer labels (0: background) or a binary
+    mask. Writes OUTDIR/<name>_labels.csv and .parquet (one row per label:
+    area, volume, area-weighted and percentiles of H, K, principal
+    curvatures, shape index and curvedness, total curvatures, Willmore
+    energy, Euler characteristic, border flag, status), a picture
+    OUTDIR/<name>_<field>.png, and with --meshes one file per label
+    OUTDIR/<name>_label_<N>.<format>. Nothing is overwritten without
+    --overwrite. Exits with 1 when a label failed (its row says why). With
+    --workers N the labels are computed on N processes (a label whose
+    process dies gets a failed row; the others are computed).
+    """
+    from .. import volume as volume_module
+    from ..io import write_curvatures
+    from ..io._files import atomic_output, check_output
+    from ..io._images import read_image
+
+    session = click.get_current_context().find_object(Session)
+    volume_module._pandas()
+    if picture:
+        from ..plotting import _pyplot
+
+        _pyplot()  # fail before computing when matplotlib is missing
+    stem = _stem(image)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    tables = [out_dir / f"{stem}_labels.csv", out_dir / f"{stem}_labels.parquet"]
+    picture_path = out_dir / f"{stem}_{field}.png"
+    for path in tables + ([picture_path] if picture else []):
+        check_output(path, overwrite=overwrite, source=image)
+    if mesh_format is not None and not overwrite:  # refused before hours of computing, not at the label
+        existing = sorted(out_dir.glob(f"{stem}_label_*.{mesh_format}"))
+        if existing:
+            check_output(existing[0], overwrite=False)
+    parquet = _has_pyarrow()
+    if not parquet:
+        session.info("pyarrow is not installed: the table is written as CSV only (pip install pyarrow)")
+
+    read = read_image(image)
+    if spacing is None:
+        spacing = read.spacing
+        if spacing is None:
+            spacing = (1.0, 1.0, 1.0)
+            session.info(f"{image}: no voxel size in the file; using 1 1 1 (give --spacing Z Y X)")
+        else:
+            session.info(f"{image}: voxel size {' x '.join(f'{s:g}' for s in spacing)} (z y x) from the file")
+    total, labels = volume_module.label_surfaces(read.array, spacing=spacing, labels_to_use=labels_to_use,
+                                                 method=method, radius=radius,
+                                                 keep_surfaces=mesh_format is not None or picture,
+                                                 workers=workers)
+    stream = sys.stderr
+    show = session.progress if session.progress is not None else stream.isatty()
+    bar = LabelBar(stream if show else None, tty=stream.isatty())
+    rows, drawn = [], []
+    try:
+        for row, surface in labels:
+            rows.append(row)
+            if surface is not None:
+                if mesh_format is not None:
+                    write_curvatures(out_dir / f"{stem}_label_{surface.label}.{mesh_format}", surface.vertices,
+                                     surface.faces, surface.result, overwrite=overwrite, source=image)
+                if picture:
+                    values = np.where(surface.used, getattr(surface.result, field), np.nan)
+                    drawn.append((surface.vertices, surface.faces, values))
+            bar(len(rows), total, row["label"], row["status"])
+    finally:
+        bar.close()
+    table = volume_module._table(rows)
+    for path in tables:
+        if path.suffix == ".parquet" and not parquet:
+            continue
+        with atomic_output(path, overwrite=overwrite) as temporary:
+            if path.suffix == ".parquet":
+                table.to_parquet(temporary, index=False)
+            else:
+                table.to_csv(temporary, index=False)
+    problems = volume_module._problems(table)
+    if problems:
+        warnings.warn(problems, volume_module.MeshQualityWarning, stacklevel=1)
+    if picture and drawn:
+        _draw(drawn, picture_path, field=field, title=f"{image.name}: {len(drawn)} objects", overwrite=overwrite)
+    counts = table["status"].value_counts()
+    written = ", ".join(str(path) for path in tables if parquet or path.suffix != ".parquet")
+    session.info(f"{len(table)} labels: " + ", ".join(f"{int(counts.get(s, 0))} {s}" for s in
+                                                      ("ok", "empty", "too_small", "failed")) + f"; table in {written}"
+                 + (f"; picture {picture_path}" if picture and drawn else ""))
+    failures = table[table["status"] == "failed"]
+    if failures.empty:
+        return 0
+    for label, error in zip(failures["label"][:_SHOWN_FAILURES], failures["error"][:_SHOWN_FAILURES]):
+        click.echo(f"meshcurv: failed: label {label}: {error}", err=True)
+    click.echo(f"meshcurv: error: {len(failures)} of {len(table)} labels failed", err=True)
+    return 1
+
+
+def _has_pyarrow() -> bool:
+    try:
+        import pyarrow  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _draw(drawn, path: pathlib.Path, *, field: str, title: str, overwrite: bool) -> None:
+    """All objects in one mesh, coloured by ``field`` (NaN, grey, where a vertex is not in the statistics)."""
+    from ..io.fields import FIELDS
+    from ..plotting import plot_field, save_figure
+
+    offsets = np.cumsum([0] + [len(vertices) for vertices, _, _ in drawn[:-1]])
+    vertices = np.concatenate([vertices for vertices, _, _ in drawn])
+    faces = np.concatenate([faces + offset for (_, faces, _), offset in zip(drawn, offsets)])
+    values = np.concatenate([values for _, _, values in drawn])
+    # image axis 0 (z) upwards
+    figure = plot_field(vertices, faces, values, view=["iso", "top"], up="x", label=f"{field}: {FIELDS[field]}",
+                        title=title)
+    save_figure(figure, path, overwrite=overwrite)
