@@ -82,7 +82,7 @@ MIN_PIVOT = 1e-5
 CHUNK_SIZE = 4096
 
 #: A fit whose ball holds more than this share of its points whose normal faces away from
-#: the centre's (``n_j . n_v < 0``) is refused (:func:`fit_jets`, ``facing``): the ball
+#: the centre's (``dot(n_j, n_v) < 0``) is refused (:func:`fit_jets`, ``facing``): the ball
 #: reaches past the part's silhouette to its other side. On a smooth surface sampled finer
 #: than its thickness the share is 0; a ball across a needle thinner than the ball holds
 #: about half; on a sphere of radius R a ball of radius 1.5 R holds 11% (2.5 R: 50%), and
