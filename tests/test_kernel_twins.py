@@ -1192,13 +1192,10 @@ TWINS = [
 #: public kernel has a row in TWINS.
 EXCEPTIONS: dict[str, str] = {}
 
-#: Cases where a kernel and its twin disagree: ``(kernel, input) -> reason`` (strict xfail).
-DISAGREEMENTS: dict[tuple[str, str], str] = {
-    ("pointcloud.pca_normals", "degenerate_cloud"): (
-        "collinear neighbourhoods (a double smallest eigenvalue): the closed form's normal is up to 0.065 "
-        "(3.7 degrees) out of the plane orthogonal to the line (A - lambda I has rank 1 there, its rows' cross "
-        "products are rounding noise); numpy.linalg.eigh's is orthogonal to 3e-16"),
-}
+#: Cases where a kernel and its twin disagree: ``(kernel, input) -> reason`` (strict xfail). Empty: the one
+#: found, pca_normals on collinear neighbourhoods (its normal up to 3.7 degrees out of the plane orthogonal
+#: to the line), was fixed (a rank-1 ``A - lambda I`` takes a direction orthogonal to its longest row).
+DISAGREEMENTS: dict[tuple[str, str], str] = {}
 
 
 def _cases():

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ._common import _JIT
+from ._common import _JIT, _tangent_frame
 from .icc import _triangle_measures
 
 
@@ -48,6 +48,13 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
     return out
 
 
+#: ``A - lambda I`` counts as rank 1 (a double smallest eigenvalue: a collinear neighbourhood) where its
+#: rows' largest squared cross product is below this times its longest row's squared length, squared: the
+#: gap of the two smallest eigenvalues below 1e-12 of the largest, where the cross products' rounding
+#: (eps times the inverse of that ratio) would turn the normal by more than 1e-4.
+RANK_ONE = 1e-24
+
+
 @nb.njit(parallel=True, **_JIT)
 def pca_normals(points, indices):
     """(N, 3) unit least-variance directions of each point with its neighbours ``indices`` (N, k).
@@ -55,7 +62,8 @@ def pca_normals(points, indices):
     The covariance ``A``'s smallest eigenvalue in closed form (Smith 1961:
     ``q + 2 p cos(acos(det(B) / 2) / 3 + 2 pi / 3)``, ``q = tr(A) / 3``,
     ``B = (A - q I) / p``), its eigenvector the longest cross product of two
-    rows of ``A - lambda I``. The NumPy path
+    rows of ``A - lambda I`` (where that matrix has rank 1, :data:`RANK_ONE`, a
+    direction orthogonal to its longest row). The NumPy path
     (:func:`meshcurv._pointcloud_normals.pca_normals`) uses ``numpy.linalg.eigh``:
     the same vector up to its sign (tests compare the two).
     """
@@ -101,8 +109,20 @@ def pca_normals(points, indices):
             ax, ay, az, la = bx, by, bz, lb
         elif le > la:
             ax, ay, az, la = ex, ey, ez, le
-        if not la > 0:
-            out[i, 2] = 1.0
+        # the longest row of A - lambda I: along the largest eigenvector when the smallest eigenvalue is double
+        # (a collinear neighbourhood), where A - lambda I has rank 1 and the cross products are rounding noise
+        s0, s1, s2 = r0x * r0x + r0y * r0y + r0z * r0z, r1x * r1x + r1y * r1y + r1z * r1z, r2x * r2x + r2y * r2y + r2z * r2z
+        if s1 > s0 and s1 >= s2:
+            r0x, r0y, r0z, s0 = r1x, r1y, r1z, s1
+        elif s2 > s0:
+            r0x, r0y, r0z, s0 = r2x, r2y, r2z, s2
+        if not la > RANK_ONE * s0 * s0:  # any direction orthogonal to the line: the frame of the line's direction
+            if not s0 > 0:
+                out[i, 2] = 1.0
+                continue
+            root = np.sqrt(s0)
+            ax, ay, az, _, _, _ = _tangent_frame(r0x / root, r0y / root, r0z / root)
+            out[i, 0], out[i, 1], out[i, 2] = ax, ay, az
             continue
         length = np.sqrt(la)
         out[i, 0], out[i, 1], out[i, 2] = ax / length, ay / length, az / length
