@@ -194,7 +194,8 @@ def _announce_compilation() -> None:
 def _cache_location() -> str:
     from numba.core import config
 
-    return f"NUMBA_CACHE_DIR={config.CACHE_DIR}" if config.CACHE_DIR else "numba's cache beside the package"
+    cache_dir = config.CACHE_DIR  # type: ignore[attr-defined]  # numba's config sets its names at import
+    return f"NUMBA_CACHE_DIR={cache_dir}" if cache_dir else "numba's cache beside the package"
 
 
 class _CompileAnnouncer:
@@ -211,7 +212,7 @@ class _CompileAnnouncer:
         data = event.data or {}
         function = getattr(data.get("dispatcher"), "py_func", None)
         module = getattr(function, "__module__", "") or ""
-        return function.__name__ if module.startswith("meshcurv.") else None
+        return function.__name__ if function is not None and module.startswith("meshcurv.") else None
 
     def on_start(self, event):
         if self._ours(event) is None:
@@ -336,7 +337,7 @@ def _locked(function):
     return call
 
 
-def _interrupt_of(error: BaseException) -> KeyboardInterrupt | None:
+def _interrupt_of(error: BaseException | None) -> KeyboardInterrupt | None:
     """The KeyboardInterrupt behind a SystemError of a compiled call (its cause or context), or None."""
     seen = 0
     while error is not None and seen < 8:

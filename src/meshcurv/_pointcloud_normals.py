@@ -265,8 +265,8 @@ def outward_signs(points: np.ndarray, normals: np.ndarray, labels: np.ndarray, a
     """
     n_labels = int(labels.max()) + 1 if labels.size else 0
     counts = np.bincount(labels, minlength=n_labels).astype(float)
-    centroid = np.stack([np.bincount(labels, weights=points[:, j], minlength=n_labels) for j in range(3)], axis=1)
-    centroid /= np.maximum(counts, 1.0)[:, None]
+    sums = np.stack([np.bincount(labels, weights=points[:, j], minlength=n_labels) for j in range(3)], axis=1)
+    centroid = sums / np.maximum(counts, 1.0)[:, None]
     flux = np.bincount(labels, weights=areas * np.einsum("ij,ij->i", normals, points - centroid[labels]),
                        minlength=n_labels)
     return np.where(flux[labels] < 0, -1.0, 1.0)

@@ -55,6 +55,7 @@ import uuid
 import warnings
 from dataclasses import dataclass
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -324,7 +325,8 @@ def _plan(paths: list[pathlib.Path], out_dir: pathlib.Path, suffix: str) -> list
     absolute = [pathlib.Path(os.path.abspath(path)) for path in paths]
     root = pathlib.Path(os.path.commonpath([path.parent for path in absolute]))
     out_dir = pathlib.Path(os.path.abspath(out_dir))
-    jobs, claimed = [], {}
+    jobs: list[_Job] = []
+    claimed: dict[pathlib.Path, pathlib.Path] = {}
     reserved = {out_dir / f"{_SUMMARY_NAME}.csv": "the summary", out_dir / f"{_SUMMARY_NAME}.parquet": "the summary"}
     for path, source in zip(paths, absolute):
         relative = source.relative_to(root).with_suffix(suffix)
@@ -418,7 +420,7 @@ def _stale_temporaries(targets) -> list[pathlib.Path]:
     by_folder: dict[pathlib.Path, list[pathlib.Path]] = {}
     for target in targets:
         by_folder.setdefault(target.parent, []).append(target)
-    found = []
+    found: list[pathlib.Path] = []
     for folder, names in by_folder.items():
         try:
             hidden = [entry.name for entry in os.scandir(folder) if entry.name.startswith(".")]
@@ -638,8 +640,8 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
 
     start = time.perf_counter()
     source, output, record = pathlib.Path(source), pathlib.Path(output), pathlib.Path(record)
-    options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
-    options = {name: value for name, value in options.items() if value is not None}
+    given = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
+    options: dict[str, Any] = {name: value for name, value in given.items() if value is not None}
     stored_options = {"method": method, **options}
     row = {"status": "computed", "error": "", "warnings": "", "method": method, "output": os.fspath(output)}
     attempt = _attempt_path(record)
@@ -980,7 +982,8 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
     _check_writable(out_dir)
 
     rows: dict[int, dict] = {}
-    todo, damaged = [], []
+    todo: list[int] = []
+    damaged: list[tuple[pathlib.Path, str]] = []
     for index, job in enumerate(jobs):
         stored = _completed(job, options, overwrite=overwrite, retry_failed=retry_failed, timeout=timeout,
                             damaged=damaged)
@@ -1009,7 +1012,7 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
                 watch = _WorkerWatch(active, NO_WORKER_SECONDS["local" if owned else "remote"])
                 try:
                     while pending:
-                        retry = []
+                        retry: list[list[int]] = []
                         for future in _finished(distributed, list(pending), watch):
                             chunk = pending.pop(future)
                             outcome = _outcome(future)
@@ -1066,7 +1069,7 @@ class _WorkerWatch:
     def __init__(self, client, patience: float):
         self.client = client
         self.patience = patience
-        self.since = None
+        self.since: float | None = None
 
     def check(self) -> None:
         try:
@@ -1123,7 +1126,7 @@ def _record_lost(job: _Job, row: dict, options: dict, timeout) -> None:
 
 
 def _completed(job: _Job, options: dict, *, overwrite: bool, retry_failed: bool, timeout: float | None,
-               damaged: list) -> dict | None:
+               damaged: list[tuple[pathlib.Path, str]]) -> dict | None:
     """The recorded row of a mesh that needs no work (status as recorded), or None when it is to be computed.
 
     A record that cannot be read is added to ``damaged`` (the mesh is computed
@@ -1198,7 +1201,7 @@ def _chunks(jobs: list[_Job], indices: list[int], *, workers: int) -> list[list[
     one by one.
     """
     runs = np.array_split(np.asarray(indices, dtype=np.int64), min(len(indices), CHUNKS_PER_WORKER * workers))
-    chunks = []
+    chunks: list[list[int]] = []
     for run in runs:
         size = CHUNK_BYTES + 1
         for index in run.tolist():

@@ -161,9 +161,9 @@ def principal_curvatures(
     >>> print(f"{np.mean(C1):.4f}")  # dimensionless, not 1/2: see the README
     0.0215
     """
-    estimator = ESTIMATORS.get(method) if isinstance(method, str) else None
-    if estimator is None:
-        check_choice(method, "method", METHODS)
+    if not isinstance(method, str) or method not in ESTIMATORS:
+        check_choice(method, "method", METHODS)  # raises: not a registered method
+    estimator = ESTIMATORS[method]
     given = {"smoothing_steps": smoothing_steps, "radius": radius}
     options = dict(estimator.options)
     for name, value in given.items():
@@ -192,7 +192,7 @@ def principal_curvatures(
     if welding is not None and welding.n_welded:
         points, topology = welding.vertices, welding.topology
     topology, n_flipped = oriented_topology(points, topology, orient)
-    found = {}
+    found: dict = {}
     if "radius" in options and options["radius"] is None:
         voxel = voxel_surface_radius(points, topology)  # a voxel surface: one default for every ball method
         if voxel is not None:

@@ -372,7 +372,7 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
         scales = vertex_length_scales(vertices, topology)
     if kernels is not None and double_areas is None:
         # the kernel computes the cross products inline: ``cross`` only spares the NumPy path that work
-        if scales is None:
+        if scales is None and mean_edge_length is not None:  # always, when no scales were computed above
             scales = np.full(topology.n_vertices, float(mean_edge_length))
         return kernels.degenerate_faces(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)
     face_scale = scales[topology.faces[:, 0]] if scales is not None else mean_edge_length
@@ -385,8 +385,11 @@ def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.
 
 def _optional_floats(value, name: str, shape: tuple) -> np.ndarray | None:
     """``value`` as a C-contiguous float64 array of ``shape`` (None stays None)."""
-    if value is None:
-        return None
+    return None if value is None else _floats(value, name, shape)
+
+
+def _floats(value, name: str, shape: tuple) -> np.ndarray:
+    """``value`` as a C-contiguous float64 array of ``shape``."""
     array = np.asarray(value)
     if array.shape != shape or array.dtype.kind not in "fiu":
         raise InvalidMeshError(f"`{name}` must be a real array of shape {shape}; got {array.dtype} {array.shape}")
@@ -409,7 +412,7 @@ def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_norm
         not a real (F, 3) array or ``usable_edges`` not an (E,) bool array.
     """
     vertices = checked_topology_points(vertices, topology)
-    unit_normals = _optional_floats(unit_normals, "unit_normals", topology.faces.shape)
+    unit_normals = _floats(unit_normals, "unit_normals", topology.faces.shape)
     usable_edges = np.asarray(usable_edges)
     if usable_edges.shape != (topology.edges.shape[0],) or usable_edges.dtype != bool:
         raise InvalidMeshError(f"`usable_edges` must be a bool array of shape ({topology.edges.shape[0]},); got "
@@ -497,6 +500,6 @@ def mixed_voronoi_corner_areas(vertices: np.ndarray, faces: np.ndarray) -> np.nd
             # sides at corner k: k-j (opposite m) and k-m (opposite j)
             voronoi[:, k] = (squared[:, m] * cot[:, m] + squared[:, j] * cot[:, j]) / 8.0
     obtuse_corner = cot < 0
-    obtuse = obtuse_corner.any(axis=1)
-    mixed = np.where(obtuse[:, None], np.where(obtuse_corner, area[:, None] / 2, area[:, None] / 4), voronoi)
+    obtuse = obtuse_corner.any(axis=1, keepdims=True)
+    mixed = np.where(obtuse, np.where(obtuse_corner, area[:, None] / 2, area[:, None] / 4), voronoi)
     return np.where(np.isfinite(mixed), mixed, 0.0)

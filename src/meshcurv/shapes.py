@@ -123,7 +123,7 @@ def _quads_to_triangles(quads: np.ndarray, rng: np.random.Generator | None = Non
     first = np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1)
     if rng is not None:
         other = np.stack([quads[:, [0, 1, 3]], quads[:, [1, 2, 3]]], axis=1)
-        first = np.where(rng.random(quads.shape[0])[:, None, None] < 0.5, first, other)
+        first = np.where(rng.random((quads.shape[0],))[:, None, None] < 0.5, first, other)
     return first.reshape(-1, 3)
 
 
@@ -403,7 +403,7 @@ def with_normal_noise(mesh: AnalyticMesh, level: float, *, seed: int = 0) -> Ana
         raise InvalidOptionError(f"`level` must be a number >= 0 (a fraction of the mean edge length); got {level!r}")
     edges = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).edges
     amplitude = level * mean_edge_length(mesh.vertices, edges)
-    t = np.random.default_rng(seed).uniform(-amplitude, amplitude, size=mesh.vertices.shape[0])
+    t = np.random.default_rng(seed).uniform(-amplitude, amplitude, size=(mesh.vertices.shape[0],))
     return AnalyticMesh(
         name=f"{mesh.name} + noise {level:g}h", vertices=mesh.vertices + t[:, None] * mesh.normals,
         faces=mesh.faces, k_min=mesh.k_min, k_max=mesh.k_max, dir_min=mesh.dir_min, dir_max=mesh.dir_max,

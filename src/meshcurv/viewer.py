@@ -219,6 +219,8 @@ def _check_angle(value, name: str) -> float:
 def _label_and_unit(name: str, method: str, length_unit: str | None) -> tuple[str, str]:
     """The words of :data:`meshcurv.io.fields.FIELDS` without their unit, and the unit."""
     match = re.fullmatch(r"(.*?)\s*\(([^()]*)\)", FIELDS[name])
+    if match is None:
+        raise RuntimeError(f"FIELDS[{name!r}] ends with no unit in parentheses: {FIELDS[name]!r}")
     label, unit = match.group(1), match.group(2)
     if method == "matgeom" and "length" in unit:
         unit = "matGeom's scaling"
@@ -422,8 +424,8 @@ def _write_page(handle, meta: dict, arrays: dict) -> None:
     specs, blocks = {}, []
     for name, array in arrays.items():
         data = np.ascontiguousarray(array)
-        spec = {"id": f"array-{name}", "dtype": {"f4": "float32", "u4": "uint32", "u1": "uint8", "i1": "int8"}[
-            data.dtype.str[1:]], "shape": list(data.shape)}
+        dtype = {"f4": "float32", "u4": "uint32", "u1": "uint8", "i1": "int8"}[data.dtype.str[1:]]
+        spec: dict[str, object] = {"id": f"array-{name}", "dtype": dtype, "shape": list(data.shape)}
         raw = data.tobytes()
         if name == "faces":  # differences of consecutive indices: small numbers where the mesh is ordered
             raw = zlib.compress(np.diff(data.ravel(), prepend=np.uint32(0)).astype("<u4").tobytes(), 1)

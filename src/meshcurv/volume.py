@@ -317,7 +317,7 @@ def _field_statistics(result: CurvatureResult, used: np.ndarray, weights: np.nda
 
 
 def _empty_row(label: int, status: str, error: str, **facts) -> dict:
-    row = dict.fromkeys(COLUMNS, np.nan)
+    row: dict[str, object] = dict.fromkeys(COLUMNS, np.nan)
     row.update({"label": label, "status": status, "error": error, "n_voxels": 0, "touches_border": False,
                 "n_vertices": 0, "n_faces": 0, "n_used": 0, "n_invalid": 0, "euler_characteristic": 0,
                 "surface": "", "warnings": ""})
@@ -498,7 +498,7 @@ def _groups(objects, workers: int) -> list[list]:
     if not labels:
         return []
     sizes = [int(np.prod([part.stop - part.start + 2 for part in objects[label]])) for label in labels]
-    groups = []
+    groups: list[list] = []
     for run in np.array_split(np.arange(len(labels)), min(len(labels), TASKS_PER_WORKER * workers)):
         total = TASK_VOXELS + 1
         for position in run.tolist():

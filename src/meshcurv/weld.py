@@ -47,7 +47,7 @@ class Welding(NamedTuple):
 
     vertices: np.ndarray
     topology: MeshTopology
-    index: np.ndarray
+    index: np.ndarray  # type: ignore[assignment]  # a field that shadows tuple.index (public name, kept)
     n_welded: int
 
 

@@ -228,7 +228,7 @@ class ProgressBar:
         self.stream = stream
         self.tty = tty
         self.width = width
-        self._shown = None
+        self._shown: object = None  # what the subclass last drew (None: nothing yet)
 
     def _draw(self, done: int, total: int, tail: str) -> None:
         filled = round(self.width * done / total) if total else self.width

@@ -80,7 +80,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
         rotate=True, mean_from_trace=True,
     )
-    parameters = {"radius": groups[0][0]}
+    parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
     return finish("normal_cycle_ball", parameters, valid, normals, k_min, k_max, dir_min, dir_max,

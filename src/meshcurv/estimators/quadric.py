@@ -103,7 +103,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
               "(a part thinner than the ball, or a ball over a whole closed part): no height function to fit; "
               "pass a smaller `radius`") if two_sided else "")
     normals_out = np.where(valid[:, None], fitted, normals)
-    parameters = {"radius": groups[0][0]}
+    parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
     return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects, extra)

@@ -85,11 +85,11 @@ def atomic_output(path: pathlib.Path, *, overwrite: bool = True):
     """
     path = pathlib.Path(path)
     try:
-        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+        handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
     except OSError as exc:
         raise MeshFileError(f"{path}: cannot be written ({exc.strerror or exc})") from exc
     os.close(handle)
-    temporary = pathlib.Path(temporary)
+    temporary = pathlib.Path(name)
     try:
         yield temporary
         try:

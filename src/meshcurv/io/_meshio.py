@@ -106,7 +106,7 @@ def _cells(faces):
 def write_with_meshio(path, vertices, faces, point_data: dict, *, file_format: str, binary: bool) -> None:
     """Write a mesh and its per-vertex fields (already flattened for PLY by the caller)."""
     meshio = _meshio()
-    options = {"binary": binary}
+    options: dict[str, bool | str] = {"binary": binary}
     if file_format == "vtk":
         options["fmt_version"] = "4.2"  # the legacy layout every VTK and ParaView version reads
     mesh = meshio.Mesh(vertices, _cells(faces), point_data=point_data)

@@ -176,7 +176,7 @@ def _read(path, *, properties: bool):
         data = handle.read()
     file_format, elements, offset = _header(data, path)
     vertex, face, corners = _roles(elements, path)
-    found = {} if properties else None
+    found: dict[str, np.ndarray] | None = {} if properties else None
     if file_format == "ascii":
         vertices, faces = _read_ascii(data, offset, elements, vertex, face, corners, path, found)
     else:

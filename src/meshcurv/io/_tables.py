@@ -47,7 +47,7 @@ def write_npz(path, vertices: np.ndarray, faces, point_data: dict) -> None:
         arrays = {"faces": faces}
     else:
         arrays = {"face_corners": np.concatenate(faces), "face_sizes": np.array([len(f) for f in faces])}
-    np.savez_compressed(path, vertices=vertices, **arrays, **point_data)
+    np.savez_compressed(path, vertices=vertices, **arrays, **point_data)  # type: ignore[arg-type]  # mypy matches **arrays with allow_pickle
 
 
 #: deflate expands at most about 1032 times; a member declaring more is corrupt (or a zip bomb)

@@ -10,6 +10,7 @@ which is refused with a message.
 from __future__ import annotations
 
 import base64
+import binascii
 import xml.etree.ElementTree as ElementTree
 import zlib
 
@@ -172,13 +173,13 @@ def read_vtp_point_data(path) -> dict[str, np.ndarray]:
     """The named point-data arrays of a VTK XML PolyData file: (V,) or (V, k), as stored."""
     piece, options = _root(path)
     arrays = piece.findall("PointData/DataArray") if piece is not None else []
-    out = {}
+    out: dict[str, np.ndarray] = {}
     for element in arrays:
         try:
             out[element.get("Name") or f"array_{len(out)}"] = _decode(element, path, **options)
         except MeshFileError:
             raise
-        except (ValueError, zlib.error, base64.binascii.Error) as exc:
+        except (ValueError, zlib.error, binascii.Error) as exc:
             raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
     return out
 
@@ -199,7 +200,7 @@ def read_vtp(path):
         offsets = _decode(arrays["offsets"], path, **options).astype(np.int64)
     except MeshFileError:
         raise
-    except (ValueError, zlib.error, base64.binascii.Error) as exc:
+    except (ValueError, zlib.error, binascii.Error) as exc:
         raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
     declared = piece.get("NumberOfPoints")
     if declared is not None and declared.strip() != str(vertices.shape[0]):
