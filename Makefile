@@ -37,9 +37,11 @@ docs: $(STAMP)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[docs]'
 	$(BIN)/python -m sphinx -W --keep-going -b html -q docs docs/_build/html
 
+# ruff, then mypy on src/meshcurv ([tool.mypy] in pyproject.toml)
 lint: $(STAMP)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check 'ruff>=0.6'
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check 'ruff>=0.6' 'mypy>=1.10'
 	$(BIN)/ruff check src tests benchmarks conftest.py
+	$(BIN)/mypy
 
 bench-accuracy: $(STAMP)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[bench]'
