@@ -56,6 +56,7 @@ import logging
 import os
 import threading
 import time
+from types import ModuleType
 
 from .errors import InvalidOptionError, MissingDependencyError
 
@@ -83,7 +84,7 @@ def _requested() -> str:
 
 #: What the once-per-process import of the kernels gave: ``(module, None)`` or ``(None, ImportError)``;
 #: None before the first call that needs a kernel.
-_imported: tuple | None = None
+_imported: tuple[ModuleType, None] | tuple[None, ImportError] | None = None
 
 #: The backend lines already logged (each once per process).
 _logged: set = set()
@@ -93,8 +94,9 @@ MISSING_MESSAGE = ("meshcurv backend: numpy (numba cannot be imported: %s); pip 
                    "the compiled kernels, several times faster")
 
 
-def _import_kernels():
-    """The kernels package, imported once per process; None when numba (or the package) cannot be imported."""
+def _import_kernels() -> tuple[ModuleType, None] | tuple[None, ImportError]:
+    """``(kernels package, None)``, imported once per process, or ``(None, ImportError)`` when numba (or the
+    package) cannot be imported."""
     global _imported
     if _imported is None:
         try:
@@ -104,7 +106,7 @@ def _import_kernels():
         else:
             _imported = (_kernels, None)
             _announce_compilation()
-    return _imported[0]
+    return _imported
 
 
 def _log_once(key: str, message: str, *args) -> None:
@@ -131,9 +133,8 @@ def _compiled():
     if choice == "numpy":
         _log_once("numpy", "meshcurv backend: numpy (asked for: MESHCURV_BACKEND or use_backend)")
         return None
-    package = _import_kernels()
+    package, error = _import_kernels()
     if package is None:
-        error = _imported[1]
         if choice == "numba":
             raise MissingDependencyError(
                 f"the numba backend needs numba ({error}): pip install 'meshcurv[fast]'"

@@ -606,7 +606,9 @@ def _draw_view(axis, points, triangles, values, normals, camera, colormap, norm,
     for field, colour in zip(strokes.values(), _STROKE_COLOURS):
         segments = _strokes(raster, points, field, camera,
                             normals if normals is not None else np.tile(camera[2], (len(points), 1)))
-        axis.add_collection(LineCollection(segments, colors=colour, linewidths=0.8, capstyle="round"))
+        axis.add_collection(LineCollection(
+            segments,  # type: ignore[arg-type]  # matplotlib's stubs want a sequence; an (N, 2, 2) array is documented
+            colors=colour, linewidths=0.8, capstyle="round"))
     axis.set_xlim(*raster.extent[:2])
     axis.set_ylim(*raster.extent[2:])
     axis.set_aspect("equal")

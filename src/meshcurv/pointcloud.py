@@ -387,7 +387,7 @@ def _compute(points, given, radius, method):
     shrunk = 0  # points whose jet fit took a smaller ball than asked for (its ball held the other side)
     two_sided = 0  # points whose every ball held the other side (or too few points)
     for group_radius, group_spacing, members in groups:
-        details = {}
+        details: dict[str, np.ndarray] = {}
         if method == "jets":
             # a default ball that holds the other side of a thin part shrinks, down to the clean-sample radius
             smallest = None if radius is not None else min(group_radius, RADIUS_RULES[method][0] * group_spacing)

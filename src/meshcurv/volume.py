@@ -325,7 +325,7 @@ def _empty_row(label: int, status: str, error: str, **facts) -> dict:
     return row
 
 
-def _crop(image: np.ndarray, label: int, box):
+def _crop(image: np.ndarray, label: int, box) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The label's mask on its box padded by one voxel of background (bool), and the box's start and stop."""
     starts = np.array([part.start for part in box], dtype=np.int64)
     stops = np.array([part.stop for part in box], dtype=np.int64)
@@ -550,7 +550,8 @@ def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client
         logger.info("%d labels in %d tasks on %d workers", len(objects), len(queue), n_workers)
         limit = _IN_FLIGHT_PER_WORKER * n_workers
         watch = batch._WorkerWatch(active, batch.NO_WORKER_SECONDS["local" if owned else "remote"])
-        pending, done = {}, {}
+        pending: dict = {}
+        done: dict = {}
         labels = list(objects)
         position = 0
         try:

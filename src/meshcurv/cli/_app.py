@@ -22,7 +22,8 @@ from ..io.fields import FIELDS, curvature_fields
 from ..plotting import MAX_DPI
 from ..topology import MeshTopology
 from ._batch import batch
-from ._common import SCALAR_FIELDS, Session, _default_method, _percentiles, common_options, estimated, method_options
+from ._common import (SCALAR_FIELDS, Session, _default_method, _percentiles, common_options, current_session,
+                      estimated, method_options)
 from ._view import view
 from ._volume import volume
 
@@ -98,7 +99,7 @@ def _viewers_epilog() -> str:
 @common_options
 def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite):
     """Compute the curvatures of MESH (a mesh or a point cloud); write them with -o, or print a summary table."""
-    session = click.get_current_context().find_object(Session)
+    session = current_session()
     if output is not None:
         _check_output(output, overwrite=overwrite, source=mesh, needs_fields=True)
     with estimated(mesh, method, smoothing_steps, radius, orient, session,
@@ -239,7 +240,7 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
 
     _pyplot()  # fail early, before computing, when matplotlib is missing
     context = click.get_current_context()
-    session = context.find_object(Session)
+    session = current_session(context)
     if dpi is not None and pixels is not None:
         raise click.UsageError("give --dpi or --pixels, not both")
     if limits is not None and context.get_parameter_source("percentiles") != click.core.ParameterSource.DEFAULT:

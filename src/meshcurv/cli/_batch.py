@@ -8,7 +8,7 @@ import sys
 import click
 
 from ..batch import DEFAULT_TIMEOUT, MAX_WORKERS, OUTPUT_FORMATS, run
-from ._common import ProgressBar, Session, common_options, method_options
+from ._common import ProgressBar, common_options, current_session, method_options
 
 __all__ = ["batch", "BatchBar"]
 
@@ -74,7 +74,7 @@ def batch(inputs, out_dir, method, smoothing_steps, radius, orient, output_forma
     if workers is not None and scheduler is not None:
         raise click.UsageError("--workers sizes the local cluster; leave it out with --scheduler "
                                "(the cluster's own workers are used)")
-    session = click.get_current_context().find_object(Session)
+    session = current_session()
     stream = sys.stderr
     show = session.progress if session.progress is not None else stream.isatty()
     bar = BatchBar(stream if show else None, tty=stream.isatty())

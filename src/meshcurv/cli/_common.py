@@ -25,7 +25,7 @@ from ..io.fields import FIELDS
 from ..pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
 from ..smoothing import MAX_SMOOTHING_STEPS
 
-__all__ = ["Session", "common_options", "method_options", "estimated"]
+__all__ = ["Session", "current_session", "common_options", "method_options", "estimated"]
 
 SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid")]
 
@@ -44,11 +44,11 @@ class Session:
         self.verbose = 0
         self.quiet = 0
         self.debug = False
-        self.progress = None
+        self.progress: bool | None = None
         self._logger = logging.getLogger("meshcurv")
-        self._handler = None
-        self._warnings = None
-        self._level = None
+        self._handler: logging.Handler | None = None
+        self._warnings: warnings.catch_warnings | None = None
+        self._level: int | None = None
 
     def __enter__(self):
         self._level = self._logger.level
@@ -63,6 +63,8 @@ class Session:
         return self
 
     def __exit__(self, *exc_info):
+        if self._warnings is None or self._handler is None or self._level is None:
+            raise RuntimeError("a Session left without being entered")
         self._warnings.__exit__(*exc_info)
         self._logger.removeHandler(self._handler)
         self._logger.setLevel(self._level)
@@ -71,7 +73,7 @@ class Session:
     def update(self) -> None:
         level = _LEVELS[max(-2, min(2, self.verbose - self.quiet))]
         self._logger.setLevel(level)
-        if level <= logging.DEBUG:
+        if level <= logging.DEBUG and self._handler is not None:  # None only before __enter__, which updates
             self._handler.setFormatter(logging.Formatter("meshcurv: %(name)s: %(message)s"))
 
     def _show_warning(self, message, category, filename, lineno, file=None, line=None):
@@ -120,8 +122,16 @@ class StageBar:
             self.stream.flush()
 
 
+def current_session(ctx: click.Context | None = None) -> Session:
+    """The :class:`Session` of this run: the context object :func:`meshcurv.cli.main` gives the commands."""
+    session = (ctx or click.get_current_context()).find_object(Session)
+    if session is None:
+        raise RuntimeError("no meshcurv Session in the click context: run the commands through meshcurv.cli.main")
+    return session
+
+
 def _store(ctx, param, value):
-    session = ctx.find_object(Session)
+    session = current_session(ctx)
     if param.name in ("verbose", "quiet"):
         setattr(session, param.name, getattr(session, param.name) + value)
     elif param.name == "debug":

@@ -7,7 +7,7 @@ import pathlib
 import click
 
 from ..viewer import VIEWER_FIELDS
-from ._common import Session, _percentiles, common_options, estimated, method_options
+from ._common import _percentiles, common_options, current_session, estimated, method_options
 
 __all__ = ["view"]
 
@@ -49,8 +49,7 @@ def view(mesh, output, field, method, smoothing_steps, radius, orient, up, perce
     from ..io._files import check_input, check_output
     from ..viewer import write_html
 
-    context = click.get_current_context()
-    session = context.find_object(Session) or Session()
+    session = current_session()
     output = output if output is not None else pathlib.Path(f"{mesh.stem}.html")
     if output.suffix.lower() not in (".html", ".htm"):
         raise click.BadParameter(f"the page is an HTML file (.html); got {output.name!r}", param_hint="'-o'")

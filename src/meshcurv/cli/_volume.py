@@ -10,7 +10,7 @@ import click
 import numpy as np
 
 from ..batch import MAX_WORKERS
-from ._common import _FLOAT_MAX, SCALAR_FIELDS, MethodChoice, ProgressBar, Session, common_options
+from ._common import _FLOAT_MAX, SCALAR_FIELDS, MethodChoice, ProgressBar, common_options, current_session
 
 __all__ = ["volume", "LabelBar", "MESH_FORMATS"]
 
@@ -101,7 +101,7 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
     from ..io._files import atomic_output, check_output
     from ..io._images import read_image
 
-    session = click.get_current_context().find_object(Session)
+    session = current_session()
     volume_module._pandas()
     if picture:
         from ..plotting import _pyplot

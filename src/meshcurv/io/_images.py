@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import pathlib
 import zipfile
-from typing import NamedTuple
+from typing import NamedTuple, cast
 
 import numpy as np
 
@@ -163,10 +163,11 @@ def _tiff_spacing(tif, series):
 def _nifti(path):
     try:
         import nibabel
+        from nibabel.spatialimages import SpatialImage
     except ImportError as exc:
         raise MissingDependencyError("reading NIfTI images needs nibabel: pip install 'meshcurv[volume]'") from exc
     try:
-        image = nibabel.load(str(path))
+        image = cast(SpatialImage, nibabel.load(str(path)))  # .nii, .nii.gz: a Nifti1Image or Nifti2Image
         shape = image.shape
         _check_size(path, shape, image.get_data_dtype())
         array = np.asanyarray(image.dataobj)

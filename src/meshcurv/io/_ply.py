@@ -203,8 +203,8 @@ def _read_binary(data, position, order, elements, vertex, face, corners, path, f
                 table = np.frombuffer(data, record, count=element.count, offset=position)
                 vertices = np.column_stack([table[axis].astype(np.float64) for axis in "xyz"])
                 if found is not None:
-                    found.update({name: table[name].astype(np.float64) for name in record.names
-                                  if name not in ("x", "y", "z")})
+                    found.update({p.name: table[p.name].astype(np.float64) for p in element.properties
+                                  if p.name not in ("x", "y", "z")})
             position += need
             continue
         keep = corners if element is face else None
@@ -224,7 +224,8 @@ def _binary_lists(data, position, order, element, keep, path):
     if element.count == 0:
         return (np.zeros((0, 3), np.int64) if keep is not None else None), position
     # the common case: every record as the first one; one structured array
-    layout, head = [], position
+    layout: list[tuple] = []
+    head = position
     for i, p in enumerate(properties):
         if p.count_kind is None:
             layout.append((f"p{i}", order + p.kind))
@@ -242,7 +243,7 @@ def _binary_lists(data, position, order, element, keep, path):
     record = np.dtype(layout)
     if element.count * record.itemsize <= available:
         table = np.frombuffer(data, record, count=element.count, offset=position)
-        counts = [name for name in record.names if name.startswith("n")]
+        counts = [name for name, *_ in layout if name.startswith("n")]
         if all((table[name] == table[name][0]).all() for name in counts):
             found = None
             if keep is not None:
@@ -253,7 +254,7 @@ def _binary_lists(data, position, order, element, keep, path):
 
 def _walk_binary(data, position, order, element, keep, sizes, path):
     """Records of different sizes: walk them, then gather the kept lists in one pass."""
-    plan = []
+    plan: list[tuple[struct.Struct | None, int, int]] = []
     for p, size in zip(element.properties, sizes):
         if p.count_kind is None:
             plan.append((None, size, 0))
@@ -261,7 +262,8 @@ def _walk_binary(data, position, order, element, keep, sizes, path):
             code = {"i1": "b", "u1": "B", "i2": "h", "u2": "H", "i4": "i", "u4": "I", "i8": "q", "u8": "Q"}
             plan.append((struct.Struct(order + code[p.count_kind]), size, np.dtype(p.kind).itemsize))
     end = len(data)
-    starts, counts = [], []
+    starts: list[int] = []
+    counts: list[int] = []
     for _ in range(element.count):
         for i, (counter, size, item) in enumerate(plan):
             if counter is None:
@@ -282,12 +284,12 @@ def _walk_binary(data, position, order, element, keep, sizes, path):
     if keep is None:
         return None, position
     kind = np.dtype(order + element.properties[keep].kind)
-    counts = np.array(counts, dtype=np.int64)
-    first = np.repeat(np.array(starts, dtype=np.int64) - np.cumsum(counts * kind.itemsize) + counts * kind.itemsize,
-                      counts * kind.itemsize)
+    lengths = np.array(counts, dtype=np.int64)
+    first = np.repeat(np.array(starts, dtype=np.int64) - np.cumsum(lengths * kind.itemsize) + lengths * kind.itemsize,
+                      lengths * kind.itemsize)
     byte_index = first + np.arange(first.size)
     values = np.frombuffer(data, np.uint8)[byte_index].view(kind).astype(np.int64)
-    return _split(values, counts), position
+    return _split(values, lengths), position
 
 
 def _split(values: np.ndarray, counts: np.ndarray):
@@ -387,7 +389,7 @@ def _ascii_lists(values, position, element, keep, path):
             raise MeshFileError(f"{path}: the PLY file ends inside its {element.plural} (cut short)")
     if keep is None:
         return None, position
-    counts = np.array(counts, dtype=np.int64)
-    first = np.repeat(np.array(starts, dtype=np.int64) - np.cumsum(counts) + counts, counts)
+    lengths = np.array(counts, dtype=np.int64)
+    first = np.repeat(np.array(starts, dtype=np.int64) - np.cumsum(lengths) + lengths, lengths)
     corner_values = values[first + np.arange(first.size)]
-    return _split(_integers(corner_values, path, "face index"), counts), position
+    return _split(_integers(corner_values, path, "face index"), lengths), position

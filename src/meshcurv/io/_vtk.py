@@ -212,16 +212,18 @@ def _cells(cursor, key, n_cells, size, version, path):
     k = int(values[0]) if values.size else -1
     if k >= 0 and size == n_cells * (k + 1) and (values[::k + 1] == k).all():
         return [values.reshape(n_cells, k + 1)[:, 1:]] if k else []
-    starts, counts, position = [], [], 0
+    starts: list[int] = []
+    lengths: list[int] = []
+    position = 0
     for _ in range(n_cells):  # cells of different sizes: each count says where the next cell starts
         if position >= size or values[position] < 0 or position + 1 + values[position] > size:
             raise MeshFileError(f"{path}: the {key} counts do not match the declared size {size}")
         starts.append(position + 1)
-        counts.append(int(values[position]))
-        position += 1 + counts[-1]
+        lengths.append(int(values[position]))
+        position += 1 + lengths[-1]
     if position != size:
         raise MeshFileError(f"{path}: the {key} counts do not match the declared size {size}")
-    return [values[start:start + count] for start, count in zip(starts, counts)]
+    return [values[start:start + length] for start, length in zip(starts, lengths)]
 
 
 def _strip_triangles(cells):
