@@ -55,6 +55,8 @@ https://doi.org/10.1111/j.1467-8659.2010.01797.x
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
@@ -101,7 +103,7 @@ def _n_terms(degree: int) -> int:
     return (degree + 1) * (degree + 2) // 2
 
 
-def _fit_chunk(offsets: np.ndarray, rows: np.ndarray, size: int, frame: tuple, weights: np.ndarray,
+def _fit_chunk(offsets: np.ndarray, rows: np.ndarray, size: int, frame: Sequence[np.ndarray], weights: np.ndarray,
                degree: int) -> tuple[np.ndarray, np.ndarray]:
     """Weighted normal equations of the jets of one chunk of centres, in units of the radius.
 
@@ -281,7 +283,8 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     kernels = numba_kernels("jets")
     if kernels is not None and n:
         n_calls = max(1, min(centres.size, int(np.ceil(mean * centres.size / PAIRS_PER_CALL))))
-        outputs = None  # the first call's outputs (the rows of the others' centres filled in from theirs)
+        # the first call's outputs (the rows of the others' centres filled in from theirs)
+        outputs: list[np.ndarray] | None = None
         if adjacency is not None:
             allowed = np.ones(n, dtype=bool) if neighbours is None else neighbours
             indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
@@ -303,6 +306,8 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
                 continue
             for whole, piece in zip(outputs, found):
                 whole[part] = piece[part]
+        if outputs is None:
+            raise RuntimeError("no kernel call ran (n_calls >= 1)")
         coefficients, t1, t2, normal, counts, away = outputs
         if details is not None:
             details["away"] = away
@@ -330,7 +335,7 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
                 keep = np.isfinite(tilted).all(axis=1, keepdims=True)
                 new_normal = np.where(keep, tilted, local[2])
                 local = [*tangent_basis(new_normal), new_normal]
-        if check:
+        if facing is not None:
             opposite = np.einsum("ij,ij->i", facing[neighbour], facing[index[rows]]) < 0
             inside = weights > 0
             total = np.bincount(rows, weights=inside.astype(float), minlength=size)
@@ -375,7 +380,7 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *,
     centres = np.arange(n)
     mean, _ = check_ball_work(vertices[allowed], radius, n, centres=vertices)
     n_calls = max(1, min(n, int(np.ceil(mean * n / PAIRS_PER_CALL))))
-    fitted = None
+    fitted: np.ndarray | None = None
     for call in range(n_calls):  # Python between calls: Ctrl-C gets through
         part = centres[call * n // n_calls:(call + 1) * n // n_calls]
         found = kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations, _exponents(degree),
@@ -385,6 +390,8 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *,
             fitted = found
         else:
             fitted[part] = found[part]
+    if fitted is None:
+        raise RuntimeError("no kernel call ran (n_calls >= 1)")
     return fitted
 
 

@@ -118,7 +118,7 @@ def default_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[fl
     level = np.full(scales.shape, np.iinfo(np.int64).min)
     positive = referenced & (scales > 0)
     level[positive] = np.round(np.log2(scales[positive])).astype(np.int64)
-    groups = []
+    groups: list[tuple[float, np.ndarray | None]] = []
     for k in np.unique(level[positive]):
         members = np.flatnonzero(level == k)
         inside = np.zeros(scales.shape, dtype=bool)
@@ -340,7 +340,7 @@ def _size_groups(reach: np.ndarray, radius: float) -> list[np.ndarray | slice]:
     first = 0
     for k in np.flatnonzero(largest):
         if radius + largest[k] > GROUP_GROWTH * (radius + largest[first]):
-            first = k
+            first = int(k)
         label[k] = first
     firsts = np.unique(label[largest > 0])
     if firsts.size == 1:
@@ -426,11 +426,13 @@ def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radiu
     indptr, indices = kernels.vertex_face_lists(faces, n)
     values = np.ascontiguousarray(values)
     n_calls = max(1, int(np.ceil(mean * n / PAIRS_PER_CALL)))
-    out = None
+    out: np.ndarray | None = None
     for call in range(n_calls):  # Python between calls: Ctrl-C gets through
         sums = kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radius, indptr, indices,
                                            kernel_threads(), call * n // n_calls, (call + 1) * n // n_calls)
         out = sums if out is None else out + sums
+    if out is None:
+        raise RuntimeError("no kernel call ran (n_calls >= 1)")
     return out
 
 

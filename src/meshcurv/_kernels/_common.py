@@ -5,20 +5,30 @@ product, the degenerate-face test, the cancellation of a normal sum, the tangent
 from __future__ import annotations
 
 import math
+from typing import Literal, TypedDict
 
 import numba as nb
 import numpy as np
 
 
+class _JitOptions(TypedDict):
+    """The keywords of ``numba.njit`` the kernels set (typed, so that ``njit(**_JIT)`` type-checks)."""
+
+    cache: bool
+    nogil: bool
+    fastmath: bool | set[str]
+    error_model: Literal["python", "numpy"]
+
+
 #: The options of every kernel: cached on disk, no GIL, IEEE arithmetic (NaN and inf keep their meaning).
-_JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+_JIT: _JitOptions = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
 
 
 _TINY = np.finfo(np.float64).tiny
 
 
 #: Sums that may be reassociated (vectorized); no other fast-math assumption (NaN and inf stay meaningful).
-_JIT_REASSOC = {**_JIT, "fastmath": {"reassoc", "contract"}}
+_JIT_REASSOC: _JitOptions = {**_JIT, "fastmath": {"reassoc", "contract"}}
 
 
 @nb.njit(inline="always", **_JIT)

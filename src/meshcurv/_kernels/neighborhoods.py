@@ -66,9 +66,9 @@ def _grid(points, reach):
     column = np.empty(n, np.int64)
     starts = np.zeros(nx * ny + 1, np.int64)
     for i in range(n):
-        c = np.int64((points[i, 0] - lo[0]) / cell) * ny + np.int64((points[i, 1] - lo[1]) / cell)
-        column[i] = c
-        starts[c + 1] += 1
+        here = np.int64((points[i, 0] - lo[0]) / cell) * ny + np.int64((points[i, 1] - lo[1]) / cell)
+        column[i] = here
+        starts[here + 1] += 1
     for c in range(nx * ny):
         starts[c + 1] += starts[c]
     order = np.empty(n, np.int64)
@@ -119,8 +119,8 @@ def _ball_members(points, grid, cx, cy, cz, cutoff, out):
     bx = np.int64(math.floor(fx))
     by = np.int64(math.floor(fy))
     bz = np.int64(math.floor(fz))
-    for ix in range(max(bx - span, 0), min(bx + span + 1, nx)):
-        for iy in range(max(by - span, 0), min(by + span + 1, ny)):
+    for ix in range(max(bx - span, np.int64(0)), min(bx + span + 1, nx)):
+        for iy in range(max(by - span, np.int64(0)), min(by + span + 1, ny)):
             c = ix * ny + iy
             k = starts[c]
             last = starts[c + 1]

@@ -336,7 +336,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     parameters = {"radius": radii[0] if len(radii) == 1 else radii,
                   "normal_radius": NORMAL_RADIUS_RATIO * radii[0] if len(radii) == 1
                   else [NORMAL_RADIUS_RATIO * r for r in radii], **found}
-    fields = None
+    fields: tuple[np.ndarray, ...] | None = None
     for group_radius, members in groups:
         computed = _curvatures(vertices, topology.faces, degenerate, normals, valid, group_radius,
                                stages if fields is None else None, neighbours=referenced,
@@ -348,5 +348,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
             fields = tuple(np.array(field, copy=True) for field in computed)
         for field, values in zip(fields, computed):
             field[members] = values[members]
+    if fields is None:
+        raise RuntimeError("default_radii gave no group")
     k_min, k_max, dir_min, dir_max, normals, valid = fields
     return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects)
