@@ -379,3 +379,13 @@ def test_installed_entry_point_runs_as_a_process(torus_file):
     done = subprocess.run([sys.executable, "-m", "meshcurv", "--version"], capture_output=True, text=True,
                           timeout=120)
     assert done.returncode == 0 and meshcurv.__version__ in done.stdout
+
+
+def test_a_command_run_without_the_session_says_how_to_run_it():
+    click_testing = pytest.importorskip("click.testing")
+    from meshcurv.cli._app import meshcurv as group
+
+    result = click_testing.CliRunner().invoke(group, ["methods"])  # no obj: not through meshcurv.cli.main
+    assert isinstance(result.exception, RuntimeError)
+    assert "no meshcurv Session in the click context: run the commands through meshcurv.cli.main" in str(
+        result.exception)

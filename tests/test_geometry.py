@@ -74,6 +74,8 @@ def test_edge_dihedral_angles_refuse_mismatched_arrays():
     normals = face_normals(vertices, faces)
     with pytest.raises(InvalidMeshError, match=r"`unit_normals` must be a real array of shape \(2, 3\)"):
         geometry.edge_dihedral_angles(vertices, top, normals[:1], top.interior_edges)
+    with pytest.raises(InvalidMeshError, match=r"`unit_normals` must be a real array of shape \(2, 3\)"):
+        geometry.edge_dihedral_angles(vertices, top, None, top.interior_edges)
     with pytest.raises(InvalidMeshError, match=r"`usable_edges` must be a bool array of shape \(5,\)"):
         geometry.edge_dihedral_angles(vertices, top, normals, np.ones(5))
     with pytest.raises(InvalidMeshError, match=r"`topology` must be a MeshTopology; got ndarray"):
