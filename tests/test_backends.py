@@ -217,6 +217,35 @@ def test_jets_fitted_at_chosen_centres(backend):
     np.testing.assert_array_equal(counts[centres], full_counts[centres])
 
 
+@pytest.mark.parametrize("connected", [False, True])
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_settled_fits_keep_their_first_fit(backend, connected):
+    # a centre whose first fit has a slope c10^2 + c01^2 below `settled` keeps that fit and its
+    # frame (the result of one iteration); every other centre gets its two iterations
+    from meshcurv.jets import fit_jets
+
+    mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=2)
+    normals = mesh.vertices / np.linalg.norm(mesh.vertices, axis=1, keepdims=True)
+    adjacency = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).neighbour_lists if connected else None
+    with use_backend(backend):
+        once, once_frame, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=1, adjacency=adjacency)
+        twice, twice_frame, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency)
+        slope = once[:, 1] ** 2 + once[:, 2] ** 2
+        settled = float(np.median(slope))
+        mixed, frame, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency,
+                                   settled=settled)
+        unchanged, _, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency,
+                                   settled=0.0)
+    kept = slope < settled
+    assert 0 < kept.sum() < kept.size and np.isfinite(once).all()
+    assert np.abs(once[kept] - twice[kept]).max() > 1e-9  # the second fit moves them: the test can tell
+    np.testing.assert_allclose(mixed[kept], once[kept], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(frame[2][kept], once_frame[2][kept], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(mixed[~kept], twice[~kept], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(frame[2][~kept], twice_frame[2][~kept], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(unchanged, twice)
+
+
 def test_ball_grid_finds_every_neighbour_of_a_sparse_flat_cloud():
     # 50 clusters of 40 points scattered over a 1000 x 1000 square, radius 5: cells of side 5
     # would make 20 columns per point, so the kernel widens its cells; every ball must still

@@ -199,7 +199,7 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
 def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
              iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
              neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
-             details: dict | None = None, adjacency: tuple | None = None):
+             details: dict | None = None, adjacency: tuple | None = None, settled: float = 0.0):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
     Parameters
@@ -241,6 +241,10 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
         centres costs only their balls). Another sheet of the surface within
         the ball (the far side of a part thinner than the ball) is left out.
         The NumPy path takes the whole Euclidean ball.
+    settled : float, default: 0.0
+        A fit whose slope ``c10^2 + c01^2`` is below this ends the iterations
+        of its vertex: its normal is within ``atan(sqrt(settled))`` of the
+        frame's, and it is kept with that frame. 0: ``iterations`` fits everywhere.
 
     Returns
     -------
@@ -296,11 +300,11 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
                 found = kernels.fit_jets_connected(
                     vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
                     kernel_threads(), allowed, indptr, indices, facing if check else vertices, check, AWAY_FRACTION,
-                    False)
+                    False, float(settled))
             else:
                 found = kernels.fit_jets(
                     vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
-                    64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION)
+                    64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION, float(settled))
             if outputs is None:
                 outputs = list(found)
                 continue
@@ -325,14 +329,20 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
         weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
         local = [*tangent_basis(normals[index]), normals[index]]
+        settle = np.zeros((size, 1), dtype=bool)  # the centres whose iterations have ended (``settled``)
         for step in range(iterations):
             matrix, right = _fit_chunk(offsets, rows, size, local, weights, degree)
-            fitted = _solve(matrix, right, count, degree)
+            found = _solve(matrix, right, count, degree)
+            if step == 0:
+                fitted = found
+            else:  # the settled centres keep their earlier fit
+                fitted = np.where(settle, fitted, found)
             if step + 1 < iterations:
                 p, q = fitted[:, 1:2], fitted[:, 2:3]
+                settle |= p * p + q * q < settled
                 tilted = local[2] - p * local[0] - q * local[1]
                 tilted /= np.linalg.norm(tilted, axis=1, keepdims=True)
-                keep = np.isfinite(tilted).all(axis=1, keepdims=True)
+                keep = np.isfinite(tilted).all(axis=1, keepdims=True) & ~settle
                 new_normal = np.where(keep, tilted, local[2])
                 local = [*tangent_basis(new_normal), new_normal]
         if facing is not None:
@@ -354,19 +364,21 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
 
 def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
                     iterations: int = ITERATIONS, neighbours: np.ndarray | None = None,
-                    adjacency: tuple | None = None) -> np.ndarray:
+                    adjacency: tuple | None = None, settled: float = 0.0) -> np.ndarray:
     """(V, 3) unit normals of the jets of :func:`fit_jets` at every vertex (NaN where no fit was possible).
 
     ``jet_normals(*fit_jets(...)[:2])`` with the same arguments; with the
     compiled kernels and ``adjacency``, one pass that writes only the normals
-    (not the coefficients, frames and counts: 136 bytes per vertex).
+    (not the coefficients, frames and counts: 136 bytes per vertex). A vertex
+    whose fit has a slope ``c10^2 + c01^2`` below ``settled`` takes its normal
+    without further iterations (:func:`fit_jets`; 0: ``iterations`` fits everywhere).
     """
     kernels = numba_kernels("jets")
     vertices = checked_points(vertices)
     n = vertices.shape[0]
     if kernels is None or adjacency is None or n == 0:
         coefficients, frame, _ = fit_jets(vertices, normals, radius, degree=degree, iterations=iterations,
-                                          neighbours=neighbours, adjacency=adjacency)
+                                          neighbours=neighbours, adjacency=adjacency, settled=settled)
         return jet_normals(coefficients, frame)
     normals = np.ascontiguousarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
@@ -385,7 +397,7 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *,
         part = centres[call * n // n_calls:(call + 1) * n // n_calls]
         found = kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations, _exponents(degree),
                                            MIN_PIVOT, part, kernel_threads(), allowed, indptr, indices, vertices,
-                                           False, AWAY_FRACTION, True)[0]
+                                           False, AWAY_FRACTION, True, float(settled))[0]
         if fitted is None:
             fitted = found
         else:

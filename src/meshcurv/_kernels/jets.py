@@ -49,7 +49,7 @@ def _cholesky_solve(a, b, low, m, min_pivot):
 
 @nb.njit(parallel=True, **_JIT)
 def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks, pool, facing,
-             check_facing, away_fraction):
+             check_facing, away_fraction, settled=0.0):
     """``jets.fit_jets``: weighted jets over the balls of ``radius``, frame re-estimated from each fit.
 
     Fits the jets of the vertices ``centres`` (the other rows of the outputs
@@ -60,7 +60,8 @@ def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot
     the tangent plane and is left NaN. Returns ``(coefficients (V, 6), t1, t2,
     n, counts, away)``, ``away`` the share of points facing away (NaN
     unless checked); the neighbours of each vertex are found on a grid of cells
-    (:func:`_grid`).
+    (:func:`_grid`). A fit whose slope ``c10^2 + c01^2`` is below ``settled``
+    ends the iterations of its vertex (0: ``iterations`` fits everywhere).
     """
     n = vertices.shape[0]
     n_pool = pool.shape[0]
@@ -102,7 +103,7 @@ def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot
                                           members)
             work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, v,
                             members, size, work, moments, right, matrix, low, scale, solution, coefficients, t1s,
-                            t2s, ns, counts, ids, facing, check_facing, away_fraction, away)
+                            t2s, ns, counts, ids, facing, check_facing, away_fraction, away, settled)
     return coefficients, t1s, t2s, ns, counts, away
 
 
@@ -135,10 +136,94 @@ def _dot(a, b, size):
     return total
 
 
+@nb.njit(**_JIT_REASSOC)
+def _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
+    """:func:`_fit_one`'s moments of a degree-3 fit, summed member by member in scalars.
+
+    ``moments[i, k] = sum w u^i v^k`` (``i + k <= 6``) and ``right[t] = sum w h
+    u^i v^k`` for the ten exponents ``(i, k)`` of ``jets._exponents(3)``
+    (by total degree), where ``u, v, h`` are the coordinates of the offsets
+    ``ox, oy, oz`` along ``a, b, n`` and ``w`` the weights: the sums of the
+    rows of powers of :func:`_fit_one`, in one pass over the members with no
+    per-member scratch (the products are formed alike, ``(w u^i) v^k``; the sums
+    are reassociated).
+    """
+    m00 = m10 = m01 = m20 = m11 = m02 = m30 = m21 = m12 = m03 = 0.0
+    m40 = m31 = m22 = m13 = m04 = m50 = m41 = m32 = m23 = m14 = m05 = 0.0
+    m60 = m51 = m42 = m33 = m24 = m15 = m06 = 0.0
+    r00 = r10 = r01 = r20 = r11 = r02 = r30 = r21 = r12 = r03 = 0.0
+    for a in range(size):
+        x, y, z, w = ox[a], oy[a], oz[a], weight[a]
+        u = x * ax + y * ay + z * az
+        v = x * bx + y * by + z * bz
+        lift = w * (x * nx + y * ny + z * nz)
+        u2 = u * u
+        u3 = u2 * u
+        u4 = u3 * u
+        u5 = u4 * u
+        u6 = u5 * u
+        v2 = v * v
+        v3 = v2 * v
+        v4 = v3 * v
+        v5 = v4 * v
+        v6 = v5 * v
+        w1, w2, w3, w4, w5, w6 = w * u, w * u2, w * u3, w * u4, w * u5, w * u6
+        m00 += w
+        m01 += w * v
+        m02 += w * v2
+        m03 += w * v3
+        m04 += w * v4
+        m05 += w * v5
+        m06 += w * v6
+        m10 += w1
+        m11 += w1 * v
+        m12 += w1 * v2
+        m13 += w1 * v3
+        m14 += w1 * v4
+        m15 += w1 * v5
+        m20 += w2
+        m21 += w2 * v
+        m22 += w2 * v2
+        m23 += w2 * v3
+        m24 += w2 * v4
+        m30 += w3
+        m31 += w3 * v
+        m32 += w3 * v2
+        m33 += w3 * v3
+        m40 += w4
+        m41 += w4 * v
+        m42 += w4 * v2
+        m50 += w5
+        m51 += w5 * v
+        m60 += w6
+        l1, l2, l3 = lift * u, lift * u2, lift * u3
+        r00 += lift
+        r10 += l1
+        r01 += lift * v
+        r20 += l2
+        r11 += l1 * v
+        r02 += lift * v2
+        r30 += l3
+        r21 += l2 * v
+        r12 += l1 * v2
+        r03 += lift * v3
+    moments[0, 0], moments[0, 1], moments[0, 2], moments[0, 3] = m00, m01, m02, m03
+    moments[0, 4], moments[0, 5], moments[0, 6] = m04, m05, m06
+    moments[1, 0], moments[1, 1], moments[1, 2] = m10, m11, m12
+    moments[1, 3], moments[1, 4], moments[1, 5] = m13, m14, m15
+    moments[2, 0], moments[2, 1], moments[2, 2], moments[2, 3], moments[2, 4] = m20, m21, m22, m23, m24
+    moments[3, 0], moments[3, 1], moments[3, 2], moments[3, 3] = m30, m31, m32, m33
+    moments[4, 0], moments[4, 1], moments[4, 2] = m40, m41, m42
+    moments[5, 0], moments[5, 1] = m50, m51
+    moments[6, 0] = m60
+    right[0], right[1], right[2], right[3], right[4] = r00, r10, r01, r20, r11
+    right[5], right[6], right[7], right[8], right[9] = r02, r30, r21, r12, r03
+
+
 @nb.njit(**_JIT)
 def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, row, members, size, work,
              moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing,
-             check_facing, away_fraction, away_out):
+             check_facing, away_fraction, away_out, settled):
     """One vertex of :func:`fit_jets` in the caller's buffers; returns ``work`` (grown when too small).
 
     The ball's points are ``points[members[:size]]`` (vertex ``ids[members[a]]``);
@@ -148,7 +233,10 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     of the weight with ``u^0..u^2d`` and of the weighted height with ``u^0..u^d``
     (:func:`_jet_scratch`), so that each moment of the normal equations is one
     vectorized dot product of two rows (the products are those of the three
-    factors in their order: the same numbers).
+    factors in their order: the same numbers). A degree-3 fit sums its moments
+    member by member instead (:func:`_cubic_jet_moments`, the same products;
+    no per-member rows). A fit whose slope ``c10^2 + c01^2`` is below ``settled``
+    ends the iterations (its frame and coefficients are kept).
     """
     n_terms = exponents.shape[0]
     top = 2 * degree
@@ -156,6 +244,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
         work = np.empty((work.shape[0], 2 * size))
     ox, oy, oz, weight, lift = work[0], work[1], work[2], work[3], work[4]
     inverse = 1.0 / radius
+    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]  # read once (the stores below may alias)
     pu = work[_JET_ROWS:_JET_ROWS + top + 1]
     pv = work[_JET_ROWS + top + 1:_JET_ROWS + 2 * (top + 1)]
     wu = work[_JET_ROWS + 2 * (top + 1):_JET_ROWS + 3 * (top + 1)]
@@ -163,13 +252,14 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     count = 0.0
     for a in range(size):
         k = members[a]
-        x = (points[k, 0] - vertices[v, 0]) * inverse
-        y = (points[k, 1] - vertices[v, 1]) * inverse
-        z = (points[k, 2] - vertices[v, 2]) * inverse
+        x = (points[k, 0] - cx) * inverse
+        y = (points[k, 1] - cy) * inverse
+        z = (points[k, 2] - cz) * inverse
         ox[a], oy[a], oz[a] = x, y, z
         w = max(1.0 - (x * x + y * y + z * z), 0.0)
-        weight[a] = w * w
-        count += weight[a] > 0
+        w = w * w
+        weight[a] = w
+        count += w > 0
         pu[0, a] = 1.0
         pv[0, a] = 1.0
     counts[row] = count
@@ -191,25 +281,28 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
     fitted = False
     for step in range(iterations):
-        for a in range(size):
-            pu[1, a] = ox[a] * ax + oy[a] * ay + oz[a] * az
-            pv[1, a] = ox[a] * bx + oy[a] * by + oz[a] * bz
-            lift[a] = weight[a] * (ox[a] * nx + oy[a] * ny + oz[a] * nz)
-        for p in range(2, top + 1):  # power by power over all members (no chain of products per member)
+        if degree == 3:  # the default normal fit: moments summed member by member
+            _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right)
+        else:
             for a in range(size):
-                pu[p, a] = pu[p - 1, a] * pu[1, a]
-                pv[p, a] = pv[p - 1, a] * pv[1, a]
-        for p in range(top + 1):  # the weight (and weighted height) times each power of u, once
-            for a in range(size):
-                wu[p, a] = weight[a] * pu[p, a]
-        for p in range(degree + 1):
-            for a in range(size):
-                lu[p, a] = lift[a] * pu[p, a]
-        for total in range(top + 1):
-            for k in range(total + 1):
-                moments[total - k, k] = _dot(wu[total - k], pv[k], size)
-        for t in range(n_terms):
-            right[t] = _dot(lu[exponents[t, 0]], pv[exponents[t, 1]], size)
+                pu[1, a] = ox[a] * ax + oy[a] * ay + oz[a] * az
+                pv[1, a] = ox[a] * bx + oy[a] * by + oz[a] * bz
+                lift[a] = weight[a] * (ox[a] * nx + oy[a] * ny + oz[a] * nz)
+            for p in range(2, top + 1):  # power by power over all members (no chain of products per member)
+                for a in range(size):
+                    pu[p, a] = pu[p - 1, a] * pu[1, a]
+                    pv[p, a] = pv[p - 1, a] * pv[1, a]
+            for p in range(top + 1):  # the weight (and weighted height) times each power of u, once
+                for a in range(size):
+                    wu[p, a] = weight[a] * pu[p, a]
+            for p in range(degree + 1):
+                for a in range(size):
+                    lu[p, a] = lift[a] * pu[p, a]
+            for total in range(top + 1):
+                for k in range(total + 1):
+                    moments[total - k, k] = _dot(wu[total - k], pv[k], size)
+            for t in range(n_terms):
+                right[t] = _dot(lu[exponents[t, 0]], pv[exponents[t, 1]], size)
         fitted = False
         for d in range(degree, 1, -1):
             m = (d + 1) * (d + 2) // 2
@@ -230,6 +323,8 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
                 break
         if step + 1 < iterations and fitted:
             p, q = solution[1], solution[2]
+            if p * p + q * q < settled:
+                break  # the fit's normal is within the frame's: another fit in its frame would change little
             tx = nx - p * ax - q * bx
             ty = ny - p * ay - q * by
             tz = nz - p * az - q * bz
@@ -249,7 +344,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
 
 @nb.njit(parallel=True, **_JIT)
 def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks,
-                       allowed, indptr, indices, facing, check_facing, away_fraction, normals_only):
+                       allowed, indptr, indices, facing, check_facing, away_fraction, normals_only, settled=0.0):
     """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
 
     The same fits, outputs and checks as :func:`fit_jets`, with the points of
@@ -261,6 +356,9 @@ def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents,
     the fitted jets, ``(n - c10 t1 - c01 t2) / sqrt(1 + c10^2 + c01^2)`` as
     ``jets.jet_normals`` computes them (NaN where no fit), and one-row
     placeholders for the other outputs (136 bytes per vertex never written).
+    A fit whose slope ``c10^2 + c01^2`` is below ``settled`` ends the
+    iterations of its vertex (its normal is within ``atan(sqrt(settled))`` of
+    the frame's normal); with 0, every vertex has ``iterations`` fits.
     """
     n = vertices.shape[0]
     m = centres.shape[0]
@@ -274,20 +372,19 @@ def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents,
         members = np.empty(n, np.int64)
         queue = np.empty(n, np.int64)
         work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, n_terms)
-        one = _jet_outputs(1)
+        c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row: unpacked once, not per vertex
         for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
             v = centres[i]
             size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, members, queue)
             if not normals_only:
                 work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v,
                                 v, members, size, work, moments, right, matrix, low, scale, solution, coefficients,
-                                t1s, t2s, ns, counts, ids, facing, check_facing, away_fraction, away)
+                                t1s, t2s, ns, counts, ids, facing, check_facing, away_fraction, away, settled)
                 continue
-            c, a, b, nn = one[0], one[1], one[2], one[3]
             c[0, :] = np.nan  # a failed fit leaves the row as it finds it
             work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v, 0,
-                            members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn, one[4],
-                            ids, facing, check_facing, away_fraction, one[5])
+                            members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn,
+                            one_count, ids, facing, check_facing, away_fraction, one_away, settled)
             p, q = c[0, 1], c[0, 2]
             width = np.sqrt(1 + p * p + q * q)
             for k in range(3):
