@@ -237,6 +237,30 @@ def check_face_cross_products(name):
     np.testing.assert_array_equal(kernels("geometry").face_cross_products(vertices, faces), expected)
 
 
+def check_patch_volumes(name):
+    from meshcurv.orient import _patch_volumes
+
+    vertices, faces = mesh(name)
+    n_labels, labels = topology(name).vertex_components
+    rng = np.random.default_rng(5)
+    # the mesh's components, and three interleaved patches over them (labels need not be contiguous)
+    for patch, count in ((labels[faces[:, 0]], n_labels), (np.arange(faces.shape[0]) * 7 % 3, 3)):
+        patch = np.ascontiguousarray(patch, dtype=np.int64)
+        flip = rng.random(faces.shape[0]) < 0.3
+        with use_backend("numpy"):
+            expected = _patch_volumes(vertices, faces, patch, flip, count)
+        got = kernels("orient").patch_volumes(vertices, faces, patch, flip, count)
+        # each face's triple product a . (b x c) grouped otherwise (np.cross and einsum against one
+        # expression): a few eps |a||b||c| apart, then the same terms summed in another order
+        centre = np.stack([np.bincount(patch, weights=vertices[faces[:, 0], k], minlength=count) for k in range(3)],
+                          axis=1) / np.maximum(np.bincount(patch, minlength=count), 1)[:, None]
+        sizes = np.prod([np.linalg.norm(vertices[faces[:, k]] - centre[patch], axis=1) for k in range(3)], axis=0)
+        magnitude = 8 * np.bincount(patch, weights=sizes, minlength=count)
+        for kind, a, b in (("signed", got[0], expected[0]), ("absolute", got[1], expected[1])):
+            assert_sums_close(a, b, magnitude, faces.shape[0], f"{name}: {kind} volumes, {count} patches")
+        assert (np.sign(got[0]) == np.sign(expected[0]))[np.abs(expected[0]) > 1e-6 * expected[1]].all()
+
+
 def check_vertex_normal_sums(name, monkeypatch):
     from meshcurv import geometry
 
@@ -1152,6 +1176,7 @@ TWINS = [
     Twin("geometry.vertex_edge_lengths", "geometry.vertex_edge_lengths", check_vertex_edge_lengths, MESHES),
     Twin("geometry.mean_edge_length", "geometry.mean_edge_length", check_mean_edge_length, MESHES),
     Twin("geometry.degenerate_faces", "geometry.degenerate_faces", check_degenerate_faces, MESHES),
+    Twin("orient.patch_volumes", "orient._patch_volumes", check_patch_volumes, MESHES),
     Twin("topology.build_edges", "topology._build_edges", check_build_edges, MESHES),
     Twin("topology.bowtie_vertices", "topology._bowtie_vertices", check_bowtie_vertices, MESHES),
     Twin("topology.count_components", "MeshTopology.n_components", check_count_components, MESHES),

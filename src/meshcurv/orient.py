@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._backend import numba_kernels
 from ._validation import as_faces, as_vertices, check_choice
 from .errors import InvalidMeshError, InvalidOptionError
 from .topology import MeshTopology
@@ -164,35 +165,43 @@ def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
     then it bounds a cavity of the solid around it, and its normals must face
     into the cavity (negative volume), out of the material.
     """
-    from .geometry import face_cross_products
-
     faces = topology.faces
     if topology.boundary_edges.any():
         on_boundary = topology.boundary_edges[np.maximum(topology.face_edges, 0)] & (topology.face_edges >= 0)
         open_patch = np.bincount(patch, weights=on_boundary.any(axis=1), minlength=n_labels) > 0
     else:
         open_patch = np.zeros(n_labels, dtype=bool)
-    # each patch's volume from a point near it (its faces' first corners' mean): no cancellation
-    first = vertices[faces[:, 0]]
-    weight = np.bincount(patch, minlength=n_labels).astype(np.float64)
-    weight[weight == 0] = 1.0
-    centroid = np.stack([np.bincount(patch, weights=first[:, k], minlength=n_labels) for k in range(3)],
-                        axis=1) / weight[:, None]
-    if n_labels == 1:  # one patch: the vertices moved once, the cross products compiled where they can be
-        shifted = vertices - centroid[0]
-        volume6 = np.einsum("ij,ij->i", shifted[faces[:, 0]], face_cross_products(shifted, faces))
-    else:
-        a = first - centroid[patch]
-        b = vertices[faces[:, 1]] - centroid[patch]
-        c = vertices[faces[:, 2]] - centroid[patch]
-        volume6 = np.einsum("ij,ij->i", a, np.cross(b, c))
-    sign = np.where(flip, -1.0, 1.0)
-    signed = np.bincount(patch, weights=sign * volume6, minlength=n_labels)
-    magnitude = np.bincount(patch, weights=np.abs(volume6), minlength=n_labels)
+    signed, magnitude = _patch_volumes(vertices, faces, patch, flip, n_labels)
     decided = ~open_patch & (np.abs(signed) > 1e-9 * magnitude)
     inverted = np.where(decided, signed < 0, invert)
     cavity = _nesting_depth(vertices, faces, patch, decided) % 2 == 1
     return np.where(decided & cavity, ~inverted, inverted)
+
+
+def _patch_volumes(vertices: np.ndarray, faces: np.ndarray, patch: np.ndarray, flip: np.ndarray,
+                   n_labels: int) -> tuple[np.ndarray, np.ndarray]:
+    """(P,) signed and (P,) absolute sums of six times the volume of each patch's faces.
+
+    A face's volume is that of the tetrahedron of its corners and the mean of
+    its patch's faces' first corners (a point near the patch: no cancellation
+    between far-off coordinates); a face to ``flip`` counts reversed. The
+    inputs are the validated arrays of :func:`face_flips` (``patch`` (F,) int64
+    in ``[0, n_labels)``, ``flip`` (F,) bool).
+    """
+    kernels = numba_kernels("orient")
+    if kernels is not None:
+        patch = np.ascontiguousarray(patch, dtype=np.int64)  # csgraph's labels are int32
+        return kernels.patch_volumes(vertices, faces, patch, np.ascontiguousarray(flip, dtype=bool), int(n_labels))
+    first = vertices[faces[:, 0]]
+    weight = np.maximum(np.bincount(patch, minlength=n_labels), 1).astype(np.float64)
+    centre = np.stack([np.bincount(patch, weights=first[:, k], minlength=n_labels) for k in range(3)],
+                      axis=1) / weight[:, None]
+    a = first - centre[patch]
+    b = vertices[faces[:, 1]] - centre[patch]
+    c = vertices[faces[:, 2]] - centre[patch]
+    volume6 = np.einsum("ij,ij->i", a, np.cross(b, c))
+    signed = np.bincount(patch, weights=np.where(flip, -volume6, volume6), minlength=n_labels)
+    return signed, np.bincount(patch, weights=np.abs(volume6), minlength=n_labels)
 
 
 def _nesting_depth(vertices, faces, patch, closed) -> np.ndarray:
