@@ -531,6 +531,12 @@ def _geometry_args(rng, name, vv, ff, v, f):
             args.append(float(rng.choice([1.0, 0.0, np.nan, 1e300])) if rng.random() < 0.8 else garbage(rng, "x"))
         elif p == "summed":
             args.append(rng.normal(size=(len(v), 3)) * float(rng.choice([1, 0, 1e300, 1e-320])))
+        elif p == "unit_normals":
+            args.append(rng.normal(size=(len(f), 3)) if rng.random() < 0.8 else garbage(rng, "normals"))
+        elif p == "usable_edges":
+            topology = next((a for a in args if isinstance(a, meshcurv.MeshTopology)), None)
+            args.append(topology.interior_edges.copy() if topology is not None and rng.random() < 0.8
+                        else garbage(rng, "edges"))
         elif p in ("cross",):
             continue
         else:

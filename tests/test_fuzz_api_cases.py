@@ -333,3 +333,64 @@ def test_a_cloud_mostly_on_a_line_raises_no_runtime_warning():
                    "valid estimates (k_min about -12) from the triangles the off-line points make in their balls")
 def test_points_on_a_line_have_no_curvature():
     assert not _mostly_on_a_line().valid[:200].any()  # a line has no surface curvature
+
+
+# --- H^2 - K overflowed where the curvatures are near 1e200 (a mesh at 1e-200), seed 21 ---------------
+
+def test_principal_curvatures_from_h_and_k_do_not_overflow():
+    from meshcurv._tensors import principal_from_mean_gaussian
+
+    rng = np.random.default_rng(3)
+    mean, gaussian = rng.normal(size=1000), rng.normal(size=1000)
+    naive = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
+    k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
+    np.testing.assert_array_equal(k_min, mean - naive)  # power-of-two scaling: the same numbers
+    np.testing.assert_array_equal(k_max, mean + naive)
+    # |H| near 1e160: H^2 is beyond float64 (1.8e308), K is not; the reference in x87 extended precision
+    big_mean, big_gaussian = mean * 1e160, gaussian * 1e300
+    wide_mean, wide_gaussian = big_mean.astype(np.longdouble), big_gaussian.astype(np.longdouble)
+    if np.finfo(np.longdouble).maxexp <= 1024:
+        pytest.skip("no extended precision on this platform for the reference")
+    half = np.sqrt(np.maximum(wide_mean**2 - wide_gaussian, 0))
+    context = _only_documented_warnings()
+    try:
+        big_min, big_max = principal_from_mean_gaussian(big_mean, big_gaussian)
+        odd = principal_from_mean_gaussian(np.array([np.nan, 1.0, np.inf, 0.0]), np.array([1.0, np.nan, 1.0, 0.0]))
+    finally:
+        context.__exit__(None, None, None)
+    np.testing.assert_allclose(big_min, (wide_mean - half).astype(float), rtol=1e-12, atol=1e148)
+    np.testing.assert_allclose(big_max, (wide_mean + half).astype(float), rtol=1e-12, atol=1e148)
+    assert np.isnan(odd[0][:3]).all() and np.isnan(odd[1][:3]).all() and odd[0][3] == odd[1][3] == 0.0
+
+
+@pytest.mark.parametrize("method", ["meyer", "icc", "normal_cycle"])
+def test_a_tiny_torus_with_a_far_spike_gives_no_numpy_warning(method):
+    # seed 21, case 3577: a torus at 1e-200 beside one coordinate at 1e75 (so the mesh is not refused as
+    # too small): the faces at the spike have areas near 1e-125, curvatures beyond 1e154 whose squares overflowed
+    torus = shapes.torus(n_major=16, n_minor=8)
+    vertices = torus.vertices * 1e-200
+    vertices[5, 1] = 1e75
+    context = _only_documented_warnings()
+    try:
+        result = meshcurv.principal_curvatures(vertices, torus.faces, method=method)
+    finally:
+        context.__exit__(None, None, None)
+    assert result.k_min.shape == (len(vertices),)
+    assert np.isfinite(result.k_min[result.valid]).all() and np.isfinite(result.k_max[result.valid]).all()
+
+
+# --- a radius far below the edges gave valid but far-off curvatures without a word (seed 21, case 4720) ---
+
+@pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
+def test_a_radius_below_half_an_edge_is_named_in_the_warning(method):
+    sphere = shapes.random_sphere(n_vertices=200)
+    median = float(np.median(np.linalg.norm(sphere.vertices[sphere.faces[:, 0]] - sphere.vertices[sphere.faces[:, 1]],
+                                            axis=1)))
+    with pytest.warns(meshcurv.MeshQualityWarning, match=r"`radius` 0\.05 is 0\.1\d of the median edge length .*"
+                                                          r"each ball holds little more than its vertex's own corner"):
+        meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method, radius=0.05)
+    assert 0.05 < 0.5 * median < 1.2 * median  # the radius of the next call is above half an edge
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method, radius=1.2 * median)
+    assert not any("own corner" in str(w.message) for w in seen)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._pointcloud_normals import grid_of
-from ._tensors import principal_from_shape_operator
+from ._tensors import principal_from_mean_gaussian, principal_from_shape_operator
 from .estimators.icc import face_measures
 from .jets import fit_jets, jet_normals, shape_operators
 
@@ -251,13 +251,13 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
             mean = summed[:, 1] / (2 * area)
             gaussian = summed[:, 2] / area
             shape_operator = -summed[:, 3:] / area[:, None]
-            # rows without area (a ball of collinear points) are NaN here and left out below
-            half = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
+        # rows without area (a ball of collinear points) are NaN here and left out below
+        k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
         _, _, dir_min, dir_max = principal_from_shape_operator(
             np.where(good[:, None], shape_operator, 0.0), normals[chunk[rows]])
         target = chunk[rows[good]]
-        out[0][target] = mean[good] - half[good]
-        out[1][target] = mean[good] + half[good]
+        out[0][target] = k_min[good]
+        out[1][target] = k_max[good]
         out[2][target] = dir_min[good]
         out[3][target] = dir_max[good]
     return (*out, normals)

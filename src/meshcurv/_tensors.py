@@ -10,7 +10,26 @@ import numpy as np
 
 from ._backend import numba_kernels
 
-__all__ = ["outer6", "apply6", "tangent_basis", "principal_from_shape_operator"]
+__all__ = ["outer6", "apply6", "tangent_basis", "principal_from_shape_operator", "principal_from_mean_gaussian"]
+
+
+def principal_from_mean_gaussian(mean: np.ndarray, gaussian: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``k_min, k_max = H -/+ sqrt(max(H^2 - K, 0))`` without overflow.
+
+    ``H`` and ``K`` are scaled by the power of two nearest ``max(|H|, sqrt|K|)``
+    before squaring (exact: the same numbers wherever ``H^2`` is a normal
+    float), so that the curvatures of a mesh at 1e-200 (about 1e200) are
+    finite rather than infinite. NaN where ``H`` or ``K`` is NaN or infinite.
+    """
+    mean, gaussian = np.asarray(mean, dtype=np.float64), np.asarray(gaussian, dtype=np.float64)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        size = np.maximum(np.abs(mean), np.sqrt(np.abs(gaussian)))
+        _, exponent = np.frexp(np.where(np.isfinite(size) & (size > 0), size, 1.0))
+        scale = np.ldexp(1.0, exponent)
+        h, k = mean / scale, gaussian / scale / scale
+        half = scale * np.sqrt(np.maximum(h * h - k, 0.0))
+        half = np.where(np.isfinite(mean) & np.isfinite(gaussian), half, np.nan)
+        return mean - half, mean + half
 
 
 def outer6(u: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:

@@ -74,11 +74,11 @@ from __future__ import annotations
 import numpy as np
 
 from .._backend import backend_name, numba_kernels
-from .._tensors import principal_from_shape_operator
+from .._tensors import principal_from_mean_gaussian, principal_from_shape_operator
 from ..geometry import robust_mean_edge_length, vertex_edge_lengths
 from ..jets import fit_jet_normals, fit_jets
 from ..lattice import voxel_grid
-from ..neighborhoods import ball_face_sums, check_radius, default_radii
+from ..neighborhoods import ball_face_sums, check_radius, default_radii, small_radius_note
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -318,8 +318,8 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
         np.where(valid[:, None], shape_operator, 0.0), frame_normals)
     with np.errstate(invalid="ignore", divide="ignore"):
         gaussian = summed[:, 2] / area
-    half_difference = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
-    return mean - half_difference, mean + half_difference, dir_min, dir_max, normals, valid
+    k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
+    return k_min, k_max, dir_min, dir_max, normals, valid
 
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
@@ -363,4 +363,5 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     if fields is None:
         raise RuntimeError("default_radii gave no group")
     k_min, k_max, dir_min, dir_max, normals, valid = fields
-    return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects)
+    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology)
+    return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, (small,))

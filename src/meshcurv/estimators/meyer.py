@@ -30,7 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import corner_angles, corner_cotangents, degenerate_faces, face_cross_products, mixed_voronoi_corner_areas, vertex_normals
+from .._tensors import principal_from_mean_gaussian
+from ..geometry import (corner_angles, corner_cotangents, degenerate_faces, face_cross_products,
+                        mixed_voronoi_corner_areas, vertex_normals)
 from ..topology import MeshTopology
 from ._common import Stages
 from ._defects import mesh_defects
@@ -76,9 +78,8 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, stages: Stages):
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = -np.einsum("ij,ij->i", laplace, normals) / (4 * areas)
         gaussian = defect / areas
-    half_difference = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
+    k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
     directions = np.full((n, 3), np.nan)
     extra = (f"{int(needles.sum())} needle faces (a corner angle that rounds to zero: a vertex far from its "
              "neighbours); their vertices have no cotangent Laplacian",) if needles.any() else ()
-    return finish("meyer", {}, valid, normals, mean - half_difference, mean + half_difference,
-                  directions, directions.copy(), defects, extra)
+    return finish("meyer", {}, valid, normals, k_min, k_max, directions, directions.copy(), defects, extra)

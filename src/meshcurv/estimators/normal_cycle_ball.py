@@ -39,7 +39,7 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from ..geometry import edge_dihedral_angles
-from ..neighborhoods import ball_edge_sums, ball_face_sums, default_radii, resolve_radius
+from ..neighborhoods import ball_edge_sums, ball_face_sums, default_radii, resolve_radius, small_radius_note
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -54,6 +54,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         groups = default_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
+    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology)
     cross, degenerate, defects, normals, valid = prepare(vertices, topology)
 
     stages.start("compute edge tensors")
@@ -84,4 +85,4 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
     return finish("normal_cycle_ball", parameters, valid, normals, k_min, k_max, dir_min, dir_max,
-                  defects)
+                  defects, (small,))

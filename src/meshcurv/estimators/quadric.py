@@ -45,7 +45,7 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, MIN_POINTS, fit_jets, shape_operators
-from ..neighborhoods import default_radii, resolve_radius
+from ..neighborhoods import default_radii, resolve_radius, small_radius_note
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -67,6 +67,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         groups = default_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
+    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology)
     _, _, defects, normals, valid = prepare(vertices, topology)
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     facing = np.where(valid[:, None], normals, np.nan)
@@ -106,4 +107,5 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
-    return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects, extra)
+    return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects,
+                  (*extra, small))
