@@ -435,19 +435,21 @@ def make_case(seed: int, index: int):
         if isinstance(method, str) and method in METHODS:  # keep most calls well-formed in their options
             if method not in BALL_METHODS and "radius" in kwargs and rng.random() < 0.8:
                 del kwargs["radius"]
-            if method not in SMOOTHING_METHODS and "smoothing_steps" in kwargs and rng.random() < 0.8:
+            if not (isinstance(method, str) and method in SMOOTHING_METHODS) and "smoothing_steps" in kwargs \
+                    and rng.random() < 0.8:
                 del kwargs["smoothing_steps"]
         vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
         ff, flabel = wrap_faces(rng, f) if rng.random() < 0.3 else (f, "array")
         labels += [f"vertices:{vlabel}", f"faces:{flabel}"]
         if vlabel == "array" and flabel == "array" and len(labels) == 3 and labels[0] in TRUTH \
-                and method in BALL_METHODS and kwargs.get("radius") is not None and rng.random() < 0.5:
+                and isinstance(method, str) and method in BALL_METHODS and kwargs.get("radius") is not None \
+                and rng.random() < 0.5:
             labels.append(f"relation truth of {labels[0]}")
             return target, (vv, ff), kwargs, labels, ("truth", labels[0])
         if vlabel == "array" and flabel == "array" and kwargs.get("radius") is None and rng.random() < 0.5 \
                 and all(label.startswith(("noise", "flipped", "faces removed", "vertices permuted")) for label in labels[1:-2]):
             relation = ["scale", "scale", "permute", "unreferenced", "translate"][int(rng.integers(5))]
-            if relation == "permute" and method == "matgeom":  # matGeom's pairing on open meshes follows the order
+            if relation == "permute" and isinstance(method, str) and method == "matgeom":  # matGeom's pairing on open meshes follows the order
                 relation = "translate"
             if relation == "scale":  # inside the documented coordinate range (about 1e-70 to 1e70)
                 clean = ("scale", float(rng.choice([2.0**-60, 2.0**40, 1e-30, 1e-8, 1e8, 1e30])))

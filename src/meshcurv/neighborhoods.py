@@ -168,22 +168,20 @@ def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
     return radius
 
 
-#: A given radius below this many median edge lengths is questionable: most balls then hold little more than
-#: their own vertex's corner (a sphere of 200 random vertices: icc has 60 of them off by more than half the
-#: curvature at 0.2 edge lengths, 26 at 0.35, none at 0.7).
-SMALL_RADIUS_EDGES = 0.5
+def small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopology, minimum_edges: float) -> str:
+    """The warning's sentence for a given ``radius`` below ``minimum_edges`` median edge lengths, else ''.
 
-
-def small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopology) -> str:
-    """The warning's sentence for a given ``radius`` below :data:`SMALL_RADIUS_EDGES` median edges, else ''."""
+    Each ball method states its own minimum (``RADIUS_WARNING_EDGES`` of its
+    module), measured where its balls start holding too little of the surface.
+    """
     if not topology.n_faces:
         return ""
     median = median_edge_length(vertices, topology.edges)
-    if not radius < SMALL_RADIUS_EDGES * median:
+    if not radius < minimum_edges * median:
         return ""
-    return (f"`radius` {radius:g} is {radius / median:.2g} of the median edge length {median:g}: each ball holds "
-            f"little more than its vertex's own corner, so the curvatures are far off; pass a radius of a few "
-            f"edge lengths, in the units of the vertices (or leave the default)")
+    return (f"`radius` {radius:g} is {radius / median:.2g} of the median edge length {median:g}: below "
+            f"{minimum_edges:g} edge lengths the balls hold too little of the surface and many curvatures are far "
+            f"off; pass a radius of a few edge lengths, in the units of the vertices (or leave the default)")
 
 
 def resolve_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:

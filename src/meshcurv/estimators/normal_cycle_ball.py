@@ -46,6 +46,11 @@ from ._support import finish, prepare
 
 STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve curvatures")
 
+#: A given radius below this many median edge lengths is named in the warning: on random spheres of 200
+#: and 2,000 vertices 10% of the vertices are off by more than half the curvature at one edge, 24-28% at
+#: 0.7, none or 0.15% from 1.5 (the default is 2.5 mean edges).
+RADIUS_WARNING_EDGES = 1.5
+
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
     """Normal-cycle tensor over balls of radius ``radius``. Returns ``(result, problems)``."""
@@ -54,7 +59,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         groups = default_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
-    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology)
+    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology, RADIUS_WARNING_EDGES)
     cross, degenerate, defects, normals, valid = prepare(vertices, topology)
 
     stages.start("compute edge tensors")

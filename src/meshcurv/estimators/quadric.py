@@ -52,6 +52,10 @@ from ._support import finish, prepare
 
 STAGES = ("compute normals", "fit jets", "retrieve curvatures")
 
+#: A given radius below this many median edge lengths is named in the warning (besides the count of balls
+#: with too few points): a degree-4 jet needs 15 points, which a ball of one edge length rarely holds.
+RADIUS_WARNING_EDGES = 1.0
+
 
 def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
     """Weighted jet fits over balls of radius ``radius``. Returns ``(result, problems)``.
@@ -67,7 +71,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         groups = default_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
-    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology)
+    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology, RADIUS_WARNING_EDGES)
     _, _, defects, normals, valid = prepare(vertices, topology)
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     facing = np.where(valid[:, None], normals, np.nan)
