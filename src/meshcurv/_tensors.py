@@ -16,7 +16,7 @@ __all__ = ["outer6", "apply6", "tangent_basis", "principal_from_shape_operator",
 def principal_from_mean_gaussian(mean: np.ndarray, gaussian: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``k_min, k_max = H -/+ sqrt(max(H^2 - K, 0))`` without overflow.
 
-    ``H`` and ``K`` are scaled by the power of two nearest ``max(|H|, sqrt|K|)``
+    ``H`` and ``K`` are scaled by the power of two just above ``max(|H|, sqrt|K|)``
     before squaring (exact: the same numbers wherever ``H^2`` is a normal
     float), so that the curvatures of a mesh at 1e-200 (about 1e200) are
     finite rather than infinite. NaN where ``H`` or ``K`` is NaN or infinite.
