@@ -389,3 +389,15 @@ def test_a_command_run_without_the_session_says_how_to_run_it():
     assert isinstance(result.exception, RuntimeError)
     assert "no meshcurv Session in the click context: run the commands through meshcurv.cli.main" in str(
         result.exception)
+
+
+def test_a_quad_mesh_is_triangulated_once_and_said_once(capsys, tmp_path):
+    # a cube of six quads: the CLI triangulates it once and hands the topology to the estimate
+    corners = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+    quads = [(1, 2, 4, 3), (5, 6, 8, 7), (1, 5, 7, 3), (2, 4, 8, 6), (1, 2, 6, 5), (3, 7, 8, 4)]
+    path = tmp_path / "cube.obj"
+    path.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "".join(f"f {a} {b} {c} {d}\n"
+                                                                                 for a, b, c, d in quads))
+    code, out, err = run(capsys, "compute", path, "-m", "normal_cycle")
+    assert code == 0 and "8 vertices, 6 faces" in out
+    assert err.count("forces triangulation") == 1, err

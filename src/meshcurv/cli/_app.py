@@ -111,8 +111,7 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
             write_curvatures(output, got.vertices, got.faces, got.result, fields=fields, quality=quality,
                              overwrite=overwrite, source=mesh, binary=not ascii_)
     if output is None:
-        faces = np.zeros((0, 3), dtype=np.int64) if got.cloud else got.faces
-        click.echo(_summary(mesh, got.vertices, faces, got.result, fields))
+        click.echo(_summary(mesh, got.vertices, 0 if got.cloud else len(got.faces), got.result, fields))
         return
     written = fields or list(FIELDS)
     hint = (" (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
@@ -121,13 +120,13 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
                  f"{', '.join(written)} (quality = {quality}){hint}")
 
 
-def _summary(path, vertices, faces, result, fields) -> str:
+def _summary(path, vertices, n_faces: int, result, fields) -> str:
     """The summary table of ``meshcurv compute``: per-vertex and area-weighted statistics, then the integrals."""
     from ..integrals import weighted_statistics
 
     parameters = ", ".join(f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
                            for key, value in result.parameters.items())
-    size = f"{len(vertices)} vertices, {len(faces)} faces" if len(faces) else f"{len(vertices)} points"
+    size = f"{len(vertices)} vertices, {n_faces} faces" if n_faces else f"{len(vertices)} points"
     lines = [f"{path}: {size}; method {result.method}"
              + (f" ({parameters})" if parameters else "")]
     values = curvature_fields(result, fields=[f for f in (fields or SCALAR_FIELDS) if f in SCALAR_FIELDS],
@@ -142,7 +141,7 @@ def _summary(path, vertices, faces, result, fields) -> str:
             continue
         row = [finite.min(), *np.percentile(finite, [5, 25, 50, 75, 95]), finite.max(), finite.mean()]
         lines.append(f"{name:<12}" + "".join(f"{value:>11.4g}" for value in row))
-    if len(faces):
+    if n_faces:
         weighted = ["p5", "p25", "median", "p75", "p95", "mean"]
         lines.append("area-weighted (each vertex counts by its area: a third of its faces)")
         lines.append(f"{'field':<12}" + "".join(f"{name:>11}" for name in weighted))
@@ -250,9 +249,10 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
         raise click.BadParameter(f"the picture is a PNG; got {output.name!r}", param_hint="'-o'")
     check_output(output, overwrite=overwrite, source=mesh)
     with estimated(mesh, method, smoothing_steps, radius, orient, session, "draw") as got:
-        vertices, triangles, result, cloud = got.vertices, got.triangles, got.result, got.cloud
+        vertices, result, cloud = got.vertices, got.result, got.cloud
+        triangles = None if got.topology is None else got.topology.faces
         if "auto" in views:
-            closed = cloud or not MeshTopology.from_faces(triangles, len(vertices)).boundary_edges.any()
+            closed = got.topology is None or not got.topology.boundary_edges.any()
             auto = ["front", "left", "back"] if closed else ["iso"]
             views = [view for name in views for view in (auto if name == "auto" else [name])]
         chosen = ""

@@ -24,6 +24,7 @@ from ..io import is_point_cloud, read_mesh, read_points
 from ..io.fields import FIELDS
 from ..pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
 from ..smoothing import MAX_SMOOTHING_STEPS
+from ..topology import MeshTopology
 
 __all__ = ["Session", "current_session", "common_options", "method_options", "estimated"]
 
@@ -198,7 +199,7 @@ def method_options(function):
     return function
 
 
-def _estimate(vertices, faces, method, options, bar, *, offset):
+def _estimate(vertices, faces, method, options, bar):
     given = {name: value for name, value in options.items() if value is not None}
     takes = ESTIMATORS[method].options
     for name in given:
@@ -207,7 +208,7 @@ def _estimate(vertices, faces, method, options, bar, *, offset):
             raise click.UsageError(f"method {method!r} does not take --{name.replace('_', '-')} "
                                    f"(its options: {accepted})")
     return principal_curvatures(vertices, faces, method=method, **given,
-                                progress=lambda stage, index, total: bar(stage, index, total, offset=offset))
+                                progress=lambda stage, index, total: bar(stage, index, total, offset=1))
 
 
 def _percentiles(ctx, param, value):
@@ -261,8 +262,8 @@ class Estimated(NamedTuple):
     vertices: np.ndarray
     #: The faces as read (polygons kept, for writing them back); None for a point cloud.
     faces: object
-    #: The faces as triangles (V-indexed (F, 3)); None for a point cloud.
-    triangles: np.ndarray | None
+    #: The mesh's topology (its faces as triangles: ``topology.faces``); None for a point cloud.
+    topology: MeshTopology | None
     result: object
     cloud: bool
 
@@ -292,15 +293,16 @@ def estimated(path, method, smoothing_steps, radius, orient, session: Session, l
         bar("read")
         if cloud:
             vertices, normals = read_points(path)
-            faces = triangles = None
+            faces = topology = None
             result = point_cloud_curvatures(vertices, normals=normals, radius=radius,
                                             method=method if given_method else None)
         else:
             vertices, faces = read_mesh(path)
-            triangles = as_faces(faces, len(vertices))
+            # triangulated (and warned about) once: the estimate takes the topology as it is
+            topology = MeshTopology.from_faces(as_faces(faces, len(vertices)), len(vertices))
             options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
-            result = _estimate(vertices, faces, method, options, bar, offset=1)
+            result = _estimate(vertices, topology, method, options, bar)
         bar(last_stage, len(stages))
-        yield Estimated(vertices, faces, triangles, result, cloud)
+        yield Estimated(vertices, faces, topology, result, cloud)
     finally:
         bar.close()

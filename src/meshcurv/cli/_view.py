@@ -56,7 +56,8 @@ def view(mesh, output, field, method, smoothing_steps, radius, orient, up, perce
     check_output(output, overwrite=overwrite, source=mesh)
     check_input(mesh)
     with estimated(mesh, method, smoothing_steps, radius, orient, session, "page") as got:
-        vertices, faces, result = got.vertices, got.triangles, got.result
+        vertices, result = got.vertices, got.result
+        faces = None if got.topology is None else got.topology.faces
         write_html(output, vertices, faces, result, field=field, title=title or mesh.name,
                    up=None if up == "auto" else up, percentiles=percentiles, max_directions=max_directions,
                    length_unit=length_unit, overwrite=overwrite, source=mesh)
