@@ -393,3 +393,14 @@ def test_a_radius_below_an_edge_is_named_in_the_warning(method):
         warnings.simplefilter("always")
         meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method, radius=1.6 * median)
     assert not any("too little of the surface" in str(w.message) for w in seen)
+
+
+@pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
+def test_the_default_radius_of_a_voxel_surface_is_not_named_as_given(method):
+    pytest.importorskip("skimage")
+    sphere = shapes.voxel_sphere(2.0, spacing=(1.0, 1.0, 1.0))  # tight: the voxel default is one voxel
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method)
+    assert result.parameters["surface"] == "voxel"
+    assert not any("too little of the surface" in str(w.message) for w in seen)

@@ -15,6 +15,7 @@ from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._common import ProgressCallback, Stages
 from .estimators.icc import voxel_surface_radius
 from .geometry import degenerate_faces
+from .neighborhoods import small_radius_note
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import INVALID_REASONS, CurvatureResult, Surface
 from .topology import MeshTopology
@@ -200,6 +201,9 @@ def principal_curvatures(
     result, problems = estimator.function(
         points, topology, stages=Stages(estimator.stages, progress), **options
     )
+    if radius is not None and estimator.radius_warning_edges is not None:  # given, not a default
+        note = small_radius_note(result.parameters["radius"], points, topology, estimator.radius_warning_edges)
+        problems = [*problems, note] if note else problems
     diagnosis = diagnose(points, topology, n_flipped_faces=n_flipped)
     reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
     parameters = {**result.parameters, **found, "orient": orient,

@@ -31,6 +31,10 @@ class Estimator:
         One line for ``meshcurv methods``.
     stages : tuple of str
         The stages it reports, in order.
+    radius_warning_edges : float or None
+        A ``radius`` given below this many median edge lengths is named in the
+        call's warning (:func:`meshcurv.neighborhoods.small_radius_note`); None
+        for the methods without a radius.
     """
 
     name: str
@@ -38,6 +42,7 @@ class Estimator:
     options: dict
     summary: str
     stages: tuple
+    radius_warning_edges: float | None = None
 
 
 ESTIMATORS: dict[str, Estimator] = {
@@ -61,6 +66,7 @@ ESTIMATORS: dict[str, Estimator] = {
         options={"radius": None},
         summary="interpolated corrected curvature measures over a ball, normals from jets (Lachaud et al. 2020), in 1/length",
         stages=icc.STAGES,
+        radius_warning_edges=icc.RADIUS_WARNING_EDGES,
     ),
     "quadric": Estimator(
         name="quadric",
@@ -68,6 +74,7 @@ ESTIMATORS: dict[str, Estimator] = {
         options={"radius": None},
         summary="weighted degree-4 jet fit over a ball, normal re-estimated (Cazals & Pouget 2005; Panozzo et al. 2010)",
         stages=quadric.STAGES,
+        radius_warning_edges=quadric.RADIUS_WARNING_EDGES,
     ),
     "rusinkiewicz": Estimator(
         name="rusinkiewicz",
@@ -82,6 +89,7 @@ ESTIMATORS: dict[str, Estimator] = {
         options={"radius": None},
         summary="normal-cycle tensor over a ball (Cohen-Steiner & Morvan 2003), in 1/length",
         stages=normal_cycle_ball.STAGES,
+        radius_warning_edges=normal_cycle_ball.RADIUS_WARNING_EDGES,
     ),
     "meyer": Estimator(
         name="meyer",

@@ -78,7 +78,7 @@ from .._tensors import principal_from_mean_gaussian, principal_from_shape_operat
 from ..geometry import robust_mean_edge_length, vertex_edge_lengths
 from ..jets import fit_jet_normals, fit_jets
 from ..lattice import voxel_grid
-from ..neighborhoods import ball_face_sums, check_radius, default_radii, small_radius_note
+from ..neighborhoods import ball_face_sums, check_radius, default_radii
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -120,7 +120,8 @@ NOISE_GAIN = 9.0
 #: The noise level of a larger mesh is measured on this many of its vertices, evenly spaced in index order.
 NOISE_SAMPLE = 65536
 
-#: A given radius below this many median edge lengths is named in the warning: on random spheres of 200
+#: A given radius below this many median edge lengths is named in the warning (the registry's
+#: ``radius_warning_edges``): on random spheres of 200
 #: and 2,000 vertices 15-16% of the vertices are off by more than half the curvature at 0.35 edges, 0-0.7% at
 #: 0.5, none from 0.7 (the default is one mean edge on a clean mesh).
 RADIUS_WARNING_EDGES = 0.6
@@ -369,5 +370,4 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     if fields is None:
         raise RuntimeError("default_radii gave no group")
     k_min, k_max, dir_min, dir_max, normals, valid = fields
-    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology, RADIUS_WARNING_EDGES)
-    return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, (small,))
+    return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects)

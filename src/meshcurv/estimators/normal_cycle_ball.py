@@ -39,14 +39,15 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from ..geometry import edge_dihedral_angles
-from ..neighborhoods import ball_edge_sums, ball_face_sums, default_radii, resolve_radius, small_radius_note
+from ..neighborhoods import ball_edge_sums, ball_face_sums, default_radii, resolve_radius
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
 
 STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve curvatures")
 
-#: A given radius below this many median edge lengths is named in the warning: on random spheres of 200
+#: A given radius below this many median edge lengths is named in the warning (the registry's
+#: ``radius_warning_edges``): on random spheres of 200
 #: and 2,000 vertices 10% of the vertices are off by more than half the curvature at one edge, 24-28% at
 #: 0.7, none or 0.15% from 1.5 (the default is 2.5 mean edges).
 RADIUS_WARNING_EDGES = 1.5
@@ -59,7 +60,6 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         groups = default_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
-    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology, RADIUS_WARNING_EDGES)
     cross, degenerate, defects, normals, valid = prepare(vertices, topology)
 
     stages.start("compute edge tensors")
@@ -90,4 +90,4 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
     return finish("normal_cycle_ball", parameters, valid, normals, k_min, k_max, dir_min, dir_max,
-                  defects, (small,))
+                  defects)

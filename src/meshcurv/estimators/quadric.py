@@ -45,14 +45,15 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, MIN_POINTS, fit_jets, shape_operators
-from ..neighborhoods import default_radii, resolve_radius, small_radius_note
+from ..neighborhoods import default_radii, resolve_radius
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
 
 STAGES = ("compute normals", "fit jets", "retrieve curvatures")
 
-#: A given radius below this many median edge lengths is named in the warning (besides the count of balls
+#: A given radius below this many median edge lengths is named in the warning (the registry's
+#: ``radius_warning_edges``) (besides the count of balls
 #: with too few points): a degree-4 jet needs 15 points, which a ball of one edge length rarely holds.
 RADIUS_WARNING_EDGES = 1.0
 
@@ -71,7 +72,6 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
         groups = default_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
-    small = "" if radius is None else small_radius_note(groups[0][0], vertices, topology, RADIUS_WARNING_EDGES)
     _, _, defects, normals, valid = prepare(vertices, topology)
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     facing = np.where(valid[:, None], normals, np.nan)
@@ -111,5 +111,4 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
-    return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects,
-                  (*extra, small))
+    return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects, extra)
