@@ -7,12 +7,14 @@ asserted too, so that a change of a reader shows here and in
 :data:`meshcurv.io.fields.VIEWERS`.
 """
 
+import importlib.util
 import json
 import subprocess
 import sys
 import textwrap
 
 import numpy as np
+
 import pytest
 
 import meshcurv
@@ -195,6 +197,15 @@ def test_read_fields_errors(tmp_path):
     bad.write_text("vertex,x,y,z,k_min\n0,1,2,3,high\n")
     with pytest.raises(MeshFileError, match=r"bad\.csv: cannot be read as a table of numbers"):
         read_fields(bad)
+    truncated = tmp_path / "cut.npz"
+    truncated.write_bytes(b"PK\x03\x04 not a whole zip")
+    with pytest.raises(MeshFileError, match=r"cut\.npz: cannot be read as NPZ"):
+        read_fields(truncated)
+    if importlib.util.find_spec("meshio") is not None:
+        broken = tmp_path / "broken.vtu"
+        broken.write_text("<VTKFile type='UnstructuredGrid'><Unstructured")  # meshio.read would sys.exit
+        with pytest.raises(MeshFileError, match=r"broken\.vtu: cannot be read as VTU"):
+            read_fields(broken)
 
 
 def test_every_recommended_extension_is_written_by_meshcurv():

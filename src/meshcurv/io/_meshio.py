@@ -62,20 +62,29 @@ def check_stl(path) -> None:
         )
 
 
+def read_meshio_file(path, file_format: str):
+    """The ``meshio.Mesh`` of a file, read by the format's own reader (``meshio.vtu.read``, ...).
+
+    Not ``meshio.read``, which prints and calls ``sys.exit(1)`` when a reader
+    fails: any failure is one :class:`MeshFileError` naming the file.
+    """
+    reader = getattr(_meshio(), file_format).read
+    try:
+        # errstate: meshio's STL reader tests for binary by multiplying a uint32 header count
+        with _to_log(), np.errstate(over="ignore"):
+            return reader(str(path))
+    except Exception as exc:  # any parser failure becomes one readable error naming the file
+        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise MeshFileError(f"{path}: cannot be read as {file_format.upper()} ({reason})") from exc
+
+
 def read_with_meshio(path, file_format: str):
     """Read the vertices and the surface faces (triangles, quads, polygons) of a mesh file.
 
     Calls the format's own reader (``meshio.ply.read``, ...): ``meshio.read``
     prints and calls ``sys.exit(1)`` when a reader fails.
     """
-    reader = getattr(_meshio(), file_format).read
-    try:
-        # errstate: meshio's STL reader tests for binary by multiplying a uint32 header count
-        with _to_log(), np.errstate(over="ignore"):
-            mesh = reader(str(path))
-    except Exception as exc:  # any parser failure becomes one readable error naming the file
-        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise MeshFileError(f"{path}: cannot be read as {file_format.upper()} ({reason})") from exc
+    mesh = read_meshio_file(path, file_format)
     blocks = [np.asarray(block.data, dtype=np.int64) for block in mesh.cells if block.type in _SURFACE_CELLS]
     points = np.asarray(mesh.points, dtype=np.float64)
     if not blocks or sum(len(b) for b in blocks) == 0:

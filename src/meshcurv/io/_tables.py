@@ -83,8 +83,12 @@ def _check_members(path, archive: zipfile.ZipFile) -> None:
             )
 
 
-def read_npz(path):
-    """Read ``vertices`` and ``faces`` back from an NPZ file written by :func:`write_npz`."""
+def npz_arrays(path, keep) -> tuple[dict, list[str]]:
+    """``({name: array}, names)``: the arrays of an NPZ file whose name ``keep(name)`` accepts, and all names.
+
+    Members are checked before numpy allocates them (:func:`_check_members`);
+    any zip, zlib or npy failure is one :class:`MeshFileError` naming the file.
+    """
     try:
         with open(path, "rb") as handle:
             with zipfile.ZipFile(handle) as archive:
@@ -92,12 +96,17 @@ def read_npz(path):
             handle.seek(0)
             with np.load(handle, allow_pickle=False) as archive:
                 names = sorted(archive.files)
-                arrays = {name: archive[name] for name in names if name.startswith(("vertices", "face"))}
+                return {name: archive[name] for name in names if keep(name)}, names
     except (MeshFileError, MemoryError):
         raise
     except Exception as exc:  # zip, zlib, npy header, tokenizer errors: all one kind for the caller
         reason = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else type(exc).__name__
         raise MeshFileError(f"{path}: cannot be read as NPZ ({reason})") from exc
+
+
+def read_npz(path):
+    """Read ``vertices`` and ``faces`` back from an NPZ file written by :func:`write_npz`."""
+    arrays, names = npz_arrays(path, lambda name: name.startswith(("vertices", "face")))
     if "vertices" not in arrays or not ({"faces"} <= set(arrays) or {"face_corners", "face_sizes"} <= set(arrays)):
         raise MeshFileError(f"{path}: an NPZ mesh needs arrays named 'vertices' and 'faces'; found {names}")
     if "faces" in arrays:

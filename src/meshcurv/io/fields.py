@@ -170,12 +170,9 @@ def _vtp_fields(path):
 
 
 def _npz_fields(path):
-    try:
-        with np.load(path, allow_pickle=False) as archive:
-            return {name: archive[name] for name in archive.files
-                    if name not in ("vertices", "faces", "face_corners", "face_sizes")}
-    except (OSError, ValueError) as exc:
-        raise MeshFileError(f"{path}: cannot be read as NPZ ({exc})") from exc
+    from ._tables import npz_arrays
+
+    return npz_arrays(path, lambda name: name not in ("vertices", "faces", "face_corners", "face_sizes"))[0]
 
 
 def _csv_fields(path):
@@ -191,15 +188,9 @@ def _csv_fields(path):
 
 
 def _meshio_fields(path):
-    from ._meshio import _meshio, _to_log
+    from ._meshio import read_meshio_file
 
-    meshio = _meshio()
-    try:
-        with _to_log():
-            mesh = meshio.read(str(path))
-    except Exception as exc:  # any parser failure: one readable error naming the file
-        raise MeshFileError(f"{path}: cannot be read ({str(exc).strip()[:200] or type(exc).__name__})") from exc
-    return dict(mesh.point_data)
+    return dict(read_meshio_file(path, path.suffix.lower()[1:]).point_data)
 
 
 def _regrouped(columns: dict) -> dict[str, np.ndarray]:
