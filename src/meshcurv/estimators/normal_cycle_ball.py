@@ -8,7 +8,7 @@ The formula of :mod:`meshcurv.estimators.normal_cycle` over the ball
     T(v) = \\frac{1}{|B \\cap S|} \\sum_{e} \\beta(e)\\, |e \\cap B|\\, \\bar e \\bar e^T
 
 ``beta(e)`` is the signed dihedral angle of edge ``e`` (positive where the surface
-bends away from its normals; :func:`~meshcurv.estimators.normal_cycle.edge_dihedral_angles`),
+bends away from its normals; :func:`~meshcurv.geometry.edge_dihedral_angles`),
 ``|e ∩ B|`` the exact length of the edge inside the ball and ``|B ∩ S|`` the
 area of the mesh inside the ball (each face weighted by its approximate share,
 :func:`meshcurv.neighborhoods.face_in_ball_ratios`). Cohen-Steiner and Morvan
