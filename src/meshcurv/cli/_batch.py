@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import pathlib
-import sys
 
 import click
 
@@ -75,9 +74,7 @@ def batch(inputs, out_dir, method, smoothing_steps, radius, orient, output_forma
         raise click.UsageError("--workers sizes the local cluster; leave it out with --scheduler "
                                "(the cluster's own workers are used)")
     session = current_session()
-    stream = sys.stderr
-    show = session.progress if session.progress is not None else stream.isatty()
-    bar = BatchBar(stream if show else None, tty=stream.isatty())
+    bar = session.bar(BatchBar)
     try:
         summary = run(list(inputs), out_dir, method=method, smoothing_steps=smoothing_steps, radius=radius,
                       orient=orient, output_format=output_format, workers=workers, scheduler=scheduler,

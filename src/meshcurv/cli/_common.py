@@ -86,41 +86,12 @@ class Session:
         if self.verbose - self.quiet >= 0:
             click.echo(f"meshcurv: {text}", err=True)
 
-    def bar(self, stages):
-        """A :class:`StageBar` for these stages, or a silent one (not a terminal, or --no-progress)."""
+    def bar(self, kind, *args):
+        """A ``kind`` progress bar (:class:`ProgressBar` subclass) on stderr, silent when not wanted:
+        stderr not a terminal, or ``--no-progress``. ``args`` go before its stream."""
         stream = sys.stderr
         show = self.progress if self.progress is not None else stream.isatty()
-        return StageBar(stages, stream if show else None, tty=stream.isatty())
-
-
-class StageBar:
-    """A progress bar over named stages, on stderr: redrawn in place on a terminal, one line per stage otherwise."""
-
-    def __init__(self, stages, stream, *, tty: bool, width: int = 24):
-        self.stages = list(stages)
-        self.stream = stream
-        self.tty = tty
-        self.width = width
-        self.done = 0
-
-    def __call__(self, stage: str, index: int | None = None, total: int | None = None, *, offset: int = 0):
-        if self.stream is None:
-            return
-        position = offset + (index if index is not None else self.stages.index(stage) + 1)
-        count = len(self.stages)
-        filled = round(self.width * (position - 1) / count)
-        text = f"[{'#' * filled}{'.' * (self.width - filled)}] {position}/{count} {stage}"
-        if self.tty:
-            self.stream.write(f"\r\033[K{text}")
-        else:
-            self.stream.write(f"meshcurv: {text}\n")
-        self.stream.flush()
-        self.done = position
-
-    def close(self) -> None:
-        if self.stream is not None and self.tty and self.done:
-            self.stream.write("\r\033[K")
-            self.stream.flush()
+        return kind(*args, stream if show else None, tty=stream.isatty())
 
 
 def current_session(ctx: click.Context | None = None) -> Session:
@@ -241,8 +212,9 @@ class ProgressBar:
         self.width = width
         self._shown: object = None  # what the subclass last drew (None: nothing yet)
 
-    def _draw(self, done: int, total: int, tail: str) -> None:
-        filled = round(self.width * done / total) if total else self.width
+    def _draw(self, done: int, total: int, tail: str, *, filled: int | None = None) -> None:
+        if filled is None:
+            filled = round(self.width * done / total) if total else self.width
         text = f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} {tail}"
         if self.tty:
             self.stream.write(f"\r\033[K{text}")
@@ -254,6 +226,22 @@ class ProgressBar:
         if self.stream is not None and self.tty and self._shown is not None:
             self.stream.write("\r\033[K")
             self.stream.flush()
+
+
+class StageBar(ProgressBar):
+    """Progress over named stages: ``[###.....] 2/6 fit normals``, the bar filled up to the stage begun."""
+
+    def __init__(self, stages, stream, *, tty: bool, width: int = 24):
+        super().__init__(stream, tty=tty, width=width)
+        self.stages = list(stages)
+
+    def __call__(self, stage: str, index: int | None = None, total: int | None = None, *, offset: int = 0):
+        if self.stream is None:
+            return
+        position = offset + (index if index is not None else self.stages.index(stage) + 1)
+        count = len(self.stages)
+        self._draw(position, count, stage, filled=round(self.width * (position - 1) / count))
+        self._shown = position
 
 
 class Estimated(NamedTuple):
@@ -288,7 +276,7 @@ def estimated(path, method, smoothing_steps, radius, orient, session: Session, l
         raise click.UsageError(f"method {method!r} is for point clouds; {path} is a mesh (methods: "
                                f"{', '.join(ESTIMATORS)})")
     stages = ["read", *([] if cloud else ESTIMATORS[method].stages), last_stage]
-    bar = session.bar(stages)
+    bar = session.bar(StageBar, stages)
     try:
         bar("read")
         if cloud:

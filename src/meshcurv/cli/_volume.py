@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import pathlib
-import sys
 import warnings
 
 import click
@@ -133,9 +132,7 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
                                                  method=method, radius=radius,
                                                  keep_surfaces=mesh_format is not None or picture,
                                                  workers=workers)
-    stream = sys.stderr
-    show = session.progress if session.progress is not None else stream.isatty()
-    bar = LabelBar(stream if show else None, tty=stream.isatty())
+    bar = session.bar(LabelBar)
     rows, drawn = [], []
     try:
         for row, surface in labels:
