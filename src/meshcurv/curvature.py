@@ -8,9 +8,9 @@ import warnings
 import numpy as np
 
 from ._adapters import mesh_arrays
-from ._validation import as_faces, as_vertices, check_choice, check_int_option, check_positive_float
+from ._validation import as_vertices, check_choice, check_int_option, check_positive_float
 from .diagnosis import diagnose, quality_message
-from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
+from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._common import ProgressCallback, Stages
 from .estimators.icc import voxel_surface_radius
@@ -18,7 +18,7 @@ from .geometry import degenerate_faces
 from .neighborhoods import small_radius_note
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import INVALID_REASONS, CurvatureResult, Surface
-from .topology import MeshTopology
+from .topology import MeshTopology, as_topology
 from .weld import weld_vertices
 
 __all__ = ["principal_curvatures", "METHODS"]
@@ -181,7 +181,7 @@ def principal_curvatures(
     if faces is None:
         vertices, faces = mesh_arrays(vertices)
     points = as_vertices(vertices)
-    topology = _as_topology(faces, points.shape[0])
+    topology = as_topology(faces, points.shape[0], stacklevel=3)
     check_choice(orient, "orient", ORIENT_CHOICES)
     if orient == "auto":
         orient = "keep" if method == "matgeom" else "outward"
@@ -270,14 +270,3 @@ def _expanded(result: CurvatureResult, index: np.ndarray) -> CurvatureResult:
     fields = {name: getattr(result, name)[index]
               for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason")}
     return dataclasses.replace(result, **fields)
-
-
-def _as_topology(faces, n_vertices: int) -> MeshTopology:
-    if isinstance(faces, MeshTopology):
-        if faces.n_vertices != n_vertices:
-            raise InvalidMeshError(
-                f"`faces` is a MeshTopology of {faces.n_vertices} vertices but `vertices` has "
-                f"{n_vertices} rows"
-            )
-        return faces
-    return MeshTopology._build(as_faces(faces, n_vertices, stacklevel=4), n_vertices)

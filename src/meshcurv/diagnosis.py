@@ -13,11 +13,11 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ._backend import numba_kernels
-from ._validation import check_int_option
+from ._validation import as_vertices, check_int_option
 from .errors import InvalidMeshError
 from .geometry import (DEGENERATE_AREA_RATIO, checked_topology_points, degenerate_face_mask, degenerate_faces,
                        edge_lengths, face_cross_products, vertex_length_scales)
-from .topology import MeshTopology
+from .topology import MeshTopology, as_topology
 
 #: Edges no longer than this times the length scale of their component (its median
 #: edge length, :func:`meshcurv.geometry.vertex_length_scales`) count as zero-length.
@@ -176,10 +176,8 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     """
     if not isinstance(topology, MeshTopology) and not isinstance(topology, (str, bytes)) \
             and hasattr(topology, "__len__"):  # a face array or polygon list: its topology
-        from ._validation import as_faces, as_vertices
-
-        points = as_vertices(vertices)
-        topology = MeshTopology.from_faces(as_faces(topology, points.shape[0]), points.shape[0])
+        vertices = as_vertices(vertices)
+        topology = as_topology(topology, vertices.shape[0])
     vertices = checked_topology_points(vertices, topology)
     n_flipped_faces = check_int_option(n_flipped_faces, "n_flipped_faces", maximum=topology.n_faces)
     faces = topology.faces

@@ -22,9 +22,9 @@ from __future__ import annotations
 import numpy as np
 
 from ._backend import numba_kernels
-from ._validation import as_faces, as_vertices, check_choice
-from .errors import InvalidMeshError, InvalidOptionError
-from .topology import MeshTopology
+from ._validation import as_vertices, check_choice
+from .errors import InvalidOptionError
+from .topology import MeshTopology, as_topology
 
 __all__ = ["orient_faces", "ORIENT_CHOICES"]
 
@@ -92,17 +92,8 @@ def orient_faces(vertices, faces, *, outward: bool = True) -> tuple[np.ndarray, 
     """
     if not isinstance(outward, (bool, np.bool_)):
         raise InvalidOptionError(f"`outward` must be True or False; got {outward!r}")
-    if isinstance(faces, MeshTopology):
-        topology = faces
-        points = as_vertices(vertices)
-        if topology.n_vertices != points.shape[0]:
-            raise InvalidMeshError(
-                f"`faces` is a MeshTopology of {topology.n_vertices} vertices but `vertices` has "
-                f"{points.shape[0]} rows"
-            )
-    else:
-        points = as_vertices(vertices)
-        topology = MeshTopology._build(as_faces(faces, points.shape[0]), points.shape[0])
+    points = as_vertices(vertices)
+    topology = as_topology(faces, points.shape[0])
     flip = face_flips(points, topology, outward=outward)
     oriented = np.array(topology.faces, dtype=np.int64, copy=True)
     oriented[flip] = oriented[flip][:, [0, 2, 1]]

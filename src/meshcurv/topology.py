@@ -442,3 +442,27 @@ def _bowtie_vertices(topology: MeshTopology) -> np.ndarray:
 def _readonly(array: np.ndarray) -> np.ndarray:
     array.flags.writeable = False
     return array
+
+
+def as_topology(faces, n_vertices: int, *, stacklevel: int = 3) -> MeshTopology:
+    """``faces`` (an (F, 3) array, polygons, or a :class:`MeshTopology`) as the topology of ``n_vertices`` vertices.
+
+    Faces are checked and triangulated by :func:`meshcurv._validation.as_faces`
+    (its warning attributed ``stacklevel`` frames up); a topology is taken as
+    it is once its vertex count matches.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``faces`` unusable, or a MeshTopology of another vertex count.
+    """
+    from ._validation import as_faces
+
+    if isinstance(faces, MeshTopology):
+        if faces.n_vertices != n_vertices:
+            raise InvalidMeshError(
+                f"`faces` is a MeshTopology of {faces.n_vertices} vertices but `vertices` has "
+                f"{n_vertices} rows"
+            )
+        return faces
+    return MeshTopology._build(as_faces(faces, n_vertices, stacklevel=stacklevel + 1), n_vertices)
