@@ -763,6 +763,46 @@ def check_face_measures(name):
     assert_sums_close(got[:, :3], expected[:, :3], magnitude, 3)
 
 
+def check_curvatures_from_measures(name):
+    from meshcurv._tensors import apply6
+    from meshcurv.estimators import icc
+
+    vertices, faces = mesh(name)
+    normals = icc_normals(name)
+    measures = icc.face_measures(vertices, faces, normals)
+    # each vertex's measures summed over its faces (the 1-ring ball), and rows the step must leave NaN
+    summed = np.zeros((vertices.shape[0], 9))
+    for k in range(3):
+        np.add.at(summed, faces[:, k], np.nan_to_num(measures))
+    summed[1::50, 0] = 0.0  # no corrected area
+    summed[2::50, 0] *= -1.0  # negative corrected area
+    summed[3::50, 1] = np.inf  # an infinite mean curvature measure: k NaN, directions finite
+    summed = np.ascontiguousarray(summed)
+    with use_backend("numpy"):
+        expected = icc.curvatures_from_measures(summed, normals)
+    got = kernels("icc").curvatures_from_measures(summed, normals)
+    # k: the same divisions, frexp/ldexp scaling and square root (exact operations in both)
+    for label, got_k, expected_k in zip(("k_min", "k_max"), got[:2], expected[:2]):
+        np.testing.assert_array_equal(got_k, expected_k, err_msg=label)
+    assert np.isnan(got[0][1::50]).all() and np.isnan(got[0][2::50]).all() and np.isnan(got[0][::97]).all()
+    # the directions: _tangent_eigen of the shape operator -sym(mu^{X,Y}) / mu_0, within the bounds of
+    # check_principal_from_shape_operator (the same closed form against NumPy's einsum association)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tensor = -summed[:, 3:] / summed[:, :1]
+    magnitude = np.abs(tensor).max(axis=1)
+    finite = np.isfinite(expected[2]).all(axis=1)
+    # the eigen-gap of the tangent restriction, d_max . T d_max - d_min . T d_min: a direction is within
+    # a few eps of |T| / gap (its condition number); an umbilic (gap 0) is the same frame on both sides
+    d_min, d_max = expected[2][finite], expected[3][finite]
+    gap = (np.einsum("ij,ij->i", d_max, apply6(tensor[finite], d_max))
+           - np.einsum("ij,ij->i", d_min, apply6(tensor[finite], d_min)))
+    atol = np.where(gap > 0, 16 * EPS * magnitude[finite] / np.where(gap > 0, gap, 1.0), 4 * EPS)
+    branch = atan2_branch(expected[3][finite], normals[finite], atol)
+    for got_d, expected_d in zip(got[2:], expected[2:]):
+        np.testing.assert_array_equal(np.isnan(got_d), np.isnan(expected_d))
+        assert_directions_close(got_d[finite], expected_d[finite], atol, name, up_to_sign=branch)
+
+
 # -- neighbourhoods -----------------------------------------------------------------------------
 
 
@@ -1195,6 +1235,7 @@ TWINS = [
          check_matgeom_principal, MESHES),
     Twin("smoothing.smooth_over_neighbours", "smoothing.smooth_vertex_field", check_smooth_over_neighbours, MESHES),
     Twin("icc.face_measures", "icc.face_measures", check_face_measures, MESHES),
+    Twin("icc.curvatures_from_measures", "icc.curvatures_from_measures", check_curvatures_from_measures, MESHES),
     Twin("neighborhoods.vertex_face_lists", "a stable sort of the corners (no twin in the library)",
          check_vertex_face_lists, MESHES),
     Twin("neighborhoods.cell_centres", "the centres and reach of neighborhoods._ball_sums", check_cell_centres,

@@ -10,8 +10,8 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._pointcloud_normals import grid_of
-from ._tensors import principal_from_mean_gaussian, principal_from_shape_operator
-from .estimators.icc import face_measures
+from ._tensors import principal_from_shape_operator
+from .estimators.icc import curvatures_from_measures, face_measures
 from .jets import fit_jets, jet_normals, shape_operators
 
 #: Degree of the jets of ``method="jets"`` (Cazals and Pouget 2005: error of order ``r^(d-1)``).
@@ -245,19 +245,11 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
             summed = compiled(points, normals, index, counts.astype(np.int64), pattern)
         else:
             summed = _triangle_sums(points, normals, index, counts, pattern)
-        area = summed[:, 0]
-        good = area > 0
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mean = summed[:, 1] / (2 * area)
-            gaussian = summed[:, 2] / area
-            shape_operator = -summed[:, 3:] / area[:, None]
-        # rows without area (a ball of collinear points) are NaN here and left out below
-        k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
-        _, _, dir_min, dir_max = principal_from_shape_operator(
-            np.where(good[:, None], shape_operator, 0.0), normals[chunk[rows]])
-        target = chunk[rows[good]]
-        out[0][target] = k_min[good]
-        out[1][target] = k_max[good]
-        out[2][target] = dir_min[good]
-        out[3][target] = dir_max[good]
+        # rows without area (a ball of collinear points) are NaN and stay so
+        k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals[chunk[rows]])
+        target = chunk[rows]
+        out[0][target] = k_min
+        out[1][target] = k_max
+        out[2][target] = dir_min
+        out[3][target] = dir_max
     return (*out, normals)

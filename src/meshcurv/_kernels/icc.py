@@ -1,5 +1,5 @@
-"""Compiled twin of :func:`meshcurv.estimators.icc.face_measures`: the corrected curvature measures of
-every face.
+"""Compiled twins of :mod:`meshcurv.estimators.icc`: the corrected curvature measures of every face, and
+the curvatures of their sums over balls.
 """
 
 from __future__ import annotations
@@ -7,7 +7,10 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+import math
+
 from ._common import _JIT
+from .tensors import _principal_from_mean_gaussian, _tangent_eigen
 
 
 @nb.njit(inline="always", **_JIT)
@@ -58,3 +61,25 @@ def face_measures(vertices, faces, normals):
         out[f, 0], out[f, 1], out[f, 2], out[f, 3], out[f, 4], out[f, 5] = m0, m1, m2, m3, m4, m5
         out[f, 6], out[f, 7], out[f, 8] = m6, m7, m8
     return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def curvatures_from_measures(summed, normals):
+    """``icc.curvatures_from_measures``: (N,) k_min, k_max and (N, 3) dir_min, dir_max of summed measures."""
+    n = summed.shape[0]
+    k_min = np.full(n, np.nan)
+    k_max = np.full(n, np.nan)
+    dir_min = np.full((n, 3), np.nan)
+    dir_max = np.full((n, 3), np.nan)
+    for i in nb.prange(n):
+        area = summed[i, 0]
+        nx, ny, nz = normals[i, 0], normals[i, 1], normals[i, 2]
+        if not (area > 0 and math.isfinite(nx) and math.isfinite(ny) and math.isfinite(nz)):
+            continue
+        k_min[i], k_max[i] = _principal_from_mean_gaussian(summed[i, 1] / (2 * area), summed[i, 2] / area)
+        _, _, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
+            -summed[i, 3] / area, -summed[i, 4] / area, -summed[i, 5] / area, -summed[i, 6] / area,
+            -summed[i, 7] / area, -summed[i, 8] / area, nx, ny, nz, False, False)
+        dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
+        dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5
+    return k_min, k_max, dir_min, dir_max

@@ -37,6 +37,19 @@ def _tangent_eigen(xx, yy, zz, xy, xz, yz, nx, ny, nz, rotate, mean_from_trace):
     return half_sum - radius, half_sum + radius, acx, acy, acz, alx, aly, alz
 
 
+@nb.njit(inline="always", **_JIT)
+def _principal_from_mean_gaussian(mean, gaussian):
+    """``_tensors.principal_from_mean_gaussian`` of one vertex: ``k_min, k_max`` (the same operations)."""
+    size = max(abs(mean), math.sqrt(abs(gaussian)))
+    exponent = math.frexp(size if math.isfinite(size) and size > 0 else 1.0)[1]
+    scale = math.ldexp(1.0, exponent)
+    h, k = mean / scale, gaussian / scale / scale
+    half = scale * math.sqrt(max(h * h - k, 0.0))
+    if not (math.isfinite(mean) and math.isfinite(gaussian)):
+        half = math.nan
+    return mean - half, mean + half
+
+
 @nb.njit(parallel=True, **_JIT)
 def principal_from_shape_operator(tensor, normals, rotate, mean_from_trace):
     """``_tensors.principal_from_shape_operator``: (N,) k_min, k_max and (N, 3) dir_min, dir_max."""

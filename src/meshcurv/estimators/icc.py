@@ -80,7 +80,7 @@ from ..jets import fit_jet_normals, fit_jets
 from ..lattice import voxel_grid
 from ..neighborhoods import ball_face_sums, check_radius, default_radii
 from ..topology import MeshTopology
-from ._common import Stages
+from ._common import Stages, nan_where
 from ._support import finish, prepare
 
 #: Degree of the jets whose normals the measures interpolate.
@@ -157,6 +157,33 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
     sym = np.stack([m[:, 0, 0], m[:, 1, 1], m[:, 2, 2], 0.5 * (m[:, 0, 1] + m[:, 1, 0]),
                     0.5 * (m[:, 0, 2] + m[:, 2, 0]), 0.5 * (m[:, 1, 2] + m[:, 2, 1])], axis=1)
     return np.column_stack([mu0, mu1, mu2, sym])
+
+
+def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
+    """``k_min, k_max, dir_min, dir_max`` of (N, 9) corrected measures summed over balls (rows of :func:`face_measures`).
+
+    ``H = mu_1 / (2 mu_0)``, ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``
+    (:func:`meshcurv._tensors.principal_from_mean_gaussian`), and the
+    directions of the shape operator ``-sym(mu^{X,Y}) / mu_0`` restricted to
+    the plane normal to each row of ``normals`` (N, 3), unit. All NaN in a row
+    whose corrected area ``mu_0`` is not positive or whose normal is not finite.
+    One pass with the compiled kernels.
+    """
+    kernels = numba_kernels("icc")
+    if kernels is not None:
+        return kernels.curvatures_from_measures(np.ascontiguousarray(summed, dtype=np.float64),
+                                                np.ascontiguousarray(normals, dtype=np.float64))
+    area = summed[:, 0]
+    good = (area > 0) & np.isfinite(normals).all(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = summed[:, 1] / (2 * area)
+        gaussian = summed[:, 2] / area
+        shape_operator = -summed[:, 3:] / area[:, None]
+    k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
+    _, _, dir_min, dir_max = principal_from_shape_operator(np.where(good[:, None], shape_operator, 0.0),
+                                                           np.where(good[:, None], normals, [0.0, 0.0, 1.0]))
+    nan_where(~good, k_min, k_max, dir_min, dir_max)
+    return k_min, k_max, dir_min, dir_max
 
 
 def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, radius: float, *,
@@ -319,17 +346,8 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
     summed = ball_face_sums(vertices, faces, radius, measures, usable=None if kept.all() else kept, connected=True)
 
     start("retrieve curvatures")
-    area = summed[:, 0]
-    valid = valid & (area > 0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = summed[:, 1] / (2 * area)
-        shape_operator = -summed[:, 3:] / area[:, None]
-    frame_normals = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
-    _, _, dir_min, dir_max = principal_from_shape_operator(
-        np.where(valid[:, None], shape_operator, 0.0), frame_normals)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        gaussian = summed[:, 2] / area
-    k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
+    k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
+    valid = valid & np.isfinite(k_min)
     return k_min, k_max, dir_min, dir_max, normals, valid
 
 
