@@ -36,8 +36,9 @@ def prepare(vertices: np.ndarray, topology: MeshTopology):
     cross = face_cross_products(vertices, topology.faces)
     degenerate = degenerate_faces(vertices, topology, cross=cross)
     defects = defects_without_boundary(topology, degenerate)
-    kept = ~degenerate
-    normals = vertex_normals(vertices, topology.faces[kept], cross=cross[kept])
+    # a degenerate face's cross product adds +0 instead (the same sums), without copies of the faces
+    used = np.where(degenerate[:, None], 0.0, cross) if degenerate.any() else cross
+    normals = vertex_normals(vertices, topology.faces, cross=used)
     valid = ~defects.invalid_vertices & np.isfinite(normals).all(axis=1)
     return cross, degenerate, defects, normals, valid
 
