@@ -9,6 +9,9 @@ import numpy as np
 
 from ._common import _JIT
 
+#: :func:`build_edges` counts the sides of at most this many ranges of faces at once ((ranges, V) int64 counts).
+_BUCKET_CHUNKS = 8
+
 
 @nb.njit(parallel=True, **_JIT)
 def build_edges(faces, n_vertices, n_chunks):
@@ -17,42 +20,50 @@ def build_edges(faces, n_vertices, n_chunks):
     Sides are bucketed by their smaller vertex (counting sort), each bucket is
     sorted by (larger vertex, direction) with a stable insertion sort, so the
     edges come out in lexicographic order, as ``np.unique`` would give them.
-    Each thread buckets the sides of its own range of vertices (scanning all
-    faces), then sorts and numbers the buckets of its vertices; the edge numbers
-    come from a prefix sum of the edges per vertex. ``n_chunks``: the number of
-    vertex ranges (one per thread, ``_backend.kernel_threads()``).
+    Each of ``n_chunks`` threads (at most :data:`_BUCKET_CHUNKS`) counts, then
+    places, the sides of its own range of faces: a vertex's bucket holds the
+    sides of the first range, then of the next, each in face order (the order
+    of one pass over all faces, whatever the number of threads). The buckets
+    are then sorted and numbered by vertex; the edge numbers come from a prefix
+    sum of the edges per vertex.
     """
     n_faces = faces.shape[0]
-    n_chunks = max(1, min(n_chunks, n_vertices))
-    bounds = np.empty(n_chunks + 1, np.int64)
-    for c in range(n_chunks + 1):
-        bounds[c] = (n_vertices * c) // n_chunks
-    bucket_start = np.zeros(n_vertices + 1, np.int64)
+    n_chunks = max(1, min(n_chunks, _BUCKET_CHUNKS, n_faces))
+    # cursor[c, v]: sides of face range c at vertex v, then where range c's next such side goes
+    cursor = np.zeros((n_chunks, n_vertices), np.int64)
     for c in nb.prange(n_chunks):
-        first, last = bounds[c], bounds[c + 1]
-        for f in range(n_faces):
+        for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
             for k in range(3):
                 a = faces[f, k]
                 b = faces[f, (k + 1) % 3]
-                low = min(a, b)
-                if a != b and first <= low < last:
-                    bucket_start[low + 1] += 1
-    for i in range(n_vertices):
-        bucket_start[i + 1] += bucket_start[i]
+                if a != b:
+                    cursor[c, min(a, b)] += 1
+    bucket_start = np.zeros(n_vertices + 1, np.int64)
+    for v in nb.prange(n_vertices):
+        total = 0
+        for c in range(n_chunks):
+            total += cursor[c, v]
+        bucket_start[v + 1] = total
+    for v in range(n_vertices):
+        bucket_start[v + 1] += bucket_start[v]
+    for v in nb.prange(n_vertices):
+        at = bucket_start[v]
+        for c in range(n_chunks):
+            count = cursor[c, v]
+            cursor[c, v] = at
+            at += count
     n_sides = bucket_start[n_vertices]
     sort_key = np.empty(n_sides, np.int64)  # 2 * larger vertex + backward
     side_of = np.empty(n_sides, np.int64)
-    fill = bucket_start[:-1].copy()
     for c in nb.prange(n_chunks):
-        first, last = bounds[c], bounds[c + 1]
-        for f in range(n_faces):
+        for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
             for k in range(3):
                 a = faces[f, k]
                 b = faces[f, (k + 1) % 3]
-                low = min(a, b)
-                if a != b and first <= low < last:
-                    slot = fill[low]
-                    fill[low] += 1
+                if a != b:
+                    low = min(a, b)
+                    slot = cursor[c, low]
+                    cursor[c, low] += 1
                     sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
                     side_of[slot] = 3 * f + k
     edges_before = np.zeros(n_vertices + 1, np.int64)

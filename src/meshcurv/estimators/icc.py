@@ -339,7 +339,8 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
                                  adjacency=adjacency)
 
     start("compute face measures")
-    kept = ~degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)
+    finite = np.isfinite(normals).all(axis=1)
+    kept = ~degenerate if finite.all() else ~degenerate & finite[faces].all(axis=1)
     measures = face_measures(vertices, faces, normals)  # rows of the faces left out are not read
 
     start("sum over balls")
