@@ -361,10 +361,9 @@ def check_bowtie_vertices(name):
     # the inputs hold what they are meant to: the two spheres' contact, the fin's ends, the hole's pinches
     assert (expected.sum() > 1) if name == "defects" else not expected.any()
     linked = (top.edge_face_counts == 2) & (top.edge_faces[:, 0] != top.edge_faces[:, 1])  # as the wrapper
-    for chunks in (kernel_threads(), 3):
-        got = kernels("topology").bowtie_vertices(top.faces, top.edges, top.edge_faces, linked, ~top.degenerate_faces,
-                                                  top.n_vertices, chunks)
-        np.testing.assert_array_equal(got, expected, err_msg=f"{chunks} chunks")
+    got = kernels("topology").bowtie_vertices(top.faces, top.face_edges, top.edge_faces, linked,
+                                              ~top.degenerate_faces, top.n_vertices)
+    np.testing.assert_array_equal(got, expected)
 
 
 def check_count_components(name):

@@ -254,8 +254,8 @@ class MeshTopology:
         if kernels is None:
             return _readonly(_bowtie_vertices(self))
         linked = (self.edge_face_counts == 2) & (self.edge_faces[:, 0] != self.edge_faces[:, 1])
-        return _readonly(kernels.bowtie_vertices(self.faces, self.edges, self.edge_faces, linked,
-                                                 ~self.degenerate_faces, self.n_vertices, kernel_threads()))
+        return _readonly(kernels.bowtie_vertices(self.faces, self.face_edges, self.edge_faces, linked,
+                                                 ~self.degenerate_faces, self.n_vertices))
 
     @cached_property
     def degenerate_faces(self) -> np.ndarray:

@@ -139,49 +139,72 @@ def _corner_at(faces, f, v):
     return 3 * f + 2
 
 
+@nb.njit(inline="always", **_JIT)
+def _position(faces, f, v):
+    """The position (0, 1 or 2) of vertex ``v`` in face ``f``."""
+    if faces[f, 0] == v:
+        return 0
+    if faces[f, 1] == v:
+        return 1
+    return 2
+
+
+@nb.njit(inline="always", **_JIT)
+def _fan_walk(faces, face_edges, edge_faces, linked, proper, v, f, side):
+    """Faces reached from face ``f`` at vertex ``v`` leaving through its side ``side`` (an edge at ``v``),
+    face to face across linked edges around ``v``, until ``f`` comes back or a side that is not linked
+    stops the walk: ``(faces reached, f not counted; whether f came back)``."""
+    start = f
+    reached = 0
+    while True:
+        e = face_edges[f, side]
+        if not linked[e]:
+            return reached, False
+        g = edge_faces[e, 0] if edge_faces[e, 1] == f else edge_faces[e, 1]
+        if not proper[g]:
+            return reached, False
+        if g == start:
+            return reached, True
+        reached += 1
+        q = _position(faces, g, v)
+        # g's two sides at v are (q, q + 1) and (q + 2, q): leave through the one it was not entered by
+        side = (q + 2) % 3 if face_edges[g, q] == e else q
+        f = g
+
+
 @nb.njit(parallel=True, **_JIT)
-def bowtie_vertices(faces, edges, edge_faces, linked, proper, n_vertices, n_chunks):
+def bowtie_vertices(faces, face_edges, edge_faces, linked, proper, n_vertices):
     """Vertices whose face corners fall in more than one fan (see MeshTopology.bowtie_vertices).
 
-    Union-find over the ``3 F`` corners: at each end of a linked edge (two
-    faces, both without a repeated vertex) the corners of its two faces are
-    joined. Corners are only ever joined to corners at the same vertex, so each
-    of ``n_chunks`` threads does the joins and the finds at its own range of
-    vertices.
+    A corner at ``v`` is joined to another across each of its two sides at
+    ``v`` whose edge is linked (two faces, both without a repeated vertex): at
+    most two joins per corner, so each fan is a chain or a cycle of faces. The
+    fan of one corner of every vertex is walked face to face around the vertex
+    (both ways when it is a chain) and the vertex is a bow-tie when the walk
+    reaches fewer than its proper corners. One pass over the faces counts the
+    corners; the walks run in parallel, one vertex each.
     """
-    n_corners = 3 * faces.shape[0]
-    parent = np.empty(n_corners, np.int64)
-    for c in nb.prange(n_corners):
-        parent[c] = c
-    n_chunks = max(1, min(n_chunks, n_vertices))
-    root_of = np.full(n_vertices, -1, np.int64)
-    several = np.zeros(n_vertices, np.bool_)
-    for chunk in nb.prange(n_chunks):
-        first = (n_vertices * chunk) // n_chunks
-        last = (n_vertices * (chunk + 1)) // n_chunks
-        for e in range(edges.shape[0]):
-            if not linked[e]:
-                continue
-            f1, f2 = edge_faces[e, 0], edge_faces[e, 1]
-            if not (proper[f1] and proper[f2]):
-                continue
-            for v in (edges[e, 0], edges[e, 1]):
-                if first <= v < last:
-                    ra = _find(parent, _corner_at(faces, f1, v))
-                    rb = _find(parent, _corner_at(faces, f2, v))
-                    if ra != rb:
-                        parent[max(ra, rb)] = min(ra, rb)
-        for f in range(faces.shape[0]):
-            if not proper[f]:
-                continue
+    n_faces = faces.shape[0]
+    corners = np.zeros(n_vertices, np.int64)
+    first = np.full(n_vertices, -1, np.int64)
+    for f in range(n_faces):
+        if proper[f]:
             for k in range(3):
                 v = faces[f, k]
-                if first <= v < last:
-                    r = _find(parent, 3 * f + k)
-                    if root_of[v] < 0:
-                        root_of[v] = r
-                    elif root_of[v] != r:
-                        several[v] = True
+                corners[v] += 1
+                if first[v] < 0:
+                    first[v] = f
+    several = np.zeros(n_vertices, np.bool_)
+    for v in nb.prange(n_vertices):
+        f = first[v]
+        if f < 0:
+            continue
+        p = _position(faces, f, v)
+        ahead, closed = _fan_walk(faces, face_edges, edge_faces, linked, proper, v, f, p)
+        reached = 1 + ahead
+        if not closed:  # a chain: the other way too
+            reached += _fan_walk(faces, face_edges, edge_faces, linked, proper, v, f, (p + 2) % 3)[0]
+        several[v] = reached < corners[v]
     return several
 
 
