@@ -371,9 +371,6 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     ``connected`` (faces only): with the compiled kernels, the faces of the
     surface-connected piece of each ball (see :func:`ball_face_sums`).
     """
-    import scipy.sparse as sp
-    from scipy.spatial import cKDTree
-
     vertices, cells = _checked_cells(vertices, cells)
     radius = _checked_radius_value(radius)
     values = np.asarray(values, dtype=np.float64)
@@ -420,6 +417,9 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
                     return sums
                 out += sums
             continue
+        import scipy.sparse as sp  # the NumPy path only: scipy.spatial costs 0.1 s to import
+        from scipy.spatial import cKDTree
+
         tree = cKDTree(centres[group])
         index = np.arange(cells.shape[0])[group]  # group position -> cell
         chunk_size = max(1, min(CHUNK, int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
