@@ -226,6 +226,33 @@ def test_jets_fitted_at_chosen_centres(backend):
 
 @pytest.mark.parametrize("connected", [False, True])
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_compact_jets_are_the_rows_of_their_centres(backend, connected):
+    # compact=True: one row per centre, in the order given (unsorted, repeats), equal to those rows of
+    # the fit with one row per vertex; details["away"] likewise
+    from meshcurv.jets import fit_jets
+    from meshcurv.topology import MeshTopology
+
+    mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=2)
+    normals = mesh.vertices / np.linalg.norm(mesh.vertices, axis=1, keepdims=True)
+    adjacency = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).neighbour_lists if connected else None
+    centres = np.array([40, 3, 3, 3, 17, 3, mesh.vertices.shape[0] - 1])  # a centre listed twice in a row
+    with use_backend(backend):
+        full_details, details = {}, {}
+        full = fit_jets(mesh.vertices, normals, 0.4, degree=3, centres=centres, facing=normals, adjacency=adjacency,
+                        details=full_details)
+        rows = fit_jets(mesh.vertices, normals, 0.4, degree=3, centres=centres, facing=normals, adjacency=adjacency,
+                        details=details, compact=True)
+    assert rows[0].shape == (centres.size, 6) and rows[2].shape == (centres.size,)
+    assert np.isfinite(rows[0]).all()
+    np.testing.assert_array_equal(rows[0], full[0][centres])
+    for got, expected in zip(rows[1], full[1]):
+        np.testing.assert_array_equal(got, expected[centres])
+    np.testing.assert_array_equal(rows[2], full[2][centres])
+    np.testing.assert_array_equal(details["away"], full_details["away"][centres])
+
+
+@pytest.mark.parametrize("connected", [False, True])
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
 def test_settled_fits_keep_their_first_fit(backend, connected):
     # a centre whose first fit has a slope c10^2 + c01^2 below `settled` keeps that fit and its
     # frame (the result of one iteration); every other centre gets its two iterations

@@ -1022,6 +1022,13 @@ def check_fit_jets(name):
             assert 0 < np.isnan(expected[0][centres]).any(axis=1).sum() < centres.size // 2, label
 
 
+def spread(rows, centres, n, fill):
+    """(n, ...) rows of all vertices from the rows of ``centres``, ``fill`` elsewhere."""
+    out = np.full((n, *rows.shape[1:]), fill)
+    out[centres] = rows
+    return out
+
+
 def check_fit_jets_connected(name):
     from meshcurv import jets
 
@@ -1043,7 +1050,11 @@ def check_fit_jets_connected(name):
         arguments = (points, normals, float(radius), degree, jets.ITERATIONS, jets._exponents(degree), jets.MIN_PIVOT,
                      centres, kernel_threads(), np.ones(n, dtype=bool) if mask is None else mask, indptr, indices,
                      facing if check else points, check, jets.AWAY_FRACTION)
-        coefficients, t1, t2, normal, counts, away = compiled(*arguments, False)
+        # one row per centre: spread to rows of all vertices (NaN, counts 0, elsewhere) as NumPy gives them
+        rows = compiled(*arguments, False)
+        assert all(row.shape[0] == centres.size for row in rows)
+        coefficients, t1, t2, normal, counts, away = (spread(row, centres, n, 0.0 if k == 4 else np.nan)
+                                                      for k, row in enumerate(rows))
         label = f"degree {degree}, {'all' if mask is None else 'some'} allowed, facing {check}"
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
         compare_jets((coefficients, (t1, t2, normal), counts), expected, label,
@@ -1051,7 +1062,7 @@ def check_fit_jets_connected(name):
         np.testing.assert_array_equal(away, details["away"], err_msg=f"{label}: away")
         # normals only: the unit normals of the same fits (jets.jet_normals), at the centres, NaN elsewhere;
         # frame-free, so compared everywhere, within the fits' tolerance (the coefficients' largest)
-        fitted = compiled(*arguments, True)[0]
+        fitted = spread(compiled(*arguments, True)[0], centres, n, np.nan)
         with use_backend("numpy"):
             expected_normals = jets.jet_normals(expected[0], expected[1])
         np.testing.assert_array_equal(np.isnan(fitted), np.isnan(expected_normals), err_msg=f"{label}: normals only")

@@ -199,7 +199,8 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
 def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
              iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
              neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
-             details: dict | None = None, adjacency: tuple | None = None, settled: float = 0.0):
+             details: dict | None = None, adjacency: tuple | None = None, settled: float = 0.0,
+             compact: bool = False):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
     Parameters
@@ -245,6 +246,10 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
         A fit whose slope ``c10^2 + c01^2`` is below this ends the iterations
         of its vertex: its normal is within ``atan(sqrt(settled))`` of the
         frame's, and it is kept with that frame. 0: ``iterations`` fits everywhere.
+    compact : bool, default: False
+        One row per centre, in the order of ``centres``, instead of one per
+        vertex (a fit at a few centres of a large mesh then allocates no row
+        for the others; ``details["away"]`` likewise).
 
     Returns
     -------
@@ -255,6 +260,8 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
         ``t1, t2, n``: the frame of the last fit.
     counts : ndarray of shape (V,)
         Points with non-zero weight in each ball.
+
+    With ``compact``, M rows for the M ``centres`` instead of V.
 
     Raises
     ------
@@ -267,6 +274,7 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     normals = np.ascontiguousarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
         raise InvalidMeshError(f"`normals` must have shape {vertices.shape}; got {normals.shape}")
+    every_vertex = centres is None  # the rows of the centres are those of all vertices
     centres = np.arange(n) if centres is None else np.asarray(centres, dtype=np.int64).ravel()
     if centres.size and (centres.min() < 0 or centres.max() >= n):
         raise InvalidMeshError(f"`centres` must be vertex indices in 0..{n - 1}")
@@ -287,32 +295,29 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     kernels = numba_kernels("jets")
     if kernels is not None and n:
         n_calls = max(1, min(centres.size, int(np.ceil(mean * centres.size / PAIRS_PER_CALL))))
-        # the first call's outputs (the rows of the others' centres filled in from theirs)
-        outputs: list[np.ndarray] | None = None
         if adjacency is not None:
             allowed = np.ones(n, dtype=bool) if neighbours is None else neighbours
             indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
             if indptr.shape != (n + 1,):
                 raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
+        pieces = []  # each call's outputs, one row per centre of its part
         for call in range(n_calls):  # Python between calls: Ctrl-C gets through
-            part = centres[call * centres.size // n_calls:(call + 1) * centres.size // n_calls]
+            lo, hi = call * centres.size // n_calls, (call + 1) * centres.size // n_calls
+            part = centres[lo:hi]
             if adjacency is not None:
-                found = kernels.fit_jets_connected(
+                pieces.append(kernels.fit_jets_connected(
                     vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
                     kernel_threads(), allowed, indptr, indices, facing if check else vertices, check, AWAY_FRACTION,
-                    False, float(settled))
-            else:
-                found = kernels.fit_jets(
+                    False, float(settled)))
+            else:  # rows of all vertices: those of the part taken (a slice when the centres are all vertices)
+                pieces.append(tuple(output[lo:hi] if every_vertex else output[part] for output in kernels.fit_jets(
                     vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
-                    64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION, float(settled))
-            if outputs is None:
-                outputs = list(found)
-                continue
-            for whole, piece in zip(outputs, found):
-                whole[part] = piece[part]
-        if outputs is None:
-            raise RuntimeError("no kernel call ran (n_calls >= 1)")
-        coefficients, t1, t2, normal, counts, away = outputs
+                    64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION,
+                    float(settled))))
+        rows = [column[0] if len(column) == 1 else np.concatenate(column) for column in zip(*pieces)]
+        if not compact and not every_vertex:
+            rows = [_all_rows(row, centres, n, 0.0 if k == 4 else np.nan) for k, row in enumerate(rows)]
+        coefficients, t1, t2, normal, counts, away = rows
         if details is not None:
             details["away"] = away
         return coefficients, (t1, t2, normal), counts
@@ -357,9 +362,19 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
             f[index] = part
         coefficients[index] = fitted
         counts[index] = count
+    if compact:
+        coefficients, frame, counts, away = (coefficients[centres], [f[centres] for f in frame], counts[centres],
+                                             away[centres])
     if details is not None:
         details["away"] = away
     return coefficients, tuple(frame), counts
+
+
+def _all_rows(rows: np.ndarray, centres: np.ndarray, n: int, fill: float) -> np.ndarray:
+    """(V, ...) rows of all vertices from the rows of ``centres``; ``fill`` elsewhere."""
+    out = np.full((n, *rows.shape[1:]), fill)
+    out[centres] = rows
+    return out
 
 
 def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
@@ -392,19 +407,14 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *,
     centres = np.arange(n)
     mean, _ = check_ball_work(vertices[allowed], radius, n, centres=vertices)
     n_calls = max(1, min(n, int(np.ceil(mean * n / PAIRS_PER_CALL))))
-    fitted: np.ndarray | None = None
+    pieces = []  # the normals of each call's part of the vertices, in order
     for call in range(n_calls):  # Python between calls: Ctrl-C gets through
         part = centres[call * n // n_calls:(call + 1) * n // n_calls]
-        found = kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations, _exponents(degree),
-                                           MIN_PIVOT, part, kernel_threads(), allowed, indptr, indices, vertices,
-                                           False, AWAY_FRACTION, True, float(settled))[0]
-        if fitted is None:
-            fitted = found
-        else:
-            fitted[part] = found[part]
-    if fitted is None:
-        raise RuntimeError("no kernel call ran (n_calls >= 1)")
-    return fitted
+        pieces.append(kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations,
+                                                 _exponents(degree), MIN_PIVOT, part, kernel_threads(), allowed,
+                                                 indptr, indices, vertices, False, AWAY_FRACTION, True,
+                                                 float(settled))[0])
+    return pieces[0] if len(pieces) == 1 else np.concatenate(pieces)
 
 
 def jet_normals(coefficients: np.ndarray, frame: tuple) -> np.ndarray:

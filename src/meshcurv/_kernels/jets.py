@@ -354,18 +354,20 @@ def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents,
     CSR) instead of on a grid: no search structure over all the points is
     built, so a fit at a few centres costs only their balls. Only ``allowed``
     (V,) vertices enter the balls. ``n_chunks``: three (V,) int64 arrays each.
-    With ``normals_only``, returns ``(fitted, ...)``: the (V, 3) unit normals of
+    The outputs have one row per centre, in the order of ``centres`` (a fit at
+    a few centres of a large mesh writes no row for the others).
+    With ``normals_only``, returns ``(fitted, ...)``: the (M, 3) unit normals of
     the fitted jets, ``(n - c10 t1 - c01 t2) / sqrt(1 + c10^2 + c01^2)`` as
     ``jets.jet_normals`` computes them (NaN where no fit), and one-row
-    placeholders for the other outputs (136 bytes per vertex never written).
+    placeholders for the other outputs (136 bytes per centre never written).
     A fit whose slope ``c10^2 + c01^2`` is below ``settled`` ends the
     iterations of its vertex (its normal is within ``atan(sqrt(settled))`` of
     the frame's normal); with 0, every vertex has ``iterations`` fits.
     """
     n = vertices.shape[0]
     m = centres.shape[0]
-    coefficients, t1s, t2s, ns, counts, away = _jet_outputs(1 if normals_only else n)
-    fitted = np.full((n if normals_only else 1, 3), np.nan)
+    coefficients, t1s, t2s, ns, counts, away = _jet_outputs(1 if normals_only else m)
+    fitted = np.full((m if normals_only else 1, 3), np.nan)
     ids = np.arange(n)
     n_terms = exponents.shape[0]
     n_chunks = max(min(m, n_chunks), 1)
@@ -377,10 +379,10 @@ def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents,
         c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row: unpacked once, not per vertex
         for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
             v = centres[i]
-            size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, members, queue)
+            size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, i, members, queue)
             if not normals_only:
                 work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v,
-                                v, members, size, work, moments, right, matrix, low, scale, solution, coefficients,
+                                i, members, size, work, moments, right, matrix, low, scale, solution, coefficients,
                                 t1s, t2s, ns, counts, ids, facing, check_facing, away_fraction, away, settled)
                 continue
             c[0, :] = np.nan  # a failed fit leaves the row as it finds it
@@ -390,7 +392,7 @@ def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents,
             p, q = c[0, 1], c[0, 2]
             width = np.sqrt(1 + p * p + q * q)
             for k in range(3):
-                fitted[v, k] = (nn[0, k] - p * a[0, k] - q * b[0, k]) / width
+                fitted[i, k] = (nn[0, k] - p * a[0, k] - q * b[0, k]) / width
     if normals_only:
         return fitted, t1s, t2s, ns, counts, away
     return coefficients, t1s, t2s, ns, counts, away

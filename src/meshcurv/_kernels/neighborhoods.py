@@ -162,7 +162,7 @@ def _segment_meets_ball(ax, ay, az, bx, by, bz, radius2):
 
 
 @nb.njit(**_JIT)
-def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, members, queue):
+def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, stamp, members, queue):
     """The vertices of the surface-connected piece of the ball ``B(x_v, cutoff)`` written to ``members``.
 
     Breadth-first from ``v`` over the edges ``indptr, indices`` (CSR) that meet
@@ -173,8 +173,10 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, memb
     from face to face through edges that meet it, and every edge of a face
     meets the ball at a corner shared with the next such edge); vertices of
     another sheet of the surface (the far side of a part thinner than the
-    ball) are left out. ``mark`` (V,) holds, per vertex, the last centre that
-    queued it (no clearing between centres); ``queue`` is scratch. ``members``
+    ball) are left out. ``mark`` (V,) holds, per vertex, the ``stamp`` (>= 0) of the
+    last search that queued it (no clearing between searches: each search of
+    a caller passes a stamp of its own, such as its position in the list of
+    centres, so that a centre listed twice is searched twice); ``queue`` is scratch. ``members``
     and ``queue`` hold V entries (a vertex is queued at most once per centre):
     no buffer is grown, so no array is reassigned in the loop, which keeps
     numba's reference counting out of it (six times slower with it). Returns
@@ -183,7 +185,7 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, memb
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
     cutoff2 = cutoff * cutoff
     size = 0
-    mark[v] = v
+    mark[v] = stamp
     queue[0] = v
     head, tail = 0, 1
     if allowed[v]:
@@ -196,7 +198,7 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, memb
         a2 = ax * ax + ay * ay + az * az
         for j in range(indptr[a], indptr[a + 1]):
             b = indices[j]
-            if mark[b] == v:
+            if mark[b] == stamp:
                 continue
             bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
             b2 = bx * bx + by * by + bz * bz
@@ -206,7 +208,7 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, memb
                     size += 1
             elif not a2 <= cutoff2 and not _segment_meets_ball(ax, ay, az, bx, by, bz, cutoff2):
                 continue  # both ends outside, and the segment passes outside too
-            mark[b] = v
+            mark[b] = stamp
             queue[tail] = b
             tail += 1
     return size

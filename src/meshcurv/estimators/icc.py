@@ -240,9 +240,9 @@ def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, ed
         members = np.flatnonzero(level == k)
         radius = NOISE_FIT_RADIUS * scale[members].mean()
         coefficients, _, _ = fit_jets(vertices, normals, radius, degree=2, centres=centres[members],
-                                      neighbours=neighbours, adjacency=adjacency)
+                                      neighbours=neighbours, adjacency=adjacency, compact=True)
         # the constant term is in units of the radius: NOISE_FIT_RADIUS class mean edge lengths
-        distances[members] = np.abs(coefficients[centres[members], 0]) * NOISE_FIT_RADIUS
+        distances[members] = np.abs(coefficients[:, 0]) * NOISE_FIT_RADIUS
     distances = distances[np.isfinite(distances)]
     return float(np.median(distances)) if distances.size else 0.0
 
