@@ -121,9 +121,12 @@ def _jet_outputs(rows):
 @nb.njit(**_JIT)
 def _jet_scratch(degree, n_terms):
     """The buffers of :func:`_fit_one` (once per chunk of vertices, not per vertex):
-    ``work, moments, right, matrix, low, scale, solution``."""
+    ``work, moments, right, matrix, low, scale, solution``. The moments and the
+    right-hand side hold at least those of degree 3, which :func:`_cubic_jet_moments`
+    writes for every fit of degree 3 or less."""
     work = np.empty((_JET_ROWS + 3 * (2 * degree + 1) + degree + 1, 64))
-    return (work, np.empty((2 * degree + 1, 2 * degree + 1)), np.empty(n_terms), np.empty((n_terms, n_terms)),
+    order = 2 * max(degree, 3) + 1
+    return (work, np.empty((order, order)), np.empty(max(n_terms, 10)), np.empty((n_terms, n_terms)),
             np.empty((n_terms, n_terms)), np.empty(n_terms), np.empty(n_terms))
 
 
@@ -236,9 +239,10 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     of the weight with ``u^0..u^2d`` and of the weighted height with ``u^0..u^d``
     (:func:`_jet_scratch`), so that each moment of the normal equations is one
     vectorized dot product of two rows (the products are those of the three
-    factors in their order: the same numbers). A degree-3 fit sums its moments
-    member by member instead (:func:`_cubic_jet_moments`, the same products;
-    no per-member rows). A fit whose slope ``c10^2 + c01^2`` is below ``settled``
+    factors in their order: the same numbers). A fit of degree 3 or less sums
+    its moments member by member instead (:func:`_cubic_jet_moments`, the same
+    products; no per-member rows; degree 2 reads the moments up to order 4).
+    A fit whose slope ``c10^2 + c01^2`` is below ``settled``
     ends the iterations (its frame and coefficients are kept).
     """
     n_terms = exponents.shape[0]
@@ -282,7 +286,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
     fitted = False
     for step in range(iterations):
-        if degree == 3:  # the default normal fit: moments summed member by member
+        if degree <= 3:  # the normal and noise fits: moments summed member by member (degree 2 reads a subset)
             _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right)
         else:
             for a in range(size):
