@@ -52,6 +52,7 @@ def finish(method: str, parameters: dict, valid: np.ndarray, normals: np.ndarray
     n_invalid = int((~valid).sum())
     if n_invalid:
         found.append(f"{n_invalid} vertices are NaN with valid=False")
-    result = CurvatureResult(k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals,
-                             valid=valid, method=method, parameters=parameters)
+    # the estimators' own arrays, taken without copies (88 bytes per vertex)
+    result = CurvatureResult._of_arrays(k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max,
+                                        normals=normals, valid=valid, method=method, parameters=parameters)
     return result, found
