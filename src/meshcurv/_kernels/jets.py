@@ -384,15 +384,20 @@ def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents,
         for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
             v = centres[i]
             size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, i, members, queue)
-            if not normals_only:
-                work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v,
-                                i, members, size, work, moments, right, matrix, low, scale, solution, coefficients,
-                                t1s, t2s, ns, counts, ids, facing, check_facing, away_fraction, away, settled)
-                continue
+            # the fit into one row, then copied: one call site (the fit is inlined, and a second call
+            # site would double its compile time)
             c[0, :] = np.nan  # a failed fit leaves the row as it finds it
+            one_away[0] = np.nan  # written only when the facing is checked
             work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v, 0,
                             members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn,
                             one_count, ids, facing, check_facing, away_fraction, one_away, settled)
+            if not normals_only:
+                for k in range(6):
+                    coefficients[i, k] = c[0, k]
+                for k in range(3):
+                    t1s[i, k], t2s[i, k], ns[i, k] = a[0, k], b[0, k], nn[0, k]
+                counts[i], away[i] = one_count[0], one_away[0]
+                continue
             p, q = c[0, 1], c[0, 2]
             width = np.sqrt(1 + p * p + q * q)
             for k in range(3):
