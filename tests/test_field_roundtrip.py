@@ -182,6 +182,23 @@ def test_meshcurv_reads_its_own_fields_back(written, name):
             close(fields[key], truth)
 
 
+@pytest.mark.parametrize("binary", [True, False])
+def test_read_fields_reads_a_point_cloud_ply(tmp_path, binary):
+    # a PLY without faces (what write_point_curvatures writes) has its fields read back by name
+    from meshcurv.io import write_point_curvatures
+    from meshcurv.io.fields import read_fields
+
+    sphere = meshcurv.shapes.icosphere(subdivisions=3)
+    result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces)
+    path = write_point_curvatures(tmp_path / "cloud.ply", sphere.vertices, result, binary=binary)
+    assert b"element face" not in path.read_bytes()[:2000]
+    fields = read_fields(path)
+    assert {"k_min", "k_max", "mean", "gaussian", "dir_min", "dir_max", "normals", "valid"} <= set(fields)
+    assert fields["dir_max"].shape == (sphere.vertices.shape[0], 3) and fields["valid"].dtype == bool
+    for key in ("k_min", "k_max", "dir_max", "normals"):
+        close(fields[key], np.asarray(getattr(result, key)))
+
+
 def test_read_fields_errors(tmp_path):
     from meshcurv.errors import MeshFileError
     from meshcurv.io.fields import read_fields

@@ -20,9 +20,10 @@ at a time (0.80 s for a 1M-vertex sphere; about 50 ms here). This reader:
 
 Only ``x, y, z`` of the ``vertex`` element and the corner list of the
 ``face`` element (``vertex_indices``, ``vertex_index`` or its only list
-property) are kept by :func:`read_ply`; :func:`read_ply_fields` keeps the
-other scalar properties of the vertices too (the curvature fields meshcurv
-writes); other elements and properties are checked for size and skipped.
+property) are kept by :func:`read_ply`; other elements and properties are
+checked for size and skipped. (The other properties of the vertices, such as
+the curvature fields meshcurv writes, are read by
+:func:`meshcurv.io.fields.read_fields` with the vertex element alone.)
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ import numpy as np
 from ..errors import MeshFileError
 from ._text import numbers
 
-__all__ = ["read_ply", "read_ply_fields", "HEADER_LIMIT"]
+__all__ = ["read_ply", "HEADER_LIMIT"]
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -158,39 +159,23 @@ def read_ply(path):
         A header cut short or malformed, counts larger than the file can
         hold, the end of the file inside an element, float indices.
     """
-    vertices, faces, _ = _read(path, properties=False)
-    return vertices, faces
-
-
-def read_ply_fields(path) -> tuple[np.ndarray, object, dict[str, np.ndarray]]:
-    """``(vertices, faces, properties)``: :func:`read_ply` and the other scalar properties of the vertices.
-
-    ``properties`` maps each property of the ``vertex`` element but ``x, y, z``
-    to a (V,) float64 array, in the order of the header.
-    """
-    return _read(path, properties=True)
-
-
-def _read(path, *, properties: bool):
     with open(path, "rb") as handle:
         data = handle.read()
     file_format, elements, offset = _header(data, path)
     vertex, face, corners = _roles(elements, path)
-    found: dict[str, np.ndarray] | None = {} if properties else None
     if file_format == "ascii":
-        vertices, faces = _read_ascii(data, offset, elements, vertex, face, corners, path, found)
+        vertices, faces = _read_ascii(data, offset, elements, vertex, face, corners, path)
     else:
-        vertices, faces = _read_binary(data, offset, _ORDERS[file_format], elements, vertex, face, corners, path,
-                                       found)
+        vertices, faces = _read_binary(data, offset, _ORDERS[file_format], elements, vertex, face, corners, path)
     if len(faces) == 0:
         raise MeshFileError(f"{path}: the PLY file holds no faces")
-    return vertices, faces, found
+    return vertices, faces
 
 
 # ---------------------------------------------------------------- binary
 
 
-def _read_binary(data, position, order, elements, vertex, face, corners, path, found=None):
+def _read_binary(data, position, order, elements, vertex, face, corners, path):
     vertices = faces = None
     for element in elements:
         available = len(data) - position
@@ -202,15 +187,12 @@ def _read_binary(data, position, order, elements, vertex, face, corners, path, f
             if element is vertex:
                 table = np.frombuffer(data, record, count=element.count, offset=position)
                 vertices = np.column_stack([table[axis].astype(np.float64) for axis in "xyz"])
-                if found is not None:
-                    found.update({p.name: table[p.name].astype(np.float64) for p in element.properties
-                                  if p.name not in ("x", "y", "z")})
             position += need
             continue
         keep = corners if element is face else None
-        found, position = _binary_lists(data, position, order, element, keep, path)
+        lists, position = _binary_lists(data, position, order, element, keep, path)
         if element is face:
-            faces = found
+            faces = lists
     return vertices, faces
 
 
@@ -315,7 +297,7 @@ def _integers(values: np.ndarray, path, what: str) -> np.ndarray:
     return values.astype(np.int64)
 
 
-def _read_ascii(data, offset, elements, vertex, face, corners, path, found=None):
+def _read_ascii(data, offset, elements, vertex, face, corners, path):
     values = _numbers(data[offset:], path)
     position, vertices, faces = 0, None, None
     for element in elements:
@@ -328,15 +310,12 @@ def _read_ascii(data, offset, elements, vertex, face, corners, path, found=None)
             if element is vertex:
                 names = [p.name for p in element.properties]
                 vertices = table[:, [names.index(axis) for axis in "xyz"]]
-                if found is not None:
-                    found.update({name: table[:, k].copy() for k, name in enumerate(names)
-                                  if name not in ("x", "y", "z")})
             position += element.count * width
             continue
         keep = corners if element is face else None
-        found, position = _ascii_lists(values, position, element, keep, path)
+        lists, position = _ascii_lists(values, position, element, keep, path)
         if element is face:
-            faces = found
+            faces = lists
     return vertices, faces
 
 

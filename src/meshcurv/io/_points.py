@@ -142,6 +142,18 @@ def _split(columns: dict, path, where: str) -> tuple[np.ndarray, np.ndarray | No
 # -- PLY ----------------------------------------------------------------------------
 
 def _read_ply(path):
+    columns = ply_vertex_columns(path)
+    return _split({name.lower(): values for name, values in columns.items()}, path, "the PLY 'vertex' element")
+
+
+def ply_vertex_columns(path) -> dict[str, np.ndarray]:
+    """The properties of the ``vertex`` element of a PLY file (ASCII or binary) by their names in the header.
+
+    Only the vertex element is read (the elements after it, such as a
+    surface's faces, are not parsed): the columns of a point cloud and of a
+    mesh alike. ASCII values are float64; binary ones keep their stored type.
+    """
+    path = pathlib.Path(path)
     data = path.read_bytes()
     file_format, elements, offset = _header(data, path)
     vertex = next((e for e in elements if e.name == "vertex"), None)
@@ -152,7 +164,6 @@ def _read_ply(path):
     before = elements[:elements.index(vertex)]
     if any(p.count_kind is not None for e in before for p in e.properties):
         raise MeshFileError(f"{path}: the PLY file has a list element before its vertices; not supported")
-    names = [p.name.lower() for p in vertex.properties]
     if file_format == "ascii":
         width = len(vertex.properties)
         skip = sum(e.count * len(e.properties) for e in before)
@@ -169,7 +180,7 @@ def _read_ply(path):
             raise MeshFileError(f"{path}: the ASCII PLY vertices do not all have {width} values "
                                 f"({values.size} values on {vertex.count} lines)")
         table = values.reshape(vertex.count, width)
-        return _split({n: table[:, i] for i, n in enumerate(names)}, path, "the PLY 'vertex' element")
+        return {p.name: table[:, i] for i, p in enumerate(vertex.properties)}
     order = _ORDERS[file_format]
     position = offset
     for element in before:
@@ -179,7 +190,7 @@ def _read_ply(path):
     if position + need > len(data):
         raise _short(path, vertex.count, "vertices", max(len(data) - position, 0), need)
     table = np.frombuffer(data, record, count=vertex.count, offset=position)
-    return _split({p.name.lower(): table[p.name] for p in vertex.properties}, path, "the PLY 'vertex' element")
+    return {p.name: table[p.name] for p in vertex.properties}
 
 
 def _short(path, count, what, available, need=None) -> MeshFileError:

@@ -158,9 +158,11 @@ def read_fields(path) -> dict[str, np.ndarray]:
 
 
 def _ply_fields(path):
-    from ._ply import read_ply_fields
+    from ._points import ply_vertex_columns
 
-    return read_ply_fields(path)[2]
+    # the vertex element alone: a point cloud's file (no faces) as well as a surface's
+    return {name: np.asarray(values, dtype=np.float64) for name, values in ply_vertex_columns(path).items()
+            if name not in ("x", "y", "z")}
 
 
 def _vtp_fields(path):
