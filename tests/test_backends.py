@@ -206,13 +206,23 @@ def test_ball_methods_agree(name, method):
                                    err_msg=field)
 
 
+def noisy_sphere():
+    """The jet tests' surface and its first frames: a sphere with noise of 0.2 edges, its radial normals."""
+    mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=2)
+    return mesh, mesh.vertices / np.linalg.norm(mesh.vertices, axis=1, keepdims=True)
+
+
+def edge_lists(mesh):
+    """The mesh's edge neighbours in CSR form (``adjacency=`` of the jet fits)."""
+    return MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).neighbour_lists
+
+
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
 def test_jets_fitted_at_chosen_centres(backend):
     # fitting a subset of the vertices gives their rows of the full fit; the other rows are NaN
     from meshcurv.jets import fit_jets
 
-    mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=2)
-    normals = mesh.vertices / np.linalg.norm(mesh.vertices, axis=1, keepdims=True)
+    mesh, normals = noisy_sphere()
     centres = np.arange(3, mesh.vertices.shape[0], 7)
     with use_backend(backend):
         full, full_frame, full_counts = fit_jets(mesh.vertices, normals, 0.4, degree=3)
@@ -230,11 +240,9 @@ def test_compact_jets_are_the_rows_of_their_centres(backend, connected):
     # compact=True: one row per centre, in the order given (unsorted, repeats), equal to those rows of
     # the fit with one row per vertex; details["away"] likewise
     from meshcurv.jets import fit_jets
-    from meshcurv.topology import MeshTopology
 
-    mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=2)
-    normals = mesh.vertices / np.linalg.norm(mesh.vertices, axis=1, keepdims=True)
-    adjacency = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).neighbour_lists if connected else None
+    mesh, normals = noisy_sphere()
+    adjacency = edge_lists(mesh) if connected else None
     centres = np.array([40, 3, 3, 3, 17, 3, mesh.vertices.shape[0] - 1])  # a centre listed twice in a row
     with use_backend(backend):
         full_details, details = {}, {}
@@ -258,9 +266,8 @@ def test_settled_fits_keep_their_first_fit(backend, connected):
     # frame (the result of one iteration); every other centre gets its two iterations
     from meshcurv.jets import fit_jets
 
-    mesh = shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=2)
-    normals = mesh.vertices / np.linalg.norm(mesh.vertices, axis=1, keepdims=True)
-    adjacency = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).neighbour_lists if connected else None
+    mesh, normals = noisy_sphere()
+    adjacency = edge_lists(mesh) if connected else None
     with use_backend(backend):
         once, once_frame, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=1, adjacency=adjacency)
         twice, twice_frame, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency)

@@ -4,10 +4,10 @@ the curvatures of their sums over balls.
 
 from __future__ import annotations
 
+import math
+
 import numba as nb
 import numpy as np
-
-import math
 
 from ._common import _JIT
 from .tensors import _principal_from_mean_gaussian, _tangent_eigen

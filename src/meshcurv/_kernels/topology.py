@@ -130,16 +130,6 @@ def _find(parent, x):
 
 
 @nb.njit(inline="always", **_JIT)
-def _corner_at(faces, f, v):
-    """The corner (3 f + k) of face ``f`` at vertex ``v``."""
-    if faces[f, 0] == v:
-        return 3 * f
-    if faces[f, 1] == v:
-        return 3 * f + 1
-    return 3 * f + 2
-
-
-@nb.njit(inline="always", **_JIT)
 def _position(faces, f, v):
     """The position (0, 1 or 2) of vertex ``v`` in face ``f``."""
     if faces[f, 0] == v:

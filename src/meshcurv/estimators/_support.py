@@ -27,6 +27,17 @@ def defects_without_boundary(topology: MeshTopology, degenerate: np.ndarray) -> 
     return VertexDefects(invalid_vertices=invalid, counts={**full.counts, "boundary_edges": 0})
 
 
+def proper_vertex_normals(vertices: np.ndarray, faces: np.ndarray, cross: np.ndarray,
+                          degenerate: np.ndarray) -> np.ndarray:
+    """:func:`~meshcurv.geometry.vertex_normals` of the faces that are not ``degenerate`` (F,) bool.
+
+    A degenerate face's cross product adds +0 instead: the same sums as
+    without its row, and no copy of the faces.
+    """
+    used = np.where(degenerate[:, None], 0.0, cross) if degenerate.any() else cross
+    return vertex_normals(vertices, faces, cross=used)
+
+
 def prepare(vertices: np.ndarray, topology: MeshTopology):
     """Face cross products, degenerate faces, defects (boundary kept) and vertex normals.
 
@@ -36,9 +47,7 @@ def prepare(vertices: np.ndarray, topology: MeshTopology):
     cross = face_cross_products(vertices, topology.faces)
     degenerate = degenerate_faces(vertices, topology, cross=cross)
     defects = defects_without_boundary(topology, degenerate)
-    # a degenerate face's cross product adds +0 instead (the same sums), without copies of the faces
-    used = np.where(degenerate[:, None], 0.0, cross) if degenerate.any() else cross
-    normals = vertex_normals(vertices, topology.faces, cross=used)
+    normals = proper_vertex_normals(vertices, topology.faces, cross, degenerate)
     valid = ~defects.invalid_vertices & np.isfinite(normals).all(axis=1)
     return cross, degenerate, defects, normals, valid
 

@@ -50,12 +50,13 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from .._backend import kernel_threads, numba_kernels
 from ..geometry import (DEGENERATE_AREA_RATIO, degenerate_faces, edge_dihedral_angles, face_cross_products,
-                        vertex_length_scales, vertex_normals)
+                        vertex_length_scales)
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from ..topology import MeshTopology
 from ._common import Stages, nan_where
 from ._defects import mesh_defects
+from ._support import proper_vertex_normals
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
 
@@ -87,7 +88,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
     )
     face_area_thirds = np.where(degenerate, 0.0, double_areas / 6.0)
     areas = np.bincount(faces.ravel(), weights=np.repeat(face_area_thirds, 3), minlength=n_vertices)
-    normals = vertex_normals(vertices, faces[~degenerate], cross=cross[~degenerate])
+    normals = proper_vertex_normals(vertices, faces, cross, degenerate)
 
     stages.start("average vertex tensors")
     valid = ~defects.invalid_vertices
