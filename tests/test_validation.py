@@ -132,3 +132,27 @@ def test_every_entry_point_checks_its_input():
         orient_faces(np.zeros((4, 2)), TRI)
     with pytest.raises(InvalidMeshError, match="negative vertex indices"):
         orient_faces(QUAD_VERTICES, -TRI)
+
+
+def test_trusted_arrays_skip_the_helpers_checks_only_as_themselves_and_only_inside_the_block():
+    from meshcurv._validation import checked_indices, checked_points, trusting
+    from meshcurv.geometry import edge_lengths
+
+    vertices = QUAD_VERTICES.copy()
+    faces = TRI.astype(np.int64)
+    with trusting(vertices, faces):
+        assert checked_points(vertices) is vertices
+        assert checked_indices(faces, 4) is faces
+        vertices[1, 0] = np.nan  # not seen: the trusted array is not checked again (the point of the block)
+        assert checked_points(vertices) is vertices
+        vertices[1, 0] = 1.0
+        with pytest.raises(InvalidMeshError, match="NaN or infinite"):  # an equal array is not the trusted one
+            checked_points(np.where(np.arange(12).reshape(4, 3) == 4, np.nan, vertices))
+        with pytest.raises(InvalidMeshError, match="out of range"):  # checked for 4 vertices, not for 3
+            checked_indices(faces, 3)
+        with pytest.raises(InvalidMeshError, match=r"must have shape \(N, 2\)"):  # the shape is still checked
+            checked_indices(faces, 4, columns=2)
+        np.testing.assert_allclose(edge_lengths(vertices, np.array([[0, 1], [0, 2]])), [1.0, np.sqrt(2)])
+    vertices[1, 0] = np.nan  # after the block the same array is checked again
+    with pytest.raises(InvalidMeshError, match="NaN or infinite"):
+        checked_points(vertices)

@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 
 from ._adapters import mesh_arrays
-from ._validation import as_vertices, check_choice, check_int_option, check_positive_float
+from ._validation import as_vertices, check_choice, check_int_option, check_positive_float, trusting
 from .diagnosis import diagnose, quality_message
 from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
@@ -193,19 +193,20 @@ def principal_curvatures(
     if welding is not None and welding.n_welded:
         points, topology = welding.vertices, welding.topology
     topology, n_flipped = oriented_topology(points, topology, orient)
-    found: dict = {}
-    if "radius" in options and options["radius"] is None:
-        voxel = voxel_surface_radius(points, topology)  # a voxel surface: one default for every ball method
-        if voxel is not None:
-            options["radius"], found = voxel
-    result, problems = estimator.function(
-        points, topology, stages=Stages(estimator.stages, progress), **options
-    )
-    if radius is not None and estimator.radius_warning_edges is not None:  # given, not a default
-        note = small_radius_note(result.parameters["radius"], points, topology, estimator.radius_warning_edges)
-        problems = [*problems, note] if note else problems
-    diagnosis = diagnose(points, topology, n_flipped_faces=n_flipped)
-    reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
+    with trusting(points, topology.faces, topology.edges):  # checked: the helpers below need not check again
+        found: dict = {}
+        if "radius" in options and options["radius"] is None:
+            voxel = voxel_surface_radius(points, topology)  # a voxel surface: one default for every ball method
+            if voxel is not None:
+                options["radius"], found = voxel
+        result, problems = estimator.function(
+            points, topology, stages=Stages(estimator.stages, progress), **options
+        )
+        if radius is not None and estimator.radius_warning_edges is not None:  # given, not a default
+            note = small_radius_note(result.parameters["radius"], points, topology, estimator.radius_warning_edges)
+            problems = [*problems, note] if note else problems
+        diagnosis = diagnose(points, topology, n_flipped_faces=n_flipped)
+        reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
     parameters = {**result.parameters, **found, "orient": orient,
                   "n_welded_vertices": welding.n_welded if welding is not None else 0}
     surface = Surface(points, topology.faces, welding.index if welding is not None and welding.n_welded else None)

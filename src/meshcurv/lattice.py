@@ -103,9 +103,12 @@ def voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
     """
     if vertices.shape[0] < 16:
         return None
-    found = [_axis_lattice(vertices[:, k]) for k in range(3)]
-    if any(axis is None for axis in found):
-        return None
+    found = []
+    for k in range(3):  # an axis without a lattice settles it: the others are not sorted (most meshes)
+        axis = _axis_lattice(vertices[:, k])
+        if axis is None:
+            return None
+        found.append(axis)
     on_grid = np.column_stack([axis[2] for axis in found])
     fraction = float((on_grid.sum(axis=1) >= 2).mean())
     if fraction < GRID_FRACTION:
