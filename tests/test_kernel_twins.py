@@ -40,6 +40,7 @@ pytest.importorskip("numba")
 
 from meshcurv import shapes  # noqa: E402
 from meshcurv._backend import kernel_threads, use_backend  # noqa: E402
+from meshcurv.neighborhoods import _face_sum_scratch  # noqa: E402
 from meshcurv.topology import MeshTopology  # noqa: E402
 
 EPS = np.finfo(float).eps
@@ -895,15 +896,22 @@ def check_connected_face_sums(name):
         # Euclidean ball's faces, the NumPy path's
         expected, magnitude = numpy_ball_sums(name, "faces", values, radius, mask)
         allowed = np.ones(faces.shape[0], dtype=bool) if mask is None else mask
-        got = compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices,
-                                           kernel_threads(), 0, n)
+        got = np.zeros_like(expected)
+        compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices, got,
+                                     _face_sum_scratch(kernel_threads(), n, faces.shape[0]), 0, n)
         assert_sums_close(got, expected, magnitude, ball_terms(name, "faces", radius),
                           "all faces" if mask is None else "usable faces")
-        # a range of centres: only their rows
-        part = compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices,
-                                            kernel_threads(), n // 3, n // 2)
+        # ranges of centres, one scratch for all (as the calls of ball_face_sums): only their rows each time
+        part = np.zeros_like(expected)
+        scratch = _face_sum_scratch(3, n, faces.shape[0])
+        compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices, part,
+                                     scratch, n // 3, n // 2)
         np.testing.assert_array_equal(part[n // 3:n // 2], got[n // 3:n // 2])
         assert not part[:n // 3].any() and not part[n // 2:].any()
+        for lo, hi in ((0, n // 3), (n // 2, n)):
+            compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices,
+                                         part, scratch, lo, hi)
+        np.testing.assert_array_equal(part, got)
 
 
 # -- jets ---------------------------------------------------------------------------------------

@@ -432,6 +432,19 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     return out
 
 
+def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int) -> tuple[np.ndarray, ...]:
+    """The per-thread scratch of the compiled ``connected_face_sums``: ``(seen, mark, known, squared, queue)``.
+
+    ``seen`` (n_chunks, F), ``mark`` and ``known`` (n_chunks, V) int64 filled with -1, ``squared``
+    (n_chunks, V) float and ``queue`` (n_chunks, V) int64. Allocated once for all the calls over
+    one mesh: each array is stamped with the centre it was last written for, and every centre is
+    summed once, so no call needs it cleared again.
+    """
+    return (np.full((n_chunks, n_faces), -1, np.int64), np.full((n_chunks, n_vertices), -1, np.int64),
+            np.full((n_chunks, n_vertices), -1, np.int64), np.empty((n_chunks, n_vertices)),
+            np.empty((n_chunks, n_vertices), np.int64))
+
+
 def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,
                          usable: np.ndarray | None) -> np.ndarray:
     """:func:`ball_face_sums` over the surface-connected piece of each ball (compiled kernel, breadth-first)."""
@@ -442,13 +455,11 @@ def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radiu
     indptr, indices = kernels.vertex_face_lists(faces, n)
     values = np.ascontiguousarray(values)
     n_calls = max(1, int(np.ceil(mean * n / PAIRS_PER_CALL)))
-    out: np.ndarray | None = None
+    out = np.zeros((n, values.shape[1]))
+    scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0])  # once for all calls
     for call in range(n_calls):  # Python between calls: Ctrl-C gets through
-        sums = kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radius, indptr, indices,
-                                           kernel_threads(), call * n // n_calls, (call + 1) * n // n_calls)
-        out = sums if out is None else out + sums
-    if out is None:
-        raise RuntimeError("no kernel call ran (n_calls >= 1)")
+        kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radius, indptr, indices, out,
+                                    scratch, call * n // n_calls, (call + 1) * n // n_calls)
     return out
 
 

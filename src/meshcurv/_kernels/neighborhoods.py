@@ -215,9 +215,10 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, stam
 
 
 @nb.njit(parallel=True, **_JIT)
-def connected_face_sums(vertices, faces, centroids, reach, usable, values, radius, indptr, indices, n_chunks, start,
-                        stop):
-    """(V, k) sums of ``share * values`` over the faces of the surface-connected piece of each ball.
+def connected_face_sums(vertices, faces, centroids, reach, usable, values, radius, indptr, indices, out, scratch,
+                        start, stop):
+    """Add to rows ``start`` to ``stop`` of ``out`` (V, k) the sums of ``share * values`` over the faces of the
+    surface-connected piece of each vertex's ball.
 
     ``share`` is ``neighborhoods.face_in_ball_ratios`` (1 inside, 0 outside,
     linear in between by the corners' and centroid's distances). The faces are
@@ -230,24 +231,24 @@ def connected_face_sums(vertices, faces, centroids, reach, usable, values, radiu
     when the ball's part of the surface is connected, every face of the
     Euclidean ball (a path inside the ball goes from face to face across edges
     that meet it); another sheet of the surface inside the ball is left out.
-    Faces not ``usable`` (F,) lead the search on but add nothing. Only the
-    balls of the vertices ``start`` to ``stop`` are summed (the other rows are
-    0). ``n_chunks``: four (V,) arrays and one (F,) array each.
+    Faces not ``usable`` (F,) lead the search on but add nothing. The other
+    rows of ``out`` are not touched: a caller that splits the vertices into
+    ranges sums them into one array. ``scratch``: ``neighborhoods._face_sum_scratch``, one
+    chunk of the vertices per row of its arrays (reused from call to call).
     """
     n = vertices.shape[0]
-    n_faces = faces.shape[0]
     n_values = values.shape[1]
-    out = np.zeros((n, n_values))
     radius2 = radius * radius
     start = max(min(start, n), 0)
     m = max(min(stop, n), start) - start
-    n_chunks = max(min(m, n_chunks), 1)
+    all_seen, all_mark, all_known, all_squared, all_queue = scratch
+    n_chunks = all_seen.shape[0]
     for chunk in nb.prange(n_chunks):
-        seen = np.full(n_faces, -1, np.int64)
-        mark = np.full(n, -1, np.int64)  # queued for this centre
-        known = np.full(n, -1, np.int64)  # distance to this centre in `squared`
-        squared = np.empty(n)
-        queue = np.empty(n, np.int64)  # a vertex is queued at most once per centre: never grown
+        seen = all_seen[chunk]
+        mark = all_mark[chunk]  # queued for this centre
+        known = all_known[chunk]  # distance to this centre in `squared`
+        squared = all_squared[chunk]
+        queue = all_queue[chunk]  # a vertex is queued at most once per centre: never grown
         for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
             cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
             mark[v] = v
@@ -299,7 +300,6 @@ def connected_face_sums(vertices, faces, centroids, reach, usable, values, radiu
                             mark[c] = v
                             queue[tail] = c
                             tail += 1
-    return out
 
 
 @nb.njit(parallel=True, **_JIT)
