@@ -224,20 +224,25 @@ def test_numpy_ball_chunks_are_bounded(monkeypatch):
 
 @pytest.mark.skipif("numba" not in BACKENDS, reason="needs numba")
 def test_compiled_balls_in_several_calls_give_the_same_sums(monkeypatch):
-    monkeypatch.setattr(neighborhoods, "PAIRS_PER_CALL", 2000)
-    monkeypatch.setattr(jets, "PAIRS_PER_CALL", 2000)
     top = MeshTopology.from_faces(SPHERE.faces, N)
     values = np.column_stack([face_areas(SPHERE.vertices, SPHERE.faces), np.arange(top.n_faces, dtype=float)])
-    with use_backend("numba"):
-        parts = neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values)
-        split = jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)
-        monkeypatch.setattr(neighborhoods, "PAIRS_PER_CALL", 10**12)
-        monkeypatch.setattr(jets, "PAIRS_PER_CALL", 10**12)
-        whole = neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values)
-        one = jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)
-    np.testing.assert_array_equal(parts, whole)
-    np.testing.assert_array_equal(split[0], one[0])
-    np.testing.assert_array_equal(split[2], one[2])
+
+    def everything():
+        with use_backend("numba"):
+            return (neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values),
+                    neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values, connected=True),
+                    *jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)[::2],
+                    *jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4, adjacency=top.neighbour_lists)[::2],
+                    jets.fit_jet_normals(SPHERE.vertices, SPHERE.normals, 0.4, adjacency=top.neighbour_lists))
+
+    monkeypatch.setattr(neighborhoods, "PAIRS_PER_CALL", 2000)  # a few centres per call
+    assert len(neighborhoods.call_ranges(N, 60.0)) > 10
+    split = everything()
+    monkeypatch.setattr(neighborhoods, "PAIRS_PER_CALL", 10**12)  # one call
+    assert len(neighborhoods.call_ranges(N, 60.0)) == 1
+    whole = everything()
+    for parts, one in zip(split, whole, strict=True):
+        np.testing.assert_array_equal(parts, one)
 
 
 @pytest.mark.slow

@@ -247,25 +247,28 @@ def test_compiled_ball_search_matches_the_k_d_tree():
     pytest.importorskip("numba")
     from scipy.spatial import cKDTree
 
+    from meshcurv._kernels.neighborhoods import pool_grid
     from meshcurv._kernels.pointcloud import ball_indices
 
     points, _ = sphere_points(3000)
     usable = np.random.default_rng(3).random(3000) > 0.05
     centres = np.flatnonzero(usable)
-    for radius, k in ((0.3, 12), (0.5, 60)):  # spacing 0.13: about 17 and 46 points per ball
-        grid = normals_module.grid_of(points, usable, radius)
-        index, squared, counts = ball_indices(points, centres, radius, k, *grid)
-        expected, expected_counts = estimators._ball_indices(
-            estimators._usable_tree(cKDTree(points), points, usable), points, centres, radius, k)
-        np.testing.assert_array_equal(index, expected)
-        np.testing.assert_array_equal(counts, expected_counts)
-        # without the table of columns (a sparse grid): bisection over all the cells, the same rows
-        unindexed = ball_indices(points, centres, radius, k, *grid[:-1], np.array([0, grid[2].size]))
-        np.testing.assert_array_equal(unindexed[0], expected)
-        assert usable[index[index < 3000]].all() and (counts == k).any() and (counts < k).any()
-        inside = np.isfinite(squared)
-        assert np.allclose(squared[inside], np.sum((points[index[inside]] - points[np.repeat(centres, counts)])**2,
-                                                    axis=1))
+    # the sphere (spacing 0.13: about 17 and 46 points per ball), and two halves of it 1e4 radii apart
+    # (half as many per ball): a sparse grid, whose cells are widened (at most four columns of cells per
+    # point) far beyond the radius
+    apart = np.where(np.arange(3000)[:, None] % 2 == 0, points, points + [1e4, 1e4, 0.0])
+    for cloud, cases in ((points, ((0.3, 12), (0.5, 60))), (apart, ((0.3, 6), (0.5, 30)))):
+        for radius, k in cases:
+            index, squared, counts = ball_indices(cloud, centres, radius, k,
+                                                  *pool_grid(cloud, np.flatnonzero(usable), radius), 64)
+            expected, expected_counts = estimators._ball_indices(
+                estimators._usable_tree(cKDTree(cloud), cloud, usable), cloud, centres, radius, k)
+            np.testing.assert_array_equal(index, expected)
+            np.testing.assert_array_equal(counts, expected_counts)
+            assert usable[index[index < 3000]].all() and (counts == k).any() and (counts < k).any()
+            inside = np.isfinite(squared)
+            assert np.allclose(squared[inside],
+                               np.sum((cloud[index[inside]] - cloud[np.repeat(centres, counts)]) ** 2, axis=1))
 
 
 def test_compiled_spanning_signs_orient_as_the_scipy_tree():

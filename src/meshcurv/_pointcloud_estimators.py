@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels
-from ._pointcloud_normals import grid_of
+from ._backend import kernel_threads, numba_kernels
 from ._tensors import principal_from_shape_operator
 from .estimators.icc import curvatures_from_measures, face_measures
 from .jets import fit_jets, jet_normals, shape_operators
@@ -223,26 +222,24 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
     n = points.shape[0]
     out = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)]
     pattern = _rank_pattern(TRIANGLES if n_triangles is None else n_triangles)
-    compiled = None
     kernels = numba_kernels("pointcloud")
-    if kernels is not None:
-        compiled = kernels.ball_triangle_sums  # locked, interruptible
-        find_balls = kernels.ball_indices
     k = min(ball_size(radius, spacing), n)
-    grid = None if compiled is None else grid_of(points, usable, radius)
-    search = _usable_tree(tree, points, usable) if grid is None else None
+    if kernels is not None:  # the grid of the compiled ball searches, once for all the chunks
+        grid = numba_kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(radius))
+    else:
+        search = _usable_tree(tree, points, usable)
     for start in range(0, centres.size, CHUNK):
         chunk = centres[start:start + CHUNK]
-        if grid is not None:
-            index, _, counts = find_balls(points, chunk, float(radius), k, *grid)
+        if kernels is not None:
+            index, _, counts = kernels.ball_indices(points, chunk, float(radius), k, *grid, 64 * kernel_threads())
         else:
             index, counts = _ball_indices(search, points, chunk, radius, k)
         rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
         if rows.size == 0:
             continue
         index, counts = index[rows], counts[rows]
-        if compiled is not None:
-            summed = compiled(points, normals, index, counts.astype(np.int64), pattern)
+        if kernels is not None:
+            summed = kernels.ball_triangle_sums(points, normals, index, counts.astype(np.int64), pattern)
         else:
             summed = _triangle_sums(points, normals, index, counts, pattern)
         # rows without area (a ball of collinear points) are NaN and stay so

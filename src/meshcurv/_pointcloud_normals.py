@@ -47,10 +47,6 @@ TANGENT_SLOPE = 0.25
 #: A point keeps its steep edges (except back-to-back ones) when fewer than this many of its edges are flat.
 MIN_FLAT_EDGES = 3
 
-#: The grid of the balls (:func:`grid_of`) indexes its columns (x, y) when they are at most this many times
-#: its occupied cells (a surface's grid has about as many columns as cells; a sparse one far more).
-GRID_COLUMNS = 8
-
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
 
@@ -84,36 +80,6 @@ def _drop_self(rows, d, i, k, distances, indices) -> None:
     keep[np.arange(rows.size), first] = False
     distances[rows] = d[keep].reshape(-1, k)
     indices[rows] = i[keep].reshape(-1, k)
-
-
-def grid_of(points, usable, side):
-    """``(low, dims, keys, starts, pool, pool_points, columns)``: the usable points by cell of a grid.
-
-    The input of :func:`meshcurv._kernels.pointcloud.ball_indices`. None when
-    the grid's cell numbers would not fit in an int64 (a side below about
-    1e-6 of the cloud's extent): the k-d tree then answers.
-    """
-    pool = np.flatnonzero(usable)
-    low = points[pool].min(axis=0)
-    with np.errstate(over="ignore", invalid="ignore"):
-        span = np.floor((points[pool].max(axis=0) - low) / side) + 1
-        if not float(np.prod(span)) < 2.0**62:  # also inf and NaN
-            return None
-    cells = np.floor((points[pool] - low) / side).astype(np.int64)
-    dims = cells.max(axis=0) + 1
-    keys = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]
-    order = np.argsort(keys)
-    keys = keys[order]
-    first = np.flatnonzero(np.concatenate([[True], keys[1:] != keys[:-1]]))
-    starts = np.append(first, keys.size).astype(np.int64)
-    pool = pool[order]
-    keys = keys[first]
-    n_columns = int(dims[0] * dims[1])
-    if n_columns <= GRID_COLUMNS * max(keys.size, 1):
-        columns = np.searchsorted(keys, np.arange(n_columns + 1, dtype=np.int64) * dims[2]).astype(np.int64)
-    else:  # a sparse grid: bisection over all the keys
-        columns = np.array([0, keys.size], dtype=np.int64)
-    return low, dims, keys, starts, pool, np.ascontiguousarray(points[pool]), columns
 
 
 def local_spacing(distances: np.ndarray) -> np.ndarray:

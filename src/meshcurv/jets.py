@@ -63,7 +63,7 @@ from ._backend import kernel_threads, numba_kernels
 from ._tensors import tangent_basis
 from ._validation import checked_points
 from .errors import InvalidMeshError
-from .neighborhoods import PAIRS_PER_CALL, _ball_pairs, check_ball_work
+from .neighborhoods import _ball_pairs, call_ranges, check_ball_work
 
 #: Highest degree of the jet (lowered to 3, then 2, where the ball holds too few points).
 DEGREE = 4
@@ -294,27 +294,18 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     mean, _ = check_ball_work(pool_points, radius, centres.size, centres=vertices[centres])
     kernels = numba_kernels("jets")
     if kernels is not None and n:
-        n_calls = max(1, min(centres.size, int(np.ceil(mean * centres.size / PAIRS_PER_CALL))))
-        if adjacency is not None:
-            allowed = np.ones(n, dtype=bool) if neighbours is None else neighbours
-            indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
-            if indptr.shape != (n + 1,):
-                raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
-        pieces = []  # each call's outputs, one row per centre of its part
-        for call in range(n_calls):  # Python between calls: Ctrl-C gets through
-            lo, hi = call * centres.size // n_calls, (call + 1) * centres.size // n_calls
-            part = centres[lo:hi]
-            if adjacency is not None:
-                pieces.append(kernels.fit_jets_connected(
-                    vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
-                    kernel_threads(), allowed, indptr, indices, facing if check else vertices, check, AWAY_FRACTION,
-                    False, float(settled)))
-            else:  # rows of all vertices: those of the part taken (a slice when the centres are all vertices)
+        if adjacency is not None:  # one row per centre
+            rows = _connected_fits(kernels, vertices, normals, radius, degree, iterations, centres, mean,
+                                   neighbours, adjacency, facing, settled, normals_only=False)
+        else:
+            pieces = []  # each call's outputs, one row per centre of its part
+            for lo, hi in call_ranges(centres.size, mean):
+                part = centres[lo:hi]  # rows of all vertices: those of the part (a slice when the centres are all)
                 pieces.append(tuple(output[lo:hi] if every_vertex else output[part] for output in kernels.fit_jets(
                     vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
                     64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION,
                     float(settled))))
-        rows = [column[0] if len(column) == 1 else np.concatenate(column) for column in zip(*pieces)]
+            rows = _joined(pieces)
         if not compact and not every_vertex:
             rows = [_all_rows(row, centres, n, 0.0 if k == 4 else np.nan) for k, row in enumerate(rows)]
         coefficients, t1, t2, normal, counts, away = rows
@@ -370,6 +361,34 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     return coefficients, tuple(frame), counts
 
 
+def _joined(pieces: list) -> list[np.ndarray]:
+    """The outputs of the calls of a kernel (a tuple of arrays per call), each joined over the calls."""
+    return [column[0] if len(column) == 1 else np.concatenate(column) for column in zip(*pieces)]
+
+
+def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius: float, degree: int, iterations: int,
+                    centres: np.ndarray, pairs_per_centre: float, neighbours: np.ndarray | None, adjacency: tuple,
+                    facing: np.ndarray | None, settled: float, *, normals_only: bool) -> list[np.ndarray]:
+    """The compiled fits over the surface-connected balls of ``centres``, in calls of about
+    :data:`~meshcurv.neighborhoods.PAIRS_PER_CALL` pairs (checked inputs; ``neighbours`` a (V,) bool
+    array or None). The kernel's outputs, one row per centre; with ``normals_only``, ``[normals]``
+    (M, 3), the fitted normals alone."""
+    n = vertices.shape[0]
+    allowed = np.ones(n, dtype=bool) if neighbours is None else neighbours
+    indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
+    if indptr.shape != (n + 1,):
+        raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
+    check = facing is not None
+    pieces = []
+    for lo, hi in call_ranges(centres.size, pairs_per_centre):
+        outputs = kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations, _exponents(degree),
+                                             MIN_PIVOT, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
+                                             facing if check else vertices, check, AWAY_FRACTION, normals_only,
+                                             float(settled))
+        pieces.append(outputs[:1] if normals_only else outputs)
+    return _joined(pieces)
+
+
 def _all_rows(rows: np.ndarray, centres: np.ndarray, n: int, fill: float) -> np.ndarray:
     """(V, ...) rows of all vertices from the rows of ``centres``; ``fill`` elsewhere."""
     out = np.full((n, *rows.shape[1:]), fill)
@@ -398,23 +417,13 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *,
     normals = np.ascontiguousarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
         raise InvalidMeshError(f"`normals` must have shape {vertices.shape}; got {normals.shape}")
-    allowed = np.ones(n, dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
-    if allowed.shape != (n,):
-        raise InvalidMeshError(f"`neighbours` must have shape ({n},); got {allowed.shape}")
-    indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
-    if indptr.shape != (n + 1,):
-        raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
-    centres = np.arange(n)
-    mean, _ = check_ball_work(vertices[allowed], radius, n, centres=vertices)
-    n_calls = max(1, min(n, int(np.ceil(mean * n / PAIRS_PER_CALL))))
-    pieces = []  # the normals of each call's part of the vertices, in order
-    for call in range(n_calls):  # Python between calls: Ctrl-C gets through
-        part = centres[call * n // n_calls:(call + 1) * n // n_calls]
-        pieces.append(kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations,
-                                                 _exponents(degree), MIN_PIVOT, part, kernel_threads(), allowed,
-                                                 indptr, indices, vertices, False, AWAY_FRACTION, True,
-                                                 float(settled))[0])
-    return pieces[0] if len(pieces) == 1 else np.concatenate(pieces)
+    if neighbours is not None:
+        neighbours = np.asarray(neighbours, dtype=bool)
+        if neighbours.shape != (n,):
+            raise InvalidMeshError(f"`neighbours` must have shape ({n},); got {neighbours.shape}")
+    mean, _ = check_ball_work(vertices if neighbours is None else vertices[neighbours], radius, n, centres=vertices)
+    return _connected_fits(kernels, vertices, normals, radius, degree, iterations, np.arange(n), mean, neighbours,
+                           adjacency, None, settled, normals_only=True)[0]
 
 
 def jet_normals(coefficients: np.ndarray, frame: tuple) -> np.ndarray:

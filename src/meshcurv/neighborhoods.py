@@ -407,13 +407,12 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
         cutoff = radius + reach[group].max()
         mean, largest = check_ball_work(centres[group], cutoff, n, centres=vertices)
         if kernels is not None:
-            n_calls = max(1, int(np.ceil(mean * n / PAIRS_PER_CALL)))
-            for call in range(n_calls):  # Python between calls: Ctrl-C gets through
+            ranges = call_ranges(n, mean)
+            for start, stop in ranges:
                 sums = kernels.ball_cell_sums(vertices, cells[group], centres[group],
                                               np.ascontiguousarray(values[group]), radius, cutoff,
-                                              64 * kernel_threads(), call * n // n_calls,
-                                              (call + 1) * n // n_calls)
-                if isinstance(group, slice) and n_calls == 1:  # one group, one call: its sums are the result
+                                              64 * kernel_threads(), start, stop)
+                if isinstance(group, slice) and len(ranges) == 1:  # one group, one call: its sums are the result
                     return sums
                 out += sums
             continue
@@ -430,6 +429,17 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
             gather = sp.csr_matrix((weights, (i, c)), shape=(chunk.stop - chunk.start, values.shape[0]))
             out[chunk] += np.asarray(gather @ values)
     return out
+
+
+def call_ranges(n: int, pairs_per_centre: float) -> list[tuple[int, int]]:
+    """``(start, stop)`` of each call of a compiled ball kernel over ``n`` centres, in order.
+
+    About :data:`PAIRS_PER_CALL` (centre, point) pairs per call (``pairs_per_centre`` on
+    average, as :func:`check_ball_work` estimates it): between calls Python gets control back,
+    so that Ctrl-C gets through. One call at least, none of them empty when ``n > 0``.
+    """
+    n_calls = max(1, min(n, int(np.ceil(pairs_per_centre * n / PAIRS_PER_CALL))))
+    return [(call * n // n_calls, (call + 1) * n // n_calls) for call in range(n_calls)]
 
 
 def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int) -> tuple[np.ndarray, ...]:
@@ -454,12 +464,11 @@ def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radiu
     mean, _ = check_ball_work(centres, radius + float(reach.max()), n, centres=vertices)
     indptr, indices = kernels.vertex_face_lists(faces, n)
     values = np.ascontiguousarray(values)
-    n_calls = max(1, int(np.ceil(mean * n / PAIRS_PER_CALL)))
     out = np.zeros((n, values.shape[1]))
     scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0])  # once for all calls
-    for call in range(n_calls):  # Python between calls: Ctrl-C gets through
+    for start, stop in call_ranges(n, mean):
         kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radius, indptr, indices, out,
-                                    scratch, call * n // n_calls, (call + 1) * n // n_calls)
+                                    scratch, start, stop)
     return out
 
 

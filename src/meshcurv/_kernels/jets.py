@@ -9,7 +9,7 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, _JIT_REASSOC, _TINY, _tangent_frame
-from .neighborhoods import _ball_members, _connected_members, _grid
+from .neighborhoods import _ball_members, _connected_members, pool_grid
 
 
 @nb.njit(**_JIT)
@@ -65,16 +65,7 @@ def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot
     """
     n = vertices.shape[0]
     n_pool = pool.shape[0]
-    pooled = np.empty((n_pool, 3))
-    for k in range(n_pool):
-        pooled[k] = vertices[pool[k]]
-    grid = _grid(pooled, radius)
-    order = grid[0]
-    points = np.empty((n_pool, 3))
-    ids = np.empty(n_pool, np.int64)
-    for k in range(n_pool):
-        points[k] = pooled[order[k]]
-        ids[k] = pool[order[k]]
+    points, ids, grid = pool_grid(vertices, pool, radius)
     # centres in grid order: consecutive balls share cells (cache); centres outside the pool last
     chosen = np.zeros(n, np.bool_)
     chosen[centres] = True

@@ -99,6 +99,28 @@ def _grid(points, reach):
 
 
 @nb.njit(**_JIT)
+def pool_grid(points, pool, reach):
+    """``(pool_points, ids, grid)``: the points ``pool`` (int64 ids) sorted into a grid of cells of side ``reach``
+    or more (:func:`_grid`), their coordinates in that order and their ids.
+
+    The search structure of ``pointcloud.ball_indices`` and of ``jets.fit_jets`` (balls on a grid),
+    built once for all the centres of a computation.
+    """
+    m = pool.shape[0]
+    gathered = np.empty((m, 3))
+    for k in range(m):
+        gathered[k] = points[pool[k]]
+    grid = _grid(gathered, reach)
+    order = grid[0]
+    pool_points = np.empty((m, 3))
+    ids = np.empty(m, np.int64)
+    for k in range(m):
+        pool_points[k] = gathered[order[k]]
+        ids[k] = pool[order[k]]
+    return pool_points, ids, grid
+
+
+@nb.njit(**_JIT)
 def _ball_members(points, grid, cx, cy, cz, cutoff, out):
     """Ranks of the points within ``cutoff`` of ``(cx, cy, cz)`` written to ``out`` (grown when full).
 

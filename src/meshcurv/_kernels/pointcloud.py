@@ -13,6 +13,7 @@ import numpy as np
 
 from ._common import _JIT, _tangent_frame
 from .icc import _triangle_measures
+from .neighborhoods import _ball_members
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -129,41 +130,18 @@ def pca_normals(points, indices):
     return out
 
 
-#: The nine columns around a cell, nearest first (the points of a ball then arrive roughly in distance
-#: order and most insertions into the sorted row move few entries).
-_AROUND_X = (0, -1, 1, 0, 0, -1, -1, 1, 1)
-
-
-_AROUND_Y = (0, 0, 0, -1, 1, -1, 1, -1, 1)
-
-
-@nb.njit(**_JIT)
-def _first_at_least(keys, key, lo, hi):
-    """Position of the first of the sorted ``keys[lo:hi]`` that is ``>= key`` (``hi`` when none is)."""
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if keys[mid] < key:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
-
-
 @nb.njit(parallel=True, **_JIT)
-def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool, pool_points, columns):
-    """(M, k) the ``k`` nearest points of ``pool`` closer than ``radius`` to each centre, (M, k) their
+def ball_indices(points, centres, radius, k, pool_points, ids, grid, n_chunks):
+    """(M, k) the ``k`` nearest points of the pool closer than ``radius`` to each centre, (M, k) their
     squared distances (inf past the count) and (M,) their count.
 
-    The pool's points are sorted by the cell of a grid of side ``radius``
-    (``keys``: the sorted distinct cell numbers ``(x dims_y + y) dims_z + z``,
-    ``starts``: where each cell's run begins in ``pool``, one more entry at the
-    end; ``pool_points``: their coordinates in that order, read in sequence;
-    ``columns``: where the keys of each column ``x dims_y + y`` begin, one
-    more entry at the end, or ``[0, keys.size]`` for one column of all);
-    each centre looks in the 27 cells around its own (nine runs of three
-    consecutive cells along z, each found by bisection in its column). Rows are in
-    distance order (equal distances: lower index first), padded with
-    ``points.shape[0]`` as :meth:`scipy.spatial.cKDTree.query` does.
+    The pool is :func:`~meshcurv._kernels.neighborhoods.pool_grid` ``(pool_points, ids, grid)`` (with a reach of
+    ``radius`` or more): each ball's candidates are the grid's
+    (:func:`meshcurv._kernels.neighborhoods._ball_members`), kept when strictly
+    closer than ``radius``. Rows are in distance order (equal distances: lower
+    index first), padded with ``points.shape[0]``, as
+    :meth:`scipy.spatial.cKDTree.query` with ``distance_upper_bound`` gives them.
+    ``n_chunks``: runs of centres shared out to the threads (a member buffer each).
     """
     n = points.shape[0]
     m = centres.shape[0]
@@ -171,32 +149,21 @@ def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool, pool
     squared = np.full((m, k), np.inf)
     counts = np.zeros(m, dtype=np.int64)
     limit = radius * radius
-    for row in nb.prange(m):
-        c = centres[row]
-        px, py, pz = points[c, 0], points[c, 1], points[c, 2]
-        gx = int(np.floor((px - low[0]) / radius))
-        gy = int(np.floor((py - low[1]) / radius))
-        gz = int(np.floor((pz - low[2]) / radius))
-        found = 0
-        for step in range(9):  # the centre's column first, then its sides, then its corners
-            x, y = gx + _AROUND_X[step], gy + _AROUND_Y[step]
-            if x < 0 or y < 0 or x >= dims[0] or y >= dims[1]:
-                continue
-            # the (up to) three cells along z are consecutive numbers: one run of the pool
-            column = x * dims[1] + y
-            if columns.shape[0] > 2:
-                lo, hi = columns[column], columns[column + 1]
-            else:
-                lo, hi = columns[0], columns[1]
-            column *= dims[2]
-            first = _first_at_least(keys, column + max(gz - 1, 0), lo, hi)
-            last = _first_at_least(keys, column + min(gz + 1, dims[2] - 1) + 1, first, hi)
-            for t in range(starts[first], starts[last]):
+    n_chunks = max(min(m, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        members = np.empty(256, np.int64)
+        for row in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
+            c = centres[row]
+            px, py, pz = points[c, 0], points[c, 1], points[c, 2]
+            members, size = _ball_members(pool_points, grid, px, py, pz, radius, members)
+            found = 0
+            for a in range(size):
+                t = members[a]
                 dx, dy, dz = pool_points[t, 0] - px, pool_points[t, 1] - py, pool_points[t, 2] - pz
                 d = dx * dx + dy * dy + dz * dz
                 if not d < limit:
                     continue
-                q = pool[t]
+                q = ids[t]
                 if found == k and (d > squared[row, k - 1] or (d == squared[row, k - 1]
                                                                and q > index[row, k - 1])):
                     continue
@@ -211,7 +178,7 @@ def ball_indices(points, centres, radius, k, low, dims, keys, starts, pool, pool
                 index[row, j] = q
                 if found < k:
                     found += 1
-        counts[row] = found
+            counts[row] = found
     return index, squared, counts
 
 
