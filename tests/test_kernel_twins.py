@@ -812,9 +812,10 @@ def check_vertex_face_lists(name):
     vertices, faces = mesh(name)
     order = np.argsort(faces.ravel(), kind="stable")
     indptr = np.concatenate([[0], np.cumsum(np.bincount(faces.ravel(), minlength=vertices.shape[0]))])
-    got_indptr, got_indices = kernels("neighborhoods").vertex_face_lists(faces, vertices.shape[0])
-    np.testing.assert_array_equal(got_indptr, indptr)
-    np.testing.assert_array_equal(got_indices, order // 3)
+    for threads in (1, 2, 3, 64):  # each thread places its range of faces: the same lists however many
+        got_indptr, got_indices = kernels("neighborhoods").vertex_face_lists(faces, vertices.shape[0], threads)
+        np.testing.assert_array_equal(got_indptr, indptr)
+        np.testing.assert_array_equal(got_indices, order // 3)
 
 
 def cells_of(name, kind):
@@ -883,13 +884,19 @@ def check_ball_cell_sums(name):
 
 
 def check_connected_face_sums(name):
+    # 0.95 edges: the ball leaves out most corners of the 1-ring, whose sides still cross it (the walk must go on
+    # through the ends of a side that meets the ball with both ends outside); 2 edges: a ball of several rings
+    for edges in (0.95, 2.0):
+        check_connected_face_sums_at(name, edges * mean_edge(name))
+
+
+def check_connected_face_sums_at(name, radius):
     vertices, faces = mesh(name)
-    radius = 2.0 * mean_edge(name)
     compiled = kernels("neighborhoods")
     values = ball_values(name, "faces")
     usable = np.random.default_rng(4).random(faces.shape[0]) > 0.1
     centres, reach = compiled.cell_centres(vertices, faces)
-    indptr, indices = compiled.vertex_face_lists(faces, vertices.shape[0])
+    indptr, indices = compiled.vertex_face_lists(faces, vertices.shape[0], kernel_threads())
     n = vertices.shape[0]
     for mask in (None, usable):
         # on these meshes every ball's part of the surface is connected: the walk finds the

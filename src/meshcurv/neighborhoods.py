@@ -462,7 +462,7 @@ def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radiu
     usable = np.ones(faces.shape[0], dtype=bool) if usable is None else usable
     centres, reach = kernels.cell_centres(vertices, faces)
     mean, _ = check_ball_work(centres, radius + float(reach.max()), n, centres=vertices)
-    indptr, indices = kernels.vertex_face_lists(faces, n)
+    indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
     values = np.ascontiguousarray(values)
     out = np.zeros((n, values.shape[1]))
     scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0])  # once for all calls

@@ -10,27 +10,38 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT
+from .topology import _BUCKET_CHUNKS, bucket_starts
 
 
 #: A ball grid has at most this many columns of cells per point (and at least 4096 in all).
 _GRID_COLUMNS_PER_POINT = 4
 
 
-@nb.njit(**_JIT)
-def vertex_face_lists(faces, n_vertices):
-    """CSR lists of the faces around every vertex: ``(indptr, indices)``, faces in index order."""
-    indptr = np.zeros(n_vertices + 1, np.int64)
-    for f in range(faces.shape[0]):
-        for k in range(faces.shape[1]):
-            indptr[faces[f, k] + 1] += 1
-    for v in range(n_vertices):
-        indptr[v + 1] += indptr[v]
+@nb.njit(parallel=True, **_JIT)
+def vertex_face_lists(faces, n_vertices, n_chunks):
+    """CSR lists of the faces around every vertex: ``(indptr, indices)``, faces in index order.
+
+    Each of ``n_chunks`` threads (at most :data:`~meshcurv._kernels.topology._BUCKET_CHUNKS`)
+    counts, then places, the corners of its own range of faces: a vertex's list holds the
+    faces of the first range, then of the next, each in face order (the order of one pass
+    over all faces, whatever the number of threads), as ``topology.build_edges`` places its sides.
+    """
+    n_faces, corners = faces.shape
+    n_chunks = max(1, min(n_chunks, _BUCKET_CHUNKS, n_faces))
+    # cursor[c, v]: corners of face range c at vertex v, then where range c's next such face goes
+    cursor = np.zeros((n_chunks, n_vertices), np.int64)
+    for c in nb.prange(n_chunks):
+        for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
+            for k in range(corners):
+                cursor[c, faces[f, k]] += 1
+    indptr = bucket_starts(cursor)
     indices = np.empty(indptr[n_vertices], np.int64)
-    fill = indptr[:-1].copy()
-    for f in range(faces.shape[0]):
-        for k in range(faces.shape[1]):
-            indices[fill[faces[f, k]]] = f
-            fill[faces[f, k]] += 1
+    for c in nb.prange(n_chunks):
+        for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
+            for k in range(corners):
+                a = faces[f, k]
+                indices[cursor[c, a]] = f
+                cursor[c, a] += 1
     return indptr, indices
 
 

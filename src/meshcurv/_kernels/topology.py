@@ -14,6 +14,29 @@ _BUCKET_CHUNKS = 8
 
 
 @nb.njit(parallel=True, **_JIT)
+def bucket_starts(cursor):
+    """``(V + 1,)`` starts of the buckets of a counting sort whose (ranges, V) ``cursor`` holds the
+    count of each range of items at each vertex; ``cursor`` then becomes where each range's next
+    item at each vertex goes (range 0's items first, then range 1's, ...)."""
+    n_chunks, n_vertices = cursor.shape
+    starts = np.zeros(n_vertices + 1, np.int64)
+    for v in nb.prange(n_vertices):
+        total = 0
+        for c in range(n_chunks):
+            total += cursor[c, v]
+        starts[v + 1] = total
+    for v in range(n_vertices):
+        starts[v + 1] += starts[v]
+    for v in nb.prange(n_vertices):
+        at = starts[v]
+        for c in range(n_chunks):
+            count = cursor[c, v]
+            cursor[c, v] = at
+            at += count
+    return starts
+
+
+@nb.njit(parallel=True, **_JIT)
 def build_edges(faces, n_vertices, n_chunks):
     """Edges of the triangles, their faces and counts (see MeshTopology._build).
 
@@ -38,20 +61,7 @@ def build_edges(faces, n_vertices, n_chunks):
                 b = faces[f, (k + 1) % 3]
                 if a != b:
                     cursor[c, min(a, b)] += 1
-    bucket_start = np.zeros(n_vertices + 1, np.int64)
-    for v in nb.prange(n_vertices):
-        total = 0
-        for c in range(n_chunks):
-            total += cursor[c, v]
-        bucket_start[v + 1] = total
-    for v in range(n_vertices):
-        bucket_start[v + 1] += bucket_start[v]
-    for v in nb.prange(n_vertices):
-        at = bucket_start[v]
-        for c in range(n_chunks):
-            count = cursor[c, v]
-            cursor[c, v] = at
-            at += count
+    bucket_start = bucket_starts(cursor)
     n_sides = bucket_start[n_vertices]
     sort_key = np.empty(n_sides, np.int64)  # 2 * larger vertex + backward
     side_of = np.empty(n_sides, np.int64)
