@@ -818,6 +818,23 @@ def check_vertex_face_lists(name):
         np.testing.assert_array_equal(got_indices, order // 3)
 
 
+def check_reordering(name):
+    # the mesh shuffled (vertices and faces), so that the order to find is not the identity
+    from meshcurv import _locality
+
+    vertices, faces = mesh(name)
+    rng = np.random.default_rng(8)
+    order = rng.permutation(vertices.shape[0])
+    index = np.empty_like(order)
+    index[order] = np.arange(order.size)
+    vertices, faces = vertices[order], index[faces][rng.permutation(faces.shape[0])]
+    with use_backend("numpy"):
+        expected = _locality.reordering(vertices, faces)
+    got = _locality.reordering(vertices, faces)  # the compiled kernel
+    for field in ("order", "index", "face_order", "vertices", "faces"):
+        np.testing.assert_array_equal(getattr(got, field), getattr(expected, field), err_msg=field)
+
+
 def cells_of(name, kind):
     vertices, faces = mesh(name)
     return faces if kind == "faces" else np.ascontiguousarray(topology(name).edges)
@@ -1261,6 +1278,7 @@ TWINS = [
     Twin("smoothing.smooth_over_neighbours", "smoothing.smooth_vertex_field", check_smooth_over_neighbours, MESHES),
     Twin("icc.face_measures", "icc.face_measures", check_face_measures, MESHES),
     Twin("icc.curvatures_from_measures", "icc.curvatures_from_measures", check_curvatures_from_measures, MESHES),
+    Twin("locality.reordering", "_locality.reordering's NumPy path", check_reordering, MESHES),
     Twin("neighborhoods.vertex_face_lists", "a stable sort of the corners (no twin in the library)",
          check_vertex_face_lists, MESHES),
     Twin("neighborhoods.cell_centres", "the centres and reach of neighborhoods._ball_sums", check_cell_centres,

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+from typing import Any
 
 import numpy as np
 
 from ._adapters import mesh_arrays
+from ._locality import local_topology
 from ._validation import as_vertices, check_choice, check_int_option, check_positive_float, trusting
 from .diagnosis import diagnose, quality_message
 from .errors import InvalidOptionError, MeshQualityWarning
@@ -18,7 +20,7 @@ from .geometry import degenerate_faces
 from .neighborhoods import small_radius_note
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import INVALID_REASONS, CurvatureResult, Surface
-from .topology import MeshTopology, as_topology
+from .topology import MeshTopology
 from .weld import weld_vertices
 
 __all__ = ["principal_curvatures", "METHODS"]
@@ -52,7 +54,12 @@ def principal_curvatures(
         0-based vertex indices. Polygons (k > 3, or lists of varying length) are
         fan-triangulated as matGeom's ``triangulateFaces`` does, with a
         :class:`~meshcurv.errors.TriangulationWarning`. A :class:`MeshTopology`
-        built once with :meth:`MeshTopology.from_faces` skips the topology step.
+        built once with :meth:`MeshTopology.from_faces` skips the topology step
+        (unless the vertices come in a scattered order: a large mesh whose
+        neighbours are far apart in index order is computed with its vertices
+        in their Morton order and its topology built for it, then its results
+        put back in the caller's order, several times faster; see
+        :mod:`meshcurv._locality`).
     method : {'icc', 'normal_cycle', 'matgeom', 'quadric', 'rusinkiewicz', 'normal_cycle_ball', 'meyer'}, default: 'icc'
         - ``'icc'`` (default): interpolated corrected curvature measures over a
           ball (Lachaud et al. 2020) of normals from fitted degree-3 jets; takes
@@ -180,8 +187,8 @@ def principal_curvatures(
 
     if faces is None:
         vertices, faces = mesh_arrays(vertices)
-    points = as_vertices(vertices)
-    topology = as_topology(faces, points.shape[0], stacklevel=3)
+    callers = as_vertices(vertices)
+    points, topology, local = local_topology(callers, faces, stacklevel=3)  # a scattered order made local
     check_choice(orient, "orient", ORIENT_CHOICES)
     if orient == "auto":
         orient = "keep" if method == "matgeom" else "outward"
@@ -209,11 +216,19 @@ def principal_curvatures(
         reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
     parameters = {**result.parameters, **found, "orient": orient,
                   "n_welded_vertices": welding.n_welded if welding is not None else 0}
-    surface = Surface(points, topology.faces, welding.index if welding is not None and welding.n_welded else None)
+    # the rows of the computed result (welded vertices, in the local order) of each of the caller's vertices
+    index = welding.index if welding is not None and welding.n_welded else None
+    if local is not None:
+        index = local.index if index is None else index[local.index]
+    if local is not None and index is local.index:  # the mesh the caller gave, its faces oriented
+        surface = Surface(callers, local.original_faces(topology.faces))
+    else:
+        surface = Surface(points, topology.faces, index)
     result = dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons, parameters=parameters,
                                  _surface=surface)
+    if index is not None:
+        result = _expanded(result, index)
     if welding is not None and welding.n_welded:
-        result = _expanded(result, welding.index)
         problems = [f"welded {welding.n_welded} coincident vertices (a triangle soup or split seams) "
                     "before the computation; copies share their values"] + list(problems)
     if n_flipped:
@@ -267,7 +282,8 @@ def _flip_reason(diagnosis, orient: str) -> str:
 
 
 def _expanded(result: CurvatureResult, index: np.ndarray) -> CurvatureResult:
-    """The result of a welded mesh on the input's vertices: row ``i`` is the welded vertex ``index[i]``."""
-    fields = {name: getattr(result, name)[index]
-              for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason")}
+    """The result of a welded or reordered mesh on the input's vertices: row ``i`` is the computed row ``index[i]``."""
+    # np.take: several times faster than indexing the rows of an (N, 3) array
+    fields: dict[str, Any] = {name: np.take(getattr(result, name), index, axis=0)
+                              for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason")}
     return dataclasses.replace(result, **fields)

@@ -10,7 +10,7 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT
-from .topology import _BUCKET_CHUNKS, bucket_starts
+from .topology import _BUCKET_CHUNKS, _bucket_starts
 
 
 #: A ball grid has at most this many columns of cells per point (and at least 4096 in all).
@@ -34,7 +34,7 @@ def vertex_face_lists(faces, n_vertices, n_chunks):
         for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
             for k in range(corners):
                 cursor[c, faces[f, k]] += 1
-    indptr = bucket_starts(cursor)
+    indptr = _bucket_starts(cursor)
     indices = np.empty(indptr[n_vertices], np.int64)
     for c in nb.prange(n_chunks):
         for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):

@@ -14,7 +14,7 @@ _BUCKET_CHUNKS = 8
 
 
 @nb.njit(parallel=True, **_JIT)
-def bucket_starts(cursor):
+def _bucket_starts(cursor):
     """``(V + 1,)`` starts of the buckets of a counting sort whose (ranges, V) ``cursor`` holds the
     count of each range of items at each vertex; ``cursor`` then becomes where each range's next
     item at each vertex goes (range 0's items first, then range 1's, ...)."""
@@ -61,7 +61,7 @@ def build_edges(faces, n_vertices, n_chunks):
                 b = faces[f, (k + 1) % 3]
                 if a != b:
                     cursor[c, min(a, b)] += 1
-    bucket_start = bucket_starts(cursor)
+    bucket_start = _bucket_starts(cursor)
     n_sides = bucket_start[n_vertices]
     sort_key = np.empty(n_sides, np.int64)  # 2 * larger vertex + backward
     side_of = np.empty(n_sides, np.int64)

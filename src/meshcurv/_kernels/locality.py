@@ -1,0 +1,87 @@
+"""Compiled twins of :mod:`meshcurv._locality`: a local order of a mesh's vertices and faces."""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+from ._common import _JIT
+
+#: ``_locality._SPREAD``: the shifts and masks that move bit ``i`` of a 21-bit number to bit ``3 i``.
+_SPREAD = ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F), (4, 0x10C30C30C30C30C3),
+           (2, 0x1249249249249249))
+
+
+@nb.njit(parallel=True, **_JIT)
+def reordering(vertices, faces, lo, scale, bits):
+    """``_locality.reordering``: ``(order, index, face_order, new_vertices, new_faces)``.
+
+    The vertices in the order of their Morton codes (``bits`` bits per axis of
+    ``(x - lo) * scale``; stable), the faces renumbered and sorted by their
+    smallest new corner (a stable counting sort).
+    """
+    n = vertices.shape[0]
+    n_faces = faces.shape[0]
+    codes = np.zeros(n, np.uint64)
+    top = np.uint64(2**bits - 1)
+    for k in nb.prange(n):
+        code = np.uint64(0)
+        for a in range(3):
+            x = np.uint64((vertices[k, a] - lo[a]) * scale) & top
+            for shift, mask in _SPREAD:
+                x = (x | (x << np.uint64(shift))) & np.uint64(mask)
+            code |= x << np.uint64(a)
+        codes[k] = code
+    order = _radix_order(codes, 3 * bits)
+    index = np.empty(n, np.int64)
+    new_vertices = np.empty((n, 3))
+    for k in nb.prange(n):
+        index[order[k]] = k
+        for a in range(3):
+            new_vertices[k, a] = vertices[order[k], a]
+    renumbered = np.empty((n_faces, 3), np.int64)
+    for f in nb.prange(n_faces):
+        for a in range(3):
+            renumbered[f, a] = index[faces[f, a]]
+    starts = np.zeros(n + 1, np.int64)
+    for f in range(n_faces):
+        starts[min(renumbered[f, 0], renumbered[f, 1], renumbered[f, 2]) + 1] += 1
+    for v in range(n):
+        starts[v + 1] += starts[v]
+    face_order = np.empty(n_faces, np.int64)
+    for f in range(n_faces):
+        low = min(renumbered[f, 0], renumbered[f, 1], renumbered[f, 2])
+        face_order[starts[low]] = f
+        starts[low] += 1
+    new_faces = np.empty((n_faces, 3), np.int64)
+    for j in nb.prange(n_faces):
+        for a in range(3):
+            new_faces[j, a] = renumbered[face_order[j], a]
+    return order, index, face_order, new_vertices, new_faces
+
+
+@nb.njit(**_JIT)
+def _radix_order(codes, bits):
+    """(N,) indices of ``codes`` (uint64 of ``bits`` bits) in ascending order, stable: a radix sort
+    of 16-bit digits, least significant first (``np.argsort(kind="stable")``)."""
+    n = codes.shape[0]
+    order = np.arange(n)
+    keys = codes.copy()
+    next_order = np.empty(n, np.int64)
+    next_keys = np.empty(n, np.uint64)
+    mask = np.uint64(0xFFFF)
+    for shift in range(0, bits, 16):
+        starts = np.zeros(65537, np.int64)
+        for i in range(n):
+            starts[np.int64((keys[i] >> np.uint64(shift)) & mask) + 1] += 1
+        for d in range(65536):
+            starts[d + 1] += starts[d]
+        for i in range(n):
+            digit = np.int64((keys[i] >> np.uint64(shift)) & mask)
+            at = starts[digit]
+            starts[digit] += 1
+            next_order[at] = order[i]
+            next_keys[at] = keys[i]
+        order, next_order = next_order, order
+        keys, next_keys = next_keys, keys
+    return order
