@@ -68,7 +68,7 @@ def main(argv=None) -> int:
              f"a side (meshcurv reorders from {_locality.SPAN_LIMIT}, at {_locality.MIN_VERTICES:,} vertices "
              "or more).", ""]
     for label in args.sizes.split(","):
-        vertices, faces = speed.build_mesh(label)[:2]
+        _, vertices, faces = speed.build_mesh(label)
         lines += [f"## {label}: {vertices.shape[0]:,} vertices", "",
                   "| order | span | reordered | " + " | ".join(speed.label_of(k) for k in keys) + " |",
                   "|---|--:|---|" + "--:|" * len(keys)]

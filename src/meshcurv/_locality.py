@@ -17,9 +17,11 @@ faces, of the smallest index difference along a side exceeds
 :data:`SPAN_LIMIT`. Orders that are local in one direction (rows of a grid,
 the slices of marching cubes, an icosphere's triangles) keep one side of
 every face short however far apart their rows are (a median of 1), and they
-measure as fast as the Morton order; a shuffle within blocks of 256 vertices
-(a median of 55) stays in the first-level cache; within blocks of 4,096 (450)
-it is 1.6 times slower.
+measure as fast as the Morton order. A shuffle within blocks of 256 vertices
+(a median of 35-55) makes ``icc`` 17-22% slower at 100,000 and 1M vertices,
+one within blocks of 4,096 (about 440) 60%, a whole shuffle six times
+at 1M (``benchmarks/order.md``); the reordering costs about a tenth of the
+computation.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ logger = logging.getLogger(__name__)
 
 #: A mesh is scattered when the median over its faces of the smallest index difference
 #: along a side exceeds this ...
-SPAN_LIMIT = 128
+SPAN_LIMIT = 32
 
 #: ... and it has at least this many vertices (a smaller mesh stays in the caches).
 MIN_VERTICES = 32768
