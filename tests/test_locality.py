@@ -168,3 +168,12 @@ def test_a_given_topology_of_a_scattered_mesh_is_rebuilt_in_the_local_order(toru
     again = run(vertices, topology, "normal_cycle")
     np.testing.assert_allclose(again.k_max, base.k_max[order], rtol=0, atol=1e-10)
     np.testing.assert_array_equal(topology.faces, faces)  # the caller's topology is not changed
+
+
+def test_a_scattered_mesh_wider_than_the_float_range_is_computed_as_given(torus):
+    # its bounding box overflows: no Morton codes; the computation in the given order is still defined
+    vertices, faces, _ = shuffle(torus.vertices, torus.faces, 9)
+    vertices = vertices * 3e307  # within the float range, but -4 to 4 apart: 2.4e308
+    points, topology, local = _locality.local_topology(vertices, faces)
+    assert local is None and points is vertices
+    np.testing.assert_array_equal(topology.faces, faces)

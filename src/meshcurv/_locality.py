@@ -138,7 +138,9 @@ def local_topology(vertices: np.ndarray, faces, *, stacklevel: int = 3
     else:
         topology = None
         triangles = as_faces(faces, n, stacklevel=stacklevel + 1)
-    if not is_scattered(n, triangles):
+    with np.errstate(over="ignore", invalid="ignore"):
+        finite = n == 0 or bool(np.isfinite(vertices.max(axis=0) - vertices.min(axis=0)).all())
+    if not (finite and is_scattered(n, triangles)):  # (a bounding box wider than the float range: as given)
         return vertices, topology if topology is not None else MeshTopology._build(triangles, n), None
     logger.info("the vertices come in a scattered order (median index difference along a face's shortest "
                 "side: %d): computed in their Morton order", median_side_span(triangles))
