@@ -58,8 +58,8 @@ def principal_curvatures(
         (unless the vertices come in a scattered order: a large mesh whose
         neighbours are far apart in index order is computed with its vertices
         in their Morton order and its topology built for it, then its results
-        put back in the caller's order, several times faster; see
-        :mod:`meshcurv._locality`).
+        put back in the caller's order: the same numbers, several times
+        faster on a shuffled mesh; ``benchmarks/order.md``).
     method : {'icc', 'normal_cycle', 'matgeom', 'quadric', 'rusinkiewicz', 'normal_cycle_ball', 'meyer'}, default: 'icc'
         - ``'icc'`` (default): interpolated corrected curvature measures over a
           ball (Lachaud et al. 2020) of normals from fitted degree-3 jets; takes
