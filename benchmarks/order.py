@@ -49,7 +49,7 @@ def shuffled(vertices, faces, block, seed=0):
 def machine_line() -> str:
     info = speed.machine_info()
     versions = ", ".join(f"{name} {version}" for name, version in info["versions"].items())
-    return (f"- Machine: {info['cpu']}, {info['cores']} cores; load average at start {info['load_start']}; "
+    return (f"- Machine: {info['cpu']}, {info['cores']} cores; load average at start {tuple(round(x, 1) for x in info['load_start'])}; "
             f"{versions}; meshcurv at commit {info['commit']}")
 
 
