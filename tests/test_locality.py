@@ -3,8 +3,8 @@
 The oracle is re-indexing invariance: a shuffled mesh (vertices and faces) must
 give the results of the mesh in its own order, permuted, to round-off (the
 sums run in another order); the reordering itself is checked against its
-definition (Morton codes, stable sorts) and the compiled path against the
-NumPy one.
+definition (Morton codes, stable sorts) on both backends; the compiled path
+against the NumPy one is a row of tests/test_kernel_twins.py.
 """
 
 import logging
@@ -97,17 +97,6 @@ def test_the_reordering_is_the_morton_order_and_its_faces_by_first_corner(backen
     assert (local.face_order[ties] < local.face_order[ties + 1]).all()  # stable
     np.testing.assert_array_equal(local.original_faces(local.faces), faces)
     assert _locality.median_side_span(local.faces) <= 2
-
-
-@pytest.mark.skipif(not HAS_NUMBA, reason="numba not installed")
-def test_the_compiled_reordering_is_the_numpy_one(torus):
-    vertices, faces, _ = shuffle(torus.vertices, torus.faces, 4)
-    with use_backend("numpy"):
-        expected = _locality.reordering(vertices, faces)
-    with use_backend("numba"):
-        got = _locality.reordering(vertices, faces)
-    for name in ("order", "index", "face_order", "vertices", "faces"):
-        np.testing.assert_array_equal(getattr(got, name), getattr(expected, name), err_msg=name)
 
 
 @pytest.mark.parametrize("method", ["icc", "normal_cycle", "matgeom"])

@@ -93,17 +93,22 @@ def is_scattered(n_vertices: int, faces: np.ndarray) -> bool:
     return n_vertices >= MIN_VERTICES and median_side_span(faces) > SPAN_LIMIT
 
 
-def reordering(vertices: np.ndarray, faces: np.ndarray) -> Reordering:
+def reordering(vertices: np.ndarray, faces: np.ndarray) -> Reordering | None:
     """The (V, 3) ``vertices`` in the order of their Morton codes (Z-order on a grid of ``2**21``
     cells along the longest side of the bounding box; stable) and the (F, 3) ``faces`` renumbered
-    and sorted by their smallest new corner (stable)."""
+    and sorted by their smallest new corner (stable). None when the bounding box is wider than
+    the float range (no codes of overflowed coordinates)."""
     n = vertices.shape[0]
-    lo = vertices.min(axis=0) if n else np.zeros(3)
-    extent = float((vertices.max(axis=0) - lo).max()) if n else 0.0
+    with np.errstate(over="ignore", invalid="ignore"):
+        lo = vertices.min(axis=0) if n else np.zeros(3)
+        extent = float((vertices.max(axis=0) - lo).max()) if n else 0.0
+    if not np.isfinite(extent):
+        return None
     scale = (2**_BITS - 1) / extent if extent > 0 else 0.0
     kernels = numba_kernels("locality")
     if kernels is not None:
-        return Reordering(*kernels.reordering(vertices, faces, lo, scale, _BITS))
+        return Reordering(*kernels.reordering(vertices, faces, lo, scale, _BITS,
+                                                np.array(_SPREAD, dtype=np.uint64)))
     codes = np.zeros(n, dtype=np.uint64)
     for axis in range(3):
         x = ((vertices[:, axis] - lo[axis]) * scale).astype(np.uint64) & np.uint64(2**_BITS - 1)
@@ -138,11 +143,9 @@ def local_topology(vertices: np.ndarray, faces, *, stacklevel: int = 3
     else:
         topology = None
         triangles = as_faces(faces, n, stacklevel=stacklevel + 1)
-    with np.errstate(over="ignore", invalid="ignore"):
-        finite = n == 0 or bool(np.isfinite(vertices.max(axis=0) - vertices.min(axis=0)).all())
-    if not (finite and is_scattered(n, triangles)):  # (a bounding box wider than the float range: as given)
+    local = reordering(vertices, triangles) if is_scattered(n, triangles) else None
+    if local is None:  # a local order (or a bounding box wider than the float range): as given
         return vertices, topology if topology is not None else MeshTopology._build(triangles, n), None
     logger.info("the vertices come in a scattered order (median index difference along a face's shortest "
                 "side: %d): computed in their Morton order", median_side_span(triangles))
-    local = reordering(vertices, triangles)
     return local.vertices, MeshTopology._build(local.faces, n), local

@@ -217,10 +217,11 @@ def principal_curvatures(
     parameters = {**result.parameters, **found, "orient": orient,
                   "n_welded_vertices": welding.n_welded if welding is not None else 0}
     # the rows of the computed result (welded vertices, in the local order) of each of the caller's vertices
-    index = welding.index if welding is not None and welding.n_welded else None
+    welded = welding if welding is not None and welding.n_welded else None
+    index = None if welded is None else welded.index
     if local is not None:
-        index = local.index if index is None else index[local.index]
-    if local is not None and index is local.index:  # the mesh the caller gave, its faces oriented
+        index = local.index if welded is None else welded.index[local.index]
+    if local is not None and welded is None:  # the mesh the caller gave, its faces oriented
         surface = Surface(callers, local.original_faces(topology.faces))
     else:
         surface = Surface(points, topology.faces, index)
@@ -228,8 +229,8 @@ def principal_curvatures(
                                  _surface=surface)
     if index is not None:
         result = _expanded(result, index)
-    if welding is not None and welding.n_welded:
-        problems = [f"welded {welding.n_welded} coincident vertices (a triangle soup or split seams) "
+    if welded is not None:
+        problems = [f"welded {welded.n_welded} coincident vertices (a triangle soup or split seams) "
                     "before the computation; copies share their values"] + list(problems)
     if n_flipped:
         problems = list(problems) + [_flip_reason(diagnosis, orient)]

@@ -6,19 +6,17 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT
-
-#: ``_locality._SPREAD``: the shifts and masks that move bit ``i`` of a 21-bit number to bit ``3 i``.
-_SPREAD = ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F), (4, 0x10C30C30C30C30C3),
-           (2, 0x1249249249249249))
+from .topology import _bucket_starts
 
 
 @nb.njit(parallel=True, **_JIT)
-def reordering(vertices, faces, lo, scale, bits):
+def reordering(vertices, faces, lo, scale, bits, spread):
     """``_locality.reordering``: ``(order, index, face_order, new_vertices, new_faces)``.
 
     The vertices in the order of their Morton codes (``bits`` bits per axis of
-    ``(x - lo) * scale``; stable), the faces renumbered and sorted by their
-    smallest new corner (a stable counting sort).
+    ``(x - lo) * scale``, spread to every third bit by the (steps, 2) uint64
+    ``(shift, mask)`` rows of ``spread``; stable), the faces renumbered and sorted by their smallest new
+    corner (a stable counting sort).
     """
     n = vertices.shape[0]
     n_faces = faces.shape[0]
@@ -28,8 +26,8 @@ def reordering(vertices, faces, lo, scale, bits):
         code = np.uint64(0)
         for a in range(3):
             x = np.uint64((vertices[k, a] - lo[a]) * scale) & top
-            for shift, mask in _SPREAD:
-                x = (x | (x << np.uint64(shift))) & np.uint64(mask)
+            for step in range(spread.shape[0]):
+                x = (x | (x << spread[step, 0])) & spread[step, 1]
             code |= x << np.uint64(a)
         codes[k] = code
     order = _radix_order(codes, 3 * bits)
@@ -43,16 +41,15 @@ def reordering(vertices, faces, lo, scale, bits):
     for f in nb.prange(n_faces):
         for a in range(3):
             renumbered[f, a] = index[faces[f, a]]
-    starts = np.zeros(n + 1, np.int64)
+    cursor = np.zeros((1, n), np.int64)  # faces by smallest corner, then where the next one goes
     for f in range(n_faces):
-        starts[min(renumbered[f, 0], renumbered[f, 1], renumbered[f, 2]) + 1] += 1
-    for v in range(n):
-        starts[v + 1] += starts[v]
+        cursor[0, min(renumbered[f, 0], renumbered[f, 1], renumbered[f, 2])] += 1
+    _bucket_starts(cursor)
     face_order = np.empty(n_faces, np.int64)
     for f in range(n_faces):
         low = min(renumbered[f, 0], renumbered[f, 1], renumbered[f, 2])
-        face_order[starts[low]] = f
-        starts[low] += 1
+        face_order[cursor[0, low]] = f
+        cursor[0, low] += 1
     new_faces = np.empty((n_faces, 3), np.int64)
     for j in nb.prange(n_faces):
         for a in range(3):
