@@ -925,9 +925,10 @@ def check_connected_face_sums_at(name, radius):
                                      _face_sum_scratch(kernel_threads(), n, faces.shape[0]), 0, n)
         assert_sums_close(got, expected, magnitude, ball_terms(name, "faces", radius),
                           "all faces" if mask is None else "usable faces")
-        # ranges of centres, one scratch for all (as the calls of ball_face_sums): only their rows each time
+        # ranges of centres, one scratch for all (as the calls of ball_face_sums): only their rows each time;
+        # with the int64 scratch of meshes whose indices do not fit in int32 (this one's are int32)
         part = np.zeros_like(expected)
-        scratch = _face_sum_scratch(3, n, faces.shape[0])
+        scratch = tuple(a.astype(np.int64) if a.dtype == np.int32 else a for a in _face_sum_scratch(3, n, faces.shape[0]))
         compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices, part,
                                      scratch, n // 3, n // 2)
         np.testing.assert_array_equal(part[n // 3:n // 2], got[n // 3:n // 2])
@@ -936,6 +937,16 @@ def check_connected_face_sums_at(name, radius):
             compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices,
                                          part, scratch, lo, hi)
         np.testing.assert_array_equal(part, got)
+
+
+def test_face_sum_scratch_takes_int64_only_beyond_int32_indices():
+    small = _face_sum_scratch(2, 10, 16)
+    assert [a.dtype for a in small] == [np.int32, np.int32, np.int32, np.float64, np.int32]
+    assert [a.shape for a in small] == [(2, 16), (2, 10), (2, 10), (2, 10), (2, 10)]
+    assert all((a == -1).all() for a in small[:3])
+    # no chunks: the dtype is chosen without allocating a mesh of 2^31 faces
+    large = _face_sum_scratch(0, 10, 2**31)
+    assert [a.dtype for a in large] == [np.int64, np.int64, np.int64, np.float64, np.int64]
 
 
 # -- jets ---------------------------------------------------------------------------------------

@@ -445,14 +445,17 @@ def call_ranges(n: int, pairs_per_centre: float) -> list[tuple[int, int]]:
 def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int) -> tuple[np.ndarray, ...]:
     """The per-thread scratch of the compiled ``connected_face_sums``: ``(seen, mark, known, squared, queue)``.
 
-    ``seen`` (n_chunks, F), ``mark`` and ``known`` (n_chunks, V) int64 filled with -1, ``squared``
-    (n_chunks, V) float and ``queue`` (n_chunks, V) int64. Allocated once for all the calls over
+    ``seen`` (n_chunks, F), ``mark`` and ``known`` (n_chunks, V) filled with -1, ``squared``
+    (n_chunks, V) float and ``queue`` (n_chunks, V). Allocated once for all the calls over
     one mesh: each array is stamped with the centre it was last written for, and every centre is
-    summed once, so no call needs it cleared again.
+    summed once, so no call needs it cleared again. The stamps and the queue hold vertex
+    indices: int32 while the vertex and face counts fit in it (half the memory: 40 bytes per vertex
+    on 2 threads), int64 beyond.
     """
-    return (np.full((n_chunks, n_faces), -1, np.int64), np.full((n_chunks, n_vertices), -1, np.int64),
-            np.full((n_chunks, n_vertices), -1, np.int64), np.empty((n_chunks, n_vertices)),
-            np.empty((n_chunks, n_vertices), np.int64))
+    index = np.int32 if max(n_vertices, n_faces) < np.iinfo(np.int32).max else np.int64
+    return (np.full((n_chunks, n_faces), -1, index), np.full((n_chunks, n_vertices), -1, index),
+            np.full((n_chunks, n_vertices), -1, index), np.empty((n_chunks, n_vertices)),
+            np.empty((n_chunks, n_vertices), index))
 
 
 def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,

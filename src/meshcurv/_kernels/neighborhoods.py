@@ -282,8 +282,11 @@ def connected_face_sums(vertices, faces, centroids, reach, usable, values, radiu
         known = all_known[chunk]  # distance to this centre in `squared`
         squared = all_squared[chunk]
         queue = all_queue[chunk]  # a vertex is queued at most once per centre: never grown
+        total = np.empty(n_values)  # the centre's sums, in the order of the face visits, then stored once
         for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
             cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+            for k in range(n_values):
+                total[k] = out[v, k]
             mark[v] = v
             queue[0] = v
             head, tail = 0, 1
@@ -326,13 +329,15 @@ def connected_face_sums(vertices, faces, centroids, reach, usable, values, radiu
                         share = (radius - root) / (math.sqrt(high) - root)
                     if share != 0.0 and usable[f]:
                         for k in range(n_values):
-                            out[v, k] += share * values[f, k]
+                            total[k] += share * values[f, k]
                     for corner in range(3):
                         c = faces[f, corner]
                         if mark[c] != v:
                             mark[c] = v
                             queue[tail] = c
                             tail += 1
+            for k in range(n_values):
+                out[v, k] = total[k]
 
 
 @nb.njit(parallel=True, **_JIT)
