@@ -9,6 +9,9 @@ a dependency of meshcurv)::
     python benchmarks/speed.py --sizes 10k,100k         # a quick check
     python benchmarks/speed.py --no-peers --budget 600  # meshcurv only, slow methods allowed 10 min per call
     python benchmarks/speed.py --sizes 100k,655k,1M --methods icc,normal_cycle,matgeom --backends numba
+    # the committed speed.md:
+    python benchmarks/speed.py --sizes 100k,1M,4M --methods icc,normal_cycle,matgeom --backends numba \
+        --radius-sizes none --rounds 3 --repeats 1
 
 Meshes: ``meshcurv.shapes.icosphere(n)`` (10 n^2 + 2 vertices: 10k n=32, 100k
 n=100, 1M n=316, 4M n=632) and ``../shared/meshes/igea.obj`` (beside the repository) (134k vertices)
@@ -17,7 +20,10 @@ when present.
 How each figure is measured:
 
 - **time**: median of ``--repeats`` calls (at most 3 from 2M vertices; a single
-  call when the first takes more than ``--long`` seconds) in this process, on the
+  call when the first takes more than ``--long`` seconds) in each of ``--rounds``
+  passes through all the implementations of a mesh (the committed table: 3 rounds
+  of one call, so that a slow spell of this shared VM, which can last seconds,
+  slows one call of several implementations rather than every call of one), in this process, on the
   same in-memory arrays, after a warm-up of every implementation on a small mesh
   (numba kernels loaded from the cache). meshcurv runs in this process; every
   peer (libigl, VTK, trueform, trimesh, pymeshlab) runs in a child process
@@ -729,6 +735,14 @@ class Bench:
                                      "skipped": f"not run above {args.trimesh_max} vertices"})
                         continue
                     rows.append(self.measure(key, label, v, f, mesh_dir, repeats))
+                for round_ in range(1, args.rounds):  # again through every implementation: times only
+                    log(f"{label}: round {round_ + 1} of {args.rounds}")
+                    for row in rows:
+                        if "times" not in row or max(row["times"]) > args.long:
+                            continue  # not run, failed, or too long to repeat (as within a round)
+                        again = self.measure(row["key"], label, v, f, mesh_dir, repeats, memory=False)
+                        row["times"] = row["times"] + again.get("times", [])
+                        row["cpu"] = row.get("cpu", []) + again.get("cpu", [])
                 self.rows[label] = rows
                 if label in args.radius_sizes.split(","):
                     self.radius_sweep(label, v, f, mesh_dir, min(repeats, 3))
@@ -834,7 +848,11 @@ def markdown(bench) -> str:
         "",
         "Time: median of the calls in one process on the same in-memory arrays, after a warm-up on a small "
         "mesh (meshcurv in this process; every peer in a child process fed the same arrays through .npy "
-        "files, its repeats inside it, `fresh` its first call there). `runs`: calls in the median. `fresh`: the same call once in a fresh "
+        "files, its repeats inside it, `fresh` its first call there). `runs`: calls in the median"
+        + (f", {args.rounds} rounds through all the implementations of a mesh, each of up to {args.repeats} calls in a row "
+           "(a slow spell of the machine then falls on one round of several implementations, not on every call of one)"
+           if args.rounds > 1 else "")
+        + ". `fresh`: the same call once in a fresh "
         "process (numba rows: kernels loaded from the numba cache). Peak RSS: the high-water mark (`VmHWM`, "
         "what `ru_maxrss` reports without the value Linux carries over from the parent process) of that fresh "
         "process after the call (interpreter, libraries and the input arrays included); bytes/vertex = peak "
@@ -1077,7 +1095,13 @@ def main(argv=None):
     parser.add_argument("--methods", default="",
                         help="meshcurv methods to time, comma-separated (default: all)")
     parser.add_argument("--backends", default="", help="numpy, numba or both (default: all installed)")
-    parser.add_argument("--repeats", type=int, default=5, help="calls per median (3 at most from 2M vertices)")
+    parser.add_argument("--repeats", type=int, default=5,
+                        help="calls in a row per implementation and round (3 at most from 2M vertices)")
+    parser.add_argument("--rounds", type=int, default=1,
+                        help="passes through all the implementations of a mesh, each timing --repeats calls: "
+                             "the median is over all of them, so that a slow spell of the machine falls on "
+                             "one call of several implementations rather than on all the calls of one "
+                             "(default: %(default)s)")
     parser.add_argument("--output", default=OUTPUT, help="markdown file to write (default: %(default)s)")
     parser.add_argument("--peers", action=argparse.BooleanOptionalAction, default=True,
                         help="time the installed peers (default: yes)")
