@@ -9,9 +9,9 @@ a dependency of meshcurv)::
     python benchmarks/speed.py --sizes 10k,100k         # a quick check
     python benchmarks/speed.py --no-peers --budget 600  # meshcurv only, slow methods allowed 10 min per call
     python benchmarks/speed.py --sizes 100k,655k,1M --methods icc,normal_cycle,matgeom --backends numba
-    # the committed speed.md:
+    # speed_rounds.md (speed.md is still the run of --repeats 3 without rounds that the README quotes):
     python benchmarks/speed.py --sizes 100k,1M,4M --methods icc,normal_cycle,matgeom --backends numba \
-        --radius-sizes none --rounds 3 --repeats 1
+        --radius-sizes none --rounds 3 --repeats 1 --long 30 --output benchmarks/speed_rounds.md
 
 Meshes: ``meshcurv.shapes.icosphere(n)`` (10 n^2 + 2 vertices: 10k n=32, 100k
 n=100, 1M n=316, 4M n=632) and ``../shared/meshes/igea.obj`` (beside the repository) (134k vertices)
@@ -21,7 +21,7 @@ How each figure is measured:
 
 - **time**: median of ``--repeats`` calls (at most 3 from 2M vertices; a single
   call when the first takes more than ``--long`` seconds) in each of ``--rounds``
-  passes through all the implementations of a mesh (the committed table: 3 rounds
+  passes through all the implementations of a mesh (speed_rounds.md: 3 rounds
   of one call, so that a slow spell of this shared VM, which can last seconds,
   slows one call of several implementations rather than every call of one), in this process, on the
   same in-memory arrays, after a warm-up of every implementation on a small mesh
