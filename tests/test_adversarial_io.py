@@ -311,7 +311,7 @@ def test_write_into_a_folder_that_refuses_the_temporary_names_the_output(tmp_pat
     def refuse(*args, **kwargs):
         raise PermissionError(13, "Permission denied", str(tmp_path / ".t.obj.abc123.obj"))
 
-    monkeypatch.setattr(_files.tempfile, "mkstemp", refuse)
+    monkeypatch.setattr(_files.os, "open", refuse)
     with pytest.raises(MeshFileError, match=r"t\.obj: cannot be written \(Permission denied\)") as caught:
         meshcurv.write_mesh(tmp_path / "t.obj", torus.vertices, torus.faces)
     assert ".t.obj." not in str(caught.value)
@@ -319,6 +319,26 @@ def test_write_into_a_folder_that_refuses_the_temporary_names_the_output(tmp_pat
     with pytest.raises(MeshFileError, match=r"gone[/\\]t\.obj: cannot be written"):
         with _files.atomic_output(tmp_path / "gone" / "t.obj"):
             pass
+
+
+def test_an_output_takes_the_umask_and_the_umask_is_never_changed(tmp_path, torus, monkeypatch):
+    """Outputs get 0o666 less the umask, as open() gives; the process-wide umask is not touched meanwhile.
+
+    Setting the umask, even for a moment, would change the mode of the files that other threads
+    create in that moment (world-writable files under a umask of 0).
+    """
+    previous = os.umask(0o027)
+    try:
+        def changed(*args):
+            raise AssertionError("the process umask was changed during a write")
+
+        monkeypatch.setattr(_files.os, "umask", changed)
+        meshcurv.write_mesh(tmp_path / "t.obj", torus.vertices, torus.faces)
+        monkeypatch.undo()
+    finally:
+        os.umask(previous)
+    assert (tmp_path / "t.obj").stat().st_mode & 0o777 == 0o640
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.obj"]
 
 
 # ---------------------------------------------------------------- 9. exclusive creation, real file identity

@@ -5,7 +5,7 @@ from __future__ import annotations
 import contextlib
 import os
 import pathlib
-import tempfile
+import secrets
 
 from ..errors import MeshFileError
 
@@ -84,16 +84,10 @@ def atomic_output(path: pathlib.Path, *, overwrite: bool = True):
         names ``path``, never the temporary.
     """
     path = pathlib.Path(path)
-    try:
-        handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
-    except OSError as exc:
-        raise MeshFileError(f"{path}: cannot be written ({exc.strerror or exc})") from exc
-    os.close(handle)
-    temporary = pathlib.Path(name)
+    temporary = _temporary_beside(path)
     try:
         yield temporary
         try:
-            os.chmod(temporary, 0o666 & ~_umask())
             if overwrite:
                 os.replace(temporary, path)
             else:
@@ -123,7 +117,23 @@ def _publish_exclusive(temporary: pathlib.Path, path: pathlib.Path) -> None:
     os.replace(temporary, path)
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
+def _temporary_beside(path: pathlib.Path) -> pathlib.Path:
+    """Create an empty, new file ``.<name>.<random><suffix>`` beside ``path`` and return its path.
+
+    It is created with mode 0o666, so the operating system applies the
+    process's umask to it, as to any file the process creates: the published
+    output gets the same permissions as a plain ``open(path, "w")`` would give
+    it. The umask itself is never read or changed (changing it, even for a
+    moment, would change the mode of the files other threads create then).
+    """
+    for _ in range(100):
+        candidate = path.parent / f".{path.name}.{secrets.token_hex(6)}{path.suffix}"
+        try:
+            descriptor = os.open(candidate, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        except FileExistsError:
+            continue
+        except OSError as exc:
+            raise MeshFileError(f"{path}: cannot be written ({exc.strerror or exc})") from exc
+        os.close(descriptor)
+        return candidate
+    raise MeshFileError(f"{path}: cannot be written (no free temporary name in {path.parent})")
