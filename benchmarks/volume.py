@@ -264,7 +264,8 @@ def _timed(image, sample, workers):
             before = sum(cpu for cpu, _ in client.run(_worker_usage).values())
         cpu = _cpu_seconds()
         start = time.perf_counter()
-        total, rows = label_surfaces(image, labels_to_use=sample, keep_surfaces=False, client=client)
+        total, rows = label_surfaces(image, spacing=(1.0, 1.0, 1.0), labels_to_use=sample, keep_surfaces=False,
+                                     client=client)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             statuses = [row["status"] for row, _ in rows]

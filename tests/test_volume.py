@@ -23,6 +23,8 @@ pandas = pytest.importorskip("pandas")
 from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshFileError, MeshQualityWarning  # noqa: E402
 from meshcurv.volume import COLUMNS, label_curvatures  # noqa: E402
 
+UNIT = (1.0, 1.0, 1.0)  # the voxel size of the tests (a call without spacing warns)
+
 REQUIRED = ("label", "n_vertices", "area", "volume", "equivalent_radius", "mean_weighted", "mean_median",
             "mean_p5", "mean_p95", "gaussian_weighted", "k_min_weighted", "k_max_weighted", "shape_index_weighted",
             "curvedness_weighted", "total_mean", "total_gaussian", "willmore", "euler_characteristic",
@@ -64,7 +66,7 @@ def relative(value, truth):
 def test_sphere_area_volume_curvature_and_gauss_bonnet():
     radius = 9.0
     image = solid((24, 24, 24), (1, 1, 1), (11.7, 12.2, 11.4), (radius,) * 3).astype(np.uint8)
-    table, surfaces = label_curvatures(image, return_meshes=True)
+    table, surfaces = label_curvatures(image, spacing=UNIT, return_meshes=True)
     assert set(REQUIRED) <= set(table.columns) and list(table.columns) == list(COLUMNS)
     row = table.iloc[0]
     assert row.status == "ok" and row.label == 1 and not row.touches_border and row.n_invalid == 0
@@ -104,7 +106,7 @@ def test_rotated_ellipsoid_with_anisotropic_voxels():
 
 def test_anisotropic_spacing_gives_the_physical_answers_of_isotropic():
     center, radius = np.array([11.3, 11.8, 12.2]), 9.0
-    iso = label_curvatures(solid((24, 24, 24), (1, 1, 1), center, (radius,) * 3)).iloc[0]
+    iso = label_curvatures(solid((24, 24, 24), (1, 1, 1), center, (radius,) * 3), spacing=UNIT).iloc[0]
     aniso = label_curvatures(solid((24, 48, 48), (1, 0.5, 0.5), center, (radius,) * 3), spacing=(1, 0.5, 0.5)).iloc[0]
     for column in ("area", "volume", "mean_weighted", "total_gaussian"):
         assert relative(aniso[column], iso[column]) < 0.03, column
@@ -116,7 +118,7 @@ def test_hollow_ball_wall_faces_into_the_cavity():
     outer, inner = 10.0, 6.0
     center = (12.4, 12.1, 11.8)
     shell = solid((25, 25, 25), (1, 1, 1), center, (outer,) * 3) & ~solid((25, 25, 25), (1, 1, 1), center, (inner,) * 3)
-    row = label_curvatures(shell).iloc[0]
+    row = label_curvatures(shell, spacing=UNIT).iloc[0]
     assert row.euler_characteristic == 4  # two closed surfaces
     assert relative(row.volume, 4 / 3 * np.pi * (outer**3 - inner**3)) < 0.02
     assert relative(row.total_gaussian, 8 * np.pi) < 0.03
@@ -129,7 +131,7 @@ def test_two_labels_touching_each_other():
     image = np.zeros(ball.shape, dtype=np.int32)
     image[ball] = 7
     image[ball & (np.arange(24)[None, None, :] >= 12)] = 3  # the right half: another label, touching
-    table = label_curvatures(image)
+    table = label_curvatures(image, spacing=UNIT)
     assert list(table.label) == [3, 7]
     assert (table.status == "ok").all() and not table.touches_border.any()
     assert list(table.n_voxels) == [(image == 3).sum(), (image == 7).sum()]
@@ -141,7 +143,7 @@ def test_two_labels_touching_each_other():
 def test_label_cut_by_the_border_is_flagged_and_its_cap_left_out():
     radius = 12.0
     image = solid((20, 30, 30), (1, 1, 1), (4.0, 14.2, 13.9), (radius,) * 3)  # cut by the plane z = -0.5
-    table, surfaces = label_curvatures(image, return_meshes=True)
+    table, surfaces = label_curvatures(image, spacing=UNIT, return_meshes=True)
     row, surface = table.iloc[0], surfaces[1]
     assert row.touches_border and row.status == "ok"
     assert 0 < row.n_used < row.n_vertices
@@ -149,14 +151,15 @@ def test_label_cut_by_the_border_is_flagged_and_its_cap_left_out():
     # no vertex within the reach of the normal fits (3 radii) of the cap in the statistics
     assert surface.vertices[surface.used, 0].min() - low >= 3 * row.radius
     assert relative(row.mean_weighted, 1 / radius) < 0.03  # the cap (H = 0) would pull it down
-    assert row.area < 4 * np.pi * radius**2
+    # the area of the part inside (a zone of height R + 4.5): more in tests/test_volume_border.py
+    assert relative(row.area, 2 * np.pi * radius * (radius + 4.5)) < 0.03
 
 
 def test_empty_and_tiny_labels_get_a_row_with_the_reason():
     image = solid((24, 24, 24), (1, 1, 1), (11.6, 11.9, 12.3), (8.0,) * 3).astype(np.uint16)
     image[1, 1, 1] = 2  # one voxel
     with pytest.warns(MeshQualityWarning, match="2 of 3 labels have no curvature"):
-        table = label_curvatures(image, labels_to_use=[1, 2, 5])
+        table = label_curvatures(image, spacing=UNIT, labels_to_use=[1, 2, 5])
     status = dict(zip(table.label, table.status))
     assert status == {1: "ok", 2: "too_small", 5: "empty"}
     errors = dict(zip(table.label, table.error))
@@ -179,7 +182,7 @@ def test_one_failing_label_does_not_sink_the_others(monkeypatch):
 
     monkeypatch.setattr(volume, "principal_curvatures", failing)
     with pytest.warns(MeshQualityWarning, match="1 failed"):
-        table = label_curvatures(image)
+        table = label_curvatures(image, spacing=UNIT)
     assert list(table.status) == ["ok", "failed"]
     assert table.error[1] == "ValueError: a fault in the estimator"
 
@@ -188,20 +191,21 @@ def test_huge_label_values_keep_their_identity():
     ball = solid((16, 16, 16), (1, 1, 1), (7.6, 7.8, 7.3), (5.0,) * 3)
     image = np.where(ball, np.uint64(2**63 + 5), np.uint64(2**40))  # no background voxel at all
     image[0] = 0
-    table = label_curvatures(image, labels_to_use=[2**63 + 5])
+    table = label_curvatures(image, spacing=UNIT, labels_to_use=[2**63 + 5])
     assert table.label.tolist() == [2**63 + 5] and table.status.tolist() == ["ok"]
     assert table.n_voxels[0] == ball.sum()
 
 
 def test_no_label_gives_an_empty_table():
-    table = label_curvatures(np.zeros((8, 8, 8), dtype=np.uint8))
+    table = label_curvatures(np.zeros((8, 8, 8), dtype=np.uint8), spacing=UNIT)
     assert table.empty and list(table.columns) == list(COLUMNS)
 
 
 def test_boolean_mask_and_progress():
     mask = solid((20, 20, 20), (1, 1, 1), (9.6, 9.9, 10.2), (7.0,) * 3)
     calls = []
-    table = label_curvatures(mask, progress=lambda done, total, label: calls.append((done, total, label)))
+    table = label_curvatures(mask, spacing=UNIT,
+                             progress=lambda done, total, label: calls.append((done, total, label)))
     assert list(table.label) == [1] and calls == [(1, 1, 1)]
 
 
@@ -230,7 +234,7 @@ def test_option_errors(options, message):
     image = np.zeros((20, 20, 20), dtype=np.uint8)
     image[5:15, 5:15, 5:15] = 1
     with pytest.raises(InvalidOptionError, match=message):
-        label_curvatures(image, **options)
+        label_curvatures(image, **{"spacing": UNIT, **options})
 
 
 # ---- the readers ---------------------------------------------------------------------------------------------------

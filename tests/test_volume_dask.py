@@ -24,6 +24,8 @@ from meshcurv import volume  # noqa: E402
 from meshcurv.errors import InvalidOptionError, MeshQualityWarning, MissingDependencyError  # noqa: E402
 from meshcurv.volume import label_curvatures  # noqa: E402
 
+UNIT = (1.0, 1.0, 1.0)  # the voxel size of the tests (a call without spacing warns)
+
 #: Labels 1-6: three balls and three rotated ellipsoids, of semi-axes 5-8 voxels (well under a second each).
 SOLIDS = {1: ((9.3, 10.1, 9.7), (6.0, 6.0, 6.0)), 2: ((10.2, 30.4, 11.1), (7.5, 5.0, 6.0)),
           3: ((29.6, 10.3, 30.2), (5.5, 5.5, 5.5)), 4: ((30.1, 29.8, 9.6), (8.0, 6.0, 5.0)),
@@ -149,7 +151,7 @@ def test_a_label_that_raises_or_kills_its_worker_fails_alone(image, serial, faul
     others = ~table.label.isin([2, 4])
     assert_same_rows(table[others].reset_index(drop=True), expected[others].reset_index(drop=True))
     with pytest.raises(InvalidOptionError, match="method"):  # wrong for every label: raised, as serially
-        label_curvatures(image, labels_to_use=[1, 3], method="nope", client=faulty_client)
+        label_curvatures(image, spacing=UNIT, labels_to_use=[1, 3], method="nope", client=faulty_client)
     # each task received its labels' crops only: the box padded by one voxel, as a boolean mask
     boxes = volume._objects(image, None)
     received = [json.loads(line) for line in faulty_client.calls.read_text().splitlines()]
@@ -213,7 +215,7 @@ def test_no_label_to_compute_starts_no_cluster(monkeypatch):
 
     monkeypatch.setattr(volume, "_cluster", refuse)
     with pytest.warns(MeshQualityWarning, match="1 empty"):
-        table = label_curvatures(np.zeros((6, 6, 6), dtype=np.uint8), labels_to_use=[3], workers=2)
+        table = label_curvatures(np.zeros((6, 6, 6), dtype=np.uint8), spacing=UNIT, labels_to_use=[3], workers=2)
     assert list(table.status) == ["empty"]
 
 
@@ -221,4 +223,5 @@ def test_workers_without_dask_name_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed raises ImportError
     with pytest.raises(MissingDependencyError, match=r"pip install 'meshcurv\[batch\]'"):
         label_curvatures(np.ones((4, 4, 4), dtype=np.uint8), workers=2)
-    assert list(label_curvatures(np.ones((4, 4, 4), dtype=np.uint8), workers=1).label) == [1]  # serial: no Dask
+    serial = label_curvatures(np.ones((4, 4, 4), dtype=np.uint8), spacing=UNIT, workers=1)  # serial: no Dask
+    assert list(serial.label) == [1]
