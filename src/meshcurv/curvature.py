@@ -21,7 +21,7 @@ from .neighborhoods import small_radius_note
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import INVALID_REASONS, CurvatureResult, Surface
 from .topology import MeshTopology
-from .weld import weld_vertices
+from .weld import drop_double_sided, weld_vertices
 
 __all__ = ["principal_curvatures", "METHODS"]
 
@@ -148,9 +148,20 @@ def principal_curvatures(
     MeshQualityWarning
         Once per call, when the mesh has boundaries, non-manifold or
         inconsistently oriented edges, zero-area faces or unreferenced vertices,
-        when vertices were welded or faces reversed, with the counts; the
-        affected vertices have ``valid=False`` and ``result.invalid_reason``
-        says why for each.
+        when vertices were welded, the faces of a second side dropped or faces
+        reversed, with the counts; the affected vertices have ``valid=False``
+        and ``result.invalid_reason`` says why for each.
+
+    Notes
+    -----
+    A double-sided mesh (every face stored twice, with opposite windings, as
+    renderers without back faces want) is computed on one side, for every
+    method: after welding, the faces that repeat another face's corners with
+    the opposite winding are dropped (:func:`meshcurv.weld.drop_double_sided`;
+    the side kept is the outward one of closed parts), their number is
+    ``result.parameters["n_double_sided_faces"]`` and is given in the warning.
+    Without this every edge would have four faces (every vertex NaN) and the
+    integrals would count the surface twice.
 
     Examples
     --------
@@ -199,6 +210,8 @@ def principal_curvatures(
     welding = weld_vertices(points, topology) if weld else None
     if welding is not None and welding.n_welded:
         points, topology = welding.vertices, welding.topology
+    one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
+    topology = one_sided.topology
     topology, n_flipped = oriented_topology(points, topology, orient)
     with trusting(points, topology.faces, topology.edges):  # checked: the helpers below need not check again
         found: dict = {}
@@ -215,26 +228,28 @@ def principal_curvatures(
         diagnosis = diagnose(points, topology, n_flipped_faces=n_flipped)
         reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
     parameters = {**result.parameters, **found, "orient": orient,
-                  "n_welded_vertices": welding.n_welded if welding is not None else 0}
+                  "n_welded_vertices": welding.n_welded if welding is not None else 0,
+                  "n_double_sided_faces": one_sided.n_dropped}
     # the rows of the computed result (welded vertices, in the local order) of each of the caller's vertices
     welded = welding if welding is not None and welding.n_welded else None
     index = None if welded is None else welded.index
     if local is not None:
         index = local.index if welded is None else welded.index[local.index]
-    if local is not None and welded is None:  # the mesh the caller gave, its faces oriented
-        surface = Surface(callers, local.original_faces(topology.faces))
+    if local is not None and welded is None:  # the mesh the caller gave, its faces oriented (and one-sided)
+        surface = Surface(callers, np.take(local.order, topology.faces) if one_sided.n_dropped
+                          else local.original_faces(topology.faces))
     else:
         surface = Surface(points, topology.faces, index)
     result = dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons, parameters=parameters,
                                  _surface=surface)
     if index is not None:
         result = _expanded(result, index)
-    if welded is not None:
-        problems = [f"welded {welded.n_welded} coincident vertices (a triangle soup or split seams) "
-                    "before the computation; copies share their values"] + list(problems)
     if n_flipped:
         problems = list(problems) + [_flip_reason(diagnosis, orient)]
     message = quality_message(method, problems, dataclasses.replace(diagnosis, n_flipped_faces=0))
+    prepared = _preparation_notes(welded, one_sided.n_dropped)
+    if prepared:  # before what the estimator and the diagnosis found (which they may not name otherwise)
+        message = f"{method}: " + "; ".join(prepared + ([message[len(method) + 2:]] if message else []))
     if message:
         counts = result.invalid_counts()
         if counts:
@@ -271,6 +286,18 @@ def invalid_reasons(vertices: np.ndarray, topology: MeshTopology, valid: np.ndar
         reasons[invalid & members & (reasons == 0)] = code
     reasons[invalid & (reasons == 0)] = len(INVALID_REASONS) - 1
     return reasons
+
+
+def _preparation_notes(welded, n_dropped: int) -> list[str]:
+    """What was done to the mesh before the computation: vertices welded, the faces of a second side dropped."""
+    notes = []
+    if welded is not None:
+        notes.append(f"welded {welded.n_welded} coincident vertices (a triangle soup or split seams) "
+                     "before the computation; copies share their values")
+    if n_dropped:
+        notes.append(f"dropped {n_dropped} faces that repeat another face's corners with the opposite winding "
+                     "(a double-sided mesh): computed on one side (result.parameters['n_double_sided_faces'])")
+    return notes
 
 
 def _flip_reason(diagnosis, orient: str) -> str:

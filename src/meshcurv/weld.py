@@ -20,9 +20,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .orient import face_flips
 from .topology import MeshTopology
 
-__all__ = ["Welding", "weld_vertices", "WELD_TOLERANCE_RATIO"]
+__all__ = ["Welding", "weld_vertices", "WELD_TOLERANCE_RATIO", "OneSided", "drop_double_sided"]
 
 #: Vertices closer than this times the median edge length are copies of one point.
 WELD_TOLERANCE_RATIO = 1e-5
@@ -121,3 +122,115 @@ def weld_vertices(vertices: np.ndarray, topology: MeshTopology, *,
     faces = index[topology.faces]
     welded_topology = MeshTopology._build(np.ascontiguousarray(faces), int(kept.sum()))
     return Welding(vertices[kept], welded_topology, index, int(n_vertices - kept.sum()))
+
+
+class OneSided(NamedTuple):
+    """What :func:`drop_double_sided` returns.
+
+    Attributes
+    ----------
+    topology : MeshTopology
+        The mesh without the dropped faces (the input itself when none was dropped).
+    dropped : ndarray of shape (F,), bool
+        The input faces that were dropped.
+    n_dropped : int
+        Their number.
+    """
+
+    topology: MeshTopology
+    dropped: np.ndarray
+    n_dropped: int
+
+
+def drop_double_sided(vertices: np.ndarray, topology: MeshTopology) -> OneSided:
+    """Keep one side of a double-sided mesh: drop the faces that repeat another face with the opposite winding.
+
+    A double-sided mesh stores every face twice, once per side, with opposite
+    windings (renderers without back faces need them). Its edges then have
+    four faces each (non-manifold: every estimator leaves their vertices
+    undefined), and its integrals count the surface twice (the total Gaussian
+    curvature of a double-sided sphere is ``8 pi``, or more when the windings
+    alternate). The surface it describes is the one-sided mesh.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3), float64
+        Validated coordinates (to tell the outside of a closed part).
+    topology : MeshTopology
+        The mesh's connectivity, after welding (a double-sided triangle soup
+        shares its vertices only once welded).
+
+    Returns
+    -------
+    OneSided
+        ``topology`` of the kept faces, the ``dropped`` mask and ``n_dropped``.
+
+    Notes
+    -----
+    Faces with the same three vertices form a group; in a group holding
+    both windings, the faces of one winding are kept and the others
+    dropped. The winding kept is the one of the group's first face (lowest
+    index), unless the other one makes the kept faces consistently oriented
+    and the closed parts outward (:func:`meshcurv.orient.face_flips`): the
+    input gives no side there, so the side taken is the one ``orient='outward'``
+    would give, whatever the order of the faces, and ``orient='keep'`` gets a
+    consistent side too. Faces repeated with the same winding
+    are kept (they stay non-manifold and are reported as such), and so are
+    faces with a repeated corner. Only faces on non-manifold edges are
+    candidates (every face of a double-sided patch has one, unless the patch
+    is a lone triangle, whose two sides make a closed pillow of manifold
+    edges, left as it is): a manifold mesh costs one look at its edge
+    classes. Vertices are never dropped: a kept face has the corners of the
+    faces it stands for.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from meshcurv import shapes, MeshTopology
+    >>> from meshcurv.weld import drop_double_sided
+    >>> sphere = shapes.icosphere(3)
+    >>> both = MeshTopology.from_faces(np.vstack([sphere.faces, sphere.faces[:, ::-1]]))
+    >>> one = drop_double_sided(sphere.vertices, both)
+    >>> one.n_dropped == sphere.faces.shape[0], bool((one.topology.faces == sphere.faces).all())
+    (True, True)
+    """
+    faces = topology.faces
+    n_faces = faces.shape[0]
+    none = OneSided(topology, np.zeros(n_faces, dtype=bool), 0)
+    suspect = topology.nonmanifold_edges
+    if not suspect.any():
+        return none
+    sides = topology.face_edges
+    candidate = (suspect[sides] & (sides >= 0)).any(axis=1) & ~topology.degenerate_faces
+    rows = np.flatnonzero(candidate)
+    if rows.size < 2:
+        return none
+    corners = faces[rows]
+    ordered = np.sort(corners, axis=1)
+    # winding: even when the corners are a rotation of their sorted order (an even number of inversions)
+    a, b, c = corners.T
+    even = ((a > b) ^ (b > c) ^ (a > c)) == 0
+    order = np.lexsort((rows, ordered[:, 2], ordered[:, 1], ordered[:, 0]))  # groups, each by face index
+    key = ordered[order]
+    starts = np.r_[True, (key[1:] != key[:-1]).any(axis=1)]
+    group = np.cumsum(starts) - 1
+    first_even = even[order][starts][group]
+    mixed = even[order] != first_even
+    group_both = np.bincount(group, weights=mixed) > 0
+    dropped = np.zeros(n_faces, dtype=bool)
+    dropped[rows[order]] = mixed
+    n_dropped = int(dropped.sum())
+    if n_dropped == 0:
+        return none
+    kept_faces = np.ascontiguousarray(faces[~dropped])
+    kept = MeshTopology._build(kept_faces, topology.n_vertices)
+    # the other copies where they make the kept faces consistent and outward, a whole group at a time
+    flips = np.zeros(n_faces, dtype=bool)
+    flips[~dropped] = face_flips(vertices, kept, outward=True)
+    group_flips = flips[rows[order][starts]] & group_both
+    other = np.zeros(n_faces, dtype=bool)
+    other[rows[order]] = group_flips[group]
+    other = other[~dropped]
+    if other.any():
+        kept = MeshTopology._build(np.where(other[:, None], kept_faces[:, ::-1], kept_faces), topology.n_vertices)
+    return OneSided(kept, dropped, n_dropped)
