@@ -1,6 +1,7 @@
 """Mesh objects of trimesh, PyVista, meshio and Open3D passed as they are (duck typing)."""
 
 import types
+import warnings
 
 import numpy as np
 import pytest
@@ -57,6 +58,110 @@ def test_open3d_triangle_mesh():
     mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(SPHERE.vertices),
                                      o3d.utility.Vector3iVector(SPHERE.faces))
     same(meshcurv.principal_curvatures(mesh))
+
+
+def polydata():
+    pv = pytest.importorskip("pyvista")
+    return pv.PolyData(SPHERE.vertices, np.c_[np.full(SPHERE.faces.shape[0], 3), SPHERE.faces].ravel())
+
+
+def test_pyvista_unstructured_grid_of_triangles():
+    same(meshcurv.principal_curvatures(polydata().cast_to_unstructured_grid()))
+
+
+@pytest.mark.parametrize("suffix", [".vtu", ".vtk"])
+def test_our_own_vtu_and_vtk_outputs_read_back_by_pyvista(tmp_path, suffix):
+    pv = pytest.importorskip("pyvista")
+    pytest.importorskip("meshio")
+    path = tmp_path / f"sphere{suffix}"
+    meshcurv.io.write_curvatures(path, SPHERE.vertices, SPHERE.faces, reference())
+    grid = pv.read(path)
+    assert type(grid).__name__ == "UnstructuredGrid"
+    same(meshcurv.principal_curvatures(grid))
+
+
+def test_pyvista_unstructured_grid_of_quads_pixels_triangles_and_lines():
+    pv = pytest.importorskip("pyvista")
+    torus = shapes.torus(3.0, 1.0, 64, 32)
+    quads = np.asarray(torus.quads)
+    expected = meshcurv.principal_curvatures(torus.vertices, torus.faces)
+    # a pixel's corners run 0, 1, 3, 2; lines and vertices are left out, as a PolyData's are
+    cells = {pv.CellType.QUAD: quads[:-2], pv.CellType.PIXEL: quads[-2:-1, [0, 1, 3, 2]],
+             pv.CellType.TRIANGLE: np.array([quads[-1, :3], quads[-1, [0, 2, 3]]]),
+             pv.CellType.LINE: quads[:4, :2], pv.CellType.VERTEX: quads[:2, :1]}
+    with pytest.warns(meshcurv.TriangulationWarning):
+        result = meshcurv.principal_curvatures(pv.UnstructuredGrid(cells, torus.vertices))
+    # the same triangles as the torus's own split of its quads (a, b, c), (a, c, d)
+    np.testing.assert_allclose(result.k_max, expected.k_max, rtol=1e-9, atol=1e-12)
+    assert np.median(np.abs(result.mean - torus.mean)) < 0.02
+    # all quads and a pixel: one (F, 4) array
+    grid = pv.UnstructuredGrid({pv.CellType.QUAD: quads[1:], pv.CellType.PIXEL: quads[:1, [0, 1, 3, 2]]},
+                               torus.vertices)
+    with pytest.warns(meshcurv.TriangulationWarning):
+        result = meshcurv.principal_curvatures(grid)
+    np.testing.assert_allclose(result.k_max, expected.k_max, rtol=1e-9, atol=1e-12)
+
+
+def test_pyvista_unstructured_grid_of_volume_cells_is_refused():
+    pv = pytest.importorskip("pyvista")
+    tetra = pv.UnstructuredGrid({pv.CellType.TETRA: np.array([[0, 1, 2, 3], [1, 2, 3, 4]]),
+                                 pv.CellType.TRIANGLE: np.array([[0, 1, 2]])}, np.r_[np.eye(4, 3), [[1, 1, 1]]])
+    with pytest.raises(InvalidMeshError, match=r"the UnstructuredGrid has cells that are not surface polygons "
+                                               r"\(2 tetra\); .*`grid.extract_surface\(\).triangulate\(\)`"):
+        meshcurv.principal_curvatures(tetra)
+    lines = pv.UnstructuredGrid({pv.CellType.LINE: np.array([[0, 1], [1, 2]])}, np.eye(3))
+    with pytest.raises(InvalidMeshError, match=r"the UnstructuredGrid has no surface cells .* it has 2 line"):
+        meshcurv.principal_curvatures(lines)
+    with warnings.catch_warnings():  # PyVista >= 0.47 warns that the default `algorithm` will change
+        warnings.simplefilter("ignore")
+        surface = tetra.extract_surface().triangulate()  # what the message suggests works
+    with pytest.warns(meshcurv.MeshQualityWarning):  # the two tetrahedra's surface is coarse, not clean
+        meshcurv.principal_curvatures(surface, method="normal_cycle")
+
+
+def test_a_point_object_without_faces_is_sent_to_the_point_cloud_function():
+    stand_in = types.SimpleNamespace(points=SPHERE.vertices)
+    with pytest.raises(InvalidMeshError, match="`vertices` is a SimpleNamespace, which has points but no faces; "
+                                               "for a point cloud use meshcurv.point_cloud_curvatures"):
+        meshcurv.principal_curvatures(stand_in)
+
+
+# ------------------------------------------------------------------------------- point clouds in
+
+
+CLOUD = shapes.icosphere(24, radius=2.0).vertices  # 5762 points on a sphere of radius 2
+
+
+def cloud_reference():
+    return meshcurv.point_cloud_curvatures(CLOUD)
+
+
+def same_cloud(result):
+    expected = cloud_reference()
+    np.testing.assert_array_equal(result.k_max, expected.k_max)
+    assert np.median(result.mean) == pytest.approx(0.5, rel=2e-2)
+
+
+def test_point_clouds_from_pyvista_objects():
+    pv = pytest.importorskip("pyvista")
+    same_cloud(meshcurv.point_cloud_curvatures(pv.PolyData(CLOUD)))
+    same_cloud(meshcurv.point_cloud_curvatures(pv.PointSet(CLOUD)))
+    same_cloud(meshcurv.point_cloud_curvatures(pv.PolyData(CLOUD).cast_to_unstructured_grid()))
+
+
+def test_point_clouds_from_trimesh_objects_and_duck_types():
+    trimesh = pytest.importorskip("trimesh")
+    same_cloud(meshcurv.point_cloud_curvatures(trimesh.PointCloud(CLOUD)))
+    sphere = shapes.icosphere(24, radius=2.0)
+    same_cloud(meshcurv.point_cloud_curvatures(trimesh.Trimesh(sphere.vertices, sphere.faces, process=False)))
+    same_cloud(meshcurv.point_cloud_curvatures(types.SimpleNamespace(points=CLOUD.tolist())))  # open3d, meshio
+    same_cloud(meshcurv.point_cloud_curvatures(types.SimpleNamespace(vertices=CLOUD)))
+
+
+def test_an_unknown_point_object_is_refused_with_a_clear_message():
+    with pytest.raises(InvalidMeshError, match=r"`points` is a dict, not an array of shape \(N, 3\), nor an object "
+                                               r"with a `.points` or `.vertices` array"):
+        meshcurv.point_cloud_curvatures({"x": 1})
 
 
 def test_an_unknown_object_is_refused_with_a_clear_message():

@@ -156,3 +156,40 @@ def test_trusted_arrays_skip_the_helpers_checks_only_as_themselves_and_only_insi
     vertices[1, 0] = np.nan  # after the block the same array is checked again
     with pytest.raises(InvalidMeshError, match="NaN or infinite"):
         checked_points(vertices)
+
+
+# ------------------------------------------------------------- hints for faces given the wrong way (issue 29)
+
+
+SPHERE = shapes.icosphere(4)
+
+
+@pytest.mark.parametrize("faces", [SPHERE.faces.T, SPHERE.faces.T.tolist(), SPHERE.faces.T.astype(float)],
+                         ids=["array", "list", "float"])
+def test_transposed_faces_are_refused_with_the_transpose_suggested(faces):
+    with pytest.raises(InvalidMeshError, match=r"`faces` has shape \(3, 320\) and looks transposed: .* pass "
+                                               r"`faces.T`"):
+        meshcurv.principal_curvatures(SPHERE.vertices, faces)
+
+
+def test_three_polygons_of_many_corners_are_not_taken_for_transposed_faces():
+    # (3, k) faces whose rows repeat no vertex are three k-gons, as before (fan-triangulated)
+    assert meshcurv.topology.triangulate_faces(np.arange(24).reshape(3, 8)).shape == (18, 3)
+
+
+def test_vertices_and_faces_swapped_are_named():
+    with pytest.raises(InvalidMeshError, match=r"`faces` has non-integer values; .*\(a float64 array of shape "
+                                               r"\(162, 3\): coordinates\? were `vertices` and `faces` swapped\?"):
+        meshcurv.principal_curvatures(SPHERE.faces, SPHERE.vertices)
+
+
+@pytest.mark.parametrize("alone, match", [
+    (SPHERE.faces, r"`faces` is missing: `vertices` is an int64 array of shape \(320, 3\), not a mesh object; "
+                   r"pass `principal_curvatures\(vertices, faces\)` \(integer indices: it looks like the faces"),
+    (SPHERE.vertices, r"`faces` is missing: `vertices` is a float64 array of shape \(162, 3\), not a mesh object; "
+                      r".*for points without faces use meshcurv.point_cloud_curvatures"),
+    (SPHERE.vertices.tolist(), r"`faces` is missing: `vertices` is a float64 array of shape \(162, 3\)"),
+])
+def test_an_array_alone_is_told_to_come_with_its_faces(alone, match):
+    with pytest.raises(InvalidMeshError, match=match):
+        meshcurv.principal_curvatures(alone)

@@ -2,15 +2,27 @@
 
 In: :func:`mesh_arrays` takes the vertices and faces of
 
+=============================  ==========================================  ==================================
+library                        recognised by                               faces from
+=============================  ==========================================  ==================================
+trimesh ``Trimesh``            ``.vertices`` and ``.faces`` arrays         ``faces``
+PyVista ``PolyData``           ``.points`` and ``.faces`` (flat, counted)  the flat VTK cell array
+PyVista ``UnstructuredGrid``   ``.points`` and ``.celltypes``              triangle, quad, pixel, polygon cells
+meshio ``Mesh``                ``.points`` and ``.cells`` (cell blocks)    "triangle" (and "quad") blocks
+Open3D ``TriangleMesh``        ``.vertices`` and ``.triangles``            ``triangles``
+=============================  ==========================================  ==================================
 
-=======================  ==========================================  ===========================
-library                  recognised by                               faces from
-=======================  ==========================================  ===========================
-trimesh ``Trimesh``      ``.vertices`` and ``.faces`` arrays         ``faces``
-PyVista ``PolyData``     ``.points`` and ``.faces`` (flat, counted)  the flat VTK cell array
-meshio ``Mesh``          ``.points`` and ``.cells`` (cell blocks)    "triangle" (and "quad") blocks
-Open3D ``TriangleMesh``  ``.vertices`` and ``.triangles``            ``triangles``
-=======================  ==========================================  ===========================
+An ``UnstructuredGrid`` is what ``pyvista.read`` returns for ``.vtu`` and
+legacy ``.vtk`` files (meshcurv's own outputs included). Its vertex and line
+cells are left out, as a ``PolyData``'s are; a grid with volume cells
+(tetrahedra, hexahedra, ...), triangle strips or higher-order cells is
+refused with an error that names them and suggests ``grid.extract_surface()``:
+its surface is not a guess meshcurv makes (inner faces of a volume mesh, a
+boundary the user may want open or closed), and the one call says which.
+
+:func:`point_array` takes the points of the same objects and of point
+clouds (PyVista ``PointSet``, trimesh ``PointCloud``, Open3D ``PointCloud``):
+anything with a ``.points`` or ``.vertices`` array.
 
 Out: :func:`to_pyvista`, :func:`to_trimesh` and :func:`to_dataframe` put the
 per-vertex fields of a :class:`~meshcurv.CurvatureResult` onto a
@@ -25,7 +37,7 @@ import numpy as np
 
 from .errors import InvalidMeshError, MissingDependencyError
 
-__all__ = ["mesh_arrays", "to_pyvista", "to_trimesh", "to_dataframe"]
+__all__ = ["mesh_arrays", "point_array", "to_pyvista", "to_trimesh", "to_dataframe"]
 
 
 def _vtk_cells(flat: np.ndarray):
@@ -48,17 +60,100 @@ def _vtk_cells(flat: np.ndarray):
     return faces
 
 
+#: VTK cell types (``vtkCellType.h``) taken as faces; a pixel's corners run 0, 1, 3, 2 around it.
+_VTK_SURFACE_CELLS = {5: "triangle", 7: "polygon", 8: "pixel", 9: "quad"}
+
+#: VTK cell types left out as a ``PolyData``'s vertices and lines are: they bound no surface.
+_VTK_POINT_AND_LINE_CELLS = {1: "vertex", 2: "poly_vertex", 3: "line", 4: "poly_line"}
+
+#: Names of the other VTK cell types an error may name (others by number).
+_VTK_OTHER_CELLS = {6: "triangle_strip", 10: "tetra", 11: "voxel", 12: "hexahedron", 13: "wedge", 14: "pyramid",
+                    15: "pentagonal_prism", 16: "hexagonal_prism", 21: "quadratic_edge", 22: "quadratic_triangle",
+                    23: "quadratic_quad", 24: "quadratic_tetra", 25: "quadratic_hexahedron", 42: "polyhedron"}
+
+_KNOWN_MESHES = ("trimesh.Trimesh, pyvista.PolyData, pyvista.UnstructuredGrid, meshio.Mesh, "
+                 "open3d.geometry.TriangleMesh")
+
+
+def _cell_name(cell_type: int) -> str:
+    known = {**_VTK_SURFACE_CELLS, **_VTK_POINT_AND_LINE_CELLS, **_VTK_OTHER_CELLS}
+    return known.get(cell_type, f"VTK cell type {cell_type}")
+
+
+def _grid_faces(grid):
+    """The surface cells of a PyVista ``UnstructuredGrid`` as faces: (F, k) when all have k corners, else a list."""
+    kind = type(grid).__name__
+    types = np.asarray(grid.celltypes, dtype=np.int64).ravel()
+    surface = np.isin(types, list(_VTK_SURFACE_CELLS))
+    other = ~surface & ~np.isin(types, list(_VTK_POINT_AND_LINE_CELLS))
+    if other.any():
+        found, counts = np.unique(types[other], return_counts=True)
+        listed = ", ".join(f"{n} {_cell_name(int(t))}" for t, n in zip(found, counts))
+        raise InvalidMeshError(
+            f"the {kind} has cells that are not surface polygons ({listed}); meshcurv computes the curvature "
+            "of surfaces: pass its boundary surface, `grid.extract_surface().triangulate()` (PyVista)")
+    if not surface.any():
+        raise InvalidMeshError(
+            f"the {kind} has no surface cells (triangle, quad, pixel or polygon); it has "
+            + (", ".join(f"{n} {_cell_name(int(t))}" for t, n in zip(*np.unique(types, return_counts=True)))
+               or "no cells"))
+    # cell_offsets in PyVista >= 0.45 (offset before, deprecated since): n_cells + 1 starts in the connectivity
+    offsets = grid.cell_offsets if hasattr(type(grid), "cell_offsets") else grid.offset
+    offsets = np.asarray(offsets, dtype=np.int64).ravel()
+    connectivity = np.asarray(grid.cell_connectivity, dtype=np.int64).ravel()
+    starts = offsets[:-1][surface]
+    lengths = np.diff(offsets)[surface]
+    pixels = types[surface] == 8
+    if lengths.min() == lengths.max():
+        faces = connectivity[starts[:, None] + np.arange(lengths[0])]
+        if pixels.any():
+            faces[pixels] = faces[pixels][:, [0, 1, 3, 2]]
+        return faces
+    # faces of several lengths: one gather of all their corners, then one array per face
+    corner = np.arange(lengths.sum()) - np.repeat(np.cumsum(lengths) - lengths, lengths)
+    if pixels.any():  # a pixel's corners 2 and 3 swap places
+        corner = np.where(np.repeat(pixels, lengths), np.array([0, 1, 3, 2])[np.minimum(corner, 3)], corner)
+    flat = connectivity[np.repeat(starts, lengths) + corner]
+    return np.split(flat, np.cumsum(lengths)[:-1])
+
+
+def _array_summary(value) -> str | None:
+    """``"an int64 array of shape (12, 3)"`` for an array or a list that converts to numbers, else None."""
+    try:
+        array = np.asarray(value)
+    except (ValueError, TypeError, OverflowError):
+        return None
+    if array.dtype == object or not (np.issubdtype(array.dtype, np.number) or array.dtype == bool):
+        return None
+    return f"{'an' if array.dtype.name[0] in 'aeiou' else 'a'} {array.dtype} array of shape {array.shape}"
+
+
 def mesh_arrays(mesh) -> tuple[np.ndarray, object]:
-    """``(vertices, faces)`` of a mesh object of trimesh, PyVista, meshio or Open3D.
+    """``(vertices, faces)`` of a mesh object of trimesh, PyVista (``PolyData``, ``UnstructuredGrid``), meshio or Open3D.
 
     Raises
     ------
     InvalidMeshError
-        The object is none of these, or has no faces.
+        The object is none of these, has no faces, or has cells that are not
+        surface polygons (a volume mesh: tetrahedra, hexahedra, ...); an array
+        (the vertices alone, or faces given as vertices) is told to come with
+        its faces.
     """
     kind = type(mesh).__name__
+    if isinstance(mesh, (np.ndarray, list, tuple)):
+        summary = _array_summary(mesh)
+        if summary is not None:
+            array = np.asarray(mesh)
+            looks_like_faces = np.issubdtype(array.dtype, np.integer) and array.ndim == 2 and array.shape[1] >= 3
+            hint = (" (integer indices: it looks like the faces; pass the vertices first)" if looks_like_faces
+                    else "; for points without faces use meshcurv.point_cloud_curvatures")
+            raise InvalidMeshError(
+                f"`faces` is missing: `vertices` is {summary}, not a mesh object; pass "
+                f"`principal_curvatures(vertices, faces)`{hint}")
     if hasattr(mesh, "triangles") and hasattr(mesh, "vertices") and not hasattr(mesh, "faces"):
         return np.asarray(mesh.vertices), np.asarray(mesh.triangles)  # Open3D
+    if hasattr(mesh, "points") and hasattr(mesh, "celltypes") and hasattr(mesh, "cell_connectivity"):
+        return np.asarray(mesh.points), _grid_faces(mesh)  # PyVista UnstructuredGrid (before meshio: both have .cells)
     if hasattr(mesh, "points") and hasattr(mesh, "cells") and not hasattr(mesh, "faces"):  # meshio
         blocks = [(block.type, np.asarray(block.data)) for block in mesh.cells]
         faces = [data for cell_type, data in blocks if cell_type in ("triangle", "quad", "polygon")]
@@ -74,9 +169,50 @@ def mesh_arrays(mesh) -> tuple[np.ndarray, object]:
         return np.asarray(mesh.points), _vtk_cells(mesh.faces)
     if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):  # trimesh (and alike)
         return np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    if hasattr(mesh, "points") or hasattr(mesh, "vertices"):  # PyVista PointSet, trimesh or Open3D PointCloud
+        raise InvalidMeshError(
+            f"`vertices` is a {kind}, which has points but no faces; for a point cloud use "
+            "meshcurv.point_cloud_curvatures, or pass `vertices, faces` arrays")
     raise InvalidMeshError(
-        f"`vertices` is a {kind}, not an array, and not a mesh object meshcurv knows (trimesh.Trimesh, "
-        "pyvista.PolyData, meshio.Mesh, open3d.geometry.TriangleMesh); pass `vertices, faces` arrays")
+        f"`vertices` is a {kind}, not an array, and not a mesh object meshcurv knows ({_KNOWN_MESHES}); "
+        "pass `vertices, faces` arrays")
+
+
+def point_array(points, *, name: str = "points"):
+    """The points of a point cloud or mesh object, or ``points`` itself when it is an array or a list.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 3), or an object with a ``.points`` or ``.vertices`` array
+        PyVista ``PolyData``, ``PointSet`` and ``UnstructuredGrid``, trimesh
+        ``Trimesh`` and ``PointCloud``, Open3D ``PointCloud`` and
+        ``TriangleMesh``, meshio ``Mesh``, ... (none of them imported).
+        Arrays, lists and objects that convert to arrays (``__array__``:
+        pandas ``DataFrame``, ...) are returned as they are, for the caller's
+        check of their shape and values.
+    name : str, default: 'points'
+        The argument's name, for the error.
+
+    Returns
+    -------
+    array_like
+
+    Raises
+    ------
+    InvalidMeshError
+        An object that is none of these (it would otherwise be read as an
+        array of one Python object).
+    """
+    if isinstance(points, (np.ndarray, list, tuple)) or hasattr(points, "__array__"):
+        return points
+    for attribute in ("points", "vertices"):
+        value = getattr(points, attribute, None)
+        if value is not None and not callable(value):
+            return np.asarray(value)
+    raise InvalidMeshError(
+        f"`{name}` is a {type(points).__name__}, not an array of shape (N, 3), nor an object with a `.points` "
+        "or `.vertices` array (pyvista.PolyData, PointSet or UnstructuredGrid, trimesh.Trimesh or PointCloud, "
+        "open3d.geometry.PointCloud, meshio.Mesh)")
 
 
 # ------------------------------------------------------------------------------------------- out

@@ -126,8 +126,10 @@ def _integer_faces(array: np.ndarray, name: str) -> np.ndarray:
         if not np.isfinite(array).all():
             raise InvalidMeshError(f"`{name}` has NaN or infinite values; indices must be integers")
         if not np.array_equal(array, np.round(array)):
+            swapped = (f" (a {array.dtype} array of shape {_shape_text(array)}: coordinates? were `vertices` "
+                       f"and `{name}` swapped? pass the vertices first)" if array.ndim == 2 else "")
             raise InvalidMeshError(
-                f"`{name}` has non-integer values; vertex indices must be whole numbers"
+                f"`{name}` has non-integer values; vertex indices must be whole numbers{swapped}"
             )
         if array.size and np.abs(array).max() >= 2.0**62:
             raise InvalidMeshError(f"`{name}` has indices too large for int64")
@@ -210,7 +212,28 @@ def polygon_arrays(faces, *, name: str = "faces") -> np.ndarray | Ragged:
         raise InvalidMeshError(
             f"`{name}` must have at least 3 columns (one vertex index per corner); got {_shape_text(array)}"
         )
+    _refuse_transposed(array, name)
     return _integer_faces(array, name)
+
+
+def _refuse_transposed(array: np.ndarray, name: str) -> None:
+    """Refuse (3, F) faces, F > 3, whose rows repeat an index: triangles given column-wise, not F-gons.
+
+    Three polygons of F corners would be read from such an array, but a
+    polygon visits each of its vertices once, while the rows of transposed
+    triangles (each row one corner of every face) repeat the vertices that
+    several faces share (always on a closed mesh, which has more faces than
+    vertices).
+    """
+    if array.shape[0] != 3 or array.shape[1] <= 3:
+        return
+    rows = np.sort(array, axis=1)
+    if (rows[:, 1:] == rows[:, :-1]).any():
+        raise InvalidMeshError(
+            f"`{name}` has shape {_shape_text(array)} and looks transposed: 3 rows of {array.shape[1]} vertex "
+            f"indices that repeat (a polygon repeats no vertex); faces go one per row, shape (F, 3): "
+            f"pass `{name}.T`"
+        )
 
 
 def as_polygons(faces, *, name: str = "faces") -> list[np.ndarray] | np.ndarray:

@@ -198,7 +198,9 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     0.500 estimated
     """
     method = POINT_CLOUD_METHODS[0] if method is None else check_choice(method, "method", POINT_CLOUD_METHODS)
-    points = as_vertices(points, name="points")
+    from ._adapters import point_array  # point and mesh objects of other libraries (duck typing)
+
+    points = as_vertices(point_array(points), name="points")
     given = None if normals is None else _checked_normals(normals, points.shape)
     if radius is not None:
         radius = check_positive_float(radius, "radius")
