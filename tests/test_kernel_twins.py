@@ -90,6 +90,10 @@ def mesh(name: str) -> tuple[np.ndarray, np.ndarray]:
         made = shapes.with_normal_noise(shapes.icosphere(12), 0.3, seed=3)
     elif name == "saddle":  # open: a boundary all around
         made = shapes.saddle(spacing=0.05)
+    elif name == "flat":  # thinner than a few edges: a ball reaches the other side
+        made = shapes.ellipsoid((3.0, 3.0, 0.15), subdivisions=16)
+    elif name == "thin_torus":
+        made = shapes.torus(major_radius=3.0, minor_radius=0.12, n_major=90, n_minor=12)
     elif name == "defects":
         vertices, faces = _defects()
         return np.ascontiguousarray(vertices, np.float64), np.ascontiguousarray(faces, np.int64)
@@ -101,6 +105,8 @@ def mesh(name: str) -> tuple[np.ndarray, np.ndarray]:
 #: Every mesh; the clean ones (whose small balls are connected pieces of surface); the closed ones.
 MESHES = ("icosphere", "torus", "ellipsoid", "noisy", "saddle", "defects")
 CLEAN = ("icosphere", "torus", "ellipsoid", "noisy", "saddle")
+#: Meshes thinner than their balls: the surface-connected balls leave the other side out (issue 29).
+THIN = ("flat", "thin_torus")
 
 
 @functools.cache
@@ -841,13 +847,18 @@ def cells_of(name, kind):
 
 
 def check_cell_centres(name):
+    from meshcurv import neighborhoods
+
     vertices, _ = mesh(name)
     for kind in ("faces", "edges"):
         cells = cells_of(name, kind)
         # the NumPy path of neighborhoods._ball_sums (corners' mean, largest corner distance)
-        corners = vertices[cells]
-        centres = corners.mean(axis=1)
-        reach = np.linalg.norm(corners - centres[:, None, :], axis=2).max(axis=1)
+        with use_backend("numpy"):
+            centres, reach = neighborhoods.cell_centres(vertices, cells)
+        corners = vertices[cells]  # and the textbook formulas, to the bit on these meshes
+        np.testing.assert_array_equal(centres, corners.mean(axis=1), err_msg=kind)
+        np.testing.assert_array_equal(reach, np.linalg.norm(corners - centres[:, None, :], axis=2).max(axis=1),
+                                      err_msg=kind)
         got_centres, got_reach = kernels("neighborhoods").cell_centres(vertices, cells)
         # the corners added in order and divided by their count; three squares added in order
         np.testing.assert_array_equal(got_centres, centres, err_msg=kind)
@@ -859,16 +870,20 @@ def ball_values(name, kind):
     return rng.uniform(-1.0, 1.0, (cells_of(name, kind).shape[0], 3))
 
 
-def numpy_ball_sums(name, kind, values, radius, usable=None):
-    """The NumPy path of ``ball_face_sums`` / ``ball_edge_sums``, and the same sums of ``|values|``."""
+def numpy_ball_sums(name, kind, values, radius, usable=None, *, connected=False):
+    """The NumPy path of ``ball_face_sums`` / ``ball_edge_sums``, and the same sums of ``|values|``
+    (``connected``: over the surface-connected piece of each ball, faces only)."""
     from meshcurv import neighborhoods
 
     vertices, _ = mesh(name)
     cells = cells_of(name, kind)
-    function = neighborhoods.ball_face_sums if kind == "faces" else neighborhoods.ball_edge_sums
     with use_backend("numpy"):
-        return (function(vertices, cells, radius, values, usable=usable),
-                function(vertices, cells, radius, np.abs(values), usable=usable))
+        if kind == "faces":
+            return (neighborhoods.ball_face_sums(vertices, cells, radius, values, usable=usable, connected=connected),
+                    neighborhoods.ball_face_sums(vertices, cells, radius, np.abs(values), usable=usable,
+                                                 connected=connected))
+        return (neighborhoods.ball_edge_sums(vertices, cells, radius, values, usable=usable),
+                neighborhoods.ball_edge_sums(vertices, cells, radius, np.abs(values), usable=usable))
 
 
 def ball_terms(name, kind, radius):
@@ -916,9 +931,9 @@ def check_connected_face_sums_at(name, radius):
     indptr, indices = compiled.vertex_face_lists(faces, vertices.shape[0], kernel_threads())
     n = vertices.shape[0]
     for mask in (None, usable):
-        # on these meshes every ball's part of the surface is connected: the walk finds the
-        # Euclidean ball's faces, the NumPy path's
-        expected, magnitude = numpy_ball_sums(name, "faces", values, radius, mask)
+        # the same faces as the NumPy path's connected pieces (the walk's, found by connected
+        # components of all balls at once), summed in another order
+        expected, magnitude = numpy_ball_sums(name, "faces", values, radius, mask, connected=True)
         allowed = np.ones(faces.shape[0], dtype=bool) if mask is None else mask
         got = np.zeros_like(expected)
         compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices, got,
@@ -961,20 +976,27 @@ def jet_inputs(name):
     return vertices, numpy_normals(name), 3.0 * mean_edge(name), topology(name).neighbour_lists
 
 
-def jet_conditions(points, pool, centres, radius, frame, degree, counts):
+def jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacency=None):
     """(N,) condition number of the scaled normal matrix each NumPy fit solved in ``frame`` (NaN: none).
 
-    The matrices of :func:`meshcurv.jets._fit_chunk` over the same balls, the degree chosen as
-    ``jets._solve`` chooses it (the highest whose Cholesky factorization passes).
+    The matrices of :func:`meshcurv.jets._fit_chunk` over the same balls (the surface-connected
+    pieces with ``adjacency``), the degree chosen as ``jets._solve`` chooses it (the highest whose
+    Cholesky factorization passes).
     """
     from meshcurv import jets
-    from meshcurv.neighborhoods import _ball_pairs
+    from meshcurv.neighborhoods import _ball_pairs, connected_ball_pairs
 
     conditions = np.full(points.shape[0], np.nan)
-    pooled = points[pool]
-    for chunk, centre, neighbour in _ball_pairs(pooled, points[centres], radius):
+    if adjacency is None:
+        balls = ((chunk, centre, pool[neighbour])
+                 for chunk, centre, neighbour in _ball_pairs(points[pool], points[centres], radius))
+    else:
+        allowed = np.zeros(points.shape[0], dtype=bool)
+        allowed[pool] = True
+        balls = connected_ball_pairs(points, centres, radius, adjacency, allowed)
+    for chunk, centre, neighbour in balls:
         index, rows = centres[chunk], centre - chunk.start
-        offsets = (pooled[neighbour] - points[index[rows]]) / radius
+        offsets = (points[neighbour] - points[index[rows]]) / radius
         weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
         matrix, right = jets._fit_chunk(offsets, rows, index.size, [part[index] for part in frame], weights, degree)
         todo = np.ones(index.size, dtype=bool)
@@ -992,9 +1014,9 @@ def jet_conditions(points, pool, centres, radius, frame, degree, counts):
     return conditions
 
 
-def compare_jets(got, expected, label, fit):
+def compare_jets(got, expected, label, fit, adjacency=None):
     """``(coefficients, frame, counts)`` of two fits of the same balls; ``fit``: ``(points, normals,
-    radius, centres, pool, degree)`` of both."""
+    radius, centres, pool, degree)`` of both; ``adjacency``: the balls are the surface-connected pieces."""
     from meshcurv import jets
     from meshcurv._tensors import tangent_basis
 
@@ -1009,8 +1031,8 @@ def compare_jets(got, expected, label, fit):
     # 2002, sec. 7.1), and the second fit inherits the first one's error through its frame: the
     # larger of the two fits' condition numbers. Coefficients are in units of the radius.
     conditions = np.fmax(jet_conditions(points, pool, centres, radius, [*tangent_basis(normals), normals], degree,
-                                        counts),
-                         jet_conditions(points, pool, centres, radius, frame, degree, counts))
+                                        counts, adjacency),
+                         jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacency))
     size = np.maximum(np.nan_to_num(np.abs(coefficients), nan=0.0).max(axis=1), 1.0)
     # where no fit was possible the frame is the first one: tangent_basis's operations, exact
     atol = np.where(np.isnan(conditions), 4 * EPS, conditions * np.maximum(counts, 1) * EPS * size)[centres]
@@ -1084,12 +1106,11 @@ def check_fit_jets_connected(name):
     facing[rng.random(n) < 0.02] *= -1
     compiled = kernels("jets").fit_jets_connected
     for degree, mask, check in ((4, None, False), (3, allowed, True)):
-        # on these meshes every ball's part of the surface is connected: the walk over the edges
-        # finds the Euclidean ball, the NumPy path's
+        # the NumPy path's connected balls (the walk's, found by connected components of all balls at once)
         details = {}
         with use_backend("numpy"):
             expected = jets.fit_jets(points, normals, radius, degree=degree, centres=centres, neighbours=mask,
-                                     facing=facing if check else None, details=details)
+                                     facing=facing if check else None, details=details, adjacency=(indptr, indices))
         arguments = (points, normals, float(radius), degree, jets.ITERATIONS, jets._exponents(degree), jets.MIN_PIVOT,
                      centres, kernel_threads(), np.ones(n, dtype=bool) if mask is None else mask, indptr, indices,
                      facing if check else points, check, jets.AWAY_FRACTION)
@@ -1101,7 +1122,7 @@ def check_fit_jets_connected(name):
         label = f"degree {degree}, {'all' if mask is None else 'some'} allowed, facing {check}"
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
         compare_jets((coefficients, (t1, t2, normal), counts), expected, label,
-                     (points, normals, radius, centres, pool, degree))
+                     (points, normals, radius, centres, pool, degree), (indptr, indices))
         np.testing.assert_array_equal(away, details["away"], err_msg=f"{label}: away")
         # normals only: the unit normals of the same fits (jets.jet_normals), at the centres, NaN elsewhere;
         # frame-free, so compared everywhere, within the fits' tolerance (the coefficients' largest)
@@ -1110,7 +1131,7 @@ def check_fit_jets_connected(name):
             expected_normals = jets.jet_normals(expected[0], expected[1])
         np.testing.assert_array_equal(np.isnan(fitted), np.isnan(expected_normals), err_msg=f"{label}: normals only")
         close = np.isfinite(expected_normals).all(axis=1)
-        worst = np.abs(coefficients[close] - expected[0][close]).max()
+        worst = np.abs(coefficients[close] - expected[0][close]).max(initial=0.0)
         assert_directions_close(fitted[close], expected_normals[close], 4 * worst + 4 * EPS, f"{label}: normals only")
 
 
@@ -1296,9 +1317,11 @@ TWINS = [
          MESHES),
     Twin("neighborhoods.ball_cell_sums", "neighborhoods.ball_face_sums / ball_edge_sums", check_ball_cell_sums,
          MESHES),
-    Twin("neighborhoods.connected_face_sums", "neighborhoods.ball_face_sums", check_connected_face_sums, CLEAN),
+    Twin("neighborhoods.connected_face_sums", "neighborhoods.ball_face_sums(connected=True)", check_connected_face_sums,
+         MESHES + THIN),
     Twin("jets.fit_jets", "jets.fit_jets", check_fit_jets, CLEAN + CLOUDS),
-    Twin("jets.fit_jets_connected", "jets.fit_jets and jets.jet_normals", check_fit_jets_connected, CLEAN),
+    Twin("jets.fit_jets_connected", "jets.fit_jets(adjacency=) and jets.jet_normals", check_fit_jets_connected,
+         MESHES + THIN),
     Twin("pointcloud.pca_normals", "_pointcloud_normals._pca_normals_numpy", check_pca_normals,
          CLOUDS + ("degenerate_cloud",)),
     Twin("pointcloud.ball_indices", "_pointcloud_estimators._ball_indices", check_ball_indices, CLOUDS),

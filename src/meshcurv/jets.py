@@ -38,9 +38,10 @@ away from its normal) is ``-I^{-1} II``, turned into a symmetric 3D tensor
 
 The fits serve the ``quadric`` estimator (:mod:`meshcurv.estimators.quadric`,
 curvatures from the jets), the normals of ``icc`` (:mod:`meshcurv.estimators.icc`)
-and the point clouds (:mod:`meshcurv.pointcloud`). With the compiled kernels
-(:mod:`meshcurv._kernels.jets`) a ball can be the surface-connected piece of the
-Euclidean ball (``adjacency=``).
+and the point clouds (:mod:`meshcurv.pointcloud`). A ball can be the
+surface-connected piece of the Euclidean ball (``adjacency=``), on both
+backends (:func:`meshcurv.neighborhoods.connected_ball_pairs` is the NumPy
+twin of the compiled walk, :mod:`meshcurv._kernels.jets`).
 
 References
 ----------
@@ -63,7 +64,7 @@ from ._backend import kernel_threads, numba_kernels
 from ._tensors import tangent_basis
 from ._validation import checked_points
 from .errors import InvalidMeshError
-from .neighborhoods import _ball_pairs, call_ranges, check_ball_work
+from .neighborhoods import _ball_pairs, call_ranges, check_ball_work, checked_adjacency, connected_ball_pairs
 
 #: Highest degree of the jet (lowered to 3, then 2, where the ball holds too few points).
 DEGREE = 4
@@ -233,15 +234,16 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
         each fitted centre (NaN unless ``facing`` is given).
     adjacency : tuple of two ndarrays of int, optional
         ``(indptr, indices)``: the edge neighbours of every vertex in CSR form
-        (:attr:`meshcurv.topology.MeshTopology.neighbour_lists`). With the
-        compiled kernels each ball is then searched breadth-first over the
-        edges that meet it, from its centre, instead of on a grid over all the
-        points: the same points wherever the ball's part of the surface is
-        connected (every ball of a radius below the surface's thickness and
-        reach), and no search structure over the whole mesh (a fit at a few
-        centres costs only their balls). Another sheet of the surface within
-        the ball (the far side of a part thinner than the ball) is left out.
-        The NumPy path takes the whole Euclidean ball.
+        (:attr:`meshcurv.topology.MeshTopology.neighbour_lists`). Each ball is
+        then the vertices reached from its centre over the edges that meet it
+        (an end inside, or the segment passing through): the same points
+        wherever the ball's part of the surface is connected (every ball of a
+        radius below the surface's thickness and reach); another sheet of the
+        surface within the ball (the far side of a part thinner than the ball)
+        is left out. The compiled kernels walk each ball breadth-first, with no
+        search structure over the whole mesh (a fit at a few centres costs only
+        their balls); the NumPy path finds the same points by connected
+        components (:func:`meshcurv.neighborhoods.connected_ball_pairs`).
     settled : float, default: 0.0
         A fit whose slope ``c10^2 + c01^2`` is below this ends the iterations
         of its vertex: its normal is within ``atan(sqrt(settled))`` of the
@@ -316,11 +318,15 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     coefficients = np.full((n, 6), np.nan)
     counts = np.zeros(n)
     away = np.full(n, np.nan)
-    for chunk, centre, neighbour in _ball_pairs(pool_points, vertices[centres], radius, chunk_size):
+    if adjacency is not None:  # the surface-connected balls, as the compiled walk finds them
+        balls = connected_ball_pairs(vertices, centres, radius, adjacency, neighbours, chunk_size=chunk_size)
+    else:
+        balls = ((chunk, centre, pool[neighbour])
+                 for chunk, centre, neighbour in _ball_pairs(pool_points, vertices[centres], radius, chunk_size))
+    for chunk, centre, neighbour in balls:
         index = centres[chunk]
         size = index.size
         rows = centre - chunk.start
-        neighbour = pool[neighbour]
         offsets = (vertices[neighbour] - vertices[index[rows]]) * (1.0 / radius)
         weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
@@ -375,9 +381,7 @@ def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius: 
     (M, 3), the fitted normals alone."""
     n = vertices.shape[0]
     allowed = np.ones(n, dtype=bool) if neighbours is None else neighbours
-    indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
-    if indptr.shape != (n + 1,):
-        raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
+    indptr, indices = checked_adjacency(adjacency, n)
     check = facing is not None
     pieces = []
     for lo, hi in call_ranges(centres.size, pairs_per_centre):

@@ -29,6 +29,17 @@ mesh itself (``connected=True`` here, ``adjacency=`` of the jet fits; what
 wherever the surface inside it is connected, another sheet of the surface
 within the ball left out (tests/test_speed_design.py). The same walk over a
 k-nearest-neighbour graph would serve point clouds.
+
+Both backends compute the same balls (issue 29: a user's numbers must not
+depend on whether numba is installed). The NumPy path finds the
+surface-connected pieces for a whole chunk of centres at once: the cells that
+may meet each ball (k-d tree pairs of centres and cell centroids), the exact
+tests of the kernels on each pair (the same operations, in the same order),
+then the connected components of the graph whose nodes are the ``(centre,
+vertex)`` pairs and whose links are the cells meeting the ball
+(:func:`scipy.sparse.csgraph.connected_components`); the nodes in their
+centre's component are the vertices the walk reaches (tests/test_backend_parity.py,
+tests/test_kernel_twins.py).
 """
 
 from __future__ import annotations
@@ -382,8 +393,10 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
         if usable.shape != (cells.shape[0],):
             raise InvalidMeshError(f"`usable` must have shape ({cells.shape[0]},); got {usable.shape}")
     kernels = numba_kernels("neighborhoods")
-    if connected and kernels is not None and cells.shape[1] == 3 and cells.shape[0]:
-        return _connected_face_sums(kernels, vertices, cells, radius, values, usable)
+    if connected and cells.shape[1] == 3 and cells.shape[0]:
+        if kernels is not None:
+            return _connected_face_sums(kernels, vertices, cells, radius, values, usable)
+        return _connected_face_sums_numpy(vertices, cells, radius, values, usable)
     if usable is not None:
         keep = np.flatnonzero(usable)
         cells, values = cells[keep], values[keep]
@@ -394,41 +407,289 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     if kernels is not None:
         centres, reach = kernels.cell_centres(vertices, cells)
     else:
-        corners = vertices[cells]
-        centres = corners.mean(axis=1)
-        reach = np.linalg.norm(corners - centres[:, None, :], axis=2).max(axis=1)
+        centres, reach = cell_centres(vertices, cells)
     # Cells are searched by their centres within radius + their own reach. One
     # search radius for all would be set by the largest cell: on a mesh with a
     # few long edges (a scan with a coarse patch) every ball would then gather
     # thousands of small cells. So cells are grouped by size: each group is
     # searched with its own largest reach, and a group takes the next power of
     # two of reach as long as its search radius grows by at most GROUP_GROWTH.
+    if kernels is None:
+        for chunk, i, c in _candidate_pairs(vertices, centres, reach, radius):
+            weights = weight(vertices[cells[c]], vertices[chunk][i], radius)
+            out[chunk] += _gathered(i, c, weights, chunk, values)
+        return out
     for group in _size_groups(reach, radius):
         cutoff = radius + reach[group].max()
-        mean, largest = check_ball_work(centres[group], cutoff, n, centres=vertices)
-        if kernels is not None:
-            ranges = call_ranges(n, mean)
-            for start, stop in ranges:
-                sums = kernels.ball_cell_sums(vertices, cells[group], centres[group],
-                                              np.ascontiguousarray(values[group]), radius, cutoff,
-                                              64 * kernel_threads(), start, stop)
-                if isinstance(group, slice) and len(ranges) == 1:  # one group, one call: its sums are the result
-                    return sums
-                out += sums
-            continue
-        import scipy.sparse as sp  # the NumPy path only: scipy.spatial costs 0.1 s to import
-        from scipy.spatial import cKDTree
-
-        tree = cKDTree(centres[group])
-        index = np.arange(cells.shape[0])[group]  # group position -> cell
-        chunk_size = max(1, min(CHUNK, int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
-        for chunk in _chunks(n, chunk_size):
-            i, c = _pairs(tree, vertices[chunk], cutoff)
-            c = index[c]
-            weights = weight(vertices[cells[c]], vertices[chunk][i], radius)
-            gather = sp.csr_matrix((weights, (i, c)), shape=(chunk.stop - chunk.start, values.shape[0]))
-            out[chunk] += np.asarray(gather @ values)
+        mean, _ = check_ball_work(centres[group], cutoff, n, centres=vertices)
+        ranges = call_ranges(n, mean)
+        for start, stop in ranges:
+            sums = kernels.ball_cell_sums(vertices, cells[group], centres[group],
+                                          np.ascontiguousarray(values[group]), radius, cutoff,
+                                          64 * kernel_threads(), start, stop)
+            if isinstance(group, slice) and len(ranges) == 1:  # one group, one call: its sums are the result
+                return sums
+            out += sums
     return out
+
+
+def _gathered(rows: np.ndarray, cells: np.ndarray, weights: np.ndarray, chunk: slice, values: np.ndarray) -> np.ndarray:
+    """(chunk length, k) ``sum weights * values[cells]`` by row: one sparse product."""
+    import scipy.sparse as sp  # the NumPy path only
+
+    gather = sp.csr_matrix((weights, (rows, cells)), shape=(chunk.stop - chunk.start, values.shape[0]))
+    return np.asarray(gather @ values)
+
+
+def cell_centres(vertices: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(C, 3) centroids of cells (faces or edges, corner indices) and (C,) their reach.
+
+    The reach is the largest distance from the centroid to a corner: every point
+    of the cell is within it. The operations of the compiled ``cell_centres``
+    (corner by corner, in order), so that both backends test the same numbers.
+    """
+    corners = cells.shape[1]
+    centres = vertices[cells[:, 0]]
+    for k in range(1, corners):
+        centres += vertices[cells[:, k]]
+    centres /= corners
+    reach = np.zeros(cells.shape[0])
+    for k in range(corners):
+        reach = np.maximum(reach, np.sqrt(_squared(*(vertices[cells[:, k]] - centres).T)))
+    return centres, reach
+
+
+def _squared(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Squared lengths of offsets given by coordinate, summed x, y, z in that order (the kernels' rounding)."""
+    return (x * x + y * y) + z * z
+
+
+def _columns(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The x, y and z coordinates of (N, 3) points as three contiguous arrays (gathers by index from
+    a column are several times faster than of rows)."""
+    return tuple(np.ascontiguousarray(column) for column in points.T)
+
+
+def _offsets(columns: tuple, index: np.ndarray, centre: tuple) -> tuple[np.ndarray, ...]:
+    """The coordinates of the points ``index`` of ``columns`` relative to ``centre`` (three arrays each)."""
+    return tuple(column[index] - c for column, c in zip(columns, centre))
+
+
+#: Relative slack of the candidate searches of the NumPy path: a cell at the search radius
+#: itself (up to the k-d tree's rounding) is a candidate, the exact tests decide.
+_SEARCH_SLACK = 1e-9
+
+
+def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np.ndarray, radius: float,
+                     chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+    """Yield ``(chunk, i, c)`` per chunk of centres: cell ``c`` may meet the ball ``B(centre_points[i], radius)``.
+
+    ``i`` indexes the chunk (0 and up). A superset of the cells that meet each
+    ball: those whose centroid is within ``radius`` plus the largest reach of
+    their size group (:func:`_size_groups`) of the centre, by k-d trees; the
+    caller tests each pair exactly. The chunks hold at most ``chunk_size`` centres
+    and about :data:`PAIRS_PER_CHUNK` pairs, all the groups' pairs of a centre in the same chunk.
+
+    Raises
+    ------
+    InvalidOptionError
+        More than :data:`MAX_BALL_PAIRS` pairs in a group (:func:`check_ball_work`).
+    """
+    from scipy.spatial import cKDTree
+
+    n = centre_points.shape[0]
+    searches = []
+    largest = 0.0
+    if centroids.shape[0]:
+        index = np.arange(centroids.shape[0])
+        for group in _size_groups(reach, radius):
+            cutoff = (radius + float(reach[group].max())) * (1 + _SEARCH_SLACK)
+            largest += check_ball_work(centroids[group], cutoff, n, centres=centre_points)[1]
+            searches.append((cKDTree(centroids[group]), index[group], cutoff))
+    chunk_size = max(1, min(int(chunk_size), int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
+    empty = np.zeros(0, dtype=np.int64)
+    for chunk in _chunks(n, chunk_size):
+        rows, cells = [empty], [empty]
+        for tree, index, cutoff in searches:
+            i, c = _pairs(tree, centre_points[chunk], cutoff)
+            rows.append(i)
+            cells.append(index[c])
+        yield chunk, np.concatenate(rows), np.concatenate(cells)
+
+
+def _segments_meet_ball(a: tuple, b: tuple, radius2: float) -> np.ndarray:
+    """(P,) whether each segment ``[a, b]`` (ends relative to the ball's centre, three coordinate arrays
+    each) passes through the ball of squared radius ``radius2`` between its ends: its closest point to the
+    centre is inside and not an end. The operations of the compiled ``_segment_meets_ball``."""
+    d = [q - p for p, q in zip(a, b)]
+    along = -((a[0] * d[0] + a[1] * d[1]) + a[2] * d[2])
+    length2 = _squared(*d)
+    return (along > 0) & (along < length2) & (_squared(*a) * length2 - along * along <= radius2 * length2)
+
+
+def _unique_inverse(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(keys, return_inverse=True)`` by one unstable argsort (several times faster)."""
+    order = np.argsort(keys)
+    ordered = keys[order]
+    first = np.ones(ordered.shape[0], dtype=bool)
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    inverse = np.empty(keys.shape[0], dtype=np.int64)
+    inverse[order] = np.cumsum(first) - 1
+    return ordered[first], inverse
+
+
+def _linked_to_centre(n: int, rows: np.ndarray, corners: list[np.ndarray],
+                      centre_vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """The nodes ``(centre, vertex)`` of a chunk of balls and whether each is joined to its centre.
+
+    Cell ``p`` (of centre ``rows[p]``, its vertices ``corners[k][p]``) joins
+    its corners: the nodes joined to the centre's own node (``centre_vertices[i]``
+    of centre ``i``) through such cells are the vertices a breadth-first walk
+    from the centre over the cells reaches. Returns ``(keys, linked, nodes)``:
+    the sorted node keys ``i * n + vertex``, (N,) whether each is joined to
+    its centre and, per corner, the node of each cell's corner.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    m = centre_vertices.shape[0]
+    base = rows * n
+    keys, inverse = _unique_inverse(np.concatenate([base + corner for corner in corners]
+                                                   + [np.arange(m, dtype=np.int64) * n + centre_vertices]))
+    size = rows.shape[0]
+    nodes = [inverse[k * size:(k + 1) * size] for k in range(len(corners))]
+    starts = np.concatenate([nodes[0]] * (len(corners) - 1))  # cell p joins its first corner to each other one
+    graph = coo_matrix((np.ones(starts.size, dtype=np.int8), (starts, np.concatenate(nodes[1:]))),
+                       shape=(keys.size, keys.size))
+    _, labels = connected_components(graph, directed=True, connection="weak")
+    centre_labels = labels[inverse[len(corners) * size:]]
+    return keys, labels == centre_labels[keys // n], nodes
+
+
+def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,
+                               usable: np.ndarray | None) -> np.ndarray:
+    """:func:`ball_face_sums` over the surface-connected piece of each ball: the compiled
+    ``connected_face_sums``'s faces, found for all centres of a chunk at once.
+
+    A face is passed through when it meets the closed ball (its centroid
+    within the radius plus its reach, and a corner or the centroid inside or a
+    side crossing the sphere); the faces summed are those passed through that
+    are joined to the centre by such faces (:func:`_linked_to_centre`), each
+    weighted by its share (:func:`face_in_ball_ratios`, from squared distances
+    as the kernel computes them).
+    """
+    n = vertices.shape[0]
+    centroids, reach = cell_centres(vertices, faces)
+    points, middles = _columns(vertices), _columns(centroids)
+    corners = [np.ascontiguousarray(faces[:, k]) for k in range(3)]
+    out = np.zeros((n, values.shape[1]))
+    radius2 = radius * radius
+    for chunk, i, f in _candidate_pairs(vertices, centroids, reach, radius):
+        ids = np.arange(chunk.start, chunk.stop)[i]
+        centre = tuple(column[ids] for column in points)
+        middle = _squared(*_offsets(middles, f, centre))
+        near = np.flatnonzero(~(middle > (radius + reach[f]) ** 2))
+        i, f, middle, centre = i[near], f[near], middle[near], tuple(c[near] for c in centre)
+        offsets = [_offsets(points, corner[f], centre) for corner in corners]
+        low, high = middle.copy(), middle.copy()
+        for offset in offsets:
+            squared = _squared(*offset)
+            np.minimum(low, squared, out=low)
+            np.maximum(high, squared, out=high)
+        inside = high <= radius2
+        partial = ~inside & (low < radius2)
+        meets = inside | partial
+        for k in range(3):  # corners and centroid outside: through the face when a side crosses the ball
+            rest = np.flatnonzero(~meets)
+            meets[rest] = _segments_meet_ball(tuple(c[rest] for c in offsets[k]),
+                                              tuple(c[rest] for c in offsets[(k + 1) % 3]), radius2)
+        i, f, low, high, inside, partial = i[meets], f[meets], low[meets], high[meets], inside[meets], partial[meets]
+        _, linked, nodes = _linked_to_centre(n, i, [corner[f] for corner in corners],
+                                             np.arange(chunk.start, chunk.stop, dtype=np.int64))
+        root = np.sqrt(low)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(inside, 1.0, np.where(partial, (radius - root) / (np.sqrt(high) - root), 0.0))
+        keep = linked[nodes[0]] & (share != 0.0)
+        if usable is not None:
+            keep &= usable[f]
+        out[chunk] += _gathered(i[keep], f[keep], share[keep], chunk, values)
+    return out
+
+
+def connected_ball_pairs(vertices: np.ndarray, centres: np.ndarray, radius: float, adjacency: tuple,
+                         allowed: np.ndarray | None = None, *,
+                         chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+    """Yield ``(chunk, centre, neighbour)``: the vertices of the surface-connected piece of each ball.
+
+    The NumPy twin of the compiled walk of the jet fits (``_connected_members``):
+    the vertices within ``radius`` of vertex ``centres[centre]`` reached from it
+    over the edges of ``adjacency`` (CSR lists, :attr:`MeshTopology.neighbour_lists`)
+    that meet the closed ball (an end inside, or the segment passing through it),
+    and ``allowed`` (V,) bool (default: all); every centre is its own first
+    neighbour when allowed. ``centre`` indexes ``centres`` (absolute), by
+    chunks of at most ``chunk_size`` of them as :func:`vertex_pairs_in_ball`;
+    ``neighbour`` is a vertex id. Trusted inputs (``centres`` int64 ids in range).
+
+    Raises
+    ------
+    InvalidMeshError
+        ``adjacency`` is not CSR lists of the vertices (:func:`checked_adjacency`).
+    InvalidOptionError
+        The balls would hold more than :data:`MAX_BALL_PAIRS` pairs (:func:`check_ball_work`).
+    """
+    n = vertices.shape[0]
+    edges = adjacency_edges(adjacency, n)
+    mids, half = cell_centres(vertices, edges)
+    points = _columns(vertices)
+    first, second = np.ascontiguousarray(edges[:, 0]), np.ascontiguousarray(edges[:, 1])
+    radius2 = radius * radius
+    for chunk, i, e in _candidate_pairs(vertices[centres], mids, half, radius, chunk_size):
+        ids = centres[chunk]
+        centre = tuple(column[ids[i]] for column in points)
+        a, b = _offsets(points, first[e], centre), _offsets(points, second[e], centre)
+        meets = (_squared(*a) <= radius2) | (_squared(*b) <= radius2)
+        rest = np.flatnonzero(~meets)
+        meets[rest] = _segments_meet_ball(tuple(c[rest] for c in a), tuple(c[rest] for c in b), radius2)
+        i, e = i[meets], e[meets]
+        keys, linked, _ = _linked_to_centre(n, i, [first[e], second[e]], ids)
+        keys = keys[linked]
+        rows, neighbour = np.divmod(keys, n)
+        inside = _squared(*_offsets(points, neighbour, tuple(column[ids[rows]] for column in points))) <= radius2
+        if allowed is not None:
+            inside &= allowed[neighbour]
+        yield chunk, rows[inside] + chunk.start, neighbour[inside]
+
+
+def checked_adjacency(adjacency, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(indptr, indices)``: CSR neighbour lists of ``n`` vertices, as contiguous int64 arrays.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``indptr`` does not hold ``n + 1`` offsets ending at the length of
+        ``indices``, or an index is not a vertex.
+    """
+    indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
+    if indptr.shape != (n + 1,) or indices.ndim != 1 or indptr[-1] != indices.shape[0]:
+        raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
+    if indices.size and (indices.min() < 0 or indices.max() >= n):
+        raise InvalidMeshError(f"`adjacency` must hold vertex indices in 0..{n - 1}")
+    return indptr, indices
+
+
+def adjacency_edges(adjacency: tuple, n: int) -> np.ndarray:
+    """(E, 2) int64 edges ``a < b`` of CSR neighbour lists ``(indptr, indices)`` of ``n`` vertices, each once.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``adjacency`` is not CSR lists of the vertices (:func:`checked_adjacency`).
+    """
+    indptr, indices = checked_adjacency(adjacency, n)
+    starts = np.repeat(np.arange(n, dtype=np.int64), np.diff(indptr))
+    low, high = np.minimum(starts, indices), np.maximum(starts, indices)
+    keys = np.unique((low * n + high)[low != high])
+    return np.column_stack([keys // n, keys % n])
 
 
 def call_ranges(n: int, pairs_per_centre: float) -> list[tuple[int, int]]:
@@ -489,14 +750,15 @@ def ball_face_sums(vertices: np.ndarray, faces: np.ndarray, radius: float, value
     """(V, k) ``sum_f ratio(f, B(x_v, r)) * values[f]`` over the faces meeting each ball.
 
     ``values`` is (F, k); ``ratio`` is :func:`face_in_ball_ratios`. Faces not
-    ``usable`` (F,) bool are left out. With ``connected`` and the compiled
-    kernels, the faces are searched breadth-first from those around each
-    vertex, through every face that may meet the ball (a corner or the centroid
-    inside, or the centroid within the radius plus the face's reach; faces not
-    ``usable`` lead the search on): the faces of the ball wherever its part of
-    the surface is connected, without a search structure over the whole mesh;
-    another sheet of the surface inside the ball is left out. The NumPy path
-    takes the whole Euclidean ball.
+    ``usable`` (F,) bool are left out. With ``connected``, only the faces
+    reached from those around each vertex through faces that meet the closed
+    ball (the centroid within the radius plus the face's reach, and a corner
+    or the centroid inside or a side crossing the sphere; faces not ``usable``
+    lead on but add nothing): the faces of the ball wherever its part of the
+    surface is connected; another sheet of the surface inside the ball is left
+    out. The compiled kernel walks each ball breadth-first (no search
+    structure over the whole mesh); the NumPy path finds the same faces by
+    connected components (see the module's doc).
     """
     return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)
 

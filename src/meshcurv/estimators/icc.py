@@ -49,14 +49,17 @@ tangent planes turn inside the ball), several times larger than that of
 Boundaries need no special case beyond the fitted normals: the measures and
 the corrected area both stop at the boundary, so boundary vertices are valid.
 
-With the compiled kernels every ball (of the normal fits and of the sums) is
-the piece of the Euclidean ball connected to its vertex on the mesh, walked
-breadth-first over the edges and faces that meet it (``adjacency=`` of
-:func:`~meshcurv.jets.fit_jets`, ``connected=`` of
-:func:`~meshcurv.neighborhoods.ball_face_sums`): the Euclidean ball wherever
-the surface inside it is connected, without a search structure over the whole
-mesh; a ball that reaches another sheet of the surface (the far side of a part
-thinner than the ball) leaves it out. The NumPy path searches Euclidean balls.
+Every ball (of the noise fits, the normal fits and the sums) is the piece of
+the Euclidean ball connected to its vertex on the mesh through the edges and
+faces that meet it (``adjacency=`` of :func:`~meshcurv.jets.fit_jets`,
+``connected=`` of :func:`~meshcurv.neighborhoods.ball_face_sums`): the
+Euclidean ball wherever the surface inside it is connected; a ball that
+reaches another sheet of the surface (the far side of a part thinner than the
+ball) leaves it out. Both backends compute these balls (the compiled kernels
+walk them breadth-first, the NumPy path finds them by connected components),
+so the default radius and the curvatures do not depend on whether numba is
+installed (issue 29: a 3 x 3 x 0.15 ellipsoid had a default radius of 0.118
+with numba and 0.538 without).
 
 References
 ----------
@@ -73,7 +76,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._backend import backend_name, numba_kernels
+from .._backend import numba_kernels
 from .._tensors import principal_from_mean_gaussian, principal_from_shape_operator
 from ..geometry import robust_mean_edge_length, vertex_edge_lengths
 from ..jets import fit_jet_normals, fit_jets
@@ -318,9 +321,9 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology) -> tuple[
         "curvature_radius": curvature_radius}
 
 
-def _adjacency(topology: MeshTopology) -> tuple | None:
-    """The edge lists the compiled ball searches walk (None on the NumPy path, which does not use them)."""
-    return topology.neighbour_lists if backend_name() == "numba" else None
+def _adjacency(topology: MeshTopology) -> tuple:
+    """The edge lists the ball searches walk (both backends: the surface-connected balls)."""
+    return topology.neighbour_lists
 
 
 def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Stages | None = None, *,
@@ -329,9 +332,9 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
-    sums are the surface-connected pieces of the Euclidean balls (the same
-    wherever the surface within the ball is connected; compiled kernels only,
-    see :func:`meshcurv.neighborhoods.ball_face_sums`).
+    sums are the surface-connected pieces of the Euclidean balls when
+    ``adjacency`` is given (the same wherever the surface within the ball is
+    connected; see :func:`meshcurv.neighborhoods.ball_face_sums`).
     """
     def start(stage):
         if stages is not None:
