@@ -1,0 +1,437 @@
+"""Fuzz label images: ``python benchmarks/fuzz_labels.py --minutes N [--seed S] [--timeout T]``.
+
+Random label images for :func:`meshcurv.volume.label_curvatures`, checked
+against analytic geometry:
+
+- ``ball``: a ball of radius 2.5-14 voxels (of the largest voxel size),
+  placed anywhere from well inside the image to cut by one, two or three of
+  its faces (on its equator, off centre, in a corner, at the far faces),
+  voxels anisotropic up to 4:1 and scaled by 1e-4 to 1e4. Truths: the area of
+  the sphere inside the image box (the fraction of 200,000 Fibonacci points
+  of the sphere inside it) and the volume of the ball inside it (a 160^3
+  midpoint grid over their common box); ``mean_weighted`` against ``1 / R``.
+- ``box``: a box of voxels touching 0-3 faces of the image (a face, an edge,
+  a corner, the far side). Truths: the area of its faces not on the image's
+  faces, its volume ``a b c``.
+- ``cylinder``: a cylinder across the image along a random axis. Truths: its
+  lateral area ``2 pi R L`` and volume ``pi R^2 L``.
+- ``many``: 20-150 blobs of 1-60 voxels (one-voxel labels included) with
+  random label values in odd dtypes (bool, int8 ... uint64, up to the dtype's
+  largest value), some touching the border. Checks: one row per label present,
+  in order, the right voxel counts, ``too_small`` exactly for surfaces of
+  fewer than 16 vertices, the volume within half a voxel layer of the voxel
+  count's.
+
+Every case also checks: finite area and volume on ``ok`` rows; the curvature
+columns NaN exactly when no vertex was used; ``area <= area_mesh`` up to the
+corrected area's rounding; exactly one ``no `spacing``` warning when the call
+gives no spacing (a quarter of the cases), none otherwise; and, for one case
+in eight, the same table from a Fortran-ordered, read-only copy of the image.
+
+Tolerances (from the measurements in :mod:`meshcurv.volume` and
+``tests/test_volume_border.py``): area 3% of the truth plus 0.5 h per unit length of
+the rim where a cut surface meets the image face (marching cubes' chamfer
+there, and the refit's extrapolation) plus, for boxes, 0.8 h per unit length
+of their edges inside (the corrected area rounds them: 0.42-0.52 h measured);
+volume 2% plus ``1.5 h / R`` (the half-voxel rounding of a digitised ball)
+plus ``h^2 / 8`` per unit length of rims and box edges (the chamfers).
+``h`` is the largest voxel size. Areas are checked from ``R >= 4 h`` (boxes of
+3 voxels a side); ``mean_weighted`` within 15% from ``R >= 5 h`` with at least
+30 vertices used.
+
+Each case runs in a forked child with a wall-clock limit (``--timeout``) and
+an address-space cap. A finding is an exception other than the documented
+ones, a crash, a timeout, or a broken check. One JSON line per finding in
+``--log``; a summary on stdout (counts per kind and outcome).
+``--replay I --seed S`` runs case ``I`` in this process and prints it.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("NUMBA_THREADING_LAYER", "workqueue")  # forked children after parallel regions (fuzz_api.py)
+
+import argparse  # noqa: E402
+import collections  # noqa: E402
+import json  # noqa: E402
+import pickle  # noqa: E402
+import re  # noqa: E402
+import resource  # noqa: E402
+import select  # noqa: E402
+import signal  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+import traceback  # noqa: E402
+import warnings  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from meshcurv.errors import (InvalidMeshError, InvalidOptionError, MeshcurvWarning, MeshFileError,  # noqa: E402
+                             MissingDependencyError)
+from meshcurv.volume import MIN_VERTICES, label_curvatures  # noqa: E402
+
+DOCUMENTED = (InvalidMeshError, InvalidOptionError, MeshFileError, MissingDependencyError)
+KINDS = ("ball", "box", "cylinder", "many")
+DTYPES = ("bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64")
+CURVATURE_COLUMNS = ("mean_weighted", "mean_median", "gaussian_weighted", "k_min_p5", "k_max_p95", "total_mean",
+                     "total_gaussian", "willmore", "shape_index_fraction_cap")
+
+
+# ---- the cases -------------------------------------------------------------------------------------------------------
+
+def _spacing(rng, unit: bool) -> np.ndarray:
+    if unit:
+        return np.ones(3)
+    ratios = np.exp(rng.uniform(np.log(0.25), 0, 3)) if rng.random() < 0.6 else np.ones(3)
+    scale = 10.0 ** rng.choice([0.0, 0.0, 0.0, rng.uniform(-4, 4)])
+    return ratios / ratios.max() * scale  # the largest voxel size is ``scale``
+
+
+def _fibonacci_sphere(n: int) -> np.ndarray:
+    index = np.arange(n) + 0.5
+    polar = np.arccos(1 - 2 * index / n)
+    azimuth = np.pi * (1 + 5**0.5) * index
+    return np.column_stack([np.cos(polar), np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth)])
+
+
+_SPHERE = _fibonacci_sphere(200_000)
+
+
+def _ball_case(rng, unit):
+    spacing = _spacing(rng, unit)
+    h = spacing.max()
+    radius = rng.uniform(2.5, 14.0) * h
+    extent = np.ceil((2 * radius + rng.uniform(2, 8) * h) / spacing).astype(int)
+    center = (extent - 1) * spacing / 2 + rng.uniform(-0.3, 0.3, 3) * spacing
+    for axis in range(3):  # cut by 0-3 image faces, low or high, at any depth (the equator included)
+        if rng.random() < 0.6:
+            depth = rng.choice([0.0, rng.uniform(-0.8, 0.8)]) * radius
+            low_face = -0.5 * spacing[axis]
+            if rng.random() < 0.5:
+                center[axis] = low_face + depth
+            else:
+                center[axis] = (extent[axis] - 0.5) * spacing[axis] - depth
+    axes = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(extent, spacing, center)], indexing="ij", sparse=True)
+    image = sum(a**2 for a in axes) <= radius**2
+    box_low, box_high = -0.5 * spacing, (extent - 0.5) * spacing
+    points = center + radius * _SPHERE
+    area = 4 * np.pi * radius**2 * np.mean(((points >= box_low) & (points <= box_high)).all(axis=1))
+    low, high = np.maximum(box_low, center - radius), np.minimum(box_high, center + radius)
+    volume, rim = 0.0, 0.0
+    if (high > low).all():
+        grid = np.meshgrid(*[low[k] + (np.arange(160) + 0.5) * (high[k] - low[k]) / 160 - center[k] for k in range(3)],
+                           indexing="ij", sparse=True)
+        volume = float(np.count_nonzero(sum(g**2 for g in grid) <= radius**2)) * np.prod(high - low) / 160**3
+        for axis in range(3):  # an upper bound of the rims' length: whole circles where a face cuts the ball
+            for face in (box_low[axis], box_high[axis]):
+                distance = abs(face - center[axis])
+                if distance < radius:
+                    rim += 2 * np.pi * np.sqrt(radius**2 - distance**2)
+    truth = {"area": area, "volume": volume, "rim": rim, "radius": radius, "h": h,
+             "check_area": radius >= 4 * h, "mean": 1 / radius}
+    return image.astype(np.uint8), spacing, truth
+
+
+def _box_case(rng, unit):
+    spacing = _spacing(rng, unit)
+    sides = rng.integers(2, 14, 3)
+    extent = sides + rng.integers(2, 8, 3)
+    start = np.array([rng.choice([0, extent[k] - sides[k], rng.integers(1, extent[k] - sides[k])]) for k in range(3)])
+    image = np.zeros(extent, dtype=np.uint8)
+    image[tuple(slice(s, s + n) for s, n in zip(start, sides))] = 1
+    size = sides * spacing
+    on_border = np.column_stack([start == 0, start + sides == extent])  # (axis, low/high)
+    area = sum(np.prod(np.delete(size, axis)) for axis in range(3) for side in range(2) if not on_border[axis, side])
+    inner_edges, rims, chamfered = 0.0, 0.0, 0.0
+    for a in range(3):
+        for b in range(a + 1, 3):
+            length = size[3 - a - b]
+            for sa in range(2):
+                for sb in range(2):
+                    border = int(on_border[a, sa]) + int(on_border[b, sb])
+                    inner_edges += length * (border == 0)
+                    rims += length * (border == 1)
+                    chamfered += length * spacing[a] * spacing[b] / 8
+    truth = {"area": area, "volume": float(np.prod(size)), "rim": rims, "edges": inner_edges,
+             "chamfer_volume": chamfered, "h": spacing.max(), "check_area": sides.min() >= 3, "box": True}
+    return image, spacing, truth
+
+
+def _cylinder_case(rng, unit):
+    spacing = _spacing(rng, unit)
+    h = spacing.max()
+    axis = int(rng.integers(3))
+    radius = rng.uniform(4.0, 10.0) * h
+    extent = np.ceil((2 * radius + rng.uniform(2, 6) * h) / spacing).astype(int)
+    extent[axis] = int(rng.integers(8, 40))
+    center = (extent - 1) * spacing / 2 + rng.uniform(-0.3, 0.3, 3) * spacing
+    axes = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(extent, spacing, center)], indexing="ij", sparse=True)
+    image = np.broadcast_to(sum(a**2 for k, a in enumerate(axes) if k != axis) <= radius**2, tuple(extent))
+    length = extent[axis] * spacing[axis]
+    truth = {"area": 2 * np.pi * radius * length, "volume": np.pi * radius**2 * length, "rim": 4 * np.pi * radius,
+             "radius": radius, "h": h, "check_area": True, "mean": 1 / (2 * radius)}
+    return np.ascontiguousarray(image, dtype=np.uint8), spacing, truth
+
+
+def _many_case(rng, unit):
+    spacing = _spacing(rng, unit)
+    dtype = np.dtype(str(rng.choice(DTYPES)))
+    extent = rng.integers(12, 40, 3)
+    n_blobs = 1 if dtype.kind == "b" else int(rng.integers(20, 150))
+    image = np.zeros(extent, dtype=dtype)
+    top = 1 if dtype.kind == "b" else int(np.iinfo(dtype).max)
+    values = rng.choice([1, top, None], p=[0.1, 0.1, 0.8], size=n_blobs)
+    for value in values:
+        value = int(rng.integers(1, top, endpoint=True, dtype=np.uint64)) if value is None else int(value)
+        side = rng.integers(1, 5, 3)
+        start = rng.integers(0, extent - side + 1)
+        image[tuple(slice(s, s + n) for s, n in zip(start, side))] = value
+    return image, spacing, {"h": spacing.max(), "many": True}
+
+
+CASES = {"ball": _ball_case, "box": _box_case, "cylinder": _cylinder_case, "many": _many_case}
+
+
+def make_case(seed: int, index: int):
+    """``(kind, image, spacing, give_spacing, truth, twin)`` of case ``index``: a quarter without spacing (1 x 1 x 1)."""
+    rng = np.random.default_rng([seed, index])
+    kind = KINDS[int(rng.choice(4, p=[0.4, 0.25, 0.15, 0.2]))]
+    give_spacing = bool(rng.random() >= 0.25)
+    image, spacing, truth = CASES[kind](rng, unit=not give_spacing)
+    twin = bool(rng.random() < 0.125)
+    return kind, image, spacing, give_spacing, truth, twin
+
+
+# ---- the checks ------------------------------------------------------------------------------------------------------
+
+def check_table(kind, image, spacing, truth, table) -> list[str]:
+    broken = []
+    present = np.unique(image.view(np.uint8) if image.dtype == bool else image)
+    present = [int(v) for v in present if v != 0]
+    if [int(v) for v in table.label] != present:
+        broken.append(f"labels: {len(table)} rows for {len(present)} labels present")
+        return broken
+    flat = image.view(np.uint8) if image.dtype == bool else image
+    for row in table.itertuples():
+        n_voxels = int(np.count_nonzero(flat == row.label)) if len(table) < 40 else row.n_voxels
+        if row.n_voxels != n_voxels:
+            broken.append(f"n_voxels: {row.n_voxels} for {n_voxels}")
+        if row.status not in ("ok", "too_small"):
+            broken.append(f"status {row.status}: {row.error[:100]}")
+            continue
+        if row.status == "too_small":
+            if row.n_vertices >= MIN_VERTICES:
+                broken.append(f"too_small with {row.n_vertices} vertices")
+            if np.isfinite(row.area) or np.isfinite(row.mean_weighted):
+                broken.append("too_small with a finite area or curvature")
+            continue
+        if row.n_vertices < MIN_VERTICES:
+            broken.append(f"ok with {row.n_vertices} vertices")
+        if not (np.isfinite(row.area) and np.isfinite(row.volume) and row.area > 0 and row.volume > 0):
+            broken.append(f"area {row.area}, volume {row.volume}: not finite and positive")
+            continue
+        if not 0 <= row.n_used <= row.n_vertices:
+            broken.append(f"n_used {row.n_used} of {row.n_vertices}")
+        nan = [np.isnan(getattr(row, column)) for column in CURVATURE_COLUMNS]
+        if row.n_used == 0 and not all(nan):
+            broken.append("curvature columns finite with no vertex used: "
+                          + ", ".join(c for c, n in zip(CURVATURE_COLUMNS, nan) if not n))
+        if row.n_used > 0 and any(nan[:2]):
+            broken.append("mean_weighted or mean_median NaN with vertices used")
+        if row.area > 1.05 * row.area_mesh:
+            broken.append(f"area {row.area:.6g} above the triangles' {row.area_mesh:.6g}")
+        voxel_volume = row.n_voxels * float(np.prod(spacing))
+        if abs(row.volume - voxel_volume) > 0.5 * truth["h"] * row.area_mesh + 1e-9 * voxel_volume:
+            broken.append(f"volume {row.volume:.6g} farther than half a voxel layer from the voxels' {voxel_volume:.6g}")
+    if truth.get("many") or len(table) != 1 or table.status[0] != "ok":
+        return broken
+    row = table.iloc[0]
+    h = truth["h"]
+    # the volume
+    if truth.get("box"):
+        loss = truth["volume"] - row.volume
+        if not -1e-9 * truth["volume"] <= loss <= 1.2 * truth["chamfer_volume"] + 1e-9 * truth["volume"]:
+            broken.append(f"box volume {row.volume:.6g} for {truth['volume']:.6g} (chamfers "
+                          f"{truth['chamfer_volume']:.3g})")
+    else:
+        tolerance = (0.02 + 1.5 * h / truth["radius"]) * truth["volume"] + h * h / 8 * truth["rim"]
+        if abs(row.volume - truth["volume"]) > tolerance:
+            broken.append(f"{kind} volume {row.volume:.6g} for {truth['volume']:.6g} (tolerance {tolerance:.3g})")
+    # the area of the surface inside the image
+    if truth["check_area"] and truth["area"] > 0:
+        tolerance = 0.03 * truth["area"] + 0.5 * h * truth["rim"] + 0.8 * h * truth.get("edges", 0.0)
+        if abs(row.area - truth["area"]) > tolerance:
+            broken.append(f"{kind} area {row.area:.6g} for {truth['area']:.6g} (tolerance {tolerance:.3g}; "
+                          f"touches_border {row.touches_border})")
+    # H where it is used, on the curved solids
+    if "mean" in truth and truth["radius"] >= 5 * h and row.n_used >= 30:
+        if abs(row.mean_weighted / truth["mean"] - 1) > 0.15:
+            broken.append(f"{kind} mean_weighted {row.mean_weighted:.6g} for {truth['mean']:.6g} "
+                          f"({row.n_used} vertices used of {row.n_vertices})")
+    return broken
+
+
+def run_case(seed, index) -> dict:
+    kind, image, spacing, give_spacing, truth, twin = make_case(seed, index)
+    options = {"spacing": tuple(spacing)} if give_spacing else {}
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            table = label_curvatures(image, **options)
+    except DOCUMENTED as exc:
+        return {"kind": kind, "status": "documented", "type": type(exc).__name__, "message": str(exc)[:200]}
+    except Exception as exc:  # noqa: BLE001
+        frame = traceback.extract_tb(exc.__traceback__)[-1]
+        return {"kind": kind, "status": "exception", "type": type(exc).__name__, "message": str(exc)[:300],
+                "where": f"{os.path.basename(frame.filename)}:{frame.lineno}"}
+    broken = check_table(kind, image, spacing, truth, table)
+    spacing_warnings = [w for w in caught if issubclass(w.category, MeshcurvWarning) and "no `spacing`" in
+                        str(w.message)]
+    if len(spacing_warnings) != (0 if give_spacing else 1):
+        broken.append(f"{len(spacing_warnings)} spacing warnings with spacing {'given' if give_spacing else 'not given'}")
+    if twin:
+        other = np.asfortranarray(image)
+        other.flags.writeable = False
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            again = label_curvatures(other, spacing=tuple(spacing))
+        numbers = [c for c in table.columns if table[c].dtype.kind == "f"]
+        if not np.allclose(table[numbers].to_numpy(), again[numbers].to_numpy(), rtol=1e-9, atol=0, equal_nan=True):
+            broken.append("a Fortran-ordered read-only copy gives another table")
+    return {"kind": kind, "status": "invariant" if broken else "ok", "broken": broken,
+            "labels": len(table), "touches_border": bool(table.touches_border.any()) if len(table) else False}
+
+
+# ---- the runner ------------------------------------------------------------------------------------------------------
+
+def _vsize() -> int:
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[0]) * resource.getpagesize()
+
+
+def run_forked(seed, index, timeout, memory_mib) -> tuple[dict, float]:
+    base = _vsize()
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # child
+        os.close(read_end)
+        code = 0
+        try:
+            resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+            limit = base + memory_mib * 2**20
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+            try:
+                outcome = run_case(seed, index)
+            except MemoryError:
+                outcome = {"kind": "?", "status": "memory", "message": "MemoryError"}
+            with os.fdopen(write_end, "wb") as fh:
+                fh.write(pickle.dumps(outcome))
+        except BaseException:  # noqa: BLE001
+            code = 3
+        os._exit(code)
+    os.close(write_end)
+    start = time.monotonic()
+    chunks, timed_out = [], False
+    while True:
+        remaining = timeout - (time.monotonic() - start)
+        if remaining <= 0:
+            timed_out = True
+            break
+        ready, _, _ = select.select([read_end], [], [], remaining)
+        if ready:
+            chunk = os.read(read_end, 1 << 20)
+            if not chunk:
+                break
+            chunks.append(chunk)
+    elapsed = time.monotonic() - start
+    if timed_out:
+        os.kill(pid, signal.SIGKILL)
+    _, status = os.waitpid(pid, 0)
+    os.close(read_end)
+    if timed_out:
+        return {"kind": "?", "status": "timeout", "message": f"no answer within {timeout:g} s"}, elapsed
+    if os.WIFSIGNALED(status):
+        return {"kind": "?", "status": "crash", "message": f"killed by signal {os.WTERMSIG(status)}"}, elapsed
+    try:
+        return pickle.loads(b"".join(chunks)), elapsed
+    except Exception:  # noqa: BLE001
+        return {"kind": "?", "status": "crash", "message": f"child exit {os.WEXITSTATUS(status)} without an answer"}, \
+            elapsed
+
+
+def _key(outcome) -> str:
+    if outcome["status"] == "invariant":
+        first = re.sub(r"[-+]?\d[\d.e+-]*", "#", outcome["broken"][0])
+        return f"{outcome['kind']} | {first.split(' for ')[0].split(' (')[0]}"
+    if outcome["status"] == "exception":
+        return f"{outcome['kind']} | {outcome['type']} at {outcome['where']}"
+    return f"{outcome['kind']} | {outcome['status']}"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--minutes", type=float, default=5.0)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--timeout", type=float, default=120.0, help="seconds per case")
+    parser.add_argument("--memory", type=int, default=1536, help="MiB above the parent's address space")
+    parser.add_argument("--start", type=int, default=0, help="first case index")
+    parser.add_argument("--log", default=os.path.join(tempfile.gettempdir(), "fuzz_labels.jsonl"))
+    parser.add_argument("--replay", type=int, default=None, help="run case I in this process and show it")
+    options = parser.parse_args(argv)
+
+    if options.replay is not None:
+        kind, image, spacing, give_spacing, truth, twin = make_case(options.seed, options.replay)
+        print(f"case {options.replay} seed {options.seed}: {kind}, image {image.shape} {image.dtype}, spacing "
+              f"{tuple(spacing.tolist())} ({'given' if give_spacing else 'not given'}), truth {truth}")
+        for key, value in run_case(options.seed, options.replay).items():
+            print(f"{key}: {value}")
+        return 0
+
+    with warnings.catch_warnings():  # compile the kernels once, before the children fork
+        warnings.simplefilter("ignore")
+        warm = np.zeros((12, 12, 12), dtype=np.uint8)
+        warm[:6, 3:9, 3:9] = 1
+        label_curvatures(warm, spacing=(1.0, 1.0, 1.0))
+    deadline = time.monotonic() + options.minutes * 60
+    counts: collections.Counter = collections.Counter()
+    first_seen: dict = {}
+    slowest = []
+    index = options.start
+    with open(options.log, "a") as log:
+        log.write(json.dumps({"run": time.strftime("%Y-%m-%d %H:%M:%S"), "seed": options.seed,
+                              "minutes": options.minutes}) + "\n")
+        while time.monotonic() < deadline:
+            outcome, elapsed = run_forked(options.seed, index, options.timeout, options.memory)
+            counts[(outcome["kind"], outcome["status"])] += 1
+            if outcome["status"] == "ok" and outcome.get("touches_border"):
+                counts[(outcome["kind"], "ok, cut by the border")] += 1
+            slowest.append((elapsed, index))
+            if outcome["status"] not in ("ok", "documented"):
+                key = _key(outcome)
+                log.write(json.dumps({"index": index, "seed": options.seed, "key": key, "elapsed": round(elapsed, 2),
+                                      **outcome}, default=str) + "\n")
+                log.flush()
+                if key not in first_seen:
+                    first_seen[key] = index
+                    detail = "; ".join(outcome.get("broken", [])) or outcome.get("message", "")
+                    print(f"[{index}] NEW {key}: {detail[:200]}", flush=True)
+                counts[("finding", key)] += 1
+            index += 1
+            if index % 200 == 0:
+                print(f"... {index - options.start} cases, {len(first_seen)} distinct findings", flush=True)
+    print(f"\n{index - options.start} cases in {options.minutes:g} min (seed {options.seed})")
+    for (kind, status), n in sorted(counts.items()):
+        if kind != "finding":
+            print(f"  {kind:10s} {status:24s} {n}")
+    print(f"\n{len(first_seen)} distinct findings:")
+    for key, first in first_seen.items():
+        print(f"  {counts[('finding', key)]:5d}x  first case {first}: {key}")
+    slowest.sort(reverse=True)
+    print("slowest cases:", ", ".join(f"{i} ({t:.1f}s)" for t, i in slowest[:5]))
+    return 1 if first_seen else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
