@@ -252,7 +252,7 @@ def test_off_faces_with_colours_are_read(tmp_path):
     vertices, faces = meshcurv.read_mesh(path)
     assert faces.tolist() == [[0, 1, 2], [0, 2, 3]]
     path.write_text("OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 9 9 9\n3 0 2\n")
-    with pytest.raises(MeshFileError, match=r"colour\.off: face 1 is truncated or has fewer than 3 corners"):
+    with pytest.raises(MeshFileError, match=r"colour\.off: line 8: 3 values, expected 4 or more"):
         meshcurv.read_mesh(path)
 
 

@@ -198,7 +198,7 @@ def test_unreadable_mesh_is_one_line_and_debug_shows_the_traceback(capsys, tmp_p
     bad.write_text("v 0 0 0\nv 1 0 0\nf 1 2 3\n")
     code, out, err = run(capsys, "compute", bad)
     assert code == 1 and out == ""
-    assert one_error_line(err) == f"meshcurv: error: {bad}: a face uses vertex 3 but the file has 2 vertices"
+    assert one_error_line(err) == f"meshcurv: error: {bad}: line 3: a face uses vertex 3 but the file has 2 vertices"
     code, _, err = run(capsys, "compute", bad, "--debug")
     assert code == 1 and "Traceback" in err and err.strip().endswith("the file has 2 vertices")
     code, _, err = run(capsys, "info", tmp_path / "missing.ply")

@@ -306,7 +306,7 @@ def test_truncated_and_mislabelled_files_are_mesh_file_errors(tmp_path, torus, e
     [
         ("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n", "the header announces 4 vertices; the file has 3"),
         ("OFF\n3 x 0\n", "the OFF counts, vertices or faces cannot be read"),
-        ("OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 1\n", "face 1 is truncated or has fewer"),
+        ("OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 1\n", r"line 8: 3 values, expected 4 or more \(a count of 3"),
         ("COFF\n3 1 0\n", "not an OFF file \\(it should start with 'OFF'; starts with 'COFF'\\)"),
     ],
 )

@@ -55,9 +55,9 @@ def test_ply_with_faces_and_other_names(tmp_path):
     (b"ply\nformat ascii 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\nproperty float z\n"
      b"end_header\n0 0 0\n", "declares 1000000000 vertices"),
     (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-     b"end_header\n0 0 0\n1 1 1\n" + b"2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2", "do not all have 3 values"),
+     b"end_header\n0 0 0\n1 1 1\n" + b"2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2", r"line 10: 18 values, expected 3 \(vertex: x, y, z\)"),
     (b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
-     b"end_header\n0 0 0\n1 one 1\n", "not a number"),
+     b"end_header\n0 0 0\n1 one 1\n", "line 9: 'one' is not a number"),
     (b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nend_header\n0 0\n1 1\n",
      "has no x, y and z"),
     (b"ply\nformat ascii 1.0\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n",
@@ -86,9 +86,9 @@ def test_text_with_header_colours_comments_and_separators(tmp_path):
 
 
 @pytest.mark.parametrize("text, match", [
-    ("1 2 3\n4 5 6\n7 8\n", "data line 3 has 2 values where the first has 3"),
+    ("1 2 3\n4 5 6\n7 8\n", r"line 3: 2 values, expected 3 \(as most rows: x, y, z\)"),
     ("1 2\n3 4\n", "rows of 2 numbers"),
-    ("1 2 3\n4 five 6\n", "not a number"),
+    ("1 2 3\n4 five 6\n", "line 2: 'five' is not a number"),
     ("# nothing\n\n", "no points"),
     ("x,y,z\n", "a header line and no points"),
     ("a,b,c\n1,2,3\n", "has no x, y and z"),
@@ -121,7 +121,7 @@ def test_pcd_binary_float32_and_ascii_with_missing_points(tmp_path):
     (_PCD.format(n=10**9, kind="binary").encode() + b"\0" * 24, "declares 1000000000 points"),
     (_PCD.format(n=2, kind="binary_compressed").encode(), "binary_compressed"),
     (_PCD.format(n=2, kind="ascii").encode() + b"0 0 0 0 0 1\n", "declares 2 points"),
-    (_PCD.format(n=2, kind="ascii").encode() + b"0 0 0 0 0 1\n1 1 1 1 1 1 1 1 1 1 1 1\n", "holds 18 values"),
+    (_PCD.format(n=2, kind="ascii").encode() + b"0 0 0 0 0 1\n1 1 1 1 1 1 1 1 1 1 1 1\n", r"line 12: 12 values, expected 6 \(x, y, z, normal_x"),
     (b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nCOUNT 1 1 1\nPOINTS 1\nDATA ascii\n0 0 0\n", "do not match"),
     (b"VERSION 0.7\nFIELDS x y z\nPOINTS many\nDATA ascii\n", "malformed PCD header"),
     (b"VERSION 0.7\nFIELDS x y z\n", "cut short"),

@@ -16,7 +16,7 @@ from .._validation import as_faces
 from ..diagnosis import diagnose
 from ..errors import MeshFileError
 from ..estimators import ESTIMATORS
-from ..io import FORMATS, read_mesh, write_curvatures, write_point_curvatures
+from ..io import FORMATS, POINT_EXTENSIONS, is_point_cloud, read_mesh, write_curvatures, write_point_curvatures
 from ..io._files import check_output
 from ..io.fields import FIELDS, curvature_fields
 from ..plotting import MAX_DPI
@@ -41,14 +41,26 @@ def _fields(ctx, param, value):
     return names
 
 
-def _check_output(path: pathlib.Path, *, overwrite: bool, source, needs_fields: bool) -> None:
+def _check_output(path: pathlib.Path, *, overwrite: bool, source, cloud: bool) -> None:
+    """Refuse an output ``compute`` cannot write for this input, naming exactly those it can write."""
     suffix = path.suffix.lower()
-    if suffix not in FORMATS:
-        raise MeshFileError(f"{path}: unknown output extension {path.suffix!r}; known: {', '.join(FORMATS)}")
+    accepted = output_extensions(cloud=cloud)
+    known = ", ".join(accepted)
+    what = "a point cloud's" if cloud else "a mesh's"
+    if suffix not in accepted and (cloud or suffix not in FORMATS):
+        shown = repr(path.suffix) if path.suffix else "(none)"
+        raise MeshFileError(f"{path}: unknown output extension {shown}; {what} fields are written to {known}")
     check_output(path, overwrite=overwrite, source=source)
-    if needs_fields and FORMATS[suffix].fields == "none":
-        raise MeshFileError(f"{path}: {FORMATS[suffix].name} files cannot hold per-vertex fields; "
-                            "write .ply, .vtk, .vtu, .vtp, .csv or .npz")
+    if suffix not in accepted:  # a mesh format without per-vertex fields (OBJ, STL, OFF)
+        raise MeshFileError(f"{path}: {FORMATS[suffix].name} files cannot hold per-vertex fields; write "
+                            f"{what} fields to {known}")
+
+
+def output_extensions(*, cloud: bool) -> tuple:
+    """The extensions ``meshcurv compute -o`` writes: those of a point cloud's fields, or of a mesh's."""
+    if cloud:
+        return POINT_EXTENSIONS
+    return tuple(extension for extension, fmt in FORMATS.items() if fmt.fields != "none")
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -88,7 +100,8 @@ def _viewers_epilog() -> str:
 @click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
 @click.option("-o", "--output", type=click.Path(readable=False, path_type=pathlib.Path), default=None,
               help="Write the fields to .vtp (ParaView, PyVista), .ply (MeshLab: one field as quality; meshio, "
-                   "trimesh), .vtu/.vtk, .csv (pandas) or .npz (NumPy); see below. Default: print a summary.")
+                   "trimesh), .vtu/.vtk, .csv (pandas) or .npz (NumPy); see below. A point cloud's fields go to "
+                   ".ply, .xyz, .txt, .pts, .csv, .pcd, .las or .laz. Default: print a summary.")
 @method_options
 @click.option("--fields", callback=_fields, default=None, metavar="NAME,...",
               help=f"Fields to write or summarise (default: all): {', '.join(FIELDS)}.")
@@ -98,10 +111,15 @@ def _viewers_epilog() -> str:
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
 @common_options
 def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite):
-    """Compute the curvatures of MESH (a mesh or a point cloud); write them with -o, or print a summary table."""
+    """Compute the curvatures of MESH (a mesh or a point cloud); write them with -o, or print a summary table.
+
+    A point cloud is a file without faces: .xyz, .txt, .pts, .csv (rows of
+    x y z, maybe a header line and more columns), .pcd, .las, .laz, or a .ply
+    without faces.
+    """
     session = current_session()
     if output is not None:
-        _check_output(output, overwrite=overwrite, source=mesh, needs_fields=True)
+        _check_output(output, overwrite=overwrite, source=mesh, cloud=is_point_cloud(mesh))
     with estimated(mesh, method, smoothing_steps, radius, orient, session,
                    "write" if output is not None else "summary") as got:
         if output is not None and got.cloud:

@@ -12,11 +12,12 @@ and numpy (about 0.5 s for igea.obj).
 from __future__ import annotations
 
 import re
+import warnings
 
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import numbers_per_line
+from ._text import first_bad_line, line_of, numbers_per_line
 
 __all__ = ["read_obj", "write_obj"]
 
@@ -24,6 +25,8 @@ _VERTEX = re.compile(rb"^v[ \t]+([^\r\n#]*)", re.M)
 _FACE = re.compile(rb"^f[ \t]+(\S+[ \t]+\S+[ \t]+\S+[^\r\n#]*)", re.M)
 _CORNER_TAIL = re.compile(rb"/\S*")
 _LEADING_BLANKS = re.compile(rb"^[ \t]+", re.M)
+_FACE_START = re.compile(rb"^f[ \t][^\n]*", re.M)
+_INTEGERS = re.compile(rb"[ \t]*[-+]?\d+(?:[ \t]+[-+]?\d+)*[ \t\r]*")
 
 
 def read_obj(path):
@@ -44,47 +47,54 @@ def read_obj(path):
         raise MeshFileError(f"{path}: no vertices (`v` lines) found; is it an OBJ file?")
     parsed = numbers_per_line(vertex_lines)
     if parsed is None:
-        raise MeshFileError(f"{path}: a vertex coordinate is not a number")
+        index, word = first_bad_line(b"\n".join(vertex_lines))
+        raise MeshFileError(f"{path}: line {_line_of_match(data, _VERTEX, index)}: a vertex coordinate is not a "
+                            f"number ({word[:30].decode('utf-8', 'replace')!r})")
     values, counts = parsed
     if (counts == 3).all():
         vertices = values.reshape(-1, 3)
     else:  # per line: `v x y z w` and `v x y z r g b` keep x y z; the next lines do not shift
         short = int(np.flatnonzero(counts < 3)[0]) if (counts < 3).any() else None
         if short is not None:
-            match = next(m for i, m in enumerate(_VERTEX.finditer(data)) if i == short)
-            line = data.count(b"\n", 0, match.start()) + 1
-            raise MeshFileError(
-                f"{path}: line {line}: a `v` line has fewer than 3 coordinates ({int(counts[short])})"
-            )
+            raise MeshFileError(f"{path}: line {_line_of_match(data, _VERTEX, short)}: a `v` line has fewer than "
+                                f"3 coordinates ({int(counts[short])})")
         first = np.cumsum(counts) - counts
         vertices = values[first[:, None] + np.arange(3)]
 
     face_lines = _FACE.findall(data)
     n_face_lines = sum(data.count(b"\nf" + blank) + data.startswith(b"f" + blank) for blank in (b" ", b"\t"))
     if len(face_lines) != n_face_lines:
-        raise MeshFileError(f"{path}: a face has fewer than 3 corners")
+        line = next(line_of(data, m.start()) for m in _FACE_START.finditer(data) if not _FACE.match(m.group()))
+        raise MeshFileError(f"{path}: line {line}: a face has fewer than 3 corners")
     if not face_lines:
         raise MeshFileError(f"{path}: no faces (`f` lines) found")
     joined = b"\n".join(face_lines)
     if b"/" in joined:
         joined = _CORNER_TAIL.sub(b"", joined)
     try:
-        corners = np.fromstring(joined, dtype=np.int64, sep=" ")
-    except ValueError:
-        raise MeshFileError(f"{path}: a face index is not an integer") from None
-
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            corners = np.fromstring(joined, dtype=np.int64, sep=" ")
+    except (ValueError, DeprecationWarning):
+        corners = np.zeros(0, dtype=np.int64)
     if corners.size == 3 * len(face_lines):  # every face has at least 3 corners: all triangles
         sizes = None
     else:
         lines = joined.split(b"\n")
         sizes = np.char.count(np.array([b" ".join(line.split()) for line in lines]), b" ") + 1
+    if corners.size != (3 * len(face_lines) if sizes is None else sizes.sum()):  # a word is not an integer
+        index = next((i for i, line in enumerate(joined.split(b"\n")) if not _INTEGERS.fullmatch(line)), 0)
+        raise MeshFileError(f"{path}: line {_line_of_match(data, _FACE, index)}: a face index is not an integer")
     if (corners < 0).any():
         corners = _resolve_relative(data, corners, sizes)
     if (corners == 0).any():
-        raise MeshFileError(f"{path}: a face uses vertex index 0; OBJ indices start at 1")
+        line = _line_of_corner(data, sizes, int(np.argmax(corners == 0)))
+        raise MeshFileError(f"{path}: line {line}: a face uses vertex index 0; OBJ indices start at 1")
     if corners.max() > vertices.shape[0]:
+        line = _line_of_corner(data, sizes, int(np.argmax(corners)))
         raise MeshFileError(
-            f"{path}: a face uses vertex {int(corners.max())} but the file has {vertices.shape[0]} vertices"
+            f"{path}: line {line}: a face uses vertex {int(corners.max())} but the file has {vertices.shape[0]} "
+            "vertices"
         )
     corners -= 1
     if sizes is None:
@@ -92,6 +102,17 @@ def read_obj(path):
     if (sizes == sizes[0]).all():
         return vertices, corners.reshape(-1, int(sizes[0]))
     return vertices, np.split(corners, np.cumsum(sizes)[:-1])
+
+
+def _line_of_match(data: bytes, pattern: re.Pattern, index: int) -> int:
+    """The line number of the ``index``-th match of ``pattern`` in ``data`` (for error messages)."""
+    return next(line_of(data, m.start()) for i, m in enumerate(pattern.finditer(data)) if i == index)
+
+
+def _line_of_corner(data: bytes, sizes, corner: int) -> int:
+    """The line number of the face holding the ``corner``-th corner (``sizes`` None: all triangles)."""
+    face = corner // 3 if sizes is None else int(np.searchsorted(np.cumsum(sizes), corner, side="right"))
+    return _line_of_match(data, _FACE, face)
 
 
 def _resolve_relative(data: bytes, corners: np.ndarray, sizes) -> np.ndarray:

@@ -11,7 +11,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import numbers_per_line
+from ._text import first_bad_line, numbers_per_line, row_error
 
 __all__ = ["read_off", "write_off"]
 
@@ -24,7 +24,9 @@ def read_off(path):
     Read line by line (in numpy): what follows the coordinates of a vertex or
     the ``k`` indices of a face on its line (a colour, as the format allows)
     is ignored. The declared counts are checked against the lines the file
-    holds before anything is allocated for them.
+    holds before anything is allocated for them. A line with fewer values
+    than its vertex or face needs, a word that is not a number, or a line
+    after the declared faces is an error naming its line number.
     """
     with open(path, "rb") as handle:
         data = _COMMENT.sub(b"", handle.read())
@@ -48,33 +50,63 @@ def read_off(path):
             f"{path}: the header declares {n_vertices} vertices and {n_faces} faces but the file holds only "
             f"{len(body)} lines for them; face {len(body) - n_vertices} is missing (the file is cut short)"
         )
+    start = len(lines) - len(body)  # body[j] is the (start + j)-th non-blank line
+
+    def line(j: int) -> int:  # the file's line number of body[j], for messages
+        return _line_number(data, start + j)
+
+    if len(body) > n_vertices + n_faces:
+        raise MeshFileError(f"{path}: line {line(n_vertices + n_faces)}: a row after the {n_vertices} vertices and "
+                            f"{n_faces} faces the header declares")
     parsed = numbers_per_line(body[:n_vertices])
     if parsed is None:
-        raise MeshFileError(f"{path}: the OFF counts, vertices or faces cannot be read (a coordinate is not a number)")
+        index, word = first_bad_line(b"\n".join(body[:n_vertices]))
+        raise MeshFileError(f"{path}: line {line(index)}: {word[:30].decode('utf-8', 'replace')!r} is not a "
+                            "number (a vertex coordinate)")
     values, counts = parsed
     if (counts < 3).any():
         bad = int(np.flatnonzero(counts < 3)[0])
-        raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; vertex {bad} has "
-                            f"{int(counts[bad])} coordinates")
+        raise row_error(path, line(bad), int(counts[bad]), "3 or more", "x, y, z, then maybe a colour")
     vertices = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
     parsed = numbers_per_line(body[n_vertices:n_vertices + n_faces])
     if parsed is None:
-        raise MeshFileError(f"{path}: the OFF counts, vertices or faces cannot be read (a face index is not a number)")
+        index, word = first_bad_line(b"\n".join(body[n_vertices:n_vertices + n_faces]))
+        raise MeshFileError(f"{path}: line {line(n_vertices + index)}: {word[:30].decode('utf-8', 'replace')!r} "
+                            "is not a number (a face)")
     values, counts = parsed
     first = np.cumsum(counts) - counts
     sizes = np.where(counts > 0, values[np.minimum(first, max(values.size - 1, 0))] if values.size else 0, 0)
-    bad = (counts == 0) | (sizes != np.floor(sizes)) | (sizes < 3) | (sizes > counts - 1)
+    bad = (counts == 0) | (sizes != np.floor(sizes)) | (sizes < 3)
     if bad.any():
         face = int(np.flatnonzero(bad)[0])
-        raise MeshFileError(f"{path}: face {face} is truncated or has fewer than 3 corners")
+        raise MeshFileError(f"{path}: line {line(n_vertices + face)}: a face of {sizes[face]:g} corners (its first "
+                            "value counts its corners: a whole number, 3 or more)")
+    bad = sizes > counts - 1
+    if bad.any():
+        face = int(np.flatnonzero(bad)[0])
+        raise row_error(path, line(n_vertices + face), int(counts[face]), f"{int(sizes[face]) + 1} or more",
+                        f"a count of {int(sizes[face])} and as many vertex indices, then maybe a colour")
     sizes = sizes.astype(np.int64)
     corners = values[np.repeat(first + 1 - (np.cumsum(sizes) - sizes), sizes) + np.arange(sizes.sum())]
-    if not (corners == np.floor(corners)).all() or (np.abs(corners) > 2.0 ** 53).any():
-        raise MeshFileError(f"{path}: a face index is not an integer")
+    bad = (corners != np.floor(corners)) | ~(np.abs(corners) <= 2.0 ** 53)
+    if bad.any():
+        face = int(np.searchsorted(np.cumsum(sizes), np.argmax(bad), side="right"))
+        raise MeshFileError(f"{path}: line {line(n_vertices + face)}: a face index is not an integer "
+                            f"({float(corners[bad][0])!r})")
     corners = corners.astype(np.int64)
     if sizes.size and (sizes == sizes[0]).all():
         return vertices, corners.reshape(sizes.size, int(sizes[0]))
     return vertices, np.split(corners, np.cumsum(sizes)[:-1])
+
+
+def _line_number(data: bytes, index: int) -> int:
+    """The 1-based line number of the ``index``-th non-blank line of ``data`` (for messages)."""
+    seen = -1
+    for number, text in enumerate(data.split(b"\n"), start=1):
+        seen += bool(text.strip())
+        if seen == index:
+            return number
+    return number
 
 
 def write_off(path, vertices: np.ndarray, faces, point_data: dict) -> None:

@@ -8,10 +8,13 @@ at a time (0.80 s for a 1M-vertex sphere; about 50 ms here). This reader:
 - looks for ``end_header`` in the first :data:`HEADER_LIMIT` bytes only, and
   refuses a header that ends before it;
 - checks every element's declared count against the bytes (binary) or the
-  numbers (ASCII) the file really holds before it allocates anything for it,
+  lines (ASCII) the file really holds before it allocates anything for it,
   so a header that declares 50 million faces over 4 is an error, not 7 GB;
 - treats the end of the file inside any element as an error, never as a
   shorter mesh;
+- reads an ASCII body one record per line, as the format writes it: a line
+  with more or fewer values than its record needs, or a line after the last
+  element, is an error naming the line, never a shift of the records after it;
 - reads faces whose records all have the same size (what scanners and most
   tools write) as one structured array, and faces of mixed sizes with a
   walk over the records (the offsets of a variable-size record depend on the
@@ -35,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import numbers
+from ._text import body_rows, fixed_rows, names_shown, row_error
 
 __all__ = ["read_ply", "HEADER_LIMIT"]
 
@@ -283,92 +286,78 @@ def _split(values: np.ndarray, counts: np.ndarray):
 # ---------------------------------------------------------------- ASCII
 
 
-def _numbers(body: bytes, path) -> np.ndarray:
-    values = numbers(body)
-    if values is None:
-        raise MeshFileError(f"{path}: the body of the ASCII PLY holds something that is not a number")
-    return values
-
-
-def _integers(values: np.ndarray, path, what: str) -> np.ndarray:
+def _integers(values: np.ndarray, path, what: str, lines=None) -> np.ndarray:
+    """``values`` as int64; a value that is not a whole number is an error (naming its line: ``lines``, per value)."""
     bad = ~(np.abs(values) <= _LARGEST_INDEX) | (values != np.floor(values))
     if bad.any():
-        raise MeshFileError(f"{path}: a PLY {what} is not an integer ({values[bad][0]!r}); indices must be whole numbers")
+        where = f" line {int(np.asarray(lines)[bad][0])}:" if lines is not None else ""
+        raise MeshFileError(f"{path}:{where} a PLY {what} is not an integer ({float(values[bad][0])!r}); "
+                            "indices must be whole numbers")
     return values.astype(np.int64)
 
 
 def _read_ascii(data, offset, elements, vertex, face, corners, path):
-    values = _numbers(data[offset:], path)
-    position, vertices, faces = 0, None, None
+    """One record per line, as the format says: a line of the wrong length is an error naming it."""
+    values, counts, first_value, lines = body_rows(data, offset, path)
+    row, vertices, faces = 0, None, None
     for element in elements:
-        available = values.size - position
-        width = len(element.properties)  # values per record at least (a list holds at least its count)
-        if element.count * width > available:
-            raise _too_short(path, element, element.count * width, available, unit="numbers")
+        available = counts.size - row
+        if element.count > available:
+            raise _too_short(path, element, element.count, available, unit="lines")
+        rows = slice(row, row + element.count)
+        row += element.count
         if all(p.count_kind is None for p in element.properties):
-            table = values[position:position + element.count * width].reshape(element.count, width)
+            names = [p.name for p in element.properties]
+            table = fixed_rows(values, counts[rows], first_value[rows], lines[rows], len(names), path,
+                               f"{element.name}: {names_shown(names)}")
             if element is vertex:
-                names = [p.name for p in element.properties]
                 vertices = table[:, [names.index(axis) for axis in "xyz"]]
-            position += element.count * width
             continue
-        keep = corners if element is face else None
-        lists, position = _ascii_lists(values, position, element, keep, path)
+        lists = _ascii_lists(values, counts[rows], first_value[rows], lines[rows], element,
+                             corners if element is face else None, path)
         if element is face:
             faces = lists
+    if row < counts.size:
+        declared = ", ".join(f"{element.count} {element.plural}" for element in elements)
+        raise MeshFileError(f"{path}: line {int(lines[row])}: a row after the last element (the header "
+                            f"declares {declared})")
     return vertices, faces
 
 
-def _ascii_lists(values, position, element, keep, path):
-    properties = element.properties
-    if element.count == 0:
-        return (np.zeros((0, 3), np.int64) if keep is not None else None), position
-    # the common case: every record as the first one
-    columns, width = {}, 0
-    for i, p in enumerate(properties):
+def _ascii_lists(values, counts, first_value, lines, element, keep, path):
+    """The records of an element with list properties, one per line, walked property by property for all lines."""
+    if counts.size == 0:
+        return np.zeros((0, 3), np.int64) if keep is not None else None
+    position = first_value.copy()
+    end = first_value + counts
+    sizes = {}
+    for i, p in enumerate(element.properties):
         if p.count_kind is None:
-            width += 1
+            position += 1
             continue
-        if position + width >= values.size:
-            raise MeshFileError(f"{path}: the PLY file ends inside its {element.plural} (cut short)")
-        n = _integers(values[position + width:position + width + 1], path, "list count")[0]
-        if n < 0:
-            raise MeshFileError(f"{path}: a PLY list of the {element.name} element has a negative count")
-        if position + width + 1 + n > values.size:
-            raise MeshFileError(f"{path}: the PLY file ends inside its {element.plural} (cut short)")
-        columns[i] = (width, int(n))
-        width += 1 + int(n)
-    if element.count * width <= values.size - position:
-        table = values[position:position + element.count * width].reshape(element.count, width)
-        if all((table[:, column] == n).all() for column, n in columns.values()):
-            found = None
-            if keep is not None:
-                column, n = columns[keep]
-                found = _integers(table[:, column + 1:column + 1 + n], path, "face index")
-            return found, position + element.count * width
-    # records of different sizes: walk them
-    starts, counts = [], []
-    end = values.size
-    for _ in range(element.count):
-        for i, p in enumerate(properties):
-            if p.count_kind is None:
-                position += 1
-                continue
-            if position >= end:
-                raise MeshFileError(f"{path}: the PLY file ends inside its {element.plural} (cut short)")
-            n = values[position]
-            if not (0 <= n <= end) or n != int(n):
-                raise MeshFileError(f"{path}: a PLY list count is not a whole number of corners ({n!r})")
-            n = int(n)
-            if i == keep:
-                starts.append(position + 1)
-                counts.append(n)
-            position += 1 + n
-        if position > end:
-            raise MeshFileError(f"{path}: the PLY file ends inside its {element.plural} (cut short)")
+        inside = position < end
+        n = np.where(inside, values[np.minimum(position, values.size - 1)], 0.0)
+        bad = inside & ((n < 0) | (n != np.floor(n)))
+        if bad.any():
+            row = int(np.argmax(bad))
+            raise MeshFileError(f"{path}: line {int(lines[row])}: the {element.name} list count of {p.name} is not "
+                                f"a whole number ({n[row]!r})")
+        sizes[i] = np.minimum(n, counts).astype(np.int64)  # beyond its line: the row is too short anyway
+        if i == keep:
+            starts = position + 1
+        position += 1 + sizes[i]
+    need = position - first_value
+    wrong = need != counts
+    if wrong.any():
+        row = int(np.argmax(wrong))
+        parts = [p.name if i not in sizes else f"{p.name}: a count of {sizes[i][row]} and {sizes[i][row]} values"
+                 for i, p in enumerate(element.properties)]
+        raise row_error(path, int(lines[row]), int(counts[row]), int(need[row]), f"{element.name}: {', '.join(parts)}")
     if keep is None:
-        return None, position
-    lengths = np.array(counts, dtype=np.int64)
-    first = np.repeat(np.array(starts, dtype=np.int64) - np.cumsum(lengths) + lengths, lengths)
-    corner_values = values[first + np.arange(first.size)]
-    return _split(_integers(corner_values, path, "face index"), lengths), position
+        return None
+    lengths = sizes[keep]
+    if (lengths == lengths[0]).all():
+        table = values[starts[:, None] + np.arange(lengths[0])]
+        return _integers(table, path, "face index", np.broadcast_to(lines[:, None], table.shape))
+    flat = np.repeat(starts - np.cumsum(lengths) + lengths, lengths) + np.arange(lengths.sum())
+    return _split(_integers(values[flat], path, "face index", np.repeat(lines, lengths)), lengths)

@@ -34,6 +34,7 @@ import numpy as np
 from ..errors import MeshFileError, MeshQualityWarning, MissingDependencyError
 from ._files import atomic_output, check_input, check_output
 from ._ply import _ORDERS, HEADER_LIMIT, _header
+from ._text import body_rows, fixed_rows, line_of, names_shown, not_a_number, numbers_by_line, row_error
 
 __all__ = ["read_points", "write_points", "write_point_curvatures", "is_point_cloud", "POINT_EXTENSIONS"]
 
@@ -85,12 +86,15 @@ def is_point_cloud(path) -> bool:
     """Whether ``path`` holds a point cloud: a points-only format, or a PLY whose header declares no faces.
 
     For the command line's choice between :func:`meshcurv.read_mesh` and
-    :func:`read_points`; reads at most the PLY header. False for unknown or
-    unreadable files (the mesh reader then says why).
+    :func:`read_points`; reads at most the PLY header. The text tables
+    (``.xyz .txt .pts .csv``) are point clouds: :func:`meshcurv.read_mesh`
+    reads no mesh from any of them (a ``.csv`` it writes holds per-vertex
+    values, without faces). False for unknown or unreadable files (the mesh
+    reader then says why).
     """
     path = pathlib.Path(path)
     suffix = path.suffix.lower()
-    if suffix in (".xyz", ".pts", ".pcd", ".las", ".laz"):
+    if suffix in (*_TEXT, ".pcd", ".las", ".laz"):
         return True
     if suffix != ".ply":
         return False
@@ -164,22 +168,22 @@ def ply_vertex_columns(path) -> dict[str, np.ndarray]:
     before = elements[:elements.index(vertex)]
     if any(p.count_kind is not None for e in before for p in e.properties):
         raise MeshFileError(f"{path}: the PLY file has a list element before its vertices; not supported")
-    if file_format == "ascii":
-        width = len(vertex.properties)
-        skip = sum(e.count * len(e.properties) for e in before)
-        body = data[offset:]
+    if file_format == "ascii":  # one record per line: a line of the wrong length is named, never re-cut
+        skip = sum(e.count for e in before)
         # each value takes at least two bytes (a digit and a separator): bound the count first
-        if (skip + vertex.count * width) * 2 > len(body) + 1:
-            raise _short(path, vertex.count, "vertices", len(body))
-        lines = body.split(b"\n", skip + vertex.count)
-        rows = lines[sum(e.count for e in before):][:vertex.count]
-        if len(rows) < vertex.count:
-            raise _short(path, vertex.count, "vertices", len(body))
-        values = _floats(b" ".join(rows), path, "the ASCII PLY body")
-        if values.size != vertex.count * width:
-            raise MeshFileError(f"{path}: the ASCII PLY vertices do not all have {width} values "
-                                f"({values.size} values on {vertex.count} lines)")
-        table = values.reshape(vertex.count, width)
+        if (sum(e.count * len(e.properties) for e in before) + vertex.count * len(vertex.properties)) * 2 > \
+                len(data) - offset + 1:
+            raise _short(path, vertex.count, "vertices", len(data) - offset)
+        values, counts, first_value, lines = body_rows(data, offset, path, n_rows=skip + vertex.count)
+        if counts.size < skip + vertex.count:
+            raise _short(path, vertex.count, "vertices", len(data) - offset)
+        row = 0
+        for element in [*before, vertex]:
+            rows = slice(row, row + element.count)
+            row += element.count
+            names = [p.name for p in element.properties]
+            table = fixed_rows(values, counts[rows], first_value[rows], lines[rows], len(names), path,
+                               f"{element.name}: {names_shown(names)}")
         return {p.name: table[:, i] for i, p in enumerate(vertex.properties)}
     order = _ORDERS[file_format]
     position = offset
@@ -199,53 +203,144 @@ def _short(path, count, what, available, need=None) -> MeshFileError:
                          f"for them{needed}; the file is cut short or its header is wrong")
 
 
-def _floats(body: bytes, path, what: str) -> np.ndarray:
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            return np.fromstring(body, dtype=np.float64, sep=" ")
-    except (ValueError, DeprecationWarning):
-        raise MeshFileError(f"{path}: {what} holds something that is not a number") from None
-
-
 # -- text ---------------------------------------------------------------------------
 
 _SEPARATORS = re.compile(rb"[,;\t ]+")
+_COMMENT_LINES = re.compile(rb"^[ \t]*(?:#|//)[^\n]*", re.M)
+_FIRST_WORD = re.compile(rb"\S")
+#: per delimiter, what it becomes: ``;`` files write decimal commas (``1,5;2,5``), so their commas are points
+_TRANSLATIONS = {b";": bytes.maketrans(b";,", b" ."), b",": bytes.maketrans(b",", b" ")}
 
 
 def _read_text(path):
     """Rows of numbers separated by spaces, tabs, commas or semicolons; ``#`` and ``//`` lines are comments."""
-    data = path.read_bytes()
-    lines = [line.strip() for line in data.splitlines()]
-    lines = [line for line in lines if line and not line.startswith((b"#", b"//"))]
-    if not lines:
+    columns = text_columns(path)
+    return _split({name.lower(): values for name, values in columns.items()}, path, "the header")
+
+
+def text_columns(path) -> dict[str, np.ndarray]:
+    """The columns of a text table of numbers (CSV, XYZ, TXT, PTS) by name: the header's, or x, y, z, ...
+
+    Rows are separated by spaces or tabs, by commas, or by semicolons (then
+    with decimal commas, ``1,5;2,5``), as on the first row. Blank lines and
+    lines starting with ``#`` or ``//`` are skipped; a first line of words is
+    the header. A row holding one whole number is a count of the rows that
+    follow it (``.pts``), checked against them. Every row must hold as many
+    values as the header has names (without a header: as most rows): a row
+    with more or fewer values, an empty value (``1,,3``, ``1,2,3,``) or a word
+    that is not a number is a :class:`~meshcurv.errors.MeshFileError` naming
+    its line, never a shift of the values after it.
+    """
+    data = pathlib.Path(path).read_bytes()
+    if b"#" in data or b"//" in data:
+        data = _COMMENT_LINES.sub(b"", data)  # the newlines stay: line numbers are the file's
+    first = _FIRST_WORD.search(data)
+    if first is None:
         raise MeshFileError(f"{path}: no points in the file")
+    start = data.rfind(b"\n", 0, first.start()) + 1
+    end = data.find(b"\n", start)
+    end = len(data) if end < 0 else end
+    line = line_of(data, start)
+    words = _SEPARATORS.split(data[start:end].strip())
     names = None
-    first = _SEPARATORS.split(lines[0])
-    try:
-        [float(word) for word in first]
-    except ValueError:
-        names = [word.decode("utf-8", "replace").strip().strip('"').lower() for word in first]
-        lines = lines[1:]
-        if not lines:
-            raise MeshFileError(f"{path}: a header line and no points") from None
-    width = len(names) if names else len(_SEPARATORS.split(lines[0]))
-    values = _floats(_SEPARATORS.sub(b" ", b"\n".join(lines)), path, "the text")
-    if values.size != width * len(lines):
-        widths = [len(_SEPARATORS.split(line)) for line in lines]
-        bad = next(i for i, w in enumerate(widths) if w != width)
-        raise MeshFileError(f"{path}: data line {bad + 1} has {widths[bad]} values where the first has {width}")
-    table = values.reshape(len(lines), width)
-    if names is None:
+    if all(numbers_by_line(word) is None for word in words):  # no word is a number: a header
+        names = [word.decode("utf-8", "replace").strip().strip('"').strip("'") for word in words]
+        start, line = end + 1, line + 1
+    body = data[start:]
+    if _FIRST_WORD.search(body) is None:
+        raise MeshFileError(f"{path}: a header line and no points" if names else f"{path}: no points in the file")
+    body = _undelimited(body, path, line)
+    parsed = numbers_by_line(body)
+    if parsed is None:
+        raise not_a_number(path, body, line)
+    values, counts = parsed
+    rows = np.flatnonzero(counts)  # the non-blank lines
+    found = counts[rows]
+    first_value = np.cumsum(counts)[rows] - found
+    keep = _counted_blocks(path, values, found, first_value, line + rows)
+    if not keep.any():
+        raise MeshFileError(f"{path}: no points in the file (only counts of points)")
+    if names is not None:
+        width = len(names)
+    else:
+        frequency = np.bincount(found[keep])
+        width = int(found[keep][0])  # as the first row, unless more rows hold another count
+        width = width if frequency[width] == frequency.max() else int(frequency.argmax())
         if width < 3:
-            raise MeshFileError(f"{path}: rows of {width} numbers; a point needs x, y and z")
+            most = "" if (found[keep] == width).all() else " (most rows)"
+            raise MeshFileError(f"{path}: rows of {width} numbers{most}; a point needs x, y and z")
+    wrong = keep & (found != width)
+    if wrong.any():
+        i = int(np.argmax(wrong))
+        meaning = names_shown(names) if names else "as most rows: x, y, z" + (f" and {width - 3} more" if width > 3
+                                                                             else "")
+        raise row_error(path, int(line + rows[i]), int(found[i]), width, meaning)
+    if not keep.all():
+        values = np.delete(values, first_value[~keep])
+    table = values.reshape(-1, width)
+    if names is None:
         names = ["x", "y", "z"]
         if width >= 6:
             length = np.linalg.norm(table[:, 3:6], axis=1)
             if np.median(np.abs(length - 1.0)) < 1e-3:  # unit vectors: normals (not colours)
                 names += ["nx", "ny", "nz"]
         names += [f"column{i}" for i in range(len(names), width)]
-    return _split({n: table[:, i] for i, n in enumerate(names)}, path, "the header")
+    return {name: table[:, i] for i, name in enumerate(names)}
+
+
+def _undelimited(body: bytes, path, line: int) -> bytes:
+    """``body`` with its delimiters (those of its first row: ``,`` or ``;``) turned into spaces.
+
+    An empty value (two delimiters with nothing but blanks between them, or
+    one at the start or end of a row) is an error naming its line.
+    """
+    first = _FIRST_WORD.search(body)
+    end = body.find(b"\n", first.start())
+    row = body[first.start():len(body) if end < 0 else end]
+    delimiter = b";" if b";" in row else b"," if b"," in row else None
+    if delimiter is None:
+        return body
+    if not body.endswith(b"\n"):
+        body += b"\n"
+    buffer = np.frombuffer(body, dtype=np.uint8)
+    is_delimiter = buffer == delimiter[0]
+    marks = np.flatnonzero(is_delimiter | (buffer == ord("\n")))  # the last one is the final newline
+    content = ~((buffer <= 32) | is_delimiter)  # blanks (and control bytes, which no number holds)
+    bounds = np.concatenate([[0], marks[:-1] + 1])
+    filled = np.add.reduceat(content, bounds, dtype=np.int64) > 0  # a field (or a blank line) holds something
+    beside = is_delimiter[marks]
+    beside[1:] |= is_delimiter[marks[:-1]]
+    empty = ~filled & beside
+    if empty.any():
+        position = int(bounds[np.argmax(empty)])
+        number = line + line_of(body, position) - 1
+        start = body.rfind(b"\n", 0, position) + 1
+        shown = body[start:body.find(b"\n", position)].strip()[:60].decode("utf-8", "replace")
+        raise MeshFileError(f"{path}: line {number}: an empty value in {shown!r} (every "
+                            f"{delimiter.decode()!r} stands between two numbers)")
+    return body.translate(_TRANSLATIONS[delimiter])
+
+
+def _counted_blocks(path, values, found, first_value, lines) -> np.ndarray:
+    """Which rows are points: not the rows of one whole number that count the rows after them (``.pts``)."""
+    single = found == 1
+    if not single[0]:
+        return np.ones(found.size, dtype=bool)  # a row of one value elsewhere is a row of the wrong length
+    heads = np.flatnonzero(single)
+    declared = values[first_value[heads]]
+    follow = np.diff(np.append(heads, found.size)) - 1
+    whole = (declared >= 0) & (declared == np.floor(declared))
+    if not whole[0]:
+        raise MeshFileError(f"{path}: line {lines[0]}: 1 value ({declared[0]!r}), expected a count of points "
+                            "or x, y, z")
+    bad = whole & (declared != follow)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise MeshFileError(f"{path}: line {lines[heads[i]]}: a count of {int(declared[i])} points, but "
+                            f"{follow[i]} rows follow it (up to the next count or the end of the file)")
+    keep = np.ones(found.size, dtype=bool)
+    keep[heads[whole]] = False
+    return keep
 
 
 # -- PCD ----------------------------------------------------------------------------
@@ -289,11 +384,13 @@ def _read_pcd(path):
         body = data[position:]
         if n * width * 2 > len(body) + 1:
             raise _short(path, n, "points", len(body))
-        values = _floats(body, path, "the PCD body")
-        if values.size != n * width:
-            raise MeshFileError(f"{path}: the PCD body holds {values.size} values; {n} points of {width} need "
-                                f"{n * width}")
-        table = values.reshape(n, width)
+        values, found, first_value, lines = body_rows(data, position, path)  # one point per line
+        if found.size < n:
+            raise _short(path, n, "points", len(body))
+        if found.size > n:
+            raise MeshFileError(f"{path}: line {int(lines[n])}: a row after the {n} points the header declares")
+        table = fixed_rows(values, found, first_value, lines, width, path, names_shown(
+            f"{f}[{c}]" if c > 1 else f for f, c in zip(fields, counts)))
         starts = np.cumsum([0] + counts[:-1])
         columns = {f: table[:, s] for f, s in zip(fields, starts)}
     elif kind == "binary":
