@@ -204,6 +204,28 @@ def _ball_indices(search, points, chunk, radius, k):
     return np.ascontiguousarray(index), (index < points.shape[0]).sum(axis=1)
 
 
+def _own_side(normals, centres, index, counts):
+    """The balls ``index`` (M, k) (``counts`` points first, padded with N) less their points facing away.
+
+    A point of the ball whose normal is opposite to the centre's
+    (``n_j . n_c < 0``) is on the other side of the surface: the other face
+    of a part thinner than the ball, a neighbouring part of the cloud a
+    spacing or two away, or the far side of a part smaller than the ball.
+    Triangles through it would measure both sides as one surface (two
+    spheres 1 spacing apart: H up to 5 times 1/r next to the gap). The kept
+    points stay in distance order. Returns ``(index, counts)``.
+    """
+    n = normals.shape[0]
+    member = np.arange(index.shape[1])[None, :] < counts[:, None]
+    safe = np.where(member, index, 0)
+    away = member & (np.einsum("mkj,mj->mk", normals[safe], normals[centres]) < 0)
+    if not away.any():
+        return index, counts
+    order = np.argsort(away | ~member, axis=1, kind="stable")
+    index = np.take_along_axis(np.where(away, n, index), order, axis=1)
+    return np.ascontiguousarray(index), counts - away.sum(axis=1)
+
+
 def corrected_measures(tree, points, normals, radius, centres, usable, *, spacing: float = 0.0,
                        n_triangles: int | None = None):
     """Randomized corrected curvature measures over balls of ``radius`` (Lachaud et al. 2023).
@@ -234,6 +256,7 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
             index, _, counts = kernels.ball_indices(points, chunk, float(radius), k, *grid, 64 * kernel_threads())
         else:
             index, counts = _ball_indices(search, points, chunk, radius, k)
+        index, counts = _own_side(normals, chunk, index, counts)
         rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
         if rows.size == 0:
             continue

@@ -12,7 +12,9 @@ queries in chunks, or, for the balls of the measures with the compiled
 backend, from a grid of the ball's radius; no O(N^2) memory):
 
 1. checks: shape, NaN, at least :data:`MIN_POINTS` points, not all on a line;
-   duplicate points are computed once and copied; points whose neighbours are
+   duplicate points, and near copies (a point's nearest neighbours closer than
+   :data:`COPY_GAP` times the distance to the next one: merged scans,
+   overlapping tiles), are computed once and copied; points whose neighbours are
    all far (outliers) stay out of every neighbourhood and are NaN; the
    distinct points are taken in Morton (Z-curve) order, so that neighbours
    are near in memory (the results do not depend on the input's order);
@@ -21,7 +23,12 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
 3. normals: the given ones (made unit), or PCA of the 10 nearest neighbours;
    oriented consistently along a minimum spanning tree of the neighbour graph
    (Hoppe et al. 1992) unless the given ones already are, and, when estimated,
-   outward on each connected component;
+   outward on each part: the sign passes along edges of one sheet, and
+   reversed across a gap between two sheets (two parts a spacing or two
+   apart, the faces of a thin part), never along other edges
+   (:func:`meshcurv._pointcloud_normals.oriented_signs`); points where two
+   sheets closer than the spacing cannot be told apart are NaN
+   (``invalid_reason``: side undecided);
 4. the noise level ``nu``: the median distance of the points to degree-2 jets
    fitted over :data:`NOISE_FIT_RADIUS` spacings, in spacings;
 5. the radius: ``s (a + b sqrt(max(nu - 0.005, 0)))``, ``(a, b)`` = (3, 11)
@@ -49,8 +56,9 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    - ``"jets"``: weighted degree-3 jets over the ball, refitted in the frame
      of their own normal (Cazals and Pouget 2005), curvatures from the jet's
      second fundamental form (:func:`meshcurv.jets.shape_operators`);
-     with the default radius, a ball that holds the other side of the surface
-     shrinks as the normal fits' do, down to ``3 s``;
+     a ball that holds the other side of the surface (the default radius or
+     a given one) shrinks as the normal fits' do, down to ``3 s``, and is NaN
+     (``invalid_reason``: every ball held the other side) below;
      the lowest error on clean samples (ellipsoid H 0.2%) and the fastest.
 
 References
@@ -124,8 +132,34 @@ MIN_SPACING = 1e-150
 #: Bits per coordinate of the Morton code that orders the points (3 x 21 bits fill 63 of a uint64).
 MORTON_BITS = 21
 
+#: Near copies: a point's nearest neighbours closer than this times the distance to the next one are copies of
+#: it (merged scans, overlapping tiles: the same points with round-off differences), merged as duplicates are.
+#: Random samples have such a gap at about one point in 10^6 (the chance scales as its square): merging those
+#: moves a point by 1e-3 spacings at most.
+COPY_GAP = 1e-3
+
+#: A point whose :data:`~meshcurv._pointcloud_normals.NEIGHBOURS` nearest neighbours all lie within this share
+#: of the cloud's size-for-its-count (bounding-box diagonal over sqrt(N)) may have more copies than that: its
+#: nearest :data:`COPY_NEIGHBOURS` are searched for the gap.
+COPY_SUSPECT = 1e-2
+
+#: Most copies of one point found (see :data:`COPY_SUSPECT`).
+COPY_NEIGHBOURS = 64
+
 #: Code of :data:`meshcurv.result.INVALID_REASONS` for points without an estimate.
 _UNDEFINED = len(INVALID_REASONS) - 1
+
+
+def _reason_code(start: str) -> int:
+    """The code of the reason that starts with ``start`` (the last one, undefined, if there is none)."""
+    return next((code for code, text in enumerate(INVALID_REASONS) if text.startswith(start)), _UNDEFINED)
+
+
+#: Code of points whose normal's side could not be decided (between two sheets closer than the spacing).
+_UNDECIDED = _reason_code("point cloud: side undecided")
+
+#: Code of points whose every ball held the other side of a thin part.
+_TWO_SIDED = _reason_code("point cloud: every ball held")
 
 
 def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | None = None) -> CurvatureResult:
@@ -213,8 +247,20 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     # the distinct points in Morton order (neighbours near in memory: the searches and fits run from cache)
     order, representative = _spatial_order(points)
     unique = order[representative[order] == order]
+    n_exact = n_all - unique.size
+    search = None
+    if unique.size >= MIN_POINTS:
+        # near copies (round-off differences) are merged into the first of them in the Morton order
+        copy_of, search = _near_copies(points[unique])
+        if search is None:
+            representative = unique[copy_of][_position(unique, n_all)[representative]]
+            unique = unique[copy_of == np.arange(unique.size)]
     if unique.size < n_all:
-        problems.append(f"{n_all - unique.size} points coincide with others (duplicates): computed once and copied")
+        near = n_all - unique.size - n_exact
+        found = [f"{n_exact} points coincide with others (duplicates)"] if n_exact else []
+        found += [f"{near} points are near copies of others (closer to one than {COPY_GAP:g} times the distance "
+                  "to their next neighbour: round-off differences)"] if near else []
+        problems.append(" and ".join(found) + ": merged, each computed once and its values copied")
     if unique.size < MIN_POINTS:
         raise InvalidMeshError(f"`points` holds {unique.size} distinct points; at least {MIN_POINTS} are needed")
     cloud = points[unique]
@@ -226,16 +272,14 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
                 f"`radius` {radius:g} is larger than the point cloud itself (bounding-box diagonal {diagonal:g}): "
                 "every ball would hold every point; pass a radius of a few point spacings, in the units of the points")
 
-    k_min, k_max, dir_min, dir_max, out_normals, valid, parameters, found = _compute(
-        cloud, None if given is None else given[unique], radius, method)
+    k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, found = _compute(
+        cloud, None if given is None else given[unique], radius, method, search)
     problems.extend(found)
 
     # back to all points: each duplicate takes its representative's values
-    position = np.zeros(n_all, dtype=np.int64)
-    position[unique] = np.arange(unique.size)
-    take = position[representative]
-    fields = [a[take] for a in (k_min, k_max, dir_min, dir_max, out_normals, valid)]
-    k_min, k_max, dir_min, dir_max, out_normals, valid = fields
+    take = _position(unique, n_all)[representative]
+    fields = [a[take] for a in (k_min, k_max, dir_min, dir_max, out_normals, valid, reason)]
+    k_min, k_max, dir_min, dir_max, out_normals, valid, reason = fields
     valid = valid & np.isfinite(k_min) & np.isfinite(k_max)
     for array in (k_min, k_max, dir_min, dir_max):
         array[~valid] = np.nan
@@ -244,10 +288,75 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         problems.append(f"{n_invalid} points are NaN with valid=False")
     if problems:
         warnings.warn("point cloud: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
-    reason = np.where(valid, 0, _UNDEFINED).astype(np.int8)
+    reason = np.where(valid, 0, np.where(reason > 0, reason, _UNDEFINED)).astype(np.int8)
     return CurvatureResult._of_arrays(k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max,
                                       normals=out_normals, valid=valid, method=method, parameters=parameters,
                                       invalid_reason=reason)
+
+
+def _position(unique: np.ndarray, n: int) -> np.ndarray:
+    """(n,) the row of each index of ``unique`` in it (0 elsewhere)."""
+    position = np.zeros(n, dtype=np.int64)
+    position[unique] = np.arange(unique.size)
+    return position
+
+
+def _near_copies(cloud: np.ndarray):
+    """``(copy_of, search)``: (M,) the point each point of ``cloud`` is a copy of (itself when none), and
+    ``(tree, distances, indices)`` of ``cloud`` for :func:`_compute` when there is no copy (else None).
+
+    Point ``j`` is a copy of ``i`` when it is among ``i``'s nearest neighbours before a gap:
+    ``d_m <= COPY_GAP d_(m+1)`` for the ``m``-th and next distances (the largest such ``m``). Groups
+    of copies are the connected components of these pairs; each becomes its first point.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    m = cloud.shape[0]
+    tree = cKDTree(cloud)
+    distances, indices = _normals.knn(tree, cloud)
+    rows, cols = _copy_pairs(np.arange(m), distances, indices)
+    with np.errstate(over="ignore", invalid="ignore"):
+        scale = float(np.linalg.norm(cloud.max(axis=0) - cloud.min(axis=0))) / np.sqrt(m)
+    # points whose every neighbour is (nearly) there may have more copies: a wider search for the gap
+    suspect = np.flatnonzero((distances[:, -1] < COPY_SUSPECT * scale) & ~np.isin(np.arange(m), rows))
+    if suspect.size and distances.shape[1] < m - 1:
+        k = min(COPY_NEIGHBOURS, m - 1)
+        d, i = tree.query(cloud[suspect], k=k + 1)
+        wide_d, wide_i = np.zeros((suspect.size, k)), np.zeros((suspect.size, k), dtype=np.int64)
+        _drop_rows(suspect, d, i, k, wide_d, wide_i)
+        more_rows, more_cols = _copy_pairs(suspect, wide_d, wide_i)
+        rows, cols = np.concatenate([rows, more_rows]), np.concatenate([cols, more_cols])
+    if rows.size == 0:
+        return np.arange(m), (tree, distances, indices)
+    graph = coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(m, m))
+    _, labels = connected_components(graph, directed=False)
+    first = np.full(int(labels.max()) + 1, m, dtype=np.int64)
+    np.minimum.at(first, labels, np.arange(m))
+    return first[labels], None
+
+
+def _drop_rows(centres, d, i, k, distances, indices) -> None:
+    """:func:`meshcurv._pointcloud_normals._drop_self` for the points ``centres`` (rows 0.. of the outputs)."""
+    own = i == centres[:, None]
+    first = np.where(own.any(axis=1), own.argmax(axis=1), 0)
+    keep = np.ones(d.shape, dtype=bool)
+    keep[np.arange(centres.size), first] = False
+    distances[:] = d[keep].reshape(-1, k)
+    indices[:] = i[keep].reshape(-1, k)
+
+
+def _copy_pairs(centres, distances, indices):
+    """``(rows, cols)``: each centre and its neighbours before the last gap of :data:`COPY_GAP` in its row."""
+    with np.errstate(invalid="ignore"):
+        gap = (distances[:, :-1] <= COPY_GAP * distances[:, 1:]) & (distances[:, 1:] > MIN_SPACING)
+    if not gap.any():
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    k = distances.shape[1]
+    last = np.where(gap.any(axis=1), k - 2 - np.argmax(gap[:, ::-1], axis=1), -1)  # neighbours 0..last are copies
+    before = np.arange(k)[None, :] <= last[:, None]
+    return np.repeat(centres, before.sum(axis=1)), indices[before]
 
 
 def _checked_normals(normals, shape) -> np.ndarray:
@@ -327,15 +436,19 @@ def _check_spread(cloud: np.ndarray) -> None:
             f"{singular[1]:.3g} across): no surface to measure")
 
 
-def _compute(points, given, radius, method):
-    """The pipeline on distinct points. Returns the fields, ``valid``, ``parameters`` and the problems."""
+def _compute(points, given, radius, method, search=None):
+    """The pipeline on distinct points. Returns the fields, ``valid``, the reason codes, ``parameters`` and the
+    problems. ``search``: ``(tree, distances, indices)`` of ``points`` when already built."""
     from scipy.spatial import cKDTree
 
     n = points.shape[0]
     problems = []
-    tree = cKDTree(points)
     logger.info("point cloud: %d points: neighbours", n)
-    distances, indices = _normals.knn(tree, points)
+    if search is None:
+        tree = cKDTree(points)
+        distances, indices = _normals.knn(tree, points)
+    else:
+        tree, distances, indices = search
     spacing = _normals.local_spacing(distances)
     measurable = spacing > MIN_SPACING
     if not measurable.any():
@@ -356,11 +469,11 @@ def _compute(points, given, radius, method):
     logger.info("point cloud: normals")
     if given is None:
         start = _normals.pca_normals(points, indices)
-        signs, labels = _normals.orientation_signs(start, indices, usable)
+        signs, labels, doubtful = _normals.oriented_signs(points, start, indices, usable, spacing)
         start = start * signs[:, None]
-        start = start * _normals.outward_signs(points, start, labels, np.where(usable, spacing**2, 0.0))[:, None]
         how = "estimated"
     else:
+        doubtful = np.zeros(n, dtype=bool)
         signs, labels = _normals.orientation_signs(given, indices, usable, given=True, points=points)
         # each component keeps the side most of its given normals point to
         majority = np.bincount(labels, weights=signs, minlength=int(labels.max()) + 1)
@@ -388,11 +501,15 @@ def _compute(points, given, radius, method):
     parameters = {"radius": groups[0][0], "spacing": median, "noise": noise, "normals": how}
     shrunk = 0  # points whose jet fit took a smaller ball than asked for (its ball held the other side)
     two_sided = 0  # points whose every ball held the other side (or too few points)
+    one_sided = np.ones(n, dtype=bool)  # points with a one-sided jet fit (or given normals)
+    two_sided_mask = np.zeros(n, dtype=bool)
+    mixed = None
     for group_radius, group_spacing, members in groups:
         details: dict[str, np.ndarray] = {}
         if method == "jets":
-            # a default ball that holds the other side of a thin part shrinks, down to the clean-sample radius
-            smallest = None if radius is not None else min(group_radius, RADIUS_RULES[method][0] * group_spacing)
+            # a ball that holds the other side of a thin or small part shrinks, down to the clean-sample radius
+            # (a given radius too: a jet through both sides is not the surface, H doubled on a small sphere)
+            smallest = min(group_radius, RADIUS_RULES[method][0] * group_spacing)
             found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest,
                                      details=details)
             asked = group_radius
@@ -403,26 +520,45 @@ def _compute(points, given, radius, method):
                                                      smallest=_estimators.NORMAL_RULE[0] * group_spacing,
                                                      details=details)
                 parameters["normal_radius"] = normal_radius
+                # a point whose every normal fit held the other side, and whose nearest neighbours hold
+                # it too, keeps a PCA normal that may mix the two sheets: it is left out (NaN, and out of
+                # the balls, where its triangles would bend the measures of its neighbours)
+                if mixed is None:
+                    mixed = _normals.facing_away(start, indices)
+                one_sided[members] = np.isfinite(details["radii"][members]) | ~mixed[members]
             else:
                 normals = start
-            found = _estimators.corrected_measures(tree, points, normals, group_radius, members, usable,
-                                                   spacing=group_spacing)
+            found = _estimators.corrected_measures(tree, points, normals, group_radius, members,
+                                                   usable & one_sided, spacing=group_spacing)
         if "radii" in details:
             fitted_radii = details["radii"][members]
             shrunk += int((fitted_radii < asked).sum())
             two_sided += int(np.isnan(fitted_radii).sum())
+            two_sided_mask[members] = np.isnan(fitted_radii)
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
             whole[members] = part[members]
     if method == "jets" or given is None:
         parameters["shrunk"] = shrunk / max(centres.size, 1)
+    if method == "jets" and radius is not None and shrunk:
+        problems.append(f"at {shrunk} points the ball of the given radius {radius:g} held the other side of a thin "
+                        "or small part (points facing away): fitted over smaller balls of one side, down to "
+                        f"{RADIUS_RULES[method][0]:g} spacings (parameters['shrunk'])")
     if two_sided:
         what = "curvatures NaN" if method == "jets" else "normals from the PCA of 10 neighbours"
         problems.append(f"{two_sided} points have no one-sided jet fit (every ball down to 3-4 spacings held "
                         f"points facing the other way: a part thinner than that, or too few points): {what}")
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
+    reason = np.zeros(n, dtype=np.int8)
+    reason[~one_sided | (two_sided_mask & usable)] = _TWO_SIDED
+    valid &= one_sided
+    if doubtful.any():
+        problems.append(f"{int(doubtful.sum())} points lie between two sheets closer than the spacing (two parts of "
+                        "the cloud, or the faces of a part thinner than that): their normals' side is undecided, NaN")
+        valid &= ~doubtful
+        reason[doubtful] = _UNDECIDED
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _, _ in groups)
-    return k_min, k_max, dir_min, dir_max, out_normals, valid, parameters, problems
+    return k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, problems
 
 
 def _noise_level(points, normals, spacing, centres, usable) -> float:

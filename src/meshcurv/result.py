@@ -26,6 +26,8 @@ INVALID_REASONS = (
     "on an edge between inconsistently oriented faces",
     "corner of a zero-area face",
     "on a boundary edge (this method needs a closed neighbourhood)",
+    "point cloud: side undecided (between two sheets closer than the spacing)",
+    "point cloud: every ball held the other side of a thin part or a neighbouring part",
     "estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)",
 )
 
