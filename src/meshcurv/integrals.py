@@ -117,7 +117,11 @@ def vertex_integrals(vertices, faces, field: str, *, normals=None, pointwise=Non
     ----------
     vertices : array_like of shape (V, 3)
     faces : array_like of shape (F, 3)
-        0-based vertex indices, consistently oriented.
+        0-based vertex indices, consistently oriented, one side: the faces of
+        a double-sided mesh (each face twice, with opposite windings) are all
+        counted (:func:`meshcurv.weld.drop_double_sided` keeps one side;
+        :meth:`meshcurv.CurvatureResult.integral` integrates over the mesh
+        :func:`~meshcurv.principal_curvatures` computed on, one-sided already).
     field : {'area', 'mean', 'gaussian', 'willmore'}
         - ``'area'``: barycentric vertex areas (a third of each incident face);
         - ``'mean'``: total mean curvature ``int H dA`` from the corrected
