@@ -177,3 +177,21 @@ def test_connected_jet_balls_leave_out_the_other_sheet(backend):
     own = distances[:sheet.shape[0]]
     assert connected[MIDDLE] == (own < 0.3).sum()  # strictly inside: a non-zero weight
     assert euclidean[MIDDLE] == (distances < 0.3).sum() > 1.5 * (own < 0.3).sum()
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_edge_lists_that_are_not_the_meshs_are_refused(backend):
+    # both backends check `adjacency` alike before walking it
+    from meshcurv.errors import InvalidMeshError
+    from meshcurv.jets import fit_jets
+
+    (vertices, faces), _ = two_sheets()
+    indptr, indices = MeshTopology.from_faces(faces, vertices.shape[0]).neighbour_lists
+    normals = np.tile([0.0, 0.0, 1.0], (vertices.shape[0], 1))
+    with use_backend(backend):
+        with pytest.raises(InvalidMeshError, match=r"`adjacency` must be CSR lists of 882 vertices; got indptr \(10,\)"):
+            fit_jets(vertices, normals, 0.3, adjacency=(indptr[:10], indices))
+        wrong = np.array(indices, copy=True)
+        wrong[5] = vertices.shape[0]
+        with pytest.raises(InvalidMeshError, match=r"`adjacency` must hold vertex indices in 0\.\.881"):
+            fit_jets(vertices, normals, 0.3, adjacency=(indptr, wrong))

@@ -481,7 +481,7 @@ _SEARCH_SLACK = 1e-9
 
 
 def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np.ndarray, radius: float,
-                     chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+                     chunk_size: int = CHUNK, *, refuse: bool = True) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """Yield ``(chunk, i, c)`` per chunk of centres: cell ``c`` may meet the ball ``B(centre_points[i], radius)``.
 
     ``i`` indexes the chunk (0 and up). A superset of the cells that meet each
@@ -489,11 +489,15 @@ def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np
     their size group (:func:`_size_groups`) of the centre, by k-d trees; the
     caller tests each pair exactly. The chunks hold at most ``chunk_size`` centres
     and about :data:`PAIRS_PER_CHUNK` pairs, all the groups' pairs of a centre in the same chunk.
+    ``refuse``: check each group's work (:func:`check_ball_work`, as the compiled
+    ``ball_cell_sums`` is called); False where the caller has made the check
+    of the compiled path already (the connected balls), so that both backends
+    refuse the same radii.
 
     Raises
     ------
     InvalidOptionError
-        More than :data:`MAX_BALL_PAIRS` pairs in a group (:func:`check_ball_work`).
+        With ``refuse``, more than :data:`MAX_BALL_PAIRS` pairs in a group (:func:`check_ball_work`).
     """
     from scipy.spatial import cKDTree
 
@@ -503,9 +507,10 @@ def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np
     if centroids.shape[0]:
         index = np.arange(centroids.shape[0])
         for group in _size_groups(reach, radius):
-            cutoff = (radius + float(reach[group].max())) * (1 + _SEARCH_SLACK)
-            largest += check_ball_work(centroids[group], cutoff, n, centres=centre_points)[1]
-            searches.append((cKDTree(centroids[group]), index[group], cutoff))
+            cutoff = radius + float(reach[group].max())
+            largest += (check_ball_work(centroids[group], cutoff, n, centres=centre_points) if refuse
+                        else estimate_ball_pairs(centroids[group], cutoff, centre_points))[1]
+            searches.append((cKDTree(centroids[group]), index[group], cutoff * (1 + _SEARCH_SLACK)))
     chunk_size = max(1, min(int(chunk_size), int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
     empty = np.zeros(0, dtype=np.int64)
     for chunk in _chunks(n, chunk_size):
@@ -580,11 +585,12 @@ def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius: 
     """
     n = vertices.shape[0]
     centroids, reach = cell_centres(vertices, faces)
+    check_ball_work(centroids, radius + float(reach.max()), n, centres=vertices)  # the compiled path's check
     points, middles = _columns(vertices), _columns(centroids)
     corners = [np.ascontiguousarray(faces[:, k]) for k in range(3)]
     out = np.zeros((n, values.shape[1]))
     radius2 = radius * radius
-    for chunk, i, f in _candidate_pairs(vertices, centroids, reach, radius):
+    for chunk, i, f in _candidate_pairs(vertices, centroids, reach, radius, refuse=False):
         ids = np.arange(chunk.start, chunk.stop)[i]
         centre = tuple(column[ids] for column in points)
         middle = _squared(*_offsets(middles, f, centre))
@@ -630,12 +636,13 @@ def connected_ball_pairs(vertices: np.ndarray, centres: np.ndarray, radius: floa
     chunks of at most ``chunk_size`` of them as :func:`vertex_pairs_in_ball`;
     ``neighbour`` is a vertex id. Trusted inputs (``centres`` int64 ids in range).
 
+    The caller checks the work (:func:`check_ball_work` of the vertices, as
+    ``jets.fit_jets`` does on both backends).
+
     Raises
     ------
     InvalidMeshError
         ``adjacency`` is not CSR lists of the vertices (:func:`checked_adjacency`).
-    InvalidOptionError
-        The balls would hold more than :data:`MAX_BALL_PAIRS` pairs (:func:`check_ball_work`).
     """
     n = vertices.shape[0]
     edges = adjacency_edges(adjacency, n)
@@ -643,7 +650,7 @@ def connected_ball_pairs(vertices: np.ndarray, centres: np.ndarray, radius: floa
     points = _columns(vertices)
     first, second = np.ascontiguousarray(edges[:, 0]), np.ascontiguousarray(edges[:, 1])
     radius2 = radius * radius
-    for chunk, i, e in _candidate_pairs(vertices[centres], mids, half, radius, chunk_size):
+    for chunk, i, e in _candidate_pairs(vertices[centres], mids, half, radius, chunk_size, refuse=False):
         ids = centres[chunk]
         centre = tuple(column[ids[i]] for column in points)
         a, b = _offsets(points, first[e], centre), _offsets(points, second[e], centre)
