@@ -77,11 +77,13 @@ def test_oriented_signs_passes_the_sign_reversed_across_a_gap():
 
     distances, indices = normals_module.knn(cKDTree(points), points)
     normals = np.tile([0.0, 0.0, 1.0], (1800, 1))
-    signs, labels, doubtful = normals_module.oriented_signs(points, normals, indices, np.ones(1800, bool),
-                                                            normals_module.local_spacing(distances))
+    signs, labels, doubtful, sheets = normals_module.oriented_signs(points, normals, indices, np.ones(1800, bool),
+                                                                    normals_module.local_spacing(distances))
     assert np.unique(labels).size == 1
     assert np.all(signs[:900] == signs[0]) and np.all(signs[900:] == -signs[0])
     assert not doubtful.any()
+    # two sheets: a ball of one never takes the other's points
+    assert np.unique(sheets[:900]).size == 1 and np.unique(sheets[900:]).size == 1 and sheets[0] != sheets[900]
 
 
 @pytest.mark.parametrize("copies", [5, 10, 30])

@@ -204,7 +204,7 @@ def _ball_indices(search, points, chunk, radius, k):
     return np.ascontiguousarray(index), (index < points.shape[0]).sum(axis=1)
 
 
-def _own_side(normals, centres, index, counts):
+def _own_side(normals, centres, index, counts, sheets=None):
     """The balls ``index`` (M, k) (``counts`` points first, padded with N) less their points facing away.
 
     A point of the ball whose normal is opposite to the centre's
@@ -212,13 +212,18 @@ def _own_side(normals, centres, index, counts):
     of a part thinner than the ball, a neighbouring part of the cloud a
     spacing or two away, or the far side of a part smaller than the ball.
     Triangles through it would measure both sides as one surface (two
-    spheres 1 spacing apart: H up to 5 times 1/r next to the gap). The kept
-    points stay in distance order. Returns ``(index, counts)``.
+    spheres 1 spacing apart: H up to 5 times 1/r next to the gap). With
+    ``sheets`` (N,) (:func:`meshcurv._pointcloud_normals.oriented_signs`),
+    points of another sheet than the centre's go too (-1 matches any). The
+    kept points stay in distance order. Returns ``(index, counts)``.
     """
     n = normals.shape[0]
     member = np.arange(index.shape[1])[None, :] < counts[:, None]
     safe = np.where(member, index, 0)
     away = member & (np.einsum("mkj,mj->mk", normals[safe], normals[centres]) < 0)
+    if sheets is not None:
+        theirs, own = sheets[safe], sheets[centres][:, None]
+        away |= member & (theirs != own) & (theirs >= 0) & (own >= 0)
     if not away.any():
         return index, counts
     order = np.argsort(away | ~member, axis=1, kind="stable")
@@ -227,7 +232,7 @@ def _own_side(normals, centres, index, counts):
 
 
 def corrected_measures(tree, points, normals, radius, centres, usable, *, spacing: float = 0.0,
-                       n_triangles: int | None = None):
+                       n_triangles: int | None = None, sheets: np.ndarray | None = None):
     """Randomized corrected curvature measures over balls of ``radius`` (Lachaud et al. 2023).
 
     For every centre, ``n_triangles`` triangles with corners drawn at random
@@ -256,7 +261,7 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
             index, _, counts = kernels.ball_indices(points, chunk, float(radius), k, *grid, 64 * kernel_threads())
         else:
             index, counts = _ball_indices(search, points, chunk, radius, k)
-        index, counts = _own_side(normals, chunk, index, counts)
+        index, counts = _own_side(normals, chunk, index, counts, sheets)
         rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
         if rows.size == 0:
             continue

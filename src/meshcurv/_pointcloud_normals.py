@@ -288,7 +288,7 @@ def outward_signs(points: np.ndarray, normals: np.ndarray, labels: np.ndarray, a
 
 
 def oriented_signs(points: np.ndarray, normals: np.ndarray, indices: np.ndarray, usable: np.ndarray,
-                   spacing: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   spacing: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Signs that orient estimated (unsigned) ``normals`` consistently, and outward on each part.
 
     The orientation is propagated (:func:`_spanning_forest`) along two kinds
@@ -338,6 +338,9 @@ def oriented_signs(points: np.ndarray, normals: np.ndarray, indices: np.ndarray,
         The part of each point.
     doubtful : ndarray of shape (N,), bool
         Points whose side could not be decided.
+    sheets : ndarray of shape (N,), int
+        The sheet of each point: the components of the flat edges (-1 for
+        components of fewer than :data:`PART_MIN_POINTS` points: noise).
     """
     n = points.shape[0]
     rows, cols, _ = _graph_edges(indices[:, :GRAPH_NEIGHBOURS], usable)
@@ -353,6 +356,7 @@ def oriented_signs(points: np.ndarray, normals: np.ndarray, indices: np.ndarray,
     stacked = (~flat & (np.abs(cosine) >= FACING_COSINE) & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
                & (ahead * behind * cosine > 0))
     used = flat | stacked
+    sheets = _sheets(n, rows[flat], cols[flat])
     # stacked edges first (weights below any flat edge's), then the flat ones by 1 - |cos|
     # (flat edges also by their slope: a tree of one sheet is grown before edges that leave it a little)
     weights = np.where(stacked, 1e-9, 1.0 - np.abs(cosine) + np.nan_to_num(slope) + 1e-6)
@@ -391,7 +395,17 @@ def oriented_signs(points: np.ndarray, normals: np.ndarray, indices: np.ndarray,
     doubtful[rows[torn]] = True
     doubtful[cols[torn]] = True
     signs = signs * outward_signs(points, normals * signs[:, None], labels, np.where(usable, spacing**2, 0.0))
-    return signs, labels, doubtful
+    return signs, labels, doubtful, sheets
+
+
+def _sheets(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """(N,) the components of the edges ``(rows, cols)``; -1 for those of fewer than :data:`PART_MIN_POINTS`."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    _, labels = connected_components(coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n)),
+                                     directed=False)
+    return np.where(np.bincount(labels)[labels] >= PART_MIN_POINTS, labels, -1)
 
 
 def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:

@@ -469,16 +469,23 @@ def _compute(points, given, radius, method, search=None):
     logger.info("point cloud: normals")
     if given is None:
         start = _normals.pca_normals(points, indices)
-        signs, labels, doubtful = _normals.oriented_signs(points, start, indices, usable, spacing)
+        signs, labels, doubtful, sheets = _normals.oriented_signs(points, start, indices, usable, spacing)
         start = start * signs[:, None]
         how = "estimated"
     else:
         doubtful = np.zeros(n, dtype=bool)
         signs, labels = _normals.orientation_signs(given, indices, usable, given=True, points=points)
+        sheets = np.where(np.bincount(labels)[labels] >= _normals.PART_MIN_POINTS, labels, -1)
         # each component keeps the side most of its given normals point to
         majority = np.bincount(labels, weights=signs, minlength=int(labels.max()) + 1)
         signs = signs * np.where(majority[labels] < 0, -1.0, 1.0)
         reoriented = bool((signs < 0).any())
+        if reoriented:
+            # inconsistent signs: oriented as estimated normals are (one sheet at a time, reversed across a
+            # gap between two), each part then on the side most of its given normals point to
+            signs, labels, doubtful, sheets = _normals.oriented_signs(points, given, indices, usable, spacing)
+            majority = np.bincount(labels, weights=signs, minlength=int(labels.max()) + 1)
+            signs = signs * np.where(majority[labels] < 0, -1.0, 1.0)
         start = given * signs[:, None]
         how = "given, reoriented" if reoriented else "given"
 
@@ -529,7 +536,7 @@ def _compute(points, given, radius, method, search=None):
             else:
                 normals = start
             found = _estimators.corrected_measures(tree, points, normals, group_radius, members,
-                                                   usable & one_sided, spacing=group_spacing)
+                                                   usable & one_sided, spacing=group_spacing, sheets=sheets)
         if "radii" in details:
             fitted_radii = details["radii"][members]
             shrunk += int((fitted_radii < asked).sum())
