@@ -19,6 +19,24 @@ not finish within ``--timeout`` seconds, or one that runs out of its memory
 limit (``--memory`` MiB, far beyond what these small files need). Prints one
 line per format and the findings with their inputs (saved in ``--keep``);
 exits 1 when there is any.
+
+Text rows (``--mode rows``; half of the time by default): a valid file of
+every text format (CSV with and without a header, with semicolons and
+decimal commas; XYZ with blanks or tabs; .pts with its count line; TXT;
+ASCII PLY clouds and meshes; ASCII PCD; OBJ; OFF; ASCII STL) is written
+from known points and faces, and one row is changed: a value dropped, one
+added, one moved to the next row (the total stays right), an empty value, a
+trailing separator (on one row or on all), a row split or joined with the
+next, a word that is not a number; or the file is changed harmlessly (a
+blank line, a comment, CRLF). The reader must return exactly the points and
+faces written, or raise a MeshFileError naming a line the change touched (or
+the count line it contradicts). A different result (a re-cut), an error for
+a harmless change or one naming no line is a finding; an error naming another
+line is counted apart (``named (another line)``: two OBJ ``v`` rows joined
+read as one vertex with a colour, then a face names a vertex beyond them), as
+is a value added to a row the format lets hold more (``another valid file``:
+OBJ ``v x y z w`` and polygons, an OFF face's colour), which no reader can
+tell from the file written.
 """
 
 from __future__ import annotations
@@ -183,6 +201,252 @@ def read_in_child(context, path: pathlib.Path, timeout: float, memory_bytes: int
         return "memory", f"child ended with code {process.exitcode} and no answer"
 
 
+# ---------------------------------------------------------------- text rows (issue 29, class 5)
+#
+# A valid text file is written from known points (and faces), one record per row; one row (or
+# the layout of every row) is then changed. The reader must either return exactly the intended
+# points and faces, or raise a MeshFileError whose message names a line the change touched. A
+# different result is a finding (a silent re-cut), as is an error for a change that leaves the
+# file valid (blank lines, CRLF, doubled blanks), an error naming no line or another line, any
+# other exception, a warning, a hang or a blow-up.
+
+#: changes that leave the file valid: the reader must read the intended points
+HARMLESS = ("none", "blank line", "crlf", "comment line")
+#: changes to one row (or two): the intended result, or an error naming a touched line
+DAMAGING = ("drop a value", "extra value", "move a value to the next row", "empty value", "trailing separator",
+            "trailing separator on every row", "split the row", "join with the next row", "not a number")
+
+
+class Row:
+    """One record of a text file: ``prefix + separator.join(words) + suffix``; ``data`` marks the mutable rows."""
+
+    def __init__(self, words, separator=" ", prefix="", data=True, free=False):
+        self.words, self.separator, self.prefix, self.data = list(words), separator, prefix, data
+        self.free = free  # the format lets this row hold more values (OBJ `v x y z w`, polygons, OFF colours)
+
+    def text(self) -> str:
+        return self.prefix + self.separator.join(self.words)
+
+
+def _number(rng: random.Random) -> str:
+    return repr(rng.choice([rng.uniform(-10, 10), float(rng.randint(-5, 5)), rng.uniform(-1e-3, 1e-3)]))
+
+
+def _cloud(rng: random.Random) -> np.ndarray:
+    return np.array([[float(_number(rng)) for _ in range(3)] for _ in range(rng.randint(3, 12))])
+
+
+def _surface(rng: random.Random) -> tuple[np.ndarray, np.ndarray]:
+    torus = shapes.torus(n_major=rng.choice([3, 4, 5]), n_minor=3)
+    return np.round(torus.vertices, 6), torus.faces
+
+
+def _words(values) -> list[str]:
+    return [repr(float(v)) if isinstance(v, float) or np.issubdtype(type(v), np.floating) else str(v)
+            for v in values]
+
+
+def text_case(kind: str, rng: random.Random):
+    """``(extension, reader, rows, points, faces, extra_lines)``: a valid file of ``kind`` as rows.
+
+    ``extra_lines`` are the indices of rows an error may also name (a count line that the
+    change contradicts).
+    """
+    faces = None
+    extra: list[int] = []
+    if kind in ("csv", "csv-header", "csv-semicolon", "xyz", "xyz-tab", "pts", "txt-header"):
+        points = _cloud(rng)
+        separator = {"csv": ",", "csv-header": ",", "csv-semicolon": ";", "xyz-tab": "\t"}.get(kind, " ")
+        rows = []
+        if kind in ("csv-header", "csv-semicolon", "txt-header"):
+            rows.append(Row(["x", "y", "z"], separator, data=False))
+        if kind == "pts":
+            rows.append(Row([str(len(points))], data=False))
+            extra.append(0)
+        for point in points:
+            words = _words(point)
+            if kind == "csv-semicolon":
+                words = [word.replace(".", ",") for word in words]
+            rows.append(Row(words, separator))
+        extension = {"csv": ".csv", "csv-header": ".csv", "csv-semicolon": ".csv", "pts": ".pts",
+                     "txt-header": ".txt"}.get(kind, ".xyz")
+        return extension, "points", rows, points, None, extra
+    if kind == "ply-cloud":
+        points = _cloud(rng)
+        header = ["ply", "format ascii 1.0", f"element vertex {len(points)}", "property double x",
+                  "property double y", "property double z", "end_header"]
+        rows = [Row([line], data=False) for line in header] + [Row(_words(p)) for p in points]
+        return ".ply", "points", rows, points, None, [2]
+    if kind == "pcd":
+        points = _cloud(rng)
+        header = ["VERSION 0.7", "FIELDS x y z", "SIZE 8 8 8", "TYPE F F F", "COUNT 1 1 1", f"WIDTH {len(points)}",
+                  "HEIGHT 1", f"POINTS {len(points)}", "DATA ascii"]
+        rows = [Row([line], data=False) for line in header] + [Row(_words(p)) for p in points]
+        return ".pcd", "points", rows, points, None, [5, 7]
+    points, faces = _surface(rng)
+    if kind == "ply-mesh":
+        header = ["ply", "format ascii 1.0", f"element vertex {len(points)}", "property double x",
+                  "property double y", "property double z", f"element face {len(faces)}",
+                  "property list uchar int vertex_indices", "end_header"]
+        rows = [Row([line], data=False) for line in header] + [Row(_words(p)) for p in points]
+        rows += [Row(["3", *map(str, face)]) for face in faces]
+        return ".ply", "mesh", rows, points, faces, [2, 6]
+    if kind == "obj":
+        rows = [Row(_words(p), prefix="v ", free=True) for p in points]
+        rows += [Row(map(str, face + 1), prefix="f ", free=True) for face in faces]
+        return ".obj", "mesh", rows, points, faces, []
+    if kind == "off":
+        rows = [Row(["OFF"], data=False), Row([f"{len(points)} {len(faces)} 0"], data=False)]
+        rows += [Row(_words(p)) for p in points] + [Row(["3", *map(str, face)], free=True) for face in faces]
+        return ".off", "mesh", rows, points, faces, [1]
+    if kind == "stl":
+        rows = [Row(["solid fuzz"], data=False)]
+        for face in faces:
+            rows += [Row(["facet normal 0 0 1"], data=False), Row(["outer loop"], data=False)]
+            rows += [Row(_words(points[i]), prefix="vertex ") for i in face]
+            rows += [Row(["endloop"], data=False), Row(["endfacet"], data=False)]
+        rows.append(Row(["endsolid fuzz"], data=False))
+        return ".stl", "mesh", rows, points, faces, []
+    raise ValueError(kind)
+
+
+TEXT_KINDS = ("csv", "csv-header", "csv-semicolon", "xyz", "xyz-tab", "pts", "txt-header", "ply-cloud", "pcd",
+              "ply-mesh", "obj", "off", "stl")
+
+
+def mutate_rows(rows: list, change: str, rng: random.Random) -> tuple[str, set]:
+    """Apply ``change`` to ``rows``: ``(text, touched, free)``, the file, the 1-based lines it touched, and
+    whether the change made another valid file (a value added to a row that may hold more)."""
+    before = "\n".join(row.text() for row in rows) + "\n"
+    data_rows = [i for i, row in enumerate(rows) if row.data]
+    i = rng.choice(data_rows)
+    row = rows[i]
+    touched = {i}
+    newline = "\n"
+    if change == "drop a value":
+        del row.words[rng.randrange(len(row.words))]
+    elif change == "extra value":
+        row.words.insert(rng.randrange(len(row.words) + 1), _number(rng))
+    elif change == "move a value to the next row" and i + 1 < len(rows) and rows[i + 1].data:
+        rows[i + 1].words.insert(0, row.words.pop())
+        touched.add(i + 1)
+    elif change == "empty value":
+        row.words.insert(rng.randrange(len(row.words) + 1), "")
+    elif change == "trailing separator":
+        row.words.append("")
+    elif change == "trailing separator on every row":
+        for other in data_rows:
+            rows[other].words.append("")
+        touched = set(data_rows)
+    elif change == "not a number":
+        row.words[rng.randrange(len(row.words))] = rng.choice(["x", "1.2.3", "--1", "nan1", "1e", "0x10"])
+    elif change == "blank line":
+        rows.insert(i + 1, Row([""], data=False))
+    elif change == "comment line" and rows[0].text().split()[0] not in ("ply", "OFF", "solid", "VERSION"):
+        rows.insert(i + 1, Row(["# a comment"], data=False))
+    elif change == "crlf":
+        newline = "\r\n"
+    elif change == "split the row" and len(row.words) > 1:
+        cut = rng.randrange(1, len(row.words))
+        rows.insert(i + 1, Row(row.words[cut:], row.separator, data=True))
+        row.words = row.words[:cut]
+        touched.add(i + 1)
+    elif change == "join with the next row" and i + 1 < len(rows) and rows[i + 1].data:
+        row.words += rows[i + 1].words
+        del rows[i + 1]
+        touched.add(i + 1)
+    lines = [row.text() for row in rows]
+    text = newline.join(lines) + newline
+    applied = change in DAMAGING and text != before
+    free = change in ("extra value", "join with the next row") and row.free
+    return text, ({t + 1 for t in touched} if applied else set()), free
+
+
+def _text_child(path: str, reader: str, memory_bytes: int, queue) -> None:
+    import resource
+    import warnings
+
+    resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            if reader == "points":
+                points, _ = io.read_points(path)
+                faces = None
+            else:
+                points, faces = io.read_mesh(path)
+                faces = np.asarray(faces) if isinstance(faces, np.ndarray) else [list(f) for f in faces]
+        queue.put(("read", (points, faces)))
+    except MeshFileError as exc:
+        queue.put(("error", str(exc)))
+    except MissingDependencyError as exc:
+        queue.put(("skipped", str(exc)))
+    except DOCUMENTED as exc:
+        queue.put(("other documented", f"{type(exc).__name__}: {exc}"))
+    except MemoryError:
+        queue.put(("memory", "MemoryError"))
+    except BaseException as exc:  # noqa: BLE001 - every other exception is a finding
+        queue.put(("crash", f"{type(exc).__name__}: {str(exc)[:300]}"))
+
+
+def judge_text(context, directory, kind, rng, timeout, memory_bytes) -> tuple[str, str, str, bytes]:
+    """One text case: ``(outcome, change, detail, content)``; outcome ``correct``, ``named`` or a finding."""
+    extension, reader, rows, points, faces, extra = text_case(kind, rng)
+    change = rng.choice(HARMLESS + DAMAGING + DAMAGING)
+    text, touched, free = mutate_rows(rows, change, rng)
+    content = text.encode()
+    path = directory / f"rows{extension}"
+    path.write_bytes(content)
+    queue = context.Queue()
+    process = context.Process(target=_text_child, args=(str(path), reader, memory_bytes, queue))
+    process.start()
+    process.join(timeout)
+    if process.is_alive():
+        process.kill()
+        process.join()
+        return "hang", change, f"no answer within {timeout} s", content
+    try:
+        outcome, payload = queue.get(timeout=1)
+    except Exception:  # noqa: BLE001 - the child died without a word
+        return "memory", change, f"child ended with code {process.exitcode}", content
+    if outcome == "read":
+        got_points, got_faces = payload
+        if faces is None:
+            same = got_points.shape == points.shape and np.array_equal(got_points, points)
+        else:  # the corners' coordinates, face by face (STL readers merge the repeated corners)
+            same = (isinstance(got_faces, np.ndarray) and got_faces.shape == faces.shape
+                    and np.array_equal(got_points[got_faces], points[faces]))
+        if same:
+            return "correct", change, "", content
+        if free:  # `v x y z` -> `v x y a z`: a valid vertex with w; a face of 4 corners; an OFF face's colour
+            return "another valid file", change, "", content
+        return "re-cut", change, f"read {got_points.shape[0]} points, not the {len(points)} written", content
+    if outcome != "error":
+        return outcome, change, payload, content
+    if change in HARMLESS or not touched:
+        return "refused a valid file", change, payload, content
+    named = {int(n) for n in re.findall(r"line (\d+)", payload)}
+    if not named:
+        return "error names no line", change, payload, content
+    if not named & (touched | {e + 1 for e in extra}):  # e.g. two OBJ `v` rows joined: a vertex with a colour,
+        return "named (another line)", change, payload, content  # then a face beyond the vertices
+    return "named", change, "", content
+
+
+def run_text_rows(context, directory, rng, stop, timeout, memory_bytes, counts, findings, keep) -> None:
+    """Text cases until ``stop``; counts per kind: ``correct`` / ``named`` / each finding."""
+    while time.monotonic() < stop:
+        kind = rng.choice(TEXT_KINDS)
+        outcome, change, detail, content = judge_text(context, directory, kind, rng, timeout, memory_bytes)
+        row = counts.setdefault(f"rows {kind}", {})
+        row[outcome] = row.get(outcome, 0) + 1
+        if outcome not in ("correct", "named", "named (another line)", "another valid file", "skipped"):
+            findings.append((f"rows {kind}", change, outcome, detail, content))
+            if keep is not None:
+                keep.mkdir(parents=True, exist_ok=True)
+                (keep / f"finding{len(findings)}-{kind}.txt").write_bytes(content)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=1.0, help="how long to fuzz (default 1)")
@@ -190,6 +454,9 @@ def main(argv=None) -> int:
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds per read (default 10)")
     parser.add_argument("--memory", type=int, default=1024, help="MiB of address space per read (default 1024)")
     parser.add_argument("--keep", type=pathlib.Path, default=None, help="folder to save the failing inputs in")
+    parser.add_argument("--mode", choices=["bytes", "rows", "both"], default="both",
+                        help="byte mutations of every format, text rows changed in every text format, or both "
+                             "(half the time each; default)")
     args = parser.parse_args(argv)
     rng = random.Random(args.seed)
     context = multiprocessing.get_context("fork")
@@ -203,8 +470,11 @@ def main(argv=None) -> int:
     findings = []
     with tempfile.TemporaryDirectory() as tmp:
         directory = pathlib.Path(tmp)
+        if args.mode != "bytes":
+            middle = stop if args.mode == "rows" else time.monotonic() + 30 * args.minutes
+            run_text_rows(context, directory, rng, middle, args.timeout, memory_bytes, counts, findings, args.keep)
         corpus = seeds(directory)
-        while time.monotonic() < stop:
+        while args.mode != "rows" and time.monotonic() < stop:
             label, extension, data = rng.choice(corpus)
             how, content = mutate(data, rng)
             path = directory / f"case{extension}"
@@ -222,8 +492,11 @@ def main(argv=None) -> int:
         print(f"{label:28s} " + "  ".join(f"{key} {value}" for key, value in sorted(row.items())))
     for label, how, outcome, detail, content in findings[:20]:
         print(f"FINDING {outcome} in {label} ({how}): {detail}\n    input starts {content[:120]!r}")
-    print(f"total {total} reads in {args.minutes:g} min, {len(findings)} findings (crash, hang or memory); "
-          f"documented errors: " + ", ".join(e.__name__ for e in DOCUMENTED))
+    rows = sum(sum(row.values()) for label, row in counts.items() if label.startswith("rows "))
+    print(f"total {total} reads in {args.minutes:g} min ({rows} text-row cases, {total - rows} byte mutations), "
+          f"{len(findings)} findings (byte mutations: crash, hang or memory; text rows: also a result other than "
+          "the points written, or an error naming no line); documented errors: "
+          + ", ".join(e.__name__ for e in DOCUMENTED))
     return 1 if findings else 0
 
 

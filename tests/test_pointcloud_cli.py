@@ -1,5 +1,6 @@
 """Point clouds (files without faces) through `meshcurv compute` and the batch task."""
 
+import importlib.util
 import re
 
 import numpy as np
@@ -83,3 +84,56 @@ def test_the_batch_task_computes_a_point_cloud(sphere_points, tmp_path):
     assert row["status"] == "computed", row["error"]
     assert row["method"] == "corrected_measures" and row["n_vertices"] == 4000 and row["n_faces"] == 0
     assert row["mean_median"] == pytest.approx(1 / RADIUS, rel=0.01)
+
+
+@pytest.mark.parametrize("extension, write", [
+    (".csv", lambda path, points: np.savetxt(path, points, delimiter=",", header="x,y,z", comments="")),
+    (".txt", lambda path, points: np.savetxt(path, points)),
+    (".pts", lambda path, points: path.write_text(f"{len(points)}\n" + "".join(
+        f"{x!r} {y!r} {z!r} 7 200 200 200\n" for x, y, z in points.tolist()))),  # Leica PTS: count, then x y z i r g b
+])
+def test_compute_takes_every_point_cloud_text_file(sphere_points, tmp_path, capsys, extension, write):
+    """Issue 29, class 9: .csv and .txt clouds exited 1 (read as meshes); .pts files were refused."""
+    points = np.loadtxt(sphere_points)
+    path = tmp_path / f"sphere{extension}"
+    write(path, points)
+    code, out, err = run(capsys, "compute", path)
+    assert code == 0, err
+    assert "4000 points" in out
+    median_mean = float(next(line for line in out.splitlines() if line.startswith("mean")).split()[4])
+    assert median_mean == pytest.approx(1 / RADIUS, rel=0.01)  # a sphere of radius 2: H = 1/2
+
+
+def _listed(err: str) -> list[str]:
+    return re.findall(r"\.\w+", err.split("written to", 1)[1].split("written to")[0])
+
+
+def test_an_unknown_output_lists_exactly_the_outputs_compute_writes(sphere_points, tmp_path, capsys):
+    """`-o out.xlsx` listed .obj, .stl, .off, which compute then refused; each extension listed must be written."""
+    from meshcurv.cli._app import output_extensions
+
+    sphere = meshcurv.shapes.icosphere(2)
+    mesh = meshcurv.write_mesh(tmp_path / "ico.obj", sphere.vertices, sphere.faces)
+    for source, cloud in ((mesh, False), (sphere_points, True)):
+        code, _, err = run(capsys, "compute", source, "-o", tmp_path / "out.xlsx")
+        assert code == 1
+        kind = "a point cloud's" if cloud else "a mesh's"
+        assert re.search(rf"out\.xlsx: unknown output extension '\.xlsx'; {kind} fields are written to \.ply", err)
+        listed = _listed(err)
+        assert listed == list(output_extensions(cloud=cloud))
+        assert ".obj" not in listed and ".stl" not in listed and ".off" not in listed
+        for extension in listed:
+            if extension in (".las", ".laz"):
+                if importlib.util.find_spec("laspy") is None:
+                    continue
+            if extension in (".vtk", ".vtu") and importlib.util.find_spec("meshio") is None:
+                continue
+            output = tmp_path / f"out-{cloud}{extension}"
+            code, _, err = run(capsys, "compute", source, "-o", output, "-q")
+            assert code == 0 and output.exists(), f"{extension}: {err}"
+    code, _, err = run(capsys, "compute", sphere_points, "-o", tmp_path / "out.stl")
+    assert code == 1 and "unknown output extension '.stl'; a point cloud's fields are written to .ply" in err
+    code, _, err = run(capsys, "compute", mesh, "-o", tmp_path / "out.stl")
+    assert code == 1 and "STL files cannot hold per-vertex fields; write a mesh's fields to .ply, .vtk" in err
+    code, _, err = run(capsys, "compute", mesh, "-o", tmp_path / "out")
+    assert code == 1 and "unknown output extension (none); a mesh's fields are written to" in err

@@ -9,16 +9,21 @@ from __future__ import annotations
 import contextlib
 import io
 import logging
+import re
 
 import numpy as np
 
 from ..errors import MeshFileError, MissingDependencyError
+from ._text import first_bad_line, line_of_match, numbers_per_line, row_error
 
 __all__ = ["read_with_meshio", "write_with_meshio"]
 
 logger = logging.getLogger(__name__)
 
 _SURFACE_CELLS = ("triangle", "quad", "polygon")
+#: the numbers of the rows of an ASCII STL that meshio reads as the last three numbers of the line
+_STL_VERTEX = re.compile(rb"^[ \t]*vertex[ \t]+([^\n]*)", re.M)
+_STL_NORMAL = re.compile(rb"^[ \t]*facet[ \t]+normal[ \t]+([^\n]*)", re.M)
 
 
 def _meshio():
@@ -48,7 +53,9 @@ def check_stl(path) -> None:
     """Refuse what is neither a binary STL (its size matches its triangle count) nor starts with ``solid``.
 
     meshio's ASCII STL reader takes the last three numbers of any line, so an
-    OBJ file named .stl would otherwise be read as nonsense.
+    OBJ file named .stl would otherwise be read as nonsense, and a ``vertex``
+    or ``facet normal`` row with a fourth number would shift: each of those
+    rows must hold three numbers (the error names the line).
     """
     with open(path, "rb") as handle:
         head = handle.read(84)
@@ -60,6 +67,19 @@ def check_stl(path) -> None:
             f"{path}: not an STL file (not a binary STL: its size does not match its triangle count; "
             "not an ASCII STL: it does not start with 'solid')"
         )
+    with open(path, "rb") as handle:
+        data = handle.read()
+    for pattern, what in ((_STL_VERTEX, "vertex x y z"), (_STL_NORMAL, "facet normal nx ny nz")):
+        rows = pattern.findall(data)
+        parsed = numbers_per_line(rows)
+        if parsed is None:
+            index, word = first_bad_line(b"\n".join(rows))
+            raise MeshFileError(f"{path}: line {line_of_match(data, pattern, index)}: "
+                                f"{word[:30].decode('utf-8', 'replace')!r} is not a number ({what})")
+        wrong = parsed[1] != 3
+        if wrong.any():  # meshio would take the last three numbers of the line
+            index = int(np.argmax(wrong))
+            raise row_error(path, line_of_match(data, pattern, index), int(parsed[1][index]), 3, what)
 
 
 def read_meshio_file(path, file_format: str):

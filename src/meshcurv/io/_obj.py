@@ -17,7 +17,7 @@ import warnings
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import first_bad_line, line_of, numbers_per_line
+from ._text import first_bad_line, line_of, line_of_match, numbers_per_line
 
 __all__ = ["read_obj", "write_obj"]
 
@@ -48,7 +48,7 @@ def read_obj(path):
     parsed = numbers_per_line(vertex_lines)
     if parsed is None:
         index, word = first_bad_line(b"\n".join(vertex_lines))
-        raise MeshFileError(f"{path}: line {_line_of_match(data, _VERTEX, index)}: a vertex coordinate is not a "
+        raise MeshFileError(f"{path}: line {line_of_match(data, _VERTEX, index)}: a vertex coordinate is not a "
                             f"number ({word[:30].decode('utf-8', 'replace')!r})")
     values, counts = parsed
     if (counts == 3).all():
@@ -56,7 +56,7 @@ def read_obj(path):
     else:  # per line: `v x y z w` and `v x y z r g b` keep x y z; the next lines do not shift
         short = int(np.flatnonzero(counts < 3)[0]) if (counts < 3).any() else None
         if short is not None:
-            raise MeshFileError(f"{path}: line {_line_of_match(data, _VERTEX, short)}: a `v` line has fewer than "
+            raise MeshFileError(f"{path}: line {line_of_match(data, _VERTEX, short)}: a `v` line has fewer than "
                                 f"3 coordinates ({int(counts[short])})")
         first = np.cumsum(counts) - counts
         vertices = values[first[:, None] + np.arange(3)]
@@ -84,7 +84,7 @@ def read_obj(path):
         sizes = np.char.count(np.array([b" ".join(line.split()) for line in lines]), b" ") + 1
     if corners.size != (3 * len(face_lines) if sizes is None else sizes.sum()):  # a word is not an integer
         index = next((i for i, line in enumerate(joined.split(b"\n")) if not _INTEGERS.fullmatch(line)), 0)
-        raise MeshFileError(f"{path}: line {_line_of_match(data, _FACE, index)}: a face index is not an integer")
+        raise MeshFileError(f"{path}: line {line_of_match(data, _FACE, index)}: a face index is not an integer")
     if (corners < 0).any():
         corners = _resolve_relative(data, corners, sizes)
     if (corners == 0).any():
@@ -104,15 +104,10 @@ def read_obj(path):
     return vertices, np.split(corners, np.cumsum(sizes)[:-1])
 
 
-def _line_of_match(data: bytes, pattern: re.Pattern, index: int) -> int:
-    """The line number of the ``index``-th match of ``pattern`` in ``data`` (for error messages)."""
-    return next(line_of(data, m.start()) for i, m in enumerate(pattern.finditer(data)) if i == index)
-
-
 def _line_of_corner(data: bytes, sizes, corner: int) -> int:
     """The line number of the face holding the ``corner``-th corner (``sizes`` None: all triangles)."""
     face = corner // 3 if sizes is None else int(np.searchsorted(np.cumsum(sizes), corner, side="right"))
-    return _line_of_match(data, _FACE, face)
+    return line_of_match(data, _FACE, face)
 
 
 def _resolve_relative(data: bytes, corners: np.ndarray, sizes) -> np.ndarray:

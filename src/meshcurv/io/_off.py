@@ -43,21 +43,11 @@ def read_off(path):
         raise MeshFileError(f"{path}: the OFF counts, vertices or faces cannot be read ({exc})") from None
     if n_vertices < 0 or n_faces < 0:
         raise MeshFileError(f"{path}: the OFF counts must not be negative; got {n_vertices} and {n_faces}")
-    if n_vertices > len(body):
-        raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; the file has {min(len(body), n_vertices)}")
-    if n_vertices + n_faces > len(body):
-        raise MeshFileError(
-            f"{path}: the header declares {n_vertices} vertices and {n_faces} faces but the file holds only "
-            f"{len(body)} lines for them; face {len(body) - n_vertices} is missing (the file is cut short)"
-        )
     start = len(lines) - len(body)  # body[j] is the (start + j)-th non-blank line
 
     def line(j: int) -> int:  # the file's line number of body[j], for messages
         return _line_number(data, start + j)
 
-    if len(body) > n_vertices + n_faces:
-        raise MeshFileError(f"{path}: line {line(n_vertices + n_faces)}: a row after the {n_vertices} vertices and "
-                            f"{n_faces} faces the header declares")
     parsed = numbers_per_line(body[:n_vertices])
     if parsed is None:
         index, word = first_bad_line(b"\n".join(body[:n_vertices]))
@@ -67,6 +57,13 @@ def read_off(path):
     if (counts < 3).any():
         bad = int(np.flatnonzero(counts < 3)[0])
         raise row_error(path, line(bad), int(counts[bad]), "3 or more", "x, y, z, then maybe a colour")
+    usual = int(np.bincount(counts).argmax()) if counts.size else 3
+    if (counts != usual).any():  # a colour on every vertex or on none: one row apart has a value too many or few
+        bad = int(np.argmax(counts != usual))
+        raise row_error(path, line(bad), int(counts[bad]), usual, "as most vertex rows: x, y, z"
+                        + (", then a colour" if usual > 3 else ""))
+    if n_vertices > len(body):  # the rows there are were checked first: a damaged row is named
+        raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; the file has {len(body)}")
     vertices = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
     parsed = numbers_per_line(body[n_vertices:n_vertices + n_faces])
     if parsed is None:
@@ -86,6 +83,15 @@ def read_off(path):
         face = int(np.flatnonzero(bad)[0])
         raise row_error(path, line(n_vertices + face), int(counts[face]), f"{int(sizes[face]) + 1} or more",
                         f"a count of {int(sizes[face])} and as many vertex indices, then maybe a colour")
+    if n_vertices + n_faces > len(body):
+        raise MeshFileError(
+            f"{path}: the header declares {n_vertices} vertices and {n_faces} faces but the file holds only "
+            f"{len(body)} lines for them, up to line {_line_number(data, len(lines) - 1)}; face "
+            f"{len(body) - n_vertices} is missing (the file is cut short, or two rows were written as one)"
+        )
+    if len(body) > n_vertices + n_faces:
+        raise MeshFileError(f"{path}: line {line(n_vertices + n_faces)}: a row after the {n_vertices} vertices and "
+                            f"{n_faces} faces the header declares")
     sizes = sizes.astype(np.int64)
     corners = values[np.repeat(first + 1 - (np.cumsum(sizes) - sizes), sizes) + np.arange(sizes.sum())]
     bad = (corners != np.floor(corners)) | ~(np.abs(corners) <= 2.0 ** 53)
@@ -94,6 +100,11 @@ def read_off(path):
         raise MeshFileError(f"{path}: line {line(n_vertices + face)}: a face index is not an integer "
                             f"({float(corners[bad][0])!r})")
     corners = corners.astype(np.int64)
+    bad = (corners < 0) | (corners >= n_vertices)
+    if bad.any():
+        face = int(np.searchsorted(np.cumsum(sizes), np.argmax(bad), side="right"))
+        raise MeshFileError(f"{path}: line {line(n_vertices + face)}: a face uses vertex {int(corners[bad][0])}; "
+                            f"the file has {n_vertices} vertices, numbered from 0")
     if sizes.size and (sizes == sizes[0]).all():
         return vertices, corners.reshape(sizes.size, int(sizes[0]))
     return vertices, np.split(corners, np.cumsum(sizes)[:-1])

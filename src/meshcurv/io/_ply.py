@@ -302,26 +302,47 @@ def _read_ascii(data, offset, elements, vertex, face, corners, path):
     row, vertices, faces = 0, None, None
     for element in elements:
         available = counts.size - row
-        if element.count > available:
-            raise _too_short(path, element, element.count, available, unit="lines")
-        rows = slice(row, row + element.count)
+        rows = slice(row, row + min(element.count, available))  # the rows there are are checked first
         row += element.count
-        if all(p.count_kind is None for p in element.properties):
+        if element.count > available:
+            try:
+                _ascii_element(values, counts[rows], first_value[rows], lines[rows], element, None, path)
+            except MeshFileError as exc:
+                raise MeshFileError(f"{exc} (and the file ends before the {element.count} {element.plural} the "
+                                    "header declares)") from None
+            end = f" after line {int(lines[-1])}" if lines.size else ""
+            raise MeshFileError(f"{path}: the PLY header declares {element.count} {element.plural} but the file "
+                                f"ends{end}, {available} rows later; the file is cut short or its header is wrong")
+        found = _ascii_element(values, counts[rows], first_value[rows], lines[rows], element,
+                               corners if element is face else None, path)
+        if element is vertex:
             names = [p.name for p in element.properties]
-            table = fixed_rows(values, counts[rows], first_value[rows], lines[rows], len(names), path,
-                               f"{element.name}: {names_shown(names)}")
-            if element is vertex:
-                vertices = table[:, [names.index(axis) for axis in "xyz"]]
-            continue
-        lists = _ascii_lists(values, counts[rows], first_value[rows], lines[rows], element,
-                             corners if element is face else None, path)
-        if element is face:
-            faces = lists
+            vertices = found[:, [names.index(axis) for axis in "xyz"]]
+        elif element is face:
+            faces = found
+    if vertices is not None and faces is not None and len(faces):
+        flat = faces if isinstance(faces, np.ndarray) else np.concatenate(faces)
+        bad = (flat < 0) | (flat >= len(vertices))
+        if bad.any():
+            sizes = np.full(len(faces), faces.shape[1]) if isinstance(faces, np.ndarray) else np.array(
+                [len(f) for f in faces])
+            index = int(np.searchsorted(np.cumsum(sizes), np.argmax(bad.ravel()), side="right"))
+            line = int(lines[sum(e.count for e in elements[:elements.index(face)]) + index])
+            raise MeshFileError(f"{path}: line {line}: a face uses vertex {int(flat.ravel()[bad.ravel()][0])}; the "
+                                f"file has {len(vertices)} vertices, numbered from 0")
     if row < counts.size:
         declared = ", ".join(f"{element.count} {element.plural}" for element in elements)
         raise MeshFileError(f"{path}: line {int(lines[row])}: a row after the last element (the header "
                             f"declares {declared})")
     return vertices, faces
+
+
+def _ascii_element(values, counts, first_value, lines, element, keep, path):
+    """The rows of one element: a table of scalars, or the kept list of a list element (None when not kept)."""
+    if all(p.count_kind is None for p in element.properties):
+        names = [p.name for p in element.properties]
+        return fixed_rows(values, counts, first_value, lines, len(names), path, f"{element.name}: {names_shown(names)}")
+    return _ascii_lists(values, counts, first_value, lines, element, keep, path)
 
 
 def _ascii_lists(values, counts, first_value, lines, element, keep, path):

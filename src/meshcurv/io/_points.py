@@ -175,15 +175,15 @@ def ply_vertex_columns(path) -> dict[str, np.ndarray]:
                 len(data) - offset + 1:
             raise _short(path, vertex.count, "vertices", len(data) - offset)
         values, counts, first_value, lines = body_rows(data, offset, path, n_rows=skip + vertex.count)
-        if counts.size < skip + vertex.count:
-            raise _short(path, vertex.count, "vertices", len(data) - offset)
         row = 0
-        for element in [*before, vertex]:
+        for element in [*before, vertex]:  # the rows there are are checked before a missing one is reported
             rows = slice(row, row + element.count)
             row += element.count
             names = [p.name for p in element.properties]
             table = fixed_rows(values, counts[rows], first_value[rows], lines[rows], len(names), path,
                                f"{element.name}: {names_shown(names)}")
+        if counts.size < skip + vertex.count:
+            raise _short(path, vertex.count, "vertices", len(data) - offset)
         return {p.name: table[:, i] for i, p in enumerate(vertex.properties)}
     order = _ORDERS[file_format]
     position = offset
@@ -263,9 +263,10 @@ def text_columns(path) -> dict[str, np.ndarray]:
     if names is not None:
         width = len(names)
     else:
-        frequency = np.bincount(found[keep])
-        width = int(found[keep][0])  # as the first row, unless more rows hold another count
-        width = width if frequency[width] == frequency.max() else int(frequency.argmax())
+        # as most rows of 3 values or more (a point needs 3); on a tie, as the first of them
+        candidates = found[keep][found[keep] >= 3] if (found[keep] >= 3).any() else found[keep]
+        frequency = np.bincount(candidates)
+        width = int(candidates[0]) if frequency[candidates[0]] == frequency.max() else int(frequency.argmax())
         if width < 3:
             most = "" if (found[keep] == width).all() else " (most rows)"
             raise MeshFileError(f"{path}: rows of {width} numbers{most}; a point needs x, y and z")
@@ -331,7 +332,7 @@ def _counted_blocks(path, values, found, first_value, lines) -> np.ndarray:
     follow = np.diff(np.append(heads, found.size)) - 1
     whole = (declared >= 0) & (declared == np.floor(declared))
     if not whole[0]:
-        raise MeshFileError(f"{path}: line {lines[0]}: 1 value ({declared[0]!r}), expected a count of points "
+        raise MeshFileError(f"{path}: line {lines[0]}: 1 value ({float(declared[0])!r}), expected a count of points "
                             "or x, y, z")
     bad = whole & (declared != follow)
     if bad.any():
@@ -385,12 +386,12 @@ def _read_pcd(path):
         if n * width * 2 > len(body) + 1:
             raise _short(path, n, "points", len(body))
         values, found, first_value, lines = body_rows(data, position, path)  # one point per line
+        table = fixed_rows(values, found[:n], first_value[:n], lines[:n], width, path, names_shown(
+            f"{f}[{c}]" if c > 1 else f for f, c in zip(fields, counts)))
         if found.size < n:
             raise _short(path, n, "points", len(body))
         if found.size > n:
             raise MeshFileError(f"{path}: line {int(lines[n])}: a row after the {n} points the header declares")
-        table = fixed_rows(values, found, first_value, lines, width, path, names_shown(
-            f"{f}[{c}]" if c > 1 else f for f, c in zip(fields, counts)))
         starts = np.cumsum([0] + counts[:-1])
         columns = {f: table[:, s] for f, s in zip(fields, starts)}
     elif kind == "binary":

@@ -15,7 +15,8 @@ import numpy as np
 
 from ..errors import MeshFileError
 
-__all__ = ["numbers", "numbers_per_line", "numbers_by_line", "first_bad_line", "line_of", "not_a_number",
+__all__ = ["numbers", "numbers_per_line", "numbers_by_line", "first_bad_line", "line_of", "line_of_match",
+           "not_a_number",
            "row_error", "names_shown", "body_rows", "fixed_rows"]
 
 _NEWLINE = 10
@@ -92,6 +93,11 @@ def first_bad_line(text: bytes) -> tuple[int, bytes]:
 def line_of(data: bytes, position: int) -> int:
     """The 1-based number of the line of ``data`` holding byte ``position``."""
     return data.count(b"\n", 0, position) + 1
+
+
+def line_of_match(data: bytes, pattern, index: int) -> int:
+    """The line number of the ``index``-th match of the regular expression ``pattern`` in ``data`` (for messages)."""
+    return next(line_of(data, m.start()) for i, m in enumerate(pattern.finditer(data)) if i == index)
 
 
 def not_a_number(path, text: bytes, first_line: int, what: str = "") -> MeshFileError:
