@@ -220,7 +220,8 @@ def select_stable(data, rule):
 
     ``D_j = sum_q |q_{j+1} - q_j|`` over the compared quantities, averaged over
     the ``rings``-ring of each vertex (``rule["rings"]``, 0: none) and over the
-    whole mesh with weight ``rule["pool"]`` (0: per vertex only); among the rungs
+    whole mesh (or, with ``rule["pool_by"] = "class"``, over the vertices whose local edge
+    length is in the same power of two) with weight ``rule["pool"]`` (0: per vertex only); among the rungs
     of at least ``min_edges`` local edge lengths, the lower end ``j`` of the pair
     with the smallest ``D_j`` (``rule["take"]`` = 1: the upper end ``j + 1``).
     """
@@ -232,7 +233,14 @@ def select_stable(data, rule):
         ring = ring_matrix(data["indptr"], data["indices"])
         change = np.stack([ring_mean(ring, row, rings) for row in change])
     pool = rule.get("pool", 0.0)
-    if pool:
+    if pool and rule.get("pool_by") == "class":  # the median over the vertices of the same resolution class
+        classes = np.round(np.log2(h / np.median(h))).astype(np.int64)
+        pooled = np.empty_like(change)
+        for k in np.unique(classes):
+            members = classes == k
+            pooled[:, members] = np.nanmedian(change[:, members], axis=1, keepdims=True)
+        change = (1 - pool) * change + pool * pooled
+    elif pool:
         change = (1 - pool) * change + pool * np.nanmedian(change, axis=1, keepdims=True)
     usable = radii[:-1, None] >= rule["min_edges"] * h[None, :]
     if rule["cap"] > 0:
