@@ -56,7 +56,7 @@ import numpy as np
 import meshcurv
 from meshcurv import shapes
 from meshcurv.estimators import DEFAULT_METHOD, ESTIMATORS
-from meshcurv.neighborhoods import default_radius
+from meshcurv.radius import edge_radius
 
 OUTPUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy.md")
 VOXEL_OUTPUT = os.path.join(os.path.dirname(OUTPUT), "accuracy_voxel.md")
@@ -258,7 +258,7 @@ def run(levels, families=None, methods=None):
     for surface, variant, level, mesh in surfaces(levels, families):
         topology = meshcurv.MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0])
         boundary = topology.boundary_vertices
-        radius = default_radius(mesh.vertices, topology)
+        radius = edge_radius(mesh.vertices, topology)
         results = {}
         for label in methods:
             t0 = time.perf_counter()
@@ -394,7 +394,7 @@ def run_voxel(methods=None):
     rows = []
     for mesh, held_out in voxel_meshes():
         topology = meshcurv.MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0])
-        radius = default_radius(mesh.vertices, topology)
+        radius = edge_radius(mesh.vertices, topology)
         for winding in WINDINGS:
             faces = mesh.faces if winding == "as returned" else np.ascontiguousarray(mesh.faces[:, ::-1])
             results = {}

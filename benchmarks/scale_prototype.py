@@ -12,7 +12,7 @@ at a ladder of global radii ``r_j = h q^j`` (``h`` the median edge length,
 ``r_j`` is what a per-vertex radius ``r_j`` would give, up to the normals (fitted
 over ``3 r_j`` for every vertex of the ball in the global run). A per-vertex
 noise estimate (:func:`vertex_noise`: the distance of each vertex to a degree-2
-jet fitted around it, as :func:`meshcurv.estimators.icc.noise_level` measures it,
+jet fitted around it, as :func:`meshcurv.radius.noise_level` measures it,
 averaged over a 2-ring) sets the standard deviation of the estimates at each
 rung (:func:`sigma_model`) and the selection rule (:func:`select`, an
 intersection-of-confidence-intervals / Lepski rule) picks the rung.
@@ -46,6 +46,7 @@ import scale_families  # noqa: E402
 from meshcurv.estimators._support import prepare  # noqa: E402
 from meshcurv.geometry import median_edge_length, vertex_edge_lengths  # noqa: E402
 from meshcurv.jets import fit_jets  # noqa: E402
+from meshcurv.measures import curvatures_from_measures, face_measures  # noqa: E402
 
 CACHE = "/tmp/meshcurv_scale_cache"
 
@@ -55,7 +56,7 @@ LADDER_RATIO = float(np.sqrt(2.0))
 LADDER_LOW = 0.7
 LADDER_HIGH = 32.0
 
-#: The noise fits: degree-2 jets over balls of this many local edge lengths (as icc.NOISE_FIT_RADIUS).
+#: The noise fits: degree-2 jets over balls of this many local edge lengths (as radius_rules.NOISE_FIT_RADIUS).
 NOISE_FIT_EDGES = 2.0
 
 
@@ -113,7 +114,7 @@ def vertex_noise(vertices, topology, local, *, fit_edges=NOISE_FIT_EDGES):
     """(V,) distance of each vertex to a degree-2 jet fitted over ``fit_edges`` local edge lengths.
 
     The vertices are grouped by powers of two of their local edge length, as in
-    :func:`meshcurv.estimators.icc.noise_level`; the distance is absolute (length units).
+    :func:`meshcurv.radius.noise_level`; the distance is absolute (length units).
     """
     _, _, _, normals, valid = prepare(vertices, topology)
     centres = np.flatnonzero(valid & (local > 0))
@@ -492,9 +493,9 @@ def normal_study(ratios=(1.0, 1.5, 2.0, 3.0)):
             t0 = time.perf_counter()
             fitted = icc.fitted_normals(v, normals, valid, ratio * radius, neighbours=topology.referenced_vertices,
                                         adjacency=adjacency)
-            measures = icc.face_measures(v, f, fitted)
-            summed = meshcurv.neighborhoods.ball_face_sums(v, f, radius, measures, connected=True)
-            k_min, k_max, _, _ = icc.curvatures_from_measures(summed, fitted)
+            per_face = face_measures(v, f, fitted)
+            summed = meshcurv.neighborhoods.ball_face_sums(v, f, radius, per_face, connected=True)
+            k_min, k_max, _, _ = curvatures_from_measures(summed, fitted)
             seconds = time.perf_counter() - t0
             e = errors({"k_min": case.k_min, "k_max": case.k_max},
                        np.stack([k_min, k_max, (k_min + k_max) / 2, k_min * k_max]))

@@ -15,7 +15,9 @@ import meshcurv
 from meshcurv import shapes
 from meshcurv.errors import InvalidOptionError, MeshQualityWarning
 from meshcurv.estimators import ESTIMATORS, icc
-from meshcurv.neighborhoods import DEFAULT_RADIUS_FACTOR, face_in_ball_ratios, segment_in_ball_lengths
+from meshcurv import radius as radius_rules
+from meshcurv.neighborhoods import face_in_ball_ratios, segment_in_ball_lengths
+from meshcurv.radius import DEFAULT_RADIUS_FACTOR
 
 from conftest import relative_error
 
@@ -176,10 +178,10 @@ def test_icc_noise_level_follows_the_noise(amplitude):
     sphere = shapes.icosphere(16)
     noisy = shapes.with_normal_noise(sphere, amplitude, seed=3)
     clean, rough = curvatures(sphere, "icc"), curvatures(noisy, "icc")
-    assert clean.parameters["noise"] < icc.NOISE_FLOOR
+    assert clean.parameters["noise"] < radius_rules.NOISE_FLOOR
     assert 0.15 * amplitude < rough.parameters["noise"] < 0.35 * amplitude
     h = meshcurv.geometry.mean_edge_length(noisy.vertices, meshcurv.MeshTopology.from_faces(noisy.faces).edges)
-    expected = h * (1 + icc.NOISE_GAIN * np.sqrt(rough.parameters["noise"] - icc.NOISE_FLOOR))
+    expected = h * (1 + radius_rules.NOISE_GAIN * np.sqrt(rough.parameters["noise"] - radius_rules.NOISE_FLOOR))
     assert rough.parameters["radius"] == pytest.approx(expected)
     assert rough.parameters["normal_radius"] == pytest.approx(icc.NORMAL_RADIUS_RATIO * expected)
 
@@ -206,7 +208,7 @@ def test_icc_noise_level_is_measured_at_the_local_resolution():
     # two components of scales 1000x apart: each is measured and summed at its own edge length
     edge_lengths = [meshcurv.geometry.mean_edge_length(mesh.vertices, meshcurv.MeshTopology.from_faces(mesh.faces).edges)
                     for mesh in (small, big)]
-    assert max(r.parameters["noise"]) < icc.NOISE_FLOOR
+    assert max(r.parameters["noise"]) < radius_rules.NOISE_FLOOR
     np.testing.assert_allclose(r.parameters["radius"], edge_lengths, rtol=1e-12)
     n = small.vertices.shape[0]
     assert np.median(relative_error(r.mean[:n], 20.0)) < 0.01
@@ -218,7 +220,7 @@ def test_icc_noise_level_on_a_sample(monkeypatch):
     # the level stays close to that of all vertices, and a run gives the same level again
     noisy = shapes.with_normal_noise(shapes.icosphere(16), 0.1, seed=6)
     full = curvatures(noisy, "icc").parameters["noise"]
-    monkeypatch.setattr(icc, "NOISE_SAMPLE", 500)
+    monkeypatch.setattr(radius_rules, "NOISE_SAMPLE", 500)
     sampled = curvatures(noisy, "icc").parameters["noise"]
     assert sampled != full
     assert sampled == pytest.approx(full, rel=0.1)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
 from ._tensors import principal_from_shape_operator
-from .estimators.icc import curvatures_from_measures, face_measures
+from .measures import curvatures_from_measures, face_measures
 from .jets import fit_jets, jet_normals, shape_operators
 
 #: Degree of the jets of ``method="jets"`` (Cazals and Pouget 2005: error of order ``r^(d-1)``).
@@ -238,7 +238,7 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
     For every centre, ``n_triangles`` triangles with corners drawn at random
     among the (at most :data:`MAX_BALL_POINTS` nearest) usable points of its
     ball, each turned so that its corrected area is positive; the
-    interpolated corrected measures of :func:`meshcurv.estimators.icc.face_measures`
+    interpolated corrected measures of :func:`meshcurv.measures.face_measures`
     of these triangles with the point normals, summed: ``H = mu_1 / (2 mu_0)``,
     ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``, the directions
     those of ``-sym(mu^{X,Y}) / mu_0`` in the tangent plane of the centre's

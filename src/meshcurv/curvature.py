@@ -15,10 +15,10 @@ from .diagnosis import diagnose, quality_message
 from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._common import ProgressCallback, Stages
-from .estimators.icc import voxel_surface_radius
+from .estimators.icc import voxel_pilot
 from .geometry import degenerate_faces
-from .neighborhoods import small_radius_note
 from .orient import ORIENT_CHOICES, oriented_topology
+from .radius import small_radius_note, voxel_surface_radius
 from .result import INVALID_REASONS, CurvatureResult, Surface
 from .topology import MeshTopology
 from .weld import drop_double_sided, weld_vertices
@@ -93,9 +93,9 @@ def principal_curvatures(
         ``vertices`` (the same meaning for all three; ``'icc'`` fits its normals
         over three times this radius). Default: for ``'icc'``, one mean edge
         length on a clean mesh, growing with the noise measured on the mesh
-        (:func:`meshcurv.estimators.icc.default_radius`; the value used and the
+        (:func:`meshcurv.radius.noise_radius`; the value used and the
         noise level are in ``result.parameters``); for the others 2.5 mean edge
-        lengths (:func:`meshcurv.neighborhoods.default_radius`). Pass the same
+        lengths (:func:`meshcurv.radius.edge_radius`). Pass the same
         value for meshes of one object at different resolutions to get the
         same estimate. Refused by the other methods.
     orient : {'auto', 'outward', 'consistent', 'keep'}, default: 'auto'
@@ -216,7 +216,7 @@ def principal_curvatures(
     with trusting(points, topology.faces, topology.edges):  # checked: the helpers below need not check again
         found: dict = {}
         if "radius" in options and options["radius"] is None:
-            voxel = voxel_surface_radius(points, topology)  # a voxel surface: one default for every ball method
+            voxel = voxel_surface_radius(points, topology, voxel_pilot(points, topology))  # a voxel surface: one default for every ball method
             if voxel is not None:
                 options["radius"], found = voxel
         result, problems = estimator.function(

@@ -13,7 +13,7 @@ face (Lachaud, Romon, Thibert and Coeurjolly 2020), which add up over faces:
 - ``"mean"``, the total mean curvature ``int H dA`` with ``H = (k_min + k_max) / 2``:
   half the corrected measure ``mu_1`` of each face,
   ``mu_1 = 1/2 <ū | (u_k - u_j) x x_i + (u_i - u_k) x x_j + (u_j - u_i) x x_k>``
-  (:func:`meshcurv.estimators.icc.face_measures`);
+  (:func:`meshcurv.measures.face_measures`);
 - ``"gaussian"``, the total Gaussian curvature ``int K dA``: the signed area
   of the spherical triangle ``(u_i, u_j, u_k)`` of each face, the image of the
   face under the normals (Van Oosterom and Strackee 1983,
@@ -58,6 +58,7 @@ import numpy as np
 from ._validation import check_choice, checked_mesh
 from .errors import InvalidMeshError
 from .geometry import face_areas, vertex_normals
+from .measures import face_measures
 
 __all__ = ["INTEGRALS", "vertex_integrals", "face_solid_angles", "weighted_percentiles", "weighted_statistics"]
 
@@ -84,7 +85,6 @@ def _face_mean_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.nda
 
     The compiled kernel of icc's face measures when numba is there (0.4 s for 2M faces against 3 s).
     """
-    from .estimators.icc import face_measures
 
     measures = face_measures(vertices, faces, normals)[:, 1] / 2
     return np.where(np.isfinite(measures), measures, 0.0)

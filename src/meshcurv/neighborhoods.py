@@ -2,15 +2,10 @@
 
 Every estimator that takes ``radius=`` uses it through this module, so the
 option has one meaning: the closed Euclidean ball ``B(x_v, radius)`` around
-each vertex position, in the units of the coordinates. The default radius is
-:data:`DEFAULT_RADIUS_FACTOR` times the mean edge length of the mesh, leaving
-out outlier edges (:func:`meshcurv.geometry.robust_mean_edge_length`: one spike
-vertex does not blow it up); on a mesh whose components differ in scale, each
-component of its own scale gets its own default (:func:`default_radii`).
+each vertex position, in the units of the coordinates. The rules that choose
+it, and the checks of a given one, are in :mod:`meshcurv.radius`.
 
-Bounds: a radius given beyond the extent of the mesh (the diagonal of the
-bounding box of its referenced vertices) is refused (:func:`check_radius`: a
-unit mistake, every ball would hold every vertex). Before any ball search, the
+Bounds: before any ball search, the
 number of (centre, point) pairs is estimated from a sample
 (:func:`estimate_ball_pairs`); beyond :data:`MAX_BALL_PAIRS` the radius is
 refused, and the work is split so that memory stays bounded (NumPy path:
@@ -51,16 +46,9 @@ import numpy as np
 from ._backend import kernel_threads, numba_kernels
 from ._validation import check_positive_float, checked_indices, checked_points
 from .errors import InvalidMeshError, InvalidOptionError
-from .geometry import median_edge_length, robust_mean_edge_length, vertex_length_scales
-from .topology import MeshTopology
 
 __all__ = [
-    "DEFAULT_RADIUS_FACTOR",
     "MAX_BALL_PAIRS",
-    "default_radius",
-    "default_radii",
-    "resolve_radius",
-    "check_radius",
     "estimate_ball_pairs",
     "check_ball_work",
     "vertex_pairs_in_ball",
@@ -69,9 +57,6 @@ __all__ = [
     "face_in_ball_ratios",
     "segment_in_ball_lengths",
 ]
-
-#: The default ``radius`` is this many mean edge lengths.
-DEFAULT_RADIUS_FACTOR = 2.5
 
 #: Centres per chunk of a ball query (bounds the memory of the pair lists).
 CHUNK = 32768
@@ -95,117 +80,6 @@ SAMPLE_POINTS = 8192
 #: Cells of different sizes share one search while its radius (radius + largest reach) grows
 #: by at most this factor over that of their smallest size class.
 GROUP_GROWTH = 1.5
-
-
-def default_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
-    """``DEFAULT_RADIUS_FACTOR`` times the robust mean edge length (0 for a mesh without edges).
-
-    :func:`meshcurv.geometry.robust_mean_edge_length`: the mean edge length
-    without edges beyond 1000 median edge lengths (equal to the mean on any
-    ordinary mesh; one spike vertex at 1e10 does not multiply it).
-    """
-    vertices = checked_points(vertices)
-    return DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, topology.edges)
-
-
-def default_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[float, np.ndarray | None]]:
-    """The default radius of each group of components of one scale: ``[(radius, vertices), ...]``.
-
-    ``vertices`` is None when the whole mesh is one group (every component within
-    a factor :data:`meshcurv.geometry.COMPONENT_SCALE_SPREAD` of the median edge
-    length: the usual case, one radius, :func:`default_radius`). Otherwise the
-    components are grouped by the power of two of their median edge length
-    (:func:`meshcurv.geometry.vertex_length_scales`) and each group gets
-    ``DEFAULT_RADIUS_FACTOR`` times the robust mean edge length of its own edges,
-    with the int64 ids of its vertices: a part at 1e-3 and one at 1e3 are each
-    fitted at their own scale.
-    """
-    vertices = checked_points(vertices)
-    scales = vertex_length_scales(vertices, topology)
-    referenced = topology.referenced_vertices
-    used = scales[referenced & (scales > 0)]
-    if used.size == 0 or used.min() == used.max():
-        return [(default_radius(vertices, topology), None)]
-    level = np.full(scales.shape, np.iinfo(np.int64).min)
-    positive = referenced & (scales > 0)
-    level[positive] = np.round(np.log2(scales[positive])).astype(np.int64)
-    groups: list[tuple[float, np.ndarray | None]] = []
-    for k in np.unique(level[positive]):
-        members = np.flatnonzero(level == k)
-        inside = np.zeros(scales.shape, dtype=bool)
-        inside[members] = True
-        edges = topology.edges[inside[topology.edges[:, 0]]]
-        groups.append((DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, edges), members))
-    return groups
-
-
-#: The smallest radius taken, in median edge lengths: a ball far inside one
-#: face measures nothing (a unit mistake: m for mm), and below about 1e-8 of
-#: the coordinates the ball's geometry is rounding noise.
-MIN_RADIUS_EDGES = 1e-3
-
-
-def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
-    """``radius`` checked: a positive finite number between a sliver of an edge and the mesh's extent.
-
-    Raises
-    ------
-    InvalidOptionError
-        ``radius`` is not a positive finite real number (strings are refused),
-        it is below :data:`MIN_RADIUS_EDGES` median edge lengths, or it exceeds the diagonal of the bounding box of the referenced
-        vertices: every ball would hold the whole mesh (a unit mistake: mm for m).
-    """
-    radius = check_positive_float(radius, "radius")
-    vertices = checked_points(vertices)
-    used = vertices[topology.referenced_vertices] if topology.n_faces else vertices
-    if used.shape[0] == 0:
-        return radius
-    diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
-    if topology.n_faces and radius < MIN_RADIUS_EDGES * diagonal:
-        median = median_edge_length(vertices, topology.edges)
-        if radius < MIN_RADIUS_EDGES * median:
-            raise InvalidOptionError(
-                f"`radius` {radius:g} is below {MIN_RADIUS_EDGES:g} of the median edge length {median:g}: "
-                f"every ball would hold its centre only and give no curvature; pass a radius of a few edge "
-                f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
-            )
-    if radius > diagonal:
-        median = median_edge_length(vertices, topology.edges)
-        raise InvalidOptionError(
-            f"`radius` {radius:g} is larger than the mesh itself (bounding-box diagonal {diagonal:g}, median "
-            f"edge length {median:g}): every ball would hold the whole mesh; pass a radius of a few edge "
-            f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
-        )
-    return radius
-
-
-def small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopology, minimum_edges: float) -> str:
-    """The warning's sentence for a given ``radius`` below ``minimum_edges`` median edge lengths, else ''.
-
-    Each ball method states its own minimum (``RADIUS_WARNING_EDGES`` of its
-    module), measured where its balls start holding too little of the surface.
-    """
-    if not topology.n_faces:
-        return ""
-    median = median_edge_length(vertices, topology.edges)
-    if not radius < minimum_edges * median:
-        return ""
-    return (f"`radius` {radius:g} is {radius / median:.2g} of the median edge length {median:g}: below "
-            f"{minimum_edges:g} edge lengths the balls hold too little of the surface and many curvatures are far "
-            f"off; pass a radius of a few edge lengths, in the units of the vertices (or leave the default)")
-
-
-def resolve_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
-    """The radius to use: ``radius`` checked (:func:`check_radius`), or the mesh's default when None.
-
-    Raises
-    ------
-    InvalidOptionError
-        ``radius`` is not a positive finite number, or larger than the mesh.
-    """
-    if radius is None:
-        return default_radius(vertices, topology)
-    return check_radius(radius, vertices, topology)
 
 
 def _sample(n: int, size: int) -> np.ndarray:

@@ -43,7 +43,7 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    - ``"corrected_measures"`` (default): randomized corrected curvature
      measures (Lachaud, Coeurjolly, Labart, Romon, Thibert 2023): 32 random
      triangles among the points of the ball, their interpolated corrected
-     measures with the point normals (:func:`meshcurv.estimators.icc.face_measures`)
+     measures with the point normals (:func:`meshcurv.measures.face_measures`)
      summed, ``H = mu_1 / 2 mu_0``, ``K = mu_2 / mu_0``; the normals, when
      not given, are those of degree-3 jets (one fit, in the frame of the PCA
      normal) over ``s (4 + 55 sqrt(max(nu - 0.005, 0)))``, or over the largest smaller ball (down to ``4 s``, steps

@@ -169,7 +169,7 @@ from ._validation import check_int_option, check_positive_float
 from .curvature import principal_curvatures
 from .errors import (InvalidMeshError, InvalidOptionError, MeshcurvWarning, MeshQualityWarning,
                      MissingDependencyError)
-from .estimators.icc import face_measures
+from .measures import face_measures
 from .integrals import vertex_integrals, weighted_percentiles
 from .result import CurvatureResult
 

@@ -3,7 +3,7 @@
 ``_kernels.geometry`` holds the compiled twins of :mod:`meshcurv.geometry`,
 ``_kernels.jets`` those of :mod:`meshcurv.jets`, and so on; a kernel has the
 name of the NumPy function it mirrors (``face_measures`` in ``_kernels.icc``
-for :func:`meshcurv.estimators.icc.face_measures`), computes exactly what it
+for :func:`meshcurv.measures.face_measures`), computes exactly what it
 computes, in one pass over the elements and without (N, 3, 3) temporaries,
 and is tested against it directly (``tests/test_kernel_twins.py``). The rules
 every kernel shares (degenerate faces, the cancellation of a normal sum, the

@@ -17,7 +17,7 @@ from .tensors import _principal_from_mean_gaussian, _tangent_eigen
 def _triangle_measures(points, normals, i, j, k, turn):
     """``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` (xx, yy, zz, xy, xz, yz) of the triangle ``(i, j, k)``.
 
-    The closed forms of :func:`meshcurv.estimators.icc.face_measures`, relative
+    The closed forms of :func:`meshcurv.measures.face_measures`, relative
     to the first corner. With ``turn``, a triangle whose corrected area is
     negative is taken as ``(i, k, j)`` (the random triangles of a point cloud's
     ball have no orientation of their own).
@@ -53,7 +53,7 @@ def _triangle_measures(points, normals, i, j, k, turn):
 
 @nb.njit(parallel=True, **_JIT)
 def face_measures(vertices, faces, normals):
-    """``icc.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
+    """``measures.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
     out = np.empty((faces.shape[0], 9))
     for f in nb.prange(faces.shape[0]):
         m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(vertices, normals, faces[f, 0], faces[f, 1],
@@ -65,7 +65,7 @@ def face_measures(vertices, faces, normals):
 
 @nb.njit(parallel=True, **_JIT)
 def curvatures_from_measures(summed, normals):
-    """``icc.curvatures_from_measures``: (N,) k_min, k_max and (N, 3) dir_min, dir_max of summed measures."""
+    """``measures.curvatures_from_measures``: (N,) k_min, k_max and (N, 3) dir_min, dir_max of summed measures."""
     n = summed.shape[0]
     k_min = np.full(n, np.nan)
     k_max = np.full(n, np.nan)

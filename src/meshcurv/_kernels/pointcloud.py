@@ -3,7 +3,7 @@
 :func:`ball_triangle_sums` does in one pass per centre what
 :func:`meshcurv._pointcloud_estimators.corrected_measures` does with arrays:
 draw the triangles, turn them, compute the measures of
-:func:`meshcurv.estimators.icc.face_measures` and sum them (tests compare the two).
+:func:`meshcurv.measures.face_measures` and sum them (tests compare the two).
 """
 
 from __future__ import annotations

@@ -26,14 +26,14 @@ class Estimator:
         ``function(vertices, topology, *, stages, **options) -> (CurvatureResult, problems)``.
     options : dict
         The options it takes, with their defaults (``radius=None``: the mesh's
-        default, :func:`meshcurv.neighborhoods.default_radius`).
+        default, :func:`meshcurv.radius.edge_radius`).
     summary : str
         One line for ``meshcurv methods``.
     stages : tuple of str
         The stages it reports, in order.
     radius_warning_edges : float or None
         A ``radius`` given below this many median edge lengths is named in the
-        call's warning (:func:`meshcurv.neighborhoods.small_radius_note`); None
+        call's warning (:func:`meshcurv.radius.small_radius_note`); None
         for the methods without a radius.
     """
 

@@ -39,7 +39,8 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from ..geometry import edge_dihedral_angles
-from ..neighborhoods import ball_edge_sums, ball_face_sums, default_radii, resolve_radius
+from ..neighborhoods import ball_edge_sums, ball_face_sums
+from ..radius import component_radii, resolve_radius
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -57,7 +58,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     """Normal-cycle tensor over balls of radius ``radius``. Returns ``(result, problems)``."""
     stages.start("compute normals")
     if radius is None:  # each group of components of one scale at its own default
-        groups = default_radii(vertices, topology)
+        groups = component_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
     cross, degenerate, defects, normals, valid = prepare(vertices, topology)

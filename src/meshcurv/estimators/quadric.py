@@ -45,7 +45,7 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, MIN_POINTS, fit_jets, shape_operators
-from ..neighborhoods import default_radii, resolve_radius
+from ..radius import component_radii, resolve_radius
 from ..topology import MeshTopology
 from ._common import Stages
 from ._support import finish, prepare
@@ -65,11 +65,11 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     side of the surface (``facing`` of :func:`fit_jets`: a ball across a needle,
     or over a whole small closed part) is NaN with ``valid=False`` and counted
     in the warning. With the default radius, each group of components of one
-    scale gets its own (:func:`meshcurv.neighborhoods.default_radii`).
+    scale gets its own (:func:`meshcurv.radius.component_radii`).
     """
     stages.start("compute normals")
     if radius is None:
-        groups = default_radii(vertices, topology)
+        groups = component_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
     _, _, defects, normals, valid = prepare(vertices, topology)

@@ -1,0 +1,93 @@
+"""The interpolated corrected curvature measures of a triangle mesh (Lachaud, Romon, Thibert, Coeurjolly 2020).
+
+Given unit normals ``u_i`` at the vertices, interpolated linearly over each
+triangle ``(x_i, x_j, x_k)``, the curvature measures of the corrected normal
+current have closed forms per face, with ``ū = (u_i + u_j + u_k) / 3``:
+
+.. math::
+
+    \\mu_0 &= \\tfrac12 \\langle ū \\mid (x_j - x_i) \\times (x_k - x_i) \\rangle
+    \\quad\\text{(corrected area)}\\\\
+    \\mu_1 &= \\tfrac12 \\langle ū \\mid (u_k - u_j) \\times x_i + (u_i - u_k) \\times x_j
+    + (u_j - u_i) \\times x_k \\rangle \\quad (2H\\,dA)\\\\
+    \\mu_2 &= \\tfrac12 \\langle u_i \\mid u_j \\times u_k \\rangle \\quad (K\\,dA)\\\\
+    \\mu^{X,Y} &= \\tfrac12 \\langle ū \\mid \\langle Y \\mid u_k - u_i \\rangle X \\times (x_j - x_i)
+    - \\langle Y \\mid u_j - u_i \\rangle X \\times (x_k - x_i) \\rangle
+
+Summed over a region and divided by its corrected area they give the mean
+and Gaussian curvature and the shape operator there. The estimator
+``method="icc"`` (:mod:`meshcurv.estimators.icc`) sums them over balls; the
+integrals of :mod:`meshcurv.integrals`, point clouds and label images use them
+too.
+
+References
+----------
+J.-O. Lachaud, P. Romon, B. Thibert, D. Coeurjolly (2020). Interpolated
+corrected curvature measures for polygonal surfaces. Computer Graphics Forum
+39(5), 41-54. https://doi.org/10.1111/cgf.14067
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._backend import numba_kernels
+from ._tensors import principal_from_mean_gaussian, principal_from_shape_operator
+
+__all__ = ["face_measures", "curvatures_from_measures"]
+
+
+def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(F, 9) per-face ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` (xx, yy, zz, xy, xz, yz).
+
+    Written relative to the first corner, so that a translation of the mesh
+    changes nothing (the sum ``(u_k - u_j) + (u_i - u_k) + (u_j - u_i)`` is 0).
+    The compiled kernel when numba is there (0.4 s for 2M faces against 3 s).
+    """
+    kernels = numba_kernels("icc")
+    if kernels is not None:
+        return kernels.face_measures(np.ascontiguousarray(vertices, dtype=np.float64),
+                                     np.ascontiguousarray(faces, dtype=np.int64),
+                                     np.ascontiguousarray(normals, dtype=np.float64))
+    x0, x1, x2 = (vertices[faces[:, k]] for k in range(3))
+    u0, u1, u2 = (normals[faces[:, k]] for k in range(3))
+    x01, x02 = x1 - x0, x2 - x0
+    u01, u02 = u1 - u0, u2 - u0
+    um = (u0 + u1 + u2) / 3
+    mu0 = 0.5 * np.einsum("ij,ij->i", um, np.cross(x01, x02))
+    mu1 = 0.5 * np.einsum("ij,ij->i", um, np.cross(u0 - u2, x01) + np.cross(u1 - u0, x02))
+    mu2 = 0.5 * np.einsum("ij,ij->i", u0, np.cross(u1, u2))
+    # mu^{X,Y} = X^T M Y with M = 1/2 [ (x01 x um) (u02)^T - (x02 x um) (u01)^T ]
+    a, b = np.cross(x01, um), np.cross(x02, um)
+    m = 0.5 * (a[:, :, None] * u02[:, None, :] - b[:, :, None] * u01[:, None, :])
+    sym = np.stack([m[:, 0, 0], m[:, 1, 1], m[:, 2, 2], 0.5 * (m[:, 0, 1] + m[:, 1, 0]),
+                    0.5 * (m[:, 0, 2] + m[:, 2, 0]), 0.5 * (m[:, 1, 2] + m[:, 2, 1])], axis=1)
+    return np.column_stack([mu0, mu1, mu2, sym])
+
+
+def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
+    """``k_min, k_max, dir_min, dir_max`` of (N, 9) corrected measures summed over balls (rows of :func:`face_measures`).
+
+    ``H = mu_1 / (2 mu_0)``, ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``
+    (:func:`meshcurv._tensors.principal_from_mean_gaussian`), and the
+    directions of the shape operator ``-sym(mu^{X,Y}) / mu_0`` restricted to
+    the plane normal to each row of ``normals`` (N, 3), unit. All NaN in a row
+    whose corrected area ``mu_0`` is not positive or whose normal is not finite.
+    One pass with the compiled kernels.
+    """
+    kernels = numba_kernels("icc")
+    if kernels is not None:
+        return kernels.curvatures_from_measures(np.ascontiguousarray(summed, dtype=np.float64),
+                                                np.ascontiguousarray(normals, dtype=np.float64))
+    area = summed[:, 0]
+    good = (area > 0) & np.isfinite(normals).all(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = summed[:, 1] / (2 * area)
+        gaussian = summed[:, 2] / area
+        shape_operator = -summed[:, 3:] / area[:, None]
+    k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
+    _, _, dir_min, dir_max = principal_from_shape_operator(np.where(good[:, None], shape_operator, 0.0),
+                                                           np.where(good[:, None], normals, [0.0, 0.0, 1.0]))
+    for field in (k_min, k_max, dir_min, dir_max):
+        field[~good] = np.nan
+    return k_min, k_max, dir_min, dir_max

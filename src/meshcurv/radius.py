@@ -1,0 +1,290 @@
+"""Every rule that chooses a ball radius: the scale at which the surface is measured.
+
+The ball estimators (``icc``, ``quadric``, ``normal_cycle_ball``), point clouds
+and label images measure curvature over balls; the radius of the ball sets the
+balance between the bias of a large ball (it averages the curvature over a
+region, an error of order ``(r k)^2``) and the noise of a small one (noise of
+amplitude ``a`` gives an error of order ``a / r^2`` in the curvature). This
+module holds the rules that choose it, and the checks of a radius given by
+the user:
+
+- :func:`edge_radius`, :func:`component_radii`: :data:`DEFAULT_RADIUS_FACTOR`
+  mean edge lengths, each group of components of one scale at its own;
+- :func:`noise_level`, :func:`noise_radius`: ``icc``'s radius on smooth and
+  noisy meshes, growing with the noise measured on the mesh;
+- :func:`voxel_radius`, :func:`voxel_surface_radius`: on voxel surfaces
+  (marching cubes), about ``sqrt(h R)`` for voxels of size ``h`` and curvature
+  radius ``R``;
+- :func:`check_radius`, :func:`resolve_radius`, :func:`small_radius_note`:
+  a radius given by the user.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ._validation import check_positive_float, checked_points
+from .errors import InvalidOptionError
+from .geometry import median_edge_length, robust_mean_edge_length, vertex_edge_lengths, vertex_length_scales
+from .jets import SETTLED_SLOPE, fit_jets
+from .lattice import voxel_grid
+from .topology import MeshTopology
+
+__all__ = [
+    "DEFAULT_RADIUS_FACTOR",
+    "edge_radius",
+    "component_radii",
+    "noise_level",
+    "noise_radius",
+    "voxel_radius",
+    "voxel_surface_radius",
+    "check_radius",
+    "resolve_radius",
+    "small_radius_note",
+]
+
+#: The default ``radius`` is this many mean edge lengths.
+DEFAULT_RADIUS_FACTOR = 2.5
+
+
+def edge_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
+    """``DEFAULT_RADIUS_FACTOR`` times the robust mean edge length (0 for a mesh without edges).
+
+    :func:`meshcurv.geometry.robust_mean_edge_length`: the mean edge length
+    without edges beyond 1000 median edge lengths (equal to the mean on any
+    ordinary mesh; one spike vertex at 1e10 does not multiply it).
+    """
+    vertices = checked_points(vertices)
+    return DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, topology.edges)
+
+
+def component_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[float, np.ndarray | None]]:
+    """The default radius of each group of components of one scale: ``[(radius, vertices), ...]``.
+
+    ``vertices`` is None when the whole mesh is one group (every component within
+    a factor :data:`meshcurv.geometry.COMPONENT_SCALE_SPREAD` of the median edge
+    length: the usual case, one radius, :func:`edge_radius`). Otherwise the
+    components are grouped by the power of two of their median edge length
+    (:func:`meshcurv.geometry.vertex_length_scales`) and each group gets
+    ``DEFAULT_RADIUS_FACTOR`` times the robust mean edge length of its own edges,
+    with the int64 ids of its vertices: a part at 1e-3 and one at 1e3 are each
+    fitted at their own scale.
+    """
+    vertices = checked_points(vertices)
+    scales = vertex_length_scales(vertices, topology)
+    referenced = topology.referenced_vertices
+    used = scales[referenced & (scales > 0)]
+    if used.size == 0 or used.min() == used.max():
+        return [(edge_radius(vertices, topology), None)]
+    level = np.full(scales.shape, np.iinfo(np.int64).min)
+    positive = referenced & (scales > 0)
+    level[positive] = np.round(np.log2(scales[positive])).astype(np.int64)
+    groups: list[tuple[float, np.ndarray | None]] = []
+    for k in np.unique(level[positive]):
+        members = np.flatnonzero(level == k)
+        inside = np.zeros(scales.shape, dtype=bool)
+        inside[members] = True
+        edges = topology.edges[inside[topology.edges[:, 0]]]
+        groups.append((DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, edges), members))
+    return groups
+
+
+#: The smallest radius taken, in median edge lengths: a ball far inside one
+#: face measures nothing (a unit mistake: m for mm), and below about 1e-8 of
+#: the coordinates the ball's geometry is rounding noise.
+MIN_RADIUS_EDGES = 1e-3
+
+
+def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
+    """``radius`` checked: a positive finite number between a sliver of an edge and the mesh's extent.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``radius`` is not a positive finite real number (strings are refused),
+        it is below :data:`MIN_RADIUS_EDGES` median edge lengths, or it exceeds the diagonal of the bounding box of the referenced
+        vertices: every ball would hold the whole mesh (a unit mistake: mm for m).
+    """
+    radius = check_positive_float(radius, "radius")
+    vertices = checked_points(vertices)
+    used = vertices[topology.referenced_vertices] if topology.n_faces else vertices
+    if used.shape[0] == 0:
+        return radius
+    diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    if topology.n_faces and radius < MIN_RADIUS_EDGES * diagonal:
+        median = median_edge_length(vertices, topology.edges)
+        if radius < MIN_RADIUS_EDGES * median:
+            raise InvalidOptionError(
+                f"`radius` {radius:g} is below {MIN_RADIUS_EDGES:g} of the median edge length {median:g}: "
+                f"every ball would hold its centre only and give no curvature; pass a radius of a few edge "
+                f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
+            )
+    if radius > diagonal:
+        median = median_edge_length(vertices, topology.edges)
+        raise InvalidOptionError(
+            f"`radius` {radius:g} is larger than the mesh itself (bounding-box diagonal {diagonal:g}, median "
+            f"edge length {median:g}): every ball would hold the whole mesh; pass a radius of a few edge "
+            f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
+        )
+    return radius
+
+
+def small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopology, minimum_edges: float) -> str:
+    """The warning's sentence for a given ``radius`` below ``minimum_edges`` median edge lengths, else ''.
+
+    Each ball method states its own minimum (``RADIUS_WARNING_EDGES`` of its
+    module), measured where its balls start holding too little of the surface.
+    """
+    if not topology.n_faces:
+        return ""
+    median = median_edge_length(vertices, topology.edges)
+    if not radius < minimum_edges * median:
+        return ""
+    return (f"`radius` {radius:g} is {radius / median:.2g} of the median edge length {median:g}: below "
+            f"{minimum_edges:g} edge lengths the balls hold too little of the surface and many curvatures are far "
+            f"off; pass a radius of a few edge lengths, in the units of the vertices (or leave the default)")
+
+
+def resolve_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
+    """The radius to use: ``radius`` checked (:func:`check_radius`), or the mesh's default when None.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``radius`` is not a positive finite number, or larger than the mesh.
+    """
+    if radius is None:
+        return edge_radius(vertices, topology)
+    return check_radius(radius, vertices, topology)
+
+
+#: The noise level is measured with degree-2 jets over balls of this many local edge lengths.
+NOISE_FIT_RADIUS = 2.0
+
+#: Noise levels (in mean edge lengths) up to this count as a clean mesh: the
+#: fit's own bias on smooth surfaces sampled with 8 or more edges per radius of curvature.
+NOISE_FLOOR = 0.005
+
+#: Growth of the default radius, in edge lengths, with the square root of the noise above the floor.
+NOISE_GAIN = 9.0
+
+#: The noise level of a larger mesh is measured on this many of its vertices, evenly spaced in index order.
+NOISE_SAMPLE = 65536
+
+
+def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, edges: np.ndarray, *,
+                neighbours: np.ndarray | None = None, adjacency: tuple | None = None) -> float:
+    """Median distance of the vertices to degree-2 jets fitted around them, in local edge lengths.
+
+    The local edge length ``h_v`` of a vertex is the mean length of its edges.
+    The vertices are taken by class of ``h_v`` (powers of two around the
+    median, so that a mesh of even resolution is one class), and each jet is
+    fitted over the ball of :data:`NOISE_FIT_RADIUS` times the mean ``h_v`` of
+    its class, the vertex included; its distance is measured in that mean. On a
+    smooth, clean mesh the distance is the fit's bias (below
+    :data:`NOISE_FLOOR`); under normal noise of uniform amplitude ``a h`` it is
+    about ``0.23 a`` (0.1 h: 0.020-0.028). Local classes keep a mesh whose
+    resolution varies (a decimated model, 40x between its shortest and longest
+    edges) from reading its fine detail as noise at the scale of its mean edge.
+    On a mesh of more than :data:`NOISE_SAMPLE` valid vertices, the median is
+    taken over that many of them, evenly spaced in index order (the median of
+    65536 draws is within about 1% of that of all vertices; a re-indexing then
+    changes the level, and the default radius, by that much). A fit whose first
+    frame is settled (:data:`NORMAL_SETTLED`) is not refitted in its own frame, as
+    for the normals: the level moves by less than 0.1% (7e-4 at most on clean and
+    noisy spheres and tori; none above 0.02 h of noise), and a clean mesh needs
+    half the fits. 0 when no jet could be fitted.
+    """
+    local = vertex_edge_lengths(vertices, edges)
+    centres = np.flatnonzero(valid & (local > 0))
+    if centres.size > NOISE_SAMPLE:
+        centres = centres[np.linspace(0, centres.size - 1, NOISE_SAMPLE).round().astype(np.int64)]
+    if centres.size == 0:
+        return 0.0
+    scale = local[centres]
+    level = np.round(np.log2(scale / np.median(scale))).astype(np.int64)
+    distances = np.full(centres.size, np.nan)
+    for k in np.unique(level):
+        members = np.flatnonzero(level == k)
+        radius = NOISE_FIT_RADIUS * scale[members].mean()
+        coefficients, _, _ = fit_jets(vertices, normals, radius, degree=2, centres=centres[members],
+                                      neighbours=neighbours, adjacency=adjacency, compact=True,
+                                      settled=SETTLED_SLOPE)
+        # the constant term is in units of the radius: NOISE_FIT_RADIUS class mean edge lengths
+        distances[members] = np.abs(coefficients[:, 0]) * NOISE_FIT_RADIUS
+    distances = distances[np.isfinite(distances)]
+    return float(np.median(distances)) if distances.size else 0.0
+
+
+def noise_radius(noise: float, edge_length: float) -> float:
+    """icc's default radius on a mesh of this noise level (:func:`noise_level`) and mean edge length.
+
+    ``h (1 + NOISE_GAIN sqrt(max(nu - NOISE_FLOOR, 0)))``: one edge length on a clean mesh, where the
+    smallest ball has the smallest bias, about 2.2 h under normal noise of amplitude 0.1 h and 3.3 h
+    under 0.3 h, where a larger ball averages the noise out (a sweep of both radii over the surfaces
+    of ``benchmarks/accuracy.py``).
+    """
+    return edge_length * (1.0 + NOISE_GAIN * np.sqrt(max(noise - NOISE_FLOOR, 0.0)))
+
+
+def voxel_radius(spacing: np.ndarray, curvature_radius: float) -> float:
+    """The default measure radius of a voxel surface: ``min(1.5 sqrt(h R), R / 2)``, at least ``h``.
+
+    ``h`` is the largest voxel size, ``R`` the typical radius of curvature of
+    the surface. The staircase of the voxels is noise of amplitude ``h`` that
+    a ball of radius ``r`` averages down as ``h / r``, while the ball's own
+    bias grows as ``(r / R)^2``: the error is smallest for ``r`` of order
+    ``sqrt(h R)`` (Lachaud et al. 2020, digitised surfaces). The factor 1.5
+    and the cap ``R / 2`` (beyond it the normals, fitted over three radii,
+    reach round the shape) come from a sweep over the marching-cubes meshes of
+    ``benchmarks/accuracy.py`` (spheres, ellipsoids and tori, voxels 1:1:1 to
+    4:1:1, ``python benchmarks/accuracy.py --voxel-sweep``).
+    """
+    h = float(np.max(spacing))
+    return float(max(h, min(VOXEL_GAIN * np.sqrt(h * curvature_radius), VOXEL_CAP * curvature_radius)))
+
+
+#: The voxel radius rule ``min(VOXEL_GAIN sqrt(h R), VOXEL_CAP R)`` (see :func:`voxel_radius`).
+VOXEL_GAIN = 1.5
+VOXEL_CAP = 0.5
+
+#: The typical radius of curvature of a voxel surface is measured with a first pass at this many voxels.
+VOXEL_PILOT = 2.0
+#: The percentile of the pilot's curvedness ``max(|k_min|, |k_max|)`` over the
+#: surface's vertices whose inverse is the typical radius of curvature ``R``.
+#: The 75th rather than the median: on the benchmark's ellipsoids (voxel sizes
+#: 0.2-1, isotropic and 1 x 0.5 x 0.5 and 2 x 0.5 x 0.5) the median let the most
+#: curved quarter of the surface be averaged over balls larger than its radius
+#: of curvature (median H error of a flat ellipsoid 33% against 11%); the tori
+#: lose at most 2 points (benchmarks/accuracy_voxel.md).
+VOXEL_CURVEDNESS_PERCENTILE = 75.0
+
+
+def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology,
+                         pilot: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+                         ) -> tuple[float, dict] | None:
+    """The default radius of a voxel surface and what it was derived from, or None for other meshes.
+
+    The grid is found on the referenced vertices (:func:`meshcurv.lattice.voxel_grid`);
+    the typical radius of curvature ``R`` is the inverse of the
+    :data:`VOXEL_CURVEDNESS_PERCENTILE` th percentile of ``max(|k_min|, |k_max|)``
+    over the referenced, valid vertices, from a first pass ``pilot(radius) -> (k_min, k_max, valid)``
+    (``icc`` at :data:`VOXEL_PILOT` voxels); the radius is :func:`voxel_radius`. Used for every method
+    that takes a radius, so that ``quadric`` and ``normal_cycle_ball`` average the staircase out as
+    ``icc`` does.
+    """
+    referenced = topology.referenced_vertices
+    grid = voxel_grid(vertices[referenced])
+    if grid is None:
+        return None
+    k_min, k_max, valid = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))
+    curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
+    curvedness = curvedness[referenced & valid & np.isfinite(curvedness) & (curvedness > 0)]
+    if curvedness.size == 0:
+        return None
+    curvature_radius = 1.0 / float(np.percentile(curvedness, VOXEL_CURVEDNESS_PERCENTILE))
+    return voxel_radius(grid.spacing, curvature_radius), {
+        "surface": "voxel", "voxel_spacing": tuple(float(x) for x in grid.spacing),
+        "curvature_radius": curvature_radius}
