@@ -43,7 +43,7 @@ if HERE not in sys.path:
 
 import meshcurv  # noqa: E402
 import scale_families  # noqa: E402
-from meshcurv.estimators._support import prepare  # noqa: E402
+from meshcurv._prepared import PreparedMesh  # noqa: E402
 from meshcurv.geometry import median_edge_length, vertex_edge_lengths  # noqa: E402
 from meshcurv.jets import fit_jets  # noqa: E402
 from meshcurv.measures import curvatures_from_measures, face_measures  # noqa: E402
@@ -116,7 +116,8 @@ def vertex_noise(vertices, topology, local, *, fit_edges=NOISE_FIT_EDGES):
     The vertices are grouped by powers of two of their local edge length, as in
     :func:`meshcurv.radius.noise_level`; the distance is absolute (length units).
     """
-    _, _, _, normals, valid = prepare(vertices, topology)
+    prepared = PreparedMesh.as_given(vertices, topology)
+    normals, (_, valid) = prepared.vertex_normals, prepared.start(boundary=True)
     centres = np.flatnonzero(valid & (local > 0))
     scale = local[centres]
     level = np.round(np.log2(scale / np.median(scale))).astype(np.int64)
@@ -486,7 +487,9 @@ def normal_study(ratios=(1.0, 1.5, 2.0, 3.0)):
         v, f = case.vertices, case.faces
         topology = meshcurv.MeshTopology.from_faces(f, v.shape[0])
         radius = wanted.pop(case.name) * median_edge_length(v, topology.edges)
-        _, degenerate, _, normals, valid = prepare(v, topology)
+        prepared = PreparedMesh.as_given(v, topology)
+        normals = prepared.vertex_normals
+        _, valid = prepared.start(boundary=True)
         adjacency = topology.neighbour_lists
         cells = []
         for ratio in ratios:

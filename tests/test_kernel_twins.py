@@ -462,7 +462,8 @@ def check_mesh_facts(name):
 def numpy_normal_cycle(name, monkeypatch, steps):
     """The NumPy path of ``normal_cycle.estimate``: its result and the (V, 7) measures and areas it smooths."""
     from meshcurv.estimators import normal_cycle
-    from meshcurv.estimators._common import Stages
+    from meshcurv._prepared import PreparedMesh
+    from meshcurv.estimators._support import Stages
 
     vertices, _ = mesh(name)
     seen = []
@@ -474,7 +475,7 @@ def numpy_normal_cycle(name, monkeypatch, steps):
 
     with use_backend("numpy"), monkeypatch.context() as patch:
         patch.setattr(normal_cycle, "smooth_vertex_field", record)
-        result, _ = normal_cycle.estimate(vertices, topology(name), smoothing_steps=steps,
+        result, _ = normal_cycle.estimate(PreparedMesh.as_given(vertices, topology(name)), smoothing_steps=steps,
                                           stages=Stages(normal_cycle.STAGES))
     assert len(seen) == 1, "normal_cycle.estimate no longer smooths its sums in one call: update this test"
     return result, seen[0]
@@ -494,14 +495,14 @@ def compiled_normal_cycle_sums(name):
 
 def check_normal_cycle_sums(name, monkeypatch):
     from meshcurv import geometry
-    from meshcurv.estimators._defects import mesh_defects
+    from meshcurv.defects import VertexDefects, defect_codes
 
     vertices, _ = mesh(name)
     top = topology(name)
     result, measures = numpy_normal_cycle(name, monkeypatch, 0)
     with use_backend("numpy"):
         degenerate = geometry.degenerate_faces(vertices, top)
-        invalid = mesh_defects(top, degenerate).invalid_vertices
+        invalid = VertexDefects(*defect_codes(top, degenerate)).invalid_vertices
     sums, got_degenerate = compiled_normal_cycle_sums(name)
     np.testing.assert_array_equal(got_degenerate, degenerate)
     # the NumPy path smooths the measures and areas of the valid vertices (the others zeroed)
@@ -524,14 +525,14 @@ def check_normal_cycle_sums(name, monkeypatch):
 
 
 def check_normal_cycle_finish(name, monkeypatch):
-    from meshcurv.estimators._defects import mesh_defects
+    from meshcurv.defects import VertexDefects, defect_codes
     from meshcurv.smoothing import smooth_vertex_field
 
     top = topology(name)
     steps = 3
     result, measures = numpy_normal_cycle(name, monkeypatch, steps)
     sums, degenerate = compiled_normal_cycle_sums(name)
-    invalid = mesh_defects(top, degenerate).invalid_vertices
+    invalid = VertexDefects(*defect_codes(top, degenerate)).invalid_vertices
     # the kernel from the NumPy path's measures and areas (and the normal sums, checked by normal_cycle_sums)
     given = np.ascontiguousarray(np.column_stack([measures, sums[:, 7:]]))
     indptr, indices = top.neighbour_lists
@@ -666,13 +667,15 @@ def check_matgeom_vertex_tensors(name):
 
 def check_matgeom_principal(name):
     from meshcurv.estimators import matgeom
-    from meshcurv.estimators._common import Stages
+    from meshcurv._prepared import PreparedMesh
+    from meshcurv.estimators._support import Stages
 
     vertices, _ = mesh(name)
     top = topology(name)
     with use_backend("numpy"):
         tensors, *_ = matgeom.matgeom_tensors(vertices, top, 3)
-        result, _ = matgeom.estimate(vertices, top, smoothing_steps=3, stages=Stages(matgeom.STAGES))
+        result, _ = matgeom.estimate(PreparedMesh.as_given(vertices, top), smoothing_steps=3,
+                                     stages=Stages(matgeom.STAGES))
     c1, c2, u1, u2, normal = kernels("matgeom").matgeom_principal(np.ascontiguousarray(tensors))
     # cyclic Jacobi against LAPACK's eigh: both backward stable, eigenvalues within p eps |T| (Frobenius)
     # with a small p (at most 6 on these meshes: 16 leaves a margin); eigenvectors within that over the

@@ -4,24 +4,17 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from typing import Any
 
-import numpy as np
 
-from ._adapters import mesh_arrays
-from ._locality import local_topology
-from ._validation import as_vertices, check_choice, check_int_option, check_positive_float, trusting
+from ._prepared import prepare_mesh
+from ._validation import check_choice, check_int_option, check_positive_float, trusting
 from .diagnosis import diagnose, quality_message
 from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
-from .estimators._common import ProgressCallback, Stages
+from .estimators._support import ProgressCallback, Stages
 from .estimators.icc import voxel_pilot
-from .geometry import degenerate_faces
-from .orient import ORIENT_CHOICES, oriented_topology
 from .radius import small_radius_note, voxel_surface_radius
-from .result import INVALID_REASONS, CurvatureResult, Surface
-from .topology import MeshTopology
-from .weld import drop_double_sided, weld_vertices
+from .result import CurvatureResult
 
 __all__ = ["principal_curvatures", "METHODS"]
 
@@ -196,58 +189,32 @@ def principal_curvatures(
     if options.get("radius") is not None:
         options["radius"] = check_positive_float(options["radius"], "radius")
 
-    if faces is None:
-        vertices, faces = mesh_arrays(vertices)
-    callers = as_vertices(vertices)
-    points, topology, local = local_topology(callers, faces, stacklevel=3)  # a scattered order made local
-    check_choice(orient, "orient", ORIENT_CHOICES)
     if orient == "auto":
         orient = "keep" if method == "matgeom" else "outward"
     if weld is None:
         weld = method != "matgeom"
-    elif not isinstance(weld, (bool, np.bool_)):
-        raise InvalidOptionError(f"`weld` must be True or False; got {weld!r}")
-    welding = weld_vertices(points, topology) if weld else None
-    if welding is not None and welding.n_welded:
-        points, topology = welding.vertices, welding.topology
-    one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
-    topology = one_sided.topology
-    topology, n_flipped = oriented_topology(points, topology, orient)
+    mesh = prepare_mesh(vertices, faces, orient=orient, weld=weld, stacklevel=3)
+    points, topology = mesh.vertices, mesh.topology
     with trusting(points, topology.faces, topology.edges):  # checked: the helpers below need not check again
         found: dict = {}
         if "radius" in options and options["radius"] is None:
-            voxel = voxel_surface_radius(points, topology, voxel_pilot(points, topology))  # a voxel surface: one default for every ball method
+            voxel = voxel_surface_radius(points, topology, voxel_pilot(mesh))  # one default for every ball method
             if voxel is not None:
                 options["radius"], found = voxel
-        result, problems = estimator.function(
-            points, topology, stages=Stages(estimator.stages, progress), **options
-        )
+        result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
         if radius is not None and estimator.radius_warning_edges is not None:  # given, not a default
             note = small_radius_note(result.parameters["radius"], points, topology, estimator.radius_warning_edges)
             problems = [*problems, note] if note else problems
-        diagnosis = diagnose(points, topology, n_flipped_faces=n_flipped)
-        reasons = invalid_reasons(points, topology, result.valid, boundary_valid=result.method in _BOUNDARY_METHODS)
-    parameters = {**result.parameters, **found, "orient": orient,
-                  "n_welded_vertices": welding.n_welded if welding is not None else 0,
-                  "n_double_sided_faces": one_sided.n_dropped}
-    # the rows of the computed result (welded vertices, in the local order) of each of the caller's vertices
-    welded = welding if welding is not None and welding.n_welded else None
-    index = None if welded is None else welded.index
-    if local is not None:
-        index = local.index if welded is None else welded.index[local.index]
-    if local is not None and welded is None:  # the mesh the caller gave, its faces oriented (and one-sided)
-        surface = Surface(callers, np.take(local.order, topology.faces) if one_sided.n_dropped
-                          else local.original_faces(topology.faces))
-    else:
-        surface = Surface(points, topology.faces, index)
-    result = dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons, parameters=parameters,
-                                 _surface=surface)
-    if index is not None:
-        result = _expanded(result, index)
-    if n_flipped:
+        diagnosis = diagnose(points, topology, n_flipped_faces=mesh.n_flipped)
+        reasons = mesh.defects(boundary=estimator.boundary).reasons(result.valid)
+    parameters = {**result.parameters, **found, "orient": orient, "n_welded_vertices": mesh.n_welded,
+                  "n_double_sided_faces": mesh.n_double_sided}
+    result = mesh.expand(dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons,
+                                             parameters=parameters, _surface=mesh.surface))
+    if mesh.n_flipped:
         problems = list(problems) + [_flip_reason(diagnosis, orient)]
     message = quality_message(method, problems, dataclasses.replace(diagnosis, n_flipped_faces=0))
-    prepared = _preparation_notes(welded, one_sided.n_dropped)
+    prepared = mesh.notes()
     if prepared:  # before what the estimator and the diagnosis found (which they may not name otherwise)
         message = f"{method}: " + "; ".join(prepared + ([message[len(method) + 2:]] if message else []))
     if message:
@@ -258,48 +225,6 @@ def principal_curvatures(
     return result
 
 
-#: Methods whose boundary vertices are valid (the others leave them undefined).
-_BOUNDARY_METHODS = frozenset({"icc", "quadric", "normal_cycle_ball", "rusinkiewicz", "matgeom"})
-
-
-def invalid_reasons(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray, *,
-                    boundary_valid: bool) -> np.ndarray:
-    """(V,) int8 codes of :data:`~meshcurv.result.INVALID_REASONS`: why each invalid vertex is.
-
-    Each invalid vertex gets the first reason that applies to it, in the
-    order of :data:`~meshcurv.result.INVALID_REASONS`; an invalid vertex
-    with no defect of the mesh gets the last one (the estimate itself was
-    undefined). 0 where ``valid``.
-    """
-    reasons = np.zeros(valid.shape[0], dtype=np.int8)
-    invalid = ~valid
-    if not invalid.any():
-        return reasons
-    degenerate = degenerate_faces(vertices, topology)
-    corners = np.zeros(valid.shape[0], dtype=bool)
-    corners[topology.faces[degenerate].ravel()] = True
-    bowties = topology.bowtie_vertices & ~topology.edge_vertices(topology.nonmanifold_edges)
-    boundary = np.zeros_like(valid) if boundary_valid else topology.boundary_vertices
-    classes = [~topology.referenced_vertices, topology.edge_vertices(topology.nonmanifold_edges), bowties,
-               topology.edge_vertices(topology.inconsistent_edges), corners, boundary]
-    for code, members in enumerate(classes, start=1):
-        reasons[invalid & members & (reasons == 0)] = code
-    reasons[invalid & (reasons == 0)] = len(INVALID_REASONS) - 1
-    return reasons
-
-
-def _preparation_notes(welded, n_dropped: int) -> list[str]:
-    """What was done to the mesh before the computation: vertices welded, the faces of a second side dropped."""
-    notes = []
-    if welded is not None:
-        notes.append(f"welded {welded.n_welded} coincident vertices (a triangle soup or split seams) "
-                     "before the computation; copies share their values")
-    if n_dropped:
-        notes.append(f"dropped {n_dropped} faces that repeat another face's corners with the opposite winding "
-                     "(a double-sided mesh): computed on one side (result.parameters['n_double_sided_faces'])")
-    return notes
-
-
 def _flip_reason(diagnosis, orient: str) -> str:
     n = diagnosis.n_flipped_faces
     if orient == "consistent" or diagnosis.n_faces == 0 or n < diagnosis.n_faces:
@@ -307,11 +232,3 @@ def _flip_reason(diagnosis, orient: str) -> str:
     else:
         why = "the mesh was wound inward (negative volume; marching cubes winds its faces so)"
     return f"orient={orient!r} reversed {n} of {diagnosis.n_faces} faces before the computation: {why}"
-
-
-def _expanded(result: CurvatureResult, index: np.ndarray) -> CurvatureResult:
-    """The result of a welded or reordered mesh on the input's vertices: row ``i`` is the computed row ``index[i]``."""
-    # np.take: several times faster than indexing the rows of an (N, 3) array
-    fields: dict[str, Any] = {name: np.take(getattr(result, name), index, axis=0)
-                              for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason")}
-    return dataclasses.replace(result, **fields)

@@ -11,25 +11,12 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from .defects import INVALID_REASONS
+
 if TYPE_CHECKING:
     from .diagnosis import MeshDiagnosis
 
 __all__ = ["CurvatureResult", "INVALID_REASONS"]
-
-#: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``. A vertex
-#: gets the first code that applies, in this order.
-INVALID_REASONS = (
-    "valid",
-    "unreferenced vertex (in no face)",
-    "on a non-manifold edge (3+ faces)",
-    "bow-tie vertex (fans of faces meeting at a point)",
-    "on an edge between inconsistently oriented faces",
-    "corner of a zero-area face",
-    "on a boundary edge (this method needs a closed neighbourhood)",
-    "point cloud: side undecided (between two sheets closer than the spacing)",
-    "point cloud: every ball held the other side of a thin part or a neighbouring part",
-    "estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)",
-)
 
 
 @dataclass(frozen=True, eq=False)

@@ -23,7 +23,8 @@ class Estimator:
     name : str
         The ``method=`` name.
     function : callable
-        ``function(vertices, topology, *, stages, **options) -> (CurvatureResult, problems)``.
+        ``function(mesh, *, stages, **options) -> (CurvatureResult, problems)``, ``mesh`` a
+        :class:`meshcurv._prepared.PreparedMesh` (checked once; the estimator trusts it).
     options : dict
         The options it takes, with their defaults (``radius=None``: the mesh's
         default, :func:`meshcurv.radius.edge_radius`).
@@ -35,6 +36,9 @@ class Estimator:
         A ``radius`` given below this many median edge lengths is named in the
         call's warning (:func:`meshcurv.radius.small_radius_note`); None
         for the methods without a radius.
+    boundary : bool
+        Whether its boundary vertices can be valid (a boundary is not a defect
+        for it: :data:`meshcurv.defects.BOUNDARY`).
     """
 
     name: str
@@ -43,6 +47,7 @@ class Estimator:
     summary: str
     stages: tuple
     radius_warning_edges: float | None = None
+    boundary: bool = False
 
 
 ESTIMATORS: dict[str, Estimator] = {
@@ -59,6 +64,7 @@ ESTIMATORS: dict[str, Estimator] = {
         options={"smoothing_steps": 3},
         summary="matGeom's meshCurvatures reproduced exactly (dimensionless values, compatibility mode)",
         stages=matgeom.STAGES,
+        boundary=True,
     ),
     "icc": Estimator(
         name="icc",
@@ -67,6 +73,7 @@ ESTIMATORS: dict[str, Estimator] = {
         summary="interpolated corrected curvature measures over a ball, normals from jets (Lachaud et al. 2020), in 1/length",
         stages=icc.STAGES,
         radius_warning_edges=icc.RADIUS_WARNING_EDGES,
+        boundary=True,
     ),
     "quadric": Estimator(
         name="quadric",
@@ -75,6 +82,7 @@ ESTIMATORS: dict[str, Estimator] = {
         summary="weighted degree-4 jet fit over a ball, normal re-estimated (Cazals & Pouget 2005; Panozzo et al. 2010)",
         stages=quadric.STAGES,
         radius_warning_edges=quadric.RADIUS_WARNING_EDGES,
+        boundary=True,
     ),
     "rusinkiewicz": Estimator(
         name="rusinkiewicz",
@@ -82,6 +90,7 @@ ESTIMATORS: dict[str, Estimator] = {
         options={},
         summary="per-face curvature tensors from normal differences, Voronoi-weighted (Rusinkiewicz 2004)",
         stages=rusinkiewicz.STAGES,
+        boundary=True,
     ),
     "normal_cycle_ball": Estimator(
         name="normal_cycle_ball",
@@ -90,6 +99,7 @@ ESTIMATORS: dict[str, Estimator] = {
         summary="normal-cycle tensor over a ball (Cohen-Steiner & Morvan 2003), in 1/length",
         stages=normal_cycle_ball.STAGES,
         radius_warning_edges=normal_cycle_ball.RADIUS_WARNING_EDGES,
+        boundary=True,
     ),
     "meyer": Estimator(
         name="meyer",

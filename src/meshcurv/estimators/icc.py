@@ -72,9 +72,9 @@ from ..jets import SETTLED_SLOPE, fit_jet_normals
 from ..measures import curvatures_from_measures, face_measures
 from ..neighborhoods import ball_face_sums
 from ..radius import check_radius, component_radii, noise_level, noise_radius
+from .._prepared import PreparedMesh
 from ..topology import MeshTopology
-from ._common import Stages
-from ._support import finish, prepare
+from ._support import Stages, finish
 
 #: Degree of the jets whose normals the measures interpolate.
 NORMAL_DEGREE = 3
@@ -123,12 +123,13 @@ def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray,
     return np.where(usable[:, None], fitted, normals)
 
 
-def voxel_pilot(vertices: np.ndarray, topology: MeshTopology):
+def voxel_pilot(mesh: PreparedMesh):
     """The first pass of :func:`meshcurv.radius.voxel_surface_radius`: ``radius -> (k_min, k_max, valid)``."""
     def run(radius: float):
-        _, degenerate, _, normals, valid = prepare(vertices, topology)
-        k_min, k_max, *_ = _curvatures(vertices, topology.faces, degenerate, normals, valid, radius,
-                                       neighbours=topology.referenced_vertices, adjacency=_adjacency(topology))
+        topology = mesh.topology
+        _, valid = mesh.start(boundary=True)
+        k_min, k_max, *_ = _curvatures(mesh.vertices, topology.faces, mesh.degenerate, mesh.vertex_normals, valid,
+                                       radius, neighbours=topology.referenced_vertices, adjacency=_adjacency(topology))
         return k_min, k_max, valid
     return run
 
@@ -171,10 +172,12 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
     return k_min, k_max, dir_min, dir_max, normals, valid
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
+def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     """Interpolated corrected curvature measures over balls. Returns ``(result, problems)``."""
+    vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
-    _, degenerate, defects, normals, valid = prepare(vertices, topology)
+    degenerate, normals = mesh.degenerate, mesh.vertex_normals
+    defects, valid = mesh.start(boundary=True)
 
     stages.start("measure noise")
     referenced = topology.referenced_vertices

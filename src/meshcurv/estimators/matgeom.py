@@ -36,12 +36,11 @@ import numpy as np
 
 from .._backend import kernel_threads, numba_kernels
 from .._tensors import outer6
-from ..geometry import degenerate_faces
 from ..result import CurvatureResult
 from ..smoothing import check_smoothing_steps, smooth_vertex_field
+from .._prepared import PreparedMesh
 from ..topology import MeshTopology
-from ._defects import mesh_defects
-from ._common import Stages
+from ._support import Stages
 from ._eigen import sorted_by_magnitude
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
@@ -171,8 +170,9 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
     return tensors, ev1.size, int(wrong_face.sum()), int(out_of_range.sum()), mispaired
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
+def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     """Run matGeom's algorithm. Returns ``(result, problems)``."""
+    vertices, topology = mesh.vertices, mesh.topology
     smoothing_steps = check_smoothing_steps(smoothing_steps)
     tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = matgeom_tensors(
         vertices, topology, smoothing_steps, stages
@@ -197,7 +197,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
     # (boundary, non-manifold, bow-tie, flipped or zero-area neighbourhood, or an
     # edge paired with a wrong face), spread over the smoothing rings as the
     # smoothing spreads it
-    doubtful = mesh_defects(topology, degenerate_faces(vertices, topology)).invalid_vertices | mispaired
+    doubtful = mesh.defects().invalid_vertices | mispaired
     doubtful &= topology.referenced_vertices
     if doubtful.any() and smoothing_steps:
         doubtful = smooth_vertex_field(doubtful.astype(np.float64), topology, smoothing_steps) > 0

@@ -31,24 +31,21 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import principal_from_mean_gaussian
-from ..geometry import (corner_angles, corner_cotangents, degenerate_faces, face_cross_products,
-                        mixed_voronoi_corner_areas, vertex_normals)
-from ..topology import MeshTopology
-from ._common import Stages
-from ._defects import mesh_defects
-from ._support import finish
+from ..geometry import (corner_angles, corner_cotangents, mixed_voronoi_corner_areas, vertex_normals)
+from .._prepared import PreparedMesh
+from ._support import Stages, finish
 
 STAGES = ("compute angles", "compute cotangent Laplacian", "retrieve curvatures")
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, stages: Stages):
+def estimate(mesh: PreparedMesh, *, stages: Stages):
     """Meyer et al. mean and Gaussian curvature. Returns ``(result, problems)``."""
+    vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute angles")
     n = vertices.shape[0]
     faces = topology.faces
-    cross = face_cross_products(vertices, faces)
-    degenerate = degenerate_faces(vertices, topology, cross=cross)
-    defects = mesh_defects(topology, degenerate)
+    degenerate = mesh.degenerate
+    defects = mesh.defects()
     good = faces[~degenerate]
     cot = corner_cotangents(vertices, good)
     # a corner whose cross product rounds to zero while its face's area does not (the corner at a vertex

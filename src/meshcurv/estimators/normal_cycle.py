@@ -49,31 +49,27 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from .._backend import kernel_threads, numba_kernels
-from ..geometry import (DEGENERATE_AREA_RATIO, degenerate_faces, edge_dihedral_angles, face_cross_products,
-                        vertex_length_scales)
+from ..geometry import (DEGENERATE_AREA_RATIO, edge_dihedral_angles, vertex_length_scales)
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
-from ..topology import MeshTopology
-from ._common import Stages, nan_where
-from ._defects import mesh_defects
-from ._support import proper_vertex_normals
+from .._prepared import PreparedMesh
+from ._support import Stages, nan_where, problems
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: int, stages: Stages):
+def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     """Normal-cycle tensor in true units. Returns ``(result, problems)``."""
+    vertices, topology = mesh.vertices, mesh.topology
     smoothing_steps = check_smoothing_steps(smoothing_steps)
     kernels = numba_kernels("normal_cycle")
     if kernels is not None:
-        return _estimate_compiled(kernels, vertices, topology, smoothing_steps, stages)
+        return _estimate_compiled(kernels, mesh, smoothing_steps, stages)
     stages.start("compute adjacencies")
     n_vertices = vertices.shape[0]
     faces = topology.faces
-    cross = face_cross_products(vertices, faces)
+    cross, degenerate, defects = mesh.cross, mesh.degenerate, mesh.defects()
     double_areas = np.linalg.norm(cross, axis=1)
-    degenerate = degenerate_faces(vertices, topology, cross=cross)
-    defects = mesh_defects(topology, degenerate)
 
     stages.start("compute edge tensors")
     usable = topology.interior_edges & ~degenerate[np.maximum(topology.edge_faces, 0)].any(axis=1)
@@ -88,7 +84,7 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
     )
     face_area_thirds = np.where(degenerate, 0.0, double_areas / 6.0)
     areas = np.bincount(faces.ravel(), weights=np.repeat(face_area_thirds, 3), minlength=n_vertices)
-    normals = proper_vertex_normals(vertices, faces, cross, degenerate)
+    normals = mesh.vertex_normals
 
     stages.start("average vertex tensors")
     valid = ~defects.invalid_vertices
@@ -110,23 +106,23 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, smoothing_steps: i
         k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
         method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},
     )
-    return result, defects.messages()
+    return result, problems(defects, valid)
 
 
-def _estimate_compiled(kernels, vertices: np.ndarray, topology: MeshTopology, smoothing_steps: int,
-                       stages: Stages):
+def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages: Stages):
     """The same with the compiled kernels: one pass for the sums, one kernel from sums to curvatures."""
+    vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute adjacencies")
     if smoothing_steps > 0:
         indptr, indices = topology.neighbour_lists
     else:  # no smoothing: no neighbour lists to build
         indptr, indices = np.zeros(vertices.shape[0] + 1, np.int64), np.zeros(0, np.int64)
     stages.start("compute edge tensors")
-    sums, degenerate = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
+    sums, _ = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
                                                  topology.edge_face_counts, topology._edge_forward_counts,
                                                  vertex_length_scales(vertices, topology), DEGENERATE_AREA_RATIO,
                                                  kernel_threads())
-    defects = mesh_defects(topology, degenerate)
+    defects = mesh.defects()  # the zero-area faces as the kernel found them (the twin tests)
     stages.start("average vertex tensors")
     stages.start("retrieve curvatures")
     if smoothing_steps > STEPS_PER_CALL:
@@ -143,4 +139,4 @@ def _estimate_compiled(kernels, vertices: np.ndarray, topology: MeshTopology, sm
         k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
         method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},
     )
-    return result, defects.messages()
+    return result, problems(defects, valid)

@@ -41,9 +41,8 @@ from .._tensors import outer6, principal_from_shape_operator
 from ..geometry import edge_dihedral_angles
 from ..neighborhoods import ball_edge_sums, ball_face_sums
 from ..radius import component_radii, resolve_radius
-from ..topology import MeshTopology
-from ._common import Stages
-from ._support import finish, prepare
+from .._prepared import PreparedMesh
+from ._support import Stages, finish
 
 STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve curvatures")
 
@@ -54,14 +53,16 @@ STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve
 RADIUS_WARNING_EDGES = 1.5
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
+def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     """Normal-cycle tensor over balls of radius ``radius``. Returns ``(result, problems)``."""
+    vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
     if radius is None:  # each group of components of one scale at its own default
         groups = component_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
-    cross, degenerate, defects, normals, valid = prepare(vertices, topology)
+    cross, degenerate, normals = mesh.cross, mesh.degenerate, mesh.vertex_normals
+    defects, valid = mesh.start(boundary=True)
 
     stages.start("compute edge tensors")
     double_areas = np.linalg.norm(cross, axis=1)

@@ -46,9 +46,8 @@ import numpy as np
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, MIN_POINTS, fit_jets, shape_operators
 from ..radius import component_radii, resolve_radius
-from ..topology import MeshTopology
-from ._common import Stages
-from ._support import finish, prepare
+from .._prepared import PreparedMesh
+from ._support import Stages, finish
 
 STAGES = ("compute normals", "fit jets", "retrieve curvatures")
 
@@ -58,7 +57,7 @@ STAGES = ("compute normals", "fit jets", "retrieve curvatures")
 RADIUS_WARNING_EDGES = 1.0
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: Stages):
+def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     """Weighted jet fits over balls of radius ``radius``. Returns ``(result, problems)``.
 
     Only referenced vertices enter the balls. A fit whose ball holds the other
@@ -67,12 +66,14 @@ def estimate(vertices: np.ndarray, topology: MeshTopology, *, radius, stages: St
     in the warning. With the default radius, each group of components of one
     scale gets its own (:func:`meshcurv.radius.component_radii`).
     """
+    vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
     if radius is None:
         groups = component_radii(vertices, topology)
     else:
         groups = [(resolve_radius(radius, vertices, topology), None)]
-    _, _, defects, normals, valid = prepare(vertices, topology)
+    normals = mesh.vertex_normals
+    defects, valid = mesh.start(boundary=True)
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     facing = np.where(valid[:, None], normals, np.nan)
     referenced = topology.referenced_vertices

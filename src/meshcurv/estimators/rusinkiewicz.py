@@ -32,9 +32,8 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from ..geometry import mixed_voronoi_corner_areas
-from ..topology import MeshTopology
-from ._common import Stages
-from ._support import finish, prepare
+from .._prepared import PreparedMesh
+from ._support import Stages, finish
 
 #: Per-face systems whose determinant, with the matrix scaled to a largest entry of 1, is at
 #: most this are not solved (the face's tensor is NaN): a collapsed or sliver face.
@@ -100,11 +99,13 @@ def rotations_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.eye(3) + skew + factor[:, None, None] * (skew @ skew)
 
 
-def estimate(vertices: np.ndarray, topology: MeshTopology, *, stages: Stages):
+def estimate(mesh: PreparedMesh, *, stages: Stages):
     """Rusinkiewicz's per-face curvature tensors averaged on vertices. Returns ``(result, problems)``."""
+    vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
     n = vertices.shape[0]
-    cross, degenerate, defects, normals, valid = prepare(vertices, topology)
+    cross, degenerate, normals = mesh.cross, mesh.degenerate, mesh.vertex_normals
+    defects, valid = mesh.start(boundary=True)
     usable = ~degenerate & np.isfinite(normals[topology.faces]).all(axis=(1, 2))
     faces = topology.faces[usable]
     face_unit_normals = cross[usable] / np.linalg.norm(cross[usable], axis=1, keepdims=True)

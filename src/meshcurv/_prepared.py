@@ -1,0 +1,167 @@
+"""A mesh checked once and made ready for the estimators, with the way back to the caller's vertices.
+
+:func:`prepare_mesh` is the one door of :func:`meshcurv.principal_curvatures`:
+it checks and coerces the caller's arrays (or mesh object), puts a scattered
+vertex order into a local one, welds coincident vertices, keeps one side of a
+double-sided mesh and orients the faces. The estimators receive the
+:class:`PreparedMesh` and trust it; what they share (face cross products,
+zero-area faces, vertex normals, the defect codes) is computed once, on first
+use. :meth:`PreparedMesh.expand` puts a result back on the caller's vertices:
+one row per vertex given, copies of a welded vertex sharing its values.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from ._adapters import mesh_arrays
+from ._locality import local_topology
+from ._validation import as_vertices, check_choice
+from .defects import BOUNDARY, VertexDefects, defect_codes
+from .errors import InvalidOptionError
+from .geometry import degenerate_faces, face_cross_products, vertex_normals
+from .orient import ORIENT_CHOICES, oriented_topology
+from .result import CurvatureResult, Surface
+from .topology import MeshTopology
+from .weld import drop_double_sided, weld_vertices
+
+__all__ = ["PreparedMesh", "prepare_mesh"]
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class PreparedMesh:
+    """A checked, welded, one-sided and oriented mesh, and how it maps to the caller's vertices.
+
+    Attributes
+    ----------
+    vertices : ndarray of shape (V, 3), float64
+        The vertices computed on (in a local order, welded).
+    topology : MeshTopology
+        Their faces' connectivity (welded, one side of a double-sided mesh, oriented).
+    index : ndarray of shape (N,), int64, or None
+        The row of ``vertices`` of each of the caller's N vertices (None: the same rows).
+    surface : Surface
+        The mesh a result keeps for its integrals.
+    orient : str
+        The orientation applied (``'auto'`` resolved).
+    n_welded, n_double_sided, n_flipped : int
+        Vertices welded, faces of a second side dropped, faces reversed.
+    """
+
+    vertices: np.ndarray
+    topology: MeshTopology
+    index: np.ndarray | None
+    surface: Surface
+    orient: str
+    n_welded: int = 0
+    n_double_sided: int = 0
+    n_flipped: int = 0
+
+    @classmethod
+    def as_given(cls, vertices: np.ndarray, topology: MeshTopology) -> PreparedMesh:
+        """A mesh already checked, taken as it is: not welded, reordered or oriented."""
+        return cls(vertices, topology, None, Surface(vertices, topology.faces), "keep")
+
+    @cached_property
+    def cross(self) -> np.ndarray:
+        """(F, 3) cross products of the faces' sides (twice their area, along their normal); read-only."""
+        return _read_only(face_cross_products(self.vertices, self.topology.faces))
+
+    @cached_property
+    def degenerate(self) -> np.ndarray:
+        """(F,) bool: the zero-area faces (:func:`meshcurv.geometry.degenerate_faces`); read-only."""
+        return _read_only(degenerate_faces(self.vertices, self.topology, cross=self.cross))
+
+    @cached_property
+    def vertex_normals(self) -> np.ndarray:
+        """(V, 3) area-weighted unit normals of the faces that are not degenerate (NaN where none); read-only."""
+        used = np.where(self.degenerate[:, None], 0.0, self.cross) if self.degenerate.any() else self.cross
+        return _read_only(vertex_normals(self.vertices, self.topology.faces, cross=used))
+
+    @cached_property
+    def _codes(self) -> tuple[np.ndarray, dict]:
+        return defect_codes(self.topology, self.degenerate)
+
+    def defects(self, *, boundary: bool = False) -> VertexDefects:
+        """The defects as a method sees them: ``boundary=True`` for the methods that keep boundary vertices."""
+        codes, counts = self._codes
+        return VertexDefects(codes, counts, frozenset({BOUNDARY}) if boundary else frozenset())
+
+    def start(self, *, boundary: bool = False) -> tuple[VertexDefects, np.ndarray]:
+        """``(defects, valid)``: the defects, and the vertices with neither a defect nor a missing normal."""
+        defects = self.defects(boundary=boundary)
+        valid = ~defects.invalid_vertices & np.isfinite(self.vertex_normals).all(axis=1)
+        return defects, valid
+
+    def notes(self) -> list[str]:
+        """What was done to the mesh before the computation, for the call's warning."""
+        notes = []
+        if self.n_welded:
+            notes.append(f"welded {self.n_welded} coincident vertices (a triangle soup or split seams) "
+                         "before the computation; copies share their values")
+        if self.n_double_sided:
+            notes.append(f"dropped {self.n_double_sided} faces that repeat another face's corners with the "
+                         "opposite winding (a double-sided mesh): computed on one side "
+                         "(result.parameters['n_double_sided_faces'])")
+        return notes
+
+    def expand(self, result: CurvatureResult) -> CurvatureResult:
+        """``result`` on the caller's vertices: row ``i`` is the computed row ``index[i]``."""
+        if self.index is None:
+            return result
+        # np.take: several times faster than indexing the rows of an (N, 3) array
+        fields: dict[str, Any] = {
+            name: np.take(getattr(result, name), self.index, axis=0)
+            for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason")}
+        return dataclasses.replace(result, **fields)
+
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    """``array``, made read-only: the estimators share it and none may change it."""
+    array.flags.writeable = False
+    return array
+
+
+def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: int = 3) -> PreparedMesh:
+    """Check ``vertices`` and ``faces`` once and prepare them: :class:`PreparedMesh`.
+
+    ``faces`` None: ``vertices`` is a mesh object (:func:`meshcurv._adapters.mesh_arrays`).
+    ``orient`` is one of :data:`meshcurv.orient.ORIENT_CHOICES` but ``'auto'``; ``weld`` a bool.
+    The faces' triangulation warning is attributed ``stacklevel`` frames up.
+
+    Raises
+    ------
+    InvalidMeshError
+        The arrays are not a mesh (shapes, dtypes, non-finite values, indices).
+    InvalidOptionError
+        ``orient`` or ``weld`` is not one of their values.
+    """
+    if faces is None:
+        vertices, faces = mesh_arrays(vertices)
+    callers = as_vertices(vertices)
+    points, topology, local = local_topology(callers, faces, stacklevel=stacklevel + 1)
+    check_choice(orient, "orient", ORIENT_CHOICES)
+    if not isinstance(weld, (bool, np.bool_)):
+        raise InvalidOptionError(f"`weld` must be True or False; got {weld!r}")
+    welding = weld_vertices(points, topology) if weld else None
+    welded = welding if welding is not None and welding.n_welded else None
+    if welded is not None:
+        points, topology = welded.vertices, welded.topology
+    one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
+    topology, n_flipped = oriented_topology(points, one_sided.topology, orient)
+    # the row computed for each of the caller's vertices (welded vertices, in the local order)
+    index = None if welded is None else welded.index
+    if local is not None:
+        index = local.index if welded is None else welded.index[local.index]
+    if local is not None and welded is None:  # the mesh the caller gave, its faces oriented (and one-sided)
+        surface = Surface(callers, np.take(local.order, topology.faces) if one_sided.n_dropped
+                          else local.original_faces(topology.faces))
+    else:
+        surface = Surface(points, topology.faces, index)
+    return PreparedMesh(points, topology, index, surface, orient, welded.n_welded if welded is not None else 0,
+                        one_sided.n_dropped, n_flipped)
