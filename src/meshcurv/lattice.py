@@ -28,6 +28,17 @@ GRID_FRACTION = 0.95
 #: A coordinate value counts as a grid plane when this many vertices share it.
 _PLANE_MULTIPLICITY = 3
 
+#: The grid planes of an axis: its most populated repeated values, taken until they hold this share of
+#: the repeated values (a plane of the grid holds dozens to thousands of vertices, a repeated interpolated
+#: coordinate a few).
+_GRID_SHARE = 0.5
+
+#: Share of those planes that must lie on one lattice (a few busy interpolated values may not).
+_PLANES_ON_GRID = 0.8
+
+#: The origin of the lattice is sought among this many of the busiest planes.
+_ORIGIN_CANDIDATES = 64
+
 #: Grid coordinates within this fraction of the spacing of a plane of the lattice lie on it.
 _ON_GRID = 1e-6
 
@@ -50,26 +61,51 @@ class VoxelGrid(NamedTuple):
     fraction: float
 
 
-def _axis_lattice(values: np.ndarray):
-    """``(spacing, origin, on_grid)`` of one coordinate axis, or None when its repeated values form no lattice."""
-    planes, counts = np.unique(values, return_counts=True)
-    planes = planes[counts >= _PLANE_MULTIPLICITY]
+def _plane_lattice(planes: np.ndarray, candidates: np.ndarray, share: float):
+    """``(spacing, origin)`` of the lattice that holds ``share`` of the sorted ``planes``, or None.
+
+    The spacing is the smallest gap common among the planes (wider gaps are
+    multiples of it), or, where small gaps are rare (a few busy interpolated
+    values among the grid planes), the median gap. The origin is the one of
+    ``candidates`` whose lattice holds the most planes.
+    """
     if planes.size < 3:
         return None
     gaps = np.diff(planes)
     gaps = gaps[gaps > 0]
     if gaps.size == 0:
         return None
-    # the smallest gap that is common among the planes is the spacing; wider gaps are multiples of it
     smallest = float(np.min(gaps))
     near = gaps[gaps < 1.5 * smallest]
-    if near.size < 0.5 * gaps.size:
-        return None
-    spacing = float(np.median(near))
-    origin = float(planes[0])
-    steps = (planes - origin) / spacing
-    if np.abs(steps - np.round(steps)).max() > 1e3 * _ON_GRID:
+    spacing = float(np.median(near if near.size >= 0.5 * gaps.size else gaps))
+    steps = (planes[None, :] - candidates[:, None]) / spacing
+    held = (np.abs(steps - np.round(steps)) <= 1e3 * _ON_GRID).mean(axis=1)
+    if held.max() < share:
         return None  # the repeated values are not evenly spaced: not a grid (a symmetric height field, say)
+    return spacing, float(candidates[np.argmax(held)])
+
+
+def _axis_lattice(values: np.ndarray):
+    """``(spacing, origin, on_grid)`` of one coordinate axis, or None when its repeated values form no lattice.
+
+    The lattice of every repeated value (a binary mask's isosurface: the grid
+    planes and the middles between them), or else that of the busiest ones:
+    the interpolated coordinates of a smoothed mask's isosurface repeat too, a
+    few times each (a symmetric solid, float32 coordinates), where a plane of
+    the grid holds every vertex on the grid edges that lie in it.
+    """
+    planes, counts = np.unique(values, return_counts=True)
+    repeated = counts >= _PLANE_MULTIPLICITY
+    planes, counts = planes[repeated], counts[repeated]
+    found = _plane_lattice(planes, planes[:1], 1.0)
+    if found is None and planes.size:
+        busiest = np.argsort(counts, kind="stable")[::-1]
+        enough = int(np.searchsorted(np.cumsum(counts[busiest]), _GRID_SHARE * counts.sum())) + 1
+        found = _plane_lattice(np.sort(planes[busiest[:enough]]), planes[busiest[:_ORIGIN_CANDIDATES]],
+                               _PLANES_ON_GRID)
+    if found is None:
+        return None
+    spacing, origin = found
     with np.errstate(over="ignore", invalid="ignore"):
         steps = (values - origin) / spacing
     if not np.isfinite(steps).all() or np.abs(steps).max() > 2.0**52:
