@@ -923,6 +923,32 @@ def check_connected_face_sums(name):
     # through the ends of a side that meets the ball with both ends outside); 2 edges: a ball of several rings
     for edges in (0.95, 2.0):
         check_connected_face_sums_at(name, edges * mean_edge(name))
+    check_connected_face_sums_radii(name)
+
+
+def check_connected_face_sums_radii(name):
+    """A radius per vertex, and three nested radii per vertex in one walk: each row against the NumPy path's
+    sums at that row's radii (the same faces and shares, summed in another order)."""
+    vertices, faces = mesh(name)
+    compiled = kernels("neighborhoods")
+    values = ball_values(name, "faces")
+    usable = np.random.default_rng(4).random(faces.shape[0]) > 0.1
+    centres, reach = compiled.cell_centres(vertices, faces)
+    n = vertices.shape[0]
+    indptr, indices = compiled.vertex_face_lists(faces, n, kernel_threads())
+    h = mean_edge(name)
+    per_vertex = np.random.default_rng(2).uniform(0.9, 2.5, n) * h
+    for radii in (per_vertex[None, :], np.array([0.5, 1.0, 2.0])[:, None] * per_vertex,
+                  np.array([[0.95], [2.0], [4.0]]) * h):
+        got = np.zeros((radii.shape[0], n, values.shape[1]))
+        compiled.connected_face_sums(vertices, faces, centres, reach, usable, values, np.ascontiguousarray(radii),
+                                     indptr, indices, got,
+                                     _face_sum_scratch(kernel_threads(), n, faces.shape[0], radii.shape[0] > 1), 0, n)
+        for r, row in enumerate(radii):
+            radius = row[0] if row.size == 1 else row
+            expected, magnitude = numpy_ball_sums(name, "faces", values, radius, usable, connected=True)
+            assert_sums_close(got[r], expected, magnitude, ball_terms(name, "faces", float(np.max(radius))),
+                              f"{radii.shape[0]} radii, row {r}")
 
 
 def check_connected_face_sums_at(name, radius):
@@ -938,33 +964,35 @@ def check_connected_face_sums_at(name, radius):
         # components of all balls at once), summed in another order
         expected, magnitude = numpy_ball_sums(name, "faces", values, radius, mask, connected=True)
         allowed = np.ones(faces.shape[0], dtype=bool) if mask is None else mask
-        got = np.zeros_like(expected)
-        compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices, got,
+        radii = np.array([[radius]])  # one radius for all vertices
+        got = np.zeros((1, *expected.shape))
+        compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices, got,
                                      _face_sum_scratch(kernel_threads(), n, faces.shape[0]), 0, n)
-        assert_sums_close(got, expected, magnitude, ball_terms(name, "faces", radius),
+        assert_sums_close(got[0], expected, magnitude, ball_terms(name, "faces", radius),
                           "all faces" if mask is None else "usable faces")
         # ranges of centres, one scratch for all (as the calls of ball_face_sums): only their rows each time;
         # with the int64 scratch of meshes whose indices do not fit in int32 (this one's are int32)
-        part = np.zeros_like(expected)
+        part = np.zeros_like(got)
         scratch = tuple(a.astype(np.int64) if a.dtype == np.int32 else a for a in _face_sum_scratch(3, n, faces.shape[0]))
-        compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices, part,
+        compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices, part,
                                      scratch, n // 3, n // 2)
-        np.testing.assert_array_equal(part[n // 3:n // 2], got[n // 3:n // 2])
-        assert not part[:n // 3].any() and not part[n // 2:].any()
+        np.testing.assert_array_equal(part[:, n // 3:n // 2], got[:, n // 3:n // 2])
+        assert not part[:, :n // 3].any() and not part[:, n // 2:].any()
         for lo, hi in ((0, n // 3), (n // 2, n)):
-            compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radius, indptr, indices,
+            compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices,
                                          part, scratch, lo, hi)
         np.testing.assert_array_equal(part, got)
 
 
 def test_face_sum_scratch_takes_int64_only_beyond_int32_indices():
     small = _face_sum_scratch(2, 10, 16)
-    assert [a.dtype for a in small] == [np.int32, np.int32, np.int32, np.float64, np.int32]
-    assert [a.shape for a in small] == [(2, 16), (2, 10), (2, 10), (2, 10), (2, 10)]
+    assert [a.dtype for a in small] == [np.int32, np.int32, np.int32, np.float64, np.int32, np.int32, np.int32]
+    assert [a.shape for a in small] == [(2, 16), (2, 10), (2, 10), (2, 10), (2, 10), (2, 0), (2, 0)]
     assert all((a == -1).all() for a in small[:3])
+    assert [a.shape for a in _face_sum_scratch(2, 10, 16, nested=True)[5:]] == [(2, 16), (2, 16)]
     # no chunks: the dtype is chosen without allocating a mesh of 2^31 faces
     large = _face_sum_scratch(0, 10, 2**31)
-    assert [a.dtype for a in large] == [np.int64, np.int64, np.int64, np.float64, np.int64]
+    assert [a.dtype for a in large] == [np.int64, np.int64, np.int64, np.float64, np.int64, np.int64, np.int64]
 
 
 # -- jets ---------------------------------------------------------------------------------------
@@ -981,6 +1009,8 @@ def jet_inputs(name):
 
 def jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacency=None):
     """(N,) condition number of the scaled normal matrix each NumPy fit solved in ``frame`` (NaN: none).
+
+    ``radius``: one for all, or one per centre.
 
     The matrices of :func:`meshcurv.jets._fit_chunk` over the same balls (the surface-connected
     pieces with ``adjacency``), the degree chosen as ``jets._solve`` chooses it (the highest whose
@@ -999,7 +1029,7 @@ def jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacen
         balls = connected_ball_pairs(points, centres, radius, adjacency, allowed)
     for chunk, centre, neighbour in balls:
         index, rows = centres[chunk], centre - chunk.start
-        offsets = (points[neighbour] - points[index[rows]]) / radius
+        offsets = (points[neighbour] - points[index[rows]]) / (radius[centre][:, None] if np.ndim(radius) else radius)
         weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
         matrix, right = jets._fit_chunk(offsets, rows, index.size, [part[index] for part in frame], weights, degree)
         todo = np.ones(index.size, dtype=bool)
@@ -1071,19 +1101,22 @@ def check_fit_jets(name):
     facing = normals.copy()
     facing[rng.random(n) < 0.02] *= -1  # a few normals facing away: some balls refused
     facing[rng.random(n) < 0.01] = np.nan  # and a few missing: not counted
-    for degree, mask, check in ((4, None, False), (3, pool_mask, True), (2, None, True)):
+    per_centre = radius * rng.uniform(1.0, 1.4, centres.size)  # a radius per centre (no smaller balls)
+    for degree, mask, check, radii in ((4, None, False, radius), (3, pool_mask, True, radius), (2, None, True, radius),
+                                       (3, pool_mask, False, per_centre)):
         details = {}
         with use_backend("numpy"):
-            expected = jets.fit_jets(points, normals, radius, degree=degree, centres=centres, neighbours=mask,
+            expected = jets.fit_jets(points, normals, radii, degree=degree, centres=centres, neighbours=mask,
                                      facing=facing if check else None, details=details)
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
-        found = kernels("jets").fit_jets(points, normals, float(radius), degree, jets.ITERATIONS,
+        by_vertex = spread(radii, centres, n, 0.0) if np.ndim(radii) else np.array([radius])
+        found = kernels("jets").fit_jets(points, normals, by_vertex, degree, jets.ITERATIONS,
                                          jets._exponents(degree), jets.MIN_PIVOT, centres, 64 * kernel_threads(),
                                          pool, facing if check else points, check, jets.AWAY_FRACTION)
         coefficients, t1, t2, normal, counts, away = found
-        label = f"degree {degree}, pool {'all' if mask is None else 'some'}, facing {check}"
+        label = f"degree {degree}, pool {'all' if mask is None else 'some'}, facing {check}, radii {np.size(radii)}"
         compare_jets((coefficients, (t1, t2, normal), counts), expected, label,
-                     (points, normals, radius, centres, pool, degree))
+                     (points, normals, radii, centres, pool, degree))
         # the shares facing away: the same counts divided alike
         np.testing.assert_array_equal(away, details["away"], err_msg=f"{label}: away")
         if check:
@@ -1108,13 +1141,15 @@ def check_fit_jets_connected(name):
     facing = normals.copy()
     facing[rng.random(n) < 0.02] *= -1
     compiled = kernels("jets").fit_jets_connected
-    for degree, mask, check in ((4, None, False), (3, allowed, True)):
+    per_centre = radius * rng.uniform(1.0, 1.4, centres.size)  # a radius per centre (no smaller balls)
+    for degree, mask, check, radii in ((4, None, False, radius), (3, allowed, True, radius),
+                                       (3, allowed, True, per_centre)):
         # the NumPy path's connected balls (the walk's, found by connected components of all balls at once)
         details = {}
         with use_backend("numpy"):
-            expected = jets.fit_jets(points, normals, radius, degree=degree, centres=centres, neighbours=mask,
+            expected = jets.fit_jets(points, normals, radii, degree=degree, centres=centres, neighbours=mask,
                                      facing=facing if check else None, details=details, adjacency=(indptr, indices))
-        arguments = (points, normals, float(radius), degree, jets.ITERATIONS, jets._exponents(degree), jets.MIN_PIVOT,
+        arguments = (points, normals, radii if np.ndim(radii) else np.array([radius]), degree, jets.ITERATIONS, jets._exponents(degree), jets.MIN_PIVOT,
                      centres, kernel_threads(), np.ones(n, dtype=bool) if mask is None else mask, indptr, indices,
                      facing if check else points, check, jets.AWAY_FRACTION)
         # one row per centre: spread to rows of all vertices (NaN, counts 0, elsewhere) as NumPy gives them
@@ -1122,10 +1157,10 @@ def check_fit_jets_connected(name):
         assert all(row.shape[0] == centres.size for row in rows)
         coefficients, t1, t2, normal, counts, away = (spread(row, centres, n, 0.0 if k == 4 else np.nan)
                                                       for k, row in enumerate(rows))
-        label = f"degree {degree}, {'all' if mask is None else 'some'} allowed, facing {check}"
+        label = f"degree {degree}, {'all' if mask is None else 'some'} allowed, facing {check}, radii {np.size(radii)}"
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
         compare_jets((coefficients, (t1, t2, normal), counts), expected, label,
-                     (points, normals, radius, centres, pool, degree), (indptr, indices))
+                     (points, normals, radii, centres, pool, degree), (indptr, indices))
         np.testing.assert_array_equal(away, details["away"], err_msg=f"{label}: away")
         # normals only: the unit normals of the same fits (jets.jet_normals), at the centres, NaN elsewhere;
         # frame-free, so compared everywhere, within the fits' tolerance (the coefficients' largest)

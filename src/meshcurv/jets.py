@@ -63,8 +63,9 @@ import numpy as np
 from ._backend import kernel_threads, numba_kernels
 from ._tensors import tangent_basis
 from ._validation import checked_points
-from .errors import InvalidMeshError
-from .neighborhoods import _ball_pairs, call_ranges, check_ball_work, checked_adjacency, connected_ball_pairs
+from .errors import InvalidMeshError, InvalidOptionError
+from .neighborhoods import (_ball_pairs, call_ranges, centre_radii, check_ball_work, checked_adjacency,
+                            connected_ball_pairs)
 
 #: Highest degree of the jet (lowered to 3, then 2, where the ball holds too few points).
 DEGREE = 4
@@ -209,7 +210,7 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
     return out
 
 
-def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
+def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int = DEGREE,
              iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
              neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
              details: dict | None = None, adjacency: tuple | None = None, settled: float = 0.0,
@@ -221,8 +222,10 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     vertices : ndarray of shape (V, 3)
     normals : ndarray of shape (V, 3)
         Unit normals of the first frame (finite at the centres).
-    radius : float
-        Radius of the ball of each fit (> 0).
+    radius : float or ndarray of shape (M,)
+        Radius of the ball of each fit (> 0): one for all, or one per centre
+        (M: the number of ``centres``, V without them; positive and finite),
+        each fit then that of the float call at its centre's radius.
     degree : int, default: DEGREE
     iterations : int, default: ITERATIONS
     centres : ndarray of int, optional
@@ -281,7 +284,9 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     ------
     InvalidOptionError
         The balls would hold more than :data:`meshcurv.neighborhoods.MAX_BALL_PAIRS`
-        pairs in all (a radius far too large for the mesh).
+        pairs in all (a radius far too large for the mesh); ``radius`` is an
+        array that does not hold one positive finite radius per centre, or that
+        gives a centre listed twice two radii.
     """
     vertices = checked_points(vertices)
     n = vertices.shape[0]
@@ -292,6 +297,9 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     centres = np.arange(n) if centres is None else np.asarray(centres, dtype=np.int64).ravel()
     if centres.size and (centres.min() < 0 or centres.max() >= n):
         raise InvalidMeshError(f"`centres` must be vertex indices in 0..{n - 1}")
+    per_centre = np.ndim(radius) > 0
+    if per_centre:
+        radius = _checked_centre_radii(radius, centres)
     if neighbours is None:
         pool = np.arange(n)
     else:
@@ -312,11 +320,12 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
             rows = _connected_fits(kernels, vertices, normals, radius, degree, iterations, centres, mean,
                                    neighbours, adjacency, facing, settled, normals_only=False)
         else:
+            radii = _all_rows(radius, centres, n, 0.0) if per_centre else np.array([float(radius)])  # by vertex
             pieces = []  # each call's outputs, one row per centre of its part
-            for lo, hi in call_ranges(centres.size, mean):
+            for lo, hi in call_ranges(centres.size, mean, radius * radius if per_centre else None):
                 part = centres[lo:hi]  # rows of all vertices: those of the part (a slice when the centres are all)
                 pieces.append(tuple(output[lo:hi] if every_vertex else output[part] for output in kernels.fit_jets(
-                    vertices, normals, float(radius), degree, iterations, _exponents(degree), MIN_PIVOT, part,
+                    vertices, normals, radii, degree, iterations, _exponents(degree), MIN_PIVOT, part,
                     64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION,
                     float(settled))))
             rows = _joined(pieces)
@@ -330,6 +339,10 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
     coefficients = np.full((n, 6), np.nan)
     counts = np.zeros(n)
     away = np.full(n, np.nan)
+    given = centres  # the rows of the compact outputs
+    if per_centre:  # by increasing radius: each chunk's search reaches little beyond its own balls
+        order = np.argsort(radius, kind="stable")
+        centres, radius = centres[order], radius[order]
     if adjacency is not None:  # the surface-connected balls, as the compiled walk finds them
         balls = connected_ball_pairs(vertices, centres, radius, adjacency, neighbours, chunk_size=chunk_size)
     else:
@@ -339,7 +352,8 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
         index = centres[chunk]
         size = index.size
         rows = centre - chunk.start
-        offsets = (vertices[neighbour] - vertices[index[rows]]) * (1.0 / radius)
+        inverse = (1.0 / radius)[centre][:, None] if per_centre else 1.0 / radius  # the kernels' operations
+        offsets = (vertices[neighbour] - vertices[index[rows]]) * inverse
         weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
         local = [*tangent_basis(normals[index]), normals[index]]
@@ -372,11 +386,30 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree
         coefficients[index] = fitted
         counts[index] = count
     if compact:
-        coefficients, frame, counts, away = (coefficients[centres], [f[centres] for f in frame], counts[centres],
-                                             away[centres])
+        coefficients, frame, counts, away = (coefficients[given], [f[given] for f in frame], counts[given],
+                                             away[given])
     if details is not None:
         details["away"] = away
     return coefficients, tuple(frame), counts
+
+
+def _checked_centre_radii(radius, centres: np.ndarray) -> np.ndarray:
+    """(M,) float64 radii of the M ``centres``, checked: positive, finite, one radius per vertex listed.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``radius`` is not an array of M positive finite numbers, or gives a
+        centre listed twice two radii.
+    """
+    radius = centre_radii(radius, centres.size)
+    order = np.argsort(centres, kind="stable")
+    ordered, radii = centres[order], radius[order]
+    twice = (ordered[1:] == ordered[:-1]) & (radii[1:] != radii[:-1])
+    if twice.any():
+        raise InvalidOptionError(f"`radius` gives vertex {int(ordered[1:][twice][0])}, listed twice in `centres`, "
+                                 f"two radii")
+    return radius
 
 
 def _joined(pieces: list) -> list[np.ndarray]:
@@ -384,20 +417,23 @@ def _joined(pieces: list) -> list[np.ndarray]:
     return [column[0] if len(column) == 1 else np.concatenate(column) for column in zip(*pieces)]
 
 
-def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius: float, degree: int, iterations: int,
+def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, degree: int, iterations: int,
                     centres: np.ndarray, pairs_per_centre: float, neighbours: np.ndarray | None, adjacency: tuple,
                     facing: np.ndarray | None, settled: float, *, normals_only: bool) -> list[np.ndarray]:
     """The compiled fits over the surface-connected balls of ``centres``, in calls of about
     :data:`~meshcurv.neighborhoods.PAIRS_PER_CALL` pairs (checked inputs; ``neighbours`` a (V,) bool
-    array or None). The kernel's outputs, one row per centre; with ``normals_only``, ``[normals]``
-    (M, 3), the fitted normals alone."""
+    array or None; ``radius`` a float or a checked (M,) array of one per centre). The kernel's outputs,
+    one row per centre; with ``normals_only``, ``[normals]`` (M, 3), the fitted normals alone."""
     n = vertices.shape[0]
     allowed = np.ones(n, dtype=bool) if neighbours is None else neighbours
     indptr, indices = checked_adjacency(adjacency, n)
     check = facing is not None
+    per_centre = np.ndim(radius) > 0
+    radii = radius if per_centre else np.array([float(radius)])
     pieces = []
-    for lo, hi in call_ranges(centres.size, pairs_per_centre):
-        outputs = kernels.fit_jets_connected(vertices, normals, float(radius), degree, iterations, _exponents(degree),
+    for lo, hi in call_ranges(centres.size, pairs_per_centre, radii * radii if per_centre else None):
+        outputs = kernels.fit_jets_connected(vertices, normals, radii[lo:hi] if per_centre else radii, degree,
+                                             iterations, _exponents(degree),
                                              MIN_PIVOT, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
                                              facing if check else vertices, check, AWAY_FRACTION, normals_only,
                                              float(settled))
@@ -412,7 +448,7 @@ def _all_rows(rows: np.ndarray, centres: np.ndarray, n: int, fill: float) -> np.
     return out
 
 
-def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *, degree: int = DEGREE,
+def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int = DEGREE,
                     iterations: int = ITERATIONS, neighbours: np.ndarray | None = None,
                     adjacency: tuple | None = None, settled: float = 0.0) -> np.ndarray:
     """(V, 3) unit normals of the jets of :func:`fit_jets` at every vertex (NaN where no fit was possible).
@@ -422,6 +458,7 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *,
     (not the coefficients, frames and counts: 136 bytes per vertex). A vertex
     whose fit has a slope ``c10^2 + c01^2`` below ``settled`` takes its normal
     without further iterations (:func:`fit_jets`; 0: ``iterations`` fits everywhere).
+    ``radius``: one for all vertices, or a (V,) array of one per vertex (as :func:`fit_jets`).
     """
     kernels = numba_kernels("jets")
     vertices = checked_points(vertices)
@@ -437,6 +474,8 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius: float, *,
         neighbours = np.asarray(neighbours, dtype=bool)
         if neighbours.shape != (n,):
             raise InvalidMeshError(f"`neighbours` must have shape ({n},); got {neighbours.shape}")
+    if np.ndim(radius):
+        radius = centre_radii(radius, n)
     mean, _ = check_ball_work(vertices if neighbours is None else vertices[neighbours], radius, n, centres=vertices)
     return _connected_fits(kernels, vertices, normals, radius, degree, iterations, np.arange(n), mean, neighbours,
                            adjacency, None, settled, normals_only=True)[0]

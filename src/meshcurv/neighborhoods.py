@@ -89,32 +89,47 @@ def _sample(n: int, size: int) -> np.ndarray:
     return np.linspace(0, n - 1, size).round().astype(np.int64)
 
 
-def estimate_ball_pairs(points: np.ndarray, radius: float, centres: np.ndarray | None = None) -> tuple[float, float]:
+def estimate_ball_pairs(points: np.ndarray, radius, centres: np.ndarray | None = None) -> tuple[float, float]:
     """Estimated points of ``points`` within ``radius`` of each centre: ``(mean, largest)`` per centre.
 
     From :data:`SAMPLE_CENTRES` centres (default: the points themselves) against
     :data:`SAMPLE_POINTS` points, both evenly spaced in index order and scaled to
     the whole cloud: some 0.3 million distances, about a millisecond, whatever
     the radius (the balls themselves are never searched). Exact when the cloud
-    and the centres are no larger than the sample.
+    and the centres are no larger than the sample. ``radius``: one for all
+    centres, or an array of one per centre; then the mean is that of the
+    evenly spaced centres, each with its own radius, and the largest ball is
+    looked for among them and the :data:`SAMPLE_CENTRES` centres of the largest radii.
     """
     points = checked_points(points, name="points")
     centres = points if centres is None else centres
     if centres.shape[0] == 0:
         return 0.0, 0.0
     sub = points[_sample(points.shape[0], SAMPLE_POINTS)]
-    probe = centres[_sample(centres.shape[0], SAMPLE_CENTRES)]
+    picked = _sample(centres.shape[0], SAMPLE_CENTRES)
+    if np.ndim(radius):  # one radius per centre: the sample and the widest balls, each with its own radius
+        widest = np.argpartition(radius, -min(SAMPLE_CENTRES, radius.size))[-SAMPLE_CENTRES:]
+        probe_radius = radius[np.concatenate([picked, widest])][:, None]
+        return _pairs_within(points, sub, centres[np.concatenate([picked, widest])], probe_radius, picked.size)
+    return _pairs_within(points, sub, centres[picked], radius, picked.size)
+
+
+def _pairs_within(points: np.ndarray, sub: np.ndarray, probe: np.ndarray, radius, n_mean: int) -> tuple[float, float]:
+    """:func:`estimate_ball_pairs` from the sample ``sub`` of ``points`` and the centres ``probe``: the mean
+    over the first ``n_mean`` centres, the largest over all (``radius``: a number, or a column per centre)."""
     origin = probe.mean(axis=0)  # |p - c|^2 = |p|^2 + |c|^2 - 2 p.c about a nearby origin: one small product
     sub, probe = sub - origin, probe - origin
     d2 = (np.einsum("ij,ij->i", probe, probe)[:, None] + np.einsum("ij,ij->i", sub, sub)[None, :]
           - 2.0 * (probe @ sub.T))
     inside = (d2 <= radius * radius).sum(axis=1) * (points.shape[0] / sub.shape[0])
-    return float(inside.mean()), float(inside.max())
+    return float(inside[:n_mean].mean()), float(inside.max())
 
 
-def check_ball_work(points: np.ndarray, radius: float, n_centres: int, *,
+def check_ball_work(points: np.ndarray, radius, n_centres: int, *,
                     centres: np.ndarray | None = None) -> tuple[float, float]:
     """Refuse a ball computation beyond :data:`MAX_BALL_PAIRS`; return :func:`estimate_ball_pairs`.
+
+    ``radius``: one for all centres, or an array of one per centre.
 
     Raises
     ------
@@ -124,8 +139,9 @@ def check_ball_work(points: np.ndarray, radius: float, n_centres: int, *,
     """
     mean, largest = estimate_ball_pairs(points, radius, centres)
     if mean * n_centres > MAX_BALL_PAIRS:
+        named = f"{radius:g}" if np.ndim(radius) == 0 else f"up to {np.max(radius):g}"
         raise InvalidOptionError(
-            f"`radius` {radius:g} is far too large for the mesh's resolution: each ball would hold about "
+            f"`radius` {named} is far too large for the mesh's resolution: each ball would hold about "
             f"{mean:.3g} of its {points.shape[0]} points ({mean * n_centres:.3g} pairs in all, more than "
             f"{MAX_BALL_PAIRS:.1g}: hours of work); pass a radius of a few edge lengths"
         )
@@ -137,6 +153,30 @@ def _checked_radius_value(radius) -> float:
     if radius == 0 and not isinstance(radius, (str, bytes, bool)):
         return 0.0
     return check_positive_float(radius, "radius")
+
+
+def centre_radii(radius, n: int, name: str = "radius"):
+    """``radius`` checked: a float (one for all, >= 0), or a (n,) float64 array of one per centre (> 0, finite).
+
+    Raises
+    ------
+    InvalidOptionError
+        ``radius`` is not a finite real number >= 0, or an array of ``n``
+        positive finite numbers.
+    """
+    if np.ndim(radius) == 0:
+        return _checked_radius_value(radius)
+    try:
+        radii = np.asarray(radius, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidOptionError(f"`{name}` must be a number or an array of {n} positive numbers") from None
+    if radii.shape != (n,):
+        raise InvalidOptionError(f"`{name}` must be a number or an array of shape ({n},): one radius per centre; "
+                                 f"got shape {radii.shape}")
+    if radii.size and not (np.isfinite(radii).all() and radii.min() > 0):
+        bad = int(np.count_nonzero(~(np.isfinite(radii) & (radii > 0))))
+        raise InvalidOptionError(f"`{name}` must hold positive finite radii; {bad} of {n} are not")
+    return np.ascontiguousarray(radii)
 
 
 def _chunks(n: int, size: int = CHUNK) -> Iterator[slice]:
@@ -175,14 +215,24 @@ def vertex_pairs_in_ball(points: np.ndarray, radius: float, *, centres: np.ndarr
 
 def _ball_pairs(points: np.ndarray, centre_points: np.ndarray, radius: float,
                 chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
-    """:func:`vertex_pairs_in_ball` around arbitrary ``centre_points`` (trusted arrays)."""
+    """:func:`vertex_pairs_in_ball` around arbitrary ``centre_points`` (trusted arrays).
+
+    ``radius``: one for all, or a (C,) array of one per centre (checked): the
+    pairs of the chunk's largest ball, then those within each centre's own
+    radius (squared distances summed x, y, z, as the compiled ``_ball_members``).
+    """
     from scipy.spatial import cKDTree
 
     _, largest = check_ball_work(points, radius, centre_points.shape[0], centres=centre_points)
     chunk_size = max(1, min(int(chunk_size), int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
     tree = cKDTree(points)
     for chunk in _chunks(centre_points.shape[0], chunk_size):
-        i, j = _pairs(tree, centre_points[chunk], radius)
+        if np.ndim(radius) == 0:
+            i, j = _pairs(tree, centre_points[chunk], radius)
+        else:
+            i, j = _pairs(tree, centre_points[chunk], float(radius[chunk].max()) * (1 + _SEARCH_SLACK))
+            inside = _squared(*(points[j] - centre_points[chunk][i]).T) <= radius[chunk][i] ** 2
+            i, j = i[inside], j[inside]
         yield chunk, i + chunk.start, j
 
 
@@ -257,20 +307,17 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     surface-connected piece of each ball (see :func:`ball_face_sums`).
     """
     vertices, cells = _checked_cells(vertices, cells)
-    radius = _checked_radius_value(radius)
-    values = np.asarray(values, dtype=np.float64)
-    if values.ndim != 2 or values.shape[0] != cells.shape[0]:
-        raise InvalidMeshError(
-            f"`values` must have shape ({cells.shape[0]}, k): one row per cell; got {values.shape}")
-    if usable is not None:
-        usable = np.asarray(usable, dtype=bool)
-        if usable.shape != (cells.shape[0],):
-            raise InvalidMeshError(f"`usable` must have shape ({cells.shape[0]},); got {usable.shape}")
+    radius = centre_radii(radius, vertices.shape[0])
+    values, usable = _checked_values(cells, values, usable)
     kernels = numba_kernels("neighborhoods")
     if connected and cells.shape[1] == 3 and cells.shape[0]:
         if kernels is not None:
-            return _connected_face_sums(kernels, vertices, cells, radius, values, usable)
+            radii = np.array([[radius]]) if np.ndim(radius) == 0 else radius[None, :]
+            return _connected_face_sums(kernels, vertices, cells, radii, values, usable)[0]
         return _connected_face_sums_numpy(vertices, cells, radius, values, usable)
+    if np.ndim(radius):
+        raise InvalidOptionError("a `radius` per vertex takes the surface-connected balls (`connected=True`); "
+                                 "the Euclidean ball sums take one radius")
     if usable is not None:
         keep = np.flatnonzero(usable)
         cells, values = cells[keep], values[keep]
@@ -305,6 +352,19 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
                 return sums
             out += sums
     return out
+
+
+def _checked_values(cells: np.ndarray, values, usable) -> tuple[np.ndarray, np.ndarray | None]:
+    """``values`` (C, k) float64 and ``usable`` (C,) bool or None, one row per cell, checked."""
+    values = np.asarray(values, dtype=np.float64)
+    if values.ndim != 2 or values.shape[0] != cells.shape[0]:
+        raise InvalidMeshError(
+            f"`values` must have shape ({cells.shape[0]}, k): one row per cell; got {values.shape}")
+    if usable is not None:
+        usable = np.asarray(usable, dtype=bool)
+        if usable.shape != (cells.shape[0],):
+            raise InvalidMeshError(f"`usable` must have shape ({cells.shape[0]},); got {usable.shape}")
+    return values, usable
 
 
 def _gathered(rows: np.ndarray, cells: np.ndarray, weights: np.ndarray, chunk: slice, values: np.ndarray) -> np.ndarray:
@@ -363,6 +423,8 @@ def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np
     their size group (:func:`_size_groups`) of the centre, by k-d trees; the
     caller tests each pair exactly. The chunks hold at most ``chunk_size`` centres
     and about :data:`PAIRS_PER_CHUNK` pairs, all the groups' pairs of a centre in the same chunk.
+    ``radius``: one for all, or a (C,) array of one per centre (each chunk is then
+    searched with its largest: callers order the centres by radius).
     ``refuse``: check each group's work (:func:`check_ball_work`, as the compiled
     ``ball_cell_sums`` is called); False where the caller has made the check
     of the compiled path already (the connected balls), so that both backends
@@ -376,21 +438,24 @@ def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np
     from scipy.spatial import cKDTree
 
     n = centre_points.shape[0]
+    per_centre = np.ndim(radius) > 0  # one radius per centre: each chunk searched with its largest
     searches = []
     largest = 0.0
-    if centroids.shape[0]:
+    if centroids.shape[0] and n:
         index = np.arange(centroids.shape[0])
-        for group in _size_groups(reach, radius):
-            cutoff = radius + float(reach[group].max())
+        for group in _size_groups(reach, float(np.max(radius))):
+            group_reach = float(reach[group].max())
+            cutoff = radius + group_reach
             largest += (check_ball_work(centroids[group], cutoff, n, centres=centre_points) if refuse
                         else estimate_ball_pairs(centroids[group], cutoff, centre_points))[1]
-            searches.append((cKDTree(centroids[group]), index[group], cutoff * (1 + _SEARCH_SLACK)))
+            searches.append((cKDTree(centroids[group]), index[group], group_reach))
     chunk_size = max(1, min(int(chunk_size), int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
     empty = np.zeros(0, dtype=np.int64)
     for chunk in _chunks(n, chunk_size):
         rows, cells = [empty], [empty]
-        for tree, index, cutoff in searches:
-            i, c = _pairs(tree, centre_points[chunk], cutoff)
+        top = float(radius[chunk].max()) if per_centre else radius
+        for tree, index, group_reach in searches:
+            i, c = _pairs(tree, centre_points[chunk], (top + group_reach) * (1 + _SEARCH_SLACK))
             rows.append(i)
             cells.append(index[c])
         yield chunk, np.concatenate(rows), np.concatenate(cells)
@@ -445,7 +510,7 @@ def _linked_to_centre(n: int, rows: np.ndarray, corners: list[np.ndarray],
     return keys, labels == centre_labels[keys // n], nodes
 
 
-def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,
+def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius, values: np.ndarray,
                                usable: np.ndarray | None) -> np.ndarray:
     """:func:`ball_face_sums` over the surface-connected piece of each ball: the compiled
     ``connected_face_sums``'s faces, found for all centres of a chunk at once.
@@ -455,7 +520,9 @@ def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius: 
     side crossing the sphere); the faces summed are those passed through that
     are joined to the centre by such faces (:func:`_linked_to_centre`), each
     weighted by its share (:func:`face_in_ball_ratios`, from squared distances
-    as the kernel computes them).
+    as the kernel computes them). ``radius``: one for all, or (V,) one per
+    vertex (the centres are then taken by increasing radius, so that each
+    chunk's search reaches little beyond its own balls).
     """
     n = vertices.shape[0]
     centroids, reach = cell_centres(vertices, faces)
@@ -463,13 +530,18 @@ def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius: 
     points, middles = _columns(vertices), _columns(centroids)
     corners = [np.ascontiguousarray(faces[:, k]) for k in range(3)]
     out = np.zeros((n, values.shape[1]))
-    radius2 = radius * radius
-    for chunk, i, f in _candidate_pairs(vertices, centroids, reach, radius, refuse=False):
-        ids = np.arange(chunk.start, chunk.stop)[i]
+    order = np.arange(n) if np.ndim(radius) == 0 else np.argsort(radius, kind="stable")
+    radii = np.broadcast_to(radius, (n,))[order]  # by centre, in the order taken
+    for chunk, i, f in _candidate_pairs(vertices[order], centroids, reach, radii if np.ndim(radius) else radius,
+                                        refuse=False):
+        ids = order[chunk][i]
         centre = tuple(column[ids] for column in points)
         middle = _squared(*_offsets(middles, f, centre))
-        near = np.flatnonzero(~(middle > (radius + reach[f]) ** 2))
+        pair_radius = radii[chunk][i]
+        near = np.flatnonzero(~(middle > (pair_radius + reach[f]) ** 2))
         i, f, middle, centre = i[near], f[near], middle[near], tuple(c[near] for c in centre)
+        ball = pair_radius[near]
+        radius2 = ball * ball
         offsets = [_offsets(points, corner[f], centre) for corner in corners]
         low, high = middle.copy(), middle.copy()
         for offset in offsets:
@@ -482,17 +554,17 @@ def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius: 
         for k in range(3):  # corners and centroid outside: through the face when a side crosses the ball
             rest = np.flatnonzero(~meets)
             meets[rest] = _segments_meet_ball(tuple(c[rest] for c in offsets[k]),
-                                              tuple(c[rest] for c in offsets[(k + 1) % 3]), radius2)
+                                              tuple(c[rest] for c in offsets[(k + 1) % 3]), radius2[rest])
         i, f, low, high, inside, partial = i[meets], f[meets], low[meets], high[meets], inside[meets], partial[meets]
-        _, linked, nodes = _linked_to_centre(n, i, [corner[f] for corner in corners],
-                                             np.arange(chunk.start, chunk.stop, dtype=np.int64))
+        ball = ball[meets]
+        _, linked, nodes = _linked_to_centre(n, i, [corner[f] for corner in corners], order[chunk])
         root = np.sqrt(low)
         with np.errstate(invalid="ignore", divide="ignore"):
-            share = np.where(inside, 1.0, np.where(partial, (radius - root) / (np.sqrt(high) - root), 0.0))
+            share = np.where(inside, 1.0, np.where(partial, (ball - root) / (np.sqrt(high) - root), 0.0))
         keep = linked[nodes[0]] & (share != 0.0)
         if usable is not None:
             keep &= usable[f]
-        out[chunk] += _gathered(i[keep], f[keep], share[keep], chunk, values)
+        out[order[chunk]] += _gathered(i[keep], f[keep], share[keep], chunk, values)
     return out
 
 
@@ -502,7 +574,9 @@ def connected_ball_pairs(vertices: np.ndarray, centres: np.ndarray, radius: floa
     """Yield ``(chunk, centre, neighbour)``: the vertices of the surface-connected piece of each ball.
 
     The NumPy twin of the compiled walk of the jet fits (``_connected_members``):
-    the vertices within ``radius`` of vertex ``centres[centre]`` reached from it
+    the vertices within ``radius`` (one for all, or a (M,) array of one per
+    centre: each chunk is then searched with its largest, so callers order the
+    centres by radius) of vertex ``centres[centre]`` reached from it
     over the edges of ``adjacency`` (CSR lists, :attr:`MeshTopology.neighbour_lists`)
     that meet the closed ball (an end inside, or the segment passing through it),
     and ``allowed`` (V,) bool (default: all); every centre is its own first
@@ -523,19 +597,21 @@ def connected_ball_pairs(vertices: np.ndarray, centres: np.ndarray, radius: floa
     mids, half = cell_centres(vertices, edges)
     points = _columns(vertices)
     first, second = np.ascontiguousarray(edges[:, 0]), np.ascontiguousarray(edges[:, 1])
-    radius2 = radius * radius
+    squares = np.broadcast_to(radius * radius, centres.shape)  # by centre
     for chunk, i, e in _candidate_pairs(vertices[centres], mids, half, radius, chunk_size, refuse=False):
         ids = centres[chunk]
         centre = tuple(column[ids[i]] for column in points)
+        radius2 = squares[chunk][i]
         a, b = _offsets(points, first[e], centre), _offsets(points, second[e], centre)
         meets = (_squared(*a) <= radius2) | (_squared(*b) <= radius2)
         rest = np.flatnonzero(~meets)
-        meets[rest] = _segments_meet_ball(tuple(c[rest] for c in a), tuple(c[rest] for c in b), radius2)
+        meets[rest] = _segments_meet_ball(tuple(c[rest] for c in a), tuple(c[rest] for c in b), radius2[rest])
         i, e = i[meets], e[meets]
         keys, linked, _ = _linked_to_centre(n, i, [first[e], second[e]], ids)
         keys = keys[linked]
         rows, neighbour = np.divmod(keys, n)
-        inside = _squared(*_offsets(points, neighbour, tuple(column[ids[rows]] for column in points))) <= radius2
+        inside = (_squared(*_offsets(points, neighbour, tuple(column[ids[rows]] for column in points)))
+                  <= squares[chunk][rows])
         if allowed is not None:
             inside &= allowed[neighbour]
         yield chunk, rows[inside] + chunk.start, neighbour[inside]
@@ -573,46 +649,61 @@ def adjacency_edges(adjacency: tuple, n: int) -> np.ndarray:
     return np.column_stack([keys // n, keys % n])
 
 
-def call_ranges(n: int, pairs_per_centre: float) -> list[tuple[int, int]]:
+def call_ranges(n: int, pairs_per_centre: float, weights: np.ndarray | None = None) -> list[tuple[int, int]]:
     """``(start, stop)`` of each call of a compiled ball kernel over ``n`` centres, in order.
 
     About :data:`PAIRS_PER_CALL` (centre, point) pairs per call (``pairs_per_centre`` on
     average, as :func:`check_ball_work` estimates it): between calls Python gets control back,
     so that Ctrl-C gets through. One call at least, none of them empty when ``n > 0``.
+    ``weights`` (n,): the relative work of each centre (the square of its radius, for
+    balls on a surface of one radius per centre): the calls then split the total
+    weight evenly rather than the centres.
     """
     n_calls = max(1, min(n, int(np.ceil(pairs_per_centre * n / PAIRS_PER_CALL))))
-    return [(call * n // n_calls, (call + 1) * n // n_calls) for call in range(n_calls)]
+    if weights is None or n_calls == 1:
+        return [(call * n // n_calls, (call + 1) * n // n_calls) for call in range(n_calls)]
+    cumulative = np.cumsum(weights, dtype=np.float64)
+    cuts = np.searchsorted(cumulative, cumulative[-1] * np.arange(1, n_calls) / n_calls, side="right")
+    bounds = np.unique(np.concatenate([[0], np.clip(cuts, 1, n - 1), [n]]))
+    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
 
 
-def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int) -> tuple[np.ndarray, ...]:
-    """The per-thread scratch of the compiled ``connected_face_sums``: ``(seen, mark, known, squared, queue)``.
+def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int,
+                      nested: bool = False) -> tuple[np.ndarray, ...]:
+    """The per-thread scratch of the compiled ``connected_face_sums``:
+    ``(seen, mark, known, squared, queue, deferred, levels)``.
 
     ``seen`` (n_chunks, F), ``mark`` and ``known`` (n_chunks, V) filled with -1, ``squared``
     (n_chunks, V) float and ``queue`` (n_chunks, V). Allocated once for all the calls over
     one mesh: each array is stamped with the centre it was last written for, and every centre is
     summed once, so no call needs it cleared again. The stamps and the queue hold vertex
     indices: int32 while the vertex and face counts fit in it (half the memory: 40 bytes per vertex
-    on 2 threads), int64 beyond.
+    on 2 threads), int64 beyond. ``deferred`` and ``levels``: (n_chunks, F) with ``nested``
+    (several radii in one walk: the faces met by a larger ball only), (n_chunks, 0) otherwise.
     """
     index = np.int32 if max(n_vertices, n_faces) < np.iinfo(np.int32).max else np.int64
+    waiting = n_faces if nested else 0
     return (np.full((n_chunks, n_faces), -1, index), np.full((n_chunks, n_vertices), -1, index),
             np.full((n_chunks, n_vertices), -1, index), np.empty((n_chunks, n_vertices)),
-            np.empty((n_chunks, n_vertices), index))
+            np.empty((n_chunks, n_vertices), index), np.empty((n_chunks, waiting), index),
+            np.empty((n_chunks, waiting), index))
 
 
-def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,
+def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radii: np.ndarray, values: np.ndarray,
                          usable: np.ndarray | None) -> np.ndarray:
-    """:func:`ball_face_sums` over the surface-connected piece of each ball (compiled kernel, breadth-first)."""
+    """(R, V, k) :func:`ball_face_sums` over the surface-connected piece of each ball (compiled kernel,
+    breadth-first), at the R nested radii ``radii`` (R, 1) (one for all vertices) or (R, V) (one per vertex)."""
     n = vertices.shape[0]
     usable = np.ones(faces.shape[0], dtype=bool) if usable is None else usable
     centres, reach = kernels.cell_centres(vertices, faces)
-    mean, _ = check_ball_work(centres, radius + float(reach.max()), n, centres=vertices)
+    outer = radii[-1, 0] if radii.shape[1] == 1 else radii[-1]  # the largest ball leads the walk
+    mean, _ = check_ball_work(centres, outer + float(reach.max()), n, centres=vertices)
     indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
     values = np.ascontiguousarray(values)
-    out = np.zeros((n, values.shape[1]))
-    scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0])  # once for all calls
-    for start, stop in call_ranges(n, mean):
-        kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radius, indptr, indices, out,
+    out = np.zeros((radii.shape[0], n, values.shape[1]))
+    scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0], radii.shape[0] > 1)
+    for start, stop in call_ranges(n, mean, None if radii.shape[1] == 1 else outer * outer):
+        kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radii, indptr, indices, out,
                                     scratch, start, stop)
     return out
 
@@ -640,8 +731,76 @@ def ball_face_sums(vertices: np.ndarray, faces: np.ndarray, radius: float, value
     out. The compiled kernel walks each ball breadth-first (no search
     structure over the whole mesh); the NumPy path finds the same faces by
     connected components (see the module's doc).
+
+    ``radius``: one for all vertices (a float), or with ``connected`` a (V,)
+    array of one per vertex (positive, finite): the sums of each vertex are
+    then those of the float call at its own radius.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``radius`` is not a number >= 0 or an array of V positive finite
+        numbers, or is an array without ``connected``.
     """
     return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)
+
+
+def ball_face_sums_nested(vertices: np.ndarray, faces: np.ndarray, radii, values: np.ndarray,
+                          *, usable: np.ndarray | None = None) -> np.ndarray:
+    """(R, V, k) :func:`ball_face_sums` with ``connected=True`` at R nested radii, one walk per vertex.
+
+    Row ``r`` equals ``ball_face_sums(vertices, faces, radii[r], values,
+    usable=usable, connected=True)`` to round-off (the same faces and shares,
+    added in another order). The compiled kernel walks the largest ball of
+    each vertex once, in passes: pass ``r`` extends the walk of ball ``r - 1``
+    by the faces that meet ball ``r``, and a face reached in pass ``r`` adds
+    its share to the sums of ball ``r`` and of every larger one. The NumPy
+    path computes each radius on its own.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3)
+    radii : array_like of shape (R,) or (R, V)
+        R >= 1 radii, one for all vertices, or one row per radius with a radius
+        per vertex; positive, finite and non-decreasing along the first axis.
+    values : array_like of shape (F, k)
+    usable : array_like of bool of shape (F,), optional
+        Faces that add to the sums (the others lead the walks on); default: all.
+
+    Returns
+    -------
+    ndarray of shape (R, V, k)
+
+    Raises
+    ------
+    InvalidOptionError
+        ``radii`` is empty, not of shape (R,) or (R, V), holds a radius that is not
+        positive and finite, or decreases.
+    """
+    vertices, faces = _checked_cells(vertices, faces)
+    n = vertices.shape[0]
+    try:
+        nested = np.array(radii, dtype=np.float64, ndmin=1)
+    except (TypeError, ValueError):
+        raise InvalidOptionError(f"`radii` must be an increasing sequence of positive radii or an (R, {n}) "
+                                 f"array of them") from None
+    if nested.ndim == 1:
+        nested = nested[:, None]
+    if nested.ndim != 2 or nested.shape[0] == 0 or nested.shape[1] not in (1, n):
+        raise InvalidOptionError(f"`radii` must have shape (R,) or (R, {n}) with R >= 1; got {np.shape(radii)}")
+    if not (np.isfinite(nested).all() and (nested > 0).all()):
+        raise InvalidOptionError("`radii` must hold positive finite radii")
+    if (np.diff(nested, axis=0) < 0).any():
+        raise InvalidOptionError("`radii` must not decrease from one radius to the next (nested balls)")
+    values, usable = _checked_values(faces, values, usable)
+    kernels = numba_kernels("neighborhoods")
+    if faces.shape[0] == 0:
+        return np.zeros((nested.shape[0], n, values.shape[1]))
+    if kernels is not None:
+        return _connected_face_sums(kernels, vertices, faces, np.ascontiguousarray(nested), values, usable)
+    return np.stack([_connected_face_sums_numpy(vertices, faces, row[0] if row.size == 1 else row, values, usable)
+                     for row in nested])
 
 
 def ball_edge_sums(vertices: np.ndarray, edges: np.ndarray, radius: float, values: np.ndarray,

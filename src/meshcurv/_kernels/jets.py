@@ -48,12 +48,14 @@ def _cholesky_solve(a, b, low, m, min_pivot):
 
 
 @nb.njit(parallel=True, **_JIT)
-def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks, pool, facing,
+def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_pivot, centres, n_chunks, pool, facing,
              check_facing, away_fraction, settled=0.0):
-    """``jets.fit_jets``: weighted jets over the balls of ``radius``, frame re-estimated from each fit.
+    """``jets.fit_jets``: weighted jets over the balls of ``radii``, frame re-estimated from each fit.
 
     Fits the jets of the vertices ``centres`` (the other rows of the outputs
-    stay NaN). Only the vertices ``pool`` (int64 ids) enter the balls. With
+    stay NaN), vertex ``v`` over the ball of radius ``radii[v]`` ((V,): one per
+    vertex) or ``radii[0]`` ((1,): one for all; the grid's cells are as wide as
+    the largest). Only the vertices ``pool`` (int64 ids) enter the balls. With
     ``check_facing``, a fit whose ball holds more than ``away_fraction`` of its
     points (of non-zero weight) with a ``facing`` normal opposite to the centre's
     (``n_j . n_v < 0``; NaN normals are not counted) is not a height function over
@@ -65,7 +67,8 @@ def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot
     """
     n = vertices.shape[0]
     n_pool = pool.shape[0]
-    points, ids, grid = pool_grid(vertices, pool, radius)
+    per_vertex = radii.shape[0] > 1
+    points, ids, grid = pool_grid(vertices, pool, radii.max())
     # centres in grid order: consecutive balls share cells (cache); centres outside the pool last
     chosen = np.zeros(n, np.bool_)
     chosen[centres] = True
@@ -90,6 +93,7 @@ def fit_jets(vertices, normals, radius, degree, iterations, exponents, min_pivot
         work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, n_terms)
         for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
             v = centres[i]
+            radius = radii[v if per_vertex else 0]
             members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius,
                                           members)
             work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, v,
@@ -340,9 +344,12 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
 
 
 @nb.njit(parallel=True, **_JIT)
-def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents, min_pivot, centres, n_chunks,
+def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, min_pivot, centres, n_chunks,
                        allowed, indptr, indices, facing, check_facing, away_fraction, normals_only, settled=0.0):
     """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
+
+    The ball of ``centres[i]`` has the radius ``radii[i]`` ((M,): one per
+    centre) or ``radii[0]`` ((1,): one for all).
 
     The same fits, outputs and checks as :func:`fit_jets`, with the points of
     each ball found breadth-first over the mesh's edges (``indptr, indices``,
@@ -365,6 +372,7 @@ def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents,
     fitted = np.full((m if normals_only else 1, 3), np.nan)
     ids = np.arange(n)
     n_terms = exponents.shape[0]
+    per_centre = radii.shape[0] > 1
     n_chunks = max(min(m, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         mark = np.full(n, -1, np.int64)
@@ -374,6 +382,7 @@ def fit_jets_connected(vertices, normals, radius, degree, iterations, exponents,
         c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row: unpacked once, not per vertex
         for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
             v = centres[i]
+            radius = radii[i if per_centre else 0]
             size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, i, members, queue)
             # the fit into one row, then copied: one call site (the fit is inlined, and a second call
             # site would double its compile time)

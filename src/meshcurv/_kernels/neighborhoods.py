@@ -247,34 +247,117 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, stam
     return size
 
 
-@nb.njit(parallel=True, **_JIT)
-def connected_face_sums(vertices, faces, centroids, reach, usable, values, radius, indptr, indices, out, scratch,
-                        start, stop):
-    """Add to rows ``start`` to ``stop`` of ``out`` (V, k) the sums of ``share * values`` over the faces of the
-    surface-connected piece of each vertex's ball.
+@nb.njit(inline="always", **_JIT)
+def _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared):
+    """The smallest and largest squared distance from ``(cx, cy, cz)`` to the corners of face ``f``
+    and its centroid (squared distance ``d``); each corner's distance computed once per centre
+    ``v`` (``known``, ``squared``)."""
+    low = d
+    high = d
+    for corner in range(3):
+        c = faces[f, corner]
+        if known[c] != v:
+            known[c] = v
+            squared[c] = (vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2 + (vertices[c, 2] - cz) ** 2
+        low = min(low, squared[c])
+        high = max(high, squared[c])
+    return low, high
 
-    ``share`` is ``neighborhoods.face_in_ball_ratios`` (1 inside, 0 outside,
-    linear in between by the corners' and centroid's distances). The faces are
-    found breadth-first from the faces around each vertex (``indptr, indices``:
+
+@nb.njit(inline="always", **_JIT)
+def _face_level(vertices, faces, f, d, low, high, reach, radii, w, cx, cy, cz):
+    """The first ``r`` whose closed ball ``B(x, radii[r, w])`` face ``f`` meets (``radii.shape[0]``: none).
+
+    A face meets a ball when its centroid is within the radius plus its reach
+    and a corner or the centroid is inside (``low``, ``high``: their smallest and
+    largest squared distance, ``d`` the centroid's) or a side crosses the sphere.
+    """
+    n_radii = radii.shape[0]
+    for r in range(n_radii):
+        radius = radii[r, w]
+        if d > (radius + reach) ** 2:
+            continue  # every point of the face is outside
+        radius2 = radius * radius
+        if high <= radius2 or low < radius2:
+            return r
+        for corner in range(3):  # corners and centroid outside: it meets the ball if a side crosses it
+            p = faces[f, corner]
+            q = faces[f, (corner + 1) % 3]
+            if _segment_meets_ball(vertices[p, 0] - cx, vertices[p, 1] - cy, vertices[p, 2] - cz,
+                                   vertices[q, 0] - cx, vertices[q, 1] - cy, vertices[q, 2] - cz, radius2):
+                return r
+    return n_radii
+
+
+@nb.njit(inline="always", **_JIT)
+def _add_face(faces, f, first, low, high, radii, w, usable, values, total, v, mark, queue, tail):
+    """Face ``f`` met by the balls ``first`` and up: ``share * values[f]`` added to their rows of ``total``
+    (``share``: ``neighborhoods.face_in_ball_ratios``), its corners queued. Returns the queue's new tail."""
+    if usable[f]:
+        for r in range(first, radii.shape[0]):
+            radius = radii[r, w]
+            radius2 = radius * radius
+            if high <= radius2:
+                share = 1.0
+            elif low >= radius2:
+                share = 0.0  # a side crosses the sphere, no corner is inside
+            else:
+                root = math.sqrt(low)
+                share = (radius - root) / (math.sqrt(high) - root)
+            if share != 0.0:
+                for k in range(values.shape[1]):
+                    total[r, k] += share * values[f, k]
+    for corner in range(3):
+        c = faces[f, corner]
+        if mark[c] != v:
+            mark[c] = v
+            queue[tail] = c
+            tail += 1
+    return tail
+
+
+@nb.njit(parallel=True, **_JIT)
+def connected_face_sums(vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch,
+                        start, stop):
+    """Add to rows ``start`` to ``stop`` of ``out`` (R, V, k) the sums of ``share * values`` over the faces of the
+    surface-connected piece of each vertex's balls, one ball per row of ``radii`` (R, 1) or (R, V).
+
+    ``radii[r, 0]`` is the radius of ball ``r`` around every vertex, ``radii[r, v]``
+    that around vertex ``v`` (one column per vertex); the balls of a vertex are
+    nested (``radii[r, v] <= radii[r + 1, v]``). ``share`` is
+    ``neighborhoods.face_in_ball_ratios`` (1 inside, 0 outside, linear in
+    between by the corners' and centroid's distances). The faces are found
+    breadth-first from the faces around each vertex (``indptr, indices``:
     :func:`vertex_face_lists`), on through the corners of every face that has a
     point of an edge, a corner or its centroid in the closed ball ``B(x_v, radius)``
     (``centroids`` and ``reach`` of :func:`cell_centres`: a face whose centroid is
     farther than ``radius + reach`` is outside, one distance; each vertex's
-    distance is computed once per ball):
-    when the ball's part of the surface is connected, every face of the
-    Euclidean ball (a path inside the ball goes from face to face across edges
-    that meet it); another sheet of the surface inside the ball is left out.
-    Faces not ``usable`` (F,) lead the search on but add nothing. The other
-    rows of ``out`` are not touched: a caller that splits the vertices into
-    ranges sums them into one array. ``scratch``: ``neighborhoods._face_sum_scratch``, one
-    chunk of the vertices per row of its arrays (reused from call to call).
+    distance is computed once per centre): when the ball's part of the surface
+    is connected, every face of the Euclidean ball (a path inside the ball goes
+    from face to face across edges that meet it); another sheet of the surface
+    inside the ball is left out. Faces not ``usable`` (F,) lead the search on but
+    add nothing. The other rows of ``out`` are not touched: a caller that splits
+    the vertices into ranges sums them into one array. ``scratch``:
+    ``neighborhoods._face_sum_scratch``, one chunk of the vertices per row of its
+    arrays (reused from call to call).
+
+    Nested balls share one walk, in passes: pass ``r`` walks the piece of ball
+    ``r``, starting from where pass ``r - 1`` stopped and from the faces it met
+    that meet ball ``r`` but not ball ``r - 1`` (kept in the scratch's
+    ``deferred``, with their ``levels``: the first ball they meet). A face
+    reached in pass ``p`` adds its share to the rows ``p`` and up: exactly the
+    faces of R separate walks (a face reached first in pass ``p`` touches no
+    vertex of the pieces of the smaller balls), summed in another order. With
+    one radius, the walk and the order of the additions are those of a single
+    ball (the deferred faces are the faces that meet no ball).
     """
     n = vertices.shape[0]
     n_values = values.shape[1]
-    radius2 = radius * radius
+    n_radii = radii.shape[0]
+    per_vertex = radii.shape[1] > 1
     start = max(min(start, n), 0)
     m = max(min(stop, n), start) - start
-    all_seen, all_mark, all_known, all_squared, all_queue = scratch
+    all_seen, all_mark, all_known, all_squared, all_queue, all_deferred, all_levels = scratch
     n_chunks = all_seen.shape[0]
     for chunk in nb.prange(n_chunks):
         seen = all_seen[chunk]
@@ -282,62 +365,57 @@ def connected_face_sums(vertices, faces, centroids, reach, usable, values, radiu
         known = all_known[chunk]  # distance to this centre in `squared`
         squared = all_squared[chunk]
         queue = all_queue[chunk]  # a vertex is queued at most once per centre: never grown
-        total = np.empty(n_values)  # the centre's sums, in the order of the face visits, then stored once
+        deferred = all_deferred[chunk]  # a face is deferred at most once per centre: never grown
+        levels = all_levels[chunk]
+        total = np.empty((n_radii, n_values))  # the centre's sums, in the order of the face visits, then stored once
         for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
+            w = v if per_vertex else 0
+            outer = radii[n_radii - 1, w]
             cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
-            for k in range(n_values):
-                total[k] = out[v, k]
+            for r in range(n_radii):
+                for k in range(n_values):
+                    total[r, k] = out[r, v, k]
             mark[v] = v
             queue[0] = v
             head, tail = 0, 1
-            while head < tail:
-                a = queue[head]
-                head += 1
-                for j in range(indptr[a], indptr[a + 1]):
-                    f = indices[j]
-                    if seen[f] == v:
+            n_deferred = 0
+            for p in range(n_radii):
+                kept = 0
+                for e in range(n_deferred):  # the faces met first by this pass's ball lead it on
+                    f = deferred[e]
+                    if levels[e] != p:
+                        deferred[kept] = f
+                        levels[kept] = levels[e]
+                        kept += 1
                         continue
-                    seen[f] = v
                     d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
-                    if d > (radius + reach[f]) ** 2:
-                        continue  # every point of the face is outside
-                    low = d
-                    high = d
-                    for corner in range(3):
-                        c = faces[f, corner]
-                        if known[c] != v:
-                            known[c] = v
-                            squared[c] = ((vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2
-                                          + (vertices[c, 2] - cz) ** 2)
-                        low = min(low, squared[c])
-                        high = max(high, squared[c])
-                    if high <= radius2:
-                        share = 1.0
-                    elif low >= radius2:  # corners and centroid outside: on through the face if an edge crosses
-                        share = 0.0
-                        crossed = False
-                        for corner in range(3):
-                            p = faces[f, corner]
-                            q = faces[f, (corner + 1) % 3]
-                            crossed = crossed or _segment_meets_ball(
-                                vertices[p, 0] - cx, vertices[p, 1] - cy, vertices[p, 2] - cz,
-                                vertices[q, 0] - cx, vertices[q, 1] - cy, vertices[q, 2] - cz, radius2)
-                        if not crossed:
+                    low, high = _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared)
+                    tail = _add_face(faces, f, p, low, high, radii, w, usable, values, total, v, mark, queue, tail)
+                n_deferred = kept
+                while head < tail:
+                    a = queue[head]
+                    head += 1
+                    for j in range(indptr[a], indptr[a + 1]):
+                        f = indices[j]
+                        if seen[f] == v:
                             continue
-                    else:
-                        root = math.sqrt(low)
-                        share = (radius - root) / (math.sqrt(high) - root)
-                    if share != 0.0 and usable[f]:
-                        for k in range(n_values):
-                            total[k] += share * values[f, k]
-                    for corner in range(3):
-                        c = faces[f, corner]
-                        if mark[c] != v:
-                            mark[c] = v
-                            queue[tail] = c
-                            tail += 1
-            for k in range(n_values):
-                out[v, k] = total[k]
+                        seen[f] = v
+                        d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
+                        if d > (outer + reach[f]) ** 2:
+                            continue  # every point of the face is outside the largest ball
+                        low, high = _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared)
+                        level = _face_level(vertices, faces, f, d, low, high, reach[f], radii, w, cx, cy, cz)
+                        if level == n_radii:
+                            continue  # it meets no ball
+                        if level > p:  # met by a larger ball only: it leads that ball's pass on
+                            deferred[n_deferred] = f
+                            levels[n_deferred] = level
+                            n_deferred += 1
+                            continue
+                        tail = _add_face(faces, f, p, low, high, radii, w, usable, values, total, v, mark, queue, tail)
+            for r in range(n_radii):
+                for k in range(n_values):
+                    out[r, v, k] = total[r, k]
 
 
 @nb.njit(parallel=True, **_JIT)
