@@ -35,8 +35,9 @@ a harmless change or one naming no line is a finding; an error naming another
 line is counted apart (``named (another line)``: two OBJ ``v`` rows joined
 read as one vertex with a colour, then a face names a vertex beyond them), as
 is a value added to a row the format lets hold more (``another valid file``:
-OBJ ``v x y z w`` and polygons, an OFF face's colour), which no reader can
-tell from the file written.
+OBJ ``v x y z w`` and polygons, an OFF face's colour, a PLY face row that
+starts with a new whole number: a polygon), which no reader can tell from
+the file written.
 """
 
 from __future__ import annotations
@@ -289,7 +290,7 @@ def text_case(kind: str, rng: random.Random):
                   "property double y", "property double z", f"element face {len(faces)}",
                   "property list uchar int vertex_indices", "end_header"]
         rows = [Row([line], data=False) for line in header] + [Row(_words(p)) for p in points]
-        rows += [Row(["3", *map(str, face)]) for face in faces]
+        rows += [Row(["3", *map(str, face)], free=True) for face in faces]  # a whole number added first: a polygon
         return ".ply", "mesh", rows, points, faces, [2, 6]
     if kind == "obj":
         rows = [Row(_words(p), prefix="v ", free=True) for p in points]

@@ -78,6 +78,7 @@ def test_a_cloud_row_of_the_wrong_length_is_named(tmp_path, name, text, message)
     ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 2 3\n3 0 1 3\n",
      r"line 9: a row after the 4 vertices and 2 faces the header declares"),
     ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n", r"the header declares 4 vertices and 2 faces but the file holds only 5 lines for them, up to line 7"),
+    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2\n2 0 2\n", r"line 15: a face of 2 corners; a face needs 3 or more"),
     ("mesh.obj", "v 0 0 0\nv 1 0 0,\nv 0 1 0\nf 1 2 3\n", r"line 2: a vertex coordinate is not a number \('0,'\)"),
     ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3\n", r"line 5: a face has fewer than 3 corners"),
     ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3,\n", r"line 4: a face index is not an integer"),
@@ -99,9 +100,13 @@ _STL = ("solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 
     (_STL.replace("vertex 1 0 0", "vertex 1 0"), r"line 5: 2 values, expected 3 \(vertex x y z\)"),
     (_STL.replace("normal 0 0 1", "normal 0 1"), r"line 2: 2 values, expected 3 \(facet normal nx ny nz\)"),
     (_STL.replace("vertex 1 0 0", "vertex 1,0,0"), r"line 5: '1,0,0' is not a number \(vertex x y z\)"),
+    # a loop of 4 vertices beside one of 2: meshio cut the rows by fours into shifted triangles
+    (_STL.replace("  vertex 0 1 0\n", "  vertex 0 1 0\n  vertex 1 1 0\n") + _STL.replace("  vertex 0 1 0\n", ""),
+     r"line 2: a facet of 4 vertices; an STL facet is a triangle of 3"),
+    ("solid t\n  vertex 0 0 0\n" + _STL[8:], r"line 2: a vertex before any facet"),
+    ("solid t\nendsolid t\n", r"no facets"),
 ])
 def test_an_ascii_stl_row_of_the_wrong_length_is_named(tmp_path, text, message):
-    pytest.importorskip("meshio")
     path = _write(tmp_path, "mesh.stl", text)
     with pytest.raises(MeshFileError, match=rf"mesh\.stl: {message}"):  # meshio took the last 3 numbers
         meshcurv.read_mesh(path)
@@ -142,6 +147,18 @@ def test_a_nul_byte_is_named_and_the_fallback_message(tmp_path, monkeypatch):
     error = not_a_number(tmp_path / "cloud.xyz", b"1 2 3\n", 1, "the rows")
     with pytest.raises(MeshFileError, match=r"cloud\.xyz: something is not a number \(the rows\)$"):
         raise error
+
+
+def test_an_ascii_stl_is_read_as_meshio_did_and_with_blank_lines(tmp_path):
+    two = _STL.replace("endsolid t\n", "") + _STL[8:].replace("vertex 0 0 0", "vertex 1 1 0")
+    vertices, faces = meshcurv.read_mesh(_write(tmp_path, "mesh.stl", two.replace("endloop", "\n\nendloop")))
+    np.testing.assert_array_equal(vertices, [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])  # first seen first
+    np.testing.assert_array_equal(faces, [[0, 1, 2], [3, 1, 2]])
+    meshio = pytest.importorskip("meshio")
+    with np.errstate(over="ignore"):  # meshio multiplies a uint32 count taken from the text's bytes
+        mesh = meshio.stl.read(str(_write(tmp_path, "plain.stl", two)))
+    np.testing.assert_array_equal(vertices, mesh.points)
+    np.testing.assert_array_equal(faces, mesh.cells[0].data)
 
 
 def test_valid_meshes_with_blank_lines_and_polygons_are_read_exactly(tmp_path):

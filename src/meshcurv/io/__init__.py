@@ -97,7 +97,9 @@ class FileFormat:
 def _meshio_format(file_format: str):
     def read(path):
         if file_format == "stl":
-            _meshio.check_stl(path)
+            ascii_mesh = _meshio.check_stl(path)  # ASCII read here: meshio shifts rows of the wrong length
+            if ascii_mesh is not None:
+                return ascii_mesh
         if file_format == "ply":
             return _ply.read_ply(path)  # our own bounded reader: meshio's loops on a header cut short
         if file_format == "vtk" and _vtk.is_polydata(path):

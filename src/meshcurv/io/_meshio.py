@@ -14,7 +14,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError, MissingDependencyError
-from ._text import first_bad_line, line_of_match, numbers_per_line, row_error
+from ._text import first_bad_line, line_of, line_of_match, numbers_per_line, row_error
 
 __all__ = ["read_with_meshio", "write_with_meshio"]
 
@@ -49,26 +49,38 @@ def _to_log():
                 logger.info("meshio: %s", line.strip())
 
 
-def check_stl(path) -> None:
+def check_stl(path):
     """Refuse what is neither a binary STL (its size matches its triangle count) nor starts with ``solid``.
 
-    meshio's ASCII STL reader takes the last three numbers of any line, so an
-    OBJ file named .stl would otherwise be read as nonsense, and a ``vertex``
-    or ``facet normal`` row with a fourth number would shift: each of those
-    rows must hold three numbers (the error names the line).
+    Returns None for a binary STL (meshio reads it) and ``(vertices, faces)``
+    for an ASCII one, read here: meshio's ASCII STL reader takes the last
+    three numbers of any line and cuts the rows into facets by fours, so an
+    OBJ file named .stl, a ``vertex`` row of four numbers or a loop of four
+    vertices beside one of two would be read as shifted triangles, and a
+    blank line makes it fail.
     """
     with open(path, "rb") as handle:
         head = handle.read(84)
     size = path.stat().st_size
     if len(head) == 84 and 84 + 50 * int.from_bytes(head[80:84], "little") == size:
-        return
+        return None
     if not head.lstrip().startswith(b"solid"):
         raise MeshFileError(
             f"{path}: not an STL file (not a binary STL: its size does not match its triangle count; "
             "not an ASCII STL: it does not start with 'solid')"
         )
     with open(path, "rb") as handle:
-        data = handle.read()
+        return read_ascii_stl(path, handle.read())
+
+
+def read_ascii_stl(path, data: bytes):
+    """The triangles of an ASCII STL: ``facet normal`` rows, each followed by 3 ``vertex x y z`` rows.
+
+    Every ``vertex`` and ``facet normal`` row must hold 3 numbers and every
+    facet 3 vertices (an error names the line otherwise). Repeated corners
+    are merged into one vertex, in the order they first appear (as meshio).
+    """
+    found = {}
     for pattern, what in ((_STL_VERTEX, "vertex x y z"), (_STL_NORMAL, "facet normal nx ny nz")):
         rows = pattern.findall(data)
         parsed = numbers_per_line(rows)
@@ -77,11 +89,27 @@ def check_stl(path) -> None:
             raise MeshFileError(f"{path}: line {line_of_match(data, pattern, index)}: "
                                 f"{word[:30].decode('utf-8', 'replace')!r} is not a number ({what})")
         wrong = parsed[1] != 3
-        if wrong.any():  # meshio would take the last three numbers of the line
+        if wrong.any():
             index = int(np.argmax(wrong))
             raise row_error(path, line_of_match(data, pattern, index), int(parsed[1][index]), 3, what)
-
-
+        found[what] = parsed[0].reshape(-1, 3)
+    corners = found["vertex x y z"]
+    facets = np.array([m.start() for m in _STL_NORMAL.finditer(data)], dtype=np.int64)
+    rows = np.array([m.start() for m in _STL_VERTEX.finditer(data)], dtype=np.int64)
+    owner = np.searchsorted(facets, rows, side="right") - 1  # the facet each vertex row follows
+    if facets.size == 0 or (owner < 0).any():
+        where = f"line {line_of(data, int(rows[0]))}: a vertex before any facet" if rows.size else "no facets"
+        raise MeshFileError(f"{path}: {where} (an ASCII STL lists 'facet normal' rows, each with 3 vertices)")
+    per_facet = np.bincount(owner, minlength=facets.size)
+    if (per_facet != 3).any():
+        facet = int(np.argmax(per_facet != 3))
+        raise MeshFileError(f"{path}: line {line_of(data, int(facets[facet]))}: a facet of {per_facet[facet]} "
+                            "vertices; an STL facet is a triangle of 3")
+    _, first, inverse = np.unique(corners, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first)  # the merged vertices in the order they first appear
+    rank = np.zeros_like(order)
+    rank[order] = np.arange(order.size)
+    return corners[first[order]], rank[inverse.ravel()].reshape(-1, 3)
 def read_meshio_file(path, file_format: str):
     """The ``meshio.Mesh`` of a file, read by the format's own reader (``meshio.vtu.read``, ...).
 

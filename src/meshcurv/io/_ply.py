@@ -377,6 +377,9 @@ def _ascii_lists(values, counts, first_value, lines, element, keep, path):
     if keep is None:
         return None
     lengths = sizes[keep]
+    if (lengths < 3).any():
+        row = int(np.argmax(lengths < 3))
+        raise MeshFileError(f"{path}: line {int(lines[row])}: a face of {lengths[row]} corners; a face needs 3 or more")
     if (lengths == lengths[0]).all():
         table = values[starts[:, None] + np.arange(lengths[0])]
         return _integers(table, path, "face index", np.broadcast_to(lines[:, None], table.shape))
