@@ -211,6 +211,9 @@ def test_icc_noise_level_is_measured_at_the_local_resolution():
     assert max(r.parameters["noise"]) < radius_rules.NOISE_FLOOR
     np.testing.assert_allclose(r.parameters["radius"], edge_lengths, rtol=1e-12)
     n = small.vertices.shape[0]
+    # result.radius: the radius of each vertex's own ball
+    np.testing.assert_allclose(r.radius[:n], edge_lengths[0], rtol=1e-12)
+    np.testing.assert_allclose(r.radius[n:], edge_lengths[1], rtol=1e-12)
     assert np.median(relative_error(r.mean[:n], 20.0)) < 0.01
     assert np.median(relative_error(r.mean[n:], 0.1)) < 0.05
 
@@ -348,3 +351,23 @@ def test_icc_converges_on_an_irregular_torus_at_second_order():
         r = curvatures(torus, "icc")
         errors.append(np.median(np.abs(r.mean - torus.mean)))
     assert errors[1] < errors[0] / 3
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_result_radius_is_the_ball_of_each_vertex(method):
+    # one radius on a mesh of one scale, given or default; None for the methods without a ball;
+    # one row per input vertex through welding (a soup: every face its own corners)
+    torus = shapes.torus()
+    soup = torus.vertices[torus.faces].reshape(-1, 3)
+    faces = np.arange(soup.shape[0]).reshape(-1, 3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        r = meshcurv.principal_curvatures(soup, faces, method=method)
+    if "radius" not in ESTIMATORS[method].options:
+        assert r.radius is None
+        return
+    assert r.radius.shape == (soup.shape[0],) and not r.radius.flags.writeable
+    np.testing.assert_array_equal(r.radius, r.parameters["radius"])
+    twice = 2.0 * float(r.parameters["radius"])
+    given = meshcurv.principal_curvatures(torus.vertices, torus.faces, method=method, radius=twice)
+    np.testing.assert_array_equal(given.radius, twice)

@@ -116,7 +116,8 @@ class PreparedMesh:
         # np.take: several times faster than indexing the rows of an (N, 3) array
         fields: dict[str, Any] = {
             name: np.take(getattr(result, name), self.index, axis=0)
-            for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason")}
+            for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason", "radius")
+            if getattr(result, name) is not None}
         return dataclasses.replace(result, **fields)
 
 

@@ -43,6 +43,7 @@ __all__ = [
     "check_radius",
     "resolve_radius",
     "small_radius_note",
+    "vertex_radii",
 ]
 
 #: The default ``radius`` is this many mean edge lengths.
@@ -288,3 +289,15 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology,
     return voxel_radius(grid.spacing, curvature_radius), {
         "surface": "voxel", "voxel_spacing": tuple(float(x) for x in grid.spacing),
         "curvature_radius": curvature_radius}
+
+
+def vertex_radii(groups: list[tuple[float, np.ndarray | None]], n_vertices: int) -> np.ndarray:
+    """(V,) the radius of each vertex from ``[(radius, members or None), ...]`` (:func:`component_radii`).
+
+    ``members`` None: every vertex (a mesh of one scale).
+    """
+    radii = np.full(n_vertices, groups[0][0] if groups[0][1] is None else np.nan)
+    for radius, members in groups:
+        if members is not None:
+            radii[members] = radius
+    return radii

@@ -65,6 +65,10 @@ class CurvatureResult:
         Why each vertex is invalid: an index into :data:`INVALID_REASONS`
         (0 where ``valid``); set by :func:`meshcurv.principal_curvatures`,
         None when the result was built directly.
+    radius : ndarray of shape (V,), or None
+        The radius of the ball each vertex's estimate was measured over, in the
+        units of the vertices (methods over balls: ``icc``, ``quadric``,
+        ``normal_cycle_ball``, point clouds); None for the other methods.
     vertex_areas : ndarray of shape (V,)
         Barycentric vertex areas (a third of each incident face), in length^2;
         they sum to the area of the mesh. Where a welded vertex has several
@@ -94,6 +98,7 @@ class CurvatureResult:
     parameters: Mapping[str, Any] = field(default_factory=dict)
     diagnosis: MeshDiagnosis | None = None
     invalid_reason: np.ndarray | None = None
+    radius: np.ndarray | None = None
     _surface: Surface | None = field(default=None, repr=False)
 
     def __post_init__(self):
@@ -107,6 +112,8 @@ class CurvatureResult:
         object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
         if self.invalid_reason is not None:
             object.__setattr__(self, "invalid_reason", _readonly(np.array(self.invalid_reason, dtype=np.int8)))
+        if self.radius is not None:
+            object.__setattr__(self, "radius", _readonly(np.array(self.radius, dtype=np.float64)))
 
     def __reduce__(self):
         # the parameters' MappingProxyType does not pickle: rebuilt from a dict

@@ -71,7 +71,7 @@ from ..geometry import robust_mean_edge_length
 from ..jets import SETTLED_SLOPE, fit_jet_normals
 from ..measures import curvatures_from_measures, face_measures
 from ..neighborhoods import ball_face_sums
-from ..radius import check_radius, component_radii, noise_level, noise_radius
+from ..radius import check_radius, component_radii, noise_level, noise_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages, finish
@@ -215,4 +215,5 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     if fields is None:
         raise RuntimeError("default_radii gave no group")
     k_min, k_max, dir_min, dir_max, normals, valid = fields
-    return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects)
+    return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects,
+                  radius=vertex_radii(groups, vertices.shape[0]))

@@ -40,7 +40,7 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from ..geometry import edge_dihedral_angles
 from ..neighborhoods import ball_edge_sums, ball_face_sums
-from ..radius import component_radii, resolve_radius
+from ..radius import component_radii, resolve_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 
@@ -92,4 +92,4 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
     return finish("normal_cycle_ball", parameters, valid, normals, k_min, k_max, dir_min, dir_max,
-                  defects)
+                  defects, radius=vertex_radii(groups, vertices.shape[0]))

@@ -45,7 +45,7 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, MIN_POINTS, fit_jets, shape_operators
-from ..radius import component_radii, resolve_radius
+from ..radius import component_radii, resolve_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 
@@ -112,4 +112,5 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
-    return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects, extra)
+    return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects, extra,
+                  radius=vertex_radii(groups, vertices.shape[0]))
