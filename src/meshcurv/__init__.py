@@ -12,7 +12,7 @@ as ``method="matgeom"``.
 """
 
 from . import errors, geometry, integrals, plotting, shapes, topology, viewer
-from .curvature import METHODS, principal_curvatures
+from .curvature import METHODS, multiscale_curvatures, principal_curvatures
 from .diagnosis import MeshDiagnosis, diagnose
 from .errors import (
     InvalidMeshError,
@@ -35,6 +35,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "principal_curvatures",
+    "multiscale_curvatures",
     "point_cloud_curvatures",
     "label_curvatures",
     "volume",

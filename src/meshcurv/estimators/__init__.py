@@ -36,6 +36,10 @@ class Estimator:
         A ``radius`` given below this many median edge lengths is named in the
         call's warning (:func:`meshcurv.radius.small_radius_note`); None
         for the methods without a radius.
+    multiscale : callable or None
+        ``multiscale(mesh, *, radii, stages) -> [(CurvatureResult, problems), ...]`` at
+        increasing radii in one pass (:func:`meshcurv.multiscale_curvatures`); None: one
+        call of ``function`` per radius.
     boundary : bool
         Whether its boundary vertices can be valid (a boundary is not a defect
         for it: :data:`meshcurv.defects.BOUNDARY`).
@@ -48,6 +52,7 @@ class Estimator:
     stages: tuple
     radius_warning_edges: float | None = None
     boundary: bool = False
+    multiscale: Callable | None = None
 
 
 ESTIMATORS: dict[str, Estimator] = {
@@ -69,6 +74,7 @@ ESTIMATORS: dict[str, Estimator] = {
     "icc": Estimator(
         name="icc",
         function=icc.estimate,
+        multiscale=icc.estimate_multiscale,
         options={"radius": None},
         summary="interpolated corrected curvature measures over a ball, normals from jets (Lachaud et al. 2020), in 1/length",
         stages=icc.STAGES,

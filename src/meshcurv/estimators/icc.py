@@ -70,7 +70,7 @@ import numpy as np
 from ..geometry import robust_mean_edge_length
 from ..jets import SETTLED_SLOPE, fit_jet_normals
 from ..measures import curvatures_from_measures, face_measures
-from ..neighborhoods import ball_face_sums
+from ..neighborhoods import ball_face_sums, ball_face_sums_nested
 from ..radius import check_radius, component_radii, noise_level, noise_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
@@ -217,3 +217,42 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     k_min, k_max, dir_min, dir_max, normals, valid = fields
     return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects,
                   radius=vertex_radii(groups, vertices.shape[0]))
+
+
+def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tuple]:
+    """:func:`estimate` at each of the increasing ``radii``, the sums of all in one walk per vertex.
+
+    Returns one ``(result, problems)`` per radius, equal to :func:`estimate` with
+    that radius to round-off (the same faces and shares, added in another
+    order): the normals are fitted at each scale (over three times each radius)
+    and the balls of every radius summed in one walk of the largest
+    (:func:`meshcurv.neighborhoods.ball_face_sums_nested`).
+    """
+    vertices, topology = mesh.vertices, mesh.topology
+    faces = topology.faces
+    stages.start("compute normals")
+    degenerate, start_normals = mesh.degenerate, mesh.vertex_normals
+    defects, valid = mesh.start(boundary=True)
+    stages.start("measure noise")
+    radii = [check_radius(radius, vertices, topology) for radius in radii]
+    stages.start("fit normals")
+    normals = [fitted_normals(vertices, start_normals, valid, NORMAL_RADIUS_RATIO * radius,
+                              neighbours=topology.referenced_vertices, adjacency=_adjacency(topology))
+               for radius in radii]
+    stages.start("compute face measures")
+    measures = np.stack([face_measures(vertices, faces, rung) for rung in normals])
+    kept = [~degenerate & np.isfinite(rung).all(axis=1)[faces].all(axis=1) for rung in normals]
+    stages.start("sum over balls")
+    if all(np.array_equal(kept[0], mask) for mask in kept):  # the same faces at every scale: one walk
+        summed = ball_face_sums_nested(vertices, faces, radii, measures, usable=None if kept[0].all() else kept[0])
+    else:
+        summed = np.stack([ball_face_sums(vertices, faces, radius, values, usable=mask, connected=True)
+                           for radius, values, mask in zip(radii, measures, kept)])
+    stages.start("retrieve curvatures")
+    out = []
+    for radius, rung, sums in zip(radii, normals, summed):
+        k_min, k_max, dir_min, dir_max = curvatures_from_measures(sums, rung)
+        parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius}
+        out.append(finish("icc", parameters, valid & np.isfinite(k_min), rung, k_min, k_max, dir_min, dir_max,
+                          defects, radius=np.full(vertices.shape[0], radius)))
+    return out

@@ -1,0 +1,91 @@
+"""meshcurv.multiscale_curvatures: one result per radius, each equal to the single call at that radius."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import meshcurv
+from meshcurv import shapes
+from meshcurv.errors import InvalidOptionError, MeshQualityWarning
+from meshcurv.estimators import ESTIMATORS
+
+BALL_METHODS = [name for name, estimator in ESTIMATORS.items() if "radius" in estimator.options]
+
+
+def _meshes():
+    hemisphere = shapes.icosphere(8)
+    kept = hemisphere.faces[(hemisphere.vertices[hemisphere.faces][:, :, 2] > -0.05).all(axis=1)]
+    return {
+        "torus": (shapes.torus().vertices, shapes.torus().faces),
+        "noisy sphere": (shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=3).vertices,
+                         shapes.icosphere(8).faces),
+        "open hemisphere": (hemisphere.vertices, kept),
+    }
+
+
+def _single(vertices, faces, method, radius):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        return meshcurv.principal_curvatures(vertices, faces, method=method, radius=radius)
+
+
+@pytest.mark.parametrize("method", BALL_METHODS)
+@pytest.mark.parametrize("name", sorted(_meshes()))
+def test_each_scale_equals_the_single_call(name, method):
+    vertices, faces = _meshes()[name]
+    h = meshcurv.geometry.mean_edge_length(vertices, meshcurv.MeshTopology.from_faces(faces).edges)
+    radii = [4.0 * h, 1.0 * h, 2.0 * h]  # any order: the results come in the order given
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        results = meshcurv.multiscale_curvatures(vertices, faces, radii, method=method)
+    assert len(results) == 3
+    for radius, result in zip(radii, results):
+        single = _single(vertices, faces, method, radius)
+        np.testing.assert_array_equal(result.radius, radius)
+        np.testing.assert_array_equal(result.valid, single.valid)
+        np.testing.assert_array_equal(result.invalid_reason, single.invalid_reason)
+        assert result.parameters == single.parameters
+        scale = np.nanmax(np.abs(single.k_max))
+        # the same faces and shares summed in another order (one walk for every radius): round-off
+        for field in ("k_min", "k_max", "mean", "gaussian"):
+            np.testing.assert_allclose(getattr(result, field), getattr(single, field), rtol=0,
+                                       atol=1e-9 * (scale**2 if field == "gaussian" else scale), err_msg=field)
+        np.testing.assert_allclose(result.normals, single.normals, rtol=0, atol=1e-12)
+
+
+def test_scales_tell_noise_from_shape():
+    # a noisy unit sphere: the smallest ball sees the noise, the larger ones the sphere (H = 1)
+    noisy = shapes.with_normal_noise(shapes.icosphere(16), 0.3, seed=1)
+    h = meshcurv.geometry.mean_edge_length(noisy.vertices, meshcurv.MeshTopology.from_faces(noisy.faces).edges)
+    spreads = [np.std(r.mean) for r in meshcurv.multiscale_curvatures(noisy.vertices, noisy.faces, [h, 4 * h])]
+    assert spreads[1] < 0.5 * spreads[0]
+
+
+def test_the_one_warning_names_the_radius_whose_note_differs():
+    torus = shapes.torus()
+    h = meshcurv.geometry.mean_edge_length(torus.vertices, meshcurv.MeshTopology.from_faces(torus.faces).edges)
+    with pytest.warns(MeshQualityWarning, match=r"at radius .*below 0\.6 edge lengths") as record:
+        meshcurv.multiscale_curvatures(torus.vertices, torus.faces, [0.3 * h, 2 * h])
+    assert len(record) == 1
+
+
+@pytest.mark.parametrize("radii, message", [
+    ([], "non-empty sequence"),
+    ("1.0", "non-empty sequence"),
+    ([[1.0, 2.0]], "non-empty sequence"),
+    ([1.0, -2.0], "radii"),
+    ([1.0, float("nan")], "radii"),
+])
+def test_bad_radii_are_refused(radii, message):
+    torus = shapes.torus()
+    with pytest.raises(InvalidOptionError, match=message):
+        meshcurv.multiscale_curvatures(torus.vertices, torus.faces, radii)
+
+
+def test_a_method_without_a_ball_is_refused():
+    torus = shapes.torus()
+    with pytest.raises(InvalidOptionError, match="'normal_cycle' measures no ball.*'icc'"):
+        meshcurv.multiscale_curvatures(torus.vertices, torus.faces, [1.0], method="normal_cycle")
