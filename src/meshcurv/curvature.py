@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -191,7 +192,7 @@ def principal_curvatures(
     return result
 
 
-def multiscale_curvatures(vertices, faces=None, radii=(), *, method: str = DEFAULT_METHOD, orient: str = "auto",
+def multiscale_curvatures(vertices, faces=None, radii: Sequence[float] | np.ndarray = (), *, method: str = DEFAULT_METHOD, orient: str = "auto",
                           weld: bool | None = None, progress: ProgressCallback | None = None
                           ) -> list[CurvatureResult]:
     """Curvatures at several scales: one :class:`CurvatureResult` per radius, in one pass.
@@ -247,7 +248,7 @@ def multiscale_curvatures(vertices, faces=None, radii=(), *, method: str = DEFAU
     if "radius" not in estimator.options:
         raise InvalidOptionError(f"method {method!r} measures no ball; multiscale_curvatures takes one of "
                                  + ", ".join(repr(name) for name, e in ESTIMATORS.items() if "radius" in e.options))
-    if isinstance(radii, (str, bytes)) or not np.iterable(radii) or np.ndim(radii) != 1 or len(radii) == 0:
+    if isinstance(radii, (str, bytes)) or np.ndim(radii) != 1 or len(radii) == 0:
         raise InvalidOptionError(f"`radii` must be a non-empty sequence of radii; got {radii!r}")
     radii = [check_positive_float(radius, "radii") for radius in radii]
     orient, weld = _resolved(method, orient, weld)
