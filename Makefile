@@ -25,11 +25,12 @@ test: $(STAMP)
 quick: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not slow"
 
-# the suite on a minimal install (numpy, scipy and the test tools only: no numba, click, dask, ...):
-# what needs an extra is skipped, the NumPy backend runs
+# the suite on a plain install without its extras (no matplotlib, pyvista, dask, scikit-image, ...),
+# numba then removed: what needs an extra is skipped, and the NumPy backend (the reference) runs
 test-minimal:
 	$(PYTHON) -m venv .venv-minimal
 	.venv-minimal/bin/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
+	.venv-minimal/bin/python -m pip uninstall --quiet --yes numba llvmlite
 	.venv-minimal/bin/python -m pytest -q -m "not slow"
 
 # the API reference from the docstrings, with the README (docs/_build/html/index.html); warnings are errors

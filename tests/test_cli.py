@@ -360,8 +360,8 @@ def test_missing_click_names_the_extra(capsys, monkeypatch):
     monkeypatch.delattr(meshcurv.cli, "_app")
     monkeypatch.setattr(builtins, "__import__", no_click)
     code, _, err = run(capsys, "methods")
-    assert code == 1 and one_error_line(err) == ("meshcurv: error: the command line needs click: "
-                                                 "pip install 'meshcurv[cli]'")
+    assert code == 1 and one_error_line(err) == ("meshcurv: error: the command line needs click (a dependency of "
+                                                 "meshcurv that cannot be imported): pip install click")
 
 
 # ---------------------------------------------------------------- real processes

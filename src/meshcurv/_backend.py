@@ -2,8 +2,8 @@
 
 The NumPy paths are always there and are the reference; the numba kernels
 (:mod:`meshcurv._kernels`, one module beside each module of NumPy code) compute
-the same quantities in single passes without temporaries. They are used when numba is installed
-(``pip install 'meshcurv[fast]'``) unless the NumPy paths are asked for.
+the same quantities in single passes without temporaries. numba is a dependency of meshcurv: they
+are used unless the NumPy paths are asked for (or numba cannot be imported: a broken install).
 
 Decided once per process: the first call that needs a kernel tries to import
 numba (never ``import meshcurv`` itself) and remembers the outcome, so that a
@@ -11,7 +11,7 @@ base install without numba does not retry the failed import (some 11 ms, 10 to
 15 times per call) on every lookup; a lookup then costs an environment read.
 The first decision of each backend is logged once, at INFO on the
 ``meshcurv`` logger (``meshcurv -v`` shows it): which backend runs and, when
-numba is missing, that ``pip install 'meshcurv[fast]'`` gives the compiled one.
+numba cannot be imported, why, and that ``pip install numba`` gives the compiled one.
 
 Which backend runs, highest precedence first: :func:`use_backend` (a context
 manager, for tests and for callers who want one block on one backend), the
@@ -90,7 +90,7 @@ _imported: tuple[ModuleType, None] | tuple[None, ImportError] | None = None
 _logged: set = set()
 
 #: The INFO line when numba cannot be imported.
-MISSING_MESSAGE = ("meshcurv backend: numpy (numba cannot be imported: %s); pip install 'meshcurv[fast]' gives "
+MISSING_MESSAGE = ("meshcurv backend: numpy (numba cannot be imported: %s); pip install numba gives "
                    "the compiled kernels, several times faster")
 
 
@@ -137,7 +137,7 @@ def _compiled():
     if package is None:
         if choice == "numba":
             raise MissingDependencyError(
-                f"the numba backend needs numba ({error}): pip install 'meshcurv[fast]'"
+                f"the numba backend needs numba ({error}): pip install numba"
             ) from None
         _log_once("missing", MISSING_MESSAGE, error)
         return None
