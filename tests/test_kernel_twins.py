@@ -923,30 +923,47 @@ def check_connected_face_sums(name):
     # through the ends of a side that meets the ball with both ends outside); 2 edges: a ball of several rings
     for edges in (0.95, 2.0):
         check_connected_face_sums_at(name, edges * mean_edge(name))
-    check_connected_face_sums_radii(name)
+    check_connected_face_sums_per_vertex(name)
 
 
-def check_connected_face_sums_radii(name):
-    """A radius per vertex, and three nested radii per vertex in one walk: each row against the NumPy path's
-    sums at that row's radii (the same faces and shares, summed in another order)."""
+def face_sum_inputs(name):
+    """``(vertices, faces, kernels, values, usable, centroids, reach, n, indptr, indices)`` of the walks' sums."""
     vertices, faces = mesh(name)
     compiled = kernels("neighborhoods")
-    values = ball_values(name, "faces")
-    usable = np.random.default_rng(4).random(faces.shape[0]) > 0.1
     centres, reach = compiled.cell_centres(vertices, faces)
     n = vertices.shape[0]
-    indptr, indices = compiled.vertex_face_lists(faces, n, kernel_threads())
+    return (vertices, faces, compiled, ball_values(name, "faces"), np.random.default_rng(4).random(faces.shape[0]) > 0.1,
+            centres, reach, n, *compiled.vertex_face_lists(faces, n, kernel_threads()))
+
+
+def check_connected_face_sums_per_vertex(name):
+    """A radius per vertex: the NumPy path's sums at those radii (the same faces and shares, in another order)."""
+    vertices, faces, compiled, values, usable, centres, reach, n, indptr, indices = face_sum_inputs(name)
+    radii = np.random.default_rng(2).uniform(0.9, 2.5, n) * mean_edge(name)
+    got = np.zeros((n, values.shape[1]))
+    compiled.connected_face_sums(vertices, faces, centres, reach, usable, values, radii, indptr, indices, got,
+                                 _face_sum_scratch(kernel_threads(), n, faces.shape[0]), 0, n)
+    expected, magnitude = numpy_ball_sums(name, "faces", values, radii, usable, connected=True)
+    assert_sums_close(got, expected, magnitude, ball_terms(name, "faces", float(radii.max())), "a radius per vertex")
+
+
+def check_connected_face_sums_nested(name):
+    """Nested radii (one for all, or per vertex; the same values or one set per radius) in one walk: each row
+    against the NumPy path's sums at that row's radii (the same faces and shares, summed in another order)."""
+    vertices, faces, compiled, values, usable, centres, reach, n, indptr, indices = face_sum_inputs(name)
     h = mean_edge(name)
     per_vertex = np.random.default_rng(2).uniform(0.9, 2.5, n) * h
-    for radii in (per_vertex[None, :], np.array([0.5, 1.0, 2.0])[:, None] * per_vertex,
-                  np.array([[0.95], [2.0], [4.0]]) * h):
+    sets = np.stack([values, -2.0 * values, values[::-1].copy()])  # one set of values per radius
+    for radii, given in ((per_vertex[None, :], values[None]), (np.array([0.5, 1.0, 2.0])[:, None] * per_vertex, sets),
+                         (np.array([[0.95], [2.0], [4.0]]) * h, values[None])):
         got = np.zeros((radii.shape[0], n, values.shape[1]))
-        compiled.connected_face_sums(vertices, faces, centres, reach, usable, values, np.ascontiguousarray(radii),
-                                     indptr, indices, got,
-                                     _face_sum_scratch(kernel_threads(), n, faces.shape[0], radii.shape[0] > 1), 0, n)
+        compiled.connected_face_sums_nested(vertices, faces, centres, reach, usable, given, np.ascontiguousarray(radii),
+                                            indptr, indices, got,
+                                            _face_sum_scratch(kernel_threads(), n, faces.shape[0], radii.shape[0] > 1), 0, n)
         for r, row in enumerate(radii):
             radius = row[0] if row.size == 1 else row
-            expected, magnitude = numpy_ball_sums(name, "faces", values, radius, usable, connected=True)
+            expected, magnitude = numpy_ball_sums(name, "faces", given[r if given.shape[0] > 1 else 0], radius,
+                                                  usable, connected=True)
             assert_sums_close(got[r], expected, magnitude, ball_terms(name, "faces", float(np.max(radius))),
                               f"{radii.shape[0]} radii, row {r}")
 
@@ -964,11 +981,11 @@ def check_connected_face_sums_at(name, radius):
         # components of all balls at once), summed in another order
         expected, magnitude = numpy_ball_sums(name, "faces", values, radius, mask, connected=True)
         allowed = np.ones(faces.shape[0], dtype=bool) if mask is None else mask
-        radii = np.array([[radius]])  # one radius for all vertices
-        got = np.zeros((1, *expected.shape))
+        radii = np.array([radius])  # one radius for all vertices
+        got = np.zeros_like(expected)
         compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices, got,
                                      _face_sum_scratch(kernel_threads(), n, faces.shape[0]), 0, n)
-        assert_sums_close(got[0], expected, magnitude, ball_terms(name, "faces", radius),
+        assert_sums_close(got, expected, magnitude, ball_terms(name, "faces", radius),
                           "all faces" if mask is None else "usable faces")
         # ranges of centres, one scratch for all (as the calls of ball_face_sums): only their rows each time;
         # with the int64 scratch of meshes whose indices do not fit in int32 (this one's are int32)
@@ -976,8 +993,8 @@ def check_connected_face_sums_at(name, radius):
         scratch = tuple(a.astype(np.int64) if a.dtype == np.int32 else a for a in _face_sum_scratch(3, n, faces.shape[0]))
         compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices, part,
                                      scratch, n // 3, n // 2)
-        np.testing.assert_array_equal(part[:, n // 3:n // 2], got[:, n // 3:n // 2])
-        assert not part[:, :n // 3].any() and not part[:, n // 2:].any()
+        np.testing.assert_array_equal(part[n // 3:n // 2], got[n // 3:n // 2])
+        assert not part[:n // 3].any() and not part[n // 2:].any()
         for lo, hi in ((0, n // 3), (n // 2, n)):
             compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices,
                                          part, scratch, lo, hi)
@@ -1357,6 +1374,8 @@ TWINS = [
          MESHES),
     Twin("neighborhoods.connected_face_sums", "neighborhoods.ball_face_sums(connected=True)", check_connected_face_sums,
          MESHES + THIN),
+    Twin("neighborhoods.connected_face_sums_nested", "neighborhoods.ball_face_sums(connected=True) at each radius",
+         check_connected_face_sums_nested, MESHES + THIN),
     Twin("jets.fit_jets", "jets.fit_jets", check_fit_jets, CLEAN + CLOUDS),
     Twin("jets.fit_jets_connected", "jets.fit_jets(adjacency=) and jets.jet_normals", check_fit_jets_connected,
          MESHES + THIN),

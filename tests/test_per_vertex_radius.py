@@ -17,7 +17,7 @@ import pytest
 
 from meshcurv import shapes
 from meshcurv._backend import use_backend
-from meshcurv.errors import InvalidOptionError
+from meshcurv.errors import InvalidMeshError, InvalidOptionError
 from meshcurv.jets import fit_jet_normals, fit_jets
 from meshcurv.neighborhoods import (ball_edge_sums, ball_face_sums, ball_face_sums_nested, call_ranges,
                                     centre_radii, estimate_ball_pairs)
@@ -143,6 +143,13 @@ def test_nested_sums_are_separate_calls(backend, name):
                 _close_sums(got[r], expected, magnitude, faces.shape[0])
                 if r == 0 and backend == "numba":  # the first pass is the walk of the smallest ball alone
                     np.testing.assert_array_equal(got[0], expected)
+    sets = np.stack([values, 3.0 * values[::-1]])  # one set of values per radius (the measures of each scale)
+    with use_backend(backend):
+        got = ball_face_sums_nested(vertices, faces, [h, 3 * h], sets)
+        for r, radius in enumerate((h, 3 * h)):
+            expected = ball_face_sums(vertices, faces, radius, sets[r], connected=True)
+            magnitude = ball_face_sums(vertices, faces, radius, np.abs(sets[r]), connected=True)
+            _close_sums(got[r], expected, magnitude, faces.shape[0])
 
 
 def test_nested_sums_keep_the_other_sheet_out_of_the_smaller_balls():
@@ -219,3 +226,5 @@ def test_nested_radii_are_checked():
         ball_face_sums_nested(vertices, faces, [2 * h, h], values)
     with pytest.raises(InvalidOptionError, match="increasing sequence of positive radii"):
         ball_face_sums_nested(vertices, faces, ["a", None], values)
+    with pytest.raises(InvalidMeshError, match=r"\(F, k\) or \(2, F, k\): one set per radius; got \(3, "):
+        ball_face_sums_nested(vertices, faces, [h, 2 * h], np.stack([values] * 3))

@@ -313,7 +313,7 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: n
     if connected and cells.shape[1] == 3 and cells.shape[0]:
         if kernels is not None:
             radii = np.array([[radius]]) if np.ndim(radius) == 0 else radius[None, :]
-            return _connected_face_sums(kernels, vertices, cells, radii, values, usable)[0]
+            return _connected_face_sums(kernels, vertices, cells, radii, values[None], usable)[0]
         return _connected_face_sums_numpy(vertices, cells, radius, values, usable)
     if np.ndim(radius):
         raise InvalidOptionError("a `radius` per vertex takes the surface-connected balls (`connected=True`); "
@@ -671,7 +671,7 @@ def call_ranges(n: int, pairs_per_centre: float, weights: np.ndarray | None = No
 def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int,
                       nested: bool = False) -> tuple[np.ndarray, ...]:
     """The per-thread scratch of the compiled ``connected_face_sums``:
-    ``(seen, mark, known, squared, queue, deferred, levels)``.
+    ``(seen, mark, known, squared, queue, deferred, levels)`` (and of ``connected_face_sums_nested``).
 
     ``seen`` (n_chunks, F), ``mark`` and ``known`` (n_chunks, V) filled with -1, ``squared``
     (n_chunks, V) float and ``queue`` (n_chunks, V). Allocated once for all the calls over
@@ -692,7 +692,9 @@ def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int,
 def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radii: np.ndarray, values: np.ndarray,
                          usable: np.ndarray | None) -> np.ndarray:
     """(R, V, k) :func:`ball_face_sums` over the surface-connected piece of each ball (compiled kernel,
-    breadth-first), at the R nested radii ``radii`` (R, 1) (one for all vertices) or (R, V) (one per vertex)."""
+    breadth-first), at the R nested radii ``radii`` (R, 1) (one for all vertices) or (R, V) (one per vertex),
+    of ``values`` (1, F, k) (the same for every radius) or (R, F, k) (one set per radius). One radius:
+    ``connected_face_sums``; several: ``connected_face_sums_nested`` (one walk per vertex, in passes)."""
     n = vertices.shape[0]
     usable = np.ones(faces.shape[0], dtype=bool) if usable is None else usable
     centres, reach = kernels.cell_centres(vertices, faces)
@@ -700,11 +702,15 @@ def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radii
     mean, _ = check_ball_work(centres, outer + float(reach.max()), n, centres=vertices)
     indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
     values = np.ascontiguousarray(values)
-    out = np.zeros((radii.shape[0], n, values.shape[1]))
+    out = np.zeros((radii.shape[0], n, values.shape[2]))
     scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0], radii.shape[0] > 1)
     for start, stop in call_ranges(n, mean, None if radii.shape[1] == 1 else outer * outer):
-        kernels.connected_face_sums(vertices, faces, centres, reach, usable, values, radii, indptr, indices, out,
-                                    scratch, start, stop)
+        if radii.shape[0] == 1:  # one ball: the kernel without the passes
+            kernels.connected_face_sums(vertices, faces, centres, reach, usable, values[0], radii[0], indptr, indices,
+                                        out[0], scratch, start, stop)
+        else:
+            kernels.connected_face_sums_nested(vertices, faces, centres, reach, usable, values, radii, indptr,
+                                               indices, out, scratch, start, stop)
     return out
 
 
@@ -750,7 +756,8 @@ def ball_face_sums_nested(vertices: np.ndarray, faces: np.ndarray, radii, values
     """(R, V, k) :func:`ball_face_sums` with ``connected=True`` at R nested radii, one walk per vertex.
 
     Row ``r`` equals ``ball_face_sums(vertices, faces, radii[r], values,
-    usable=usable, connected=True)`` to round-off (the same faces and shares,
+    usable=usable, connected=True)`` (``values[r]`` when ``values`` holds one
+    set per radius) to round-off (the same faces and shares,
     added in another order). The compiled kernel walks the largest ball of
     each vertex once, in passes: pass ``r`` extends the walk of ball ``r - 1``
     by the faces that meet ball ``r``, and a face reached in pass ``r`` adds
@@ -764,7 +771,9 @@ def ball_face_sums_nested(vertices: np.ndarray, faces: np.ndarray, radii, values
     radii : array_like of shape (R,) or (R, V)
         R >= 1 radii, one for all vertices, or one row per radius with a radius
         per vertex; positive, finite and non-decreasing along the first axis.
-    values : array_like of shape (F, k)
+    values : array_like of shape (F, k) or (R, F, k)
+        The same values for every radius, or one set per radius (the face
+        measures of normals fitted at each scale).
     usable : array_like of bool of shape (F,), optional
         Faces that add to the sums (the others lead the walks on); default: all.
 
@@ -793,14 +802,21 @@ def ball_face_sums_nested(vertices: np.ndarray, faces: np.ndarray, radii, values
         raise InvalidOptionError("`radii` must hold positive finite radii")
     if (np.diff(nested, axis=0) < 0).any():
         raise InvalidOptionError("`radii` must not decrease from one radius to the next (nested balls)")
-    values, usable = _checked_values(faces, values, usable)
+    values = np.asarray(values, dtype=np.float64)
+    if values.ndim == 3 and values.shape[0] != nested.shape[0]:
+        raise InvalidMeshError(f"`values` must have shape (F, k) or ({nested.shape[0]}, F, k): one set per radius; "
+                               f"got {values.shape}")
+    sets = values if values.ndim == 3 else values[None]
+    sets = np.stack([_checked_values(faces, one, usable)[0] for one in sets])
+    _, usable = _checked_values(faces, sets[0], usable)
     kernels = numba_kernels("neighborhoods")
     if faces.shape[0] == 0:
-        return np.zeros((nested.shape[0], n, values.shape[1]))
+        return np.zeros((nested.shape[0], n, sets.shape[2]))
     if kernels is not None:
-        return _connected_face_sums(kernels, vertices, faces, np.ascontiguousarray(nested), values, usable)
-    return np.stack([_connected_face_sums_numpy(vertices, faces, row[0] if row.size == 1 else row, values, usable)
-                     for row in nested])
+        return _connected_face_sums(kernels, vertices, faces, np.ascontiguousarray(nested), sets, usable)
+    return np.stack([_connected_face_sums_numpy(vertices, faces, row[0] if row.size == 1 else row,
+                                                sets[r if sets.shape[0] > 1 else 0], usable)
+                     for r, row in enumerate(nested)])
 
 
 def ball_edge_sums(vertices: np.ndarray, edges: np.ndarray, radius: float, values: np.ndarray,
