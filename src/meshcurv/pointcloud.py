@@ -26,9 +26,14 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    outward on each part: the sign passes along edges of one sheet, and
    reversed across a gap between two sheets (two parts a spacing or two
    apart, the faces of a thin part), never along other edges
-   (:func:`meshcurv._pointcloud_normals.oriented_signs`); points where two
-   sheets closer than the spacing cannot be told apart are NaN
-   (``invalid_reason``: side undecided);
+   (:func:`meshcurv._pointcloud_normals.oriented_signs`); then each point's
+   side is checked against the generalized winding number of the oriented
+   cloud (Barill et al. 2018: 1/2 on a surface whose side agrees with the
+   whole cloud's; :func:`meshcurv._pointcloud_normals.winding_sides`): a part
+   left inside out is turned, the wall of a cavity (a closed part inside
+   another) faces into the cavity, as for meshes; points where two sheets
+   closer than the spacing cannot be told apart, or whose side turning does
+   not settle, are NaN (``invalid_reason``: side undecided);
 4. the noise level ``nu``: the median distance of the points to degree-2 jets
    fitted over :data:`NOISE_FIT_RADIUS` spacings, in spacings;
 5. the radius: ``s (a + b sqrt(max(nu - 0.005, 0)))``, ``(a, b)`` = (3, 11)
@@ -63,6 +68,10 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
 
 References
 ----------
+G. Barill, N. G. Dickson, R. Schmidt, D. I. W. Levin, A. Jacobson (2018).
+Fast winding numbers for soups and clouds. ACM Transactions on Graphics
+37(4), 43. https://doi.org/10.1145/3197517.3201337
+
 F. Cazals and M. Pouget (2005). Estimating differential quantities using
 polynomial fitting of osculating jets. Computer Aided Geometric Design 22(2),
 121-146. https://doi.org/10.1016/j.cagd.2004.09.004
@@ -178,7 +187,8 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         point back to back, are not joined, so that both keep their sides).
         The curvature signs follow them. Default: estimated (PCA of the 10
         nearest neighbours), oriented consistently and outward on closed
-        shapes.
+        shapes (into the cavity on the wall of a cavity: a closed part
+        inside another).
     radius : float, optional
         Radius of the Euclidean ball of each estimate, in the units of the
         points. Default: from the data, ``s (3 + 11 sqrt(max(nu - 0.005, 0)))``
@@ -469,11 +479,12 @@ def _compute(points, given, radius, method, search=None):
     logger.info("point cloud: normals")
     if given is None:
         start = _normals.pca_normals(points, indices)
-        signs, labels, doubtful, sheets = _normals.oriented_signs(points, start, indices, usable, spacing)
+        signs, labels, doubtful, sheets, unsettled = _normals.oriented_signs(points, start, indices, usable, spacing,
+                                                                             tree)
         start = start * signs[:, None]
         how = "estimated"
     else:
-        doubtful = np.zeros(n, dtype=bool)
+        doubtful = unsettled = np.zeros(n, dtype=bool)
         signs, labels = _normals.orientation_signs(given, indices, usable, given=True, points=points)
         sheets = np.where(np.bincount(labels)[labels] >= _normals.PART_MIN_POINTS, labels, -1)
         # each component keeps the side most of its given normals point to
@@ -483,7 +494,8 @@ def _compute(points, given, radius, method, search=None):
         if reoriented:
             # inconsistent signs: oriented as estimated normals are (one sheet at a time, reversed across a
             # gap between two), each part then on the side most of its given normals point to
-            signs, labels, doubtful, sheets = _normals.oriented_signs(points, given, indices, usable, spacing)
+            signs, labels, doubtful, sheets, unsettled = _normals.oriented_signs(points, given, indices, usable,
+                                                                                 spacing, tree)
             majority = np.bincount(labels, weights=signs, minlength=int(labels.max()) + 1)
             signs = signs * np.where(majority[labels] < 0, -1.0, 1.0)
         start = given * signs[:, None]
@@ -559,8 +571,14 @@ def _compute(points, given, radius, method, search=None):
     reason[~one_sided | (two_sided_mask & usable)] = _TWO_SIDED
     valid &= one_sided
     if doubtful.any():
-        problems.append(f"{int(doubtful.sum())} points lie between two sheets closer than the spacing (two parts of "
-                        "the cloud, or the faces of a part thinner than that): their normals' side is undecided, NaN")
+        found = []
+        if (doubtful & ~unsettled).any():
+            found.append(f"{int((doubtful & ~unsettled).sum())} points lie between two sheets closer than the "
+                         "spacing (two parts of the cloud, or the faces of a part thinner than that)")
+        if unsettled.any():
+            found.append(f"{int(unsettled.sum())} points are on a side the winding number of the cloud contradicts "
+                         "(a part inside out, or an outward part inside another) and turning them did not settle it")
+        problems.append(" and ".join(found) + ": their normals' side is undecided, NaN")
         valid &= ~doubtful
         reason[doubtful] = _UNDECIDED
     if len(groups) > 1:

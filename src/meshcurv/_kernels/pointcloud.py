@@ -244,3 +244,29 @@ def edge_cosines(normals, indices):
             q = indices[i, j]
             out[i, j] = normals[i, 0] * normals[q, 0] + normals[i, 1] * normals[q, 1] + normals[i, 2] * normals[q, 2]
     return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def far_winding(points, normals, weights, soft, sources, queries, reach_squared):
+    """(M,) the sums ``sum_j w_j n_j . (p_j - q) / (|p_j - q|^2 + soft_j)^(3/2)`` over the far ``sources``.
+
+    ``q`` = ``points[queries[i]]``, a source counted when its squared distance
+    to ``q`` exceeds ``reach_squared[i]``; ``weights`` and ``soft`` (S,) per source. The
+    far part of :func:`meshcurv._pointcloud_normals.winding_numbers` (times
+    ``4 pi``); its NumPy path sums the same terms with arrays.
+    """
+    m = queries.shape[0]
+    out = np.zeros(m)
+    for i in nb.prange(m):
+        q = queries[i]
+        qx, qy, qz = points[q, 0], points[q, 1], points[q, 2]
+        total = 0.0
+        for j in range(sources.shape[0]):
+            s = sources[j]
+            dx, dy, dz = points[s, 0] - qx, points[s, 1] - qy, points[s, 2] - qz
+            d = dx * dx + dy * dy + dz * dz
+            if d > reach_squared[i]:
+                d += soft[j]
+                total += weights[j] * (dx * normals[s, 0] + dy * normals[s, 1] + dz * normals[s, 2]) / (d * np.sqrt(d))
+        out[i] = total
+    return out
