@@ -22,12 +22,17 @@ collect_ignore = [path for module, paths in _NEEDS.items() if importlib.util.fin
 _README_NEEDS = ("skimage", "click", "meshio", "matplotlib", "pandas")
 
 
+# The modules whose doctests draw pictures.
+_DOCTEST_NEEDS = {"src/meshcurv/plotting.py": "matplotlib"}
+
+
 def pytest_collection_modifyitems(config, items):
     import pytest
 
     missing = [module for module in _README_NEEDS if importlib.util.find_spec(module) is None]
-    if not missing:
-        return
     for item in items:
-        if item.nodeid.startswith("README.md"):
+        if missing and item.nodeid.startswith("README.md"):
             item.add_marker(pytest.mark.skip(reason=f"the README's examples need {', '.join(missing)}"))
+        for path, module in _DOCTEST_NEEDS.items():
+            if item.nodeid.startswith(path) and importlib.util.find_spec(module) is None:
+                item.add_marker(pytest.mark.skip(reason=f"the example needs {module}"))
