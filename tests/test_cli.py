@@ -1,5 +1,6 @@
 """The ``meshcurv`` command, run in-process through ``main(argv)`` (and once as a real process)."""
 
+import importlib.util
 import builtins
 import logging
 import pathlib
@@ -229,7 +230,9 @@ def test_usage_errors_exit_2(capsys):
     code, out, _ = run(capsys, "--help")
     assert code == 0 and "compute" in out and "methods" in out
     code, out, _ = run(capsys, "--version")
-    assert code == 0 and meshcurv.__version__ in out
+    assert code == 0 and out.startswith(f"meshcurv {meshcurv.__version__} (backend ")
+    backend = "numba" if importlib.util.find_spec("numba") else "numpy"
+    assert f"backend {backend}, numba " in out
 
 
 # ---------------------------------------------------------------- messages: warnings, logging, progress

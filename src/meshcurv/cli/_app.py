@@ -63,8 +63,30 @@ def output_extensions(*, cloud: bool) -> tuple:
     return tuple(extension for extension, fmt in FORMATS.items() if fmt.fields != "none")
 
 
+def version_text() -> str:
+    """``meshcurv --version``: the version, the backend the computations use, numba's and Python's versions."""
+    import importlib.metadata
+    import platform
+
+    from .._backend import backend_name
+
+    try:
+        numba = importlib.metadata.version("numba")
+    except importlib.metadata.PackageNotFoundError:
+        numba = "not installed"
+    return (f"meshcurv {__version__} (backend {backend_name()}, numba {numba}, "
+            f"Python {platform.python_version()})")
+
+
+def _print_version(ctx, param, value):
+    if value and not ctx.resilient_parsing:
+        click.echo(version_text())
+        ctx.exit()
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="meshcurv")
+@click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
+              help="Show the version, the backend (numba or numpy) and numba's version, and exit.")
 @common_options
 def meshcurv():
     """Curvature of triangle meshes: principal curvatures and directions, mean and Gaussian curvature.

@@ -8,7 +8,6 @@ package but the library, so that the dependencies point one way.
 from __future__ import annotations
 
 import contextlib
-import inspect
 import logging
 import sys
 import warnings
@@ -19,7 +18,7 @@ import numpy as np
 
 from .._validation import as_faces
 from ..curvature import principal_curvatures
-from ..estimators import ESTIMATORS
+from ..estimators import DEFAULT_METHOD, ESTIMATORS
 from ..io import is_point_cloud, read_mesh, read_points
 from ..io.fields import FIELDS
 from ..pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
@@ -148,7 +147,7 @@ class MethodChoice(click.Choice):
 
 
 def _default_method() -> str:
-    return inspect.signature(principal_curvatures).parameters["method"].default
+    return DEFAULT_METHOD
 
 
 def method_options(function):
