@@ -1296,6 +1296,26 @@ def check_edge_cosines(name):
     assert_sums_close(kernels("pointcloud").edge_cosines(normals, indices), expected, 1.0, 3)
 
 
+def check_far_winding(name):
+    """The winding numbers of an oriented cloud with the far sum compiled and in NumPy (the same terms)."""
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_normals import winding_numbers
+
+    points, normals = cloud(name)
+    rng = np.random.default_rng(3)
+    areas = rng.uniform(0.5, 1.5, points.shape[0]) * 1e-3
+    usable = rng.random(points.shape[0]) > 0.05
+    queries = np.arange(0, points.shape[0], 7)
+    sources = np.flatnonzero(usable)[::3]
+    results = {}
+    for backend in ("numpy", "numba"):
+        with use_backend(backend):
+            results[backend] = winding_numbers(points, normals, areas, usable, cKDTree(points), queries, sources)
+    # the same terms, summed in another order: round-off of sums of about a thousand terms of size <= 1
+    np.testing.assert_allclose(results["numba"], results["numpy"], rtol=0, atol=1e-9)
+
+
 def check_spanning_signs(name):
     from meshcurv._pointcloud_normals import orientation_signs
 
@@ -1385,6 +1405,7 @@ TWINS = [
     Twin("pointcloud.ball_triangle_sums", "_pointcloud_estimators._triangle_sums", check_ball_triangle_sums, CLOUDS),
     Twin("pointcloud.edge_cosines", "the cosines of _pointcloud_normals.orientation_signs", check_edge_cosines,
          CLOUDS),
+    Twin("pointcloud.far_winding", "_pointcloud_normals.winding_numbers", check_far_winding, CLOUDS),
     Twin("pointcloud.spanning_signs", "_pointcloud_normals.orientation_signs", check_spanning_signs, CLOUDS),
 ]
 
