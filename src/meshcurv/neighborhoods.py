@@ -213,7 +213,7 @@ def vertex_pairs_in_ball(points: np.ndarray, radius: float, *, centres: np.ndarr
     yield from _ball_pairs(points, points[centres], radius, chunk_size)
 
 
-def _ball_pairs(points: np.ndarray, centre_points: np.ndarray, radius: float,
+def _ball_pairs(points: np.ndarray, centre_points: np.ndarray, radius,
                 chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """:func:`vertex_pairs_in_ball` around arbitrary ``centre_points`` (trusted arrays).
 
@@ -299,7 +299,7 @@ def _size_groups(reach: np.ndarray, radius: float) -> list[np.ndarray | slice]:
     return [np.flatnonzero(label[level] == first) for first in firsts]
 
 
-def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius: float, values: np.ndarray,
+def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius, values: np.ndarray,
                usable: np.ndarray | None, weight, connected: bool = False) -> np.ndarray:
     """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices.
 
@@ -401,7 +401,8 @@ def _squared(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
 def _columns(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The x, y and z coordinates of (N, 3) points as three contiguous arrays (gathers by index from
     a column are several times faster than of rows)."""
-    return tuple(np.ascontiguousarray(column) for column in points.T)
+    x, y, z = (np.ascontiguousarray(column) for column in points.T)
+    return x, y, z
 
 
 def _offsets(columns: tuple, index: np.ndarray, centre: tuple) -> tuple[np.ndarray, ...]:
@@ -414,7 +415,7 @@ def _offsets(columns: tuple, index: np.ndarray, centre: tuple) -> tuple[np.ndarr
 _SEARCH_SLACK = 1e-9
 
 
-def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np.ndarray, radius: float,
+def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np.ndarray, radius,
                      chunk_size: int = CHUNK, *, refuse: bool = True) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """Yield ``(chunk, i, c)`` per chunk of centres: cell ``c`` may meet the ball ``B(centre_points[i], radius)``.
 

@@ -447,15 +447,6 @@ def _area_inside(vertices, faces, cap, border, normals, triangle, corrected, opt
     return out
 
 
-def _takes_radius(method) -> bool:
-    """Whether ``method`` (None: the default) is a registered method over balls (it takes a ``radius``)."""
-    from .estimators import DEFAULT_METHOD, ESTIMATORS
-
-    estimator = ESTIMATORS.get(DEFAULT_METHOD if method is None else method) if isinstance(method, (str, type(None))) \
-        else None
-    return estimator is not None and "radius" in estimator.options
-
-
 #: On a label cut by the image border, the default radius is chosen as on any voxel surface
 #: (:func:`meshcurv.radius.voxel_surface_radius`) but from the pilot's curvature of its open surface (the
 #: cap's faces left out) and of the vertices farther than this many voxels from the image faces it touches:

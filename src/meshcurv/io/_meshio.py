@@ -95,10 +95,10 @@ def read_ascii_stl(path, data: bytes):
         found[what] = parsed[0].reshape(-1, 3)
     corners = found["vertex x y z"]
     facets = np.array([m.start() for m in _STL_NORMAL.finditer(data)], dtype=np.int64)
-    rows = np.array([m.start() for m in _STL_VERTEX.finditer(data)], dtype=np.int64)
-    owner = np.searchsorted(facets, rows, side="right") - 1  # the facet each vertex row follows
+    starts = np.array([m.start() for m in _STL_VERTEX.finditer(data)], dtype=np.int64)
+    owner = np.searchsorted(facets, starts, side="right") - 1  # the facet each vertex row follows
     if facets.size == 0 or (owner < 0).any():
-        where = f"line {line_of(data, int(rows[0]))}: a vertex before any facet" if rows.size else "no facets"
+        where = f"line {line_of(data, int(starts[0]))}: a vertex before any facet" if starts.size else "no facets"
         raise MeshFileError(f"{path}: {where} (an ASCII STL lists 'facet normal' rows, each with 3 vertices)")
     per_facet = np.bincount(owner, minlength=facets.size)
     if (per_facet != 3).any():

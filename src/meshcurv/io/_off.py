@@ -55,12 +55,12 @@ def read_off(path):
                             "number (a vertex coordinate)")
     values, counts = parsed
     if (counts < 3).any():
-        bad = int(np.flatnonzero(counts < 3)[0])
-        raise row_error(path, line(bad), int(counts[bad]), "3 or more", "x, y, z, then maybe a colour")
+        row = int(np.flatnonzero(counts < 3)[0])
+        raise row_error(path, line(row), int(counts[row]), "3 or more", "x, y, z, then maybe a colour")
     usual = int(np.bincount(counts).argmax()) if counts.size else 3
     if (counts != usual).any():  # a colour on every vertex or on none: one row apart has a value too many or few
-        bad = int(np.argmax(counts != usual))
-        raise row_error(path, line(bad), int(counts[bad]), usual, "as most vertex rows: x, y, z"
+        row = int(np.argmax(counts != usual))
+        raise row_error(path, line(row), int(counts[row]), usual, "as most vertex rows: x, y, z"
                         + (", then a colour" if usual > 3 else ""))
     if n_vertices > len(body):  # the rows there are were checked first: a damaged row is named
         raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; the file has {len(body)}")
@@ -73,9 +73,9 @@ def read_off(path):
     values, counts = parsed
     first = np.cumsum(counts) - counts
     sizes = np.where(counts > 0, values[np.minimum(first, max(values.size - 1, 0))] if values.size else 0, 0)
-    bad = (counts == 0) | (sizes != np.floor(sizes)) | (sizes < 3)
-    if bad.any():
-        face = int(np.flatnonzero(bad)[0])
+    malformed = (counts == 0) | (sizes != np.floor(sizes)) | (sizes < 3)
+    if malformed.any():
+        face = int(np.flatnonzero(malformed)[0])
         raise MeshFileError(f"{path}: line {line(n_vertices + face)}: a face of {sizes[face]:g} corners (its first "
                             "value counts its corners: a whole number, 3 or more)")
     bad = sizes > counts - 1

@@ -296,8 +296,9 @@ def _undelimited(body: bytes, path, line: int) -> bytes:
     one at the start or end of a row) is an error naming its line.
     """
     first = _FIRST_WORD.search(body)
-    end = body.find(b"\n", first.start())
-    row = body[first.start():len(body) if end < 0 else end]
+    start = 0 if first is None else first.start()
+    end = body.find(b"\n", start)
+    row = body[start:len(body) if end < 0 else end]
     delimiter = b";" if b";" in row else b"," if b"," in row else None
     if delimiter is None:
         return body

@@ -145,7 +145,7 @@ def body_rows(data: bytes, offset: int, path, n_rows: int | None = None):
             parsed = numbers_by_line(text) if text else (np.zeros(0), np.zeros(0, dtype=np.int64))
             if parsed is None or text is body or np.count_nonzero(parsed[1]) >= n_rows:
                 break
-            cut += n_rows - np.count_nonzero(parsed[1])
+            cut += n_rows - int(np.count_nonzero(parsed[1]))
     else:
         parsed = numbers_by_line(body)
     if parsed is None:
