@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import MeshFileError, MeshQualityWarning, MissingDependencyError
 from ._files import atomic_output, check_input, check_output
-from ._ply import _ORDERS, HEADER_LIMIT, _header
+from ._ply import HEADER_LIMIT, _header, _short, ply_vertex_columns
 from ._text import body_rows, fixed_rows, line_of, names_shown, not_a_number, numbers_by_line, row_error
 
 __all__ = ["read_points", "write_points", "write_point_curvatures", "is_point_cloud", "POINT_EXTENSIONS"]
@@ -148,59 +148,6 @@ def _split(columns: dict, path, where: str) -> tuple[np.ndarray, np.ndarray | No
 def _read_ply(path):
     columns = ply_vertex_columns(path)
     return _split({name.lower(): values for name, values in columns.items()}, path, "the PLY 'vertex' element")
-
-
-def ply_vertex_columns(path) -> dict[str, np.ndarray]:
-    """The properties of the ``vertex`` element of a PLY file (ASCII or binary) by their names in the header.
-
-    Only the vertex element is read (the elements after it, such as a
-    surface's faces, are not parsed): the columns of a point cloud and of a
-    mesh alike. ASCII values are float64; binary ones keep their stored type.
-    """
-    path = pathlib.Path(path)
-    data = path.read_bytes()
-    file_format, elements, offset = _header(data, path)
-    vertex = next((e for e in elements if e.name == "vertex"), None)
-    if vertex is None:
-        raise MeshFileError(f"{path}: the PLY header has no 'vertex' element")
-    if any(p.count_kind is not None for p in vertex.properties):
-        raise MeshFileError(f"{path}: the PLY 'vertex' element has a list property; not supported")
-    before = elements[:elements.index(vertex)]
-    if any(p.count_kind is not None for e in before for p in e.properties):
-        raise MeshFileError(f"{path}: the PLY file has a list element before its vertices; not supported")
-    if file_format == "ascii":  # one record per line: a line of the wrong length is named, never re-cut
-        skip = sum(e.count for e in before)
-        # each value takes at least two bytes (a digit and a separator): bound the count first
-        if (sum(e.count * len(e.properties) for e in before) + vertex.count * len(vertex.properties)) * 2 > \
-                len(data) - offset + 1:
-            raise _short(path, vertex.count, "vertices", len(data) - offset)
-        values, counts, first_value, lines = body_rows(data, offset, path, n_rows=skip + vertex.count)
-        row = 0
-        for element in [*before, vertex]:  # the rows there are are checked before a missing one is reported
-            rows = slice(row, row + element.count)
-            row += element.count
-            names = [p.name for p in element.properties]
-            table = fixed_rows(values, counts[rows], first_value[rows], lines[rows], len(names), path,
-                               f"{element.name}: {names_shown(names)}")
-        if counts.size < skip + vertex.count:
-            raise _short(path, vertex.count, "vertices", len(data) - offset)
-        return {p.name: table[:, i] for i, p in enumerate(vertex.properties)}
-    order = _ORDERS[file_format]
-    position = offset
-    for element in before:
-        position += element.count * np.dtype([(p.name, order + p.kind) for p in element.properties]).itemsize
-    record = np.dtype([(p.name, order + p.kind) for p in vertex.properties])
-    need = vertex.count * record.itemsize
-    if position + need > len(data):
-        raise _short(path, vertex.count, "vertices", max(len(data) - position, 0), need)
-    table = np.frombuffer(data, record, count=vertex.count, offset=position)
-    return {p.name: table[p.name] for p in vertex.properties}
-
-
-def _short(path, count, what, available, need=None) -> MeshFileError:
-    needed = f" ({need} needed)" if need is not None else ""
-    return MeshFileError(f"{path}: the header declares {count} {what} but the file holds only {available} bytes "
-                         f"for them{needed}; the file is cut short or its header is wrong")
 
 
 # -- text ---------------------------------------------------------------------------

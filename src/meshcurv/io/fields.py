@@ -158,7 +158,7 @@ def read_fields(path) -> dict[str, np.ndarray]:
 
 
 def _ply_fields(path):
-    from ._points import ply_vertex_columns
+    from ._ply import ply_vertex_columns
 
     # the vertex element alone: a point cloud's file (no faces) as well as a surface's
     return {name: np.asarray(values, dtype=np.float64) for name, values in ply_vertex_columns(path).items()
