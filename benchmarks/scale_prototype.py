@@ -62,16 +62,17 @@ NOISE_FIT_EDGES = 2.0
 
 # -- computing ---------------------------------------------------------------------------
 
-def ladder(vertices, faces, topology):
-    """The radii ``h_5 LADDER_LOW q^j`` up to ``min(LADDER_HIGH h, sqrt(area / (18 pi)))``."""
+def ladder(vertices, faces, topology, *, ratio=LADDER_RATIO, high=LADDER_HIGH):
+    """The radii ``h_5 LADDER_LOW q^j`` up to ``min(high h, sqrt(area / (18 pi)))`` (``q``: ``ratio``)."""
     local = vertex_edge_lengths(vertices, topology.edges)
     h = median_edge_length(vertices, topology.edges)
     a, b, c = (vertices[faces[:, k]] for k in range(3))
     area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
-    top = min(LADDER_HIGH * h, np.sqrt(area / (18 * np.pi)))
+    top = min(high * h, np.sqrt(area / (18 * np.pi)))
     low = LADDER_LOW * np.percentile(local[np.isfinite(local)], 5)
-    count = int(np.floor(np.log(top / low) / np.log(LADDER_RATIO))) + 1
-    return low * LADDER_RATIO ** np.arange(count)
+    # the small slack keeps the rungs of a finer ratio that coincide with a coarser one's (2^(2/4) = 2^(1/2))
+    count = int(np.floor(np.log(top / low) / np.log(ratio) + 1e-9)) + 1
+    return low * ratio ** np.arange(count)
 
 
 def ring_matrix(indptr, indices):
@@ -245,6 +246,9 @@ def select_stable(data, rule):
     elif pool:
         change = (1 - pool) * change + pool * np.nanmedian(change, axis=1, keepdims=True)
     usable = radii[:-1, None] >= rule["min_edges"] * h[None, :]
+    if rule.get("floor_r0", 0) > 0:  # variant B: no rung below this many default radii (data["r0"])
+        usable &= radii[:-1, None] >= rule["floor_r0"] * data["r0"] * (1 - 1e-9)
+        usable[-1] |= ~usable.any(axis=0)
     if rule["cap"] > 0:
         k = np.maximum(np.abs(data["fields"][0]), np.abs(data["fields"][1]))[:-1]
         usable &= ~(radii[:-1, None] * k > rule["cap"]) | (np.cumsum(usable, axis=0) == 1)
