@@ -202,6 +202,7 @@ def test_the_faces_of_a_flat_ellipsoid_are_outward_or_invalid():
 def test_winding_number_of_a_sphere_is_one_half_on_it_and_its_backends_agree():
     # Barill et al. 2018: the winding number is 1/2 on a closed surface, -1/2 with its normals inward; the
     # NumPy path sums the same terms as the compiled one (a sampled far field: 1500 sources of 6000 points)
+    pytest.importorskip("numba")  # the two backends compared
     from scipy.spatial import cKDTree
 
     from meshcurv._backend import use_backend

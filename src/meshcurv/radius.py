@@ -21,9 +21,11 @@ the user:
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 
 import numpy as np
+from scipy import sparse
 
 from ._validation import check_positive_float, checked_points
 from .errors import InvalidOptionError
@@ -44,6 +46,8 @@ __all__ = [
     "resolve_radius",
     "small_radius_note",
     "vertex_radii",
+    "scale_ladder",
+    "stable_scales",
 ]
 
 #: The default ``radius`` is this many mean edge lengths.
@@ -301,3 +305,58 @@ def vertex_radii(groups: list[tuple[float, np.ndarray | None]], n_vertices: int)
         if members is not None:
             radii[members] = radius
     return radii
+
+
+#: The adaptive scale (``radius="adaptive"``): rungs ``r0 sqrt(2)^j`` from the default radius ``r0``...
+LADDER_RATIO = float(np.sqrt(2.0))
+#: ... up to this many median edge lengths ...
+LADDER_HIGH = 12.0
+#: ... and never a ball whose normal fits (three radii) would cover half a sphere of the surface's area:
+#: ``r <= sqrt(area / (LADDER_AREA pi))``.
+LADDER_AREA = 18.0
+#: The change between rungs is averaged over this many rings of each vertex ...
+STABLE_RINGS = 2
+#: ... and mixed with its median over the mesh with this weight.
+STABLE_POOL = 0.5
+
+
+def scale_ladder(base: float, median_edge: float, area: float) -> np.ndarray:
+    """The radii of the adaptive scale: ``base sqrt(2)^j`` up to ``min(12 h, sqrt(area / (18 pi)))``, at least 2.
+
+    ``base`` is the default radius (:func:`noise_radius`, :func:`voxel_radius`), ``h`` the median edge
+    length. From ``benchmarks/scale.md`` (variant B, the ladder anchored at the default).
+    """
+    top = min(LADDER_HIGH * median_edge, float(np.sqrt(area / (LADDER_AREA * np.pi))))
+    count = int(np.floor(np.log(max(top, base) / base) / np.log(LADDER_RATIO) + 1e-9)) + 1
+    return base * LADDER_RATIO ** np.arange(max(count, 2))
+
+
+def stable_scales(k_min: np.ndarray, k_max: np.ndarray, neighbour_lists: tuple) -> np.ndarray:
+    """(V,) the rung of each vertex where its estimates change least along the ladder.
+
+    ``k_min``, ``k_max`` (J, V): the curvatures at the J rungs of :func:`scale_ladder`. The change
+    ``D_j = |dH| + |dk_min| + |dk_max|`` between rungs ``j`` and ``j + 1`` is averaged over the
+    :data:`STABLE_RINGS` rings of each vertex and mixed half and half with its median over the mesh
+    (:data:`STABLE_POOL`); the vertex takes the upper rung of the pair where it is smallest, or the
+    first rung when that pair is the first (its estimates agree from the start). Noise error falls
+    and bias grows with the radius: the estimate is flattest where they balance, which needs no model
+    of the noise (a Lepski rule with one, measured, did worse: ``benchmarks/scale.md``).
+    """
+    mean = 0.5 * (k_min + k_max)
+    change = np.abs(np.diff(mean, axis=0)) + np.abs(np.diff(k_min, axis=0)) + np.abs(np.diff(k_max, axis=0))
+    finite = np.isfinite(change)
+    indptr, indices = neighbour_lists
+    n = k_min.shape[1]
+    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n)) + sparse.identity(n)
+    total, count = np.where(finite, change, 0.0).T, finite.astype(np.float64).T
+    for _ in range(STABLE_RINGS):
+        total, count = ring @ total, ring @ count
+    with np.errstate(invalid="ignore", divide="ignore"):
+        local = (total / count).T
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a rung NaN at every vertex
+        pooled = np.nanmedian(local, axis=1, keepdims=True)
+    mixed = (1 - STABLE_POOL) * local + STABLE_POOL * pooled
+    mixed = np.where(np.isfinite(mixed), mixed, np.inf)
+    best = np.argmin(mixed, axis=0)
+    return np.where(best == 0, 0, np.minimum(best + 1, k_min.shape[0] - 1))
