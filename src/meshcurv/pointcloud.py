@@ -35,10 +35,10 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    closer than the spacing cannot be told apart, or whose side turning does
    not settle, are NaN (``invalid_reason``: side undecided);
 4. the noise level ``nu``: the median distance of the points to degree-2 jets
-   fitted over :data:`NOISE_FIT_RADIUS` spacings, in spacings;
+   fitted over :data:`meshcurv.radius.CLOUD_NOISE_FIT_RADIUS` spacings, in spacings;
 5. the radius: ``s (a + b sqrt(max(nu - 0.005, 0)))``, ``(a, b)`` = (3, 11)
    for ``corrected_measures`` and (3, 22) for ``jets``
-   (:data:`RADIUS_RULES`, from a sweep of ``benchmarks/pointcloud.py``: three
+   (:data:`meshcurv.radius.CLOUD_RADIUS_RULES`, from a sweep of ``benchmarks/pointcloud.py``: three
    spacings on clean samples, about 4.3 and 5.9 under noise of 0.05 and 0.2
    spacings for the measures; jets need larger balls under noise); when the
    density varies by more than a factor 2 across the cloud, each class of
@@ -97,7 +97,7 @@ from . import _pointcloud_estimators as _estimators
 from . import _pointcloud_normals as _normals
 from ._validation import as_vertices, check_choice, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
-from .jets import fit_jets
+from .radius import CLOUD_EXTENT_CAP, CLOUD_RADIUS_RULES, cloud_noise_level, cloud_radius, noise_rule
 from .result import INVALID_REASONS, CurvatureResult
 
 __all__ = ["point_cloud_curvatures", "POINT_CLOUD_METHODS", "MIN_POINTS"]
@@ -110,27 +110,12 @@ POINT_CLOUD_METHODS = ("corrected_measures", "jets")
 #: Fewest points accepted.
 MIN_POINTS = 10
 
-#: The default radius ``s (a + b sqrt(max(nu - NOISE_FLOOR, 0)))`` per method: ``(a, b)``.
-RADIUS_RULES = {"corrected_measures": (3.0, 11.0), "jets": (3.0, 22.0)}
-
-#: Noise levels (in spacings) up to this count as clean samples: the fit's own bias.
-NOISE_FLOOR = 0.005
-
-#: The noise level is measured with degree-2 jets over balls of this many spacings.
-NOISE_FIT_RADIUS = 3.0
-
-#: The noise level is measured on at most this many points, evenly spaced in index order.
-NOISE_SAMPLE = 16384
-
 #: A point whose local spacing exceeds this many times the median is an outlier.
 OUTLIER_FACTOR = 10.0
 
 #: The density counts as uneven (and each class of spacing gets its own radius) when the 95th
 #: percentile of the (neighbour-averaged) local spacing exceeds this many times the 5th.
 UNEVEN_DENSITY = 2.0
-
-#: A default radius is at most this share of the cloud's extent (its bounding-box diagonal).
-EXTENT_CAP = 0.25
 
 #: Points whose local spacing is at most this are left out (NaN): the k-d tree's squared distances
 #: underflow float64 below about 1.5e-154 (the square root of the smallest normal number, 2.2e-308)
@@ -502,11 +487,11 @@ def _compute(points, given, radius, method, search=None):
         how = "given, reoriented" if reoriented else "given"
 
     logger.info("point cloud: noise level")
-    noise = _noise_level(points, start, median, centres, usable)
+    noise = cloud_noise_level(points, start, median, centres, usable)
     groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems)
     if radius is None:
         extent = points[usable]
-        largest = EXTENT_CAP * float(np.linalg.norm(extent.max(axis=0) - extent.min(axis=0)))
+        largest = CLOUD_EXTENT_CAP * float(np.linalg.norm(extent.max(axis=0) - extent.min(axis=0)))
         if max(r for r, _, _ in groups) > largest:
             problems.append(f"the cloud is too sparse or too noisy for its size (default radius "
                             f"{max(r for r, _, _ in groups):.3g} beyond a quarter of its extent): radius cut to "
@@ -528,13 +513,13 @@ def _compute(points, given, radius, method, search=None):
         if method == "jets":
             # a ball that holds the other side of a thin or small part shrinks, down to the clean-sample radius
             # (a given radius too: a jet through both sides is not the surface, H doubled on a small sphere)
-            smallest = min(group_radius, RADIUS_RULES[method][0] * group_spacing)
+            smallest = min(group_radius, CLOUD_RADIUS_RULES[method][0] * group_spacing)
             found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest,
                                      details=details)
             asked = group_radius
         else:
             if given is None:
-                asked = normal_radius = _rule(_estimators.NORMAL_RULE, group_spacing, noise)
+                asked = normal_radius = noise_rule(_estimators.NORMAL_RULE, group_spacing, noise)
                 normals = _estimators.fitted_normals(points, start, normal_radius, members, usable,
                                                      smallest=_estimators.NORMAL_RULE[0] * group_spacing,
                                                      details=details)
@@ -561,7 +546,7 @@ def _compute(points, given, radius, method, search=None):
     if method == "jets" and radius is not None and shrunk:
         problems.append(f"at {shrunk} points the ball of the given radius {radius:g} held the other side of a thin "
                         "or small part (points facing away): fitted over smaller balls of one side, down to "
-                        f"{RADIUS_RULES[method][0]:g} spacings (parameters['shrunk'])")
+                        f"{CLOUD_RADIUS_RULES[method][0]:g} spacings (parameters['shrunk'])")
     if two_sided:
         what = "curvatures NaN" if method == "jets" else "normals from the PCA of 10 neighbours"
         problems.append(f"{two_sided} points have no one-sided jet fit (every ball down to 3-4 spacings held "
@@ -586,30 +571,6 @@ def _compute(points, given, radius, method, search=None):
     return k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, problems
 
 
-def _noise_level(points, normals, spacing, centres, usable) -> float:
-    """Median distance of the points to degree-2 jets over :data:`NOISE_FIT_RADIUS` spacings, in spacings."""
-    sample = centres[np.linspace(0, centres.size - 1, min(centres.size, NOISE_SAMPLE)).round().astype(np.int64)]
-    if spacing <= 0 or sample.size == 0:
-        return 0.0
-    radius = NOISE_FIT_RADIUS * spacing
-    coefficients, _, _ = fit_jets(points, normals, radius, degree=2, iterations=1, centres=sample,
-                                  neighbours=usable)
-    heights = np.abs(coefficients[sample, 0]) * NOISE_FIT_RADIUS  # c00 is in units of the radius
-    heights = heights[np.isfinite(heights)]
-    return float(np.median(heights)) if heights.size else 0.0
-
-
-def _rule(rule, spacing: float, noise: float) -> float:
-    """``spacing (a + b sqrt(max(noise - NOISE_FLOOR, 0)))`` for ``rule = (a, b)``."""
-    a, b = rule
-    return float(spacing * (a + b * np.sqrt(max(noise - NOISE_FLOOR, 0.0))))
-
-
-def default_radius(spacing: float, noise: float, method: str = POINT_CLOUD_METHODS[0]) -> float:
-    """The default radius for points of this median ``spacing`` and ``noise`` level (in spacings)."""
-    return _rule(RADIUS_RULES[method], spacing, noise)
-
-
 def _radius_groups(spacing, indices, usable, median, noise, radius, method, problems):
     """``[(radius, spacing, centres), ...]``: one radius, or one per class of density when it is uneven."""
     centres = np.flatnonzero(usable)
@@ -621,12 +582,12 @@ def _radius_groups(spacing, indices, usable, median, noise, radius, method, prob
     smooth = np.nanmean(np.concatenate([smooth[centres, None], smooth[indices[centres]]], axis=1), axis=1)
     low, high = np.percentile(smooth, [5, 95])
     if high <= UNEVEN_DENSITY * low:
-        return [(default_radius(median, noise, method), median, centres)]
+        return [(cloud_radius(median, noise, method), median, centres)]
     level = np.round(np.log2(smooth / median)).astype(np.int64)
     groups = []
     for k in np.unique(level):
         members = centres[level == k]
-        groups.append((default_radius(median * 2.0**k, noise, method), median * 2.0**k, members))
+        groups.append((cloud_radius(median * 2.0**k, noise, method), median * 2.0**k, members))
     problems.append(f"the density of the points is very uneven (local spacing from {low:.3g} to {high:.3g}, "
                     f"5th to 95th percentile): each of {len(groups)} classes of spacing got its own radius")
     return groups

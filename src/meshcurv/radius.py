@@ -15,6 +15,10 @@ the user:
 - :func:`voxel_radius`, :func:`voxel_surface_radius`: on voxel surfaces
   (marching cubes), about ``sqrt(h R)`` for voxels of size ``h`` and curvature
   radius ``R``;
+- :func:`scale_ladder`, :func:`stable_scales`: ``radius="adaptive"``, each
+  vertex at the rung of a ladder of radii where its estimate is stable;
+- :func:`cloud_noise_level`, :func:`cloud_radius`: point clouds, growing with
+  their noise in units of their spacing;
 - :func:`check_radius`, :func:`resolve_radius`, :func:`small_radius_note`:
   a radius given by the user.
 """
@@ -48,6 +52,9 @@ __all__ = [
     "vertex_radii",
     "scale_ladder",
     "stable_scales",
+    "cloud_noise_level",
+    "cloud_radius",
+    "noise_rule",
 ]
 
 #: The default ``radius`` is this many mean edge lengths.
@@ -360,3 +367,47 @@ def stable_scales(k_min: np.ndarray, k_max: np.ndarray, neighbour_lists: tuple) 
     mixed = np.where(np.isfinite(mixed), mixed, np.inf)
     best = np.argmin(mixed, axis=0)
     return np.where(best == 0, 0, np.minimum(best + 1, k_min.shape[0] - 1))
+
+
+# -- point clouds (meshcurv.point_cloud_curvatures) ----------------------------------------------------
+
+#: The default radius of a point cloud, ``s (a + b sqrt(max(nu - NOISE_FLOOR, 0)))`` for a median spacing
+#: ``s`` and noise level ``nu`` (in spacings), per method: ``(a, b)`` (a sweep of ``benchmarks/pointcloud.py``).
+CLOUD_RADIUS_RULES = {"corrected_measures": (3.0, 11.0), "jets": (3.0, 22.0)}
+
+#: A cloud's noise level is measured with degree-2 jets over balls of this many spacings ...
+CLOUD_NOISE_FIT_RADIUS = 3.0
+
+#: ... on at most this many points, evenly spaced in index order.
+CLOUD_NOISE_SAMPLE = 16384
+
+#: A default radius is at most this share of the cloud's extent (its bounding-box diagonal).
+CLOUD_EXTENT_CAP = 0.25
+
+
+def cloud_noise_level(points, normals, spacing, centres, usable) -> float:
+    """Median distance of the points to degree-2 jets over :data:`CLOUD_NOISE_FIT_RADIUS` spacings, in spacings.
+
+    ``centres`` are the usable points, of which at most :data:`CLOUD_NOISE_SAMPLE`, evenly spaced, are fitted.
+    """
+    taken = np.linspace(0, centres.size - 1, min(centres.size, CLOUD_NOISE_SAMPLE)).round().astype(np.int64)
+    sample = centres[taken]
+    if spacing <= 0 or sample.size == 0:
+        return 0.0
+    radius = CLOUD_NOISE_FIT_RADIUS * spacing
+    coefficients, _, _ = fit_jets(points, normals, radius, degree=2, iterations=1, centres=sample,
+                                  neighbours=usable)
+    heights = np.abs(coefficients[sample, 0]) * CLOUD_NOISE_FIT_RADIUS  # c00 is in units of the radius
+    heights = heights[np.isfinite(heights)]
+    return float(np.median(heights)) if heights.size else 0.0
+
+
+def noise_rule(rule, spacing: float, noise: float) -> float:
+    """``spacing (a + b sqrt(max(noise - NOISE_FLOOR, 0)))`` for ``rule = (a, b)``."""
+    a, b = rule
+    return float(spacing * (a + b * np.sqrt(max(noise - NOISE_FLOOR, 0.0))))
+
+
+def cloud_radius(spacing: float, noise: float, method: str = "corrected_measures") -> float:
+    """The default radius of a point cloud's ``method`` at this median ``spacing`` and ``noise`` (in spacings)."""
+    return noise_rule(CLOUD_RADIUS_RULES[method], spacing, noise)
