@@ -183,7 +183,7 @@ def test_to_pyvista_copies_the_polydata_and_adds_every_field():
     r = meshcurv.principal_curvatures(mesh)
     out = r.to_pyvista(mesh)
     assert out is not mesh and list(mesh.point_data) == ["label"]  # the input is not changed
-    assert set(out.point_data) == {"label", *SCALARS, "dir_min", "dir_max", "normals", "valid"}
+    assert set(out.point_data) == {"label", *SCALARS, "dir_min", "dir_max", "normals", "valid", "radius"}
     for name in SCALARS:
         np.testing.assert_array_equal(out.point_data[name], getattr(r, name))
     np.testing.assert_array_equal(out.point_data["dir_max"], r.dir_max)
@@ -236,7 +236,7 @@ def test_to_dataframe_one_row_per_vertex():
     frame = r.to_dataframe()
     assert isinstance(frame, pd.DataFrame) and len(frame) == SPHERE.vertices.shape[0]
     assert list(frame.columns) == [*SCALARS, "dir_min_x", "dir_min_y", "dir_min_z", "dir_max_x", "dir_max_y",
-                                   "dir_max_z", "normals_x", "normals_y", "normals_z", "valid", "vertex_area"]
+                                   "dir_max_z", "normals_x", "normals_y", "normals_z", "valid", "radius", "vertex_area"]
     assert frame["valid"].dtype == bool
     np.testing.assert_array_equal(frame["normals_y"], r.normals[:, 1])
     corners = SPHERE.vertices[SPHERE.faces]

@@ -27,7 +27,7 @@ from ..topology import MeshTopology
 
 __all__ = ["Session", "current_session", "common_options", "method_options", "estimated"]
 
-SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid")]
+SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid", "radius")]
 
 
 #: The largest finite float: an option value that parses to infinity (``1e400``) is beyond it.

@@ -20,6 +20,7 @@ FIELDS = {
     "dir_max": "unit direction of k_max (3-vector)",
     "normals": "unit vertex normal (3-vector)",
     "valid": "1 where the estimate is defined, 0 where it is not",
+    "radius": "radius of the ball each vertex was measured over (length; NaN for methods without a ball)",
 }
 
 
@@ -103,6 +104,8 @@ VIEWERS = {
 def _field(result, name: str) -> np.ndarray:
     if name == "valid":
         return result.valid.astype(np.uint8)
+    if name == "radius" and result.radius is None:
+        return np.full(result.n_vertices, np.nan)
     return np.array(getattr(result, name), dtype=np.float64)
 
 
