@@ -56,14 +56,13 @@ import inspect  # noqa: E402
 import json  # noqa: E402
 import pickle  # noqa: E402
 import resource  # noqa: E402
-import select  # noqa: E402
-import signal  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 import traceback  # noqa: E402
 import warnings  # noqa: E402
 
 import numpy as np  # noqa: E402
+from _forked import collect, vsize  # noqa: E402
 
 import meshcurv  # noqa: E402
 from meshcurv import geometry, shapes  # noqa: E402
@@ -943,11 +942,6 @@ def _nbytes(value):
         return 0
 
 
-def _vsize() -> int:
-    with open("/proc/self/statm") as fh:
-        return int(fh.read().split()[0]) * resource.getpagesize()
-
-
 def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
     """Make case ``index`` and run it in a forked child: ``(outcome, elapsed)``.
 
@@ -955,7 +949,7 @@ def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
     index can itself allocate without bound), under a first cap of the
     parent's size plus 2 GiB, lowered to the call's own cap before the call.
     """
-    base = _vsize()
+    base = vsize()
     read_end, write_end = os.pipe()
     pid = os.fork()
     if pid == 0:  # child
@@ -986,26 +980,7 @@ def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
             code = 3
         os._exit(code)
     os.close(write_end)
-    start = time.monotonic()
-    chunks = []
-    timed_out = False
-    while True:
-        remaining = timeout - (time.monotonic() - start)
-        if remaining <= 0:
-            timed_out = True
-            break
-        ready, _, _ = select.select([read_end], [], [], remaining)
-        if ready:
-            chunk = os.read(read_end, 1 << 20)
-            if not chunk:
-                break
-            chunks.append(chunk)
-    elapsed = time.monotonic() - start
-    if timed_out:
-        os.kill(pid, signal.SIGKILL)
-    _, status = os.waitpid(pid, 0)
-    os.close(read_end)
-    data = b"".join(chunks)
+    data, status, timed_out, elapsed = collect(pid, read_end, timeout)
     head = {"target": "?", "call": "?", "mutations": [], "method": None}
     if len(data) >= 8:
         size = int.from_bytes(data[:8], "little")
@@ -1101,7 +1076,7 @@ def main(argv=None) -> int:
         return 0
 
     if options.replay is not None:
-        guard = _vsize() + 4 * 2**30
+        guard = vsize() + 4 * 2**30
         resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
         if options.replay % 4 == 3:  # as in the run: every fourth case on the NumPy paths
             os.environ["MESHCURV_BACKEND"] = "numpy"
@@ -1123,7 +1098,7 @@ def main(argv=None) -> int:
         if pointcloud is not None:
             pointcloud.point_cloud_curvatures(shapes.random_sphere(n_vertices=200).vertices)
 
-    guard = _vsize() + 3 * 2**30  # the parent itself never needs more (it builds no case)
+    guard = vsize() + 3 * 2**30  # the parent itself never needs more (it builds no case)
     resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
     deadline = time.monotonic() + options.minutes * 60
     counts = collections.Counter()

@@ -62,8 +62,6 @@ import json  # noqa: E402
 import pickle  # noqa: E402
 import re  # noqa: E402
 import resource  # noqa: E402
-import select  # noqa: E402
-import signal  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -71,6 +69,7 @@ import traceback  # noqa: E402
 import warnings  # noqa: E402
 
 import numpy as np  # noqa: E402
+from _forked import collect, vsize  # noqa: E402
 
 from meshcurv.errors import (InvalidMeshError, InvalidOptionError, MeshcurvWarning, MeshFileError,  # noqa: E402
                              MissingDependencyError)
@@ -314,13 +313,8 @@ def run_case(seed, index) -> dict:
 
 # ---- the runner ------------------------------------------------------------------------------------------------------
 
-def _vsize() -> int:
-    with open("/proc/self/statm") as fh:
-        return int(fh.read().split()[0]) * resource.getpagesize()
-
-
 def run_forked(seed, index, timeout, memory_mib) -> tuple[dict, float]:
-    base = _vsize()
+    base = vsize()
     read_end, write_end = os.pipe()
     pid = os.fork()
     if pid == 0:  # child
@@ -340,30 +334,13 @@ def run_forked(seed, index, timeout, memory_mib) -> tuple[dict, float]:
             code = 3
         os._exit(code)
     os.close(write_end)
-    start = time.monotonic()
-    chunks, timed_out = [], False
-    while True:
-        remaining = timeout - (time.monotonic() - start)
-        if remaining <= 0:
-            timed_out = True
-            break
-        ready, _, _ = select.select([read_end], [], [], remaining)
-        if ready:
-            chunk = os.read(read_end, 1 << 20)
-            if not chunk:
-                break
-            chunks.append(chunk)
-    elapsed = time.monotonic() - start
-    if timed_out:
-        os.kill(pid, signal.SIGKILL)
-    _, status = os.waitpid(pid, 0)
-    os.close(read_end)
+    data, status, timed_out, elapsed = collect(pid, read_end, timeout)
     if timed_out:
         return {"kind": "?", "status": "timeout", "message": f"no answer within {timeout:g} s"}, elapsed
     if os.WIFSIGNALED(status):
         return {"kind": "?", "status": "crash", "message": f"killed by signal {os.WTERMSIG(status)}"}, elapsed
     try:
-        return pickle.loads(b"".join(chunks)), elapsed
+        return pickle.loads(data), elapsed
     except Exception:  # noqa: BLE001
         return {"kind": "?", "status": "crash", "message": f"child exit {os.WEXITSTATUS(status)} without an answer"}, \
             elapsed
