@@ -34,7 +34,7 @@ import numpy as np
 from ._backend import numba_kernels
 from ._tensors import principal_from_mean_gaussian, principal_from_shape_operator
 
-__all__ = ["face_measures", "curvatures_from_measures"]
+__all__ = ["face_measures", "curvatures_from_measures", "principal_from_measures"]
 
 
 def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -81,13 +81,24 @@ def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
                                                 np.ascontiguousarray(normals, dtype=np.float64))
     area = summed[:, 0]
     good = (area > 0) & np.isfinite(normals).all(axis=1)
+    k_min, k_max = principal_from_measures(summed)
     with np.errstate(invalid="ignore", divide="ignore"):
-        mean = summed[:, 1] / (2 * area)
-        gaussian = summed[:, 2] / area
         shape_operator = -summed[:, 3:] / area[:, None]
-    k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
     _, _, dir_min, dir_max = principal_from_shape_operator(np.where(good[:, None], shape_operator, 0.0),
                                                            np.where(good[:, None], normals, [0.0, 0.0, 1.0]))
     for field in (k_min, k_max, dir_min, dir_max):
         field[~good] = np.nan
     return k_min, k_max, dir_min, dir_max
+
+
+def principal_from_measures(summed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``k_min, k_max`` of summed measures (..., 9) from their scalar measures alone (no directions).
+
+    ``H = mu_1 / (2 mu_0)``, ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``; NaN where the
+    corrected area ``mu_0`` is not positive. Any leading shape (the rungs of a ladder of balls, say).
+    """
+    area = summed[..., 0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(area > 0, summed[..., 1] / (2 * area), np.nan)
+        gaussian = np.where(area > 0, summed[..., 2] / area, np.nan)
+    return principal_from_mean_gaussian(mean, gaussian)

@@ -69,9 +69,8 @@ import numpy as np
 
 from ..geometry import median_edge_length, robust_mean_edge_length
 from ..jets import SETTLED_SLOPE, fit_jet_normals
-from ..measures import curvatures_from_measures, face_measures
+from ..measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import ball_face_sums, ball_face_sums_nested
-from .._tensors import principal_from_mean_gaussian
 from ..radius import (check_radius, component_radii, noise_level, noise_radius, scale_ladder, stable_scales,
                       vertex_radii)
 from .._prepared import PreparedMesh
@@ -141,6 +140,14 @@ def _adjacency(topology: MeshTopology) -> tuple:
     return topology.neighbour_lists
 
 
+def _usable_faces(faces: np.ndarray, degenerate: np.ndarray, normals: np.ndarray) -> np.ndarray | None:
+    """(F,) bool: the faces whose measures enter the sums (not degenerate, finite normals at their corners), or
+    None when all do."""
+    finite = np.isfinite(normals).all(axis=1)
+    kept = ~degenerate if finite.all() else ~degenerate & finite[faces].all(axis=1)
+    return None if kept.all() else kept
+
+
 def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Stages | None = None, *,
                 neighbours: np.ndarray | None = None, adjacency: tuple | None = None):
     """``k_min, k_max, dir_min, dir_max, normals, valid`` of the measures over balls of ``radius``.
@@ -161,12 +168,11 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
                                  adjacency=adjacency)
 
     start("compute face measures")
-    finite = np.isfinite(normals).all(axis=1)
-    kept = ~degenerate if finite.all() else ~degenerate & finite[faces].all(axis=1)
     measures = face_measures(vertices, faces, normals)  # rows of the faces left out are not read
 
     start("sum over balls")
-    summed = ball_face_sums(vertices, faces, radius, measures, usable=None if kept.all() else kept, connected=True)
+    summed = ball_face_sums(vertices, faces, radius, measures, usable=_usable_faces(faces, degenerate, normals),
+                            connected=True)
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
@@ -249,10 +255,11 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
                for radius in radii]
     stages.start("compute face measures")
     measures = np.stack([face_measures(vertices, faces, rung) for rung in normals])
-    kept = [~degenerate & np.isfinite(rung).all(axis=1)[faces].all(axis=1) for rung in normals]
+    kept = [_usable_faces(faces, degenerate, rung) for rung in normals]
     stages.start("sum over balls")
-    if all(np.array_equal(kept[0], mask) for mask in kept):  # the same faces at every scale: one walk
-        summed = ball_face_sums_nested(vertices, faces, radii, measures, usable=None if kept[0].all() else kept[0])
+    if all(mask is None if kept[0] is None else mask is not None and np.array_equal(mask, kept[0]) for mask in kept):
+        # the same faces at every scale: one walk
+        summed = ball_face_sums_nested(vertices, faces, radii, measures, usable=kept[0])
     else:
         summed = np.stack([ball_face_sums(vertices, faces, radius, values, usable=mask, connected=True)
                            for radius, values, mask in zip(radii, measures, kept)])
@@ -283,17 +290,14 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     normals = fitted_normals(vertices, mesh.vertex_normals, valid, NORMAL_RADIUS_RATIO * base,
                              neighbours=topology.referenced_vertices, adjacency=_adjacency(topology))
     stages.start("compute face measures")
-    kept = ~mesh.degenerate & np.isfinite(normals).all(axis=1)[faces].all(axis=1)
     measures = face_measures(vertices, faces, normals)
     stages.start("sum over balls")
     area = 0.5 * float(np.linalg.norm(mesh.cross[~mesh.degenerate], axis=1).sum())
     radii = scale_ladder(base, median_edge_length(vertices, topology.edges), area)
-    summed = ball_face_sums_nested(vertices, faces, radii, measures, usable=None if kept.all() else kept)
+    summed = ball_face_sums_nested(vertices, faces, radii, measures,
+                                   usable=_usable_faces(faces, mesh.degenerate, normals))
     stages.start("retrieve curvatures")
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean, gaussian = summed[..., 1] / (2 * summed[..., 0]), summed[..., 2] / summed[..., 0]
-    k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
-    rung = stable_scales(k_min, k_max, topology.neighbour_lists)
+    rung = stable_scales(*principal_from_measures(summed), topology.neighbour_lists)
     chosen = summed[rung, np.arange(vertices.shape[0])]
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(chosen, normals)
     parameters = {**parameters, "scale": "adaptive", "radii": tuple(float(r) for r in radii)}
