@@ -324,11 +324,8 @@ def _finished(mesh, estimator, result: CurvatureResult, problems: list, found: d
                                              parameters=parameters, _surface=mesh.surface))
     if mesh.n_flipped:
         problems = list(problems) + [_flip_reason(diagnosis, mesh.orient)]
-    message = quality_message(estimator.name, problems, dataclasses.replace(diagnosis, n_flipped_faces=0))
-    prepared = mesh.notes()
-    if prepared:  # before what the estimator and the diagnosis found (which they may not name otherwise)
-        message = f"{estimator.name}: " + "; ".join(prepared + ([message[len(estimator.name) + 2:]] if message
-                                                               else []))
+    message = quality_message(estimator.name, problems, dataclasses.replace(diagnosis, n_flipped_faces=0),
+                              notes=mesh.notes())
     if message:
         counts = result.invalid_counts()
         if counts:

@@ -236,13 +236,16 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     )
 
 
-def quality_message(method: str, problems: list[str], diagnosis: MeshDiagnosis | None) -> str | None:
+def quality_message(method: str, problems: list[str], diagnosis: MeshDiagnosis | None, *,
+                    notes: list[str] | tuple = ()) -> str | None:
     """The text of the one :class:`~meshcurv.errors.MeshQualityWarning` of a call, or None.
 
     ``problems`` are the estimator's own phrases (what it did about the
     defects); the diagnosis adds the defects they do not mention (bow-tie
     vertices; all its defects but boundaries when the estimator reported none)
-    and the number of faces ``orient=`` reversed.
+    and the number of faces ``orient=`` reversed. ``notes``, what was done to
+    the mesh before the computation (welding, a second side dropped), come
+    first.
     """
     parts = list(problems)
     if diagnosis is not None:
@@ -253,6 +256,6 @@ def quality_message(method: str, problems: list[str], diagnosis: MeshDiagnosis |
         if diagnosis.n_flipped_faces:
             parts.append(f"orient reversed {diagnosis.n_flipped_faces} faces before the computation")
     if not parts:
-        return None
+        return f"{method}: " + "; ".join(notes) if notes else None
     suffix = " (details: result.diagnosis)" if diagnosis is not None else ""
-    return f"{method}: " + "; ".join(parts) + suffix
+    return f"{method}: " + "; ".join([*notes, *parts]) + suffix
