@@ -95,6 +95,7 @@ import numpy as np
 
 from . import _pointcloud_estimators as _estimators
 from . import _pointcloud_normals as _normals
+from ._adapters import point_array
 from ._validation import as_vertices, check_choice, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .radius import CLOUD_EXTENT_CAP, CLOUD_RADIUS_RULES, cloud_noise_level, cloud_radius, noise_rule
@@ -227,8 +228,6 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     0.500 estimated
     """
     method = POINT_CLOUD_METHODS[0] if method is None else check_choice(method, "method", POINT_CLOUD_METHODS)
-    from ._adapters import point_array  # point and mesh objects of other libraries (duck typing)
-
     points = as_vertices(point_array(points), name="points")
     given = None if normals is None else _checked_normals(normals, points.shape)
     if radius is not None:
