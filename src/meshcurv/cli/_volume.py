@@ -127,7 +127,9 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
             spacing = (1.0, 1.0, 1.0)
             session.info(f"{image}: no voxel size in the file; using 1 1 1 (give --spacing Z Y X)")
         else:
-            session.info(f"{image}: voxel size {' x '.join(f'{s:g}' for s in spacing)} (z y x) from the file")
+            unit = f" {read.unit}" if read.unit else ""
+            session.info(f"{image}: voxel size {' x '.join(f'{s:g}' for s in spacing)}{unit} (z y x) from the file"
+                         + (f"; lengths in the table in {read.unit}" if read.unit else ""))
     total, labels = volume_module.label_surfaces(read.array, spacing=spacing, labels_to_use=labels_to_use,
                                                  method=method, radius=radius,
                                                  keep_surfaces=mesh_format is not None or picture,

@@ -1,4 +1,4 @@
-"""3D images for :mod:`meshcurv.volume`: TIFF stacks, NumPy ``.npy`` / ``.npz``, NIfTI.
+"""3D images for :mod:`meshcurv.volume`: TIFF stacks, NumPy ``.npy`` / ``.npz``, NIfTI, MRC.
 
 :func:`read_image` returns the array with its axes as image axes 0, 1, 2
 (z, y, x: planes, rows, columns) and the voxel size along them when the file
@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import MeshFileError, MissingDependencyError
 from ._files import check_input
+from ._mrc import MRC_UNIT, read_mrc
 
 __all__ = ["read_image", "Image", "IMAGE_FORMATS", "MAX_IMAGE_BYTES"]
 
@@ -26,7 +27,8 @@ MAX_IMAGE_BYTES = 32 * 2**30
 #: Extensions read, and what they are.
 IMAGE_FORMATS = {".tif": "TIFF stack (tifffile)", ".tiff": "TIFF stack (tifffile)", ".npy": "NumPy array",
                  ".npz": "NumPy archive (the array 'labels', or its only array)", ".nii": "NIfTI (nibabel)",
-                 ".nii.gz": "NIfTI, gzipped (nibabel)"}
+                 ".nii.gz": "NIfTI, gzipped (nibabel)", ".mrc": "MRC map (cryo-EM, tomography)",
+                 ".rec": "MRC map (IMOD reconstruction)", ".map": "MRC / CCP4 map"}
 
 #: deflate expands at most about 1032 times; a member declaring more is corrupt
 _DEFLATE_RATIO = 1100
@@ -40,11 +42,15 @@ class Image(NamedTuple):
     array : ndarray of shape (Z, Y, X)
     spacing : tuple of 3 floats or None
         Voxel size along image axes 0, 1, 2 when the file records it (NIfTI
-        header; ImageJ TIFF), else None.
+        header; ImageJ TIFF; MRC header), else None.
+    unit : str or None
+        The unit of ``spacing`` when the format fixes it (``"angstrom"`` for
+        MRC), else None.
     """
 
     array: np.ndarray
     spacing: tuple[float, float, float] | None
+    unit: str | None = None
 
 
 def _suffix(path: pathlib.Path) -> str:
@@ -187,7 +193,17 @@ def _reason(exc: BaseException) -> str:
     return text.splitlines()[0][:200] if text else type(exc).__name__
 
 
-_READERS = {".tif": _tiff, ".tiff": _tiff, ".npy": _npy, ".npz": _npz, ".nii": _nifti, ".nii.gz": _nifti}
+def _mrc(path):
+    try:
+        return read_mrc(path, _check_size)
+    except MeshFileError:
+        raise
+    except Exception as exc:
+        raise MeshFileError(f"{path}: cannot be read as MRC ({_reason(exc)})") from exc
+
+
+_READERS = {".tif": _tiff, ".tiff": _tiff, ".npy": _npy, ".npz": _npz, ".nii": _nifti, ".nii.gz": _nifti,
+            ".mrc": _mrc, ".rec": _mrc, ".map": _mrc}
 
 
 def read_image(path) -> Image:
@@ -199,13 +215,17 @@ def read_image(path) -> Image:
         ``.tif``/``.tiff`` (tifffile: the first series; the spacing of an
         ImageJ hyperstack), ``.npy``, ``.npz`` (the array ``labels``, or the
         only array), ``.nii``/``.nii.gz`` (nibabel; the spacing from the
-        header's ``pixdim``). Axes of length 1 are dropped.
+        header's ``pixdim``), ``.mrc``/``.rec``/``.map`` (MRC2014, modes 0,
+        1, 2, 6; the spacing ``cella / (mx, my, mz)`` of the header, in
+        Angstrom, :mod:`meshcurv.io._mrc`). Axes of length 1 are dropped.
 
     Returns
     -------
     Image
         ``array`` with image axes 0, 1, 2 = z, y, x (NIfTI's (i, j, k) array
-        is transposed to (k, j, i), and its spacing with it), ``spacing`` or None.
+        is transposed to (k, j, i), and its spacing with it; an MRC map's
+        axes are put in the order Z, Y, X whatever its ``mapc, mapr, maps``),
+        ``spacing`` or None, and ``unit`` (``"angstrom"`` for MRC, else None).
 
     Raises
     ------
@@ -223,4 +243,4 @@ def read_image(path) -> Image:
         raise MeshFileError(f"{path}: unknown image extension {suffix or '(none)'!r}; known: {known}")
     array, spacing = reader(path)
     array = _check_3d(path, np.asarray(array) if not isinstance(array, np.ndarray) else array)
-    return Image(array, spacing)
+    return Image(array, spacing, MRC_UNIT if reader is _mrc else None)
