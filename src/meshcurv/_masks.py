@@ -1,0 +1,198 @@
+"""Masks before marching cubes: label images from probability maps, and each object's mask smoothed.
+
+:mod:`meshcurv.volume` measures the objects of a label image. Segmentations
+do not always come as one: a network gives a probability map, an MRC
+segmentation is often stored as float32. This module turns those into label
+images, and blurs an object's mask before its surface is extracted, as
+biologists do to take the voxel staircase away.
+
+Probability maps (``threshold``)
+--------------------------------
+The voxels whose value is greater than ``threshold`` are the foreground; its
+connected components, with **6-connectivity** (voxels that share a face;
+:func:`scipy.ndimage.label`'s default structure), are the objects, numbered
+1, 2, ... in the order of their first voxel (C order). 6-connectivity is
+chosen because marching cubes at level 0.5 separates two voxels that touch
+only along an edge or at a corner: each object is then exactly the voxels its
+surface encloses, with no pinched vertex where two blobs touch diagonally (the
+cost: a single voxel touching an object only diagonally is an object of its
+own, a ``too_small`` row). NaN voxels are background (one warning gives their
+count).
+
+Smoothing (``smooth``)
+----------------------
+Each object's mask, on its bounding box padded by ``ceil(3 sigma / h) + 1``
+voxels along each axis (``h`` the voxel size there) and clipped to the image,
+is blurred by :func:`scipy.ndimage.gaussian_filter` with the standard
+deviation ``sigma / h`` voxels per axis (``sigma`` in physical units, as the
+spacing), and its surface is marching cubes at level 0.5 of the blurred
+mask. Along an image face the object touches, the mask is continued beyond
+the image by its last plane (``mode="nearest"``: the object is taken to go on
+as it was), and the surface is closed there by a flat cap in the plane of the
+image's outer voxel faces, as for an unsmoothed mask, so that
+:mod:`meshcurv.volume` leaves the cap out of the area and the statistics.
+The level set of a blurred convex object lies inside the object, by about
+``sigma^2 H`` (``H`` the mean curvature; Gaussian smoothing moves a level set
+as mean curvature flow does for a time ``sigma^2 / 2``): ``sigma^2 / R`` on
+a ball of radius ``R``, so area and volume shrink by about
+``2 sigma^2 / R^2`` and ``3 sigma^2 / R^2`` (1% and 1.5% for ``R = 10
+sigma``).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from ._validation import check_positive_float
+from .errors import InvalidMeshError, InvalidOptionError, MeshcurvWarning
+
+__all__ = ["check_threshold", "check_smooth", "labels_from_image", "smooth_padding", "smoothed_crop",
+           "smoothed_surface", "CONNECTIVITY", "SMOOTH_TRUNCATE"]
+
+#: Connectivity of the components of a thresholded probability map: 6 (voxels sharing a face).
+CONNECTIVITY = 6
+
+#: The crop around each object reaches this many standard deviations beyond its box (plus one voxel).
+SMOOTH_TRUNCATE = 3.0
+
+#: Whole-number labels stored as floats are taken as labels up to this value (exact in float64).
+_EXACT_FLOAT = 2.0**53
+
+
+def check_threshold(threshold) -> float | None:
+    """``threshold`` as a finite float, or None."""
+    if threshold is None:
+        return None
+    if isinstance(threshold, bool) or not isinstance(threshold, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(threshold):
+        raise InvalidOptionError(f"`threshold` must be a finite number (voxels greater than it are objects); got "
+                                 f"{threshold!r}")
+    return float(threshold)
+
+
+def check_smooth(smooth) -> float | None:
+    """``smooth`` (sigma in physical units) as a positive finite float, or None."""
+    if smooth is None:
+        return None
+    return check_positive_float(smooth, "smooth")
+
+
+def labels_from_image(image: np.ndarray, threshold: float | None, *, caller: str, stacklevel: int) -> np.ndarray:
+    """The label image of ``image``: its components above ``threshold``, or ``image`` itself.
+
+    Without ``threshold``: an integer or boolean image is returned as it is;
+    a float image whose values are all whole numbers >= 0 (a label image
+    stored as floats, as MRC segmentations often are) is cast to the smallest
+    unsigned integer type that holds them, with one warning; any other float
+    image is an error that says to pass a threshold. With ``threshold``: the
+    components (:data:`CONNECTIVITY`) of ``image > threshold``, as int32 (or
+    int64 beyond 2**31 - 1 components).
+
+    Raises
+    ------
+    InvalidMeshError
+        A float image of fractional, negative or non-finite values without
+        ``threshold``; an image of another kind (complex, text) with one.
+    """
+    if threshold is None:
+        if image.dtype.kind != "f":
+            return image
+        return _float_labels(image, caller=caller, stacklevel=stacklevel + 1)
+    if image.dtype.kind not in "biuf":
+        raise InvalidMeshError(f"`labels` with `threshold` must be an image of real numbers (a probability map); "
+                               f"got dtype {image.dtype}")
+    from scipy import ndimage
+
+    foreground = image > threshold  # NaN > t is False: background
+    if image.dtype.kind == "f":
+        n_nan = int(np.count_nonzero(np.isnan(image)))
+        if n_nan:
+            warnings.warn(f"{caller}: {n_nan} voxels of the image are NaN; they are taken as background",
+                          MeshcurvWarning, stacklevel=stacklevel + 1)
+    structure = ndimage.generate_binary_structure(3, 1)  # 6-connectivity
+    try:
+        labels, _ = ndimage.label(foreground, structure=structure, output=np.int32)
+    except RuntimeError:  # more components than int32 holds
+        labels, _ = ndimage.label(foreground, structure=structure, output=np.int64)
+    return labels
+
+
+def _float_labels(image: np.ndarray, *, caller: str, stacklevel: int) -> np.ndarray:
+    finite = np.isfinite(image)
+    whole = finite.all() and bool(np.all(image == np.floor(image)))
+    if not whole or (image.size and (image.min() < 0 or image.max() > _EXACT_FLOAT)):
+        what = ("non-finite values" if not finite.all() else "negative values" if image.size and image.min() < 0
+                else "fractional values" if not whole else "values beyond 2**53")
+        raise InvalidMeshError(
+            f"`labels` is a float image ({image.dtype}) with {what}: a probability map, not a label image; pass "
+            "threshold=T (--threshold T): the voxels greater than T are the objects, split into connected "
+            "components")
+    top = int(image.max()) if image.size else 0
+    dtype = next(np.dtype(code) for code in ("u1", "u2", "u4", "u8") if top <= np.iinfo(code).max)
+    warnings.warn(f"{caller}: the label image is stored as {image.dtype}; its values are whole numbers (0 to {top}), "
+                  f"read as labels ({dtype}); pass threshold=T (--threshold T) if it is a probability map",
+                  MeshcurvWarning, stacklevel=stacklevel + 1)
+    return image.astype(dtype)
+
+
+def smooth_padding(spacing: np.ndarray, sigma: float) -> np.ndarray:
+    """(3,) int: the voxels added around an object's box before it is blurred, ``ceil(3 sigma / h) + 1`` per axis."""
+    return np.array([math.ceil(SMOOTH_TRUNCATE * sigma / h) + 1 for h in np.asarray(spacing, dtype=float)],
+                    dtype=np.int64)
+
+
+def smoothed_crop(image: np.ndarray, label: int, box, spacing: np.ndarray, sigma: float):
+    """``(mask, origin, starts, stops)``: the object's mask on its box padded by :func:`smooth_padding`.
+
+    ``mask`` is bool, clipped to the image; ``origin`` the image index of its
+    first voxel; ``starts``, ``stops`` the object's box (int64 arrays).
+    """
+    starts = np.array([part.start for part in box], dtype=np.int64)
+    stops = np.array([part.stop for part in box], dtype=np.int64)
+    pad = smooth_padding(spacing, sigma)
+    low = np.maximum(starts - pad, 0)
+    high = np.minimum(stops + pad, np.array(image.shape, dtype=np.int64))
+    region = tuple(slice(int(a), int(b)) for a, b in zip(low, high))
+    return image[region] == label, low, starts, stops
+
+
+def smoothed_surface(mask: np.ndarray, origin: np.ndarray, starts: np.ndarray, stops: np.ndarray, image_shape,
+                     spacing: np.ndarray, sigma: float, marching_cubes):
+    """Vertices (in voxels), outward faces, voxel count, centroid and touching faces of a blurred mask.
+
+    ``mask``, ``origin``: :func:`smoothed_crop`. The blurred mask is padded by
+    one voxel of 0 and cut at 0.5 by ``marching_cubes``; the vertices between
+    an image face and that padding (strictly within the outer half voxel
+    beyond the face's voxel centres, and a voxel beyond) are put on the face,
+    ``-0.5`` or ``shape - 0.5``, the plane of the cap of an unsmoothed mask.
+    ``touching`` (3, 2) bool: the low and high image face of each axis that
+    the surface reaches (the object's box touches it, or its blur reaches
+    0.5 there).
+    """
+    from scipy import ndimage
+
+    shape = np.asarray(image_shape, dtype=np.int64)
+    n_voxels = int(np.count_nonzero(mask))
+    centroid = (np.array([np.mean(axis) for axis in np.nonzero(mask)]) + origin) * spacing
+    blurred = ndimage.gaussian_filter(mask.astype(np.float32), sigma / np.asarray(spacing, dtype=float),
+                                      mode="nearest", truncate=4.0)
+    end = origin + np.array(mask.shape)
+    touching = np.zeros((3, 2), dtype=bool)
+    for axis in range(3):
+        first = np.take(blurred, 0, axis=axis)
+        last = np.take(blurred, -1, axis=axis)
+        touching[axis, 0] = origin[axis] == 0 and (starts[axis] == 0 or bool((first > 0.5).any()))
+        touching[axis, 1] = end[axis] == shape[axis] and (stops[axis] == shape[axis] or bool((last > 0.5).any()))
+    vertices, faces, _, _ = marching_cubes(np.pad(blurred, 1), 0.5, method="lewiner", allow_degenerate=False)
+    index = vertices.astype(np.float64) + (origin - 1)
+    for axis in range(3):
+        column = index[:, axis]
+        if touching[axis, 0]:
+            column[(column > -1.0) & (column < 0.0)] = -0.5
+        if touching[axis, 1]:
+            column[(column > shape[axis] - 1.0) & (column < shape[axis])] = shape[axis] - 0.5
+    faces = np.ascontiguousarray(faces[:, ::-1], dtype=np.int64)  # marching cubes winds a bright object inward
+    return index, faces, n_voxels, centroid, touching
