@@ -346,7 +346,7 @@ def test_cli_writes_csv_and_parquet_meshes_and_picture(tmp_path):
     assert isinstance(again.exception, MeshFileError) and "already exists" in str(again.exception)
     (out / "cells_labels.csv").unlink()
     (out / "cells_labels.parquet").unlink()
-    again = run_volume([tmp_path / "cells.npy", "-o", out, "--no-picture", "--meshes", "vtp"])
+    again = run_volume([tmp_path / "cells.npy", "-o", out, "--no-picture", "--no-objects", "--meshes", "vtp"])
     assert isinstance(again.exception, MeshFileError) and "cells_label_2.vtp: already exists" in str(again.exception)
     assert not (out / "cells_labels.csv").exists()  # refused before computing
     assert run_volume([tmp_path / "cells.npy", "-o", out, "--overwrite", "--no-picture"]).exit_code == 0

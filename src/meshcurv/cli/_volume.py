@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import pathlib
 import warnings
 
@@ -64,6 +65,9 @@ def _label_list(ctx, param, value):
               help="Ball radius in physical units (default: per label, from its voxels and curvature).")
 @click.option("--meshes", "mesh_format", type=click.Choice(MESH_FORMATS), default=None,
               help="Also write one mesh file per label with its curvature fields, in this format.")
+@click.option("--objects/--no-objects", "objects", default=True, show_default=True,
+              help="One VTP file of all objects' surfaces, OUTDIR/<name>_objects.vtp, with a 'label' per point "
+                   "and per cell beside the curvature fields (ParaView colours by object).")
 @click.option("--picture/--no-picture", default=True, show_default=True,
               help="A picture of all objects coloured by --field (needs matplotlib).")
 @click.option("-f", "--field", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
@@ -73,7 +77,7 @@ def _label_list(ctx, param, value):
                    "meshcurv[batch]; default: one label after the other in this process).")
 @click.option("--overwrite", is_flag=True, help="Replace existing outputs.")
 @common_options
-def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, picture, field, workers,
+def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, objects, picture, field, workers,
            overwrite):
     """Curvature of every object of a 3D label image: one table row per label.
 
@@ -88,7 +92,10 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
     mask. Writes OUTDIR/<name>_labels.csv and .parquet (one row per label:
     area, volume, area-weighted and percentiles of H, K, principal
     curvatures, shape index and curvedness, total curvatures, Willmore
-    energy, Euler characteristic, border flag, status), a picture
+    energy, Euler characteristic, border flag, status), the surfaces of all
+    objects in one VTK file OUTDIR/<name>_objects.vtp (per point: the
+    curvature fields, 'label', 'used' (1 where the vertex is in the
+    statistics), 'vertex_area'; per cell: 'label'), a picture
     OUTDIR/<name>_<field>.png, and with --meshes one file per label
     OUTDIR/<name>_label_<N>.<format>. Nothing is overwritten without
     --overwrite. Exits with 1 when a label failed (its row says why). With
@@ -110,7 +117,8 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
     out_dir.mkdir(parents=True, exist_ok=True)
     tables = [out_dir / f"{stem}_labels.csv", out_dir / f"{stem}_labels.parquet"]
     picture_path = out_dir / f"{stem}_{field}.png"
-    for path in tables + ([picture_path] if picture else []):
+    objects_path = out_dir / f"{stem}_objects.vtp"
+    for path in tables + ([picture_path] if picture else []) + ([objects_path] if objects else []):
         check_output(path, overwrite=overwrite, source=image)
     if mesh_format is not None and not overwrite:  # refused before hours of computing, not at the label
         existing = sorted(out_dir.glob(f"{stem}_label_*.{mesh_format}"))
@@ -132,23 +140,24 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
                          + (f"; lengths in the table in {read.unit}" if read.unit else ""))
     total, labels = volume_module.label_surfaces(read.array, spacing=spacing, labels_to_use=labels_to_use,
                                                  method=method, radius=radius,
-                                                 keep_surfaces=mesh_format is not None or picture,
+                                                 keep_surfaces=mesh_format is not None or picture or objects,
                                                  workers=workers)
     bar = session.bar(LabelBar)
     rows, drawn = [], []
-    try:
-        for row, surface in labels:
-            rows.append(row)
+    with contextlib.ExitStack() as stack:
+        writer = _objects_writer(stack, objects_path, overwrite) if objects else None
+        for surface in _with_bar(labels, bar, total, rows):
             if surface is not None:
+                if writer is not None:
+                    writer.add(*_object_piece(surface))
                 if mesh_format is not None:
                     write_curvatures(out_dir / f"{stem}_label_{surface.label}.{mesh_format}", surface.vertices,
                                      surface.faces, surface.result, overwrite=overwrite, source=image)
                 if picture:
                     values = np.where(surface.used, getattr(surface.result, field), np.nan)
                     drawn.append((surface.vertices, surface.faces, values))
-            bar(len(rows), total, row["label"], row["status"])
-    finally:
-        bar.close()
+        if writer is not None and writer.n_pieces == 0:
+            writer.add(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), {})  # no surface: an empty dataset
     table = volume_module._table(rows)
     for path in tables:
         if path.suffix == ".parquet" and not parquet:
@@ -167,7 +176,8 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
     written = ", ".join(str(path) for path in tables if parquet or path.suffix != ".parquet")
     session.info(f"{len(table)} labels: " + ", ".join(f"{int(counts.get(s, 0))} {s}" for s in
                                                       ("ok", "empty", "too_small", "failed")) + f"; table in {written}"
-                 + (f"; picture {picture_path}" if picture and drawn else ""))
+                 + (f"; picture {picture_path}" if picture and drawn else "")
+                 + (f"; surfaces in {objects_path}" if objects else ""))
     failures = table[table["status"] == "failed"]
     if failures.empty:
         return 0
@@ -175,6 +185,38 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
         click.echo(f"meshcurv: failed: label {label}: {error}", err=True)
     click.echo(f"meshcurv: error: {len(failures)} of {len(table)} labels failed", err=True)
     return 1
+
+
+def _with_bar(labels, bar, total: int, rows: list):
+    """Yield the surface of each ``(row, surface)`` of ``labels`` once ``row`` is in ``rows``; the bar drawn after each."""
+    try:
+        for row, surface in labels:
+            rows.append(row)
+            yield surface
+            bar(len(rows), total, row["label"], row["status"])
+    finally:
+        bar.close()
+
+
+def _objects_writer(stack: contextlib.ExitStack, path: pathlib.Path, overwrite: bool):
+    """A :class:`~meshcurv.io._vtp.PieceWriter` onto ``path``, published when ``stack`` closes without error."""
+    from ..io._files import atomic_output
+    from ..io._vtp import PieceWriter
+
+    temporary = stack.enter_context(atomic_output(path, overwrite=overwrite))
+    handle = stack.enter_context(open(temporary, "wb"))
+    return stack.enter_context(PieceWriter(handle))
+
+
+def _object_piece(surface):
+    """``(vertices, faces, point_data, cell_data)`` of one object in the objects' VTP file."""
+    from ..io.fields import curvature_fields
+
+    n_vertices, n_faces = surface.vertices.shape[0], surface.faces.shape[0]
+    point_data = {**curvature_fields(surface.result), "label": np.full(n_vertices, surface.label, dtype=np.uint64),
+                  "used": np.asarray(surface.used, dtype=np.uint8),
+                  "vertex_area": np.asarray(surface.vertex_areas, dtype=np.float64)}
+    return surface.vertices, surface.faces, point_data, {"label": np.full(n_faces, surface.label, dtype=np.uint64)}
 
 
 def _has_pyarrow() -> bool:

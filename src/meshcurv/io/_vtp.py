@@ -4,7 +4,9 @@ meshio reads and writes .vtu but not .vtp. This module writes inline base64
 binary arrays (UInt64 headers, little-endian) and reads inline arrays in the
 ``ascii`` and ``binary`` encodings, compressed with zlib or not, with UInt32 or
 UInt64 headers: what ParaView and VTK write by default except appended data,
-which is refused with a message.
+which is refused with a message. A file of several ``<Piece>`` elements (as
+:class:`PieceWriter` writes: one per object of a label image) is read as one
+surface, its pieces joined in order, as VTK's reader does.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import numpy as np
 from ..errors import MeshFileError
 from ._text import numbers
 
-__all__ = ["read_vtp", "read_vtp_point_data", "write_vtp"]
+__all__ = ["read_vtp", "read_vtp_point_data", "read_vtp_cell_data", "write_vtp", "PieceWriter"]
 
 _TYPES = {
     "Int8": "i1", "UInt8": "u1", "Int16": "i2", "UInt16": "u2", "Int32": "i4", "UInt32": "u4",
@@ -46,39 +48,77 @@ def _data_array(parent, array: np.ndarray, name: str | None = None) -> None:
     element.text = _encode(array)
 
 
-def write_vtp(path, vertices: np.ndarray, faces, point_data: dict) -> None:
-    """Write a surface and its per-vertex fields (scalars and 3-vectors) as VTK XML PolyData."""
+def _piece(vertices: np.ndarray, faces, point_data: dict, cell_data: dict | None = None):
+    """The ``<Piece>`` element of a surface, its per-vertex fields and its per-face fields."""
     if isinstance(faces, np.ndarray):
         connectivity = faces.reshape(-1)
         offsets = np.arange(1, faces.shape[0] + 1) * faces.shape[1]
     else:
-        connectivity = np.concatenate(faces)
-        offsets = np.cumsum([len(face) for face in faces])
-    root = ElementTree.Element(
-        "VTKFile", {"type": "PolyData", "version": "1.0", "byte_order": "LittleEndian", "header_type": "UInt64"}
-    )
-    piece = ElementTree.SubElement(
-        ElementTree.SubElement(root, "PolyData"),
+        connectivity = np.concatenate(faces) if len(faces) else np.zeros(0, dtype=np.int64)
+        offsets = np.cumsum([len(face) for face in faces], dtype=np.int64)
+    piece = ElementTree.Element(
         "Piece",
         {"NumberOfPoints": str(vertices.shape[0]), "NumberOfVerts": "0", "NumberOfLines": "0",
          "NumberOfStrips": "0", "NumberOfPolys": str(len(offsets))},
     )
-    scalars = [name for name, value in point_data.items() if np.ndim(value) == 1]
-    vectors = [name for name, value in point_data.items() if np.ndim(value) == 2]
-    attributes = {}
-    if scalars:
-        attributes["Scalars"] = scalars[0]
-    if vectors:
-        attributes["Normals" if "normals" in vectors else "Vectors"] = "normals" if "normals" in vectors else vectors[0]
-    fields = ElementTree.SubElement(piece, "PointData", attributes)
-    for name, value in point_data.items():
-        _data_array(fields, np.asarray(value), name)
-    _data_array(ElementTree.SubElement(piece, "Points"), np.asarray(vertices, dtype=np.float64))
+    for tag, data in (("PointData", point_data), ("CellData", cell_data)):
+        if data is None:
+            continue
+        scalars = [name for name, value in data.items() if np.ndim(value) == 1]
+        vectors = [name for name, value in data.items() if np.ndim(value) == 2]
+        attributes = {}
+        if scalars:
+            attributes["Scalars"] = scalars[0]
+        if vectors:
+            attributes["Normals" if "normals" in vectors else "Vectors"] = ("normals" if "normals" in vectors
+                                                                            else vectors[0])
+        fields = ElementTree.SubElement(piece, tag, attributes)
+        for name, value in data.items():
+            _data_array(fields, np.asarray(value), name)
+    _data_array(ElementTree.SubElement(piece, "Points"), np.asarray(vertices, dtype=np.float64).reshape(-1, 3))
     polys = ElementTree.SubElement(piece, "Polys")
     _data_array(polys, np.asarray(connectivity, dtype=np.int64), "connectivity")
     _data_array(polys, np.asarray(offsets, dtype=np.int64), "offsets")
+    return piece
+
+
+_ROOT = {"type": "PolyData", "version": "1.0", "byte_order": "LittleEndian", "header_type": "UInt64"}
+
+
+def write_vtp(path, vertices: np.ndarray, faces, point_data: dict, cell_data: dict | None = None) -> None:
+    """Write a surface and its per-vertex (and per-face) fields (scalars and 3-vectors) as VTK XML PolyData."""
+    root = ElementTree.Element("VTKFile", _ROOT)
+    ElementTree.SubElement(root, "PolyData").append(_piece(vertices, faces, point_data, cell_data))
     ElementTree.indent(root)
     ElementTree.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+
+
+class PieceWriter:
+    """A VTK XML PolyData file written one ``<Piece>`` at a time: many surfaces, one file, bounded memory.
+
+    VTK's reader (ParaView's) appends the pieces of a file into one
+    dataset; every piece must carry the same point and cell arrays. Use as
+    a context manager on an open binary file; :meth:`add` writes one piece.
+    """
+
+    def __init__(self, handle) -> None:
+        self._handle = handle
+        self.n_pieces = 0
+
+    def __enter__(self) -> PieceWriter:
+        attributes = " ".join(f'{key}="{value}"' for key, value in _ROOT.items())
+        self._handle.write(f"<?xml version='1.0' encoding='utf-8'?>\n<VTKFile {attributes}>\n  <PolyData>\n"
+                           .encode())
+        return self
+
+    def add(self, vertices: np.ndarray, faces, point_data: dict, cell_data: dict | None = None) -> None:
+        piece = _piece(vertices, faces, point_data, cell_data)
+        ElementTree.indent(piece, level=2)
+        self._handle.write(b"    " + ElementTree.tostring(piece, encoding="utf-8", xml_declaration=False) + b"\n")
+        self.n_pieces += 1
+
+    def __exit__(self, *exc) -> None:
+        self._handle.write(b"  </PolyData>\n</VTKFile>\n")
 
 
 def _decode(element, path, *, header: str, order: str, compressed: bool) -> np.ndarray:
@@ -155,7 +195,7 @@ def _binary(text: str, path, header_type: np.dtype, compressed: bool) -> bytes:
 
 
 def _root(path):
-    """``(piece, decoding options)`` of a VTK XML PolyData file."""
+    """``(root element, decoding options)`` of a VTK XML PolyData file."""
     try:
         root = ElementTree.parse(path).getroot()
     except ElementTree.ParseError as exc:
@@ -166,29 +206,48 @@ def _root(path):
     options = {"header": root.get("header_type", "UInt32"),
                "order": "<" if root.get("byte_order", "LittleEndian") == "LittleEndian" else ">",
                "compressed": compressed}
-    return root.find("PolyData/Piece"), options
+    return root, options
+
+
+def _arrays(path, tag: str) -> dict[str, np.ndarray]:
+    """The named ``tag`` (``PointData``, ``CellData``) arrays of every piece, joined: (N,) or (N, k), as stored."""
+    root, options = _root(path)
+    pieces: list[dict[str, np.ndarray]] = []
+    for piece in root.findall("PolyData/Piece"):
+        out: dict[str, np.ndarray] = {}
+        for element in piece.findall(f"{tag}/DataArray"):
+            try:
+                out[element.get("Name") or f"array_{len(out)}"] = _decode(element, path, **options)
+            except MeshFileError:
+                raise
+            except (ValueError, zlib.error, binascii.Error) as exc:
+                raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
+        pieces.append(out)
+    if len(pieces) <= 1:
+        return pieces[0] if pieces else {}
+    names = list(pieces[0])
+    if any(list(piece) != names for piece in pieces[1:]):
+        raise MeshFileError(f"{path}: the pieces of the file do not carry the same {tag} arrays")
+    try:
+        return {name: np.concatenate([piece[name] for piece in pieces]) for name in names}
+    except ValueError as exc:
+        raise MeshFileError(f"{path}: the {tag} array pieces do not match ({exc})") from exc
 
 
 def read_vtp_point_data(path) -> dict[str, np.ndarray]:
-    """The named point-data arrays of a VTK XML PolyData file: (V,) or (V, k), as stored."""
-    piece, options = _root(path)
-    arrays = piece.findall("PointData/DataArray") if piece is not None else []
-    out: dict[str, np.ndarray] = {}
-    for element in arrays:
-        try:
-            out[element.get("Name") or f"array_{len(out)}"] = _decode(element, path, **options)
-        except MeshFileError:
-            raise
-        except (ValueError, zlib.error, binascii.Error) as exc:
-            raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
-    return out
+    """The named point-data arrays of a VTK XML PolyData file (every piece, joined): (V,) or (V, k), as stored."""
+    return _arrays(path, "PointData")
 
 
-def read_vtp(path):
-    """Read the points and polygons of a VTK XML PolyData file."""
-    piece, options = _root(path)
-    points = piece.find("Points/DataArray") if piece is not None else None
-    polys = piece.find("Polys") if piece is not None else None
+def read_vtp_cell_data(path) -> dict[str, np.ndarray]:
+    """The named cell-data arrays of a VTK XML PolyData file (every piece, joined): (F,) or (F, k), as stored."""
+    return _arrays(path, "CellData")
+
+
+def _read_piece(piece, path, options):
+    """``(vertices, connectivity, offsets)`` of one ``<Piece>``."""
+    points = piece.find("Points/DataArray")
+    polys = piece.find("Polys")
     if points is None or polys is None:
         raise MeshFileError(f"{path}: the PolyData has no points or no polygons")
     arrays = {element.get("Name"): element for element in polys.findall("DataArray")}
@@ -205,11 +264,29 @@ def read_vtp(path):
     declared = piece.get("NumberOfPoints")
     if declared is not None and declared.strip() != str(vertices.shape[0]):
         raise MeshFileError(f"{path}: the PolyData declares {declared.strip()[:20]} points but holds {vertices.shape[0]}")
+    sizes = np.diff(offsets, prepend=0)
+    if (offsets.size and offsets[-1] != connectivity.size) or (sizes < 3).any():
+        raise MeshFileError(f"{path}: the polygon offsets do not match the connectivity")
+    return vertices, connectivity, offsets
+
+
+def read_vtp(path):
+    """Read the points and polygons of a VTK XML PolyData file (its pieces joined into one surface)."""
+    root, options = _root(path)
+    pieces = [_read_piece(piece, path, options) for piece in root.findall("PolyData/Piece")]
+    if not pieces:
+        raise MeshFileError(f"{path}: the PolyData has no points or no polygons")
+    if len(pieces) == 1:
+        vertices, connectivity, offsets = pieces[0]
+    else:
+        starts = np.cumsum([0] + [len(v) for v, _, _ in pieces[:-1]])
+        ends = np.cumsum([0] + [c.size for _, c, _ in pieces[:-1]])
+        vertices = np.concatenate([v for v, _, _ in pieces])
+        connectivity = np.concatenate([c + start for (_, c, _), start in zip(pieces, starts)])
+        offsets = np.concatenate([o + end for (_, _, o), end in zip(pieces, ends)])
     if vertices.shape[0] == 0 or offsets.size == 0:
         raise MeshFileError(f"{path}: the PolyData has no points or no polygons")
     sizes = np.diff(offsets, prepend=0)
-    if offsets[-1] != connectivity.size or (sizes < 3).any():
-        raise MeshFileError(f"{path}: the polygon offsets do not match the connectivity")
     if (sizes == sizes[0]).all():
         return vertices, connectivity.reshape(-1, int(sizes[0]))
     return vertices, np.split(connectivity, offsets[:-1])
