@@ -48,9 +48,18 @@ then for each field of :data:`FIELDS` (``mean`` is H, ``gaussian`` is K,
 ``<field>_p95`` (area-weighted percentiles: a value counts by its vertex
 area, :func:`meshcurv.integrals.weighted_percentiles`); then ``total_mean`` (the integral
 of H dA), ``total_gaussian`` (the integral of K dA), ``willmore`` (the integral
-of H^2 dA), the area fractions of the nine shape-index categories of
-Koenderink and van Doorn (``shape_index_fraction_cup`` ... ``_cap``) and
-``warnings``. See :data:`COLUMNS`.
+of H^2 dA), then FreeSurfer's per-object statistics of
+:func:`meshcurv.statistics.curvature_statistics` (:data:`meshcurv.statistics.COLUMNS`:
+``<field>_mean``, ``_std``, ``_min``, ``_max`` of each field; the natural,
+rectified, positive and negative integrals ``mean_integral*`` and
+``gaussian_integral*``; ``bending_energy``, ``folding_index``,
+``ici_positive``, ``ici_negative``), computed by the same code over the same
+vertices and faces as the columns above, then the area fractions of the nine
+shape-index categories of Koenderink and van Doorn
+(``shape_index_fraction_cup`` ... ``_cap``) and ``warnings``. See
+:data:`COLUMNS`. ``<field>_mean`` is ``<field>_weighted`` and
+``mean_integral``, ``gaussian_integral`` are ``total_mean``,
+``total_gaussian``, under FreeSurfer's names.
 
 - ``mean_weighted`` and ``gaussian_weighted`` are ``total_mean / A`` and
   ``total_gaussian / A`` (``A`` the corrected area of the same faces): the
@@ -111,14 +120,16 @@ measures:
 - ``euler_characteristic``: that of the mesh closed by its cap (2 for a
   hemisphere).
 - The curvature columns (``<field>_<statistic>``, ``total_mean``,
-  ``total_gaussian``, ``willmore``, the shape-index fractions): over the
+  ``total_gaussian``, ``willmore``, FreeSurfer's statistics, the shape-index
+  fractions): over the
   part of the surface beyond the reach of the estimator from the cap, where
   the estimates do not see it: the vertices farther than the radius over
   which ``icc`` fits its normals (``3 r``,
   ``result.parameters["normal_radius"]``; the ball radius ``r`` for the
   other methods) from the image faces the label touches (``n_used`` counts
   them), and for ``total_mean`` the faces all of whose corners are such
-  vertices. On a ball of radius 12 voxels cut by the image border, H is 5-7%
+  vertices (the integrals of K: the vertices off the border). On a ball of
+  radius 12 voxels cut by the image border, H is 5-7%
   too high at 2 r from the cap and right beyond 3 r. ``mean_weighted`` and
   ``gaussian_weighted`` divide by the corrected area of those same faces
   (not by ``area``): they are means over that part.
@@ -185,6 +196,8 @@ from .measures import face_measures
 from .radius import VOXEL_CURVEDNESS_PERCENTILE, VOXEL_PILOT, voxel_radius
 from .integrals import vertex_integrals, weighted_percentiles
 from .result import CurvatureResult
+from .statistics import COLUMNS as STATISTICS_COLUMNS
+from .statistics import _face_average, _region_statistics
 
 __all__ = ["label_curvatures", "label_surfaces", "LabelSurface", "COLUMNS", "FIELDS", "STATISTICS",
            "SHAPE_CATEGORIES", "MIN_VERTICES"]
@@ -211,6 +224,7 @@ COLUMNS = ("label", "status", "error", "n_voxels", "touches_border", "n_vertices
            "centroid_0", "centroid_1", "centroid_2", "radius", "surface",
            *(f"{field}_{statistic}" for field in FIELDS for statistic in STATISTICS),
            "total_mean", "total_gaussian", "willmore",
+           *STATISTICS_COLUMNS,
            *(f"shape_index_fraction_{name}" for name, _ in SHAPE_CATEGORIES), "warnings")
 
 _INTEGER_COLUMNS = ("label", "n_voxels", "n_vertices", "n_faces", "n_used", "n_invalid", "euler_characteristic")
@@ -600,8 +614,12 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
     total_mean = float(0.5 * measures[inside_faces, 1].sum()) if inside_faces.any() else np.nan
     # the area of the image of the normals (meshcurv.integrals): 2 pi chi on a closed surface whatever
     # the estimator's errors; on a label cut by the border, that of its vertices off the border
-    total_gaussian = (float(vertex_integrals(vertices, faces, "gaussian", normals=normals)[~border].sum())
-                      if (~border).any() else np.nan)
+    gaussian_shares = vertex_integrals(vertices, faces, "gaussian", normals=normals)
+    total_gaussian = float(gaussian_shares[~border].sum()) if (~border).any() else np.nan
+    # FreeSurfer's statistics (meshcurv.statistics) over the same vertices and faces: the same code as a mesh's
+    statistics = _region_statistics(result.k_min, result.k_max, used, vertex_areas, measures[inside_faces, :2],
+                                    _face_average(mean, faces[inside_faces]), gaussian_shares[~border],
+                                    np.asarray(result.gaussian)[~border])
     row = {"label": label, "status": "ok", "error": "", **facts, "n_used": int(used.sum()),
            "n_invalid": int((~np.asarray(result.valid)).sum()),
            "euler_characteristic": int(vertices.shape[0] - n_edges + faces.shape[0]),
@@ -612,7 +630,7 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
            **_field_statistics(result, used, vertex_areas),
            "total_mean": total_mean, "total_gaussian": total_gaussian,
            "willmore": float(np.sum(mean[keep] ** 2 * vertex_areas[keep])) if keep.any() else np.nan,
-           "warnings": "; ".join(messages)}
+           **statistics, "warnings": "; ".join(messages)}
     if measured_area > 0:  # H and K weighted by area: the ratios of the corrected measures (see the module)
         row["mean_weighted"] = total_mean / measured_area
         row["gaussian_weighted"] = total_gaussian / measured_area
@@ -764,7 +782,7 @@ def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client
     run again label by label when it held several; a label whose task alone
     still fails gets a ``failed`` row.
     """
-    from . import batch
+    from .batch import _driver as batch  # until this loop is batch._driver.run_tasks (see its docstring)
 
     distributed = _dask()
     with _cluster(client, workers) as (active, owned):
