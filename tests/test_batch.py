@@ -442,17 +442,17 @@ def test_a_worker_killed_mid_run_has_its_meshes_run_again(tmp_path, client):
 
 def test_small_meshes_travel_in_chunks_in_path_order(tmp_path, monkeypatch):
     paths = write_spheres(tmp_path / "in", 40, 4)
-    jobs = batch._plan(paths, tmp_path / "out", ".npz")
-    chunks = batch._chunks(jobs, list(range(40)), workers=2)
+    jobs = batch._inputs._plan(paths, tmp_path / "out", ".npz")
+    chunks = batch._run._chunks(jobs, list(range(40)), workers=2)
     assert [index for chunk in chunks for index in chunk] == list(range(40))
     assert len(chunks) == 2 * batch.CHUNKS_PER_WORKER and {len(chunk) for chunk in chunks} == {2, 3}
-    assert batch._chunks(jobs, [5, 7, 9], workers=2) == [[5], [7], [9]]  # fewer meshes than tasks
+    assert batch._run._chunks(jobs, [5, 7, 9], workers=2) == [[5], [7], [9]]  # fewer meshes than tasks
     # the byte budget: two files fit, not three; a file larger than the budget is a task of its own
     size = os.path.getsize(paths[0])
-    monkeypatch.setattr(batch, "CHUNK_BYTES", 2 * size)
-    assert batch._chunks(jobs, list(range(5)), workers=0.125) == [[0, 1], [2, 3], [4]]
-    monkeypatch.setattr(batch, "CHUNK_BYTES", size // 2)
-    assert batch._chunks(jobs, list(range(3)), workers=0.125) == [[0], [1], [2]]
+    monkeypatch.setattr(batch._run, "CHUNK_BYTES", 2 * size)
+    assert batch._run._chunks(jobs, list(range(5)), workers=0.125) == [[0, 1], [2, 3], [4]]
+    monkeypatch.setattr(batch._run, "CHUNK_BYTES", size // 2)
+    assert batch._run._chunks(jobs, list(range(3)), workers=0.125) == [[0], [1], [2]]
 
 
 def test_a_task_lost_with_its_workers_is_split_into_single_meshes(tmp_path, caplog):
@@ -475,7 +475,7 @@ def test_a_task_lost_with_its_workers_is_split_into_single_meshes(tmp_path, capl
         with caplog.at_level("INFO", logger="meshcurv.batch"):
             summary = batch.run(paths, out_dir, client=client, output_format="npz", progress=kill_a_busy_worker)
     assert killed, "no worker was busy"
-    assert "a task of 2 meshes killed its workers; running them one by one" in caplog.text
+    assert "a task of 2 meshes ended with KilledWorker; running them one by one" in caplog.text
     assert (summary["status"] == "computed").all(), summary["error"].tolist()
     for path in paths:
         assert_complete_npz(out_dir / (path.stem + ".npz"), 2562)

@@ -258,7 +258,7 @@ try:
     with distributed.Client(address, timeout=60) as client:
         client.wait_for_workers(1, timeout=60)
         client.register_plugin(Faults())
-    batch.NO_WORKER_SECONDS = {{"local": 3.0, "remote": 3.0}}
+    batch._driver.NO_WORKER_SECONDS = {{"local": 3.0, "remote": 3.0}}
     start = time.monotonic()
     try:
         batch.run(folder, out_dir, scheduler=address, output_format="npz")
@@ -283,8 +283,8 @@ print(json.dumps({{"message": message, "seconds": seconds}}))
 def computed_batch(tmp_path, names):
     """Meshes processed as a batch's tasks do (no cluster): their jobs, with results and records."""
     paths = write_meshes(tmp_path / "in", names)
-    jobs = batch._plan(paths, tmp_path / "out", ".npz")
-    options = batch._options("icc", None, None, None)
+    jobs = batch._inputs._plan(paths, tmp_path / "out", ".npz")
+    options = batch._inputs._options("icc", None, None, None)
     for job in jobs:
         row = batch.process_mesh(job.source, job.output, job.record)
         assert row["status"] == "computed", row["error"]
@@ -294,7 +294,7 @@ def computed_batch(tmp_path, names):
 def completed(jobs, options, **given):
     damaged = []
     settings = {"overwrite": False, "retry_failed": False, "timeout": batch.DEFAULT_TIMEOUT, **given}
-    return [batch._completed(job, options, damaged=damaged, **settings) for job in jobs], damaged
+    return [batch._run._completed(job, options, damaged=damaged, **settings) for job in jobs], damaged
 
 
 def test_an_input_changed_after_its_result_is_computed_again(tmp_path):
@@ -321,8 +321,8 @@ def test_an_input_changed_after_its_result_is_computed_again(tmp_path):
 
 
 def test_a_large_file_is_fingerprinted_by_its_ends(tmp_path, monkeypatch):
-    monkeypatch.setattr(batch, "HASH_WHOLE_BYTES", 1000)
-    monkeypatch.setattr(batch, "HASH_PART_BYTES", 100)
+    monkeypatch.setattr(batch._records, "HASH_WHOLE_BYTES", 1000)
+    monkeypatch.setattr(batch._records, "HASH_PART_BYTES", 100)
     path = tmp_path / "big.bin"
     path.write_bytes(bytes(range(256)) * 10)
     first = batch.fingerprint(path)
@@ -344,11 +344,11 @@ def test_a_damaged_record_is_ignored_with_one_warning_not_a_refusal(tmp_path, mo
     # through run: one warning, then the three meshes go to a cluster (stopped there: none in this test)
     asked = []
 
-    def no_cluster(distributed, **given):
+    def no_cluster(**given):
         asked.append(given)
         raise ConnectionError("no cluster in this test")
 
-    monkeypatch.setattr(batch, "_cluster", no_cluster)
+    monkeypatch.setattr(batch._run, "cluster", no_cluster)
     with pytest.warns(MeshcurvWarning, match=r"3 records in .* cannot be read \(cut short or corrupt: "
                                              r"a\.npz\.json: JSONDecodeError"):
         with pytest.raises(ConnectionError, match="no cluster in this test"):
@@ -397,13 +397,13 @@ def test_a_read_only_output_folder_is_one_line_and_exit_1_before_a_cluster(tmp_p
 def test_a_summary_that_cannot_be_written_keeps_the_failure_rows(tmp_path, monkeypatch):
     paths, jobs, _ = computed_batch(tmp_path, ["a.obj", "b.obj"])
     (tmp_path / "in" / "bad.obj").write_text("v 0 0 0\nf 1 2 3\n")
-    bad = batch._plan([tmp_path / "in" / "bad.obj"], tmp_path / "out", ".npz")[0]
+    bad = batch._inputs._plan([tmp_path / "in" / "bad.obj"], tmp_path / "out", ".npz")[0]
     assert batch.process_mesh(bad.source, bad.output, bad.record)["status"] == "failed"
 
     def full_disk(summary, out_dir):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(batch, "_write_summary", full_disk)
+    monkeypatch.setattr(batch._run, "_write_summary", full_disk)
     with pytest.warns(MeshcurvWarning, match="the summary could not be written"):
         summary = batch.run(tmp_path / "in", tmp_path / "out", scheduler=DEAD, output_format="npz")
     assert summary["status"].tolist() == ["skipped", "skipped", "failed"]
