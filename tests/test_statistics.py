@@ -287,3 +287,8 @@ def test_empty_region_gives_nan_and_one_warning():
         stats = curvature_statistics(result, where=np.zeros(result.n_vertices, dtype=bool))
     assert len(caught) == 1
     assert all(np.isnan(value) for value in stats.values())
+
+
+def test_public_name():
+    assert meshcurv.curvature_statistics is curvature_statistics
+    assert "curvature_statistics" in meshcurv.__all__

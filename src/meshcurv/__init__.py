@@ -26,6 +26,7 @@ from .io import read_mesh, read_points, write_mesh, write_points
 from .pointcloud import point_cloud_curvatures
 from . import volume
 from .volume import label_curvatures
+from .statistics import curvature_statistics
 from .orient import orient_faces
 from .result import CurvatureResult
 from .smoothing import smooth_vertex_field
@@ -38,6 +39,7 @@ __all__ = [
     "multiscale_curvatures",
     "point_cloud_curvatures",
     "label_curvatures",
+    "curvature_statistics",
     "volume",
     "read_mesh",
     "read_points",
