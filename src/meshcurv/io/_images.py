@@ -28,7 +28,8 @@ MAX_IMAGE_BYTES = 32 * 2**30
 IMAGE_FORMATS = {".tif": "TIFF stack (tifffile)", ".tiff": "TIFF stack (tifffile)", ".npy": "NumPy array",
                  ".npz": "NumPy archive (the array 'labels', or its only array)", ".nii": "NIfTI (nibabel)",
                  ".nii.gz": "NIfTI, gzipped (nibabel)", ".mrc": "MRC map (cryo-EM, tomography)",
-                 ".rec": "MRC map (IMOD reconstruction)", ".map": "MRC / CCP4 map"}
+                 ".rec": "MRC map (IMOD reconstruction)", ".map": "MRC / CCP4 map",
+                 ".zarr": "Zarr or OME-Zarr folder, read lazily (zarr)"}
 
 #: deflate expands at most about 1032 times; a member declaring more is corrupt
 _DEFLATE_RATIO = 1100
@@ -39,7 +40,9 @@ class Image(NamedTuple):
 
     Attributes
     ----------
-    array : ndarray of shape (Z, Y, X)
+    array : ndarray of shape (Z, Y, X), or LazyImage
+        A :class:`meshcurv._lazy.LazyImage` for a Zarr store: read box by
+        box, never whole.
     spacing : tuple of 3 floats or None
         Voxel size along image axes 0, 1, 2 when the file records it (NIfTI
         header; ImageJ TIFF; MRC header), else None.
@@ -217,7 +220,9 @@ def read_image(path) -> Image:
         only array), ``.nii``/``.nii.gz`` (nibabel; the spacing from the
         header's ``pixdim``), ``.mrc``/``.rec``/``.map`` (MRC2014, modes 0,
         1, 2, 6; the spacing ``cella / (mx, my, mz)`` of the header, in
-        Angstrom, :mod:`meshcurv.io._mrc`). Axes of length 1 are dropped.
+        Angstrom, :mod:`meshcurv.io._mrc`), a ``.zarr`` folder (Zarr or
+        OME-Zarr, read lazily: :mod:`meshcurv.io._zarr`). Axes of length 1
+        are dropped.
 
     Returns
     -------
@@ -233,8 +238,13 @@ def read_image(path) -> Image:
         Missing, empty or unreadable file, unknown extension, not 3D, larger
         than :data:`MAX_IMAGE_BYTES`; the message names the file.
     MissingDependencyError
-        tifffile or nibabel missing (``pip install 'meshcurv[volume]'``).
+        tifffile or nibabel missing (``pip install 'meshcurv[volume]'``);
+        zarr missing (``pip install zarr``).
     """
+    if _suffix(pathlib.Path(path)) == ".zarr":
+        from ._zarr import read_zarr
+
+        return Image(*read_zarr(path))
     path = check_input(path)
     suffix = _suffix(path)
     reader = _READERS.get(suffix)
