@@ -1,4 +1,6 @@
-"""Sphinx configuration of meshcurv's reference (``make docs`` builds it into docs/_build/html)."""
+"""Sphinx configuration of meshcurv's user guide and API reference (``make docs`` builds it into docs/_build/html)."""
+
+import re
 
 import meshcurv
 
@@ -15,5 +17,15 @@ autodoc_typehints = "none"  # the numpydoc sections give the types
 numpydoc_show_class_members = False
 numpydoc_validation_checks = set()
 myst_heading_anchors = 3
-suppress_warnings = ["myst.xref_missing"]  # README links to files of the repository, not to pages
+suppress_warnings = ["myst.xref_missing"]  # links to files of the repository (benchmarks/...), not to pages
 html_theme = "alabaster"
+
+
+def _readme_links(app, relative_path, parent_docname, content):
+    """The README's links into the guide (``docs/guide/x.md``) made relative to docs/readme.md."""
+    if parent_docname == "readme":
+        content[0] = re.sub(r"\]\(docs/(guide/[\w.-]+\.md)", r"](\1", content[0])
+
+
+def setup(app):
+    app.connect("include-read", _readme_links)

@@ -44,7 +44,11 @@ hang, and WARNING is the lowest level that Python shows without any logging
 configuration (its last-resort handler) and that the CLI shows by default; it
 happens once per installation, so it is no noise. numba's event API
 (:mod:`numba.core.event`, ``numba:compile``, fired on cache misses only) tells
-a compilation from a load.
+a compilation from a load. While kernels compile, a clock on stderr gives the
+compilation's elapsed time every :data:`TICK_SECONDS` (one line rewritten in
+place, cleared when the compilation ends), only when stderr is a terminal
+(:func:`show_compile_time` changes that), so that the library stays silent
+in tests, pipes and logs.
 """
 
 from __future__ import annotations
@@ -54,6 +58,7 @@ import functools
 import importlib
 import logging
 import os
+import sys
 import threading
 import time
 from types import ModuleType
@@ -199,6 +204,74 @@ def _cache_location() -> str:
     return f"NUMBA_CACHE_DIR={cache_dir}" if cache_dir else "numba's cache beside the package"
 
 
+#: Seconds between two readings of the compilation clock (see :func:`show_compile_time`).
+TICK_SECONDS = 3.0
+
+#: Whether the compilation clock runs: None on a terminal only (the default), True always, False never.
+_clock_wanted: bool | None = None
+
+
+def show_compile_time(enabled: bool | None = True) -> None:
+    """Show the elapsed time of a compilation of the kernels on stderr while it runs.
+
+    Parameters
+    ----------
+    enabled : bool or None, default: True
+        True: always (a line every :data:`TICK_SECONDS`, rewritten in place on
+        a terminal); False: never; None: only when stderr is a terminal (what
+        happens without any call).
+    """
+    global _clock_wanted
+    _clock_wanted = enabled
+
+
+class _CompileClock:
+    """A thread that writes the compilation's elapsed time to stderr every :data:`TICK_SECONDS`."""
+
+    def __init__(self, elapsed_before: float, started: float):
+        self.elapsed_before = elapsed_before
+        self.started = started
+        self.wrote = False
+        self.stream = sys.stderr
+        self.terminal = _isatty(self.stream)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="meshcurv-compile-clock", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        # on a terminal, a later kernel's clock goes on at once from the time of the earlier ones
+        wait = 0.0 if self.elapsed_before > 0 and self.terminal else TICK_SECONDS
+        while not self._stop.wait(wait):
+            wait = TICK_SECONDS
+            seconds = self.elapsed_before + time.perf_counter() - self.started
+            line = f"meshcurv: compiling the numba kernels (first use): {seconds:.0f} s"
+            try:
+                self.stream.write(f"\r{line}\033[K" if self.terminal else f"{line}\n")
+                self.stream.flush()
+            except (OSError, ValueError):  # stderr closed under us: no clock, never an error
+                return
+            self.wrote = True
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join()
+        if self.wrote and self.terminal:
+            with contextlib.suppress(OSError, ValueError):
+                self.stream.write("\r\033[K")  # the line cleared: what follows starts on a clean line
+                self.stream.flush()
+
+
+def _isatty(stream) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, OSError, ValueError):
+        return False
+
+
+def _clock_runs() -> bool:
+    return _isatty(sys.stderr) if _clock_wanted is None else _clock_wanted
+
+
 class _CompileAnnouncer:
     """numba event listener: logs the compilation of meshcurv's kernels (not loads from the cache)."""
 
@@ -207,6 +280,7 @@ class _CompileAnnouncer:
         self.depth = 0
         self.started = 0.0
         self.compiled: list[tuple[str, float]] = []
+        self.clock: _CompileClock | None = None
 
     @staticmethod
     def _ours(event) -> str | None:
@@ -223,6 +297,8 @@ class _CompileAnnouncer:
             if not self.announced:
                 self.announced = True
                 logger.warning(COMPILE_MESSAGE, _cache_location())
+            if _clock_runs():
+                self.clock = _CompileClock(sum(seconds for _, seconds in self.compiled), self.started)
         self.depth += 1
 
     def on_end(self, event):
@@ -232,6 +308,9 @@ class _CompileAnnouncer:
         self.depth = max(self.depth - 1, 0)
         if self.depth == 0:
             seconds = time.perf_counter() - self.started
+            if self.clock is not None:
+                self.clock.stop()
+                self.clock = None
             self.compiled.append((name, seconds))
             logger.info("compiled the numba kernel %s in %.1f s", name, seconds)
 
