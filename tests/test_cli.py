@@ -55,7 +55,13 @@ def test_methods_lists_the_registry_as_it_is_now(capsys, monkeypatch):
     assert code == 0
     for name, estimator in ESTIMATORS.items():
         assert f"{name} " in out and estimator.summary in out
-    assert "(default)" in out.splitlines()[0] or "(default)" in out
+    # the default method, and it alone, is marked (its line, not the first one nor any line)
+    marked = [line.split()[0] for line in out.splitlines() if line.endswith(" (default)")]
+    assert marked == [DEFAULT_METHOD], out
+    other = next(name for name in ESTIMATORS if name != DEFAULT_METHOD)  # the mark follows the default
+    monkeypatch.setattr(meshcurv.cli._app, "_default_method", lambda: other)
+    _, out, _ = run(capsys, "methods")
+    assert [line.split()[0] for line in out.splitlines() if line.endswith(" (default)")] == [other], out
     extra = Estimator(name="made_up", function=None, options={"radius": None, "width": 2},
                       summary="an estimator added later", stages=())
     monkeypatch.setitem(ESTIMATORS, "made_up", extra)

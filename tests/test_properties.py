@@ -6,6 +6,7 @@ rotation of each face's corners; the expected values follow from the
 transformation (curvature / s, directions rotated), never from a stored output.
 """
 
+import functools
 import warnings
 
 import numpy as np
@@ -15,7 +16,8 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import meshcurv
-from meshcurv import shapes
+from meshcurv import jets, shapes
+from meshcurv._tensors import tangent_basis
 from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning, TriangulationWarning
 from meshcurv.estimators import ESTIMATORS
 from meshcurv.orient import orient_faces
@@ -51,13 +53,51 @@ def radius_for(method, mesh, scale=1.0):
     return {"radius": 2.5 * mean * scale}
 
 
-def assert_same(a, b, index=slice(None), scale=1.0):
-    """``a`` (transformed) against ``b`` (original) at ``index``, curvatures times ``scale``."""
-    np.testing.assert_array_equal(a.valid, b.valid[index])
+def assert_same(a, b, index=slice(None), scale=1.0, keep=slice(None)):
+    """``a`` (transformed) against ``b`` (original) at ``index``, curvatures times ``scale``, at ``keep`` of ``a``."""
+    np.testing.assert_array_equal(a.valid[keep], b.valid[index][keep])
     size = np.nanmax(np.abs(b.k_max)) + np.nanmax(np.abs(b.k_min))
     for name in ("k_min", "k_max", "mean"):
-        np.testing.assert_allclose(getattr(a, name) * scale, getattr(b, name)[index], rtol=1e-6,
+        np.testing.assert_allclose(getattr(a, name)[keep] * scale, getattr(b, name)[index][keep], rtol=1e-6,
                                    atol=1e-7 * size, err_msg=name)
+
+
+@functools.cache
+def poised_vertices(name: str, method: str) -> np.ndarray:
+    """Where ``method``'s fits on ``MESHES[name]`` are determined: all vertices, but for quadric on the torus.
+
+    quadric's jets fall back from degree 4 to 3 to 2 where the Cholesky
+    factor of the (unit-diagonal) normal equations has a pivot <= 1e-5
+    (:data:`meshcurv.jets.MIN_PIVOT`). On this torus the balls of 2.5 mean
+    edges hold only three meridians at the outer side (major edges 5.2 long
+    there): 624 of the 1,536 vertices have degree-4 equations whose smallest
+    eigenvalue is below 1e-7, while their smallest pivot ranges from 1e-8 to
+    1e-4 with the frame's turn in the tangent plane. Whether such a vertex
+    is solved at degree 4 (an ill-conditioned fit: k_min off by up to 0.33,
+    true range -0.05..0.025) or falls back depends on the rotation: a defect
+    of the degree choice in meshcurv.jets (the pivot is no bound on the
+    conditioning), not of the test. The other 912 have a smallest eigenvalue
+    above 2e-3 (a gap of four decades): there every pose gives the same
+    result to 1e-15, and within 3.5e-4 of the exact curvatures.
+    """
+    mesh = MESHES[name]
+    if not (method == "quadric" and name == "torus"):
+        return np.ones(mesh.vertices.shape[0], dtype=bool)
+    radius = radius_for(method, mesh)["radius"]
+    vertices, normals = mesh.vertices, mesh.normals
+    smallest = np.empty(vertices.shape[0])
+    for chunk, centre, neighbour in jets._ball_pairs(vertices, vertices, radius, 4096):
+        index = np.arange(chunk.start, chunk.stop)
+        rows = centre - chunk.start
+        offsets = (vertices[neighbour] - vertices[index[rows]]) / radius
+        weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
+        frame = [*tangent_basis(normals[index]), normals[index]]
+        matrix, _ = jets._fit_chunk(offsets, rows, index.size, frame, weights, jets.DEGREE)
+        scale = 1.0 / np.sqrt(np.einsum("nii->ni", matrix))
+        smallest[index] = np.linalg.eigvalsh(matrix * scale[:, :, None] * scale[:, None, :])[:, 0]
+    poised = smallest > 1e-5
+    assert poised.sum() > 0.55 * poised.size  # the check stays one of most of the torus
+    return poised
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -65,10 +105,6 @@ def assert_same(a, b, index=slice(None), scale=1.0):
 @given(name=st.sampled_from(sorted(MESHES)), seed=st.integers(0, 2**32 - 1),
        log_scale=st.floats(-6, 6), shift=st.floats(-1e3, 1e3))
 def test_rigid_motion_and_scale(method, name, seed, log_scale, shift):
-    if method == "quadric" and name == "torus":
-        pytest.xfail("quadric's degree-4 fit over balls of 2.5 edge lengths on this regular torus grid is "
-                     "ill-conditioned: a rotation changes k_min at 13% of the vertices by up to 0.33 (true range "
-                     "-0.05..0.025); so it was at 5a0bddd, hidden by a torus so coarse that every ball was refused")
     mesh = MESHES[name]
     s = 10.0**log_scale
     rotation = random_rotation(seed)
@@ -76,9 +112,10 @@ def test_rigid_motion_and_scale(method, name, seed, log_scale, shift):
     base = curvatures(mesh.vertices, mesh.faces, method, **radius_for(method, mesh))
     r = curvatures(moved, mesh.faces, method, **radius_for(method, mesh, s))
     # curvature in 1/length: divided by s (matGeom's values are dimensionless)
-    assert_same(r, base, scale=1.0 if method == "matgeom" else s)
+    keep = poised_vertices(name, method)  # quadric on the torus: where its fits are determined (see there)
+    assert_same(r, base, scale=1.0 if method == "matgeom" else s, keep=keep)
     if method != "matgeom":  # matGeom's normal is unoriented
-        valid = base.valid
+        valid = base.valid & keep
         np.testing.assert_allclose(r.normals[valid], base.normals[valid] @ rotation.T, atol=1e-6)
 
 
