@@ -373,6 +373,7 @@ def test_a_file_created_meanwhile_is_not_replaced_without_overwrite(tmp_path, to
     np.testing.assert_array_equal(meshcurv.read_mesh(target).vertices, torus.vertices[::-1])
 
 
+@pytest.mark.slow
 def test_writers_started_together_do_not_both_succeed(tmp_path):
     pytest.importorskip("meshio")  # PLY is written through meshio
     script = ("import sys, time, meshcurv\nfrom meshcurv import shapes\n"

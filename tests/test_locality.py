@@ -123,6 +123,7 @@ def test_a_scattered_mesh_gives_the_numbers_of_the_mesh_in_its_own_order(method,
         assert shuffled.parameters["radius"] == pytest.approx(base.parameters["radius"], rel=1e-12)
 
 
+@pytest.mark.slow
 def test_a_scattered_soup_is_welded_and_put_back_in_the_callers_order(torus):
     # split the torus along one ring of vertices (a seam): the faces of the last ring take copies
     n = torus.vertices.shape[0]

@@ -94,6 +94,7 @@ def test_a_method_without_a_ball_is_refused():
 # ---------------------------------------------------------------- radius="adaptive": each vertex at its own scale
 
 
+@pytest.mark.slow
 def test_adaptive_scale_averages_the_noise_out_where_one_radius_does_not():
     # normal noise of 0.3 edge lengths on a unit sphere: the default radius (noise rule) leaves about 3% of
     # median H error; each vertex at the stable rung of the ladder gets below 1.5% (measured 0.7%)

@@ -125,6 +125,7 @@ def test_per_centre_jet_radius_is_the_float_fit_at_each_centre(backend):
             np.testing.assert_allclose(fitted[at], expected[at], rtol=0, atol=0 if backend == "numba" else 1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("name", ["ellipsoid", "flat"])
 def test_nested_sums_are_separate_calls(backend, name):

@@ -24,6 +24,7 @@ def png_size(path):
     return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
 
 
+@pytest.mark.slow
 def test_dpi_sets_the_size_of_the_picture(tmp_path):
     sizes = {}
     for dpi in (50, 100, 200):

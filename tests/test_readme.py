@@ -136,6 +136,7 @@ def same_output(expected, actual):
         TIMING.sub("TIME", want).rstrip() == TIMING.sub("TIME", got).rstrip() for want, got in zip(expected, actual))
 
 
+@pytest.mark.slow  # meshcurv compute and plot, cold: several seconds
 @pytest.mark.parametrize("index", range(len(blocks("console"))))
 def test_console_transcript_is_the_real_output(index, readme_folder, capsys):
     pytest.importorskip("matplotlib")  # meshcurv plot

@@ -172,6 +172,7 @@ def test_valid_meshes_with_blank_lines_and_polygons_are_read_exactly(tmp_path):
     np.testing.assert_array_equal(faces, [[0, 1, 2], [0, 2, 3]])
 
 
+@pytest.mark.slow
 def test_reading_stays_vectorised(tmp_path):
     """A row check must not make reading slow: 200k rows read in well under a Python loop's time per row."""
     import time
