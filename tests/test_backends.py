@@ -74,29 +74,29 @@ def test_topology_is_identical(name):
         assert expected.sum() == 1
 
 
-@pytest.mark.parametrize("chunks", [1, 3, 7])
-def test_topology_does_not_depend_on_the_number_of_threads(chunks):
-    """The compiled build splits the vertices into one range per thread: any split gives the same edges."""
+@pytest.mark.parametrize("width", [np.int32, np.int64])
+def test_topology_does_not_depend_on_the_bucket_width(width):
+    """The compiled build sorts its buckets in int32 when the mesh fits, else int64: the same edges."""
     from meshcurv._kernels import topology as kernels_topology
     from meshcurv.topology import _build_edges
 
     vertices, faces = MESHES["defects"]
     faces = np.asarray(faces, np.int64)
     expected = _build_edges(faces, vertices.shape[0])
-    for got, want in zip(kernels_topology.build_edges(faces, vertices.shape[0], chunks), expected, strict=True):
+    built = kernels_topology.build_edges(faces, vertices.shape[0], np.zeros(0, width))
+    for got, want in zip(built, expected, strict=True):
         np.testing.assert_array_equal(got, want)
+    assert kernels_topology.index_template(10, 20).dtype == np.int32
+    assert kernels_topology.index_template(2**30, 20).dtype == np.int64  # 2 V + 1 beyond int32
+    assert kernels_topology.index_template(10, 2**30).dtype == np.int64  # 3 F beyond int32
 
 
-def test_neighbour_lists_do_not_depend_on_the_number_of_threads():
+def test_neighbour_lists_match_the_adjacency():
     from meshcurv._kernels import topology as kernels_topology
 
     vertices, faces = MESHES["defects"]
     top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
-    indptr, indices = kernels_topology.neighbour_lists(top.edges, top.n_vertices, 1)
-    for chunks in (2, 7):
-        other = kernels_topology.neighbour_lists(top.edges, top.n_vertices, chunks)
-        np.testing.assert_array_equal(other[0], indptr)
-        np.testing.assert_array_equal(other[1], indices)
+    indptr, indices = kernels_topology.neighbour_lists(top.edges, top.n_vertices)
     with use_backend("numpy"):  # the same neighbours as the adjacency matrix, in edge order
         adjacency = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0]).adjacency
     for v in range(top.n_vertices):

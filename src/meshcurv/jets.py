@@ -430,15 +430,24 @@ def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, 
     check = facing is not None
     per_centre = np.ndim(radius) > 0
     radii = radius if per_centre else np.array([float(radius)])
+    # read-only views: one numba signature whatever the callers' flags (each new one costs ~10 s of compilation)
+    vertices, normals, allowed, indptr, indices = (_read_only_view(a) for a in (vertices, normals, allowed, indptr,
+                                                                             indices))
     pieces = []
     for lo, hi in call_ranges(centres.size, pairs_per_centre, radii * radii if per_centre else None):
         outputs = kernels.fit_jets_connected(vertices, normals, radii[lo:hi] if per_centre else radii, degree,
                                              iterations, _exponents(degree),
                                              MIN_PIVOT, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
-                                             facing if check else vertices, check, AWAY_FRACTION, normals_only,
-                                             float(settled))
+                                             _read_only_view(facing) if check else vertices, check, AWAY_FRACTION,
+                                             normals_only, float(settled))
         pieces.append(outputs[:1] if normals_only else outputs)
     return _joined(pieces)
+
+
+def _read_only_view(array: np.ndarray) -> np.ndarray:
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 def _all_rows(rows: np.ndarray, centres: np.ndarray, n: int, fill: float) -> np.ndarray:

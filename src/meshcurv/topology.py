@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._backend import kernel_threads, numba_kernels
+from ._backend import numba_kernels
 from ._validation import (MAX_VERTICES, Ragged, check_vertex_count, checked_triangles, fan_triangles,
                           polygon_arrays)
 from .errors import InvalidMeshError
@@ -169,7 +169,8 @@ class MeshTopology:
         """Build from already validated int64 (F, 3) triangles."""
         kernels = numba_kernels("topology")
         if kernels is not None:
-            edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(faces, n_vertices, kernel_threads())
+            edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(
+                faces, n_vertices, kernels.index_template(n_vertices, faces.shape[0]))
         else:
             edges, face_edges, edge_faces, counts, forward_counts = _build_edges(faces, n_vertices)
         return cls(
@@ -284,7 +285,7 @@ class MeshTopology:
         """
         kernels = numba_kernels("topology")
         if kernels is not None:
-            indptr, indices = kernels.neighbour_lists(self.edges, self.n_vertices, kernel_threads())
+            indptr, indices = kernels.neighbour_lists(self.edges, self.n_vertices)
         else:
             adjacency = self.adjacency
             indptr, indices = adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64)
@@ -335,10 +336,7 @@ class MeshTopology:
     @cached_property
     def n_components(self) -> int:
         """Number of connected components of the faces."""
-        kernels = numba_kernels("topology")
-        if kernels is None:
-            return int(self.face_components[0])
-        return int(kernels.count_components(self.edges, self.referenced_vertices, self.n_vertices))
+        return int(self.vertex_components[0])  # the labels are asked for on every call: one pass for both
 
     @cached_property
     def euler_characteristic(self) -> int:

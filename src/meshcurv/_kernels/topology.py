@@ -9,7 +9,9 @@ import numpy as np
 
 from ._common import _JIT
 
-#: :func:`build_edges` counts the sides of at most this many ranges of faces at once ((ranges, V) int64 counts).
+
+#: :func:`meshcurv._kernels.neighborhoods.vertex_face_lists` counts the faces of at most this many ranges of
+#: faces at once ((ranges, V) int64 counts).
 _BUCKET_CHUNKS = 8
 
 
@@ -36,48 +38,52 @@ def _bucket_starts(cursor):
     return starts
 
 
-@nb.njit(parallel=True, **_JIT)
-def build_edges(faces, n_vertices, n_chunks):
+def index_template(n_vertices: int, n_faces: int) -> np.ndarray:
+    """An empty array of the integer type :func:`build_edges` sorts in: int32 when ``2 V + 1`` and ``3 F``
+    fit in it (half the memory traffic of int64), else int64."""
+    small = 2 * n_vertices + 1 < 2**31 and 3 * n_faces < 2**31
+    return np.zeros(0, np.int32 if small else np.int64)
+
+
+@nb.njit(**_JIT)
+def build_edges(faces, n_vertices, template):
     """Edges of the triangles, their faces and counts (see MeshTopology._build).
 
-    Sides are bucketed by their smaller vertex (counting sort), each bucket is
-    sorted by (larger vertex, direction) with a stable insertion sort, so the
-    edges come out in lexicographic order, as ``np.unique`` would give them.
-    Each of ``n_chunks`` threads (at most :data:`_BUCKET_CHUNKS`) counts, then
-    places, the sides of its own range of faces: a vertex's bucket holds the
-    sides of the first range, then of the next, each in face order (the order
-    of one pass over all faces, whatever the number of threads). The buckets
-    are then sorted and numbered by vertex; the edge numbers come from a prefix
-    sum of the edges per vertex.
+    Sides are bucketed by their smaller vertex (a counting sort: one pass
+    counts, one places, each in face order), each bucket is sorted by (larger
+    vertex, direction) with a stable insertion sort, so the edges come out in
+    lexicographic order, as ``np.unique`` would give them. The buckets are
+    held in the integer type of ``template`` (:func:`index_template`). One
+    thread: the passes are bound by memory, and a parallel version took twice
+    the CPU time for at best the same wall time on 2 cores, and 5 s more to
+    compile.
     """
     n_faces = faces.shape[0]
-    n_chunks = max(1, min(n_chunks, _BUCKET_CHUNKS, n_faces))
-    # cursor[c, v]: sides of face range c at vertex v, then where range c's next such side goes
-    cursor = np.zeros((n_chunks, n_vertices), np.int64)
-    for c in nb.prange(n_chunks):
-        for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
-            for k in range(3):
-                a = faces[f, k]
-                b = faces[f, (k + 1) % 3]
-                if a != b:
-                    cursor[c, min(a, b)] += 1
-    bucket_start = _bucket_starts(cursor)
+    bucket_start = np.zeros(n_vertices + 1, template.dtype)
+    for f in range(n_faces):
+        for k in range(3):
+            a = faces[f, k]
+            b = faces[f, (k + 1) % 3]
+            if a != b:
+                bucket_start[min(a, b) + 1] += 1
+    for v in range(n_vertices):
+        bucket_start[v + 1] += bucket_start[v]
     n_sides = bucket_start[n_vertices]
-    sort_key = np.empty(n_sides, np.int64)  # 2 * larger vertex + backward
-    side_of = np.empty(n_sides, np.int64)
-    for c in nb.prange(n_chunks):
-        for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
-            for k in range(3):
-                a = faces[f, k]
-                b = faces[f, (k + 1) % 3]
-                if a != b:
-                    low = min(a, b)
-                    slot = cursor[c, low]
-                    cursor[c, low] += 1
-                    sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
-                    side_of[slot] = 3 * f + k
-    edges_before = np.zeros(n_vertices + 1, np.int64)
-    for v in nb.prange(n_vertices):  # stable insertion sort of each (small) bucket; count its edges
+    cursor = bucket_start[:-1].copy()
+    sort_key = np.empty(n_sides, template.dtype)  # 2 * larger vertex + backward
+    side_of = np.empty(n_sides, template.dtype)
+    for f in range(n_faces):
+        for k in range(3):
+            a = faces[f, k]
+            b = faces[f, (k + 1) % 3]
+            if a != b:
+                low = min(a, b)
+                slot = cursor[low]
+                cursor[low] += 1
+                sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
+                side_of[slot] = 3 * f + k
+    n_edges = 0
+    for v in range(n_vertices):  # stable insertion sort of each (small) bucket; count its edges
         start, stop = bucket_start[v], bucket_start[v + 1]
         for i in range(start + 1, stop):
             key = sort_key[i]
@@ -89,21 +95,16 @@ def build_edges(faces, n_vertices, n_chunks):
                 j -= 1
             sort_key[j + 1] = key
             side_of[j + 1] = side
-        distinct = 0
         for i in range(start, stop):
             if i == start or (sort_key[i] >> 1) != (sort_key[i - 1] >> 1):
-                distinct += 1
-        edges_before[v + 1] = distinct
-    for v in range(n_vertices):
-        edges_before[v + 1] += edges_before[v]
-    n_edges = edges_before[n_vertices]
+                n_edges += 1
     edges = np.empty((n_edges, 2), np.int64)
     edge_faces = np.full((n_edges, 2), -1, np.int64)
     counts = np.zeros(n_edges, np.int64)
     forward = np.zeros(n_edges, np.int64)
     face_edges = np.full(3 * n_faces, -1, np.int64)
-    for v in nb.prange(n_vertices):
-        e = edges_before[v] - 1
+    e = -1
+    for v in range(n_vertices):
         previous_high = -1
         for i in range(bucket_start[v], bucket_start[v + 1]):
             high = sort_key[i] >> 1
@@ -248,35 +249,26 @@ def component_labels(edges, referenced, n_vertices):
     return labels, count
 
 
-@nb.njit(parallel=True, **_JIT)
-def neighbour_lists(edges, n_vertices, n_chunks):
+@nb.njit(**_JIT)
+def neighbour_lists(edges, n_vertices):
     """CSR lists of the edge neighbours of every vertex: ``(indptr, indices)``.
 
-    Each of ``n_chunks`` threads fills the lists of its own range of vertices,
-    scanning the edges in order: the lists are the same for any number of threads.
+    One pass counts, one places, scanning the (sorted) edges in order: each
+    list comes out in increasing order. One thread: two passes over the edges
+    bound by memory (a parallel version read every edge once per thread).
     """
-    n_chunks = max(1, min(n_chunks, n_vertices))
     indptr = np.zeros(n_vertices + 1, np.int64)
-    for chunk in nb.prange(n_chunks):
-        first = (n_vertices * chunk) // n_chunks
-        last = (n_vertices * (chunk + 1)) // n_chunks
-        for e in range(edges.shape[0]):
-            for v in (edges[e, 0], edges[e, 1]):
-                if first <= v < last:
-                    indptr[v + 1] += 1
+    for e in range(edges.shape[0]):
+        indptr[edges[e, 0] + 1] += 1
+        indptr[edges[e, 1] + 1] += 1
     for v in range(n_vertices):
         indptr[v + 1] += indptr[v]
     indices = np.empty(indptr[n_vertices], np.int64)
     fill = indptr[:-1].copy()
-    for chunk in nb.prange(n_chunks):
-        first = (n_vertices * chunk) // n_chunks
-        last = (n_vertices * (chunk + 1)) // n_chunks
-        for e in range(edges.shape[0]):
-            p, q = edges[e, 0], edges[e, 1]
-            if first <= p < last:
-                indices[fill[p]] = q
-                fill[p] += 1
-            if first <= q < last:
-                indices[fill[q]] = p
-                fill[q] += 1
+    for e in range(edges.shape[0]):
+        p, q = edges[e, 0], edges[e, 1]
+        indices[fill[p]] = q
+        fill[p] += 1
+        indices[fill[q]] = p
+        fill[q] += 1
     return indptr, indices
