@@ -87,6 +87,7 @@ class MeshDiagnosis:
 
     @property
     def is_closed(self) -> bool:
+        """True when the mesh has no boundary edge."""
         return self.n_boundary_edges == 0
 
     @property
@@ -127,6 +128,13 @@ class MeshDiagnosis:
         return found
 
     def as_dict(self) -> dict:
+        """The facts as a dict (field name -> value).
+
+        Returns
+        -------
+        dict
+            Every field of the diagnosis, by name.
+        """
         return asdict(self)
 
 

@@ -151,6 +151,7 @@ class CurvatureResult:
 
     @property
     def n_vertices(self) -> int:
+        """The number of vertices (rows of every per-vertex field)."""
         return int(self.k_min.shape[0])
 
     @cached_property

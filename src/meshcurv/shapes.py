@@ -65,10 +65,12 @@ class AnalyticMesh:
 
     @property
     def mean(self) -> np.ndarray:
+        """(V,) exact mean curvature ``(k_min + k_max) / 2``."""
         return (self.k_min + self.k_max) / 2
 
     @property
     def gaussian(self) -> np.ndarray:
+        """(V,) exact Gaussian curvature ``k_min * k_max``."""
         return self.k_min * self.k_max
 
 

@@ -186,10 +186,12 @@ class MeshTopology:
     # -- sizes ------------------------------------------------------------------
     @property
     def n_faces(self) -> int:
+        """The number of faces."""
         return int(self.faces.shape[0])
 
     @property
     def n_edges(self) -> int:
+        """The number of unique undirected edges."""
         return int(self.edges.shape[0])
 
     # -- edge classes -----------------------------------------------------------

@@ -177,6 +177,21 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
 
 
 def process_meshes(sources, outputs, records, **options) -> list[dict]:
-    """:func:`process_mesh` on several meshes in turn (one Dask task); their rows, in order."""
+    """:func:`process_mesh` on several meshes in turn (one Dask task); their rows, in order.
+
+    Parameters
+    ----------
+    sources, outputs, records : sequence of str or os.PathLike
+        The ``source``, ``output`` and ``record`` of each mesh, in the same
+        order (of the same length).
+    **options
+        The options of :func:`process_mesh` (``method``, ``timeout``, ...),
+        the same for every mesh.
+
+    Returns
+    -------
+    list of dict
+        The summary row of each mesh (:func:`process_mesh`), in order.
+    """
     return [process_mesh(source, output, record, **options)
             for source, output, record in zip(sources, outputs, records, strict=True)]

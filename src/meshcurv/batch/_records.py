@@ -66,6 +66,7 @@ def fingerprint(path) -> dict:
     Parameters
     ----------
     path : str or os.PathLike
+        The input file.
 
     Returns
     -------
