@@ -12,7 +12,7 @@ PIP := $(BIN)/python -m pip --disable-pip-version-check
 STAMP := $(VENV)/.installed
 DEMO_STAMP := $(VENV)/.installed-demo
 
-.PHONY: demo test quick test-minimal lint docs package-check bench-accuracy clean
+.PHONY: demo test quick test-minimal lint docs pictures package-check bench-accuracy clean
 
 $(BIN)/python:
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "meshcurv needs Python 3.11 or newer: make PYTHON=python3.11 ...")'
