@@ -59,6 +59,15 @@ own measure gives ``ICIn = 0.008`` and ``int H- = -0.25%`` of ``int H``; a torus
 faces' own signs. ``positive + negative = natural`` exactly, and
 ``rectified = positive - negative``.
 
+Where the fitted normals wobble at a scale below the estimator's radius, the
+Gauss image folds over itself: its folds cancel in ``int K dA`` but add to
+both ``int K+`` and ``int |K-|``. This was seen on tori whose tube is 5 voxels
+across the coarse axis of 2 x 1 x 1 voxels, at 2 of 24 offsets (``ICIp = ICIn
+= 1.30`` and ``1.81``; the pointwise K is off there too). When
+``int |K| dA`` from the Gauss image exceeds the sum of the pointwise
+``|K| A_i`` by more than :data:`FOLD_TOLERANCE`, a note says so (the
+``warnings`` column of the label table; a warning here).
+
 ``bending_energy`` and ``folding_index`` are quadratic in the curvatures and
 have no additive measure: they are sums of the pointwise ``k_min``, ``k_max``
 times ``A_i`` over the valid vertices, as FreeSurfer's. ``FI``'s integrand is
@@ -181,6 +190,28 @@ def _region_statistics(k_min, k_max, used, weights, face_measures_in, face_mean_
     return {name: float(row[name]) for name in COLUMNS}
 
 
+#: ``gaussian_integral_rectified`` above the sum of the pointwise ``|K| A_i`` by more than this fraction: the
+#: Gauss image of the normals folds, and the split integrals of K are questionable (a note says so). Measured
+#: on label images of spheres and tori with voxels 0.7 x 0.5 x 0.4 and 2 x 1 x 1, 12 offsets each
+#: (``benchmarks/label_statistics.py``): 1.002-1.087 where ICIp and ICIn are within 2% of the truth; 1.28 and
+#: 1.50 on the offsets of tori whose tube is 5 voxels across the coarse axis where they are 30% and 80% high.
+FOLD_TOLERANCE = 0.15
+
+
+def _fold_note(row: dict, k_min, k_max, used, weights) -> str:
+    """A note when the Gauss image folds (:data:`FOLD_TOLERANCE`), else ``""``."""
+    gaussian = np.asarray(k_min, dtype=np.float64) * np.asarray(k_max, dtype=np.float64)
+    keep = used & np.isfinite(gaussian) & (weights > 0)
+    pointwise = float(np.sum(np.abs(gaussian[keep]) * weights[keep]))
+    measured = row["gaussian_integral_rectified"]
+    if not (pointwise > 0 and measured > (1 + FOLD_TOLERANCE) * pointwise):
+        return ""
+    return (f"ici_positive, ici_negative and the rectified, positive and negative integrals of K are questionable: "
+            f"the Gauss image of the fitted normals folds (int |K| dA from it is {measured:.4g}, "
+            f"{100 * (measured / pointwise - 1):.0f}% above the {pointwise:.4g} of the pointwise |K| times the "
+            "areas): the normals wobble at a scale below the estimator's radius")
+
+
 def _face_average(field: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(F,) ``field`` (V,) averaged over the finite values at each face's corners (NaN when none is finite)."""
     values = np.asarray(field, dtype=np.float64)[faces]
@@ -228,6 +259,9 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
     -----
     MeshQualityWarning
         When no valid vertex is left to summarise: the statistics are NaN.
+        When the Gauss image of the normals folds (the rectified integral of
+        K from it more than :data:`FOLD_TOLERANCE` above the sum of the
+        pointwise ``|K| A_i``): the split integrals of K are then too high.
 
     Notes
     -----
@@ -292,6 +326,10 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
     inside = region[faces].all(axis=1) & np.isfinite(measures).all(axis=1)
     gaussian_shares = np.bincount(faces.ravel(), np.repeat(face_solid_angles(normals, faces) / 3.0, 3),
                                   minlength=vertices.shape[0])
-    return _region_statistics(k_min, k_max, used, weights, measures[inside], _face_average((k_min + k_max) / 2,
-                                                                                            faces[inside]),
-                              gaussian_shares[region], (k_min * k_max)[region])
+    row = _region_statistics(k_min, k_max, used, weights, measures[inside],
+                             _face_average((k_min + k_max) / 2, faces[inside]), gaussian_shares[region],
+                             (k_min * k_max)[region])
+    note = _fold_note(row, k_min, k_max, used, weights)
+    if note:
+        warnings.warn(f"curvature_statistics: {note}", MeshQualityWarning, stacklevel=2)
+    return row

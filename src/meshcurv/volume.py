@@ -197,7 +197,7 @@ from .radius import VOXEL_CURVEDNESS_PERCENTILE, VOXEL_PILOT, voxel_radius
 from .integrals import vertex_integrals, weighted_percentiles
 from .result import CurvatureResult
 from .statistics import COLUMNS as STATISTICS_COLUMNS
-from .statistics import _face_average, _region_statistics
+from .statistics import _face_average, _fold_note, _region_statistics
 
 __all__ = ["label_curvatures", "label_surfaces", "LabelSurface", "COLUMNS", "FIELDS", "STATISTICS",
            "SHAPE_CATEGORIES", "MIN_VERTICES"]
@@ -620,6 +620,7 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
     statistics = _region_statistics(result.k_min, result.k_max, used, vertex_areas, measures[inside_faces, :2],
                                     _face_average(mean, faces[inside_faces]), gaussian_shares[~border],
                                     np.asarray(result.gaussian)[~border])
+    messages.extend(filter(None, [_fold_note(statistics, result.k_min, result.k_max, used, vertex_areas)]))
     row = {"label": label, "status": "ok", "error": "", **facts, "n_used": int(used.sum()),
            "n_invalid": int((~np.asarray(result.valid)).sum()),
            "euler_characteristic": int(vertices.shape[0] - n_edges + faces.shape[0]),
