@@ -1429,6 +1429,7 @@ def _cases():
             yield pytest.param(twin, name, id=f"{twin.kernel}-{name}", marks=marks)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("twin", "name"), list(_cases()))
 def test_kernel_agrees_with_its_twin(twin, name, monkeypatch):
     parameters = inspect.signature(twin.check).parameters

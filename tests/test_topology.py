@@ -145,6 +145,7 @@ def test_from_faces_checks_the_faces_against_the_vertex_count():
         MeshTopology.from_faces(np.array([[1, 2, 3]]), 3)
 
 
+@pytest.mark.slow
 def test_from_faces_without_a_count_refuses_a_stray_huge_index():
     far = 2**24  # the floor of inferred counts: one face may reach it, not beyond
     with pytest.raises(InvalidMeshError, match=rf"reference vertex index {far} but hold only 3 corners: pass "

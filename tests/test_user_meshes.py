@@ -85,6 +85,7 @@ def _smoothed_sphere(radius, sigma):
     return vertices.astype(float), np.ascontiguousarray(faces[:, ::-1])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sigma", [0.5, 1.0])
 def test_a_smoothed_masks_isosurface_is_measured_as_a_voxel_surface(sigma):
     # the blurred level set stays within a fraction of a voxel of the sphere at sigma <= 1 (radius 20): the

@@ -191,6 +191,7 @@ def test_a_sliver_cut_by_three_image_faces_has_nan_statistics_with_the_reason():
     assert "curvature columns NaN: the label is cut by the image border" in row.warnings
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("spacing", [(1.0, 1.0, 1.0), (1.0, 0.5, 0.5)])
 @pytest.mark.parametrize("faces, depth", [(1, 0.0), (1, 0.5), (2, 0.6), (2, 0.9), (3, 0.8), (3, 0.3)])
 def test_balls_cut_by_image_faces_give_right_curvature_or_none(spacing, faces, depth):
