@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from meshcurv._lazy import LazyImage, check_lazy_labels, lazy_objects
-from meshcurv.errors import InvalidMeshError, MeshFileError
+from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshFileError
 from meshcurv.io._images import read_image
 from meshcurv.volume import _objects
 
@@ -151,3 +151,83 @@ def test_missing_zarr_names_the_pip_command(tmp_path, monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_zarr)
     with pytest.raises(MissingDependencyError, match="reading Zarr images needs the zarr package: pip install zarr"):
         read_image(tmp_path / "a.zarr")
+
+
+# ---- label_curvatures on a lazy image ------------------------------------------------------------------------------
+
+def balls_image(shape=(24, 40, 40), n=6, seed=11):
+    """Balls of radius 3-5 voxels, apart, some cut by the image border."""
+    rng = np.random.default_rng(seed)
+    grid = np.ogrid[tuple(slice(0, s) for s in shape)]
+    image = np.zeros(shape, dtype=np.uint16)
+    for label in range(1, n + 1):
+        centre = [rng.uniform(0, s) for s in shape]
+        radius = rng.uniform(3, 5)
+        inside = sum((axis - c) ** 2 for axis, c in zip(grid, centre)) <= radius**2
+        image[inside & (image == 0)] = 7 * label
+    return image
+
+
+def zarr_image(path, image, chunks=(8, 16, 16)):
+    array = zarr.create_array(store=str(path), shape=image.shape, chunks=chunks, dtype=image.dtype)
+    array[...] = image
+    return zarr.open(str(path), mode="r")
+
+
+def test_label_curvatures_of_a_zarr_store_are_those_of_the_array(tmp_path):
+    pandas = pytest.importorskip("pandas")
+    pytest.importorskip("skimage")
+    from meshcurv.volume import label_curvatures
+
+    image = balls_image()
+    expected = label_curvatures(image, spacing=(1.0, 0.8, 0.8))
+    assert expected.status.eq("ok").sum() >= 4
+    store = zarr_image(tmp_path / "cells.zarr", image)
+    pandas.testing.assert_frame_equal(label_curvatures(store, spacing=(1.0, 0.8, 0.8)), expected)
+    smoothed = label_curvatures(LazyImage(store), spacing=(1.0, 0.8, 0.8), smooth=0.8, labels_to_use=[7, 14])
+    pandas.testing.assert_frame_equal(smoothed, label_curvatures(image, spacing=(1.0, 0.8, 0.8), smooth=0.8,
+                                                                 labels_to_use=[7, 14]))
+    with pytest.raises(InvalidOptionError, match="`threshold` needs the image in memory"):
+        label_curvatures(store, spacing=(1.0, 0.8, 0.8), threshold=0.5)
+
+
+@pytest.mark.slow  # starts a local cluster of 2 processes: several seconds
+def test_zarr_labels_on_two_workers_are_the_serial_rows(tmp_path):
+    pandas = pytest.importorskip("pandas")
+    pytest.importorskip("distributed")
+    from meshcurv.volume import label_curvatures
+
+    image = balls_image(n=10, seed=4)
+    zarr_image(tmp_path / "cells.zarr", image)
+    read = read_image(tmp_path / "cells.zarr")
+    from meshcurv.batch import local_cluster
+
+    with local_cluster(workers=2, dashboard=False) as client:
+        for smooth in (None, 1.0):  # the smoothed crops travel with their origin
+            serial = label_curvatures(image, spacing=(1.0, 1.0, 1.0), smooth=smooth)
+            parallel = label_curvatures(read, spacing=(1.0, 1.0, 1.0), client=client, smooth=smooth)
+            pandas.testing.assert_frame_equal(parallel, serial, check_exact=False, rtol=1e-9)
+
+
+def test_cli_volume_on_an_ome_zarr_store(tmp_path):
+    pandas = pytest.importorskip("pandas")
+    pytest.importorskip("skimage")
+    click_testing = pytest.importorskip("click.testing")
+    from meshcurv.cli._common import Session
+    from meshcurv.cli._volume import volume
+
+    spacing, radius = (2.0, 1.0, 1.0), 9.0
+    shape = (12, 24, 24)
+    grid = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(shape, spacing, (11.3, 11.6, 11.9))],
+                       indexing="ij", sparse=True)
+    image = (sum(axis**2 for axis in grid) <= radius**2).astype(np.uint8) * 5
+    ome_group(tmp_path / "cells.ome.zarr", image, list(spacing))
+    session = Session()
+    with session:
+        result = click_testing.CliRunner().invoke(volume, [str(tmp_path / "cells.ome.zarr"), "-o", str(tmp_path),
+                                                           "--no-picture"], obj=session)
+    assert result.exit_code == 0, result.output
+    assert "voxel size 2 x 1 x 1 micrometer (z y x) from the file" in result.output
+    row = pandas.read_csv(tmp_path / "cells_labels.csv").iloc[0]
+    assert row.label == 5 and row.area == pytest.approx(4 * np.pi * radius**2, rel=0.03)
+    assert (tmp_path / "cells_objects.vtp").is_file()

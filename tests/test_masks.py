@@ -57,22 +57,14 @@ def test_nan_voxels_are_background_with_one_warning():
     assert labels.max() == 1 and labels[4, 4, 0] == 0
 
 
-def test_float_images_without_threshold():
+def test_float_images_need_a_threshold():
     image = np.zeros((4, 4, 4), dtype=np.float32)
-    image[1:3, 1:3, 1:3] = 300.0
-    with pytest.warns(MeshcurvWarning, match=r"stored as float32; its values are whole numbers \(0 to 300\), read as "
-                                             r"labels \(uint16\)"):
-        labels = _masks.labels_from_image(image, None, caller="test", stacklevel=1)
-    assert labels.dtype == np.uint16 and labels.max() == 300
+    image[1:3, 1:3, 1:3] = 3.0
+    with pytest.raises(InvalidMeshError, match=r"an integer label image or a boolean mask; got dtype float32: for a "
+                                               r"probability map pass threshold=T \(--threshold T\).*cast them"):
+        _masks.labels_from_image(image, None, caller="test", stacklevel=1)
     integers = np.ones((2, 2, 2), dtype=np.int16)
     assert _masks.labels_from_image(integers, None, caller="test", stacklevel=1) is integers
-    for values, what in ((0.5, "fractional values"), (-1.0, "negative values"), (np.inf, "non-finite values"),
-                         (2.0**60, "values beyond 2")):
-        bad = image.astype(np.float64)
-        bad[0, 0, 0] = values
-        with pytest.raises(InvalidMeshError, match=rf"a float image \(float64\) with {what}.*pass threshold=T "
-                                                   r"\(--threshold T\)"):
-            _masks.labels_from_image(bad, None, caller="test", stacklevel=1)
     with pytest.raises(InvalidMeshError, match="with `threshold` must be an image of real numbers"):
         _masks.labels_from_image(np.ones((2, 2, 2), dtype=complex), 0.5, caller="test", stacklevel=1)
 
@@ -131,3 +123,92 @@ def test_smoothed_ball_cut_by_the_border_is_closed_by_a_flat_cap():
     # inside the image: the hemisphere and the side of the half voxel between z = 0 and the cap at z = -0.5
     assert area - cap_area == pytest.approx(2 * np.pi * radius**2 + np.pi * radius, rel=0.05)
     assert volume == pytest.approx(2 / 3 * np.pi * radius**3 + 0.5 * np.pi * radius**2, rel=0.05)
+
+
+# ---- through label_curvatures --------------------------------------------------------------------------------------
+
+pandas = pytest.importorskip("pandas")
+
+
+def test_label_curvatures_of_a_probability_map():
+    from meshcurv.volume import label_curvatures
+
+    spacing = (1.0, 0.5, 0.5)
+    shape, width = (20, 36, 60), 7.0
+    grid = np.meshgrid(*[np.arange(n) * s for n, s in zip(shape, spacing)], indexing="ij", sparse=True)
+    centres = [(9.6, 8.7, 7.9), (10.2, 9.1, 21.3)]
+    # two Gaussian blobs: p > 0.5 where r < width sqrt(ln 2), two balls of that radius
+    probability = np.maximum(*[np.exp(-sum((axis - c) ** 2 for axis, c in zip(grid, centre)) / width**2)
+                               for centre in centres]).astype(np.float32)
+    radius = width * np.sqrt(np.log(2.0))
+    table = label_curvatures(probability, spacing=spacing, threshold=0.5)
+    assert table.label.tolist() == [1, 2] and (table.status == "ok").all()
+    assert table.area.to_numpy() == pytest.approx(4 * np.pi * radius**2, rel=0.03)
+    assert table.volume.to_numpy() == pytest.approx(4 / 3 * np.pi * radius**3, rel=0.03)
+    assert table.centroid_2.to_numpy() == pytest.approx([7.9, 21.3], abs=0.1)
+    with pytest.raises(InvalidMeshError, match="got dtype float32: for a probability map pass threshold=T"):
+        label_curvatures(probability, spacing=spacing)
+    with pytest.raises(InvalidOptionError, match="`threshold` must be a finite number"):
+        label_curvatures(probability, spacing=spacing, threshold=float("nan"))
+
+
+def test_label_curvatures_of_smoothed_masks_with_anisotropic_voxels():
+    from meshcurv.volume import label_curvatures
+
+    spacing = np.array([1.0, 0.5, 0.5])
+    radius, sigma = 8.0, 0.5
+    image = ball((22, 40, 40), spacing, (10.3, 9.8, 10.1), radius).astype(np.uint8)
+    table = label_curvatures(image, spacing=spacing, smooth=sigma)
+    row = table.iloc[0]
+    assert row.status == "ok" and not row.touches_border
+    assert row.area == pytest.approx(4 * np.pi * radius**2, rel=0.03)
+    assert row.volume == pytest.approx(4 / 3 * np.pi * radius**3, rel=0.03)
+    assert row.mean_weighted == pytest.approx(1 / radius, rel=0.03)
+    assert row.total_gaussian == pytest.approx(4 * np.pi, rel=0.02)  # Gauss-Bonnet on the closed surface
+    assert row.n_voxels == image.sum()
+    with pytest.raises(InvalidOptionError, match="smooth"):
+        label_curvatures(image, spacing=spacing, smooth=-1.0)
+
+
+def test_smoothed_label_cut_by_the_border_leaves_its_cap_out():
+    from meshcurv.volume import label_curvatures
+
+    spacing = np.array([1.0, 0.5, 0.5])
+    radius = 8.0
+    image = ball((12, 40, 40), spacing, (0.0, 9.8, 10.1), radius).astype(np.uint8)  # half a ball on z = 0
+    row = label_curvatures(image, spacing=spacing, smooth=0.5).iloc[0]
+    assert row.status == "ok" and row.touches_border
+    # the hemisphere and the side of the half voxel (0.5) down to the cap
+    assert row.area == pytest.approx(2 * np.pi * radius**2 + 2 * np.pi * radius * 0.5, rel=0.03)
+    # as unsmoothed: a hemisphere of a few ball radii keeps no surface beyond the estimator's reach of the cap
+    assert np.isnan(row.mean_weighted) and "curvature columns NaN: the label is cut by the image border" in row.warnings
+
+
+def test_cli_threshold_and_smooth(tmp_path):
+    click_testing = pytest.importorskip("click.testing")
+    from meshcurv.cli._common import Session
+    from meshcurv.cli._volume import volume
+
+    spacing = (1.0, 0.5, 0.5)
+    shape, width = (20, 36, 36), 9.0
+    grid = np.meshgrid(*[np.arange(n) * s for n, s in zip(shape, spacing)], indexing="ij", sparse=True)
+    probability = np.exp(-sum((axis - c) ** 2 for axis, c in zip(grid, (9.6, 8.7, 8.9))) / width**2)
+    np.save(tmp_path / "p.npy", probability.astype(np.float32))
+    radius = width * np.sqrt(np.log(2.0))  # 7.5
+
+    def run(*args):
+        session = Session()
+        with session:
+            return click_testing.CliRunner().invoke(volume, [str(tmp_path / "p.npy"), "-o", str(tmp_path / "out"),
+                                                             "--spacing", *map(str, spacing), "--no-picture",
+                                                             "--overwrite", *args], obj=session)
+
+    result = run("--threshold", "0.5", "--smooth", "0.5")
+    assert result.exit_code == 0, result.output
+    row = pandas.read_csv(tmp_path / "out" / "p_labels.csv").iloc[0]
+    assert row.area == pytest.approx(4 * np.pi * radius**2, rel=0.03)
+    assert row.volume == pytest.approx(4 / 3 * np.pi * radius**3, rel=0.03)
+    refused = run()
+    assert isinstance(refused.exception, InvalidMeshError)
+    assert "pass threshold=T (--threshold T)" in str(refused.exception)
+    assert run("--threshold", "0.5", "--smooth", "0").exit_code == 2  # click refuses sigma 0

@@ -1,10 +1,12 @@
 """Masks before marching cubes: label images from probability maps, and each object's mask smoothed.
 
 :mod:`meshcurv.volume` measures the objects of a label image. Segmentations
-do not always come as one: a network gives a probability map, an MRC
-segmentation is often stored as float32. This module turns those into label
-images, and blurs an object's mask before its surface is extracted, as
-biologists do to take the voxel staircase away.
+do not always come as one: a network gives a probability map, a membrane
+segmentation in an MRC file is often a float32 mask. This module turns those
+into label images (a float image without a threshold is refused: whether it
+holds labels or probabilities is the user's to say), and blurs an object's
+mask before its surface is extracted, as biologists do to take the voxel
+staircase away.
 
 Probability maps (``threshold``)
 --------------------------------
@@ -58,10 +60,6 @@ CONNECTIVITY = 6
 #: The crop around each object reaches this many standard deviations beyond its box (plus one voxel).
 SMOOTH_TRUNCATE = 3.0
 
-#: Whole-number labels stored as floats are taken as labels up to this value (exact in float64).
-_EXACT_FLOAT = 2.0**53
-
-
 def check_threshold(threshold) -> float | None:
     """``threshold`` as a finite float, or None."""
     if threshold is None:
@@ -84,23 +82,24 @@ def labels_from_image(image: np.ndarray, threshold: float | None, *, caller: str
     """The label image of ``image``: its components above ``threshold``, or ``image`` itself.
 
     Without ``threshold``: an integer or boolean image is returned as it is;
-    a float image whose values are all whole numbers >= 0 (a label image
-    stored as floats, as MRC segmentations often are) is cast to the smallest
-    unsigned integer type that holds them, with one warning; any other float
-    image is an error that says to pass a threshold. With ``threshold``: the
-    components (:data:`CONNECTIVITY`) of ``image > threshold``, as int32 (or
-    int64 beyond 2**31 - 1 components).
+    a float image is an error that says to pass a threshold (or to cast
+    labels stored as floats). With ``threshold``: the components
+    (:data:`CONNECTIVITY`) of ``image > threshold``, as int32 (or int64
+    beyond 2**31 - 1 components).
 
     Raises
     ------
     InvalidMeshError
-        A float image of fractional, negative or non-finite values without
-        ``threshold``; an image of another kind (complex, text) with one.
+        A float image without ``threshold``; an image of another kind
+        (complex, text) with one.
     """
     if threshold is None:
-        if image.dtype.kind != "f":
-            return image
-        return _float_labels(image, caller=caller, stacklevel=stacklevel + 1)
+        if image.dtype.kind == "f":
+            raise InvalidMeshError(
+                f"`labels` must be an integer label image or a boolean mask; got dtype {image.dtype}: for a "
+                "probability map pass threshold=T (--threshold T), the voxels greater than T are the objects, split "
+                "into connected components; labels stored as floats: cast them first (.astype(int))")
+        return image
     if image.dtype.kind not in "biuf":
         raise InvalidMeshError(f"`labels` with `threshold` must be an image of real numbers (a probability map); "
                                f"got dtype {image.dtype}")
@@ -112,30 +111,12 @@ def labels_from_image(image: np.ndarray, threshold: float | None, *, caller: str
         if n_nan:
             warnings.warn(f"{caller}: {n_nan} voxels of the image are NaN; they are taken as background",
                           MeshcurvWarning, stacklevel=stacklevel + 1)
-    structure = ndimage.generate_binary_structure(3, 1)  # 6-connectivity
+    structure = ndimage.generate_binary_structure(3, 1) if foreground.ndim == 3 else None  # 6-connectivity
     try:
         labels, _ = ndimage.label(foreground, structure=structure, output=np.int32)
     except RuntimeError:  # more components than int32 holds
         labels, _ = ndimage.label(foreground, structure=structure, output=np.int64)
     return labels
-
-
-def _float_labels(image: np.ndarray, *, caller: str, stacklevel: int) -> np.ndarray:
-    finite = np.isfinite(image)
-    whole = finite.all() and bool(np.all(image == np.floor(image)))
-    if not whole or (image.size and (image.min() < 0 or image.max() > _EXACT_FLOAT)):
-        what = ("non-finite values" if not finite.all() else "negative values" if image.size and image.min() < 0
-                else "fractional values" if not whole else "values beyond 2**53")
-        raise InvalidMeshError(
-            f"`labels` is a float image ({image.dtype}) with {what}: a probability map, not a label image; pass "
-            "threshold=T (--threshold T): the voxels greater than T are the objects, split into connected "
-            "components")
-    top = int(image.max()) if image.size else 0
-    dtype = next(np.dtype(code) for code in ("u1", "u2", "u4", "u8") if top <= np.iinfo(code).max)
-    warnings.warn(f"{caller}: the label image is stored as {image.dtype}; its values are whole numbers (0 to {top}), "
-                  f"read as labels ({dtype}); pass threshold=T (--threshold T) if it is a probability map",
-                  MeshcurvWarning, stacklevel=stacklevel + 1)
-    return image.astype(dtype)
 
 
 def smooth_padding(spacing: np.ndarray, sigma: float) -> np.ndarray:

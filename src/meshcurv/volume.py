@@ -24,13 +24,16 @@ of 1 x 0.25 x 0.25). The area reported is instead the *corrected area*
 2020), ``sum over faces of <u_bar, face area vector>``, with the normals ``u``
 fitted by ``icc`` over a few voxels: it is the area of the smooth surface those
 normals describe (the same spheres: -1.1% to +0.6%). Smoothing the mask with a
-Gaussian of one voxel before marching cubes was measured too and rejected: it
-removes most of the bias (+1 to +2.4% left with 1 x 0.25 x 0.25 voxels), but
-shrinks the objects (volume -0.2% at radius 20 to -10% at radius 6 with cubic
-voxels: the level set moves inward by about ``sigma^2 H``), and its vertices
-are no longer on the half grid, so the voxel radius is no longer recognised
-and K goes wrong (total Gaussian curvature off by up to 15%). The raw
-triangle area stays in the table as ``area_mesh``.
+Gaussian before marching cubes (``smooth=sigma``, below) is not the default:
+it removes most of the staircase's bias but shrinks the objects, the level
+set moving inward by about ``sigma^2 H``. Measured on spheres (3 random
+centres each, voxels 1 x 1 x 1 and 1 x 0.5 x 0.5, the worst of the 6):
+sigma 0.5 area -2.4%, volume -3.2% at radius 6, -0.8% and -1.1% at radius
+10, -0.3% and -0.3% at radius 20; sigma 1 area -6.9%, volume -9.6% at
+radius 6, -2.9% and -4.1% at radius 10, -0.7% and -0.9% at radius 20
+(without smoothing: -1.4% and -1.7% at radius 6, within 0.5% beyond); the
+blurred surface is recognised as a voxel surface, and total K stays 4 pi.
+The raw triangle area stays in the table as ``area_mesh``.
 
 Each vertex carries a third of the corrected area of its faces (the
 barycentric cell, with ``mu_0`` in place of the triangle area); these are the
@@ -148,6 +151,24 @@ measures:
   an estimate of too few vertices), ``n_used`` 0, and the reason in
   ``warnings``; its area and volume are those of the part inside.
 
+Probability maps, smoothing, images larger than memory
+-------------------------------------------------------
+- ``threshold=T``: the image is a probability map; the voxels greater than
+  ``T`` are the foreground and its connected components (6-connectivity) the
+  labels, numbered 1, 2, ... (:func:`meshcurv._masks.labels_from_image`). A
+  float image without ``threshold`` is refused with a message saying so.
+- ``smooth=sigma`` (the unit of ``spacing``): each object's mask, on its box
+  padded by ``ceil(3 sigma / h) + 1`` voxels, is blurred by a Gaussian of
+  ``sigma / h`` voxels along each axis before marching cubes at 0.5; along
+  an image face it touches, the mask goes on beyond the face and the surface
+  is closed by a flat cap on the face, left out as above
+  (:mod:`meshcurv._masks`). The radius is the default rules' (:mod:`meshcurv.radius`).
+- A label image read by slicing (Zarr, Dask, :class:`meshcurv._lazy.LazyImage`,
+  what :func:`meshcurv.io._images.read_image` returns for a ``.zarr`` store)
+  is never loaded whole: the labels' boxes are found one chunk at a time,
+  then each label's box is read from the store, in this process, and sent to
+  the workers as below (:mod:`meshcurv._lazy`).
+
 Many labels on several processes
 --------------------------------
 With ``workers=N`` (a local Dask cluster, :func:`meshcurv.batch.local_cluster`,
@@ -197,6 +218,8 @@ from .radius import VOXEL_CURVEDNESS_PERCENTILE, VOXEL_PILOT, voxel_radius
 from .integrals import vertex_integrals, weighted_percentiles
 from .result import CurvatureResult
 from .statistics import COLUMNS as STATISTICS_COLUMNS
+from ._lazy import as_lazy, check_lazy_labels, is_lazy, lazy_objects
+from ._masks import check_smooth, check_threshold, labels_from_image, smoothed_crop, smoothed_surface
 from .statistics import _face_average, _fold_note, _region_statistics
 
 __all__ = ["label_curvatures", "label_surfaces", "LabelSurface", "COLUMNS", "FIELDS", "STATISTICS",
@@ -538,18 +561,39 @@ def _cut_radius(vertices, faces, cap, distance, spacing) -> float | None:
                                                                         VOXEL_CURVEDNESS_PERCENTILE))))
 
 
-def _one_label(image, label, box, spacing, method, radius):
-    """``(row, LabelSurface or None)`` of one label."""
+def _one_label(image, label, box, spacing, method, radius, smooth=None):
+    """``(row, LabelSurface or None)`` of one label (its mask blurred by ``smooth``, sigma, when given)."""
     if box is None:
         return _empty_row(label, "empty", f"label {label} has no voxel in the image"), None
-    return _crop_label(label, *_crop(image, label, box), image.shape, spacing, method, radius)
+    label, *crop, options = _task_crop(image, label, box, spacing, smooth)
+    return _crop_label(label, *crop, image.shape, spacing, method, radius, **options)
 
 
-def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radius):
-    """``(row, LabelSurface or None)`` of one label from its crop (:func:`_crop`) and the image's shape."""
-    index, faces, n_voxels, centroid = _surface(padded, starts, spacing)
+def _task_crop(image, label, box, spacing, smooth):
+    """``(label, crop, starts, stops, options)``: what :func:`_crop_label` needs of the image for one label.
+
+    Without ``smooth``: :func:`_crop` and no options. With it: the mask of
+    :func:`meshcurv._masks.smoothed_crop` and ``{"smoothing": (sigma, origin)}``.
+    """
+    if smooth is None:
+        return (label, *_crop(image, label, box), {})
+    mask, origin, starts, stops = smoothed_crop(image, label, box, spacing, smooth)
+    return label, mask, starts, stops, {"smoothing": (smooth, origin)}
+
+
+def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radius, smoothing=None):
+    """``(row, LabelSurface or None)`` of one label from its crop (:func:`_crop`) and the image's shape.
+
+    ``smoothing``: ``(sigma, origin)`` when ``padded`` is the mask of
+    :func:`meshcurv._masks.smoothed_crop`, whose first voxel is ``origin``.
+    """
     shape = np.array(image_shape)
-    touching = np.column_stack([starts == 0, stops == shape])  # (3, 2): low and high face of each axis
+    if smoothing is None:
+        index, faces, n_voxels, centroid = _surface(padded, starts, spacing)
+        touching = np.column_stack([starts == 0, stops == shape])  # (3, 2): low and high face of each axis
+    else:
+        index, faces, n_voxels, centroid, touching = smoothed_surface(padded, smoothing[1], starts, stops, shape,
+                                                                      spacing, smoothing[0], _marching_cubes())
     facts = {"n_voxels": n_voxels, "touches_border": bool(touching.any()), "n_vertices": int(index.shape[0]),
              "n_faces": int(faces.shape[0]), **{f"centroid_{k}": float(centroid[k]) for k in range(3)}}
     if index.shape[0] < MIN_VERTICES:
@@ -668,14 +712,30 @@ def _warn_spacing(caller: str, stacklevel: int) -> None:
                   "the voxel size along image axes 0, 1, 2 in your unit", MeshcurvWarning, stacklevel=stacklevel + 1)
 
 
-def _plan(labels, spacing, labels_to_use, radius):
-    """Check the inputs and find the labels' boxes: ``(image, spacing, {label: box or None}, radius)``."""
-    image = _check_labels(labels)
+def _plan(labels, spacing, labels_to_use, radius, threshold=None, *, caller: str = "label_curvatures",
+          stacklevel: int = 2):
+    """Check the inputs and find the labels' boxes: ``(image, spacing, {label: box or None}, radius)``.
+
+    A lazy image (:func:`meshcurv._lazy.is_lazy`) is read a chunk at a time
+    (:func:`meshcurv._lazy.lazy_objects`); an image in memory is first turned
+    into labels by ``threshold`` (:func:`meshcurv._masks.labels_from_image`).
+    """
+    threshold = check_threshold(threshold)
     spacing = _check_spacing(spacing)
     wanted = _check_labels_to_use(labels_to_use)
     if radius is not None:
         radius = check_positive_float(radius, "radius")
     _marching_cubes()
+    if is_lazy(labels):
+        if threshold is not None:
+            raise InvalidOptionError("`threshold` needs the image in memory (its components span chunks); a lazily "
+                                     "read image (Zarr, Dask) must be a label image: label it first")
+        image = check_lazy_labels(as_lazy(labels))
+        return image, spacing, lazy_objects(image, wanted, _objects), radius
+    if isinstance(labels, np.ma.MaskedArray):
+        raise InvalidMeshError("`labels` must be a plain array; got a masked array (fill it first)")
+    image = _check_labels(labels_from_image(np.asanyarray(labels), threshold, caller=caller,
+                                            stacklevel=stacklevel + 1))
     return image, spacing, _objects(image, wanted), radius
 
 
@@ -691,9 +751,10 @@ def _guarded(label, compute, keep_surfaces):
     return row, (surface if keep_surfaces else None)
 
 
-def _iterate(image, spacing, objects, method, radius, keep_surfaces):
+def _iterate(image, spacing, objects, method, radius, keep_surfaces, smooth=None):
     for label, box in objects.items():
-        yield _guarded(label, functools.partial(_one_label, image, label, box, spacing, method, radius), keep_surfaces)
+        yield _guarded(label, functools.partial(_one_label, image, label, box, spacing, method, radius, smooth),
+                       keep_surfaces)
 
 
 def _dask():
@@ -723,10 +784,13 @@ def _check_parallel(workers, client):
 
 
 def _crop_task(crops, image_shape, spacing, method, radius, keep_surfaces):
-    """One Dask task: ``(row, surface)`` of each ``(label, padded, starts, stops)`` of ``crops`` (:func:`_crop`)."""
+    """One Dask task: ``(row, surface)`` of each ``(label, padded, starts, stops, options)`` of ``crops``.
+
+    (:func:`_task_crop`: ``options`` holds the ``smoothing`` of a smoothed crop.)
+    """
     return [_guarded(label, functools.partial(_crop_label, label, padded, starts, stops, image_shape, spacing, method,
-                                              radius), keep_surfaces)
-            for label, padded, starts, stops in crops]
+                                              radius, **options), keep_surfaces)
+            for label, padded, starts, stops, options in crops]
 
 
 def _groups(objects, workers: int) -> list[list]:
@@ -774,7 +838,7 @@ def _lost(outcome, distributed) -> str:
     return f"{type(outcome).__name__}: {outcome}"
 
 
-def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers):
+def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers, smooth=None):
     """As :func:`_iterate` (the same rows, in the same order), each group of labels a task on a Dask cluster.
 
     Each task gets only its labels' crops (the box padded by one voxel, as a
@@ -810,7 +874,7 @@ def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client
                     return
                 while queue and len(pending) < limit:
                     group = queue.popleft()
-                    crops = [(label, *_crop(image, label, objects[label])) for label in group]
+                    crops = [_task_crop(image, label, objects[label], spacing, smooth) for label in group]
                     future = active.submit(_crop_task, crops, image.shape, spacing, method, radius, keep_surfaces,
                                            pure=False)
                     pending[future] = group
@@ -836,7 +900,8 @@ def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client
 
 
 def label_surfaces(labels, *, spacing=None, labels_to_use=None, method: str | None = None,
-                   radius: float | None = None, keep_surfaces: bool = True, workers: int | None = None, client=None):
+                   radius: float | None = None, keep_surfaces: bool = True, workers: int | None = None, client=None,
+                   threshold: float | None = None, smooth: float | None = None):
     """``(total, iterator)``: the number of labels, and ``(row, surface)`` for each, one at a time.
 
     ``row`` is a dict of :data:`COLUMNS` (see :func:`label_curvatures`);
@@ -847,22 +912,26 @@ def label_surfaces(labels, *, spacing=None, labels_to_use=None, method: str | No
     checked, and the labels found, before this returns. With ``workers`` or
     ``client`` (as in :func:`label_curvatures`) the labels are computed on a
     Dask cluster, a few tasks ahead, and yielded in the same order.
+    ``threshold``, ``smooth`` and lazy images as in :func:`label_curvatures`.
     """
     return _label_surfaces(labels, spacing, labels_to_use, method, radius, keep_surfaces, workers, client,
-                           caller="label_surfaces", stacklevel=2)
+                           caller="label_surfaces", stacklevel=2, threshold=threshold, smooth=smooth)
 
 
 def _label_surfaces(labels, spacing, labels_to_use, method, radius, keep_surfaces, workers, client, *, caller: str,
-                    stacklevel: int):
+                    stacklevel: int, threshold=None, smooth=None):
     """:func:`label_surfaces`; the warning of a missing spacing names ``caller``, ``stacklevel`` frames up."""
     workers, client = _check_parallel(workers, client)
+    smooth = check_smooth(smooth)
     labels, spacing, assumed = _image_and_spacing(labels, spacing)
-    image, spacing, objects, radius = _plan(labels, spacing, labels_to_use, radius)
+    image, spacing, objects, radius = _plan(labels, spacing, labels_to_use, radius, threshold, caller=caller,
+                                            stacklevel=stacklevel + 1)
     if assumed:
         _warn_spacing(caller, stacklevel + 1)
     if (workers is None and client is None) or all(box is None for box in objects.values()):
-        return len(objects), _iterate(image, spacing, objects, method, radius, keep_surfaces)
-    return len(objects), _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers)
+        return len(objects), _iterate(image, spacing, objects, method, radius, keep_surfaces, smooth)
+    return len(objects), _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers,
+                                       smooth)
 
 
 def _table(rows):
@@ -893,7 +962,7 @@ def _pandas():
 def label_curvatures(labels, *, spacing=None, labels_to_use=None, method: str | None = None,
                      radius: float | None = None, return_meshes: bool = False,
                      progress: Callable[[int, int, int], None] | None = None, workers: int | None = None,
-                     client=None):
+                     client=None, threshold: float | None = None, smooth: float | None = None):
     """Curvature statistics of every object of a 3D label image, one row per label.
 
     Each label's surface is extracted by marching cubes on its bounding box
@@ -903,11 +972,18 @@ def label_curvatures(labels, *, spacing=None, labels_to_use=None, method: str | 
 
     Parameters
     ----------
-    labels : array_like of shape (Z, Y, X), integer or bool
+    labels : array_like of shape (Z, Y, X), integer, bool or float
         A label image (0 is the background, each positive value one object)
-        or a binary mask (one object, label 1); or the ``Image`` that
+        or a binary mask (one object, label 1); with ``threshold``, a
+        probability map; or the ``Image`` that
         ``meshcurv.io._images.read_image`` returns, whose spacing (from the
-        file) is used when ``spacing`` is not given.
+        file) is used when ``spacing`` is not given. A float image of whole
+        numbers is read as labels (with a warning); another float image
+        needs ``threshold``. An array read by slicing, a ``zarr.Array``, a
+        ``dask.array.Array`` or a :class:`meshcurv._lazy.LazyImage` (what
+        ``read_image`` returns for a ``.zarr`` store), is never loaded
+        whole: the objects' boxes are found a chunk at a time, then each
+        object's box is read (:mod:`meshcurv._lazy`); it must hold labels.
     spacing : sequence of 3 floats, optional
         Voxel size along image axes 0, 1, 2 (z, y, x), in the unit of the
         results (areas in unit^2, curvatures in 1/unit). Without it (and no
@@ -952,6 +1028,23 @@ def label_curvatures(labels, *, spacing=None, labels_to_use=None, method: str | 
         cluster (``distributed.scheduler.allowed-failures`` times on a
         ``client``'s), and the other labels are computed.
 
+    threshold : float, optional
+        ``labels`` is a probability map (any real image): the voxels greater
+        than ``threshold`` are the foreground, and its connected components
+        (6-connectivity: voxels sharing a face) are the objects, numbered 1,
+        2, ... in the order of their first voxel; NaN voxels are background
+        (with a warning). See :mod:`meshcurv._masks`. Not for lazy images.
+    smooth : float, optional
+        Blur each object's mask with a Gaussian of this standard deviation,
+        in the unit of ``spacing`` (``smooth / spacing`` voxels along each
+        axis), on its box padded by ``ceil(3 smooth / h) + 1`` voxels,
+        before marching cubes at level 0.5 (:mod:`meshcurv._masks`). The
+        staircase is gone from the surface; the level set moves inward by
+        about ``smooth^2 H``, so a ball of radius ``R`` loses about
+        ``2 smooth^2 / R^2`` of its area and ``3 smooth^2 / R^2`` of its volume.
+        The radius is then chosen by the default rules (a blurred mask's
+        surface is recognised as a voxel surface).
+
     Returns
     -------
     pandas.DataFrame
@@ -961,10 +1054,13 @@ def label_curvatures(labels, *, spacing=None, labels_to_use=None, method: str | 
     Raises
     ------
     InvalidMeshError
-        ``labels`` not a 3D integer or boolean array, empty, or with negative labels.
+        ``labels`` not a 3D integer or boolean array (or a float array of
+        whole numbers, or one with ``threshold``), empty, or with negative
+        labels; a float image of other values without ``threshold``.
     InvalidOptionError
         ``spacing`` not 3 positive finite numbers; bad ``labels_to_use``,
-        ``method``, ``radius`` or ``workers``; both ``workers`` and ``client``.
+        ``method``, ``radius``, ``workers``, ``threshold`` or ``smooth``;
+        both ``workers`` and ``client``; ``threshold`` with a lazy image.
     MissingDependencyError
         Without scikit-image or pandas (``pip install 'meshcurv[volume]'``);
         ``workers`` or ``client`` without dask.distributed (``pip install
@@ -977,7 +1073,8 @@ def label_curvatures(labels, *, spacing=None, labels_to_use=None, method: str | 
         failed, or have invalid vertices: the counts (the rows say which).
     MeshcurvWarning
         When no ``spacing`` was given and the image carries none: what was
-        assumed (1 x 1 x 1) and how to pass it.
+        assumed (1 x 1 x 1) and how to pass it. When a float image of whole
+        numbers is read as labels; when a thresholded image has NaN voxels.
 
     Examples
     --------
@@ -995,7 +1092,8 @@ def label_curvatures(labels, *, spacing=None, labels_to_use=None, method: str | 
     if progress is not None and not callable(progress):
         raise InvalidOptionError(f"`progress` must be a callable progress(done, total, label); got {progress!r}")
     total, surfaces_and_rows = _label_surfaces(labels, spacing, labels_to_use, method, radius, return_meshes,
-                                               workers, client, caller="label_curvatures", stacklevel=2)
+                                               workers, client, caller="label_curvatures", stacklevel=2,
+                                               threshold=threshold, smooth=smooth)
     rows, surfaces = [], {}
     for row, surface in surfaces_and_rows:
         rows.append(row)

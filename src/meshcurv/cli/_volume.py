@@ -35,7 +35,10 @@ class LabelBar(ProgressBar):
 
 def _stem(path: pathlib.Path) -> str:
     name = path.name
-    return name[: -len(".nii.gz")] if name.lower().endswith(".nii.gz") else path.stem
+    for double in (".nii.gz", ".ome.zarr"):
+        if name.lower().endswith(double):
+            return name[: -len(double)]
+    return path.stem
 
 
 def _label_list(ctx, param, value):
@@ -63,6 +66,13 @@ def _label_list(ctx, param, value):
               help="Curvature estimator (default: icc, with a radius chosen for voxel surfaces).")
 @click.option("--radius", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
               help="Ball radius in physical units (default: per label, from its voxels and curvature).")
+@click.option("--threshold", type=float, default=None, metavar="T",
+              help="IMAGE is a probability map: the voxels greater than T are the objects, split into connected "
+                   "components (voxels sharing a face); not for Zarr stores.")
+@click.option("--smooth", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
+              metavar="SIGMA", help="Blur each object's mask with a Gaussian of this standard deviation, in the "
+                                    "unit of the voxel size, before its surface is extracted (shrinks objects by "
+                                    "about SIGMA^2/R).")
 @click.option("--meshes", "mesh_format", type=click.Choice(MESH_FORMATS), default=None,
               help="Also write one mesh file per label with its curvature fields, in this format.")
 @click.option("--objects/--no-objects", "objects", default=True, show_default=True,
@@ -77,8 +87,8 @@ def _label_list(ctx, param, value):
                    "meshcurv[batch]; default: one label after the other in this process).")
 @click.option("--overwrite", is_flag=True, help="Replace existing outputs.")
 @common_options
-def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, objects, picture, field, workers,
-           overwrite):
+def volume(image, out_dir, spacing, labels_to_use, method, radius, threshold, smooth, mesh_format, objects, picture,
+           field, workers, overwrite):
     """Curvature of every object of a 3D label image: one table row per label.
 
     \b
@@ -86,10 +96,15 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
     meshcurv volume brain_labels.nii.gz -o results/        spacing from the header
     meshcurv volume mask.npy -o results/ --meshes vtp --field gaussian
     meshcurv volume cells.tif -o results/ --workers 2      labels on 2 processes
+    meshcurv volume membranes.mrc -o results/              voxel size in Angstrom
+    meshcurv volume cells.ome.zarr -o results/ --workers 2 read lazily, per object
+    meshcurv volume probability.tif -o results/ --threshold 0.5 --smooth 0.5
 
-    IMAGE is a TIFF stack, .npy, .npz (the array 'labels', or its only array)
-    or NIfTI (.nii, .nii.gz) of integer labels (0: background) or a binary
-    mask. Writes OUTDIR/<name>_labels.csv and .parquet (one row per label:
+    IMAGE is a TIFF stack, .npy, .npz (the array 'labels', or its only array),
+    NIfTI (.nii, .nii.gz), MRC (.mrc, .rec, .map: the voxel size of its header,
+    in Angstrom) or a Zarr / OME-Zarr folder (.zarr: read a chunk at a time,
+    never whole; needs pip install zarr) of integer labels (0: background) or
+    a binary mask, or with --threshold a probability map. Writes OUTDIR/<name>_labels.csv and .parquet (one row per label:
     area, volume, area-weighted and percentiles of H, K, principal
     curvatures, shape index and curvedness, total curvatures, Willmore
     energy, Euler characteristic, border flag, status), the surfaces of all
@@ -139,7 +154,7 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, mesh_format, 
             session.info(f"{image}: voxel size {' x '.join(f'{s:g}' for s in spacing)}{unit} (z y x) from the file"
                          + (f"; lengths in the table in {read.unit}" if read.unit else ""))
     total, labels = volume_module.label_surfaces(read.array, spacing=spacing, labels_to_use=labels_to_use,
-                                                 method=method, radius=radius,
+                                                 method=method, radius=radius, threshold=threshold, smooth=smooth,
                                                  keep_surfaces=mesh_format is not None or picture or objects,
                                                  workers=workers)
     bar = session.bar(LabelBar)
