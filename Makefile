@@ -20,12 +20,12 @@ $(BIN)/python:
 
 # pip's progress stays visible: the first install downloads a few hundred MB (demo) to 1.6 GB (tests)
 $(DEMO_STAMP): pyproject.toml | $(BIN)/python
-	@echo "make demo: installing meshcurv and matplotlib into $(VENV) (about 350 MB, once)"
+	@echo "make demo: installing meshcurv and matplotlib into $(VENV) (about 550 MB, once)"
 	$(PIP) install --progress-bar on -e '.[plot]'
 	@touch $(DEMO_STAMP)
 
 $(STAMP): pyproject.toml | $(BIN)/python
-	@echo "make test: installing meshcurv, its optional parts and the test tools into $(VENV) (about 1.6 GB, once)"
+	@echo "make test: installing meshcurv, its optional parts and the test tools into $(VENV) (about 2 GB, once)"
 	$(PIP) install --progress-bar on -e '.[all,batch,test]'
 	@touch $(STAMP)
 
