@@ -231,3 +231,47 @@ def test_cli_volume_on_an_ome_zarr_store(tmp_path):
     row = pandas.read_csv(tmp_path / "cells_labels.csv").iloc[0]
     assert row.label == 5 and row.area == pytest.approx(4 * np.pi * radius**2, rel=0.03)
     assert (tmp_path / "cells_objects.vtp").is_file()
+
+
+# ---- the small version of benchmarks/zarr_labels.py ----------------------------------------------------------------
+
+def zarr_benchmark():
+    import importlib.util
+    import pathlib
+
+    path = pathlib.Path(__file__).parent.parent / "benchmarks" / "zarr_labels.py"
+    if not path.is_file():
+        pytest.skip("benchmarks/zarr_labels.py is not here (an installed package)")
+    spec = importlib.util.spec_from_file_location("zarr_labels", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_benchmark_store_written_chunk_by_chunk_gives_its_balls(tmp_path):
+    pytest.importorskip("pandas")
+    pytest.importorskip("skimage")
+    from meshcurv.volume import label_curvatures
+
+    benchmark = zarr_benchmark()
+    shape = np.array([30, 40, 50])
+    centres, radii = benchmark.balls(shape, 6, 5.0, 6.0, seed=2)
+    benchmark.write_store(tmp_path / "b.zarr", shape, 16, centres, radii)
+    read = read_image(tmp_path / "b.zarr")
+    whole = read.array[0:30, 0:40, 0:50]
+    assert sorted(np.unique(whole).tolist()) == list(range(7))  # every ball, none overwritten
+    table = label_curvatures(read, spacing=(1.0, 1.0, 1.0)).set_index("label")
+    inner = table[~table.touches_border]
+    assert len(inner) >= 4 and (inner.status == "ok").all()
+    truth = 4 * np.pi * radii[inner.index.to_numpy() - 1] ** 2
+    assert inner.area.to_numpy() == pytest.approx(truth, rel=0.03)
+
+
+@pytest.mark.slow  # a local cluster of 2 processes
+def test_benchmark_runs_under_its_cap(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    pytest.importorskip("psutil")
+    benchmark = zarr_benchmark()
+    assert benchmark.main(["--shape", "96", "96", "96", "--objects", "12", "--chunk", "32", "--cap", "4",
+                           "--store", str(tmp_path)]) == 0
+    assert "| cap | 4.00 GiB: kept |" in capsys.readouterr().out
