@@ -1,4 +1,4 @@
-"""The seed's own example: matGeom's torus, its curvatures, a picture.
+"""The demo: matGeom's torus (torusMesh), its curvatures, a picture.
 
 matGeom's doc runs::
 

@@ -368,7 +368,7 @@ def methods():
 @click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
 @common_options
 def demo(output, overwrite):
-    """The seed's example: matGeom's torus, its curvatures against the exact ones, a picture (OUTPUT)."""
+    """A torus (matGeom's torusMesh), its curvatures against the exact ones, a picture (OUTPUT)."""
     from ..demo import run_demo
     from ..plotting import _pyplot
 
