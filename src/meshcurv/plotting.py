@@ -347,7 +347,7 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     """Draw a triangle mesh (or a point cloud) coloured by a per-vertex field, with a colour bar.
 
     Vertex values are interpolated across each triangle (matGeom's
-    ``drawMesh(v, f, 'VertexColor', c)``), so the seed's example is one call:
+    ``drawMesh(v, f, 'VertexColor', c)``), so matGeom's demo is one call:
     ``plot_field(v, f, c1 * c2)``. Signed fields get a diverging colour map
     centred on zero; the limits are robust (the given percentiles of the
     finite values, stated on the colour bar) unless fixed by ``limits``,
