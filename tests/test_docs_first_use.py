@@ -103,3 +103,16 @@ def test_the_clock_can_be_asked_for_in_whole_lines(clock):
     lines = written.splitlines(keepends=True)
     assert lines and all(line.startswith("meshcurv: compiling") and line.endswith(" s\n") for line in lines)
     assert "\r" not in written
+
+
+def test_the_command_lines_progress_option_runs_the_clock_and_leaves_it_as_it_was():
+    pytest.importorskip("click")
+    from meshcurv import _backend
+    from meshcurv.cli._common import Session
+
+    for progress, wanted in ((True, True), (False, False), (None, None)):
+        with Session() as session:
+            session.progress = progress
+            session.update()  # what --progress / --no-progress do
+            assert _backend._clock_wanted is wanted
+        assert _backend._clock_wanted is None  # the library's rule again: a terminal only

@@ -16,6 +16,7 @@ from typing import NamedTuple
 import click
 import numpy as np
 
+from .. import _backend
 from .._validation import as_faces
 from ..curvature import principal_curvatures
 from ..estimators import DEFAULT_METHOD, ESTIMATORS
@@ -68,11 +69,13 @@ class Session:
         self._warnings.__exit__(*exc_info)
         self._logger.removeHandler(self._handler)
         self._logger.setLevel(self._level)
+        _backend.show_compile_time(None)
         return False
 
     def update(self) -> None:
         level = _LEVELS[max(-2, min(2, self.verbose - self.quiet))]
         self._logger.setLevel(level)
+        _backend.show_compile_time(self.progress)  # the compile's clock as the bars: --progress, terminal
         if level <= logging.DEBUG and self._handler is not None:  # None only before __enter__, which updates
             self._handler.setFormatter(logging.Formatter("meshcurv: %(name)s: %(message)s"))
 
