@@ -18,14 +18,14 @@ $(BIN)/python:
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "meshcurv needs Python 3.11 or newer: make PYTHON=python3.11 ...")'
 	$(PYTHON) -m venv $(VENV)
 
-# pip's progress stays visible: the first install downloads a few hundred MB (demo) to 1.6 GB (tests)
+# pip's progress stays visible: the environment weighs 550 MB after make demo, 1.6 GB after make test
 $(DEMO_STAMP): pyproject.toml | $(BIN)/python
 	@echo "make demo: installing meshcurv and matplotlib into $(VENV) (about 550 MB, once)"
 	$(PIP) install --progress-bar on -e '.[plot]'
 	@touch $(DEMO_STAMP)
 
 $(STAMP): pyproject.toml | $(BIN)/python
-	@echo "make test: installing meshcurv, its optional parts and the test tools into $(VENV) (about 2 GB, once)"
+	@echo "make test: installing meshcurv, its optional parts and the test tools into $(VENV) (1.6 GB in all, once)"
 	$(PIP) install --progress-bar on -e '.[all,batch,test]'
 	@touch $(STAMP)
 
