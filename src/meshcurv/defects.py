@@ -67,7 +67,7 @@ BOUNDARY = 6
 #: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the last
 #: two reasons: codes 7 and 8.
 POINT_CLOUD_REASONS = (
-    "point cloud: side undecided (between two sheets closer than the spacing)",
+    "point cloud: side undecided (two sheets closer than the spacing, or stacked with normals the same way)",
     "point cloud: every ball held the other side of a thin part or a neighbouring part",
 )
 

@@ -31,9 +31,17 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    cloud (Barill et al. 2018: 1/2 on a surface whose side agrees with the
    whole cloud's; :func:`meshcurv._pointcloud_normals.winding_sides`): a part
    left inside out is turned, the wall of a cavity (a closed part inside
-   another) faces into the cavity, as for meshes; points where two sheets
-   closer than the spacing cannot be told apart, or whose side turning does
-   not settle, are NaN (``invalid_reason``: side undecided);
+   another) faces into the cavity, as for meshes; two stacked sheets whose
+   normals face each other across a part (the faces of a thin part turned
+   together: the winding number between them about -1) are turned
+   (:func:`meshcurv._pointcloud_normals.between_sides`); points where two
+   sheets closer than the spacing cannot be told apart (and every point of a
+   part where they mix over :data:`THIN_PART_SHARE` of it), whose side
+   turning does not settle, or, after the estimate, whose normals point the
+   same way as a sheet stacked on theirs
+   (:func:`meshcurv._pointcloud_normals.two_sheets`: one of the two is inside
+   out, and nothing local tells which) are NaN (``invalid_reason``: side
+   undecided);
 4. the noise level ``nu``: the median distance of the points to degree-2 jets
    fitted over :data:`meshcurv.radius.CLOUD_NOISE_FIT_RADIUS` spacings, in spacings;
 5. the radius: ``s (a + b sqrt(max(nu - 0.005, 0)))``, ``(a, b)`` = (3, 11)
@@ -140,6 +148,10 @@ COPY_SUSPECT = 1e-2
 
 #: Most copies of one point found (see :data:`COPY_SUSPECT`).
 COPY_NEIGHBOURS = 64
+
+#: A part of the cloud whose points are this share or more between two sheets closer than the spacing
+#: (:func:`meshcurv._pointcloud_normals.two_sheets`) is thinner than the spacing: every point's side is undecided.
+THIN_PART_SHARE = 0.25
 
 #: Code of :data:`meshcurv.result.INVALID_REASONS` for points without an estimate.
 _UNDEFINED = len(INVALID_REASONS) - 1
@@ -551,17 +563,32 @@ def _compute(points, given, radius, method, search=None):
         problems.append(f"{two_sided} points have no one-sided jet fit (every ball down to 3-4 spacings held "
                         f"points facing the other way: a part thinner than that, or too few points): {what}")
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
+    alike = np.zeros(n, dtype=bool)
+    if how != "given":
+        # a sheet stacked on another with normals the same way (one of the two is inside out), and two sheets
+        # closer than the spacing, whose points mix (the faces of a part thinner than that)
+        alike, interleaved = _normals.two_sheets(points, out_normals, usable, spacing, tree)
+        # a part whose faces mix over a good share of it is thinner than the spacing: its sides are a coin's toss
+        share = np.bincount(labels, weights=interleaved, minlength=int(labels.max()) + 1) / np.maximum(
+            np.bincount(labels, weights=usable, minlength=int(labels.max()) + 1), 1.0)
+        interleaved |= usable & (share[labels] >= THIN_PART_SHARE)
+        doubtful = doubtful | alike | interleaved
     reason = np.zeros(n, dtype=np.int8)
     reason[~one_sided | (two_sided_mask & usable)] = _TWO_SIDED
     valid &= one_sided
     if doubtful.any():
         found = []
-        if (doubtful & ~unsettled).any():
-            found.append(f"{int((doubtful & ~unsettled).sum())} points lie between two sheets closer than the "
-                         "spacing (two parts of the cloud, or the faces of a part thinner than that)")
-        if unsettled.any():
-            found.append(f"{int(unsettled.sum())} points are on a side the winding number of the cloud contradicts "
-                         "(a part inside out, or an outward part inside another) and turning them did not settle it")
+        between = doubtful & ~unsettled & ~alike
+        if between.any():
+            found.append(f"{int(between.sum())} points lie between two sheets closer than the spacing (two parts "
+                         "of the cloud, or the faces of a part thinner than that)")
+        if (unsettled & ~alike).any():
+            found.append(f"{int((unsettled & ~alike).sum())} points are on a side the winding number of the cloud "
+                         "contradicts (a part inside out, or an outward part inside another) and turning them did "
+                         "not settle it")
+        if alike.any():
+            found.append(f"{int(alike.sum())} points face the same way as a sheet stacked on theirs a few spacings "
+                         "away (the faces of a thin part, or two parts: one of the two is inside out)")
         problems.append(" and ".join(found) + ": their normals' side is undecided, NaN")
         valid &= ~doubtful
         reason[doubtful] = _UNDECIDED
