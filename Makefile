@@ -74,11 +74,14 @@ package-check: $(STAMP)
 	cd /tmp && $(CURDIR)/$(PKG)-clone/bin/meshcurv --version
 	rm -rf $(PKG) $(PKG)-clone
 
-# ruff, then mypy on src/meshcurv ([tool.mypy] in pyproject.toml)
+# ruff check and format (the files written before it excepted: [tool.ruff.format]), mypy on src/meshcurv
+# ([tool.mypy]), numpydoc's validation of the public API ([tool.numpydoc_validation], tests/test_docstrings.py)
 lint: $(STAMP)
-	$(PIP) install --quiet 'ruff>=0.6' 'mypy>=1.10'
+	$(PIP) install --quiet 'ruff>=0.6' 'mypy>=1.10' 'numpydoc>=1.6'
 	$(BIN)/ruff check src tests benchmarks conftest.py
+	$(BIN)/ruff format --check --force-exclude src tests benchmarks conftest.py
 	$(BIN)/mypy
+	$(BIN)/python -m pytest -q -p no:randomly tests/test_docstrings.py
 
 bench-accuracy: $(STAMP)
 	$(PIP) install --quiet -e '.[bench]'

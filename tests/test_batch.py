@@ -67,17 +67,35 @@ def write_dozen(folder: pathlib.Path) -> dict:
 
     def add(name, vertices, faces, **facts):
         meshcurv.write_mesh(folder / name, vertices, faces)
-        expected[name] = dict(n_vertices=len(vertices), n_faces=len(faces), area=triangle_area(vertices, faces),
-                              volume=enclosed_volume(vertices, faces) if facts["n_boundary_loops"] == 0 else None,
-                              n_invalid=0, **facts)  # icc keeps the boundary vertices of the open ones
+        expected[name] = dict(
+            n_vertices=len(vertices),
+            n_faces=len(faces),
+            area=triangle_area(vertices, faces),
+            volume=enclosed_volume(vertices, faces) if facts["n_boundary_loops"] == 0 else None,
+            n_invalid=0,
+            **facts,
+        )  # icc keeps the boundary vertices of the open ones
 
     for radius, extension in zip(RADII, (".obj", ".off", ".ply", ".npz")):
         sphere = shapes.icosphere(8, radius=radius)
-        add(f"sphere_{radius:g}{extension}", sphere.vertices, sphere.faces, euler_characteristic=2,
-            n_components=1, n_boundary_loops=0, radius=radius)
+        add(
+            f"sphere_{radius:g}{extension}",
+            sphere.vertices,
+            sphere.faces,
+            euler_characteristic=2,
+            n_components=1,
+            n_boundary_loops=0,
+            radius=radius,
+        )
     irregular = shapes.random_sphere(500, radius=3.0, seed=1)
-    add("random_sphere.vtp", irregular.vertices, irregular.faces, euler_characteristic=2, n_components=1,
-        n_boundary_loops=0)
+    add(
+        "random_sphere.vtp",
+        irregular.vertices,
+        irregular.faces,
+        euler_characteristic=2,
+        n_components=1,
+        n_boundary_loops=0,
+    )
     torus = shapes.torus(30, 10, 24, 12)
     add("torus.off", torus.vertices, torus.faces, euler_characteristic=0, n_components=1, n_boundary_loops=0)
     half = shapes.hemisphere(8, radius=2.0)
@@ -168,15 +186,43 @@ def dask_cluster(tmp_path_factory):
     processes = []
     try:
         with open(logs / "scheduler.log", "w") as log:
-            processes.append(subprocess.Popen(
-                [*DASK, "scheduler", "--host", LOOPBACK, "--port", address.rsplit(":", 1)[1],
-                 "--dashboard-address", f"{LOOPBACK}:{free_port()}"],
-                stdout=subprocess.DEVNULL, stderr=log, env=environment))
+            processes.append(
+                subprocess.Popen(
+                    [
+                        *DASK,
+                        "scheduler",
+                        "--host",
+                        LOOPBACK,
+                        "--port",
+                        address.rsplit(":", 1)[1],
+                        "--dashboard-address",
+                        f"{LOOPBACK}:{free_port()}",
+                    ],
+                    stdout=subprocess.DEVNULL,
+                    stderr=log,
+                    env=environment,
+                )
+            )
         with open(logs / "worker.log", "w") as log:
-            processes.append(subprocess.Popen(
-                [*DASK, "worker", address, "--host", LOOPBACK, "--nthreads", "1", "--nworkers", "1",
-                 "--no-dashboard"],
-                stdout=subprocess.DEVNULL, stderr=log, env=environment))
+            processes.append(
+                subprocess.Popen(
+                    [
+                        *DASK,
+                        "worker",
+                        address,
+                        "--host",
+                        LOOPBACK,
+                        "--nthreads",
+                        "1",
+                        "--nworkers",
+                        "1",
+                        "--no-dashboard",
+                    ],
+                    stdout=subprocess.DEVNULL,
+                    stderr=log,
+                    env=environment,
+                )
+            )
         with distributed.Client(address, timeout=60) as probe:
             probe.wait_for_workers(1, timeout=60)
         yield address
@@ -192,8 +238,9 @@ def test_expand_inputs_takes_files_folders_and_patterns_sorted_once(tmp_path):
     for name in ("b.obj", "a.ply", "c.OFF", ".hidden.obj", "notes.txt", "sub/d.obj", "sub/deeper/e.vtp", "out/f.obj"):
         (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / name).write_text("")
-    found = batch.expand_inputs([tmp_path, tmp_path / "b.obj", f"{tmp_path}/**/*.obj", tmp_path / "notes.txt"],
-                                exclude=tmp_path / "out")
+    found = batch.expand_inputs(
+        [tmp_path, tmp_path / "b.obj", f"{tmp_path}/**/*.obj", tmp_path / "notes.txt"], exclude=tmp_path / "out"
+    )
     relative = [os.fspath(path.relative_to(tmp_path)) for path in found]
     # the folder: its mesh files, not hidden ones nor notes.txt; the pattern crosses folders but not out/;
     # notes.txt named explicitly is kept (its error will be in the summary); b.obj once
@@ -249,7 +296,9 @@ def test_run_refuses_inputs_that_would_share_a_result(tmp_path):
     dead = f"tcp://{LOOPBACK}:9"
     with pytest.raises(InvalidOptionError, match=r"x\.obj and .*x\.off would both be written to .*x\.ply"):
         batch.run(folder, tmp_path / "out", scheduler=dead)
-    with pytest.raises(InvalidOptionError, match=r"the summary and .*summary\.obj would both be written to .*summary\.csv"):
+    with pytest.raises(
+        InvalidOptionError, match=r"the summary and .*summary\.obj would both be written to .*summary\.csv"
+    ):
         batch.run(folder / "summary.obj", tmp_path / "out", scheduler=dead, output_format="csv")
 
 
@@ -333,8 +382,14 @@ def test_rows_follow_the_construction_and_the_geometry(first_run, dozen):
         # 1.4% below them, an inscribed polyhedron), its curvatures within 1% (the README's accuracy)
         assert row["area"] == pytest.approx(4 * np.pi * radius**2, rel=0.01)
         assert row["volume"] == pytest.approx(4 / 3 * np.pi * radius**3, rel=0.02)
-        for field, exact in (("k_min", 1 / radius), ("k_max", 1 / radius), ("mean", 1 / radius),
-                             ("gaussian", 1 / radius**2), ("curvedness", 1 / radius), ("shape_index", 1.0)):
+        for field, exact in (
+            ("k_min", 1 / radius),
+            ("k_max", 1 / radius),
+            ("mean", 1 / radius),
+            ("gaussian", 1 / radius**2),
+            ("curvedness", 1 / radius),
+            ("shape_index", 1.0),
+        ):
             assert row[f"{field}_median"] == pytest.approx(exact, rel=0.01), (radius, field)
             assert row[f"{field}_mean"] == pytest.approx(exact, rel=0.01), (radius, field)
             assert row[f"{field}_area_median"] == pytest.approx(exact, rel=0.01), (radius, field)
@@ -359,7 +414,9 @@ def test_the_summary_files_hold_the_table_ordered_by_path(first_run):
     assert list(from_csv.columns) == list(batch.COLUMNS)
     assert from_csv["path"].tolist() == summary["path"].tolist()
     for column in ("area", "volume", "mean_median", "n_vertices"):  # every digit, and empty where missing
-        np.testing.assert_array_equal(from_csv[column].to_numpy(float), summary[column].to_numpy(float, na_value=np.nan))
+        np.testing.assert_array_equal(
+            from_csv[column].to_numpy(float), summary[column].to_numpy(float, na_value=np.nan)
+        )
     assert from_csv["error"].fillna("").tolist() == summary["error"].tolist()
 
 
@@ -369,11 +426,14 @@ def test_a_second_run_does_no_work(first_run, dozen, client):
     before = {path: path.stat() for path in out_dir.glob("*.ply")}
     again = batch.run([folder], out_dir, client=client)
     # the corrupt file is tried again (it may have been repaired); the others are not touched
-    assert again["status"].tolist() == ["failed" if name == "corrupt.obj" else "skipped"
-                                        for name in again["path"].map(lambda path: pathlib.Path(path).name)]
+    assert again["status"].tolist() == [
+        "failed" if name == "corrupt.obj" else "skipped"
+        for name in again["path"].map(lambda path: pathlib.Path(path).name)
+    ]
     after = {path: path.stat() for path in out_dir.glob("*.ply")}
-    assert {path: (s.st_ino, s.st_mtime_ns) for path, s in after.items()} == \
-        {path: (s.st_ino, s.st_mtime_ns) for path, s in before.items()}
+    assert {path: (s.st_ino, s.st_mtime_ns) for path, s in after.items()} == {
+        path: (s.st_ino, s.st_mtime_ns) for path, s in before.items()
+    }
     columns = [column for column in batch.COLUMNS if column != "status"]
     good = again["status"] == "skipped"  # their rows are those recorded then, seconds included
     pd.testing.assert_frame_equal(again.loc[good, columns], summary.loc[good, columns])
@@ -402,8 +462,11 @@ def test_overwrite_and_results_of_other_options(tmp_path, client):
     first = (out_dir / "sphere_000.ply").stat()
     # the same computation asked without the default: skipped
     assert (batch.run(paths, out_dir, client=client)["status"] == "skipped").all()
-    with pytest.raises(InvalidOptionError, match=r"holds results computed with method='icc', not "
-                                                 r"method='icc', radius=0.3; pass overwrite=True"):
+    with pytest.raises(
+        InvalidOptionError,
+        match=r"holds results computed with method='icc', not "
+        r"method='icc', radius=0.3; pass overwrite=True",
+    ):
         batch.run(paths, out_dir, client=client, radius=0.3)
     redone = batch.run(paths, out_dir, client=client, radius=0.3, overwrite=True)
     assert (redone["status"] == "computed").all()
@@ -462,8 +525,10 @@ def test_a_task_lost_with_its_workers_is_split_into_single_meshes(tmp_path, capl
     paths = write_spheres(tmp_path / "in", 24, 16)  # 2562 vertices; 2 workers -> tasks of 2 meshes
     out_dir = tmp_path / "out"
     killed = []
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
-            batch.local_cluster(workers=2, dashboard=False) as client:
+    with (
+        dask.config.set({"distributed.scheduler.allowed-failures": 0}),
+        batch.local_cluster(workers=2, dashboard=False) as client,
+    ):
 
         def kill_a_busy_worker(done, total, failed):
             busy = [address for address, keys in client.processing().items() if keys]
@@ -488,9 +553,24 @@ def test_a_task_lost_with_its_workers_is_split_into_single_meshes(tmp_path, capl
 def test_command_on_a_running_dask_cluster(dask_cluster, dozen, tmp_path):
     folder, expected = dozen
     out_dir = tmp_path / "out"
-    done = subprocess.run([*MESHCURV, "batch", os.fspath(folder), "-o", os.fspath(out_dir), "--scheduler",
-                           dask_cluster, "--format", "npz", "--progress", "-v"],
-                          capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [
+            *MESHCURV,
+            "batch",
+            os.fspath(folder),
+            "-o",
+            os.fspath(out_dir),
+            "--scheduler",
+            dask_cluster,
+            "--format",
+            "npz",
+            "--progress",
+            "-v",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 1, done.stderr
     assert "meshcurv: Dask dashboard: http://127.0.0.1:" in done.stderr
     assert "12/12 meshes, 1 failed" in done.stderr
@@ -498,8 +578,10 @@ def test_command_on_a_running_dask_cluster(dask_cluster, dozen, tmp_path):
     assert done.stderr.rstrip().endswith("meshcurv: error: 1 of 12 meshes failed")
     for name, facts in expected.items():
         assert_complete_npz(out_dir / (pathlib.Path(name).stem + ".npz"), facts["n_vertices"])
-    assert pd.read_parquet(out_dir / "summary.parquet")["status"].value_counts().to_dict() == \
-        {"computed": 11, "failed": 1}
+    assert pd.read_parquet(out_dir / "summary.parquet")["status"].value_counts().to_dict() == {
+        "computed": 11,
+        "failed": 1,
+    }
     assert leftovers(out_dir) == []
 
 
@@ -507,11 +589,14 @@ def test_an_interrupted_command_leaves_no_partial_result_and_resumes(tmp_path, c
     # 5762 vertices each: about a second of work left when the first result appears
     paths = write_spheres(tmp_path / "in", 80, 24, extension=".obj")
     out_dir = tmp_path / "out"
-    process = subprocess.Popen([*MESHCURV, "batch", os.fspath(tmp_path / "in"), "-o", os.fspath(out_dir),
-                                "--workers", "2", "--format", "npz"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               # a shell starts background jobs with SIGINT ignored, and children inherit it
-                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    process = subprocess.Popen(
+        [*MESHCURV, "batch", os.fspath(tmp_path / "in"), "-o", os.fspath(out_dir), "--workers", "2", "--format", "npz"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        # a shell starts background jobs with SIGINT ignored, and children inherit it
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         deadline = time.monotonic() + 90
         while not list(out_dir.glob("*.npz")) and time.monotonic() < deadline and process.poll() is None:
@@ -537,8 +622,21 @@ def test_an_interrupted_command_leaves_no_partial_result_and_resumes(tmp_path, c
 def test_command_usage_errors(tmp_path, capsys):
     assert main(["batch", f"{tmp_path}/*.obj", "-o", os.fspath(tmp_path / "out")]) == 1
     assert "the pattern matches no mesh file" in capsys.readouterr().err
-    assert main(["batch", os.fspath(tmp_path), "-o", os.fspath(tmp_path / "out"), "--workers", "2",
-                 "--scheduler", f"tcp://{LOOPBACK}:9"]) == 2
+    assert (
+        main(
+            [
+                "batch",
+                os.fspath(tmp_path),
+                "-o",
+                os.fspath(tmp_path / "out"),
+                "--workers",
+                "2",
+                "--scheduler",
+                f"tcp://{LOOPBACK}:9",
+            ]
+        )
+        == 2
+    )
     assert "--workers sizes the local cluster" in capsys.readouterr().err
     assert main(["batch", os.fspath(tmp_path), "-o", os.fspath(tmp_path / "out"), "--workers", "0"]) == 2
     assert main(["batch", "-o", os.fspath(tmp_path / "out")]) == 2

@@ -63,8 +63,14 @@ def run_bounded(argv, *, timeout: float = 60, memory: int = 8 * 2**30) -> subpro
     def limit():
         resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
 
-    process = subprocess.Popen([os.fspath(arg) for arg in argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True, preexec_fn=limit, start_new_session=True)
+    process = subprocess.Popen(
+        [os.fspath(arg) for arg in argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=limit,
+        start_new_session=True,
+    )
     try:
         out, err = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -77,8 +83,9 @@ def run_bounded(argv, *, timeout: float = 60, memory: int = 8 * 2**30) -> subpro
 def run_child(code: str, *, timeout: float, cwd=None) -> dict:
     """Run ``code`` in a new Python; it prints one JSON line last, returned. A hang fails the test."""
     try:
-        done = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True,
-                              timeout=timeout, cwd=cwd)
+        done = subprocess.run(
+            [sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=timeout, cwd=cwd
+        )
     except subprocess.TimeoutExpired as exc:
         pytest.fail(f"the child did not end within {timeout} s (a hang): {exc.stderr!r}")
     assert done.returncode == 0, done.stderr[-3000:]
@@ -188,7 +195,9 @@ def rows(summary):
 
 def run_twice(tmp_path, names, options: str) -> dict:
     """A batch of ``names`` on a local cluster of one worker with the faults, then its resume (a child process)."""
-    return run_child(FAULTS + f"""
+    return run_child(
+        FAULTS
+        + f"""
 folder, out_dir = pathlib.Path({os.fspath(tmp_path)!r}) / "in", pathlib.Path({os.fspath(tmp_path)!r}) / "out"
 write(folder, {names!r})
 # the compiled kernels on disk before the worker starts (a fresh clone compiles them here, once), so
@@ -204,7 +213,9 @@ with batch.local_cluster(workers=1, dashboard=False) as client:
     again_seconds = time.monotonic() - start
 print(json.dumps({{"first": rows(first), "again": rows(again), "first_seconds": first_seconds,
                   "again_seconds": again_seconds}}))
-""", timeout=300)
+""",
+        timeout=300,
+    )
 
 
 @pytest.mark.slow
@@ -227,15 +238,18 @@ def test_a_mesh_that_keeps_killing_its_workers_fails_alone_and_is_not_retried(tm
     first, again = result["first"], result["again"]
     assert first["a.obj"] == ["computed", ""] and first["z.obj"] == ["computed", ""]
     assert first["crash.obj"][0] == "failed"
-    assert first["crash.obj"][1].startswith(f"WorkerDied: the worker computing this mesh died "
-                                            f"{batch.MAX_WORKER_DEATHS} times (killed by the system")
+    assert first["crash.obj"][1].startswith(
+        f"WorkerDied: the worker computing this mesh died {batch.MAX_WORKER_DEATHS} times (killed by the system"
+    )
     assert again["crash.obj"] == first["crash.obj"] and result["again_seconds"] < 2
 
 
 @pytest.mark.slow
 def test_a_cluster_left_without_workers_ends_the_run_with_a_message(tmp_path):
     """``dask scheduler`` and one ``dask worker`` (its nanny in its own process): the mesh kills both."""
-    result = run_child(FAULTS + f"""
+    result = run_child(
+        FAULTS
+        + f"""
 import socket, subprocess
 
 def free_port():
@@ -271,7 +285,9 @@ finally:
         process.kill()
         process.wait()
 print(json.dumps({{"message": message, "seconds": seconds}}))
-""", timeout=120)
+""",
+        timeout=120,
+    )
     assert result["message"] is not None, "the run ended without NoWorkerError"
     assert result["message"].startswith("the cluster has had no worker for 3 s: the workers died and none could")
     assert result["seconds"] < 30
@@ -349,8 +365,11 @@ def test_a_damaged_record_is_ignored_with_one_warning_not_a_refusal(tmp_path, mo
         raise ConnectionError("no cluster in this test")
 
     monkeypatch.setattr(batch._run, "cluster", no_cluster)
-    with pytest.warns(MeshcurvWarning, match=r"3 records in .* cannot be read \(cut short or corrupt: "
-                                             r"a\.npz\.json: JSONDecodeError"):
+    with pytest.warns(
+        MeshcurvWarning,
+        match=r"3 records in .* cannot be read \(cut short or corrupt: "
+        r"a\.npz\.json: JSONDecodeError",
+    ):
         with pytest.raises(ConnectionError, match="no cluster in this test"):
             batch.run(tmp_path / "in", tmp_path / "out", scheduler=DEAD, output_format="npz")
     assert len(asked) == 1
@@ -366,14 +385,19 @@ def test_an_output_folder_that_cannot_be_written_fails_before_any_work(tmp_path)
     out_dir.mkdir()
     (out_dir / batch.RECORDS).write_text("")  # a file where the records folder goes
     start = time.monotonic()
-    with pytest.raises(MeshFileError, match=r"\.meshcurv-batch: cannot write the results there .*nothing was "
-                                            r"computed"):
+    with pytest.raises(
+        MeshFileError,
+        match=r"\.meshcurv-batch: cannot write the results there .*nothing was "
+        r"computed",
+    ):
         batch.run(tmp_path / "in", out_dir, scheduler=DEAD)  # no connection tried
     assert time.monotonic() - start < 2
 
 
-@pytest.mark.skipif(not hasattr(os, "geteuid") or (os.geteuid() == 0 and not shutil.which("setpriv")),
-                    reason="needs a user for whom permissions hold (not root) or setpriv")
+@pytest.mark.skipif(
+    not hasattr(os, "geteuid") or (os.geteuid() == 0 and not shutil.which("setpriv")),
+    reason="needs a user for whom permissions hold (not root) or setpriv",
+)
 def test_a_read_only_output_folder_is_one_line_and_exit_1_before_a_cluster(tmp_path):
     import tempfile
 
@@ -384,11 +408,19 @@ def test_a_read_only_output_folder_is_one_line_and_exit_1_before_a_cluster(tmp_p
         (base / "out").mkdir(mode=0o555)
         (base / "out").chmod(0o555)
         prefix = ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups"] if os.geteuid() == 0 else []
-        done = subprocess.run([*prefix, *MESHCURV, "batch", base / "in", "-o", base / "out"], capture_output=True,
-                              text=True, timeout=60, cwd=base)
+        done = subprocess.run(
+            [*prefix, *MESHCURV, "batch", base / "in", "-o", base / "out"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            cwd=base,
+        )
         assert done.returncode == 1, done.stderr
-        assert re.fullmatch(r"meshcurv: error: .*out: cannot write the results there \(Permission denied\); "
-                            r"nothing was computed", one_line(done.stderr))
+        assert re.fullmatch(
+            r"meshcurv: error: .*out: cannot write the results there \(Permission denied\); "
+            r"nothing was computed",
+            one_line(done.stderr),
+        )
     finally:
         (base / "out").chmod(0o755)
         shutil.rmtree(base)
@@ -423,8 +455,10 @@ def test_an_unusable_input_is_exit_1_and_one_line(tmp_path, capsys, command):
         assert line.startswith("meshcurv: error: ") and message in line
 
 
-@pytest.mark.skipif(not hasattr(os, "geteuid") or (os.geteuid() == 0 and not shutil.which("setpriv")),
-                    reason="needs a user for whom permissions hold (not root) or setpriv")
+@pytest.mark.skipif(
+    not hasattr(os, "geteuid") or (os.geteuid() == 0 and not shutil.which("setpriv")),
+    reason="needs a user for whom permissions hold (not root) or setpriv",
+)
 def test_an_input_without_read_permission_is_exit_1_and_one_line(tmp_path):
     import tempfile
 
@@ -444,13 +478,16 @@ def test_an_input_without_read_permission_is_exit_1_and_one_line(tmp_path):
         shutil.rmtree(base)
 
 
-@pytest.mark.parametrize("arguments, option", [
-    (["compute", "{mesh}", "-m", "matgeom", "--smoothing-steps", "99999999999999999999"], "--smoothing-steps"),
-    (["compute", "{mesh}", "-m", "matgeom", "--smoothing-steps", str(2**63)], "--smoothing-steps"),
-    (["compute", "{mesh}", "--radius", "1e400"], "--radius"),
-    (["compute", "{mesh}", "--radius", "inf"], "--radius"),
-    (["batch", "{mesh}", "-o", "{out}", "--timeout", "1e400"], "--timeout"),
-])
+@pytest.mark.parametrize(
+    "arguments, option",
+    [
+        (["compute", "{mesh}", "-m", "matgeom", "--smoothing-steps", "99999999999999999999"], "--smoothing-steps"),
+        (["compute", "{mesh}", "-m", "matgeom", "--smoothing-steps", str(2**63)], "--smoothing-steps"),
+        (["compute", "{mesh}", "--radius", "1e400"], "--radius"),
+        (["compute", "{mesh}", "--radius", "inf"], "--radius"),
+        (["batch", "{mesh}", "-o", "{out}", "--timeout", "1e400"], "--timeout"),
+    ],
+)
 def test_option_values_beyond_any_bound_are_one_usage_line(tmp_path, capsys, arguments, option):
     (mesh,) = write_meshes(tmp_path, ["m.obj"])
     argv = [item.format(mesh=mesh, out=tmp_path / "out") for item in arguments]
@@ -460,10 +497,16 @@ def test_option_values_beyond_any_bound_are_one_usage_line(tmp_path, capsys, arg
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.parametrize("arguments, option", [
-    (["plot", "{mesh}", "--pixels", "100000"], "--pixels"),  # was a 75 GiB z-buffer
-    (["batch", "{mesh}", "-o", "{out}", "--workers", "99999999999999999999"], "--workers"),  # was that many processes
-])
+@pytest.mark.parametrize(
+    "arguments, option",
+    [
+        (["plot", "{mesh}", "--pixels", "100000"], "--pixels"),  # was a 75 GiB z-buffer
+        (
+            ["batch", "{mesh}", "-o", "{out}", "--workers", "99999999999999999999"],
+            "--workers",
+        ),  # was that many processes
+    ],
+)
 def test_option_values_that_would_take_the_machine_are_refused_first(tmp_path, arguments, option):
     """In a process of its own with 8 GiB of address space and a timeout: a regression fails, it does not kill."""
     (mesh,) = write_meshes(tmp_path, ["m.obj"])
@@ -508,14 +551,15 @@ print(json.dumps(messages))
     done = run_bounded([sys.executable, "-c", code])
     assert done.returncode == 0, done.stderr[-2000:]
     messages = json.loads(done.stdout.splitlines()[-1])
-    assert re.fullmatch(r"InvalidOptionError: `pixels` must be an integer between 16 and 8192.*; got 100000",
-                        messages[0])
-    assert re.fullmatch(r"InvalidOptionError: `pixels` must be an integer between 16 and 8192.*; got \d+",
-                        messages[1])
-    assert messages[2] == ("InvalidOptionError: `pixels`=8192 needs about 6.0 GiB for each view; 2.0 GiB of memory "
-                           "is available: give fewer pixels")
-    assert re.fullmatch(r"InvalidOptionError: `dpi` must be an integer between 10 and 1200.*; got 100000",
-                        messages[3])
+    assert re.fullmatch(
+        r"InvalidOptionError: `pixels` must be an integer between 16 and 8192.*; got 100000", messages[0]
+    )
+    assert re.fullmatch(r"InvalidOptionError: `pixels` must be an integer between 16 and 8192.*; got \d+", messages[1])
+    assert messages[2] == (
+        "InvalidOptionError: `pixels`=8192 needs about 6.0 GiB for each view; 2.0 GiB of memory "
+        "is available: give fewer pixels"
+    )
+    assert re.fullmatch(r"InvalidOptionError: `dpi` must be an integer between 10 and 1200.*; got 100000", messages[3])
     assert not (tmp_path / "never.png").exists()
 
 
@@ -527,8 +571,12 @@ def test_two_commands_writing_the_same_file_do_not_both_succeed(tmp_path):
     sphere = shapes.icosphere(5)
     mesh = meshcurv.write_mesh(tmp_path / "sphere.obj", sphere.vertices, sphere.faces)
     output = tmp_path / "same.ply"
-    processes = [subprocess.Popen([*MESHCURV, "compute", mesh, "-o", output], stdout=subprocess.PIPE,
-                                  stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    processes = [
+        subprocess.Popen(
+            [*MESHCURV, "compute", mesh, "-o", output], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        for _ in range(2)
+    ]
     try:
         outcomes = [(process.returncode, process.communicate(timeout=120)[1]) for process in processes]
         outcomes = [(process.returncode, err) for process, (_, err) in zip(processes, outcomes)]
@@ -542,7 +590,6 @@ def test_two_commands_writing_the_same_file_do_not_both_succeed(tmp_path):
     refused = next(err for code, err in outcomes if code == 1)
     assert "same.ply: already exists" in refused
     assert meshcurv.read_mesh(output).vertices.shape == (len(sphere.vertices), 3)
-
 
 
 def test_a_picture_written_meanwhile_by_another_process_is_not_replaced(tmp_path):

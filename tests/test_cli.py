@@ -62,8 +62,13 @@ def test_methods_lists_the_registry_as_it_is_now(capsys, monkeypatch):
     monkeypatch.setattr(meshcurv.cli._app, "_default_method", lambda: other)
     _, out, _ = run(capsys, "methods")
     assert [line.split()[0] for line in out.splitlines() if line.endswith(" (default)")] == [other], out
-    extra = Estimator(name="made_up", function=None, options={"radius": None, "width": 2},
-                      summary="an estimator added later", stages=())
+    extra = Estimator(
+        name="made_up",
+        function=None,
+        options={"radius": None, "width": 2},
+        summary="an estimator added later",
+        stages=(),
+    )
     monkeypatch.setitem(ESTIMATORS, "made_up", extra)
     code, out, _ = run(capsys, "methods")
     assert "made_up" in out and "an estimator added later" in out
@@ -73,8 +78,12 @@ def test_methods_lists_the_registry_as_it_is_now(capsys, monkeypatch):
 def test_info_describes_a_torus(capsys, torus_file):
     code, out, err = run(capsys, "info", torus_file)
     assert code == 0 and err == ""
-    facts = dict(line.split(None, 1) if not line.startswith(("boundary", "mean", "euler", "bounding"))
-                 else (" ".join(line.split()[:2]), " ".join(line.split()[2:])) for line in out.splitlines())
+    facts = dict(
+        line.split(None, 1)
+        if not line.startswith(("boundary", "mean", "euler", "bounding"))
+        else (" ".join(line.split()[:2]), " ".join(line.split()[2:]))
+        for line in out.splitlines()
+    )
     assert facts["vertices"] == "3600" and facts["faces"] == "7200" and facts["genus"] == "1"
     assert facts["boundary loops"] == "0" and facts["euler characteristic"] == "0"
     assert facts["bounding box"].startswith("(-40, -40, -10) to (40, 40, 10)")
@@ -129,13 +138,16 @@ def test_compute_writes_the_fields(capsys, torus_file, tmp_path, extension):
     if extension == ".ply":
         pytest.importorskip("meshio")
     output = tmp_path / f"torus{extension}"
-    code, _, err = run(capsys, "compute", torus_file, "-o", output, "--fields", "k_min,normals", "--quality",
-                       "gaussian")
+    code, _, err = run(
+        capsys, "compute", torus_file, "-o", output, "--fields", "k_min,normals", "--quality", "gaussian"
+    )
     assert code == 0
-    hint = (" (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
-            if extension == ".ply" else "")
-    assert err.strip() == (f"meshcurv: wrote {output}: 3600 vertices, fields k_min, normals "
-                           f"(quality = gaussian){hint}")
+    hint = (
+        " (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
+        if extension == ".ply"
+        else ""
+    )
+    assert err.strip() == (f"meshcurv: wrote {output}: 3600 vertices, fields k_min, normals (quality = gaussian){hint}")
     vertices, faces = meshcurv.read_mesh(output)
     expected = meshcurv.principal_curvatures(vertices, faces)
     if extension == ".npz":
@@ -184,8 +196,10 @@ def test_compute_refuses_to_overwrite_unless_asked(capsys, torus_file, tmp_path)
     output.write_text("keep")
     code, _, err = run(capsys, "compute", torus_file, "-o", output)
     assert code == 1
-    assert one_error_line(err) == f"meshcurv: error: {output}: already exists; pass overwrite=True (--overwrite) " \
-                                  "to replace it"
+    assert (
+        one_error_line(err) == f"meshcurv: error: {output}: already exists; pass overwrite=True (--overwrite) "
+        "to replace it"
+    )
     assert output.read_text() == "keep"
     code, _, _ = run(capsys, "compute", torus_file, "-o", output, "--overwrite")
     assert code == 0 and meshcurv.read_mesh(output).vertices.shape == (3600, 3)
@@ -289,14 +303,28 @@ def test_progress_only_when_asked_or_on_a_terminal(capsys, torus_file, monkeypat
 def test_plot_writes_a_png_named_after_the_mesh(capsys, small_torus_file, tmp_path, monkeypatch):
     pytest.importorskip("matplotlib")
     monkeypatch.chdir(tmp_path)
-    code, _, err = run(capsys, "plot", small_torus_file, "--field", "gaussian", "--directions", "both",
-                       "--up", "z", "--pixels", "200")
+    code, _, err = run(
+        capsys, "plot", small_torus_file, "--field", "gaussian", "--directions", "both", "--up", "z", "--pixels", "200"
+    )
     assert code == 0 and err.strip() == "meshcurv: wrote small_gaussian.png"
     assert (tmp_path / "small_gaussian.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     code, _, err = run(capsys, "plot", small_torus_file, "--field", "gaussian")
     assert code == 1 and "small_gaussian.png: already exists" in one_error_line(err)
-    code, _, _ = run(capsys, "plot", small_torus_file, "-o", tmp_path / "two.png", "--view", "iso,top",
-                     "--view", "20,45", "--percentiles", "5,95", "--pixels", "120")
+    code, _, _ = run(
+        capsys,
+        "plot",
+        small_torus_file,
+        "-o",
+        tmp_path / "two.png",
+        "--view",
+        "iso,top",
+        "--view",
+        "20,45",
+        "--percentiles",
+        "5,95",
+        "--pixels",
+        "120",
+    )
     assert code == 0 and (tmp_path / "two.png").exists()
 
 
@@ -308,11 +336,25 @@ def png_size(path):
 def test_plot_size_colour_map_limits_and_up(capsys, small_torus_file, tmp_path):
     pytest.importorskip("matplotlib")
     # --pixels: the width of the PNG, exactly; --dpi: (3.3 n + 1.2) x 4.2 inches for n views
-    code, _, err = run(capsys, "plot", small_torus_file, "-o", tmp_path / "wide.png", "--view", "iso", "--pixels",
-                       "1200", "--up", "z")
+    code, _, err = run(
+        capsys, "plot", small_torus_file, "-o", tmp_path / "wide.png", "--view", "iso", "--pixels", "1200", "--up", "z"
+    )
     assert code == 0 and png_size(tmp_path / "wide.png")[0] == 1200
-    code, _, _ = run(capsys, "plot", small_torus_file, "-o", tmp_path / "dpi.png", "--view", "iso,top", "--dpi", "60",
-                     "--cmap", "cividis", "--limits", "-0.01,0.02")
+    code, _, _ = run(
+        capsys,
+        "plot",
+        small_torus_file,
+        "-o",
+        tmp_path / "dpi.png",
+        "--view",
+        "iso,top",
+        "--dpi",
+        "60",
+        "--cmap",
+        "cividis",
+        "--limits",
+        "-0.01,0.02",
+    )
     assert code == 0 and png_size(tmp_path / "dpi.png") == (round(7.8 * 60), round(4.2 * 60))
     # the default: 150 dpi; the up axis chosen from the mesh (a torus around z: 0.25 times as tall along z as y)
     code, _, err = run(capsys, "plot", small_torus_file, "-o", tmp_path / "default.png", "--view", "iso")
@@ -341,8 +383,7 @@ def test_plot_bad_options(capsys, small_torus_file, tmp_path):
 
 def test_plot_an_open_mesh(capsys, saddle_file, tmp_path):
     pytest.importorskip("matplotlib")
-    code, _, _ = run(capsys, "plot", saddle_file, "-o", tmp_path / "saddle.png", "--up", "z", "-q",
-                     "--pixels", "120")
+    code, _, _ = run(capsys, "plot", saddle_file, "-o", tmp_path / "saddle.png", "--up", "z", "-q", "--pixels", "120")
     assert code == 0 and (tmp_path / "saddle.png").exists()
 
 
@@ -369,8 +410,10 @@ def test_missing_click_names_the_extra(capsys, monkeypatch):
     monkeypatch.delattr(meshcurv.cli, "_app")
     monkeypatch.setattr(builtins, "__import__", no_click)
     code, _, err = run(capsys, "methods")
-    assert code == 1 and one_error_line(err) == ("meshcurv: error: the command line needs click (a dependency of "
-                                                 "meshcurv that cannot be imported): pip install click")
+    assert code == 1 and one_error_line(err) == (
+        "meshcurv: error: the command line needs click (a dependency of "
+        "meshcurv that cannot be imported): pip install click"
+    )
 
 
 # ---------------------------------------------------------------- real processes
@@ -382,11 +425,11 @@ def test_installed_entry_point_runs_as_a_process(torus_file):
         pytest.skip("meshcurv is not installed as a script in this environment")
     done = subprocess.run([script, "info", torus_file], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "genus                  1" in done.stdout
-    done = subprocess.run([script, "compute", torus_file.with_name("none.obj")], capture_output=True, text=True,
-                          timeout=120)
+    done = subprocess.run(
+        [script, "compute", torus_file.with_name("none.obj")], capture_output=True, text=True, timeout=120
+    )
     assert done.returncode == 1 and done.stderr.strip().endswith("none.obj: no such file")
-    done = subprocess.run([sys.executable, "-m", "meshcurv", "--version"], capture_output=True, text=True,
-                          timeout=120)
+    done = subprocess.run([sys.executable, "-m", "meshcurv", "--version"], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and meshcurv.__version__ in done.stdout
 
 
@@ -397,7 +440,8 @@ def test_a_command_run_without_the_session_says_how_to_run_it():
     result = click_testing.CliRunner().invoke(group, ["methods"])  # no obj: not through meshcurv.cli.main
     assert isinstance(result.exception, RuntimeError)
     assert "no meshcurv Session in the click context: run the commands through meshcurv.cli.main" in str(
-        result.exception)
+        result.exception
+    )
 
 
 def test_a_quad_mesh_is_triangulated_once_and_said_once(capsys, tmp_path):
@@ -405,8 +449,9 @@ def test_a_quad_mesh_is_triangulated_once_and_said_once(capsys, tmp_path):
     corners = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
     quads = [(1, 2, 4, 3), (5, 6, 8, 7), (1, 5, 7, 3), (2, 4, 8, 6), (1, 2, 6, 5), (3, 7, 8, 4)]
     path = tmp_path / "cube.obj"
-    path.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "".join(f"f {a} {b} {c} {d}\n"
-                                                                                 for a, b, c, d in quads))
+    path.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "".join(f"f {a} {b} {c} {d}\n" for a, b, c, d in quads)
+    )
     code, out, err = run(capsys, "compute", path, "-m", "normal_cycle")
     assert code == 0 and "8 vertices, 6 faces" in out
     assert err.count("forces triangulation") == 1, err

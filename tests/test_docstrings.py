@@ -4,8 +4,9 @@ The public API is every name in the ``__all__`` of :mod:`meshcurv` and of
 its public modules (no part of the dotted name starting with ``_``), and the
 public methods and properties of those classes. A violation fails the test
 unless it is listed in ``tests/numpydoc_baseline.txt`` (the violations
-found when the check was turned on, to be fixed and removed from the list);
-a listed violation that is gone fails the test too, so that the list only
+found when the check was turned on, ``<name> <code>`` per line, to be fixed
+and removed from the list); a listed violation that is gone fails the test
+too (unless the object is not in the API at all), so that the list only
 shrinks.
 
 One rule is relaxed for classes: a dataclass documents its fields under
@@ -57,9 +58,9 @@ def public_objects() -> dict[str, object]:
             found[qualified] = value
             if inspect.isclass(value):
                 for attribute, member in vars(value).items():
-                    if not attribute.startswith("_") and (inspect.isfunction(member)
-                                                          or isinstance(member, (property, classmethod,
-                                                                                 staticmethod))):
+                    if not attribute.startswith("_") and (
+                        inspect.isfunction(member) or isinstance(member, (property, classmethod, staticmethod))
+                    ):
                         found[f"{qualified}.{attribute}"] = member
     excluded = [re.compile(pattern) for pattern in CONFIG.get("exclude", [])]
     return {name: value for name, value in found.items() if not any(p.search(name) for p in excluded)}
@@ -106,10 +107,11 @@ def test_the_configured_checks_include_the_contract_ones():
 def test_public_api_docstrings_pass_numpydoc_validation():
     objects = public_objects()
     assert "meshcurv.principal_curvatures" in objects and "meshcurv.batch.run" in objects  # the walk sees the API
-    found = {line for name, value in objects.items() for line in violations(name, value)}
-    known = baseline()
-    new = sorted(found - known)
-    fixed = sorted(known - found)
+    found = {" ".join(line.split()[:2]): line for name, value in objects.items() for line in violations(name, value)}
+    known = baseline()  # "<name> <code>": the message (which parameters) may change with the signature
+    new = sorted(found[key] for key in set(found) - known)
+    # a listed object that is not in the API (renamed, removed, or not yet committed) is not counted
+    fixed = sorted(key for key in known - set(found) if key.split()[0] in objects)
     assert not new, "numpydoc violations (fix the docstring):\n" + "\n".join(new)
     assert not fixed, f"fixed, now remove these lines from {BASELINE.name}:\n" + "\n".join(fixed)
 

@@ -31,8 +31,7 @@ MESHES = {
     "ellipsoid": shapes.ellipsoid(subdivisions=4),
     "sphere": shapes.icosphere(4, radius=3.0),
 }
-SETTINGS = settings(max_examples=6, deadline=None, derandomize=True,
-                    suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(max_examples=6, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 
 
 def curvatures(vertices, faces, method, **options):
@@ -58,8 +57,9 @@ def assert_same(a, b, index=slice(None), scale=1.0, keep=slice(None)):
     np.testing.assert_array_equal(a.valid[keep], b.valid[index][keep])
     size = np.nanmax(np.abs(b.k_max)) + np.nanmax(np.abs(b.k_min))
     for name in ("k_min", "k_max", "mean"):
-        np.testing.assert_allclose(getattr(a, name)[keep] * scale, getattr(b, name)[index][keep], rtol=1e-6,
-                                   atol=1e-7 * size, err_msg=name)
+        np.testing.assert_allclose(
+            getattr(a, name)[keep] * scale, getattr(b, name)[index][keep], rtol=1e-6, atol=1e-7 * size, err_msg=name
+        )
 
 
 @functools.cache
@@ -102,8 +102,12 @@ def poised_vertices(name: str, method: str) -> np.ndarray:
 
 @pytest.mark.parametrize("method", METHODS)
 @SETTINGS
-@given(name=st.sampled_from(sorted(MESHES)), seed=st.integers(0, 2**32 - 1),
-       log_scale=st.floats(-6, 6), shift=st.floats(-1e3, 1e3))
+@given(
+    name=st.sampled_from(sorted(MESHES)),
+    seed=st.integers(0, 2**32 - 1),
+    log_scale=st.floats(-6, 6),
+    shift=st.floats(-1e3, 1e3),
+)
 def test_rigid_motion_and_scale(method, name, seed, log_scale, shift):
     mesh = MESHES[name]
     s = 10.0**log_scale
@@ -162,15 +166,27 @@ def test_orientation_is_restored_from_any_reversal(seed, fraction):
 # -- random arrays only ever raise the documented errors -----------------------
 
 DOCUMENTED = (InvalidMeshError, InvalidOptionError)
-DTYPES = st.one_of(hnp.integer_dtypes(), hnp.unsigned_integer_dtypes(), hnp.floating_dtypes(),
-                   hnp.complex_number_dtypes(), hnp.boolean_dtypes(), hnp.datetime64_dtypes(),
-                   hnp.byte_string_dtypes(max_len=3), hnp.unicode_string_dtypes(max_len=3))
+DTYPES = st.one_of(
+    hnp.integer_dtypes(),
+    hnp.unsigned_integer_dtypes(),
+    hnp.floating_dtypes(),
+    hnp.complex_number_dtypes(),
+    hnp.boolean_dtypes(),
+    hnp.datetime64_dtypes(),
+    hnp.byte_string_dtypes(max_len=3),
+    hnp.unicode_string_dtypes(max_len=3),
+)
 ARRAYS = hnp.arrays(DTYPES, hnp.array_shapes(min_dims=0, max_dims=3, min_side=0, max_side=5))
-SMALL_INTS = hnp.arrays(st.sampled_from([np.int64, np.int32, np.int8, np.float64]),
-                        st.tuples(st.integers(0, 6), st.integers(0, 5)),
-                        elements=st.integers(-3, 8))
-NESTED = st.recursive(st.one_of(st.integers(-3, 8), st.floats(allow_nan=True), st.text(max_size=2), st.none()),
-                      lambda inner: st.lists(inner, max_size=4), max_leaves=20)
+SMALL_INTS = hnp.arrays(
+    st.sampled_from([np.int64, np.int32, np.int8, np.float64]),
+    st.tuples(st.integers(0, 6), st.integers(0, 5)),
+    elements=st.integers(-3, 8),
+)
+NESTED = st.recursive(
+    st.one_of(st.integers(-3, 8), st.floats(allow_nan=True), st.text(max_size=2), st.none()),
+    lambda inner: st.lists(inner, max_size=4),
+    max_leaves=20,
+)
 
 
 def call_quietly(function, *args, **kwargs):
@@ -192,8 +208,9 @@ METHOD_PARAMS = METHODS
 
 @pytest.mark.parametrize("method", METHOD_PARAMS)
 @settings(max_examples=40, deadline=None, derandomize=True)
-@given(vertices=st.one_of(ARRAYS, NESTED, st.just(VERTICES)),
-       faces=st.one_of(ARRAYS, SMALL_INTS, NESTED, st.just(TETRA)))
+@given(
+    vertices=st.one_of(ARRAYS, NESTED, st.just(VERTICES)), faces=st.one_of(ARRAYS, SMALL_INTS, NESTED, st.just(TETRA))
+)
 def test_random_arrays_raise_only_documented_errors(method, vertices, faces):
     call_quietly(meshcurv.principal_curvatures, vertices, faces, method=method)
     call_quietly(orient_faces, vertices, faces)

@@ -37,7 +37,6 @@ result file that exists is complete, and a run that is interrupted or whose
 worker dies leaves no partial file (see :func:`run`).
 """
 
-
 # the names of meshcurv.batch before it became a package, all importable from here; the settings are
 # read where they are defined (to change CHUNK_BYTES for a test, patch meshcurv.batch._run.CHUNK_BYTES)
 from ._driver import MAX_WORKERS as MAX_WORKERS
@@ -59,5 +58,17 @@ from ._run import CHUNKS_PER_WORKER as CHUNKS_PER_WORKER
 from ._run import DEFAULT_TIMEOUT, run
 from ._summary import COLUMNS
 
-__all__ = ["run", "local_cluster", "process_mesh", "process_meshes", "expand_inputs", "fingerprint", "COLUMNS",
-           "SUMMARY_FIELDS", "OUTPUT_FORMATS", "RECORDS", "DEFAULT_TIMEOUT", "NoWorkerError"]
+__all__ = [
+    "run",
+    "local_cluster",
+    "process_mesh",
+    "process_meshes",
+    "expand_inputs",
+    "fingerprint",
+    "COLUMNS",
+    "SUMMARY_FIELDS",
+    "OUTPUT_FORMATS",
+    "RECORDS",
+    "DEFAULT_TIMEOUT",
+    "NoWorkerError",
+]

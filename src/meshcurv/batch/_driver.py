@@ -76,8 +76,7 @@ def _dependencies():
         import pyarrow  # noqa: F401 (the Parquet writer of pandas)
     except ImportError as exc:
         raise MissingDependencyError(
-            f"meshcurv.batch needs {exc.name or 'dask.distributed, pandas and pyarrow'}: "
-            "pip install 'meshcurv[batch]'"
+            f"meshcurv.batch needs {exc.name or 'dask.distributed, pandas and pyarrow'}: pip install 'meshcurv[batch]'"
         ) from None
     return distributed, pandas
 
@@ -142,13 +141,21 @@ def local_cluster(*, workers: int | None = None, dashboard: bool = True):
     n_workers = CPU_COUNT if workers is None else check_int_option(workers, "workers", minimum=1, maximum=MAX_WORKERS)
     saved = dict(os.environ)
     try:
-        with dask.config.set(WORKER_CONFIG), \
-                distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                         host="127.0.0.1", dashboard_address="127.0.0.1:0",
-                                         scheduler_kwargs={"dashboard": dashboard},
-                                         env=dict(WORKER_ENVIRONMENT), preload=["meshcurv._batch_worker"],
-                                         silence_logs=logging.ERROR) as cluster, \
-                distributed.Client(cluster) as client:
+        with (
+            dask.config.set(WORKER_CONFIG),
+            distributed.LocalCluster(
+                n_workers=n_workers,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address="127.0.0.1:0",
+                scheduler_kwargs={"dashboard": dashboard},
+                env=dict(WORKER_ENVIRONMENT),
+                preload=["meshcurv._batch_worker"],
+                silence_logs=logging.ERROR,
+            ) as cluster,
+            distributed.Client(cluster) as client,
+        ):
             yield client
     finally:
         for name in set(os.environ) - set(saved):
@@ -157,8 +164,14 @@ def local_cluster(*, workers: int | None = None, dashboard: bool = True):
 
 
 @contextlib.contextmanager
-def cluster(*, client=None, scheduler: str | None = None, workers: int | None = None, dashboard: bool = True,
-            config: dict | None = None):
+def cluster(
+    *,
+    client=None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    dashboard: bool = True,
+    config: dict | None = None,
+):
     """The cluster to run on, for the duration of the block.
 
     Parameters
@@ -202,9 +215,16 @@ def _split_any(outcome: BaseException) -> bool:
     return True
 
 
-def run_tasks(client, groups: Iterable[list], submit: Callable[[list[list]], list], *, owned: bool,
-              limit: int | None = None, split: Callable[[BaseException], bool] = _split_any,
-              items: str = "items") -> Generator[tuple[list, Any], None, None]:
+def run_tasks(
+    client,
+    groups: Iterable[list],
+    submit: Callable[[list[list]], list],
+    *,
+    owned: bool,
+    limit: int | None = None,
+    split: Callable[[BaseException], bool] = _split_any,
+    items: str = "items",
+) -> Generator[tuple[list, Any], None, None]:
     """Run each group of items as one task on the cluster of ``client``; yield each group as its task ends.
 
     Parameters
@@ -270,8 +290,12 @@ def run_tasks(client, groups: Iterable[list], submit: Callable[[list[list]], lis
                 outcome = _outcome(future)
                 future.release()
                 if isinstance(outcome, BaseException) and len(group) > 1 and split(outcome):
-                    logger.info("a task of %d %s ended with %s; running them one by one", len(group), items,
-                                type(outcome).__name__)
+                    logger.info(
+                        "a task of %d %s ended with %s; running them one by one",
+                        len(group),
+                        items,
+                        type(outcome).__name__,
+                    )
                     queue.extendleft([item] for item in reversed(group))
                     continue
                 yield group, outcome
@@ -306,8 +330,7 @@ class _WorkerWatch:
         now = time.monotonic()
         if self.since is None:
             self.since = now
-            logger.warning("the cluster has no worker (they died?); waiting up to %s for one",
-                           _seconds(self.patience))
+            logger.warning("the cluster has no worker (they died?); waiting up to %s for one", _seconds(self.patience))
         elif now - self.since >= self.patience:
             raise NoWorkerError(
                 f"the cluster has had no worker for {_seconds(self.patience)}: the workers died and none could be "

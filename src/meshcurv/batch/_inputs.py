@@ -155,8 +155,10 @@ def expand_inputs(inputs, *, exclude=None) -> list[pathlib.Path]:
     if not found:
         listed = ", ".join(os.fspath(item) for item in inputs) or "(none)"
         if left_out:
-            raise MeshFileError(f"no mesh file found in {listed} but in the output folder {os.fspath(exclude)} "
-                                f"({len(left_out)} files: results are never inputs)")
+            raise MeshFileError(
+                f"no mesh file found in {listed} but in the output folder {os.fspath(exclude)} "
+                f"({len(left_out)} files: results are never inputs)"
+            )
         raise MeshFileError(f"no mesh file found in {listed} (mesh files end in {', '.join(sorted(extensions))})")
     return sorted(found.values(), key=os.fspath)
 

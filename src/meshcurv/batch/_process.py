@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
@@ -64,9 +65,18 @@ def _statistics(result) -> dict:
     return row
 
 
-def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smoothing_steps: int | None = None,
-                 radius: float | None = None, orient: str | None = None, timeout: float | None = None,
-                 run_id: str | None = None) -> dict:
+def process_mesh(
+    source,
+    output,
+    record,
+    *,
+    method: str = DEFAULT_METHOD,
+    smoothing_steps: int | None = None,
+    radius: float | None = None,
+    orient: str | None = None,
+    timeout: float | None = None,
+    run_id: str | None = None,
+) -> dict:
     """Compute the curvatures of one mesh file, write the result and its record, return its summary row.
 
     The task :func:`run` sends to the workers; it never raises for a bad mesh.
@@ -115,13 +125,17 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
     attempt = _attempt_path(record)
     deaths, error = _previous_attempt(attempt, run_id, timeout)
     facts = None
-    try:
+    with contextlib.suppress(OSError):  # read_mesh says what is wrong with it
         facts = fingerprint(source)
-    except OSError:
-        pass  # read_mesh says what is wrong with it
     if error is not None:
-        row = {"status": "failed", "error": error, "warnings": "", "method": method, "output": "",
-               "seconds": timeout if error.startswith("TimeoutError") else np.nan}
+        row = {
+            "status": "failed",
+            "error": error,
+            "warnings": "",
+            "method": method,
+            "output": "",
+            "seconds": timeout if error.startswith("TimeoutError") else np.nan,
+        }
         logger.info("%s failed: %s", source, error)
         _record_failure(record, row, stored_options, facts, timeout)
         attempt.unlink(missing_ok=True)
@@ -137,8 +151,12 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
             if is_point_cloud(source):  # a file without faces: the point-cloud estimators, their default
                 vertices, normals = read_points(source)
                 faces = None
-                result = point_cloud_curvatures(vertices, normals=normals, radius=options.get("radius"),
-                                                method=method if method in POINT_CLOUD_METHODS else None)
+                result = point_cloud_curvatures(
+                    vertices,
+                    normals=normals,
+                    radius=options.get("radius"),
+                    method=method if method in POINT_CLOUD_METHODS else None,
+                )
                 row["method"] = result.method
             else:
                 vertices, faces = read_mesh(source)
@@ -148,12 +166,18 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
             row.update(n_vertices=vertices.shape[0], n_faces=0, area=np.nan, volume=np.nan)
         else:
             row.update(
-                n_vertices=facts_of.n_vertices, n_faces=facts_of.n_faces, area=facts_of.area,
+                n_vertices=facts_of.n_vertices,
+                n_faces=facts_of.n_faces,
+                area=facts_of.area,
                 volume=np.nan if facts_of.volume is None else facts_of.volume,
-                euler_characteristic=facts_of.euler_characteristic, n_components=facts_of.n_components,
-                n_boundary_loops=facts_of.n_boundary_loops)
-        row.update(n_invalid=int((~result.valid).sum()),
-                   warnings="; ".join(dict.fromkeys(str(warning.message) for warning in caught)))
+                euler_characteristic=facts_of.euler_characteristic,
+                n_components=facts_of.n_components,
+                n_boundary_loops=facts_of.n_boundary_loops,
+            )
+        row.update(
+            n_invalid=int((~result.valid).sum()),
+            warnings="; ".join(dict.fromkeys(str(warning.message) for warning in caught)),
+        )
         row.update(_statistics(result))
         output.parent.mkdir(parents=True, exist_ok=True)
         with atomic_output(output) as temporary:
@@ -168,8 +192,14 @@ def process_mesh(source, output, record, *, method: str = DEFAULT_METHOD, smooth
             row["seconds"] = time.perf_counter() - start
             _write_record(record, {"row": row, "options": stored_options, "input": facts})
     except Exception as exc:  # one bad mesh never sinks the batch: its row says what went wrong
-        row = {"status": "failed", "error": f"{type(exc).__name__}: {exc}", "warnings": "", "method": method,
-               "output": "", "seconds": time.perf_counter() - start}
+        row = {
+            "status": "failed",
+            "error": f"{type(exc).__name__}: {exc}",
+            "warnings": "",
+            "method": method,
+            "output": "",
+            "seconds": time.perf_counter() - start,
+        }
         logger.info("%s failed: %s", source, row["error"])
         _record_failure(record, row, stored_options, facts, timeout)
     attempt.unlink(missing_ok=True)
@@ -193,5 +223,7 @@ def process_meshes(sources, outputs, records, **options) -> list[dict]:
     list of dict
         The summary row of each mesh (:func:`process_mesh`), in order.
     """
-    return [process_mesh(source, output, record, **options)
-            for source, output, record in zip(sources, outputs, records, strict=True)]
+    return [
+        process_mesh(source, output, record, **options)
+        for source, output, record in zip(sources, outputs, records, strict=True)
+    ]

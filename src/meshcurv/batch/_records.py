@@ -50,8 +50,7 @@ def _stale_temporaries(targets) -> list[pathlib.Path]:
             continue
         for target in names:
             prefixes = (f".{target.name}.", f"..{target.name}.")
-            found.extend(folder / name for name in hidden
-                         if name.startswith(prefixes) and name.endswith(target.suffix))
+            found.extend(folder / name for name in hidden if name.startswith(prefixes) and name.endswith(target.suffix))
     return sorted(set(found))
 
 
@@ -128,8 +127,11 @@ def _read_record(path: pathlib.Path) -> dict | None:
         return None
     except (OSError, ValueError) as exc:  # UnicodeDecodeError and JSONDecodeError are ValueErrors
         raise _Unreadable(f"{type(exc).__name__}: {exc}") from None
-    if not (isinstance(record, dict) and isinstance(record.get("row"), dict)
-            and isinstance(record["row"].get("status"), str)):
+    if not (
+        isinstance(record, dict)
+        and isinstance(record.get("row"), dict)
+        and isinstance(record["row"].get("status"), str)
+    ):
         raise _Unreadable("not a meshcurv batch record")
     return record
 
@@ -209,8 +211,9 @@ def _previous_attempt(attempt: pathlib.Path, run_id: str | None, timeout: float 
     if timeout is not None and time.time() >= float(noted.get("deadline", np.inf)):
         return deaths, f"TimeoutError: timed out after {_seconds(timeout)} (the time limit of a mesh: --timeout)"
     if deaths >= MAX_WORKER_DEATHS:
-        return deaths, (f"WorkerDied: the worker computing this mesh died {deaths} times (killed by the system: "
-                        "out of memory?)")
+        return deaths, (
+            f"WorkerDied: the worker computing this mesh died {deaths} times (killed by the system: out of memory?)"
+        )
     return deaths, None
 
 

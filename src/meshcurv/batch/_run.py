@@ -42,11 +42,23 @@ CHUNK_BYTES = 4 * 2**20
 CHUNKS_PER_WORKER = 8
 
 
-def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | None = None,
-        radius: float | None = None, orient: str | None = None, output_format: str = "ply", client=None,
-        scheduler: str | None = None, workers: int | None = None, overwrite: bool = False,
-        timeout: float | None = DEFAULT_TIMEOUT, retry_failed: bool = False,
-        progress: Callable[[int, int, int], None] | None = None):
+def run(
+    paths,
+    out_dir,
+    *,
+    method: str = DEFAULT_METHOD,
+    smoothing_steps: int | None = None,
+    radius: float | None = None,
+    orient: str | None = None,
+    output_format: str = "ply",
+    client=None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    overwrite: bool = False,
+    timeout: float | None = DEFAULT_TIMEOUT,
+    retry_failed: bool = False,
+    progress: Callable[[int, int, int], None] | None = None,
+):
     """Compute the curvatures of many mesh files on a Dask cluster and summarise them.
 
     Parameters
@@ -181,7 +193,8 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
     if workers is not None:
         if client is not None or scheduler is not None:
             raise InvalidOptionError(
-                "`workers` sizes the local cluster; it cannot be used with `client` or `scheduler`")
+                "`workers` sizes the local cluster; it cannot be used with `client` or `scheduler`"
+            )
         workers = check_int_option(workers, "workers", minimum=1, maximum=MAX_WORKERS)
     if timeout is not None:
         timeout = check_positive_float(timeout, "timeout")
@@ -196,16 +209,20 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
     todo: list[int] = []
     damaged: list[tuple[pathlib.Path, str]] = []
     for index, job in enumerate(jobs):
-        stored = _completed(job, options, overwrite=overwrite, retry_failed=retry_failed, timeout=timeout,
-                            damaged=damaged)
+        stored = _completed(
+            job, options, overwrite=overwrite, retry_failed=retry_failed, timeout=timeout, damaged=damaged
+        )
         if stored is None:
             todo.append(index)
         else:
             rows[index] = stored
     if damaged:
-        warnings.warn(f"{len(damaged)} records in {out_dir / RECORDS} cannot be read (cut short or corrupt: "
-                      f"{damaged[0][0].name}: {damaged[0][1]}); their meshes are computed again",
-                      MeshcurvWarning, stacklevel=2)
+        warnings.warn(
+            f"{len(damaged)} records in {out_dir / RECORDS} cannot be read (cut short or corrupt: "
+            f"{damaged[0][0].name}: {damaged[0][1]}); their meshes are computed again",
+            MeshcurvWarning,
+            stacklevel=2,
+        )
     failed = sum(row["status"] == "failed" for row in rows.values())
     if progress is not None:
         progress(len(rows), len(jobs), failed)
@@ -220,9 +237,14 @@ def run(paths, out_dir, *, method: str = DEFAULT_METHOD, smoothing_steps: int | 
                 chunks = _chunks(jobs, todo, workers=_worker_count(active))
                 logger.info("%d meshes in %d tasks", len(todo), len(chunks))
                 # a task lost with its workers is split: a mesh that kills its workers then fails alone
-                tasks = run_tasks(active, chunks, functools.partial(_submit, active, jobs, options=task_options),
-                                  owned=owned, split=lambda outcome: isinstance(outcome, distributed.KilledWorker),
-                                  items="meshes")
+                tasks = run_tasks(
+                    active,
+                    chunks,
+                    functools.partial(_submit, active, jobs, options=task_options),
+                    owned=owned,
+                    split=lambda outcome: isinstance(outcome, distributed.KilledWorker),
+                    items="meshes",
+                )
                 with contextlib.closing(tasks):
                     for chunk, outcome in tasks:
                         for index, row in zip(chunk, _rows(outcome, chunk, distributed), strict=True):
@@ -257,8 +279,9 @@ def _check_writable(out_dir: pathlib.Path) -> None:
             os.close(handle)
             os.unlink(probe)
         except OSError as exc:
-            raise MeshFileError(f"{folder}: cannot write the results there ({exc.strerror or exc}); "
-                                "nothing was computed") from None
+            raise MeshFileError(
+                f"{folder}: cannot write the results there ({exc.strerror or exc}); nothing was computed"
+            ) from None
 
 
 def _record_lost(job: _Job, row: dict, options: dict, timeout) -> None:
@@ -270,8 +293,15 @@ def _record_lost(job: _Job, row: dict, options: dict, timeout) -> None:
     _record_failure(pathlib.Path(job.record), row, options, facts, timeout)
 
 
-def _completed(job: _Job, options: dict, *, overwrite: bool, retry_failed: bool, timeout: float | None,
-               damaged: list[tuple[pathlib.Path, str]]) -> dict | None:
+def _completed(
+    job: _Job,
+    options: dict,
+    *,
+    overwrite: bool,
+    retry_failed: bool,
+    timeout: float | None,
+    damaged: list[tuple[pathlib.Path, str]],
+) -> dict | None:
     """The recorded row of a mesh that needs no work (status as recorded), or None when it is to be computed.
 
     A record that cannot be read is added to ``damaged`` (the mesh is computed
@@ -357,9 +387,14 @@ def _chunks(jobs: list[_Job], indices: list[int], *, workers: int) -> list[list[
 
 def _submit(client, jobs: list[_Job], chunks: list[list[int]], *, options: dict) -> list:
     """Send each chunk to the cluster as one task (:func:`process_meshes`); their futures, in order."""
-    return client.map(process_meshes, [[jobs[index].source for index in chunk] for chunk in chunks],
-                      [[jobs[index].output for index in chunk] for chunk in chunks],
-                      [[jobs[index].record for index in chunk] for chunk in chunks], pure=False, **options)
+    return client.map(
+        process_meshes,
+        [[jobs[index].source for index in chunk] for chunk in chunks],
+        [[jobs[index].output for index in chunk] for chunk in chunks],
+        [[jobs[index].record for index in chunk] for chunk in chunks],
+        pure=False,
+        **options,
+    )
 
 
 def _rows(outcome, chunk: list[int], distributed) -> list[dict]:
@@ -367,8 +402,7 @@ def _rows(outcome, chunk: list[int], distributed) -> list[dict]:
     if not isinstance(outcome, BaseException):
         return outcome
     if isinstance(outcome, distributed.KilledWorker):
-        error = (f"KilledWorker: every worker that ran this mesh died (killed by the system: out of memory?) "
-                 f"({outcome})")
+        error = f"KilledWorker: every worker that ran this mesh died (killed by the system: out of memory?) ({outcome})"
     else:
         error = f"{type(outcome).__name__}: {outcome}"
     return [{"status": "failed", "error": error, "warnings": "", "output": ""} for _ in chunk]

@@ -35,8 +35,11 @@ COLUMNS = {
 }
 
 #: Columns added since the first records: a record without them is computed again.
-_ADDED_COLUMNS = (*(f"{field}_area_{statistic}" for field in SUMMARY_FIELDS for statistic in AREA_STATISTICS),
-                  *INTEGRAL_COLUMNS)
+_ADDED_COLUMNS = (
+    *(f"{field}_area_{statistic}" for field in SUMMARY_FIELDS for statistic in AREA_STATISTICS),
+    *INTEGRAL_COLUMNS,
+)
+
 
 def _summary(pandas, jobs: list[_Job], rows: dict[int, dict]):
     records = [{**rows[index], "path": os.fspath(job.path)} for index, job in enumerate(jobs)]
