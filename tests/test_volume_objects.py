@@ -113,3 +113,25 @@ def test_cli_objects_file_of_an_image_without_surfaces_is_an_empty_dataset(tmp_p
     with pytest.raises(MeshFileError, match="dot_objects.vtp: the PolyData has no points or no polygons"):
         read_vtp(tmp_path / "dot_objects.vtp")
     assert read_vtp_point_data(tmp_path / "dot_objects.vtp") == {}
+
+
+def test_vtk_reads_the_pieces_as_one_dataset(tmp_path):
+    vtk = pytest.importorskip("vtk")
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    first = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), np.array([[0, 1, 2]]))
+    second = (np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1], [1, 1, 1.0]]), np.array([[0, 1, 2], [1, 3, 2]]))
+    with open(tmp_path / "two.vtp", "wb") as handle, PieceWriter(handle) as writer:
+        for number, (vertices, faces) in enumerate((first, second), start=1):
+            writer.add(vertices, faces, {"label": np.full(len(vertices), number, dtype=np.uint64),
+                                         "normals": np.tile([0, 0, 1.0], (len(vertices), 1))},
+                       {"label": np.full(len(faces), number, dtype=np.uint64)})
+    reader = vtk.vtkXMLPolyDataReader()  # what ParaView opens a .vtp with
+    reader.SetFileName(str(tmp_path / "two.vtp"))
+    reader.Update()
+    data = reader.GetOutput()
+    assert (data.GetNumberOfPoints(), data.GetNumberOfCells()) == (7, 3)
+    assert vtk_to_numpy(data.GetPointData().GetArray("label")).tolist() == [1, 1, 1, 2, 2, 2, 2]
+    assert vtk_to_numpy(data.GetCellData().GetArray("label")).tolist() == [1, 2, 2]
+    assert vtk_to_numpy(data.GetPolys().GetConnectivityArray()).tolist() == [0, 1, 2, 3, 4, 5, 4, 6, 5]
+    assert data.GetPointData().GetNormals() is not None
