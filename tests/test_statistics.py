@@ -119,8 +119,8 @@ def test_label_torus_matches_the_analytic_values(spacing, major, minor):
 
 
 def test_folded_gauss_image_is_flagged():
-    # a torus whose tube is 5 voxels across the coarse axis, at an offset where the fitted normals wobble along
-    # its bottom terrace (benchmarks/label_statistics.py --repeats 12 --seed 1): ICIp = ICIn = 1.30, not 1
+    # a torus of tube radius 5 voxels along the coarse axis, at an offset where the fitted normals wobble along
+    # its bottom terrace (found by a sweep of 12 random placements): ICIp = ICIn = 1.30, not 1
     spacing = (2.0, 1.0, 1.0)
     image = torus_image(20.0, 10.0, spacing, offset=(0.99228238, -0.25678454, -0.24313253))
     row, surface = one_row(image, spacing)

@@ -51,9 +51,9 @@ pointwise H averaged over its corners is positive, a vertex's share of the
 Gauss image when the pointwise K there is (the sign of the measure itself
 where the estimate is NaN). The pointwise estimates are averages over balls of
 a few edge lengths, whose sign is that of the surface; the sign of each face's
-own measure follows the voxel staircase. Measured on label images with voxels
-0.7 x 0.5 x 0.4 and 2 x 1 x 1 (``benchmarks/label_statistics.py``): a sphere
-gets ``ICIn = 0`` and ``int H- dA = 0`` exactly, where the sign of each face's
+own measure follows the voxel staircase. Measured on label images of spheres
+of radius 10 and 12 voxels and tori of radii 5 and 2, 12 and 5 (voxels 0.7 x
+0.5 x 0.4 and 2 x 1 x 1): a sphere gets ``ICIn = 0`` and ``int H- dA = 0`` exactly, where the sign of each face's
 own measure gives ``ICIn = 0.008`` and ``int H- = -0.25%`` of ``int H``; a torus
 ``ICIp = ICIn = 1.007`` and ``1.013``, against ``1.029`` and ``1.037`` with the
 faces' own signs. ``positive + negative = natural`` exactly, and
@@ -61,9 +61,9 @@ faces' own signs. ``positive + negative = natural`` exactly, and
 
 Where the fitted normals wobble at a scale below the estimator's radius, the
 Gauss image folds over itself: its folds cancel in ``int K dA`` but add to
-both ``int K+`` and ``int |K-|``. This was seen on tori whose tube is 5 voxels
-across the coarse axis of 2 x 1 x 1 voxels, at 2 of 24 offsets (``ICIp = ICIn
-= 1.30`` and ``1.81``; the pointwise K is off there too). When
+both ``int K+`` and ``int |K-|``. This was seen on tori of tube radius 5 and
+2.5 voxels along the coarse axis of 2 x 1 x 1 voxels, at one placement of 12
+each (``ICIp = ICIn = 1.30`` and ``1.81``; the pointwise K is off there too). When
 ``int |K| dA`` from the Gauss image exceeds the sum of the pointwise
 ``|K| A_i`` by more than :data:`FOLD_TOLERANCE`, a note says so (the
 ``warnings`` column of the label table; a warning here).
@@ -72,8 +72,8 @@ across the coarse axis of 2 x 1 x 1 voxels, at 2 of 24 offsets (``ICIp = ICIn
 have no additive measure: they are sums of the pointwise ``k_min``, ``k_max``
 times ``A_i`` over the valid vertices, as FreeSurfer's. ``FI``'s integrand is
 ``>= 0``, so the estimator's noise in ``k_max - k_min`` makes a sphere's ``FI``
-small but positive (0.07 to 0.09 on the spheres of radius 10-12 voxels
-above, where a torus has 6).
+small but positive (0.05 to 0.15 on spheres of radius 10-20 voxels with
+voxels 0.7 x 0.5 x 0.4 and 2 x 1 x 1, where tori have 4 to 6).
 
 References
 ----------
@@ -194,7 +194,8 @@ def _region_statistics(k_min, k_max, used, weights, face_measures_in, face_mean_
 #: Gauss image of the normals folds, and the split integrals of K are questionable (a note says so). Measured
 #: on label images of spheres and tori with voxels 0.7 x 0.5 x 0.4 and 2 x 1 x 1, 12 offsets each
 #: (``benchmarks/label_statistics.py``): 1.002-1.087 where ICIp and ICIn are within 2% of the truth; 1.28 and
-#: 1.50 on the offsets of tori whose tube is 5 voxels across the coarse axis where they are 30% and 80% high.
+#: 1.50 at the placements of tori of tube radius 5 and 2.5 voxels along the coarse axis where they are 30% and
+#: 80% high.
 FOLD_TOLERANCE = 0.15
 
 
