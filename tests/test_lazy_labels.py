@@ -63,10 +63,14 @@ def test_dask_arrays_are_read_by_their_chunks():
 
 # ---- Zarr and OME-Zarr ---------------------------------------------------------------------------------------------
 
-zarr = pytest.importorskip("zarr")
+@pytest.fixture
+def zarr():
+    """The zarr package (the tests of the reader skip without it; those of LazyImage do not need it)."""
+    return pytest.importorskip("zarr")
 
 
 def ome_group(path, image, scale, axes="zyx", unit="micrometer", version="0.4", whole=None):
+    zarr = pytest.importorskip("zarr")
     group = zarr.open_group(str(path), mode="w")
     multiscale = {"version": version, "axes": [{"name": name, "type": "space" if name in "zyx" else name,
                                                 **({"unit": unit} if name in "zyx" else {})} for name in axes],
@@ -83,7 +87,7 @@ def ome_group(path, image, scale, axes="zyx", unit="micrometer", version="0.4", 
     return group
 
 
-def test_zarr_array_and_groups(tmp_path):
+def test_zarr_array_and_groups(tmp_path, zarr):
     image = scattered_labels()
     array = zarr.create_array(store=str(tmp_path / "plain.zarr"), shape=image.shape, chunks=(8, 8, 8),
                               dtype=image.dtype)
@@ -105,7 +109,7 @@ def test_zarr_array_and_groups(tmp_path):
 
 
 @pytest.mark.parametrize("version", ["0.4", "0.5"])
-def test_ome_zarr_spacing_unit_and_singleton_axes(tmp_path, version):
+def test_ome_zarr_spacing_unit_and_singleton_axes(tmp_path, version, zarr):
     image = scattered_labels()
     ome_group(tmp_path / "cells.ome.zarr", image[None, None], [1.0, 1.0, 2.0, 0.5, 0.25], axes="tczyx",
               version=version, whole=[1.0, 1.0, 1.0, 2.0, 2.0])
@@ -116,7 +120,7 @@ def test_ome_zarr_spacing_unit_and_singleton_axes(tmp_path, version):
     assert lazy_objects(read.array, None, _objects) == _objects(image, None)
 
 
-def test_zarr_errors_name_the_path(tmp_path):
+def test_zarr_errors_name_the_path(tmp_path, zarr):
     image = np.zeros((3, 4, 5, 6), dtype=np.uint8)
     ome_group(tmp_path / "time.zarr", image, [1.0, 1.0, 1.0, 1.0], axes="tzyx")
     with pytest.raises(MeshFileError, match="time.zarr: the OME-Zarr axis 't' has length 3"):
@@ -168,13 +172,7 @@ def balls_image(shape=(24, 40, 40), n=6, seed=11):
     return image
 
 
-def zarr_image(path, image, chunks=(8, 16, 16)):
-    array = zarr.create_array(store=str(path), shape=image.shape, chunks=chunks, dtype=image.dtype)
-    array[...] = image
-    return zarr.open(str(path), mode="r")
-
-
-def test_label_curvatures_of_a_zarr_store_are_those_of_the_array(tmp_path):
+def test_label_curvatures_of_a_lazy_image_are_those_of_the_array():
     pandas = pytest.importorskip("pandas")
     pytest.importorskip("skimage")
     from meshcurv.volume import label_curvatures
@@ -182,9 +180,9 @@ def test_label_curvatures_of_a_zarr_store_are_those_of_the_array(tmp_path):
     image = balls_image()
     expected = label_curvatures(image, spacing=(1.0, 0.8, 0.8))
     assert expected.status.eq("ok").sum() >= 4
-    store = zarr_image(tmp_path / "cells.zarr", image)
+    store = LazyImage(image, chunks=(8, 16, 16))  # read box by box, as a Zarr store (tests below)
     pandas.testing.assert_frame_equal(label_curvatures(store, spacing=(1.0, 0.8, 0.8)), expected)
-    smoothed = label_curvatures(LazyImage(store), spacing=(1.0, 0.8, 0.8), smooth=0.8, labels_to_use=[7, 14])
+    smoothed = label_curvatures(store, spacing=(1.0, 0.8, 0.8), smooth=0.8, labels_to_use=[7, 14])
     pandas.testing.assert_frame_equal(smoothed, label_curvatures(image, spacing=(1.0, 0.8, 0.8), smooth=0.8,
                                                                  labels_to_use=[7, 14]))
     with pytest.raises(InvalidOptionError, match="`threshold` needs the image in memory"):
@@ -192,14 +190,13 @@ def test_label_curvatures_of_a_zarr_store_are_those_of_the_array(tmp_path):
 
 
 @pytest.mark.slow  # starts a local cluster of 2 processes: several seconds
-def test_zarr_labels_on_two_workers_are_the_serial_rows(tmp_path):
+def test_lazy_labels_on_two_workers_are_the_serial_rows():
     pandas = pytest.importorskip("pandas")
     pytest.importorskip("distributed")
     from meshcurv.volume import label_curvatures
 
     image = balls_image(n=10, seed=4)
-    zarr_image(tmp_path / "cells.zarr", image)
-    read = read_image(tmp_path / "cells.zarr")
+    read = LazyImage(image, chunks=(8, 16, 16))
     from meshcurv.batch import local_cluster
 
     with local_cluster(workers=2, dashboard=False) as client:
@@ -209,7 +206,7 @@ def test_zarr_labels_on_two_workers_are_the_serial_rows(tmp_path):
             pandas.testing.assert_frame_equal(parallel, serial, check_exact=False, rtol=1e-9)
 
 
-def test_cli_volume_on_an_ome_zarr_store(tmp_path):
+def test_cli_volume_on_an_ome_zarr_store(tmp_path, zarr):
     pandas = pytest.importorskip("pandas")
     pytest.importorskip("skimage")
     click_testing = pytest.importorskip("click.testing")
@@ -248,7 +245,7 @@ def zarr_benchmark():
     return module
 
 
-def test_benchmark_store_written_chunk_by_chunk_gives_its_balls(tmp_path):
+def test_benchmark_store_written_chunk_by_chunk_gives_its_balls(tmp_path, zarr):
     pytest.importorskip("pandas")
     pytest.importorskip("skimage")
     from meshcurv.volume import label_curvatures
@@ -268,7 +265,7 @@ def test_benchmark_store_written_chunk_by_chunk_gives_its_balls(tmp_path):
 
 
 @pytest.mark.slow  # a local cluster of 2 processes
-def test_benchmark_runs_under_its_cap(tmp_path, capsys):
+def test_benchmark_runs_under_its_cap(tmp_path, capsys, zarr):
     pytest.importorskip("distributed")
     pytest.importorskip("psutil")
     benchmark = zarr_benchmark()
