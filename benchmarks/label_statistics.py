@@ -31,8 +31,17 @@ from scipy import integrate
 import meshcurv
 from meshcurv.errors import MeshQualityWarning
 
-COLUMNS = ("area", "mean_integral", "gaussian_integral", "bending_energy", "folding_index", "ici_positive",
-           "ici_negative", "shape_index_mean", "curvedness_mean")
+COLUMNS = (
+    "area",
+    "mean_integral",
+    "gaussian_integral",
+    "bending_energy",
+    "folding_index",
+    "ici_positive",
+    "ici_negative",
+    "shape_index_mean",
+    "curvedness_mean",
+)
 
 
 def voxelise(inside, extent, spacing, offset):
@@ -44,9 +53,17 @@ def voxelise(inside, extent, spacing, offset):
 
 
 def sphere_case(radius):
-    truth = {"area": 4 * np.pi * radius**2, "mean_integral": 4 * np.pi * radius, "gaussian_integral": 4 * np.pi,
-             "bending_energy": 8 * np.pi, "folding_index": 0.0, "ici_positive": 1.0, "ici_negative": 0.0,
-             "shape_index_mean": 1.0, "curvedness_mean": 1 / radius}
+    truth = {
+        "area": 4 * np.pi * radius**2,
+        "mean_integral": 4 * np.pi * radius,
+        "gaussian_integral": 4 * np.pi,
+        "bending_energy": 8 * np.pi,
+        "folding_index": 0.0,
+        "ici_positive": 1.0,
+        "ici_negative": 0.0,
+        "shape_index_mean": 1.0,
+        "curvedness_mean": 1 / radius,
+    }
     return (lambda z, y, x: z**2 + y**2 + x**2 <= radius**2), [2 * radius] * 3, truth
 
 
@@ -62,14 +79,22 @@ def torus_case(major, minor):
     k1 = 1 / minor
     k2 = lambda t: np.cos(t) / (major + minor * np.cos(t))  # noqa: E731
     area = 4 * np.pi**2 * major * minor
-    truth = {"area": area, "mean_integral": 2 * np.pi**2 * major, "gaussian_integral": 0.0,
-             "bending_energy": over_surface(lambda t: k1**2 + k2(t) ** 2),
-             "folding_index": over_surface(lambda t: k1 * (k1 - abs(k2(t)))) / (4 * np.pi),
-             "ici_positive": 1.0, "ici_negative": 1.0,
-             "shape_index_mean": over_surface(lambda t: (2 / np.pi) * np.arctan2(k1 + k2(t), k1 - k2(t))) / area,
-             "curvedness_mean": over_surface(lambda t: np.sqrt((k1**2 + k2(t) ** 2) / 2)) / area}
-    return (lambda z, y, x: in_torus(z, y, x, major, minor)), [2 * minor, 2 * (major + minor), 2 * (major + minor)], \
-        truth
+    truth = {
+        "area": area,
+        "mean_integral": 2 * np.pi**2 * major,
+        "gaussian_integral": 0.0,
+        "bending_energy": over_surface(lambda t: k1**2 + k2(t) ** 2),
+        "folding_index": over_surface(lambda t: k1 * (k1 - abs(k2(t)))) / (4 * np.pi),
+        "ici_positive": 1.0,
+        "ici_negative": 1.0,
+        "shape_index_mean": over_surface(lambda t: (2 / np.pi) * np.arctan2(k1 + k2(t), k1 - k2(t))) / area,
+        "curvedness_mean": over_surface(lambda t: np.sqrt((k1**2 + k2(t) ** 2) / 2)) / area,
+    }
+    return (
+        (lambda z, y, x: in_torus(z, y, x, major, minor)),
+        [2 * minor, 2 * (major + minor), 2 * (major + minor)],
+        truth,
+    )
 
 
 def double_torus_case(major, minor):
@@ -82,13 +107,15 @@ def double_torus_case(major, minor):
     return inside, [2 * minor, 2 * (shift + major + minor), 2 * (major + minor)], truth
 
 
-CASES = (("sphere R=6", sphere_case(6.0), (0.7, 0.5, 0.4)),
-         ("sphere R=20", sphere_case(20.0), (2.0, 1.0, 1.0)),
-         ("torus R=8 r=3.5", torus_case(8.0, 3.5), (0.7, 0.5, 0.4)),
-         ("torus R=20 r=10", torus_case(20.0, 10.0), (2.0, 1.0, 1.0)),
-         ("torus R=5 r=2", torus_case(5.0, 2.0), (0.7, 0.5, 0.4)),
-         ("torus R=12 r=5", torus_case(12.0, 5.0), (2.0, 1.0, 1.0)),
-         ("genus 2, R=6 r=2.8", double_torus_case(6.0, 2.8), (0.7, 0.5, 0.4)))
+CASES = (
+    ("sphere R=6", sphere_case(6.0), (0.7, 0.5, 0.4)),
+    ("sphere R=20", sphere_case(20.0), (2.0, 1.0, 1.0)),
+    ("torus R=8 r=3.5", torus_case(8.0, 3.5), (0.7, 0.5, 0.4)),
+    ("torus R=20 r=10", torus_case(20.0, 10.0), (2.0, 1.0, 1.0)),
+    ("torus R=5 r=2", torus_case(5.0, 2.0), (0.7, 0.5, 0.4)),
+    ("torus R=12 r=5", torus_case(12.0, 5.0), (2.0, 1.0, 1.0)),
+    ("genus 2, R=6 r=2.8", double_torus_case(6.0, 2.8), (0.7, 0.5, 0.4)),
+)
 
 
 def measure(case, spacing, offset):
@@ -110,8 +137,11 @@ def main(argv=None) -> None:
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
     rng = np.random.default_rng(args.seed)
-    print("| object (voxels z x y x x) | column | exact | measured | error |" if args.repeats == 1 else
-          f"| object (voxels z x y x x) | column | exact | worst error over {args.repeats} offsets |")
+    print(
+        "| object (voxels z x y x x) | column | exact | measured | error |"
+        if args.repeats == 1
+        else f"| object (voxels z x y x x) | column | exact | worst error over {args.repeats} offsets |"
+    )
     print("|---|---|---|---|---|" if args.repeats == 1 else "|---|---|---|---|")
     for name, case, spacing in CASES:
         truth = case[2]
@@ -123,8 +153,11 @@ def main(argv=None) -> None:
             exact = truth.get(column)
             if args.repeats == 1:
                 measured = rows[0][column]
-                text = "" if exact is None else (f"{error(measured, exact):+.4f}" if exact == 0 else
-                                                 f"{100 * error(measured, exact):+.2f}%")
+                text = (
+                    ""
+                    if exact is None
+                    else (f"{error(measured, exact):+.4f}" if exact == 0 else f"{100 * error(measured, exact):+.2f}%")
+                )
                 print(f"| {label} | `{column}` | {'' if exact is None else f'{exact:.4g}'} | {measured:.4g} | {text} |")
             elif exact is not None:
                 worst = max((error(row[column], exact) for row in rows), key=abs)

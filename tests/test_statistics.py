@@ -53,6 +53,7 @@ def torus_image(major, minor, spacing, offset=OFFSET):
 
 def torus_truth(major, minor):
     """Bending energy and folding index of a torus, by quadrature over the tube angle t."""
+
     def around(f):  # int f dA, dA = r (R + r cos t) dt dp
         value, _ = integrate.quad(lambda t: f(t) * minor * (major + minor * np.cos(t)), 0, 2 * np.pi, limit=200)
         return 2 * np.pi * value
@@ -125,8 +126,10 @@ def test_folded_gauss_image_is_flagged():
     image = torus_image(20.0, 10.0, spacing, offset=(0.99228238, -0.25678454, -0.24313253))
     row, surface = one_row(image, spacing)
     assert row.ici_positive > 1.15
-    assert "ici_positive, ici_negative and the rectified, positive and negative integrals of K are questionable" \
+    assert (
+        "ici_positive, ici_negative and the rectified, positive and negative integrals of K are questionable"
         in row.warnings
+    )
     with pytest.warns(MeshQualityWarning, match="the Gauss image of the fitted normals folds"):
         stats = curvature_statistics(surface.result)
     assert stats["ici_positive"] == pytest.approx(row.ici_positive, rel=1e-9)
@@ -152,8 +155,15 @@ def test_mesh_function_gives_the_numbers_of_the_label_table():
 
 def test_table_has_every_statistic_and_freesurfer_aliases():
     assert set(COLUMNS) <= set(TABLE_COLUMNS)
-    for name in ("bending_energy", "folding_index", "ici_positive", "ici_negative", "mean_integral",
-                 "shape_index_mean", "curvedness_mean"):
+    for name in (
+        "bending_energy",
+        "folding_index",
+        "ici_positive",
+        "ici_negative",
+        "mean_integral",
+        "shape_index_mean",
+        "curvedness_mean",
+    ):
         assert name in COLUMNS
     spacing = (0.7, 0.5, 0.4)
     row, _ = one_row(ball_image(5.0, spacing), spacing)
@@ -166,7 +176,7 @@ def test_table_has_every_statistic_and_freesurfer_aliases():
 def test_label_cut_by_the_border_summarises_the_part_away_from_it():
     spacing, radius = (1.2, 1.0, 1.0), 18.0
     whole = ball_image(radius, spacing)
-    cut = whole[whole.shape[0] // 4:]  # cut by the image face a little above its bottom
+    cut = whole[whole.shape[0] // 4 :]  # cut by the image face a little above its bottom
     row, surface = one_row(cut, spacing)
     assert row.touches_border and 0 < row.n_used < row.n_vertices
     # only the vertices out of reach of the cap count: a spherical cap, less than the ball's Gauss image
@@ -204,8 +214,13 @@ def test_icosphere_matches_the_analytic_values():
     assert stats["folding_index"] == pytest.approx(0.0, abs=0.01)
     assert stats["mean_integral"] == pytest.approx(4 * np.pi * radius, rel=0.01)
     assert stats["shape_index_mean"] == pytest.approx(1.0, rel=0.01)
-    for field, value in (("k_min", 1 / radius), ("k_max", 1 / radius), ("mean", 1 / radius),
-                         ("gaussian", 1 / radius**2), ("curvedness", 1 / radius)):
+    for field, value in (
+        ("k_min", 1 / radius),
+        ("k_max", 1 / radius),
+        ("mean", 1 / radius),
+        ("gaussian", 1 / radius**2),
+        ("curvedness", 1 / radius),
+    ):
         for moment in ("mean", "min", "max"):
             assert stats[f"{field}_{moment}"] == pytest.approx(value, rel=0.02), (field, moment)
         assert stats[f"{field}_std"] < 0.01 * value
@@ -252,8 +267,9 @@ def test_scaling_and_flipping_invariances():
     for name in ("bending_energy", "folding_index", "ici_positive", "ici_negative", "shape_index_mean"):
         assert scaled[name] == pytest.approx(base[name], rel=1e-6, abs=1e-9), name
     assert scaled["mean_integral"] == pytest.approx(3.0 * base["mean_integral"], rel=1e-6)
-    flipped = curvature_statistics(meshcurv.principal_curvatures(ellipsoid.vertices, ellipsoid.faces[:, ::-1],
-                                                                 orient="keep"))
+    flipped = curvature_statistics(
+        meshcurv.principal_curvatures(ellipsoid.vertices, ellipsoid.faces[:, ::-1], orient="keep")
+    )
     assert flipped["mean_integral"] == pytest.approx(-base["mean_integral"], rel=1e-6)
     assert flipped["mean_integral_negative"] == pytest.approx(-base["mean_integral_positive"], rel=1e-6)
     assert flipped["gaussian_integral"] == pytest.approx(base["gaussian_integral"], rel=1e-6)
@@ -284,8 +300,9 @@ def test_rejects_a_result_without_a_mesh():
         curvature_statistics(result)
 
 
-@pytest.mark.parametrize("where, found", [(np.ones(5, dtype=bool), "bool of shape \\(5,\\)"),
-                                          ("ones", "int64 of shape")])
+@pytest.mark.parametrize(
+    "where, found", [(np.ones(5, dtype=bool), "bool of shape \\(5,\\)"), ("ones", "int64 of shape")]
+)
 def test_rejects_a_bad_where(where, found):
     sphere = meshcurv.shapes.icosphere(subdivisions=4)
     result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces)

@@ -116,9 +116,20 @@ FIELDS = ("mean", "gaussian", "k_min", "k_max", "shape_index", "curvedness")
 MOMENTS = ("mean", "std", "min", "max")
 
 #: The integrals over the surface (see the module's documentation).
-INTEGRALS = ("mean_integral", "mean_integral_rectified", "mean_integral_positive", "mean_integral_negative",
-             "gaussian_integral", "gaussian_integral_rectified", "gaussian_integral_positive",
-             "gaussian_integral_negative", "bending_energy", "folding_index", "ici_positive", "ici_negative")
+INTEGRALS = (
+    "mean_integral",
+    "mean_integral_rectified",
+    "mean_integral_positive",
+    "mean_integral_negative",
+    "gaussian_integral",
+    "gaussian_integral_rectified",
+    "gaussian_integral_positive",
+    "gaussian_integral_negative",
+    "bending_energy",
+    "folding_index",
+    "ici_positive",
+    "ici_negative",
+)
 
 #: The keys of :func:`curvature_statistics`, in order (columns of :func:`meshcurv.label_curvatures` too).
 COLUMNS = (*(f"{field}_{moment}" for field in FIELDS for moment in MOMENTS), *INTEGRALS)
@@ -145,8 +156,9 @@ def _split(masses: np.ndarray, signs: np.ndarray) -> tuple[float, float, float, 
     return positive + negative, positive - negative, positive, negative
 
 
-def _region_statistics(k_min, k_max, used, weights, face_measures_in, face_mean_sign, gaussian_shares,
-                       gaussian_sign) -> dict[str, float]:
+def _region_statistics(
+    k_min, k_max, used, weights, face_measures_in, face_mean_sign, gaussian_shares, gaussian_sign
+) -> dict[str, float]:
     """The :data:`COLUMNS` of one region of a surface, from its pieces (shared by the mesh and the label table).
 
     ``k_min, k_max`` (V,) pointwise, NaN where invalid; ``used`` (V,) the
@@ -162,8 +174,14 @@ def _region_statistics(k_min, k_max, used, weights, face_measures_in, face_mean_
     curvedness = np.sqrt((k_min**2 + k_max**2) / 2)
     with np.errstate(invalid="ignore"):
         shape_index = np.where(curvedness > 0, (2 / np.pi) * np.arctan2(k_max + k_min, k_max - k_min), np.nan)
-    fields = {"mean": mean, "gaussian": gaussian, "k_min": k_min, "k_max": k_max, "shape_index": shape_index,
-              "curvedness": curvedness}
+    fields = {
+        "mean": mean,
+        "gaussian": gaussian,
+        "k_min": k_min,
+        "k_max": k_max,
+        "shape_index": shape_index,
+        "curvedness": curvedness,
+    }
     row: dict[str, float] = {}
     for name in FIELDS:
         row.update(zip((f"{name}_{moment}" for moment in MOMENTS), _moments(fields[name], weights, used)))
@@ -207,10 +225,12 @@ def _fold_note(row: dict, k_min, k_max, used, weights) -> str:
     measured = row["gaussian_integral_rectified"]
     if not (pointwise > 0 and measured > (1 + FOLD_TOLERANCE) * pointwise):
         return ""
-    return (f"ici_positive, ici_negative and the rectified, positive and negative integrals of K are questionable: "
-            f"the Gauss image of the fitted normals folds (int |K| dA from it is {measured:.4g}, "
-            f"{100 * (measured / pointwise - 1):.0f}% above the {pointwise:.4g} of the pointwise |K| times the "
-            "areas): the normals wobble at a scale below the estimator's radius")
+    return (
+        f"ici_positive, ici_negative and the rectified, positive and negative integrals of K are questionable: "
+        f"the Gauss image of the fitted normals folds (int |K| dA from it is {measured:.4g}, "
+        f"{100 * (measured / pointwise - 1):.0f}% above the {pointwise:.4g} of the pointwise |K| times the "
+        "areas): the normals wobble at a scale below the estimator's radius"
+    )
 
 
 def _face_average(field: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -294,42 +314,59 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
     from .result import CurvatureResult, _first_rows
 
     if not isinstance(result, CurvatureResult):
-        raise InvalidOptionError(f"`result` must be a CurvatureResult (from meshcurv.principal_curvatures); got "
-                                 f"{type(result).__name__}")
+        raise InvalidOptionError(
+            f"`result` must be a CurvatureResult (from meshcurv.principal_curvatures); got {type(result).__name__}"
+        )
     surface = result._surface
     if surface is None:
-        raise InvalidOptionError(f"curvature_statistics needs the triangles of a mesh; this {result.method!r} result "
-                                 "has none (a point cloud's, or one built directly): compute it with "
-                                 "meshcurv.principal_curvatures on a mesh")
+        raise InvalidOptionError(
+            f"curvature_statistics needs the triangles of a mesh; this {result.method!r} result "
+            "has none (a point cloud's, or one built directly): compute it with "
+            "meshcurv.principal_curvatures on a mesh"
+        )
     region = np.ones(result.n_vertices, dtype=bool)
     if where is not None:
         region = np.asarray(where)
         if region.dtype != bool or region.shape != (result.n_vertices,):
-            raise InvalidOptionError(f"`where` must be a bool array of shape ({result.n_vertices},); got "
-                                     f"{region.dtype} of shape {region.shape}")
+            raise InvalidOptionError(
+                f"`where` must be a bool array of shape ({result.n_vertices},); got "
+                f"{region.dtype} of shape {region.shape}"
+            )
     vertices, faces = np.asarray(surface.vertices), np.asarray(surface.faces)
     rows = slice(None) if surface.index is None else _first_rows(surface.index, vertices.shape[0])
     valid = np.asarray(result.valid)[rows]
     k_min, k_max = np.asarray(result.k_min)[rows], np.asarray(result.k_max)[rows]
     region = region[rows]
-    normals = None if result.method == "matgeom" else np.where(valid[:, None], np.asarray(result.normals)[rows],
-                                                                np.nan)
+    normals = None if result.method == "matgeom" else np.where(valid[:, None], np.asarray(result.normals)[rows], np.nan)
     normals = _unit_normals(vertices, faces, normals)
     measures = face_measures(vertices, faces, normals)[:, :2]
-    triangle = 0.5 * np.linalg.norm(np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]],
-                                             vertices[faces[:, 2]] - vertices[faces[:, 0]]), axis=1)
+    triangle = 0.5 * np.linalg.norm(
+        np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]]), axis=1
+    )
     corrected = np.where(np.isfinite(measures[:, 0]), measures[:, 0], triangle)
     weights = np.bincount(faces.ravel(), np.repeat(np.maximum(corrected, 0.0) / 3.0, 3), minlength=vertices.shape[0])
     used = region & valid
     if not used.any():
-        warnings.warn(f"curvature_statistics: no valid vertex to summarise ({int(region.sum())} in `where`, "
-                      f"{int(valid.sum())} valid): the statistics are NaN", MeshQualityWarning, stacklevel=2)
+        warnings.warn(
+            f"curvature_statistics: no valid vertex to summarise ({int(region.sum())} in `where`, "
+            f"{int(valid.sum())} valid): the statistics are NaN",
+            MeshQualityWarning,
+            stacklevel=2,
+        )
     inside = region[faces].all(axis=1) & np.isfinite(measures).all(axis=1)
-    gaussian_shares = np.bincount(faces.ravel(), np.repeat(face_solid_angles(normals, faces) / 3.0, 3),
-                                  minlength=vertices.shape[0])
-    row = _region_statistics(k_min, k_max, used, weights, measures[inside],
-                             _face_average((k_min + k_max) / 2, faces[inside]), gaussian_shares[region],
-                             (k_min * k_max)[region])
+    gaussian_shares = np.bincount(
+        faces.ravel(), np.repeat(face_solid_angles(normals, faces) / 3.0, 3), minlength=vertices.shape[0]
+    )
+    row = _region_statistics(
+        k_min,
+        k_max,
+        used,
+        weights,
+        measures[inside],
+        _face_average((k_min + k_max) / 2, faces[inside]),
+        gaussian_shares[region],
+        (k_min * k_max)[region],
+    )
     note = _fold_note(row, k_min, k_max, used, weights)
     if note:
         warnings.warn(f"curvature_statistics: {note}", MeshQualityWarning, stacklevel=2)
