@@ -565,8 +565,8 @@ def _one_label(image, label, box, spacing, method, radius, smooth=None):
     """``(row, LabelSurface or None)`` of one label (its mask blurred by ``smooth``, sigma, when given)."""
     if box is None:
         return _empty_row(label, "empty", f"label {label} has no voxel in the image"), None
-    label, *crop, options = _task_crop(image, label, box, spacing, smooth)
-    return _crop_label(label, *crop, image.shape, spacing, method, radius, **options)
+    label, crop, starts, stops, options = _task_crop(image, label, box, spacing, smooth)
+    return _crop_label(label, crop, starts, stops, image.shape, spacing, method, radius, **options)
 
 
 def _task_crop(image, label, box, spacing, smooth):
@@ -730,8 +730,8 @@ def _plan(labels, spacing, labels_to_use, radius, threshold=None, *, caller: str
         if threshold is not None:
             raise InvalidOptionError("`threshold` needs the image in memory (its components span chunks); a lazily "
                                      "read image (Zarr, Dask) must be a label image: label it first")
-        image = check_lazy_labels(as_lazy(labels))
-        return image, spacing, lazy_objects(image, wanted, _objects), radius
+        lazy = check_lazy_labels(as_lazy(labels))
+        return lazy, spacing, lazy_objects(lazy, wanted, _objects), radius
     if isinstance(labels, np.ma.MaskedArray):
         raise InvalidMeshError("`labels` must be a plain array; got a masked array (fill it first)")
     image = _check_labels(labels_from_image(np.asanyarray(labels), threshold, caller=caller,

@@ -158,7 +158,8 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, threshold, sm
                                                  keep_surfaces=mesh_format is not None or picture or objects,
                                                  workers=workers)
     bar = session.bar(LabelBar)
-    rows, drawn = [], []
+    rows: list[dict] = []
+    drawn: list[tuple] = []
     with contextlib.ExitStack() as stack:
         writer = _objects_writer(stack, objects_path, overwrite) if objects else None
         for surface in _with_bar(labels, bar, total, rows):

@@ -11,13 +11,16 @@ from __future__ import annotations
 
 import pathlib
 import zipfile
-from typing import NamedTuple, cast
+from typing import TYPE_CHECKING, NamedTuple, cast
 
 import numpy as np
 
 from ..errors import MeshFileError, MissingDependencyError
 from ._files import check_input
 from ._mrc import MRC_UNIT, read_mrc
+
+if TYPE_CHECKING:
+    from .._lazy import LazyImage
 
 __all__ = ["read_image", "Image", "IMAGE_FORMATS", "MAX_IMAGE_BYTES"]
 
@@ -51,7 +54,7 @@ class Image(NamedTuple):
         MRC), else None.
     """
 
-    array: np.ndarray
+    array: np.ndarray | LazyImage
     spacing: tuple[float, float, float] | None
     unit: str | None = None
 

@@ -129,7 +129,7 @@ def read_mrc(path, check_size) -> tuple[np.ndarray, tuple[float, float, float] |
         raise MeshFileError(f"{path}: the MRC header declares {n_columns} x {n_rows} x {n_sections} values of "
                             f"{_NAMES[mode]} after {HEADER_BYTES + nsymbt} header bytes ({need} bytes in all), "
                             f"but the file holds only {size}")
-    data = np.memmap(path, dtype=dtype, mode="r", offset=HEADER_BYTES + nsymbt, shape=disk_shape)
+    data: np.ndarray = np.memmap(path, dtype=dtype, mode="r", offset=HEADER_BYTES + nsymbt, shape=disk_shape)
     if not dtype.isnative:
         data = data.astype(dtype.newbyteorder("="))
     # the file's axes (sections, rows, columns) are the map axes (maps, mapr, mapc); wanted: (Z, Y, X) = (3, 2, 1)

@@ -66,7 +66,7 @@ def _ome(path, group, multiscales):
     if len(names) != len(array.shape) or not {"z", "y", "x"} <= set(names):
         raise MeshFileError(f"{path}: an OME-Zarr image with axes z, y, x is needed; its axes are {names} for "
                             f"shape {tuple(array.shape)}")
-    selection = []
+    selection: list[int | None] = []
     for name, n in zip(names, array.shape):
         if name in ("z", "y", "x"):
             selection.append(None)
