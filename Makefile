@@ -78,7 +78,7 @@ package-check: $(STAMP)
 # ([tool.mypy]), numpydoc's validation of the public API ([tool.numpydoc_validation], tests/test_docstrings.py)
 lint: $(STAMP)
 	$(PIP) install --quiet 'ruff>=0.6' 'mypy>=1.10' 'numpydoc>=1.6'
-	$(BIN)/ruff check src tests benchmarks conftest.py
+	$(BIN)/ruff check src tests benchmarks conftest.py docs
 	$(BIN)/ruff format --check --force-exclude src tests benchmarks conftest.py
 	$(BIN)/mypy
 	$(BIN)/python -m pytest -q -p no:randomly tests/test_docstrings.py
