@@ -20,8 +20,12 @@ myst_heading_anchors = 3
 suppress_warnings = ["myst.xref_missing"]  # links to files of the repository (benchmarks/...), not to pages
 html_theme = "alabaster"
 # wide enough for the examples' lines (up to 110 characters) without a scroll bar
-html_theme_options = {"page_width": "1320px", "sidebar_width": "230px", "body_max_width": "none",
-                      "code_font_size": "0.85em"}
+html_theme_options = {
+    "page_width": "1320px",
+    "sidebar_width": "230px",
+    "body_max_width": "none",
+    "code_font_size": "0.85em",
+}
 
 
 def _readme_links(app, relative_path, parent_docname, content):

@@ -48,19 +48,32 @@ def dirty_sphere():
     vertices = np.vstack([vertices, [[0.0, 0.0, 1.4]]])  # a fin: a third face on an edge at the top
     faces = np.vstack([faces, [[top[0], top[1], len(vertices) - 1]]])
     result = _quiet(meshcurv.principal_curvatures, vertices, faces)
-    return plot_field(vertices, faces, result.mean, view=["iso", "top"], up="z", limits=(0.8, 1.2),
-                      label="mean curvature H (exact 1)",
-                      title=f"a unit sphere with a hole, flipped faces and a fin: {int((~result.valid).sum())} "
-                            "vertices without an estimate (grey)")
+    return plot_field(
+        vertices,
+        faces,
+        result.mean,
+        view=["iso", "top"],
+        up="z",
+        limits=(0.8, 1.2),
+        label="mean curvature H (exact 1)",
+        title=f"a unit sphere with a hole, flipped faces and a fin: {int((~result.valid).sum())} "
+        "vertices without an estimate (grey)",
+    )
 
 
 def voxel_ellipsoid():
     """label_images.md: the marching-cubes mesh of a voxelised ellipsoid, the default call's mean curvature."""
     mesh = meshcurv.shapes.voxel_ellipsoid((12.0, 8.0, 6.0), spacing=(1.0, 0.5, 0.5))
     result = _quiet(meshcurv.principal_curvatures, mesh.vertices, mesh.faces)
-    return plot_field(mesh.vertices, mesh.faces, result.mean, view=["iso", "top"], up="z",
-                      label="mean curvature H (1/voxel)",
-                      title="marching cubes of a 12 x 8 x 6 ellipsoid, voxels 1 x 0.5 x 0.5: the default call")
+    return plot_field(
+        mesh.vertices,
+        mesh.faces,
+        result.mean,
+        view=["iso", "top"],
+        up="z",
+        label="mean curvature H (1/voxel)",
+        title="marching cubes of a 12 x 8 x 6 ellipsoid, voxels 1 x 0.5 x 0.5: the default call",
+    )
 
 
 def gaussian_shares():
@@ -70,9 +83,15 @@ def gaussian_shares():
     result = meshcurv.principal_curvatures(vertices, faces)
     shares = result.vertex_integrals("gaussian")
     total = result.integral("gaussian") / np.pi
-    return plot_field(vertices, faces, shares, view=["left", "right"], up="y",
-                      label="share of int K dA per vertex",
-                      title=f"spot.obj: the shares of the total Gaussian curvature sum to {total:.4f} pi")
+    return plot_field(
+        vertices,
+        faces,
+        shares,
+        view=["left", "right"],
+        up="y",
+        label="share of int K dA per vertex",
+        title=f"spot.obj: the shares of the total Gaussian curvature sum to {total:.4f} pi",
+    )
 
 
 def batch_summary():
@@ -89,8 +108,7 @@ def batch_summary():
             order = np.argsort(result.mean)
             cumulative = np.cumsum(weights[order]) / weights.sum()
             medians.append(result.mean[order][np.searchsorted(cumulative, 0.5)])
-        axis.plot(1 / radii, medians, marker, label=f"icosphere({subdivisions}): "
-                  f"{len(sphere.vertices)} vertices")
+        axis.plot(1 / radii, medians, marker, label=f"icosphere({subdivisions}): {len(sphere.vertices)} vertices")
     axis.plot([0, 2.2], [0, 2.2], "k-", lw=0.8, label="exact")
     axis.set_xlabel("1 / R (exact mean curvature)")
     axis.set_ylabel("mean_area_median")
