@@ -78,7 +78,7 @@ def test_topology_is_identical(name):
 def test_topology_does_not_depend_on_the_bucket_width(width):
     """The compiled build sorts its buckets in int32 when the mesh fits, else int64: the same edges."""
     from meshcurv._kernels import topology as kernels_topology
-    from meshcurv.topology import _build_edges
+    from meshcurv.topology import _bucket_template, _build_edges
 
     vertices, faces = MESHES["defects"]
     faces = np.asarray(faces, np.int64)
@@ -86,9 +86,9 @@ def test_topology_does_not_depend_on_the_bucket_width(width):
     built = kernels_topology.build_edges(faces, vertices.shape[0], np.zeros(0, width))
     for got, want in zip(built, expected, strict=True):
         np.testing.assert_array_equal(got, want)
-    assert kernels_topology.index_template(10, 20).dtype == np.int32
-    assert kernels_topology.index_template(2**30, 20).dtype == np.int64  # 2 V + 1 beyond int32
-    assert kernels_topology.index_template(10, 2**30).dtype == np.int64  # 3 F beyond int32
+    assert _bucket_template(10, 20).dtype == np.int32
+    assert _bucket_template(2**30, 20).dtype == np.int64  # 2 V + 1 beyond int32
+    assert _bucket_template(10, 2**30).dtype == np.int64  # 3 F beyond int32
 
 
 def test_neighbour_lists_match_the_adjacency():

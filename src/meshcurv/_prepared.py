@@ -23,7 +23,7 @@ from ._locality import local_topology
 from ._validation import as_vertices, check_choice
 from .defects import BOUNDARY, VertexDefects, defect_codes
 from .errors import InvalidOptionError
-from .geometry import degenerate_faces, face_cross_products, vertex_normals
+from .geometry import degenerate_faces, face_cross_products, vertex_length_scales, vertex_normals
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import CurvatureResult, Surface
 from .topology import MeshTopology
@@ -72,9 +72,17 @@ class PreparedMesh:
         return _read_only(face_cross_products(self.vertices, self.topology.faces))
 
     @cached_property
+    def length_scales(self) -> np.ndarray:
+        """(V,) the length scale of each vertex (:func:`meshcurv.geometry.vertex_length_scales`), found once
+        for the zero-area faces, the estimators and the diagnosis. Kept writable: the kernels it is passed to
+        are compiled for writable arrays (a read-only one is another numba signature)."""
+        return vertex_length_scales(self.vertices, self.topology)
+
+    @cached_property
     def degenerate(self) -> np.ndarray:
         """(F,) bool: the zero-area faces (:func:`meshcurv.geometry.degenerate_faces`); read-only."""
-        return _read_only(degenerate_faces(self.vertices, self.topology, cross=self.cross))
+        return _read_only(degenerate_faces(self.vertices, self.topology, cross=self.cross,
+                                           scales=self.length_scales))
 
     @cached_property
     def vertex_normals(self) -> np.ndarray:

@@ -10,7 +10,7 @@ import numpy as np
 
 from ._prepared import prepare_mesh
 from ._validation import check_choice, check_int_option, check_positive_float, trusting
-from .diagnosis import diagnose, quality_message
+from .diagnosis import mesh_diagnosis, quality_message
 from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._support import ProgressCallback, Stages
@@ -316,7 +316,7 @@ def _finished(mesh, estimator, result: CurvatureResult, problems: list, found: d
     if given_radius and estimator.radius_warning_edges is not None:  # given, not a default
         note = small_radius_note(result.parameters["radius"], points, topology, estimator.radius_warning_edges)
         problems = [*problems, note] if note else problems
-    diagnosis = diagnose(points, topology, n_flipped_faces=mesh.n_flipped)
+    diagnosis = mesh_diagnosis(points, topology, mesh.n_flipped, mesh.length_scales)  # checked by prepare_mesh
     reasons = mesh.defects(boundary=estimator.boundary).reasons(result.valid)
     parameters = {**result.parameters, **found, "orient": mesh.orient, "n_welded_vertices": mesh.n_welded,
                   "n_double_sided_faces": mesh.n_double_sided}

@@ -188,10 +188,17 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
         topology = as_topology(topology, vertices.shape[0])
     vertices = checked_topology_points(vertices, topology)
     n_flipped_faces = check_int_option(n_flipped_faces, "n_flipped_faces", maximum=topology.n_faces)
+    return mesh_diagnosis(vertices, topology, n_flipped_faces, vertex_length_scales(vertices, topology))
+
+
+def mesh_diagnosis(vertices: np.ndarray, topology: MeshTopology, n_flipped_faces: int,
+                   scales: np.ndarray) -> MeshDiagnosis:
+    """:func:`diagnose` of checked inputs: (V, 3) float64 ``vertices`` of ``topology``, ``n_flipped_faces``
+    in ``[0, F]`` and the (V,) ``scales`` of :func:`meshcurv.geometry.vertex_length_scales` (a prepared
+    mesh has them already: ``principal_curvatures`` checks its inputs once and measures them once)."""
     faces = topology.faces
     referenced = topology.referenced_vertices
     n_unreferenced = int(topology.n_vertices - referenced.sum())
-    scales = vertex_length_scales(vertices, topology)
     kernels = numba_kernels("diagnosis")
     if kernels is not None:
         lower, upper, area, six_volume, scale, n_degenerate, n_zero_length = kernels.mesh_facts(

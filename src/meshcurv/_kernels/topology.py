@@ -38,13 +38,6 @@ def _bucket_starts(cursor):
     return starts
 
 
-def index_template(n_vertices: int, n_faces: int) -> np.ndarray:
-    """An empty array of the integer type :func:`build_edges` sorts in: int32 when ``2 V + 1`` and ``3 F``
-    fit in it (half the memory traffic of int64), else int64."""
-    small = 2 * n_vertices + 1 < 2**31 and 3 * n_faces < 2**31
-    return np.zeros(0, np.int32 if small else np.int64)
-
-
 @nb.njit(**_JIT)
 def build_edges(faces, n_vertices, template):
     """Edges of the triangles, their faces and counts (see MeshTopology._build).
@@ -53,7 +46,7 @@ def build_edges(faces, n_vertices, template):
     counts, one places, each in face order), each bucket is sorted by (larger
     vertex, direction) with a stable insertion sort, so the edges come out in
     lexicographic order, as ``np.unique`` would give them. The buckets are
-    held in the integer type of ``template`` (:func:`index_template`). One
+    held in the integer type of ``template`` (``topology._bucket_template``). One
     thread: the passes are bound by memory, and a parallel version took twice
     the CPU time for at best the same wall time on 2 cores, and 5 s more to
     compile.

@@ -49,7 +49,7 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from .._backend import kernel_threads, numba_kernels
-from ..geometry import (DEGENERATE_AREA_RATIO, edge_dihedral_angles, vertex_length_scales)
+from ..geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from .._prepared import PreparedMesh
@@ -120,7 +120,7 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     stages.start("compute edge tensors")
     sums, _ = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
                                                  topology.edge_face_counts, topology._edge_forward_counts,
-                                                 vertex_length_scales(vertices, topology), DEGENERATE_AREA_RATIO,
+                                                 mesh.length_scales, DEGENERATE_AREA_RATIO,
                                                  kernel_threads())
     defects = mesh.defects()  # the zero-area faces as the kernel found them (the twin tests)
     stages.start("average vertex tensors")
