@@ -481,6 +481,7 @@ def test_overwrite_and_results_of_other_options(tmp_path, client):
         batch.run(tmp_path / "in", out_dir, client=client, radius=0.3)
 
 
+@pytest.mark.slow
 def test_a_worker_killed_mid_run_has_its_meshes_run_again(tmp_path, client):
     paths = write_spheres(tmp_path / "in", 10, 24)  # 5762 vertices: long enough to be killed while computing
     out_dir = tmp_path / "out"
@@ -518,6 +519,7 @@ def test_small_meshes_travel_in_chunks_in_path_order(tmp_path, monkeypatch):
     assert batch._run._chunks(jobs, list(range(3)), workers=0.125) == [[0], [1], [2]]
 
 
+@pytest.mark.slow
 def test_a_task_lost_with_its_workers_is_split_into_single_meshes(tmp_path, caplog):
     """With no retry allowed, killing a worker fails its task at once: its meshes are run again one by one."""
     import dask
@@ -550,6 +552,7 @@ def test_a_task_lost_with_its_workers_is_split_into_single_meshes(tmp_path, capl
 # ---------------------------------------------------------------------------------------------- the command
 
 
+@pytest.mark.slow
 def test_command_on_a_running_dask_cluster(dask_cluster, dozen, tmp_path):
     folder, expected = dozen
     out_dir = tmp_path / "out"
@@ -585,6 +588,7 @@ def test_command_on_a_running_dask_cluster(dask_cluster, dozen, tmp_path):
     assert leftovers(out_dir) == []
 
 
+@pytest.mark.slow
 def test_an_interrupted_command_leaves_no_partial_result_and_resumes(tmp_path, client):
     # 5762 vertices each: about a second of work left when the first result appears
     paths = write_spheres(tmp_path / "in", 80, 24, extension=".obj")
