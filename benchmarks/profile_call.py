@@ -65,6 +65,7 @@ STAGES = (
     ("curvatures from sums", "meshcurv.measures", "curvatures_from_measures"),
     ("finish (NaN, result)", "meshcurv.estimators._support", "finish"),
     ("diagnosis", "meshcurv.diagnosis", "diagnose"),
+    ("diagnosis", "meshcurv.diagnosis", "mesh_diagnosis"),
     ("result: reasons, expand, warning", "meshcurv.curvature", "_finished"),
 )
 
@@ -110,7 +111,9 @@ def install(timers: Timers) -> None:
         if "." in attribute:
             owner_name, name = attribute.split(".")
             owner = getattr(module, owner_name)
-            value = owner.__dict__[name]
+            value = owner.__dict__.get(name)
+            if value is None:  # not in this version of meshcurv
+                continue
             if isinstance(value, cached_property):
                 value.func = timers.wrap(stage, value.func)
             elif isinstance(value, classmethod):
@@ -118,7 +121,9 @@ def install(timers: Timers) -> None:
             else:
                 setattr(owner, name, timers.wrap(stage, value))
             continue
-        original = getattr(module, attribute)
+        original = getattr(module, attribute, None)
+        if original is None:  # not in this version of meshcurv
+            continue
         timed = timers.wrap(stage, original)
         for loaded in list(sys.modules.values()):
             if getattr(loaded, "__name__", "").startswith("meshcurv") and getattr(loaded, attribute, None) is original:
