@@ -35,7 +35,7 @@ demo: $(DEMO_STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest
 
-# the suite without the tests marked slow (2.2 minutes of CPU; 4.3 min wall on 2 cores at load 6-9)
+# the suite without the tests marked slow (3 minutes on 2 cores at load 6-8, 1.8 minutes of CPU)
 quick: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not slow"
 
