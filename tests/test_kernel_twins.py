@@ -1118,19 +1118,23 @@ def check_fit_jets(name):
     facing[rng.random(n) < 0.02] *= -1  # a few normals facing away: some balls refused
     facing[rng.random(n) < 0.01] = np.nan  # and a few missing: not counted
     per_centre = radius * rng.uniform(1.0, 1.4, centres.size)  # a radius per centre (no smaller balls)
-    for degree, mask, check, radii in ((4, None, False, radius), (3, pool_mask, True, radius), (2, None, True, radius),
-                                       (3, pool_mask, False, per_centre)):
+    areas = rng.uniform(0.5, 2.0, n)  # points weighted by their areas (a mesh whose sampling varies)
+    for degree, mask, check, radii, weights in ((4, None, False, radius, None), (3, pool_mask, True, radius, None),
+                                                (2, None, True, radius, None), (3, pool_mask, False, per_centre, None),
+                                                (3, pool_mask, True, radius, areas)):
         details = {}
         with use_backend("numpy"):
             expected = jets.fit_jets(points, normals, radii, degree=degree, centres=centres, neighbours=mask,
-                                     facing=facing if check else None, details=details)
+                                     facing=facing if check else None, details=details, areas=weights)
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
         by_vertex = spread(radii, centres, n, 0.0) if np.ndim(radii) else np.array([radius])
         found = kernels("jets").fit_jets(points, normals, by_vertex, degree, jets.ITERATIONS,
                                          jets._exponents(degree), jets.MIN_PIVOT, centres, 64 * kernel_threads(),
-                                         pool, facing if check else points, check, jets.AWAY_FRACTION)
+                                         pool, facing if check else points, check, jets.AWAY_FRACTION, 0.0,
+                                         np.zeros(0) if weights is None else weights)
         coefficients, t1, t2, normal, counts, away = found
-        label = f"degree {degree}, pool {'all' if mask is None else 'some'}, facing {check}, radii {np.size(radii)}"
+        label = (f"degree {degree}, pool {'all' if mask is None else 'some'}, facing {check}, radii {np.size(radii)}, "
+                 f"areas {weights is not None}")
         compare_jets((coefficients, (t1, t2, normal), counts), expected, label,
                      (points, normals, radii, centres, pool, degree))
         # the shares facing away: the same counts divided alike
@@ -1158,29 +1162,33 @@ def check_fit_jets_connected(name):
     facing[rng.random(n) < 0.02] *= -1
     compiled = kernels("jets").fit_jets_connected
     per_centre = radius * rng.uniform(1.0, 1.4, centres.size)  # a radius per centre (no smaller balls)
-    for degree, mask, check, radii in ((4, None, False, radius), (3, allowed, True, radius),
-                                       (3, allowed, True, per_centre)):
+    areas = rng.uniform(0.5, 2.0, n)
+    for degree, mask, check, radii, weights in ((4, None, False, radius, None), (3, allowed, True, radius, None),
+                                                (3, allowed, True, per_centre, None), (3, allowed, False, radius, areas)):
         # the NumPy path's connected balls (the walk's, found by connected components of all balls at once)
         details = {}
         with use_backend("numpy"):
             expected = jets.fit_jets(points, normals, radii, degree=degree, centres=centres, neighbours=mask,
-                                     facing=facing if check else None, details=details, adjacency=(indptr, indices))
+                                     facing=facing if check else None, details=details, adjacency=(indptr, indices),
+                                     areas=weights)
         arguments = (points, normals, radii if np.ndim(radii) else np.array([radius]), degree, jets.ITERATIONS, jets._exponents(degree), jets.MIN_PIVOT,
                      centres, kernel_threads(), np.ones(n, dtype=bool) if mask is None else mask, indptr, indices,
                      facing if check else points, check, jets.AWAY_FRACTION)
         # one row per centre: spread to rows of all vertices (NaN, counts 0, elsewhere) as NumPy gives them
-        rows = compiled(*arguments, False)
+        extra = (0.0, np.zeros(0) if weights is None else weights)  # settled, areas
+        rows = compiled(*arguments, False, *extra)
         assert all(row.shape[0] == centres.size for row in rows)
         coefficients, t1, t2, normal, counts, away = (spread(row, centres, n, 0.0 if k == 4 else np.nan)
                                                       for k, row in enumerate(rows))
-        label = f"degree {degree}, {'all' if mask is None else 'some'} allowed, facing {check}, radii {np.size(radii)}"
+        label = (f"degree {degree}, {'all' if mask is None else 'some'} allowed, facing {check}, radii {np.size(radii)}, "
+                 f"areas {weights is not None}")
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
         compare_jets((coefficients, (t1, t2, normal), counts), expected, label,
                      (points, normals, radii, centres, pool, degree), (indptr, indices))
         np.testing.assert_array_equal(away, details["away"], err_msg=f"{label}: away")
         # normals only: the unit normals of the same fits (jets.jet_normals), at the centres, NaN elsewhere;
         # frame-free, so compared everywhere, within the fits' tolerance (the coefficients' largest)
-        fitted = spread(compiled(*arguments, True)[0], centres, n, np.nan)
+        fitted = spread(compiled(*arguments, True, *extra)[0], centres, n, np.nan)
         with use_backend("numpy"):
             expected_normals = jets.jet_normals(expected[0], expected[1])
         np.testing.assert_array_equal(np.isnan(fitted), np.isnan(expected_normals), err_msg=f"{label}: normals only")

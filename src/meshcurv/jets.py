@@ -214,7 +214,7 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
              iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
              neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
              details: dict | None = None, adjacency: tuple | None = None, settled: float = 0.0,
-             compact: bool = False):
+             compact: bool = False, areas: np.ndarray | None = None):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
     Parameters
@@ -267,6 +267,10 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
         One row per centre, in the order of ``centres``, instead of one per
         vertex (a fit at a few centres of a large mesh then allocates no row
         for the others; ``details["away"]`` likewise).
+    areas : ndarray of shape (V,), optional
+        Each point's weight is its kernel weight times its area (the fit then
+        approximates the integral over the surface: a part sampled more densely
+        does not outweigh its neighbours). Default: the kernel weight alone.
 
     Returns
     -------
@@ -313,12 +317,13 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
         if facing.shape != vertices.shape:
             raise InvalidMeshError(f"`facing` must have shape {vertices.shape}; got {facing.shape}")
     pool_points = vertices[pool]
+    areas = _checked_areas(areas, n)
     mean, _ = check_ball_work(pool_points, radius, centres.size, centres=vertices[centres])
     kernels = numba_kernels("jets")
     if kernels is not None and n:
         if adjacency is not None:  # one row per centre
             rows = _connected_fits(kernels, vertices, normals, radius, degree, iterations, centres, mean,
-                                   neighbours, adjacency, facing, settled, normals_only=False)
+                                   neighbours, adjacency, facing, settled, normals_only=False, areas=areas)
         else:
             radii = _all_rows(radius, centres, n, 0.0) if per_centre else np.array([float(radius)])  # by vertex
             pieces = []  # each call's outputs, one row per centre of its part
@@ -327,7 +332,7 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
                 pieces.append(tuple(output[lo:hi] if every_vertex else output[part] for output in kernels.fit_jets(
                     vertices, normals, radii, degree, iterations, _exponents(degree), MIN_PIVOT, part,
                     64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION,
-                    float(settled))))
+                    float(settled), areas)))
             rows = _joined(pieces)
         if not compact and not every_vertex:
             rows = [_all_rows(row, centres, n, 0.0 if k == 4 else np.nan) for k, row in enumerate(rows)]
@@ -355,6 +360,8 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
         inverse = (1.0 / radius)[centre][:, None] if per_centre else 1.0 / radius  # the kernels' operations
         offsets = (vertices[neighbour] - vertices[index[rows]]) * inverse
         weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
+        if areas.size:
+            weights = weights * areas[neighbour]
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
         local = [*tangent_basis(normals[index]), normals[index]]
         settle = np.zeros((size, 1), dtype=bool)  # the centres whose iterations have ended (``settled``)
@@ -393,6 +400,23 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
     return coefficients, tuple(frame), counts
 
 
+def _checked_areas(areas, n: int) -> np.ndarray:
+    """(V,) float64 areas, or an empty array for none.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``areas`` does not hold one finite number >= 0 per vertex.
+    """
+    if areas is None:
+        return np.zeros(0)
+    areas = np.ascontiguousarray(areas, dtype=np.float64)
+    if areas.shape != (n,) or not np.all(np.isfinite(areas) & (areas >= 0)):
+        raise InvalidMeshError(f"`areas` must hold one finite number >= 0 per vertex, shape ({n},); got shape "
+                               f"{areas.shape}")
+    return areas
+
+
 def _checked_centre_radii(radius, centres: np.ndarray) -> np.ndarray:
     """(M,) float64 radii of the M ``centres``, checked: positive, finite, one radius per vertex listed.
 
@@ -419,7 +443,8 @@ def _joined(pieces: list) -> list[np.ndarray]:
 
 def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, degree: int, iterations: int,
                     centres: np.ndarray, pairs_per_centre: float, neighbours: np.ndarray | None, adjacency: tuple,
-                    facing: np.ndarray | None, settled: float, *, normals_only: bool) -> list[np.ndarray]:
+                    facing: np.ndarray | None, settled: float, *, normals_only: bool,
+                    areas: np.ndarray) -> list[np.ndarray]:
     """The compiled fits over the surface-connected balls of ``centres``, in calls of about
     :data:`~meshcurv.neighborhoods.PAIRS_PER_CALL` pairs (checked inputs; ``neighbours`` a (V,) bool
     array or None; ``radius`` a float or a checked (M,) array of one per centre). The kernel's outputs,
@@ -438,8 +463,8 @@ def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, 
         outputs = kernels.fit_jets_connected(vertices, normals, radii[lo:hi] if per_centre else radii, degree,
                                              iterations, _exponents(degree),
                                              MIN_PIVOT, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
-                                             _read_only_view(facing) if check else vertices, check, AWAY_FRACTION,
-                                             normals_only, float(settled))
+                                             vertices if facing is None else _read_only_view(facing), check,
+                                             AWAY_FRACTION, normals_only, float(settled), _read_only_view(areas))
         pieces.append(outputs[:1] if normals_only else outputs)
     return _joined(pieces)
 
@@ -459,7 +484,8 @@ def _all_rows(rows: np.ndarray, centres: np.ndarray, n: int, fill: float) -> np.
 
 def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int = DEGREE,
                     iterations: int = ITERATIONS, neighbours: np.ndarray | None = None,
-                    adjacency: tuple | None = None, settled: float = 0.0) -> np.ndarray:
+                    adjacency: tuple | None = None, settled: float = 0.0,
+                    areas: np.ndarray | None = None) -> np.ndarray:
     """(V, 3) unit normals of the jets of :func:`fit_jets` at every vertex (NaN where no fit was possible).
 
     ``jet_normals(*fit_jets(...)[:2])`` with the same arguments; with the
@@ -467,14 +493,15 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree
     (not the coefficients, frames and counts: 136 bytes per vertex). A vertex
     whose fit has a slope ``c10^2 + c01^2`` below ``settled`` takes its normal
     without further iterations (:func:`fit_jets`; 0: ``iterations`` fits everywhere).
-    ``radius``: one for all vertices, or a (V,) array of one per vertex (as :func:`fit_jets`).
+    ``radius``: one for all vertices, or a (V,) array of one per vertex (as :func:`fit_jets`);
+    ``areas``: the points weighted by their areas (:func:`fit_jets`).
     """
     kernels = numba_kernels("jets")
     vertices = checked_points(vertices)
     n = vertices.shape[0]
     if kernels is None or adjacency is None or n == 0:
         coefficients, frame, _ = fit_jets(vertices, normals, radius, degree=degree, iterations=iterations,
-                                          neighbours=neighbours, adjacency=adjacency, settled=settled)
+                                          neighbours=neighbours, adjacency=adjacency, settled=settled, areas=areas)
         return jet_normals(coefficients, frame)
     normals = np.ascontiguousarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
@@ -487,7 +514,7 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree
         radius = centre_radii(radius, n)
     mean, _ = check_ball_work(vertices if neighbours is None else vertices[neighbours], radius, n, centres=vertices)
     return _connected_fits(kernels, vertices, normals, radius, degree, iterations, np.arange(n), mean, neighbours,
-                           adjacency, None, settled, normals_only=True)[0]
+                           adjacency, None, settled, normals_only=True, areas=_checked_areas(areas, n))[0]
 
 
 def jet_normals(coefficients: np.ndarray, frame: tuple) -> np.ndarray:

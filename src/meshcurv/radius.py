@@ -10,6 +10,9 @@ the user:
 
 - :func:`edge_radius`, :func:`component_radii`: :data:`DEFAULT_RADIUS_FACTOR`
   mean edge lengths, each group of components of one scale at its own;
+- :func:`local_scale_ratios`: ``icc``'s default radius at each vertex, the
+  component's radius times how much coarser or finer the mesh is sampled
+  around the vertex (below);
 - :func:`noise_level`, :func:`noise_radius`: ``icc``'s radius on smooth and
   noisy meshes, growing with the noise measured on the mesh;
 - :func:`voxel_radius`, :func:`voxel_surface_radius`: on voxel surfaces
@@ -21,6 +24,34 @@ the user:
   their noise in units of their spacing;
 - :func:`check_radius`, :func:`resolve_radius`, :func:`small_radius_note`:
   a radius given by the user.
+
+The scale of each vertex (issue 30). The rules above set one radius per
+surface: the noise rule in units of the mean edge length, the voxel rule in
+units of the lattice. Where the sampling of one surface changes (a decimated
+or adaptively remeshed model, fine where its detail is), one radius follows
+the majority: on a sphere sampled 100 times more densely on one half, the
+coarse half's balls held little more than their centre's faces and 38% of its
+vertices were off by more than 25% (median 17%). The default of ``icc`` on
+meshes that are not voxel surfaces is therefore per vertex: the component's
+radius (the noise rule) times :func:`local_scale_ratios`, the vertex's mean
+edge length averaged over two rings, over the component's median edge length.
+The noise rule is in units of edge lengths, so a part sampled ten times more
+coarsely needs a radius ten times larger for the same balance of bias and
+noise. Local edge lengths within :data:`LOCAL_EVEN` (2) of the median keep
+the component's radius: on the evenly sampled meshes of
+``benchmarks/accuracy.py`` the two-ring means still spread from 0.46 to 1.77
+of the median (random points; the regular torus, whose outer ring edges are
+twice the inner ones; the saddle's grid, stretched by its slopes), and
+following that spread made the clean torus 15% and the saddle 15% worse
+(median H); beyond :data:`LOCAL_FOLLOW` (4) the radius follows the edges in
+proportion (``benchmarks/scale_default.py``). Those fits weigh each point by its area (a part sampled 100 times
+more densely must not pull the normals of its coarse neighbours). Voxel
+surfaces keep one radius per surface: their rule is set by the lattice and
+the curvature, not by the edges, whose lengths change with the orientation of
+the surface in anisotropic voxels (a factor 2 at 2:1) without any change of
+the noise. ``radius="adaptive"`` (:func:`scale_ladder`, :func:`stable_scales`)
+chooses each vertex's scale from its estimates instead, at 1.4-4 times the
+cost; the local default costs one sparse product per ring.
 """
 
 from __future__ import annotations
@@ -33,7 +64,8 @@ from scipy import sparse
 
 from ._validation import check_positive_float, checked_points
 from .errors import InvalidOptionError
-from .geometry import median_edge_length, robust_mean_edge_length, vertex_edge_lengths, vertex_length_scales
+from .geometry import (COMPONENT_SCALE_SPREAD, median_edge_length, robust_mean_edge_length, vertex_edge_lengths,
+                       vertex_length_scales)
 from .jets import SETTLED_SLOPE, fit_jets
 from .lattice import voxel_grid
 from .topology import MeshTopology
@@ -50,6 +82,7 @@ __all__ = [
     "resolve_radius",
     "small_radius_note",
     "vertex_radii",
+    "local_scale_ratios",
     "scale_ladder",
     "stable_scales",
     "cloud_noise_level",
@@ -300,6 +333,50 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology,
     return voxel_radius(grid.spacing, curvature_radius), {
         "surface": "voxel", "voxel_spacing": tuple(float(x) for x in grid.spacing),
         "curvature_radius": curvature_radius}
+
+
+#: The local edge length of a vertex is averaged (in log) over this many rings around it.
+LOCAL_RINGS = 2
+#: Local edge lengths within this factor of the component's median keep the component's radius ...
+LOCAL_EVEN = 2.0
+#: ... beyond this factor the radius follows them in proportion; in between it passes from one to the other.
+LOCAL_FOLLOW = 4.0
+
+
+def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarray:
+    """(V,) the factor of each vertex's radius over its component's: how much coarser or finer it is sampled.
+
+    ``rho_v`` is the vertex's mean edge length averaged in log over its
+    :data:`LOCAL_RINGS` rings (the geometric mean of about 19 vertices on an
+    even mesh), over the median edge length of its connected component
+    (:func:`meshcurv.geometry.vertex_length_scales`). The factor is 1 while
+    ``rho_v`` is within :data:`LOCAL_EVEN` of 1 (the spread of a triangulation
+    of even density: 0.46-1.77 on the meshes of ``benchmarks/accuracy.py``),
+    ``rho_v`` itself beyond :data:`LOCAL_FOLLOW` (a real change of
+    resolution: a decimated or adaptively remeshed part), linear in log in
+    between (continuous), and clipped to ``[1 / 16, 16]``
+    (:data:`meshcurv.geometry.COMPONENT_SCALE_SPREAD`). Vertices without edges get 1.
+    """
+    n = topology.n_vertices
+    local = vertex_edge_lengths(vertices, topology.edges)
+    scales = vertex_length_scales(vertices, topology)
+    known = np.isfinite(local) & (local > 0) & (scales > 0)
+    if not known.any():
+        return np.ones(n)
+    indptr, indices = topology.neighbour_lists
+    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n)) + sparse.identity(n)
+    logs = np.where(known, np.log(np.where(known, local, 1.0) / np.where(known, scales, 1.0)), 0.0)
+    weights = known.astype(np.float64)
+    for _ in range(LOCAL_RINGS):
+        logs, weights = ring @ logs, ring @ weights
+    with np.errstate(invalid="ignore", divide="ignore"):
+        logs = np.where(weights > 0, logs / np.where(weights > 0, weights, 1.0), 0.0)
+    even, follow = np.log(LOCAL_EVEN), np.log(LOCAL_FOLLOW)
+    size = np.abs(logs)
+    factor = np.where(size <= even, 0.0,
+                      np.where(size >= follow, size, (size - even) * follow / (follow - even)))
+    limit = np.log(COMPONENT_SCALE_SPREAD)
+    return np.exp(np.clip(np.sign(logs) * factor, -limit, limit))
 
 
 def vertex_radii(groups: list[tuple[float, np.ndarray | None]], n_vertices: int) -> np.ndarray:

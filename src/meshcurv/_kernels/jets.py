@@ -49,7 +49,7 @@ def _cholesky_solve(a, b, low, m, min_pivot):
 
 @nb.njit(parallel=True, **_JIT)
 def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_pivot, centres, n_chunks, pool, facing,
-             check_facing, away_fraction, settled=0.0):
+             check_facing, away_fraction, settled, areas):
     """``jets.fit_jets``: weighted jets over the balls of ``radii``, frame re-estimated from each fit.
 
     Fits the jets of the vertices ``centres`` (the other rows of the outputs
@@ -64,6 +64,7 @@ def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_pivot,
     unless checked); the neighbours of each vertex are found on a grid of cells
     (:func:`_grid`). A fit whose slope ``c10^2 + c01^2`` is below ``settled``
     ends the iterations of its vertex (0: ``iterations`` fits everywhere).
+    ``areas`` (V,): each point's weight is also its area (empty: none).
     """
     n = vertices.shape[0]
     n_pool = pool.shape[0]
@@ -86,6 +87,7 @@ def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_pivot,
             m += 1
     centres = sorted_centres[:m]
     coefficients, t1s, t2s, ns, counts, away = _jet_outputs(n)
+    limits = np.array([away_fraction, settled])
     n_terms = exponents.shape[0]
     n_chunks = max(min(m, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
@@ -98,7 +100,7 @@ def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_pivot,
                                           members)
             work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, v,
                             members, size, work, moments, right, matrix, low, scale, solution, coefficients, t1s,
-                            t2s, ns, counts, ids, facing, check_facing, away_fraction, away, settled)
+                            t2s, ns, counts, ids, facing[:facing.shape[0] if check_facing else 0], limits, away, areas)
     return coefficients, t1s, t2s, ns, counts, away
 
 
@@ -220,12 +222,15 @@ def _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny,
 
 @nb.njit(inline="always", **_JIT)
 def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, row, members, size, work,
-             moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing,
-             check_facing, away_fraction, away_out, settled):
+             moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing, limits,
+             away_out, areas):
     """One vertex of :func:`fit_jets` in the caller's buffers; returns ``work`` (grown when too small).
 
     Inlined into its callers: a call per vertex passing thirty arrays cost a
     quarter of the normal fits' time (reference counts of the arguments).
+    numba inlines no function of more than 31 arguments: the scalar options
+    come in ``limits = (away_fraction, settled)``, and the facing check is
+    on when ``facing`` has rows (an empty ``facing``: no check).
 
     The ball's points are ``points[members[:size]]`` (vertex ``ids[members[a]]``);
     the fit is written to row ``row`` of the outputs. ``work`` holds one column per ball member: its offset from the centre in
@@ -239,8 +244,14 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     products; no per-member rows; degree 2 reads the moments up to order 4).
     A fit whose slope ``c10^2 + c01^2`` is below ``settled``
     ends the iterations (its frame and coefficients are kept).
+
+    With ``areas`` (V,) not empty, each point's weight is its kernel weight
+    times its area (the fit approximates the surface integral: a part sampled
+    100 times more densely does not outweigh its neighbour).
     """
     n_terms = exponents.shape[0]
+    away_fraction, settled = limits[0], limits[1]
+    check_facing = facing.shape[0] > 0
     top = 2 * degree
     if size > work.shape[1]:
         work = np.empty((work.shape[0], 2 * size))
@@ -252,6 +263,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     wu = work[_JET_ROWS + 2 * (top + 1):_JET_ROWS + 3 * (top + 1)]
     lu = work[_JET_ROWS + 3 * (top + 1):]
     count = 0.0
+    weighted = areas.shape[0] > 0
     for a in range(size):
         k = members[a]
         x = (points[k, 0] - cx) * inverse
@@ -260,6 +272,8 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
         ox[a], oy[a], oz[a] = x, y, z
         w = max(1.0 - (x * x + y * y + z * z), 0.0)
         w = w * w
+        if weighted:
+            w = w * areas[ids[k]]
         weight[a] = w
         count += w > 0
     counts[row] = count
@@ -345,7 +359,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
 
 @nb.njit(parallel=True, **_JIT)
 def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, min_pivot, centres, n_chunks,
-                       allowed, indptr, indices, facing, check_facing, away_fraction, normals_only, settled=0.0):
+                       allowed, indptr, indices, facing, check_facing, away_fraction, normals_only, settled, areas):
     """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
 
     The ball of ``centres[i]`` has the radius ``radii[i]`` ((M,): one per
@@ -365,6 +379,7 @@ def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, 
     A fit whose slope ``c10^2 + c01^2`` is below ``settled`` ends the
     iterations of its vertex (its normal is within ``atan(sqrt(settled))`` of
     the frame's normal); with 0, every vertex has ``iterations`` fits.
+    ``areas``: as :func:`fit_jets`.
     """
     n = vertices.shape[0]
     m = centres.shape[0]
@@ -373,6 +388,7 @@ def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, 
     ids = np.arange(n)
     n_terms = exponents.shape[0]
     per_centre = radii.shape[0] > 1
+    limits = np.array([away_fraction, settled])
     n_chunks = max(min(m, n_chunks), 1)
     for chunk in nb.prange(n_chunks):
         mark = np.full(n, -1, np.int64)
@@ -390,7 +406,7 @@ def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, 
             one_away[0] = np.nan  # written only when the facing is checked
             work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v, 0,
                             members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn,
-                            one_count, ids, facing, check_facing, away_fraction, one_away, settled)
+                            one_count, ids, facing[:facing.shape[0] if check_facing else 0], limits, one_away, areas)
             if not normals_only:
                 for k in range(6):
                     coefficients[i, k] = c[0, k]

@@ -19,7 +19,14 @@ in units of the local edge length) and its mean edge length ``h``:
 one edge length on a clean mesh, where the smallest ball has the smallest bias,
 about 2.2 h under normal noise of amplitude 0.1 h and 3.3 h under 0.3 h, where
 a larger ball averages the noise out. The constants come from a sweep of both
-radii over the surfaces of ``benchmarks/accuracy.py``.
+radii over the surfaces of ``benchmarks/accuracy.py``. Where the sampling of
+the mesh changes (a part two or more times coarser or finer than the median
+edge), each vertex takes that radius times its local factor
+(:func:`meshcurv.radius.local_scale_ratios`; ``parameters["scale"] ==
+"local"``, ``result.radius`` per vertex) and the normal fits weigh each point
+by its area. On dense surfaces (normal-fit balls wider than 16 edge lengths,
+marching cubes of fine voxels) the normals are fitted on clusters of vertices
+(:func:`fitted_normals`).
 
 The normals ``u_i`` are interpolated linearly over each triangle; the
 curvature measures ``mu_0`` (corrected area), ``mu_1`` (2H dA), ``mu_2`` (K dA)
@@ -68,11 +75,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import median_edge_length, robust_mean_edge_length
-from ..jets import SETTLED_SLOPE, fit_jet_normals
+from ..jets import SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
 from ..measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import ball_face_sums, ball_face_sums_nested
-from ..radius import (check_radius, component_radii, noise_level, noise_radius, scale_ladder, stable_scales,
-                      vertex_radii)
+from ..radius import (check_radius, component_radii, local_scale_ratios, noise_level, noise_radius, scale_ladder,
+                      stable_scales, vertex_radii)
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages, finish
@@ -89,6 +96,15 @@ NORMAL_SETTLED = SETTLED_SLOPE
 #: Fits per normal: the first in the frame of the mean of the face normals, the next in that of the first fit.
 NORMAL_ITERATIONS = 2
 
+#: Normal fits over balls wider than this many median edge lengths are fitted on a coarser level of the
+#: surface (dense voxel surfaces: 20-40 edge lengths, balls of thousands of vertices; the default on a clean
+#: mesh is 3 edge lengths, under noise of 0.3 edge lengths 10) ...
+COARSE_EDGES = 16.0
+#: ... of clusters in cubes of 1 / COARSE_CELLS of the normal-fit radius (a ball then holds about 300 of them;
+#: 6 and 8 made the marching-cubes sphere r 1 at voxel 0.05 of ``benchmarks/accuracy.py`` 13% worse, 10 is
+#: within 4% of the fits over every vertex on each binary marching-cubes mesh there, ``benchmarks/scale_default.py``).
+COARSE_CELLS = 10.0
+
 #: A fitted normal is kept where its cosine with the mean of the face normals exceeds this (60 degrees).
 NORMAL_AGREEMENT = 0.5
 
@@ -103,8 +119,9 @@ STAGES = ("compute normals", "measure noise", "fit normals", "compute face measu
           "retrieve curvatures")
 
 
-def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, radius: float, *,
-                   neighbours: np.ndarray | None = None, adjacency: tuple | None = None) -> np.ndarray:
+def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, radius, *,
+                   neighbours: np.ndarray | None = None, adjacency: tuple | None = None,
+                   areas: np.ndarray | None = None, weighted: bool = False) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
     Only the ``neighbours`` (V,) bool vertices enter the balls (default: all;
@@ -115,13 +132,94 @@ def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray,
     of a part thinner than the ball, a voxel surface's tip) and the fit
     describes neither. ``adjacency``: the mesh's edge lists, so that each ball
     is its surface-connected piece (:func:`meshcurv.jets.fit_jets`).
+
+    ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
+    weighs its area (a mesh whose sampling varies: a part sampled 100 times
+    more densely does not outweigh its neighbour). Where the balls are wider
+    than :data:`COARSE_EDGES` edge lengths (dense voxel surfaces: balls of
+    thousands of vertices), the jets are fitted on a coarser level of the
+    surface (:func:`_coarse_level`), so that a fit costs about the same whatever
+    the density. The clusters are cubes of the coordinate axes: a rotated mesh
+    gets other clusters, and normals that differ within the fits' precision.
     """
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
-    fitted = fit_jet_normals(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS,
-                             neighbours=neighbours, adjacency=adjacency, settled=NORMAL_SETTLED)
+    coarse = None
+    if areas is not None:  # in units of their median: weights of order 1 whatever the units of the mesh
+        positive = areas[areas > 0]
+        areas = areas / np.median(positive) if positive.size else None
+    if areas is not None and adjacency is not None:
+        coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency)
+    if coarse is not None:
+        points, point_normals, allowed, lists, point_areas = coarse
+        coefficients, frame, _ = fit_jets(points, point_normals, radius, degree=NORMAL_DEGREE,
+                                          iterations=NORMAL_ITERATIONS, centres=np.arange(vertices.shape[0]),
+                                          neighbours=allowed, adjacency=lists, settled=NORMAL_SETTLED,
+                                          areas=point_areas, compact=True)
+        fitted = jet_normals(coefficients, frame)
+    else:
+        fitted = fit_jet_normals(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS,
+                                 neighbours=neighbours, adjacency=adjacency, settled=NORMAL_SETTLED,
+                                 areas=areas if weighted else None)
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     return np.where(usable[:, None], fitted, normals)
+
+
+def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
+    """The points of the normal fits of a dense surface: clusters of vertices, or None for an ordinary mesh.
+
+    Used when the median ``radius`` exceeds :data:`COARSE_EDGES` median edge lengths. The vertices that may enter the balls are grouped by cube of side
+    ``median radius / COARSE_CELLS`` and by the axis and sign of their normal's largest component (the two
+    sides of a part thinner than a cube stay apart); each group is one point at its area-weighted centroid,
+    weighing the group's area, linked to the groups that a mesh edge joins it to. Returns ``(points,
+    normals, allowed, (indptr, indices), areas)`` over V + C points: the V vertices come first, each linked
+    to its own group only and not allowed in a ball (the fit of vertex ``v`` is centred on it and walks the
+    groups from its own), the C groups after them.
+    """
+    n = vertices.shape[0]
+    inside = np.ones(n, dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
+    inside = inside & (areas > 0)
+    if not inside.any():
+        return None
+    typical = float(np.median(radius))
+    indptr, indices = adjacency
+    tails = np.repeat(np.arange(n), np.diff(indptr))
+    lengths = np.linalg.norm(vertices[indices] - vertices[tails], axis=1)
+    if not lengths.size or not typical > COARSE_EDGES * float(np.median(lengths)):
+        return None
+    cell = typical / COARSE_CELLS
+    members = np.flatnonzero(inside)
+    corner = vertices[members].min(axis=0)
+    cube = np.floor((vertices[members] - corner) / cell).astype(np.int64)
+    axis = np.argmax(np.abs(normals[members]), axis=1)
+    side = 2 * axis + (normals[members, axis] < 0)
+    keys = np.column_stack([cube, side])
+    _, group = np.unique(keys, axis=0, return_inverse=True)
+    group = group.ravel()
+    c = int(group.max()) + 1
+    weight = areas[members]
+    total = np.bincount(group, weights=weight, minlength=c)
+    centroid = np.stack([np.bincount(group, weights=weight * vertices[members, k], minlength=c) for k in range(3)],
+                        axis=1) / total[:, None]
+    summed = np.stack([np.bincount(group, weights=weight * normals[members, k], minlength=c) for k in range(3)],
+                      axis=1)
+    length = np.linalg.norm(summed, axis=1, keepdims=True)
+    group_normals = np.divide(summed, length, out=np.zeros_like(summed), where=length > 0)
+    of = np.full(n, -1, dtype=np.int64)
+    of[members] = n + group
+    a, b = of[tails], of[indices]
+    joined = (a >= 0) & (b >= 0) & (a != b)
+    links = np.unique(np.column_stack([a[joined], b[joined]]), axis=0)
+    own = np.flatnonzero(of >= 0)
+    heads = np.concatenate([own, links[:, 0]])
+    ends = np.concatenate([of[own], links[:, 1]])
+    order = np.argsort(heads, kind="stable")
+    count = np.bincount(heads, minlength=n + c)
+    lists = (np.concatenate([[0], np.cumsum(count)]).astype(np.int64), ends[order].astype(np.int64))
+    allowed = np.concatenate([np.zeros(n, dtype=bool), np.ones(c, dtype=bool)])
+    point_areas = np.concatenate([np.zeros(n), total])
+    return (np.concatenate([vertices, centroid]), np.concatenate([normals, group_normals]), allowed, lists,
+            point_areas)
 
 
 def voxel_pilot(mesh: PreparedMesh):
@@ -130,9 +228,18 @@ def voxel_pilot(mesh: PreparedMesh):
         topology = mesh.topology
         _, valid = mesh.start(boundary=True)
         k_min, k_max, *_ = _curvatures(mesh.vertices, topology.faces, mesh.degenerate, mesh.vertex_normals, valid,
-                                       radius, neighbours=topology.referenced_vertices, adjacency=_adjacency(topology))
+                                       radius, neighbours=topology.referenced_vertices, adjacency=_adjacency(topology),
+                                       areas=_vertex_areas(mesh))
         return k_min, k_max, valid
     return run
+
+
+def _vertex_areas(mesh: PreparedMesh) -> np.ndarray:
+    """(V,) a third of the area of the faces at each vertex (the weights of the fits)."""
+    faces = mesh.topology.faces
+    third = np.linalg.norm(mesh.cross, axis=1) / 6.0
+    third[mesh.degenerate] = 0.0
+    return np.bincount(faces.ravel(), weights=np.repeat(third, 3), minlength=mesh.vertices.shape[0])
 
 
 def _adjacency(topology: MeshTopology) -> tuple:
@@ -149,7 +256,8 @@ def _usable_faces(faces: np.ndarray, degenerate: np.ndarray, normals: np.ndarray
 
 
 def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Stages | None = None, *,
-                neighbours: np.ndarray | None = None, adjacency: tuple | None = None):
+                neighbours: np.ndarray | None = None, adjacency: tuple | None = None,
+                areas: np.ndarray | None = None, weighted: bool = False):
     """``k_min, k_max, dir_min, dir_max, normals, valid`` of the measures over balls of ``radius``.
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
@@ -163,9 +271,9 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
             stages.start(stage)
 
     start("fit normals")
-    if radius > 0:
+    if np.all(np.asarray(radius) > 0):
         normals = fitted_normals(vertices, normals, valid, NORMAL_RADIUS_RATIO * radius, neighbours=neighbours,
-                                 adjacency=adjacency)
+                                 adjacency=adjacency, areas=areas, weighted=weighted)
 
     start("compute face measures")
     measures = face_measures(vertices, faces, normals)  # rows of the faces left out are not read
@@ -214,11 +322,19 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                   else [NORMAL_RADIUS_RATIO * r for r in radii], **found}
     if adaptive and len(groups) == 1:
         return _adaptive(mesh, groups[0][0], parameters, defects, valid, stages)
+    if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor
+        radii_v = vertex_radii(groups, vertices.shape[0]) * local_scale_ratios(vertices, topology)
+        if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not np.all(radii_v == radii_v[0]):
+            k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
+                vertices, topology.faces, degenerate, normals, valid, radii_v, stages, neighbours=referenced,
+                adjacency=_adjacency(topology), areas=_vertex_areas(mesh), weighted=True)
+            return finish("icc", {**parameters, "scale": "local"}, valid, normals, k_min, k_max, dir_min, dir_max,
+                          defects, radius=radii_v)
     fields: tuple[np.ndarray, ...] | None = None
     for group_radius, members in groups:
         computed = _curvatures(vertices, topology.faces, degenerate, normals, valid, group_radius,
                                stages if fields is None else None, neighbours=referenced,
-                               adjacency=_adjacency(topology))
+                               adjacency=_adjacency(topology), areas=_vertex_areas(mesh))
         if members is None:
             fields = computed
             continue
@@ -250,8 +366,9 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     stages.start("measure noise")
     radii = [check_radius(radius, vertices, topology) for radius in radii]
     stages.start("fit normals")
+    areas = _vertex_areas(mesh)
     normals = [fitted_normals(vertices, start_normals, valid, NORMAL_RADIUS_RATIO * radius,
-                              neighbours=topology.referenced_vertices, adjacency=_adjacency(topology))
+                              neighbours=topology.referenced_vertices, adjacency=_adjacency(topology), areas=areas)
                for radius in radii]
     stages.start("compute face measures")
     measures = np.stack([face_measures(vertices, faces, rung) for rung in normals])
@@ -288,7 +405,8 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     faces = topology.faces
     stages.start("fit normals")
     normals = fitted_normals(vertices, mesh.vertex_normals, valid, NORMAL_RADIUS_RATIO * base,
-                             neighbours=topology.referenced_vertices, adjacency=_adjacency(topology))
+                             neighbours=topology.referenced_vertices, adjacency=_adjacency(topology),
+                             areas=_vertex_areas(mesh))
     stages.start("compute face measures")
     measures = face_measures(vertices, faces, normals)
     stages.start("sum over balls")
