@@ -363,6 +363,9 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarr
     known = np.isfinite(local) & (local > 0) & (scales > 0)
     if not known.any():
         return np.ones(n)
+    raw = local[known] / scales[known]
+    if raw.min() >= 1.0 / LOCAL_EVEN and raw.max() <= LOCAL_EVEN:  # the ring means of these stay within too
+        return np.ones(n)
     indptr, indices = topology.neighbour_lists
     ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n)) + sparse.identity(n)
     logs = np.where(known, np.log(np.where(known, local, 1.0) / np.where(known, scales, 1.0)), 0.0)

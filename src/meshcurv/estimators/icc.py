@@ -104,6 +104,8 @@ COARSE_EDGES = 16.0
 #: 6 and 8 made the marching-cubes sphere r 1 at voxel 0.05 of ``benchmarks/accuracy.py`` 13% worse, 10 is
 #: within 4% of the fits over every vertex on each binary marching-cubes mesh there, ``benchmarks/scale_default.py``).
 COARSE_CELLS = 10.0
+#: The median edge length that decides is taken over this many edges, evenly spaced (a threshold: a sample will do).
+COARSE_SAMPLE = 65536
 
 #: A fitted normal is kept where its cosine with the mean of the face normals exceeds this (60 degrees).
 NORMAL_AGREEMENT = 0.5
@@ -183,10 +185,14 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
         return None
     typical = float(np.median(radius))
     indptr, indices = adjacency
-    tails = np.repeat(np.arange(n), np.diff(indptr))
-    lengths = np.linalg.norm(vertices[indices] - vertices[tails], axis=1)
-    if not lengths.size or not typical > COARSE_EDGES * float(np.median(lengths)):
+    if indices.size == 0:
         return None
+    taken = np.linspace(0, indices.size - 1, min(indices.size, COARSE_SAMPLE)).round().astype(np.int64)
+    tails = np.searchsorted(indptr, taken, side="right") - 1
+    lengths = np.linalg.norm(vertices[indices[taken]] - vertices[tails], axis=1)
+    if not typical > COARSE_EDGES * float(np.median(lengths)):
+        return None
+    tails = np.repeat(np.arange(n), np.diff(indptr))
     cell = typical / COARSE_CELLS
     members = np.flatnonzero(inside)
     corner = vertices[members].min(axis=0)
