@@ -329,8 +329,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
     if adaptive and len(groups) == 1:
         return _adaptive(mesh, groups[0][0], parameters, defects, valid, stages)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor
-        radii_v = vertex_radii(groups, vertices.shape[0]) * local_scale_ratios(vertices, topology)
-        if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not np.all(radii_v == radii_v[0]):
+        ratios = local_scale_ratios(vertices, topology)
+        radii_v = vertex_radii(groups, vertices.shape[0]) * ratios
+        if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not np.all(ratios == 1.0):
             k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
                 vertices, topology.faces, degenerate, normals, valid, radii_v, stages, neighbours=referenced,
                 adjacency=_adjacency(topology), areas=_vertex_areas(mesh), weighted=True)
