@@ -423,3 +423,71 @@ def test_normal_fits_shrink_to_one_sheet_of_a_thin_plate():
     assert np.isfinite(radii[inner]).all()
     assert radii[inner].max() <= 1.03 * 0.4
     assert radii[inner].min() >= 0.4 * estimators.SHRINK  # the largest such ball of the sequence 1, 0.71, 0.5, ...
+
+
+# ----------------------------------------------------------------------------- compiled twins and reused searches
+
+def _random_cloud(n, seed):
+    rng = np.random.default_rng(seed)
+    u = rng.normal(size=(n, 3))
+    points = u / np.linalg.norm(u, axis=1, keepdims=True)
+    normals = points * np.where(rng.random(n) < 0.1, -1.0, 1.0)[:, None]  # 10% facing away
+    return points, normals, rng
+
+
+def test_compiled_own_side_keeps_what_the_numpy_path_keeps():
+    pytest.importorskip("numba")
+    from meshcurv._backend import numba_kernels
+
+    points, normals, rng = _random_cloud(3000, 1)
+    from scipy.spatial import cKDTree
+
+    _, index = cKDTree(points).query(points[:500], k=40)
+    counts = rng.integers(3, 41, size=500)
+    index = np.where(np.arange(40)[None, :] < counts[:, None], index, 3000)
+    centres = np.arange(500)
+    sheets = rng.integers(-1, 3, size=3000)
+    for given in (None, sheets):
+        expected = estimators._own_side(normals, centres, index.copy(), counts, given)
+        found = numba_kernels("pointcloud").own_side(normals, centres, index.copy(), counts,
+                                                     np.zeros(0, dtype=np.int64) if given is None else given)
+        np.testing.assert_array_equal(found[0], expected[0])
+        np.testing.assert_array_equal(found[1], expected[1])
+
+
+def test_compiled_edge_geometry_is_that_of_the_gathers():
+    pytest.importorskip("numba")
+    from meshcurv._backend import numba_kernels
+
+    points, normals, _ = _random_cloud(2000, 2)
+    from scipy.spatial import cKDTree
+
+    _, indices = normals_module.knn(cKDTree(points), points, k=6)
+    length, ahead, behind, cosine = numba_kernels("pointcloud").edge_geometry(points, normals, indices)
+    offsets = points[indices] - points[:, None, :]
+    # sums of three products of numbers of size <= 2: round-off of a few units of 2e-16
+    np.testing.assert_allclose(length, np.linalg.norm(offsets, axis=2), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(ahead, np.einsum("nkj,nj->nk", offsets, normals), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(behind, np.einsum("nkj,nkj->nk", offsets, normals[indices]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(cosine, np.einsum("nj,nkj->nk", normals, normals[indices]), rtol=0, atol=1e-15)
+
+
+def test_the_neighbours_kept_after_merging_near_copies_are_those_of_a_new_search():
+    # near copies merged: the kept points' neighbours are reused (searched again only where a copy went), and
+    # equal those of a new k-d tree over the kept points
+    from scipy.spatial import cKDTree
+
+    from meshcurv import pointcloud
+
+    points, _, rng = _random_cloud(5000, 3)
+    pick = rng.choice(5000, 60, replace=False)
+    cloud = np.concatenate([points, points[pick] * (1 + 1e-12)])[rng.permutation(5060)]
+    copy_of, search = pointcloud._near_copies(cloud)
+    keep = copy_of == np.arange(cloud.shape[0])
+    assert (~keep).sum() == 60
+    _, distances, indices = pointcloud._kept_search(cloud[keep], keep, *search[1:])
+    expected_distances, expected_indices = normals_module.knn(cKDTree(cloud[keep]), cloud[keep])
+    np.testing.assert_array_equal(indices, expected_indices)
+    np.testing.assert_array_equal(distances, expected_distances)
+    # more than a tenth gone: searched again from scratch
+    assert pointcloud._kept_search(cloud[keep], np.arange(10) < 5, *search[1:]) is None

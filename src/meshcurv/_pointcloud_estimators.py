@@ -6,12 +6,16 @@ Both take trusted arrays (float64 points, unit oriented normals) and return
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
 from ._tensors import principal_from_shape_operator
 from .measures import curvatures_from_measures, face_measures
 from .jets import fit_jets, jet_normals, shape_operators
+
+logger = logging.getLogger(__name__)
 
 #: Degree of the jets of ``method="jets"`` (Cazals and Pouget 2005: error of order ``r^(d-1)``).
 JET_DEGREE = 3
@@ -104,7 +108,9 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
     of the fitted jets (the given ones where the fit failed). ``details``
     receives ``"radii"``: (N,) the radius of each point's fit.
     """
+    logger.debug("point cloud: jet fits")
     coefficients, frame, radii = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest)
+    logger.debug("point cloud: curvatures of the jets")
     if details is not None:
         details["radii"] = radii
     six, fitted = shape_operators(coefficients, frame, 1.0)
@@ -127,10 +133,12 @@ def fitted_normals(points, normals, radius, centres, usable, *, smallest: float,
     (:func:`one_sided_fits`); ``details`` receives ``"radii"``, (N,) the
     radius of each point's fit.
     """
+    logger.debug("point cloud: normal fits")
     coefficients, frame, radii = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest,
                                                 degree=3, iterations=NORMAL_ITERATIONS)
     if details is not None:
         details["radii"] = radii
+    logger.debug("point cloud: measures")
     fitted = jet_normals(coefficients, frame)
     ok = np.isfinite(fitted).all(axis=1)
     return np.where(ok[:, None], fitted, normals)
@@ -257,11 +265,16 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
         search = _usable_tree(tree, points, usable)
     for start in range(0, centres.size, CHUNK):
         chunk = centres[start:start + CHUNK]
+        logger.debug("point cloud: ball search")
         if kernels is not None:
             index, _, counts = kernels.ball_indices(points, chunk, float(radius), k, *grid, 64 * kernel_threads())
+            index, counts = kernels.own_side(normals, chunk, index, counts,
+                                             np.zeros(0, dtype=np.int64) if sheets is None
+                                             else np.ascontiguousarray(sheets, dtype=np.int64))
         else:
             index, counts = _ball_indices(search, points, chunk, radius, k)
-        index, counts = _own_side(normals, chunk, index, counts, sheets)
+            index, counts = _own_side(normals, chunk, index, counts, sheets)
+        logger.debug("point cloud: triangle sums")
         rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
         if rows.size == 0:
             continue

@@ -140,8 +140,15 @@ INTERLEAVED_GAP = 0.3
 #: ... (or apart by this many times the spread of each group: two clean sheets closer than that) ...
 INTERLEAVED_SPREAD = 3.0
 
+#: ... (but at least this many spacings: on a clean sheet every gap is a fraction of the curvature's height) ...
+INTERLEAVED_MIN_GAP = 0.1
+
 #: ... at this share of the point's nearest neighbours (itself counted) at least.
 INTERLEAVED_SHARE = 0.25
+
+#: :func:`two_sheets` runs at every point when this share of its sample has two sheets (a thin part of a cloud
+#: of 1M points is seen from about 5000 points).
+INTERLEAVED_SAMPLE = 0.005
 
 #: Query points per chunk of the NumPy far sum (bounds memory: a few (chunk, sources) arrays).
 WINDING_CHUNK = 256
@@ -426,11 +433,16 @@ def oriented_signs(points: np.ndarray, normals: np.ndarray, indices: np.ndarray,
     """
     n = points.shape[0]
     rows, cols, kept = _graph_edges(indices[:, :GRAPH_NEIGHBOURS], usable)
-    offsets = points[cols] - points[rows]
-    length = np.linalg.norm(offsets, axis=1)
-    ahead = np.einsum("ij,ij->i", offsets, normals[rows])
-    behind = np.einsum("ij,ij->i", offsets, normals[cols])
-    cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
+    compiled = numba_kernels("pointcloud")
+    if compiled is not None:  # without (E, 3) gathers
+        geometry = compiled.edge_geometry(points, normals, np.ascontiguousarray(indices[:, :GRAPH_NEIGHBOURS]))
+        length, ahead, behind, cosine = (array.ravel()[kept] for array in geometry)
+    else:
+        offsets = points[cols] - points[rows]
+        length = np.linalg.norm(offsets, axis=1)
+        ahead = np.einsum("ij,ij->i", offsets, normals[rows])
+        behind = np.einsum("ij,ij->i", offsets, normals[cols])
+        cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
     with np.errstate(invalid="ignore", divide="ignore"):
         slope = np.maximum(np.abs(ahead), np.abs(behind)) / length
     flat = slope <= SHEET_SLOPE  # NaN (a zero offset) is not flat
@@ -741,7 +753,8 @@ def two_sheets(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spac
     :data:`INTERLEAVED_SHARE` of its nearest neighbours have two sheets.
 
     Both are evaluated at :data:`WINDING_QUERIES` evenly spaced points first,
-    and at every point when any of those is flagged.
+    and at every point when any of those is ``alike`` or at least
+    :data:`INTERLEAVED_SAMPLE` of them have two sheets.
     """
     n = points.shape[0]
     alike, interleaved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
@@ -751,7 +764,7 @@ def two_sheets(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spac
     step = float(np.median(spacing[candidates]))
     sample = _evenly(candidates, WINDING_QUERIES)
     found = _sheet_signs(points, normals, usable, step, tree, sample)
-    if sample.size < candidates.size and (found[0].any() or found[1].any()):
+    if sample.size < candidates.size and (found[0].any() or found[3].mean() >= INTERLEAVED_SAMPLE):
         found = _sheet_signs(points, normals, usable, step, tree, candidates)
         sample = candidates
     hit, near, flags, two = found
@@ -837,7 +850,8 @@ def _two_heights(points, group, usable, step):
     # the spread of each group: two clean sheets closer than the noise of a noisy one are two sheets too
     lower = height[rows, widest] - height[:, 0]
     upper = height[rows, np.maximum(count - 1, 0)] - height[rows, np.minimum(widest + 1, height.shape[1] - 1)]
-    apart = (gap >= INTERLEAVED_GAP * step) | (gap >= INTERLEAVED_SPREAD * np.maximum(lower, upper))
+    apart = (gap >= INTERLEAVED_GAP * step) | ((gap >= INTERLEAVED_SPREAD * np.maximum(lower, upper))
+                                              & (gap >= INTERLEAVED_MIN_GAP * step))
     return apart & (gap <= STACKED_OFFSET * step) & (below >= INTERLEAVED_GROUP) & (count - below >= INTERLEAVED_GROUP)
 
 

@@ -146,6 +146,10 @@ COPY_GAP = 1e-3
 #: nearest :data:`COPY_NEIGHBOURS` are searched for the gap.
 COPY_SUSPECT = 1e-2
 
+#: When near copies are merged, the neighbours of the points kept are those found before (searched again where one
+#: of them went) unless more than this share of the points went (then all are searched again).
+KEPT_SEARCH_SHARE = 0.1
+
 #: Most copies of one point found (see :data:`COPY_SUSPECT`).
 COPY_NEIGHBOURS = 64
 
@@ -239,6 +243,7 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     >>> print(f"{np.median(r.mean):.3f}", r.parameters["normals"])
     0.500 estimated
     """
+    logger.info("point cloud: checks, duplicates and near copies")
     method = POINT_CLOUD_METHODS[0] if method is None else check_choice(method, "method", POINT_CLOUD_METHODS)
     points = as_vertices(point_array(points), name="points")
     given = None if normals is None else _checked_normals(normals, points.shape)
@@ -258,9 +263,11 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     if unique.size >= MIN_POINTS:
         # near copies (round-off differences) are merged into the first of them in the Morton order
         copy_of, search = _near_copies(points[unique])
-        if search is None:
+        keep = copy_of == np.arange(unique.size)
+        if not keep.all():
             representative = unique[copy_of][_position(unique, n_all)[representative]]
-            unique = unique[copy_of == np.arange(unique.size)]
+            unique = unique[keep]
+            search = _kept_search(points[unique], keep, *search[1:])
     if unique.size < n_all:
         near = n_all - unique.size - n_exact
         found = [f"{n_exact} points coincide with others (duplicates)"] if n_exact else []
@@ -281,6 +288,7 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, found = _compute(
         cloud, None if given is None else given[unique], radius, method, search)
     problems.extend(found)
+    logger.info("point cloud: results")
 
     # back to all points: each duplicate takes its representative's values
     take = _position(unique, n_all)[representative]
@@ -295,6 +303,7 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     if problems:
         warnings.warn("point cloud: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
     reason = np.where(valid, 0, np.where(reason > 0, reason, _UNDEFINED)).astype(np.int8)
+    logger.info("point cloud: done")
     return CurvatureResult._of_arrays(k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max,
                                       normals=out_normals, valid=valid, method=method, parameters=parameters,
                                       invalid_reason=reason)
@@ -309,7 +318,7 @@ def _position(unique: np.ndarray, n: int) -> np.ndarray:
 
 def _near_copies(cloud: np.ndarray):
     """``(copy_of, search)``: (M,) the point each point of ``cloud`` is a copy of (itself when none), and
-    ``(tree, distances, indices)`` of ``cloud`` for :func:`_compute` when there is no copy (else None).
+    ``(tree, distances, indices)`` of ``cloud`` (:func:`_kept_search` makes them those of the points kept).
 
     Point ``j`` is a copy of ``i`` when it is among ``i``'s nearest neighbours before a gap:
     ``d_m <= COPY_GAP d_(m+1)`` for the ``m``-th and next distances (the largest such ``m``). Groups
@@ -340,7 +349,32 @@ def _near_copies(cloud: np.ndarray):
     _, labels = connected_components(graph, directed=False)
     first = np.full(int(labels.max()) + 1, m, dtype=np.int64)
     np.minimum.at(first, labels, np.arange(m))
-    return first[labels], None
+    return first[labels], (tree, distances, indices)
+
+
+def _kept_search(kept: np.ndarray, keep: np.ndarray, distances: np.ndarray, indices: np.ndarray):
+    """``(tree, distances, indices)`` of the points ``kept`` (M,), those of ``keep`` of a cloud whose neighbours
+    were ``distances, indices``; or None when more than :data:`KEPT_SEARCH_SHARE` of its points went.
+
+    A kept point whose nearest neighbours were all kept has the same nearest neighbours among the kept points;
+    the others are searched again.
+    """
+    from scipy.spatial import cKDTree
+
+    if (~keep).mean() > KEPT_SEARCH_SHARE:
+        return None
+    tree = cKDTree(kept)
+    position = np.cumsum(keep) - 1
+    distances, indices = distances[keep], indices[keep]
+    again = np.flatnonzero((~keep[indices]).any(axis=1))
+    indices = position[indices]
+    if again.size:
+        k = distances.shape[1]
+        d, i = tree.query(kept[again], k=k + 1, workers=-1)
+        found_distances, found_indices = np.zeros((again.size, k)), np.zeros((again.size, k), dtype=np.int64)
+        _drop_rows(again, d, i, k, found_distances, found_indices)
+        distances[again], indices[again] = found_distances, found_indices
+    return tree, distances, indices
 
 
 def _drop_rows(centres, d, i, k, distances, indices) -> None:
@@ -475,6 +509,7 @@ def _compute(points, given, radius, method, search=None):
     logger.info("point cloud: normals")
     if given is None:
         start = _normals.pca_normals(points, indices)
+        logger.info("point cloud: orientation")
         signs, labels, doubtful, sheets, unsettled = _normals.oriented_signs(points, start, indices, usable, spacing,
                                                                              tree)
         start = start * signs[:, None]
@@ -565,6 +600,7 @@ def _compute(points, given, radius, method, search=None):
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
     alike = np.zeros(n, dtype=bool)
     if how != "given":
+        logger.info("point cloud: stacked sheets")
         # a sheet stacked on another with normals the same way (one of the two is inside out), and two sheets
         # closer than the spacing, whose points mix (the faces of a part thinner than that)
         alike, interleaved = _normals.two_sheets(points, out_normals, usable, spacing, tree)

@@ -270,3 +270,55 @@ def far_winding(points, normals, weights, soft, sources, queries, reach_squared)
                 total += weights[j] * (dx * normals[s, 0] + dy * normals[s, 1] + dz * normals[s, 2]) / (d * np.sqrt(d))
         out[i] = total
     return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def own_side(normals, centres, index, counts, sheets):
+    """``(index, counts)``: the balls ``index`` (M, k) less their points facing away from their centre, in place.
+
+    The compiled :func:`meshcurv._pointcloud_estimators._own_side`: a point ``j`` of the ball of ``c`` (the first
+    ``counts`` of its row) goes when ``n_j . n_c < 0``, or when ``sheets`` (N,) is not empty and ``j`` and ``c`` are
+    on two sheets (both >= 0); the kept points stay in order, the row is padded with ``N``.
+    """
+    n = normals.shape[0]
+    m, k = index.shape
+    kept = np.zeros(m, dtype=np.int64)
+    by_sheet = sheets.shape[0] == n
+    for row in nb.prange(m):
+        c = centres[row]
+        cx, cy, cz = normals[c, 0], normals[c, 1], normals[c, 2]
+        own = sheets[c] if by_sheet else -1
+        found = 0
+        for a in range(counts[row]):
+            j = index[row, a]
+            if normals[j, 0] * cx + normals[j, 1] * cy + normals[j, 2] * cz < 0:
+                continue
+            if own >= 0 and sheets[j] >= 0 and sheets[j] != own:
+                continue
+            index[row, found] = j
+            found += 1
+        for a in range(found, k):
+            index[row, a] = n
+        kept[row] = found
+    return index, kept
+
+
+@nb.njit(parallel=True, **_JIT)
+def edge_geometry(points, normals, indices):
+    """(N, k) four times: ``|d|``, ``n_i . d``, ``n_j . d`` and ``n_i . n_j`` of each edge ``d = p_j - p_i``,
+    ``j = indices[i, c]`` (the edges of :func:`meshcurv._pointcloud_normals.oriented_signs`, without (E, 3)
+    gathers)."""
+    n, k = indices.shape
+    length, ahead, behind, cosine = np.zeros((n, k)), np.zeros((n, k)), np.zeros((n, k)), np.zeros((n, k))
+    for i in nb.prange(n):
+        px, py, pz = points[i, 0], points[i, 1], points[i, 2]
+        ax, ay, az = normals[i, 0], normals[i, 1], normals[i, 2]
+        for c in range(k):
+            j = indices[i, c]
+            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+            bx, by, bz = normals[j, 0], normals[j, 1], normals[j, 2]
+            length[i, c] = np.sqrt(dx * dx + dy * dy + dz * dz)
+            ahead[i, c] = dx * ax + dy * ay + dz * az
+            behind[i, c] = dx * bx + dy * by + dz * bz
+            cosine[i, c] = ax * bx + ay * by + az * bz
+    return length, ahead, behind, cosine

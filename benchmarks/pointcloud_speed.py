@@ -1,0 +1,98 @@
+"""Speed of meshcurv's point-cloud curvatures, stage by stage (issue 31: 1M points in <= 5 s wall).
+
+Torus samples (R 3, r 1, uniform by area, as ``benchmarks/pointcloud.py``),
+normals estimated, both methods, end to end. The stages are the log messages
+of :mod:`meshcurv.pointcloud` and :mod:`meshcurv._pointcloud_estimators`
+(INFO and DEBUG): a stage lasts from its message to the next one; repeated
+messages (chunks) are summed. Wall seconds and CPU seconds of the process (all
+threads); the load average of the machine at the end (other processes share
+its cores: the wall time grows with the load, the CPU time much less).
+No peer: Open3D (which estimates normals, not curvatures) is not installed.
+
+Usage::
+
+    python benchmarks/pointcloud_speed.py                   # 100k and 1M points
+    python benchmarks/pointcloud_speed.py --sizes 100000    # one size
+    python benchmarks/pointcloud_speed.py --repeat 1        # one run each (default: the median of 3)
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import logging
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from pointcloud import sample  # noqa: E402
+
+from meshcurv.pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures  # noqa: E402
+
+
+class StageClock(logging.Handler):
+    """Collects the wall and CPU time between consecutive log messages of the point-cloud modules."""
+
+    def __init__(self):
+        super().__init__(level=logging.DEBUG)
+        self.marks = []
+
+    def emit(self, record):
+        label = record.msg.replace("%d ", "").replace("%s ", "")
+        self.marks.append((label, time.perf_counter(), time.process_time()))
+
+    def stages(self, end_wall, end_cpu):
+        totals = collections.OrderedDict()
+        ends = self.marks[1:] + [("end", end_wall, end_cpu)]
+        for (label, wall, cpu), (_, next_wall, next_cpu) in zip(self.marks, ends):
+            old = totals.get(label, (0.0, 0.0))
+            totals[label] = (old[0] + next_wall - wall, old[1] + next_cpu - cpu)
+        return totals
+
+
+def timed(points, method):
+    clock = StageClock()
+    loggers = [logging.getLogger(name) for name in ("meshcurv.pointcloud", "meshcurv._pointcloud_estimators")]
+    for logger in loggers:
+        logger.addHandler(clock)
+        logger.setLevel(logging.DEBUG)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            start, start_cpu = time.perf_counter(), time.process_time()
+            result = point_cloud_curvatures(points, method=method)
+            wall, cpu = time.perf_counter() - start, time.process_time() - start_cpu
+    finally:
+        for logger in loggers:
+            logger.removeHandler(clock)
+    return result, wall, cpu, clock.stages(start + wall, start_cpu + cpu)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[100_000, 1_000_000])
+    parser.add_argument("--methods", nargs="+", default=list(POINT_CLOUD_METHODS))
+    parser.add_argument("--repeat", type=int, default=3, help="runs per size and method (the median one shown)")
+    args = parser.parse_args(argv)
+    timed(sample("torus", 2_000)[0], POINT_CLOUD_METHODS[0])  # compiled kernels loaded before any timing
+    lines = ["| points | method | wall s | CPU s | valid | stages: wall s (CPU s) |", "|---|---|---|---|---|---|"]
+    for n in args.sizes:
+        points = sample("torus", n)[0]
+        for method in args.methods:
+            runs = sorted((timed(points, method) for _ in range(args.repeat)), key=lambda run: run[1])
+            result, wall, cpu, stages = runs[len(runs) // 2]  # the run of median wall time
+            detail = "; ".join(f"{label.replace('point cloud: ', '')} {w:.2f} ({c:.2f})"
+                               for label, (w, c) in stages.items() if w >= 0.005)
+            lines.append(f"| {n} | {method} | {wall:.2f} | {cpu:.2f} | {result.valid.mean():.4f} | {detail} |")
+            print(lines[-1], flush=True)
+    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
+    print("\n".join(["", *lines, "", f"load average at the end: {load} ({os.cpu_count()} cores)"]))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
