@@ -2,7 +2,8 @@
 
 A marching-cubes sphere of radius 6 at the confocal spacing 0.5 x 0.2 x 0.2 (10,172 vertices: its
 balls of about 2.5 units hold hundreds of vertices, the normal fits over three radii thousands),
-a sphere of radius 10 at 0.25 x 0.1 x 0.1, and an icosphere of 100,002 vertices, in the same process.
+a sphere of radius 3 at 0.25 x 0.1 x 0.1 (``--large``: radius 10, 113,072 vertices), and an icosphere of
+100,002 vertices, in the same process.
 Each figure is the median of ``--repeats`` calls after a warm-up (numba's compilation not counted):
 CPU microseconds per vertex, the stage that costs most (from the ``progress`` callback), and the median
 ``|H - H_exact| / max|k|`` (issue 30's target: CPU per vertex within 3 times the icosphere's at <= 1%
@@ -51,10 +52,15 @@ def _timed(vertices, faces, repeats):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--large", action="store_true", help="also a sphere R 10 at 0.25 x 0.1 x 0.1 (113,072 "
+                        "vertices; a minute a call before the coarse level)")
     args = parser.parse_args(argv)
     meshes = [("voxel sphere R 6, 0.5 x 0.2 x 0.2", shapes.voxel_sphere(6.0, (0.5, 0.2, 0.2), seed=0), True),
-              ("voxel sphere R 10, 0.25 x 0.1 x 0.1", shapes.voxel_sphere(10.0, (0.25, 0.1, 0.1), seed=1), True),
-              ("icosphere 100,002", shapes.icosphere(subdivisions=100, radius=1.0), False)]
+              ("voxel sphere R 3, 0.25 x 0.1 x 0.1", shapes.voxel_sphere(3.0, (0.25, 0.1, 0.1), seed=2), True)]
+    if args.large:
+        meshes.append(("voxel sphere R 10, 0.25 x 0.1 x 0.1", shapes.voxel_sphere(10.0, (0.25, 0.1, 0.1), seed=1),
+                       True))
+    meshes.append(("icosphere 100,002", shapes.icosphere(subdivisions=100, radius=1.0), False))
     rows = []
     for name, mesh, inward in meshes:
         faces = mesh.faces[:, ::-1] if inward else mesh.faces
