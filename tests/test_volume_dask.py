@@ -210,10 +210,10 @@ def test_parallel_option_errors(options, message):
 def test_no_label_to_compute_starts_no_cluster(monkeypatch):
     pytest.importorskip("distributed")
 
-    def refuse(client, workers):
+    def refuse(**options):
         raise AssertionError("a cluster was started")
 
-    monkeypatch.setattr(volume, "_cluster", refuse)
+    monkeypatch.setattr(volume.driver, "cluster", refuse)
     with pytest.warns(MeshQualityWarning, match="1 empty"):
         table = label_curvatures(np.zeros((6, 6, 6), dtype=np.uint8), spacing=UNIT, labels_to_use=[3], workers=2)
     assert list(table.status) == ["empty"]

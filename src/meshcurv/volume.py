@@ -199,7 +199,6 @@ surface construction algorithm. SIGGRAPH 87. https://doi.org/10.1145/37402.37422
 
 from __future__ import annotations
 
-import collections
 import contextlib
 import functools
 import logging
@@ -217,6 +216,7 @@ from .measures import face_measures
 from .radius import VOXEL_CURVEDNESS_PERCENTILE, VOXEL_PILOT, voxel_radius
 from .integrals import vertex_integrals, weighted_percentiles
 from .result import CurvatureResult
+from .batch import _driver as driver
 from .statistics import COLUMNS as STATISTICS_COLUMNS
 from ._lazy import as_lazy, check_lazy_labels, is_lazy, lazy_objects
 from ._masks import check_smooth, check_threshold, labels_from_image, smoothed_crop, smoothed_surface
@@ -816,20 +816,6 @@ def _groups(objects, workers: int) -> list[list]:
     return groups
 
 
-@contextlib.contextmanager
-def _cluster(client, workers):
-    """Yield ``(client, owned)``: the given client, or that of a new local cluster (:func:`meshcurv.batch.local_cluster`)."""
-    if client is not None:
-        yield client, False
-        return
-    import dask
-
-    from .batch import local_cluster
-
-    with dask.config.set(CLUSTER_CONFIG), local_cluster(workers=workers, dashboard=False) as local:
-        yield local, True
-
-
 def _lost(outcome, distributed) -> str:
     """The error of a label whose task ended without rows (its worker died, or the task raised)."""
     if isinstance(outcome, distributed.KilledWorker):
@@ -841,62 +827,46 @@ def _lost(outcome, distributed) -> str:
 def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers, smooth=None):
     """As :func:`_iterate` (the same rows, in the same order), each group of labels a task on a Dask cluster.
 
-    Each task gets only its labels' crops (the box padded by one voxel, as a
-    boolean mask), their offsets, the image's shape and the spacing. A task
-    that raises or whose worker dies (:class:`distributed.KilledWorker`) is
-    run again label by label when it held several; a label whose task alone
-    still fails gets a ``failed`` row.
+    The driver is batch's (:func:`meshcurv.batch._driver.run_tasks`). Each task
+    gets only its labels' crops (the box padded by one voxel, as a boolean
+    mask, or its smoothed mask), their offsets, the image's shape and the
+    spacing; the crops are made only for the tasks in flight. A task that
+    raises or whose worker dies (:class:`distributed.KilledWorker`) is run
+    again label by label when it held several; a label whose task alone still
+    fails gets a ``failed`` row.
     """
-    from .batch import _driver as batch  # until this loop is batch._driver.run_tasks (see its docstring)
-
     distributed = _dask()
-    with _cluster(client, workers) as (active, owned):
-        n_workers = batch._worker_count(active)
-        queue = collections.deque(_groups(objects, n_workers))
-        logger.info("%d labels in %d tasks on %d workers", len(objects), len(queue), n_workers)
-        limit = _IN_FLIGHT_PER_WORKER * n_workers
-        watch = batch._WorkerWatch(active, batch.NO_WORKER_SECONDS["local" if owned else "remote"])
-        pending: dict = {}
-        done: dict = {}
-        labels = list(objects)
-        position = 0
-        try:
-            while True:
-                while position < len(labels) and (objects[labels[position]] is None or labels[position] in done):
-                    label = labels[position]
-                    if label in done:
-                        yield done.pop(label)
-                    else:
-                        yield _guarded(label, functools.partial(_one_label, image, label, None, spacing, method,
-                                                                radius), keep_surfaces)
-                    position += 1
-                if position == len(labels):
-                    return
-                while queue and len(pending) < limit:
-                    group = queue.popleft()
-                    crops = [_task_crop(image, label, objects[label], spacing, smooth) for label in group]
-                    future = active.submit(_crop_task, crops, image.shape, spacing, method, radius, keep_surfaces,
-                                           pure=False)
-                    pending[future] = group
-                    del crops
-                for future in batch._finished(distributed, list(pending), watch):
-                    group = pending.pop(future)
-                    outcome = batch._outcome(future)
-                    future.release()
-                    if isinstance(outcome, (InvalidOptionError, MissingDependencyError)):
+    fatal = (InvalidOptionError, MissingDependencyError)
+    with driver.cluster(client=client, workers=workers, dashboard=False, config=CLUSTER_CONFIG) as (active, owned):
+        n_workers = driver._worker_count(active)
+        groups = _groups(objects, n_workers)
+        logger.info("%d labels in %d tasks on %d workers", len(objects), len(groups), n_workers)
+
+        def submit(chosen):
+            return [active.submit(_crop_task, [_task_crop(image, label, objects[label], spacing, smooth)
+                                               for label in group],
+                                  image.shape, spacing, method, radius, keep_surfaces, pure=False)
+                    for group in chosen]
+
+        tasks = driver.run_tasks(active, groups, submit, owned=owned, limit=_IN_FLIGHT_PER_WORKER * n_workers,
+                                 split=lambda outcome: not isinstance(outcome, fatal), items="labels")
+        with contextlib.closing(tasks):
+            done: dict = {}
+            for label, box in objects.items():
+                if box is None:
+                    yield _guarded(label, functools.partial(_one_label, image, label, None, spacing, method, radius),
+                                   keep_surfaces)
+                    continue
+                while label not in done:
+                    group, outcome = next(tasks)
+                    if isinstance(outcome, fatal):
                         raise outcome
-                    if not isinstance(outcome, BaseException):
-                        done.update(zip(group, outcome))
-                    elif len(group) > 1:  # one of its labels kills its worker, or raises: each alone, at once
-                        logger.info("a task of %d labels failed (%s); running them one by one", len(group),
-                                    type(outcome).__name__)
-                        queue.extendleft([label] for label in reversed(group))
-                    else:
+                    if isinstance(outcome, BaseException):
                         logger.debug("label %d failed: %r", group[0], outcome)
                         done[group[0]] = (_empty_row(group[0], "failed", _lost(outcome, distributed)), None)
-        finally:
-            if pending:
-                active.cancel(list(pending))
+                    else:
+                        done.update(zip(group, outcome))
+                yield done.pop(label)
 
 
 def label_surfaces(labels, *, spacing=None, labels_to_use=None, method: str | None = None,
