@@ -153,7 +153,7 @@ def test_missing_zarr_names_the_pip_command(tmp_path, monkeypatch):
         return real_import(name, *args, **kwargs)
 
     monkeypatch.setattr(builtins, "__import__", no_zarr)
-    with pytest.raises(MissingDependencyError, match="reading Zarr images needs the zarr package: pip install zarr"):
+    with pytest.raises(MissingDependencyError, match=r"reading Zarr images needs the zarr package: pip install 'meshcurv\[volume\]'"):
         read_image(tmp_path / "a.zarr")
 
 

@@ -26,7 +26,7 @@ from ..errors import InvalidMeshError, MeshFileError, MissingDependencyError
 
 __all__ = ["read_zarr", "ZARR_INSTALL"]
 
-ZARR_INSTALL = "pip install zarr"
+ZARR_INSTALL = "pip install 'meshcurv[volume]' (or: pip install zarr)"
 
 
 def _zarr():
