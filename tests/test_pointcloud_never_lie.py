@@ -363,3 +363,18 @@ def test_two_spheres_a_gap_apart_are_not_turned_between():
     flips = normals_module.between_sides(points, normals, np.ones(2 * n, dtype=bool),
                                          normals_module.local_spacing(distances), tree, indices)
     assert (flips > 0).all()
+
+
+def test_a_plate_thinner_than_the_spacing_beside_a_coarser_part_is_never_inward_and_valid():
+    # the fuzzer's "mixed" clouds: a 0.02 plate of 400 points beside a sphere of 400 (its spacing about 1.4 times the
+    # plate's): the plate was judged with the median spacing of the whole cloud, the sphere's, and its faces, 0.3
+    # spacings apart, kept one face inward and valid (183 points, case 451 of seed 29)
+    plate, exact, resolved = thin_ellipsoid(400, (1.0, 1.0, 0.02), 451, noise=0.05)
+    ball = sphere(400, seed=451)
+    points = np.concatenate([ball, plate + [0.0, 3.0, 0.0]])
+    r = quiet(points)
+    on_plate = np.arange(800) >= 400
+    inward = r.valid[on_plate] & resolved & (np.einsum("ij,ij->i", r.normals[on_plate], exact) < 0)
+    assert inward.sum() <= 10
+    assert r.valid[~on_plate].mean() > 0.95
+    assert np.median(r.mean[~on_plate][r.valid[~on_plate]]) == pytest.approx(1.0, rel=0.05)

@@ -763,9 +763,9 @@ def two_sheets(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spac
         return alike, interleaved
     step = float(np.median(spacing[candidates]))
     sample = _evenly(candidates, WINDING_QUERIES)
-    found = _sheet_signs(points, normals, usable, step, tree, sample)
+    found = _sheet_signs(points, normals, usable, spacing, step, tree, sample)
     if sample.size < candidates.size and (found[0].any() or found[3].mean() >= INTERLEAVED_SAMPLE):
-        found = _sheet_signs(points, normals, usable, step, tree, candidates)
+        found = _sheet_signs(points, normals, usable, spacing, step, tree, candidates)
         sample = candidates
     hit, near, flags, two = found
     alike[sample[hit]] = True
@@ -780,7 +780,7 @@ def two_sheets(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spac
     return alike & usable, interleaved & usable
 
 
-def _sheet_signs(points, normals, usable, step, tree, queries):
+def _sheet_signs(points, normals, usable, spacing, step, tree, queries):
     """``(hit, near, alike, two)`` of :func:`two_sheets` at ``queries`` (M,), in chunks of :data:`CHUNK`.
 
     ``hit`` (M,): stacked neighbours oriented alike; ``near`` (M, k): the
@@ -799,7 +799,10 @@ def _sheet_signs(points, normals, usable, step, tree, queries):
         alike = _stacked(points, normals, usable, step, q, ball, alike=True)
         hit[rows] = alike.sum(axis=1) >= STACKED_ALIKE_MIN
         flags[rows] = alike
-        two[rows] = _two_heights(points, ball[:, :INTERLEAVED_NEIGHBOURS + 1], usable, step)
+        group = ball[:, :INTERLEAVED_NEIGHBOURS + 1]
+        # the spacing of the neighbourhood (the median over the cloud is another part's in a cloud of two densities)
+        local = np.median(np.where(usable[group], spacing[group], np.nan), axis=1)
+        two[rows] = _two_heights(points, group, usable, np.where(np.isfinite(local), local, step))
     return hit, near, flags, two
 
 
@@ -831,14 +834,15 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool):
 
 def _two_heights(points, group, usable, step):
     """(M,) bool: the heights of the points ``group`` (M, k) (the centre first) across their least-variance
-    direction, within :data:`INTERLEAVED_REACH` of the centre along it, fall into two groups (see :func:`two_sheets`)."""
+    direction, within :data:`INTERLEAVED_REACH` of the centre along it, fall into two groups (see :func:`two_sheets`).
+    ``step`` (M,): the spacing of each group."""
     cloud = points[group]
     centred = cloud - cloud.mean(axis=1, keepdims=True)
     _, vectors = np.linalg.eigh(np.einsum("mki,mkj->mij", centred, centred))
     offsets = cloud - cloud[:, :1]
     height = np.einsum("mkj,mj->mk", offsets, vectors[:, :, 0])
     across = np.einsum("mkj,mkj->mk", offsets, offsets) - height * height
-    inside = (across <= (INTERLEAVED_REACH * step) ** 2) & usable[group]
+    inside = (across <= (INTERLEAVED_REACH * step[:, None]) ** 2) & usable[group]
     height = np.sort(np.where(inside, height, np.inf), axis=1)
     count = inside.sum(axis=1)
     with np.errstate(invalid="ignore"):
