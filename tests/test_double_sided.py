@@ -136,3 +136,72 @@ def test_the_batch_table_totals_a_double_sided_sphere_once(tmp_path):
     assert row["total_gaussian"] == pytest.approx(4 * np.pi, abs=1e-9)
     assert row["n_invalid"] == 0
     assert f"dropped {SPHERE.faces.shape[0]} faces" in row["warnings"]
+
+
+# ---- closed parts stored twice, with vertices of their own (coincident copies) ----
+
+def _stored_twice(mesh, *, reverse: bool, seed: int = 0):
+    """``mesh`` and a coincident copy: its vertices shuffled and moved by round-off, its faces in another order."""
+    rng = np.random.default_rng(seed)
+    n = mesh.vertices.shape[0]
+    permutation = rng.permutation(n)
+    inverse = np.argsort(permutation)
+    copy_vertices = mesh.vertices[permutation] * (1.0 + 1e-13)
+    copy_faces = inverse[mesh.faces][rng.permutation(mesh.faces.shape[0])]
+    if reverse:
+        copy_faces = copy_faces[:, ::-1]
+    return (np.vstack([mesh.vertices, copy_vertices]), np.vstack([mesh.faces, copy_faces + n]),
+            permutation)
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+@pytest.mark.parametrize("method", ["icc", "normal_cycle", "quadric", "meyer"])
+def test_a_closed_part_stored_twice_is_measured_once(method, reverse):
+    sphere = shapes.icosphere(3, radius=2.0)
+    vertices, faces, permutation = _stored_twice(sphere, reverse=reverse)
+    n = sphere.vertices.shape[0]
+    with pytest.warns(meshcurv.errors.MeshQualityWarning, match=rf"closed parts stored twice.*\({n} vertices of copies\)"):
+        result = meshcurv.principal_curvatures(vertices, faces, method=method)
+    assert result.parameters["n_copy_vertices"] == n
+    assert result.valid.all()
+    # the sphere's curvature everywhere, and each copy's vertex has the value of the vertex it repeats
+    np.testing.assert_allclose(result.mean, 0.5, rtol=0.05)
+    np.testing.assert_array_equal(result.mean[n:], result.mean[permutation])
+    # Gauss-Bonnet counts the surface once: 4 pi, not 8 pi
+    assert result.integral("gaussian") == pytest.approx(4.0 * np.pi, rel=1e-9)
+    # and every figure is that of the sphere stored once
+    once = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method)
+    assert result.integral("area") == pytest.approx(once.integral("area"), rel=1e-9)
+    np.testing.assert_allclose(result.mean[:n], once.mean, rtol=1e-9)
+
+
+def test_near_copies_and_distinct_parts_are_not_merged():
+    sphere = shapes.icosphere(3)
+    # a second sphere of the same mesh moved by a tenth of an edge: a distinct part, not a copy
+    moved = sphere.vertices + [0.05, 0.0, 0.0]
+    vertices = np.vstack([sphere.vertices, moved])
+    faces = np.vstack([sphere.faces, sphere.faces + sphere.vertices.shape[0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", meshcurv.errors.MeshQualityWarning)  # two intersecting spheres: other warnings may come
+        result = meshcurv.principal_curvatures(vertices, faces)
+    assert result.parameters["n_copy_vertices"] == 0
+    assert result.integral("gaussian") == pytest.approx(8.0 * np.pi, rel=1e-9)
+    # two spheres far apart: no copy either, and no warning at all
+    far = np.vstack([sphere.vertices, sphere.vertices + [10.0, 0.0, 0.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = meshcurv.principal_curvatures(far, faces)
+    assert result.parameters["n_copy_vertices"] == 0
+
+
+def test_weld_false_keeps_the_copies_each_outward():
+    # weld=False: both copies measured, neither taken for a cavity of the other (the corner tested for
+    # nesting lies on the other copy's surface): H = +1/R on both, and totals count the surface twice
+    sphere = shapes.icosphere(2)
+    vertices, faces, _ = _stored_twice(sphere, reverse=False, seed=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = meshcurv.principal_curvatures(vertices, faces, weld=False)
+    assert result.parameters["n_copy_vertices"] == 0
+    assert (result.mean[result.valid] > 0).all() and result.valid.all()
+    assert result.integral("gaussian") == pytest.approx(8.0 * np.pi, rel=1e-9)

@@ -27,7 +27,7 @@ from .geometry import degenerate_faces, face_cross_products, vertex_length_scale
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import CurvatureResult, Surface
 from .topology import MeshTopology
-from .weld import drop_double_sided, weld_vertices
+from .weld import Welding, drop_closed_copies, drop_double_sided, weld_vertices
 
 __all__ = ["PreparedMesh", "prepare_mesh"]
 
@@ -50,6 +50,8 @@ class PreparedMesh:
         The orientation applied (``'auto'`` resolved).
     n_welded, n_double_sided, n_flipped : int
         Vertices welded, faces of a second side dropped, faces reversed.
+    n_copies : int
+        Vertices of closed parts stored twice, measured once (:func:`meshcurv.weld.drop_closed_copies`).
     """
 
     vertices: np.ndarray
@@ -60,6 +62,7 @@ class PreparedMesh:
     n_welded: int = 0
     n_double_sided: int = 0
     n_flipped: int = 0
+    n_copies: int = 0
 
     @classmethod
     def as_given(cls, vertices: np.ndarray, topology: MeshTopology) -> PreparedMesh:
@@ -111,6 +114,10 @@ class PreparedMesh:
         if self.n_welded:
             notes.append(f"welded {self.n_welded} coincident vertices (a triangle soup or split seams) "
                          "before the computation; copies share their values")
+        if self.n_copies:
+            notes.append(f"found closed parts stored twice, their vertices coincident ({self.n_copies} vertices "
+                         "of copies): each measured once, a copy's vertices get the values of the part they repeat "
+                         "and totals count it once (result.parameters['n_copy_vertices'])")
         if self.n_double_sided:
             notes.append(f"dropped {self.n_double_sided} faces that repeat another face's corners with the "
                          "opposite winding (a double-sided mesh): computed on one side "
@@ -161,6 +168,14 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     welded = welding if welding is not None and welding.n_welded else None
     if welded is not None:
         points, topology = welded.vertices, welded.topology
+    copies = drop_closed_copies(points, topology) if weld else None
+    n_copies = 0
+    if copies is not None and copies.n_welded:  # one welding: the caller's vertices onto the surface measured once
+        n_copies = copies.n_welded
+        first = welded.index if welded is not None else np.arange(points.shape[0])
+        welded = Welding(copies.vertices, copies.topology, copies.index[first],
+                         (welded.n_welded if welded is not None else 0))
+        points, topology = welded.vertices, welded.topology
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
     topology, n_flipped = oriented_topology(points, one_sided.topology, orient)
     # the row computed for each of the caller's vertices (welded vertices, in the local order)
@@ -173,4 +188,4 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     else:
         surface = Surface(points, topology.faces, index)
     return PreparedMesh(points, topology, index, surface, orient, welded.n_welded if welded is not None else 0,
-                        one_sided.n_dropped, n_flipped)
+                        one_sided.n_dropped, n_flipped, n_copies)

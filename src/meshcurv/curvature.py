@@ -120,7 +120,10 @@ def principal_curvatures(
         copies of a welded vertex get the same values. Default: True for every
         method but ``'matgeom'`` (matGeom's numbers); the number of vertices
         welded is ``result.parameters["n_welded_vertices"]`` and is given in
-        the warning.
+        the warning. A closed part stored twice, its vertices coincident
+        (:func:`meshcurv.weld.drop_closed_copies`), is measured once, its
+        copy's vertices getting the same values
+        (``result.parameters["n_copy_vertices"]``, in the warning).
     progress : callable, optional
         Called as ``progress(stage, index, total)`` when each stage starts (matGeom's
         ShowProgress, per stage). Stage messages also go to the ``meshcurv``
@@ -319,7 +322,7 @@ def _finished(mesh, estimator, result: CurvatureResult, problems: list, found: d
     diagnosis = mesh_diagnosis(points, topology, mesh.n_flipped, mesh.length_scales)  # checked by prepare_mesh
     reasons = mesh.defects(boundary=estimator.boundary).reasons(result.valid)
     parameters = {**result.parameters, **found, "orient": mesh.orient, "n_welded_vertices": mesh.n_welded,
-                  "n_double_sided_faces": mesh.n_double_sided}
+                  "n_copy_vertices": mesh.n_copies, "n_double_sided_faces": mesh.n_double_sided}
     result = mesh.expand(dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons,
                                              parameters=parameters, _surface=mesh.surface))
     if mesh.n_flipped:

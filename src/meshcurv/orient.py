@@ -202,8 +202,10 @@ def _nesting_depth(vertices, faces, patch, closed) -> np.ndarray:
     One corner of each closed patch is tested against every other closed patch
     whose bounding box holds it, by the winding number of that patch (the sum
     of the solid angles of its faces, Van Oosterom and Strackee 1983): about 1
-    inside, 0 outside. The loop runs over these (patch, patch) candidates only,
-    none on a mesh with one closed part.
+    inside, 0 outside. A corner within 1e-6 of the other patch's size from one
+    of its corners (a part stored twice, its copy coincident) is inside
+    neither. The loop runs over these (patch, patch) candidates only, none on
+    a mesh with one closed part.
     """
     depth = np.zeros(closed.shape[0], dtype=np.int64)
     ids = np.flatnonzero(closed)
@@ -229,7 +231,9 @@ def _nesting_depth(vertices, faces, patch, closed) -> np.ndarray:
         denominator = (lp * lq * lr + np.einsum("ij,ij->i", p, q) * lr + np.einsum("ij,ij->i", p, r) * lq
                        + np.einsum("ij,ij->i", q, r) * lp)
         winding = np.sum(2 * np.arctan2(numerator, denominator)) / (4 * np.pi)
-        depth[ids[i]] += abs(winding) > 0.5
+        # a probe on a corner of patch j (a part stored twice) is on its surface, inside neither
+        touching = np.min(np.minimum(np.minimum(lp, lq), lr)) <= 1e-6 * np.linalg.norm(upper[j] - lower[j])
+        depth[ids[i]] += (abs(winding) > 0.5) and not touching
     return depth
 
 

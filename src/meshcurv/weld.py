@@ -23,7 +23,7 @@ import numpy as np
 from .orient import face_flips
 from .topology import MeshTopology
 
-__all__ = ["Welding", "weld_vertices", "WELD_TOLERANCE_RATIO", "OneSided", "drop_double_sided"]
+__all__ = ["Welding", "weld_vertices", "WELD_TOLERANCE_RATIO", "OneSided", "drop_double_sided", "drop_closed_copies"]
 
 #: Vertices closer than this times the median edge length are copies of one point.
 WELD_TOLERANCE_RATIO = 1e-5
@@ -97,11 +97,9 @@ def weld_vertices(vertices: np.ndarray, topology: MeshTopology, *,
     if not topology.boundary_edges.any():
         return unchanged
     candidates = np.flatnonzero(topology.boundary_vertices)
-    lengths = np.linalg.norm(vertices[topology.edges[:, 0]] - vertices[topology.edges[:, 1]], axis=1)
-    lengths = lengths[lengths > 0]
-    if candidates.size < 2 or lengths.size == 0:
+    tolerance = _tolerance(vertices, topology, tolerance_ratio)
+    if candidates.size < 2 or tolerance == 0.0:
         return unchanged
-    tolerance = tolerance_ratio * float(np.median(lengths))
     from scipy.sparse import coo_matrix  # imported on use: keeps `import meshcurv` fast
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
@@ -234,3 +232,96 @@ def drop_double_sided(vertices: np.ndarray, topology: MeshTopology) -> OneSided:
     if other.any():
         kept = MeshTopology._build(np.where(other[:, None], kept_faces[:, ::-1], kept_faces), topology.n_vertices)
     return OneSided(kept, dropped, n_dropped)
+
+
+def _tolerance(vertices: np.ndarray, topology: MeshTopology, tolerance_ratio: float) -> float:
+    """``tolerance_ratio`` times the median length of the mesh's edges of non-zero length (0 with none)."""
+    lengths = np.linalg.norm(vertices[topology.edges[:, 0]] - vertices[topology.edges[:, 1]], axis=1)
+    lengths = lengths[lengths > 0]
+    return tolerance_ratio * float(np.median(lengths)) if lengths.size else 0.0
+
+
+def drop_closed_copies(vertices: np.ndarray, topology: MeshTopology, *,
+                       tolerance_ratio: float = WELD_TOLERANCE_RATIO) -> Welding:
+    """Measure a closed part stored twice once: drop the faces of its coincident copies.
+
+    Two closed parts whose vertices coincide point for point (a part exported
+    twice, a scene holding an object and its copy in place) describe one
+    surface. Each copy alone has the right curvature, but every total counts
+    the surface as often as it is stored (the total Gaussian curvature of a
+    sphere stored twice is ``8 pi``). Welding does not see them: their
+    vertices are on no boundary edge.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3), float64
+        Validated coordinates.
+    topology : MeshTopology
+        The mesh's connectivity (after welding).
+    tolerance_ratio : float, default: 1e-5
+        A vertex of a copy lies within ``tolerance_ratio`` times the median
+        edge length of a vertex of the part it repeats.
+
+    Returns
+    -------
+    Welding
+        The mesh without the copies' vertices and faces; ``index`` maps every
+        input vertex to its vertex (a copy's vertex to the one it repeats);
+        ``n_welded`` is the number of vertices of the dropped copies. The
+        inputs themselves when no copy was found.
+
+    Notes
+    -----
+    Candidates are the closed components (no boundary edge) with the same
+    number of vertices and centroids within the tolerance; a candidate is a
+    copy of the lowest-numbered such component when each of its vertices has
+    one of that component's vertices within the tolerance, whatever the order
+    of the vertices and faces and the winding. Only meshes with two closed
+    components or more cost more than a look at their component sizes.
+    """
+    n_vertices = vertices.shape[0]
+    unchanged = Welding(vertices, topology, np.arange(n_vertices), 0)
+    n_components, labels = topology.vertex_components
+    if n_components < 2:
+        return unchanged
+    referenced = labels >= 0
+    sizes = np.bincount(labels[referenced], minlength=n_components)
+    open_parts = np.zeros(n_components, dtype=bool)
+    open_parts[labels[topology.boundary_vertices & referenced]] = True
+    repeated_size = np.bincount(sizes[~open_parts], minlength=sizes.max() + 1)[sizes] > 1
+    closed = np.flatnonzero(~open_parts & repeated_size & (sizes >= 4))
+    if closed.size < 2:
+        return unchanged
+    tolerance = _tolerance(vertices, topology, tolerance_ratio)
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    members = referenced & np.isin(labels, closed)
+    centroids = np.column_stack([np.bincount(labels[members], vertices[members, k], minlength=n_components)
+                                 for k in range(3)])[closed] / sizes[closed, None]
+    pairs = cKDTree(centroids).query_pairs(max(tolerance, 0.0), output_type="ndarray")
+    if pairs.size == 0:
+        return unchanged
+    order = np.argsort(labels, kind="stable")
+    starts = np.r_[0, np.cumsum(np.bincount(labels[referenced], minlength=n_components))]
+    first = np.sum(~referenced)  # the unreferenced vertices (-1) come first in ``order``
+    representative = np.arange(n_vertices)
+    copy_of: dict[int, int] = {}
+    candidates = np.sort(closed[pairs], axis=1)  # (a, b), a < b, in order: the first part of a group is kept
+    for a, b in candidates[np.lexsort((candidates[:, 1], candidates[:, 0]))].tolist():
+        if sizes[a] != sizes[b] or b in copy_of:
+            continue
+        a = copy_of.get(a, a)  # a copy of a copy repeats the first
+        part_a = order[first + starts[a]:first + starts[a + 1]]
+        part_b = order[first + starts[b]:first + starts[b + 1]]
+        distance, nearest = cKDTree(vertices[part_a]).query(vertices[part_b])
+        if np.all(distance <= tolerance) and np.unique(nearest).size == nearest.size:
+            representative[part_b] = part_a[nearest]
+            copy_of[b] = a
+    if not copy_of:
+        return unchanged
+    kept = representative == np.arange(n_vertices)
+    compact = np.cumsum(kept) - 1
+    index = compact[representative]
+    dropped_faces = np.isin(labels[topology.faces[:, 0]], list(copy_of))
+    faces = np.ascontiguousarray(compact[topology.faces[~dropped_faces]])
+    return Welding(vertices[kept], MeshTopology._build(faces, int(kept.sum())), index, int(n_vertices - kept.sum()))
