@@ -103,7 +103,7 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, threshold, sm
     IMAGE is a TIFF stack, .npy, .npz (the array 'labels', or its only array),
     NIfTI (.nii, .nii.gz), MRC (.mrc, .rec, .map: the voxel size of its header,
     in Angstrom) or a Zarr / OME-Zarr folder (.zarr: read a chunk at a time,
-    never whole; needs pip install zarr) of integer labels (0: background) or
+    never whole; needs pip install 'meshcurv[volume]') of integer labels (0: background) or
     a binary mask, or with --threshold a probability map. Writes OUTDIR/<name>_labels.csv and .parquet (one row per label:
     area, volume, area-weighted and percentiles of H, K, principal
     curvatures, shape index and curvedness, total curvatures, Willmore
