@@ -197,3 +197,27 @@ def test_without_numba_point_clouds_take_the_numpy_path(no_numba):
     assert no_numba.attempts == 1
     np.testing.assert_array_equal(hidden.k_max, reference.k_max)
     assert abs(np.median(hidden.mean) - 0.5) < 0.005  # 1% (measured 0.03%): a median over 2000 points
+
+
+def test_use_backend_holds_in_its_own_thread_only(fresh_backend, monkeypatch):
+    # the override is a context variable: a block on NumPy in one thread leaves another thread on its backend
+    monkeypatch.delenv("MESHCURV_BACKEND", raising=False)
+    import threading
+
+    seen = {}
+    entered, release = threading.Event(), threading.Event()
+
+    def on_numpy():
+        with use_backend("numpy"):
+            entered.set()
+            release.wait(10)
+            seen["inside"] = backend_name()
+
+    worker = threading.Thread(target=on_numpy)
+    worker.start()
+    entered.wait(10)
+    seen["other"] = backend_name()
+    release.set()
+    worker.join()
+    assert seen["inside"] == "numpy"
+    assert seen["other"] == ("numba" if _importable("numba") else "numpy")

@@ -54,6 +54,7 @@ in tests, pipes and logs.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import functools
 import importlib
 import logging
@@ -66,7 +67,10 @@ from types import ModuleType
 from .errors import InvalidOptionError, MissingDependencyError
 
 BACKENDS = ("auto", "numpy", "numba")
-_override: str | None = None
+
+#: The backend :func:`use_backend` asks for in this thread or task (None: the environment decides). A
+#: context variable: a block on one backend in one thread (or asyncio task) leaves the others' as it was.
+_override: contextvars.ContextVar[str | None] = contextvars.ContextVar("meshcurv_backend", default=None)
 
 logger = logging.getLogger(__name__)
 
@@ -79,7 +83,7 @@ COMPILE_MESSAGE = (
 
 
 def _requested() -> str:
-    choice = _override or os.environ.get("MESHCURV_BACKEND", "auto")
+    choice = _override.get() or os.environ.get("MESHCURV_BACKEND", "auto")
     if choice not in BACKENDS:
         raise InvalidOptionError(
             f"unknown backend {choice!r} (MESHCURV_BACKEND); choose one of {', '.join(BACKENDS)}"
@@ -440,12 +444,25 @@ def _serialised(module) -> _SerialisedKernels:
 
 @contextlib.contextmanager
 def use_backend(name: str):
-    """Run a block with the given backend (``'numpy'``, ``'numba'`` or ``'auto'``)."""
-    global _override
+    """Run a block with the given backend (``'numpy'``, ``'numba'`` or ``'auto'``).
+
+    The choice holds in the calling thread (or asyncio task) only: other
+    threads keep theirs (:mod:`contextvars`).
+
+    Parameters
+    ----------
+    name : {'numpy', 'numba', 'auto'}
+        The backend of the block.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``name`` is not one of :data:`BACKENDS`.
+    """
     if name not in BACKENDS:
         raise InvalidOptionError(f"unknown backend {name!r}; choose one of {', '.join(BACKENDS)}")
-    previous, _override = _override, name
+    token = _override.set(name)
     try:
         yield
     finally:
-        _override = previous
+        _override.reset(token)
