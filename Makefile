@@ -55,6 +55,7 @@ docs: $(STAMP)
 # the pictures of the user guide, made with meshcurv's own plotting (docs/make_pictures.py)
 pictures: $(STAMP)
 	$(BIN)/python docs/make_pictures.py
+	$(BIN)/python docs/cells_example.py
 
 # the packages as users get them: wheel and sdist built and checked (twine), the wheel installed in a
 # clean environment (not editable) and run on a mesh of the repository, then the README's install
