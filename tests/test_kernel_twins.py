@@ -1030,7 +1030,7 @@ def jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacen
 
     The matrices of :func:`meshcurv.jets._fit_chunk` over the same balls (the surface-connected
     pieces with ``adjacency``), the degree chosen as ``jets._solve`` chooses it (the highest whose
-    Cholesky factorization passes).
+    points are spread, :data:`meshcurv.jets.MIN_SPREAD`).
     """
     from meshcurv import jets
     from meshcurv.neighborhoods import _ball_pairs, connected_ball_pairs
@@ -1054,10 +1054,7 @@ def jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacen
             candidates = np.flatnonzero(todo & (counts[index] >= m))
             if candidates.size == 0:
                 continue
-            block = matrix[candidates, :m, :m]
-            scale = 1.0 / np.sqrt(np.einsum("nii->ni", block))
-            scaled = block * scale[:, :, None] * scale[:, None, :]
-            _, ok = jets._cholesky_solve(scaled, right[candidates, :m] * scale)
+            _, ok, scaled = jets._solve_block(matrix[candidates, :m, :m], right[candidates, :m], d)
             conditions[index[candidates[ok]]] = np.linalg.cond(scaled[ok])
             todo[candidates[ok]] = False
     return conditions
@@ -1129,7 +1126,7 @@ def check_fit_jets(name):
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
         by_vertex = spread(radii, centres, n, 0.0) if np.ndim(radii) else np.array([radius])
         found = kernels("jets").fit_jets(points, normals, by_vertex, degree, jets.ITERATIONS,
-                                         jets._exponents(degree), jets.MIN_PIVOT, centres, 64 * kernel_threads(),
+                                         jets._exponents(degree), jets.MIN_SPREAD, centres, 64 * kernel_threads(),
                                          pool, facing if check else points, check, jets.AWAY_FRACTION, 0.0,
                                          np.zeros(0) if weights is None else weights)
         coefficients, t1, t2, normal, counts, away = found
@@ -1171,7 +1168,7 @@ def check_fit_jets_connected(name):
             expected = jets.fit_jets(points, normals, radii, degree=degree, centres=centres, neighbours=mask,
                                      facing=facing if check else None, details=details, adjacency=(indptr, indices),
                                      areas=weights)
-        arguments = (points, normals, radii if np.ndim(radii) else np.array([radius]), degree, jets.ITERATIONS, jets._exponents(degree), jets.MIN_PIVOT,
+        arguments = (points, normals, radii if np.ndim(radii) else np.array([radius]), degree, jets.ITERATIONS, jets._exponents(degree), jets.MIN_SPREAD,
                      centres, kernel_threads(), np.ones(n, dtype=bool) if mask is None else mask, indptr, indices,
                      facing if check else points, check, jets.AWAY_FRACTION)
         # one row per centre: spread to rows of all vertices (NaN, counts 0, elsewhere) as NumPy gives them

@@ -6,7 +6,6 @@ rotation of each face's corners; the expected values follow from the
 transformation (curvature / s, directions rotated), never from a stored output.
 """
 
-import functools
 import warnings
 
 import numpy as np
@@ -16,8 +15,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import meshcurv
-from meshcurv import jets, shapes
-from meshcurv._tensors import tangent_basis
+from meshcurv import shapes
 from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning, TriangulationWarning
 from meshcurv.estimators import ESTIMATORS
 from meshcurv.orient import orient_faces
@@ -31,6 +29,12 @@ MESHES = {
     "ellipsoid": shapes.ellipsoid(subdivisions=4),
     "sphere": shapes.icosphere(4, radius=3.0),
 }
+#: Agreement of the curvatures of a mesh and of its transformed copy, relative to the largest |k|:
+#: floating point (each method's choices, quadric's degree of fit included, are invariant). matgeom
+#: differs by up to 3.1e-8 on the torus under a rotation and scaling, 1.4e-8 under a turn of the
+#: faces' corners (measured over six poses; a rounding error amplified by its fits): 1e-7 for it.
+TOLERANCE = 1e-9
+TOLERANCES = {"matgeom": 1e-7}
 SETTINGS = settings(max_examples=6, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 
 
@@ -52,52 +56,15 @@ def radius_for(method, mesh, scale=1.0):
     return {"radius": 2.5 * mean * scale}
 
 
-def assert_same(a, b, index=slice(None), scale=1.0, keep=slice(None)):
-    """``a`` (transformed) against ``b`` (original) at ``index``, curvatures times ``scale``, at ``keep`` of ``a``."""
-    np.testing.assert_array_equal(a.valid[keep], b.valid[index][keep])
+def assert_same(a, b, index=slice(None), scale=1.0, tolerance=TOLERANCE):
+    """``a`` (transformed) against ``b`` (original) at ``index``, curvatures times ``scale``, at every vertex,
+    within ``tolerance`` of the largest |k|."""
+    np.testing.assert_array_equal(a.valid, b.valid[index])
     size = np.nanmax(np.abs(b.k_max)) + np.nanmax(np.abs(b.k_min))
     for name in ("k_min", "k_max", "mean"):
         np.testing.assert_allclose(
-            getattr(a, name)[keep] * scale, getattr(b, name)[index][keep], rtol=1e-6, atol=1e-7 * size, err_msg=name
+            getattr(a, name) * scale, getattr(b, name)[index], rtol=0, atol=tolerance * size, err_msg=name
         )
-
-
-@functools.cache
-def poised_vertices(name: str, method: str) -> np.ndarray:
-    """Where ``method``'s fits on ``MESHES[name]`` are determined: all vertices, but for quadric on the torus.
-
-    quadric's jets fall back from degree 4 to 3 to 2 where the Cholesky
-    factor of the (unit-diagonal) normal equations has a pivot <= 1e-5
-    (:data:`meshcurv.jets.MIN_PIVOT`). On this torus the balls of 2.5 mean
-    edges hold only three meridians at the outer side (major edges 5.2 long
-    there): 624 of the 1,536 vertices have degree-4 equations whose smallest
-    eigenvalue is below 1e-7, while their smallest pivot ranges from 1e-8 to
-    1e-4 with the frame's turn in the tangent plane. Whether such a vertex
-    is solved at degree 4 (an ill-conditioned fit: k_min off by up to 0.33,
-    true range -0.05..0.025) or falls back depends on the rotation: a defect
-    of the degree choice in meshcurv.jets (the pivot is no bound on the
-    conditioning), not of the test. The other 912 have a smallest eigenvalue
-    above 2e-3 (a gap of four decades): there every pose gives the same
-    result to 1e-15, and within 3.5e-4 of the exact curvatures.
-    """
-    mesh = MESHES[name]
-    if not (method == "quadric" and name == "torus"):
-        return np.ones(mesh.vertices.shape[0], dtype=bool)
-    radius = radius_for(method, mesh)["radius"]
-    vertices, normals = mesh.vertices, mesh.normals
-    smallest = np.empty(vertices.shape[0])
-    for chunk, centre, neighbour in jets._ball_pairs(vertices, vertices, radius, 4096):
-        index = np.arange(chunk.start, chunk.stop)
-        rows = centre - chunk.start
-        offsets = (vertices[neighbour] - vertices[index[rows]]) / radius
-        weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
-        frame = [*tangent_basis(normals[index]), normals[index]]
-        matrix, _ = jets._fit_chunk(offsets, rows, index.size, frame, weights, jets.DEGREE)
-        scale = 1.0 / np.sqrt(np.einsum("nii->ni", matrix))
-        smallest[index] = np.linalg.eigvalsh(matrix * scale[:, :, None] * scale[:, None, :])[:, 0]
-    poised = smallest > 1e-5
-    assert poised.sum() > 0.55 * poised.size  # the check stays one of most of the torus
-    return poised
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -116,11 +83,9 @@ def test_rigid_motion_and_scale(method, name, seed, log_scale, shift):
     base = curvatures(mesh.vertices, mesh.faces, method, **radius_for(method, mesh))
     r = curvatures(moved, mesh.faces, method, **radius_for(method, mesh, s))
     # curvature in 1/length: divided by s (matGeom's values are dimensionless)
-    keep = poised_vertices(name, method)  # quadric on the torus: where its fits are determined (see there)
-    assert_same(r, base, scale=1.0 if method == "matgeom" else s, keep=keep)
+    assert_same(r, base, scale=1.0 if method == "matgeom" else s, tolerance=TOLERANCES.get(method, TOLERANCE))
     if method != "matgeom":  # matGeom's normal is unoriented
-        valid = base.valid & keep
-        np.testing.assert_allclose(r.normals[valid], base.normals[valid] @ rotation.T, atol=1e-6)
+        np.testing.assert_allclose(r.normals[base.valid], base.normals[base.valid] @ rotation.T, atol=1e-6)
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -135,7 +100,7 @@ def test_vertex_reindexing_and_face_order(method, name, seed):
     faces = inverse[mesh.faces][rng.permutation(mesh.faces.shape[0])]
     base = curvatures(mesh.vertices, mesh.faces, method, **radius_for(method, mesh))
     r = curvatures(mesh.vertices[permutation], faces, method, **radius_for(method, mesh))
-    assert_same(r, base, index=permutation)
+    assert_same(r, base, index=permutation, tolerance=TOLERANCES.get(method, TOLERANCE))
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -148,7 +113,7 @@ def test_cyclic_rotation_of_each_face(method, name, shifts):
     rotated = np.take_along_axis(mesh.faces, columns, axis=1)
     base = curvatures(mesh.vertices, mesh.faces, method, **radius_for(method, mesh))
     r = curvatures(mesh.vertices, rotated, method, **radius_for(method, mesh))
-    assert_same(r, base)
+    assert_same(r, base, tolerance=TOLERANCES.get(method, TOLERANCE))
 
 
 @SETTINGS

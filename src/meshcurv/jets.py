@@ -13,7 +13,10 @@ degree ``d``:
     \\omega_j = \\big(1 - |x_j - x_v|^2 / r^2\\big)^2 .
 
 A fit of degree ``d`` falls back to ``d - 1`` (down to 2) where the ball holds
-too few points, or too degenerate a set, for a well-conditioned fit. The
+too few points, or too degenerate a set, for a well-conditioned fit: a set
+whose spread (:data:`MIN_SPREAD`, a bound on the smallest eigenvalue of the
+normal equations in a basis that a turn of the tangent plane leaves
+orthonormal) is too small; the choice is the same in every pose. The
 constant term is free (on a noisy mesh the vertex is not on the surface), and
 so are the linear terms.
 
@@ -57,6 +60,7 @@ https://doi.org/10.1111/j.1467-8659.2010.01797.x
 from __future__ import annotations
 
 from collections.abc import Sequence
+from math import comb
 
 import numpy as np
 
@@ -77,9 +81,25 @@ ITERATIONS = 2
 #: Fewest points (with non-zero weight) a fit takes: the six coefficients of a quadric.
 MIN_POINTS = 6
 
-#: Smallest Cholesky pivot of a diagonally scaled normal matrix (unit diagonal) that is
-#: solved: a smaller one means a nearly degenerate set of points (for example collinear).
-MIN_PIVOT = 1e-5
+#: Smallest spread of a ball's points that a fit of degree ``d`` is solved on (else it falls
+#: back to ``d - 1``): ``1 / (sum(w) trace(G^-1))``, the Gram matrix ``G = sum_j w_j
+#: b(u_j, v_j) b(u_j, v_j)^T`` of the monomials in the basis ``b = sqrt(C(i + k, i)) u^i v^k``
+#: (coordinates in units of the radius). A turn of the tangent plane acts on that basis by an
+#: orthogonal matrix (the Bombieri norm of binary forms is invariant), so the spread, a
+#: lower bound of the smallest eigenvalue of ``G / sum(w)`` (and above a ``1 / m`` of it), does
+#: not depend on the frame chosen in the tangent plane, nor on a rigid motion or scaling of
+#: the points: the degree of every fit is the same in every pose. (A bound on the pivots of
+#: the Cholesky factor, the rule until 2026, was not: on a torus of 48 x 32 vertices, balls
+#: over three meridians had pivots from 1e-8 to 1e-4 with the turn of the frame, and k_min of
+#: the degree-4 fits they kept was off by up to 0.33 where the exact one is -0.05..0.025.)
+#: Points along a line (or three meridians for degree 4) have a spread near 0; the balls of a
+#: clean mesh of 2.5 edge lengths hold ~1e-4 (degree 4) and ~1e-3 (degree 3).
+MIN_SPREAD = 1e-7
+
+#: Smallest Cholesky pivot of a diagonally scaled normal matrix (unit diagonal) for which
+#: the factorization goes on (a matrix numerically singular). Never decisive: a pivot is
+#: at least the smallest eigenvalue, itself at least ``MIN_SPREAD / 6``, on a fit kept.
+PIVOT_FLOOR = 1e-12
 
 #: Centres per chunk of pair queries (bounds the memory of the per-pair arrays; fewer
 #: where the balls are large, see :data:`meshcurv.neighborhoods.PAIRS_PER_CHUNK`).
@@ -151,13 +171,21 @@ def _fit_chunk(offsets: np.ndarray, rows: np.ndarray, size: int, frame: Sequence
     return matrix, right
 
 
-def _cholesky_solve(matrix: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Solve the (N, m, m) symmetric systems of unit diagonal by Cholesky.
+def _binomials(degree: int) -> np.ndarray:
+    """(m,) ``C(i + k, i)`` for the exponents ``(i, k)`` of :func:`_exponents`: the squares of the Bombieri weights."""
+    return np.array([float(comb(i + k, i)) for i, k in _exponents(degree)])
+
+
+def _cholesky_solve(matrix: np.ndarray, right: np.ndarray, factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Solve the (N, m, m) symmetric systems of unit diagonal by Cholesky, where their points are spread.
 
     Returns the (N, m) solutions and (N,) whether every pivot exceeded
-    :data:`MIN_PIVOT` (the solutions of the others are meaningless). A loop over
-    the m <= 15 columns, vectorized over the systems; the compiled kernel does
-    the same operations in the same order.
+    :data:`PIVOT_FLOOR` and ``sum_j factors[:, j] (matrix^-1)_jj < 1 /``
+    :data:`MIN_SPREAD` (the solutions of the others are meaningless).
+    ``(matrix^-1)_jj`` is the squared norm of column ``j`` of the inverse of
+    the Cholesky factor, found by forward substitution. A loop over the
+    m <= 15 columns, vectorized over the systems; the compiled kernel does the
+    same operations in the same order.
     """
     n, m = right.shape
     low = np.zeros_like(matrix)  # the factor below the diagonal, the inverse of each pivot's root on it
@@ -166,7 +194,7 @@ def _cholesky_solve(matrix: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, 
         d = matrix[:, k, k].copy()
         for j in range(k):
             d -= low[:, k, j] * low[:, k, j]
-        ok &= d > MIN_PIVOT
+        ok &= d > PIVOT_FLOOR
         inverse = 1.0 / np.sqrt(np.where(ok, d, 1.0))
         low[:, k, k] = inverse
         for i in range(k + 1, m):
@@ -174,6 +202,19 @@ def _cholesky_solve(matrix: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, 
             for j in range(k):
                 t -= low[:, i, j] * low[:, k, j]
             low[:, i, k] = t * inverse
+    trace = np.zeros(n)
+    for j in range(m):  # column j of the inverse of the factor: zero above the diagonal
+        column = np.zeros((n, m))
+        column[:, j] = low[:, j, j]
+        total = column[:, j] * column[:, j]
+        for i in range(j + 1, m):
+            t = low[:, i, j] * column[:, j]
+            for k in range(j + 1, i):
+                t += low[:, i, k] * column[:, k]
+            column[:, i] = -t * low[:, i, i]
+            total += column[:, i] * column[:, i]
+        trace += total * factors[:, j]
+    ok &= trace * MIN_SPREAD < 1.0
     x = right.copy()
     for i in range(m):
         for j in range(i):
@@ -186,11 +227,23 @@ def _cholesky_solve(matrix: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, 
     return x, ok
 
 
+def _solve_block(block: np.ndarray, right: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The (N, m) solutions of the (N, m, m) normal equations ``block`` of ``degree``, whether each is
+    kept (its points spread, :data:`MIN_SPREAD`) and the (N, m, m) diagonally scaled matrices solved."""
+    scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
+    scaled = block * scale[:, :, None] * scale[:, None, :]
+    factors = block[:, :1, 0] * scale * scale / _binomials(degree)  # sum(w) s_j^2 / C_j
+    solution, ok = _cholesky_solve(scaled, right * scale, factors)
+    return solution * scale, ok, scaled
+
+
 def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: int) -> np.ndarray:
     """(N, 6) the constant, linear and quadratic coefficients of the highest solvable degree (NaN: none).
 
     The monomials are ordered by degree, so the normal equations of a lower
-    degree are the leading block of those of ``degree``.
+    degree are the leading block of those of ``degree``. A degree is solved
+    where the ball holds as many points as its coefficients and they are
+    spread (:data:`MIN_SPREAD`, a criterion that no turn of the frame changes).
     """
     out = np.full((matrix.shape[0], 6), np.nan)
     todo = np.ones(matrix.shape[0], dtype=bool)
@@ -199,13 +252,10 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
         candidates = np.flatnonzero(todo & (counts >= m))
         if candidates.size == 0:
             continue
-        block = matrix[candidates, :m, :m]
-        scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
-        scaled = block * scale[:, :, None] * scale[:, None, :]
-        solution, ok = _cholesky_solve(scaled, right[candidates, :m] * scale)
+        solution, ok, _ = _solve_block(matrix[candidates, :m, :m], right[candidates, :m], d)
         chosen = candidates[ok]
         if chosen.size:
-            out[chosen] = (solution[ok] * scale[ok])[:, :6]
+            out[chosen] = solution[ok][:, :6]
             todo[chosen] = False
     return out
 
@@ -330,7 +380,7 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
             for lo, hi in call_ranges(centres.size, mean, radius * radius if per_centre else None):
                 part = centres[lo:hi]  # rows of all vertices: those of the part (a slice when the centres are all)
                 pieces.append(tuple(output[lo:hi] if every_vertex else output[part] for output in kernels.fit_jets(
-                    vertices, normals, radii, degree, iterations, _exponents(degree), MIN_PIVOT, part,
+                    vertices, normals, radii, degree, iterations, _exponents(degree), MIN_SPREAD, part,
                     64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION,
                     float(settled), areas)))
             rows = _joined(pieces)
@@ -462,7 +512,7 @@ def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, 
     for lo, hi in call_ranges(centres.size, pairs_per_centre, radii * radii if per_centre else None):
         outputs = kernels.fit_jets_connected(vertices, normals, radii[lo:hi] if per_centre else radii, degree,
                                              iterations, _exponents(degree),
-                                             MIN_PIVOT, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
+                                             MIN_SPREAD, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
                                              vertices if facing is None else _read_only_view(facing), check,
                                              AWAY_FRACTION, normals_only, float(settled), _read_only_view(areas))
         pieces.append(outputs[:1] if normals_only else outputs)

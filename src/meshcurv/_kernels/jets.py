@@ -12,20 +12,29 @@ from ._common import _JIT, _JIT_REASSOC, _TINY, _tangent_frame
 from .neighborhoods import _ball_members, _connected_members, pool_grid
 
 
-@nb.njit(**_JIT)
-def _cholesky_solve(a, b, low, m, min_pivot):
-    """Solve ``a[:m, :m] x = b[:m]`` in place of ``b``; False if a pivot <= min_pivot.
+#: ``jets.PIVOT_FLOOR``: the smallest pivot for which the factorization goes on.
+_PIVOT_FLOOR = 1e-12
 
-    ``a`` is symmetric with a unit diagonal; only its lower triangle is read.
-    The same operations in the same order as ``jets._cholesky_solve``; ``low`` is scratch
-    (the factor below its diagonal, the inverse of each pivot's root on it: m
-    divisions instead of m (m + 3) / 2, the slowest operations of a fit).
+
+@nb.njit(**_JIT)
+def _cholesky_solve(a, b, low, m, min_spread, scale, exponents, total):
+    """Solve ``a[:m, :m] x = b[:m]`` in place of ``b``; False if a pivot <= ``_PIVOT_FLOOR``
+    or the points are not spread.
+
+    ``a`` is symmetric with a unit diagonal (the normal matrix scaled by ``scale``);
+    only its lower triangle is read. The points are spread where
+    ``sum_j total scale_j^2 / C(i_j + k_j, i_j) (a^-1)_jj < 1 / min_spread``
+    (``jets.MIN_SPREAD``; ``total``: the sum of the weights, ``(i_j, k_j)`` the
+    ``exponents``). The same operations in the same order as ``jets._cholesky_solve``;
+    ``low`` is scratch (the factor below its diagonal, the inverse of each pivot's
+    root on it: m divisions instead of m (m + 3) / 2, the slowest operations of a
+    fit; above it, row ``j`` holds column ``j`` of the factor's inverse in turn).
     """
     for k in range(m):
         d = a[k, k]
         for j in range(k):
             d -= low[k, j] * low[k, j]
-        if not d > min_pivot:
+        if not d > _PIVOT_FLOOR:
             return False
         inverse = 1.0 / math.sqrt(d)
         low[k, k] = inverse
@@ -34,6 +43,23 @@ def _cholesky_solve(a, b, low, m, min_pivot):
             for j in range(k):
                 s -= low[i, j] * low[k, j]
             low[i, k] = s * inverse
+    trace = 0.0
+    for j in range(m):  # column j of the factor's inverse (zero above the diagonal), in row j above the diagonal
+        first = low[j, j]
+        norm = first * first
+        for i in range(j + 1, m):
+            s = low[i, j] * first
+            for k in range(j + 1, i):
+                s += low[i, k] * low[j, k]
+            x = -s * low[i, i]
+            low[j, i] = x
+            norm += x * x
+        binomial = 1.0
+        for t in range(exponents[j, 0]):  # C(i + k, i), exactly
+            binomial = binomial * (exponents[j, 0] + exponents[j, 1] - t) / (t + 1)
+        trace += norm * (total * scale[j] * scale[j] / binomial)
+    if not trace * min_spread < 1.0:
+        return False
     for i in range(m):
         s = b[i]
         for j in range(i):
@@ -48,7 +74,7 @@ def _cholesky_solve(a, b, low, m, min_pivot):
 
 
 @nb.njit(parallel=True, **_JIT)
-def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_pivot, centres, n_chunks, pool, facing,
+def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_spread, centres, n_chunks, pool, facing,
              check_facing, away_fraction, settled, areas):
     """``jets.fit_jets``: weighted jets over the balls of ``radii``, frame re-estimated from each fit.
 
@@ -98,7 +124,7 @@ def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_pivot,
             radius = radii[v if per_vertex else 0]
             members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius,
                                           members)
-            work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, v,
+            work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_spread, v, v,
                             members, size, work, moments, right, matrix, low, scale, solution, coefficients, t1s,
                             t2s, ns, counts, ids, facing[:facing.shape[0] if check_facing else 0], limits, away, areas)
     return coefficients, t1s, t2s, ns, counts, away
@@ -221,7 +247,7 @@ def _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny,
 
 
 @nb.njit(inline="always", **_JIT)
-def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_pivot, v, row, members, size, work,
+def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_spread, v, row, members, size, work,
              moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing, limits,
              away_out, areas):
     """One vertex of :func:`fit_jets` in the caller's buffers; returns ``work`` (grown when too small).
@@ -331,7 +357,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
                     matrix[r, c] = (moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
                                     * scale[r] * scale[c])
                 solution[r] = right[r] * scale[r]
-            if _cholesky_solve(matrix, solution, low, m, min_pivot):
+            if _cholesky_solve(matrix, solution, low, m, min_spread, scale, exponents, moments[0, 0]):
                 for r in range(6):
                     solution[r] = solution[r] * scale[r]
                 fitted = True
@@ -358,7 +384,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
 
 
 @nb.njit(parallel=True, **_JIT)
-def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, min_pivot, centres, n_chunks,
+def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, min_spread, centres, n_chunks,
                        allowed, indptr, indices, facing, check_facing, away_fraction, normals_only, settled, areas):
     """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
 
@@ -404,7 +430,7 @@ def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, 
             # site would double its compile time)
             c[0, :] = np.nan  # a failed fit leaves the row as it finds it
             one_away[0] = np.nan  # written only when the facing is checked
-            work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_pivot, v, 0,
+            work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_spread, v, 0,
                             members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn,
                             one_count, ids, facing[:facing.shape[0] if check_facing else 0], limits, one_away, areas)
             if not normals_only:

@@ -6,8 +6,11 @@ vertices of the ball ``B(x_v, r)`` as the points and weights
 ``(1 - |x_j - x_v|^2 / r^2)^2``. The fits are those of :mod:`meshcurv.jets`
 (weights, normal re-estimation and the shape operator of a jet are described
 there). The degree is
-:data:`~meshcurv.jets.DEGREE` (4) where the ball holds enough points for a
-well-conditioned fit, else 3, else 2 (Cazals and Pouget: a degree-``d`` jet
+:data:`~meshcurv.jets.DEGREE` (4) where the ball holds enough points, spread
+enough for a well-conditioned fit (:data:`~meshcurv.jets.MIN_SPREAD`, a measure
+that no rigid motion, scaling or turn of the tangent frame changes: every pose
+of a mesh gets the same degrees, so the same curvatures), else 3, else 2
+(Cazals and Pouget: a degree-``d`` jet
 gives the curvatures with an error of order ``r^{d-1}`` on a smooth surface,
 against ``r`` or ``r^2`` for the quadric, the bias that grows as
 ``(r k)^2``). The constant term is free (on a noisy mesh the vertex is not on
@@ -23,9 +26,9 @@ The fit uses only vertex positions, not the triangles: it is indifferent to
 the quality of the triangulation (irregular meshes), and the ball, unlike a
 number of rings, keeps its size in length units across resolutions.
 
-A fit needs at least six points with non-zero weight: vertices with fewer (or
-a degenerate set, for example collinear points) are NaN with ``valid=False``
-(use a larger ``radius``). Boundary vertices are fitted on their one-sided
+A fit needs at least six points with non-zero weight, spread enough for a
+quadric: vertices with fewer (or a degenerate set, for example collinear
+points) are NaN with ``valid=False`` (use a larger ``radius``). Boundary vertices are fitted on their one-sided
 neighbourhood and kept.
 
 References
