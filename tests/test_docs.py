@@ -17,7 +17,8 @@ PAGES = sorted(GUIDE.glob("*.md"))
 
 # the pages of the guide the README's list names (other pages may join through the toctree's glob)
 NAMED = ["methods", "meshes", "label_images", "point_clouds", "integrals", "batch", "files", "cli", "speed",
-         "matgeom", "development"]
+         "matgeom", "development", "worked_example_cells",
+         "label_statistics"]
 
 # the modules beyond the core that the examples of a page need (skipped without them)
 NEEDS = {
