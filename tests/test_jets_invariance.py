@@ -24,6 +24,7 @@ from meshcurv import jets, shapes
 from meshcurv._backend import use_backend
 from meshcurv._tensors import tangent_basis
 from meshcurv.geometry import mean_edge_length
+from meshcurv.result import INVALID_REASONS
 from meshcurv.topology import MeshTopology
 
 from conftest import random_rotation
@@ -79,3 +80,22 @@ def test_degree_choice_does_not_depend_on_the_turn_of_the_frame():
                 pivots.append(np.min(np.diag(np.linalg.cholesky(scaled[0]))) ** 2)
     assert kept == {4: [False] * 13, 3: [False] * 13, 2: [True] * 13}
     assert max(pivots) > 10 * min(pivots)  # the old criterion would have turned with the frame
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_ribbon_two_vertices_wide_has_no_quadric_in_any_pose(seed):
+    """Every ball of a ribbon of two rows of vertices holds points on two lines: no quadric is determined
+    (``v^2`` is a multiple of ``v`` there), so every vertex is invalid, in every pose, with the warning."""
+    along = np.arange(40.0)
+    vertices = np.concatenate([np.stack([along, np.zeros(40), np.zeros(40)], axis=1),
+                               np.stack([along, np.ones(40), np.zeros(40)], axis=1)])
+    i = np.arange(39)
+    faces = np.concatenate([np.stack([i, i + 1, i + 41], axis=1), np.stack([i, i + 41, i + 40], axis=1)])
+    moved = vertices @ random_rotation(seed).T * 10.0 ** (seed - 1) + 5.0
+    with pytest.warns(meshcurv.errors.MeshQualityWarning, match=r"80 vertices have fewer than 6 vertices \(or a "
+                      r"degenerate set\)"):
+        result = meshcurv.principal_curvatures(moved, faces, method="quadric", radius=3.0 * 10.0 ** (seed - 1))
+    assert not result.valid.any()
+    assert np.isnan(result.k_min).all()
+    reasons = {INVALID_REASONS[code] for code in result.invalid_reason}
+    assert reasons == {"estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)"}

@@ -96,6 +96,14 @@ MIN_POINTS = 6
 #: clean mesh of 2.5 edge lengths hold ~1e-4 (degree 4) and ~1e-3 (degree 3).
 MIN_SPREAD = 1e-7
 
+#: :data:`MIN_SPREAD` of the fits that give normals only (``icc``'s, of degree 3): their linear
+#: coefficients bear a smaller spread than the curvatures do. From ``benchmarks/accuracy.py``
+#: (icc): 1e-7 makes the median H error of the finest regular saddle's boundary 27% larger
+#: (0.22% -> 0.28%), 1e-8 leaves every row as it was with the pivot rule; on the demo torus
+#: (R 30, r 10, 60 x 60) both give max |H error| 4.9e-4 (pivot rule: 9.7e-4, and 1.7e-3
+#: between two poses).
+NORMAL_MIN_SPREAD = 1e-8
+
 #: Smallest Cholesky pivot of a diagonally scaled normal matrix (unit diagonal) for which
 #: the factorization goes on (a matrix numerically singular). Never decisive: a pivot is
 #: at least the smallest eigenvalue, itself at least ``MIN_SPREAD / 6``, on a fit kept.
@@ -176,12 +184,13 @@ def _binomials(degree: int) -> np.ndarray:
     return np.array([float(comb(i + k, i)) for i, k in _exponents(degree)])
 
 
-def _cholesky_solve(matrix: np.ndarray, right: np.ndarray, factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _cholesky_solve(matrix: np.ndarray, right: np.ndarray, factors: np.ndarray,
+                    min_spread: float = MIN_SPREAD) -> tuple[np.ndarray, np.ndarray]:
     """Solve the (N, m, m) symmetric systems of unit diagonal by Cholesky, where their points are spread.
 
     Returns the (N, m) solutions and (N,) whether every pivot exceeded
-    :data:`PIVOT_FLOOR` and ``sum_j factors[:, j] (matrix^-1)_jj < 1 /``
-    :data:`MIN_SPREAD` (the solutions of the others are meaningless).
+    :data:`PIVOT_FLOOR` and ``sum_j factors[:, j] (matrix^-1)_jj < 1 / min_spread``
+    (:data:`MIN_SPREAD`; the solutions of the others are meaningless).
     ``(matrix^-1)_jj`` is the squared norm of column ``j`` of the inverse of
     the Cholesky factor, found by forward substitution. A loop over the
     m <= 15 columns, vectorized over the systems; the compiled kernel does the
@@ -214,7 +223,7 @@ def _cholesky_solve(matrix: np.ndarray, right: np.ndarray, factors: np.ndarray) 
             column[:, i] = -t * low[:, i, i]
             total += column[:, i] * column[:, i]
         trace += total * factors[:, j]
-    ok &= trace * MIN_SPREAD < 1.0
+    ok &= trace * min_spread < 1.0
     x = right.copy()
     for i in range(m):
         for j in range(i):
@@ -227,23 +236,25 @@ def _cholesky_solve(matrix: np.ndarray, right: np.ndarray, factors: np.ndarray) 
     return x, ok
 
 
-def _solve_block(block: np.ndarray, right: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _solve_block(block: np.ndarray, right: np.ndarray, degree: int,
+                 min_spread: float = MIN_SPREAD) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The (N, m) solutions of the (N, m, m) normal equations ``block`` of ``degree``, whether each is
-    kept (its points spread, :data:`MIN_SPREAD`) and the (N, m, m) diagonally scaled matrices solved."""
+    kept (its points spread, ``min_spread``) and the (N, m, m) diagonally scaled matrices solved."""
     scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
     scaled = block * scale[:, :, None] * scale[:, None, :]
     factors = block[:, :1, 0] * scale * scale / _binomials(degree)  # sum(w) s_j^2 / C_j
-    solution, ok = _cholesky_solve(scaled, right * scale, factors)
+    solution, ok = _cholesky_solve(scaled, right * scale, factors, min_spread)
     return solution * scale, ok, scaled
 
 
-def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: int) -> np.ndarray:
+def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: int,
+           min_spread: float = MIN_SPREAD) -> np.ndarray:
     """(N, 6) the constant, linear and quadratic coefficients of the highest solvable degree (NaN: none).
 
     The monomials are ordered by degree, so the normal equations of a lower
     degree are the leading block of those of ``degree``. A degree is solved
     where the ball holds as many points as its coefficients and they are
-    spread (:data:`MIN_SPREAD`, a criterion that no turn of the frame changes).
+    spread (``min_spread``, :data:`MIN_SPREAD`: a criterion that no turn of the frame changes).
     """
     out = np.full((matrix.shape[0], 6), np.nan)
     todo = np.ones(matrix.shape[0], dtype=bool)
@@ -252,7 +263,7 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
         candidates = np.flatnonzero(todo & (counts >= m))
         if candidates.size == 0:
             continue
-        solution, ok, _ = _solve_block(matrix[candidates, :m, :m], right[candidates, :m], d)
+        solution, ok, _ = _solve_block(matrix[candidates, :m, :m], right[candidates, :m], d, min_spread)
         chosen = candidates[ok]
         if chosen.size:
             out[chosen] = solution[ok][:, :6]
@@ -264,7 +275,7 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
              iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
              neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
              details: dict | None = None, adjacency: tuple | None = None, settled: float = 0.0,
-             compact: bool = False, areas: np.ndarray | None = None):
+             compact: bool = False, areas: np.ndarray | None = None, min_spread: float = MIN_SPREAD):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
     Parameters
@@ -321,6 +332,10 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
         Each point's weight is its kernel weight times its area (the fit then
         approximates the integral over the surface: a part sampled more densely
         does not outweigh its neighbours). Default: the kernel weight alone.
+    min_spread : float, default: MIN_SPREAD
+        Smallest spread of a ball's points that a degree is solved on (else
+        the next lower degree): :data:`MIN_SPREAD` for curvatures,
+        :data:`NORMAL_MIN_SPREAD` for fits that give normals only.
 
     Returns
     -------
@@ -373,14 +388,15 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
     if kernels is not None and n:
         if adjacency is not None:  # one row per centre
             rows = _connected_fits(kernels, vertices, normals, radius, degree, iterations, centres, mean,
-                                   neighbours, adjacency, facing, settled, normals_only=False, areas=areas)
+                                   neighbours, adjacency, facing, settled, normals_only=False, areas=areas,
+                                   min_spread=min_spread)
         else:
             radii = _all_rows(radius, centres, n, 0.0) if per_centre else np.array([float(radius)])  # by vertex
             pieces = []  # each call's outputs, one row per centre of its part
             for lo, hi in call_ranges(centres.size, mean, radius * radius if per_centre else None):
                 part = centres[lo:hi]  # rows of all vertices: those of the part (a slice when the centres are all)
                 pieces.append(tuple(output[lo:hi] if every_vertex else output[part] for output in kernels.fit_jets(
-                    vertices, normals, radii, degree, iterations, _exponents(degree), MIN_SPREAD, part,
+                    vertices, normals, radii, degree, iterations, _exponents(degree), min_spread, part,
                     64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION,
                     float(settled), areas)))
             rows = _joined(pieces)
@@ -417,7 +433,7 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
         settle = np.zeros((size, 1), dtype=bool)  # the centres whose iterations have ended (``settled``)
         for step in range(iterations):
             matrix, right = _fit_chunk(offsets, rows, size, local, weights, degree)
-            found = _solve(matrix, right, count, degree)
+            found = _solve(matrix, right, count, degree, min_spread)
             if step == 0:
                 fitted = found
             else:  # the settled centres keep their earlier fit
@@ -494,7 +510,7 @@ def _joined(pieces: list) -> list[np.ndarray]:
 def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, degree: int, iterations: int,
                     centres: np.ndarray, pairs_per_centre: float, neighbours: np.ndarray | None, adjacency: tuple,
                     facing: np.ndarray | None, settled: float, *, normals_only: bool,
-                    areas: np.ndarray) -> list[np.ndarray]:
+                    areas: np.ndarray, min_spread: float) -> list[np.ndarray]:
     """The compiled fits over the surface-connected balls of ``centres``, in calls of about
     :data:`~meshcurv.neighborhoods.PAIRS_PER_CALL` pairs (checked inputs; ``neighbours`` a (V,) bool
     array or None; ``radius`` a float or a checked (M,) array of one per centre). The kernel's outputs,
@@ -512,7 +528,7 @@ def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, 
     for lo, hi in call_ranges(centres.size, pairs_per_centre, radii * radii if per_centre else None):
         outputs = kernels.fit_jets_connected(vertices, normals, radii[lo:hi] if per_centre else radii, degree,
                                              iterations, _exponents(degree),
-                                             MIN_SPREAD, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
+                                             min_spread, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
                                              vertices if facing is None else _read_only_view(facing), check,
                                              AWAY_FRACTION, normals_only, float(settled), _read_only_view(areas))
         pieces.append(outputs[:1] if normals_only else outputs)
@@ -535,7 +551,7 @@ def _all_rows(rows: np.ndarray, centres: np.ndarray, n: int, fill: float) -> np.
 def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int = DEGREE,
                     iterations: int = ITERATIONS, neighbours: np.ndarray | None = None,
                     adjacency: tuple | None = None, settled: float = 0.0,
-                    areas: np.ndarray | None = None) -> np.ndarray:
+                    areas: np.ndarray | None = None, min_spread: float = MIN_SPREAD) -> np.ndarray:
     """(V, 3) unit normals of the jets of :func:`fit_jets` at every vertex (NaN where no fit was possible).
 
     ``jet_normals(*fit_jets(...)[:2])`` with the same arguments; with the
@@ -544,14 +560,16 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree
     whose fit has a slope ``c10^2 + c01^2`` below ``settled`` takes its normal
     without further iterations (:func:`fit_jets`; 0: ``iterations`` fits everywhere).
     ``radius``: one for all vertices, or a (V,) array of one per vertex (as :func:`fit_jets`);
-    ``areas``: the points weighted by their areas (:func:`fit_jets`).
+    ``areas``: the points weighted by their areas (:func:`fit_jets`); ``min_spread``: as :func:`fit_jets`
+    (:data:`NORMAL_MIN_SPREAD` for normals that feed other estimates).
     """
     kernels = numba_kernels("jets")
     vertices = checked_points(vertices)
     n = vertices.shape[0]
     if kernels is None or adjacency is None or n == 0:
         coefficients, frame, _ = fit_jets(vertices, normals, radius, degree=degree, iterations=iterations,
-                                          neighbours=neighbours, adjacency=adjacency, settled=settled, areas=areas)
+                                          neighbours=neighbours, adjacency=adjacency, settled=settled, areas=areas,
+                                          min_spread=min_spread)
         return jet_normals(coefficients, frame)
     normals = np.ascontiguousarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
@@ -564,7 +582,8 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree
         radius = centre_radii(radius, n)
     mean, _ = check_ball_work(vertices if neighbours is None else vertices[neighbours], radius, n, centres=vertices)
     return _connected_fits(kernels, vertices, normals, radius, degree, iterations, np.arange(n), mean, neighbours,
-                           adjacency, None, settled, normals_only=True, areas=_checked_areas(areas, n))[0]
+                           adjacency, None, settled, normals_only=True, areas=_checked_areas(areas, n),
+                           min_spread=min_spread)[0]
 
 
 def jet_normals(coefficients: np.ndarray, frame: tuple) -> np.ndarray:

@@ -75,7 +75,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import median_edge_length, robust_mean_edge_length
-from ..jets import SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
+from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
 from ..measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import ball_face_sums, ball_face_sums_nested
 from ..radius import (check_radius, component_radii, local_scale_ratios, noise_level, noise_radius, scale_ladder,
@@ -156,12 +156,12 @@ def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray,
         coefficients, frame, _ = fit_jets(points, point_normals, radius, degree=NORMAL_DEGREE,
                                           iterations=NORMAL_ITERATIONS, centres=np.arange(vertices.shape[0]),
                                           neighbours=allowed, adjacency=lists, settled=NORMAL_SETTLED,
-                                          areas=point_areas, compact=True)
+                                          areas=point_areas, compact=True, min_spread=NORMAL_MIN_SPREAD)
         fitted = jet_normals(coefficients, frame)
     else:
         fitted = fit_jet_normals(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS,
                                  neighbours=neighbours, adjacency=adjacency, settled=NORMAL_SETTLED,
-                                 areas=areas if weighted else None)
+                                 areas=areas if weighted else None, min_spread=NORMAL_MIN_SPREAD)
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     return np.where(usable[:, None], fitted, normals)
