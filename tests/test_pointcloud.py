@@ -491,3 +491,26 @@ def test_the_neighbours_kept_after_merging_near_copies_are_those_of_a_new_search
     np.testing.assert_array_equal(distances, expected_distances)
     # more than a tenth gone: searched again from scratch
     assert pointcloud._kept_search(cloud[keep], np.arange(10) < 5, *search[1:]) is None
+
+
+@pytest.mark.parametrize("alike", [True, False])
+def test_compiled_stacked_sheets_are_those_of_the_numpy_path(alike):
+    # two noisy planes 1.5 apart, 30% of the normals turned: both kinds of stacked neighbours occur
+    pytest.importorskip("numba")
+    from scipy.spatial import cKDTree
+
+    from meshcurv._backend import use_backend
+
+    rng = np.random.default_rng(4)
+    points = np.c_[rng.uniform(0, 30, size=(2000, 2)), np.where(np.arange(2000) < 1000, 1.5, 0.0)
+                   + rng.uniform(-0.2, 0.2, 2000)]
+    normals = np.tile([0.0, 0.0, 1.0], (2000, 1)) * np.where(rng.random(2000) < 0.3, -1.0, 1.0)[:, None]
+    queries = np.arange(0, 2000, 3)
+    _, near = cKDTree(points).query(points[queries], k=49)
+    usable = rng.random(2000) > 0.05
+    found = {}
+    for backend in ("numpy", "numba"):
+        with use_backend(backend):
+            found[backend] = normals_module._stacked(points, normals, usable, 0.5, queries, near, alike=alike)
+    assert found["numpy"].any()
+    np.testing.assert_array_equal(found["numba"], found["numpy"])

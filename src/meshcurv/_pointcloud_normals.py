@@ -765,7 +765,9 @@ def two_sheets(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spac
     sample = _evenly(candidates, WINDING_QUERIES)
     found = _sheet_signs(points, normals, usable, spacing, step, tree, sample)
     if sample.size < candidates.size and (found[0].any() or found[3].mean() >= INTERLEAVED_SAMPLE):
-        found = _sheet_signs(points, normals, usable, spacing, step, tree, candidates)
+        # every point (the stacked sheets' 48 neighbours only when the sample has any: a thin sheet of 1M
+        # points costs about 20 us a point with them)
+        found = _sheet_signs(points, normals, usable, spacing, step, tree, candidates, with_alike=found[0].any())
         sample = candidates
     hit, near, flags, two = found
     alike[sample[hit]] = True
@@ -774,20 +776,22 @@ def two_sheets(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spac
         # the share of each point's nearest neighbours with two sheets (a region, not a point that noise split)
         mark = np.zeros(n)
         mark[sample[two]] = 1.0
-        crowd = near[:, :INTERLEAVED_NEIGHBOURS]
+        crowd = near[:, 1:INTERLEAVED_NEIGHBOURS + 1]  # (the point itself first)
         share = (mark[sample] + (mark[crowd] * usable[crowd]).sum(axis=1)) / (1.0 + usable[crowd].sum(axis=1))
         interleaved[sample[share >= INTERLEAVED_SHARE]] = True
     return alike & usable, interleaved & usable
 
 
-def _sheet_signs(points, normals, usable, spacing, step, tree, queries):
+def _sheet_signs(points, normals, usable, spacing, step, tree, queries, *, with_alike: bool = True):
     """``(hit, near, alike, two)`` of :func:`two_sheets` at ``queries`` (M,), in chunks of :data:`CHUNK`.
 
     ``hit`` (M,): stacked neighbours oriented alike; ``near`` (M, k): the
     nearest neighbours (the query itself first); ``alike`` (M, k): which of
     them; ``two`` (M,): two sheets closer than :data:`STACKED_OFFSET` spacings.
+    ``with_alike=False``: ``hit`` and ``alike`` all False, and ``near`` the
+    :data:`INTERLEAVED_NEIGHBOURS` nearest only.
     """
-    k = min(WINDING_NEAR + 1, points.shape[0])
+    k = min((WINDING_NEAR if with_alike else INTERLEAVED_NEIGHBOURS) + 1, points.shape[0])
     hit, two = np.zeros(queries.size, dtype=bool), np.zeros(queries.size, dtype=bool)
     near = np.zeros((queries.size, k), dtype=np.int64)
     flags = np.zeros((queries.size, k), dtype=bool)
@@ -796,9 +800,10 @@ def _sheet_signs(points, normals, usable, spacing, step, tree, queries):
         q = queries[rows]
         _, ball = tree.query(points[q], k=k, workers=-1)
         near[rows] = ball
-        alike = _stacked(points, normals, usable, step, q, ball, alike=True)
-        hit[rows] = alike.sum(axis=1) >= STACKED_ALIKE_MIN
-        flags[rows] = alike
+        if with_alike:
+            alike = _stacked(points, normals, usable, step, q, ball, alike=True)
+            hit[rows] = alike.sum(axis=1) >= STACKED_ALIKE_MIN
+            flags[rows] = alike
         group = ball[:, :INTERLEAVED_NEIGHBOURS + 1]
         # the spacing of the neighbourhood (the median over the cloud is another part's in a cloud of two densities)
         local = np.median(np.where(usable[group], spacing[group], np.nan), axis=1)
@@ -817,8 +822,14 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool):
     normals the same way (``alike``: ``n_i . n_j >=`` :data:`FACING_COSINE`,
     ``(n_i . d)(n_j . d) > 0``) or opposite ones (``n_i . n_j <= -FACING_COSINE``,
     ``(n_i . d)(n_j . d) < 0``). On one curved sheet the offsets of two points
-    with normals the same way have opposite signs.
+    with normals the same way have opposite signs. Compiled:
+    :func:`meshcurv._kernels.pointcloud.stacked`.
     """
+    compiled = numba_kernels("pointcloud")
+    if compiled is not None:
+        return compiled.stacked(points, normals, usable, np.ascontiguousarray(queries), np.ascontiguousarray(near),
+                                min(GRAPH_NEIGHBOURS, near.shape[1] - 1), STACKED_ALIKE_OFFSET * step,
+                                STACKED_ALIKE_TILT, FACING_COSINE, alike)
     offsets = points[near] - points[queries][:, None, :]
     ahead = np.einsum("mkj,mj->mk", offsets, normals[queries])
     behind = np.einsum("mkj,mkj->mk", offsets, normals[near])

@@ -322,3 +322,43 @@ def edge_geometry(points, normals, indices):
             behind[i, c] = dx * bx + dy * by + dz * bz
             cosine[i, c] = ax * bx + ay * by + az * bz
     return length, ahead, behind, cosine
+
+
+@nb.njit(parallel=True, **_JIT)
+def stacked(points, normals, usable, queries, near, ring, offset, tilt_factor, facing, alike):
+    """(M, k) bool: the compiled :func:`meshcurv._pointcloud_normals._stacked` (its constants as arguments).
+
+    ``near`` (M, k) the neighbours of ``queries`` (M,), ``ring``: how many of them after the first give the tilt
+    (the median angle of the query's normal to theirs); ``offset``: the reach at distance 0; ``tilt_factor``: its
+    growth per unit of distance and of tilt; ``facing``: the cosine; ``alike``: normals the same way (else
+    opposite).
+    """
+    m, k = near.shape
+    out = np.zeros((m, k), dtype=np.bool_)
+    for row in nb.prange(m):
+        q = queries[row]
+        px, py, pz = points[q, 0], points[q, 1], points[q, 2]
+        ax, ay, az = normals[q, 0], normals[q, 1], normals[q, 2]
+        angles = np.empty(ring)
+        for c in range(ring):
+            j = near[row, c + 1]
+            angles[c] = np.arccos(min(abs(ax * normals[j, 0] + ay * normals[j, 1] + az * normals[j, 2]), 1.0))
+        angles.sort()
+        half = ring // 2
+        tilt = angles[half] if ring % 2 else 0.5 * (angles[half - 1] + angles[half])
+        for c in range(k):
+            j = near[row, c]
+            if j == q or not usable[j]:
+                continue
+            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+            ahead = dx * ax + dy * ay + dz * az
+            behind = dx * normals[j, 0] + dy * normals[j, 1] + dz * normals[j, 2]
+            cosine = ax * normals[j, 0] + ay * normals[j, 1] + az * normals[j, 2]
+            if alike:
+                if not (cosine >= facing and ahead * behind > 0):
+                    continue
+            elif not (cosine <= -facing and ahead * behind < 0):
+                continue
+            reach = offset + tilt_factor * tilt * np.sqrt(dx * dx + dy * dy + dz * dz)
+            out[row, c] = min(abs(ahead), abs(behind)) >= reach
+    return out
