@@ -242,7 +242,7 @@ def _solve_block(block: np.ndarray, right: np.ndarray, degree: int,
     kept (its points spread, ``min_spread``) and the (N, m, m) diagonally scaled matrices solved."""
     scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
     scaled = block * scale[:, :, None] * scale[:, None, :]
-    factors = block[:, :1, 0] * scale * scale / _binomials(degree)  # sum(w) s_j^2 / C_j
+    factors = block[:, :1, 0] * scale * scale * (1.0 / _binomials(degree))  # sum(w) s_j^2 / C_j, as the kernel
     solution, ok = _cholesky_solve(scaled, right * scale, factors, min_spread)
     return solution * scale, ok, scaled
 

@@ -17,15 +17,15 @@ _PIVOT_FLOOR = 1e-12
 
 
 @nb.njit(**_JIT)
-def _cholesky_solve(a, b, low, m, min_spread, scale, exponents, total):
+def _cholesky_solve(a, b, low, m, min_spread, scale, total):
     """Solve ``a[:m, :m] x = b[:m]`` in place of ``b``; False if a pivot <= ``_PIVOT_FLOOR``
     or the points are not spread.
 
-    ``a`` is symmetric with a unit diagonal (the normal matrix scaled by ``scale``);
-    only its lower triangle is read. The points are spread where
+    ``a`` is symmetric with a unit diagonal (the normal matrix scaled by the first
+    half of ``scale``); only its lower triangle is read. The points are spread where
     ``sum_j total scale_j^2 / C(i_j + k_j, i_j) (a^-1)_jj < 1 / min_spread``
     (``jets.MIN_SPREAD``; ``total``: the sum of the weights, ``(i_j, k_j)`` the
-    ``exponents``). The same operations in the same order as ``jets._cholesky_solve``;
+    exponents; the second half of ``scale`` holds the ``1 / C``, :func:`_jet_scratch`). The same operations in the same order as ``jets._cholesky_solve``;
     ``low`` is scratch (the factor below its diagonal, the inverse of each pivot's
     root on it: m divisions instead of m (m + 3) / 2, the slowest operations of a
     fit; above it, row ``j`` holds column ``j`` of the factor's inverse in turn).
@@ -44,6 +44,7 @@ def _cholesky_solve(a, b, low, m, min_spread, scale, exponents, total):
                 s -= low[i, j] * low[k, j]
             low[i, k] = s * inverse
     trace = 0.0
+    half = scale.shape[0] // 2
     for j in range(m):  # column j of the factor's inverse (zero above the diagonal), in row j above the diagonal
         first = low[j, j]
         norm = first * first
@@ -54,10 +55,7 @@ def _cholesky_solve(a, b, low, m, min_spread, scale, exponents, total):
             x = -s * low[i, i]
             low[j, i] = x
             norm += x * x
-        binomial = 1.0
-        for t in range(exponents[j, 0]):  # C(i + k, i), exactly
-            binomial = binomial * (exponents[j, 0] + exponents[j, 1] - t) / (t + 1)
-        trace += norm * (total * scale[j] * scale[j] / binomial)
+        trace += norm * (total * scale[j] * scale[j] * scale[half + j])
     if not trace * min_spread < 1.0:
         return False
     for i in range(m):
@@ -146,11 +144,22 @@ def _jet_scratch(degree, n_terms):
     """The buffers of :func:`_fit_one` (once per chunk of vertices, not per vertex):
     ``work, moments, right, matrix, low, scale, solution``. The moments and the
     right-hand side hold at least those of degree 3, which :func:`_cubic_jet_moments`
-    writes for every fit of degree 3 or less."""
+    writes for every fit of degree 3 or less. ``scale`` holds the scales of the
+    monomials, then ``1 / C(i + k, i)`` for each exponent ``(i, k)`` (by total
+    degree, as ``jets._exponents``): the weights of :func:`_cholesky_solve`'s spread."""
     work = np.empty((_JET_ROWS + 3 * (2 * degree + 1) + degree + 1, 64))
     order = 2 * max(degree, 3) + 1
+    scale = np.empty(2 * n_terms)
+    t = n_terms
+    for total in range(degree + 1):
+        for k in range(total + 1):
+            binomial = 1
+            for step in range(total - k):  # C(total, i), i = total - k, in integers
+                binomial = binomial * (total - step) // (step + 1)
+            scale[t] = 1.0 / binomial
+            t += 1
     return (work, np.empty((order, order)), np.empty(max(n_terms, 10)), np.empty((n_terms, n_terms)),
-            np.empty((n_terms, n_terms)), np.empty(n_terms), np.empty(n_terms))
+            np.empty((n_terms, n_terms)), scale, np.empty(n_terms))
 
 
 @nb.njit(**_JIT_REASSOC)
@@ -357,7 +366,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
                     matrix[r, c] = (moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
                                     * scale[r] * scale[c])
                 solution[r] = right[r] * scale[r]
-            if _cholesky_solve(matrix, solution, low, m, min_spread, scale, exponents, moments[0, 0]):
+            if _cholesky_solve(matrix, solution, low, m, min_spread, scale, moments[0, 0]):
                 for r in range(6):
                     solution[r] = solution[r] * scale[r]
                 fitted = True
