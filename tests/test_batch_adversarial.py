@@ -156,7 +156,7 @@ def test_compute_refuses_an_output_that_is_its_input_by_another_name(tmp_path, c
 FAULTS = """
 import json, os, pathlib, signal, sys, time
 import distributed
-import meshcurv, meshcurv.io
+import meshcurv, meshcurv.io, meshcurv.batch._process
 from meshcurv import batch, shapes
 
 
@@ -178,6 +178,8 @@ class Faults(distributed.WorkerPlugin):
             return original(path, *args, **kwargs)
 
         meshcurv.io.read_mesh = read_mesh
+        # the task's own name for it (imported at module level there)
+        sys.modules["meshcurv.batch._process"].read_mesh = read_mesh
 
 
 def write(folder, names):

@@ -1359,6 +1359,66 @@ class Twin:
     inputs: tuple
 
 
+
+def check_edge_geometry(name):
+    points, normals = cloud(name)
+    indices = knn_indices(points)
+    got = kernels("pointcloud").edge_geometry(points, normals, np.ascontiguousarray(indices))
+    # the NumPy path of _pointcloud_normals.oriented_signs: the same products over the (E, 3) gathers
+    offsets = points[indices] - points[:, None, :]
+    expected = (np.linalg.norm(offsets, axis=2), np.einsum("nkj,nj->nk", offsets, normals),
+                np.einsum("nkj,nkj->nk", offsets, normals[indices]), np.einsum("nj,nkj->nk", normals, normals[indices]))
+    for label, a, b in zip(("length", "ahead", "behind", "cosine"), got, expected):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14, err_msg=label)
+
+
+def check_own_side(name):
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_estimators import _ball_indices, _own_side, _usable_tree
+
+    points, normals = cloud(name)
+    n = points.shape[0]
+    rng = np.random.default_rng(5)
+    flipped = np.where((rng.random(n) < 0.2)[:, None], -normals, normals)  # some points facing away
+    centres = np.flatnonzero(rng.random(n) > 0.5)
+    radius = 0.4 if name == "ellipsoid_cloud" else 0.12
+    index, counts = _ball_indices(_usable_tree(cKDTree(points), points, np.ones(n, dtype=bool)), points, centres,
+                                  radius, 32)
+    sheets = rng.integers(-1, 3, n)
+    for given in (None, sheets):
+        expected_index, expected_counts = _own_side(flipped, centres, index.copy(), counts.copy(), given)
+        got_index, got_counts = kernels("pointcloud").own_side(
+            flipped, centres, index.copy(), counts.copy(),
+            np.zeros(0, dtype=np.int64) if given is None else np.ascontiguousarray(given, dtype=np.int64))
+        label = "sheets" if given is not None else "no sheets"
+        np.testing.assert_array_equal(got_counts, expected_counts, err_msg=label)
+        np.testing.assert_array_equal(got_index, expected_index, err_msg=label)
+        assert (expected_counts < counts).any(), label  # points were dropped
+
+
+def check_stacked(name):
+    from meshcurv._pointcloud_normals import _stacked
+
+    points, normals = cloud(name)
+    n = points.shape[0]
+    rng = np.random.default_rng(9)
+    # a second sheet over the cloud: the same points lifted along their normals, half of them turned
+    lifted = points + 0.05 * normals
+    turned = np.where((rng.random(n) < 0.5)[:, None], -normals, normals)
+    both, both_normals = np.vstack([points, lifted]), np.vstack([normals, turned])
+    near = knn_indices(both, k=17)
+    queries = np.flatnonzero(rng.random(2 * n) > 0.5)
+    usable = rng.random(2 * n) > 0.1
+    step = float(np.median(np.linalg.norm(both[near[:, 1]] - both, axis=1)))
+    for alike in (True, False):
+        with use_backend("numpy"):
+            expected = _stacked(both, both_normals, usable, step, queries, near[queries], alike=alike)
+        with use_backend("numba"):
+            got = _stacked(both, both_normals, usable, step, queries, near[queries], alike=alike)
+        np.testing.assert_array_equal(got, expected, err_msg=f"alike={alike}")
+    assert expected.any() or got.any()
+
 TWINS = [
     Twin("geometry.face_cross_products", "geometry.face_cross_products", check_face_cross_products, MESHES),
     Twin("geometry.vertex_normal_sums", "the np.bincount sums of geometry.vertex_normals", check_vertex_normal_sums,
@@ -1411,6 +1471,10 @@ TWINS = [
          CLOUDS),
     Twin("pointcloud.far_winding", "_pointcloud_normals.winding_numbers", check_far_winding, CLOUDS),
     Twin("pointcloud.spanning_signs", "_pointcloud_normals.orientation_signs", check_spanning_signs, CLOUDS),
+    Twin("pointcloud.edge_geometry", "the products of _pointcloud_normals.oriented_signs", check_edge_geometry,
+         CLOUDS),
+    Twin("pointcloud.own_side", "_pointcloud_estimators._own_side", check_own_side, CLOUDS),
+    Twin("pointcloud.stacked", "_pointcloud_normals._stacked", check_stacked, CLOUDS),
 ]
 
 #: Public kernels checked here only through another path, each with the reason. Empty: every

@@ -157,6 +157,9 @@ def test_bad_orient_values_and_inputs_are_refused():
         meshcurv.principal_curvatures(sphere.vertices, sphere.faces, orient="inward")
     with pytest.raises(InvalidOptionError, match="unknown orient True"):
         meshcurv.principal_curvatures(sphere.vertices, sphere.faces, orient=True)
+    # an array is refused by name too (it was compared with 'auto': numpy's "truth value ... ambiguous")
+    with pytest.raises(InvalidOptionError, match=r"unknown orient array\(\[1\., 2\.\]\)"):
+        meshcurv.principal_curvatures(sphere.vertices, sphere.faces, orient=np.array([1.0, 2.0]))
     top = MeshTopology.from_faces(sphere.faces, sphere.vertices.shape[0] + 1)
     with pytest.raises(InvalidMeshError, match="MeshTopology of 43 vertices but `vertices` has 42 rows"):
         orient_faces(sphere.vertices, top)

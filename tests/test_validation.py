@@ -193,3 +193,12 @@ def test_vertices_and_faces_swapped_are_named():
 def test_an_array_alone_is_told_to_come_with_its_faces(alone, match):
     with pytest.raises(InvalidMeshError, match=match):
         meshcurv.principal_curvatures(alone)
+
+
+def test_a_subnormal_radius_is_refused_by_name():
+    # 5e-324 > 0, but 1 / 5e-324 is inf: the balls' offsets became inf * 0 = NaN deep in the fits
+    sphere = meshcurv.shapes.icosphere(2)
+    with pytest.raises(meshcurv.errors.InvalidOptionError, match=r"`radius` must be at least 2\.23e-308 .*got 5e-324"):
+        meshcurv.principal_curvatures(sphere.vertices, sphere.faces, radius=5e-324)
+    with pytest.raises(meshcurv.errors.InvalidOptionError, match=r"`radius` must be at least 2\.23e-308"):
+        meshcurv.point_cloud_curvatures(sphere.vertices, radius=5e-324)

@@ -365,6 +365,9 @@ def check_positive_float(value, name: str) -> float:
         raise InvalidOptionError(f"`{name}` must be a positive finite number; got {_short_repr(value)}") from None
     if not np.isfinite(number) or number <= 0:
         raise InvalidOptionError(f"`{name}` must be a positive finite number; got {_short_repr(value)}")
+    if number < np.finfo(float).tiny:  # subnormal: its inverse is inf
+        raise InvalidOptionError(f"`{name}` must be at least {np.finfo(float).tiny:.3g} (the smallest normal "
+                                 f"float64: its inverse is finite); got {number!r}")
     return number
 
 

@@ -306,7 +306,7 @@ def _checked_options(method, **given) -> tuple:
 
 def _resolved(method: str, orient, weld) -> tuple:
     """``orient`` and ``weld`` with their defaults for ``method`` (matGeom's numbers: the mesh as given)."""
-    if orient == "auto":
+    if isinstance(orient, str) and orient == "auto":  # anything else is checked by prepare_mesh
         orient = "keep" if method == "matgeom" else "outward"
     if weld is None:
         weld = method != "matgeom"

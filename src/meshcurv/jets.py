@@ -212,18 +212,19 @@ def _cholesky_solve(matrix: np.ndarray, right: np.ndarray, factors: np.ndarray,
                 t -= low[:, i, j] * low[:, k, j]
             low[:, i, k] = t * inverse
     trace = np.zeros(n)
-    for j in range(m):  # column j of the inverse of the factor: zero above the diagonal
-        column = np.zeros((n, m))
-        column[:, j] = low[:, j, j]
-        total = column[:, j] * column[:, j]
-        for i in range(j + 1, m):
-            t = low[:, i, j] * column[:, j]
-            for k in range(j + 1, i):
-                t += low[:, i, k] * column[:, k]
-            column[:, i] = -t * low[:, i, i]
-            total += column[:, i] * column[:, i]
-        trace += total * factors[:, j]
-    ok &= trace * min_spread < 1.0
+    with np.errstate(over="ignore", invalid="ignore"):  # inf or NaN traces: not spread (as the kernel)
+        for j in range(m):  # column j of the inverse of the factor: zero above the diagonal
+            column = np.zeros((n, m))
+            column[:, j] = low[:, j, j]
+            total = column[:, j] * column[:, j]
+            for i in range(j + 1, m):
+                t = low[:, i, j] * column[:, j]
+                for k in range(j + 1, i):
+                    t += low[:, i, k] * column[:, k]
+                column[:, i] = -t * low[:, i, i]
+                total += column[:, i] * column[:, i]
+            trace += total * factors[:, j]
+        ok &= trace * min_spread < 1.0
     x = right.copy()
     for i in range(m):
         for j in range(i):
@@ -242,7 +243,8 @@ def _solve_block(block: np.ndarray, right: np.ndarray, degree: int,
     kept (its points spread, ``min_spread``) and the (N, m, m) diagonally scaled matrices solved."""
     scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
     scaled = block * scale[:, :, None] * scale[:, None, :]
-    factors = block[:, :1, 0] * scale * scale * (1.0 / _binomials(degree))  # sum(w) s_j^2 / C_j, as the kernel
+    with np.errstate(over="ignore"):  # a monomial zero on every point (a flat ball): inf, not spread, as the kernel
+        factors = block[:, :1, 0] * scale * scale * (1.0 / _binomials(degree))  # sum(w) s_j^2 / C_j
     solution, ok = _cholesky_solve(scaled, right * scale, factors, min_spread)
     return solution * scale, ok, scaled
 

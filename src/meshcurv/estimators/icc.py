@@ -196,7 +196,8 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
     cell = typical / COARSE_CELLS
     members = np.flatnonzero(inside)
     corner = vertices[members].min(axis=0)
-    cube = np.floor((vertices[members] - corner) / cell).astype(np.int64)
+    # cells beyond 2^52 (a vertex flung far away) share the last one: a cast of such a float is undefined
+    cube = np.minimum(np.floor((vertices[members] - corner) / cell), 2.0**52).astype(np.int64)
     axis = np.argmax(np.abs(normals[members]), axis=1)
     side = 2 * axis + (normals[members, axis] < 0)
     keys = np.column_stack([cube, side])
