@@ -85,8 +85,11 @@ def main(argv=None):
         for method in args.methods:
             runs = sorted((timed(points, method) for _ in range(args.repeat)), key=lambda run: run[1])
             result, wall, cpu, stages = runs[len(runs) // 2]  # the run of median wall time
-            detail = "; ".join(f"{label.replace('point cloud: ', '')} {w:.2f} ({c:.2f})"
-                               for label, (w, c) in stages.items() if w >= 0.005)
+            detail = "; ".join(
+                f"{label.replace('point cloud: ', '')} {w:.2f} ({c:.2f})"
+                for label, (w, c) in stages.items()
+                if w >= 0.005
+            )
             lines.append(f"| {n} | {method} | {wall:.2f} | {cpu:.2f} | {result.valid.mean():.4f} | {detail} |")
             print(lines[-1], flush=True)
     load = ", ".join(f"{x:.1f}" for x in os.getloadavg())

@@ -31,8 +31,12 @@ from conftest import random_rotation
 
 TORUS = shapes.torus(n_major=48, n_minor=32)
 RADIUS = 2.5 * mean_edge_length(TORUS.vertices, MeshTopology.from_faces(TORUS.faces).edges)
-BACKENDS = ["numpy", pytest.param("numba", marks=pytest.mark.skipif(importlib.util.find_spec("numba") is None,
-                                                                  reason="numba is not installed"))]
+BACKENDS = [
+    "numpy",
+    pytest.param(
+        "numba", marks=pytest.mark.skipif(importlib.util.find_spec("numba") is None, reason="numba is not installed")
+    ),
+]
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -65,7 +69,7 @@ def test_degree_choice_does_not_depend_on_the_turn_of_the_frame():
     offsets = (vertices[inside] - vertices[vertex]) / RADIUS
     weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
     rows = np.zeros(offsets.shape[0], dtype=np.int64)
-    normal = TORUS.normals[vertex:vertex + 1]
+    normal = TORUS.normals[vertex : vertex + 1]
     t1, t2 = tangent_basis(normal)
     kept = {4: [], 3: [], 2: []}
     pivots = []
@@ -87,13 +91,17 @@ def test_a_ribbon_two_vertices_wide_has_no_quadric_in_any_pose(seed):
     """Every ball of a ribbon of two rows of vertices holds points on two lines: no quadric is determined
     (``v^2`` is a multiple of ``v`` there), so every vertex is invalid, in every pose, with the warning."""
     along = np.arange(40.0)
-    vertices = np.concatenate([np.stack([along, np.zeros(40), np.zeros(40)], axis=1),
-                               np.stack([along, np.ones(40), np.zeros(40)], axis=1)])
+    vertices = np.concatenate(
+        [np.stack([along, np.zeros(40), np.zeros(40)], axis=1), np.stack([along, np.ones(40), np.zeros(40)], axis=1)]
+    )
     i = np.arange(39)
     faces = np.concatenate([np.stack([i, i + 1, i + 41], axis=1), np.stack([i, i + 41, i + 40], axis=1)])
     moved = vertices @ random_rotation(seed).T * 10.0 ** (seed - 1) + 5.0
-    with pytest.warns(meshcurv.errors.MeshQualityWarning, match=r"80 vertices have fewer than 6 vertices \(or a "
-                      r"degenerate set\)"):
+    with pytest.warns(
+        meshcurv.errors.MeshQualityWarning,
+        match=r"80 vertices have fewer than 6 vertices \(or a "
+        r"degenerate set\)",
+    ):
         result = meshcurv.principal_curvatures(moved, faces, method="quadric", radius=3.0 * 10.0 ** (seed - 1))
     assert not result.valid.any()
     assert np.isnan(result.k_min).all()
