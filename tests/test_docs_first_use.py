@@ -59,6 +59,7 @@ class _Event:
 @pytest.fixture
 def clock(monkeypatch, caplog):
     """The announcer with a fast clock; the announcement's WARNING goes to caplog."""
+    pytest.importorskip("numba")  # what compiles, and the cache the announcement names
     from meshcurv import _backend
 
     monkeypatch.setattr(_backend, "TICK_SECONDS", 0.02)
