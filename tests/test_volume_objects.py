@@ -40,14 +40,20 @@ def two_balls():
     return image
 
 
-def test_pieces_round_trip_as_one_surface(tmp_path):
+def _write_two_pieces(path):
+    """Two surfaces (a triangle, labelled 1; a square, labelled 2) written as two pieces of one VTP file."""
     first = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), np.array([[0, 1, 2]]))
     second = (np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1], [1, 1, 1.0]]), np.array([[0, 1, 2], [1, 3, 2]]))
-    with open(tmp_path / "two.vtp", "wb") as handle, PieceWriter(handle) as writer:
+    with open(path, "wb") as handle, PieceWriter(handle) as writer:
         for number, (vertices, faces) in enumerate((first, second), start=1):
             writer.add(vertices, faces, {"label": np.full(len(vertices), number, dtype=np.uint64),
                                          "normals": np.tile([0, 0, 1.0], (len(vertices), 1))},
                        {"label": np.full(len(faces), number, dtype=np.uint64)})
+    return first, second
+
+
+def test_pieces_round_trip_as_one_surface(tmp_path):
+    first, second = _write_two_pieces(tmp_path / "two.vtp")
     vertices, faces = read_vtp(tmp_path / "two.vtp")
     assert np.array_equal(vertices, np.concatenate([first[0], second[0]]))
     assert np.array_equal(faces, [[0, 1, 2], [3, 4, 5], [4, 6, 5]])
@@ -119,13 +125,7 @@ def test_vtk_reads_the_pieces_as_one_dataset(tmp_path):
     vtk = pytest.importorskip("vtk")
     from vtk.util.numpy_support import vtk_to_numpy
 
-    first = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), np.array([[0, 1, 2]]))
-    second = (np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1], [1, 1, 1.0]]), np.array([[0, 1, 2], [1, 3, 2]]))
-    with open(tmp_path / "two.vtp", "wb") as handle, PieceWriter(handle) as writer:
-        for number, (vertices, faces) in enumerate((first, second), start=1):
-            writer.add(vertices, faces, {"label": np.full(len(vertices), number, dtype=np.uint64),
-                                         "normals": np.tile([0, 0, 1.0], (len(vertices), 1))},
-                       {"label": np.full(len(faces), number, dtype=np.uint64)})
+    first, second = _write_two_pieces(tmp_path / "two.vtp")
     reader = vtk.vtkXMLPolyDataReader()  # what ParaView opens a .vtp with
     reader.SetFileName(str(tmp_path / "two.vtp"))
     reader.Update()

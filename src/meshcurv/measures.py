@@ -33,8 +33,9 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._tensors import principal_from_mean_gaussian, principal_from_shape_operator
+from .geometry import face_areas
 
-__all__ = ["face_measures", "curvatures_from_measures", "principal_from_measures"]
+__all__ = ["face_measures", "corrected_areas", "curvatures_from_measures", "principal_from_measures"]
 
 
 def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -63,6 +64,13 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
     sym = np.stack([m[:, 0, 0], m[:, 1, 1], m[:, 2, 2], 0.5 * (m[:, 0, 1] + m[:, 1, 0]),
                     0.5 * (m[:, 0, 2] + m[:, 2, 0]), 0.5 * (m[:, 1, 2] + m[:, 2, 1])], axis=1)
     return np.column_stack([mu0, mu1, mu2, sym])
+
+
+def corrected_areas(vertices: np.ndarray, faces: np.ndarray, measures: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(triangle, corrected)``, (F,) each: the faces' triangle areas, and their corrected areas ``mu_0``
+    (``measures[:, 0]`` of :func:`face_measures`), the triangle's where ``mu_0`` is not finite."""
+    triangle = face_areas(vertices, faces)
+    return triangle, np.where(np.isfinite(measures[:, 0]), measures[:, 0], triangle)
 
 
 def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):

@@ -105,7 +105,7 @@ import numpy as np
 
 from .errors import InvalidOptionError, MeshQualityWarning
 from .integrals import _unit_normals, face_solid_angles
-from .measures import face_measures
+from .measures import corrected_areas, face_measures
 
 __all__ = ["curvature_statistics", "FIELDS", "MOMENTS", "INTEGRALS", "COLUMNS"]
 
@@ -340,10 +340,7 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
     normals = None if result.method == "matgeom" else np.where(valid[:, None], np.asarray(result.normals)[rows], np.nan)
     normals = _unit_normals(vertices, faces, normals)
     measures = face_measures(vertices, faces, normals)[:, :2]
-    triangle = 0.5 * np.linalg.norm(
-        np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]]), axis=1
-    )
-    corrected = np.where(np.isfinite(measures[:, 0]), measures[:, 0], triangle)
+    _, corrected = corrected_areas(vertices, faces, measures)
     weights = np.bincount(faces.ravel(), np.repeat(np.maximum(corrected, 0.0) / 3.0, 3), minlength=vertices.shape[0])
     used = region & valid
     if not used.any():

@@ -212,7 +212,7 @@ from ._validation import check_int_option, check_positive_float
 from .curvature import principal_curvatures
 from .errors import (InvalidMeshError, InvalidOptionError, MeshcurvWarning, MeshQualityWarning,
                      MissingDependencyError)
-from .measures import face_measures
+from .measures import corrected_areas, face_measures
 from .radius import VOXEL_CURVEDNESS_PERCENTILE, VOXEL_PILOT, voxel_radius
 from .integrals import vertex_integrals, weighted_percentiles
 from .result import CurvatureResult
@@ -625,9 +625,7 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
 
     normals = np.asarray(result.normals)
     measures = face_measures(vertices, faces, normals)[:, :3]
-    triangle = 0.5 * np.linalg.norm(np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]],
-                                             vertices[faces[:, 2]] - vertices[faces[:, 0]]), axis=1)
-    corrected = np.where(np.isfinite(measures[:, 0]), measures[:, 0], triangle)
+    triangle, corrected = corrected_areas(vertices, faces, measures)
     if cap.any():  # the area of the surface inside the image, with normals that do not see the cap
         corrected = _area_inside(vertices, faces, cap, border, normals, triangle, corrected, options,
                                  parameters.get("radius"), messages)
