@@ -60,7 +60,6 @@ import warnings
 from collections.abc import Callable
 
 import numpy as np
-from scipy import sparse
 
 from ._validation import check_positive_float, checked_points
 from .errors import InvalidOptionError
@@ -343,6 +342,20 @@ LOCAL_EVEN = 2.0
 LOCAL_FOLLOW = 4.0
 
 
+def _ring_sums(neighbour_lists: tuple, rings: int, *arrays: np.ndarray) -> list[np.ndarray]:
+    """Each of ``arrays`` (V, ...) summed ``rings`` times over every vertex and its edge neighbours
+    (``neighbour_lists``: :attr:`meshcurv.topology.MeshTopology.neighbour_lists`)."""
+    from scipy import sparse  # imported on use: keeps `import meshcurv` fast
+
+    indptr, indices = neighbour_lists
+    n = indptr.size - 1
+    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n)) + sparse.identity(n)
+    sums = list(arrays)
+    for _ in range(rings):
+        sums = [ring @ array for array in sums]
+    return sums
+
+
 def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarray:
     """(V,) the factor of each vertex's radius over its component's: how much coarser or finer it is sampled.
 
@@ -366,12 +379,8 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarr
     raw = local[known] / scales[known]
     if raw.min() >= 1.0 / LOCAL_EVEN and raw.max() <= LOCAL_EVEN:  # the ring means of these stay within too
         return np.ones(n)
-    indptr, indices = topology.neighbour_lists
-    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n)) + sparse.identity(n)
     logs = np.where(known, np.log(np.where(known, local, 1.0) / np.where(known, scales, 1.0)), 0.0)
-    weights = known.astype(np.float64)
-    for _ in range(LOCAL_RINGS):
-        logs, weights = ring @ logs, ring @ weights
+    logs, weights = _ring_sums(topology.neighbour_lists, LOCAL_RINGS, logs, known.astype(np.float64))
     with np.errstate(invalid="ignore", divide="ignore"):
         logs = np.where(weights > 0, logs / np.where(weights > 0, weights, 1.0), 0.0)
     even, follow = np.log(LOCAL_EVEN), np.log(LOCAL_FOLLOW)
@@ -432,12 +441,8 @@ def stable_scales(k_min: np.ndarray, k_max: np.ndarray, neighbour_lists: tuple) 
     mean = 0.5 * (k_min + k_max)
     change = np.abs(np.diff(mean, axis=0)) + np.abs(np.diff(k_min, axis=0)) + np.abs(np.diff(k_max, axis=0))
     finite = np.isfinite(change)
-    indptr, indices = neighbour_lists
-    n = k_min.shape[1]
-    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n)) + sparse.identity(n)
-    total, count = np.where(finite, change, 0.0).T, finite.astype(np.float64).T
-    for _ in range(STABLE_RINGS):
-        total, count = ring @ total, ring @ count
+    total, count = _ring_sums(neighbour_lists, STABLE_RINGS, np.where(finite, change, 0.0).T,
+                              finite.astype(np.float64).T)
     with np.errstate(invalid="ignore", divide="ignore"):
         local = (total / count).T
     with warnings.catch_warnings():
