@@ -67,8 +67,24 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
 
 
 def corrected_areas(vertices: np.ndarray, faces: np.ndarray, measures: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(triangle, corrected)``, (F,) each: the faces' triangle areas, and their corrected areas ``mu_0``
-    (``measures[:, 0]`` of :func:`face_measures`), the triangle's where ``mu_0`` is not finite."""
+    """The faces' triangle areas, and their corrected areas, the triangle's where the measure is undefined.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+        The mesh's vertices.
+    faces : ndarray of shape (F, 3)
+        Its faces.
+    measures : ndarray of shape (F, k)
+        The faces' measures (:func:`face_measures`); ``measures[:, 0]`` is the corrected area ``mu_0``.
+
+    Returns
+    -------
+    triangle : ndarray of shape (F,)
+        The area of each triangle.
+    corrected : ndarray of shape (F,)
+        ``mu_0``, the triangle's area where ``mu_0`` is not finite.
+    """
     triangle = face_areas(vertices, faces)
     return triangle, np.where(np.isfinite(measures[:, 0]), measures[:, 0], triangle)
 
