@@ -51,8 +51,12 @@ def read_in_child(paths, *, memory_mib=None):
     if memory_mib is not None and not os.path.exists("/proc/self/status"):
         pytest.skip("the memory limit needs /proc (Linux)")
     try:
-        done = subprocess.run([sys.executable, "-c", _CHILD, json.dumps([[str(p) for p in paths], memory_mib])],
-                              capture_output=True, text=True, timeout=TIMEOUT)
+        done = subprocess.run(
+            [sys.executable, "-c", _CHILD, json.dumps([[str(p) for p in paths], memory_mib])],
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT,
+        )
     except subprocess.TimeoutExpired:
         pytest.fail(f"reading {[p.name for p in paths]} did not finish within {TIMEOUT} s (a reader hangs)")
     assert done.returncode == 0, done.stderr[-2000:]
@@ -65,9 +69,11 @@ def torus():
 
 
 def ply_header(n_vertices, n_faces, *, fmt="binary_little_endian", index="int"):
-    return (f"ply\nformat {fmt} 1.0\ncomment adversarial\nelement vertex {n_vertices}\nproperty float x\n"
-            f"property float y\nproperty float z\nelement face {n_faces}\n"
-            f"property list uchar {index} vertex_indices\nend_header\n").encode()
+    return (
+        f"ply\nformat {fmt} 1.0\ncomment adversarial\nelement vertex {n_vertices}\nproperty float x\n"
+        f"property float y\nproperty float z\nelement face {n_faces}\n"
+        f"property list uchar {index} vertex_indices\nend_header\n"
+    ).encode()
 
 
 # ---------------------------------------------------------------- 1. PLY header cut short: an error, not a hang
@@ -78,8 +84,9 @@ def test_ply_cut_anywhere_in_its_header_is_an_error_not_a_hang(tmp_path, torus):
     pytest.importorskip("meshio")
     good = meshcurv.write_mesh(tmp_path / "good.ply", torus.vertices, torus.faces).read_bytes()
     header_end = good.index(b"end_header")
-    cuts = sorted({3, 4, *[i + 1 for i, byte in enumerate(good[:header_end]) if byte == ord("\n")],
-                   header_end, header_end + 5})
+    cuts = sorted(
+        {3, 4, *[i + 1 for i, byte in enumerate(good[:header_end]) if byte == ord("\n")], header_end, header_end + 5}
+    )
     paths = []
     for cut in cuts:
         paths.append(tmp_path / f"cut{cut}.ply")
@@ -106,23 +113,30 @@ def test_ply_header_without_end_header_within_the_limit_is_refused(tmp_path):
 def test_huge_declared_counts_are_refused_before_allocating(tmp_path):
     """300 million faces declared over 4 would allocate gigabytes; the child has 300 MiB to spare."""
     square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype="<f4")
-    face_records = np.array([(3, [0, 1, 2]), (3, [0, 2, 3]), (3, [0, 1, 3]), (3, [1, 2, 3])],
-                            dtype=[("n", "u1"), ("i", "<i4", (3,))])
+    face_records = np.array(
+        [(3, [0, 1, 2]), (3, [0, 2, 3]), (3, [0, 1, 3]), (3, [1, 2, 3])], dtype=[("n", "u1"), ("i", "<i4", (3,))]
+    )
     files = {}
     files["faces.ply"] = ply_header(4, 300_000_000) + square.tobytes() + face_records.tobytes()
     files["vertices.ply"] = ply_header(300_000_000, 4) + square.tobytes() + face_records.tobytes()
     files["ascii.ply"] = ply_header(4, 300_000_000, fmt="ascii") + b"0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n"
     files["mixed.ply"] = ply_header(4, 300_000_000) + square.tobytes() + b"\x04" + b"\0" * 16
     files["count.off"] = b"OFF\n4 300000000 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n"
-    files["points.vtk"] = (b"# vtk DataFile Version 4.2\nx\nBINARY\nDATASET POLYDATA\nPOINTS 300000000 double\n"
-                           + b"\0" * 96 + b"\nPOLYGONS 1 4\n" + np.array([3, 0, 1, 2], ">i4").tobytes())
+    files["points.vtk"] = (
+        b"# vtk DataFile Version 4.2\nx\nBINARY\nDATASET POLYDATA\nPOINTS 300000000 double\n"
+        + b"\0" * 96
+        + b"\nPOLYGONS 1 4\n"
+        + np.array([3, 0, 1, 2], ">i4").tobytes()
+    )
     header = np.array([2_400_000_000], "<u8").tobytes()
-    files["size.vtp"] = (f'<VTKFile type="PolyData" header_type="UInt64"><PolyData><Piece><Points>'
-                         f'<DataArray type="Float64" NumberOfComponents="3" format="binary">'
-                         f'{base64.b64encode(header).decode()}AAAA</DataArray></Points><Polys><DataArray type="Int64" '
-                         f'Name="connectivity" format="ascii">0 1 2</DataArray><DataArray type="Int64" '
-                         f'Name="offsets" format="ascii">3</DataArray></Polys></Piece></PolyData>'
-                         f'</VTKFile>').encode()
+    files["size.vtp"] = (
+        f'<VTKFile type="PolyData" header_type="UInt64"><PolyData><Piece><Points>'
+        f'<DataArray type="Float64" NumberOfComponents="3" format="binary">'
+        f'{base64.b64encode(header).decode()}AAAA</DataArray></Points><Polys><DataArray type="Int64" '
+        f'Name="connectivity" format="ascii">0 1 2</DataArray><DataArray type="Int64" '
+        f'Name="offsets" format="ascii">3</DataArray></Polys></Piece></PolyData>'
+        f"</VTKFile>"
+    ).encode()
     # an NPZ whose .npy header claims 10**11 vertices over 96 bytes of data
     npy = bytearray()
     npy += b"\x93NUMPY\x01\x00"
@@ -186,13 +200,13 @@ def test_float_indices_are_refused(tmp_path):
         "a.ply": ply_header(3, 1, fmt="ascii") + b"0 0 0\n1 0 0\n0 1 0\n3 0.5 1 2\n",
         "b.ply": ply_header(4, 2, fmt="ascii") + b"0 0 0\n1 0 0\n0 1 0\n1 1 0\n4 0 1 3 2\n3 0 1 2.5\n",
         "c.vtp": b'<VTKFile type="PolyData"><PolyData><Piece><Points><DataArray type="Float64" '
-                 b'NumberOfComponents="3" format="ascii">0 0 0 1 0 0 0 1 0</DataArray></Points><Polys>'
-                 b'<DataArray type="Int64" Name="connectivity" format="ascii">0 1.5 2</DataArray>'
-                 b'<DataArray type="Int64" Name="offsets" format="ascii">3</DataArray></Polys></Piece>'
-                 b'</PolyData></VTKFile>',
+        b'NumberOfComponents="3" format="ascii">0 0 0 1 0 0 0 1 0</DataArray></Points><Polys>'
+        b'<DataArray type="Int64" Name="connectivity" format="ascii">0 1.5 2</DataArray>'
+        b'<DataArray type="Int64" Name="offsets" format="ascii">3</DataArray></Polys></Piece>'
+        b"</PolyData></VTKFile>",
         "d.off": b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1.5 2\n",
         "e.vtk": b"# vtk DataFile Version 4.2\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
-                 b"POLYGONS 1 4\n3 0 1.5 2\n",
+        b"POLYGONS 1 4\n3 0 1.5 2\n",
     }
     for name, data in cases.items():
         (tmp_path / name).write_bytes(data)
@@ -206,16 +220,20 @@ def test_float_indices_are_refused(tmp_path):
 def test_vtp_empty_binary_array_and_npz_corruption_are_mesh_file_errors(tmp_path, torus):
     good = meshcurv.write_mesh(tmp_path / "good.vtp", torus.vertices, torus.faces).read_text()
     start = good.index('Name="offsets">') + len('Name="offsets">')
-    (tmp_path / "empty.vtp").write_text(good[:start] + good[good.index("</DataArray>", start):])
+    (tmp_path / "empty.vtp").write_text(good[:start] + good[good.index("</DataArray>", start) :])
     with pytest.raises(MeshFileError, match=r"empty\.vtp: a binary DataArray is empty or cut short"):
         meshcurv.read_mesh(tmp_path / "empty.vtp")
 
     npz = meshcurv.write_mesh(tmp_path / "good.npz", torus.vertices, torus.faces).read_bytes()
-    cases = {"cut.npz": npz[: len(npz) // 2],
-             "flipped.npz": npz[:60] + bytes(b ^ 0xFF for b in npz[60:200]) + npz[200:]}
+    cases = {
+        "cut.npz": npz[: len(npz) // 2],
+        "flipped.npz": npz[:60] + bytes(b ^ 0xFF for b in npz[60:200]) + npz[200:],
+    }
     stored = bytearray()
     with zipfile.ZipFile(tmp_path / "stored.npz", "w") as archive:  # a .npy header that is not a dict
-        archive.writestr("vertices.npy", b"\x93NUMPY\x01\x00" + (118).to_bytes(2, "little") + b"{'descr': (" + b" " * 106 + b"\n")
+        archive.writestr(
+            "vertices.npy", b"\x93NUMPY\x01\x00" + (118).to_bytes(2, "little") + b"{'descr': (" + b" " * 106 + b"\n"
+        )
         archive.writestr("faces.npy", b"")
     stored += (tmp_path / "stored.npz").read_bytes()
     cases["header.npz"] = bytes(stored)
@@ -233,6 +251,7 @@ def test_unexpected_reader_exceptions_become_mesh_file_errors_but_memory_errors_
     def raises(error):
         def read(path):
             raise error
+
         return read
 
     monkeypatch.setitem(FORMATS, ".obj", dataclasses.replace(FORMATS[".obj"], read=raises(IndexError("index 0"))))
@@ -261,24 +280,34 @@ def test_off_faces_with_colours_are_read(tmp_path):
 
 def legacy_polydata(vertices, faces, *, binary, version):
     """A legacy .vtk POLYDATA as vtkPolyDataWriter writes it (4.2: count-prefixed cells; 5.1: offsets)."""
+
     def array(values, code):
         if binary:
             return np.asarray(values).astype(">" + code).tobytes() + b"\n"
         return (" ".join(map(str, np.asarray(values).ravel().tolist())) + "\n").encode()
 
-    parts = [f"# vtk DataFile Version {version}\nvtk output\n{'BINARY' if binary else 'ASCII'}\n"
-             "DATASET POLYDATA\nFIELD FieldData 1\nTimeValue 1 1 double\n".encode() + array([0.5], "f8"),
-             f"POINTS {len(vertices)} double\n".encode() + array(vertices, "f8")]
+    parts = [
+        f"# vtk DataFile Version {version}\nvtk output\n{'BINARY' if binary else 'ASCII'}\n"
+        "DATASET POLYDATA\nFIELD FieldData 1\nTimeValue 1 1 double\n".encode()
+        + array([0.5], "f8"),
+        f"POINTS {len(vertices)} double\n".encode() + array(vertices, "f8"),
+    ]
     if version == "5.1":
         offsets = np.arange(len(faces) + 1) * faces.shape[1]
         parts.append(b"METADATA\nINFORMATION 0\n\n")
-        parts.append(f"POLYGONS {len(offsets)} {faces.size}\nOFFSETS vtktypeint64\n".encode() + array(offsets, "i8")
-                     + b"CONNECTIVITY vtktypeint64\n" + array(faces, "i8"))
+        parts.append(
+            f"POLYGONS {len(offsets)} {faces.size}\nOFFSETS vtktypeint64\n".encode()
+            + array(offsets, "i8")
+            + b"CONNECTIVITY vtktypeint64\n"
+            + array(faces, "i8")
+        )
     else:
         cells = np.column_stack([np.full(len(faces), faces.shape[1]), faces])
         parts.append(f"POLYGONS {len(faces)} {cells.size}\n".encode() + array(cells, "i4"))
-    parts.append(f"POINT_DATA {len(vertices)}\nSCALARS k float 1\nLOOKUP_TABLE default\n".encode()
-                 + array(np.arange(len(vertices)), "f4"))
+    parts.append(
+        f"POINT_DATA {len(vertices)}\nSCALARS k float 1\nLOOKUP_TABLE default\n".encode()
+        + array(np.arange(len(vertices)), "f4")
+    )
     return b"".join(parts)
 
 
@@ -297,9 +326,11 @@ def test_legacy_vtk_polydata_is_read(tmp_path, torus, version, binary):
 
 def test_legacy_vtk_mixed_polygons_and_triangle_strips(tmp_path):
     path = tmp_path / "strips.vtk"
-    path.write_text("# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 5 float\n"
-                    "0 0 0 1 0 0 1 1 0 0 1 0 2 0 0\nPOLYGONS 2 9\n4 0 1 2 3\n3 1 4 2\n"
-                    "TRIANGLE_STRIPS 1 5\n4 0 1 3 2\n")
+    path.write_text(
+        "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 5 float\n"
+        "0 0 0 1 0 0 1 1 0 0 1 0 2 0 0\nPOLYGONS 2 9\n4 0 1 2 3\n3 1 4 2\n"
+        "TRIANGLE_STRIPS 1 5\n4 0 1 3 2\n"
+    )
     vertices, faces = meshcurv.read_mesh(path)
     assert [face.tolist() for face in faces] == [[0, 1, 2, 3], [1, 4, 2], [0, 1, 3], [3, 1, 2]]
 
@@ -329,6 +360,7 @@ def test_an_output_takes_the_umask_and_the_umask_is_never_changed(tmp_path, toru
     """
     previous = os.umask(0o027)
     try:
+
         def changed(*args):
             raise AssertionError("the process umask was changed during a write")
 
@@ -357,8 +389,10 @@ def test_a_file_created_meanwhile_is_not_replaced_without_overwrite(tmp_path, to
         target.write_text("the other writer's mesh")
 
     if not hard_links:
+
         def no_link(*args):
             raise OSError(1, "Operation not permitted")
+
         monkeypatch.setattr(_files.os, "link", no_link)
     monkeypatch.setitem(FORMATS, ".obj", dataclasses.replace(FORMATS[".obj"], write=write_while_another_finishes))
     with pytest.raises(MeshFileError, match=r"t\.obj: already exists \(another writer created it meanwhile\)"):
@@ -376,17 +410,21 @@ def test_a_file_created_meanwhile_is_not_replaced_without_overwrite(tmp_path, to
 @pytest.mark.slow
 def test_writers_started_together_do_not_both_succeed(tmp_path):
     pytest.importorskip("meshio")  # PLY is written through meshio
-    script = ("import sys, time, meshcurv\nfrom meshcurv import shapes\n"
-              "s = shapes.icosphere(subdivisions=60)\nstart = float(sys.argv[2])\n"
-              "time.sleep(max(0.0, start - time.time()))\n"
-              "try:\n    meshcurv.write_mesh(sys.argv[1], s.vertices, s.faces)\n    print('written')\n"
-              "except meshcurv.errors.MeshFileError as exc:\n    print('refused', exc)\n")
+    script = (
+        "import sys, time, meshcurv\nfrom meshcurv import shapes\n"
+        "s = shapes.icosphere(subdivisions=60)\nstart = float(sys.argv[2])\n"
+        "time.sleep(max(0.0, start - time.time()))\n"
+        "try:\n    meshcurv.write_mesh(sys.argv[1], s.vertices, s.faces)\n    print('written')\n"
+        "except meshcurv.errors.MeshFileError as exc:\n    print('refused', exc)\n"
+    )
     import time
 
     start = str(time.time() + 3)
     target = str(tmp_path / "same.ply")
-    children = [subprocess.Popen([sys.executable, "-c", script, target, start], stdout=subprocess.PIPE, text=True)
-                for _ in range(2)]
+    children = [
+        subprocess.Popen([sys.executable, "-c", script, target, start], stdout=subprocess.PIPE, text=True)
+        for _ in range(2)
+    ]
     outputs = [child.communicate(timeout=TIMEOUT)[0] for child in children]
     assert sorted(out.split()[0] for out in outputs) == ["refused", "written"], outputs
     assert "already exists" in next(out for out in outputs if out.startswith("refused"))
@@ -397,8 +435,12 @@ def test_the_input_is_never_the_output_through_any_alias(tmp_path, torus):
     (tmp_path / "link.obj").symlink_to(source)
     os.link(source, tmp_path / "hard.obj")
     (tmp_path / "folder_link").symlink_to(tmp_path, target_is_directory=True)
-    for alias in (tmp_path / "link.obj", tmp_path / "hard.obj", tmp_path / "folder_link" / "in.obj",
-                  tmp_path / "folder_link" / ".." / tmp_path.name / "in.obj"):
+    for alias in (
+        tmp_path / "link.obj",
+        tmp_path / "hard.obj",
+        tmp_path / "folder_link" / "in.obj",
+        tmp_path / "folder_link" / ".." / tmp_path.name / "in.obj",
+    ):
         with pytest.raises(MeshFileError, match="the output would replace the input file"):
             _files.check_output(alias, overwrite=True, source=source)
         with pytest.raises(MeshFileError, match="the output would replace the input file"):

@@ -16,6 +16,7 @@ READABLE = sorted({ext for fmt in io.FORMATS.values() if fmt.read is not None fo
 def readers_available(extension):
     try:
         import meshio  # noqa: F401
+
         return True
     except ImportError:
         return extension in (".obj", ".vtp", ".npz")
@@ -45,8 +46,11 @@ def test_bad_files_name_the_file(tmp_path, extension):
     cases["garbage"].write_bytes(bytes(range(256)) * 4)
     other = ".ply" if extension != ".ply" else ".obj"
     cases["mislabelled"] = tmp_path / f"mislabelled{extension}"
-    cases["mislabelled"].write_bytes(b"ply\nformat ascii 1.0\nelement vertex 1\nend_header\n1 2\n"
-                                     if other == ".ply" else b"v 0 0 0\nv 1 0 0\nf 1 2 3\n")
+    cases["mislabelled"].write_bytes(
+        b"ply\nformat ascii 1.0\nelement vertex 1\nend_header\n1 2\n"
+        if other == ".ply"
+        else b"v 0 0 0\nv 1 0 0\nf 1 2 3\n"
+    )
     if extension == ".npz":
         # io/_tables.py read_npz leaves the file open when np.load fails on a truncated
         # archive (a ResourceWarning at some later garbage collection): reported, left out here

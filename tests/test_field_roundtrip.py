@@ -25,9 +25,16 @@ SCALARS = ("k_min", "k_max", "mean", "gaussian", "shape_index", "curvedness")
 VECTORS = ("dir_min", "dir_max", "normals")
 
 #: Files as written: PLY binary and ASCII, legacy VTK binary and ASCII, VTU, VTP, CSV, NPZ.
-WRITTEN = {"ply": (".ply", True), "ply-ascii": (".ply", False), "vtk": (".vtk", True),
-           "vtk-ascii": (".vtk", False), "vtu": (".vtu", True), "vtp": (".vtp", True), "csv": (".csv", True),
-           "npz": (".npz", True)}
+WRITTEN = {
+    "ply": (".ply", True),
+    "ply-ascii": (".ply", False),
+    "vtk": (".vtk", True),
+    "vtk-ascii": (".vtk", False),
+    "vtu": (".vtu", True),
+    "vtp": (".vtp", True),
+    "csv": (".csv", True),
+    "npz": (".npz", True),
+}
 
 #: The properties of a PLY file are float32: compared within float32 round-off of the field's scale.
 FLOAT32 = 1e-6
@@ -42,8 +49,9 @@ def written(tmp_path_factory):
     folder = tmp_path_factory.mktemp("fields")
     paths = {}
     for name, (extension, binary) in WRITTEN.items():
-        paths[name] = write_curvatures(folder / f"{name}{extension}", mesh.vertices, mesh.faces, result,
-                                       quality="gaussian", binary=binary)
+        paths[name] = write_curvatures(
+            folder / f"{name}{extension}", mesh.vertices, mesh.faces, result, quality="gaussian", binary=binary
+        )
     return mesh, result, paths
 
 
@@ -137,8 +145,9 @@ def test_meshlab_keeps_the_quality_and_the_normals(written, name):
     pytest.importorskip("pymeshlab")
     _, result, paths = written
     names = [*SCALARS, "valid", "dir_min_x"]
-    run = subprocess.run([sys.executable, "-c", MESHLAB_SCRIPT, str(paths[name]), *names], capture_output=True,
-                         text=True, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-c", MESHLAB_SCRIPT, str(paths[name]), *names], capture_output=True, text=True, timeout=120
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     read = json.loads(run.stdout.strip().splitlines()[-1])
     assert read["n"] == result.n_vertices

@@ -20,8 +20,21 @@ from meshcurv.io._images import read_image
 MODES = {np.dtype("i1"): 0, np.dtype("i2"): 1, np.dtype("f4"): 2, np.dtype("u2"): 6}
 
 
-def mrc_bytes(array_zyx, voxel_xyz=(1.0, 1.0, 1.0), *, axes=(1, 2, 3), order="<", extended=b"", mode=None,
-              ispg=1, sampling=None, stamp=True, imod_flags=None, shape_crs=None, header_axes=None):
+def mrc_bytes(
+    array_zyx,
+    voxel_xyz=(1.0, 1.0, 1.0),
+    *,
+    axes=(1, 2, 3),
+    order="<",
+    extended=b"",
+    mode=None,
+    ispg=1,
+    sampling=None,
+    stamp=True,
+    imod_flags=None,
+    shape_crs=None,
+    header_axes=None,
+):
     """The bytes of an MRC2014 file holding ``array_zyx`` (axes Z, Y, X) stored with ``axes`` = (mapc, mapr, maps)."""
     array_zyx = np.asarray(array_zyx)
     mapc, mapr, maps = axes
@@ -96,16 +109,25 @@ def test_errors_name_the_file(tmp_path, monkeypatch):
     image = labels_image()
     whole = mrc_bytes(image)
     cases = {
-        "cut.mrc": (whole[:-10], r"cut.mrc: the MRC header declares 7 x 6 x 5 values of uint16 after 1024 header "
-                                 r"bytes \(1444 bytes in all\), but the file holds only 1434"),
+        "cut.mrc": (
+            whole[:-10],
+            r"cut.mrc: the MRC header declares 7 x 6 x 5 values of uint16 after 1024 header "
+            r"bytes \(1444 bytes in all\), but the file holds only 1434",
+        ),
         "short.mrc": (whole[:500], r"short.mrc: an MRC file starts with a 1024-byte header; the file holds 500"),
         "mode.mrc": (mrc_bytes(image, mode=4), r"mode.mrc: MRC mode 4 is not read; known modes: 0 \(int8\)"),
-        "axes.mrc": (mrc_bytes(image, header_axes=(1, 1, 3)), r"axes.mrc: the MRC header's axes \(mapc, mapr, maps\) = "
-                                                        r"\(1, 1, 3\) are not an order of 1, 2, 3"),
+        "axes.mrc": (
+            mrc_bytes(image, header_axes=(1, 1, 3)),
+            r"axes.mrc: the MRC header's axes \(mapc, mapr, maps\) = "
+            r"\(1, 1, 3\) are not an order of 1, 2, 3",
+        ),
         "ext.mrc": (mrc_bytes(image, extended=b"x" * 4000)[:2000], r"ext.mrc: .* after 5024 header bytes"),
         "zero.mrc": (mrc_bytes(image, shape_crs=(7, 0, 5)), r"zero.mrc: the MRC header declares \(7, 0, 5\) columns"),
-        "stack.mrc": (mrc_bytes(image, ispg=401, sampling=(7, 6, 1)), r"stack.mrc: the MRC file is a stack of 5 "
-                                                                      r"volumes"),
+        "stack.mrc": (
+            mrc_bytes(image, ispg=401, sampling=(7, 6, 1)),
+            r"stack.mrc: the MRC file is a stack of 5 "
+            r"volumes",
+        ),
     }
     for name, (data, message) in cases.items():
         (tmp_path / name).write_bytes(data)
@@ -147,6 +169,7 @@ def test_files_written_by_mrcfile(tmp_path):
 
 # ---- the command on an MRC file ------------------------------------------------------------------------------------
 
+
 def test_cli_volume_on_an_mrc_sphere_gives_the_table_in_angstrom(tmp_path):
     pandas = pytest.importorskip("pandas")
     pytest.importorskip("skimage")
@@ -157,14 +180,16 @@ def test_cli_volume_on_an_mrc_sphere_gives_the_table_in_angstrom(tmp_path):
     voxel = np.array([20.0, 10.0, 10.0])  # z, y, x in Angstrom: anisotropic
     radius = 120.0  # 6 planes, 12 rows of voxels
     shape = (16, 30, 30)
-    grid = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(shape, voxel, (153.0, 148.0, 152.0))],
-                       indexing="ij", sparse=True)
+    grid = np.meshgrid(
+        *[np.arange(n) * s - c for n, s, c in zip(shape, voxel, (153.0, 148.0, 152.0))], indexing="ij", sparse=True
+    )
     ball = (sum(axis**2 for axis in grid) <= radius**2).astype(np.int16)
     (tmp_path / "cells.mrc").write_bytes(mrc_bytes(ball, voxel[::-1], axes=(2, 1, 3)))
     session = Session()
     with session:
-        result = click_testing.CliRunner().invoke(volume, [str(tmp_path / "cells.mrc"), "-o", str(tmp_path / "out"),
-                                                           "--no-picture"], obj=session)
+        result = click_testing.CliRunner().invoke(
+            volume, [str(tmp_path / "cells.mrc"), "-o", str(tmp_path / "out"), "--no-picture"], obj=session
+        )
     assert result.exit_code == 0, result.output
     assert "voxel size 20 x 10 x 10 angstrom (z y x) from the file" in result.output
     table = pandas.read_csv(tmp_path / "out" / "cells_labels.csv")

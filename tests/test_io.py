@@ -14,7 +14,9 @@ from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshFileError,
 from meshcurv.io import FORMATS, Mesh, write_curvatures
 from meshcurv.io.fields import curvature_fields
 
-MESHES = pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "meshes"  # ../shared beside the repository; tests skip when absent
+MESHES = (
+    pathlib.Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+)  # ../shared beside the repository; tests skip when absent
 MESH_FORMATS = [".obj", ".ply", ".stl", ".off", ".vtk", ".vtu", ".vtp", ".npz"]
 FIELD_FORMATS = [".ply", ".vtk", ".vtu", ".vtp", ".npz"]
 MESHIO_FORMATS = {".ply", ".stl", ".vtk", ".vtu"}
@@ -85,8 +87,9 @@ def test_point_data_round_trips(tmp_path, torus, extension):
     if extension == ".ply":  # float properties: float32, vectors split into components
         np.testing.assert_allclose(stored["k_min"], result.k_min, rtol=1e-6)
         np.testing.assert_allclose(stored["quality"], result.mean, rtol=1e-6)
-        np.testing.assert_allclose(np.column_stack([stored["nx"], stored["ny"], stored["nz"]]), result.normals,
-                                   rtol=1e-6, atol=1e-7)
+        np.testing.assert_allclose(
+            np.column_stack([stored["nx"], stored["ny"], stored["nz"]]), result.normals, rtol=1e-6, atol=1e-7
+        )
         np.testing.assert_allclose(stored["dir_max_z"], result.dir_max[:, 2], rtol=1e-6, atol=1e-7)
         assert stored["k_max"].dtype == np.float32
     else:
@@ -123,8 +126,18 @@ def test_csv_has_one_row_per_vertex_with_named_columns(tmp_path, torus):
     result = meshcurv.principal_curvatures(torus.vertices, torus.faces)
     write_curvatures(tmp_path / "k.csv", torus.vertices, torus.faces, result, fields=["k_min", "normals", "valid"])
     table = np.genfromtxt(tmp_path / "k.csv", delimiter=",", names=True)
-    assert table.dtype.names == ("vertex", "x", "y", "z", "k_min", "normals_x", "normals_y", "normals_z",
-                                 "valid", "quality")
+    assert table.dtype.names == (
+        "vertex",
+        "x",
+        "y",
+        "z",
+        "k_min",
+        "normals_x",
+        "normals_y",
+        "normals_z",
+        "valid",
+        "quality",
+    )
     np.testing.assert_array_equal(table["vertex"], np.arange(96))
     np.testing.assert_array_equal(table["z"], torus.vertices[:, 2])
     np.testing.assert_array_equal(table["k_min"], result.k_min)
@@ -145,8 +158,19 @@ def test_ply_fields_read_by_trimesh(tmp_path, torus):
     np.testing.assert_allclose(loaded.vertices, torus.vertices, rtol=1e-12)
     np.testing.assert_array_equal(loaded.faces, torus.faces)
     properties = loaded.metadata["_ply_raw"]["vertex"]["data"]
-    for name in ("k_min", "k_max", "mean", "gaussian", "shape_index", "curvedness", "quality", "nx",
-                 "dir_min_x", "dir_max_z", "valid"):
+    for name in (
+        "k_min",
+        "k_max",
+        "mean",
+        "gaussian",
+        "shape_index",
+        "curvedness",
+        "quality",
+        "nx",
+        "dir_min_x",
+        "dir_max_z",
+        "valid",
+    ):
         assert name in properties.dtype.names, name
     np.testing.assert_allclose(properties["k_max"], result.k_max, rtol=1e-6)
     np.testing.assert_allclose(properties["quality"], result.mean, rtol=1e-6)
@@ -208,7 +232,10 @@ def write_text(tmp_path, name, text):
 
 
 def test_obj_comments_normals_texture_polygons_and_relative_indices(tmp_path):
-    path = write_text(tmp_path, "square.obj", """# a comment
+    path = write_text(
+        tmp_path,
+        "square.obj",
+        """# a comment
 # another
 o square
 v 0 0 0 1.0
@@ -219,7 +246,8 @@ vt 0 0
 vn 0 0 1
 f 1/1/1 2/1/1 3/1/1 # inline comment
 f -4 -2 -1
-""")
+""",
+    )
     vertices, faces = meshcurv.read_mesh(path)
     np.testing.assert_array_equal(vertices, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
     np.testing.assert_array_equal(faces, [[0, 1, 2], [0, 2, 3]])
@@ -256,8 +284,11 @@ def test_missing_directory_empty_and_unknown_files(tmp_path):
         meshcurv.read_mesh(tmp_path / "folder.obj")
     with pytest.raises(MeshFileError, match=r"empty\.ply: the file is empty"):
         meshcurv.read_mesh(write_text(tmp_path, "empty.ply", ""))
-    with pytest.raises(MeshFileError, match=r"x\.dxf: unknown mesh file extension '\.dxf'; known formats: \.obj, "
-                                            r"\.ply, \.stl, \.off, \.vtk, \.vtu, \.vtp, \.csv, \.npz"):
+    with pytest.raises(
+        MeshFileError,
+        match=r"x\.dxf: unknown mesh file extension '\.dxf'; known formats: \.obj, "
+        r"\.ply, \.stl, \.off, \.vtk, \.vtu, \.vtp, \.csv, \.npz",
+    ):
         meshcurv.read_mesh(write_text(tmp_path, "x.dxf", "0\nSECTION\n"))
     with pytest.raises(MeshFileError, match="unknown mesh file format 'dxf'"):
         meshcurv.read_mesh(tmp_path / "x.obj", file_format="dxf")
@@ -306,7 +337,10 @@ def test_truncated_and_mislabelled_files_are_mesh_file_errors(tmp_path, torus, e
     [
         ("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n", "the header announces 4 vertices; the file has 3"),
         ("OFF\n3 x 0\n", "the OFF counts, vertices or faces cannot be read"),
-        ("OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 1\n", r"line 8: 3 values, expected 4 or more \(a count of 3"),
+        (
+            "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 1\n",
+            r"line 8: 3 values, expected 4 or more \(a count of 3",
+        ),
         ("COFF\n3 1 0\n", "not an OFF file \\(it should start with 'OFF'; starts with 'COFF'\\)"),
     ],
 )
@@ -338,11 +372,16 @@ def without_meshio(monkeypatch):
 def _ply_bytes(order, vertex_fields, vertex_rows, face_fields, face_rows, *, extra=""):
     """A binary PLY built by hand: header lines and numpy records of the given fields."""
     vertex_type = np.dtype([(name, order + kind) for name, kind, _ in vertex_fields])
-    face_type = np.dtype([(name, order + kind, shape) if shape else (name, order + kind)
-                          for name, kind, shape in face_fields])
+    face_type = np.dtype(
+        [(name, order + kind, shape) if shape else (name, order + kind) for name, kind, shape in face_fields]
+    )
     names = {"f8": "double", "f4": "float", "u1": "uchar", "i4": "int", "u4": "uint", "i2": "short"}
-    header = ["ply", f"format binary_{'little' if order == '<' else 'big'}_endian 1.0", "comment by hand",
-              f"element vertex {len(vertex_rows)}"]
+    header = [
+        "ply",
+        f"format binary_{'little' if order == '<' else 'big'}_endian 1.0",
+        "comment by hand",
+        f"element vertex {len(vertex_rows)}",
+    ]
     header += [f"property {names[kind]} {name}" for name, kind, _ in vertex_fields]
     header += [f"element face {len(face_rows)}"]
     for name, kind, _shape in face_fields:
@@ -353,8 +392,11 @@ def _ply_bytes(order, vertex_fields, vertex_rows, face_fields, face_rows, *, ext
         else:
             header.append(f"property {names[kind]} {name}")
     header += [line for line in extra.splitlines() if line] + ["end_header", ""]
-    return ("\n".join(header).encode() + np.array(vertex_rows, vertex_type).tobytes()
-            + np.array(face_rows, face_type).tobytes())
+    return (
+        "\n".join(header).encode()
+        + np.array(vertex_rows, vertex_type).tobytes()
+        + np.array(face_rows, face_type).tobytes()
+    )
 
 
 def test_binary_ply_fast_path_reads_other_tools_layouts(tmp_path):
@@ -362,16 +404,22 @@ def test_binary_ply_fast_path_reads_other_tools_layouts(tmp_path):
     from meshcurv.io import _ply
 
     quad = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.5], [1.0, 1.0, 0.25], [0.0, 1.0, 0.125]])
-    vertex_fields = [("red", "u1", None), ("x", "f4", None), ("y", "f4", None), ("z", "f4", None),
-                     ("nx", "f4", None)]
+    vertex_fields = [("red", "u1", None), ("x", "f4", None), ("y", "f4", None), ("z", "f4", None), ("nx", "f4", None)]
     vertex_rows = [(200, *point, 1.0) for point in quad]
     face_fields = [("flags", "i2", None), ("count", "u1", None), ("corners", "u4", (3,)), ("quality", "f4", None)]
     triangles = [[0, 1, 2], [0, 2, 3]]
     for order in "<>":
         path = tmp_path / f"hand{order == '>'}.ply"
-        path.write_bytes(_ply_bytes(order, vertex_fields, vertex_rows, face_fields,
-                                    [(7, 3, corners, 0.5) for corners in triangles],
-                                    extra="element edge 0\nproperty int vertex1"))
+        path.write_bytes(
+            _ply_bytes(
+                order,
+                vertex_fields,
+                vertex_rows,
+                face_fields,
+                [(7, 3, corners, 0.5) for corners in triangles],
+                extra="element edge 0\nproperty int vertex1",
+            )
+        )
         vertices, faces = _ply.read_ply(path)
         np.testing.assert_array_equal(vertices, quad)  # these coordinates are exact in float32
         assert faces.dtype == np.int64 and faces.tolist() == triangles
@@ -380,8 +428,11 @@ def test_binary_ply_fast_path_reads_other_tools_layouts(tmp_path):
         assert mesh.faces.tolist() == triangles
     # quads stay quads, as meshio gives them
     path = tmp_path / "quad.ply"
-    path.write_bytes(_ply_bytes("<", vertex_fields, vertex_rows, [("count", "u1", None), ("corners", "i4", (4,))],
-                                [(4, [0, 1, 2, 3])]))
+    path.write_bytes(
+        _ply_bytes(
+            "<", vertex_fields, vertex_rows, [("count", "u1", None), ("corners", "i4", (4,))], [(4, [0, 1, 2, 3])]
+        )
+    )
     assert _ply.read_ply(path)[1].tolist() == [[0, 1, 2, 3]]
 
 
@@ -389,8 +440,9 @@ def test_binary_ply_fast_path_agrees_with_meshio_and_steps_aside_for_the_rest(tm
     meshio = pytest.importorskip("meshio")
     from meshcurv.io import _ply
 
-    path = meshcurv.write_mesh(tmp_path / "t.ply", torus.vertices, torus.faces,
-                               point_data={"k": np.arange(len(torus.vertices), dtype=float)})
+    path = meshcurv.write_mesh(
+        tmp_path / "t.ply", torus.vertices, torus.faces, point_data={"k": np.arange(len(torus.vertices), dtype=float)}
+    )
     vertices, faces = _ply.read_ply(path)
     reference = meshio.ply.read(str(path))
     np.testing.assert_array_equal(vertices, reference.points)
@@ -440,8 +492,9 @@ def test_meshio_messages_go_to_the_log_not_the_terminal(tmp_path, torus, caplog,
     from meshcurv.io import _meshio
 
     with caplog.at_level(logging.INFO, logger="meshcurv.io._meshio"):
-        _meshio.write_with_meshio(tmp_path / "t.ply", torus.vertices, torus.faces,
-                                  {"normals": torus.normals}, file_format="ply", binary=True)
+        _meshio.write_with_meshio(
+            tmp_path / "t.ply", torus.vertices, torus.faces, {"normals": torus.normals}, file_format="ply", binary=True
+        )
     assert "meshio: Warning: PLY writer doesn't support multidimensional point data" in caplog.text
     assert capfd.readouterr().err == ""
 
@@ -466,18 +519,32 @@ def test_bad_vtp_files(tmp_path, torus):
     cases = {
         "d": (good.replace('Name="offsets"', 'Name="sizes"'), "the polygons lack a connectivity or an offsets"),
         "e": (good.replace('format="binary"', 'format="appended"'), "DataArray format 'appended' is not supported"),
-        "f": (good.replace('type="Int64" format="binary" Name="connectivity"',
-                           'type="Int128" format="binary" Name="connectivity"'),
-              "unsupported DataArray type 'Int128'"),
-        "g": (good.replace('format="binary" Name="offsets">', 'format="ascii" Name="offsets">x</DataArray>'
-                           '<DataArray type="Int64" format="binary" Name="old">'),
-              "a data array cannot be decoded"),
-        "h": (good.replace('format="binary" Name="offsets">', 'format="ascii" Name="offsets">2 5 </DataArray>'
-                           '<DataArray type="Int64" format="binary" Name="old">'), "the polygon offsets do not match the connectivity"),
-        "i": ('<VTKFile type="PolyData"><PolyData><Piece><Points><DataArray type="Float64" format="ascii"/>'
-              '</Points><Polys><DataArray type="Int64" Name="connectivity" format="ascii"/><DataArray '
-              'type="Int64" Name="offsets" format="ascii"/></Polys></Piece></PolyData></VTKFile>',
-              "the PolyData has no points or no polygons"),
+        "f": (
+            good.replace(
+                'type="Int64" format="binary" Name="connectivity"', 'type="Int128" format="binary" Name="connectivity"'
+            ),
+            "unsupported DataArray type 'Int128'",
+        ),
+        "g": (
+            good.replace(
+                'format="binary" Name="offsets">',
+                'format="ascii" Name="offsets">x</DataArray><DataArray type="Int64" format="binary" Name="old">',
+            ),
+            "a data array cannot be decoded",
+        ),
+        "h": (
+            good.replace(
+                'format="binary" Name="offsets">',
+                'format="ascii" Name="offsets">2 5 </DataArray><DataArray type="Int64" format="binary" Name="old">',
+            ),
+            "the polygon offsets do not match the connectivity",
+        ),
+        "i": (
+            '<VTKFile type="PolyData"><PolyData><Piece><Points><DataArray type="Float64" format="ascii"/>'
+            '</Points><Polys><DataArray type="Int64" Name="connectivity" format="ascii"/><DataArray '
+            'type="Int64" Name="offsets" format="ascii"/></Polys></Piece></PolyData></VTKFile>',
+            "the PolyData has no points or no polygons",
+        ),
     }
     for name, (text, message) in cases.items():
         with pytest.raises(MeshFileError, match=rf"{name}\.vtp: {message}"):
@@ -506,8 +573,11 @@ def test_bad_npz_files(tmp_path, torus):
     with pytest.raises(MeshFileError, match=r"a\.npz: cannot be read as NPZ"):
         meshcurv.read_mesh(write_text(tmp_path, "a.npz", "not a zip"))
     np.savez(tmp_path / "b.npz", points=torus.vertices)
-    with pytest.raises(MeshFileError, match=r"b\.npz: an NPZ mesh needs arrays named 'vertices' and 'faces'; "
-                                            r"found \['points'\]"):
+    with pytest.raises(
+        MeshFileError,
+        match=r"b\.npz: an NPZ mesh needs arrays named 'vertices' and 'faces'; "
+        r"found \['points'\]",
+    ):
         meshcurv.read_mesh(tmp_path / "b.npz")
     with pytest.raises(MeshFileError, match=r"c\.npz: a field may not be called 'faces' in an NPZ file"):
         meshcurv.write_mesh(tmp_path / "c.npz", torus.vertices, torus.faces, point_data={"faces": torus.k_min})
@@ -545,8 +615,7 @@ def test_bad_output_paths(tmp_path, torus):
 @pytest.mark.parametrize("extension", [".obj", ".stl", ".off"])
 def test_formats_without_fields_refuse_point_data(tmp_path, torus, extension):
     with pytest.raises(MeshFileError, match=r"files cannot hold per-vertex fields; write \.ply, \.vtk"):
-        meshcurv.write_mesh(tmp_path / f"t{extension}", torus.vertices, torus.faces,
-                            point_data={"k": torus.k_min})
+        meshcurv.write_mesh(tmp_path / f"t{extension}", torus.vertices, torus.faces, point_data={"k": torus.k_min})
     from meshcurv.io import _obj
 
     with pytest.raises(MeshFileError, match="OBJ files cannot hold per-vertex fields"):

@@ -24,8 +24,13 @@ def test_write_then_read_round_trip(tmp_path, cloud, extension, binary, with_nor
     points, normals = cloud
     before = points.copy(), normals.copy()
     path = tmp_path / f"cloud{extension}"
-    write_points(path, points, normals if with_normals else None, binary=binary,
-                 point_data={"k_max": points[:, 0], "dir_max": normals})
+    write_points(
+        path,
+        points,
+        normals if with_normals else None,
+        binary=binary,
+        point_data={"k_max": points[:, 0], "dir_max": normals},
+    )
     read, read_normals = read_points(path)
     # LAS stores integers: scale = extent / 2^30
     tolerance = np.ptp(points, axis=0) / 2.0**30 if extension in (".las", ".laz") else 0.0
@@ -40,31 +45,52 @@ def test_write_then_read_round_trip(tmp_path, cloud, extension, binary, with_nor
 
 def test_ply_with_faces_and_other_names(tmp_path):
     path = tmp_path / "mesh.ply"
-    path.write_bytes(b"ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 3\nproperty float x\n"
-                     b"property float y\nproperty float z\nproperty float normal_x\nproperty float normal_y\n"
-                     b"property float normal_z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                     b"0 0 0 0 0 1\r\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n")
+    path.write_bytes(
+        b"ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 3\nproperty float x\n"
+        b"property float y\nproperty float z\nproperty float normal_x\nproperty float normal_y\n"
+        b"property float normal_z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        b"0 0 0 0 0 1\r\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n"
+    )
     points, normals = read_points(path)
     np.testing.assert_array_equal(points, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
     np.testing.assert_array_equal(normals, [[0, 0, 1]] * 3)
 
 
-@pytest.mark.parametrize("body, match", [
-    (b"ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty double x\nproperty double y\n"
-     b"property double z\nend_header\n" + b"\0" * 48, "declares 1000000000 vertices but the file holds only 48 bytes"),
-    (b"ply\nformat ascii 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\nproperty float z\n"
-     b"end_header\n0 0 0\n", "declares 1000000000 vertices"),
-    (b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-     b"end_header\n0 0 0\n1 1 1\n" + b"2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2", r"line 10: 18 values, expected 3 \(vertex: x, y, z\)"),
-    (b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
-     b"end_header\n0 0 0\n1 one 1\n", "line 9: 'one' is not a number"),
-    (b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nend_header\n0 0\n1 1\n",
-     "has no x, y and z"),
-    (b"ply\nformat ascii 1.0\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n",
-     "no 'vertex' element"),
-    (b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n", "cut short"),
-    (b"solid cube\n", "not a PLY file"),
-])
+@pytest.mark.parametrize(
+    "body, match",
+    [
+        (
+            b"ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty double x\nproperty double y\n"
+            b"property double z\nend_header\n" + b"\0" * 48,
+            "declares 1000000000 vertices but the file holds only 48 bytes",
+        ),
+        (
+            b"ply\nformat ascii 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\nproperty float z\n"
+            b"end_header\n0 0 0\n",
+            "declares 1000000000 vertices",
+        ),
+        (
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            b"end_header\n0 0 0\n1 1 1\n" + b"2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2 2",
+            r"line 10: 18 values, expected 3 \(vertex: x, y, z\)",
+        ),
+        (
+            b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+            b"end_header\n0 0 0\n1 one 1\n",
+            "line 9: 'one' is not a number",
+        ),
+        (
+            b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nend_header\n0 0\n1 1\n",
+            "has no x, y and z",
+        ),
+        (
+            b"ply\nformat ascii 1.0\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n",
+            "no 'vertex' element",
+        ),
+        (b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n", "cut short"),
+        (b"solid cube\n", "not a PLY file"),
+    ],
+)
 def test_malformed_ply_is_refused_by_name(tmp_path, body, match):
     path = tmp_path / "bad.ply"
     path.write_bytes(body)
@@ -85,14 +111,17 @@ def test_text_with_header_colours_comments_and_separators(tmp_path):
     np.testing.assert_array_equal(read_points(path)[1], [[0, 0, 1], [0, 1, 0]])
 
 
-@pytest.mark.parametrize("text, match", [
-    ("1 2 3\n4 5 6\n7 8\n", r"line 3: 2 values, expected 3 \(as most rows: x, y, z\)"),
-    ("1 2\n3 4\n", "rows of 2 numbers"),
-    ("1 2 3\n4 five 6\n", "line 2: 'five' is not a number"),
-    ("# nothing\n\n", "no points"),
-    ("x,y,z\n", "a header line and no points"),
-    ("a,b,c\n1,2,3\n", "has no x, y and z"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("1 2 3\n4 5 6\n7 8\n", r"line 3: 2 values, expected 3 \(as most rows: x, y, z\)"),
+        ("1 2\n3 4\n", "rows of 2 numbers"),
+        ("1 2 3\n4 five 6\n", "line 2: 'five' is not a number"),
+        ("# nothing\n\n", "no points"),
+        ("x,y,z\n", "a header line and no points"),
+        ("a,b,c\n1,2,3\n", "has no x, y and z"),
+    ],
+)
 def test_malformed_text_is_refused_by_name(tmp_path, text, match):
     path = tmp_path / "bad.txt"
     path.write_text(text)
@@ -100,8 +129,10 @@ def test_malformed_text_is_refused_by_name(tmp_path, text, match):
         read_points(path)
 
 
-_PCD = ("VERSION 0.7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n"
-        "COUNT 1 1 1 1 1 1\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {kind}\n")
+_PCD = (
+    "VERSION 0.7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n"
+    "COUNT 1 1 1 1 1 1\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {kind}\n"
+)
 
 
 def test_pcd_binary_float32_and_ascii_with_missing_points(tmp_path):
@@ -117,17 +148,28 @@ def test_pcd_binary_float32_and_ascii_with_missing_points(tmp_path):
     np.testing.assert_array_equal(points, [[0, 0, 0], [2, 0, 0]])
 
 
-@pytest.mark.parametrize("body, match", [
-    (_PCD.format(n=10**9, kind="binary").encode() + b"\0" * 24, "declares 1000000000 points"),
-    (_PCD.format(n=2, kind="binary_compressed").encode(), "binary_compressed"),
-    (_PCD.format(n=2, kind="ascii").encode() + b"0 0 0 0 0 1\n", "declares 2 points"),
-    (_PCD.format(n=2, kind="ascii").encode() + b"0 0 0 0 0 1\n1 1 1 1 1 1 1 1 1 1 1 1\n", r"line 12: 12 values, expected 6 \(x, y, z, normal_x"),
-    (b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nCOUNT 1 1 1\nPOINTS 1\nDATA ascii\n0 0 0\n", "do not match"),
-    (b"VERSION 0.7\nFIELDS x y z\nPOINTS many\nDATA ascii\n", "malformed PCD header"),
-    (b"VERSION 0.7\nFIELDS x y z\n", "cut short"),
-    (b"VERSION 0.7\nFIELDS x y z\nSIZE 3 3 3\nTYPE F F F\nCOUNT 1 1 1\nPOINTS 1\nDATA binary\n" + b"\0" * 9,
-     "unknown TYPE/SIZE"),
-])
+@pytest.mark.parametrize(
+    "body, match",
+    [
+        (_PCD.format(n=10**9, kind="binary").encode() + b"\0" * 24, "declares 1000000000 points"),
+        (_PCD.format(n=2, kind="binary_compressed").encode(), "binary_compressed"),
+        (_PCD.format(n=2, kind="ascii").encode() + b"0 0 0 0 0 1\n", "declares 2 points"),
+        (
+            _PCD.format(n=2, kind="ascii").encode() + b"0 0 0 0 0 1\n1 1 1 1 1 1 1 1 1 1 1 1\n",
+            r"line 12: 12 values, expected 6 \(x, y, z, normal_x",
+        ),
+        (
+            b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nCOUNT 1 1 1\nPOINTS 1\nDATA ascii\n0 0 0\n",
+            "do not match",
+        ),
+        (b"VERSION 0.7\nFIELDS x y z\nPOINTS many\nDATA ascii\n", "malformed PCD header"),
+        (b"VERSION 0.7\nFIELDS x y z\n", "cut short"),
+        (
+            b"VERSION 0.7\nFIELDS x y z\nSIZE 3 3 3\nTYPE F F F\nCOUNT 1 1 1\nPOINTS 1\nDATA binary\n" + b"\0" * 9,
+            "unknown TYPE/SIZE",
+        ),
+    ],
+)
 def test_malformed_pcd_is_refused_by_name(tmp_path, body, match):
     path = tmp_path / "bad.pcd"
     path.write_bytes(body)
@@ -163,8 +205,9 @@ def test_paths_are_checked(tmp_path, cloud):
         read_points(tmp_path / "missing.xyz")
     unknown = tmp_path / "cloud.e57"
     unknown.write_text("1 2 3\n")
-    with pytest.raises(MeshFileError,
-                       match=r"cloud.e57: unknown point-cloud file extension '.e57'; known formats: .ply"):
+    with pytest.raises(
+        MeshFileError, match=r"cloud.e57: unknown point-cloud file extension '.e57'; known formats: .ply"
+    ):
         read_points(unknown)
     path = tmp_path / "cloud.ply"
     write_points(path, cloud[0])
@@ -183,9 +226,11 @@ def test_is_point_cloud_and_curvature_fields(tmp_path, cloud):
     points /= np.linalg.norm(points, axis=1, keepdims=True)
     write_points(tmp_path / "cloud.ply", points)
     mesh = tmp_path / "mesh.ply"
-    mesh.write_bytes(b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                     b"property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                     b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    mesh.write_bytes(
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        b"property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+    )
     assert is_point_cloud(tmp_path / "cloud.ply") and not is_point_cloud(mesh)
     assert is_point_cloud(tmp_path / "scan.laz") and not is_point_cloud(tmp_path / "m.obj")
     result = point_cloud_curvatures(points)

@@ -12,13 +12,15 @@ import meshcurv
 from meshcurv.errors import MeshFileError
 from meshcurv.io._text import not_a_number
 
-_PLY_CLOUD = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-              "end_header\n")
-_PLY_MESH = ("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
-             "element face 2\nproperty list uchar int vertex_indices\nend_header\n")
+_PLY_CLOUD = (
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+)
+_PLY_MESH = (
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+)
 _FOUR = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
-_PCD = ("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\n"
-        "DATA ascii\n")
+_PCD = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n"
 
 
 def _write(tmp_path, name, text):
@@ -27,113 +29,179 @@ def _write(tmp_path, name, text):
     return path
 
 
-@pytest.mark.parametrize("name, text, message", [
-    # 2 + 4 values: the total (9) is still 3 points of 3; read before as shifted points
-    ("cloud.csv", "x,y,z\n1,2,3\n4,5\n6,7,8,9\n", r"line 3: 2 values, expected 3 \(x, y, z\)"),
-    ("cloud.xyz", "1 2 3\n4 5\n6 7 8 9\n", r"line 2: 2 values, expected 3 \(as most rows: x, y, z\)"),
-    ("cloud.txt", "1 2 3\n4 5 6 7\n8 9\n", r"line 2: 4 values, expected 3"),
-    ("cloud.xyz", "1 2\n3 4 5\n6 7 8 9\n", r"line 1: 2 values, expected 3"),  # a tie: rows of 3 or more win
-    ("cloud.csv", "x,y,z\n1,,3\n4,5,6\n", r"line 2: an empty value in '1,,3'"),
-    ("cloud.csv", "1,2,3,\n4,5,6,\n", r"line 1: an empty value in '1,2,3,'"),  # was a StopIteration
-    ("cloud.csv", "1;2;3\n;4;5\n", r"line 2: an empty value in ';4;5'"),
-    ("cloud.txt", "# scan\n\n1 2 3\n4 five 6\n", r"line 4: 'five' is not a number"),
-    ("cloud.csv", "1 2 x\n4 5 6\n", r"line 1: 'x' is not a number"),  # a word among numbers: not a header
-    ("cloud.ply", _PLY_CLOUD + "0 0 0\n1 0\n0 1 0 5\n", r"line 9: 2 values, expected 3 \(vertex: x, y, z\)"),
-    ("cloud.ply", _PLY_CLOUD + "0 0 0\n1 0 0 0 1 0\n", r"line 9: 6 values, expected 3"),  # two rows as one
-    ("cloud.pcd", _PCD + "0 0 0\n1 0\n0 1 0 5\n", r"line 11: 2 values, expected 3 \(x, y, z\)"),
-    ("cloud.pcd", _PCD + "0 0 0\n1 0 0\n0 1 0\n1 1 1\n", r"line 13: a row after the 3 points the header declares"),
-])
+@pytest.mark.parametrize(
+    "name, text, message",
+    [
+        # 2 + 4 values: the total (9) is still 3 points of 3; read before as shifted points
+        ("cloud.csv", "x,y,z\n1,2,3\n4,5\n6,7,8,9\n", r"line 3: 2 values, expected 3 \(x, y, z\)"),
+        ("cloud.xyz", "1 2 3\n4 5\n6 7 8 9\n", r"line 2: 2 values, expected 3 \(as most rows: x, y, z\)"),
+        ("cloud.txt", "1 2 3\n4 5 6 7\n8 9\n", r"line 2: 4 values, expected 3"),
+        ("cloud.xyz", "1 2\n3 4 5\n6 7 8 9\n", r"line 1: 2 values, expected 3"),  # a tie: rows of 3 or more win
+        ("cloud.csv", "x,y,z\n1,,3\n4,5,6\n", r"line 2: an empty value in '1,,3'"),
+        ("cloud.csv", "1,2,3,\n4,5,6,\n", r"line 1: an empty value in '1,2,3,'"),  # was a StopIteration
+        ("cloud.csv", "1;2;3\n;4;5\n", r"line 2: an empty value in ';4;5'"),
+        ("cloud.txt", "# scan\n\n1 2 3\n4 five 6\n", r"line 4: 'five' is not a number"),
+        ("cloud.csv", "1 2 x\n4 5 6\n", r"line 1: 'x' is not a number"),  # a word among numbers: not a header
+        ("cloud.ply", _PLY_CLOUD + "0 0 0\n1 0\n0 1 0 5\n", r"line 9: 2 values, expected 3 \(vertex: x, y, z\)"),
+        ("cloud.ply", _PLY_CLOUD + "0 0 0\n1 0 0 0 1 0\n", r"line 9: 6 values, expected 3"),  # two rows as one
+        ("cloud.pcd", _PCD + "0 0 0\n1 0\n0 1 0 5\n", r"line 11: 2 values, expected 3 \(x, y, z\)"),
+        ("cloud.pcd", _PCD + "0 0 0\n1 0 0\n0 1 0\n1 1 1\n", r"line 13: a row after the 3 points the header declares"),
+    ],
+)
 def test_a_cloud_row_of_the_wrong_length_is_named(tmp_path, name, text, message):
     path = _write(tmp_path, name, text)
     with pytest.raises(MeshFileError, match=rf"{name}: {message}"):
         meshcurv.read_points(path)
 
 
-@pytest.mark.parametrize("name, text, message", [
-    ("mesh.ply", _PLY_MESH + "0 0 0\n1 0\n0 0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
-     r"line 11: 2 values, expected 3 \(vertex: x, y, z\)"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1\n4 0 2 3 1\n",
-     r"line 14: 3 values, expected 4 \(face: vertex_indices: a count of 3 and 3 values\)"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2 0\n3 0 2 3\n", r"line 14: 5 values, expected 4"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2\n3 0 2 3\n3 0 1 3\n",
-     r"line 16: a row after the last element \(the header declares 4 vertices, 2 faces\)"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2\n3 0 2.5 3\n", r"line 15: a PLY face index is not an integer \(2.5\)"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2\n2.5 0 2 3\n", r"line 15: the face list count of vertex_indices is not"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2\n3 0 2 7\n", r"line 15: a face uses vertex 7; the file has 4 vertices"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2 3 0 2 3\n",  # two faces on one line: the row is named
-     r"line 14: 8 values, expected 4 .*and the file ends before the 2 faces"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2\n",
-     r"the PLY header declares 2 faces but the file ends after line 14, 1 rows later"),
-    ("mesh.off", "OFF\n4 2 0\n0 0 0\n1 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
-     r"line 4: 2 values, expected 3 or more \(x, y, z, then maybe a colour\)"),
-    ("mesh.off", "OFF\n4 2 0\n0 0 0\n1 0 0 7\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
-     r"line 4: 4 values, expected 3 \(as most vertex rows: x, y, z\)"),
-    ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1\n3 0 2 3\n", r"line 7: 3 values, expected 4 or more"),
-    ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "2 0 1\n3 0 2 3\n", r"line 7: a face of 2 corners"),
-    ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 x 3\n", r"line 8: 'x' is not a number \(a face\)"),
-    ("mesh.off", "OFF\n4 2 0\n0 0 0\n1 0 0,\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
-     r"line 4: '0,' is not a number \(a vertex coordinate\)"),
-    ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 2.5 3\n", r"line 8: a face index is not an integer \(2.5\)"),
-    ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 2 9\n", r"line 8: a face uses vertex 9; the file has 4"),
-    ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 2 3\n3 0 1 3\n",
-     r"line 9: a row after the 4 vertices and 2 faces the header declares"),
-    ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n", r"the header declares 4 vertices and 2 faces but the file holds only 5 lines for them, up to line 7"),
-    ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2\n2 0 2\n", r"line 15: a face of 2 corners; a face needs 3 or more"),
-    ("mesh.obj", "v 0 0 0\nv 1 0 0,\nv 0 1 0\nf 1 2 3\n", r"line 2: a vertex coordinate is not a number \('0,'\)"),
-    ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3\n", r"line 5: a face has fewer than 3 corners"),
-    ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3,\n", r"line 4: a face index is not an integer"),
-    ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4 5\nf 1 2 x\n", r"line 5: a face index is not an integer"),
-    ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 0 2 3\n", r"line 5: a face uses vertex index 0"),
-])
+@pytest.mark.parametrize(
+    "name, text, message",
+    [
+        (
+            "mesh.ply",
+            _PLY_MESH + "0 0 0\n1 0\n0 0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
+            r"line 11: 2 values, expected 3 \(vertex: x, y, z\)",
+        ),
+        (
+            "mesh.ply",
+            _PLY_MESH + _FOUR + "3 0 1\n4 0 2 3 1\n",
+            r"line 14: 3 values, expected 4 \(face: vertex_indices: a count of 3 and 3 values\)",
+        ),
+        ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2 0\n3 0 2 3\n", r"line 14: 5 values, expected 4"),
+        (
+            "mesh.ply",
+            _PLY_MESH + _FOUR + "3 0 1 2\n3 0 2 3\n3 0 1 3\n",
+            r"line 16: a row after the last element \(the header declares 4 vertices, 2 faces\)",
+        ),
+        (
+            "mesh.ply",
+            _PLY_MESH + _FOUR + "3 0 1 2\n3 0 2.5 3\n",
+            r"line 15: a PLY face index is not an integer \(2.5\)",
+        ),
+        (
+            "mesh.ply",
+            _PLY_MESH + _FOUR + "3 0 1 2\n2.5 0 2 3\n",
+            r"line 15: the face list count of vertex_indices is not",
+        ),
+        (
+            "mesh.ply",
+            _PLY_MESH + _FOUR + "3 0 1 2\n3 0 2 7\n",
+            r"line 15: a face uses vertex 7; the file has 4 vertices",
+        ),
+        (
+            "mesh.ply",
+            _PLY_MESH + _FOUR + "3 0 1 2 3 0 2 3\n",  # two faces on one line: the row is named
+            r"line 14: 8 values, expected 4 .*and the file ends before the 2 faces",
+        ),
+        (
+            "mesh.ply",
+            _PLY_MESH + _FOUR + "3 0 1 2\n",
+            r"the PLY header declares 2 faces but the file ends after line 14, 1 rows later",
+        ),
+        (
+            "mesh.off",
+            "OFF\n4 2 0\n0 0 0\n1 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
+            r"line 4: 2 values, expected 3 or more \(x, y, z, then maybe a colour\)",
+        ),
+        (
+            "mesh.off",
+            "OFF\n4 2 0\n0 0 0\n1 0 0 7\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
+            r"line 4: 4 values, expected 3 \(as most vertex rows: x, y, z\)",
+        ),
+        ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1\n3 0 2 3\n", r"line 7: 3 values, expected 4 or more"),
+        ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "2 0 1\n3 0 2 3\n", r"line 7: a face of 2 corners"),
+        ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 x 3\n", r"line 8: 'x' is not a number \(a face\)"),
+        (
+            "mesh.off",
+            "OFF\n4 2 0\n0 0 0\n1 0 0,\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
+            r"line 4: '0,' is not a number \(a vertex coordinate\)",
+        ),
+        (
+            "mesh.off",
+            "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 2.5 3\n",
+            r"line 8: a face index is not an integer \(2.5\)",
+        ),
+        ("mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 2 9\n", r"line 8: a face uses vertex 9; the file has 4"),
+        (
+            "mesh.off",
+            "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n3 0 2 3\n3 0 1 3\n",
+            r"line 9: a row after the 4 vertices and 2 faces the header declares",
+        ),
+        (
+            "mesh.off",
+            "OFF\n4 2 0\n" + _FOUR + "3 0 1 2\n",
+            r"the header declares 4 vertices and 2 faces but the file holds only 5 lines for them, up to line 7",
+        ),
+        ("mesh.ply", _PLY_MESH + _FOUR + "3 0 1 2\n2 0 2\n", r"line 15: a face of 2 corners; a face needs 3 or more"),
+        ("mesh.obj", "v 0 0 0\nv 1 0 0,\nv 0 1 0\nf 1 2 3\n", r"line 2: a vertex coordinate is not a number \('0,'\)"),
+        ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3\n", r"line 5: a face has fewer than 3 corners"),
+        ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3,\n", r"line 4: a face index is not an integer"),
+        ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4 5\nf 1 2 x\n", r"line 5: a face index is not an integer"),
+        ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 0 2 3\n", r"line 5: a face uses vertex index 0"),
+    ],
+)
 def test_a_mesh_row_of_the_wrong_length_is_named(tmp_path, name, text, message):
     path = _write(tmp_path, name, text)
     with pytest.raises(MeshFileError, match=rf"{name}: {message}"):
         meshcurv.read_mesh(path)
 
 
-_STL = ("solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\n"
-        "endfacet\nendsolid t\n")
+_STL = (
+    "solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\n"
+    "endfacet\nendsolid t\n"
+)
 
 
-@pytest.mark.parametrize("text, message", [
-    (_STL.replace("vertex 1 0 0", "vertex 1 0 0 5"), r"line 5: 4 values, expected 3 \(vertex x y z\)"),
-    (_STL.replace("vertex 1 0 0", "vertex 1 0"), r"line 5: 2 values, expected 3 \(vertex x y z\)"),
-    (_STL.replace("normal 0 0 1", "normal 0 1"), r"line 2: 2 values, expected 3 \(facet normal nx ny nz\)"),
-    (_STL.replace("vertex 1 0 0", "vertex 1,0,0"), r"line 5: '1,0,0' is not a number \(vertex x y z\)"),
-    # a loop of 4 vertices beside one of 2: meshio cut the rows by fours into shifted triangles
-    (_STL.replace("  vertex 0 1 0\n", "  vertex 0 1 0\n  vertex 1 1 0\n") + _STL.replace("  vertex 0 1 0\n", ""),
-     r"line 2: a facet of 4 vertices; an STL facet is a triangle of 3"),
-    ("solid t\n  vertex 0 0 0\n" + _STL[8:], r"line 2: a vertex before any facet"),
-    ("solid t\nendsolid t\n", r"no facets"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (_STL.replace("vertex 1 0 0", "vertex 1 0 0 5"), r"line 5: 4 values, expected 3 \(vertex x y z\)"),
+        (_STL.replace("vertex 1 0 0", "vertex 1 0"), r"line 5: 2 values, expected 3 \(vertex x y z\)"),
+        (_STL.replace("normal 0 0 1", "normal 0 1"), r"line 2: 2 values, expected 3 \(facet normal nx ny nz\)"),
+        (_STL.replace("vertex 1 0 0", "vertex 1,0,0"), r"line 5: '1,0,0' is not a number \(vertex x y z\)"),
+        # a loop of 4 vertices beside one of 2: meshio cut the rows by fours into shifted triangles
+        (
+            _STL.replace("  vertex 0 1 0\n", "  vertex 0 1 0\n  vertex 1 1 0\n") + _STL.replace("  vertex 0 1 0\n", ""),
+            r"line 2: a facet of 4 vertices; an STL facet is a triangle of 3",
+        ),
+        ("solid t\n  vertex 0 0 0\n" + _STL[8:], r"line 2: a vertex before any facet"),
+        ("solid t\nendsolid t\n", r"no facets"),
+    ],
+)
 def test_an_ascii_stl_row_of_the_wrong_length_is_named(tmp_path, text, message):
     path = _write(tmp_path, "mesh.stl", text)
     with pytest.raises(MeshFileError, match=rf"mesh\.stl: {message}"):  # meshio took the last 3 numbers
         meshcurv.read_mesh(path)
 
 
-@pytest.mark.parametrize("name, text", [
-    ("cloud.csv", "# exported\nX, Y, Z\n1.5, 2, 3\n\n4, 5, 6\n"),  # comma and blank, a blank line
-    ("cloud.csv", "x;y;z\n1,5;2;3\n4;5;6\n"),  # semicolons with decimal commas
-    ("cloud.xyz", "1.5\t2\t3 \r\n4  5\t6\r\n"),  # tabs, doubled blanks, CRLF, trailing blanks
-    ("cloud.pts", "2\n1.5 2 3 7 200 200 200\n4 5 6 7 200 200 200\n"),  # Leica PTS: a count, then x y z i r g b
-    ("cloud.pts", "1\n1.5 2 3\n1\n4 5 6\n"),  # two scans, each with its count
-    ("cloud.ply", _PLY_CLOUD.replace("3\n", "2\n", 1) + "1.5 2 3\n\n4 5 6\n"),  # a blank line
-])
+@pytest.mark.parametrize(
+    "name, text",
+    [
+        ("cloud.csv", "# exported\nX, Y, Z\n1.5, 2, 3\n\n4, 5, 6\n"),  # comma and blank, a blank line
+        ("cloud.csv", "x;y;z\n1,5;2;3\n4;5;6\n"),  # semicolons with decimal commas
+        ("cloud.xyz", "1.5\t2\t3 \r\n4  5\t6\r\n"),  # tabs, doubled blanks, CRLF, trailing blanks
+        ("cloud.pts", "2\n1.5 2 3 7 200 200 200\n4 5 6 7 200 200 200\n"),  # Leica PTS: a count, then x y z i r g b
+        ("cloud.pts", "1\n1.5 2 3\n1\n4 5 6\n"),  # two scans, each with its count
+        ("cloud.ply", _PLY_CLOUD.replace("3\n", "2\n", 1) + "1.5 2 3\n\n4 5 6\n"),  # a blank line
+    ],
+)
 def test_valid_text_rows_are_read_exactly(tmp_path, name, text):
     points, _ = meshcurv.read_points(_write(tmp_path, name, text))
     np.testing.assert_array_equal(points, [[1.5, 2, 3], [4, 5, 6]])
 
 
-@pytest.mark.parametrize("text, message", [
-    ("3\n1 2 3\n4 5 6\n", r"line 1: a count of 3 points, but 2 rows follow it"),
-    ("2.5\n1 2 3\n4 5 6\n", r"line 1: 1 value \(2.5\), expected a count of points or x, y, z"),
-    ("0\n", r"no points in the file \(only counts of points\)"),
-    ("1 2\n3 4\n", r"rows of 2 numbers; a point needs x, y and z"),
-    ("1 2\n3\n4 5\n", r"rows of 2 numbers \(most rows\); a point needs x, y and z"),
-    ("# only a comment\n", "no points in the file"),
-    ("x y z\n\n", "a header line and no points"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("3\n1 2 3\n4 5 6\n", r"line 1: a count of 3 points, but 2 rows follow it"),
+        ("2.5\n1 2 3\n4 5 6\n", r"line 1: 1 value \(2.5\), expected a count of points or x, y, z"),
+        ("0\n", r"no points in the file \(only counts of points\)"),
+        ("1 2\n3 4\n", r"rows of 2 numbers; a point needs x, y and z"),
+        ("1 2\n3\n4 5\n", r"rows of 2 numbers \(most rows\); a point needs x, y and z"),
+        ("# only a comment\n", "no points in the file"),
+        ("x y z\n\n", "a header line and no points"),
+    ],
+)
 def test_counts_and_sizes_of_pts_files(tmp_path, text, message):
     with pytest.raises(MeshFileError, match=rf"cloud\.pts: {message}"):
         meshcurv.read_points(_write(tmp_path, "cloud.pts", text))
@@ -166,8 +234,9 @@ def test_valid_meshes_with_blank_lines_and_polygons_are_read_exactly(tmp_path):
     vertices, faces = meshcurv.read_mesh(_write(tmp_path, "mesh.ply", _PLY_MESH + _FOUR + "\n4 0 1 2 3\n3 0 2 3\n\n"))
     np.testing.assert_array_equal(vertices, expected)
     assert [list(face) for face in faces] == [[0, 1, 2, 3], [0, 2, 3]]
-    vertices, faces = meshcurv.read_mesh(_write(tmp_path, "mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2 255 0 0\n"
-                                                "3 0 2 3\n"))
+    vertices, faces = meshcurv.read_mesh(
+        _write(tmp_path, "mesh.off", "OFF\n4 2 0\n" + _FOUR + "3 0 1 2 255 0 0\n3 0 2 3\n")
+    )
     np.testing.assert_array_equal(vertices, expected)
     np.testing.assert_array_equal(faces, [[0, 1, 2], [0, 2, 3]])
 

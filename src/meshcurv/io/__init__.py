@@ -54,9 +54,22 @@ from ._files import atomic_output, check_input, check_output
 from ._points import POINT_EXTENSIONS, is_point_cloud, read_points, write_point_curvatures, write_points
 from .fields import FIELDS, curvature_fields, read_fields
 
-__all__ = ["Mesh", "FileFormat", "FORMATS", "read_mesh", "write_mesh", "write_curvatures", "read_fields",
-           "curvature_fields", "FIELDS", "read_points", "write_points", "write_point_curvatures",
-           "is_point_cloud", "POINT_EXTENSIONS"]
+__all__ = [
+    "Mesh",
+    "FileFormat",
+    "FORMATS",
+    "read_mesh",
+    "write_mesh",
+    "write_curvatures",
+    "read_fields",
+    "curvature_fields",
+    "FIELDS",
+    "read_points",
+    "write_points",
+    "write_point_curvatures",
+    "is_point_cloud",
+    "POINT_EXTENSIONS",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -108,10 +121,13 @@ def _meshio_format(file_format: str):
 
     def write(path, vertices, faces, point_data, binary):
         if file_format == "ply":
-            point_data = {name: value.astype(np.float32) if value.dtype.kind == "f" else value
-                          for name, value in _tables.flat_columns(point_data).items()}
-        _meshio.write_with_meshio(path, vertices, faces, point_data, file_format=file_format,
-                                  binary=binary or file_format == "vtu")
+            point_data = {
+                name: value.astype(np.float32) if value.dtype.kind == "f" else value
+                for name, value in _tables.flat_columns(point_data).items()
+            }
+        _meshio.write_with_meshio(
+            path, vertices, faces, point_data, file_format=file_format, binary=binary or file_format == "vtu"
+        )
 
     return read, write
 
@@ -143,11 +159,17 @@ FORMATS: dict[str, FileFormat] = _registry()
 
 
 def _format_of(path: pathlib.Path, file_format: str | None) -> FileFormat:
-    key = (file_format if file_format is None or file_format.startswith(".") else "." + file_format)
+    key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
     key = (key or path.suffix).lower()
     if key not in FORMATS:
         known = ", ".join(FORMATS)
-        what = f"format {file_format!r}" if file_format else f"extension {path.suffix!r}" if path.suffix else "no extension"
+        what = (
+            f"format {file_format!r}"
+            if file_format
+            else f"extension {path.suffix!r}"
+            if path.suffix
+            else "no extension"
+        )
         raise MeshFileError(f"{path}: unknown mesh file {what}; known formats: {known}")
     return FORMATS[key]
 
@@ -201,8 +223,9 @@ def read_mesh(path, *, file_format: str | None = None) -> Mesh:
         raise MeshFileError(f"{path}: {exc.strerror or exc}") from exc
     except Exception as exc:  # any other parser failure: one readable error naming the file
         reason = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
-        raise MeshFileError(f"{path}: cannot be read as {fmt.name} ({type(exc).__name__}"
-                            + (f": {reason})" if reason else ")")) from exc
+        raise MeshFileError(
+            f"{path}: cannot be read as {fmt.name} ({type(exc).__name__}" + (f": {reason})" if reason else ")")
+        ) from exc
     try:
         vertices = as_vertices(vertices)
         polygons = as_polygons(faces)
@@ -228,8 +251,17 @@ def _point_data(point_data, n_vertices: int) -> dict[str, np.ndarray]:
     return arrays
 
 
-def write_mesh(path, vertices, faces, *, point_data=None, overwrite: bool = False, source=None,
-               binary: bool = True, file_format: str | None = None) -> pathlib.Path:
+def write_mesh(
+    path,
+    vertices,
+    faces,
+    *,
+    point_data=None,
+    overwrite: bool = False,
+    source=None,
+    binary: bool = True,
+    file_format: str | None = None,
+) -> pathlib.Path:
     """Write a mesh, and optionally per-vertex fields, to a file chosen by its extension.
 
     The file is written to a temporary name in the same folder and renamed
@@ -281,8 +313,7 @@ def write_mesh(path, vertices, faces, *, point_data=None, overwrite: bool = Fals
     data = _point_data(point_data, points.shape[0])
     if data and fmt.fields == "none":
         raise MeshFileError(
-            f"{path}: {fmt.name} files cannot hold per-vertex fields; "
-            "write .ply, .vtk, .vtu, .vtp, .csv or .npz"
+            f"{path}: {fmt.name} files cannot hold per-vertex fields; write .ply, .vtk, .vtu, .vtp, .csv or .npz"
         )
     path = check_output(path, overwrite=overwrite, source=source)
     with atomic_output(path, overwrite=overwrite) as temporary:
@@ -296,8 +327,18 @@ def write_mesh(path, vertices, faces, *, point_data=None, overwrite: bool = Fals
     return path
 
 
-def write_curvatures(path, vertices, faces, result, *, fields=None, quality: str | None = "mean",
-                     overwrite: bool = False, source=None, binary: bool = True) -> pathlib.Path:
+def write_curvatures(
+    path,
+    vertices,
+    faces,
+    result,
+    *,
+    fields=None,
+    quality: str | None = "mean",
+    overwrite: bool = False,
+    source=None,
+    binary: bool = True,
+) -> pathlib.Path:
     """Write a mesh with the fields of a curvature result as per-vertex data.
 
     ``write_mesh(path, vertices, faces, point_data=curvature_fields(result, ...))``;
@@ -320,5 +361,4 @@ def write_curvatures(path, vertices, faces, result, *, fields=None, quality: str
     ['faces', 'mean', 'quality', 'vertices']
     """
     point_data = curvature_fields(result, fields=fields, quality=quality)
-    return write_mesh(path, vertices, faces, point_data=point_data, overwrite=overwrite, source=source,
-                      binary=binary)
+    return write_mesh(path, vertices, faces, point_data=point_data, overwrite=overwrite, source=source, binary=binary)

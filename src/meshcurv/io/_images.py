@@ -28,11 +28,18 @@ __all__ = ["read_image", "Image", "IMAGE_FORMATS", "MAX_IMAGE_BYTES"]
 MAX_IMAGE_BYTES = 32 * 2**30
 
 #: Extensions read, and what they are.
-IMAGE_FORMATS = {".tif": "TIFF stack (tifffile)", ".tiff": "TIFF stack (tifffile)", ".npy": "NumPy array",
-                 ".npz": "NumPy archive (the array 'labels', or its only array)", ".nii": "NIfTI (nibabel)",
-                 ".nii.gz": "NIfTI, gzipped (nibabel)", ".mrc": "MRC map (cryo-EM, tomography)",
-                 ".rec": "MRC map (IMOD reconstruction)", ".map": "MRC / CCP4 map",
-                 ".zarr": "Zarr or OME-Zarr folder, read lazily (zarr)"}
+IMAGE_FORMATS = {
+    ".tif": "TIFF stack (tifffile)",
+    ".tiff": "TIFF stack (tifffile)",
+    ".npy": "NumPy array",
+    ".npz": "NumPy archive (the array 'labels', or its only array)",
+    ".nii": "NIfTI (nibabel)",
+    ".nii.gz": "NIfTI, gzipped (nibabel)",
+    ".mrc": "MRC map (cryo-EM, tomography)",
+    ".rec": "MRC map (IMOD reconstruction)",
+    ".map": "MRC / CCP4 map",
+    ".zarr": "Zarr or OME-Zarr folder, read lazily (zarr)",
+}
 
 #: deflate expands at most about 1032 times; a member declaring more is corrupt
 _DEFLATE_RATIO = 1100
@@ -67,8 +74,10 @@ def _suffix(path: pathlib.Path) -> str:
 def _check_size(path, shape, dtype) -> None:
     need = int(np.prod([int(n) for n in shape], dtype=object)) * np.dtype(dtype).itemsize
     if need > MAX_IMAGE_BYTES:
-        raise MeshFileError(f"{path}: the image declares shape {tuple(int(n) for n in shape)} of {np.dtype(dtype)} "
-                            f"({need} bytes), more than the {MAX_IMAGE_BYTES} bytes meshcurv reads")
+        raise MeshFileError(
+            f"{path}: the image declares shape {tuple(int(n) for n in shape)} of {np.dtype(dtype)} "
+            f"({need} bytes), more than the {MAX_IMAGE_BYTES} bytes meshcurv reads"
+        )
 
 
 def _check_3d(path, array: np.ndarray) -> np.ndarray:
@@ -110,24 +119,31 @@ def _npy(path):
 def _npz(path):
     try:
         with zipfile.ZipFile(path) as archive:
-            members = {info.filename[:-4] if info.filename.endswith(".npy") else info.filename: info
-                       for info in archive.infolist()}
+            members = {
+                info.filename[:-4] if info.filename.endswith(".npy") else info.filename: info
+                for info in archive.infolist()
+            }
             if "labels" in members:
                 name = "labels"
             elif len(members) == 1:
                 name = next(iter(members))
             else:
-                raise MeshFileError(f"{path}: an archive of several arrays needs one named 'labels'; found "
-                                    f"{sorted(members)}")
+                raise MeshFileError(
+                    f"{path}: an archive of several arrays needs one named 'labels'; found {sorted(members)}"
+                )
             info = members[name]
             if info.file_size > _DEFLATE_RATIO * info.compress_size + 4096:
-                raise MeshFileError(f"{path}: the member {name!r} claims {info.file_size} bytes from "
-                                    f"{info.compress_size} compressed ones; the archive is corrupt")
+                raise MeshFileError(
+                    f"{path}: the member {name!r} claims {info.file_size} bytes from "
+                    f"{info.compress_size} compressed ones; the archive is corrupt"
+                )
             with archive.open(info) as member:
                 shape, dtype = _npy_header(member, path, f" {name!r}")
             if int(np.prod(shape, dtype=object)) * dtype.itemsize > info.file_size:
-                raise MeshFileError(f"{path}: the array {name!r} declares shape {shape} but the archive holds "
-                                    f"only {info.file_size} bytes for it")
+                raise MeshFileError(
+                    f"{path}: the array {name!r} declares shape {shape} but the archive holds "
+                    f"only {info.file_size} bytes for it"
+                )
         with np.load(path, allow_pickle=False) as archive:
             return archive[name], None
     except MeshFileError:
@@ -208,8 +224,17 @@ def _mrc(path):
         raise MeshFileError(f"{path}: cannot be read as MRC ({_reason(exc)})") from exc
 
 
-_READERS = {".tif": _tiff, ".tiff": _tiff, ".npy": _npy, ".npz": _npz, ".nii": _nifti, ".nii.gz": _nifti,
-            ".mrc": _mrc, ".rec": _mrc, ".map": _mrc}
+_READERS = {
+    ".tif": _tiff,
+    ".tiff": _tiff,
+    ".npy": _npy,
+    ".npz": _npz,
+    ".nii": _nifti,
+    ".nii.gz": _nifti,
+    ".mrc": _mrc,
+    ".rec": _mrc,
+    ".map": _mrc,
+}
 
 
 def read_image(path) -> Image:

@@ -86,8 +86,10 @@ def read_ascii_stl(path, data: bytes):
         parsed = numbers_per_line(rows)
         if parsed is None:
             index, word = first_bad_line(b"\n".join(rows))
-            raise MeshFileError(f"{path}: line {line_of_match(data, pattern, index)}: "
-                                f"{word[:30].decode('utf-8', 'replace')!r} is not a number ({what})")
+            raise MeshFileError(
+                f"{path}: line {line_of_match(data, pattern, index)}: "
+                f"{word[:30].decode('utf-8', 'replace')!r} is not a number ({what})"
+            )
         wrong = parsed[1] != 3
         if wrong.any():
             index = int(np.argmax(wrong))
@@ -103,13 +105,17 @@ def read_ascii_stl(path, data: bytes):
     per_facet = np.bincount(owner, minlength=facets.size)
     if (per_facet != 3).any():
         facet = int(np.argmax(per_facet != 3))
-        raise MeshFileError(f"{path}: line {line_of(data, int(facets[facet]))}: a facet of {per_facet[facet]} "
-                            "vertices; an STL facet is a triangle of 3")
+        raise MeshFileError(
+            f"{path}: line {line_of(data, int(facets[facet]))}: a facet of {per_facet[facet]} "
+            "vertices; an STL facet is a triangle of 3"
+        )
     _, first, inverse = np.unique(corners, axis=0, return_index=True, return_inverse=True)
     order = np.argsort(first)  # the merged vertices in the order they first appear
     rank = np.zeros_like(order)
     rank[order] = np.arange(order.size)
     return corners[first[order]], rank[inverse.ravel()].reshape(-1, 3)
+
+
 def read_meshio_file(path, file_format: str):
     """The ``meshio.Mesh`` of a file, read by the format's own reader (``meshio.vtu.read``, ...).
 

@@ -56,9 +56,17 @@ _NAMES = {0: "int8", 1: "int16", 2: "float32", 6: "uint16"}
 def _header(raw: bytes, order: str) -> dict:
     words = np.frombuffer(raw, dtype=order + "i4", count=56)
     floats = np.frombuffer(raw, dtype=order + "f4", count=56)
-    return {"shape_crs": words[0:3].astype(np.int64), "mode": int(words[3]), "sampling": words[7:10].astype(np.int64),
-            "cell": floats[10:13].astype(np.float64), "axes": words[16:19].astype(np.int64), "ispg": int(words[22]),
-            "nsymbt": int(words[23]), "imod_stamp": int(words[38]), "imod_flags": int(words[39])}
+    return {
+        "shape_crs": words[0:3].astype(np.int64),
+        "mode": int(words[3]),
+        "sampling": words[7:10].astype(np.int64),
+        "cell": floats[10:13].astype(np.float64),
+        "axes": words[16:19].astype(np.int64),
+        "ispg": int(words[22]),
+        "nsymbt": int(words[23]),
+        "imod_stamp": int(words[38]),
+        "imod_flags": int(words[39]),
+    }
 
 
 def _byte_order(raw: bytes) -> str:
@@ -94,14 +102,17 @@ def read_mrc(path, check_size) -> tuple[np.ndarray, tuple[float, float, float] |
     with open(path, "rb") as handle:
         raw = handle.read(HEADER_BYTES)
     if len(raw) < HEADER_BYTES:
-        raise MeshFileError(f"{path}: an MRC file starts with a {HEADER_BYTES}-byte header; the file holds "
-                            f"{len(raw)} bytes")
+        raise MeshFileError(
+            f"{path}: an MRC file starts with a {HEADER_BYTES}-byte header; the file holds {len(raw)} bytes"
+        )
     order = _byte_order(raw)
     header = _header(raw, order)
     shape_crs, mode = header["shape_crs"], header["mode"]
     if not (shape_crs > 0).all():
-        raise MeshFileError(f"{path}: the MRC header declares {tuple(shape_crs.tolist())} columns, rows and "
-                            "sections; each must be at least 1")
+        raise MeshFileError(
+            f"{path}: the MRC header declares {tuple(shape_crs.tolist())} columns, rows and "
+            "sections; each must be at least 1"
+        )
     if mode not in MRC_MODES:
         known = ", ".join(f"{key} ({name})" for key, name in _NAMES.items())
         raise MeshFileError(f"{path}: MRC mode {mode} is not read; known modes: {known}")
@@ -110,25 +121,31 @@ def read_mrc(path, check_size) -> tuple[np.ndarray, tuple[float, float, float] |
         code = "u1"
     axes = header["axes"]
     if sorted(axes.tolist()) != [1, 2, 3]:
-        raise MeshFileError(f"{path}: the MRC header's axes (mapc, mapr, maps) = {tuple(axes.tolist())} are not "
-                            "an order of 1, 2, 3 (X, Y, Z)")
+        raise MeshFileError(
+            f"{path}: the MRC header's axes (mapc, mapr, maps) = {tuple(axes.tolist())} are not "
+            "an order of 1, 2, 3 (X, Y, Z)"
+        )
     nsymbt = header["nsymbt"]
     if nsymbt < 0:
         raise MeshFileError(f"{path}: the MRC header declares an extended header of {nsymbt} bytes")
     n_columns, n_rows, n_sections = (int(n) for n in shape_crs)
     sampling = header["sampling"]
     if 401 <= header["ispg"] <= 630 and sampling[2] > 0 and n_sections > sampling[2]:
-        raise MeshFileError(f"{path}: the MRC file is a stack of {n_sections // int(sampling[2])} volumes "
-                            f"(space group {header['ispg']}, {n_sections} sections of {int(sampling[2])}); "
-                            "meshcurv reads one volume")
+        raise MeshFileError(
+            f"{path}: the MRC file is a stack of {n_sections // int(sampling[2])} volumes "
+            f"(space group {header['ispg']}, {n_sections} sections of {int(sampling[2])}); "
+            "meshcurv reads one volume"
+        )
     dtype = np.dtype(order + code)
     disk_shape = (n_sections, n_rows, n_columns)
     check_size(path, disk_shape, dtype)
     need = HEADER_BYTES + nsymbt + n_sections * n_rows * n_columns * dtype.itemsize
     if need > size:
-        raise MeshFileError(f"{path}: the MRC header declares {n_columns} x {n_rows} x {n_sections} values of "
-                            f"{_NAMES[mode]} after {HEADER_BYTES + nsymbt} header bytes ({need} bytes in all), "
-                            f"but the file holds only {size}")
+        raise MeshFileError(
+            f"{path}: the MRC header declares {n_columns} x {n_rows} x {n_sections} values of "
+            f"{_NAMES[mode]} after {HEADER_BYTES + nsymbt} header bytes ({need} bytes in all), "
+            f"but the file holds only {size}"
+        )
     data: np.ndarray = np.memmap(path, dtype=dtype, mode="r", offset=HEADER_BYTES + nsymbt, shape=disk_shape)
     if not dtype.isnative:
         data = data.astype(dtype.newbyteorder("="))

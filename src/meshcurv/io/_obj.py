@@ -48,16 +48,20 @@ def read_obj(path):
     parsed = numbers_per_line(vertex_lines)
     if parsed is None:
         index, word = first_bad_line(b"\n".join(vertex_lines))
-        raise MeshFileError(f"{path}: line {line_of_match(data, _VERTEX, index)}: a vertex coordinate is not a "
-                            f"number ({word[:30].decode('utf-8', 'replace')!r})")
+        raise MeshFileError(
+            f"{path}: line {line_of_match(data, _VERTEX, index)}: a vertex coordinate is not a "
+            f"number ({word[:30].decode('utf-8', 'replace')!r})"
+        )
     values, counts = parsed
     if (counts == 3).all():
         vertices = values.reshape(-1, 3)
     else:  # per line: `v x y z w` and `v x y z r g b` keep x y z; the next lines do not shift
         short = int(np.flatnonzero(counts < 3)[0]) if (counts < 3).any() else None
         if short is not None:
-            raise MeshFileError(f"{path}: line {line_of_match(data, _VERTEX, short)}: a `v` line has fewer than "
-                                f"3 coordinates ({int(counts[short])})")
+            raise MeshFileError(
+                f"{path}: line {line_of_match(data, _VERTEX, short)}: a `v` line has fewer than "
+                f"3 coordinates ({int(counts[short])})"
+            )
         first = np.cumsum(counts) - counts
         vertices = values[first[:, None] + np.arange(3)]
 

@@ -51,8 +51,10 @@ def read_off(path):
     parsed = numbers_per_line(body[:n_vertices])
     if parsed is None:
         index, word = first_bad_line(b"\n".join(body[:n_vertices]))
-        raise MeshFileError(f"{path}: line {line(index)}: {word[:30].decode('utf-8', 'replace')!r} is not a "
-                            "number (a vertex coordinate)")
+        raise MeshFileError(
+            f"{path}: line {line(index)}: {word[:30].decode('utf-8', 'replace')!r} is not a "
+            "number (a vertex coordinate)"
+        )
     values, counts = parsed
     if (counts < 3).any():
         row = int(np.flatnonzero(counts < 3)[0])
@@ -60,29 +62,43 @@ def read_off(path):
     usual = int(np.bincount(counts).argmax()) if counts.size else 3
     if (counts != usual).any():  # a colour on every vertex or on none: one row apart has a value too many or few
         row = int(np.argmax(counts != usual))
-        raise row_error(path, line(row), int(counts[row]), usual, "as most vertex rows: x, y, z"
-                        + (", then a colour" if usual > 3 else ""))
+        raise row_error(
+            path,
+            line(row),
+            int(counts[row]),
+            usual,
+            "as most vertex rows: x, y, z" + (", then a colour" if usual > 3 else ""),
+        )
     if n_vertices > len(body):  # the rows there are were checked first: a damaged row is named
         raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; the file has {len(body)}")
     vertices = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
-    parsed = numbers_per_line(body[n_vertices:n_vertices + n_faces])
+    parsed = numbers_per_line(body[n_vertices : n_vertices + n_faces])
     if parsed is None:
-        index, word = first_bad_line(b"\n".join(body[n_vertices:n_vertices + n_faces]))
-        raise MeshFileError(f"{path}: line {line(n_vertices + index)}: {word[:30].decode('utf-8', 'replace')!r} "
-                            "is not a number (a face)")
+        index, word = first_bad_line(b"\n".join(body[n_vertices : n_vertices + n_faces]))
+        raise MeshFileError(
+            f"{path}: line {line(n_vertices + index)}: {word[:30].decode('utf-8', 'replace')!r} "
+            "is not a number (a face)"
+        )
     values, counts = parsed
     first = np.cumsum(counts) - counts
     sizes = np.where(counts > 0, values[np.minimum(first, max(values.size - 1, 0))] if values.size else 0, 0)
     malformed = (counts == 0) | (sizes != np.floor(sizes)) | (sizes < 3)
     if malformed.any():
         face = int(np.flatnonzero(malformed)[0])
-        raise MeshFileError(f"{path}: line {line(n_vertices + face)}: a face of {sizes[face]:g} corners (its first "
-                            "value counts its corners: a whole number, 3 or more)")
+        raise MeshFileError(
+            f"{path}: line {line(n_vertices + face)}: a face of {sizes[face]:g} corners (its first "
+            "value counts its corners: a whole number, 3 or more)"
+        )
     bad = sizes > counts - 1
     if bad.any():
         face = int(np.flatnonzero(bad)[0])
-        raise row_error(path, line(n_vertices + face), int(counts[face]), f"{int(sizes[face]) + 1} or more",
-                        f"a count of {int(sizes[face])} and as many vertex indices, then maybe a colour")
+        raise row_error(
+            path,
+            line(n_vertices + face),
+            int(counts[face]),
+            f"{int(sizes[face]) + 1} or more",
+            f"a count of {int(sizes[face])} and as many vertex indices, then maybe a colour",
+        )
     if n_vertices + n_faces > len(body):
         raise MeshFileError(
             f"{path}: the header declares {n_vertices} vertices and {n_faces} faces but the file holds only "
@@ -90,21 +106,26 @@ def read_off(path):
             f"{len(body) - n_vertices} is missing (the file is cut short, or two rows were written as one)"
         )
     if len(body) > n_vertices + n_faces:
-        raise MeshFileError(f"{path}: line {line(n_vertices + n_faces)}: a row after the {n_vertices} vertices and "
-                            f"{n_faces} faces the header declares")
+        raise MeshFileError(
+            f"{path}: line {line(n_vertices + n_faces)}: a row after the {n_vertices} vertices and "
+            f"{n_faces} faces the header declares"
+        )
     sizes = sizes.astype(np.int64)
     corners = values[np.repeat(first + 1 - (np.cumsum(sizes) - sizes), sizes) + np.arange(sizes.sum())]
-    bad = (corners != np.floor(corners)) | ~(np.abs(corners) <= 2.0 ** 53)
+    bad = (corners != np.floor(corners)) | ~(np.abs(corners) <= 2.0**53)
     if bad.any():
         face = int(np.searchsorted(np.cumsum(sizes), np.argmax(bad), side="right"))
-        raise MeshFileError(f"{path}: line {line(n_vertices + face)}: a face index is not an integer "
-                            f"({float(corners[bad][0])!r})")
+        raise MeshFileError(
+            f"{path}: line {line(n_vertices + face)}: a face index is not an integer ({float(corners[bad][0])!r})"
+        )
     corners = corners.astype(np.int64)
     bad = (corners < 0) | (corners >= n_vertices)
     if bad.any():
         face = int(np.searchsorted(np.cumsum(sizes), np.argmax(bad), side="right"))
-        raise MeshFileError(f"{path}: line {line(n_vertices + face)}: a face uses vertex {int(corners[bad][0])}; "
-                            f"the file has {n_vertices} vertices, numbered from 0")
+        raise MeshFileError(
+            f"{path}: line {line(n_vertices + face)}: a face uses vertex {int(corners[bad][0])}; "
+            f"the file has {n_vertices} vertices, numbered from 0"
+        )
     if sizes.size and (sizes == sizes[0]).all():
         return vertices, corners.reshape(sizes.size, int(sizes[0]))
     return vertices, np.split(corners, np.cumsum(sizes)[:-1])

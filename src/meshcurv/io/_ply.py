@@ -44,11 +44,24 @@ from ._text import body_rows, fixed_rows, names_shown, row_error
 __all__ = ["read_ply", "HEADER_LIMIT"]
 
 _TYPES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
-    "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
-    "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
-    "int64": "i8", "uint64": "u8",
-    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
+    "char": "i1",
+    "int8": "i1",
+    "uchar": "u1",
+    "uint8": "u1",
+    "short": "i2",
+    "int16": "i2",
+    "ushort": "u2",
+    "uint16": "u2",
+    "int": "i4",
+    "int32": "i4",
+    "uint": "u4",
+    "uint32": "u4",
+    "int64": "i8",
+    "uint64": "u8",
+    "float": "f4",
+    "float32": "f4",
+    "double": "f8",
+    "float64": "f8",
 }
 _ORDERS = {"ascii": "", "binary_little_endian": "<", "binary_big_endian": ">"}
 _CORNER_NAMES = ("vertex_indices", "vertex_index")
@@ -56,7 +69,7 @@ _CORNER_NAMES = ("vertex_indices", "vertex_index")
 #: The header (``ply`` ... ``end_header``) must end within this many bytes.
 HEADER_LIMIT = 1 << 20
 _END_HEADER = re.compile(rb"(?:\r\n|\n|\r)end_header[ \t]*(?:\r\n|\n|\r|$)")
-_LARGEST_INDEX = 2.0 ** 53  # beyond this a float cannot hold an exact integer
+_LARGEST_INDEX = 2.0**53  # beyond this a float cannot hold an exact integer
 
 
 @dataclass
@@ -87,7 +100,7 @@ def _header(data: bytes, path):
             raise MeshFileError(f"{path}: the PLY header ends before its 'end_header' line (the file is cut short)")
         raise MeshFileError(f"{path}: no 'end_header' line in the first {HEADER_LIMIT} bytes; not a PLY header")
     file_format, elements = None, []
-    lines = data[:match.start()].decode("ascii", "replace").splitlines()
+    lines = data[: match.start()].decode("ascii", "replace").splitlines()
     for number, line in enumerate(lines[1:], start=2):
         words = line.split()
         if not words or words[0] in ("comment", "obj_info"):
@@ -271,8 +284,10 @@ def _walk_binary(data, position, order, element, keep, sizes, path):
         return None, position
     kind = np.dtype(order + element.properties[keep].kind)
     lengths = np.array(counts, dtype=np.int64)
-    first = np.repeat(np.array(starts, dtype=np.int64) - np.cumsum(lengths * kind.itemsize) + lengths * kind.itemsize,
-                      lengths * kind.itemsize)
+    first = np.repeat(
+        np.array(starts, dtype=np.int64) - np.cumsum(lengths * kind.itemsize) + lengths * kind.itemsize,
+        lengths * kind.itemsize,
+    )
     byte_index = first + np.arange(first.size)
     values = np.frombuffer(data, np.uint8)[byte_index].view(kind).astype(np.int64)
     return _split(values, lengths), position
@@ -292,8 +307,9 @@ def _integers(values: np.ndarray, path, what: str, lines=None) -> np.ndarray:
     bad = ~(np.abs(values) <= _LARGEST_INDEX) | (values != np.floor(values))
     if bad.any():
         where = f" line {int(np.asarray(lines)[bad][0])}:" if lines is not None else ""
-        raise MeshFileError(f"{path}:{where} a PLY {what} is not an integer ({float(values[bad][0])!r}); "
-                            "indices must be whole numbers")
+        raise MeshFileError(
+            f"{path}:{where} a PLY {what} is not an integer ({float(values[bad][0])!r}); indices must be whole numbers"
+        )
     return values.astype(np.int64)
 
 
@@ -309,13 +325,17 @@ def _read_ascii(data, offset, elements, vertex, face, corners, path):
             try:
                 _ascii_element(values, counts[rows], first_value[rows], lines[rows], element, None, path)
             except MeshFileError as exc:
-                raise MeshFileError(f"{exc} (and the file ends before the {element.count} {element.plural} the "
-                                    "header declares)") from None
+                raise MeshFileError(
+                    f"{exc} (and the file ends before the {element.count} {element.plural} the header declares)"
+                ) from None
             end = f" after line {int(lines[-1])}" if lines.size else ""
-            raise MeshFileError(f"{path}: the PLY header declares {element.count} {element.plural} but the file "
-                                f"ends{end}, {available} rows later; the file is cut short or its header is wrong")
-        found = _ascii_element(values, counts[rows], first_value[rows], lines[rows], element,
-                               corners if element is face else None, path)
+            raise MeshFileError(
+                f"{path}: the PLY header declares {element.count} {element.plural} but the file "
+                f"ends{end}, {available} rows later; the file is cut short or its header is wrong"
+            )
+        found = _ascii_element(
+            values, counts[rows], first_value[rows], lines[rows], element, corners if element is face else None, path
+        )
         if element is vertex:
             names = [p.name for p in element.properties]
             vertices = found[:, [names.index(axis) for axis in "xyz"]]
@@ -325,16 +345,22 @@ def _read_ascii(data, offset, elements, vertex, face, corners, path):
         flat = faces if isinstance(faces, np.ndarray) else np.concatenate(faces)
         bad = (flat < 0) | (flat >= len(vertices))
         if bad.any():
-            sizes = np.full(len(faces), faces.shape[1]) if isinstance(faces, np.ndarray) else np.array(
-                [len(f) for f in faces])
+            sizes = (
+                np.full(len(faces), faces.shape[1])
+                if isinstance(faces, np.ndarray)
+                else np.array([len(f) for f in faces])
+            )
             index = int(np.searchsorted(np.cumsum(sizes), np.argmax(bad.ravel()), side="right"))
-            line = int(lines[sum(e.count for e in elements[:elements.index(face)]) + index])
-            raise MeshFileError(f"{path}: line {line}: a face uses vertex {int(flat.ravel()[bad.ravel()][0])}; the "
-                                f"file has {len(vertices)} vertices, numbered from 0")
+            line = int(lines[sum(e.count for e in elements[: elements.index(face)]) + index])
+            raise MeshFileError(
+                f"{path}: line {line}: a face uses vertex {int(flat.ravel()[bad.ravel()][0])}; the "
+                f"file has {len(vertices)} vertices, numbered from 0"
+            )
     if row < counts.size:
         declared = ", ".join(f"{element.count} {element.plural}" for element in elements)
-        raise MeshFileError(f"{path}: line {int(lines[row])}: a row after the last element (the header "
-                            f"declares {declared})")
+        raise MeshFileError(
+            f"{path}: line {int(lines[row])}: a row after the last element (the header declares {declared})"
+        )
     return vertices, faces
 
 
@@ -362,8 +388,10 @@ def _ascii_lists(values, counts, first_value, lines, element, keep, path):
         bad = inside & ((n < 0) | (n != np.floor(n)))
         if bad.any():
             row = int(np.argmax(bad))
-            raise MeshFileError(f"{path}: line {int(lines[row])}: the {element.name} list count of {p.name} is not "
-                                f"a whole number ({n[row]!r})")
+            raise MeshFileError(
+                f"{path}: line {int(lines[row])}: the {element.name} list count of {p.name} is not "
+                f"a whole number ({n[row]!r})"
+            )
         sizes[i] = np.minimum(n, counts).astype(np.int64)  # beyond its line: the row is too short anyway
         if i == keep:
             starts = position + 1
@@ -372,8 +400,10 @@ def _ascii_lists(values, counts, first_value, lines, element, keep, path):
     wrong = need != counts
     if wrong.any():
         row = int(np.argmax(wrong))
-        parts = [p.name if i not in sizes else f"{p.name}: a count of {sizes[i][row]} and {sizes[i][row]} values"
-                 for i, p in enumerate(element.properties)]
+        parts = [
+            p.name if i not in sizes else f"{p.name}: a count of {sizes[i][row]} and {sizes[i][row]} values"
+            for i, p in enumerate(element.properties)
+        ]
         raise row_error(path, int(lines[row]), int(counts[row]), int(need[row]), f"{element.name}: {', '.join(parts)}")
     if keep is None:
         return None
@@ -403,14 +433,15 @@ def ply_vertex_columns(path) -> dict[str, np.ndarray]:
         raise MeshFileError(f"{path}: the PLY header has no 'vertex' element")
     if any(p.count_kind is not None for p in vertex.properties):
         raise MeshFileError(f"{path}: the PLY 'vertex' element has a list property; not supported")
-    before = elements[:elements.index(vertex)]
+    before = elements[: elements.index(vertex)]
     if any(p.count_kind is not None for e in before for p in e.properties):
         raise MeshFileError(f"{path}: the PLY file has a list element before its vertices; not supported")
     if file_format == "ascii":  # one record per line: a line of the wrong length is named, never re-cut
         skip = sum(e.count for e in before)
         # each value takes at least two bytes (a digit and a separator): bound the count first
-        if (sum(e.count * len(e.properties) for e in before) + vertex.count * len(vertex.properties)) * 2 > \
-                len(data) - offset + 1:
+        if (sum(e.count * len(e.properties) for e in before) + vertex.count * len(vertex.properties)) * 2 > len(
+            data
+        ) - offset + 1:
             raise _short(path, vertex.count, "vertices", len(data) - offset)
         values, counts, first_value, lines = body_rows(data, offset, path, n_rows=skip + vertex.count)
         row = 0
@@ -418,8 +449,15 @@ def ply_vertex_columns(path) -> dict[str, np.ndarray]:
             rows = slice(row, row + element.count)
             row += element.count
             names = [p.name for p in element.properties]
-            table = fixed_rows(values, counts[rows], first_value[rows], lines[rows], len(names), path,
-                               f"{element.name}: {names_shown(names)}")
+            table = fixed_rows(
+                values,
+                counts[rows],
+                first_value[rows],
+                lines[rows],
+                len(names),
+                path,
+                f"{element.name}: {names_shown(names)}",
+            )
         if counts.size < skip + vertex.count:
             raise _short(path, vertex.count, "vertices", len(data) - offset)
         return {p.name: table[:, i] for i, p in enumerate(vertex.properties)}
@@ -437,5 +475,7 @@ def ply_vertex_columns(path) -> dict[str, np.ndarray]:
 
 def _short(path, count, what, available, need=None) -> MeshFileError:
     needed = f" ({need} needed)" if need is not None else ""
-    return MeshFileError(f"{path}: the header declares {count} {what} but the file holds only {available} bytes "
-                         f"for them{needed}; the file is cut short or its header is wrong")
+    return MeshFileError(
+        f"{path}: the header declares {count} {what} but the file holds only {available} bytes "
+        f"for them{needed}; the file is cut short or its header is wrong"
+    )

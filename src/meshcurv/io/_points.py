@@ -106,8 +106,17 @@ def is_point_cloud(path) -> bool:
     return not any(e.name == "face" and e.count > 0 for e in elements)
 
 
-def write_point_curvatures(path, points, result, *, fields=None, quality: str | None = "mean",
-                           overwrite: bool = False, source=None, binary: bool = True) -> pathlib.Path:
+def write_point_curvatures(
+    path,
+    points,
+    result,
+    *,
+    fields=None,
+    quality: str | None = "mean",
+    overwrite: bool = False,
+    source=None,
+    binary: bool = True,
+) -> pathlib.Path:
     """Write a point cloud with the fields of a curvature result (those of :func:`meshcurv.io.write_curvatures`).
 
     ``write_points(path, points, point_data=curvature_fields(result, ...))``:
@@ -116,16 +125,27 @@ def write_point_curvatures(path, points, result, *, fields=None, quality: str | 
     """
     from .fields import curvature_fields
 
-    return write_points(path, points, point_data=curvature_fields(result, fields=fields, quality=quality),
-                        overwrite=overwrite, source=source, binary=binary)
+    return write_points(
+        path,
+        points,
+        point_data=curvature_fields(result, fields=fields, quality=quality),
+        overwrite=overwrite,
+        source=source,
+        binary=binary,
+    )
 
 
 def _suffix(path: pathlib.Path, file_format: str | None) -> str:
     key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
     key = (key or path.suffix).lower()
     if key not in POINT_EXTENSIONS:
-        what = (f"format {file_format!r}" if file_format
-                else f"extension {path.suffix!r}" if path.suffix else "no extension")
+        what = (
+            f"format {file_format!r}"
+            if file_format
+            else f"extension {path.suffix!r}"
+            if path.suffix
+            else "no extension"
+        )
         raise MeshFileError(f"{path}: unknown point-cloud file {what}; known formats: {', '.join(POINT_EXTENSIONS)}")
     return key
 
@@ -144,6 +164,7 @@ def _split(columns: dict, path, where: str) -> tuple[np.ndarray, np.ndarray | No
 
 
 # -- PLY ----------------------------------------------------------------------------
+
 
 def _read_ply(path):
     columns = ply_vertex_columns(path)
@@ -220,8 +241,9 @@ def text_columns(path) -> dict[str, np.ndarray]:
     wrong = keep & (found != width)
     if wrong.any():
         i = int(np.argmax(wrong))
-        meaning = names_shown(names) if names else "as most rows: x, y, z" + (f" and {width - 3} more" if width > 3
-                                                                             else "")
+        meaning = (
+            names_shown(names) if names else "as most rows: x, y, z" + (f" and {width - 3} more" if width > 3 else "")
+        )
         raise row_error(path, int(line + rows[i]), int(found[i]), width, meaning)
     if not keep.all():
         values = np.delete(values, first_value[~keep])
@@ -245,7 +267,7 @@ def _undelimited(body: bytes, path, line: int) -> bytes:
     first = _FIRST_WORD.search(body)
     start = 0 if first is None else first.start()
     end = body.find(b"\n", start)
-    row = body[start:len(body) if end < 0 else end]
+    row = body[start : len(body) if end < 0 else end]
     delimiter = b";" if b";" in row else b"," if b"," in row else None
     if delimiter is None:
         return body
@@ -264,9 +286,11 @@ def _undelimited(body: bytes, path, line: int) -> bytes:
         position = int(bounds[np.argmax(empty)])
         number = line + line_of(body, position) - 1
         start = body.rfind(b"\n", 0, position) + 1
-        shown = body[start:body.find(b"\n", position)].strip()[:60].decode("utf-8", "replace")
-        raise MeshFileError(f"{path}: line {number}: an empty value in {shown!r} (every "
-                            f"{delimiter.decode()!r} stands between two numbers)")
+        shown = body[start : body.find(b"\n", position)].strip()[:60].decode("utf-8", "replace")
+        raise MeshFileError(
+            f"{path}: line {number}: an empty value in {shown!r} (every "
+            f"{delimiter.decode()!r} stands between two numbers)"
+        )
     return body.translate(_TRANSLATIONS[delimiter])
 
 
@@ -280,13 +304,16 @@ def _counted_blocks(path, values, found, first_value, lines) -> np.ndarray:
     follow = np.diff(np.append(heads, found.size)) - 1
     whole = (declared >= 0) & (declared == np.floor(declared))
     if not whole[0]:
-        raise MeshFileError(f"{path}: line {lines[0]}: 1 value ({float(declared[0])!r}), expected a count of points "
-                            "or x, y, z")
+        raise MeshFileError(
+            f"{path}: line {lines[0]}: 1 value ({float(declared[0])!r}), expected a count of points or x, y, z"
+        )
     bad = whole & (declared != follow)
     if bad.any():
         i = int(np.argmax(bad))
-        raise MeshFileError(f"{path}: line {lines[heads[i]]}: a count of {int(declared[i])} points, but "
-                            f"{follow[i]} rows follow it (up to the next count or the end of the file)")
+        raise MeshFileError(
+            f"{path}: line {lines[heads[i]]}: a count of {int(declared[i])} points, but "
+            f"{follow[i]} rows follow it (up to the next count or the end of the file)"
+        )
     keep = np.ones(found.size, dtype=bool)
     keep[heads[whole]] = False
     return keep
@@ -294,8 +321,18 @@ def _counted_blocks(path, values, found, first_value, lines) -> np.ndarray:
 
 # -- PCD ----------------------------------------------------------------------------
 
-_PCD_TYPES = {("F", 4): "f4", ("F", 8): "f8", ("I", 1): "i1", ("I", 2): "i2", ("I", 4): "i4", ("I", 8): "i8",
-              ("U", 1): "u1", ("U", 2): "u2", ("U", 4): "u4", ("U", 8): "u8"}
+_PCD_TYPES = {
+    ("F", 4): "f4",
+    ("F", 8): "f8",
+    ("I", 1): "i1",
+    ("I", 2): "i2",
+    ("I", 4): "i4",
+    ("I", 8): "i8",
+    ("U", 1): "u1",
+    ("U", 2): "u2",
+    ("U", 4): "u4",
+    ("U", 8): "u8",
+}
 
 
 def _read_pcd(path):
@@ -334,8 +371,15 @@ def _read_pcd(path):
         if n * width * 2 > len(body) + 1:
             raise _short(path, n, "points", len(body))
         values, found, first_value, lines = body_rows(data, position, path)  # one point per line
-        table = fixed_rows(values, found[:n], first_value[:n], lines[:n], width, path, names_shown(
-            f"{f}[{c}]" if c > 1 else f for f, c in zip(fields, counts)))
+        table = fixed_rows(
+            values,
+            found[:n],
+            first_value[:n],
+            lines[:n],
+            width,
+            path,
+            names_shown(f"{f}[{c}]" if c > 1 else f for f, c in zip(fields, counts)),
+        )
         if found.size < n:
             raise _short(path, n, "points", len(body))
         if found.size > n:
@@ -344,8 +388,9 @@ def _read_pcd(path):
         columns = {f: table[:, s] for f, s in zip(fields, starts)}
     elif kind == "binary":
         try:
-            record = np.dtype([(f"f{i}", "<" + _PCD_TYPES[t, s], (c,)) for i, (t, s, c) in
-                               enumerate(zip(types, sizes, counts))])
+            record = np.dtype(
+                [(f"f{i}", "<" + _PCD_TYPES[t, s], (c,)) for i, (t, s, c) in enumerate(zip(types, sizes, counts))]
+            )
         except KeyError:
             raise MeshFileError(f"{path}: a PCD field has an unknown TYPE/SIZE pair") from None
         need = n * record.itemsize
@@ -358,8 +403,11 @@ def _read_pcd(path):
     points, normals = _split(columns, path, "the PCD FIELDS")
     finite = np.isfinite(points).all(axis=1)
     if not finite.all():
-        warnings.warn(f"{path}: {int((~finite).sum())} of {n} points have NaN coordinates (missing measurements): "
-                      "left out", MeshQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{path}: {int((~finite).sum())} of {n} points have NaN coordinates (missing measurements): left out",
+            MeshQualityWarning,
+            stacklevel=3,
+        )
         points = points[finite]
         normals = None if normals is None else normals[finite]
     return points, normals
@@ -367,12 +415,14 @@ def _read_pcd(path):
 
 # -- LAS / LAZ ----------------------------------------------------------------------
 
+
 def _laspy(path):
     try:
         import laspy
     except ImportError:
-        raise MissingDependencyError(f"{path}: reading or writing LAS / LAZ needs laspy: "
-                                     "pip install 'meshcurv[points]'") from None
+        raise MissingDependencyError(
+            f"{path}: reading or writing LAS / LAZ needs laspy: pip install 'meshcurv[points]'"
+        ) from None
     return laspy
 
 
@@ -387,8 +437,13 @@ def _read_las(path):
                 if need > path.stat().st_size:
                     raise _short(path, count, "points", path.stat().st_size, need)
             data = reader.read()
-        points = np.column_stack([np.asarray(data.x, dtype=np.float64), np.asarray(data.y, dtype=np.float64),
-                                  np.asarray(data.z, dtype=np.float64)])
+        points = np.column_stack(
+            [
+                np.asarray(data.x, dtype=np.float64),
+                np.asarray(data.y, dtype=np.float64),
+                np.asarray(data.z, dtype=np.float64),
+            ]
+        )
         extra = {name.lower(): name for name in data.point_format.extra_dimension_names}
         normals = None
         for names in _NORMAL_NAMES:
@@ -406,6 +461,7 @@ def _read_las(path):
 
 # -- writing ------------------------------------------------------------------------
 
+
 def _columns(points, normals, point_data) -> dict[str, np.ndarray]:
     """Named float64 columns: x, y, z, nx, ny, nz, then each field (vectors as ``name_x`` ...)."""
     columns = {a: points[:, i] for i, a in enumerate("xyz")}
@@ -418,13 +474,23 @@ def _columns(points, normals, point_data) -> dict[str, np.ndarray]:
         elif value.shape == (points.shape[0], 3):
             columns.update({f"{name}_{a}": value[:, i] for i, a in enumerate("xyz")})
         else:
-            raise MeshFileError(f"field {name!r} must have shape ({points.shape[0]},) or ({points.shape[0]}, 3); "
-                                f"got {value.shape}")
+            raise MeshFileError(
+                f"field {name!r} must have shape ({points.shape[0]},) or ({points.shape[0]}, 3); got {value.shape}"
+            )
     return columns
 
 
-def write_points(path, points, normals=None, *, point_data=None, overwrite: bool = False, binary: bool = True,
-                 source=None, file_format: str | None = None) -> pathlib.Path:
+def write_points(
+    path,
+    points,
+    normals=None,
+    *,
+    point_data=None,
+    overwrite: bool = False,
+    binary: bool = True,
+    source=None,
+    file_format: str | None = None,
+) -> pathlib.Path:
     """Write a point cloud with its normals and per-point fields.
 
     Parameters
@@ -494,17 +560,25 @@ def _write_table(temporary, header: list[str], columns: dict, binary: bool) -> N
 def _write_ply(temporary, columns, binary):
     n = next(iter(columns.values())).shape[0]
     lines = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0", f"element vertex {n}"]
-    _write_table(temporary, lines + [f"property double {name}" for name in columns] + ["end_header"], columns,
-                 binary)
+    _write_table(temporary, lines + [f"property double {name}" for name in columns] + ["end_header"], columns, binary)
 
 
 def _write_pcd(temporary, columns, binary):
     n = next(iter(columns.values())).shape[0]
     names = [{"nx": "normal_x", "ny": "normal_y", "nz": "normal_z"}.get(name, name) for name in columns]
-    lines = ["# .PCD v0.7 - Point Cloud Data file format", "VERSION 0.7", "FIELDS " + " ".join(names),
-             "SIZE " + " ".join(["8"] * len(names)), "TYPE " + " ".join(["F"] * len(names)),
-             "COUNT " + " ".join(["1"] * len(names)), f"WIDTH {n}", "HEIGHT 1", "VIEWPOINT 0 0 0 1 0 0 0",
-             f"POINTS {n}", f"DATA {'binary' if binary else 'ascii'}"]
+    lines = [
+        "# .PCD v0.7 - Point Cloud Data file format",
+        "VERSION 0.7",
+        "FIELDS " + " ".join(names),
+        "SIZE " + " ".join(["8"] * len(names)),
+        "TYPE " + " ".join(["F"] * len(names)),
+        "COUNT " + " ".join(["1"] * len(names)),
+        f"WIDTH {n}",
+        "HEIGHT 1",
+        "VIEWPOINT 0 0 0 1 0 0 0",
+        f"POINTS {n}",
+        f"DATA {'binary' if binary else 'ascii'}",
+    ]
     _write_table(temporary, lines, columns, binary)
 
 

@@ -30,8 +30,7 @@ def flat_columns(point_data: dict, *, normals_as_nxyz: bool = True) -> dict[str,
 
 def write_csv(path, vertices: np.ndarray, faces, point_data: dict) -> None:
     """One row per vertex: ``vertex, x, y, z`` then the fields (vectors split into columns)."""
-    columns = {"vertex": np.arange(vertices.shape[0]), "x": vertices[:, 0], "y": vertices[:, 1],
-               "z": vertices[:, 2]}
+    columns = {"vertex": np.arange(vertices.shape[0]), "x": vertices[:, 0], "y": vertices[:, 1], "z": vertices[:, 2]}
     columns.update(flat_columns(point_data, normals_as_nxyz=False))
     table = np.column_stack([np.asarray(value, dtype=np.float64) for value in columns.values()])
     formats = ["%d" if np.issubdtype(np.asarray(v).dtype, np.integer) else "%.17g" for v in columns.values()]
@@ -68,8 +67,10 @@ def _check_members(path, archive: zipfile.ZipFile) -> None:
         if not key.startswith(("vertices", "face")):
             continue
         if info.file_size > _DEFLATE_RATIO * info.compress_size + 4096:
-            raise MeshFileError(f"{path}: the NPZ member {key!r} claims {info.file_size} bytes from "
-                                f"{info.compress_size} compressed ones; the archive is corrupt")
+            raise MeshFileError(
+                f"{path}: the NPZ member {key!r} claims {info.file_size} bytes from "
+                f"{info.compress_size} compressed ones; the archive is corrupt"
+            )
         with archive.open(info) as member:
             version = np.lib.format.read_magic(member)
             if version not in readers:
@@ -112,7 +113,12 @@ def read_npz(path):
     if "faces" in arrays:
         return arrays["vertices"], arrays["faces"]
     corners, sizes = arrays["face_corners"], arrays["face_sizes"]
-    if corners.ndim != 1 or sizes.ndim != 1 or sizes.dtype.kind not in "iu" or (sizes < 0).any() \
-            or int(sizes.sum(dtype=np.int64)) != corners.size:
+    if (
+        corners.ndim != 1
+        or sizes.ndim != 1
+        or sizes.dtype.kind not in "iu"
+        or (sizes < 0).any()
+        or int(sizes.sum(dtype=np.int64)) != corners.size
+    ):
         raise MeshFileError(f"{path}: the NPZ 'face_sizes' do not add up to the {corners.size} 'face_corners'")
     return arrays["vertices"], np.split(corners, np.cumsum(sizes)[:-1])

@@ -15,9 +15,19 @@ import numpy as np
 
 from ..errors import MeshFileError
 
-__all__ = ["numbers", "numbers_per_line", "numbers_by_line", "first_bad_line", "line_of", "line_of_match",
-           "not_a_number",
-           "row_error", "names_shown", "body_rows", "fixed_rows"]
+__all__ = [
+    "numbers",
+    "numbers_per_line",
+    "numbers_by_line",
+    "first_bad_line",
+    "line_of",
+    "line_of_match",
+    "not_a_number",
+    "row_error",
+    "names_shown",
+    "body_rows",
+    "fixed_rows",
+]
 
 _NEWLINE = 10
 _CHUNK = 4096  # lines tried at once when looking for the one that is not numbers
@@ -80,7 +90,7 @@ def first_bad_line(text: bytes) -> tuple[int, bytes]:
     """
     lines = text.split(b"\n")
     for start in range(0, len(lines), _CHUNK):
-        chunk = lines[start:start + _CHUNK]
+        chunk = lines[start : start + _CHUNK]
         if numbers_by_line(b"\n".join(chunk)) is not None:
             continue
         for offset, line in enumerate(chunk):
@@ -141,7 +151,7 @@ def body_rows(data: bytes, offset: int, path, n_rows: int | None = None):
         ends = np.flatnonzero(np.frombuffer(body, dtype=np.uint8) == _NEWLINE)
         cut = n_rows
         while True:  # parse n_rows lines; more if some of them are blank
-            text = body[:ends[cut - 1] + 1] if 0 < cut <= ends.size else body if cut > ends.size else b""
+            text = body[: ends[cut - 1] + 1] if 0 < cut <= ends.size else body if cut > ends.size else b""
             parsed = numbers_by_line(text) if text else (np.zeros(0), np.zeros(0, dtype=np.int64))
             if parsed is None or text is body or np.count_nonzero(parsed[1]) >= n_rows:
                 break
@@ -165,4 +175,4 @@ def fixed_rows(values, counts, first_value, lines, width: int, path, meaning: st
     if counts.size == 0:
         return np.zeros((0, width))
     start = int(first_value[0])
-    return values[start:start + counts.size * width].reshape(counts.size, width)
+    return values[start : start + counts.size * width].reshape(counts.size, width)

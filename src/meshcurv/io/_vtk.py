@@ -22,15 +22,28 @@ from ._text import numbers
 __all__ = ["is_polydata", "read_vtk_polydata"]
 
 _TYPES = {
-    "bit": None, "unsigned_char": "u1", "char": "i1", "unsigned_short": "u2", "short": "i2",
-    "unsigned_int": "u4", "int": "i4", "unsigned_long": "u8", "long": "i8", "float": "f4", "double": "f8",
-    "vtktypeint64": "i8", "vtktypeuint64": "u8", "vtkidtype": "i8", "vtktypeint32": "i4", "vtktypeuint32": "u4",
+    "bit": None,
+    "unsigned_char": "u1",
+    "char": "i1",
+    "unsigned_short": "u2",
+    "short": "i2",
+    "unsigned_int": "u4",
+    "int": "i4",
+    "unsigned_long": "u8",
+    "long": "i8",
+    "float": "f4",
+    "double": "f8",
+    "vtktypeint64": "i8",
+    "vtktypeuint64": "u8",
+    "vtkidtype": "i8",
+    "vtktypeint32": "i4",
+    "vtktypeuint32": "u4",
 }
 _DATASET = re.compile(rb"^\s*DATASET\s+(\w+)", re.M | re.I)
 _WHITE = np.zeros(256, dtype=bool)
 _WHITE[[9, 10, 11, 12, 13, 32]] = True
 _CELL_SECTIONS = ("VERTICES", "LINES", "POLYGONS", "TRIANGLE_STRIPS")
-_LARGEST_INDEX = 2.0 ** 53
+_LARGEST_INDEX = 2.0**53
 
 
 def is_polydata(path) -> bool:
@@ -53,7 +66,7 @@ class _Cursor:
         while self.position < len(data):
             end = data.find(b"\n", self.position)
             end = len(data) if end < 0 else end
-            text = data[self.position:end]
+            text = data[self.position : end]
             self.position = end + 1
             if text.strip() or not skip_blank:
                 return text.decode("ascii", "replace").split()
@@ -80,7 +93,7 @@ class _Cursor:
             return np.zeros(0)
         window = 16 * n + 64
         while True:
-            chunk = self.data[self.position:self.position + window]
+            chunk = self.data[self.position : self.position + window]
             white = _WHITE[np.frombuffer(chunk, np.uint8)]
             starts = np.flatnonzero(~white[1:] & white[:-1]) + 1
             if chunk and not white[0]:
@@ -177,11 +190,14 @@ def read_vtk_polydata(path):
 
 def _merge(blocks):
     """Faces from blocks (F, k) arrays and single faces: one (F, k) array when they all have k corners."""
-    if all(isinstance(block, np.ndarray) and block.ndim == 2 for block in blocks) and len(
-            {block.shape[1] for block in blocks}) == 1:
+    if (
+        all(isinstance(block, np.ndarray) and block.ndim == 2 for block in blocks)
+        and len({block.shape[1] for block in blocks}) == 1
+    ):
         return np.concatenate(blocks)
-    return [face for block in blocks for face in (block if isinstance(block, np.ndarray) and block.ndim == 2
-                                                   else [block])]
+    return [
+        face for block in blocks for face in (block if isinstance(block, np.ndarray) and block.ndim == 2 else [block])
+    ]
 
 
 def _cells(cursor, key, n_cells, size, version, path):
@@ -210,7 +226,7 @@ def _cells(cursor, key, n_cells, size, version, path):
     if n_cells == 0:
         return []
     k = int(values[0]) if values.size else -1
-    if k >= 0 and size == n_cells * (k + 1) and (values[::k + 1] == k).all():
+    if k >= 0 and size == n_cells * (k + 1) and (values[:: k + 1] == k).all():
         return [values.reshape(n_cells, k + 1)[:, 1:]] if k else []
     starts: list[int] = []
     lengths: list[int] = []
@@ -223,14 +239,14 @@ def _cells(cursor, key, n_cells, size, version, path):
         position += 1 + lengths[-1]
     if position != size:
         raise MeshFileError(f"{path}: the {key} counts do not match the declared size {size}")
-    return [values[start:start + length] for start, length in zip(starts, lengths)]
+    return [values[start : start + length] for start, length in zip(starts, lengths)]
 
 
 def _strip_triangles(cells):
     """Triangles of triangle strips, every second one flipped to keep the strip's orientation."""
     triangles = []
     for block in cells:
-        for strip in (block if block.ndim == 2 else [block]):
+        for strip in block if block.ndim == 2 else [block]:
             if len(strip) < 3:
                 continue
             corners = np.column_stack([strip[:-2], strip[1:-1], strip[2:]])

@@ -24,8 +24,16 @@ from ._text import numbers
 __all__ = ["read_vtp", "read_vtp_point_data", "read_vtp_cell_data", "write_vtp", "PieceWriter"]
 
 _TYPES = {
-    "Int8": "i1", "UInt8": "u1", "Int16": "i2", "UInt16": "u2", "Int32": "i4", "UInt32": "u4",
-    "Int64": "i8", "UInt64": "u8", "Float32": "f4", "Float64": "f8",
+    "Int8": "i1",
+    "UInt8": "u1",
+    "Int16": "i2",
+    "UInt16": "u2",
+    "Int32": "i4",
+    "UInt32": "u4",
+    "Int64": "i8",
+    "UInt64": "u8",
+    "Float32": "f4",
+    "Float64": "f8",
 }
 _NAMES = {np.dtype(code).newbyteorder("<"): name for name, code in _TYPES.items()}
 
@@ -58,8 +66,13 @@ def _piece(vertices: np.ndarray, faces, point_data: dict, cell_data: dict | None
         offsets = np.cumsum([len(face) for face in faces], dtype=np.int64)
     piece = ElementTree.Element(
         "Piece",
-        {"NumberOfPoints": str(vertices.shape[0]), "NumberOfVerts": "0", "NumberOfLines": "0",
-         "NumberOfStrips": "0", "NumberOfPolys": str(len(offsets))},
+        {
+            "NumberOfPoints": str(vertices.shape[0]),
+            "NumberOfVerts": "0",
+            "NumberOfLines": "0",
+            "NumberOfStrips": "0",
+            "NumberOfPolys": str(len(offsets)),
+        },
     )
     for tag, data in (("PointData", point_data), ("CellData", cell_data)):
         if data is None:
@@ -70,8 +83,9 @@ def _piece(vertices: np.ndarray, faces, point_data: dict, cell_data: dict | None
         if scalars:
             attributes["Scalars"] = scalars[0]
         if vectors:
-            attributes["Normals" if "normals" in vectors else "Vectors"] = ("normals" if "normals" in vectors
-                                                                            else vectors[0])
+            attributes["Normals" if "normals" in vectors else "Vectors"] = (
+                "normals" if "normals" in vectors else vectors[0]
+            )
         fields = ElementTree.SubElement(piece, tag, attributes)
         for name, value in data.items():
             _data_array(fields, np.asarray(value), name)
@@ -107,8 +121,7 @@ class PieceWriter:
 
     def __enter__(self) -> PieceWriter:
         attributes = " ".join(f'{key}="{value}"' for key, value in _ROOT.items())
-        self._handle.write(f"<?xml version='1.0' encoding='utf-8'?>\n<VTKFile {attributes}>\n  <PolyData>\n"
-                           .encode())
+        self._handle.write(f"<?xml version='1.0' encoding='utf-8'?>\n<VTKFile {attributes}>\n  <PolyData>\n".encode())
         return self
 
     def add(self, vertices: np.ndarray, faces, point_data: dict, cell_data: dict | None = None) -> None:
@@ -131,15 +144,18 @@ def _decode(element, path, *, header: str, order: str, compressed: bool) -> np.n
     if encoding == "ascii":
         values = _numbers(text, path)
         if dtype.kind in "iu":
-            bad = ~(np.abs(values) <= 2.0 ** 53) | (values != np.floor(values))
+            bad = ~(np.abs(values) <= 2.0**53) | (values != np.floor(values))
             if bad.any():
-                raise MeshFileError(f"{path}: a DataArray of type {kind} holds a value that is not an integer "
-                                    f"({values[bad][0]!r}); indices must be whole numbers")
+                raise MeshFileError(
+                    f"{path}: a DataArray of type {kind} holds a value that is not an integer "
+                    f"({values[bad][0]!r}); indices must be whole numbers"
+                )
         with np.errstate(over="ignore", invalid="ignore"):  # beyond Float32: inf, refused later
             values = values.astype(dtype)
     elif encoding == "binary":
-        values = np.frombuffer(_binary(text, path, np.dtype(order + ("u8" if header == "UInt64" else "u4")),
-                                       compressed), dtype=dtype)
+        values = np.frombuffer(
+            _binary(text, path, np.dtype(order + ("u8" if header == "UInt64" else "u4")), compressed), dtype=dtype
+        )
     else:
         raise MeshFileError(
             f"{path}: DataArray format {encoding!r} is not supported (only inline 'ascii' and 'binary'); "
@@ -152,7 +168,9 @@ def _decode(element, path, *, header: str, order: str, compressed: bool) -> np.n
 def _numbers(text: str, path) -> np.ndarray:
     values = numbers(text.encode("ascii", "replace"))
     if values is None:
-        raise MeshFileError(f"{path}: a data array cannot be decoded (an ascii DataArray holds a word that is not a number)")
+        raise MeshFileError(
+            f"{path}: a data array cannot be decoded (an ascii DataArray holds a word that is not a number)"
+        )
     return values
 
 
@@ -169,7 +187,7 @@ def _binary(text: str, path, header_type: np.dtype, compressed: bool) -> bytes:
     """The bytes of a base64 binary DataArray; declared sizes checked before anything is allocated."""
     if not compressed:
         n_bytes = int(_header_values(text, 1, header_type, path)[0])
-        data = base64.b64decode(text[4 * -(-header_type.itemsize // 3):])
+        data = base64.b64decode(text[4 * -(-header_type.itemsize // 3) :])
         if len(data) < n_bytes:
             raise MeshFileError(f"{path}: a binary DataArray declares {n_bytes} bytes but holds {len(data)}")
         return data[:n_bytes]
@@ -179,14 +197,14 @@ def _binary(text: str, path, header_type: np.dtype, compressed: bool) -> bytes:
         raise MeshFileError(f"{path}: a compressed DataArray declares {n_blocks} blocks; the file holds far fewer")
     head = _header_values(text, 3 + n_blocks, header_type, path)
     block_size, last_size, sizes = int(head[1]), int(head[2]), head[3:].astype(np.int64)
-    raw = base64.b64decode(text[4 * -(-(3 + n_blocks) * header_type.itemsize // 3):])
+    raw = base64.b64decode(text[4 * -(-(3 + n_blocks) * header_type.itemsize // 3) :])
     if int(sizes.sum()) > len(raw):
         raise MeshFileError(f"{path}: a compressed DataArray declares {int(sizes.sum())} bytes but holds {len(raw)}")
     blocks, start = [], 0
     for i, size in enumerate(sizes.tolist()):
         expected = last_size if i == n_blocks - 1 and last_size else block_size
         inflater = zlib.decompressobj()
-        block = inflater.decompress(raw[start:start + size], expected + 1)  # never more than declared
+        block = inflater.decompress(raw[start : start + size], expected + 1)  # never more than declared
         if len(block) != expected or not inflater.eof:
             raise MeshFileError(f"{path}: a compressed DataArray block does not hold its declared {expected} bytes")
         blocks.append(block)
@@ -203,9 +221,11 @@ def _root(path):
     if root.tag != "VTKFile" or root.get("type") != "PolyData":
         raise MeshFileError(f"{path}: not a VTK PolyData file (root <{root.tag} type={root.get('type')!r}>)")
     compressed = root.get("compressor") is not None
-    options = {"header": root.get("header_type", "UInt32"),
-               "order": "<" if root.get("byte_order", "LittleEndian") == "LittleEndian" else ">",
-               "compressed": compressed}
+    options = {
+        "header": root.get("header_type", "UInt32"),
+        "order": "<" if root.get("byte_order", "LittleEndian") == "LittleEndian" else ">",
+        "compressed": compressed,
+    }
     return root, options
 
 
@@ -263,7 +283,9 @@ def _read_piece(piece, path, options):
         raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
     declared = piece.get("NumberOfPoints")
     if declared is not None and declared.strip() != str(vertices.shape[0]):
-        raise MeshFileError(f"{path}: the PolyData declares {declared.strip()[:20]} points but holds {vertices.shape[0]}")
+        raise MeshFileError(
+            f"{path}: the PolyData declares {declared.strip()[:20]} points but holds {vertices.shape[0]}"
+        )
     sizes = np.diff(offsets, prepend=0)
     if (offsets.size and offsets[-1] != connectivity.size) or (sizes < 3).any():
         raise MeshFileError(f"{path}: the polygon offsets do not match the connectivity")

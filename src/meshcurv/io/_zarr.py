@@ -58,14 +58,17 @@ def _ome(path, group, multiscales):
         scale = multiscales[0]
         dataset = scale["datasets"][0]
         array = group[dataset["path"]]
-        axes = scale.get("axes") or [{"name": name} for name in "tczyx"[-len(array.shape):]]
+        axes = scale.get("axes") or [{"name": name} for name in "tczyx"[-len(array.shape) :]]
         names = [axis["name"] if isinstance(axis, dict) else str(axis) for axis in axes]
     except (KeyError, IndexError, TypeError) as exc:
-        raise MeshFileError(f"{path}: the OME-Zarr 'multiscales' metadata is incomplete ({type(exc).__name__}: "
-                            f"{exc})") from None
+        raise MeshFileError(
+            f"{path}: the OME-Zarr 'multiscales' metadata is incomplete ({type(exc).__name__}: {exc})"
+        ) from None
     if len(names) != len(array.shape) or not {"z", "y", "x"} <= set(names):
-        raise MeshFileError(f"{path}: an OME-Zarr image with axes z, y, x is needed; its axes are {names} for "
-                            f"shape {tuple(array.shape)}")
+        raise MeshFileError(
+            f"{path}: an OME-Zarr image with axes z, y, x is needed; its axes are {names} for "
+            f"shape {tuple(array.shape)}"
+        )
     selection: list[int | None] = []
     for name, n in zip(names, array.shape):
         if name in ("z", "y", "x"):
@@ -73,8 +76,10 @@ def _ome(path, group, multiscales):
         elif n == 1:
             selection.append(0)
         else:
-            raise MeshFileError(f"{path}: the OME-Zarr axis {name!r} has length {n}; one 3D image (z, y, x) is "
-                                "needed: save one time point and channel")
+            raise MeshFileError(
+                f"{path}: the OME-Zarr axis {name!r} has length {n}; one 3D image (z, y, x) is "
+                "needed: save one time point and channel"
+            )
     order = [names.index(name) for name in ("z", "y", "x")]
     if order != sorted(order):
         raise MeshFileError(f"{path}: the OME-Zarr axes are {names}; meshcurv reads them in the order z, y, x")
@@ -122,8 +127,10 @@ def read_zarr(path) -> tuple[LazyImage, tuple[float, float, float] | None, str |
             elif len(names) == 1:
                 node = node[names[0]]
             else:
-                raise MeshFileError(f"{path}: a Zarr group of several arrays (or none) needs one named 'labels', or "
-                                    f"OME-Zarr 'multiscales' metadata; found arrays {names}")
+                raise MeshFileError(
+                    f"{path}: a Zarr group of several arrays (or none) needs one named 'labels', or "
+                    f"OME-Zarr 'multiscales' metadata; found arrays {names}"
+                )
     if selection is None:
         shape = tuple(int(n) for n in node.shape)
         if len(shape) > 3 and sum(n != 1 for n in shape) <= 3:  # axes of length 1 dropped, as the other readers
@@ -133,6 +140,7 @@ def read_zarr(path) -> tuple[LazyImage, tuple[float, float, float] | None, str |
     try:
         image = LazyImage(node, axes=selection)
     except InvalidMeshError:
-        raise MeshFileError(f"{path}: a 3D image (z, y, x) is needed; the store holds shape "
-                            f"{tuple(int(n) for n in node.shape)}") from None
+        raise MeshFileError(
+            f"{path}: a 3D image (z, y, x) is needed; the store holds shape {tuple(int(n) for n in node.shape)}"
+        ) from None
     return image, spacing, unit

@@ -58,9 +58,7 @@ def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> di
     names = list(FIELDS) if fields is None else list(fields)
     unknown = [name for name in names if name not in FIELDS]
     if unknown:
-        raise InvalidOptionError(
-            f"unknown field {unknown[0]!r}; choose from {', '.join(FIELDS)}"
-        )
+        raise InvalidOptionError(f"unknown field {unknown[0]!r}; choose from {', '.join(FIELDS)}")
     if quality is not None and (quality not in FIELDS or quality in _NOT_FOR_QUALITY):
         scalars = [name for name in FIELDS if name not in _NOT_FOR_QUALITY]
         raise InvalidOptionError(f"`quality` must be a scalar field ({', '.join(scalars)}); got {quality!r}")
@@ -81,23 +79,28 @@ VIEWERS = {
     "ParaView / PyVista (VTK)": (
         (".vtp", ".vtu", ".vtk"),
         "every field by name, vectors as 3-component arrays; from .ply only the normals "
-        "(VTK's PLY reader reads no other vertex property)"),
+        "(VTK's PLY reader reads no other vertex property)",
+    ),
     "MeshLab / pymeshlab": (
         (".ply",),
         "one field, as the vertex quality (--quality; default mean), and the normals; "
-        "no other property of a PLY file (MeshLab reads no .vtk/.vtu/.vtp)"),
+        "no other property of a PLY file (MeshLab reads no .vtk/.vtu/.vtp)",
+    ),
     "meshio": (
         (".ply", ".vtu", ".vtk"),
-        "every field by name (from .ply, vectors split into _x, _y, _z); meshio has no .vtp reader"),
+        "every field by name (from .ply, vectors split into _x, _y, _z); meshio has no .vtp reader",
+    ),
     "trimesh": (
         (".ply",),
         'every field in mesh.metadata["_ply_raw"]["vertex"]["data"] (load with process=False to keep the '
-        "vertex order); vertex_attributes stay empty with every file: use CurvatureResult.to_trimesh"),
+        "vertex order); vertex_attributes stay empty with every file: use CurvatureResult.to_trimesh",
+    ),
     "pandas / spreadsheets": ((".csv",), "every field as columns, vectors split into _x, _y, _z"),
     "NumPy": ((".npz",), "every field as arrays, with the vertices and faces"),
     "meshcurv.io.fields.read_fields": (
         (".ply", ".vtp", ".npz", ".csv", ".vtu", ".vtk"),
-        "every field by name (float32 from .ply, float64 from the others)"),
+        "every field by name (float32 from .ply, float64 from the others)",
+    ),
 }
 
 
@@ -150,11 +153,19 @@ def read_fields(path) -> dict[str, np.ndarray]:
 
     path = pathlib.Path(path)
     suffix = path.suffix.lower()
-    readers = {".ply": _ply_fields, ".vtp": _vtp_fields, ".npz": _npz_fields, ".csv": _csv_fields,
-               ".vtk": _meshio_fields, ".vtu": _meshio_fields}
+    readers = {
+        ".ply": _ply_fields,
+        ".vtp": _vtp_fields,
+        ".npz": _npz_fields,
+        ".csv": _csv_fields,
+        ".vtk": _meshio_fields,
+        ".vtu": _meshio_fields,
+    }
     if suffix not in readers:
-        raise MeshFileError(f"{path}: no per-vertex fields in a {suffix or 'file without extension'}; "
-                            f"read_fields knows {', '.join(readers)}")
+        raise MeshFileError(
+            f"{path}: no per-vertex fields in a {suffix or 'file without extension'}; "
+            f"read_fields knows {', '.join(readers)}"
+        )
     check_input(path)
     columns = readers[suffix](path)
     return _regrouped(columns)
@@ -164,8 +175,11 @@ def _ply_fields(path):
     from ._ply import ply_vertex_columns
 
     # the vertex element alone: a point cloud's file (no faces) as well as a surface's
-    return {name: np.asarray(values, dtype=np.float64) for name, values in ply_vertex_columns(path).items()
-            if name not in ("x", "y", "z")}
+    return {
+        name: np.asarray(values, dtype=np.float64)
+        for name, values in ply_vertex_columns(path).items()
+        if name not in ("x", "y", "z")
+    }
 
 
 def _vtp_fields(path):
@@ -212,8 +226,9 @@ def _regrouped(columns: dict) -> dict[str, np.ndarray]:
             continue
         if name in ("nx", "ny", "nz") and all(key in columns for key in ("nx", "ny", "nz")):
             if name == "nx":
-                out["normals"] = np.column_stack([np.asarray(columns[key], dtype=np.float64)
-                                                  for key in ("nx", "ny", "nz")])
+                out["normals"] = np.column_stack(
+                    [np.asarray(columns[key], dtype=np.float64) for key in ("nx", "ny", "nz")]
+                )
             continue
         out[name] = values.astype(bool) if name == "valid" else values.astype(np.float64)
     return out
