@@ -93,9 +93,15 @@ def serial(inputs: pathlib.Path, out_dir: pathlib.Path, *, threads: int | None, 
         environment.pop("NUMBA_NUM_THREADS", None)
     else:
         environment.update(NUMBA_NUM_THREADS=str(threads), OMP_NUM_THREADS=str(threads))
-    children = [subprocess.Popen([sys.executable, __file__, "--serial-child", os.fspath(inputs), os.fspath(out_dir),
-                                  f"{part}/{parts}"], stdout=subprocess.PIPE, text=True, env=environment)
-                for part in range(parts)]
+    children = [
+        subprocess.Popen(
+            [sys.executable, __file__, "--serial-child", os.fspath(inputs), os.fspath(out_dir), f"{part}/{parts}"],
+            stdout=subprocess.PIPE,
+            text=True,
+            env=environment,
+        )
+        for part in range(parts)
+    ]
     outputs = [child.communicate()[0] for child in children]
     if any(child.returncode for child in children):
         raise RuntimeError("a serial loop failed")
@@ -104,8 +110,21 @@ def serial(inputs: pathlib.Path, out_dir: pathlib.Path, *, threads: int | None, 
 
 def whole_command(inputs: pathlib.Path, out_dir: pathlib.Path, workers: int) -> float:
     start = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "meshcurv", "batch", os.fspath(inputs), "-o", os.fspath(out_dir),
-                    "--workers", str(workers), "-q"], check=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "meshcurv",
+            "batch",
+            os.fspath(inputs),
+            "-o",
+            os.fspath(out_dir),
+            "--workers",
+            str(workers),
+            "-q",
+        ],
+        check=True,
+    )
     return time.perf_counter() - start
 
 
@@ -130,8 +149,13 @@ def warm_cluster(inputs: pathlib.Path, out_dir: pathlib.Path, workers: int) -> d
         closing = time.perf_counter()
     closed = time.perf_counter() - closing
     assert (summary["status"] == "computed").all(), summary["error"].unique()
-    return {"meshes": elapsed, "start": started, "warm_up": warmed, "close": closed,
-            "task_seconds": float(summary["seconds"].sum())}
+    return {
+        "meshes": elapsed,
+        "start": started,
+        "warm_up": warmed,
+        "close": closed,
+        "task_seconds": float(summary["seconds"].sum()),
+    }
 
 
 def versions() -> str:
@@ -168,8 +192,11 @@ def main(argv=None) -> int:
         for workers in (1, 2):
             figures[f"command_{workers}"] = whole_command(inputs, work / f"command_{workers}", workers)
             figures[f"warm_{workers}"] = warm_cluster(inputs, work / f"warm_{workers}", workers)
-            print(f"workers {workers}: {figures[f'command_{workers}']:.1f} s whole command, "
-                  f"{figures[f'warm_{workers}']['meshes']:.1f} s on a warm cluster", file=sys.stderr)
+            print(
+                f"workers {workers}: {figures[f'command_{workers}']:.1f} s whole command, "
+                f"{figures[f'warm_{workers}']['meshes']:.1f} s on a warm cluster",
+                file=sys.stderr,
+            )
     finally:
         shutil.rmtree(work, ignore_errors=True)
     load_after = os.getloadavg()
@@ -181,21 +208,39 @@ def main(argv=None) -> int:
     overhead = (figures["warm_1"]["meshes"] - serial_total) / n
     rows = [
         ("serial loop, NUMBA_NUM_THREADS=1", serial_total, f"per mesh {1000 * serial_total / n:.1f} ms"),
-        ("serial loop, numba's default threads", serial_default_total,
-         f"per mesh {1000 * serial_default_total / n:.1f} ms"),
+        (
+            "serial loop, numba's default threads",
+            serial_default_total,
+            f"per mesh {1000 * serial_default_total / n:.1f} ms",
+        ),
     ]
     # two loops at once, half the meshes each, each timed without its first mesh: what two cores of this
     # machine give without Dask, the best a 2-worker cluster can do
     side_by_side = max(loop["per_mesh"] * n / 2 for loop in figures["side_by_side"])
-    rows.append(("two serial loops side by side, half the meshes each (no Dask)", side_by_side,
-                 "the machine's own two-core speed-up: the ceiling for --workers 2"))
+    rows.append(
+        (
+            "two serial loops side by side, half the meshes each (no Dask)",
+            side_by_side,
+            "the machine's own two-core speed-up: the ceiling for --workers 2",
+        )
+    )
     for workers in (1, 2):
         warm = figures[f"warm_{workers}"]
-        rows.append((f"--workers {workers}, warm cluster (meshes only)", warm["meshes"],
-                     f"cluster start {warm['start']:.1f} s, kernels loaded {warm['warm_up']:.1f} s, "
-                     f"close {warm['close']:.1f} s (not included)"))
-        rows.append((f"`meshcurv batch --workers {workers}`, whole command", figures[f"command_{workers}"],
-                     "import, cluster start and close, summary included"))
+        rows.append(
+            (
+                f"--workers {workers}, warm cluster (meshes only)",
+                warm["meshes"],
+                f"cluster start {warm['start']:.1f} s, kernels loaded {warm['warm_up']:.1f} s, "
+                f"close {warm['close']:.1f} s (not included)",
+            )
+        )
+        rows.append(
+            (
+                f"`meshcurv batch --workers {workers}`, whole command",
+                figures[f"command_{workers}"],
+                "import, cluster start and close, summary included",
+            )
+        )
     speedup_warm = serial_total / figures["warm_2"]["meshes"]
     speedup_command = serial_total / figures["command_2"]
     lines = [

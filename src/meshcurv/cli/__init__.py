@@ -49,8 +49,11 @@ def main(argv=None) -> int:
     except ImportError as exc:
         if exc.name != "click":
             raise
-        print("meshcurv: error: the command line needs click (a dependency of meshcurv that cannot be imported): "
-              "pip install click", file=sys.stderr)
+        print(
+            "meshcurv: error: the command line needs click (a dependency of meshcurv that cannot be imported): "
+            "pip install click",
+            file=sys.stderr,
+        )
         return 1
     import click
 

@@ -22,8 +22,16 @@ from ..io.fields import FIELDS, curvature_fields
 from ..plotting import MAX_DPI
 from ..topology import MeshTopology
 from ._batch import batch
-from ._common import (SCALAR_FIELDS, Session, _default_method, _percentiles, common_options, current_session,
-                      estimated, method_options)
+from ._common import (
+    SCALAR_FIELDS,
+    Session,
+    _default_method,
+    _percentiles,
+    common_options,
+    current_session,
+    estimated,
+    method_options,
+)
 from ._view import view
 from ._volume import volume
 
@@ -36,8 +44,9 @@ def _fields(ctx, param, value):
     names = [name.strip() for name in value.split(",") if name.strip()]
     unknown = [name for name in names if name not in FIELDS]
     if unknown or not names:
-        raise click.BadParameter(f"unknown field {unknown[0] if unknown else value!r}; choose from "
-                                 f"{', '.join(FIELDS)} (separated by commas)")
+        raise click.BadParameter(
+            f"unknown field {unknown[0] if unknown else value!r}; choose from {', '.join(FIELDS)} (separated by commas)"
+        )
     return names
 
 
@@ -52,8 +61,9 @@ def _check_output(path: pathlib.Path, *, overwrite: bool, source, cloud: bool) -
         raise MeshFileError(f"{path}: unknown output extension {shown}; {what} fields are written to {known}")
     check_output(path, overwrite=overwrite, source=source)
     if suffix not in accepted:  # a mesh format without per-vertex fields (OBJ, STL, OFF)
-        raise MeshFileError(f"{path}: {FORMATS[suffix].name} files cannot hold per-vertex fields; write "
-                            f"{what} fields to {known}")
+        raise MeshFileError(
+            f"{path}: {FORMATS[suffix].name} files cannot hold per-vertex fields; write {what} fields to {known}"
+        )
 
 
 def output_extensions(*, cloud: bool) -> tuple:
@@ -74,8 +84,7 @@ def version_text() -> str:
         numba = importlib.metadata.version("numba")
     except importlib.metadata.PackageNotFoundError:
         numba = "not installed"
-    return (f"meshcurv {__version__} (backend {backend_name()}, numba {numba}, "
-            f"Python {platform.python_version()})")
+    return f"meshcurv {__version__} (backend {backend_name()}, numba {numba}, Python {platform.python_version()})"
 
 
 def _print_version(ctx, param, value):
@@ -85,8 +94,14 @@ def _print_version(ctx, param, value):
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
-              help="Show the version, the backend (numba or numpy) and numba's version, and exit.")
+@click.option(
+    "--version",
+    is_flag=True,
+    expose_value=False,
+    is_eager=True,
+    callback=_print_version,
+    help="Show the version, the backend (numba or numpy) and numba's version, and exit.",
+)
 @common_options
 def meshcurv():
     """Curvature of triangle meshes: principal curvatures and directions, mean and Gaussian curvature.
@@ -113,22 +128,38 @@ def _viewers_epilog() -> str:
     lines = ["\b", "Which file for which reader (what it keeps of the fields):"]
     for reader, (extensions, keeps) in VIEWERS.items():
         lines.append(f"  {reader}: {', '.join(extensions)}")
-        lines.extend(textwrap.wrap(keeps, width=78, initial_indent="      ", subsequent_indent="      ",
-                                   break_on_hyphens=False))
+        lines.extend(
+            textwrap.wrap(keeps, width=78, initial_indent="      ", subsequent_indent="      ", break_on_hyphens=False)
+        )
     return "\n".join(lines)
 
 
 @meshcurv.command(epilog=_viewers_epilog())
 @click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
-@click.option("-o", "--output", type=click.Path(readable=False, path_type=pathlib.Path), default=None,
-              help="Write the fields to .vtp (ParaView, PyVista), .ply (MeshLab: one field as quality; meshio, "
-                   "trimesh), .vtu/.vtk, .csv (pandas) or .npz (NumPy); see below. A point cloud's fields go to "
-                   ".ply, .xyz, .txt, .pts, .csv, .pcd, .las or .laz. Default: print a summary.")
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(readable=False, path_type=pathlib.Path),
+    default=None,
+    help="Write the fields to .vtp (ParaView, PyVista), .ply (MeshLab: one field as quality; meshio, "
+    "trimesh), .vtu/.vtk, .csv (pandas) or .npz (NumPy); see below. A point cloud's fields go to "
+    ".ply, .xyz, .txt, .pts, .csv, .pcd, .las or .laz. Default: print a summary.",
+)
 @method_options
-@click.option("--fields", callback=_fields, default=None, metavar="NAME,...",
-              help=f"Fields to write or summarise (default: all): {', '.join(FIELDS)}.")
-@click.option("--quality", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
-              help="Field copied as `quality`, the vertex property MeshLab colours by.")
+@click.option(
+    "--fields",
+    callback=_fields,
+    default=None,
+    metavar="NAME,...",
+    help=f"Fields to write or summarise (default: all): {', '.join(FIELDS)}.",
+)
+@click.option(
+    "--quality",
+    type=click.Choice(SCALAR_FIELDS),
+    default="mean",
+    show_default=True,
+    help="Field copied as `quality`, the vertex property MeshLab colours by.",
+)
 @click.option("--ascii", "ascii_", is_flag=True, help="ASCII rather than binary PLY, STL or VTK.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
 @common_options
@@ -142,35 +173,58 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
     session = current_session()
     if output is not None:
         _check_output(output, overwrite=overwrite, source=mesh, cloud=is_point_cloud(mesh))
-    with estimated(mesh, method, smoothing_steps, radius, orient, session,
-                   "write" if output is not None else "summary") as got:
+    with estimated(
+        mesh, method, smoothing_steps, radius, orient, session, "write" if output is not None else "summary"
+    ) as got:
         if output is not None and got.cloud:
-            write_point_curvatures(output, got.vertices, got.result, fields=fields, quality=quality,
-                                   overwrite=overwrite, source=mesh, binary=not ascii_)
+            write_point_curvatures(
+                output,
+                got.vertices,
+                got.result,
+                fields=fields,
+                quality=quality,
+                overwrite=overwrite,
+                source=mesh,
+                binary=not ascii_,
+            )
         elif output is not None:
-            write_curvatures(output, got.vertices, got.faces, got.result, fields=fields, quality=quality,
-                             overwrite=overwrite, source=mesh, binary=not ascii_)
+            write_curvatures(
+                output,
+                got.vertices,
+                got.faces,
+                got.result,
+                fields=fields,
+                quality=quality,
+                overwrite=overwrite,
+                source=mesh,
+                binary=not ascii_,
+            )
     if output is None:
         click.echo(_summary(mesh, got.vertices, 0 if got.cloud else len(got.faces), got.result, fields))
         return
     written = fields or list(FIELDS)
-    hint = (" (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
-            if output.suffix.lower() == ".ply" and not got.cloud else "")
-    session.info(f"wrote {output}: {len(got.vertices)} {'points' if got.cloud else 'vertices'}, fields "
-                 f"{', '.join(written)} (quality = {quality}){hint}")
+    hint = (
+        " (ParaView and PyVista read only the normals of a PLY file: write .vtp for them)"
+        if output.suffix.lower() == ".ply" and not got.cloud
+        else ""
+    )
+    session.info(
+        f"wrote {output}: {len(got.vertices)} {'points' if got.cloud else 'vertices'}, fields "
+        f"{', '.join(written)} (quality = {quality}){hint}"
+    )
 
 
 def _summary(path, vertices, n_faces: int, result, fields) -> str:
     """The summary table of ``meshcurv compute``: per-vertex and area-weighted statistics, then the integrals."""
     from ..integrals import weighted_statistics
 
-    parameters = ", ".join(f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
-                           for key, value in result.parameters.items())
+    parameters = ", ".join(
+        f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
+        for key, value in result.parameters.items()
+    )
     size = f"{len(vertices)} vertices, {n_faces} faces" if n_faces else f"{len(vertices)} points"
-    lines = [f"{path}: {size}; method {result.method}"
-             + (f" ({parameters})" if parameters else "")]
-    values = curvature_fields(result, fields=[f for f in (fields or SCALAR_FIELDS) if f in SCALAR_FIELDS],
-                              quality=None)
+    lines = [f"{path}: {size}; method {result.method}" + (f" ({parameters})" if parameters else "")]
+    values = curvature_fields(result, fields=[f for f in (fields or SCALAR_FIELDS) if f in SCALAR_FIELDS], quality=None)
     columns = ["min", "p5", "p25", "median", "p75", "p95", "max", "mean"]
     lines.append("per vertex (each vertex counts once: depends on the sampling density)")
     lines.append(f"{'field':<12}" + "".join(f"{name:>11}" for name in columns))
@@ -203,8 +257,10 @@ def _integrals_line(result) -> str:
     check = f" = {gaussian / np.pi:.4f} pi" + (f"; 2 pi chi = {2 * chi} pi" if closed and chi is not None else "")
     willmore = result.integral("willmore", where=result.valid)
     partial = "" if result.valid.all() else " over the valid vertices"
-    return (f"integrals: area {result.integral('area'):.6g}, total mean curvature {result.integral('mean'):.6g}, "
-            f"total Gaussian curvature {gaussian:.6g}{check}, Willmore energy{partial} {willmore:.6g}")
+    return (
+        f"integrals: area {result.integral('area'):.6g}, total mean curvature {result.integral('mean'):.6g}, "
+        f"total Gaussian curvature {gaussian:.6g}{check}, Willmore energy{partial} {willmore:.6g}"
+    )
 
 
 def _views(ctx, param, values):
@@ -215,8 +271,10 @@ def _views(ctx, param, values):
             continue
         for name in filter(None, (part.strip() for part in value.split(","))):
             if name != "auto" and name not in _plotting_views():
-                raise click.BadParameter(f"unknown view {name!r}; choose auto, {', '.join(_plotting_views())}, "
-                                         "or ELEVATION,AZIMUTH in degrees")
+                raise click.BadParameter(
+                    f"unknown view {name!r}; choose auto, {', '.join(_plotting_views())}, "
+                    "or ELEVATION,AZIMUTH in degrees"
+                )
             views.append(name)
     return views or ["auto"]
 
@@ -245,35 +303,99 @@ def _limits(ctx, param, value):
 
 @meshcurv.command()
 @click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
-@click.option("-o", "--output", type=click.Path(readable=False, path_type=pathlib.Path), default=None,
-              help="The PNG to write (default: MESH-NAME_FIELD.png in the current folder).")
-@click.option("-f", "--field", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
-              help="The field that colours the mesh.")
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(readable=False, path_type=pathlib.Path),
+    default=None,
+    help="The PNG to write (default: MESH-NAME_FIELD.png in the current folder).",
+)
+@click.option(
+    "-f",
+    "--field",
+    type=click.Choice(SCALAR_FIELDS),
+    default="mean",
+    show_default=True,
+    help="The field that colours the mesh.",
+)
 @method_options
-@click.option("--view", "views", multiple=True, callback=_views, metavar="VIEW",
-              help="auto (several views of a closed mesh, one of an open one), names separated by commas "
-                   "(iso, front, back, left, right, top, bottom, iso-back) or ELEVATION,AZIMUTH; repeatable.")
-@click.option("--up", type=click.Choice(["auto", "y", "z", "x"]), default="auto", show_default=True,
-              help="The axis drawn upwards; auto: z when the mesh is more than 1.2 times as tall along z as "
-                   "along y, else y (most OBJ and PLY files).")
-@click.option("--directions", type=click.Choice(["none", "max", "min", "both"]), default="none",
-              show_default=True, help="Strokes along the principal directions.")
-@click.option("--percentiles", callback=_percentiles, default="2,98", show_default=True, metavar="LOW,HIGH",
-              help="Colour limits as percentiles of the field (symmetric about 0 for a signed field).")
-@click.option("--limits", callback=_limits, default=None, metavar="LOW,HIGH",
-              help="Fixed colour limits (e.g. -5,5), to compare pictures of several meshes; replaces "
-                   "--percentiles.")
-@click.option("--cmap", default=None, metavar="NAME",
-              help="A matplotlib colour map (default: RdBu_r for signed limits, viridis otherwise).")
-@click.option("--dpi", type=click.IntRange(min=10, max=MAX_DPI), default=None,
-              help="Resolution of the PNG (default 150): one view is 4.5 x 4.2 inches, n views "
-                   "(3.3 n + 1.2) x 4.2.")
-@click.option("--pixels", type=click.IntRange(min=100, max=20000), default=None,
-              help="Width of the PNG in pixels (sets the resolution; instead of --dpi).")
+@click.option(
+    "--view",
+    "views",
+    multiple=True,
+    callback=_views,
+    metavar="VIEW",
+    help="auto (several views of a closed mesh, one of an open one), names separated by commas "
+    "(iso, front, back, left, right, top, bottom, iso-back) or ELEVATION,AZIMUTH; repeatable.",
+)
+@click.option(
+    "--up",
+    type=click.Choice(["auto", "y", "z", "x"]),
+    default="auto",
+    show_default=True,
+    help="The axis drawn upwards; auto: z when the mesh is more than 1.2 times as tall along z as "
+    "along y, else y (most OBJ and PLY files).",
+)
+@click.option(
+    "--directions",
+    type=click.Choice(["none", "max", "min", "both"]),
+    default="none",
+    show_default=True,
+    help="Strokes along the principal directions.",
+)
+@click.option(
+    "--percentiles",
+    callback=_percentiles,
+    default="2,98",
+    show_default=True,
+    metavar="LOW,HIGH",
+    help="Colour limits as percentiles of the field (symmetric about 0 for a signed field).",
+)
+@click.option(
+    "--limits",
+    callback=_limits,
+    default=None,
+    metavar="LOW,HIGH",
+    help="Fixed colour limits (e.g. -5,5), to compare pictures of several meshes; replaces --percentiles.",
+)
+@click.option(
+    "--cmap",
+    default=None,
+    metavar="NAME",
+    help="A matplotlib colour map (default: RdBu_r for signed limits, viridis otherwise).",
+)
+@click.option(
+    "--dpi",
+    type=click.IntRange(min=10, max=MAX_DPI),
+    default=None,
+    help="Resolution of the PNG (default 150): one view is 4.5 x 4.2 inches, n views (3.3 n + 1.2) x 4.2.",
+)
+@click.option(
+    "--pixels",
+    type=click.IntRange(min=100, max=20000),
+    default=None,
+    help="Width of the PNG in pixels (sets the resolution; instead of --dpi).",
+)
 @click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
 @common_options
-def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up, directions, percentiles,
-         limits, cmap, dpi, pixels, overwrite):
+def plot(
+    mesh,
+    output,
+    field,
+    method,
+    smoothing_steps,
+    radius,
+    orient,
+    views,
+    up,
+    directions,
+    percentiles,
+    limits,
+    cmap,
+    dpi,
+    pixels,
+    overwrite,
+):
     """Draw MESH coloured by a curvature field, with a colour bar."""
     from ..plotting import _PANEL_INCHES, _EXTRA_INCHES, _pyplot, choose_up, plot_field, save_figure
 
@@ -302,13 +424,27 @@ def plot(mesh, output, field, method, smoothing_steps, radius, orient, views, up
         if pixels is not None:
             dpi = pixels / (_PANEL_INCHES * len(views) + _EXTRA_INCHES)
             dpi = max(10, min(MAX_DPI, round(dpi)))
-        strokes = {"max": {"k_max": result.dir_max}, "min": {"k_min": result.dir_min},
-                   "both": {"k_max": result.dir_max, "k_min": result.dir_min}}.get(directions)
+        strokes = {
+            "max": {"k_max": result.dir_max},
+            "min": {"k_min": result.dir_min},
+            "both": {"k_max": result.dir_max, "k_min": result.dir_min},
+        }.get(directions)
         values = curvature_fields(result, fields=[field], quality=None)[field]
-        figure = plot_field(vertices, triangles, values, view=views, up=up, percentiles=percentiles, limits=limits,
-                            cmap=cmap, label=f"{field}: {FIELDS[field]}", directions=strokes,
-                            dpi=dpi if dpi is not None else DEFAULT_DPI, title=f"{mesh.name}, method {result.method}",
-                            normals=result.normals if cloud else None)
+        figure = plot_field(
+            vertices,
+            triangles,
+            values,
+            view=views,
+            up=up,
+            percentiles=percentiles,
+            limits=limits,
+            cmap=cmap,
+            label=f"{field}: {FIELDS[field]}",
+            directions=strokes,
+            dpi=dpi if dpi is not None else DEFAULT_DPI,
+            title=f"{mesh.name}, method {result.method}",
+            normals=result.normals if cloud else None,
+        )
         if pixels is not None:  # exactly the width asked: the size in inches follows the rounded dpi
             width, height = figure.get_size_inches()
             figure.set_size_inches(pixels / figure.dpi, height * pixels / figure.dpi / width)
@@ -356,9 +492,11 @@ def methods():
     for name, estimator in ESTIMATORS.items():
         marker = " (default)" if name == default else ""
         lines.append(f"{name:<{width}}{estimator.summary}{marker}")
-        options = [f"--{option.replace('_', '-')} "
-                   + (f"(default {value})" if value is not None else "(default: from the mesh)")
-                   for option, value in estimator.options.items()]
+        options = [
+            f"--{option.replace('_', '-')} "
+            + (f"(default {value})" if value is not None else "(default: from the mesh)")
+            for option, value in estimator.options.items()
+        ]
         lines.append(" " * width + "options: " + (", ".join(options) if options else "none"))
     click.echo("\n".join(lines))
 

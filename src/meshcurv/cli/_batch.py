@@ -32,26 +32,65 @@ class BatchBar(ProgressBar):
 
 @click.command("batch")
 @click.argument("inputs", nargs=-1, required=True)
-@click.option("-o", "--output-dir", "out_dir", required=True,
-              type=click.Path(readable=False, path_type=pathlib.Path),
-              help="Folder of the results and of summary.parquet / summary.csv (created if needed).")
+@click.option(
+    "-o",
+    "--output-dir",
+    "out_dir",
+    required=True,
+    type=click.Path(readable=False, path_type=pathlib.Path),
+    help="Folder of the results and of summary.parquet / summary.csv (created if needed).",
+)
 @method_options
-@click.option("--format", "output_format", type=click.Choice(OUTPUT_FORMATS), default="ply", show_default=True,
-              help="Format of the result files.")
-@click.option("--workers", type=click.IntRange(min=1, max=MAX_WORKERS), default=None,
-              help="Worker processes of the local cluster (default: one per core).")
-@click.option("--scheduler", metavar="ADDRESS", default=None,
-              help="Run on an existing Dask cluster, e.g. tcp://host:8786, instead of a local one.")
+@click.option(
+    "--format",
+    "output_format",
+    type=click.Choice(OUTPUT_FORMATS),
+    default="ply",
+    show_default=True,
+    help="Format of the result files.",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1, max=MAX_WORKERS),
+    default=None,
+    help="Worker processes of the local cluster (default: one per core).",
+)
+@click.option(
+    "--scheduler",
+    metavar="ADDRESS",
+    default=None,
+    help="Run on an existing Dask cluster, e.g. tcp://host:8786, instead of a local one.",
+)
 @click.option("--overwrite", is_flag=True, help="Compute again the meshes whose results exist.")
-@click.option("--timeout", type=click.FloatRange(min=0, max=1e9), default=DEFAULT_TIMEOUT, show_default=True,
-              metavar="SECONDS", help="Time limit of one mesh; a mesh over it fails as timed out "
-                                      "(its worker is restarted). 0: no limit.")
-@click.option("--retry-failed", is_flag=True,
-              help="Compute again the meshes that failed in an earlier run (by default their recorded "
-                   "failure is reported; a changed input is always computed again).")
+@click.option(
+    "--timeout",
+    type=click.FloatRange(min=0, max=1e9),
+    default=DEFAULT_TIMEOUT,
+    show_default=True,
+    metavar="SECONDS",
+    help="Time limit of one mesh; a mesh over it fails as timed out (its worker is restarted). 0: no limit.",
+)
+@click.option(
+    "--retry-failed",
+    is_flag=True,
+    help="Compute again the meshes that failed in an earlier run (by default their recorded "
+    "failure is reported; a changed input is always computed again).",
+)
 @common_options
-def batch(inputs, out_dir, method, smoothing_steps, radius, orient, output_format, workers, scheduler, overwrite,
-          timeout, retry_failed):
+def batch(
+    inputs,
+    out_dir,
+    method,
+    smoothing_steps,
+    radius,
+    orient,
+    output_format,
+    workers,
+    scheduler,
+    overwrite,
+    timeout,
+    retry_failed,
+):
     """Curvatures of many meshes on Dask: INPUTS are files, folders and glob patterns.
 
     \b
@@ -71,21 +110,36 @@ def batch(inputs, out_dir, method, smoothing_steps, radius, orient, output_forma
     Exits with 1 when a mesh failed (the summary has its error).
     """
     if workers is not None and scheduler is not None:
-        raise click.UsageError("--workers sizes the local cluster; leave it out with --scheduler "
-                               "(the cluster's own workers are used)")
+        raise click.UsageError(
+            "--workers sizes the local cluster; leave it out with --scheduler (the cluster's own workers are used)"
+        )
     session = current_session()
     bar = session.bar(BatchBar)
     try:
-        summary = run(list(inputs), out_dir, method=method, smoothing_steps=smoothing_steps, radius=radius,
-                      orient=orient, output_format=output_format, workers=workers, scheduler=scheduler,
-                      overwrite=overwrite, timeout=timeout or None, retry_failed=retry_failed, progress=bar)
+        summary = run(
+            list(inputs),
+            out_dir,
+            method=method,
+            smoothing_steps=smoothing_steps,
+            radius=radius,
+            orient=orient,
+            output_format=output_format,
+            workers=workers,
+            scheduler=scheduler,
+            overwrite=overwrite,
+            timeout=timeout or None,
+            retry_failed=retry_failed,
+            progress=bar,
+        )
     finally:
         bar.close()
     counts = summary["status"].value_counts()
     failures = summary[summary["status"] == "failed"]
-    session.info(f"{len(summary)} meshes: {counts.get('computed', 0)} computed, {counts.get('skipped', 0)} skipped "
-                 f"(done before), {len(failures)} failed; summary in {out_dir / 'summary.parquet'} and "
-                 f"{out_dir / 'summary.csv'}")
+    session.info(
+        f"{len(summary)} meshes: {counts.get('computed', 0)} computed, {counts.get('skipped', 0)} skipped "
+        f"(done before), {len(failures)} failed; summary in {out_dir / 'summary.parquet'} and "
+        f"{out_dir / 'summary.csv'}"
+    )
     not_written = summary.attrs.get("not_written")
     if failures.empty and not not_written:
         return 0
@@ -94,8 +148,10 @@ def batch(inputs, out_dir, method, smoothing_steps, radius, orient, output_forma
     if len(failures) > _SHOWN_FAILURES:
         click.echo(f"meshcurv: ... and {len(failures) - _SHOWN_FAILURES} more (see the summary)", err=True)
     if not failures.empty and not retry_failed:
-        session.info("meshes that failed before are reported, not tried again, until their file changes "
-                     "(--retry-failed tries them)")
+        session.info(
+            "meshes that failed before are reported, not tried again, until their file changes "
+            "(--retry-failed tries them)"
+        )
     if not failures.empty:
         click.echo(f"meshcurv: error: {len(failures)} of {len(summary)} meshes failed", err=True)
     if not_written:

@@ -120,14 +120,36 @@ def _store(ctx, param, value):
 def common_options(function):
     """-v/-q/--debug/--progress, accepted before or after the command name."""
     options = [
-        click.option("-v", "--verbose", count=True, expose_value=False, callback=_store,
-                     help="More messages on stderr (-v: stages, -vv: debug)."),
-        click.option("-q", "--quiet", count=True, expose_value=False, callback=_store,
-                     help="Fewer messages: no warnings (-q), only errors."),
-        click.option("--debug", is_flag=True, expose_value=False, callback=_store,
-                     help="Show the traceback when something fails."),
-        click.option("--progress/--no-progress", default=None, expose_value=False, callback=_store,
-                     help="Progress bar on stderr (default: only when stderr is a terminal)."),
+        click.option(
+            "-v",
+            "--verbose",
+            count=True,
+            expose_value=False,
+            callback=_store,
+            help="More messages on stderr (-v: stages, -vv: debug).",
+        ),
+        click.option(
+            "-q",
+            "--quiet",
+            count=True,
+            expose_value=False,
+            callback=_store,
+            help="Fewer messages: no warnings (-q), only errors.",
+        ),
+        click.option(
+            "--debug",
+            is_flag=True,
+            expose_value=False,
+            callback=_store,
+            help="Show the traceback when something fails.",
+        ),
+        click.option(
+            "--progress/--no-progress",
+            default=None,
+            expose_value=False,
+            callback=_store,
+            help="Progress bar on stderr (default: only when stderr is a terminal).",
+        ),
     ]
     for option in reversed(options):
         function = option(function)
@@ -156,16 +178,33 @@ def _default_method() -> str:
 def method_options(function):
     """--method and the estimator options, passed on only when given."""
     options = [
-        click.option("-m", "--method", type=MethodChoice(), default=_default_method(), show_default=True,
-                     help="Curvature estimator (see `meshcurv methods`)."),
-        click.option("--smoothing-steps", type=click.IntRange(min=0, max=MAX_SMOOTHING_STEPS), default=None,
-                     help=f"Passes of 1-ring smoothing (normal_cycle, matgeom; default 3; at most "
-                          f"{MAX_SMOOTHING_STEPS})."),
-        click.option("--radius", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
-                     help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
-                          "default from the mesh: see `meshcurv methods`)."),
-        click.option("--orient", type=click.Choice(["auto", "outward", "consistent", "keep"]), default=None,
-                     help="Reorient the faces first (default: auto = outward, keep for matgeom)."),
+        click.option(
+            "-m",
+            "--method",
+            type=MethodChoice(),
+            default=_default_method(),
+            show_default=True,
+            help="Curvature estimator (see `meshcurv methods`).",
+        ),
+        click.option(
+            "--smoothing-steps",
+            type=click.IntRange(min=0, max=MAX_SMOOTHING_STEPS),
+            default=None,
+            help=f"Passes of 1-ring smoothing (normal_cycle, matgeom; default 3; at most {MAX_SMOOTHING_STEPS}).",
+        ),
+        click.option(
+            "--radius",
+            type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX),
+            default=None,
+            help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
+            "default from the mesh: see `meshcurv methods`).",
+        ),
+        click.option(
+            "--orient",
+            type=click.Choice(["auto", "outward", "consistent", "keep"]),
+            default=None,
+            help="Reorient the faces first (default: auto = outward, keep for matgeom).",
+        ),
     ]
     for option in reversed(options):
         function = option(function)
@@ -178,10 +217,12 @@ def _estimate(vertices, faces, method, options, bar):
     for name in given:
         if name != "orient" and name not in takes:
             accepted = ", ".join(f"--{option.replace('_', '-')}" for option in takes) or "none"
-            raise click.UsageError(f"method {method!r} does not take --{name.replace('_', '-')} "
-                                   f"(its options: {accepted})")
-    return principal_curvatures(vertices, faces, method=method, **given,
-                                progress=lambda stage, index, total: bar(stage, index, total, offset=1))
+            raise click.UsageError(
+                f"method {method!r} does not take --{name.replace('_', '-')} (its options: {accepted})"
+            )
+    return principal_curvatures(
+        vertices, faces, method=method, **given, progress=lambda stage, index, total: bar(stage, index, total, offset=1)
+    )
 
 
 def _percentiles(ctx, param, value):
@@ -197,8 +238,9 @@ def _percentiles(ctx, param, value):
 def _check_point_cloud_options(path, method, smoothing_steps, orient) -> None:
     """Refuse the options of meshes for a point cloud (``method`` None when not given)."""
     if method is not None and method not in POINT_CLOUD_METHODS:
-        raise click.UsageError(f"method {method!r} needs faces; {path} is a point cloud (methods: "
-                               f"{', '.join(POINT_CLOUD_METHODS)})")
+        raise click.UsageError(
+            f"method {method!r} needs faces; {path} is a point cloud (methods: {', '.join(POINT_CLOUD_METHODS)})"
+        )
     for name, value in (("smoothing-steps", smoothing_steps), ("orient", orient)):
         if value is not None:
             raise click.UsageError(f"--{name} is for meshes; {path} is a point cloud")
@@ -275,8 +317,9 @@ def estimated(path, method, smoothing_steps, radius, orient, session: Session, l
     if cloud:
         _check_point_cloud_options(path, method if given_method else None, smoothing_steps, orient)
     elif method in POINT_CLOUD_METHODS:
-        raise click.UsageError(f"method {method!r} is for point clouds; {path} is a mesh (methods: "
-                               f"{', '.join(ESTIMATORS)})")
+        raise click.UsageError(
+            f"method {method!r} is for point clouds; {path} is a mesh (methods: {', '.join(ESTIMATORS)})"
+        )
     stages = ["read", *([] if cloud else ESTIMATORS[method].stages), last_stage]
     bar = session.bar(StageBar, stages)
     try:
@@ -284,8 +327,9 @@ def estimated(path, method, smoothing_steps, radius, orient, session: Session, l
         if cloud:
             vertices, normals = read_points(path)
             faces = topology = None
-            result = point_cloud_curvatures(vertices, normals=normals, radius=radius,
-                                            method=method if given_method else None)
+            result = point_cloud_curvatures(
+                vertices, normals=normals, radius=radius, method=method if given_method else None
+            )
         else:
             vertices, faces = read_mesh(path)
             # triangulated (and warned about) once: the estimate takes the topology as it is

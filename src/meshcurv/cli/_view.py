@@ -14,25 +14,71 @@ __all__ = ["view"]
 
 @click.command("view")
 @click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
-@click.option("-o", "--output", type=click.Path(readable=False, path_type=pathlib.Path), default=None,
-              help="The page to write (default: MESH-NAME.html in the current folder).")
-@click.option("-f", "--field", type=click.Choice(VIEWER_FIELDS), default="mean", show_default=True,
-              help="The field shown first (the page has a menu of all of them).")
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(readable=False, path_type=pathlib.Path),
+    default=None,
+    help="The page to write (default: MESH-NAME.html in the current folder).",
+)
+@click.option(
+    "-f",
+    "--field",
+    type=click.Choice(VIEWER_FIELDS),
+    default="mean",
+    show_default=True,
+    help="The field shown first (the page has a menu of all of them).",
+)
 @method_options
-@click.option("--up", type=click.Choice(["auto", "y", "z", "x"]), default="auto", show_default=True,
-              help="The axis drawn upwards at first; auto: z when the mesh is clearly taller along z than "
-                   "along y, else y (most OBJ and PLY files).")
-@click.option("--percentiles", callback=_percentiles, default="2,98", show_default=True, metavar="LOW,HIGH",
-              help="Default colour limits as percentiles of each field (symmetric for signed fields).")
-@click.option("--directions", "max_directions", type=click.IntRange(min=0, max=10**7), default=20000,
-              show_default=True, help="Principal directions at most at this many vertices, evenly spread.")
-@click.option("--unit", "length_unit", default=None, metavar="UNIT",
-              help="The unit of the coordinates (mm, um, ...) for the colour bar: 1/UNIT.")
+@click.option(
+    "--up",
+    type=click.Choice(["auto", "y", "z", "x"]),
+    default="auto",
+    show_default=True,
+    help="The axis drawn upwards at first; auto: z when the mesh is clearly taller along z than "
+    "along y, else y (most OBJ and PLY files).",
+)
+@click.option(
+    "--percentiles",
+    callback=_percentiles,
+    default="2,98",
+    show_default=True,
+    metavar="LOW,HIGH",
+    help="Default colour limits as percentiles of each field (symmetric for signed fields).",
+)
+@click.option(
+    "--directions",
+    "max_directions",
+    type=click.IntRange(min=0, max=10**7),
+    default=20000,
+    show_default=True,
+    help="Principal directions at most at this many vertices, evenly spread.",
+)
+@click.option(
+    "--unit",
+    "length_unit",
+    default=None,
+    metavar="UNIT",
+    help="The unit of the coordinates (mm, um, ...) for the colour bar: 1/UNIT.",
+)
 @click.option("--title", default=None, help="The page's heading (default: the file name).")
 @click.option("--overwrite", is_flag=True, help="Replace an existing page.")
 @common_options
-def view(mesh, output, field, method, smoothing_steps, radius, orient, up, percentiles, max_directions,
-         length_unit, title, overwrite):
+def view(
+    mesh,
+    output,
+    field,
+    method,
+    smoothing_steps,
+    radius,
+    orient,
+    up,
+    percentiles,
+    max_directions,
+    length_unit,
+    title,
+    overwrite,
+):
     """Write MESH (a mesh or a point cloud) and its curvatures as one interactive HTML page.
 
     \b
@@ -58,9 +104,22 @@ def view(mesh, output, field, method, smoothing_steps, radius, orient, up, perce
     with estimated(mesh, method, smoothing_steps, radius, orient, session, "page") as got:
         vertices, result = got.vertices, got.result
         faces = None if got.topology is None else got.topology.faces
-        write_html(output, vertices, faces, result, field=field, title=title or mesh.name,
-                   up=None if up == "auto" else up, percentiles=percentiles, max_directions=max_directions,
-                   length_unit=length_unit, overwrite=overwrite, source=mesh)
+        write_html(
+            output,
+            vertices,
+            faces,
+            result,
+            field=field,
+            title=title or mesh.name,
+            up=None if up == "auto" else up,
+            percentiles=percentiles,
+            max_directions=max_directions,
+            length_unit=length_unit,
+            overwrite=overwrite,
+            source=mesh,
+        )
     size = output.stat().st_size / 1e6
-    session.info(f"wrote {output} ({size:.1f} MB, {len(vertices)} {'points' if faces is None else 'vertices'}); "
-                 "open it in a browser")
+    session.info(
+        f"wrote {output} ({size:.1f} MB, {len(vertices)} {'points' if faces is None else 'vertices'}); "
+        "open it in a browser"
+    )

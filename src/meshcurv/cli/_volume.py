@@ -55,40 +55,114 @@ def _label_list(ctx, param, value):
 
 @click.command("volume")
 @click.argument("image", type=click.Path(readable=False, path_type=pathlib.Path))
-@click.option("-o", "--output-dir", "out_dir", required=True, type=click.Path(readable=False, path_type=pathlib.Path),
-              help="Folder of the table, pictures and meshes (created if needed).")
-@click.option("--spacing", nargs=3, type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
-              metavar="Z Y X", help="Voxel size along image axes 0, 1, 2 (default: from the file, "
-                                    "else 1 1 1).")
-@click.option("--labels", "labels_to_use", callback=_label_list, default=None, metavar="N,...",
-              help="Only these labels (default: every label in the image).")
-@click.option("-m", "--method", type=MethodChoice(), default=None,
-              help="Curvature estimator (default: icc, with a radius chosen for voxel surfaces).")
-@click.option("--radius", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
-              help="Ball radius in physical units (default: per label, from its voxels and curvature).")
-@click.option("--threshold", type=float, default=None, metavar="T",
-              help="IMAGE is a probability map: the voxels greater than T are the objects, split into connected "
-                   "components (voxels sharing a face); not for Zarr stores.")
-@click.option("--smooth", type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX), default=None,
-              metavar="SIGMA", help="Blur each object's mask with a Gaussian of this standard deviation, in the "
-                                    "unit of the voxel size, before its surface is extracted (shrinks objects by "
-                                    "about SIGMA^2/R).")
-@click.option("--meshes", "mesh_format", type=click.Choice(MESH_FORMATS), default=None,
-              help="Also write one mesh file per label with its curvature fields, in this format.")
-@click.option("--objects/--no-objects", "objects", default=True, show_default=True,
-              help="One VTP file of all objects' surfaces, OUTDIR/<name>_objects.vtp, with a 'label' per point "
-                   "and per cell beside the curvature fields (ParaView colours by object).")
-@click.option("--picture/--no-picture", default=True, show_default=True,
-              help="A picture of all objects coloured by --field (needs matplotlib).")
-@click.option("-f", "--field", type=click.Choice(SCALAR_FIELDS), default="mean", show_default=True,
-              help="The field of the picture.")
-@click.option("--workers", type=click.IntRange(min=1, max=MAX_WORKERS), default=None,
-              help="Compute the labels on a local Dask cluster of this many processes (needs "
-                   "meshcurv[batch]; default: one label after the other in this process).")
+@click.option(
+    "-o",
+    "--output-dir",
+    "out_dir",
+    required=True,
+    type=click.Path(readable=False, path_type=pathlib.Path),
+    help="Folder of the table, pictures and meshes (created if needed).",
+)
+@click.option(
+    "--spacing",
+    nargs=3,
+    type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX),
+    default=None,
+    metavar="Z Y X",
+    help="Voxel size along image axes 0, 1, 2 (default: from the file, else 1 1 1).",
+)
+@click.option(
+    "--labels",
+    "labels_to_use",
+    callback=_label_list,
+    default=None,
+    metavar="N,...",
+    help="Only these labels (default: every label in the image).",
+)
+@click.option(
+    "-m",
+    "--method",
+    type=MethodChoice(),
+    default=None,
+    help="Curvature estimator (default: icc, with a radius chosen for voxel surfaces).",
+)
+@click.option(
+    "--radius",
+    type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX),
+    default=None,
+    help="Ball radius in physical units (default: per label, from its voxels and curvature).",
+)
+@click.option(
+    "--threshold",
+    type=float,
+    default=None,
+    metavar="T",
+    help="IMAGE is a probability map: the voxels greater than T are the objects, split into connected "
+    "components (voxels sharing a face); not for Zarr stores.",
+)
+@click.option(
+    "--smooth",
+    type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX),
+    default=None,
+    metavar="SIGMA",
+    help="Blur each object's mask with a Gaussian of this standard deviation, in the "
+    "unit of the voxel size, before its surface is extracted (shrinks objects by "
+    "about SIGMA^2/R).",
+)
+@click.option(
+    "--meshes",
+    "mesh_format",
+    type=click.Choice(MESH_FORMATS),
+    default=None,
+    help="Also write one mesh file per label with its curvature fields, in this format.",
+)
+@click.option(
+    "--objects/--no-objects",
+    "objects",
+    default=True,
+    show_default=True,
+    help="One VTP file of all objects' surfaces, OUTDIR/<name>_objects.vtp, with a 'label' per point "
+    "and per cell beside the curvature fields (ParaView colours by object).",
+)
+@click.option(
+    "--picture/--no-picture",
+    default=True,
+    show_default=True,
+    help="A picture of all objects coloured by --field (needs matplotlib).",
+)
+@click.option(
+    "-f",
+    "--field",
+    type=click.Choice(SCALAR_FIELDS),
+    default="mean",
+    show_default=True,
+    help="The field of the picture.",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1, max=MAX_WORKERS),
+    default=None,
+    help="Compute the labels on a local Dask cluster of this many processes (needs "
+    "meshcurv[batch]; default: one label after the other in this process).",
+)
 @click.option("--overwrite", is_flag=True, help="Replace existing outputs.")
 @common_options
-def volume(image, out_dir, spacing, labels_to_use, method, radius, threshold, smooth, mesh_format, objects, picture,
-           field, workers, overwrite):
+def volume(
+    image,
+    out_dir,
+    spacing,
+    labels_to_use,
+    method,
+    radius,
+    threshold,
+    smooth,
+    mesh_format,
+    objects,
+    picture,
+    field,
+    workers,
+    overwrite,
+):
     """Curvature of every object of a 3D label image: one table row per label.
 
     \b
@@ -151,12 +225,21 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, threshold, sm
             session.info(f"{image}: no voxel size in the file; using 1 1 1 (give --spacing Z Y X)")
         else:
             unit = f" {read.unit}" if read.unit else ""
-            session.info(f"{image}: voxel size {' x '.join(f'{s:g}' for s in spacing)}{unit} (z y x) from the file"
-                         + (f"; lengths in the table in {read.unit}" if read.unit else ""))
-    total, labels = volume_module.label_surfaces(read.array, spacing=spacing, labels_to_use=labels_to_use,
-                                                 method=method, radius=radius, threshold=threshold, smooth=smooth,
-                                                 keep_surfaces=mesh_format is not None or picture or objects,
-                                                 workers=workers)
+            session.info(
+                f"{image}: voxel size {' x '.join(f'{s:g}' for s in spacing)}{unit} (z y x) from the file"
+                + (f"; lengths in the table in {read.unit}" if read.unit else "")
+            )
+    total, labels = volume_module.label_surfaces(
+        read.array,
+        spacing=spacing,
+        labels_to_use=labels_to_use,
+        method=method,
+        radius=radius,
+        threshold=threshold,
+        smooth=smooth,
+        keep_surfaces=mesh_format is not None or picture or objects,
+        workers=workers,
+    )
     bar = session.bar(LabelBar)
     rows: list[dict] = []
     drawn: list[tuple] = []
@@ -167,8 +250,14 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, threshold, sm
                 if writer is not None:
                     writer.add(*_object_piece(surface))
                 if mesh_format is not None:
-                    write_curvatures(out_dir / f"{stem}_label_{surface.label}.{mesh_format}", surface.vertices,
-                                     surface.faces, surface.result, overwrite=overwrite, source=image)
+                    write_curvatures(
+                        out_dir / f"{stem}_label_{surface.label}.{mesh_format}",
+                        surface.vertices,
+                        surface.faces,
+                        surface.result,
+                        overwrite=overwrite,
+                        source=image,
+                    )
                 if picture:
                     values = np.where(surface.used, getattr(surface.result, field), np.nan)
                     drawn.append((surface.vertices, surface.faces, values))
@@ -190,10 +279,13 @@ def volume(image, out_dir, spacing, labels_to_use, method, radius, threshold, sm
         _draw(drawn, picture_path, field=field, title=f"{image.name}: {len(drawn)} objects", overwrite=overwrite)
     counts = table["status"].value_counts()
     written = ", ".join(str(path) for path in tables if parquet or path.suffix != ".parquet")
-    session.info(f"{len(table)} labels: " + ", ".join(f"{int(counts.get(s, 0))} {s}" for s in
-                                                      ("ok", "empty", "too_small", "failed")) + f"; table in {written}"
-                 + (f"; picture {picture_path}" if picture and drawn else "")
-                 + (f"; surfaces in {objects_path}" if objects else ""))
+    session.info(
+        f"{len(table)} labels: "
+        + ", ".join(f"{int(counts.get(s, 0))} {s}" for s in ("ok", "empty", "too_small", "failed"))
+        + f"; table in {written}"
+        + (f"; picture {picture_path}" if picture and drawn else "")
+        + (f"; surfaces in {objects_path}" if objects else "")
+    )
     failures = table[table["status"] == "failed"]
     if failures.empty:
         return 0
@@ -229,9 +321,12 @@ def _object_piece(surface):
     from ..io.fields import curvature_fields
 
     n_vertices, n_faces = surface.vertices.shape[0], surface.faces.shape[0]
-    point_data = {**curvature_fields(surface.result), "label": np.full(n_vertices, surface.label, dtype=np.uint64),
-                  "used": np.asarray(surface.used, dtype=np.uint8),
-                  "vertex_area": np.asarray(surface.vertex_areas, dtype=np.float64)}
+    point_data = {
+        **curvature_fields(surface.result),
+        "label": np.full(n_vertices, surface.label, dtype=np.uint64),
+        "used": np.asarray(surface.used, dtype=np.uint8),
+        "vertex_area": np.asarray(surface.vertex_areas, dtype=np.float64),
+    }
     return surface.vertices, surface.faces, point_data, {"label": np.full(n_faces, surface.label, dtype=np.uint64)}
 
 
@@ -253,6 +348,7 @@ def _draw(drawn, path: pathlib.Path, *, field: str, title: str, overwrite: bool)
     faces = np.concatenate([faces + offset for (_, faces, _), offset in zip(drawn, offsets)])
     values = np.concatenate([values for _, _, values in drawn])
     # image axis 0 (z) upwards
-    figure = plot_field(vertices, faces, values, view=["iso", "top"], up="x", label=f"{field}: {FIELDS[field]}",
-                        title=title)
+    figure = plot_field(
+        vertices, faces, values, view=["iso", "top"], up="x", label=f"{field}: {FIELDS[field]}", title=title
+    )
     save_figure(figure, path, overwrite=overwrite)
