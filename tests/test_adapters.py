@@ -35,8 +35,10 @@ def test_pyvista_polydata_and_its_split_corners():
     same(meshcurv.principal_curvatures(pv.PolyData(SPHERE.vertices, flat)))
     # what pyvista.read makes of an OBJ with normals: every corner its own point (welded back, same values)
     corners = SPHERE.faces.ravel()
-    split = pv.PolyData(SPHERE.vertices[corners], np.c_[np.full(SPHERE.faces.shape[0], 3),
-                                                        np.arange(corners.size).reshape(-1, 3)].ravel())
+    split = pv.PolyData(
+        SPHERE.vertices[corners],
+        np.c_[np.full(SPHERE.faces.shape[0], 3), np.arange(corners.size).reshape(-1, 3)].ravel(),
+    )
     with pytest.warns(meshcurv.MeshQualityWarning, match="welded"):
         r = meshcurv.principal_curvatures(split)
     np.testing.assert_allclose(r.k_max, reference().k_max[corners], rtol=1e-9)  # vertex order differs: round-off
@@ -55,8 +57,9 @@ def test_open3d_triangle_mesh():
     stand_in = types.SimpleNamespace(vertices=SPHERE.vertices.tolist(), triangles=SPHERE.faces.tolist())
     same(meshcurv.principal_curvatures(stand_in))
     o3d = pytest.importorskip("open3d")
-    mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(SPHERE.vertices),
-                                     o3d.utility.Vector3iVector(SPHERE.faces))
+    mesh = o3d.geometry.TriangleMesh(
+        o3d.utility.Vector3dVector(SPHERE.vertices), o3d.utility.Vector3iVector(SPHERE.faces)
+    )
     same(meshcurv.principal_curvatures(mesh))
 
 
@@ -86,17 +89,22 @@ def test_pyvista_unstructured_grid_of_quads_pixels_triangles_and_lines():
     quads = np.asarray(torus.quads)
     expected = meshcurv.principal_curvatures(torus.vertices, torus.faces)
     # a pixel's corners run 0, 1, 3, 2; lines and vertices are left out, as a PolyData's are
-    cells = {pv.CellType.QUAD: quads[:-2], pv.CellType.PIXEL: quads[-2:-1, [0, 1, 3, 2]],
-             pv.CellType.TRIANGLE: np.array([quads[-1, :3], quads[-1, [0, 2, 3]]]),
-             pv.CellType.LINE: quads[:4, :2], pv.CellType.VERTEX: quads[:2, :1]}
+    cells = {
+        pv.CellType.QUAD: quads[:-2],
+        pv.CellType.PIXEL: quads[-2:-1, [0, 1, 3, 2]],
+        pv.CellType.TRIANGLE: np.array([quads[-1, :3], quads[-1, [0, 2, 3]]]),
+        pv.CellType.LINE: quads[:4, :2],
+        pv.CellType.VERTEX: quads[:2, :1],
+    }
     with pytest.warns(meshcurv.TriangulationWarning):
         result = meshcurv.principal_curvatures(pv.UnstructuredGrid(cells, torus.vertices))
     # the same triangles as the torus's own split of its quads (a, b, c), (a, c, d)
     np.testing.assert_allclose(result.k_max, expected.k_max, rtol=1e-9, atol=1e-12)
     assert np.median(np.abs(result.mean - torus.mean)) < 0.02
     # all quads and a pixel: one (F, 4) array
-    grid = pv.UnstructuredGrid({pv.CellType.QUAD: quads[1:], pv.CellType.PIXEL: quads[:1, [0, 1, 3, 2]]},
-                               torus.vertices)
+    grid = pv.UnstructuredGrid(
+        {pv.CellType.QUAD: quads[1:], pv.CellType.PIXEL: quads[:1, [0, 1, 3, 2]]}, torus.vertices
+    )
     with pytest.warns(meshcurv.TriangulationWarning):
         result = meshcurv.principal_curvatures(grid)
     np.testing.assert_allclose(result.k_max, expected.k_max, rtol=1e-9, atol=1e-12)
@@ -104,10 +112,15 @@ def test_pyvista_unstructured_grid_of_quads_pixels_triangles_and_lines():
 
 def test_pyvista_unstructured_grid_of_volume_cells_is_refused():
     pv = pytest.importorskip("pyvista")
-    tetra = pv.UnstructuredGrid({pv.CellType.TETRA: np.array([[0, 1, 2, 3], [1, 2, 3, 4]]),
-                                 pv.CellType.TRIANGLE: np.array([[0, 1, 2]])}, np.r_[np.eye(4, 3), [[1, 1, 1]]])
-    with pytest.raises(InvalidMeshError, match=r"the UnstructuredGrid has cells that are not surface polygons "
-                                               r"\(2 tetra\); .*`grid.extract_surface\(\).triangulate\(\)`"):
+    tetra = pv.UnstructuredGrid(
+        {pv.CellType.TETRA: np.array([[0, 1, 2, 3], [1, 2, 3, 4]]), pv.CellType.TRIANGLE: np.array([[0, 1, 2]])},
+        np.r_[np.eye(4, 3), [[1, 1, 1]]],
+    )
+    with pytest.raises(
+        InvalidMeshError,
+        match=r"the UnstructuredGrid has cells that are not surface polygons "
+        r"\(2 tetra\); .*`grid.extract_surface\(\).triangulate\(\)`",
+    ):
         meshcurv.principal_curvatures(tetra)
     lines = pv.UnstructuredGrid({pv.CellType.LINE: np.array([[0, 1], [1, 2]])}, np.eye(3))
     with pytest.raises(InvalidMeshError, match=r"the UnstructuredGrid has no surface cells .* it has 2 line"):
@@ -121,8 +134,11 @@ def test_pyvista_unstructured_grid_of_volume_cells_is_refused():
 
 def test_a_point_object_without_faces_is_sent_to_the_point_cloud_function():
     stand_in = types.SimpleNamespace(points=SPHERE.vertices)
-    with pytest.raises(InvalidMeshError, match="`vertices` is a SimpleNamespace, which has points but no faces; "
-                                               "for a point cloud use meshcurv.point_cloud_curvatures"):
+    with pytest.raises(
+        InvalidMeshError,
+        match="`vertices` is a SimpleNamespace, which has points but no faces; "
+        "for a point cloud use meshcurv.point_cloud_curvatures",
+    ):
         meshcurv.principal_curvatures(stand_in)
 
 
@@ -159,8 +175,11 @@ def test_point_clouds_from_trimesh_objects_and_duck_types():
 
 
 def test_an_unknown_point_object_is_refused_with_a_clear_message():
-    with pytest.raises(InvalidMeshError, match=r"`points` is a dict, not an array of shape \(N, 3\), nor an object "
-                                               r"with a `.points` or `.vertices` array"):
+    with pytest.raises(
+        InvalidMeshError,
+        match=r"`points` is a dict, not an array of shape \(N, 3\), nor an object "
+        r"with a `.points` or `.vertices` array",
+    ):
         meshcurv.point_cloud_curvatures({"x": 1})
 
 
@@ -209,8 +228,9 @@ def test_to_pyvista_polygons_and_errors():
     soup = SPHERE.vertices[SPHERE.faces].reshape(-1, 3)
     with pytest.warns(meshcurv.MeshQualityWarning, match="welded"):
         welded = meshcurv.principal_curvatures(soup, np.arange(soup.shape[0]).reshape(-1, 3))
-    with pytest.raises(InvalidMeshError, match="to_pyvista: pass the mesh the result was computed on; its mesh "
-                                               "was welded"):
+    with pytest.raises(
+        InvalidMeshError, match="to_pyvista: pass the mesh the result was computed on; its mesh was welded"
+    ):
         welded.to_pyvista()
     assert pv.PolyData  # the module was there: the errors above are meshcurv's
 
@@ -235,8 +255,21 @@ def test_to_dataframe_one_row_per_vertex():
     r = reference()
     frame = r.to_dataframe()
     assert isinstance(frame, pd.DataFrame) and len(frame) == SPHERE.vertices.shape[0]
-    assert list(frame.columns) == [*SCALARS, "dir_min_x", "dir_min_y", "dir_min_z", "dir_max_x", "dir_max_y",
-                                   "dir_max_z", "normals_x", "normals_y", "normals_z", "valid", "radius", "vertex_area"]
+    assert list(frame.columns) == [
+        *SCALARS,
+        "dir_min_x",
+        "dir_min_y",
+        "dir_min_z",
+        "dir_max_x",
+        "dir_max_y",
+        "dir_max_z",
+        "normals_x",
+        "normals_y",
+        "normals_z",
+        "valid",
+        "radius",
+        "vertex_area",
+    ]
     assert frame["valid"].dtype == bool
     np.testing.assert_array_equal(frame["normals_y"], r.normals[:, 1])
     corners = SPHERE.vertices[SPHERE.faces]
@@ -245,8 +278,9 @@ def test_to_dataframe_one_row_per_vertex():
     assert list(r.to_dataframe(fields=["mean"]).columns) == ["mean"]
 
 
-@pytest.mark.parametrize("method, module", [("to_pyvista", "pyvista"), ("to_trimesh", "trimesh"),
-                                            ("to_dataframe", "pandas")])
+@pytest.mark.parametrize(
+    "method, module", [("to_pyvista", "pyvista"), ("to_trimesh", "trimesh"), ("to_dataframe", "pandas")]
+)
 def test_missing_library_names_what_to_install(monkeypatch, method, module):
     import sys
 

@@ -122,10 +122,10 @@ def test_reindexing_and_flip():
     r = meshcurv.principal_curvatures(mesh.vertices[permutation], inverse[mesh.faces], method="normal_cycle")
     for field in ("area", "mean", "gaussian", "willmore"):
         assert r.integral(field) == pytest.approx(base.integral(field), rel=1e-9)
-    np.testing.assert_allclose(r.vertex_integrals("mean"), base.vertex_integrals("mean")[permutation],
-                               rtol=1e-9, atol=1e-12)
-    flipped = meshcurv.principal_curvatures(mesh.vertices, mesh.faces[:, ::-1], method="normal_cycle",
-                                            orient="keep")
+    np.testing.assert_allclose(
+        r.vertex_integrals("mean"), base.vertex_integrals("mean")[permutation], rtol=1e-9, atol=1e-12
+    )
+    flipped = meshcurv.principal_curvatures(mesh.vertices, mesh.faces[:, ::-1], method="normal_cycle", orient="keep")
     assert flipped.integral("mean") == pytest.approx(-base.integral("mean"), rel=1e-9)
     assert flipped.integral("gaussian") == pytest.approx(base.integral("gaussian"), rel=1e-9)
 
@@ -236,8 +236,9 @@ def test_weighted_percentiles():
 
     values = np.random.default_rng(1).normal(size=200)
     q = [0, 5, 25, 50, 75, 95, 100]
-    np.testing.assert_allclose(weighted_percentiles(values, np.ones(200), q),
-                               np.percentile(values, q, method="inverted_cdf"), rtol=1e-12)
+    np.testing.assert_allclose(
+        weighted_percentiles(values, np.ones(200), q), np.percentile(values, q, method="inverted_cdf"), rtol=1e-12
+    )
     # a value that holds more than half of the weight is the median
     weights = np.ones(200)
     weights[7] = 300.0
@@ -245,8 +246,9 @@ def test_weighted_percentiles():
     # a weight of 2 counts as the value twice
     weights = np.where(np.arange(200) < 50, 2.0, 1.0)
     doubled = np.concatenate([values, values[:50]])
-    np.testing.assert_allclose(weighted_percentiles(values, weights, q),
-                               np.percentile(doubled, q, method="inverted_cdf"), rtol=1e-12)
+    np.testing.assert_allclose(
+        weighted_percentiles(values, weights, q), np.percentile(doubled, q, method="inverted_cdf"), rtol=1e-12
+    )
     # NaN values and zero weights are left out
     figures = weighted_statistics(np.append(values, [np.nan, 1e9]), np.append(weights, [1.0, 0.0]))
     assert figures["mean"] == pytest.approx(np.mean(doubled), rel=1e-12)

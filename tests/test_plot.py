@@ -58,8 +58,16 @@ def test_camera_is_a_rotation_and_front_looks_from_minus_y():
 
 def test_plot_field_several_views_colour_bar_and_legend():
     torus = meshcurv.shapes.torus(n_major=24, n_minor=12)
-    fig = plot_field(torus.vertices, torus.faces, torus.gaussian, view=["iso", "top", (10, 20)], label="K",
-                     directions={"k_max": torus.dir_max, "k_min": torus.dir_min}, pixels=120, title="t")
+    fig = plot_field(
+        torus.vertices,
+        torus.faces,
+        torus.gaussian,
+        view=["iso", "top", (10, 20)],
+        label="K",
+        directions={"k_max": torus.dir_max, "k_min": torus.dir_min},
+        pixels=120,
+        title="t",
+    )
     assert len(fig.axes) == 4  # three views and the colour bar
     bar = fig.axes[-1]
     low, high = bar.get_ylim()
@@ -77,8 +85,16 @@ def test_plot_field_unsigned_into_given_axes_and_quads():
     torus = meshcurv.shapes.torus(n_major=12, n_minor=8)
     fig, ax = plt.subplots()
     with pytest.warns(meshcurv.TriangulationWarning):
-        out = plot_field(torus.vertices, torus.quads, np.abs(torus.gaussian) + 1, ax=ax, view="front",
-                         directions=torus.dir_max, pixels=60, percentiles=(0, 100))
+        out = plot_field(
+            torus.vertices,
+            torus.quads,
+            np.abs(torus.gaussian) + 1,
+            ax=ax,
+            view="front",
+            directions=torus.dir_max,
+            pixels=60,
+            percentiles=(0, 100),
+        )
     assert out is fig
     assert "centred" not in fig.axes[-1].get_ylabel()
     assert fig.axes[-1].get_ylim()[0] > 0
@@ -98,8 +114,10 @@ def test_save_figure_is_atomic_and_refuses_to_overwrite(tmp_path):
     [
         ({"values": np.zeros(5)}, r"`values` must have shape \(96,\), one per vertex; got \(5,\)"),
         ({"directions": np.zeros((5, 3))}, r"`directions` arrays must have shape \(96, 3\); got \(5, 3\)"),
-        ({"directions": {"a": np.zeros((96, 3)), "b": np.zeros((96, 3)), "c": np.zeros((96, 3))}},
-         "`directions` takes at most two fields; got 3"),
+        (
+            {"directions": {"a": np.zeros((96, 3)), "b": np.zeros((96, 3)), "c": np.zeros((96, 3))}},
+            "`directions` takes at most two fields; got 3",
+        ),
         ({"view": "sideways"}, "unknown view 'sideways'; choose one of iso, front"),
         ({"view": [(1, 2, 3)]}, r"a view is a name or \(elevation, azimuth\) in degrees"),
         ({"view": []}, "`view` is empty"),
@@ -123,6 +141,7 @@ def test_plot_field_errors(options, message):
 
 
 # --- point clouds: discs of each point's spacing, the nearest point per pixel ------------------------
+
 
 def grid_points(z, half, n):
     u = np.linspace(-half, half, n)

@@ -66,13 +66,16 @@ def test_fixed_limits_and_colour_map():
     assert np.median((seen @ viridis.T).max(axis=1)) < np.median((seen @ unit.T).max(axis=1))
 
 
-@pytest.mark.parametrize(("options", "message"), [
-    ({"cmap": "no-such-map"}, "unknown colour map 'no-such-map'; choose a name of matplotlib.colormaps"),
-    ({"limits": (1.0, -1.0)}, r"`limits` must be finite with low < high; got \(1.0, -1.0\)"),
-    ({"limits": (0.0, np.inf)}, "`limits` must be finite with low < high"),
-    ({"limits": "wide"}, "`limits` must be"),
-    ({"dpi": 5}, "`dpi` must be an integer between 10 and 1200; got 5"),
-])
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"cmap": "no-such-map"}, "unknown colour map 'no-such-map'; choose a name of matplotlib.colormaps"),
+        ({"limits": (1.0, -1.0)}, r"`limits` must be finite with low < high; got \(1.0, -1.0\)"),
+        ({"limits": (0.0, np.inf)}, "`limits` must be finite with low < high"),
+        ({"limits": "wide"}, "`limits` must be"),
+        ({"dpi": 5}, "`dpi` must be an integer between 10 and 1200; got 5"),
+    ],
+)
 def test_errors(options, message):
     with pytest.raises(InvalidOptionError, match=message):
         plot_field(TORUS.vertices, TORUS.faces, TORUS.mean, pixels=40, **options)
@@ -115,7 +118,7 @@ def test_the_backend_and_pyplot_are_left_alone(tmp_path):
         import meshcurv
         from meshcurv.plotting import plot_field, save_figure
         t = meshcurv.shapes.torus(n_major=12, n_minor=8)
-        save_figure(plot_field(t.vertices, t.faces, t.mean, pixels=40), {str(tmp_path / 'p.png')!r})
+        save_figure(plot_field(t.vertices, t.faces, t.mean, pixels=40), {str(tmp_path / "p.png")!r})
         print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
     """)
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)

@@ -81,6 +81,7 @@ def test_torus_and_cylinder_closed_forms():
 
 # -- marching-cubes meshes of voxelised solids (the `volume` extra) -------------------
 
+
 @pytest.fixture
 def skimage():
     return pytest.importorskip("skimage")

@@ -37,9 +37,15 @@ def exact_result(shape, *, invalid=()) -> CurvatureResult:
     def nan_where_invalid(values):
         return np.where(valid.reshape((-1,) + (1,) * (np.ndim(values) - 1)), values, np.nan)
 
-    return CurvatureResult(k_min=nan_where_invalid(shape.k_min), k_max=nan_where_invalid(shape.k_max),
-                           dir_min=nan_where_invalid(shape.dir_min), dir_max=nan_where_invalid(shape.dir_max),
-                           normals=shape.normals, valid=valid, method="exact")
+    return CurvatureResult(
+        k_min=nan_where_invalid(shape.k_min),
+        k_max=nan_where_invalid(shape.k_max),
+        dir_min=nan_where_invalid(shape.dir_min),
+        dir_max=nan_where_invalid(shape.dir_max),
+        normals=shape.normals,
+        valid=valid,
+        method="exact",
+    )
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +54,7 @@ def torus():
 
 
 # ---- the page's contents ----------------------------------------------------------------------------------------
+
 
 def test_page_is_self_contained(tmp_path, torus):
     page = write_html(tmp_path / "torus.html", torus.vertices, torus.faces, exact_result(torus))
@@ -77,8 +84,7 @@ def test_round_trip_of_a_mesh(tmp_path, torus):
     assert (meta["field"], meta["title"], meta["method"]) == ("gaussian", "a torus", "exact")
     # positions: float32 relative to the box centre, so the error is float32's of the mesh's extent, not of 2e4
     extent = np.ptp(vertices, axis=0).max()
-    np.testing.assert_allclose(arrays["positions"] + np.array(meta["offset"]), vertices, rtol=0,
-                               atol=extent * 2.0**-23)
+    np.testing.assert_allclose(arrays["positions"] + np.array(meta["offset"]), vertices, rtol=0, atol=extent * 2.0**-23)
     np.testing.assert_array_equal(arrays["faces"], faces)
     np.testing.assert_array_equal(arrays["k_min"], result.k_min.astype(np.float32))
     np.testing.assert_array_equal(arrays["k_max"], result.k_max.astype(np.float32))
@@ -146,8 +152,15 @@ def test_page_limits_leave_out_invalid_vertices(tmp_path):
     k[7] = 1e6  # a wild number at a vertex marked invalid (as matgeom keeps them)
     valid = np.ones(len(k), dtype=bool)
     valid[7] = False
-    result = CurvatureResult(k_min=result.k_min, k_max=k, dir_min=result.dir_min, dir_max=result.dir_max,
-                             normals=result.normals, valid=valid, method="exact")
+    result = CurvatureResult(
+        k_min=result.k_min,
+        k_max=k,
+        dir_min=result.dir_min,
+        dir_max=result.dir_max,
+        normals=result.normals,
+        valid=valid,
+        method="exact",
+    )
     meta, _ = read_page_data(write_html(tmp_path / "s.html", sphere.vertices, sphere.faces, result))
     limits = {name: spec["limits"] for name, spec in meta["fields"].items()}
     np.testing.assert_allclose(limits["k_max"], (-0.5, 0.5))
@@ -159,16 +172,18 @@ def test_page_limits_leave_out_invalid_vertices(tmp_path):
 
 
 def test_length_unit_on_the_colour_bar(tmp_path, torus):
-    meta, _ = read_page_data(write_html(tmp_path / "t.html", torus.vertices, torus.faces, exact_result(torus),
-                                        length_unit="mm"))
+    meta, _ = read_page_data(
+        write_html(tmp_path / "t.html", torus.vertices, torus.faces, exact_result(torus), length_unit="mm")
+    )
     assert meta["fields"]["mean"]["unit"] == "1/mm" and meta["fields"]["gaussian"]["unit"] == "1/mm²"
 
 
 def test_direction_subsample_is_even_and_bounded(tmp_path):
     torus = meshcurv.shapes.torus(n_major=200, n_minor=100)
     result = exact_result(torus)
-    meta, arrays = read_page_data(write_html(tmp_path / "t.html", torus.vertices, torus.faces, result,
-                                             max_directions=1000))
+    meta, arrays = read_page_data(
+        write_html(tmp_path / "t.html", torus.vertices, torus.faces, result, max_directions=1000)
+    )
     chosen = arrays["direction_vertices"]
     assert 600 <= len(chosen) <= 1000 and len(np.unique(chosen)) == len(chosen)
     # spread in space: on this torus an even sample of 1000 has a nearest neighbour at about
@@ -203,6 +218,7 @@ def test_title_cannot_close_the_script(tmp_path, torus):
 
 # ---- writing: atomic, never over an existing file unless asked -------------------------------------------------
 
+
 def test_existing_page_is_kept_unless_overwrite(tmp_path, torus):
     path = tmp_path / "t.html"
     path.write_text("mine")
@@ -233,18 +249,22 @@ def test_page_never_replaces_its_source(tmp_path, torus):
 
 # ---- bad input -------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("options, error, match", [
-    ({"field": "k_mean"}, InvalidOptionError, "field"),
-    ({"up": "w"}, InvalidOptionError, "up"),
-    ({"percentiles": (98, 2)}, InvalidOptionError, "0 <= low < high <= 100"),
-    ({"percentiles": (2, 101)}, InvalidOptionError, "0 <= low < high <= 100"),
-    ({"percentiles": (2,)}, InvalidOptionError, "two numbers"),
-    ({"max_directions": -1}, InvalidOptionError, "max_directions"),
-    ({"max_directions": 2.5}, InvalidOptionError, "max_directions"),
-    ({"max_directions": True}, InvalidOptionError, "max_directions"),
-    ({"elevation": float("nan")}, InvalidOptionError, "elevation"),
-    ({"azimuth": "left"}, InvalidOptionError, "azimuth"),
-])
+
+@pytest.mark.parametrize(
+    "options, error, match",
+    [
+        ({"field": "k_mean"}, InvalidOptionError, "field"),
+        ({"up": "w"}, InvalidOptionError, "up"),
+        ({"percentiles": (98, 2)}, InvalidOptionError, "0 <= low < high <= 100"),
+        ({"percentiles": (2, 101)}, InvalidOptionError, "0 <= low < high <= 100"),
+        ({"percentiles": (2,)}, InvalidOptionError, "two numbers"),
+        ({"max_directions": -1}, InvalidOptionError, "max_directions"),
+        ({"max_directions": 2.5}, InvalidOptionError, "max_directions"),
+        ({"max_directions": True}, InvalidOptionError, "max_directions"),
+        ({"elevation": float("nan")}, InvalidOptionError, "elevation"),
+        ({"azimuth": "left"}, InvalidOptionError, "azimuth"),
+    ],
+)
 def test_bad_options(tmp_path, torus, options, error, match):
     with pytest.raises(error, match=match):
         write_html(tmp_path / "t.html", torus.vertices, torus.faces, exact_result(torus), **options)
@@ -278,6 +298,7 @@ def test_array_too_large_for_a_browser(tmp_path, torus, monkeypatch):
 
 
 # ---- the command -------------------------------------------------------------------------------------------------
+
 
 def run_view(args):
     """``meshcurv view ARGS`` in-process (click's CliRunner, the group's Session as meshcurv.cli.main makes it)."""
@@ -321,17 +342,22 @@ def test_cli_point_cloud(tmp_path):
     meta, arrays = read_page_data(tmp_path / "cloud.html")
     assert meta["kind"] == "points" and meta["method"] == "corrected_measures"
     assert len(arrays["direction_vertices"]) <= 50
-    assert "--smoothing-steps is for meshes" in run_view([cloud, "-o", tmp_path / "c2.html",
-                                                         "--smoothing-steps", "2"]).output
+    assert (
+        "--smoothing-steps is for meshes"
+        in run_view([cloud, "-o", tmp_path / "c2.html", "--smoothing-steps", "2"]).output
+    )
 
 
-@pytest.mark.parametrize("args, message", [
-    (["-o", "page.png"], "the page is an HTML file"),
-    (["-m", "jets"], "is for point clouds"),
-    (["-f", "volume"], "Invalid value for '-f'"),
-    (["--directions", "-3"], "Invalid value for '--directions'"),
-    (["--percentiles", "90,10"], "LOW < HIGH"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["-o", "page.png"], "the page is an HTML file"),
+        (["-m", "jets"], "is for point clouds"),
+        (["-f", "volume"], "Invalid value for '-f'"),
+        (["--directions", "-3"], "Invalid value for '--directions'"),
+        (["--percentiles", "90,10"], "LOW < HIGH"),
+    ],
+)
 def test_cli_usage_errors(tmp_path, torus_file, args, message):
     done = run_view([torus_file, *[tmp_path / arg if arg.endswith(".png") else arg for arg in args]])
     assert done.exit_code == 2 and message in done.output
@@ -345,8 +371,9 @@ def test_cli_missing_mesh(tmp_path):
 
 # ---- in a real browser -------------------------------------------------------------------------------------------
 
-CHROMIUM = next((shutil.which(name) for name in ("chromium", "chromium-browser", "google-chrome")
-                 if shutil.which(name)), None)
+CHROMIUM = next(
+    (shutil.which(name) for name in ("chromium", "chromium-browser", "google-chrome") if shutil.which(name)), None
+)
 needs_browser = pytest.mark.skipif(CHROMIUM is None, reason="no chromium (apt-get install chromium)")
 
 
@@ -356,8 +383,15 @@ class Chromium:
     def __init__(self, width: int = 900, height: int = 700, *, flags=()):
         to_browser, self._writer = os.pipe()
         self._reader, from_browser = os.pipe()
-        flags = ["--headless=new", "--remote-debugging-pipe", "--no-first-run", "--hide-scrollbars",
-                 "--enable-unsafe-swiftshader", f"--window-size={width},{height}", *flags]
+        flags = [
+            "--headless=new",
+            "--remote-debugging-pipe",
+            "--no-first-run",
+            "--hide-scrollbars",
+            "--enable-unsafe-swiftshader",
+            f"--window-size={width},{height}",
+            *flags,
+        ]
         if os.geteuid() == 0:
             flags.append("--no-sandbox")  # Chromium refuses to run as root with its sandbox
 
@@ -366,8 +400,13 @@ class Chromium:
             os.dup2(ends[0], 3)
             os.dup2(ends[1], 4)
 
-        self.process = subprocess.Popen([CHROMIUM, *flags, "about:blank"], preexec_fn=pipe_fds, pass_fds=(3, 4),
-                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.process = subprocess.Popen(
+            [CHROMIUM, *flags, "about:blank"],
+            preexec_fn=pipe_fds,
+            pass_fds=(3, 4),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         os.close(to_browser)
         os.close(from_browser)
         self._buffer, self._count = b"", 0
@@ -418,8 +457,10 @@ class Chromium:
             state = self.evaluate("document.getElementById('status')?.dataset.state")
             if state in ("ok", "error"):
                 seconds = time.perf_counter() - start
-                return self.evaluate("({...document.getElementById('status').dataset, "
-                                     "text: document.getElementById('status').textContent})"), seconds
+                return self.evaluate(
+                    "({...document.getElementById('status').dataset, "
+                    "text: document.getElementById('status').textContent})"
+                ), seconds
             time.sleep(0.05)
         raise TimeoutError(f"{url}: no status after {timeout} s")
 
@@ -458,7 +499,7 @@ def browser():
 def beside_panel(browser, image: np.ndarray) -> np.ndarray:
     """The part of a screenshot right of the page's control panel (which has a colour bar of its own)."""
     right = browser.evaluate("document.getElementById('panel').getBoundingClientRect().right")
-    return image[:, int(np.ceil(right)) + 1:]
+    return image[:, int(np.ceil(right)) + 1 :]
 
 
 def colour_fractions(image: np.ndarray) -> tuple[float, float]:
@@ -472,8 +513,15 @@ def colour_fractions(image: np.ndarray) -> tuple[float, float]:
 @pytest.mark.slow
 @needs_browser
 def test_browser_torus_gaussian(tmp_path, browser, torus):
-    page = write_html(tmp_path / "torus.html", torus.vertices, torus.faces, exact_result(torus), field="gaussian",
-                      up="z", title="torus")
+    page = write_html(
+        tmp_path / "torus.html",
+        torus.vertices,
+        torus.faces,
+        exact_result(torus),
+        field="gaussian",
+        up="z",
+        title="torus",
+    )
     facts, _ = browser.open(page.as_uri())
     assert facts["state"] == "ok", facts["text"]
     assert facts["field"] == "gaussian" and float(facts["low"]) == -float(facts["high"])
@@ -550,8 +598,10 @@ def test_browser_mouse_and_controls(tmp_path, browser, torus):
     browser.mouse("mouseWheel", 600, 400, deltaX=0, deltaY=200)
     assert browser.evaluate("meshcurvViewer.state.distance") > distance  # wheel down: farther
     # the field menu: the colour bar follows, with the field's unit, and the address keeps the choice
-    address = browser.evaluate("(() => { const menu = document.getElementById('field'); menu.value = 'curvedness';"
-                               " menu.dispatchEvent(new Event('change')); return location.hash; })()")
+    address = browser.evaluate(
+        "(() => { const menu = document.getElementById('field'); menu.value = 'curvedness';"
+        " menu.dispatchEvent(new Event('change')); return location.hash; })()"
+    )
     assert address.startswith("#field=curvedness&lo=")
     assert "[1/length]" in browser.evaluate("document.getElementById('bar-label').textContent")
     limits = [float(part.split("=")[1]) for part in address.split("&")[1:3]]
@@ -566,7 +616,7 @@ def test_browser_reports_a_damaged_page(tmp_path, browser, torus):
     page = write_html(tmp_path / "torus.html", torus.vertices, torus.faces, exact_result(torus))
     text = page.read_text(encoding="utf-8")
     start = text.index('id="array-k_min">') + len('id="array-k_min">')
-    page.write_text(text[:start] + text[start + 400:], encoding="utf-8")  # 300 bytes of k_min gone
+    page.write_text(text[:start] + text[start + 400 :], encoding="utf-8")  # 300 bytes of k_min gone
     facts, _ = browser.open(page.as_uri())
     assert facts["state"] == "error" and "array-k_min" in facts["text"] and "expected 14400" in facts["text"]
     assert "error" in browser.evaluate("document.title")
@@ -613,8 +663,7 @@ def test_browser_point_cloud(tmp_path, browser):
 @needs_browser
 def test_browser_million_vertices_open_within_10_seconds(tmp_path, browser):
     torus = meshcurv.shapes.torus(n_major=1000, n_minor=1000)
-    page = write_html(tmp_path / "big.html", torus.vertices, torus.faces, exact_result(torus), field="gaussian",
-                      up="z")
+    page = write_html(tmp_path / "big.html", torus.vertices, torus.faces, exact_result(torus), field="gaussian", up="z")
     size = page.stat().st_size
     facts, seconds = browser.open(page.as_uri())
     assert facts["state"] == "ok", facts["text"]
@@ -622,8 +671,10 @@ def test_browser_million_vertices_open_within_10_seconds(tmp_path, browser):
     red, blue = colour_fractions(beside_panel(browser, browser.screenshot(tmp_path / "big.png")))
     assert red > 0.03 and blue > 0.01
     frame = browser.evaluate("meshcurvViewer.timeFrames(2)")
-    print(f"\n1M vertices: {size / 1e6:.1f} MB, open {seconds:.2f} s (first frame at {facts['openMs']} ms in the page), "
-          f"{frame:.0f} ms a frame, renderer {facts['renderer']}")
+    print(
+        f"\n1M vertices: {size / 1e6:.1f} MB, open {seconds:.2f} s (first frame at {facts['openMs']} ms in the page), "
+        f"{frame:.0f} ms a frame, renderer {facts['renderer']}"
+    )
 
 
 @pytest.mark.parametrize("stretch, expected", [((1.0, 1.0, 2.0), "z"), ((1.0, 2.0, 1.0), "y"), ((1.0, 1.0, 1.0), "y")])

@@ -55,7 +55,7 @@ def _vtk_cells(flat: np.ndarray):
         count = int(flat[position])
         if count < 1 or position + 1 + count > flat.size:
             raise InvalidMeshError("the PyVista mesh's face array is malformed (a count runs past its end)")
-        faces.append(flat[position + 1:position + 1 + count])
+        faces.append(flat[position + 1 : position + 1 + count])
         position += 1 + count
     return faces
 
@@ -67,12 +67,24 @@ _VTK_SURFACE_CELLS = {5: "triangle", 7: "polygon", 8: "pixel", 9: "quad"}
 _VTK_POINT_AND_LINE_CELLS = {1: "vertex", 2: "poly_vertex", 3: "line", 4: "poly_line"}
 
 #: Names of the other VTK cell types an error may name (others by number).
-_VTK_OTHER_CELLS = {6: "triangle_strip", 10: "tetra", 11: "voxel", 12: "hexahedron", 13: "wedge", 14: "pyramid",
-                    15: "pentagonal_prism", 16: "hexagonal_prism", 21: "quadratic_edge", 22: "quadratic_triangle",
-                    23: "quadratic_quad", 24: "quadratic_tetra", 25: "quadratic_hexahedron", 42: "polyhedron"}
+_VTK_OTHER_CELLS = {
+    6: "triangle_strip",
+    10: "tetra",
+    11: "voxel",
+    12: "hexahedron",
+    13: "wedge",
+    14: "pyramid",
+    15: "pentagonal_prism",
+    16: "hexagonal_prism",
+    21: "quadratic_edge",
+    22: "quadratic_triangle",
+    23: "quadratic_quad",
+    24: "quadratic_tetra",
+    25: "quadratic_hexahedron",
+    42: "polyhedron",
+}
 
-_KNOWN_MESHES = ("trimesh.Trimesh, pyvista.PolyData, pyvista.UnstructuredGrid, meshio.Mesh, "
-                 "open3d.geometry.TriangleMesh")
+_KNOWN_MESHES = "trimesh.Trimesh, pyvista.PolyData, pyvista.UnstructuredGrid, meshio.Mesh, open3d.geometry.TriangleMesh"
 
 
 def _cell_name(cell_type: int) -> str:
@@ -91,12 +103,16 @@ def _grid_faces(grid):
         listed = ", ".join(f"{n} {_cell_name(int(t))}" for t, n in zip(found, counts))
         raise InvalidMeshError(
             f"the {kind} has cells that are not surface polygons ({listed}); meshcurv computes the curvature "
-            "of surfaces: pass its boundary surface, `grid.extract_surface().triangulate()` (PyVista)")
+            "of surfaces: pass its boundary surface, `grid.extract_surface().triangulate()` (PyVista)"
+        )
     if not surface.any():
         raise InvalidMeshError(
             f"the {kind} has no surface cells (triangle, quad, pixel or polygon); it has "
-            + (", ".join(f"{n} {_cell_name(int(t))}" for t, n in zip(*np.unique(types, return_counts=True)))
-               or "no cells"))
+            + (
+                ", ".join(f"{n} {_cell_name(int(t))}" for t, n in zip(*np.unique(types, return_counts=True)))
+                or "no cells"
+            )
+        )
     # cell_offsets in PyVista >= 0.45 (offset before, deprecated since): n_cells + 1 starts in the connectivity
     offsets = grid.cell_offsets if hasattr(type(grid), "cell_offsets") else grid.offset
     offsets = np.asarray(offsets, dtype=np.int64).ravel()
@@ -145,11 +161,15 @@ def mesh_arrays(mesh) -> tuple[np.ndarray, object]:
         if summary is not None:
             array = np.asarray(mesh)
             looks_like_faces = np.issubdtype(array.dtype, np.integer) and array.ndim == 2 and array.shape[1] >= 3
-            hint = (" (integer indices: it looks like the faces; pass the vertices first)" if looks_like_faces
-                    else "; for points without faces use meshcurv.point_cloud_curvatures")
+            hint = (
+                " (integer indices: it looks like the faces; pass the vertices first)"
+                if looks_like_faces
+                else "; for points without faces use meshcurv.point_cloud_curvatures"
+            )
             raise InvalidMeshError(
                 f"`faces` is missing: `vertices` is {summary}, not a mesh object; pass "
-                f"`principal_curvatures(vertices, faces)`{hint}")
+                f"`principal_curvatures(vertices, faces)`{hint}"
+            )
     if hasattr(mesh, "triangles") and hasattr(mesh, "vertices") and not hasattr(mesh, "faces"):
         return np.asarray(mesh.vertices), np.asarray(mesh.triangles)  # Open3D
     if hasattr(mesh, "points") and hasattr(mesh, "celltypes") and hasattr(mesh, "cell_connectivity"):
@@ -160,7 +180,8 @@ def mesh_arrays(mesh) -> tuple[np.ndarray, object]:
         if not faces:
             raise InvalidMeshError(
                 f"the meshio mesh has no surface cells (triangle, quad or polygon); it has "
-                f"{', '.join(t for t, _ in blocks) or 'no cells'}")
+                f"{', '.join(t for t, _ in blocks) or 'no cells'}"
+            )
         polygons = faces[0] if len(faces) == 1 else [face for block in faces for face in block]
         return np.asarray(mesh.points), polygons
     if hasattr(mesh, "points") and hasattr(mesh, "faces"):  # PyVista PolyData
@@ -172,10 +193,12 @@ def mesh_arrays(mesh) -> tuple[np.ndarray, object]:
     if hasattr(mesh, "points") or hasattr(mesh, "vertices"):  # PyVista PointSet, trimesh or Open3D PointCloud
         raise InvalidMeshError(
             f"`vertices` is a {kind}, which has points but no faces; for a point cloud use "
-            "meshcurv.point_cloud_curvatures, or pass `vertices, faces` arrays")
+            "meshcurv.point_cloud_curvatures, or pass `vertices, faces` arrays"
+        )
     raise InvalidMeshError(
         f"`vertices` is a {kind}, not an array, and not a mesh object meshcurv knows ({_KNOWN_MESHES}); "
-        "pass `vertices, faces` arrays")
+        "pass `vertices, faces` arrays"
+    )
 
 
 def point_array(points, *, name: str = "points"):
@@ -212,7 +235,8 @@ def point_array(points, *, name: str = "points"):
     raise InvalidMeshError(
         f"`{name}` is a {type(points).__name__}, not an array of shape (N, 3), nor an object with a `.points` "
         "or `.vertices` array (pyvista.PolyData, PointSet or UnstructuredGrid, trimesh.Trimesh or PointCloud, "
-        "open3d.geometry.PointCloud, meshio.Mesh)")
+        "open3d.geometry.PointCloud, meshio.Mesh)"
+    )
 
 
 # ------------------------------------------------------------------------------------------- out
@@ -238,8 +262,11 @@ def _mesh_of(result, mesh, purpose: str) -> tuple[np.ndarray, object]:
     if mesh is None:
         surface = result._surface
         if surface is None or surface.index is not None:
-            why = ("it has no mesh (a point cloud's, or built directly)" if surface is None else
-                   "its mesh was welded (rows of copies were merged)")
+            why = (
+                "it has no mesh (a point cloud's, or built directly)"
+                if surface is None
+                else "its mesh was welded (rows of copies were merged)"
+            )
             raise InvalidMeshError(f"{purpose}: pass the mesh the result was computed on; {why}")
         return np.array(surface.vertices), np.array(surface.faces)
     if isinstance(mesh, tuple) and len(mesh) == 2:
@@ -252,7 +279,8 @@ def _mesh_of(result, mesh, purpose: str) -> tuple[np.ndarray, object]:
     if vertices.shape[0] != result.n_vertices:
         raise InvalidMeshError(
             f"{purpose}: the mesh has {vertices.shape[0]} vertices but the result {result.n_vertices} rows; "
-            "pass the mesh the result was computed on")
+            "pass the mesh the result was computed on"
+        )
     return vertices, faces
 
 

@@ -38,9 +38,15 @@ def run_demo(output: str | os.PathLike = "torus_gaussian.png", *, overwrite: boo
     result = principal_curvatures(torus.vertices, torus.faces)
     compat = principal_curvatures(torus.vertices, torus.faces, method="matgeom")
 
-    fig = plot_field(torus.vertices, torus.faces, result.gaussian, view=["iso", "top"], up="z",  # matGeom: z up
-                     label="Gaussian curvature K (1/length²)",
-                     title="matGeom's torusMesh (R 30, r 10): K = k_min · k_max")
+    fig = plot_field(
+        torus.vertices,
+        torus.faces,
+        result.gaussian,
+        view=["iso", "top"],
+        up="z",  # matGeom: z up
+        label="Gaussian curvature K (1/length²)",
+        title="matGeom's torusMesh (R 30, r 10): K = k_min · k_max",
+    )
     save_figure(fig, output, overwrite=overwrite)
 
     rows = [

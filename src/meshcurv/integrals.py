@@ -97,9 +97,7 @@ def _unit_normals(vertices: np.ndarray, faces: np.ndarray, normals) -> np.ndarra
         return fallback
     normals = np.asarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
-        raise InvalidMeshError(
-            f"`normals` must have shape {vertices.shape} (one per vertex); got {normals.shape}"
-        )
+        raise InvalidMeshError(f"`normals` must have shape {vertices.shape} (one per vertex); got {normals.shape}")
     with np.errstate(invalid="ignore", divide="ignore"):
         unit = normals / np.linalg.norm(normals, axis=1, keepdims=True)
     with np.errstate(invalid="ignore"):
@@ -204,8 +202,9 @@ def weighted_percentiles(values, weights, percentiles) -> np.ndarray:
     values = np.asarray(values, dtype=np.float64)
     weights = np.asarray(weights, dtype=np.float64)
     if values.shape != weights.shape or values.ndim != 1:
-        raise InvalidMeshError(f"`values` and `weights` must have one shape (N,); got {values.shape} and "
-                               f"{weights.shape}")
+        raise InvalidMeshError(
+            f"`values` and `weights` must have one shape (N,); got {values.shape} and {weights.shape}"
+        )
     wanted = np.asarray(percentiles, dtype=np.float64) / 100.0
     kept = np.isfinite(values) & np.isfinite(weights) & (weights > 0)
     if not kept.any():
@@ -224,5 +223,11 @@ def weighted_statistics(values, weights) -> dict[str, float]:
     p5, p25, median, p75, p95 = weighted_percentiles(values, weights, [5, 25, 50, 75, 95])
     kept = np.isfinite(values) & np.isfinite(weights) & (weights > 0)
     mean = float(np.sum(values[kept] * weights[kept]) / np.sum(weights[kept])) if kept.any() else np.nan
-    return {"mean": mean, "median": float(median), "p5": float(p5), "p25": float(p25), "p75": float(p75),
-            "p95": float(p95)}
+    return {
+        "mean": mean,
+        "median": float(median),
+        "p5": float(p5),
+        "p25": float(p25),
+        "p75": float(p75),
+        "p95": float(p95),
+    }

@@ -47,9 +47,11 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
     """
     kernels = numba_kernels("icc")
     if kernels is not None:
-        return kernels.face_measures(np.ascontiguousarray(vertices, dtype=np.float64),
-                                     np.ascontiguousarray(faces, dtype=np.int64),
-                                     np.ascontiguousarray(normals, dtype=np.float64))
+        return kernels.face_measures(
+            np.ascontiguousarray(vertices, dtype=np.float64),
+            np.ascontiguousarray(faces, dtype=np.int64),
+            np.ascontiguousarray(normals, dtype=np.float64),
+        )
     x0, x1, x2 = (vertices[faces[:, k]] for k in range(3))
     u0, u1, u2 = (normals[faces[:, k]] for k in range(3))
     x01, x02 = x1 - x0, x2 - x0
@@ -61,8 +63,17 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
     # mu^{X,Y} = X^T M Y with M = 1/2 [ (x01 x um) (u02)^T - (x02 x um) (u01)^T ]
     a, b = np.cross(x01, um), np.cross(x02, um)
     m = 0.5 * (a[:, :, None] * u02[:, None, :] - b[:, :, None] * u01[:, None, :])
-    sym = np.stack([m[:, 0, 0], m[:, 1, 1], m[:, 2, 2], 0.5 * (m[:, 0, 1] + m[:, 1, 0]),
-                    0.5 * (m[:, 0, 2] + m[:, 2, 0]), 0.5 * (m[:, 1, 2] + m[:, 2, 1])], axis=1)
+    sym = np.stack(
+        [
+            m[:, 0, 0],
+            m[:, 1, 1],
+            m[:, 2, 2],
+            0.5 * (m[:, 0, 1] + m[:, 1, 0]),
+            0.5 * (m[:, 0, 2] + m[:, 2, 0]),
+            0.5 * (m[:, 1, 2] + m[:, 2, 1]),
+        ],
+        axis=1,
+    )
     return np.column_stack([mu0, mu1, mu2, sym])
 
 
@@ -101,15 +112,17 @@ def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
     """
     kernels = numba_kernels("icc")
     if kernels is not None:
-        return kernels.curvatures_from_measures(np.ascontiguousarray(summed, dtype=np.float64),
-                                                np.ascontiguousarray(normals, dtype=np.float64))
+        return kernels.curvatures_from_measures(
+            np.ascontiguousarray(summed, dtype=np.float64), np.ascontiguousarray(normals, dtype=np.float64)
+        )
     area = summed[:, 0]
     good = (area > 0) & np.isfinite(normals).all(axis=1)
     k_min, k_max = principal_from_measures(summed)
     with np.errstate(invalid="ignore", divide="ignore"):
         shape_operator = -summed[:, 3:] / area[:, None]
-    _, _, dir_min, dir_max = principal_from_shape_operator(np.where(good[:, None], shape_operator, 0.0),
-                                                           np.where(good[:, None], normals, [0.0, 0.0, 1.0]))
+    _, _, dir_min, dir_max = principal_from_shape_operator(
+        np.where(good[:, None], shape_operator, 0.0), np.where(good[:, None], normals, [0.0, 0.0, 1.0])
+    )
     for field in (k_min, k_max, dir_min, dir_max):
         field[~good] = np.nan
     return k_min, k_max, dir_min, dir_max

@@ -66,9 +66,7 @@ def _pyplot():
     try:
         import matplotlib
     except ImportError:
-        raise MissingDependencyError(
-            "pictures need matplotlib: pip install 'meshcurv[plot]'"
-        ) from None
+        raise MissingDependencyError("pictures need matplotlib: pip install 'meshcurv[plot]'") from None
     return matplotlib
 
 
@@ -96,15 +94,14 @@ Z_UP_RATIO = 1.2
 
 def _as_views(view) -> list[tuple[str, tuple[float, float]]]:
     """``view`` as a list of (title, (elevation, azimuth))."""
-    single = isinstance(view, str) or (
-        len(view) == 2 and all(isinstance(v, (int, float, np.number)) for v in view)
-    )
+    single = isinstance(view, str) or (len(view) == 2 and all(isinstance(v, (int, float, np.number)) for v in view))
     views = []
     for item in [view] if single else list(view):
         if isinstance(item, str):
             if item not in VIEWS:
-                raise InvalidOptionError(f"unknown view {item!r}; choose one of {', '.join(VIEWS)} "
-                                         "or give (elevation, azimuth) in degrees")
+                raise InvalidOptionError(
+                    f"unknown view {item!r}; choose one of {', '.join(VIEWS)} or give (elevation, azimuth) in degrees"
+                )
             views.append((item, VIEWS[item]))
         else:
             angles = np.asarray(item, dtype=float)
@@ -127,8 +124,9 @@ def _camera(elevation: float, azimuth: float) -> np.ndarray:
 
 def _vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     cross = np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]])
-    normals = np.stack([np.bincount(faces.ravel(), np.repeat(cross[:, k], 3), minlength=len(vertices))
-                        for k in range(3)], axis=1)
+    normals = np.stack(
+        [np.bincount(faces.ravel(), np.repeat(cross[:, k], 3), minlength=len(vertices)) for k in range(3)], axis=1
+    )
     return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), np.finfo(float).tiny)
 
 
@@ -161,8 +159,7 @@ class _Raster:
         bounds = np.searchsorted(np.cumsum(counts[drawn]), np.arange(chunk, counts[drawn].sum() + chunk, chunk))
         for part in np.split(drawn, np.unique(bounds)[:-1] + 1):  # a few chunks bound the memory
             if part.size:
-                self._draw(part, corners[part], area[part], x_first[part], y_first[part], columns[part],
-                           counts[part])
+                self._draw(part, corners[part], area[part], x_first[part], y_first[part], columns[part], counts[part])
         self.face = self.face.reshape(self.height, self.width)
         self.weights = self.weights.reshape(self.height, self.width, 3)
         self.depth = self.depth.reshape(self.height, self.width)
@@ -193,7 +190,7 @@ class _Raster:
             members = np.flatnonzero(radii == radius)
             step = max(1, chunk // len(offsets))
             for start in range(0, members.size, step):  # chunks bound the memory and the keys' 23 bits
-                rows = members[start:start + step]
+                rows = members[start : start + step]
                 x = (centre[rows, 0][:, None] + offsets[:, 0]).ravel()
                 y = (centre[rows, 1][:, None] + offsets[:, 1]).ravel()
                 owner = np.repeat(rows, len(offsets))
@@ -219,11 +216,15 @@ class _Raster:
         # no supersampling: the image has about twice the resolution of its panel in the figure,
         # and matplotlib's antialiased resampling smooths the edges when it is drawn
         scale = (pixels - 2) / span.max()  # one pixel of margin each side
-        self.width, self.height = (np.ceil(span * scale).astype(int) + 2)
+        self.width, self.height = np.ceil(span * scale).astype(int) + 2
         self.offset = low - 1 / scale
         self.scale = scale
-        self.extent = (self.offset[0], self.offset[0] + self.width / scale,
-                       self.offset[1], self.offset[1] + self.height / scale)
+        self.extent = (
+            self.offset[0],
+            self.offset[0] + self.width / scale,
+            self.offset[1],
+            self.offset[1] + self.height / scale,
+        )
         self.depth_low = screen[:, 2].min()
         self.depth_step = (2**30 - 1) / max(np.ptp(screen[:, 2]), 1e-300)
 
@@ -240,8 +241,22 @@ class _Raster:
         p2, q2 = -(y[:, 1] - y[:, 0]) / area, (x[:, 1] - x[:, 0]) / area
         r1, r2 = -(p1 * x[:, 0] + q1 * y[:, 0]), -(p2 * x[:, 0] + q2 * y[:, 0])
         dz1, dz2 = z[:, 1] - z[:, 0], z[:, 2] - z[:, 0]
-        plane = np.column_stack([p1, q1, r1, p2, q2, r2, p1 * dz1 + p2 * dz2, q1 * dz1 + q2 * dz2,
-                                 z[:, 0] + r1 * dz1 + r2 * dz2, x_first + 0.5, y_first + 0.5, faces])
+        plane = np.column_stack(
+            [
+                p1,
+                q1,
+                r1,
+                p2,
+                q2,
+                r2,
+                p1 * dz1 + p2 * dz2,
+                q1 * dz1 + q2 * dz2,
+                z[:, 0] + r1 * dz1 + r2 * dz2,
+                x_first + 0.5,
+                y_first + 0.5,
+                faces,
+            ]
+        )
         c = np.repeat(plane, counts, axis=0)
         local = np.arange(c.shape[0]) - np.repeat(np.cumsum(counts) - counts, counts)
         row, column = np.divmod(local, np.repeat(columns, counts))
@@ -308,8 +323,10 @@ def _colormap(matplotlib, cmap, signed: bool):
         colormap = matplotlib.colormaps[name] if isinstance(name, str) else name
     except KeyError:
         known = sorted(matplotlib.colormaps)
-        raise InvalidOptionError(f"unknown colour map {name!r}; choose a name of matplotlib.colormaps "
-                                 f"({len(known)} of them, e.g. viridis, cividis, magma, RdBu_r, coolwarm)") from None
+        raise InvalidOptionError(
+            f"unknown colour map {name!r}; choose a name of matplotlib.colormaps "
+            f"({len(known)} of them, e.g. viridis, cividis, magma, RdBu_r, coolwarm)"
+        ) from None
     return colormap.with_extremes(bad="0.6")
 
 
@@ -340,10 +357,24 @@ def _fitted_lines(text: str, bar_height_points: float, fontsize: float) -> list[
     return [line for paragraph in text.split("\n") for line in textwrap.wrap(paragraph, width)]
 
 
-def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: str | None = None,
-               label: str = "", percentiles: tuple[float, float] = (2.0, 98.0), limits=None,
-               cmap: str | None = None, directions=None, up: str | None = None, pixels: int | None = None,
-               dpi: int = 100, normals=None):
+def plot_field(
+    vertices,
+    faces,
+    values,
+    *,
+    ax=None,
+    view=(30.0, -60.0),
+    title: str | None = None,
+    label: str = "",
+    percentiles: tuple[float, float] = (2.0, 98.0),
+    limits=None,
+    cmap: str | None = None,
+    directions=None,
+    up: str | None = None,
+    pixels: int | None = None,
+    dpi: int = 100,
+    normals=None,
+):
     """Draw a triangle mesh (or a point cloud) coloured by a per-vertex field, with a colour bar.
 
     Vertex values are interpolated across each triangle (matGeom's
@@ -445,8 +476,11 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
 
     points = as_vertices(vertices)
     cloud = faces is None
-    triangles = np.repeat(np.arange(points.shape[0])[:, None], 3, axis=1) if cloud else \
-        as_faces(faces, points.shape[0], stacklevel=3)
+    triangles = (
+        np.repeat(np.arange(points.shape[0])[:, None], 3, axis=1)
+        if cloud
+        else as_faces(faces, points.shape[0], stacklevel=3)
+    )
     values = np.asarray(values, dtype=float)
     if values.shape != (points.shape[0],):
         raise InvalidOptionError(f"`values` must have shape ({points.shape[0]},), one per vertex; got {values.shape}")
@@ -483,8 +517,9 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
-        fig = Figure(figsize=(_PANEL_INCHES * len(views) + _EXTRA_INCHES, _HEIGHT_INCHES), dpi=dpi,
-                     layout="constrained")
+        fig = Figure(
+            figsize=(_PANEL_INCHES * len(views) + _EXTRA_INCHES, _HEIGHT_INCHES), dpi=dpi, layout="constrained"
+        )
         FigureCanvasAgg(fig)
         axes = list(fig.subplots(1, len(views), squeeze=False)[0])
         panel_pixels = _PANEL_INCHES * dpi
@@ -496,22 +531,38 @@ def plot_field(vertices, faces, values, *, ax=None, view=(30.0, -60.0), title: s
     if pixels is None:
         pixels = _auto_pixels(panel_pixels)
     for axis, (name, angles) in zip(axes, views):
-        _draw_view(axis, points - center, triangles, values, normals, _camera(*angles), colormap, norm,
-                   strokes, pixels=pixels, spacing=spacing)
+        _draw_view(
+            axis,
+            points - center,
+            triangles,
+            values,
+            normals,
+            _camera(*angles),
+            colormap,
+            norm,
+            strokes,
+            pixels=pixels,
+            spacing=spacing,
+        )
         if len(views) > 1:
             axis.set_title(name, fontsize=9)
     mappable = ScalarMappable(norm=norm, cmap=colormap)
     bar = fig.colorbar(mappable, ax=axes, shrink=0.8, pad=0.02, aspect=30)
     how = f"percentiles {percentiles[0]:g}-{percentiles[1]:g}{', centred on 0' if signed else ''}"
     bar_points = 0.8 * (fig.get_size_inches()[1] - 0.9) * 72  # the bar's length, titles and margins aside
-    limit_lines = ([f"colour limits {low:.3g} to {high:.3g} (fixed)"] if limits is not None
-                   else [f"colour limits {low:.3g} to {high:.3g}:", *_fitted_lines(how, bar_points, 8)])
+    limit_lines = (
+        [f"colour limits {low:.3g} to {high:.3g} (fixed)"]
+        if limits is not None
+        else [f"colour limits {low:.3g} to {high:.3g}:", *_fitted_lines(how, bar_points, 8)]
+    )
     lines = [*_fitted_lines(label, bar_points, 8), *limit_lines]
     bar.set_label("\n".join(lines), fontsize=8)
     bar.ax.tick_params(labelsize=8)
     if strokes:
-        handles = [Line2D([], [], color=colour, lw=1.2, label=f"{name} direction")
-                   for (name, _), colour in zip(strokes.items(), _STROKE_COLOURS)]
+        handles = [
+            Line2D([], [], color=colour, lw=1.2, label=f"{name} direction")
+            for (name, _), colour in zip(strokes.items(), _STROKE_COLOURS)
+        ]
         if ax is None:
             fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8, frameon=False)
         else:
@@ -529,8 +580,10 @@ def _check_pixels(pixels) -> int:
     needed = pixels * pixels * _BYTES_PER_PIXEL + _BYTES_FIXED
     available = _available_memory()
     if available is not None and needed > available:
-        raise InvalidOptionError(f"`pixels`={pixels} needs about {needed / 2**30:.1f} GiB for each view; "
-                                 f"{available / 2**30:.1f} GiB of memory is available: give fewer pixels")
+        raise InvalidOptionError(
+            f"`pixels`={pixels} needs about {needed / 2**30:.1f} GiB for each view; "
+            f"{available / 2**30:.1f} GiB of memory is available: give fewer pixels"
+        )
     return pixels
 
 
@@ -584,8 +637,7 @@ DISC_NEIGHBOUR = 5
 MAX_DISC_PIXELS = 12.0
 
 
-def _draw_view(axis, points, triangles, values, normals, camera, colormap, norm, strokes, *, pixels,
-               spacing=None):
+def _draw_view(axis, points, triangles, values, normals, camera, colormap, norm, strokes, *, pixels, spacing=None):
     from matplotlib.collections import LineCollection
 
     if spacing is None:
@@ -601,14 +653,19 @@ def _draw_view(axis, points, triangles, values, normals, camera, colormap, norm,
     colours = colormap(norm(np.ma.masked_invalid(both[..., 0])))
     colours[covered, :3] *= (0.45 + 0.55 * both[covered, 1])[:, None]
     colours[~covered] = 0.0
-    axis.imshow(colours.clip(0, 1), origin="lower", extent=raster.extent,
-                interpolation="antialiased")
+    axis.imshow(colours.clip(0, 1), origin="lower", extent=raster.extent, interpolation="antialiased")
     for field, colour in zip(strokes.values(), _STROKE_COLOURS):
-        segments = _strokes(raster, points, field, camera,
-                            normals if normals is not None else np.tile(camera[2], (len(points), 1)))
-        axis.add_collection(LineCollection(
-            segments,  # type: ignore[arg-type]  # matplotlib's stubs want a sequence; an (N, 2, 2) array is documented
-            colors=colour, linewidths=0.8, capstyle="round"))
+        segments = _strokes(
+            raster, points, field, camera, normals if normals is not None else np.tile(camera[2], (len(points), 1))
+        )
+        axis.add_collection(
+            LineCollection(
+                segments,  # type: ignore[arg-type]  # matplotlib's stubs want a sequence; an (N, 2, 2) array is documented
+                colors=colour,
+                linewidths=0.8,
+                capstyle="round",
+            )
+        )
     axis.set_xlim(*raster.extent[:2])
     axis.set_ylim(*raster.extent[2:])
     axis.set_aspect("equal")
@@ -621,7 +678,7 @@ def _strokes(raster, points, directions, camera, normals, *, per_side: int = 30)
     column = np.clip(pixel[:, 0].astype(int), 0, raster.width - 1)
     row = np.clip(pixel[:, 1].astype(int), 0, raster.height - 1)
     depth_range = np.ptp(raster.depth[np.isfinite(raster.depth)]) if np.isfinite(raster.depth).any() else 1.0
-    visible = (pixel[:, 2] >= raster.depth[row, column] - 2e-3 * max(depth_range, 1e-300))
+    visible = pixel[:, 2] >= raster.depth[row, column] - 2e-3 * max(depth_range, 1e-300)
     visible &= np.isfinite(directions).all(axis=1) & (normals @ camera[2] > 0.2)
     cell = max(raster.width, raster.height) / per_side
     candidates = np.flatnonzero(visible)

@@ -362,8 +362,9 @@ class Surface:
         from .integrals import vertex_integrals
 
         rows = slice(None) if self.index is None else _first_rows(self.index, self.vertices.shape[0])
-        normals = None if result.method == "matgeom" else np.where(
-            result.valid[rows, None], result.normals[rows], np.nan)
+        normals = (
+            None if result.method == "matgeom" else np.where(result.valid[rows, None], result.normals[rows], np.nan)
+        )
         pointwise = result.mean[rows] if field == "willmore" else None
         shares = vertex_integrals(self.vertices, self.faces, field, normals=normals, pointwise=pointwise)
         if self.index is None:

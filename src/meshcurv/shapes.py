@@ -28,9 +28,22 @@ from ._validation import check_int_option
 from .errors import InvalidOptionError, MissingDependencyError
 
 __all__ = [
-    "AnalyticMesh", "icosphere", "uv_sphere", "torus", "ellipsoid", "cylinder", "saddle",
-    "random_sphere", "random_ellipsoid", "hemisphere", "with_normal_noise",
-    "VoxelMesh", "voxel_sphere", "voxel_ellipsoid", "voxel_torus", "ellipsoid_closest_points",
+    "AnalyticMesh",
+    "icosphere",
+    "uv_sphere",
+    "torus",
+    "ellipsoid",
+    "cylinder",
+    "saddle",
+    "random_sphere",
+    "random_ellipsoid",
+    "hemisphere",
+    "with_normal_noise",
+    "VoxelMesh",
+    "voxel_sphere",
+    "voxel_ellipsoid",
+    "voxel_torus",
+    "ellipsoid_closest_points",
 ]
 
 
@@ -84,9 +97,15 @@ def _make(name, vertices, faces, k_min, k_max, dir_min, dir_max, normals, quads=
     dir_min[umbilic] = np.nan
     dir_max[umbilic] = np.nan
     return AnalyticMesh(
-        name=name, vertices=vertices, faces=np.ascontiguousarray(faces, dtype=np.int64),
-        k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max,
-        normals=np.asarray(normals, dtype=float), quads=quads,
+        name=name,
+        vertices=vertices,
+        faces=np.ascontiguousarray(faces, dtype=np.int64),
+        k_min=k_min,
+        k_max=k_max,
+        dir_min=dir_min,
+        dir_max=dir_max,
+        normals=np.asarray(normals, dtype=float),
+        quads=quads,
     )
 
 
@@ -142,15 +161,47 @@ def _jitter(values: np.ndarray, step: float, jitter: float, rng, fixed=None) -> 
 def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
     phi = (1 + 5**0.5) / 2
     v = np.array(
-        [[-1, phi, 0], [1, phi, 0], [-1, -phi, 0], [1, -phi, 0],
-         [0, -1, phi], [0, 1, phi], [0, -1, -phi], [0, 1, -phi],
-         [phi, 0, -1], [phi, 0, 1], [-phi, 0, -1], [-phi, 0, 1]], dtype=float)
+        [
+            [-1, phi, 0],
+            [1, phi, 0],
+            [-1, -phi, 0],
+            [1, -phi, 0],
+            [0, -1, phi],
+            [0, 1, phi],
+            [0, -1, -phi],
+            [0, 1, -phi],
+            [phi, 0, -1],
+            [phi, 0, 1],
+            [-phi, 0, -1],
+            [-phi, 0, 1],
+        ],
+        dtype=float,
+    )
     v /= np.linalg.norm(v, axis=1, keepdims=True)
     f = np.array(
-        [[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11],
-         [1, 5, 9], [5, 11, 4], [11, 10, 2], [10, 7, 6], [7, 1, 8],
-         [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9],
-         [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]])
+        [
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ]
+    )
     return v, f
 
 
@@ -174,16 +225,23 @@ def _subdivided_sphere(subdivisions: int) -> tuple[np.ndarray, np.ndarray]:
     unique_keys, first, inverse = np.unique(key.ravel(), return_index=True, return_inverse=True)
     inverse = inverse.reshape(20, -1)
     a, b, c = (corners[ico_faces[:, k]] for k in range(3))
-    points = (a[:, None, :] * weights[None, :, 0:1] + b[:, None, :] * weights[None, :, 1:2]
-              + c[:, None, :] * weights[None, :, 2:3]) / n
+    points = (
+        a[:, None, :] * weights[None, :, 0:1]
+        + b[:, None, :] * weights[None, :, 1:2]
+        + c[:, None, :] * weights[None, :, 2:3]
+    ) / n
     vertices = points.reshape(-1, 3)[first]
     vertices /= np.linalg.norm(vertices, axis=1, keepdims=True)
     up = i + j <= n - 1
     down = i + j <= n - 2
-    tri_local = np.concatenate([
-        np.stack([local[i[up], j[up]], local[i[up] + 1, j[up]], local[i[up], j[up] + 1]], axis=1),
-        np.stack([local[i[down] + 1, j[down]], local[i[down] + 1, j[down] + 1], local[i[down], j[down] + 1]], axis=1),
-    ])
+    tri_local = np.concatenate(
+        [
+            np.stack([local[i[up], j[up]], local[i[up] + 1, j[up]], local[i[up], j[up] + 1]], axis=1),
+            np.stack(
+                [local[i[down] + 1, j[down]], local[i[down] + 1, j[down] + 1], local[i[down], j[down] + 1]], axis=1
+            ),
+        ]
+    )
     faces = inverse[:, tri_local].reshape(-1, 3)
     return vertices, faces
 
@@ -197,8 +255,7 @@ def icosphere(subdivisions: int = 16, radius: float = 1.0, center=(0.0, 0.0, 0.0
     """
     unit, faces = _subdivided_sphere(subdivisions)
     vertices = unit * radius + np.asarray(center, dtype=float)
-    return _make(f"icosphere({subdivisions})", vertices, faces, 1 / radius, 1 / radius,
-                 np.nan, np.nan, unit)
+    return _make(f"icosphere({subdivisions})", vertices, faces, 1 / radius, 1 / radius, np.nan, np.nan, unit)
 
 
 def uv_sphere(n_longitude: int = 32, n_latitude: int = 16, radius: float = 1.0) -> AnalyticMesh:
@@ -216,17 +273,27 @@ def uv_sphere(n_longitude: int = 32, n_latitude: int = 16, radius: float = 1.0) 
     idx = 1 + np.arange((n_latitude - 1) * n_longitude).reshape(n_latitude - 1, n_longitude)
     nxt = np.roll(idx, -1, axis=1)
     quads = np.stack([idx[:-1], idx[1:], nxt[1:], nxt[:-1]], axis=-1).reshape(-1, 4)
-    caps = np.concatenate([
-        np.stack([np.full(n_longitude, north), idx[0], nxt[0]], axis=1),
-        np.stack([np.full(n_longitude, south), nxt[-1], idx[-1]], axis=1),
-    ])
+    caps = np.concatenate(
+        [
+            np.stack([np.full(n_longitude, north), idx[0], nxt[0]], axis=1),
+            np.stack([np.full(n_longitude, south), nxt[-1], idx[-1]], axis=1),
+        ]
+    )
     faces = np.concatenate([caps[:n_longitude], _quads_to_triangles(quads), caps[n_longitude:]])
-    return _make(f"uv_sphere({n_longitude}x{n_latitude})", unit * radius, faces,
-                 1 / radius, 1 / radius, np.nan, np.nan, unit)
+    return _make(
+        f"uv_sphere({n_longitude}x{n_latitude})", unit * radius, faces, 1 / radius, 1 / radius, np.nan, np.nan, unit
+    )
 
 
-def torus(major_radius: float = 30.0, minor_radius: float = 10.0, n_major: int = 60,
-          n_minor: int = 60, *, jitter: float = 0.0, seed: int = 0) -> AnalyticMesh:
+def torus(
+    major_radius: float = 30.0,
+    minor_radius: float = 10.0,
+    n_major: int = 60,
+    n_minor: int = 60,
+    *,
+    jitter: float = 0.0,
+    seed: int = 0,
+) -> AnalyticMesh:
     """Torus around the z axis, laid out as matGeom's ``torusMesh``.
 
     Vertex ``i * n_minor + j`` sits at ring angle ``2 pi i / n_major`` and tube
@@ -261,8 +328,17 @@ def torus(major_radius: float = 30.0, minor_radius: float = 10.0, n_major: int =
     quads = np.stack([idx, i_next, np.roll(i_next, -1, axis=1), np.roll(idx, -1, axis=1)], axis=-1).reshape(-1, 4)
     k_ring = np.cos(p) / (R + r * np.cos(p))
     name = f"torus(R={R:g}, r={r:g})" + (f", jitter {jitter:g}" if jitter else "")
-    return _make(name, vertices, _quads_to_triangles(quads, rng), k_ring, 1 / r,
-                 ring_direction, tube_direction, normals, quads=quads)
+    return _make(
+        name,
+        vertices,
+        _quads_to_triangles(quads, rng),
+        k_ring,
+        1 / r,
+        ring_direction,
+        tube_direction,
+        normals,
+        quads=quads,
+    )
 
 
 def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh:
@@ -278,8 +354,15 @@ def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh
     return _make(f"ellipsoid{tuple(a.tolist())}", vertices, faces, k_min, k_max, dir_min, dir_max, normals)
 
 
-def cylinder(radius: float = 1.0, height: float = 2.0, n_around: int = 32, n_along: int = 16, *,
-             jitter: float = 0.0, seed: int = 0) -> AnalyticMesh:
+def cylinder(
+    radius: float = 1.0,
+    height: float = 2.0,
+    n_around: int = 32,
+    n_along: int = 16,
+    *,
+    jitter: float = 0.0,
+    seed: int = 0,
+) -> AnalyticMesh:
     """Open cylinder around the z axis (two boundary rings), split quads.
 
     Exact curvatures: ``k_max = 1 / radius`` around, ``k_min = 0`` along the axis.
@@ -300,8 +383,7 @@ def cylinder(radius: float = 1.0, height: float = 2.0, n_around: int = 32, n_alo
     nxt = np.roll(idx, -1, axis=1)
     quads = np.stack([idx[:-1], nxt[:-1], nxt[1:], idx[1:]], axis=-1).reshape(-1, 4)
     name = f"cylinder(r={radius:g})" + (f", jitter {jitter:g}" if jitter else "")
-    return _make(name, vertices, _quads_to_triangles(quads, rng), 0.0, 1 / radius,
-                 axis, around, normals, quads=quads)
+    return _make(name, vertices, _quads_to_triangles(quads, rng), 0.0, 1 / radius, axis, around, normals, quads=quads)
 
 
 def saddle(half_width: float = 1.0, spacing: float = 0.025, *, jitter: float = 0.0, seed: int = 0) -> AnalyticMesh:
@@ -328,8 +410,7 @@ def saddle(half_width: float = 1.0, spacing: float = 0.025, *, jitter: float = 0
     idx = np.arange(n * n).reshape(n, n)  # idx[row = y, column = x]
     quads = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], axis=-1).reshape(-1, 4)
     name = f"saddle(spacing={spacing:g})" + (f", jitter {jitter:g}" if jitter else "")
-    return _make(name, vertices, _quads_to_triangles(quads, rng), k_min, k_max,
-                 dir_min, dir_max, normals, quads=quads)
+    return _make(name, vertices, _quads_to_triangles(quads, rng), k_min, k_max, dir_min, dir_max, normals, quads=quads)
 
 
 def _random_unit_sphere(n_vertices: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -356,8 +437,9 @@ def random_sphere(n_vertices: int = 2562, radius: float = 1.0, *, seed: int = 0)
     1-ring estimators fail. Exact curvature ``1 / radius``.
     """
     unit, faces = _random_unit_sphere(n_vertices, seed)
-    return _make(f"random_sphere({n_vertices}, seed {seed})", unit * radius, faces, 1 / radius, 1 / radius,
-                 np.nan, np.nan, unit)
+    return _make(
+        f"random_sphere({n_vertices}, seed {seed})", unit * radius, faces, 1 / radius, 1 / radius, np.nan, np.nan, unit
+    )
 
 
 def random_ellipsoid(semi_axes=(3.0, 2.0, 1.0), n_vertices: int = 2562, *, seed: int = 0) -> AnalyticMesh:
@@ -379,14 +461,23 @@ def hemisphere(subdivisions: int = 16, radius: float = 1.0, *, irregular: bool =
     re-indexed: one boundary loop near ``z = 0``. Exact curvature ``1 / radius``.
     """
     if irregular:
-        whole = random_sphere(10 * check_int_option(subdivisions, "subdivisions", minimum=1) ** 2 + 2, radius,
-                              seed=seed)
+        whole = random_sphere(
+            10 * check_int_option(subdivisions, "subdivisions", minimum=1) ** 2 + 2, radius, seed=seed
+        )
     else:
         whole = icosphere(subdivisions, radius)
     keep = whole.vertices[whole.faces].mean(axis=1)[:, 2] > 0
     used, faces = np.unique(whole.faces[keep], return_inverse=True)
-    return _make(f"hemisphere({whole.name})", whole.vertices[used], faces.reshape(-1, 3), 1 / radius, 1 / radius,
-                 np.nan, np.nan, whole.normals[used])
+    return _make(
+        f"hemisphere({whole.name})",
+        whole.vertices[used],
+        faces.reshape(-1, 3),
+        1 / radius,
+        1 / radius,
+        np.nan,
+        np.nan,
+        whole.normals[used],
+    )
 
 
 def with_normal_noise(mesh: AnalyticMesh, level: float, *, seed: int = 0) -> AnalyticMesh:
@@ -407,13 +498,20 @@ def with_normal_noise(mesh: AnalyticMesh, level: float, *, seed: int = 0) -> Ana
     amplitude = level * mean_edge_length(mesh.vertices, edges)
     t = np.random.default_rng(seed).uniform(-amplitude, amplitude, size=(mesh.vertices.shape[0],))
     return AnalyticMesh(
-        name=f"{mesh.name} + noise {level:g}h", vertices=mesh.vertices + t[:, None] * mesh.normals,
-        faces=mesh.faces, k_min=mesh.k_min, k_max=mesh.k_max, dir_min=mesh.dir_min, dir_max=mesh.dir_max,
-        normals=mesh.normals, quads=mesh.quads,
+        name=f"{mesh.name} + noise {level:g}h",
+        vertices=mesh.vertices + t[:, None] * mesh.normals,
+        faces=mesh.faces,
+        k_min=mesh.k_min,
+        k_max=mesh.k_max,
+        dir_min=mesh.dir_min,
+        dir_max=mesh.dir_max,
+        normals=mesh.normals,
+        quads=mesh.quads,
     )
 
 
 # -- voxelised solids: marching-cubes meshes of binary images -------------------------
+
 
 @dataclass(frozen=True, eq=False)
 class VoxelMesh(AnalyticMesh):
@@ -469,7 +567,8 @@ def _marching_cubes(inside, extent: np.ndarray, spacing: np.ndarray, seed: int, 
     counts = np.ceil(2 * extent / spacing).astype(int) + 5
     if np.prod(counts.astype(float)) > 2e8:
         raise InvalidOptionError(
-            f"shapes.{name}: the voxel grid would have {' x '.join(map(str, counts))} voxels; use a larger `spacing`")
+            f"shapes.{name}: the voxel grid would have {' x '.join(map(str, counts))} voxels; use a larger `spacing`"
+        )
     offset = np.random.default_rng(seed).random(3)
     center = ((counts - 1) / 2 + offset - 0.5) * spacing
     axes = [np.arange(n) * s - c for n, s, c in zip(counts, spacing, center)]
@@ -480,9 +579,19 @@ def _marching_cubes(inside, extent: np.ndarray, spacing: np.ndarray, seed: int, 
 
 def _voxel_mesh(name, vertices, faces, center, spacing, closest, k_min, k_max, dir_min, dir_max, normals):
     base = _make(name, vertices, faces, k_min, k_max, dir_min, dir_max, normals)
-    return VoxelMesh(name=base.name, vertices=base.vertices, faces=base.faces, k_min=base.k_min, k_max=base.k_max,
-                     dir_min=base.dir_min, dir_max=base.dir_max, normals=base.normals,
-                     closest_points=closest, center=center, spacing=tuple(spacing.tolist()))
+    return VoxelMesh(
+        name=base.name,
+        vertices=base.vertices,
+        faces=base.faces,
+        k_min=base.k_min,
+        k_max=base.k_max,
+        dir_min=base.dir_min,
+        dir_max=base.dir_max,
+        normals=base.normals,
+        closest_points=closest,
+        center=center,
+        spacing=tuple(spacing.tolist()),
+    )
 
 
 def _spacing_label(spacing: np.ndarray) -> str:
@@ -523,12 +632,24 @@ def voxel_sphere(radius: float = 10.0, spacing=(1.0, 1.0, 1.0), *, seed: int = 0
     """
     r = float(_check_lengths(radius, "radius", 1)[0])
     s = _check_spacing(spacing)
-    vertices, faces, center = _marching_cubes(lambda x, y, z: x * x + y * y + z * z <= r * r,
-                                              np.full(3, r), s, seed, "voxel_sphere")
+    vertices, faces, center = _marching_cubes(
+        lambda x, y, z: x * x + y * y + z * z <= r * r, np.full(3, r), s, seed, "voxel_sphere"
+    )
     offset = vertices - center
     normals = offset / np.linalg.norm(offset, axis=1, keepdims=True)
-    return _voxel_mesh(f"voxel_sphere(r={r:g}, voxel {_spacing_label(s)})", vertices, faces, center, s,
-                       center + r * normals, 1 / r, 1 / r, np.nan, np.nan, normals)
+    return _voxel_mesh(
+        f"voxel_sphere(r={r:g}, voxel {_spacing_label(s)})",
+        vertices,
+        faces,
+        center,
+        s,
+        center + r * normals,
+        1 / r,
+        1 / r,
+        np.nan,
+        np.nan,
+        normals,
+    )
 
 
 def ellipsoid_closest_points(points, semi_axes, *, iterations: int = 60) -> np.ndarray:
@@ -583,17 +704,30 @@ def voxel_ellipsoid(semi_axes=(10.0, 7.0, 5.0), spacing=(1.0, 1.0, 1.0), *, seed
     s = _check_spacing(spacing)
     inv2 = 1.0 / a**2
     vertices, faces, center = _marching_cubes(
-        lambda x, y, z: x * x * inv2[0] + y * y * inv2[1] + z * z * inv2[2] <= 1, a, s, seed, "voxel_ellipsoid")
+        lambda x, y, z: x * x * inv2[0] + y * y * inv2[1] + z * z * inv2[2] <= 1, a, s, seed, "voxel_ellipsoid"
+    )
     local = ellipsoid_closest_points(vertices - center, a)
     hessian = np.zeros((local.shape[0], 6))
     hessian[:, :3] = 2 * inv2
     k_min, k_max, dir_min, dir_max, normals = _implicit(local, 2 * local * inv2, hessian)
-    return _voxel_mesh(f"voxel_ellipsoid{tuple(a.tolist())}, voxel {_spacing_label(s)}", vertices, faces, center, s,
-                       center + local, k_min, k_max, dir_min, dir_max, normals)
+    return _voxel_mesh(
+        f"voxel_ellipsoid{tuple(a.tolist())}, voxel {_spacing_label(s)}",
+        vertices,
+        faces,
+        center,
+        s,
+        center + local,
+        k_min,
+        k_max,
+        dir_min,
+        dir_max,
+        normals,
+    )
 
 
-def voxel_torus(major_radius: float = 12.0, minor_radius: float = 4.0, spacing=(1.0, 1.0, 1.0), *,
-                seed: int = 0) -> VoxelMesh:
+def voxel_torus(
+    major_radius: float = 12.0, minor_radius: float = 4.0, spacing=(1.0, 1.0, 1.0), *, seed: int = 0
+) -> VoxelMesh:
     """Marching-cubes mesh of a voxelised solid torus whose axis is image axis 0.
 
     Grid, centre offset, vertex coordinates and (inward) winding as in
@@ -622,6 +756,16 @@ def voxel_torus(major_radius: float = 12.0, minor_radius: float = 4.0, spacing=(
     cos_phi = np.sum(normals * radial, axis=1)
     ring_direction = np.stack([np.zeros_like(rho), -radial[:, 2], radial[:, 1]], axis=1)
     tube_direction = np.cross(normals, ring_direction)
-    return _voxel_mesh(f"voxel_torus(R={R:g}, r={r:g}, voxel {_spacing_label(s)})", vertices, faces, center, s,
-                       center + R * radial + r * normals, cos_phi / (R + r * cos_phi), 1 / r,
-                       ring_direction, tube_direction, normals)
+    return _voxel_mesh(
+        f"voxel_torus(R={R:g}, r={r:g}, voxel {_spacing_label(s)})",
+        vertices,
+        faces,
+        center,
+        s,
+        center + R * radial + r * normals,
+        cos_phi / (R + r * cos_phi),
+        1 / r,
+        ring_direction,
+        tube_direction,
+        normals,
+    )

@@ -30,7 +30,7 @@ def check_smoothing_steps(steps) -> int:
         raise InvalidOptionError(
             f"`smoothing_steps` must be at most {MAX_SMOOTHING_STEPS}; got {number} (each pass averages over "
             f"one more ring: {MAX_SMOOTHING_STEPS} passes already spread every value over about "
-            f"{int(MAX_SMOOTHING_STEPS ** 0.5)} rings)"
+            f"{int(MAX_SMOOTHING_STEPS**0.5)} rings)"
         )
     return number
 

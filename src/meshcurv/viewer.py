@@ -69,11 +69,23 @@ _MAX_BLOCK = 2**29 - 64
 _UPS = ("y", "z", "x")
 
 
-def write_html(path, vertices, faces=None, result: CurvatureResult | None = None, *, field: str = "mean",
-               title: str | None = None, up: str | None = None, elevation: float = 20.0, azimuth: float = -30.0,
-               percentiles: tuple[float, float] = (2.0, 98.0), max_directions: int = 20000,
-               length_unit: str | None = None, overwrite: bool = False,
-               source=None) -> pathlib.Path:
+def write_html(
+    path,
+    vertices,
+    faces=None,
+    result: CurvatureResult | None = None,
+    *,
+    field: str = "mean",
+    title: str | None = None,
+    up: str | None = None,
+    elevation: float = 20.0,
+    azimuth: float = -30.0,
+    percentiles: tuple[float, float] = (2.0, 98.0),
+    max_directions: int = 20000,
+    length_unit: str | None = None,
+    overwrite: bool = False,
+    source=None,
+) -> pathlib.Path:
     """Write an interactive 3D view of a mesh (or a point cloud) coloured by its curvatures.
 
     Parameters
@@ -170,8 +182,15 @@ def write_html(path, vertices, faces=None, result: CurvatureResult | None = None
         raise InvalidOptionError(
             f"`result` has {result.n_vertices} vertices; the mesh has {len(points)}: pass the result of these vertices"
         )
-    meta, arrays = _page_data(points, triangles, result, field=field, percentiles=percentiles,
-                              max_directions=max_directions, length_unit=length_unit)
+    meta, arrays = _page_data(
+        points,
+        triangles,
+        result,
+        field=field,
+        percentiles=percentiles,
+        max_directions=max_directions,
+        length_unit=length_unit,
+    )
     meta.update(title=title or "meshcurv viewer", up=up, elevation=angles[0], azimuth=angles[1])
     with atomic_output(path, overwrite=overwrite) as temporary:
         with open(temporary, "wb") as handle:
@@ -315,8 +334,9 @@ def _page_data(points, triangles, result, *, field, percentiles, max_directions,
     radius = float(np.sqrt((relative**2).sum(axis=1).max())) or 1.0
     reason = np.where(result.valid, 0, _UNKNOWN_REASON).astype(np.uint8)
     if result.invalid_reason is not None:
-        reason = np.where(result.valid, 0, np.where(result.invalid_reason > 0, result.invalid_reason,
-                                                    _UNKNOWN_REASON)).astype(np.uint8)
+        reason = np.where(
+            result.valid, 0, np.where(result.invalid_reason > 0, result.invalid_reason, _UNKNOWN_REASON)
+        ).astype(np.uint8)
     arrays = {
         "positions": relative.astype("<f4"),
         "k_min": np.asarray(result.k_min, dtype="<f4"),
@@ -332,8 +352,12 @@ def _page_data(points, triangles, result, *, field, percentiles, max_directions,
     for name in VIEWER_FIELDS:
         values = np.where(result.valid, getattr(result, name), np.nan)
         label, unit = _label_and_unit(name, result.method, length_unit)
-        fields[name] = {"label": label, "unit": unit, "signed": name not in _UNSIGNED,
-                        "limits": list(_default_limits(values, name, percentiles))}
+        fields[name] = {
+            "label": label,
+            "unit": unit,
+            "signed": name not in _UNSIGNED,
+            "limits": list(_default_limits(values, name, percentiles)),
+        }
     stroke = None
     directions = np.isfinite(result.dir_min).all(axis=1) & np.isfinite(result.dir_max).all(axis=1) & result.valid
     if max_directions and directions.any():
@@ -342,8 +366,10 @@ def _page_data(points, triangles, result, *, field, percentiles, max_directions,
         arrays["dir_min"] = np.asarray(result.dir_min[chosen], dtype="<f4")
         arrays["dir_max"] = np.asarray(result.dir_max[chosen], dtype="<f4")
         stroke = 0.4 * _spacing(points[chosen])
-    parameters = ", ".join(f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
-                           for key, value in result.parameters.items())
+    parameters = ", ".join(
+        f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
+        for key, value in result.parameters.items()
+    )
     size = f"{len(points)} vertices, {len(triangles)} triangles" if triangles is not None else f"{len(points)} points"
     meta = {
         "format": 1,
@@ -359,8 +385,10 @@ def _page_data(points, triangles, result, *, field, percentiles, max_directions,
         "method": result.method,
         "field": field,
         "fields": fields,
-        "invalid_reasons": {**{str(code): text for code, text in enumerate(INVALID_REASONS) if code},
-                            str(_UNKNOWN_REASON): "estimate undefined"},
+        "invalid_reasons": {
+            **{str(code): text for code, text in enumerate(INVALID_REASONS) if code},
+            str(_UNKNOWN_REASON): "estimate undefined",
+        },
         "percentiles": list(percentiles),
     }
     return meta, arrays
@@ -407,8 +435,9 @@ _BODY = """
 """
 
 # No network at all: no fetch, no connection, no image or script from elsewhere.
-_POLICY = ("default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src data: blob:; "
-           "connect-src 'none'")
+_POLICY = (
+    "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src data: blob:; connect-src 'none'"
+)
 
 
 def _script() -> str:
@@ -432,17 +461,21 @@ def _write_page(handle, meta: dict, arrays: dict) -> None:
             spec.update(delta=True, compression="deflate")
         encoded = base64.b64encode(raw)
         if len(encoded) > _MAX_BLOCK:
-            raise InvalidMeshError(f"the array {name} takes {len(encoded)} characters in the page, more than a "
-                                   f"browser reads as one string ({_MAX_BLOCK}); the mesh is too large to view")
+            raise InvalidMeshError(
+                f"the array {name} takes {len(encoded)} characters in the page, more than a "
+                f"browser reads as one string ({_MAX_BLOCK}); the mesh is too large to view"
+            )
         specs[name] = spec
         blocks.append((spec["id"], encoded))
     meta = {**meta, "arrays": specs}
-    head = (f'<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
-            f'<meta http-equiv="Content-Security-Policy" content="{_POLICY}">\n'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-            f"<title>{html.escape(meta['title'])} - meshcurv viewer</title>\n"
-            f"<style>{_STYLE}</style>\n</head>\n<body>{_BODY}\n"
-            f'<script type="application/json" id="meshcurv-meta">{_json_for_script(meta)}</script>\n')
+    head = (
+        f'<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        f'<meta http-equiv="Content-Security-Policy" content="{_POLICY}">\n'
+        f'<meta name="viewport" content="width=device-width, initial-scale=1">\n'
+        f"<title>{html.escape(meta['title'])} - meshcurv viewer</title>\n"
+        f"<style>{_STYLE}</style>\n</head>\n<body>{_BODY}\n"
+        f'<script type="application/json" id="meshcurv-meta">{_json_for_script(meta)}</script>\n'
+    )
     handle.write(head.encode("utf-8"))
     for identifier, encoded in blocks:
         handle.write(f'<script type="application/octet-stream" id="{identifier}">'.encode("ascii"))
@@ -470,8 +503,9 @@ def read_page_data(path) -> tuple[dict, dict[str, np.ndarray]]:
     meta = json.loads(found.group(1))
     arrays = {}
     for name, spec in meta["arrays"].items():
-        block = re.search(f'<script type="application/octet-stream" id="{re.escape(spec["id"])}">(.*?)</script>',
-                          text, re.S)
+        block = re.search(
+            f'<script type="application/octet-stream" id="{re.escape(spec["id"])}">(.*?)</script>', text, re.S
+        )
         if block is None:
             raise MeshFileError(f"{path}: the block {spec['id']} is missing")
         raw = base64.b64decode(block.group(1))
