@@ -33,9 +33,13 @@ result's methods (``result.to_pyvista(mesh)``, ...).
 
 from __future__ import annotations
 
+import importlib
+
 import numpy as np
 
 from .errors import InvalidMeshError, MissingDependencyError
+from .io.fields import curvature_fields
+from .topology import triangulate_faces
 
 __all__ = ["mesh_arrays", "point_array", "to_pyvista", "to_trimesh", "to_dataframe"]
 
@@ -243,8 +247,6 @@ def point_array(points, *, name: str = "points"):
 
 
 def _require(module: str, purpose: str, install: str):
-    import importlib
-
     try:
         return importlib.import_module(module)
     except ImportError as exc:
@@ -252,8 +254,6 @@ def _require(module: str, purpose: str, install: str):
 
 
 def _result_fields(result, fields) -> dict[str, np.ndarray]:
-    from .io.fields import curvature_fields
-
     return curvature_fields(result, fields=fields, quality=None)
 
 
@@ -361,8 +361,6 @@ def to_trimesh(result, mesh=None, *, fields=None):
         _mesh_of(result, mesh, "to_trimesh")
         out = mesh.copy()
     else:
-        from .topology import triangulate_faces
-
         vertices, faces = _mesh_of(result, mesh, "to_trimesh")
         out = trimesh.Trimesh(vertices, triangulate_faces(faces), process=False)
     for name, array in values.items():

@@ -17,6 +17,8 @@ import numpy as np
 
 from . import shapes
 from .curvature import principal_curvatures
+from .io._files import check_output
+from .plotting import plot_field, save_figure
 
 __all__ = ["run_demo"]
 
@@ -28,9 +30,6 @@ def run_demo(output: str | os.PathLike = "torus_gaussian.png", *, overwrite: boo
     ``overwrite=True``), creating its folder, and returns a short summary
     comparing the estimate to the exact curvatures of the torus.
     """
-    from .io._files import check_output
-    from .plotting import plot_field, save_figure
-
     output = pathlib.Path(output)
     output.parent.mkdir(parents=True, exist_ok=True)
     check_output(output, overwrite=overwrite)  # before the work, not after

@@ -12,11 +12,14 @@ igea.obj; this takes about 2 s.
 from __future__ import annotations
 
 import os
+import sys
+import textwrap
 
 import numpy as np
 
-from ._validation import as_faces, as_vertices
+from ._validation import as_faces, as_vertices, check_int_option
 from .errors import InvalidOptionError, MissingDependencyError
+from .io._files import atomic_output, check_output
 
 __all__ = ["plot_field", "save_figure", "choose_up", "VIEWS", "MAX_PIXELS", "MAX_DPI", "Z_UP_RATIO"]
 
@@ -351,8 +354,6 @@ _HEIGHT_INCHES = 4.2
 
 def _fitted_lines(text: str, bar_height_points: float, fontsize: float) -> list[str]:
     """``text`` in lines no longer than the colour bar (about 0.55 em a character)."""
-    import textwrap
-
     width = max(12, int(bar_height_points / (0.55 * fontsize)))
     return [line for paragraph in text.split("\n") for line in textwrap.wrap(paragraph, width)]
 
@@ -467,8 +468,6 @@ def plot_field(
     >>> [round(x) for x in fig.get_size_inches() * fig.dpi]   # pixels of the saved picture
     [780, 420]
     """
-    from ._validation import check_int_option
-
     matplotlib = _pyplot()
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
@@ -574,8 +573,6 @@ def plot_field(
 
 def _check_pixels(pixels) -> int:
     """``pixels`` as an int in [16, :data:`MAX_PIXELS`] whose image fits in the memory available."""
-    from ._validation import check_int_option
-
     pixels = check_int_option(pixels, "pixels", minimum=16, maximum=MAX_PIXELS)
     needed = pixels * pixels * _BYTES_PER_PIXEL + _BYTES_FIXED
     available = _available_memory()
@@ -719,11 +716,6 @@ def save_figure(fig, path, *, overwrite: bool = False, dpi: int | None = None):
     InvalidOptionError
         ``dpi`` outside 10 to :data:`MAX_DPI`.
     """
-    import sys
-
-    from ._validation import check_int_option
-    from .io._files import atomic_output, check_output
-
     _pyplot()
     dpi = fig.dpi if dpi is None else check_int_option(dpi, "dpi", minimum=10, maximum=MAX_DPI)
     path = check_output(os.fspath(path), overwrite=overwrite)

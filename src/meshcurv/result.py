@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
-from collections.abc import Mapping
 
 import numpy as np
 
+from . import _adapters, integrals
+from ._validation import check_choice
 from .defects import INVALID_REASONS
+from .errors import InvalidOptionError
 
 if TYPE_CHECKING:
     from .diagnosis import MeshDiagnosis
@@ -214,11 +217,7 @@ class CurvatureResult:
         InvalidOptionError
             Unknown ``field``, or a result with no mesh (point clouds, results built directly).
         """
-        from ._validation import check_choice
-        from .errors import InvalidOptionError
-        from .integrals import INTEGRALS
-
-        check_choice(field, "field", INTEGRALS)
+        check_choice(field, "field", integrals.INTEGRALS)
         cache = self.__dict__.setdefault("_vertex_integrals", {})
         if field in cache:
             return cache[field]
@@ -280,8 +279,6 @@ class CurvatureResult:
         """
         shares = self.vertex_integrals(field)
         if where is not None:
-            from .errors import InvalidOptionError
-
             mask = np.asarray(where)
             if mask.dtype != bool or mask.shape != shares.shape:
                 raise InvalidOptionError(
@@ -298,24 +295,18 @@ class CurvatureResult:
         another mesh object; or ``(vertices, faces)``); by default the one the
         result keeps. ``fields``: names of :data:`meshcurv.io.fields.FIELDS`.
         """
-        from ._adapters import to_pyvista
-
-        return to_pyvista(self, mesh, fields=fields)
+        return _adapters.to_pyvista(self, mesh, fields=fields)
 
     def to_trimesh(self, mesh=None, *, fields=None):
         """A ``trimesh.Trimesh`` with the fields in ``vertex_attributes``: :func:`meshcurv._adapters.to_trimesh`."""
-        from ._adapters import to_trimesh
-
-        return to_trimesh(self, mesh, fields=fields)
+        return _adapters.to_trimesh(self, mesh, fields=fields)
 
     def to_dataframe(self, *, fields=None):
         """A ``pandas.DataFrame``, one row per vertex: :func:`meshcurv._adapters.to_dataframe`.
 
         Vectors as ``<name>_x, _y, _z``; ``vertex_area`` added when ``fields`` is not given.
         """
-        from ._adapters import to_dataframe
-
-        return to_dataframe(self, fields=fields)
+        return _adapters.to_dataframe(self, fields=fields)
 
     def as_matgeom(self) -> tuple[np.ndarray, ...]:
         """The seven outputs of matGeom's ``meshCurvatures``, in its order.
@@ -359,14 +350,12 @@ class Surface:
 
     def shares(self, field: str, result: CurvatureResult) -> np.ndarray:
         """(V,) per-row shares of ``field`` (see :func:`meshcurv.integrals.vertex_integrals`)."""
-        from .integrals import vertex_integrals
-
         rows = slice(None) if self.index is None else _first_rows(self.index, self.vertices.shape[0])
         normals = (
             None if result.method == "matgeom" else np.where(result.valid[rows, None], result.normals[rows], np.nan)
         )
         pointwise = result.mean[rows] if field == "willmore" else None
-        shares = vertex_integrals(self.vertices, self.faces, field, normals=normals, pointwise=pointwise)
+        shares = integrals.vertex_integrals(self.vertices, self.faces, field, normals=normals, pointwise=pointwise)
         if self.index is None:
             return shares
         out = np.zeros(result.n_vertices, dtype=np.float64)

@@ -26,6 +26,8 @@ import numpy as np
 
 from ._validation import check_int_option
 from .errors import InvalidOptionError, MissingDependencyError
+from .geometry import mean_edge_length
+from .topology import MeshTopology
 
 __all__ = [
     "AnalyticMesh",
@@ -489,9 +491,6 @@ def with_normal_noise(mesh: AnalyticMesh, level: float, *, seed: int = 0) -> Ana
     curvatures, directions and normals stay those of the unperturbed surface
     at the original points: what an estimator should recover.
     """
-    from .geometry import mean_edge_length
-    from .topology import MeshTopology
-
     if not (isinstance(level, (int, float)) and np.isfinite(level) and level >= 0):
         raise InvalidOptionError(f"`level` must be a number >= 0 (a fraction of the mean edge length); got {level!r}")
     edges = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).edges

@@ -106,6 +106,7 @@ import numpy as np
 from .errors import InvalidOptionError, MeshQualityWarning
 from .integrals import _unit_normals, face_solid_angles
 from .measures import corrected_areas, face_measures
+from .result import CurvatureResult, _first_rows
 
 __all__ = ["curvature_statistics", "FIELDS", "MOMENTS", "INTEGRALS", "COLUMNS"]
 
@@ -311,8 +312,6 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
     >>> print(f"{stats['mean_integral'] / (4 * np.pi * 2.0):.3f} {stats['shape_index_mean']:.3f}")
     0.998 1.000
     """
-    from .result import CurvatureResult, _first_rows
-
     if not isinstance(result, CurvatureResult):
         raise InvalidOptionError(
             f"`result` must be a CurvatureResult (from meshcurv.principal_curvatures); got {type(result).__name__}"

@@ -44,9 +44,12 @@ import zlib
 import numpy as np
 
 from ._validation import as_faces, check_choice, checked_points
+from .curvature import principal_curvatures
 from .errors import InvalidMeshError, InvalidOptionError, MeshFileError
 from .io._files import atomic_output, check_output
 from .io.fields import FIELDS
+from .plotting import choose_up
+from .pointcloud import point_cloud_curvatures
 from .result import INVALID_REASONS, CurvatureResult
 
 __all__ = ["write_html", "VIEWER_FIELDS"]
@@ -162,8 +165,6 @@ def write_html(
     check_output(path, overwrite=overwrite, source=source)
     field = check_choice(field, "field", VIEWER_FIELDS)
     if up is None:
-        from .plotting import choose_up
-
         up, why = choose_up(checked_points(vertices))
         logger.info("viewer: up axis %s (%s)", up, why)
     up = check_choice(up, "up", _UPS)
@@ -201,11 +202,7 @@ def write_html(
 
 def _compute(points: np.ndarray, triangles: np.ndarray | None) -> CurvatureResult:
     if triangles is None:
-        from .pointcloud import point_cloud_curvatures
-
         return point_cloud_curvatures(points)
-    from .curvature import principal_curvatures
-
     return principal_curvatures(points, triangles)
 
 

@@ -23,7 +23,7 @@ from ..estimators import DEFAULT_METHOD
 from ._driver import MAX_WORKERS, _dashboard, _dependencies, _worker_count, cluster, run_tasks
 from ._inputs import OUTPUT_FORMATS, RECORDS, _Job, _options, _plan, expand_inputs
 from ._process import process_meshes
-from ._records import _read_record, _record_failure, _remove_temporaries, _Unreadable, _unchanged, fingerprint
+from ._records import _read_record, _record_failure, _remove_temporaries, _unchanged, _Unreadable, fingerprint
 from ._summary import _ADDED_COLUMNS, _summary, _write_summary
 
 logger = logging.getLogger(__name__)

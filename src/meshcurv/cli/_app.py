@@ -5,21 +5,27 @@ Run them through :func:`meshcurv.cli.main`.
 
 from __future__ import annotations
 
+import importlib.metadata
 import pathlib
+import platform
 import re
+import textwrap
 
 import click
 import numpy as np
 
 from .. import __version__
+from .._backend import backend_name
 from .._validation import as_faces
+from ..demo import run_demo
 from ..diagnosis import diagnose
 from ..errors import MeshFileError
 from ..estimators import ESTIMATORS
+from ..integrals import weighted_statistics
 from ..io import FORMATS, POINT_EXTENSIONS, is_point_cloud, read_mesh, write_curvatures, write_point_curvatures
 from ..io._files import check_output
-from ..io.fields import FIELDS, curvature_fields
-from ..plotting import MAX_DPI
+from ..io.fields import FIELDS, VIEWERS, curvature_fields
+from ..plotting import _EXTRA_INCHES, _PANEL_INCHES, MAX_DPI, VIEWS, _pyplot, choose_up, plot_field, save_figure
 from ..topology import MeshTopology
 from ._batch import batch
 from ._common import (
@@ -75,11 +81,6 @@ def output_extensions(*, cloud: bool) -> tuple:
 
 def version_text() -> str:
     """``meshcurv --version``: the version, the backend the computations use, numba's and Python's versions."""
-    import importlib.metadata
-    import platform
-
-    from .._backend import backend_name
-
     try:
         numba = importlib.metadata.version("numba")
     except importlib.metadata.PackageNotFoundError:
@@ -121,10 +122,6 @@ def meshcurv():
 
 def _viewers_epilog() -> str:
     """The file to write for each reader (:data:`meshcurv.io.fields.VIEWERS`), for ``compute --help``."""
-    import textwrap
-
-    from ..io.fields import VIEWERS
-
     lines = ["\b", "Which file for which reader (what it keeps of the fields):"]
     for reader, (extensions, keeps) in VIEWERS.items():
         lines.append(f"  {reader}: {', '.join(extensions)}")
@@ -216,8 +213,6 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
 
 def _summary(path, vertices, n_faces: int, result, fields) -> str:
     """The summary table of ``meshcurv compute``: per-vertex and area-weighted statistics, then the integrals."""
-    from ..integrals import weighted_statistics
-
     parameters = ", ".join(
         f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
         for key, value in result.parameters.items()
@@ -280,8 +275,6 @@ def _views(ctx, param, values):
 
 
 def _plotting_views():
-    from ..plotting import VIEWS
-
     return list(VIEWS)
 
 
@@ -397,8 +390,6 @@ def plot(
     overwrite,
 ):
     """Draw MESH coloured by a curvature field, with a colour bar."""
-    from ..plotting import _PANEL_INCHES, _EXTRA_INCHES, _pyplot, choose_up, plot_field, save_figure
-
     _pyplot()  # fail early, before computing, when matplotlib is missing
     context = click.get_current_context()
     session = current_session(context)
@@ -507,9 +498,6 @@ def methods():
 @common_options
 def demo(output, overwrite):
     """A torus (matGeom's torusMesh), its curvatures against the exact ones, a picture (OUTPUT)."""
-    from ..demo import run_demo
-    from ..plotting import _pyplot
-
     _pyplot()
     click.echo(run_demo(output, overwrite=overwrite))
 

@@ -6,7 +6,8 @@ import pathlib
 
 import click
 
-from ..viewer import VIEWER_FIELDS
+from ..io._files import check_input, check_output
+from ..viewer import VIEWER_FIELDS, write_html
 from ._common import _percentiles, common_options, current_session, estimated, method_options
 
 __all__ = ["view"]
@@ -92,9 +93,6 @@ def view(
     cursor is shown, principal directions on demand. Grey: vertices
     without an estimate. About 28-52 MB per million vertices.
     """
-    from ..io._files import check_input, check_output
-    from ..viewer import write_html
-
     session = current_session()
     output = output if output is not None else pathlib.Path(f"{mesh.stem}.html")
     if output.suffix.lower() not in (".html", ".htm"):

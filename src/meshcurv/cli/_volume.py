@@ -9,7 +9,14 @@ import warnings
 import click
 import numpy as np
 
+from .. import volume as volume_module
 from ..batch import MAX_WORKERS
+from ..io import write_curvatures
+from ..io._files import atomic_output, check_output
+from ..io._images import read_image
+from ..io._vtp import PieceWriter
+from ..io.fields import FIELDS, curvature_fields
+from ..plotting import _pyplot, plot_field, save_figure
 from ._common import _FLOAT_MAX, SCALAR_FIELDS, MethodChoice, ProgressBar, common_options, current_session
 
 __all__ = ["volume", "LabelBar", "MESH_FORMATS"]
@@ -191,16 +198,9 @@ def volume(
     --workers N the labels are computed on N processes (a label whose
     process dies gets a failed row; the others are computed).
     """
-    from .. import volume as volume_module
-    from ..io import write_curvatures
-    from ..io._files import atomic_output, check_output
-    from ..io._images import read_image
-
     session = current_session()
     volume_module._pandas()
     if picture:
-        from ..plotting import _pyplot
-
         _pyplot()  # fail before computing when matplotlib is missing
     stem = _stem(image)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -308,9 +308,6 @@ def _with_bar(labels, bar, total: int, rows: list):
 
 def _objects_writer(stack: contextlib.ExitStack, path: pathlib.Path, overwrite: bool):
     """A :class:`~meshcurv.io._vtp.PieceWriter` onto ``path``, published when ``stack`` closes without error."""
-    from ..io._files import atomic_output
-    from ..io._vtp import PieceWriter
-
     temporary = stack.enter_context(atomic_output(path, overwrite=overwrite))
     handle = stack.enter_context(open(temporary, "wb"))
     return stack.enter_context(PieceWriter(handle))
@@ -318,8 +315,6 @@ def _objects_writer(stack: contextlib.ExitStack, path: pathlib.Path, overwrite: 
 
 def _object_piece(surface):
     """``(vertices, faces, point_data, cell_data)`` of one object in the objects' VTP file."""
-    from ..io.fields import curvature_fields
-
     n_vertices, n_faces = surface.vertices.shape[0], surface.faces.shape[0]
     point_data = {
         **curvature_fields(surface.result),
@@ -340,9 +335,6 @@ def _has_pyarrow() -> bool:
 
 def _draw(drawn, path: pathlib.Path, *, field: str, title: str, overwrite: bool) -> None:
     """All objects in one mesh, coloured by ``field`` (NaN, grey, where a vertex is not in the statistics)."""
-    from ..io.fields import FIELDS
-    from ..plotting import plot_field, save_figure
-
     offsets = np.cumsum([0] + [len(vertices) for vertices, _, _ in drawn[:-1]])
     vertices = np.concatenate([vertices for vertices, _, _ in drawn])
     faces = np.concatenate([faces + offset for (_, faces, _), offset in zip(drawn, offsets)])

@@ -41,9 +41,9 @@ from __future__ import annotations
 
 import logging
 import pathlib
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple
-from collections.abc import Callable
 
 import numpy as np
 

@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import MeshFileError, MissingDependencyError
 from ._files import check_input
 from ._mrc import MRC_UNIT, read_mrc
+from ._zarr import read_zarr
 
 if TYPE_CHECKING:
     from .._lazy import LazyImage
@@ -270,8 +271,6 @@ def read_image(path) -> Image:
         zarr missing (``pip install zarr``).
     """
     if _suffix(pathlib.Path(path)) == ".zarr":
-        from ._zarr import read_zarr
-
         return Image(*read_zarr(path))
     path = check_input(path)
     suffix = _suffix(path)

@@ -31,10 +31,12 @@ import warnings
 
 import numpy as np
 
+from .._validation import as_vertices
 from ..errors import MeshFileError, MeshQualityWarning, MissingDependencyError
 from ._files import atomic_output, check_input, check_output
 from ._ply import HEADER_LIMIT, _header, _short, ply_vertex_columns
 from ._text import body_rows, fixed_rows, line_of, names_shown, not_a_number, numbers_by_line, row_error
+from .fields import curvature_fields
 
 __all__ = ["read_points", "write_points", "write_point_curvatures", "is_point_cloud", "POINT_EXTENSIONS"]
 
@@ -123,8 +125,6 @@ def write_point_curvatures(
     the normals go out as ``normals_x ...`` with the other fields (``nx ...``
     only when passed to :func:`write_points` directly).
     """
-    from .fields import curvature_fields
-
     return write_points(
         path,
         points,
@@ -520,8 +520,6 @@ def write_points(
         Unknown extension, existing file without ``overwrite``, the input file,
         a field of the wrong shape, a folder that cannot be written.
     """
-    from .._validation import as_vertices
-
     path = check_output(path, overwrite=overwrite, source=source)
     suffix = _suffix(path, file_format)
     points = as_vertices(points, name="points")

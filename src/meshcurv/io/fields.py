@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
+import pathlib
+
 import numpy as np
 
 from ..errors import InvalidOptionError, MeshFileError
+from ._files import check_input
+from ._meshio import read_meshio_file
+from ._ply import ply_vertex_columns
+from ._tables import npz_arrays
+from ._vtp import read_vtp_point_data
 
 __all__ = ["FIELDS", "VIEWERS", "curvature_fields", "read_fields"]
 
@@ -147,10 +154,6 @@ def read_fields(path) -> dict[str, np.ndarray]:
     >>> fields["dir_max"].shape, bool((fields["k_max"] == r.k_max).all())
     ((162, 3), True)
     """
-    import pathlib
-
-    from ._files import check_input
-
     path = pathlib.Path(path)
     suffix = path.suffix.lower()
     readers = {
@@ -172,8 +175,6 @@ def read_fields(path) -> dict[str, np.ndarray]:
 
 
 def _ply_fields(path):
-    from ._ply import ply_vertex_columns
-
     # the vertex element alone: a point cloud's file (no faces) as well as a surface's
     return {
         name: np.asarray(values, dtype=np.float64)
@@ -183,14 +184,10 @@ def _ply_fields(path):
 
 
 def _vtp_fields(path):
-    from ._vtp import read_vtp_point_data
-
     return read_vtp_point_data(path)
 
 
 def _npz_fields(path):
-    from ._tables import npz_arrays
-
     return npz_arrays(path, lambda name: name not in ("vertices", "faces", "face_corners", "face_sizes"))[0]
 
 
@@ -207,8 +204,6 @@ def _csv_fields(path):
 
 
 def _meshio_fields(path):
-    from ._meshio import read_meshio_file
-
     return dict(read_meshio_file(path, path.suffix.lower()[1:]).point_data)
 
 
