@@ -95,7 +95,7 @@ class PreparedMesh:
 
     @cached_property
     def _codes(self) -> tuple[np.ndarray, dict]:
-        return defect_codes(self.topology, self.degenerate)
+        return defect_codes(self.topology, self.degenerate, self.vertices, self.length_scales)
 
     def defects(self, *, boundary: bool = False) -> VertexDefects:
         """The defects as a method sees them: ``boundary=True`` for the methods that keep boundary vertices."""

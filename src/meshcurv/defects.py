@@ -20,10 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import degenerate_face_mask
 from .topology import MeshTopology
 
 __all__ = ["Defect", "DEFECTS", "POINT_CLOUD_REASONS", "INVALID_REASONS", "UNDEFINED", "BOUNDARY", "VertexDefects",
-           "defect_codes"]
+           "NEEDLE_ANGLE", "NEEDLE_REACH", "defect_codes", "needle_vertices"]
 
 
 @dataclass(frozen=True)
@@ -48,7 +49,8 @@ class Defect:
     counted: str
 
 
-#: The defects, in the order in which a vertex takes the first that applies.
+#: The defects, in the order in which a vertex takes the first that applies (a needle vertex on
+#: the boundary is a needle vertex: the methods that keep boundary vertices must not keep it).
 DEFECTS = (
     Defect(1, "unreferenced_vertices", "unreferenced vertex (in no face)", "unreferenced vertices"),
     Defect(2, "nonmanifold_edges", "on a non-manifold edge (3+ faces)", "non-manifold edges (3+ faces)"),
@@ -57,6 +59,8 @@ DEFECTS = (
     Defect(4, "inconsistent_edges", "on an edge between inconsistently oriented faces",
            "edges between inconsistently oriented faces"),
     Defect(5, "degenerate_faces", "corner of a zero-area face", "zero-area faces"),
+    Defect(7, "needle_vertices", "needle vertex: its faces are slivers reaching far beyond its neighbourhood "
+           "(a vertex flung away)", "needle vertices (their faces are slivers from a vertex flung far away)"),
     Defect(6, "boundary_edges", "on a boundary edge (this method needs a closed neighbourhood)",
            "boundary edges (their vertices have no complete neighbourhood)"),
 )
@@ -65,10 +69,11 @@ DEFECTS = (
 BOUNDARY = 6
 
 #: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the last
-#: two reasons: codes 7 and 8.
+#: the defects of meshes: codes 8 and 9.
 POINT_CLOUD_REASONS = (
     "point cloud: side undecided (two sheets closer than the spacing, or stacked with normals the same way)",
     "point cloud: every ball held the other side of a thin part or a neighbouring part",
+    "point cloud: on a line (its neighbours lie on a line with no surface around it)",
 )
 
 #: The code of a vertex invalid for no defect of the mesh: its estimate itself is undefined.
@@ -77,18 +82,82 @@ UNDEFINED = len(DEFECTS) + len(POINT_CLOUD_REASONS) + 1
 #: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``.
 INVALID_REASONS = (
     "valid",
-    *(defect.reason for defect in DEFECTS),
+    *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code)),
     *POINT_CLOUD_REASONS,
     "estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)",
 )
 
 #: The order of the phrases in the warning.
 _WARNING_ORDER = ("boundary_edges", "nonmanifold_edges", "bowtie_vertices", "inconsistent_edges",
-                  "degenerate_faces", "unreferenced_vertices")
+                  "degenerate_faces", "needle_vertices", "unreferenced_vertices")
 _COUNTED = {defect.name: defect.counted for defect in DEFECTS}
 
 
-def defect_codes(topology: MeshTopology, degenerate: np.ndarray) -> tuple[np.ndarray, dict[str, int]]:
+#: A vertex whose faces' corner angles at it sum to less than this (radians, about 5.7 degrees: the tip of
+#: a cone of half-angle 0.9 degrees) ...
+NEEDLE_ANGLE = 0.1
+#: ... and whose every edge is longer than this many length scales (the median edge length of its
+#: component) is a needle vertex: a vertex flung far from its neighbours (a spike of a corrupted file).
+#: Every ball around it holds the tips of its own slivers only, and the estimators' shares of faces
+#: wider than the ball (linear in the distance) turn them into a finite, wrong curvature (issue 29:
+#: a hemisphere's vertex moved to x = 1e40 kept a valid H of -2 with icc). Both conditions together:
+#: a coarse part of a mesh has long edges and full fans; a sliver of a fine mesh has short edges.
+NEEDLE_REACH = 4.0
+
+
+def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray:
+    """(V,) bool: the needle vertices (:data:`NEEDLE_ANGLE`, :data:`NEEDLE_REACH`).
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3), float64
+    topology : MeshTopology
+        Their faces' connectivity.
+    scales : ndarray of shape (V,)
+        The length scale of each vertex (:func:`meshcurv.geometry.vertex_length_scales`).
+
+    Returns
+    -------
+    ndarray of shape (V,), bool
+        Vertices with a face that is not of zero area, whose edges are all
+        longer than ``NEEDLE_REACH * scales`` and whose corner angles (over
+        the faces that are not of zero area) sum to less than ``NEEDLE_ANGLE``.
+    """
+    n = topology.n_vertices
+    edges = topology.edges
+    sides = vertices[edges[:, 1]] - vertices[edges[:, 0]]
+    reach = NEEDLE_REACH * scales
+    long = np.einsum("ij,ij->i", sides, sides) > np.square(np.minimum(reach[edges[:, 0]], reach[edges[:, 1]]))
+    if not long.any():  # the usual case: one pass over the edges
+        return np.zeros(n, dtype=bool)
+    # the vertices all of whose edges are long
+    candidates = np.bincount(edges[long].ravel(), minlength=n) == topology.vertex_degrees
+    candidates &= topology.referenced_vertices & (scales > 0)
+    if not candidates.any():
+        return candidates
+    faces = topology.faces
+    touched = np.flatnonzero(candidates[faces].any(axis=1))
+    corners = vertices[faces[touched]]  # (T, 3, 3)
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    double_areas = np.linalg.norm(cross, axis=1)
+    scale = scales[faces[touched, 0]]
+    usable = ~degenerate_face_mask(0.5 * double_areas, scale)
+    usable &= (faces[touched, 0] != faces[touched, 1]) & (faces[touched, 1] != faces[touched, 2]) \
+        & (faces[touched, 0] != faces[touched, 2])
+    angle_sums = np.zeros(n)
+    covered = np.zeros(n, dtype=bool)
+    for k in range(3):  # the corner angle at corner k: atan2(|u x w|, u . w), 2 x area the same at each corner
+        u = corners[:, (k + 1) % 3] - corners[:, k]
+        w = corners[:, (k + 2) % 3] - corners[:, k]
+        angle = np.arctan2(double_areas, np.einsum("ij,ij->i", u, w))
+        at = faces[touched, k]
+        angle_sums += np.bincount(at[usable], weights=angle[usable], minlength=n)
+        covered[at[usable]] = True
+    return candidates & covered & (angle_sums < NEEDLE_ANGLE)
+
+
+def defect_codes(topology: MeshTopology, degenerate: np.ndarray, vertices: np.ndarray | None = None,
+                 scales: np.ndarray | None = None) -> tuple[np.ndarray, dict[str, int]]:
     """(V,) int8 code of the first defect at each vertex (0: none), and the count of each defect.
 
     Parameters
@@ -97,6 +166,12 @@ def defect_codes(topology: MeshTopology, degenerate: np.ndarray) -> tuple[np.nda
         The mesh's connectivity.
     degenerate : ndarray of shape (F,), bool
         The zero-area faces (:func:`meshcurv.geometry.degenerate_faces`).
+    vertices : ndarray of shape (V, 3), optional
+        The coordinates, for the needle vertices (:func:`needle_vertices`);
+        None: the defects of the connectivity and ``degenerate`` only.
+    scales : ndarray of shape (V,), optional
+        The length scale of each vertex (:func:`meshcurv.geometry.vertex_length_scales`),
+        with ``vertices``.
 
     Returns
     -------
@@ -106,6 +181,7 @@ def defect_codes(topology: MeshTopology, degenerate: np.ndarray) -> tuple[np.nda
         ``{defect.name: count}``: edges, faces or vertices, as the name says.
         A bow-tie vertex on a non-manifold edge is counted with that edge only.
     """
+    needles = None if vertices is None or scales is None else needle_vertices(vertices, topology, scales)
     nonmanifold = topology.edge_vertices(topology.nonmanifold_edges)
     bowties = topology.bowtie_vertices & ~nonmanifold
     corners = np.zeros(topology.n_vertices, dtype=bool)
@@ -116,6 +192,7 @@ def defect_codes(topology: MeshTopology, degenerate: np.ndarray) -> tuple[np.nda
         "bowtie_vertices": bowties,
         "inconsistent_edges": topology.edge_vertices(topology.inconsistent_edges),
         "degenerate_faces": corners,
+        "needle_vertices": np.zeros(topology.n_vertices, dtype=bool) if needles is None else needles,
         "boundary_edges": topology.edge_vertices(topology.boundary_edges),
     }
     codes = np.zeros(topology.n_vertices, dtype=np.int8)
@@ -127,6 +204,7 @@ def defect_codes(topology: MeshTopology, degenerate: np.ndarray) -> tuple[np.nda
         "bowtie_vertices": int(bowties.sum()),
         "inconsistent_edges": int(topology.inconsistent_edges.sum()),
         "degenerate_faces": int(degenerate.sum()),
+        "needle_vertices": 0 if needles is None else int(needles.sum()),
         "unreferenced_vertices": int((~topology.referenced_vertices).sum()),
     }
     return codes, counts

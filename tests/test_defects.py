@@ -1,0 +1,148 @@
+"""The defect table and the needle vertices (issue 29: a vertex flung far away kept a valid estimate)."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import meshcurv
+from meshcurv import shapes
+from meshcurv.defects import (DEFECTS, INVALID_REASONS, NEEDLE_ANGLE, NEEDLE_REACH, UNDEFINED, defect_codes,
+                              needle_vertices)
+from meshcurv.errors import MeshQualityWarning
+from meshcurv.geometry import degenerate_faces, vertex_length_scales
+from meshcurv.topology import MeshTopology
+
+NEEDLE = INVALID_REASONS.index(next(text for text in INVALID_REASONS if text.startswith("needle vertex")))
+
+
+def _needles(vertices, faces):
+    topology = MeshTopology.from_faces(faces)
+    return needle_vertices(np.asarray(vertices, dtype=float), topology, vertex_length_scales(vertices, topology))
+
+
+def _compute(vertices, faces, method):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = meshcurv.principal_curvatures(vertices, faces, method=method)
+    return result, [str(w.message) for w in caught if issubclass(w.category, MeshQualityWarning)]
+
+
+def _pyramid(n: int, height: float):
+    """A closed pyramid over a regular ``n``-gon of circumradius 1 (its base a fan from the centre), and the
+    sum of the apex's corner angles in closed form: ``n * 2 atan((s / 2) / slant)``, ``s = 2 sin(pi / n)``
+    the side of the base and ``slant = sqrt(h^2 + cos(pi / n)^2)`` the height of a side face."""
+    angles = 2 * np.pi * np.arange(n) / n
+    ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros(n)])
+    vertices = np.vstack([ring, [[0.0, 0.0, height]], [[0.0, 0.0, 0.0]]])
+    apex, centre = n, n + 1
+    nxt = (np.arange(n) + 1) % n
+    sides = np.column_stack([np.arange(n), nxt, np.full(n, apex)])
+    base = np.column_stack([nxt, np.arange(n), np.full(n, centre)])
+    slant = np.hypot(height, np.cos(np.pi / n))
+    return vertices, np.vstack([sides, base]), n * 2 * np.arctan(np.sin(np.pi / n) / slant)
+
+
+# --- the code table -----------------------------------------------------------------------------
+
+def test_each_defect_reads_its_own_reason():
+    assert all(INVALID_REASONS[defect.code] == defect.reason for defect in DEFECTS)
+    assert INVALID_REASONS[0] == "valid" and UNDEFINED == len(INVALID_REASONS) - 1
+    assert INVALID_REASONS[UNDEFINED].startswith("estimate undefined")
+    assert sorted(defect.code for defect in DEFECTS) == list(range(1, len(DEFECTS) + 1))
+
+
+def test_a_needle_on_the_boundary_is_a_needle_not_a_boundary_vertex():
+    order = [defect.name for defect in DEFECTS]
+    assert order.index("needle_vertices") < order.index("boundary_edges")
+
+
+def test_defect_codes_of_the_connectivity_alone_count_no_needle():
+    vertices, faces, _ = _pyramid(12, 100.0)
+    topology = MeshTopology.from_faces(faces)
+    degenerate = degenerate_faces(vertices, topology)
+    codes, counts = defect_codes(topology, degenerate)
+    assert counts["needle_vertices"] == 0 and not codes.any()
+    codes, counts = defect_codes(topology, degenerate, vertices, vertex_length_scales(vertices, topology))
+    assert counts["needle_vertices"] == 1 and codes[12] == NEEDLE
+
+
+# --- what a needle vertex is ------------------------------------------------------------------
+
+@pytest.mark.parametrize("factor, needle", [(0.9, True), (1.1, False)])
+def test_the_apex_of_a_pyramid_is_a_needle_below_the_angle(factor, needle):
+    # the apex angle in closed form; the base edges (1 and 0.52) set the median, the apex edges reach 50+
+    heights = np.linspace(20.0, 200.0, 2001)
+    sums = np.array([_pyramid(12, h)[2] for h in heights])
+    height = heights[np.argmin(np.abs(sums - factor * NEEDLE_ANGLE))]
+    vertices, faces, angle_sum = _pyramid(12, height)
+    assert angle_sum == pytest.approx(factor * NEEDLE_ANGLE, rel=0.01)
+    assert height > NEEDLE_REACH * 1.0  # the median edge is a base radius, 1
+    found = _needles(vertices, faces)
+    assert found[12] == needle and found.sum() == needle
+
+
+def test_long_edges_around_a_full_fan_make_no_needle():
+    # a pyramid 60 base radii high on 400 sides: apex edges of 60 (the median edge is 1), but a fan of
+    # 400 faces whose angles sum to 400 * 2 atan(sin(pi/400) / 60) = 0.105 > NEEDLE_ANGLE ...
+    vertices, faces, angle_sum = _pyramid(400, 60.0)
+    assert angle_sum > NEEDLE_ANGLE and not _needles(vertices, faces).any()
+    # ... and a flat fan of long edges (the apex in the base plane: 2 pi) is no needle either
+    vertices, faces, _ = _pyramid(12, 0.0)
+    vertices[12] = [0.0, 0.0, 1e-3]
+    assert not _needles(vertices * [40.0, 40.0, 1.0], faces).any()
+
+
+def test_a_sliver_of_short_edges_is_no_needle():
+    # a flat strip with one sliver at its end: corner angle 0.5 degrees, but edges of a median edge
+    xs = np.arange(11.0)
+    vertices = np.vstack([np.column_stack([xs, np.zeros(11), np.zeros(11)]),
+                          np.column_stack([xs, np.ones(11), np.zeros(11)]), [[11.0, np.tan(np.radians(0.5)), 0.0]]])
+    quads = [(i, i + 1, 12 + i, 11 + i) for i in range(10)]
+    faces = np.array([f for a, b, c, d in quads for f in ((a, b, c), (a, c, d))] + [(10, 22, 21)])
+    assert not _needles(vertices, faces).any()
+
+
+@pytest.mark.parametrize("mesh", [
+    shapes.icosphere(8), shapes.uv_sphere(24, 12), shapes.torus(), shapes.ellipsoid(subdivisions=8),
+    shapes.cylinder(), shapes.saddle(spacing=0.1, jitter=0.3), shapes.random_sphere(500),
+    shapes.hemisphere(8, irregular=True), shapes.with_normal_noise(shapes.icosphere(8), 0.3),
+    shapes.voxel_sphere(6.0),
+], ids=lambda mesh: getattr(mesh, "name", "mesh"))
+def test_no_analytic_surface_has_a_needle(mesh):
+    assert not _needles(mesh.vertices, mesh.faces).any()
+
+
+# --- every method leaves a needle vertex undefined, with its reason ------------------------------
+
+@pytest.mark.parametrize("method", meshcurv.METHODS)
+@pytest.mark.parametrize("distance", [30.0, 1e40])
+def test_a_flung_vertex_is_invalid_with_its_reason(method, distance):
+    mesh = shapes.hemisphere(subdivisions=4)
+    vertices = mesh.vertices.copy()
+    vertices[5, 0] = distance  # an interior vertex: all its faces become needles
+    result, messages = _compute(vertices, mesh.faces, method)
+    assert not result.valid[5] and result.invalid_reason[5] == NEEDLE
+    if method != "matgeom":  # matgeom keeps matGeom's numbers where valid is False
+        assert np.isnan(result.k_min[5]) and np.isnan(result.k_max[5])
+    assert len(messages) == 1 and "1 needle vert" in messages[0]
+
+
+@pytest.mark.parametrize("method", ["icc", "normal_cycle_ball", "quadric"])
+def test_a_flung_boundary_vertex_is_invalid_for_the_methods_that_keep_boundaries(method):
+    mesh = shapes.hemisphere(subdivisions=4)
+    topology = MeshTopology.from_faces(mesh.faces)
+    vertex = int(np.flatnonzero(topology.boundary_vertices)[0])
+    vertices = mesh.vertices.copy()
+    vertices[vertex] *= 1e6
+    result, _ = _compute(vertices, mesh.faces, method)
+    assert result.invalid_reason[vertex] == NEEDLE and not result.valid[vertex]
+
+
+def test_a_clean_closed_mesh_keeps_every_vertex():
+    mesh = shapes.icosphere(6)
+    result, messages = _compute(mesh.vertices, mesh.faces, "icc")
+    assert result.valid.all() and not messages
+    assert "needle_vertices" not in result.invalid_counts()
