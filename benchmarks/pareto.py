@@ -197,6 +197,43 @@ def dominating(family: dict, peer: str) -> list:
     return [name for _, name in sorted(better)]
 
 
+def more_accurate(family: dict, peer: str):
+    """``(name, CPU ratio)`` of the fastest meshcurv method more accurate than ``peer``, or None."""
+    p = family.get(peer)
+    if p is None or not np.isfinite(p["error"]):
+        return None
+    better = sorted((e["cpu"], name) for name, e in family.items() if name.startswith("meshcurv")
+                    and np.isfinite(e["error"]) and e["error"] < p["error"])
+    return (better[0][1], better[0][0] / p["cpu"]) if better else None
+
+
+def in_short(summary, peer: str) -> str:
+    """One sentence: where a meshcurv method is at least as accurate and faster than ``peer``; elsewhere, the
+    fastest more accurate one and its CPU time as a multiple of the peer's."""
+    wins, slower = {}, {}
+    for family, entries in summary.items():
+        if peer not in entries:
+            continue
+        best = dominating(entries, peer)
+        if best:
+            wins.setdefault(best[0].removeprefix("meshcurv "), []).append(family)
+            continue
+        found = more_accurate(entries, peer)
+        if found:
+            slower.setdefault(found[0].removeprefix("meshcurv "), []).append((family, found[1]))
+    parts = []
+    if wins:
+        parts.append("at least as accurate and faster: " + "; ".join(
+            f"{method} ({', '.join(families)})" for method, families in wins.items()))
+    if slower:
+        parts.append("more accurate but slower: " + "; ".join(
+            f"{method} ({', '.join(f'{family}: {r:.2g}x the CPU time' for family, r in found)})"
+            for method, found in slower.items()))
+    if not parts:
+        parts.append("no meshcurv method at least as accurate")
+    return f"**{peer}**: " + "; ".join(parts) + "."
+
+
 def _source_commit() -> str:
     """The commit of the meshcurv imported (its source tree may be another checkout than this script's)."""
     import subprocess
@@ -229,6 +266,10 @@ def markdown(summary, found, missing, args, load_start, load_end, n_by_family) -
         "`cover`: the lowest share of interior vertices reported. `front`: no implementation is both faster "
         "(CPU) and at least as accurate.",
         "",
+        "These meshes are small (the vertex counts above): the fixed cost of a call (meshcurv's: checks of the "
+        "input and of the mesh, topology, orientation) weighs more in these times than on large meshes; "
+        "`speed.md` has the times at 100k to 4M vertices.",
+        "",
     ]
     for family, entries in summary.items():
         kept = front(entries)
@@ -245,39 +286,92 @@ def markdown(summary, found, missing, args, load_start, load_end, n_by_family) -
         cells = [", ".join(m.removeprefix("meshcurv ") for m in dominating(entries, peer)) or "none"
                  for entries in summary.values()]
         lines.append(f"| {peer} | " + " | ".join(cells) + " |")
+    lines += ["", "In short, for each peer (the fastest such meshcurv method; CPU seconds):", ""]
+    lines += [f"- {in_short(summary, peer)}" for peer in peers]
     lines.append("")
     return "\n".join(lines)
 
 
-def figure(summary, path: str) -> None:
+def _place_labels(ax, points, fontsize=7):
+    """Label ``points`` [(x, y, text)] where a label covers no other label, no marker, and stays in the axes.
+
+    Places are tried near the point first (right or left of it, above or below), then further up or down
+    (a grey line then joins label and point); the positions are computed in pixels of the final layout.
+    """
+    to_px = ax.transData.transform
+    to_data = ax.transData.inverted().transform
+    dpi = ax.figure.dpi
+    char, line = 0.6 * fontsize / 72 * dpi, 1.25 * fontsize / 72 * dpi
+    box = ax.bbox
+    markers = [to_px((x, y)) for x, y, _ in points]
+    placed = []  # (left, right, bottom, top) in pixels
+
+    def free(left, bottom, width):
+        right, top = left + width, bottom + line
+        if left < box.x0 or right > box.x1 or bottom < box.y0 or top > box.y1:
+            return False
+        if any(left < r and right > lft and bottom < t and top > b for lft, r, b, t in placed):
+            return False
+        return not any(left - 4 < mx < right + 4 and bottom - 4 < my < top + 4 for mx, my in markers)
+
+    for x, y, text in sorted(points, key=lambda p: -p[1]):
+        px, py = to_px((x, y))
+        width = char * len(text)
+        near = [(px + 6, py + 2), (px + 6, py - line - 2), (px - 6 - width, py + 2), (px - 6 - width, py - line - 2)]
+        tries = [(k, (lx, ly + sign * k * line)) for k in range(8) for sign in ((1, -1) if k else (1,))
+                 for lx, ly in near]
+        k, (lx, ly) = next(((k, spot) for k, spot in tries if free(*spot, width)), tries[0])
+        placed.append((lx, lx + width, ly, ly + line))
+        ax.annotate(text, (x, y), xytext=to_data((lx, ly)), textcoords="data", fontsize=fontsize, ha="left",
+                    va="bottom", arrowprops={"arrowstyle": "-", "color": "0.6", "lw": 0.5} if k else None)
+
+
+def _short(name: str) -> str:
+    """The label of an implementation in the figure."""
+    if name.startswith("meshcurv"):
+        return name.removeprefix("meshcurv ")
+    return name.split(" (")[0].replace(" principal_curvatures", "").replace(" principal_curvature", "")
+
+
+def figure(summary, path: str, n_by_family=None) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
 
-    fig, axes = plt.subplots(2, 2, figsize=(13, 10))
+    fig, axes = plt.subplots(2, 2, figsize=(13, 10.5))
     for ax, (family, entries) in zip(axes.ravel(), summary.items()):
         kept = front(entries)
-        for name, e in entries.items():
-            if not np.isfinite(e["error"]) or e["error"] <= 0:
-                continue
+        shown = {name: e for name, e in entries.items() if np.isfinite(e["error"]) and e["error"] > 0}
+        for name, e in shown.items():
             ours = name.startswith("meshcurv")
             ax.scatter(e["cpu"], 100 * e["error"], color="tab:blue" if ours else "tab:orange",
                        marker="o" if ours else "s", s=40, zorder=3)
-            short = name.removeprefix("meshcurv ") if ours else name.split(" (")[0].replace(" principal_curvatures",
-                                                                                          "")
-            ax.annotate(short, (e["cpu"], 100 * e["error"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
         points = sorted((entries[n]["cpu"], 100 * entries[n]["error"]) for n in kept)
         if points:
             ax.step(*zip(*points), where="post", color="gray", lw=1, zorder=1)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_title(family)
-        ax.set_xlabel("CPU seconds (sum over the family's surfaces)")
-        ax.set_ylabel("median relative error of H (%)")
+        cpus = [e["cpu"] for e in shown.values()]
+        errors = [100 * e["error"] for e in shown.values()]
+        if cpus:
+            ax.set_xlim(min(cpus) / 1.6, max(cpus) * 6)  # room for the labels right of the points
+            ax.set_ylim(min(errors) / 2.5, max(errors) * 2.5)
+        size = f" ({n_by_family[family]} vertices)" if n_by_family and family in n_by_family else ""
+        ax.set_title(f"{family}{size}")
+        ax.set_xlabel("CPU seconds, log scale (sum over the family's surfaces)")
+        ax.set_ylabel("median relative error of H (%), log scale")
         ax.grid(True, which="both", alpha=0.3)
-    fig.suptitle("meshcurv (blue) and peers (orange): time against error; grey: the front")
-    fig.tight_layout()
+    handles = [Line2D([], [], color="tab:blue", marker="o", ls="", label="meshcurv methods"),
+               Line2D([], [], color="tab:orange", marker="s", ls="", label="peers"),
+               Line2D([], [], color="gray", lw=1, label="front: nothing faster and at least as accurate")]
+    fig.legend(handles=handles, loc="upper center", ncol=3, bbox_to_anchor=(0.5, 0.965), frameon=False)
+    fig.suptitle("Time against error, one run: lower left is better (benchmarks/pareto.md)")
+    fig.tight_layout(rect=(0, 0, 1, 0.94))
+    for ax, entries in zip(axes.ravel(), summary.values()):  # in the final layout: positions in pixels hold
+        _place_labels(ax, [(e["cpu"], 100 * e["error"], _short(name)) for name, e in entries.items()
+                           if np.isfinite(e["error"]) and e["error"] > 0])
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
@@ -302,7 +396,7 @@ def main(argv=None) -> int:
     text = markdown(summary, found, missing, args, load_start, load_end, n_by_family)
     with open(args.output, "w", encoding="utf-8") as handle:
         handle.write(text)
-    figure(summary, args.figure)
+    figure(summary, args.figure, n_by_family)
     print(text)
     return 0
 
