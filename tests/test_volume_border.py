@@ -212,3 +212,59 @@ def test_balls_cut_by_image_faces_give_right_curvature_or_none(spacing, faces, d
         assert relative(row.mean_median, 1 / radius) < 0.1
     if (faces, depth) in ((1, 0.5), (2, 0.9)):  # the part around the pole, 3 radii (13-14 voxels) from the cap
         assert row.n_used > 0
+
+
+# ---- the area of the part inside, whichever image faces cut it (issue 29, class 4) -----------------------------------
+
+def sphere_fraction_inside(depths, n=1_000_000):
+    """The fraction of the unit sphere with ``x_k >= -depths[k]`` on the first axes: a Fibonacci lattice of
+    ``n`` points (equal-area cells; error of order 1 / n on these piecewise-smooth regions)."""
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    phi = np.pi * (1 + 5**0.5) * i
+    rho = np.sqrt(1 - z * z)
+    points = np.column_stack([rho * np.cos(phi), rho * np.sin(phi), z])
+    inside = np.ones(n, dtype=bool)
+    for axis, depth in enumerate(depths):
+        inside &= points[:, axis] >= -depth
+    return inside.mean()
+
+
+def test_the_lattice_fraction_is_exact_where_it_is_known():
+    assert sphere_fraction_inside([0.0]) == pytest.approx(0.5, abs=1e-5)
+    assert sphere_fraction_inside([0.0, 0.0]) == pytest.approx(0.25, abs=1e-5)
+    assert sphere_fraction_inside([0.0, 0.0, 0.0]) == pytest.approx(0.125, abs=1e-5)
+    assert sphere_fraction_inside([0.5]) == pytest.approx(0.75, abs=1e-5)  # a zone of height 1.5 R: 2 pi R h
+
+
+@pytest.mark.parametrize("radius, depths", [(9.0, (0.0, 0.0)), (10.0, (0.4, 0.4)), (10.0, (0.3, 0.6, 0.8)),
+                                            (12.0, (0.0, 0.0, 0.0))],
+                         ids=["quarter", "two-faces", "three-faces", "eighth"])
+def test_ball_cut_by_several_image_faces_has_the_area_of_its_part_inside(radius, depths):
+    # the centre ``depth * R`` inside the low face of the first axes (the face at -0.5 voxel); measured 0.0-1.3% off
+    center = np.full(3, radius + 3.0)
+    for axis, depth in enumerate(depths):
+        center[axis] = depth * radius - 0.5
+    shape = np.ceil(center + radius + 3.0).astype(int)
+    row = label_curvatures(ball(shape, UNIT, center, radius).astype(np.uint8), spacing=UNIT).iloc[0]
+    assert row.touches_border and row.status == "ok"
+    assert relative(row.area, sphere_fraction_inside(depths) * 4 * np.pi * radius**2) < 0.03
+
+
+def test_a_hemisphere_cut_by_a_high_face_in_any_axis_order_and_read_in_chunks_has_the_same_area():
+    from meshcurv._lazy import LazyImage
+
+    radius = 9.0
+    image = ball((24, 24, 14), UNIT, (11.7, 12.2, 13.5), radius).astype(np.uint8)  # cut by the last x plane
+    row = label_curvatures(image, spacing=UNIT).iloc[0]
+    assert row.touches_border and relative(row.area, 2 * np.pi * radius**2) < 0.03  # measured +0.6%
+    # the same solid cut by the low face (every axis reversed) and by a z face (axes swapped): the same surface
+    # up to the marching-cubes triangulation's orientation (measured 1e-4)
+    for turned in (image[::-1, ::-1, ::-1], image.transpose(2, 1, 0)):
+        assert label_curvatures(np.ascontiguousarray(turned), spacing=UNIT).area[0] == pytest.approx(row.area,
+                                                                                                      rel=1e-3)
+    # read a chunk at a time (chunk faces through the object are no image border), and by label_surfaces
+    lazy = label_curvatures(LazyImage(image, chunks=(5, 7, 4)), spacing=UNIT).iloc[0]
+    assert lazy.touches_border and lazy.area == pytest.approx(row.area, rel=1e-12)
+    _, rows = label_surfaces(image, spacing=UNIT)
+    assert next(rows)[0]["area"] == pytest.approx(row.area, rel=1e-12)
