@@ -80,7 +80,7 @@ def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> di
 _NOT_FOR_QUALITY = ("dir_min", "dir_max", "normals", "valid")
 
 #: Which file to write for each reader, and what it keeps of the fields, as measured with the readers
-#: themselves (``tests/test_field_roundtrip.py``: VTK 9.7 through PyVista 0.49, trimesh 5.2, meshio 5.3,
+#: themselves (``tests/test_io_fields.py``: VTK 9.7 through PyVista 0.49, trimesh 5.2, meshio 5.3,
 #: pymeshlab 2025): reader -> (extensions, what it keeps).
 VIEWERS = {
     "ParaView / PyVista (VTK)": (
