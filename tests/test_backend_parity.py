@@ -97,21 +97,50 @@ def assert_same(a, b, label: str) -> None:
         unit = scale * scale if field == "gaussian" else scale
         np.testing.assert_array_equal(np.isnan(got), np.isnan(expected), err_msg=f"{label}: {field} NaN")
         np.testing.assert_allclose(got, expected, rtol=0, atol=RTOL * unit, err_msg=f"{label}: {field}")
-    np.testing.assert_allclose(b.normals, a.normals, rtol=0, atol=RTOL, err_msg=f"{label}: normals")
+    normals = b.normals
+    if a.method == "matgeom":  # matGeom's N is an eigenvector, unoriented (documented): the same up to sign
+        normals = normals * np.where(np.einsum("ij,ij->i", normals, a.normals) < 0, -1.0, 1.0)[:, None]
+    np.testing.assert_allclose(normals, a.normals, rtol=0, atol=RTOL, err_msg=f"{label}: normals")
 
 
-CASES = [("icc", None), ("icc", 2.0), ("quadric", None), ("normal_cycle_ball", None), ("normal_cycle_ball", 3.0)]
+#: Every method (all run compiled kernels: geometry, orientation, tensors, their own), the ball methods at
+#: their default radius and at a given one (in mean edge lengths), icc's adaptive scale too.
+CASES = [("icc", None), ("icc", 2.0), ("icc", "adaptive"), ("quadric", None), ("quadric", 3.0),
+         ("normal_cycle_ball", None), ("normal_cycle_ball", 3.0), ("normal_cycle", None), ("matgeom", None),
+         ("meyer", None), ("rusinkiewicz", None)]
 
 
-@pytest.mark.parametrize(("method", "edges"), CASES, ids=[f"{m}-{e or 'default'}" for m, e in CASES])
+@pytest.mark.parametrize(("method", "edges"), [
+    pytest.param(m, e, id=f"{m}-{e or 'default'}", marks=[pytest.mark.slow] if e == "adaptive" else [])
+    for m, e in CASES])
 @pytest.mark.parametrize("name", sorted(MESHES))
 def test_backends_compute_one_estimator(name, method, edges):
     # the default radius (icc: from the noise level of fits over connected balls; a voxel surface:
     # from a pilot pass) and a given one, in mean edge lengths
-    radius = None if edges is None else edges * mean_edge(name)
+    radius = edges * mean_edge(name) if isinstance(edges, float) else edges
     compiled = compute(name, method, "numba", radius)
     reference = compute(name, method, "numpy", radius)
     assert_same(compiled, reference, f"{name}, {method}, radius {radius}")
+
+
+def test_methods_without_a_radius_are_all_covered():
+    assert {method for method, _ in CASES} == set(meshcurv.METHODS)
+
+
+@pytest.mark.slow  # 1-10 s each: the NumPy path of three radii
+@pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
+@pytest.mark.parametrize("name", ["flat_ellipsoid", "sphere_with_hole", "voxel_flat_ellipsoid"])
+def test_backends_compute_one_multiscale_estimate(name, method):
+    # icc sums every radius in one walk (another kernel than one radius at a time)
+    vertices, faces = MESHES[name]
+    radii = [r * mean_edge(name) for r in (1.0, 2.0, 4.0)]
+    results = {}
+    for backend in ("numba", "numpy"):
+        with use_backend(backend), warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshQualityWarning)
+            results[backend] = meshcurv.multiscale_curvatures(vertices, faces, radii, method=method)
+    for radius, compiled, reference in zip(radii, results["numba"], results["numpy"]):
+        assert_same(compiled, reference, f"{name}, {method}, multiscale radius {radius}")
 
 
 def test_flat_ellipsoid_default_radius_does_not_depend_on_the_backend():
