@@ -14,6 +14,7 @@ from ._backend import kernel_threads, numba_kernels
 from ._tensors import principal_from_shape_operator
 from .measures import curvatures_from_measures, face_measures
 from .jets import fit_jets, jet_normals, shape_operators
+from . import _pointcloud_normals as _normals
 
 logger = logging.getLogger(__name__)
 
@@ -41,6 +42,18 @@ NORMAL_RULE = (4.0, 55.0)
 #: median error of ``benchmarks/pointcloud.py`` by more than 0.02 points (ellipsoid, torus, saddle, noise 0
 #: to 0.2 spacings) and cost 7-18% of the fits' time at 1M points (their neighbour search dominates).
 NORMAL_ITERATIONS = 1
+
+#: Points of a ball (evenly spread over its distance order) that :func:`flat_balls` checks for a surface ...
+SUPPORT_POINTS = 48
+
+#: ... and power iterations for their main direction; a point counts as beside the line through the centre when
+#: farther from it than this times the farthest point's distance (94% of a disc's area) ...
+SUPPORT_ITERATIONS = 6
+BALL_OFFSET = 0.1
+
+#: ... and a ball holds a surface when this share of its points (or more) is beside the line: an elongated
+#: ball of a surface (trimmed by :func:`_own_side`, at a rim) has, a line with a few points beside it has not.
+BALL_SHARE = 0.25
 
 #: Centres per chunk of ``corrected_measures`` (bounds memory: chunk x TRIANGLES triangles).
 CHUNK = 32768
@@ -239,6 +252,32 @@ def _own_side(normals, centres, index, counts, sheets=None):
     return np.ascontiguousarray(index), counts - away.sum(axis=1)
 
 
+def flat_balls(points, centres, index, counts) -> np.ndarray:
+    """(M,) bool: the balls ``index`` (M, k) (``counts`` points first, padded with N) that hold a surface.
+
+    A ball holds a surface when at least :data:`meshcurv._pointcloud_normals.LINE_SUPPORT` and
+    :data:`BALL_SHARE` of :data:`SUPPORT_POINTS` of its points (every few in distance order) lie farther than
+    :data:`BALL_OFFSET` times the farthest one's distance from the line through the centre along their main
+    direction (a few power iterations on their covariance): a ball of points on a line and one or two beside it (the end of a scan line,
+    a line of points beside a few others) gives triangles of those few points only, and no surface.
+    """
+    stride = -(-index.shape[1] // SUPPORT_POINTS)  # every stride-th in distance order: the whole ball
+    column = np.arange(0, index.shape[1], stride)
+    member = column[None, :] < counts[:, None]
+    offsets = points[np.where(member, index[:, column], centres[:, None])] - points[centres][:, None, :]
+    covariance = np.einsum("mki,mkj->mij", offsets, offsets)
+    direction = offsets[np.arange(index.shape[0]), np.argmax(np.einsum("mkj,mkj->mk", offsets, offsets), axis=1)]
+    for _ in range(SUPPORT_ITERATIONS):
+        direction = np.einsum("mij,mj->mi", covariance, direction)
+        direction /= np.maximum(np.linalg.norm(direction, axis=1), np.finfo(float).tiny)[:, None]
+    along = np.einsum("mkj,mj->mk", offsets, direction)
+    squared = np.einsum("mkj,mkj->mk", offsets, offsets)
+    across = squared - along * along
+    far = squared.max(axis=1)
+    beside = (across > BALL_OFFSET**2 * far[:, None]).sum(axis=1)
+    return beside >= np.maximum(_normals.LINE_SUPPORT, BALL_SHARE * member.sum(axis=1))
+
+
 def corrected_measures(tree, points, normals, radius, centres, usable, *, spacing: float = 0.0,
                        n_triangles: int | None = None, sheets: np.ndarray | None = None):
     """Randomized corrected curvature measures over balls of ``radius`` (Lachaud et al. 2023).
@@ -276,6 +315,7 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
             index, counts = _own_side(normals, chunk, index, counts, sheets)
         logger.debug("point cloud: triangle sums")
         rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
+        rows = rows[flat_balls(points, chunk[rows], index[rows], counts[rows])]
         if rows.size == 0:
             continue
         index, counts = index[rows], counts[rows]

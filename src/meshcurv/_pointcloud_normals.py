@@ -90,6 +90,29 @@ SMALL_PART_ROUNDS = 8
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
 
+#: A point's nearest neighbours lie on a line when their spread across their main direction (the square root
+#: of the second eigenvalue of their covariance) is below this share of the spread along it (see
+#: :func:`scan_lines`); a random sample of a surface has no such neighbourhood.
+LINE_SPREAD = 0.1
+
+#: ... then its this many nearest neighbours are searched for support beyond the line ...
+LINE_NEIGHBOURS = 64
+
+#: ... the points no farther along the line than its nearest neighbours reach (``w``) and farther than this times
+#: ``w`` from the line ...
+LINE_OFFSET = 0.5
+
+#: ... and no farther than this times ``w`` (lines up to about 25 times sparser across than along) ...
+LINE_FAR = 5.0
+
+#: ... at least this many of them: a surface sampled along lines (scan lines), measured over balls that reach
+#: the neighbouring lines; fewer: the point is on a line, and has no surface to measure.
+LINE_SUPPORT = 4
+
+#: A point of a scan line is measured over balls of at least this many times the distance to the neighbouring
+#: lines (three lines or more in each ball).
+LINE_REACH = 2.0
+
 #: The winding number (see :func:`winding_sides`) is evaluated at this many points at most (all when fewer) ...
 WINDING_QUERIES = 8192
 
@@ -183,6 +206,125 @@ def _drop_self(rows, d, i, k, distances, indices) -> None:
     keep[np.arange(rows.size), first] = False
     distances[rows] = d[keep].reshape(-1, k)
     indices[rows] = i[keep].reshape(-1, k)
+
+
+def line_spread(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """(N,) the spread of each point and its neighbours ``indices`` (N, k) across their main direction, over the
+    spread along it: ``sqrt(lambda_2 / lambda_1)`` of their covariance (0 on a line, 1 when isotropic).
+
+    The eigenvalues in closed form (Smith 1961), in chunks of :data:`CHUNK` points.
+    """
+    n = points.shape[0]
+    ratio = np.ones(n)
+    for start in range(0, n, CHUNK):
+        stop = min(n, start + CHUNK)
+        group = np.concatenate([points[start:stop, None, :], points[indices[start:stop]]], axis=1)
+        group = group - group.mean(axis=1, keepdims=True)
+        covariance = np.einsum("nki,nkj->nij", group, group)
+        mean = np.trace(covariance, axis1=1, axis2=2) / 3.0
+        shifted = covariance - mean[:, None, None] * np.eye(3)
+        spread = np.sqrt(np.einsum("nij,nij->n", shifted, shifted) / 6.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            half = np.linalg.det(shifted / np.where(spread > 0, spread, 1.0)[:, None, None]) / 2.0
+            angle = np.arccos(np.clip(half, -1.0, 1.0)) / 3.0
+            largest = mean + 2.0 * spread * np.cos(angle)
+            smallest = mean + 2.0 * spread * np.cos(angle + 2.0 * np.pi / 3.0)
+            second = np.maximum(3.0 * mean - largest - smallest, 0.0)
+            ratio[start:stop] = np.where(largest > 0, np.sqrt(second / np.where(largest > 0, largest, 1.0)), 1.0)
+    return ratio
+
+
+def scan_lines(points: np.ndarray, distances: np.ndarray, indices: np.ndarray, usable: np.ndarray, tree,
+               radius: float | None = None):
+    """The points whose nearest neighbours lie on a line: on a surface sampled along lines, or on a line alone.
+
+    A surface scanned along lines (LiDAR, profilometers) is sampled densely
+    along each line and sparsely across: the nearest neighbours of a point
+    all lie on its own line (their spread across it below
+    :data:`LINE_SPREAD` of their spread along it, :func:`line_spread`), and the
+    spacing, the PCA normal and the graph of the orientation made of them
+    describe a line, not the surface. The :data:`LINE_NEIGHBOURS` nearest
+    points of such a point are searched for support beyond the line: points
+    within the reach ``w`` of its nearest neighbours along the line,
+    farther than :data:`LINE_OFFSET` ``w`` from it and no farther than
+    :data:`LINE_FAR` ``w`` (within ``radius`` when given). With :data:`LINE_SUPPORT` of them or more the point is on a
+    scan line: its spacing is the side of the area per point of the larger
+    neighbourhood (``d_k sqrt(pi / k)``), its normal the least-variance
+    direction of the point, its nearest neighbours and its support, its
+    neighbours half on its line and half beyond (alternately, each in
+    distance order), and its balls reach :data:`LINE_REACH` times the
+    distance to the neighbouring lines. With fewer the point is on a line
+    (a wire, a line of points beside a few others): no surface to measure.
+
+    Parameters
+    ----------
+    points : ndarray of shape (N, 3)
+    distances, indices : ndarray of shape (N, k)
+        The nearest neighbours of each point (:func:`knn`).
+    usable : ndarray of shape (N,), bool
+        The points that count (the others are never searched, nor support).
+    tree : scipy.spatial.cKDTree
+        The points' tree.
+    radius : float, optional
+        The radius the user gave: the support must lie within it.
+
+    Returns
+    -------
+    lonely : ndarray of shape (N,), bool
+        Points on a line without a surface around them.
+    rows : ndarray of shape (M,), int
+        Points on scan lines; for each of them:
+    neighbours : ndarray of shape (M, k), int
+        New rows of ``indices``.
+    spacing : ndarray of shape (M,)
+        The local spacing.
+    least : ndarray of shape (M,)
+        The smallest radius of their balls.
+    normals : ndarray of shape (M, 3)
+        Unit normals (unoriented).
+    """
+    n, k = indices.shape
+    lonely = np.zeros(n, dtype=bool)
+    line = np.flatnonzero(usable & (line_spread(points, indices) < LINE_SPREAD))
+    empty = np.zeros(0, dtype=np.int64)
+    if line.size == 0 or n <= k + 1:
+        return lonely, empty, np.zeros((0, k), dtype=np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3))
+    wide = min(LINE_NEIGHBOURS, n - 1)
+    found = []
+    for start in range(0, line.size, CHUNK // 4):
+        rows = line[start:start + CHUNK // 4]
+        far, near = tree.query(points[rows], k=wide + 1, workers=-1)
+        far, near = far[:, 1:], near[:, 1:]  # (distinct points: each is its own nearest)
+        reach = distances[rows, -1]
+        direction = points[indices[rows, -1]] - points[rows]
+        direction /= np.maximum(np.linalg.norm(direction, axis=1), reach * 1e-12)[:, None]
+        offsets = points[near] - points[rows][:, None, :]
+        along = np.einsum("mkj,mj->mk", offsets, direction)
+        across = np.sqrt(np.maximum(np.einsum("mkj,mkj->mk", offsets, offsets) - along * along, 0.0))
+        support = (usable[near] & (np.abs(along) <= reach[:, None]) & (across > LINE_OFFSET * reach[:, None])
+                   & (across <= LINE_FAR * reach[:, None]) & (near != rows[:, None]))
+        if radius is not None:
+            support &= far < radius
+        held = support.sum(axis=1) >= LINE_SUPPORT
+        lonely[rows[~held]] = True
+        rows, far, near, support, across = rows[held], far[held], near[held], support[held], across[held]
+        if rows.size == 0:
+            continue
+        # alternately the nearest on the line and the nearest beyond it
+        rank = np.cumsum(support, axis=1) * support + np.cumsum(~support, axis=1) * ~support
+        order = np.argsort(2 * rank + ~support, axis=1, kind="stable")[:, :k]
+        neighbours = np.take_along_axis(near, order, axis=1)
+        spacing = far[:, -1] * np.sqrt(np.pi / wide)
+        gap = np.nanmedian(np.where(support, across, np.nan), axis=1)
+        members = np.concatenate([rows[:, None], indices[rows], np.where(support, near, rows[:, None])], axis=1)
+        group = points[members] - points[rows][:, None, :]
+        group = group - group.mean(axis=1, keepdims=True)
+        _, vectors = np.linalg.eigh(np.einsum("mki,mkj->mij", group, group))
+        found.append((rows, neighbours, spacing, LINE_REACH * gap, vectors[:, :, 0]))
+    if not found:
+        return lonely, empty, np.zeros((0, k), dtype=np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3))
+    rows, neighbours, spacing, least, normals = (np.concatenate(parts) for parts in zip(*found))
+    return lonely, rows, neighbours, spacing, least, normals
 
 
 def local_spacing(distances: np.ndarray) -> np.ndarray:

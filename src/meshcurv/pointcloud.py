@@ -172,6 +172,9 @@ _UNDECIDED = _reason_code("point cloud: side undecided")
 #: Code of points whose every ball held the other side of a thin part.
 _TWO_SIDED = _reason_code("point cloud: every ball held")
 
+#: Code of points on a line with no surface around them.
+_ON_A_LINE = _reason_code("point cloud: on a line")
+
 
 def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | None = None) -> CurvatureResult:
     """Principal curvatures, directions and normals at every point of a point cloud.
@@ -504,11 +507,35 @@ def _compute(points, given, radius, method, search=None):
         problems.append(f"{int((~usable & measurable).sum())} points are outliers (their "
                         f"{_normals.SPACING_NEIGHBOUR}th neighbour is beyond {OUTLIER_FACTOR:g} times the median "
                         "spacing): left out, NaN")
+    # neighbourhoods on a line: a surface scanned along lines (its own spacing, normals, neighbours and balls), or
+    # a line with no surface around it (NaN)
+    lonely, line, line_neighbours, line_spacing, least, line_normals = _normals.scan_lines(
+        points, distances, indices, usable, tree, radius)
+    if lonely.any():
+        problems.append(f"{int(lonely.sum())} points lie on a line (their nearest neighbours on a line, fewer than "
+                        f"{_normals.LINE_SUPPORT} points beside it within their reach): no surface there, NaN")
+        usable &= ~lonely
+    if line.size:
+        indices = indices.copy()
+        indices[line] = line_neighbours
+        spacing = spacing.copy()
+        spacing[line] = line_spacing
+        median = float(np.median(spacing[usable]))
+    if not usable.any():  # every point an outlier or on a line: nothing to measure
+        reason = np.where(lonely, _ON_A_LINE, 0).astype(np.int8)
+        nothing, nowhere = np.full(n, np.nan), np.full((n, 3), np.nan)
+        parameters = {"radius": np.nan if radius is None else radius, "spacing": median, "noise": np.nan,
+                      "normals": "estimated" if given is None else "given"}
+        return (nothing, nothing.copy(), nowhere, nowhere.copy(), nowhere.copy() if given is None else given,
+                usable, reason, parameters, problems)
+    least_radius = np.zeros(n)
+    least_radius[line] = least
     centres = np.flatnonzero(usable)
 
     logger.info("point cloud: normals")
     if given is None:
         start = _normals.pca_normals(points, indices)
+        start[line] = line_normals
         logger.info("point cloud: orientation")
         signs, labels, doubtful, sheets, unsettled = _normals.oriented_signs(points, start, indices, usable, spacing,
                                                                              tree)
@@ -534,15 +561,15 @@ def _compute(points, given, radius, method, search=None):
 
     logger.info("point cloud: noise level")
     noise = cloud_noise_level(points, start, median, centres, usable)
-    groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems)
+    groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems, least_radius)
     if radius is None:
         extent = points[usable]
         largest = CLOUD_EXTENT_CAP * float(np.linalg.norm(extent.max(axis=0) - extent.min(axis=0)))
-        if max(r for r, _, _ in groups) > largest:
+        if max(r for r, *_ in groups) > largest:
             problems.append(f"the cloud is too sparse or too noisy for its size (default radius "
-                            f"{max(r for r, _, _ in groups):.3g} beyond a quarter of its extent): radius cut to "
+                            f"{max(r for r, *_ in groups):.3g} beyond a quarter of its extent): radius cut to "
                             f"{largest:.3g}; the curvatures are rough")
-            groups = [(min(r, largest), s, m) for r, s, m in groups]
+            groups = [(min(r, largest), s, m, min(f, largest)) for r, s, m, f in groups]
 
     k_min, k_max = np.full(n, np.nan), np.full(n, np.nan)
     dir_min, dir_max = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
@@ -554,20 +581,20 @@ def _compute(points, given, radius, method, search=None):
     one_sided = np.ones(n, dtype=bool)  # points with a one-sided jet fit (or given normals)
     two_sided_mask = np.zeros(n, dtype=bool)
     mixed = None
-    for group_radius, group_spacing, members in groups:
+    for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
         if method == "jets":
             # a ball that holds the other side of a thin or small part shrinks, down to the clean-sample radius
             # (a given radius too: a jet through both sides is not the surface, H doubled on a small sphere)
-            smallest = min(group_radius, CLOUD_RADIUS_RULES[method][0] * group_spacing)
+            smallest = min(group_radius, max(CLOUD_RADIUS_RULES[method][0] * group_spacing, floor))
             found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest,
                                      details=details)
             asked = group_radius
         else:
             if given is None:
-                asked = normal_radius = noise_rule(_estimators.NORMAL_RULE, group_spacing, noise)
+                asked = normal_radius = max(noise_rule(_estimators.NORMAL_RULE, group_spacing, noise), floor)
                 normals = _estimators.fitted_normals(points, start, normal_radius, members, usable,
-                                                     smallest=_estimators.NORMAL_RULE[0] * group_spacing,
+                                                     smallest=max(_estimators.NORMAL_RULE[0] * group_spacing, floor),
                                                      details=details)
                 parameters["normal_radius"] = normal_radius
                 # a point whose every normal fit held the other side, and whose nearest neighbours hold
@@ -611,6 +638,7 @@ def _compute(points, given, radius, method, search=None):
         doubtful = doubtful | alike | interleaved
     reason = np.zeros(n, dtype=np.int8)
     reason[~one_sided | (two_sided_mask & usable)] = _TWO_SIDED
+    reason[lonely] = _ON_A_LINE
     valid &= one_sided
     if doubtful.any():
         found = []
@@ -629,27 +657,45 @@ def _compute(points, given, radius, method, search=None):
         valid &= ~doubtful
         reason[doubtful] = _UNDECIDED
     if len(groups) > 1:
-        parameters["radii"] = tuple(r for r, _, _ in groups)
+        parameters["radii"] = tuple(r for r, *_ in groups)
     return k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, problems
 
 
-def _radius_groups(spacing, indices, usable, median, noise, radius, method, problems):
-    """``[(radius, spacing, centres), ...]``: one radius, or one per class of density when it is uneven."""
+def _radius_groups(spacing, indices, usable, median, noise, radius, method, problems, least=None):
+    """``[(radius, spacing, centres, floor), ...]``: one radius, or one per class of density when it is uneven.
+
+    ``least`` (N,): the smallest radius of each point's balls (points of scan lines, see
+    :func:`meshcurv._pointcloud_normals.scan_lines`; 0 elsewhere): those points get groups of their own, by
+    powers of two of ``least``, whose radius and ``floor`` (the smallest radius of their fits) are the largest
+    ``least`` of the group or more.
+    """
     centres = np.flatnonzero(usable)
     if radius is not None:
-        return [(radius, median, centres)]
+        return [(radius, median, centres, 0.0)]
+    lines = []
+    if least is not None and (least[centres] > 0).any():
+        on_line = centres[least[centres] > 0]
+        centres = centres[least[centres] == 0]
+        level = np.round(np.log2(least[on_line] / median)).astype(np.int64)
+        for k in np.unique(level):
+            members = on_line[level == k]
+            floor = float(least[members].max())
+            group_spacing = float(np.median(spacing[members]))
+            lines.append((max(cloud_radius(group_spacing, noise, method), floor), group_spacing, members, floor))
+    if centres.size == 0:  # (no usable point: every point an outlier or on a line)
+        return lines or [(cloud_radius(median, noise, method), median, centres, 0.0)]
     # the spacing averaged over the neighbours: one class per region, not per random gap
     # (over the usable neighbours of usable points only: a row of outliers alone would have no mean)
     smooth = np.where(usable, spacing, np.nan)
     smooth = np.nanmean(np.concatenate([smooth[centres, None], smooth[indices[centres]]], axis=1), axis=1)
     low, high = np.percentile(smooth, [5, 95])
     if high <= UNEVEN_DENSITY * low:
-        return [(cloud_radius(median, noise, method), median, centres)]
+        return [(cloud_radius(median, noise, method), median, centres, 0.0), *lines]
     level = np.round(np.log2(smooth / median)).astype(np.int64)
     groups = []
     for k in np.unique(level):
         members = centres[level == k]
-        groups.append((cloud_radius(median * 2.0**k, noise, method), median * 2.0**k, members))
+        groups.append((cloud_radius(median * 2.0**k, noise, method), median * 2.0**k, members, 0.0))
     problems.append(f"the density of the points is very uneven (local spacing from {low:.3g} to {high:.3g}, "
                     f"5th to 95th percentile): each of {len(groups)} classes of spacing got its own radius")
-    return groups
+    return groups + lines

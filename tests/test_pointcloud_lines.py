@@ -1,0 +1,115 @@
+"""Point clouds on lines (issue 29): a line has no surface; a surface scanned along lines has one.
+
+Oracles: a plane (curvature 0) and a unit sphere (H = K = 1 with outward
+normals) sampled along scan lines ten times sparser across than along, and a
+line of points beside a few others (no surface: NaN with the reason code).
+Tolerances: the scan lines are exact samples; the median H error of the
+measures is below 0.5% and no valid point is off by half of H (a line's
+balls reach two neighbouring lines on each side, the sphere's band curves
+across them).
+"""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from meshcurv import _pointcloud_normals as normals_module
+from meshcurv.errors import MeshQualityWarning
+from meshcurv.pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
+from meshcurv.result import INVALID_REASONS
+
+ON_A_LINE = next(code for code, text in enumerate(INVALID_REASONS) if text.startswith("point cloud: on a line"))
+
+
+def quiet(points, **options):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        return point_cloud_curvatures(points, **options)
+
+
+def scanned_plane(along=0.01, ratio=10, seed=0):
+    """A unit square, tilted, scanned along x (step ``along``, jittered) every ``ratio * along`` in y."""
+    rng = np.random.default_rng(seed)
+    x, y = np.meshgrid(np.arange(0, 1, along), np.arange(0, 1, along * ratio))
+    x = x + rng.uniform(-0.2, 0.2, x.shape) * along
+    rotation = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    return np.stack([x.ravel(), y.ravel(), np.zeros(x.size)], axis=1) @ rotation.T
+
+
+def scanned_sphere(along=0.02, ratio=10, latitude=1.2, seed=0):
+    """A band of the unit sphere (|latitude| below 1.2 rad) scanned along circles of latitude (step ``along``)
+    every ``ratio * along`` of latitude."""
+    rng = np.random.default_rng(seed)
+    rings = []
+    for theta in np.arange(np.pi / 2 - latitude, np.pi / 2 + latitude, ratio * along):
+        count = int(2 * np.pi * np.sin(theta) / along)
+        phi = (np.arange(count) + rng.random()) * 2 * np.pi / count
+        rings.append(np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi),
+                               np.full(count, np.cos(theta))], axis=1))
+    return np.concatenate(rings)
+
+
+def test_the_nearest_neighbours_of_a_scan_line_lie_on_a_line():
+    from scipy.spatial import cKDTree
+
+    points = scanned_plane()
+    distances, indices = normals_module.knn(cKDTree(points), points)
+    assert np.median(normals_module.line_spread(points, indices)) < normals_module.LINE_SPREAD
+    rng = np.random.default_rng(1)
+    random = np.concatenate([rng.random((2000, 2)), np.zeros((2000, 1))], axis=1)  # a random sample of a plane
+    _, indices = normals_module.knn(cKDTree(random), random)
+    assert normals_module.line_spread(random, indices).min() > normals_module.LINE_SPREAD
+
+
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
+def test_a_plane_scanned_along_lines_is_flat(method):
+    points = scanned_plane()
+    r = quiet(points, method=method)
+    spacing = 0.01 * np.sqrt(10)
+    assert r.valid.mean() > 0.95 if method == "corrected_measures" else r.valid.mean() > 0.9
+    # the exact plane: zero to round-off (relative to 1 / spacing)
+    assert np.abs(r.k_min[r.valid]).max() < 1e-6 / spacing
+    assert np.abs(r.k_max[r.valid]).max() < 1e-6 / spacing
+    normal = np.linalg.svd(points - points.mean(axis=0))[2][2]
+    assert np.abs(r.normals[r.valid] @ normal).min() > 0.999
+
+
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
+def test_a_sphere_scanned_along_lines_has_its_curvature(method):
+    points = scanned_sphere()
+    r = quiet(points, method=method)
+    assert r.valid.mean() > 0.9
+    assert (np.einsum("ij,ij->i", r.normals[r.valid], points[r.valid]) > 0).all()  # outward
+    error = np.abs(r.mean[r.valid] - 1.0)
+    assert np.median(error) < (0.005 if method == "corrected_measures" else 0.03)
+    assert error.max() < 0.5
+    assert np.abs(np.median(r.gaussian[r.valid]) - 1.0) < 0.06
+
+
+def test_a_line_beside_a_plane_has_no_curvature():
+    rng = np.random.default_rng(3)
+    plane = np.concatenate([rng.random((3000, 2)), np.zeros((3000, 1))], axis=1)
+    t = np.linspace(0.0, 1.0, 200)
+    line = np.stack([t, 0.5 + 0 * t, 0.3 + 0 * t], axis=1)  # 0.3 above the plane, 15 spacings
+    with pytest.warns(MeshQualityWarning, match="200 points lie on a line"):
+        r = point_cloud_curvatures(np.concatenate([line, plane]))
+    assert not r.valid[:200].any()
+    assert (r.invalid_reason[:200] == ON_A_LINE).all()
+    assert r.valid[200:].mean() > 0.95
+    assert np.abs(r.mean[200:][r.valid[200:]]).max() < 1e-6
+
+
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
+def test_two_skew_lines_have_no_curvature(method):
+    t = np.linspace(-1.0, 1.0, 300)
+    points = np.concatenate([np.stack([t, 0 * t, 0 * t], axis=1), np.stack([0 * t, t, 0 * t + 1.0], axis=1)])
+    r = quiet(points, method=method)
+    assert not r.valid.any()
+    assert (r.invalid_reason == ON_A_LINE).all()
+
+
+def test_a_given_radius_below_the_neighbouring_lines_finds_no_surface():
+    points = scanned_plane()
+    r = quiet(points, radius=0.05)  # the lines are 0.1 apart
+    assert not r.valid.any()
