@@ -616,6 +616,7 @@ class Bench:
         self.meshes = []      # (label, name, n_vertices, n_faces)
         self.radius = {}      # (label, method, factor) -> row
         self.profiles = {}
+        self.mesh_load = {}   # mesh label -> [load average at its start, at its end]
 
     def predicted(self, key, n):
         rate = self.rates.get(key)
@@ -747,6 +748,7 @@ class Bench:
                 np.save(os.path.join(mesh_dir, "f.npy"), f)
                 repeats = args.repeats if n < 2_000_000 else min(args.repeats, 3)
                 log(f"{label}: {name}, {n} vertices, {f.shape[0]} faces, {repeats} repeats")
+                self.mesh_load[label] = [os.getloadavg()]
                 rows = []
                 for key in keys:
                     if key == "trimesh" and n > args.trimesh_max:
@@ -763,6 +765,7 @@ class Bench:
                         row["times"] = row["times"] + again.get("times", [])
                         row["cpu"] = row.get("cpu", []) + again.get("cpu", [])
                 self.rows[label] = rows
+                self.mesh_load[label].append(os.getloadavg())
                 if label in args.radius_sizes.split(","):
                     self.radius_sweep(label, v, f, mesh_dir, min(repeats, 3))
                 if args.profile and label == args.profile_size:
@@ -852,7 +855,7 @@ def markdown(bench) -> str:
         f"- Load average (1, 5, 15 min) at start {tuple(round(x, 1) for x in info['load_start'])}, "
         f"at end {tuple(round(x, 1) for x in info.get('load_end', (0, 0, 0)))}"
         + (" — **shared machine: other jobs were running, timings are noisy**"
-           if info["load_start"][0] > 0.5 * info["cores"] else " (the load at the end is the benchmark's own)"),
+           if max(info["load_start"][0], info.get("load_end", (0,))[0]) > 0.5 * info["cores"] else " (the load at the end is the benchmark's own)"),
         f"- Python {info['python']}, numpy {v.get('numpy', '—')}, scipy {v.get('scipy', '—')}, "
         f"numba {v.get('numba', 'not installed')} (llvmlite {v.get('llvmlite', '—')}); "
         f"meshcurv {v.get('meshcurv', '—')} at commit {info['commit'] or '?'}",
@@ -1022,7 +1025,12 @@ def markdown(bench) -> str:
         igl_t, vtk_t, tf_t = t(label, "libigl"), t(label, "vtk"), t(label, TRUEFORM)
         tf_row = find(label, TRUEFORM)
         tf_cpu = statistics.median(tf_row["cpu"]) if tf_row and tf_row.get("cpu") else None
-        lines += [f"## {label}: {name}, {n:,} vertices, {n_faces:,} faces", "",
+        load = (getattr(bench, "mesh_load", None) or {}).get(label)
+        lines += [f"## {label}: {name}, {n:,} vertices, {n_faces:,} faces", ""]
+        if load and len(load) == 2:
+            lines += [f"Load average (1 min) of the machine: {load[0][0]:.1f} when this mesh began, {load[1][0]:.1f} "
+                      f"when it ended ({bench.info['cores']} cores; the benchmark itself adds 1 to 2).", ""]
+        lines += [
                   "| implementation | median s | CPU s | runs | fresh s | peak RSS MiB | bytes/vertex | ÷ lower | "
                   "÷ default | libigl ÷ | VTK ÷ | trueform ÷ | CPU: trueform ÷ |",
                   "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
@@ -1151,7 +1159,7 @@ def markdown(bench) -> str:
 
 #: Bench attributes that ``--json`` saves and ``--from-json`` restores (all that ``markdown`` reads).
 SAVED = ("info", "meshes", "rows", "import_time", "compile", "found", "missing", "default_backend",
-         "default_method", "default_key", "warm", "cli", "profiles", "command", "generated")
+         "default_method", "default_key", "warm", "cli", "profiles", "command", "generated", "mesh_load")
 
 
 def save_bench(bench, path: str) -> None:
@@ -1171,7 +1179,7 @@ def load_bench(path: str):
         setattr(bench, name, data.get(name))
     bench.radius = {tuple(key): row for key, row in data.get("radius", [])}
     bench.meshes = [tuple(m) for m in bench.meshes]
-    for name in ("warm", "cli", "profiles", "found", "missing"):
+    for name in ("warm", "cli", "profiles", "found", "missing", "mesh_load"):
         setattr(bench, name, getattr(bench, name) or {})
     return bench
 
