@@ -1,12 +1,10 @@
 """Integrals of curvature over a triangle mesh: area, total mean and Gaussian curvature, Willmore energy.
 
-Pointwise curvatures averaged over balls do not integrate to the totals: the
-sum of a barycentric vertex area times the default estimator's pointwise
-Gaussian curvature is 20% off Gauss-Bonnet on ``spot.obj`` (a ball average
-spreads the curvature of a sharp fold over a larger area than the fold's own
-and clips it), so the totals are taken from curvature *measures* of the
-surface with the estimator's vertex normals ``u_i`` interpolated over each
-face (Lachaud, Romon, Thibert and Coeurjolly 2020), which add up over faces:
+Pointwise curvatures averaged over balls do not integrate to the totals (a
+ball average spreads a sharp fold over a larger area and clips it), so the
+totals are taken from curvature *measures* of the surface with the
+estimator's vertex normals ``u_i`` interpolated over each face (Lachaud,
+Romon, Thibert and Coeurjolly 2020), which add up over faces:
 
 - ``"area"``: the barycentric vertex areas (a third of each incident face),
   whose sum is the area of the mesh;
@@ -29,16 +27,9 @@ face (Lachaud, Romon, Thibert and Coeurjolly 2020), which add up over faces:
   radius).
 
 Each face's measure goes a third to each of its corners, so that per-vertex
-shares (:func:`vertex_integrals`) add up over any set of vertices. Measured
-on ``spot.obj`` (closed, chi = 2) and ``rocker-arm.obj`` (chi = 0), the
-Gaussian total is ``4 pi`` and ``0`` to 1e-12 with every method's normals,
-where ``mu_2`` gives 10.62 (15% off) with the default's normals and the
-pointwise sums 10.05 (icc), 32.2 (normal_cycle), 11.79 (meyer).
-``mu_1`` rather than the edge formula ``1/2 sum l_e theta_e``
-(dihedral angles) for the mean: both are within 1% on clean spheres and tori,
-but the dihedral angles add the noise of the vertices (+1.3% on a sphere
-with normal noise of 0.1 edge length, against -0.5% with the default's fitted
-normals).
+shares (:func:`vertex_integrals`) add up over any set of vertices.
+Measured figures (Gauss-Bonnet on spot.obj and rocker-arm.obj, ``mu_1``
+against dihedral angles): ``benchmarks/docstring_figures.md``.
 
 References
 ----------
@@ -81,11 +72,7 @@ def face_solid_angles(normals: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def _face_mean_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """(F,) ``mu_1 / 2`` of each face (the corrected total mean curvature), 0 where a normal is not finite.
-
-    The compiled kernel of icc's face measures when numba is there (0.4 s for 2M faces against 3 s).
-    """
-
+    """(F,) ``mu_1 / 2`` of each face (the corrected total mean curvature), 0 where a normal is not finite."""
     measures = face_measures(vertices, faces, normals)[:, 1] / 2
     return np.where(np.isfinite(measures), measures, 0.0)
 
@@ -220,14 +207,8 @@ def weighted_statistics(values, weights) -> dict[str, float]:
     """``mean, median, p5, p25, p75, p95`` of ``values`` weighted by ``weights`` (see :func:`weighted_percentiles`)."""
     values = np.asarray(values, dtype=np.float64)
     weights = np.asarray(weights, dtype=np.float64)
-    p5, p25, median, p75, p95 = weighted_percentiles(values, weights, [5, 25, 50, 75, 95])
+    names = ("p5", "p25", "median", "p75", "p95")
+    figures = dict(zip(names, weighted_percentiles(values, weights, [5, 25, 50, 75, 95]).tolist()))
     kept = np.isfinite(values) & np.isfinite(weights) & (weights > 0)
     mean = float(np.sum(values[kept] * weights[kept]) / np.sum(weights[kept])) if kept.any() else np.nan
-    return {
-        "mean": mean,
-        "median": float(median),
-        "p5": float(p5),
-        "p25": float(p25),
-        "p75": float(p75),
-        "p95": float(p95),
-    }
+    return {"mean": mean, **{name: figures[name] for name in ("median", "p5", "p25", "p75", "p95")}}

@@ -20,6 +20,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -87,6 +88,10 @@ class AnalyticMesh:
     def gaussian(self) -> np.ndarray:
         """(V,) exact Gaussian curvature ``k_min * k_max``."""
         return self.k_min * self.k_max
+
+
+def _analytic_fields(mesh: AnalyticMesh) -> dict:
+    return {field.name: getattr(mesh, field.name) for field in dataclasses.fields(AnalyticMesh)}
 
 
 def _make(name, vertices, faces, k_min, k_max, dir_min, dir_max, normals, quads=None) -> AnalyticMesh:
@@ -161,50 +166,14 @@ def _jitter(values: np.ndarray, step: float, jitter: float, rng, fixed=None) -> 
 
 
 def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
-    phi = (1 + 5**0.5) / 2
-    v = np.array(
-        [
-            [-1, phi, 0],
-            [1, phi, 0],
-            [-1, -phi, 0],
-            [1, -phi, 0],
-            [0, -1, phi],
-            [0, 1, phi],
-            [0, -1, -phi],
-            [0, 1, -phi],
-            [phi, 0, -1],
-            [phi, 0, 1],
-            [-phi, 0, -1],
-            [-phi, 0, 1],
-        ],
-        dtype=float,
-    )
+    """The 12 unit vertices (cyclic permutations of ``(+-1, +-phi, 0)``) and 20 outward faces."""
+    signs = np.array([[-1, 1], [1, 1], [-1, -1], [1, -1]]) * [1.0, (1 + 5**0.5) / 2]
+    base = np.column_stack([signs, np.zeros(4)])
+    v = np.concatenate([np.roll(base, k, axis=1) for k in range(3)])
     v /= np.linalg.norm(v, axis=1, keepdims=True)
-    f = np.array(
-        [
-            [0, 11, 5],
-            [0, 5, 1],
-            [0, 1, 7],
-            [0, 7, 10],
-            [0, 10, 11],
-            [1, 5, 9],
-            [5, 11, 4],
-            [11, 10, 2],
-            [10, 7, 6],
-            [7, 1, 8],
-            [3, 9, 4],
-            [3, 4, 2],
-            [3, 2, 6],
-            [3, 6, 8],
-            [3, 8, 9],
-            [4, 9, 5],
-            [2, 4, 11],
-            [6, 2, 10],
-            [8, 6, 7],
-            [9, 8, 1],
-        ]
-    )
-    return v, f
+    f = "0 11 5 0 5 1 0 1 7 0 7 10 0 10 11 1 5 9 5 11 4 11 10 2 10 7 6 7 1 8 3 9 4 3 4 2 3 2 6 3 6 8 3 8 9 4 9 5 "
+    f += "2 4 11 6 2 10 8 6 7 9 8 1"
+    return v, np.array(f.split(), dtype=np.int64).reshape(-1, 3)
 
 
 def _subdivided_sphere(subdivisions: int) -> tuple[np.ndarray, np.ndarray]:
@@ -224,7 +193,7 @@ def _subdivided_sphere(subdivisions: int) -> tuple[np.ndarray, np.ndarray]:
     ids = np.take_along_axis(ids, order, axis=2)
     w = np.take_along_axis(w, order, axis=2)
     key = ((ids[..., 0] * 13 + ids[..., 1]) * 13 + ids[..., 2]) * (n + 1) ** 2 + w[..., 0] * (n + 1) + w[..., 1]
-    unique_keys, first, inverse = np.unique(key.ravel(), return_index=True, return_inverse=True)
+    _, first, inverse = np.unique(key.ravel(), return_index=True, return_inverse=True)
     inverse = inverse.reshape(20, -1)
     a, b, c = (corners[ico_faces[:, k]] for k in range(3))
     points = (
@@ -330,17 +299,8 @@ def torus(
     quads = np.stack([idx, i_next, np.roll(i_next, -1, axis=1), np.roll(idx, -1, axis=1)], axis=-1).reshape(-1, 4)
     k_ring = np.cos(p) / (R + r * np.cos(p))
     name = f"torus(R={R:g}, r={r:g})" + (f", jitter {jitter:g}" if jitter else "")
-    return _make(
-        name,
-        vertices,
-        _quads_to_triangles(quads, rng),
-        k_ring,
-        1 / r,
-        ring_direction,
-        tube_direction,
-        normals,
-        quads=quads,
-    )
+    exact = (k_ring, 1 / r, ring_direction, tube_direction, normals)
+    return _make(name, vertices, _quads_to_triangles(quads, rng), *exact, quads=quads)
 
 
 def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh:
@@ -470,16 +430,8 @@ def hemisphere(subdivisions: int = 16, radius: float = 1.0, *, irregular: bool =
         whole = icosphere(subdivisions, radius)
     keep = whole.vertices[whole.faces].mean(axis=1)[:, 2] > 0
     used, faces = np.unique(whole.faces[keep], return_inverse=True)
-    return _make(
-        f"hemisphere({whole.name})",
-        whole.vertices[used],
-        faces.reshape(-1, 3),
-        1 / radius,
-        1 / radius,
-        np.nan,
-        np.nan,
-        whole.normals[used],
-    )
+    exact = (1 / radius, 1 / radius, np.nan, np.nan, whole.normals[used])
+    return _make(f"hemisphere({whole.name})", whole.vertices[used], faces.reshape(-1, 3), *exact)
 
 
 def with_normal_noise(mesh: AnalyticMesh, level: float, *, seed: int = 0) -> AnalyticMesh:
@@ -496,17 +448,8 @@ def with_normal_noise(mesh: AnalyticMesh, level: float, *, seed: int = 0) -> Ana
     edges = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).edges
     amplitude = level * mean_edge_length(mesh.vertices, edges)
     t = np.random.default_rng(seed).uniform(-amplitude, amplitude, size=(mesh.vertices.shape[0],))
-    return AnalyticMesh(
-        name=f"{mesh.name} + noise {level:g}h",
-        vertices=mesh.vertices + t[:, None] * mesh.normals,
-        faces=mesh.faces,
-        k_min=mesh.k_min,
-        k_max=mesh.k_max,
-        dir_min=mesh.dir_min,
-        dir_max=mesh.dir_max,
-        normals=mesh.normals,
-        quads=mesh.quads,
-    )
+    moved = {**_analytic_fields(mesh), "vertices": mesh.vertices + t[:, None] * mesh.normals}
+    return AnalyticMesh(**{**moved, "name": f"{mesh.name} + noise {level:g}h"})
 
 
 # -- voxelised solids: marching-cubes meshes of binary images -------------------------
@@ -577,20 +520,8 @@ def _marching_cubes(inside, extent: np.ndarray, spacing: np.ndarray, seed: int, 
 
 
 def _voxel_mesh(name, vertices, faces, center, spacing, closest, k_min, k_max, dir_min, dir_max, normals):
-    base = _make(name, vertices, faces, k_min, k_max, dir_min, dir_max, normals)
-    return VoxelMesh(
-        name=base.name,
-        vertices=base.vertices,
-        faces=base.faces,
-        k_min=base.k_min,
-        k_max=base.k_max,
-        dir_min=base.dir_min,
-        dir_max=base.dir_max,
-        normals=base.normals,
-        closest_points=closest,
-        center=center,
-        spacing=tuple(spacing.tolist()),
-    )
+    base = _analytic_fields(_make(name, vertices, faces, k_min, k_max, dir_min, dir_max, normals))
+    return VoxelMesh(**base, closest_points=closest, center=center, spacing=tuple(spacing.tolist()))
 
 
 def _spacing_label(spacing: np.ndarray) -> str:
@@ -636,19 +567,9 @@ def voxel_sphere(radius: float = 10.0, spacing=(1.0, 1.0, 1.0), *, seed: int = 0
     )
     offset = vertices - center
     normals = offset / np.linalg.norm(offset, axis=1, keepdims=True)
-    return _voxel_mesh(
-        f"voxel_sphere(r={r:g}, voxel {_spacing_label(s)})",
-        vertices,
-        faces,
-        center,
-        s,
-        center + r * normals,
-        1 / r,
-        1 / r,
-        np.nan,
-        np.nan,
-        normals,
-    )
+    name = f"voxel_sphere(r={r:g}, voxel {_spacing_label(s)})"
+    exact = (1 / r, 1 / r, np.nan, np.nan, normals)
+    return _voxel_mesh(name, vertices, faces, center, s, center + r * normals, *exact)
 
 
 def ellipsoid_closest_points(points, semi_axes, *, iterations: int = 60) -> np.ndarray:
@@ -709,19 +630,9 @@ def voxel_ellipsoid(semi_axes=(10.0, 7.0, 5.0), spacing=(1.0, 1.0, 1.0), *, seed
     hessian = np.zeros((local.shape[0], 6))
     hessian[:, :3] = 2 * inv2
     k_min, k_max, dir_min, dir_max, normals = _implicit(local, 2 * local * inv2, hessian)
-    return _voxel_mesh(
-        f"voxel_ellipsoid{tuple(a.tolist())}, voxel {_spacing_label(s)}",
-        vertices,
-        faces,
-        center,
-        s,
-        center + local,
-        k_min,
-        k_max,
-        dir_min,
-        dir_max,
-        normals,
-    )
+    name = f"voxel_ellipsoid{tuple(a.tolist())}, voxel {_spacing_label(s)}"
+    exact = (k_min, k_max, dir_min, dir_max, normals)
+    return _voxel_mesh(name, vertices, faces, center, s, center + local, *exact)
 
 
 def voxel_torus(
@@ -755,16 +666,6 @@ def voxel_torus(
     cos_phi = np.sum(normals * radial, axis=1)
     ring_direction = np.stack([np.zeros_like(rho), -radial[:, 2], radial[:, 1]], axis=1)
     tube_direction = np.cross(normals, ring_direction)
-    return _voxel_mesh(
-        f"voxel_torus(R={R:g}, r={r:g}, voxel {_spacing_label(s)})",
-        vertices,
-        faces,
-        center,
-        s,
-        center + R * radial + r * normals,
-        cos_phi / (R + r * cos_phi),
-        1 / r,
-        ring_direction,
-        tube_direction,
-        normals,
-    )
+    name = f"voxel_torus(R={R:g}, r={r:g}, voxel {_spacing_label(s)})"
+    exact = (cos_phi / (R + r * cos_phi), 1 / r, ring_direction, tube_direction, normals)
+    return _voxel_mesh(name, vertices, faces, center, s, center + R * radial + r * normals, *exact)

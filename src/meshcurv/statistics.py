@@ -30,50 +30,25 @@ How each is computed
 --------------------
 The weights ``A_i`` are a third of the *corrected area* ``mu_0`` of each face
 around vertex ``i`` (Lachaud et al. 2020; :func:`meshcurv.measures.face_measures`
-with the result's normals): the area of the smooth surface the normals
-describe, which is what :func:`meshcurv.label_curvatures` reports as ``area``
-(on a voxel staircase the triangles' own area is 8-19% too large). The
-moments are over the valid vertices (and those of ``where``).
+with the result's normals), the ``area`` of :func:`meshcurv.label_curvatures`.
+The moments are over the valid vertices (and those of ``where``).
 
-The integrals of H and K are not pointwise fields times areas: they are the
-curvature measures of the surface with the estimator's normals interpolated
-over each face, which add up over faces whatever the estimator's pointwise
-errors (:mod:`meshcurv.integrals`): ``int H dA`` is the sum of
-``mu_1 / 2`` over the faces, ``int K dA`` the sum of the signed areas of the
-spherical triangles of the normals (the Gauss image, ``2 pi chi`` on a closed
-surface, Gauss-Bonnet) a third of each to each corner. ``<field>_mean`` of H
-and K are these integrals divided by the corrected area of the same faces
-(as ``mean_weighted`` in :func:`meshcurv.label_curvatures`).
-
+The integrals of H and K are the curvature measures of the surface with the
+estimator's normals interpolated over each face (:mod:`meshcurv.integrals`):
+``int H dA`` is the sum of ``mu_1 / 2`` over the faces, ``int K dA`` the sum of
+the signed areas of the spherical triangles of the normals (the Gauss image,
+``2 pi chi`` on a closed surface), a third of each to each corner.
+``<field>_mean`` of H and K are these integrals over the corrected area.
 The positive and negative integrals split those measures by the sign of the
-curvature where they lie: a face's ``mu_1 / 2`` counts as positive when the
-pointwise H averaged over its corners is positive, a vertex's share of the
-Gauss image when the pointwise K there is (the sign of the measure itself
-where the estimate is NaN). The pointwise estimates are averages over balls of
-a few edge lengths, whose sign is that of the surface; the sign of each face's
-own measure follows the voxel staircase. Measured on label images of spheres
-of radius 10 and 12 voxels and tori of radii 5 and 2, 12 and 5 (voxels 0.7 x
-0.5 x 0.4 and 2 x 1 x 1): a sphere gets ``ICIn = 0`` and ``int H- dA = 0`` exactly, where the sign of each face's
-own measure gives ``ICIn = 0.008`` and ``int H- = -0.25%`` of ``int H``; a torus
-``ICIp = ICIn = 1.007`` and ``1.013``, against ``1.029`` and ``1.037`` with the
-faces' own signs. ``positive + negative = natural`` exactly, and
-``rectified = positive - negative``.
-
-Where the fitted normals wobble at a scale below the estimator's radius, the
-Gauss image folds over itself: its folds cancel in ``int K dA`` but add to
-both ``int K+`` and ``int |K-|``. This was seen on tori of tube radius 5 and
-2.5 voxels along the coarse axis of 2 x 1 x 1 voxels, at one placement of 12
-each (``ICIp = ICIn = 1.30`` and ``1.81``; the pointwise K is off there too). When
-``int |K| dA`` from the Gauss image exceeds the sum of the pointwise
-``|K| A_i`` by more than :data:`FOLD_TOLERANCE`, a note says so (the
-``warnings`` column of the label table; a warning here).
-
-``bending_energy`` and ``folding_index`` are quadratic in the curvatures and
-have no additive measure: they are sums of the pointwise ``k_min``, ``k_max``
-times ``A_i`` over the valid vertices, as FreeSurfer's. ``FI``'s integrand is
-``>= 0``, so the estimator's noise in ``k_max - k_min`` makes a sphere's ``FI``
-small but positive (0.05 to 0.15 on spheres of radius 10-20 voxels with
-voxels 0.7 x 0.5 x 0.4 and 2 x 1 x 1, where tori have 4 to 6).
+pointwise estimate where they lie (a face's ``mu_1 / 2`` by the pointwise H
+averaged over its corners, a vertex's share of the Gauss image by the
+pointwise K there; the measure's own sign where the estimate is NaN):
+``positive + negative = natural`` and ``rectified = positive - negative``.
+When the Gauss image folds (``int |K| dA`` from it above the sum of the
+pointwise ``|K| A_i`` by more than :data:`FOLD_TOLERANCE`), a note says so.
+``bending_energy`` and ``folding_index`` are sums of the pointwise ``k_min``,
+``k_max`` times ``A_i`` over the valid vertices, as FreeSurfer's. Measured
+figures: ``benchmarks/label_statistics.py``.
 
 References
 ----------
@@ -210,11 +185,8 @@ def _region_statistics(
 
 
 #: ``gaussian_integral_rectified`` above the sum of the pointwise ``|K| A_i`` by more than this fraction: the
-#: Gauss image of the normals folds, and the split integrals of K are questionable (a note says so). Measured
-#: on label images of spheres and tori with voxels 0.7 x 0.5 x 0.4 and 2 x 1 x 1, 12 offsets each
-#: (``benchmarks/label_statistics.py``): 1.002-1.087 where ICIp and ICIn are within 2% of the truth; 1.28 and
-#: 1.50 at the placements of tori of tube radius 5 and 2.5 voxels along the coarse axis where they are 30% and
-#: 80% high.
+#: Gauss image of the normals folds, and the split integrals of K are questionable (a note says so; the
+#: figures behind the value: ``benchmarks/label_statistics.py``).
 FOLD_TOLERANCE = 0.15
 
 

@@ -18,23 +18,13 @@ extension     format                 per-vertex fields          needs
 .. [2] Reading a legacy POLYDATA file (what VTK and ParaView write for
    surfaces) needs only numpy; UNSTRUCTURED_GRID files and writing need meshio.
 
-PLY is read here, ASCII and binary, with a bounded header parser and every
-declared count checked against the size of the file before anything is
-allocated (meshio's reader loops forever on a header cut short and allocates
-for what a header declares); faces whose records all have the same size
-(what scanners and most tools write) are read in one numpy pass (about 50 ms
-for a 1M-vertex sphere, against 0.80 s with meshio's face-by-face reader).
-Legacy VTK POLYDATA is read here too (:mod:`._vtk`); STL, UNSTRUCTURED_GRID
-.vtk and .vtu go through meshio (its STL reader merges the repeated corners
-of each facet into shared vertices), and so does writing PLY, STL, VTK and
-VTU. OFF is read and written here (meshio reads only triangles and writes 12
-digits), line by line so that face colours are ignored. OBJ has its own numpy
-reader, faster than meshio's and tolerant of ``f v/vt/vn`` corners whose
-texture coordinates outnumber the vertices; meshio has no .vtp, which has its
-own small XML module. Outputs are written to a temporary file and published
-atomically, without replacing a file that appeared meanwhile unless
-``overwrite=True``. Every failure to read or write is a
-:class:`~meshcurv.errors.MeshFileError` naming the file.
+PLY (:mod:`._ply`), legacy VTK POLYDATA (:mod:`._vtk`), OBJ, OFF and VTP are
+read here with numpy, every count a header declares checked against the size
+of the file before anything is allocated; STL, UNSTRUCTURED_GRID .vtk and
+.vtu go through meshio, and so does writing PLY, STL, VTK and VTU. Outputs
+are written to a temporary file and published atomically, without replacing
+a file that appeared meanwhile unless ``overwrite=True``. Every failure to
+read or write is a :class:`~meshcurv.errors.MeshFileError` naming the file.
 """
 
 from __future__ import annotations

@@ -1,12 +1,9 @@
 """Wavefront OBJ, read and written with numpy (no optional dependency).
 
-meshio's OBJ reader refuses files whose texture coordinates outnumber their
-vertices (``f v/vt`` with seams, as ``spot.obj``) and parses line by line in
-Python (1.7 s for igea.obj, 134k vertices); trimesh splits vertices along UV
-seams, which would cut the surface open. This reader keeps only ``v`` and ``f``
-records, takes the part of each corner before its first slash, accepts
-polygons and negative (relative) indices, and parses with regular expressions
-and numpy (about 0.5 s for igea.obj).
+Only ``v`` and ``f`` records are kept, each corner's part before its first
+slash (texture coordinates may outnumber the vertices, as in ``spot.obj``;
+vertices are not split along UV seams), polygons and negative (relative)
+indices accepted.
 """
 
 from __future__ import annotations

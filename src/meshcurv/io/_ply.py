@@ -1,15 +1,10 @@
-"""PLY read with numpy: ASCII and binary (both byte orders), without meshio.
-
-meshio's PLY reader loops forever on a file cut before ``end_header`` (its
-header loop reads past the end of the file), allocates for the counts a
-header declares before reading them, and reads a binary face list one face
-at a time (0.80 s for a 1M-vertex sphere; about 50 ms here). This reader:
+"""PLY read with numpy: ASCII and binary (both byte orders), without meshio. This reader:
 
 - looks for ``end_header`` in the first :data:`HEADER_LIMIT` bytes only, and
   refuses a header that ends before it;
 - checks every element's declared count against the bytes (binary) or the
   lines (ASCII) the file really holds before it allocates anything for it,
-  so a header that declares 50 million faces over 4 is an error, not 7 GB;
+  so a header that declares 50 million faces over 4 is an error;
 - treats the end of the file inside any element as an error, never as a
   shorter mesh;
 - reads an ASCII body one record per line, as the format writes it: a line
