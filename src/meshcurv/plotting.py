@@ -3,10 +3,9 @@
 The mesh is rasterised here, with numpy, into an image per view (orthographic
 camera, z-buffer, vertex values interpolated across each triangle as matGeom's
 ``drawMesh(v, f, 'VertexColor', c)`` does, Gouraud shading),
-and matplotlib lays out the images, the colour bar and the direction strokes.
-matplotlib's own 3D axes sort whole polygons by depth (wrong where a
-non-convex surface hides itself) and took about 30 s for the 268k triangles of
-igea.obj; this takes about 2 s.
+and matplotlib lays out the images, the colour bar and the direction strokes
+(its own 3D axes sort whole polygons by depth, wrong where a non-convex
+surface hides itself).
 """
 
 from __future__ import annotations
@@ -31,8 +30,8 @@ MAX_PIXELS = 8192
 MAX_DPI = 1200
 
 #: The memory a view takes while it is drawn: bytes per pixel (z-buffer, face and barycentric weights,
-#: interpolated values, RGBA colours) and the rasteriser's chunks of pixel-face pairs. Measured with
-#: tracemalloc (one view of a 2562-vertex sphere): a peak of 1.07 GB at 2000 pixels, 1.46 GB at 3000.
+#: interpolated values, RGBA colours) and the rasteriser's chunks of pixel-face pairs (measured:
+#: benchmarks/docstring_figures.md).
 _BYTES_PER_PIXEL = 80
 _BYTES_FIXED = 2**30
 

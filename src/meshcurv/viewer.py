@@ -9,18 +9,12 @@ k_max, mean, gaussian, shape_index, curvedness), two boxes set the colour
 limits, another menu draws the principal directions, and the value under the
 cursor is shown.
 
-How the data are stored, per vertex (a mesh of V vertices has about 2V
-triangles): positions as float32 (12 bytes, relative to the bounding box's
-centre, which the page records as ``offset``), ``k_min`` and ``k_max`` as
-float32 (8 bytes; the four other fields are computed from them in the page),
-the reason a vertex has no value as uint8 (1 byte), and the triangles as uint32
-differences of consecutive indices, deflated (the page inflates them with the
-browser's ``DecompressionStream``): close to nothing for a mesh whose vertices
-are numbered along its surface, about 18 bytes when they are shuffled. Principal
-directions are stored for a spatially even subsample of at most
-``max_directions`` vertices. Everything is base64 (4/3): a page of 1M vertices
-takes 28 MB (ordered) to 52 MB (shuffled). For a point cloud the normals (int8,
-3 bytes) replace the triangles.
+Per vertex the page stores the position (float32, relative to the bounding
+box's centre, recorded as ``offset``), ``k_min`` and ``k_max`` (float32; the
+other fields are computed from them in the page) and the reason a vertex has
+no value (uint8); the triangles as deflated uint32 differences of consecutive
+indices (a point cloud: int8 normals instead); principal directions for a
+spatially even subsample of at most ``max_directions`` vertices; all base64.
 
 The address can set the page's state: ``page.html#field=gaussian&lo=-0.01&hi=0.01&directions=both``
 (also ``elevation``, ``azimuth``, ``zoom``, and ``probe=X,Y``, the vertex under that pixel). The

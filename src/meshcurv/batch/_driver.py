@@ -32,7 +32,7 @@ from ..errors import MissingDependencyError
 
 logger = logging.getLogger(__name__)
 
-#: The most worker processes of a local cluster (each a Python process of about 100 MB, before any mesh).
+#: The most worker processes of a local cluster.
 MAX_WORKERS = 1024
 
 #: Seconds without any worker after which :func:`run_tasks` gives up (:class:`NoWorkerError`): on the local
@@ -115,14 +115,10 @@ def local_cluster(*, workers: int | None = None, dashboard: bool = True):
     -----
     The worker processes get ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS``,
     ``OPENBLAS_NUM_THREADS`` and ``NUMBA_NUM_THREADS`` set to 1, so that N
-    workers keep to N cores; they ignore Ctrl-C (the caller closes them). Dask
-    normally starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536``, which
-    makes glibc hand every large array back to the system when freed: meshcurv
-    allocates many, and each mesh then takes about twice as long; this cluster
-    leaves the variable unset (glibc's own adaptive threshold), unless it is
-    set in the environment. It sets ``MALLOC_ARENA_MAX=1``: the task runs in a
-    thread of its worker, and glibc's per-thread arenas made each mesh about 7%
-    slower there than in a main thread. It turns Dask's statistical profiler
+    workers keep to N cores; they ignore Ctrl-C (the caller closes them). Dask's
+    ``MALLOC_TRIM_THRESHOLD_=65536`` is left unset (glibc's own adaptive
+    threshold) unless set in the environment, ``MALLOC_ARENA_MAX=1`` is set,
+    and Dask's statistical profiler is turned
     off (:data:`WORKER_CONFIG`). The variables Dask writes into ``os.environ`` of
     this process to start the workers are put back as they were on closing.
 

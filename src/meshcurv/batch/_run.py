@@ -33,9 +33,7 @@ logger = logging.getLogger(__name__)
 DEFAULT_TIMEOUT = 3600.0
 
 #: The most bytes of input files sent to a worker as one task (a single larger mesh is a task of its
-#: own). Dask costs a few milliseconds per task, and the process that schedules competes with the
-#: workers for the cores: with a task per mesh of 10k vertices (30 ms of work), two workers on two
-#: cores ran 1.1x as fast as one; in tasks of about 4 MiB (a few hundred milliseconds) the cost is shared.
+#: own), so that Dask's cost per task is shared by several meshes.
 CHUNK_BYTES = 4 * 2**20
 
 #: The fewest tasks per worker when there are enough meshes, so that no worker waits for another's long task.

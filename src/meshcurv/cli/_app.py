@@ -29,14 +29,17 @@ from ..plotting import _EXTRA_INCHES, _PANEL_INCHES, MAX_DPI, VIEWS, _pyplot, ch
 from ..topology import MeshTopology
 from ._batch import batch
 from ._common import (
+    PATH,
     SCALAR_FIELDS,
     Session,
     _default_method,
     _percentiles,
+    choice,
     common_options,
     current_session,
     estimated,
     method_options,
+    path_option,
 )
 from ._view import view
 from ._volume import volume
@@ -132,13 +135,10 @@ def _viewers_epilog() -> str:
 
 
 @meshcurv.command(epilog=_viewers_epilog())
-@click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
-@click.option(
-    "-o",
-    "--output",
-    type=click.Path(readable=False, path_type=pathlib.Path),
-    default=None,
-    help="Write the fields to .vtp (ParaView, PyVista), .ply (MeshLab: one field as quality; meshio, "
+@click.argument("mesh", type=PATH)
+@path_option(
+    ("-o", "--output"),
+    "Write the fields to .vtp (ParaView, PyVista), .ply (MeshLab: one field as quality; meshio, "
     "trimesh), .vtu/.vtk, .csv (pandas) or .npz (NumPy); see below. A point cloud's fields go to "
     ".ply, .xyz, .txt, .pts, .csv, .pcd, .las or .laz. Default: print a summary.",
 )
@@ -150,13 +150,7 @@ def _viewers_epilog() -> str:
     metavar="NAME,...",
     help=f"Fields to write or summarise (default: all): {', '.join(FIELDS)}.",
 )
-@click.option(
-    "--quality",
-    type=click.Choice(SCALAR_FIELDS),
-    default="mean",
-    show_default=True,
-    help="Field copied as `quality`, the vertex property MeshLab colours by.",
-)
+@choice("--quality", SCALAR_FIELDS, "mean", "Field copied as `quality`, the vertex property MeshLab colours by.")
 @click.option("--ascii", "ascii_", is_flag=True, help="ASCII rather than binary PLY, STL or VTK.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
 @common_options
@@ -295,22 +289,9 @@ def _limits(ctx, param, value):
 
 
 @meshcurv.command()
-@click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
-@click.option(
-    "-o",
-    "--output",
-    type=click.Path(readable=False, path_type=pathlib.Path),
-    default=None,
-    help="The PNG to write (default: MESH-NAME_FIELD.png in the current folder).",
-)
-@click.option(
-    "-f",
-    "--field",
-    type=click.Choice(SCALAR_FIELDS),
-    default="mean",
-    show_default=True,
-    help="The field that colours the mesh.",
-)
+@click.argument("mesh", type=PATH)
+@path_option(("-o", "--output"), "The PNG to write (default: MESH-NAME_FIELD.png in the current folder).")
+@choice(("-f", "--field"), SCALAR_FIELDS, "mean", "The field that colours the mesh.")
 @method_options
 @click.option(
     "--view",
@@ -321,21 +302,14 @@ def _limits(ctx, param, value):
     help="auto (several views of a closed mesh, one of an open one), names separated by commas "
     "(iso, front, back, left, right, top, bottom, iso-back) or ELEVATION,AZIMUTH; repeatable.",
 )
-@click.option(
+@choice(
     "--up",
-    type=click.Choice(["auto", "y", "z", "x"]),
-    default="auto",
-    show_default=True,
-    help="The axis drawn upwards; auto: z when the mesh is more than 1.2 times as tall along z as "
+    ["auto", "y", "z", "x"],
+    "auto",
+    "The axis drawn upwards; auto: z when the mesh is more than 1.2 times as tall along z as "
     "along y, else y (most OBJ and PLY files).",
 )
-@click.option(
-    "--directions",
-    type=click.Choice(["none", "max", "min", "both"]),
-    default="none",
-    show_default=True,
-    help="Strokes along the principal directions.",
-)
+@choice("--directions", ["none", "max", "min", "both"], "none", "Strokes along the principal directions.")
 @click.option(
     "--percentiles",
     callback=_percentiles,
@@ -444,7 +418,7 @@ def plot(
 
 
 @meshcurv.command()
-@click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
+@click.argument("mesh", type=PATH)
 @common_options
 def info(mesh):
     """What MESH is: sizes, topology, defects, bounding box, edge length."""
@@ -493,7 +467,7 @@ def methods():
 
 
 @meshcurv.command()
-@click.argument("output", type=click.Path(readable=False, path_type=pathlib.Path), default="torus_gaussian.png")
+@click.argument("output", type=PATH, default="torus_gaussian.png")
 @click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
 @common_options
 def demo(output, overwrite):

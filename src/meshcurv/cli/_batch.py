@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import pathlib
-
 import click
 
 from ..batch import DEFAULT_TIMEOUT, MAX_WORKERS, OUTPUT_FORMATS, run
-from ._common import ProgressBar, common_options, current_session, method_options
+from ._common import ProgressBar, choice, common_options, current_session, method_options, path_option
 
 __all__ = ["batch", "BatchBar"]
 
@@ -32,23 +30,14 @@ class BatchBar(ProgressBar):
 
 @click.command("batch")
 @click.argument("inputs", nargs=-1, required=True)
-@click.option(
-    "-o",
-    "--output-dir",
-    "out_dir",
+@path_option(
+    ("-o", "--output-dir", "out_dir"),
+    "Folder of the results and of summary.parquet / summary.csv (created if needed).",
     required=True,
-    type=click.Path(readable=False, path_type=pathlib.Path),
-    help="Folder of the results and of summary.parquet / summary.csv (created if needed).",
+    default=None,
 )
 @method_options
-@click.option(
-    "--format",
-    "output_format",
-    type=click.Choice(OUTPUT_FORMATS),
-    default="ply",
-    show_default=True,
-    help="Format of the result files.",
-)
+@choice(("--format", "output_format"), OUTPUT_FORMATS, "ply", "Format of the result files.")
 @click.option(
     "--workers",
     type=click.IntRange(min=1, max=MAX_WORKERS),

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import pathlib
 import sys
 import warnings
 from typing import NamedTuple
@@ -29,6 +30,25 @@ from ..topology import MeshTopology
 __all__ = ["Session", "current_session", "common_options", "method_options", "estimated"]
 
 SCALAR_FIELDS = [name for name in FIELDS if name not in ("dir_min", "dir_max", "normals", "valid", "radius")]
+
+#: The type of the path arguments and options: the library checks the file and names it in its errors.
+PATH = click.Path(readable=False, path_type=pathlib.Path)
+
+
+def _names(names) -> tuple:
+    return (names,) if isinstance(names, str) else tuple(names)
+
+
+def path_option(names, help_text: str, **settings):
+    """A :data:`PATH` option (default None); ``names`` one name or a tuple of them."""
+    return click.option(*_names(names), type=PATH, help=help_text, **{"default": None, **settings})
+
+
+def choice(names, choices, default, help_text: str, **settings):
+    """An option of ``choices`` whose default is shown in the help; ``names`` one name or a tuple of them."""
+    return click.option(
+        *_names(names), type=click.Choice(choices), default=default, show_default=True, help=help_text, **settings
+    )
 
 
 #: The largest finite float: an option value that parses to infinity (``1e400``) is beyond it.

@@ -8,35 +8,21 @@ import click
 
 from ..io._files import check_input, check_output
 from ..viewer import VIEWER_FIELDS, write_html
-from ._common import _percentiles, common_options, current_session, estimated, method_options
+from ._common import PATH, _percentiles, choice, common_options, current_session, estimated, method_options, path_option
 
 __all__ = ["view"]
 
 
 @click.command("view")
-@click.argument("mesh", type=click.Path(readable=False, path_type=pathlib.Path))
-@click.option(
-    "-o",
-    "--output",
-    type=click.Path(readable=False, path_type=pathlib.Path),
-    default=None,
-    help="The page to write (default: MESH-NAME.html in the current folder).",
-)
-@click.option(
-    "-f",
-    "--field",
-    type=click.Choice(VIEWER_FIELDS),
-    default="mean",
-    show_default=True,
-    help="The field shown first (the page has a menu of all of them).",
-)
+@click.argument("mesh", type=PATH)
+@path_option(("-o", "--output"), "The page to write (default: MESH-NAME.html in the current folder).")
+@choice(("-f", "--field"), VIEWER_FIELDS, "mean", "The field shown first (the page has a menu of all of them).")
 @method_options
-@click.option(
+@choice(
     "--up",
-    type=click.Choice(["auto", "y", "z", "x"]),
-    default="auto",
-    show_default=True,
-    help="The axis drawn upwards at first; auto: z when the mesh is clearly taller along z than "
+    ["auto", "y", "z", "x"],
+    "auto",
+    "The axis drawn upwards at first; auto: z when the mesh is clearly taller along z than "
     "along y, else y (most OBJ and PLY files).",
 )
 @click.option(
@@ -91,7 +77,7 @@ def view(
     browser): drag to rotate, right drag to pan, the wheel zooms; a menu
     picks the field, boxes set the colour limits, the value under the
     cursor is shown, principal directions on demand. Grey: vertices
-    without an estimate. About 28-52 MB per million vertices.
+    without an estimate.
     """
     session = current_session()
     output = output if output is not None else pathlib.Path(f"{mesh.stem}.html")

@@ -17,7 +17,17 @@ from ..io._images import read_image
 from ..io._vtp import PieceWriter
 from ..io.fields import FIELDS, curvature_fields
 from ..plotting import _pyplot, plot_field, save_figure
-from ._common import _FLOAT_MAX, SCALAR_FIELDS, MethodChoice, ProgressBar, common_options, current_session
+from ._common import (
+    _FLOAT_MAX,
+    PATH,
+    SCALAR_FIELDS,
+    MethodChoice,
+    ProgressBar,
+    choice,
+    common_options,
+    current_session,
+    path_option,
+)
 
 __all__ = ["volume", "LabelBar", "MESH_FORMATS"]
 
@@ -61,14 +71,12 @@ def _label_list(ctx, param, value):
 
 
 @click.command("volume")
-@click.argument("image", type=click.Path(readable=False, path_type=pathlib.Path))
-@click.option(
-    "-o",
-    "--output-dir",
-    "out_dir",
+@click.argument("image", type=PATH)
+@path_option(
+    ("-o", "--output-dir", "out_dir"),
+    "Folder of the table, pictures and meshes (created if needed).",
     required=True,
-    type=click.Path(readable=False, path_type=pathlib.Path),
-    help="Folder of the table, pictures and meshes (created if needed).",
+    default=None,
 )
 @click.option(
     "--spacing",
@@ -137,14 +145,7 @@ def _label_list(ctx, param, value):
     show_default=True,
     help="A picture of all objects coloured by --field (needs matplotlib).",
 )
-@click.option(
-    "-f",
-    "--field",
-    type=click.Choice(SCALAR_FIELDS),
-    default="mean",
-    show_default=True,
-    help="The field of the picture.",
-)
+@choice(("-f", "--field"), SCALAR_FIELDS, "mean", "The field of the picture.")
 @click.option(
     "--workers",
     type=click.IntRange(min=1, max=MAX_WORKERS),
