@@ -343,7 +343,7 @@ class _Event:
 def test_compilation_is_announced_once_on_the_logger(caplog):
     from meshcurv import _backend
     from meshcurv._kernels.icc import face_measures
-    from meshcurv._kernels.jets import fit_jets
+    from meshcurv._kernels.jets import _grid_chunk
 
     announcer = _backend._CompileAnnouncer()
     foreign = _Event(warnings.warn, True)  # a function of another package: never announced
@@ -351,29 +351,29 @@ def test_compilation_is_announced_once_on_the_logger(caplog):
         announcer.on_start(foreign)
         announcer.on_end(_Event(warnings.warn, False))
         assert not caplog.records
-        for kernel in (fit_jets.py_func, face_measures.py_func):
+        for kernel in (_grid_chunk.py_func, face_measures.py_func):
             announcer.on_start(_Event(kernel, True))
             announcer.on_end(_Event(kernel, False))
     warned = [r for r in caplog.records if r.levelname == "WARNING"]
     assert len(warned) == 1 and "compiling meshcurv's numba kernels" in warned[0].getMessage()
     assert "cached on disk" in warned[0].getMessage()
     infos = [r.getMessage() for r in caplog.records if r.levelname == "INFO"]
-    assert [m.split()[4] for m in infos] == ["fit_jets", "face_measures"]
-    assert [name for name, _ in announcer.compiled] == ["fit_jets", "face_measures"]
+    assert [m.split()[4] for m in infos] == ["_grid_chunk", "face_measures"]
+    assert [name for name, _ in announcer.compiled] == ["_grid_chunk", "face_measures"]
 
 
 def test_nested_compilations_count_once(caplog):
     from meshcurv import _backend
-    from meshcurv._kernels.jets import fit_jets
+    from meshcurv._kernels.jets import _grid_chunk
     from meshcurv._kernels.neighborhoods import _grid
 
     announcer = _backend._CompileAnnouncer()
     with caplog.at_level("INFO", logger="meshcurv"):
-        announcer.on_start(_Event(fit_jets.py_func, True))
+        announcer.on_start(_Event(_grid_chunk.py_func, True))
         announcer.on_start(_Event(_grid.py_func, True))  # a callee compiled inside its caller
         announcer.on_end(_Event(_grid.py_func, False))
-        announcer.on_end(_Event(fit_jets.py_func, False))
-    assert [name for name, _ in announcer.compiled] == ["fit_jets"]
+        announcer.on_end(_Event(_grid_chunk.py_func, False))
+    assert [name for name, _ in announcer.compiled] == ["_grid_chunk"]
 
 
 SNIPPET = """
@@ -434,3 +434,29 @@ def test_kernel_threads_are_numbas_thread_count():
     from meshcurv._backend import kernel_threads
 
     assert kernel_threads() == numba.get_num_threads()
+
+
+def test_a_kernel_of_threaded_chunks_runs_on_one_thread_when_small():
+    """A kernel that runs compiled chunks on Python threads (``_common.threaded``) is handed out as the compiled
+    ones are: on one thread for arrays of fewer than SERIAL_ROWS rows (issue 31)."""
+    import numba
+
+    from meshcurv import _backend
+    from meshcurv._kernels._common import threaded
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba has one thread here (NUMBA_NUM_THREADS)")
+
+    @threaded
+    def kernel(array):
+        return numba.get_num_threads()
+
+    call = _backend._locked(kernel)
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(2)
+        assert call(np.zeros(10)) == 1
+        assert call(np.zeros(_backend.SERIAL_ROWS)) == 2
+        assert numba.get_num_threads() == 2  # given back
+    finally:
+        numba.set_num_threads(threads)

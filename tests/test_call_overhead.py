@@ -38,23 +38,21 @@ def test_a_result_keeps_the_arrays_a_kernel_allocated():
 
 
 def test_the_default_call_types_its_jet_fits_once(monkeypatch):
-    """The noise fits and the normal fits reach fit_jets_connected with the same argument types, so numba
-    compiles it once on a cold cache (the normals were read-only in one and writable in the other: two
+    """The noise fits and the normal fits reach the compiled jet fits with the same argument types, so numba
+    compiles them once on a cold cache (the normals were read-only in one and writable in the other: two
     signatures, 8-10 s of CPU each)."""
-    from meshcurv import _backend
     from meshcurv._kernels import jets
 
-    original = jets.fit_jets_connected
+    original = jets._connected_chunk
     seen = []
 
     def recording(*args):
         seen.append(tuple(str(numba.typeof(a)) for a in args))
         return original(*args)
 
-    recording.py_func = original.py_func  # run as a compiled kernel by the backend
-    monkeypatch.setattr(jets, "fit_jets_connected", recording)
-    monkeypatch.setattr(_backend, "_proxies", {})
+    monkeypatch.setattr(jets, "_connected_chunk", recording)
     sphere = shapes.icosphere(8)
     principal_curvatures(sphere.vertices, sphere.faces)
     assert len(seen) >= 2  # the noise fits and the normal fits
     assert len(set(seen)) == 1
+    assert seen[0][-1] == "none"  # fits of degree 3 or less: no code of the general moments compiled

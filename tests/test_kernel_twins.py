@@ -704,6 +704,20 @@ def check_matgeom_principal(name):
         assert_directions_close(got[separated], expected[separated], atol[separated], label, up_to_sign=True)
 
 
+def check_matgeom_finish(name):
+    """Its twins composed: smooth_over_neighbours, then matgeom_principal (each checked against NumPy above), to the bit."""
+    vertices, faces = mesh(name)
+    ev1, ev2, ef1, ef2, _ = matgeom_pairing_of(name)
+    tensors = kernels("matgeom").matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, kernel_threads())
+    indptr, indices = topology(name).neighbour_lists
+    for steps in (0, 1, 3):
+        smoothed = kernels("smoothing").smooth_over_neighbours(tensors, indptr, indices, steps)
+        expected = kernels("matgeom").matgeom_principal(smoothed)
+        got = kernels("matgeom").matgeom_finish(tensors.copy(), indptr, indices, steps)
+        for label, a, b in zip(("c1", "c2", "u1", "u2", "normal"), got, expected, strict=True):
+            np.testing.assert_array_equal(a, b, err_msg=f"{label}, {steps} steps")
+
+
 # -- smoothing ----------------------------------------------------------------------------------
 
 
@@ -1446,6 +1460,8 @@ TWINS = [
     Twin("matgeom.matgeom_vertex_tensors", "matgeom._vertex_tensors", check_matgeom_vertex_tensors, MESHES),
     Twin("matgeom.matgeom_principal", "matgeom.estimate (_eigen.sorted_by_magnitude and the swap)",
          check_matgeom_principal, MESHES),
+    Twin("matgeom.matgeom_finish", "smoothing.smooth_over_neighbours, then matgeom.matgeom_principal",
+         check_matgeom_finish, MESHES),
     Twin("smoothing.smooth_over_neighbours", "smoothing.smooth_vertex_field", check_smooth_over_neighbours, MESHES),
     Twin("icc.face_measures", "icc.face_measures", check_face_measures, MESHES),
     Twin("icc.curvatures_from_measures", "icc.curvatures_from_measures", check_curvatures_from_measures, MESHES),
@@ -1538,3 +1554,81 @@ def test_every_kernel_has_a_twin():
     for twin in TWINS:
         module, _, name = twin.kernel.partition(".")
         assert callable(getattr(kernels(module), name)), twin.kernel
+
+
+# -- the chunks of the jet fits on threads (issue 31: no numba parallel pipeline to compile) ------------
+
+
+def test_run_chunks_covers_every_item_once_in_the_ranges_of_prange():
+    from meshcurv._kernels._common import run_chunks
+
+    seen = []
+    run_chunks(lambda lo, hi, out: out.append((lo, hi)), 10, 4, seen)
+    assert sorted(seen) == [(0, 2), (2, 5), (5, 7), (7, 10)]  # c * n // k, as numba.prange's chunks
+    seen.clear()
+    run_chunks(lambda lo, hi, out: out.append((lo, hi)), 3, 64, seen)  # never more chunks than items
+    assert sorted(seen) == [(0, 1), (1, 2), (2, 3)]
+    seen.clear()
+    run_chunks(lambda lo, hi, out: out.append((lo, hi)), 0, 8, seen)  # nothing to do: one empty range
+    assert seen == [(0, 0)]
+
+
+def test_run_chunks_passes_on_an_error_of_a_chunk():
+    import numba
+
+    from meshcurv._kernels._common import run_chunks
+
+    def failing(lo, hi):
+        if lo > 0:
+            raise ValueError(f"chunk {lo}-{hi} failed")
+
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        with pytest.raises(ValueError, match="chunk 5-10 failed"):
+            run_chunks(failing, 10, 2)
+    finally:
+        numba.set_num_threads(threads)
+
+
+@pytest.mark.parametrize("connected", [False, True])
+def test_jet_fits_on_two_threads_are_those_of_one(connected):
+    """The chunks of the fits write their own rows: the outputs are equal to the bit whatever the threads."""
+    import numba
+
+    from meshcurv import jets
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba has one thread here (NUMBA_NUM_THREADS)")
+    points, normals, radius, (indptr, indices) = jet_inputs("ellipsoid")
+    n = points.shape[0]
+    compiled = kernels("jets")
+
+    def fits():
+        if connected:
+            return compiled.fit_jets_connected(points, normals, np.array([radius]), 3, jets.ITERATIONS,
+                                               jets._exponents(3), jets.MIN_SPREAD, np.arange(n), 7,
+                                               np.ones(n, dtype=bool), indptr, indices, points, False,
+                                               jets.AWAY_FRACTION, False, 0.0, np.zeros(0))
+        return compiled.fit_jets(points, normals, np.array([radius]), 3, jets.ITERATIONS, jets._exponents(3),
+                                 jets.MIN_SPREAD, np.arange(n), 7, np.arange(n), points, False, jets.AWAY_FRACTION,
+                                 0.0, np.zeros(0))
+
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = fits()
+        numba.set_num_threads(2)
+        two = fits()
+    finally:
+        numba.set_num_threads(threads)
+    assert np.isfinite(one[0]).all(axis=1).sum() > n // 2  # fits were made
+    for a, b in zip(one, two):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_the_jet_moments_are_compiled_only():
+    from meshcurv._kernels.jets import _jet_moments
+
+    with pytest.raises(NotImplementedError, match="compiled only"):
+        _jet_moments(None, *([None] * 15))

@@ -398,8 +398,9 @@ def _direct(function, args, kwargs):
 
 
 def _locked(function):
-    # compiled kernels only: a module's Python helpers run as they are
-    run = _run if hasattr(function, "py_func") else _direct
+    # compiled kernels (and those that run compiled chunks on threads) only: a module's Python helpers run as
+    # they are
+    run = _run if hasattr(function, "py_func") or getattr(function, "runs_chunks", False) else _direct
 
     @functools.wraps(function)
     def call(*args, **kwargs):

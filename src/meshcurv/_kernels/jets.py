@@ -7,8 +7,10 @@ import math
 
 import numba as nb
 import numpy as np
+from numba.core import types
+from numba.extending import overload
 
-from ._common import _JIT, _JIT_REASSOC, _TINY, _tangent_frame
+from ._common import _JIT, _JIT_REASSOC, _TINY, _tangent_frame, run_chunks, threaded
 from .neighborhoods import _ball_members, _connected_members, pool_grid
 
 
@@ -71,7 +73,7 @@ def _cholesky_solve(a, b, low, m, min_spread, scale, total):
     return True
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_spread, centres, n_chunks, pool, facing,
              check_facing, away_fraction, settled, areas):
     """``jets.fit_jets``: weighted jets over the balls of ``radii``, frame re-estimated from each fit.
@@ -89,12 +91,27 @@ def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_spread
     (:func:`_grid`). A fit whose slope ``c10^2 + c01^2`` is below ``settled``
     ends the iterations of its vertex (0: ``iterations`` fits everywhere).
     ``areas`` (V,): each point's weight is also its area (empty: none).
+
+    The fits run in ``n_chunks`` ranges of the centres (:func:`_grid_chunk`)
+    on threads (:func:`~meshcurv._kernels._common.run_chunks`).
     """
+    points, ids, grid, centres = _grid_centres(vertices, pool, radii, centres)
+    outputs = _jet_outputs(vertices.shape[0])
+    limits = np.array([away_fraction, settled])
+    facing = facing[:facing.shape[0] if check_facing else 0]
+    run_chunks(_grid_chunk, centres.shape[0], n_chunks, vertices, points, normals, radii, degree, iterations,
+               exponents, min_spread, centres, grid, ids, facing, limits, areas, *outputs,
+               _general(degree))
+    return outputs
+
+
+@nb.njit(**_JIT)
+def _grid_centres(vertices, pool, radii, centres):
+    """``(points, ids, grid, centres)`` of :func:`fit_jets`: the pool's grid (``pool_grid``) and the centres
+    in grid order (consecutive balls share cells: cache), the centres outside the pool last."""
     n = vertices.shape[0]
     n_pool = pool.shape[0]
-    per_vertex = radii.shape[0] > 1
     points, ids, grid = pool_grid(vertices, pool, radii.max())
-    # centres in grid order: consecutive balls share cells (cache); centres outside the pool last
     chosen = np.zeros(n, np.bool_)
     chosen[centres] = True
     sorted_centres = np.empty(centres.shape[0], np.int64)
@@ -109,23 +126,29 @@ def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_spread
             sorted_centres[m] = centres[k]
             chosen[centres[k]] = False
             m += 1
-    centres = sorted_centres[:m]
-    coefficients, t1s, t2s, ns, counts, away = _jet_outputs(n)
-    limits = np.array([away_fraction, settled])
-    n_terms = exponents.shape[0]
-    n_chunks = max(min(m, n_chunks), 1)
-    for chunk in nb.prange(n_chunks):
-        members = np.empty(64, np.int64)
-        work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, n_terms)
-        for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
-            v = centres[i]
-            radius = radii[v if per_vertex else 0]
-            members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius,
-                                          members)
-            work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_spread, v, v,
-                            members, size, work, moments, right, matrix, low, scale, solution, coefficients, t1s,
-                            t2s, ns, counts, ids, facing[:facing.shape[0] if check_facing else 0], limits, away, areas)
-    return coefficients, t1s, t2s, ns, counts, away
+    return points, ids, grid, sorted_centres[:m]
+
+
+@nb.njit(**_JIT)
+def _grid_chunk(lo, hi, vertices, points, normals, radii, degree, iterations, exponents, min_spread, centres, grid,
+                ids, facing, limits, areas, coefficients, t1s, t2s, ns, counts, away, general):
+    """The fits of ``centres[lo:hi]`` of :func:`fit_jets`, written to their rows of the outputs."""
+    per_vertex = radii.shape[0] > 1
+    members = np.empty(64, np.int64)
+    work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
+    for i in range(lo, hi):
+        v = centres[i]
+        radius = radii[v if per_vertex else 0]
+        members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius,
+                                      members)
+        work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_spread, v, v,
+                        members, size, work, moments, right, matrix, low, scale, solution, coefficients, t1s,
+                        t2s, ns, counts, ids, facing, limits, away, areas, general)
+
+
+def _general(degree: int) -> bool | None:
+    """The ``general`` argument of the chunks (:func:`_jet_moments`): None for fits of degree 3 or less."""
+    return None if degree <= 3 else True
 
 
 #: Rows of a jet fit's scratch before the powers of u and v: the offsets x, y, z, the weight, weight * height.
@@ -255,10 +278,77 @@ def _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny,
     right[5], right[6], right[7], right[8], right[9] = r02, r30, r21, r12, r03
 
 
+@nb.njit(**_JIT)
+def _general_jet_moments(work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
+    """:func:`_fit_one`'s moments of a fit of degree 4 or more, from the rows of ``work`` (:func:`_jet_scratch`).
+
+    The offsets and weights are in its first rows; the powers of ``u`` and
+    ``v``, the weight times each power of ``u`` and the weighted height times
+    each power of ``u`` are written to the rows after them, then each moment
+    is one dot product of two rows (:func:`_dot`). A function of its own, not
+    inlined: the default fits (degrees 2 and 3, :func:`_cubic_jet_moments`)
+    do not compile it into their loop.
+    """
+    top = 2 * degree
+    ox, oy, oz, weight, lift = work[0], work[1], work[2], work[3], work[4]
+    pu = work[_JET_ROWS:_JET_ROWS + top + 1]
+    pv = work[_JET_ROWS + top + 1:_JET_ROWS + 2 * (top + 1)]
+    wu = work[_JET_ROWS + 2 * (top + 1):_JET_ROWS + 3 * (top + 1)]
+    lu = work[_JET_ROWS + 3 * (top + 1):]
+    for a in range(size):
+        pu[0, a] = 1.0
+        pv[0, a] = 1.0
+        pu[1, a] = ox[a] * ax + oy[a] * ay + oz[a] * az
+        pv[1, a] = ox[a] * bx + oy[a] * by + oz[a] * bz
+        lift[a] = weight[a] * (ox[a] * nx + oy[a] * ny + oz[a] * nz)
+    for p in range(2, top + 1):  # power by power over all members (no chain of products per member)
+        for a in range(size):
+            pu[p, a] = pu[p - 1, a] * pu[1, a]
+            pv[p, a] = pv[p - 1, a] * pv[1, a]
+    for p in range(top + 1):  # the weight (and weighted height) times each power of u, once
+        for a in range(size):
+            wu[p, a] = weight[a] * pu[p, a]
+    for p in range(degree + 1):
+        for a in range(size):
+            lu[p, a] = lift[a] * pu[p, a]
+    for total in range(top + 1):
+        for k in range(total + 1):
+            moments[total - k, k] = _dot(wu[total - k], pv[k], size)
+    for t in range(exponents.shape[0]):
+        right[t] = _dot(lu[exponents[t, 0]], pv[exponents[t, 1]], size)
+
+
+def _jet_moments(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
+    """:func:`_fit_one`'s moments: :func:`_cubic_jet_moments` up to degree 3, else :func:`_general_jet_moments`.
+
+    Compiled only (:func:`_jet_moments_typed`). ``general`` is None where every fit has degree 3 or less (what
+    the callers pass then), True otherwise: with None, the compiled fit holds no code of the general
+    moments (0.5 s of CPU less to compile the default's fits on a cold cache).
+    """
+    raise NotImplementedError("compiled only: called from the compiled jet fits")
+
+
+@overload(_jet_moments, jit_options=_JIT)
+def _jet_moments_typed(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
+    if isinstance(general, types.NoneType):
+        def cubic(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
+            _cubic_jet_moments(work[0], work[1], work[2], work[3], size, ax, ay, az, bx, by, bz, nx, ny, nz,
+                               moments, right)
+        return cubic
+
+    def either(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
+        if degree <= 3:  # the normal and noise fits: moments summed member by member (degree 2 reads a subset)
+            _cubic_jet_moments(work[0], work[1], work[2], work[3], size, ax, ay, az, bx, by, bz, nx, ny, nz,
+                               moments, right)
+        else:
+            _general_jet_moments(work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right)
+    return either
+
+
 @nb.njit(inline="always", **_JIT)
 def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_spread, v, row, members, size, work,
              moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing, limits,
-             away_out, areas):
+             away_out, areas, general):
     """One vertex of :func:`fit_jets` in the caller's buffers; returns ``work`` (grown when too small).
 
     Inlined into its callers: a call per vertex passing thirty arrays cost a
@@ -278,25 +368,20 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     its moments member by member instead (:func:`_cubic_jet_moments`, the same
     products; no per-member rows; degree 2 reads the moments up to order 4).
     A fit whose slope ``c10^2 + c01^2`` is below ``settled``
-    ends the iterations (its frame and coefficients are kept).
+    ends the iterations (its frame and coefficients are kept). ``general``:
+    None when ``degree <= 3`` (:func:`_jet_moments`).
 
     With ``areas`` (V,) not empty, each point's weight is its kernel weight
     times its area (the fit approximates the surface integral: a part sampled
     100 times more densely does not outweigh its neighbour).
     """
-    n_terms = exponents.shape[0]
     away_fraction, settled = limits[0], limits[1]
     check_facing = facing.shape[0] > 0
-    top = 2 * degree
     if size > work.shape[1]:
         work = np.empty((work.shape[0], 2 * size))
-    ox, oy, oz, weight, lift = work[0], work[1], work[2], work[3], work[4]
+    ox, oy, oz, weight = work[0], work[1], work[2], work[3]
     inverse = 1.0 / radius
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]  # read once (the stores below may alias)
-    pu = work[_JET_ROWS:_JET_ROWS + top + 1]
-    pv = work[_JET_ROWS + top + 1:_JET_ROWS + 2 * (top + 1)]
-    wu = work[_JET_ROWS + 2 * (top + 1):_JET_ROWS + 3 * (top + 1)]
-    lu = work[_JET_ROWS + 3 * (top + 1):]
     count = 0.0
     weighted = areas.shape[0] > 0
     for a in range(size):
@@ -330,30 +415,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     ax, ay, az, bx, by, bz = _tangent_frame(nx, ny, nz)
     fitted = False
     for step in range(iterations):
-        if degree <= 3:  # the normal and noise fits: moments summed member by member (degree 2 reads a subset)
-            _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right)
-        else:
-            for a in range(size):
-                pu[0, a] = 1.0
-                pv[0, a] = 1.0
-                pu[1, a] = ox[a] * ax + oy[a] * ay + oz[a] * az
-                pv[1, a] = ox[a] * bx + oy[a] * by + oz[a] * bz
-                lift[a] = weight[a] * (ox[a] * nx + oy[a] * ny + oz[a] * nz)
-            for p in range(2, top + 1):  # power by power over all members (no chain of products per member)
-                for a in range(size):
-                    pu[p, a] = pu[p - 1, a] * pu[1, a]
-                    pv[p, a] = pv[p - 1, a] * pv[1, a]
-            for p in range(top + 1):  # the weight (and weighted height) times each power of u, once
-                for a in range(size):
-                    wu[p, a] = weight[a] * pu[p, a]
-            for p in range(degree + 1):
-                for a in range(size):
-                    lu[p, a] = lift[a] * pu[p, a]
-            for total in range(top + 1):
-                for k in range(total + 1):
-                    moments[total - k, k] = _dot(wu[total - k], pv[k], size)
-            for t in range(n_terms):
-                right[t] = _dot(lu[exponents[t, 0]], pv[exponents[t, 1]], size)
+        _jet_moments(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right)
         fitted = False
         for d in range(degree, 1, -1):
             m = (d + 1) * (d + 2) // 2
@@ -392,7 +454,7 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
     return work
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, min_spread, centres, n_chunks,
                        allowed, indptr, indices, facing, check_facing, away_fraction, normals_only, settled, areas):
     """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
@@ -414,45 +476,54 @@ def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, 
     A fit whose slope ``c10^2 + c01^2`` is below ``settled`` ends the
     iterations of its vertex (its normal is within ``atan(sqrt(settled))`` of
     the frame's normal); with 0, every vertex has ``iterations`` fits.
-    ``areas``: as :func:`fit_jets`.
+    ``areas``: as :func:`fit_jets`. The fits run in ``n_chunks`` ranges of the centres
+    (:func:`_connected_chunk`) on threads (:func:`~meshcurv._kernels._common.run_chunks`).
     """
     n = vertices.shape[0]
     m = centres.shape[0]
-    coefficients, t1s, t2s, ns, counts, away = _jet_outputs(1 if normals_only else m)
+    outputs = _jet_outputs(1 if normals_only else m)
     fitted = np.full((m if normals_only else 1, 3), np.nan)
-    ids = np.arange(n)
-    n_terms = exponents.shape[0]
-    per_centre = radii.shape[0] > 1
     limits = np.array([away_fraction, settled])
-    n_chunks = max(min(m, n_chunks), 1)
-    for chunk in nb.prange(n_chunks):
-        mark = np.full(n, -1, np.int64)
-        members = np.empty(n, np.int64)
-        queue = np.empty(n, np.int64)
-        work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, n_terms)
-        c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row: unpacked once, not per vertex
-        for i in range(chunk * m // n_chunks, (chunk + 1) * m // n_chunks):
-            v = centres[i]
-            radius = radii[i if per_centre else 0]
-            size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, i, members, queue)
-            # the fit into one row, then copied: one call site (the fit is inlined, and a second call
-            # site would double its compile time)
-            c[0, :] = np.nan  # a failed fit leaves the row as it finds it
-            one_away[0] = np.nan  # written only when the facing is checked
-            work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_spread, v, 0,
-                            members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn,
-                            one_count, ids, facing[:facing.shape[0] if check_facing else 0], limits, one_away, areas)
-            if not normals_only:
-                for k in range(6):
-                    coefficients[i, k] = c[0, k]
-                for k in range(3):
-                    t1s[i, k], t2s[i, k], ns[i, k] = a[0, k], b[0, k], nn[0, k]
-                counts[i], away[i] = one_count[0], one_away[0]
-                continue
-            p, q = c[0, 1], c[0, 2]
-            width = np.sqrt(1 + p * p + q * q)
+    facing = facing[:facing.shape[0] if check_facing else 0]
+    run_chunks(_connected_chunk, m, n_chunks, vertices, normals, radii, degree, iterations, exponents, min_spread,
+               centres, allowed, indptr, indices, np.arange(n), facing, limits, normals_only, areas, *outputs, fitted,
+               _general(degree))
+    return (fitted, *outputs[1:]) if normals_only else outputs
+
+
+@nb.njit(**_JIT)
+def _connected_chunk(lo, hi, vertices, normals, radii, degree, iterations, exponents, min_spread, centres, allowed,
+                     indptr, indices, ids, facing, limits, normals_only, areas, coefficients, t1s, t2s, ns, counts,
+                     away, fitted, general):
+    """The fits of ``centres[lo:hi]`` of :func:`fit_jets_connected`, written to their rows of the outputs
+    (of ``fitted`` with ``normals_only``)."""
+    n = vertices.shape[0]
+    per_centre = radii.shape[0] > 1
+    mark = np.full(n, -1, np.int64)
+    members = np.empty(n, np.int64)
+    queue = np.empty(n, np.int64)
+    work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
+    # one row, unpacked once, not per vertex (np.int64: the literal 1 would compile _jet_outputs a second time)
+    c, a, b, nn, one_count, one_away = _jet_outputs(np.int64(1))
+    for i in range(lo, hi):
+        v = centres[i]
+        radius = radii[i if per_centre else 0]
+        size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, i, members, queue)
+        # the fit into one row, then copied: one call site (the fit is inlined, and a second call
+        # site would double its compile time)
+        c[0, :] = np.nan  # a failed fit leaves the row as it finds it
+        one_away[0] = np.nan  # written only when the facing is checked
+        work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_spread, v, 0,
+                        members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn,
+                        one_count, ids, facing, limits, one_away, areas, general)
+        if not normals_only:
+            for k in range(6):
+                coefficients[i, k] = c[0, k]
             for k in range(3):
-                fitted[i, k] = (nn[0, k] - p * a[0, k] - q * b[0, k]) / width
-    if normals_only:
-        return fitted, t1s, t2s, ns, counts, away
-    return coefficients, t1s, t2s, ns, counts, away
+                t1s[i, k], t2s[i, k], ns[i, k] = a[0, k], b[0, k], nn[0, k]
+            counts[i], away[i] = one_count[0], one_away[0]
+            continue
+        p, q = c[0, 1], c[0, 2]
+        width = np.sqrt(1 + p * p + q * q)
+        for k in range(3):
+            fitted[i, k] = (nn[0, k] - p * a[0, k] - q * b[0, k]) / width
