@@ -211,7 +211,7 @@ def test_title_cannot_close_the_script(tmp_path, torus):
     page = write_html(tmp_path / "t.html", torus.vertices, torus.faces, exact_result(torus), title=title)
     text = page.read_text(encoding="utf-8")
     assert "</script><script>document" not in text and "<!--" not in text
-    assert "</script" not in viewer._script().lower()  # the inlined script cannot end its element either
+    assert "</script" not in viewer._resource("_viewer.js").lower()  # the inlined script cannot end its element either
     meta, _ = read_page_data(page)
     assert meta["title"] == title
 

@@ -385,54 +385,15 @@ def _page_data(points, triangles, result, *, field, percentiles, max_directions,
     return meta, arrays
 
 
-_STYLE = """
-html, body { margin: 0; height: 100%; overflow: hidden; font: 13px system-ui, sans-serif; color: #222; }
-#view { position: absolute; inset: 0; width: 100%; height: 100%; display: block; cursor: grab; touch-action: none; }
-#panel { position: absolute; top: 8px; left: 8px; width: 360px; padding: 8px 10px;
-         background: rgba(255, 255, 255, 0.88); border: 1px solid #ccc; border-radius: 4px; }
-#panel h1 { font-size: 14px; margin: 0 0 2px; }
-#subtitle, #help { color: #555; font-size: 11px; margin-bottom: 6px; }
-#panel label { margin-right: 8px; }
-#panel input[type=number] { width: 7em; }
-#panel input.bad { background: #fdd; }
-#bar { width: 256px; height: 14px; display: block; margin-top: 8px; border: 1px solid #888; }
-#bar-ticks { width: 258px; display: flex; justify-content: space-between; font-size: 11px; }
-#bar-label { font-size: 11px; margin-top: 2px; }
-#probe { margin-top: 6px; font-size: 12px; min-height: 1.2em; font-variant-numeric: tabular-nums; }
-#status { font-size: 11px; color: #555; margin-top: 4px; }
-#status.error { color: #b00; font-weight: bold; }
-"""
-
-_BODY = """
-<canvas id="view"></canvas>
-<div id="panel">
-  <h1 id="title"></h1>
-  <div id="subtitle"></div>
-  <label>field <select id="field"></select></label>
-  <label>directions <select id="directions">
-    <option value="none">none</option><option value="max">k_max (black)</option>
-    <option value="min">k_min (grey)</option><option value="both">both</option></select></label>
-  <div style="margin-top: 6px">
-    <label>limits <input id="low" type="number" step="any"> to <input id="high" type="number" step="any"></label>
-    <button id="auto" type="button" title="the default percentiles">auto</button>
-  </div>
-  <canvas id="bar" width="256" height="14"></canvas>
-  <div id="bar-ticks"><span id="bar-low"></span><span id="bar-middle"></span><span id="bar-high"></span></div>
-  <div id="bar-label"></div>
-  <div id="probe"></div>
-  <div id="help">drag: rotate; right or shift drag: pan; wheel: zoom; double click: reset</div>
-  <div id="status" data-state="loading">loading...</div>
-</div>
-"""
-
 # No network at all: no fetch, no connection, no image or script from elsewhere.
 _POLICY = (
     "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src data: blob:; connect-src 'none'"
 )
 
 
-def _script() -> str:
-    return importlib.resources.files("meshcurv").joinpath("_viewer.js").read_text(encoding="utf-8")
+def _resource(name: str) -> str:
+    """A file of the package: ``_viewer.js`` (the page's script), ``_viewer.html`` (its style and body)."""
+    return importlib.resources.files("meshcurv").joinpath(name).read_text(encoding="utf-8")
 
 
 def _json_for_script(value) -> str:
@@ -459,12 +420,13 @@ def _write_page(handle, meta: dict, arrays: dict) -> None:
         specs[name] = spec
         blocks.append((spec["id"], encoded))
     meta = {**meta, "arrays": specs}
+    style, body = _resource("_viewer.html").split("<!-- body -->")
     head = (
         f'<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         f'<meta http-equiv="Content-Security-Policy" content="{_POLICY}">\n'
         f'<meta name="viewport" content="width=device-width, initial-scale=1">\n'
         f"<title>{html.escape(meta['title'])} - meshcurv viewer</title>\n"
-        f"<style>{_STYLE}</style>\n</head>\n<body>{_BODY}\n"
+        f"<style>{style}</style>\n</head>\n<body>{body}\n"
         f'<script type="application/json" id="meshcurv-meta">{_json_for_script(meta)}</script>\n'
     )
     handle.write(head.encode("utf-8"))
@@ -472,7 +434,7 @@ def _write_page(handle, meta: dict, arrays: dict) -> None:
         handle.write(f'<script type="application/octet-stream" id="{identifier}">'.encode("ascii"))
         handle.write(encoded)
         handle.write(b"</script>\n")
-    handle.write(f"<script>\n{_script()}\n</script>\n</body>\n</html>\n".encode())
+    handle.write(f"<script>\n{_resource('_viewer.js')}\n</script>\n</body>\n</html>\n".encode())
 
 
 def read_page_data(path) -> tuple[dict, dict[str, np.ndarray]]:
