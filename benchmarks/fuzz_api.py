@@ -29,7 +29,8 @@ finding, not a stuck run. A finding is:
   must give the same valid mask and curvatures divided by ``s`` (``matgeom``:
   unchanged); translated or with its vertices permuted, the same values; with
   unreferenced points added near its surface, the same values at every
-  referenced vertex.
+  referenced vertex; with one vertex flung 1e3 to 1e40 times its size away
+  (its faces needles), that vertex invalid with the reason "needle vertex".
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -73,6 +74,7 @@ from meshcurv.errors import (  # noqa: E402
     MeshFileError,
     MissingDependencyError,
 )
+from meshcurv.result import INVALID_REASONS  # noqa: E402
 
 try:
     from meshcurv import pointcloud
@@ -449,6 +451,16 @@ def make_case(seed: int, index: int):
                 and rng.random() < 0.5:
             labels.append(f"relation truth of {labels[0]}")
             return target, (vv, ff), kwargs, labels, ("truth", labels[0])
+        if vlabel == "array" and flabel == "array" and len(labels) == 3 and isinstance(method, str) \
+                and method in METHODS and rng.random() < 0.25:
+            # one vertex of a clean shape flung 1e3-1e40 sizes away: its faces are needles (issue 29)
+            row = int(rng.integers(len(v)))
+            direction = rng.normal(size=3)
+            distance = float(np.ptp(v)) * 10.0 ** rng.uniform(3.0, 40.0)
+            vv = v.copy()
+            vv[row] += distance * direction / np.linalg.norm(direction)
+            labels.append(f"relation needle {distance:.3g}")
+            return target, (vv, ff), kwargs, labels, ("needle", row)
         if vlabel == "array" and flabel == "array" and kwargs.get("radius") is None and rng.random() < 0.5 \
                 and all(label.startswith(("noise", "flipped", "faces removed", "vertices permuted")) for label in labels[1:-2]):
             relation = ["scale", "scale", "permute", "unreferenced", "translate"][int(rng.integers(5))]
@@ -872,6 +884,13 @@ def relation_check(args, kwargs, result, relation):
     if kind == "cloud truth":
         return cloud_truth_check(args, kwargs, result, value)
     v, f = args
+    if kind == "needle":  # the flung vertex: invalid, for its needle faces, whatever the method and radius
+        # (beyond about 1e16 edge lengths its faces' sides lose the width of their base in float64: zero-area faces)
+        reason = INVALID_REASONS[int(result.invalid_reason[value])]
+        if result.valid[value] or not reason.startswith(("needle vertex", "corner of a zero-area face")):
+            return [f"needle: the flung vertex {value} is {'valid' if result.valid[value] else 'invalid'} "
+                    f"(reason {reason!r})"]
+        return []
     if kind == "truth":  # valid estimates on a clean closed analytic shape: within half the largest curvature
         k_min, k_max = TRUTH[value]
         edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))
