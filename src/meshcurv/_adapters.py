@@ -71,22 +71,9 @@ _VTK_SURFACE_CELLS = {5: "triangle", 7: "polygon", 8: "pixel", 9: "quad"}
 _VTK_POINT_AND_LINE_CELLS = {1: "vertex", 2: "poly_vertex", 3: "line", 4: "poly_line"}
 
 #: Names of the other VTK cell types an error may name (others by number).
-_VTK_OTHER_CELLS = {
-    6: "triangle_strip",
-    10: "tetra",
-    11: "voxel",
-    12: "hexahedron",
-    13: "wedge",
-    14: "pyramid",
-    15: "pentagonal_prism",
-    16: "hexagonal_prism",
-    21: "quadratic_edge",
-    22: "quadratic_triangle",
-    23: "quadratic_quad",
-    24: "quadratic_tetra",
-    25: "quadratic_hexahedron",
-    42: "polyhedron",
-}
+_OTHER_NAMES = "triangle_strip tetra voxel hexahedron wedge pyramid pentagonal_prism hexagonal_prism quadratic_edge"
+_OTHER_NAMES += " quadratic_triangle quadratic_quad quadratic_tetra quadratic_hexahedron polyhedron"
+_VTK_OTHER_CELLS = dict(zip((6, 10, 11, 12, 13, 14, 15, 16, 21, 22, 23, 24, 25, 42), _OTHER_NAMES.split()))
 
 _KNOWN_MESHES = "trimesh.Trimesh, pyvista.PolyData, pyvista.UnstructuredGrid, meshio.Mesh, open3d.geometry.TriangleMesh"
 

@@ -221,12 +221,8 @@ class _Raster:
         self.width, self.height = np.ceil(span * scale).astype(int) + 2
         self.offset = low - 1 / scale
         self.scale = scale
-        self.extent = (
-            self.offset[0],
-            self.offset[0] + self.width / scale,
-            self.offset[1],
-            self.offset[1] + self.height / scale,
-        )
+        right, top = self.offset + np.array([self.width, self.height]) / scale
+        self.extent = (self.offset[0], right, self.offset[1], top)
         self.depth_low = screen[:, 2].min()
         self.depth_step = (2**30 - 1) / max(np.ptp(screen[:, 2]), 1e-300)
 
@@ -243,22 +239,8 @@ class _Raster:
         p2, q2 = -(y[:, 1] - y[:, 0]) / area, (x[:, 1] - x[:, 0]) / area
         r1, r2 = -(p1 * x[:, 0] + q1 * y[:, 0]), -(p2 * x[:, 0] + q2 * y[:, 0])
         dz1, dz2 = z[:, 1] - z[:, 0], z[:, 2] - z[:, 0]
-        plane = np.column_stack(
-            [
-                p1,
-                q1,
-                r1,
-                p2,
-                q2,
-                r2,
-                p1 * dz1 + p2 * dz2,
-                q1 * dz1 + q2 * dz2,
-                z[:, 0] + r1 * dz1 + r2 * dz2,
-                x_first + 0.5,
-                y_first + 0.5,
-                faces,
-            ]
-        )
+        depth_plane = (p1 * dz1 + p2 * dz2, q1 * dz1 + q2 * dz2, z[:, 0] + r1 * dz1 + r2 * dz2)
+        plane = np.column_stack([p1, q1, r1, p2, q2, r2, *depth_plane, x_first + 0.5, y_first + 0.5, faces])
         c = np.repeat(plane, counts, axis=0)
         local = np.arange(c.shape[0]) - np.repeat(np.cumsum(counts) - counts, counts)
         row, column = np.divmod(local, np.repeat(columns, counts))
@@ -528,19 +510,11 @@ def plot_field(
         panel_pixels = max(box.width * width, box.height * height) * fig.dpi
     if pixels is None:
         pixels = _auto_pixels(panel_pixels)
+    centred = points - center
     for axis, (name, angles) in zip(axes, views):
+        camera = _camera(*angles)
         _draw_view(
-            axis,
-            points - center,
-            triangles,
-            values,
-            normals,
-            _camera(*angles),
-            colormap,
-            norm,
-            strokes,
-            pixels=pixels,
-            spacing=spacing,
+            axis, centred, triangles, values, normals, camera, colormap, norm, strokes, pixels=pixels, spacing=spacing
         )
         if len(views) > 1:
             axis.set_title(name, fontsize=9)
