@@ -115,6 +115,19 @@ def test_no_analytic_surface_has_a_needle(mesh):
     assert not _needles(mesh.vertices, mesh.faces).any()
 
 
+def test_cad_meshes_with_long_slivers_have_no_needle():
+    # fandisk (tests/data/matgeom) and pyvista's airplane: flat parts cut into long slivers, fans of long edges
+    from pathlib import Path
+
+    fandisk = np.load(Path(__file__).parent / "data" / "matgeom" / "fandisk.npz")
+    assert not _needles(fandisk["vertices"], fandisk["faces"]).any()
+    examples = pytest.importorskip("pyvista.examples")
+    from meshcurv.io import read_mesh
+
+    airplane = read_mesh(Path(examples.__file__).parent / "airplane.ply")
+    assert not _needles(airplane.vertices, airplane.faces).any()
+
+
 # --- every method leaves a needle vertex undefined, with its reason ------------------------------
 
 @pytest.mark.parametrize("method", meshcurv.METHODS)
