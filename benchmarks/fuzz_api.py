@@ -29,7 +29,8 @@ finding, not a stuck run. A finding is:
   must give the same valid mask and curvatures divided by ``s`` (``matgeom``:
   unchanged); translated or with its vertices permuted, the same values; with
   unreferenced points added near its surface, the same values at every
-  referenced vertex; with one vertex flung 1e3 to 1e40 times its size away
+  referenced vertex; with every face given twice, the second wound the other
+  way (a double-sided mesh, orient='outward'), the same values; with one vertex flung 1e3 to 1e40 times its size away
   (its faces needles), that vertex invalid with the reason "needle vertex".
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
@@ -463,9 +464,13 @@ def make_case(seed: int, index: int):
             return target, (vv, ff), kwargs, labels, ("needle", row)
         if vlabel == "array" and flabel == "array" and kwargs.get("radius") is None and rng.random() < 0.5 \
                 and all(label.startswith(("noise", "flipped", "faces removed", "vertices permuted")) for label in labels[1:-2]):
-            relation = ["scale", "scale", "permute", "unreferenced", "translate"][int(rng.integers(5))]
+            relation = ["scale", "scale", "permute", "unreferenced", "translate", "double-sided"][int(rng.integers(6))]
             if relation == "permute" and isinstance(method, str) and method == "matgeom":  # matGeom's pairing on open meshes follows the order
                 relation = "translate"
+            if relation == "double-sided" and (not isinstance(method, str) or method == "matgeom"
+                                               or str(kwargs.get("orient", "auto")) not in ("auto", "outward")
+                                               or kwargs.get("weld", True) is not True):
+                relation = "translate"  # one side is kept where the faces are oriented outward (matgeom: as given)
             if relation == "scale":  # inside the documented coordinate range (about 1e-70 to 1e70)
                 clean = ("scale", float(rng.choice([2.0**-60, 2.0**40, 1e-30, 1e-8, 1e8, 1e30])))
             elif relation == "translate":
@@ -921,6 +926,8 @@ def relation_check(args, kwargs, result, relation):
         inverse = np.argsort(perm)
         v2, f2 = v[perm], inverse[f]
         take = inverse  # old vertex j is new inverse[j]
+    elif kind == "double-sided":  # every face twice, the second with the opposite winding: one side measured
+        v2, f2 = v, np.concatenate([f, f[:, ::-1]])
     else:
         rng = np.random.default_rng(value)
         edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1))) if len(f) else 1.0
