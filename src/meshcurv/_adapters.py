@@ -33,11 +33,9 @@ result's methods (``result.to_pyvista(mesh)``, ...).
 
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 
-from .errors import InvalidMeshError, MissingDependencyError
+from .errors import InvalidMeshError, optional_module
 from .io.fields import curvature_fields
 from .topology import triangulate_faces
 
@@ -234,10 +232,7 @@ def point_array(points, *, name: str = "points"):
 
 
 def _require(module: str, purpose: str, install: str):
-    try:
-        return importlib.import_module(module)
-    except ImportError as exc:
-        raise MissingDependencyError(f"{purpose} needs {module}: pip install {install}") from exc
+    return optional_module(module, f"{purpose} needs {module}: pip install {install}")
 
 
 def _result_fields(result, fields) -> dict[str, np.ndarray]:

@@ -5,6 +5,9 @@ ValueError`` catches them all; the subclasses say which kind of input was wrong.
 Warnings subclass :class:`MeshcurvWarning` so they can be filtered together.
 """
 
+import sys
+import types
+
 __all__ = [
     "InvalidMeshError",
     "InvalidOptionError",
@@ -30,6 +33,15 @@ class MeshFileError(ValueError):
 
 class MissingDependencyError(ImportError):
     """An optional dependency needed by the requested feature is not installed."""
+
+
+def optional_module(name: str, message: str) -> types.ModuleType:
+    """The optional dependency ``name`` imported, or a :class:`MissingDependencyError` saying ``message``."""
+    try:
+        __import__(name)
+    except ImportError as exc:
+        raise MissingDependencyError(message) from exc
+    return sys.modules[name]
 
 
 class MeshcurvWarning(UserWarning):

@@ -17,7 +17,7 @@ import textwrap
 import numpy as np
 
 from ._validation import as_faces, as_vertices, check_int_option
-from .errors import InvalidOptionError, MissingDependencyError
+from .errors import InvalidOptionError, optional_module
 from .io._files import atomic_output, check_output
 
 __all__ = ["plot_field", "save_figure", "choose_up", "VIEWS", "MAX_PIXELS", "MAX_DPI", "Z_UP_RATIO"]
@@ -65,11 +65,7 @@ def _pyplot():
     Figures are :class:`matplotlib.figure.Figure` objects with an Agg canvas of their own, so the
     user's backend (and any open pyplot windows) are left as they are.
     """
-    try:
-        import matplotlib
-    except ImportError:
-        raise MissingDependencyError("pictures need matplotlib: pip install 'meshcurv[plot]'") from None
-    return matplotlib
+    return optional_module("matplotlib", "pictures need matplotlib: pip install 'meshcurv[plot]'")
 
 
 def choose_up(vertices) -> tuple[str, str]:

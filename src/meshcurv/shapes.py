@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import check_int_option
-from .errors import InvalidOptionError, MissingDependencyError
+from .errors import InvalidOptionError, optional_module
 from .geometry import mean_edge_length
 from .topology import MeshTopology
 
@@ -502,10 +502,8 @@ def _marching_cubes(inside, extent: np.ndarray, spacing: np.ndarray, seed: int, 
     each side; the centre sits at a random sub-voxel offset drawn with
     ``numpy.random.default_rng(seed)``. Returns ``vertices, faces, center``.
     """
-    try:
-        from skimage.measure import marching_cubes
-    except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise MissingDependencyError(f"shapes.{name} needs scikit-image: pip install 'meshcurv[volume]'") from exc
+    message = f"shapes.{name} needs scikit-image: pip install 'meshcurv[volume]'"
+    marching_cubes = optional_module("skimage.measure", message).marching_cubes
     counts = np.ceil(2 * extent / spacing).astype(int) + 5
     if np.prod(counts.astype(float)) > 2e8:
         raise InvalidOptionError(

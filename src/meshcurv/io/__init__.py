@@ -40,7 +40,7 @@ import numpy as np
 from .._validation import _check_range, as_polygons, as_vertices
 from ..errors import InvalidMeshError, InvalidOptionError, MeshFileError, MissingDependencyError
 from . import _meshio, _obj, _off, _ply, _tables, _vtk, _vtp
-from ._files import atomic_output, check_input, check_output
+from ._files import atomic_output, check_input, check_output, format_key
 from ._points import POINT_EXTENSIONS, is_point_cloud, read_points, write_point_curvatures, write_points
 from .fields import FIELDS, curvature_fields, read_fields
 
@@ -149,19 +149,7 @@ FORMATS: dict[str, FileFormat] = _registry()
 
 
 def _format_of(path: pathlib.Path, file_format: str | None) -> FileFormat:
-    key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
-    key = (key or path.suffix).lower()
-    if key not in FORMATS:
-        known = ", ".join(FORMATS)
-        what = (
-            f"format {file_format!r}"
-            if file_format
-            else f"extension {path.suffix!r}"
-            if path.suffix
-            else "no extension"
-        )
-        raise MeshFileError(f"{path}: unknown mesh file {what}; known formats: {known}")
-    return FORMATS[key]
+    return FORMATS[format_key(path, file_format, FORMATS, "mesh file")]
 
 
 def read_mesh(path, *, file_format: str | None = None) -> Mesh:

@@ -9,7 +9,7 @@ import secrets
 
 from ..errors import MeshFileError
 
-__all__ = ["check_output", "atomic_output", "check_input"]
+__all__ = ["check_output", "atomic_output", "check_input", "format_key"]
 
 
 def check_input(path) -> pathlib.Path:
@@ -137,3 +137,17 @@ def _temporary_beside(path: pathlib.Path) -> pathlib.Path:
         os.close(descriptor)
         return candidate
     raise MeshFileError(f"{path}: cannot be written (no free temporary name in {path.parent})")
+
+
+def format_key(path: pathlib.Path, file_format: str | None, known, what: str) -> str:
+    """The lower-case extension of the format: ``file_format`` (``'ply'`` or ``'.ply'``), else ``path``'s.
+
+    A :class:`~meshcurv.errors.MeshFileError` naming the file, the ``what``
+    and the ``known`` extensions when it is not one of them.
+    """
+    key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
+    key = (key or path.suffix).lower()
+    if key not in known:
+        given = f"format {file_format!r}" if file_format else f"extension {path.suffix!r}" if path.suffix else ""
+        raise MeshFileError(f"{path}: unknown {what} {given or 'no extension'}; known formats: {', '.join(known)}")
+    return key

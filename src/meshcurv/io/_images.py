@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import pathlib
 import zipfile
-from typing import TYPE_CHECKING, NamedTuple, cast
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..errors import MeshFileError, MissingDependencyError
+from ..errors import MeshFileError, optional_module
 from ._files import check_input
 from ._mrc import MRC_UNIT, read_mrc
 from ._zarr import read_zarr
@@ -154,10 +154,7 @@ def _npz(path):
 
 
 def _tiff(path):
-    try:
-        import tifffile
-    except ImportError as exc:
-        raise MissingDependencyError("reading TIFF images needs tifffile: pip install 'meshcurv[volume]'") from exc
+    tifffile = optional_module("tifffile", "reading TIFF images needs tifffile: pip install 'meshcurv[volume]'")
     try:
         with tifffile.TiffFile(path) as tif:
             if not tif.series:
@@ -190,13 +187,9 @@ def _tiff_spacing(tif, series):
 
 
 def _nifti(path):
+    nibabel = optional_module("nibabel", "reading NIfTI images needs nibabel: pip install 'meshcurv[volume]'")
     try:
-        import nibabel
-        from nibabel.spatialimages import SpatialImage
-    except ImportError as exc:
-        raise MissingDependencyError("reading NIfTI images needs nibabel: pip install 'meshcurv[volume]'") from exc
-    try:
-        image = cast(SpatialImage, nibabel.load(str(path)))  # .nii, .nii.gz: a Nifti1Image or Nifti2Image
+        image = nibabel.load(str(path))  # .nii, .nii.gz: a Nifti1Image or Nifti2Image
         shape = image.shape
         _check_size(path, shape, image.get_data_dtype())
         array = np.asanyarray(image.dataobj)

@@ -13,7 +13,7 @@ import re
 
 import numpy as np
 
-from ..errors import MeshFileError, MissingDependencyError
+from ..errors import MeshFileError, optional_module
 from ._text import first_bad_line, line_of, line_of_match, numbers_per_line, row_error
 
 __all__ = ["read_with_meshio", "write_with_meshio"]
@@ -27,13 +27,9 @@ _STL_NORMAL = re.compile(rb"^[ \t]*facet[ \t]+normal[ \t]+([^\n]*)", re.M)
 
 
 def _meshio():
-    try:
-        import meshio
-    except ImportError:
-        raise MissingDependencyError(
-            "reading and writing PLY, STL, VTK and VTU files needs meshio: pip install 'meshcurv[io]'"
-        ) from None
-    return meshio
+    return optional_module(
+        "meshio", "reading and writing PLY, STL, VTK and VTU files needs meshio: pip install 'meshcurv[io]'"
+    )
 
 
 @contextlib.contextmanager

@@ -32,8 +32,8 @@ import warnings
 import numpy as np
 
 from .._validation import as_vertices
-from ..errors import MeshFileError, MeshQualityWarning, MissingDependencyError
-from ._files import atomic_output, check_input, check_output
+from ..errors import MeshFileError, MeshQualityWarning, MissingDependencyError, optional_module
+from ._files import atomic_output, check_input, check_output, format_key
 from ._ply import HEADER_LIMIT, _header, _short, ply_vertex_columns
 from ._text import body_rows, fixed_rows, line_of, names_shown, not_a_number, numbers_by_line, row_error
 from .fields import curvature_fields
@@ -136,18 +136,7 @@ def write_point_curvatures(
 
 
 def _suffix(path: pathlib.Path, file_format: str | None) -> str:
-    key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
-    key = (key or path.suffix).lower()
-    if key not in POINT_EXTENSIONS:
-        what = (
-            f"format {file_format!r}"
-            if file_format
-            else f"extension {path.suffix!r}"
-            if path.suffix
-            else "no extension"
-        )
-        raise MeshFileError(f"{path}: unknown point-cloud file {what}; known formats: {', '.join(POINT_EXTENSIONS)}")
-    return key
+    return format_key(path, file_format, POINT_EXTENSIONS, "point-cloud file")
 
 
 def _split(columns: dict, path, where: str) -> tuple[np.ndarray, np.ndarray | None]:
@@ -322,16 +311,7 @@ def _counted_blocks(path, values, found, first_value, lines) -> np.ndarray:
 # -- PCD ----------------------------------------------------------------------------
 
 _PCD_TYPES = {
-    ("F", 4): "f4",
-    ("F", 8): "f8",
-    ("I", 1): "i1",
-    ("I", 2): "i2",
-    ("I", 4): "i4",
-    ("I", 8): "i8",
-    ("U", 1): "u1",
-    ("U", 2): "u2",
-    ("U", 4): "u4",
-    ("U", 8): "u8",
+    (kind, size): f"{kind.lower()}{size}" for kind in "FIU" for size in (1, 2, 4, 8) if kind != "F" or size > 2
 }
 
 
@@ -371,15 +351,8 @@ def _read_pcd(path):
         if n * width * 2 > len(body) + 1:
             raise _short(path, n, "points", len(body))
         values, found, first_value, lines = body_rows(data, position, path)  # one point per line
-        table = fixed_rows(
-            values,
-            found[:n],
-            first_value[:n],
-            lines[:n],
-            width,
-            path,
-            names_shown(f"{f}[{c}]" if c > 1 else f for f, c in zip(fields, counts)),
-        )
+        shown = names_shown(f"{f}[{c}]" if c > 1 else f for f, c in zip(fields, counts))
+        table = fixed_rows(values, found[:n], first_value[:n], lines[:n], width, path, shown)
         if found.size < n:
             raise _short(path, n, "points", len(body))
         if found.size > n:
@@ -417,13 +390,7 @@ def _read_pcd(path):
 
 
 def _laspy(path):
-    try:
-        import laspy
-    except ImportError:
-        raise MissingDependencyError(
-            f"{path}: reading or writing LAS / LAZ needs laspy: pip install 'meshcurv[points]'"
-        ) from None
-    return laspy
+    return optional_module("laspy", f"{path}: reading or writing LAS / LAZ needs laspy: pip install 'meshcurv[points]'")
 
 
 def _read_las(path):

@@ -22,7 +22,7 @@ import pathlib
 import numpy as np
 
 from .._lazy import LazyImage
-from ..errors import InvalidMeshError, MeshFileError, MissingDependencyError
+from ..errors import InvalidMeshError, MeshFileError, optional_module
 
 __all__ = ["read_zarr", "ZARR_INSTALL"]
 
@@ -30,11 +30,7 @@ ZARR_INSTALL = "pip install 'meshcurv[volume]' (or: pip install zarr)"
 
 
 def _zarr():
-    try:
-        import zarr
-    except ImportError as exc:
-        raise MissingDependencyError(f"reading Zarr images needs the zarr package: {ZARR_INSTALL}") from exc
-    return zarr
+    return optional_module("zarr", f"reading Zarr images needs the zarr package: {ZARR_INSTALL}")
 
 
 def _multiscales(attributes) -> list | None:
