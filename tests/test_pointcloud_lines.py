@@ -113,3 +113,20 @@ def test_a_given_radius_below_the_neighbouring_lines_finds_no_surface():
     points = scanned_plane()
     r = quiet(points, radius=0.05)  # the lines are 0.1 apart
     assert not r.valid.any()
+
+
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
+def test_a_default_radius_beyond_the_work_budget_is_cut_with_a_warning(method, monkeypatch):
+    # 1M points of a thin plate under noise of a third of a spacing: the default normal fits' balls held 7000
+    # points each (7e9 pairs) and the call raised "radius far too large"; here the same budget at 3000 points
+    from meshcurv import neighborhoods
+
+    monkeypatch.setattr(neighborhoods, "MAX_BALL_PAIRS", 100_000)
+    rng = np.random.default_rng(0)
+    u = rng.normal(size=(3000, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    points = u * (1.0 + rng.uniform(-1, 1, (3000, 1)) * 0.3 * np.sqrt(4 * np.pi / 3000))
+    with pytest.warns(MeshQualityWarning, match="would hold about .* points a ball .* cut to"):
+        r = point_cloud_curvatures(points, method=method)
+    assert r.valid.mean() > 0.9
+    assert abs(np.median(r.mean[r.valid]) - 1.0) < 0.1

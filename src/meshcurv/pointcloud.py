@@ -166,6 +166,11 @@ def _reason_code(start: str) -> int:
     return next((code for code, text in enumerate(INVALID_REASONS) if text.startswith(start)), _UNDEFINED)
 
 
+#: Share of :data:`meshcurv.neighborhoods.MAX_BALL_PAIRS` that the balls of one default fit may take: a default
+#: radius whose balls would hold more (noise calls for balls of tens of spacings: a million points under noise
+#: of a third of a spacing, or a thin plate whose two faces both fall in each ball) is cut to fit, with a warning.
+BALL_PAIRS_SHARE = 0.5
+
 #: Code of points whose normal's side could not be decided (between two sheets closer than the spacing).
 _UNDECIDED = _reason_code("point cloud: side undecided")
 
@@ -586,15 +591,20 @@ def _compute(points, given, radius, method, search=None):
         if method == "jets":
             # a ball that holds the other side of a thin or small part shrinks, down to the clean-sample radius
             # (a given radius too: a jet through both sides is not the surface, H doubled on a small sphere)
+            if radius is None:
+                group_radius = _within_budget(points, group_radius, members, "jet fits", problems)
             smallest = min(group_radius, max(CLOUD_RADIUS_RULES[method][0] * group_spacing, floor))
             found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest,
                                      details=details)
             asked = group_radius
         else:
             if given is None:
-                asked = normal_radius = max(noise_rule(_estimators.NORMAL_RULE, group_spacing, noise), floor)
+                asked = normal_radius = _within_budget(
+                    points, max(noise_rule(_estimators.NORMAL_RULE, group_spacing, noise), floor), members,
+                    "normal fits", problems)
+                smallest = min(normal_radius, max(_estimators.NORMAL_RULE[0] * group_spacing, floor))
                 normals = _estimators.fitted_normals(points, start, normal_radius, members, usable,
-                                                     smallest=max(_estimators.NORMAL_RULE[0] * group_spacing, floor),
+                                                     smallest=smallest,
                                                      details=details)
                 parameters["normal_radius"] = normal_radius
                 # a point whose every normal fit held the other side, and whose nearest neighbours hold
@@ -659,6 +669,25 @@ def _compute(points, given, radius, method, search=None):
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, *_ in groups)
     return k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, problems
+
+
+def _within_budget(points, radius, members, what, problems) -> float:
+    """``radius``, or less: balls around ``members`` that hold :data:`BALL_PAIRS_SHARE` of
+    :data:`meshcurv.neighborhoods.MAX_BALL_PAIRS` (centre, point) pairs at most (the count grows as the square
+    of the radius on a surface). A cut is added to ``problems``."""
+    from .neighborhoods import MAX_BALL_PAIRS, estimate_ball_pairs
+
+    if members.size == 0:
+        return radius
+    mean, _ = estimate_ball_pairs(points, radius, points[members])
+    budget = BALL_PAIRS_SHARE * MAX_BALL_PAIRS
+    if mean * members.size <= budget:
+        return radius
+    cut = float(radius * np.sqrt(budget / (mean * members.size)))
+    problems.append(f"the default radius of the {what}, {radius:.3g}, would hold about {mean:.3g} points a ball "
+                    f"({mean * members.size:.3g} in all, hours of work: noise of many spacings, or both faces "
+                    f"of a thin part in each ball): cut to {cut:.3g}; the curvatures are rougher")
+    return cut
 
 
 def _radius_groups(spacing, indices, usable, median, noise, radius, method, problems, least=None):
