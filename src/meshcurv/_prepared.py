@@ -89,8 +89,13 @@ class PreparedMesh:
 
     @cached_property
     def vertex_normals(self) -> np.ndarray:
-        """(V, 3) area-weighted unit normals of the faces that are not degenerate (NaN where none); read-only."""
-        used = np.where(self.degenerate[:, None], 0.0, self.cross) if self.degenerate.any() else self.cross
+        """(V, 3) area-weighted unit normals of the faces that are not degenerate nor a needle's (NaN where none);
+        read-only."""
+        dropped = self.degenerate
+        needle = self.defects().needle_cells(self.topology.faces)  # slivers of a vertex flung away: huge areas
+        if needle is not None:
+            dropped = dropped | needle
+        used = np.where(dropped[:, None], 0.0, self.cross) if dropped.any() else self.cross
         return _read_only(vertex_normals(self.vertices, self.topology.faces, cross=used))
 
     @cached_property

@@ -24,7 +24,7 @@ from .geometry import degenerate_face_mask
 from .topology import MeshTopology
 
 __all__ = ["Defect", "DEFECTS", "POINT_CLOUD_REASONS", "INVALID_REASONS", "UNDEFINED", "BOUNDARY", "VertexDefects",
-           "NEEDLE_ANGLE", "NEEDLE_REACH", "defect_codes", "needle_vertices"]
+           "NEEDLE", "NEEDLE_ANGLE", "NEEDLE_REACH", "defect_codes", "needle_vertices"]
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,9 @@ class Defect:
 
 
 #: The defects, in the order in which a vertex takes the first that applies (a needle vertex on
-#: the boundary is a needle vertex: the methods that keep boundary vertices must not keep it).
+#: the boundary is a needle vertex: the methods that keep boundary vertices must not keep it; some of
+#: a needle's faces may be of zero area in float64, its width lost beyond 1e16 edge lengths: it is
+#: still a needle, and its faces are found by its code, :meth:`VertexDefects.needle_cells`).
 DEFECTS = (
     Defect(1, "unreferenced_vertices", "unreferenced vertex (in no face)", "unreferenced vertices"),
     Defect(2, "nonmanifold_edges", "on a non-manifold edge (3+ faces)", "non-manifold edges (3+ faces)"),
@@ -58,15 +60,19 @@ DEFECTS = (
            "bow-tie vertices (fans meeting at a point)"),
     Defect(4, "inconsistent_edges", "on an edge between inconsistently oriented faces",
            "edges between inconsistently oriented faces"),
+    Defect(7, "needle_vertices", "needle vertex, or a corner of its faces: slivers reaching far beyond the "
+           "neighbourhood (a vertex flung away)",
+           "needle vertices (their faces are slivers from a vertex flung far away; their corners are NaN too)"),
     Defect(5, "degenerate_faces", "corner of a zero-area face", "zero-area faces"),
-    Defect(7, "needle_vertices", "needle vertex: its faces are slivers reaching far beyond its neighbourhood "
-           "(a vertex flung away)", "needle vertices (their faces are slivers from a vertex flung far away)"),
     Defect(6, "boundary_edges", "on a boundary edge (this method needs a closed neighbourhood)",
            "boundary edges (their vertices have no complete neighbourhood)"),
 )
 
 #: The code of a boundary vertex (a defect only for the methods that need a closed neighbourhood).
 BOUNDARY = 6
+
+#: The code of a needle vertex and of the corners of its faces (:func:`needle_vertices`).
+NEEDLE = 7
 
 #: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the last
 #: the defects of meshes: codes 8 and 9.
@@ -102,6 +108,9 @@ NEEDLE_ANGLE = 0.1
 #: wider than the ball (linear in the distance) turn them into a finite, wrong curvature (issue 29:
 #: a hemisphere's vertex moved to x = 1e40 kept a valid H of -2 with icc). Both conditions together:
 #: a coarse part of a mesh has long edges and full fans; a sliver of a fine mesh has short edges.
+#: The corners of a needle's faces take its code too: each has a sliver in its ring, whose area and
+#: normal outweigh the rest (on an icosphere with a vertex moved 10 radii out, normal_cycle was 4 times
+#: off in H over the next three rings, rusinkiewicz 2.7 times, meyer 5 times at the corners).
 NEEDLE_REACH = 4.0
 
 
@@ -176,12 +185,18 @@ def defect_codes(topology: MeshTopology, degenerate: np.ndarray, vertices: np.nd
     Returns
     -------
     codes : ndarray of shape (V,), int8
-        Codes of :data:`DEFECTS`.
+        Codes of :data:`DEFECTS`; the needle code also marks the corners of
+        a needle vertex's faces.
     counts : dict
-        ``{defect.name: count}``: edges, faces or vertices, as the name says.
+        ``{defect.name: count}``: edges, faces or vertices, as the name says
+        (``needle_vertices``: the needle vertices themselves).
         A bow-tie vertex on a non-manifold edge is counted with that edge only.
     """
     needles = None if vertices is None or scales is None else needle_vertices(vertices, topology, scales)
+    needle_corners = None
+    if needles is not None and needles.any():  # the corners of a needle's faces: each has a sliver in its ring
+        needle_corners = np.zeros(topology.n_vertices, dtype=bool)
+        needle_corners[topology.faces[needles[topology.faces].any(axis=1)].ravel()] = True
     nonmanifold = topology.edge_vertices(topology.nonmanifold_edges)
     bowties = topology.bowtie_vertices & ~nonmanifold
     corners = np.zeros(topology.n_vertices, dtype=bool)
@@ -192,7 +207,7 @@ def defect_codes(topology: MeshTopology, degenerate: np.ndarray, vertices: np.nd
         "bowtie_vertices": bowties,
         "inconsistent_edges": topology.edge_vertices(topology.inconsistent_edges),
         "degenerate_faces": corners,
-        "needle_vertices": np.zeros(topology.n_vertices, dtype=bool) if needles is None else needles,
+        "needle_vertices": np.zeros(topology.n_vertices, dtype=bool) if needle_corners is None else needle_corners,
         "boundary_edges": topology.edge_vertices(topology.boundary_edges),
     }
     codes = np.zeros(topology.n_vertices, dtype=np.int8)
@@ -227,6 +242,15 @@ class VertexDefects:
     codes: np.ndarray
     counts: dict
     tolerated: frozenset = frozenset()
+
+    def needle_cells(self, cells: np.ndarray) -> np.ndarray | None:
+        """(C,) bool: the edges or faces (``cells``, (C, k) vertex indices) all of whose vertices carry the
+        needle code (a needle's faces, and the edges between its corners, whose dihedral angles are those
+        of its slivers), or None when the mesh has no needle vertex."""
+        needle = self.codes == NEEDLE
+        if not needle.any():
+            return None
+        return needle[cells].all(axis=1)
 
     @property
     def invalid_vertices(self) -> np.ndarray:

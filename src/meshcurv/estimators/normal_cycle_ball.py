@@ -25,6 +25,9 @@ normals), with the eigenvectors turned by 90 degrees.
 Edges on the boundary, non-manifold or inconsistently oriented edges and
 edges of zero-area faces have no dihedral angle and add nothing; the area
 stops at the boundary as well, so boundary vertices keep a (one-sided) estimate.
+The faces of a needle vertex (a vertex flung far away,
+:func:`meshcurv.defects.needle_vertices`) and the edges between their corners
+add nothing either: the balls around them stop there as at a boundary.
 
 References
 ----------
@@ -69,6 +72,11 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     with np.errstate(invalid="ignore", divide="ignore"):
         unit_normals = cross / double_areas[:, None]
     usable = topology.interior_edges & ~degenerate[np.maximum(topology.edge_faces, 0)].any(axis=1)
+    # a needle's slivers (and the edges between its corners) add nothing: they would outweigh the balls around it
+    needle_edges, needle_faces = defects.needle_cells(topology.edges), defects.needle_cells(topology.faces)
+    if needle_edges is not None:
+        usable &= ~needle_edges
+    kept_faces = ~degenerate if needle_faces is None else ~degenerate & ~needle_faces
     beta, _, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
 
     stages.start("sum over balls")
@@ -78,7 +86,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     for group_radius, members in groups:
         rows = slice(None) if members is None else members
         measures[rows] = ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=usable)[rows]
-        areas[rows] = ball_face_sums(vertices, topology.faces, group_radius, face_values, usable=~degenerate)[rows, 0]
+        areas[rows] = ball_face_sums(vertices, topology.faces, group_radius, face_values, usable=kept_faces)[rows, 0]
 
     stages.start("retrieve curvatures")
     valid &= areas > 0
