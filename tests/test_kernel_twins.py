@@ -1386,6 +1386,42 @@ def check_edge_geometry(name):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14, err_msg=label)
 
 
+def check_line_spread(name):
+    from meshcurv._pointcloud_normals import _line_spread_numpy
+
+    points, _ = cloud(name)
+    indices = knn_indices(points)
+    line = np.stack([np.linspace(0, 1, 40), np.zeros(40), np.zeros(40)], axis=1)  # spread 0
+    for p, i in ((points, indices), (line, knn_indices(line))):
+        np.testing.assert_allclose(kernels("pointcloud").line_spread(p, np.ascontiguousarray(i)),
+                                   _line_spread_numpy(p, i), rtol=1e-9, atol=1e-6)
+
+
+def check_flat_balls(name):
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_estimators import (BALL_OFFSET, BALL_SHARE, SUPPORT_ITERATIONS, SUPPORT_POINTS,
+                                                 _ball_indices, _flat_balls, _usable_tree)
+    from meshcurv._pointcloud_normals import LINE_SUPPORT
+
+    points, _ = cloud(name)
+    n = points.shape[0]
+    # the cloud and a line beside it with a few points: balls with and without a surface
+    t = np.linspace(0.0, 1.0, 200)
+    points = np.concatenate([points, np.stack([t, t, t + 5.0], axis=1), [[0.5, 0.6, 5.5], [0.2, 0.1, 5.1]]])
+    centres = np.arange(points.shape[0])
+    radius = 0.4 if name == "ellipsoid_cloud" else 0.12
+    for k in (24, 96):
+        index, counts = _ball_indices(_usable_tree(cKDTree(points), points, np.ones(points.shape[0], dtype=bool)),
+                                      points, centres, radius, k)
+        expected = _flat_balls(points, centres, index, counts)
+        got = kernels("pointcloud").flat_balls(points, centres, index, counts.astype(np.int64),
+                                               -(-k // SUPPORT_POINTS), SUPPORT_ITERATIONS, BALL_OFFSET, BALL_SHARE,
+                                               LINE_SUPPORT)
+        np.testing.assert_array_equal(got, expected)
+        assert expected[:n].mean() > 0.9 and not expected[n:n + 200].any()  # (the line's own balls)
+
+
 def check_own_side(name):
     from scipy.spatial import cKDTree
 
@@ -1490,6 +1526,8 @@ TWINS = [
     Twin("pointcloud.edge_geometry", "the products of _pointcloud_normals.oriented_signs", check_edge_geometry,
          CLOUDS),
     Twin("pointcloud.own_side", "_pointcloud_estimators._own_side", check_own_side, CLOUDS),
+    Twin("pointcloud.line_spread", "_pointcloud_normals._line_spread_numpy", check_line_spread, CLOUDS),
+    Twin("pointcloud.flat_balls", "_pointcloud_estimators._flat_balls", check_flat_balls, CLOUDS),
     Twin("pointcloud.stacked", "_pointcloud_normals._stacked", check_stacked, CLOUDS),
 ]
 

@@ -155,3 +155,29 @@ def test_from_faces_without_a_count_refuses_a_stray_huge_index():
         MeshTopology.from_faces(np.array([[0, 1, 2**31]]))
     assert MeshTopology.from_faces(np.array([[0, 1, far - 1]])).n_vertices == far
     assert MeshTopology.from_faces(np.array([[0, 1, far]]), far + 1).n_vertices == far + 1  # when asked for
+
+
+def test_smoothing_lists_are_the_neighbour_lists_or_empty_without_smoothing():
+    top = MeshTopology.from_faces(shapes.icosphere(2).faces)
+    indptr, indices = top.smoothing_lists(3)
+    assert indptr is top.neighbour_lists[0] and indices is top.neighbour_lists[1]
+    empty_indptr, empty_indices = MeshTopology.from_faces(shapes.icosphere(2).faces).smoothing_lists(0)
+    np.testing.assert_array_equal(empty_indptr, np.zeros(top.n_vertices + 1))
+    assert empty_indices.size == 0 and empty_indptr.dtype == empty_indices.dtype == np.int64
+
+
+def test_normal_cycle_keeps_the_zero_area_faces_its_kernel_found():
+    """The kernel's zero-area faces serve the defects (not searched twice): the same as geometry.degenerate_faces."""
+    from meshcurv._prepared import prepare_mesh
+    from meshcurv.estimators import ESTIMATORS
+    from meshcurv.estimators._support import Stages
+    from meshcurv.geometry import degenerate_faces
+
+    sphere = shapes.icosphere(4)
+    faces = np.vstack([sphere.faces, [[0, 1, 1]]])  # a repeated corner: zero area
+    mesh = prepare_mesh(sphere.vertices, faces, orient="keep", weld=False)
+    estimator = ESTIMATORS["normal_cycle"]
+    estimator.function(mesh, smoothing_steps=1, stages=Stages(estimator.stages))
+    expected = degenerate_faces(mesh.vertices, mesh.topology)
+    np.testing.assert_array_equal(mesh.degenerate, expected)
+    assert expected.sum() == 1

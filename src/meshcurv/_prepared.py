@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ._adapters import mesh_arrays
+from ._backend import numba_kernels
 from ._locality import local_topology
 from ._validation import as_vertices, check_choice
 from .defects import BOUNDARY, VertexDefects, defect_codes
@@ -84,8 +85,14 @@ class PreparedMesh:
     @cached_property
     def degenerate(self) -> np.ndarray:
         """(F,) bool: the zero-area faces (:func:`meshcurv.geometry.degenerate_faces`); read-only."""
-        return _read_only(degenerate_faces(self.vertices, self.topology, cross=self.cross,
-                                           scales=self.length_scales))
+        # the compiled test computes the cross products inline: asking for self.cross would build them for nothing
+        cross = self.__dict__.get("cross") if numba_kernels("geometry") is not None else self.cross
+        return _read_only(degenerate_faces(self.vertices, self.topology, cross=cross, scales=self.length_scales))
+
+    def found_degenerate(self, degenerate: np.ndarray) -> None:
+        """Keep (F,) ``degenerate``, found by a kernel with the test of :attr:`degenerate` (the same scales and
+        ratio), as :attr:`degenerate`: the zero-area faces are not searched twice."""
+        self.__dict__.setdefault("degenerate", _read_only(degenerate))
 
     @cached_property
     def vertex_normals(self) -> np.ndarray:

@@ -293,6 +293,13 @@ class MeshTopology:
             indptr, indices = adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64)
         return _readonly(indptr), _readonly(indices)
 
+    def smoothing_lists(self, steps: int) -> tuple[np.ndarray, np.ndarray]:
+        """:attr:`neighbour_lists` for ``steps`` passes of a 1-ring smoothing: empty lists when ``steps`` is 0
+        (none built)."""
+        if steps > 0:
+            return self.neighbour_lists
+        return np.zeros(self.n_vertices + 1, np.int64), np.zeros(0, np.int64)
+
     @cached_property
     def vertex_degrees(self) -> np.ndarray:
         """(V,) int64: number of edges at each vertex."""

@@ -103,6 +103,52 @@ def _magnitude_order(w0, w1, w2):
     return o0, o1, o2
 
 
+@nb.njit(inline="always", **_JIT)
+def _ring_sums6(current, indptr, indices, i):
+    """Columns 0 to 5 of row ``i`` of ``current`` plus those of its neighbours (in list order, each
+    column's sum in registers), and ``1 / (degree + 1)``: one pass of ``smoothing.smooth_over_neighbours``
+    at ``i`` before its scaling, the same sums in the same order."""
+    start, stop = indptr[i], indptr[i + 1]
+    t0, t1, t2 = current[i, 0], current[i, 1], current[i, 2]
+    t3, t4, t5 = current[i, 3], current[i, 4], current[i, 5]
+    for j in range(start, stop):
+        w = indices[j]
+        t0 += current[w, 0]
+        t1 += current[w, 1]
+        t2 += current[w, 2]
+        t3 += current[w, 3]
+        t4 += current[w, 4]
+        t5 += current[w, 5]
+    return t0, t1, t2, t3, t4, t5, 1.0 / (stop - start + 1.0)
+
+
+@nb.njit(inline="always", **_JIT)
+def _principal_row(i, t0, t1, t2, t3, t4, t5, c1, c2, u1, u2, normal):
+    """Row ``i`` of :func:`matgeom_principal` from the tensor ``(t0, ..., t5)`` (xx, yy, zz, xy, xz, yz)."""
+    if not (math.isfinite(t0) and math.isfinite(t1) and math.isfinite(t2) and math.isfinite(t3)
+            and math.isfinite(t4) and math.isfinite(t5)):
+        c1[i] = c2[i] = np.nan
+        for k in range(3):
+            u1[i, k] = u2[i, k] = normal[i, k] = np.nan
+        return
+    w0, w1, w2, v00, v01, v02, v10, v11, v12, v20, v21, v22 = _jacobi3(t0, t1, t2, t3, t4, t5)
+    o0, o1, o2 = _magnitude_order(w0, w1, w2)
+    w = (w0, w1, w2)
+    columns = ((v00, v10, v20), (v01, v11, v21), (v02, v12, v22))
+    small, middle, large = columns[o0], columns[o1], columns[o2]
+    a, b = w[o1], w[o2]
+    if a > b:  # matGeom's swap: c1 <= c2, u1 with c1
+        c1[i], c2[i] = b, a
+        first, second = middle, large
+    else:
+        c1[i], c2[i] = a, b
+        first, second = large, middle
+    for k in range(3):
+        u1[i, k] = first[k]
+        u2[i, k] = second[k]
+        normal[i, k] = small[k]
+
+
 @nb.njit(parallel=True, **_JIT)
 def matgeom_principal(tensors):
     """matGeom's step 7 per vertex: eigenpairs by magnitude, the two largest as curvatures, swapped so c1 <= c2.
@@ -114,39 +160,43 @@ def matgeom_principal(tensors):
     swap of ``estimators.matgeom.estimate``.
     """
     n = tensors.shape[0]
-    c1 = np.empty(n)
-    c2 = np.empty(n)
-    u1 = np.empty((n, 3))
-    u2 = np.empty((n, 3))
-    normal = np.empty((n, 3))
+    c1, c2, u1, u2, normal = np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     for i in nb.prange(n):
-        finite = True
-        for k in range(6):
-            if not math.isfinite(tensors[i, k]):
-                finite = False
-        if not finite:
-            c1[i] = c2[i] = np.nan
-            for k in range(3):
-                u1[i, k] = u2[i, k] = normal[i, k] = np.nan
-            continue
-        w0, w1, w2, v00, v01, v02, v10, v11, v12, v20, v21, v22 = _jacobi3(
-            tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4], tensors[i, 5]
-        )
-        o0, o1, o2 = _magnitude_order(w0, w1, w2)
-        w = (w0, w1, w2)
-        columns = ((v00, v10, v20), (v01, v11, v21), (v02, v12, v22))
-        small, middle, large = columns[o0], columns[o1], columns[o2]
-        a, b = w[o1], w[o2]
-        if a > b:  # matGeom's swap: c1 <= c2, u1 with c1
-            c1[i], c2[i] = b, a
-            first, second = middle, large
-        else:
-            c1[i], c2[i] = a, b
-            first, second = large, middle
-        for k in range(3):
-            u1[i, k] = first[k]
-            u2[i, k] = second[k]
-            normal[i, k] = small[k]
+        _principal_row(i, tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4], tensors[i, 5],
+                       c1, c2, u1, u2, normal)
+    return c1, c2, u1, u2, normal
+
+
+@nb.njit(parallel=True, **_JIT)
+def matgeom_finish(tensors, indptr, indices, steps):
+    """matGeom's steps 6 and 7 in one kernel: ``steps`` passes of the 1-ring mean over the (V, 6)
+    ``tensors`` (overwritten), then :func:`matgeom_principal` of the result.
+
+    Each pass is ``smoothing.smooth_over_neighbours``'s, its sums in the same
+    order (the vertex's own value, then its neighbours in list order, times
+    ``1 / (degree + 1)``), the six of a row in registers; the last pass goes
+    straight into the eigen-decomposition, so that only one (V, 6) buffer is
+    added to ``tensors``.
+    """
+    n = tensors.shape[0]
+    c1, c2, u1, u2, normal = np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+    current = tensors
+    following = np.empty((n, 6)) if steps > 1 else tensors
+    for step in range(steps):
+        last = step == steps - 1
+        for i in nb.prange(n):
+            t0, t1, t2, t3, t4, t5, scale = _ring_sums6(current, indptr, indices, i)
+            if last:
+                _principal_row(i, t0 * scale, t1 * scale, t2 * scale, t3 * scale, t4 * scale, t5 * scale,
+                               c1, c2, u1, u2, normal)
+            else:
+                following[i, 0], following[i, 1], following[i, 2] = t0 * scale, t1 * scale, t2 * scale
+                following[i, 3], following[i, 4], following[i, 5] = t3 * scale, t4 * scale, t5 * scale
+        current, following = following, current
+    if steps == 0:
+        for i in nb.prange(n):
+            _principal_row(i, tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4],
+                           tensors[i, 5], c1, c2, u1, u2, normal)
     return c1, c2, u1, u2, normal
 
 

@@ -10,6 +10,7 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, _degenerate, _face_cross, _unit
+from .matgeom import _ring_sums6
 from .tensors import _tangent_eigen
 
 
@@ -111,19 +112,10 @@ def normal_cycle_finish(sums, invalid, indptr, indices, steps):
         following = np.empty((n, 7))
         for _ in range(steps):
             for i in nb.prange(n):
-                start, stop = indptr[i], indptr[i + 1]
-                scale = 1.0 / (stop - start + 1.0)
-                t0, t1, t2, t3 = current[i, 0], current[i, 1], current[i, 2], current[i, 3]
-                t4, t5, t6 = current[i, 4], current[i, 5], current[i, 6]
-                for j in range(start, stop):  # one pass over the neighbours, seven sums in registers
-                    w = indices[j]
-                    t0 += current[w, 0]
-                    t1 += current[w, 1]
-                    t2 += current[w, 2]
-                    t3 += current[w, 3]
-                    t4 += current[w, 4]
-                    t5 += current[w, 5]
-                    t6 += current[w, 6]
+                t0, t1, t2, t3, t4, t5, scale = _ring_sums6(current, indptr, indices, i)
+                t6 = current[i, 6]
+                for j in range(indptr[i], indptr[i + 1]):  # the area: the same neighbours, cached rows
+                    t6 += current[indices[j], 6]
                 following[i, 0], following[i, 1], following[i, 2] = t0 * scale, t1 * scale, t2 * scale
                 following[i, 3], following[i, 4], following[i, 5] = t3 * scale, t4 * scale, t5 * scale
                 following[i, 6] = t6 * scale

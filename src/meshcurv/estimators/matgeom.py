@@ -37,7 +37,7 @@ import numpy as np
 from .._backend import kernel_threads, numba_kernels
 from .._tensors import outer6
 from ..result import CurvatureResult
-from ..smoothing import check_smoothing_steps, smooth_vertex_field
+from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages
@@ -133,6 +133,13 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
         Ends of the edges paired with a face that does not contain them.
     """
     stages = stages or Stages(STAGES)
+    tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = _edge_tensors(vertices, topology, stages)
+    stages.start("average vertex tensors")
+    return smooth_vertex_field(tensors, topology, smoothing_steps), n_kept, n_wrong_face, n_out_of_range, mispaired
+
+
+def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages):
+    """Steps 1 to 5 of :func:`matgeom_tensors`: the vertex tensors before the smoothing, and the same counts."""
     faces = topology.faces
     n_vertices = vertices.shape[0]
     n_faces = faces.shape[0]
@@ -162,8 +169,6 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
         tensors = _vertex_tensors(vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1),
                                   np.where(out_of_range, 0, ef2), out_of_range)
 
-    stages.start("average vertex tensors")
-    tensors = smooth_vertex_field(tensors, topology, smoothing_steps)
     mispaired = np.zeros(n_vertices, dtype=bool)
     mispaired[ev1[wrong_face]] = True
     mispaired[ev2[wrong_face]] = True
@@ -174,22 +179,31 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     """Run matGeom's algorithm. Returns ``(result, problems)``."""
     vertices, topology = mesh.vertices, mesh.topology
     smoothing_steps = check_smoothing_steps(smoothing_steps)
-    tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = matgeom_tensors(
-        vertices, topology, smoothing_steps, stages
-    )
-    problems: list[str] = []
-
-    stages.start("retrieve curvatures")
     kernels = numba_kernels("matgeom")
-    if kernels is not None:
-        c1, c2, u1, u2, normal = kernels.matgeom_principal(np.ascontiguousarray(tensors))
+    problems: list[str] = []
+    if kernels is not None and smoothing_steps <= STEPS_PER_CALL:
+        # the smoothing and the eigen-decomposition in one kernel (the same sums in the same order as
+        # smooth_vertex_field's kernel): no copy of the tensors, the last pass straight into the eigen-solver
+        tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = _edge_tensors(vertices, topology, stages)
+        stages.start("average vertex tensors")
+        indptr, indices = topology.smoothing_lists(smoothing_steps)
+        stages.start("retrieve curvatures")
+        c1, c2, u1, u2, normal = kernels.matgeom_finish(np.ascontiguousarray(tensors), indptr, indices,
+                                                        smoothing_steps)
     else:
-        values, vectors = sorted_by_magnitude(tensors)
-        c1, c2 = values[:, 1].copy(), values[:, 2].copy()
-        u1, u2, normal = vectors[:, :, 2].copy(), vectors[:, :, 1].copy(), vectors[:, :, 0].copy()
-        swap = c1 > c2
-        c1[swap], c2[swap] = c2[swap], c1[swap]
-        u1[swap], u2[swap] = u2[swap], u1[swap]
+        tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = matgeom_tensors(
+            vertices, topology, smoothing_steps, stages
+        )
+        stages.start("retrieve curvatures")
+        if kernels is not None:
+            c1, c2, u1, u2, normal = kernels.matgeom_principal(np.ascontiguousarray(tensors))
+        else:
+            values, vectors = sorted_by_magnitude(tensors)
+            c1, c2 = values[:, 1].copy(), values[:, 2].copy()
+            u1, u2, normal = vectors[:, :, 2].copy(), vectors[:, :, 1].copy(), vectors[:, :, 0].copy()
+            swap = c1 > c2
+            c1[swap], c2[swap] = c2[swap], c1[swap]
+            u1[swap], u2[swap] = u2[swap], u1[swap]
 
     finite = ~np.isnan(c1)  # NaN exactly where a tensor component is not finite
     # matGeom's numbers are kept everywhere it computes them; valid=False marks

@@ -113,16 +113,14 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     """The same with the compiled kernels: one pass for the sums, one kernel from sums to curvatures."""
     vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute adjacencies")
-    if smoothing_steps > 0:
-        indptr, indices = topology.neighbour_lists
-    else:  # no smoothing: no neighbour lists to build
-        indptr, indices = np.zeros(vertices.shape[0] + 1, np.int64), np.zeros(0, np.int64)
+    indptr, indices = topology.smoothing_lists(smoothing_steps)
     stages.start("compute edge tensors")
-    sums, _ = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
+    sums, degenerate = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
                                                  topology.edge_face_counts, topology._edge_forward_counts,
                                                  mesh.length_scales, DEGENERATE_AREA_RATIO,
                                                  kernel_threads())
-    defects = mesh.defects()  # the zero-area faces as the kernel found them (the twin tests)
+    mesh.found_degenerate(degenerate)  # the same test as mesh.degenerate (the twin tests): not made twice
+    defects = mesh.defects()
     stages.start("average vertex tensors")
     stages.start("retrieve curvatures")
     if smoothing_steps > STEPS_PER_CALL:
