@@ -74,7 +74,7 @@ def test_defect_codes_of_the_connectivity_alone_count_no_needle():
 @pytest.mark.parametrize("factor, needle", [(0.9, True), (1.1, False)])
 def test_the_apex_of_a_pyramid_is_a_needle_below_the_angle(factor, needle):
     # the apex angle in closed form; the base edges (1 and 0.52) set the median, the apex edges reach 50+
-    heights = np.linspace(20.0, 200.0, 2001)
+    heights = np.linspace(5.0, 200.0, 3901)
     sums = np.array([_pyramid(12, h)[2] for h in heights])
     height = heights[np.argmin(np.abs(sums - factor * NEEDLE_ANGLE))]
     vertices, faces, angle_sum = _pyramid(12, height)
@@ -85,9 +85,9 @@ def test_the_apex_of_a_pyramid_is_a_needle_below_the_angle(factor, needle):
 
 
 def test_long_edges_around_a_full_fan_make_no_needle():
-    # a pyramid 60 base radii high on 400 sides: apex edges of 60 (the median edge is 1), but a fan of
-    # 400 faces whose angles sum to 400 * 2 atan(sin(pi/400) / 60) = 0.105 > NEEDLE_ANGLE ...
-    vertices, faces, angle_sum = _pyramid(400, 60.0)
+    # a pyramid 10 base radii high on 400 sides: apex edges of 10 (the median edge is 1), but a fan of
+    # 400 faces whose angles sum to 400 * 2 atan(sin(pi/400) / 10) = 0.63 > NEEDLE_ANGLE ...
+    vertices, faces, angle_sum = _pyramid(400, 10.0)
     assert angle_sum > NEEDLE_ANGLE and not _needles(vertices, faces).any()
     # ... and a flat fan of long edges (the apex in the base plane: 2 pi) is no needle either
     vertices, faces, _ = _pyramid(12, 0.0)

@@ -99,9 +99,9 @@ _WARNING_ORDER = ("boundary_edges", "nonmanifold_edges", "bowtie_vertices", "inc
 _COUNTED = {defect.name: defect.counted for defect in DEFECTS}
 
 
-#: A vertex whose faces' corner angles at it sum to less than this (radians, about 5.7 degrees: the tip of
-#: a cone of half-angle 0.9 degrees) ...
-NEEDLE_ANGLE = 0.1
+#: A vertex whose faces' corner angles at it sum to less than this (radians, about 29 degrees: the tip of
+#: a cone of half-angle 4.6 degrees, a vertex moved 4 edge lengths out of a regular mesh) ...
+NEEDLE_ANGLE = 0.5
 #: ... and whose every edge is longer than this many length scales (the median edge length of its
 #: component) is a needle vertex: a vertex flung far from its neighbours (a spike of a corrupted file).
 #: Every ball around it holds the tips of its own slivers only, and the estimators' shares of faces
