@@ -255,6 +255,19 @@ def _own_side(normals, centres, index, counts, sheets=None):
 def flat_balls(points, centres, index, counts) -> np.ndarray:
     """(M,) bool: the balls ``index`` (M, k) (``counts`` points first, padded with N) that hold a surface.
 
+    See :func:`_flat_balls`; compiled: :func:`meshcurv._kernels.pointcloud.flat_balls`.
+    """
+    compiled = numba_kernels("pointcloud")
+    if compiled is None:
+        return _flat_balls(points, centres, index, counts)
+    return compiled.flat_balls(points, np.ascontiguousarray(centres), np.ascontiguousarray(index),
+                               np.ascontiguousarray(counts, dtype=np.int64), -(-index.shape[1] // SUPPORT_POINTS),
+                               SUPPORT_ITERATIONS, BALL_OFFSET, BALL_SHARE, _normals.LINE_SUPPORT)
+
+
+def _flat_balls(points, centres, index, counts) -> np.ndarray:
+    """The NumPy path of :func:`flat_balls`.
+
     A ball holds a surface when at least :data:`meshcurv._pointcloud_normals.LINE_SUPPORT` and
     :data:`BALL_SHARE` of :data:`SUPPORT_POINTS` of its points (every few in distance order) lie farther than
     :data:`BALL_OFFSET` times the farthest one's distance from the line through the centre along their main

@@ -212,8 +212,17 @@ def line_spread(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """(N,) the spread of each point and its neighbours ``indices`` (N, k) across their main direction, over the
     spread along it: ``sqrt(lambda_2 / lambda_1)`` of their covariance (0 on a line, 1 when isotropic).
 
-    The eigenvalues in closed form (Smith 1961), in chunks of :data:`CHUNK` points.
+    The eigenvalues in closed form (Smith 1961): compiled
+    (:func:`meshcurv._kernels.pointcloud.line_spread`), or with arrays in chunks of :data:`CHUNK` points.
     """
+    compiled = numba_kernels("pointcloud")
+    if compiled is not None:
+        return compiled.line_spread(points, np.ascontiguousarray(indices))
+    return _line_spread_numpy(points, indices)
+
+
+def _line_spread_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """The NumPy path of :func:`line_spread`."""
     n = points.shape[0]
     ratio = np.ones(n)
     for start in range(0, n, CHUNK):

@@ -56,6 +56,96 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
 RANK_ONE = 1e-24
 
 
+@nb.njit(**_JIT)
+def _covariance(points, indices, i):
+    """``xx, xy, xz, yy, yz, zz``: the (unnormalised) covariance of point ``i`` and its neighbours ``indices[i]``."""
+    k = indices.shape[1]
+    cx, cy, cz = points[i, 0], points[i, 1], points[i, 2]
+    for j in range(k):
+        cx += points[indices[i, j], 0]
+        cy += points[indices[i, j], 1]
+        cz += points[indices[i, j], 2]
+    cx, cy, cz = cx / (k + 1), cy / (k + 1), cz / (k + 1)
+    dx, dy, dz = points[i, 0] - cx, points[i, 1] - cy, points[i, 2] - cz
+    xx, xy, xz, yy, yz, zz = dx * dx, dx * dy, dx * dz, dy * dy, dy * dz, dz * dz
+    for j in range(k):
+        q = indices[i, j]
+        xx, xy, xz, yy, yz, zz = _add_outer(xx, xy, xz, yy, yz, zz, points[q, 0] - cx, points[q, 1] - cy,
+                                            points[q, 2] - cz)
+    return xx, xy, xz, yy, yz, zz
+
+
+@nb.njit(**_JIT)
+def _add_outer(xx, xy, xz, yy, yz, zz, dx, dy, dz):
+    """The six entries of a symmetric 3 x 3 sum plus those of ``d d^T``."""
+    return xx + dx * dx, xy + dx * dy, xz + dx * dz, yy + dy * dy, yz + dy * dz, zz + dz * dz
+
+
+@nb.njit(parallel=True, **_JIT)
+def line_spread(points, indices):
+    """(N,) ``sqrt(lambda_2 / lambda_1)`` of the covariance of each point with its neighbours ``indices`` (N, k).
+
+    The compiled :func:`meshcurv._pointcloud_normals.line_spread`: the same closed form (Smith 1961).
+    """
+    n = indices.shape[0]
+    out = np.ones(n)
+    for i in nb.prange(n):
+        xx, xy, xz, yy, yz, zz = _covariance(points, indices, i)
+        mean = (xx + yy + zz) / 3
+        sxx, syy, szz = xx - mean, yy - mean, zz - mean
+        spread = np.sqrt((sxx * sxx + syy * syy + szz * szz + 2 * (xy * xy + xz * xz + yz * yz)) / 6)
+        scale = spread if spread > 0 else 1.0
+        bxx, byy, bzz, bxy, bxz, byz = sxx / scale, syy / scale, szz / scale, xy / scale, xz / scale, yz / scale
+        half = 0.5 * (bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz) + bxz * (bxy * byz - byy * bxz))
+        angle = np.arccos(min(1.0, max(-1.0, half))) / 3
+        largest = mean + 2 * spread * np.cos(angle)
+        smallest = mean + 2 * spread * np.cos(angle + 2 * np.pi / 3)
+        second = max(3 * mean - largest - smallest, 0.0)
+        if largest > 0:
+            out[i] = np.sqrt(second / largest)
+    return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def flat_balls(points, centres, index, counts, stride, iterations, offset, share, least):
+    """(M,) bool: the compiled :func:`meshcurv._pointcloud_estimators.flat_balls` (its constants as arguments).
+
+    Every ``stride``-th column of each ball ``index`` (M, k) (its first ``counts`` are points); ``iterations`` of
+    the power method from the farthest of them; a ball holds a surface when ``least`` and ``share`` of them lie
+    farther than ``offset`` times the farthest one's distance from the line along the main direction.
+    """
+    m, k = index.shape
+    out = np.zeros(m, dtype=np.bool_)
+    for row in nb.prange(m):
+        c = centres[row]
+        px, py, pz = points[c, 0], points[c, 1], points[c, 2]
+        xx = xy = xz = yy = yz = zz = 0.0
+        far, ux, uy, uz = 0.0, 0.0, 0.0, 0.0
+        members = 0
+        for a in range(0, min(counts[row], k), stride):
+            j = index[row, a]
+            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+            xx, xy, xz, yy, yz, zz = _add_outer(xx, xy, xz, yy, yz, zz, dx, dy, dz)
+            d = dx * dx + dy * dy + dz * dz
+            if d > far:
+                far, ux, uy, uz = d, dx, dy, dz
+            members += 1
+        for _ in range(iterations):
+            vx, vy, vz = xx * ux + xy * uy + xz * uz, xy * ux + yy * uy + yz * uz, xz * ux + yz * uy + zz * uz
+            length = max(np.sqrt(vx * vx + vy * vy + vz * vz), 2.2250738585072014e-308)
+            ux, uy, uz = vx / length, vy / length, vz / length
+        beside = 0
+        limit = offset * offset * far
+        for a in range(0, min(counts[row], k), stride):
+            j = index[row, a]
+            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+            along = dx * ux + dy * uy + dz * uz
+            if dx * dx + dy * dy + dz * dz - along * along > limit:
+                beside += 1
+        out[row] = beside >= max(least, share * members)
+    return out
+
+
 @nb.njit(parallel=True, **_JIT)
 def pca_normals(points, indices):
     """(N, 3) unit least-variance directions of each point with its neighbours ``indices`` (N, k).
@@ -68,26 +158,10 @@ def pca_normals(points, indices):
     (:func:`meshcurv._pointcloud_normals.pca_normals`) uses ``numpy.linalg.eigh``:
     the same vector up to its sign (tests compare the two).
     """
-    n, k = indices.shape
+    n = indices.shape[0]
     out = np.zeros((n, 3))
     for i in nb.prange(n):
-        cx, cy, cz = points[i, 0], points[i, 1], points[i, 2]
-        for j in range(k):
-            cx += points[indices[i, j], 0]
-            cy += points[indices[i, j], 1]
-            cz += points[indices[i, j], 2]
-        cx, cy, cz = cx / (k + 1), cy / (k + 1), cz / (k + 1)
-        dx, dy, dz = points[i, 0] - cx, points[i, 1] - cy, points[i, 2] - cz
-        xx, xy, xz, yy, yz, zz = dx * dx, dx * dy, dx * dz, dy * dy, dy * dz, dz * dz
-        for j in range(k):
-            q = indices[i, j]
-            dx, dy, dz = points[q, 0] - cx, points[q, 1] - cy, points[q, 2] - cz
-            xx += dx * dx
-            xy += dx * dy
-            xz += dx * dz
-            yy += dy * dy
-            yz += dy * dz
-            zz += dz * dz
+        xx, xy, xz, yy, yz, zz = _covariance(points, indices, i)
         off = xy * xy + xz * xz + yz * yz
         mean = (xx + yy + zz) / 3
         spread = np.sqrt(((xx - mean) ** 2 + (yy - mean) ** 2 + (zz - mean) ** 2 + 2 * off) / 6)
