@@ -11,7 +11,9 @@ as ``method="matgeom"``.
 ((3600,), (3600, 3))
 """
 
-from . import errors, geometry, integrals, plotting, shapes, topology, viewer
+import importlib
+
+from . import errors, geometry, shapes, topology
 from .curvature import METHODS, multiscale_curvatures, principal_curvatures
 from .diagnosis import MeshDiagnosis, diagnose
 from .errors import (
@@ -24,9 +26,6 @@ from .errors import (
 )
 from .io import read_mesh, read_points, write_mesh, write_points
 from .pointcloud import point_cloud_curvatures
-from . import volume
-from .volume import label_curvatures
-from .statistics import curvature_statistics
 from .orient import orient_faces
 from .result import CurvatureResult
 from .smoothing import smooth_vertex_field
@@ -67,3 +66,30 @@ __all__ = [
     "MeshQualityWarning",
     "TriangulationWarning",
 ]
+
+#: Names imported on first use (PEP 562): modules a curvature call does not need, kept out of
+#: ``import meshcurv`` (the label images and their statistics, the plots, the viewer: some 15 ms of a
+#: fresh process's start, issue 31). ``name -> (module, attribute or None for the module itself)``.
+_LAZY = {
+    "volume": (".volume", None),
+    "label_curvatures": (".volume", "label_curvatures"),
+    "curvature_statistics": (".statistics", "curvature_statistics"),
+    "integrals": (".integrals", None),
+    "plotting": (".plotting", None),
+    "viewer": (".viewer", None),
+}
+
+
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'meshcurv' has no attribute {name!r}")
+    module, attribute = _LAZY[name]
+    value = importlib.import_module(module, __name__)
+    if attribute is not None:
+        value = getattr(value, attribute)
+    globals()[name] = value  # once: later lookups find it without this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

@@ -96,7 +96,7 @@ def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_spread
     on threads (:func:`~meshcurv._kernels._common.run_chunks`).
     """
     points, ids, grid, centres = _grid_centres(vertices, pool, radii, centres)
-    outputs = _jet_outputs(vertices.shape[0])
+    outputs = _jet_outputs.py_func(vertices.shape[0])  # NumPy's: one compiled function fewer to load
     limits = np.array([away_fraction, settled])
     facing = facing[:facing.shape[0] if check_facing else 0]
     run_chunks(_grid_chunk, centres.shape[0], n_chunks, vertices, points, normals, radii, degree, iterations,
@@ -481,7 +481,7 @@ def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, 
     """
     n = vertices.shape[0]
     m = centres.shape[0]
-    outputs = _jet_outputs(1 if normals_only else m)
+    outputs = _jet_outputs.py_func(1 if normals_only else m)  # NumPy's: one compiled function fewer to load
     fitted = np.full((m if normals_only else 1, 3), np.nan)
     limits = np.array([away_fraction, settled])
     facing = facing[:facing.shape[0] if check_facing else 0]
@@ -503,8 +503,7 @@ def _connected_chunk(lo, hi, vertices, normals, radii, degree, iterations, expon
     members = np.empty(n, np.int64)
     queue = np.empty(n, np.int64)
     work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
-    # one row, unpacked once, not per vertex (np.int64: the literal 1 would compile _jet_outputs a second time)
-    c, a, b, nn, one_count, one_away = _jet_outputs(np.int64(1))
+    c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row: unpacked once, not per vertex
     for i in range(lo, hi):
         v = centres[i]
         radius = radii[i if per_centre else 0]
