@@ -74,8 +74,8 @@ BOUNDARY = 6
 #: The code of a needle vertex and of the corners of its faces (:func:`needle_vertices`).
 NEEDLE = 7
 
-#: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the last
-#: the defects of meshes: codes 8 and 9.
+#: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the
+#: defects of meshes: the codes after theirs (8, 9, 10).
 POINT_CLOUD_REASONS = (
     "point cloud: side undecided (two sheets closer than the spacing, or stacked with normals the same way)",
     "point cloud: every ball held the other side of a thin part or a neighbouring part",
