@@ -154,7 +154,7 @@ def test_compute_refuses_an_output_that_is_its_input_by_another_name(tmp_path, c
 # ------------------------------------------------------------------------- 2, 3. hangs and dying workers
 
 FAULTS = """
-import json, os, pathlib, signal, sys, time
+import importlib, json, os, pathlib, signal, sys, time
 import distributed
 import meshcurv, meshcurv.io, meshcurv.batch._process
 from meshcurv import batch, shapes
@@ -179,7 +179,7 @@ class Faults(distributed.WorkerPlugin):
 
         meshcurv.io.read_mesh = read_mesh
         # the task's own name for it (imported at module level there)
-        sys.modules["meshcurv.batch._process"].read_mesh = read_mesh
+        importlib.import_module("meshcurv.batch._process").read_mesh = read_mesh
 
 
 def write(folder, names):

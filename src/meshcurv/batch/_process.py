@@ -115,7 +115,6 @@ def process_mesh(
         and message) when the mesh could not be read, computed or written,
         took longer than ``timeout`` or killed its workers.
     """
-
     start = time.perf_counter()
     source, output, record = pathlib.Path(source), pathlib.Path(output), pathlib.Path(record)
     given = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
@@ -127,17 +126,9 @@ def process_mesh(
     facts = None
     with contextlib.suppress(OSError):  # read_mesh says what is wrong with it
         facts = fingerprint(source)
+    failure = (source, record, method, stored_options, facts, timeout)
     if error is not None:
-        row = {
-            "status": "failed",
-            "error": error,
-            "warnings": "",
-            "method": method,
-            "output": "",
-            "seconds": timeout if error.startswith("TimeoutError") else np.nan,
-        }
-        logger.info("%s failed: %s", source, error)
-        _record_failure(record, row, stored_options, facts, timeout)
+        row = _failed(*failure, error, timeout if error.startswith("TimeoutError") else np.nan)
         attempt.unlink(missing_ok=True)
         return row
     try:
@@ -165,15 +156,9 @@ def process_mesh(
         if facts_of is None:  # a point cloud
             row.update(n_vertices=vertices.shape[0], n_faces=0, area=np.nan, volume=np.nan)
         else:
-            row.update(
-                n_vertices=facts_of.n_vertices,
-                n_faces=facts_of.n_faces,
-                area=facts_of.area,
-                volume=np.nan if facts_of.volume is None else facts_of.volume,
-                euler_characteristic=facts_of.euler_characteristic,
-                n_components=facts_of.n_components,
-                n_boundary_loops=facts_of.n_boundary_loops,
-            )
+            names = ("n_vertices", "n_faces", "area", "euler_characteristic", "n_components", "n_boundary_loops")
+            row.update({name: getattr(facts_of, name) for name in names})
+            row["volume"] = np.nan if facts_of.volume is None else facts_of.volume
         row.update(
             n_invalid=int((~result.valid).sum()),
             warnings="; ".join(dict.fromkeys(str(warning.message) for warning in caught)),
@@ -192,17 +177,16 @@ def process_mesh(
             row["seconds"] = time.perf_counter() - start
             _write_record(record, {"row": row, "options": stored_options, "input": facts})
     except Exception as exc:  # one bad mesh never sinks the batch: its row says what went wrong
-        row = {
-            "status": "failed",
-            "error": f"{type(exc).__name__}: {exc}",
-            "warnings": "",
-            "method": method,
-            "output": "",
-            "seconds": time.perf_counter() - start,
-        }
-        logger.info("%s failed: %s", source, row["error"])
-        _record_failure(record, row, stored_options, facts, timeout)
+        row = _failed(*failure, f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
     attempt.unlink(missing_ok=True)
+    return row
+
+
+def _failed(source, record, method, stored_options, facts, timeout, error: str, seconds: float | None) -> dict:
+    """The row of a mesh that failed with ``error``, recorded."""
+    row = {"status": "failed", "error": error, "warnings": "", "method": method, "output": "", "seconds": seconds}
+    logger.info("%s failed: %s", source, error)
+    _record_failure(record, row, stored_options, facts, timeout)
     return row
 
 

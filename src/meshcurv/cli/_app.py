@@ -167,29 +167,11 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
     with estimated(
         mesh, method, smoothing_steps, radius, orient, session, "write" if output is not None else "summary"
     ) as got:
+        settings = {"fields": fields, "quality": quality, "overwrite": overwrite, "source": mesh, "binary": not ascii_}
         if output is not None and got.cloud:
-            write_point_curvatures(
-                output,
-                got.vertices,
-                got.result,
-                fields=fields,
-                quality=quality,
-                overwrite=overwrite,
-                source=mesh,
-                binary=not ascii_,
-            )
+            write_point_curvatures(output, got.vertices, got.result, **settings)
         elif output is not None:
-            write_curvatures(
-                output,
-                got.vertices,
-                got.faces,
-                got.result,
-                fields=fields,
-                quality=quality,
-                overwrite=overwrite,
-                source=mesh,
-                binary=not ascii_,
-            )
+            write_curvatures(output, got.vertices, got.faces, got.result, **settings)
     if output is None:
         click.echo(_summary(mesh, got.vertices, 0 if got.cloud else len(got.faces), got.result, fields))
         return
@@ -259,17 +241,12 @@ def _views(ctx, param, values):
             views.append(tuple(float(x) for x in value.split(",")))
             continue
         for name in filter(None, (part.strip() for part in value.split(","))):
-            if name != "auto" and name not in _plotting_views():
+            if name != "auto" and name not in VIEWS:
                 raise click.BadParameter(
-                    f"unknown view {name!r}; choose auto, {', '.join(_plotting_views())}, "
-                    "or ELEVATION,AZIMUTH in degrees"
+                    f"unknown view {name!r}; choose auto, {', '.join(VIEWS)}, or ELEVATION,AZIMUTH in degrees"
                 )
             views.append(name)
     return views or ["auto"]
-
-
-def _plotting_views():
-    return list(VIEWS)
 
 
 #: The resolution of ``meshcurv plot`` pictures when neither --dpi nor --pixels is given.
