@@ -278,15 +278,7 @@ class CurvatureResult:
         1.00
         """
         shares = self.vertex_integrals(field)
-        if where is not None:
-            mask = np.asarray(where)
-            if mask.dtype != bool or mask.shape != shares.shape:
-                raise InvalidOptionError(
-                    f"`where` must be a bool array of shape ({self.n_vertices},); got "
-                    f"{mask.dtype} of shape {mask.shape}"
-                )
-            shares = shares[mask]
-        return float(np.sum(shares))
+        return float(np.sum(shares if where is None else shares[_where_mask(where, self.n_vertices)]))
 
     def to_pyvista(self, mesh=None, *, fields=None):
         """A ``pyvista.PolyData`` with the fields as ``point_data``: :func:`meshcurv._adapters.to_pyvista`.
@@ -365,6 +357,16 @@ class Surface:
 
 def _rebuild(cls, fields):
     return cls(**fields)
+
+
+def _where_mask(where, n_vertices: int) -> np.ndarray:
+    """``where`` as a (V,) bool mask, all True when None; an InvalidOptionError when it is not one."""
+    mask = np.ones(n_vertices, dtype=bool) if where is None else np.asarray(where)
+    if mask.dtype != bool or mask.shape != (n_vertices,):
+        raise InvalidOptionError(
+            f"`where` must be a bool array of shape ({n_vertices},); got {mask.dtype} of shape {mask.shape}"
+        )
+    return mask
 
 
 def _first_rows(index: np.ndarray, n_welded: int) -> np.ndarray:

@@ -81,7 +81,7 @@ import numpy as np
 from .errors import InvalidOptionError, MeshQualityWarning
 from .integrals import _unit_normals, face_solid_angles
 from .measures import corrected_areas, face_measures
-from .result import CurvatureResult, _first_rows
+from .result import CurvatureResult, _first_rows, _where_mask
 
 __all__ = ["curvature_statistics", "FIELDS", "MOMENTS", "INTEGRALS", "COLUMNS"]
 
@@ -295,14 +295,7 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
             "has none (a point cloud's, or one built directly): compute it with "
             "meshcurv.principal_curvatures on a mesh"
         )
-    region = np.ones(result.n_vertices, dtype=bool)
-    if where is not None:
-        region = np.asarray(where)
-        if region.dtype != bool or region.shape != (result.n_vertices,):
-            raise InvalidOptionError(
-                f"`where` must be a bool array of shape ({result.n_vertices},); got "
-                f"{region.dtype} of shape {region.shape}"
-            )
+    region = _where_mask(where, result.n_vertices)
     vertices, faces = np.asarray(surface.vertices), np.asarray(surface.faces)
     rows = slice(None) if surface.index is None else _first_rows(surface.index, vertices.shape[0])
     valid = np.asarray(result.valid)[rows]
