@@ -63,17 +63,8 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
     # mu^{X,Y} = X^T M Y with M = 1/2 [ (x01 x um) (u02)^T - (x02 x um) (u01)^T ]
     a, b = np.cross(x01, um), np.cross(x02, um)
     m = 0.5 * (a[:, :, None] * u02[:, None, :] - b[:, :, None] * u01[:, None, :])
-    sym = np.stack(
-        [
-            m[:, 0, 0],
-            m[:, 1, 1],
-            m[:, 2, 2],
-            0.5 * (m[:, 0, 1] + m[:, 1, 0]),
-            0.5 * (m[:, 0, 2] + m[:, 2, 0]),
-            0.5 * (m[:, 1, 2] + m[:, 2, 1]),
-        ],
-        axis=1,
-    )
+    rows, columns = [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]  # xx, yy, zz, xy, xz, yz
+    sym = 0.5 * (m[:, rows, columns] + m[:, columns, rows])
     return np.column_stack([mu0, mu1, mu2, sym])
 
 

@@ -218,17 +218,8 @@ def _mrc(path):
         raise MeshFileError(f"{path}: cannot be read as MRC ({_reason(exc)})") from exc
 
 
-_READERS = {
-    ".tif": _tiff,
-    ".tiff": _tiff,
-    ".npy": _npy,
-    ".npz": _npz,
-    ".nii": _nifti,
-    ".nii.gz": _nifti,
-    ".mrc": _mrc,
-    ".rec": _mrc,
-    ".map": _mrc,
-}
+_FILES = ((".tif .tiff", _tiff), (".npy", _npy), (".npz", _npz), (".nii .nii.gz", _nifti), (".mrc .rec .map", _mrc))
+_READERS = {extension: reader for extensions, reader in _FILES for extension in extensions.split()}
 
 
 def read_image(path) -> Image:

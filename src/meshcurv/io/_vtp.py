@@ -23,18 +23,8 @@ from ._text import numbers
 
 __all__ = ["read_vtp", "read_vtp_point_data", "read_vtp_cell_data", "write_vtp", "PieceWriter"]
 
-_TYPES = {
-    "Int8": "i1",
-    "UInt8": "u1",
-    "Int16": "i2",
-    "UInt16": "u2",
-    "Int32": "i4",
-    "UInt32": "u4",
-    "Int64": "i8",
-    "UInt64": "u8",
-    "Float32": "f4",
-    "Float64": "f8",
-}
+_TYPES = {f"{u}Int{8 * n}": f"{'u' if u else 'i'}{n}" for n in (1, 2, 4, 8) for u in ("", "U")}
+_TYPES.update(Float32="f4", Float64="f8")
 _NAMES = {np.dtype(code).newbyteorder("<"): name for name, code in _TYPES.items()}
 
 
@@ -64,16 +54,8 @@ def _piece(vertices: np.ndarray, faces, point_data: dict, cell_data: dict | None
     else:
         connectivity = np.concatenate(faces) if len(faces) else np.zeros(0, dtype=np.int64)
         offsets = np.cumsum([len(face) for face in faces], dtype=np.int64)
-    piece = ElementTree.Element(
-        "Piece",
-        {
-            "NumberOfPoints": str(vertices.shape[0]),
-            "NumberOfVerts": "0",
-            "NumberOfLines": "0",
-            "NumberOfStrips": "0",
-            "NumberOfPolys": str(len(offsets)),
-        },
-    )
+    counts = {"NumberOfPoints": str(vertices.shape[0]), **dict.fromkeys(("NumberOfVerts", "NumberOfLines"), "0")}
+    piece = ElementTree.Element("Piece", {**counts, "NumberOfStrips": "0", "NumberOfPolys": str(len(offsets))})
     for tag, data in (("PointData", point_data), ("CellData", cell_data)):
         if data is None:
             continue
