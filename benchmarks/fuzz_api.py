@@ -30,8 +30,9 @@ finding, not a stuck run. A finding is:
   unchanged); translated or with its vertices permuted, the same values; with
   unreferenced points added near its surface, the same values at every
   referenced vertex; with every face given twice, the second wound the other
-  way (a double-sided mesh, orient='outward'), the same values; with one vertex flung 1e3 to 1e40 times its size away
-  (its faces needles), that vertex invalid with the reason "needle vertex".
+  way (a double-sided mesh, orient='outward'), the same values; with one
+  vertex (or it and a neighbour) flung 1e3 to 1e40 times its size away (their
+  faces needles), those vertices invalid ("needle vertex" for one).
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -454,14 +455,18 @@ def make_case(seed: int, index: int):
             return target, (vv, ff), kwargs, labels, ("truth", labels[0])
         if vlabel == "array" and flabel == "array" and len(labels) == 3 and isinstance(method, str) \
                 and method in METHODS and rng.random() < 0.25:
-            # one vertex of a clean shape flung 1e3-1e40 sizes away: its faces are needles (issue 29)
-            row = int(rng.integers(len(v)))
+            # one vertex of a clean shape, or it and a neighbour together, flung 1e3-1e40 sizes away: their
+            # faces are needles (issue 29)
+            rows = [int(rng.integers(len(v)))]
+            if rng.random() < 0.5:
+                star = f[(f == rows[0]).any(axis=1)]
+                rows.append(int(star[0][star[0] != rows[0]][0]))
             direction = rng.normal(size=3)
             distance = float(np.ptp(v)) * 10.0 ** rng.uniform(3.0, 40.0)
             vv = v.copy()
-            vv[row] += distance * direction / np.linalg.norm(direction)
-            labels.append(f"relation needle {distance:.3g}")
-            return target, (vv, ff), kwargs, labels, ("needle", row)
+            vv[rows] += distance * direction / np.linalg.norm(direction)
+            labels.append(f"relation needle {distance:.3g} ({len(rows)} vertices)")
+            return target, (vv, ff), kwargs, labels, ("needle", rows)
         if vlabel == "array" and flabel == "array" and kwargs.get("radius") is None and rng.random() < 0.5 \
                 and all(label.startswith(("noise", "flipped", "faces removed", "vertices permuted")) for label in labels[1:-2]):
             relation = ["scale", "scale", "permute", "unreferenced", "translate", "double-sided"][int(rng.integers(6))]
@@ -891,11 +896,15 @@ def relation_check(args, kwargs, result, relation):
     v, f = args
     if kind == "needle":  # the flung vertex: invalid, for its needle faces, whatever the method and radius
         # (beyond about 1e16 edge lengths its faces' sides lose the width of their base in float64: zero-area faces)
-        reason = INVALID_REASONS[int(result.invalid_reason[value])]
-        if result.valid[value] or not reason.startswith(("needle vertex", "corner of a zero-area face")):
-            return [f"needle: the flung vertex {value} is {'valid' if result.valid[value] else 'invalid'} "
-                    f"(reason {reason!r})"]
-        return []
+        broken = []
+        for row in value:
+            reason = INVALID_REASONS[int(result.invalid_reason[row])]
+            # a pair beyond about 1e15 sizes: float64 loses their distance to each other, any reason will do
+            expected = ("needle vertex", "corner of a zero-area face") if len(value) == 1 else ("",)
+            if result.valid[row] or not reason.startswith(expected):
+                broken.append(f"needle: the flung vertex {row} of {len(value)} is "
+                              f"{'valid' if result.valid[row] else 'invalid'} (reason {reason!r})")
+        return broken
     if kind == "truth":  # valid estimates on a clean closed analytic shape: within half the largest curvature
         k_min, k_max = TRUTH[value]
         edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))

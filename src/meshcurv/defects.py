@@ -117,6 +117,17 @@ NEEDLE_REACH = 4.0
 def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray:
     """(V,) bool: the needle vertices (:data:`NEEDLE_ANGLE`, :data:`NEEDLE_REACH`).
 
+    The vertices are grouped by the edges no longer than ``NEEDLE_REACH *
+    scales`` (their clusters); a cluster whose edges to the rest of the mesh
+    are all longer is flung away when the corner angles at its vertices, over
+    the faces with one corner in it, sum to less than ``NEEDLE_ANGLE``: one
+    vertex flung away (its fan of slivers), or a few neighbours flung together
+    (the faces between two of them and the rest collapse into slivers too,
+    and have two corners in the cluster). Only a cluster with an edge to a
+    larger one may be flung (not the rest of the mesh, nor a whole component);
+    a patch sampled finer than its surroundings is not: the faces around it
+    span its turning, about 2 pi.
+
     Parameters
     ----------
     vertices : ndarray of shape (V, 3), float64
@@ -128,9 +139,8 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
     Returns
     -------
     ndarray of shape (V,), bool
-        Vertices with a face that is not of zero area, whose edges are all
-        longer than ``NEEDLE_REACH * scales`` and whose corner angles (over
-        the faces that are not of zero area) sum to less than ``NEEDLE_ANGLE``.
+        The vertices of such clusters that have a face of non-zero area with
+        one corner in the cluster (the angles are summed over those faces).
     """
     n = topology.n_vertices
     edges = topology.edges
@@ -139,30 +149,40 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
     long = np.einsum("ij,ij->i", sides, sides) > np.square(np.minimum(reach[edges[:, 0]], reach[edges[:, 1]]))
     if not long.any():  # the usual case: one pass over the edges
         return np.zeros(n, dtype=bool)
-    # the vertices all of whose edges are long
-    candidates = np.bincount(edges[long].ravel(), minlength=n) == topology.vertex_degrees
-    candidates &= topology.referenced_vertices & (scales > 0)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    short = edges[~long]
+    graph = coo_matrix((np.ones(short.shape[0], dtype=np.int8), (short[:, 0], short[:, 1])), shape=(n, n))
+    n_clusters, cluster = connected_components(graph, directed=False)
+    ends = cluster[edges[long]]
+    size = np.bincount(cluster, minlength=n_clusters)
+    # the clusters with a (long) edge to a larger one: the rest of the mesh is not flung away from a spike
+    reaching = np.zeros(n_clusters, dtype=bool)
+    reaching[ends[size[ends[:, 0]] < size[ends[:, 1]], 0]] = True
+    reaching[ends[size[ends[:, 1]] < size[ends[:, 0]], 1]] = True
+    candidates = reaching[cluster] & topology.referenced_vertices & (scales > 0)
     if not candidates.any():
         return candidates
     faces = topology.faces
-    touched = np.flatnonzero(candidates[faces].any(axis=1))
-    corners = vertices[faces[touched]]  # (T, 3, 3)
+    touched = faces[candidates[faces].any(axis=1)]
+    corners = vertices[touched]  # (T, 3, 3)
     cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     double_areas = np.linalg.norm(cross, axis=1)
-    scale = scales[faces[touched, 0]]
-    usable = ~degenerate_face_mask(0.5 * double_areas, scale)
-    usable &= (faces[touched, 0] != faces[touched, 1]) & (faces[touched, 1] != faces[touched, 2]) \
-        & (faces[touched, 0] != faces[touched, 2])
-    angle_sums = np.zeros(n)
-    covered = np.zeros(n, dtype=bool)
+    usable = ~degenerate_face_mask(0.5 * double_areas, scales[touched[:, 0]])
+    usable &= (touched[:, 0] != touched[:, 1]) & (touched[:, 1] != touched[:, 2]) & (touched[:, 0] != touched[:, 2])
+    owner = cluster[touched]  # (T, 3): the cluster of each corner
+    angle_sums = np.zeros(n_clusters)
+    covered = np.zeros(n_clusters, dtype=bool)
     for k in range(3):  # the corner angle at corner k: atan2(|u x w|, u . w), 2 x area the same at each corner
-        u = corners[:, (k + 1) % 3] - corners[:, k]
-        w = corners[:, (k + 2) % 3] - corners[:, k]
-        angle = np.arctan2(double_areas, np.einsum("ij,ij->i", u, w))
-        at = faces[touched, k]
-        angle_sums += np.bincount(at[usable], weights=angle[usable], minlength=n)
-        covered[at[usable]] = True
-    return candidates & covered & (angle_sums < NEEDLE_ANGLE)
+        alone = usable & (owner[:, k] != owner[:, (k + 1) % 3]) & (owner[:, k] != owner[:, (k + 2) % 3])
+        u = corners[alone, (k + 1) % 3] - corners[alone, k]
+        w = corners[alone, (k + 2) % 3] - corners[alone, k]
+        angle = np.arctan2(double_areas[alone], np.einsum("ij,ij->i", u, w))
+        angle_sums += np.bincount(owner[alone, k], weights=angle, minlength=n_clusters)
+        covered[owner[alone, k]] = True
+    flung = reaching & covered & (angle_sums < NEEDLE_ANGLE)
+    return candidates & flung[cluster]
 
 
 def defect_codes(topology: MeshTopology, degenerate: np.ndarray, vertices: np.ndarray | None = None,
