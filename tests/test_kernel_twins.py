@@ -1670,3 +1670,31 @@ def test_the_jet_moments_are_compiled_only():
 
     with pytest.raises(NotImplementedError, match="compiled only"):
         _jet_moments(None, *([None] * 15))
+
+
+def test_corrected_measures_on_two_threads_are_those_of_one():
+    import numba
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba has one thread here (NUMBA_NUM_THREADS)")
+    vertices, faces = mesh("ellipsoid")
+    normals = numpy_normals("ellipsoid")
+    compiled = kernels("icc")
+
+    def both():
+        measures = compiled.face_measures(vertices, faces, normals)
+        summed = np.zeros((vertices.shape[0], 9))
+        np.add.at(summed, faces[:, 0], measures)  # any per-vertex sums will do
+        return (measures, *compiled.curvatures_from_measures(summed, normals))
+
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = both()
+        numba.set_num_threads(2)
+        two = both()
+    finally:
+        numba.set_num_threads(threads)
+    assert np.isfinite(one[1]).sum() > vertices.shape[0] // 4
+    for a, b in zip(one, two):
+        np.testing.assert_array_equal(a, b)

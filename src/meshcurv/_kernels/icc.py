@@ -9,7 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ._common import _JIT
+from ._common import _JIT, run_chunks, threaded
 from .tensors import _principal_from_mean_gaussian, _tangent_eigen
 
 
@@ -51,27 +51,37 @@ def _triangle_measures(points, normals, i, j, k, turn):
             0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy)))
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def face_measures(vertices, faces, normals):
     """``measures.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
-    out = np.empty((faces.shape[0], 9))
-    for f in nb.prange(faces.shape[0]):
+    out = np.zeros((faces.shape[0], 9))
+    run_chunks(_face_measures_chunk, faces.shape[0], nb.get_num_threads(), vertices, faces, normals, out)
+    return out
+
+
+@nb.njit(**_JIT)
+def _face_measures_chunk(lo, hi, vertices, faces, normals, out):
+    """Faces ``lo:hi`` of :func:`face_measures` (chunks on threads: no parallel pipeline to compile, issue 31)."""
+    for f in range(lo, hi):
         m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(vertices, normals, faces[f, 0], faces[f, 1],
                                                                 faces[f, 2], False)
         out[f, 0], out[f, 1], out[f, 2], out[f, 3], out[f, 4], out[f, 5] = m0, m1, m2, m3, m4, m5
         out[f, 6], out[f, 7], out[f, 8] = m6, m7, m8
-    return out
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def curvatures_from_measures(summed, normals):
     """``measures.curvatures_from_measures``: (N,) k_min, k_max and (N, 3) dir_min, dir_max of summed measures."""
     n = summed.shape[0]
-    k_min = np.full(n, np.nan)
-    k_max = np.full(n, np.nan)
-    dir_min = np.full((n, 3), np.nan)
-    dir_max = np.full((n, 3), np.nan)
-    for i in nb.prange(n):
+    out = (np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan))
+    run_chunks(_curvatures_chunk, n, nb.get_num_threads(), summed, normals, *out)
+    return out
+
+
+@nb.njit(**_JIT)
+def _curvatures_chunk(lo, hi, summed, normals, k_min, k_max, dir_min, dir_max):
+    """Rows ``lo:hi`` of :func:`curvatures_from_measures` (chunks on threads, as :func:`face_measures`)."""
+    for i in range(lo, hi):
         area = summed[i, 0]
         nx, ny, nz = normals[i, 0], normals[i, 1], normals[i, 2]
         if not (area > 0 and math.isfinite(nx) and math.isfinite(ny) and math.isfinite(nz)):
@@ -82,4 +92,3 @@ def curvatures_from_measures(summed, normals):
             -summed[i, 7] / area, -summed[i, 8] / area, nx, ny, nz, False, False)
         dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
         dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5
-    return k_min, k_max, dir_min, dir_max
