@@ -150,14 +150,7 @@ def _region_statistics(
     curvedness = np.sqrt((k_min**2 + k_max**2) / 2)
     with np.errstate(invalid="ignore"):
         shape_index = np.where(curvedness > 0, (2 / np.pi) * np.arctan2(k_max + k_min, k_max - k_min), np.nan)
-    fields = {
-        "mean": mean,
-        "gaussian": gaussian,
-        "k_min": k_min,
-        "k_max": k_max,
-        "shape_index": shape_index,
-        "curvedness": curvedness,
-    }
+    fields = dict(zip(FIELDS, (mean, gaussian, k_min, k_max, shape_index, curvedness), strict=True))
     row: dict[str, float] = {}
     for name in FIELDS:
         row.update(zip((f"{name}_{moment}" for moment in MOMENTS), _moments(fields[name], weights, used)))
@@ -318,16 +311,9 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
     gaussian_shares = np.bincount(
         faces.ravel(), np.repeat(face_solid_angles(normals, faces) / 3.0, 3), minlength=vertices.shape[0]
     )
-    row = _region_statistics(
-        k_min,
-        k_max,
-        used,
-        weights,
-        measures[inside],
-        _face_average((k_min + k_max) / 2, faces[inside]),
-        gaussian_shares[region],
-        (k_min * k_max)[region],
-    )
+    mean_integrand = (measures[inside], _face_average((k_min + k_max) / 2, faces[inside]))
+    gaussian_integrand = (gaussian_shares[region], (k_min * k_max)[region])
+    row = _region_statistics(k_min, k_max, used, weights, *mean_integrand, *gaussian_integrand)
     note = _fold_note(row, k_min, k_max, used, weights)
     if note:
         warnings.warn(f"curvature_statistics: {note}", MeshQualityWarning, stacklevel=2)

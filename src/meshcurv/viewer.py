@@ -177,15 +177,8 @@ def write_html(
         raise InvalidOptionError(
             f"`result` has {result.n_vertices} vertices; the mesh has {len(points)}: pass the result of these vertices"
         )
-    meta, arrays = _page_data(
-        points,
-        triangles,
-        result,
-        field=field,
-        percentiles=percentiles,
-        max_directions=max_directions,
-        length_unit=length_unit,
-    )
+    options = {"field": field, "percentiles": percentiles, "max_directions": max_directions, "length_unit": length_unit}
+    meta, arrays = _page_data(points, triangles, result, **options)
     meta.update(title=title or "meshcurv viewer", up=up, elevation=angles[0], azimuth=angles[1])
     with atomic_output(path, overwrite=overwrite) as temporary:
         with open(temporary, "wb") as handle:

@@ -139,37 +139,13 @@ def _store(ctx, param, value):
 
 def common_options(function):
     """-v/-q/--debug/--progress, accepted before or after the command name."""
+    stored = {"expose_value": False, "callback": _store}
+    progress = "Progress bar on stderr (default: only when stderr is a terminal)."
     options = [
-        click.option(
-            "-v",
-            "--verbose",
-            count=True,
-            expose_value=False,
-            callback=_store,
-            help="More messages on stderr (-v: stages, -vv: debug).",
-        ),
-        click.option(
-            "-q",
-            "--quiet",
-            count=True,
-            expose_value=False,
-            callback=_store,
-            help="Fewer messages: no warnings (-q), only errors.",
-        ),
-        click.option(
-            "--debug",
-            is_flag=True,
-            expose_value=False,
-            callback=_store,
-            help="Show the traceback when something fails.",
-        ),
-        click.option(
-            "--progress/--no-progress",
-            default=None,
-            expose_value=False,
-            callback=_store,
-            help="Progress bar on stderr (default: only when stderr is a terminal).",
-        ),
+        click.option("-v", "--verbose", count=True, help="More messages on stderr (-v: stages, -vv: debug).", **stored),
+        click.option("-q", "--quiet", count=True, help="Fewer messages: no warnings (-q), only errors.", **stored),
+        click.option("--debug", is_flag=True, help="Show the traceback when something fails.", **stored),
+        click.option("--progress/--no-progress", default=None, help=progress, **stored),
     ]
     for option in reversed(options):
         function = option(function)

@@ -251,14 +251,9 @@ def volume(
                 if writer is not None:
                     writer.add(*_object_piece(surface))
                 if mesh_format is not None:
-                    write_curvatures(
-                        out_dir / f"{stem}_label_{surface.label}.{mesh_format}",
-                        surface.vertices,
-                        surface.faces,
-                        surface.result,
-                        overwrite=overwrite,
-                        source=image,
-                    )
+                    mesh_path = out_dir / f"{stem}_label_{surface.label}.{mesh_format}"
+                    mesh = (surface.vertices, surface.faces, surface.result)
+                    write_curvatures(mesh_path, *mesh, overwrite=overwrite, source=image)
                 if picture:
                     values = np.where(surface.used, getattr(surface.result, field), np.nan)
                     drawn.append((surface.vertices, surface.faces, values))

@@ -444,15 +444,8 @@ def ply_vertex_columns(path) -> dict[str, np.ndarray]:
             rows = slice(row, row + element.count)
             row += element.count
             names = [p.name for p in element.properties]
-            table = fixed_rows(
-                values,
-                counts[rows],
-                first_value[rows],
-                lines[rows],
-                len(names),
-                path,
-                f"{element.name}: {names_shown(names)}",
-            )
+            shown = f"{element.name}: {names_shown(names)}"
+            table = fixed_rows(values, counts[rows], first_value[rows], lines[rows], len(names), path, shown)
         if counts.size < skip + vertex.count:
             raise _short(path, vertex.count, "vertices", len(data) - offset)
         return {p.name: table[:, i] for i, p in enumerate(vertex.properties)}

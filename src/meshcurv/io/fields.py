@@ -156,14 +156,8 @@ def read_fields(path) -> dict[str, np.ndarray]:
     """
     path = pathlib.Path(path)
     suffix = path.suffix.lower()
-    readers = {
-        ".ply": _ply_fields,
-        ".vtp": _vtp_fields,
-        ".npz": _npz_fields,
-        ".csv": _csv_fields,
-        ".vtk": _meshio_fields,
-        ".vtu": _meshio_fields,
-    }
+    readers = {".ply": _ply_fields, ".vtp": _vtp_fields, ".npz": _npz_fields, ".csv": _csv_fields}
+    readers.update(dict.fromkeys((".vtk", ".vtu"), _meshio_fields))
     if suffix not in readers:
         raise MeshFileError(
             f"{path}: no per-vertex fields in a {suffix or 'file without extension'}; "
