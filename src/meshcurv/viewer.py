@@ -336,12 +336,8 @@ def _page_data(points, triangles, result, *, field, percentiles, max_directions,
     for name in VIEWER_FIELDS:
         values = np.where(result.valid, getattr(result, name), np.nan)
         label, unit = _label_and_unit(name, result.method, length_unit)
-        fields[name] = {
-            "label": label,
-            "unit": unit,
-            "signed": name not in _UNSIGNED,
-            "limits": list(_default_limits(values, name, percentiles)),
-        }
+        limits = list(_default_limits(values, name, percentiles))
+        fields[name] = {"label": label, "unit": unit, "signed": name not in _UNSIGNED, "limits": limits}
     stroke = None
     directions = np.isfinite(result.dir_min).all(axis=1) & np.isfinite(result.dir_max).all(axis=1) & result.valid
     if max_directions and directions.any():

@@ -142,11 +142,9 @@ def process_mesh(
             if is_point_cloud(source):  # a file without faces: the point-cloud estimators, their default
                 vertices, normals = read_points(source)
                 faces = None
+                cloud_method = method if method in POINT_CLOUD_METHODS else None
                 result = point_cloud_curvatures(
-                    vertices,
-                    normals=normals,
-                    radius=options.get("radius"),
-                    method=method if method in POINT_CLOUD_METHODS else None,
+                    vertices, normals=normals, radius=options.get("radius"), method=cloud_method
                 )
                 row["method"] = result.method
             else:

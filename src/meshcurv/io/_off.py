@@ -62,13 +62,8 @@ def read_off(path):
     usual = int(np.bincount(counts).argmax()) if counts.size else 3
     if (counts != usual).any():  # a colour on every vertex or on none: one row apart has a value too many or few
         row = int(np.argmax(counts != usual))
-        raise row_error(
-            path,
-            line(row),
-            int(counts[row]),
-            usual,
-            "as most vertex rows: x, y, z" + (", then a colour" if usual > 3 else ""),
-        )
+        meaning = "as most vertex rows: x, y, z" + (", then a colour" if usual > 3 else "")
+        raise row_error(path, line(row), int(counts[row]), usual, meaning)
     if n_vertices > len(body):  # the rows there are were checked first: a damaged row is named
         raise MeshFileError(f"{path}: the header announces {n_vertices} vertices; the file has {len(body)}")
     vertices = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
@@ -92,13 +87,8 @@ def read_off(path):
     bad = sizes > counts - 1
     if bad.any():
         face = int(np.flatnonzero(bad)[0])
-        raise row_error(
-            path,
-            line(n_vertices + face),
-            int(counts[face]),
-            f"{int(sizes[face]) + 1} or more",
-            f"a count of {int(sizes[face])} and as many vertex indices, then maybe a colour",
-        )
+        meaning = f"a count of {int(sizes[face])} and as many vertex indices, then maybe a colour"
+        raise row_error(path, line(n_vertices + face), int(counts[face]), f"{int(sizes[face]) + 1} or more", meaning)
     if n_vertices + n_faces > len(body):
         raise MeshFileError(
             f"{path}: the header declares {n_vertices} vertices and {n_faces} faces but the file holds only "

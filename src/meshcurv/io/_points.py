@@ -125,14 +125,8 @@ def write_point_curvatures(
     the normals go out as ``normals_x ...`` with the other fields (``nx ...``
     only when passed to :func:`write_points` directly).
     """
-    return write_points(
-        path,
-        points,
-        point_data=curvature_fields(result, fields=fields, quality=quality),
-        overwrite=overwrite,
-        source=source,
-        binary=binary,
-    )
+    point_data = curvature_fields(result, fields=fields, quality=quality)
+    return write_points(path, points, point_data=point_data, overwrite=overwrite, source=source, binary=binary)
 
 
 def _suffix(path: pathlib.Path, file_format: str | None) -> str:
@@ -404,13 +398,7 @@ def _read_las(path):
                 if need > path.stat().st_size:
                     raise _short(path, count, "points", path.stat().st_size, need)
             data = reader.read()
-        points = np.column_stack(
-            [
-                np.asarray(data.x, dtype=np.float64),
-                np.asarray(data.y, dtype=np.float64),
-                np.asarray(data.z, dtype=np.float64),
-            ]
-        )
+        points = np.column_stack([np.asarray(getattr(data, axis), dtype=np.float64) for axis in "xyz"])
         extra = {name.lower(): name for name in data.point_format.extra_dimension_names}
         normals = None
         for names in _NORMAL_NAMES:
