@@ -44,14 +44,18 @@ def build_edges(faces, n_vertices, template):
 
     Sides are bucketed by their smaller vertex (a counting sort: one pass
     counts, one places, each in face order), each bucket is sorted by (larger
-    vertex, direction) with a stable insertion sort, so the edges come out in
-    lexicographic order, as ``np.unique`` would give them. The buckets are
-    held in the integer type of ``template`` (``topology._bucket_template``). One
-    thread: the passes are bound by memory, and a parallel version took twice
-    the CPU time for at best the same wall time on 2 cores, and 5 s more to
-    compile.
+    vertex, direction) with a stable insertion sort and its edges written
+    out at once, so the edges come out in lexicographic order, as
+    ``np.unique`` would give them. Every output element is written once (no
+    fill beforehand); the edge arrays are sized for one edge per side and
+    returned cut to the edges found (the rows beyond are never touched, so
+    never paged in). The buckets are held in the integer type of
+    ``template`` (``topology._bucket_template``). One thread: the passes are
+    bound by memory, and a parallel version took twice the CPU time for at
+    best the same wall time on 2 cores, and 5 s more to compile.
     """
     n_faces = faces.shape[0]
+    face_edges = np.empty(3 * n_faces, np.int64)
     bucket_start = np.zeros(n_vertices + 1, template.dtype)
     for f in range(n_faces):
         for k in range(3):
@@ -59,6 +63,8 @@ def build_edges(faces, n_vertices, template):
             b = faces[f, (k + 1) % 3]
             if a != b:
                 bucket_start[min(a, b) + 1] += 1
+            else:  # a side from a vertex to itself: no edge
+                face_edges[3 * f + k] = -1
     for v in range(n_vertices):
         bucket_start[v + 1] += bucket_start[v]
     n_sides = bucket_start[n_vertices]
@@ -75,10 +81,15 @@ def build_edges(faces, n_vertices, template):
                 cursor[low] += 1
                 sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
                 side_of[slot] = 3 * f + k
-    n_edges = 0
-    for v in range(n_vertices):  # stable insertion sort of each (small) bucket; count its edges
+    # at most one edge per side: sized for that, the rows past the last edge never written (never touched)
+    edges = np.empty((n_sides, 2), np.int64)
+    edge_faces = np.empty((n_sides, 2), np.int64)
+    counts = np.empty(n_sides, np.int64)
+    forward = np.empty(n_sides, np.int64)
+    e = -1
+    for v in range(n_vertices):
         start, stop = bucket_start[v], bucket_start[v + 1]
-        for i in range(start + 1, stop):
+        for i in range(start + 1, stop):  # stable insertion sort of the (small) bucket
             key = sort_key[i]
             side = side_of[i]
             j = i - 1
@@ -88,18 +99,8 @@ def build_edges(faces, n_vertices, template):
                 j -= 1
             sort_key[j + 1] = key
             side_of[j + 1] = side
-        for i in range(start, stop):
-            if i == start or (sort_key[i] >> 1) != (sort_key[i - 1] >> 1):
-                n_edges += 1
-    edges = np.empty((n_edges, 2), np.int64)
-    edge_faces = np.full((n_edges, 2), -1, np.int64)
-    counts = np.zeros(n_edges, np.int64)
-    forward = np.zeros(n_edges, np.int64)
-    face_edges = np.full(3 * n_faces, -1, np.int64)
-    e = -1
-    for v in range(n_vertices):
         previous_high = -1
-        for i in range(bucket_start[v], bucket_start[v + 1]):
+        for i in range(start, stop):
             high = sort_key[i] >> 1
             backward = sort_key[i] & 1
             side = side_of[i]
@@ -109,20 +110,22 @@ def build_edges(faces, n_vertices, template):
                 previous_high = high
                 edges[e, 0] = v
                 edges[e, 1] = high
-                if backward:
-                    edge_faces[e, 1] = face
-                else:
-                    edge_faces[e, 0] = face
-            elif counts[e] == 1:
-                if edge_faces[e, 1] == -1:
-                    edge_faces[e, 1] = face
-                else:
-                    edge_faces[e, 0] = face
-            counts[e] += 1
-            if not backward:
-                forward[e] += 1
+                edge_faces[e, 0] = -1 if backward else face
+                edge_faces[e, 1] = face if backward else -1
+                counts[e] = 1
+                forward[e] = 0 if backward else 1
+            else:
+                if counts[e] == 1:
+                    if edge_faces[e, 1] == -1:
+                        edge_faces[e, 1] = face
+                    else:
+                        edge_faces[e, 0] = face
+                counts[e] += 1
+                if not backward:
+                    forward[e] += 1
             face_edges[side] = e
-    return edges, face_edges.reshape(n_faces, 3), edge_faces, counts, forward
+    n_edges = e + 1
+    return edges[:n_edges], face_edges.reshape(n_faces, 3), edge_faces[:n_edges], counts[:n_edges], forward[:n_edges]
 
 
 @nb.njit(inline="always", **_JIT)
