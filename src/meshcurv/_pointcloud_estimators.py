@@ -308,6 +308,8 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
     """
     n = points.shape[0]
     out = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)]
+    if not usable.any():  # no point may enter a ball (every normal fit failed): nothing to measure
+        return (*out, normals)
     pattern = _rank_pattern(TRIANGLES if n_triangles is None else n_triangles)
     kernels = numba_kernels("pointcloud")
     k = min(ball_size(radius, spacing), n)

@@ -87,6 +87,12 @@ PART_MIN_POINTS = 32
 #: Rounds of attaching small parts to their neighbours (each round reaches one part further).
 SMALL_PART_ROUNDS = 8
 
+#: A point whose every jet fit held the other side keeps its PCA normal only when the spread of its nearest
+#: neighbours along it is below this share of that along their middle direction (:func:`flat_neighbours`):
+#: uniform noise of about 0.1 spacings, where the fits of :mod:`meshcurv.pointcloud` fail on a part thinner than
+#: their balls (a plate 4 spacings thick under noise of one spacing: H 0.8 for 0.002 before).
+FLAT_SPREAD = 0.1
+
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
 
@@ -465,7 +471,7 @@ def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.nd
     if compiled is not None:
         signs, roots = compiled.spanning_signs(
             n, rows, cols, np.asarray(opposite).astype(np.int8), np.argsort(weights))
-        return signs, np.unique(roots, return_inverse=True)[1].reshape(-1)
+        return signs, _dense_labels(roots)
     graph = coo_matrix((weights, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
     # both searches treat the graph as undirected: (i, j) is an edge when either is among the other's neighbours
     n_components, labels = connected_components(graph[:n, :n], directed=False)
@@ -673,14 +679,44 @@ def _supported(flat, slope, rows, cols, kept, indices):
     return flat
 
 
-def _sheets(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """(N,) the components of the edges ``(rows, cols)``; -1 for those of fewer than :data:`PART_MIN_POINTS`."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+def _dense_labels(roots: np.ndarray) -> np.ndarray:
+    """(N,) ``roots`` (N,) (indices below N) numbered 0, 1, ... in increasing order: ``np.unique``'s inverse
+    without its sort."""
+    mark = np.zeros(roots.size, dtype=bool)
+    mark[roots] = True
+    return (np.cumsum(mark) - 1)[roots]
 
-    _, labels = connected_components(coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n)),
-                                     directed=False)
+
+def _sheets(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """(N,) the components of the edges ``(rows, cols)``; -1 for those of fewer than :data:`PART_MIN_POINTS`.
+
+    Compiled: the union-find of :func:`meshcurv._kernels.pointcloud.spanning_signs` over the edges in any order
+    (no sign passed); else :func:`scipy.sparse.csgraph.connected_components`.
+    """
+    compiled = numba_kernels("pointcloud")
+    if compiled is not None:
+        labels = _dense_labels(compiled.spanning_signs(n, rows, cols, np.zeros(rows.size, dtype=np.int8),
+                                                       np.arange(rows.size))[1])
+    else:
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        _, labels = connected_components(coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)),
+                                                    shape=(n, n)), directed=False)
     return np.where(np.bincount(labels)[labels] >= PART_MIN_POINTS, labels, -1)
+
+
+def flat_neighbours(points: np.ndarray, indices: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """(M,) bool: the points ``rows`` whose nearest neighbours ``indices`` lie on a plane: the spread along
+    their least-variance direction below :data:`FLAT_SPREAD` of that along the middle one."""
+    flat = np.zeros(rows.size, dtype=bool)
+    for start in range(0, rows.size, CHUNK):
+        chunk = rows[start:start + CHUNK]
+        group = np.concatenate([points[chunk, None, :], points[indices[chunk]]], axis=1)
+        group = group - group.mean(axis=1, keepdims=True)
+        values = np.linalg.eigvalsh(np.einsum("nki,nkj->nij", group, group))
+        flat[start:start + CHUNK] = values[:, 0] <= FLAT_SPREAD**2 * values[:, 1]
+    return flat
 
 
 def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:

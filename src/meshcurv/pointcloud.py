@@ -171,6 +171,12 @@ def _reason_code(start: str) -> int:
 #: of a third of a spacing, or a thin plate whose two faces both fall in each ball) is cut to fit, with a warning.
 BALL_PAIRS_SHARE = 0.5
 
+#: Noise level (in spacings, :func:`meshcurv.radius.cloud_noise_level`) from which a point without a one-sided
+#: normal fit keeps its PCA normal only where its nearest neighbours are flat
+#: (:func:`meshcurv._pointcloud_normals.flat_neighbours`); below it a sharp rim's PCA normals are right.
+#: A plate 4 spacings thick under uniform noise of one spacing measures 0.29: H 0.8 for 0.002 before, valid.
+NOISY_PCA = 0.1
+
 #: Code of points whose normal's side could not be decided (between two sheets closer than the spacing).
 _UNDECIDED = _reason_code("point cloud: side undecided")
 
@@ -610,9 +616,15 @@ def _compute(points, given, radius, method, search=None):
                 # a point whose every normal fit held the other side, and whose nearest neighbours hold
                 # it too, keeps a PCA normal that may mix the two sheets: it is left out (NaN, and out of
                 # the balls, where its triangles would bend the measures of its neighbours)
+                # (nor, under noise of NOISY_PCA spacings or more, one whose nearest neighbours are not flat:
+                # noise as thick as the part's faces are apart makes the PCA normal a coin's toss)
                 if mixed is None:
                     mixed = _normals.facing_away(start, indices)
-                one_sided[members] = np.isfinite(details["radii"][members]) | ~mixed[members]
+                failed = members[~np.isfinite(details["radii"][members])]
+                one_sided[failed] = ~mixed[failed]
+                if noise >= NOISY_PCA:
+                    one_sided[failed[one_sided[failed]]] = _normals.flat_neighbours(points, indices,
+                                                                                    failed[one_sided[failed]])
             else:
                 normals = start
             found = _estimators.corrected_measures(tree, points, normals, group_radius, members,
