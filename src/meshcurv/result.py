@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _adapters, integrals
+from . import _adapters
 from ._validation import check_choice
 from .defects import INVALID_REASONS
 from .errors import InvalidOptionError
@@ -217,6 +217,8 @@ class CurvatureResult:
         InvalidOptionError
             Unknown ``field``, or a result with no mesh (point clouds, results built directly).
         """
+        from . import integrals  # on use: kept out of `import meshcurv` (its _LAZY names)
+
         check_choice(field, "field", integrals.INTEGRALS)
         cache = self.__dict__.setdefault("_vertex_integrals", {})
         if field in cache:
@@ -347,7 +349,9 @@ class Surface:
             None if result.method == "matgeom" else np.where(result.valid[rows, None], result.normals[rows], np.nan)
         )
         pointwise = result.mean[rows] if field == "willmore" else None
-        shares = integrals.vertex_integrals(self.vertices, self.faces, field, normals=normals, pointwise=pointwise)
+        from .integrals import vertex_integrals  # on use, as in CurvatureResult.vertex_integrals
+
+        shares = vertex_integrals(self.vertices, self.faces, field, normals=normals, pointwise=pointwise)
         if self.index is None:
             return shares
         out = np.zeros(result.n_vertices, dtype=np.float64)
