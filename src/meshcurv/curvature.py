@@ -193,6 +193,9 @@ def principal_curvatures(
             voxel = voxel_surface_radius(points, topology, voxel_pilot(mesh))  # one default for every ball method
             if voxel is not None:
                 options["radius"], found = voxel
+                vertex_scale = found.pop("vertex_scale", None)  # icc: each vertex at its own scale (issue 30)
+                if estimator.name == "icc":
+                    options["vertex_scale"] = vertex_scale
         result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
         result, message = _finished(mesh, estimator, result, problems, found,
                                     given_radius=radius is not None and not options.get("adaptive"))

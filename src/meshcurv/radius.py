@@ -77,6 +77,7 @@ __all__ = [
     "noise_radius",
     "voxel_radius",
     "voxel_surface_radius",
+    "voxel_vertex_radii",
     "check_radius",
     "resolve_radius",
     "small_radius_note",
@@ -323,15 +324,168 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology,
     grid = voxel_grid(vertices[referenced])
     if grid is None:
         return None
-    k_min, k_max, valid = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))
+    k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))
     curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
     curvedness = curvedness[referenced & valid & np.isfinite(curvedness) & (curvedness > 0)]
     if curvedness.size == 0:
         return None
     curvature_radius = 1.0 / float(np.percentile(curvedness, VOXEL_CURVEDNESS_PERCENTILE))
-    return voxel_radius(grid.spacing, curvature_radius), {
-        "surface": "voxel", "voxel_spacing": tuple(float(x) for x in grid.spacing),
-        "curvature_radius": curvature_radius}
+    radius = voxel_radius(grid.spacing, curvature_radius)
+    found = {"surface": "voxel", "voxel_spacing": tuple(float(x) for x in grid.spacing),
+             "curvature_radius": curvature_radius}
+    if more:  # the pilot's normals: each vertex's own scale (icc's default)
+        corners = vertices[topology.faces]
+        area = 0.5 * float(np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
+                                          axis=1).sum())
+        rings = int(np.clip(np.ceil(radius / median_edge_length(vertices, topology.edges)), 1, VOXEL_REGION_RINGS))
+        found["vertex_scale"] = voxel_vertex_radii(grid.spacing, more[0], k_min, k_max, referenced & valid,
+                                                   curvature_radius, topology.neighbour_lists, radius, area=area,
+                                                   rings=rings)
+    return radius, found
+
+
+#: The scale of each vertex of a voxel surface (:func:`voxel_vertex_radii`, ``icc``'s default):
+#: ``r_v = VOXEL_LOCAL_GAIN h_v^a R^(1 - a)`` with ``a = VOXEL_LOCAL_EXPONENT`` ...
+VOXEL_LOCAL_GAIN = 2.0
+VOXEL_LOCAL_EXPONENT = 0.5
+#: ... at most ``VOXEL_LOCAL_CAP / c_v`` (``c_v`` the vertex's curvedness) ...
+VOXEL_LOCAL_CAP = 1.0
+#: ... and ``VOXEL_GAUSS_CAP / sqrt(|K_v|)`` ...
+VOXEL_GAUSS_CAP = 0.5
+#: ... and ``sqrt(area / (LADDER_AREA pi))`` (normal fits over half a sphere of the surface's area), and
+#: ``VOXEL_CAP R`` (:func:`voxel_radius`) except on the tube-like vertices, curved one way
+#: (``sqrt|K_v| <= c_v / VOXEL_TUBE``), where it rises to ``1 / c_v``;
+#: at least the largest voxel size. The normals are fitted over ``min(3 r_v, max(VOXEL_NORMAL_CAP / c_v,
+#: VOXEL_NORMAL_VOXELS h_max))``.
+VOXEL_NORMAL_CAP = 1.5
+VOXEL_NORMAL_VOXELS = 4.0
+#: The pilot's curvatures are averaged over this many rings of each vertex.
+VOXEL_LOCAL_RINGS = 2
+#: The region whose most curved vertex sets a vertex's curvature radius: at most this many rings.
+VOXEL_REGION_RINGS = 24
+#: ... when that radius exceeds this many times the surface's (fully from twice this).
+VOXEL_REGION_APART = 2.0
+#: A vertex is tube-like in proportion to ``1 - VOXEL_TUBE sqrt|K_v| / c_v`` (clipped to [0, 1]).
+VOXEL_TUBE = 2.0
+
+#: How ``parameters["scale_rule"]`` names the rule.
+VOXEL_SCALE_RULE = ("voxel: r_v = max(h_max, min(2 sqrt(h_v R), 1 / c_v, 0.5 / sqrt|K_v|, sqrt(area / (18 pi)), "
+                    "R / 2 + t_v (1 / c_v - R / 2)+)), t_v = clip(1 - 2 sqrt|K_v| / c_v, 0, 1), h_v the voxel "
+                    "extent along the pilot's normal, R the surface's curvature radius, c_v and K_v the pilot's "
+                    "curvedness and Gaussian curvature over 2 rings; normals over min(3 r_v, max(1.5 / c_v, 4 h_max))")
+
+
+def _ring_max(neighbour_lists: tuple, rings: int, values: np.ndarray) -> np.ndarray:
+    """(V,) the largest of ``values`` over each vertex and the vertices within ``rings`` edges of it."""
+    indptr, indices = neighbour_lists
+    rows = np.flatnonzero(np.diff(indptr) > 0)
+    out = np.array(values, dtype=np.float64, copy=True)
+    for _ in range(rings if rows.size else 0):
+        # the rows without neighbours are skipped: each start then ends where the next row with any begins
+        out[rows] = np.maximum(out[rows], np.maximum.reduceat(out[indices], indptr[rows]))
+    return out
+
+
+def voxel_vertex_radii(spacing, normals: np.ndarray, k_min: np.ndarray, k_max: np.ndarray, valid: np.ndarray,
+                       curvature_radius: float, neighbour_lists: tuple, fallback: float, *,
+                       area: float = np.inf, rings: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """``(radii, normal_radii)`` (V,): the measure and normal-fit radius of each vertex of a voxel surface.
+
+    Parameters
+    ----------
+    spacing : array_like of shape (3,)
+        The voxel sizes along x, y, z (:func:`meshcurv.lattice.voxel_grid`).
+    normals : ndarray of shape (V, 3)
+        The pilot's unit normals.
+    k_min, k_max : ndarray of shape (V,)
+        The pilot's principal curvatures (``icc`` at :data:`VOXEL_PILOT` voxels).
+    valid : ndarray of shape (V,) of bool
+        The vertices whose pilot values are used.
+    curvature_radius : float
+        The surface's typical radius of curvature ``R`` (:func:`voxel_surface_radius`).
+    neighbour_lists : tuple of ndarray
+        The mesh's edge lists (:attr:`meshcurv.topology.MeshTopology.neighbour_lists`).
+    fallback : float
+        The radius of the vertices without pilot values in reach (:func:`voxel_radius`).
+    area : float, default: inf
+        The surface's area: no radius exceeds ``sqrt(area / (LADDER_AREA pi))`` (as the adaptive ladder).
+    rings : int, default: 0
+        The region of a vertex: its curvature radius ``R_v`` is that of the most curved vertex within this
+        many rings (about the ball of ``fallback`` in edge lengths); 0: the vertex alone.
+
+    Returns
+    -------
+    radii, normal_radii : ndarray of shape (V,)
+
+    Notes
+    -----
+    The staircase of the voxels is noise whose amplitude at a vertex is the
+    voxel's extent along the normal, ``h_v = |diag(spacing) n_v|`` (in
+    anisotropic voxels it changes with the orientation of the surface: a factor
+    4 between the faces of a sphere at 2 x 0.5 x 0.5). The radius grows with it
+    as ``r_v = G h_v^a R^(1 - a)`` (:data:`VOXEL_LOCAL_GAIN` 2,
+    :data:`VOXEL_LOCAL_EXPONENT` 1/2: the balance of the ball's bias with the
+    staircase's noise of :func:`voxel_radius`, each vertex with its own ``h_v``;
+    ``a = 2/3``, ``G = 2.5`` was 10% worse on the tuning meshes), and is capped where the pilot sees the surface bend
+    fast: ``1 / c_v`` (a thin tube, ``c_v = max(|k_min|, |k_max|)`` averaged
+    over :data:`VOXEL_LOCAL_RINGS` rings) and ``0.5 / sqrt(|K_v|)`` (a tip,
+    curved both ways, where the curvature changes within the ball; a tube's
+    ``K`` is small), and, as the rungs of the adaptive ladder, by
+    ``sqrt(area / (18 pi))`` (:data:`LADDER_AREA`: a small closed surface, whose
+    curvature changes within balls of a few voxels). The cap of the one-radius
+    rule, ``R / 2`` (:data:`VOXEL_CAP`), stays where the surface is curved both
+    ways: the flank of an ellipsoid next to its tip has a small curvature and a
+    small ``K`` of its own, but its ball reaches the tip (a bias that the pilot,
+    at two voxels, does not see); on a tube-like vertex (``k_min`` small
+    against ``k_max``: ``t_v = 1 - 2 sqrt|K_v| / c_v`` clipped to [0, 1]) the cap
+    rises towards ``1 / c_v``, which a tube needs in elongated voxels (a torus
+    of tube radius 4 under 2 x 0.5 x 0.5 voxels: median H error of 25% of
+    ``|H|`` at one radius for the surface). The radius is at least the largest voxel size (the
+    staircase's period along the coarse axis). The normals are fitted over
+    ``min(3 r_v, max(1.5 / c_v, 4 h_max))`` (:data:`VOXEL_NORMAL_CAP`,
+    :data:`VOXEL_NORMAL_VOXELS`): a ball of three radii round a tube reaches
+    its far side, where a jet no longer describes it (the isotropic tori of the
+    tuning set: 1.5 to 1.0% median H error), but a fit spans a few of the
+    longest voxels (the torus under 2 x 0.5 x 0.5 voxels: 8.0 against 6.8%). The exponents are dimensionless, so the radii scale
+    with the mesh. Constants tuned on the binary marching-cubes meshes of
+    ``benchmarks/accuracy.py --voxel`` (``benchmarks/scale_default.md``).
+    """
+    spacing = np.asarray(spacing, dtype=np.float64)
+    largest = float(np.max(spacing))
+    with np.errstate(invalid="ignore"):
+        extent = np.sqrt(np.sum((normals * spacing) ** 2, axis=1))
+        curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
+        gauss = np.abs(k_min * k_max)
+    known = valid & np.isfinite(curvedness) & np.isfinite(gauss)
+    extent = np.where(np.isfinite(extent) & (extent > 0), extent, largest)
+    curvedness, gauss, weights = _ring_sums(neighbour_lists, VOXEL_LOCAL_RINGS, np.where(known, curvedness, 0.0),
+                                            np.where(known, gauss, 0.0), known.astype(np.float64))
+    reached = weights > 0
+    weights = np.where(reached, weights, 1.0)
+    curvedness, gauss = curvedness / weights, gauss / weights
+    # a region whose most curved vertex within `rings` rings (its ball) is much flatter than the surface's
+    # typical curvature radius R (another part: a big sphere beside a thin tube) takes its own, 2 to 4 R
+    # passing from one to the other (the flank of an ellipsoid, within 2 R, keeps R: its ball reaches the tip)
+    region = _ring_max(neighbour_lists, rings, np.where(reached, curvedness, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(region > 0, 1.0 / (region * curvature_radius), 1.0)
+        share = np.clip((ratio - VOXEL_REGION_APART) / VOXEL_REGION_APART, 0.0, 1.0)
+        curvature_radius = curvature_radius * ratio**share
+    a = VOXEL_LOCAL_EXPONENT
+    radii = VOXEL_LOCAL_GAIN * extent**a * curvature_radius ** (1.0 - a)
+    with np.errstate(divide="ignore"):
+        radii = np.minimum(radii, VOXEL_LOCAL_CAP / curvedness)
+        radii = np.minimum(radii, VOXEL_GAUSS_CAP / np.sqrt(gauss))
+        radii = np.minimum(radii, np.sqrt(area / (LADDER_AREA * np.pi)))
+        tube = np.clip(1.0 - VOXEL_TUBE * np.sqrt(gauss) / np.where(curvedness > 0, curvedness, np.inf), 0.0, 1.0)
+        general = VOXEL_CAP * curvature_radius
+        radii = np.minimum(radii, general + tube * np.maximum(1.0 / curvedness - general, 0.0))
+    radii = np.maximum(radii, largest)
+    with np.errstate(divide="ignore"):
+        normal_radii = np.minimum(3.0 * radii, np.maximum(VOXEL_NORMAL_CAP / curvedness, VOXEL_NORMAL_VOXELS * largest))
+    unknown = ~reached | ~np.isfinite(radii)
+    radii[unknown], normal_radii[unknown] = fallback, 3.0 * fallback
+    return radii, normal_radii
 
 
 #: The local edge length of a vertex is averaged (in log) over this many rings around it.

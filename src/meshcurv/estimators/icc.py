@@ -78,8 +78,8 @@ from ..geometry import median_edge_length, robust_mean_edge_length
 from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
 from ..measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import ball_face_sums, ball_face_sums_nested
-from ..radius import (check_radius, component_radii, local_scale_ratios, noise_level, noise_radius, scale_ladder,
-                      stable_scales, vertex_radii)
+from ..radius import (VOXEL_SCALE_RULE, check_radius, component_radii, local_scale_ratios, noise_level, noise_radius,
+                      scale_ladder, stable_scales, vertex_radii)
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages, finish
@@ -230,14 +230,14 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
 
 
 def voxel_pilot(mesh: PreparedMesh):
-    """The first pass of :func:`meshcurv.radius.voxel_surface_radius`: ``radius -> (k_min, k_max, valid)``."""
+    """The first pass of :func:`meshcurv.radius.voxel_surface_radius`: ``radius -> (k_min, k_max, valid, normals)``."""
     def run(radius: float):
         topology = mesh.topology
         _, valid = mesh.start(boundary=True)
-        k_min, k_max, *_ = _curvatures(mesh.vertices, topology.faces, mesh.degenerate, mesh.vertex_normals, valid,
-                                       radius, neighbours=topology.referenced_vertices, adjacency=_adjacency(topology),
-                                       areas=_vertex_areas(mesh))
-        return k_min, k_max, valid
+        k_min, k_max, _, _, normals, _ = _curvatures(
+            mesh.vertices, topology.faces, mesh.degenerate, mesh.vertex_normals, valid, radius,
+            neighbours=topology.referenced_vertices, adjacency=_adjacency(topology), areas=_vertex_areas(mesh))
+        return k_min, k_max, valid, normals
     return run
 
 
@@ -264,8 +264,10 @@ def _usable_faces(faces: np.ndarray, degenerate: np.ndarray, normals: np.ndarray
 
 def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Stages | None = None, *,
                 neighbours: np.ndarray | None = None, adjacency: tuple | None = None,
-                areas: np.ndarray | None = None, weighted: bool = False):
+                areas: np.ndarray | None = None, weighted: bool = False, normal_radius=None):
     """``k_min, k_max, dir_min, dir_max, normals, valid`` of the measures over balls of ``radius``.
+
+    The normals are fitted over ``normal_radius`` (default: :data:`NORMAL_RADIUS_RATIO` times ``radius``).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -279,7 +281,9 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
 
     start("fit normals")
     if np.all(np.asarray(radius) > 0):
-        normals = fitted_normals(vertices, normals, valid, NORMAL_RADIUS_RATIO * radius, neighbours=neighbours,
+        if normal_radius is None:
+            normal_radius = NORMAL_RADIUS_RATIO * radius
+        normals = fitted_normals(vertices, normals, valid, normal_radius, neighbours=neighbours,
                                  adjacency=adjacency, areas=areas, weighted=weighted)
 
     start("compute face measures")
@@ -295,11 +299,13 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
     return k_min, k_max, dir_min, dir_max, normals, valid
 
 
-def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = False):
+def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = False, vertex_scale=None):
     """Interpolated corrected curvature measures over balls. Returns ``(result, problems)``.
 
     ``adaptive``: each vertex at its own scale (:func:`_adaptive`), from ``radius`` (the default
-    radius when None) upwards.
+    radius when None) upwards. ``vertex_scale``: ``(radii, normal_radii)`` (V,) of a voxel surface's default
+    (:func:`meshcurv.radius.voxel_vertex_radii`), used instead of ``radius`` (then the surface's one radius,
+    :func:`meshcurv.radius.voxel_radius`) unless ``adaptive``.
     """
     vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
@@ -329,6 +335,15 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                   else [NORMAL_RADIUS_RATIO * r for r in radii], **found}
     if adaptive and len(groups) == 1:
         return _adaptive(mesh, groups[0][0], parameters, defects, valid, stages)
+    if vertex_scale is not None:  # a voxel surface: each vertex at the scale its pilot calls for
+        radii_v, normal_radii = vertex_scale
+        k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
+            vertices, topology.faces, degenerate, normals, valid, radii_v, stages, neighbours=referenced,
+            adjacency=_adjacency(topology), areas=_vertex_areas(mesh), normal_radius=normal_radii)
+        parameters = {**parameters, "radius": float(np.median(radii_v)),
+                      "normal_radius": float(np.median(normal_radii)), "scale": "voxel",
+                      "scale_rule": VOXEL_SCALE_RULE}
+        return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor
         ratios = local_scale_ratios(vertices, topology)
         radii_v = vertex_radii(groups, vertices.shape[0]) * ratios

@@ -1,0 +1,151 @@
+"""Each vertex of a voxel surface at its own scale (issue 30): icc's default on marching-cubes meshes.
+
+Oracles: the exact curvatures of voxelised analytic solids (at each vertex's
+closest point, :mod:`meshcurv.shapes`); the closed form of the rule on given
+normals and curvatures (:func:`meshcurv.radius.voxel_vertex_radii`); and
+invariances of the radii: a translation and a rotation that maps the voxel grid
+onto itself (a cyclic permutation of the axes, with the spacing permuted) leave
+them unchanged, a scaling of the mesh scales them.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import meshcurv
+from meshcurv import shapes
+from meshcurv.errors import MeshQualityWarning
+from meshcurv.radius import voxel_vertex_radii
+from meshcurv.topology import MeshTopology
+
+
+def quiet(vertices, faces, **options):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        return meshcurv.principal_curvatures(vertices, faces, **options)
+
+
+def _lists(n):
+    """Edge lists of ``n`` vertices without edges (each vertex its own ring)."""
+    return np.zeros(n + 1, dtype=np.int64), np.zeros(0, dtype=np.int64)
+
+
+def test_the_rule_in_closed_form():
+    # isolated vertices (each its own ring) in 2 x 0.5 x 0.5 voxels, surface curvature radius R = 32:
+    # r_v = max(2, min(2 sqrt(h_v R), 1 / c_v, 0.5 / sqrt(K_v), sqrt(area / (18 pi)), R / 2 + t_v (1 / c_v - R / 2)))
+    spacing = np.array([2.0, 0.5, 0.5])
+    x, y = [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]
+    normals = np.array([x, y, x, y, x])
+    k_min = np.array([1 / 20, 1 / 20, 0.0, 0.0, 1 / 4])
+    k_max = np.array([1 / 20, 1 / 20, 1 / 24, 1 / 24, 1 / 4])
+    radii, normal_radii = voxel_vertex_radii(spacing, normals, k_min, k_max, np.ones(5, bool), 32.0, _lists(5), 3.0)
+    # sphere-like at R_v 20: 0.5 / sqrt(K) = 10 below 2 sqrt(2 * 32) = 16 (h_v 2 along x); 2 sqrt(0.5 * 32) = 8
+    # (h_v 0.5 along y); a tube of radius 24 (t_v = 1): the cap R / 2 = 16 rises to 24, above 16 and 8;
+    # a small sphere (R_v 4): 0.5 / sqrt(K) = 2, the largest voxel size
+    np.testing.assert_allclose(radii, [10.0, 8.0, 16.0, 8.0, 2.0], rtol=1e-12)
+    # min(3 r_v, max(1.5 / c_v, 4 h_max)): the tube's 48 capped at 1.5 / c_v = 36; elsewhere 3 r_v
+    np.testing.assert_allclose(normal_radii, [30.0, 24.0, 36.0, 24.0, 6.0], rtol=1e-12)
+    capped, _ = voxel_vertex_radii(
+        spacing, normals, k_min, k_max, np.ones(5, bool), 32.0, _lists(5), 3.0, area=18 * np.pi * 25.0
+    )
+    np.testing.assert_allclose(capped, [5.0, 5.0, 5.0, 5.0, 2.0], rtol=1e-12)  # sqrt(area / (18 pi)) = 5
+
+
+def test_vertices_without_pilot_values_take_the_fallback():
+    normals = np.array([[0, 0, 1.0], [0, 0, 1.0]])
+    radii, normal_radii = voxel_vertex_radii(
+        (1.0, 1.0, 1.0),
+        normals,
+        np.array([np.nan, 0.1]),
+        np.array([np.nan, 0.1]),
+        np.array([True, False]),
+        10.0,
+        _lists(2),
+        4.5,
+    )
+    np.testing.assert_array_equal(radii, [4.5, 4.5])
+    np.testing.assert_array_equal(normal_radii, [13.5, 13.5])
+
+
+@pytest.fixture(scope="module")
+def torus_2x():
+    pytest.importorskip("skimage")
+    return shapes.voxel_torus(12.0, 4.0, (2.0, 0.5, 0.5), seed=12)
+
+
+def _relative_h_error(mesh, result):
+    return float(np.median(np.abs(result.mean - mesh.mean) / np.abs(mesh.mean)))
+
+
+@pytest.mark.slow
+def test_a_thin_torus_in_elongated_voxels_is_within_the_anisotropic_target():
+    # R 20, r 2 under voxels of 0.5 x 0.25 x 0.25 (2:1; 26,262 vertices): the torus H = (1/r + cos(phi) /
+    # (R + r cos(phi))) / 2 at each vertex's closest point; target 6% (issue 14). One radius for the surface gave
+    # 10% (benchmarks/scale_default.md, 5.2% of max|k|)
+    pytest.importorskip("skimage")
+    mesh = shapes.voxel_torus(20.0, 2.0, (0.5, 0.25, 0.25), seed=207)
+    r = quiet(mesh.vertices, mesh.faces)
+    assert r.parameters["scale"] == "voxel"
+    assert _relative_h_error(mesh, r) <= 0.06
+
+
+def test_the_torus_under_4_to_1_voxels_is_no_longer_a_quarter_off(torus_2x):
+    # R 12, r 4 under voxels of 2 x 0.5 x 0.5 (4 voxels across the tube along the torus axis): one radius for
+    # the surface gave a median H error of 25% of |H| (benchmarks/accuracy_voxel.md); each vertex at its own
+    # scale 14% (still above the 6% target: the pilot at two voxels, 4 units, barely resolves the tube)
+    mesh = torus_2x
+    r = quiet(mesh.vertices, mesh.faces)
+    assert r.parameters["scale"] == "voxel" and r.parameters["scale_rule"].startswith("voxel:")
+    assert r.radius.shape == (mesh.vertices.shape[0],) and np.ptp(r.radius) > 0
+    assert r.valid.all()
+    assert _relative_h_error(mesh, r) <= 0.16
+
+
+def _sphere_and_thin_torus():
+    """Marching cubes of one mask: a ball of radius 10 at the origin and, beside it, a torus R 6, r 1.5 (voxel 0.5)."""
+    measure = pytest.importorskip("skimage.measure")
+    spacing = 0.5
+    x0, y0, z0 = -12.87, -12.93, -12.89  # origins off the grid's symmetry
+    ax, ay, az = (np.arange(n) * spacing + o for n, o in ((88, x0), (52, y0), (52, z0)))
+    x, y, z = np.meshgrid(ax, ay, az, indexing="ij", sparse=True)
+    ball = x**2 + y**2 + z**2 <= 10.0**2
+    tube = (np.sqrt((x - 22.0) ** 2 + y**2) - 6.0) ** 2 + z**2 <= 1.5**2
+    vertices, faces, _, _ = measure.marching_cubes((ball | tube).astype(float), 0.5, spacing=(spacing,) * 3)
+    vertices = vertices + np.array([x0, y0, z0])  # the ball's centre at the origin
+    on_ball = np.linalg.norm(vertices, axis=1) < 10.0 + 2 * spacing
+    return vertices.astype(float), np.ascontiguousarray(faces[:, ::-1]), on_ball
+
+
+def test_radii_are_smaller_on_a_thin_tube_than_on_a_big_sphere_of_the_same_mesh():
+    vertices, faces, on_ball = _sphere_and_thin_torus()
+    r = quiet(vertices, faces)
+    assert r.parameters["scale"] == "voxel"
+    tube, ball = np.median(r.radius[~on_ball]), np.median(r.radius[on_ball])
+    assert tube < 0.6 * ball and tube <= 2 * 1.5  # about its radius of curvature, 1.5 (1 / c_v)
+    exact = 1.0 / np.linalg.norm(vertices[on_ball], axis=1)  # the closest sphere point's curvature
+    assert float(np.median(np.abs(r.mean[on_ball] - exact) / exact)) < 0.03  # isotropic target
+
+
+def test_radii_follow_rigid_motions_of_the_grid_and_scale_with_the_mesh():
+    pytest.importorskip("skimage")
+    mesh = shapes.voxel_ellipsoid((6.0, 4.0, 3.0), (1.0, 0.5, 0.5), seed=4)
+    vertices, faces = np.asarray(mesh.vertices, float), mesh.faces
+    reference = quiet(vertices, faces).radius
+    moved = quiet(vertices + np.array([7.25, -3.5, 1.75]), faces).radius  # a translation by a grid step's multiple
+    np.testing.assert_allclose(moved, reference, rtol=1e-6)
+    turned = quiet(np.ascontiguousarray(vertices[:, [1, 2, 0]]), faces).radius  # x->z, y->x, z->y: a rotation
+    np.testing.assert_allclose(turned, reference, rtol=1e-6)
+    scaled = quiet(3.0 * vertices, faces).radius
+    np.testing.assert_allclose(scaled, 3.0 * reference, rtol=1e-6)
+
+
+def test_other_ball_methods_keep_one_radius_on_a_voxel_surface(torus_2x):
+    mesh = torus_2x
+    topology = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0])
+    assert topology.n_faces
+    r = quiet(mesh.vertices, mesh.faces, method="quadric")
+    assert r.parameters["surface"] == "voxel" and "scale" not in r.parameters
+    assert np.ptp(r.radius[r.valid]) == 0
