@@ -9,11 +9,9 @@ import warnings
 import click
 import numpy as np
 
-from .. import volume as volume_module
 from ..batch import MAX_WORKERS
 from ..io import write_curvatures
 from ..io._files import atomic_output, check_output
-from ..io._images import read_image
 from ..io._vtp import PieceWriter
 from ..io.fields import FIELDS, curvature_fields
 from ..plotting import _pyplot, plot_field, save_figure
@@ -199,6 +197,10 @@ def volume(
     --workers N the labels are computed on N processes (a label whose
     process dies gets a failed row; the others are computed).
     """
+    # on use: the label images' modules stay out of the command line's start (issue 31)
+    from .. import volume as volume_module
+    from ..io._images import read_image
+
     session = current_session()
     volume_module._pandas()
     if picture:
