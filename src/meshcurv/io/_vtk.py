@@ -21,24 +21,9 @@ from ._text import numbers
 
 __all__ = ["is_polydata", "read_vtk_polydata"]
 
-_TYPES = {
-    "bit": None,
-    "unsigned_char": "u1",
-    "char": "i1",
-    "unsigned_short": "u2",
-    "short": "i2",
-    "unsigned_int": "u4",
-    "int": "i4",
-    "unsigned_long": "u8",
-    "long": "i8",
-    "float": "f4",
-    "double": "f8",
-    "vtktypeint64": "i8",
-    "vtktypeuint64": "u8",
-    "vtkidtype": "i8",
-    "vtktypeint32": "i4",
-    "vtktypeuint32": "u4",
-}
+_NAMES = "bit unsigned_char char unsigned_short short unsigned_int int unsigned_long long float double"
+_TYPES = dict(zip(_NAMES.split(), (None, "u1", "i1", "u2", "i2", "u4", "i4", "u8", "i8", "f4", "f8")))
+_TYPES.update(vtktypeint64="i8", vtktypeuint64="u8", vtkidtype="i8", vtktypeint32="i4", vtktypeuint32="u4")
 _DATASET = re.compile(rb"^\s*DATASET\s+(\w+)", re.M | re.I)
 _WHITE = np.zeros(256, dtype=bool)
 _WHITE[[9, 10, 11, 12, 13, 32]] = True
