@@ -1400,9 +1400,8 @@ def check_line_spread(name):
 def check_flat_balls(name):
     from scipy.spatial import cKDTree
 
-    from meshcurv._pointcloud_estimators import (BALL_OFFSET, BALL_SHARE, SUPPORT_ITERATIONS, SUPPORT_POINTS,
-                                                 _ball_indices, _flat_balls, _usable_tree)
-    from meshcurv._pointcloud_normals import LINE_SUPPORT
+    from meshcurv._pointcloud_estimators import (BALL_OFFSET, BALL_SHARE, BALL_SUPPORT, SUPPORT_ITERATIONS,
+                                                 SUPPORT_POINTS, _ball_indices, _flat_balls, _usable_tree)
 
     points, _ = cloud(name)
     n = points.shape[0]
@@ -1417,7 +1416,7 @@ def check_flat_balls(name):
         expected = _flat_balls(points, centres, index, counts)
         got = kernels("pointcloud").flat_balls(points, centres, index, counts.astype(np.int64),
                                                -(-k // SUPPORT_POINTS), SUPPORT_ITERATIONS, BALL_OFFSET, BALL_SHARE,
-                                               LINE_SUPPORT)
+                                               BALL_SUPPORT)
         np.testing.assert_array_equal(got, expected)
         assert expected[:n].mean() > 0.9 and not expected[n:n + 200].any()  # (the line's own balls)
 

@@ -51,7 +51,10 @@ SUPPORT_POINTS = 48
 SUPPORT_ITERATIONS = 6
 BALL_OFFSET = 0.1
 
-#: ... and a ball holds a surface when this share of its points (or more) is beside the line: an elongated
+#: ... and a ball holds a surface when this many of them (or more) ...
+BALL_SUPPORT = 3
+
+#: ... and this share of its points (or more) are beside the line: an elongated
 #: ball of a surface (trimmed by :func:`_own_side`, at a rim) has, a line with a few points beside it has not.
 BALL_SHARE = 0.25
 
@@ -262,13 +265,13 @@ def flat_balls(points, centres, index, counts) -> np.ndarray:
         return _flat_balls(points, centres, index, counts)
     return compiled.flat_balls(points, np.ascontiguousarray(centres), np.ascontiguousarray(index),
                                np.ascontiguousarray(counts, dtype=np.int64), -(-index.shape[1] // SUPPORT_POINTS),
-                               SUPPORT_ITERATIONS, BALL_OFFSET, BALL_SHARE, _normals.LINE_SUPPORT)
+                               SUPPORT_ITERATIONS, BALL_OFFSET, BALL_SHARE, BALL_SUPPORT)
 
 
 def _flat_balls(points, centres, index, counts) -> np.ndarray:
     """The NumPy path of :func:`flat_balls`.
 
-    A ball holds a surface when at least :data:`meshcurv._pointcloud_normals.LINE_SUPPORT` and
+    A ball holds a surface when at least :data:`BALL_SUPPORT` and
     :data:`BALL_SHARE` of :data:`SUPPORT_POINTS` of its points (every few in distance order) lie farther than
     :data:`BALL_OFFSET` times the farthest one's distance from the line through the centre along their main
     direction (a few power iterations on their covariance): a ball of points on a line and one or two beside it (the end of a scan line,
@@ -288,7 +291,7 @@ def _flat_balls(points, centres, index, counts) -> np.ndarray:
     across = squared - along * along
     far = squared.max(axis=1)
     beside = (across > BALL_OFFSET**2 * far[:, None]).sum(axis=1)
-    return beside >= np.maximum(_normals.LINE_SUPPORT, BALL_SHARE * member.sum(axis=1))
+    return beside >= np.maximum(BALL_SUPPORT, BALL_SHARE * member.sum(axis=1))
 
 
 def corrected_measures(tree, points, normals, radius, centres, usable, *, spacing: float = 0.0,
