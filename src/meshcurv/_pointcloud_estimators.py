@@ -14,7 +14,6 @@ from ._backend import kernel_threads, numba_kernels
 from ._tensors import principal_from_shape_operator
 from .measures import curvatures_from_measures, face_measures
 from .jets import fit_jets, jet_normals, shape_operators
-from . import _pointcloud_normals as _normals
 
 logger = logging.getLogger(__name__)
 
