@@ -24,6 +24,7 @@ import json
 import os
 import platform
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -162,15 +163,29 @@ def main(argv=None) -> int:
     import numba
     import numpy
 
-    lines.append(f"numba {numba.__version__}, numpy {numpy.__version__}.")
+    source = os.environ.get("PYTHONPATH")
+    lines.append(f"numba {numba.__version__}, numpy {numpy.__version__}; meshcurv "
+                 f"{'from PYTHONPATH=' + source if source else 'as installed'}.")
     lines.append("")
     colds = []
-    last_cache = None
-    for _ in range(args.cold):
-        cache = tempfile.mkdtemp(prefix="meshcurv-cold-")
-        data, wall, cpu = _child(COLD, args.mesh, _environment(cache))
-        colds.append((data, wall, cpu, os.getloadavg()[0]))
-        last_cache = cache
+    caches = []
+    try:
+        for _ in range(args.cold):
+            caches.append(tempfile.mkdtemp(prefix="meshcurv-cold-"))
+            data, wall, cpu = _child(COLD, args.mesh, _environment(caches[-1]))
+            colds.append((data, wall, cpu, os.getloadavg()[0]))
+        text = _report(args, lines, colds, _environment(caches[-1]))
+    finally:
+        for cache in caches:
+            shutil.rmtree(cache, ignore_errors=True)
+    print(text)
+    if args.output:
+        Path(args.output).write_text(text)
+    return 0
+
+
+def _report(args, lines: list[str], colds: list, env: dict) -> str:
+    """The markdown of the cold runs, then of the warm processes run on ``env``'s cache."""
     lines.append("## Cold cache: compile CPU of the default call")
     lines.append("")
     lines.append("| run | compile CPU s (numba events) | first call CPU s | process CPU s | process wall s | load |")
@@ -185,7 +200,6 @@ def main(argv=None) -> int:
     lines.extend(_kernels_table(colds[0][0]["records"]))
     lines.append("")
 
-    env = _environment(last_cache)
     _child(WARM, args.mesh, env)  # untimed: the bytecode cache written, the pages warm
     warms = [(*_child(WARM, args.mesh, env), os.getloadavg()[0]) for _ in range(args.warm)]
     lines.append(f"## Warm cache: a fresh process, median of {args.warm}")
@@ -209,11 +223,7 @@ def main(argv=None) -> int:
     for key in parts[0]:
         values = [p[key] for p in parts]
         lines.append(f"| {key} | {statistics.median(values):.3f} | {', '.join(f'{v:.3f}' for v in values)} |")
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.output:
-        Path(args.output).write_text(text)
-    return 0
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

@@ -342,7 +342,7 @@ class _Event:
 
 def test_compilation_is_announced_once_on_the_logger(caplog):
     from meshcurv import _backend
-    from meshcurv._kernels.icc import face_measures
+    from meshcurv._kernels.icc import _face_measures_chunk
     from meshcurv._kernels.jets import _grid_chunk
 
     announcer = _backend._CompileAnnouncer()
@@ -351,15 +351,15 @@ def test_compilation_is_announced_once_on_the_logger(caplog):
         announcer.on_start(foreign)
         announcer.on_end(_Event(warnings.warn, False))
         assert not caplog.records
-        for kernel in (_grid_chunk.py_func, face_measures.py_func):
+        for kernel in (_grid_chunk.py_func, _face_measures_chunk.py_func):
             announcer.on_start(_Event(kernel, True))
             announcer.on_end(_Event(kernel, False))
     warned = [r for r in caplog.records if r.levelname == "WARNING"]
     assert len(warned) == 1 and "compiling meshcurv's numba kernels" in warned[0].getMessage()
     assert "cached on disk" in warned[0].getMessage()
     infos = [r.getMessage() for r in caplog.records if r.levelname == "INFO"]
-    assert [m.split()[4] for m in infos] == ["_grid_chunk", "face_measures"]
-    assert [name for name, _ in announcer.compiled] == ["_grid_chunk", "face_measures"]
+    assert [m.split()[4] for m in infos] == ["_grid_chunk", "_face_measures_chunk"]
+    assert [name for name, _ in announcer.compiled] == ["_grid_chunk", "_face_measures_chunk"]
 
 
 def test_nested_compilations_count_once(caplog):

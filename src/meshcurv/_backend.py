@@ -76,9 +76,8 @@ logger = logging.getLogger(__name__)
 
 #: Logged once per process (WARNING) when a kernel is compiled rather than loaded from the disk cache.
 COMPILE_MESSAGE = (
-    "compiling meshcurv's numba kernels for first use (once per installation: 30 s to a minute for the "
-    "default method, up to 2 minutes for all methods, on 2 cores); they are cached on disk for later "
-    "processes (%s)"
+    "compiling meshcurv's numba kernels for first use (once per installation: about 15 s of CPU for the "
+    "default method, up to a minute for all methods); they are cached on disk for later processes (%s)"
 )
 
 
