@@ -17,7 +17,8 @@ the user:
   noisy meshes, growing with the noise measured on the mesh;
 - :func:`voxel_radius`, :func:`voxel_surface_radius`: on voxel surfaces
   (marching cubes), about ``sqrt(h R)`` for voxels of size ``h`` and curvature
-  radius ``R``;
+  radius ``R``; :func:`voxel_vertex_radii`: ``icc``'s default there, each
+  vertex at its own (below);
 - :func:`scale_ladder`, :func:`stable_scales`: ``radius="adaptive"``, each
   vertex at the rung of a ladder of radii where its estimate is stable;
 - :func:`cloud_noise_level`, :func:`cloud_radius`: point clouds, growing with
@@ -45,11 +46,17 @@ twice the inner ones; the saddle's grid, stretched by its slopes), and
 following that spread made the clean torus 15% and the saddle 15% worse
 (median H); beyond :data:`LOCAL_FOLLOW` (4) the radius follows the edges in
 proportion (``benchmarks/scale_default.py``). Those fits weigh each point by its area (a part sampled 100 times
-more densely must not pull the normals of its coarse neighbours). Voxel
-surfaces keep one radius per surface: their rule is set by the lattice and
-the curvature, not by the edges, whose lengths change with the orientation of
-the surface in anisotropic voxels (a factor 2 at 2:1) without any change of
-the noise. ``radius="adaptive"`` (:func:`scale_ladder`, :func:`stable_scales`)
+more densely must not pull the normals of its coarse neighbours). On voxel
+surfaces the rule is set by the lattice and the curvature, not by the edges,
+whose lengths change with the orientation of the surface in anisotropic
+voxels (a factor 2 at 2:1) without any change of the noise: ``icc``'s default
+there gives each vertex ``2 sqrt(h_v R)`` with ``h_v`` the voxel's extent
+along its normal, capped where the pilot pass sees the surface bend fast
+(:func:`voxel_vertex_radii`; ``parameters["scale"] == "voxel"``); one radius
+per surface made a torus of tube radius 4 under 2 x 0.5 x 0.5 voxels 25% off
+(median H), now 14%, and halved the errors of thin tori in elongated voxels
+(``benchmarks/scale_default.md``). The other ball methods keep the one
+radius of :func:`voxel_radius`. ``radius="adaptive"`` (:func:`scale_ladder`, :func:`stable_scales`)
 chooses each vertex's scale from its estimates instead, at 1.4-4 times the
 cost; the local default costs one sparse product per ring.
 """
@@ -371,7 +378,8 @@ VOXEL_TUBE = 2.0
 #: How ``parameters["scale_rule"]`` names the rule.
 VOXEL_SCALE_RULE = ("voxel: r_v = max(h_max, min(2 sqrt(h_v R), 1 / c_v, 0.5 / sqrt|K_v|, sqrt(area / (18 pi)), "
                     "R / 2 + t_v (1 / c_v - R / 2)+)), t_v = clip(1 - 2 sqrt|K_v| / c_v, 0, 1), h_v the voxel "
-                    "extent along the pilot's normal, R the surface's curvature radius, c_v and K_v the pilot's "
+                    "extent along the pilot's normal, R the surface's curvature radius (a region flatter than 2 R: its "
+                    "own), c_v and K_v the pilot's "
                     "curvedness and Gaussian curvature over 2 rings; normals over min(3 r_v, max(1.5 / c_v, 4 h_max))")
 
 

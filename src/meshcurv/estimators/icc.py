@@ -26,7 +26,10 @@ edge), each vertex takes that radius times its local factor
 "local"``, ``result.radius`` per vertex) and the normal fits weigh each point
 by its area. On dense surfaces (normal-fit balls wider than 16 edge lengths,
 marching cubes of fine voxels) the normals are fitted on clusters of vertices
-(:func:`fitted_normals`).
+(:func:`fitted_normals`). On voxel surfaces each vertex takes the radius its
+pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
+``2 sqrt(h_v R)`` for the voxel extent ``h_v`` along its normal, capped where
+the surface bends fast; ``parameters["scale"] == "voxel"``).
 
 The normals ``u_i`` are interpolated linearly over each triangle; the
 curvature measures ``mu_0`` (corrected area), ``mu_1`` (2H dA), ``mu_2`` (K dA)
