@@ -74,9 +74,8 @@ def choose_up(vertices) -> tuple[str, str]:
     Most OBJ and PLY files are made with y up (trimesh, Blender's OBJ export,
     the Stanford and Keenan Crane models); CAD, scanners and medical tools
     often write z up. A mesh is taken as z-up when it is more than
-    :data:`Z_UP_RATIO` times as tall along z as along y (nefertiti.obj: 1.36),
-    else y-up (spot.obj: 1.02, igea.obj: 1.0, ogre.obj: 0.30). x is never
-    chosen.
+    :data:`Z_UP_RATIO` times as tall along z as along y, else y-up; x is
+    never chosen.
     """
     points = np.asarray(vertices, dtype=float)
     extent = np.ptp(points, axis=0) if points.size else np.zeros(3)

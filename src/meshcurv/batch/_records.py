@@ -75,8 +75,7 @@ def fingerprint(path) -> dict:
         the first and the last :data:`HASH_PART_BYTES` (16 MiB) are hashed:
         every format keeps its header (and so the counts) at the start and
         ends with the last faces, so a mesh of another size or shape changes
-        them, while hashing a 10 GB scan whole would cost a resume tens of
-        seconds for each file.
+        them, and a resume does not read every large scan whole.
 
     Raises
     ------

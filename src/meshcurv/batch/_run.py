@@ -28,8 +28,8 @@ from ._summary import _ADDED_COLUMNS, _summary, _write_summary
 
 logger = logging.getLogger(__name__)
 
-#: The default time limit of one mesh, in seconds (``timeout`` of :func:`run`, ``--timeout``): a hundred
-#: times what icc takes on a mesh of ten million vertices, so only a mesh that never ends reaches it.
+#: The default time limit of one mesh, in seconds (``timeout`` of :func:`run`, ``--timeout``): far beyond
+#: what a large mesh takes, so that only a mesh that never ends reaches it.
 DEFAULT_TIMEOUT = 3600.0
 
 #: The most bytes of input files sent to a worker as one task (a single larger mesh is a task of its
