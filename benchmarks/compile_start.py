@@ -81,6 +81,20 @@ t4 = time.perf_counter()
 json.dump({"import": t1 - t0, "read": t2 - t1, "first call": t3 - t2, "second call": t4 - t3}, sys.stdout)
 """
 
+ALL = r"""
+import json, sys, time, warnings
+warnings.simplefilter("ignore")
+import meshcurv
+
+mesh = meshcurv.read_mesh(sys.argv[1])
+cpu = {}
+for method in meshcurv.METHODS:
+    start = time.process_time()
+    meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method=method)
+    cpu[method] = time.process_time() - start
+json.dump(cpu, sys.stdout)
+"""
+
 PARTS = r"""
 import json, sys, time
 parts = {}
@@ -154,6 +168,8 @@ def main(argv=None) -> int:
     parser.add_argument("--cold", type=int, default=1, help="cold processes (each on an empty cache)")
     parser.add_argument("--warm", type=int, default=5, help="warm processes (after one untimed)")
     parser.add_argument("--output", default=None, help="write the markdown there (default: stdout only)")
+    parser.add_argument("--all-methods", action="store_true",
+                        help="also every method's first call in one more cold process (about a minute of CPU)")
     args = parser.parse_args(argv)
 
     lines = [f"Generated {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC by "
@@ -170,6 +186,8 @@ def main(argv=None) -> int:
     colds = []
     caches = []
     try:
+        if not args.cold:  # the warm processes' cache, written by their untimed first run
+            caches.append(tempfile.mkdtemp(prefix="meshcurv-cold-"))
         for _ in range(args.cold):
             caches.append(tempfile.mkdtemp(prefix="meshcurv-cold-"))
             data, wall, cpu = _child(COLD, args.mesh, _environment(caches[-1]))
@@ -186,6 +204,16 @@ def main(argv=None) -> int:
 
 def _report(args, lines: list[str], colds: list, env: dict) -> str:
     """The markdown of the cold runs, then of the warm processes run on ``env``'s cache."""
+    if colds:
+        _cold_report(lines, colds)
+    if args.all_methods:
+        _all_methods_report(args, lines)
+    if args.warm:
+        _warm_report(args, lines, env)
+    return "\n".join(lines) + "\n"
+
+
+def _cold_report(lines: list[str], colds: list) -> None:
     lines.append("## Cold cache: compile CPU of the default call")
     lines.append("")
     lines.append("| run | compile CPU s (numba events) | first call CPU s | process CPU s | process wall s | load |")
@@ -200,6 +228,23 @@ def _report(args, lines: list[str], colds: list, env: dict) -> str:
     lines.extend(_kernels_table(colds[0][0]["records"]))
     lines.append("")
 
+
+def _all_methods_report(args, lines: list[str]) -> None:
+    cache = tempfile.mkdtemp(prefix="meshcurv-cold-")
+    try:
+        cpu = _child(ALL, args.mesh, _environment(cache))[0]
+    finally:
+        shutil.rmtree(cache, ignore_errors=True)
+    lines.append("Every method's first call, in the order of `meshcurv.METHODS`, in one more fresh process on an "
+                 "empty cache (CPU s; a method finds compiled the kernels it shares with those before it):")
+    lines.append("")
+    lines.append("| " + " | ".join(cpu) + " | all |")
+    lines.append("|" + "--:|" * (len(cpu) + 1))
+    lines.append("| " + " | ".join(f"{v:.2f}" for v in cpu.values()) + f" | {sum(cpu.values()):.2f} |")
+    lines.append("")
+
+
+def _warm_report(args, lines: list[str], env: dict) -> None:
     _child(WARM, args.mesh, env)  # untimed: the bytecode cache written, the pages warm
     warms = [(*_child(WARM, args.mesh, env), os.getloadavg()[0]) for _ in range(args.warm)]
     lines.append(f"## Warm cache: a fresh process, median of {args.warm}")
@@ -223,7 +268,6 @@ def _report(args, lines: list[str], colds: list, env: dict) -> str:
     for key in parts[0]:
         values = [p[key] for p in parts]
         lines.append(f"| {key} | {statistics.median(values):.3f} | {', '.join(f'{v:.3f}' for v in values)} |")
-    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":
