@@ -518,7 +518,8 @@ def _ring_sums(neighbour_lists: tuple, rings: int, *arrays: np.ndarray) -> list[
     return sums
 
 
-def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarray:
+def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology, *, valid: np.ndarray | None = None
+                       ) -> np.ndarray:
     """(V,) the factor of each vertex's radius over its component's: how much coarser or finer it is sampled.
 
     ``rho_v`` is the vertex's mean edge length averaged in log over its
@@ -531,9 +532,12 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarr
     resolution: a decimated or adaptively remeshed part), linear in log in
     between (continuous), and clipped to ``[1 / 16, 16]``
     (:data:`meshcurv.geometry.COMPONENT_SCALE_SPREAD`). Vertices without edges get 1.
+    ``valid`` (V,) bool: only the edges between two of these count (a needle's edges, 1e3 long beside
+    edges of 0.1, would make its neighbours' radii 9 times larger).
     """
     n = topology.n_vertices
-    local = vertex_edge_lengths(vertices, topology.edges)
+    edges = topology.edges if valid is None else topology.edges[valid[topology.edges].all(axis=1)]
+    local = vertex_edge_lengths(vertices, edges)
     scales = vertex_length_scales(vertices, topology)
     known = np.isfinite(local) & (local > 0) & (scales > 0)
     if not known.any():

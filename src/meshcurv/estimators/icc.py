@@ -238,18 +238,31 @@ def voxel_pilot(mesh: PreparedMesh):
         topology = mesh.topology
         _, valid = mesh.start(boundary=True)
         k_min, k_max, _, _, normals, _ = _curvatures(
-            mesh.vertices, topology.faces, mesh.degenerate, mesh.vertex_normals, valid, radius,
+            mesh.vertices, topology.faces, _dropped(mesh), mesh.vertex_normals, valid, radius,
             neighbours=topology.referenced_vertices, adjacency=_adjacency(topology), areas=_vertex_areas(mesh))
         return k_min, k_max, valid, normals
     return run
 
 
 def _vertex_areas(mesh: PreparedMesh) -> np.ndarray:
-    """(V,) a third of the area of the faces at each vertex (the weights of the fits)."""
+    """(V,) a third of the area of the faces at each vertex (the weights of the fits).
+
+    Degenerate faces and the slivers of a needle (faces of a vertex flung away, ``needle_cells``) count
+    nothing, as in the vertex normals: a sliver's area would make its corners outweigh the surface in the
+    normal fits of every vertex within three radii (H 0.04 for 1 three rings from a pair flung to 1e3).
+    """
     faces = mesh.topology.faces
     third = np.linalg.norm(mesh.cross, axis=1) / 6.0
-    third[mesh.degenerate] = 0.0
+    third[_dropped(mesh)] = 0.0
     return np.bincount(faces.ravel(), weights=np.repeat(third, 3), minlength=mesh.vertices.shape[0])
+
+
+def _dropped(mesh: PreparedMesh) -> np.ndarray:
+    """(F,) bool: the faces left out of the sums and of the fits' weights: degenerate, or the slivers of a
+    needle (``needle_cells``: the faces of a vertex flung far away, whose huge areas would outweigh the
+    surface within three radii), as in the vertex normals."""
+    needle = mesh.defects().needle_cells(mesh.topology.faces)
+    return mesh.degenerate if needle is None else mesh.degenerate | needle
 
 
 def _adjacency(topology: MeshTopology) -> tuple:
@@ -312,7 +325,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
     """
     vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
-    degenerate, normals = mesh.degenerate, mesh.vertex_normals
+    degenerate, normals = _dropped(mesh), mesh.vertex_normals
     defects, valid = mesh.start(boundary=True)
 
     stages.start("measure noise")
@@ -348,7 +361,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                       "scale_rule": VOXEL_SCALE_RULE}
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor
-        ratios = local_scale_ratios(vertices, topology)
+        ratios = local_scale_ratios(vertices, topology, valid=valid)
         radii_v = vertex_radii(groups, vertices.shape[0]) * ratios
         if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not np.all(ratios == 1.0):
             k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
@@ -387,7 +400,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     vertices, topology = mesh.vertices, mesh.topology
     faces = topology.faces
     stages.start("compute normals")
-    degenerate, start_normals = mesh.degenerate, mesh.vertex_normals
+    degenerate, start_normals = _dropped(mesh), mesh.vertex_normals
     defects, valid = mesh.start(boundary=True)
     stages.start("measure noise")
     radii = [check_radius(radius, vertices, topology) for radius in radii]
@@ -436,10 +449,10 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     stages.start("compute face measures")
     measures = face_measures(vertices, faces, normals)
     stages.start("sum over balls")
-    area = 0.5 * float(np.linalg.norm(mesh.cross[~mesh.degenerate], axis=1).sum())
+    area = 0.5 * float(np.linalg.norm(mesh.cross[~_dropped(mesh)], axis=1).sum())
     radii = scale_ladder(base, median_edge_length(vertices, topology.edges), area)
     summed = ball_face_sums_nested(vertices, faces, radii, measures,
-                                   usable=_usable_faces(faces, mesh.degenerate, normals))
+                                   usable=_usable_faces(faces, _dropped(mesh), normals))
     stages.start("retrieve curvatures")
     rung = stable_scales(*principal_from_measures(summed), topology.neighbour_lists)
     chosen = summed[rung, np.arange(vertices.shape[0])]
