@@ -643,7 +643,9 @@ def _compute(points, given, radius, method, search=None):
                         "or small part (points facing away): fitted over smaller balls of one side, down to "
                         f"{CLOUD_RADIUS_RULES[method][0]:g} spacings (parameters['shrunk'])")
     if two_sided:
-        what = "curvatures NaN" if method == "jets" else "normals from the PCA of 10 neighbours"
+        what = ("curvatures NaN" if method == "jets" else "normals from the PCA of 10 neighbours" if noise < NOISY_PCA
+                else "normals from the PCA of 10 neighbours where those lie on a plane, else NaN (noise of "
+                     f"{noise:.2g} spacings)")
         problems.append(f"{two_sided} points have no one-sided jet fit (every ball down to 3-4 spacings held "
                         f"points facing the other way: a part thinner than that, or too few points): {what}")
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
