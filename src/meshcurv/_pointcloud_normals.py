@@ -725,6 +725,9 @@ def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:
     Such a point's nearest neighbours hold another sheet (a neighbouring part, the other face of a thin
     part): its PCA normal may mix the two.
     """
+    compiled = numba_kernels("pointcloud")
+    if compiled is not None:  # the cosines without (N, 3) gathers
+        return (compiled.edge_cosines(normals, np.ascontiguousarray(indices)) < 0).any(axis=1)
     away = np.zeros(normals.shape[0], dtype=bool)
     for column in range(indices.shape[1]):
         away |= np.einsum("ij,ij->i", normals, normals[indices[:, column]]) < 0
