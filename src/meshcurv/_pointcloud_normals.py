@@ -87,12 +87,6 @@ PART_MIN_POINTS = 32
 #: Rounds of attaching small parts to their neighbours (each round reaches one part further).
 SMALL_PART_ROUNDS = 8
 
-#: A point whose every jet fit held the other side keeps its PCA normal only when the spread of its nearest
-#: neighbours along it is below this share of that along their middle direction (:func:`flat_neighbours`):
-#: uniform noise of about 0.1 spacings, where the fits of :mod:`meshcurv.pointcloud` fail on a part thinner than
-#: their balls (a plate 4 spacings thick under noise of one spacing: H 0.8 for 0.002 before).
-FLAT_SPREAD = 0.1
-
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
 
@@ -704,19 +698,6 @@ def _sheets(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         _, labels = connected_components(coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)),
                                                     shape=(n, n)), directed=False)
     return np.where(np.bincount(labels)[labels] >= PART_MIN_POINTS, labels, -1)
-
-
-def flat_neighbours(points: np.ndarray, indices: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """(M,) bool: the points ``rows`` whose nearest neighbours ``indices`` lie on a plane: the spread along
-    their least-variance direction below :data:`FLAT_SPREAD` of that along the middle one."""
-    flat = np.zeros(rows.size, dtype=bool)
-    for start in range(0, rows.size, CHUNK):
-        chunk = rows[start:start + CHUNK]
-        group = np.concatenate([points[chunk, None, :], points[indices[chunk]]], axis=1)
-        group = group - group.mean(axis=1, keepdims=True)
-        values = np.linalg.eigvalsh(np.einsum("nki,nkj->nij", group, group))
-        flat[start:start + CHUNK] = values[:, 0] <= FLAT_SPREAD**2 * values[:, 1]
-    return flat
 
 
 def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:

@@ -171,11 +171,16 @@ def _reason_code(start: str) -> int:
 #: of a third of a spacing, or a thin plate whose two faces both fall in each ball) is cut to fit, with a warning.
 BALL_PAIRS_SHARE = 0.5
 
-#: Noise level (in spacings, :func:`meshcurv.radius.cloud_noise_level`) from which a point without a one-sided
-#: normal fit keeps its PCA normal only where its nearest neighbours are flat
-#: (:func:`meshcurv._pointcloud_normals.flat_neighbours`); below it a sharp rim's PCA normals are right.
-#: A plate 4 spacings thick under uniform noise of one spacing measures 0.29: H 0.8 for 0.002 before, valid.
+#: Noise level (in spacings, :func:`meshcurv.radius.cloud_noise_level`) from which a point whose one-sided fit
+#: (of the normals, or of ``"jets"``) took a ball below :data:`NOISY_SHRINK` times the radius asked for, or none
+#: (then its PCA normal is kept below this level: right at a sharp rim), is NaN: the noise dominates such a fit.
+#: A plate 4 spacings thick under uniform noise of 1 (0.3) spacing measures 0.29 (0.15): before, 0.3% (7%) of
+#: its points were valid with H off by 100 times (3 times) its value. The clouds of ``benchmarks/pointcloud.py``
+#: under noise of 0.2 spacings measure about 0.08.
 NOISY_PCA = 0.1
+
+#: See :data:`NOISY_PCA`.
+NOISY_SHRINK = 0.5
 
 #: Code of points whose normal's side could not be decided (between two sheets closer than the spacing).
 _UNDECIDED = _reason_code("point cloud: side undecided")
@@ -591,6 +596,7 @@ def _compute(points, given, radius, method, search=None):
     two_sided = 0  # points whose every ball held the other side (or too few points)
     one_sided = np.ones(n, dtype=bool)  # points with a one-sided jet fit (or given normals)
     two_sided_mask = np.zeros(n, dtype=bool)
+    noisy = 0  # points whose fits the noise dominates (see NOISY_PCA)
     mixed = None
     for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
@@ -603,6 +609,7 @@ def _compute(points, given, radius, method, search=None):
             found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest,
                                      details=details)
             asked = group_radius
+            noisy += _noise_dominated(details["radii"], members, asked, noise, one_sided)
         else:
             if given is None:
                 asked = normal_radius = _within_budget(
@@ -616,15 +623,11 @@ def _compute(points, given, radius, method, search=None):
                 # a point whose every normal fit held the other side, and whose nearest neighbours hold
                 # it too, keeps a PCA normal that may mix the two sheets: it is left out (NaN, and out of
                 # the balls, where its triangles would bend the measures of its neighbours)
-                # (nor, under noise of NOISY_PCA spacings or more, one whose nearest neighbours are not flat:
-                # noise as thick as the part's faces are apart makes the PCA normal a coin's toss)
                 if mixed is None:
                     mixed = _normals.facing_away(start, indices)
                 failed = members[~np.isfinite(details["radii"][members])]
                 one_sided[failed] = ~mixed[failed]
-                if noise >= NOISY_PCA:
-                    one_sided[failed[one_sided[failed]]] = _normals.flat_neighbours(points, indices,
-                                                                                    failed[one_sided[failed]])
+                noisy += _noise_dominated(details["radii"], members, asked, noise, one_sided)
             else:
                 normals = start
             found = _estimators.corrected_measures(tree, points, normals, group_radius, members,
@@ -644,10 +647,13 @@ def _compute(points, given, radius, method, search=None):
                         f"{CLOUD_RADIUS_RULES[method][0]:g} spacings (parameters['shrunk'])")
     if two_sided:
         what = ("curvatures NaN" if method == "jets" else "normals from the PCA of 10 neighbours" if noise < NOISY_PCA
-                else "normals from the PCA of 10 neighbours where those lie on a plane, else NaN (noise of "
-                     f"{noise:.2g} spacings)")
+                else f"NaN (under noise of {noise:.2g} spacings the PCA normals of 10 neighbours are not kept)")
         problems.append(f"{two_sided} points have no one-sided jet fit (every ball down to 3-4 spacings held "
                         f"points facing the other way: a part thinner than that, or too few points): {what}")
+    if noisy:
+        problems.append(f"{noisy} points under noise of {noise:.2g} spacings have a one-sided fit only over balls "
+                        f"below {NOISY_SHRINK:g} times the radius the noise calls for, or none (a part thinner than "
+                        "that): NaN")
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
     alike = np.zeros(n, dtype=bool)
     if how != "given":
@@ -683,6 +689,16 @@ def _compute(points, given, radius, method, search=None):
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, *_ in groups)
     return k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, problems
+
+
+def _noise_dominated(radii, members, asked, noise, one_sided) -> int:
+    """Mark in ``one_sided`` the ``members`` whose fit ``radii`` (N,) is NaN or below :data:`NOISY_SHRINK` times
+    ``asked`` when ``noise`` is :data:`NOISY_PCA` or more; return how many had a (small) fit."""
+    if noise < NOISY_PCA:
+        return 0
+    small = members[~(radii[members] >= NOISY_SHRINK * asked)]
+    one_sided[small] = False
+    return int(np.isfinite(radii[small]).sum())  # (those without a fit are counted as such)
 
 
 def _within_budget(points, radius, members, what, problems) -> float:
