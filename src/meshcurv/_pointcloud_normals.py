@@ -839,14 +839,14 @@ def winding_sides(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, s
     queries = _evenly(candidates, WINDING_QUERIES)
     sources = _evenly(candidates, WINDING_SOURCES)
     areas = np.where(usable, spacing**2, 0.0)
-    rows, cols, _ = _graph_edges(indices[:, :GRAPH_NEIGHBOURS], usable)
     nearest = None
     for evaluation in range(WINDING_ROUNDS):
         winding = winding_numbers(points, normals * flips[:, None], areas, usable, tree, queries, sources)
         wrong_queries = np.abs(winding - 0.5) > WINDING_WRONG
         if not wrong_queries.any():
             return flips, np.zeros(n, dtype=bool)
-        if nearest is None:
+        if nearest is None:  # (the graph's edges only when a side is wrong)
+            rows, cols, _ = _graph_edges(indices[:, :GRAPH_NEIGHBOURS], usable)
             nearest = _nearest_queries(points, normals, usable, queries, rows, cols)
         wrong = np.zeros(n, dtype=bool)
         wrong[usable] = wrong_queries[nearest[usable]]
