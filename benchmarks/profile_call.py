@@ -14,6 +14,18 @@ measured around the whole call, outside the wrappers. Run::
 
 Numbers depend on the load of the machine; the script prints ``uptime``'s
 load averages before and after.
+
+``--walks`` adds a second table: inside the two kernels of the estimator, the
+share of the breadth-first walks of the balls (issue 31, "one walk for both
+balls"). It times, on the same meshes at the default radius ``r`` of the call,
+the normal fits over ``3 r`` (:func:`meshcurv.jets.fit_jet_normals` with icc's
+options), the walk of those balls alone (the compiled ``_connected_members``
+over every vertex, nothing fitted), and the ball sums over ``r``
+(:func:`meshcurv.neighborhoods.ball_face_sums`, ``connected=True``); CPU
+seconds, the median of ``--repeats`` after a warm-up (``--fit-scales 3,6,12``: the
+fits of ``multiscale_curvatures`` at ``h, 2 h, 4 h``)::
+
+    .venv/bin/python benchmarks/profile_call.py --sizes 100k,1M --walks --fit-scales 3,6,12
 """
 
 from __future__ import annotations
@@ -172,6 +184,83 @@ def table(results) -> str:
     return "\n".join(lines)
 
 
+def _median_cpu(call, repeats: int) -> float:
+    call()  # warm-up: compilation, pages touched
+    seconds = []
+    for _ in range(repeats):
+        cpu = time.process_time()
+        call()
+        seconds.append(time.process_time() - cpu)
+    return float(np.median(seconds))
+
+
+def _walk_kernel():
+    """A compiled pass of ``_connected_members`` (the normal fits' walk) over every vertex, nothing fitted."""
+    import numba
+
+    from meshcurv._kernels.neighborhoods import _connected_members
+
+    @numba.njit(parallel=True, cache=False)
+    def walk_all(vertices, indptr, indices, allowed, radius, n_chunks):
+        n = vertices.shape[0]
+        found = np.zeros(n_chunks, np.int64)
+        for chunk in numba.prange(n_chunks):
+            mark = np.full(n, -1, np.int64)
+            members = np.empty(n, np.int64)
+            queue = np.empty(n, np.int64)
+            for v in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
+                found[chunk] += _connected_members(vertices, indptr, indices, allowed, v, radius, mark, v, members,
+                                                   queue)
+        return found.sum()
+
+    return walk_all
+
+
+def walks(label: str, repeats: int, scales=(3.0,)) -> list[tuple]:
+    """``(name, n_vertices, radius / h, fit radius / r, members per fit ball, fits s, walk s, sums s)`` (CPU
+    seconds), one row per normal-fit radius ``scale * r`` (the sums at ``r`` timed once, in the first row)."""
+    from meshcurv.estimators import icc
+    from meshcurv.jets import NORMAL_MIN_SPREAD, fit_jet_normals
+    from meshcurv.measures import face_measures
+    from meshcurv.neighborhoods import ball_face_sums
+
+    n = SIZES[label]
+    mesh = meshcurv.shapes.icosphere(n)
+    v = np.ascontiguousarray(mesh.vertices)
+    f = np.ascontiguousarray(mesh.faces, dtype=np.int64)
+    radius = float(meshcurv.principal_curvatures(v, f).parameters["radius"])
+    topology = meshcurv.MeshTopology.from_faces(f)
+    h = meshcurv.geometry.mean_edge_length(v, topology.edges)
+    adjacency = topology.neighbour_lists
+    normals = v / np.linalg.norm(v, axis=1, keepdims=True)
+    walk_all = _walk_kernel()
+    allowed = np.ones(v.shape[0], dtype=bool)
+    measures = face_measures(v, f, normals)
+    sums = _median_cpu(lambda: ball_face_sums(v, f, radius, measures, connected=True), repeats)
+    rows = []
+    for scale in scales:
+        fit_radius = scale * radius
+        fits = _median_cpu(lambda: fit_jet_normals(v, normals, fit_radius, degree=icc.NORMAL_DEGREE,
+                                                   iterations=icc.NORMAL_ITERATIONS, adjacency=adjacency,
+                                                   settled=icc.NORMAL_SETTLED, min_spread=NORMAL_MIN_SPREAD),
+                           repeats)
+        members = walk_all(v, *adjacency, allowed, fit_radius, _threads()) / v.shape[0]
+        walk = _median_cpu(lambda: walk_all(v, *adjacency, allowed, fit_radius, _threads()), repeats)
+        rows.append((f"icosphere({n})", v.shape[0], radius / h, scale, members, fits, walk, sums if not rows else None))
+    return rows
+
+
+def walks_table(results) -> str:
+    lines = [f"CPU s, median of the calls after a warm-up; {_threads()} threads; load average {load()}", "",
+             "| mesh | vertices | r / h | fit radius / r | vertices per fit ball | normal fits | their walk alone | "
+             "walk / fits | ball sums (r) |", "|---|--:|--:|--:|--:|--:|--:|--:|--:|"]
+    for name, n_vertices, ratio, scale, members, fits, walk, sums in results:
+        summed = "" if sums is None else f"{sums:.3f}"
+        lines.append(f"| {name} | {n_vertices:,} | {ratio:.2f} | {scale:g} | {members:.1f} | {fits:.3f} | "
+                     f"{walk:.3f} | {walk / fits:.0%} | {summed} |")
+    return "\n".join(lines)
+
+
 TIMERS = Timers()
 
 
@@ -180,7 +269,16 @@ def main(argv=None) -> int:
     parser.add_argument("--sizes", default="100k,1M,4M")
     parser.add_argument("--repeats", type=int, default=3, help="calls per size (the median by wall time is shown)")
     parser.add_argument("--markdown", help="write the table to this file")
+    parser.add_argument("--walks", action="store_true",
+                        help="only the table of the walks inside the kernels (see the module's doc)")
+    parser.add_argument("--fit-scales", default="3",
+                        help="with --walks: the radii of the normal fits, in units of r (icc: 3; multiscale "
+                             "h, 2h, 4h: 3,6,12)")
     args = parser.parse_args(argv)
+    if args.walks:
+        scales = [float(scale) for scale in args.fit_scales.split(",")]
+        print(walks_table([row for label in args.sizes.split(",") for row in walks(label, args.repeats, scales)]))
+        return 0
     install(TIMERS)
     start_load = load()
     results = []
