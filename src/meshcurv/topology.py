@@ -294,8 +294,18 @@ class MeshTopology:
         return _readonly(indptr), _readonly(indices)
 
     def smoothing_lists(self, steps: int) -> tuple[np.ndarray, np.ndarray]:
-        """:attr:`neighbour_lists` for ``steps`` passes of a 1-ring smoothing: empty lists when ``steps`` is 0
-        (none built)."""
+        """The neighbour lists that ``steps`` passes of a 1-ring smoothing read.
+
+        Parameters
+        ----------
+        steps : int
+            Number of smoothing passes.
+
+        Returns
+        -------
+        offsets, neighbours : numpy.ndarray
+            :attr:`neighbour_lists` when ``steps`` is positive; empty lists (none built) when it is 0.
+        """
         if steps > 0:
             return self.neighbour_lists
         return np.zeros(self.n_vertices + 1, np.int64), np.zeros(0, np.int64)
