@@ -168,20 +168,28 @@ def main(argv=None) -> int:
     parser.add_argument("--cold", type=int, default=1, help="cold processes (each on an empty cache)")
     parser.add_argument("--warm", type=int, default=5, help="warm processes (after one untimed)")
     parser.add_argument("--output", default=None, help="write the markdown there (default: stdout only)")
-    parser.add_argument("--all-methods", action="store_true",
-                        help="also every method's first call in one more cold process (about a minute of CPU)")
+    parser.add_argument(
+        "--all-methods",
+        action="store_true",
+        help="also every method's first call in one more cold process (about a minute of CPU)",
+    )
     args = parser.parse_args(argv)
 
-    lines = [f"Generated {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC by "
-             f"`python benchmarks/compile_start.py {' '.join(argv if argv is not None else sys.argv[1:])}`".rstrip(),
-             "", f"Machine: {platform.machine()}, {os.cpu_count()} CPUs, Python {platform.python_version()}; "
-             f"mesh {args.mesh}.", ""]
+    lines = [
+        f"Generated {time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC by "
+        f"`python benchmarks/compile_start.py {' '.join(argv if argv is not None else sys.argv[1:])}`".rstrip(),
+        "",
+        f"Machine: {platform.machine()}, {os.cpu_count()} CPUs, Python {platform.python_version()}; mesh {args.mesh}.",
+        "",
+    ]
     import numba
     import numpy
 
     source = os.environ.get("PYTHONPATH")
-    lines.append(f"numba {numba.__version__}, numpy {numpy.__version__}; meshcurv "
-                 f"{'from PYTHONPATH=' + source if source else 'as installed'}.")
+    lines.append(
+        f"numba {numba.__version__}, numpy {numpy.__version__}; meshcurv "
+        f"{'from PYTHONPATH=' + source if source else 'as installed'}."
+    )
     lines.append("")
     colds = []
     caches = []
@@ -219,11 +227,14 @@ def _cold_report(lines: list[str], colds: list) -> None:
     lines.append("| run | compile CPU s (numba events) | first call CPU s | process CPU s | process wall s | load |")
     lines.append("|--:|--:|--:|--:|--:|--:|")
     for k, (data, wall, cpu, load) in enumerate(colds):
-        lines.append(f"| {k + 1} | {data['compile_cpu']:.2f} | {data['call_cpu']:.2f} | {cpu:.2f} | {wall:.1f} | "
-                     f"{load:.1f} |")
+        lines.append(
+            f"| {k + 1} | {data['compile_cpu']:.2f} | {data['call_cpu']:.2f} | {cpu:.2f} | {wall:.1f} | {load:.1f} |"
+        )
     lines.append("")
-    lines.append("Each function compiled in the first cold run (bold: compiled at a call from Python; the others "
-                 "inside their caller's compilation); functions under 0.05 s alone left out:")
+    lines.append(
+        "Each function compiled in the first cold run (bold: compiled at a call from Python; the others "
+        "inside their caller's compilation); functions under 0.05 s alone left out:"
+    )
     lines.append("")
     lines.extend(_kernels_table(colds[0][0]["records"]))
     lines.append("")
@@ -235,8 +246,10 @@ def _all_methods_report(args, lines: list[str]) -> None:
         cpu = _child(ALL, args.mesh, _environment(cache))[0]
     finally:
         shutil.rmtree(cache, ignore_errors=True)
-    lines.append("Every method's first call, in the order of `meshcurv.METHODS`, in one more fresh process on an "
-                 "empty cache (CPU s; a method finds compiled the kernels it shares with those before it):")
+    lines.append(
+        "Every method's first call, in the order of `meshcurv.METHODS`, in one more fresh process on an "
+        "empty cache (CPU s; a method finds compiled the kernels it shares with those before it):"
+    )
     lines.append("")
     lines.append("| " + " | ".join(cpu) + " | all |")
     lines.append("|" + "--:|" * (len(cpu) + 1))
@@ -251,8 +264,10 @@ def _warm_report(args, lines: list[str], env: dict) -> None:
     lines.append("")
     lines.append("| | median | runs |")
     lines.append("|---|--:|---|")
-    rows = [("process wall s (whole process)", [w for _, w, _, _ in warms]),
-            ("process CPU s (user + system)", [c for _, _, c, _ in warms])]
+    rows = [
+        ("process wall s (whole process)", [w for _, w, _, _ in warms]),
+        ("process CPU s (user + system)", [c for _, _, c, _ in warms]),
+    ]
     for key in ("import", "read", "first call", "second call"):
         rows.append((f"{key} wall s (inside)", [d[key] for d, _, _, _ in warms]))
     for label, values in rows:
@@ -260,8 +275,10 @@ def _warm_report(args, lines: list[str], env: dict) -> None:
     lines.append(f"| load average (1 min) | {statistics.median(load for *_, load in warms):.1f} | |")
     lines.append("")
     parts = [_child(PARTS, args.mesh, env)[0] for _ in range(3)]
-    lines.append("Where the warm process's time goes (wall s inside the process, median of 3 more processes; "
-                 "numba imported and its registries loaded before the call, then each load from the cache timed):")
+    lines.append(
+        "Where the warm process's time goes (wall s inside the process, median of 3 more processes; "
+        "numba imported and its registries loaded before the call, then each load from the cache timed):"
+    )
     lines.append("")
     lines.append("| stage | median | runs |")
     lines.append("|---|--:|---|")

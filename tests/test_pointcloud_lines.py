@@ -45,8 +45,9 @@ def scanned_sphere(along=0.02, ratio=10, latitude=1.2, seed=0):
     for theta in np.arange(np.pi / 2 - latitude, np.pi / 2 + latitude, ratio * along):
         count = int(2 * np.pi * np.sin(theta) / along)
         phi = (np.arange(count) + rng.random()) * 2 * np.pi / count
-        rings.append(np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi),
-                               np.full(count, np.cos(theta))], axis=1))
+        rings.append(
+            np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.full(count, np.cos(theta))], axis=1)
+        )
     return np.concatenate(rings)
 
 
@@ -163,5 +164,7 @@ def test_a_plate_as_thick_as_its_noise_is_invalid_not_wrong(method, noise, monke
     faces = np.hypot(points[:, 0], points[:, 1]) < 2.0
     # exact |H| on the faces below c / 9 / (1 - 4 / 9)^(3/2) < 0.01; no valid point off by 0.1
     assert not (r.valid & faces & (np.abs(r.mean) > 0.1)).any()
-    assert (r.invalid_reason[~r.valid] != next(code for code, text in enumerate(INVALID_REASONS)
-                                               if text.startswith("estimate undefined"))).mean() > 0.9
+    assert (
+        r.invalid_reason[~r.valid]
+        != next(code for code, text in enumerate(INVALID_REASONS) if text.startswith("estimate undefined"))
+    ).mean() > 0.9

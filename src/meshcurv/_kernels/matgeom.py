@@ -125,8 +125,14 @@ def _ring_sums6(current, indptr, indices, i):
 @nb.njit(inline="always", **_JIT)
 def _principal_row(i, t0, t1, t2, t3, t4, t5, c1, c2, u1, u2, normal):
     """Row ``i`` of :func:`matgeom_principal` from the tensor ``(t0, ..., t5)`` (xx, yy, zz, xy, xz, yz)."""
-    if not (math.isfinite(t0) and math.isfinite(t1) and math.isfinite(t2) and math.isfinite(t3)
-            and math.isfinite(t4) and math.isfinite(t5)):
+    if not (
+        math.isfinite(t0)
+        and math.isfinite(t1)
+        and math.isfinite(t2)
+        and math.isfinite(t3)
+        and math.isfinite(t4)
+        and math.isfinite(t5)
+    ):
         c1[i] = c2[i] = np.nan
         for k in range(3):
             u1[i, k] = u2[i, k] = normal[i, k] = np.nan
@@ -162,8 +168,20 @@ def matgeom_principal(tensors):
     n = tensors.shape[0]
     c1, c2, u1, u2, normal = np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     for i in nb.prange(n):
-        _principal_row(i, tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4], tensors[i, 5],
-                       c1, c2, u1, u2, normal)
+        _principal_row(
+            i,
+            tensors[i, 0],
+            tensors[i, 1],
+            tensors[i, 2],
+            tensors[i, 3],
+            tensors[i, 4],
+            tensors[i, 5],
+            c1,
+            c2,
+            u1,
+            u2,
+            normal,
+        )
     return c1, c2, u1, u2, normal
 
 
@@ -187,16 +205,29 @@ def matgeom_finish(tensors, indptr, indices, steps):
         for i in nb.prange(n):
             t0, t1, t2, t3, t4, t5, scale = _ring_sums6(current, indptr, indices, i)
             if last:
-                _principal_row(i, t0 * scale, t1 * scale, t2 * scale, t3 * scale, t4 * scale, t5 * scale,
-                               c1, c2, u1, u2, normal)
+                _principal_row(
+                    i, t0 * scale, t1 * scale, t2 * scale, t3 * scale, t4 * scale, t5 * scale, c1, c2, u1, u2, normal
+                )
             else:
                 following[i, 0], following[i, 1], following[i, 2] = t0 * scale, t1 * scale, t2 * scale
                 following[i, 3], following[i, 4], following[i, 5] = t3 * scale, t4 * scale, t5 * scale
         current, following = following, current
     if steps == 0:
         for i in nb.prange(n):
-            _principal_row(i, tensors[i, 0], tensors[i, 1], tensors[i, 2], tensors[i, 3], tensors[i, 4],
-                           tensors[i, 5], c1, c2, u1, u2, normal)
+            _principal_row(
+                i,
+                tensors[i, 0],
+                tensors[i, 1],
+                tensors[i, 2],
+                tensors[i, 3],
+                tensors[i, 4],
+                tensors[i, 5],
+                c1,
+                c2,
+                u1,
+                u2,
+                normal,
+            )
     return c1, c2, u1, u2, normal
 
 
