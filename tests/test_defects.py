@@ -211,3 +211,22 @@ def test_a_flung_pair_leaves_the_rest_of_a_sphere_right(method):
     rest[corners] = False
     assert result.valid[rest].mean() > 0.9
     assert np.abs(result.mean[rest & result.valid] - 1.0).max() < 0.1
+
+
+def test_normal_cycle_ball_leaves_a_ball_without_a_neighbour_undefined():
+    # radius 0.02 on the 200-point random sphere (0.07 of an edge): 83 of 200 vertices were valid and off
+    # by more than half the curvature (fuzz_api seed 41, case 7032); a ball holding no neighbour holds only
+    # the vertex's corner
+    sphere = shapes.random_sphere(n_vertices=200)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball",
+                                               radius=0.02)
+    topology = MeshTopology.from_faces(sphere.faces)
+    lengths = np.linalg.norm(sphere.vertices[topology.edges[:, 0]] - sphere.vertices[topology.edges[:, 1]], axis=1)
+    near = np.zeros(len(sphere.vertices), dtype=bool)
+    near[topology.edges[lengths < 0.02].ravel()] = True
+    assert not result.valid[~near].any()
+    assert (np.array(INVALID_REASONS)[result.invalid_reason[~near]] == INVALID_REASONS[UNDEFINED]).all()
+    # the default radius (2.5 mean edges) keeps every vertex
+    assert meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball").valid.all()

@@ -27,7 +27,10 @@ edges of zero-area faces have no dihedral angle and add nothing; the area
 stops at the boundary as well, so boundary vertices keep a (one-sided) estimate.
 The faces of a needle vertex (a vertex flung far away,
 :func:`meshcurv.defects.needle_vertices`) and the edges between their corners
-add nothing either: the balls around them stop there as at a boundary.
+add nothing either: the balls around them stop there as at a boundary. A
+vertex whose ball holds none of its neighbours (a given radius below its
+shortest edge) holds only its own corner: it is undefined (NaN, "estimate
+undefined"), not the cone of the polyhedron at the vertex.
 
 References
 ----------
@@ -90,6 +93,15 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
 
     stages.start("retrieve curvatures")
     valid &= areas > 0
+    # a ball that holds none of the vertex's neighbours holds only its own corner: the polyhedron's cone at
+    # the vertex, not the surface (a given radius far below the edges; issue 29): undefined
+    radii = vertex_radii(groups, vertices.shape[0])
+    first, second = topology.edges[:, 0], topology.edges[:, 1]
+    lengths = np.linalg.norm(np.take(vertices, second, axis=0) - np.take(vertices, first, axis=0), axis=1)
+    near = np.zeros(vertices.shape[0], dtype=bool)
+    near[first[lengths < radii[first]]] = True
+    near[second[lengths < radii[second]]] = True
+    valid &= near
     with np.errstate(invalid="ignore", divide="ignore"):
         tensors = measures / areas[:, None]
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
@@ -100,4 +112,4 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
     return finish("normal_cycle_ball", parameters, valid, normals, k_min, k_max, dir_min, dir_max,
-                  defects, radius=vertex_radii(groups, vertices.shape[0]))
+                  defects, radius=radii)
