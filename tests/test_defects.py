@@ -9,8 +9,15 @@ import pytest
 
 import meshcurv
 from meshcurv import shapes
-from meshcurv.defects import (DEFECTS, INVALID_REASONS, NEEDLE_ANGLE, NEEDLE_REACH, UNDEFINED, defect_codes,
-                              needle_vertices)
+from meshcurv.defects import (
+    DEFECTS,
+    INVALID_REASONS,
+    NEEDLE_ANGLE,
+    NEEDLE_REACH,
+    UNDEFINED,
+    defect_codes,
+    needle_vertices,
+)
 from meshcurv.errors import MeshQualityWarning
 from meshcurv.geometry import degenerate_faces, vertex_length_scales
 from meshcurv.topology import MeshTopology
@@ -47,6 +54,7 @@ def _pyramid(n: int, height: float):
 
 # --- the code table -----------------------------------------------------------------------------
 
+
 def test_each_defect_reads_its_own_reason():
     assert all(INVALID_REASONS[defect.code] == defect.reason for defect in DEFECTS)
     assert INVALID_REASONS[0] == "valid" and UNDEFINED == len(INVALID_REASONS) - 1
@@ -70,6 +78,7 @@ def test_defect_codes_of_the_connectivity_alone_count_no_needle():
 
 
 # --- what a needle vertex is ------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("factor, needle", [(0.9, True), (1.1, False)])
 def test_the_apex_of_a_pyramid_is_a_needle_below_the_angle(factor, needle):
@@ -98,19 +107,34 @@ def test_long_edges_around_a_full_fan_make_no_needle():
 def test_a_sliver_of_short_edges_is_no_needle():
     # a flat strip with one sliver at its end: corner angle 0.5 degrees, but edges of a median edge
     xs = np.arange(11.0)
-    vertices = np.vstack([np.column_stack([xs, np.zeros(11), np.zeros(11)]),
-                          np.column_stack([xs, np.ones(11), np.zeros(11)]), [[11.0, np.tan(np.radians(0.5)), 0.0]]])
+    vertices = np.vstack(
+        [
+            np.column_stack([xs, np.zeros(11), np.zeros(11)]),
+            np.column_stack([xs, np.ones(11), np.zeros(11)]),
+            [[11.0, np.tan(np.radians(0.5)), 0.0]],
+        ]
+    )
     quads = [(i, i + 1, 12 + i, 11 + i) for i in range(10)]
     faces = np.array([f for a, b, c, d in quads for f in ((a, b, c), (a, c, d))] + [(10, 22, 21)])
     assert not _needles(vertices, faces).any()
 
 
-@pytest.mark.parametrize("mesh", [
-    shapes.icosphere(8), shapes.uv_sphere(24, 12), shapes.torus(), shapes.ellipsoid(subdivisions=8),
-    shapes.cylinder(), shapes.saddle(spacing=0.1, jitter=0.3), shapes.random_sphere(500),
-    shapes.hemisphere(8, irregular=True), shapes.with_normal_noise(shapes.icosphere(8), 0.3),
-    shapes.voxel_sphere(6.0),
-], ids=lambda mesh: getattr(mesh, "name", "mesh"))
+@pytest.mark.parametrize(
+    "mesh",
+    [
+        shapes.icosphere(8),
+        shapes.uv_sphere(24, 12),
+        shapes.torus(),
+        shapes.ellipsoid(subdivisions=8),
+        shapes.cylinder(),
+        shapes.saddle(spacing=0.1, jitter=0.3),
+        shapes.random_sphere(500),
+        shapes.hemisphere(8, irregular=True),
+        shapes.with_normal_noise(shapes.icosphere(8), 0.3),
+        shapes.voxel_sphere(6.0),
+    ],
+    ids=lambda mesh: getattr(mesh, "name", "mesh"),
+)
 def test_no_analytic_surface_has_a_needle(mesh):
     assert not _needles(mesh.vertices, mesh.faces).any()
 
@@ -129,6 +153,7 @@ def test_cad_meshes_with_long_slivers_have_no_needle():
 
 
 # --- every method leaves a needle vertex undefined, with its reason ------------------------------
+
 
 @pytest.mark.parametrize("method", meshcurv.METHODS)
 @pytest.mark.parametrize("distance", [30.0, 1e40])
@@ -200,10 +225,17 @@ def test_two_neighbours_flung_together_are_needles(method, distance):
     assert not result.valid[pair].any() and (result.invalid_reason[corners] == NEEDLE).all()
 
 
-@pytest.mark.parametrize("method", [
-    "normal_cycle", "meyer", "rusinkiewicz", "quadric", "normal_cycle_ball",
-    "icc",  # its local scale counts no needle edge, its fits and sums no sliver (estimators/icc.py, helper S)
-])
+@pytest.mark.parametrize(
+    "method",
+    [
+        "normal_cycle",
+        "meyer",
+        "rusinkiewicz",
+        "quadric",
+        "normal_cycle_ball",
+        "icc",  # its local scale counts no needle edge, its fits and sums no sliver (estimators/icc.py, helper S)
+    ],
+)
 def test_a_flung_pair_leaves_the_rest_of_a_sphere_right(method):
     vertices, faces, _, corners = _flung_pair(1e3)
     result, _ = _compute(vertices, faces, method)
@@ -220,8 +252,7 @@ def test_normal_cycle_ball_leaves_a_ball_without_a_neighbour_undefined():
     sphere = shapes.random_sphere(n_vertices=200)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshQualityWarning)
-        result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball",
-                                               radius=0.02)
+        result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball", radius=0.02)
     topology = MeshTopology.from_faces(sphere.faces)
     lengths = np.linalg.norm(sphere.vertices[topology.edges[:, 0]] - sphere.vertices[topology.edges[:, 1]], axis=1)
     near = np.zeros(len(sphere.vertices), dtype=bool)

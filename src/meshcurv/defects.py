@@ -294,9 +294,19 @@ class VertexDefects:
     tolerated: frozenset = frozenset()
 
     def needle_cells(self, cells: np.ndarray) -> np.ndarray | None:
-        """(C,) bool: the edges or faces (``cells``, (C, k) vertex indices) all of whose vertices carry the
-        needle code (a needle's faces, and the edges between its corners, whose dihedral angles are those
-        of its slivers), or None when the mesh has no needle vertex."""
+        """The edges or faces all of whose vertices carry the needle code.
+
+        Parameters
+        ----------
+        cells : numpy.ndarray
+            (C, k) vertex indices: edges (k = 2) or faces (k = 3).
+
+        Returns
+        -------
+        numpy.ndarray or None
+            (C,) bool: a needle's faces, and the edges between its corners (whose dihedral angles are those
+            of its slivers); None when the mesh has no needle vertex.
+        """
         needle = self.codes == NEEDLE
         if not needle.any():
             return None
