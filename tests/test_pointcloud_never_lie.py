@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from meshcurv import _pointcloud_normals as normals_module
-from meshcurv.errors import MeshQualityWarning
+from meshcurv.errors import InvalidMeshError, MeshQualityWarning
 from meshcurv.pointcloud import COPY_GAP, POINT_CLOUD_METHODS, point_cloud_curvatures
 from meshcurv.result import INVALID_REASONS
 
@@ -378,3 +378,27 @@ def test_a_plate_thinner_than_the_spacing_beside_a_coarser_part_is_never_inward_
     assert inward.sum() <= 10
     assert r.valid[~on_plate].mean() > 0.95
     assert np.median(r.mean[~on_plate][r.valid[~on_plate]]) == pytest.approx(1.0, rel=0.05)
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_a_sphere_at_1e75_gives_the_curvatures_of_the_unit_sphere_scaled(backend):
+    # fuzz seed 41 case 5535: the NumPy test of flat balls overflowed (RuntimeWarnings are errors here); and
+    # the compiled PCA normals' rank test overflowed from 1e60 on (75% of the points invalid, the rest 27% off);
+    # scaling the points by s scales the curvatures by 1/s and changes nothing else
+    from meshcurv._backend import use_backend
+
+    points = sphere(800, seed=3)
+    with use_backend(backend):
+        unit, big = quiet(points), quiet(points * 1e75)
+    np.testing.assert_array_equal(big.valid, unit.valid)
+    assert unit.valid.mean() > 0.9
+    np.testing.assert_allclose(big.mean[big.valid] * 1e75, unit.mean[unit.valid], rtol=1e-6)
+
+
+def test_a_cloud_whose_bulk_is_below_the_smallest_scale_is_refused_before_any_work():
+    # fuzz seed 42 case 996: an outlier at 1e75 let a cloud of scale 1e-125 through the check of the largest
+    # coordinate; the refusal came late, after RuntimeWarnings of the orientation
+    points = sphere(400, seed=4) * 1e-125
+    points[7] = (1e75, 0.0, 0.0)
+    with pytest.raises(InvalidMeshError, match=r"90% of the coordinates are below 9.*e-126 .*rescale the points"):
+        point_cloud_curvatures(points)

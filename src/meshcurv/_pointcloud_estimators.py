@@ -280,6 +280,8 @@ def _flat_balls(points, centres, index, counts) -> np.ndarray:
     column = np.arange(0, index.shape[1], stride)
     member = column[None, :] < counts[:, None]
     offsets = points[np.where(member, index[:, column], centres[:, None])] - points[centres][:, None, :]
+    scale = np.abs(offsets).max(axis=(1, 2))  # each ball in units of its extent: no overflow at 1e75, no underflow
+    offsets /= np.where(scale > 0, scale, 1.0)[:, None, None]
     covariance = np.einsum("mki,mkj->mij", offsets, offsets)
     direction = offsets[np.arange(index.shape[0]), np.argmax(np.einsum("mkj,mkj->mk", offsets, offsets), axis=1)]
     for _ in range(SUPPORT_ITERATIONS):

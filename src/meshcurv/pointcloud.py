@@ -104,7 +104,7 @@ import numpy as np
 from . import _pointcloud_estimators as _estimators
 from . import _pointcloud_normals as _normals
 from ._adapters import point_array
-from ._validation import as_vertices, check_choice, check_positive_float
+from ._validation import MIN_COORDINATE, as_vertices, check_choice, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .radius import CLOUD_EXTENT_CAP, CLOUD_RADIUS_RULES, cloud_noise_level, cloud_radius, noise_rule
 from .result import INVALID_REASONS, CurvatureResult
@@ -485,8 +485,14 @@ def _representatives(points: np.ndarray) -> np.ndarray:
 
 
 def _check_spread(cloud: np.ndarray) -> None:
-    """Refuse a cloud whose points all lie on one line (no surface through them)."""
+    """Refuse a cloud whose points all lie on one line (no surface through them), or whose bulk lies below
+    the smallest scale the estimators take (a few far outliers pass the check of the largest coordinate)."""
     sample = cloud[np.linspace(0, cloud.shape[0] - 1, min(cloud.shape[0], 100_000)).round().astype(np.int64)]
+    bulk = float(np.quantile(np.abs(sample), 0.9))
+    if 0.0 < bulk < MIN_COORDINATE:
+        raise InvalidMeshError(
+            f"`points`: 90% of the coordinates are below {bulk:.3g} (the few larger ones are outliers); products "
+            f"of four lengths (squared areas) would underflow float64 below {MIN_COORDINATE:.0e}: rescale the points")
     centred = sample - sample.mean(axis=0)
     singular = np.linalg.svd(centred, compute_uv=False)
     if singular[1] <= 1e-9 * singular[0]:

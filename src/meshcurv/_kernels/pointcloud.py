@@ -122,9 +122,15 @@ def flat_balls(points, centres, index, counts, stride, iterations, offset, share
         xx = xy = xz = yy = yz = zz = 0.0
         far, ux, uy, uz = 0.0, 0.0, 0.0, 0.0
         members = 0
+        scale = 0.0  # the ball in units of its extent (as the NumPy path): no overflow at 1e75, no underflow
         for a in range(0, min(counts[row], k), stride):
             j = index[row, a]
-            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+            scale = max(scale, abs(points[j, 0] - px), abs(points[j, 1] - py), abs(points[j, 2] - pz))
+        if scale == 0.0:
+            scale = 1.0
+        for a in range(0, min(counts[row], k), stride):
+            j = index[row, a]
+            dx, dy, dz = (points[j, 0] - px) / scale, (points[j, 1] - py) / scale, (points[j, 2] - pz) / scale
             xx, xy, xz, yy, yz, zz = _add_outer(xx, xy, xz, yy, yz, zz, dx, dy, dz)
             d = dx * dx + dy * dy + dz * dz
             if d > far:
@@ -138,7 +144,7 @@ def flat_balls(points, centres, index, counts, stride, iterations, offset, share
         limit = offset * offset * far
         for a in range(0, min(counts[row], k), stride):
             j = index[row, a]
-            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+            dx, dy, dz = (points[j, 0] - px) / scale, (points[j, 1] - py) / scale, (points[j, 2] - pz) / scale
             along = dx * ux + dy * uy + dz * uz
             if dx * dx + dy * dy + dz * dz - along * along > limit:
                 beside += 1
@@ -162,6 +168,9 @@ def pca_normals(points, indices):
     out = np.zeros((n, 3))
     for i in nb.prange(n):
         xx, xy, xz, yy, yz, zz = _covariance(points, indices, i)
+        trace = xx + yy + zz  # in units of its trace: the rank test below squares squared rows (1e60^8 overflows)
+        if trace > 0:
+            xx, xy, xz, yy, yz, zz = xx / trace, xy / trace, xz / trace, yy / trace, yz / trace, zz / trace
         off = xy * xy + xz * xz + yz * yz
         mean = (xx + yy + zz) / 3
         spread = np.sqrt(((xx - mean) ** 2 + (yy - mean) ** 2 + (zz - mean) ** 2 + 2 * off) / 6)
