@@ -120,14 +120,14 @@ def batch_summary():
 def speed():
     """speed.md: seconds per call at 1M vertices, from the last run of benchmarks/speed.md."""
     names = ["icc (default)", "normal_cycle", "matgeom", "libigl", "MeshLab quadric", "VTK (H, K)", "trueform"]
-    seconds = [2.38, 0.78, 0.91, 17.6, 5.4, 0.88, 0.55]
+    seconds = [4.34, 1.35, 1.35, 14.9, 5.49, 0.823, 0.784]  # CPU s, benchmarks/speed.md at 02c995b
     fig = _figure(6.4, 3.4)
     axis = fig.add_subplot()
     colours = ["tab:blue"] * 3 + ["tab:grey"] * 4
     axis.barh(names[::-1], seconds[::-1], color=colours[::-1])
     axis.set_xscale("log")
     axis.set_xlim(0.3, 60)
-    axis.set_xlabel("seconds (log scale), icosphere of 1M vertices, 2 cores")
+    axis.set_xlabel("CPU seconds (log scale), icosphere of 1M vertices, one run")
     axis.set_title("meshcurv (blue) and the peers (grey): benchmarks/speed.md")
     for y, value in enumerate(seconds[::-1]):
         axis.text(value * 1.05, y, f"{value:g} s", va="center", fontsize=8)
