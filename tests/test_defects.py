@@ -261,3 +261,27 @@ def test_normal_cycle_ball_leaves_a_ball_without_a_neighbour_undefined():
     assert (np.array(INVALID_REASONS)[result.invalid_reason[~near]] == INVALID_REASONS[UNDEFINED]).all()
     # the default radius (2.5 mean edges) keeps every vertex
     assert meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball").valid.all()
+
+
+@pytest.mark.parametrize(
+    "mesh",
+    [shapes.icosphere(12), shapes.voxel_sphere(6.0), shapes.with_normal_noise(shapes.icosphere(8), 0.3, seed=2)],
+    ids=["icosphere", "voxel", "noisy"],
+)
+@pytest.mark.parametrize("factor", [1.0, 1e3, 1e40])
+def test_needle_vertices_are_the_same_on_both_backends(mesh, factor):
+    # the compiled long-edge pass (diagnosis.long_edges) and the NumPy path find the same needles
+    from meshcurv._backend import numba_kernels, use_backend
+
+    if numba_kernels("diagnosis") is None:
+        pytest.skip("numba is not installed")
+    vertices = mesh.vertices.copy()
+    vertices[5] *= factor
+    topology = MeshTopology.from_faces(mesh.faces)
+    scales = vertex_length_scales(vertices, topology)
+    with use_backend("numpy"):
+        expected = needle_vertices(vertices, topology, scales)
+    with use_backend("numba"):
+        got = needle_vertices(vertices, topology, scales)
+    np.testing.assert_array_equal(got, expected)
+    assert got[5] == (factor > 1)

@@ -60,3 +60,16 @@ def mesh_facts(vertices, faces, edges, referenced, scales, area_ratio, zero_leng
         six_volume += ((vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny
                        + (vertices[a, 2] - centre[2]) * nz)
     return lower, upper, area, six_volume, mean, n_degenerate, n_zero_length
+
+
+@nb.njit(**_JIT)
+def long_edges(vertices, edges, reach):
+    """(E,) bool: the edges longer than the smaller ``reach`` of their two ends (the NumPy path of
+    :func:`meshcurv.defects.needle_vertices`: the same squared lengths, x + y + z in that order)."""
+    out = np.empty(edges.shape[0], dtype=np.bool_)
+    for e in range(edges.shape[0]):
+        a, b = edges[e, 0], edges[e, 1]
+        dx, dy, dz = vertices[b, 0] - vertices[a, 0], vertices[b, 1] - vertices[a, 1], vertices[b, 2] - vertices[a, 2]
+        r = min(reach[a], reach[b])
+        out[e] = dx * dx + dy * dy + dz * dz > r * r
+    return out
