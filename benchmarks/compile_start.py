@@ -32,7 +32,7 @@ import tempfile
 import time
 from pathlib import Path
 
-MESH = "/work/shared/meshes/spot.obj"
+MESH = str(Path(__file__).resolve().parents[2] / "shared" / "meshes" / "spot.obj")  # ../shared beside the repository
 
 COLD = r"""
 import json, sys, time
