@@ -9,7 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ._common import _JIT
+from ._common import _JIT, run_chunks, threaded
 from .topology import _BUCKET_CHUNKS, _bucket_starts
 
 
@@ -517,16 +517,27 @@ def connected_face_sums_nested(vertices, faces, centroids, reach, usable, values
                     out[r, v, k] = total[r, k]
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def cell_centres(vertices, cells):
     """``neighborhoods._ball_sums``'s (C, 3) centroids of cells (faces or edges) and (C,) their reach.
 
-    The reach is the largest distance from the centroid to a corner.
+    The reach is the largest distance from the centroid to a corner. The cells
+    run in ranges (:func:`_centres_chunk`) on threads
+    (:func:`~meshcurv._kernels._common.run_chunks`); each cell's sums are its own,
+    in the same order whatever the ranges.
     """
-    n, corners = cells.shape
+    n = cells.shape[0]
     centres = np.zeros((n, 3))
     reach = np.zeros(n)
-    for c in nb.prange(n):
+    run_chunks(_centres_chunk, n, 4 * nb.get_num_threads(), vertices, cells, centres, reach)
+    return centres, reach
+
+
+@nb.njit(**_JIT)
+def _centres_chunk(lo, hi, vertices, cells, centres, reach):
+    """:func:`cell_centres` of the cells ``lo`` to ``hi - 1``, written to ``centres`` and ``reach``."""
+    corners = cells.shape[1]
+    for c in range(lo, hi):
         for k in range(corners):
             for a in range(3):
                 centres[c, a] += vertices[cells[c, k], a]
@@ -537,7 +548,6 @@ def cell_centres(vertices, cells):
             for a in range(3):
                 d += (vertices[cells[c, k], a] - centres[c, a]) ** 2
             reach[c] = max(reach[c], math.sqrt(d))
-    return centres, reach
 
 
 @nb.njit(parallel=True, **_JIT)
