@@ -17,32 +17,49 @@ from .topology import _BUCKET_CHUNKS, _bucket_starts
 _GRID_COLUMNS_PER_POINT = 4
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def vertex_face_lists(faces, n_vertices, n_chunks):
     """CSR lists of the faces around every vertex: ``(indptr, indices)``, faces in index order.
 
-    Each of ``n_chunks`` threads (at most :data:`~meshcurv._kernels.topology._BUCKET_CHUNKS`)
-    counts, then places, the corners of its own range of faces: a vertex's list holds the
+    Each of ``n_chunks`` ranges of faces (at most :data:`~meshcurv._kernels.topology._BUCKET_CHUNKS`)
+    counts, then places, the corners of its own faces, on threads (:func:`_count_corners`,
+    :func:`_place_corners`, :func:`~meshcurv._kernels._common.run_chunks`): a vertex's list holds the
     faces of the first range, then of the next, each in face order (the order of one pass
     over all faces, whatever the number of threads), as ``topology.build_edges`` places its sides.
     """
-    n_faces, corners = faces.shape
-    n_chunks = max(1, min(n_chunks, _BUCKET_CHUNKS, n_faces))
+    n_faces = faces.shape[0]
+    n_chunks = max(1, min(int(n_chunks), _BUCKET_CHUNKS, n_faces))
     # cursor[c, v]: corners of face range c at vertex v, then where range c's next such face goes
     cursor = np.zeros((n_chunks, n_vertices), np.int64)
-    for c in nb.prange(n_chunks):
+    run_chunks(_count_corners, n_chunks, n_chunks, faces, cursor)
+    indptr = _bucket_starts(cursor)
+    indices = np.empty(indptr[n_vertices], np.int64)
+    run_chunks(_place_corners, n_chunks, n_chunks, faces, cursor, indices)
+    return indptr, indices
+
+
+@nb.njit(**_JIT)
+def _count_corners(lo, hi, faces, cursor):
+    """:func:`vertex_face_lists`' counts of the face ranges ``lo`` to ``hi - 1`` in ``cursor``."""
+    n_faces, corners = faces.shape
+    n_chunks = cursor.shape[0]
+    for c in range(lo, hi):
         for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
             for k in range(corners):
                 cursor[c, faces[f, k]] += 1
-    indptr = _bucket_starts(cursor)
-    indices = np.empty(indptr[n_vertices], np.int64)
-    for c in nb.prange(n_chunks):
+
+
+@nb.njit(**_JIT)
+def _place_corners(lo, hi, faces, cursor, indices):
+    """:func:`vertex_face_lists`' placing of the faces of the face ranges ``lo`` to ``hi - 1``."""
+    n_faces, corners = faces.shape
+    n_chunks = cursor.shape[0]
+    for c in range(lo, hi):
         for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
             for k in range(corners):
                 a = faces[f, k]
                 indices[cursor[c, a]] = f
                 cursor[c, a] += 1
-    return indptr, indices
 
 
 @nb.njit(**_JIT)
