@@ -424,6 +424,22 @@ def check_degenerate_faces(name):
                                   one_scale)
 
 
+def check_long_edges(name):
+    from meshcurv.defects import NEEDLE_REACH
+    from meshcurv.geometry import vertex_length_scales
+
+    vertices, _ = mesh(name)
+    vertices = vertices.copy()
+    vertices[0] *= 1e3  # a vertex flung away: its edges are long
+    top = topology(name)
+    with use_backend("numpy"):
+        reach = NEEDLE_REACH * vertex_length_scales(vertices, top)
+    first, second = top.edges[:, 0], top.edges[:, 1]
+    sides = vertices[second] - vertices[first]  # the NumPy path of defects.needle_vertices
+    expected = np.einsum("ij,ij->i", sides, sides) > np.square(np.minimum(reach[first], reach[second]))
+    np.testing.assert_array_equal(kernels("diagnosis").long_edges(vertices, top.edges, reach), expected)
+
+
 def check_mesh_facts(name):
     from meshcurv import diagnosis
     from meshcurv.geometry import DEGENERATE_AREA_RATIO, face_cross_products, vertex_length_scales
@@ -1486,6 +1502,7 @@ TWINS = [
     Twin("topology.neighbour_lists", "MeshTopology.neighbour_lists (the adjacency matrix)", check_neighbour_lists,
          MESHES),
     Twin("diagnosis.mesh_facts", "diagnosis.diagnose", check_mesh_facts, MESHES),
+    Twin("diagnosis.long_edges", "defects.needle_vertices (its long edges)", check_long_edges, MESHES),
     Twin("normal_cycle.normal_cycle_sums", "normal_cycle.estimate up to its smoothing", check_normal_cycle_sums,
          MESHES),
     Twin("normal_cycle.normal_cycle_finish", "normal_cycle.estimate from its smoothing on", check_normal_cycle_finish,
