@@ -487,7 +487,8 @@ def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.nd
                                                                   np.concatenate([cols, rows]))),
                         shape=(n, n)).tocsr()
     child = np.flatnonzero(has_parent)
-    signs[child] = np.sign(np.asarray(lookup[child, parent[child]]).reshape(-1))
+    if child.size:  # no edge at all (every point unusable, e.g. on a line): every point its own root
+        signs[child] = np.sign(np.asarray(lookup[child, parent[child]]).reshape(-1))
     signs[signs == 0] = 1.0
     while True:
         moved = anchor[anchor] != anchor
