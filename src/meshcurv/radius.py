@@ -331,7 +331,7 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology,
     grid = voxel_grid(vertices[referenced])
     if grid is None:
         return None
-    k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))
+    k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
     curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
     curvedness = curvedness[referenced & valid & np.isfinite(curvedness) & (curvedness > 0)]
     if curvedness.size == 0:
@@ -478,7 +478,7 @@ def voxel_vertex_radii(spacing, normals: np.ndarray, k_min: np.ndarray, k_max: n
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(region > 0, 1.0 / (region * curvature_radius), 1.0)
         share = np.clip((ratio - VOXEL_REGION_APART) / VOXEL_REGION_APART, 0.0, 1.0)
-        curvature_radius = curvature_radius * ratio**share
+        curvature_radius = curvature_radius * ratio**share  # type: ignore[assignment]  # (V,) from here on
     a = VOXEL_LOCAL_EXPONENT
     radii = VOXEL_LOCAL_GAIN * extent**a * curvature_radius ** (1.0 - a)
     with np.errstate(divide="ignore"):

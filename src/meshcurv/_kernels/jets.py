@@ -328,7 +328,7 @@ def _jet_moments(general, work, size, degree, exponents, ax, ay, az, bx, by, bz,
     raise NotImplementedError("compiled only: called from the compiled jet fits")
 
 
-@overload(_jet_moments, jit_options=_JIT)
+@overload(_jet_moments, jit_options=_JIT)  # type: ignore[arg-type]  # numba's stub types a TypedDict
 def _jet_moments_typed(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
     if isinstance(general, types.NoneType):
         def cubic(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):

@@ -12,7 +12,7 @@ import logging
 import pathlib
 import sys
 import warnings
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import click
 import numpy as np
@@ -139,7 +139,7 @@ def _store(ctx, param, value):
 
 def common_options(function):
     """-v/-q/--debug/--progress, accepted before or after the command name."""
-    stored = {"expose_value": False, "callback": _store}
+    stored: dict[str, Any] = {"expose_value": False, "callback": _store}
     progress = "Progress bar on stderr (default: only when stderr is a terminal)."
     options = [
         click.option("-v", "--verbose", count=True, help="More messages on stderr (-v: stages, -vv: debug).", **stored),
