@@ -14,8 +14,9 @@ _NEEDS = {
     "numba": ["src/meshcurv/_kernels"],
 }
 
-collect_ignore = [path for module, paths in _NEEDS.items() if importlib.util.find_spec(module) is None
-                  for path in paths]
+collect_ignore = [
+    path for module, paths in _NEEDS.items() if importlib.util.find_spec(module) is None for path in paths
+]
 
 # The README's examples use the optional extras (marching cubes, the command line, files through
 # meshio, pictures): on an install without one of them its doctest is skipped, not failed.

@@ -65,6 +65,7 @@ SWEEP_OUTPUT = os.path.join(os.path.dirname(OUTPUT), "accuracy_voxel_sweep.md")
 
 # -- meshes -----------------------------------------------------------------------
 
+
 def _selected(families, surface, variant):
     """True when ``surface variant`` matches one of ``families`` (``"torus"`` or ``"torus:noise 0.1h"``)."""
     if not families:
@@ -117,6 +118,7 @@ def surfaces(levels, families=None):
 
 # -- peers ------------------------------------------------------------------------
 
+
 def _from_mean_gaussian(mean, gaussian):
     half = np.sqrt(np.maximum(mean**2 - gaussian, 0.0))
     nan = np.full((mean.size, 3), np.nan)
@@ -140,8 +142,10 @@ def _vtk_polydata(v, f):
     points = vtk.vtkPoints()
     points.SetData(numpy_to_vtk(np.ascontiguousarray(v), deep=True))
     cells = vtk.vtkCellArray()
-    cells.SetData(numpy_to_vtkIdTypeArray(np.arange(0, 3 * len(f) + 1, 3, dtype=np.int64), deep=True),
-                  numpy_to_vtkIdTypeArray(np.ascontiguousarray(f.ravel(), dtype=np.int64), deep=True))
+    cells.SetData(
+        numpy_to_vtkIdTypeArray(np.arange(0, 3 * len(f) + 1, 3, dtype=np.int64), deep=True),
+        numpy_to_vtkIdTypeArray(np.ascontiguousarray(f.ravel(), dtype=np.int64), deep=True),
+    )
     data = vtk.vtkPolyData()
     data.SetPoints(points)
     data.SetPolys(cells)
@@ -189,8 +193,7 @@ def _meshlab(v, f, method):
         ms = pymeshlab.MeshSet()
         ms.add_mesh(pymeshlab.Mesh(v, f))
         with contextlib.redirect_stdout(io.StringIO()):
-            ms.compute_curvature_principal_directions_per_vertex(method=method, curvcolormethod=label,
-                                                                 autoclean=False)
+            ms.compute_curvature_principal_directions_per_vertex(method=method, curvcolormethod=label, autoclean=False)
         mesh = ms.current_mesh()
         scalars.append(mesh.vertex_scalar_array().astype(float))
         dir1 = mesh.vertex_curvature_principal_dir1_matrix()
@@ -214,10 +217,13 @@ def peers(methods=None):
         ("libigl principal_curvature (5-ring quadric)", "igl", "libigl", lambda v, f, r: peer_libigl(v, f)),
         ("VTK vtkCurvatures (1-ring)", "vtk", "vtk", lambda v, f, r: peer_vtk(v, f)),
         ("trimesh ball measures (r = default radius)", "trimesh", "trimesh", peer_trimesh),
-        ("MeshLab quadric fitting", "pymeshlab", "pymeshlab",
-         lambda v, f, r: peer_meshlab(v, f, "Quadric Fitting")),
-        ("MeshLab scale-dependent quadric", "pymeshlab", "pymeshlab",
-         lambda v, f, r: peer_meshlab(v, f, "Scale Dependent Quadric Fitting")),
+        ("MeshLab quadric fitting", "pymeshlab", "pymeshlab", lambda v, f, r: peer_meshlab(v, f, "Quadric Fitting")),
+        (
+            "MeshLab scale-dependent quadric",
+            "pymeshlab",
+            "pymeshlab",
+            lambda v, f, r: peer_meshlab(v, f, "Scale Dependent Quadric Fitting"),
+        ),
         ("MeshLab Taubin", "pymeshlab", "pymeshlab", lambda v, f, r: peer_meshlab(v, f, "Taubin approximation")),
     ]
     for name, module, dist, function in candidates:
@@ -233,12 +239,17 @@ def peers(methods=None):
 
 # -- errors -----------------------------------------------------------------------
 
+
 def errors(mesh, k_min, k_max, dir_max, mask):
     scale = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))[mask]
     out = {}
     est_mean, est_gauss = (k_min + k_max) / 2, k_min * k_max
-    for key, est, exact, s in (("k_min", k_min, mesh.k_min, scale), ("k_max", k_max, mesh.k_max, scale),
-                               ("H", est_mean, mesh.mean, scale), ("K", est_gauss, mesh.gaussian, scale**2)):
+    for key, est, exact, s in (
+        ("k_min", k_min, mesh.k_min, scale),
+        ("k_max", k_max, mesh.k_max, scale),
+        ("H", est_mean, mesh.mean, scale),
+        ("K", est_gauss, mesh.gaussian, scale**2),
+    ):
         e = np.abs(est[mask] - exact[mask]) / s
         out[key] = (np.median(e), np.percentile(e, 95)) if e.size else (np.nan, np.nan)
     distinct = (np.abs(mesh.k_max - mesh.k_min)[mask] > 0.1 * scale) & np.isfinite(mesh.dir_max[mask]).all(axis=1)
@@ -284,9 +295,18 @@ def run(levels, families=None, methods=None):
                 if not region.any():
                     continue
                 mask = region & valid
-                rows.append({"surface": surface, "variant": variant, "level": level,
-                             "n": mesh.vertices.shape[0], "where": where, "method": label,
-                             "cover": mask.sum() / region.sum(), **errors(mesh, k_min, k_max, dir_max, mask)})
+                rows.append(
+                    {
+                        "surface": surface,
+                        "variant": variant,
+                        "level": level,
+                        "n": mesh.vertices.shape[0],
+                        "where": where,
+                        "method": label,
+                        "cover": mask.sum() / region.sum(),
+                        **errors(mesh, k_min, k_max, dir_max, mask),
+                    }
+                )
         print(f"{surface:10s} {variant:10s} level {level} ({mesh.vertices.shape[0]} vertices) done", file=sys.stderr)
     return rows, found, missing, timings
 
@@ -340,8 +360,12 @@ def voxel_errors(mesh, mean, gaussian, valid):
         e_k = np.abs(gaussian - mesh.gaussian) / np.abs(mesh.gaussian)
     e_h, e_k = e_h[valid & np.isfinite(e_h)], e_k[valid & np.isfinite(e_k)]
     sign = np.mean(valid & (np.sign(mean) == np.sign(mesh.mean)))
-    return {"H": np.median(e_h) if e_h.size else np.nan, "K": np.median(e_k) if e_k.size else np.nan,
-            "sign": sign, "cover": np.mean(valid)}
+    return {
+        "H": np.median(e_h) if e_h.size else np.nan,
+        "K": np.median(e_k) if e_k.size else np.nan,
+        "sign": sign,
+        "cover": np.mean(valid),
+    }
 
 
 def _child_call(function, *args, timeout=900):
@@ -389,8 +413,9 @@ WINDINGS = ("as returned", "reversed")
 def run_voxel(methods=None):
     """Every meshcurv method (default call) and every peer on each marching-cubes mesh, both windings."""
     found, missing = peers(methods)
-    labels = [label for label in ["meshcurv default"] + [f"meshcurv {name}" for name in ESTIMATORS]
-              if _wanted(label, methods)]
+    labels = [
+        label for label in ["meshcurv default"] + [f"meshcurv {name}" for name in ESTIMATORS] if _wanted(label, methods)
+    ]
     rows = []
     for mesh, held_out in voxel_meshes():
         topology = meshcurv.MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0])
@@ -413,16 +438,20 @@ def run_voxel(methods=None):
                         warnings.simplefilter("ignore")
                         k_min, k_max, _, _ = _child_call(function, mesh.vertices, faces, radius)
                 except Exception as exc:  # noqa: BLE001 - a peer failing (or crashing) on a mesh is a result
-                    print(f"  {label} failed on {mesh.name}, {winding}: {type(exc).__name__}: {exc}",
-                          file=sys.stderr)
+                    print(f"  {label} failed on {mesh.name}, {winding}: {type(exc).__name__}: {exc}", file=sys.stderr)
                     results[label] = None
                     continue
                 valid = np.isfinite(k_min) & np.isfinite(k_max)
                 results[label] = ((k_min + k_max) / 2, k_min * k_max, valid)
             for label, result in results.items():
-                row = {"mesh": _voxel_label(mesh, held_out), "n": mesh.vertices.shape[0], "method": label,
-                       "winding": winding, "peer": not label.startswith("meshcurv"),
-                       "aspect": max(mesh.spacing) / min(mesh.spacing)}
+                row = {
+                    "mesh": _voxel_label(mesh, held_out),
+                    "n": mesh.vertices.shape[0],
+                    "method": label,
+                    "winding": winding,
+                    "peer": not label.startswith("meshcurv"),
+                    "aspect": max(mesh.spacing) / min(mesh.spacing),
+                }
                 if result is None:
                     row.update(H=np.nan, K=np.nan, sign=np.nan, cover=np.nan, failed=True)
                 else:
@@ -460,8 +489,15 @@ def sweep_voxel():
                 warnings.simplefilter("ignore")
                 r = meshcurv.principal_curvatures(mesh.vertices, topology, method="icc", radius=radius)
             cells[name] = (voxel_errors(mesh, r.mean, r.gaussian, r.valid), radius / h, time.perf_counter() - t0)
-        rows.append({"mesh": _voxel_label(mesh, held_out), "n": mesh.vertices.shape[0], "h": h,
-                     "R": curvature_radius, "cells": cells})
+        rows.append(
+            {
+                "mesh": _voxel_label(mesh, held_out),
+                "n": mesh.vertices.shape[0],
+                "h": h,
+                "R": curvature_radius,
+                "cells": cells,
+            }
+        )
         print(f"sweep {mesh.name} ({mesh.vertices.shape[0]} vertices) done", file=sys.stderr)
     return rows
 
@@ -484,15 +520,24 @@ def sweep_markdown(rows):
     lines.append("| mesh | V | R/h | " + " | ".join(names) + " |")
     lines.append("|---" * (len(names) + 3) + "|")
     for row in rows:
-        cells = [f"{_pct(e['H'])} / {_pct(e['K'])}" + ("" if e["cover"] == 1 else f" ({_pct(e['cover'])} valid)")
-                 for e, _, _ in row["cells"].values()]
+        cells = [
+            f"{_pct(e['H'])} / {_pct(e['K'])}" + ("" if e["cover"] == 1 else f" ({_pct(e['cover'])} valid)")
+            for e, _, _ in row["cells"].values()
+        ]
         lines.append(f"| {row['mesh']} | {row['n']} | {row['R'] / row['h']:.3g} | " + " | ".join(cells) + " |")
-    lines += ["", "Radius in voxels (r / h) of the default and of the √(hR) columns:", "",
-              "| mesh | " + " | ".join(n for n in names if "√" in n or n == "default") + " |",
-              "|---" * (1 + sum("√" in n or n == "default" for n in names)) + "|"]
+    lines += [
+        "",
+        "Radius in voxels (r / h) of the default and of the √(hR) columns:",
+        "",
+        "| mesh | " + " | ".join(n for n in names if "√" in n or n == "default") + " |",
+        "|---" * (1 + sum("√" in n or n == "default" for n in names)) + "|",
+    ]
     for row in rows:
-        lines.append(f"| {row['mesh']} | " + " | ".join(f"{v[1]:.2g}" for n, v in row["cells"].items()
-                                                         if "√" in n or n == "default") + " |")
+        lines.append(
+            f"| {row['mesh']} | "
+            + " | ".join(f"{v[1]:.2g}" for n, v in row["cells"].items() if "√" in n or n == "default")
+            + " |"
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -527,19 +572,30 @@ def voxel_markdown(rows, found, missing):
     ]
     lines += _voxel_targets(rows, meshes)
     for winding in WINDINGS:
-        lines += [f"# Faces {winding}" + (" (marching cubes' own winding: inward)" if winding == "as returned"
-                                           else " (outward)"), ""]
-        for quantity, title in (("H", "median error of H"), ("K", "median error of K"),
-                                ("sign", "share of right H signs"), ("cover", "share of vertices reported")):
+        lines += [
+            f"# Faces {winding}"
+            + (" (marching cubes' own winding: inward)" if winding == "as returned" else " (outward)"),
+            "",
+        ]
+        for quantity, title in (
+            ("H", "median error of H"),
+            ("K", "median error of K"),
+            ("sign", "share of right H signs"),
+            ("cover", "share of vertices reported"),
+        ):
             best = quantity in ("H", "K")
-            lines += [f"## {title}, faces {winding}", "",
-                      "| mesh | " + " | ".join(methods) + (" | best peer, either winding |" if best else " |"),
-                      "|---" * (len(methods) + 1 + best) + "|"]
+            lines += [
+                f"## {title}, faces {winding}",
+                "",
+                "| mesh | " + " | ".join(methods) + (" | best peer, either winding |" if best else " |"),
+                "|---" * (len(methods) + 1 + best) + "|",
+            ]
             for mesh in meshes:
                 cells = []
                 for method in methods:
-                    row = next(r for r in rows if r["mesh"] == mesh and r["method"] == method
-                               and r["winding"] == winding)
+                    row = next(
+                        r for r in rows if r["mesh"] == mesh and r["method"] == method and r["winding"] == winding
+                    )
                     cells.append("crash" if row["failed"] else _pct(row[quantity]))
                 if best:
                     values = [r[quantity] for r in rows if r["mesh"] == mesh and r["peer"] and not r["failed"]]
@@ -555,12 +611,17 @@ VOXEL_TARGETS = [(1.0, 0.03, 0.06), (4.0, 0.06, 0.12)]
 
 def _voxel_targets(rows, meshes):
     """The default call on the faces as returned, against the targets and against the best peer."""
-    lines = ["## The default call against issue 14's targets (faces as returned)", "",
-             "| mesh | voxel aspect | H | K | right H sign | target H / K | met | best peer H / K (either winding) "
-             "| ahead of every peer |", "|---" * 9 + "|"]
+    lines = [
+        "## The default call against issue 14's targets (faces as returned)",
+        "",
+        "| mesh | voxel aspect | H | K | right H sign | target H / K | met | best peer H / K (either winding) "
+        "| ahead of every peer |",
+        "|---" * 9 + "|",
+    ]
     for mesh in meshes:
-        default = [r for r in rows if r["mesh"] == mesh and r["method"] == "meshcurv default"
-                   and r["winding"] == "as returned"]
+        default = [
+            r for r in rows if r["mesh"] == mesh and r["method"] == "meshcurv default" and r["winding"] == "as returned"
+        ]
         if not default:
             continue
         row = default[0]
@@ -569,9 +630,11 @@ def _voxel_targets(rows, meshes):
         best = [min((r[q] for r in peers_ok), default=np.nan) for q in ("H", "K")]
         met = "—" if target is None else ("yes" if row["H"] <= target[0] and row["K"] <= target[1] else "**no**")
         ahead = "yes" if all(row[q] < b for q, b in zip(("H", "K"), best) if np.isfinite(b)) else "**no**"
-        lines.append(f"| {mesh} | {row['aspect']:.3g} | {_pct(row['H'])} | {_pct(row['K'])} | {_pct(row['sign'])} | "
-                     + (f"{_pct(target[0])} / {_pct(target[1])}" if target else "—")
-                     + f" | {met} | {_pct(best[0])} / {_pct(best[1])} | {ahead} |")
+        lines.append(
+            f"| {mesh} | {row['aspect']:.3g} | {_pct(row['H'])} | {_pct(row['K'])} | {_pct(row['sign'])} | "
+            + (f"{_pct(target[0])} / {_pct(target[1])}" if target else "—")
+            + f" | {met} | {_pct(best[0])} / {_pct(best[1])} | {ahead} |"
+        )
     return lines + [""]
 
 
@@ -579,13 +642,22 @@ def _git_head():
     import subprocess
 
     try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, timeout=10,
-                              cwd=os.path.dirname(os.path.abspath(__file__))).stdout.strip() or "?"
+        return (
+            subprocess.run(
+                ["git", "rev-parse", "--short", "HEAD"],
+                capture_output=True,
+                text=True,
+                timeout=10,
+                cwd=os.path.dirname(os.path.abspath(__file__)),
+            ).stdout.strip()
+            or "?"
+        )
     except (OSError, subprocess.SubprocessError):
         return "?"
 
 
 # -- report -----------------------------------------------------------------------
+
 
 def _pct(x):
     return "—" if not np.isfinite(x) else (f"{100 * x:.2g}%" if x < 0.1 else f"{100 * x:.0f}%")
@@ -629,39 +701,65 @@ def markdown(rows, found, missing, timings, levels):
     for m in methods:
         cells = []
         for s, v in families:
-            sel = [r for r in rows if r["method"] == m and r["surface"] == s and r["variant"] == v
-                   and r["where"] == "interior"]
+            sel = [
+                r
+                for r in rows
+                if r["method"] == m and r["surface"] == s and r["variant"] == v and r["where"] == "interior"
+            ]
             h = np.mean([r["H"][0] for r in sel]) if sel else np.nan
             k = np.mean([r["K"][0] for r in sel]) if sel else np.nan
             cells.append(f"{_pct(h)} / {_pct(k)}")
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
     lines += ["", "## Time (s, all meshes)", "", "| method | seconds |", "|---|---|"]
     lines += [f"| {m} | {t:.1f} |" for m, t in timings.items()]
-    lines += ["", "## All results", "",
-              "| surface | variant | V | where | method | cover | k_min | k_max | H | K | dir < 8° |",
-              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines += [
+        "",
+        "## All results",
+        "",
+        "| surface | variant | V | where | method | cover | k_min | k_max | H | K | dir < 8° |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         cells = [f"{_pct(r[q][0])} / {_pct(r[q][1])}" for q in ("k_min", "k_max", "H", "K")]
-        lines.append(f"| {r['surface']} | {r['variant']} | {r['n']} | {r['where']} | {r['method']} | "
-                     f"{_pct(r['cover'])} | " + " | ".join(cells) + f" | {_pct(r['dir'])} |")
+        lines.append(
+            f"| {r['surface']} | {r['variant']} | {r['n']} | {r['where']} | {r['method']} | "
+            f"{_pct(r['cover'])} | " + " | ".join(cells) + f" | {_pct(r['dir'])} |"
+        )
     return "\n".join(lines) + "\n"
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the two coarser resolutions only")
-    parser.add_argument("--levels", "--resolutions", type=int, nargs="+", dest="levels",
-                        help="resolutions to run (0, 1, 2)")
-    parser.add_argument("--families", nargs="+", metavar="SURFACE[:VARIANT]",
-                        help="surfaces or surface:variant pairs to run, e.g. torus 'sphere:noise 0.1h' (default: all)")
-    parser.add_argument("--methods", nargs="+", metavar="NAME",
-                        help="methods whose label contains one of these (case-insensitive), e.g. icc MeshLab")
-    parser.add_argument("--voxel", action="store_true",
-                        help=f"the marching-cubes family instead (writes {os.path.basename(VOXEL_OUTPUT)})")
-    parser.add_argument("--voxel-sweep", action="store_true",
-                        help=f"icc's error vs radius on the marching-cubes family (writes {os.path.basename(SWEEP_OUTPUT)})")
-    parser.add_argument("--output", help="markdown file to write (default: accuracy.md, or the --voxel "
-                        "or --voxel-sweep file, beside this script)")
+    parser.add_argument(
+        "--levels", "--resolutions", type=int, nargs="+", dest="levels", help="resolutions to run (0, 1, 2)"
+    )
+    parser.add_argument(
+        "--families",
+        nargs="+",
+        metavar="SURFACE[:VARIANT]",
+        help="surfaces or surface:variant pairs to run, e.g. torus 'sphere:noise 0.1h' (default: all)",
+    )
+    parser.add_argument(
+        "--methods",
+        nargs="+",
+        metavar="NAME",
+        help="methods whose label contains one of these (case-insensitive), e.g. icc MeshLab",
+    )
+    parser.add_argument(
+        "--voxel",
+        action="store_true",
+        help=f"the marching-cubes family instead (writes {os.path.basename(VOXEL_OUTPUT)})",
+    )
+    parser.add_argument(
+        "--voxel-sweep",
+        action="store_true",
+        help=f"icc's error vs radius on the marching-cubes family (writes {os.path.basename(SWEEP_OUTPUT)})",
+    )
+    parser.add_argument(
+        "--output",
+        help="markdown file to write (default: accuracy.md, or the --voxel or --voxel-sweep file, beside this script)",
+    )
     args = parser.parse_args(argv)
     if args.voxel_sweep:
         text, output = sweep_markdown(sweep_voxel()), args.output or SWEEP_OUTPUT

@@ -52,14 +52,20 @@ def _timed(vertices, faces, repeats):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--large", action="store_true", help="also a sphere R 10 at 0.25 x 0.1 x 0.1 (113,072 "
-                        "vertices; a minute a call before the coarse level)")
+    parser.add_argument(
+        "--large",
+        action="store_true",
+        help="also a sphere R 10 at 0.25 x 0.1 x 0.1 (113,072 vertices; a minute a call before the coarse level)",
+    )
     args = parser.parse_args(argv)
-    meshes = [("voxel sphere R 6, 0.5 x 0.2 x 0.2", shapes.voxel_sphere(6.0, (0.5, 0.2, 0.2), seed=0), True),
-              ("voxel sphere R 3, 0.25 x 0.1 x 0.1", shapes.voxel_sphere(3.0, (0.25, 0.1, 0.1), seed=2), True)]
+    meshes = [
+        ("voxel sphere R 6, 0.5 x 0.2 x 0.2", shapes.voxel_sphere(6.0, (0.5, 0.2, 0.2), seed=0), True),
+        ("voxel sphere R 3, 0.25 x 0.1 x 0.1", shapes.voxel_sphere(3.0, (0.25, 0.1, 0.1), seed=2), True),
+    ]
     if args.large:
-        meshes.append(("voxel sphere R 10, 0.25 x 0.1 x 0.1", shapes.voxel_sphere(10.0, (0.25, 0.1, 0.1), seed=1),
-                       True))
+        meshes.append(
+            ("voxel sphere R 10, 0.25 x 0.1 x 0.1", shapes.voxel_sphere(10.0, (0.25, 0.1, 0.1), seed=1), True)
+        )
     meshes.append(("icosphere 100,002", shapes.icosphere(subdivisions=100, radius=1.0), False))
     rows = []
     for name, mesh, inward in meshes:
@@ -70,17 +76,20 @@ def main(argv=None):
         error = float(np.median(np.abs(result.mean - exact)[result.valid] / scale[result.valid]))
         n = mesh.vertices.shape[0]
         top = max(stages, key=stages.get)
-        rows.append((name, n, cpu, 1e6 * cpu / n, top, stages[top] / cpu, error,
-                     float(np.median(result.radius))))
+        rows.append((name, n, cpu, 1e6 * cpu / n, top, stages[top] / cpu, error, float(np.median(result.radius))))
         before = cpu - sum(stages.values())  # the voxel pilot and the checks run before the estimator's stages
         print(f"{name}: " + ", ".join(f"{k} {v:.2f} s" for k, v in {"before the stages": before, **stages}.items()))
     reference = rows[-1][3]
-    print("| mesh | vertices | CPU s | CPU us / vertex | x icosphere | costliest stage (share) | median H error | "
-          "radius |")
+    print(
+        "| mesh | vertices | CPU s | CPU us / vertex | x icosphere | costliest stage (share) | median H error | "
+        "radius |"
+    )
     print("|---|--:|--:|--:|--:|---|--:|--:|")
     for name, n, cpu, per, top, share, error, radius in rows:
-        print(f"| {name} | {n:,} | {cpu:.2f} | {per:.1f} | {per / reference:.1f} | {top} ({100 * share:.0f}%) | "
-              f"{100 * error:.2f}% | {radius:.3g} |")
+        print(
+            f"| {name} | {n:,} | {cpu:.2f} | {per:.1f} | {per / reference:.1f} | {top} ({100 * share:.0f}%) | "
+            f"{100 * error:.2f}% | {radius:.3g} |"
+        )
 
 
 if __name__ == "__main__":

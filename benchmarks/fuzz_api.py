@@ -91,6 +91,7 @@ SMOOTHING_METHODS = ("normal_cycle", "matgeom")
 
 # ----------------------------------------------------------------------------- base meshes
 
+
 def base_meshes():
     """Small clean shapes: ``(name, vertices, faces)``."""
     return [
@@ -109,22 +110,61 @@ def base_meshes():
 _SHAPES = base_meshes()
 BASES = [(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)) for name, m in _SHAPES]
 #: Exact (k_min, k_max) of the closed analytic shapes, for the "truth" relation.
-TRUTH = {name: (np.asarray(m.k_min, float), np.asarray(m.k_max, float)) for name, m in _SHAPES
-         if name in ("icosphere", "torus", "ellipsoid", "random_sphere")}
+TRUTH = {
+    name: (np.asarray(m.k_min, float), np.asarray(m.k_max, float))
+    for name, m in _SHAPES
+    if name in ("icosphere", "torus", "ellipsoid", "random_sphere")
+}
 
 # ----------------------------------------------------------------------------- garbage values
 
 BIG_INTS = [2**31, 2**31 - 1, 2**32, 2**53 + 1, 2**63 - 1, 2**63, 2**64, 10**400, -(2**63), -1]
-FLOATS = [0.0, -0.0, -1.0, 1e-300, 5e-324, 1e-12, 1e300, 1.7976931348623157e308, float("inf"),
-          float("-inf"), float("nan")]
+FLOATS = [
+    0.0,
+    -0.0,
+    -1.0,
+    1e-300,
+    5e-324,
+    1e-12,
+    1e300,
+    1.7976931348623157e308,
+    float("inf"),
+    float("-inf"),
+    float("nan"),
+]
 
 
 def garbage(rng, kind: str):
     """A value that a careless or hostile caller could pass for an option."""
-    pool = [None, True, False, "0.5", "abc", "", b"1", [1], (1, 2), {}, object(), np.array(1.5),
-            np.array([1.0, 2.0]), np.float32(0.5), np.float16(2.0), np.int8(3), np.uint64(2**63),
-            np.int64(-5), np.bool_(True), np.longdouble(0.5), 1 + 0j, np.complex128(1.0), fractions.Fraction(1, 3),
-            np.nan, np.ma.masked, 1.5, 2.0]
+    pool = [
+        None,
+        True,
+        False,
+        "0.5",
+        "abc",
+        "",
+        b"1",
+        [1],
+        (1, 2),
+        {},
+        object(),
+        np.array(1.5),
+        np.array([1.0, 2.0]),
+        np.float32(0.5),
+        np.float16(2.0),
+        np.int8(3),
+        np.uint64(2**63),
+        np.int64(-5),
+        np.bool_(True),
+        np.longdouble(0.5),
+        1 + 0j,
+        np.complex128(1.0),
+        fractions.Fraction(1, 3),
+        np.nan,
+        np.ma.masked,
+        1.5,
+        2.0,
+    ]
     pool += BIG_INTS + FLOATS
     if kind == "radius":
         pool += [0.1, 0.5, 2.0, 1e3, 1e6, 1e10, 10**400, np.float64(np.nextafter(0, 1))]
@@ -134,6 +174,7 @@ def garbage(rng, kind: str):
 
 
 # ----------------------------------------------------------------------------- mesh mutations
+
 
 def _rows(rng, n, k):
     return rng.choice(n, size=min(k, n), replace=False) if n else np.zeros(0, np.int64)
@@ -314,15 +355,37 @@ def m_indices(rng, v, f):
     return v[perm], inverse[f], "vertices permuted"
 
 
-MUTATIONS = [m_scale, m_translate, m_spike, m_nonfinite, m_duplicate, m_soup, m_collapse, m_all_same, m_flat,
-             m_collinear, m_random_faces, m_degenerate_faces, m_nonmanifold, m_bowtie, m_duplicate_faces, m_flip,
-             m_holes, m_unreferenced, m_components, m_noise, m_empty, m_indices]
+MUTATIONS = [
+    m_scale,
+    m_translate,
+    m_spike,
+    m_nonfinite,
+    m_duplicate,
+    m_soup,
+    m_collapse,
+    m_all_same,
+    m_flat,
+    m_collinear,
+    m_random_faces,
+    m_degenerate_faces,
+    m_nonmanifold,
+    m_bowtie,
+    m_duplicate_faces,
+    m_flip,
+    m_holes,
+    m_unreferenced,
+    m_components,
+    m_noise,
+    m_empty,
+    m_indices,
+]
 # the rarer, more destructive mutations get lower weight
 WEIGHTS = np.array([3, 1, 2, 1, 2, 2, 2, 0.5, 1, 0.5, 1, 2, 2, 1, 1, 1, 1, 2, 2, 1, 0.5, 1.5])
 WEIGHTS = WEIGHTS / WEIGHTS.sum()
 
 
 # ----------------------------------------------------------------------------- container wrappers
+
 
 def wrap_vertices(rng, v):
     choice = int(rng.integers(20))
@@ -339,8 +402,9 @@ def wrap_vertices(rng, v):
         r.flags.writeable = False
         return r, "read-only"
     if choice == 4:
-        dtype = rng.choice(["float32", "float16", "longdouble", ">f8", "int64", "uint8", "bool", "complex128",
-                            "object"])
+        dtype = rng.choice(
+            ["float32", "float16", "longdouble", ">f8", "int64", "uint8", "bool", "complex128", "object"]
+        )
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return v.astype(str(dtype)), f"dtype {dtype}"
@@ -398,6 +462,7 @@ def wrap_faces(rng, f):
 
 # ----------------------------------------------------------------------------- cases
 
+
 def make_mesh(rng):
     name, v, f = BASES[int(rng.integers(len(BASES)))]
     labels = [name]
@@ -430,31 +495,53 @@ def make_case(seed: int, index: int):
         method = METHODS[int(rng.integers(len(METHODS)))] if rng.random() > 0.03 else garbage(rng, "method")
         kwargs = {"method": method}
         if rng.random() < 0.5:
-            kwargs["radius"] = garbage(rng, "radius") if rng.random() < 0.5 else float(
-                rng.choice([0.01, 0.1, 0.3, 1.0, 3.0, 30.0, 1e4])) * (float(np.ptp(v)) if v.size else 1.0)
+            kwargs["radius"] = (
+                garbage(rng, "radius")
+                if rng.random() < 0.5
+                else float(rng.choice([0.01, 0.1, 0.3, 1.0, 3.0, 30.0, 1e4])) * (float(np.ptp(v)) if v.size else 1.0)
+            )
         if rng.random() < 0.4:
             kwargs["smoothing_steps"] = garbage(rng, "steps") if rng.random() < 0.5 else int(rng.integers(0, 20))
         if rng.random() < 0.3:
-            kwargs["orient"] = rng.choice(["auto", "outward", "consistent", "keep", "KEEP", "", "in"]) \
-                if rng.random() < 0.9 else garbage(rng, "orient")
+            kwargs["orient"] = (
+                rng.choice(["auto", "outward", "consistent", "keep", "KEEP", "", "in"])
+                if rng.random() < 0.9
+                else garbage(rng, "orient")
+            )
         if rng.random() < 0.3:
             kwargs["weld"] = [True, False, None, np.bool_(True), 1, 0, "yes", np.array(True)][int(rng.integers(8))]
         if isinstance(method, str) and method in METHODS:  # keep most calls well-formed in their options
             if method not in BALL_METHODS and "radius" in kwargs and rng.random() < 0.8:
                 del kwargs["radius"]
-            if not (isinstance(method, str) and method in SMOOTHING_METHODS) and "smoothing_steps" in kwargs \
-                    and rng.random() < 0.8:
+            if (
+                not (isinstance(method, str) and method in SMOOTHING_METHODS)
+                and "smoothing_steps" in kwargs
+                and rng.random() < 0.8
+            ):
                 del kwargs["smoothing_steps"]
         vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
         ff, flabel = wrap_faces(rng, f) if rng.random() < 0.3 else (f, "array")
         labels += [f"vertices:{vlabel}", f"faces:{flabel}"]
-        if vlabel == "array" and flabel == "array" and len(labels) == 3 and labels[0] in TRUTH \
-                and isinstance(method, str) and method in BALL_METHODS and kwargs.get("radius") is not None \
-                and rng.random() < 0.5:
+        if (
+            vlabel == "array"
+            and flabel == "array"
+            and len(labels) == 3
+            and labels[0] in TRUTH
+            and isinstance(method, str)
+            and method in BALL_METHODS
+            and kwargs.get("radius") is not None
+            and rng.random() < 0.5
+        ):
             labels.append(f"relation truth of {labels[0]}")
             return target, (vv, ff), kwargs, labels, ("truth", labels[0])
-        if vlabel == "array" and flabel == "array" and len(labels) == 3 and isinstance(method, str) \
-                and method in METHODS and rng.random() < 0.25:
+        if (
+            vlabel == "array"
+            and flabel == "array"
+            and len(labels) == 3
+            and isinstance(method, str)
+            and method in METHODS
+            and rng.random() < 0.25
+        ):
             # one vertex of a clean shape, or it and a neighbour together, flung 1e3-1e40 sizes away: their
             # faces are needles (issue 29)
             rows = [int(rng.integers(len(v)))]
@@ -467,14 +554,26 @@ def make_case(seed: int, index: int):
             vv[rows] += distance * direction / np.linalg.norm(direction)
             labels.append(f"relation needle {distance:.3g} ({len(rows)} vertices)")
             return target, (vv, ff), kwargs, labels, ("needle", rows)
-        if vlabel == "array" and flabel == "array" and kwargs.get("radius") is None and rng.random() < 0.5 \
-                and all(label.startswith(("noise", "flipped", "faces removed", "vertices permuted")) for label in labels[1:-2]):
+        if (
+            vlabel == "array"
+            and flabel == "array"
+            and kwargs.get("radius") is None
+            and rng.random() < 0.5
+            and all(
+                label.startswith(("noise", "flipped", "faces removed", "vertices permuted")) for label in labels[1:-2]
+            )
+        ):
             relation = ["scale", "scale", "permute", "unreferenced", "translate", "double-sided"][int(rng.integers(6))]
-            if relation == "permute" and isinstance(method, str) and method == "matgeom":  # matGeom's pairing on open meshes follows the order
+            if (
+                relation == "permute" and isinstance(method, str) and method == "matgeom"
+            ):  # matGeom's pairing on open meshes follows the order
                 relation = "translate"
-            if relation == "double-sided" and (not isinstance(method, str) or method == "matgeom"
-                                               or str(kwargs.get("orient", "auto")) not in ("auto", "outward")
-                                               or kwargs.get("weld", True) is not True):
+            if relation == "double-sided" and (
+                not isinstance(method, str)
+                or method == "matgeom"
+                or str(kwargs.get("orient", "auto")) not in ("auto", "outward")
+                or kwargs.get("weld", True) is not True
+            ):
                 relation = "translate"  # one side is kept where the faces are oriented outward (matgeom: as given)
             if relation == "scale":  # inside the documented coordinate range (about 1e-70 to 1e70)
                 clean = ("scale", float(rng.choice([2.0**-60, 2.0**40, 1e-30, 1e-8, 1e8, 1e30])))
@@ -488,11 +587,15 @@ def make_case(seed: int, index: int):
         target = "point_cloud_curvatures"
         kwargs = {}
         if rng.random() < 0.4:
-            kwargs["radius"] = garbage(rng, "radius") if rng.random() < 0.5 else float(
-                rng.choice([0.05, 0.2, 1.0, 1e3])) * (float(np.ptp(v)) if v.size else 1.0)
+            kwargs["radius"] = (
+                garbage(rng, "radius")
+                if rng.random() < 0.5
+                else float(rng.choice([0.05, 0.2, 1.0, 1e3])) * (float(np.ptp(v)) if v.size else 1.0)
+            )
         if rng.random() < 0.3:
-            kwargs["method"] = pointcloud.POINT_CLOUD_METHODS[int(rng.integers(2))] if rng.random() < 0.9 \
-                else garbage(rng, "method")
+            kwargs["method"] = (
+                pointcloud.POINT_CLOUD_METHODS[int(rng.integers(2))] if rng.random() < 0.9 else garbage(rng, "method")
+            )
         if rng.random() < 0.3 and len(v):
             normals = rng.normal(size=v.shape)
             if rng.random() < 0.3:
@@ -504,8 +607,14 @@ def make_case(seed: int, index: int):
     vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
     ff, flabel = wrap_faces(rng, f) if rng.random() < 0.3 else (f, "array")
     labels += [f"vertices:{vlabel}", f"faces:{flabel}"]
-    target = ["diagnose", "orient_faces", "MeshTopology.from_faces", "triangulate_faces", "smooth_vertex_field",
-              "geometry"][int(rng.integers(6))]
+    target = [
+        "diagnose",
+        "orient_faces",
+        "MeshTopology.from_faces",
+        "triangulate_faces",
+        "smooth_vertex_field",
+        "geometry",
+    ][int(rng.integers(6))]
     if target == "diagnose":
         topo = ff if isinstance(ff, meshcurv.MeshTopology) else _topology_or_raw(rng, f, len(v))
         return target, (vv, topo), {}, labels, None
@@ -518,9 +627,15 @@ def make_case(seed: int, index: int):
     if target == "triangulate_faces":
         return target, (ff,), {}, labels, None
     if target == "smooth_vertex_field":
-        values = [rng.normal(size=len(v)), rng.normal(size=(len(v), 3)), rng.normal(size=len(v) + 1),
-                  np.full(len(v), np.nan), np.zeros((len(v), 0)), "abc", rng.normal(size=(len(v), 2, 2))][
-            int(rng.integers(7))]
+        values = [
+            rng.normal(size=len(v)),
+            rng.normal(size=(len(v), 3)),
+            rng.normal(size=len(v) + 1),
+            np.full(len(v), np.nan),
+            np.zeros((len(v), 0)),
+            "abc",
+            rng.normal(size=(len(v), 2, 2)),
+        ][int(rng.integers(7))]
         topo = _topology_or_raw(rng, f, len(v))
         steps = garbage(rng, "steps") if rng.random() < 0.5 else int(rng.integers(0, 30))
         return target, (values, topo, steps), {}, labels, None
@@ -651,8 +766,14 @@ def make_cloud_case(rng):
         labels.append(f"moved, scale {s:g}")
     # points whose radius of curvature is below 4 spacings (a thin ellipsoid's rim) are not checked: no
     # estimator resolves them; all others are
-    truth = {"mean": mean, "kmax": kmax, "normals": normals, "sign": sign, "given": "normals" in kwargs,
-             "resolved": kmax * area_spacing * (s if labels[-1].startswith("moved") else 1.0) <= 0.25}
+    truth = {
+        "mean": mean,
+        "kmax": kmax,
+        "normals": normals,
+        "sign": sign,
+        "given": "normals" in kwargs,
+        "resolved": kmax * area_spacing * (s if labels[-1].startswith("moved") else 1.0) <= 0.25,
+    }
     labels.append("relation cloud truth")
     return "point_cloud_curvatures", (points,), kwargs, labels, ("cloud truth", truth)
 
@@ -668,13 +789,16 @@ def cloud_truth_check(args, kwargs, result, truth):
     valid = valid & truth["resolved"]
     wrong = valid & ~(error <= CLOUD_TRUTH_TOLERANCE)
     if wrong.any():
-        broken.append(f"cloud truth: H off by more than {CLOUD_TRUTH_TOLERANCE:g} of the largest |k| at "
-                      f"{int(wrong.sum())} of {int(valid.sum())} valid points (up to {float(np.nanmax(error[wrong])):.3g})")
+        broken.append(
+            f"cloud truth: H off by more than {CLOUD_TRUTH_TOLERANCE:g} of the largest |k| at "
+            f"{int(wrong.sum())} of {int(valid.sum())} valid points (up to {float(np.nanmax(error[wrong])):.3g})"
+        )
     if not truth["given"]:
         inward = valid & (side < 0)
         if inward.any():
-            broken.append(f"cloud truth: estimated normal inward at {int(inward.sum())} of {int(valid.sum())} "
-                          "valid points")
+            broken.append(
+                f"cloud truth: estimated normal inward at {int(inward.sum())} of {int(valid.sum())} valid points"
+            )
     elif truth["sign"] < 0 and not (result.parameters.get("normals") == "given"):
         broken.append("cloud truth: consistent given (inward) normals were reoriented")
     return broken
@@ -690,8 +814,11 @@ def _topology_or_raw(rng, f, n):
 
 
 def _geometry_args(rng, name, vv, ff, v, f):
-    params = [p.name for p in inspect.signature(getattr(geometry, name)).parameters.values()
-              if p.kind == p.POSITIONAL_OR_KEYWORD]
+    params = [
+        p.name
+        for p in inspect.signature(getattr(geometry, name)).parameters.values()
+        if p.kind == p.POSITIONAL_OR_KEYWORD
+    ]
     args = []
     for p in params:
         if p == "vertices":
@@ -713,8 +840,9 @@ def _geometry_args(rng, name, vv, ff, v, f):
             args.append(rng.normal(size=(len(f), 3)) if rng.random() < 0.8 else garbage(rng, "normals"))
         elif p == "usable_edges":
             topology = next((a for a in args if isinstance(a, meshcurv.MeshTopology)), None)
-            args.append(topology.interior_edges.copy() if topology is not None and rng.random() < 0.8
-                        else garbage(rng, "edges"))
+            args.append(
+                topology.interior_edges.copy() if topology is not None and rng.random() < 0.8 else garbage(rng, "edges")
+            )
         elif p in ("cross",):
             continue
         else:
@@ -723,6 +851,7 @@ def _geometry_args(rng, name, vv, ff, v, f):
 
 
 # ----------------------------------------------------------------------------- running one case
+
 
 def call(target, args, kwargs):
     if target == "principal_curvatures":
@@ -812,7 +941,8 @@ def _unchanged(value, snap):
     kind = snap[0]
     if kind == "masked":
         return np.array_equal(np.ma.getdata(value), snap[1], equal_nan=True) and np.array_equal(
-            np.ma.getmaskarray(value), snap[2])
+            np.ma.getmaskarray(value), snap[2]
+        )
     if kind == "array":
         if value.dtype == object:  # NaN objects compare unequal: compare what they pickle to
             return pickle.dumps(value) == pickle.dumps(snap[1])
@@ -856,10 +986,14 @@ def run_case(target, args, kwargs, clean):
             tb = traceback.extract_tb(error.__traceback__)
             ours = [fr for fr in tb if "meshcurv" in fr.filename and "benchmarks" not in fr.filename]
             where = ours[-1] if ours else tb[-1]
-            outcome = {"status": "exception", "type": type(error).__name__, "message": str(error)[:300],
-                       "where": f"{os.path.relpath(where.filename, ROOT)}:{where.lineno} ({where.name})",
-                       "inner": f"{os.path.basename(tb[-1].filename)}:{tb[-1].lineno}",
-                       "traceback": "".join(traceback.format_list(tb[-6:]))[-2000:]}
+            outcome = {
+                "status": "exception",
+                "type": type(error).__name__,
+                "message": str(error)[:300],
+                "where": f"{os.path.relpath(where.filename, ROOT)}:{where.lineno} ({where.name})",
+                "inner": f"{os.path.basename(tb[-1].filename)}:{tb[-1].lineno}",
+                "traceback": "".join(traceback.format_list(tb[-6:]))[-2000:],
+            }
             result = None
         for w in seen:
             caught.append((w.category.__name__, issubclass(w.category, MeshcurvWarning), str(w.message)[:160]))
@@ -902,8 +1036,10 @@ def relation_check(args, kwargs, result, relation):
             # a pair beyond about 1e15 sizes: float64 loses their distance to each other, any reason will do
             expected = ("needle vertex", "corner of a zero-area face") if len(value) == 1 else ("",)
             if result.valid[row] or not reason.startswith(expected):
-                broken.append(f"needle: the flung vertex {row} of {len(value)} is "
-                              f"{'valid' if result.valid[row] else 'invalid'} (reason {reason!r})")
+                broken.append(
+                    f"needle: the flung vertex {row} of {len(value)} is "
+                    f"{'valid' if result.valid[row] else 'invalid'} (reason {reason!r})"
+                )
         return broken
     if kind == "truth":  # valid estimates on a clean closed analytic shape: within half the largest curvature
         k_min, k_max = TRUTH[value]
@@ -918,9 +1054,11 @@ def relation_check(args, kwargs, result, relation):
         with np.errstate(all="ignore"):
             error = np.maximum(np.abs(result.k_min - k_min), np.abs(result.k_max - k_max))[valid] / scale
         if error.size and not (error < 0.5).all():
-            return [f"truth of {value}: {int((~(error < 0.5)).sum())} of {int(valid.sum())} valid vertices off by more "
-                    f"than half the largest curvature (up to {float(np.nanmax(error)):.3g}; parameters "
-                    f"{dict(result.parameters)})"]
+            return [
+                f"truth of {value}: {int((~(error < 0.5)).sum())} of {int(valid.sum())} valid vertices off by more "
+                f"than half the largest curvature (up to {float(np.nanmax(error)):.3g}; parameters "
+                f"{dict(result.parameters)})"
+            ]
         return []
     n = len(v)
     factor = 1.0
@@ -952,11 +1090,16 @@ def relation_check(args, kwargs, result, relation):
     old_valid, new_valid = result.valid, other.valid[take]
     changed = (old_valid != new_valid) & referenced
     if changed.any():
-        return [f"{kind} {value:g}: valid changed at {int(changed.sum())} vertices "
-                f"({int(old_valid.sum())} -> {int(new_valid.sum())} valid)"]
+        return [
+            f"{kind} {value:g}: valid changed at {int(changed.sum())} vertices "
+            f"({int(old_valid.sum())} -> {int(new_valid.sum())} valid)"
+        ]
     both = old_valid & referenced
-    size = max(np.abs(result.k_min[both]).max(initial=0), np.abs(result.k_max[both]).max(initial=0),
-               1e-6 / max(float(np.ptp(v)) if v.size else 1.0, 1e-300))  # a flat patch: k ~ 1e-17, noise
+    size = max(
+        np.abs(result.k_min[both]).max(initial=0),
+        np.abs(result.k_max[both]).max(initial=0),
+        1e-6 / max(float(np.ptp(v)) if v.size else 1.0, 1e-300),
+    )  # a flat patch: k ~ 1e-17, noise
     broken = []
     for name in ("k_min", "k_max"):
         a, b = getattr(result, name)[both], getattr(other, name)[take][both] * factor
@@ -999,9 +1142,13 @@ def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
             input_bytes = sum(_nbytes(a) for a in args)
             limit = base + memory_mib * 2**20 + factor * input_bytes
             resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-            head = {"target": target, "call": describe(args, kwargs), "mutations": labels,
-                    "method": kwargs.get("method") if isinstance(kwargs.get("method"), str) else None,
-                    "cap_mib": round((limit - base) / 2**20)}
+            head = {
+                "target": target,
+                "call": describe(args, kwargs),
+                "mutations": labels,
+                "method": kwargs.get("method") if isinstance(kwargs.get("method"), str) else None,
+                "cap_mib": round((limit - base) / 2**20),
+            }
             data = pickle.dumps(head)
             os.write(write_end, len(data).to_bytes(8, "little") + data)
             try:
@@ -1020,8 +1167,8 @@ def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
     if len(data) >= 8:
         size = int.from_bytes(data[:8], "little")
         if len(data) >= 8 + size:
-            head = pickle.loads(data[8:8 + size])
-            data = data[8 + size:]
+            head = pickle.loads(data[8 : 8 + size])
+            data = data[8 + size :]
     if timed_out:
         outcome = {"status": "timeout", "message": f"no answer within {timeout:g} s"}
     elif os.WIFSIGNALED(status):
@@ -1030,9 +1177,11 @@ def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
         try:
             outcome = pickle.loads(data)
         except Exception:  # noqa: BLE001
-            outcome = {"status": "crash" if head["target"] != "?" else "memory",
-                       "message": f"child exit {os.WEXITSTATUS(status)} without an answer"
-                                  + ("" if head["target"] != "?" else " (building the case: over 2 GiB?)")}
+            outcome = {
+                "status": "crash" if head["target"] != "?" else "memory",
+                "message": f"child exit {os.WEXITSTATUS(status)} without an answer"
+                + ("" if head["target"] != "?" else " (building the case: over 2 GiB?)"),
+            }
     if outcome.get("type") == "MemoryError":
         outcome["status"] = "memory"
         outcome["message"] = f"MemoryError under a cap of {head.get('cap_mib')} MiB above the parent"
@@ -1063,6 +1212,7 @@ def describe(args, kwargs):
             return f"MeshTopology(F={len(value.faces)}, V={value.n_vertices})"
         text = repr(value)
         return text if len(text) < 60 else text[:57] + "..."
+
     return ", ".join([short(a) for a in args] + [f"{k}={short(v)}" for k, v in kwargs.items()])
 
 
@@ -1078,13 +1228,16 @@ def summary_table(path) -> str:
         entry = groups.setdefault(record["key"], {"count": 0, "first": record})
         entry["count"] += 1
     rows = ["| finding | times | first case (seed, index, backend) | detail |", "|---|---|---|---|"]
-    for key, entry in sorted(groups.items(), key=lambda item: (item[0].split(" | ")[1].startswith("warning"),
-                                                                -item[1]["count"])):
+    for key, entry in sorted(
+        groups.items(), key=lambda item: (item[0].split(" | ")[1].startswith("warning"), -item[1]["count"])
+    ):
         first = entry["first"]
         detail = "; ".join(first.get("broken", [])) or first.get("message", "") or ", ".join(first.get("warnings", []))
         detail = detail.replace("|", "/").replace("\n", " ")[:160]
-        rows.append(f"| `{key.replace('|', '/')}` | {entry['count']} | {first['seed']}, {first['index']}, "
-                    f"{first.get('backend', '')} | {detail} |")
+        rows.append(
+            f"| `{key.replace('|', '/')}` | {entry['count']} | {first['seed']}, {first['index']}, "
+            f"{first.get('backend', '')} | {detail} |"
+        )
     return "\n".join(rows)
 
 
@@ -1099,9 +1252,12 @@ def main(argv=None) -> int:
     parser.add_argument("--log", default=os.path.join(ROOT, "benchmarks", "fuzz_api.jsonl"))
     parser.add_argument("--replay", type=int, default=None, help="run case I in this process and show it")
     parser.add_argument("--summary", metavar="LOG", help="print a markdown table of the findings in LOG and exit")
-    parser.add_argument("--point-clouds", action="store_true",
-                        help="only point_cloud_curvatures: the mutated meshes' vertices and the analytic clouds "
-                             "of make_cloud_case (gaps, copies, thin parts, given radii) with their truth")
+    parser.add_argument(
+        "--point-clouds",
+        action="store_true",
+        help="only point_cloud_curvatures: the mutated meshes' vertices and the analytic clouds "
+        "of make_cloud_case (gaps, copies, thin parts, given radii) with their truth",
+    )
     options = parser.parse_args(argv)
     global ONLY_POINT_CLOUDS
     ONLY_POINT_CLOUDS = options.point_clouds
@@ -1141,22 +1297,42 @@ def main(argv=None) -> int:
     slowest = []
     index = options.start
     with open(options.log, "a") as log:
-        log.write(json.dumps({"run": time.strftime("%Y-%m-%d %H:%M:%S"), "seed": options.seed,
-                              "minutes": options.minutes, "timeout": options.timeout,
-                              "memory": options.memory, "factor": options.factor}) + "\n")
+        log.write(
+            json.dumps(
+                {
+                    "run": time.strftime("%Y-%m-%d %H:%M:%S"),
+                    "seed": options.seed,
+                    "minutes": options.minutes,
+                    "timeout": options.timeout,
+                    "memory": options.memory,
+                    "factor": options.factor,
+                }
+            )
+            + "\n"
+        )
         while time.monotonic() < deadline:
             numpy_backend = index % 4 == 3
-            head, outcome, elapsed = run_forked(options.seed, index, options.timeout, options.memory,
-                                                options.factor, numpy_backend)
+            head, outcome, elapsed = run_forked(
+                options.seed, index, options.timeout, options.memory, options.factor, numpy_backend
+            )
             target = head["target"]
             counts[(target, outcome["status"])] += 1
             slowest.append((elapsed, index))
             if outcome["status"] not in ("ok", "documented") or outcome.get("warnings"):
-                key = signature(target, head["method"], outcome) if outcome["status"] not in ("ok", "documented") \
+                key = (
+                    signature(target, head["method"], outcome)
+                    if outcome["status"] not in ("ok", "documented")
                     else f"{target} | warning {outcome['warnings'][0][:60]}"
-                record = {"index": index, "seed": options.seed, "key": key,
-                          "backend": "numpy" if numpy_backend else "auto", **head, "elapsed": round(elapsed, 2),
-                          **outcome}
+                )
+                record = {
+                    "index": index,
+                    "seed": options.seed,
+                    "key": key,
+                    "backend": "numpy" if numpy_backend else "auto",
+                    **head,
+                    "elapsed": round(elapsed, 2),
+                    **outcome,
+                }
                 log.write(json.dumps(record, default=str) + "\n")
                 log.flush()
                 if key not in first_seen:

@@ -71,18 +71,33 @@ import warnings  # noqa: E402
 import numpy as np  # noqa: E402
 from _forked import collect, vsize  # noqa: E402
 
-from meshcurv.errors import (InvalidMeshError, InvalidOptionError, MeshcurvWarning, MeshFileError,  # noqa: E402
-                             MissingDependencyError)
+from meshcurv.errors import (
+    InvalidMeshError,
+    InvalidOptionError,
+    MeshcurvWarning,
+    MeshFileError,  # noqa: E402
+    MissingDependencyError,
+)
 from meshcurv.volume import MIN_VERTICES, label_curvatures  # noqa: E402
 
 DOCUMENTED = (InvalidMeshError, InvalidOptionError, MeshFileError, MissingDependencyError)
 KINDS = ("ball", "box", "cylinder", "many")
 DTYPES = ("bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64")
-CURVATURE_COLUMNS = ("mean_weighted", "mean_median", "gaussian_weighted", "k_min_p5", "k_max_p95", "total_mean",
-                     "total_gaussian", "willmore", "shape_index_fraction_cap")
+CURVATURE_COLUMNS = (
+    "mean_weighted",
+    "mean_median",
+    "gaussian_weighted",
+    "k_min_p5",
+    "k_max_p95",
+    "total_mean",
+    "total_gaussian",
+    "willmore",
+    "shape_index_fraction_cap",
+)
 
 
 # ---- the cases -------------------------------------------------------------------------------------------------------
+
 
 def _spacing(rng, unit: bool) -> np.ndarray:
     if unit:
@@ -124,16 +139,26 @@ def _ball_case(rng, unit):
     low, high = np.maximum(box_low, center - radius), np.minimum(box_high, center + radius)
     volume, rim = 0.0, 0.0
     if (high > low).all():
-        grid = np.meshgrid(*[low[k] + (np.arange(160) + 0.5) * (high[k] - low[k]) / 160 - center[k] for k in range(3)],
-                           indexing="ij", sparse=True)
+        grid = np.meshgrid(
+            *[low[k] + (np.arange(160) + 0.5) * (high[k] - low[k]) / 160 - center[k] for k in range(3)],
+            indexing="ij",
+            sparse=True,
+        )
         volume = float(np.count_nonzero(sum(g**2 for g in grid) <= radius**2)) * np.prod(high - low) / 160**3
         for axis in range(3):  # an upper bound of the rims' length: whole circles where a face cuts the ball
             for face in (box_low[axis], box_high[axis]):
                 distance = abs(face - center[axis])
                 if distance < radius:
                     rim += 2 * np.pi * np.sqrt(radius**2 - distance**2)
-    truth = {"area": area, "volume": volume, "rim": rim, "radius": radius, "h": h,
-             "check_area": radius >= 4 * h, "mean": 1 / radius}
+    truth = {
+        "area": area,
+        "volume": volume,
+        "rim": rim,
+        "radius": radius,
+        "h": h,
+        "check_area": radius >= 4 * h,
+        "mean": 1 / radius,
+    }
     return image.astype(np.uint8), spacing, truth
 
 
@@ -157,8 +182,16 @@ def _box_case(rng, unit):
                     inner_edges += length * (border == 0)
                     rims += length * (border == 1)
                     chamfered += length * spacing[a] * spacing[b] / 8
-    truth = {"area": area, "volume": float(np.prod(size)), "rim": rims, "edges": inner_edges,
-             "chamfer_volume": chamfered, "h": spacing.max(), "check_area": sides.min() >= 3, "box": True}
+    truth = {
+        "area": area,
+        "volume": float(np.prod(size)),
+        "rim": rims,
+        "edges": inner_edges,
+        "chamfer_volume": chamfered,
+        "h": spacing.max(),
+        "check_area": sides.min() >= 3,
+        "box": True,
+    }
     return image, spacing, truth
 
 
@@ -173,8 +206,15 @@ def _cylinder_case(rng, unit):
     axes = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(extent, spacing, center)], indexing="ij", sparse=True)
     image = np.broadcast_to(sum(a**2 for k, a in enumerate(axes) if k != axis) <= radius**2, tuple(extent))
     length = extent[axis] * spacing[axis]
-    truth = {"area": 2 * np.pi * radius * length, "volume": np.pi * radius**2 * length, "rim": 4 * np.pi * radius,
-             "radius": radius, "h": h, "check_area": True, "mean": 1 / (2 * radius)}
+    truth = {
+        "area": 2 * np.pi * radius * length,
+        "volume": np.pi * radius**2 * length,
+        "rim": 4 * np.pi * radius,
+        "radius": radius,
+        "h": h,
+        "check_area": True,
+        "mean": 1 / (2 * radius),
+    }
     return np.ascontiguousarray(image, dtype=np.uint8), spacing, truth
 
 
@@ -209,6 +249,7 @@ def make_case(seed: int, index: int):
 
 # ---- the checks ------------------------------------------------------------------------------------------------------
 
+
 def check_table(kind, image, spacing, truth, table) -> list[str]:
     broken = []
     present = np.unique(image.view(np.uint8) if image.dtype == bool else image)
@@ -239,8 +280,10 @@ def check_table(kind, image, spacing, truth, table) -> list[str]:
             broken.append(f"n_used {row.n_used} of {row.n_vertices}")
         nan = [np.isnan(getattr(row, column)) for column in CURVATURE_COLUMNS]
         if row.n_used == 0 and not all(nan):
-            broken.append("curvature columns finite with no vertex used: "
-                          + ", ".join(c for c, n in zip(CURVATURE_COLUMNS, nan) if not n))
+            broken.append(
+                "curvature columns finite with no vertex used: "
+                + ", ".join(c for c, n in zip(CURVATURE_COLUMNS, nan) if not n)
+            )
         if row.n_used > 0 and any(nan[:2]):
             broken.append("mean_weighted or mean_median NaN with vertices used")
         if row.touches_border and row.n_used == 0 and "curvature columns NaN" not in row.warnings:
@@ -249,7 +292,9 @@ def check_table(kind, image, spacing, truth, table) -> list[str]:
             broken.append(f"area {row.area:.6g} above the triangles' {row.area_mesh:.6g}")
         voxel_volume = row.n_voxels * float(np.prod(spacing))
         if abs(row.volume - voxel_volume) > 0.5 * truth["h"] * row.area_mesh + 1e-9 * voxel_volume:
-            broken.append(f"volume {row.volume:.6g} farther than half a voxel layer from the voxels' {voxel_volume:.6g}")
+            broken.append(
+                f"volume {row.volume:.6g} farther than half a voxel layer from the voxels' {voxel_volume:.6g}"
+            )
     if truth.get("many") or len(table) != 1 or table.status[0] != "ok":
         return broken
     row = table.iloc[0]
@@ -258,8 +303,9 @@ def check_table(kind, image, spacing, truth, table) -> list[str]:
     if truth.get("box"):
         loss = truth["volume"] - row.volume
         if not -1e-9 * truth["volume"] <= loss <= 1.2 * truth["chamfer_volume"] + 1e-9 * truth["volume"]:
-            broken.append(f"box volume {row.volume:.6g} for {truth['volume']:.6g} (chamfers "
-                          f"{truth['chamfer_volume']:.3g})")
+            broken.append(
+                f"box volume {row.volume:.6g} for {truth['volume']:.6g} (chamfers {truth['chamfer_volume']:.3g})"
+            )
     else:
         tolerance = (0.02 + 1.5 * h / truth["radius"]) * truth["volume"] + h * h / 8 * truth["rim"]
         if abs(row.volume - truth["volume"]) > tolerance:
@@ -268,15 +314,19 @@ def check_table(kind, image, spacing, truth, table) -> list[str]:
     if truth["check_area"] and truth["area"] > 0:
         tolerance = 0.03 * truth["area"] + 0.5 * h * truth["rim"] + 0.8 * h * truth.get("edges", 0.0)
         if abs(row.area - truth["area"]) > tolerance:
-            broken.append(f"{kind} area {row.area:.6g} for {truth['area']:.6g} (tolerance {tolerance:.3g}; "
-                          f"touches_border {row.touches_border})")
+            broken.append(
+                f"{kind} area {row.area:.6g} for {truth['area']:.6g} (tolerance {tolerance:.3g}; "
+                f"touches_border {row.touches_border})"
+            )
     # H wherever it is given (not NaN), on the curved solids
     if "mean" in truth and truth["radius"] >= 5 * h:
         for column in ("mean_weighted", "mean_median"):
             value = getattr(row, column)
             if np.isfinite(value) and abs(value / truth["mean"] - 1) > 0.15:
-                broken.append(f"{kind} {column} {value:.6g} for {truth['mean']:.6g} "
-                              f"({row.n_used} vertices used of {row.n_vertices})")
+                broken.append(
+                    f"{kind} {column} {value:.6g} for {truth['mean']:.6g} "
+                    f"({row.n_used} vertices used of {row.n_vertices})"
+                )
     return broken
 
 
@@ -291,13 +341,21 @@ def run_case(seed, index) -> dict:
         return {"kind": kind, "status": "documented", "type": type(exc).__name__, "message": str(exc)[:200]}
     except Exception as exc:  # noqa: BLE001
         frame = traceback.extract_tb(exc.__traceback__)[-1]
-        return {"kind": kind, "status": "exception", "type": type(exc).__name__, "message": str(exc)[:300],
-                "where": f"{os.path.basename(frame.filename)}:{frame.lineno}"}
+        return {
+            "kind": kind,
+            "status": "exception",
+            "type": type(exc).__name__,
+            "message": str(exc)[:300],
+            "where": f"{os.path.basename(frame.filename)}:{frame.lineno}",
+        }
     broken = check_table(kind, image, spacing, truth, table)
-    spacing_warnings = [w for w in caught if issubclass(w.category, MeshcurvWarning) and "no `spacing`" in
-                        str(w.message)]
+    spacing_warnings = [
+        w for w in caught if issubclass(w.category, MeshcurvWarning) and "no `spacing`" in str(w.message)
+    ]
     if len(spacing_warnings) != (0 if give_spacing else 1):
-        broken.append(f"{len(spacing_warnings)} spacing warnings with spacing {'given' if give_spacing else 'not given'}")
+        broken.append(
+            f"{len(spacing_warnings)} spacing warnings with spacing {'given' if give_spacing else 'not given'}"
+        )
     if twin:
         other = np.asfortranarray(image)
         other.flags.writeable = False
@@ -307,11 +365,17 @@ def run_case(seed, index) -> dict:
         numbers = [c for c in table.columns if table[c].dtype.kind == "f"]
         if not np.allclose(table[numbers].to_numpy(), again[numbers].to_numpy(), rtol=1e-9, atol=0, equal_nan=True):
             broken.append("a Fortran-ordered read-only copy gives another table")
-    return {"kind": kind, "status": "invariant" if broken else "ok", "broken": broken,
-            "labels": len(table), "touches_border": bool(table.touches_border.any()) if len(table) else False}
+    return {
+        "kind": kind,
+        "status": "invariant" if broken else "ok",
+        "broken": broken,
+        "labels": len(table),
+        "touches_border": bool(table.touches_border.any()) if len(table) else False,
+    }
 
 
 # ---- the runner ------------------------------------------------------------------------------------------------------
+
 
 def run_forked(seed, index, timeout, memory_mib) -> tuple[dict, float]:
     base = vsize()
@@ -342,8 +406,11 @@ def run_forked(seed, index, timeout, memory_mib) -> tuple[dict, float]:
     try:
         return pickle.loads(data), elapsed
     except Exception:  # noqa: BLE001
-        return {"kind": "?", "status": "crash", "message": f"child exit {os.WEXITSTATUS(status)} without an answer"}, \
-            elapsed
+        return {
+            "kind": "?",
+            "status": "crash",
+            "message": f"child exit {os.WEXITSTATUS(status)} without an answer",
+        }, elapsed
 
 
 def _key(outcome) -> str:
@@ -368,8 +435,10 @@ def main(argv=None) -> int:
 
     if options.replay is not None:
         kind, image, spacing, give_spacing, truth, twin = make_case(options.seed, options.replay)
-        print(f"case {options.replay} seed {options.seed}: {kind}, image {image.shape} {image.dtype}, spacing "
-              f"{tuple(spacing.tolist())} ({'given' if give_spacing else 'not given'}), truth {truth}")
+        print(
+            f"case {options.replay} seed {options.seed}: {kind}, image {image.shape} {image.dtype}, spacing "
+            f"{tuple(spacing.tolist())} ({'given' if give_spacing else 'not given'}), truth {truth}"
+        )
         for key, value in run_case(options.seed, options.replay).items():
             print(f"{key}: {value}")
         return 0
@@ -385,8 +454,10 @@ def main(argv=None) -> int:
     slowest = []
     index = options.start
     with open(options.log, "a") as log:
-        log.write(json.dumps({"run": time.strftime("%Y-%m-%d %H:%M:%S"), "seed": options.seed,
-                              "minutes": options.minutes}) + "\n")
+        log.write(
+            json.dumps({"run": time.strftime("%Y-%m-%d %H:%M:%S"), "seed": options.seed, "minutes": options.minutes})
+            + "\n"
+        )
         while time.monotonic() < deadline:
             outcome, elapsed = run_forked(options.seed, index, options.timeout, options.memory)
             counts[(outcome["kind"], outcome["status"])] += 1
@@ -395,8 +466,13 @@ def main(argv=None) -> int:
             slowest.append((elapsed, index))
             if outcome["status"] not in ("ok", "documented"):
                 key = _key(outcome)
-                log.write(json.dumps({"index": index, "seed": options.seed, "key": key, "elapsed": round(elapsed, 2),
-                                      **outcome}, default=str) + "\n")
+                log.write(
+                    json.dumps(
+                        {"index": index, "seed": options.seed, "key": key, "elapsed": round(elapsed, 2), **outcome},
+                        default=str,
+                    )
+                    + "\n"
+                )
                 log.flush()
                 if key not in first_seen:
                     first_seen[key] = index

@@ -69,18 +69,26 @@ def _legacy_polydata(binary: bool, version: str) -> bytes:
             return np.asarray(values).astype(">" + code).tobytes() + b"\n"
         return (" ".join(map(str, np.asarray(values).ravel().tolist())) + "\n").encode()
 
-    parts = [f"# vtk DataFile Version {version}\nfuzz\n{'BINARY' if binary else 'ASCII'}\nDATASET POLYDATA\n".encode(),
-             f"POINTS {len(vertices)} double\n".encode() + array(vertices, "f8")]
+    parts = [
+        f"# vtk DataFile Version {version}\nfuzz\n{'BINARY' if binary else 'ASCII'}\nDATASET POLYDATA\n".encode(),
+        f"POINTS {len(vertices)} double\n".encode() + array(vertices, "f8"),
+    ]
     if version.startswith("5"):
         offsets = np.arange(len(faces) + 1) * 3
         parts.append(b"METADATA\nINFORMATION 0\n\n")
-        parts.append(f"POLYGONS {len(offsets)} {faces.size}\nOFFSETS vtktypeint64\n".encode() + array(offsets, "i8")
-                     + b"CONNECTIVITY vtktypeint64\n" + array(faces, "i8"))
+        parts.append(
+            f"POLYGONS {len(offsets)} {faces.size}\nOFFSETS vtktypeint64\n".encode()
+            + array(offsets, "i8")
+            + b"CONNECTIVITY vtktypeint64\n"
+            + array(faces, "i8")
+        )
     else:
         cells = np.column_stack([np.full(len(faces), 3), faces])
         parts.append(f"POLYGONS {len(faces)} {cells.size}\n".encode() + array(cells, "i4"))
-    parts.append(f"POINT_DATA {len(vertices)}\nSCALARS k float 1\nLOOKUP_TABLE default\n".encode()
-                 + array(np.arange(len(vertices)), "f4"))
+    parts.append(
+        f"POINT_DATA {len(vertices)}\nSCALARS k float 1\nLOOKUP_TABLE default\n".encode()
+        + array(np.arange(len(vertices)), "f4")
+    )
     return b"".join(parts)
 
 
@@ -100,12 +108,14 @@ def seeds(directory: pathlib.Path) -> list[tuple[str, str, bytes]]:
                         io.write_mesh(path, torus.vertices, faces, binary=binary, overwrite=True)
                     except (MissingDependencyError, MeshFileError, InvalidMeshError):
                         continue
-                    found.append((f"{extension[1:]}-{label}-{'bin' if binary else 'ascii'}", extension,
-                                  path.read_bytes()))
+                    found.append(
+                        (f"{extension[1:]}-{label}-{'bin' if binary else 'ascii'}", extension, path.read_bytes())
+                    )
     for binary in (True, False):
         for version in ("4.2", "5.1"):
-            found.append((f"vtk-polydata{version}-{'bin' if binary else 'ascii'}", ".vtk",
-                          _legacy_polydata(binary, version)))
+            found.append(
+                (f"vtk-polydata{version}-{'bin' if binary else 'ascii'}", ".vtk", _legacy_polydata(binary, version))
+            )
     unique = {}
     for label, extension, data in found:
         unique.setdefault((extension, data), label)
@@ -114,8 +124,15 @@ def seeds(directory: pathlib.Path) -> list[tuple[str, str, bytes]]:
 
 def _boundaries(data: bytes) -> list[int]:
     marks = {0, len(data)}
-    for pattern in (rb"\n", rb"\s", rb"end_header", rb"POLYGONS|POINTS|OFFSETS|CONNECTIVITY|POINT_DATA",
-                    rb"<DataArray|</DataArray>|>", rb"PK\x03\x04|PK\x01\x02|PK\x05\x06", rb"\nf |\nv "):
+    for pattern in (
+        rb"\n",
+        rb"\s",
+        rb"end_header",
+        rb"POLYGONS|POINTS|OFFSETS|CONNECTIVITY|POINT_DATA",
+        rb"<DataArray|</DataArray>|>",
+        rb"PK\x03\x04|PK\x01\x02|PK\x05\x06",
+        rb"\nf |\nv ",
+    ):
         for match in re.finditer(pattern, data[:200000]):
             marks.update((match.start(), match.end()))
     return sorted(marks)
@@ -125,7 +142,7 @@ def mutate(data: bytes, rng: random.Random) -> tuple[str, bytes]:
     choice = rng.randrange(6)
     if choice == 0:  # truncation at a boundary (or next to one)
         cut = rng.choice(_boundaries(data)) + rng.choice([-1, 0, 0, 0, 1])
-        return f"cut at {cut}", data[:max(cut, 0)]
+        return f"cut at {cut}", data[: max(cut, 0)]
     if choice == 1:
         cut = rng.randrange(len(data) + 1)
         return f"cut at {cut}", data[:cut]
@@ -137,18 +154,18 @@ def mutate(data: bytes, rng: random.Random) -> tuple[str, bytes]:
             if what == 0 and buffer:
                 buffer[i] = rng.randrange(256)
             elif what == 1:
-                del buffer[i:i + rng.randint(1, 16)]
+                del buffer[i : i + rng.randint(1, 16)]
             elif what == 2:
                 buffer[i:i] = bytes(rng.randrange(256) for _ in range(rng.randint(1, 16)))
             else:
-                buffer[i:i] = buffer[i:i + rng.randint(1, 64)]
+                buffer[i:i] = buffer[i : i + rng.randint(1, 64)]
         return "bytes changed", bytes(buffer)
     if choice == 3:  # a huge (or negative, or zero) declared count
         numbers = list(re.finditer(rb"(?<![\w.\-])\d+(?![\w.])", data[:4096]))
         if numbers:
             match = rng.choice(numbers)
             value = rng.choice(HUGE)
-            return f"count at {match.start()} -> {value.decode()}", data[:match.start()] + value + data[match.end():]
+            return f"count at {match.start()} -> {value.decode()}", data[: match.start()] + value + data[match.end() :]
         return "unchanged", data
     if choice == 4:  # header garbage: a line dropped, doubled or replaced
         lines = data[:4096].split(b"\n")
@@ -165,7 +182,9 @@ def mutate(data: bytes, rng: random.Random) -> tuple[str, bytes]:
     numbers = list(re.finditer(rb"(?<![\w.\-])\d+(?![\w.])", data))
     if numbers:
         match = rng.choice(numbers)
-        return f"number at {match.start()} -> float", data[:match.start()] + match.group() + b".5" + data[match.end():]
+        return f"number at {match.start()} -> float", data[: match.start()] + match.group() + b".5" + data[
+            match.end() :
+        ]
     return "unchanged", data
 
 
@@ -214,8 +233,17 @@ def read_in_child(context, path: pathlib.Path, timeout: float, memory_bytes: int
 #: changes that leave the file valid: the reader must read the intended points
 HARMLESS = ("none", "blank line", "crlf", "comment line")
 #: changes to one row (or two): the intended result, or an error naming a touched line
-DAMAGING = ("drop a value", "extra value", "move a value to the next row", "empty value", "trailing separator",
-            "trailing separator on every row", "split the row", "join with the next row", "not a number")
+DAMAGING = (
+    "drop a value",
+    "extra value",
+    "move a value to the next row",
+    "empty value",
+    "trailing separator",
+    "trailing separator on every row",
+    "split the row",
+    "join with the next row",
+    "not a number",
+)
 
 
 class Row:
@@ -243,8 +271,7 @@ def _surface(rng: random.Random) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _words(values) -> list[str]:
-    return [repr(float(v)) if isinstance(v, float) or np.issubdtype(type(v), np.floating) else str(v)
-            for v in values]
+    return [repr(float(v)) if isinstance(v, float) or np.issubdtype(type(v), np.floating) else str(v) for v in values]
 
 
 def text_case(kind: str, rng: random.Random):
@@ -269,26 +296,55 @@ def text_case(kind: str, rng: random.Random):
             if kind == "csv-semicolon":
                 words = [word.replace(".", ",") for word in words]
             rows.append(Row(words, separator))
-        extension = {"csv": ".csv", "csv-header": ".csv", "csv-semicolon": ".csv", "pts": ".pts",
-                     "txt-header": ".txt"}.get(kind, ".xyz")
+        extension = {
+            "csv": ".csv",
+            "csv-header": ".csv",
+            "csv-semicolon": ".csv",
+            "pts": ".pts",
+            "txt-header": ".txt",
+        }.get(kind, ".xyz")
         return extension, "points", rows, points, None, extra
     if kind == "ply-cloud":
         points = _cloud(rng)
-        header = ["ply", "format ascii 1.0", f"element vertex {len(points)}", "property double x",
-                  "property double y", "property double z", "end_header"]
+        header = [
+            "ply",
+            "format ascii 1.0",
+            f"element vertex {len(points)}",
+            "property double x",
+            "property double y",
+            "property double z",
+            "end_header",
+        ]
         rows = [Row([line], data=False) for line in header] + [Row(_words(p)) for p in points]
         return ".ply", "points", rows, points, None, [2]
     if kind == "pcd":
         points = _cloud(rng)
-        header = ["VERSION 0.7", "FIELDS x y z", "SIZE 8 8 8", "TYPE F F F", "COUNT 1 1 1", f"WIDTH {len(points)}",
-                  "HEIGHT 1", f"POINTS {len(points)}", "DATA ascii"]
+        header = [
+            "VERSION 0.7",
+            "FIELDS x y z",
+            "SIZE 8 8 8",
+            "TYPE F F F",
+            "COUNT 1 1 1",
+            f"WIDTH {len(points)}",
+            "HEIGHT 1",
+            f"POINTS {len(points)}",
+            "DATA ascii",
+        ]
         rows = [Row([line], data=False) for line in header] + [Row(_words(p)) for p in points]
         return ".pcd", "points", rows, points, None, [5, 7]
     points, faces = _surface(rng)
     if kind == "ply-mesh":
-        header = ["ply", "format ascii 1.0", f"element vertex {len(points)}", "property double x",
-                  "property double y", "property double z", f"element face {len(faces)}",
-                  "property list uchar int vertex_indices", "end_header"]
+        header = [
+            "ply",
+            "format ascii 1.0",
+            f"element vertex {len(points)}",
+            "property double x",
+            "property double y",
+            "property double z",
+            f"element face {len(faces)}",
+            "property list uchar int vertex_indices",
+            "end_header",
+        ]
         rows = [Row([line], data=False) for line in header] + [Row(_words(p)) for p in points]
         rows += [Row(["3", *map(str, face)], free=True) for face in faces]  # a whole number added first: a polygon
         return ".ply", "mesh", rows, points, faces, [2, 6]
@@ -311,8 +367,21 @@ def text_case(kind: str, rng: random.Random):
     raise ValueError(kind)
 
 
-TEXT_KINDS = ("csv", "csv-header", "csv-semicolon", "xyz", "xyz-tab", "pts", "txt-header", "ply-cloud", "pcd",
-              "ply-mesh", "obj", "off", "stl")
+TEXT_KINDS = (
+    "csv",
+    "csv-header",
+    "csv-semicolon",
+    "xyz",
+    "xyz-tab",
+    "pts",
+    "txt-header",
+    "ply-cloud",
+    "pcd",
+    "ply-mesh",
+    "obj",
+    "off",
+    "stl",
+)
 
 
 def mutate_rows(rows: list, change: str, rng: random.Random) -> tuple[str, set]:
@@ -415,8 +484,11 @@ def judge_text(context, directory, kind, rng, timeout, memory_bytes) -> tuple[st
         if faces is None:
             same = got_points.shape == points.shape and np.array_equal(got_points, points)
         else:  # the corners' coordinates, face by face (STL readers merge the repeated corners)
-            same = (isinstance(got_faces, np.ndarray) and got_faces.shape == faces.shape
-                    and np.array_equal(got_points[got_faces], points[faces]))
+            same = (
+                isinstance(got_faces, np.ndarray)
+                and got_faces.shape == faces.shape
+                and np.array_equal(got_points[got_faces], points[faces])
+            )
         if same:
             return "correct", change, "", content
         if free:  # `v x y z` -> `v x y a z`: a valid vertex with w; a face of 4 corners; an OFF face's colour
@@ -455,9 +527,13 @@ def main(argv=None) -> int:
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds per read (default 10)")
     parser.add_argument("--memory", type=int, default=1024, help="MiB of address space per read (default 1024)")
     parser.add_argument("--keep", type=pathlib.Path, default=None, help="folder to save the failing inputs in")
-    parser.add_argument("--mode", choices=["bytes", "rows", "both"], default="both",
-                        help="byte mutations of every format, text rows changed in every text format, or both "
-                             "(half the time each; default)")
+    parser.add_argument(
+        "--mode",
+        choices=["bytes", "rows", "both"],
+        default="both",
+        help="byte mutations of every format, text rows changed in every text format, or both "
+        "(half the time each; default)",
+    )
     args = parser.parse_args(argv)
     rng = random.Random(args.seed)
     context = multiprocessing.get_context("fork")
@@ -465,7 +541,7 @@ def main(argv=None) -> int:
     import resource
 
     base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-    memory_bytes = args.memory * 2 ** 20 + 4 * base
+    memory_bytes = args.memory * 2**20 + 4 * base
     stop = time.monotonic() + 60 * args.minutes
     counts: dict[str, dict[str, int]] = {}
     findings = []
@@ -494,10 +570,12 @@ def main(argv=None) -> int:
     for label, how, outcome, detail, content in findings[:20]:
         print(f"FINDING {outcome} in {label} ({how}): {detail}\n    input starts {content[:120]!r}")
     rows = sum(sum(row.values()) for label, row in counts.items() if label.startswith("rows "))
-    print(f"total {total} reads in {args.minutes:g} min ({rows} text-row cases, {total - rows} byte mutations), "
-          f"{len(findings)} findings (byte mutations: crash, hang or memory; text rows: also a result other than "
-          "the points written, or an error naming no line); documented errors: "
-          + ", ".join(e.__name__ for e in DOCUMENTED))
+    print(
+        f"total {total} reads in {args.minutes:g} min ({rows} text-row cases, {total - rows} byte mutations), "
+        f"{len(findings)} findings (byte mutations: crash, hang or memory; text rows: also a result other than "
+        "the points written, or an error naming no line); documented errors: "
+        + ", ".join(e.__name__ for e in DOCUMENTED)
+    )
     return 1 if findings else 0
 
 

@@ -41,8 +41,10 @@ def main(argv=None):
     parser.add_argument("--repeats", type=int, default=3)
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore", meshcurv.MeshQualityWarning)
-    print(f"meshcurv {meshcurv.__version__}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; "
-          f"median of {args.repeats} calls, wall s (CPU s)\n")
+    print(
+        f"meshcurv {meshcurv.__version__}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; "
+        f"median of {args.repeats} calls, wall s (CPU s)\n"
+    )
     print("| vertices | icc at 4h alone | 3 calls h, 2h, 4h | multiscale h, 2h, 4h | multiscale / 4h alone |")
     print("|--:|--:|--:|--:|--:|")
     for size in args.sizes.split(","):
@@ -53,8 +55,10 @@ def main(argv=None):
         alone = timed(lambda: meshcurv.principal_curvatures(v, f, radius=4 * h), args.repeats)
         separate = timed(lambda: [meshcurv.principal_curvatures(v, f, radius=r) for r in radii], args.repeats)
         multi = timed(lambda: meshcurv.multiscale_curvatures(v, f, radii), args.repeats)
-        print(f"| {v.shape[0]:,} | {alone[0]:.3f} ({alone[1]:.2f}) | {separate[0]:.3f} ({separate[1]:.2f}) | "
-              f"{multi[0]:.3f} ({multi[1]:.2f}) | {multi[0] / alone[0]:.2f}x ({multi[1] / alone[1]:.2f}x) |")
+        print(
+            f"| {v.shape[0]:,} | {alone[0]:.3f} ({alone[1]:.2f}) | {separate[0]:.3f} ({separate[1]:.2f}) | "
+            f"{multi[0]:.3f} ({multi[1]:.2f}) | {multi[0] / alone[0]:.2f}x ({multi[1] / alone[1]:.2f}x) |"
+        )
 
 
 if __name__ == "__main__":

@@ -49,8 +49,10 @@ def shuffled(vertices, faces, block, seed=0):
 def machine_line() -> str:
     info = speed.machine_info()
     versions = ", ".join(f"{name} {version}" for name, version in info["versions"].items())
-    return (f"- Machine: {info['cpu']}, {info['cores']} cores; load average at start {tuple(round(x, 1) for x in info['load_start'])}; "
-            f"{versions}; meshcurv at commit {info['commit']}")
+    return (
+        f"- Machine: {info['cpu']}, {info['cores']} cores; load average at start {tuple(round(x, 1) for x in info['load_start'])}; "
+        f"{versions}; meshcurv at commit {info['commit']}"
+    )
 
 
 def main(argv=None) -> int:
@@ -61,17 +63,28 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     installed, _ = speed.peers_installed()
     keys = [key for key in IMPLEMENTATIONS if key.startswith("meshcurv/") or key in installed]
-    lines = ["# Speed against the vertex order (issue 15)", "",
-             f"Generated {time.strftime('%Y-%m-%d %H:%M')} by `python benchmarks/order.py --sizes {args.sizes} "
-             f"--repeats {args.repeats}`", "", machine_line(), "", "Wall seconds, median of the calls after the first, each implementation in a fresh process "
-             "on the same arrays. `span`: the median over the faces of the smallest index difference along "
-             f"a side (meshcurv reorders from {_locality.SPAN_LIMIT}, at {_locality.MIN_VERTICES:,} vertices "
-             "or more).", ""]
+    lines = [
+        "# Speed against the vertex order (issue 15)",
+        "",
+        f"Generated {time.strftime('%Y-%m-%d %H:%M')} by `python benchmarks/order.py --sizes {args.sizes} "
+        f"--repeats {args.repeats}`",
+        "",
+        machine_line(),
+        "",
+        "Wall seconds, median of the calls after the first, each implementation in a fresh process "
+        "on the same arrays. `span`: the median over the faces of the smallest index difference along "
+        f"a side (meshcurv reorders from {_locality.SPAN_LIMIT}, at {_locality.MIN_VERTICES:,} vertices "
+        "or more).",
+        "",
+    ]
     for label in args.sizes.split(","):
         _, vertices, faces = speed.build_mesh(label)
-        lines += [f"## {label}: {vertices.shape[0]:,} vertices", "",
-                  "| order | span | reordered | " + " | ".join(speed.label_of(k) for k in keys) + " |",
-                  "|---|--:|---|" + "--:|" * len(keys)]
+        lines += [
+            f"## {label}: {vertices.shape[0]:,} vertices",
+            "",
+            "| order | span | reordered | " + " | ".join(speed.label_of(k) for k in keys) + " |",
+            "|---|--:|---|" + "--:|" * len(keys),
+        ]
         for name, block in ORDERS:
             v, f = shuffled(vertices, faces, block)
             span = _locality.median_side_span(f)
@@ -84,8 +97,11 @@ def main(argv=None) -> int:
                     times = found.get("times", [])[1:] or found.get("times", [])
                     cells.append(f"{np.median(times):.2f}" if times else str(found)[:40])
                     print(label, name, key, cells[-1], flush=True)
-            lines.append(f"| {name} | {span:,} | {'yes' if _locality.is_scattered(v.shape[0], f) else 'no'} | "
-                         + " | ".join(cells) + " |")
+            lines.append(
+                f"| {name} | {span:,} | {'yes' if _locality.is_scattered(v.shape[0], f) else 'no'} | "
+                + " | ".join(cells)
+                + " |"
+            )
         lines.append("")
     text = "\n".join(lines)
     partial = args.output + ".partial"

@@ -62,8 +62,9 @@ TRUEFORM = "trueform principal_curvatures(k=2, directions=True)"
 def peer_trueform(v, f):
     import trueform
 
-    k0, k1, d0, _ = trueform.principal_curvatures((np.ascontiguousarray(f, dtype=np.int32),
-                                                   np.ascontiguousarray(v)), k=2, directions=True)
+    k0, k1, d0, _ = trueform.principal_curvatures(
+        (np.ascontiguousarray(f, dtype=np.int32), np.ascontiguousarray(v)), k=2, directions=True
+    )
     # trueform: k0 the larger, positive on an outward sphere (as meshcurv); d0 its direction
     k_min, k_max = np.minimum(k0, k1), np.maximum(k0, k1)
     dir_max = np.where((k0 >= k1)[:, None], d0, np.nan)
@@ -87,8 +88,11 @@ def implementations(selected=None):
             import importlib.metadata
 
             import trueform  # noqa: F401 - a benchmark peer only (non-commercial licence)
-            found[TRUEFORM] = (_peer_call(lambda v, f, r: peer_trueform(v, f)),
-                               f"trueform {importlib.metadata.version('trueform')}")
+
+            found[TRUEFORM] = (
+                _peer_call(lambda v, f, r: peer_trueform(v, f)),
+                f"trueform {importlib.metadata.version('trueform')}",
+            )
         except Exception as exc:  # noqa: BLE001 - any import failure: not installed
             missing[TRUEFORM] = f"trueform: not installed ({type(exc).__name__})"
     return found, missing
@@ -98,6 +102,7 @@ def _meshcurv_call(method):
     def call(v, f, radius):
         r = meshcurv.principal_curvatures(v, f, method=method)  # the faces as given: topology in the call
         return r.k_min, r.k_max, r.valid
+
     return call
 
 
@@ -105,6 +110,7 @@ def _peer_call(function):
     def call(v, f, radius):
         k_min, k_max, _, _ = function(v, f, radius)
         return k_min, k_max, np.isfinite(k_min) & np.isfinite(k_max)
+
     return call
 
 
@@ -117,8 +123,9 @@ def timed(call, repeats):
         result = call()
         wall = time.perf_counter() - t0
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpus.append(time.process_time() - c0 + (after.ru_utime - children.ru_utime)
-                    + (after.ru_stime - children.ru_stime))
+        cpus.append(
+            time.process_time() - c0 + (after.ru_utime - children.ru_utime) + (after.ru_stime - children.ru_stime)
+        )
         walls.append(wall)
     return result, statistics.median(walls), statistics.median(cpus)
 
@@ -149,8 +156,18 @@ def run(level: int, repeats: int, selected=None):
                     continue
             mask = interior & valid
             error = accuracy.errors(mesh, k_min, k_max, np.full((v.shape[0], 3), np.nan), mask)["H"][0]
-            rows.append({"family": variant, "surface": surface, "n": v.shape[0], "method": name, "wall": wall,
-                         "cpu": cpu, "error": float(error), "cover": float(mask.sum() / max(interior.sum(), 1))})
+            rows.append(
+                {
+                    "family": variant,
+                    "surface": surface,
+                    "n": v.shape[0],
+                    "method": name,
+                    "wall": wall,
+                    "cpu": cpu,
+                    "error": float(error),
+                    "cover": float(mask.sum() / max(interior.sum(), 1)),
+                }
+            )
         print(f"{variant:10s} {surface:10s} ({v.shape[0]} vertices) done", file=sys.stderr)
     return rows, found, missing
 
@@ -159,8 +176,9 @@ def summarise(rows):
     """{family: {implementation: {wall, cpu, error, cover, surfaces}}}."""
     out: dict = {}
     for row in rows:
-        entry = out.setdefault(row["family"], {}).setdefault(row["method"], {"wall": 0.0, "cpu": 0.0, "errors": [],
-                                                                              "covers": [], "surfaces": 0})
+        entry = out.setdefault(row["family"], {}).setdefault(
+            row["method"], {"wall": 0.0, "cpu": 0.0, "errors": [], "covers": [], "surfaces": 0}
+        )
         entry["wall"] += row["wall"]
         entry["cpu"] += row["cpu"]
         entry["errors"].append(row["error"])
@@ -180,8 +198,10 @@ def front(family: dict) -> set:
     for name, entry in family.items():
         if not np.isfinite(entry["error"]):
             continue
-        beaten = any(other != name and np.isfinite(o["error"]) and o["cpu"] < entry["cpu"]
-                     and o["error"] <= entry["error"] for other, o in family.items())
+        beaten = any(
+            other != name and np.isfinite(o["error"]) and o["cpu"] < entry["cpu"] and o["error"] <= entry["error"]
+            for other, o in family.items()
+        )
         if not beaten:
             kept.add(name)
     return kept
@@ -192,8 +212,11 @@ def dominating(family: dict, peer: str) -> list:
     p = family.get(peer)
     if p is None or not np.isfinite(p["error"]):
         return []
-    better = [(e["cpu"], name) for name, e in family.items() if name.startswith("meshcurv")
-              and np.isfinite(e["error"]) and e["error"] <= p["error"] and e["cpu"] < p["cpu"]]
+    better = [
+        (e["cpu"], name)
+        for name, e in family.items()
+        if name.startswith("meshcurv") and np.isfinite(e["error"]) and e["error"] <= p["error"] and e["cpu"] < p["cpu"]
+    ]
     return [name for _, name in sorted(better)]
 
 
@@ -202,8 +225,11 @@ def more_accurate(family: dict, peer: str):
     p = family.get(peer)
     if p is None or not np.isfinite(p["error"]):
         return None
-    better = sorted((e["cpu"], name) for name, e in family.items() if name.startswith("meshcurv")
-                    and np.isfinite(e["error"]) and e["error"] < p["error"])
+    better = sorted(
+        (e["cpu"], name)
+        for name, e in family.items()
+        if name.startswith("meshcurv") and np.isfinite(e["error"]) and e["error"] < p["error"]
+    )
     return (better[0][1], better[0][0] / p["cpu"]) if better else None
 
 
@@ -223,12 +249,18 @@ def in_short(summary, peer: str) -> str:
             slower.setdefault(found[0].removeprefix("meshcurv "), []).append((family, found[1]))
     parts = []
     if wins:
-        parts.append("at least as accurate and faster: " + "; ".join(
-            f"{method} ({', '.join(families)})" for method, families in wins.items()))
+        parts.append(
+            "at least as accurate and faster: "
+            + "; ".join(f"{method} ({', '.join(families)})" for method, families in wins.items())
+        )
     if slower:
-        parts.append("more accurate but slower: " + "; ".join(
-            f"{method} ({', '.join(f'{family}: {r:.2g}x the CPU time' for family, r in found)})"
-            for method, found in slower.items()))
+        parts.append(
+            "more accurate but slower: "
+            + "; ".join(
+                f"{method} ({', '.join(f'{family}: {r:.2g}x the CPU time' for family, r in found)})"
+                for method, found in slower.items()
+            )
+        )
     if not parts:
         parts.append("no meshcurv method at least as accurate")
     return f"**{peer}**: " + "; ".join(parts) + "."
@@ -239,8 +271,16 @@ def _source_commit() -> str:
     import subprocess
 
     try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, timeout=10,
-                              cwd=os.path.dirname(os.path.abspath(meshcurv.__file__))).stdout.strip() or "?"
+        return (
+            subprocess.run(
+                ["git", "rev-parse", "--short", "HEAD"],
+                capture_output=True,
+                text=True,
+                timeout=10,
+                cwd=os.path.dirname(os.path.abspath(meshcurv.__file__)),
+            ).stdout.strip()
+            or "?"
+        )
     except (OSError, subprocess.SubprocessError):
         return "?"
 
@@ -251,12 +291,13 @@ def markdown(summary, found, missing, args, load_start, load_end, n_by_family) -
         "# Time against error: the Pareto table (issue 31)",
         "",
         f"Generated {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')} by `python benchmarks/pareto.py "
-        + " ".join(sys.argv[1:]) + f"`, meshcurv at commit {_source_commit()}.",
+        + " ".join(sys.argv[1:])
+        + f"`, meshcurv at commit {_source_commit()}.",
         "",
-        f"- Meshes: level {args.level} of `benchmarks/accuracy.py` (" + "; ".join(
-            f"{family}: {n}" for family, n in n_by_family.items()) + " vertices); meshcurv's default method: "
-        f"{DEFAULT_METHOD}; peers: {packages}"
-        + ("; not run: " + "; ".join(missing.values()) if missing else ""),
+        f"- Meshes: level {args.level} of `benchmarks/accuracy.py` ("
+        + "; ".join(f"{family}: {n}" for family, n in n_by_family.items())
+        + " vertices); meshcurv's default method: "
+        f"{DEFAULT_METHOD}; peers: {packages}" + ("; not run: " + "; ".join(missing.values()) if missing else ""),
         f"- Load average (1, 5, 15 min) at start {load_start}, at end {load_end} (2 cores; other jobs "
         "lengthen wall times, CPU seconds less)",
         "",
@@ -273,18 +314,30 @@ def markdown(summary, found, missing, args, load_start, load_end, n_by_family) -
     ]
     for family, entries in summary.items():
         kept = front(entries)
-        lines += [f"## {family}", "", "| implementation | wall s | CPU s | median H error | cover | front |",
-                  "|---|--:|--:|--:|--:|:-:|"]
+        lines += [
+            f"## {family}",
+            "",
+            "| implementation | wall s | CPU s | median H error | cover | front |",
+            "|---|--:|--:|--:|--:|:-:|",
+        ]
         for name, e in sorted(entries.items(), key=lambda item: item[1]["cpu"]):
-            lines.append(f"| {name} | {e['wall']:.3f} | {e['cpu']:.3f} | {100 * e['error']:.3g}% | "
-                         f"{100 * e['cover']:.0f}% | {'yes' if name in kept else ''} |")
+            lines.append(
+                f"| {name} | {e['wall']:.3f} | {e['cpu']:.3f} | {100 * e['error']:.3g}% | "
+                f"{100 * e['cover']:.0f}% | {'yes' if name in kept else ''} |"
+            )
         lines.append("")
-    lines += ["## For each peer: the meshcurv methods at least as accurate and faster", "",
-              "| peer | " + " | ".join(summary) + " |", "|---|" + "---|" * len(summary)]
+    lines += [
+        "## For each peer: the meshcurv methods at least as accurate and faster",
+        "",
+        "| peer | " + " | ".join(summary) + " |",
+        "|---|" + "---|" * len(summary),
+    ]
     peers = [name for name in found if not name.startswith("meshcurv")]
     for peer in peers:
-        cells = [", ".join(m.removeprefix("meshcurv ") for m in dominating(entries, peer)) or "none"
-                 for entries in summary.values()]
+        cells = [
+            ", ".join(m.removeprefix("meshcurv ") for m in dominating(entries, peer)) or "none"
+            for entries in summary.values()
+        ]
         lines.append(f"| {peer} | " + " | ".join(cells) + " |")
     lines += ["", "In short, for each peer (the fastest such meshcurv method; CPU seconds):", ""]
     lines += [f"- {in_short(summary, peer)}" for peer in peers]
@@ -318,12 +371,21 @@ def _place_labels(ax, points, fontsize=7):
         px, py = to_px((x, y))
         width = char * len(text)
         near = [(px + 6, py + 2), (px + 6, py - line - 2), (px - 6 - width, py + 2), (px - 6 - width, py - line - 2)]
-        tries = [(k, (lx, ly + sign * k * line)) for k in range(8) for sign in ((1, -1) if k else (1,))
-                 for lx, ly in near]
+        tries = [
+            (k, (lx, ly + sign * k * line)) for k in range(8) for sign in ((1, -1) if k else (1,)) for lx, ly in near
+        ]
         k, (lx, ly) = next(((k, spot) for k, spot in tries if free(*spot, width)), tries[0])
         placed.append((lx, lx + width, ly, ly + line))
-        ax.annotate(text, (x, y), xytext=to_data((lx, ly)), textcoords="data", fontsize=fontsize, ha="left",
-                    va="bottom", arrowprops={"arrowstyle": "-", "color": "0.6", "lw": 0.5} if k else None)
+        ax.annotate(
+            text,
+            (x, y),
+            xytext=to_data((lx, ly)),
+            textcoords="data",
+            fontsize=fontsize,
+            ha="left",
+            va="bottom",
+            arrowprops={"arrowstyle": "-", "color": "0.6", "lw": 0.5} if k else None,
+        )
 
 
 def _short(name: str) -> str:
@@ -346,8 +408,14 @@ def figure(summary, path: str, n_by_family=None) -> None:
         shown = {name: e for name, e in entries.items() if np.isfinite(e["error"]) and e["error"] > 0}
         for name, e in shown.items():
             ours = name.startswith("meshcurv")
-            ax.scatter(e["cpu"], 100 * e["error"], color="tab:blue" if ours else "tab:orange",
-                       marker="o" if ours else "s", s=40, zorder=3)
+            ax.scatter(
+                e["cpu"],
+                100 * e["error"],
+                color="tab:blue" if ours else "tab:orange",
+                marker="o" if ours else "s",
+                s=40,
+                zorder=3,
+            )
         points = sorted((entries[n]["cpu"], 100 * entries[n]["error"]) for n in kept)
         if points:
             ax.step(*zip(*points), where="post", color="gray", lw=1, zorder=1)
@@ -363,23 +431,36 @@ def figure(summary, path: str, n_by_family=None) -> None:
         ax.set_xlabel("CPU seconds, log scale (sum over the family's surfaces)")
         ax.set_ylabel("median relative error of H (%), log scale")
         ax.grid(True, which="both", alpha=0.3)
-    handles = [Line2D([], [], color="tab:blue", marker="o", ls="", label="meshcurv methods"),
-               Line2D([], [], color="tab:orange", marker="s", ls="", label="peers"),
-               Line2D([], [], color="gray", lw=1, label="front: nothing faster and at least as accurate")]
+    handles = [
+        Line2D([], [], color="tab:blue", marker="o", ls="", label="meshcurv methods"),
+        Line2D([], [], color="tab:orange", marker="s", ls="", label="peers"),
+        Line2D([], [], color="gray", lw=1, label="front: nothing faster and at least as accurate"),
+    ]
     fig.legend(handles=handles, loc="upper center", ncol=3, bbox_to_anchor=(0.5, 0.965), frameon=False)
     fig.suptitle("Time against error, one run: lower left is better (benchmarks/pareto.md)")
     fig.tight_layout(rect=(0, 0, 1, 0.94))
     for ax, entries in zip(axes.ravel(), summary.values()):  # in the final layout: positions in pixels hold
-        _place_labels(ax, [(e["cpu"], 100 * e["error"], _short(name)) for name, e in entries.items()
-                           if np.isfinite(e["error"]) and e["error"] > 0])
+        _place_labels(
+            ax,
+            [
+                (e["cpu"], 100 * e["error"], _short(name))
+                for name, e in entries.items()
+                if np.isfinite(e["error"]) and e["error"] > 0
+            ],
+        )
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--level", type=int, default=2, choices=(0, 1, 2),
-                        help="resolution of accuracy.py's meshes (default: %(default)s, the finest)")
+    parser.add_argument(
+        "--level",
+        type=int,
+        default=2,
+        choices=(0, 1, 2),
+        help="resolution of accuracy.py's meshes (default: %(default)s, the finest)",
+    )
     parser.add_argument("--repeats", type=int, default=3, help="calls per mesh and implementation (median)")
     parser.add_argument("--methods", nargs="*", help="only the implementations whose name contains one of these")
     parser.add_argument("--output", default=OUTPUT)

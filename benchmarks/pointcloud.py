@@ -107,7 +107,7 @@ def sample(surface: str, n: int, *, uniform: bool = True, seed: int = 0):
             area = 4 * np.pi
         else:
             p = 1.6075
-            area = 4 * np.pi * ((a[0]**p * a[1]**p + a[0]**p * a[2]**p + a[1]**p * a[2]**p) / 3) ** (1 / p)
+            area = 4 * np.pi * ((a[0] ** p * a[1] ** p + a[0] ** p * a[2] ** p + a[1] ** p * a[2] ** p) / 3) ** (1 / p)
     elif surface in TORUS_RADII:
         R, r = TORUS_RADII[surface]
 
@@ -115,8 +115,14 @@ def sample(surface: str, n: int, *, uniform: bool = True, seed: int = 0):
             return {"t": rng.uniform(0, 2 * np.pi, m), "p": rng.uniform(0, 2 * np.pi, m)}
 
         def position(q):
-            return np.stack([(R + r * np.cos(q["p"])) * np.cos(q["t"]), (R + r * np.cos(q["p"])) * np.sin(q["t"]),
-                             r * np.sin(q["p"])], axis=1)
+            return np.stack(
+                [
+                    (R + r * np.cos(q["p"])) * np.cos(q["t"]),
+                    (R + r * np.cos(q["p"])) * np.sin(q["t"]),
+                    r * np.sin(q["p"]),
+                ],
+                axis=1,
+            )
 
         q = _rejection(rng, n, draw, lambda q: (R + r * np.cos(q["p"])) * weight(position(q)))
         t, p = q["t"], q["p"]
@@ -126,30 +132,34 @@ def sample(surface: str, n: int, *, uniform: bool = True, seed: int = 0):
         dir_max = np.stack([-np.sin(p) * np.cos(t), -np.sin(p) * np.sin(t), np.cos(p)], axis=1)
         area = 4 * np.pi**2 * R * r
     elif surface == "cylinder":
+
         def draw(m, rng):
             return {"phi": rng.uniform(0, 2 * np.pi, m), "z": rng.uniform(-2, 2, m)}
 
-        q = _rejection(rng, n, draw,
-                       lambda q: np.ones(q["z"].size) * weight(np.stack([np.cos(q["phi"]), q["z"], q["z"]], 1)))
+        q = _rejection(
+            rng, n, draw, lambda q: np.ones(q["z"].size) * weight(np.stack([np.cos(q["phi"]), q["z"], q["z"]], 1))
+        )
         normals = np.stack([np.cos(q["phi"]), np.sin(q["phi"]), 0 * q["z"]], axis=1)
         x = normals + np.stack([0 * q["z"], 0 * q["z"], q["z"]], axis=1)
         k_min, k_max = np.zeros(n), np.ones(n)
         dir_max = np.stack([-np.sin(q["phi"]), np.cos(q["phi"]), 0 * q["z"]], axis=1)
         area = 2 * np.pi * 4
     elif surface == "saddle":
+
         def draw(m, rng):
             return {"x": rng.uniform(-1, 1, m), "y": rng.uniform(-1, 1, m)}
 
         def density(q):
-            pts = np.stack([q["x"], q["y"], q["x"]**2 - q["y"]**2], axis=1)
-            return np.sqrt(1 + 4 * q["x"]**2 + 4 * q["y"]**2) * weight(pts)
+            pts = np.stack([q["x"], q["y"], q["x"] ** 2 - q["y"] ** 2], axis=1)
+            return np.sqrt(1 + 4 * q["x"] ** 2 + 4 * q["y"] ** 2) * weight(pts)
 
         q = _rejection(rng, n, draw, density)
         xx, yy = q["x"], q["y"]
         x = np.stack([xx, yy, xx**2 - yy**2], axis=1)
         k_min, k_max, dir_max, normals = _implicit(
-            x, np.stack([-2 * xx, 2 * yy, np.ones_like(xx)], axis=1), np.array([-2.0, 2.0, 0.0]))
-        area = float(np.mean(np.sqrt(1 + 4 * rng.uniform(-1, 1, 10**6)**2 + 4 * rng.uniform(-1, 1, 10**6)**2))) * 4
+            x, np.stack([-2 * xx, 2 * yy, np.ones_like(xx)], axis=1), np.array([-2.0, 2.0, 0.0])
+        )
+        area = float(np.mean(np.sqrt(1 + 4 * rng.uniform(-1, 1, 10**6) ** 2 + 4 * rng.uniform(-1, 1, 10**6) ** 2))) * 4
     else:
         raise ValueError(surface)
     return x, normals, k_min, k_max, dir_max, area
@@ -172,8 +182,7 @@ def errors(normals, k_min, k_max, dir_max, valid, exact, dir_min=None):
     m = valid & np.isfinite(lo) & np.isfinite(hi)
     e_h = np.abs((lo + hi) / 2 - (e_min + e_max) / 2)[m] / s[m]
     e_k = np.abs(lo * hi - e_min * e_max)[m] / s[m] ** 2
-    out = {"H": np.median(e_h), "K": np.median(e_k), "out": float(np.mean(side[valid] > 0)),
-           "cover": float(np.mean(m))}
+    out = {"H": np.median(e_h), "K": np.median(e_k), "out": float(np.mean(side[valid] > 0)), "cover": float(np.mean(m))}
     distinct = m & (np.abs(e_max - e_min) > 0.5 * s)
     if dir_max is not None and distinct.any():
         # where the normal is on the other side, the exact k_max goes with the estimate's k_min direction
@@ -240,6 +249,7 @@ def run(surfaces, noise_levels, n, peer=True, methods=POINT_CLOUD_METHODS):
     rows = []
     try:
         import pymeshlab  # noqa: F401
+
         has_peer = peer
     except ImportError:
         has_peer = False
@@ -286,26 +296,38 @@ def _pct(x):
 
 
 def markdown(rows, n, command):
-    lines = ["# Point-cloud curvature accuracy (issue 16)", "",
-             f"Produced by `{command}` (commit {_git_head()}); {n} points per cloud.", "",
-             "Cells: median |H - H_exact| / s, median |K - K_exact| / s^2 (s = largest exact |k| at the point),",
-             "median angle of dir_max to the exact direction where |k_max - k_min| > s/2, share of normals on the",
-             "exact (outward) side, time in seconds (one process, 2 cores). Noise: uniform along the exact normal,",
-             "amplitude in mean spacings sqrt(area / N). MeshLab APSS reports mean and Gaussian curvature only",
-             "(principal values from them; no directions); its sign is taken on the side that fits best; it runs",
-             "with its default parameters. The given normals are the exact ones at the unperturbed points.", ""]
-    lines += _summary(rows) + ["## All rows", "",
-                               "| surface | sampling | noise | normals | method | H | K | dir (deg) | out | cover "
-                               "| time (s) | radius |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "# Point-cloud curvature accuracy (issue 16)",
+        "",
+        f"Produced by `{command}` (commit {_git_head()}); {n} points per cloud.",
+        "",
+        "Cells: median |H - H_exact| / s, median |K - K_exact| / s^2 (s = largest exact |k| at the point),",
+        "median angle of dir_max to the exact direction where |k_max - k_min| > s/2, share of normals on the",
+        "exact (outward) side, time in seconds (one process, 2 cores). Noise: uniform along the exact normal,",
+        "amplitude in mean spacings sqrt(area / N). MeshLab APSS reports mean and Gaussian curvature only",
+        "(principal values from them; no directions); its sign is taken on the side that fits best; it runs",
+        "with its default parameters. The given normals are the exact ones at the unperturbed points.",
+        "",
+    ]
+    lines += _summary(rows) + [
+        "## All rows",
+        "",
+        "| surface | sampling | noise | normals | method | H | K | dir (deg) | out | cover | time (s) | radius |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for surface, sampling, level, normals, method, e, seconds, radius in rows:
         if "failed" in e:
-            lines.append(f"| {surface} | {sampling} | {level:g} | {normals} | {method} | failed: {e['failed']} "
-                         f"| | | | | {seconds:.2f} | |")
+            lines.append(
+                f"| {surface} | {sampling} | {level:g} | {normals} | {method} | failed: {e['failed']} "
+                f"| | | | | {seconds:.2f} | |"
+            )
             continue
         direction = "-" if not np.isfinite(e["dir"]) else f"{e['dir']:.2f}"
-        lines.append(f"| {surface} | {sampling} | {level:g} | {normals} | {method} | {_pct(e['H'])} | {_pct(e['K'])} "
-                     f"| {direction} | {e['out']:.3f} | {e['cover']:.3f} | {seconds:.2f} | "
-                     f"{'' if radius is None else f'{radius:.4g}'} |")
+        lines.append(
+            f"| {surface} | {sampling} | {level:g} | {normals} | {method} | {_pct(e['H'])} | {_pct(e['K'])} "
+            f"| {direction} | {e['out']:.3f} | {e['cover']:.3f} | {seconds:.2f} | "
+            f"{'' if radius is None else f'{radius:.4g}'} |"
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -319,12 +341,19 @@ def _summary(rows):
         h, k = worst.get(key, (0.0, 0.0))
         worst[key] = (max(h, e["H"]), max(k, e["K"]))
     methods = list(dict.fromkeys(key[2] for key in worst))
-    lines = ["## Summary: worst median error of H / K over sampling (uniform or not) and normals (given or "
-             "estimated)", "", "| surface | noise | " + " | ".join(methods) + " |",
-             "|---|---|" + "---|" * len(methods)]
+    lines = [
+        "## Summary: worst median error of H / K over sampling (uniform or not) and normals (given or estimated)",
+        "",
+        "| surface | noise | " + " | ".join(methods) + " |",
+        "|---|---|" + "---|" * len(methods),
+    ]
     for surface, level in dict.fromkeys((key[0], key[1]) for key in worst):
-        cells = [f"{_pct(worst[surface, level, m][0])} / {_pct(worst[surface, level, m][1])}"
-                 if (surface, level, m) in worst else "-" for m in methods]
+        cells = [
+            f"{_pct(worst[surface, level, m][0])} / {_pct(worst[surface, level, m][1])}"
+            if (surface, level, m) in worst
+            else "-"
+            for m in methods
+        ]
         lines.append(f"| {surface} | {level:g} | " + " | ".join(cells) + " |")
     return lines + [""]
 
@@ -358,8 +387,13 @@ def speed(sizes=(10_000, 100_000, 1_000_000), methods=POINT_CLOUD_METHODS):
 
 def _git_head():
     try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                              cwd=Path(__file__).parent, timeout=10).stdout.strip()
+        return subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            cwd=Path(__file__).parent,
+            timeout=10,
+        ).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return "unknown"
 
@@ -370,19 +404,29 @@ def main(argv=None):
     parser.add_argument("--speed", action="store_true", help="speed at 10k, 100k, 1M points")
     parser.add_argument("--n", type=int, default=N_POINTS)
     parser.add_argument("--no-peer", action="store_true")
-    parser.add_argument("--held-out", action="store_true",
-                        help="surfaces, densities and noise no constant was tuned on (writes pointcloud_heldout.md)")
+    parser.add_argument(
+        "--held-out",
+        action="store_true",
+        help="surfaces, densities and noise no constant was tuned on (writes pointcloud_heldout.md)",
+    )
     parser.add_argument("--output", default=str(Path(__file__).with_suffix(".md")))
     args = parser.parse_args(argv)
     command = "python benchmarks/pointcloud.py " + " ".join(argv if argv is not None else sys.argv[1:])
     if args.speed:
         rows = speed()
-        text = ["", "## Speed (torus samples, normals estimated, end to end)", "",
-                "| points | method | seconds | CPU seconds (all threads) |", "|---|---|---|---|"]
+        text = [
+            "",
+            "## Speed (torus samples, normals estimated, end to end)",
+            "",
+            "| points | method | seconds | CPU seconds (all threads) |",
+            "|---|---|---|---|",
+        ]
         text += [f"| {n} | {m} | {s:.2f} | {c:.2f} |" for n, m, s, c in rows]
         load = ", ".join(f"{x:.1f}" for x in __import__("os").getloadavg())
-        text.append(f"\nProduced by `{command.strip()}` (commit {_git_head()}); load average at the end: {load} "
-                    f"(on {__import__('os').cpu_count()} cores: other processes share the machine).")
+        text.append(
+            f"\nProduced by `{command.strip()}` (commit {_git_head()}); load average at the end: {load} "
+            f"(on {__import__('os').cpu_count()} cores: other processes share the machine)."
+        )
         print("\n".join(text))
         output = Path(args.output)
         if output.exists():
@@ -392,14 +436,20 @@ def main(argv=None):
     if args.held_out:
         rows = []
         for n in HELD_OUT["n"]:
-            rows += [(f"{surface}, {n} points", sampling, *rest) for surface, sampling, *rest
-                     in run(HELD_OUT["surfaces"], HELD_OUT["noise"], n, peer=False)]
+            rows += [
+                (f"{surface}, {n} points", sampling, *rest)
+                for surface, sampling, *rest in run(HELD_OUT["surfaces"], HELD_OUT["noise"], n, peer=False)
+            ]
         text = markdown(rows, "5000 and 80000", command.strip()).replace(
             "# Point-cloud curvature accuracy (issue 16)",
             "# Point-cloud curvature accuracy on held-out families (issue 16)\n\nNo constant of the point-cloud "
-            "methods was tuned on these surfaces, densities or noise level.")
-        output = Path(args.output) if args.output != str(Path(__file__).with_suffix(".md")) \
+            "methods was tuned on these surfaces, densities or noise level.",
+        )
+        output = (
+            Path(args.output)
+            if args.output != str(Path(__file__).with_suffix(".md"))
             else Path(__file__).with_name("pointcloud_heldout.md")
+        )
         output.write_text(text)
         print(text)
         return 0

@@ -105,6 +105,7 @@ class Timers:
                 if self.stack:
                     self.stack[-1][0] += wall
                     self.stack[-1][1] += cpu
+
         timed.__wrapped_stage__ = True
         return timed
 
@@ -209,8 +210,9 @@ def _walk_kernel():
             members = np.empty(n, np.int64)
             queue = np.empty(n, np.int64)
             for v in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
-                found[chunk] += _connected_members(vertices, indptr, indices, allowed, v, radius, mark, v, members,
-                                                   queue)
+                found[chunk] += _connected_members(
+                    vertices, indptr, indices, allowed, v, radius, mark, v, members, queue
+                )
         return found.sum()
 
     return walk_all
@@ -240,10 +242,19 @@ def walks(label: str, repeats: int, scales=(3.0,)) -> list[tuple]:
     rows = []
     for scale in scales:
         fit_radius = scale * radius
-        fits = _median_cpu(lambda: fit_jet_normals(v, normals, fit_radius, degree=icc.NORMAL_DEGREE,
-                                                   iterations=icc.NORMAL_ITERATIONS, adjacency=adjacency,
-                                                   settled=icc.NORMAL_SETTLED, min_spread=NORMAL_MIN_SPREAD),
-                           repeats)
+        fits = _median_cpu(
+            lambda: fit_jet_normals(
+                v,
+                normals,
+                fit_radius,
+                degree=icc.NORMAL_DEGREE,
+                iterations=icc.NORMAL_ITERATIONS,
+                adjacency=adjacency,
+                settled=icc.NORMAL_SETTLED,
+                min_spread=NORMAL_MIN_SPREAD,
+            ),
+            repeats,
+        )
         members = walk_all(v, *adjacency, allowed, fit_radius, _threads()) / v.shape[0]
         walk = _median_cpu(lambda: walk_all(v, *adjacency, allowed, fit_radius, _threads()), repeats)
         rows.append((f"icosphere({n})", v.shape[0], radius / h, scale, members, fits, walk, sums if not rows else None))
@@ -251,13 +262,19 @@ def walks(label: str, repeats: int, scales=(3.0,)) -> list[tuple]:
 
 
 def walks_table(results) -> str:
-    lines = [f"CPU s, median of the calls after a warm-up; {_threads()} threads; load average {load()}", "",
-             "| mesh | vertices | r / h | fit radius / r | vertices per fit ball | normal fits | their walk alone | "
-             "walk / fits | ball sums (r) |", "|---|--:|--:|--:|--:|--:|--:|--:|--:|"]
+    lines = [
+        f"CPU s, median of the calls after a warm-up; {_threads()} threads; load average {load()}",
+        "",
+        "| mesh | vertices | r / h | fit radius / r | vertices per fit ball | normal fits | their walk alone | "
+        "walk / fits | ball sums (r) |",
+        "|---|--:|--:|--:|--:|--:|--:|--:|--:|",
+    ]
     for name, n_vertices, ratio, scale, members, fits, walk, sums in results:
         summed = "" if sums is None else f"{sums:.3f}"
-        lines.append(f"| {name} | {n_vertices:,} | {ratio:.2f} | {scale:g} | {members:.1f} | {fits:.3f} | "
-                     f"{walk:.3f} | {walk / fits:.0%} | {summed} |")
+        lines.append(
+            f"| {name} | {n_vertices:,} | {ratio:.2f} | {scale:g} | {members:.1f} | {fits:.3f} | "
+            f"{walk:.3f} | {walk / fits:.0%} | {summed} |"
+        )
     return "\n".join(lines)
 
 
@@ -269,11 +286,14 @@ def main(argv=None) -> int:
     parser.add_argument("--sizes", default="100k,1M,4M")
     parser.add_argument("--repeats", type=int, default=3, help="calls per size (the median by wall time is shown)")
     parser.add_argument("--markdown", help="write the table to this file")
-    parser.add_argument("--walks", action="store_true",
-                        help="only the table of the walks inside the kernels (see the module's doc)")
-    parser.add_argument("--fit-scales", default="3",
-                        help="with --walks: the radii of the normal fits, in units of r (icc: 3; multiscale "
-                             "h, 2h, 4h: 3,6,12)")
+    parser.add_argument(
+        "--walks", action="store_true", help="only the table of the walks inside the kernels (see the module's doc)"
+    )
+    parser.add_argument(
+        "--fit-scales",
+        default="3",
+        help="with --walks: the radii of the normal fits, in units of r (icc: 3; multiscale h, 2h, 4h: 3,6,12)",
+    )
     args = parser.parse_args(argv)
     if args.walks:
         scales = [float(scale) for scale in args.fit_scales.split(",")]
@@ -286,24 +306,26 @@ def main(argv=None) -> int:
         results.append(profile(label, args.repeats))
         print(f"{label}: {results[-1][2]:.3f} s wall, {results[-1][3]:.3f} s CPU", file=sys.stderr)
     names = ", ".join(f"{name} ({n:,} vertices)" for name, n, *_ in results)
-    text = "\n".join([
-        "# Where the default's time goes, stage by stage (issue 31)",
-        "",
-        f"Generated {time.strftime('%Y-%m-%d %H:%M')} by `python benchmarks/profile_call.py --sizes {args.sizes} "
-        f"--repeats {args.repeats}`: `meshcurv.principal_curvatures(v, f)` (method {meshcurv.estimators.DEFAULT_METHOD!r}, "
-        f"backend {_backend.backend_name()}, {_threads()} threads) on {names}; the call of median wall time of "
-        f"{args.repeats} after a warm-up call on the same mesh.",
-        "",
-        f"- Machine: {platform.platform()}, {os.cpu_count()} cores; load average (1, 5, 15 min) at start "
-        f"({start_load}), at end ({load()}) (other jobs share the cores: wall times vary, CPU seconds less)",
-        f"- meshcurv at commit {_commit()}",
-        "",
-        "Exclusive times: a stage's own time, without the stages it calls. `other`: the call's total minus "
-        "every stage (argument checks, dataclass copies, Python between the stages).",
-        "",
-        table(results),
-        "",
-    ])
+    text = "\n".join(
+        [
+            "# Where the default's time goes, stage by stage (issue 31)",
+            "",
+            f"Generated {time.strftime('%Y-%m-%d %H:%M')} by `python benchmarks/profile_call.py --sizes {args.sizes} "
+            f"--repeats {args.repeats}`: `meshcurv.principal_curvatures(v, f)` (method {meshcurv.estimators.DEFAULT_METHOD!r}, "
+            f"backend {_backend.backend_name()}, {_threads()} threads) on {names}; the call of median wall time of "
+            f"{args.repeats} after a warm-up call on the same mesh.",
+            "",
+            f"- Machine: {platform.platform()}, {os.cpu_count()} cores; load average (1, 5, 15 min) at start "
+            f"({start_load}), at end ({load()}) (other jobs share the cores: wall times vary, CPU seconds less)",
+            f"- meshcurv at commit {_commit()}",
+            "",
+            "Exclusive times: a stage's own time, without the stages it calls. `other`: the call's total minus "
+            "every stage (argument checks, dataclass copies, Python between the stages).",
+            "",
+            table(results),
+            "",
+        ]
+    )
     print(text)
     if args.markdown:
         with open(args.markdown, "w", encoding="utf-8") as handle:
@@ -321,8 +343,13 @@ def _commit() -> str:
     import subprocess
 
     try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                              cwd=os.path.dirname(os.path.abspath(__file__)), check=True).stdout.strip()
+        return subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            cwd=os.path.dirname(os.path.abspath(__file__)),
+            check=True,
+        ).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
 

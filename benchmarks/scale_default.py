@@ -52,13 +52,20 @@ def measure(case) -> dict:
     h_error = np.abs(result.mean - case.mean) / scale
     edge = median_edge_length(case.vertices, MeshTopology.from_faces(case.faces, case.vertices.shape[0]).edges)
     radius = np.asarray(result.radius, dtype=float)[ok] / edge
-    row = {"name": case.name, "family": case.family, "tuning": case.tuning, "V": int(case.vertices.shape[0]),
-           "H": median(h_error), "H95": float(np.percentile(h_error[ok], 95)),
-           "k_min": median(np.abs(result.k_min - case.k_min) / scale),
-           "k_max": median(np.abs(result.k_max - case.k_max) / scale),
-           "K": median(np.abs(result.gaussian - case.gaussian) / scale**2),
-           "radius": [float(np.percentile(radius, q)) for q in (10, 50, 90)], "cpu": cpu,
-           "surface": result.parameters.get("surface")}
+    row = {
+        "name": case.name,
+        "family": case.family,
+        "tuning": case.tuning,
+        "V": int(case.vertices.shape[0]),
+        "H": median(h_error),
+        "H95": float(np.percentile(h_error[ok], 95)),
+        "k_min": median(np.abs(result.k_min - case.k_min) / scale),
+        "k_max": median(np.abs(result.k_max - case.k_max) / scale),
+        "K": median(np.abs(result.gaussian - case.gaussian) / scale**2),
+        "radius": [float(np.percentile(radius, q)) for q in (10, 50, 90)],
+        "cpu": cpu,
+        "surface": result.parameters.get("surface"),
+    }
     for part, mask in case.parts.items():
         row[f"H {part}"] = median(h_error, mask)
         row[f"radius {part}"] = float(np.median(np.asarray(result.radius)[ok & mask] / edge))
@@ -95,10 +102,14 @@ def compare(before_path: str, after_path: str) -> str:
         if row["family"] != family:
             family = row["family"]
             kind = "tuning" if row["tuning"] else "held out"
-            lines += ["", f"### {family} ({kind})", "",
-                      "| mesh | V | H (p95) before | H (p95) after | k_min / k_max before | k_min / k_max after "
-                      "| r/h before [10-90%] | r/h after [10-90%] | CPU s before / after | moved |",
-                      "|---|--:|--:|--:|--:|--:|--:|--:|--:|---|"]
+            lines += [
+                "",
+                f"### {family} ({kind})",
+                "",
+                "| mesh | V | H (p95) before | H (p95) after | k_min / k_max before | k_min / k_max after "
+                "| r/h before [10-90%] | r/h after [10-90%] | CPU s before / after | moved |",
+                "|---|--:|--:|--:|--:|--:|--:|--:|--:|---|",
+            ]
         worse = row["H"] > 1.1 * old["H"] + 1e-6
         better = row["H"] < old["H"] / 1.1 - 1e-6
         moved = "worse" if worse else "better" if better else ""
@@ -110,19 +121,24 @@ def compare(before_path: str, after_path: str) -> str:
             f"({_pct(row['H95'])}) | {_pct(old['k_min'])} / {_pct(old['k_max'])} | {_pct(row['k_min'])} / "
             f"{_pct(row['k_max'])} | {old['radius'][1]:.2f} [{old['radius'][0]:.2f}-{old['radius'][2]:.2f}] | "
             f"{row['radius'][1]:.2f} [{row['radius'][0]:.2f}-{row['radius'][2]:.2f}] | "
-            f"{old['cpu']:.2f} / {row['cpu']:.2f} | {moved.strip()} |")
+            f"{old['cpu']:.2f} / {row['cpu']:.2f} | {moved.strip()} |"
+        )
         total = totals.setdefault(family, [0.0, 0.0, [], [], 0])
         total[0] += old["cpu"]
         total[1] += row["cpu"]
         total[2].append(old["H"])
         total[3].append(row["H"])
         total[4] += worse
-    summary = ["| family | meshes | geometric mean of median H, before -> after | worse by > 1/10 | CPU s before -> after |",
-               "|---|--:|--:|--:|--:|"]
+    summary = [
+        "| family | meshes | geometric mean of median H, before -> after | worse by > 1/10 | CPU s before -> after |",
+        "|---|--:|--:|--:|--:|",
+    ]
     for family, (cpu_old, cpu_new, h_old, h_new, worse) in totals.items():
         geo = [float(np.exp(np.mean(np.log(np.maximum(h, 1e-9))))) for h in (h_old, h_new)]
-        summary.append(f"| {family} | {len(h_old)} | {_pct(geo[0])} -> {_pct(geo[1])} | {worse} | "
-                       f"{cpu_old:.1f} -> {cpu_new:.1f} ({cpu_new / cpu_old:.2f}x) |")
+        summary.append(
+            f"| {family} | {len(h_old)} | {_pct(geo[0])} -> {_pct(geo[1])} | {worse} | "
+            f"{cpu_old:.1f} -> {cpu_new:.1f} ({cpu_new / cpu_old:.2f}x) |"
+        )
     return "\n".join(summary + lines)
 
 

@@ -85,12 +85,22 @@ class Case:
 
 def _from_analytic(mesh, family, group, tuning, *, outward=True, spacing=None, parts=None) -> Case:
     faces = np.ascontiguousarray(mesh.faces if outward else mesh.faces[:, ::-1], dtype=np.int64)
-    return Case(mesh.name, family, group, tuning, np.asarray(mesh.vertices, dtype=float), faces,
-                np.asarray(mesh.k_min, dtype=float), np.asarray(mesh.k_max, dtype=float),
-                parts or {}, spacing)
+    return Case(
+        mesh.name,
+        family,
+        group,
+        tuning,
+        np.asarray(mesh.vertices, dtype=float),
+        faces,
+        np.asarray(mesh.k_min, dtype=float),
+        np.asarray(mesh.k_max, dtype=float),
+        parts or {},
+        spacing,
+    )
 
 
 # -- tuning families ------------------------------------------------------------------
+
 
 def accuracy_cases(levels=(0, 1, 2)):
     """The spheres, tori and ellipsoids of ``benchmarks/accuracy.py`` (clean, irregular, noisy)."""
@@ -109,11 +119,13 @@ def voxel_cases(held_out=False):
 
     for mesh, out in accuracy.voxel_meshes(held_out=held_out):
         aspect = max(mesh.spacing) / min(mesh.spacing)
-        yield _from_analytic(mesh, "voxel", "isotropic" if aspect == 1 else "anisotropic", not out,
-                             outward=False, spacing=mesh.spacing)
+        yield _from_analytic(
+            mesh, "voxel", "isotropic" if aspect == 1 else "anisotropic", not out, outward=False, spacing=mesh.spacing
+        )
 
 
 # -- held-out families ------------------------------------------------------------------
+
 
 def _grid(extent, spacing, seed):
     """Axes of a grid spanning ``extent`` (half-widths) plus margins, centred at a random sub-voxel offset."""
@@ -169,11 +181,17 @@ def _solid(kind, size):
         return (lambda x, y, z: x * x + y * y + z * z <= r * r), np.full(3, r), lambda p: _sphere_exact(p, r)
     if kind == "torus":
         big, small = size
-        return ((lambda x, y, z: x * x + (np.sqrt(y * y + z * z) - big) ** 2 <= small * small),
-                np.array([small, big + small, big + small]), lambda p: _torus_exact(p, big, small))
+        return (
+            (lambda x, y, z: x * x + (np.sqrt(y * y + z * z) - big) ** 2 <= small * small),
+            np.array([small, big + small, big + small]),
+            lambda p: _torus_exact(p, big, small),
+        )
     a = np.asarray(size, dtype=float)
-    return ((lambda x, y, z: x * x / a[0] ** 2 + y * y / a[1] ** 2 + z * z / a[2] ** 2 <= 1), a,
-            lambda p: _ellipsoid_exact(p, a))
+    return (
+        (lambda x, y, z: x * x / a[0] ** 2 + y * y / a[1] ** 2 + z * z / a[2] ** 2 <= 1),
+        a,
+        lambda p: _ellipsoid_exact(p, a),
+    )
 
 
 #: The smoothed isosurfaces: (kind, size in voxels, blur sigmas).
@@ -198,8 +216,17 @@ def smoothed_cases():
             vertices, faces = _smoothed_mesh(inside, extent, sigma, seed)
             k_min, k_max = exact(vertices)
             label = ", ".join(f"{s:g}" for s in size)
-            yield Case(f"smoothed {kind}({label}), sigma {sigma:g}", "smoothed", f"sigma {sigma:g}", False,
-                       vertices, faces, k_min, k_max, spacing=(1.0, 1.0, 1.0))
+            yield Case(
+                f"smoothed {kind}({label}), sigma {sigma:g}",
+                "smoothed",
+                f"sigma {sigma:g}",
+                False,
+                vertices,
+                faces,
+                k_min,
+                k_max,
+                spacing=(1.0, 1.0, 1.0),
+            )
 
 
 def _varying_points(n_coarse, ratio, seed):
@@ -230,12 +257,30 @@ def varying_cases(n_coarse=250, ratio=100.0):
     faces = _hull(unit)
     parts = {"fine": unit[:, 2] > 0.1, "coarse": unit[:, 2] < -0.1}
     n = unit.shape[0]
-    yield Case(f"varying sphere ({n} points, density 100:1)", "varying", "sphere", False, unit, faces,
-               np.ones(n), np.ones(n), parts)
+    yield Case(
+        f"varying sphere ({n} points, density 100:1)",
+        "varying",
+        "sphere",
+        False,
+        unit,
+        faces,
+        np.ones(n),
+        np.ones(n),
+        parts,
+    )
     a = np.array([3.0, 2.0, 1.0])
     k_min, k_max = _ellipsoid_exact(unit * a, a, closest=False)
-    yield Case(f"varying ellipsoid(3, 2, 1) ({n} points, density 100:1)", "varying", "ellipsoid", False, unit * a,
-               faces, k_min, k_max, parts)
+    yield Case(
+        f"varying ellipsoid(3, 2, 1) ({n} points, density 100:1)",
+        "varying",
+        "ellipsoid",
+        False,
+        unit * a,
+        faces,
+        k_min,
+        k_max,
+        parts,
+    )
 
 
 #: Elongated ellipsoids and thin tori under anisotropic voxels: (kind, size, spacing).
@@ -254,8 +299,11 @@ ELONGATED = [
 def elongated_cases():
     """Binary marching cubes of elongated ellipsoids and thin tori, voxels 2:1 and 3:1 (held out)."""
     for seed, (kind, size, spacing) in enumerate(ELONGATED, start=200):
-        mesh = (shapes.voxel_ellipsoid(size, spacing, seed=seed) if kind == "ellipsoid"
-                else shapes.voxel_torus(*size, spacing, seed=seed))
+        mesh = (
+            shapes.voxel_ellipsoid(size, spacing, seed=seed)
+            if kind == "ellipsoid"
+            else shapes.voxel_torus(*size, spacing, seed=seed)
+        )
         aspect = max(spacing) / min(spacing)
         yield _from_analytic(mesh, "elongated", f"{kind} {aspect:g}:1", False, outward=False, spacing=mesh.spacing)
 
@@ -276,12 +324,19 @@ def failing_cases():
         build = shapes.voxel_torus if kind == "torus" else shapes.voxel_ellipsoid
         mesh = build(*arguments, spacing, seed=seed)
         aspect = max(spacing) / min(spacing)
-        yield _from_analytic(mesh, "failing", "isotropic" if aspect == 1 else "anisotropic", False,
-                             outward=False, spacing=mesh.spacing)
+        yield _from_analytic(
+            mesh, "failing", "isotropic" if aspect == 1 else "anisotropic", False, outward=False, spacing=mesh.spacing
+        )
 
 
-BUILDERS = {"accuracy": accuracy_cases, "voxel": voxel_cases, "smoothed": smoothed_cases,
-            "varying": varying_cases, "elongated": elongated_cases, "failing": failing_cases}
+BUILDERS = {
+    "accuracy": accuracy_cases,
+    "voxel": voxel_cases,
+    "smoothed": smoothed_cases,
+    "varying": varying_cases,
+    "elongated": elongated_cases,
+    "failing": failing_cases,
+}
 
 
 def cases(families=None):

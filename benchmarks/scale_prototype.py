@@ -62,6 +62,7 @@ NOISE_FIT_EDGES = 2.0
 
 # -- computing ---------------------------------------------------------------------------
 
+
 def ladder(vertices, faces, topology, *, ratio=LADDER_RATIO, high=LADDER_HIGH):
     """The radii ``h_5 LADDER_LOW q^j`` up to ``min(high h, sqrt(area / (18 pi)))`` (``q``: ``ratio``)."""
     local = vertex_edge_lengths(vertices, topology.edges)
@@ -126,8 +127,16 @@ def vertex_noise(vertices, topology, local, *, fit_edges=NOISE_FIT_EDGES):
     for k in np.unique(level):
         members = centres[level == k]
         radius = fit_edges * local[members].mean()
-        coefficients, _, _ = fit_jets(vertices, normals, radius, degree=2, centres=members, compact=True,
-                                      neighbours=topology.referenced_vertices, adjacency=topology.neighbour_lists)
+        coefficients, _, _ = fit_jets(
+            vertices,
+            normals,
+            radius,
+            degree=2,
+            centres=members,
+            compact=True,
+            neighbours=topology.referenced_vertices,
+            adjacency=topology.neighbour_lists,
+        )
         out[members] = np.abs(coefficients[:, 0]) * radius
     return out
 
@@ -162,15 +171,28 @@ def compute(case, cache=CACHE):
     default_radius = default.parameters.get("radius")
     os.makedirs(cache, exist_ok=True)
     np.savez_compressed(
-        path, name=case.name, family=case.family, group=case.group, tuning=case.tuning,
-        k_min=case.k_min, k_max=case.k_max, radii=radii, fields=fields, seconds=seconds,
+        path,
+        name=case.name,
+        family=case.family,
+        group=case.group,
+        tuning=case.tuning,
+        k_min=case.k_min,
+        k_max=case.k_max,
+        radii=radii,
+        fields=fields,
+        seconds=seconds,
         default=np.stack([default.k_min, default.k_max, default.mean, default.gaussian]),
-        default_radius=np.atleast_1d(np.asarray(default_radius, dtype=float)), t_default=t_default,
+        default_radius=np.atleast_1d(np.asarray(default_radius, dtype=float)),
+        t_default=t_default,
         local=local,
         spacing=np.asarray(case.spacing if case.spacing is not None else (np.nan,) * 3, dtype=float),
-        **{f"part_{k}": m for k, m in case.parts.items()})
-    print(f"{case.name}: {v.shape[0]} vertices, {radii.size} rungs {radii[0]:.3g}..{radii[-1]:.3g}, "
-          f"{seconds.sum() + t_default:.1f} s", file=sys.stderr)
+        **{f"part_{k}": m for k, m in case.parts.items()},
+    )
+    print(
+        f"{case.name}: {v.shape[0]} vertices, {radii.size} rungs {radii[0]:.3g}..{radii[-1]:.3g}, "
+        f"{seconds.sum() + t_default:.1f} s",
+        file=sys.stderr,
+    )
     return path
 
 
@@ -191,12 +213,28 @@ def load(path):
 #: The recommended rule (tuned on the tuning families only; see benchmarks/scale.md): the rung where H, k1
 #: and k2 change least along the ladder, the change averaged over the 2-ring and pooled half with the
 #: mesh median; the upper rung of that pair, or the first rung when the change is smallest there.
-RULE = {"kind": "stable", "quantities": ("H", "k1", "k2"), "rings": 2, "pool": 0.5, "take": 1,
-        "first_low": True, "min_edges": 0.75, "cap": 0.0}
+RULE = {
+    "kind": "stable",
+    "quantities": ("H", "k1", "k2"),
+    "rings": 2,
+    "pool": 0.5,
+    "take": 1,
+    "first_low": True,
+    "min_edges": 0.75,
+    "cap": 0.0,
+}
 
 #: The Lepski / ICI rule with the jet-residual noise model, at its best tuning-family constants (it fails).
-ICI_RULE = {"kind": "ici", "noise": "noise2_ring", "c": 4.0, "beta": 1.0, "floor": 0.0, "quantities": ("H",),
-            "cap": 0.0, "min_edges": 0.75}
+ICI_RULE = {
+    "kind": "ici",
+    "noise": "noise2_ring",
+    "c": 4.0,
+    "beta": 1.0,
+    "floor": 0.0,
+    "quantities": ("H",),
+    "cap": 0.0,
+    "min_edges": 0.75,
+}
 
 
 def sigma_model(data, rule):
@@ -331,6 +369,7 @@ def oracle(data, mask=None):
 
 # -- reporting -----------------------------------------------------------------------------
 
+
 def _labels():
     """name -> (family, tuning) from the builders (a mesh in two families keeps the first, tuning, one)."""
     out = {}
@@ -357,22 +396,28 @@ def runs(data):
     h = np.median(data["local"])
     j = oracle(data)
     rule, ici = select(data, RULE), select(data, ICI_RULE)
-    return {"default": (errors(data, data["default"]), data["default_radius"] / h),
-            "oracle": (errors(data, data["fields"][:, j]), np.array([data["radii"][j] / h])),
-            "rule": (errors(data, picked(data, rule)), data["radii"][rule] / h),
-            "ici": (errors(data, picked(data, ici)), data["radii"][ici] / h)}
+    return {
+        "default": (errors(data, data["default"]), data["default_radius"] / h),
+        "oracle": (errors(data, data["fields"][:, j]), np.array([data["radii"][j] / h])),
+        "rule": (errors(data, picked(data, rule)), data["radii"][rule] / h),
+        "ici": (errors(data, picked(data, ici)), data["radii"][ici] / h),
+    }
 
 
 def _radius(r):
-    return f"{r[0]:.1f}" if r.size == 1 else f"{np.median(r):.1f} [{np.percentile(r, 10):.1f}-{np.percentile(r, 90):.1f}]"
+    return (
+        f"{r[0]:.1f}" if r.size == 1 else f"{np.median(r):.1f} [{np.percentile(r, 10):.1f}-{np.percentile(r, 90):.1f}]"
+    )
 
 
-FAMILY_TITLES = {"accuracy": "Tuning: clean, irregular and noisy meshes of accuracy.py",
-                 "voxel": "Tuning: binary marching cubes of accuracy.py --voxel",
-                 "smoothed": "Held out: smoothed isosurfaces (blurred masks, voxel 1)",
-                 "varying": "Held out: 10:1 change of resolution (one component)",
-                 "elongated": "Held out: elongated ellipsoids and thin tori, anisotropic voxels",
-                 "failing": "Held out (3 of 5) : the 5 failing rows of accuracy_voxel.md"}
+FAMILY_TITLES = {
+    "accuracy": "Tuning: clean, irregular and noisy meshes of accuracy.py",
+    "voxel": "Tuning: binary marching cubes of accuracy.py --voxel",
+    "smoothed": "Held out: smoothed isosurfaces (blurred masks, voxel 1)",
+    "varying": "Held out: 10:1 change of resolution (one component)",
+    "elongated": "Held out: elongated ellipsoids and thin tori, anisotropic voxels",
+    "failing": "Held out (3 of 5) : the 5 failing rows of accuracy_voxel.md",
+}
 
 
 def report(cache=CACHE):
@@ -388,14 +433,20 @@ def report(cache=CACHE):
     lines = []
     summary = []
     for family, title in FAMILY_TITLES.items():
-        names = ([n for n in cases if n in failing_names] if family == "failing"
-                 else [n for n, d in cases.items() if d["family"] == family])
+        names = (
+            [n for n in cases if n in failing_names]
+            if family == "failing"
+            else [n for n, d in cases.items() if d["family"] == family]
+        )
         if not names:
             continue
-        lines += [f"### {title}", "",
-                  "| mesh | V | default r/h | default H (p95) | oracle r/h | oracle H (p95) | rule r/h median [10-90%] "
-                  "| rule H (p95) | rule k1 / k2 / K | default k1 / k2 / K | ICI H (p95) |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|"]
+        lines += [
+            f"### {title}",
+            "",
+            "| mesh | V | default r/h | default H (p95) | oracle r/h | oracle H (p95) | rule r/h median [10-90%] "
+            "| rule H (p95) | rule k1 / k2 / K | default k1 / k2 / K | ICI H (p95) |",
+            "|---|---|---|---|---|---|---|---|---|---|---|",
+        ]
         agg = {k: [] for k in ("default", "oracle", "rule", "ici")}
         worse = 0
         for name in sorted(names, key=lambda n: (cases[n]["group"], n)):
@@ -407,21 +458,28 @@ def report(cache=CACHE):
             worse += re_["H"][0] > 1.1 * de["H"][0] + 2e-4
             kk = " / ".join(_pct(re_[q][0]) for q in ("k1", "k2", "K"))
             dk = " / ".join(_pct(de[q][0]) for q in ("k1", "k2", "K"))
-            lines.append(f"| {name} | {d['local'].size} | {_radius(out['default'][1])} | {_cell(de)} | "
-                         f"{_radius(out['oracle'][1])} | {_cell(out['oracle'][0])} | {_radius(out['rule'][1])} | "
-                         f"{_cell(re_)} | {kk} | {dk} | {_cell(out['ici'][0])} |")
+            lines.append(
+                f"| {name} | {d['local'].size} | {_radius(out['default'][1])} | {_cell(de)} | "
+                f"{_radius(out['oracle'][1])} | {_cell(out['oracle'][0])} | {_radius(out['rule'][1])} | "
+                f"{_cell(re_)} | {kk} | {dk} | {_cell(out['ici'][0])} |"
+            )
         lines.append("")
-        summary.append(f"| {title} | {len(names)} | " + " | ".join(_pct(_geo(agg[k])) for k in agg)
-                       + f" | {worse} |")
-    head = ["| family | meshes | default | oracle (one radius) | rule | ICI rule | rule worse than default by >10% |",
-            "|---|---|---|---|---|---|---|"]
-    return "\n".join(["Geometric mean over the meshes of the median |H error| / max|k|:", ""] + head + summary + [""]
-                     + lines)
+        summary.append(f"| {title} | {len(names)} | " + " | ".join(_pct(_geo(agg[k])) for k in agg) + f" | {worse} |")
+    head = [
+        "| family | meshes | default | oracle (one radius) | rule | ICI rule | rule worse than default by >10% |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    return "\n".join(
+        ["Geometric mean over the meshes of the median |H error| / max|k|:", ""] + head + summary + [""] + lines
+    )
 
 
 def voxel_report(cache=CACHE):
     """The accuracy_voxel.md metric (median |H - H_exact| / |H_exact|, same for K) on the voxel meshes."""
-    lines = ["| mesh | family | target H / K | default H / K | rule H / K | oracle H / K |", "|---|---|---|---|---|---|"]
+    lines = [
+        "| mesh | family | target H / K | default H / K | rule H / K | oracle H / K |",
+        "|---|---|---|---|---|---|",
+    ]
     for path in sorted(p for p in os.listdir(cache) if p.endswith(".noise.npz")):
         d = load(os.path.join(cache, path.replace(".noise", "")))
         if not d["name"].startswith("voxel_"):
@@ -437,8 +495,10 @@ def voxel_report(cache=CACHE):
 
 def varying_report(cache=CACHE):
     """Fine and coarse parts of the varying-resolution meshes: median H error and share off by > 25%."""
-    lines = ["| mesh | part | V | default H / >25% | oracle H / >25% | rule H / >25% | rule r/h (of the median edge) |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| mesh | part | V | default H / >25% | oracle H / >25% | rule H / >25% | rule r/h (of the median edge) |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for path in sorted(p for p in os.listdir(cache) if p.endswith(".noise.npz")):
         d = load(os.path.join(cache, path.replace(".noise", "")))
         if d["family"] != "varying":
@@ -451,15 +511,20 @@ def varying_report(cache=CACHE):
             for fields in (d["default"], d["fields"][:, j], picked(d, rule)):
                 e = errors(d, fields, mask)
                 cells.append(f"{_pct(e['H'][0])} / {_pct(e['bad25'])}")
-            lines.append(f"| {d['name']} | {part} | {int(mask.sum())} | " + " | ".join(cells)
-                         + f" | {_radius(d['radii'][rule[mask]] / h)} |")
+            lines.append(
+                f"| {d['name']} | {part} | {int(mask.sum())} | "
+                + " | ".join(cells)
+                + f" | {_radius(d['radii'][rule[mask]] / h)} |"
+            )
     return "\n".join(lines)
 
 
 def shrinkage_report(cache=CACHE):
     """Smoothed spheres: how far the level set shrank, and the H error that alone explains."""
-    lines = ["| mesh | mean vertex radius / R | H error from the shrinkage alone | rule H error | oracle H error |",
-             "|---|---|---|---|---|"]
+    lines = [
+        "| mesh | mean vertex radius / R | H error from the shrinkage alone | rule H error | oracle H error |",
+        "|---|---|---|---|---|",
+    ]
     for case in scale_families.smoothed_cases():
         if "sphere" not in case.name:
             continue
@@ -467,15 +532,22 @@ def shrinkage_report(cache=CACHE):
         measured = np.linalg.norm(case.vertices, axis=1).mean()
         d = load(os.path.join(cache, _slug(case.name) + ".npz"))
         out = runs(d)
-        lines.append(f"| {case.name} | {measured / radius:.4f} | {_pct(abs(radius / measured - 1))} | "
-                     f"{_pct(out['rule'][0]['H'][0])} | {_pct(out['oracle'][0]['H'][0])} |")
+        lines.append(
+            f"| {case.name} | {measured / radius:.4f} | {_pct(abs(radius / measured - 1))} | "
+            f"{_pct(out['rule'][0]['H'][0])} | {_pct(out['oracle'][0]['H'][0])} |"
+        )
     return "\n".join(lines)
 
 
 #: (mesh name, measure radius in median edge lengths) of the normal-radius study: each near its oracle radius.
-NORMAL_STUDY = [("smoothed sphere(20), sigma 1", 8.0), ("smoothed torus(25, 10), sigma 1", 5.6),
-                ("icosphere(32) + noise 0.3h [level 2]", 9.7), ("ellipsoid(3.0, 2.0, 1.0) + noise 0.1h [level 2]", 3.0),
-                ("voxel_torus(R=12, r=4, voxel 0.5x0.5x0.5)", 4.5), ("torus(R=3, r=1) [level 1]", 1.0)]
+NORMAL_STUDY = [
+    ("smoothed sphere(20), sigma 1", 8.0),
+    ("smoothed torus(25, 10), sigma 1", 5.6),
+    ("icosphere(32) + noise 0.3h [level 2]", 9.7),
+    ("ellipsoid(3.0, 2.0, 1.0) + noise 0.1h [level 2]", 3.0),
+    ("voxel_torus(R=12, r=4, voxel 0.5x0.5x0.5)", 4.5),
+    ("torus(R=3, r=1) [level 1]", 1.0),
+]
 
 
 def normal_study(ratios=(1.0, 1.5, 2.0, 3.0)):
@@ -483,8 +555,10 @@ def normal_study(ratios=(1.0, 1.5, 2.0, 3.0)):
     from meshcurv.estimators import icc
 
     wanted = dict(NORMAL_STUDY)
-    lines = ["| mesh | r / h | " + " | ".join(f"normals over {q:g} r: H (p95), s" for q in ratios) + " |",
-             "|---|---|" + "---|" * len(ratios)]
+    lines = [
+        "| mesh | r / h | " + " | ".join(f"normals over {q:g} r: H (p95), s" for q in ratios) + " |",
+        "|---|---|" + "---|" * len(ratios),
+    ]
     for case in scale_families.cases(["accuracy", "smoothed", "voxel"]):
         if case.name not in wanted:
             continue
@@ -498,16 +572,20 @@ def normal_study(ratios=(1.0, 1.5, 2.0, 3.0)):
         cells = []
         for ratio in ratios:
             t0 = time.perf_counter()
-            fitted = icc.fitted_normals(v, normals, valid, ratio * radius, neighbours=topology.referenced_vertices,
-                                        adjacency=adjacency)
+            fitted = icc.fitted_normals(
+                v, normals, valid, ratio * radius, neighbours=topology.referenced_vertices, adjacency=adjacency
+            )
             per_face = face_measures(v, f, fitted)
             summed = meshcurv.neighborhoods.ball_face_sums(v, f, radius, per_face, connected=True)
             k_min, k_max, _, _ = curvatures_from_measures(summed, fitted)
             seconds = time.perf_counter() - t0
-            e = errors({"k_min": case.k_min, "k_max": case.k_max},
-                       np.stack([k_min, k_max, (k_min + k_max) / 2, k_min * k_max]))
+            e = errors(
+                {"k_min": case.k_min, "k_max": case.k_max}, np.stack([k_min, k_max, (k_min + k_max) / 2, k_min * k_max])
+            )
             cells.append(f"{_cell(e)}, {seconds:.2f}")
-        lines.append(f"| {case.name} | {radius / median_edge_length(v, topology.edges):.1f} | " + " | ".join(cells) + " |")
+        lines.append(
+            f"| {case.name} | {radius / median_edge_length(v, topology.edges):.1f} | " + " | ".join(cells) + " |"
+        )
         if not wanted:
             break
     return "\n".join(lines)

@@ -61,8 +61,13 @@ from meshcurv.neighborhoods import ball_face_sums, ball_face_sums_nested  # noqa
 CACHE = os.path.join(proto.CACHE, "variant_b")
 
 #: name -> (ratio, top in median edge lengths) of the ladders compared.
-LADDERS = {"q2-32": (2 ** 0.5, 32.0), "q2-12": (2 ** 0.5, 12.0), "q2-8": (2 ** 0.5, 8.0),
-           "q4-32": (2 ** 0.25, 32.0), "q4-12": (2 ** 0.25, 12.0)}
+LADDERS = {
+    "q2-32": (2**0.5, 32.0),
+    "q2-12": (2**0.5, 12.0),
+    "q2-8": (2**0.5, 8.0),
+    "q4-32": (2**0.25, 32.0),
+    "q4-12": (2**0.25, 12.0),
+}
 
 #: The normals of the ladder walk: ``r0`` (the brief's variant B: fitted over 3 r0, today's default radius) or
 #: ``low`` (fitted over 3 x 0.75 h_v per vertex: the ladder's first usable rung), and the ladders run with each.
@@ -72,9 +77,14 @@ NORMAL_MODES = {"r0": tuple(LADDERS), "low": ("q2-32", "q2-12", "q4-12")}
 FINEST = "q4-32"
 
 #: The meshes of the stage timings (3 repeats, the minimum kept): one per kind.
-TIMING_MESHES = ["icosphere(32) [level 2]", "torus(R=3, r=1) + noise 0.3h [level 2]",
-                 "voxel_torus(R=12, r=4, voxel 0.5x0.5x0.5)", "smoothed sphere(20), sigma 1",
-                 "smoothed torus(25, 10), sigma 1", "varying ellipsoid(3, 2, 1) (25250 points, density 100:1)"]
+TIMING_MESHES = [
+    "icosphere(32) [level 2]",
+    "torus(R=3, r=1) + noise 0.3h [level 2]",
+    "voxel_torus(R=12, r=4, voxel 0.5x0.5x0.5)",
+    "smoothed sphere(20), sigma 1",
+    "smoothed torus(25, 10), sigma 1",
+    "varying ellipsoid(3, 2, 1) (25250 points, density 100:1)",
+]
 
 
 def _quiet(call, *args, **kwargs):
@@ -100,8 +110,9 @@ class Mesh:
 
     def fitted(self, radius):
         """Normals fitted over ``radius`` (a float, or (V,) one per vertex)."""
-        return icc.fitted_normals(self.vertices, self.normals, self.valid, radius, neighbours=self.referenced,
-                                  adjacency=self.adjacency)
+        return icc.fitted_normals(
+            self.vertices, self.normals, self.valid, radius, neighbours=self.referenced, adjacency=self.adjacency
+        )
 
     def measures(self, normals):
         finite = np.isfinite(normals).all(axis=1)
@@ -133,8 +144,13 @@ def selection_data(mesh, radii, k):
     """The ``data`` dict :func:`scale_prototype.select_stable` reads."""
     k_min, k_max = k
     indptr, indices = mesh.adjacency
-    return {"fields": np.stack([k_min, k_max, (k_min + k_max) / 2, k_min * k_max]), "radii": radii,
-            "local": mesh.local, "indptr": np.asarray(indptr), "indices": np.asarray(indices)}
+    return {
+        "fields": np.stack([k_min, k_max, (k_min + k_max) / 2, k_min * k_max]),
+        "radii": radii,
+        "local": mesh.local,
+        "indptr": np.asarray(indptr),
+        "indices": np.asarray(indices),
+    }
 
 
 def pick(summed, normals, chosen):
@@ -156,8 +172,10 @@ def final_pass(mesh, radius):
 
 
 def ladders(mesh):
-    return {name: proto.ladder(mesh.vertices, mesh.faces, mesh.topology, ratio=q, high=top)
-            for name, (q, top) in LADDERS.items()}
+    return {
+        name: proto.ladder(mesh.vertices, mesh.faces, mesh.topology, ratio=q, high=top)
+        for name, (q, top) in LADDERS.items()
+    }
 
 
 def rungs_of(finest, radii):
@@ -184,8 +202,14 @@ def compute(case, cache=CACHE, rule=None, final=True):
     t_default, default = default_call(mesh)
     r0 = float(default.parameters["radius"])
     radii = ladders(mesh)
-    out = {"name": case.name, "r0": r0, "h": mesh.h, "t_default": t_default, "n": mesh.vertices.shape[0],
-           "default": np.stack([default.k_min, default.k_max])}
+    out = {
+        "name": case.name,
+        "r0": r0,
+        "h": mesh.h,
+        "t_default": t_default,
+        "n": mesh.vertices.shape[0],
+        "default": np.stack([default.k_min, default.k_max]),
+    }
     for mode, configs in NORMAL_MODES.items():
         t0 = time.perf_counter()
         normals = mesh.fitted(ladder_normal_radius(mesh, mode, r0))
@@ -210,14 +234,21 @@ def compute(case, cache=CACHE, rule=None, final=True):
                 out[f"{key}_t_final_normals"], out[f"{key}_t_final_sums"] = t_fit, t_sum
     os.makedirs(cache, exist_ok=True)
     np.savez_compressed(path, **out)
-    print(f"{case.name}: {mesh.vertices.shape[0]} vertices, default {t_default:.2f} s, "
-          + ", ".join(f"{m} {n} {out[f'{m} {n}_t_ladder']:.2f}"
-                      f"+{out[f'{m} {n}_t_final_normals'] + out[f'{m} {n}_t_final_sums']:.2f} s"
-                      for m, c in NORMAL_MODES.items() for n in c if final), file=sys.stderr)
+    print(
+        f"{case.name}: {mesh.vertices.shape[0]} vertices, default {t_default:.2f} s, "
+        + ", ".join(
+            f"{m} {n} {out[f'{m} {n}_t_ladder']:.2f}"
+            f"+{out[f'{m} {n}_t_final_normals'] + out[f'{m} {n}_t_final_sums']:.2f} s"
+            for m, c in NORMAL_MODES.items()
+            for n in c
+            if final
+        ),
+        file=sys.stderr,
+    )
     return path
 
 
-def anchored_ladder(mesh, r0, *, ratio=2 ** 0.5, high=12.0):
+def anchored_ladder(mesh, r0, *, ratio=2**0.5, high=12.0):
     """The rungs ``r0 q^j`` up to ``min(high h, sqrt(area / (18 pi)))``: a ladder that starts at today's default."""
     top = proto.ladder(mesh.vertices, mesh.faces, mesh.topology, ratio=ratio, high=high)[-1]
     count = int(np.floor(np.log(max(top, r0) / r0) / np.log(ratio) + 1e-9)) + 1
@@ -238,17 +269,31 @@ def compute_anchored(case, cache=CACHE + "_anchored"):
     k, _ = ladder_sums(mesh, normals, rr)
     t_ladder = time.perf_counter() - t0
     os.makedirs(cache, exist_ok=True)
-    np.savez_compressed(path, name=case.name, r0=r0, h=mesh.h, radii=rr, k=k, t_default=t_default,
-                        t_ladder=t_ladder, default=np.stack([default.k_min, default.k_max]))
-    print(f"{case.name}: anchored ladder of {rr.size} rungs, {t_ladder:.2f} s (default {t_default:.2f} s)",
-          file=sys.stderr)
+    np.savez_compressed(
+        path,
+        name=case.name,
+        r0=r0,
+        h=mesh.h,
+        radii=rr,
+        k=k,
+        t_default=t_default,
+        t_ladder=t_ladder,
+        default=np.stack([default.k_min, default.k_max]),
+    )
+    print(
+        f"{case.name}: anchored ladder of {rr.size} rungs, {t_ladder:.2f} s (default {t_default:.2f} s)",
+        file=sys.stderr,
+    )
     return path
 
 
 def anchored_report(cache=CACHE + "_anchored", rules=None):
     """Geometric means per family of B1 on the anchored ladder under ``rules`` (label -> rule)."""
-    rules = rules or {"anchored q2-12, RULE": proto.RULE, "anchored q2-12, tuned pool 0.75": dict(RULE_B1, pool=0.75),
-                      "anchored q2-12, tuned pool 1": RULE_B1}
+    rules = rules or {
+        "anchored q2-12, RULE": proto.RULE,
+        "anchored q2-12, tuned pool 0.75": dict(RULE_B1, pool=0.75),
+        "anchored q2-12, tuned pool 1": RULE_B1,
+    }
     labels = proto._labels()
     per_family = {}
     for path in sorted(p for p in os.listdir(cache) if p.endswith(".npz")):
@@ -257,8 +302,14 @@ def anchored_report(cache=CACHE + "_anchored", rules=None):
         a = proto.load(os.path.join(proto.CACHE, path))
         family = labels.get(a["name"], (a["family"], a["tuning"]))[0]
         d = proto.errors(a, _fields(b["default"]))
-        data = {"fields": _fields(b["k"]), "radii": b["radii"], "local": a["local"], "indptr": a["indptr"],
-                "indices": a["indices"], "r0": float(b["r0"])}
+        data = {
+            "fields": _fields(b["k"]),
+            "radii": b["radii"],
+            "local": a["local"],
+            "indptr": a["indptr"],
+            "indices": a["indices"],
+            "r0": float(b["r0"]),
+        }
         row = per_family.setdefault(family, {k: [] for k in ["default", *rules]})
         worse = per_family.setdefault(family + " worse", {k: 0 for k in rules})
         row["default"].append(d["H"][0])
@@ -266,8 +317,10 @@ def anchored_report(cache=CACHE + "_anchored", rules=None):
             e = proto.errors(a, proto.picked(data, proto.select_stable(data, rule)))
             row[label].append(e["H"][0])
             worse[label] += e["H"][0] > 1.1 * d["H"][0] + 2e-4
-    lines = ["| run | " + " | ".join(f for f in per_family if not f.endswith("worse")) + " |",
-             "|---|" + "---|" * (len(per_family) // 2)]
+    lines = [
+        "| run | " + " | ".join(f for f in per_family if not f.endswith("worse")) + " |",
+        "|---|" + "---|" * (len(per_family) // 2),
+    ]
     for key in ["default", *rules]:
         cells = []
         for family, row in per_family.items():
@@ -281,8 +334,10 @@ def anchored_report(cache=CACHE + "_anchored", rules=None):
 
 def anchored_cost(cache=CACHE + "_anchored", names=TIMING_MESHES):
     """(default + anchored ladder) / default per timing mesh, from the single timings of ``--anchored``."""
-    lines = ["| mesh | V | rungs | default, us per vertex | ladder, us per vertex | (default + ladder) / default |",
-             "|---|---|---|---|---|---|"]
+    lines = [
+        "| mesh | V | rungs | default, us per vertex | ladder, us per vertex | (default + ladder) / default |",
+        "|---|---|---|---|---|---|",
+    ]
     ratios = []
     for path in sorted(os.listdir(cache)):
         with np.load(os.path.join(cache, path)) as z:
@@ -290,18 +345,25 @@ def anchored_cost(cache=CACHE + "_anchored", names=TIMING_MESHES):
             ratio = (z["t_default"] + z["t_ladder"]) / z["t_default"]
             ratios.append(ratio)
             if name in names:
-                lines.append(f"| {name} | {n} | {z['radii'].size} | {1e6 * z['t_default'] / n:.0f} | "
-                             f"{1e6 * z['t_ladder'] / n:.0f} | {ratio:.1f} |")
-    lines.append(f"| all {len(ratios)} meshes: median [10-90%, max] | | | | | {np.median(ratios):.1f} "
-                 f"[{np.percentile(ratios, 10):.1f}-{np.percentile(ratios, 90):.1f}, {np.max(ratios):.1f}] |")
+                lines.append(
+                    f"| {name} | {n} | {z['radii'].size} | {1e6 * z['t_default'] / n:.0f} | "
+                    f"{1e6 * z['t_ladder'] / n:.0f} | {ratio:.1f} |"
+                )
+    lines.append(
+        f"| all {len(ratios)} meshes: median [10-90%, max] | | | | | {np.median(ratios):.1f} "
+        f"[{np.percentile(ratios, 10):.1f}-{np.percentile(ratios, 90):.1f}, {np.max(ratios):.1f}] |"
+    )
     return "\n".join(lines)
 
 
 def anchored_timing(names=TIMING_MESHES, repeats=3):
     """Per-vertex microseconds of the recommended variant's stages (minimum of ``repeats`` interleaved runs)."""
     warm_up()
-    lines = ["| mesh | V | rungs | default | normals 3 r0 (in default) | ladder sums | selection + pick | "
-             "B1 total / default |", "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| mesh | V | rungs | default | normals 3 r0 (in default) | ladder sums | selection + pick | "
+        "B1 total / default |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     wanted = set(names)
     for case in scale_families.cases():
         if case.name not in wanted:
@@ -324,9 +386,11 @@ def anchored_timing(names=TIMING_MESHES, repeats=3):
             for key, value in (("default", t), ("normals", t1 - t0), ("ladder", t2 - t1), ("select", t3 - t2)):
                 best[key] = min(best.get(key, np.inf), value)
         total = best["default"] + best["ladder"] + best["select"]
-        lines.append(f"| {case.name} | {n} | {rr.size} | " + " | ".join(
-            f"{1e6 * best[k] / n:.0f}" for k in ("default", "normals", "ladder", "select"))
-            + f" | {total / best['default']:.2f} |")
+        lines.append(
+            f"| {case.name} | {n} | {rr.size} | "
+            + " | ".join(f"{1e6 * best[k] / n:.0f}" for k in ("default", "normals", "ladder", "select"))
+            + f" | {total / best['default']:.2f} |"
+        )
         if not wanted:
             break
     return "\n".join(lines)
@@ -417,18 +481,28 @@ def timing_report(rows, configs=TIMED):
     ``low`` normals: B1 = the low normal fit + ladder + selection (no default call). B2 = B1 + final pass.
     """
     us = 1e6
-    head = ("| mesh | V | r0/h | default | A (icc per rung, q2-32, 1 run) | normals 3 r0 (in default) | "
-            "normals 2.25 h_v | " + " | ".join(f"{c}: rungs, ladder, select, final normals + sums, r_v/h"
-                                              for c in configs) + " |")
+    head = (
+        "| mesh | V | r0/h | default | A (icc per rung, q2-32, 1 run) | normals 3 r0 (in default) | "
+        "normals 2.25 h_v | "
+        + " | ".join(f"{c}: rungs, ladder, select, final normals + sums, r_v/h" for c in configs)
+        + " |"
+    )
     lines = [head, "|---|---|---|---|---|---|---|" + "---|" * len(configs)]
-    ratio_lines = ["| mesh | A / default | " + " | ".join(f"{c}: B1, B2" for c in configs) + " |",
-                   "|---|---|" + "---|" * len(configs)]
+    ratio_lines = [
+        "| mesh | A / default | " + " | ".join(f"{c}: B1, B2" for c in configs) + " |",
+        "|---|---|" + "---|" * len(configs),
+    ]
     for name, n, r0h, b in rows:
-        cells = [f"{b[c + ' rungs']}, {us * b[c + ' ladder'] / n:.0f}, {us * b[c + ' select'] / n:.0f}, "
-                 f"{us * b[c + ' final normals'] / n:.0f} + {us * b[c + ' final sums'] / n:.0f}, "
-                 f"{b[c + ' r_v/h']:.1f}" for c in configs]
-        lines.append(f"| {name} | {n} | {r0h:.1f} | {us * b['default'] / n:.0f} | {us * b['A'] / n:.0f} | "
-                     f"{us * b['r0 normals'] / n:.0f} | {us * b['low normals'] / n:.0f} | " + " | ".join(cells) + " |")
+        cells = [
+            f"{b[c + ' rungs']}, {us * b[c + ' ladder'] / n:.0f}, {us * b[c + ' select'] / n:.0f}, "
+            f"{us * b[c + ' final normals'] / n:.0f} + {us * b[c + ' final sums'] / n:.0f}, "
+            f"{b[c + ' r_v/h']:.1f}"
+            for c in configs
+        ]
+        lines.append(
+            f"| {name} | {n} | {r0h:.1f} | {us * b['default'] / n:.0f} | {us * b['A'] / n:.0f} | "
+            f"{us * b['r0 normals'] / n:.0f} | {us * b['low normals'] / n:.0f} | " + " | ".join(cells) + " |"
+        )
         ratios = []
         for c in configs:
             start = b["default"] if c.startswith("r0") else b["low normals"]
@@ -440,6 +514,7 @@ def timing_report(rows, configs=TIMED):
 
 
 # -- accuracy ---------------------------------------------------------------------------------
+
 
 def load_b(name, cache=CACHE):
     path = os.path.join(cache, proto._slug(name) + ".npz")
@@ -457,11 +532,20 @@ def _fields(k):
 def reselect(a, b, mode, name, rule):
     """B1's fields with another ``rule`` (from the cached rungs of the finest ladder): (4, V), chosen radii."""
     rr = b[f"{name}_radii"]
-    source = next(c for c in ("q2-32", FINEST) if f"{mode} {c}_k" in b and np.all(np.isin(
-        np.round(rr, 9), np.round(b[f"{c}_radii"], 9))))
+    source = next(
+        c
+        for c in ("q2-32", FINEST)
+        if f"{mode} {c}_k" in b and np.all(np.isin(np.round(rr, 9), np.round(b[f"{c}_radii"], 9)))
+    )
     k = b[f"{mode} {source}_k"][:, rungs_of(b[f"{source}_radii"], rr)]
-    data = {"fields": _fields(k), "radii": rr, "local": a["local"], "indptr": a["indptr"], "indices": a["indices"],
-            "r0": float(b["r0"])}
+    data = {
+        "fields": _fields(k),
+        "radii": rr,
+        "local": a["local"],
+        "indptr": a["indptr"],
+        "indices": a["indices"],
+        "r0": float(b["r0"]),
+    }
     chosen = proto.select_stable(data, rule)
     return proto.picked(data, chosen), rr[chosen]
 
@@ -486,12 +570,15 @@ def grid(cache=CACHE, ladder_name="q2-32"):
     tuning = [(a, b) for a, b in cases.values() if a["tuning"]]
     held = [(a, b) for a, b in cases.values() if not a["tuning"]]
     defaults = {id(a): proto.errors(a, _fields(b["default"])) for a, b in cases.values()}
-    lines = ["| normals | pool | take | rings | min_edges | floor r0 | B1 tuning score | B2 tuning score "
-             "| B2 one rung lower, tuning | B1 held-out score | B2 held-out score | B2 one rung lower, held out |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| normals | pool | take | rings | min_edges | floor r0 | B1 tuning score | B2 tuning score "
+        "| B2 one rung lower, tuning | B1 held-out score | B2 held-out score | B2 one rung lower, held out |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     rows = []
     for mode, pool, take, rings, min_edges, floor in itertools.product(
-            NORMAL_MODES, (0.0, 0.5, 0.75, 1.0), (0, 1), (0, 2), (0.75, 1.0), (0.0, 1.0)):
+        NORMAL_MODES, (0.0, 0.5, 0.75, 1.0), (0, 1), (0, 2), (0.75, 1.0), (0.0, 1.0)
+    ):
         rule = dict(proto.RULE, pool=pool, take=take, rings=rings, min_edges=min_edges, floor_r0=floor)
         scores = []
         for group in (tuning, held):
@@ -501,16 +588,28 @@ def grid(cache=CACHE, ladder_name="q2-32"):
                     continue
                 rr = b[f"{ladder_name}_radii"]
                 k = b[f"{mode} {ladder_name}_k"]
-                data = {"fields": _fields(k), "radii": rr, "local": a["local"], "indptr": a["indptr"],
-                        "indices": a["indices"], "r0": float(b["r0"])}
+                data = {
+                    "fields": _fields(k),
+                    "radii": rr,
+                    "local": a["local"],
+                    "indptr": a["indptr"],
+                    "indices": a["indices"],
+                    "r0": float(b["r0"]),
+                }
                 chosen = proto.select_stable(data, rule)
                 b1.append(proto.errors(a, proto.picked(data, chosen)))
                 b2.append(proto.errors(a, proxy_b2(a, rr, chosen)))
                 lower.append(proto.errors(a, proxy_b2(a, rr, np.maximum(chosen - 1, 0))))
                 d.append(defaults[id(a)])
             scores += [score(b1, d), score(b2, d), score(lower, d)]
-        rows.append((scores[1], f"| {mode} | {pool:g} | {take} | {rings} | {min_edges:g} | {floor:g} | "
-                     + " | ".join(f"{x:.3f}" for x in scores) + " |"))
+        rows.append(
+            (
+                scores[1],
+                f"| {mode} | {pool:g} | {take} | {rings} | {min_edges:g} | {floor:g} | "
+                + " | ".join(f"{x:.3f}" for x in scores)
+                + " |",
+            )
+        )
         print(rows[-1][1], file=sys.stderr)
     reference = []
     for group in (tuning, held):
@@ -525,9 +624,11 @@ def runs(a, b, rules=None):
     every normal mode and ladder (and B1 under extra ``rules``: label -> (mode, ladder, rule))."""
     h = np.median(a["local"])
     chosen_a = proto.select(a, proto.RULE)
-    out = {"default": (proto.errors(a, _fields(b["default"])), np.array([b["r0"] / h])),
-           "default@ce27127": (proto.errors(a, a["default"]), a["default_radius"] / h),
-           "A": (proto.errors(a, proto.picked(a, chosen_a)), a["radii"][chosen_a] / h)}
+    out = {
+        "default": (proto.errors(a, _fields(b["default"])), np.array([b["r0"] / h])),
+        "default@ce27127": (proto.errors(a, a["default"]), a["default_radius"] / h),
+        "A": (proto.errors(a, proto.picked(a, chosen_a)), a["radii"][chosen_a] / h),
+    }
     for cap in (12.0, 8.0):  # variant A with its ladder capped lower: the rule among the rungs up to cap h
         m = int(np.sum(a["radii"] <= cap * float(b["h"]) * (1 + 1e-9)))
         capped = dict(a, fields=a["fields"][:, :m], radii=a["radii"][:m])
@@ -559,13 +660,18 @@ def runs(a, b, rules=None):
 #: pooled fully (one curve per mesh); the upper rung for B1, the lower for B2.
 RULE_B1 = dict(proto.RULE, pool=1.0, take=1, rings=2, min_edges=0.75, floor_r0=1.0)
 RULE_B2 = dict(proto.RULE, pool=1.0, take=0, rings=2, min_edges=0.75, floor_r0=1.0)
-TUNED = {"B1 r0 q2-32 tuned": ("r0", "q2-32", RULE_B1), "B1 r0 q2-8 tuned": ("r0", "q2-8", RULE_B1),
-         "B1 r0 q4-12 tuned": ("r0", "q4-12", RULE_B1), "B1 r0 q2-32 tuned for B2": ("r0", "q2-32", RULE_B2),
-         "B1 r0 q2-8 tuned for B2": ("r0", "q2-8", RULE_B2), "B1 r0 q2-32 RULE": ("r0", "q2-32", proto.RULE),
-         "B1 r0 q2-32 tuned, pool 0.75": ("r0", "q2-32", dict(RULE_B1, pool=0.75)),
-         "B1 r0 q2-12 tuned, pool 0.75": ("r0", "q2-12", dict(RULE_B1, pool=0.75)),
-         "B1 r0 q2-8 tuned, pool 0.75": ("r0", "q2-8", dict(RULE_B1, pool=0.75)),
-         "B1 r0 q4-12 tuned, pool 0.75": ("r0", "q4-12", dict(RULE_B1, pool=0.75))}
+TUNED = {
+    "B1 r0 q2-32 tuned": ("r0", "q2-32", RULE_B1),
+    "B1 r0 q2-8 tuned": ("r0", "q2-8", RULE_B1),
+    "B1 r0 q4-12 tuned": ("r0", "q4-12", RULE_B1),
+    "B1 r0 q2-32 tuned for B2": ("r0", "q2-32", RULE_B2),
+    "B1 r0 q2-8 tuned for B2": ("r0", "q2-8", RULE_B2),
+    "B1 r0 q2-32 RULE": ("r0", "q2-32", proto.RULE),
+    "B1 r0 q2-32 tuned, pool 0.75": ("r0", "q2-32", dict(RULE_B1, pool=0.75)),
+    "B1 r0 q2-12 tuned, pool 0.75": ("r0", "q2-12", dict(RULE_B1, pool=0.75)),
+    "B1 r0 q2-8 tuned, pool 0.75": ("r0", "q2-8", dict(RULE_B1, pool=0.75)),
+    "B1 r0 q4-12 tuned, pool 0.75": ("r0", "q4-12", dict(RULE_B1, pool=0.75)),
+}
 
 #: The recommended setting (see benchmarks/scale.md, "Variant B"): B1 on the ladder r0 sqrt(2)^j up to 12 h
 #: (:func:`anchored_ladder`), normals over 3 r0, the colleague's RULE unchanged.
@@ -575,8 +681,14 @@ RECOMMENDED = "B1 anchored q2-12"
 def anchored_fields(a, b, rule=None):
     """(4, V) fields and (V,) radii of B1 on the anchored ladder (``b["anchored"]``) under ``rule`` (RULE)."""
     z = b["anchored"]
-    data = {"fields": _fields(z["k"]), "radii": z["radii"], "local": a["local"], "indptr": a["indptr"],
-            "indices": a["indices"], "r0": float(z["r0"])}
+    data = {
+        "fields": _fields(z["k"]),
+        "radii": z["radii"],
+        "local": a["local"],
+        "indptr": a["indptr"],
+        "indices": a["indices"],
+        "r0": float(z["r0"]),
+    }
     chosen = proto.select_stable(data, proto.RULE if rule is None else rule)
     return proto.picked(data, chosen), z["radii"][chosen]
 
@@ -619,8 +731,11 @@ def report(cache=CACHE, rules=None, keys=None):
     keys = all_keys(rules) if keys is None else keys
     summary, tables = [], []
     for family, title in proto.FAMILY_TITLES.items():
-        names = ([n for n in cases if n in failing] if family == "failing"
-                 else [n for n, (a, _) in cases.items() if a["family"] == family])
+        names = (
+            [n for n in cases if n in failing]
+            if family == "failing"
+            else [n for n, (a, _) in cases.items() if a["family"] == family]
+        )
         if not names:
             continue
         agg = {k: [] for k in keys}
@@ -638,9 +753,12 @@ def report(cache=CACHE, rules=None, keys=None):
             rows.append((name, a["local"].size, out))
         summary.append((title, len(names), agg, worse))
         tables.append((title, rows))
-    lines = ["| run | " + " | ".join(f"{title.split(':')[0]}: {title.split(': ')[-1]} ({count})"
-                                     for title, count, _, _ in summary) + " |",
-             "|---|" + "---|" * len(summary)]
+    lines = [
+        "| run | "
+        + " | ".join(f"{title.split(':')[0]}: {title.split(': ')[-1]} ({count})" for title, count, _, _ in summary)
+        + " |",
+        "|---|" + "---|" * len(summary),
+    ]
     for k in keys:
         cells = [f"{proto._pct(proto._geo(agg[k]))} ({worse[k]})" if agg[k] else "-" for _, _, agg, worse in summary]
         lines.append(f"| {k} | " + " | ".join(cells) + " |")
@@ -650,14 +768,21 @@ def report(cache=CACHE, rules=None, keys=None):
 def mesh_tables(tables, shown=("default", "A", "B1 r0 q2-32", "B2 r0 q2-32", "B2 low q2-32", RECOMMENDED)):
     lines = []
     for title, rows in tables:
-        lines += [f"#### {title}", "",
-                  "| mesh | V | " + " | ".join(f"{k}: H (p95), r/h" for k in shown) + " | A k1 / k2 | "
-                  "recommended k1 / k2 |", "|---|---|" + "---|" * (len(shown) + 2)]
+        lines += [
+            f"#### {title}",
+            "",
+            "| mesh | V | " + " | ".join(f"{k}: H (p95), r/h" for k in shown) + " | A k1 / k2 | recommended k1 / k2 |",
+            "|---|---|" + "---|" * (len(shown) + 2),
+        ]
         for name, n, out in rows:
-            cells = [f"{proto._cell(out[k][0])}, {proto._radius(np.atleast_1d(out[k][1]))}" if k in out else "-"
-                     for k in shown]
-            kk = [" / ".join(proto._pct(out[k][0][q][0]) for q in ("k1", "k2")) if k in out else "-"
-                  for k in ("A", RECOMMENDED)]
+            cells = [
+                f"{proto._cell(out[k][0])}, {proto._radius(np.atleast_1d(out[k][1]))}" if k in out else "-"
+                for k in shown
+            ]
+            kk = [
+                " / ".join(proto._pct(out[k][0][q][0]) for q in ("k1", "k2")) if k in out else "-"
+                for k in ("A", RECOMMENDED)
+            ]
             lines.append(f"| {name} | {n} | " + " | ".join(cells + kk) + " |")
         lines.append("")
     return "\n".join(lines)
@@ -665,9 +790,14 @@ def mesh_tables(tables, shown=("default", "A", "B1 r0 q2-32", "B2 r0 q2-32", "B2
 
 def target_report(cache=CACHE):
     """The accuracy_voxel.md metric on the voxel meshes, and the varying meshes' parts, for ``label``."""
-    lines = ["| mesh | family | target H / K | default H / K | A H / K | recommended H / K |", "|---|---|---|---|---|---|"]
-    parts = ["| mesh | part | default H / >25% | A H / >25% | recommended H / >25% | recommended r/h |",
-             "|---|---|---|---|---|---|"]
+    lines = [
+        "| mesh | family | target H / K | default H / K | A H / K | recommended H / K |",
+        "|---|---|---|---|---|---|",
+    ]
+    parts = [
+        "| mesh | part | default H / >25% | A H / >25% | recommended H / >25% | recommended r/h |",
+        "|---|---|---|---|---|---|",
+    ]
     for a, b in cases_ab(cache).values():
         fields, rr = anchored_fields(a, b)
         chosen_a = proto.select(a, proto.RULE)
@@ -678,15 +808,21 @@ def target_report(cache=CACHE):
             for fields_ in runs_.values():
                 e = proto.errors(a, fields_)
                 cells.append(f"{proto._pct(e['Hrel'])} / {proto._pct(e['Krel'])}")
-            lines.append(f"| {a['name']} | {a['family']} | {'3% / 6%' if aspect == 1 else '6% / 12%'} | "
-                         + " | ".join(cells) + " |")
+            lines.append(
+                f"| {a['name']} | {a['family']} | {'3% / 6%' if aspect == 1 else '6% / 12%'} | "
+                + " | ".join(cells)
+                + " |"
+            )
         for part, mask in a["parts"].items():
             cells = []
             for fields_ in runs_.values():
                 e = proto.errors(a, fields_, mask)
                 cells.append(f"{proto._pct(e['H'][0])} / {proto._pct(e['bad25'])}")
-            parts.append(f"| {a['name']} | {part} | " + " | ".join(cells)
-                         + f" | {proto._radius(rr[mask] / np.median(a['local']))} |")
+            parts.append(
+                f"| {a['name']} | {part} | "
+                + " | ".join(cells)
+                + f" | {proto._radius(rr[mask] / np.median(a['local']))} |"
+            )
     return "\n".join(lines[:2] + sorted(lines[2:])) + "\n\n" + "\n".join(parts)
 
 
@@ -697,8 +833,9 @@ def main(argv=None):
     parser.add_argument("--timing", action="store_true", help="the stage timings instead")
     parser.add_argument("--grid", action="store_true", help="the rule-constant grid for variant B instead")
     parser.add_argument("--anchored-timing", action="store_true", help="the recommended variant's stage timings")
-    parser.add_argument("--anchored", action="store_true",
-                        help="B1 on a ladder that starts at r0 (compute, cached, then its table)")
+    parser.add_argument(
+        "--anchored", action="store_true", help="B1 on a ladder that starts at r0 (compute, cached, then its table)"
+    )
     parser.add_argument("--cache", default=CACHE)
     args = parser.parse_args(argv)
     if args.compute:

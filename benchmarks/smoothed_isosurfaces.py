@@ -33,8 +33,10 @@ def main():
             if radius is None:
                 default = r
         radius = np.atleast_1d(default.parameters["radius"])[0]
-        print(f"| {case.name} | {case.vertices.shape[0]:,} | {default.parameters.get('surface')} | {radius:.3g} | "
-              f"{100 * errors[0]:.2f}% | {100 * errors[1]:.2f}% |")
+        print(
+            f"| {case.name} | {case.vertices.shape[0]:,} | {default.parameters.get('surface')} | {radius:.3g} | "
+            f"{100 * errors[0]:.2f}% | {100 * errors[1]:.2f}% |"
+        )
 
 
 if __name__ == "__main__":

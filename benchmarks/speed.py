@@ -82,23 +82,24 @@ MESHLAB_METHODS = ("Quadric Fitting", "Taubin approximation", "Normal Cycles")
 RADIUS_FACTORS = (1.0, 2.0, 4.0)
 
 TARGETS = {
-    "time_1m": 1.0,          # s at 1M, the default method and matgeom
-    "vs_libigl": 10.0,       # libigl / the default method at 1M (issue 31)
-    "vs_vtk": 1.0,           # VTK / meshcurv at 1M (> 1)
-    "vs_trueform": 0.4,      # trueform (k=2, directions) / default method at 1M: within 2.5x (issue 31)
+    "time_1m": 1.0,  # s at 1M, the default method and matgeom
+    "vs_libigl": 10.0,  # libigl / the default method at 1M (issue 31)
+    "vs_vtk": 1.0,  # VTK / meshcurv at 1M (> 1)
+    "vs_trueform": 0.4,  # trueform (k=2, directions) / default method at 1M: within 2.5x (issue 31)
     "vs_trueform_ring": 1.5,  # trueform (k=2, directions) / normal_cycle and matgeom, topology inside (issue 31)
-    "bytes_4m": 976,         # the default's peak RSS per vertex at 4M: not above issue 31's measure
-    "vs_lower": 10.0,        # meshcurv / lower bound at 1M
-    "growth": 4.5,           # t(4M) / t(1M)
-    "rss_4m": 6 * GIB,       # peak RSS at 4M
-    "radius_vs_ring": 3.0,   # default-radius time / normal_cycle time
-    "import": 0.3,           # s
-    "compile_cpu": 15.0,     # CPU s of the default's first call on a cold numba cache, less a warm call (issue 31)
-    "spot": 1.0,             # s, `meshcurv compute spot.obj` in a fresh process on a warm cache (issue 31)
+    "bytes_4m": 976,  # the default's peak RSS per vertex at 4M: not above issue 31's measure
+    "vs_lower": 10.0,  # meshcurv / lower bound at 1M
+    "growth": 4.5,  # t(4M) / t(1M)
+    "rss_4m": 6 * GIB,  # peak RSS at 4M
+    "radius_vs_ring": 3.0,  # default-radius time / normal_cycle time
+    "import": 0.3,  # s
+    "compile_cpu": 15.0,  # CPU s of the default's first call on a cold numba cache, less a warm call (issue 31)
+    "spot": 1.0,  # s, `meshcurv compute spot.obj` in a fresh process on a warm cache (issue 31)
 }
 
 
 # -- meshes -----------------------------------------------------------------------
+
 
 def subdivisions_for(label: str) -> int:
     if label in NAMED_SIZES:
@@ -144,6 +145,7 @@ def build_mesh(label: str):
 
 
 # -- implementations ----------------------------------------------------------------
+
 
 def numba_available() -> bool:
     try:
@@ -192,14 +194,28 @@ PEERS = {
     "libigl": ("libigl principal_curvature (quadric, radius 5 rings)", "igl", "libigl", "child process"),
     "vtk": ("VTK vtkCurvatures mean + Gaussian (1-ring, no directions)", "vtk", "vtk", "child process"),
     # trueform: non-commercial licence, a benchmark peer only (never a dependency of meshcurv)
-    "trueform": ("trueform principal_curvatures(k=2) (k-ring quadric, no directions)", "trueform", "trueform",
-                 "child process"),
-    "trueform/directions": ("trueform principal_curvatures(k=2, directions=True)", "trueform", "trueform",
-                            "child process"),
-    "trimesh": ("trimesh ball measures, mean + Gaussian (r = 2 mean edges, no directions)", "trimesh",
-                "trimesh", "child process"),
-    **{f"meshlab/{m}": (f"pymeshlab principal directions, {m}", "pymeshlab", "pymeshlab", "child process")
-       for m in MESHLAB_METHODS},
+    "trueform": (
+        "trueform principal_curvatures(k=2) (k-ring quadric, no directions)",
+        "trueform",
+        "trueform",
+        "child process",
+    ),
+    "trueform/directions": (
+        "trueform principal_curvatures(k=2, directions=True)",
+        "trueform",
+        "trueform",
+        "child process",
+    ),
+    "trimesh": (
+        "trimesh ball measures, mean + Gaussian (r = 2 mean edges, no directions)",
+        "trimesh",
+        "trimesh",
+        "child process",
+    ),
+    **{
+        f"meshlab/{m}": (f"pymeshlab principal directions, {m}", "pymeshlab", "pymeshlab", "child process")
+        for m in MESHLAB_METHODS
+    },
 }
 #: Every peer runs in a child process fed the same arrays (its repeats inside it): a peer's threads,
 #: allocator and crashes (pymeshlab can abort) stay out of meshcurv's measurements.
@@ -265,8 +281,11 @@ def make_call(key: str, v: np.ndarray, f: np.ndarray):
 
         def call():
             mesh = trimesh.Trimesh(v, f, process=False)
-            return (trimesh.curvature.discrete_mean_curvature_measure(mesh, v, radius),
-                    trimesh.curvature.discrete_gaussian_curvature_measure(mesh, v, radius))
+            return (
+                trimesh.curvature.discrete_mean_curvature_measure(mesh, v, radius),
+                trimesh.curvature.discrete_gaussian_curvature_measure(mesh, v, radius),
+            )
+
         return call
     if key.startswith("meshlab/"):
         return lambda: run_meshlab(v, f, key.split("/", 1)[1])
@@ -281,6 +300,7 @@ def make_call(key: str, v: np.ndarray, f: np.ndarray):
         def call():
             with use_backend(backend):
                 return meshcurv.MeshTopology.from_faces(f, v.shape[0])
+
         return call
     _, method, backend, *extras = parts
     faces, options = f, {}
@@ -298,6 +318,7 @@ def make_call(key: str, v: np.ndarray, f: np.ndarray):
         with use_backend(backend), warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return meshcurv.principal_curvatures(v, faces, method=method, **options)
+
     return call
 
 
@@ -323,8 +344,10 @@ def run_vtk(v, f):
     points = vtk.vtkPoints()
     points.SetData(numpy_to_vtk(v, deep=True))
     cells = vtk.vtkCellArray()
-    cells.SetData(numpy_to_vtkIdTypeArray(np.arange(0, 3 * len(f) + 1, 3, dtype=np.int64), deep=True),
-                  numpy_to_vtkIdTypeArray(f.ravel(), deep=True))
+    cells.SetData(
+        numpy_to_vtkIdTypeArray(np.arange(0, 3 * len(f) + 1, 3, dtype=np.int64), deep=True),
+        numpy_to_vtkIdTypeArray(f.ravel(), deep=True),
+    )
     data = vtk.vtkPolyData()
     data.SetPoints(points)
     data.SetPolys(cells)
@@ -344,13 +367,15 @@ def run_meshlab(v, f, method):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(v, f))
     with contextlib.redirect_stdout(io.StringIO()):
-        ms.compute_curvature_principal_directions_per_vertex(method=method, curvcolormethod="Min Curvature",
-                                                             autoclean=False)
+        ms.compute_curvature_principal_directions_per_vertex(
+            method=method, curvcolormethod="Min Curvature", autoclean=False
+        )
     mesh = ms.current_mesh()
     return mesh.vertex_scalar_array(), mesh.vertex_curvature_principal_dir1_matrix()
 
 
 # -- measuring ----------------------------------------------------------------------
+
 
 def current_rss() -> int:
     with open("/proc/self/statm") as handle:
@@ -426,8 +451,13 @@ def worker(args) -> int:
     times = [first]
     if args.repeats > 1 and first <= args.long:
         times += time_calls(call, args.repeats - 1, args.long, args.budget, cpu)
-    print("RESULT " + json.dumps({"first": first, "times": times, "cpu": cpu, "peak_rss": peak,
-                                  "base_rss": base_rss, "base_peak": base_peak}), flush=True)
+    print(
+        "RESULT "
+        + json.dumps(
+            {"first": first, "times": times, "cpu": cpu, "peak_rss": peak, "base_rss": base_rss, "base_peak": base_peak}
+        ),
+        flush=True,
+    )
     return 0
 
 
@@ -446,11 +476,25 @@ def user_environment(**extra) -> dict:
 
 def run_child(key, mesh_dir, repeats, long, budget, timeout, env=None):
     """Run the worker in a fresh process; returns the RESULT dict, or {'error': ...}."""
-    cmd = [sys.executable, os.path.abspath(__file__), "--worker", "--impl", key, "--mesh-dir", mesh_dir,
-           "--repeats", str(repeats), "--long", str(long), "--budget", str(budget)]
+    cmd = [
+        sys.executable,
+        os.path.abspath(__file__),
+        "--worker",
+        "--impl",
+        key,
+        "--mesh-dir",
+        mesh_dir,
+        "--repeats",
+        str(repeats),
+        "--long",
+        str(long),
+        "--budget",
+        str(budget),
+    ]
     try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout,
-                              env=user_environment() if env is None else env)
+        proc = subprocess.run(
+            cmd, capture_output=True, text=True, timeout=timeout, env=user_environment() if env is None else env
+        )
     except subprocess.TimeoutExpired:
         return {"timeout": timeout}
     for line in reversed(proc.stdout.splitlines()):
@@ -462,8 +506,10 @@ def run_child(key, mesh_dir, repeats, long, budget, timeout, env=None):
 
 # -- import and compile costs -------------------------------------------------------
 
-IMPORT_SNIPPET = ("import time, sys; t0 = time.perf_counter(); import meshcurv; "
-                  "print(time.perf_counter() - t0, 'numba' in sys.modules)")
+IMPORT_SNIPPET = (
+    "import time, sys; t0 = time.perf_counter(); import meshcurv; "
+    "print(time.perf_counter() - t0, 'numba' in sys.modules)"
+)
 
 COMPILE_SNIPPET = r"""
 import json, sys, time, warnings
@@ -497,8 +543,9 @@ def measure_import(n=5):
         t, loaded = proc.stdout.split()
         runs.append(float(t))
         numba_loaded |= loaded == "True"
-    proc = subprocess.run([sys.executable, "-X", "importtime", "-c", "import meshcurv"],
-                          capture_output=True, text=True, env=env)
+    proc = subprocess.run(
+        [sys.executable, "-X", "importtime", "-c", "import meshcurv"], capture_output=True, text=True, env=env
+    )
     top = []
     for line in proc.stderr.splitlines():
         match = re.match(r"import time:\s+(\d+)\s+\|\s+(\d+)\s+\|( *)(\S+)", line)
@@ -507,8 +554,12 @@ def measure_import(n=5):
             top.append((int(match.group(2)), depth, match.group(4)))
     # the heaviest imports made by meshcurv and its modules (nesting depth 1 to 3)
     heavy = sorted((t for t in top if 1 <= t[1] <= 3), reverse=True)[:10]
-    return {"runs": runs, "median": statistics.median(runs), "numba_loaded": numba_loaded,
-            "heavy": [(name, us / 1e6) for us, _, name in heavy]}
+    return {
+        "runs": runs,
+        "median": statistics.median(runs),
+        "numba_loaded": numba_loaded,
+        "heavy": [(name, us / 1e6) for us, _, name in heavy],
+    }
 
 
 def measure_compile():
@@ -518,8 +569,9 @@ def measure_compile():
     env = user_environment(NUMBA_CACHE_DIR=cache, MESHCURV_BACKEND="numba")
     results = []
     for _ in range(2):  # empty cache, then the cache the first process filled
-        proc = subprocess.run([sys.executable, "-c", COMPILE_SNIPPET], capture_output=True, text=True, env=env,
-                              timeout=1800)
+        proc = subprocess.run(
+            [sys.executable, "-c", COMPILE_SNIPPET], capture_output=True, text=True, env=env, timeout=1800
+        )
         line = [x for x in proc.stdout.splitlines() if x.startswith("RESULT ")]
         if not line:
             shutil.rmtree(cache, ignore_errors=True)
@@ -549,12 +601,18 @@ def measure_cli(n=3):
         v, _ = read_obj(path)
         runs = []
         env = user_environment()
-        subprocess.run([sys.executable, "-m", "meshcurv", "compute", path], capture_output=True, env=env,
-                       timeout=600)  # untimed: writes the bytecode of the command-line modules
+        subprocess.run(
+            [sys.executable, "-m", "meshcurv", "compute", path], capture_output=True, env=env, timeout=600
+        )  # untimed: writes the bytecode of the command-line modules
         for _ in range(n):
             t0 = time.perf_counter()
-            proc = subprocess.run([sys.executable, "-m", "meshcurv", "compute", path], capture_output=True,
-                                  text=True, timeout=600, env=env)
+            proc = subprocess.run(
+                [sys.executable, "-m", "meshcurv", "compute", path],
+                capture_output=True,
+                text=True,
+                timeout=600,
+                env=env,
+            )
             runs.append(time.perf_counter() - t0)
             if proc.returncode != 0:
                 out[name] = {"error": (proc.stderr.strip().splitlines() or ["?"])[-1][:200]}
@@ -566,6 +624,7 @@ def measure_cli(n=3):
 
 
 # -- machine ------------------------------------------------------------------------
+
 
 def machine_info():
     cpu = platform.processor() or "unknown CPU"
@@ -582,27 +641,48 @@ def machine_info():
                 if line.startswith("MemTotal"):
                     mem = int(line.split()[1]) * 1024
     versions = {}
-    for dist in ("meshcurv", "numpy", "scipy", "numba", "llvmlite", "libigl", "vtk", "trimesh", "rtree",
-                 "pymeshlab", "trueform"):
+    for dist in (
+        "meshcurv",
+        "numpy",
+        "scipy",
+        "numba",
+        "llvmlite",
+        "libigl",
+        "vtk",
+        "trimesh",
+        "rtree",
+        "pymeshlab",
+        "trueform",
+    ):
         with contextlib.suppress(importlib.metadata.PackageNotFoundError):
             versions[dist] = importlib.metadata.version(dist)
     commit = ""
     with contextlib.suppress(Exception):
-        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                                text=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--", "src"], capture_output=True,
-                               text=True).stdout.strip()
+        commit = subprocess.run(
+            ["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", ROOT, "status", "--porcelain", "--", "src"], capture_output=True, text=True
+        ).stdout.strip()
         if dirty:
             commit += " (with uncommitted changes in src/)"
     cores = os.cpu_count()
     with contextlib.suppress(AttributeError):
         cores = len(os.sched_getaffinity(0))
-    return {"cpu": cpu, "cores": cores, "memory": mem, "python": platform.python_version(),
-            "platform": platform.platform(), "versions": versions, "commit": commit,
-            "load_start": os.getloadavg()}
+    return {
+        "cpu": cpu,
+        "cores": cores,
+        "memory": mem,
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "versions": versions,
+        "commit": commit,
+        "load_start": os.getloadavg(),
+    }
 
 
 # -- the run ------------------------------------------------------------------------
+
 
 def log(*items):
     print(*items, file=sys.stderr, flush=True)
@@ -611,12 +691,12 @@ def log(*items):
 class Bench:
     def __init__(self, args):
         self.args = args
-        self.rates = {}       # key -> seconds per vertex (last measured)
-        self.rows = {}        # mesh label -> list of row dicts
-        self.meshes = []      # (label, name, n_vertices, n_faces)
-        self.radius = {}      # (label, method, factor) -> row
+        self.rates = {}  # key -> seconds per vertex (last measured)
+        self.rows = {}  # mesh label -> list of row dicts
+        self.meshes = []  # (label, name, n_vertices, n_faces)
+        self.radius = {}  # (label, method, factor) -> row
         self.profiles = {}
-        self.mesh_load = {}   # mesh label -> [load average at its start, at its end]
+        self.mesh_load = {}  # mesh label -> [load average at its start, at its end]
 
     def predicted(self, key, n):
         rate = self.rates.get(key)
@@ -653,8 +733,14 @@ class Bench:
             elif "error" in res:
                 row["error"] = res["error"]
             else:
-                row.update(times=res["times"], cpu=res.get("cpu", []), first_fresh=res["first"],
-                           peak_rss=res["peak_rss"], base_rss=res["base_rss"], where="child")
+                row.update(
+                    times=res["times"],
+                    cpu=res.get("cpu", []),
+                    first_fresh=res["first"],
+                    peak_rss=res["peak_rss"],
+                    base_rss=res["base_rss"],
+                    where="child",
+                )
                 self.record(key, n, min(res["times"]))
             log(f"  {row['label']}: {summary(row)}")
             return row
@@ -752,8 +838,13 @@ class Bench:
                 rows = []
                 for key in keys:
                     if key == "trimesh" and n > args.trimesh_max:
-                        rows.append({"key": key, "label": label_of(key),
-                                     "skipped": f"not run above {args.trimesh_max} vertices"})
+                        rows.append(
+                            {
+                                "key": key,
+                                "label": label_of(key),
+                                "skipped": f"not run above {args.trimesh_max} vertices",
+                            }
+                        )
                         continue
                     rows.append(self.measure(key, label, v, f, mesh_dir, repeats))
                 for round_ in range(1, args.rounds):  # again through every implementation: times only
@@ -785,8 +876,7 @@ class Bench:
                 if key not in self.rates and base is not None:
                     # ball cost grows with the number of vertices in the ball (~ r^2)
                     self.rates[key] = base * max(factor / 2.5, 0.4) ** 2
-                self.radius[(label, method, factor)] = self.measure(key, label, v, f, mesh_dir, repeats,
-                                                                    memory=False)
+                self.radius[(label, method, factor)] = self.measure(key, label, v, f, mesh_dir, repeats, memory=False)
 
     def profile(self, v, f):
         for method in dict.fromkeys((self.default_method, "normal_cycle", "matgeom")):
@@ -804,11 +894,11 @@ class Bench:
             lines = [ln.replace(ROOT + "/src/", "") for ln in text.splitlines()]
             start = next((i for i, ln in enumerate(lines) if ln.strip().startswith("ncalls")), 0)
             total = next((ln.strip() for ln in lines if "function calls" in ln), "")
-            self.profiles[method] = (total, "\n".join(ln for ln in lines[start:start + top + 1]
-                                                      if ln.strip()))
+            self.profiles[method] = (total, "\n".join(ln for ln in lines[start : start + top + 1] if ln.strip()))
 
 
 # -- report -------------------------------------------------------------------------
+
 
 def median(row):
     return statistics.median(row["times"]) if row.get("times") else None
@@ -854,8 +944,11 @@ def markdown(bench) -> str:
         f"- Machine: {info['cpu']}, {info['cores']} cores, {gib:.1f} GiB; {info['platform']}",
         f"- Load average (1, 5, 15 min) at start {tuple(round(x, 1) for x in info['load_start'])}, "
         f"at end {tuple(round(x, 1) for x in info.get('load_end', (0, 0, 0)))}"
-        + (" — **shared machine: other jobs were running, timings are noisy**"
-           if max(info["load_start"][0], info.get("load_end", (0,))[0]) > 0.5 * info["cores"] else " (the load at the end is the benchmark's own)"),
+        + (
+            " — **shared machine: other jobs were running, timings are noisy**"
+            if max(info["load_start"][0], info.get("load_end", (0,))[0]) > 0.5 * info["cores"]
+            else " (the load at the end is the benchmark's own)"
+        ),
         f"- Python {info['python']}, numpy {v.get('numpy', '—')}, scipy {v.get('scipy', '—')}, "
         f"numba {v.get('numba', 'not installed')} (llvmlite {v.get('llvmlite', '—')}); "
         f"meshcurv {v.get('meshcurv', '—')} at commit {info['commit'] or '?'}",
@@ -869,16 +962,21 @@ def markdown(bench) -> str:
         "",
         "Time: median of the calls in one process on the same in-memory arrays, after a warm-up on a small "
         "mesh ("
-        + ("meshcurv and every peer each in a child process fed the same arrays through .npy files, its repeats "
-           "inside it, its first call there not counted for meshcurv (the kernels loaded from the numba cache)"
-           if args.children else
-           "meshcurv in this process; every peer in a child process fed the same arrays through .npy "
-           "files, its repeats inside it")
+        + (
+            "meshcurv and every peer each in a child process fed the same arrays through .npy files, its repeats "
+            "inside it, its first call there not counted for meshcurv (the kernels loaded from the numba cache)"
+            if args.children
+            else "meshcurv in this process; every peer in a child process fed the same arrays through .npy "
+            "files, its repeats inside it"
+        )
         + ", `fresh` its first call there). `runs`: calls in the median"
-        + (f", {args.rounds} rounds through all the implementations of a mesh, each of up to {args.repeats} "
-           "call(s) in a row, a peer's first call in its child process not counted (a slow spell of the machine "
-           "then falls on one round of several implementations, not on every call of one)"
-           if args.rounds > 1 else "")
+        + (
+            f", {args.rounds} rounds through all the implementations of a mesh, each of up to {args.repeats} "
+            "call(s) in a row, a peer's first call in its child process not counted (a slow spell of the machine "
+            "then falls on one round of several implementations, not on every call of one)"
+            if args.rounds > 1
+            else ""
+        )
         + ". `fresh`: the same call once in a fresh "
         "process (numba rows: kernels loaded from the numba cache). Peak RSS: the high-water mark (`VmHWM`, "
         "what `ru_maxrss` reports without the value Linux carries over from the parent process) of that fresh "
@@ -891,14 +989,16 @@ def markdown(bench) -> str:
         f"Budget: {args.budget:.0f} s per call (trimesh {args.trimesh_budget:.0f} s); 'est.' = linear "
         "extrapolation from the previous size, not run.",
         "",
-        (f"Memory warm-up: {args.prefault:.0f} bytes per vertex of memory are touched and freed just before "
-         "each measurement (`--prefault`). This machine is a Firecracker VM whose balloon device hands free "
-         "memory back to the host after a few seconds; touching a page the host has taken back costs about "
-         "2.5 s per GiB (0.1 s per GiB for a backed page), so without the warm-up a time depends on what ran "
-         "before it (up to 3x at 4M vertices). The warm-up applies to every row, peers included."
-         if args.prefault > 0 else
-         "No memory warm-up (`--prefault 0`): on this VM, the first touch of memory the host has taken back "
-         "costs about 2.5 s per GiB, and times at 4M vertices depend on what ran before."),
+        (
+            f"Memory warm-up: {args.prefault:.0f} bytes per vertex of memory are touched and freed just before "
+            "each measurement (`--prefault`). This machine is a Firecracker VM whose balloon device hands free "
+            "memory back to the host after a few seconds; touching a page the host has taken back costs about "
+            "2.5 s per GiB (0.1 s per GiB for a backed page), so without the warm-up a time depends on what ran "
+            "before it (up to 3x at 4M vertices). The warm-up applies to every row, peers included."
+            if args.prefault > 0
+            else "No memory warm-up (`--prefault 0`): on this VM, the first touch of memory the host has taken back "
+            "costs about 2.5 s per GiB, and times at 4M vertices depend on what ran before."
+        ),
         "",
     ]
 
@@ -934,21 +1034,49 @@ def markdown(bench) -> str:
             shown += f" ({fmt_s(mine)} s ÷ {fmt_s(theirs)} s {what})"
         return shown, met(None if r is None else ok(r))
 
-    lines += ["## Targets (issue 31)", "",
-              "One run; ratios at 1M vertices, wall time and CPU time (on this shared machine, the CPU seconds "
-              "are the steadier figure). trueform: `principal_curvatures(k=2, directions=True)`; VTK: "
-              "`vtkCurvatures` mean and Gaussian; libigl: `principal_curvature`.", "",
-              "| target | measured | |", "|---|---|---|"]
+    lines += [
+        "## Targets (issue 31)",
+        "",
+        "One run; ratios at 1M vertices, wall time and CPU time (on this shared machine, the CPU seconds "
+        "are the steadier figure). trueform: `principal_curvatures(k=2, directions=True)`; VTK: "
+        "`vtkCurvatures` mean and Gaussian; libigl: `principal_curvature`.",
+        "",
+        "| target | measured | |",
+        "|---|---|---|",
+    ]
     if one_m:
         limit, need = 1 / TARGETS["vs_trueform"], TARGETS["vs_trueform_ring"]
         # (method, target, peer key, peer name, ratio = peer / method (else method / peer), test of the ratio)
-        checks = [(dm, f"{dm} (default, full output) <= {limit:g}x trueform", TRUEFORM, "trueform", False,
-                   lambda r: r <= limit),
-                  (dm, f"{dm} faster than VTK", "vtk", "VTK", True, lambda r: r > TARGETS["vs_vtk"]),
-                  (dm, f"{dm} >= {TARGETS['vs_libigl']:g}x faster than libigl", "libigl", "libigl", True,
-                   lambda r: r >= TARGETS["vs_libigl"])]
-        checks += [(method, f"{method} (topology built in the call) >= {need:g}x faster than trueform", TRUEFORM,
-                    "trueform", True, lambda r: r >= need) for method in ("normal_cycle", "matgeom")]
+        checks = [
+            (
+                dm,
+                f"{dm} (default, full output) <= {limit:g}x trueform",
+                TRUEFORM,
+                "trueform",
+                False,
+                lambda r: r <= limit,
+            ),
+            (dm, f"{dm} faster than VTK", "vtk", "VTK", True, lambda r: r > TARGETS["vs_vtk"]),
+            (
+                dm,
+                f"{dm} >= {TARGETS['vs_libigl']:g}x faster than libigl",
+                "libigl",
+                "libigl",
+                True,
+                lambda r: r >= TARGETS["vs_libigl"],
+            ),
+        ]
+        checks += [
+            (
+                method,
+                f"{method} (topology built in the call) >= {need:g}x faster than trueform",
+                TRUEFORM,
+                "trueform",
+                True,
+                lambda r: r >= need,
+            )
+            for method in ("normal_cycle", "matgeom")
+        ]
         for method, text, peer, peer_name, theirs_first, ok in checks:
             key = f"meshcurv/{method}/{db}"
             for what, of in (("wall", t), ("CPU", cpu_of)):
@@ -960,62 +1088,92 @@ def markdown(bench) -> str:
                 lines.append(f"| {text}, {what} s | {shown} | {verdict} |")
     if one_m and four_m:
         n1, n4 = (next(m[2] for m in bench.meshes if m[0] == label) for label in (one_m, four_m))
-        run_there = [row["key"].split("/")[1] for row in bench.rows[four_m] if row["key"].startswith("meshcurv/")
-                     and row["key"].count("/") == 2]
+        run_there = [
+            row["key"].split("/")[1]
+            for row in bench.rows[four_m]
+            if row["key"].startswith("meshcurv/") and row["key"].count("/") == 2
+        ]
         for method in dict.fromkeys((dm, "normal_cycle", "matgeom", *run_there)):
             key = f"meshcurv/{method}/{db}"
             if find(four_m, key) is None:
                 continue
             for what, of in (("wall", t), ("CPU", cpu_of)):
                 r = ratio(of(four_m, key), of(one_m, key))
-                lines.append(f"| linear growth: {method} t(4M) / t(1M) <= {TARGETS['growth']:g} "
-                             f"({n4 / n1:.2f}x the vertices), {what} s | {fmt_ratio(r)} | "
-                             f"{met(None if r is None else r <= TARGETS['growth'])} |")
+                lines.append(
+                    f"| linear growth: {method} t(4M) / t(1M) <= {TARGETS['growth']:g} "
+                    f"({n4 / n1:.2f}x the vertices), {what} s | {fmt_ratio(r)} | "
+                    f"{met(None if r is None else r <= TARGETS['growth'])} |"
+                )
     row = find(four_m, f"meshcurv/{dm}/{db}") if four_m else None
     if row and "peak_rss" in row:
         n = next(m[2] for m in bench.meshes if m[0] == four_m)
-        lines.append(f"| {dm}: peak RSS per vertex at 4M <= {TARGETS['bytes_4m']} B | {row['peak_rss'] / n:.0f} "
-                     f"B/vertex ({row['peak_rss'] / GIB:.2f} GiB, the whole process) | "
-                     f"{met(row['peak_rss'] / n <= TARGETS['bytes_4m'])} |")
+        lines.append(
+            f"| {dm}: peak RSS per vertex at 4M <= {TARGETS['bytes_4m']} B | {row['peak_rss'] / n:.0f} "
+            f"B/vertex ({row['peak_rss'] / GIB:.2f} GiB, the whole process) | "
+            f"{met(row['peak_rss'] / n <= TARGETS['bytes_4m'])} |"
+        )
     lines.append("| no accuracy row worse | not measured here: `benchmarks/accuracy.md` before and after | — |")
     comp = bench.compile
     if comp and "cold" in comp and dm in comp["cold"]:
         cold, warm = comp["cold"][dm], comp["warm"][dm]
         cpu = cold[2] - warm[3] if len(cold) > 2 else None
-        lines.append(f"| first use: {dm}'s kernels compile in <= {TARGETS['compile_cpu']:g} s CPU (cold cache) | "
-                     + (f"{cpu:.1f} s CPU, {cold[0] - warm[1]:.1f} s wall (first call in a fresh process, "
-                        "cold cache, less a warm call)" if cpu is not None else "no CPU figure")
-                     + f" | {met(None if cpu is None else cpu <= TARGETS['compile_cpu'])} |")
+        lines.append(
+            f"| first use: {dm}'s kernels compile in <= {TARGETS['compile_cpu']:g} s CPU (cold cache) | "
+            + (
+                f"{cpu:.1f} s CPU, {cold[0] - warm[1]:.1f} s wall (first call in a fresh process, "
+                "cold cache, less a warm call)"
+                if cpu is not None
+                else "no CPU figure"
+            )
+            + f" | {met(None if cpu is None else cpu <= TARGETS['compile_cpu'])} |"
+        )
     cli = (getattr(bench, "cli", None) or {}).get("spot.obj")
     if cli and "runs" in cli:
         s = statistics.median(cli["runs"])
-        lines.append(f"| a fresh process, warm cache, computes spot.obj in <= {TARGETS['spot']:g} s | "
-                     f"`meshcurv compute spot.obj`: {s:.2f} s (median of {len(cli['runs'])} processes) | "
-                     f"{met(s <= TARGETS['spot'])} |")
+        lines.append(
+            f"| a fresh process, warm cache, computes spot.obj in <= {TARGETS['spot']:g} s | "
+            f"`meshcurv compute spot.obj`: {s:.2f} s (median of {len(cli['runs'])} processes) | "
+            f"{met(s <= TARGETS['spot'])} |"
+        )
     lines += ["", "Earlier targets (issues 4 and 15):", "", "| target | measured | |", "|---|---|---|"]
     if four_m:
-        for key in dict.fromkeys((f"meshcurv/{dm}/{db}", f"meshcurv/normal_cycle/{db}",
-                                  f"meshcurv/matgeom/{db}", f"meshcurv/{dm}/numpy",
-                                  "meshcurv/normal_cycle/numpy", "meshcurv/matgeom/numpy")):
+        for key in dict.fromkeys(
+            (
+                f"meshcurv/{dm}/{db}",
+                f"meshcurv/normal_cycle/{db}",
+                f"meshcurv/matgeom/{db}",
+                f"meshcurv/{dm}/numpy",
+                "meshcurv/normal_cycle/numpy",
+                "meshcurv/matgeom/numpy",
+            )
+        ):
             row = find(four_m, key)
             if row and "peak_rss" in row:
                 n = next(m[2] for m in bench.meshes if m[0] == four_m)
-                lines.append(f"| {label_of(key)}: peak RSS at 4M < 6 GiB | {row['peak_rss'] / GIB:.2f} GiB "
-                             f"({row['peak_rss'] / n:.0f} B/vertex) | {met(row['peak_rss'] < TARGETS['rss_4m'])} |")
+                lines.append(
+                    f"| {label_of(key)}: peak RSS at 4M < 6 GiB | {row['peak_rss'] / GIB:.2f} GiB "
+                    f"({row['peak_rss'] / n:.0f} B/vertex) | {met(row['peak_rss'] < TARGETS['rss_4m'])} |"
+                )
     for label in args.radius_sizes.split(","):
         ring = t(label, f"meshcurv/normal_cycle/{db}")
         for method in radius_methods():
             tr = t(label, f"meshcurv/{method}/{db}")
             r = ratio(tr, ring)
             if label in sizes:
-                lines.append(f"| {method} (default radius) within 3x of normal_cycle at {label} | {fmt_ratio(r)} | "
-                             f"{met(None if r is None else r <= TARGETS['radius_vs_ring'])} |")
+                lines.append(
+                    f"| {method} (default radius) within 3x of normal_cycle at {label} | {fmt_ratio(r)} | "
+                    f"{met(None if r is None else r <= TARGETS['radius_vs_ring'])} |"
+                )
     imp = bench.import_time["median"]
-    lines.append(f"| `import meshcurv` < 0.3 s | {imp:.3f} s (median of {len(bench.import_time['runs'])}) | "
-                 f"{met(imp < TARGETS['import'])} |")
+    lines.append(
+        f"| `import meshcurv` < 0.3 s | {imp:.3f} s (median of {len(bench.import_time['runs'])}) | "
+        f"{met(imp < TARGETS['import'])} |"
+    )
     if comp and "cold" in comp:
-        lines.append(f"| compile step cached across processes | {comp['cache_files']} files in NUMBA_CACHE_DIR; "
-                     f"see below | {met(comp['cache_files'] > 0)} |")
+        lines.append(
+            f"| compile step cached across processes | {comp['cache_files']} files in NUMBA_CACHE_DIR; "
+            f"see below | {met(comp['cache_files'] > 0)} |"
+        )
     lines.append("")
 
     # per mesh
@@ -1028,12 +1186,16 @@ def markdown(bench) -> str:
         load = (getattr(bench, "mesh_load", None) or {}).get(label)
         lines += [f"## {label}: {name}, {n:,} vertices, {n_faces:,} faces", ""]
         if load and len(load) == 2:
-            lines += [f"Load average (1 min) of the machine: {load[0][0]:.1f} when this mesh began, {load[1][0]:.1f} "
-                      f"when it ended ({bench.info['cores']} cores; the benchmark itself adds 1 to 2).", ""]
+            lines += [
+                f"Load average (1 min) of the machine: {load[0][0]:.1f} when this mesh began, {load[1][0]:.1f} "
+                f"when it ended ({bench.info['cores']} cores; the benchmark itself adds 1 to 2).",
+                "",
+            ]
         lines += [
-                  "| implementation | median s | CPU s | runs | fresh s | peak RSS MiB | bytes/vertex | ÷ lower | "
-                  "÷ default | libigl ÷ | VTK ÷ | trueform ÷ | CPU: trueform ÷ |",
-                  "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
+            "| implementation | median s | CPU s | runs | fresh s | peak RSS MiB | bytes/vertex | ÷ lower | "
+            "÷ default | libigl ÷ | VTK ÷ | trueform ÷ | CPU: trueform ÷ |",
+            "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
+        ]
         for row in bench.rows[label]:
             key = row["key"]
             if "skipped" in row or "error" in row:
@@ -1044,22 +1206,32 @@ def markdown(bench) -> str:
             cpu = statistics.median(row["cpu"]) if row.get("cpu") else None
             peak = row.get("peak_rss")
             is_mc = key.startswith("meshcurv/")
-            cells = [row["label"] + (" (child process)" if row.get("where") == "child" else ""),
-                     fmt_s(tm), fmt_s(cpu), str(len(row["times"])), fmt_s(row.get("first_fresh")),
-                     f"{peak / MIB:.0f}" if peak else "—", f"{peak / n:.0f}" if peak else "—",
-                     fmt_ratio(ratio(tm, lb)) if key != "lower_bound" else "1x",
-                     fmt_ratio(ratio(tm, ref)),
-                     fmt_ratio(ratio(igl_t, tm)) if is_mc else "",
-                     fmt_ratio(ratio(vtk_t, tm)) if is_mc else "",
-                     fmt_ratio(ratio(tf_t, tm)) if is_mc else "",
-                     fmt_ratio(ratio(tf_cpu, cpu)) if is_mc else ""]
+            cells = [
+                row["label"] + (" (child process)" if row.get("where") == "child" else ""),
+                fmt_s(tm),
+                fmt_s(cpu),
+                str(len(row["times"])),
+                fmt_s(row.get("first_fresh")),
+                f"{peak / MIB:.0f}" if peak else "—",
+                f"{peak / n:.0f}" if peak else "—",
+                fmt_ratio(ratio(tm, lb)) if key != "lower_bound" else "1x",
+                fmt_ratio(ratio(tm, ref)),
+                fmt_ratio(ratio(igl_t, tm)) if is_mc else "",
+                fmt_ratio(ratio(vtk_t, tm)) if is_mc else "",
+                fmt_ratio(ratio(tf_t, tm)) if is_mc else "",
+                fmt_ratio(ratio(tf_cpu, cpu)) if is_mc else "",
+            ]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
 
     # growth
     if one_m and four_m:
-        lines += ["## Linear growth: t(4M) / t(1M)", "", "| implementation | 1M s | 4M s | ratio |",
-                  "|---|--:|--:|--:|"]
+        lines += [
+            "## Linear growth: t(4M) / t(1M)",
+            "",
+            "| implementation | 1M s | 4M s | ratio |",
+            "|---|--:|--:|--:|",
+        ]
         for row in bench.rows[one_m]:
             key = row["key"]
             a, b = t(one_m, key), t(four_m, key)
@@ -1069,13 +1241,17 @@ def markdown(bench) -> str:
 
     # radius
     if bench.radius:
-        lines += ["## Radius-based methods: time as the radius grows", "",
-                  f"Default backend ({db}); radius in mean edge lengths `h`. The default radius is 2.5 h for "
-                  "quadric and normal_cycle_ball, and for icc follows the measured noise: 1 h on these clean "
-                  "icospheres (its normals are fitted over 3 r). "
-                  "`÷ 1-ring` = time / normal_cycle time on the same mesh.", "",
-                  "| mesh | method | r = 1 | r = 2 | default r | r = 4 | default ÷ 1-ring |",
-                  "|---|---|--:|--:|--:|--:|--:|"]
+        lines += [
+            "## Radius-based methods: time as the radius grows",
+            "",
+            f"Default backend ({db}); radius in mean edge lengths `h`. The default radius is 2.5 h for "
+            "quadric and normal_cycle_ball, and for icc follows the measured noise: 1 h on these clean "
+            "icospheres (its normals are fitted over 3 r). "
+            "`÷ 1-ring` = time / normal_cycle time on the same mesh.",
+            "",
+            "| mesh | method | r = 1 | r = 2 | default r | r = 4 | default ÷ 1-ring |",
+            "|---|---|--:|--:|--:|--:|--:|",
+        ]
         for label in [m[0] for m in bench.meshes]:
             ring = t(label, f"meshcurv/normal_cycle/{db}")
             for method in radius_methods():
@@ -1083,31 +1259,44 @@ def markdown(bench) -> str:
                     continue
                 cells = []
                 for factor in (1.0, 2.0, None, 4.0):
-                    row = (find(label, f"meshcurv/{method}/{db}") if factor is None
-                           else bench.radius[(label, method, factor)])
+                    row = (
+                        find(label, f"meshcurv/{method}/{db}")
+                        if factor is None
+                        else bench.radius[(label, method, factor)]
+                    )
                     if row is None or "skipped" in row or "error" in row:
                         cells.append(row.get("skipped", row.get("error", "—")) if row else "—")
                     else:
                         cells.append(fmt_s(median(row)))
-                lines.append(f"| {label} | {method} | " + " | ".join(cells) + " | "
-                             f"{fmt_ratio(ratio(t(label, f'meshcurv/{method}/{db}'), ring))} |")
+                lines.append(
+                    f"| {label} | {method} | " + " | ".join(cells) + " | "
+                    f"{fmt_ratio(ratio(t(label, f'meshcurv/{method}/{db}'), ring))} |"
+                )
         lines.append("")
 
     # import and compile
     imp = bench.import_time
-    lines += ["## Import and compile", "",
-              f"`import meshcurv` in a fresh interpreter: median {imp['median']:.3f} s over {len(imp['runs'])} "
-              f"runs ({', '.join(f'{x:.3f}' for x in imp['runs'])}); numba imported by `import meshcurv`: "
-              f"{'yes' if imp['numba_loaded'] else 'no'}. Heaviest imports (`python -X importtime`, cumulative): "
-              + ", ".join(f"{name} {s:.3f} s" for name, s in imp["heavy"]) + ".", ""]
+    lines += [
+        "## Import and compile",
+        "",
+        f"`import meshcurv` in a fresh interpreter: median {imp['median']:.3f} s over {len(imp['runs'])} "
+        f"runs ({', '.join(f'{x:.3f}' for x in imp['runs'])}); numba imported by `import meshcurv`: "
+        f"{'yes' if imp['numba_loaded'] else 'no'}. Heaviest imports (`python -X importtime`, cumulative): "
+        + ", ".join(f"{name} {s:.3f} s" for name, s in imp["heavy"])
+        + ".",
+        "",
+    ]
     if comp and "cold" in comp:
         cold, warm = comp["cold"], comp["warm"]
-        lines += ["numba compile cost: each method's first and second call on a 10k-vertex icosphere in a "
-                  "fresh process with `MESHCURV_BACKEND=numba` and `NUMBA_CACHE_DIR` an empty temporary "
-                  "directory (cold), then in a second fresh process on the cache the first one wrote (warm). "
-                  "`compile` = cold first call − warm second call.", "",
-                  "| method | cold first call s | warm-cache first call s | warm call s | compile s |",
-                  "|---|--:|--:|--:|--:|"]
+        lines += [
+            "numba compile cost: each method's first and second call on a 10k-vertex icosphere in a "
+            "fresh process with `MESHCURV_BACKEND=numba` and `NUMBA_CACHE_DIR` an empty temporary "
+            "directory (cold), then in a second fresh process on the cache the first one wrote (warm). "
+            "`compile` = cold first call − warm second call.",
+            "",
+            "| method | cold first call s | warm-cache first call s | warm call s | compile s |",
+            "|---|--:|--:|--:|--:|",
+        ]
         total_cold = total_warm_first = total_warm = 0.0
         for method in cold:
             if method in ("import", "kernels_import"):
@@ -1117,49 +1306,91 @@ def markdown(bench) -> str:
             total_warm_first += w[0]
             total_warm += w[1]
             cost = c[0] - w[1]
-            lines.append(f"| {method} | {c[0]:.2f} | {w[0]:.3f} | {w[1]:.3f} | "
-                         f"{f'{cost:.2f}' if cost > 0.05 else '~0 (no kernel of its own)'} |")
-        lines.append(f"| **all methods, one process** | {total_cold:.2f} | {total_warm_first:.3f} | "
-                     f"{total_warm:.3f} | {total_cold - total_warm:.2f} |")
-        lines += ["", f"Importing the kernels module (numba itself): {cold['kernels_import']:.2f} s cold, "
-                  f"{warm['kernels_import']:.2f} s warm. Cache files written: {comp['cache_files']}.", ""]
+            lines.append(
+                f"| {method} | {c[0]:.2f} | {w[0]:.3f} | {w[1]:.3f} | "
+                f"{f'{cost:.2f}' if cost > 0.05 else '~0 (no kernel of its own)'} |"
+            )
+        lines.append(
+            f"| **all methods, one process** | {total_cold:.2f} | {total_warm_first:.3f} | "
+            f"{total_warm:.3f} | {total_cold - total_warm:.2f} |"
+        )
+        lines += [
+            "",
+            f"Importing the kernels module (numba itself): {cold['kernels_import']:.2f} s cold, "
+            f"{warm['kernels_import']:.2f} s warm. Cache files written: {comp['cache_files']}.",
+            "",
+        ]
     elif comp:
         lines += [f"numba compile measurement failed: {comp}", ""]
     if bench.warm:
-        lines += ["Warm-up of this process (first call of each implementation on icosphere(8), "
-                  "642 vertices; numba kernels from the default cache): "
-                  + ", ".join(f"{label_of(k)} {s:.2f} s" for k, s in bench.warm.items() if s > 0.05) + ".", ""]
+        lines += [
+            "Warm-up of this process (first call of each implementation on icosphere(8), "
+            "642 vertices; numba kernels from the default cache): "
+            + ", ".join(f"{label_of(k)} {s:.2f} s" for k, s in bench.warm.items() if s > 0.05)
+            + ".",
+            "",
+        ]
 
     # the command line, fresh processes
     if getattr(bench, "cli", None):
-        lines += ["## `meshcurv compute` in a fresh process", "",
-                  "`python -m meshcurv compute MESH` (default method, summary table printed), wall time of the "
-                  "whole process (interpreter start, imports, reading the OBJ, numba kernels loaded from the warm "
-                  "cache, the computation), each run a new process, after an untimed one. Every fresh process of "
-                  "this benchmark runs with Python's default bytecode cache (`PYTHONDONTWRITEBYTECODE` removed from "
-                  "its environment, which this machine's sessions set: with it, each process compiled meshcurv's "
-                  "modules from source again, 0.1-0.2 s that a user's installation spends once):", "",
-                  "| mesh | vertices | median s | runs |", "|---|--:|--:|---|"]
+        lines += [
+            "## `meshcurv compute` in a fresh process",
+            "",
+            "`python -m meshcurv compute MESH` (default method, summary table printed), wall time of the "
+            "whole process (interpreter start, imports, reading the OBJ, numba kernels loaded from the warm "
+            "cache, the computation), each run a new process, after an untimed one. Every fresh process of "
+            "this benchmark runs with Python's default bytecode cache (`PYTHONDONTWRITEBYTECODE` removed from "
+            "its environment, which this machine's sessions set: with it, each process compiled meshcurv's "
+            "modules from source again, 0.1-0.2 s that a user's installation spends once):",
+            "",
+            "| mesh | vertices | median s | runs |",
+            "|---|--:|--:|---|",
+        ]
         for name, res in bench.cli.items():
             if "error" in res:
                 lines.append(f"| {name} | | error: {res['error']} | |")
             else:
-                lines.append(f"| {name} | {res['vertices']:,} | {statistics.median(res['runs']):.2f} | "
-                             + ", ".join(f"{x:.2f}" for x in res["runs"]) + " |")
+                lines.append(
+                    f"| {name} | {res['vertices']:,} | {statistics.median(res['runs']):.2f} | "
+                    + ", ".join(f"{x:.2f}" for x in res["runs"])
+                    + " |"
+                )
         lines.append("")
 
     # profile
     if bench.profiles:
         lines += [f"## Where the time goes ({args.profile_size}, default backend)", ""]
         for method, (total, text) in bench.profiles.items():
-            lines += [f"cProfile of one `{method}` call ({total}), top entries by own time:", "", "```", text,
-                      "```", ""]
+            lines += [
+                f"cProfile of one `{method}` call ({total}), top entries by own time:",
+                "",
+                "```",
+                text,
+                "```",
+                "",
+            ]
     return "\n".join(lines) + "\n"
 
 
 #: Bench attributes that ``--json`` saves and ``--from-json`` restores (all that ``markdown`` reads).
-SAVED = ("info", "meshes", "rows", "import_time", "compile", "found", "missing", "default_backend",
-         "default_method", "default_key", "warm", "cli", "profiles", "command", "generated", "mesh_load")
+SAVED = (
+    "info",
+    "meshes",
+    "rows",
+    "import_time",
+    "compile",
+    "found",
+    "missing",
+    "default_backend",
+    "default_method",
+    "default_key",
+    "warm",
+    "cli",
+    "profiles",
+    "command",
+    "generated",
+    "mesh_load",
+)
 
 
 def save_bench(bench, path: str) -> None:
@@ -1186,50 +1417,93 @@ def load_bench(path: str):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sizes", default="10k,100k,1M,4M",
-                        help="icosphere sizes (10k, 100k, 1M, 4M or e.g. 250k); default %(default)s")
-    parser.add_argument("--methods", default="",
-                        help="meshcurv methods to time, comma-separated (default: all)")
+    parser.add_argument(
+        "--sizes",
+        default="10k,100k,1M,4M",
+        help="icosphere sizes (10k, 100k, 1M, 4M or e.g. 250k); default %(default)s",
+    )
+    parser.add_argument("--methods", default="", help="meshcurv methods to time, comma-separated (default: all)")
     parser.add_argument("--backends", default="", help="numpy, numba or both (default: all installed)")
-    parser.add_argument("--repeats", type=int, default=5,
-                        help="calls in a row per implementation and round (3 at most from 2M vertices)")
-    parser.add_argument("--rounds", type=int, default=1,
-                        help="passes through all the implementations of a mesh, each timing --repeats calls: "
-                             "the median is over all of them, so that a slow spell of the machine falls on "
-                             "one call of several implementations rather than on all the calls of one "
-                             "(default: %(default)s)")
+    parser.add_argument(
+        "--repeats",
+        type=int,
+        default=5,
+        help="calls in a row per implementation and round (3 at most from 2M vertices)",
+    )
+    parser.add_argument(
+        "--rounds",
+        type=int,
+        default=1,
+        help="passes through all the implementations of a mesh, each timing --repeats calls: "
+        "the median is over all of them, so that a slow spell of the machine falls on "
+        "one call of several implementations rather than on all the calls of one "
+        "(default: %(default)s)",
+    )
     parser.add_argument("--output", default=OUTPUT, help="markdown file to write (default: %(default)s)")
-    parser.add_argument("--children", action=argparse.BooleanOptionalAction, default=True,
-                        help="time meshcurv in child processes too, as the peers, their first call not counted "
-                             "(default: yes; --no-children: in this process)")
-    parser.add_argument("--peers", action=argparse.BooleanOptionalAction, default=True,
-                        help="time the installed peers (default: yes)")
-    parser.add_argument("--igea", action=argparse.BooleanOptionalAction, default=True,
-                        help=f"also igea.obj when present ({IGEA})")
-    parser.add_argument("--memory", action=argparse.BooleanOptionalAction, default=True,
-                        help="peak RSS of each implementation in a fresh process (default: yes)")
-    parser.add_argument("--compile", action=argparse.BooleanOptionalAction, default=True,
-                        help="measure the numba compile cost with an empty cache (default: yes)")
-    parser.add_argument("--budget", type=float, default=300.0,
-                        help="seconds per call above which (extrapolated) an implementation is not run")
-    parser.add_argument("--long", type=float, default=10.0,
-                        help="a first call longer than this many seconds is not repeated")
+    parser.add_argument(
+        "--children",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="time meshcurv in child processes too, as the peers, their first call not counted "
+        "(default: yes; --no-children: in this process)",
+    )
+    parser.add_argument(
+        "--peers", action=argparse.BooleanOptionalAction, default=True, help="time the installed peers (default: yes)"
+    )
+    parser.add_argument(
+        "--igea", action=argparse.BooleanOptionalAction, default=True, help=f"also igea.obj when present ({IGEA})"
+    )
+    parser.add_argument(
+        "--memory",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="peak RSS of each implementation in a fresh process (default: yes)",
+    )
+    parser.add_argument(
+        "--compile",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="measure the numba compile cost with an empty cache (default: yes)",
+    )
+    parser.add_argument(
+        "--budget",
+        type=float,
+        default=300.0,
+        help="seconds per call above which (extrapolated) an implementation is not run",
+    )
+    parser.add_argument(
+        "--long", type=float, default=10.0, help="a first call longer than this many seconds is not repeated"
+    )
     parser.add_argument("--trimesh-budget", type=float, default=120.0, help="seconds before trimesh is stopped")
     parser.add_argument("--trimesh-max", type=int, default=200_000, help="trimesh only up to this many vertices")
     parser.add_argument("--radius-sizes", default="100k,1M", help="sizes of the radius sweep")
-    parser.add_argument("--profile", action=argparse.BooleanOptionalAction, default=True,
-                        help="cProfile one normal_cycle and matgeom call (default: yes)")
+    parser.add_argument(
+        "--profile",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="cProfile one normal_cycle and matgeom call (default: yes)",
+    )
     parser.add_argument("--profile-size", default="1M", help="mesh of the profile (default: %(default)s)")
     parser.add_argument("--profile-top", type=int, default=15)
-    parser.add_argument("--prefault", type=float, default=2000.0,
-                        help="bytes per vertex of memory touched just before each measurement (0: none); "
-                             "see prefault() (default: %(default)s)")
-    parser.add_argument("--cli", action=argparse.BooleanOptionalAction, default=True,
-                        help="time `meshcurv compute` on spot.obj and igea.obj in fresh processes (default: yes)")
+    parser.add_argument(
+        "--prefault",
+        type=float,
+        default=2000.0,
+        help="bytes per vertex of memory touched just before each measurement (0: none); "
+        "see prefault() (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--cli",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="time `meshcurv compute` on spot.obj and igea.obj in fresh processes (default: yes)",
+    )
     parser.add_argument("--json", help="also write the raw measurements to this JSON file")
-    parser.add_argument("--from-json", metavar="JSON",
-                        help="write the tables of a run saved with --json (its options and figures), measuring "
-                             "nothing")
+    parser.add_argument(
+        "--from-json",
+        metavar="JSON",
+        help="write the tables of a run saved with --json (its options and figures), measuring nothing",
+    )
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--impl", help=argparse.SUPPRESS)
     parser.add_argument("--mesh-dir", help=argparse.SUPPRESS)

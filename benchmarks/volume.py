@@ -81,14 +81,18 @@ def synthetic_labels(n_labels: int, spacing, min_radius: float, max_radius: floa
         label = index + 1
         cell_index = np.array(np.unravel_index(index, (per_side,) * 3))
         kind = "sphere" if index % 2 == 0 else "ellipsoid"
-        axes = np.full(3, rng.uniform(min_radius, max_radius)) if kind == "sphere" else \
-            np.sort(rng.uniform(min_radius, max_radius, 3))[::-1]
+        axes = (
+            np.full(3, rng.uniform(min_radius, max_radius))
+            if kind == "sphere"
+            else np.sort(rng.uniform(min_radius, max_radius, 3))[::-1]
+        )
         turn = rotation(rng)
         center = (cell_index + 0.5) * cell + rng.uniform(-1, 1, 3) * spacing + spacing
         low = np.maximum(np.floor((center - axes.max() - 1) / spacing).astype(int), 0)
         high = np.minimum(np.ceil((center + axes.max() + 1) / spacing).astype(int) + 1, shape)
-        grids = np.meshgrid(*[np.arange(lo, hi) * s - c for lo, hi, s, c in zip(low, high, spacing, center)],
-                            indexing="ij", sparse=True)
+        grids = np.meshgrid(
+            *[np.arange(lo, hi) * s - c for lo, hi, s, c in zip(low, high, spacing, center)], indexing="ij", sparse=True
+        )
         # body coordinates q = turn^T p: inside when sum((q / axes)^2) <= 1
         q = [sum(turn[k, j] * grids[k] for k in range(3)) for j in range(3)]
         inside = sum((q[j] / axes[j]) ** 2 for j in range(3)) <= 1
@@ -99,8 +103,14 @@ def synthetic_labels(n_labels: int, spacing, min_radius: float, max_radius: floa
             area, integral_h = 4 * np.pi * a * a, 4 * np.pi * a
         else:
             area, integral_h, _ = ellipsoid_exact(a, b, c)
-        exact[label] = {"kind": kind, "axes": axes, "area": area, "volume": 4 / 3 * np.pi * a * b * c,
-                        "mean_weighted": integral_h / area, "total_gaussian": 4 * np.pi}
+        exact[label] = {
+            "kind": kind,
+            "axes": axes,
+            "area": area,
+            "volume": 4 / 3 * np.pi * a * b * c,
+            "mean_weighted": integral_h / area,
+            "total_gaussian": 4 * np.pi,
+        }
     return image, exact
 
 
@@ -120,55 +130,88 @@ def accuracy(args) -> list[str]:
                 keep = surface.used & np.isfinite(surface.result.gaussian)
                 alternatives[row["label"]] = {
                     "total_gaussian": float(np.sum(surface.result.gaussian[keep] * surface.vertex_areas[keep])),
-                    "mean_weighted": float(np.sum(surface.result.mean[keep] * surface.vertex_areas[keep])
-                                           / np.sum(surface.vertex_areas[keep]))}
-            print(f"label {row['label']:3d} {truth['kind']:9s} axes {np.round(truth['axes'], 1)} "
-                  f"{row['n_vertices']:7d} vertices  area {row['area'] / truth['area'] - 1:+.4f} "
-                  f"volume {row['volume'] / truth['volume'] - 1:+.4f} "
-                  f"H {row['mean_weighted'] / truth['mean_weighted'] - 1:+.4f} "
-                  f"K {row['total_gaussian'] / (4 * np.pi) - 1:+.4f} {row['surface']} r {row['radius']:.2f} "
-                  f"{time.perf_counter() - start:.0f} s", file=sys.stderr, flush=True)
+                    "mean_weighted": float(
+                        np.sum(surface.result.mean[keep] * surface.vertex_areas[keep])
+                        / np.sum(surface.vertex_areas[keep])
+                    ),
+                }
+            print(
+                f"label {row['label']:3d} {truth['kind']:9s} axes {np.round(truth['axes'], 1)} "
+                f"{row['n_vertices']:7d} vertices  area {row['area'] / truth['area'] - 1:+.4f} "
+                f"volume {row['volume'] / truth['volume'] - 1:+.4f} "
+                f"H {row['mean_weighted'] / truth['mean_weighted'] - 1:+.4f} "
+                f"K {row['total_gaussian'] / (4 * np.pi) - 1:+.4f} {row['surface']} r {row['radius']:.2f} "
+                f"{time.perf_counter() - start:.0f} s",
+                file=sys.stderr,
+                flush=True,
+            )
     seconds = time.perf_counter() - start
     table = _table(rows)
     inner = table[~table["touches_border"] & (table["status"] == "ok")]
     errors = {}
-    for column, name in [("area", "area"), ("area_mesh", "area (raw triangles)"), ("volume", "volume"),
-                         ("mean_weighted", "area-weighted mean of H"),
-                         ("total_gaussian", "total Gaussian curvature")]:
+    for column, name in [
+        ("area", "area"),
+        ("area_mesh", "area (raw triangles)"),
+        ("volume", "volume"),
+        ("mean_weighted", "area-weighted mean of H"),
+        ("total_gaussian", "total Gaussian curvature"),
+    ]:
         key = "area" if column == "area_mesh" else column
         truth = np.array([exact[label][key] for label in inner["label"]])
         errors[name] = np.abs(inner[column].to_numpy() / truth - 1)
     labels = inner["label"].to_numpy()
     errors["total Gaussian curvature, vertex sum K_i A_i (not used)"] = np.abs(
-        np.array([alternatives[label]["total_gaussian"] for label in labels]) / (4 * np.pi) - 1)
+        np.array([alternatives[label]["total_gaussian"] for label in labels]) / (4 * np.pi) - 1
+    )
     errors["area-weighted mean of H as sum H_i A_i / sum A_i (not used)"] = np.abs(
-        np.array([alternatives[label]["mean_weighted"] / exact[label]["mean_weighted"] for label in labels]) - 1)
+        np.array([alternatives[label]["mean_weighted"] / exact[label]["mean_weighted"] for label in labels]) - 1
+    )
     targets = {"area": 0.03, "volume": 0.02, "area-weighted mean of H": 0.03, "total Gaussian curvature": 0.02}
-    lines = [f"## Accuracy: {args.labels} spheres and ellipsoids, semi-axes {args.min_radius:g}-{args.max_radius:g}, "
-             f"voxels {' x '.join(f'{s:g}' for s in args.spacing)} (z y x)", "",
-             f"Image {' x '.join(map(str, image.shape))} voxels; {len(inner)} labels measured (none touch the "
-             f"border), {int((table['surface'] == 'voxel').sum())} with the voxel radius detected; "
-             f"{seconds:.0f} s for all labels ({seconds / max(len(table), 1):.1f} s per label, median "
-             f"{int(np.median(table['n_vertices']))} vertices).", "",
-             "| quantity | median error | 95th percentile | worst | target | labels within |",
-             "|---|--:|--:|--:|--:|--:|"]
+    lines = [
+        f"## Accuracy: {args.labels} spheres and ellipsoids, semi-axes {args.min_radius:g}-{args.max_radius:g}, "
+        f"voxels {' x '.join(f'{s:g}' for s in args.spacing)} (z y x)",
+        "",
+        f"Image {' x '.join(map(str, image.shape))} voxels; {len(inner)} labels measured (none touch the "
+        f"border), {int((table['surface'] == 'voxel').sum())} with the voxel radius detected; "
+        f"{seconds:.0f} s for all labels ({seconds / max(len(table), 1):.1f} s per label, median "
+        f"{int(np.median(table['n_vertices']))} vertices).",
+        "",
+        "| quantity | median error | 95th percentile | worst | target | labels within |",
+        "|---|--:|--:|--:|--:|--:|",
+    ]
     for name, values in errors.items():
         target = targets.get(name)
         within = f"{int((values <= target).sum())}/{values.size}" if target else "-"
-        lines.append(f"| {name} | {np.median(values):.2%} | {np.percentile(values, 95):.2%} | {values.max():.2%} | "
-                     f"{f'{target:.0%}' if target else '-'} | {within} |")
-    worst = inner.assign(area_error=errors["area"], h_error=errors["area-weighted mean of H"],
-                         k_error=errors["total Gaussian curvature"], volume_error=errors["volume"])
-    lines += ["", "Worst labels:", "", "| label | kind | semi-axes | vertices | area | volume | mean H | total K |",
-              "|--:|---|---|--:|--:|--:|--:|--:|"]
-    order = np.argsort(-np.maximum.reduce([worst["area_error"] / 0.03, worst["volume_error"] / 0.02,
-                                            worst["h_error"] / 0.03, worst["k_error"] / 0.02]))
+        lines.append(
+            f"| {name} | {np.median(values):.2%} | {np.percentile(values, 95):.2%} | {values.max():.2%} | "
+            f"{f'{target:.0%}' if target else '-'} | {within} |"
+        )
+    worst = inner.assign(
+        area_error=errors["area"],
+        h_error=errors["area-weighted mean of H"],
+        k_error=errors["total Gaussian curvature"],
+        volume_error=errors["volume"],
+    )
+    lines += [
+        "",
+        "Worst labels:",
+        "",
+        "| label | kind | semi-axes | vertices | area | volume | mean H | total K |",
+        "|--:|---|---|--:|--:|--:|--:|--:|",
+    ]
+    order = np.argsort(
+        -np.maximum.reduce(
+            [worst["area_error"] / 0.03, worst["volume_error"] / 0.02, worst["h_error"] / 0.03, worst["k_error"] / 0.02]
+        )
+    )
     for position in order[:5]:
         row = worst.iloc[position]
         truth = exact[int(row["label"])]
-        lines.append(f"| {int(row['label'])} | {truth['kind']} | {', '.join(f'{x:.1f}' for x in truth['axes'])} | "
-                     f"{int(row['n_vertices'])} | {row['area_error']:.2%} | {row['volume_error']:.2%} | "
-                     f"{row['h_error']:.2%} | {row['k_error']:.2%} |")
+        lines.append(
+            f"| {int(row['label'])} | {truth['kind']} | {', '.join(f'{x:.1f}' for x in truth['axes'])} | "
+            f"{int(row['n_vertices'])} | {row['area_error']:.2%} | {row['volume_error']:.2%} | "
+            f"{row['h_error']:.2%} | {row['k_error']:.2%} |"
+        )
     return lines
 
 
@@ -185,8 +228,9 @@ def scale(args) -> list[str]:
         turn = rotation(rng)
         low = np.maximum(np.floor(centre - axes.max() - 1).astype(int), 0)
         high = np.minimum(np.ceil(centre + axes.max() + 1).astype(int) + 1, shape)
-        grids = np.meshgrid(*[np.arange(lo, hi) - c for lo, hi, c in zip(low, high, centre)], indexing="ij",
-                            sparse=True)
+        grids = np.meshgrid(
+            *[np.arange(lo, hi) - c for lo, hi, c in zip(low, high, centre)], indexing="ij", sparse=True
+        )
         q = [sum(turn[k, j] * grids[k] for k in range(3)) for j in range(3)]
         inside = sum((q[j] / axes[j]) ** 2 for j in range(3)) <= 1
         box = image[tuple(slice(lo, hi) for lo, hi in zip(low, high))]
@@ -201,26 +245,36 @@ def scale(args) -> list[str]:
     if args.workers and args.workers > 1:
         runs.append((f"{args.workers} workers", *_timed(image, sample, args.workers)))
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
-    lines = [f"## Scale: {' x '.join(map(str, shape))} voxels (uint16, {image.nbytes / 2**30:.2f} GiB), "
-             f"{len(present)} labels", "",
-             f"- image built in {built:.0f} s; the labels' boxes found (one pass, scipy.ndimage.find_objects) "
-             f"in {found:.1f} s",
-             f"- {len(sample)} labels spread over the label range processed end to end (crop, marching cubes, "
-             f"curvatures, statistics), the same labels in each run; load average before the runs "
-             f"{' '.join(f'{value:.1f}' for value in runs[0][5])} on {os.cpu_count()} cores", "",
-             "| run | wall | per label | CPU seconds (all processes) | extrapolated to all labels | "
-             "peak resident memory | labels ok |", "|---|--:|--:|--:|--:|--:|--:|"]
+    lines = [
+        f"## Scale: {' x '.join(map(str, shape))} voxels (uint16, {image.nbytes / 2**30:.2f} GiB), "
+        f"{len(present)} labels",
+        "",
+        f"- image built in {built:.0f} s; the labels' boxes found (one pass, scipy.ndimage.find_objects) "
+        f"in {found:.1f} s",
+        f"- {len(sample)} labels spread over the label range processed end to end (crop, marching cubes, "
+        f"curvatures, statistics), the same labels in each run; load average before the runs "
+        f"{' '.join(f'{value:.1f}' for value in runs[0][5])} on {os.cpu_count()} cores",
+        "",
+        "| run | wall | per label | CPU seconds (all processes) | extrapolated to all labels | "
+        "peak resident memory | labels ok |",
+        "|---|--:|--:|--:|--:|--:|--:|",
+    ]
     serial_seconds = runs[0][1]
     for name, seconds, cpu, statuses, extra, _, memory in runs:
         per_label = seconds / len(sample)
         estimate = found + extra + per_label * len(present)
         speedup = "" if name == "serial" else f" ({serial_seconds / seconds:.2f}x)"
-        lines.append(f"| {name} | {seconds:.0f} s{speedup} | {per_label:.2f} s | {cpu:.0f} s | {estimate / 60:.1f} min | "
-                     f"{memory} | {statuses.count('ok')}/{len(sample)} |")
-    lines += ["", f"Extrapolated: the label pass ({found:.1f} s), the cluster's start (workers) and the wall "
-              f"time per label times the {len(present)} labels. Peak resident memory: of this process "
-              f"({peak:.2f} GiB over the whole benchmark, the image itself {image.nbytes / 2**30:.2f} GiB), "
-              "and of each worker process."]
+        lines.append(
+            f"| {name} | {seconds:.0f} s{speedup} | {per_label:.2f} s | {cpu:.0f} s | {estimate / 60:.1f} min | "
+            f"{memory} | {statuses.count('ok')}/{len(sample)} |"
+        )
+    lines += [
+        "",
+        f"Extrapolated: the label pass ({found:.1f} s), the cluster's start (workers) and the wall "
+        f"time per label times the {len(present)} labels. Peak resident memory: of this process "
+        f"({peak:.2f} GiB over the whole benchmark, the image itself {image.nbytes / 2**30:.2f} GiB), "
+        "and of each worker process.",
+    ]
     return lines
 
 
@@ -264,8 +318,9 @@ def _timed(image, sample, workers):
             before = sum(cpu for cpu, _ in client.run(_worker_usage).values())
         cpu = _cpu_seconds()
         start = time.perf_counter()
-        total, rows = label_surfaces(image, spacing=(1.0, 1.0, 1.0), labels_to_use=sample, keep_surfaces=False,
-                                     client=client)
+        total, rows = label_surfaces(
+            image, spacing=(1.0, 1.0, 1.0), labels_to_use=sample, keep_surfaces=False, client=client
+        )
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             statuses = [row["status"] for row, _ in rows]
@@ -291,13 +346,21 @@ def main(argv=None) -> int:
     parser.add_argument("--scale-shape", type=int, nargs=3, default=[512, 1024, 1024])
     parser.add_argument("--scale-labels", type=int, default=2000)
     parser.add_argument("--scale-sample", type=int, default=100)
-    parser.add_argument("--workers", type=int, default=None,
-                        help="Also run the scale sample on a local Dask cluster of this many processes.")
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="Also run the scale sample on a local Dask cluster of this many processes.",
+    )
     parser.add_argument("--markdown", default=None, help="Also write the tables to this file.")
     args = parser.parse_args(argv)
-    lines = ["# Label images: per-label curvature tables (benchmarks/volume.py)", "",
-             f"`python benchmarks/volume.py {' '.join(sys.argv[1:] if argv is None else argv)}` on "
-             f"{platform.machine()}, Python {platform.python_version()}.", ""]
+    lines = [
+        "# Label images: per-label curvature tables (benchmarks/volume.py)",
+        "",
+        f"`python benchmarks/volume.py {' '.join(sys.argv[1:] if argv is None else argv)}` on "
+        f"{platform.machine()}, Python {platform.python_version()}.",
+        "",
+    ]
     if not args.no_accuracy:
         lines += accuracy(args) + [""]
     if args.scale:

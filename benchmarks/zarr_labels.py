@@ -62,8 +62,7 @@ def write_store(path, shape, chunk: int, centres, radii) -> float:
     import zarr
 
     start = time.perf_counter()
-    array = zarr.create_array(store=str(path), shape=tuple(shape), chunks=(chunk,) * 3, dtype="uint16",
-                              fill_value=0)
+    array = zarr.create_array(store=str(path), shape=tuple(shape), chunks=(chunk,) * 3, dtype="uint16", fill_value=0)
     low, high = np.floor(centres - radii[:, None]), np.ceil(centres + radii[:, None]) + 1
     for corner in itertools.product(*[range(0, n, chunk) for n in shape]):
         a = np.array(corner)
@@ -139,8 +138,11 @@ def run(path, workers: int):
     from meshcurv import batch, volume
     from meshcurv.io._images import read_image
 
-    with TreeMemory() as tree, dask.config.set(volume.CLUSTER_CONFIG), \
-            batch.local_cluster(workers=workers, dashboard=False) as client:
+    with (
+        TreeMemory() as tree,
+        dask.config.set(volume.CLUSTER_CONFIG),
+        batch.local_cluster(workers=workers, dashboard=False) as client,
+    ):
         before = sum(cpu for cpu, _ in client.run(_worker_usage).values())
         cpu = _cpu()
         start = time.perf_counter()
@@ -183,11 +185,14 @@ def main(argv=None) -> int:
     error = np.abs(inner.area.to_numpy() / truth - 1)
     statuses = table.status.value_counts().to_dict()
     lines = [
-        "# A Zarr label image larger than its memory cap, on 2 workers (benchmarks/zarr_labels.py)", "",
+        "# A Zarr label image larger than its memory cap, on 2 workers (benchmarks/zarr_labels.py)",
+        "",
         f"`python benchmarks/zarr_labels.py {' '.join(sys.argv[1:] if argv is None else argv)}` on "
         f"{platform.machine()}, {os.cpu_count()} cores shared with other work (load average before the run "
-        f"{load[0]:.1f}), Python {platform.python_version()}.", "",
-        "| what | value |", "|---|--:|",
+        f"{load[0]:.1f}), Python {platform.python_version()}.",
+        "",
+        "| what | value |",
+        "|---|--:|",
         f"| image | {' x '.join(map(str, shape))} uint16, {nbytes / 2**30:.2f} GiB in memory, chunks {args.chunk}^3, "
         f"{on_disk / 2**20:.0f} MiB on disk (written chunk by chunk in {writing:.0f} s) |",
         f"| objects | {len(table)} balls of radius {args.min_radius:g}-{args.max_radius:g} voxels "

@@ -33,6 +33,7 @@ RNG = np.random.default_rng(7)
 
 # ---------------------------------------------------------------- the cells and their analytic values
 
+
 def _rotation(rng) -> np.ndarray:
     """A random rotation matrix (QR of a Gaussian matrix, signs fixed)."""
     q, r = np.linalg.qr(rng.normal(size=(3, 3)))
@@ -58,8 +59,9 @@ def _ellipsoid_integrals(a: float, b: float, c: float, n: int = 400) -> dict[str
     weight = wu[:, None] * wv[None, :]
     x, y, z = a * np.cos(uu) * np.sin(vv), b * np.sin(uu) * np.sin(vv), c * np.cos(vv)
     # |p_u x p_v| = sin v sqrt(b^2 c^2 cos^2 u sin^2 v + a^2 c^2 sin^2 u sin^2 v + a^2 b^2 cos^2 v)
-    element = np.sin(vv) * np.sqrt((b * c * np.cos(uu) * np.sin(vv)) ** 2 + (a * c * np.sin(uu) * np.sin(vv)) ** 2
-                                   + (a * b * np.cos(vv)) ** 2)
+    element = np.sin(vv) * np.sqrt(
+        (b * c * np.cos(uu) * np.sin(vv)) ** 2 + (a * c * np.sin(uu) * np.sin(vv)) ** 2 + (a * b * np.cos(vv)) ** 2
+    )
     q = x**2 / a**4 + y**2 / b**4 + z**2 / c**4
     abc2 = (a * b * c) ** 2
     gaussian = 1 / (abc2 * q**2)
@@ -68,9 +70,13 @@ def _ellipsoid_integrals(a: float, b: float, c: float, n: int = 400) -> dict[str
     k_min = mean - np.sqrt(np.maximum(mean**2 - gaussian, 0))
     dA = element * weight
     shape_index = 2 / np.pi * np.arctan2(k_max + k_min, k_max - k_min)
-    return {"area": dA.sum(), "mean_integral": (mean * dA).sum(),
-            "bending_energy": ((k_max**2 + k_min**2) * dA).sum(), "gaussian_integral": (gaussian * dA).sum(),
-            "shape_index_mean": (shape_index * dA).sum() / dA.sum()}
+    return {
+        "area": dA.sum(),
+        "mean_integral": (mean * dA).sum(),
+        "bending_energy": ((k_max**2 + k_min**2) * dA).sum(),
+        "gaussian_integral": (gaussian * dA).sum(),
+        "shape_index_mean": (shape_index * dA).sum() / dA.sum(),
+    }
 
 
 def _torus_integrals(big: float, small: float, n: int = 2000) -> dict[str, float]:
@@ -80,24 +86,42 @@ def _torus_integrals(big: float, small: float, n: int = 2000) -> dict[str, float
     k_tube, k_ring = 1 / small, np.cos(v) / (big + small * np.cos(v))
     k_max, k_min = np.maximum(k_tube, k_ring), np.minimum(k_tube, k_ring)
     shape_index = 2 / np.pi * np.arctan2(k_max + k_min, k_max - k_min)
-    return {"area": element.sum(), "mean_integral": ((k_tube + k_ring) / 2 * element).sum(),
-            "bending_energy": ((k_tube**2 + k_ring**2) * element).sum(),
-            "gaussian_integral": (k_tube * k_ring * element).sum(),
-            "shape_index_mean": (shape_index * element).sum() / element.sum()}
+    return {
+        "area": element.sum(),
+        "mean_integral": ((k_tube + k_ring) / 2 * element).sum(),
+        "bending_energy": ((k_tube**2 + k_ring**2) * element).sum(),
+        "gaussian_integral": (k_tube * k_ring * element).sum(),
+        "shape_index_mean": (shape_index * element).sum() / element.sum(),
+    }
 
 
 def _cells(rng) -> list[dict]:
     """The 12 cells: shape, semi-axes, rotation, centre (um), analytic values; placed without overlap."""
     extent = np.array(SHAPE) * SPACING
-    wanted = [("sphere", (2.0, 2.0, 2.0)), ("sphere", (3.0, 3.0, 3.0)), ("sphere", (4.0, 4.0, 4.0)),
-              ("sphere", (5.0, 5.0, 5.0)), ("sphere", (3.5, 3.5, 3.5)),
-              ("ellipsoid", (4.5, 3.0, 2.5)), ("ellipsoid", (5.0, 4.0, 3.0)), ("ellipsoid", (3.5, 2.5, 2.0)),
-              ("ellipsoid", (5.0, 3.0, 3.0)), ("ellipsoid", (4.0, 4.0, 2.5)),
-              ("torus", (4.5, 2.2, 0.0))]
+    wanted = [
+        ("sphere", (2.0, 2.0, 2.0)),
+        ("sphere", (3.0, 3.0, 3.0)),
+        ("sphere", (4.0, 4.0, 4.0)),
+        ("sphere", (5.0, 5.0, 5.0)),
+        ("sphere", (3.5, 3.5, 3.5)),
+        ("ellipsoid", (4.5, 3.0, 2.5)),
+        ("ellipsoid", (5.0, 4.0, 3.0)),
+        ("ellipsoid", (3.5, 2.5, 2.0)),
+        ("ellipsoid", (5.0, 3.0, 3.0)),
+        ("ellipsoid", (4.0, 4.0, 2.5)),
+        ("torus", (4.5, 2.2, 0.0)),
+    ]
     cells = []
     # the cut cell first, at a fixed place: a sphere of radius 4 whose centre is 1 um outside the face x = 0
-    cells.append({"shape": "sphere, cut", "axes": (4.0, 4.0, 4.0), "rotation": np.eye(3),
-                  "centre": np.array([extent[0] / 2, extent[1] / 2, -1.0]), "bound": 4.0})
+    cells.append(
+        {
+            "shape": "sphere, cut",
+            "axes": (4.0, 4.0, 4.0),
+            "rotation": np.eye(3),
+            "centre": np.array([extent[0] / 2, extent[1] / 2, -1.0]),
+            "bound": 4.0,
+        }
+    )
     for shape, axes in wanted:
         bound = axes[0] + axes[1] if shape == "torus" else max(axes)
         for _ in range(10_000):
@@ -121,8 +145,15 @@ def _exact(cell: dict, extent) -> dict[str, float]:
     if cell["shape"] == "sphere, cut":
         # the image ends half a voxel before the centre of its first voxel: the cap inside has height h
         h = a + cell["centre"][2] + SPACING[2] / 2
-        return {"area": 2 * np.pi * a * h, "volume": np.pi * h**2 * (3 * a - h) / 3, "mean_integral": np.nan,
-                "bending_energy": np.nan, "gaussian_integral": np.nan, "shape_index_mean": 1.0, "genus": np.nan}
+        return {
+            "area": 2 * np.pi * a * h,
+            "volume": np.pi * h**2 * (3 * a - h) / 3,
+            "mean_integral": np.nan,
+            "bending_energy": np.nan,
+            "gaussian_integral": np.nan,
+            "shape_index_mean": 1.0,
+            "genus": np.nan,
+        }
     return {**_ellipsoid_integrals(a, b, c), "volume": 4 / 3 * np.pi * a * b * c, "genus": 0}
 
 
@@ -145,12 +176,13 @@ def label_image(cells: list[dict]) -> np.ndarray:
         high = np.minimum(np.ceil((cell["centre"] + cell["bound"]) / spacing).astype(int) + 2, SHAPE)
         box = np.stack(np.meshgrid(*[np.arange(lo, hi) for lo, hi in zip(low, high)], indexing="ij"), axis=-1)
         inside = _inside(cell, box.reshape(-1, 3) * spacing).reshape(box.shape[:3])
-        region = labels[low[0]:high[0], low[1]:high[1], low[2]:high[2]]
+        region = labels[low[0] : high[0], low[1] : high[1], low[2] : high[2]]
         region[inside] = label
     return labels
 
 
 # ---------------------------------------------------------------- the table as users read it
+
 
 def _error(measured, exact) -> str:
     if not np.isfinite(measured):
@@ -162,35 +194,54 @@ def _error(measured, exact) -> str:
 
 def comparison(table, cells) -> str:
     """A Markdown table: each column measured (relative error to the analytic value)."""
-    lines = ["| label | cell (semi-axes, um) | area um² | volume um³ | ∫H dA um | ∫K dA / 4π (exact) | "
-             "bending energy | ici_positive | shape_index_mean |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| label | cell (semi-axes, um) | area um² | volume um³ | ∫H dA um | ∫K dA / 4π (exact) | "
+        "bending energy | ici_positive | shape_index_mean |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for cell, row in zip(cells, table.itertuples()):
         exact = cell["exact"]
-        size = "R " + f"{cell['axes'][0]:g}" if cell["shape"].startswith("sphere") else \
-            (f"R {cell['axes'][0]:g}, r {cell['axes'][1]:g}" if cell["shape"] == "torus" else
-             " x ".join(f"{x:g}" for x in cell["axes"]))
+        size = (
+            "R " + f"{cell['axes'][0]:g}"
+            if cell["shape"].startswith("sphere")
+            else (
+                f"R {cell['axes'][0]:g}, r {cell['axes'][1]:g}"
+                if cell["shape"] == "torus"
+                else " x ".join(f"{x:g}" for x in cell["axes"])
+            )
+        )
         genus = exact["genus"]
-        gauss = "NaN" if not np.isfinite(row.gaussian_integral) else \
-            f"{row.gaussian_integral / (4 * np.pi):.3f} ({1 - genus:g})"
+        gauss = (
+            "NaN"
+            if not np.isfinite(row.gaussian_integral)
+            else f"{row.gaussian_integral / (4 * np.pi):.3f} ({1 - genus:g})"
+        )
         lines.append(
             f"| {row.label} | {cell['shape']} {size} | {_error(row.area, exact['area'])} | "
             f"{_error(row.volume, exact['volume'])} | {_error(row.mean_integral, exact['mean_integral'])} | "
             f"{gauss} | {_error(row.bending_energy, exact['bending_energy'])} | "
-            f"{_error(row.ici_positive, np.nan)} | {_error(row.shape_index_mean, exact['shape_index_mean'])} |")
-    notes = [f"label {row.label}: {row.warnings}" for row in table.itertuples()
-             if isinstance(row.warnings, str) and row.warnings]
+            f"{_error(row.ici_positive, np.nan)} | {_error(row.shape_index_mean, exact['shape_index_mean'])} |"
+        )
+    notes = [
+        f"label {row.label}: {row.warnings}"
+        for row in table.itertuples()
+        if isinstance(row.warnings, str) and row.warnings
+    ]
     return "\n".join(lines + [""] + notes)
 
 
 def exact_table(cells) -> str:
     """The analytic values the comparison uses."""
-    lines = ["| label | cell | area um² | volume um³ | ∫H dA um | bending energy | shape_index_mean |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| label | cell | area um² | volume um³ | ∫H dA um | bending energy | shape_index_mean |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for label, cell in enumerate(cells, start=1):
         e = cell["exact"]
-        values = [f"{e[key]:.4g}" if np.isfinite(e[key]) else "-" for key in
-                  ("area", "volume", "mean_integral", "bending_energy", "shape_index_mean")]
+        values = [
+            f"{e[key]:.4g}" if np.isfinite(e[key]) else "-"
+            for key in ("area", "volume", "mean_integral", "bending_energy", "shape_index_mean")
+        ]
         lines.append(f"| {label} | {cell['shape']} | " + " | ".join(values) + " |")
     return "\n".join(lines)
 
@@ -203,11 +254,20 @@ def picture(surfaces, path: pathlib.Path) -> None:
     faces = np.concatenate([s.faces + offset for s, offset in zip(drawn, offsets)])
     values = np.concatenate([np.where(s.used, s.result.mean, np.nan) for s in drawn])
     normals = np.concatenate([s.result.normals for s in drawn])  # the fitted normals: shading without the staircase
-    figure = plot_field(vertices, faces, values, view=[(25.0, -60.0), "top"], up="x", limits=(0.0, 0.55),
-                        cmap="viridis", normals=normals,
-                        label="mean curvature H (1/um); grey: too close to the image border",
-                        title="12 cells, voxels 0.5 x 0.2 x 0.2 um (image z up; right: seen from +z)",
-                        pixels=1600, dpi=130)
+    figure = plot_field(
+        vertices,
+        faces,
+        values,
+        view=[(25.0, -60.0), "top"],
+        up="x",
+        limits=(0.0, 0.55),
+        cmap="viridis",
+        normals=normals,
+        label="mean curvature H (1/um); grey: too close to the image border",
+        title="12 cells, voxels 0.5 x 0.2 x 0.2 um (image z up; right: seen from +z)",
+        pixels=1600,
+        dpi=130,
+    )
     save_figure(figure, path, overwrite=True)
 
 
@@ -221,14 +281,25 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     cells = _cells(RNG)
     labels = label_image(cells)
-    _say(f"image {labels.shape} voxels of {' x '.join(map(str, SPACING))} um, {labels.max()} cells, "
-          f"{labels.nbytes / 2**20:.1f} MiB")
+    _say(
+        f"image {labels.shape} voxels of {' x '.join(map(str, SPACING))} um, {labels.max()} cells, "
+        f"{labels.nbytes / 2**20:.1f} MiB"
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the one MeshQualityWarning names the cut cell: the table says it too
         table, surfaces = meshcurv.label_curvatures(labels, spacing=SPACING, return_meshes=True)
         smoothed = meshcurv.label_curvatures(labels, spacing=SPACING, smooth=SPACING[2])
-    columns = ["label", "touches_border", "area", "volume", "mean_integral", "gaussian_integral",
-               "bending_energy", "ici_positive", "shape_index_mean"]
+    columns = [
+        "label",
+        "touches_border",
+        "area",
+        "volume",
+        "mean_integral",
+        "gaussian_integral",
+        "bending_energy",
+        "ici_positive",
+        "shape_index_mean",
+    ]
     import pandas as pd
 
     with pd.option_context("display.width", 200, "display.max_columns", 20, "display.precision", 4):

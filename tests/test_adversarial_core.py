@@ -24,8 +24,16 @@ from meshcurv import neighborhoods, shapes, smoothing
 from meshcurv._backend import use_backend
 from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from meshcurv import jets
-from meshcurv.geometry import (degenerate_face_mask, edge_lengths, face_areas, mean_edge_length, median_edge_length,
-                               robust_mean_edge_length, vertex_length_scales, vertex_normals)
+from meshcurv.geometry import (
+    degenerate_face_mask,
+    edge_lengths,
+    face_areas,
+    mean_edge_length,
+    median_edge_length,
+    robust_mean_edge_length,
+    vertex_length_scales,
+    vertex_normals,
+)
 from meshcurv.topology import MeshTopology
 
 try:
@@ -52,8 +60,13 @@ def run_child(code: str, timeout: float, env: dict | None = None) -> subprocess.
     """Run ``code`` in a fresh interpreter on this source tree; a hang is a failed test."""
     environment = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", ""), **(env or {})}
     try:
-        return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True,
-                              timeout=timeout, env=environment)
+        return subprocess.run(
+            [sys.executable, "-c", textwrap.dedent(code)],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            env=environment,
+        )
     except subprocess.TimeoutExpired:
         pytest.fail(f"the child process did not finish within {timeout} s")
 
@@ -94,10 +107,8 @@ def test_robust_edge_statistics_ignore_the_spike():
     edges = MeshTopology.from_faces(faces, vertices.shape[0]).edges
     clean = MeshTopology.from_faces(SPHERE.faces, N).edges
     assert mean_edge_length(vertices, edges) > 1e6  # the mean is ruined by two edges
-    assert robust_mean_edge_length(vertices, edges) == pytest.approx(mean_edge_length(SPHERE.vertices, clean),
-                                                                     rel=0.01)
-    assert median_edge_length(vertices, edges) == pytest.approx(median_edge_length(SPHERE.vertices, clean),
-                                                                rel=0.01)
+    assert robust_mean_edge_length(vertices, edges) == pytest.approx(mean_edge_length(SPHERE.vertices, clean), rel=0.01)
+    assert median_edge_length(vertices, edges) == pytest.approx(median_edge_length(SPHERE.vertices, clean), rel=0.01)
     # no outlier: exactly the mean (default radii unchanged on ordinary meshes)
     assert robust_mean_edge_length(SPHERE.vertices, clean) == mean_edge_length(SPHERE.vertices, clean)
 
@@ -153,8 +164,7 @@ def test_fit_jets_only_gathers_the_given_neighbours(backend):
     mask = np.arange(vertices.shape[0]) < N
     with use_backend(backend):
         alone, _, alone_counts = jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4, degree=3)
-        mixed, _, counts = jets.fit_jets(vertices, normals, 0.4, degree=3, neighbours=mask,
-                                            centres=np.arange(N))
+        mixed, _, counts = jets.fit_jets(vertices, normals, 0.4, degree=3, neighbours=mask, centres=np.arange(N))
     np.testing.assert_array_equal(mixed[:N], alone)
     np.testing.assert_array_equal(counts[:N], alone_counts)
 
@@ -193,8 +203,11 @@ def test_default_radius_still_fits_every_vertex_of_a_noisy_sphere():
 # -- 4. a radius larger than the mesh ----------------------------------------------------------------
 @pytest.mark.parametrize("method", ["quadric", "normal_cycle_ball"])
 def test_radius_beyond_the_mesh_is_refused(method):
-    with pytest.raises(InvalidOptionError, match=r"`radius` 1000 is larger than the mesh itself "
-                                                 r"\(bounding-box diagonal 3.46.*median edge length 0.1"):
+    with pytest.raises(
+        InvalidOptionError,
+        match=r"`radius` 1000 is larger than the mesh itself "
+        r"\(bounding-box diagonal 3.46.*median edge length 0.1",
+    ):
         meshcurv.principal_curvatures(SPHERE.vertices, SPHERE.faces, method=method, radius=1000.0)
 
 
@@ -229,11 +242,13 @@ def test_compiled_balls_in_several_calls_give_the_same_sums(monkeypatch):
 
     def everything():
         with use_backend("numba"):
-            return (neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values),
-                    neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values, connected=True),
-                    *jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)[::2],
-                    *jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4, adjacency=top.neighbour_lists)[::2],
-                    jets.fit_jet_normals(SPHERE.vertices, SPHERE.normals, 0.4, adjacency=top.neighbour_lists))
+            return (
+                neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values),
+                neighborhoods.ball_face_sums(SPHERE.vertices, SPHERE.faces, 0.4, values, connected=True),
+                *jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4)[::2],
+                *jets.fit_jets(SPHERE.vertices, SPHERE.normals, 0.4, adjacency=top.neighbour_lists)[::2],
+                jets.fit_jet_normals(SPHERE.vertices, SPHERE.normals, 0.4, adjacency=top.neighbour_lists),
+            )
 
     monkeypatch.setattr(neighborhoods, "PAIRS_PER_CALL", 2000)  # a few centres per call
     assert len(neighborhoods.call_ranges(N, 60.0)) > 10
@@ -308,8 +323,13 @@ def test_long_compiled_smoothing_stops_on_ctrl_c():
         print("finished", flush=True)
     """
     environment = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    child = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True, env=environment)
+    child = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(code)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=environment,
+    )
     # the whole smoothing takes a minute or more (157 kernel calls on 400k vertices); one call, after the
     # signal, takes a second or two on a loaded machine: 30 s tells an interrupted run from one that goes on
     try:
@@ -439,8 +459,11 @@ def test_smoothing_and_diagnose_refuse_mismatched_arrays():
 
 def test_geometry_helpers_refuse_what_is_not_a_topology_or_a_scale():
     top = MeshTopology.from_faces(SPHERE.faces, N)
-    with pytest.raises(InvalidMeshError, match=r"`topology` must be a MeshTopology; got ndarray \(a face array: "
-                                               r"build one with MeshTopology.from_faces"):
+    with pytest.raises(
+        InvalidMeshError,
+        match=r"`topology` must be a MeshTopology; got ndarray \(a face array: "
+        r"build one with MeshTopology.from_faces",
+    ):
         vertex_length_scales(SPHERE.vertices, SPHERE.faces)
     with pytest.raises(InvalidMeshError, match=f"`vertices` has {N + 1} rows but the topology has {N}"):
         vertex_length_scales(np.vstack([SPHERE.vertices, [[0.0, 0.0, 0.0]]]), top)
@@ -464,8 +487,9 @@ def test_geometry_helpers_refuse_what_is_not_a_topology_or_a_scale():
 
 
 @pytest.mark.parametrize("scale, word", [(1e200, "overflow"), (1e-200, "underflow")])
-@pytest.mark.parametrize("name", ["face_areas", "face_normals", "vertex_normals", "face_cross_products",
-                                  "corner_angles", "signed_volume"])
+@pytest.mark.parametrize(
+    "name", ["face_areas", "face_normals", "vertex_normals", "face_cross_products", "corner_angles", "signed_volume"]
+)
 def test_geometry_helpers_refuse_coordinates_beyond_the_float64_range_of_areas(name, scale, word):
     from meshcurv import geometry
 
@@ -499,8 +523,11 @@ def test_diagnose_and_degenerate_faces_refuse_bad_arguments():
 @pytest.mark.parametrize("values, dtype", [(np.ones(N) * 1j, "complex128"), (np.array(["a"] * N), "<U1")])
 def test_smooth_vertex_field_refuses_values_that_are_not_real(values, dtype):
     top = MeshTopology.from_faces(SPHERE.faces, N)
-    with pytest.raises(InvalidMeshError, match=rf"`values` must hold real numbers \(float, int or bool\); "
-                                               rf"got dtype {dtype}"):
+    with pytest.raises(
+        InvalidMeshError,
+        match=rf"`values` must hold real numbers \(float, int or bool\); "
+        rf"got dtype {dtype}",
+    ):
         smoothing.smooth_vertex_field(values, top, 1)
 
 
@@ -542,8 +569,9 @@ def test_helper_arrays_of_the_wrong_shape_are_refused():
         bowtie_vertices(SPHERE.faces)
     # the barycentric areas given or computed: the same, summing to the total area
     areas = face_areas(SPHERE.vertices, SPHERE.faces)
-    np.testing.assert_array_equal(vertex_areas(SPHERE.vertices, SPHERE.faces, areas=areas),
-                                  vertex_areas(SPHERE.vertices, SPHERE.faces))
+    np.testing.assert_array_equal(
+        vertex_areas(SPHERE.vertices, SPHERE.faces, areas=areas), vertex_areas(SPHERE.vertices, SPHERE.faces)
+    )
     assert np.isclose(vertex_areas(SPHERE.vertices, SPHERE.faces).sum(), areas.sum(), rtol=1e-12)
 
 

@@ -58,7 +58,10 @@ def test_silent_by_default_and_stages_on_the_logger_at_info(caplog, capsys):
         meshcurv.principal_curvatures(torus.vertices, torus.faces, method="matgeom")
     messages = [rec.getMessage() for rec in caplog.records]
     assert [m.split(" (")[0] for m in messages] == [
-        "compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures"
+        "compute adjacencies",
+        "compute edge tensors",
+        "average vertex tensors",
+        "retrieve curvatures",
     ]
     out = capsys.readouterr()
     assert out.out == "" and out.err == ""
@@ -67,7 +70,9 @@ def test_silent_by_default_and_stages_on_the_logger_at_info(caplog, capsys):
 def test_progress_callback_sees_every_stage():
     torus = shapes.torus(n_major=12, n_minor=8)
     calls = []
-    meshcurv.principal_curvatures(torus.vertices, torus.faces, method="normal_cycle", progress=lambda *a: calls.append(a))
+    meshcurv.principal_curvatures(
+        torus.vertices, torus.faces, method="normal_cycle", progress=lambda *a: calls.append(a)
+    )
     assert [c[1:] for c in calls] == [(1, 4), (2, 4), (3, 4), (4, 4)]
     assert calls[-1][0] == "retrieve curvatures"
 

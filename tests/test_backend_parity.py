@@ -105,14 +105,28 @@ def assert_same(a, b, label: str) -> None:
 
 #: Every method (all run compiled kernels: geometry, orientation, tensors, their own), the ball methods at
 #: their default radius and at a given one (in mean edge lengths), icc's adaptive scale too.
-CASES = [("icc", None), ("icc", 2.0), ("icc", "adaptive"), ("quadric", None), ("quadric", 3.0),
-         ("normal_cycle_ball", None), ("normal_cycle_ball", 3.0), ("normal_cycle", None), ("matgeom", None),
-         ("meyer", None), ("rusinkiewicz", None)]
+CASES = [
+    ("icc", None),
+    ("icc", 2.0),
+    ("icc", "adaptive"),
+    ("quadric", None),
+    ("quadric", 3.0),
+    ("normal_cycle_ball", None),
+    ("normal_cycle_ball", 3.0),
+    ("normal_cycle", None),
+    ("matgeom", None),
+    ("meyer", None),
+    ("rusinkiewicz", None),
+]
 
 
-@pytest.mark.parametrize(("method", "edges"), [
-    pytest.param(m, e, id=f"{m}-{e or 'default'}", marks=[pytest.mark.slow] if e == "adaptive" else [])
-    for m, e in CASES])
+@pytest.mark.parametrize(
+    ("method", "edges"),
+    [
+        pytest.param(m, e, id=f"{m}-{e or 'default'}", marks=[pytest.mark.slow] if e == "adaptive" else [])
+        for m, e in CASES
+    ],
+)
 @pytest.mark.parametrize("name", sorted(MESHES))
 def test_backends_compute_one_estimator(name, method, edges):
     # the default radius (icc: from the noise level of fits over connected balls; a voxel surface:
@@ -166,8 +180,9 @@ def two_sheets():
     x, y = np.meshgrid(side, side, indexing="ij")
     sheet = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
     corner = (np.arange(20)[:, None] * 21 + np.arange(20)[None, :]).ravel()
-    faces = np.vstack([np.column_stack([corner, corner + 21, corner + 22]),
-                       np.column_stack([corner, corner + 22, corner + 1])])
+    faces = np.vstack(
+        [np.column_stack([corner, corner + 21, corner + 22]), np.column_stack([corner, corner + 22, corner + 1])]
+    )
     return (np.vstack([sheet, sheet + [0.0, 0.0, 0.1]]), np.vstack([faces, faces + sheet.shape[0]])), (sheet, faces)
 
 
@@ -186,7 +201,7 @@ def test_connected_balls_leave_out_the_other_sheet(backend):
     with use_backend(backend):
         connected = ball_face_sums(vertices, faces, 0.3, ones, connected=True)[MIDDLE, 0]
         both = ball_face_sums(vertices, faces, 0.3, ones)[MIDDLE, 0]
-        alone = ball_face_sums(sheet, sheet_faces, 0.3, ones[:sheet_faces.shape[0]])[MIDDLE, 0]
+        alone = ball_face_sums(sheet, sheet_faces, 0.3, ones[: sheet_faces.shape[0]])[MIDDLE, 0]
     assert connected == pytest.approx(alone, rel=1e-12)
     assert both > 1.5 * alone  # the other sheet's disc, of radius sqrt(0.3^2 - 0.1^2)
 
@@ -203,7 +218,7 @@ def test_connected_jet_balls_leave_out_the_other_sheet(backend):
         _, _, connected = fit_jets(vertices, normals, 0.3, degree=2, centres=[MIDDLE], adjacency=adjacency)
         _, _, euclidean = fit_jets(vertices, normals, 0.3, degree=2, centres=[MIDDLE])
     distances = np.linalg.norm(vertices - vertices[MIDDLE], axis=1)
-    own = distances[:sheet.shape[0]]
+    own = distances[: sheet.shape[0]]
     assert connected[MIDDLE] == (own < 0.3).sum()  # strictly inside: a non-zero weight
     assert euclidean[MIDDLE] == (distances < 0.3).sum() > 1.5 * (own < 0.3).sum()
 
@@ -218,7 +233,9 @@ def test_edge_lists_that_are_not_the_meshs_are_refused(backend):
     indptr, indices = MeshTopology.from_faces(faces, vertices.shape[0]).neighbour_lists
     normals = np.tile([0.0, 0.0, 1.0], (vertices.shape[0], 1))
     with use_backend(backend):
-        with pytest.raises(InvalidMeshError, match=r"`adjacency` must be CSR lists of 882 vertices; got indptr \(10,\)"):
+        with pytest.raises(
+            InvalidMeshError, match=r"`adjacency` must be CSR lists of 882 vertices; got indptr \(10,\)"
+        ):
             fit_jets(vertices, normals, 0.3, adjacency=(indptr[:10], indices))
         wrong = np.array(indices, copy=True)
         wrong[5] = vertices.shape[0]

@@ -45,8 +45,9 @@ def no_numba(monkeypatch):
     """numba cannot be imported for the duration of the test; the backend decides afresh before and after."""
     finder = _NoNumba()
     monkeypatch.setattr(sys, "meta_path", [finder, *sys.meta_path])
-    for name in [name for name in sys.modules
-                 if name in ("numba", COMPILED) or name.startswith(("numba.", COMPILED + "."))]:
+    for name in [
+        name for name in sys.modules if name in ("numba", COMPILED) or name.startswith(("numba.", COMPILED + "."))
+    ]:
         monkeypatch.delitem(sys.modules, name, raising=False)
     monkeypatch.delattr(meshcurv, "_kernels", raising=False)
     monkeypatch.delenv("MESHCURV_BACKEND", raising=False)

@@ -100,8 +100,9 @@ def test_neighbour_lists_match_the_adjacency():
     with use_backend("numpy"):  # the same neighbours as the adjacency matrix, in edge order
         adjacency = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0]).adjacency
     for v in range(top.n_vertices):
-        assert sorted(indices[indptr[v]:indptr[v + 1]]) == sorted(adjacency.indices[adjacency.indptr[v]:
-                                                                                    adjacency.indptr[v + 1]])
+        assert sorted(indices[indptr[v] : indptr[v + 1]]) == sorted(
+            adjacency.indices[adjacency.indptr[v] : adjacency.indptr[v + 1]]
+        )
 
 
 @pytest.mark.parametrize("threads", [1, 2])
@@ -117,8 +118,9 @@ def test_bowtie_vertices_do_not_depend_on_the_number_of_threads(threads):
     before = numba.get_num_threads()
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     try:
-        found = kernels_topology.bowtie_vertices(top.faces, top.face_edges, top.edge_faces, linked,
-                                                 ~top.degenerate_faces, top.n_vertices)
+        found = kernels_topology.bowtie_vertices(
+            top.faces, top.face_edges, top.edge_faces, linked, ~top.degenerate_faces, top.n_vertices
+        )
     finally:
         numba.set_num_threads(before)
     np.testing.assert_array_equal(found, _bowtie_vertices(top))
@@ -133,8 +135,16 @@ def test_normal_cycle_sums_do_not_depend_on_the_number_of_threads(name):
 
     vertices, faces = MESHES[name]
     top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
-    arguments = (vertices, top.faces, top.edges, top.edge_faces, top.edge_face_counts, top._edge_forward_counts,
-                 vertex_length_scales(vertices, top), DEGENERATE_AREA_RATIO)
+    arguments = (
+        vertices,
+        top.faces,
+        top.edges,
+        top.edge_faces,
+        top.edge_face_counts,
+        top._edge_forward_counts,
+        vertex_length_scales(vertices, top),
+        DEGENERATE_AREA_RATIO,
+    )
     sums, degenerate = kernels_normal_cycle.normal_cycle_sums(*arguments, 1)
     for chunks in (2, 5):
         other_sums, other_degenerate = kernels_normal_cycle.normal_cycle_sums(*arguments, chunks)
@@ -149,8 +159,14 @@ def test_matgeom_sums_do_not_depend_on_the_number_of_threads(name):
 
     vertices, faces = MESHES[name]
     top = MeshTopology._build(np.asarray(faces, np.int64), vertices.shape[0])
-    arguments = (vertices, top.faces, top.edges[:, 0].copy(), top.edges[:, 1].copy(),
-                 np.maximum(top.edge_faces[:, 0], 0), np.maximum(top.edge_faces[:, 1], 0))
+    arguments = (
+        vertices,
+        top.faces,
+        top.edges[:, 0].copy(),
+        top.edges[:, 1].copy(),
+        np.maximum(top.edge_faces[:, 0], 0),
+        np.maximum(top.edge_faces[:, 1], 0),
+    )
     sums = kernels_matgeom.matgeom_vertex_tensors(*arguments, 1)
     assert np.isfinite(sums).any()
     for chunks in (2, 5):
@@ -166,8 +182,9 @@ def test_curvatures_agree(name, method):
     finite = np.abs(a.k_max[np.isfinite(a.k_max)])
     scale = finite.max() if finite.size else 1.0  # quadric on the coarse torus: every ball holds the tube's far side
     for field in ("k_min", "k_max", "mean", "gaussian"):
-        np.testing.assert_allclose(getattr(b, field), getattr(a, field), rtol=0, atol=1e-11 * scale * max(scale, 1),
-                                   err_msg=field)
+        np.testing.assert_allclose(
+            getattr(b, field), getattr(a, field), rtol=0, atol=1e-11 * scale * max(scale, 1), err_msg=field
+        )
     separated = a.valid & (np.abs(a.k_max - a.k_min) > 1e-6 * scale)
     for field in ("dir_min", "dir_max"):
         dots = np.abs(np.sum(getattr(a, field) * getattr(b, field), axis=1))[separated]
@@ -198,12 +215,14 @@ def test_ball_methods_agree(name, method):
     numeric = {k for k, v in a.parameters.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
     assert {k: a.parameters[k] for k in numeric} == pytest.approx({k: b.parameters[k] for k in numeric}, rel=1e-9)
     assert {k: v for k, v in a.parameters.items() if k not in numeric} == {
-        k: v for k, v in b.parameters.items() if k not in numeric}
+        k: v for k, v in b.parameters.items() if k not in numeric
+    }
     finite = np.abs(a.k_max[np.isfinite(a.k_max)])
     scale = finite.max() if finite.size else 1.0  # quadric on the coarse torus: every ball holds the tube's far side
     for field in ("k_min", "k_max", "normals"):
-        np.testing.assert_allclose(getattr(b, field), getattr(a, field), rtol=0, atol=1e-8 * max(scale, 1),
-                                   err_msg=field)
+        np.testing.assert_allclose(
+            getattr(b, field), getattr(a, field), rtol=0, atol=1e-8 * max(scale, 1), err_msg=field
+        )
 
 
 def noisy_sphere():
@@ -246,10 +265,27 @@ def test_compact_jets_are_the_rows_of_their_centres(backend, connected):
     centres = np.array([40, 3, 3, 3, 17, 3, mesh.vertices.shape[0] - 1])  # a centre listed twice in a row
     with use_backend(backend):
         full_details, details = {}, {}
-        full = fit_jets(mesh.vertices, normals, 0.4, degree=3, centres=centres, facing=normals, adjacency=adjacency,
-                        details=full_details)
-        rows = fit_jets(mesh.vertices, normals, 0.4, degree=3, centres=centres, facing=normals, adjacency=adjacency,
-                        details=details, compact=True)
+        full = fit_jets(
+            mesh.vertices,
+            normals,
+            0.4,
+            degree=3,
+            centres=centres,
+            facing=normals,
+            adjacency=adjacency,
+            details=full_details,
+        )
+        rows = fit_jets(
+            mesh.vertices,
+            normals,
+            0.4,
+            degree=3,
+            centres=centres,
+            facing=normals,
+            adjacency=adjacency,
+            details=details,
+            compact=True,
+        )
     assert rows[0].shape == (centres.size, 6) and rows[2].shape == (centres.size,)
     assert np.isfinite(rows[0]).all()
     np.testing.assert_array_equal(rows[0], full[0][centres])
@@ -273,10 +309,12 @@ def test_settled_fits_keep_their_first_fit(backend, connected):
         twice, twice_frame, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency)
         slope = once[:, 1] ** 2 + once[:, 2] ** 2
         settled = float(np.median(slope))
-        mixed, frame, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency,
-                                   settled=settled)
-        unchanged, _, _ = fit_jets(mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency,
-                                   settled=0.0)
+        mixed, frame, _ = fit_jets(
+            mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency, settled=settled
+        )
+        unchanged, _, _ = fit_jets(
+            mesh.vertices, normals, 0.4, degree=3, iterations=2, adjacency=adjacency, settled=0.0
+        )
     kept = slope < settled
     assert 0 < kept.sum() < kept.size and np.isfinite(once).all()
     assert np.abs(once[kept] - twice[kept]).max() > 1e-9  # the second fit moves them: the test can tell
@@ -331,6 +369,7 @@ def test_diagnosis_agrees(name):
 
 
 # -- first use: a compilation is announced, a load from the cache is not --------------------
+
 
 class _Event:
     """A stand-in for numba.core.event.Event of kind ``numba:compile``."""
@@ -391,8 +430,10 @@ def test_cold_cache_compiles_and_announces_warm_cache_loads_silently(tmp_path):
     import sys
 
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), MESHCURV_BACKEND="numba")
-    runs = [subprocess.run([sys.executable, "-c", SNIPPET], capture_output=True, text=True, env=env, timeout=120)
-            for _ in range(2)]
+    runs = [
+        subprocess.run([sys.executable, "-c", SNIPPET], capture_output=True, text=True, env=env, timeout=120)
+        for _ in range(2)
+    ]
     cold, warm = (run.stderr for run in runs)
     assert all(run.returncode == 0 for run in runs), cold + warm
     assert cold.count("WARNING compiling meshcurv's numba kernels") == 1

@@ -26,8 +26,14 @@ def test_a_result_keeps_the_arrays_a_kernel_allocated():
     lengths = numba_kernels("geometry").edge_lengths(sphere.vertices, topology.edges)
     assert not lengths.flags.owndata  # numba's MemInfo owns the buffer
     n = lengths.size
-    fields = {"k_min": lengths, "k_max": np.ones(n), "dir_min": np.zeros((n, 3)), "dir_max": np.zeros((n, 3)),
-              "normals": np.zeros((n, 3)), "valid": np.ones(n, dtype=bool)}
+    fields = {
+        "k_min": lengths,
+        "k_max": np.ones(n),
+        "dir_min": np.zeros((n, 3)),
+        "dir_max": np.zeros((n, 3)),
+        "normals": np.zeros((n, 3)),
+        "valid": np.ones(n, dtype=bool),
+    }
     result = CurvatureResult._of_arrays(method="test", **fields)
     assert result.k_min is lengths and not lengths.flags.writeable
     again = dataclasses.replace(result, parameters={"radius": 1.0})

@@ -28,9 +28,14 @@ RADIUS = 2.5 * EDGE  # fixed ball radius: the default follows the global mean ed
 FAR_RINGS = 12  # more rings than any method's neighbourhood (smoothing 3 + 1, icc's jets and ball ~11 rings)
 
 # What the warning must name, per kind of defect.
-NAMED = {"boundary": "boundary", "nonmanifold": "non-manifold", "bowtie": "bow-tie",
-         "inconsistent": "inconsistent", "degenerate": "zero-area|undefined tensors",
-         "unreferenced": "unreferenced"}
+NAMED = {
+    "boundary": "boundary",
+    "nonmanifold": "non-manifold",
+    "bowtie": "bow-tie",
+    "inconsistent": "inconsistent",
+    "degenerate": "zero-area|undefined tensors",
+    "unreferenced": "unreferenced",
+}
 
 # matGeom's compatibility mode reproduces matGeom, which neither stops nor
 # gives NaN on these defects; its values there are matGeom's (wrong) numbers and
@@ -56,8 +61,7 @@ def run(vertices, faces, method, **extra):
 
 @pytest.fixture(scope="module")
 def clean():
-    return {m: meshcurv.principal_curvatures(TORUS.vertices, TORUS.faces, method=m, **options(m))
-            for m in METHODS}
+    return {m: meshcurv.principal_curvatures(TORUS.vertices, TORUS.faces, method=m, **options(m)) for m in METHODS}
 
 
 @functools.cache
@@ -84,8 +88,9 @@ def test_dirty_mesh_gives_a_defined_answer(name, method, clean, request):
         np.testing.assert_array_equal(r.valid, reference.valid[case.clean_index])
         scale = np.nanmax(np.abs(reference.k_max))
         for field in ("k_min", "k_max"):
-            np.testing.assert_allclose(getattr(r, field), getattr(reference, field)[case.clean_index],
-                                       rtol=1e-9, atol=1e-9 * scale)
+            np.testing.assert_allclose(
+                getattr(r, field), getattr(reference, field)[case.clean_index], rtol=1e-9, atol=1e-9 * scale
+            )
         return
     # one warning, naming the defect; none for a clean mesh in several pieces, and a
     # boundary is no defect to a method that keeps boundary vertices
@@ -132,8 +137,13 @@ def test_far_from_the_defect_nothing_changes(name, method, clean):
     # chunked sums change with the number of vertices: it keeps about 6 digits
     tolerance = 1e-5 if method == "quadric" else 1e-9
     for field in ("k_min", "k_max", "mean", "gaussian"):
-        np.testing.assert_allclose(getattr(r, field)[far], getattr(reference, field)[index],
-                                   rtol=tolerance, atol=tolerance * scale, err_msg=field)
+        np.testing.assert_allclose(
+            getattr(r, field)[far],
+            getattr(reference, field)[index],
+            rtol=tolerance,
+            atol=tolerance * scale,
+            err_msg=field,
+        )
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -180,8 +190,9 @@ def test_a_vertex_of_valence_1000(method):
             # the apexes' balls (the rim at 1.41, nothing nearer) hold both cones: no height function
             warnings.filterwarnings("ignore", "quadric: .* pass a (larger|smaller) `radius`", MeshQualityWarning)
         if method == "normal_cycle_ball":  # 1.5 is about one spoke (1.41, the median edge): named as small
-            warnings.filterwarnings("ignore", "normal_cycle_ball: `radius` 1.5 is 1.1 of the median edge length",
-                                    MeshQualityWarning)
+            warnings.filterwarnings(
+                "ignore", "normal_cycle_ball: `radius` 1.5 is 1.1 of the median edge length", MeshQualityWarning
+            )
         r = meshcurv.principal_curvatures(vertices, faces, method=method, **radius)
     assert r.diagnosis.is_clean and r.diagnosis.genus == 0
     for apex in (n, n + 1):

@@ -50,8 +50,16 @@ def cases() -> list[Dirty]:
     # non-manifold edge: a fin on edge (a, b) of face 0
     a, b, c = F[star[0]]
     tip = (V[a] + V[b]) / 2 + 0.5 * EDGE * (V[a] - TORUS.vertices.mean(0)) / np.linalg.norm(V[a])
-    out.append(Dirty("fin", np.vstack([V, tip]), np.vstack([F, [[a, b, n]]]), np.array([a, b]),
-                     np.append(ident, -1), "nonmanifold"))
+    out.append(
+        Dirty(
+            "fin",
+            np.vstack([V, tip]),
+            np.vstack([F, [[a, b, n]]]),
+            np.array([a, b]),
+            np.append(ident, -1),
+            "nonmanifold",
+        )
+    )
 
     # bow-tie vertex: a small closed icosahedron touching the torus at p from outside
     ico = shapes.icosphere(1, radius=0.4 * EDGE)
@@ -60,8 +68,16 @@ def cases() -> list[Dirty]:
     others = np.arange(ico.vertices.shape[0]) != touch
     new_index = np.full(ico.vertices.shape[0], p)
     new_index[others] = n + np.arange(others.sum())
-    out.append(Dirty("bowtie", np.vstack([V, small[others]]), np.vstack([F, new_index[ico.faces]]),
-                     np.array([p]), np.append(ident, -np.ones(others.sum(), int)), "bowtie"))
+    out.append(
+        Dirty(
+            "bowtie",
+            np.vstack([V, small[others]]),
+            np.vstack([F, new_index[ico.faces]]),
+            np.array([p]),
+            np.append(ident, -np.ones(others.sum(), int)),
+            "bowtie",
+        )
+    )
 
     # inconsistently oriented faces: two faces of the star reversed
     flipped = F.copy()
@@ -90,19 +106,37 @@ def cases() -> list[Dirty]:
     from meshcurv.topology import MeshTopology
 
     seam = MeshTopology.from_faces(cut, n + 1).boundary_vertices
-    out.append(Dirty("coincident", np.vstack([V, V[p]]), cut, np.flatnonzero(seam),
-                     np.append(ident, p), "boundary"))
+    out.append(Dirty("coincident", np.vstack([V, V[p]]), cut, np.flatnonzero(seam), np.append(ident, p), "boundary"))
 
     # unreferenced vertices, in the middle and at the end
     middle = np.vstack([V[:5], [[100.0, 100.0, 100.0]], V[5:]])
-    out.append(Dirty("unreferenced_middle", middle, np.where(F >= 5, F + 1, F), np.array([5]),
-                     np.concatenate([ident[:5], [-1], ident[5:]]), "unreferenced"))
-    out.append(Dirty("unreferenced_end", np.vstack([V, [0.0, 0.0, 0.0]]), F, np.array([n]),
-                     np.append(ident, -1), "unreferenced"))
+    out.append(
+        Dirty(
+            "unreferenced_middle",
+            middle,
+            np.where(F >= 5, F + 1, F),
+            np.array([5]),
+            np.concatenate([ident[:5], [-1], ident[5:]]),
+            "unreferenced",
+        )
+    )
+    out.append(
+        Dirty(
+            "unreferenced_end", np.vstack([V, [0.0, 0.0, 0.0]]), F, np.array([n]), np.append(ident, -1), "unreferenced"
+        )
+    )
 
     # several components: a sphere far away
     sphere = shapes.icosphere(2, radius=5.0, center=(200.0, 0.0, 0.0))
-    out.append(Dirty("components", np.vstack([V, sphere.vertices]), np.vstack([F, sphere.faces + n]),
-                     np.array([], dtype=int), np.append(ident, -np.ones(sphere.vertices.shape[0], int)),
-                     "clean", warns=False))
+    out.append(
+        Dirty(
+            "components",
+            np.vstack([V, sphere.vertices]),
+            np.vstack([F, sphere.faces + n]),
+            np.array([], dtype=int),
+            np.append(ident, -np.ones(sphere.vertices.shape[0], int)),
+            "clean",
+            warns=False,
+        )
+    )
     return out

@@ -16,13 +16,16 @@ import meshcurv
 from meshcurv.errors import MeshQualityWarning
 from meshcurv.estimators import ESTIMATORS
 
-FOLDER = pathlib.Path(os.environ.get("MESHCURV_SHARED_MESHES",
-                                     pathlib.Path(__file__).resolve().parents[2] / "shared" / "meshes"))
+FOLDER = pathlib.Path(
+    os.environ.get("MESHCURV_SHARED_MESHES", pathlib.Path(__file__).resolve().parents[2] / "shared" / "meshes")
+)
 MESHES = sorted(FOLDER.glob("*.obj")) if FOLDER.is_dir() else []
 
-pytestmark = [pytest.mark.slow,
-              pytest.mark.skipif(not os.environ.get("MESHCURV_RUN_SLOW"), reason="slow: set MESHCURV_RUN_SLOW=1"),
-              pytest.mark.skipif(not MESHES, reason=f"no shared meshes at {FOLDER}")]
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(not os.environ.get("MESHCURV_RUN_SLOW"), reason="slow: set MESHCURV_RUN_SLOW=1"),
+    pytest.mark.skipif(not MESHES, reason=f"no shared meshes at {FOLDER}"),
+]
 
 
 @pytest.fixture(scope="module", params=[p.name for p in MESHES] or ["none"])

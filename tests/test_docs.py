@@ -16,9 +16,21 @@ GUIDE = DOCS / "guide"
 PAGES = sorted(GUIDE.glob("*.md"))
 
 # the pages of the guide the README's list names (other pages may join through the toctree's glob)
-NAMED = ["methods", "meshes", "label_images", "point_clouds", "integrals", "batch", "files", "cli", "speed",
-         "matgeom", "development", "worked_example_cells",
-         "label_statistics"]
+NAMED = [
+    "methods",
+    "meshes",
+    "label_images",
+    "point_clouds",
+    "integrals",
+    "batch",
+    "files",
+    "cli",
+    "speed",
+    "matgeom",
+    "development",
+    "worked_example_cells",
+    "label_statistics",
+]
 
 # the modules beyond the core that the examples of a page need (skipped without them)
 NEEDS = {
@@ -57,8 +69,11 @@ SLOW_PAGES = {"files", "label_images"}
 
 
 def _pages_with_examples():
-    return [pytest.param(page.stem, marks=[pytest.mark.slow] if page.stem in SLOW_PAGES else [])
-            for page in PAGES if ">>> " in page.read_text(encoding="utf-8")]
+    return [
+        pytest.param(page.stem, marks=[pytest.mark.slow] if page.stem in SLOW_PAGES else [])
+        for page in PAGES
+        if ">>> " in page.read_text(encoding="utf-8")
+    ]
 
 
 @pytest.mark.parametrize("name", _pages_with_examples())
@@ -84,8 +99,11 @@ def test_make_docs_builds_without_a_warning(tmp_path):
     source = tmp_path / "docs"
     shutil.copytree(DOCS, source, ignore=shutil.ignore_patterns("_build", "api"))
     shutil.copy(ROOT / "README.md", tmp_path / "README.md")
-    result = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-b", "html", "-q", str(source),
-                             str(tmp_path / "html")], capture_output=True, text=True)
+    result = subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-b", "html", "-q", str(source), str(tmp_path / "html")],
+        capture_output=True,
+        text=True,
+    )
     assert result.returncode == 0, result.stderr
     built = {path.stem for path in (tmp_path / "html" / "guide").glob("*.html")}
     assert built >= set(NAMED)

@@ -78,8 +78,7 @@ def test_a_double_sided_triangle_soup_is_welded_then_made_one_sided():
 
 def test_an_open_double_sided_patch_keeps_its_boundary():
     # a hemisphere-like cap of the sphere, both sides: its rim edges have 2 faces, its inner edges 4
-    used, cap = np.unique(SPHERE.faces[(SPHERE.vertices[SPHERE.faces][:, :, 2] > 0.5).all(axis=1)],
-                          return_inverse=True)
+    used, cap = np.unique(SPHERE.faces[(SPHERE.vertices[SPHERE.faces][:, :, 2] > 0.5).all(axis=1)], return_inverse=True)
     cap, vertices = cap.reshape(-1, 3), SPHERE.vertices[used]
     one = meshcurv.principal_curvatures(vertices, cap, method="icc")
     result, message = one_warning(vertices, stacked(cap), method="icc")
@@ -130,8 +129,9 @@ def test_the_batch_table_totals_a_double_sided_sphere_once(tmp_path):
     lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in SPHERE.vertices]
     lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in stacked(SPHERE.faces)]
     source.write_text("\n".join(lines) + "\n")
-    row = batch.process_mesh(source, tmp_path / "out" / "double.npz", tmp_path / "out" / ".double.json",
-                             method="normal_cycle")
+    row = batch.process_mesh(
+        source, tmp_path / "out" / "double.npz", tmp_path / "out" / ".double.json", method="normal_cycle"
+    )
     assert row["status"] == "computed", row
     assert row["total_gaussian"] == pytest.approx(4 * np.pi, abs=1e-9)
     assert row["n_invalid"] == 0
@@ -139,6 +139,7 @@ def test_the_batch_table_totals_a_double_sided_sphere_once(tmp_path):
 
 
 # ---- closed parts stored twice, with vertices of their own (coincident copies) ----
+
 
 def _stored_twice(mesh, *, reverse: bool, seed: int = 0):
     """``mesh`` and a coincident copy: its vertices shuffled and moved by round-off, its faces in another order."""
@@ -150,8 +151,7 @@ def _stored_twice(mesh, *, reverse: bool, seed: int = 0):
     copy_faces = inverse[mesh.faces][rng.permutation(mesh.faces.shape[0])]
     if reverse:
         copy_faces = copy_faces[:, ::-1]
-    return (np.vstack([mesh.vertices, copy_vertices]), np.vstack([mesh.faces, copy_faces + n]),
-            permutation)
+    return (np.vstack([mesh.vertices, copy_vertices]), np.vstack([mesh.faces, copy_faces + n]), permutation)
 
 
 @pytest.mark.parametrize("reverse", [False, True])
@@ -160,7 +160,9 @@ def test_a_closed_part_stored_twice_is_measured_once(method, reverse):
     sphere = shapes.icosphere(3, radius=2.0)
     vertices, faces, permutation = _stored_twice(sphere, reverse=reverse)
     n = sphere.vertices.shape[0]
-    with pytest.warns(meshcurv.errors.MeshQualityWarning, match=rf"closed parts stored twice.*\({n} vertices of copies\)"):
+    with pytest.warns(
+        meshcurv.errors.MeshQualityWarning, match=rf"closed parts stored twice.*\({n} vertices of copies\)"
+    ):
         result = meshcurv.principal_curvatures(vertices, faces, method=method)
     assert result.parameters["n_copy_vertices"] == n
     assert result.valid.all()
@@ -182,7 +184,9 @@ def test_near_copies_and_distinct_parts_are_not_merged():
     vertices = np.vstack([sphere.vertices, moved])
     faces = np.vstack([sphere.faces, sphere.faces + sphere.vertices.shape[0]])
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", meshcurv.errors.MeshQualityWarning)  # two intersecting spheres: other warnings may come
+        warnings.simplefilter(
+            "ignore", meshcurv.errors.MeshQualityWarning
+        )  # two intersecting spheres: other warnings may come
         result = meshcurv.principal_curvatures(vertices, faces)
     assert result.parameters["n_copy_vertices"] == 0
     assert result.integral("gaussian") == pytest.approx(8.0 * np.pi, rel=1e-9)

@@ -206,8 +206,10 @@ def test_icc_noise_level_is_measured_at_the_local_resolution():
     faces = np.vstack([small.faces, big.faces + small.vertices.shape[0]])
     r = meshcurv.principal_curvatures(vertices, faces, method="icc")
     # two components of scales 1000x apart: each is measured and summed at its own edge length
-    edge_lengths = [meshcurv.geometry.mean_edge_length(mesh.vertices, meshcurv.MeshTopology.from_faces(mesh.faces).edges)
-                    for mesh in (small, big)]
+    edge_lengths = [
+        meshcurv.geometry.mean_edge_length(mesh.vertices, meshcurv.MeshTopology.from_faces(mesh.faces).edges)
+        for mesh in (small, big)
+    ]
     assert max(r.parameters["noise"]) < radius_rules.NOISE_FLOOR
     np.testing.assert_allclose(r.parameters["radius"], edge_lengths, rtol=1e-12)
     n = small.vertices.shape[0]
@@ -289,9 +291,15 @@ def test_segment_in_ball_lengths_are_exact():
 
 
 def exact_result(mesh):
-    return meshcurv.CurvatureResult(k_min=mesh.k_min, k_max=mesh.k_max, dir_min=mesh.dir_min,
-                                    dir_max=mesh.dir_max, normals=mesh.normals,
-                                    valid=np.ones(mesh.k_min.shape, bool), method="exact")
+    return meshcurv.CurvatureResult(
+        k_min=mesh.k_min,
+        k_max=mesh.k_max,
+        dir_min=mesh.dir_min,
+        dir_max=mesh.dir_max,
+        normals=mesh.normals,
+        valid=np.ones(mesh.k_min.shape, bool),
+        method="exact",
+    )
 
 
 def test_shape_index_sign_convention_on_exact_curvatures():
@@ -304,9 +312,15 @@ def test_shape_index_sign_convention_on_exact_curvatures():
     np.testing.assert_allclose(exact_result(tube).curvedness, 0.5 / np.sqrt(2))
     centre = np.argmin(np.linalg.norm(saddle.vertices[:, :2], axis=1))
     assert abs(exact_result(saddle).shape_index[centre]) < 1e-12
-    inside_out = meshcurv.CurvatureResult(k_min=-tube.k_max, k_max=-tube.k_min, dir_min=tube.dir_max,
-                                          dir_max=tube.dir_min, normals=-tube.normals,
-                                          valid=np.ones(tube.k_min.shape, bool), method="exact")
+    inside_out = meshcurv.CurvatureResult(
+        k_min=-tube.k_max,
+        k_max=-tube.k_min,
+        dir_min=tube.dir_max,
+        dir_max=tube.dir_min,
+        normals=-tube.normals,
+        valid=np.ones(tube.k_min.shape, bool),
+        method="exact",
+    )
     np.testing.assert_allclose(inside_out.shape_index, -0.5)
 
 
@@ -320,9 +334,15 @@ def test_estimated_shape_index_follows_the_faces(method):
 
 
 def test_shape_index_is_nan_where_flat():
-    flat = meshcurv.CurvatureResult(k_min=[0.0, -1.0], k_max=[0.0, 1.0], dir_min=np.zeros((2, 3)),
-                                    dir_max=np.zeros((2, 3)), normals=np.zeros((2, 3)), valid=[True, True],
-                                    method="test")
+    flat = meshcurv.CurvatureResult(
+        k_min=[0.0, -1.0],
+        k_max=[0.0, 1.0],
+        dir_min=np.zeros((2, 3)),
+        dir_max=np.zeros((2, 3)),
+        normals=np.zeros((2, 3)),
+        valid=[True, True],
+        method="test",
+    )
     assert np.isnan(flat.shape_index[0]) and flat.shape_index[1] == 0.0
     with pytest.raises(ValueError, match="read-only"):
         flat.shape_index[0] = 1.0

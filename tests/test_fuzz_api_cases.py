@@ -34,8 +34,10 @@ def _only_documented_warnings():
 
 # --- MeshTopology.from_faces: n_vertices is not checked ---------------------------------------
 
-@pytest.mark.parametrize("n_vertices", ["7", 2**63, 10**400, np.uint64(2**63)], ids=["str", "2**63", "10**400",
-                                                                                    "uint64"])
+
+@pytest.mark.parametrize(
+    "n_vertices", ["7", 2**63, 10**400, np.uint64(2**63)], ids=["str", "2**63", "10**400", "uint64"]
+)
 def test_from_faces_refuses_an_unusable_vertex_count(sphere, n_vertices):
     with pytest.raises(DOCUMENTED, match="n_vertices"):
         meshcurv.MeshTopology.from_faces(sphere.faces, n_vertices)
@@ -48,16 +50,20 @@ def test_from_faces_refuses_an_index_far_beyond_the_faces():
 
 # --- triangulate_faces: no validation at all ---------------------------------------------------
 
-@pytest.mark.parametrize("polygons", [
-    pytest.param(np.array([0, 1, 2]), id="flat"),
-    pytest.param(5, id="int"),
-    pytest.param("abc", id="str"),
-    pytest.param([[0, 1]], id="two-corners"),
-    pytest.param([[]], id="empty-face"),
-    pytest.param([[0, 1, 2.5]], id="float-index"),
-    pytest.param([[2**64, 0, 1]], id="beyond-int64"),
-    pytest.param([[-1, 0, 1]], id="negative"),
-])
+
+@pytest.mark.parametrize(
+    "polygons",
+    [
+        pytest.param(np.array([0, 1, 2]), id="flat"),
+        pytest.param(5, id="int"),
+        pytest.param("abc", id="str"),
+        pytest.param([[0, 1]], id="two-corners"),
+        pytest.param([[]], id="empty-face"),
+        pytest.param([[0, 1, 2.5]], id="float-index"),
+        pytest.param([[2**64, 0, 1]], id="beyond-int64"),
+        pytest.param([[-1, 0, 1]], id="negative"),
+    ],
+)
 def test_triangulate_faces_refuses_what_is_not_polygons(polygons):
     with pytest.raises(InvalidMeshError, match="faces|polygons"):
         meshcurv.triangulate_faces(polygons)
@@ -73,6 +79,7 @@ def test_triangulate_faces_of_a_topology(sphere):
 
 
 # --- geometry: public functions that do not check their arguments ------------------------------
+
 
 def test_vertex_length_scales_refuses_a_face_array(sphere):
     with pytest.raises(InvalidMeshError, match="topology"):
@@ -96,6 +103,7 @@ def test_geometry_of_huge_coordinates_is_finite_or_refused(sphere, name):
 
 
 # --- numpy RuntimeWarnings escaping from the library (errors under -W error) -------------------
+
 
 @pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
 def test_spike_on_an_open_mesh_raises_no_runtime_warning(method):
@@ -137,6 +145,7 @@ def test_point_cloud_of_two_scales_raises_no_runtime_warning():
 
 # --- unreferenced points change the default radius of voxel surfaces -------------------------
 
+
 @pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
 def test_unreferenced_points_leave_a_voxel_surface_unchanged(method):
     pytest.importorskip("skimage")
@@ -155,6 +164,7 @@ def test_unreferenced_points_leave_a_voxel_surface_unchanged(method):
 
 # --- point clouds: a part at 1e-200 on the NumPy path -----------------------------------------
 
+
 @pytest.mark.parametrize("method", ["jets", "corrected_measures"])
 def test_point_cloud_with_a_vanishing_part_on_the_numpy_path(monkeypatch, method):
     monkeypatch.setenv("MESHCURV_BACKEND", "numpy")
@@ -172,6 +182,7 @@ def test_point_cloud_with_a_vanishing_part_on_the_numpy_path(monkeypatch, method
 
 
 # --- diagnose: coordinates beyond the documented range ----------------------------------------
+
 
 def test_diagnose_of_a_huge_spike_is_finite_or_refused(sphere):
     vertices = sphere.vertices.copy()
@@ -211,8 +222,9 @@ def test_ctrl_c_in_a_ball_kernel_is_a_keyboard_interrupt():
     import time
 
     pytest.importorskip("numba")
-    child = subprocess.Popen([sys.executable, "-c", _INTERRUPTED], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                             text=True)
+    child = subprocess.Popen(
+        [sys.executable, "-c", _INTERRUPTED], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
     try:
         assert child.stdout.readline().strip() == "ready"
         time.sleep(2.0)  # inside the jet fits (about 6 s for 16002 vertices with this radius)
@@ -226,6 +238,7 @@ def test_ctrl_c_in_a_ball_kernel_is_a_keyboard_interrupt():
 
 
 # --- per-component length scales: a last component with no edge ---------------------------------
+
 
 def _two_scales_and_a_collapsed_face():
     """Two spheres (radius 1 and 1000: per-component scales) and a face (a, a, a) on a vertex of its own."""
@@ -243,7 +256,7 @@ def test_length_scales_of_a_component_without_edges():
     n = (len(vertices) - 1) // 2
     edge = float(np.median(np.linalg.norm(vertices[faces[:n, 0]] - vertices[faces[:n, 1]], axis=1)))
     np.testing.assert_allclose(scales[:n], edge, rtol=0.05)
-    np.testing.assert_allclose(scales[n:2 * n], 1000.0 * edge, rtol=0.05)
+    np.testing.assert_allclose(scales[n : 2 * n], 1000.0 * edge, rtol=0.05)
     assert np.isfinite(scales[-1])
 
 
@@ -259,6 +272,7 @@ def test_curvatures_with_a_component_without_edges(method):
 
 # --- orient_faces and smooth_vertex_field: loosely taken arguments -----------------------------
 
+
 @pytest.mark.parametrize("outward", ["no", None, [True], 1], ids=["str", "None", "list", "int"])
 def test_orient_faces_refuses_a_non_bool_outward(sphere, outward):
     with pytest.raises(InvalidOptionError, match="outward"):
@@ -273,6 +287,7 @@ def test_smooth_vertex_field_refuses_complex_values(sphere):
 
 # --- a radius far below the edge length --------------------------------------------------------
 
+
 @pytest.mark.parametrize("radius, backend", [(1e-100, "auto"), (1e-100, "numpy"), (1e-300, "numpy")])
 def test_radius_far_below_the_edges_is_refused_or_invalid(monkeypatch, radius, backend):
     monkeypatch.setenv("MESHCURV_BACKEND", backend)
@@ -280,8 +295,9 @@ def test_radius_far_below_the_edges_is_refused_or_invalid(monkeypatch, radius, b
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", MeshcurvWarning)
-            result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball",
-                                                   radius=radius)
+            result = meshcurv.principal_curvatures(
+                sphere.vertices, sphere.faces, method="normal_cycle_ball", radius=radius
+            )
     except InvalidOptionError as error:
         assert "radius" in str(error)
         return
@@ -291,6 +307,7 @@ def test_radius_far_below_the_edges_is_refused_or_invalid(monkeypatch, radius, b
 
 
 # --- numpy warnings found by the run of seed 12 (after the fixes above) -------------------------
+
 
 def test_degenerate_face_mask_of_a_huge_scale_raises_no_overflow_warning():
     from meshcurv.geometry import degenerate_face_mask
@@ -331,10 +348,12 @@ def test_points_on_a_line_have_no_curvature():
     result = _mostly_on_a_line()
     assert not result.valid[:200].any()  # a line has no surface curvature
     assert {INVALID_REASONS[code] for code in result.invalid_reason[:200]} == {
-        next(text for text in INVALID_REASONS if text.startswith("point cloud: on a line"))}
+        next(text for text in INVALID_REASONS if text.startswith("point cloud: on a line"))
+    }
 
 
 # --- H^2 - K overflowed where the curvatures are near 1e200 (a mesh at 1e-200), seed 21 ---------------
+
 
 def test_principal_curvatures_from_h_and_k_do_not_overflow():
     from meshcurv._tensors import principal_from_mean_gaussian
@@ -380,13 +399,18 @@ def test_a_tiny_torus_with_a_far_spike_gives_no_numpy_warning(method):
 
 # --- a radius far below the edges gave valid but far-off curvatures without a word (seed 21, case 4720) ---
 
+
 @pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
 def test_a_radius_below_an_edge_is_named_in_the_warning(method):
     sphere = shapes.random_sphere(n_vertices=200)
-    median = float(np.median(np.linalg.norm(sphere.vertices[sphere.faces[:, 0]] - sphere.vertices[sphere.faces[:, 1]],
-                                            axis=1)))
-    with pytest.warns(meshcurv.MeshQualityWarning, match=r"`radius` 0\.05 is 0\.1\d of the median edge length .*: below "
-                                                          r"[\d.]+ edge lengths the balls hold too little of the surface"):
+    median = float(
+        np.median(np.linalg.norm(sphere.vertices[sphere.faces[:, 0]] - sphere.vertices[sphere.faces[:, 1]], axis=1))
+    )
+    with pytest.warns(
+        meshcurv.MeshQualityWarning,
+        match=r"`radius` 0\.05 is 0\.1\d of the median edge length .*: below "
+        r"[\d.]+ edge lengths the balls hold too little of the surface",
+    ):
         meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method, radius=0.05)
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")

@@ -61,8 +61,10 @@ def _defects():
     vertices[faces[0, 2]] = vertices[faces[0, 0]]  # two zero-area faces and a zero-length edge
     faces[100] = faces[100, ::-1]  # a flipped face: three inconsistently oriented edges
     faces = np.delete(faces, range(200, 206), axis=0)  # a hole: a boundary loop
-    extra = [[faces[50, 0], faces[50, 1], 0],  # a fin: a non-manifold edge
-             [faces[7, 1], faces[7, 1], faces[9, 2]]]  # a face repeating a vertex
+    extra = [
+        [faces[50, 0], faces[50, 1], 0],  # a fin: a non-manifold edge
+        [faces[7, 1], faces[7, 1], faces[9, 2]],
+    ]  # a face repeating a vertex
     top, bottom = np.argmax(vertices[:, 2]), np.argmin(vertices[:, 2])
     n = vertices.shape[0]
     other = sphere.faces + n
@@ -73,8 +75,7 @@ def _defects():
     # a lone triangle a thousand times smaller, far away: a second component of its own scale
     lone = 1e-3 * np.eye(3) + 10.0
     m = n + moved.shape[0] + 2
-    return (np.vstack([vertices, moved, unreferenced, lone]),
-            np.vstack([faces, extra, other, [[m, m + 1, m + 2]]]))
+    return (np.vstack([vertices, moved, unreferenced, lone]), np.vstack([faces, extra, other, [[m, m + 1, m + 2]]]))
 
 
 @functools.cache
@@ -115,8 +116,15 @@ def topology(name: str) -> MeshTopology:
     vertices, faces = mesh(name)
     with use_backend("numpy"):
         built = MeshTopology._build(faces, vertices.shape[0])
-        for attribute in ("bowtie_vertices", "neighbour_lists", "vertex_components", "n_components",
-                          "referenced_vertices", "degenerate_faces", "interior_edges"):
+        for attribute in (
+            "bowtie_vertices",
+            "neighbour_lists",
+            "vertex_components",
+            "n_components",
+            "referenced_vertices",
+            "degenerate_faces",
+            "interior_edges",
+        ):
             getattr(built, attribute)
     return built
 
@@ -156,8 +164,10 @@ def cloud(name: str) -> tuple[np.ndarray, np.ndarray]:
         normals = np.tile([0.0, 0.0, 1.0], (2000, 1))
     elif name == "degenerate_cloud":  # neighbourhoods without a unique normal: three lines, 15 copies of a point
         steps = np.arange(40)[:, None] * 0.01
-        lines = [steps * direction + 10.0 * k for k, direction in enumerate(([1.0, 2.0, 3.0], [0.0, 0.0, 1.0],
-                                                                             [1.0, -1.0, 0.0]))]
+        lines = [
+            steps * direction + 10.0 * k
+            for k, direction in enumerate(([1.0, 2.0, 3.0], [0.0, 0.0, 1.0], [1.0, -1.0, 0.0]))
+        ]
         points = np.vstack([*lines, np.tile([-20.0, 0.0, 0.0], (15, 1))])
         normals = np.tile([0.0, 0.0, 1.0], (points.shape[0], 1))
     else:
@@ -197,7 +207,8 @@ def assert_sums_close(actual, desired, magnitude, terms, err_msg="", *, relative
     excess = difference - bound[finite]
     assert (excess <= 0).all(), (
         f"{err_msg}: {int((excess > 0).sum())} entries beyond the bound; largest difference "
-        f"{difference.max():.3g} (bound there {bound[finite][np.argmax(excess)]:.3g})")
+        f"{difference.max():.3g} (bound there {bound[finite][np.argmax(excess)]:.3g})"
+    )
 
 
 def assert_directions_close(actual, desired, atol, err_msg="", *, up_to_sign=False):
@@ -212,8 +223,10 @@ def assert_directions_close(actual, desired, atol, err_msg="", *, up_to_sign=Fal
     difference = np.abs(actual - desired).max(axis=1)
     atol = np.broadcast_to(atol, difference.shape)
     bad = ~(difference <= atol)
-    assert not bad.any(), (f"{err_msg}: {int(bad.sum())} of {bad.size} rows differ; largest difference "
-                           f"{np.nanmax(difference):.3g}, tolerance there {atol[np.nanargmax(difference)]:.3g}")
+    assert not bad.any(), (
+        f"{err_msg}: {int(bad.sum())} of {bad.size} rows differ; largest difference "
+        f"{np.nanmax(difference):.3g}, tolerance there {atol[np.nanargmax(difference)]:.3g}"
+    )
 
 
 def atan2_branch(along, normals, atol):
@@ -259,8 +272,10 @@ def check_patch_volumes(name):
         got = kernels("orient").patch_volumes(vertices, faces, patch, flip, count)
         # each face's triple product a . (b x c) grouped otherwise (np.cross and einsum against one
         # expression): a few eps |a||b||c| apart, then the same terms summed in another order
-        centre = np.stack([np.bincount(patch, weights=vertices[faces[:, 0], k], minlength=count) for k in range(3)],
-                          axis=1) / np.maximum(np.bincount(patch, minlength=count), 1)[:, None]
+        centre = (
+            np.stack([np.bincount(patch, weights=vertices[faces[:, 0], k], minlength=count) for k in range(3)], axis=1)
+            / np.maximum(np.bincount(patch, minlength=count), 1)[:, None]
+        )
         sizes = np.prod([np.linalg.norm(vertices[faces[:, k]] - centre[patch], axis=1) for k in range(3)], axis=0)
         magnitude = 8 * np.bincount(patch, weights=sizes, minlength=count)
         for kind, a, b in (("signed", got[0], expected[0]), ("absolute", got[1], expected[1])):
@@ -329,8 +344,12 @@ def check_vertex_edge_lengths(name):
     # the lengths themselves differ by up to 2 eps (see check_edge_lengths): the means of at most
     # `degree` of them, rounded alike, within (degree + 2) eps
     degree = int(topology(name).vertex_degrees.max())
-    np.testing.assert_allclose(kernels("geometry").vertex_edge_lengths(vertices, edges, vertices.shape[0]),
-                               expected, rtol=(degree + 2) * EPS, atol=0)
+    np.testing.assert_allclose(
+        kernels("geometry").vertex_edge_lengths(vertices, edges, vertices.shape[0]),
+        expected,
+        rtol=(degree + 2) * EPS,
+        atol=0,
+    )
 
 
 def check_mean_edge_length(name):
@@ -368,8 +387,9 @@ def check_bowtie_vertices(name):
     # the inputs hold what they are meant to: the two spheres' contact, the fin's ends, the hole's pinches
     assert (expected.sum() > 1) if name == "defects" else not expected.any()
     linked = (top.edge_face_counts == 2) & (top.edge_faces[:, 0] != top.edge_faces[:, 1])  # as the wrapper
-    got = kernels("topology").bowtie_vertices(top.faces, top.face_edges, top.edge_faces, linked,
-                                              ~top.degenerate_faces, top.n_vertices)
+    got = kernels("topology").bowtie_vertices(
+        top.faces, top.face_edges, top.edge_faces, linked, ~top.degenerate_faces, top.n_vertices
+    )
     np.testing.assert_array_equal(got, expected)
 
 
@@ -420,8 +440,9 @@ def check_degenerate_faces(name):
     # (einsum's), which could only matter for an area within an ulp of the threshold: none here
     # (the zero-area faces are exactly 0, the others far above 1e-12 of the squared scale)
     np.testing.assert_array_equal(compiled(vertices, top.faces, scales, DEGENERATE_AREA_RATIO), expected)
-    np.testing.assert_array_equal(compiled(vertices, top.faces, np.full(top.n_vertices, 0.5), DEGENERATE_AREA_RATIO),
-                                  one_scale)
+    np.testing.assert_array_equal(
+        compiled(vertices, top.faces, np.full(top.n_vertices, 0.5), DEGENERATE_AREA_RATIO), one_scale
+    )
 
 
 def check_long_edges(name):
@@ -451,8 +472,8 @@ def check_mesh_facts(name):
         facts = diagnosis.diagnose(vertices, top)
         cross = face_cross_products(vertices, faces)
     lower, upper, area, six_volume, mean, n_degenerate, n_zero_length = kernels("diagnosis").mesh_facts(
-        vertices, faces, top.edges, top.referenced_vertices, scales, DEGENERATE_AREA_RATIO,
-        diagnosis.ZERO_LENGTH_RATIO)
+        vertices, faces, top.edges, top.referenced_vertices, scales, DEGENERATE_AREA_RATIO, diagnosis.ZERO_LENGTH_RATIO
+    )
     # minima, maxima and counts are exact; the three sums are parallel reductions in another order
     np.testing.assert_array_equal(lower, facts.bounding_box[0])
     np.testing.assert_array_equal(upper, facts.bounding_box[1])
@@ -461,8 +482,9 @@ def check_mesh_facts(name):
     double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
     assert_sums_close(area, facts.area, 0.5 * double_areas.sum(), faces.shape[0], "area")
     n_edges = top.edges.shape[0]
-    assert_sums_close(mean * n_edges, facts.mean_edge_length * n_edges, facts.mean_edge_length * n_edges, n_edges,
-                      "mean edge length")
+    assert_sums_close(
+        mean * n_edges, facts.mean_edge_length * n_edges, facts.mean_edge_length * n_edges, n_edges, "mean edge length"
+    )
     if facts.volume is not None:
         # each term (a - centre) . cross: the centre itself is a sum of V coordinates in another
         # order (a relative error of V eps in it), hence V + F terms
@@ -490,8 +512,9 @@ def numpy_normal_cycle(name, monkeypatch, steps):
 
     with use_backend("numpy"), monkeypatch.context() as patch:
         patch.setattr(normal_cycle, "smooth_vertex_field", record)
-        result, _ = normal_cycle.estimate(PreparedMesh.as_given(vertices, topology(name)), smoothing_steps=steps,
-                                          stages=Stages(normal_cycle.STAGES))
+        result, _ = normal_cycle.estimate(
+            PreparedMesh.as_given(vertices, topology(name)), smoothing_steps=steps, stages=Stages(normal_cycle.STAGES)
+        )
     assert len(seen) == 1, "normal_cycle.estimate no longer smooths its sums in one call: update this test"
     return result, seen[0]
 
@@ -503,9 +526,17 @@ def compiled_normal_cycle_sums(name):
     top = topology(name)
     with use_backend("numpy"):
         scales = vertex_length_scales(vertices, top)
-    return kernels("normal_cycle").normal_cycle_sums(vertices, top.faces, top.edges, top.edge_faces,
-                                                    top.edge_face_counts, top._edge_forward_counts, scales,
-                                                    DEGENERATE_AREA_RATIO, kernel_threads())
+    return kernels("normal_cycle").normal_cycle_sums(
+        vertices,
+        top.faces,
+        top.edges,
+        top.edge_faces,
+        top.edge_face_counts,
+        top._edge_forward_counts,
+        scales,
+        DEGENERATE_AREA_RATIO,
+        kernel_threads(),
+    )
 
 
 def check_normal_cycle_sums(name, monkeypatch):
@@ -552,7 +583,8 @@ def check_normal_cycle_finish(name, monkeypatch):
     given = np.ascontiguousarray(np.column_stack([measures, sums[:, 7:]]))
     indptr, indices = top.neighbour_lists
     k_min, k_max, dir_min, dir_max, normals, valid = kernels("normal_cycle").normal_cycle_finish(
-        given, invalid, indptr, indices, steps)
+        given, invalid, indptr, indices, steps
+    )
     np.testing.assert_array_equal(valid, result.valid)
     np.testing.assert_array_equal(normals, result.normals)
     # Each smoothing pass adds a vertex's (degree + 1) values in another order (the sparse product:
@@ -616,8 +648,9 @@ def check_principal_from_shape_operator(name):
     for rotate in (False, True):
         for mean_from_trace in (False, True):
             with use_backend("numpy"):
-                expected = _tensors.principal_from_shape_operator(tensor, normals, rotate=rotate,
-                                                                  mean_from_trace=mean_from_trace)
+                expected = _tensors.principal_from_shape_operator(
+                    tensor, normals, rotate=rotate, mean_from_trace=mean_from_trace
+                )
             got = kernels("tensors").principal_from_shape_operator(tensor, normals, rotate, mean_from_trace)
             label = f"rotate={rotate}, mean_from_trace={mean_from_trace}"
             # the frame and T t are the same operations; einsum's three-term dots (a, b, c) add in
@@ -628,7 +661,8 @@ def check_principal_from_shape_operator(name):
                 np.testing.assert_array_equal(np.isnan(got_k), np.isnan(expected_k))
                 finite = ~np.isnan(expected_k)
                 assert (np.abs(got_k - expected_k)[finite] <= 8 * EPS * magnitude[finite]).all(), (
-                    f"{label}, k {k}: largest difference {np.nanmax(np.abs(got_k - expected_k)):.3g}")
+                    f"{label}, k {k}: largest difference {np.nanmax(np.abs(got_k - expected_k)):.3g}"
+                )
             gap = expected[1] - expected[0]
             finite = np.isfinite(gap)
             umbilic = gap[finite] == 0  # theta = atan2(0, 0) = 0 on both sides: the same frame
@@ -664,8 +698,9 @@ def check_matgeom_vertex_tensors(name):
     vertices, faces = mesh(name)
     ev1, ev2, ef1, ef2, out_of_range = matgeom_pairing_of(name)
     assert out_of_range.any() == (name == "defects")
-    expected = _vertex_tensors(vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1),
-                               np.where(out_of_range, 0, ef2), out_of_range)
+    expected = _vertex_tensors(
+        vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1), np.where(out_of_range, 0, ef2), out_of_range
+    )
     got = kernels("matgeom").matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, kernel_threads())
     # each edge's term is the same operations in the same order (Octave's), except that (1) the mean
     # edge length is NumPy's pairwise sum against the kernel's loop, within E eps of each other: the
@@ -689,8 +724,9 @@ def check_matgeom_principal(name):
     top = topology(name)
     with use_backend("numpy"):
         tensors, *_ = matgeom.matgeom_tensors(vertices, top, 3)
-        result, _ = matgeom.estimate(PreparedMesh.as_given(vertices, top), smoothing_steps=3,
-                                     stages=Stages(matgeom.STAGES))
+        result, _ = matgeom.estimate(
+            PreparedMesh.as_given(vertices, top), smoothing_steps=3, stages=Stages(matgeom.STAGES)
+        )
     c1, c2, u1, u2, normal = kernels("matgeom").matgeom_principal(np.ascontiguousarray(tensors))
     # cyclic Jacobi against LAPACK's eigh: both backward stable, eigenvalues within p eps |T| (Frobenius)
     # with a small p (at most 6 on these meshes: 16 leaves a margin); eigenvectors within that over the
@@ -714,8 +750,11 @@ def check_matgeom_principal(name):
     # all three eigenvalues apart (the vectors then defined up to sign) and not a zero tensor
     separated = np.isfinite(gaps) & (gaps > 1e6 * EPS * frobenius)
     assert separated.sum() > (0 if name in ("icosphere", "noisy") else tensors.shape[0] // 2)
-    for label, got, expected in (("u1", u1, result.dir_min), ("u2", u2, result.dir_max),
-                                 ("normal", normal, result.normals)):
+    for label, got, expected in (
+        ("u1", u1, result.dir_min),
+        ("u2", u2, result.dir_max),
+        ("normal", normal, result.normals),
+    ):
         np.testing.assert_array_equal(np.isnan(got), np.isnan(expected), err_msg=label)
         assert_directions_close(got[separated], expected[separated], atol[separated], label, up_to_sign=True)
 
@@ -757,8 +796,9 @@ def check_smooth_over_neighbours(name):
         # neighbours, then the vertex; the kernel: the vertex, then its neighbours) and scales them
         # alike: within 2 (degree + 1) eps of the largest |value| per pass
         assert_sums_close(got, expected, magnitude, steps * (degree + 1), f"{steps} passes")
-        got_flat = kernels("smoothing").smooth_over_neighbours(np.ascontiguousarray(field[:, :1]), indptr, indices,
-                                                               steps)[:, 0]
+        got_flat = kernels("smoothing").smooth_over_neighbours(
+            np.ascontiguousarray(field[:, :1]), indptr, indices, steps
+        )[:, 0]
         assert_sums_close(got_flat, expected_flat, magnitude[0], steps * (degree + 1), f"{steps} passes, (V,)")
 
 
@@ -793,11 +833,17 @@ def check_face_measures(name):
     mean = np.linalg.norm(normals[faces].mean(axis=1), axis=1)
     x01, x02 = np.linalg.norm(x1 - x0, axis=1), np.linalg.norm(x2 - x0, axis=1)
     corners = normals[faces]
-    magnitude = 0.5 * np.column_stack([
-        mean * np.linalg.norm(np.cross(x1 - x0, x2 - x0), axis=1),
-        mean * (np.linalg.norm(corners[:, 0] - corners[:, 2], axis=1) * x01
-                + np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1) * x02),
-        u0 * u1 * u2])
+    magnitude = 0.5 * np.column_stack(
+        [
+            mean * np.linalg.norm(np.cross(x1 - x0, x2 - x0), axis=1),
+            mean
+            * (
+                np.linalg.norm(corners[:, 0] - corners[:, 2], axis=1) * x01
+                + np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1) * x02
+            ),
+            u0 * u1 * u2,
+        ]
+    )
     assert_sums_close(got[:, :3], expected[:, :3], magnitude, 3)
 
 
@@ -832,8 +878,9 @@ def check_curvatures_from_measures(name):
     # the eigen-gap of the tangent restriction, d_max . T d_max - d_min . T d_min: a direction is within
     # a few eps of |T| / gap (its condition number); an umbilic (gap 0) is the same frame on both sides
     d_min, d_max = expected[2][finite], expected[3][finite]
-    gap = (np.einsum("ij,ij->i", d_max, apply6(tensor[finite], d_max))
-           - np.einsum("ij,ij->i", d_min, apply6(tensor[finite], d_min)))
+    gap = np.einsum("ij,ij->i", d_max, apply6(tensor[finite], d_max)) - np.einsum(
+        "ij,ij->i", d_min, apply6(tensor[finite], d_min)
+    )
     atol = np.where(gap > 0, 16 * EPS * magnitude[finite] / np.where(gap > 0, gap, 1.0), 4 * EPS)
     branch = atan2_branch(expected[3][finite], normals[finite], atol)
     for got_d, expected_d in zip(got[2:], expected[2:]):
@@ -889,8 +936,9 @@ def check_cell_centres(name):
             centres, reach = neighborhoods.cell_centres(vertices, cells)
         corners = vertices[cells]  # and the textbook formulas, to the bit on these meshes
         np.testing.assert_array_equal(centres, corners.mean(axis=1), err_msg=kind)
-        np.testing.assert_array_equal(reach, np.linalg.norm(corners - centres[:, None, :], axis=2).max(axis=1),
-                                      err_msg=kind)
+        np.testing.assert_array_equal(
+            reach, np.linalg.norm(corners - centres[:, None, :], axis=2).max(axis=1), err_msg=kind
+        )
         got_centres, got_reach = kernels("neighborhoods").cell_centres(vertices, cells)
         # the corners added in order and divided by their count; three squares added in order
         np.testing.assert_array_equal(got_centres, centres, err_msg=kind)
@@ -911,11 +959,16 @@ def numpy_ball_sums(name, kind, values, radius, usable=None, *, connected=False)
     cells = cells_of(name, kind)
     with use_backend("numpy"):
         if kind == "faces":
-            return (neighborhoods.ball_face_sums(vertices, cells, radius, values, usable=usable, connected=connected),
-                    neighborhoods.ball_face_sums(vertices, cells, radius, np.abs(values), usable=usable,
-                                                 connected=connected))
-        return (neighborhoods.ball_edge_sums(vertices, cells, radius, values, usable=usable),
-                neighborhoods.ball_edge_sums(vertices, cells, radius, np.abs(values), usable=usable))
+            return (
+                neighborhoods.ball_face_sums(vertices, cells, radius, values, usable=usable, connected=connected),
+                neighborhoods.ball_face_sums(
+                    vertices, cells, radius, np.abs(values), usable=usable, connected=connected
+                ),
+            )
+        return (
+            neighborhoods.ball_edge_sums(vertices, cells, radius, values, usable=usable),
+            neighborhoods.ball_edge_sums(vertices, cells, radius, np.abs(values), usable=usable),
+        )
 
 
 def ball_terms(name, kind, radius):
@@ -939,8 +992,9 @@ def check_ball_cell_sums(name):
         expected, magnitude = numpy_ball_sums(name, kind, values, radius)
         centres, reach = compiled.cell_centres(vertices, cells)
         cutoff = radius + float(reach.max())  # one group of cells, searched with their largest reach
-        got = compiled.ball_cell_sums(vertices, cells, centres, values, radius, cutoff, 64 * kernel_threads(), 0,
-                                      vertices.shape[0])
+        got = compiled.ball_cell_sums(
+            vertices, cells, centres, values, radius, cutoff, 64 * kernel_threads(), 0, vertices.shape[0]
+        )
         # the same weights (face_in_ball_ratios / segment_in_ball_lengths: the same operations),
         # summed in grid order against the k-d tree's sparse product
         assert_sums_close(got, expected, magnitude, ball_terms(name, kind, radius), kind)
@@ -961,8 +1015,17 @@ def face_sum_inputs(name):
     compiled = kernels("neighborhoods")
     centres, reach = compiled.cell_centres(vertices, faces)
     n = vertices.shape[0]
-    return (vertices, faces, compiled, ball_values(name, "faces"), np.random.default_rng(4).random(faces.shape[0]) > 0.1,
-            centres, reach, n, *compiled.vertex_face_lists(faces, n, kernel_threads()))
+    return (
+        vertices,
+        faces,
+        compiled,
+        ball_values(name, "faces"),
+        np.random.default_rng(4).random(faces.shape[0]) > 0.1,
+        centres,
+        reach,
+        n,
+        *compiled.vertex_face_lists(faces, n, kernel_threads()),
+    )
 
 
 def check_connected_face_sums_per_vertex(name):
@@ -970,8 +1033,21 @@ def check_connected_face_sums_per_vertex(name):
     vertices, faces, compiled, values, usable, centres, reach, n, indptr, indices = face_sum_inputs(name)
     radii = np.random.default_rng(2).uniform(0.9, 2.5, n) * mean_edge(name)
     got = np.zeros((n, values.shape[1]))
-    compiled.connected_face_sums(vertices, faces, centres, reach, usable, values, radii, indptr, indices, got,
-                                 _face_sum_scratch(kernel_threads(), n, faces.shape[0]), 0, n)
+    compiled.connected_face_sums(
+        vertices,
+        faces,
+        centres,
+        reach,
+        usable,
+        values,
+        radii,
+        indptr,
+        indices,
+        got,
+        _face_sum_scratch(kernel_threads(), n, faces.shape[0]),
+        0,
+        n,
+    )
     expected, magnitude = numpy_ball_sums(name, "faces", values, radii, usable, connected=True)
     assert_sums_close(got, expected, magnitude, ball_terms(name, "faces", float(radii.max())), "a radius per vertex")
 
@@ -983,18 +1059,39 @@ def check_connected_face_sums_nested(name):
     h = mean_edge(name)
     per_vertex = np.random.default_rng(2).uniform(0.9, 2.5, n) * h
     sets = np.stack([values, -2.0 * values, values[::-1].copy()])  # one set of values per radius
-    for radii, given in ((per_vertex[None, :], values[None]), (np.array([0.5, 1.0, 2.0])[:, None] * per_vertex, sets),
-                         (np.array([[0.95], [2.0], [4.0]]) * h, values[None])):
+    for radii, given in (
+        (per_vertex[None, :], values[None]),
+        (np.array([0.5, 1.0, 2.0])[:, None] * per_vertex, sets),
+        (np.array([[0.95], [2.0], [4.0]]) * h, values[None]),
+    ):
         got = np.zeros((radii.shape[0], n, values.shape[1]))
-        compiled.connected_face_sums_nested(vertices, faces, centres, reach, usable, given, np.ascontiguousarray(radii),
-                                            indptr, indices, got,
-                                            _face_sum_scratch(kernel_threads(), n, faces.shape[0], radii.shape[0] > 1), 0, n)
+        compiled.connected_face_sums_nested(
+            vertices,
+            faces,
+            centres,
+            reach,
+            usable,
+            given,
+            np.ascontiguousarray(radii),
+            indptr,
+            indices,
+            got,
+            _face_sum_scratch(kernel_threads(), n, faces.shape[0], radii.shape[0] > 1),
+            0,
+            n,
+        )
         for r, row in enumerate(radii):
             radius = row[0] if row.size == 1 else row
-            expected, magnitude = numpy_ball_sums(name, "faces", given[r if given.shape[0] > 1 else 0], radius,
-                                                  usable, connected=True)
-            assert_sums_close(got[r], expected, magnitude, ball_terms(name, "faces", float(np.max(radius))),
-                              f"{radii.shape[0]} radii, row {r}")
+            expected, magnitude = numpy_ball_sums(
+                name, "faces", given[r if given.shape[0] > 1 else 0], radius, usable, connected=True
+            )
+            assert_sums_close(
+                got[r],
+                expected,
+                magnitude,
+                ball_terms(name, "faces", float(np.max(radius))),
+                f"{radii.shape[0]} radii, row {r}",
+            )
 
 
 def check_connected_face_sums_at(name, radius):
@@ -1012,21 +1109,39 @@ def check_connected_face_sums_at(name, radius):
         allowed = np.ones(faces.shape[0], dtype=bool) if mask is None else mask
         radii = np.array([radius])  # one radius for all vertices
         got = np.zeros_like(expected)
-        compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices, got,
-                                     _face_sum_scratch(kernel_threads(), n, faces.shape[0]), 0, n)
-        assert_sums_close(got, expected, magnitude, ball_terms(name, "faces", radius),
-                          "all faces" if mask is None else "usable faces")
+        compiled.connected_face_sums(
+            vertices,
+            faces,
+            centres,
+            reach,
+            allowed,
+            values,
+            radii,
+            indptr,
+            indices,
+            got,
+            _face_sum_scratch(kernel_threads(), n, faces.shape[0]),
+            0,
+            n,
+        )
+        assert_sums_close(
+            got, expected, magnitude, ball_terms(name, "faces", radius), "all faces" if mask is None else "usable faces"
+        )
         # ranges of centres, one scratch for all (as the calls of ball_face_sums): only their rows each time;
         # with the int64 scratch of meshes whose indices do not fit in int32 (this one's are int32)
         part = np.zeros_like(got)
-        scratch = tuple(a.astype(np.int64) if a.dtype == np.int32 else a for a in _face_sum_scratch(3, n, faces.shape[0]))
-        compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices, part,
-                                     scratch, n // 3, n // 2)
-        np.testing.assert_array_equal(part[n // 3:n // 2], got[n // 3:n // 2])
-        assert not part[:n // 3].any() and not part[n // 2:].any()
+        scratch = tuple(
+            a.astype(np.int64) if a.dtype == np.int32 else a for a in _face_sum_scratch(3, n, faces.shape[0])
+        )
+        compiled.connected_face_sums(
+            vertices, faces, centres, reach, allowed, values, radii, indptr, indices, part, scratch, n // 3, n // 2
+        )
+        np.testing.assert_array_equal(part[n // 3 : n // 2], got[n // 3 : n // 2])
+        assert not part[: n // 3].any() and not part[n // 2 :].any()
         for lo, hi in ((0, n // 3), (n // 2, n)):
-            compiled.connected_face_sums(vertices, faces, centres, reach, allowed, values, radii, indptr, indices,
-                                         part, scratch, lo, hi)
+            compiled.connected_face_sums(
+                vertices, faces, centres, reach, allowed, values, radii, indptr, indices, part, scratch, lo, hi
+            )
         np.testing.assert_array_equal(part, got)
 
 
@@ -1067,8 +1182,10 @@ def jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacen
 
     conditions = np.full(points.shape[0], np.nan)
     if adjacency is None:
-        balls = ((chunk, centre, pool[neighbour])
-                 for chunk, centre, neighbour in _ball_pairs(points[pool], points[centres], radius))
+        balls = (
+            (chunk, centre, pool[neighbour])
+            for chunk, centre, neighbour in _ball_pairs(points[pool], points[centres], radius)
+        )
     else:
         allowed = np.zeros(points.shape[0], dtype=bool)
         allowed[pool] = True
@@ -1106,9 +1223,10 @@ def compare_jets(got, expected, label, fit, adjacency=None):
     # then moves by the scaled matrix's condition number times that, relative to its size (Higham
     # 2002, sec. 7.1), and the second fit inherits the first one's error through its frame: the
     # larger of the two fits' condition numbers. Coefficients are in units of the radius.
-    conditions = np.fmax(jet_conditions(points, pool, centres, radius, [*tangent_basis(normals), normals], degree,
-                                        counts, adjacency),
-                         jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacency))
+    conditions = np.fmax(
+        jet_conditions(points, pool, centres, radius, [*tangent_basis(normals), normals], degree, counts, adjacency),
+        jet_conditions(points, pool, centres, radius, frame, degree, counts, adjacency),
+    )
     size = np.maximum(np.nan_to_num(np.abs(coefficients), nan=0.0).max(axis=1), 1.0)
     # where no fit was possible the frame is the first one: tangent_basis's operations, exact
     atol = np.where(np.isnan(conditions), 4 * EPS, conditions * np.maximum(counts, 1) * EPS * size)[centres]
@@ -1130,7 +1248,9 @@ def compare_jets(got, expected, label, fit, adjacency=None):
         six, fitted = jets.shape_operators(coefficients[other], [part[other] for part in frame], 1.0)
         got_six, got_fitted = jets.shape_operators(got_coefficients[other], [part[other] for part in got_frame], 1.0)
     assert_directions_close(got_fitted, fitted, atol[turned], f"{label}: jet normals (turned frames)")
-    assert_directions_close(got_six, six, atol[turned] * size[centres][turned], f"{label}: shape operators (turned frames)")
+    assert_directions_close(
+        got_six, six, atol[turned] * size[centres][turned], f"{label}: shape operators (turned frames)"
+    )
 
 
 def check_fit_jets(name):
@@ -1146,24 +1266,53 @@ def check_fit_jets(name):
     facing[rng.random(n) < 0.01] = np.nan  # and a few missing: not counted
     per_centre = radius * rng.uniform(1.0, 1.4, centres.size)  # a radius per centre (no smaller balls)
     areas = rng.uniform(0.5, 2.0, n)  # points weighted by their areas (a mesh whose sampling varies)
-    for degree, mask, check, radii, weights in ((4, None, False, radius, None), (3, pool_mask, True, radius, None),
-                                                (2, None, True, radius, None), (3, pool_mask, False, per_centre, None),
-                                                (3, pool_mask, True, radius, areas)):
+    for degree, mask, check, radii, weights in (
+        (4, None, False, radius, None),
+        (3, pool_mask, True, radius, None),
+        (2, None, True, radius, None),
+        (3, pool_mask, False, per_centre, None),
+        (3, pool_mask, True, radius, areas),
+    ):
         details = {}
         with use_backend("numpy"):
-            expected = jets.fit_jets(points, normals, radii, degree=degree, centres=centres, neighbours=mask,
-                                     facing=facing if check else None, details=details, areas=weights)
+            expected = jets.fit_jets(
+                points,
+                normals,
+                radii,
+                degree=degree,
+                centres=centres,
+                neighbours=mask,
+                facing=facing if check else None,
+                details=details,
+                areas=weights,
+            )
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
         by_vertex = spread(radii, centres, n, 0.0) if np.ndim(radii) else np.array([radius])
-        found = kernels("jets").fit_jets(points, normals, by_vertex, degree, jets.ITERATIONS,
-                                         jets._exponents(degree), jets.MIN_SPREAD, centres, 64 * kernel_threads(),
-                                         pool, facing if check else points, check, jets.AWAY_FRACTION, 0.0,
-                                         np.zeros(0) if weights is None else weights)
+        found = kernels("jets").fit_jets(
+            points,
+            normals,
+            by_vertex,
+            degree,
+            jets.ITERATIONS,
+            jets._exponents(degree),
+            jets.MIN_SPREAD,
+            centres,
+            64 * kernel_threads(),
+            pool,
+            facing if check else points,
+            check,
+            jets.AWAY_FRACTION,
+            0.0,
+            np.zeros(0) if weights is None else weights,
+        )
         coefficients, t1, t2, normal, counts, away = found
-        label = (f"degree {degree}, pool {'all' if mask is None else 'some'}, facing {check}, radii {np.size(radii)}, "
-                 f"areas {weights is not None}")
-        compare_jets((coefficients, (t1, t2, normal), counts), expected, label,
-                     (points, normals, radii, centres, pool, degree))
+        label = (
+            f"degree {degree}, pool {'all' if mask is None else 'some'}, facing {check}, radii {np.size(radii)}, "
+            f"areas {weights is not None}"
+        )
+        compare_jets(
+            (coefficients, (t1, t2, normal), counts), expected, label, (points, normals, radii, centres, pool, degree)
+        )
         # the shares facing away: the same counts divided alike
         np.testing.assert_array_equal(away, details["away"], err_msg=f"{label}: away")
         if check:
@@ -1190,28 +1339,63 @@ def check_fit_jets_connected(name):
     compiled = kernels("jets").fit_jets_connected
     per_centre = radius * rng.uniform(1.0, 1.4, centres.size)  # a radius per centre (no smaller balls)
     areas = rng.uniform(0.5, 2.0, n)
-    for degree, mask, check, radii, weights in ((4, None, False, radius, None), (3, allowed, True, radius, None),
-                                                (3, allowed, True, per_centre, None), (3, allowed, False, radius, areas)):
+    for degree, mask, check, radii, weights in (
+        (4, None, False, radius, None),
+        (3, allowed, True, radius, None),
+        (3, allowed, True, per_centre, None),
+        (3, allowed, False, radius, areas),
+    ):
         # the NumPy path's connected balls (the walk's, found by connected components of all balls at once)
         details = {}
         with use_backend("numpy"):
-            expected = jets.fit_jets(points, normals, radii, degree=degree, centres=centres, neighbours=mask,
-                                     facing=facing if check else None, details=details, adjacency=(indptr, indices),
-                                     areas=weights)
-        arguments = (points, normals, radii if np.ndim(radii) else np.array([radius]), degree, jets.ITERATIONS, jets._exponents(degree), jets.MIN_SPREAD,
-                     centres, kernel_threads(), np.ones(n, dtype=bool) if mask is None else mask, indptr, indices,
-                     facing if check else points, check, jets.AWAY_FRACTION)
+            expected = jets.fit_jets(
+                points,
+                normals,
+                radii,
+                degree=degree,
+                centres=centres,
+                neighbours=mask,
+                facing=facing if check else None,
+                details=details,
+                adjacency=(indptr, indices),
+                areas=weights,
+            )
+        arguments = (
+            points,
+            normals,
+            radii if np.ndim(radii) else np.array([radius]),
+            degree,
+            jets.ITERATIONS,
+            jets._exponents(degree),
+            jets.MIN_SPREAD,
+            centres,
+            kernel_threads(),
+            np.ones(n, dtype=bool) if mask is None else mask,
+            indptr,
+            indices,
+            facing if check else points,
+            check,
+            jets.AWAY_FRACTION,
+        )
         # one row per centre: spread to rows of all vertices (NaN, counts 0, elsewhere) as NumPy gives them
         extra = (0.0, np.zeros(0) if weights is None else weights)  # settled, areas
         rows = compiled(*arguments, False, *extra)
         assert all(row.shape[0] == centres.size for row in rows)
-        coefficients, t1, t2, normal, counts, away = (spread(row, centres, n, 0.0 if k == 4 else np.nan)
-                                                      for k, row in enumerate(rows))
-        label = (f"degree {degree}, {'all' if mask is None else 'some'} allowed, facing {check}, radii {np.size(radii)}, "
-                 f"areas {weights is not None}")
+        coefficients, t1, t2, normal, counts, away = (
+            spread(row, centres, n, 0.0 if k == 4 else np.nan) for k, row in enumerate(rows)
+        )
+        label = (
+            f"degree {degree}, {'all' if mask is None else 'some'} allowed, facing {check}, radii {np.size(radii)}, "
+            f"areas {weights is not None}"
+        )
         pool = np.arange(n) if mask is None else np.flatnonzero(mask)
-        compare_jets((coefficients, (t1, t2, normal), counts), expected, label,
-                     (points, normals, radii, centres, pool, degree), (indptr, indices))
+        compare_jets(
+            (coefficients, (t1, t2, normal), counts),
+            expected,
+            label,
+            (points, normals, radii, centres, pool, degree),
+            (indptr, indices),
+        )
         np.testing.assert_array_equal(away, details["away"], err_msg=f"{label}: away")
         # normals only: the unit normals of the same fits (jets.jet_normals), at the centres, NaN elsewhere;
         # frame-free, so compared everywhere, within the fits' tolerance (the coefficients' largest)
@@ -1252,8 +1436,10 @@ def check_pca_normals(name):
     assert line.sum() == (120 if name == "degenerate_cloud" else 0)
     for label, normal in (("numpy", expected), ("kernel", got)):
         along = np.abs(np.einsum("ij,ij->i", normal[line], vectors[line, :, 2]))
-        assert (along <= 1e-6).all(), (f"{label}: {int((along > 1e-6).sum())} of {line.sum()} normals of collinear "
-                                       f"neighbourhoods not orthogonal to their line (|n . d| up to {along.max():.3g})")
+        assert (along <= 1e-6).all(), (
+            f"{label}: {int((along > 1e-6).sum())} of {line.sum()} normals of collinear "
+            f"neighbourhoods not orthogonal to their line (|n . d| up to {along.max():.3g})"
+        )
 
 
 def check_ball_indices(name):
@@ -1270,8 +1456,9 @@ def check_ball_indices(name):
     for usable, k in ((np.ones(n, dtype=bool), 24), (rng.random(n) > 0.2, 96)):
         expected_index, expected_counts = _ball_indices(_usable_tree(tree, points, usable), points, centres, radius, k)
         grid = kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(radius))
-        index, squared, counts = kernels("pointcloud").ball_indices(points, centres, float(radius), k, *grid,
-                                                                    64 * kernel_threads())
+        index, squared, counts = kernels("pointcloud").ball_indices(
+            points, centres, float(radius), k, *grid, 64 * kernel_threads()
+        )
         # continuous random points: no two distances tie, so the nearest k are the same in the same order
         label = f"k={k}, {'all' if usable.all() else 'some'} usable"
         np.testing.assert_array_equal(counts, expected_counts, err_msg=label)
@@ -1284,16 +1471,22 @@ def check_ball_indices(name):
 
 
 def check_ball_triangle_sums(name):
-    from meshcurv._pointcloud_estimators import (MIN_BALL_POINTS, TRIANGLES, _distinct_ranks, _rank_pattern,
-                                                 _triangle_sums)
+    from meshcurv._pointcloud_estimators import (
+        MIN_BALL_POINTS,
+        TRIANGLES,
+        _distinct_ranks,
+        _rank_pattern,
+        _triangle_sums,
+    )
     from meshcurv.estimators.icc import face_measures
 
     points, normals = cloud(name)
     n = points.shape[0]
     radius = 0.4 if name == "ellipsoid_cloud" else 0.12
     grid = kernels("neighborhoods").pool_grid(points, np.arange(n), float(radius))
-    index, _, counts = kernels("pointcloud").ball_indices(points, np.arange(n), float(radius), 48, *grid,
-                                                          64 * kernel_threads())
+    index, _, counts = kernels("pointcloud").ball_indices(
+        points, np.arange(n), float(radius), 48, *grid, 64 * kernel_threads()
+    )
     rows = counts >= MIN_BALL_POINTS
     index, counts = np.ascontiguousarray(index[rows]), counts[rows]
     pattern = _rank_pattern(TRIANGLES)
@@ -1362,8 +1555,9 @@ def check_spanning_signs(name):
         results = {}
         for backend in ("numpy", "numba"):
             with use_backend(backend):
-                results[backend] = orientation_signs(normals, indices, usable, given=given,
-                                                     points=points if with_points else None)
+                results[backend] = orientation_signs(
+                    normals, indices, usable, given=given, points=points if with_points else None
+                )
         (expected, labels), (got, got_labels) = results["numpy"], results["numba"]
         label = f"given={given}, points={with_points}"
         # the same partition into components, under other names
@@ -1389,15 +1583,18 @@ class Twin:
     inputs: tuple
 
 
-
 def check_edge_geometry(name):
     points, normals = cloud(name)
     indices = knn_indices(points)
     got = kernels("pointcloud").edge_geometry(points, normals, np.ascontiguousarray(indices))
     # the NumPy path of _pointcloud_normals.oriented_signs: the same products over the (E, 3) gathers
     offsets = points[indices] - points[:, None, :]
-    expected = (np.linalg.norm(offsets, axis=2), np.einsum("nkj,nj->nk", offsets, normals),
-                np.einsum("nkj,nkj->nk", offsets, normals[indices]), np.einsum("nj,nkj->nk", normals, normals[indices]))
+    expected = (
+        np.linalg.norm(offsets, axis=2),
+        np.einsum("nkj,nj->nk", offsets, normals),
+        np.einsum("nkj,nkj->nk", offsets, normals[indices]),
+        np.einsum("nj,nkj->nk", normals, normals[indices]),
+    )
     for label, a, b in zip(("length", "ahead", "behind", "cosine"), got, expected):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14, err_msg=label)
 
@@ -1409,15 +1606,27 @@ def check_line_spread(name):
     indices = knn_indices(points)
     line = np.stack([np.linspace(0, 1, 40), np.zeros(40), np.zeros(40)], axis=1)  # spread 0
     for p, i in ((points, indices), (line, knn_indices(line))):
-        np.testing.assert_allclose(kernels("pointcloud").line_spread(p, np.ascontiguousarray(i)),
-                                   _line_spread_numpy(p, i), rtol=1e-9, atol=1e-6)
+        np.testing.assert_allclose(
+            kernels("pointcloud").line_spread(p, np.ascontiguousarray(i)),
+            _line_spread_numpy(p, i),
+            rtol=1e-9,
+            atol=1e-6,
+        )
 
 
 def check_flat_balls(name):
     from scipy.spatial import cKDTree
 
-    from meshcurv._pointcloud_estimators import (BALL_OFFSET, BALL_SHARE, BALL_SUPPORT, SUPPORT_ITERATIONS,
-                                                 SUPPORT_POINTS, _ball_indices, _flat_balls, _usable_tree)
+    from meshcurv._pointcloud_estimators import (
+        BALL_OFFSET,
+        BALL_SHARE,
+        BALL_SUPPORT,
+        SUPPORT_ITERATIONS,
+        SUPPORT_POINTS,
+        _ball_indices,
+        _flat_balls,
+        _usable_tree,
+    )
 
     points, _ = cloud(name)
     n = points.shape[0]
@@ -1427,14 +1636,23 @@ def check_flat_balls(name):
     centres = np.arange(points.shape[0])
     radius = 0.4 if name == "ellipsoid_cloud" else 0.12
     for k in (24, 96):
-        index, counts = _ball_indices(_usable_tree(cKDTree(points), points, np.ones(points.shape[0], dtype=bool)),
-                                      points, centres, radius, k)
+        index, counts = _ball_indices(
+            _usable_tree(cKDTree(points), points, np.ones(points.shape[0], dtype=bool)), points, centres, radius, k
+        )
         expected = _flat_balls(points, centres, index, counts)
-        got = kernels("pointcloud").flat_balls(points, centres, index, counts.astype(np.int64),
-                                               -(-k // SUPPORT_POINTS), SUPPORT_ITERATIONS, BALL_OFFSET, BALL_SHARE,
-                                               BALL_SUPPORT)
+        got = kernels("pointcloud").flat_balls(
+            points,
+            centres,
+            index,
+            counts.astype(np.int64),
+            -(-k // SUPPORT_POINTS),
+            SUPPORT_ITERATIONS,
+            BALL_OFFSET,
+            BALL_SHARE,
+            BALL_SUPPORT,
+        )
         np.testing.assert_array_equal(got, expected)
-        assert expected[:n].mean() > 0.9 and not expected[n:n + 200].any()  # (the line's own balls)
+        assert expected[:n].mean() > 0.9 and not expected[n : n + 200].any()  # (the line's own balls)
 
 
 def check_own_side(name):
@@ -1448,14 +1666,19 @@ def check_own_side(name):
     flipped = np.where((rng.random(n) < 0.2)[:, None], -normals, normals)  # some points facing away
     centres = np.flatnonzero(rng.random(n) > 0.5)
     radius = 0.4 if name == "ellipsoid_cloud" else 0.12
-    index, counts = _ball_indices(_usable_tree(cKDTree(points), points, np.ones(n, dtype=bool)), points, centres,
-                                  radius, 32)
+    index, counts = _ball_indices(
+        _usable_tree(cKDTree(points), points, np.ones(n, dtype=bool)), points, centres, radius, 32
+    )
     sheets = rng.integers(-1, 3, n)
     for given in (None, sheets):
         expected_index, expected_counts = _own_side(flipped, centres, index.copy(), counts.copy(), given)
         got_index, got_counts = kernels("pointcloud").own_side(
-            flipped, centres, index.copy(), counts.copy(),
-            np.zeros(0, dtype=np.int64) if given is None else np.ascontiguousarray(given, dtype=np.int64))
+            flipped,
+            centres,
+            index.copy(),
+            counts.copy(),
+            np.zeros(0, dtype=np.int64) if given is None else np.ascontiguousarray(given, dtype=np.int64),
+        )
         label = "sheets" if given is not None else "no sheets"
         np.testing.assert_array_equal(got_counts, expected_counts, err_msg=label)
         np.testing.assert_array_equal(got_index, expected_index, err_msg=label)
@@ -1484,12 +1707,21 @@ def check_stacked(name):
         np.testing.assert_array_equal(got, expected, err_msg=f"alike={alike}")
     assert expected.any() or got.any()
 
+
 TWINS = [
     Twin("geometry.face_cross_products", "geometry.face_cross_products", check_face_cross_products, MESHES),
-    Twin("geometry.vertex_normal_sums", "the np.bincount sums of geometry.vertex_normals", check_vertex_normal_sums,
-         MESHES),
-    Twin("geometry.normalize_normal_sums", "geometry.normalize_normal_sums", check_normalize_normal_sums,
-         ("random", "torus", "defects")),
+    Twin(
+        "geometry.vertex_normal_sums",
+        "the np.bincount sums of geometry.vertex_normals",
+        check_vertex_normal_sums,
+        MESHES,
+    ),
+    Twin(
+        "geometry.normalize_normal_sums",
+        "geometry.normalize_normal_sums",
+        check_normalize_normal_sums,
+        ("random", "torus", "defects"),
+    ),
     Twin("geometry.edge_lengths", "geometry.edge_lengths", check_edge_lengths, MESHES),
     Twin("geometry.vertex_edge_lengths", "geometry.vertex_edge_lengths", check_vertex_edge_lengths, MESHES),
     Twin("geometry.mean_edge_length", "geometry.mean_edge_length", check_mean_edge_length, MESHES),
@@ -1499,48 +1731,82 @@ TWINS = [
     Twin("topology.bowtie_vertices", "topology._bowtie_vertices", check_bowtie_vertices, MESHES),
     Twin("topology.count_components", "MeshTopology.n_components", check_count_components, MESHES),
     Twin("topology.component_labels", "MeshTopology.vertex_components", check_component_labels, MESHES),
-    Twin("topology.neighbour_lists", "MeshTopology.neighbour_lists (the adjacency matrix)", check_neighbour_lists,
-         MESHES),
+    Twin(
+        "topology.neighbour_lists", "MeshTopology.neighbour_lists (the adjacency matrix)", check_neighbour_lists, MESHES
+    ),
     Twin("diagnosis.mesh_facts", "diagnosis.diagnose", check_mesh_facts, MESHES),
     Twin("diagnosis.long_edges", "defects.needle_vertices (its long edges)", check_long_edges, MESHES),
-    Twin("normal_cycle.normal_cycle_sums", "normal_cycle.estimate up to its smoothing", check_normal_cycle_sums,
-         MESHES),
-    Twin("normal_cycle.normal_cycle_finish", "normal_cycle.estimate from its smoothing on", check_normal_cycle_finish,
-         MESHES),
-    Twin("tensors.principal_from_shape_operator", "_tensors.principal_from_shape_operator",
-         check_principal_from_shape_operator, ("random", "torus", "ellipsoid", "defects")),
+    Twin(
+        "normal_cycle.normal_cycle_sums", "normal_cycle.estimate up to its smoothing", check_normal_cycle_sums, MESHES
+    ),
+    Twin(
+        "normal_cycle.normal_cycle_finish",
+        "normal_cycle.estimate from its smoothing on",
+        check_normal_cycle_finish,
+        MESHES,
+    ),
+    Twin(
+        "tensors.principal_from_shape_operator",
+        "_tensors.principal_from_shape_operator",
+        check_principal_from_shape_operator,
+        ("random", "torus", "ellipsoid", "defects"),
+    ),
     Twin("matgeom.matgeom_vertex_tensors", "matgeom._vertex_tensors", check_matgeom_vertex_tensors, MESHES),
-    Twin("matgeom.matgeom_principal", "matgeom.estimate (_eigen.sorted_by_magnitude and the swap)",
-         check_matgeom_principal, MESHES),
-    Twin("matgeom.matgeom_finish", "smoothing.smooth_over_neighbours, then matgeom.matgeom_principal",
-         check_matgeom_finish, MESHES),
+    Twin(
+        "matgeom.matgeom_principal",
+        "matgeom.estimate (_eigen.sorted_by_magnitude and the swap)",
+        check_matgeom_principal,
+        MESHES,
+    ),
+    Twin(
+        "matgeom.matgeom_finish",
+        "smoothing.smooth_over_neighbours, then matgeom.matgeom_principal",
+        check_matgeom_finish,
+        MESHES,
+    ),
     Twin("smoothing.smooth_over_neighbours", "smoothing.smooth_vertex_field", check_smooth_over_neighbours, MESHES),
     Twin("icc.face_measures", "icc.face_measures", check_face_measures, MESHES),
     Twin("icc.curvatures_from_measures", "icc.curvatures_from_measures", check_curvatures_from_measures, MESHES),
     Twin("locality.reordering", "_locality.reordering's NumPy path", check_reordering, MESHES),
-    Twin("neighborhoods.vertex_face_lists", "a stable sort of the corners (no twin in the library)",
-         check_vertex_face_lists, MESHES),
-    Twin("neighborhoods.cell_centres", "the centres and reach of neighborhoods._ball_sums", check_cell_centres,
-         MESHES),
-    Twin("neighborhoods.ball_cell_sums", "neighborhoods.ball_face_sums / ball_edge_sums", check_ball_cell_sums,
-         MESHES),
-    Twin("neighborhoods.connected_face_sums", "neighborhoods.ball_face_sums(connected=True)", check_connected_face_sums,
-         MESHES + THIN),
-    Twin("neighborhoods.connected_face_sums_nested", "neighborhoods.ball_face_sums(connected=True) at each radius",
-         check_connected_face_sums_nested, MESHES + THIN),
+    Twin(
+        "neighborhoods.vertex_face_lists",
+        "a stable sort of the corners (no twin in the library)",
+        check_vertex_face_lists,
+        MESHES,
+    ),
+    Twin("neighborhoods.cell_centres", "the centres and reach of neighborhoods._ball_sums", check_cell_centres, MESHES),
+    Twin("neighborhoods.ball_cell_sums", "neighborhoods.ball_face_sums / ball_edge_sums", check_ball_cell_sums, MESHES),
+    Twin(
+        "neighborhoods.connected_face_sums",
+        "neighborhoods.ball_face_sums(connected=True)",
+        check_connected_face_sums,
+        MESHES + THIN,
+    ),
+    Twin(
+        "neighborhoods.connected_face_sums_nested",
+        "neighborhoods.ball_face_sums(connected=True) at each radius",
+        check_connected_face_sums_nested,
+        MESHES + THIN,
+    ),
     Twin("jets.fit_jets", "jets.fit_jets", check_fit_jets, CLEAN + CLOUDS),
-    Twin("jets.fit_jets_connected", "jets.fit_jets(adjacency=) and jets.jet_normals", check_fit_jets_connected,
-         MESHES + THIN),
-    Twin("pointcloud.pca_normals", "_pointcloud_normals._pca_normals_numpy", check_pca_normals,
-         CLOUDS + ("degenerate_cloud",)),
+    Twin(
+        "jets.fit_jets_connected",
+        "jets.fit_jets(adjacency=) and jets.jet_normals",
+        check_fit_jets_connected,
+        MESHES + THIN,
+    ),
+    Twin(
+        "pointcloud.pca_normals",
+        "_pointcloud_normals._pca_normals_numpy",
+        check_pca_normals,
+        CLOUDS + ("degenerate_cloud",),
+    ),
     Twin("pointcloud.ball_indices", "_pointcloud_estimators._ball_indices", check_ball_indices, CLOUDS),
     Twin("pointcloud.ball_triangle_sums", "_pointcloud_estimators._triangle_sums", check_ball_triangle_sums, CLOUDS),
-    Twin("pointcloud.edge_cosines", "the cosines of _pointcloud_normals.orientation_signs", check_edge_cosines,
-         CLOUDS),
+    Twin("pointcloud.edge_cosines", "the cosines of _pointcloud_normals.orientation_signs", check_edge_cosines, CLOUDS),
     Twin("pointcloud.far_winding", "_pointcloud_normals.winding_numbers", check_far_winding, CLOUDS),
     Twin("pointcloud.spanning_signs", "_pointcloud_normals.orientation_signs", check_spanning_signs, CLOUDS),
-    Twin("pointcloud.edge_geometry", "the products of _pointcloud_normals.oriented_signs", check_edge_geometry,
-         CLOUDS),
+    Twin("pointcloud.edge_geometry", "the products of _pointcloud_normals.oriented_signs", check_edge_geometry, CLOUDS),
     Twin("pointcloud.own_side", "_pointcloud_estimators._own_side", check_own_side, CLOUDS),
     Twin("pointcloud.line_spread", "_pointcloud_normals._line_spread_numpy", check_line_spread, CLOUDS),
     Twin("pointcloud.flat_balls", "_pointcloud_estimators._flat_balls", check_flat_balls, CLOUDS),
@@ -1551,7 +1817,7 @@ TWINS = [
 #: public kernel has a row in TWINS.
 EXCEPTIONS: dict[str, str] = {
     "neighborhoods.pool_grid": "a search structure, not a result: the twins of pointcloud.ball_indices and "
-                               "jets.fit_jets, which search it, find the same balls with k-d trees",
+    "jets.fit_jets, which search it, find the same balls with k-d trees",
 }
 
 #: Cases where a kernel and its twin disagree: ``(kernel, input) -> reason`` (strict xfail). Empty: the one
@@ -1589,8 +1855,11 @@ def public_kernels() -> set[str]:
         module = importlib.import_module(f"{package.__name__}.{info.name}")
         for attribute, value in vars(module).items():
             function = getattr(value, "py_func", value)  # a numba dispatcher or a plain function
-            if (not attribute.startswith("_") and inspect.isfunction(function)
-                    and function.__module__ == module.__name__):
+            if (
+                not attribute.startswith("_")
+                and inspect.isfunction(function)
+                and function.__module__ == module.__name__
+            ):
                 found.add(f"{info.name}.{attribute}")
     return found
 
@@ -1660,13 +1929,43 @@ def test_jet_fits_on_two_threads_are_those_of_one(connected):
 
     def fits():
         if connected:
-            return compiled.fit_jets_connected(points, normals, np.array([radius]), 3, jets.ITERATIONS,
-                                               jets._exponents(3), jets.MIN_SPREAD, np.arange(n), 7,
-                                               np.ones(n, dtype=bool), indptr, indices, points, False,
-                                               jets.AWAY_FRACTION, False, 0.0, np.zeros(0))
-        return compiled.fit_jets(points, normals, np.array([radius]), 3, jets.ITERATIONS, jets._exponents(3),
-                                 jets.MIN_SPREAD, np.arange(n), 7, np.arange(n), points, False, jets.AWAY_FRACTION,
-                                 0.0, np.zeros(0))
+            return compiled.fit_jets_connected(
+                points,
+                normals,
+                np.array([radius]),
+                3,
+                jets.ITERATIONS,
+                jets._exponents(3),
+                jets.MIN_SPREAD,
+                np.arange(n),
+                7,
+                np.ones(n, dtype=bool),
+                indptr,
+                indices,
+                points,
+                False,
+                jets.AWAY_FRACTION,
+                False,
+                0.0,
+                np.zeros(0),
+            )
+        return compiled.fit_jets(
+            points,
+            normals,
+            np.array([radius]),
+            3,
+            jets.ITERATIONS,
+            jets._exponents(3),
+            jets.MIN_SPREAD,
+            np.arange(n),
+            7,
+            np.arange(n),
+            points,
+            False,
+            jets.AWAY_FRACTION,
+            0.0,
+            np.zeros(0),
+        )
 
     threads = numba.get_num_threads()
     try:

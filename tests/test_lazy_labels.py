@@ -63,6 +63,7 @@ def test_dask_arrays_are_read_by_their_chunks():
 
 # ---- Zarr and OME-Zarr ---------------------------------------------------------------------------------------------
 
+
 @pytest.fixture
 def zarr():
     """The zarr package (the tests of the reader skip without it; those of LazyImage do not need it)."""
@@ -72,9 +73,14 @@ def zarr():
 def ome_group(path, image, scale, axes="zyx", unit="micrometer", version="0.4", whole=None):
     zarr = pytest.importorskip("zarr")
     group = zarr.open_group(str(path), mode="w")
-    multiscale = {"version": version, "axes": [{"name": name, "type": "space" if name in "zyx" else name,
-                                                **({"unit": unit} if name in "zyx" else {})} for name in axes],
-                  "datasets": [{"path": "0", "coordinateTransformations": [{"type": "scale", "scale": scale}]}]}
+    multiscale = {
+        "version": version,
+        "axes": [
+            {"name": name, "type": "space" if name in "zyx" else name, **({"unit": unit} if name in "zyx" else {})}
+            for name in axes
+        ],
+        "datasets": [{"path": "0", "coordinateTransformations": [{"type": "scale", "scale": scale}]}],
+    }
     if whole is not None:
         multiscale["coordinateTransformations"] = [{"type": "scale", "scale": whole}]
     if version == "0.5":
@@ -89,8 +95,9 @@ def ome_group(path, image, scale, axes="zyx", unit="micrometer", version="0.4", 
 
 def test_zarr_array_and_groups(tmp_path, zarr):
     image = scattered_labels()
-    array = zarr.create_array(store=str(tmp_path / "plain.zarr"), shape=image.shape, chunks=(8, 8, 8),
-                              dtype=image.dtype)
+    array = zarr.create_array(
+        store=str(tmp_path / "plain.zarr"), shape=image.shape, chunks=(8, 8, 8), dtype=image.dtype
+    )
     array[...] = image
     read = read_image(tmp_path / "plain.zarr")
     assert isinstance(read.array, LazyImage) and read.spacing is None and read.unit is None
@@ -103,16 +110,25 @@ def test_zarr_array_and_groups(tmp_path, zarr):
     assert np.array_equal(read_image(tmp_path / "group.zarr").array[0:30, 0:41, 0:37], image)
     del group["labels"]
     group.create_array("other", shape=(2, 2, 2), dtype="u1")
-    with pytest.raises(MeshFileError, match=r"group.zarr: a Zarr group of several arrays .* found arrays "
-                                            r"\['other', 'raw'\]"):
+    with pytest.raises(
+        MeshFileError,
+        match=r"group.zarr: a Zarr group of several arrays .* found arrays "
+        r"\['other', 'raw'\]",
+    ):
         read_image(tmp_path / "group.zarr")
 
 
 @pytest.mark.parametrize("version", ["0.4", "0.5"])
 def test_ome_zarr_spacing_unit_and_singleton_axes(tmp_path, version, zarr):
     image = scattered_labels()
-    ome_group(tmp_path / "cells.ome.zarr", image[None, None], [1.0, 1.0, 2.0, 0.5, 0.25], axes="tczyx",
-              version=version, whole=[1.0, 1.0, 1.0, 2.0, 2.0])
+    ome_group(
+        tmp_path / "cells.ome.zarr",
+        image[None, None],
+        [1.0, 1.0, 2.0, 0.5, 0.25],
+        axes="tczyx",
+        version=version,
+        whole=[1.0, 1.0, 1.0, 2.0, 2.0],
+    )
     read = read_image(tmp_path / "cells.ome.zarr")
     assert read.array.shape == image.shape and read.spacing == pytest.approx((2.0, 1.0, 0.5))
     assert read.unit == "micrometer"
@@ -126,8 +142,11 @@ def test_zarr_errors_name_the_path(tmp_path, zarr):
     with pytest.raises(MeshFileError, match="time.zarr: the OME-Zarr axis 't' has length 3"):
         read_image(tmp_path / "time.zarr")
     ome_group(tmp_path / "flat.zarr", np.zeros((4, 5), dtype=np.uint8), [1.0, 1.0], axes="yx")
-    with pytest.raises(MeshFileError, match=r"flat.zarr: an OME-Zarr image with axes z, y, x is needed; its axes "
-                                            r"are \['y', 'x'\]"):
+    with pytest.raises(
+        MeshFileError,
+        match=r"flat.zarr: an OME-Zarr image with axes z, y, x is needed; its axes "
+        r"are \['y', 'x'\]",
+    ):
         read_image(tmp_path / "flat.zarr")
     (tmp_path / "empty.zarr").mkdir()
     with pytest.raises(MeshFileError, match="empty.zarr: cannot be opened as Zarr"):
@@ -135,8 +154,11 @@ def test_zarr_errors_name_the_path(tmp_path, zarr):
     with pytest.raises(MeshFileError, match="missing.zarr: no such file or folder"):
         read_image(tmp_path / "missing.zarr")
     zarr.create_array(store=str(tmp_path / "two.zarr"), shape=(4, 5), dtype="u1")
-    with pytest.raises(MeshFileError, match=r"two.zarr: a 3D image \(z, y, x\) is needed; the store holds shape "
-                                            r"\(4, 5\)"):
+    with pytest.raises(
+        MeshFileError,
+        match=r"two.zarr: a 3D image \(z, y, x\) is needed; the store holds shape "
+        r"\(4, 5\)",
+    ):
         read_image(tmp_path / "two.zarr")
 
 
@@ -153,11 +175,14 @@ def test_missing_zarr_names_the_pip_command(tmp_path, monkeypatch):
         return real_import(name, *args, **kwargs)
 
     monkeypatch.setattr(builtins, "__import__", no_zarr)
-    with pytest.raises(MissingDependencyError, match=r"reading Zarr images needs the zarr package: pip install 'meshcurv\[volume\]'"):
+    with pytest.raises(
+        MissingDependencyError, match=r"reading Zarr images needs the zarr package: pip install 'meshcurv\[volume\]'"
+    ):
         read_image(tmp_path / "a.zarr")
 
 
 # ---- label_curvatures on a lazy image ------------------------------------------------------------------------------
+
 
 def balls_image(shape=(24, 40, 40), n=6, seed=11):
     """Balls of radius 3-5 voxels, apart, some cut by the image border."""
@@ -183,8 +208,9 @@ def test_label_curvatures_of_a_lazy_image_are_those_of_the_array():
     store = LazyImage(image, chunks=(8, 16, 16))  # read box by box, as a Zarr store (tests below)
     pandas.testing.assert_frame_equal(label_curvatures(store, spacing=(1.0, 0.8, 0.8)), expected)
     smoothed = label_curvatures(store, spacing=(1.0, 0.8, 0.8), smooth=0.8, labels_to_use=[7, 14])
-    pandas.testing.assert_frame_equal(smoothed, label_curvatures(image, spacing=(1.0, 0.8, 0.8), smooth=0.8,
-                                                                 labels_to_use=[7, 14]))
+    pandas.testing.assert_frame_equal(
+        smoothed, label_curvatures(image, spacing=(1.0, 0.8, 0.8), smooth=0.8, labels_to_use=[7, 14])
+    )
     with pytest.raises(InvalidOptionError, match="`threshold` needs the image in memory"):
         label_curvatures(store, spacing=(1.0, 0.8, 0.8), threshold=0.5)
 
@@ -215,14 +241,16 @@ def test_cli_volume_on_an_ome_zarr_store(tmp_path, zarr):
 
     spacing, radius = (2.0, 1.0, 1.0), 9.0
     shape = (12, 24, 24)
-    grid = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(shape, spacing, (11.3, 11.6, 11.9))],
-                       indexing="ij", sparse=True)
+    grid = np.meshgrid(
+        *[np.arange(n) * s - c for n, s, c in zip(shape, spacing, (11.3, 11.6, 11.9))], indexing="ij", sparse=True
+    )
     image = (sum(axis**2 for axis in grid) <= radius**2).astype(np.uint8) * 5
     ome_group(tmp_path / "cells.ome.zarr", image, list(spacing))
     session = Session()
     with session:
-        result = click_testing.CliRunner().invoke(volume, [str(tmp_path / "cells.ome.zarr"), "-o", str(tmp_path),
-                                                           "--no-picture"], obj=session)
+        result = click_testing.CliRunner().invoke(
+            volume, [str(tmp_path / "cells.ome.zarr"), "-o", str(tmp_path), "--no-picture"], obj=session
+        )
     assert result.exit_code == 0, result.output
     assert "voxel size 2 x 1 x 1 micrometer (z y x) from the file" in result.output
     row = pandas.read_csv(tmp_path / "cells_labels.csv").iloc[0]
@@ -231,6 +259,7 @@ def test_cli_volume_on_an_ome_zarr_store(tmp_path, zarr):
 
 
 # ---- the small version of benchmarks/zarr_labels.py ----------------------------------------------------------------
+
 
 def zarr_benchmark():
     import importlib.util
@@ -269,6 +298,10 @@ def test_benchmark_runs_under_its_cap(tmp_path, capsys, zarr):
     pytest.importorskip("distributed")
     pytest.importorskip("psutil")
     benchmark = zarr_benchmark()
-    assert benchmark.main(["--shape", "96", "96", "96", "--objects", "12", "--chunk", "32", "--cap", "4",
-                           "--store", str(tmp_path)]) == 0
+    assert (
+        benchmark.main(
+            ["--shape", "96", "96", "96", "--objects", "12", "--chunk", "32", "--cap", "4", "--store", str(tmp_path)]
+        )
+        == 0
+    )
     assert "| cap | 4.00 GiB: kept |" in capsys.readouterr().out

@@ -72,8 +72,9 @@ def test_a_shuffled_mesh_is_scattered_when_large(torus):
     assert not _locality.is_scattered(small.vertices.shape[0], small_faces)  # stays in the caches
 
 
-@pytest.mark.parametrize("backend", ["numpy", pytest.param("numba", marks=pytest.mark.skipif(
-    not HAS_NUMBA, reason="numba not installed"))])
+@pytest.mark.parametrize(
+    "backend", ["numpy", pytest.param("numba", marks=pytest.mark.skipif(not HAS_NUMBA, reason="numba not installed"))]
+)
 def test_the_reordering_is_the_morton_order_and_its_faces_by_first_corner(backend, torus):
     vertices, faces, _ = shuffle(torus.vertices, torus.faces, 3)
     with use_backend(backend):
@@ -108,12 +109,14 @@ def test_a_scattered_mesh_gives_the_numbers_of_the_mesh_in_its_own_order(method,
     assert "scattered order" in caplog.text
     scale = np.abs(base.k_max).max()
     for name in ("k_min", "k_max", "normals"):
-        np.testing.assert_allclose(getattr(shuffled, name), getattr(base, name)[order], rtol=0, atol=1e-10 * scale,
-                                   err_msg=name)
+        np.testing.assert_allclose(
+            getattr(shuffled, name), getattr(base, name)[order], rtol=0, atol=1e-10 * scale, err_msg=name
+        )
     np.testing.assert_array_equal(shuffled.valid, base.valid[order])
     for name in ("dir_min", "dir_max"):
-        np.testing.assert_allclose(np.abs(np.sum(getattr(shuffled, name) * getattr(base, name)[order], axis=1)), 1,
-                                   atol=1e-8)
+        np.testing.assert_allclose(
+            np.abs(np.sum(getattr(shuffled, name) * getattr(base, name)[order], axis=1)), 1, atol=1e-8
+        )
     # the mesh kept for the integrals is the caller's, in the caller's order
     np.testing.assert_allclose(shuffled.vertex_areas, base.vertex_areas[order], rtol=1e-12)
     assert shuffled.integral("gaussian") == pytest.approx(base.integral("gaussian"), abs=1e-9)
@@ -145,8 +148,7 @@ def test_a_scattered_soup_is_welded_and_put_back_in_the_callers_order(torus):
     np.testing.assert_array_equal(shuffled.k_max[copies], shuffled.k_max[originals])  # copies share their values
     # a welded vertex's area is on the first of its rows (another copy once shuffled): the pairs' sums agree
     areas, base_areas = shuffled.vertex_areas, base.vertex_areas[order]
-    np.testing.assert_allclose(areas[copies] + areas[originals], base_areas[copies] + base_areas[originals],
-                               rtol=1e-12)
+    np.testing.assert_allclose(areas[copies] + areas[originals], base_areas[copies] + base_areas[originals], rtol=1e-12)
     others = np.setdiff1d(np.arange(order.size), np.concatenate([copies, originals]))
     np.testing.assert_allclose(areas[others], base_areas[others], rtol=1e-12)
 

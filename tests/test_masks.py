@@ -20,8 +20,7 @@ skimage_measure = pytest.importorskip("skimage.measure")
 
 
 def ball(shape, spacing, center, radius):
-    grid = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(shape, spacing, center)], indexing="ij",
-                       sparse=True)
+    grid = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(shape, spacing, center)], indexing="ij", sparse=True)
     return sum(axis**2 for axis in grid) <= radius**2
 
 
@@ -44,8 +43,9 @@ def test_threshold_splits_six_connected_components():
     assert len(np.unique(labels[1:4, 1:4, 1:4])) == 1 and labels[4, 4, 4] not in (0, labels[1, 1, 1])
     assert labels[5, 1, 1] == 0
     # an integer probability map (0-255) with a threshold is thresholded too
-    assert np.array_equal(_masks.labels_from_image((image * 255).astype(np.uint8), 127, caller="test",
-                                                   stacklevel=1) > 0, labels > 0)
+    assert np.array_equal(
+        _masks.labels_from_image((image * 255).astype(np.uint8), 127, caller="test", stacklevel=1) > 0, labels > 0
+    )
 
 
 def test_nan_voxels_are_background_with_one_warning():
@@ -60,8 +60,11 @@ def test_nan_voxels_are_background_with_one_warning():
 def test_float_images_need_a_threshold():
     image = np.zeros((4, 4, 4), dtype=np.float32)
     image[1:3, 1:3, 1:3] = 3.0
-    with pytest.raises(InvalidMeshError, match=r"an integer label image or a boolean mask; got dtype float32: for a "
-                                               r"probability map pass threshold=T \(--threshold T\).*cast them"):
+    with pytest.raises(
+        InvalidMeshError,
+        match=r"an integer label image or a boolean mask; got dtype float32: for a "
+        r"probability map pass threshold=T \(--threshold T\).*cast them",
+    ):
         _masks.labels_from_image(image, None, caller="test", stacklevel=1)
     integers = np.ones((2, 2, 2), dtype=np.int16)
     assert _masks.labels_from_image(integers, None, caller="test", stacklevel=1) is integers
@@ -69,9 +72,14 @@ def test_float_images_need_a_threshold():
         _masks.labels_from_image(np.ones((2, 2, 2), dtype=complex), 0.5, caller="test", stacklevel=1)
 
 
-@pytest.mark.parametrize("value, message", [("1", "`threshold` must be a finite number"),
-                                            (np.nan, "`threshold` must be a finite number"),
-                                            (True, "`threshold` must be a finite number")])
+@pytest.mark.parametrize(
+    "value, message",
+    [
+        ("1", "`threshold` must be a finite number"),
+        (np.nan, "`threshold` must be a finite number"),
+        (True, "`threshold` must be a finite number"),
+    ],
+)
 def test_threshold_option_errors(value, message):
     with pytest.raises(InvalidOptionError, match=message):
         _masks.check_threshold(value)
@@ -97,7 +105,8 @@ def test_smoothed_ball_keeps_area_and_volume_with_anisotropic_voxels():
     mask, origin, starts, stops = _masks.smoothed_crop(image, 1, box, spacing, sigma)
     assert origin.tolist() == [0, 0, 0] and mask.shape == (22, 40, 40)  # 3 and 4 voxels added, clipped
     index, faces, n_voxels, centroid, touching = _masks.smoothed_surface(
-        mask, origin, starts, stops, shape, spacing, sigma, skimage_measure.marching_cubes)
+        mask, origin, starts, stops, shape, spacing, sigma, skimage_measure.marching_cubes
+    )
     assert n_voxels == image.sum() and not touching.any()
     assert centroid == pytest.approx([10.3, 9.8, 10.1], abs=0.05)
     area, volume = mesh_area_volume(index * spacing, faces)
@@ -111,8 +120,9 @@ def test_smoothed_ball_cut_by_the_border_is_closed_by_a_flat_cap():
     image = ball(shape, spacing, (0.0, 12.0, 12.0), radius).astype(np.uint8)  # half a ball on the face z = 0
     box = tuple(slice(int(a.min()), int(a.max()) + 1) for a in np.nonzero(image))
     mask, origin, starts, stops = _masks.smoothed_crop(image, 1, box, spacing, sigma)
-    index, faces, _, _, touching = _masks.smoothed_surface(mask, origin, starts, stops, shape, spacing, sigma,
-                                                           skimage_measure.marching_cubes)
+    index, faces, _, _, touching = _masks.smoothed_surface(
+        mask, origin, starts, stops, shape, spacing, sigma, skimage_measure.marching_cubes
+    )
     assert touching.tolist() == [[True, False], [False, False], [False, False]]
     # the cap lies on the image's outer voxel face, as that of an unsmoothed mask (meshcurv.volume leaves it out)
     assert index[:, 0].min() == -0.5 and not ((index[:, 0] > -0.5) & (index[:, 0] < 0.0)).any()
@@ -138,8 +148,9 @@ def test_label_curvatures_of_a_probability_map():
     grid = np.meshgrid(*[np.arange(n) * s for n, s in zip(shape, spacing)], indexing="ij", sparse=True)
     centres = [(9.6, 8.7, 7.9), (10.2, 9.1, 21.3)]
     # two Gaussian blobs: p > 0.5 where r < width sqrt(ln 2), two balls of that radius
-    probability = np.maximum(*[np.exp(-sum((axis - c) ** 2 for axis, c in zip(grid, centre)) / width**2)
-                               for centre in centres]).astype(np.float32)
+    probability = np.maximum(
+        *[np.exp(-sum((axis - c) ** 2 for axis, c in zip(grid, centre)) / width**2) for centre in centres]
+    ).astype(np.float32)
     radius = width * np.sqrt(np.log(2.0))
     table = label_curvatures(probability, spacing=spacing, threshold=0.5)
     assert table.label.tolist() == [1, 2] and (table.status == "ok").all()
@@ -199,9 +210,20 @@ def test_cli_threshold_and_smooth(tmp_path):
     def run(*args):
         session = Session()
         with session:
-            return click_testing.CliRunner().invoke(volume, [str(tmp_path / "p.npy"), "-o", str(tmp_path / "out"),
-                                                             "--spacing", *map(str, spacing), "--no-picture",
-                                                             "--overwrite", *args], obj=session)
+            return click_testing.CliRunner().invoke(
+                volume,
+                [
+                    str(tmp_path / "p.npy"),
+                    "-o",
+                    str(tmp_path / "out"),
+                    "--spacing",
+                    *map(str, spacing),
+                    "--no-picture",
+                    "--overwrite",
+                    *args,
+                ],
+                obj=session,
+            )
 
     result = run("--threshold", "0.5", "--smooth", "0.5")
     assert result.exit_code == 0, result.output

@@ -20,9 +20,16 @@ from conftest import DATA
 
 CASES = sorted(p.stem for p in (DATA / "matgeom").glob("*.npz"))
 # mask sizes stated in the reference README (rules 2 and 3)
-UMBILIC_COUNTS = {"cube_sub4": 38, "fandisk": 954, "icosphere_r1_sub4": 12, "icosphere_r1_sub16": 12,
-                  "icosphere_r5_sub8": 12, "icosphere_flipped": 12, "isolated_vertex": 13,
-                  "uvsphere_r1_32x16": 2}
+UMBILIC_COUNTS = {
+    "cube_sub4": 38,
+    "fandisk": 954,
+    "icosphere_r1_sub4": 12,
+    "icosphere_r1_sub16": 12,
+    "icosphere_r5_sub8": 12,
+    "icosphere_flipped": 12,
+    "isolated_vertex": 13,
+    "uvsphere_r1_32x16": 2,
+}
 FLAT_COUNTS = {"cube_sub4": 32, "fandisk": 1101, "isolated_vertex": 1}
 
 
@@ -36,7 +43,9 @@ def run_matgeom(case):
         warnings.simplefilter("ignore", TriangulationWarning)
         warnings.simplefilter("ignore", MeshQualityWarning)
         return meshcurv.principal_curvatures(
-            case["vertices"], case["faces"], method="matgeom",
+            case["vertices"],
+            case["faces"],
+            method="matgeom",
             smoothing_steps=int(case["smoothing_steps"]),
         )
 
@@ -112,6 +121,7 @@ def test_open_mesh_values_near_the_boundary_are_kept_but_marked_invalid():
     # boundary ends plus three smoothing rings are doubtful; the centre is not
     inner = np.maximum(np.abs(x), np.abs(y)) < 0.55
     assert result.valid[inner].all()
+
 
 def test_unreferenced_vertex_keeps_matgeoms_zeros_and_is_invalid():
     case = load("isolated_vertex")

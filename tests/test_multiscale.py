@@ -20,8 +20,10 @@ def _meshes():
     kept = hemisphere.faces[(hemisphere.vertices[hemisphere.faces][:, :, 2] > -0.05).all(axis=1)]
     return {
         "torus": (shapes.torus().vertices, shapes.torus().faces),
-        "noisy sphere": (shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=3).vertices,
-                         shapes.icosphere(8).faces),
+        "noisy sphere": (
+            shapes.with_normal_noise(shapes.icosphere(8), 0.2, seed=3).vertices,
+            shapes.icosphere(8).faces,
+        ),
         "open hemisphere": (hemisphere.vertices, kept),
     }
 
@@ -51,8 +53,13 @@ def test_each_scale_equals_the_single_call(name, method):
         scale = np.nanmax(np.abs(single.k_max))
         # the same faces and shares summed in another order (one walk for every radius): round-off
         for field in ("k_min", "k_max", "mean", "gaussian"):
-            np.testing.assert_allclose(getattr(result, field), getattr(single, field), rtol=0,
-                                       atol=1e-9 * (scale**2 if field == "gaussian" else scale), err_msg=field)
+            np.testing.assert_allclose(
+                getattr(result, field),
+                getattr(single, field),
+                rtol=0,
+                atol=1e-9 * (scale**2 if field == "gaussian" else scale),
+                err_msg=field,
+            )
         np.testing.assert_allclose(result.normals, single.normals, rtol=0, atol=1e-12)
 
 
@@ -72,13 +79,16 @@ def test_the_one_warning_names_the_radius_whose_note_differs():
     assert len(record) == 1
 
 
-@pytest.mark.parametrize("radii, message", [
-    ([], "non-empty sequence"),
-    ("1.0", "non-empty sequence"),
-    ([[1.0, 2.0]], "non-empty sequence"),
-    ([1.0, -2.0], "radii"),
-    ([1.0, float("nan")], "radii"),
-])
+@pytest.mark.parametrize(
+    "radii, message",
+    [
+        ([], "non-empty sequence"),
+        ("1.0", "non-empty sequence"),
+        ([[1.0, 2.0]], "non-empty sequence"),
+        ([1.0, -2.0], "radii"),
+        ([1.0, float("nan")], "radii"),
+    ],
+)
 def test_bad_radii_are_refused(radii, message):
     torus = shapes.torus()
     with pytest.raises(InvalidOptionError, match=message):

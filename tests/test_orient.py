@@ -58,7 +58,7 @@ def test_open_patch_keeps_its_majority_and_each_component_is_oriented_on_its_own
     truth = np.vstack([saddle.faces, sphere.faces + n])
     which = np.zeros(truth.shape[0], dtype=bool)
     which[:5] = True  # a few saddle faces
-    which[saddle.faces.shape[0]:] = True  # the whole sphere, inward
+    which[saddle.faces.shape[0] :] = True  # the whole sphere, inward
     fixed, n_flipped = orient_faces(vertices, reverse(truth, which))
     assert n_flipped == which.sum()
     np.testing.assert_array_equal(fixed, truth)
@@ -78,12 +78,15 @@ def test_inconsistent_faces_make_curvature_invalid_unless_oriented():
         assert r.diagnosis.n_inconsistent_edges == 0
         reference = meshcurv.principal_curvatures(torus.vertices, torus.faces, method=method)
         np.testing.assert_array_equal(r.valid, reference.valid)
-        np.testing.assert_allclose(r.k_max, reference.k_max, rtol=1e-12, atol=1e-12 * np.nanmax(np.abs(reference.k_max)))
+        np.testing.assert_allclose(
+            r.k_max, reference.k_max, rtol=1e-12, atol=1e-12 * np.nanmax(np.abs(reference.k_max))
+        )
     with pytest.warns(MeshQualityWarning, match="inconsistently oriented"):
         kept = meshcurv.principal_curvatures(torus.vertices, faces, orient="keep")
     assert not kept.valid.all() and kept.diagnosis.n_flipped_faces == 0
-    assert (kept.invalid_reason[~kept.valid] == INVALID_REASONS.index(
-        "on an edge between inconsistently oriented faces")).all()
+    assert (
+        kept.invalid_reason[~kept.valid] == INVALID_REASONS.index("on an edge between inconsistently oriented faces")
+    ).all()
     assert clean.valid.all()
     # the default orients: the same numbers as the clean mesh, with one warning that says what was done
     with pytest.warns(MeshQualityWarning, match=f"reversed {n} of {n_faces} faces before the computation: to orient"):
@@ -153,7 +156,9 @@ def test_inputs_are_not_modified():
 
 def test_bad_orient_values_and_inputs_are_refused():
     sphere = shapes.icosphere(2)
-    with pytest.raises(InvalidOptionError, match="unknown orient 'inward'; choose one of 'auto', 'outward', 'consistent', 'keep'"):
+    with pytest.raises(
+        InvalidOptionError, match="unknown orient 'inward'; choose one of 'auto', 'outward', 'consistent', 'keep'"
+    ):
         meshcurv.principal_curvatures(sphere.vertices, sphere.faces, orient="inward")
     with pytest.raises(InvalidOptionError, match="unknown orient True"):
         meshcurv.principal_curvatures(sphere.vertices, sphere.faces, orient=True)
@@ -176,12 +181,16 @@ def test_a_cavity_wall_faces_into_the_cavity(wound):
     n = outer.vertices.shape[0]
     vertices = np.vstack([outer.vertices, inner.vertices])
     right = np.vstack([outer.faces, inner.faces[:, ::-1] + n])
-    faces = {"as it should be": right, "every patch outward": np.vstack([outer.faces, inner.faces + n]),
-             "every face inward": right[:, ::-1]}[wound]
+    faces = {
+        "as it should be": right,
+        "every patch outward": np.vstack([outer.faces, inner.faces + n]),
+        "every face inward": right[:, ::-1],
+    }[wound]
     fixed, n_flipped = orient_faces(vertices, faces)
     np.testing.assert_array_equal(np.sort(fixed, axis=1), np.sort(right, axis=1))
     assert (meshcurv.geometry.face_normals(vertices, fixed) * meshcurv.geometry.face_normals(vertices, right)).sum(
-        axis=1).min() > 0.99
+        axis=1
+    ).min() > 0.99
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshQualityWarning)
         r = meshcurv.principal_curvatures(vertices, faces)

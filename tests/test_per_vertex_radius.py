@@ -19,19 +19,32 @@ from meshcurv import shapes
 from meshcurv._backend import use_backend
 from meshcurv.errors import InvalidMeshError, InvalidOptionError
 from meshcurv.jets import fit_jet_normals, fit_jets
-from meshcurv.neighborhoods import (ball_edge_sums, ball_face_sums, ball_face_sums_nested, call_ranges,
-                                    centre_radii, estimate_ball_pairs)
+from meshcurv.neighborhoods import (
+    ball_edge_sums,
+    ball_face_sums,
+    ball_face_sums_nested,
+    call_ranges,
+    centre_radii,
+    estimate_ball_pairs,
+)
 from meshcurv.topology import MeshTopology
 
 EPS = np.finfo(float).eps
-BACKENDS = ["numpy", pytest.param("numba", marks=pytest.mark.skipif(
-    __import__("importlib").util.find_spec("numba") is None, reason="numba not installed"))]
+BACKENDS = [
+    "numpy",
+    pytest.param(
+        "numba",
+        marks=pytest.mark.skipif(__import__("importlib").util.find_spec("numba") is None, reason="numba not installed"),
+    ),
+]
 
 
 def _mesh(name):
-    made = {"ellipsoid": lambda: shapes.ellipsoid(subdivisions=6),
-            # thinner than the larger balls: the other sheet is inside them, reached only round the rim
-            "flat": lambda: shapes.ellipsoid((3.0, 3.0, 0.15), subdivisions=12)}[name]()
+    made = {
+        "ellipsoid": lambda: shapes.ellipsoid(subdivisions=6),
+        # thinner than the larger balls: the other sheet is inside them, reached only round the rim
+        "flat": lambda: shapes.ellipsoid((3.0, 3.0, 0.15), subdivisions=12),
+    }[name]()
     vertices, faces = np.ascontiguousarray(made.vertices), np.ascontiguousarray(made.faces)
     topology = MeshTopology.from_faces(faces, vertices.shape[0])
     edges = vertices[topology.edges]
@@ -56,18 +69,27 @@ def test_equal_radii_array_is_the_float_call(backend):
     normals = vertices / np.linalg.norm(vertices, axis=1, keepdims=True)
     centres = np.arange(0, n, 3)
     with use_backend(backend):
-        np.testing.assert_array_equal(ball_face_sums(vertices, faces, np.full(n, 2 * h), values, connected=True),
-                                      ball_face_sums(vertices, faces, 2 * h, values, connected=True))
+        np.testing.assert_array_equal(
+            ball_face_sums(vertices, faces, np.full(n, 2 * h), values, connected=True),
+            ball_face_sums(vertices, faces, 2 * h, values, connected=True),
+        )
         for adjacency in (topology.neighbour_lists, None):
-            got = fit_jets(vertices, normals, np.full(centres.size, 3 * h), degree=3, centres=centres,
-                           adjacency=adjacency, compact=True)
-            expected = fit_jets(vertices, normals, 3 * h, degree=3, centres=centres, adjacency=adjacency,
-                                compact=True)
+            got = fit_jets(
+                vertices,
+                normals,
+                np.full(centres.size, 3 * h),
+                degree=3,
+                centres=centres,
+                adjacency=adjacency,
+                compact=True,
+            )
+            expected = fit_jets(vertices, normals, 3 * h, degree=3, centres=centres, adjacency=adjacency, compact=True)
             np.testing.assert_array_equal(got[0], expected[0])
             np.testing.assert_array_equal(got[2], expected[2])
         np.testing.assert_array_equal(
             fit_jet_normals(vertices, normals, np.full(n, 3 * h), degree=3, adjacency=topology.neighbour_lists),
-            fit_jet_normals(vertices, normals, 3 * h, degree=3, adjacency=topology.neighbour_lists))
+            fit_jet_normals(vertices, normals, 3 * h, degree=3, adjacency=topology.neighbour_lists),
+        )
 
 
 def _radius_classes(n, h):
@@ -106,8 +128,9 @@ def test_per_centre_jet_radius_is_the_float_fit_at_each_centre(backend):
             got = fit_jets(vertices, normals, radii, degree=3, centres=centres, adjacency=adjacency, compact=True)
             for level in levels:
                 at = radii == level
-                expected = fit_jets(vertices, normals, level, degree=3, centres=centres[at], adjacency=adjacency,
-                                    compact=True)
+                expected = fit_jets(
+                    vertices, normals, level, degree=3, centres=centres[at], adjacency=adjacency, compact=True
+                )
                 np.testing.assert_array_equal(got[2][at], expected[2])  # the same balls
                 if backend == "numba" and adjacency is not None:  # the same walk and fit as the float call
                     np.testing.assert_array_equal(got[0][at], expected[0])
@@ -133,8 +156,12 @@ def test_nested_sums_are_separate_calls(backend, name):
     values, n = _values(faces), vertices.shape[0]
     usable = np.random.default_rng(4).random(faces.shape[0]) > 0.1
     per_vertex = np.random.default_rng(6).uniform(0.8, 1.2, n)
-    for radii in (np.array([1.0, 2.0, 4.0]) * h, np.array([1.0, 2.0, 4.0])[:, None] * h * per_vertex,
-                  np.array([2.0]) * h, np.array([1.0, 1.0, 3.0]) * h):
+    for radii in (
+        np.array([1.0, 2.0, 4.0]) * h,
+        np.array([1.0, 2.0, 4.0])[:, None] * h * per_vertex,
+        np.array([2.0]) * h,
+        np.array([1.0, 1.0, 3.0]) * h,
+    ):
         with use_backend(backend):
             got = ball_face_sums_nested(vertices, faces, radii, values, usable=usable)
             assert got.shape == (radii.shape[0], n, values.shape[1])

@@ -170,13 +170,16 @@ def test_uneven_density_gets_one_radius_per_class_and_a_warning():
     assert r.valid.mean() > 0.99 and np.median(np.abs(r.k_max[r.valid] - 0.5)) < 0.01
 
 
-@pytest.mark.parametrize("points, match", [
-    (np.zeros((20, 2)), r"must have shape \(V, 3\)"),
-    (np.full((20, 3), np.nan), "NaN or infinite"),
-    (np.random.default_rng(0).normal(size=(9, 3)), "at least 10 are needed"),
-    (np.repeat(np.random.default_rng(0).normal(size=(5, 3)), 4, axis=0), "5 distinct points; at least 10"),
-    (np.outer(np.arange(30.0), [1.0, 2.0, 3.0]), "lie on one line"),
-])
+@pytest.mark.parametrize(
+    "points, match",
+    [
+        (np.zeros((20, 2)), r"must have shape \(V, 3\)"),
+        (np.full((20, 3), np.nan), "NaN or infinite"),
+        (np.random.default_rng(0).normal(size=(9, 3)), "at least 10 are needed"),
+        (np.repeat(np.random.default_rng(0).normal(size=(5, 3)), 4, axis=0), "5 distinct points; at least 10"),
+        (np.outer(np.arange(30.0), [1.0, 2.0, 3.0]), "lie on one line"),
+    ],
+)
 def test_bad_points_are_refused(points, match):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshQualityWarning)
@@ -219,8 +222,9 @@ def test_compiled_triangle_sums_match_the_numpy_path():
     counts = rng.integers(3, 41, size=50)
     pattern = estimators._rank_pattern(16)
     expected = estimators._triangle_sums(points, normals, index, counts, pattern)
-    np.testing.assert_allclose(ball_triangle_sums(points, normals, index, counts, pattern), expected,
-                               rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(
+        ball_triangle_sums(points, normals, index, counts, pattern), expected, rtol=1e-10, atol=1e-14
+    )
     assert (expected[:, 0] > 0).all()  # every triangle turned to a positive corrected area
 
 
@@ -259,16 +263,19 @@ def test_compiled_ball_search_matches_the_k_d_tree():
     apart = np.where(np.arange(3000)[:, None] % 2 == 0, points, points + [1e4, 1e4, 0.0])
     for cloud, cases in ((points, ((0.3, 12), (0.5, 60))), (apart, ((0.3, 6), (0.5, 30)))):
         for radius, k in cases:
-            index, squared, counts = ball_indices(cloud, centres, radius, k,
-                                                  *pool_grid(cloud, np.flatnonzero(usable), radius), 64)
+            index, squared, counts = ball_indices(
+                cloud, centres, radius, k, *pool_grid(cloud, np.flatnonzero(usable), radius), 64
+            )
             expected, expected_counts = estimators._ball_indices(
-                estimators._usable_tree(cKDTree(cloud), cloud, usable), cloud, centres, radius, k)
+                estimators._usable_tree(cKDTree(cloud), cloud, usable), cloud, centres, radius, k
+            )
             np.testing.assert_array_equal(index, expected)
             np.testing.assert_array_equal(counts, expected_counts)
             assert usable[index[index < 3000]].all() and (counts == k).any() and (counts < k).any()
             inside = np.isfinite(squared)
-            assert np.allclose(squared[inside],
-                               np.sum((cloud[index[inside]] - cloud[np.repeat(centres, counts)]) ** 2, axis=1))
+            assert np.allclose(
+                squared[inside], np.sum((cloud[index[inside]] - cloud[np.repeat(centres, counts)]) ** 2, axis=1)
+            )
 
 
 def test_compiled_spanning_signs_orient_as_the_scipy_tree():
@@ -418,14 +425,16 @@ def test_normal_fits_shrink_to_one_sheet_of_a_thin_plate():
     normals = np.zeros((26000, 3))
     normals[:, 2] = side
     inner = np.flatnonzero((np.abs(sheet) < 1.0).all(axis=1))
-    _, _, radii = estimators.one_sided_fits(points, normals, 1.0, inner, np.ones(26000, dtype=bool),
-                                            smallest=0.1, degree=3, iterations=2)
+    _, _, radii = estimators.one_sided_fits(
+        points, normals, 1.0, inner, np.ones(26000, dtype=bool), smallest=0.1, degree=3, iterations=2
+    )
     assert np.isfinite(radii[inner]).all()
     assert radii[inner].max() <= 1.03 * 0.4
     assert radii[inner].min() >= 0.4 * estimators.SHRINK  # the largest such ball of the sequence 1, 0.71, 0.5, ...
 
 
 # ----------------------------------------------------------------------------- compiled twins and reused searches
+
 
 def _random_cloud(n, seed):
     rng = np.random.default_rng(seed)
@@ -449,8 +458,9 @@ def test_compiled_own_side_keeps_what_the_numpy_path_keeps():
     sheets = rng.integers(-1, 3, size=3000)
     for given in (None, sheets):
         expected = estimators._own_side(normals, centres, index.copy(), counts, given)
-        found = numba_kernels("pointcloud").own_side(normals, centres, index.copy(), counts,
-                                                     np.zeros(0, dtype=np.int64) if given is None else given)
+        found = numba_kernels("pointcloud").own_side(
+            normals, centres, index.copy(), counts, np.zeros(0, dtype=np.int64) if given is None else given
+        )
         np.testing.assert_array_equal(found[0], expected[0])
         np.testing.assert_array_equal(found[1], expected[1])
 
@@ -502,8 +512,9 @@ def test_compiled_stacked_sheets_are_those_of_the_numpy_path(alike):
     from meshcurv._backend import use_backend
 
     rng = np.random.default_rng(4)
-    points = np.c_[rng.uniform(0, 30, size=(2000, 2)), np.where(np.arange(2000) < 1000, 1.5, 0.0)
-                   + rng.uniform(-0.2, 0.2, 2000)]
+    points = np.c_[
+        rng.uniform(0, 30, size=(2000, 2)), np.where(np.arange(2000) < 1000, 1.5, 0.0) + rng.uniform(-0.2, 0.2, 2000)
+    ]
     normals = np.tile([0.0, 0.0, 1.0], (2000, 1)) * np.where(rng.random(2000) < 0.3, -1.0, 1.0)[:, None]
     queries = np.arange(0, 2000, 3)
     _, near = cKDTree(points).query(points[queries], k=49)

@@ -47,10 +47,13 @@ def test_compute_writes_the_fields_of_a_point_cloud(sphere_points, tmp_path, cap
     np.testing.assert_allclose(points, np.loadtxt(sphere_points), rtol=1e-6)  # float32 in PLY
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["-m", "icc"], "method 'icc' needs faces; .* is a point cloud"),
-    (["--smoothing-steps", "2"], "--smoothing-steps is for meshes"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["-m", "icc"], "method 'icc' needs faces; .* is a point cloud"),
+        (["--smoothing-steps", "2"], "--smoothing-steps is for meshes"),
+    ],
+)
 @pytest.mark.parametrize("command", ["compute", "plot"])
 def test_mesh_options_are_refused_for_a_point_cloud(sphere_points, capsys, argv, message, command):
     if command == "plot":
@@ -63,8 +66,9 @@ def test_mesh_options_are_refused_for_a_point_cloud(sphere_points, capsys, argv,
 def test_plot_draws_a_point_cloud(sphere_points, tmp_path, capsys):
     pytest.importorskip("matplotlib")
     output = tmp_path / "sphere.png"
-    code, _, err = run(capsys, "plot", sphere_points, "-o", output, "--field", "mean", "--view", "iso",
-                       "--pixels", "600")
+    code, _, err = run(
+        capsys, "plot", sphere_points, "-o", output, "--field", "mean", "--view", "iso", "--pixels", "600"
+    )
     assert code == 0, err
     from matplotlib.image import imread
 
@@ -88,12 +92,19 @@ def test_the_batch_task_computes_a_point_cloud(sphere_points, tmp_path):
     assert row["mean_median"] == pytest.approx(1 / RADIUS, rel=0.01)
 
 
-@pytest.mark.parametrize("extension, write", [
-    (".csv", lambda path, points: np.savetxt(path, points, delimiter=",", header="x,y,z", comments="")),
-    (".txt", lambda path, points: np.savetxt(path, points)),
-    (".pts", lambda path, points: path.write_text(f"{len(points)}\n" + "".join(
-        f"{x!r} {y!r} {z!r} 7 200 200 200\n" for x, y, z in points.tolist()))),  # Leica PTS: count, then x y z i r g b
-])
+@pytest.mark.parametrize(
+    "extension, write",
+    [
+        (".csv", lambda path, points: np.savetxt(path, points, delimiter=",", header="x,y,z", comments="")),
+        (".txt", lambda path, points: np.savetxt(path, points)),
+        (
+            ".pts",
+            lambda path, points: path.write_text(
+                f"{len(points)}\n" + "".join(f"{x!r} {y!r} {z!r} 7 200 200 200\n" for x, y, z in points.tolist())
+            ),
+        ),  # Leica PTS: count, then x y z i r g b
+    ],
+)
 def test_compute_takes_every_point_cloud_text_file(sphere_points, tmp_path, capsys, extension, write):
     """Issue 29, class 9: .csv and .txt clouds exited 1 (read as meshes); .pts files were refused."""
     points = np.loadtxt(sphere_points)

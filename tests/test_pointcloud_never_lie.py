@@ -60,8 +60,9 @@ def test_oriented_signs_passes_the_sign_reversed_across_a_gap():
 
     distances, indices = normals_module.knn(cKDTree(points), points)
     normals = np.tile([0.0, 0.0, 1.0], (1800, 1))
-    signs, labels, doubtful, sheets, _ = normals_module.oriented_signs(points, normals, indices, np.ones(1800, bool),
-                                                                    normals_module.local_spacing(distances))
+    signs, labels, doubtful, sheets, _ = normals_module.oriented_signs(
+        points, normals, indices, np.ones(1800, bool), normals_module.local_spacing(distances)
+    )
     assert np.unique(labels).size == 1
     assert np.all(signs[:900] == signs[0]) and np.all(signs[900:] == -signs[0])
     assert not doubtful.any()
@@ -75,8 +76,9 @@ def test_near_duplicates_are_merged_with_one_warning(copies):
     n = 1500
     base = sphere(n)
     rng = np.random.default_rng(4)
-    points = np.concatenate([base * (1 + 1e-12 * rng.normal(size=(n, 1))) + 1e-13 * rng.normal(size=base.shape)
-                             for _ in range(copies)])
+    points = np.concatenate(
+        [base * (1 + 1e-12 * rng.normal(size=(n, 1))) + 1e-13 * rng.normal(size=base.shape) for _ in range(copies)]
+    )
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
         r = point_cloud_curvatures(points)
@@ -86,7 +88,7 @@ def test_near_duplicates_are_merged_with_one_warning(copies):
     assert r.valid.all()
     assert np.abs(r.mean - 1.0).max() < 0.1
     # the copies carry their representative's values, and the radius comes from the spacing of the distinct points
-    assert np.array_equal(r.mean[:n], r.mean[n:2 * n])
+    assert np.array_equal(r.mean[:n], r.mean[n : 2 * n])
     single = quiet(base)
     assert r.parameters["radius"] == pytest.approx(single.parameters["radius"], rel=1e-6)
 
@@ -136,11 +138,14 @@ def test_jets_on_a_plate_thinner_than_any_ball_are_invalid_with_the_reason():
     r = quiet(points, normals=normals, method="jets", radius=0.5)
     inside = np.abs(g).max(axis=1) < 2.0
     assert not r.valid[inside].any()
-    assert (r.invalid_reason[inside] == INVALID_REASONS.index(
-        "point cloud: every ball held the other side of a thin part or a neighbouring part")).all()
+    assert (
+        r.invalid_reason[inside]
+        == INVALID_REASONS.index("point cloud: every ball held the other side of a thin part or a neighbouring part")
+    ).all()
 
 
 # ----------------------------------------------------------------------------- the side of whole parts (winding)
+
 
 def _outward_or_invalid(r, points, centres, expected_mean):
     """Valid points: normal on the exact side, H within 20% of the exact value (never the opposite sign)."""
@@ -153,15 +158,18 @@ def _outward_or_invalid(r, points, centres, expected_mean):
 
 
 @pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
-@pytest.mark.parametrize("n, gap, seed", [(400, 1.0, 3), (400, 1.0, 5), (1000, 1.0, 2), (1000, 1.5, 29), (1000, 1.5, 0)])
+@pytest.mark.parametrize(
+    "n, gap, seed", [(400, 1.0, 3), (400, 1.0, 5), (1000, 1.0, 2), (1000, 1.5, 29), (1000, 1.5, 0)]
+)
 def test_two_spheres_of_different_sizes_close_together_are_outward_or_invalid(method, n, gap, seed):
     # class 1 (the fuzzer's last 17 cases): spheres of radii 1 and 1.5, 1-1.5 spacings apart; one came out
     # inside out (H = -1/R at every point, valid): with these seeds (found by sampling; seed 0 was right), the
     # orientation's forest crosses the gap by flat edges. Exact: outward normals, H = +1/R
     spacing = np.sqrt(4 * np.pi / n)
     gap_centre = 2.5 + gap * spacing
-    points = np.concatenate([sphere(n, seed=seed),
-                             sphere(int(2.25 * n), radius=1.5, centre=(gap_centre, 0, 0), seed=seed + 100)])
+    points = np.concatenate(
+        [sphere(n, seed=seed), sphere(int(2.25 * n), radius=1.5, centre=(gap_centre, 0, 0), seed=seed + 100)]
+    )
     first = np.arange(points.shape[0]) < n
     centres = np.where(first[:, None], 0.0, np.array([gap_centre, 0.0, 0.0]))
     r = quiet(points, method=method)
@@ -215,8 +223,7 @@ def test_winding_number_of_a_sphere_is_one_half_on_it_and_its_backends_agree():
     values = {}
     for backend in ("numpy", "numba"):
         with use_backend(backend):
-            values[backend] = normals_module.winding_numbers(points, points, spacing**2, usable, tree, queries,
-                                                             sources)
+            values[backend] = normals_module.winding_numbers(points, points, spacing**2, usable, tree, queries, sources)
     np.testing.assert_allclose(values["numba"], values["numpy"], rtol=1e-9, atol=1e-12)
     # the areas d_8^2 pi / 8 of random samples sum to the sphere's area within a few percent
     assert np.abs(values["numpy"] - 0.5).max() < 0.05
@@ -225,6 +232,7 @@ def test_winding_number_of_a_sphere_is_one_half_on_it_and_its_backends_agree():
 
 
 # ----------------------------------------------------------------------------- thin plates (issue 29, class 1 gap)
+
 
 def thin_ellipsoid(n, axes, seed, noise=0.0):
     """``n`` samples of the ellipsoid ``axes``, uniform by area, moved along the exact normal by uniform noise of
@@ -249,14 +257,17 @@ def thin_ellipsoid(n, axes, seed, noise=0.0):
     return points + rng.uniform(-noise, noise, size=(n, 1)) * spacing * exact, exact, resolved
 
 
-@pytest.mark.parametrize("n, axes, seed, noise, method", [
-    (2000, (1.0, 1.0, 0.02), 17, 0.0, "corrected_measures"),  # faces 0-0.97 spacings apart
-    (2000, (1.0, 1.0, 0.02), 5, 0.2, "corrected_measures"),
-    (4000, (1.0, 0.5, 0.02), 2, 0.0, "corrected_measures"),  # 0-1.7 spacings
-    (1000, (1.0, 0.5, 0.1), 36, 0.0, "corrected_measures"),  # 0-3.6 spacings: a face turned with the other
-    (2000, (1.0, 0.5, 0.05), 8, 0.2, "corrected_measures"),
-    (400, (1.0, 1.0, 0.05), 27, 0.0, "jets"),
-])
+@pytest.mark.parametrize(
+    "n, axes, seed, noise, method",
+    [
+        (2000, (1.0, 1.0, 0.02), 17, 0.0, "corrected_measures"),  # faces 0-0.97 spacings apart
+        (2000, (1.0, 1.0, 0.02), 5, 0.2, "corrected_measures"),
+        (4000, (1.0, 0.5, 0.02), 2, 0.0, "corrected_measures"),  # 0-1.7 spacings
+        (1000, (1.0, 0.5, 0.1), 36, 0.0, "corrected_measures"),  # 0-3.6 spacings: a face turned with the other
+        (2000, (1.0, 0.5, 0.05), 8, 0.2, "corrected_measures"),
+        (400, (1.0, 1.0, 0.05), 27, 0.0, "jets"),
+    ],
+)
 def test_the_faces_of_thin_plates_are_never_inward_and_valid(n, axes, seed, noise, method):
     # the fuzzer's thin ellipsoids (seed 29: 91 of 1488 cases with more than 50 inward valid points): a patch of a
     # face, or a whole face, turned with the other face, consistent with itself, valid. Exact: outward normals;
@@ -305,8 +316,11 @@ def _sheets_of(points, normals):
 def test_two_sheets_stacked_with_normals_the_same_way_are_flagged(gap):
     # one of the two is inside out: both faces of a thin part, or two parts, have opposite outward normals
     inner = None
-    for top, bottom, expected in (((0, 0, 1), (0, 0, 1), True), ((0, 0, 1), (0, 0, -1), False),
-                                  ((0, 0, -1), (0, 0, 1), False)):
+    for top, bottom, expected in (
+        ((0, 0, 1), (0, 0, 1), True),
+        ((0, 0, 1), (0, 0, -1), False),
+        ((0, 0, -1), (0, 0, 1), False),
+    ):
         points, normals = two_planes(gap, top, bottom)
         alike, _ = _sheets_of(points, normals)
         inner = (np.abs(points[:, :2] - 20) < 15).all(axis=1)
@@ -338,8 +352,9 @@ def test_between_sides_turns_the_faces_of_a_thin_part_that_face_each_other():
     normals = np.where(turned[:, None], -exact, exact)
     tree = cKDTree(points)
     distances, indices = normals_module.knn(tree, points)
-    flips = normals_module.between_sides(points, normals, np.ones(4000, dtype=bool),
-                                         normals_module.local_spacing(distances), tree, indices)
+    flips = normals_module.between_sides(
+        points, normals, np.ones(4000, dtype=bool), normals_module.local_spacing(distances), tree, indices
+    )
     # where the faces are 1 to 3 spacings apart (the other face among the 48 nearest neighbours)
     spacing = np.median(normals_module.local_spacing(distances))
     apart = 0.2 * np.sqrt(np.maximum(1 - np.linalg.norm(points[:, :2], axis=1) ** 2, 0)) / spacing
@@ -360,8 +375,9 @@ def test_two_spheres_a_gap_apart_are_not_turned_between():
     normals = points - centres
     tree = cKDTree(points)
     distances, indices = normals_module.knn(tree, points)
-    flips = normals_module.between_sides(points, normals, np.ones(2 * n, dtype=bool),
-                                         normals_module.local_spacing(distances), tree, indices)
+    flips = normals_module.between_sides(
+        points, normals, np.ones(2 * n, dtype=bool), normals_module.local_spacing(distances), tree, indices
+    )
     assert (flips > 0).all()
 
 

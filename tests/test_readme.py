@@ -133,7 +133,8 @@ TIMING = re.compile(r"\d+(\.\d+)? ?(s|ms|min)\b")
 def same_output(expected, actual):
     """Lines equal, but for the numbers of timings (``1.2 s``, ``35 ms``)."""
     return len(expected) == len(actual) and all(
-        TIMING.sub("TIME", want).rstrip() == TIMING.sub("TIME", got).rstrip() for want, got in zip(expected, actual))
+        TIMING.sub("TIME", want).rstrip() == TIMING.sub("TIME", got).rstrip() for want, got in zip(expected, actual)
+    )
 
 
 @pytest.mark.slow  # meshcurv compute and plot, cold: several seconds
@@ -149,8 +150,9 @@ def test_console_transcript_is_the_real_output(index, readme_folder, capsys):
         out, err = capsys.readouterr()
         actual = (out + err).splitlines()
         assert code == 0, f"{command}: exit {code}\n{err}"
-        assert same_output(expected, actual), f"{command}\nREADME:\n" + "\n".join(expected) + "\nreal:\n" + "\n".join(
-            actual)
+        assert same_output(expected, actual), (
+            f"{command}\nREADME:\n" + "\n".join(expected) + "\nreal:\n" + "\n".join(actual)
+        )
 
 
 def test_every_console_command_is_checked():

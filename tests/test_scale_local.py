@@ -22,8 +22,13 @@ from meshcurv.jets import fit_jets
 from meshcurv.radius import LOCAL_EVEN, local_scale_ratios
 from meshcurv.topology import MeshTopology
 
-BACKENDS = ["numpy", pytest.param("numba", marks=pytest.mark.skipif(
-    __import__("importlib").util.find_spec("numba") is None, reason="numba not installed"))]
+BACKENDS = [
+    "numpy",
+    pytest.param(
+        "numba",
+        marks=pytest.mark.skipif(__import__("importlib").util.find_spec("numba") is None, reason="numba not installed"),
+    ),
+]
 
 
 def _half_refined_sphere(n_coarse=150, ratio=30.0, seed=7):

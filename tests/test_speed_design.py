@@ -71,8 +71,7 @@ def test_connected_jets_are_the_euclidean_jets_on_a_connected_surface():
     with use_backend("numpy"):
         euclidean, frame, counts = fit_jets(vertices, normals, 3 * h, degree=3)
     with use_backend("numba"):
-        connected, frame_c, counts_c = fit_jets(vertices, normals, 3 * h, degree=3,
-                                                adjacency=topology.neighbour_lists)
+        connected, frame_c, counts_c = fit_jets(vertices, normals, 3 * h, degree=3, adjacency=topology.neighbour_lists)
         normals_c = fit_jet_normals(vertices, normals, 3 * h, degree=3, adjacency=topology.neighbour_lists)
     np.testing.assert_array_equal(counts_c, counts)
     assert counts.min() >= 10  # every ball holds a degree-3 fit
@@ -89,8 +88,9 @@ def test_connected_jets_leave_out_the_other_sheet_and_unlisted_vertices():
     neighbours[::5] = False
     with use_backend("numba"):
         _, _, both = fit_jets(vertices, normals, 0.27, degree=2, neighbours=neighbours)
-        _, _, counts = fit_jets(vertices, normals, 0.27, degree=2, neighbours=neighbours,
-                                adjacency=topology.neighbour_lists)
+        _, _, counts = fit_jets(
+            vertices, normals, 0.27, degree=2, neighbours=neighbours, adjacency=topology.neighbour_lists
+        )
     # brute force: the points of the centre's own sheet within the radius, listed in `neighbours`
     distances = np.linalg.norm(vertices[:, None, :] - vertices[None, :, :], axis=2)
     sheet = np.arange(vertices.shape[0]) >= n
@@ -108,12 +108,18 @@ def test_adjacency_of_another_mesh_is_refused(function):
         function(vertices, vertices, 3 * h, adjacency=(indptr[:-1], indices))
 
 
-@pytest.mark.parametrize(("option", "match"), [("normals", "`normals` must have shape"),
-                                               ("neighbours", "`neighbours` must have shape")])
+@pytest.mark.parametrize(
+    ("option", "match"), [("normals", "`normals` must have shape"), ("neighbours", "`neighbours` must have shape")]
+)
 def test_fit_jet_normals_refuses_arrays_of_another_size(option, match):
     vertices, _, topology, h = _irregular_sphere()
     arguments = {"normals": vertices, "neighbours": np.ones(vertices.shape[0], dtype=bool)}
     arguments[option] = arguments[option][:-1]
     with use_backend("numba"), pytest.raises(ValueError, match=match):
-        fit_jet_normals(vertices, arguments["normals"], 3 * h, neighbours=arguments["neighbours"],
-                        adjacency=topology.neighbour_lists)
+        fit_jet_normals(
+            vertices,
+            arguments["normals"],
+            3 * h,
+            neighbours=arguments["neighbours"],
+            adjacency=topology.neighbour_lists,
+        )

@@ -114,19 +114,22 @@ def test_triangulate_faces_returns_a_new_array():
     assert triangulate_faces(top).tolist() == faces.tolist() and triangulate_faces(top).flags.writeable
 
 
-@pytest.mark.parametrize("polygons, message", [
-    ([[0, 1, 2], [0, 1]], "has a face with fewer than 3 vertices"),
-    ([[[0, 1], [2, 3], [4, 5]], [[0, 1], [2, 3], [4, 5], [6, 7]]], "a face holds nested lists"),
-    ([[0, 1, 2, 3], [[0, 1], [2, 3], [4, 5]]], "could not be converted to an array"),
-    ([[0, 1, 2], 3], "items are not sequences"),
-    ([[0, 1, 2], "abc"], "items are not sequences"),
-    ([[0, 1, 2], [0, 1, 2.5, 3]], "non-integer values"),
-    ([[0, 1, 2], [2**64, 0, 1, 3]], "indices too large for int64"),
-    ([[0, 1, 2], [0, 1, "x", 3]], "must hold integer vertex indices"),
-    ([[0, 1, 2], [0, -4, 1, 3]], r"negative vertex indices \(smallest -4\)"),
-    (np.zeros((0, 3), np.int64), "is empty"),
-    (b"012", "got a bytes"),
-])
+@pytest.mark.parametrize(
+    "polygons, message",
+    [
+        ([[0, 1, 2], [0, 1]], "has a face with fewer than 3 vertices"),
+        ([[[0, 1], [2, 3], [4, 5]], [[0, 1], [2, 3], [4, 5], [6, 7]]], "a face holds nested lists"),
+        ([[0, 1, 2, 3], [[0, 1], [2, 3], [4, 5]]], "could not be converted to an array"),
+        ([[0, 1, 2], 3], "items are not sequences"),
+        ([[0, 1, 2], "abc"], "items are not sequences"),
+        ([[0, 1, 2], [0, 1, 2.5, 3]], "non-integer values"),
+        ([[0, 1, 2], [2**64, 0, 1, 3]], "indices too large for int64"),
+        ([[0, 1, 2], [0, 1, "x", 3]], "must hold integer vertex indices"),
+        ([[0, 1, 2], [0, -4, 1, 3]], r"negative vertex indices \(smallest -4\)"),
+        (np.zeros((0, 3), np.int64), "is empty"),
+        (b"012", "got a bytes"),
+    ],
+)
 def test_triangulate_faces_names_what_is_wrong(polygons, message):
     with pytest.raises(InvalidMeshError, match=rf"^`polygons` .*{message}"):
         triangulate_faces(polygons)
@@ -148,8 +151,11 @@ def test_from_faces_checks_the_faces_against_the_vertex_count():
 @pytest.mark.slow
 def test_from_faces_without_a_count_refuses_a_stray_huge_index():
     far = 2**24  # the floor of inferred counts: one face may reach it, not beyond
-    with pytest.raises(InvalidMeshError, match=rf"reference vertex index {far} but hold only 3 corners: pass "
-                                               r"`n_vertices`"):
+    with pytest.raises(
+        InvalidMeshError,
+        match=rf"reference vertex index {far} but hold only 3 corners: pass "
+        r"`n_vertices`",
+    ):
         MeshTopology.from_faces(np.array([[0, 1, far]]))
     with pytest.raises(InvalidMeshError, match=r"beyond the largest mesh meshcurv takes \(n_vertices up to"):
         MeshTopology.from_faces(np.array([[0, 1, 2**31]]))

@@ -107,8 +107,15 @@ def test_voxel_grid_is_found_on_marching_cubes_meshes_only(voxel_meshes):
         grid = voxel_grid(moved)
         assert grid is not None and grid.fraction >= 0.95
         np.testing.assert_allclose(grid.spacing, mesh.spacing, rtol=1e-9)
-    for smooth in (shapes.torus(), shapes.saddle(), shapes.icosphere(8), shapes.cylinder(), shapes.uv_sphere(),
-                   shapes.random_sphere(), shapes.ellipsoid()):
+    for smooth in (
+        shapes.torus(),
+        shapes.saddle(),
+        shapes.icosphere(8),
+        shapes.cylinder(),
+        shapes.uv_sphere(),
+        shapes.random_sphere(),
+        shapes.ellipsoid(),
+    ):
         assert voxel_grid(smooth.vertices) is None
         r = quiet(smooth.vertices, smooth.faces)
         assert r.parameters["surface"] == "smooth"
@@ -150,8 +157,9 @@ def test_soups_and_seams_give_the_welded_mesh_values(method, split):
     np.testing.assert_array_equal(r.valid[used], welded.valid[origin[used]])
     scale = np.nanmax(np.abs(welded.k_max))
     for field in ("k_min", "k_max", "mean", "gaussian"):
-        np.testing.assert_allclose(getattr(r, field)[used], getattr(welded, field)[origin[used]],
-                                   rtol=1e-9, atol=1e-9 * scale)
+        np.testing.assert_allclose(
+            getattr(r, field)[used], getattr(welded, field)[origin[used]], rtol=1e-9, atol=1e-9 * scale
+        )
 
 
 def test_weld_false_keeps_the_soup_as_given():
@@ -160,8 +168,9 @@ def test_weld_false_keeps_the_soup_as_given():
     with pytest.warns(MeshQualityWarning, match="boundary"):
         r = meshcurv.principal_curvatures(vertices, faces, method="normal_cycle", weld=False)
     assert not r.valid.any()
-    assert (r.invalid_reason == INVALID_REASONS.index(
-        "on a boundary edge (this method needs a closed neighbourhood)")).all()
+    assert (
+        r.invalid_reason == INVALID_REASONS.index("on a boundary edge (this method needs a closed neighbourhood)")
+    ).all()
     with pytest.raises(InvalidOptionError, match="`weld` must be True or False; got 'yes'"):
         meshcurv.principal_curvatures(vertices, faces, weld="yes")
 

@@ -28,7 +28,10 @@ def call(vertices=QUAD_VERTICES, faces=TRI, **options):
         (np.array([["a", "b", "c"]] * 4), "must hold real numbers"),
         (np.zeros((4, 3), dtype=complex), "must hold real numbers"),
         ([[0, 0, 0], [1, 0], [1, 1, 0], [0, 1, 0]], "could not be converted"),
-        (np.where(np.arange(12).reshape(4, 3) == 4, np.nan, 0.0), r"NaN or infinite coordinates at 1 vertices \(first at index 1\)"),
+        (
+            np.where(np.arange(12).reshape(4, 3) == 4, np.nan, 0.0),
+            r"NaN or infinite coordinates at 1 vertices \(first at index 1\)",
+        ),
         (np.where(np.arange(12).reshape(4, 3) == 11, np.inf, 0.0), "NaN or infinite"),
     ],
 )
@@ -67,11 +70,13 @@ def test_integral_float_faces_are_accepted():
 @pytest.mark.parametrize(
     "options, match",
     [
-        ({"method": "rusinkiewicz_typo"}, "unknown method 'rusinkiewicz_typo'; choose one of 'normal_cycle', 'matgeom'"),
+        (
+            {"method": "rusinkiewicz_typo"},
+            "unknown method 'rusinkiewicz_typo'; choose one of 'normal_cycle', 'matgeom'",
+        ),
         ({"method": None}, "unknown method None"),
         ({"method": "normal_cycle", "smoothing_steps": -1}, "`smoothing_steps` must be an integer >= 0; got -1"),
-        ({"method": "normal_cycle", "smoothing_steps": 2.5},
-         r"`smoothing_steps` must be an integer >= 0; got 2.5"),
+        ({"method": "normal_cycle", "smoothing_steps": 2.5}, r"`smoothing_steps` must be an integer >= 0; got 2.5"),
         ({"method": "matgeom", "smoothing_steps": True}, "`smoothing_steps` must be an integer"),
         ({"smoothing_steps": 2}, "method 'icc' does not take the option `smoothing_steps`"),
     ],
@@ -164,11 +169,15 @@ def test_trusted_arrays_skip_the_helpers_checks_only_as_themselves_and_only_insi
 SPHERE = shapes.icosphere(4)
 
 
-@pytest.mark.parametrize("faces", [SPHERE.faces.T, SPHERE.faces.T.tolist(), SPHERE.faces.T.astype(float)],
-                         ids=["array", "list", "float"])
+@pytest.mark.parametrize(
+    "faces", [SPHERE.faces.T, SPHERE.faces.T.tolist(), SPHERE.faces.T.astype(float)], ids=["array", "list", "float"]
+)
 def test_transposed_faces_are_refused_with_the_transpose_suggested(faces):
-    with pytest.raises(InvalidMeshError, match=r"`faces` has shape \(3, 320\) and looks transposed: .* pass "
-                                               r"`faces.T`"):
+    with pytest.raises(
+        InvalidMeshError,
+        match=r"`faces` has shape \(3, 320\) and looks transposed: .* pass "
+        r"`faces.T`",
+    ):
         meshcurv.principal_curvatures(SPHERE.vertices, faces)
 
 
@@ -178,18 +187,30 @@ def test_three_polygons_of_many_corners_are_not_taken_for_transposed_faces():
 
 
 def test_vertices_and_faces_swapped_are_named():
-    with pytest.raises(InvalidMeshError, match=r"`faces` has non-integer values; .*\(a float64 array of shape "
-                                               r"\(162, 3\): coordinates\? were `vertices` and `faces` swapped\?"):
+    with pytest.raises(
+        InvalidMeshError,
+        match=r"`faces` has non-integer values; .*\(a float64 array of shape "
+        r"\(162, 3\): coordinates\? were `vertices` and `faces` swapped\?",
+    ):
         meshcurv.principal_curvatures(SPHERE.faces, SPHERE.vertices)
 
 
-@pytest.mark.parametrize("alone, match", [
-    (SPHERE.faces, r"`faces` is missing: `vertices` is an int64 array of shape \(320, 3\), not a mesh object; "
-                   r"pass `principal_curvatures\(vertices, faces\)` \(integer indices: it looks like the faces"),
-    (SPHERE.vertices, r"`faces` is missing: `vertices` is a float64 array of shape \(162, 3\), not a mesh object; "
-                      r".*for points without faces use meshcurv.point_cloud_curvatures"),
-    (SPHERE.vertices.tolist(), r"`faces` is missing: `vertices` is a float64 array of shape \(162, 3\)"),
-])
+@pytest.mark.parametrize(
+    "alone, match",
+    [
+        (
+            SPHERE.faces,
+            r"`faces` is missing: `vertices` is an int64 array of shape \(320, 3\), not a mesh object; "
+            r"pass `principal_curvatures\(vertices, faces\)` \(integer indices: it looks like the faces",
+        ),
+        (
+            SPHERE.vertices,
+            r"`faces` is missing: `vertices` is a float64 array of shape \(162, 3\), not a mesh object; "
+            r".*for points without faces use meshcurv.point_cloud_curvatures",
+        ),
+        (SPHERE.vertices.tolist(), r"`faces` is missing: `vertices` is a float64 array of shape \(162, 3\)"),
+    ],
+)
 def test_an_array_alone_is_told_to_come_with_its_faces(alone, match):
     with pytest.raises(InvalidMeshError, match=match):
         meshcurv.principal_curvatures(alone)

@@ -13,7 +13,6 @@ total Gaussian curvature within 1.2%. The tests allow 3% (area, H) and 2%
 (volume, total K): the targets of issue 17.
 """
 
-
 import numpy as np
 import pytest
 
@@ -25,16 +24,35 @@ from meshcurv.volume import COLUMNS, label_curvatures  # noqa: E402
 
 UNIT = (1.0, 1.0, 1.0)  # the voxel size of the tests (a call without spacing warns)
 
-REQUIRED = ("label", "n_vertices", "area", "volume", "equivalent_radius", "mean_weighted", "mean_median",
-            "mean_p5", "mean_p95", "gaussian_weighted", "k_min_weighted", "k_max_weighted", "shape_index_weighted",
-            "curvedness_weighted", "total_mean", "total_gaussian", "willmore", "euler_characteristic",
-            "touches_border", "n_invalid", "status", "error")
+REQUIRED = (
+    "label",
+    "n_vertices",
+    "area",
+    "volume",
+    "equivalent_radius",
+    "mean_weighted",
+    "mean_median",
+    "mean_p5",
+    "mean_p95",
+    "gaussian_weighted",
+    "k_min_weighted",
+    "k_max_weighted",
+    "shape_index_weighted",
+    "curvedness_weighted",
+    "total_mean",
+    "total_gaussian",
+    "willmore",
+    "euler_characteristic",
+    "touches_border",
+    "n_invalid",
+    "status",
+    "error",
+)
 
 
 def solid(shape, spacing, center, semi_axes, rotation=None):
     """Boolean image of the solid ellipsoid ``|R^T (p - center) / semi_axes| <= 1``, physical units."""
-    axes = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(shape, spacing, center)], indexing="ij",
-                       sparse=True)
+    axes = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(shape, spacing, center)], indexing="ij", sparse=True)
     turn = np.eye(3) if rotation is None else rotation
     body = [sum(turn[k, j] * axes[k] for k in range(3)) for j in range(3)]
     return sum((body[j] / semi_axes[j]) ** 2 for j in range(3)) <= 1
@@ -46,8 +64,13 @@ def ellipsoid_integrals(a, b, c, n=600):
     p = (np.arange(2 * n) + 0.5) * np.pi / n
     t, p = np.meshgrid(t, p, indexing="ij")
     x, y, z = a * np.sin(t) * np.cos(p), b * np.sin(t) * np.sin(p), c * np.cos(t)
-    element = np.sin(t) * np.sqrt((b * c * np.sin(t) * np.cos(p)) ** 2 + (a * c * np.sin(t) * np.sin(p)) ** 2
-                                  + (a * b * np.cos(t)) ** 2) * (np.pi / n) ** 2
+    element = (
+        np.sin(t)
+        * np.sqrt(
+            (b * c * np.sin(t) * np.cos(p)) ** 2 + (a * c * np.sin(t) * np.sin(p)) ** 2 + (a * b * np.cos(t)) ** 2
+        )
+        * (np.pi / n) ** 2
+    )
     g2 = (x / a**2) ** 2 + (y / b**2) ** 2 + (z / c**2) ** 2
     mean = (a * a + b * b + c * c - x * x - y * y - z * z) / (2 * (a * b * c) ** 2 * g2**1.5)
     return element.sum(), (mean * element).sum()
@@ -92,8 +115,9 @@ def test_sphere_area_volume_curvature_and_gauss_bonnet():
 def test_rotated_ellipsoid_with_anisotropic_voxels():
     semi_axes = np.array([10.0, 7.0, 6.0])
     spacing = (1.0, 0.5, 0.5)
-    rotation = np.array([[0.8, 0.6, 0.0], [-0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]) @ \
-        np.array([[1.0, 0.0, 0.0], [0.0, 0.6, -0.8], [0.0, 0.8, 0.6]])
+    rotation = np.array([[0.8, 0.6, 0.0], [-0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]) @ np.array(
+        [[1.0, 0.0, 0.0], [0.0, 0.6, -0.8], [0.0, 0.8, 0.6]]
+    )
     image = solid((26, 52, 52), spacing, (12.6, 12.9, 13.1), semi_axes, rotation)
     row = label_curvatures(image, spacing=spacing).iloc[0]
     area, integral = ellipsoid_integrals(*semi_axes)
@@ -204,32 +228,37 @@ def test_no_label_gives_an_empty_table():
 def test_boolean_mask_and_progress():
     mask = solid((20, 20, 20), (1, 1, 1), (9.6, 9.9, 10.2), (7.0,) * 3)
     calls = []
-    table = label_curvatures(mask, spacing=UNIT,
-                             progress=lambda done, total, label: calls.append((done, total, label)))
+    table = label_curvatures(mask, spacing=UNIT, progress=lambda done, total, label: calls.append((done, total, label)))
     assert list(table.label) == [1] and calls == [(1, 1, 1)]
 
 
-@pytest.mark.parametrize("labels, message", [
-    (np.zeros((5, 5, 5)), "integer label image or a boolean mask; got dtype float64"),
-    (np.zeros((5, 5), dtype=int), "3D image .* got 2 dimensions"),
-    (np.zeros((0, 5, 5), dtype=int), "empty"),
-    (-np.ones((5, 5, 5), dtype=int), ">= 0"),
-])
+@pytest.mark.parametrize(
+    "labels, message",
+    [
+        (np.zeros((5, 5, 5)), "integer label image or a boolean mask; got dtype float64"),
+        (np.zeros((5, 5), dtype=int), "3D image .* got 2 dimensions"),
+        (np.zeros((0, 5, 5), dtype=int), "empty"),
+        (-np.ones((5, 5, 5), dtype=int), ">= 0"),
+    ],
+)
 def test_image_errors(labels, message):
     with pytest.raises(InvalidMeshError, match=message):
         label_curvatures(labels)
 
 
-@pytest.mark.parametrize("options, message", [
-    ({"spacing": (1, 0, 1)}, "positive and finite"),
-    ({"spacing": (1, -0.5, 1)}, "positive and finite"),
-    ({"spacing": (1, 1)}, "3 numbers"),
-    ({"labels_to_use": [0]}, ">= 1"),
-    ({"labels_to_use": [1.5]}, "integer labels"),
-    ({"radius": -1.0}, "radius"),
-    ({"method": "nope"}, "method"),
-    ({"progress": 3}, "callable"),
-])
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"spacing": (1, 0, 1)}, "positive and finite"),
+        ({"spacing": (1, -0.5, 1)}, "positive and finite"),
+        ({"spacing": (1, 1)}, "3 numbers"),
+        ({"labels_to_use": [0]}, ">= 1"),
+        ({"labels_to_use": [1.5]}, "integer labels"),
+        ({"radius": -1.0}, "radius"),
+        ({"method": "nope"}, "method"),
+        ({"progress": 3}, "callable"),
+    ],
+)
 def test_option_errors(options, message):
     image = np.zeros((20, 20, 20), dtype=np.uint8)
     image[5:15, 5:15, 5:15] = 1
@@ -238,6 +267,7 @@ def test_option_errors(options, message):
 
 
 # ---- the readers ---------------------------------------------------------------------------------------------------
+
 
 def small_labels():
     image = np.zeros((6, 7, 8), dtype=np.uint16)
@@ -263,8 +293,9 @@ def test_read_tiff_and_nifti_with_spacing(tmp_path):
     from meshcurv.io._images import read_image
 
     image = small_labels()
-    tifffile.imwrite(tmp_path / "a.tif", image, imagej=True, resolution=(1 / 0.25, 1 / 0.3),
-                     metadata={"spacing": 2.0, "unit": "um"})
+    tifffile.imwrite(
+        tmp_path / "a.tif", image, imagej=True, resolution=(1 / 0.25, 1 / 0.3), metadata={"spacing": 2.0, "unit": "um"}
+    )
     read = read_image(tmp_path / "a.tif")
     assert np.array_equal(read.array, image) and read.spacing == pytest.approx((2.0, 0.3, 0.25))
     # NIfTI holds (i, j, k) = (x, y, z): read back as (z, y, x), pixdim with it
@@ -311,6 +342,7 @@ def test_reader_refuses_huge_declared_sizes(tmp_path, monkeypatch):
 
 # ---- the command ---------------------------------------------------------------------------------------------------
 
+
 def run_volume(args):
     """``meshcurv volume ARGS`` in-process (click's CliRunner, the group's Session as meshcurv.cli.main makes it)."""
     click_testing = pytest.importorskip("click.testing")
@@ -331,8 +363,7 @@ def test_cli_writes_csv_and_parquet_meshes_and_picture(tmp_path):
     image[3, 30, 30] = 9  # one voxel
     np.save(tmp_path / "cells.npy", image)
     out = tmp_path / "out"
-    result = run_volume([tmp_path / "cells.npy", "-o", out, "--spacing", 1, 0.5, 0.5, "--meshes", "vtp",
-                         "--progress"])
+    result = run_volume([tmp_path / "cells.npy", "-o", out, "--spacing", 1, 0.5, 0.5, "--meshes", "vtp", "--progress"])
     assert result.exit_code == 0, result.output
     assert "2/2 labels, label 9 too_small" in result.output
     csv = pandas.read_csv(out / "cells_labels.csv")

@@ -29,8 +29,16 @@ from meshcurv.errors import MeshcurvWarning  # noqa: E402
 from meshcurv.volume import label_curvatures, label_surfaces  # noqa: E402
 
 UNIT = (1.0, 1.0, 1.0)
-CURVATURE_COLUMNS = ("mean_weighted", "mean_median", "gaussian_weighted", "k_max_p95", "total_mean", "total_gaussian",
-                     "willmore", "shape_index_fraction_cap")
+CURVATURE_COLUMNS = (
+    "mean_weighted",
+    "mean_median",
+    "gaussian_weighted",
+    "k_max_p95",
+    "total_mean",
+    "total_gaussian",
+    "willmore",
+    "shape_index_fraction_cap",
+)
 
 
 def ball(shape, spacing, center, radius):
@@ -86,7 +94,7 @@ def test_box_in_a_corner_has_the_area_of_its_three_inner_faces():
     corner = np.zeros((16, 16, 16), dtype=np.uint8)
     corner[:side, :side, :side] = 1
     whole = np.zeros((2 * side + 4,) * 3, dtype=np.uint8)
-    whole[2:2 + 2 * side, 2:2 + 2 * side, 2:2 + 2 * side] = 1  # the corner box mirrored across three image faces
+    whole[2 : 2 + 2 * side, 2 : 2 + 2 * side, 2 : 2 + 2 * side] = 1  # the corner box mirrored across three image faces
     row = label_curvatures(corner, spacing=UNIT).iloc[0]
     full = label_curvatures(whole, spacing=UNIT).iloc[0]
     assert row.touches_border and row.area > 0  # was 0: every vertex within reach of the cap
@@ -137,13 +145,17 @@ def test_one_voxel_thick_image_keeps_the_walls():
 
 # ---- the voxel size --------------------------------------------------------------------------------------------------
 
+
 def small_ball():
     return ball((16, 16, 16), UNIT, (7.6, 7.8, 7.3), 5.0).astype(np.uint8)
 
 
 def test_no_spacing_warns_once_saying_what_was_assumed():
-    with pytest.warns(MeshcurvWarning, match=r"label_curvatures: no `spacing` given .* taken as 1 x 1 x 1.* "
-                                             r"pass spacing=\(z, y, x\)") as caught:
+    with pytest.warns(
+        MeshcurvWarning,
+        match=r"label_curvatures: no `spacing` given .* taken as 1 x 1 x 1.* "
+        r"pass spacing=\(z, y, x\)",
+    ) as caught:
         table = label_curvatures(small_ball())
     assert len([w for w in caught if issubclass(w.category, MeshcurvWarning)]) == 1
     with warnings.catch_warnings():
@@ -176,6 +188,7 @@ def test_an_image_read_from_a_file_carries_its_spacing():
 
 
 # ---- curvature statistics of cut objects (issue 29, class 4 follow-up) -----------------------------------------------
+
 
 def test_a_sliver_cut_by_three_image_faces_has_nan_statistics_with_the_reason():
     # a ball of radius 10 voxels whose centre is 3.2-3.6 voxels beyond three image faces: a corner sliver.
@@ -216,6 +229,7 @@ def test_balls_cut_by_image_faces_give_right_curvature_or_none(spacing, faces, d
 
 # ---- the area of the part inside, whichever image faces cut it (issue 29, class 4) -----------------------------------
 
+
 def sphere_fraction_inside(depths, n=1_000_000):
     """The fraction of the unit sphere with ``x_k >= -depths[k]`` on the first axes: a Fibonacci lattice of
     ``n`` points (equal-area cells; error of order 1 / n on these piecewise-smooth regions)."""
@@ -237,9 +251,11 @@ def test_the_lattice_fraction_is_exact_where_it_is_known():
     assert sphere_fraction_inside([0.5]) == pytest.approx(0.75, abs=1e-5)  # a zone of height 1.5 R: 2 pi R h
 
 
-@pytest.mark.parametrize("radius, depths", [(9.0, (0.0, 0.0)), (10.0, (0.4, 0.4)), (10.0, (0.3, 0.6, 0.8)),
-                                            (12.0, (0.0, 0.0, 0.0))],
-                         ids=["quarter", "two-faces", "three-faces", "eighth"])
+@pytest.mark.parametrize(
+    "radius, depths",
+    [(9.0, (0.0, 0.0)), (10.0, (0.4, 0.4)), (10.0, (0.3, 0.6, 0.8)), (12.0, (0.0, 0.0, 0.0))],
+    ids=["quarter", "two-faces", "three-faces", "eighth"],
+)
 def test_ball_cut_by_several_image_faces_has_the_area_of_its_part_inside(radius, depths):
     # the centre ``depth * R`` inside the low face of the first axes (the face at -0.5 voxel); measured 0.0-1.3% off
     center = np.full(3, radius + 3.0)
@@ -261,8 +277,7 @@ def test_a_hemisphere_cut_by_a_high_face_in_any_axis_order_and_read_in_chunks_ha
     # the same solid cut by the low face (every axis reversed) and by a z face (axes swapped): the same surface
     # up to the marching-cubes triangulation's orientation (measured 1e-4)
     for turned in (image[::-1, ::-1, ::-1], image.transpose(2, 1, 0)):
-        assert label_curvatures(np.ascontiguousarray(turned), spacing=UNIT).area[0] == pytest.approx(row.area,
-                                                                                                      rel=1e-3)
+        assert label_curvatures(np.ascontiguousarray(turned), spacing=UNIT).area[0] == pytest.approx(row.area, rel=1e-3)
     # read a chunk at a time (chunk faces through the object are no image border), and by label_surfaces
     lazy = label_curvatures(LazyImage(image, chunks=(5, 7, 4)), spacing=UNIT).iloc[0]
     assert lazy.touches_border and lazy.area == pytest.approx(row.area, rel=1e-12)

@@ -27,9 +27,14 @@ from meshcurv.volume import label_curvatures  # noqa: E402
 UNIT = (1.0, 1.0, 1.0)  # the voxel size of the tests (a call without spacing warns)
 
 #: Labels 1-6: three balls and three rotated ellipsoids, of semi-axes 5-8 voxels (well under a second each).
-SOLIDS = {1: ((9.3, 10.1, 9.7), (6.0, 6.0, 6.0)), 2: ((10.2, 30.4, 11.1), (7.5, 5.0, 6.0)),
-          3: ((29.6, 10.3, 30.2), (5.5, 5.5, 5.5)), 4: ((30.1, 29.8, 9.6), (8.0, 6.0, 5.0)),
-          5: ((10.4, 10.6, 30.3), (6.5, 6.5, 6.5)), 6: ((29.7, 30.2, 29.9), (7.0, 5.5, 5.0))}
+SOLIDS = {
+    1: ((9.3, 10.1, 9.7), (6.0, 6.0, 6.0)),
+    2: ((10.2, 30.4, 11.1), (7.5, 5.0, 6.0)),
+    3: ((29.6, 10.3, 30.2), (5.5, 5.5, 5.5)),
+    4: ((30.1, 29.8, 9.6), (8.0, 6.0, 5.0)),
+    5: ((10.4, 10.6, 30.3), (6.5, 6.5, 6.5)),
+    6: ((29.7, 30.2, 29.9), (7.0, 5.5, 5.0)),
+}
 
 
 def labelled_solids() -> np.ndarray:
@@ -62,8 +67,9 @@ def image():
 @pytest.fixture(scope="module")
 def serial(image):
     with pytest.warns(MeshQualityWarning):
-        return label_curvatures(image, spacing=(1.0, 0.8, 0.8), labels_to_use=[6, 9, 2, 11, 7, 1, 3, 4, 5],
-                                return_meshes=True)
+        return label_curvatures(
+            image, spacing=(1.0, 0.8, 0.8), labels_to_use=[6, 9, 2, 11, 7, 1, 3, 4, 5], return_meshes=True
+        )
 
 
 def test_the_image_has_what_the_tests_need(serial):
@@ -79,9 +85,14 @@ def test_two_workers_give_the_rows_and_surfaces_of_the_serial_run(image, serial)
     expected, expected_surfaces = serial
     calls = []
     with pytest.warns(MeshQualityWarning, match="1 empty, 1 too_small"):
-        table, surfaces = label_curvatures(image, spacing=(1.0, 0.8, 0.8), labels_to_use=[6, 9, 2, 11, 7, 1, 3, 4, 5],
-                                           return_meshes=True, workers=2,
-                                           progress=lambda done, total, label: calls.append((done, total, label)))
+        table, surfaces = label_curvatures(
+            image,
+            spacing=(1.0, 0.8, 0.8),
+            labels_to_use=[6, 9, 2, 11, 7, 1, 3, 4, 5],
+            return_meshes=True,
+            workers=2,
+            progress=lambda done, total, label: calls.append((done, total, label)),
+        )
     assert_same_rows(table, expected)
     assert calls == [(done, 9, label) for done, label in enumerate(expected.label, start=1)]
     assert sorted(surfaces) == sorted(expected_surfaces)
@@ -92,7 +103,7 @@ def test_two_workers_give_the_rows_and_surfaces_of_the_serial_run(image, serial)
         np.testing.assert_allclose(surface.result.mean, expected_surfaces[label].result.mean, rtol=1e-9)
 
 
-FAULTS = '''
+FAULTS = """
 import json, os
 
 import numpy as np
@@ -115,7 +126,7 @@ def _faulty(label, padded, starts, stops, image_shape, spacing, method, radius):
 
 def dask_setup(worker):
     volume._crop_label = _faulty
-'''
+"""
 
 
 @pytest.fixture(scope="module")
@@ -127,10 +138,18 @@ def faulty_client(tmp_path_factory):
     folder = tmp_path_factory.mktemp("faults")
     preload = folder / "meshcurv_faults.py"
     preload.write_text(textwrap.dedent(FAULTS.format(log=str(folder / "calls.jsonl"), raising=2, dying=4)))
-    with dask.config.set(volume.CLUSTER_CONFIG), \
-            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                     dashboard_address=None, preload=[str(preload)]) as cluster, \
-            distributed.Client(cluster) as client:
+    with (
+        dask.config.set(volume.CLUSTER_CONFIG),
+        distributed.LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            preload=[str(preload)],
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
         client.calls = folder / "calls.jsonl"
         yield client
 
@@ -141,8 +160,9 @@ def test_a_label_that_raises_or_kills_its_worker_fails_alone(image, serial, faul
 
     expected, _ = serial
     with pytest.warns(MeshQualityWarning, match="2 failed"):
-        table = label_curvatures(image, spacing=(1.0, 0.8, 0.8), labels_to_use=[6, 9, 2, 11, 7, 1, 3, 4, 5],
-                                 client=faulty_client)
+        table = label_curvatures(
+            image, spacing=(1.0, 0.8, 0.8), labels_to_use=[6, 9, 2, 11, 7, 1, 3, 4, 5], client=faulty_client
+        )
     assert list(table.label) == list(expected.label)
     failed = table[table.status == "failed"].set_index("label")
     assert list(failed.index) == [2, 4]
@@ -171,14 +191,31 @@ def test_cli_workers_writes_the_serial_table(tmp_path, image, serial):
     from test_volume import run_volume
 
     np.save(tmp_path / "cells.npy", image)
-    result = run_volume([tmp_path / "cells.npy", "-o", tmp_path / "out", "--spacing", 1, 0.8, 0.8, "--no-picture",
-                         "--workers", 2, "--labels", "6,9,2,11,7,1,3,4,5", "--meshes", "npz"])
+    result = run_volume(
+        [
+            tmp_path / "cells.npy",
+            "-o",
+            tmp_path / "out",
+            "--spacing",
+            1,
+            0.8,
+            0.8,
+            "--no-picture",
+            "--workers",
+            2,
+            "--labels",
+            "6,9,2,11,7,1,3,4,5",
+            "--meshes",
+            "npz",
+        ]
+    )
     assert result.exit_code == 0, result.output
     table = pandas.read_parquet(tmp_path / "out" / "cells_labels.parquet")
     expected, _ = serial
     assert_same_rows(table, expected)
     assert sorted(path.name for path in (tmp_path / "out").glob("*.npz")) == sorted(
-        f"cells_label_{label}.npz" for label in (1, 2, 3, 4, 5, 6, 7))
+        f"cells_label_{label}.npz" for label in (1, 2, 3, 4, 5, 6, 7)
+    )
 
 
 def test_groups_share_the_labels_out_by_voxels_in_order():
@@ -195,12 +232,15 @@ def test_groups_share_the_labels_out_by_voxels_in_order():
     assert volume._groups(volume._objects(image, [100]), workers=2) == []  # an empty label is no task
 
 
-@pytest.mark.parametrize("options, message", [
-    ({"workers": 0}, "`workers` must be an integer between 1 and"),
-    ({"workers": 2.5}, "`workers` must be an integer"),
-    ({"workers": 2, "client": object()}, "not both"),
-    ({"client": object()}, "`client` must be a distributed.Client; got object"),
-])
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"workers": 0}, "`workers` must be an integer between 1 and"),
+        ({"workers": 2.5}, "`workers` must be an integer"),
+        ({"workers": 2, "client": object()}, "not both"),
+        ({"client": object()}, "`client` must be a distributed.Client; got object"),
+    ],
+)
 def test_parallel_option_errors(options, message):
     pytest.importorskip("distributed")
     with pytest.raises(InvalidOptionError, match=message):

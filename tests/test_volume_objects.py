@@ -46,9 +46,15 @@ def _write_two_pieces(path):
     second = (np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1], [1, 1, 1.0]]), np.array([[0, 1, 2], [1, 3, 2]]))
     with open(path, "wb") as handle, PieceWriter(handle) as writer:
         for number, (vertices, faces) in enumerate((first, second), start=1):
-            writer.add(vertices, faces, {"label": np.full(len(vertices), number, dtype=np.uint64),
-                                         "normals": np.tile([0, 0, 1.0], (len(vertices), 1))},
-                       {"label": np.full(len(faces), number, dtype=np.uint64)})
+            writer.add(
+                vertices,
+                faces,
+                {
+                    "label": np.full(len(vertices), number, dtype=np.uint64),
+                    "normals": np.tile([0, 0, 1.0], (len(vertices), 1)),
+                },
+                {"label": np.full(len(faces), number, dtype=np.uint64)},
+            )
     return first, second
 
 

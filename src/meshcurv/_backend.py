@@ -84,9 +84,7 @@ COMPILE_MESSAGE = (
 def _requested() -> str:
     choice = _override.get() or os.environ.get("MESHCURV_BACKEND", "auto")
     if choice not in BACKENDS:
-        raise InvalidOptionError(
-            f"unknown backend {choice!r} (MESHCURV_BACKEND); choose one of {', '.join(BACKENDS)}"
-        )
+        raise InvalidOptionError(f"unknown backend {choice!r} (MESHCURV_BACKEND); choose one of {', '.join(BACKENDS)}")
     return choice
 
 
@@ -98,8 +96,10 @@ _imported: tuple[ModuleType, None] | tuple[None, ImportError] | None = None
 _logged: set = set()
 
 #: The INFO line when numba cannot be imported.
-MISSING_MESSAGE = ("meshcurv backend: numpy (numba cannot be imported: %s); pip install numba gives "
-                   "the compiled kernels, several times faster")
+MISSING_MESSAGE = (
+    "meshcurv backend: numpy (numba cannot be imported: %s); pip install numba gives "
+    "the compiled kernels, several times faster"
+)
 
 
 def _import_kernels() -> tuple[ModuleType, None] | tuple[None, ImportError]:
@@ -144,9 +144,7 @@ def _compiled():
     package, error = _import_kernels()
     if package is None:
         if choice == "numba":
-            raise MissingDependencyError(
-                f"the numba backend needs numba ({error}): pip install numba"
-            ) from None
+            raise MissingDependencyError(f"the numba backend needs numba ({error}): pip install numba") from None
         _log_once("missing", MISSING_MESSAGE, error)
         return None
     if "numba" not in _logged:

@@ -103,8 +103,12 @@ class LazyImage:
 
 def is_lazy(labels) -> bool:
     """Whether ``labels`` is read box by box: a :class:`LazyImage` (or a Zarr or Dask array, wrapped by :func:`as_lazy`)."""
-    return isinstance(labels, LazyImage) or (not isinstance(labels, np.ndarray) and hasattr(labels, "chunks")
-                                             and hasattr(labels, "shape") and hasattr(labels, "dtype"))
+    return isinstance(labels, LazyImage) or (
+        not isinstance(labels, np.ndarray)
+        and hasattr(labels, "chunks")
+        and hasattr(labels, "shape")
+        and hasattr(labels, "dtype")
+    )
 
 
 def as_lazy(labels) -> LazyImage:
@@ -118,7 +122,8 @@ def check_lazy_labels(image: LazyImage) -> LazyImage:
         raise InvalidMeshError(
             f"`labels` must be an integer label image or a boolean mask; got dtype {image.dtype} (a probability map "
             "read lazily cannot be thresholded: its components would span chunks; threshold it into a label image "
-            "first)")
+            "first)"
+        )
     if image.size == 0:
         raise InvalidMeshError(f"`labels` is empty; got shape {image.shape}")
     return image
@@ -140,8 +145,10 @@ def lazy_objects(image: LazyImage, wanted, find_objects) -> dict:
         if block.dtype == bool:
             block = block.view(np.uint8)
         if block.dtype.kind == "i" and block.size and block.min() < 0:
-            raise InvalidMeshError(f"`labels` must be >= 0 (0 is the background); got the value {int(block.min())} "
-                                   f"in the chunk at {tuple(starts.tolist())}")
+            raise InvalidMeshError(
+                f"`labels` must be >= 0 (0 is the background); got the value {int(block.min())} "
+                f"in the chunk at {tuple(starts.tolist())}"
+            )
         for label, box in find_objects(block, None).items():
             a = np.array([part.start for part in box], dtype=np.int64) + starts
             b = np.array([part.stop for part in box], dtype=np.int64) + starts

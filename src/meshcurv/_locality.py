@@ -50,8 +50,13 @@ SPAN_SAMPLE = 65536
 _BITS = 21
 
 #: The shifts and masks that move bit ``i`` of a 21-bit number to bit ``3 i``.
-_SPREAD = ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F), (4, 0x10C30C30C30C30C3),
-           (2, 0x1249249249249249))
+_SPREAD = (
+    (32, 0x1F00000000FFFF),
+    (16, 0x1F0000FF0000FF),
+    (8, 0x100F00F00F00F00F),
+    (4, 0x10C30C30C30C30C3),
+    (2, 0x1249249249249249),
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -107,8 +112,7 @@ def reordering(vertices: np.ndarray, faces: np.ndarray) -> Reordering | None:
     scale = (2**_BITS - 1) / extent if extent > 0 else 0.0
     kernels = numba_kernels("locality")
     if kernels is not None:
-        return Reordering(*kernels.reordering(vertices, faces, lo, scale, _BITS,
-                                                np.array(_SPREAD, dtype=np.uint64)))
+        return Reordering(*kernels.reordering(vertices, faces, lo, scale, _BITS, np.array(_SPREAD, dtype=np.uint64)))
     codes = np.zeros(n, dtype=np.uint64)
     for axis in range(3):
         x = ((vertices[:, axis] - lo[axis]) * scale).astype(np.uint64) & np.uint64(2**_BITS - 1)
@@ -120,12 +124,14 @@ def reordering(vertices: np.ndarray, faces: np.ndarray) -> Reordering | None:
     index[order] = np.arange(n)
     renumbered = index[faces]
     face_order = np.argsort(renumbered.min(axis=1), kind="stable")
-    return Reordering(order, index, face_order, np.take(vertices, order, axis=0),
-                      np.take(renumbered, face_order, axis=0))
+    return Reordering(
+        order, index, face_order, np.take(vertices, order, axis=0), np.take(renumbered, face_order, axis=0)
+    )
 
 
-def local_topology(vertices: np.ndarray, faces, *, stacklevel: int = 3
-                   ) -> tuple[np.ndarray, MeshTopology, Reordering | None]:
+def local_topology(
+    vertices: np.ndarray, faces, *, stacklevel: int = 3
+) -> tuple[np.ndarray, MeshTopology, Reordering | None]:
     """``(vertices, topology, reordering)``: :func:`meshcurv.topology.as_topology` of ``faces``, in a
     local order (:func:`reordering`) when the mesh is scattered (:func:`is_scattered`).
 
@@ -146,6 +152,9 @@ def local_topology(vertices: np.ndarray, faces, *, stacklevel: int = 3
     local = reordering(vertices, triangles) if is_scattered(n, triangles) else None
     if local is None:  # a local order (or a bounding box wider than the float range): as given
         return vertices, topology if topology is not None else MeshTopology._build(triangles, n), None
-    logger.info("the vertices come in a scattered order (median index difference along a face's shortest "
-                "side: %d): computed in their Morton order", median_side_span(triangles))
+    logger.info(
+        "the vertices come in a scattered order (median index difference along a face's shortest "
+        "side: %d): computed in their Morton order",
+        median_side_span(triangles),
+    )
     return local.vertices, MeshTopology._build(local.faces, n), local

@@ -51,8 +51,16 @@ import numpy as np
 from ._validation import check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshcurvWarning
 
-__all__ = ["check_threshold", "check_smooth", "labels_from_image", "smooth_padding", "smoothed_crop",
-           "smoothed_surface", "CONNECTIVITY", "SMOOTH_TRUNCATE"]
+__all__ = [
+    "check_threshold",
+    "check_smooth",
+    "labels_from_image",
+    "smooth_padding",
+    "smoothed_crop",
+    "smoothed_surface",
+    "CONNECTIVITY",
+    "SMOOTH_TRUNCATE",
+]
 
 #: Connectivity of the components of a thresholded probability map: 6 (voxels sharing a face).
 CONNECTIVITY = 6
@@ -60,14 +68,19 @@ CONNECTIVITY = 6
 #: The crop around each object reaches this many standard deviations beyond its box (plus one voxel).
 SMOOTH_TRUNCATE = 3.0
 
+
 def check_threshold(threshold) -> float | None:
     """``threshold`` as a finite float, or None."""
     if threshold is None:
         return None
-    if isinstance(threshold, bool) or not isinstance(threshold, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(threshold):
-        raise InvalidOptionError(f"`threshold` must be a finite number (voxels greater than it are objects); got "
-                                 f"{threshold!r}")
+    if (
+        isinstance(threshold, bool)
+        or not isinstance(threshold, (int, float, np.integer, np.floating))
+        or not np.isfinite(threshold)
+    ):
+        raise InvalidOptionError(
+            f"`threshold` must be a finite number (voxels greater than it are objects); got {threshold!r}"
+        )
     return float(threshold)
 
 
@@ -98,19 +111,24 @@ def labels_from_image(image: np.ndarray, threshold: float | None, *, caller: str
             raise InvalidMeshError(
                 f"`labels` must be an integer label image or a boolean mask; got dtype {image.dtype}: for a "
                 "probability map pass threshold=T (--threshold T), the voxels greater than T are the objects, split "
-                "into connected components; labels stored as floats: cast them first (.astype(int))")
+                "into connected components; labels stored as floats: cast them first (.astype(int))"
+            )
         return image
     if image.dtype.kind not in "biuf":
-        raise InvalidMeshError(f"`labels` with `threshold` must be an image of real numbers (a probability map); "
-                               f"got dtype {image.dtype}")
+        raise InvalidMeshError(
+            f"`labels` with `threshold` must be an image of real numbers (a probability map); got dtype {image.dtype}"
+        )
     from scipy import ndimage
 
     foreground = image > threshold  # NaN > t is False: background
     if image.dtype.kind == "f":
         n_nan = int(np.count_nonzero(np.isnan(image)))
         if n_nan:
-            warnings.warn(f"{caller}: {n_nan} voxels of the image are NaN; they are taken as background",
-                          MeshcurvWarning, stacklevel=stacklevel + 1)
+            warnings.warn(
+                f"{caller}: {n_nan} voxels of the image are NaN; they are taken as background",
+                MeshcurvWarning,
+                stacklevel=stacklevel + 1,
+            )
     structure = ndimage.generate_binary_structure(3, 1) if foreground.ndim == 3 else None  # 6-connectivity
     try:
         labels, _ = ndimage.label(foreground, structure=structure, output=np.int32)
@@ -121,8 +139,9 @@ def labels_from_image(image: np.ndarray, threshold: float | None, *, caller: str
 
 def smooth_padding(spacing: np.ndarray, sigma: float) -> np.ndarray:
     """(3,) int: the voxels added around an object's box before it is blurred, ``ceil(3 sigma / h) + 1`` per axis."""
-    return np.array([math.ceil(SMOOTH_TRUNCATE * sigma / h) + 1 for h in np.asarray(spacing, dtype=float)],
-                    dtype=np.int64)
+    return np.array(
+        [math.ceil(SMOOTH_TRUNCATE * sigma / h) + 1 for h in np.asarray(spacing, dtype=float)], dtype=np.int64
+    )
 
 
 def smoothed_crop(image: np.ndarray, label: int, box, spacing: np.ndarray, sigma: float):
@@ -140,8 +159,16 @@ def smoothed_crop(image: np.ndarray, label: int, box, spacing: np.ndarray, sigma
     return image[region] == label, low, starts, stops
 
 
-def smoothed_surface(mask: np.ndarray, origin: np.ndarray, starts: np.ndarray, stops: np.ndarray, image_shape,
-                     spacing: np.ndarray, sigma: float, marching_cubes):
+def smoothed_surface(
+    mask: np.ndarray,
+    origin: np.ndarray,
+    starts: np.ndarray,
+    stops: np.ndarray,
+    image_shape,
+    spacing: np.ndarray,
+    sigma: float,
+    marching_cubes,
+):
     """Vertices (in voxels), outward faces, voxel count, centroid and touching faces of a blurred mask.
 
     ``mask``, ``origin``: :func:`smoothed_crop`. The blurred mask is padded by
@@ -158,8 +185,9 @@ def smoothed_surface(mask: np.ndarray, origin: np.ndarray, starts: np.ndarray, s
     shape = np.asarray(image_shape, dtype=np.int64)
     n_voxels = int(np.count_nonzero(mask))
     centroid = (np.array([np.mean(axis) for axis in np.nonzero(mask)]) + origin) * spacing
-    blurred = ndimage.gaussian_filter(mask.astype(np.float32), sigma / np.asarray(spacing, dtype=float),
-                                      mode="nearest", truncate=4.0)
+    blurred = ndimage.gaussian_filter(
+        mask.astype(np.float32), sigma / np.asarray(spacing, dtype=float), mode="nearest", truncate=4.0
+    )
     end = origin + np.array(mask.shape)
     touching = np.zeros((3, 2), dtype=bool)
     for axis in range(3):

@@ -62,11 +62,20 @@ CHUNK = 32768
 
 #: A jet fit whose ball reaches the other side of the surface is redone over a ball this many times
 #: smaller (:func:`one_sided_fits`): sqrt(2) halves the ball's area per step.
-SHRINK = 2.0 ** -0.5
+SHRINK = 2.0**-0.5
 
 
-def one_sided_fits(points, normals, radius, centres, usable, *, smallest: float | None, degree: int = JET_DEGREE,
-                   iterations: int = JET_ITERATIONS):
+def one_sided_fits(
+    points,
+    normals,
+    radius,
+    centres,
+    usable,
+    *,
+    smallest: float | None,
+    degree: int = JET_DEGREE,
+    iterations: int = JET_ITERATIONS,
+):
     """Jets over the largest ball, from ``radius`` down to ``smallest``, that holds one side of the surface.
 
     A ball larger than the thickness of a part (a flat ellipsoid's two faces,
@@ -89,8 +98,9 @@ def one_sided_fits(points, normals, radius, centres, usable, *, smallest: float 
     """
     n = points.shape[0]
     if smallest is None:
-        coefficients, frame, _ = fit_jets(points, normals, radius, degree=degree, iterations=iterations,
-                                          centres=centres, neighbours=usable)
+        coefficients, frame, _ = fit_jets(
+            points, normals, radius, degree=degree, iterations=iterations, centres=centres, neighbours=usable
+        )
         return coefficients, frame, np.full(n, float(radius))
     coefficients = np.full((n, 6), np.nan)
     frame = tuple(np.full((n, 3), np.nan) for _ in range(3))
@@ -98,8 +108,16 @@ def one_sided_fits(points, normals, radius, centres, usable, *, smallest: float 
     todo = np.asarray(centres, dtype=np.int64)
     current = float(radius)
     while todo.size:
-        found, local, _ = fit_jets(points, normals, current, degree=degree, iterations=iterations, centres=todo,
-                                   neighbours=usable, facing=normals)
+        found, local, _ = fit_jets(
+            points,
+            normals,
+            current,
+            degree=degree,
+            iterations=iterations,
+            centres=todo,
+            neighbours=usable,
+            facing=normals,
+        )
         done = todo[np.isfinite(found[todo]).all(axis=1)]
         coefficients[done] = found[done]
         for whole, part in zip(frame, local):
@@ -133,7 +151,8 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
         six = six / radii[:, None]
     ok = np.isfinite(coefficients).all(axis=1) & np.isfinite(fitted).all(axis=1)
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-        np.where(ok[:, None], six, 0.0), np.where(ok[:, None], fitted, [0.0, 0.0, 1.0]))
+        np.where(ok[:, None], six, 0.0), np.where(ok[:, None], fitted, [0.0, 0.0, 1.0])
+    )
     out_normals = np.where(ok[:, None], fitted, normals)
     for array in (k_min, k_max, dir_min, dir_max):
         array[~ok] = np.nan
@@ -149,8 +168,9 @@ def fitted_normals(points, normals, radius, centres, usable, *, smallest: float,
     radius of each point's fit.
     """
     logger.debug("point cloud: normal fits")
-    coefficients, frame, radii = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest,
-                                                degree=3, iterations=NORMAL_ITERATIONS)
+    coefficients, frame, radii = one_sided_fits(
+        points, normals, radius, centres, usable, smallest=smallest, degree=3, iterations=NORMAL_ITERATIONS
+    )
     if details is not None:
         details["radii"] = radii
     logger.debug("point cloud: measures")
@@ -262,9 +282,17 @@ def flat_balls(points, centres, index, counts) -> np.ndarray:
     compiled = numba_kernels("pointcloud")
     if compiled is None:
         return _flat_balls(points, centres, index, counts)
-    return compiled.flat_balls(points, np.ascontiguousarray(centres), np.ascontiguousarray(index),
-                               np.ascontiguousarray(counts, dtype=np.int64), -(-index.shape[1] // SUPPORT_POINTS),
-                               SUPPORT_ITERATIONS, BALL_OFFSET, BALL_SHARE, BALL_SUPPORT)
+    return compiled.flat_balls(
+        points,
+        np.ascontiguousarray(centres),
+        np.ascontiguousarray(index),
+        np.ascontiguousarray(counts, dtype=np.int64),
+        -(-index.shape[1] // SUPPORT_POINTS),
+        SUPPORT_ITERATIONS,
+        BALL_OFFSET,
+        BALL_SHARE,
+        BALL_SUPPORT,
+    )
 
 
 def _flat_balls(points, centres, index, counts) -> np.ndarray:
@@ -295,8 +323,18 @@ def _flat_balls(points, centres, index, counts) -> np.ndarray:
     return beside >= np.maximum(BALL_SUPPORT, BALL_SHARE * member.sum(axis=1))
 
 
-def corrected_measures(tree, points, normals, radius, centres, usable, *, spacing: float = 0.0,
-                       n_triangles: int | None = None, sheets: np.ndarray | None = None):
+def corrected_measures(
+    tree,
+    points,
+    normals,
+    radius,
+    centres,
+    usable,
+    *,
+    spacing: float = 0.0,
+    n_triangles: int | None = None,
+    sheets: np.ndarray | None = None,
+):
     """Randomized corrected curvature measures over balls of ``radius`` (Lachaud et al. 2023).
 
     For every centre, ``n_triangles`` triangles with corners drawn at random
@@ -322,13 +360,17 @@ def corrected_measures(tree, points, normals, radius, centres, usable, *, spacin
     else:
         search = _usable_tree(tree, points, usable)
     for start in range(0, centres.size, CHUNK):
-        chunk = centres[start:start + CHUNK]
+        chunk = centres[start : start + CHUNK]
         logger.debug("point cloud: ball search")
         if kernels is not None:
             index, _, counts = kernels.ball_indices(points, chunk, float(radius), k, *grid, 64 * kernel_threads())
-            index, counts = kernels.own_side(normals, chunk, index, counts,
-                                             np.zeros(0, dtype=np.int64) if sheets is None
-                                             else np.ascontiguousarray(sheets, dtype=np.int64))
+            index, counts = kernels.own_side(
+                normals,
+                chunk,
+                index,
+                counts,
+                np.zeros(0, dtype=np.int64) if sheets is None else np.ascontiguousarray(sheets, dtype=np.int64),
+            )
         else:
             index, counts = _ball_indices(search, points, chunk, radius, k)
             index, counts = _own_side(normals, chunk, index, counts, sheets)

@@ -243,8 +243,14 @@ def _line_spread_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     return ratio
 
 
-def scan_lines(points: np.ndarray, distances: np.ndarray, indices: np.ndarray, usable: np.ndarray, tree,
-               radius: float | None = None):
+def scan_lines(
+    points: np.ndarray,
+    distances: np.ndarray,
+    indices: np.ndarray,
+    usable: np.ndarray,
+    tree,
+    radius: float | None = None,
+):
     """The points whose nearest neighbours lie on a line: on a surface sampled along lines, or on a line alone.
 
     A surface scanned along lines (LiDAR, profilometers) is sampled densely
@@ -301,7 +307,7 @@ def scan_lines(points: np.ndarray, distances: np.ndarray, indices: np.ndarray, u
     wide = min(LINE_NEIGHBOURS, n - 1)
     found = []
     for start in range(0, line.size, CHUNK // 4):
-        rows = line[start:start + CHUNK // 4]
+        rows = line[start : start + CHUNK // 4]
         far, near = tree.query(points[rows], k=wide + 1, workers=-1)
         far, near = far[:, 1:], near[:, 1:]  # (distinct points: each is its own nearest)
         reach = distances[rows, -1]
@@ -310,8 +316,13 @@ def scan_lines(points: np.ndarray, distances: np.ndarray, indices: np.ndarray, u
         offsets = points[near] - points[rows][:, None, :]
         along = np.einsum("mkj,mj->mk", offsets, direction)
         across = np.sqrt(np.maximum(np.einsum("mkj,mkj->mk", offsets, offsets) - along * along, 0.0))
-        support = (usable[near] & (np.abs(along) <= reach[:, None]) & (across > LINE_OFFSET * reach[:, None])
-                   & (across <= LINE_FAR * reach[:, None]) & (near != rows[:, None]))
+        support = (
+            usable[near]
+            & (np.abs(along) <= reach[:, None])
+            & (across > LINE_OFFSET * reach[:, None])
+            & (across <= LINE_FAR * reach[:, None])
+            & (near != rows[:, None])
+        )
         if radius is not None:
             support &= far < radius
         held = support.sum(axis=1) >= LINE_SUPPORT
@@ -375,8 +386,14 @@ def _pca_normals_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     return normals
 
 
-def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarray, *, given: bool = False,
-                      points: np.ndarray | None = None):
+def orientation_signs(
+    normals: np.ndarray,
+    indices: np.ndarray,
+    usable: np.ndarray,
+    *,
+    given: bool = False,
+    points: np.ndarray | None = None,
+):
     """Signs (+1/-1) that orient ``normals`` consistently, and the component label of each point.
 
     Parameters
@@ -420,8 +437,9 @@ def orientation_signs(normals: np.ndarray, indices: np.ndarray, usable: np.ndarr
     if points is not None:
         offsets = points[cols] - points[rows]
         reach = TANGENT_SLOPE * np.linalg.norm(offsets, axis=1)
-        along = np.maximum(np.abs(np.einsum("ij,ij->i", offsets, normals[rows])),
-                           np.abs(np.einsum("ij,ij->i", offsets, normals[cols])))
+        along = np.maximum(
+            np.abs(np.einsum("ij,ij->i", offsets, normals[rows])), np.abs(np.einsum("ij,ij->i", offsets, normals[cols]))
+        )
         flat = along <= reach
         # a steep edge is dropped only where its point keeps enough flat ones: a point that noise
         # lifted off its neighbours' planes stays joined to them
@@ -463,8 +481,7 @@ def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.nd
 
     compiled = numba_kernels("pointcloud")
     if compiled is not None:
-        signs, roots = compiled.spanning_signs(
-            n, rows, cols, np.asarray(opposite).astype(np.int8), np.argsort(weights))
+        signs, roots = compiled.spanning_signs(n, rows, cols, np.asarray(opposite).astype(np.int8), np.argsort(weights))
         return signs, _dense_labels(roots)
     graph = coo_matrix((weights, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
     # both searches treat the graph as undirected: (i, j) is an edge when either is among the other's neighbours
@@ -483,9 +500,10 @@ def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.nd
     anchor = np.where(has_parent, parent, np.arange(n))
     # the relation of each tree edge, looked up in a matrix of the edges in both directions
     relation = np.where(opposite, -1.0, 1.0)
-    lookup = coo_matrix((np.concatenate([relation, relation]), (np.concatenate([rows, cols]),
-                                                                  np.concatenate([cols, rows]))),
-                        shape=(n, n)).tocsr()
+    lookup = coo_matrix(
+        (np.concatenate([relation, relation]), (np.concatenate([rows, cols]), np.concatenate([cols, rows]))),
+        shape=(n, n),
+    ).tocsr()
     child = np.flatnonzero(has_parent)
     if child.size:  # no edge at all (every point unusable, e.g. on a line): every point its own root
         signs[child] = np.sign(np.asarray(lookup[child, parent[child]]).reshape(-1))
@@ -511,13 +529,15 @@ def outward_signs(points: np.ndarray, normals: np.ndarray, labels: np.ndarray, a
     counts = np.bincount(labels, minlength=n_labels).astype(float)
     sums = np.stack([np.bincount(labels, weights=points[:, j], minlength=n_labels) for j in range(3)], axis=1)
     centroid = sums / np.maximum(counts, 1.0)[:, None]
-    flux = np.bincount(labels, weights=areas * np.einsum("ij,ij->i", normals, points - centroid[labels]),
-                       minlength=n_labels)
+    flux = np.bincount(
+        labels, weights=areas * np.einsum("ij,ij->i", normals, points - centroid[labels]), minlength=n_labels
+    )
     return np.where(flux[labels] < 0, -1.0, 1.0)
 
 
-def oriented_signs(points: np.ndarray, normals: np.ndarray, indices: np.ndarray, usable: np.ndarray,
-                   spacing: np.ndarray, tree=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def oriented_signs(
+    points: np.ndarray, normals: np.ndarray, indices: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree=None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Signs that orient estimated (unsigned) ``normals`` consistently, and outward on each part.
 
     The orientation is propagated (:func:`_spanning_forest`) along two kinds
@@ -601,8 +621,12 @@ def oriented_signs(points: np.ndarray, normals: np.ndarray, indices: np.ndarray,
     flat = _supported(flat, slope, rows, cols, kept, indices[:, :GRAPH_NEIGHBOURS])
     sheets = _sheets(n, rows[flat], cols[flat])
     reach = STACKED_OFFSET * 0.5 * (spacing[rows] + spacing[cols])
-    stacked = (~flat & (np.abs(cosine) >= FACING_COSINE) & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
-               & (ahead * behind * cosine > 0))
+    stacked = (
+        ~flat
+        & (np.abs(cosine) >= FACING_COSINE)
+        & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
+        & (ahead * behind * cosine > 0)
+    )
     used = flat | stacked
     # (flat edges also by their slope: a tree of one sheet is grown before edges that leave it a little)
     # flat edges first, by 1 - |cos| and their slope (a tree of one sheet is grown before edges that leave it a
@@ -667,8 +691,9 @@ def _supported(flat, slope, rows, cols, kept, indices):
     directed[np.flatnonzero(kept)] = flat  # flatness of each (point, neighbour column) of the graph
     directed = directed.reshape(n, k)
     a, b = rows[check], cols[check]
-    common = ((indices[a][:, :, None] == indices[b][:, None, :]) & directed[a][:, :, None]
-              & directed[b][:, None, :]).any(axis=(1, 2))
+    common = (
+        (indices[a][:, :, None] == indices[b][:, None, :]) & directed[a][:, :, None] & directed[b][:, None, :]
+    ).any(axis=(1, 2))
     flat = flat.copy()
     flat[check[~common]] = False
     return flat
@@ -690,14 +715,16 @@ def _sheets(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """
     compiled = numba_kernels("pointcloud")
     if compiled is not None:
-        labels = _dense_labels(compiled.spanning_signs(n, rows, cols, np.zeros(rows.size, dtype=np.int8),
-                                                       np.arange(rows.size))[1])
+        labels = _dense_labels(
+            compiled.spanning_signs(n, rows, cols, np.zeros(rows.size, dtype=np.int8), np.arange(rows.size))[1]
+        )
     else:
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
 
-        _, labels = connected_components(coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)),
-                                                    shape=(n, n)), directed=False)
+        _, labels = connected_components(
+            coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n)), directed=False
+        )
     return np.where(np.bincount(labels)[labels] >= PART_MIN_POINTS, labels, -1)
 
 
@@ -716,8 +743,15 @@ def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:
     return away
 
 
-def winding_numbers(points: np.ndarray, normals: np.ndarray, areas: np.ndarray, usable: np.ndarray, tree,
-                    queries: np.ndarray, sources: np.ndarray) -> np.ndarray:
+def winding_numbers(
+    points: np.ndarray,
+    normals: np.ndarray,
+    areas: np.ndarray,
+    usable: np.ndarray,
+    tree,
+    queries: np.ndarray,
+    sources: np.ndarray,
+) -> np.ndarray:
     """(M,) the generalized winding number of the oriented cloud at the points ``queries`` (M,).
 
     ``w(q) = 1 / (4 pi) sum_j a_j n_j . (p_j - q) / |p_j - q|^3`` (Barill et al.
@@ -737,8 +771,15 @@ def winding_numbers(points: np.ndarray, normals: np.ndarray, areas: np.ndarray, 
     return _winding(points, normals, areas, usable, tree, points[queries], queries, sources)
 
 
-def winding_at(points: np.ndarray, normals: np.ndarray, areas: np.ndarray, usable: np.ndarray, tree,
-               positions: np.ndarray, sources: np.ndarray) -> np.ndarray:
+def winding_at(
+    points: np.ndarray,
+    normals: np.ndarray,
+    areas: np.ndarray,
+    usable: np.ndarray,
+    tree,
+    positions: np.ndarray,
+    sources: np.ndarray,
+) -> np.ndarray:
     """(M,) the generalized winding number of the oriented cloud at ``positions`` (M, 3), off the points.
 
     As :func:`winding_numbers`, every usable point counted.
@@ -754,8 +795,9 @@ def _winding(points, normals, areas, usable, tree, q, queries, sources):
     offsets = points[near] - q[:, None, :]
     counted = usable[near] if queries is None else (near != queries[:, None]) & usable[near]
     softened = np.where(counted, np.einsum("mkj,mkj->mk", offsets, offsets) + areas[near] / np.pi, 1.0)
-    total = np.where(counted, areas[near] * np.einsum("mkj,mkj->mk", offsets, normals[near])
-                     / (softened * np.sqrt(softened)), 0.0).sum(axis=1)
+    total = np.where(
+        counted, areas[near] * np.einsum("mkj,mkj->mk", offsets, normals[near]) / (softened * np.sqrt(softened)), 0.0
+    ).sum(axis=1)
     reach_squared = distances[:, -1] ** 2
     weights = areas[sources] * (np.count_nonzero(usable) / sources.size)
     soft = areas[sources] / np.pi
@@ -764,8 +806,15 @@ def _winding(points, normals, areas, usable, tree, q, queries, sources):
         if queries is None:  # the positions appended to the points: the kernel reads its queries by index
             n = points.shape[0]
             extended = np.concatenate([points, q])
-            total += compiled.far_winding(extended, np.concatenate([normals, np.zeros_like(q)]), weights, soft,
-                                          sources, np.arange(n, n + q.shape[0]), reach_squared)
+            total += compiled.far_winding(
+                extended,
+                np.concatenate([normals, np.zeros_like(q)]),
+                weights,
+                soft,
+                sources,
+                np.arange(n, n + q.shape[0]),
+                reach_squared,
+            )
         else:
             total += compiled.far_winding(points, normals, weights, soft, sources, queries, reach_squared)
     else:
@@ -782,8 +831,9 @@ def _winding(points, normals, areas, usable, tree, q, queries, sources):
     return total / (4.0 * np.pi)
 
 
-def winding_sides(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree,
-                  indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def winding_sides(
+    points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree, indices: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """``(flips, unsettled)``: the side of oriented ``normals`` checked against the winding number of the cloud.
 
     The orientation of :func:`oriented_signs` can still cross a gap of a
@@ -885,8 +935,9 @@ def _nearest_queries(points, normals, usable, queries, rows, cols) -> np.ndarray
         return np.maximum(position, 0)
     offsets = points[cols] - points[rows]
     length = np.linalg.norm(offsets, axis=1)
-    steep = np.maximum(np.abs(np.einsum("ij,ij->i", offsets, normals[rows])),
-                       np.abs(np.einsum("ij,ij->i", offsets, normals[cols])))
+    steep = np.maximum(
+        np.abs(np.einsum("ij,ij->i", offsets, normals[rows])), np.abs(np.einsum("ij,ij->i", offsets, normals[cols]))
+    )
     flat = (steep <= SHEET_SLOPE * length) & (length > 0)
     graph = coo_matrix((length[flat], (rows[flat], cols[flat])), shape=(n, n)).tocsr()
     _, _, source = dijkstra(graph, directed=False, indices=queries, min_only=True, return_predecessors=True)
@@ -896,9 +947,9 @@ def _nearest_queries(points, normals, usable, queries, rows, cols) -> np.ndarray
     return np.maximum(position[np.maximum(source, 0)], 0)
 
 
-
-def two_sheets(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray,
-               tree) -> tuple[np.ndarray, np.ndarray]:
+def two_sheets(
+    points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree
+) -> tuple[np.ndarray, np.ndarray]:
     """``(alike, interleaved)``: (N,) bool, points beside a second sheet whose side cannot be trusted.
 
     Two sheets stacked within a few spacings (the faces of a thin part, two
@@ -948,7 +999,7 @@ def two_sheets(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spac
         # the share of each point's nearest neighbours with two sheets (a region, not a point that noise split)
         mark = np.zeros(n)
         mark[sample[two]] = 1.0
-        crowd = near[:, 1:INTERLEAVED_NEIGHBOURS + 1]  # (the point itself first)
+        crowd = near[:, 1 : INTERLEAVED_NEIGHBOURS + 1]  # (the point itself first)
         share = (mark[sample] + (mark[crowd] * usable[crowd]).sum(axis=1)) / (1.0 + usable[crowd].sum(axis=1))
         interleaved[sample[share >= INTERLEAVED_SHARE]] = True
     return alike & usable, interleaved & usable
@@ -976,7 +1027,7 @@ def _sheet_signs(points, normals, usable, spacing, step, tree, queries, *, with_
             alike = _stacked(points, normals, usable, step, q, ball, alike=True)
             hit[rows] = alike.sum(axis=1) >= STACKED_ALIKE_MIN
             flags[rows] = alike
-        group = ball[:, :INTERLEAVED_NEIGHBOURS + 1]
+        group = ball[:, : INTERLEAVED_NEIGHBOURS + 1]
         # the spacing of the neighbourhood (the median over the cloud is another part's in a cloud of two densities)
         local = np.median(np.where(usable[group], spacing[group], np.nan), axis=1)
         two[rows] = _two_heights(points, group, usable, np.where(np.isfinite(local), local, step))
@@ -999,19 +1050,30 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool):
     """
     compiled = numba_kernels("pointcloud")
     if compiled is not None:
-        return compiled.stacked(points, normals, usable, np.ascontiguousarray(queries), np.ascontiguousarray(near),
-                                min(GRAPH_NEIGHBOURS, near.shape[1] - 1), STACKED_ALIKE_OFFSET * step,
-                                STACKED_ALIKE_TILT, FACING_COSINE, alike)
+        return compiled.stacked(
+            points,
+            normals,
+            usable,
+            np.ascontiguousarray(queries),
+            np.ascontiguousarray(near),
+            min(GRAPH_NEIGHBOURS, near.shape[1] - 1),
+            STACKED_ALIKE_OFFSET * step,
+            STACKED_ALIKE_TILT,
+            FACING_COSINE,
+            alike,
+        )
     offsets = points[near] - points[queries][:, None, :]
     ahead = np.einsum("mkj,mj->mk", offsets, normals[queries])
     behind = np.einsum("mkj,mkj->mk", offsets, normals[near])
     cosine = np.einsum("mj,mkj->mk", normals[queries], normals[near])
-    ring = near[:, 1:GRAPH_NEIGHBOURS + 1]
-    tilt = np.median(np.arccos(np.minimum(np.abs(np.einsum("mj,mkj->mk", normals[queries], normals[ring])), 1.0)),
-                     axis=1)
+    ring = near[:, 1 : GRAPH_NEIGHBOURS + 1]
+    tilt = np.median(
+        np.arccos(np.minimum(np.abs(np.einsum("mj,mkj->mk", normals[queries], normals[ring])), 1.0)), axis=1
+    )
     reach = STACKED_ALIKE_OFFSET * step + STACKED_ALIKE_TILT * tilt[:, None] * np.linalg.norm(offsets, axis=2)
-    sides = (cosine >= FACING_COSINE) & (ahead * behind > 0) if alike else \
-        (cosine <= -FACING_COSINE) & (ahead * behind < 0)
+    sides = (
+        (cosine >= FACING_COSINE) & (ahead * behind > 0) if alike else (cosine <= -FACING_COSINE) & (ahead * behind < 0)
+    )
     return usable[near] & (near != queries[:, None]) & sides & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
 
 
@@ -1037,13 +1099,15 @@ def _two_heights(points, group, usable, step):
     # the spread of each group: two clean sheets closer than the noise of a noisy one are two sheets too
     lower = height[rows, widest] - height[:, 0]
     upper = height[rows, np.maximum(count - 1, 0)] - height[rows, np.minimum(widest + 1, height.shape[1] - 1)]
-    apart = (gap >= INTERLEAVED_GAP * step) | ((gap >= INTERLEAVED_SPREAD * np.maximum(lower, upper))
-                                              & (gap >= INTERLEAVED_MIN_GAP * step))
+    apart = (gap >= INTERLEAVED_GAP * step) | (
+        (gap >= INTERLEAVED_SPREAD * np.maximum(lower, upper)) & (gap >= INTERLEAVED_MIN_GAP * step)
+    )
     return apart & (gap <= STACKED_OFFSET * step) & (below >= INTERLEAVED_GROUP) & (count - below >= INTERLEAVED_GROUP)
 
 
-def between_sides(points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree,
-                  indices: np.ndarray) -> np.ndarray:
+def between_sides(
+    points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree, indices: np.ndarray
+) -> np.ndarray:
     """(N,) +1 or -1: turns the points of two stacked sheets that face each other across an inside-out part.
 
     Where two sheets are stacked a spacing or more apart with opposite

@@ -124,16 +124,22 @@ class PreparedMesh:
         """What was done to the mesh before the computation, for the call's warning."""
         notes = []
         if self.n_welded:
-            notes.append(f"welded {self.n_welded} coincident vertices (a triangle soup or split seams) "
-                         "before the computation; copies share their values")
+            notes.append(
+                f"welded {self.n_welded} coincident vertices (a triangle soup or split seams) "
+                "before the computation; copies share their values"
+            )
         if self.n_copies:
-            notes.append(f"found closed parts stored twice, their vertices coincident ({self.n_copies} vertices "
-                         "of copies): each measured once, a copy's vertices get the values of the part they repeat "
-                         "and totals count it once (result.parameters['n_copy_vertices'])")
+            notes.append(
+                f"found closed parts stored twice, their vertices coincident ({self.n_copies} vertices "
+                "of copies): each measured once, a copy's vertices get the values of the part they repeat "
+                "and totals count it once (result.parameters['n_copy_vertices'])"
+            )
         if self.n_double_sided:
-            notes.append(f"dropped {self.n_double_sided} faces that repeat another face's corners with the "
-                         "opposite winding (a double-sided mesh): computed on one side "
-                         "(result.parameters['n_double_sided_faces'])")
+            notes.append(
+                f"dropped {self.n_double_sided} faces that repeat another face's corners with the "
+                "opposite winding (a double-sided mesh): computed on one side "
+                "(result.parameters['n_double_sided_faces'])"
+            )
         return notes
 
     def expand(self, result: CurvatureResult) -> CurvatureResult:
@@ -144,9 +150,9 @@ class PreparedMesh:
         fields: dict[str, Any] = {
             name: np.take(getattr(result, name), self.index, axis=0)
             for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "invalid_reason", "radius")
-            if getattr(result, name) is not None}
+            if getattr(result, name) is not None
+        }
         return dataclasses.replace(result, **fields)
-
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:
@@ -185,8 +191,9 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     if copies is not None and copies.n_welded:  # one welding: the caller's vertices onto the surface measured once
         n_copies = copies.n_welded
         first = welded.index if welded is not None else np.arange(points.shape[0])
-        welded = Welding(copies.vertices, copies.topology, copies.index[first],
-                         (welded.n_welded if welded is not None else 0))
+        welded = Welding(
+            copies.vertices, copies.topology, copies.index[first], (welded.n_welded if welded is not None else 0)
+        )
         points, topology = welded.vertices, welded.topology
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
     topology, n_flipped = oriented_topology(points, one_sided.topology, orient)
@@ -195,9 +202,20 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     if local is not None:
         index = local.index if welded is None else welded.index[local.index]
     if local is not None and welded is None:  # the mesh the caller gave, its faces oriented (and one-sided)
-        surface = Surface(callers, np.take(local.order, topology.faces) if one_sided.n_dropped
-                          else local.original_faces(topology.faces))
+        surface = Surface(
+            callers,
+            np.take(local.order, topology.faces) if one_sided.n_dropped else local.original_faces(topology.faces),
+        )
     else:
         surface = Surface(points, topology.faces, index)
-    return PreparedMesh(points, topology, index, surface, orient, welded.n_welded if welded is not None else 0,
-                        one_sided.n_dropped, n_flipped, n_copies)
+    return PreparedMesh(
+        points,
+        topology,
+        index,
+        surface,
+        orient,
+        welded.n_welded if welded is not None else 0,
+        one_sided.n_dropped,
+        n_flipped,
+        n_copies,
+    )

@@ -60,8 +60,9 @@ def tangent_basis(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return t1, t2
 
 
-def principal_from_shape_operator(tensor: np.ndarray, normals: np.ndarray, *, rotate: bool = False,
-                                  mean_from_trace: bool = False):
+def principal_from_shape_operator(
+    tensor: np.ndarray, normals: np.ndarray, *, rotate: bool = False, mean_from_trace: bool = False
+):
     """Principal curvatures and directions from (N, 6) tensors restricted to the tangent planes.
 
     The tensor is restricted to the plane orthogonal to each unit normal and its

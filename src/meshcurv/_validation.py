@@ -20,15 +20,30 @@ import numpy as np
 
 from .errors import InvalidMeshError, InvalidOptionError, TriangulationWarning
 
-__all__ = ["as_vertices", "as_faces", "as_polygons", "polygon_arrays", "fan_triangles", "checked_triangles", "Ragged",
-           "check_int_option", "check_vertex_count", "check_positive_float", "check_choice", "checked_mesh",
-           "checked_points", "checked_indices", "trusting", "MAX_VERTICES"]
+__all__ = [
+    "as_vertices",
+    "as_faces",
+    "as_polygons",
+    "polygon_arrays",
+    "fan_triangles",
+    "checked_triangles",
+    "Ragged",
+    "check_int_option",
+    "check_vertex_count",
+    "check_positive_float",
+    "check_choice",
+    "checked_mesh",
+    "checked_points",
+    "checked_indices",
+    "trusting",
+    "MAX_VERTICES",
+]
 
 
 def _short_repr(value, limit: int = 40) -> str:
     """``repr(value)``, cut to ``limit`` characters (an option of 400 digits stays readable)."""
     text = repr(value)
-    return text if len(text) <= limit else f"{text[:limit - 12]}... ({len(text)} chars)"
+    return text if len(text) <= limit else f"{text[: limit - 12]}... ({len(text)} chars)"
 
 
 def _shape_text(array) -> str:
@@ -50,12 +65,8 @@ def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
         raise InvalidMeshError(
             f"`{name}` must be an array of shape (V, 3); it could not be converted to an array ({exc})"
         ) from None
-    if array.dtype == object or not (
-        np.issubdtype(array.dtype, np.floating) or np.issubdtype(array.dtype, np.integer)
-    ):
-        raise InvalidMeshError(
-            f"`{name}` must hold real numbers (float or int); got dtype {array.dtype}"
-        )
+    if array.dtype == object or not (np.issubdtype(array.dtype, np.floating) or np.issubdtype(array.dtype, np.integer)):
+        raise InvalidMeshError(f"`{name}` must hold real numbers (float or int); got dtype {array.dtype}")
     if array.ndim != 2 or array.shape[1] != 3:
         raise InvalidMeshError(f"`{name}` must have shape (V, 3); got {_shape_text(array)}")
     if array.shape[0] == 0:
@@ -71,8 +82,7 @@ def as_vertices(vertices, *, name: str = "vertices") -> np.ndarray:
     if finite is not None and not finite.all():
         bad = np.flatnonzero(~finite)
         raise InvalidMeshError(
-            f"`{name}` has NaN or infinite coordinates at {bad.size} vertices "
-            f"(first at index {bad[0]})"
+            f"`{name}` has NaN or infinite coordinates at {bad.size} vertices (first at index {bad[0]})"
         )
     largest = max(float(out.max()), -float(out.min()))
     if largest > MAX_COORDINATE:
@@ -116,9 +126,7 @@ def _refuse_masked(value, name: str) -> None:
 
 def _integer_faces(array: np.ndarray, name: str) -> np.ndarray:
     """Coerce a numeric face array to int64, refusing non-integral values."""
-    if array.dtype == bool or not (
-        np.issubdtype(array.dtype, np.integer) or np.issubdtype(array.dtype, np.floating)
-    ):
+    if array.dtype == bool or not (np.issubdtype(array.dtype, np.integer) or np.issubdtype(array.dtype, np.floating)):
         if array.dtype == object and array.size and all(isinstance(x, numbers.Integral) for x in array.flat):
             raise InvalidMeshError(f"`{name}` has indices too large for int64")  # Python ints beyond uint64
         raise InvalidMeshError(f"`{name}` must hold integer vertex indices; got dtype {array.dtype}")
@@ -126,11 +134,13 @@ def _integer_faces(array: np.ndarray, name: str) -> np.ndarray:
         if not np.isfinite(array).all():
             raise InvalidMeshError(f"`{name}` has NaN or infinite values; indices must be integers")
         if not np.array_equal(array, np.round(array)):
-            swapped = (f" (a {array.dtype} array of shape {_shape_text(array)}: coordinates? were `vertices` "
-                       f"and `{name}` swapped? pass the vertices first)" if array.ndim == 2 else "")
-            raise InvalidMeshError(
-                f"`{name}` has non-integer values; vertex indices must be whole numbers{swapped}"
+            swapped = (
+                f" (a {array.dtype} array of shape {_shape_text(array)}: coordinates? were `vertices` "
+                f"and `{name}` swapped? pass the vertices first)"
+                if array.ndim == 2
+                else ""
             )
+            raise InvalidMeshError(f"`{name}` has non-integer values; vertex indices must be whole numbers{swapped}")
         if array.size and np.abs(array).max() >= 2.0**62:
             raise InvalidMeshError(f"`{name}` has indices too large for int64")
     if np.issubdtype(array.dtype, np.unsignedinteger) and array.size and array.max() > np.iinfo(np.int64).max:
@@ -203,9 +213,7 @@ def polygon_arrays(faces, *, name: str = "faces") -> np.ndarray | Ragged:
             return Ragged(_integer_faces(flat, name), lengths)
         array = flat.reshape(lengths.size, -1) if lengths.size else flat
     if array.ndim != 2:
-        raise InvalidMeshError(
-            f"`{name}` must have shape (F, 3) or (F, k) with k >= 3; got {_shape_text(array)}"
-        )
+        raise InvalidMeshError(f"`{name}` must have shape (F, 3) or (F, k) with k >= 3; got {_shape_text(array)}")
     if array.shape[0] == 0:
         raise InvalidMeshError(f"`{name}` is empty: the mesh has no faces")
     if array.shape[1] < 3:
@@ -265,9 +273,7 @@ def _check_range(triangles: np.ndarray, n_vertices: int, name: str) -> None:
     low = int(triangles.min())
     high = int(triangles.max())
     if low < 0:
-        raise InvalidMeshError(
-            f"`{name}` has negative vertex indices (smallest {low}); indices are 0-based and >= 0"
-        )
+        raise InvalidMeshError(f"`{name}` has negative vertex indices (smallest {low}); indices are 0-based and >= 0")
     if high >= n_vertices:
         if high == n_vertices and low >= 1:
             raise InvalidMeshError(
@@ -275,8 +281,7 @@ def _check_range(triangles: np.ndarray, n_vertices: int, name: str) -> None:
                 "meshcurv uses 0-based indices, pass `faces - 1`"
             )
         raise InvalidMeshError(
-            f"`{name}` has vertex index {high} out of range for {n_vertices} vertices "
-            f"(valid: 0 to {n_vertices - 1})"
+            f"`{name}` has vertex index {high} out of range for {n_vertices} vertices (valid: 0 to {n_vertices - 1})"
         )
 
 
@@ -297,8 +302,9 @@ def as_faces(faces, n_vertices: int, *, name: str = "faces", stacklevel: int = 3
     return checked_triangles(polygon_arrays(faces, name=name), n_vertices, name=name, stacklevel=stacklevel + 1)
 
 
-def checked_triangles(shaped: np.ndarray | Ragged, n_vertices: int, *, name: str = "faces",
-                      stacklevel: int = 3) -> np.ndarray:
+def checked_triangles(
+    shaped: np.ndarray | Ragged, n_vertices: int, *, name: str = "faces", stacklevel: int = 3
+) -> np.ndarray:
     """:func:`as_faces` of faces already shaped by :func:`polygon_arrays`."""
     _check_range(shaped.flat if isinstance(shaped, Ragged) else shaped, n_vertices, name)
     if isinstance(shaped, Ragged) or shaped.shape[1] != 3:
@@ -354,8 +360,9 @@ def check_positive_float(value, name: str) -> float:
     """
     if isinstance(value, (bool, np.bool_, str, bytes)) or not isinstance(value, (numbers.Real, np.ndarray)):
         raise InvalidOptionError(f"`{name}` must be a positive number; got {_short_repr(value)}")
-    if isinstance(value, np.ndarray) and (value.ndim != 0 or not np.issubdtype(value.dtype, np.number)
-                                          or np.issubdtype(value.dtype, np.complexfloating)):
+    if isinstance(value, np.ndarray) and (
+        value.ndim != 0 or not np.issubdtype(value.dtype, np.number) or np.issubdtype(value.dtype, np.complexfloating)
+    ):
         raise InvalidOptionError(f"`{name}` must be a positive number; got {_short_repr(value)}")
     if isinstance(value, np.ma.MaskedArray) and np.ma.getmaskarray(value).any():  # numpy.ma.masked
         raise InvalidOptionError(f"`{name}` must be a positive finite number; got a masked value")
@@ -366,8 +373,10 @@ def check_positive_float(value, name: str) -> float:
     if not np.isfinite(number) or number <= 0:
         raise InvalidOptionError(f"`{name}` must be a positive finite number; got {_short_repr(value)}")
     if number < np.finfo(float).tiny:  # subnormal: its inverse is inf
-        raise InvalidOptionError(f"`{name}` must be at least {np.finfo(float).tiny:.3g} (the smallest normal "
-                                 f"float64: its inverse is finite); got {number!r}")
+        raise InvalidOptionError(
+            f"`{name}` must be at least {np.finfo(float).tiny:.3g} (the smallest normal "
+            f"float64: its inverse is finite); got {number!r}"
+        )
     return number
 
 
@@ -423,8 +432,14 @@ def checked_points(vertices, *, name: str = "vertices") -> np.ndarray:
     so they are refused here as by :func:`as_vertices`); anything else goes
     through :func:`as_vertices`.
     """
-    if not (isinstance(vertices, np.ndarray) and type(vertices) is np.ndarray and vertices.dtype == np.float64
-            and vertices.ndim == 2 and vertices.shape[1] == 3 and vertices.shape[0] > 0):
+    if not (
+        isinstance(vertices, np.ndarray)
+        and type(vertices) is np.ndarray
+        and vertices.dtype == np.float64
+        and vertices.ndim == 2
+        and vertices.shape[1] == 3
+        and vertices.shape[0] > 0
+    ):
         return as_vertices(vertices, name=name)
     if _trusted(vertices, None):
         return vertices

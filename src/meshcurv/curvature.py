@@ -197,16 +197,24 @@ def principal_curvatures(
                 if estimator.name == "icc":
                     options["vertex_scale"] = vertex_scale
         result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
-        result, message = _finished(mesh, estimator, result, problems, found,
-                                    given_radius=radius is not None and not options.get("adaptive"))
+        result, message = _finished(
+            mesh, estimator, result, problems, found, given_radius=radius is not None and not options.get("adaptive")
+        )
     if message:
         warnings.warn(message, MeshQualityWarning, stacklevel=2)
     return result
 
 
-def multiscale_curvatures(vertices, faces=None, radii: Sequence[float] | np.ndarray = (), *, method: str = DEFAULT_METHOD, orient: str = "auto",
-                          weld: bool | None = None, progress: ProgressCallback | None = None
-                          ) -> list[CurvatureResult]:
+def multiscale_curvatures(
+    vertices,
+    faces=None,
+    radii: Sequence[float] | np.ndarray = (),
+    *,
+    method: str = DEFAULT_METHOD,
+    orient: str = "auto",
+    weld: bool | None = None,
+    progress: ProgressCallback | None = None,
+) -> list[CurvatureResult]:
     """Curvatures at several scales: one :class:`CurvatureResult` per radius, in one pass.
 
     Each result equals ``principal_curvatures(vertices, faces, method=method,
@@ -258,8 +266,10 @@ def multiscale_curvatures(vertices, faces=None, radii: Sequence[float] | np.ndar
     """
     estimator, options = _checked_options(method)
     if "radius" not in estimator.options:
-        raise InvalidOptionError(f"method {method!r} measures no ball; multiscale_curvatures takes one of "
-                                 + ", ".join(repr(name) for name, e in ESTIMATORS.items() if "radius" in e.options))
+        raise InvalidOptionError(
+            f"method {method!r} measures no ball; multiscale_curvatures takes one of "
+            + ", ".join(repr(name) for name, e in ESTIMATORS.items() if "radius" in e.options)
+        )
     if isinstance(radii, (str, bytes)) or np.ndim(radii) != 1 or len(radii) == 0:
         raise InvalidOptionError(f"`radii` must be a non-empty sequence of radii; got {radii!r}")
     radii = [check_positive_float(radius, "radii") for radius in radii]
@@ -272,16 +282,18 @@ def multiscale_curvatures(vertices, faces=None, radii: Sequence[float] | np.ndar
             computed = estimator.multiscale(mesh, radii=[radii[i] for i in order], stages=stages)
         else:
             computed = [estimator.function(mesh, stages=stages, **{**options, "radius": radii[i]}) for i in order]
-        finished = [_finished(mesh, estimator, result, problems, {}, given_radius=True)
-                    for result, problems in computed]
+        finished = [
+            _finished(mesh, estimator, result, problems, {}, given_radius=True) for result, problems in computed
+        ]
     results: list = [None] * len(radii)
     for rank, index in enumerate(order):
         results[index] = finished[rank][0]
     messages = {radii[i]: finished[rank][1] for rank, i in enumerate(order)}
     if any(messages.values()):
         texts = set(messages.values())
-        message = texts.pop() if len(texts) == 1 else "; ".join(f"at radius {r:g}: {m}" for r, m in messages.items()
-                                                                if m)
+        message = (
+            texts.pop() if len(texts) == 1 else "; ".join(f"at radius {r:g}: {m}" for r, m in messages.items() if m)
+        )
         warnings.warn(message, MeshQualityWarning, stacklevel=2)
     return results
 
@@ -324,14 +336,24 @@ def _finished(mesh, estimator, result: CurvatureResult, problems: list, found: d
         problems = [*problems, note] if note else problems
     diagnosis = mesh_diagnosis(points, topology, mesh.n_flipped, mesh.length_scales)  # checked by prepare_mesh
     reasons = mesh.defects(boundary=estimator.boundary).reasons(result.valid)
-    parameters = {**result.parameters, **found, "orient": mesh.orient, "n_welded_vertices": mesh.n_welded,
-                  "n_copy_vertices": mesh.n_copies, "n_double_sided_faces": mesh.n_double_sided}
-    result = mesh.expand(dataclasses.replace(result, diagnosis=diagnosis, invalid_reason=reasons,
-                                             parameters=parameters, _surface=mesh.surface))
+    parameters = {
+        **result.parameters,
+        **found,
+        "orient": mesh.orient,
+        "n_welded_vertices": mesh.n_welded,
+        "n_copy_vertices": mesh.n_copies,
+        "n_double_sided_faces": mesh.n_double_sided,
+    }
+    result = mesh.expand(
+        dataclasses.replace(
+            result, diagnosis=diagnosis, invalid_reason=reasons, parameters=parameters, _surface=mesh.surface
+        )
+    )
     if mesh.n_flipped:
         problems = list(problems) + [_flip_reason(diagnosis, mesh.orient)]
-    message = quality_message(estimator.name, problems, dataclasses.replace(diagnosis, n_flipped_faces=0),
-                              notes=mesh.notes())
+    message = quality_message(
+        estimator.name, problems, dataclasses.replace(diagnosis, n_flipped_faces=0), notes=mesh.notes()
+    )
     if message:
         counts = result.invalid_counts()
         if counts:

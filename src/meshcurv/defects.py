@@ -24,8 +24,20 @@ from ._backend import numba_kernels
 from .geometry import degenerate_face_mask
 from .topology import MeshTopology
 
-__all__ = ["Defect", "DEFECTS", "POINT_CLOUD_REASONS", "INVALID_REASONS", "UNDEFINED", "BOUNDARY", "VertexDefects",
-           "NEEDLE", "NEEDLE_ANGLE", "NEEDLE_REACH", "defect_codes", "needle_vertices"]
+__all__ = [
+    "Defect",
+    "DEFECTS",
+    "POINT_CLOUD_REASONS",
+    "INVALID_REASONS",
+    "UNDEFINED",
+    "BOUNDARY",
+    "VertexDefects",
+    "NEEDLE",
+    "NEEDLE_ANGLE",
+    "NEEDLE_REACH",
+    "defect_codes",
+    "needle_vertices",
+]
 
 
 @dataclass(frozen=True)
@@ -57,16 +69,31 @@ class Defect:
 DEFECTS = (
     Defect(1, "unreferenced_vertices", "unreferenced vertex (in no face)", "unreferenced vertices"),
     Defect(2, "nonmanifold_edges", "on a non-manifold edge (3+ faces)", "non-manifold edges (3+ faces)"),
-    Defect(3, "bowtie_vertices", "bow-tie vertex (fans of faces meeting at a point)",
-           "bow-tie vertices (fans meeting at a point)"),
-    Defect(4, "inconsistent_edges", "on an edge between inconsistently oriented faces",
-           "edges between inconsistently oriented faces"),
-    Defect(7, "needle_vertices", "needle vertex, or a corner of its faces: slivers reaching far beyond the "
-           "neighbourhood (a vertex flung away)",
-           "needle vertices (their faces are slivers from a vertex flung far away; their corners are NaN too)"),
+    Defect(
+        3,
+        "bowtie_vertices",
+        "bow-tie vertex (fans of faces meeting at a point)",
+        "bow-tie vertices (fans meeting at a point)",
+    ),
+    Defect(
+        4,
+        "inconsistent_edges",
+        "on an edge between inconsistently oriented faces",
+        "edges between inconsistently oriented faces",
+    ),
+    Defect(
+        7,
+        "needle_vertices",
+        "needle vertex, or a corner of its faces: slivers reaching far beyond the neighbourhood (a vertex flung away)",
+        "needle vertices (their faces are slivers from a vertex flung far away; their corners are NaN too)",
+    ),
     Defect(5, "degenerate_faces", "corner of a zero-area face", "zero-area faces"),
-    Defect(6, "boundary_edges", "on a boundary edge (this method needs a closed neighbourhood)",
-           "boundary edges (their vertices have no complete neighbourhood)"),
+    Defect(
+        6,
+        "boundary_edges",
+        "on a boundary edge (this method needs a closed neighbourhood)",
+        "boundary edges (their vertices have no complete neighbourhood)",
+    ),
 )
 
 #: The code of a boundary vertex (a defect only for the methods that need a closed neighbourhood).
@@ -95,8 +122,15 @@ INVALID_REASONS = (
 )
 
 #: The order of the phrases in the warning.
-_WARNING_ORDER = ("boundary_edges", "nonmanifold_edges", "bowtie_vertices", "inconsistent_edges",
-                  "degenerate_faces", "needle_vertices", "unreferenced_vertices")
+_WARNING_ORDER = (
+    "boundary_edges",
+    "nonmanifold_edges",
+    "bowtie_vertices",
+    "inconsistent_edges",
+    "degenerate_faces",
+    "needle_vertices",
+    "unreferenced_vertices",
+)
 _COUNTED = {defect.name: defect.counted for defect in DEFECTS}
 
 
@@ -181,8 +215,9 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
     from scipy.sparse.csgraph import connected_components
 
     pairs = local[edges[inner]]
-    graph = coo_matrix((np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])),
-                       shape=(members.size, members.size))
+    graph = coo_matrix(
+        (np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(members.size, members.size)
+    )
     n_clusters, labels = connected_components(graph, directed=False)
     size = np.bincount(labels, minlength=n_clusters).astype(float)
     size[np.unique(labels[unbounded[members]])] = np.inf
@@ -220,8 +255,9 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
     return candidates & flung[cluster]
 
 
-def defect_codes(topology: MeshTopology, degenerate: np.ndarray, vertices: np.ndarray | None = None,
-                 scales: np.ndarray | None = None) -> tuple[np.ndarray, dict[str, int]]:
+def defect_codes(
+    topology: MeshTopology, degenerate: np.ndarray, vertices: np.ndarray | None = None, scales: np.ndarray | None = None
+) -> tuple[np.ndarray, dict[str, int]]:
     """(V,) int8 code of the first defect at each vertex (0: none), and the count of each defect.
 
     Parameters
@@ -328,8 +364,9 @@ class VertexDefects:
     def messages(self) -> list[str]:
         """The warning's phrases: the count of each defect the method does not cope with."""
         shown = {defect.name for defect in DEFECTS if defect.code not in self.tolerated}
-        return [f"{self.counts[name]} {_COUNTED[name]}" for name in _WARNING_ORDER
-                if name in shown and self.counts[name]]
+        return [
+            f"{self.counts[name]} {_COUNTED[name]}" for name in _WARNING_ORDER if name in shown and self.counts[name]
+        ]
 
     def reasons(self, valid: np.ndarray) -> np.ndarray:
         """(V,) int8 :data:`INVALID_REASONS` codes of the vertices not ``valid`` (0 where valid).

@@ -15,8 +15,15 @@ import numpy as np
 from ._backend import numba_kernels
 from ._validation import as_vertices, check_int_option
 from .errors import InvalidMeshError
-from .geometry import (DEGENERATE_AREA_RATIO, checked_topology_points, degenerate_face_mask, degenerate_faces,
-                       edge_lengths, face_cross_products, vertex_length_scales)
+from .geometry import (
+    DEGENERATE_AREA_RATIO,
+    checked_topology_points,
+    degenerate_face_mask,
+    degenerate_faces,
+    edge_lengths,
+    face_cross_products,
+    vertex_length_scales,
+)
 from .topology import MeshTopology, as_topology
 
 #: Edges no longer than this times the length scale of their component (its median
@@ -182,8 +189,11 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     >>> diagnose(sphere.vertices, sphere.faces).n_faces     # faces as they are
     320
     """
-    if not isinstance(topology, MeshTopology) and not isinstance(topology, (str, bytes)) \
-            and hasattr(topology, "__len__"):  # a face array or polygon list: its topology
+    if (
+        not isinstance(topology, MeshTopology)
+        and not isinstance(topology, (str, bytes))
+        and hasattr(topology, "__len__")
+    ):  # a face array or polygon list: its topology
         vertices = as_vertices(vertices)
         topology = as_topology(topology, vertices.shape[0])
     vertices = checked_topology_points(vertices, topology)
@@ -191,8 +201,9 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
     return mesh_diagnosis(vertices, topology, n_flipped_faces, vertex_length_scales(vertices, topology))
 
 
-def mesh_diagnosis(vertices: np.ndarray, topology: MeshTopology, n_flipped_faces: int,
-                   scales: np.ndarray) -> MeshDiagnosis:
+def mesh_diagnosis(
+    vertices: np.ndarray, topology: MeshTopology, n_flipped_faces: int, scales: np.ndarray
+) -> MeshDiagnosis:
     """:func:`diagnose` of checked inputs: (V, 3) float64 ``vertices`` of ``topology``, ``n_flipped_faces``
     in ``[0, F]`` and the (V,) ``scales`` of :func:`meshcurv.geometry.vertex_length_scales` (a prepared
     mesh has them already: ``principal_curvatures`` checks its inputs once and measures them once)."""
@@ -202,7 +213,8 @@ def mesh_diagnosis(vertices: np.ndarray, topology: MeshTopology, n_flipped_faces
     kernels = numba_kernels("diagnosis")
     if kernels is not None:
         lower, upper, area, six_volume, scale, n_degenerate, n_zero_length = kernels.mesh_facts(
-            vertices, faces, topology.edges, referenced, scales, DEGENERATE_AREA_RATIO, ZERO_LENGTH_RATIO)
+            vertices, faces, topology.edges, referenced, scales, DEGENERATE_AREA_RATIO, ZERO_LENGTH_RATIO
+        )
     else:
         used = vertices if n_unreferenced == 0 else vertices[referenced]
         centre = used.mean(axis=0)
@@ -213,8 +225,9 @@ def mesh_diagnosis(vertices: np.ndarray, topology: MeshTopology, n_flipped_faces
         # the cross products are translation-invariant: a . (b x c) = (a - o) . cross(b - a, c - a)
         six_volume = float(np.einsum("ij,ij->i", vertices[faces[:, 0]] - centre, cross).sum())
         scale = float(lengths.mean()) if lengths.size else 0.0
-        n_degenerate = int((degenerate_face_mask(0.5 * double_areas, scales[faces[:, 0]])
-                            | topology.degenerate_faces).sum())
+        n_degenerate = int(
+            (degenerate_face_mask(0.5 * double_areas, scales[faces[:, 0]]) | topology.degenerate_faces).sum()
+        )
         n_zero_length = int((lengths <= ZERO_LENGTH_RATIO * scales[topology.edges[:, 0]]).sum())
         lower, upper = used.min(axis=0), used.max(axis=0)
     n_boundary = int(topology.boundary_edges.sum())
@@ -251,8 +264,9 @@ def mesh_diagnosis(vertices: np.ndarray, topology: MeshTopology, n_flipped_faces
     )
 
 
-def quality_message(method: str, problems: list[str], diagnosis: MeshDiagnosis | None, *,
-                    notes: list[str] | tuple = ()) -> str | None:
+def quality_message(
+    method: str, problems: list[str], diagnosis: MeshDiagnosis | None, *, notes: list[str] | tuple = ()
+) -> str | None:
     """The text of the one :class:`~meshcurv.errors.MeshQualityWarning` of a call, or None.
 
     ``problems`` are the estimator's own phrases (what it did about the

@@ -73,8 +73,11 @@ def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     u = vertices[faces[:, 1]] - a
     w = vertices[faces[:, 2]] - a
     return np.stack(
-        [u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1], u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2],
-         u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]],
+        [
+            u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1],
+            u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2],
+            u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0],
+        ],
         axis=1,
     )
 
@@ -140,9 +143,7 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
     if kernels is not None:
         return kernels.normalize_normal_sums(kernels.vertex_normal_sums(cross, faces, n))
     flat = faces.ravel()
-    summed = np.stack(
-        [np.bincount(flat, weights=np.repeat(cross[:, k], 3), minlength=n) for k in range(3)], axis=1
-    )
+    summed = np.stack([np.bincount(flat, weights=np.repeat(cross[:, k], 3), minlength=n) for k in range(3)], axis=1)
     return normalize_normal_sums(summed)
 
 
@@ -173,8 +174,9 @@ def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
         return kernels.vertex_edge_lengths(vertices, edges, n)
     flat = edges.ravel()
     with np.errstate(invalid="ignore", divide="ignore"):
-        return (np.bincount(flat, weights=np.repeat(edge_lengths(vertices, edges), 2), minlength=n)
-                / np.bincount(flat, minlength=n))
+        return np.bincount(flat, weights=np.repeat(edge_lengths(vertices, edges), 2), minlength=n) / np.bincount(
+            flat, minlength=n
+        )
 
 
 def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
@@ -211,7 +213,7 @@ def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     lengths = edge_lengths(vertices, edges)
     if lengths.size == 0:
         return 0.0
-    median = float(np.median(lengths[::max(1, lengths.size // MEDIAN_SAMPLE)]))  # a threshold: a sample will do
+    median = float(np.median(lengths[:: max(1, lengths.size // MEDIAN_SAMPLE)]))  # a threshold: a sample will do
     longest = float(lengths.max())
     if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean, to the last bit
         return mean_edge_length(vertices, edges)
@@ -292,8 +294,11 @@ def checked_topology_points(vertices, topology) -> np.ndarray:
         ``topology`` not a MeshTopology, ``vertices`` unusable or of another length.
     """
     if not isinstance(topology, MeshTopology):
-        hint = (" (a face array: build one with MeshTopology.from_faces(faces, len(vertices)))"
-                if isinstance(topology, (np.ndarray, list, tuple)) else "")
+        hint = (
+            " (a face array: build one with MeshTopology.from_faces(faces, len(vertices)))"
+            if isinstance(topology, (np.ndarray, list, tuple))
+            else ""
+        )
         raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}{hint}")
     vertices = checked_points(vertices)
     if vertices.shape[0] != topology.n_vertices:
@@ -342,9 +347,15 @@ def degenerate_face_mask(areas: np.ndarray, length_scale) -> np.ndarray:
         return areas <= DEGENERATE_AREA_RATIO * scale**2
 
 
-def degenerate_faces(vertices: np.ndarray, topology: MeshTopology, *, cross: np.ndarray | None = None,
-                     mean_edge_length: float | None = None, double_areas: np.ndarray | None = None,
-                     scales: np.ndarray | None = None) -> np.ndarray:
+def degenerate_faces(
+    vertices: np.ndarray,
+    topology: MeshTopology,
+    *,
+    cross: np.ndarray | None = None,
+    mean_edge_length: float | None = None,
+    double_areas: np.ndarray | None = None,
+    scales: np.ndarray | None = None,
+) -> np.ndarray:
     """(F,) bool: faces with a repeated corner or an area below 1e-12 x (length scale)^2.
 
     The length scale of a face is the median edge length of its connected
@@ -396,8 +407,9 @@ def _floats(value, name: str, shape: tuple) -> np.ndarray:
     return np.ascontiguousarray(array, dtype=np.float64)
 
 
-def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_normals: np.ndarray,
-                         usable_edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def edge_dihedral_angles(
+    vertices: np.ndarray, topology: MeshTopology, unit_normals: np.ndarray, usable_edges: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Signed angle between the two face normals of each usable edge.
 
     ``unit_normals`` (F, 3): the unit face normals; ``usable_edges`` (E,) bool:
@@ -415,8 +427,10 @@ def edge_dihedral_angles(vertices: np.ndarray, topology: MeshTopology, unit_norm
     unit_normals = _floats(unit_normals, "unit_normals", topology.faces.shape)
     usable_edges = np.asarray(usable_edges)
     if usable_edges.shape != (topology.edges.shape[0],) or usable_edges.dtype != bool:
-        raise InvalidMeshError(f"`usable_edges` must be a bool array of shape ({topology.edges.shape[0]},); got "
-                               f"{usable_edges.dtype} {usable_edges.shape}")
+        raise InvalidMeshError(
+            f"`usable_edges` must be a bool array of shape ({topology.edges.shape[0]},); got "
+            f"{usable_edges.dtype} {usable_edges.shape}"
+        )
     edges = topology.edges
     vectors = vertices[edges[:, 1]] - vertices[edges[:, 0]]
     lengths = np.linalg.norm(vectors, axis=1)

@@ -68,8 +68,14 @@ from ._backend import kernel_threads, numba_kernels
 from ._tensors import tangent_basis
 from ._validation import checked_points
 from .errors import InvalidMeshError, InvalidOptionError
-from .neighborhoods import (_ball_pairs, call_ranges, centre_radii, check_ball_work, checked_adjacency,
-                            connected_ball_pairs)
+from .neighborhoods import (
+    _ball_pairs,
+    call_ranges,
+    centre_radii,
+    check_ball_work,
+    checked_adjacency,
+    connected_ball_pairs,
+)
 
 #: Highest degree of the jet (lowered to 3, then 2, where the ball holds too few points).
 DEGREE = 4
@@ -145,8 +151,9 @@ def _n_terms(degree: int) -> int:
     return (degree + 1) * (degree + 2) // 2
 
 
-def _fit_chunk(offsets: np.ndarray, rows: np.ndarray, size: int, frame: Sequence[np.ndarray], weights: np.ndarray,
-               degree: int) -> tuple[np.ndarray, np.ndarray]:
+def _fit_chunk(
+    offsets: np.ndarray, rows: np.ndarray, size: int, frame: Sequence[np.ndarray], weights: np.ndarray, degree: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Weighted normal equations of the jets of one chunk of centres, in units of the radius.
 
     ``offsets`` (P, 3) are ``(x_j - x_v) / r``, ``rows`` (P,) the centre of each
@@ -168,14 +175,17 @@ def _fit_chunk(offsets: np.ndarray, rows: np.ndarray, size: int, frame: Sequence
     moments = {}
     for total in range(2 * degree + 1):
         for k in range(total + 1):
-            moments[total - k, k] = np.bincount(rows, weights=weights * u_powers[total - k] * v_powers[k],
-                                                minlength=size)
+            moments[total - k, k] = np.bincount(
+                rows, weights=weights * u_powers[total - k] * v_powers[k], minlength=size
+            )
     matrix = np.zeros((size, m, m))
     for a in range(m):
         for b in range(a, m):
             matrix[:, a, b] = matrix[:, b, a] = moments[tuple(exponents[a] + exponents[b])]
-    right = np.stack([np.bincount(rows, weights=weights * w * u_powers[i] * v_powers[k], minlength=size)
-                      for i, k in exponents], axis=1)
+    right = np.stack(
+        [np.bincount(rows, weights=weights * w * u_powers[i] * v_powers[k], minlength=size) for i, k in exponents],
+        axis=1,
+    )
     return matrix, right
 
 
@@ -184,8 +194,9 @@ def _binomials(degree: int) -> np.ndarray:
     return np.array([float(comb(i + k, i)) for i, k in _exponents(degree)])
 
 
-def _cholesky_solve(matrix: np.ndarray, right: np.ndarray, factors: np.ndarray,
-                    min_spread: float = MIN_SPREAD) -> tuple[np.ndarray, np.ndarray]:
+def _cholesky_solve(
+    matrix: np.ndarray, right: np.ndarray, factors: np.ndarray, min_spread: float = MIN_SPREAD
+) -> tuple[np.ndarray, np.ndarray]:
     """Solve the (N, m, m) symmetric systems of unit diagonal by Cholesky, where their points are spread.
 
     Returns the (N, m) solutions and (N,) whether every pivot exceeded
@@ -237,8 +248,9 @@ def _cholesky_solve(matrix: np.ndarray, right: np.ndarray, factors: np.ndarray,
     return x, ok
 
 
-def _solve_block(block: np.ndarray, right: np.ndarray, degree: int,
-                 min_spread: float = MIN_SPREAD) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _solve_block(
+    block: np.ndarray, right: np.ndarray, degree: int, min_spread: float = MIN_SPREAD
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The (N, m) solutions of the (N, m, m) normal equations ``block`` of ``degree``, whether each is
     kept (its points spread, ``min_spread``) and the (N, m, m) diagonally scaled matrices solved."""
     scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
@@ -249,8 +261,9 @@ def _solve_block(block: np.ndarray, right: np.ndarray, degree: int,
     return solution * scale, ok, scaled
 
 
-def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: int,
-           min_spread: float = MIN_SPREAD) -> np.ndarray:
+def _solve(
+    matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: int, min_spread: float = MIN_SPREAD
+) -> np.ndarray:
     """(N, 6) the constant, linear and quadratic coefficients of the highest solvable degree (NaN: none).
 
     The monomials are ordered by degree, so the normal equations of a lower
@@ -273,11 +286,24 @@ def _solve(matrix: np.ndarray, right: np.ndarray, counts: np.ndarray, degree: in
     return out
 
 
-def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int = DEGREE,
-             iterations: int = ITERATIONS, centres: np.ndarray | None = None, chunk_size: int = CHUNK_SIZE,
-             neighbours: np.ndarray | None = None, facing: np.ndarray | None = None,
-             details: dict | None = None, adjacency: tuple | None = None, settled: float = 0.0,
-             compact: bool = False, areas: np.ndarray | None = None, min_spread: float = MIN_SPREAD):
+def fit_jets(
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    radius,
+    *,
+    degree: int = DEGREE,
+    iterations: int = ITERATIONS,
+    centres: np.ndarray | None = None,
+    chunk_size: int = CHUNK_SIZE,
+    neighbours: np.ndarray | None = None,
+    facing: np.ndarray | None = None,
+    details: dict | None = None,
+    adjacency: tuple | None = None,
+    settled: float = 0.0,
+    compact: bool = False,
+    areas: np.ndarray | None = None,
+    min_spread: float = MIN_SPREAD,
+):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
     Parameters
@@ -389,18 +415,50 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
     kernels = numba_kernels("jets")
     if kernels is not None and n:
         if adjacency is not None:  # one row per centre
-            rows = _connected_fits(kernels, vertices, normals, radius, degree, iterations, centres, mean,
-                                   neighbours, adjacency, facing, settled, normals_only=False, areas=areas,
-                                   min_spread=min_spread)
+            rows = _connected_fits(
+                kernels,
+                vertices,
+                normals,
+                radius,
+                degree,
+                iterations,
+                centres,
+                mean,
+                neighbours,
+                adjacency,
+                facing,
+                settled,
+                normals_only=False,
+                areas=areas,
+                min_spread=min_spread,
+            )
         else:
             radii = _all_rows(radius, centres, n, 0.0) if per_centre else np.array([float(radius)])  # by vertex
             pieces = []  # each call's outputs, one row per centre of its part
             for lo, hi in call_ranges(centres.size, mean, radius * radius if per_centre else None):
                 part = centres[lo:hi]  # rows of all vertices: those of the part (a slice when the centres are all)
-                pieces.append(tuple(output[lo:hi] if every_vertex else output[part] for output in kernels.fit_jets(
-                    vertices, normals, radii, degree, iterations, _exponents(degree), min_spread, part,
-                    64 * kernel_threads(), pool, facing if check else vertices, check, AWAY_FRACTION,
-                    float(settled), areas)))
+                pieces.append(
+                    tuple(
+                        output[lo:hi] if every_vertex else output[part]
+                        for output in kernels.fit_jets(
+                            vertices,
+                            normals,
+                            radii,
+                            degree,
+                            iterations,
+                            _exponents(degree),
+                            min_spread,
+                            part,
+                            64 * kernel_threads(),
+                            pool,
+                            facing if check else vertices,
+                            check,
+                            AWAY_FRACTION,
+                            float(settled),
+                            areas,
+                        )
+                    )
+                )
             rows = _joined(pieces)
         if not compact and not every_vertex:
             rows = [_all_rows(row, centres, n, 0.0 if k == 4 else np.nan) for k, row in enumerate(rows)]
@@ -419,8 +477,10 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
     if adjacency is not None:  # the surface-connected balls, as the compiled walk finds them
         balls = connected_ball_pairs(vertices, centres, radius, adjacency, neighbours, chunk_size=chunk_size)
     else:
-        balls = ((chunk, centre, pool[neighbour])
-                 for chunk, centre, neighbour in _ball_pairs(pool_points, vertices[centres], radius, chunk_size))
+        balls = (
+            (chunk, centre, pool[neighbour])
+            for chunk, centre, neighbour in _ball_pairs(pool_points, vertices[centres], radius, chunk_size)
+        )
     for chunk, centre, neighbour in balls:
         index = centres[chunk]
         size = index.size
@@ -461,8 +521,7 @@ def fit_jets(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int =
         coefficients[index] = fitted
         counts[index] = count
     if compact:
-        coefficients, frame, counts, away = (coefficients[given], [f[given] for f in frame], counts[given],
-                                             away[given])
+        coefficients, frame, counts, away = (coefficients[given], [f[given] for f in frame], counts[given], away[given])
     if details is not None:
         details["away"] = away
     return coefficients, tuple(frame), counts
@@ -480,8 +539,9 @@ def _checked_areas(areas, n: int) -> np.ndarray:
         return np.zeros(0)
     areas = np.ascontiguousarray(areas, dtype=np.float64)
     if areas.shape != (n,) or not np.all(np.isfinite(areas) & (areas >= 0)):
-        raise InvalidMeshError(f"`areas` must hold one finite number >= 0 per vertex, shape ({n},); got shape "
-                               f"{areas.shape}")
+        raise InvalidMeshError(
+            f"`areas` must hold one finite number >= 0 per vertex, shape ({n},); got shape {areas.shape}"
+        )
     return areas
 
 
@@ -499,8 +559,9 @@ def _checked_centre_radii(radius, centres: np.ndarray) -> np.ndarray:
     ordered, radii = centres[order], radius[order]
     twice = (ordered[1:] == ordered[:-1]) & (radii[1:] != radii[:-1])
     if twice.any():
-        raise InvalidOptionError(f"`radius` gives vertex {int(ordered[1:][twice][0])}, listed twice in `centres`, "
-                                 f"two radii")
+        raise InvalidOptionError(
+            f"`radius` gives vertex {int(ordered[1:][twice][0])}, listed twice in `centres`, two radii"
+        )
     return radius
 
 
@@ -509,10 +570,24 @@ def _joined(pieces: list) -> list[np.ndarray]:
     return [column[0] if len(column) == 1 else np.concatenate(column) for column in zip(*pieces)]
 
 
-def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, degree: int, iterations: int,
-                    centres: np.ndarray, pairs_per_centre: float, neighbours: np.ndarray | None, adjacency: tuple,
-                    facing: np.ndarray | None, settled: float, *, normals_only: bool,
-                    areas: np.ndarray, min_spread: float) -> list[np.ndarray]:
+def _connected_fits(
+    kernels,
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    radius,
+    degree: int,
+    iterations: int,
+    centres: np.ndarray,
+    pairs_per_centre: float,
+    neighbours: np.ndarray | None,
+    adjacency: tuple,
+    facing: np.ndarray | None,
+    settled: float,
+    *,
+    normals_only: bool,
+    areas: np.ndarray,
+    min_spread: float,
+) -> list[np.ndarray]:
     """The compiled fits over the surface-connected balls of ``centres``, in calls of about
     :data:`~meshcurv.neighborhoods.PAIRS_PER_CALL` pairs (checked inputs; ``neighbours`` a (V,) bool
     array or None; ``radius`` a float or a checked (M,) array of one per centre). The kernel's outputs,
@@ -524,15 +599,31 @@ def _connected_fits(kernels, vertices: np.ndarray, normals: np.ndarray, radius, 
     per_centre = np.ndim(radius) > 0
     radii = radius if per_centre else np.array([float(radius)])
     # read-only views: one numba signature whatever the callers' flags (each new one costs ~10 s of compilation)
-    vertices, normals, allowed, indptr, indices = (_read_only_view(a) for a in (vertices, normals, allowed, indptr,
-                                                                             indices))
+    vertices, normals, allowed, indptr, indices = (
+        _read_only_view(a) for a in (vertices, normals, allowed, indptr, indices)
+    )
     pieces = []
     for lo, hi in call_ranges(centres.size, pairs_per_centre, radii * radii if per_centre else None):
-        outputs = kernels.fit_jets_connected(vertices, normals, radii[lo:hi] if per_centre else radii, degree,
-                                             iterations, _exponents(degree),
-                                             min_spread, centres[lo:hi], kernel_threads(), allowed, indptr, indices,
-                                             vertices if facing is None else _read_only_view(facing), check,
-                                             AWAY_FRACTION, normals_only, float(settled), _read_only_view(areas))
+        outputs = kernels.fit_jets_connected(
+            vertices,
+            normals,
+            radii[lo:hi] if per_centre else radii,
+            degree,
+            iterations,
+            _exponents(degree),
+            min_spread,
+            centres[lo:hi],
+            kernel_threads(),
+            allowed,
+            indptr,
+            indices,
+            vertices if facing is None else _read_only_view(facing),
+            check,
+            AWAY_FRACTION,
+            normals_only,
+            float(settled),
+            _read_only_view(areas),
+        )
         pieces.append(outputs[:1] if normals_only else outputs)
     return _joined(pieces)
 
@@ -550,10 +641,19 @@ def _all_rows(rows: np.ndarray, centres: np.ndarray, n: int, fill: float) -> np.
     return out
 
 
-def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree: int = DEGREE,
-                    iterations: int = ITERATIONS, neighbours: np.ndarray | None = None,
-                    adjacency: tuple | None = None, settled: float = 0.0,
-                    areas: np.ndarray | None = None, min_spread: float = MIN_SPREAD) -> np.ndarray:
+def fit_jet_normals(
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    radius,
+    *,
+    degree: int = DEGREE,
+    iterations: int = ITERATIONS,
+    neighbours: np.ndarray | None = None,
+    adjacency: tuple | None = None,
+    settled: float = 0.0,
+    areas: np.ndarray | None = None,
+    min_spread: float = MIN_SPREAD,
+) -> np.ndarray:
     """(V, 3) unit normals of the jets of :func:`fit_jets` at every vertex (NaN where no fit was possible).
 
     ``jet_normals(*fit_jets(...)[:2])`` with the same arguments; with the
@@ -569,9 +669,18 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree
     vertices = checked_points(vertices)
     n = vertices.shape[0]
     if kernels is None or adjacency is None or n == 0:
-        coefficients, frame, _ = fit_jets(vertices, normals, radius, degree=degree, iterations=iterations,
-                                          neighbours=neighbours, adjacency=adjacency, settled=settled, areas=areas,
-                                          min_spread=min_spread)
+        coefficients, frame, _ = fit_jets(
+            vertices,
+            normals,
+            radius,
+            degree=degree,
+            iterations=iterations,
+            neighbours=neighbours,
+            adjacency=adjacency,
+            settled=settled,
+            areas=areas,
+            min_spread=min_spread,
+        )
         return jet_normals(coefficients, frame)
     normals = np.ascontiguousarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
@@ -583,9 +692,23 @@ def fit_jet_normals(vertices: np.ndarray, normals: np.ndarray, radius, *, degree
     if np.ndim(radius):
         radius = centre_radii(radius, n)
     mean, _ = check_ball_work(vertices if neighbours is None else vertices[neighbours], radius, n, centres=vertices)
-    return _connected_fits(kernels, vertices, normals, radius, degree, iterations, np.arange(n), mean, neighbours,
-                           adjacency, None, settled, normals_only=True, areas=_checked_areas(areas, n),
-                           min_spread=min_spread)[0]
+    return _connected_fits(
+        kernels,
+        vertices,
+        normals,
+        radius,
+        degree,
+        iterations,
+        np.arange(n),
+        mean,
+        neighbours,
+        adjacency,
+        None,
+        settled,
+        normals_only=True,
+        areas=_checked_areas(areas, n),
+        min_spread=min_spread,
+    )[0]
 
 
 def jet_normals(coefficients: np.ndarray, frame: tuple) -> np.ndarray:

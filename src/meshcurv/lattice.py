@@ -101,8 +101,7 @@ def _axis_lattice(values: np.ndarray):
     if found is None and planes.size:
         busiest = np.argsort(counts, kind="stable")[::-1]
         enough = int(np.searchsorted(np.cumsum(counts[busiest]), _GRID_SHARE * counts.sum())) + 1
-        found = _plane_lattice(np.sort(planes[busiest[:enough]]), planes[busiest[:_ORIGIN_CANDIDATES]],
-                               _PLANES_ON_GRID)
+        found = _plane_lattice(np.sort(planes[busiest[:enough]]), planes[busiest[:_ORIGIN_CANDIDATES]], _PLANES_ON_GRID)
     if found is None:
         return None
     spacing, origin = found

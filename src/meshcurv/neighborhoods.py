@@ -119,14 +119,14 @@ def _pairs_within(points: np.ndarray, sub: np.ndarray, probe: np.ndarray, radius
     over the first ``n_mean`` centres, the largest over all (``radius``: a number, or a column per centre)."""
     origin = probe.mean(axis=0)  # |p - c|^2 = |p|^2 + |c|^2 - 2 p.c about a nearby origin: one small product
     sub, probe = sub - origin, probe - origin
-    d2 = (np.einsum("ij,ij->i", probe, probe)[:, None] + np.einsum("ij,ij->i", sub, sub)[None, :]
-          - 2.0 * (probe @ sub.T))
+    d2 = np.einsum("ij,ij->i", probe, probe)[:, None] + np.einsum("ij,ij->i", sub, sub)[None, :] - 2.0 * (probe @ sub.T)
     inside = (d2 <= radius * radius).sum(axis=1) * (points.shape[0] / sub.shape[0])
     return float(inside[:n_mean].mean()), float(inside.max())
 
 
-def check_ball_work(points: np.ndarray, radius, n_centres: int, *,
-                    centres: np.ndarray | None = None) -> tuple[float, float]:
+def check_ball_work(
+    points: np.ndarray, radius, n_centres: int, *, centres: np.ndarray | None = None
+) -> tuple[float, float]:
     """Refuse a ball computation beyond :data:`MAX_BALL_PAIRS`; return :func:`estimate_ball_pairs`.
 
     ``radius``: one for all centres, or an array of one per centre.
@@ -171,8 +171,9 @@ def centre_radii(radius, n: int, name: str = "radius"):
     except (TypeError, ValueError):
         raise InvalidOptionError(f"`{name}` must be a number or an array of {n} positive numbers") from None
     if radii.shape != (n,):
-        raise InvalidOptionError(f"`{name}` must be a number or an array of shape ({n},): one radius per centre; "
-                                 f"got shape {radii.shape}")
+        raise InvalidOptionError(
+            f"`{name}` must be a number or an array of shape ({n},): one radius per centre; got shape {radii.shape}"
+        )
     if radii.size and not (np.isfinite(radii).all() and radii.min() > 0):
         bad = int(np.count_nonzero(~(np.isfinite(radii) & (radii > 0))))
         raise InvalidOptionError(f"`{name}` must hold positive finite radii; {bad} of {n} are not")
@@ -192,8 +193,9 @@ def _pairs(tree, centers: np.ndarray, cutoff: float) -> tuple[np.ndarray, np.nda
     return found["i"].astype(np.int64), found["j"].astype(np.int64)
 
 
-def vertex_pairs_in_ball(points: np.ndarray, radius: float, *, centres: np.ndarray | None = None,
-                         chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+def vertex_pairs_in_ball(
+    points: np.ndarray, radius: float, *, centres: np.ndarray | None = None, chunk_size: int = CHUNK
+) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """Yield ``(chunk, centre, neighbour)``: every point within ``radius`` of each centre.
 
     The centres are the points ``centres`` (default: all), taken by chunk of
@@ -213,8 +215,9 @@ def vertex_pairs_in_ball(points: np.ndarray, radius: float, *, centres: np.ndarr
     yield from _ball_pairs(points, points[centres], radius, chunk_size)
 
 
-def _ball_pairs(points: np.ndarray, centre_points: np.ndarray, radius,
-                chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+def _ball_pairs(
+    points: np.ndarray, centre_points: np.ndarray, radius, chunk_size: int = CHUNK
+) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """:func:`vertex_pairs_in_ball` around arbitrary ``centre_points`` (trusted arrays).
 
     ``radius``: one for all, or a (C,) array of one per centre (checked): the
@@ -299,8 +302,15 @@ def _size_groups(reach: np.ndarray, radius: float) -> list[np.ndarray | slice]:
     return [np.flatnonzero(label[level] == first) for first in firsts]
 
 
-def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius, values: np.ndarray,
-               usable: np.ndarray | None, weight, connected: bool = False) -> np.ndarray:
+def _ball_sums(
+    vertices: np.ndarray,
+    cells: np.ndarray,
+    radius,
+    values: np.ndarray,
+    usable: np.ndarray | None,
+    weight,
+    connected: bool = False,
+) -> np.ndarray:
     """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices.
 
     ``connected`` (faces only): with the compiled kernels, the faces of the
@@ -316,8 +326,10 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius, values: np.ndarr
             return _connected_face_sums(kernels, vertices, cells, radii, values[None], usable)[0]
         return _connected_face_sums_numpy(vertices, cells, radius, values, usable)
     if np.ndim(radius):
-        raise InvalidOptionError("a `radius` per vertex takes the surface-connected balls (`connected=True`); "
-                                 "the Euclidean ball sums take one radius")
+        raise InvalidOptionError(
+            "a `radius` per vertex takes the surface-connected balls (`connected=True`); "
+            "the Euclidean ball sums take one radius"
+        )
     if usable is not None:
         keep = np.flatnonzero(usable)
         cells, values = cells[keep], values[keep]
@@ -345,9 +357,17 @@ def _ball_sums(vertices: np.ndarray, cells: np.ndarray, radius, values: np.ndarr
         mean, _ = check_ball_work(centres[group], cutoff, n, centres=vertices)
         ranges = call_ranges(n, mean)
         for start, stop in ranges:
-            sums = kernels.ball_cell_sums(vertices, cells[group], centres[group],
-                                          np.ascontiguousarray(values[group]), radius, cutoff,
-                                          64 * kernel_threads(), start, stop)
+            sums = kernels.ball_cell_sums(
+                vertices,
+                cells[group],
+                centres[group],
+                np.ascontiguousarray(values[group]),
+                radius,
+                cutoff,
+                64 * kernel_threads(),
+                start,
+                stop,
+            )
             if isinstance(group, slice) and len(ranges) == 1:  # one group, one call: its sums are the result
                 return sums
             out += sums
@@ -358,8 +378,7 @@ def _checked_values(cells: np.ndarray, values, usable) -> tuple[np.ndarray, np.n
     """``values`` (C, k) float64 and ``usable`` (C,) bool or None, one row per cell, checked."""
     values = np.asarray(values, dtype=np.float64)
     if values.ndim != 2 or values.shape[0] != cells.shape[0]:
-        raise InvalidMeshError(
-            f"`values` must have shape ({cells.shape[0]}, k): one row per cell; got {values.shape}")
+        raise InvalidMeshError(f"`values` must have shape ({cells.shape[0]}, k): one row per cell; got {values.shape}")
     if usable is not None:
         usable = np.asarray(usable, dtype=bool)
         if usable.shape != (cells.shape[0],):
@@ -415,8 +434,15 @@ def _offsets(columns: tuple, index: np.ndarray, centre: tuple) -> tuple[np.ndarr
 _SEARCH_SLACK = 1e-9
 
 
-def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np.ndarray, radius,
-                     chunk_size: int = CHUNK, *, refuse: bool = True) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+def _candidate_pairs(
+    centre_points: np.ndarray,
+    centroids: np.ndarray,
+    reach: np.ndarray,
+    radius,
+    chunk_size: int = CHUNK,
+    *,
+    refuse: bool = True,
+) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """Yield ``(chunk, i, c)`` per chunk of centres: cell ``c`` may meet the ball ``B(centre_points[i], radius)``.
 
     ``i`` indexes the chunk (0 and up). A superset of the cells that meet each
@@ -447,8 +473,11 @@ def _candidate_pairs(centre_points: np.ndarray, centroids: np.ndarray, reach: np
         for group in _size_groups(reach, float(np.max(radius))):
             group_reach = float(reach[group].max())
             cutoff = radius + group_reach
-            largest += (check_ball_work(centroids[group], cutoff, n, centres=centre_points) if refuse
-                        else estimate_ball_pairs(centroids[group], cutoff, centre_points))[1]
+            largest += (
+                check_ball_work(centroids[group], cutoff, n, centres=centre_points)
+                if refuse
+                else estimate_ball_pairs(centroids[group], cutoff, centre_points)
+            )[1]
             searches.append((cKDTree(centroids[group]), index[group], group_reach))
     chunk_size = max(1, min(int(chunk_size), int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
     empty = np.zeros(0, dtype=np.int64)
@@ -483,8 +512,9 @@ def _unique_inverse(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return ordered[first], inverse
 
 
-def _linked_to_centre(n: int, rows: np.ndarray, corners: list[np.ndarray],
-                      centre_vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+def _linked_to_centre(
+    n: int, rows: np.ndarray, corners: list[np.ndarray], centre_vertices: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
     """The nodes ``(centre, vertex)`` of a chunk of balls and whether each is joined to its centre.
 
     Cell ``p`` (of centre ``rows[p]``, its vertices ``corners[k][p]``) joins
@@ -499,20 +529,23 @@ def _linked_to_centre(n: int, rows: np.ndarray, corners: list[np.ndarray],
 
     m = centre_vertices.shape[0]
     base = rows * n
-    keys, inverse = _unique_inverse(np.concatenate([base + corner for corner in corners]
-                                                   + [np.arange(m, dtype=np.int64) * n + centre_vertices]))
+    keys, inverse = _unique_inverse(
+        np.concatenate([base + corner for corner in corners] + [np.arange(m, dtype=np.int64) * n + centre_vertices])
+    )
     size = rows.shape[0]
-    nodes = [inverse[k * size:(k + 1) * size] for k in range(len(corners))]
+    nodes = [inverse[k * size : (k + 1) * size] for k in range(len(corners))]
     starts = np.concatenate([nodes[0]] * (len(corners) - 1))  # cell p joins its first corner to each other one
-    graph = coo_matrix((np.ones(starts.size, dtype=np.int8), (starts, np.concatenate(nodes[1:]))),
-                       shape=(keys.size, keys.size))
+    graph = coo_matrix(
+        (np.ones(starts.size, dtype=np.int8), (starts, np.concatenate(nodes[1:]))), shape=(keys.size, keys.size)
+    )
     _, labels = connected_components(graph, directed=True, connection="weak")
-    centre_labels = labels[inverse[len(corners) * size:]]
+    centre_labels = labels[inverse[len(corners) * size :]]
     return keys, labels == centre_labels[keys // n], nodes
 
 
-def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius, values: np.ndarray,
-                               usable: np.ndarray | None) -> np.ndarray:
+def _connected_face_sums_numpy(
+    vertices: np.ndarray, faces: np.ndarray, radius, values: np.ndarray, usable: np.ndarray | None
+) -> np.ndarray:
     """:func:`ball_face_sums` over the surface-connected piece of each ball: the compiled
     ``connected_face_sums``'s faces, found for all centres of a chunk at once.
 
@@ -533,8 +566,9 @@ def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius, 
     out = np.zeros((n, values.shape[1]))
     order = np.arange(n) if np.ndim(radius) == 0 else np.argsort(radius, kind="stable")
     radii = np.broadcast_to(radius, (n,))[order]  # by centre, in the order taken
-    for chunk, i, f in _candidate_pairs(vertices[order], centroids, reach, radii if np.ndim(radius) else radius,
-                                        refuse=False):
+    for chunk, i, f in _candidate_pairs(
+        vertices[order], centroids, reach, radii if np.ndim(radius) else radius, refuse=False
+    ):
         ids = order[chunk][i]
         centre = tuple(column[ids] for column in points)
         middle = _squared(*_offsets(middles, f, centre))
@@ -554,8 +588,9 @@ def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius, 
         meets = inside | partial
         for k in range(3):  # corners and centroid outside: through the face when a side crosses the ball
             rest = np.flatnonzero(~meets)
-            meets[rest] = _segments_meet_ball(tuple(c[rest] for c in offsets[k]),
-                                              tuple(c[rest] for c in offsets[(k + 1) % 3]), radius2[rest])
+            meets[rest] = _segments_meet_ball(
+                tuple(c[rest] for c in offsets[k]), tuple(c[rest] for c in offsets[(k + 1) % 3]), radius2[rest]
+            )
         i, f, low, high, inside, partial = i[meets], f[meets], low[meets], high[meets], inside[meets], partial[meets]
         ball = ball[meets]
         _, linked, nodes = _linked_to_centre(n, i, [corner[f] for corner in corners], order[chunk])
@@ -569,9 +604,15 @@ def _connected_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius, 
     return out
 
 
-def connected_ball_pairs(vertices: np.ndarray, centres: np.ndarray, radius: float, adjacency: tuple,
-                         allowed: np.ndarray | None = None, *,
-                         chunk_size: int = CHUNK) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
+def connected_ball_pairs(
+    vertices: np.ndarray,
+    centres: np.ndarray,
+    radius: float,
+    adjacency: tuple,
+    allowed: np.ndarray | None = None,
+    *,
+    chunk_size: int = CHUNK,
+) -> Iterator[tuple[slice, np.ndarray, np.ndarray]]:
     """Yield ``(chunk, centre, neighbour)``: the vertices of the surface-connected piece of each ball.
 
     The NumPy twin of the compiled walk of the jet fits (``_connected_members``):
@@ -611,8 +652,10 @@ def connected_ball_pairs(vertices: np.ndarray, centres: np.ndarray, radius: floa
         keys, linked, _ = _linked_to_centre(n, i, [first[e], second[e]], ids)
         keys = keys[linked]
         rows, neighbour = np.divmod(keys, n)
-        inside = (_squared(*_offsets(points, neighbour, tuple(column[ids[rows]] for column in points)))
-                  <= squares[chunk][rows])
+        inside = (
+            _squared(*_offsets(points, neighbour, tuple(column[ids[rows]] for column in points)))
+            <= squares[chunk][rows]
+        )
         if allowed is not None:
             inside &= allowed[neighbour]
         yield chunk, rows[inside] + chunk.start, neighbour[inside]
@@ -669,8 +712,7 @@ def call_ranges(n: int, pairs_per_centre: float, weights: np.ndarray | None = No
     return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
 
 
-def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int,
-                      nested: bool = False) -> tuple[np.ndarray, ...]:
+def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int, nested: bool = False) -> tuple[np.ndarray, ...]:
     """The per-thread scratch of the compiled ``connected_face_sums``:
     ``(seen, mark, known, squared, queue, deferred, levels)`` (and of ``connected_face_sums_nested``).
 
@@ -684,14 +726,20 @@ def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int,
     """
     index = np.int32 if max(n_vertices, n_faces) < np.iinfo(np.int32).max else np.int64
     waiting = n_faces if nested else 0
-    return (np.full((n_chunks, n_faces), -1, index), np.full((n_chunks, n_vertices), -1, index),
-            np.full((n_chunks, n_vertices), -1, index), np.empty((n_chunks, n_vertices)),
-            np.empty((n_chunks, n_vertices), index), np.empty((n_chunks, waiting), index),
-            np.empty((n_chunks, waiting), index))
+    return (
+        np.full((n_chunks, n_faces), -1, index),
+        np.full((n_chunks, n_vertices), -1, index),
+        np.full((n_chunks, n_vertices), -1, index),
+        np.empty((n_chunks, n_vertices)),
+        np.empty((n_chunks, n_vertices), index),
+        np.empty((n_chunks, waiting), index),
+        np.empty((n_chunks, waiting), index),
+    )
 
 
-def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radii: np.ndarray, values: np.ndarray,
-                         usable: np.ndarray | None) -> np.ndarray:
+def _connected_face_sums(
+    kernels, vertices: np.ndarray, faces: np.ndarray, radii: np.ndarray, values: np.ndarray, usable: np.ndarray | None
+) -> np.ndarray:
     """(R, V, k) :func:`ball_face_sums` over the surface-connected piece of each ball (compiled kernel,
     breadth-first), at the R nested radii ``radii`` (R, 1) (one for all vertices) or (R, V) (one per vertex),
     of ``values`` (1, F, k) (the same for every radius) or (R, F, k) (one set per radius). One radius:
@@ -707,11 +755,25 @@ def _connected_face_sums(kernels, vertices: np.ndarray, faces: np.ndarray, radii
     scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0], radii.shape[0] > 1)
     for start, stop in call_ranges(n, mean, None if radii.shape[1] == 1 else outer * outer):
         if radii.shape[0] == 1:  # one ball: the kernel without the passes
-            kernels.connected_face_sums(vertices, faces, centres, reach, usable, values[0], radii[0], indptr, indices,
-                                        out[0], scratch, start, stop)
+            kernels.connected_face_sums(
+                vertices,
+                faces,
+                centres,
+                reach,
+                usable,
+                values[0],
+                radii[0],
+                indptr,
+                indices,
+                out[0],
+                scratch,
+                start,
+                stop,
+            )
         else:
-            kernels.connected_face_sums_nested(vertices, faces, centres, reach, usable, values, radii, indptr,
-                                               indices, out, scratch, start, stop)
+            kernels.connected_face_sums_nested(
+                vertices, faces, centres, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
+            )
     return out
 
 
@@ -720,12 +782,20 @@ def _checked_cells(vertices, cells) -> tuple[np.ndarray, np.ndarray]:
     vertices = checked_points(vertices)
     shape = np.shape(cells)
     columns = shape[1] if len(shape) == 2 and shape[1] in (2, 3) else 3
-    return vertices, checked_indices(cells, vertices.shape[0], columns=columns,
-                                     name="edges" if columns == 2 else "faces")
+    return vertices, checked_indices(
+        cells, vertices.shape[0], columns=columns, name="edges" if columns == 2 else "faces"
+    )
 
 
-def ball_face_sums(vertices: np.ndarray, faces: np.ndarray, radius: float, values: np.ndarray,
-                   *, usable: np.ndarray | None = None, connected: bool = False) -> np.ndarray:
+def ball_face_sums(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    radius: float,
+    values: np.ndarray,
+    *,
+    usable: np.ndarray | None = None,
+    connected: bool = False,
+) -> np.ndarray:
     """(V, k) ``sum_f ratio(f, B(x_v, r)) * values[f]`` over the faces meeting each ball.
 
     ``values`` is (F, k); ``ratio`` is :func:`face_in_ball_ratios`. Faces not
@@ -752,8 +822,9 @@ def ball_face_sums(vertices: np.ndarray, faces: np.ndarray, radius: float, value
     return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)
 
 
-def ball_face_sums_nested(vertices: np.ndarray, faces: np.ndarray, radii, values: np.ndarray,
-                          *, usable: np.ndarray | None = None) -> np.ndarray:
+def ball_face_sums_nested(
+    vertices: np.ndarray, faces: np.ndarray, radii, values: np.ndarray, *, usable: np.ndarray | None = None
+) -> np.ndarray:
     """(R, V, k) :func:`ball_face_sums` with ``connected=True`` at R nested radii, one walk per vertex.
 
     Row ``r`` equals ``ball_face_sums(vertices, faces, radii[r], values,
@@ -793,8 +864,9 @@ def ball_face_sums_nested(vertices: np.ndarray, faces: np.ndarray, radii, values
     try:
         nested = np.array(radii, dtype=np.float64, ndmin=1)
     except (TypeError, ValueError):
-        raise InvalidOptionError(f"`radii` must be an increasing sequence of positive radii or an (R, {n}) "
-                                 f"array of them") from None
+        raise InvalidOptionError(
+            f"`radii` must be an increasing sequence of positive radii or an (R, {n}) array of them"
+        ) from None
     if nested.ndim == 1:
         nested = nested[:, None]
     if nested.ndim != 2 or nested.shape[0] == 0 or nested.shape[1] not in (1, n):
@@ -805,8 +877,9 @@ def ball_face_sums_nested(vertices: np.ndarray, faces: np.ndarray, radii, values
         raise InvalidOptionError("`radii` must not decrease from one radius to the next (nested balls)")
     values = np.asarray(values, dtype=np.float64)
     if values.ndim == 3 and values.shape[0] != nested.shape[0]:
-        raise InvalidMeshError(f"`values` must have shape (F, k) or ({nested.shape[0]}, F, k): one set per radius; "
-                               f"got {values.shape}")
+        raise InvalidMeshError(
+            f"`values` must have shape (F, k) or ({nested.shape[0]}, F, k): one set per radius; got {values.shape}"
+        )
     sets = values if values.ndim == 3 else values[None]
     sets = np.stack([_checked_values(faces, one, usable)[0] for one in sets])
     _, usable = _checked_values(faces, sets[0], usable)
@@ -815,13 +888,25 @@ def ball_face_sums_nested(vertices: np.ndarray, faces: np.ndarray, radii, values
         return np.zeros((nested.shape[0], n, sets.shape[2]))
     if kernels is not None:
         return _connected_face_sums(kernels, vertices, faces, np.ascontiguousarray(nested), sets, usable)
-    return np.stack([_connected_face_sums_numpy(vertices, faces, row[0] if row.size == 1 else row,
-                                                sets[r if sets.shape[0] > 1 else 0], usable)
-                     for r, row in enumerate(nested)])
+    return np.stack(
+        [
+            _connected_face_sums_numpy(
+                vertices, faces, row[0] if row.size == 1 else row, sets[r if sets.shape[0] > 1 else 0], usable
+            )
+            for r, row in enumerate(nested)
+        ]
+    )
 
 
-def ball_edge_sums(vertices: np.ndarray, edges: np.ndarray, radius: float, values: np.ndarray,
-                   *, usable: np.ndarray | None = None) -> np.ndarray:
+def ball_edge_sums(
+    vertices: np.ndarray, edges: np.ndarray, radius: float, values: np.ndarray, *, usable: np.ndarray | None = None
+) -> np.ndarray:
     """(V, k) ``sum_e |e ∩ B(x_v, r)| * values[e]`` over the edges meeting each ball (exact lengths)."""
-    return _ball_sums(vertices, edges, radius, values, usable,
-                      lambda ends, centres, r: segment_in_ball_lengths(ends[:, 0], ends[:, 1], centres, r))
+    return _ball_sums(
+        vertices,
+        edges,
+        radius,
+        values,
+        usable,
+        lambda ends, centres, r: segment_in_ball_lengths(ends[:, 0], ends[:, 1], centres, r),
+    )

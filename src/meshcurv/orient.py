@@ -108,8 +108,12 @@ def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = 
     proper = ~topology.degenerate_faces
     if not proper.any():  # every face has a repeated corner: nothing to orient
         return proper
-    if proper.all() and not (counts > 2).any() and not topology.inconsistent_edges.any() \
-            and not topology.bowtie_vertices.any():
+    if (
+        proper.all()
+        and not (counts > 2).any()
+        and not topology.inconsistent_edges.any()
+        and not topology.bowtie_vertices.any()
+    ):
         # consistently wound already, and the patches are the components through shared vertices
         # (faces that share only a vertex would make it a bow-tie): no graph of face sides needed,
         # only each closed patch's side (a fifth of the time at a million vertices)
@@ -130,9 +134,7 @@ def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = 
     import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
     from scipy.sparse.csgraph import connected_components
 
-    graph = sp.csr_matrix(
-        (np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(2 * n_faces, 2 * n_faces)
-    )
+    graph = sp.csr_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(2 * n_faces, 2 * n_faces))
     _, labels = connected_components(graph, directed=False)
     kept, reversed_ = labels[:n_faces], labels[n_faces:]
     orientable = kept != reversed_
@@ -170,8 +172,9 @@ def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
     return np.where(decided & cavity, ~inverted, inverted)
 
 
-def _patch_volumes(vertices: np.ndarray, faces: np.ndarray, patch: np.ndarray, flip: np.ndarray,
-                   n_labels: int) -> tuple[np.ndarray, np.ndarray]:
+def _patch_volumes(
+    vertices: np.ndarray, faces: np.ndarray, patch: np.ndarray, flip: np.ndarray, n_labels: int
+) -> tuple[np.ndarray, np.ndarray]:
     """(P,) signed and (P,) absolute sums of six times the volume of each patch's faces.
 
     A face's volume is that of the tetrahedron of its corners and the mean of
@@ -186,8 +189,10 @@ def _patch_volumes(vertices: np.ndarray, faces: np.ndarray, patch: np.ndarray, f
         return kernels.patch_volumes(vertices, faces, patch, np.ascontiguousarray(flip, dtype=bool), int(n_labels))
     first = vertices[faces[:, 0]]
     weight = np.maximum(np.bincount(patch, minlength=n_labels), 1).astype(np.float64)
-    centre = np.stack([np.bincount(patch, weights=first[:, k], minlength=n_labels) for k in range(3)],
-                      axis=1) / weight[:, None]
+    centre = (
+        np.stack([np.bincount(patch, weights=first[:, k], minlength=n_labels) for k in range(3)], axis=1)
+        / weight[:, None]
+    )
     a = first - centre[patch]
     b = vertices[faces[:, 1]] - centre[patch]
     c = vertices[faces[:, 2]] - centre[patch]
@@ -224,12 +229,16 @@ def _nesting_depth(vertices, faces, patch, closed) -> np.ndarray:
     inside_box = ((probe[:, None, :] >= lower[None]) & (probe[:, None, :] <= upper[None])).all(axis=2)
     np.fill_diagonal(inside_box, False)
     for i, j in zip(*np.nonzero(inside_box)):  # candidate pairs: probe of patch i in the box of patch j
-        tri = corners[starts[j]:ends[j]] - probe[i]
+        tri = corners[starts[j] : ends[j]] - probe[i]
         p, q, r = tri[:, 0], tri[:, 1], tri[:, 2]
         lp, lq, lr = (np.linalg.norm(x, axis=1) for x in (p, q, r))
         numerator = np.einsum("ij,ij->i", p, np.cross(q, r))
-        denominator = (lp * lq * lr + np.einsum("ij,ij->i", p, q) * lr + np.einsum("ij,ij->i", p, r) * lq
-                       + np.einsum("ij,ij->i", q, r) * lp)
+        denominator = (
+            lp * lq * lr
+            + np.einsum("ij,ij->i", p, q) * lr
+            + np.einsum("ij,ij->i", p, r) * lq
+            + np.einsum("ij,ij->i", q, r) * lp
+        )
         winding = np.sum(2 * np.arctan2(numerator, denominator)) / (4 * np.pi)
         # a probe on a corner of patch j (a part stored twice) is on its surface, inside neither
         touching = np.min(np.minimum(np.minimum(lp, lq), lr)) <= 1e-6 * np.linalg.norm(upper[j] - lower[j])

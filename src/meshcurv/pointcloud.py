@@ -290,8 +290,14 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     if unique.size < n_all:
         near = n_all - unique.size - n_exact
         found = [f"{n_exact} points coincide with others (duplicates)"] if n_exact else []
-        found += [f"{near} points are near copies of others (closer to one than {COPY_GAP:g} times the distance "
-                  "to their next neighbour: round-off differences)"] if near else []
+        found += (
+            [
+                f"{near} points are near copies of others (closer to one than {COPY_GAP:g} times the distance "
+                "to their next neighbour: round-off differences)"
+            ]
+            if near
+            else []
+        )
         problems.append(" and ".join(found) + ": merged, each computed once and its values copied")
     if unique.size < MIN_POINTS:
         raise InvalidMeshError(f"`points` holds {unique.size} distinct points; at least {MIN_POINTS} are needed")
@@ -302,10 +308,12 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         if radius > diagonal:
             raise InvalidOptionError(
                 f"`radius` {radius:g} is larger than the point cloud itself (bounding-box diagonal {diagonal:g}): "
-                "every ball would hold every point; pass a radius of a few point spacings, in the units of the points")
+                "every ball would hold every point; pass a radius of a few point spacings, in the units of the points"
+            )
 
     k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, found = _compute(
-        cloud, None if given is None else given[unique], radius, method, search)
+        cloud, None if given is None else given[unique], radius, method, search
+    )
     problems.extend(found)
     logger.info("point cloud: results")
 
@@ -323,9 +331,17 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         warnings.warn("point cloud: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
     reason = np.where(valid, 0, np.where(reason > 0, reason, _UNDEFINED)).astype(np.int8)
     logger.info("point cloud: done")
-    return CurvatureResult._of_arrays(k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max,
-                                      normals=out_normals, valid=valid, method=method, parameters=parameters,
-                                      invalid_reason=reason)
+    return CurvatureResult._of_arrays(
+        k_min=k_min,
+        k_max=k_max,
+        dir_min=dir_min,
+        dir_max=dir_max,
+        normals=out_normals,
+        valid=valid,
+        method=method,
+        parameters=parameters,
+        invalid_reason=reason,
+    )
 
 
 def _position(unique: np.ndarray, n: int) -> np.ndarray:
@@ -451,8 +467,13 @@ def _spatial_order(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     for axis in range(3):
         spread = cells[:, axis]
         # spread the 21 bits two apart (bit b goes to bit 3 b)
-        for shift, mask in ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F),
-                            (4, 0x10C30C30C30C30C3), (2, 0x1249249249249249)):
+        for shift, mask in (
+            (32, 0x1F00000000FFFF),
+            (16, 0x1F0000FF0000FF),
+            (8, 0x100F00F00F00F00F),
+            (4, 0x10C30C30C30C30C3),
+            (2, 0x1249249249249249),
+        ):
             spread = (spread | (spread << np.uint64(shift))) & np.uint64(mask)
         code |= spread << np.uint64(axis)
     order = np.argsort(code, kind="stable")
@@ -492,13 +513,15 @@ def _check_spread(cloud: np.ndarray) -> None:
     if 0.0 < bulk < MIN_COORDINATE:
         raise InvalidMeshError(
             f"`points`: 90% of the coordinates are below {bulk:.3g} (the few larger ones are outliers); products "
-            f"of four lengths (squared areas) would underflow float64 below {MIN_COORDINATE:.0e}: rescale the points")
+            f"of four lengths (squared areas) would underflow float64 below {MIN_COORDINATE:.0e}: rescale the points"
+        )
     centred = sample - sample.mean(axis=0)
     singular = np.linalg.svd(centred, compute_uv=False)
     if singular[1] <= 1e-9 * singular[0]:
         raise InvalidMeshError(
             f"all {cloud.shape[0]} distinct points lie on one line (extent {singular[0]:.3g} along it, "
-            f"{singular[1]:.3g} across): no surface to measure")
+            f"{singular[1]:.3g} across): no surface to measure"
+        )
 
 
 def _compute(points, given, radius, method, search=None):
@@ -519,23 +542,31 @@ def _compute(points, given, radius, method, search=None):
     if not measurable.any():
         raise InvalidMeshError(
             f"`points` are spaced below {MIN_SPACING:.0e} everywhere: their squared distances underflow "
-            "float64; rescale the points")
+            "float64; rescale the points"
+        )
     median = float(np.median(spacing[measurable]))
     usable = measurable & (spacing <= OUTLIER_FACTOR * median)
     if not measurable.all():
-        problems.append(f"{int((~measurable).sum())} points are spaced below {MIN_SPACING:.0e} (their squared "
-                        "distances underflow float64): left out, NaN")
+        problems.append(
+            f"{int((~measurable).sum())} points are spaced below {MIN_SPACING:.0e} (their squared "
+            "distances underflow float64): left out, NaN"
+        )
     if not (usable | ~measurable).all():
-        problems.append(f"{int((~usable & measurable).sum())} points are outliers (their "
-                        f"{_normals.SPACING_NEIGHBOUR}th neighbour is beyond {OUTLIER_FACTOR:g} times the median "
-                        "spacing): left out, NaN")
+        problems.append(
+            f"{int((~usable & measurable).sum())} points are outliers (their "
+            f"{_normals.SPACING_NEIGHBOUR}th neighbour is beyond {OUTLIER_FACTOR:g} times the median "
+            "spacing): left out, NaN"
+        )
     # neighbourhoods on a line: a surface scanned along lines (its own spacing, normals, neighbours and balls), or
     # a line with no surface around it (NaN)
     lonely, line, line_neighbours, line_spacing, least, line_normals = _normals.scan_lines(
-        points, distances, indices, usable, tree, radius)
+        points, distances, indices, usable, tree, radius
+    )
     if lonely.any():
-        problems.append(f"{int(lonely.sum())} points lie on a line (their nearest neighbours on a line, fewer than "
-                        f"{_normals.LINE_SUPPORT} points beside it within their reach): no surface there, NaN")
+        problems.append(
+            f"{int(lonely.sum())} points lie on a line (their nearest neighbours on a line, fewer than "
+            f"{_normals.LINE_SUPPORT} points beside it within their reach): no surface there, NaN"
+        )
         usable &= ~lonely
     if line.size:
         indices = indices.copy()
@@ -546,10 +577,23 @@ def _compute(points, given, radius, method, search=None):
     if not usable.any():  # every point an outlier or on a line: nothing to measure
         reason = np.where(lonely, _ON_A_LINE, 0).astype(np.int8)
         nothing, nowhere = np.full(n, np.nan), np.full((n, 3), np.nan)
-        parameters = {"radius": np.nan if radius is None else radius, "spacing": median, "noise": np.nan,
-                      "normals": "estimated" if given is None else "given"}
-        return (nothing, nothing.copy(), nowhere, nowhere.copy(), nowhere.copy() if given is None else given,
-                usable, reason, parameters, problems)
+        parameters = {
+            "radius": np.nan if radius is None else radius,
+            "spacing": median,
+            "noise": np.nan,
+            "normals": "estimated" if given is None else "given",
+        }
+        return (
+            nothing,
+            nothing.copy(),
+            nowhere,
+            nowhere.copy(),
+            nowhere.copy() if given is None else given,
+            usable,
+            reason,
+            parameters,
+            problems,
+        )
     least_radius = np.zeros(n)
     least_radius[line] = least
     centres = np.flatnonzero(usable)
@@ -559,8 +603,9 @@ def _compute(points, given, radius, method, search=None):
         start = _normals.pca_normals(points, indices)
         start[line] = line_normals
         logger.info("point cloud: orientation")
-        signs, labels, doubtful, sheets, unsettled = _normals.oriented_signs(points, start, indices, usable, spacing,
-                                                                             tree)
+        signs, labels, doubtful, sheets, unsettled = _normals.oriented_signs(
+            points, start, indices, usable, spacing, tree
+        )
         start = start * signs[:, None]
         how = "estimated"
     else:
@@ -574,8 +619,9 @@ def _compute(points, given, radius, method, search=None):
         if reoriented:
             # inconsistent signs: oriented as estimated normals are (one sheet at a time, reversed across a
             # gap between two), each part then on the side most of its given normals point to
-            signs, labels, doubtful, sheets, unsettled = _normals.oriented_signs(points, given, indices, usable,
-                                                                                 spacing, tree)
+            signs, labels, doubtful, sheets, unsettled = _normals.oriented_signs(
+                points, given, indices, usable, spacing, tree
+            )
             majority = np.bincount(labels, weights=signs, minlength=int(labels.max()) + 1)
             signs = signs * np.where(majority[labels] < 0, -1.0, 1.0)
         start = given * signs[:, None]
@@ -588,9 +634,11 @@ def _compute(points, given, radius, method, search=None):
         extent = points[usable]
         largest = CLOUD_EXTENT_CAP * float(np.linalg.norm(extent.max(axis=0) - extent.min(axis=0)))
         if max(r for r, *_ in groups) > largest:
-            problems.append(f"the cloud is too sparse or too noisy for its size (default radius "
-                            f"{max(r for r, *_ in groups):.3g} beyond a quarter of its extent): radius cut to "
-                            f"{largest:.3g}; the curvatures are rough")
+            problems.append(
+                f"the cloud is too sparse or too noisy for its size (default radius "
+                f"{max(r for r, *_ in groups):.3g} beyond a quarter of its extent): radius cut to "
+                f"{largest:.3g}; the curvatures are rough"
+            )
             groups = [(min(r, largest), s, m, min(f, largest)) for r, s, m, f in groups]
 
     k_min, k_max = np.full(n, np.nan), np.full(n, np.nan)
@@ -612,19 +660,22 @@ def _compute(points, given, radius, method, search=None):
             if radius is None:
                 group_radius = _within_budget(points, group_radius, members, "jet fits", problems)
             smallest = min(group_radius, max(CLOUD_RADIUS_RULES[method][0] * group_spacing, floor))
-            found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest,
-                                     details=details)
+            found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest, details=details)
             asked = group_radius
             noisy += _noise_dominated(details["radii"], members, asked, noise, one_sided)
         else:
             if given is None:
                 asked = normal_radius = _within_budget(
-                    points, max(noise_rule(_estimators.NORMAL_RULE, group_spacing, noise), floor), members,
-                    "normal fits", problems)
+                    points,
+                    max(noise_rule(_estimators.NORMAL_RULE, group_spacing, noise), floor),
+                    members,
+                    "normal fits",
+                    problems,
+                )
                 smallest = min(normal_radius, max(_estimators.NORMAL_RULE[0] * group_spacing, floor))
-                normals = _estimators.fitted_normals(points, start, normal_radius, members, usable,
-                                                     smallest=smallest,
-                                                     details=details)
+                normals = _estimators.fitted_normals(
+                    points, start, normal_radius, members, usable, smallest=smallest, details=details
+                )
                 parameters["normal_radius"] = normal_radius
                 # a point whose every normal fit held the other side, and whose nearest neighbours hold
                 # it too, keeps a PCA normal that may mix the two sheets: it is left out (NaN, and out of
@@ -636,8 +687,9 @@ def _compute(points, given, radius, method, search=None):
                 noisy += _noise_dominated(details["radii"], members, asked, noise, one_sided)
             else:
                 normals = start
-            found = _estimators.corrected_measures(tree, points, normals, group_radius, members,
-                                                   usable & one_sided, spacing=group_spacing, sheets=sheets)
+            found = _estimators.corrected_measures(
+                tree, points, normals, group_radius, members, usable & one_sided, spacing=group_spacing, sheets=sheets
+            )
         if "radii" in details:
             fitted_radii = details["radii"][members]
             shrunk += int((fitted_radii < asked).sum())
@@ -648,18 +700,29 @@ def _compute(points, given, radius, method, search=None):
     if method == "jets" or given is None:
         parameters["shrunk"] = shrunk / max(centres.size, 1)
     if method == "jets" and radius is not None and shrunk:
-        problems.append(f"at {shrunk} points the ball of the given radius {radius:g} held the other side of a thin "
-                        "or small part (points facing away): fitted over smaller balls of one side, down to "
-                        f"{CLOUD_RADIUS_RULES[method][0]:g} spacings (parameters['shrunk'])")
+        problems.append(
+            f"at {shrunk} points the ball of the given radius {radius:g} held the other side of a thin "
+            "or small part (points facing away): fitted over smaller balls of one side, down to "
+            f"{CLOUD_RADIUS_RULES[method][0]:g} spacings (parameters['shrunk'])"
+        )
     if two_sided:
-        what = ("curvatures NaN" if method == "jets" else "normals from the PCA of 10 neighbours" if noise < NOISY_PCA
-                else f"NaN (under noise of {noise:.2g} spacings the PCA normals of 10 neighbours are not kept)")
-        problems.append(f"{two_sided} points have no one-sided jet fit (every ball down to 3-4 spacings held "
-                        f"points facing the other way: a part thinner than that, or too few points): {what}")
+        what = (
+            "curvatures NaN"
+            if method == "jets"
+            else "normals from the PCA of 10 neighbours"
+            if noise < NOISY_PCA
+            else f"NaN (under noise of {noise:.2g} spacings the PCA normals of 10 neighbours are not kept)"
+        )
+        problems.append(
+            f"{two_sided} points have no one-sided jet fit (every ball down to 3-4 spacings held "
+            f"points facing the other way: a part thinner than that, or too few points): {what}"
+        )
     if noisy:
-        problems.append(f"{noisy} points under noise of {noise:.2g} spacings have a one-sided fit only over balls "
-                        f"below {NOISY_SHRINK:g} times the radius the noise calls for, or none (a part thinner than "
-                        "that): NaN")
+        problems.append(
+            f"{noisy} points under noise of {noise:.2g} spacings have a one-sided fit only over balls "
+            f"below {NOISY_SHRINK:g} times the radius the noise calls for, or none (a part thinner than "
+            "that): NaN"
+        )
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
     alike = np.zeros(n, dtype=bool)
     if how != "given":
@@ -669,7 +732,8 @@ def _compute(points, given, radius, method, search=None):
         alike, interleaved = _normals.two_sheets(points, out_normals, usable, spacing, tree)
         # a part whose faces mix over a good share of it is thinner than the spacing: its sides are a coin's toss
         share = np.bincount(labels, weights=interleaved, minlength=int(labels.max()) + 1) / np.maximum(
-            np.bincount(labels, weights=usable, minlength=int(labels.max()) + 1), 1.0)
+            np.bincount(labels, weights=usable, minlength=int(labels.max()) + 1), 1.0
+        )
         interleaved |= usable & (share[labels] >= THIN_PART_SHARE)
         doubtful = doubtful | alike | interleaved
     reason = np.zeros(n, dtype=np.int8)
@@ -680,15 +744,21 @@ def _compute(points, given, radius, method, search=None):
         found = []
         between = doubtful & ~unsettled & ~alike
         if between.any():
-            found.append(f"{int(between.sum())} points lie between two sheets closer than the spacing (two parts "
-                         "of the cloud, or the faces of a part thinner than that)")
+            found.append(
+                f"{int(between.sum())} points lie between two sheets closer than the spacing (two parts "
+                "of the cloud, or the faces of a part thinner than that)"
+            )
         if (unsettled & ~alike).any():
-            found.append(f"{int((unsettled & ~alike).sum())} points are on a side the winding number of the cloud "
-                         "contradicts (a part inside out, or an outward part inside another) and turning them did "
-                         "not settle it")
+            found.append(
+                f"{int((unsettled & ~alike).sum())} points are on a side the winding number of the cloud "
+                "contradicts (a part inside out, or an outward part inside another) and turning them did "
+                "not settle it"
+            )
         if alike.any():
-            found.append(f"{int(alike.sum())} points face the same way as a sheet stacked on theirs a few spacings "
-                         "away (the faces of a thin part, or two parts: one of the two is inside out)")
+            found.append(
+                f"{int(alike.sum())} points face the same way as a sheet stacked on theirs a few spacings "
+                "away (the faces of a thin part, or two parts: one of the two is inside out)"
+            )
         problems.append(" and ".join(found) + ": their normals' side is undecided, NaN")
         valid &= ~doubtful
         reason[doubtful] = _UNDECIDED
@@ -720,9 +790,11 @@ def _within_budget(points, radius, members, what, problems) -> float:
     if mean * members.size <= budget:
         return radius
     cut = float(radius * np.sqrt(budget / (mean * members.size)))
-    problems.append(f"the default radius of the {what}, {radius:.3g}, would hold about {mean:.3g} points a ball "
-                    f"({mean * members.size:.3g} in all, hours of work: noise of many spacings, or both faces "
-                    f"of a thin part in each ball): cut to {cut:.3g}; the curvatures are rougher")
+    problems.append(
+        f"the default radius of the {what}, {radius:.3g}, would hold about {mean:.3g} points a ball "
+        f"({mean * members.size:.3g} in all, hours of work: noise of many spacings, or both faces "
+        f"of a thin part in each ball): cut to {cut:.3g}; the curvatures are rougher"
+    )
     return cut
 
 
@@ -761,6 +833,8 @@ def _radius_groups(spacing, indices, usable, median, noise, radius, method, prob
     for k in np.unique(level):
         members = centres[level == k]
         groups.append((cloud_radius(median * 2.0**k, noise, method), median * 2.0**k, members, 0.0))
-    problems.append(f"the density of the points is very uneven (local spacing from {low:.3g} to {high:.3g}, "
-                    f"5th to 95th percentile): each of {len(groups)} classes of spacing got its own radius")
+    problems.append(
+        f"the density of the points is very uneven (local spacing from {low:.3g} to {high:.3g}, "
+        f"5th to 95th percentile): each of {len(groups)} classes of spacing got its own radius"
+    )
     return groups + lines

@@ -70,8 +70,13 @@ import numpy as np
 
 from ._validation import check_positive_float, checked_points
 from .errors import InvalidOptionError
-from .geometry import (COMPONENT_SCALE_SPREAD, median_edge_length, robust_mean_edge_length, vertex_edge_lengths,
-                       vertex_length_scales)
+from .geometry import (
+    COMPONENT_SCALE_SPREAD,
+    median_edge_length,
+    robust_mean_edge_length,
+    vertex_edge_lengths,
+    vertex_length_scales,
+)
 from .jets import SETTLED_SLOPE, fit_jets
 from .lattice import voxel_grid
 from .topology import MeshTopology
@@ -194,9 +199,11 @@ def small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopolog
     median = median_edge_length(vertices, topology.edges)
     if not radius < minimum_edges * median:
         return ""
-    return (f"`radius` {radius:g} is {radius / median:.2g} of the median edge length {median:g}: below "
-            f"{minimum_edges:g} edge lengths the balls hold too little of the surface and many curvatures are far "
-            f"off; pass a radius of a few edge lengths, in the units of the vertices (or leave the default)")
+    return (
+        f"`radius` {radius:g} is {radius / median:.2g} of the median edge length {median:g}: below "
+        f"{minimum_edges:g} edge lengths the balls hold too little of the surface and many curvatures are far "
+        f"off; pass a radius of a few edge lengths, in the units of the vertices (or leave the default)"
+    )
 
 
 def resolve_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
@@ -226,8 +233,15 @@ NOISE_GAIN = 9.0
 NOISE_SAMPLE = 65536
 
 
-def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, edges: np.ndarray, *,
-                neighbours: np.ndarray | None = None, adjacency: tuple | None = None) -> float:
+def noise_level(
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    valid: np.ndarray,
+    edges: np.ndarray,
+    *,
+    neighbours: np.ndarray | None = None,
+    adjacency: tuple | None = None,
+) -> float:
     """Median distance of the vertices to degree-2 jets fitted around them, in local edge lengths.
 
     The local edge length ``h_v`` of a vertex is the mean length of its edges.
@@ -261,9 +275,17 @@ def noise_level(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, ed
     for k in np.unique(level):
         members = np.flatnonzero(level == k)
         radius = NOISE_FIT_RADIUS * scale[members].mean()
-        coefficients, _, _ = fit_jets(vertices, normals, radius, degree=2, centres=centres[members],
-                                      neighbours=neighbours, adjacency=adjacency, compact=True,
-                                      settled=SETTLED_SLOPE)
+        coefficients, _, _ = fit_jets(
+            vertices,
+            normals,
+            radius,
+            degree=2,
+            centres=centres[members],
+            neighbours=neighbours,
+            adjacency=adjacency,
+            compact=True,
+            settled=SETTLED_SLOPE,
+        )
         # the constant term is in units of the radius: NOISE_FIT_RADIUS class mean edge lengths
         distances[members] = np.abs(coefficients[:, 0]) * NOISE_FIT_RADIUS
     distances = distances[np.isfinite(distances)]
@@ -314,9 +336,9 @@ VOXEL_PILOT = 2.0
 VOXEL_CURVEDNESS_PERCENTILE = 75.0
 
 
-def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology,
-                         pilot: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
-                         ) -> tuple[float, dict] | None:
+def voxel_surface_radius(
+    vertices: np.ndarray, topology: MeshTopology, pilot: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+) -> tuple[float, dict] | None:
     """The default radius of a voxel surface and what it was derived from, or None for other meshes.
 
     The grid is found on the referenced vertices (:func:`meshcurv.lattice.voxel_grid`);
@@ -338,16 +360,29 @@ def voxel_surface_radius(vertices: np.ndarray, topology: MeshTopology,
         return None
     curvature_radius = 1.0 / float(np.percentile(curvedness, VOXEL_CURVEDNESS_PERCENTILE))
     radius = voxel_radius(grid.spacing, curvature_radius)
-    found = {"surface": "voxel", "voxel_spacing": tuple(float(x) for x in grid.spacing),
-             "curvature_radius": curvature_radius}
+    found = {
+        "surface": "voxel",
+        "voxel_spacing": tuple(float(x) for x in grid.spacing),
+        "curvature_radius": curvature_radius,
+    }
     if more:  # the pilot's normals: each vertex's own scale (icc's default)
         corners = vertices[topology.faces]
-        area = 0.5 * float(np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
-                                          axis=1).sum())
+        area = 0.5 * float(
+            np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1).sum()
+        )
         rings = int(np.clip(np.ceil(radius / median_edge_length(vertices, topology.edges)), 1, VOXEL_REGION_RINGS))
-        found["vertex_scale"] = voxel_vertex_radii(grid.spacing, more[0], k_min, k_max, referenced & valid,
-                                                   curvature_radius, topology.neighbour_lists, radius, area=area,
-                                                   rings=rings)
+        found["vertex_scale"] = voxel_vertex_radii(
+            grid.spacing,
+            more[0],
+            k_min,
+            k_max,
+            referenced & valid,
+            curvature_radius,
+            topology.neighbour_lists,
+            radius,
+            area=area,
+            rings=rings,
+        )
     return radius, found
 
 
@@ -376,11 +411,13 @@ VOXEL_REGION_APART = 2.0
 VOXEL_TUBE = 2.0
 
 #: How ``parameters["scale_rule"]`` names the rule.
-VOXEL_SCALE_RULE = ("voxel: r_v = max(h_max, min(2 sqrt(h_v R), 1 / c_v, 0.5 / sqrt|K_v|, sqrt(area / (18 pi)), "
-                    "R / 2 + t_v (1 / c_v - R / 2)+)), t_v = clip(1 - 2 sqrt|K_v| / c_v, 0, 1), h_v the voxel "
-                    "extent along the pilot's normal, R the surface's curvature radius (a region flatter than 2 R: its "
-                    "own), c_v and K_v the pilot's "
-                    "curvedness and Gaussian curvature over 2 rings; normals over min(3 r_v, max(1.5 / c_v, 4 h_max))")
+VOXEL_SCALE_RULE = (
+    "voxel: r_v = max(h_max, min(2 sqrt(h_v R), 1 / c_v, 0.5 / sqrt|K_v|, sqrt(area / (18 pi)), "
+    "R / 2 + t_v (1 / c_v - R / 2)+)), t_v = clip(1 - 2 sqrt|K_v| / c_v, 0, 1), h_v the voxel "
+    "extent along the pilot's normal, R the surface's curvature radius (a region flatter than 2 R: its "
+    "own), c_v and K_v the pilot's "
+    "curvedness and Gaussian curvature over 2 rings; normals over min(3 r_v, max(1.5 / c_v, 4 h_max))"
+)
 
 
 def _ring_max(neighbour_lists: tuple, rings: int, values: np.ndarray) -> np.ndarray:
@@ -394,9 +431,19 @@ def _ring_max(neighbour_lists: tuple, rings: int, values: np.ndarray) -> np.ndar
     return out
 
 
-def voxel_vertex_radii(spacing, normals: np.ndarray, k_min: np.ndarray, k_max: np.ndarray, valid: np.ndarray,
-                       curvature_radius: float, neighbour_lists: tuple, fallback: float, *,
-                       area: float = np.inf, rings: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def voxel_vertex_radii(
+    spacing,
+    normals: np.ndarray,
+    k_min: np.ndarray,
+    k_max: np.ndarray,
+    valid: np.ndarray,
+    curvature_radius: float,
+    neighbour_lists: tuple,
+    fallback: float,
+    *,
+    area: float = np.inf,
+    rings: int = 0,
+) -> tuple[np.ndarray, np.ndarray]:
     """``(radii, normal_radii)`` (V,): the measure and normal-fit radius of each vertex of a voxel surface.
 
     Parameters
@@ -466,8 +513,13 @@ def voxel_vertex_radii(spacing, normals: np.ndarray, k_min: np.ndarray, k_max: n
         gauss = np.abs(k_min * k_max)
     known = valid & np.isfinite(curvedness) & np.isfinite(gauss)
     extent = np.where(np.isfinite(extent) & (extent > 0), extent, largest)
-    curvedness, gauss, weights = _ring_sums(neighbour_lists, VOXEL_LOCAL_RINGS, np.where(known, curvedness, 0.0),
-                                            np.where(known, gauss, 0.0), known.astype(np.float64))
+    curvedness, gauss, weights = _ring_sums(
+        neighbour_lists,
+        VOXEL_LOCAL_RINGS,
+        np.where(known, curvedness, 0.0),
+        np.where(known, gauss, 0.0),
+        known.astype(np.float64),
+    )
     reached = weights > 0
     weights = np.where(reached, weights, 1.0)
     curvedness, gauss = curvedness / weights, gauss / weights
@@ -518,8 +570,7 @@ def _ring_sums(neighbour_lists: tuple, rings: int, *arrays: np.ndarray) -> list[
     return sums
 
 
-def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology, *, valid: np.ndarray | None = None
-                       ) -> np.ndarray:
+def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology, *, valid: np.ndarray | None = None) -> np.ndarray:
     """(V,) the factor of each vertex's radius over its component's: how much coarser or finer it is sampled.
 
     ``rho_v`` is the vertex's mean edge length averaged in log over its
@@ -551,8 +602,7 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology, *, valid: n
         logs = np.where(weights > 0, logs / np.where(weights > 0, weights, 1.0), 0.0)
     even, follow = np.log(LOCAL_EVEN), np.log(LOCAL_FOLLOW)
     size = np.abs(logs)
-    factor = np.where(size <= even, 0.0,
-                      np.where(size >= follow, size, (size - even) * follow / (follow - even)))
+    factor = np.where(size <= even, 0.0, np.where(size >= follow, size, (size - even) * follow / (follow - even)))
     limit = np.log(COMPONENT_SCALE_SPREAD)
     return np.exp(np.clip(np.sign(logs) * factor, -limit, limit))
 
@@ -607,8 +657,9 @@ def stable_scales(k_min: np.ndarray, k_max: np.ndarray, neighbour_lists: tuple) 
     mean = 0.5 * (k_min + k_max)
     change = np.abs(np.diff(mean, axis=0)) + np.abs(np.diff(k_min, axis=0)) + np.abs(np.diff(k_max, axis=0))
     finite = np.isfinite(change)
-    total, count = _ring_sums(neighbour_lists, STABLE_RINGS, np.where(finite, change, 0.0).T,
-                              finite.astype(np.float64).T)
+    total, count = _ring_sums(
+        neighbour_lists, STABLE_RINGS, np.where(finite, change, 0.0).T, finite.astype(np.float64).T
+    )
     with np.errstate(invalid="ignore", divide="ignore"):
         local = (total / count).T
     with warnings.catch_warnings():
@@ -646,8 +697,7 @@ def cloud_noise_level(points, normals, spacing, centres, usable) -> float:
     if spacing <= 0 or sample.size == 0:
         return 0.0
     radius = CLOUD_NOISE_FIT_RADIUS * spacing
-    coefficients, _, _ = fit_jets(points, normals, radius, degree=2, iterations=1, centres=sample,
-                                  neighbours=usable)
+    coefficients, _, _ = fit_jets(points, normals, radius, degree=2, iterations=1, centres=sample, neighbours=usable)
     heights = np.abs(coefficients[sample, 0]) * CLOUD_NOISE_FIT_RADIUS  # c00 is in units of the radius
     heights = heights[np.isfinite(heights)]
     return float(np.median(heights)) if heights.size else 0.0

@@ -24,8 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ._backend import numba_kernels
-from ._validation import (MAX_VERTICES, Ragged, check_vertex_count, checked_triangles, fan_triangles,
-                          polygon_arrays)
+from ._validation import MAX_VERTICES, Ragged, check_vertex_count, checked_triangles, fan_triangles, polygon_arrays
 from .errors import InvalidMeshError
 
 if TYPE_CHECKING:
@@ -81,9 +80,7 @@ def triangulate_faces(polygons) -> np.ndarray:
     flat = shaped.flat if isinstance(shaped, Ragged) else shaped
     low = int(flat.min())
     if low < 0:
-        raise InvalidMeshError(
-            f"`polygons` has negative vertex indices (smallest {low}); indices are 0-based and >= 0"
-        )
+        raise InvalidMeshError(f"`polygons` has negative vertex indices (smallest {low}); indices are 0-based and >= 0")
     return np.array(fan_triangles(shaped), dtype=np.int64, order="C", copy=True)
 
 
@@ -156,8 +153,8 @@ class MeshTopology:
                 raise InvalidMeshError(
                     f"`faces` reference vertex index {largest} but hold only {flat.size} corners: pass "
                     f"`n_vertices` (the number of vertices) if the mesh really has {largest + 1} of them"
-                    if largest < MAX_VERTICES else
-                    f"`faces` reference vertex index {largest}, beyond the largest mesh meshcurv takes "
+                    if largest < MAX_VERTICES
+                    else f"`faces` reference vertex index {largest}, beyond the largest mesh meshcurv takes "
                     f"(n_vertices up to {MAX_VERTICES})"
                 )
             n_vertices = largest + 1
@@ -170,7 +167,8 @@ class MeshTopology:
         kernels = numba_kernels("topology")
         if kernels is not None:
             edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(
-                faces, n_vertices, _bucket_template(n_vertices, faces.shape[0]))
+                faces, n_vertices, _bucket_template(n_vertices, faces.shape[0])
+            )
         else:
             edges, face_edges, edge_faces, counts, forward_counts = _build_edges(faces, n_vertices)
         return cls(
@@ -257,8 +255,11 @@ class MeshTopology:
         if kernels is None:
             return _readonly(_bowtie_vertices(self))
         linked = (self.edge_face_counts == 2) & (self.edge_faces[:, 0] != self.edge_faces[:, 1])
-        return _readonly(kernels.bowtie_vertices(self.faces, self.face_edges, self.edge_faces, linked,
-                                                 ~self.degenerate_faces, self.n_vertices))
+        return _readonly(
+            kernels.bowtie_vertices(
+                self.faces, self.face_edges, self.edge_faces, linked, ~self.degenerate_faces, self.n_vertices
+            )
+        )
 
     @cached_property
     def degenerate_faces(self) -> np.ndarray:
@@ -372,9 +373,7 @@ class MeshTopology:
         import scipy.sparse as sp
         from scipy.sparse.csgraph import connected_components
 
-        graph = sp.csr_matrix(
-            (np.ones(boundary.shape[0]), (boundary[:, 0], boundary[:, 1])), shape=(n, n)
-        )
+        graph = sp.csr_matrix((np.ones(boundary.shape[0]), (boundary[:, 0], boundary[:, 1])), shape=(n, n))
         count, labels = connected_components(graph, directed=False)
         return int(np.unique(labels[boundary[:, 0]]).size)
 
@@ -420,9 +419,7 @@ def _build_edges(faces: np.ndarray, n_vertices: int):
     column = np.where(edge_faces[has_second, 1] == -1, 1, 0)
     rows = np.flatnonzero(has_second)
     edge_faces[rows, column] = side_face[second]
-    forward_counts = np.bincount(
-        edge_of_sorted, weights=1 - backward[order], minlength=n_edges
-    ).astype(np.int64)
+    forward_counts = np.bincount(edge_of_sorted, weights=1 - backward[order], minlength=n_edges).astype(np.int64)
     return edges, face_edges.reshape(n_faces, 3), edge_faces, counts.astype(np.int64), forward_counts
 
 
@@ -450,11 +447,8 @@ def _bowtie_vertices(topology: MeshTopology) -> np.ndarray:
     # side s runs from corner s to corner head_corner[s]; join the corners at the same vertex
     same = tail[one] == tail[second]
     rows = np.concatenate([one, head_corner[one]])
-    cols = np.concatenate([np.where(same, second, head_corner[second]),
-                           np.where(same, head_corner[second], second)])
-    graph = sp.csr_matrix(
-        (np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n_corners, n_corners)
-    )
+    cols = np.concatenate([np.where(same, second, head_corner[second]), np.where(same, head_corner[second], second)])
+    graph = sp.csr_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n_corners, n_corners))
     _, labels = connected_components(graph, directed=False)
     first_label = np.full(topology.n_vertices, -1, dtype=np.int64)
     first_label[tail[proper]] = labels[proper]
@@ -485,8 +479,7 @@ def as_topology(faces, n_vertices: int, *, stacklevel: int = 3) -> MeshTopology:
     if isinstance(faces, MeshTopology):
         if faces.n_vertices != n_vertices:
             raise InvalidMeshError(
-                f"`faces` is a MeshTopology of {faces.n_vertices} vertices but `vertices` has "
-                f"{n_vertices} rows"
+                f"`faces` is a MeshTopology of {faces.n_vertices} vertices but `vertices` has {n_vertices} rows"
             )
         return faces
     return MeshTopology._build(as_faces(faces, n_vertices, stacklevel=stacklevel + 1), n_vertices)

@@ -210,8 +210,7 @@ import numpy as np
 
 from ._validation import check_int_option, check_positive_float
 from .curvature import principal_curvatures
-from .errors import (InvalidMeshError, InvalidOptionError, MeshcurvWarning, MeshQualityWarning,
-                     MissingDependencyError)
+from .errors import InvalidMeshError, InvalidOptionError, MeshcurvWarning, MeshQualityWarning, MissingDependencyError
 from .measures import corrected_areas, face_measures
 from .radius import VOXEL_CURVEDNESS_PERCENTILE, VOXEL_PILOT, voxel_radius
 from .integrals import vertex_integrals, weighted_percentiles
@@ -222,8 +221,16 @@ from ._lazy import as_lazy, check_lazy_labels, is_lazy, lazy_objects
 from ._masks import check_smooth, check_threshold, labels_from_image, smoothed_crop, smoothed_surface
 from .statistics import _face_average, _fold_note, _region_statistics
 
-__all__ = ["label_curvatures", "label_surfaces", "LabelSurface", "COLUMNS", "FIELDS", "STATISTICS",
-           "SHAPE_CATEGORIES", "MIN_VERTICES"]
+__all__ = [
+    "label_curvatures",
+    "label_surfaces",
+    "LabelSurface",
+    "COLUMNS",
+    "FIELDS",
+    "STATISTICS",
+    "SHAPE_CATEGORIES",
+    "MIN_VERTICES",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -235,20 +242,50 @@ STATISTICS = ("weighted", "median", "p5", "p25", "p75", "p95")
 _QUANTILES = {"median": 0.5, "p5": 0.05, "p25": 0.25, "p75": 0.75, "p95": 0.95}
 
 #: Koenderink and van Doorn's nine shape categories, as intervals of the shape index (upper bounds).
-SHAPE_CATEGORIES = (("cup", -7 / 8), ("trough", -5 / 8), ("rut", -3 / 8), ("saddle_rut", -1 / 8),
-                    ("saddle", 1 / 8), ("saddle_ridge", 3 / 8), ("ridge", 5 / 8), ("dome", 7 / 8), ("cap", 1.0))
+SHAPE_CATEGORIES = (
+    ("cup", -7 / 8),
+    ("trough", -5 / 8),
+    ("rut", -3 / 8),
+    ("saddle_rut", -1 / 8),
+    ("saddle", 1 / 8),
+    ("saddle_ridge", 3 / 8),
+    ("ridge", 5 / 8),
+    ("dome", 7 / 8),
+    ("cap", 1.0),
+)
 
 #: Surfaces of fewer vertices are ``too_small`` (below it :func:`meshcurv.lattice.voxel_grid` sees no grid).
 MIN_VERTICES = 16
 
 #: The columns of the table, in order (see the module's documentation).
-COLUMNS = ("label", "status", "error", "n_voxels", "touches_border", "n_vertices", "n_faces", "n_used", "n_invalid",
-           "euler_characteristic", "area", "area_mesh", "volume", "equivalent_radius",
-           "centroid_0", "centroid_1", "centroid_2", "radius", "surface",
-           *(f"{field}_{statistic}" for field in FIELDS for statistic in STATISTICS),
-           "total_mean", "total_gaussian", "willmore",
-           *STATISTICS_COLUMNS,
-           *(f"shape_index_fraction_{name}" for name, _ in SHAPE_CATEGORIES), "warnings")
+COLUMNS = (
+    "label",
+    "status",
+    "error",
+    "n_voxels",
+    "touches_border",
+    "n_vertices",
+    "n_faces",
+    "n_used",
+    "n_invalid",
+    "euler_characteristic",
+    "area",
+    "area_mesh",
+    "volume",
+    "equivalent_radius",
+    "centroid_0",
+    "centroid_1",
+    "centroid_2",
+    "radius",
+    "surface",
+    *(f"{field}_{statistic}" for field in FIELDS for statistic in STATISTICS),
+    "total_mean",
+    "total_gaussian",
+    "willmore",
+    *STATISTICS_COLUMNS,
+    *(f"shape_index_fraction_{name}" for name, _ in SHAPE_CATEGORIES),
+    "warnings",
+)
 
 _INTEGER_COLUMNS = ("label", "n_voxels", "n_vertices", "n_faces", "n_used", "n_invalid", "euler_characteristic")
 _TEXT_COLUMNS = ("status", "error", "surface", "warnings")
@@ -307,10 +344,12 @@ def _check_labels(labels) -> np.ndarray:
         raise InvalidMeshError(
             f"`labels` must be an integer label image or a boolean mask; got dtype {image.dtype} "
             "(a float image is not a segmentation: threshold or label it first, or cast whole-number "
-            "values with .astype(int))")
+            "values with .astype(int))"
+        )
     if image.ndim != 3:
-        raise InvalidMeshError(f"`labels` must be a 3D image (axes 0, 1, 2 = z, y, x); got {image.ndim} "
-                               f"dimensions, shape {image.shape}")
+        raise InvalidMeshError(
+            f"`labels` must be a 3D image (axes 0, 1, 2 = z, y, x); got {image.ndim} dimensions, shape {image.shape}"
+        )
     if image.size == 0:
         raise InvalidMeshError(f"`labels` is empty; got shape {image.shape}")
     if image.dtype.kind == "i" and image.min() < 0:
@@ -324,11 +363,13 @@ def _check_spacing(spacing) -> np.ndarray:
     except (TypeError, ValueError):
         values = None
     if values is None or values.shape != (3,):
-        raise InvalidOptionError(f"`spacing` must be 3 numbers, the voxel size along image axes 0, 1, 2 "
-                                 f"(z, y, x); got {spacing!r}")
+        raise InvalidOptionError(
+            f"`spacing` must be 3 numbers, the voxel size along image axes 0, 1, 2 (z, y, x); got {spacing!r}"
+        )
     if not (np.isfinite(values).all() and (values > 0).all()):
-        raise InvalidOptionError(f"`spacing` must be positive and finite along every axis (z, y, x); got "
-                                 f"{tuple(values.tolist())}")
+        raise InvalidOptionError(
+            f"`spacing` must be positive and finite along every axis (z, y, x); got {tuple(values.tolist())}"
+        )
     return values
 
 
@@ -339,8 +380,9 @@ def _check_labels_to_use(labels_to_use):
     if values.ndim != 1 or (values.size and values.dtype.kind not in "iu"):
         raise InvalidOptionError(f"`labels_to_use` must be a sequence of integer labels; got {labels_to_use!r}")
     if values.size and values.min() <= 0:
-        raise InvalidOptionError(f"`labels_to_use` must hold labels >= 1 (0 is the background); got "
-                                 f"{int(values.min())}")
+        raise InvalidOptionError(
+            f"`labels_to_use` must hold labels >= 1 (0 is the background); got {int(values.min())}"
+        )
     return [int(value) for value in dict.fromkeys(values.tolist())]
 
 
@@ -390,17 +432,33 @@ def _field_statistics(result: CurvatureResult, used: np.ndarray, weights: np.nda
     total = weights[keep].sum()
     bounds = np.array([upper for _, upper in SHAPE_CATEGORIES])
     category = np.minimum(np.searchsorted(bounds, index[keep], side="left"), len(bounds) - 1)
-    fractions = np.bincount(category, weights[keep], minlength=len(bounds)) / total if total > 0 else \
-        np.full(len(bounds), np.nan)
+    fractions = (
+        np.bincount(category, weights[keep], minlength=len(bounds)) / total
+        if total > 0
+        else np.full(len(bounds), np.nan)
+    )
     row.update({f"shape_index_fraction_{name}": float(value) for (name, _), value in zip(SHAPE_CATEGORIES, fractions)})
     return row
 
 
 def _empty_row(label: int, status: str, error: str, **facts) -> dict:
     row: dict[str, object] = dict.fromkeys(COLUMNS, np.nan)
-    row.update({"label": label, "status": status, "error": error, "n_voxels": 0, "touches_border": False,
-                "n_vertices": 0, "n_faces": 0, "n_used": 0, "n_invalid": 0, "euler_characteristic": 0,
-                "surface": "", "warnings": ""})
+    row.update(
+        {
+            "label": label,
+            "status": status,
+            "error": error,
+            "n_voxels": 0,
+            "touches_border": False,
+            "n_vertices": 0,
+            "n_faces": 0,
+            "n_used": 0,
+            "n_invalid": 0,
+            "euler_characteristic": 0,
+            "surface": "",
+            "warnings": "",
+        }
+    )
     row.update(facts)
     return row
 
@@ -469,9 +527,11 @@ def _area_inside(vertices, faces, cap, border, normals, triangle, corrected, opt
             warnings.simplefilter("ignore")
             opened = principal_curvatures(vertices[referenced], renumber[faces[~cap]], orient="consistent", **refit)
     except (InvalidMeshError, InvalidOptionError, ValueError, ArithmeticError) as exc:
-        messages.append(f"area: the normals near the image border could not be fitted without the cap "
-                        f"({type(exc).__name__}: {exc}); the {int(near.sum())} faces there count by their "
-                        "triangle area")
+        messages.append(
+            f"area: the normals near the image border could not be fitted without the cap "
+            f"({type(exc).__name__}: {exc}); the {int(near.sum())} faces there count by their "
+            "triangle area"
+        )
         return np.where(near, triangle, corrected)
     refitted = np.array(normals, dtype=np.float64, copy=True)
     moved = border & referenced
@@ -547,18 +607,22 @@ def _cut_radius(vertices, faces, cap, distance, spacing) -> float | None:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            pilot = principal_curvatures(vertices[referenced], renumber[faces[~cap]], method="icc", orient="consistent",
-                                         radius=VOXEL_PILOT * h)
+            pilot = principal_curvatures(
+                vertices[referenced], renumber[faces[~cap]], method="icc", orient="consistent", radius=VOXEL_PILOT * h
+            )
     except (InvalidMeshError, InvalidOptionError, ValueError, ArithmeticError):
         return None
     curvedness = np.maximum(np.abs(np.asarray(pilot.k_min)), np.abs(np.asarray(pilot.k_max)))
-    keep = (np.asarray(pilot.valid) & np.isfinite(curvedness) & (curvedness > 0)
-            & (distance[referenced] > CUT_PILOT_RIM * h))
+    keep = (
+        np.asarray(pilot.valid)
+        & np.isfinite(curvedness)
+        & (curvedness > 0)
+        & (distance[referenced] > CUT_PILOT_RIM * h)
+    )
     floor = CUT_RADIUS_FLOOR * h
     if not keep.any():
         return floor
-    return max(floor, voxel_radius(spacing, 1.0 / float(np.percentile(curvedness[keep],
-                                                                        VOXEL_CURVEDNESS_PERCENTILE))))
+    return max(floor, voxel_radius(spacing, 1.0 / float(np.percentile(curvedness[keep], VOXEL_CURVEDNESS_PERCENTILE))))
 
 
 def _one_label(image, label, box, spacing, method, radius, smooth=None):
@@ -592,14 +656,24 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
         index, faces, n_voxels, centroid = _surface(padded, starts, spacing)
         touching = np.column_stack([starts == 0, stops == shape])  # (3, 2): low and high face of each axis
     else:
-        index, faces, n_voxels, centroid, touching = smoothed_surface(padded, smoothing[1], starts, stops, shape,
-                                                                      spacing, smoothing[0], _marching_cubes())
-    facts = {"n_voxels": n_voxels, "touches_border": bool(touching.any()), "n_vertices": int(index.shape[0]),
-             "n_faces": int(faces.shape[0]), **{f"centroid_{k}": float(centroid[k]) for k in range(3)}}
+        index, faces, n_voxels, centroid, touching = smoothed_surface(
+            padded, smoothing[1], starts, stops, shape, spacing, smoothing[0], _marching_cubes()
+        )
+    facts = {
+        "n_voxels": n_voxels,
+        "touches_border": bool(touching.any()),
+        "n_vertices": int(index.shape[0]),
+        "n_faces": int(faces.shape[0]),
+        **{f"centroid_{k}": float(centroid[k]) for k in range(3)},
+    }
     if index.shape[0] < MIN_VERTICES:
-        return _empty_row(label, "too_small", f"label {label} has {n_voxels} voxel(s): a surface of "
-                          f"{index.shape[0]} vertices is too small to have a curvature (at least {MIN_VERTICES})",
-                          **facts), None
+        return _empty_row(
+            label,
+            "too_small",
+            f"label {label} has {n_voxels} voxel(s): a surface of "
+            f"{index.shape[0]} vertices is too small to have a curvature (at least {MIN_VERTICES})",
+            **facts,
+        ), None
     vertices = index * spacing
     options = {} if method is None else {"method": method}
     if radius is not None:
@@ -627,12 +701,15 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
     measures = face_measures(vertices, faces, normals)[:, :3]
     triangle, corrected = corrected_areas(vertices, faces, measures)
     if cap.any():  # the area of the surface inside the image, with normals that do not see the cap
-        corrected = _area_inside(vertices, faces, cap, border, normals, triangle, corrected, options,
-                                 parameters.get("radius"), messages)
+        corrected = _area_inside(
+            vertices, faces, cap, border, normals, triangle, corrected, options, parameters.get("radius"), messages
+        )
     surface_faces = ~cap
-    vertex_areas = np.bincount(faces[surface_faces].ravel(),
-                               np.repeat(np.maximum(corrected[surface_faces], 0.0) / 3.0, 3),
-                               minlength=vertices.shape[0])
+    vertex_areas = np.bincount(
+        faces[surface_faces].ravel(),
+        np.repeat(np.maximum(corrected[surface_faces], 0.0) / 3.0, 3),
+        minlength=vertices.shape[0],
+    )
     on_object = ~border[faces].any(axis=1)
     inside_faces = on_object & np.isfinite(measures[:, 1:]).all(axis=1)
     measured_area = float(measures[inside_faces, 0].sum())
@@ -640,10 +717,12 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
         scale = float(parameters.get("radius", margin))
         needed = CUT_MIN_AREA_BALLS * np.pi * scale**2
         if not measured_area >= needed:
-            messages.append(f"curvature columns NaN: the label is cut by the image border and keeps an area of "
-                            f"{measured_area:.3g} beyond the estimator's reach ({margin:.3g}) of the image faces it "
-                            f"touches, less than the {needed:.3g} (pi r^2, r = {scale:.3g}) its statistics need; "
-                            "area and volume are those of its part inside the image")
+            messages.append(
+                f"curvature columns NaN: the label is cut by the image border and keeps an area of "
+                f"{measured_area:.3g} beyond the estimator's reach ({margin:.3g}) of the image faces it "
+                f"touches, less than the {needed:.3g} (pi r^2, r = {scale:.3g}) its statistics need; "
+                "area and volume are those of its part inside the image"
+            )
             used = np.zeros_like(used)
             border = np.ones_like(border)
             inside_faces = np.zeros_like(inside_faces)
@@ -659,21 +738,38 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
     gaussian_shares = vertex_integrals(vertices, faces, "gaussian", normals=normals)
     total_gaussian = float(gaussian_shares[~border].sum()) if (~border).any() else np.nan
     # FreeSurfer's statistics (meshcurv.statistics) over the same vertices and faces: the same code as a mesh's
-    statistics = _region_statistics(result.k_min, result.k_max, used, vertex_areas, measures[inside_faces, :2],
-                                    _face_average(mean, faces[inside_faces]), gaussian_shares[~border],
-                                    np.asarray(result.gaussian)[~border])
+    statistics = _region_statistics(
+        result.k_min,
+        result.k_max,
+        used,
+        vertex_areas,
+        measures[inside_faces, :2],
+        _face_average(mean, faces[inside_faces]),
+        gaussian_shares[~border],
+        np.asarray(result.gaussian)[~border],
+    )
     messages.extend(filter(None, [_fold_note(statistics, result.k_min, result.k_max, used, vertex_areas)]))
-    row = {"label": label, "status": "ok", "error": "", **facts, "n_used": int(used.sum()),
-           "n_invalid": int((~np.asarray(result.valid)).sum()),
-           "euler_characteristic": int(vertices.shape[0] - n_edges + faces.shape[0]),
-           "area": float(corrected[surface_faces].sum()), "area_mesh": float(triangle[surface_faces].sum()),
-           "volume": volume, "equivalent_radius": float(np.cbrt(3.0 * max(volume, 0.0) / (4.0 * np.pi))),
-           "radius": float(result.parameters["radius"]) if "radius" in result.parameters else np.nan,
-           "surface": "voxel" if chosen is not None else str(result.parameters.get("surface", "")),
-           **_field_statistics(result, used, vertex_areas),
-           "total_mean": total_mean, "total_gaussian": total_gaussian,
-           "willmore": float(np.sum(mean[keep] ** 2 * vertex_areas[keep])) if keep.any() else np.nan,
-           **statistics, "warnings": "; ".join(messages)}
+    row = {
+        "label": label,
+        "status": "ok",
+        "error": "",
+        **facts,
+        "n_used": int(used.sum()),
+        "n_invalid": int((~np.asarray(result.valid)).sum()),
+        "euler_characteristic": int(vertices.shape[0] - n_edges + faces.shape[0]),
+        "area": float(corrected[surface_faces].sum()),
+        "area_mesh": float(triangle[surface_faces].sum()),
+        "volume": volume,
+        "equivalent_radius": float(np.cbrt(3.0 * max(volume, 0.0) / (4.0 * np.pi))),
+        "radius": float(result.parameters["radius"]) if "radius" in result.parameters else np.nan,
+        "surface": "voxel" if chosen is not None else str(result.parameters.get("surface", "")),
+        **_field_statistics(result, used, vertex_areas),
+        "total_mean": total_mean,
+        "total_gaussian": total_gaussian,
+        "willmore": float(np.sum(mean[keep] ** 2 * vertex_areas[keep])) if keep.any() else np.nan,
+        **statistics,
+        "warnings": "; ".join(messages),
+    }
     if measured_area > 0:  # H and K weighted by area: the ratios of the corrected measures (see the module)
         row["mean_weighted"] = total_mean / measured_area
         row["gaussian_weighted"] = total_gaussian / measured_area
@@ -705,13 +801,18 @@ def _image_and_spacing(labels, spacing):
 
 
 def _warn_spacing(caller: str, stacklevel: int) -> None:
-    warnings.warn(f"{caller}: no `spacing` given (and none carried by the image): the voxels are taken as "
-                  "1 x 1 x 1, so areas are in voxel faces and curvatures per voxel length; pass spacing=(z, y, x), "
-                  "the voxel size along image axes 0, 1, 2 in your unit", MeshcurvWarning, stacklevel=stacklevel + 1)
+    warnings.warn(
+        f"{caller}: no `spacing` given (and none carried by the image): the voxels are taken as "
+        "1 x 1 x 1, so areas are in voxel faces and curvatures per voxel length; pass spacing=(z, y, x), "
+        "the voxel size along image axes 0, 1, 2 in your unit",
+        MeshcurvWarning,
+        stacklevel=stacklevel + 1,
+    )
 
 
-def _plan(labels, spacing, labels_to_use, radius, threshold=None, *, caller: str = "label_curvatures",
-          stacklevel: int = 2):
+def _plan(
+    labels, spacing, labels_to_use, radius, threshold=None, *, caller: str = "label_curvatures", stacklevel: int = 2
+):
     """Check the inputs and find the labels' boxes: ``(image, spacing, {label: box or None}, radius)``.
 
     A lazy image (:func:`meshcurv._lazy.is_lazy`) is read a chunk at a time
@@ -726,14 +827,15 @@ def _plan(labels, spacing, labels_to_use, radius, threshold=None, *, caller: str
     _marching_cubes()
     if is_lazy(labels):
         if threshold is not None:
-            raise InvalidOptionError("`threshold` needs the image in memory (its components span chunks); a lazily "
-                                     "read image (Zarr, Dask) must be a label image: label it first")
+            raise InvalidOptionError(
+                "`threshold` needs the image in memory (its components span chunks); a lazily "
+                "read image (Zarr, Dask) must be a label image: label it first"
+            )
         lazy = check_lazy_labels(as_lazy(labels))
         return lazy, spacing, lazy_objects(lazy, wanted, _objects), radius
     if isinstance(labels, np.ma.MaskedArray):
         raise InvalidMeshError("`labels` must be a plain array; got a masked array (fill it first)")
-    image = _check_labels(labels_from_image(np.asanyarray(labels), threshold, caller=caller,
-                                            stacklevel=stacklevel + 1))
+    image = _check_labels(labels_from_image(np.asanyarray(labels), threshold, caller=caller, stacklevel=stacklevel + 1))
     return image, spacing, _objects(image, wanted), radius
 
 
@@ -751,16 +853,18 @@ def _guarded(label, compute, keep_surfaces):
 
 def _iterate(image, spacing, objects, method, radius, keep_surfaces, smooth=None):
     for label, box in objects.items():
-        yield _guarded(label, functools.partial(_one_label, image, label, box, spacing, method, radius, smooth),
-                       keep_surfaces)
+        yield _guarded(
+            label, functools.partial(_one_label, image, label, box, spacing, method, radius, smooth), keep_surfaces
+        )
 
 
 def _dask():
     try:
         import distributed
     except ImportError:
-        raise MissingDependencyError("label_curvatures with `workers` or `client` runs the labels on Dask: "
-                                     "pip install 'meshcurv[batch]'") from None
+        raise MissingDependencyError(
+            "label_curvatures with `workers` or `client` runs the labels on Dask: pip install 'meshcurv[batch]'"
+        ) from None
     return distributed
 
 
@@ -786,9 +890,16 @@ def _crop_task(crops, image_shape, spacing, method, radius, keep_surfaces):
 
     (:func:`_task_crop`: ``options`` holds the ``smoothing`` of a smoothed crop.)
     """
-    return [_guarded(label, functools.partial(_crop_label, label, padded, starts, stops, image_shape, spacing, method,
-                                              radius, **options), keep_surfaces)
-            for label, padded, starts, stops, options in crops]
+    return [
+        _guarded(
+            label,
+            functools.partial(
+                _crop_label, label, padded, starts, stops, image_shape, spacing, method, radius, **options
+            ),
+            keep_surfaces,
+        )
+        for label, padded, starts, stops, options in crops
+    ]
 
 
 def _groups(objects, workers: int) -> list[list]:
@@ -817,8 +928,10 @@ def _groups(objects, workers: int) -> list[list]:
 def _lost(outcome, distributed) -> str:
     """The error of a label whose task ended without rows (its worker died, or the task raised)."""
     if isinstance(outcome, distributed.KilledWorker):
-        return (f"WorkerDied: the worker process computing this label died each time it ran (killed by the system: "
-                f"out of memory? a crash in a compiled library?) ({type(outcome).__name__}: {outcome})")
+        return (
+            f"WorkerDied: the worker process computing this label died each time it ran (killed by the system: "
+            f"out of memory? a crash in a compiled library?) ({type(outcome).__name__}: {outcome})"
+        )
     return f"{type(outcome).__name__}: {outcome}"
 
 
@@ -841,19 +954,36 @@ def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client
         logger.info("%d labels in %d tasks on %d workers", len(objects), len(groups), n_workers)
 
         def submit(chosen):
-            return [active.submit(_crop_task, [_task_crop(image, label, objects[label], spacing, smooth)
-                                               for label in group],
-                                  image.shape, spacing, method, radius, keep_surfaces, pure=False)
-                    for group in chosen]
+            return [
+                active.submit(
+                    _crop_task,
+                    [_task_crop(image, label, objects[label], spacing, smooth) for label in group],
+                    image.shape,
+                    spacing,
+                    method,
+                    radius,
+                    keep_surfaces,
+                    pure=False,
+                )
+                for group in chosen
+            ]
 
-        tasks = driver.run_tasks(active, groups, submit, owned=owned, limit=_IN_FLIGHT_PER_WORKER * n_workers,
-                                 split=lambda outcome: not isinstance(outcome, fatal), items="labels")
+        tasks = driver.run_tasks(
+            active,
+            groups,
+            submit,
+            owned=owned,
+            limit=_IN_FLIGHT_PER_WORKER * n_workers,
+            split=lambda outcome: not isinstance(outcome, fatal),
+            items="labels",
+        )
         with contextlib.closing(tasks):
             done: dict = {}
             for label, box in objects.items():
                 if box is None:
-                    yield _guarded(label, functools.partial(_one_label, image, label, None, spacing, method, radius),
-                                   keep_surfaces)
+                    yield _guarded(
+                        label, functools.partial(_one_label, image, label, None, spacing, method, radius), keep_surfaces
+                    )
                     continue
                 while label not in done:
                     group, outcome = next(tasks)
@@ -867,9 +997,19 @@ def _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client
                 yield done.pop(label)
 
 
-def label_surfaces(labels, *, spacing=None, labels_to_use=None, method: str | None = None,
-                   radius: float | None = None, keep_surfaces: bool = True, workers: int | None = None, client=None,
-                   threshold: float | None = None, smooth: float | None = None):
+def label_surfaces(
+    labels,
+    *,
+    spacing=None,
+    labels_to_use=None,
+    method: str | None = None,
+    radius: float | None = None,
+    keep_surfaces: bool = True,
+    workers: int | None = None,
+    client=None,
+    threshold: float | None = None,
+    smooth: float | None = None,
+):
     """``(total, iterator)``: the number of labels, and ``(row, surface)`` for each, one at a time.
 
     ``row`` is a dict of :data:`COLUMNS` (see :func:`label_curvatures`);
@@ -882,24 +1022,49 @@ def label_surfaces(labels, *, spacing=None, labels_to_use=None, method: str | No
     Dask cluster, a few tasks ahead, and yielded in the same order.
     ``threshold``, ``smooth`` and lazy images as in :func:`label_curvatures`.
     """
-    return _label_surfaces(labels, spacing, labels_to_use, method, radius, keep_surfaces, workers, client,
-                           caller="label_surfaces", stacklevel=2, threshold=threshold, smooth=smooth)
+    return _label_surfaces(
+        labels,
+        spacing,
+        labels_to_use,
+        method,
+        radius,
+        keep_surfaces,
+        workers,
+        client,
+        caller="label_surfaces",
+        stacklevel=2,
+        threshold=threshold,
+        smooth=smooth,
+    )
 
 
-def _label_surfaces(labels, spacing, labels_to_use, method, radius, keep_surfaces, workers, client, *, caller: str,
-                    stacklevel: int, threshold=None, smooth=None):
+def _label_surfaces(
+    labels,
+    spacing,
+    labels_to_use,
+    method,
+    radius,
+    keep_surfaces,
+    workers,
+    client,
+    *,
+    caller: str,
+    stacklevel: int,
+    threshold=None,
+    smooth=None,
+):
     """:func:`label_surfaces`; the warning of a missing spacing names ``caller``, ``stacklevel`` frames up."""
     workers, client = _check_parallel(workers, client)
     smooth = check_smooth(smooth)
     labels, spacing, assumed = _image_and_spacing(labels, spacing)
-    image, spacing, objects, radius = _plan(labels, spacing, labels_to_use, radius, threshold, caller=caller,
-                                            stacklevel=stacklevel + 1)
+    image, spacing, objects, radius = _plan(
+        labels, spacing, labels_to_use, radius, threshold, caller=caller, stacklevel=stacklevel + 1
+    )
     if assumed:
         _warn_spacing(caller, stacklevel + 1)
     if (workers is None and client is None) or all(box is None for box in objects.values()):
         return len(objects), _iterate(image, spacing, objects, method, radius, keep_surfaces, smooth)
-    return len(objects), _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers,
-                                       smooth)
+    return len(objects), _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers, smooth)
 
 
 def _table(rows):
@@ -922,15 +1087,26 @@ def _pandas():
     try:
         import pandas
     except ImportError as exc:
-        raise MissingDependencyError("label_curvatures returns a pandas DataFrame: pip install "
-                                     "'meshcurv[volume]'") from exc
+        raise MissingDependencyError(
+            "label_curvatures returns a pandas DataFrame: pip install 'meshcurv[volume]'"
+        ) from exc
     return pandas
 
 
-def label_curvatures(labels, *, spacing=None, labels_to_use=None, method: str | None = None,
-                     radius: float | None = None, return_meshes: bool = False,
-                     progress: Callable[[int, int, int], None] | None = None, workers: int | None = None,
-                     client=None, threshold: float | None = None, smooth: float | None = None):
+def label_curvatures(
+    labels,
+    *,
+    spacing=None,
+    labels_to_use=None,
+    method: str | None = None,
+    radius: float | None = None,
+    return_meshes: bool = False,
+    progress: Callable[[int, int, int], None] | None = None,
+    workers: int | None = None,
+    client=None,
+    threshold: float | None = None,
+    smooth: float | None = None,
+):
     """Curvature statistics of every object of a 3D label image, one row per label.
 
     Each label's surface is extracted by marching cubes on its bounding box
@@ -1059,9 +1235,20 @@ def label_curvatures(labels, *, spacing=None, labels_to_use=None, method: str | 
     _pandas()
     if progress is not None and not callable(progress):
         raise InvalidOptionError(f"`progress` must be a callable progress(done, total, label); got {progress!r}")
-    total, surfaces_and_rows = _label_surfaces(labels, spacing, labels_to_use, method, radius, return_meshes,
-                                               workers, client, caller="label_curvatures", stacklevel=2,
-                                               threshold=threshold, smooth=smooth)
+    total, surfaces_and_rows = _label_surfaces(
+        labels,
+        spacing,
+        labels_to_use,
+        method,
+        radius,
+        return_meshes,
+        workers,
+        client,
+        caller="label_curvatures",
+        stacklevel=2,
+        threshold=threshold,
+        smooth=smooth,
+    )
     rows, surfaces = [], {}
     for row, surface in surfaces_and_rows:
         rows.append(row)
@@ -1081,10 +1268,15 @@ def _problems(table) -> str:
     counts = table["status"].value_counts()
     bad = {status: int(counts.get(status, 0)) for status in ("empty", "too_small", "failed") if counts.get(status, 0)}
     if bad:
-        parts.append(f"{sum(bad.values())} of {len(table)} labels have no curvature ("
-                     + ", ".join(f"{n} {status}" for status, n in bad.items()) + "; see the status and error columns)")
+        parts.append(
+            f"{sum(bad.values())} of {len(table)} labels have no curvature ("
+            + ", ".join(f"{n} {status}" for status, n in bad.items())
+            + "; see the status and error columns)"
+        )
     invalid = table["n_invalid"]
     if (invalid > 0).any():
-        parts.append(f"{int(invalid.sum())} invalid vertices (no estimate) in {int((invalid > 0).sum())} labels "
-                     "(n_invalid, warnings columns)")
+        parts.append(
+            f"{int(invalid.sum())} invalid vertices (no estimate) in {int((invalid > 0).sum())} labels "
+            "(n_invalid, warnings columns)"
+        )
     return "label_curvatures: " + "; ".join(parts) if parts else ""

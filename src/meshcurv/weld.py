@@ -52,8 +52,9 @@ class Welding(NamedTuple):
     n_welded: int
 
 
-def weld_vertices(vertices: np.ndarray, topology: MeshTopology, *,
-                  tolerance_ratio: float = WELD_TOLERANCE_RATIO) -> Welding:
+def weld_vertices(
+    vertices: np.ndarray, topology: MeshTopology, *, tolerance_ratio: float = WELD_TOLERANCE_RATIO
+) -> Welding:
     """Merge coincident boundary vertices of a mesh (soups, seams).
 
     Parameters
@@ -241,8 +242,9 @@ def _tolerance(vertices: np.ndarray, topology: MeshTopology, tolerance_ratio: fl
     return tolerance_ratio * float(np.median(lengths)) if lengths.size else 0.0
 
 
-def drop_closed_copies(vertices: np.ndarray, topology: MeshTopology, *,
-                       tolerance_ratio: float = WELD_TOLERANCE_RATIO) -> Welding:
+def drop_closed_copies(
+    vertices: np.ndarray, topology: MeshTopology, *, tolerance_ratio: float = WELD_TOLERANCE_RATIO
+) -> Welding:
     """Measure a closed part stored twice once: drop the faces of its coincident copies.
 
     Two closed parts whose vertices coincide point for point (a part exported
@@ -296,8 +298,12 @@ def drop_closed_copies(vertices: np.ndarray, topology: MeshTopology, *,
     from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
 
     members = referenced & np.isin(labels, closed)
-    centroids = np.column_stack([np.bincount(labels[members], vertices[members, k], minlength=n_components)
-                                 for k in range(3)])[closed] / sizes[closed, None]
+    centroids = (
+        np.column_stack([np.bincount(labels[members], vertices[members, k], minlength=n_components) for k in range(3)])[
+            closed
+        ]
+        / sizes[closed, None]
+    )
     pairs = cKDTree(centroids).query_pairs(max(tolerance, 0.0), output_type="ndarray")
     if pairs.size == 0:
         return unchanged
@@ -311,8 +317,8 @@ def drop_closed_copies(vertices: np.ndarray, topology: MeshTopology, *,
         if sizes[a] != sizes[b] or b in copy_of:
             continue
         a = copy_of.get(a, a)  # a copy of a copy repeats the first
-        part_a = order[first + starts[a]:first + starts[a + 1]]
-        part_b = order[first + starts[b]:first + starts[b + 1]]
+        part_a = order[first + starts[a] : first + starts[a + 1]]
+        part_b = order[first + starts[b] : first + starts[b + 1]]
         distance, nearest = cKDTree(vertices[part_a]).query(vertices[part_b])
         if np.all(distance <= tolerance) and np.unique(nearest).size == nearest.size:
             representative[part_b] = part_a[nearest]

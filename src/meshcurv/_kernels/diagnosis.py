@@ -1,5 +1,4 @@
-"""Compiled twin of :mod:`meshcurv.diagnosis`: the facts of a mesh in one pass.
-"""
+"""Compiled twin of :mod:`meshcurv.diagnosis`: the facts of a mesh in one pass."""
 
 from __future__ import annotations
 
@@ -57,8 +56,9 @@ def mesh_facts(vertices, faces, edges, referenced, scales, area_ratio, zero_leng
         half = 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz)
         area += half
         n_degenerate += 1 if _degenerate(a, b, c, half, area_ratio * scales[a] * scales[a]) else 0
-        six_volume += ((vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny
-                       + (vertices[a, 2] - centre[2]) * nz)
+        six_volume += (
+            (vertices[a, 0] - centre[0]) * nx + (vertices[a, 1] - centre[1]) * ny + (vertices[a, 2] - centre[2]) * nz
+        )
     return lower, upper, area, six_volume, mean, n_degenerate, n_zero_length
 
 

@@ -46,9 +46,17 @@ def _triangle_measures(points, normals, i, j, k, turn):
     gx, gy, gz = ay * mz - az * my, az * mx - ax * mz, ax * my - ay * mx
     hx, hy, hz = by * mz - bz * my, bz * mx - bx * mz, bx * my - by * mx
     ex, ey, ez = u2x - u0x, u2y - u0y, u2z - u0z
-    return (mu0, mu1, mu2, 0.5 * (gx * ex - hx * qx), 0.5 * (gy * ey - hy * qy), 0.5 * (gz * ez - hz * qz),
-            0.25 * ((gx * ey - hx * qy) + (gy * ex - hy * qx)), 0.25 * ((gx * ez - hx * qz) + (gz * ex - hz * qx)),
-            0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy)))
+    return (
+        mu0,
+        mu1,
+        mu2,
+        0.5 * (gx * ex - hx * qx),
+        0.5 * (gy * ey - hy * qy),
+        0.5 * (gz * ez - hz * qz),
+        0.25 * ((gx * ey - hx * qy) + (gy * ex - hy * qx)),
+        0.25 * ((gx * ez - hx * qz) + (gz * ex - hz * qx)),
+        0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy)),
+    )
 
 
 @threaded
@@ -63,8 +71,9 @@ def face_measures(vertices, faces, normals):
 def _face_measures_chunk(lo, hi, vertices, faces, normals, out):
     """Faces ``lo:hi`` of :func:`face_measures` (chunks on threads: no parallel pipeline to compile, issue 31)."""
     for f in range(lo, hi):
-        m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(vertices, normals, faces[f, 0], faces[f, 1],
-                                                                faces[f, 2], False)
+        m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(
+            vertices, normals, faces[f, 0], faces[f, 1], faces[f, 2], False
+        )
         out[f, 0], out[f, 1], out[f, 2], out[f, 3], out[f, 4], out[f, 5] = m0, m1, m2, m3, m4, m5
         out[f, 6], out[f, 7], out[f, 8] = m6, m7, m8
 
@@ -88,7 +97,17 @@ def _curvatures_chunk(lo, hi, summed, normals, k_min, k_max, dir_min, dir_max):
             continue
         k_min[i], k_max[i] = _principal_from_mean_gaussian(summed[i, 1] / (2 * area), summed[i, 2] / area)
         _, _, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
-            -summed[i, 3] / area, -summed[i, 4] / area, -summed[i, 5] / area, -summed[i, 6] / area,
-            -summed[i, 7] / area, -summed[i, 8] / area, nx, ny, nz, False, False)
+            -summed[i, 3] / area,
+            -summed[i, 4] / area,
+            -summed[i, 5] / area,
+            -summed[i, 6] / area,
+            -summed[i, 7] / area,
+            -summed[i, 8] / area,
+            nx,
+            ny,
+            nz,
+            False,
+            False,
+        )
         dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
         dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5

@@ -1,5 +1,4 @@
-"""Compiled twins of :mod:`meshcurv.jets`: weighted jets fitted over Euclidean or surface-connected balls.
-"""
+"""Compiled twins of :mod:`meshcurv.jets`: weighted jets fitted over Euclidean or surface-connected balls."""
 
 from __future__ import annotations
 
@@ -74,8 +73,23 @@ def _cholesky_solve(a, b, low, m, min_spread, scale, total):
 
 
 @threaded
-def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_spread, centres, n_chunks, pool, facing,
-             check_facing, away_fraction, settled, areas):
+def fit_jets(
+    vertices,
+    normals,
+    radii,
+    degree,
+    iterations,
+    exponents,
+    min_spread,
+    centres,
+    n_chunks,
+    pool,
+    facing,
+    check_facing,
+    away_fraction,
+    settled,
+    areas,
+):
     """``jets.fit_jets``: weighted jets over the balls of ``radii``, frame re-estimated from each fit.
 
     Fits the jets of the vertices ``centres`` (the other rows of the outputs
@@ -98,10 +112,28 @@ def fit_jets(vertices, normals, radii, degree, iterations, exponents, min_spread
     points, ids, grid, centres = _grid_centres(vertices, pool, radii, centres)
     outputs = _jet_outputs.py_func(vertices.shape[0])  # NumPy's: one compiled function fewer to load
     limits = np.array([away_fraction, settled])
-    facing = facing[:facing.shape[0] if check_facing else 0]
-    run_chunks(_grid_chunk, centres.shape[0], n_chunks, vertices, points, normals, radii, degree, iterations,
-               exponents, min_spread, centres, grid, ids, facing, limits, areas, *outputs,
-               _general(degree))
+    facing = facing[: facing.shape[0] if check_facing else 0]
+    run_chunks(
+        _grid_chunk,
+        centres.shape[0],
+        n_chunks,
+        vertices,
+        points,
+        normals,
+        radii,
+        degree,
+        iterations,
+        exponents,
+        min_spread,
+        centres,
+        grid,
+        ids,
+        facing,
+        limits,
+        areas,
+        *outputs,
+        _general(degree),
+    )
     return outputs
 
 
@@ -130,8 +162,31 @@ def _grid_centres(vertices, pool, radii, centres):
 
 
 @nb.njit(**_JIT)
-def _grid_chunk(lo, hi, vertices, points, normals, radii, degree, iterations, exponents, min_spread, centres, grid,
-                ids, facing, limits, areas, coefficients, t1s, t2s, ns, counts, away, general):
+def _grid_chunk(
+    lo,
+    hi,
+    vertices,
+    points,
+    normals,
+    radii,
+    degree,
+    iterations,
+    exponents,
+    min_spread,
+    centres,
+    grid,
+    ids,
+    facing,
+    limits,
+    areas,
+    coefficients,
+    t1s,
+    t2s,
+    ns,
+    counts,
+    away,
+    general,
+):
     """The fits of ``centres[lo:hi]`` of :func:`fit_jets`, written to their rows of the outputs."""
     per_vertex = radii.shape[0] > 1
     members = np.empty(64, np.int64)
@@ -139,11 +194,39 @@ def _grid_chunk(lo, hi, vertices, points, normals, radii, degree, iterations, ex
     for i in range(lo, hi):
         v = centres[i]
         radius = radii[v if per_vertex else 0]
-        members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius,
-                                      members)
-        work = _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_spread, v, v,
-                        members, size, work, moments, right, matrix, low, scale, solution, coefficients, t1s,
-                        t2s, ns, counts, ids, facing, limits, away, areas, general)
+        members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius, members)
+        work = _fit_one(
+            vertices,
+            points,
+            normals,
+            radius,
+            degree,
+            iterations,
+            exponents,
+            min_spread,
+            v,
+            v,
+            members,
+            size,
+            work,
+            moments,
+            right,
+            matrix,
+            low,
+            scale,
+            solution,
+            coefficients,
+            t1s,
+            t2s,
+            ns,
+            counts,
+            ids,
+            facing,
+            limits,
+            away,
+            areas,
+            general,
+        )
 
 
 def _general(degree: int) -> bool | None:
@@ -158,8 +241,14 @@ _JET_ROWS = 5
 @nb.njit(**_JIT)
 def _jet_outputs(rows):
     """The outputs of the jet fits, ``coefficients (rows, 6), t1, t2, n (rows, 3), counts, away``: NaN, counts 0."""
-    return (np.full((rows, 6), np.nan), np.full((rows, 3), np.nan), np.full((rows, 3), np.nan),
-            np.full((rows, 3), np.nan), np.zeros(rows), np.full(rows, np.nan))
+    return (
+        np.full((rows, 6), np.nan),
+        np.full((rows, 3), np.nan),
+        np.full((rows, 3), np.nan),
+        np.full((rows, 3), np.nan),
+        np.zeros(rows),
+        np.full(rows, np.nan),
+    )
 
 
 @nb.njit(**_JIT)
@@ -181,8 +270,15 @@ def _jet_scratch(degree, n_terms):
                 binomial = binomial * (total - step) // (step + 1)
             scale[t] = 1.0 / binomial
             t += 1
-    return (work, np.empty((order, order)), np.empty(max(n_terms, 10)), np.empty((n_terms, n_terms)),
-            np.empty((n_terms, n_terms)), scale, np.empty(n_terms))
+    return (
+        work,
+        np.empty((order, order)),
+        np.empty(max(n_terms, 10)),
+        np.empty((n_terms, n_terms)),
+        np.empty((n_terms, n_terms)),
+        scale,
+        np.empty(n_terms),
+    )
 
 
 @nb.njit(**_JIT_REASSOC)
@@ -291,10 +387,10 @@ def _general_jet_moments(work, size, degree, exponents, ax, ay, az, bx, by, bz, 
     """
     top = 2 * degree
     ox, oy, oz, weight, lift = work[0], work[1], work[2], work[3], work[4]
-    pu = work[_JET_ROWS:_JET_ROWS + top + 1]
-    pv = work[_JET_ROWS + top + 1:_JET_ROWS + 2 * (top + 1)]
-    wu = work[_JET_ROWS + 2 * (top + 1):_JET_ROWS + 3 * (top + 1)]
-    lu = work[_JET_ROWS + 3 * (top + 1):]
+    pu = work[_JET_ROWS : _JET_ROWS + top + 1]
+    pv = work[_JET_ROWS + top + 1 : _JET_ROWS + 2 * (top + 1)]
+    wu = work[_JET_ROWS + 2 * (top + 1) : _JET_ROWS + 3 * (top + 1)]
+    lu = work[_JET_ROWS + 3 * (top + 1) :]
     for a in range(size):
         pu[0, a] = 1.0
         pv[0, a] = 1.0
@@ -331,24 +427,58 @@ def _jet_moments(general, work, size, degree, exponents, ax, ay, az, bx, by, bz,
 @overload(_jet_moments, jit_options=_JIT)  # type: ignore[arg-type]  # numba's stub types a TypedDict
 def _jet_moments_typed(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
     if isinstance(general, types.NoneType):
+
         def cubic(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
-            _cubic_jet_moments(work[0], work[1], work[2], work[3], size, ax, ay, az, bx, by, bz, nx, ny, nz,
-                               moments, right)
+            _cubic_jet_moments(
+                work[0], work[1], work[2], work[3], size, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right
+            )
+
         return cubic
 
     def either(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
         if degree <= 3:  # the normal and noise fits: moments summed member by member (degree 2 reads a subset)
-            _cubic_jet_moments(work[0], work[1], work[2], work[3], size, ax, ay, az, bx, by, bz, nx, ny, nz,
-                               moments, right)
+            _cubic_jet_moments(
+                work[0], work[1], work[2], work[3], size, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right
+            )
         else:
             _general_jet_moments(work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right)
+
     return either
 
 
 @nb.njit(inline="always", **_JIT)
-def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, min_spread, v, row, members, size, work,
-             moments, right, matrix, low, scale, solution, coefficients, t1s, t2s, ns, counts, ids, facing, limits,
-             away_out, areas, general):
+def _fit_one(
+    vertices,
+    points,
+    normals,
+    radius,
+    degree,
+    iterations,
+    exponents,
+    min_spread,
+    v,
+    row,
+    members,
+    size,
+    work,
+    moments,
+    right,
+    matrix,
+    low,
+    scale,
+    solution,
+    coefficients,
+    t1s,
+    t2s,
+    ns,
+    counts,
+    ids,
+    facing,
+    limits,
+    away_out,
+    areas,
+    general,
+):
     """One vertex of :func:`fit_jets` in the caller's buffers; returns ``work`` (grown when too small).
 
     Inlined into its callers: a call per vertex passing thirty arrays cost a
@@ -425,8 +555,11 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
                 scale[r] = 1.0 / math.sqrt(max(moments[2 * exponents[r, 0], 2 * exponents[r, 1]], _TINY))
             for r in range(m):  # the lower triangle: all the Cholesky factorization reads
                 for c in range(r + 1):
-                    matrix[r, c] = (moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
-                                    * scale[r] * scale[c])
+                    matrix[r, c] = (
+                        moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
+                        * scale[r]
+                        * scale[c]
+                    )
                 solution[r] = right[r] * scale[r]
             if _cholesky_solve(matrix, solution, low, m, min_spread, scale, moments[0, 0]):
                 for r in range(6):
@@ -455,8 +588,26 @@ def _fit_one(vertices, points, normals, radius, degree, iterations, exponents, m
 
 
 @threaded
-def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, min_spread, centres, n_chunks,
-                       allowed, indptr, indices, facing, check_facing, away_fraction, normals_only, settled, areas):
+def fit_jets_connected(
+    vertices,
+    normals,
+    radii,
+    degree,
+    iterations,
+    exponents,
+    min_spread,
+    centres,
+    n_chunks,
+    allowed,
+    indptr,
+    indices,
+    facing,
+    check_facing,
+    away_fraction,
+    normals_only,
+    settled,
+    areas,
+):
     """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
 
     The ball of ``centres[i]`` has the radius ``radii[i]`` ((M,): one per
@@ -484,17 +635,63 @@ def fit_jets_connected(vertices, normals, radii, degree, iterations, exponents, 
     outputs = _jet_outputs.py_func(1 if normals_only else m)  # NumPy's: one compiled function fewer to load
     fitted = np.full((m if normals_only else 1, 3), np.nan)
     limits = np.array([away_fraction, settled])
-    facing = facing[:facing.shape[0] if check_facing else 0]
-    run_chunks(_connected_chunk, m, n_chunks, vertices, normals, radii, degree, iterations, exponents, min_spread,
-               centres, allowed, indptr, indices, np.arange(n), facing, limits, normals_only, areas, *outputs, fitted,
-               _general(degree))
+    facing = facing[: facing.shape[0] if check_facing else 0]
+    run_chunks(
+        _connected_chunk,
+        m,
+        n_chunks,
+        vertices,
+        normals,
+        radii,
+        degree,
+        iterations,
+        exponents,
+        min_spread,
+        centres,
+        allowed,
+        indptr,
+        indices,
+        np.arange(n),
+        facing,
+        limits,
+        normals_only,
+        areas,
+        *outputs,
+        fitted,
+        _general(degree),
+    )
     return (fitted, *outputs[1:]) if normals_only else outputs
 
 
 @nb.njit(**_JIT)
-def _connected_chunk(lo, hi, vertices, normals, radii, degree, iterations, exponents, min_spread, centres, allowed,
-                     indptr, indices, ids, facing, limits, normals_only, areas, coefficients, t1s, t2s, ns, counts,
-                     away, fitted, general):
+def _connected_chunk(
+    lo,
+    hi,
+    vertices,
+    normals,
+    radii,
+    degree,
+    iterations,
+    exponents,
+    min_spread,
+    centres,
+    allowed,
+    indptr,
+    indices,
+    ids,
+    facing,
+    limits,
+    normals_only,
+    areas,
+    coefficients,
+    t1s,
+    t2s,
+    ns,
+    counts,
+    away,
+    fitted,
+    general,
+):
     """The fits of ``centres[lo:hi]`` of :func:`fit_jets_connected`, written to their rows of the outputs
     (of ``fitted`` with ``normals_only``)."""
     n = vertices.shape[0]
@@ -512,9 +709,38 @@ def _connected_chunk(lo, hi, vertices, normals, radii, degree, iterations, expon
         # site would double its compile time)
         c[0, :] = np.nan  # a failed fit leaves the row as it finds it
         one_away[0] = np.nan  # written only when the facing is checked
-        work = _fit_one(vertices, vertices, normals, radius, degree, iterations, exponents, min_spread, v, 0,
-                        members, size, work, moments, right, matrix, low, scale, solution, c, a, b, nn,
-                        one_count, ids, facing, limits, one_away, areas, general)
+        work = _fit_one(
+            vertices,
+            vertices,
+            normals,
+            radius,
+            degree,
+            iterations,
+            exponents,
+            min_spread,
+            v,
+            0,
+            members,
+            size,
+            work,
+            moments,
+            right,
+            matrix,
+            low,
+            scale,
+            solution,
+            c,
+            a,
+            b,
+            nn,
+            one_count,
+            ids,
+            facing,
+            limits,
+            one_away,
+            areas,
+            general,
+        )
         if not normals_only:
             for k in range(6):
                 coefficients[i, k] = c[0, k]

@@ -163,8 +163,9 @@ def _ball_members(points, grid, cx, cy, cz, cutoff, out):
     cutoff2 = cutoff * cutoff
     count = 0
     span = np.int64(math.ceil(cutoff / cell))  # cells each way from the centre's
-    if not (fx > -1 - span and fy > -1 - span and fz > -1 - span and fx < nx + span and fy < ny + span
-            and fz < 2.0**61):
+    if not (
+        fx > -1 - span and fy > -1 - span and fz > -1 - span and fx < nx + span and fy < ny + span and fz < 2.0**61
+    ):
         return out, count
     bx = np.int64(math.floor(fx))
     by = np.int64(math.floor(fy))
@@ -300,8 +301,15 @@ def _face_level(vertices, faces, f, d, low, high, reach, ball, ball2, cx, cy, cz
         for corner in range(3):  # corners and centroid outside: it meets the ball if a side crosses it
             p = faces[f, corner]
             q = faces[f, (corner + 1) % 3]
-            if _segment_meets_ball(vertices[p, 0] - cx, vertices[p, 1] - cy, vertices[p, 2] - cz,
-                                   vertices[q, 0] - cx, vertices[q, 1] - cy, vertices[q, 2] - cz, radius2):
+            if _segment_meets_ball(
+                vertices[p, 0] - cx,
+                vertices[p, 1] - cy,
+                vertices[p, 2] - cz,
+                vertices[q, 0] - cx,
+                vertices[q, 1] - cy,
+                vertices[q, 2] - cz,
+                radius2,
+            ):
                 return r
     return n_radii
 
@@ -337,8 +345,9 @@ def _add_face(faces, f, first, low, high, ball, ball2, usable, values, total, v,
 
 
 @nb.njit(parallel=True, **_JIT)
-def connected_face_sums(vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch,
-                        start, stop):
+def connected_face_sums(
+    vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
+):
     """Add to rows ``start`` to ``stop`` of ``out`` (V, k) the sums of ``share * values`` over the faces of the
     surface-connected piece of each vertex's ball, of radius ``radii[v]`` ((V,): one per vertex) or
     ``radii[0]`` ((1,): one for all). :func:`connected_face_sums_nested` sums several nested balls in one walk;
@@ -404,8 +413,14 @@ def connected_face_sums(vertices, faces, centroids, reach, usable, values, radii
                             p = faces[f, corner]
                             q = faces[f, (corner + 1) % 3]
                             crossed = crossed or _segment_meets_ball(
-                                vertices[p, 0] - cx, vertices[p, 1] - cy, vertices[p, 2] - cz,
-                                vertices[q, 0] - cx, vertices[q, 1] - cy, vertices[q, 2] - cz, radius2)
+                                vertices[p, 0] - cx,
+                                vertices[p, 1] - cy,
+                                vertices[p, 2] - cz,
+                                vertices[q, 0] - cx,
+                                vertices[q, 1] - cy,
+                                vertices[q, 2] - cz,
+                                radius2,
+                            )
                         if not crossed:
                             continue
                     else:
@@ -425,8 +440,9 @@ def connected_face_sums(vertices, faces, centroids, reach, usable, values, radii
 
 
 @nb.njit(parallel=True, **_JIT)
-def connected_face_sums_nested(vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch,
-                               start, stop):
+def connected_face_sums_nested(
+    vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
+):
     """Add to rows ``start`` to ``stop`` of ``out`` (R, V, k) the sums of ``share * values`` over the faces of the
     surface-connected piece of each vertex's balls, one ball per row of ``radii`` (R, 1) or (R, V).
 
@@ -527,8 +543,9 @@ def connected_face_sums_nested(vertices, faces, centroids, reach, usable, values
                             levels[n_deferred] = level
                             n_deferred += 1
                             continue
-                        tail = _add_face(faces, f, p, low, high, ball, ball2, usable, values, total, v, mark, queue,
-                                         tail)
+                        tail = _add_face(
+                            faces, f, p, low, high, ball, ball2, usable, values, total, v, mark, queue, tail
+                        )
             for r in range(n_radii):
                 for k in range(n_values):
                     out[r, v, k] = total[r, k]
@@ -602,8 +619,9 @@ def ball_cell_sums(vertices, cells, centroids, values, radius, cutoff, n_chunks,
     for chunk in nb.prange(n_chunks):
         members = np.empty(64, np.int64)
         for rank in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
-            members = _cell_weight_sums(vertices, points, grid, sorted_values, radius, cutoff, centres[rank],
-                                        members, out)
+            members = _cell_weight_sums(
+                vertices, points, grid, sorted_values, radius, cutoff, centres[rank], members, out
+            )
     return out
 
 

@@ -136,8 +136,18 @@ def normal_cycle_finish(sums, invalid, indptr, indices, steps):
             continue
         valid[i] = True
         lo, hi, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
-            current[i, 0] / area, current[i, 1] / area, current[i, 2] / area, current[i, 3] / area,
-            current[i, 4] / area, current[i, 5] / area, nx, ny, nz, True, True)
+            current[i, 0] / area,
+            current[i, 1] / area,
+            current[i, 2] / area,
+            current[i, 3] / area,
+            current[i, 4] / area,
+            current[i, 5] / area,
+            nx,
+            ny,
+            nz,
+            True,
+            True,
+        )
         k_min[i], k_max[i] = lo, hi
         dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
         dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5

@@ -39,8 +39,9 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
                 z += 1
             if z >= high:
                 z += 1
-            m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(points, normals, index[row, a], index[row, b],
-                                                                    index[row, z], True)
+            m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(
+                points, normals, index[row, a], index[row, b], index[row, z], True
+            )
             s0, s1, s2, s3, s4, s5 = s0 + m0, s1 + m1, s2 + m2, s3 + m3, s4 + m4, s5 + m5
             s6, s7, s8 = s6 + m6, s7 + m7, s8 + m8
         out[row, 0], out[row, 1], out[row, 2] = s0, s1, s2
@@ -70,8 +71,9 @@ def _covariance(points, indices, i):
     xx, xy, xz, yy, yz, zz = dx * dx, dx * dy, dx * dz, dy * dy, dy * dz, dz * dz
     for j in range(k):
         q = indices[i, j]
-        xx, xy, xz, yy, yz, zz = _add_outer(xx, xy, xz, yy, yz, zz, points[q, 0] - cx, points[q, 1] - cy,
-                                            points[q, 2] - cz)
+        xx, xy, xz, yy, yz, zz = _add_outer(
+            xx, xy, xz, yy, yz, zz, points[q, 0] - cx, points[q, 1] - cy, points[q, 2] - cz
+        )
     return xx, xy, xz, yy, yz, zz
 
 
@@ -195,7 +197,11 @@ def pca_normals(points, indices):
             ax, ay, az, la = ex, ey, ez, le
         # the longest row of A - lambda I: along the largest eigenvector when the smallest eigenvalue is double
         # (a collinear neighbourhood), where A - lambda I has rank 1 and the cross products are rounding noise
-        s0, s1, s2 = r0x * r0x + r0y * r0y + r0z * r0z, r1x * r1x + r1y * r1y + r1z * r1z, r2x * r2x + r2y * r2y + r2z * r2z
+        s0, s1, s2 = (
+            r0x * r0x + r0y * r0y + r0z * r0z,
+            r1x * r1x + r1y * r1y + r1z * r1z,
+            r2x * r2x + r2y * r2y + r2z * r2z,
+        )
         if s1 > s0 and s1 >= s2:
             r0x, r0y, r0z, s0 = r1x, r1y, r1z, s1
         elif s2 > s0:
@@ -247,13 +253,11 @@ def ball_indices(points, centres, radius, k, pool_points, ids, grid, n_chunks):
                 if not d < limit:
                     continue
                 q = ids[t]
-                if found == k and (d > squared[row, k - 1] or (d == squared[row, k - 1]
-                                                               and q > index[row, k - 1])):
+                if found == k and (d > squared[row, k - 1] or (d == squared[row, k - 1] and q > index[row, k - 1])):
                     continue
                 # insert in order, dropping the last when full
                 j = found if found < k else k - 1
-                while j > 0 and (squared[row, j - 1] > d or (squared[row, j - 1] == d
-                                                             and index[row, j - 1] > q)):
+                while j > 0 and (squared[row, j - 1] > d or (squared[row, j - 1] == d and index[row, j - 1] > q)):
                     squared[row, j] = squared[row, j - 1]
                     index[row, j] = index[row, j - 1]
                     j -= 1

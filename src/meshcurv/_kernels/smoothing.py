@@ -1,5 +1,4 @@
-"""Compiled twin of :mod:`meshcurv.smoothing`: repeated averages over the neighbour lists.
-"""
+"""Compiled twin of :mod:`meshcurv.smoothing`: repeated averages over the neighbour lists."""
 
 from __future__ import annotations
 

@@ -21,8 +21,11 @@ def _tangent_eigen(xx, yy, zz, xy, xz, yz, nx, ny, nz, rotate, mean_from_trace):
     s1z = xz * t1x + yz * t1y + zz * t1z
     a = t1x * s1x + t1y * s1y + t1z * s1z
     b = t2x * s1x + t2y * s1y + t2z * s1z
-    c = (t2x * (xx * t2x + xy * t2y + xz * t2z) + t2y * (xy * t2x + yy * t2y + yz * t2z)
-         + t2z * (xz * t2x + yz * t2y + zz * t2z))
+    c = (
+        t2x * (xx * t2x + xy * t2y + xz * t2z)
+        + t2y * (xy * t2x + yy * t2y + yz * t2z)
+        + t2z * (xz * t2x + yz * t2y + zz * t2z)
+    )
     half_sum = 0.5 * (a + c)
     if mean_from_trace:
         half_sum = 0.5 * (xx + yy + zz)
@@ -60,8 +63,18 @@ def principal_from_shape_operator(tensor, normals, rotate, mean_from_trace):
     dir_max = np.empty((n, 3))
     for i in nb.prange(n):
         lo, hi, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
-            tensor[i, 0], tensor[i, 1], tensor[i, 2], tensor[i, 3], tensor[i, 4], tensor[i, 5],
-            normals[i, 0], normals[i, 1], normals[i, 2], rotate, mean_from_trace)
+            tensor[i, 0],
+            tensor[i, 1],
+            tensor[i, 2],
+            tensor[i, 3],
+            tensor[i, 4],
+            tensor[i, 5],
+            normals[i, 0],
+            normals[i, 1],
+            normals[i, 2],
+            rotate,
+            mean_from_trace,
+        )
         k_min[i], k_max[i] = lo, hi
         dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
         dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5

@@ -44,8 +44,19 @@ def nan_where(invalid: np.ndarray, *arrays: np.ndarray) -> None:
         array[invalid] = np.nan
 
 
-def finish(method: str, parameters: dict, valid: np.ndarray, normals: np.ndarray, k_min, k_max,
-           dir_min, dir_max, defects: VertexDefects, extra: tuple[str, ...] = (), radius: np.ndarray | None = None):
+def finish(
+    method: str,
+    parameters: dict,
+    valid: np.ndarray,
+    normals: np.ndarray,
+    k_min,
+    k_max,
+    dir_min,
+    dir_max,
+    defects: VertexDefects,
+    extra: tuple[str, ...] = (),
+    radius: np.ndarray | None = None,
+):
     """NaN where invalid, the one result, and the problem list for the one warning.
 
     ``radius``: the (V,) radius of each vertex's ball (the methods over balls).
@@ -53,9 +64,17 @@ def finish(method: str, parameters: dict, valid: np.ndarray, normals: np.ndarray
     valid = valid & np.isfinite(k_min) & np.isfinite(k_max)
     nan_where(~valid, k_min, k_max, dir_min, dir_max)
     # the estimators' own arrays, taken without copies (88 bytes per vertex)
-    result = CurvatureResult._of_arrays(k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max,
-                                        normals=normals, valid=valid, method=method, parameters=parameters,
-                                        radius=radius)
+    result = CurvatureResult._of_arrays(
+        k_min=k_min,
+        k_max=k_max,
+        dir_min=dir_min,
+        dir_max=dir_max,
+        normals=normals,
+        valid=valid,
+        method=method,
+        parameters=parameters,
+        radius=radius,
+    )
     return result, problems(defects, valid, extra)
 
 

@@ -81,8 +81,17 @@ from ..geometry import median_edge_length, robust_mean_edge_length
 from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
 from ..measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import ball_face_sums, ball_face_sums_nested
-from ..radius import (VOXEL_SCALE_RULE, check_radius, component_radii, local_scale_ratios, noise_level, noise_radius,
-                      scale_ladder, stable_scales, vertex_radii)
+from ..radius import (
+    VOXEL_SCALE_RULE,
+    check_radius,
+    component_radii,
+    local_scale_ratios,
+    noise_level,
+    noise_radius,
+    scale_ladder,
+    stable_scales,
+    vertex_radii,
+)
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages, finish
@@ -120,13 +129,27 @@ NORMAL_AGREEMENT = 0.5
 RADIUS_WARNING_EDGES = 0.6
 
 
-STAGES = ("compute normals", "measure noise", "fit normals", "compute face measures", "sum over balls",
-          "retrieve curvatures")
+STAGES = (
+    "compute normals",
+    "measure noise",
+    "fit normals",
+    "compute face measures",
+    "sum over balls",
+    "retrieve curvatures",
+)
 
 
-def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray, radius, *,
-                   neighbours: np.ndarray | None = None, adjacency: tuple | None = None,
-                   areas: np.ndarray | None = None, weighted: bool = False) -> np.ndarray:
+def fitted_normals(
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    valid: np.ndarray,
+    radius,
+    *,
+    neighbours: np.ndarray | None = None,
+    adjacency: tuple | None = None,
+    areas: np.ndarray | None = None,
+    weighted: bool = False,
+) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
     Only the ``neighbours`` (V,) bool vertices enter the balls (default: all;
@@ -156,15 +179,34 @@ def fitted_normals(vertices: np.ndarray, normals: np.ndarray, valid: np.ndarray,
         coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency)
     if coarse is not None:
         points, point_normals, allowed, lists, point_areas = coarse
-        coefficients, frame, _ = fit_jets(points, point_normals, radius, degree=NORMAL_DEGREE,
-                                          iterations=NORMAL_ITERATIONS, centres=np.arange(vertices.shape[0]),
-                                          neighbours=allowed, adjacency=lists, settled=NORMAL_SETTLED,
-                                          areas=point_areas, compact=True, min_spread=NORMAL_MIN_SPREAD)
+        coefficients, frame, _ = fit_jets(
+            points,
+            point_normals,
+            radius,
+            degree=NORMAL_DEGREE,
+            iterations=NORMAL_ITERATIONS,
+            centres=np.arange(vertices.shape[0]),
+            neighbours=allowed,
+            adjacency=lists,
+            settled=NORMAL_SETTLED,
+            areas=point_areas,
+            compact=True,
+            min_spread=NORMAL_MIN_SPREAD,
+        )
         fitted = jet_normals(coefficients, frame)
     else:
-        fitted = fit_jet_normals(vertices, start, radius, degree=NORMAL_DEGREE, iterations=NORMAL_ITERATIONS,
-                                 neighbours=neighbours, adjacency=adjacency, settled=NORMAL_SETTLED,
-                                 areas=areas if weighted else None, min_spread=NORMAL_MIN_SPREAD)
+        fitted = fit_jet_normals(
+            vertices,
+            start,
+            radius,
+            degree=NORMAL_DEGREE,
+            iterations=NORMAL_ITERATIONS,
+            neighbours=neighbours,
+            adjacency=adjacency,
+            settled=NORMAL_SETTLED,
+            areas=areas if weighted else None,
+            min_spread=NORMAL_MIN_SPREAD,
+        )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     return np.where(usable[:, None], fitted, normals)
@@ -209,10 +251,11 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
     c = int(group.max()) + 1
     weight = areas[members]
     total = np.bincount(group, weights=weight, minlength=c)
-    centroid = np.stack([np.bincount(group, weights=weight * vertices[members, k], minlength=c) for k in range(3)],
-                        axis=1) / total[:, None]
-    summed = np.stack([np.bincount(group, weights=weight * normals[members, k], minlength=c) for k in range(3)],
-                      axis=1)
+    centroid = (
+        np.stack([np.bincount(group, weights=weight * vertices[members, k], minlength=c) for k in range(3)], axis=1)
+        / total[:, None]
+    )
+    summed = np.stack([np.bincount(group, weights=weight * normals[members, k], minlength=c) for k in range(3)], axis=1)
     length = np.linalg.norm(summed, axis=1, keepdims=True)
     group_normals = np.divide(summed, length, out=np.zeros_like(summed), where=length > 0)
     of = np.full(n, -1, dtype=np.int64)
@@ -228,19 +271,28 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
     lists = (np.concatenate([[0], np.cumsum(count)]).astype(np.int64), ends[order].astype(np.int64))
     allowed = np.concatenate([np.zeros(n, dtype=bool), np.ones(c, dtype=bool)])
     point_areas = np.concatenate([np.zeros(n), total])
-    return (np.concatenate([vertices, centroid]), np.concatenate([normals, group_normals]), allowed, lists,
-            point_areas)
+    return (np.concatenate([vertices, centroid]), np.concatenate([normals, group_normals]), allowed, lists, point_areas)
 
 
 def voxel_pilot(mesh: PreparedMesh):
     """The first pass of :func:`meshcurv.radius.voxel_surface_radius`: ``radius -> (k_min, k_max, valid, normals)``."""
+
     def run(radius: float):
         topology = mesh.topology
         _, valid = mesh.start(boundary=True)
         k_min, k_max, _, _, normals, _ = _curvatures(
-            mesh.vertices, topology.faces, _dropped(mesh), mesh.vertex_normals, valid, radius,
-            neighbours=topology.referenced_vertices, adjacency=_adjacency(topology), areas=_vertex_areas(mesh))
+            mesh.vertices,
+            topology.faces,
+            _dropped(mesh),
+            mesh.vertex_normals,
+            valid,
+            radius,
+            neighbours=topology.referenced_vertices,
+            adjacency=_adjacency(topology),
+            areas=_vertex_areas(mesh),
+        )
         return k_min, k_max, valid, normals
+
     return run
 
 
@@ -278,9 +330,21 @@ def _usable_faces(faces: np.ndarray, degenerate: np.ndarray, normals: np.ndarray
     return None if kept.all() else kept
 
 
-def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Stages | None = None, *,
-                neighbours: np.ndarray | None = None, adjacency: tuple | None = None,
-                areas: np.ndarray | None = None, weighted: bool = False, normal_radius=None):
+def _curvatures(
+    vertices,
+    faces,
+    degenerate,
+    normals,
+    valid,
+    radius,
+    stages: Stages | None = None,
+    *,
+    neighbours: np.ndarray | None = None,
+    adjacency: tuple | None = None,
+    areas: np.ndarray | None = None,
+    weighted: bool = False,
+    normal_radius=None,
+):
     """``k_min, k_max, dir_min, dir_max, normals, valid`` of the measures over balls of ``radius``.
 
     The normals are fitted over ``normal_radius`` (default: :data:`NORMAL_RADIUS_RATIO` times ``radius``).
@@ -291,6 +355,7 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
     ``adjacency`` is given (the same wherever the surface within the ball is
     connected; see :func:`meshcurv.neighborhoods.ball_face_sums`).
     """
+
     def start(stage):
         if stages is not None:
             stages.start(stage)
@@ -299,15 +364,24 @@ def _curvatures(vertices, faces, degenerate, normals, valid, radius, stages: Sta
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
-        normals = fitted_normals(vertices, normals, valid, normal_radius, neighbours=neighbours,
-                                 adjacency=adjacency, areas=areas, weighted=weighted)
+        normals = fitted_normals(
+            vertices,
+            normals,
+            valid,
+            normal_radius,
+            neighbours=neighbours,
+            adjacency=adjacency,
+            areas=areas,
+            weighted=weighted,
+        )
 
     start("compute face measures")
     measures = face_measures(vertices, faces, normals)  # rows of the faces left out are not read
 
     start("sum over balls")
-    summed = ball_face_sums(vertices, faces, radius, measures, usable=_usable_faces(faces, degenerate, normals),
-                            connected=True)
+    summed = ball_face_sums(
+        vertices, faces, radius, measures, usable=_usable_faces(faces, degenerate, normals), connected=True
+    )
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
@@ -336,9 +410,11 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             inside = valid if members is None else valid & np.isin(np.arange(vertices.shape[0]), members)
             edges = topology.edges if members is None else topology.edges[inside[topology.edges[:, 0]]]
             edge_length = robust_mean_edge_length(vertices, edges)
-            level = (noise_level(vertices, normals, inside, edges, neighbours=referenced,
-                                 adjacency=_adjacency(topology))
-                     if edge_length > 0 else 0.0)
+            level = (
+                noise_level(vertices, normals, inside, edges, neighbours=referenced, adjacency=_adjacency(topology))
+                if edge_length > 0
+                else 0.0
+            )
             groups.append((float(noise_radius(level, edge_length)), members))
             levels.append(level)
         found = {"surface": "smooth", "noise": levels[0] if len(levels) == 1 else levels}
@@ -346,34 +422,81 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         groups, found = [(check_radius(radius, vertices, topology), None)], {}
     # one radius; a list of them (one per group of components of one scale) when the scales differ
     radii = [group_radius for group_radius, _ in groups]
-    parameters = {"radius": radii[0] if len(radii) == 1 else radii,
-                  "normal_radius": NORMAL_RADIUS_RATIO * radii[0] if len(radii) == 1
-                  else [NORMAL_RADIUS_RATIO * r for r in radii], **found}
+    parameters = {
+        "radius": radii[0] if len(radii) == 1 else radii,
+        "normal_radius": NORMAL_RADIUS_RATIO * radii[0]
+        if len(radii) == 1
+        else [NORMAL_RADIUS_RATIO * r for r in radii],
+        **found,
+    }
     if adaptive and len(groups) == 1:
         return _adaptive(mesh, groups[0][0], parameters, defects, valid, stages)
     if vertex_scale is not None:  # a voxel surface: each vertex at the scale its pilot calls for
         radii_v, normal_radii = vertex_scale
         k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
-            vertices, topology.faces, degenerate, normals, valid, radii_v, stages, neighbours=referenced,
-            adjacency=_adjacency(topology), areas=_vertex_areas(mesh), normal_radius=normal_radii)
-        parameters = {**parameters, "radius": float(np.median(radii_v)),
-                      "normal_radius": float(np.median(normal_radii)), "scale": "voxel",
-                      "scale_rule": VOXEL_SCALE_RULE}
+            vertices,
+            topology.faces,
+            degenerate,
+            normals,
+            valid,
+            radii_v,
+            stages,
+            neighbours=referenced,
+            adjacency=_adjacency(topology),
+            areas=_vertex_areas(mesh),
+            normal_radius=normal_radii,
+        )
+        parameters = {
+            **parameters,
+            "radius": float(np.median(radii_v)),
+            "normal_radius": float(np.median(normal_radii)),
+            "scale": "voxel",
+            "scale_rule": VOXEL_SCALE_RULE,
+        }
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor
         ratios = local_scale_ratios(vertices, topology, valid=valid)
         radii_v = vertex_radii(groups, vertices.shape[0]) * ratios
         if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not np.all(ratios == 1.0):
             k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
-                vertices, topology.faces, degenerate, normals, valid, radii_v, stages, neighbours=referenced,
-                adjacency=_adjacency(topology), areas=_vertex_areas(mesh), weighted=True)
-            return finish("icc", {**parameters, "scale": "local"}, valid, normals, k_min, k_max, dir_min, dir_max,
-                          defects, radius=radii_v)
+                vertices,
+                topology.faces,
+                degenerate,
+                normals,
+                valid,
+                radii_v,
+                stages,
+                neighbours=referenced,
+                adjacency=_adjacency(topology),
+                areas=_vertex_areas(mesh),
+                weighted=True,
+            )
+            return finish(
+                "icc",
+                {**parameters, "scale": "local"},
+                valid,
+                normals,
+                k_min,
+                k_max,
+                dir_min,
+                dir_max,
+                defects,
+                radius=radii_v,
+            )
     fields: tuple[np.ndarray, ...] | None = None
     for group_radius, members in groups:
-        computed = _curvatures(vertices, topology.faces, degenerate, normals, valid, group_radius,
-                               stages if fields is None else None, neighbours=referenced,
-                               adjacency=_adjacency(topology), areas=_vertex_areas(mesh))
+        computed = _curvatures(
+            vertices,
+            topology.faces,
+            degenerate,
+            normals,
+            valid,
+            group_radius,
+            stages if fields is None else None,
+            neighbours=referenced,
+            adjacency=_adjacency(topology),
+            areas=_vertex_areas(mesh),
+        )
         if members is None:
             fields = computed
             continue
@@ -384,8 +507,18 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
     if fields is None:
         raise RuntimeError("default_radii gave no group")
     k_min, k_max, dir_min, dir_max, normals, valid = fields
-    return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects,
-                  radius=vertex_radii(groups, vertices.shape[0]))
+    return finish(
+        "icc",
+        parameters,
+        valid,
+        normals,
+        k_min,
+        k_max,
+        dir_min,
+        dir_max,
+        defects,
+        radius=vertex_radii(groups, vertices.shape[0]),
+    )
 
 
 def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tuple]:
@@ -406,9 +539,18 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     radii = [check_radius(radius, vertices, topology) for radius in radii]
     stages.start("fit normals")
     areas = _vertex_areas(mesh)
-    normals = [fitted_normals(vertices, start_normals, valid, NORMAL_RADIUS_RATIO * radius,
-                              neighbours=topology.referenced_vertices, adjacency=_adjacency(topology), areas=areas)
-               for radius in radii]
+    normals = [
+        fitted_normals(
+            vertices,
+            start_normals,
+            valid,
+            NORMAL_RADIUS_RATIO * radius,
+            neighbours=topology.referenced_vertices,
+            adjacency=_adjacency(topology),
+            areas=areas,
+        )
+        for radius in radii
+    ]
     stages.start("compute face measures")
     measures = np.stack([face_measures(vertices, faces, rung) for rung in normals])
     kept = [_usable_faces(faces, degenerate, rung) for rung in normals]
@@ -417,15 +559,31 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         # the same faces at every scale: one walk
         summed = ball_face_sums_nested(vertices, faces, radii, measures, usable=kept[0])
     else:
-        summed = np.stack([ball_face_sums(vertices, faces, radius, values, usable=mask, connected=True)
-                           for radius, values, mask in zip(radii, measures, kept)])
+        summed = np.stack(
+            [
+                ball_face_sums(vertices, faces, radius, values, usable=mask, connected=True)
+                for radius, values, mask in zip(radii, measures, kept)
+            ]
+        )
     stages.start("retrieve curvatures")
     out = []
     for radius, rung, sums in zip(radii, normals, summed):
         k_min, k_max, dir_min, dir_max = curvatures_from_measures(sums, rung)
         parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius}
-        out.append(finish("icc", parameters, valid & np.isfinite(k_min), rung, k_min, k_max, dir_min, dir_max,
-                          defects, radius=np.full(vertices.shape[0], radius)))
+        out.append(
+            finish(
+                "icc",
+                parameters,
+                valid & np.isfinite(k_min),
+                rung,
+                k_min,
+                k_max,
+                dir_min,
+                dir_max,
+                defects,
+                radius=np.full(vertices.shape[0], radius),
+            )
+        )
     return out
 
 
@@ -443,20 +601,37 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     vertices, topology = mesh.vertices, mesh.topology
     faces = topology.faces
     stages.start("fit normals")
-    normals = fitted_normals(vertices, mesh.vertex_normals, valid, NORMAL_RADIUS_RATIO * base,
-                             neighbours=topology.referenced_vertices, adjacency=_adjacency(topology),
-                             areas=_vertex_areas(mesh))
+    normals = fitted_normals(
+        vertices,
+        mesh.vertex_normals,
+        valid,
+        NORMAL_RADIUS_RATIO * base,
+        neighbours=topology.referenced_vertices,
+        adjacency=_adjacency(topology),
+        areas=_vertex_areas(mesh),
+    )
     stages.start("compute face measures")
     measures = face_measures(vertices, faces, normals)
     stages.start("sum over balls")
     area = 0.5 * float(np.linalg.norm(mesh.cross[~_dropped(mesh)], axis=1).sum())
     radii = scale_ladder(base, median_edge_length(vertices, topology.edges), area)
-    summed = ball_face_sums_nested(vertices, faces, radii, measures,
-                                   usable=_usable_faces(faces, _dropped(mesh), normals))
+    summed = ball_face_sums_nested(
+        vertices, faces, radii, measures, usable=_usable_faces(faces, _dropped(mesh), normals)
+    )
     stages.start("retrieve curvatures")
     rung = stable_scales(*principal_from_measures(summed), topology.neighbour_lists)
     chosen = summed[rung, np.arange(vertices.shape[0])]
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(chosen, normals)
     parameters = {**parameters, "scale": "adaptive", "radii": tuple(float(r) for r in radii)}
-    return finish("icc", parameters, valid & np.isfinite(k_min), normals, k_min, k_max, dir_min, dir_max, defects,
-                  radius=radii[rung])
+    return finish(
+        "icc",
+        parameters,
+        valid & np.isfinite(k_min),
+        normals,
+        k_min,
+        k_max,
+        dir_min,
+        dir_max,
+        defects,
+        radius=radii[rung],
+    )

@@ -111,14 +111,16 @@ def _vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, out_of_range):
     ends = np.concatenate([ev1, ev2])
     counts = np.bincount(ends, minlength=n_vertices).astype(np.float64)
     counts[counts < np.finfo(float).eps] = 1.0
-    return np.stack(
-        [np.bincount(ends, weights=np.tile(edge_tensors[:, k], 2), minlength=n_vertices) for k in range(6)],
-        axis=1,
-    ) / counts[:, None]
+    return (
+        np.stack(
+            [np.bincount(ends, weights=np.tile(edge_tensors[:, k], 2), minlength=n_vertices) for k in range(6)],
+            axis=1,
+        )
+        / counts[:, None]
+    )
 
 
-def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_steps: int,
-                    stages: Stages | None = None):
+def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_steps: int, stages: Stages | None = None):
     """matGeom's smoothed vertex tensors (steps 1 to 6).
 
     Returns
@@ -166,8 +168,9 @@ def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages):
         # columns of the topology's arrays as they are (strided views): numba reads them without a copy
         tensors = kernels.matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, kernel_threads())
     else:
-        tensors = _vertex_tensors(vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1),
-                                  np.where(out_of_range, 0, ef2), out_of_range)
+        tensors = _vertex_tensors(
+            vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1), np.where(out_of_range, 0, ef2), out_of_range
+        )
 
     mispaired = np.zeros(n_vertices, dtype=bool)
     mispaired[ev1[wrong_face]] = True
@@ -188,8 +191,7 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         stages.start("average vertex tensors")
         indptr, indices = topology.smoothing_lists(smoothing_steps)
         stages.start("retrieve curvatures")
-        c1, c2, u1, u2, normal = kernels.matgeom_finish(np.ascontiguousarray(tensors), indptr, indices,
-                                                        smoothing_steps)
+        c1, c2, u1, u2, normal = kernels.matgeom_finish(np.ascontiguousarray(tensors), indptr, indices, smoothing_steps)
     else:
         tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = matgeom_tensors(
             vertices, topology, smoothing_steps, stages
@@ -241,13 +243,17 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         )
     n_unreferenced = int((~topology.referenced_vertices).sum())
     if n_unreferenced:
-        problems.append(
-            f"{n_unreferenced} unreferenced vertices: matGeom's zeros, valid=False"
-        )
+        problems.append(f"{n_unreferenced} unreferenced vertices: matGeom's zeros, valid=False")
     if problems:
         problems.append("method='normal_cycle' handles such meshes correctly")
     result = CurvatureResult._of_arrays(
-        k_min=c1, k_max=c2, dir_min=u1, dir_max=u2, normals=normal, valid=valid,
-        method="matgeom", parameters={"smoothing_steps": smoothing_steps},
+        k_min=c1,
+        k_max=c2,
+        dir_min=u1,
+        dir_max=u2,
+        normals=normal,
+        valid=valid,
+        method="matgeom",
+        parameters={"smoothing_steps": smoothing_steps},
     )
     return result, problems

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import principal_from_mean_gaussian
-from ..geometry import (corner_angles, corner_cotangents, mixed_voronoi_corner_areas, vertex_normals)
+from ..geometry import corner_angles, corner_cotangents, mixed_voronoi_corner_areas, vertex_normals
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 
@@ -77,6 +77,12 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
         gaussian = defect / areas
     k_min, k_max = principal_from_mean_gaussian(mean, gaussian)
     directions = np.full((n, 3), np.nan)
-    extra = (f"{int(needles.sum())} needle faces (a corner angle that rounds to zero: a vertex far from its "
-             "neighbours); their vertices have no cotangent Laplacian",) if needles.any() else ()
+    extra = (
+        (
+            f"{int(needles.sum())} needle faces (a corner angle that rounds to zero: a vertex far from its "
+            "neighbours); their vertices have no cotangent Laplacian",
+        )
+        if needles.any()
+        else ()
+    )
     return finish("meyer", {}, valid, normals, k_min, k_max, directions, directions.copy(), defects, extra)

@@ -98,13 +98,21 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     stages.start("retrieve curvatures")
     valid &= np.isfinite(normals).all(axis=1) & (pooled[:, 6] > 0)
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-        np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
-        rotate=True, mean_from_trace=True,
+        np.where(valid[:, None], tensors, 0.0),
+        np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
+        rotate=True,
+        mean_from_trace=True,
     )
     nan_where(~valid, k_min, k_max, dir_min, dir_max)
     result = CurvatureResult._of_arrays(
-        k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
-        method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},
+        k_min=k_min,
+        k_max=k_max,
+        dir_min=dir_min,
+        dir_max=dir_max,
+        normals=normals,
+        valid=valid,
+        method="normal_cycle",
+        parameters={"smoothing_steps": smoothing_steps},
     )
     return result, problems(defects, valid)
 
@@ -115,10 +123,17 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     stages.start("compute adjacencies")
     indptr, indices = topology.smoothing_lists(smoothing_steps)
     stages.start("compute edge tensors")
-    sums, degenerate = kernels.normal_cycle_sums(vertices, topology.faces, topology.edges, topology.edge_faces,
-                                                 topology.edge_face_counts, topology._edge_forward_counts,
-                                                 mesh.length_scales, DEGENERATE_AREA_RATIO,
-                                                 kernel_threads())
+    sums, degenerate = kernels.normal_cycle_sums(
+        vertices,
+        topology.faces,
+        topology.edges,
+        topology.edge_faces,
+        topology.edge_face_counts,
+        topology._edge_forward_counts,
+        mesh.length_scales,
+        DEGENERATE_AREA_RATIO,
+        kernel_threads(),
+    )
     mesh.found_degenerate(degenerate)  # the same test as mesh.degenerate (the twin tests): not made twice
     defects = mesh.defects()
     stages.start("average vertex tensors")
@@ -132,9 +147,16 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     else:
         smoothing_left = smoothing_steps
     k_min, k_max, dir_min, dir_max, normals, valid = kernels.normal_cycle_finish(
-        sums, defects.invalid_vertices, indptr, indices, smoothing_left)
+        sums, defects.invalid_vertices, indptr, indices, smoothing_left
+    )
     result = CurvatureResult._of_arrays(
-        k_min=k_min, k_max=k_max, dir_min=dir_min, dir_max=dir_max, normals=normals, valid=valid,
-        method="normal_cycle", parameters={"smoothing_steps": smoothing_steps},
+        k_min=k_min,
+        k_max=k_max,
+        dir_min=dir_min,
+        dir_max=dir_max,
+        normals=normals,
+        valid=valid,
+        method="normal_cycle",
+        parameters={"smoothing_steps": smoothing_steps},
     )
     return result, problems(defects, valid)

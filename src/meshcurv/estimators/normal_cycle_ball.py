@@ -105,11 +105,14 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     with np.errstate(invalid="ignore", divide="ignore"):
         tensors = measures / areas[:, None]
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-        np.where(valid[:, None], tensors, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
-        rotate=True, mean_from_trace=True,
+        np.where(valid[:, None], tensors, 0.0),
+        np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
+        rotate=True,
+        mean_from_trace=True,
     )
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
-    return finish("normal_cycle_ball", parameters, valid, normals, k_min, k_max, dir_min, dir_max,
-                  defects, radius=radii)
+    return finish(
+        "normal_cycle_ball", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii
+    )

@@ -90,8 +90,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     for group_radius, members in groups:
         unit = group_radius if group_radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
         details: dict = {}
-        found, frame, _ = fit_jets(vertices, start, unit, centres=members, neighbours=referenced, facing=facing,
-                                   details=details)
+        found, frame, _ = fit_jets(
+            vertices, start, unit, centres=members, neighbours=referenced, facing=facing, details=details
+        )
         part_six, part_fitted = shape_operators(found, frame, unit)
         rows = slice(None) if members is None else members
         six[rows], fitted[rows], coefficients[rows] = part_six[rows], part_fitted[rows], found[rows]
@@ -101,19 +102,41 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     fitted = np.where(np.isfinite(fitted).all(axis=1, keepdims=True), fitted, normals)
     valid &= np.isfinite(coefficients).all(axis=1)
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-        np.where(valid[:, None], six, 0.0), np.where(valid[:, None], fitted, [0.0, 0.0, 1.0]))
+        np.where(valid[:, None], six, 0.0), np.where(valid[:, None], fitted, [0.0, 0.0, 1.0])
+    )
     failed = ~valid & ~defects.invalid_vertices
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     few = int(failed.sum()) - two_sided
     shown = ", ".join(f"{r:g}" for r, _ in groups)
-    extra = ((f"{few} vertices have fewer than {MIN_POINTS} vertices (or a degenerate set) within "
-              f"radius {shown}; pass a larger `radius`") if few else "",
-             (f"{two_sided} vertices have a ball of radius {shown} that holds the other side of the surface "
-              "(a part thinner than the ball, or a ball over a whole closed part): no height function to fit; "
-              "pass a smaller `radius`") if two_sided else "")
+    extra = (
+        (
+            f"{few} vertices have fewer than {MIN_POINTS} vertices (or a degenerate set) within "
+            f"radius {shown}; pass a larger `radius`"
+        )
+        if few
+        else "",
+        (
+            f"{two_sided} vertices have a ball of radius {shown} that holds the other side of the surface "
+            "(a part thinner than the ball, or a ball over a whole closed part): no height function to fit; "
+            "pass a smaller `radius`"
+        )
+        if two_sided
+        else "",
+    )
     normals_out = np.where(valid[:, None], fitted, normals)
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
-    return finish("quadric", parameters, valid, normals_out, k_min, k_max, dir_min, dir_max, defects, extra,
-                  radius=vertex_radii(groups, vertices.shape[0]))
+    return finish(
+        "quadric",
+        parameters,
+        valid,
+        normals_out,
+        k_min,
+        k_max,
+        dir_min,
+        dir_max,
+        defects,
+        extra,
+        radius=vertex_radii(groups, vertices.shape[0]),
+    )

@@ -44,8 +44,9 @@ STAGES = ("compute normals", "fit face tensors", "average vertex tensors", "retr
 _SIX = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))  # 3x3 -> (xx, yy, zz, xy, xz, yz)
 
 
-def face_second_fundamental_forms(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray,
-                                  face_unit_normals: np.ndarray) -> np.ndarray:
+def face_second_fundamental_forms(
+    vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray, face_unit_normals: np.ndarray
+) -> np.ndarray:
     """(F, 3, 3) least-squares shape operator of every face, as a 3D tensor in its plane."""
     x = [vertices[faces[:, k]] for k in range(3)]
     u = [normals[faces[:, k]] for k in range(3)]
@@ -74,14 +75,20 @@ def face_second_fundamental_forms(vertices: np.ndarray, faces: np.ndarray, norma
     with np.errstate(over="ignore", invalid="ignore"):
         size = np.abs(lhs).max(axis=(1, 2))
         unit = lhs / np.where(size > 0, size, 1.0)[:, None, None]
-        solvable = (np.isfinite(lhs).all(axis=(1, 2)) & np.isfinite(rhs).all(axis=1) & (size > 0)
-                    & (np.abs(np.linalg.det(np.where(np.isfinite(unit), unit, 0.0))) > SINGULAR_DETERMINANT))
+        solvable = (
+            np.isfinite(lhs).all(axis=(1, 2))
+            & np.isfinite(rhs).all(axis=1)
+            & (size > 0)
+            & (np.abs(np.linalg.det(np.where(np.isfinite(unit), unit, 0.0))) > SINGULAR_DETERMINANT)
+        )
     lmn = np.full(rhs.shape, np.nan)
     lmn[solvable] = np.linalg.solve(lhs[solvable], rhs[solvable][:, :, None])[:, :, 0]
     uu = e_u[:, :, None] * e_u[:, None, :]
     vv = e_v[:, :, None] * e_v[:, None, :]
     uv = e_u[:, :, None] * e_v[:, None, :]
-    return lmn[:, 0, None, None] * uu + lmn[:, 1, None, None] * (uv + uv.transpose(0, 2, 1)) + lmn[:, 2, None, None] * vv
+    return (
+        lmn[:, 0, None, None] * uu + lmn[:, 1, None, None] * (uv + uv.transpose(0, 2, 1)) + lmn[:, 2, None, None] * vv
+    )
 
 
 def rotations_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -130,5 +137,6 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
     with np.errstate(invalid="ignore", divide="ignore"):
         shape_operator = summed / total[:, None]
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-        np.where(valid[:, None], shape_operator, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0]))
+        np.where(valid[:, None], shape_operator, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
+    )
     return finish("rusinkiewicz", {}, valid, normals, k_min, k_max, dir_min, dir_max, defects)
