@@ -6,6 +6,7 @@ Run them through :func:`meshcurv.cli.main`.
 from __future__ import annotations
 
 import importlib.metadata
+import operator
 import pathlib
 import platform
 import re
@@ -33,13 +34,18 @@ from ._common import (
     SCALAR_FIELDS,
     Session,
     _default_method,
-    _percentiles,
     choice,
     common_options,
     current_session,
     estimated,
+    low_high,
+    mesh_argument,
     method_options,
+    output_file,
+    overwrite_option,
     path_option,
+    percentiles_option,
+    up_option,
 )
 from ._view import view
 from ._volume import volume
@@ -135,7 +141,7 @@ def _viewers_epilog() -> str:
 
 
 @meshcurv.command(epilog=_viewers_epilog())
-@click.argument("mesh", type=PATH)
+@mesh_argument
 @path_option(
     ("-o", "--output"),
     "Write the fields to .vtp (ParaView, PyVista), .ply (MeshLab: one field as quality; meshio, "
@@ -152,7 +158,7 @@ def _viewers_epilog() -> str:
 )
 @choice("--quality", SCALAR_FIELDS, "mean", "Field copied as `quality`, the vertex property MeshLab colours by.")
 @click.option("--ascii", "ascii_", is_flag=True, help="ASCII rather than binary PLY, STL or VTK.")
-@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
+@overwrite_option("Replace an existing output file.")
 @common_options
 def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite):
     """Compute the curvatures of MESH (a mesh or a point cloud); write them with -o, or print a summary table.
@@ -254,19 +260,11 @@ DEFAULT_DPI = 150
 
 
 def _limits(ctx, param, value):
-    if value is None:
-        return None
-    try:
-        low, high = (float(part) for part in value.split(","))
-    except ValueError:
-        raise click.BadParameter(f"give two numbers as LOW,HIGH (e.g. -5,5); got {value!r}") from None
-    if not (np.isfinite(low) and np.isfinite(high) and low < high):
-        raise click.BadParameter(f"need finite LOW < HIGH; got {value!r}")
-    return low, high
+    return low_high(value, what="numbers", example="-5,5", need="finite LOW < HIGH", holds=operator.lt)
 
 
 @meshcurv.command()
-@click.argument("mesh", type=PATH)
+@mesh_argument
 @path_option(("-o", "--output"), "The PNG to write (default: MESH-NAME_FIELD.png in the current folder).")
 @choice(("-f", "--field"), SCALAR_FIELDS, "mean", "The field that colours the mesh.")
 @method_options
@@ -279,22 +277,12 @@ def _limits(ctx, param, value):
     help="auto (several views of a closed mesh, one of an open one), names separated by commas "
     "(iso, front, back, left, right, top, bottom, iso-back) or ELEVATION,AZIMUTH; repeatable.",
 )
-@choice(
-    "--up",
-    ["auto", "y", "z", "x"],
-    "auto",
+@up_option(
     "The axis drawn upwards; auto: z when the mesh is more than 1.2 times as tall along z as "
-    "along y, else y (most OBJ and PLY files).",
+    "along y, else y (most OBJ and PLY files)."
 )
 @choice("--directions", ["none", "max", "min", "both"], "none", "Strokes along the principal directions.")
-@click.option(
-    "--percentiles",
-    callback=_percentiles,
-    default="2,98",
-    show_default=True,
-    metavar="LOW,HIGH",
-    help="Colour limits as percentiles of the field (symmetric about 0 for a signed field).",
-)
+@percentiles_option("Colour limits as percentiles of the field (symmetric about 0 for a signed field).")
 @click.option(
     "--limits",
     callback=_limits,
@@ -320,7 +308,7 @@ def _limits(ctx, param, value):
     default=None,
     help="Width of the PNG in pixels (sets the resolution; instead of --dpi).",
 )
-@click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
+@overwrite_option("Replace an existing picture.")
 @common_options
 def plot(
     mesh,
@@ -348,10 +336,9 @@ def plot(
         raise click.UsageError("give --dpi or --pixels, not both")
     if limits is not None and context.get_parameter_source("percentiles") != click.core.ParameterSource.DEFAULT:
         raise click.UsageError("give --limits or --percentiles, not both")
-    output = output if output is not None else pathlib.Path(f"{mesh.stem}_{field}.png")
-    if output.suffix.lower() != ".png":
-        raise click.BadParameter(f"the picture is a PNG; got {output.name!r}", param_hint="'-o'")
-    check_output(output, overwrite=overwrite, source=mesh)
+    output = output_file(
+        output, f"{mesh.stem}_{field}.png", (".png",), "the picture is a PNG", overwrite=overwrite, source=mesh
+    )
     with estimated(mesh, method, smoothing_steps, radius, orient, session, "draw") as got:
         vertices, result, cloud = got.vertices, got.result, got.cloud
         triangles = None if got.topology is None else got.topology.faces
@@ -395,7 +382,7 @@ def plot(
 
 
 @meshcurv.command()
-@click.argument("mesh", type=PATH)
+@mesh_argument
 @common_options
 def info(mesh):
     """What MESH is: sizes, topology, defects, bounding box, edge length."""
@@ -445,7 +432,7 @@ def methods():
 
 @meshcurv.command()
 @click.argument("output", type=PATH, default="torus_gaussian.png")
-@click.option("--overwrite", is_flag=True, help="Replace an existing picture.")
+@overwrite_option("Replace an existing picture.")
 @common_options
 def demo(output, overwrite):
     """A torus (matGeom's torusMesh), its curvatures against the exact ones, a picture (OUTPUT)."""

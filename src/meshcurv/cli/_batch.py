@@ -4,12 +4,20 @@ from __future__ import annotations
 
 import click
 
-from ..batch import DEFAULT_TIMEOUT, MAX_WORKERS, OUTPUT_FORMATS, run
-from ._common import ProgressBar, choice, common_options, current_session, method_options, path_option
+from ..batch import DEFAULT_TIMEOUT, OUTPUT_FORMATS, run
+from ._common import (
+    ProgressBar,
+    choice,
+    common_options,
+    current_session,
+    method_options,
+    output_dir_option,
+    overwrite_option,
+    report_failures,
+    workers_option,
+)
 
 __all__ = ["batch", "BatchBar"]
-
-_SHOWN_FAILURES = 10
 
 
 class BatchBar(ProgressBar):
@@ -30,27 +38,17 @@ class BatchBar(ProgressBar):
 
 @click.command("batch")
 @click.argument("inputs", nargs=-1, required=True)
-@path_option(
-    ("-o", "--output-dir", "out_dir"),
-    "Folder of the results and of summary.parquet / summary.csv (created if needed).",
-    required=True,
-    default=None,
-)
+@output_dir_option("Folder of the results and of summary.parquet / summary.csv (created if needed).")
 @method_options
 @choice(("--format", "output_format"), OUTPUT_FORMATS, "ply", "Format of the result files.")
-@click.option(
-    "--workers",
-    type=click.IntRange(min=1, max=MAX_WORKERS),
-    default=None,
-    help="Worker processes of the local cluster (default: one per core).",
-)
+@workers_option("Worker processes of the local cluster (default: one per core).")
 @click.option(
     "--scheduler",
     metavar="ADDRESS",
     default=None,
     help="Run on an existing Dask cluster, e.g. tcp://host:8786, instead of a local one.",
 )
-@click.option("--overwrite", is_flag=True, help="Compute again the meshes whose results exist.")
+@overwrite_option("Compute again the meshes whose results exist.")
 @click.option(
     "--timeout",
     type=click.FloatRange(min=0, max=1e9),
@@ -103,8 +101,7 @@ def batch(
             "--workers sizes the local cluster; leave it out with --scheduler (the cluster's own workers are used)"
         )
     session = current_session()
-    bar = session.bar(BatchBar)
-    try:
+    with session.bar(BatchBar) as bar:
         summary = run(
             list(inputs),
             out_dir,
@@ -120,8 +117,6 @@ def batch(
             retry_failed=retry_failed,
             progress=bar,
         )
-    finally:
-        bar.close()
     counts = summary["status"].value_counts()
     failures = summary[summary["status"] == "failed"]
     session.info(
@@ -132,10 +127,7 @@ def batch(
     not_written = summary.attrs.get("not_written")
     if failures.empty and not not_written:
         return 0
-    for path, error in zip(failures["path"][:_SHOWN_FAILURES], failures["error"][:_SHOWN_FAILURES]):
-        click.echo(f"meshcurv: failed: {path}: {error}", err=True)
-    if len(failures) > _SHOWN_FAILURES:
-        click.echo(f"meshcurv: ... and {len(failures) - _SHOWN_FAILURES} more (see the summary)", err=True)
+    report_failures(failures["path"], failures["error"], "the summary")
     if not failures.empty and not retry_failed:
         session.info(
             "meshes that failed before are reported, not tried again, until their file changes "

@@ -19,9 +19,11 @@ import numpy as np
 
 from .. import _backend
 from .._validation import as_faces
+from ..batch import MAX_WORKERS
 from ..curvature import principal_curvatures
 from ..estimators import DEFAULT_METHOD, ESTIMATORS
 from ..io import is_point_cloud, read_mesh, read_points
+from ..io._files import check_output
 from ..io.fields import FIELDS
 from ..pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
 from ..smoothing import MAX_SMOOTHING_STEPS
@@ -51,8 +53,52 @@ def choice(names, choices, default, help_text: str, **settings):
     )
 
 
-#: The largest finite float: an option value that parses to infinity (``1e400``) is beyond it.
-_FLOAT_MAX = sys.float_info.max
+#: A length or a width: a float > 0 and finite (a value that parses to infinity, ``1e400``, is beyond it).
+POSITIVE = click.FloatRange(min=0, min_open=True, max=sys.float_info.max)
+
+
+def mesh_argument(function):
+    """The MESH argument: a :data:`PATH`."""
+    return click.argument("mesh", type=PATH)(function)
+
+
+def output_dir_option(help_text: str):
+    """-o/--output-dir (the parameter ``out_dir``), required."""
+    return path_option(("-o", "--output-dir", "out_dir"), help_text, required=True)
+
+
+def overwrite_option(help_text: str):
+    """--overwrite, a flag."""
+    return click.option("--overwrite", is_flag=True, help=help_text)
+
+
+def workers_option(help_text: str):
+    """--workers, 1 to :data:`meshcurv.batch.MAX_WORKERS` processes (default None)."""
+    return click.option("--workers", type=click.IntRange(min=1, max=MAX_WORKERS), default=None, help=help_text)
+
+
+def up_option(help_text: str):
+    """--up, the axis drawn upwards: auto (the default), y, z or x."""
+    return choice("--up", ["auto", "y", "z", "x"], "auto", help_text)
+
+
+def percentiles_option(help_text: str):
+    """--percentiles LOW,HIGH (default 2,98), parsed to a pair of floats."""
+    return click.option(
+        "--percentiles", callback=_percentiles, default="2,98", show_default=True, metavar="LOW,HIGH", help=help_text
+    )
+
+
+def method_option(default, help_text: str, **settings):
+    """-m/--method, one of :class:`MethodChoice`."""
+    return click.option("-m", "--method", type=MethodChoice(), default=default, help=help_text, **settings)
+
+
+def _stacked(function, options):
+    """``function`` under the decorators ``options``, the first outermost (as written above a ``def``)."""
+    for option in reversed(options):
+        function = option(function)
+    return function
 
 
 _LEVELS = {-2: logging.CRITICAL, -1: logging.ERROR, 0: logging.WARNING, 1: logging.INFO, 2: logging.DEBUG}
@@ -147,9 +193,7 @@ def common_options(function):
         click.option("--debug", is_flag=True, help="Show the traceback when something fails.", **stored),
         click.option("--progress/--no-progress", default=None, help=progress, **stored),
     ]
-    for option in reversed(options):
-        function = option(function)
-    return function
+    return _stacked(function, options)
 
 
 class MethodChoice(click.Choice):
@@ -174,14 +218,7 @@ def _default_method() -> str:
 def method_options(function):
     """--method and the estimator options, passed on only when given."""
     options = [
-        click.option(
-            "-m",
-            "--method",
-            type=MethodChoice(),
-            default=_default_method(),
-            show_default=True,
-            help="Curvature estimator (see `meshcurv methods`).",
-        ),
+        method_option(_default_method(), "Curvature estimator (see `meshcurv methods`).", show_default=True),
         click.option(
             "--smoothing-steps",
             type=click.IntRange(min=0, max=MAX_SMOOTHING_STEPS),
@@ -190,7 +227,7 @@ def method_options(function):
         ),
         click.option(
             "--radius",
-            type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX),
+            type=POSITIVE,
             default=None,
             help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
             "default from the mesh: see `meshcurv methods`).",
@@ -202,9 +239,7 @@ def method_options(function):
             help="Reorient the faces first (default: auto = outward, keep for matgeom).",
         ),
     ]
-    for option in reversed(options):
-        function = option(function)
-    return function
+    return _stacked(function, options)
 
 
 def _estimate(vertices, faces, method, options, bar):
@@ -221,14 +256,51 @@ def _estimate(vertices, faces, method, options, bar):
     )
 
 
-def _percentiles(ctx, param, value):
+def low_high(value, *, what: str, example: str, need: str, holds):
+    """``value`` "LOW,HIGH" as two finite floats for which ``holds(low, high)``; None stays None.
+
+    A ``click.BadParameter`` otherwise: "give two ``what`` as LOW,HIGH (e.g.
+    ``example``)", or "need ``need``".
+    """
+    if value is None:
+        return None
     try:
         low, high = (float(part) for part in value.split(","))
     except ValueError:
-        raise click.BadParameter(f"give two percentiles as LOW,HIGH (e.g. 2,98); got {value!r}") from None
-    if not 0 <= low < high <= 100:
-        raise click.BadParameter(f"need 0 <= LOW < HIGH <= 100; got {value!r}")
+        raise click.BadParameter(f"give two {what} as LOW,HIGH (e.g. {example}); got {value!r}") from None
+    if not (np.isfinite(low) and np.isfinite(high) and holds(low, high)):
+        raise click.BadParameter(f"need {need}; got {value!r}")
     return low, high
+
+
+def _percentiles(ctx, param, value):
+    return low_high(
+        value, what="percentiles", example="2,98", need="0 <= LOW < HIGH <= 100", holds=lambda a, b: 0 <= a < b <= 100
+    )
+
+
+def output_file(output, default: str, suffixes, expected: str, *, overwrite: bool, source) -> pathlib.Path:
+    """The -o file of a command that writes one (``default`` when None), checked before computing.
+
+    Its suffix must be one of ``suffixes`` (else "``expected``; got NAME",
+    a bad -o); it must not exist unless ``overwrite``, nor be ``source``.
+    """
+    output = output if output is not None else pathlib.Path(default)
+    if output.suffix.lower() not in suffixes:
+        raise click.BadParameter(f"{expected}; got {output.name!r}", param_hint="'-o'")
+    check_output(output, overwrite=overwrite, source=source)
+    return output
+
+
+_SHOWN_FAILURES = 10
+
+
+def report_failures(names, errors, where: str) -> None:
+    """On stderr, "failed: NAME: ERROR" for the first ten ``names`` that failed, and how many more (see ``where``)."""
+    for name, error in zip(list(names)[:_SHOWN_FAILURES], list(errors)[:_SHOWN_FAILURES]):
+        click.echo(f"meshcurv: failed: {name}: {error}", err=True)
+    if len(names) > _SHOWN_FAILURES:
+        click.echo(f"meshcurv: ... and {len(names) - _SHOWN_FAILURES} more (see {where})", err=True)
 
 
 def _check_point_cloud_options(path, method, smoothing_steps, orient) -> None:
@@ -266,6 +338,13 @@ class ProgressBar:
         if self.stream is not None and self.tty and self._shown is not None:
             self.stream.write("\r\033[K")
             self.stream.flush()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info):
+        self.close()
+        return False
 
 
 class StageBar(ProgressBar):
@@ -317,8 +396,7 @@ def estimated(path, method, smoothing_steps, radius, orient, session: Session, l
             f"method {method!r} is for point clouds; {path} is a mesh (methods: {', '.join(ESTIMATORS)})"
         )
     stages = ["read", *([] if cloud else ESTIMATORS[method].stages), last_stage]
-    bar = session.bar(StageBar, stages)
-    try:
+    with session.bar(StageBar, stages) as bar:
         bar("read")
         if cloud:
             vertices, normals = read_points(path)
@@ -334,5 +412,3 @@ def estimated(path, method, smoothing_steps, radius, orient, session: Session, l
             result = _estimate(vertices, topology, method, options, bar)
         bar(last_stage, len(stages))
         yield Estimated(vertices, faces, topology, result, cloud)
-    finally:
-        bar.close()

@@ -2,37 +2,37 @@
 
 from __future__ import annotations
 
-import pathlib
-
 import click
 
-from ..io._files import check_input, check_output
+from ..io._files import check_input
 from ..viewer import VIEWER_FIELDS, write_html
-from ._common import PATH, _percentiles, choice, common_options, current_session, estimated, method_options, path_option
+from ._common import (
+    choice,
+    common_options,
+    current_session,
+    estimated,
+    mesh_argument,
+    method_options,
+    output_file,
+    overwrite_option,
+    path_option,
+    percentiles_option,
+    up_option,
+)
 
 __all__ = ["view"]
 
 
 @click.command("view")
-@click.argument("mesh", type=PATH)
+@mesh_argument
 @path_option(("-o", "--output"), "The page to write (default: MESH-NAME.html in the current folder).")
 @choice(("-f", "--field"), VIEWER_FIELDS, "mean", "The field shown first (the page has a menu of all of them).")
 @method_options
-@choice(
-    "--up",
-    ["auto", "y", "z", "x"],
-    "auto",
+@up_option(
     "The axis drawn upwards at first; auto: z when the mesh is clearly taller along z than "
-    "along y, else y (most OBJ and PLY files).",
+    "along y, else y (most OBJ and PLY files)."
 )
-@click.option(
-    "--percentiles",
-    callback=_percentiles,
-    default="2,98",
-    show_default=True,
-    metavar="LOW,HIGH",
-    help="Default colour limits as percentiles of each field (symmetric for signed fields).",
-)
+@percentiles_option("Default colour limits as percentiles of each field (symmetric for signed fields).")
 @click.option(
     "--directions",
     "max_directions",
@@ -49,7 +49,7 @@ __all__ = ["view"]
     help="The unit of the coordinates (mm, um, ...) for the colour bar: 1/UNIT.",
 )
 @click.option("--title", default=None, help="The page's heading (default: the file name).")
-@click.option("--overwrite", is_flag=True, help="Replace an existing page.")
+@overwrite_option("Replace an existing page.")
 @common_options
 def view(
     mesh,
@@ -80,10 +80,8 @@ def view(
     without an estimate.
     """
     session = current_session()
-    output = output if output is not None else pathlib.Path(f"{mesh.stem}.html")
-    if output.suffix.lower() not in (".html", ".htm"):
-        raise click.BadParameter(f"the page is an HTML file (.html); got {output.name!r}", param_hint="'-o'")
-    check_output(output, overwrite=overwrite, source=mesh)
+    page = "the page is an HTML file (.html)"
+    output = output_file(output, f"{mesh.stem}.html", (".html", ".htm"), page, overwrite=overwrite, source=mesh)
     check_input(mesh)
     with estimated(mesh, method, smoothing_steps, radius, orient, session, "page") as got:
         vertices, result = got.vertices, got.result

@@ -9,30 +9,30 @@ import warnings
 import click
 import numpy as np
 
-from ..batch import MAX_WORKERS
 from ..io import write_curvatures
 from ..io._files import atomic_output, check_output
 from ..io._vtp import PieceWriter
 from ..io.fields import FIELDS, curvature_fields
 from ..plotting import _pyplot, plot_field, save_figure
 from ._common import (
-    _FLOAT_MAX,
     PATH,
+    POSITIVE,
     SCALAR_FIELDS,
-    MethodChoice,
     ProgressBar,
     choice,
     common_options,
     current_session,
-    path_option,
+    method_option,
+    output_dir_option,
+    overwrite_option,
+    report_failures,
+    workers_option,
 )
 
 __all__ = ["volume", "LabelBar", "MESH_FORMATS"]
 
 #: Formats of the per-label mesh files (those of :data:`meshcurv.io.FORMATS` that hold per-vertex fields).
 MESH_FORMATS = ("ply", "vtp", "vtu", "vtk", "npz", "csv")
-
-_SHOWN_FAILURES = 10
 
 
 class LabelBar(ProgressBar):
@@ -70,16 +70,11 @@ def _label_list(ctx, param, value):
 
 @click.command("volume")
 @click.argument("image", type=PATH)
-@path_option(
-    ("-o", "--output-dir", "out_dir"),
-    "Folder of the table, pictures and meshes (created if needed).",
-    required=True,
-    default=None,
-)
+@output_dir_option("Folder of the table, pictures and meshes (created if needed).")
 @click.option(
     "--spacing",
     nargs=3,
-    type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX),
+    type=POSITIVE,
     default=None,
     metavar="Z Y X",
     help="Voxel size along image axes 0, 1, 2 (default: from the file, else 1 1 1).",
@@ -92,16 +87,10 @@ def _label_list(ctx, param, value):
     metavar="N,...",
     help="Only these labels (default: every label in the image).",
 )
-@click.option(
-    "-m",
-    "--method",
-    type=MethodChoice(),
-    default=None,
-    help="Curvature estimator (default: icc, with a radius chosen for voxel surfaces).",
-)
+@method_option(None, "Curvature estimator (default: icc, with a radius chosen for voxel surfaces).")
 @click.option(
     "--radius",
-    type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX),
+    type=POSITIVE,
     default=None,
     help="Ball radius in physical units (default: per label, from its voxels and curvature).",
 )
@@ -115,7 +104,7 @@ def _label_list(ctx, param, value):
 )
 @click.option(
     "--smooth",
-    type=click.FloatRange(min=0, min_open=True, max=_FLOAT_MAX),
+    type=POSITIVE,
     default=None,
     metavar="SIGMA",
     help="Blur each object's mask with a Gaussian of this standard deviation, in the "
@@ -144,14 +133,11 @@ def _label_list(ctx, param, value):
     help="A picture of all objects coloured by --field (needs matplotlib).",
 )
 @choice(("-f", "--field"), SCALAR_FIELDS, "mean", "The field of the picture.")
-@click.option(
-    "--workers",
-    type=click.IntRange(min=1, max=MAX_WORKERS),
-    default=None,
-    help="Compute the labels on a local Dask cluster of this many processes (needs "
-    "meshcurv[batch]; default: one label after the other in this process).",
+@workers_option(
+    "Compute the labels on a local Dask cluster of this many processes (needs "
+    "meshcurv[batch]; default: one label after the other in this process)."
 )
-@click.option("--overwrite", is_flag=True, help="Replace existing outputs.")
+@overwrite_option("Replace existing outputs.")
 @common_options
 def volume(
     image,
@@ -287,21 +273,18 @@ def volume(
     failures = table[table["status"] == "failed"]
     if failures.empty:
         return 0
-    for label, error in zip(failures["label"][:_SHOWN_FAILURES], failures["error"][:_SHOWN_FAILURES]):
-        click.echo(f"meshcurv: failed: label {label}: {error}", err=True)
+    report_failures([f"label {label}" for label in failures["label"]], failures["error"], "the table")
     click.echo(f"meshcurv: error: {len(failures)} of {len(table)} labels failed", err=True)
     return 1
 
 
 def _with_bar(labels, bar, total: int, rows: list):
     """Yield the surface of each ``(row, surface)`` of ``labels`` once ``row`` is in ``rows``; the bar drawn after each."""
-    try:
+    with bar:
         for row, surface in labels:
             rows.append(row)
             yield surface
             bar(len(rows), total, row["label"], row["status"])
-    finally:
-        bar.close()
 
 
 def _objects_writer(stack: contextlib.ExitStack, path: pathlib.Path, overwrite: bool):
