@@ -6,19 +6,8 @@ import click
 
 from ..io._files import check_input
 from ..viewer import VIEWER_FIELDS, write_html
-from ._common import (
-    choice,
-    common_options,
-    current_session,
-    estimated,
-    mesh_argument,
-    method_options,
-    output_file,
-    overwrite_option,
-    path_option,
-    percentiles_option,
-    up_option,
-)
+from ._common import choice, common_options, current_session, estimated, mesh_argument, method_options
+from ._common import output_file, overwrite_option, path_option, percentiles_option, up_option
 
 __all__ = ["view"]
 
