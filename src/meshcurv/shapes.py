@@ -155,14 +155,34 @@ def _quads_to_triangles(quads: np.ndarray, rng: np.random.Generator | None = Non
     return first.reshape(-1, 3)
 
 
-def _jitter(values: np.ndarray, step: float, jitter: float, rng, fixed=None) -> np.ndarray:
-    """``values`` plus uniform noise in ``[-jitter * step, jitter * step]`` (none where ``fixed``)."""
+def _jittered(coordinates, steps, bounds, jitter: float, seed: int):
+    """The grid ``coordinates`` moved by ``jitter`` (:func:`torus`): ``(moved, generator, name suffix)``.
+
+    Each array of ``coordinates`` in turn gets uniform noise in ``[-jitter *
+    step, jitter * step]`` from one generator seeded with ``seed``, none where
+    ``|value| >= bound`` (a boundary; no bound: None). Without jitter the
+    coordinates are returned as they are, with no generator and no suffix.
+    """
+    if not jitter:
+        return coordinates, None, ""
     if not 0 <= jitter < 0.5:
         raise InvalidOptionError(f"`jitter` must be in [0, 0.5) (a fraction of the grid spacing); got {jitter!r}")
-    noise = rng.uniform(-jitter * step, jitter * step, size=values.shape)
-    if fixed is not None:
-        noise[fixed] = 0.0
-    return values + noise
+    rng = np.random.default_rng(seed)
+    moved = []
+    for values, step, bound in zip(coordinates, steps, bounds):
+        noise = rng.uniform(-jitter * step, jitter * step, size=values.shape)
+        if bound is not None:
+            noise[np.abs(values) >= bound] = 0.0
+        moved.append(values + noise)
+    return moved, rng, f", jitter {jitter:g}"
+
+
+def _ellipsoid_exact(points: np.ndarray, semi_axes: np.ndarray):
+    """:func:`_implicit` on the centred axis-aligned ellipsoid ``sum(x_k**2 / a_k**2) = 1`` (outward)."""
+    inv2 = 1.0 / semi_axes**2
+    hessian = np.zeros((points.shape[0], 6))
+    hessian[:, :3] = 2 * inv2
+    return _implicit(points, 2 * points * inv2, hessian)
 
 
 def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
@@ -285,11 +305,8 @@ def torus(
     R, r = float(major_radius), float(minor_radius)
     theta = 2 * np.pi * np.arange(n_major) / n_major
     phi = 2 * np.pi * np.arange(n_minor) / n_minor
-    t, p = (a.ravel() for a in np.meshgrid(theta, phi, indexing="ij"))
-    rng = np.random.default_rng(seed) if jitter else None
-    if rng is not None:
-        t = _jitter(t, 2 * np.pi / n_major, jitter, rng)
-        p = _jitter(p, 2 * np.pi / n_minor, jitter, rng)
+    grid = [a.ravel() for a in np.meshgrid(theta, phi, indexing="ij")]
+    (t, p), rng, jittered = _jittered(grid, (2 * np.pi / n_major, 2 * np.pi / n_minor), (None, None), jitter, seed)
     normals = np.stack([np.cos(p) * np.cos(t), np.cos(p) * np.sin(t), np.sin(p)], axis=1)
     vertices = np.stack([(R + r * np.cos(p)) * np.cos(t), (R + r * np.cos(p)) * np.sin(t), r * np.sin(p)], axis=1)
     tube_direction = np.stack([-np.sin(p) * np.cos(t), -np.sin(p) * np.sin(t), np.cos(p)], axis=1)
@@ -298,9 +315,8 @@ def torus(
     i_next = np.roll(idx, -1, axis=0)
     quads = np.stack([idx, i_next, np.roll(i_next, -1, axis=1), np.roll(idx, -1, axis=1)], axis=-1).reshape(-1, 4)
     k_ring = np.cos(p) / (R + r * np.cos(p))
-    name = f"torus(R={R:g}, r={r:g})" + (f", jitter {jitter:g}" if jitter else "")
     exact = (k_ring, 1 / r, ring_direction, tube_direction, normals)
-    return _make(name, vertices, _quads_to_triangles(quads, rng), *exact, quads=quads)
+    return _make(f"torus(R={R:g}, r={r:g}){jittered}", vertices, _quads_to_triangles(quads, rng), *exact, quads=quads)
 
 
 def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh:
@@ -308,12 +324,7 @@ def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh
     a = np.asarray(semi_axes, dtype=float)
     unit, faces = _subdivided_sphere(subdivisions)
     vertices = unit * a
-    inv2 = 1.0 / a**2
-    gradient = 2 * vertices * inv2
-    hessian = np.zeros((vertices.shape[0], 6))
-    hessian[:, :3] = 2 * inv2
-    k_min, k_max, dir_min, dir_max, normals = _implicit(vertices, gradient, hessian)
-    return _make(f"ellipsoid{tuple(a.tolist())}", vertices, faces, k_min, k_max, dir_min, dir_max, normals)
+    return _make(f"ellipsoid{tuple(a.tolist())}", vertices, faces, *_ellipsoid_exact(vertices, a))
 
 
 def cylinder(
@@ -333,10 +344,8 @@ def cylinder(
     phi = 2 * np.pi * np.arange(n_around) / n_around
     z = np.linspace(-height / 2, height / 2, n_along + 1)
     zz, pp = (a.ravel() for a in np.meshgrid(z, phi, indexing="ij"))
-    rng = np.random.default_rng(seed) if jitter else None
-    if rng is not None:
-        pp = _jitter(pp, 2 * np.pi / n_around, jitter, rng)
-        zz = _jitter(zz, height / n_along, jitter, rng, fixed=np.abs(zz) >= height / 2)
+    steps, bounds = (2 * np.pi / n_around, height / n_along), (None, height / 2)  # the boundary rings stay flat
+    (pp, zz), rng, jittered = _jittered([pp, zz], steps, bounds, jitter, seed)
     normals = np.stack([np.cos(pp), np.sin(pp), np.zeros_like(pp)], axis=1)
     vertices = normals * radius + np.stack([0 * zz, 0 * zz, zz], axis=1)
     around = np.stack([-np.sin(pp), np.cos(pp), np.zeros_like(pp)], axis=1)
@@ -344,8 +353,8 @@ def cylinder(
     idx = np.arange(vertices.shape[0]).reshape(n_along + 1, n_around)
     nxt = np.roll(idx, -1, axis=1)
     quads = np.stack([idx[:-1], nxt[:-1], nxt[1:], idx[1:]], axis=-1).reshape(-1, 4)
-    name = f"cylinder(r={radius:g})" + (f", jitter {jitter:g}" if jitter else "")
-    return _make(name, vertices, _quads_to_triangles(quads, rng), 0.0, 1 / radius, axis, around, normals, quads=quads)
+    exact = (0.0, 1 / radius, axis, around, normals)
+    return _make(f"cylinder(r={radius:g}){jittered}", vertices, _quads_to_triangles(quads, rng), *exact, quads=quads)
 
 
 def saddle(half_width: float = 1.0, spacing: float = 0.025, *, jitter: float = 0.0, seed: int = 0) -> AnalyticMesh:
@@ -359,11 +368,8 @@ def saddle(half_width: float = 1.0, spacing: float = 0.025, *, jitter: float = 0
     n = int(round(2 * half_width / spacing)) + 1
     x = np.linspace(-half_width, half_width, n)
     yy, xx = (a.ravel() for a in np.meshgrid(x, x, indexing="ij"))
-    rng = np.random.default_rng(seed) if jitter else None
-    if rng is not None:
-        step = x[1] - x[0]
-        xx = _jitter(xx, step, jitter, rng, fixed=np.abs(xx) >= half_width)
-        yy = _jitter(yy, step, jitter, rng, fixed=np.abs(yy) >= half_width)
+    step = x[1] - x[0] if n > 1 else 0.0
+    (xx, yy), rng, jittered = _jittered([xx, yy], (step, step), (half_width, half_width), jitter, seed)
     vertices = np.stack([xx, yy, xx**2 - yy**2], axis=1)
     gradient = np.stack([-2 * xx, 2 * yy, np.ones_like(xx)], axis=1)  # of F = z - x^2 + y^2
     hessian = np.zeros((vertices.shape[0], 6))
@@ -371,8 +377,10 @@ def saddle(half_width: float = 1.0, spacing: float = 0.025, *, jitter: float = 0
     k_min, k_max, dir_min, dir_max, normals = _implicit(vertices, gradient, hessian)
     idx = np.arange(n * n).reshape(n, n)  # idx[row = y, column = x]
     quads = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], axis=-1).reshape(-1, 4)
-    name = f"saddle(spacing={spacing:g})" + (f", jitter {jitter:g}" if jitter else "")
-    return _make(name, vertices, _quads_to_triangles(quads, rng), k_min, k_max, dir_min, dir_max, normals, quads=quads)
+    exact = (k_min, k_max, dir_min, dir_max, normals)
+    return _make(
+        f"saddle(spacing={spacing:g}){jittered}", vertices, _quads_to_triangles(quads, rng), *exact, quads=quads
+    )
 
 
 def _random_unit_sphere(n_vertices: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -409,11 +417,7 @@ def random_ellipsoid(semi_axes=(3.0, 2.0, 1.0), n_vertices: int = 2562, *, seed:
     a = np.asarray(semi_axes, dtype=float)
     unit, faces = _random_unit_sphere(n_vertices, seed)
     vertices = unit * a
-    inv2 = 1.0 / a**2
-    hessian = np.zeros((vertices.shape[0], 6))
-    hessian[:, :3] = 2 * inv2
-    k_min, k_max, dir_min, dir_max, normals = _implicit(vertices, 2 * vertices * inv2, hessian)
-    return _make(f"random_ellipsoid{tuple(a.tolist())}", vertices, faces, k_min, k_max, dir_min, dir_max, normals)
+    return _make(f"random_ellipsoid{tuple(a.tolist())}", vertices, faces, *_ellipsoid_exact(vertices, a))
 
 
 def hemisphere(subdivisions: int = 16, radius: float = 1.0, *, irregular: bool = False, seed: int = 0) -> AnalyticMesh:
@@ -625,12 +629,8 @@ def voxel_ellipsoid(semi_axes=(10.0, 7.0, 5.0), spacing=(1.0, 1.0, 1.0), *, seed
         lambda x, y, z: x * x * inv2[0] + y * y * inv2[1] + z * z * inv2[2] <= 1, a, s, seed, "voxel_ellipsoid"
     )
     local = ellipsoid_closest_points(vertices - center, a)
-    hessian = np.zeros((local.shape[0], 6))
-    hessian[:, :3] = 2 * inv2
-    k_min, k_max, dir_min, dir_max, normals = _implicit(local, 2 * local * inv2, hessian)
     name = f"voxel_ellipsoid{tuple(a.tolist())}, voxel {_spacing_label(s)}"
-    exact = (k_min, k_max, dir_min, dir_max, normals)
-    return _voxel_mesh(name, vertices, faces, center, s, center + local, *exact)
+    return _voxel_mesh(name, vertices, faces, center, s, center + local, *_ellipsoid_exact(local, a))
 
 
 def voxel_torus(
