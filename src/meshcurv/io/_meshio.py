@@ -14,7 +14,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError, optional_module
-from ._text import first_bad_line, line_of, line_of_match, numbers_per_line, row_error
+from ._text import line_of, line_of_match, not_a_number, numbers_per_line, row_error
 
 __all__ = ["read_with_meshio", "write_with_meshio"]
 
@@ -81,11 +81,7 @@ def read_ascii_stl(path, data: bytes):
         rows = pattern.findall(data)
         parsed = numbers_per_line(rows)
         if parsed is None:
-            index, word = first_bad_line(b"\n".join(rows))
-            raise MeshFileError(
-                f"{path}: line {line_of_match(data, pattern, index)}: "
-                f"{word[:30].decode('utf-8', 'replace')!r} is not a number ({what})"
-            )
+            raise not_a_number(path, b"\n".join(rows), lambda i: line_of_match(data, pattern, i), what)
         wrong = parsed[1] != 3
         if wrong.any():
             index = int(np.argmax(wrong))

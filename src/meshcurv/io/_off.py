@@ -11,7 +11,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import first_bad_line, numbers_per_line, row_error
+from ._text import not_a_number, numbers_per_line, row_error
 
 __all__ = ["read_off", "write_off"]
 
@@ -50,11 +50,7 @@ def read_off(path):
 
     parsed = numbers_per_line(body[:n_vertices])
     if parsed is None:
-        index, word = first_bad_line(b"\n".join(body[:n_vertices]))
-        raise MeshFileError(
-            f"{path}: line {line(index)}: {word[:30].decode('utf-8', 'replace')!r} is not a "
-            "number (a vertex coordinate)"
-        )
+        raise not_a_number(path, b"\n".join(body[:n_vertices]), line, "a vertex coordinate")
     values, counts = parsed
     if (counts < 3).any():
         row = int(np.flatnonzero(counts < 3)[0])
@@ -69,10 +65,8 @@ def read_off(path):
     vertices = values[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
     parsed = numbers_per_line(body[n_vertices : n_vertices + n_faces])
     if parsed is None:
-        index, word = first_bad_line(b"\n".join(body[n_vertices : n_vertices + n_faces]))
-        raise MeshFileError(
-            f"{path}: line {line(n_vertices + index)}: {word[:30].decode('utf-8', 'replace')!r} "
-            "is not a number (a face)"
+        raise not_a_number(
+            path, b"\n".join(body[n_vertices : n_vertices + n_faces]), lambda j: line(n_vertices + j), "a face"
         )
     values, counts = parsed
     first = np.cumsum(counts) - counts

@@ -110,14 +110,19 @@ def line_of_match(data: bytes, pattern, index: int) -> int:
     return next(line_of(data, m.start()) for i, m in enumerate(pattern.finditer(data)) if i == index)
 
 
-def not_a_number(path, text: bytes, first_line: int, what: str = "") -> MeshFileError:
-    """The error for a word of ``text`` (which starts at line ``first_line`` of the file) that is not a number."""
+def not_a_number(path, text: bytes, first_line, what: str = "") -> MeshFileError:
+    """The error for a word of ``text`` that is not a number, naming its line.
+
+    ``first_line`` is the file's line number of the first line of ``text``,
+    or a function from a line index of ``text`` (0-based) to the file's line
+    number (when ``text`` is lines picked from the file).
+    """
     index, word = first_bad_line(text)
     tail = f" ({what})" if what else ""
     if index < 0:
         return MeshFileError(f"{path}: something is not a number{tail}")
-    shown = word[:30].decode("utf-8", "replace")
-    return MeshFileError(f"{path}: line {first_line + index}: {shown!r} is not a number{tail}")
+    line = first_line(index) if callable(first_line) else first_line + index
+    return MeshFileError(f"{path}: line {line}: {word[:30].decode('utf-8', 'replace')!r} is not a number{tail}")
 
 
 def row_error(path, line: int, found: int, expected, meaning: str = "") -> MeshFileError:
