@@ -385,8 +385,8 @@ _ARRAY_FIELDS = ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid")
 
 def _keepable(array: np.ndarray, name: str) -> bool:
     dtype = np.bool_ if name == "valid" else np.float64
-    # owning its data, or over a buffer a compiled kernel allocated for it (a numba MemInfo): 0.16 s of copies
-    # per call at a million vertices otherwise
+    # owning its data, or over a buffer a compiled kernel allocated for it (a numba MemInfo): kept without a
+    # copy (what a copy costs: benchmarks/docstring_figures.md)
     sole = array.flags.owndata or type(array.base).__name__ == "_MemInfo"
     return array.dtype == dtype and sole and array.flags.c_contiguous
 

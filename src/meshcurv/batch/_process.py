@@ -134,7 +134,8 @@ def process_mesh(
     try:
         if run_id is not None:
             deadline = time.time() + timeout if timeout is not None else None
-            # a plain write (no temporary, no sync: 0.1 ms, not 5): a note cut short reads as no note
+            # a plain write, no temporary nor sync (cost: benchmarks/docstring_figures.md): a note cut short reads
+            # as no note
             attempt.parent.mkdir(parents=True, exist_ok=True)
             attempt.write_text(json.dumps({"run": run_id, "deaths": deaths, "deadline": deadline}))
         with _time_limit(timeout), warnings.catch_warnings(record=True) as caught:
