@@ -9,7 +9,25 @@ import secrets
 
 from ..errors import MeshFileError
 
-__all__ = ["check_output", "atomic_output", "check_input", "format_key"]
+__all__ = ["check_output", "atomic_output", "check_input", "format_key", "read_as"]
+
+
+@contextlib.contextmanager
+def read_as(path, kind: str, *, passes: tuple = (MeshFileError,)):
+    """A block that reads ``path``: what it raises becomes one :class:`MeshFileError` naming the file.
+
+    "``path``: cannot be read as ``kind`` (the first line of the error, at
+    most 200 characters, or its type)"; the exceptions of ``passes`` (a
+    :class:`MeshFileError` already naming the file) go through as they are.
+    """
+    try:
+        yield
+    except passes:
+        raise
+    except Exception as exc:
+        text = str(exc).strip()
+        reason = text.splitlines()[0][:200] if text else type(exc).__name__
+        raise MeshFileError(f"{path}: cannot be read as {kind} ({reason})") from exc
 
 
 def check_input(path) -> pathlib.Path:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ..errors import MeshFileError, optional_module
-from ._files import check_input
+from ._files import check_input, read_as
 from ._mrc import MRC_UNIT, read_mrc
 from ._zarr import read_zarr
 
@@ -103,22 +103,14 @@ def _npy_header(handle, path, where: str = ""):
 
 
 def _npy(path):
-    try:
-        with open(path, "rb") as handle:
-            _npy_header(handle, path)
-    except MeshFileError:
-        raise
-    except Exception as exc:
-        raise MeshFileError(f"{path}: cannot be read as .npy ({_reason(exc)})") from exc
-    try:
-        array = np.load(path, mmap_mode="r", allow_pickle=False)  # a file shorter than its header says fails here
-    except Exception as exc:
-        raise MeshFileError(f"{path}: cannot be read as .npy ({_reason(exc)})") from exc
-    return array, None
+    with read_as(path, ".npy"), open(path, "rb") as handle:
+        _npy_header(handle, path)
+    with read_as(path, ".npy", passes=()):
+        return np.load(path, mmap_mode="r", allow_pickle=False), None  # a file shorter than its header says fails
 
 
 def _npz(path):
-    try:
+    with read_as(path, ".npz"):
         with zipfile.ZipFile(path) as archive:
             members = {
                 info.filename[:-4] if info.filename.endswith(".npy") else info.filename: info
@@ -147,27 +139,16 @@ def _npz(path):
                 )
         with np.load(path, allow_pickle=False) as archive:
             return archive[name], None
-    except MeshFileError:
-        raise
-    except Exception as exc:
-        raise MeshFileError(f"{path}: cannot be read as .npz ({_reason(exc)})") from exc
 
 
 def _tiff(path):
     tifffile = optional_module("tifffile", "reading TIFF images needs tifffile: pip install 'meshcurv[volume]'")
-    try:
-        with tifffile.TiffFile(path) as tif:
-            if not tif.series:
-                raise MeshFileError(f"{path}: the TIFF file holds no image")
-            series = tif.series[0]
-            _check_size(path, series.shape, series.dtype)
-            array = series.asarray()
-            spacing = _tiff_spacing(tif, series)
-    except MeshFileError:
-        raise
-    except Exception as exc:
-        raise MeshFileError(f"{path}: cannot be read as TIFF ({_reason(exc)})") from exc
-    return array, spacing
+    with read_as(path, "TIFF"), tifffile.TiffFile(path) as tif:
+        if not tif.series:
+            raise MeshFileError(f"{path}: the TIFF file holds no image")
+        series = tif.series[0]
+        _check_size(path, series.shape, series.dtype)
+        return series.asarray(), _tiff_spacing(tif, series)
 
 
 def _tiff_spacing(tif, series):
@@ -188,34 +169,20 @@ def _tiff_spacing(tif, series):
 
 def _nifti(path):
     nibabel = optional_module("nibabel", "reading NIfTI images needs nibabel: pip install 'meshcurv[volume]'")
-    try:
+    with read_as(path, "NIfTI"):
         image = nibabel.load(str(path))  # .nii, .nii.gz: a Nifti1Image or Nifti2Image
-        shape = image.shape
-        _check_size(path, shape, image.get_data_dtype())
+        _check_size(path, image.shape, image.get_data_dtype())
         array = np.asanyarray(image.dataobj)
         zooms = [float(z) for z in image.header.get_zooms()[:3]]
-    except MeshFileError:
-        raise
-    except Exception as exc:
-        raise MeshFileError(f"{path}: cannot be read as NIfTI ({_reason(exc)})") from exc
     array = _check_3d(path, np.asarray(array))
     # NIfTI's array axes are (i, j, k), x fastest on disk: turned to (k, j, i) = (z, y, x), a view
     spacing = tuple(zooms[::-1]) if len(zooms) == 3 and all(np.isfinite(z) and z > 0 for z in zooms) else None
     return array.transpose(2, 1, 0), spacing
 
 
-def _reason(exc: BaseException) -> str:
-    text = str(exc).strip()
-    return text.splitlines()[0][:200] if text else type(exc).__name__
-
-
 def _mrc(path):
-    try:
+    with read_as(path, "MRC"):
         return read_mrc(path, _check_size)
-    except MeshFileError:
-        raise
-    except Exception as exc:
-        raise MeshFileError(f"{path}: cannot be read as MRC ({_reason(exc)})") from exc
 
 
 _FILES = ((".tif .tiff", _tiff), (".npy", _npy), (".npz", _npz), (".nii .nii.gz", _nifti), (".mrc .rec .map", _mrc))

@@ -7,6 +7,7 @@ import zipfile
 import numpy as np
 
 from ..errors import MeshFileError
+from ._files import read_as
 
 __all__ = ["flat_columns", "write_csv", "write_npz", "read_npz"]
 
@@ -90,19 +91,14 @@ def npz_arrays(path, keep) -> tuple[dict, list[str]]:
     Members are checked before numpy allocates them (:func:`_check_members`);
     any zip, zlib or npy failure is one :class:`MeshFileError` naming the file.
     """
-    try:
-        with open(path, "rb") as handle:
-            with zipfile.ZipFile(handle) as archive:
-                _check_members(path, archive)
-            handle.seek(0)
-            with np.load(handle, allow_pickle=False) as archive:
-                names = sorted(archive.files)
-                return {name: archive[name] for name in names if keep(name)}, names
-    except (MeshFileError, MemoryError):
-        raise
-    except Exception as exc:  # zip, zlib, npy header, tokenizer errors: all one kind for the caller
-        reason = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else type(exc).__name__
-        raise MeshFileError(f"{path}: cannot be read as NPZ ({reason})") from exc
+    # zip, zlib, npy header, tokenizer errors: all one kind for the caller
+    with read_as(path, "NPZ", passes=(MeshFileError, MemoryError)), open(path, "rb") as handle:
+        with zipfile.ZipFile(handle) as archive:
+            _check_members(path, archive)
+        handle.seek(0)
+        with np.load(handle, allow_pickle=False) as archive:
+            names = sorted(archive.files)
+            return {name: archive[name] for name in names if keep(name)}, names
 
 
 def read_npz(path):
