@@ -297,6 +297,23 @@ def test_progress_only_when_asked_or_on_a_terminal(capsys, torus_file, monkeypat
     assert err == ""
 
 
+def test_failures_are_listed_ten_at_most_and_the_rest_counted(capsys):
+    # batch (meshes) and volume (labels) list their failures through the one helper
+    from meshcurv.cli._common import report_failures
+
+    names = [f"label {n}" for n in range(1, 13)]
+    report_failures(names, [f"error {n}" for n in range(1, 13)], "the table")
+    out, err = capsys.readouterr()
+    lines = err.splitlines()
+    assert out == "" and len(lines) == 11
+    assert lines[0] == "meshcurv: failed: label 1: error 1" and lines[9] == "meshcurv: failed: label 10: error 10"
+    assert lines[10] == "meshcurv: ... and 2 more (see the table)"
+    report_failures(names[:3], ["a", "b", "c"], "the summary")
+    assert capsys.readouterr().err.splitlines() == [
+        f"meshcurv: failed: label {n}: {e}" for n, e in zip((1, 2, 3), "abc")
+    ]
+
+
 # ---------------------------------------------------------------- plot, demo
 
 
