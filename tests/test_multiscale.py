@@ -63,6 +63,59 @@ def test_each_scale_equals_the_single_call(name, method):
         np.testing.assert_allclose(result.normals, single.normals, rtol=0, atol=1e-12)
 
 
+# ---------------------------------------------------------------- the normal fits of every radius in one walk
+
+
+def _jet_options():
+    from meshcurv.jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE
+
+    return {"degree": 3, "iterations": 2, "settled": SETTLED_SLOPE, "min_spread": NORMAL_MIN_SPREAD}
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+@pytest.mark.parametrize("name", sorted(_meshes()))
+def test_nested_fits_equal_the_fits_of_each_radius(name, backend):
+    # one walk per vertex for three nested balls (the compiled kernel): the same points in each ball as the
+    # walk of that radius alone, so the same normals up to the order of the moments' sums (round-off)
+    from meshcurv._backend import use_backend
+    from meshcurv.jets import fit_jet_normals
+    from meshcurv.neighborhoods import nested_jet_normals
+
+    if backend == "numba":
+        pytest.importorskip("numba")
+    vertices, faces = _meshes()[name]
+    topology = meshcurv.MeshTopology.from_faces(faces)
+    h = meshcurv.geometry.mean_edge_length(vertices, topology.edges)
+    normals = meshcurv.geometry.vertex_normals(vertices, faces)
+    allowed = np.ones(vertices.shape[0], dtype=bool)
+    allowed[::7] = False  # some vertices kept out of every ball
+    radii = [0.9 * h, 3.0 * h, 6.0 * h]  # the smallest holds too few points at some vertices: NaN there
+    with use_backend(backend):
+        got = nested_jet_normals(
+            vertices, normals, radii, adjacency=topology.neighbour_lists, neighbours=allowed, **_jet_options()
+        )
+        for radius, fitted in zip(radii, got):
+            alone = fit_jet_normals(
+                vertices, normals, radius, adjacency=topology.neighbour_lists, neighbours=allowed, **_jet_options()
+            )
+            np.testing.assert_array_equal(np.isnan(fitted), np.isnan(alone))
+            np.testing.assert_allclose(fitted, alone, rtol=0, atol=1e-12)
+    assert np.isnan(got[0]).sum() > np.isnan(got[2]).sum()  # the smallest balls: too few points at some vertices
+
+
+@pytest.mark.parametrize(
+    "radii, message",
+    [([], "non-empty sequence"), ([1.0, float("inf")], "positive finite"), ([2.0, 1.0], "must not decrease")],
+)
+def test_nested_fits_refuse_bad_radii(radii, message):
+    from meshcurv.neighborhoods import nested_jet_normals
+
+    torus = shapes.torus()
+    adjacency = meshcurv.MeshTopology.from_faces(torus.faces).neighbour_lists
+    with pytest.raises(InvalidOptionError, match=message):
+        nested_jet_normals(torus.vertices, torus.vertices, radii, adjacency=adjacency, **_jet_options())
+
+
 def test_scales_tell_noise_from_shape():
     # a noisy unit sphere: the smallest ball sees the noise, the larger ones the sphere (H = 1)
     noisy = shapes.with_normal_noise(shapes.icosphere(16), 0.3, seed=1)

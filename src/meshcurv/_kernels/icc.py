@@ -10,6 +10,8 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, run_chunks, threaded
+from .jets import _fit_one, _general, _jet_outputs, _jet_scratch
+from .neighborhoods import _connected_walk_nested
 from .tensors import _principal_from_mean_gaussian, _tangent_eigen
 
 
@@ -111,3 +113,137 @@ def _curvatures_chunk(lo, hi, summed, normals, k_min, k_max, dir_min, dir_max):
         )
         dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
         dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5
+
+
+@threaded
+def nested_jet_normals(
+    vertices,
+    normals,
+    radii,
+    degree,
+    iterations,
+    exponents,
+    min_spread,
+    centres,
+    n_chunks,
+    allowed,
+    indptr,
+    indices,
+    settled,
+):
+    """(R, M, 3) unit normals of the jets of ``jets.fit_jet_normals`` at R non-decreasing ``radii`` around
+    ``centres`` (M,), one walk per centre for all of them (``icc.estimate_multiscale``'s fits).
+
+    Row ``r`` is ``kernels.jets.fit_jets_connected(..., normals_only=True)`` at ``radii[r]`` (the same
+    points, frames and checks, no areas): each centre's balls are walked once, in passes
+    (:func:`~meshcurv._kernels.neighborhoods._connected_walk_nested`), and each fit takes the vertices
+    queued by its pass within its radius (``allowed`` ones). Ball 0 holds its points in the order of the
+    single walk (the same numbers); a larger ball holds them in the order of the passes (the same points,
+    moments summed in another order: round-off). NaN where no jet could be fitted. The centres run in
+    ``n_chunks`` ranges (:func:`_nested_fits_chunk`) on threads.
+    """
+    fitted = np.full((radii.shape[0], centres.shape[0], 3), np.nan)
+    limits = np.array([1.0, settled])  # no facing check: the away fraction is not read
+    run_chunks(
+        _nested_fits_chunk,
+        centres.shape[0],
+        n_chunks,
+        vertices,
+        normals,
+        radii,
+        degree,
+        iterations,
+        exponents,
+        min_spread,
+        centres,
+        allowed,
+        indptr,
+        indices,
+        limits,
+        fitted,
+        _general(degree),
+    )
+    return fitted
+
+
+@nb.njit(**_JIT)
+def _nested_fits_chunk(
+    lo,
+    hi,
+    vertices,
+    normals,
+    radii,
+    degree,
+    iterations,
+    exponents,
+    min_spread,
+    centres,
+    allowed,
+    indptr,
+    indices,
+    limits,
+    fitted,
+    general,
+):
+    """The fits of ``centres[lo:hi]`` of :func:`nested_jet_normals`, written to their columns of ``fitted``."""
+    n = vertices.shape[0]
+    n_radii = radii.shape[0]
+    mark = np.full(n, -1, np.int64)
+    members = np.empty(n, np.int64)
+    queue = np.empty(n, np.int64)  # a vertex is queued at most once per centre: never grown
+    squared = np.empty(n)
+    deferred = np.empty((2, indices.shape[0]), np.int64)  # an edge is left out at most once per centre
+    ends = np.empty(n_radii, np.int64)
+    cutoffs2 = radii * radii
+    ids = np.arange(n)
+    facing = np.empty((0, 3))  # no facing check
+    areas = np.empty(0)  # unweighted
+    work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
+    c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row, rewritten for each fit
+    for i in range(lo, hi):
+        v = centres[i]
+        _connected_walk_nested(vertices, indptr, indices, v, cutoffs2, mark, queue, squared, deferred, ends)
+        for r in range(n_radii):
+            size = 0
+            for j in range(ends[r]):  # the vertices queued by pass r inside ball r: its members
+                if squared[j] <= cutoffs2[r] and allowed[queue[j]]:
+                    members[size] = queue[j]
+                    size += 1
+            c[0, :] = np.nan
+            # one call site (the fit is inlined): numba refuses *args there, hence the whole list
+            work = _fit_one(
+                vertices,
+                vertices,
+                normals,
+                radii[r],
+                degree,
+                iterations,
+                exponents,
+                min_spread,
+                v,
+                0,
+                members,
+                size,
+                work,
+                moments,
+                right,
+                matrix,
+                low,
+                scale,
+                solution,
+                c,
+                a,
+                b,
+                nn,
+                one_count,
+                ids,
+                facing,
+                limits,
+                one_away,
+                areas,
+                general,
+            )
+            p, q = c[0, 1], c[0, 2]
+            width = np.sqrt(1 + p * p + q * q)
+            for k in range(3):
+                fitted[r, i, k] = (nn[0, k] - p * a[0, k] - q * b[0, k]) / width

@@ -265,6 +265,71 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, stam
     return size
 
 
+@nb.njit(**_JIT)
+def _connected_walk_nested(vertices, indptr, indices, v, cutoffs2, mark, queue, squared, deferred, ends):
+    """The surface-connected pieces of the nested balls ``B(x_v, sqrt(cutoffs2[r]))`` in one walk, in passes.
+
+    Pass ``r`` walks breadth-first from ``v`` over the edges ``indptr, indices`` (CSR) that meet ball ``r``
+    (an end inside, or the segment passing through it), as :func:`_connected_members`; the edges it leaves
+    out are kept in ``deferred`` (2, 2E: the ends each edge leads from and to) and tried again by the next,
+    larger ball, whose pass goes on from the vertices they reach. The vertices queued by the end of pass
+    ``r`` are ``queue[:ends[r]]`` (``squared``: their squared distances to ``x_v``, in the same order):
+    exactly the vertices :func:`_connected_members` queues for ball ``r`` alone (the closure of ``v`` over
+    the edges that meet it), so the members of ball ``r`` are those of them within its radius. Pass 0
+    is that walk itself, in the same order. ``mark`` (V,): stamped with ``v`` (one walk per centre: no
+    clearing). ``cutoffs2`` (R,): the squared radii, non-decreasing.
+    """
+    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+    mark[v] = v
+    queue[0] = v
+    squared[0] = 0.0
+    head, tail = 0, 1
+    n_deferred = 0
+    for r in range(cutoffs2.shape[0]):
+        cutoff2 = cutoffs2[r]
+        kept = 0
+        for e in range(n_deferred):  # the edges the smaller balls left out: this ball may meet them
+            a, b = deferred[0, e], deferred[1, e]
+            if mark[b] == v:
+                continue  # queued since, over another edge
+            ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
+            bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
+            b2 = bx * bx + by * by + bz * bz
+            if (
+                b2 <= cutoff2
+                or ax * ax + ay * ay + az * az <= cutoff2
+                or _segment_meets_ball(ax, ay, az, bx, by, bz, cutoff2)
+            ):
+                mark[b] = v
+                queue[tail] = b
+                squared[tail] = b2
+                tail += 1
+            else:
+                deferred[0, kept], deferred[1, kept] = a, b
+                kept += 1
+        n_deferred = kept
+        while head < tail:
+            a = queue[head]
+            a2 = squared[head]
+            head += 1
+            ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
+            for j in range(indptr[a], indptr[a + 1]):
+                b = indices[j]
+                if mark[b] == v:
+                    continue
+                bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
+                b2 = bx * bx + by * by + bz * bz
+                if not b2 <= cutoff2 and not a2 <= cutoff2 and not _segment_meets_ball(ax, ay, az, bx, by, bz, cutoff2):
+                    deferred[0, n_deferred], deferred[1, n_deferred] = a, b  # each (a, b) once: a is queued once
+                    n_deferred += 1
+                    continue
+                mark[b] = v
+                queue[tail] = b
+                squared[tail] = b2
+                tail += 1
+        ends[r] = tail
+
+
 @nb.njit(inline="always", **_JIT)
 def _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared):
     """The smallest and largest squared distance from ``(cx, cy, cz)`` to the corners of face ``f``
