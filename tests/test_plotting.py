@@ -74,6 +74,10 @@ def test_fixed_limits_and_colour_map():
         ({"limits": (0.0, np.inf)}, "`limits` must be finite with low < high"),
         ({"limits": "wide"}, "`limits` must be"),
         ({"dpi": 5}, "`dpi` must be an integer between 10 and 1200; got 5"),
+        # checked as the viewer checks them, not numpy's ValueError nor a silent swap
+        ({"percentiles": (2, 101)}, r"`percentiles` must satisfy 0 <= low < high <= 100; got \(2, 101\)"),
+        ({"percentiles": (98, 2)}, "`percentiles` must satisfy 0 <= low < high <= 100"),
+        ({"percentiles": (2,)}, r"`percentiles` must be two numbers \(low, high\); got \(2,\)"),
     ],
 )
 def test_errors(options, message):

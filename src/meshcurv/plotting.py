@@ -284,6 +284,17 @@ def _colour_limits(values, percentiles, limits=None):
     return float(low), float(high), signed
 
 
+def check_percentiles(percentiles) -> tuple[float, float]:
+    """``percentiles`` as ``(low, high)`` floats with ``0 <= low < high <= 100``, or an InvalidOptionError."""
+    try:
+        low, high = (float(value) for value in percentiles)
+    except (TypeError, ValueError):
+        raise InvalidOptionError(f"`percentiles` must be two numbers (low, high); got {percentiles!r}") from None
+    if not 0 <= low < high <= 100:
+        raise InvalidOptionError(f"`percentiles` must satisfy 0 <= low < high <= 100; got {percentiles!r}")
+    return low, high
+
+
 def _check_limits(limits):
     if limits is None:
         return None
@@ -467,6 +478,7 @@ def plot_field(
     if pixels is not None:
         pixels = _check_pixels(pixels)
     limits = _check_limits(limits)
+    percentiles = check_percentiles(percentiles)
     if up is None:
         up, _ = choose_up(points)
     if up not in _UP:

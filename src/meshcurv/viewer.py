@@ -42,7 +42,7 @@ from .curvature import principal_curvatures
 from .errors import InvalidMeshError, InvalidOptionError, MeshFileError
 from .io._files import atomic_output, check_output
 from .io.fields import FIELDS
-from .plotting import choose_up
+from .plotting import check_percentiles, choose_up
 from .pointcloud import point_cloud_curvatures
 from .result import INVALID_REASONS, CurvatureResult
 
@@ -162,7 +162,7 @@ def write_html(
         up, why = choose_up(checked_points(vertices))
         logger.info("viewer: up axis %s (%s)", up, why)
     up = check_choice(up, "up", _UPS)
-    percentiles = _check_percentiles(percentiles)
+    percentiles = check_percentiles(percentiles)
     max_directions = _check_count(max_directions, "max_directions")
     angles = [_check_angle(value, name) for value, name in ((elevation, "elevation"), (azimuth, "azimuth"))]
     points = checked_points(vertices)
@@ -191,16 +191,6 @@ def _compute(points: np.ndarray, triangles: np.ndarray | None) -> CurvatureResul
     if triangles is None:
         return point_cloud_curvatures(points)
     return principal_curvatures(points, triangles)
-
-
-def _check_percentiles(percentiles) -> tuple[float, float]:
-    try:
-        low, high = (float(value) for value in percentiles)
-    except (TypeError, ValueError):
-        raise InvalidOptionError(f"`percentiles` must be two numbers (low, high); got {percentiles!r}") from None
-    if not 0 <= low < high <= 100:
-        raise InvalidOptionError(f"`percentiles` must satisfy 0 <= low < high <= 100; got {percentiles!r}")
-    return low, high
 
 
 def _check_count(value, name: str) -> int:
