@@ -187,3 +187,29 @@ def test_voxel_shapes_name_the_extra_without_scikit_image(monkeypatch):
     monkeypatch.setitem(sys.modules, "skimage", None)
     with pytest.raises(ImportError, match=r"pip install 'meshcurv\[volume\]'"):
         shapes.voxel_sphere(5.0)
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda: shapes.torus(n_major=0), r"`n_major` must be an integer >= 3; got 0"),
+        (lambda: shapes.torus(n_minor=2.5), r"`n_minor` must be an integer >= 3; got 2.5"),
+        (lambda: shapes.torus(0, 0), r"`major_radius` must be a positive finite number; got 0"),
+        (lambda: shapes.uv_sphere(8, 1), r"`n_latitude` must be an integer >= 2; got 1"),
+        (lambda: shapes.uv_sphere(0, 4), r"`n_longitude` must be an integer >= 3; got 0"),
+        (lambda: shapes.uv_sphere(radius=0), r"`radius` must be a positive finite number; got 0"),
+        (lambda: shapes.icosphere(2, radius=-1), r"`radius` must be a positive finite number; got -1"),
+        (lambda: shapes.cylinder(n_around=0), r"`n_around` must be an integer >= 3; got 0"),
+        (lambda: shapes.cylinder(height=np.inf), r"`height` must be a positive finite number; got inf"),
+        (lambda: shapes.saddle(spacing=0), r"`spacing` must be a positive finite number; got 0"),
+        (lambda: shapes.saddle(half_width=np.nan), r"`half_width` must be a positive finite number; got nan"),
+        (lambda: shapes.saddle(half_width=1.0, spacing=5.0), r"`spacing` must be below 4 times `half_width`"),
+        (lambda: shapes.ellipsoid((1.0, 2.0)), r"`semi_axes` must be 3 positive number\(s\); got \(1.0, 2.0\)"),
+        (lambda: shapes.random_ellipsoid((1.0, 0.0, 1.0)), r"`semi_axes` must be 3 positive number"),
+        (lambda: shapes.random_sphere(100, 0), r"`radius` must be a positive finite number; got 0"),
+    ],
+)
+def test_shape_options_are_checked_not_numpy_errors(make, message):
+    # before: ZeroDivisionError, IndexError, numpy broadcast or RuntimeWarning, or a silently inverted sphere
+    with pytest.raises(InvalidOptionError, match=message):
+        make()

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import check_int_option
+from ._validation import check_int_option, check_positive_float
 from .errors import InvalidOptionError, optional_module
 from .geometry import mean_edge_length
 from .topology import MeshTopology
@@ -244,6 +244,7 @@ def icosphere(subdivisions: int = 16, radius: float = 1.0, center=(0.0, 0.0, 0.0
     ``subdivideMesh(createIcosahedron, n)`` projected on the sphere. Exact
     curvature ``1 / radius`` everywhere (every point is umbilic).
     """
+    radius = check_positive_float(radius, "radius")
     unit, faces = _subdivided_sphere(subdivisions)
     vertices = unit * radius + np.asarray(center, dtype=float)
     return _make(f"icosphere({subdivisions})", vertices, faces, 1 / radius, 1 / radius, np.nan, np.nan, unit)
@@ -255,6 +256,9 @@ def uv_sphere(n_longitude: int = 32, n_latitude: int = 16, radius: float = 1.0) 
     ``n_longitude * (n_latitude - 1) + 2`` vertices; triangles at the poles, split
     quads elsewhere.
     """
+    n_longitude = check_int_option(n_longitude, "n_longitude", minimum=3)
+    n_latitude = check_int_option(n_latitude, "n_latitude", minimum=2)
+    radius = check_positive_float(radius, "radius")
     theta = np.pi * np.arange(1, n_latitude) / n_latitude  # colatitude of the rings
     phi = 2 * np.pi * np.arange(n_longitude) / n_longitude
     t, p = np.meshgrid(theta, phi, indexing="ij")
@@ -302,7 +306,8 @@ def torus(
     (generator seeded with ``seed``); the exact values are those of the moved
     points.
     """
-    R, r = float(major_radius), float(minor_radius)
+    R, r = check_positive_float(major_radius, "major_radius"), check_positive_float(minor_radius, "minor_radius")
+    n_major, n_minor = check_int_option(n_major, "n_major", minimum=3), check_int_option(n_minor, "n_minor", minimum=3)
     theta = 2 * np.pi * np.arange(n_major) / n_major
     phi = 2 * np.pi * np.arange(n_minor) / n_minor
     grid = [a.ravel() for a in np.meshgrid(theta, phi, indexing="ij")]
@@ -321,7 +326,7 @@ def torus(
 
 def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh:
     """Unit icosphere scaled by ``semi_axes`` (matGeom reference ``ellipsoid_321``)."""
-    a = np.asarray(semi_axes, dtype=float)
+    a = _check_lengths(semi_axes, "semi_axes", 3)
     unit, faces = _subdivided_sphere(subdivisions)
     vertices = unit * a
     return _make(f"ellipsoid{tuple(a.tolist())}", vertices, faces, *_ellipsoid_exact(vertices, a))
@@ -341,6 +346,11 @@ def cylinder(
     Exact curvatures: ``k_max = 1 / radius`` around, ``k_min = 0`` along the axis.
     ``jitter`` and ``seed``: as for :func:`torus` (the boundary rings stay flat).
     """
+    radius, height = check_positive_float(radius, "radius"), check_positive_float(height, "height")
+    n_around, n_along = (
+        check_int_option(n_around, "n_around", minimum=3),
+        check_int_option(n_along, "n_along", minimum=1),
+    )
     phi = 2 * np.pi * np.arange(n_around) / n_around
     z = np.linspace(-height / 2, height / 2, n_along + 1)
     zz, pp = (a.ravel() for a in np.meshgrid(z, phi, indexing="ij"))
@@ -365,7 +375,10 @@ def saddle(half_width: float = 1.0, spacing: float = 0.025, *, jitter: float = 0
     along the same diagonal. ``jitter`` and ``seed``: as for :func:`torus`
     (boundary vertices move along the boundary only).
     """
+    half_width, spacing = check_positive_float(half_width, "half_width"), check_positive_float(spacing, "spacing")
     n = int(round(2 * half_width / spacing)) + 1
+    if n < 2:
+        raise InvalidOptionError(f"`spacing` must be below 4 times `half_width` (one grid square); got {spacing!r}")
     x = np.linspace(-half_width, half_width, n)
     yy, xx = (a.ravel() for a in np.meshgrid(x, x, indexing="ij"))
     step = x[1] - x[0] if n > 1 else 0.0
@@ -406,6 +419,7 @@ def random_sphere(n_vertices: int = 2562, radius: float = 1.0, *, seed: int = 0)
     outward. Valences and angles vary freely (slivers included), the test that
     1-ring estimators fail. Exact curvature ``1 / radius``.
     """
+    radius = check_positive_float(radius, "radius")
     unit, faces = _random_unit_sphere(n_vertices, seed)
     return _make(
         f"random_sphere({n_vertices}, seed {seed})", unit * radius, faces, 1 / radius, 1 / radius, np.nan, np.nan, unit
@@ -414,7 +428,7 @@ def random_sphere(n_vertices: int = 2562, radius: float = 1.0, *, seed: int = 0)
 
 def random_ellipsoid(semi_axes=(3.0, 2.0, 1.0), n_vertices: int = 2562, *, seed: int = 0) -> AnalyticMesh:
     """:func:`random_sphere` (unit radius) scaled by ``semi_axes``: an irregular ellipsoid mesh."""
-    a = np.asarray(semi_axes, dtype=float)
+    a = _check_lengths(semi_axes, "semi_axes", 3)
     unit, faces = _random_unit_sphere(n_vertices, seed)
     vertices = unit * a
     return _make(f"random_ellipsoid{tuple(a.tolist())}", vertices, faces, *_ellipsoid_exact(vertices, a))
