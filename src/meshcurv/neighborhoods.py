@@ -118,9 +118,11 @@ def estimate_ball_pairs(points: np.ndarray, radius, centres: np.ndarray | None =
 def _pairs_within(points: np.ndarray, sub: np.ndarray, probe: np.ndarray, radius, n_mean: int) -> tuple[float, float]:
     """:func:`estimate_ball_pairs` from the sample ``sub`` of ``points`` and the centres ``probe``: the mean
     over the first ``n_mean`` centres, the largest over all (``radius``: a number, or a column per centre)."""
-    origin = probe.mean(axis=0)  # |p - c|^2 = |p|^2 + |c|^2 - 2 p.c about a nearby origin: one small product
+    origin = probe.mean(axis=0)  # |p - c|^2 = |p|^2 + |c|^2 - 2 p.c about a nearby origin
     sub, probe = sub - origin, probe - origin
-    d2 = np.einsum("ij,ij->i", probe, probe)[:, None] + np.einsum("ij,ij->i", sub, sub)[None, :] - 2.0 * (probe @ sub.T)
+    d2 = np.einsum("ij,ij->i", probe, probe)[:, None] + np.einsum("ij,ij->i", sub, sub)[None, :]
+    for axis in range(3):  # p.c axis by axis: a BLAS product of inner size 3 cost 5 times more CPU (16 ms for 10k)
+        d2 -= 2.0 * np.multiply.outer(probe[:, axis], sub[:, axis])
     inside = (d2 <= radius * radius).sum(axis=1) * (points.shape[0] / sub.shape[0])
     return float(inside[:n_mean].mean()), float(inside.max())
 
