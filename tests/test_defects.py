@@ -268,6 +268,85 @@ def test_normal_cycle_ball_leaves_a_ball_without_a_neighbour_undefined():
     assert meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball").valid.all()
 
 
+def _random_sphere_at(edges: float):
+    """The 200-point random unit sphere and a radius of ``edges`` mean edge lengths."""
+    sphere = shapes.random_sphere(n_vertices=200)
+    topology = MeshTopology.from_faces(sphere.faces)
+    lengths = np.linalg.norm(sphere.vertices[topology.edges[:, 0]] - sphere.vertices[topology.edges[:, 1]], axis=1)
+    return sphere, edges * float(lengths.mean())
+
+
+@pytest.mark.parametrize("edges", [0.07, 0.15, 0.25, 0.35, 0.5])
+def test_icc_at_a_tiny_radius_gives_no_valid_wrong_number(edges):
+    # issue 29: at 0.07 edge lengths (radius 0.02) every vertex was valid and 25 of 200 were off by more than
+    # half the curvature (the normal fits over three radii held too few points: only the mean of the face
+    # normals was left, whose error of order one edge is the whole curvature). Where a fit failed, at the
+    # vertex or a corner of its faces, the vertex is undefined; the rest are within half of H = 1
+    sphere, radius = _random_sphere_at(edges)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="icc", radius=radius)
+    assert np.all(np.abs(result.mean[result.valid] - 1.0) < 0.5)
+    reasons = np.array(INVALID_REASONS)[result.invalid_reason[~result.valid]]
+    assert (reasons == INVALID_REASONS[UNDEFINED]).all()
+    if edges < 0.2:  # no fit anywhere: nothing is left
+        assert not result.valid.any()
+
+
+def test_failed_fits_leave_a_vertex_undefined_only_in_a_ball_inside_its_star():
+    from meshcurv.estimators._support import ball_holds_neighbours, failed_fits_undefined
+
+    # a closed pyramid over a square: apex 4, base centre 5; spokes of 1 (base) and sqrt(2) (apex)
+    vertices, faces, _ = _pyramid(4, 1.0)
+    failed = np.zeros(6, dtype=bool)
+    failed[4] = True  # the apex's fit failed: it and the corners of its faces (the base ring) are near it
+    np.testing.assert_array_equal(
+        failed_fits_undefined(vertices, faces, 0.5, failed), [True, True, True, True, True, False]
+    )
+    # a ball of 1.5 holds every neighbour of the apex (1.41) and of the centre (1), not those of the ring
+    # (sides of 1.41, spokes of 1.41 to the apex): 1.5 > 1.41, so every ball holds its whole star
+    assert ball_holds_neighbours(vertices, faces, 1.5, every=True).all()
+    assert not failed_fits_undefined(vertices, faces, 1.5, failed).any()
+    assert not failed_fits_undefined(vertices, faces, 0.5, np.zeros(6, dtype=bool)).any()
+    # one neighbour is enough without ``every``: the base ring's spokes to the centre are 1
+    np.testing.assert_array_equal(ball_holds_neighbours(vertices, faces, 1.2), [True] * 4 + [False, True])
+
+
+def test_icc_at_its_default_and_at_one_edge_keeps_every_vertex():
+    sphere, radius = _random_sphere_at(1.0)
+    for given in (None, radius):
+        result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="icc", radius=given)
+        assert result.valid.all()
+
+
+def test_icc_multiscale_at_a_tiny_radius_gives_no_valid_wrong_number():
+    sphere, radius = _random_sphere_at(1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        tiny, one = meshcurv.multiscale_curvatures(
+            sphere.vertices, sphere.faces, method="icc", radii=[0.07 * radius, radius]
+        )
+    assert not tiny.valid.any() and one.valid.all()
+
+
+@pytest.mark.parametrize("method", ["icc", "normal_cycle_ball", "quadric"])
+@pytest.mark.parametrize("distance", [5.0, 30.0, 999.0])
+def test_a_spike_leaves_the_default_radius_as_it_was(method, distance):
+    # issue 29: a vertex flung 30 radii out of a hemisphere raised the default radius 2.6 times (its edges,
+    # short of the 1000 median edges the robust mean leaves out, counted in the mean edge length), and
+    # quadric then lost 98% of its vertices. The needle's edges measure nothing now: the radius is that of
+    # the mesh without the spike (within 1%: the mean over the edges that remain)
+    mesh = shapes.hemisphere(subdivisions=4)
+    clean = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method=method)
+    vertices = mesh.vertices.copy()
+    vertices[5] *= distance
+    result, messages = _compute(vertices, mesh.faces, method)
+    assert result.parameters["radius"] == pytest.approx(clean.parameters["radius"], rel=0.01)
+    assert result.invalid_reason[5] == NEEDLE and "needle vert" in messages[0]
+    corners = np.unique(mesh.faces[(mesh.faces == 5).any(axis=1)])
+    assert result.valid.sum() >= clean.valid.sum() - len(corners)
+
+
 @pytest.mark.parametrize("name", ["icosphere", "voxel_sphere", "noisy_icosphere"])
 @pytest.mark.parametrize("factor", [1.0, 1e3, 1e40])
 def test_needle_vertices_are_the_same_on_both_backends(name, factor):

@@ -37,6 +37,7 @@ __all__ = [
     "NEEDLE_REACH",
     "defect_codes",
     "needle_vertices",
+    "scale_edges",
 ]
 
 
@@ -103,11 +104,13 @@ BOUNDARY = 6
 NEEDLE = 7
 
 #: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the
-#: defects of meshes: the codes after theirs (8, 9, 10).
+#: defects of meshes: the codes after theirs (8, 9, 10, 11).
 POINT_CLOUD_REASONS = (
     "point cloud: side undecided (two sheets closer than the spacing, or stacked with normals the same way)",
     "point cloud: every ball held the other side of a thin part or a neighbouring part",
     "point cloud: on a line (its neighbours lie on a line with no surface around it)",
+    "point cloud: the estimate changed over a ball half the size (a rim or part sharper than the ball, "
+    "the other side of a thin part, or noise)",
 )
 
 #: The code of a vertex invalid for no defect of the mesh: its estimate itself is undefined.
@@ -253,6 +256,32 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
         covered[owner[alone, k]] = True
     flung = reaching & covered & (angle_sums < NEEDLE_ANGLE)
     return candidates & flung[cluster]
+
+
+def scale_edges(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray:
+    """The edges that measure the mesh's scale: all but those of the needle vertices (:func:`needle_vertices`).
+
+    The default radii are multiples of the mean edge length; a spike's edges
+    (a vertex flung 30 edge lengths away, short of the 1000 median edges that
+    :func:`meshcurv.geometry.robust_mean_edge_length` leaves out) raised it 2.6
+    times on a hemisphere (issue 29).
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3), float64
+    topology : MeshTopology
+    scales : ndarray of shape (V,)
+        :func:`meshcurv.geometry.vertex_length_scales`.
+
+    Returns
+    -------
+    ndarray of shape (E', 2), int
+        ``topology.edges`` itself when the mesh has no needle vertex.
+    """
+    needles = needle_vertices(vertices, topology, scales)
+    if not needles.any():
+        return topology.edges
+    return topology.edges[~needles[topology.edges].any(axis=1)]
 
 
 def defect_codes(

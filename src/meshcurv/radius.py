@@ -130,11 +130,14 @@ def component_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[
     fitted at their own scale.
     """
     vertices = checked_points(vertices)
+    from .defects import scale_edges
+
     scales = vertex_length_scales(vertices, topology)
+    all_edges = scale_edges(vertices, topology, scales)  # no spike's edges (issue 29: a spike raised it 2.6x)
     referenced = topology.referenced_vertices
     used = scales[referenced & (scales > 0)]
     if used.size == 0 or used.min() == used.max():
-        return [(edge_radius(vertices, topology), None)]
+        return [(DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, all_edges), None)]
     level = np.full(scales.shape, np.iinfo(np.int64).min)
     positive = referenced & (scales > 0)
     level[positive] = np.round(np.log2(scales[positive])).astype(np.int64)
@@ -143,7 +146,7 @@ def component_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[
         members = np.flatnonzero(level == k)
         inside = np.zeros(scales.shape, dtype=bool)
         inside[members] = True
-        edges = topology.edges[inside[topology.edges[:, 0]]]
+        edges = all_edges[inside[all_edges[:, 0]]]
         groups.append((DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, edges), members))
     return groups
 

@@ -94,7 +94,7 @@ from ..radius import (
 )
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
-from ._support import Stages, finish
+from ._support import Stages, failed_fits_undefined, finish
 
 #: Degree of the jets whose normals the measures interpolate.
 NORMAL_DEGREE = 3
@@ -149,8 +149,12 @@ def fitted_normals(
     adjacency: tuple | None = None,
     areas: np.ndarray | None = None,
     weighted: bool = False,
+    failed: np.ndarray | None = None,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
+
+    ``failed``: a (V,) bool array set True, in place, where no jet could be fitted (too few points, or a
+    degenerate set).
 
     Only the ``neighbours`` (V,) bool vertices enter the balls (default: all;
     the estimator passes the referenced vertices). ``normals`` (the first
@@ -209,6 +213,8 @@ def fitted_normals(
         )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
+    if failed is not None:
+        failed |= valid & ~np.isfinite(fitted).all(axis=1)
     return np.where(usable[:, None], fitted, normals)
 
 
@@ -361,6 +367,7 @@ def _curvatures(
             stages.start(stage)
 
     start("fit normals")
+    failed = np.zeros(vertices.shape[0], dtype=bool)
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
@@ -373,6 +380,7 @@ def _curvatures(
             adjacency=adjacency,
             areas=areas,
             weighted=weighted,
+            failed=failed,
         )
 
     start("compute face measures")
@@ -385,7 +393,7 @@ def _curvatures(
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
-    valid = valid & np.isfinite(k_min)
+    valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, failed)
     return k_min, k_max, dir_min, dir_max, normals, valid
 
 
@@ -409,6 +417,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         for _group_radius, members in component_radii(vertices, topology):
             inside = valid if members is None else valid & np.isin(np.arange(vertices.shape[0]), members)
             edges = topology.edges if members is None else topology.edges[inside[topology.edges[:, 0]]]
+            spike = defects.needle_cells(edges) if members is None else None  # a needle's edges measure nothing
+            edges = edges if spike is None else edges[~spike]
             edge_length = robust_mean_edge_length(vertices, edges)
             level = (
                 noise_level(vertices, normals, inside, edges, neighbours=referenced, adjacency=_adjacency(topology))
@@ -539,6 +549,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     radii = [check_radius(radius, vertices, topology) for radius in radii]
     stages.start("fit normals")
     areas = _vertex_areas(mesh)
+    failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
     normals = [
         fitted_normals(
             vertices,
@@ -548,8 +559,9 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             neighbours=topology.referenced_vertices,
             adjacency=_adjacency(topology),
             areas=areas,
+            failed=failed[j],
         )
-        for radius in radii
+        for j, radius in enumerate(radii)
     ]
     stages.start("compute face measures")
     measures = np.stack([face_measures(vertices, faces, rung) for rung in normals])
@@ -567,14 +579,14 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         )
     stages.start("retrieve curvatures")
     out = []
-    for radius, rung, sums in zip(radii, normals, summed):
+    for radius, rung, sums, rung_failed in zip(radii, normals, summed, failed):
         k_min, k_max, dir_min, dir_max = curvatures_from_measures(sums, rung)
         parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius}
         out.append(
             finish(
                 "icc",
                 parameters,
-                valid & np.isfinite(k_min),
+                valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed),
                 rung,
                 k_min,
                 k_max,

@@ -48,7 +48,7 @@ from ..geometry import edge_dihedral_angles
 from ..neighborhoods import ball_edge_sums, ball_face_sums
 from ..radius import component_radii, resolve_radius, vertex_radii
 from .._prepared import PreparedMesh
-from ._support import Stages, finish
+from ._support import Stages, ball_holds_neighbours, finish
 
 STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve curvatures")
 
@@ -96,12 +96,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # a ball that holds none of the vertex's neighbours holds only its own corner: the polyhedron's cone at
     # the vertex, not the surface (a given radius far below the edges; issue 29): undefined
     radii = vertex_radii(groups, vertices.shape[0])
-    first, second = topology.edges[:, 0], topology.edges[:, 1]
-    lengths = np.linalg.norm(np.take(vertices, second, axis=0) - np.take(vertices, first, axis=0), axis=1)
-    near = np.zeros(vertices.shape[0], dtype=bool)
-    near[first[lengths < radii[first]]] = True
-    near[second[lengths < radii[second]]] = True
-    valid &= near
+    valid &= ball_holds_neighbours(vertices, topology.edges, radii)
     with np.errstate(invalid="ignore", divide="ignore"):
         tensors = measures / areas[:, None]
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
