@@ -14,6 +14,7 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._validation import as_vertices, check_int_option
+from .defects import DEFECTS, NEEDLE, needle_vertices
 from .errors import InvalidMeshError
 from .geometry import (
     DEGENERATE_AREA_RATIO,
@@ -29,6 +30,9 @@ from .topology import MeshTopology, as_topology
 #: Edges no longer than this times the length scale of their component (its median
 #: edge length, :func:`meshcurv.geometry.vertex_length_scales`) count as zero-length.
 ZERO_LENGTH_RATIO = 1e-6
+
+#: The phrase after the count of needle vertices (that of the defect table, :data:`meshcurv.defects.DEFECTS`).
+NEEDLE_PHRASE = next(defect.counted for defect in DEFECTS if defect.code == NEEDLE)
 
 __all__ = ["MeshDiagnosis", "diagnose", "degenerate_faces", "bowtie_vertices"]
 
@@ -67,6 +71,11 @@ class MeshDiagnosis:
     n_zero_length_edges : int
         Edges whose two ends coincide (length below ``1e-6`` x the median edge
         length of their connected component).
+    n_needle_vertices : int
+        Vertices flung far from their neighbours (a spike of a corrupted file,
+        alone or with a few neighbours): their faces are slivers, and every
+        method leaves them and the corners of their faces undefined
+        (:func:`meshcurv.defects.needle_vertices`).
     n_flipped_faces : int
         Faces reversed by ``orient=`` before the computation (0 when nothing was
         reversed, and for :func:`diagnose` itself).
@@ -90,6 +99,7 @@ class MeshDiagnosis:
     bounding_box: tuple
     n_bowtie_vertices: int = 0
     n_zero_length_edges: int = 0
+    n_needle_vertices: int = 0
     n_flipped_faces: int = 0
 
     @property
@@ -106,6 +116,7 @@ class MeshDiagnosis:
             or self.n_degenerate_faces
             or self.n_unreferenced_vertices
             or self.n_bowtie_vertices
+            or self.n_needle_vertices
         )
 
     def problems(self, *, boundary: bool = True) -> list[str]:
@@ -130,6 +141,8 @@ class MeshDiagnosis:
             found.append(f"{self.n_degenerate_faces} zero-area faces")
         if self.n_zero_length_edges:
             found.append(f"{self.n_zero_length_edges} zero-length edges")
+        if self.n_needle_vertices:
+            found.append(f"{self.n_needle_vertices} {NEEDLE_PHRASE}")
         if self.n_unreferenced_vertices:
             found.append(f"{self.n_unreferenced_vertices} unreferenced vertices")
         return found
@@ -202,11 +215,19 @@ def diagnose(vertices: np.ndarray, topology: MeshTopology, *, n_flipped_faces: i
 
 
 def mesh_diagnosis(
-    vertices: np.ndarray, topology: MeshTopology, n_flipped_faces: int, scales: np.ndarray
+    vertices: np.ndarray,
+    topology: MeshTopology,
+    n_flipped_faces: int,
+    scales: np.ndarray,
+    *,
+    n_needle_vertices: int | None = None,
 ) -> MeshDiagnosis:
     """:func:`diagnose` of checked inputs: (V, 3) float64 ``vertices`` of ``topology``, ``n_flipped_faces``
     in ``[0, F]`` and the (V,) ``scales`` of :func:`meshcurv.geometry.vertex_length_scales` (a prepared
-    mesh has them already: ``principal_curvatures`` checks its inputs once and measures them once)."""
+    mesh has them already: ``principal_curvatures`` checks its inputs once and measures them once).
+    ``n_needle_vertices``: their count when known (``counts`` of :func:`meshcurv.defects.defect_codes`),
+    else found here (:func:`meshcurv.defects.needle_vertices`: one pass over the edges on a mesh without
+    a long edge)."""
     faces = topology.faces
     referenced = topology.referenced_vertices
     n_unreferenced = int(topology.n_vertices - referenced.sum())
@@ -238,6 +259,8 @@ def mesh_diagnosis(
     closed = n_boundary == 0
     genus = (2 - chi) // 2 if closed and n_components == 1 and n_nonmanifold == 0 else None
     volume = float(six_volume) / 6.0 if closed and faces.shape[0] else None
+    if n_needle_vertices is None:
+        n_needle_vertices = int(needle_vertices(vertices, topology, scales).sum())
     bowties = bowtie_vertices(topology)
     if n_nonmanifold:
         bowties = bowties & ~topology.edge_vertices(nonmanifold)
@@ -260,6 +283,7 @@ def mesh_diagnosis(
         bounding_box=(tuple(lower.tolist()), tuple(upper.tolist())),
         n_bowtie_vertices=int(bowties.sum()),
         n_zero_length_edges=int(n_zero_length),
+        n_needle_vertices=int(n_needle_vertices),
         n_flipped_faces=int(n_flipped_faces),
     )
 
