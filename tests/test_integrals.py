@@ -255,6 +255,10 @@ def test_weighted_percentiles():
     assert np.isnan(weighted_percentiles([np.nan], [1.0], [50])).all()
     with pytest.raises(InvalidMeshError, match=r"`values` and `weights` must have one shape \(N,\)"):
         weighted_percentiles(np.ones(3), np.ones(4), [50])
+    # a percentile beyond [0, 100] or NaN was the largest value, a valid wrong number; a word numpy's ValueError
+    for wrong in ([150], [np.nan], [-1, 50], "median"):
+        with pytest.raises(InvalidOptionError, match=r"`percentiles` must be numbers in \[0, 100\]; got"):
+            weighted_percentiles(values, np.ones(200), wrong)
 
 
 def test_a_spherical_cap():

@@ -660,6 +660,11 @@ def test_curvature_fields_errors(torus):
     with pytest.raises(InvalidOptionError, match=r"`quality` must be a scalar field \(k_min, .*\); got 'normals'"):
         curvature_fields(result, quality="normals")
     assert list(curvature_fields(result, fields=["k_min"], quality=None)) == ["k_min"]
+    # a string was read letter by letter ("unknown field 'm'")
+    with pytest.raises(
+        InvalidOptionError, match=r"`fields` must be a list of names; got the string 'mean' \(fields=\['mean'\]\)"
+    ):
+        curvature_fields(result, fields="mean")
 
 
 # ----------------------------------------------------------------------------------------------------

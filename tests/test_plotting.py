@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import meshcurv
-from meshcurv.errors import InvalidOptionError, MeshFileError
+from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshFileError
 from meshcurv.plotting import VIEWS, _camera, _point_spacing, _Raster, choose_up, plot_field, save_figure
 
 matplotlib = pytest.importorskip("matplotlib")
@@ -103,6 +103,8 @@ def test_up_axis_is_chosen_from_the_extent():
     assert choose_up(box)[0] == "z"
     assert choose_up(box[:, [0, 2, 1]])[0] == "y"  # 2 / 3: y up
     assert choose_up(np.array([[0, 0, 0], [1, 1, 1.1]]))[0] == "y"  # 1.1: below the 1.2 ratio
+    with pytest.raises(InvalidMeshError, match=r"`vertices` must have shape \(V, 3\); got \(4, 2\)"):
+        choose_up(box[:, :2])  # was numpy's IndexError
     # a tall column along z, drawn front on: taller than wide in the picture
     column = meshcurv.shapes.cylinder(radius=1.0, height=6.0)  # axis along z
     fig = plot_field(column.vertices, column.faces, column.mean, view="front", pixels=100)

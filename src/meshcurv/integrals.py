@@ -47,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validation import check_choice, checked_mesh
-from .errors import InvalidMeshError
+from .errors import InvalidMeshError, InvalidOptionError
 from .geometry import face_areas, vertex_normals
 from .measures import face_measures
 
@@ -185,14 +185,26 @@ def weighted_percentiles(values, weights, percentiles) -> np.ndarray:
     Returns
     -------
     ndarray of the shape of ``percentiles``
+
+    Raises
+    ------
+    InvalidMeshError
+        ``values`` and ``weights`` not of one shape (N,).
+    InvalidOptionError
+        A percentile that is not a number in [0, 100].
     """
+    try:
+        wanted = np.asarray(percentiles, dtype=np.float64) / 100.0
+    except (TypeError, ValueError):
+        raise InvalidOptionError(f"`percentiles` must be numbers in [0, 100]; got {percentiles!r}") from None
+    if not ((wanted >= 0) & (wanted <= 1)).all():  # NaN fails too
+        raise InvalidOptionError(f"`percentiles` must be numbers in [0, 100]; got {percentiles!r}")
     values = np.asarray(values, dtype=np.float64)
     weights = np.asarray(weights, dtype=np.float64)
     if values.shape != weights.shape or values.ndim != 1:
         raise InvalidMeshError(
             f"`values` and `weights` must have one shape (N,); got {values.shape} and {weights.shape}"
         )
-    wanted = np.asarray(percentiles, dtype=np.float64) / 100.0
     kept = np.isfinite(values) & np.isfinite(weights) & (weights > 0)
     if not kept.any():
         return np.full(wanted.shape, np.nan)

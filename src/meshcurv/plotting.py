@@ -17,7 +17,7 @@ import textwrap
 import numpy as np
 
 from ._validation import as_faces, as_vertices, check_int_option
-from .errors import InvalidOptionError, optional_module
+from .errors import InvalidMeshError, InvalidOptionError, optional_module
 from .io._files import atomic_output, check_output
 
 __all__ = ["plot_field", "save_figure", "choose_up", "VIEWS", "MAX_PIXELS", "MAX_DPI", "Z_UP_RATIO"]
@@ -78,6 +78,8 @@ def choose_up(vertices) -> tuple[str, str]:
     never chosen.
     """
     points = np.asarray(vertices, dtype=float)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise InvalidMeshError(f"`vertices` must have shape (V, 3); got {points.shape}")
     extent = np.ptp(points, axis=0) if points.size else np.zeros(3)
     ratio = extent[2] / extent[1] if extent[1] > 0 else np.inf if extent[2] > 0 else 1.0
     if ratio > Z_UP_RATIO:

@@ -51,7 +51,8 @@ def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> di
     Raises
     ------
     InvalidOptionError
-        An unknown field name, or a ``quality`` that is not a scalar field.
+        An unknown field name, ``fields`` a string rather than a list of
+        names, or a ``quality`` that is not a scalar field.
 
     Examples
     --------
@@ -62,6 +63,8 @@ def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> di
     >>> sorted(curvature_fields(r, fields=["mean", "normals"]))
     ['mean', 'normals', 'quality']
     """
+    if isinstance(fields, str):
+        raise InvalidOptionError(f"`fields` must be a list of names; got the string {fields!r} (fields=[{fields!r}])")
     names = list(FIELDS) if fields is None else list(fields)
     unknown = [name for name in names if name not in FIELDS]
     if unknown:
