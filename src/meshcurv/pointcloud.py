@@ -104,6 +104,7 @@ import numpy as np
 from . import _pointcloud_estimators as _estimators
 from . import _pointcloud_normals as _normals
 from ._adapters import point_array
+from ._backend import numba_kernels
 from ._validation import MIN_COORDINATE, as_vertices, check_choice, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .radius import CLOUD_EXTENT_CAP, CLOUD_RADIUS_RULES, cloud_noise_level, cloud_radius, noise_rule
@@ -156,6 +157,11 @@ COPY_NEIGHBOURS = 64
 #: A part of the cloud whose points are this share or more between two sheets closer than the spacing
 #: (:func:`meshcurv._pointcloud_normals.two_sheets`) is thinner than the spacing: every point's side is undecided.
 THIN_PART_SHARE = 0.25
+
+#: A group of points with a radius of its own (a class of density, a scan line) whose box, grown by the reach of
+#: its balls, holds at most this share of the cloud is computed on those points only (no search structure, no
+#: output over the whole cloud: at 1M points a group of one point cost about 0.6 CPU s).
+LOCAL_SHARE = 0.5
 
 #: Code of :data:`meshcurv.result.INVALID_REASONS` for points without an estimate.
 _UNDEFINED = len(INVALID_REASONS) - 1
@@ -414,6 +420,9 @@ def _kept_search(kept: np.ndarray, keep: np.ndarray, distances: np.ndarray, indi
 
 def _drop_rows(centres, d, i, k, distances, indices) -> None:
     """:func:`meshcurv._pointcloud_normals._drop_self` for the points ``centres`` (rows 0.. of the outputs)."""
+    if (i[:, 0] == centres).all():  # distinct points: each is its own nearest
+        distances[:], indices[:] = d[:, 1:], i[:, 1:]
+        return
     own = i == centres[:, None]
     first = np.where(own.any(axis=1), own.argmax(axis=1), 0)
     keep = np.ones(d.shape, dtype=bool)
@@ -652,51 +661,90 @@ def _compute(points, given, radius, method, search=None):
     two_sided_mask = np.zeros(n, dtype=bool)
     noisy = 0  # points whose fits the noise dominates (see NOISY_PCA)
     mixed = None
+    compiled = numba_kernels("pointcloud") is not None
     for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
+        if method == "jets" and radius is None:
+            group_radius = _within_budget(points, group_radius, members, "jet fits", problems)
+        if method == "corrected_measures" and given is None:
+            normal_radius = _within_budget(
+                points,
+                max(noise_rule(_estimators.NORMAL_RULE, group_spacing, noise), floor),
+                members,
+                "normal fits",
+                problems,
+            )
+            reach = max(normal_radius, group_radius)
+        else:
+            reach = group_radius
+        if method == "corrected_measures" and given is None and mixed is None:
+            # a point whose every normal fit held the other side, and whose nearest neighbours hold
+            # it too, keeps a PCA normal that may mix the two sheets: it is left out (NaN, and out of
+            # the balls, where its triangles would bend the measures of its neighbours)
+            mixed = _normals.facing_away(start, indices)
+        # a small group (a few points of a scan line, a class of density in one corner) is computed on the
+        # points within reach of it only: the same balls, without a search structure over the whole cloud
+        near = _within_reach(points, members, reach)
+        if near is None:
+            local = (points, start, usable, members, sheets, one_sided, mixed)
+        else:
+            local = (
+                points[near],
+                start[near],
+                usable[near],
+                np.searchsorted(near, members),
+                None if sheets is None else sheets[near],
+                one_sided[near],
+                None if mixed is None else mixed[near],
+            )
+        part_points, part_start, part_usable, part_members, part_sheets, part_one_sided, part_mixed = local
         if method == "jets":
             # a ball that holds the other side of a thin or small part shrinks, down to the clean-sample radius
             # (a given radius too: a jet through both sides is not the surface, H doubled on a small sphere)
-            if radius is None:
-                group_radius = _within_budget(points, group_radius, members, "jet fits", problems)
             smallest = min(group_radius, max(CLOUD_RADIUS_RULES[method][0] * group_spacing, floor))
-            found = _estimators.jets(points, start, group_radius, members, usable, smallest=smallest, details=details)
+            found = _estimators.jets(
+                part_points, part_start, group_radius, part_members, part_usable, smallest=smallest, details=details
+            )
             asked = group_radius
-            noisy += _noise_dominated(details["radii"], members, asked, noise, one_sided)
+            noisy += _noise_dominated(details["radii"], part_members, asked, noise, part_one_sided)
         else:
             if given is None:
-                asked = normal_radius = _within_budget(
-                    points,
-                    max(noise_rule(_estimators.NORMAL_RULE, group_spacing, noise), floor),
-                    members,
-                    "normal fits",
-                    problems,
-                )
+                asked = normal_radius
                 smallest = min(normal_radius, max(_estimators.NORMAL_RULE[0] * group_spacing, floor))
                 normals = _estimators.fitted_normals(
-                    points, start, normal_radius, members, usable, smallest=smallest, details=details
+                    part_points,
+                    part_start,
+                    normal_radius,
+                    part_members,
+                    part_usable,
+                    smallest=smallest,
+                    details=details,
                 )
                 parameters["normal_radius"] = normal_radius
-                # a point whose every normal fit held the other side, and whose nearest neighbours hold
-                # it too, keeps a PCA normal that may mix the two sheets: it is left out (NaN, and out of
-                # the balls, where its triangles would bend the measures of its neighbours)
-                if mixed is None:
-                    mixed = _normals.facing_away(start, indices)
-                failed = members[~np.isfinite(details["radii"][members])]
-                one_sided[failed] = ~mixed[failed]
-                noisy += _noise_dominated(details["radii"], members, asked, noise, one_sided)
+                failed = part_members[~np.isfinite(details["radii"][part_members])]
+                part_one_sided[failed] = ~part_mixed[failed]
+                noisy += _noise_dominated(details["radii"], part_members, asked, noise, part_one_sided)
             else:
-                normals = start
+                normals = part_start
             found = _estimators.corrected_measures(
-                tree, points, normals, group_radius, members, usable & one_sided, spacing=group_spacing, sheets=sheets
+                tree if near is None else None if compiled else cKDTree(part_points),  # (the NumPy path's search)
+                part_points,
+                normals,
+                group_radius,
+                part_members,
+                part_usable & part_one_sided,
+                spacing=group_spacing,
+                sheets=part_sheets,
             )
+        if near is not None:
+            one_sided[near] = part_one_sided
         if "radii" in details:
-            fitted_radii = details["radii"][members]
+            fitted_radii = details["radii"][part_members]
             shrunk += int((fitted_radii < asked).sum())
             two_sided += int(np.isnan(fitted_radii).sum())
             two_sided_mask[members] = np.isnan(fitted_radii)
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
-            whole[members] = part[members]
+            whole[members] = part[part_members]
     if method == "jets" or given is None:
         parameters["shrunk"] = shrunk / max(centres.size, 1)
     if method == "jets" and radius is not None and shrunk:
@@ -767,6 +815,19 @@ def _compute(points, given, radius, method, search=None):
     return k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, problems
 
 
+def _within_reach(points: np.ndarray, members: np.ndarray, reach: float) -> np.ndarray | None:
+    """(M,) the sorted indices of the points in the box of ``members`` grown by ``reach`` (every point within
+    ``reach`` of one of them), or None when that is more than :data:`LOCAL_SHARE` of the cloud."""
+    n = points.shape[0]
+    if members.size == 0 or members.size > LOCAL_SHARE * n:
+        return None
+    own = points[members]
+    margin = reach * (1.0 + 1e-9)
+    low, high = own.min(axis=0) - margin, own.max(axis=0) + margin
+    inside = np.flatnonzero(((points >= low) & (points <= high)).all(axis=1))
+    return inside if inside.size <= LOCAL_SHARE * n else None
+
+
 def _noise_dominated(radii, members, asked, noise, one_sided) -> int:
     """Mark in ``one_sided`` the ``members`` whose fit ``radii`` (N,) is NaN or below :data:`NOISY_SHRINK` times
     ``asked`` when ``noise`` is :data:`NOISY_PCA` or more; return how many had a (small) fit."""
@@ -823,8 +884,8 @@ def _radius_groups(spacing, indices, usable, median, noise, radius, method, prob
         return lines or [(cloud_radius(median, noise, method), median, centres, 0.0)]
     # the spacing averaged over the neighbours: one class per region, not per random gap
     # (over the usable neighbours of usable points only: a row of outliers alone would have no mean)
-    smooth = np.where(usable, spacing, np.nan)
-    smooth = np.nanmean(np.concatenate([smooth[centres, None], smooth[indices[centres]]], axis=1), axis=1)
+    values, rows = np.where(usable, spacing, 0.0), indices[centres]
+    smooth = (values[centres] + values[rows].sum(axis=1)) / (1.0 + np.count_nonzero(usable[rows], axis=1))
     low, high = np.percentile(smooth, [5, 95])
     if high <= UNEVEN_DENSITY * low:
         return [(cloud_radius(median, noise, method), median, centres, 0.0), *lines]
