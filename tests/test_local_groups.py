@@ -57,9 +57,7 @@ def test_a_small_group_is_computed_on_its_neighbourhood_alone(method, backend, m
     for field in ("k_min", "k_max", "normals"):
         np.testing.assert_allclose(getattr(local, field), getattr(whole, field), rtol=1e-12, atol=1e-12)
     for field in ("dir_min", "dir_max"):  # directions up to sign
-        np.testing.assert_allclose(
-            np.abs(getattr(local, field)), np.abs(getattr(whole, field)), rtol=1e-12, atol=1e-12
-        )
+        np.testing.assert_allclose(np.abs(getattr(local, field)), np.abs(getattr(whole, field)), rtol=1e-12, atol=1e-12)
 
 
 def test_a_group_over_most_of_the_cloud_is_not_cut_out():
@@ -69,3 +67,21 @@ def test_a_group_over_most_of_the_cloud_is_not_cut_out():
     near = pointcloud._within_reach(points, np.array([2500]), 0.05)
     inside = np.flatnonzero(np.linalg.norm(points - points[2500], axis=1) <= 0.05)
     assert np.isin(inside, near).all() and near.size < 0.1 * points.shape[0]
+
+
+def test_the_near_copies_are_found_in_the_rows_with_a_gap_only():
+    """``_copy_pairs`` looks at the rows whose first distance is below ``COPY_GAP`` times their last: the pairs
+    of the whole (rows, neighbours) array, each row's neighbours before its last gap."""
+    rng = np.random.default_rng(2)
+    distances = np.sort(rng.random((500, 10)), axis=1)
+    distances[::7, :3] *= 1e-6  # three copies before a gap
+    distances[::11, 0] = 0.0  # one copy at distance 0 (kept: a gap from 0 to the next)
+    distances[::13] = 1e-200  # all below MIN_SPACING: no gap counts
+    indices = rng.integers(0, 10_000, size=(500, 10))
+    centres = np.arange(500) + 20_000
+    rows, cols = pointcloud._copy_pairs(centres, distances, indices)
+    gap = (distances[:, :-1] <= pointcloud.COPY_GAP * distances[:, 1:]) & (distances[:, 1:] > pointcloud.MIN_SPACING)
+    expected = [
+        (centres[r], indices[r, j]) for r in range(500) if gap[r].any() for j in range(9 - int(np.argmax(gap[r, ::-1])))
+    ]
+    assert list(zip(rows, cols)) == expected and len(expected) > 50

@@ -434,13 +434,16 @@ def _drop_rows(centres, d, i, k, distances, indices) -> None:
 def _copy_pairs(centres, distances, indices):
     """``(rows, cols)``: each centre and its neighbours before the last gap of :data:`COPY_GAP` in its row."""
     with np.errstate(invalid="ignore"):
-        gap = (distances[:, :-1] <= COPY_GAP * distances[:, 1:]) & (distances[:, 1:] > MIN_SPACING)
+        # the distances ascend along a row: a gap anywhere puts its first below COPY_GAP times its last
+        maybe = np.flatnonzero(distances[:, 0] <= COPY_GAP * distances[:, -1])
+        near = distances[maybe]
+        gap = (near[:, :-1] <= COPY_GAP * near[:, 1:]) & (near[:, 1:] > MIN_SPACING)
     if not gap.any():
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
     k = distances.shape[1]
     last = np.where(gap.any(axis=1), k - 2 - np.argmax(gap[:, ::-1], axis=1), -1)  # neighbours 0..last are copies
     before = np.arange(k)[None, :] <= last[:, None]
-    return np.repeat(centres, before.sum(axis=1)), indices[before]
+    return np.repeat(centres[maybe], before.sum(axis=1)), indices[maybe][before]
 
 
 def _checked_normals(normals, shape) -> np.ndarray:
