@@ -3,15 +3,25 @@
 Three radii ``h, 2h, 4h`` (``h`` the mean edge length) on icospheres, icc:
 the multi-scale call against the largest radius alone and against three
 separate calls (issue 30's target: at most 1.3 times the largest alone). Each
-figure is the median of ``--repeats`` calls after a warm-up call (numba's
-compilation not counted); wall and CPU seconds.
+figure is the median of ``--repeats`` rounds after a warm-up round (numba's
+compilation not counted); in each round the calls run one after the other, so
+that the ratios compare calls made under the same load; wall and CPU seconds,
+the ratios of CPU time (the machine is shared). ``--stages`` adds the CPU
+seconds of each stage (the ``progress`` callback) of the largest radius alone
+and of the multi-scale call. The row "nested fits" runs the multi-scale call
+with its normal fits from :func:`meshcurv.neighborhoods.nested_jet_normals`
+(one walk per vertex for the three fit radii) in place of one
+``fitted_normals`` call per radius: what ``icc.estimate_multiscale`` gives once
+it calls it (the rest of the call unchanged; the results are checked equal to
+round-off).
 
-    python benchmarks/multiscale.py --sizes 100k,1M --repeats 3
+    python benchmarks/multiscale.py --sizes 100k,1M --repeats 5 --stages
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import time
 import warnings
@@ -20,45 +30,132 @@ import numpy as np
 
 import meshcurv
 from meshcurv import shapes
+from meshcurv.estimators import ESTIMATORS, icc
+from meshcurv.neighborhoods import nested_jet_normals
 
 SIZES = {"10k": 32, "100k": 100, "1M": 316}  # icosphere subdivisions: 10 n^2 + 2 vertices
 
 
-def timed(call, repeats):
-    call()  # warm-up: compilation, caches
-    walls, cpus = [], []
-    for _ in range(repeats):
-        wall, cpu = time.perf_counter(), time.process_time()
-        call()
-        walls.append(time.perf_counter() - wall)
-        cpus.append(time.process_time() - cpu)
-    return float(np.median(walls)), float(np.median(cpus))
+def _nested_estimator():
+    """icc's registry entry with its multi-scale fits from one walk (nested_jet_normals), for this benchmark."""
+    fits: dict[float, np.ndarray] = {}
+    fitted_normals = icc.fitted_normals
+
+    def from_walk(vertices, normals, valid, radius, **options):
+        if float(radius) not in fits:
+            return fitted_normals(vertices, normals, valid, radius, **options)
+        fitted = fits[float(radius)]  # then the agreement test of fitted_normals
+        start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
+        with np.errstate(invalid="ignore"):
+            usable = valid & (np.einsum("ij,ij->i", fitted, start) > icc.NORMAL_AGREEMENT)
+        if options.get("failed") is not None:
+            options["failed"] |= valid & ~np.isfinite(fitted).all(axis=1)
+        return np.where(usable[:, None], fitted, normals)
+
+    def multiscale(mesh, *, radii, stages):
+        topology = mesh.topology
+        _, valid = mesh.start(boundary=True)
+        start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
+        normal_radii = [icc.NORMAL_RADIUS_RATIO * icc.check_radius(r, mesh.vertices, topology) for r in radii]
+        stages.start("fit normals")
+        found = nested_jet_normals(
+            mesh.vertices,
+            start,
+            normal_radii,
+            adjacency=topology.neighbour_lists,
+            neighbours=topology.referenced_vertices,
+            degree=icc.NORMAL_DEGREE,
+            iterations=icc.NORMAL_ITERATIONS,
+            settled=icc.NORMAL_SETTLED,
+            min_spread=icc.NORMAL_MIN_SPREAD,
+        )
+        fits.update({float(r): normals for r, normals in zip(normal_radii, found)})
+        icc.fitted_normals = from_walk
+        try:
+            return icc.estimate_multiscale(mesh, radii=radii, stages=stages)
+        finally:
+            icc.fitted_normals = fitted_normals
+            fits.clear()
+
+    return dataclasses.replace(ESTIMATORS["icc"], multiscale=multiscale)
+
+
+def _call(function, stages_out=None):
+    """(wall s, CPU s) of ``function(progress)``; the CPU seconds by stage added to ``stages_out``."""
+    marks = []
+
+    def progress(stage, index, total):
+        marks.append((stage, time.process_time()))
+
+    wall, cpu = time.perf_counter(), time.process_time()
+    function(progress)
+    end = time.process_time()
+    if stages_out is not None:
+        for (stage, at), (_, after) in zip(marks, marks[1:] + [("", end)]):
+            stages_out[stage] = stages_out.get(stage, 0.0) + after - at
+    return time.perf_counter() - wall, end - cpu
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="100k")
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--stages", action="store_true", help="the CPU seconds of each stage")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore", meshcurv.MeshQualityWarning)
     print(
         f"meshcurv {meshcurv.__version__}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; "
-        f"median of {args.repeats} calls, wall s (CPU s)\n"
+        f"median of {args.repeats} rounds, wall s (CPU s); ratios of CPU time\n"
     )
-    print("| vertices | icc at 4h alone | 3 calls h, 2h, 4h | multiscale h, 2h, 4h | multiscale / 4h alone |")
-    print("|--:|--:|--:|--:|--:|")
+    nested = _nested_estimator()
+    original = ESTIMATORS["icc"]
+    header = "| vertices | icc at 4h alone | 3 calls h, 2h, 4h | multiscale h, 2h, 4h | multiscale / 4h alone |"
+    rows, splits = [header, "|--:|--:|--:|--:|--:|"], []
     for size in args.sizes.split(","):
         sphere = shapes.icosphere(SIZES[size])
         v, f = sphere.vertices, sphere.faces
         h = meshcurv.geometry.mean_edge_length(v, meshcurv.MeshTopology.from_faces(f).edges)
         radii = [h, 2 * h, 4 * h]
-        alone = timed(lambda: meshcurv.principal_curvatures(v, f, radius=4 * h), args.repeats)
-        separate = timed(lambda: [meshcurv.principal_curvatures(v, f, radius=r) for r in radii], args.repeats)
-        multi = timed(lambda: meshcurv.multiscale_curvatures(v, f, radii), args.repeats)
-        print(
-            f"| {v.shape[0]:,} | {alone[0]:.3f} ({alone[1]:.2f}) | {separate[0]:.3f} ({separate[1]:.2f}) | "
-            f"{multi[0]:.3f} ({multi[1]:.2f}) | {multi[0] / alone[0]:.2f}x ({multi[1] / alone[1]:.2f}x) |"
+        check = [r.mean for r in meshcurv.multiscale_curvatures(v, f, radii)]
+        ESTIMATORS["icc"] = nested
+        try:
+            for got, expected in zip(meshcurv.multiscale_curvatures(v, f, radii), check):
+                np.testing.assert_allclose(got.mean, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
+        finally:
+            ESTIMATORS["icc"] = original
+        calls = {
+            "alone": lambda p: meshcurv.principal_curvatures(v, f, radius=4 * h, progress=p),
+            "separate": lambda p: [meshcurv.principal_curvatures(v, f, radius=r, progress=p) for r in radii],
+            "multi": lambda p: meshcurv.multiscale_curvatures(v, f, radii, progress=p),
+            "nested": lambda p: meshcurv.multiscale_curvatures(v, f, radii, progress=p),
+        }
+        times = {name: [] for name in calls}
+        stages = {name: {} for name in calls}
+        for round_ in range(args.repeats + 1):  # round 0 warms up
+            for name, call in calls.items():
+                ESTIMATORS["icc"] = nested if name == "nested" else original
+                try:
+                    measured = _call(call, stages[name] if round_ else None)
+                finally:
+                    ESTIMATORS["icc"] = original
+                if round_:
+                    times[name].append(measured)
+        wall = {name: float(np.median([t[0] for t in ts])) for name, ts in times.items()}
+        cpu = {name: float(np.median([t[1] for t in ts])) for name, ts in times.items()}
+        ratio = {name: float(np.median([m[1] / a[1] for m, a in zip(times[name], times["alone"])])) for name in calls}
+        rows.append(
+            f"| {v.shape[0]:,} | {wall['alone']:.3f} ({cpu['alone']:.2f}) | {wall['separate']:.3f} "
+            f"({cpu['separate']:.2f}) | {wall['multi']:.3f} ({cpu['multi']:.2f}) | {ratio['multi']:.2f}x |"
         )
+        rows.append(
+            f"| {v.shape[0]:,}, nested fits | | | {wall['nested']:.3f} ({cpu['nested']:.2f}) | {ratio['nested']:.2f}x |"
+        )
+        for name in ("alone", "multi", "nested"):
+            split = ", ".join(f"{k} {s / args.repeats:.2f}" for k, s in stages[name].items())
+            splits.append(f"- {v.shape[0]:,}, {name}: {split}")
+    print("\n".join(rows))
+    if args.stages:
+        print("\nCPU s by stage (mean of the rounds):\n" + "\n".join(splits))
 
 
 if __name__ == "__main__":
