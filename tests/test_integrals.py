@@ -273,3 +273,26 @@ def test_a_spherical_cap():
     cap = mesh.vertices[:, 2] > radius / 2
     assert relative_error(r.integral("gaussian", where=cap), np.pi) < MESH_TOLERANCE
     assert relative_error(r.integral("mean", where=cap), 2 * np.pi * (radius - radius / 2)) < MESH_TOLERANCE
+
+
+def test_measure_functions_check_their_shapes():
+    # before: the compiled kernel read past the end of a short `normals` (a valid wrong number), float faces
+    # were truncated, and the others were numpy's IndexError or broadcast error
+    from meshcurv.measures import corrected_areas, curvatures_from_measures, face_measures, principal_from_measures
+
+    sphere = shapes.icosphere(2)
+    v, f, n = sphere.vertices, sphere.faces, sphere.normals
+    cases = [
+        (lambda: face_measures(v, f, n[:3]), r"`normals` must have shape \(42, 3\); got \(3, 3\)"),
+        (lambda: face_measures(v[:, :2], f, n), r"`vertices` must have shape \(N, 3\); got \(42, 2\)"),
+        (lambda: face_measures(v, f + 0.5, n), "`faces` must hold integers; got dtype float64"),
+        (lambda: corrected_areas(v, f, np.ones((3, 3))), r"`measures` must have shape \(80, N\); got \(3, 3\)"),
+        (lambda: curvatures_from_measures(np.ones((5, 2)), n[:5]), r"`summed` must have shape \(N, 9\)"),
+        (lambda: curvatures_from_measures(np.ones((5, 9)), n), r"`normals` must have shape \(5, 3\); got \(42, 3\)"),
+        (lambda: principal_from_measures(np.ones((3, 2))), r"`summed` must have shape \(\.\.\., 9\)"),
+        (lambda: face_solid_angles(n[:, :2], f), r"`normals` and `faces` must have shapes \(V, 3\) and \(F, 3\)"),
+    ]
+    for make, message in cases:
+        with pytest.raises(InvalidMeshError, match=message):
+            make()
+    assert face_measures(v, f, n).shape == (80, 9)  # and the right shapes still pass

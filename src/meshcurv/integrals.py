@@ -62,7 +62,13 @@ def face_solid_angles(normals: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
     Positive where the normals turn as the corners do (a convex face of an
     outward-wound mesh), 0 where a corner's normal is not finite.
+    ``normals`` (V, 3), ``faces`` (F, 3) indices into them.
     """
+    normals, faces = np.asarray(normals), np.asarray(faces)
+    if normals.ndim != 2 or normals.shape[1] != 3 or faces.ndim != 2 or faces.shape[1] != 3:
+        raise InvalidMeshError(
+            f"`normals` and `faces` must have shapes (V, 3) and (F, 3); got {normals.shape} and {faces.shape}"
+        )
     u0, u1, u2 = (normals[faces[:, k]] for k in range(3))
     triple = np.einsum("ij,ij->i", u0, np.cross(u1, u2))
     cosines = 1.0 + np.einsum("ij,ij->i", u0, u1) + np.einsum("ij,ij->i", u1, u2) + np.einsum("ij,ij->i", u2, u0)

@@ -33,9 +33,27 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._tensors import principal_from_mean_gaussian, principal_from_shape_operator
+from .errors import InvalidMeshError
 from .geometry import face_areas
 
 __all__ = ["face_measures", "corrected_areas", "curvatures_from_measures", "principal_from_measures"]
+
+
+def _shaped(array, name: str, shape: tuple, kinds: str = "fiu") -> np.ndarray:
+    """``array`` as an ndarray of ``shape`` (None: any length) and a dtype kind of ``kinds``, else an InvalidMeshError.
+
+    Shapes and dtypes only (O(1)): the indices of the faces are the caller's
+    to check (the public functions that build a mesh validate it once).
+    """
+    out = np.asarray(array)
+    if out.ndim != len(shape) or any(n is not None and n != m for n, m in zip(shape, out.shape)):
+        expected = ", ".join("N" if n is None else str(n) for n in shape)
+        raise InvalidMeshError(f"`{name}` must have shape ({expected}); got {out.shape}")
+    if out.dtype.kind not in kinds:
+        raise InvalidMeshError(
+            f"`{name}` must hold {'integers' if kinds == 'iu' else 'numbers'}; got dtype {out.dtype}"
+        )
+    return out
 
 
 def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -43,8 +61,13 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
 
     Written relative to the first corner, so that a translation of the mesh
     changes nothing (the sum ``(u_k - u_j) + (u_i - u_k) + (u_j - u_i)`` is 0).
-    The compiled kernel when numba is there.
+    The compiled kernel when numba is there. ``vertices`` and ``normals``
+    (V, 3), ``faces`` (F, 3) integers: their shapes are checked, not whether
+    the faces index the vertices (the caller's mesh is validated).
     """
+    vertices = _shaped(vertices, "vertices", (None, 3))
+    normals = _shaped(normals, "normals", vertices.shape)
+    faces = _shaped(faces, "faces", (None, 3), "iu")
     kernels = numba_kernels("icc")
     if kernels is not None:
         return kernels.face_measures(
@@ -88,6 +111,7 @@ def corrected_areas(vertices: np.ndarray, faces: np.ndarray, measures: np.ndarra
         ``mu_0``, the triangle's area where ``mu_0`` is not finite.
     """
     triangle = face_areas(vertices, faces)
+    measures = _shaped(measures, "measures", (triangle.shape[0], None))
     return triangle, np.where(np.isfinite(measures[:, 0]), measures[:, 0], triangle)
 
 
@@ -101,6 +125,8 @@ def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
     whose corrected area ``mu_0`` is not positive or whose normal is not finite.
     One pass with the compiled kernels.
     """
+    summed = _shaped(summed, "summed", (None, 9))
+    normals = _shaped(normals, "normals", (summed.shape[0], 3))
     kernels = numba_kernels("icc")
     if kernels is not None:
         return kernels.curvatures_from_measures(
@@ -125,6 +151,9 @@ def principal_from_measures(summed: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     ``H = mu_1 / (2 mu_0)``, ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``; NaN where the
     corrected area ``mu_0`` is not positive. Any leading shape (the rungs of a ladder of balls, say).
     """
+    summed = np.asarray(summed)
+    if summed.ndim == 0 or summed.shape[-1] < 3:
+        raise InvalidMeshError(f"`summed` must have shape (..., 9) (at least mu_0, mu_1, mu_2); got {summed.shape}")
     area = summed[..., 0]
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(area > 0, summed[..., 1] / (2 * area), np.nan)
