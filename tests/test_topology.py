@@ -187,3 +187,63 @@ def test_normal_cycle_keeps_the_zero_area_faces_its_kernel_found():
     expected = degenerate_faces(mesh.vertices, mesh.topology)
     np.testing.assert_array_equal(mesh.degenerate, expected)
     assert expected.sum() == 1
+
+
+def _defective_faces(seed: int) -> np.ndarray:
+    """A closed sphere with the defects of the fan walks: two bow-ties (two spheres glued at a vertex, a
+    fan split by reversing faces), non-manifold edges, repeated corners, a boundary, a face used twice."""
+    rng = np.random.default_rng(seed)
+    sphere = shapes.icosphere(3)
+    n = sphere.vertices.shape[0]
+    faces = sphere.faces.copy()
+    second = sphere.faces + n
+    second[second == n] = 0  # the second sphere's vertex 0 is the first's: a bow-tie
+    flipped = rng.choice(faces.shape[0], 5, replace=False)
+    faces[flipped] = faces[flipped][:, ::-1]  # inconsistent edges
+    dropped = rng.choice(np.arange(10, faces.shape[0]), 6, replace=False)  # holes: boundaries, half fans
+    extra = np.array([[1, 2, 2 * n], [3, 3, 4], [5, 6, 5], faces[20], faces[21][::-1]])  # non-manifold, repeated
+    return np.vstack([np.delete(faces, dropped, axis=0), second, extra])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_bowtie_vertices_from_the_twin_sides_are_those_of_the_definition(seed):
+    """The compiled build's twin sides give the bow-ties of the corner graph (the NumPy definition)."""
+    pytest.importorskip("numba")
+    from meshcurv._backend import use_backend
+    from meshcurv.topology import _bowtie_vertices
+
+    faces = _defective_faces(seed)
+    n_vertices = int(faces.max()) + 2  # one unreferenced vertex
+    with use_backend("numba"):
+        top = MeshTopology.from_faces(faces, n_vertices)
+        found = top.bowtie_vertices
+    assert top._side_twins is not None
+    expected = _bowtie_vertices(top)
+    np.testing.assert_array_equal(found, expected)
+    assert expected[0] and expected.sum() >= 2
+    with use_backend("numpy"):
+        assert MeshTopology.from_faces(faces, n_vertices)._side_twins is None
+
+
+def test_twin_sides_pair_the_two_sides_of_each_edge_of_two_faces():
+    pytest.importorskip("numba")
+    from meshcurv._backend import use_backend
+
+    faces = _defective_faces(0)
+    with use_backend("numba"):
+        top = MeshTopology.from_faces(faces)
+    encoded = top._side_twins.astype(np.int64)
+    twins = np.where(encoded < -1, -2 - encoded, encoded)  # -2 - t: the two sides run the edge the same way
+    side_edge = top.face_edges.ravel()
+    paired = np.flatnonzero(twins >= 0)
+    np.testing.assert_array_equal(twins[twins[paired]], paired)  # an involution
+    np.testing.assert_array_equal(side_edge[twins[paired]], side_edge[paired])  # the same edge
+    assert (paired // 3 != twins[paired] // 3).all()  # of another face
+    linked = (top.edge_face_counts == 2) & (top.edge_faces[:, 0] != top.edge_faces[:, 1])
+    has_edge = side_edge >= 0
+    np.testing.assert_array_equal(twins >= 0, has_edge & linked[np.where(has_edge, side_edge, 0)])
+    # the same way: the tails of the two sides are the same vertex
+    tail = top.faces.ravel()
+    same_way = tail[paired] == tail[twins[paired]]
+    np.testing.assert_array_equal(encoded[paired] < -1, same_way)
+    assert same_way.any() and not same_way.all()

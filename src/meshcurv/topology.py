@@ -117,6 +117,9 @@ class MeshTopology:
     edge_faces: np.ndarray
     edge_face_counts: np.ndarray
     _edge_forward_counts: np.ndarray = field(repr=False)
+    #: (3 F,) the other side ``3 g + j`` of the edge of each side ``3 f + k`` where the edge joins exactly two
+    #: faces, -1 elsewhere (``_kernels.topology.build_edges_into``); None when not built (the NumPy path)
+    _side_twins: np.ndarray | None = field(default=None, repr=False)
 
     @classmethod
     def from_faces(cls, faces, n_vertices: int | None = None) -> MeshTopology:
@@ -165,9 +168,10 @@ class MeshTopology:
     def _build(cls, faces: np.ndarray, n_vertices: int) -> MeshTopology:
         """Build from already validated int64 (F, 3) triangles."""
         kernels = numba_kernels("topology")
+        twins = None
         if kernels is not None:
-            edges, face_edges, edge_faces, counts, forward_counts = kernels.build_edges(
-                faces, n_vertices, _bucket_template(n_vertices, faces.shape[0])
+            edges, face_edges, edge_faces, counts, forward_counts, twins = kernels.build_topology(
+                faces, n_vertices, _bucket_template(n_vertices, faces.shape[0]), True
             )
         else:
             edges, face_edges, edge_faces, counts, forward_counts = _build_edges(faces, n_vertices)
@@ -179,6 +183,7 @@ class MeshTopology:
             edge_faces=_readonly(edge_faces),
             edge_face_counts=_readonly(counts),
             _edge_forward_counts=_readonly(forward_counts),
+            _side_twins=None if twins is None else _readonly(twins),
         )
 
     # -- sizes ------------------------------------------------------------------
@@ -254,6 +259,8 @@ class MeshTopology:
         kernels = numba_kernels("topology")
         if kernels is None:
             return _readonly(_bowtie_vertices(self))
+        if self._side_twins is not None:
+            return _readonly(kernels.bowtie_from_twins(self.faces, self._side_twins, self.n_vertices))
         linked = (self.edge_face_counts == 2) & (self.edge_faces[:, 0] != self.edge_faces[:, 1])
         return _readonly(
             kernels.bowtie_vertices(

@@ -40,22 +40,61 @@ def _bucket_starts(cursor):
 
 @nb.njit(**_JIT)
 def build_edges(faces, n_vertices, template):
-    """Edges of the triangles, their faces and counts (see MeshTopology._build).
+    """Edges of the triangles, their faces and counts (see MeshTopology._build): :func:`build_topology`
+    without the twins of the sides, ``(edges, face_edges, edge_faces, counts, forward)``."""
+    edges, face_edges, edge_faces, counts, forward, _ = build_topology(faces, n_vertices, template, False)
+    return edges, face_edges, edge_faces, counts, forward
+
+
+@nb.njit(**_JIT)
+def build_topology(faces, n_vertices, template, with_twins):
+    """:func:`build_edges_into` on arrays allocated here: ``(edges, face_edges, edge_faces, counts, forward,
+    twins)``, the twins (when ``with_twins``, else an empty array) in the integer type of ``template``."""
+    n_faces = faces.shape[0]
+    face_edges = np.empty(3 * n_faces, np.int64)
+    edges = np.empty((3 * n_faces, 2), np.int64)
+    edge_faces = np.empty((3 * n_faces, 2), np.int64)
+    counts = np.empty(3 * n_faces, np.int64)
+    forward = np.empty(3 * n_faces, np.int64)
+    twins = np.empty(3 * n_faces if with_twins else 0, template.dtype)
+    n_edges = build_edges_into(faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins)
+    return (
+        edges[:n_edges],
+        face_edges.reshape(n_faces, 3),
+        edge_faces[:n_edges],
+        counts[:n_edges],
+        forward[:n_edges],
+        twins,
+    )
+
+
+@nb.njit(**_JIT)
+def build_edges_into(faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins):
+    """Edges of the triangles, their faces and counts, written into the given arrays; returns their number E.
+
+    ``face_edges`` (3 F,) receives the edge of each side (-1 for a side from a
+    vertex to itself), rows ``:E`` of ``edges`` and ``edge_faces`` (at least
+    (3 F, 2)), ``counts`` and ``forward`` (at least (3 F,)) those of each edge
+    (see MeshTopology._build). ``twins``, of shape (3 F,) or empty (not
+    wanted), receives for each side ``3 f + k`` the other side ``t`` of its
+    edge when the edge has exactly two sides, in two different faces (the
+    edges that join two fans' faces, see :func:`bowtie_from_twins`): ``t``
+    where the two sides run the edge both ways, ``-2 - t`` where they run it
+    the same way (inconsistently wound faces); -1 for the other sides.
 
     Sides are bucketed by their smaller vertex (a counting sort: one pass
     counts, one places, each in face order), each bucket is sorted by (larger
     vertex, direction) with a stable insertion sort and its edges written
     out at once, so the edges come out in lexicographic order, as
     ``np.unique`` would give them. Every output element is written once (no
-    fill beforehand); the edge arrays are sized for one edge per side and
-    returned cut to the edges found (the rows beyond are never touched, so
-    never paged in). The buckets are held in the integer type of
-    ``template`` (``topology._bucket_template``). One thread: the passes are
-    bound by memory, and a parallel version took twice the CPU time for at
-    best the same wall time on 2 cores, and 5 s more to compile.
+    fill beforehand; the rows past the last edge are never touched, so never
+    paged in). The buckets are held in the integer type of ``template``
+    (``topology._bucket_template``). One thread: the passes are bound by
+    memory, and a parallel version took twice the CPU time for at best the
+    same wall time on 2 cores, and 5 s more to compile.
     """
     n_faces = faces.shape[0]
-    face_edges = np.empty(3 * n_faces, np.int64)
+    with_twins = twins.shape[0] > 0
     bucket_start = np.zeros(n_vertices + 1, template.dtype)
     for f in range(n_faces):
         for k in range(3):
@@ -65,6 +104,8 @@ def build_edges(faces, n_vertices, template):
                 bucket_start[min(a, b) + 1] += 1
             else:  # a side from a vertex to itself: no edge
                 face_edges[3 * f + k] = -1
+                if with_twins:
+                    twins[3 * f + k] = -1
     for v in range(n_vertices):
         bucket_start[v + 1] += bucket_start[v]
     n_sides = bucket_start[n_vertices]
@@ -81,11 +122,6 @@ def build_edges(faces, n_vertices, template):
                 cursor[low] += 1
                 sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
                 side_of[slot] = 3 * f + k
-    # at most one edge per side: sized for that, the rows past the last edge never written (never touched)
-    edges = np.empty((n_sides, 2), np.int64)
-    edge_faces = np.empty((n_sides, 2), np.int64)
-    counts = np.empty(n_sides, np.int64)
-    forward = np.empty(n_sides, np.int64)
     e = -1
     for v in range(n_vertices):
         start, stop = bucket_start[v], bucket_start[v + 1]
@@ -124,8 +160,24 @@ def build_edges(faces, n_vertices, template):
                 if not backward:
                     forward[e] += 1
             face_edges[side] = e
-    n_edges = e + 1
-    return edges[:n_edges], face_edges.reshape(n_faces, 3), edge_faces[:n_edges], counts[:n_edges], forward[:n_edges]
+        if with_twins:  # the sides of each edge are next to each other in the sorted bucket
+            i = start
+            while i < stop:
+                j = i + 1
+                while j < stop and sort_key[j] >> 1 == sort_key[i] >> 1:
+                    j += 1
+                if j - i == 2 and side_of[i] // 3 != side_of[i + 1] // 3:
+                    if (sort_key[i] & 1) != (sort_key[i + 1] & 1):  # run both ways: consistently wound
+                        twins[side_of[i]] = side_of[i + 1]
+                        twins[side_of[i + 1]] = side_of[i]
+                    else:
+                        twins[side_of[i]] = -2 - side_of[i + 1]
+                        twins[side_of[i + 1]] = -2 - side_of[i]
+                else:
+                    for k in range(i, j):
+                        twins[side_of[k]] = -1
+                i = j
+    return e + 1
 
 
 @nb.njit(inline="always", **_JIT)
@@ -203,6 +255,74 @@ def bowtie_vertices(faces, face_edges, edge_faces, linked, proper, n_vertices):
             reached += _fan_walk(faces, face_edges, edge_faces, linked, proper, v, f, (p + 2) % 3)[0]
         several[v] = reached < corners[v]
     return several
+
+
+@nb.njit(inline="always", **_JIT)
+def _twin_walk(twins, side, leaving):
+    """:func:`_fan_walk` on the twins of :func:`build_edges_into`: the faces reached around a vertex from
+    the face of ``side`` (a side of that face at the vertex, ``leaving`` it or entering it) through that
+    side. One read of ``twins`` a face, no read of the faces: crossing a consistently wound edge, the
+    next side at the vertex is the one after the twin (``leaving``) or the one before it; crossing an
+    inconsistent one swaps the two."""
+    start = side // 3
+    reached = 0
+    while True:
+        t = twins[side]
+        if t == -1:
+            return reached, False
+        if t < -1:  # the two faces run the edge the same way
+            t = -2 - t
+            leaving = not leaving
+        g = t // 3
+        if g == start:
+            return reached, True
+        reached += 1
+        k = t - 3 * g
+        if leaving:
+            side = t + 1 if k < 2 else t - 2
+        else:
+            side = t + 2 if k < 1 else t - 1
+
+
+@nb.njit(parallel=True, **_JIT)
+def bowtie_from_twins(faces, twins, n_vertices):
+    """:func:`bowtie_vertices` from the twins of the sides (:func:`build_edges_into`), the same vertices.
+
+    A side has a twin exactly when its edge is linked (two faces, two
+    different ones; a face with a repeated corner never has one: each of its
+    edges has two of its own sides), so the walk crosses to the twin's face
+    without looking up edges. One pass over the faces counts the corners of
+    the faces without a repeated corner; the walks run in parallel.
+    """
+    n_faces = faces.shape[0]
+    corners = np.zeros(n_vertices, np.int64)
+    first = np.full(n_vertices, -1, np.int64)  # the side leaving v of its first proper face
+    for f in range(n_faces):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        if a != b and b != c and c != a:
+            for k in range(3):
+                v = faces[f, k]
+                corners[v] += 1
+                if first[v] < 0:
+                    first[v] = 3 * f + k
+    several = np.zeros(n_vertices, np.bool_)
+    for v in nb.prange(n_vertices):
+        several[v] = _several_fans(twins, first[v], corners[v])
+    return several
+
+
+@nb.njit(**_JIT)
+def _several_fans(twins, side, n_corners):
+    """Whether the fan of ``side`` (leaving its vertex; -1: none) reaches fewer than the vertex's ``n_corners``
+    corners."""
+    if side < 0:
+        return False
+    ahead, closed = _twin_walk(twins, side, True)
+    reached = 1 + ahead
+    if not closed:  # a chain: the other way too, from the side entering v
+        k = side % 3
+        reached += _twin_walk(twins, side + 2 if k < 1 else side - 1, False)[0]
+    return reached < n_corners
 
 
 @nb.njit(**_JIT)
