@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from meshcurv.errors import MeshFileError, MeshQualityWarning, MissingDependencyError
+from meshcurv.errors import InvalidMeshError, MeshFileError, MeshQualityWarning, MissingDependencyError
 from meshcurv.io._points import POINT_EXTENSIONS, read_points, write_points
 
 
@@ -215,6 +215,10 @@ def test_paths_are_checked(tmp_path, cloud):
         write_points(path, cloud[0])
     with pytest.raises(MeshFileError, match=r"field 'k' must have shape \(50,\) or \(50, 3\)"):
         write_points(tmp_path / "other.ply", cloud[0], point_data={"k": np.zeros(3)})
+    # normals were reshaped: (3, 3) was numpy's ValueError, (25, 6) passed as (50, 3)
+    for normals in (cloud[1][:3], cloud[1].reshape(25, 6)):
+        with pytest.raises(InvalidMeshError, match=r"`normals` must have shape \(50, 3\), one per point; got"):
+            write_points(tmp_path / "other.ply", cloud[0], normals)
     assert not (tmp_path / "other.ply").exists()
 
 

@@ -263,6 +263,9 @@ def test_page_never_replaces_its_source(tmp_path, torus):
         ({"max_directions": True}, InvalidOptionError, "max_directions"),
         ({"elevation": float("nan")}, InvalidOptionError, "elevation"),
         ({"azimuth": "left"}, InvalidOptionError, "azimuth"),
+        # were an AttributeError and a TypeError deep in the page's writing
+        ({"title": 5}, InvalidOptionError, "`title` must be a string or None; got int"),
+        ({"length_unit": 5}, InvalidOptionError, "`length_unit` must be a string or None; got int"),
     ],
 )
 def test_bad_options(tmp_path, torus, options, error, match):

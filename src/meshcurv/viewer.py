@@ -164,6 +164,9 @@ def write_html(
     up = check_choice(up, "up", _UPS)
     percentiles = check_percentiles(percentiles)
     max_directions = _check_count(max_directions, "max_directions")
+    for text, name in ((title, "title"), (length_unit, "length_unit")):
+        if text is not None and not isinstance(text, str):
+            raise InvalidOptionError(f"`{name}` must be a string or None; got {type(text).__name__}")
     angles = [_check_angle(value, name) for value, name in ((elevation, "elevation"), (azimuth, "azimuth"))]
     points = checked_points(vertices)
     triangles = None

@@ -32,7 +32,7 @@ import warnings
 import numpy as np
 
 from .._validation import as_vertices
-from ..errors import MeshFileError, MeshQualityWarning, MissingDependencyError, optional_module
+from ..errors import InvalidMeshError, MeshFileError, MeshQualityWarning, MissingDependencyError, optional_module
 from ._files import atomic_output, check_input, check_output, format_key
 from ._ply import HEADER_LIMIT, _header, _short, ply_vertex_columns
 from ._text import body_rows, fixed_rows, line_of, names_shown, not_a_number, numbers_by_line, row_error
@@ -474,11 +474,15 @@ def write_points(
     MeshFileError
         Unknown extension, existing file without ``overwrite``, the input file,
         a field of the wrong shape, a folder that cannot be written.
+    InvalidMeshError
+        ``points`` not of shape (N, 3), ``normals`` not of the shape of ``points``.
     """
     path = check_output(path, overwrite=overwrite, source=source)
     suffix = _suffix(path, file_format)
     points = as_vertices(points, name="points")
-    normals = None if normals is None else np.asarray(normals, dtype=np.float64).reshape(points.shape)
+    normals = None if normals is None else np.asarray(normals, dtype=np.float64)
+    if normals is not None and normals.shape != points.shape:  # not reshaped: (N/2, 6) would pass as (N, 3)
+        raise InvalidMeshError(f"`normals` must have shape {points.shape}, one per point; got {normals.shape}")
     columns = _columns(points, normals, point_data)
     with atomic_output(path, overwrite=overwrite) as temporary:
         try:
