@@ -78,11 +78,20 @@ def test_fixed_limits_and_colour_map():
         ({"percentiles": (2, 101)}, r"`percentiles` must satisfy 0 <= low < high <= 100; got \(2, 101\)"),
         ({"percentiles": (98, 2)}, "`percentiles` must satisfy 0 <= low < high <= 100"),
         ({"percentiles": (2,)}, r"`percentiles` must be two numbers \(low, high\); got \(2,\)"),
+        # were an AttributeError deep in matplotlib, and numpy's ValueError
+        ({"cmap": 5}, "`cmap` must be a name of matplotlib.colormaps or a Colormap; got 5"),
+        ({"label": 5}, "`label` must be a string; got int"),
+        ({"title": ["a"]}, "`title` must be a string; got list"),
     ],
 )
 def test_errors(options, message):
     with pytest.raises(InvalidOptionError, match=message):
         plot_field(TORUS.vertices, TORUS.faces, TORUS.mean, pixels=40, **options)
+
+
+def test_values_that_are_not_numbers():  # was numpy's ValueError
+    with pytest.raises(InvalidOptionError, match="`values` must be numbers, one per vertex; got a list of others"):
+        plot_field(TORUS.vertices, TORUS.faces, ["a"] * len(TORUS.vertices), pixels=40)
 
 
 def test_the_colour_bar_label_fits_in_the_picture():

@@ -311,6 +311,8 @@ def _check_limits(limits):
 
 def _colormap(matplotlib, cmap, signed: bool):
     name = cmap or ("RdBu_r" if signed else "viridis")
+    if not isinstance(name, (str, matplotlib.colors.Colormap)):
+        raise InvalidOptionError(f"`cmap` must be a name of matplotlib.colormaps or a Colormap; got {name!r}")
     try:
         colormap = matplotlib.colormaps[name] if isinstance(name, str) else name
     except KeyError:
@@ -469,7 +471,15 @@ def plot_field(
         if cloud
         else as_faces(faces, points.shape[0], stacklevel=3)
     )
-    values = np.asarray(values, dtype=float)
+    for text, name in ((title, "title"), (label, "label")):
+        if text is not None and not isinstance(text, str):
+            raise InvalidOptionError(f"`{name}` must be a string; got {type(text).__name__}")
+    try:
+        values = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidOptionError(
+            f"`values` must be numbers, one per vertex; got a {type(values).__name__} of others"
+        ) from None
     if values.shape != (points.shape[0],):
         raise InvalidOptionError(f"`values` must have shape ({points.shape[0]},), one per vertex; got {values.shape}")
     strokes = _as_directions(directions, points.shape[0])
