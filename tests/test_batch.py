@@ -281,6 +281,11 @@ def test_run_refuses_bad_options_before_any_work(tmp_path):
         batch.run(folder, out_dir, scheduler=dead, orient="inward")
     with pytest.raises(InvalidOptionError, match="unknown output_format 'obj'"):
         batch.run(folder, out_dir, scheduler=dead, output_format="obj")
+    # were TypeErrors: dask's on connecting, and the first call of `progress` once the cluster ran
+    with pytest.raises(InvalidOptionError, match=r"`scheduler` must be an address such as 'tcp://host:8786'; got 8786"):
+        batch.run(folder, out_dir, scheduler=8786)
+    with pytest.raises(InvalidOptionError, match=r"`progress` must be a function of \(done, total, failed\); got 5"):
+        batch.run(folder, out_dir, scheduler=dead, progress=5)
     (tmp_path / "file").write_text("")
     with pytest.raises(MeshFileError, match="file: is a file; the output must be a folder"):
         batch.run(folder, tmp_path / "file", scheduler=dead)

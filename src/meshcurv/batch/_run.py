@@ -188,6 +188,10 @@ def run(
     check_choice(output_format, "output_format", OUTPUT_FORMATS)
     if client is not None and scheduler is not None:
         raise InvalidOptionError("give `client` or `scheduler`, not both")
+    if scheduler is not None and not isinstance(scheduler, str) and not hasattr(scheduler, "scheduler_address"):
+        raise InvalidOptionError(f"`scheduler` must be an address such as 'tcp://host:8786'; got {scheduler!r}")
+    if progress is not None and not callable(progress):
+        raise InvalidOptionError(f"`progress` must be a function of (done, total, failed); got {progress!r}")
     if workers is not None:
         if client is not None or scheduler is not None:
             raise InvalidOptionError(
