@@ -9,12 +9,17 @@ CPU microseconds per vertex, the stage that costs most (from the ``progress`` ca
 ``|H - H_exact| / max|k|`` (issue 30's target: CPU per vertex within 3 times the icosphere's at <= 1%
 median H error).
 
-    python benchmarks/dense_voxel.py --repeats 3
+``--profile`` adds where the CPU time of one default call on the first mesh goes, by function
+(``cProfile`` on CPU time; the pilot is the first pass of ``radius.voxel_surface_radius``).
+
+    python benchmarks/dense_voxel.py --repeats 3 --profile
 """
 
 from __future__ import annotations
 
 import argparse
+import cProfile
+import pstats
 import time
 import warnings
 
@@ -49,6 +54,40 @@ def _timed(vertices, faces, repeats):
     return float(np.median(totals)), {k: float(np.median([s.get(k, 0.0) for s in stages_all])) for k in names}, result
 
 
+#: The functions whose cumulative CPU time ``--profile`` lists (file suffix, function name, label).
+PROFILED = (
+    ("radius.py", "voxel_surface_radius", "voxel pilot and per-vertex radii (before the stages)"),
+    ("icc.py", "run", "  pilot: icc at 2 voxels"),
+    ("radius.py", "voxel_vertex_radii", "  per-vertex radii from the pilot"),
+    ("icc.py", "fitted_normals", "normal fits (pilot and main pass)"),
+    ("jets.py", "fit_jet_normals", "  fits over every vertex (pilot)"),
+    ("icc.py", "_coarse_level", "  coarse level of the main fits"),
+    ("jets.py", "fit_jets", "  fits on the coarse level (main)"),
+    ("neighborhoods.py", "ball_face_sums", "sums over balls (pilot and main pass)"),
+    ("neighborhoods.py", "check_ball_work", "  pair estimates (all ball computations)"),
+    ("_kernels/neighborhoods.py", "vertex_face_lists", "  faces around each vertex (each sum)"),
+    ("thread.py", "_adjust_thread_count", "threads started by run_chunks (a new pool per kernel call)"),
+)
+
+
+def _profile(vertices, faces, repeats):
+    """Print the CPU seconds of :data:`PROFILED` in one default call (median over ``repeats`` calls)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        meshcurv.principal_curvatures(vertices, faces)  # compiled and cached first
+        profiler = cProfile.Profile(timer=time.process_time)
+        profiler.enable()
+        for _ in range(repeats):
+            meshcurv.principal_curvatures(vertices, faces)
+        profiler.disable()
+    stats = pstats.Stats(profiler).stats  # type: ignore[attr-defined]
+    total = sum(row[3] for (_, _, name), row in stats.items() if name == "principal_curvatures")
+    for suffix, function, label in PROFILED:
+        seconds = sum(row[3] for (path, _, name), row in stats.items() if name == function and path.endswith(suffix))
+        print(f"| {label} | {seconds / repeats:.3f} | {100 * seconds / max(total, 1e-12):.0f}% |")
+    print(f"| the call | {total / repeats:.3f} | 100% |")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
@@ -57,6 +96,7 @@ def main(argv=None):
         action="store_true",
         help="also a sphere R 10 at 0.25 x 0.1 x 0.1 (113,072 vertices; a minute a call before the coarse level)",
     )
+    parser.add_argument("--profile", action="store_true", help="where one call's CPU time goes, by function")
     args = parser.parse_args(argv)
     meshes = [
         ("voxel sphere R 6, 0.5 x 0.2 x 0.2", shapes.voxel_sphere(6.0, (0.5, 0.2, 0.2), seed=0), True),
@@ -90,6 +130,10 @@ def main(argv=None):
             f"| {name} | {n:,} | {cpu:.2f} | {per:.1f} | {per / reference:.1f} | {top} ({100 * share:.0f}%) | "
             f"{100 * error:.2f}% | {radius:.3g} |"
         )
+    if args.profile:
+        name, mesh, _ = meshes[0]
+        print(f"\n{name}, one default call: CPU s by function\n\n| function | CPU s | share |\n|---|--:|--:|")
+        _profile(np.asarray(mesh.vertices, float), mesh.faces[:, ::-1], args.repeats)
 
 
 if __name__ == "__main__":
