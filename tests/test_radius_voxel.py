@@ -149,3 +149,33 @@ def test_other_ball_methods_keep_one_radius_on_a_voxel_surface(torus_2x):
     r = quiet(mesh.vertices, mesh.faces, method="quadric")
     assert r.parameters["surface"] == "voxel" and "scale" not in r.parameters
     assert np.ptp(r.radius[r.valid]) == 0
+
+
+def _smoothed_sphere(radius, sigma):
+    """Marching cubes at 0.5 of a ball's mask (voxel 1) blurred by a Gaussian of ``sigma`` voxels, centred at 0."""
+    measure = pytest.importorskip("skimage.measure")
+    from scipy.ndimage import gaussian_filter
+
+    n = int(2 * radius + 16)
+    centre = np.array([0.5 * (n - 1) + 0.31, 0.5 * (n - 1) - 0.27, 0.5 * (n - 1) + 0.13])  # off the grid's symmetry
+    x, y, z = np.meshgrid(*(np.arange(n) - c for c in centre), indexing="ij", sparse=True)
+    mask = (x**2 + y**2 + z**2 <= radius**2).astype(float)
+    vertices, faces, _, _ = measure.marching_cubes(gaussian_filter(mask, sigma), 0.5)
+    return vertices - centre, np.ascontiguousarray(faces[:, ::-1])
+
+
+def test_a_smoothed_isosurface_sphere_is_within_half_a_percent_of_the_blurred_sphere():
+    # the isosurface of a blurred mask (the biology pipeline; a held-out family of benchmarks/scale_families.py):
+    # the 0.5 level set of a ball of radius R blurred by a Gaussian of sigma is, to first order, the sphere of
+    # radius R - sigma^2 / R (heat flow for a time sigma^2 / 2 moves it at k_1 + k_2 = 2 / R); H = 1 / (R - sigma^2
+    # / R). Issue 30's target is a median H error of 0.5% of max|k| on spheres of radius >= 10 voxels; at R 20,
+    # sigma 1 the default gives 0.33% (benchmarks/smoothed_isosurfaces.md). The shift is the input's geometry: the
+    # analytic 1 / R is 0.25% away from the blurred sphere's H here, 1% at sigma 2
+    radius, sigma = 20.0, 1.0
+    vertices, faces = _smoothed_sphere(radius, sigma)
+    r = quiet(vertices, faces)
+    assert r.parameters["scale"] == "voxel" and r.valid.all()
+    blurred = 1.0 / (radius - sigma**2 / radius)
+    assert float(np.median(np.abs(r.mean - blurred))) / blurred <= 0.005
+    # the measured mean distance to the centre confirms the shift within a hundredth of a voxel
+    assert abs(float(np.mean(np.linalg.norm(vertices, axis=1))) - (radius - sigma**2 / radius)) < 0.01

@@ -404,6 +404,10 @@ VOXEL_GAUSS_CAP = 0.5
 #: VOXEL_NORMAL_VOXELS h_max))``.
 VOXEL_NORMAL_CAP = 1.5
 VOXEL_NORMAL_VOXELS = 4.0
+#: The normal fits' radius over the measure radius (as icc's ``NORMAL_RADIUS_RATIO`` elsewhere). 2 and 4 were
+#: worse on the tuning voxel meshes (geometric mean of the median H error 1.30% -> 1.75% and 1.36%), as were
+#: ``VOXEL_NORMAL_CAP`` 1.0 and 2.0 (1.62%, 1.35%; ``benchmarks/scale_default.md``).
+VOXEL_NORMAL_RATIO = 3.0
 #: The pilot's curvatures are averaged over this many rings of each vertex.
 VOXEL_LOCAL_RINGS = 2
 #: The region whose most curved vertex sets a vertex's curvature radius: at most this many rings.
@@ -545,9 +549,11 @@ def voxel_vertex_radii(
         radii = np.minimum(radii, general + tube * np.maximum(1.0 / curvedness - general, 0.0))
     radii = np.maximum(radii, largest)
     with np.errstate(divide="ignore"):
-        normal_radii = np.minimum(3.0 * radii, np.maximum(VOXEL_NORMAL_CAP / curvedness, VOXEL_NORMAL_VOXELS * largest))
+        normal_radii = np.minimum(
+            VOXEL_NORMAL_RATIO * radii, np.maximum(VOXEL_NORMAL_CAP / curvedness, VOXEL_NORMAL_VOXELS * largest)
+        )
     unknown = ~reached | ~np.isfinite(radii)
-    radii[unknown], normal_radii[unknown] = fallback, 3.0 * fallback
+    radii[unknown], normal_radii[unknown] = fallback, VOXEL_NORMAL_RATIO * fallback
     return radii, normal_radii
 
 
