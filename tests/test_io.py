@@ -635,6 +635,13 @@ def test_bad_point_data_and_meshes_are_refused(tmp_path, torus):
         meshcurv.write_mesh(tmp_path / "t.vtp", torus.vertices, torus.faces, point_data={"k min": torus.k_min})
     with pytest.raises(InvalidMeshError, match="`faces` has vertex index 97 out of range"):
         meshcurv.write_mesh(tmp_path / "t.vtp", torus.vertices, torus.faces + 2)
+    # were AttributeErrors: point_data not a dict, a file format not a string, a result that is none
+    with pytest.raises(InvalidOptionError, match="`point_data` must be a dict of name -> array; got list"):
+        meshcurv.write_mesh(tmp_path / "t.vtp", torus.vertices, torus.faces, point_data=[torus.k_min])
+    with pytest.raises(InvalidOptionError, match="`file_format` must be an extension such as 'ply'; got 5"):
+        meshcurv.write_mesh(tmp_path / "t.vtp", torus.vertices, torus.faces, file_format=5)
+    with pytest.raises(InvalidOptionError, match="`result` must be a CurvatureResult; got int"):
+        meshcurv.io.write_curvatures(tmp_path / "t.vtp", torus.vertices, torus.faces, 5)
     assert list(tmp_path.iterdir()) == []
 
 

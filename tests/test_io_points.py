@@ -3,7 +3,13 @@
 import numpy as np
 import pytest
 
-from meshcurv.errors import InvalidMeshError, MeshFileError, MeshQualityWarning, MissingDependencyError
+from meshcurv.errors import (
+    InvalidMeshError,
+    InvalidOptionError,
+    MeshFileError,
+    MeshQualityWarning,
+    MissingDependencyError,
+)
 from meshcurv.io._points import POINT_EXTENSIONS, read_points, write_points
 
 
@@ -215,6 +221,16 @@ def test_paths_are_checked(tmp_path, cloud):
         write_points(path, cloud[0])
     with pytest.raises(MeshFileError, match=r"field 'k' must have shape \(50,\) or \(50, 3\)"):
         write_points(tmp_path / "other.ply", cloud[0], point_data={"k": np.zeros(3)})
+    # point_data as write_mesh takes it: a name with a space wrote a PLY header no reader reads, a key 5 was
+    # written as "5", words were numpy's ValueError and a list an AttributeError
+    for point_data, message in [
+        ({"k max": np.zeros(50)}, r"`point_data` names must be identifiers \(letters, digits, _\); got 'k max'"),
+        ({5: np.zeros(50)}, "`point_data` names must be identifiers"),
+        ({"k": np.array(["x"] * 50)}, r"`point_data\['k'\]` must be a numeric array; got dtype <U1"),
+        ([np.zeros(50)], "`point_data` must be a dict of name -> array; got list"),
+    ]:
+        with pytest.raises(InvalidOptionError, match=message):
+            write_points(tmp_path / "other.ply", cloud[0], point_data=point_data)
     # normals were reshaped: (3, 3) was numpy's ValueError, (25, 6) passed as (50, 3)
     for normals in (cloud[1][:3], cloud[1].reshape(25, 6)):
         with pytest.raises(InvalidMeshError, match=r"`normals` must have shape \(50, 3\), one per point; got"):

@@ -40,7 +40,7 @@ import numpy as np
 from .._validation import _check_range, as_polygons, as_vertices
 from ..errors import InvalidMeshError, InvalidOptionError, MeshFileError, MissingDependencyError
 from . import _meshio, _obj, _off, _ply, _tables, _vtk, _vtp
-from ._files import atomic_output, check_input, check_output, format_key
+from ._files import atomic_output, check_input, check_output, format_key, named_fields
 from ._points import POINT_EXTENSIONS, is_point_cloud, read_points, write_point_curvatures, write_points
 from .fields import FIELDS, curvature_fields, read_fields
 
@@ -216,10 +216,7 @@ def read_mesh(path, *, file_format: str | None = None) -> Mesh:
 
 def _point_data(point_data, n_vertices: int) -> dict[str, np.ndarray]:
     arrays = {}
-    for name, value in (point_data or {}).items():
-        array = np.asarray(value)
-        if not isinstance(name, str) or not name.isidentifier():
-            raise InvalidOptionError(f"`point_data` names must be identifiers (letters, digits, _); got {name!r}")
+    for name, array in named_fields(point_data).items():
         if array.dtype.kind not in "biuf" or array.ndim not in (1, 2) or array.shape[0] != n_vertices:
             raise InvalidOptionError(
                 f"`point_data[{name!r}]` must be a numeric array of shape ({n_vertices},) or ({n_vertices}, k); "

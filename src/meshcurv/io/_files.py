@@ -6,10 +6,13 @@ import contextlib
 import os
 import pathlib
 import secrets
+from collections.abc import Mapping
 
-from ..errors import MeshFileError
+import numpy as np
 
-__all__ = ["check_output", "atomic_output", "check_input", "format_key", "read_as"]
+from ..errors import InvalidOptionError, MeshFileError
+
+__all__ = ["check_output", "atomic_output", "check_input", "format_key", "read_as", "named_fields"]
 
 
 @contextlib.contextmanager
@@ -163,9 +166,28 @@ def format_key(path: pathlib.Path, file_format: str | None, known, what: str) ->
     A :class:`~meshcurv.errors.MeshFileError` naming the file, the ``what``
     and the ``known`` extensions when it is not one of them.
     """
+    if file_format is not None and not isinstance(file_format, str):
+        raise InvalidOptionError(f"`file_format` must be an extension such as 'ply'; got {file_format!r}")
     key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
     key = (key or path.suffix).lower()
     if key not in known:
         given = f"format {file_format!r}" if file_format else f"extension {path.suffix!r}" if path.suffix else ""
         raise MeshFileError(f"{path}: unknown {what} {given or 'no extension'}; known formats: {', '.join(known)}")
     return key
+
+
+def named_fields(point_data) -> dict[str, np.ndarray]:
+    """``point_data`` (None, or a mapping of identifiers to arrays) as a dict of ndarrays, checked before a write.
+
+    The names become PLY properties, table headers and PCD fields, where a
+    space or a symbol would break the file: an InvalidOptionError names the
+    first that is not an identifier, or what was given instead of a mapping.
+    """
+    if point_data is None:
+        return {}
+    if not isinstance(point_data, Mapping):
+        raise InvalidOptionError(f"`point_data` must be a dict of name -> array; got {type(point_data).__name__}")
+    for name in point_data:
+        if not isinstance(name, str) or not name.isidentifier():
+            raise InvalidOptionError(f"`point_data` names must be identifiers (letters, digits, _); got {name!r}")
+    return {name: np.asarray(value) for name, value in point_data.items()}

@@ -32,8 +32,15 @@ import warnings
 import numpy as np
 
 from .._validation import as_vertices
-from ..errors import InvalidMeshError, MeshFileError, MeshQualityWarning, MissingDependencyError, optional_module
-from ._files import atomic_output, check_input, check_output, format_key
+from ..errors import (
+    InvalidMeshError,
+    InvalidOptionError,
+    MeshFileError,
+    MeshQualityWarning,
+    MissingDependencyError,
+    optional_module,
+)
+from ._files import atomic_output, check_input, check_output, format_key, named_fields
 from ._ply import HEADER_LIMIT, _header, _short, ply_vertex_columns
 from ._text import body_rows, fixed_rows, line_of, names_shown, not_a_number, numbers_by_line, row_error
 from .fields import curvature_fields
@@ -422,8 +429,10 @@ def _columns(points, normals, point_data) -> dict[str, np.ndarray]:
     columns = {a: points[:, i] for i, a in enumerate("xyz")}
     if normals is not None:
         columns.update({a: normals[:, i] for i, a in enumerate(("nx", "ny", "nz"))})
-    for name, value in (point_data or {}).items():
-        value = np.asarray(value, dtype=np.float64)
+    for name, value in named_fields(point_data).items():
+        if value.dtype.kind not in "biuf":
+            raise InvalidOptionError(f"`point_data[{name!r}]` must be a numeric array; got dtype {value.dtype}")
+        value = value.astype(np.float64)
         if value.shape == (points.shape[0],):
             columns[name] = value
         elif value.shape == (points.shape[0], 3):
@@ -476,6 +485,9 @@ def write_points(
         a field of the wrong shape, a folder that cannot be written.
     InvalidMeshError
         ``points`` not of shape (N, 3), ``normals`` not of the shape of ``points``.
+    InvalidOptionError
+        ``point_data`` not a dict, a name that is not an identifier (it would
+        break the file's header), an array that is not numeric.
     """
     path = check_output(path, overwrite=overwrite, source=source)
     suffix = _suffix(path, file_format)

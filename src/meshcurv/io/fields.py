@@ -51,8 +51,9 @@ def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> di
     Raises
     ------
     InvalidOptionError
-        An unknown field name, ``fields`` a string rather than a list of
-        names, or a ``quality`` that is not a scalar field.
+        ``result`` not a curvature result, an unknown field name, ``fields`` a
+        string rather than a list of names, or a ``quality`` that is not a
+        scalar field.
 
     Examples
     --------
@@ -63,6 +64,8 @@ def curvature_fields(result, *, fields=None, quality: str | None = "mean") -> di
     >>> sorted(curvature_fields(r, fields=["mean", "normals"]))
     ['mean', 'normals', 'quality']
     """
+    if not all(hasattr(result, name) for name in ("k_min", "k_max", "valid", "n_vertices")):
+        raise InvalidOptionError(f"`result` must be a CurvatureResult; got {type(result).__name__}")
     if isinstance(fields, str):
         raise InvalidOptionError(f"`fields` must be a list of names; got the string {fields!r} (fields=[{fields!r}])")
     names = list(FIELDS) if fields is None else list(fields)
