@@ -1470,6 +1470,33 @@ def check_ball_indices(name):
         assert np.isinf(squared[~inside]).all()
 
 
+def check_nearest_neighbours(name):
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_normals import knn
+
+    points, _ = cloud(name)
+    n, k = points.shape[0], 10
+    tree = cKDTree(points)
+    expected_distances, expected_indices = knn(tree, points, k)
+    # a reach at the median distance of the 11th neighbour: about half the rows settled on the grid, the others
+    # left over; then a reach that holds every row's neighbours
+    for reach in (float(np.median(expected_distances[:, -1])), 0.5):
+        grid = kernels("neighborhoods").pool_grid(points, np.arange(n), reach)
+        distances, indices, exact = kernels("pointcloud").nearest_neighbours(
+            points, k, reach, *grid, 64 * kernel_threads()
+        )
+        # settled rows: k + 1 neighbours within reach at distinct distances, the k-d tree's to the bit
+        assert 0.2 < exact.mean() < 0.8 if reach < 0.5 else exact.all(), reach
+        np.testing.assert_array_equal(distances[exact], expected_distances[exact])
+        np.testing.assert_array_equal(indices[exact], expected_indices[exact])
+    x, y = np.meshgrid(np.arange(40.0), np.arange(30.0))  # a square lattice: two neighbours at 1 at least
+    lattice = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    grid = kernels("neighborhoods").pool_grid(lattice, np.arange(lattice.shape[0]), 5.0)
+    exact = kernels("pointcloud").nearest_neighbours(lattice, k, 5.0, *grid, 64 * kernel_threads())[2]
+    assert not exact.any()  # (a lattice's neighbours tie: their order is the k-d tree's, searched by the caller)
+
+
 def check_ball_triangle_sums(name):
     from meshcurv._pointcloud_estimators import (
         MIN_BALL_POINTS,
@@ -1802,6 +1829,7 @@ TWINS = [
         CLOUDS + ("degenerate_cloud",),
     ),
     Twin("pointcloud.ball_indices", "_pointcloud_estimators._ball_indices", check_ball_indices, CLOUDS),
+    Twin("pointcloud.nearest_neighbours", "_pointcloud_normals.knn", check_nearest_neighbours, CLOUDS),
     Twin("pointcloud.ball_triangle_sums", "_pointcloud_estimators._triangle_sums", check_ball_triangle_sums, CLOUDS),
     Twin("pointcloud.edge_cosines", "the cosines of _pointcloud_normals.orientation_signs", check_edge_cosines, CLOUDS),
     Twin("pointcloud.far_winding", "_pointcloud_normals.winding_numbers", check_far_winding, CLOUDS),

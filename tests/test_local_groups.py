@@ -85,3 +85,27 @@ def test_the_near_copies_are_found_in_the_rows_with_a_gap_only():
         (centres[r], indices[r, j]) for r in range(500) if gap[r].any() for j in range(9 - int(np.argmax(gap[r, ::-1])))
     ]
     assert list(zip(rows, cols)) == expected and len(expected) > 50
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_the_nearest_neighbours_on_a_grid_are_the_k_d_trees(backend, monkeypatch):
+    """``_knn`` (a grid with the compiled kernels) gives the k-d tree's arrays to the bit: on a random sample,
+    on a lattice (every neighbour tied with another: its order is the tree's) and on sparse outliers."""
+    from scipy.spatial import cKDTree
+
+    from meshcurv import _pointcloud_normals
+
+    if backend == "numba":
+        pytest.importorskip("numba")
+    monkeypatch.setattr(pointcloud, "KNN_GRID_POINTS", 0)
+    rng = np.random.default_rng(4)
+    x, y = np.meshgrid(np.arange(30.0), np.arange(20.0))
+    lattice = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)]) / 30.0 + [2.0, 0.0, 0.0]
+    far = rng.normal(size=(10, 3)) * 10.0
+    cloud = np.concatenate([plane_and_line(), lattice, far])
+    tree = cKDTree(cloud)
+    with use_backend(backend):
+        distances, indices = pointcloud._knn(tree, cloud)
+    expected_distances, expected_indices = _pointcloud_normals.knn(tree, cloud)
+    np.testing.assert_array_equal(indices, expected_indices)
+    np.testing.assert_array_equal(distances, expected_distances)

@@ -449,3 +449,57 @@ def stacked(points, normals, usable, queries, near, ring, offset, tilt_factor, f
             reach = offset + tilt_factor * tilt * np.sqrt(dx * dx + dy * dy + dz * dz)
             out[row, c] = min(abs(ahead), abs(behind)) >= reach
     return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def nearest_neighbours(points, k, reach, pool_points, ids, grid, n_chunks):
+    """(N, k) distances and indices of the ``k`` nearest other points of each point, and (N,) which rows are exact.
+
+    The candidates of each point are those of the grid ``(pool_points, ids, grid)`` of all the points
+    (:func:`~meshcurv._kernels.neighborhoods.pool_grid` with a reach of ``reach`` or more) closer than
+    ``reach``; the ``k + 1`` nearest are kept in distance order. A row is exact when ``k + 1`` others lie
+    closer than ``reach`` at distinct distances, the first above 0: its ``k`` nearest and their order are then
+    the only ones, those of :meth:`scipy.spatial.cKDTree.query` less the point itself, to the bit (the
+    distance is the square root of ``dx^2 + dy^2 + dz^2`` summed in that order, as the k-d tree's). The other
+    rows (ties, sparse parts, outliers) are for the caller to search again. ``n_chunks``: runs of points
+    shared out to the threads.
+    """
+    n = points.shape[0]
+    distances = np.zeros((n, k))
+    indices = np.zeros((n, k), dtype=np.int64)
+    exact = np.zeros(n, dtype=np.bool_)
+    limit = reach * reach
+    n_chunks = max(min(n, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        members = np.empty(256, np.int64)
+        best = np.empty(k + 1)
+        which = np.empty(k + 1, np.int64)
+        for c in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
+            px, py, pz = points[c, 0], points[c, 1], points[c, 2]
+            members, size = _ball_members(pool_points, grid, px, py, pz, reach, members)
+            found = 0
+            for a in range(size):
+                t = members[a]
+                q = ids[t]
+                if q == c:
+                    continue
+                dx, dy, dz = pool_points[t, 0] - px, pool_points[t, 1] - py, pool_points[t, 2] - pz
+                d = dx * dx + dy * dy + dz * dz
+                if not d < limit or (found == k + 1 and not d < best[k]):
+                    continue
+                j = found if found <= k else k  # insert in order, dropping the last when full
+                while j > 0 and best[j - 1] > d:
+                    best[j] = best[j - 1]
+                    which[j] = which[j - 1]
+                    j -= 1
+                best[j] = d
+                which[j] = q
+                if found <= k:
+                    found += 1
+            ok = found == k + 1 and best[0] > 0.0
+            for j in range(min(found, k)):
+                ok = ok and best[j] < best[j + 1]
+                distances[c, j] = np.sqrt(best[j])
+                indices[c, j] = which[j]
+            exact[c] = ok
+    return distances, indices, exact
