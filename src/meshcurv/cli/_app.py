@@ -160,7 +160,7 @@ def _viewers_epilog() -> str:
 @click.option("--ascii", "ascii_", is_flag=True, help="ASCII rather than binary PLY, STL or VTK.")
 @overwrite_option("Replace an existing output file.")
 @common_options
-def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quality, ascii_, overwrite):
+def compute(mesh, output, fields, quality, ascii_, overwrite, **estimate):
     """Compute the curvatures of MESH (a mesh or a point cloud); write them with -o, or print a summary table.
 
     A point cloud is a file without faces: .xyz, .txt, .pts, .csv (rows of
@@ -170,9 +170,7 @@ def compute(mesh, output, method, smoothing_steps, radius, orient, fields, quali
     session = current_session()
     if output is not None:
         _check_output(output, overwrite=overwrite, source=mesh, cloud=is_point_cloud(mesh))
-    with estimated(
-        mesh, method, smoothing_steps, radius, orient, session, "write" if output is not None else "summary"
-    ) as got:
+    with estimated(mesh, session, "write" if output is not None else "summary", **estimate) as got:
         settings = {"fields": fields, "quality": quality, "overwrite": overwrite, "source": mesh, "binary": not ascii_}
         if output is not None and got.cloud:
             write_point_curvatures(output, got.vertices, got.result, **settings)
@@ -314,10 +312,6 @@ def plot(
     mesh,
     output,
     field,
-    method,
-    smoothing_steps,
-    radius,
-    orient,
     views,
     up,
     directions,
@@ -327,6 +321,7 @@ def plot(
     dpi,
     pixels,
     overwrite,
+    **estimate,
 ):
     """Draw MESH coloured by a curvature field, with a colour bar."""
     _pyplot()  # fail early, before computing, when matplotlib is missing
@@ -339,7 +334,7 @@ def plot(
     output = output_file(
         output, f"{mesh.stem}_{field}.png", (".png",), "the picture is a PNG", overwrite=overwrite, source=mesh
     )
-    with estimated(mesh, method, smoothing_steps, radius, orient, session, "draw") as got:
+    with estimated(mesh, session, "draw", **estimate) as got:
         vertices, result, cloud = got.vertices, got.result, got.cloud
         triangles = None if got.topology is None else got.topology.faces
         if "auto" in views:

@@ -67,16 +67,13 @@ class BatchBar(ProgressBar):
 def batch(
     inputs,
     out_dir,
-    method,
-    smoothing_steps,
-    radius,
-    orient,
     output_format,
     workers,
     scheduler,
     overwrite,
     timeout,
     retry_failed,
+    **estimate,
 ):
     """Curvatures of many meshes on Dask: INPUTS are files, folders and glob patterns.
 
@@ -105,10 +102,7 @@ def batch(
         summary = run(
             list(inputs),
             out_dir,
-            method=method,
-            smoothing_steps=smoothing_steps,
-            radius=radius,
-            orient=orient,
+            **estimate,
             output_format=output_format,
             workers=workers,
             scheduler=scheduler,

@@ -216,7 +216,7 @@ def _default_method() -> str:
 
 
 def method_options(function):
-    """--method and the estimator options, passed on only when given."""
+    """--method and the estimator options: the command takes them as ``**estimate`` and hands them on."""
     options = [
         method_option(_default_method(), "Curvature estimator (see `meshcurv methods`).", show_default=True),
         click.option(
@@ -376,7 +376,7 @@ class Estimated(NamedTuple):
 
 
 @contextlib.contextmanager
-def estimated(path, method, smoothing_steps, radius, orient, session: Session, last_stage: str):
+def estimated(path, session: Session, last_stage: str, *, method, smoothing_steps, radius, orient):
     """Read ``path`` (a mesh, or a point cloud: a file without faces) and compute its curvatures.
 
     A progress bar runs over the stages ``read``, the method's own and

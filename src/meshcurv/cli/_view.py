@@ -44,16 +44,13 @@ def view(
     mesh,
     output,
     field,
-    method,
-    smoothing_steps,
-    radius,
-    orient,
     up,
     percentiles,
     max_directions,
     length_unit,
     title,
     overwrite,
+    **estimate,
 ):
     """Write MESH (a mesh or a point cloud) and its curvatures as one interactive HTML page.
 
@@ -72,7 +69,7 @@ def view(
     page = "the page is an HTML file (.html)"
     output = output_file(output, f"{mesh.stem}.html", (".html", ".htm"), page, overwrite=overwrite, source=mesh)
     check_input(mesh)
-    with estimated(mesh, method, smoothing_steps, radius, orient, session, "page") as got:
+    with estimated(mesh, session, "page", **estimate) as got:
         vertices, result = got.vertices, got.result
         faces = None if got.topology is None else got.topology.faces
         write_html(
