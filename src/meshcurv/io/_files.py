@@ -171,8 +171,14 @@ def format_key(path: pathlib.Path, file_format: str | None, known, what: str) ->
     key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
     key = (key or path.suffix).lower()
     if key not in known:
-        given = f"format {file_format!r}" if file_format else f"extension {path.suffix!r}" if path.suffix else ""
-        raise MeshFileError(f"{path}: unknown {what} {given or 'no extension'}; known formats: {', '.join(known)}")
+        given = (
+            f"format {file_format!r}"
+            if file_format
+            else f"extension {path.suffix!r}"
+            if path.suffix
+            else "extension (none)"
+        )
+        raise MeshFileError(f"{path}: unknown {what} {given}; known formats: {', '.join(known)}")
     return key
 
 
