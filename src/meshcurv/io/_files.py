@@ -171,13 +171,8 @@ def format_key(path: pathlib.Path, file_format: str | None, known, what: str) ->
     key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
     key = (key or path.suffix).lower()
     if key not in known:
-        given = (
-            f"format {file_format!r}"
-            if file_format
-            else f"extension {path.suffix!r}"
-            if path.suffix
-            else "extension (none)"
-        )
+        given = f"extension {path.suffix!r}" if path.suffix else "extension (none)"
+        given = f"format {file_format!r}" if file_format else given
         raise MeshFileError(f"{path}: unknown {what} {given}; known formats: {', '.join(known)}")
     return key
 
