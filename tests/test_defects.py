@@ -293,6 +293,36 @@ def test_icc_at_a_tiny_radius_gives_no_valid_wrong_number(edges):
         assert not result.valid.any()
 
 
+@pytest.mark.parametrize("edges", [0.07, 0.35, 0.7, 1.0, 1.5])
+def test_normal_cycle_ball_below_one_edge_is_undefined(edges):
+    # fuzz_api seed 51, case 5992: radius 0.02 (0.07 edges), 4 of the 6 valid vertices off by more than half
+    # of H = 1. Below one median edge length every ball holds a few partial edges: undefined
+    sphere, radius = _random_sphere_at(edges)
+    topology = MeshTopology.from_faces(sphere.faces)
+    median = float(vertex_length_scales(sphere.vertices, topology)[0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method="normal_cycle_ball", radius=radius)
+    assert result.valid.any() == (radius >= median)
+    assert np.all(np.abs(result.mean[result.valid] - 1.0) < 0.5)
+    reasons = np.array(INVALID_REASONS)[result.invalid_reason[~result.valid]]
+    assert (reasons == INVALID_REASONS[UNDEFINED]).all()
+
+
+@pytest.mark.parametrize("method", ["icc", "normal_cycle_ball", "quadric"])
+def test_a_spike_leaves_a_voxel_surface_a_voxel_surface(method):
+    # fuzz_api seed 51, cases 711 and 3942: a vertex of a voxel sphere flung to 1e22 is on no grid, and the
+    # mesh lost its voxel default (1.4-1.5 times the radius); the grid is now found without the needles
+    mesh = _voxel_sphere()
+    clean, _ = _compute(mesh.vertices, mesh.faces, method)  # marching cubes' inward winding: one warning
+    vertices = mesh.vertices.copy()
+    vertices[5] = [1e22, 0.0, 0.0]
+    result, _ = _compute(vertices, mesh.faces, method)
+    assert result.parameters["surface"] == clean.parameters["surface"] == "voxel"
+    assert result.parameters["radius"] == pytest.approx(clean.parameters["radius"], rel=0.02)
+    assert not result.valid[5]
+
+
 def test_failed_fits_leave_a_vertex_undefined_only_in_a_ball_inside_its_star():
     from meshcurv.estimators._support import ball_holds_neighbours, failed_fits_undefined
 

@@ -427,3 +427,19 @@ def test_the_default_radius_of_a_voxel_surface_is_not_named_as_given(method):
         result = meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method)
     assert result.parameters["surface"] == "voxel"
     assert not any("too little of the surface" in str(w.message) for w in seen)
+
+
+def test_a_voxel_grid_of_subnormal_spacing_raises_no_overflow_warning():
+    # fuzz_api seed 51, case 8613: an ellipsoid at 1e-312 (subnormal coordinates) beside a sphere at 1e6: the
+    # lattice search of the default radius divided the 1e6 planes by a subnormal spacing ('overflow
+    # encountered in divide' from lattice._plane_lattice)
+    tiny, large = shapes.ellipsoid(subdivisions=5), shapes.uv_sphere(n_longitude=12, n_latitude=8)
+    vertices = np.concatenate([tiny.vertices * 1e-312, large.vertices * 1e6 + 5e6])
+    faces = np.concatenate([tiny.faces, large.faces + len(tiny.vertices)])
+    context = _only_documented_warnings()
+    try:
+        meshcurv.principal_curvatures(vertices, faces, method="quadric")
+    except DOCUMENTED:
+        pass
+    finally:
+        context.__exit__(None, None, None)

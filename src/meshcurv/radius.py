@@ -352,8 +352,12 @@ def voxel_surface_radius(
     that takes a radius, so that ``quadric`` and ``normal_cycle_ball`` average the staircase out as
     ``icc`` does.
     """
+    from .defects import needle_vertices
+
     referenced = topology.referenced_vertices
-    grid = voxel_grid(vertices[referenced])
+    # a spike is on no grid (issue 29: one flung to 1e22 made a voxel sphere an ordinary mesh, radius 1.4x)
+    spikes = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
+    grid = voxel_grid(vertices[referenced & ~spikes])
     if grid is None:
         return None
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
