@@ -405,10 +405,14 @@ def test_noisy_flat_ellipsoid_normals_are_fitted_on_one_face():
     # thickness 1.4 at most, below the asked radius: every ball reaches the other face; the fits shrink
     # where it holds more than 5% of the ball's points (the faces' middles, most of the area)
     assert r.parameters["shrunk"] > 0.5
-    assert r.valid.all() and (np.einsum("ij,ij->i", r.normals, exact) > 0).all()
+    assert (np.einsum("ij,ij->i", r.normals, exact) > 0).all()
+    # the estimates a ball sqrt(2) times larger, or the neighbours', do not reproduce are NaN (unsteady): the
+    # band by the rim, where the curvature changes several times within a ball (21% of the points)
+    unsteady = INVALID_REASONS.index(next(t for t in INVALID_REASONS if t.startswith("point cloud: unsteady")))
+    assert r.valid.mean() > 0.7 and (r.invalid_reason[~r.valid] == unsteady).all()
     largest = np.abs(mean) + np.sqrt(np.maximum(mean**2 - gaussian, 0.0))  # max |k|: |H| + sqrt(H^2 - K)
-    assert np.median(np.abs(r.mean - mean) / largest) < 0.15
-    assert np.median(np.abs(r.gaussian - gaussian) / largest**2) < 0.15
+    assert np.median(np.abs(r.mean - mean)[r.valid] / largest[r.valid]) < 0.15
+    assert np.median(np.abs(r.gaussian - gaussian)[r.valid] / largest[r.valid] ** 2) < 0.15
     angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", r.normals, exact), -1, 1)))
     assert np.median(angle) < 2.0
 

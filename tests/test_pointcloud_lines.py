@@ -129,8 +129,11 @@ def test_a_default_radius_beyond_the_work_budget_is_cut_with_a_warning(method, m
     points = u * (1.0 + rng.uniform(-1, 1, (3000, 1)) * 0.3 * np.sqrt(4 * np.pi / 3000))
     with pytest.warns(MeshQualityWarning, match="would hold about .* points a ball .* cut to"):
         r = point_cloud_curvatures(points, method=method)
-    assert r.valid.mean() > 0.9
-    assert abs(np.median(r.mean[r.valid]) - 1.0) < 0.1
+    # the radius cut below what the noise calls for: the fits follow the noise (jets: 86% of the points off by
+    # more than 50%, median 210%; the measures 6.5%): their estimates are unsteady, NaN, and the few left are right
+    assert (np.abs(r.mean[r.valid] - 1.0) > 0.5).sum() <= max(1, 0.01 * r.valid.sum())
+    unsteady = [code for code, text in enumerate(INVALID_REASONS) if text.startswith("point cloud: unsteady")]
+    assert np.isin(r.invalid_reason[~r.valid], unsteady).mean() > 0.9
 
 
 def flat_ellipsoid(n, c, noise, seed=0):

@@ -41,7 +41,8 @@ def test_two_spheres_a_spacing_or_two_apart_are_both_outward(method, gap, n):
     for part in (slice(0, n), slice(n, 2 * n)):
         assert np.mean(outward[part][r.valid[part]]) > 0.99
         assert np.median(r.mean[part][r.valid[part]]) == pytest.approx(1.0, rel=0.02)
-        assert r.valid[part].mean() > 0.9
+        # (the points beside the gap whose larger ball, or neighbours, hold the other sphere are NaN: unsteady)
+        assert r.valid[part].mean() > 0.85
     # beside the gap: jets refuse every two-sided ball; the measures keep a few rough points where the
     # two spheres' neighbourhoods mix (16 of 6000 off by more than 50% at 1 spacing; 3000 inverted before)
     wrong = np.abs(r.mean[r.valid] - 1.0) > 0.5
@@ -174,7 +175,8 @@ def test_two_spheres_of_different_sizes_close_together_are_outward_or_invalid(me
     centres = np.where(first[:, None], 0.0, np.array([gap_centre, 0.0, 0.0]))
     r = quiet(points, method=method)
     _outward_or_invalid(r, points, centres, np.where(first, 1.0, 1 / 1.5))
-    assert r.valid[first].mean() > 0.8 and r.valid[~first].mean() > 0.8
+    # (beside the gap, estimates a larger ball or the neighbours do not reproduce are NaN: 20-21% at 400 points)
+    assert r.valid[first].mean() > 0.75 and r.valid[~first].mean() > 0.75
 
 
 @pytest.mark.parametrize("method", POINT_CLOUD_METHODS)

@@ -7,6 +7,7 @@ Both take trusted arrays (float64 points, unit oriented normals) and return
 from __future__ import annotations
 
 import logging
+import warnings
 
 import numpy as np
 
@@ -63,6 +64,25 @@ CHUNK = 32768
 #: A jet fit whose ball reaches the other side of the surface is redone over a ball this many times
 #: smaller (:func:`one_sided_fits`): sqrt(2) halves the ball's area per step.
 SHRINK = 2.0**-0.5
+
+#: An estimate is kept where the same estimator over balls :data:`LARGER` times larger (twice the points)
+#: reproduces it (:func:`unsteady`): both principal curvatures within this share of the smaller of the two
+#: estimates' largest |k|. A bias that grows as r^2 (a curvature that changes within the ball) differs between
+#: the two balls by about itself, and the fuzzer calls a valid H a lie beyond 0.5 of |k|; a fit that follows
+#: noise differs from the larger ball's by about its own error.
+AGREEMENT = 0.4
+
+#: ... where a change of the curvature by this many radians of normal turning over the ball (``0.05 / r``)
+#: counts as none: a flat region's two estimates agree within it.
+FLAT_TURN = 0.05
+
+#: A point's estimate is kept where its nearest neighbours' (whose balls hold nearly the same points) reproduce it
+#: (:func:`erratic`): the median over them of the largest difference of a principal curvature within this share
+#: of the smaller largest |k|.
+NEIGHBOUR_AGREEMENT = 0.3
+
+#: The ball of the check of :func:`unsteady` is this many times the radius of the estimate.
+LARGER = 2.0**0.5
 
 
 def one_sided_fits(
@@ -146,6 +166,60 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
     logger.debug("point cloud: curvatures of the jets")
     if details is not None:
         details["radii"] = radii
+    found = _jet_curvatures(coefficients, frame, radii, normals)
+    if details is not None:
+        # the same fits over balls LARGER times larger, from the same normals: the estimate must not depend on it
+        done = np.asarray(centres, dtype=np.int64)
+        done = done[np.isfinite(found[0][done])]
+        again = one_sided_fits(
+            points, normals, radius * LARGER, done, usable, smallest=None if smallest is None else smallest * LARGER
+        )
+        details["unsteady"] = unsteady(found, _jet_curvatures(*again, normals), done, radius)
+    return found
+
+
+def erratic(k_min, k_max, indices, valid, spacing) -> np.ndarray:
+    """(N,) bool: the ``valid`` points whose estimate its nearest neighbours' do not reproduce.
+
+    The balls of a point and of its :data:`~meshcurv._pointcloud_normals.NEIGHBOURS` nearest neighbours
+    ``indices`` (N, k) (a spacing or two apart) hold nearly the same points: on a surface the estimator resolves
+    their estimates differ by the change of the curvature over a spacing or two. A point whose principal
+    curvatures differ from its neighbours' estimates (those that have one, valid or not; none: flagged) by
+    more than :data:`NEIGHBOUR_AGREEMENT` times the smaller
+    largest |k| (median over the neighbours; at least ``FLAT_TURN / (3 spacing)``) is measured by a fit that
+    follows noise, or by balls whose content changes abruptly (a rim sharper than the sampling): NaN.
+    """
+    n = k_min.shape[0]
+    estimated = np.isfinite(k_min) & np.isfinite(k_max)
+    safe = np.where(valid[:, None] & estimated[indices], indices, -1)
+    with np.errstate(invalid="ignore"):
+        own = np.stack([k_min, k_max], axis=1)
+        theirs = np.where((safe >= 0)[..., None], own[np.maximum(safe, 0)], np.nan)
+        largest = np.minimum(np.abs(own).max(axis=1)[:, None], np.abs(theirs).max(axis=2))
+        scale = np.maximum(largest, FLAT_TURN / (3.0 * spacing)[:, None])
+        apart = np.abs(theirs - own[:, None, :]).max(axis=2) / scale
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            typical = np.nanmedian(apart, axis=1)
+    out = np.zeros(n, dtype=bool)
+    out[valid] = ~(typical[valid] <= NEIGHBOUR_AGREEMENT)  # (no neighbour with an estimate: nothing reproduces it)
+    return out
+
+
+def unsteady_problem(flagged: np.ndarray) -> list[str]:
+    """The phrase of the call's warning for the ``flagged`` (N,) points of :func:`unsteady` (none when none)."""
+    if not flagged.any():
+        return []
+    return [
+        f"at {int(flagged.sum())} points the estimate changed by more than {AGREEMENT:g} of |k| over a ball "
+        f"{LARGER:.3g} times larger, or differs from its neighbours' by more than {NEIGHBOUR_AGREEMENT:g} of |k| "
+        "(a rim or part sharper than the ball, the other side of a thin part, or noise the fit follows): NaN"
+    ]
+
+
+def _jet_curvatures(coefficients, frame, radii, normals):
+    """``(k_min, k_max, dir_min, dir_max, normals)`` of jets ``coefficients`` (N, 6) in units of their ``radii``
+    (N,), fitted in ``frame``; NaN (and the given ``normals``) where a fit failed."""
     six, fitted = shape_operators(coefficients, frame, 1.0)
     with np.errstate(invalid="ignore"):
         six = six / radii[:, None]
@@ -157,6 +231,31 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
     for array in (k_min, k_max, dir_min, dir_max):
         array[~ok] = np.nan
     return k_min, k_max, dir_min, dir_max, out_normals
+
+
+def unsteady(found, larger, centres, radius) -> np.ndarray:
+    """(N,) bool: the ``centres`` whose estimate ``found`` (``k_min, k_max, ...``) over balls of ``radius`` is
+    not reproduced by the estimate ``larger`` over balls :data:`LARGER` times larger: a principal curvature off by
+    more than :data:`AGREEMENT` times the smaller largest |k| of the two (and at least ``FLAT_TURN / radius``),
+    or no estimate there.
+
+    An estimate over a ball is a measurement of the surface when it does not depend on the ball: where the ball
+    resolves the surface (radius of curvature, thickness and features larger than the ball, noise averaged out)
+    both estimates agree to within their small error. A rim sharper than the ball or a curvature that changes
+    several times within it, the other side of a thin part or of a neighbouring one, or noise that a fit
+    follows, weigh differently in the two balls.
+    """
+    n = found[0].shape[0]
+    out = np.zeros(n, dtype=bool)
+    if centres.size == 0:
+        return out
+    a = np.stack([found[0][centres], found[1][centres]], axis=1)
+    b = np.stack([larger[0][centres], larger[1][centres]], axis=1)
+    with np.errstate(invalid="ignore"):
+        scale = np.maximum(np.minimum(np.abs(a).max(axis=1), np.abs(b).max(axis=1)), FLAT_TURN / radius)
+        close = np.abs(a - b).max(axis=1) <= AGREEMENT * scale
+    out[centres] = ~close
+    return out
 
 
 def fitted_normals(points, normals, radius, centres, usable, *, smallest: float, details: dict | None = None):
@@ -334,6 +433,7 @@ def corrected_measures(
     spacing: float = 0.0,
     n_triangles: int | None = None,
     sheets: np.ndarray | None = None,
+    details: dict | None = None,
 ):
     """Randomized corrected curvature measures over balls of ``radius`` (Lachaud et al. 2023).
 
@@ -346,11 +446,15 @@ def corrected_measures(
     those of ``-sym(mu^{X,Y}) / mu_0`` in the tangent plane of the centre's
     normal. The draws are ranks in the ball's distance order from one fixed
     pattern: the result does not depend on the order of the points, and moves
-    with them under rigid motions and scaling.
+    with them under rigid motions and scaling. ``details`` receives
+    ``"unsteady"`` (:func:`unsteady`: the estimates that the same measures
+    over balls :data:`LARGER` times larger do not reproduce).
     """
     n = points.shape[0]
     out = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)]
     if not usable.any():  # no point may enter a ball (every normal fit failed): nothing to measure
+        if details is not None:
+            details["unsteady"] = np.zeros(n, dtype=bool)
         return (*out, normals)
     pattern = _rank_pattern(TRIANGLES if n_triangles is None else n_triangles)
     kernels = numba_kernels("pointcloud")
@@ -391,4 +495,18 @@ def corrected_measures(
         out[1][target] = k_max
         out[2][target] = dir_min
         out[3][target] = dir_max
+    if details is not None:
+        done = centres[np.isfinite(out[0][centres])]
+        larger = corrected_measures(
+            tree,
+            points,
+            normals,
+            radius * LARGER,
+            done,
+            usable,
+            spacing=spacing,
+            n_triangles=n_triangles,
+            sheets=sheets,
+        )
+        details["unsteady"] = unsteady(out, larger, done, radius)
     return (*out, normals)

@@ -422,6 +422,17 @@ def orientation_signs(
         two sides of a part thinner than the neighbourhood, whose consistent
         normals must not be "corrected" into one direction). A point that
         noise lifted off its neighbours' planes keeps its other steep edges.
+        When the given normals are not consistent on that graph, they still
+        are (signs all +1, a user's orientation is kept) when every edge of
+        the graph between opposite normals runs between two stacked sheets:
+        both normals point to the other end (face to face: the inward faces
+        of a thin part, two outward parts across a gap) or both away from it
+        (back to back), and no point has edges of both kinds. A normal flipped
+        within one sheet has opposite edges whose two ends point the same way
+        (across the chord of a curved sheet), or, under noise, both kinds
+        (it lies above some neighbours and below others). This settles a part
+        thinner than the spacing, or a rim sharper than it, whose two faces
+        join by opposite edges only.
 
     Returns
     -------
@@ -434,30 +445,53 @@ def orientation_signs(
     indices = indices[:, :GRAPH_NEIGHBOURS]
     n = indices.shape[0]
     rows, cols, keep = _graph_edges(indices, usable)
-    if points is not None:
-        offsets = points[cols] - points[rows]
-        reach = TANGENT_SLOPE * np.linalg.norm(offsets, axis=1)
-        along = np.maximum(
-            np.abs(np.einsum("ij,ij->i", offsets, normals[rows])), np.abs(np.einsum("ij,ij->i", offsets, normals[cols]))
-        )
-        flat = along <= reach
-        # a steep edge is dropped only where its point keeps enough flat ones: a point that noise
-        # lifted off its neighbours' planes stays joined to them
-        enough = np.bincount(rows, weights=flat, minlength=n) >= MIN_FLAT_EDGES
-        # opposite normals that both point away from the other point: the two sides of a thin part
-        ahead = np.einsum("ij,ij->i", offsets, normals[rows])
-        behind = np.einsum("ij,ij->i", offsets, normals[cols])
-        back_to_back = (ahead < 0) & (behind > 0) & (np.einsum("ij,ij->i", normals[rows], normals[cols]) < 0)
-        keep = flat | (~enough[rows] & ~back_to_back)
-        rows, cols = rows[keep], cols[keep]
-    compiled = numba_kernels("pointcloud")
-    if compiled is not None and points is None:  # every kept edge's cosine without (E, 3) gathers
-        cosine = compiled.edge_cosines(normals, np.ascontiguousarray(indices)).ravel()[keep]
-    else:
-        cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
-    # weight 1 - |cos| (1 - cos for given signs), plus a floor so that parallel pairs stay edges of the sparse graph
+    if points is None:
+        compiled = numba_kernels("pointcloud")
+        if compiled is not None:  # every kept edge's cosine without (E, 3) gathers
+            cosine = compiled.edge_cosines(normals, np.ascontiguousarray(indices)).ravel()[keep]
+        else:
+            cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
+        # weight 1 - |cos| (1 - cos for given signs), plus a floor so that parallel pairs stay edges of the sparse graph
+        weights = (1.0 - cosine if given else 1.0 - np.abs(cosine)) + 1e-6
+        return _spanning_forest(n, rows, cols, cosine < 0, weights)
+    offsets = points[cols] - points[rows]
+    cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
+    ahead = np.einsum("ij,ij->i", offsets, normals[rows])
+    behind = np.einsum("ij,ij->i", offsets, normals[cols])
+    flat = np.maximum(np.abs(ahead), np.abs(behind)) <= TANGENT_SLOPE * np.linalg.norm(offsets, axis=1)
+    # a steep edge is dropped only where its point keeps enough flat ones: a point that noise
+    # lifted off its neighbours' planes stays joined to them
+    enough = np.bincount(rows, weights=flat, minlength=n) >= MIN_FLAT_EDGES
+    # opposite normals that both point away from the other point: the two sides of a thin part
+    back_to_back = (ahead < 0) & (behind > 0) & (cosine < 0)
+    kept = flat | (~enough[rows] & ~back_to_back)
     weights = (1.0 - cosine if given else 1.0 - np.abs(cosine)) + 1e-6
-    return _spanning_forest(n, rows, cols, cosine < 0, weights)
+    signs, labels = _spanning_forest(n, rows[kept], cols[kept], cosine[kept] < 0, weights[kept])
+    if not given or (signs > 0).all():
+        return signs, labels
+    # opposite normals that both point to the other point: the inward faces of a thin part, two outward parts
+    face_to_face = (ahead > 0) & (behind < 0) & (cosine < 0)
+    if (((cosine < 0) & ~back_to_back & ~face_to_face).any()) or _both_ways(n, rows, cols, back_to_back, face_to_face):
+        return signs, labels
+    # every opposite pair lies across two stacked sheets, each point's one way: the normals are consistent
+    apart = cosine >= 0
+    _, labels = _spanning_forest(n, rows[apart], cols[apart], np.zeros(int(apart.sum()), dtype=bool), weights[apart])
+    return np.ones(n), labels
+
+
+def _both_ways(n: int, rows: np.ndarray, cols: np.ndarray, one: np.ndarray, other: np.ndarray) -> bool:
+    """Whether a point is an end of an edge ``(rows, cols)`` of ``one`` (E,) bool and of one of ``other``."""
+    ends = np.concatenate([rows, cols])
+    on_one = np.bincount(ends, weights=np.concatenate([one, one]), minlength=n) > 0
+    on_other = np.bincount(ends, weights=np.concatenate([other, other]), minlength=n) > 0
+    return bool((on_one & on_other).any())
+
+
+def _smallest_part(labels: np.ndarray, usable: np.ndarray) -> int:
+    """Points of the smallest component ``labels`` (N,) of the ``usable`` points (N,) (0 when none is usable)."""
+    sizes = np.bincount(labels[usable])
+    sizes = sizes[sizes > 0]
+    return int(sizes.min()) if sizes.size else 0
 
 
 def _graph_edges(indices: np.ndarray, usable: np.ndarray):

@@ -109,8 +109,8 @@ POINT_CLOUD_REASONS = (
     "point cloud: side undecided (two sheets closer than the spacing, or stacked with normals the same way)",
     "point cloud: every ball held the other side of a thin part or a neighbouring part",
     "point cloud: on a line (its neighbours lie on a line with no surface around it)",
-    "point cloud: the estimate changed over a ball half the size (a rim or part sharper than the ball, "
-    "the other side of a thin part, or noise)",
+    "point cloud: unsteady estimate (changed over a larger ball or against its neighbours': a rim or part "
+    "sharper than the ball, the other side of a thin part, or noise)",
 )
 
 #: The code of a vertex invalid for no defect of the mesh: its estimate itself is undefined.

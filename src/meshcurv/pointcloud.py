@@ -74,6 +74,16 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
      (``invalid_reason``: every ball held the other side) below;
      the lowest error on clean samples (ellipsoid H 0.2%) and the fastest.
 
+7. the check: an estimate that the same estimator over balls sqrt(2)
+   times larger does not reproduce (a principal curvature off by more than
+   0.4 of the smaller |k|), or that its nearest neighbours' estimates do not
+   (by more than 0.3 of |k|, median), is NaN (``invalid_reason``: unsteady
+   estimate): a rim or part sharper than the ball, the other side of a thin
+   part, or noise the fit follows
+   (:func:`meshcurv._pointcloud_estimators.unsteady`,
+   :func:`meshcurv._pointcloud_estimators.erratic`). Clean samples keep every
+   point (``benchmarks/pointcloud.md``).
+
 References
 ----------
 G. Barill, N. G. Dickson, R. Schmidt, D. I. W. Levin, A. Jacobson (2018).
@@ -204,6 +214,9 @@ _TWO_SIDED = _reason_code("point cloud: every ball held")
 
 #: Code of points on a line with no surface around them.
 _ON_A_LINE = _reason_code("point cloud: on a line")
+
+#: Code of points whose estimate a larger ball, or their neighbours' estimates, do not reproduce.
+_UNSTEADY = _reason_code("point cloud: unsteady estimate")
 
 
 def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | None = None) -> CurvatureResult:
@@ -698,6 +711,7 @@ def _compute(points, given, radius, method, search=None):
     two_sided = 0  # points whose every ball held the other side (or too few points)
     one_sided = np.ones(n, dtype=bool)  # points with a one-sided jet fit (or given normals)
     two_sided_mask = np.zeros(n, dtype=bool)
+    unsteady = np.zeros(n, dtype=bool)  # estimates a larger ball does not reproduce
     noisy = 0  # points whose fits the noise dominates (see NOISY_PCA)
     mixed = None
     compiled = numba_kernels("pointcloud") is not None
@@ -774,6 +788,7 @@ def _compute(points, given, radius, method, search=None):
                 part_usable & part_one_sided,
                 spacing=group_spacing,
                 sheets=part_sheets,
+                details=details,
             )
         if near is not None:
             one_sided[near] = part_one_sided
@@ -782,6 +797,7 @@ def _compute(points, given, radius, method, search=None):
             shrunk += int((fitted_radii < asked).sum())
             two_sided += int(np.isnan(fitted_radii).sum())
             two_sided_mask[members] = np.isnan(fitted_radii)
+        unsteady[members] = details["unsteady"][part_members]
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
             whole[members] = part[part_members]
     if method == "jets" or given is None:
@@ -827,6 +843,10 @@ def _compute(points, given, radius, method, search=None):
     reason[~one_sided | (two_sided_mask & usable)] = _TWO_SIDED
     reason[lonely] = _ON_A_LINE
     valid &= one_sided
+    unsteady |= _estimators.erratic(k_min, k_max, indices, valid & ~unsteady, spacing)
+    problems.extend(_estimators.unsteady_problem(unsteady & valid))
+    reason[unsteady & valid] = _UNSTEADY
+    valid &= ~unsteady
     if doubtful.any():
         found = []
         between = doubtful & ~unsettled & ~alike
