@@ -9,7 +9,7 @@ The first form runs the default call on the five voxel meshes of ``accuracy_voxe
 target, then the same ball sums at the same per-vertex radii (``result.radius``) with the analytic surface's
 normals in place of the fitted ones, and prints both median errors of ``|H|`` over ``|H_exact|`` (the metric of
 ``accuracy_voxel.md``) and the fitted normals' angle to the analytic ones. ``--set NAME=VALUE`` changes
-constants of :mod:`meshcurv.radius` and runs ``scale_default.py`` on ``--families``; ``--normal-ladder``
+constants of :mod:`meshcurv.radius` (``--normal-degree`` icc's ``NORMAL_DEGREE``) and runs ``scale_default.py`` on ``--families``; ``--normal-ladder``
 replaces the voxel path's normal fits by fits over each ``q`` times the per-vertex normal radius, keeping at
 each vertex the upper rung of the consecutive pair whose normals turn least (averaged over 2 rings).
 ``--smoothed-normals`` fits the normals of three smoothed isosurfaces in other ways (jets of degree 2, 3, 4 over
@@ -171,13 +171,14 @@ def main(argv=None):
     parser.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE")
     parser.add_argument("--normal-ladder", metavar="Q1,Q2,...")
     parser.add_argument("--smoothed-normals", action="store_true")
+    parser.add_argument("--normal-degree", type=int, help="icc.NORMAL_DEGREE (the jets of the normal fits)")
     parser.add_argument("--families", nargs="+")
     parser.add_argument("--output")
     args = parser.parse_args(argv)
     if args.smoothed_normals:
         smoothed_normals_table()
         return
-    if not (args.set or args.normal_ladder):
+    if not (args.set or args.normal_ladder or args.normal_degree):
         exact_normals_table()
         return
     for setting in args.set:
@@ -185,6 +186,8 @@ def main(argv=None):
         if not hasattr(radius_rules, name):
             raise SystemExit(f"meshcurv.radius has no constant {name}")
         setattr(radius_rules, name, float(value))
+    if args.normal_degree:
+        icc.NORMAL_DEGREE = args.normal_degree
     if args.normal_ladder:
         normal_ladder([float(q) for q in args.normal_ladder.split(",")])
     import scale_default
