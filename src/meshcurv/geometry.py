@@ -61,9 +61,28 @@ COMPONENT_SCALE_SPREAD = 16.0
 
 
 def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F, 3) ``cross(b - a, c - a)`` for every face ``(a, b, c)``: twice the area times the unit normal.
+    """The cross product ``cross(b - a, c - a)`` of every face ``(a, b, c)``.
 
     Written out component by component (faster than :func:`numpy.cross`, same values).
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+        Finite coordinates.
+    faces : array_like of shape (F, 3), int
+        0-based vertex indices of the triangles (F may be 0).
+
+    Returns
+    -------
+    ndarray of shape (F, 3), float64
+        Twice the face's area times its unit normal (right-hand rule on the
+        vertex order), in length^2; 0 on zero-area faces.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``vertices`` or ``faces`` of the wrong shape or dtype, coordinates not
+        finite, or indices out of range.
     """
     vertices, faces = checked_mesh(vertices, faces)
     kernels = numba_kernels("geometry")
@@ -83,14 +102,46 @@ def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F,) area of every face."""
+    """The area of every face, ``|cross(b - a, c - a)| / 2``.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based.
+
+    Returns
+    -------
+    ndarray of shape (F,), float64
+        In length^2, >= 0 (0 for a repeated corner or collinear corners).
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`face_cross_products`.
+    """
     return 0.5 * np.linalg.norm(face_cross_products(vertices, faces), axis=1)
 
 
 def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F, 3) unit normal of every face, by the right-hand rule on its vertex order.
+    """The unit normal of every face, by the right-hand rule on its vertex order.
 
-    A face with zero area has no normal: its row is NaN.
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based.
+
+    Returns
+    -------
+    ndarray of shape (F, 3), float64
+        ``cross / |cross|`` (:func:`face_cross_products`); a face with zero
+        area has no normal: its row is NaN.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`face_cross_products`.
     """
     cross = face_cross_products(vertices, faces)
     norm = np.linalg.norm(cross, axis=1, keepdims=True)
@@ -101,8 +152,26 @@ def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 def signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
     """Signed volume enclosed by the faces (positive for a closed, outward-wound mesh).
 
-    Computed relative to the centroid of the vertices, which reduces rounding and
-    makes the value independent of translation on closed meshes.
+    ``V = sum(a . (b x c)) / 6`` over the faces ``(a, b, c)``, with the
+    coordinates taken relative to the centroid of the vertices, which reduces
+    rounding and makes the value independent of translation on closed meshes
+    (on an open mesh it depends on that origin).
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based.
+
+    Returns
+    -------
+    float
+        In length^3; reversing every face negates it; 0 when there are no faces.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`face_cross_products`.
     """
     vertices, faces = checked_mesh(vertices, faces)
     centred = vertices - vertices.mean(axis=0)
@@ -111,9 +180,26 @@ def signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
 
 
 def vertex_areas(vertices: np.ndarray, faces: np.ndarray, *, areas: np.ndarray | None = None) -> np.ndarray:
-    """(V,) barycentric vertex areas: a third of the area of every incident face.
+    """Barycentric vertex areas: a third of the area of every incident face.
 
-    They sum to the total area of the mesh; an unreferenced vertex gets 0.
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based.
+    areas : array_like of shape (F,), optional
+        The face areas when already computed (:func:`face_areas`).
+
+    Returns
+    -------
+    ndarray of shape (V,), float64
+        In length^2; they sum to the total area of the mesh; an unreferenced
+        vertex gets 0.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`face_cross_products`, or ``areas`` not real numbers of shape (F,).
     """
     vertices, faces = checked_mesh(vertices, faces)
     if areas is None:
@@ -126,10 +212,30 @@ def vertex_areas(vertices: np.ndarray, faces: np.ndarray, *, areas: np.ndarray |
 
 
 def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray | None = None) -> np.ndarray:
-    """(V, 3) unit vertex normals, the area-weighted mean of the incident face normals.
+    """Unit vertex normals, the area-weighted mean of the incident face normals.
 
-    Oriented like the faces (outward on an outward-wound closed mesh). A vertex
-    with no incident face of non-zero area, or whose face normals cancel, is NaN.
+    ``n_v = s / |s|`` with ``s`` the sum of :func:`face_cross_products` over
+    the faces at ``v`` (each weighted by twice its area).
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based.
+    cross : array_like of shape (F, 3), optional
+        The face cross products when already computed.
+
+    Returns
+    -------
+    ndarray of shape (V, 3), float64
+        Oriented like the faces (outward on an outward-wound closed mesh). NaN
+        where ``s`` is 0: a vertex with no incident face of non-zero area, or
+        whose face normals cancel exactly.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`face_cross_products`, or ``cross`` not real numbers of shape (F, 3).
     """
     vertices, faces = checked_mesh(vertices, faces)
     if cross is not None:
@@ -148,7 +254,11 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
 
 
 def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
-    """Unit vectors from (V, 3) sums of face cross products; NaN where they (nearly) cancel."""
+    """Unit vectors from (V, 3) sums of face cross products; NaN where a sum is 0.
+
+    (The test ``|s| > 1e-12 max(max|s_k|, tiny)`` fails only for a zero or
+    subnormal sum, since ``|s| >= max|s_k|``.)
+    """
     norm = np.linalg.norm(summed, axis=1, keepdims=True)
     scale = np.abs(summed).max(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -156,7 +266,25 @@ def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
 
 
 def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """(E,) length of each of the given (E, 2) edges."""
+    """The length of each of the given edges.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    edges : array_like of shape (E, 2), int
+        0-based vertex indices of the edges' ends (E may be 0).
+
+    Returns
+    -------
+    ndarray of shape (E,), float64
+        ``|x_j - x_i|`` for each edge ``(i, j)``.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``vertices`` or ``edges`` of the wrong shape or dtype, coordinates not
+        finite, or indices out of range.
+    """
     vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
     kernels = numba_kernels("geometry")
     if kernels is not None:
@@ -166,7 +294,24 @@ def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
 
 
 def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """(V,) mean length of the given (E, 2) edges at each vertex: the local resolution (NaN where none)."""
+    """The mean length of the given edges at each vertex: the local resolution.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    edges : array_like of shape (E, 2), int
+        0-based; each edge counts at both its ends.
+
+    Returns
+    -------
+    ndarray of shape (V,), float64
+        NaN at a vertex that is the end of no edge.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`edge_lengths`.
+    """
     vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
     n = vertices.shape[0]
     kernels = numba_kernels("geometry")
@@ -180,11 +325,27 @@ def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
 
 
 def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
-    """Mean length of the given (E, 2) edges (0 when there are none).
+    """Mean length of the given edges.
 
     Not robust: one edge to a vertex at 1e10 sets it. Tolerances and default
     radii use :func:`median_edge_length`, :func:`robust_mean_edge_length` or
     :func:`vertex_length_scales` instead.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    edges : array_like of shape (E, 2), int
+        0-based.
+
+    Returns
+    -------
+    float
+        0 when there are no edges.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`edge_lengths`.
     """
     vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
     if edges.shape[0] == 0:
@@ -196,19 +357,52 @@ def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
 
 
 def median_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
-    """Median length of the given (E, 2) edges (0 when there are none): a scale no outlier moves."""
+    """Median length of the given edges: a scale no outlier moves.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    edges : array_like of shape (E, 2), int
+        0-based.
+
+    Returns
+    -------
+    float
+        0 when there are no edges.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`edge_lengths`.
+    """
     lengths = edge_lengths(vertices, edges)
     return float(np.median(lengths)) if lengths.size else 0.0
 
 
 def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
-    """Mean length of the given (E, 2) edges, leaving out those beyond ``OUTLIER_EDGE_RATIO`` medians.
+    """Mean length of the given edges, leaving out those beyond ``OUTLIER_EDGE_RATIO`` medians.
 
     Equal to :func:`mean_edge_length` on any mesh whose longest edge is within
-    :data:`OUTLIER_EDGE_RATIO` (1000) times its median (a decimated model has
-    some 40 between its shortest and longest edges), so default radii keep their
-    values there; an edge to a spike vertex (a scanner's sentinel at 1e10) is left
-    out instead of multiplying the mean. 0 when there are no edges.
+    :data:`OUTLIER_EDGE_RATIO` (1000) times its median, so default radii keep
+    their values there; an edge to a spike vertex (a scanner's sentinel at
+    1e10) is left out instead of multiplying the mean. The median is that of
+    an even sample of at most about :data:`MEDIAN_SAMPLE` edges.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    edges : array_like of shape (E, 2), int
+        0-based.
+
+    Returns
+    -------
+    float
+        0 when there are no edges.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`edge_lengths`.
     """
     lengths = edge_lengths(vertices, edges)
     if lengths.size == 0:
@@ -287,6 +481,17 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
 
 def checked_topology_points(vertices, topology) -> np.ndarray:
     """``vertices`` checked (:func:`~meshcurv._validation.checked_points`), one row per vertex of ``topology``.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    topology : MeshTopology
+        With ``topology.n_vertices == V``.
+
+    Returns
+    -------
+    ndarray of shape (V, 3), float64
+        C-contiguous; ``vertices`` itself when it already is such an array.
 
     Raises
     ------
@@ -367,6 +572,28 @@ def degenerate_faces(
     alone); per component, a part at 1e-3 and a part at 1e3 are each measured
     against their own edges.
 
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    topology : MeshTopology
+        With ``topology.n_vertices == V``.
+    cross : array_like of shape (F, 3), optional
+        The face cross products (:func:`face_cross_products`), when already computed.
+    mean_edge_length : float, optional
+        One length scale for every face, instead of the per-component medians.
+    double_areas : array_like of shape (F,), optional
+        Twice the face areas, when already computed.
+    scales : array_like of shape (V,), optional
+        The length scale of each vertex (:func:`vertex_length_scales`), when
+        already computed; a face takes that of its first corner.
+
+    Returns
+    -------
+    ndarray of shape (F,), bool
+        True for a face with a repeated corner
+        (``topology.degenerate_faces``) or with
+        ``area <= DEGENERATE_AREA_RATIO * scale ** 2``.
+
     Raises
     ------
     InvalidMeshError
@@ -412,10 +639,31 @@ def edge_dihedral_angles(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Signed angle between the two face normals of each usable edge.
 
-    ``unit_normals`` (F, 3): the unit face normals; ``usable_edges`` (E,) bool:
-    the interior manifold edges between proper faces. Returns ``(beta, lengths,
-    unit_edges)`` of shapes (E,), (E,), (E, 3); ``beta`` is 0 on edges that are
-    not usable (boundary, non-manifold, degenerate).
+    ``beta = atan2((n1 x n2) . e, n1 . n2)`` with ``n1, n2`` the normals of
+    the edge's faces ``topology.edge_faces`` and ``e`` its unit vector.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    topology : MeshTopology
+        With ``topology.n_vertices == V``.
+    unit_normals : array_like of shape (F, 3)
+        The unit face normals (:func:`face_normals`).
+    usable_edges : ndarray of shape (E,), bool
+        The edges to measure: interior manifold edges between proper faces.
+
+    Returns
+    -------
+    beta : ndarray of shape (E,), float64
+        In radians, in ``[-pi, pi]``: positive where the surface is convex
+        across the edge on a consistently wound mesh (every edge of an
+        outward-wound sphere), negative where it is concave; 0 on edges that
+        are not usable.
+    lengths : ndarray of shape (E,), float64
+        The edges' lengths.
+    unit_edges : ndarray of shape (E, 3), float64
+        The edges' unit vectors from ``topology.edges[:, 0]`` to
+        ``topology.edges[:, 1]``; 0 on zero-length edges.
 
     Raises
     ------
@@ -462,10 +710,27 @@ def _real_array(value, name: str) -> np.ndarray:
 
 
 def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F, 3) cotangent of the angle at each corner of every face.
+    """The cotangent of the angle at each corner of every face.
 
     ``cot = (a . b) / |a x b|`` for the two edge vectors ``a, b`` leaving the
-    corner; NaN on zero-area faces.
+    corner.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based.
+
+    Returns
+    -------
+    ndarray of shape (F, 3), float64
+        Column ``k`` for corner ``faces[:, k]``. Not finite on a zero-area
+        face: +-inf at collinear corners, NaN at a repeated one.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`face_cross_products`.
     """
     vertices, faces = checked_mesh(vertices, faces)
     out = np.zeros(faces.shape, dtype=np.float64)
@@ -479,7 +744,28 @@ def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F, 3) interior angle at each corner of every face, in radians (0 on zero-area faces)."""
+    """The interior angle at each corner of every face.
+
+    ``atan2(|a x b|, a . b)`` for the two edge vectors ``a, b`` leaving the corner.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based.
+
+    Returns
+    -------
+    ndarray of shape (F, 3), float64
+        In radians, in ``[0, pi]``; column ``k`` for corner ``faces[:, k]``.
+        The angles of a face sum to ``pi``; a face of collinear corners gets
+        ``0, 0, pi`` and one with a repeated corner 0 everywhere.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`face_cross_products`.
+    """
     vertices, faces = checked_mesh(vertices, faces)
     out = np.zeros(faces.shape, dtype=np.float64)
     for k in range(3):
@@ -496,8 +782,32 @@ def mixed_voronoi_corner_areas(vertices: np.ndarray, faces: np.ndarray) -> np.nd
     Meyer, Desbrun, Schroeder and Barr (2003), Fig. 4: on a non-obtuse triangle
     the Voronoi region of corner ``i``, ``(|e_ij|^2 cot k + |e_ik|^2 cot j) / 8``;
     on an obtuse one, half the area for the obtuse corner and a quarter for the
-    other two. The shares of a face sum to its area; summed per vertex
-    (``np.bincount(faces.ravel(), shares.ravel())``) they tile the surface.
+    other two.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based.
+
+    Returns
+    -------
+    ndarray of shape (F, 3), float64
+        In length^2, >= 0; column ``k`` for corner ``faces[:, k]``. The shares
+        of a face sum to its area; summed per vertex
+        (``np.bincount(faces.ravel(), shares.ravel())``) they tile the surface.
+        0 on zero-area faces.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`face_cross_products`.
+
+    References
+    ----------
+    M. Meyer, M. Desbrun, P. Schroeder, A. H. Barr (2003). Discrete
+    differential-geometry operators for triangulated 2-manifolds.
+    Visualization and Mathematics III, 35-57.
     https://doi.org/10.1007/978-3-662-05105-4_2
     """
     vertices, faces = checked_mesh(vertices, faces)
