@@ -80,7 +80,7 @@ import numpy as np
 from ..geometry import median_edge_length, robust_mean_edge_length
 from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
 from ..measures import curvatures_from_measures, face_measures, principal_from_measures
-from ..neighborhoods import ball_face_sums, ball_face_sums_nested
+from ..neighborhoods import ball_face_sums, ball_face_sums_nested, nested_jet_normals
 from ..radius import (
     VOXEL_SCALE_RULE,
     check_radius,
@@ -150,8 +150,13 @@ def fitted_normals(
     areas: np.ndarray | None = None,
     weighted: bool = False,
     failed: np.ndarray | None = None,
+    fits: np.ndarray | None = None,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
+
+    ``fits``: the (V, 3) jet normals at ``radius``, fitted already (:func:`estimate_multiscale`'s one
+    walk, :func:`meshcurv.neighborhoods.nested_jet_normals`): used where the surface is not fitted on its
+    coarse level.
 
     ``failed``: a (V,) bool array set True, in place, where no jet could be fitted (too few points, or a
     degenerate set).
@@ -198,6 +203,8 @@ def fitted_normals(
             min_spread=NORMAL_MIN_SPREAD,
         )
         fitted = jet_normals(coefficients, frame)
+    elif fits is not None:
+        fitted = fits
     else:
         fitted = fit_jet_normals(
             vertices,
@@ -236,12 +243,7 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
         return None
     typical = float(np.median(radius))
     indptr, indices = adjacency
-    if indices.size == 0:
-        return None
-    taken = np.linspace(0, indices.size - 1, min(indices.size, COARSE_SAMPLE)).round().astype(np.int64)
-    tails = np.searchsorted(indptr, taken, side="right") - 1
-    lengths = np.linalg.norm(vertices[indices[taken]] - vertices[tails], axis=1)
-    if not typical > COARSE_EDGES * float(np.median(lengths)):
+    if not _dense(vertices, typical, adjacency):
         return None
     tails = np.repeat(np.arange(n), np.diff(indptr))
     cell = typical / COARSE_CELLS
@@ -278,6 +280,18 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
     allowed = np.concatenate([np.zeros(n, dtype=bool), np.ones(c, dtype=bool)])
     point_areas = np.concatenate([np.zeros(n), total])
     return (np.concatenate([vertices, centroid]), np.concatenate([normals, group_normals]), allowed, lists, point_areas)
+
+
+def _dense(vertices: np.ndarray, radius: float, adjacency: tuple) -> bool:
+    """Whether normal fits over ``radius`` run on the coarse level: wider than :data:`COARSE_EDGES` median
+    edge lengths (taken over :data:`COARSE_SAMPLE` edges of the CSR lists ``adjacency``)."""
+    indptr, indices = adjacency
+    if indices.size == 0:
+        return False
+    taken = np.linspace(0, indices.size - 1, min(indices.size, COARSE_SAMPLE)).round().astype(np.int64)
+    tails = np.searchsorted(indptr, taken, side="right") - 1
+    lengths = np.linalg.norm(vertices[indices[taken]] - vertices[tails], axis=1)
+    return bool(radius > COARSE_EDGES * float(np.median(lengths)))
 
 
 def voxel_pilot(mesh: PreparedMesh):
@@ -550,6 +564,25 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     stages.start("fit normals")
     areas = _vertex_areas(mesh)
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
+    # the fits of the radii not fitted on the coarse level, from one walk per vertex (the radii increase)
+    fine = [
+        NORMAL_RADIUS_RATIO * r for r in radii if not _dense(vertices, NORMAL_RADIUS_RATIO * r, _adjacency(topology))
+    ]
+    fits = (
+        nested_jet_normals(
+            vertices,
+            np.where(valid[:, None], start_normals, [0.0, 0.0, 1.0]),
+            fine,
+            adjacency=_adjacency(topology),
+            neighbours=topology.referenced_vertices,
+            degree=NORMAL_DEGREE,
+            iterations=NORMAL_ITERATIONS,
+            settled=NORMAL_SETTLED,
+            min_spread=NORMAL_MIN_SPREAD,
+        )
+        if fine
+        else []
+    )
     normals = [
         fitted_normals(
             vertices,
@@ -560,6 +593,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             adjacency=_adjacency(topology),
             areas=areas,
             failed=failed[j],
+            fits=fits[j] if j < len(fits) else None,
         )
         for j, radius in enumerate(radii)
     ]
