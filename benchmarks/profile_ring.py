@@ -32,6 +32,7 @@ RING_STAGES = (
     ("normal_cycle kernel: edge sums", "meshcurv._kernels.normal_cycle", "normal_cycle_sums"),
     ("normal_cycle kernel: smoothing, curvatures", "meshcurv._kernels.normal_cycle", "normal_cycle_finish"),
     ("matgeom kernel: edge tensors", "meshcurv._kernels.matgeom", "matgeom_vertex_tensors"),
+    ("matgeom kernel: edge tensors", "meshcurv._kernels.matgeom", "matgeom_vertex_sums"),
     ("matgeom kernel: smoothing, eigenvectors", "meshcurv._kernels.matgeom", "matgeom_finish"),
     ("matgeom: pairing (open meshes)", "meshcurv.estimators.matgeom", "matgeom_pairing"),
     ("topology: bow-tie walks (twin sides)", "meshcurv._kernels.topology", "bowtie_from_twins"),

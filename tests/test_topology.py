@@ -172,21 +172,30 @@ def test_smoothing_lists_are_the_neighbour_lists_or_empty_without_smoothing():
     assert empty_indices.size == 0 and empty_indptr.dtype == empty_indices.dtype == np.int64
 
 
-def test_normal_cycle_keeps_the_zero_area_faces_its_kernel_found():
+@pytest.mark.parametrize("method", ["normal_cycle", "matgeom"])
+def test_the_zero_area_faces_a_kernel_found_are_kept(method, monkeypatch):
     """The kernel's zero-area faces serve the defects (not searched twice): the same as geometry.degenerate_faces."""
-    from meshcurv._prepared import prepare_mesh
+    pytest.importorskip("numba")
+    from meshcurv import _prepared
+    from meshcurv._backend import use_backend
     from meshcurv.estimators import ESTIMATORS
     from meshcurv.estimators._support import Stages
     from meshcurv.geometry import degenerate_faces
 
     sphere = shapes.icosphere(4)
-    faces = np.vstack([sphere.faces, [[0, 1, 1]]])  # a repeated corner: zero area
-    mesh = prepare_mesh(sphere.vertices, faces, orient="keep", weld=False)
-    estimator = ESTIMATORS["normal_cycle"]
-    estimator.function(mesh, smoothing_steps=1, stages=Stages(estimator.stages))
-    expected = degenerate_faces(mesh.vertices, mesh.topology)
+    n = sphere.vertices.shape[0]
+    middle = 0.5 * (sphere.vertices[0] + sphere.vertices[1])  # on edge 0-1: a face of no area, three corners
+    vertices = np.vstack([sphere.vertices, middle])
+    faces = np.vstack([sphere.faces, [[0, 1, 1], [0, n, 1]]])  # and a repeated corner
+    with use_backend("numba"):
+        mesh = _prepared.prepare_mesh(vertices, faces, orient="keep", weld=False)
+        estimator = ESTIMATORS[method]
+        with monkeypatch.context() as patch:
+            patch.setattr(_prepared, "degenerate_faces", lambda *args, **kwargs: pytest.fail("searched twice"))
+            estimator.function(mesh, smoothing_steps=1, stages=Stages(estimator.stages))
+        expected = degenerate_faces(mesh.vertices, mesh.topology)
     np.testing.assert_array_equal(mesh.degenerate, expected)
-    assert expected.sum() == 1
+    assert expected.sum() == 2
 
 
 def _defective_faces(seed: int) -> np.ndarray:

@@ -9,7 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ._common import _JIT, _face_cross
+from ._common import _JIT, _degenerate, _face_cross
 
 
 @nb.njit(inline="always", **_JIT)
@@ -231,9 +231,22 @@ def matgeom_finish(tensors, indptr, indices, steps):
     return c1, c2, u1, u2, normal
 
 
-@nb.njit(parallel=True, **_JIT)
+@nb.njit(**_JIT)
 def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, n_chunks):
-    """Steps 2 to 5 of matGeom's meshCurvatures (see estimators/matgeom.py).
+    """Steps 2 to 5 of matGeom's meshCurvatures: the (V, 6) vertex tensors of
+    :func:`matgeom_vertex_sums`, without the zero-area faces."""
+    return matgeom_vertex_sums(vertices, faces, ev1, ev2, ef1, ef2, n_chunks, np.empty(0), 0.0, False)[0]
+
+
+@nb.njit(parallel=True, **_JIT)
+def matgeom_vertex_sums(vertices, faces, ev1, ev2, ef1, ef2, n_chunks, scales, area_ratio, with_degenerate):
+    """Steps 2 to 5 of matGeom's meshCurvatures (see estimators/matgeom.py), and the zero-area faces.
+
+    Returns ``(tensors, degenerate)``: the (V, 6) vertex tensors and, when
+    ``with_degenerate``, the (F,) faces that repeat a vertex or whose area is at
+    most ``area_ratio`` x ``scales[a]^2`` (``geometry.degenerate_faces``, the
+    same test on the same cross product, found in the pass that normalises it;
+    else an empty array).
 
     Same operations in the same order as Octave (sums of three products left
     to right), so that ``arccos`` of nearly parallel normals gets the same input.
@@ -246,9 +259,13 @@ def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, n_chunks):
     n_faces = faces.shape[0]
     n_edges = ev1.shape[0]
     normals = np.empty((n_faces, 3))
+    degenerate = np.zeros(n_faces if with_degenerate else 0, np.bool_)
     for f in nb.prange(n_faces):
-        nx, ny, nz = _face_cross(vertices, faces[f, 0], faces[f, 1], faces[f, 2])  # Octave's cross
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        nx, ny, nz = _face_cross(vertices, a, b, c)  # Octave's cross
         norm = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        if with_degenerate:
+            degenerate[f] = _degenerate(a, b, c, 0.5 * norm, area_ratio * scales[a] * scales[a])
         normals[f, 0] = nx / norm if norm > 0 else np.nan
         normals[f, 1] = ny / norm if norm > 0 else np.nan
         normals[f, 2] = nz / norm if norm > 0 else np.nan
@@ -309,4 +326,4 @@ def matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, n_chunks):
         if counts[i] > 0:
             for k in range(6):
                 sums[i, k] /= counts[i]
-    return sums
+    return sums, degenerate

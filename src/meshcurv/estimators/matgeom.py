@@ -36,6 +36,7 @@ import numpy as np
 
 from .._backend import kernel_threads, numba_kernels
 from .._tensors import outer6
+from ..geometry import DEGENERATE_AREA_RATIO
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from .._prepared import PreparedMesh
@@ -140,8 +141,11 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
     return smooth_vertex_field(tensors, topology, smoothing_steps), n_kept, n_wrong_face, n_out_of_range, mispaired
 
 
-def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages):
-    """Steps 1 to 5 of :func:`matgeom_tensors`: the vertex tensors before the smoothing, and the same counts."""
+def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages, mesh: PreparedMesh | None = None):
+    """Steps 1 to 5 of :func:`matgeom_tensors`: the vertex tensors before the smoothing, and the same counts.
+
+    With ``mesh`` (the prepared mesh of ``vertices`` and ``topology``), the compiled path also finds its
+    zero-area faces (:attr:`PreparedMesh.degenerate`) in its pass over the faces, when not found yet."""
     faces = topology.faces
     n_vertices = vertices.shape[0]
     n_faces = faces.shape[0]
@@ -166,7 +170,13 @@ def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages):
     kernels = numba_kernels("matgeom")
     if kernels is not None:
         # columns of the topology's arrays as they are (strided views): numba reads them without a copy
-        tensors = kernels.matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, kernel_threads())
+        if mesh is not None and "degenerate" not in mesh.__dict__:
+            tensors, degenerate = kernels.matgeom_vertex_sums(
+                vertices, faces, ev1, ev2, ef1, ef2, kernel_threads(), mesh.length_scales, DEGENERATE_AREA_RATIO, True
+            )
+            mesh.found_degenerate(degenerate)  # the test of mesh.degenerate (the twin tests): not made twice
+        else:
+            tensors = kernels.matgeom_vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, kernel_threads())
     else:
         tensors = _vertex_tensors(
             vertices, faces, ev1, ev2, np.where(out_of_range, 0, ef1), np.where(out_of_range, 0, ef2), out_of_range
@@ -187,7 +197,7 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     if kernels is not None and smoothing_steps <= STEPS_PER_CALL:
         # the smoothing and the eigen-decomposition in one kernel (the same sums in the same order as
         # smooth_vertex_field's kernel): no copy of the tensors, the last pass straight into the eigen-solver
-        tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = _edge_tensors(vertices, topology, stages)
+        tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = _edge_tensors(vertices, topology, stages, mesh)
         stages.start("average vertex tensors")
         indptr, indices = topology.smoothing_lists(smoothing_steps)
         stages.start("retrieve curvatures")
