@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from meshcurv import geometry, shapes
-from meshcurv.errors import InvalidOptionError
+from meshcurv.errors import InvalidMeshError, InvalidOptionError
 from meshcurv.topology import MeshTopology
 
 from conftest import DATA
@@ -207,9 +207,30 @@ def test_voxel_shapes_name_the_extra_without_scikit_image(monkeypatch):
         (lambda: shapes.ellipsoid((1.0, 2.0)), r"`semi_axes` must be 3 positive number\(s\); got \(1.0, 2.0\)"),
         (lambda: shapes.random_ellipsoid((1.0, 0.0, 1.0)), r"`semi_axes` must be 3 positive number"),
         (lambda: shapes.random_sphere(100, 0), r"`radius` must be a positive finite number; got 0"),
+        # before: a numpy broadcast error, a spindle torus with infinite k_min, a level of True taken as 1
+        (lambda: shapes.icosphere(2, center=(1.0, 2.0)), r"`center` must be 3 finite numbers; got \(1.0, 2.0\)"),
+        (lambda: shapes.icosphere(2, center="abc"), r"`center` must be 3 finite numbers; got 'abc'"),
+        (lambda: shapes.torus(1.0, 2.0), r"`minor_radius` must be below `major_radius` \(a ring torus\)"),
+        (lambda: shapes.with_normal_noise(shapes.icosphere(2), True), r"`level` must be a number >= 0"),
+        (lambda: shapes.with_normal_noise(shapes.icosphere(2), np.inf), r"`level` must be a number >= 0"),
     ],
 )
 def test_shape_options_are_checked_not_numpy_errors(make, message):
     # before: ZeroDivisionError, IndexError, numpy broadcast or RuntimeWarning, or a silently inverted sphere
     with pytest.raises(InvalidOptionError, match=message):
         make()
+
+
+def test_with_normal_noise_takes_numpy_levels_and_refuses_other_meshes():
+    mesh = shapes.icosphere(2)
+    moved = shapes.with_normal_noise(mesh, np.float32(0.1), seed=3)
+    assert moved.vertices.shape == mesh.vertices.shape and (moved.faces == mesh.faces).all()
+    # each vertex moved along its exact normal only: the unit sphere's points stay on their rays
+    assert np.allclose(np.cross(moved.vertices, mesh.normals), 0.0, atol=1e-12)
+    with pytest.raises(InvalidMeshError, match=r"`mesh` must be an AnalyticMesh .*; got tuple"):
+        shapes.with_normal_noise((mesh.vertices, mesh.faces), 0.1)
+
+
+def test_icosphere_center_moves_the_sphere():
+    sphere = shapes.icosphere(3, radius=2.0, center=(1.0, -2.0, 3.0))
+    assert np.allclose(np.linalg.norm(sphere.vertices - [1.0, -2.0, 3.0], axis=1), 2.0)

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import check_int_option, check_positive_float
-from .errors import InvalidOptionError, optional_module
+from .errors import InvalidMeshError, InvalidOptionError, optional_module
 from .geometry import mean_edge_length
 from .topology import MeshTopology
 
@@ -240,21 +240,61 @@ def _subdivided_sphere(subdivisions: int) -> tuple[np.ndarray, np.ndarray]:
 def icosphere(subdivisions: int = 16, radius: float = 1.0, center=(0.0, 0.0, 0.0)) -> AnalyticMesh:
     """Sphere from a regular icosahedron whose edges are split into ``subdivisions`` parts.
 
-    ``10 * subdivisions**2 + 2`` vertices (2562 for 16), as matGeom's
-    ``subdivideMesh(createIcosahedron, n)`` projected on the sphere. Exact
-    curvature ``1 / radius`` everywhere (every point is umbilic).
+    As matGeom's ``subdivideMesh(createIcosahedron, n)`` projected on the sphere.
+
+    Parameters
+    ----------
+    subdivisions : int, default: 16
+        Parts each icosahedron edge is split into, >= 1.
+    radius : float, default: 1.0
+        > 0.
+    center : sequence of 3 floats, default: (0, 0, 0)
+
+    Returns
+    -------
+    AnalyticMesh
+        Closed, outward; ``10 * subdivisions**2 + 2`` vertices (2562 for 16)
+        and twice as many faces less 4. Exact curvature ``1 / radius``
+        everywhere; directions NaN (every point is umbilic).
+
+    Raises
+    ------
+    InvalidOptionError
+        ``subdivisions`` not an integer >= 1, ``radius`` not a positive finite
+        number, ``center`` not 3 finite numbers.
     """
     radius = check_positive_float(radius, "radius")
     unit, faces = _subdivided_sphere(subdivisions)
-    vertices = unit * radius + np.asarray(center, dtype=float)
+    vertices = unit * radius + _check_center(center)
     return _make(f"icosphere({subdivisions})", vertices, faces, 1 / radius, 1 / radius, np.nan, np.nan, unit)
 
 
 def uv_sphere(n_longitude: int = 32, n_latitude: int = 16, radius: float = 1.0) -> AnalyticMesh:
     """Latitude-longitude sphere with single pole vertices (matGeom's sphereMesh, poles merged).
 
-    ``n_longitude * (n_latitude - 1) + 2`` vertices; triangles at the poles, split
-    quads elsewhere.
+    Triangles at the poles, split quads elsewhere.
+
+    Parameters
+    ----------
+    n_longitude : int, default: 32
+        Vertices around each ring of latitude, >= 3.
+    n_latitude : int, default: 16
+        Bands from pole to pole, >= 2 (``n_latitude - 1`` rings).
+    radius : float, default: 1.0
+        > 0; centred at the origin, poles on the z axis.
+
+    Returns
+    -------
+    AnalyticMesh
+        Closed, outward; ``n_longitude * (n_latitude - 1) + 2`` vertices and
+        ``2 * n_longitude * (n_latitude - 1)`` faces. Exact curvature
+        ``1 / radius``; directions NaN.
+
+    Raises
+    ------
+    InvalidOptionError
+        A count below its minimum or not an integer, ``radius`` not a positive
+        finite number.
     """
     n_longitude = check_int_option(n_longitude, "n_longitude", minimum=3)
     n_latitude = check_int_option(n_latitude, "n_latitude", minimum=2)
@@ -300,13 +340,40 @@ def torus(
     Exact curvatures: ``1 / r`` along the tube circle (``k_max``), and
     ``cos(phi) / (R + r cos(phi))`` along the ring (``k_min``).
 
-    ``jitter > 0`` gives an irregular mesh of the same surface: both angles of
-    every vertex move by a uniform random fraction (up to ``jitter``, below 0.5)
-    of the grid step, and each quad is split along a random diagonal
-    (generator seeded with ``seed``); the exact values are those of the moved
-    points.
+    Parameters
+    ----------
+    major_radius : float, default: 30.0
+        ``R``, the radius of the centre circle of the tube.
+    minor_radius : float, default: 10.0
+        ``r``, the radius of the tube, ``0 < r < R``.
+    n_major : int, default: 60
+        Vertices around the ring, >= 3.
+    n_minor : int, default: 60
+        Vertices around the tube, >= 3.
+    jitter : float, default: 0.0
+        In ``[0, 0.5)``. Above 0, an irregular mesh of the same surface: both
+        angles of every vertex move by a uniform random fraction (up to
+        ``jitter``) of the grid step, and each quad is split along a random
+        diagonal; the exact values are those of the moved points.
+    seed : int, default: 0
+        Seed of ``numpy.random.default_rng`` for ``jitter``.
+
+    Returns
+    -------
+    AnalyticMesh
+        Closed, outward, genus 1: ``n_major * n_minor`` vertices,
+        ``2 * n_major * n_minor`` faces, ``quads`` of shape
+        ``(n_major * n_minor, 4)``.
+
+    Raises
+    ------
+    InvalidOptionError
+        A radius not a positive finite number, ``minor_radius >= major_radius``,
+        a count below 3, ``jitter`` outside ``[0, 0.5)``.
     """
     R, r = check_positive_float(major_radius, "major_radius"), check_positive_float(minor_radius, "minor_radius")
+    if r >= R:
+        raise InvalidOptionError(f"`minor_radius` must be below `major_radius` (a ring torus); got {r!r} >= {R!r}")
     n_major, n_minor = check_int_option(n_major, "n_major", minimum=3), check_int_option(n_minor, "n_minor", minimum=3)
     theta = 2 * np.pi * np.arange(n_major) / n_major
     phi = 2 * np.pi * np.arange(n_minor) / n_minor
@@ -325,7 +392,29 @@ def torus(
 
 
 def ellipsoid(semi_axes=(3.0, 2.0, 1.0), subdivisions: int = 12) -> AnalyticMesh:
-    """Unit icosphere scaled by ``semi_axes`` (matGeom reference ``ellipsoid_321``)."""
+    """Unit icosphere scaled by ``semi_axes`` (matGeom reference ``ellipsoid_321``).
+
+    The exact values are those of ``sum(x_k**2 / a_k**2) = 1`` at each vertex
+    (vertices lie on it exactly), from the eigenpairs of the projected Hessian.
+
+    Parameters
+    ----------
+    semi_axes : sequence of 3 floats, default: (3, 2, 1)
+        ``a_k`` along x, y, z; > 0.
+    subdivisions : int, default: 12
+        As for :func:`icosphere`.
+
+    Returns
+    -------
+    AnalyticMesh
+        Closed, outward; ``10 * subdivisions**2 + 2`` vertices. Directions NaN
+        where ``k_min == k_max`` (umbilics; to 1e-9 relative).
+
+    Raises
+    ------
+    InvalidOptionError
+        ``semi_axes`` not 3 positive finite numbers, ``subdivisions`` not an integer >= 1.
+    """
     a = _check_lengths(semi_axes, "semi_axes", 3)
     unit, faces = _subdivided_sphere(subdivisions)
     vertices = unit * a
@@ -344,7 +433,31 @@ def cylinder(
     """Open cylinder around the z axis (two boundary rings), split quads.
 
     Exact curvatures: ``k_max = 1 / radius`` around, ``k_min = 0`` along the axis.
-    ``jitter`` and ``seed``: as for :func:`torus` (the boundary rings stay flat).
+
+    Parameters
+    ----------
+    radius : float, default: 1.0
+        > 0.
+    height : float, default: 2.0
+        > 0; the cylinder spans ``z`` in ``[-height / 2, height / 2]``.
+    n_around : int, default: 32
+        Vertices around each ring, >= 3.
+    n_along : int, default: 16
+        Bands along the axis, >= 1 (``n_along + 1`` rings).
+    jitter, seed
+        As for :func:`torus` (the boundary rings stay flat).
+
+    Returns
+    -------
+    AnalyticMesh
+        Outward normals; ``(n_along + 1) * n_around`` vertices,
+        ``2 * n_around * n_along`` faces and their ``quads``.
+
+    Raises
+    ------
+    InvalidOptionError
+        A length not a positive finite number, a count below its minimum,
+        ``jitter`` outside ``[0, 0.5)``.
     """
     radius, height = check_positive_float(radius, "radius"), check_positive_float(height, "height")
     n_around, n_along = (
@@ -371,9 +484,31 @@ def saddle(half_width: float = 1.0, spacing: float = 0.025, *, jitter: float = 0
     """Open height field ``z = x**2 - y**2`` on a square grid over ``[-w, w]^2``, normals up.
 
     At the centre the exact curvatures are ``-2`` (along x: the surface bends
-    towards its upward normal) and ``+2`` (along y). Each grid square is split
-    along the same diagonal. ``jitter`` and ``seed``: as for :func:`torus`
-    (boundary vertices move along the boundary only).
+    towards its upward normal) and ``+2`` (along y); elsewhere those of the
+    height field at the vertex. Each grid square is split along the same
+    diagonal.
+
+    Parameters
+    ----------
+    half_width : float, default: 1.0
+        ``w`` > 0.
+    spacing : float, default: 0.025
+        The grid step, rounded so that ``round(2 w / spacing) + 1`` points span
+        each side; below ``4 w``.
+    jitter, seed
+        As for :func:`torus` (boundary vertices move along the boundary only).
+
+    Returns
+    -------
+    AnalyticMesh
+        Open (one boundary loop), normals up; ``n**2`` vertices with
+        ``n = round(2 w / spacing) + 1``, and the grid's ``quads``.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``half_width`` or ``spacing`` not a positive finite number, ``spacing``
+        of ``4 w`` or more, ``jitter`` outside ``[0, 0.5)``.
     """
     half_width, spacing = check_positive_float(half_width, "half_width"), check_positive_float(spacing, "spacing")
     n = int(round(2 * half_width / spacing)) + 1
@@ -417,7 +552,26 @@ def random_sphere(n_vertices: int = 2562, radius: float = 1.0, *, seed: int = 0)
     The points are drawn with ``numpy.random.default_rng(seed)`` and triangulated
     by their convex hull (the Delaunay triangulation on the sphere), faces wound
     outward. Valences and angles vary freely (slivers included), the test that
-    1-ring estimators fail. Exact curvature ``1 / radius``.
+    1-ring estimators fail.
+
+    Parameters
+    ----------
+    n_vertices : int, default: 2562
+        >= 4.
+    radius : float, default: 1.0
+        > 0; centred at the origin.
+    seed : int, default: 0
+
+    Returns
+    -------
+    AnalyticMesh
+        Closed, outward; ``n_vertices`` vertices and ``2 * n_vertices - 4``
+        faces. Exact curvature ``1 / radius``; directions NaN.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``n_vertices`` not an integer >= 4, ``radius`` not a positive finite number.
     """
     radius = check_positive_float(radius, "radius")
     unit, faces = _random_unit_sphere(n_vertices, seed)
@@ -427,7 +581,26 @@ def random_sphere(n_vertices: int = 2562, radius: float = 1.0, *, seed: int = 0)
 
 
 def random_ellipsoid(semi_axes=(3.0, 2.0, 1.0), n_vertices: int = 2562, *, seed: int = 0) -> AnalyticMesh:
-    """:func:`random_sphere` (unit radius) scaled by ``semi_axes``: an irregular ellipsoid mesh."""
+    """:func:`random_sphere` (unit radius) scaled by ``semi_axes``: an irregular ellipsoid mesh.
+
+    Parameters
+    ----------
+    semi_axes : sequence of 3 floats, default: (3, 2, 1)
+        As for :func:`ellipsoid`.
+    n_vertices : int, default: 2562
+        >= 4.
+    seed : int, default: 0
+
+    Returns
+    -------
+    AnalyticMesh
+        Closed, outward; exact values as for :func:`ellipsoid`.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``semi_axes`` not 3 positive finite numbers, ``n_vertices`` not an integer >= 4.
+    """
     a = _check_lengths(semi_axes, "semi_axes", 3)
     unit, faces = _random_unit_sphere(n_vertices, seed)
     vertices = unit * a
@@ -438,7 +611,29 @@ def hemisphere(subdivisions: int = 16, radius: float = 1.0, *, irregular: bool =
     """Open upper half (z > 0) of :func:`icosphere` (or of :func:`random_sphere` with ``irregular=True``).
 
     The faces whose centroid lies above the equator are kept and the vertices
-    re-indexed: one boundary loop near ``z = 0``. Exact curvature ``1 / radius``.
+    re-indexed: one boundary loop near ``z = 0``.
+
+    Parameters
+    ----------
+    subdivisions : int, default: 16
+        As for :func:`icosphere`; with ``irregular=True`` the sphere has the
+        same number of points, ``10 * subdivisions**2 + 2``.
+    radius : float, default: 1.0
+        > 0.
+    irregular : bool, default: False
+        Cut :func:`random_sphere` instead of :func:`icosphere`.
+    seed : int, default: 0
+        Seed of :func:`random_sphere`.
+
+    Returns
+    -------
+    AnalyticMesh
+        Open, outward. Exact curvature ``1 / radius``; directions NaN.
+
+    Raises
+    ------
+    InvalidOptionError
+        As :func:`icosphere` and :func:`random_sphere`.
     """
     if irregular:
         whole = random_sphere(
@@ -457,11 +652,35 @@ def with_normal_noise(mesh: AnalyticMesh, level: float, *, seed: int = 0) -> Ana
 
     Each vertex moves by ``t * n`` with ``t`` uniform in ``[-a, a]``,
     ``a = level * mean edge length`` (``level`` 0.1 and 0.3 in the accuracy
-    benchmark), drawn with ``numpy.random.default_rng(seed)``. The exact
-    curvatures, directions and normals stay those of the unperturbed surface
-    at the original points: what an estimator should recover.
+    benchmark), drawn with ``numpy.random.default_rng(seed)``.
+
+    Parameters
+    ----------
+    mesh : AnalyticMesh
+    level : float
+        >= 0, the amplitude as a fraction of the mean edge length.
+    seed : int, default: 0
+
+    Returns
+    -------
+    AnalyticMesh
+        A new mesh, the same faces; the exact curvatures, directions and
+        normals stay those of the unperturbed surface at the original points:
+        what an estimator should recover.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``mesh`` not an :class:`AnalyticMesh`.
+    InvalidOptionError
+        ``level`` not a finite number >= 0.
     """
-    if not (isinstance(level, (int, float)) and np.isfinite(level) and level >= 0):
+    if not isinstance(mesh, AnalyticMesh):
+        raise InvalidMeshError(
+            f"`mesh` must be an AnalyticMesh (a shape of meshcurv.shapes); got {type(mesh).__name__}"
+        )
+    real = isinstance(level, (int, float, np.integer, np.floating)) and not isinstance(level, bool)
+    if not (real and np.isfinite(level) and level >= 0):
         raise InvalidOptionError(f"`level` must be a number >= 0 (a fraction of the mean edge length); got {level!r}")
     edges = MeshTopology.from_faces(mesh.faces, mesh.vertices.shape[0]).edges
     amplitude = level * mean_edge_length(mesh.vertices, edges)
@@ -485,6 +704,8 @@ class VoxelMesh(AnalyticMesh):
 
     Attributes
     ----------
+    name, vertices, faces, k_min, k_max, dir_min, dir_max, normals, quads
+        As for :class:`AnalyticMesh` (``quads`` None).
     closest_points : ndarray of shape (V, 3)
         The closest point on the analytic surface to each vertex, where the
         exact values are taken.
@@ -503,6 +724,16 @@ def _check_spacing(spacing) -> np.ndarray:
     values = np.asarray(spacing, dtype=float)
     if values.shape != (3,) or not (np.isfinite(values).all() and (values > 0).all()):
         raise InvalidOptionError(f"`spacing` must be 3 positive numbers (image axes 0, 1, 2); got {spacing!r}")
+    return values
+
+
+def _check_center(center) -> np.ndarray:
+    try:
+        values = np.asarray(center, dtype=float)
+    except (TypeError, ValueError):
+        values = None
+    if values is None or values.shape != (3,) or not np.isfinite(values).all():
+        raise InvalidOptionError(f"`center` must be 3 finite numbers; got {center!r}")
     return values
 
 
@@ -632,9 +863,29 @@ def voxel_ellipsoid(semi_axes=(10.0, 7.0, 5.0), spacing=(1.0, 1.0, 1.0), *, seed
     """Marching-cubes mesh of a voxelised solid ellipsoid.
 
     ``semi_axes[k]`` is along image axis ``k``; grid, centre offset, vertex
-    coordinates and (inward) winding as in :func:`voxel_sphere`. The exact
-    curvatures are those at each vertex's closest point on the ellipsoid
-    (:func:`ellipsoid_closest_points`, a vectorised Newton solve), outward.
+    coordinates and (inward) winding as in :func:`voxel_sphere`.
+
+    Parameters
+    ----------
+    semi_axes : sequence of 3 floats, default: (10, 7, 5)
+        > 0, in physical units.
+    spacing, seed
+        As for :func:`voxel_sphere`: voxel size along image axes 0, 1, 2
+        (default 1, 1, 1) and seed of the centre's offset (default 0).
+
+    Returns
+    -------
+    VoxelMesh
+        Exact curvatures (outward) at each vertex's closest point on the
+        ellipsoid (:func:`ellipsoid_closest_points`, a vectorised Newton solve).
+
+    Raises
+    ------
+    InvalidOptionError
+        A length or ``spacing`` not positive finite numbers, or a grid
+        of more than 2e8 voxels.
+    MissingDependencyError
+        Without scikit-image (``pip install 'meshcurv[volume]'``).
     """
     a = _check_lengths(semi_axes, "semi_axes", 3)
     s = _check_spacing(spacing)
@@ -658,6 +909,28 @@ def voxel_torus(
     (outward) are ``1 / r`` around the tube (``k_max``) and
     ``cos(phi) / (R + r cos(phi))`` along the ring, ``phi`` the angle from the
     outer equator.
+
+    Parameters
+    ----------
+    major_radius : float, default: 12.0
+        ``R``, in physical units.
+    minor_radius : float, default: 4.0
+        ``r``, ``0 < r < R``.
+    spacing, seed
+        As for :func:`voxel_sphere`.
+
+    Returns
+    -------
+    VoxelMesh
+        Closed, genus 1, faces wound inward, exact values outward.
+
+    Raises
+    ------
+    InvalidOptionError
+        A length or ``spacing`` not positive finite numbers,
+        ``minor_radius >= major_radius``, or a grid of more than 2e8 voxels.
+    MissingDependencyError
+        Without scikit-image (``pip install 'meshcurv[volume]'``).
     """
     R = float(_check_lengths(major_radius, "major_radius", 1)[0])
     r = float(_check_lengths(minor_radius, "minor_radius", 1)[0])
