@@ -1497,6 +1497,32 @@ def check_nearest_neighbours(name):
     assert not exact.any()  # (a lattice's neighbours tie: their order is the k-d tree's, searched by the caller)
 
 
+def check_neighbour_differences(name):
+    from meshcurv._pointcloud_estimators import FLAT_TURN, _neighbour_differences
+
+    points, normals = cloud(name)
+    n = points.shape[0]
+    indices = knn_indices(points)
+    rng = np.random.default_rng(13)
+    # curvatures varying over the cloud, some undefined (NaN, inf), some points not valid
+    k_min = points[:, 0] + 0.01 * rng.standard_normal(n)
+    k_max = k_min + np.abs(points[:, 1])
+    k_min[rng.random(n) < 0.05] = np.nan
+    k_max[rng.random(n) < 0.01] = np.inf
+    k_min[indices[0]] = np.nan  # point 0: no neighbour with an estimate
+    k_min[0], k_max[0] = 0.1, 0.2
+    valid = (rng.random(n) < 0.9) & np.isfinite(k_min) & np.isfinite(k_max)
+    valid[0] = True
+    spacing = 0.01 + 0.001 * rng.random(n)
+    expected = _neighbour_differences(k_min, k_max, indices, valid, spacing)
+    got = kernels("pointcloud").neighbour_differences(
+        k_min, k_max, indices, valid, spacing, float(FLAT_TURN), 64 * kernel_threads()
+    )
+    # the same operations per neighbour, the same sort and mean of the two middle values: to the bit
+    np.testing.assert_array_equal(got[valid], expected[valid])
+    assert np.isnan(got[~valid]).all() and np.isnan(got[valid]).any()  # (a point with no estimated neighbour)
+
+
 def check_ball_triangle_sums(name):
     from meshcurv._pointcloud_estimators import (
         MIN_BALL_POINTS,
@@ -1830,6 +1856,12 @@ TWINS = [
     ),
     Twin("pointcloud.ball_indices", "_pointcloud_estimators._ball_indices", check_ball_indices, CLOUDS),
     Twin("pointcloud.nearest_neighbours", "_pointcloud_normals.knn", check_nearest_neighbours, CLOUDS),
+    Twin(
+        "pointcloud.neighbour_differences",
+        "_pointcloud_estimators._neighbour_differences",
+        check_neighbour_differences,
+        CLOUDS,
+    ),
     Twin("pointcloud.ball_triangle_sums", "_pointcloud_estimators._triangle_sums", check_ball_triangle_sums, CLOUDS),
     Twin("pointcloud.edge_cosines", "the cosines of _pointcloud_normals.orientation_signs", check_edge_cosines, CLOUDS),
     Twin("pointcloud.far_winding", "_pointcloud_normals.winding_numbers", check_far_winding, CLOUDS),

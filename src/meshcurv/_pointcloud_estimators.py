@@ -190,6 +190,27 @@ def erratic(k_min, k_max, indices, valid, spacing) -> np.ndarray:
     follows noise, or by balls whose content changes abruptly (a rim sharper than the sampling): NaN.
     """
     n = k_min.shape[0]
+    compiled = numba_kernels("pointcloud")
+    if compiled is not None:  # the same median, compiled (1M points: about 0.05 CPU s instead of 2.4)
+        typical = compiled.neighbour_differences(
+            np.ascontiguousarray(k_min, dtype=np.float64),
+            np.ascontiguousarray(k_max, dtype=np.float64),
+            np.ascontiguousarray(indices, dtype=np.int64),
+            np.ascontiguousarray(valid, dtype=bool),
+            np.ascontiguousarray(spacing, dtype=np.float64),
+            float(FLAT_TURN),
+            64 * kernel_threads(),
+        )
+    else:
+        typical = _neighbour_differences(k_min, k_max, indices, valid, spacing)
+    out = np.zeros(n, dtype=bool)
+    out[valid] = ~(typical[valid] <= NEIGHBOUR_AGREEMENT)  # (no neighbour with an estimate: nothing reproduces it)
+    return out
+
+
+def _neighbour_differences(k_min, k_max, indices, valid, spacing) -> np.ndarray:
+    """(N,) the ``typical`` of :func:`erratic` (NaN where no neighbour has an estimate): the NumPy path of
+    :func:`meshcurv._kernels.pointcloud.neighbour_differences`."""
     estimated = np.isfinite(k_min) & np.isfinite(k_max)
     safe = np.where(valid[:, None] & estimated[indices], indices, -1)
     with np.errstate(invalid="ignore"):
@@ -200,10 +221,7 @@ def erratic(k_min, k_max, indices, valid, spacing) -> np.ndarray:
         apart = np.abs(theirs - own[:, None, :]).max(axis=2) / scale
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            typical = np.nanmedian(apart, axis=1)
-    out = np.zeros(n, dtype=bool)
-    out[valid] = ~(typical[valid] <= NEIGHBOUR_AGREEMENT)  # (no neighbour with an estimate: nothing reproduces it)
-    return out
+            return np.nanmedian(apart, axis=1)
 
 
 def unsteady_problem(flagged: np.ndarray) -> list[str]:

@@ -503,3 +503,47 @@ def nearest_neighbours(points, k, reach, pool_points, ids, grid, n_chunks):
                 indices[c, j] = which[j]
             exact[c] = ok
     return distances, indices, exact
+
+
+@nb.njit(parallel=True, **_JIT)
+def neighbour_differences(k_min, k_max, indices, valid, spacing, flat_turn, n_chunks):
+    """(N,) the median over the neighbours ``indices`` (N, k) of a ``valid`` point of how far their principal
+    curvatures are from its own, in units of the smaller largest ``|k|`` (at least ``flat_turn / (3 spacing)``).
+
+    The compiled :func:`meshcurv._pointcloud_estimators.erratic`'s ``typical``: the neighbours with an estimate
+    (``k_min`` and ``k_max`` finite) count; NaN where none does and at the points not ``valid``. The median of an
+    even count is the mean of the two middle values, as :func:`numpy.nanmedian`'s (of an odd count, the middle
+    one added to itself and halved, as there). ``n_chunks``: runs of points shared out to the threads.
+    """
+    n, k = indices.shape
+    out = np.full(n, np.nan)
+    n_chunks = max(min(n, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):
+        values = np.empty(max(k, 1))
+        for i in range(chunk * n // n_chunks, (chunk + 1) * n // n_chunks):
+            if not valid[i]:
+                continue
+            a0, a1 = k_min[i], k_max[i]
+            if not (np.isfinite(a0) and np.isfinite(a1)):
+                continue  # (NaN: no estimate reproduces it)
+            big = max(abs(a0), abs(a1))
+            floor = flat_turn / (3.0 * spacing[i])
+            m = 0
+            for j in range(k):
+                q = indices[i, j]
+                b0, b1 = k_min[q], k_max[q]
+                if not (np.isfinite(b0) and np.isfinite(b1)):
+                    continue
+                scale = max(min(big, max(abs(b0), abs(b1))), floor)
+                d = max(abs(b0 - a0), abs(b1 - a1)) / scale
+                t = m  # insert in order
+                while t > 0 and values[t - 1] > d:
+                    values[t] = values[t - 1]
+                    t -= 1
+                values[t] = d
+                m += 1
+            if m:
+                high = m // 2
+                low = high if m % 2 else high - 1
+                out[i] = (values[low] + values[high]) / 2.0
+    return out
