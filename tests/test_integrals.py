@@ -296,3 +296,22 @@ def test_measure_functions_check_their_shapes():
         with pytest.raises(InvalidMeshError, match=message):
             make()
     assert face_measures(v, f, n).shape == (80, 9)  # and the right shapes still pass
+
+
+@pytest.mark.parametrize("index", [42, 10**6, -1])
+def test_measure_functions_check_the_range_of_their_indices(index):
+    # before: face_measures' compiled kernel read out of bounds (a segmentation fault at 10**6) and
+    # face_solid_angles raised numpy's IndexError, or took -1 as the last vertex
+    from meshcurv.measures import face_measures
+
+    sphere = shapes.icosphere(2)
+    faces = sphere.faces.copy()
+    faces[5, 1] = index
+    for make in (
+        lambda: face_measures(sphere.vertices, faces, sphere.normals),
+        lambda: face_solid_angles(sphere.normals, faces),
+    ):
+        with pytest.raises(
+            InvalidMeshError, match=r"`faces` has (vertex index \d+ out of range|negative vertex indices)"
+        ):
+            make()

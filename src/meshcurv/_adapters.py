@@ -274,32 +274,7 @@ def _flat_cells(faces) -> np.ndarray:
 
 
 def to_pyvista(result, mesh=None, *, fields=None):
-    """A ``pyvista.PolyData`` of the mesh with the result's fields as ``point_data``.
-
-    Parameters
-    ----------
-    result : CurvatureResult
-    mesh : pyvista.PolyData, other mesh object, or (vertices, faces), optional
-        The mesh the result was computed on. A ``PolyData`` is copied (never
-        changed) with its own point and cell data; other meshes are built
-        anew. Default: the mesh the result keeps (when nothing was welded).
-    fields : sequence of str, optional
-        Names of :data:`meshcurv.io.fields.FIELDS` (default all): (V,)
-        scalars, (V, 3) vectors (``dir_min``, ``dir_max``, ``normals``),
-        ``valid`` as uint8.
-
-    Returns
-    -------
-    pyvista.PolyData
-
-    Raises
-    ------
-    MissingDependencyError
-        PyVista is not installed.
-    InvalidMeshError
-        The mesh has another number of vertices than the result has rows, or
-        no mesh was given and the result keeps none.
-    """
+    """:meth:`meshcurv.CurvatureResult.to_pyvista` (parameters, result and errors there): a ``pyvista.PolyData``."""
     pv = _require("pyvista", "to_pyvista", "pyvista")
     values = _result_fields(result, fields)
     if isinstance(mesh, pv.PolyData):
@@ -314,29 +289,7 @@ def to_pyvista(result, mesh=None, *, fields=None):
 
 
 def to_trimesh(result, mesh=None, *, fields=None):
-    """A ``trimesh.Trimesh`` of the mesh with the result's fields in ``vertex_attributes``.
-
-    Parameters
-    ----------
-    result : CurvatureResult
-    mesh : trimesh.Trimesh, other mesh object, or (vertices, faces), optional
-        As for :func:`to_pyvista`; a ``Trimesh`` is copied, others are
-        built with ``process=False`` (vertices kept in their order). Faces
-        with more than three corners are fan-triangulated.
-    fields : sequence of str, optional
-        As for :func:`to_pyvista`.
-
-    Returns
-    -------
-    trimesh.Trimesh
-
-    Raises
-    ------
-    MissingDependencyError
-        trimesh is not installed.
-    InvalidMeshError
-        As for :func:`to_pyvista`.
-    """
+    """:meth:`meshcurv.CurvatureResult.to_trimesh` (parameters, result and errors there): a ``trimesh.Trimesh``."""
     trimesh = _require("trimesh", "to_trimesh", "trimesh")
     values = _result_fields(result, fields)
     if isinstance(mesh, trimesh.Trimesh):
@@ -351,18 +304,7 @@ def to_trimesh(result, mesh=None, *, fields=None):
 
 
 def to_dataframe(result, *, fields=None):
-    """A ``pandas.DataFrame`` of the per-vertex fields, one row per vertex.
-
-    Columns: the scalar fields by name, the vectors as ``<name>_x``,
-    ``<name>_y``, ``<name>_z``, ``valid`` as bool, and ``vertex_area``
-    (:attr:`~meshcurv.CurvatureResult.vertex_areas`, NaN when the result has
-    no mesh) when ``fields`` is not given.
-
-    Raises
-    ------
-    MissingDependencyError
-        pandas is not installed.
-    """
+    """:meth:`meshcurv.CurvatureResult.to_dataframe` (parameters, result and errors there): a ``pandas.DataFrame``."""
     pd = _require("pandas", "to_dataframe", "pandas")
     columns = {}
     for name, array in _result_fields(result, fields).items():

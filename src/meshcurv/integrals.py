@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import check_choice, checked_mesh
+from ._validation import check_choice, checked_indices, checked_mesh
 from .errors import InvalidMeshError, InvalidOptionError
 from .geometry import face_areas, vertex_normals
 from .measures import face_measures
@@ -58,17 +58,36 @@ INTEGRALS = ("area", "mean", "gaussian", "willmore")
 
 
 def face_solid_angles(normals: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F,) signed area of the spherical triangle of the unit normals at each face's corners.
+    """Signed area of the spherical triangle of the unit normals at each face's corners.
 
-    Positive where the normals turn as the corners do (a convex face of an
-    outward-wound mesh), 0 where a corner's normal is not finite.
-    ``normals`` (V, 3), ``faces`` (F, 3) indices into them.
+    ``tan(Omega / 2) = <u_i | u_j x u_k> / (1 + <u_i|u_j> + <u_j|u_k> + <u_k|u_i>)``
+    (Van Oosterom and Strackee 1983).
+
+    Parameters
+    ----------
+    normals : array_like of shape (V, 3)
+        Unit normals at the vertices.
+    faces : array_like of shape (F, 3), int
+        0-based indices into ``normals``.
+
+    Returns
+    -------
+    ndarray of shape (F,), float64
+        In steradians, in ``(-2 pi, 2 pi]``: positive where the normals turn
+        as the corners do (a convex face of an outward-wound mesh), 0 where a
+        corner's normal is not finite.
+
+    Raises
+    ------
+    InvalidMeshError
+        Arrays of the wrong shape, ``faces`` not integers in range.
     """
     normals, faces = np.asarray(normals), np.asarray(faces)
     if normals.ndim != 2 or normals.shape[1] != 3 or faces.ndim != 2 or faces.shape[1] != 3:
         raise InvalidMeshError(
             f"`normals` and `faces` must have shapes (V, 3) and (F, 3); got {normals.shape} and {faces.shape}"
         )
+    faces = checked_indices(faces, normals.shape[0])
     u0, u1, u2 = (normals[faces[:, k]] for k in range(3))
     triple = np.einsum("ij,ij->i", u0, np.cross(u1, u2))
     cosines = 1.0 + np.einsum("ij,ij->i", u0, u1) + np.einsum("ij,ij->i", u1, u2) + np.einsum("ij,ij->i", u2, u0)
@@ -222,7 +241,24 @@ def weighted_percentiles(values, weights, percentiles) -> np.ndarray:
 
 
 def weighted_statistics(values, weights) -> dict[str, float]:
-    """``mean, median, p5, p25, p75, p95`` of ``values`` weighted by ``weights`` (see :func:`weighted_percentiles`)."""
+    """Weighted mean and percentiles of ``values`` (see :func:`weighted_percentiles`).
+
+    Parameters
+    ----------
+    values, weights : array_like of shape (N,)
+        Values not finite and weights not positive are left out.
+
+    Returns
+    -------
+    dict of str to float
+        ``mean`` (``sum(w v) / sum(w)``), ``median``, ``p5``, ``p25``,
+        ``p75``, ``p95``; all NaN when nothing is left.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``values`` and ``weights`` not of one shape (N,).
+    """
     values = np.asarray(values, dtype=np.float64)
     weights = np.asarray(weights, dtype=np.float64)
     names = ("p5", "p25", "median", "p75", "p95")

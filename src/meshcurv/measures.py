@@ -33,6 +33,7 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._tensors import principal_from_mean_gaussian, principal_from_shape_operator
+from ._validation import checked_indices
 from .errors import InvalidMeshError
 from .geometry import face_areas
 
@@ -57,17 +58,35 @@ def _shaped(array, name: str, shape: tuple, kinds: str = "fiu") -> np.ndarray:
 
 
 def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """(F, 9) per-face ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` (xx, yy, zz, xy, xz, yz).
+    """The corrected curvature measures of every face (formulas: the module's docstring).
 
     Written relative to the first corner, so that a translation of the mesh
     changes nothing (the sum ``(u_k - u_j) + (u_i - u_k) + (u_j - u_i)`` is 0).
-    The compiled kernel when numba is there. ``vertices`` and ``normals``
-    (V, 3), ``faces`` (F, 3) integers: their shapes are checked, not whether
-    the faces index the vertices (the caller's mesh is validated).
+    The compiled kernel when numba is there.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+    faces : array_like of shape (F, 3), int
+        0-based indices into ``vertices``.
+    normals : array_like of shape (V, 3)
+        Unit normals ``u_i`` at the vertices, interpolated linearly over each face.
+
+    Returns
+    -------
+    ndarray of shape (F, 9), float64
+        Columns ``mu_0`` (length^2), ``mu_1`` (length), ``mu_2``
+        (dimensionless), then the symmetrized ``mu^{X,Y}`` (xx, yy, zz, xy,
+        xz, yz; length). NaN where a corner's coordinates or normal are not finite.
+
+    Raises
+    ------
+    InvalidMeshError
+        Arrays of the wrong shape or dtype, indices out of range.
     """
     vertices = _shaped(vertices, "vertices", (None, 3))
     normals = _shaped(normals, "normals", vertices.shape)
-    faces = _shaped(faces, "faces", (None, 3), "iu")
+    faces = checked_indices(_shaped(faces, "faces", (None, 3), "iu"), vertices.shape[0])
     kernels = numba_kernels("icc")
     if kernels is not None:
         return kernels.face_measures(
@@ -116,14 +135,34 @@ def corrected_areas(vertices: np.ndarray, faces: np.ndarray, measures: np.ndarra
 
 
 def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
-    """``k_min, k_max, dir_min, dir_max`` of (N, 9) corrected measures summed over balls (rows of :func:`face_measures`).
+    """Principal curvatures and directions of corrected measures summed over regions (balls).
 
     ``H = mu_1 / (2 mu_0)``, ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``
     (:func:`meshcurv._tensors.principal_from_mean_gaussian`), and the
     directions of the shape operator ``-sym(mu^{X,Y}) / mu_0`` restricted to
-    the plane normal to each row of ``normals`` (N, 3), unit. All NaN in a row
-    whose corrected area ``mu_0`` is not positive or whose normal is not finite.
-    One pass with the compiled kernels.
+    the plane normal to each row of ``normals``. One pass with the compiled
+    kernels.
+
+    Parameters
+    ----------
+    summed : array_like of shape (N, 9)
+        Sums of rows of :func:`face_measures`, one row per region.
+    normals : array_like of shape (N, 3)
+        The unit normal of each region.
+
+    Returns
+    -------
+    k_min, k_max : ndarray of shape (N,), float64
+        In 1/length, ``k_min <= k_max``.
+    dir_min, dir_max : ndarray of shape (N, 3), float64
+        Unit, orthogonal to each other and to the normal, defined up to sign.
+        All four NaN in a row whose corrected area ``mu_0`` is not positive
+        or whose normal is not finite.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``summed`` or ``normals`` of the wrong shape or dtype.
     """
     summed = _shaped(summed, "summed", (None, 9))
     normals = _shaped(normals, "normals", (summed.shape[0], 3))
@@ -146,10 +185,25 @@ def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
 
 
 def principal_from_measures(summed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``k_min, k_max`` of summed measures (..., 9) from their scalar measures alone (no directions).
+    """Principal curvatures of summed measures from their scalar measures alone (no directions).
 
-    ``H = mu_1 / (2 mu_0)``, ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``; NaN where the
-    corrected area ``mu_0`` is not positive. Any leading shape (the rungs of a ladder of balls, say).
+    ``H = mu_1 / (2 mu_0)``, ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``.
+
+    Parameters
+    ----------
+    summed : array_like of shape (..., k), k >= 3
+        Sums of :func:`face_measures` (at least ``mu_0, mu_1, mu_2``), any
+        leading shape (the rungs of a ladder of balls, say).
+
+    Returns
+    -------
+    k_min, k_max : ndarray of shape ``summed.shape[:-1]``, float64
+        In 1/length, ``k_min <= k_max``; NaN where ``mu_0`` is not positive.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``summed`` a scalar or with fewer than 3 columns.
     """
     summed = np.asarray(summed)
     if summed.ndim == 0 or summed.shape[-1] < 3:

@@ -127,8 +127,13 @@ class CurvatureResult:
     def invalid_counts(self) -> dict[str, int]:
         """How many vertices are invalid for each reason (:data:`INVALID_REASONS`), largest first.
 
-        Empty when every vertex is valid; ``{"unknown": n}`` when the result
-        carries no ``invalid_reason``.
+        Returns
+        -------
+        dict of str to int
+            Reason phrase -> number of vertices, only reasons with at least
+            one vertex, in decreasing count (ties in the order of
+            :data:`INVALID_REASONS`). Empty when every vertex is valid;
+            ``{"unknown": n}`` when the result carries no ``invalid_reason``.
         """
         if self.invalid_reason is None:
             n_invalid = int((~self.valid).sum())
@@ -283,22 +288,76 @@ class CurvatureResult:
         return float(np.sum(shares if where is None else shares[_where_mask(where, self.n_vertices)]))
 
     def to_pyvista(self, mesh=None, *, fields=None):
-        """A ``pyvista.PolyData`` with the fields as ``point_data``: :func:`meshcurv._adapters.to_pyvista`.
+        """A ``pyvista.PolyData`` of the mesh with the result's fields as ``point_data``.
 
-        ``mesh``: the mesh the result was computed on (a ``PolyData``, copied;
-        another mesh object; or ``(vertices, faces)``); by default the one the
-        result keeps. ``fields``: names of :data:`meshcurv.io.fields.FIELDS`.
+        Parameters
+        ----------
+        mesh : pyvista.PolyData, other mesh object, or (vertices, faces), optional
+            The mesh the result was computed on, one vertex per row of the
+            result; a ``PolyData`` is copied (never changed). By default the
+            mesh the result keeps (when nothing was welded).
+        fields : sequence of str, optional
+            Names of :data:`meshcurv.io.fields.FIELDS` (default all).
+
+        Returns
+        -------
+        pyvista.PolyData
+            (V,) scalars and (V, 3) vectors as ``point_data``, ``valid`` as uint8.
+
+        Raises
+        ------
+        MissingDependencyError
+            PyVista is not installed.
+        InvalidMeshError
+            The mesh has another number of vertices than the result has rows,
+            or none was given and the result keeps none.
         """
         return _adapters.to_pyvista(self, mesh, fields=fields)
 
     def to_trimesh(self, mesh=None, *, fields=None):
-        """A ``trimesh.Trimesh`` with the fields in ``vertex_attributes``: :func:`meshcurv._adapters.to_trimesh`."""
+        """A ``trimesh.Trimesh`` of the mesh with the result's fields in ``vertex_attributes``.
+
+        Parameters
+        ----------
+        mesh : trimesh.Trimesh, other mesh object, or (vertices, faces), optional
+            As for :meth:`to_pyvista`; a ``Trimesh`` is copied, others are
+            built with ``process=False`` (vertices kept in their order) and
+            their polygons fan-triangulated.
+        fields : sequence of str, optional
+            As for :meth:`to_pyvista`.
+
+        Returns
+        -------
+        trimesh.Trimesh
+
+        Raises
+        ------
+        MissingDependencyError
+            trimesh is not installed.
+        InvalidMeshError
+            As for :meth:`to_pyvista`.
+        """
         return _adapters.to_trimesh(self, mesh, fields=fields)
 
     def to_dataframe(self, *, fields=None):
-        """A ``pandas.DataFrame``, one row per vertex: :func:`meshcurv._adapters.to_dataframe`.
+        """A ``pandas.DataFrame`` of the per-vertex fields, one row per vertex.
 
-        Vectors as ``<name>_x, _y, _z``; ``vertex_area`` added when ``fields`` is not given.
+        Parameters
+        ----------
+        fields : sequence of str, optional
+            Names of :data:`meshcurv.io.fields.FIELDS` (default all).
+
+        Returns
+        -------
+        pandas.DataFrame
+            V rows; the scalar fields by name, vectors as ``<name>_x``,
+            ``<name>_y``, ``<name>_z``, ``valid`` as bool, and ``vertex_area``
+            (:attr:`vertex_areas`) when ``fields`` is not given.
+
+        Raises
+        ------
+        MissingDependencyError
+            pandas is not installed.
         """
         return _adapters.to_dataframe(self, fields=fields)
 
