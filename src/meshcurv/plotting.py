@@ -69,13 +69,31 @@ def _pyplot():
 
 
 def choose_up(vertices) -> tuple[str, str]:
-    """The axis drawn upwards when none is given, and why: ``('y' or 'z', reason)``.
+    """The axis drawn upwards when none is given, and why.
 
     Most OBJ and PLY files are made with y up (trimesh, Blender's OBJ export,
     the Stanford and Keenan Crane models); CAD, scanners and medical tools
     often write z up. A mesh is taken as z-up when it is more than
     :data:`Z_UP_RATIO` times as tall along z as along y, else y-up; x is
     never chosen.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3)
+        V may be 0 (y up).
+
+    Returns
+    -------
+    axis : {'y', 'z'}
+        ``'z'`` when ``ptp(z) > Z_UP_RATIO * ptp(y)`` (a flat y extent with
+        some z extent included).
+    reason : str
+        The ratio found, for a log line.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``vertices`` not of shape (V, 3).
     """
     points = np.asarray(vertices, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3:

@@ -24,7 +24,24 @@ STEPS_PER_CALL = 64
 
 
 def check_smoothing_steps(steps) -> int:
-    """``steps`` as an int in ``[0, MAX_SMOOTHING_STEPS]`` or :class:`InvalidOptionError`."""
+    """Check the ``smoothing_steps`` option of the estimators.
+
+    Parameters
+    ----------
+    steps : int
+        An integer (``operator.index``: a Python or NumPy int, not a bool
+        nor a float).
+
+    Returns
+    -------
+    int
+        ``steps``, in ``[0, MAX_SMOOTHING_STEPS]``.
+
+    Raises
+    ------
+    InvalidOptionError
+        Not an integer, negative, or above :data:`MAX_SMOOTHING_STEPS`.
+    """
     number = check_int_option(steps, "smoothing_steps", maximum=None)
     if number > MAX_SMOOTHING_STEPS:
         raise InvalidOptionError(

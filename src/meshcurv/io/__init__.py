@@ -65,7 +65,16 @@ logger = logging.getLogger(__name__)
 
 
 class Mesh(NamedTuple):
-    """What :func:`read_mesh` returns; unpacks as ``vertices, faces``."""
+    """What :func:`read_mesh` returns; unpacks as ``vertices, faces``.
+
+    Attributes
+    ----------
+    vertices : ndarray of shape (V, 3), float64
+        Finite coordinates.
+    faces : ndarray of shape (F, 3) or (F, k), int64, or list of ndarray
+        0-based indices in ``[0, V)``: triangles, polygons of k corners, or
+        one array per face when their sizes differ.
+    """
 
     vertices: np.ndarray
     """(V, 3) float64 coordinates."""
@@ -316,13 +325,34 @@ def write_curvatures(
 ) -> pathlib.Path:
     """Write a mesh with the fields of a curvature result as per-vertex data.
 
-    ``write_mesh(path, vertices, faces, point_data=curvature_fields(result, ...))``;
-    see :func:`write_mesh` and :func:`~meshcurv.io.fields.curvature_fields` for
-    the parameters.
+    ``write_mesh(path, vertices, faces, point_data=curvature_fields(result, ...))``.
+
+    Parameters
+    ----------
+    path, vertices, faces
+        As for :func:`write_mesh`; ``vertices`` has one row per row of ``result``.
+    result, fields, quality
+        As for :func:`~meshcurv.io.fields.curvature_fields`: the
+        :class:`~meshcurv.CurvatureResult`, which of its fields (default all),
+        and the scalar field copied as ``quality`` (default ``'mean'``; None
+        for none).
+    overwrite, source, binary
+        As for :func:`write_mesh` (defaults False, None, True).
 
     Returns
     -------
     pathlib.Path
+        The mesh written, ``path``.
+
+    Raises
+    ------
+    MeshFileError
+        As :func:`write_mesh`, and for OBJ, STL and OFF, which hold no fields.
+    InvalidMeshError
+        As :func:`write_mesh`.
+    InvalidOptionError
+        As :func:`~meshcurv.io.fields.curvature_fields`, or a result with
+        another number of rows than ``vertices``.
 
     Examples
     --------

@@ -98,8 +98,19 @@ def is_point_cloud(path) -> bool:
     :func:`read_points`; reads at most the PLY header. The text tables
     (``.xyz .txt .pts .csv``) are point clouds: :func:`meshcurv.read_mesh`
     reads no mesh from any of them (a ``.csv`` it writes holds per-vertex
-    values, without faces). False for unknown or unreadable files (the mesh
-    reader then says why).
+    values, without faces).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    bool
+        True for the extensions ``.xyz .txt .pts .csv .pcd .las .laz`` (the
+        file is not opened) and for a PLY whose header declares no face;
+        False otherwise, unknown, missing or unreadable files included (the
+        mesh reader then says why).
     """
     path = pathlib.Path(path)
     suffix = path.suffix.lower()
@@ -131,6 +142,27 @@ def write_point_curvatures(
     ``write_points(path, points, point_data=curvature_fields(result, ...))``:
     the normals go out as ``normals_x ...`` with the other fields (``nx ...``
     only when passed to :func:`write_points` directly).
+
+    Parameters
+    ----------
+    path, points
+        As for :func:`write_points`; ``points`` has one row per row of ``result``.
+    result, fields, quality
+        As for :func:`meshcurv.io.write_curvatures`.
+    overwrite, source, binary
+        As for :func:`write_points` (defaults False, None, True).
+
+    Returns
+    -------
+    pathlib.Path
+        The point cloud written, ``path``.
+
+    Raises
+    ------
+    MeshFileError, InvalidMeshError
+        As :func:`write_points`.
+    InvalidOptionError
+        As :func:`meshcurv.io.write_curvatures`.
     """
     point_data = curvature_fields(result, fields=fields, quality=quality)
     return write_points(path, points, point_data=point_data, overwrite=overwrite, source=source, binary=binary)
