@@ -420,9 +420,10 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
 
     The scale of every tolerance in the core (zero-area faces, zero-length
     edges). On a connected mesh it is the median of at most about
-    :data:`MEDIAN_SAMPLE` edges evenly spaced in index order (within a percent
-    of the median of all; a tolerance needs no more, and it keeps this step at
-    a millisecond per million vertices). On a mesh whose components are of one scale (each component's
+    :data:`MEDIAN_SAMPLE` edges evenly spaced in index order (a tolerance
+    needs no more; how close to the median of all and how fast:
+    ``benchmarks/docstring_figures.md``). On a mesh whose components are of
+    one scale (each component's
     geometric-mean edge within :data:`COMPONENT_SCALE_SPREAD` of the mesh's
     median edge) it is the mesh's median edge length everywhere, found in one
     pass; otherwise each component gets its own median (a sort of the edges by
