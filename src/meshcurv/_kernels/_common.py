@@ -6,7 +6,9 @@ the threads that run a kernel's chunks (:func:`run_chunks`).
 from __future__ import annotations
 
 import math
-from concurrent.futures import ThreadPoolExecutor
+import os
+import threading
+from concurrent.futures import ThreadPoolExecutor, wait
 from typing import Literal, TypedDict
 
 import numba as nb
@@ -108,8 +110,9 @@ def run_chunks(chunk, n_items, n_chunks, *args) -> None:
     The ranges are those of ``numba.prange`` over the chunks (``lo = c * n_items // n_chunks``), at most
     ``n_items`` of them and at least one. ``chunk`` is a compiled function without the GIL (``nogil``)
     that writes its range's rows of arrays in ``args``; the ranges run on ``numba.get_num_threads()``
-    Python threads (the calling thread alone when that is 1, as ``numba.set_num_threads`` or
-    ``NUMBA_NUM_THREADS`` make it).
+    threads: the calling thread and workers of one pool kept between calls (:func:`_pool`), the calling
+    thread alone when that is 1 (as ``numba.set_num_threads`` or ``NUMBA_NUM_THREADS`` make it). Each
+    thread takes the next range left until none is; the call returns when every range is written.
 
     Why threads rather than ``parallel=True``: numba's parallel pipeline compiles the body of a parallel
     loop twice and optimises the functions it calls again in the loop's module; for the jet fits that was
@@ -117,12 +120,51 @@ def run_chunks(chunk, n_items, n_chunks, *args) -> None:
     on the number of threads: each range writes its own rows.
     """
     n_chunks = max(min(int(n_items), int(n_chunks)), 1)
-    bounds = [(c * n_items // n_chunks, (c + 1) * n_items // n_chunks) for c in range(n_chunks)]
+    bounds = iter([(c * n_items // n_chunks, (c + 1) * n_items // n_chunks) for c in range(n_chunks)])
     threads = min(nb.get_num_threads(), n_chunks)
-    if threads <= 1:
-        for lo, hi in bounds:
+
+    def work():
+        for lo, hi in bounds:  # a list iterator hands out each range once, whatever the thread
             chunk(lo, hi, *args)
+
+    if threads <= 1:
+        work()
         return
-    with ThreadPoolExecutor(threads, thread_name_prefix="meshcurv-kernel") as pool:
-        for future in [pool.submit(chunk, lo, hi, *args) for lo, hi in bounds]:
-            future.result()
+    helpers = [_pool().submit(work) for _ in range(threads - 1)]
+    try:
+        work()
+    finally:
+        # a helper not started yet (the pool busy with another call's ranges) has nothing left to do: it is
+        # cancelled rather than waited for, so that a call never waits on the queue of another; the others
+        # are waited for, all of them, before any error of theirs is raised
+        started = [future for future in helpers if not future.cancel()]
+        wait(started)
+    for future in started:
+        future.result()
+
+
+_POOL: ThreadPoolExecutor | None = None
+_POOL_LOCK = threading.Lock()
+
+
+def _pool() -> ThreadPoolExecutor:
+    """The workers of :func:`run_chunks`: one pool per process, made on first use with
+    ``NUMBA_NUM_THREADS - 1`` threads (the most ``numba.set_num_threads`` allows, less the calling thread).
+
+    Its idle threads wait on a queue; ``concurrent.futures`` joins them at the interpreter's exit. A child
+    made by ``fork`` (which has the pool's object but not its threads) makes its own (:func:`_forget_pool`).
+    """
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None:
+            _POOL = ThreadPoolExecutor(max(nb.config.NUMBA_NUM_THREADS - 1, 1), thread_name_prefix="meshcurv-kernel")
+        return _POOL
+
+
+def _forget_pool() -> None:
+    global _POOL, _POOL_LOCK
+    _POOL, _POOL_LOCK = None, threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pool)
