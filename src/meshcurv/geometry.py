@@ -433,12 +433,14 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
     Parameters
     ----------
     vertices : array_like of shape (V, 3)
+        Finite coordinates.
     topology : MeshTopology
         The connectivity, with ``topology.n_vertices == V``.
 
     Returns
     -------
     ndarray of shape (V,), float64
+        In the vertices' length unit, >= 0.
 
     Raises
     ------

@@ -791,6 +791,7 @@ def voxel_sphere(radius: float = 10.0, spacing=(1.0, 1.0, 1.0), *, seed: int = 0
     Parameters
     ----------
     radius : float, default: 10.0
+        > 0, in physical units (those of ``spacing``).
     spacing : sequence of 3 floats, default: (1, 1, 1)
         Voxel size along image axes 0, 1, 2.
     seed : int, default: 0
