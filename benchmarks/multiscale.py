@@ -8,12 +8,10 @@ compilation not counted); in each round the calls run one after the other, so
 that the ratios compare calls made under the same load; wall and CPU seconds,
 the ratios of CPU time (the machine is shared). ``--stages`` adds the CPU
 seconds of each stage (the ``progress`` callback) of the largest radius alone
-and of the multi-scale call. The row "nested fits" runs the multi-scale call
-with its normal fits from :func:`meshcurv.neighborhoods.nested_jet_normals`
-(one walk per vertex for the three fit radii) in place of one
-``fitted_normals`` call per radius: what ``icc.estimate_multiscale`` gives once
-it calls it (the rest of the call unchanged; the results are checked equal to
-round-off).
+and of the multi-scale call. The multi-scale call fits the normals of the
+radii from one walk per vertex (:func:`meshcurv.neighborhoods.nested_jet_normals`);
+the row "fits per radius" runs it with one ``fitted_normals`` call per radius
+instead (the call before aae8001; the results are checked equal to round-off).
 
     python benchmarks/multiscale.py --sizes 100k,1M --repeats 5 --stages
 """
@@ -21,7 +19,7 @@ round-off).
 from __future__ import annotations
 
 import argparse
-import dataclasses
+import contextlib
 import os
 import time
 import warnings
@@ -30,54 +28,21 @@ import numpy as np
 
 import meshcurv
 from meshcurv import shapes
-from meshcurv.estimators import ESTIMATORS, icc
-from meshcurv.neighborhoods import nested_jet_normals
+from meshcurv.estimators import icc
 
 SIZES = {"10k": 32, "100k": 100, "1M": 316}  # icosphere subdivisions: 10 n^2 + 2 vertices
 
 
-def _nested_estimator():
-    """icc's registry entry with its multi-scale fits from one walk (nested_jet_normals), for this benchmark."""
-    fits: dict[float, np.ndarray] = {}
-    fitted_normals = icc.fitted_normals
-
-    def from_walk(vertices, normals, valid, radius, **options):
-        if float(radius) not in fits:
-            return fitted_normals(vertices, normals, valid, radius, **options)
-        fitted = fits[float(radius)]  # then the agreement test of fitted_normals
-        start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
-        with np.errstate(invalid="ignore"):
-            usable = valid & (np.einsum("ij,ij->i", fitted, start) > icc.NORMAL_AGREEMENT)
-        if options.get("failed") is not None:
-            options["failed"] |= valid & ~np.isfinite(fitted).all(axis=1)
-        return np.where(usable[:, None], fitted, normals)
-
-    def multiscale(mesh, *, radii, stages):
-        topology = mesh.topology
-        _, valid = mesh.start(boundary=True)
-        start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
-        normal_radii = [icc.NORMAL_RADIUS_RATIO * icc.check_radius(r, mesh.vertices, topology) for r in radii]
-        stages.start("fit normals")
-        found = nested_jet_normals(
-            mesh.vertices,
-            start,
-            normal_radii,
-            adjacency=topology.neighbour_lists,
-            neighbours=topology.referenced_vertices,
-            degree=icc.NORMAL_DEGREE,
-            iterations=icc.NORMAL_ITERATIONS,
-            settled=icc.NORMAL_SETTLED,
-            min_spread=icc.NORMAL_MIN_SPREAD,
-        )
-        fits.update({float(r): normals for r, normals in zip(normal_radii, found)})
-        icc.fitted_normals = from_walk
-        try:
-            return icc.estimate_multiscale(mesh, radii=radii, stages=stages)
-        finally:
-            icc.fitted_normals = fitted_normals
-            fits.clear()
-
-    return dataclasses.replace(ESTIMATORS["icc"], multiscale=multiscale)
+@contextlib.contextmanager
+def _per_radius_fits():
+    """Within the block, ``icc.estimate_multiscale`` fits the normals of each radius on its own walk (one
+    ``fitted_normals`` call per radius, as before it took them from ``nested_jet_normals``)."""
+    nested = icc.nested_jet_normals
+    icc.nested_jet_normals = lambda *args, **options: []  # no fits given: fitted_normals fits each radius
+    try:
+        yield
+    finally:
+        icc.nested_jet_normals = nested
 
 
 def _call(function, stages_out=None):
@@ -107,8 +72,6 @@ def main(argv=None):
         f"meshcurv {meshcurv.__version__}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}; "
         f"median of {args.repeats} rounds, wall s (CPU s); ratios of CPU time\n"
     )
-    nested = _nested_estimator()
-    original = ESTIMATORS["icc"]
     header = "| vertices | icc at 4h alone | 3 calls h, 2h, 4h | multiscale h, 2h, 4h | multiscale / 4h alone |"
     rows, splits = [header, "|--:|--:|--:|--:|--:|"], []
     for size in args.sizes.split(","):
@@ -117,27 +80,21 @@ def main(argv=None):
         h = meshcurv.geometry.mean_edge_length(v, meshcurv.MeshTopology.from_faces(f).edges)
         radii = [h, 2 * h, 4 * h]
         check = [r.mean for r in meshcurv.multiscale_curvatures(v, f, radii)]
-        ESTIMATORS["icc"] = nested
-        try:
+        with _per_radius_fits():
             for got, expected in zip(meshcurv.multiscale_curvatures(v, f, radii), check):
                 np.testing.assert_allclose(got.mean, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
-        finally:
-            ESTIMATORS["icc"] = original
         calls = {
             "alone": lambda p: meshcurv.principal_curvatures(v, f, radius=4 * h, progress=p),
             "separate": lambda p: [meshcurv.principal_curvatures(v, f, radius=r, progress=p) for r in radii],
             "multi": lambda p: meshcurv.multiscale_curvatures(v, f, radii, progress=p),
-            "nested": lambda p: meshcurv.multiscale_curvatures(v, f, radii, progress=p),
+            "per radius": lambda p: meshcurv.multiscale_curvatures(v, f, radii, progress=p),
         }
         times = {name: [] for name in calls}
         stages = {name: {} for name in calls}
         for round_ in range(args.repeats + 1):  # round 0 warms up
             for name, call in calls.items():
-                ESTIMATORS["icc"] = nested if name == "nested" else original
-                try:
+                with _per_radius_fits() if name == "per radius" else contextlib.nullcontext():
                     measured = _call(call, stages[name] if round_ else None)
-                finally:
-                    ESTIMATORS["icc"] = original
                 if round_:
                     times[name].append(measured)
         wall = {name: float(np.median([t[0] for t in ts])) for name, ts in times.items()}
@@ -148,9 +105,10 @@ def main(argv=None):
             f"({cpu['separate']:.2f}) | {wall['multi']:.3f} ({cpu['multi']:.2f}) | {ratio['multi']:.2f}x |"
         )
         rows.append(
-            f"| {v.shape[0]:,}, nested fits | | | {wall['nested']:.3f} ({cpu['nested']:.2f}) | {ratio['nested']:.2f}x |"
+            f"| {v.shape[0]:,}, fits per radius | | | {wall['per radius']:.3f} ({cpu['per radius']:.2f}) "
+            f"| {ratio['per radius']:.2f}x |"
         )
-        for name in ("alone", "multi", "nested"):
+        for name in ("alone", "multi", "per radius"):
             split = ", ".join(f"{k} {s / args.repeats:.2f}" for k, s in stages[name].items())
             splits.append(f"- {v.shape[0]:,}, {name}: {split}")
     print("\n".join(rows))
