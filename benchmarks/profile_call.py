@@ -26,6 +26,12 @@ seconds, the median of ``--repeats`` after a warm-up (``--fit-scales 3,6,12``: t
 fits of ``multiscale_curvatures`` at ``h, 2 h, 4 h``)::
 
     .venv/bin/python benchmarks/profile_call.py --sizes 100k,1M --walks --fit-scales 3,6,12
+
+``--preparation`` prints instead what the ball sums do besides their kernel (the checks,
+the face centroids, the faces around each vertex, the scratch), each piece timed alone on
+the default call's radius, and the cost of one ``run_chunks`` call (CPU and wall s)::
+
+    .venv/bin/python benchmarks/profile_call.py --sizes 1M --preparation --repeats 7
 """
 
 from __future__ import annotations
@@ -278,6 +284,77 @@ def walks_table(results) -> str:
     return "\n".join(lines)
 
 
+def _median_cpu_wall(call, repeats: int) -> tuple[float, float]:
+    call()  # warm-up
+    cpu, wall = [], []
+    for _ in range(repeats):
+        c, w = time.process_time(), time.perf_counter()
+        call()
+        cpu.append(time.process_time() - c)
+        wall.append(time.perf_counter() - w)
+    return float(np.median(cpu)), float(np.median(wall))
+
+
+def preparation(label: str, repeats: int) -> list[tuple[str, float, float]]:
+    """``(piece, CPU s, wall s)``: what :func:`meshcurv.neighborhoods.ball_face_sums` (``connected=True``, the
+    default call's radius and face measures) does besides its kernel, each piece timed alone, and the cost of
+    one :func:`meshcurv._kernels._common.run_chunks` call of a trivial kernel (the threads' hand-over)."""
+    import numba
+
+    from meshcurv import neighborhoods
+    from meshcurv._kernels import _common
+    from meshcurv._kernels import neighborhoods as compiled
+    from meshcurv.measures import face_measures
+
+    mesh = meshcurv.shapes.icosphere(SIZES[label])
+    v = np.ascontiguousarray(mesh.vertices)
+    f = np.ascontiguousarray(mesh.faces, dtype=np.int64)
+    n = v.shape[0]
+    result = meshcurv.principal_curvatures(v, f)
+    radius = float(result.parameters["radius"])
+    measures = face_measures(v, f, result.normals)
+    adjacency = meshcurv.MeshTopology.from_faces(f).neighbour_lists
+    centres, reach = compiled.cell_centres(v, f)
+    threads = _threads()
+    pieces = {
+        "faces and vertices checked (`_checked_cells`)": lambda: neighborhoods._checked_cells(v, f),
+        "face centroids and reach (`cell_centres`)": lambda: compiled.cell_centres(v, f),
+        "work estimate (`check_ball_work`)": lambda: neighborhoods.check_ball_work(
+            centres, radius + float(reach.max()), n, centres=v
+        ),
+        "faces around each vertex (`vertex_face_lists`)": lambda: compiled.vertex_face_lists(f, n, threads),
+        "scratch of the walks (`_face_sum_scratch`)": lambda: neighborhoods._face_sum_scratch(threads, n, f.shape[0]),
+        "whole `ball_face_sums(connected=True)`": lambda: neighborhoods.ball_face_sums(
+            v, f, radius, measures, connected=True
+        ),
+        "(normal fits) `checked_adjacency` of the neighbour lists": lambda: neighborhoods.checked_adjacency(
+            adjacency, n
+        ),
+    }
+    rows = [(f"{name}, icosphere({SIZES[label]})", *_median_cpu_wall(call, repeats)) for name, call in pieces.items()]
+
+    @numba.njit(nogil=True, cache=False)
+    def fill(lo, hi, out):
+        for i in range(lo, hi):
+            out[i] = 2.0 * i
+
+    out = np.zeros(1000)
+    cpu, wall = _median_cpu_wall(lambda: [_common.run_chunks(fill, 1000, 8, out) for _ in range(1000)], repeats)
+    rows.append(("one `run_chunks` call, trivial kernel, 8 ranges (per call)", cpu / 1000, wall / 1000))
+    return rows
+
+
+def preparation_table(rows) -> str:
+    lines = [
+        f"CPU and wall s, median of the calls after a warm-up; {_threads()} threads; load average {load()}",
+        "",
+        "| piece | CPU s | wall s |",
+        "|---|--:|--:|",
+    ]
+    lines += [f"| {name} | {cpu:.2g} | {wall:.2g} |" for name, cpu, wall in rows]
+    return "\n".join(lines)
+
+
 TIMERS = Timers()
 
 
@@ -294,7 +371,15 @@ def main(argv=None) -> int:
         default="3",
         help="with --walks: the radii of the normal fits, in units of r (icc: 3; multiscale h, 2h, 4h: 3,6,12)",
     )
+    parser.add_argument(
+        "--preparation",
+        action="store_true",
+        help="only the table of what the ball sums do besides their kernel (see the module's doc)",
+    )
     args = parser.parse_args(argv)
+    if args.preparation:
+        print(preparation_table([row for label in args.sizes.split(",") for row in preparation(label, args.repeats)]))
+        return 0
     if args.walks:
         scales = [float(scale) for scale in args.fit_scales.split(",")]
         print(walks_table([row for label in args.sizes.split(",") for row in walks(label, args.repeats, scales)]))
