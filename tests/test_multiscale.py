@@ -188,3 +188,31 @@ def test_adaptive_is_for_icc_only():
     torus = shapes.torus()
     with pytest.raises(InvalidOptionError, match="radius"):
         meshcurv.principal_curvatures(torus.vertices, torus.faces, method="quadric", radius="adaptive")
+
+
+def test_radii_on_the_coarse_level_are_fitted_there_and_the_others_from_one_walk(monkeypatch):
+    """icc's multi-scale fits: the radii below the coarse level (normal radius <= COARSE_EDGES median edges) from
+    nested_jet_normals, the others on the coarse level as the single call fits them; each equals its single call."""
+    from meshcurv.estimators import icc
+
+    vertices, faces = _meshes()["torus"]
+    h = meshcurv.geometry.mean_edge_length(vertices, meshcurv.MeshTopology.from_faces(faces).edges)
+    radii = [1.5 * h, 2.0 * h, 9.0 * h]  # normal radii 4.5 h, 6 h (walked) and 27 h (coarse level)
+    walked = []
+    nested = icc.nested_jet_normals
+
+    def recorded(vertices, normals, radii, **options):
+        walked.append(list(radii))
+        return nested(vertices, normals, radii, **options)
+
+    monkeypatch.setattr(icc, "nested_jet_normals", recorded)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        results = meshcurv.multiscale_curvatures(vertices, faces, radii, method="icc")
+    np.testing.assert_allclose(walked, [[icc.NORMAL_RADIUS_RATIO * r for r in radii[:2]]], rtol=1e-15)
+    for radius, result in zip(radii, results):
+        single = _single(vertices, faces, "icc", radius)
+        np.testing.assert_array_equal(result.valid, single.valid)
+        scale = np.nanmax(np.abs(single.k_max))
+        np.testing.assert_allclose(result.mean, single.mean, rtol=0, atol=1e-9 * scale)
+        np.testing.assert_allclose(result.normals, single.normals, rtol=0, atol=1e-12)
