@@ -271,7 +271,7 @@ def _ball_average(
     return np.where(np.isfinite(out).all(axis=1, keepdims=True), out, normals)
 
 
-def _tapered_normals(vertices, start, radius, *, neighbours, adjacency, areas, kernel, iterations=2):
+def _tapered_normals(vertices, start, radius, *, neighbours, adjacency, areas, kernel, iterations=2, robust=0):
     """(V, 3) normals of icc's degree-3 jets (coarse level and area weights as the default) with another kernel
     of ``d = |x_j - x_v| / R``: ``kernel(d2)`` in place of ``(1 - d2)^2``. NumPy; per-vertex ``radius``."""
     from meshcurv import jets
@@ -310,6 +310,21 @@ def _tapered_normals(vertices, start, radius, *, neighbours, adjacency, areas, k
                 keep = np.isfinite(tilted).all(axis=1, keepdims=True)
                 new_normal = np.where(keep, tilted, local[2])
                 local = [*tangent_basis(new_normal), new_normal]
+        for _ in range(robust):  # refits in the last frame, each point weighed down by its residual (Cauchy)
+            solution, ok, _ = jets._solve_block(matrix, right, degree, jets.NORMAL_MIN_SPREAD)
+            u, v, w = (np.einsum("ij,ij->i", offsets, axis[rows]) for axis in local)
+            terms = np.stack([u**i * v**k for i, k in jets._exponents(degree)], axis=1)
+            residual = w - np.einsum("ij,ij->i", terms, solution[rows])
+            spread = np.bincount(rows, weights=weights * residual**2, minlength=size) / np.maximum(
+                np.bincount(rows, weights=weights, minlength=size), 1e-300
+            )
+            robust_weights = weights / (1.0 + residual**2 / np.maximum(spread[rows], 1e-30))
+            matrix, right = jets._fit_chunk(offsets, rows, size, local, robust_weights, degree)
+            fitted = jets._solve(matrix, right, count, degree, jets.NORMAL_MIN_SPREAD)
+            p, q = fitted[:, 1:2], fitted[:, 2:3]
+            refit = local[2] - p * local[0] - q * local[1]
+            refit /= np.linalg.norm(refit, axis=1, keepdims=True)
+            tilted = np.where((ok[:, None] & np.isfinite(refit).all(axis=1, keepdims=True)), refit, tilted)
         out[index] = tilted
     return out
 
@@ -325,7 +340,8 @@ def normal_variant(name):
     passes, the plain area-weighted mean moved from the ball's centroid to the vertex by the vertex's shape operator;
     ``extrapolated:A``: the same average of the neighbours' jets' normals at the vertex's position (the
     slope of each neighbour's quadric there); ``taper:P`` and ``gauss:S``: the fits with the kernel
-    ``(1 - d^2 / R^2)^P`` (today ``P = 2``) or ``exp(-d^2 / (2 S^2 R^2))`` within the ball (NumPy,
+    ``(1 - d^2 / R^2)^P`` (today ``P = 2``) or ``exp(-d^2 / (2 S^2 R^2))`` within the ball; ``robust:N``: N refits
+    with Cauchy weights on the residuals (iteratively reweighted; NumPy,
     :func:`_tapered_normals`); a suffix ``+area`` (``mean:1+area``) adds ``area``.
     """
     fit = icc.fitted_normals
@@ -341,11 +357,11 @@ def normal_variant(name):
         fitted = fit(vertices, normals, valid, radius, failed=failed, **options)
         if kind == "area":
             return fitted
-        if kind in ("taper", "gauss"):
-            if kind == "taper":
+        if kind in ("taper", "gauss", "robust"):
+            if kind in ("taper", "robust"):
 
                 def kernel(d2):
-                    return (1 - d2) ** factor
+                    return (1 - d2) ** (factor if kind == "taper" else 2)
             else:
 
                 def kernel(d2):
@@ -360,6 +376,7 @@ def normal_variant(name):
                 adjacency=options["adjacency"],
                 areas=options["areas"],
                 kernel=kernel,
+                robust=int(factor) if kind == "robust" else 0,
             )
             with np.errstate(invalid="ignore"):
                 usable = valid & (np.einsum("ij,ij->i", found, start) > icc.NORMAL_AGREEMENT)
