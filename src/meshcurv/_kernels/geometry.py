@@ -12,13 +12,32 @@ import numpy as np
 from ._common import _JIT, _degenerate, _edge_length, _face_cross, _unit
 
 
+#: the fixed number of runs of a reduction that must not depend on the thread count
+_SUM_CHUNKS = 256
+
+
 @nb.njit(parallel=True, **_JIT)
 def _mean_edge_length(vertices, edges):
-    """Mean length of the edges (0 when there are none), a parallel reduction."""
+    """Mean length of the edges (0 when there are none), summed in a fixed order.
+
+    The edges are cut into :data:`_SUM_CHUNKS` runs whatever the thread count; each run is summed in order and the
+    runs' sums are added in order, so the result (and every radius derived from it) is the same bit for bit on any
+    number of threads (a ``prange`` reduction adds in the order the threads finish).
+    """
+    n = edges.shape[0]
+    if n == 0:
+        return 0.0
+    chunks = min(_SUM_CHUNKS, n)
+    partial = np.zeros(chunks)
+    for c in nb.prange(chunks):
+        total = 0.0
+        for e in range(c * n // chunks, (c + 1) * n // chunks):
+            total += _edge_length(vertices, edges[e, 0], edges[e, 1])
+        partial[c] = total
     total = 0.0
-    for e in nb.prange(edges.shape[0]):
-        total += _edge_length(vertices, edges[e, 0], edges[e, 1])
-    return total / edges.shape[0] if edges.shape[0] else 0.0
+    for c in range(chunks):
+        total += partial[c]
+    return total / n
 
 
 @nb.njit(parallel=True, **_JIT)
