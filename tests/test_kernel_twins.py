@@ -1879,6 +1879,12 @@ EXCEPTIONS: dict[str, str] = {
     "neighborhoods.pool_grid": "a search structure, not a result: the twins of pointcloud.ball_indices and "
     "jets.fit_jets, which search it, find the same balls with k-d trees",
     "icc.nested_jet_normals": "tests/test_multiscale.py: against jets.fit_jet_normals at each radius, on both backends",
+    "topology.build_topology": "the body of topology.build_edges (its row above), which calls it",
+    "topology.build_edges_into": "the body of topology.build_topology, called by topology.build_edges (its row above)",
+    "topology.bowtie_from_twins": "tests/test_topology.py::test_bowtie_vertices_from_the_twin_sides_are_those_of_the_"
+    "definition: against the NumPy definition on random defective spheres",
+    "matgeom.matgeom_vertex_sums": "the body of matgeom.matgeom_vertex_tensors (its row above), which calls it; its "
+    "zero-area faces: tests/test_topology.py::test_the_zero_area_faces_a_kernel_found_are_kept",
 }
 
 #: Cases where a kernel and its twin disagree: ``(kernel, input) -> reason`` (strict xfail). Empty: the one
