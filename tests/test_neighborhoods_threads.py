@@ -8,12 +8,13 @@ import sys
 import threading
 import time
 
-import numba
 import numpy as np
 import pytest
 
-from meshcurv._kernels import _common
-from meshcurv._kernels._common import run_chunks
+numba = pytest.importorskip("numba")
+
+from meshcurv._kernels import _common  # noqa: E402  (numba first: the kernels need it)
+from meshcurv._kernels._common import run_chunks  # noqa: E402
 
 
 def _fill(lo, hi, out, value):
