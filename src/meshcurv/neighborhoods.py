@@ -40,6 +40,7 @@ tests/test_kernel_twins.py).
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 
@@ -716,7 +717,7 @@ def nested_jet_normals(
         raise InvalidOptionError("`radii` must not decrease from one radius to the next (nested balls)")
     kernels = numba_kernels("icc")
     n = vertices.shape[0]
-    options = {"degree": degree, "iterations": iterations, "settled": settled, "min_spread": min_spread}
+    options: dict[str, Any] = {"degree": degree, "iterations": iterations, "settled": settled, "min_spread": min_spread}
     if kernels is None or n == 0:
         return [
             fit_jet_normals(vertices, normals, radius, adjacency=adjacency, neighbours=neighbours, **options)

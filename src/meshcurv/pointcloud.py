@@ -775,6 +775,7 @@ def _compute(points, given, radius, method, search=None):
                 )
                 parameters["normal_radius"] = normal_radius
                 failed = part_members[~np.isfinite(details["radii"][part_members])]
+                assert part_mixed is not None  # found above for corrected_measures without given normals
                 part_one_sided[failed] = ~part_mixed[failed]
                 noisy += _noise_dominated(details["radii"], part_members, asked, noise, part_one_sided)
             else:

@@ -157,7 +157,8 @@ def _pool() -> ThreadPoolExecutor:
     global _POOL
     with _POOL_LOCK:
         if _POOL is None:
-            _POOL = ThreadPoolExecutor(max(nb.config.NUMBA_NUM_THREADS - 1, 1), thread_name_prefix="meshcurv-kernel")
+            threads = nb.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]
+            _POOL = ThreadPoolExecutor(max(threads - 1, 1), thread_name_prefix="meshcurv-kernel")
         return _POOL
 
 
