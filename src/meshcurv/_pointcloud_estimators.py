@@ -171,10 +171,10 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
         # the same fits over balls LARGER times larger, from the same normals: the estimate must not depend on it
         done = np.asarray(centres, dtype=np.int64)
         done = done[np.isfinite(found[0][done])]
-        wide = one_sided_fits(
+        wide_coefficients, wide_frame, wide_radii = one_sided_fits(
             points, normals, radius * LARGER, done, usable, smallest=None if smallest is None else smallest * LARGER
         )
-        wide_found = _jet_curvatures(wide[0], wide[1], wide[2], normals)
+        wide_found = _jet_curvatures(wide_coefficients, wide_frame, wide_radii, normals)
         details["unsteady"] = unsteady(found, wide_found, done, radius)
     return found
 
