@@ -128,6 +128,9 @@ CHUNK_SIZE = 4096
 #: for 1 at 1.5 R). Noisy normals of a clean surface rarely turn beyond 90 degrees: 5%
 #: leaves room for a few that do.
 AWAY_FRACTION = 0.05
+#: Normals whose dot product is below this face away: orthogonal ones (a voxel surface's faces at right
+#: angles) do not, whatever the round-off (issue 29: a voxel sphere scaled by 1e-8 lost quadric fits).
+AWAY_DOT = -1e-9
 
 #: A fit whose first frame tilts its normal less than 0.5 degrees (slope ``c10^2 + c01^2``
 #: below this) is settled: a refit in the frame of its own normal (``settled=`` of
@@ -509,7 +512,7 @@ def fit_jets(
                 new_normal = np.where(keep, tilted, local[2])
                 local = [*tangent_basis(new_normal), new_normal]
         if facing is not None:
-            opposite = np.einsum("ij,ij->i", facing[neighbour], facing[index[rows]]) < 0
+            opposite = np.einsum("ij,ij->i", facing[neighbour], facing[index[rows]]) < AWAY_DOT
             inside = weights > 0
             total = np.bincount(rows, weights=inside.astype(float), minlength=size)
             against = np.bincount(rows, weights=(inside & opposite).astype(float), minlength=size)

@@ -176,10 +176,10 @@ def drop_double_sided(vertices: np.ndarray, topology: MeshTopology) -> OneSided:
     consistent side too. Faces repeated with the same winding
     are kept (they stay non-manifold and are reported as such), and so are
     faces with a repeated corner. Only faces on non-manifold edges are
-    candidates (every face of a double-sided patch has one, unless the patch
-    is a lone triangle, whose two sides make a closed pillow of manifold
-    edges, left as it is): a manifold mesh costs one look at its edge
-    classes. Vertices are never dropped: a kept face has the corners of the
+    candidates (every face of a double-sided patch has one), and so are the
+    faces on an edge whose two faces share their third corner (a lone
+    triangle's two sides: a closed pillow of manifold edges): a manifold mesh
+    costs one look at its edge classes and corner sums. Vertices are never dropped: a kept face has the corners of the
     faces it stands for.
 
     Examples
@@ -196,7 +196,12 @@ def drop_double_sided(vertices: np.ndarray, topology: MeshTopology) -> OneSided:
     faces = topology.faces
     n_faces = faces.shape[0]
     none = OneSided(topology, np.zeros(n_faces, dtype=bool), 0)
-    suspect = topology.nonmanifold_edges
+    # a lone triangle's two sides make a closed pillow of manifold edges: an edge whose two faces have the same
+    # third corner (the same corner sums, as both hold the edge's ends) is a candidate as well
+    corner_sums = faces[:, 0] + faces[:, 1] + faces[:, 2]
+    pairs = topology.edge_faces  # both >= 0 on an interior edge
+    pillow = topology.interior_edges & (corner_sums[pairs[:, 0]] == corner_sums[pairs[:, 1]])
+    suspect = topology.nonmanifold_edges | pillow
     if not suspect.any():
         return none
     sides = topology.face_edges
