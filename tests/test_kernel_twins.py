@@ -1470,6 +1470,41 @@ def check_ball_indices(name):
         assert np.isinf(squared[~inside]).all()
 
 
+def check_inner_balls(name):
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_estimators import LARGER, _ball_indices, _usable_tree
+
+    points, _ = cloud(name)
+    n, radius = points.shape[0], (0.4 if name == "ellipsoid_cloud" else 0.12)
+    centres, usable = np.arange(0, n, 2), np.random.default_rng(13).random(n) > 0.2
+    lattice = np.stack(np.meshgrid(*[np.arange(12.0)] * 2, [0.0]), axis=-1).reshape(-1, 3)  # distances tie
+    for k, wide_k in ((24, 48), (40, 96), (96, 96)):
+        grid = kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(radius * LARGER))
+        wide = kernels("pointcloud").ball_indices(
+            points, centres, float(radius * LARGER), wide_k, *grid, 64 * kernel_threads()
+        )
+        index, counts = kernels("pointcloud").inner_balls(*wide, float(radius), k, n)
+        # the k-d tree's balls of the smaller radius: no two distances of continuous random points tie
+        expected_index, expected_counts = _ball_indices(
+            _usable_tree(cKDTree(points), points, usable), points, centres, radius, k
+        )
+        np.testing.assert_array_equal(counts, expected_counts, err_msg=f"k={k}")
+        np.testing.assert_array_equal(index, expected_index, err_msg=f"k={k}")
+        assert (counts < k).any() and (k > 24 or (counts == k).any())  # partial balls, and full ones cut to k
+        # ties (a lattice): the search over the smaller radius itself, to the bit
+        everything = np.arange(lattice.shape[0])
+        grid = kernels("neighborhoods").pool_grid(lattice, everything, 2.5 * LARGER)
+        wide = kernels("pointcloud").ball_indices(lattice, everything, 2.5 * LARGER, wide_k, *grid, 4)
+        index, counts = kernels("pointcloud").inner_balls(*wide, 2.5, min(k, 20), lattice.shape[0])
+        grid = kernels("neighborhoods").pool_grid(lattice, everything, 2.5)
+        expected_index, _, expected_counts = kernels("pointcloud").ball_indices(
+            lattice, everything, 2.5, min(k, 20), *grid, 4
+        )
+        np.testing.assert_array_equal(counts, expected_counts)
+        np.testing.assert_array_equal(index, expected_index)
+
+
 def check_nearest_neighbours(name):
     from scipy.spatial import cKDTree
 
@@ -1855,6 +1890,7 @@ TWINS = [
         CLOUDS + ("degenerate_cloud",),
     ),
     Twin("pointcloud.ball_indices", "_pointcloud_estimators._ball_indices", check_ball_indices, CLOUDS),
+    Twin("pointcloud.inner_balls", "_pointcloud_estimators._ball_indices (smaller radius)", check_inner_balls, CLOUDS),
     Twin("pointcloud.nearest_neighbours", "_pointcloud_normals.knn", check_nearest_neighbours, CLOUDS),
     Twin(
         "pointcloud.neighbour_differences",

@@ -478,54 +478,69 @@ def corrected_measures(
     pattern = _rank_pattern(TRIANGLES if n_triangles is None else n_triangles)
     kernels = numba_kernels("pointcloud")
     k = min(ball_size(radius, spacing), n)
+    # the check of unsteady: the same measures over balls LARGER times larger, from the same search
+    check = details is not None
+    wide = radius * LARGER
+    k_wide = min(ball_size(wide, spacing), n)
+    larger = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)] if check else []
     if kernels is not None:  # the grid of the compiled ball searches, once for all the chunks
-        grid = numba_kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(radius))
+        grid = numba_kernels("neighborhoods").pool_grid(
+            points, np.flatnonzero(usable), float(wide if check else radius)
+        )
+        own_sheets = np.zeros(0, dtype=np.int64) if sheets is None else np.ascontiguousarray(sheets, dtype=np.int64)
     else:
         search = _usable_tree(tree, points, usable)
     for start in range(0, centres.size, CHUNK):
         chunk = centres[start : start + CHUNK]
         logger.debug("point cloud: ball search")
         if kernels is not None:
-            index, _, counts = kernels.ball_indices(points, chunk, float(radius), k, *grid, 64 * kernel_threads())
-            index, counts = kernels.own_side(
-                normals,
-                chunk,
-                index,
-                counts,
-                np.zeros(0, dtype=np.int64) if sheets is None else np.ascontiguousarray(sheets, dtype=np.int64),
-            )
+            threads = 64 * kernel_threads()
+            if check:  # one search for both balls: the smaller is the prefix of the larger closer than radius
+                wide_index, squared, wide_counts = kernels.ball_indices(
+                    points, chunk, float(wide), k_wide, *grid, threads
+                )
+                index, counts = kernels.inner_balls(wide_index, squared, wide_counts, float(radius), k, n)
+            else:
+                index, _, counts = kernels.ball_indices(points, chunk, float(radius), k, *grid, threads)
+            index, counts = kernels.own_side(normals, chunk, index, counts, own_sheets)
         else:
             index, counts = _ball_indices(search, points, chunk, radius, k)
             index, counts = _own_side(normals, chunk, index, counts, sheets)
         logger.debug("point cloud: triangle sums")
-        rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
-        rows = rows[flat_balls(points, chunk[rows], index[rows], counts[rows])]
-        if rows.size == 0:
-            continue
-        index, counts = index[rows], counts[rows]
-        if kernels is not None:
-            summed = kernels.ball_triangle_sums(points, normals, index, counts.astype(np.int64), pattern)
-        else:
-            summed = _triangle_sums(points, normals, index, counts, pattern)
-        # rows without area (a ball of collinear points) are NaN and stay so
-        k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals[chunk[rows]])
-        target = chunk[rows]
-        out[0][target] = k_min
-        out[1][target] = k_max
-        out[2][target] = dir_min
-        out[3][target] = dir_max
-    if details is not None:
+        done = _measured(out, points, normals, chunk, index, counts, pattern, kernels)
+        if check and done.size:
+            logger.debug("point cloud: larger balls")
+            if kernels is not None:
+                wide_index, wide_counts = kernels.own_side(
+                    normals, chunk[done], wide_index[done], wide_counts[done], own_sheets
+                )
+            else:
+                wide_index, wide_counts = _ball_indices(search, points, chunk[done], wide, k_wide)
+                wide_index, wide_counts = _own_side(normals, chunk[done], wide_index, wide_counts, sheets)
+            _measured(larger, points, normals, chunk[done], wide_index, wide_counts, pattern, kernels)
+    if check:
         done = centres[np.isfinite(out[0][centres])]
-        larger = corrected_measures(
-            tree,
-            points,
-            normals,
-            radius * LARGER,
-            done,
-            usable,
-            spacing=spacing,
-            n_triangles=n_triangles,
-            sheets=sheets,
-        )
         details["unsteady"] = unsteady(out, larger, done, radius)
     return (*out, normals)
+
+
+def _measured(out, points, normals, chunk, index, counts, pattern, kernels) -> np.ndarray:
+    """Write into ``out`` (``k_min, k_max, dir_min, dir_max``) the measures of the balls ``index`` (M, k) of the
+    centres ``chunk`` (M,) (``counts`` points first) that hold a surface; return the rows measured (finite)."""
+    rows = np.flatnonzero(counts >= MIN_BALL_POINTS)
+    rows = rows[flat_balls(points, chunk[rows], index[rows], counts[rows])]
+    if rows.size == 0:
+        return rows
+    index, counts = index[rows], counts[rows]
+    if kernels is not None:
+        summed = kernels.ball_triangle_sums(points, normals, index, counts.astype(np.int64), pattern)
+    else:
+        summed = _triangle_sums(points, normals, index, counts, pattern)
+    # rows without area (a ball of collinear points) are NaN and stay so
+    k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals[chunk[rows]])
+    target = chunk[rows]
+    out[0][target] = k_min
+    out[1][target] = k_max
+    out[2][target] = dir_min
+    out[3][target] = dir_max
+    return rows[np.isfinite(k_min)]

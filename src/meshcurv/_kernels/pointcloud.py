@@ -269,6 +269,30 @@ def ball_indices(points, centres, radius, k, pool_points, ids, grid, n_chunks):
     return index, squared, counts
 
 
+@nb.njit(parallel=True, **_JIT)
+def inner_balls(index, squared, counts, radius, k, n):
+    """(M, k) the balls of ``radius`` inside the balls ``index`` (M, K) of a larger radius, and (M,) their counts.
+
+    ``index``, ``squared``, ``counts``: :func:`ball_indices` over a radius larger than ``radius``, with ``K >= k``
+    points a ball. Its rows are in the order of ``(squared distance, index)``: the points strictly closer than
+    ``radius`` are a prefix of each row, and its first ``k`` (or fewer) are what :func:`ball_indices` over
+    ``radius`` with ``k`` points a ball gives, to the bit (the same squared distances, the same test), padded
+    with ``n`` (the number of points) as there. One search serves both balls of
+    :func:`meshcurv._pointcloud_estimators.corrected_measures` (the estimate and its check).
+    """
+    m = index.shape[0]
+    out = np.full((m, k), n, dtype=np.int64)
+    found = np.zeros(m, dtype=np.int64)
+    limit = radius * radius
+    for row in nb.prange(m):
+        c = 0
+        while c < k and c < counts[row] and squared[row, c] < limit:
+            out[row, c] = index[row, c]
+            c += 1
+        found[row] = c
+    return out, found
+
+
 @nb.njit(**_JIT)
 def _root(parent, flip, i):
     """The root of ``i`` in the union-find forest and whether ``i``'s sign is flipped relative to it.
