@@ -130,25 +130,23 @@ def reordering(vertices: np.ndarray, faces: np.ndarray) -> Reordering | None:
 
 
 def local_topology(
-    vertices: np.ndarray, faces, *, stacklevel: int = 3
+    vertices: np.ndarray, faces: np.ndarray | MeshTopology
 ) -> tuple[np.ndarray, MeshTopology, Reordering | None]:
-    """``(vertices, topology, reordering)``: :func:`meshcurv.topology.as_topology` of ``faces``, in a
-    local order (:func:`reordering`) when the mesh is scattered (:func:`is_scattered`).
+    """``(vertices, topology, reordering)``: the topology of the checked (F, 3) triangles ``faces`` (or the
+    given :class:`MeshTopology`, its vertex count checked), in a local order (:func:`reordering`) when the
+    mesh is scattered (:func:`is_scattered`).
 
     ``reordering`` is None, and ``vertices`` the caller's, for a mesh in a local order; otherwise
     ``vertices`` and the topology are those of the new order (a given :class:`MeshTopology` is
-    rebuilt for it). The faces are checked and triangulated first, their warning attributed
-    ``stacklevel`` frames up.
+    rebuilt for it).
     """
-    from ._validation import as_faces
-
     n = vertices.shape[0]
     if isinstance(faces, MeshTopology):
         topology = as_topology(faces, n)
         triangles = topology.faces
     else:
         topology = None
-        triangles = as_faces(faces, n, stacklevel=stacklevel + 1)
+        triangles = faces
     local = reordering(vertices, triangles) if is_scattered(n, triangles) else None
     if local is None:  # a local order (or a bounding box wider than the float range): as given
         return vertices, topology if topology is not None else MeshTopology._build(triangles, n), None

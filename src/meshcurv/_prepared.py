@@ -21,10 +21,10 @@ import numpy as np
 from ._adapters import mesh_arrays
 from ._backend import numba_kernels
 from ._locality import local_topology
-from ._validation import as_vertices, check_choice
+from ._validation import as_faces, as_vertices, check_choice
 from .defects import BOUNDARY, VertexDefects, defect_codes
 from .errors import InvalidOptionError
-from .geometry import degenerate_faces, face_cross_products, vertex_length_scales, vertex_normals
+from ._geometry import degenerate_faces, face_cross_products, vertex_length_scales, vertex_normals
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import CurvatureResult, Surface
 from .topology import MeshTopology
@@ -178,7 +178,9 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     if faces is None:
         vertices, faces = mesh_arrays(vertices)
     callers = as_vertices(vertices)
-    points, topology, local = local_topology(callers, faces, stacklevel=stacklevel + 1)
+    if not isinstance(faces, MeshTopology):
+        faces = as_faces(faces, callers.shape[0], stacklevel=stacklevel + 1)
+    points, topology, local = local_topology(callers, faces)
     check_choice(orient, "orient", ORIENT_CHOICES)
     if not isinstance(weld, (bool, np.bool_)):
         raise InvalidOptionError(f"`weld` must be True or False; got {weld!r}")

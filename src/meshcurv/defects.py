@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._backend import numba_kernels
-from .geometry import degenerate_face_mask
+from ._geometry import degenerate_face_mask
 from .topology import MeshTopology
 
 __all__ = [

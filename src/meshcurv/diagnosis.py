@@ -13,18 +13,17 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ._backend import numba_kernels
-from ._validation import as_vertices, check_int_option
-from .defects import DEFECTS, NEEDLE, needle_vertices
-from .errors import InvalidMeshError
-from .geometry import (
+from ._geometry import (
     DEGENERATE_AREA_RATIO,
-    checked_topology_points,
     degenerate_face_mask,
-    degenerate_faces,
     edge_lengths,
     face_cross_products,
     vertex_length_scales,
 )
+from ._validation import as_vertices, check_int_option
+from .defects import DEFECTS, NEEDLE, needle_vertices
+from .errors import InvalidMeshError
+from .geometry import checked_topology_points, degenerate_faces
 from .topology import MeshTopology, as_topology
 
 #: Edges no longer than this times the length scale of their component (its median

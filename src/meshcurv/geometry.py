@@ -18,7 +18,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels
+from . import _geometry
+from ._geometry import (  # noqa: F401  (normalize_normal_sums: named here by the kernels' docs and tests)
+    COMPONENT_SCALE_SPREAD,
+    DEGENERATE_AREA_RATIO,
+    MEDIAN_SAMPLE,
+    OUTLIER_EDGE_RATIO,
+    normalize_normal_sums,
+)
 from ._validation import checked_mesh, checked_points
 from .errors import InvalidMeshError, InvalidOptionError
 from .topology import MeshTopology
@@ -45,20 +52,6 @@ __all__ = [
     "mixed_voronoi_corner_areas",
 ]
 
-#: Faces with area below this fraction of the squared length scale of their component
-#: (:func:`vertex_length_scales`, the median edge length) count as degenerate.
-DEGENERATE_AREA_RATIO = 1e-12
-
-#: :func:`robust_mean_edge_length` leaves out edges longer than this many median edge lengths.
-OUTLIER_EDGE_RATIO = 1000.0
-
-#: :func:`vertex_length_scales` takes the median of a connected mesh over about this many edges.
-MEDIAN_SAMPLE = 65536
-
-#: Components whose typical edge (geometric mean) is within this factor of the mesh's median
-#: edge length share that median as their scale (one pass, no sort); others get their own.
-COMPONENT_SCALE_SPREAD = 16.0
-
 
 def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """The cross product ``cross(b - a, c - a)`` of every face ``(a, b, c)``.
@@ -84,21 +77,7 @@ def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
         ``vertices`` or ``faces`` of the wrong shape or dtype, coordinates not
         finite, or indices out of range.
     """
-    vertices, faces = checked_mesh(vertices, faces)
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return kernels.face_cross_products(vertices, faces)
-    a = vertices[faces[:, 0]]
-    u = vertices[faces[:, 1]] - a
-    w = vertices[faces[:, 2]] - a
-    return np.stack(
-        [
-            u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1],
-            u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2],
-            u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0],
-        ],
-        axis=1,
-    )
+    return _geometry.face_cross_products(*checked_mesh(vertices, faces))
 
 
 def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -120,7 +99,7 @@ def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     InvalidMeshError
         As :func:`face_cross_products`.
     """
-    return 0.5 * np.linalg.norm(face_cross_products(vertices, faces), axis=1)
+    return _geometry.face_areas(*checked_mesh(vertices, faces))
 
 
 def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -143,7 +122,7 @@ def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     InvalidMeshError
         As :func:`face_cross_products`.
     """
-    cross = face_cross_products(vertices, faces)
+    cross = _geometry.face_cross_products(*checked_mesh(vertices, faces))
     norm = np.linalg.norm(cross, axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(norm > 0, cross / norm, np.nan)
@@ -203,7 +182,7 @@ def vertex_areas(vertices: np.ndarray, faces: np.ndarray, *, areas: np.ndarray |
     """
     vertices, faces = checked_mesh(vertices, faces)
     if areas is None:
-        areas = face_areas(vertices, faces)
+        areas = _geometry.face_areas(vertices, faces)
     else:
         areas = _real_array(areas, "areas")
         if areas.shape != faces.shape[:1]:
@@ -242,27 +221,7 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
         cross = np.ascontiguousarray(_real_array(cross, "cross"))
         if cross.shape != faces.shape:
             raise InvalidMeshError(f"`cross` must have shape {faces.shape} (one row per face); got {cross.shape}")
-    if cross is None:
-        cross = face_cross_products(vertices, faces)
-    n = vertices.shape[0]
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return kernels.normalize_normal_sums(kernels.vertex_normal_sums(cross, faces, n))
-    flat = faces.ravel()
-    summed = np.stack([np.bincount(flat, weights=np.repeat(cross[:, k], 3), minlength=n) for k in range(3)], axis=1)
-    return normalize_normal_sums(summed)
-
-
-def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
-    """Unit vectors from (V, 3) sums of face cross products; NaN where a sum is 0.
-
-    (The test ``|s| > 1e-12 max(max|s_k|, tiny)`` fails only for a zero or
-    subnormal sum, since ``|s| >= max|s_k|``.)
-    """
-    norm = np.linalg.norm(summed, axis=1, keepdims=True)
-    scale = np.abs(summed).max(axis=1, keepdims=True)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(norm > 1e-12 * np.maximum(scale, np.finfo(float).tiny), summed / norm, np.nan)
+    return _geometry.vertex_normals(vertices, faces, cross=cross)
 
 
 def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
@@ -285,12 +244,7 @@ def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
         ``vertices`` or ``edges`` of the wrong shape or dtype, coordinates not
         finite, or indices out of range.
     """
-    vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return kernels.edge_lengths(vertices, edges)
-    d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
-    return np.sqrt(np.einsum("ij,ij->i", d, d))
+    return _geometry.edge_lengths(*checked_mesh(vertices, edges, columns=2, name="edges"))
 
 
 def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
@@ -312,16 +266,7 @@ def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     InvalidMeshError
         As :func:`edge_lengths`.
     """
-    vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
-    n = vertices.shape[0]
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return kernels.vertex_edge_lengths(vertices, edges, n)
-    flat = edges.ravel()
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.bincount(flat, weights=np.repeat(edge_lengths(vertices, edges), 2), minlength=n) / np.bincount(
-            flat, minlength=n
-        )
+    return _geometry.vertex_edge_lengths(*checked_mesh(vertices, edges, columns=2, name="edges"))
 
 
 def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
@@ -347,13 +292,7 @@ def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     InvalidMeshError
         As :func:`edge_lengths`.
     """
-    vertices, edges = checked_mesh(vertices, edges, columns=2, name="edges")
-    if edges.shape[0] == 0:
-        return 0.0
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return float(kernels.mean_edge_length(vertices, edges))
-    return float(edge_lengths(vertices, edges).mean())
+    return _geometry.mean_edge_length(*checked_mesh(vertices, edges, columns=2, name="edges"))
 
 
 def median_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
@@ -375,8 +314,7 @@ def median_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     InvalidMeshError
         As :func:`edge_lengths`.
     """
-    lengths = edge_lengths(vertices, edges)
-    return float(np.median(lengths)) if lengths.size else 0.0
+    return _geometry.median_edge_length(*checked_mesh(vertices, edges, columns=2, name="edges"))
 
 
 def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
@@ -404,15 +342,7 @@ def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     InvalidMeshError
         As :func:`edge_lengths`.
     """
-    lengths = edge_lengths(vertices, edges)
-    if lengths.size == 0:
-        return 0.0
-    median = float(np.median(lengths[:: max(1, lengths.size // MEDIAN_SAMPLE)]))  # a threshold: a sample will do
-    longest = float(lengths.max())
-    if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean, to the last bit
-        return mean_edge_length(vertices, edges)
-    kept = lengths[lengths <= OUTLIER_EDGE_RATIO * median]
-    return float(kept.mean())
+    return _geometry.robust_mean_edge_length(*checked_mesh(vertices, edges, columns=2, name="edges"))
 
 
 def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
@@ -449,37 +379,7 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
         array: build the topology with ``MeshTopology.from_faces``), or
         ``vertices`` unusable or not one row per vertex of ``topology``.
     """
-    vertices = checked_topology_points(vertices, topology)
-    edges = topology.edges
-    n = topology.n_vertices
-    if edges.shape[0] == 0:
-        return np.zeros(n)
-    referenced = topology.referenced_vertices
-    n_components, labels = topology.vertex_components
-    if n_components <= 1:  # one scale: the median of an even sample of the edges
-        step = max(1, edges.shape[0] // MEDIAN_SAMPLE)
-        overall = float(np.median(edge_lengths(vertices, edges[::step])))
-        return np.where(referenced, overall, 0.0)
-    lengths = edge_lengths(vertices, edges)
-    overall = float(np.median(lengths))
-    edge_label = labels[edges[:, 0]]
-    positive = lengths > 0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log_sums = np.bincount(edge_label[positive], weights=np.log2(lengths[positive]), minlength=n_components)
-        typical = log_sums / np.bincount(edge_label[positive], minlength=n_components)
-    spread = np.abs(typical[np.isfinite(typical)] - np.log2(overall)) if overall > 0 else np.array([np.inf])
-    if spread.size and spread.max() <= np.log2(COMPONENT_SCALE_SPREAD):
-        return np.where(referenced, overall, 0.0)
-    order = np.lexsort((lengths, edge_label))
-    counts = np.bincount(edge_label, minlength=n_components)
-    starts = np.cumsum(counts) - counts
-    ranked = lengths[order]
-    medians = np.zeros(n_components)
-    some = counts > 0  # a component of faces (a, a, a) only has no edge: scale 0
-    low = ranked[starts[some] + (counts[some] - 1) // 2]
-    high = ranked[starts[some] + counts[some] // 2]
-    medians[some] = 0.5 * (low + high)
-    return np.where(referenced, medians[np.maximum(labels, 0)], 0.0)
+    return _geometry.vertex_length_scales(checked_topology_points(vertices, topology), topology)
 
 
 def checked_topology_points(vertices, topology) -> np.ndarray:
@@ -551,8 +451,7 @@ def degenerate_face_mask(areas: np.ndarray, length_scale) -> np.ndarray:
         )
     if not (scale >= 0).all():
         raise InvalidOptionError("`length_scale` must be >= 0 (not NaN)")
-    with np.errstate(over="ignore"):  # a scale beyond 1e154 squares to inf: every face is below it
-        return areas <= DEGENERATE_AREA_RATIO * scale**2
+    return _geometry.degenerate_face_mask(areas, scale)
 
 
 def degenerate_faces(
@@ -604,24 +503,14 @@ def degenerate_faces(
         (F, 3), ``double_areas`` (F,), ``scales`` (V,) not real arrays of
         those shapes.
     """
-    vertices = checked_topology_points(vertices, topology)
-    cross = _optional_floats(cross, "cross", topology.faces.shape)
-    double_areas = _optional_floats(double_areas, "double_areas", (topology.n_faces,))
-    scales = _optional_floats(scales, "scales", (topology.n_vertices,))
-    kernels = numba_kernels("geometry")
-    if scales is None and mean_edge_length is None:
-        scales = vertex_length_scales(vertices, topology)
-    if kernels is not None and double_areas is None:
-        # the kernel computes the cross products inline: ``cross`` only spares the NumPy path that work
-        if scales is None and mean_edge_length is not None:  # always, when no scales were computed above
-            scales = np.full(topology.n_vertices, float(mean_edge_length))
-        return kernels.degenerate_faces(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)
-    face_scale = scales[topology.faces[:, 0]] if scales is not None else mean_edge_length
-    if double_areas is None:
-        if cross is None:
-            cross = face_cross_products(vertices, topology.faces)
-        double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
-    return degenerate_face_mask(0.5 * double_areas, face_scale) | topology.degenerate_faces
+    return _geometry.degenerate_faces(
+        checked_topology_points(vertices, topology),
+        topology,
+        cross=_optional_floats(cross, "cross", topology.faces.shape),
+        mean_edge_length=mean_edge_length,
+        double_areas=_optional_floats(double_areas, "double_areas", (topology.n_faces,)),
+        scales=_optional_floats(scales, "scales", (topology.n_vertices,)),
+    )
 
 
 def _optional_floats(value, name: str, shape: tuple) -> np.ndarray | None:
@@ -682,19 +571,7 @@ def edge_dihedral_angles(
             f"`usable_edges` must be a bool array of shape ({topology.edges.shape[0]},); got "
             f"{usable_edges.dtype} {usable_edges.shape}"
         )
-    edges = topology.edges
-    vectors = vertices[edges[:, 1]] - vertices[edges[:, 0]]
-    lengths = np.linalg.norm(vectors, axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit = np.where(lengths[:, None] > 0, vectors / lengths[:, None], 0.0)
-    beta = np.zeros(edges.shape[0])
-    faces = topology.edge_faces[usable_edges]
-    n1 = unit_normals[faces[:, 0]]
-    n2 = unit_normals[faces[:, 1]]
-    sine = np.einsum("ij,ij->i", np.cross(n1, n2), unit[usable_edges])
-    cosine = np.einsum("ij,ij->i", n1, n2)
-    beta[usable_edges] = np.arctan2(sine, cosine)
-    return beta, lengths, unit
+    return _geometry.edge_dihedral_angles(vertices, topology, unit_normals, usable_edges)
 
 
 def _real_array(value, name: str) -> np.ndarray:
@@ -735,15 +612,7 @@ def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     InvalidMeshError
         As :func:`face_cross_products`.
     """
-    vertices, faces = checked_mesh(vertices, faces)
-    out = np.zeros(faces.shape, dtype=np.float64)
-    for k in range(3):
-        p = vertices[faces[:, k]]
-        a = vertices[faces[:, (k + 1) % 3]] - p
-        b = vertices[faces[:, (k + 2) % 3]] - p
-        with np.errstate(invalid="ignore", divide="ignore"):
-            out[:, k] = np.einsum("ij,ij->i", a, b) / np.linalg.norm(np.cross(a, b), axis=1)
-    return out
+    return _geometry.corner_cotangents(*checked_mesh(vertices, faces))
 
 
 def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -769,14 +638,7 @@ def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     InvalidMeshError
         As :func:`face_cross_products`.
     """
-    vertices, faces = checked_mesh(vertices, faces)
-    out = np.zeros(faces.shape, dtype=np.float64)
-    for k in range(3):
-        p = vertices[faces[:, k]]
-        a = vertices[faces[:, (k + 1) % 3]] - p
-        b = vertices[faces[:, (k + 2) % 3]] - p
-        out[:, k] = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
-    return out
+    return _geometry.corner_angles(*checked_mesh(vertices, faces))
 
 
 def mixed_voronoi_corner_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -813,20 +675,4 @@ def mixed_voronoi_corner_areas(vertices: np.ndarray, faces: np.ndarray) -> np.nd
     Visualization and Mathematics III, 35-57.
     https://doi.org/10.1007/978-3-662-05105-4_2
     """
-    vertices, faces = checked_mesh(vertices, faces)
-    cot = corner_cotangents(vertices, faces)
-    area = face_areas(vertices, faces)
-    squared = np.zeros(faces.shape, dtype=np.float64)  # squared length of the side opposite corner k
-    for k in range(3):
-        d = vertices[faces[:, (k + 2) % 3]] - vertices[faces[:, (k + 1) % 3]]
-        squared[:, k] = np.einsum("ij,ij->i", d, d)
-    voronoi = np.zeros(faces.shape, dtype=np.float64)
-    with np.errstate(invalid="ignore", over="ignore"):  # the infinite cotangents of zero-area faces: 0 below
-        for k in range(3):
-            j, m = (k + 1) % 3, (k + 2) % 3
-            # sides at corner k: k-j (opposite m) and k-m (opposite j)
-            voronoi[:, k] = (squared[:, m] * cot[:, m] + squared[:, j] * cot[:, j]) / 8.0
-    obtuse_corner = cot < 0
-    obtuse = obtuse_corner.any(axis=1, keepdims=True)
-    mixed = np.where(obtuse, np.where(obtuse_corner, area[:, None] / 2, area[:, None] / 4), voronoi)
-    return np.where(np.isfinite(mixed), mixed, 0.0)
+    return _geometry.mixed_voronoi_corner_areas(*checked_mesh(vertices, faces))

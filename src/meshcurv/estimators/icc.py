@@ -77,7 +77,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import median_edge_length, robust_mean_edge_length
+from .._geometry import median_edge_length, robust_mean_edge_length
 from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
 from ..measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import ball_face_sums, ball_face_sums_nested, nested_jet_normals

@@ -36,7 +36,7 @@ import numpy as np
 
 from .._backend import kernel_threads, numba_kernels
 from .._tensors import outer6
-from ..geometry import DEGENERATE_AREA_RATIO
+from .._geometry import DEGENERATE_AREA_RATIO
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from .._prepared import PreparedMesh

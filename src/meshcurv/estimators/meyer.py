@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import principal_from_mean_gaussian
-from ..geometry import corner_angles, corner_cotangents, mixed_voronoi_corner_areas, vertex_normals
+from .._geometry import corner_angles, corner_cotangents, mixed_voronoi_corner_areas, vertex_normals
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 

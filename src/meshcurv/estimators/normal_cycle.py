@@ -49,7 +49,7 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from .._backend import kernel_threads, numba_kernels
-from ..geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles
+from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
 from .._prepared import PreparedMesh

@@ -45,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
-from ..geometry import edge_dihedral_angles
+from .._geometry import edge_dihedral_angles
 from ..neighborhoods import ball_edge_sums, ball_face_sums
 from ..radius import component_radii, resolve_radius, vertex_radii
 from .._prepared import PreparedMesh

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import principal_from_shape_operator
-from ..geometry import mixed_voronoi_corner_areas
+from .._geometry import mixed_voronoi_corner_areas
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 

@@ -1,0 +1,274 @@
+"""The cores of :mod:`meshcurv.geometry`: the same quantities over arrays already checked.
+
+Each function here has the name, the arguments and the result of the public
+function of :mod:`meshcurv.geometry` that checks its input and calls it (its
+docstring holds the contract and the formula). They trust their input:
+``vertices`` a C-contiguous float64 (V, 3) array of finite coordinates, faces
+and edges C-contiguous int64 arrays of indices in range, a
+:class:`~meshcurv.topology.MeshTopology` of ``V`` vertices. The library calls
+them on the arrays of a :class:`~meshcurv._prepared.PreparedMesh`, checked once
+by :func:`meshcurv._prepared.prepare_mesh`; a check here would be the second.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._backend import numba_kernels
+
+#: Faces with area below this fraction of the squared length scale of their component
+#: (:func:`vertex_length_scales`, the median edge length) count as degenerate.
+DEGENERATE_AREA_RATIO = 1e-12
+
+#: :func:`robust_mean_edge_length` leaves out edges longer than this many median edge lengths.
+OUTLIER_EDGE_RATIO = 1000.0
+
+#: :func:`vertex_length_scales` takes the median of a connected mesh over about this many edges.
+MEDIAN_SAMPLE = 65536
+
+#: Components whose typical edge (geometric mean) is within this factor of the mesh's median
+#: edge length share that median as their scale (one pass, no sort); others get their own.
+COMPONENT_SCALE_SPREAD = 16.0
+
+
+def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) ``cross(b - a, c - a)`` of every face ``(a, b, c)`` (:func:`meshcurv.geometry.face_cross_products`)."""
+    kernels = numba_kernels("geometry")
+    if kernels is not None:
+        return kernels.face_cross_products(vertices, faces)
+    a = vertices[faces[:, 0]]
+    u = vertices[faces[:, 1]] - a
+    w = vertices[faces[:, 2]] - a
+    return np.stack(
+        [
+            u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1],
+            u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2],
+            u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0],
+        ],
+        axis=1,
+    )
+
+
+def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F,) the area of every face (:func:`meshcurv.geometry.face_areas`)."""
+    return 0.5 * np.linalg.norm(face_cross_products(vertices, faces), axis=1)
+
+
+def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray | None = None) -> np.ndarray:
+    """(V, 3) area-weighted unit vertex normals (:func:`meshcurv.geometry.vertex_normals`).
+
+    ``cross``, when given, is a C-contiguous float64 (F, 3) array.
+    """
+    if cross is None:
+        cross = face_cross_products(vertices, faces)
+    n = vertices.shape[0]
+    kernels = numba_kernels("geometry")
+    if kernels is not None:
+        return kernels.normalize_normal_sums(kernels.vertex_normal_sums(cross, faces, n))
+    return normalize_normal_sums(vertex_normal_sums(cross, faces, n))
+
+
+def vertex_normal_sums(cross: np.ndarray, faces: np.ndarray, n_vertices: int) -> np.ndarray:
+    """(V, 3) the sums of the (F, 3) face cross products ``cross`` at each vertex, in face order."""
+    flat = faces.ravel()
+    return np.stack(
+        [np.bincount(flat, weights=np.repeat(cross[:, k], 3), minlength=n_vertices) for k in range(3)], axis=1
+    )
+
+
+def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
+    """Unit vectors from (V, 3) sums of face cross products; NaN where a sum is 0.
+
+    (The test ``|s| > 1e-12 max(max|s_k|, tiny)`` fails only for a zero or
+    subnormal sum, since ``|s| >= max|s_k|``.)
+    """
+    norm = np.linalg.norm(summed, axis=1, keepdims=True)
+    scale = np.abs(summed).max(axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(norm > 1e-12 * np.maximum(scale, np.finfo(float).tiny), summed / norm, np.nan)
+
+
+def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(E,) ``|x_j - x_i|`` for each edge ``(i, j)`` (:func:`meshcurv.geometry.edge_lengths`)."""
+    kernels = numba_kernels("geometry")
+    if kernels is not None:
+        return kernels.edge_lengths(vertices, edges)
+    d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
+    return np.sqrt(np.einsum("ij,ij->i", d, d))
+
+
+def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(V,) the mean length of the edges at each vertex, NaN at none (:func:`meshcurv.geometry.vertex_edge_lengths`)."""
+    n = vertices.shape[0]
+    kernels = numba_kernels("geometry")
+    if kernels is not None:
+        return kernels.vertex_edge_lengths(vertices, edges, n)
+    flat = edges.ravel()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.bincount(flat, weights=np.repeat(edge_lengths(vertices, edges), 2), minlength=n) / np.bincount(
+            flat, minlength=n
+        )
+
+
+def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
+    """Mean length of the edges, 0 without edges (:func:`meshcurv.geometry.mean_edge_length`)."""
+    if edges.shape[0] == 0:
+        return 0.0
+    kernels = numba_kernels("geometry")
+    if kernels is not None:
+        return float(kernels.mean_edge_length(vertices, edges))
+    return float(edge_lengths(vertices, edges).mean())
+
+
+def median_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
+    """Median length of the edges, 0 without edges (:func:`meshcurv.geometry.median_edge_length`)."""
+    lengths = edge_lengths(vertices, edges)
+    return float(np.median(lengths)) if lengths.size else 0.0
+
+
+def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
+    """Mean length of the edges within :data:`OUTLIER_EDGE_RATIO` medians
+    (:func:`meshcurv.geometry.robust_mean_edge_length`)."""
+    lengths = edge_lengths(vertices, edges)
+    if lengths.size == 0:
+        return 0.0
+    median = float(np.median(lengths[:: max(1, lengths.size // MEDIAN_SAMPLE)]))  # a threshold: a sample will do
+    longest = float(lengths.max())
+    if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean, to the last bit
+        return mean_edge_length(vertices, edges)
+    kept = lengths[lengths <= OUTLIER_EDGE_RATIO * median]
+    return float(kept.mean())
+
+
+def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
+    """(V,) the median edge length of each vertex's component (:func:`meshcurv.geometry.vertex_length_scales`)."""
+    edges = topology.edges
+    n = topology.n_vertices
+    if edges.shape[0] == 0:
+        return np.zeros(n)
+    referenced = topology.referenced_vertices
+    n_components, labels = topology.vertex_components
+    if n_components <= 1:  # one scale: the median of an even sample of the edges
+        step = max(1, edges.shape[0] // MEDIAN_SAMPLE)
+        overall = float(np.median(edge_lengths(vertices, np.ascontiguousarray(edges[::step]))))
+        return np.where(referenced, overall, 0.0)
+    lengths = edge_lengths(vertices, edges)
+    overall = float(np.median(lengths))
+    edge_label = labels[edges[:, 0]]
+    positive = lengths > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_sums = np.bincount(edge_label[positive], weights=np.log2(lengths[positive]), minlength=n_components)
+        typical = log_sums / np.bincount(edge_label[positive], minlength=n_components)
+    spread = np.abs(typical[np.isfinite(typical)] - np.log2(overall)) if overall > 0 else np.array([np.inf])
+    if spread.size and spread.max() <= np.log2(COMPONENT_SCALE_SPREAD):
+        return np.where(referenced, overall, 0.0)
+    order = np.lexsort((lengths, edge_label))
+    counts = np.bincount(edge_label, minlength=n_components)
+    starts = np.cumsum(counts) - counts
+    ranked = lengths[order]
+    medians = np.zeros(n_components)
+    some = counts > 0  # a component of faces (a, a, a) only has no edge: scale 0
+    low = ranked[starts[some] + (counts[some] - 1) // 2]
+    high = ranked[starts[some] + counts[some] // 2]
+    medians[some] = 0.5 * (low + high)
+    return np.where(referenced, medians[np.maximum(labels, 0)], 0.0)
+
+
+def degenerate_face_mask(areas: np.ndarray, length_scale) -> np.ndarray:
+    """(F,) bool: ``areas <= DEGENERATE_AREA_RATIO * length_scale ** 2``
+    (:func:`meshcurv.geometry.degenerate_face_mask`); ``length_scale`` >= 0, a number or one per face."""
+    with np.errstate(over="ignore"):  # a scale beyond 1e154 squares to inf: every face is below it
+        return areas <= DEGENERATE_AREA_RATIO * np.asarray(length_scale, dtype=np.float64) ** 2
+
+
+def degenerate_faces(
+    vertices: np.ndarray,
+    topology,
+    *,
+    cross: np.ndarray | None = None,
+    mean_edge_length: float | None = None,
+    double_areas: np.ndarray | None = None,
+    scales: np.ndarray | None = None,
+) -> np.ndarray:
+    """(F,) bool: faces with a repeated corner or an area below 1e-12 x (length scale)^2
+    (:func:`meshcurv.geometry.degenerate_faces`); the optional arrays C-contiguous float64 of their shapes."""
+    kernels = numba_kernels("geometry")
+    if scales is None and mean_edge_length is None:
+        scales = vertex_length_scales(vertices, topology)
+    if kernels is not None and double_areas is None:
+        # the kernel computes the cross products inline: ``cross`` only spares the NumPy path that work
+        if scales is None and mean_edge_length is not None:  # always, when no scales were computed above
+            scales = np.full(topology.n_vertices, float(mean_edge_length))
+        return kernels.degenerate_faces(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)
+    face_scale = scales[topology.faces[:, 0]] if scales is not None else mean_edge_length
+    if double_areas is None:
+        if cross is None:
+            cross = face_cross_products(vertices, topology.faces)
+        double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
+    return degenerate_face_mask(0.5 * double_areas, face_scale) | topology.degenerate_faces
+
+
+def edge_dihedral_angles(
+    vertices: np.ndarray, topology, unit_normals: np.ndarray, usable_edges: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(beta, lengths, unit_edges)``: the signed angle between the face normals of each usable edge, the
+    edges' lengths and unit vectors (:func:`meshcurv.geometry.edge_dihedral_angles`)."""
+    edges = topology.edges
+    vectors = vertices[edges[:, 1]] - vertices[edges[:, 0]]
+    lengths = np.linalg.norm(vectors, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(lengths[:, None] > 0, vectors / lengths[:, None], 0.0)
+    beta = np.zeros(edges.shape[0])
+    faces = topology.edge_faces[usable_edges]
+    n1 = unit_normals[faces[:, 0]]
+    n2 = unit_normals[faces[:, 1]]
+    sine = np.einsum("ij,ij->i", np.cross(n1, n2), unit[usable_edges])
+    cosine = np.einsum("ij,ij->i", n1, n2)
+    beta[usable_edges] = np.arctan2(sine, cosine)
+    return beta, lengths, unit
+
+
+def corner_cotangents(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) the cotangent of the angle at each corner (:func:`meshcurv.geometry.corner_cotangents`)."""
+    out = np.zeros(faces.shape, dtype=np.float64)
+    for k in range(3):
+        a, b = _corner_sides(vertices, faces, k)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[:, k] = np.einsum("ij,ij->i", a, b) / np.linalg.norm(np.cross(a, b), axis=1)
+    return out
+
+
+def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) the interior angle at each corner (:func:`meshcurv.geometry.corner_angles`)."""
+    out = np.zeros(faces.shape, dtype=np.float64)
+    for k in range(3):
+        a, b = _corner_sides(vertices, faces, k)
+        out[:, k] = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+    return out
+
+
+def _corner_sides(vertices: np.ndarray, faces: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """The (F, 3) vectors of the two sides that leave corner ``k`` of every face, in the faces' order."""
+    p = vertices[faces[:, k]]
+    return vertices[faces[:, (k + 1) % 3]] - p, vertices[faces[:, (k + 2) % 3]] - p
+
+
+def mixed_voronoi_corner_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) each face's share of the mixed Voronoi area of its corners
+    (:func:`meshcurv.geometry.mixed_voronoi_corner_areas`, Meyer et al. 2003)."""
+    cot = corner_cotangents(vertices, faces)
+    area = face_areas(vertices, faces)
+    squared = np.zeros(faces.shape, dtype=np.float64)  # squared length of the side opposite corner k
+    for k in range(3):
+        d = vertices[faces[:, (k + 2) % 3]] - vertices[faces[:, (k + 1) % 3]]
+        squared[:, k] = np.einsum("ij,ij->i", d, d)
+    voronoi = np.zeros(faces.shape, dtype=np.float64)
+    with np.errstate(invalid="ignore", over="ignore"):  # the infinite cotangents of zero-area faces: 0 below
+        for k in range(3):
+            j, m = (k + 1) % 3, (k + 2) % 3
+            # sides at corner k: k-j (opposite m) and k-m (opposite j)
+            voronoi[:, k] = (squared[:, m] * cot[:, m] + squared[:, j] * cot[:, j]) / 8.0
+    obtuse_corner = cot < 0
+    obtuse = obtuse_corner.any(axis=1, keepdims=True)
+    mixed = np.where(obtuse, np.where(obtuse_corner, area[:, None] / 2, area[:, None] / 4), voronoi)
+    return np.where(np.isfinite(mixed), mixed, 0.0)
