@@ -97,17 +97,25 @@ class MeshTopology:
         The triangles.
     n_vertices : int
         Number of vertices (unreferenced ones included).
-    edges : ndarray of shape (E, 2), int64
+    edges : ndarray of shape (E, 2), int32 or int64
         Unique undirected edges ``(p, q)`` with ``p < q``, sorted.
-    face_edges : ndarray of shape (F, 3), int64
+    face_edges : ndarray of shape (F, 3), int32 or int64
         Edge of side ``k`` of each face (``faces[f, k] -> faces[f, (k+1) % 3]``);
         -1 for a side whose two ends are the same vertex.
-    edge_faces : ndarray of shape (E, 2), int64
+    edge_faces : ndarray of shape (E, 2), int32 or int64
         Two faces of each edge: column 0 one that runs ``p -> q``, column 1 one
         that runs ``q -> p`` where the mesh is consistently oriented; -1 = none.
         On a non-manifold edge these are two of its faces.
-    edge_face_counts : ndarray of shape (E,), int64
+    edge_face_counts : ndarray of shape (E,), int32 or int64
         Number of faces of each edge (1 = boundary, 2 = interior, 3+ = non-manifold).
+
+    Notes
+    -----
+    The four edge arrays are int32 when ``2 * n_vertices + 1`` and ``3 * n_faces``
+    are below ``2**31`` (every mesh up to about 700 million faces), else int64
+    (:func:`index_dtype`; the convention of ``scipy.sparse`` for its index
+    arrays): half the memory, and half the memory traffic of every pass over
+    them. ``faces`` stays int64 (the validated input).
     """
 
     faces: np.ndarray
@@ -174,7 +182,10 @@ class MeshTopology:
                 faces, n_vertices, _bucket_template(n_vertices, faces.shape[0]), True
             )
         else:
-            edges, face_edges, edge_faces, counts, forward_counts = _build_edges(faces, n_vertices)
+            index = index_dtype(n_vertices, faces.shape[0])
+            edges, face_edges, edge_faces, counts, forward_counts = (
+                array.astype(index, copy=False) for array in _build_edges(faces, n_vertices)
+            )
         return cls(
             faces=_readonly(faces),
             n_vertices=n_vertices,
@@ -385,11 +396,17 @@ class MeshTopology:
         return int(np.unique(labels[boundary[:, 0]]).size)
 
 
-def _bucket_template(n_vertices: int, n_faces: int) -> np.ndarray:
-    """An empty array of the integer type the compiled edge build sorts its sides in: int32 when ``2 V + 1``
-    and ``3 F`` fit in it (half the memory traffic of int64), else int64."""
+def index_dtype(n_vertices: int, n_faces: int) -> type[np.signedinteger]:
+    """The integer type of a topology's edge arrays (and of the compiled build's buckets): int32 when
+    ``2 V + 1`` (the build's sort keys) and ``3 F`` (its side ids, beyond any edge id) are below ``2**31``, else
+    int64."""
     small = 2 * n_vertices + 1 < 2**31 and 3 * n_faces < 2**31
-    return np.zeros(0, np.int32 if small else np.int64)
+    return np.int32 if small else np.int64
+
+
+def _bucket_template(n_vertices: int, n_faces: int) -> np.ndarray:
+    """An empty array of :func:`index_dtype`: the compiled build makes its arrays of its type."""
+    return np.zeros(0, index_dtype(n_vertices, n_faces))
 
 
 def _build_edges(faces: np.ndarray, n_vertices: int):

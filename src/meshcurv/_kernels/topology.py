@@ -49,14 +49,15 @@ def build_edges(faces, n_vertices, template):
 @nb.njit(**_JIT)
 def build_topology(faces, n_vertices, template, with_twins):
     """:func:`build_edges_into` on arrays allocated here: ``(edges, face_edges, edge_faces, counts, forward,
-    twins)``, the twins (when ``with_twins``, else an empty array) in the integer type of ``template``."""
+    twins)``, all in the integer type of ``template``, the twins only when ``with_twins`` (else an empty array)."""
     n_faces = faces.shape[0]
-    face_edges = np.empty(3 * n_faces, np.int64)
-    edges = np.empty((3 * n_faces, 2), np.int64)
-    edge_faces = np.empty((3 * n_faces, 2), np.int64)
-    counts = np.empty(3 * n_faces, np.int64)
-    forward = np.empty(3 * n_faces, np.int64)
-    twins = np.empty(3 * n_faces if with_twins else 0, template.dtype)
+    index = template.dtype
+    face_edges = np.empty(3 * n_faces, index)
+    edges = np.empty((3 * n_faces, 2), index)
+    edge_faces = np.empty((3 * n_faces, 2), index)
+    counts = np.empty(3 * n_faces, index)
+    forward = np.empty(3 * n_faces, index)
+    twins = np.empty(3 * n_faces if with_twins else 0, index)
     n_edges = build_edges_into(faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins)
     return (
         edges[:n_edges],
