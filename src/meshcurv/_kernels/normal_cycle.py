@@ -10,7 +10,6 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, _degenerate, _face_cross, _unit
-from .matgeom import _ring_sums6
 from .tensors import _tangent_eigen
 
 
@@ -92,6 +91,29 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, scale
     return sums, degenerate
 
 
+@nb.njit(inline="always", **_JIT)
+def _ring_sums7(source, invalid, weighted, indptr, indices, i):
+    """Columns 0 to 6 of row ``i`` of ``source`` plus those of its neighbours, in list order, and
+    ``1 / (degree + 1)``: one pass of ``smoothing.smooth_over_neighbours`` at ``i`` before its scaling.
+    With ``weighted``, each row counts times 0.0 where ``invalid`` (1.0 elsewhere), as the rows of the
+    weighted copy the first pass reads."""
+    start, stop = indptr[i], indptr[i + 1]
+    w = (0.0 if invalid[i] else 1.0) if weighted else 1.0
+    t0, t1, t2 = source[i, 0] * w, source[i, 1] * w, source[i, 2] * w
+    t3, t4, t5, t6 = source[i, 3] * w, source[i, 4] * w, source[i, 5] * w, source[i, 6] * w
+    for j in range(start, stop):
+        u = indices[j]
+        w = (0.0 if invalid[u] else 1.0) if weighted else 1.0
+        t0 += source[u, 0] * w
+        t1 += source[u, 1] * w
+        t2 += source[u, 2] * w
+        t3 += source[u, 3] * w
+        t4 += source[u, 4] * w
+        t5 += source[u, 5] * w
+        t6 += source[u, 6] * w
+    return t0, t1, t2, t3, t4, t5, t6, 1.0 / (stop - start + 1.0)
+
+
 @nb.njit(parallel=True, **_JIT)
 def normal_cycle_finish(sums, invalid, indptr, indices, steps):
     """From :func:`normal_cycle_sums` to the curvatures, in one kernel.
@@ -101,52 +123,62 @@ def normal_cycle_finish(sums, invalid, indptr, indices, steps):
     divided, restricted to the tangent plane of the unit normal and solved in
     closed form (``tangent_principal`` with ``rotate`` and ``mean_from_trace``).
     Returns ``(k_min, k_max, dir_min, dir_max, normals, valid)``, NaN where not valid.
+
+    The first pass reads ``sums`` times the weights as it goes, the last one
+    goes straight into the eigen-problem, and the passes between alternate
+    between one (V, 7) buffer and columns 0 to 6 of ``sums``, which are
+    overwritten when ``steps >= 3`` (columns 7 to 9, the normal sums, are
+    kept): no weighted copy, at most one buffer added, the same sums in the
+    same order as smoothing a weighted copy.
     """
     n = sums.shape[0]
-    current = np.empty((n, 7))
-    for i in nb.prange(n):
-        weight = 0.0 if invalid[i] else 1.0
-        for c in range(7):
-            current[i, c] = sums[i, c] * weight
-    if steps > 0:
-        following = np.empty((n, 7))
-        for _ in range(steps):
-            for i in nb.prange(n):
-                t0, t1, t2, t3, t4, t5, scale = _ring_sums6(current, indptr, indices, i)
-                t6 = current[i, 6]
-                for j in range(indptr[i], indptr[i + 1]):  # the area: the same neighbours, cached rows
-                    t6 += current[indices[j], 6]
-                following[i, 0], following[i, 1], following[i, 2] = t0 * scale, t1 * scale, t2 * scale
-                following[i, 3], following[i, 4], following[i, 5] = t3 * scale, t4 * scale, t5 * scale
-                following[i, 6] = t6 * scale
-            current, following = following, current
-    k_min = np.full(n, np.nan)
-    k_max = np.full(n, np.nan)
-    dir_min = np.full((n, 3), np.nan)
-    dir_max = np.full((n, 3), np.nan)
-    normals = np.full((n, 3), np.nan)
+    spare = np.empty((n if steps >= 2 else 0, 7))
+    for step in range(steps - 1):  # every pass but the last: into the other buffer
+        source = spare if step % 2 == 1 else sums
+        target = sums if step % 2 == 1 else spare
+        for i in nb.prange(n):
+            t0, t1, t2, t3, t4, t5, t6, scale = _ring_sums7(source, invalid, step == 0, indptr, indices, i)
+            target[i, 0], target[i, 1], target[i, 2] = t0 * scale, t1 * scale, t2 * scale
+            target[i, 3], target[i, 4], target[i, 5] = t3 * scale, t4 * scale, t5 * scale
+            target[i, 6] = t6 * scale
+    source = spare if steps >= 2 and steps % 2 == 0 else sums
+    k_min, k_max = np.empty(n), np.empty(n)
+    dir_min, dir_max, normals = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     valid = np.zeros(n, np.bool_)
     for i in nb.prange(n):
         nx, ny, nz, directed = _unit(sums[i, 7], sums[i, 8], sums[i, 9])
-        if not directed:
-            continue
         normals[i, 0], normals[i, 1], normals[i, 2] = nx, ny, nz
-        area = current[i, 6]
-        if invalid[i] or not area > 0:
+        k_min[i] = k_max[i] = np.nan
+        for c in range(3):
+            dir_min[i, c] = dir_max[i, c] = np.nan
+        if not directed or invalid[i]:
+            continue
+        if steps > 0:  # the last pass
+            t0, t1, t2, t3, t4, t5, t6, scale = _ring_sums7(source, invalid, steps == 1, indptr, indices, i)
+            t0, t1, t2, t3, t4, t5, area = (
+                t0 * scale,
+                t1 * scale,
+                t2 * scale,
+                t3 * scale,
+                t4 * scale,
+                t5 * scale,
+                t6 * scale,
+            )
+        else:  # a valid vertex's own sums (times 1.0)
+            t0, t1, t2, t3, t4, t5, area = (
+                sums[i, 0],
+                sums[i, 1],
+                sums[i, 2],
+                sums[i, 3],
+                sums[i, 4],
+                sums[i, 5],
+                sums[i, 6],
+            )
+        if not area > 0:
             continue
         valid[i] = True
         lo, hi, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
-            current[i, 0] / area,
-            current[i, 1] / area,
-            current[i, 2] / area,
-            current[i, 3] / area,
-            current[i, 4] / area,
-            current[i, 5] / area,
-            nx,
-            ny,
-            nz,
-            True,
-            True,
+            t0 / area, t1 / area, t2 / area, t3 / area, t4 / area, t5 / area, nx, ny, nz, True, True
         )
         k_min[i], k_max[i] = lo, hi
         dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
