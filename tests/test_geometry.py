@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from meshcurv import geometry, shapes
+from meshcurv import _geometry, geometry, shapes
 from meshcurv.errors import InvalidMeshError
 from meshcurv.geometry import face_normals
 from meshcurv.topology import MeshTopology
@@ -80,3 +80,47 @@ def test_edge_dihedral_angles_refuse_mismatched_arrays():
         geometry.edge_dihedral_angles(vertices, top, normals, np.ones(5))
     with pytest.raises(InvalidMeshError, match=r"`topology` must be a MeshTopology; got ndarray"):
         geometry.edge_dihedral_angles(vertices, faces, normals, top.interior_edges)
+
+
+def _arguments(name: str, mesh, topology: MeshTopology) -> tuple:
+    """The arguments of ``geometry.<name>`` on one mesh (vertices first)."""
+    vertices, faces = mesh.vertices, mesh.faces
+    if name.endswith(("edge_length", "edge_lengths")):
+        return vertices, topology.edges
+    if name in ("vertex_length_scales", "degenerate_faces"):
+        return vertices, topology
+    if name == "degenerate_face_mask":
+        return geometry.face_areas(vertices, faces), 0.5
+    if name == "edge_dihedral_angles":
+        return vertices, topology, geometry.face_normals(vertices, faces), topology.interior_edges
+    return vertices, faces
+
+
+#: The public functions of meshcurv.geometry over a core of the same name in meshcurv._geometry.
+SHELLS = [name for name in geometry.__all__ if hasattr(_geometry, name)]
+
+
+@pytest.mark.parametrize("name", SHELLS)
+def test_a_public_function_is_its_core_on_checked_arrays(name):
+    mesh = shapes.with_normal_noise(shapes.torus(), 0.1)  # an irregular mesh: no tie hides a difference
+    topology = MeshTopology.from_faces(mesh.faces, len(mesh.vertices))
+    arguments = _arguments(name, mesh, topology)
+    public = getattr(geometry, name)(*arguments)
+    core = getattr(_geometry, name)(*arguments)
+    for a, b in zip(public if isinstance(public, tuple) else (public,), core if isinstance(core, tuple) else (core,)):
+        np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("name", SHELLS)
+def test_a_public_function_checks_its_vertices(name):
+    mesh = shapes.icosphere(2)
+    topology = MeshTopology.from_faces(mesh.faces, len(mesh.vertices))
+    arguments = _arguments(name, mesh, topology)
+    if name == "degenerate_face_mask":  # areas and a scale, no vertices
+        with pytest.raises(InvalidMeshError, match="`areas` must hold real numbers"):
+            geometry.degenerate_face_mask(["a"], 0.5)
+        return
+    vertices = mesh.vertices.copy()
+    vertices[3, 1] = np.nan
+    with pytest.raises(InvalidMeshError, match="`vertices` has NaN or infinite coordinates at 1 vertices"):
+        getattr(geometry, name)(vertices, *arguments[1:])

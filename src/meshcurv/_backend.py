@@ -5,6 +5,13 @@ The NumPy paths are always there and are the reference; the numba kernels
 the same quantities in single passes without temporaries. numba is a dependency of meshcurv: they
 are used unless the NumPy paths are asked for (or numba cannot be imported: a broken install).
 
+Twins: a kernel bears the name of the NumPy function it mirrors, and that
+function carries the decorator :func:`twin`, which registers the pair in
+:data:`TWINS` and runs the kernel in its place on the compiled backend
+(``tests/test_backend.py`` holds every registered twin to a kernel of its
+name). Code whose NumPy side does not yet have the kernel's arguments asks
+:func:`numba_kernels` for the module and branches itself.
+
 Decided once per process: the first call that needs a kernel tries to import
 numba (never ``import meshcurv`` itself) and remembers the outcome, so that a
 base install without numba does not retry the failed import (some 11 ms, 10 to
@@ -62,11 +69,15 @@ import os
 import sys
 import threading
 import time
+from collections.abc import Callable
 from types import ModuleType
+from typing import TypeVar
 
 from .errors import InvalidOptionError, MissingDependencyError
 
 BACKENDS = ("auto", "numpy", "numba")
+
+_F = TypeVar("_F", bound=Callable)
 
 #: The backend :func:`use_backend` asks for in this thread or task (None: the environment decides). A
 #: context variable: a block on one backend in one thread (or asyncio task) leaves the others' as it was.
@@ -163,6 +174,49 @@ def numba_kernels(module: str):
     if package is None:
         return None
     return _serialised(importlib.import_module(f"{package.__name__}.{module}"))
+
+
+#: The registered twins: ``"module.name"`` of a kernel of :mod:`meshcurv._kernels` -> the NumPy function it
+#: mirrors (:func:`twin`), which bears its name.
+TWINS: dict[str, Callable] = {}
+
+
+def twin(module: str) -> Callable[[_F], _F]:
+    """Decorator: the NumPy function is the twin of the kernel of the same name in ``meshcurv._kernels.<module>``.
+
+    The kernel takes the same arguments and returns the same result (to the
+    bit, or within the tolerance ``tests/test_kernel_twins.py`` states). The
+    decorated function runs the kernel when the compiled backend is to be used
+    (:func:`numba_kernels`), its own NumPy body otherwise; the body stays
+    reachable as ``function.numpy``, the reference the kernel is tested
+    against. The pair is registered in :data:`TWINS`.
+
+    Parameters
+    ----------
+    module : str
+        The module of :mod:`meshcurv._kernels` that holds the kernel (``"geometry"``, ...).
+
+    Returns
+    -------
+    callable
+        The decorator.
+    """
+
+    def register(function: _F) -> _F:
+        name = function.__name__
+        TWINS[f"{module}.{name}"] = function
+
+        @functools.wraps(function)
+        def dispatch(*args, **kwargs):
+            kernels = numba_kernels(module)
+            if kernels is None:
+                return function(*args, **kwargs)
+            return getattr(kernels, name)(*args, **kwargs)
+
+        dispatch.numpy = function  # type: ignore[attr-defined]
+        return dispatch  # type: ignore[return-value]
+
+    return register
 
 
 def kernel_threads() -> int:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import numba_kernels, twin
 
 #: Faces with area below this fraction of the squared length scale of their component
 #: (:func:`vertex_length_scales`, the median edge length) count as degenerate.
@@ -31,11 +31,9 @@ MEDIAN_SAMPLE = 65536
 COMPONENT_SCALE_SPREAD = 16.0
 
 
+@twin("geometry")
 def face_cross_products(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(F, 3) ``cross(b - a, c - a)`` of every face ``(a, b, c)`` (:func:`meshcurv.geometry.face_cross_products`)."""
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return kernels.face_cross_products(vertices, faces)
     a = vertices[faces[:, 0]]
     u = vertices[faces[:, 1]] - a
     w = vertices[faces[:, 2]] - a
@@ -61,13 +59,10 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray, *, cross: np.ndarray
     """
     if cross is None:
         cross = face_cross_products(vertices, faces)
-    n = vertices.shape[0]
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return kernels.normalize_normal_sums(kernels.vertex_normal_sums(cross, faces, n))
-    return normalize_normal_sums(vertex_normal_sums(cross, faces, n))
+    return normalize_normal_sums(vertex_normal_sums(cross, faces, vertices.shape[0]))
 
 
+@twin("geometry")
 def vertex_normal_sums(cross: np.ndarray, faces: np.ndarray, n_vertices: int) -> np.ndarray:
     """(V, 3) the sums of the (F, 3) face cross products ``cross`` at each vertex, in face order."""
     flat = faces.ravel()
@@ -76,6 +71,7 @@ def vertex_normal_sums(cross: np.ndarray, faces: np.ndarray, n_vertices: int) ->
     )
 
 
+@twin("geometry")
 def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
     """Unit vectors from (V, 3) sums of face cross products; NaN where a sum is 0.
 
@@ -88,11 +84,9 @@ def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
         return np.where(norm > 1e-12 * np.maximum(scale, np.finfo(float).tiny), summed / norm, np.nan)
 
 
+@twin("geometry")
 def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """(E,) ``|x_j - x_i|`` for each edge ``(i, j)`` (:func:`meshcurv.geometry.edge_lengths`)."""
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return kernels.edge_lengths(vertices, edges)
     d = vertices[edges[:, 1]] - vertices[edges[:, 0]]
     return np.sqrt(np.einsum("ij,ij->i", d, d))
 
@@ -110,13 +104,11 @@ def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
         )
 
 
+@twin("geometry")
 def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     """Mean length of the edges, 0 without edges (:func:`meshcurv.geometry.mean_edge_length`)."""
     if edges.shape[0] == 0:
         return 0.0
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return float(kernels.mean_edge_length(vertices, edges))
     return float(edge_lengths(vertices, edges).mean())
 
 

@@ -1,0 +1,51 @@
+"""The prepared mesh: the caller's arrays checked once, then trusted (issue 33)."""
+
+import numpy as np
+import pytest
+
+import meshcurv
+from meshcurv import _prepared, _validation, shapes
+from meshcurv.errors import InvalidMeshError
+from meshcurv.topology import MeshTopology
+
+
+def _counted(monkeypatch, module, name: str) -> list:
+    calls: list = []
+    original = getattr(module, name)
+
+    def spy(*args, **kwargs):
+        calls.append(name)
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(module, name, spy)
+    return calls
+
+
+@pytest.mark.parametrize("method", ["normal_cycle", "icc"])
+def test_the_vertices_and_faces_are_checked_once_per_call(method, monkeypatch):
+    sphere = shapes.icosphere(4)
+    vertices = _counted(monkeypatch, _prepared, "as_vertices")
+    faces = _counted(monkeypatch, _prepared, "as_faces")
+    again = _counted(monkeypatch, _validation, "as_vertices")  # a helper that would check them a second time
+    meshcurv.principal_curvatures(sphere.vertices, sphere.faces.tolist(), method=method)
+    assert (len(vertices), len(faces), len(again)) == (1, 1, 0)
+
+
+def test_a_prepared_mesh_holds_the_checked_arrays_and_leaves_the_callers_alone():
+    sphere = shapes.icosphere(3)
+    given = sphere.vertices.astype(np.float32)
+    mesh = _prepared.prepare_mesh(given, sphere.faces.astype(np.int32), orient="keep", weld=False)
+    assert mesh.vertices.dtype == np.float64 and mesh.vertices.flags.c_contiguous
+    assert mesh.topology.faces.dtype == np.int64
+    assert mesh.vertices is not given and given.dtype == np.float32
+    np.testing.assert_array_equal(mesh.topology.faces, sphere.faces)
+
+
+def test_a_given_topology_is_taken_once_its_vertex_count_matches():
+    sphere = shapes.icosphere(3)
+    topology = MeshTopology.from_faces(sphere.faces, len(sphere.vertices))
+    mesh = _prepared.prepare_mesh(sphere.vertices, topology, orient="keep", weld=False)
+    assert mesh.topology is topology
+    n = len(sphere.vertices)
+    with pytest.raises(InvalidMeshError, match=f"is a MeshTopology of {n} vertices but `vertices` has {n - 1} rows"):
+        _prepared.prepare_mesh(sphere.vertices[:-1], topology, orient="keep", weld=False)
