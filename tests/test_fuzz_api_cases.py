@@ -489,3 +489,40 @@ def test_an_open_voxel_surface_is_scale_invariant(monkeypatch, method, backend):
                 size = np.abs(base.k_max[base.valid]).max()
                 np.testing.assert_allclose(scaled.k_max * scale, base.k_max, rtol=0, atol=1e-9 * size)
                 np.testing.assert_allclose(scaled.k_min * scale, base.k_min, rtol=0, atol=1e-9 * size)
+
+
+# --- normal_cycle_ball at radii of 1-1.5 edges: valid vertices off by half of H (issue 29) ----------------
+
+
+@pytest.mark.parametrize("edges", [1.0, 1.25, 1.5])
+def test_normal_cycle_ball_at_small_radii_is_not_off_by_half(edges):
+    # the tensor's edge measure was exact and its area approximate (each face's linear share): a ball cutting
+    # a few long edges of a random unit sphere gave H off by more than 0.5 at 26 of 1,942 valid vertices at
+    # one edge, 3 at 1.25, and k off by half at 224, 66 and 6; the area is now measured on the same edges
+    sphere = shapes.random_sphere(n_vertices=2000, seed=0)
+    vertices, faces = sphere.vertices, sphere.faces
+    median = float(np.median(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshcurvWarning)
+        result = meshcurv.principal_curvatures(vertices, faces, method="normal_cycle_ball", radius=edges * median)
+    valid = result.valid
+    assert valid.mean() > 0.95
+    assert not (np.abs(result.mean[valid] - 1.0) > 0.5).any()
+    off = np.maximum(np.abs(result.k_min - 1.0), np.abs(result.k_max - 1.0))[valid] >= 0.5
+    assert off.mean() <= {1.0: 0.02, 1.25: 0.002, 1.5: 0.0}[edges]  # the k of a few long edges: O(edge / radius)
+
+
+def test_edge_area_densities_spread_each_face_over_its_edges():
+    from meshcurv.estimators.normal_cycle_ball import edge_area_densities
+
+    sphere = shapes.random_sphere(n_vertices=200, seed=1)
+    topology = meshcurv.MeshTopology.from_faces(sphere.faces)
+    areas = geometry.face_areas(sphere.vertices, sphere.faces)
+    edges = topology.edges
+    lengths = np.linalg.norm(sphere.vertices[edges[:, 1]] - sphere.vertices[edges[:, 0]], axis=1)
+    density = edge_area_densities(topology, areas, lengths)
+    np.testing.assert_allclose((density * lengths).sum(), areas.sum(), rtol=1e-12)  # a ball over everything
+    # one face's share: a third of its area on each of its sides
+    one = np.where(np.arange(len(areas)) == 7, areas, 0.0)
+    shares = edge_area_densities(topology, one, lengths) * lengths
+    np.testing.assert_allclose(np.sort(shares[shares > 0]), np.full(3, areas[7] / 3), rtol=1e-12)

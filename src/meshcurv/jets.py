@@ -128,9 +128,10 @@ CHUNK_SIZE = 4096
 #: for 1 at 1.5 R). Noisy normals of a clean surface rarely turn beyond 90 degrees: 5%
 #: leaves room for a few that do.
 AWAY_FRACTION = 0.05
-#: Normals whose dot product is below this face away: orthogonal ones (a voxel surface's faces at right
-#: angles) do not, whatever the round-off (issue 29: a voxel sphere scaled by 1e-8 lost quadric fits).
-AWAY_DOT = -1e-9
+#: Normals whose dot product is below this face away, orthogonal ones included (the surface is vertical
+#: to the tangent plane there: no height function), whatever the round-off makes of their 0 (issue 29:
+#: a voxel sphere scaled by 1e-8 lost quadric fits, faces at right angles giving -1e-17 or 1e-15).
+AWAY_DOT = 1e-9
 
 #: A fit whose first frame tilts its normal less than 0.5 degrees (slope ``c10^2 + c01^2``
 #: below this) is settled: a refit in the frame of its own normal (``settled=`` of

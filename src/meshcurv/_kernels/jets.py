@@ -537,7 +537,7 @@ def _fit_one(
                 continue
             k = ids[members[a]]
             total += 1.0
-            if fx * facing[k, 0] + fy * facing[k, 1] + fz * facing[k, 2] < -1e-9:  # jets.AWAY_DOT
+            if fx * facing[k, 0] + fy * facing[k, 1] + fz * facing[k, 2] < 1e-9:  # jets.AWAY_DOT
                 away += 1.0
         away_out[row] = away / total if total > 0 else 0.0
         graph = not away > away_fraction * total

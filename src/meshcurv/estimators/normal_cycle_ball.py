@@ -10,8 +10,16 @@ The formula of :mod:`meshcurv.estimators.normal_cycle` over the ball
 ``beta(e)`` is the signed dihedral angle of edge ``e`` (positive where the surface
 bends away from its normals; :func:`~meshcurv.geometry.edge_dihedral_angles`),
 ``|e ∩ B|`` the exact length of the edge inside the ball and ``|B ∩ S|`` the
-area of the mesh inside the ball (each face weighted by its approximate share,
-:func:`meshcurv.neighborhoods.face_in_ball_ratios`). Cohen-Steiner and Morvan
+area of the mesh inside the ball, measured on the same edges:
+``sum_e |e ∩ B| a(e) / |e|`` with ``a(e)`` a third of the area of each face of
+``e`` (:func:`edge_area_densities`; a ball holding whole faces holds their whole
+area). Both measures of the ratio then share the ball's cut through the edges:
+with each face weighted by its approximate share instead
+(:func:`meshcurv.neighborhoods.face_in_ball_ratios`), a ball of one to one and a
+half edge lengths cutting a few long edges gave 10% of the vertices of a random
+sphere off by more than half the curvature and 1.3% off by half of H (issue 29;
+now 1.2% and none at one edge, none from 1.5; the median error of H at the default
+radius is 0.013 against 0.033). Cohen-Steiner and Morvan
 prove that this converges to the integral of the shape operator over the ball
 when the mesh is a fine enough, well-shaped sampling, at a rate of the edge
 length over the radius: the ball, unlike a fixed number of rings, keeps its
@@ -46,7 +54,7 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from .._geometry import edge_dihedral_angles
-from ..neighborhoods import ball_edge_sums, ball_face_sums
+from ..neighborhoods import ball_edge_sums
 from ..radius import component_radii, resolve_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, ball_holds_neighbours, finish
@@ -54,17 +62,38 @@ from ._support import Stages, ball_holds_neighbours, finish
 STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve curvatures")
 
 #: A given radius below this many median edge lengths is named in the warning (the registry's
-#: ``radius_warning_edges``): on random spheres of 200
-#: and 2,000 vertices 10% of the vertices are off by more than half the curvature at one edge, 24-28% at
-#: 0.7, none or 0.15% from 1.5 (the default is 2.5 mean edges).
+#: ``radius_warning_edges``): on random spheres of 200 to 5,000 vertices (three seeds each), the valid
+#: vertices off by more than half the curvature were 0.7% at one length scale, 0.28% at 1.1, 0.06% at 1.25
+#: and none from 1.4 (none off by half of H from one; the default is 2.5 mean edges). Before the area was
+#: measured on the edges (issue 29): 10% at one edge, 0.15-0.5% at 1.5.
 RADIUS_WARNING_EDGES = 1.5
 
 #: A ball whose radius is below this many length scales (the median edge length of the vertex's component,
 #: :func:`meshcurv.geometry.vertex_length_scales`) holds a few partial edges and faces, not the surface:
 #: its vertex is undefined. On the 2,000-point random unit sphere, the vertices off by more than half of
 #: H = 1 were 186 of 767 valid at 0.35 mean edge lengths, 204 of 1,260 at 0.5, 133 of 1,739 at 0.7, 21 of
-#: 1,962 at 1 and none from 1.5 (issue 29; fuzz_api seed 51, case 5992: 4 of 6 valid off at 0.07 edges).
+#: 1,962 at 1 and none from 1.5 (issue 29; fuzz_api seed 51, case 5992: 4 of 6 valid off at 0.07 edges);
+#: with the area measured on the edges, none from one. Not higher: the voxel default of a ball of radius
+#: 2 voxels is one length scale.
 MIN_RADIUS_SCALES = 1.0
+
+
+def edge_area_densities(topology, face_areas: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """(E,) area per unit length of each edge: a third of the area of each of its faces, over its length.
+
+    Summed over the part of each edge inside a ball (``|e ∩ B|`` times the
+    density), the area of the mesh in the ball measured on the edges, as the
+    curvature tensor is: an edge wholly inside adds a third of each of its
+    faces, so a ball that holds whole faces holds their whole area. Zero on
+    edges of zero length (their faces have no area) and for faces of zero
+    ``face_areas`` (degenerate faces, needle slivers).
+    """
+    sides = topology.face_edges
+    held = sides >= 0
+    thirds = np.broadcast_to((face_areas / 3.0)[:, None], sides.shape)
+    shares = np.bincount(sides[held], weights=thirds[held], minlength=lengths.shape[0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(lengths > 0, shares / lengths, 0.0)
 
 
 def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
@@ -88,16 +117,18 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     if needle_edges is not None:
         usable &= ~needle_edges
     kept_faces = ~degenerate if needle_faces is None else ~degenerate & ~needle_faces
-    beta, _, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
+    beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
+    density = edge_area_densities(topology, np.where(kept_faces, double_areas / 2, 0.0), lengths)
 
     stages.start("sum over balls")
-    edge_values, face_values = outer6(unit, beta), (double_areas / 2)[:, None]
-    measures = np.zeros((vertices.shape[0], 6))
-    areas = np.zeros(vertices.shape[0])
+    # the tensor and the area on the same support, the edges inside the ball: one sum of seven columns
+    edge_values = np.column_stack([outer6(unit, beta), density])
+    measured = usable | (density > 0)
+    measures = np.zeros((vertices.shape[0], 7))
     for group_radius, members in groups:
         rows = slice(None) if members is None else members
-        measures[rows] = ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=usable)[rows]
-        areas[rows] = ball_face_sums(vertices, topology.faces, group_radius, face_values, usable=kept_faces)[rows, 0]
+        measures[rows] = ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
+    measures, areas = measures[:, :6], measures[:, 6]
 
     stages.start("retrieve curvatures")
     valid &= areas > 0
