@@ -1608,6 +1608,50 @@ def check_edge_cosines(name):
     assert_sums_close(kernels("pointcloud").edge_cosines(normals, indices), expected, 1.0, 3)
 
 
+def check_graph_edges(name):
+    from meshcurv._pointcloud_normals import GRAPH_NEIGHBOURS, _graph_geometry
+
+    points, normals, indices, usable = orientation_inputs(name)
+    indices = np.ascontiguousarray(indices[:, :GRAPH_NEIGHBOURS])
+    indices[::97, 0] = np.arange(0, indices.shape[0], 97)  # some points their own neighbour: no edge
+    got = kernels("pointcloud").graph_edges(points, normals, indices, usable)
+    expected = _graph_geometry(points, normals, indices, usable)
+    for label, a, b in zip(("rows", "cols", "kept"), got[:3], expected[:3]):
+        np.testing.assert_array_equal(a, b, err_msg=label)
+    # einsum adds the three products in another order: within 2 eps of the sum of |products| (at most |d|,
+    # and 1 for the cosine); the slope over |d| then within a few eps
+    length = np.linalg.norm(points[expected[1]] - points[expected[0]], axis=1)
+    for label, a, b, magnitude in zip(
+        ("ahead", "behind", "cosine"), got[3:6], expected[3:6], (length, length, np.ones_like(length))
+    ):
+        assert_sums_close(a, b, magnitude, 3, err_msg=label)
+    assert_sums_close(got[6], expected[6], 1.0, 3, err_msg="slope", relative=4 * EPS)
+    # the products as the kernel of the other edge products forms them, to the bit
+    geometry = kernels("pointcloud").edge_geometry(points, normals, indices)
+    for label, a, b in zip(("ahead", "behind", "cosine"), got[3:6], geometry[1:]):
+        np.testing.assert_array_equal(a, b.ravel()[got[2]], err_msg=label)
+
+
+def check_edge_weights(name):
+    from meshcurv._pointcloud_normals import FACING_COSINE, GRAPH_NEIGHBOURS, STACKED_OFFSET, _edge_weights
+
+    points, normals, indices, usable = orientation_inputs(name)
+    rows, cols, _, ahead, behind, cosine, slope = kernels("pointcloud").graph_edges(
+        points, normals, np.ascontiguousarray(indices[:, :GRAPH_NEIGHBOURS]), usable
+    )
+    rng = np.random.default_rng(17)
+    spacing = rng.uniform(0.0, 0.2, points.shape[0])  # some ends far enough off the other's plane to be stacked
+    flat = rng.random(rows.size) < 0.5
+    slope[::53], ahead[::71] = np.nan, np.nan  # zero offsets: NaN products
+    got = kernels("pointcloud").edge_weights(
+        flat, ahead, behind, cosine, slope, spacing, rows, cols, STACKED_OFFSET, FACING_COSINE
+    )
+    expected = _edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols)
+    for label, a, b in zip(("stacked", "weights", "opposite"), got, expected):
+        np.testing.assert_array_equal(a, b, err_msg=label)  # the same operations in the same order
+    assert expected[0].any() and (~expected[0] & ~flat).any()
+
+
 def check_far_winding(name):
     """The winding numbers of an oriented cloud with the far sum compiled and in NumPy (the same terms)."""
     from scipy.spatial import cKDTree
@@ -1794,7 +1838,7 @@ def check_stacked(name):
 
 
 TWINS = [
-    Twin("geometry.face_cross_products", "_geometry.face_cross_products", check_face_cross_products, MESHES),
+    Twin("geometry.face_cross_products", "geometry.face_cross_products", check_face_cross_products, MESHES),
     Twin(
         "geometry.vertex_normal_sums",
         "_geometry.vertex_normal_sums",
@@ -1803,13 +1847,13 @@ TWINS = [
     ),
     Twin(
         "geometry.normalize_normal_sums",
-        "_geometry.normalize_normal_sums",
+        "geometry.normalize_normal_sums",
         check_normalize_normal_sums,
         ("random", "torus", "defects"),
     ),
-    Twin("geometry.edge_lengths", "_geometry.edge_lengths", check_edge_lengths, MESHES),
+    Twin("geometry.edge_lengths", "geometry.edge_lengths", check_edge_lengths, MESHES),
     Twin("geometry.vertex_edge_lengths", "geometry.vertex_edge_lengths", check_vertex_edge_lengths, MESHES),
-    Twin("geometry.mean_edge_length", "_geometry.mean_edge_length", check_mean_edge_length, MESHES),
+    Twin("geometry.mean_edge_length", "geometry.mean_edge_length", check_mean_edge_length, MESHES),
     Twin("geometry.degenerate_faces", "geometry.degenerate_faces", check_degenerate_faces, MESHES),
     Twin("orient.patch_volumes", "orient._patch_volumes", check_patch_volumes, MESHES),
     Twin("topology.build_edges", "topology._build_edges", check_build_edges, MESHES),
@@ -1900,6 +1944,8 @@ TWINS = [
     Twin("pointcloud.far_winding", "_pointcloud_normals.winding_numbers", check_far_winding, CLOUDS),
     Twin("pointcloud.spanning_signs", "_pointcloud_normals.orientation_signs", check_spanning_signs, CLOUDS),
     Twin("pointcloud.edge_geometry", "the products of _pointcloud_normals.oriented_signs", check_edge_geometry, CLOUDS),
+    Twin("pointcloud.graph_edges", "_pointcloud_normals._graph_geometry", check_graph_edges, CLOUDS),
+    Twin("pointcloud.edge_weights", "_pointcloud_normals._edge_weights", check_edge_weights, CLOUDS),
     Twin("pointcloud.own_side", "_pointcloud_estimators._own_side", check_own_side, CLOUDS),
     Twin("pointcloud.line_spread", "_pointcloud_normals._line_spread_numpy", check_line_spread, CLOUDS),
     Twin("pointcloud.flat_balls", "_pointcloud_estimators._flat_balls", check_flat_balls, CLOUDS),
@@ -1977,11 +2023,6 @@ def test_every_kernel_has_a_twin():
     for twin in TWINS:
         module, _, name = twin.kernel.partition(".")
         assert callable(getattr(kernels(module), name)), twin.kernel
-    from meshcurv._backend import TWINS as REGISTERED  # the twins that carry @twin: the row names that function
-
-    for kernel, function in REGISTERED.items():
-        named = f"{function.__module__.removeprefix('meshcurv.')}.{function.__qualname__}"
-        assert [twin.twin for twin in TWINS if twin.kernel == kernel] == [named], kernel
 
 
 # -- the chunks of the jet fits on threads (issue 31: no numba parallel pipeline to compile) ------------

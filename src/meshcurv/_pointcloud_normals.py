@@ -638,36 +638,25 @@ def oriented_signs(
         (:func:`winding_sides`).
     """
     n = points.shape[0]
-    rows, cols, kept = _graph_edges(indices[:, :GRAPH_NEIGHBOURS], usable)
+    graph = np.ascontiguousarray(indices[:, :GRAPH_NEIGHBOURS])
     compiled = numba_kernels("pointcloud")
-    if compiled is not None:  # without (E, 3) gathers
-        geometry = compiled.edge_geometry(points, normals, np.ascontiguousarray(indices[:, :GRAPH_NEIGHBOURS]))
-        length, ahead, behind, cosine = (array.ravel()[kept] for array in geometry)
+    if compiled is not None:  # the edges and their products in one pass on every core, without (E, 3) gathers
+        rows, cols, kept, ahead, behind, cosine, slope = compiled.graph_edges(points, normals, graph, usable)
     else:
-        offsets = points[cols] - points[rows]
-        length = np.linalg.norm(offsets, axis=1)
-        ahead = np.einsum("ij,ij->i", offsets, normals[rows])
-        behind = np.einsum("ij,ij->i", offsets, normals[cols])
-        cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        slope = np.maximum(np.abs(ahead), np.abs(behind)) / length
+        rows, cols, kept, ahead, behind, cosine, slope = _graph_geometry(points, normals, graph, usable)
     flat = slope <= SHEET_SLOPE  # NaN (a zero offset) is not flat
-    flat = _supported(flat, slope, rows, cols, kept, indices[:, :GRAPH_NEIGHBOURS])
+    flat = _supported(flat, slope, rows, cols, kept, graph)
     sheets = _sheets(n, rows[flat], cols[flat])
-    reach = STACKED_OFFSET * 0.5 * (spacing[rows] + spacing[cols])
-    stacked = (
-        ~flat
-        & (np.abs(cosine) >= FACING_COSINE)
-        & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
-        & (ahead * behind * cosine > 0)
-    )
-    used = flat | stacked
-    # (flat edges also by their slope: a tree of one sheet is grown before edges that leave it a little)
     # flat edges first, by 1 - |cos| and their slope (a tree of one sheet is grown before edges that leave it a
     # little); stacked edges after them all: they only join sheets that no flat path joins (taken first, an
     # accidental stacked edge inside a sphere of 1000 points turned half of it)
-    weights = np.where(stacked, 3.0 + (1.0 - np.abs(cosine)), 1.0 - np.abs(cosine) + np.nan_to_num(slope) + 1e-6)
-    opposite = (cosine < 0) ^ stacked
+    if compiled is not None:
+        stacked, weights, opposite = compiled.edge_weights(
+            flat, ahead, behind, cosine, slope, spacing, rows, cols, STACKED_OFFSET, FACING_COSINE
+        )
+    else:
+        stacked, weights, opposite = _edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols)
+    used = flat | stacked
     signs, labels = _spanning_forest(n, rows[used], cols[used], opposite[used], weights[used])
     sizes = np.bincount(labels)
     part = np.where((sizes >= PART_MIN_POINTS)[labels] & usable, labels, -1)
@@ -708,6 +697,36 @@ def oriented_signs(
     doubtful[rows[torn]] = True
     doubtful[cols[torn]] = True
     return signs, labels, doubtful | unsettled, sheets, unsettled
+
+
+def _graph_geometry(points, normals, indices, usable):
+    """``(rows, cols, kept, ahead, behind, cosine, slope)``: the edges of the graph ``indices`` (N, k) between
+    usable points (:func:`_graph_edges`) and (E,) ``n_i . d``, ``n_j . d``, ``n_i . n_j`` and
+    ``max(|n_i . d|, |n_j . d|) / |d|`` of ``d = p_j - p_i`` (NaN where ``d`` is 0). Compiled:
+    :func:`meshcurv._kernels.pointcloud.graph_edges`."""
+    rows, cols, kept = _graph_edges(indices, usable)
+    offsets = points[cols] - points[rows]
+    length = np.linalg.norm(offsets, axis=1)
+    ahead = np.einsum("ij,ij->i", offsets, normals[rows])
+    behind = np.einsum("ij,ij->i", offsets, normals[cols])
+    cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        slope = np.maximum(np.abs(ahead), np.abs(behind)) / length
+    return rows, cols, kept, ahead, behind, cosine, slope
+
+
+def _edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols):
+    """(E,) ``stacked``, ``weights`` and ``opposite`` of the edges of :func:`oriented_signs` (see there).
+    Compiled: :func:`meshcurv._kernels.pointcloud.edge_weights`."""
+    reach = STACKED_OFFSET * 0.5 * (spacing[rows] + spacing[cols])
+    stacked = (
+        ~flat
+        & (np.abs(cosine) >= FACING_COSINE)
+        & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
+        & (ahead * behind * cosine > 0)
+    )
+    weights = np.where(stacked, 3.0 + (1.0 - np.abs(cosine)), 1.0 - np.abs(cosine) + np.nan_to_num(slope) + 1e-6)
+    return stacked, weights, (cosine < 0) ^ stacked
 
 
 def _supported(flat, slope, rows, cols, kept, indices):

@@ -436,6 +436,93 @@ def edge_geometry(points, normals, indices):
 
 
 @nb.njit(parallel=True, **_JIT)
+def graph_edges(points, normals, indices, usable):
+    """The edges of the graph ``indices`` (N, k) between ``usable`` points, and their geometry, in one pass.
+
+    Returns ``rows, cols`` (E,) (the edges ``i -> indices[i, c]``, both ends usable and distinct, in the order
+    of the rows of ``indices``), ``kept`` (N k,) (which entries of ``indices`` they are), and (E,) ``ahead`` =
+    ``n_i . d``, ``behind`` = ``n_j . d``, ``cosine`` = ``n_i . n_j`` and ``slope`` = ``max(|ahead|, |behind|) /
+    |d|`` of ``d = p_j - p_i`` (NaN where ``|d|`` is 0): the compiled
+    :func:`meshcurv._pointcloud_normals._graph_geometry`, on every core instead of NumPy over (E,) arrays (the
+    products as :func:`edge_geometry` forms them, left to right).
+    """
+    n, k = indices.shape
+    kept = np.zeros(n * k, dtype=np.bool_)
+    starts = np.zeros(n + 1, dtype=np.int64)
+    for i in nb.prange(n):
+        found = 0
+        if usable[i]:
+            for c in range(k):
+                j = indices[i, c]
+                if usable[j] and j != i:
+                    kept[i * k + c] = True
+                    found += 1
+        starts[i + 1] = found
+    for i in range(n):
+        starts[i + 1] += starts[i]
+    e = starts[n]
+    rows, cols = np.zeros(e, dtype=np.int64), np.zeros(e, dtype=np.int64)
+    ahead, behind, cosine, slope = np.zeros(e), np.zeros(e), np.zeros(e), np.zeros(e)
+    for i in nb.prange(n):
+        t = starts[i]
+        px, py, pz = points[i, 0], points[i, 1], points[i, 2]
+        ax, ay, az = normals[i, 0], normals[i, 1], normals[i, 2]
+        for c in range(k):
+            if not kept[i * k + c]:
+                continue
+            j = indices[i, c]
+            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+            bx, by, bz = normals[j, 0], normals[j, 1], normals[j, 2]
+            length = np.sqrt(dx * dx + dy * dy + dz * dz)
+            a = dx * ax + dy * ay + dz * az
+            b = dx * bx + dy * by + dz * bz
+            rows[t], cols[t] = i, j
+            ahead[t], behind[t], cosine[t] = a, b, ax * bx + ay * by + az * bz
+            larger = abs(a) if abs(a) >= abs(b) or a != a else abs(b)  # numpy.maximum: NaN wins
+            slope[t] = larger / length
+            t += 1
+    return rows, cols, kept, ahead, behind, cosine, slope
+
+
+@nb.njit(parallel=True, **_JIT)
+def edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols, offset, facing):
+    """(E,) ``stacked``, ``weights`` and ``opposite`` of the edges of
+    :func:`meshcurv._pointcloud_normals.oriented_signs`: the compiled
+    :func:`meshcurv._pointcloud_normals._edge_weights`, the same operations (``offset``: ``STACKED_OFFSET``,
+    ``facing``: ``FACING_COSINE``).
+
+    An edge not ``flat`` is stacked when ``|cosine| >= facing``, both ends at least ``offset`` times the mean
+    ``spacing`` of its ends off the other's tangent plane, on the sides parallel planes give
+    (``ahead behind cosine > 0``). Weights: ``3 + (1 - |cosine|)`` for stacked edges, else ``1 - |cosine| +
+    slope + 1e-6`` (a NaN slope read as 0); ``opposite``: ``cosine < 0`` unless stacked (then reversed).
+    """
+    e = flat.shape[0]
+    stacked = np.zeros(e, dtype=np.bool_)
+    weights = np.zeros(e)
+    opposite = np.zeros(e, dtype=np.bool_)
+    half = offset * 0.5
+    for t in nb.prange(e):
+        a, b, c = ahead[t], behind[t], cosine[t]
+        reach = half * (spacing[rows[t]] + spacing[cols[t]])
+        near = abs(a) if abs(a) <= abs(b) or a != a else abs(b)  # numpy.minimum: NaN wins
+        up = (not flat[t]) and abs(c) >= facing and near >= reach and a * b * c > 0
+        stacked[t] = up
+        if up:
+            weights[t] = 3.0 + (1.0 - abs(c))
+        else:
+            s = slope[t]
+            if s != s:
+                s = 0.0
+            elif s == np.inf:
+                s = 1.7976931348623157e308
+            elif s == -np.inf:
+                s = -1.7976931348623157e308
+            weights[t] = 1.0 - abs(c) + s + 1e-6
+        opposite[t] = (c < 0) != up
+    return stacked, weights, opposite
+
+
+@nb.njit(parallel=True, **_JIT)
 def stacked(points, normals, usable, queries, near, ring, offset, tilt_factor, facing, alike):
     """(M, k) bool: the compiled :func:`meshcurv._pointcloud_normals._stacked` (its constants as arguments).
 
