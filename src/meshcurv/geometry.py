@@ -4,7 +4,10 @@ Inputs are ``vertices`` of shape (V, 3) and ``faces`` of shape (F, 3)
 (0-based); outputs are new float64 arrays. Each function checks its arrays
 cheaply (:func:`meshcurv._validation.checked_mesh`: dtype, shape, finite
 coordinates, indices in range; no copy of arrays that are already float64 and
-int64), so that the compiled kernels never read out of bounds.
+int64), so that the compiled kernels never read out of bounds, then computes
+with the core of the same name in :mod:`meshcurv._geometry`. The library
+calls those cores directly on the arrays it has checked once
+(:func:`meshcurv._prepared.prepare_mesh`).
 
 Length scales: every tolerance of the core is relative to a *robust* length
 scale, the median edge length of the vertex's connected component
