@@ -1962,6 +1962,7 @@ EXCEPTIONS: dict[str, str] = {
     "topology.build_edges_into": "the body of topology.build_topology, called by topology.build_edges (its row above)",
     "topology.bowtie_from_twins": "tests/test_topology.py::test_bowtie_vertices_from_the_twin_sides_are_those_of_the_"
     "definition: against the NumPy definition on random defective spheres",
+    "topology.double_sided_suspects": "tests/test_weld_suspects.py: against weld._suspect_edges's NumPy path",
     "matgeom.matgeom_vertex_sums": "the body of matgeom.matgeom_vertex_tensors (its row above), which calls it; its "
     "zero-area faces: tests/test_topology.py::test_the_zero_area_faces_a_kernel_found_are_kept",
 }

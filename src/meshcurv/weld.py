@@ -20,6 +20,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ._backend import numba_kernels
 from .orient import face_flips
 from .topology import MeshTopology
 
@@ -196,12 +197,7 @@ def drop_double_sided(vertices: np.ndarray, topology: MeshTopology) -> OneSided:
     faces = topology.faces
     n_faces = faces.shape[0]
     none = OneSided(topology, np.zeros(n_faces, dtype=bool), 0)
-    # a lone triangle's two sides make a closed pillow of manifold edges: an edge whose two faces have the same
-    # third corner (the same corner sums, as both hold the edge's ends) is a candidate as well
-    corner_sums = faces[:, 0] + faces[:, 1] + faces[:, 2]
-    pairs = topology.edge_faces  # both >= 0 on an interior edge
-    pillow = topology.interior_edges & (corner_sums[pairs[:, 0]] == corner_sums[pairs[:, 1]])
-    suspect = topology.nonmanifold_edges | pillow
+    suspect = _suspect_edges(topology)
     if not suspect.any():
         return none
     sides = topology.face_edges
@@ -336,3 +332,19 @@ def drop_closed_copies(
     dropped_faces = np.isin(labels[topology.faces[:, 0]], list(copy_of))
     faces = np.ascontiguousarray(compact[topology.faces[~dropped_faces]])
     return Welding(vertices[kept], MeshTopology._build(faces, int(kept.sum())), index, int(n_vertices - kept.sum()))
+
+
+def _suspect_edges(topology: MeshTopology) -> np.ndarray:
+    """(E,) bool: the edges whose faces :func:`drop_double_sided` looks at (its Notes), compiled when numba is there."""
+    kernels = numba_kernels("topology")
+    if kernels is not None:
+        return kernels.double_sided_suspects(
+            topology.faces, topology.edge_faces, topology.edge_face_counts, topology._edge_forward_counts
+        )
+    # a lone triangle's two sides make a closed pillow of manifold edges: an edge whose two faces have the same
+    # third corner (the same corner sums, as both hold the edge's ends) is a candidate as well
+    faces = topology.faces
+    corner_sums = faces[:, 0] + faces[:, 1] + faces[:, 2]
+    pairs = topology.edge_faces  # both >= 0 on an interior edge
+    pillow = topology.interior_edges & (corner_sums[pairs[:, 0]] == corner_sums[pairs[:, 1]])
+    return topology.nonmanifold_edges | pillow

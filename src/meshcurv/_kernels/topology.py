@@ -389,3 +389,28 @@ def neighbour_lists(edges, n_vertices):
         indices[fill[q]] = p
         fill[q] += 1
     return indptr, indices
+
+
+@nb.njit(parallel=True, **_JIT)
+def double_sided_suspects(faces, edge_faces, counts, forward):
+    """(E,) bool: the edges ``weld.drop_double_sided`` looks at, in one pass over the edges.
+
+    An edge is a suspect when it has three faces or more (non-manifold), or
+    two consistently oriented faces whose corner sums are equal (both hold
+    the edge's ends, so their third corners are the same vertex: a lone
+    triangle stored with both windings). The NumPy path builds the corner sums
+    of every face and gathers them per edge (four temporaries of the size of
+    the edges or faces).
+    """
+    n_edges = counts.shape[0]
+    out = np.empty(n_edges, np.bool_)
+    for e in nb.prange(n_edges):
+        count = counts[e]
+        if count > 2:
+            out[e] = True
+        elif count == 2 and forward[e] == 1:
+            f, g = edge_faces[e, 0], edge_faces[e, 1]
+            out[e] = faces[f, 0] + faces[f, 1] + faces[f, 2] == faces[g, 0] + faces[g, 1] + faces[g, 2]
+        else:
+            out[e] = False
+    return out
