@@ -548,7 +548,7 @@ def test_point_cloud_spaced_below_float64_squares_is_refused():
     points = np.zeros((40, 3))
     points[:, 0] = 2.0**-249  # 1.1e-75 shared by all (accepted; a power of two: centred exactly to 0)
     points[:, 1:] = rng.random((40, 2)) * 1e-200
-    with pytest.raises(InvalidMeshError, match=r"`points` are spaced below 1e-150 everywhere"):
+    with pytest.raises(InvalidMeshError, match=r"`points` are spaced below 1e-74 everywhere"):
         point_cloud_curvatures(points)
 
 

@@ -171,3 +171,53 @@ def test_a_plate_as_thick_as_its_noise_is_invalid_not_wrong(method, noise, monke
         r.invalid_reason[~r.valid]
         != next(code for code, text in enumerate(INVALID_REASONS) if text.startswith("estimate undefined"))
     ).mean() > 0.9
+
+
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
+@pytest.mark.parametrize("n", [30, 50, 70, 200])
+def test_a_lone_ring_has_no_surface(method, n):
+    # a ring of 30-70 points was valid with H = 0 (its 10 nearest neighbours span 70-150 degrees of it: not on a
+    # straight line; its far side, a diameter away, was taken for the next scan line); a ring is a curve, and
+    # no surface through it is sampled
+    t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    rotation = np.linalg.qr(np.random.default_rng(n).normal(size=(3, 3)))[0]
+    points = np.stack([np.cos(t), np.sin(t), 0 * t], axis=1) @ rotation.T * 5.0
+    r = quiet(points, method=method)
+    assert not r.valid.any()
+    assert (r.invalid_reason == ON_A_LINE).all()
+
+
+def test_a_helix_and_a_noisy_ring_have_no_surface():
+    s = np.linspace(0.0, 6 * np.pi, 150)
+    assert not quiet(np.stack([np.cos(s), np.sin(s), 0.2 * s], axis=1)).valid.any()
+    rng = np.random.default_rng(2)
+    t = rng.uniform(0.0, 2 * np.pi, 50)
+    r = quiet(np.stack([np.cos(t), np.sin(t), 0.01 * rng.normal(size=50)], axis=1))
+    assert not r.valid.any()
+
+
+def test_the_curve_fit_tells_a_ring_from_a_surface():
+    from scipy.spatial import cKDTree
+
+    t = np.linspace(0.0, 2 * np.pi, 50, endpoint=False)
+    ring = np.stack([np.cos(t), np.sin(t), 0 * t], axis=1) * 2.0
+    _, indices = normals_module.knn(cKDTree(ring), ring)
+    spread, curvature = normals_module.curve_fits(ring, indices, np.arange(50))
+    assert spread.max() < normals_module.CURVE_SPREAD
+    np.testing.assert_allclose(curvature, 0.5, rtol=0.15)  # a circle of radius 2 (chord fits: within 15%)
+    rng = np.random.default_rng(1)
+    plane = np.concatenate([rng.random((2000, 2)), np.zeros((2000, 1))], axis=1)
+    _, indices = normals_module.knn(cKDTree(plane), plane)
+    assert normals_module.curve_fits(plane, indices, np.arange(2000))[0].min() > normals_module.CURVE_SPREAD
+
+
+def test_concentric_rings_sample_a_flat_disc():
+    # rings of radius 1 to 5, one apart (a turntable's scan of a disc): each ring's support is the next one, a
+    # gap no farther than the ring's radius: a surface, measured flat (H = 0 to round-off)
+    rings = []
+    for radius in (1.0, 2.0, 3.0, 4.0, 5.0):
+        t = np.linspace(0.0, 2 * np.pi, int(60 * radius), endpoint=False)
+        rings.append(np.stack([radius * np.cos(t), radius * np.sin(t), 0 * t], axis=1))
+    r = quiet(np.concatenate(rings))
+    assert r.valid.mean() > 0.95
+    assert np.abs(r.mean[r.valid]).max() < 1e-6

@@ -422,3 +422,49 @@ def test_a_cloud_whose_bulk_is_below_the_smallest_scale_is_refused_before_any_wo
     points[7] = (1e75, 0.0, 0.0)
     with pytest.raises(InvalidMeshError, match=r"90% of the coordinates are below 9.*e-126 .*rescale the points"):
         point_cloud_curvatures(points)
+
+
+def flat_ellipsoid_samples(n, axes, rng):
+    """``n`` samples (uniform by area) of the ellipsoid with these ``axes`` and their exact outward normals."""
+    u = rng.normal(size=(8 * n, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    weight = np.linalg.norm(u / axes, axis=1)
+    x = u[rng.random(u.shape[0]) < weight / weight.max()][:n] * axes
+    normal = x / axes**2
+    return x, normal / np.linalg.norm(normal, axis=1, keepdims=True)
+
+
+def test_a_plate_thinner_than_half_a_spacing_is_undecided_not_inward():
+    # fuzzer seed 42 case 973: a 1 x 1 x 0.02 ellipsoid of 400 points (faces 0.44 spacings apart) beside a sphere,
+    # noise of 0.05 spacings: 15 points of the plate valid with their normal inward. Its faces' points face the
+    # same way as the sheet stacked on theirs (one of the two is inside out), closer than the 0.45 spacings that
+    # noise of 0.2 spacings calls for; the noise measured here (0.03) lets 0.19 spacings count
+    rng = np.random.default_rng(973)
+    plate, plate_normals = flat_ellipsoid_samples(400, np.array([1.0, 1.0, 0.02]), rng)
+    plate += np.array([0.0, 3.0, 0.0])
+    ball = sphere(400, seed=5)
+    points = np.concatenate([ball, plate])
+    exact = np.concatenate([ball, plate_normals])
+    spacing = 0.09  # the plate's (both faces)
+    points += rng.uniform(-0.05, 0.05, (800, 1)) * spacing * exact
+    r = quiet(points)
+    assert not (r.valid & (np.einsum("ij,ij->i", r.normals, exact) < 0)).any()
+    undecided = next(
+        code for code, text in enumerate(INVALID_REASONS) if text.startswith("point cloud: side undecided")
+    )
+    assert (r.invalid_reason[400:] == undecided).mean() > 0.9  # the whole plate: its sides are a coin's toss
+    assert r.valid[:400].mean() > 0.9  # the sphere is measured
+    assert np.abs(r.mean[:400][r.valid[:400]] - 1.0).max() < 0.5
+
+
+def test_a_part_spaced_too_finely_for_products_of_four_lengths_is_left_out():
+    # mesh fuzzer seed 61 case 8724: a part spaced about 1e-144 beside one at 1e12; the winding number's cubed
+    # distances underflowed to 0 (RuntimeWarning: invalid value in divide) and the noise fit refused the cloud
+    # ("no coordinate larger than 1.05e-143") although its other part is measurable
+    tiny = sphere(500, radius=1e-140, seed=1)
+    big = sphere(500, centre=(3.0, 0.0, 0.0), seed=2)
+    with pytest.warns(MeshQualityWarning, match=r"500 points are spaced below 1e-74 \(products of four"):
+        r = point_cloud_curvatures(np.concatenate([tiny, big]))  # (a RuntimeWarning would fail: warnings are errors)
+    assert not r.valid[:500].any()
+    assert r.valid[500:].mean() > 0.9
+    assert np.abs(r.mean[500:][r.valid[500:]] - 1.0).max() < 0.5

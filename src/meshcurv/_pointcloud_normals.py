@@ -113,6 +113,26 @@ LINE_SUPPORT = 4
 #: lines (three lines or more in each ball).
 LINE_REACH = 2.0
 
+#: A point whose nearest neighbours spread across their main direction by up to this share of their spread along
+#: it (see :data:`LINE_SPREAD`) is checked for a curve: a lone ring of 30 to 70 points measures 0.30 to 0.13 (its
+#: neighbours span 70 to 150 degrees of it), a random sample of a surface 0.16 at the least, 0.70 typically ...
+CURVE_CANDIDATE = 0.35
+
+#: ... and its neighbours lie on a curve through it when their offsets across the main direction, less the best
+#: ``b t + c t^2`` (``t`` along it), spread by less than :data:`LINE_SPREAD` of their spread along it
+#: (:func:`curve_fits`): rings of 30, 50 and 200 points measure 0.034, 0.007 and 1e-4, random samples of a plane or a
+#: sphere (noisy or not) 0.17 at the least, 0.70 typically. Such a point is on a line (the scan line of a
+#: surface, or no surface) when the points beside its curve are not on it (see :func:`scan_lines`).
+CURVE_SPREAD = 0.1
+
+#: A line whose support beyond it (see :func:`scan_lines`) is farther than this many times its radius of
+#: curvature is not the scan line of a surface: a lone ring's only support is its own far side, a diameter
+#: (twice its radius) away, and no surface through the two is measured by them (a surface between two lines
+#: has no curvature across them to measure: three lines are needed, and a line that curves within the gap to
+#: the next does not sample the surface between). Lines of a scanned sphere measure 0.56 at the most (rings of
+#: latitude 0.2 apart, radius 0.36), concentric rings one gap apart 1 (the innermost).
+LINE_BEND = 1.5
+
 #: The winding number (see :func:`winding_sides`) is evaluated at this many points at most (all when fewer) ...
 WINDING_QUERIES = 8192
 
@@ -135,6 +155,15 @@ WINDING_ROUNDS = 3
 #: A neighbour is on a sheet stacked on a point's (see :func:`stacked_alike`) when each lies at least this many
 #: spacings off the other's tangent plane ...
 STACKED_ALIKE_OFFSET = 0.45
+
+#: ... or, with the noise level ``nu`` measured (in spacings, :func:`meshcurv.radius.cloud_noise_level`), at least
+#: :data:`ALIKE_NOISE` ``nu`` and :data:`ALIKE_MIN_OFFSET` spacings when that is less: two points of one sheet under
+#: uniform noise of ``a`` spacings (``nu`` about ``a / 2``, less where the fit absorbs some) differ by at most
+#: ``2 a`` along the normal (4 ``nu``: 599 false pairs on a torus under noise of 0.2 spacings; 6 leaves a margin),
+#: while the two faces of a plate thinner than :data:`STACKED_ALIKE_OFFSET` (0.44 spacings: 1 x 1 x 0.02 at 400
+#: points under noise of 0.05 spacings, a face left inward, valid) are stacked by their thickness ...
+ALIKE_NOISE = 6.0
+ALIKE_MIN_OFFSET = 0.15
 
 #: ... plus this many times its distance times the tilt of the point's normal (normals tilted by noise lift far
 #: neighbours off a tangent plane) ...
@@ -206,6 +235,51 @@ def _drop_self(rows, d, i, k, distances, indices) -> None:
     keep[np.arange(rows.size), first] = False
     distances[rows] = d[keep].reshape(-1, k)
     indices[rows] = i[keep].reshape(-1, k)
+
+
+def curve_fits(points: np.ndarray, indices: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(spread, curvature)``: (M,) how far the points ``rows`` and their neighbours ``indices[rows]`` lie from a
+    curve through each point, and (M,) that curve's curvature.
+
+    In the frame of the main direction ``e`` of each group (its covariance's
+    largest eigenvector), the offsets ``d`` from the point have ``t = d . e``
+    along and ``a = d - t e`` across; ``a`` is fitted by ``b t + c t^2``
+    (``b, c`` vectors, least squares). ``spread``: the root mean square of the
+    residuals over that of ``t`` (0 on a smooth curve, about 0.7 on a
+    random sample of a surface); ``curvature``: ``2 |c|`` over ``1 + |b|^2``
+    to the power 3/2 (the curvature of the fitted curve at the point).
+    """
+    spread, curvature = np.ones(rows.size), np.zeros(rows.size)
+    for start in range(0, rows.size, CHUNK // 4):
+        part = rows[start : start + CHUNK // 4]
+        offsets = points[indices[part]] - points[part][:, None, :]
+        scale = np.maximum(np.abs(offsets).max(axis=(1, 2)), np.finfo(float).tiny)  # each group in its own units
+        offsets = offsets / scale[:, None, None]
+        centred = offsets - offsets.mean(axis=1, keepdims=True)
+        _, vectors = np.linalg.eigh(np.einsum("mki,mkj->mij", centred, centred))
+        main = vectors[:, :, 2]
+        along = np.einsum("mkj,mj->mk", offsets, main)
+        across = offsets - along[..., None] * main[:, None, :]
+        basis = np.stack([along, along * along], axis=2)  # (M, k, 2)
+        gram = np.einsum("mki,mkj->mij", basis, basis)
+        determinant = gram[:, 0, 0] * gram[:, 1, 1] - gram[:, 0, 1] ** 2
+        fitted = determinant > 1e-12 * np.maximum(gram[:, 0, 0] * gram[:, 1, 1], np.finfo(float).tiny)
+        inverse = (
+            np.stack(
+                [np.stack([gram[:, 1, 1], -gram[:, 0, 1]], axis=1), np.stack([-gram[:, 1, 0], gram[:, 0, 0]], axis=1)],
+                axis=1,
+            )
+            / np.where(fitted, determinant, 1.0)[:, None, None]
+        )
+        coefficients = np.einsum("mij,mkj,mkl->mil", inverse, basis, across)  # (M, 2, 3): b and c
+        residual = across - np.einsum("mki,mil->mkl", basis, coefficients)
+        length = np.sqrt((along * along).mean(axis=1))
+        ratio = np.sqrt((residual * residual).sum(axis=2).mean(axis=1)) / np.maximum(length, np.finfo(float).tiny)
+        slope = (coefficients[:, 0, :] ** 2).sum(axis=1)
+        bend = 2.0 * np.linalg.norm(coefficients[:, 1, :], axis=1) / (1.0 + slope) ** 1.5 / scale
+        spread[start : start + part.size] = np.where(fitted & (length > 0), ratio, 1.0)
+        curvature[start : start + part.size] = np.where(fitted, bend, 0.0)
+    return spread, curvature
 
 
 def line_spread(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
@@ -300,32 +374,31 @@ def scan_lines(
     """
     n, k = indices.shape
     lonely = np.zeros(n, dtype=bool)
-    line = np.flatnonzero(usable & (line_spread(points, indices) < LINE_SPREAD))
+    spread = line_spread(points, indices)
+    line = np.flatnonzero(usable & (spread < LINE_SPREAD))
     empty = np.zeros(0, dtype=np.int64)
-    if line.size == 0 or n <= k + 1:
+    if n <= k + 1:
         return lonely, empty, np.zeros((0, k), dtype=np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3))
-    wide = min(LINE_NEIGHBOURS, n - 1)
+    # neighbourhoods on a curve that bends within them (a lone ring of 30 to 70 points): on a line too, but the
+    # curve comes back beside its straight line, and only points off the curve itself support a surface
+    candidates = np.flatnonzero(usable & (spread >= LINE_SPREAD) & (spread < CURVE_CANDIDATE))
+    curve = candidates[curve_fits(points, indices, candidates)[0] < CURVE_SPREAD] if candidates.size else empty
+    if line.size == 0 and curve.size == 0:
+        return lonely, empty, np.zeros((0, k), dtype=np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3))
+    if curve.size:
+        own = _curve_labels(indices, line, curve)
+        for start in range(0, curve.size, CHUNK // 4):
+            rows = curve[start : start + CHUNK // 4]
+            far, near, support, across = _line_support(points, distances, indices, usable, tree, rows, radius)
+            support &= own[near] != own[rows][:, None]
+            held = _surface_beside(support, across, curve_fits(points, indices, rows)[1])
+            lonely[rows[~held]] = True  # (held: points beside a bent scan line, measured as any other)
     found = []
+    wide = min(LINE_NEIGHBOURS, n - 1)
     for start in range(0, line.size, CHUNK // 4):
         rows = line[start : start + CHUNK // 4]
-        far, near = tree.query(points[rows], k=wide + 1, workers=-1)
-        far, near = far[:, 1:], near[:, 1:]  # (distinct points: each is its own nearest)
-        reach = distances[rows, -1]
-        direction = points[indices[rows, -1]] - points[rows]
-        direction /= np.maximum(np.linalg.norm(direction, axis=1), reach * 1e-12)[:, None]
-        offsets = points[near] - points[rows][:, None, :]
-        along = np.einsum("mkj,mj->mk", offsets, direction)
-        across = np.sqrt(np.maximum(np.einsum("mkj,mkj->mk", offsets, offsets) - along * along, 0.0))
-        support = (
-            usable[near]
-            & (np.abs(along) <= reach[:, None])
-            & (across > LINE_OFFSET * reach[:, None])
-            & (across <= LINE_FAR * reach[:, None])
-            & (near != rows[:, None])
-        )
-        if radius is not None:
-            support &= far < radius
-        held = support.sum(axis=1) >= LINE_SUPPORT
+        far, near, support, across = _line_support(points, distances, indices, usable, tree, rows, radius)
+        held = _surface_beside(support, across, curve_fits(points, indices, rows)[1])
         lonely[rows[~held]] = True
         rows, far, near, support, across = rows[held], far[held], near[held], support[held], across[held]
         if rows.size == 0:
@@ -345,6 +418,58 @@ def scan_lines(
         return lonely, empty, np.zeros((0, k), dtype=np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3))
     rows, neighbours, spacing, least, normals = (np.concatenate(parts) for parts in zip(*found))
     return lonely, rows, neighbours, spacing, least, normals
+
+
+def _line_support(points, distances, indices, usable, tree, rows, radius):
+    """``(far, near, support, across)`` of the line points ``rows`` (M,) (see :func:`scan_lines`): the distances
+    and indices (M, w) of their :data:`LINE_NEIGHBOURS` nearest, which of them support a surface beside the
+    line, and their distances from the line."""
+    wide = min(LINE_NEIGHBOURS, points.shape[0] - 1)
+    far, near = tree.query(points[rows], k=wide + 1, workers=-1)
+    far, near = far[:, 1:], near[:, 1:]  # (distinct points: each is its own nearest)
+    reach = distances[rows, -1]
+    direction = points[indices[rows, -1]] - points[rows]
+    direction /= np.maximum(np.linalg.norm(direction, axis=1), reach * 1e-12)[:, None]
+    offsets = points[near] - points[rows][:, None, :]
+    along = np.einsum("mkj,mj->mk", offsets, direction)
+    across = np.sqrt(np.maximum(np.einsum("mkj,mkj->mk", offsets, offsets) - along * along, 0.0))
+    support = (
+        usable[near]
+        & (np.abs(along) <= reach[:, None])
+        & (across > LINE_OFFSET * reach[:, None])
+        & (across <= LINE_FAR * reach[:, None])
+        & (near != rows[:, None])
+    )
+    if radius is not None:
+        support &= far < radius
+    return far, near, support, across
+
+
+def _surface_beside(support, across, curvature) -> np.ndarray:
+    """(M,) bool: lines with :data:`LINE_SUPPORT` points of ``support`` (M, w) or more, whose median distance
+    ``across`` (M, w) from the line is at most :data:`LINE_BEND` over the line's ``curvature`` (M,)."""
+    held = support.sum(axis=1) >= LINE_SUPPORT
+    gap = np.zeros(held.size)
+    if held.any():  # (the rows with support only: no median of nothing)
+        gap[held] = np.nanmedian(np.where(support[held], across[held], np.nan), axis=1)
+    return held & ~(gap * curvature > LINE_BEND)
+
+
+def _curve_labels(indices, line, curve) -> np.ndarray:
+    """(N,) the connected part of each point of ``line`` and ``curve`` along the edges of ``indices`` (N, k) between
+    two of them (the curve a point lies on, and its continuation); -1 elsewhere."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = indices.shape[0]
+    member = np.zeros(n, dtype=bool)
+    member[line] = member[curve] = True
+    rows = np.repeat(np.arange(n), indices.shape[1])
+    cols = indices.ravel()
+    keep = member[rows] & member[cols]
+    graph = coo_matrix((np.ones(int(keep.sum()), dtype=np.int8), (rows[keep], cols[keep])), shape=(n, n))
+    _, labels = connected_components(graph, directed=False)
+    return np.where(member, labels, -1)
 
 
 def local_spacing(distances: np.ndarray) -> np.ndarray:
@@ -1001,7 +1126,7 @@ def _nearest_queries(points, normals, usable, queries, rows, cols) -> np.ndarray
 
 
 def two_sheets(
-    points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree
+    points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree, noise: float | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(alike, interleaved)``: (N,) bool, points beside a second sheet whose side cannot be trusted.
 
@@ -1014,7 +1139,10 @@ def two_sheets(
     neighbours: one of the two sheets is inside out, and nothing local says
     which (a patch of a face turned with the other face is consistent with
     itself; the winding number at a point does not depend on its own normal).
-    Stacked sheets as :func:`_stacked` finds them.
+    Stacked sheets as :func:`_stacked` finds them, at least
+    :data:`STACKED_ALIKE_OFFSET` spacings apart, or, with the ``noise`` level
+    (in spacings) measured, :data:`ALIKE_NOISE` times it (and at least
+    :data:`ALIKE_MIN_OFFSET`) when that is less.
 
     ``interleaved``: points in a region where two sheets lie closer than
     :data:`STACKED_OFFSET` spacings (a part thinner than that, the rim of a
@@ -1038,12 +1166,17 @@ def two_sheets(
     if candidates.size <= INTERLEAVED_NEIGHBOURS:
         return alike, interleaved
     step = float(np.median(spacing[candidates]))
+    offset = STACKED_ALIKE_OFFSET
+    if noise is not None and np.isfinite(noise):
+        offset = min(STACKED_ALIKE_OFFSET, max(ALIKE_MIN_OFFSET, ALIKE_NOISE * noise))
     sample = _evenly(candidates, WINDING_QUERIES)
-    found = _sheet_signs(points, normals, usable, spacing, step, tree, sample)
+    found = _sheet_signs(points, normals, usable, spacing, step, tree, sample, offset=offset)
     if sample.size < candidates.size and (found[0].any() or found[3].mean() >= INTERLEAVED_SAMPLE):
         # every point (the stacked sheets' 48 neighbours only when the sample has any: a thin sheet of 1M
         # points costs about 20 us a point with them)
-        found = _sheet_signs(points, normals, usable, spacing, step, tree, candidates, with_alike=found[0].any())
+        found = _sheet_signs(
+            points, normals, usable, spacing, step, tree, candidates, with_alike=found[0].any(), offset=offset
+        )
         sample = candidates
     hit, near, flags, two = found
     alike[sample[hit]] = True
@@ -1058,7 +1191,18 @@ def two_sheets(
     return alike & usable, interleaved & usable
 
 
-def _sheet_signs(points, normals, usable, spacing, step, tree, queries, *, with_alike: bool = True):
+def _sheet_signs(
+    points,
+    normals,
+    usable,
+    spacing,
+    step,
+    tree,
+    queries,
+    *,
+    with_alike: bool = True,
+    offset: float = STACKED_ALIKE_OFFSET,
+):
     """``(hit, near, alike, two)`` of :func:`two_sheets` at ``queries`` (M,), in chunks of :data:`CHUNK`.
 
     ``hit`` (M,): stacked neighbours oriented alike; ``near`` (M, k): the
@@ -1077,7 +1221,7 @@ def _sheet_signs(points, normals, usable, spacing, step, tree, queries, *, with_
         _, ball = tree.query(points[q], k=k, workers=-1)
         near[rows] = ball
         if with_alike:
-            alike = _stacked(points, normals, usable, step, q, ball, alike=True)
+            alike = _stacked(points, normals, usable, step, q, ball, alike=True, offset=offset)
             hit[rows] = alike.sum(axis=1) >= STACKED_ALIKE_MIN
             flags[rows] = alike
         group = ball[:, : INTERLEAVED_NEIGHBOURS + 1]
@@ -1087,7 +1231,7 @@ def _sheet_signs(points, normals, usable, spacing, step, tree, queries, *, with_
     return hit, near, flags, two
 
 
-def _stacked(points, normals, usable, step, queries, near, *, alike: bool):
+def _stacked(points, normals, usable, step, queries, near, *, alike: bool, offset: float = STACKED_ALIKE_OFFSET):
     """(M, k) bool: the neighbours ``near`` (M, k) of ``queries`` (M,) on a sheet stacked on theirs.
 
     Each of the two points at least :data:`STACKED_ALIKE_OFFSET` times ``step``
@@ -1110,7 +1254,7 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool):
             np.ascontiguousarray(queries),
             np.ascontiguousarray(near),
             min(GRAPH_NEIGHBOURS, near.shape[1] - 1),
-            STACKED_ALIKE_OFFSET * step,
+            offset * step,
             STACKED_ALIKE_TILT,
             FACING_COSINE,
             alike,
@@ -1123,7 +1267,7 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool):
     tilt = np.median(
         np.arccos(np.minimum(np.abs(np.einsum("mj,mkj->mk", normals[queries], normals[ring])), 1.0)), axis=1
     )
-    reach = STACKED_ALIKE_OFFSET * step + STACKED_ALIKE_TILT * tilt[:, None] * np.linalg.norm(offsets, axis=2)
+    reach = offset * step + STACKED_ALIKE_TILT * tilt[:, None] * np.linalg.norm(offsets, axis=2)
     sides = (
         (cosine >= FACING_COSINE) & (ahead * behind > 0) if alike else (cosine <= -FACING_COSINE) & (ahead * behind < 0)
     )

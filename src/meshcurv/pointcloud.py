@@ -137,11 +137,19 @@ OUTLIER_FACTOR = 10.0
 #: percentile of the (neighbour-averaged) local spacing exceeds this many times the 5th.
 UNEVEN_DENSITY = 2.0
 
-#: Points whose local spacing is at most this are left out (NaN): the k-d tree's squared distances
-#: underflow float64 below about 1.5e-154 (the square root of the smallest normal number, 2.2e-308)
-#: and read as 0, and the fits would divide by a radius of 0. A part of a cloud at 1e-200 beside
-#: a part at 1 cannot be measured in float64; a cloud all at 1e-200 is refused as for meshes.
-MIN_SPACING = 1e-150
+#: A part of the cloud whose points are this share or more beside a sheet stacked on theirs with normals the same
+#: way (:func:`meshcurv._pointcloud_normals.two_sheets`, alike: one of the two is inside out) cannot be told apart
+#: from its other face anywhere: every point's side is undecided (a plate 1 x 1 x 0.02 at 400 points: 89%; the
+#: clean 3 x 3 x 0.15 ellipsoid at 8,000 points, inward by its rim: 18%).
+ALIKE_PART_SHARE = 0.5
+
+#: Points whose local spacing is at most this are left out (NaN): the estimators form products of up to four
+#: lengths of the order of the spacing (squared areas of triangles; the cubed distances of the winding number,
+#: which read 0 below about 1e-103 and gave 0 / 0), which underflow float64's smallest normal number (2.2e-308)
+#: below about 1e-77; ten times :data:`meshcurv._validation.MIN_COORDINATE`, so that the points kept have a
+#: coordinate above it (the ball checks refuse a cloud without one). A part of a cloud at 1e-100 beside a part
+#: at 1 cannot be measured in float64; a cloud all at 1e-200 is refused as for meshes.
+MIN_SPACING = 10.0 * MIN_COORDINATE
 
 #: Bits per coordinate of the Morton code that orders the points (3 x 21 bits fill 63 of a uint64).
 MORTON_BITS = 21
@@ -602,15 +610,15 @@ def _compute(points, given, radius, method, search=None):
     measurable = spacing > MIN_SPACING
     if not measurable.any():
         raise InvalidMeshError(
-            f"`points` are spaced below {MIN_SPACING:.0e} everywhere: their squared distances underflow "
+            f"`points` are spaced below {MIN_SPACING:.0e} everywhere: products of four such lengths underflow "
             "float64; rescale the points"
         )
     median = float(np.median(spacing[measurable]))
     usable = measurable & (spacing <= OUTLIER_FACTOR * median)
     if not measurable.all():
         problems.append(
-            f"{int((~measurable).sum())} points are spaced below {MIN_SPACING:.0e} (their squared "
-            "distances underflow float64): left out, NaN"
+            f"{int((~measurable).sum())} points are spaced below {MIN_SPACING:.0e} (products of four such "
+            "lengths underflow float64): left out, NaN"
         )
     if not (usable | ~measurable).all():
         problems.append(
@@ -625,8 +633,9 @@ def _compute(points, given, radius, method, search=None):
     )
     if lonely.any():
         problems.append(
-            f"{int(lonely.sum())} points lie on a line (their nearest neighbours on a line, fewer than "
-            f"{_normals.LINE_SUPPORT} points beside it within their reach): no surface there, NaN"
+            f"{int(lonely.sum())} points lie on a line (their nearest neighbours on a line or a curve, fewer than "
+            f"{_normals.LINE_SUPPORT} points beside it within their reach, or only points beyond "
+            f"{_normals.LINE_BEND:g} times its radius of curvature: a lone ring's far side): no surface there, NaN"
         )
         usable &= ~lonely
     if line.size:
@@ -833,12 +842,13 @@ def _compute(points, given, radius, method, search=None):
         logger.info("point cloud: stacked sheets")
         # a sheet stacked on another with normals the same way (one of the two is inside out), and two sheets
         # closer than the spacing, whose points mix (the faces of a part thinner than that)
-        alike, interleaved = _normals.two_sheets(points, out_normals, usable, spacing, tree)
-        # a part whose faces mix over a good share of it is thinner than the spacing: its sides are a coin's toss
-        share = np.bincount(labels, weights=interleaved, minlength=int(labels.max()) + 1) / np.maximum(
-            np.bincount(labels, weights=usable, minlength=int(labels.max()) + 1), 1.0
-        )
-        interleaved |= usable & (share[labels] >= THIN_PART_SHARE)
+        alike, interleaved = _normals.two_sheets(points, out_normals, usable, spacing, tree, noise=noise)
+        # a part whose faces mix over a good share of it, or face the same way over most of it, is thinner than
+        # the spacing: its sides are a coin's toss
+        count = np.maximum(np.bincount(labels, weights=usable, minlength=int(labels.max()) + 1), 1.0)
+        share = np.bincount(labels, weights=interleaved, minlength=count.size) / count
+        alike_share = np.bincount(labels, weights=alike, minlength=count.size) / count
+        interleaved |= usable & ((share[labels] >= THIN_PART_SHARE) | (alike_share[labels] >= ALIKE_PART_SHARE))
         doubtful = doubtful | alike | interleaved
     reason = np.zeros(n, dtype=np.int8)
     reason[~one_sided | (two_sided_mask & usable)] = _TWO_SIDED
