@@ -36,6 +36,7 @@ RING_STAGES = (
     ("matgeom kernel: smoothing, eigenvectors", "meshcurv._kernels.matgeom", "matgeom_finish"),
     ("matgeom: pairing (open meshes)", "meshcurv.estimators.matgeom", "matgeom_pairing"),
     ("topology: bow-tie walks (twin sides)", "meshcurv._kernels.topology", "bowtie_from_twins"),
+    ("topology: bow-tie walks (twin sides)", "meshcurv._kernels.topology", "bowtie_walks"),
     ("topology: degenerate_faces", "meshcurv.topology", "MeshTopology.degenerate_faces"),
     ("topology: interior_edges", "meshcurv.topology", "MeshTopology.interior_edges"),
     ("validate faces: triangles", "meshcurv._validation", "checked_triangles"),

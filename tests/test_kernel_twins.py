@@ -1652,6 +1652,24 @@ def check_edge_weights(name):
     assert expected[0].any() and (~expected[0] & ~flat).any()
 
 
+def check_kept_rows(name):
+    from meshcurv.pointcloud import _kept_rows
+
+    points, _ = cloud(name)
+    indices = knn_indices(points)
+    distances = np.linalg.norm(points[indices] - points[:, None, :], axis=2)
+    n = points.shape[0]
+    for keep in (np.ones(n, dtype=bool), np.random.default_rng(19).random(n) > 0.01, np.arange(n) >= 5):
+        expected = _kept_rows(distances, indices, keep)
+        got_distances, got_indices = distances.copy(), indices.copy()
+        m, again = kernels("pointcloud").kept_rows(got_distances, got_indices, keep)  # (in place)
+        assert m == keep.sum()
+        np.testing.assert_array_equal(got_distances[:m], expected[0])
+        np.testing.assert_array_equal(got_indices[:m], expected[1])
+        np.testing.assert_array_equal(np.flatnonzero(again), expected[2])
+        assert keep.all() or expected[2].size  # rows that held a point gone
+
+
 def check_far_winding(name):
     """The winding numbers of an oriented cloud with the far sum compiled and in NumPy (the same terms)."""
     from scipy.spatial import cKDTree
@@ -1946,6 +1964,7 @@ TWINS = [
     Twin("pointcloud.edge_geometry", "the products of _pointcloud_normals.oriented_signs", check_edge_geometry, CLOUDS),
     Twin("pointcloud.graph_edges", "_pointcloud_normals._graph_geometry", check_graph_edges, CLOUDS),
     Twin("pointcloud.edge_weights", "_pointcloud_normals._edge_weights", check_edge_weights, CLOUDS),
+    Twin("pointcloud.kept_rows", "pointcloud._kept_rows", check_kept_rows, CLOUDS),
     Twin("pointcloud.own_side", "_pointcloud_estimators._own_side", check_own_side, CLOUDS),
     Twin("pointcloud.line_spread", "_pointcloud_normals._line_spread_numpy", check_line_spread, CLOUDS),
     Twin("pointcloud.flat_balls", "_pointcloud_estimators._flat_balls", check_flat_balls, CLOUDS),
@@ -1963,6 +1982,8 @@ EXCEPTIONS: dict[str, str] = {
     "topology.bowtie_from_twins": "tests/test_topology.py::test_bowtie_vertices_from_the_twin_sides_are_those_of_the_"
     "definition: against the NumPy definition on random defective spheres",
     "topology.double_sided_suspects": "tests/test_weld_suspects.py: against weld._suspect_edges's NumPy path",
+    "topology.bowtie_walks": "the body of topology.bowtie_from_twins (its row above), which calls it; from the "
+    "build's corner counts: tests/test_topology.py::test_bowtie_vertices_from_the_twin_sides_are_those_of_the_definition",
     "matgeom.matgeom_vertex_sums": "the body of matgeom.matgeom_vertex_tensors (its row above), which calls it; its "
     "zero-area faces: tests/test_topology.py::test_the_zero_area_faces_a_kernel_found_are_kept",
 }

@@ -234,6 +234,32 @@ def test_bowtie_vertices_from_the_twin_sides_are_those_of_the_definition(seed):
         assert MeshTopology.from_faces(faces, n_vertices)._side_twins is None
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_the_builds_corner_counts_give_the_bowties_and_referenced_vertices_of_the_definitions(seed):
+    """The compiled build's first pass (corners of faces without a repeated corner, the first side leaving each
+    vertex) gives what bowtie_from_twins counts itself, and the referenced vertices of faces.ravel()."""
+    pytest.importorskip("numba")
+    from meshcurv._backend import use_backend
+    from meshcurv._kernels import topology as kernels_topology
+
+    faces = _defective_faces(seed)
+    lone = int(faces.max()) + 1
+    faces = np.vstack([faces, [[lone, lone, 7]]])  # a vertex only in a face with a repeated corner
+    n_vertices = lone + 2  # and one unreferenced vertex
+    with use_backend("numba"):
+        top = MeshTopology.from_faces(faces, n_vertices)
+        referenced, bowties = top.referenced_vertices, top.bowtie_vertices
+    assert top._first_sides is not None and top._first_sides[lone] == -2 and top._first_sides[-1] == -1
+    np.testing.assert_array_equal(
+        bowties, kernels_topology.bowtie_from_twins(top.faces, top._side_twins, top.n_vertices)
+    )
+    used = np.zeros(n_vertices, dtype=bool)
+    used[faces.ravel()] = True
+    np.testing.assert_array_equal(referenced, used)
+    proper = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 2] != faces[:, 0])
+    np.testing.assert_array_equal(top._corner_counts, np.bincount(faces[proper].ravel(), minlength=n_vertices))
+
+
 def test_twin_sides_pair_the_two_sides_of_each_edge_of_two_faces():
     pytest.importorskip("numba")
     from meshcurv._backend import use_backend

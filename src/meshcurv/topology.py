@@ -128,6 +128,11 @@ class MeshTopology:
     #: (3 F,) the other side ``3 g + j`` of the edge of each side ``3 f + k`` where the edge joins exactly two
     #: faces, -1 elsewhere (``_kernels.topology.build_edges_into``); None when not built (the NumPy path)
     _side_twins: np.ndarray | None = field(default=None, repr=False)
+    #: (V,) corners of the faces without a repeated corner at each vertex, and (V,) the side leaving each vertex of
+    #: its first such face (-1: unreferenced, -2: only in faces with a repeated corner), from the compiled build's
+    #: first pass (``_kernels.topology.build_edges_into``); None on the NumPy path
+    _corner_counts: np.ndarray | None = field(default=None, repr=False)
+    _first_sides: np.ndarray | None = field(default=None, repr=False)
 
     @classmethod
     def from_faces(cls, faces, n_vertices: int | None = None) -> MeshTopology:
@@ -176,9 +181,9 @@ class MeshTopology:
     def _build(cls, faces: np.ndarray, n_vertices: int) -> MeshTopology:
         """Build from already validated int64 (F, 3) triangles."""
         kernels = numba_kernels("topology")
-        twins = None
+        twins = corners = first = None
         if kernels is not None:
-            edges, face_edges, edge_faces, counts, forward_counts, twins = kernels.build_topology(
+            edges, face_edges, edge_faces, counts, forward_counts, twins, corners, first = kernels.build_topology(
                 faces, n_vertices, _bucket_template(n_vertices, faces.shape[0]), True
             )
         else:
@@ -195,6 +200,8 @@ class MeshTopology:
             edge_face_counts=_readonly(counts),
             _edge_forward_counts=_readonly(forward_counts),
             _side_twins=None if twins is None else _readonly(twins),
+            _corner_counts=None if corners is None else _readonly(corners),
+            _first_sides=None if first is None else _readonly(first),
         )
 
     # -- sizes ------------------------------------------------------------------
@@ -234,6 +241,8 @@ class MeshTopology:
     @cached_property
     def referenced_vertices(self) -> np.ndarray:
         """(V,) bool: vertices used by at least one face."""
+        if self._first_sides is not None:  # found by the compiled build
+            return _readonly(self._first_sides != -1)
         used = np.zeros(self.n_vertices, dtype=bool)
         used[self.faces.ravel()] = True
         return _readonly(used)
@@ -270,6 +279,8 @@ class MeshTopology:
         kernels = numba_kernels("topology")
         if kernels is None:
             return _readonly(_bowtie_vertices(self))
+        if self._side_twins is not None and self._first_sides is not None and self._corner_counts is not None:
+            return _readonly(kernels.bowtie_walks(self._side_twins, self._first_sides, self._corner_counts))
         if self._side_twins is not None:
             return _readonly(kernels.bowtie_from_twins(self.faces, self._side_twins, self.n_vertices))
         linked = (self.edge_face_counts == 2) & (self.edge_faces[:, 0] != self.edge_faces[:, 1])

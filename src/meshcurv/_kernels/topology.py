@@ -42,14 +42,15 @@ def _bucket_starts(cursor):
 def build_edges(faces, n_vertices, template):
     """Edges of the triangles, their faces and counts (see MeshTopology._build): :func:`build_topology`
     without the twins of the sides, ``(edges, face_edges, edge_faces, counts, forward)``."""
-    edges, face_edges, edge_faces, counts, forward, _ = build_topology(faces, n_vertices, template, False)
+    edges, face_edges, edge_faces, counts, forward, _, _, _ = build_topology(faces, n_vertices, template, False)
     return edges, face_edges, edge_faces, counts, forward
 
 
 @nb.njit(**_JIT)
 def build_topology(faces, n_vertices, template, with_twins):
     """:func:`build_edges_into` on arrays allocated here: ``(edges, face_edges, edge_faces, counts, forward,
-    twins)``, all in the integer type of ``template``, the twins only when ``with_twins`` (else an empty array)."""
+    twins, corners, first)``, all in the integer type of ``template``; the last three only when ``with_twins``
+    (else empty arrays)."""
     n_faces = faces.shape[0]
     index = template.dtype
     face_edges = np.empty(3 * n_faces, index)
@@ -58,7 +59,11 @@ def build_topology(faces, n_vertices, template, with_twins):
     counts = np.empty(3 * n_faces, index)
     forward = np.empty(3 * n_faces, index)
     twins = np.empty(3 * n_faces if with_twins else 0, index)
-    n_edges = build_edges_into(faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins)
+    corners = np.zeros(n_vertices if with_twins else 0, index)
+    first = np.full(n_vertices if with_twins else 0, -1, index)
+    n_edges = build_edges_into(
+        faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins, corners, first
+    )
     return (
         edges[:n_edges],
         face_edges.reshape(n_faces, 3),
@@ -66,11 +71,15 @@ def build_topology(faces, n_vertices, template, with_twins):
         counts[:n_edges],
         forward[:n_edges],
         twins,
+        corners,
+        first,
     )
 
 
 @nb.njit(**_JIT)
-def build_edges_into(faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins):
+def build_edges_into(
+    faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins, corners, first
+):
     """Edges of the triangles, their faces and counts, written into the given arrays; returns their number E.
 
     ``face_edges`` (3 F,) receives the edge of each side (-1 for a side from a
@@ -82,6 +91,12 @@ def build_edges_into(faces, n_vertices, template, face_edges, edges, edge_faces,
     edges that join two fans' faces, see :func:`bowtie_from_twins`): ``t``
     where the two sides run the edge both ways, ``-2 - t`` where they run it
     the same way (inconsistently wound faces); -1 for the other sides.
+    With the twins, ``corners`` and ``first`` (V,), zeros and -1 on entry,
+    receive in the first pass over the faces what :func:`bowtie_walks` needs
+    (the corners of the faces without a repeated corner at each vertex, the
+    side leaving each vertex of its first such face) and what
+    ``MeshTopology.referenced_vertices`` reads: ``first`` is -2 at a vertex
+    whose faces all repeat a corner, -1 at an unreferenced vertex.
 
     Sides are bucketed by their smaller vertex (a counting sort: one pass
     counts, one places, each in face order), each bucket is sorted by (larger
@@ -98,9 +113,17 @@ def build_edges_into(faces, n_vertices, template, face_edges, edges, edge_faces,
     with_twins = twins.shape[0] > 0
     bucket_start = np.zeros(n_vertices + 1, template.dtype)
     for f in range(n_faces):
+        proper = faces[f, 0] != faces[f, 1] and faces[f, 1] != faces[f, 2] and faces[f, 2] != faces[f, 0]
         for k in range(3):
             a = faces[f, k]
             b = faces[f, (k + 1) % 3]
+            if with_twins:
+                if proper:
+                    corners[a] += 1
+                    if first[a] < 0:
+                        first[a] = 3 * f + k
+                elif first[a] == -1:
+                    first[a] = -2
             if a != b:
                 bucket_start[min(a, b) + 1] += 1
             else:  # a side from a vertex to itself: no edge
@@ -285,7 +308,7 @@ def _twin_walk(twins, side, leaving):
             side = t + 2 if k < 1 else t - 1
 
 
-@nb.njit(parallel=True, **_JIT)
+@nb.njit(**_JIT)
 def bowtie_from_twins(faces, twins, n_vertices):
     """:func:`bowtie_vertices` from the twins of the sides (:func:`build_edges_into`), the same vertices.
 
@@ -293,7 +316,8 @@ def bowtie_from_twins(faces, twins, n_vertices):
     different ones; a face with a repeated corner never has one: each of its
     edges has two of its own sides), so the walk crosses to the twin's face
     without looking up edges. One pass over the faces counts the corners of
-    the faces without a repeated corner; the walks run in parallel.
+    the faces without a repeated corner (the pass :func:`build_edges_into`
+    makes along with its own), then :func:`bowtie_walks`.
     """
     n_faces = faces.shape[0]
     corners = np.zeros(n_vertices, np.int64)
@@ -306,6 +330,15 @@ def bowtie_from_twins(faces, twins, n_vertices):
                 corners[v] += 1
                 if first[v] < 0:
                     first[v] = 3 * f + k
+    return bowtie_walks(twins, first, corners)
+
+
+@nb.njit(parallel=True, **_JIT)
+def bowtie_walks(twins, first, corners):
+    """(V,) bool: the vertices whose fan, walked from the side ``first[v]`` (a side leaving ``v`` of its first
+    face without a repeated corner; negative: none) over the ``twins``, reaches fewer than its ``corners[v]``
+    corners (see :func:`bowtie_from_twins`). The walks run in parallel, one vertex each."""
+    n_vertices = first.shape[0]
     several = np.zeros(n_vertices, np.bool_)
     for v in nb.prange(n_vertices):
         several[v] = _several_fans(twins, first[v], corners[v])
