@@ -56,3 +56,25 @@ def test_a_twin_keeps_its_name_and_documentation():
     assert _geometry.face_cross_products.__name__ == "face_cross_products"
     assert "cross(b - a, c - a)" in _geometry.face_cross_products.__doc__
     assert TWINS["geometry.face_cross_products"] is _geometry.face_cross_products.numpy
+
+
+def test_a_twin_hands_its_kernel_every_argument_by_position_with_the_defaults(monkeypatch):
+    pytest.importorskip("numba")
+    from meshcurv._backend import numba_kernels
+
+    monkeypatch.setattr(_backend, "TWINS", dict(TWINS))
+
+    @twin("tensors")
+    def principal_from_shape_operator(tensor, normals, *, rotate=False, mean_from_trace=False):
+        return "the NumPy body"
+
+    rng = np.random.default_rng(3)
+    tensor = rng.standard_normal((50, 6))
+    normals = rng.standard_normal((50, 3))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    with use_backend("numba"):
+        kernel = numba_kernels("tensors").principal_from_shape_operator
+        for given, positional in (({}, (False, False)), ({"rotate": True}, (True, False))):
+            got = principal_from_shape_operator(tensor, normals, **given)
+            for a, b in zip(got, kernel(tensor, normals, *positional)):
+                np.testing.assert_array_equal(a, b)

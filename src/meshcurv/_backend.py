@@ -64,6 +64,7 @@ import contextlib
 import contextvars
 import functools
 import importlib
+import inspect
 import logging
 import os
 import sys
@@ -184,8 +185,10 @@ TWINS: dict[str, Callable] = {}
 def twin(module: str) -> Callable[[_F], _F]:
     """Decorator: the NumPy function is the twin of the kernel of the same name in ``meshcurv._kernels.<module>``.
 
-    The kernel takes the same arguments and returns the same result (to the
-    bit, or within the tolerance ``tests/test_kernel_twins.py`` states). The
+    The kernel takes the same arguments, in the same order (keyword-only
+    ones too: the kernel gets them all by position, defaults filled in), and
+    returns the same result (to the bit, or within the tolerance
+    ``tests/test_kernel_twins.py`` states). The
     decorated function runs the kernel when the compiled backend is to be used
     (:func:`numba_kernels`), its own NumPy body otherwise; the body stays
     reachable as ``function.numpy``, the reference the kernel is tested
@@ -205,13 +208,17 @@ def twin(module: str) -> Callable[[_F], _F]:
     def register(function: _F) -> _F:
         name = function.__name__
         TWINS[f"{module}.{name}"] = function
+        signature = inspect.signature(function)
 
         @functools.wraps(function)
         def dispatch(*args, **kwargs):
             kernels = numba_kernels(module)
             if kernels is None:
                 return function(*args, **kwargs)
-            return getattr(kernels, name)(*args, **kwargs)
+            # the kernel takes every argument by position, in the order of the NumPy function's (defaults filled)
+            bound = signature.bind(*args, **kwargs)
+            bound.apply_defaults()
+            return getattr(kernels, name)(*bound.arguments.values())
 
         dispatch.numpy = function  # type: ignore[attr-defined]
         return dispatch  # type: ignore[return-value]

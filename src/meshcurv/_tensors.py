@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import twin
 
 __all__ = ["outer6", "apply6", "tangent_basis", "principal_from_shape_operator", "principal_from_mean_gaussian"]
 
@@ -60,6 +60,7 @@ def tangent_basis(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return t1, t2
 
 
+@twin("tensors")
 def principal_from_shape_operator(
     tensor: np.ndarray, normals: np.ndarray, *, rotate: bool = False, mean_from_trace: bool = False
 ):
@@ -92,9 +93,6 @@ def principal_from_shape_operator(
     k_min, k_max : ndarray of shape (N,)
     dir_min, dir_max : ndarray of shape (N, 3)
     """
-    kernels = numba_kernels("tensors")
-    if kernels is not None:
-        return kernels.principal_from_shape_operator(tensor, normals, rotate, mean_from_trace)
     t1, t2 = tangent_basis(normals)
     s1 = apply6(tensor, t1)
     a = np.einsum("ij,ij->i", t1, s1)
