@@ -258,6 +258,11 @@ def test_the_builds_corner_counts_give_the_bowties_and_referenced_vertices_of_th
     np.testing.assert_array_equal(referenced, used)
     proper = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 2] != faces[:, 0])
     np.testing.assert_array_equal(top._corner_counts, np.bincount(faces[proper].ravel(), minlength=n_vertices))
+    np.testing.assert_array_equal(top.degenerate_faces, ~proper)
+    with use_backend("numba"):  # no face with a repeated corner: the build's counts say so
+        clean = MeshTopology.from_faces(shapes.icosphere(3).faces)
+    assert clean._corner_counts is not None and not clean.degenerate_faces.any()
+    assert clean.degenerate_faces.shape == (clean.n_faces,)
 
 
 def test_twin_sides_pair_the_two_sides_of_each_edge_of_two_faces():

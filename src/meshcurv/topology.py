@@ -293,6 +293,8 @@ class MeshTopology:
     @cached_property
     def degenerate_faces(self) -> np.ndarray:
         """(F,) bool: faces that repeat a vertex index (no area whatever the positions)."""
+        if self._corner_counts is not None and int(self._corner_counts.sum()) == 3 * self.n_faces:
+            return _readonly(np.zeros(self.n_faces, dtype=bool))  # the build counted three corners for every face
         f = self.faces
         return _readonly((f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0]))
 
