@@ -763,7 +763,7 @@ def oriented_signs(
         (:func:`winding_sides`).
     """
     n = points.shape[0]
-    graph = np.ascontiguousarray(indices[:, :GRAPH_NEIGHBOURS])
+    graph = indices[:, :GRAPH_NEIGHBOURS]  # (a view: the kernel reads it in place)
     compiled = numba_kernels("pointcloud")
     if compiled is not None:  # the edges and their products in one pass on every core, without (E, 3) gathers
         rows, cols, kept, ahead, behind, cosine, slope = compiled.graph_edges(points, normals, graph, usable)

@@ -616,6 +616,36 @@ def nearest_neighbours(points, k, reach, pool_points, ids, grid, n_chunks):
     return distances, indices, exact
 
 
+@nb.njit(**_JIT)
+def kept_rows(distances, indices, keep):
+    """The nearest neighbours ``distances, indices`` (N, k) of the points ``keep`` (N,) renumbered among them, in
+    place: ``(m, again)``, the kept rows the first ``m`` (in order), and (m,) the rows that held a point not kept.
+
+    The compiled :func:`meshcurv.pointcloud._kept_rows` (the index of a point not kept is that of the last kept
+    point before it, as ``cumsum(keep) - 1`` gives; those rows are for the caller to search again): one pass
+    without (N, k) copies. Each row moves up (to its kept rank, at most its own), after it was read.
+    """
+    n, k = indices.shape
+    position = np.zeros(n, dtype=np.int64)
+    m = 0
+    for i in range(n):
+        if keep[i]:
+            m += 1
+        position[i] = m - 1
+    again = np.zeros(m, dtype=np.bool_)
+    for i in range(n):
+        if not keep[i]:
+            continue
+        row = position[i]
+        for j in range(k):
+            q = indices[i, j]
+            if not keep[q]:
+                again[row] = True
+            distances[row, j] = distances[i, j]
+            indices[row, j] = position[q]
+    return m, again
+
+
 @nb.njit(parallel=True, **_JIT)
 def neighbour_differences(k_min, k_max, indices, valid, spacing, flat_turn, n_chunks):
     """(N,) the median over the neighbours ``indices`` (N, k) of a ``valid`` point of how far their principal
