@@ -1914,7 +1914,7 @@ TWINS = [
     Twin("smoothing.smooth_over_neighbours", "smoothing.smooth_vertex_field", check_smooth_over_neighbours, MESHES),
     Twin("icc.face_measures", "icc.face_measures", check_face_measures, MESHES),
     Twin("icc.curvatures_from_measures", "icc.curvatures_from_measures", check_curvatures_from_measures, MESHES),
-    Twin("locality.reordering", "_locality.reordering's NumPy path", check_reordering, MESHES),
+    Twin("locality.morton_reordering", "_locality.morton_reordering", check_reordering, MESHES),
     Twin(
         "neighborhoods.vertex_face_lists",
         "a stable sort of the corners (no twin in the library)",

@@ -31,7 +31,7 @@ import logging
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import twin
 from .topology import MeshTopology, as_topology
 
 logger = logging.getLogger(__name__)
@@ -110,23 +110,29 @@ def reordering(vertices: np.ndarray, faces: np.ndarray) -> Reordering | None:
     if not np.isfinite(extent):
         return None
     scale = (2**_BITS - 1) / extent if extent > 0 else 0.0
-    kernels = numba_kernels("locality")
-    if kernels is not None:
-        return Reordering(*kernels.reordering(vertices, faces, lo, scale, _BITS, np.array(_SPREAD, dtype=np.uint64)))
+    return Reordering(*morton_reordering(vertices, faces, lo, scale, _BITS, np.array(_SPREAD, dtype=np.uint64)))
+
+
+@twin("locality")
+def morton_reordering(
+    vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, scale: float, bits: int, spread: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The fields of :class:`Reordering`: the vertices in the order of their Morton codes (``bits`` bits
+    per axis of ``(x - lo) * scale``, spread to every third bit by the (steps, 2) uint64 ``(shift, mask)``
+    rows of ``spread``; stable), the faces renumbered and sorted by their smallest new corner (stable)."""
+    n = vertices.shape[0]
     codes = np.zeros(n, dtype=np.uint64)
     for axis in range(3):
-        x = ((vertices[:, axis] - lo[axis]) * scale).astype(np.uint64) & np.uint64(2**_BITS - 1)
-        for shift, mask in _SPREAD:
-            x = (x | (x << np.uint64(shift))) & np.uint64(mask)
+        x = ((vertices[:, axis] - lo[axis]) * scale).astype(np.uint64) & np.uint64(2**bits - 1)
+        for shift, mask in spread:
+            x = (x | (x << shift)) & mask
         codes |= x << np.uint64(axis)
     order = np.argsort(codes, kind="stable")
     index = np.empty_like(order)
     index[order] = np.arange(n)
     renumbered = index[faces]
     face_order = np.argsort(renumbered.min(axis=1), kind="stable")
-    return Reordering(
-        order, index, face_order, np.take(vertices, order, axis=0), np.take(renumbered, face_order, axis=0)
-    )
+    return order, index, face_order, np.take(vertices, order, axis=0), np.take(renumbered, face_order, axis=0)
 
 
 def local_topology(

@@ -10,8 +10,8 @@ from .topology import _bucket_starts
 
 
 @nb.njit(parallel=True, **_JIT)
-def reordering(vertices, faces, lo, scale, bits, spread):
-    """``_locality.reordering``: ``(order, index, face_order, new_vertices, new_faces)``.
+def morton_reordering(vertices, faces, lo, scale, bits, spread):
+    """``_locality.morton_reordering``: ``(order, index, face_order, new_vertices, new_faces)``.
 
     The vertices in the order of their Morton codes (``bits`` bits per axis of
     ``(x - lo) * scale``, spread to every third bit by the (steps, 2) uint64
