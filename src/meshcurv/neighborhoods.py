@@ -83,6 +83,12 @@ SAMPLE_POINTS = 8192
 #: by at most this factor over that of their smallest size class.
 GROUP_GROWTH = 1.5
 
+#: Surface-connected balls of more faces than this (on average) are summed over clusters of faces
+#: (:func:`_face_clusters`), each cluster inside a ball added as one precomputed sum ...
+CLUSTER_MIN_FACES = 800
+#: ... of about this many faces each.
+CLUSTER_FACES = 16
+
 
 def _sample(n: int, size: int) -> np.ndarray:
     """``size`` indices evenly spread over ``range(n)`` (all of them when n <= size): deterministic."""
@@ -826,43 +832,131 @@ def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int, nested: bool
 
 
 def _connected_face_sums(
-    kernels, vertices: np.ndarray, faces: np.ndarray, radii: np.ndarray, values: np.ndarray, usable: np.ndarray | None
+    kernels,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    radii: np.ndarray,
+    values: np.ndarray,
+    usable: np.ndarray | None,
+    n_centres: int | None = None,
 ) -> np.ndarray:
     """(R, V, k) :func:`ball_face_sums` over the surface-connected piece of each ball (compiled kernel,
     breadth-first), at the R nested radii ``radii`` (R, 1) (one for all vertices) or (R, V) (one per vertex),
     of ``values`` (1, F, k) (the same for every radius) or (R, F, k) (one set per radius). One radius:
-    ``connected_face_sums``; several: ``connected_face_sums_nested`` (one walk per vertex, in passes)."""
+    ``connected_face_sums``; several: ``connected_face_sums_nested`` (one walk per vertex, in passes).
+    ``n_centres``: only the balls of the first ``n_centres`` vertices (the other rows are 0)."""
     n = vertices.shape[0]
+    m = n if n_centres is None else n_centres
     usable = np.ones(faces.shape[0], dtype=bool) if usable is None else usable
     centres, reach = kernels.cell_centres(vertices, faces)
-    outer = radii[-1, 0] if radii.shape[1] == 1 else radii[-1]  # the largest ball leads the walk
-    mean, _ = check_ball_work(centres, outer + float(reach.max()), n, centres=vertices)
+    outer = radii[-1, 0] if radii.shape[1] == 1 else radii[-1, :m]  # the largest ball leads the walk
+    mean, _ = check_ball_work(centres, outer + float(reach.max()), m, centres=vertices[:m])
     indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
     values = np.ascontiguousarray(values)
     out = np.zeros((radii.shape[0], n, values.shape[2]))
     scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0], radii.shape[0] > 1)
-    for start, stop in call_ranges(n, mean, None if radii.shape[1] == 1 else outer * outer):
-        if radii.shape[0] == 1:  # one ball: the kernel without the passes
-            kernels.connected_face_sums(
-                vertices,
-                faces,
-                centres,
-                reach,
-                usable,
-                values[0],
-                radii[0],
-                indptr,
-                indices,
-                out[0],
-                scratch,
-                start,
-                stop,
-            )
-        else:
+    clusters = None
+    if radii.shape[0] == 1 and mean >= CLUSTER_MIN_FACES:  # dense balls: clusters inside a ball added whole
+        clusters = _face_clusters(vertices, faces, centres, reach, values[0], usable)
+        scratch = scratch[:5] + tuple(
+            np.full((scratch[0].shape[0], clusters[1].shape[0]), -1, scratch[0].dtype) for _ in range(3)
+        )
+    for start, stop in call_ranges(m, mean, None if radii.shape[1] == 1 else outer * outer):
+        if radii.shape[0] > 1:
             kernels.connected_face_sums_nested(
                 vertices, faces, centres, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
             )
+            continue
+        ball = (vertices, faces, centres, reach, usable, values[0], radii[0], indptr, indices)
+        if clusters is None:  # one ball: the kernel without the passes
+            kernels.connected_face_sums(*ball, out[0], scratch, start, stop)
+        else:
+            kernels.clustered_face_sums(*ball, clusters, out[0], scratch, start, stop)
     return out
+
+
+def _face_clusters(
+    vertices: np.ndarray, faces: np.ndarray, centres: np.ndarray, reach: np.ndarray, values: np.ndarray, usable
+) -> tuple:
+    """The clusters of faces of the compiled ``clustered_face_sums``: ``(of, centres, spans, sums, links_indptr,
+    links, shared_indptr, shared, slack)``.
+
+    The faces are grouped by the cube of side ``sqrt(CLUSTER_FACES * median area)`` that holds their
+    centroid, and each cube's faces split into the pieces connected through their corners (a cluster is
+    connected: once the walk of a ball reaches one of its faces, and it lies inside the ball, the walk
+    reaches all of them). ``of`` (F,): each face's cluster; ``centres`` (C, 3) and ``spans`` (C,): a sphere
+    holding every face of a cluster (the mean of its centroids, the largest distance to it plus the face's
+    reach); ``sums`` (C, k): the sums of the usable faces' ``values``; ``links``: the clusters that share a
+    vertex with each cluster (CSR over the clusters, each list increasing), ``shared``: the shared vertices of
+    each link (CSR over the links, increasing); ``slack``: the round-off of the coordinates, a margin of the
+    inside and outside tests.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n_faces = faces.shape[0]
+    twice = np.linalg.norm(
+        np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]]), axis=1
+    )
+    area = 0.5 * float(np.median(twice))
+    side = np.sqrt(CLUSTER_FACES * area) if area > 0 else float(reach.max()) + 1.0
+    corner = centres.min(axis=0)
+    # cubes beyond 2^20 per axis share the last one (a face flung far away): the key fits in an int64
+    cube = np.minimum(np.floor((centres - corner) / side), 2.0**20).astype(np.int64)
+    _, cell = np.unique(cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2], return_inverse=True)
+    cell = cell.ravel()
+    # faces linked through (vertex, cube) nodes: two faces of one cube that share a corner are connected
+    _, node = np.unique(faces.ravel() * (int(cell.max()) + 1) + np.repeat(cell, 3), return_inverse=True)
+    n_nodes = n_faces + int(node.max()) + 1
+    graph = coo_matrix(
+        (np.ones(3 * n_faces, dtype=np.int8), (np.repeat(np.arange(n_faces), 3), n_faces + node.ravel())),
+        shape=(n_nodes, n_nodes),
+    )
+    _, label = connected_components(graph, directed=False)
+    _, of = np.unique(label[:n_faces], return_inverse=True)
+    of = of.ravel().astype(np.int64)
+    n_clusters = int(of.max()) + 1
+    count = np.bincount(of, minlength=n_clusters)
+    middle = np.stack([np.bincount(of, weights=centres[:, k], minlength=n_clusters) for k in range(3)], axis=1)
+    middle /= count[:, None]
+    far = np.linalg.norm(centres - middle[of], axis=1) + reach
+    order = np.argsort(of, kind="stable")
+    spans = np.maximum.reduceat(far[order], np.concatenate([[0], np.cumsum(count)[:-1]]))
+    kept = np.ones(n_faces, dtype=bool) if usable is None else usable
+    sums = np.stack(
+        [np.bincount(of[kept], weights=values[kept, k], minlength=n_clusters) for k in range(values.shape[1])], axis=1
+    )
+    # the (vertex, cluster) incidences, by vertex; each ordered pair of clusters at a vertex is a link
+    keys = np.unique(faces.ravel() * n_clusters + np.repeat(of, 3))
+    vertex, cluster = keys // n_clusters, keys % n_clusters
+    per_vertex = np.bincount(vertex, minlength=vertices.shape[0])
+    firsts = np.concatenate([[0], np.cumsum(per_vertex)])[vertex]
+    repeats = per_vertex[vertex]
+    tails = np.repeat(np.arange(keys.size), repeats)
+    heads = np.repeat(firsts - np.concatenate([[0], np.cumsum(repeats)[:-1]]), repeats) + np.arange(tails.size)
+    pair = cluster[tails] != cluster[heads]
+    tails, heads = cluster[tails[pair]], cluster[heads[pair]]
+    at = vertex[np.repeat(np.arange(keys.size), repeats)[pair]]
+    order = np.lexsort((at, heads, tails))
+    tails, heads, at = tails[order], heads[order], at[order]
+    starts = np.flatnonzero(np.concatenate([[True], (tails[1:] != tails[:-1]) | (heads[1:] != heads[:-1])]))
+    starts = starts if tails.size else starts[:0]
+    links = heads[starts].astype(np.int64)
+    links_indptr = np.concatenate([[0], np.cumsum(np.bincount(tails[starts], minlength=n_clusters))]).astype(np.int64)
+    shared_indptr = np.concatenate([starts, [tails.size]]).astype(np.int64)
+    scale = float(np.abs(vertices).max()) if vertices.size else 0.0
+    slack = 64 * np.finfo(np.float64).eps * (scale + float(spans.max()) if n_clusters else scale)
+    return (
+        of,
+        np.ascontiguousarray(middle),
+        np.ascontiguousarray(spans, dtype=np.float64),
+        np.ascontiguousarray(sums),
+        links_indptr,
+        links,
+        shared_indptr,
+        np.ascontiguousarray(at, dtype=np.int64),
+        slack,
+    )
 
 
 def _checked_cells(vertices, cells) -> tuple[np.ndarray, np.ndarray]:
@@ -883,6 +977,7 @@ def ball_face_sums(
     *,
     usable: np.ndarray | None = None,
     connected: bool = False,
+    centres: np.ndarray | None = None,
 ) -> np.ndarray:
     """(V, k) ``sum_f ratio(f, B(x_v, r)) * values[f]`` over the faces meeting each ball.
 
@@ -901,13 +996,39 @@ def ball_face_sums(
     array of one per vertex (positive, finite): the sums of each vertex are
     then those of the float call at its own radius.
 
+    ``centres`` (M,) vertex indices, with ``connected``: the (M, k) sums of
+    those vertices' balls only (the rows of the call without ``centres``, to
+    round-off; the compiled kernel walks no other ball).
+
     Raises
     ------
     InvalidOptionError
         ``radius`` is not a number >= 0 or an array of V positive finite
-        numbers, or is an array without ``connected``.
+        numbers, or is an array without ``connected``; ``centres`` without
+        ``connected``.
+    InvalidMeshError
+        ``centres`` is not a 1-d array of vertex indices in range.
     """
-    return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)
+    if centres is None:
+        return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)
+    if not connected:
+        raise InvalidOptionError("`centres` takes the surface-connected balls (`connected=True`)")
+    vertices, faces = _checked_cells(vertices, faces)
+    n = vertices.shape[0]
+    ids = _checked_ids(centres, n)
+    kernels = numba_kernels("neighborhoods")
+    if kernels is None or faces.shape[0] == 0:
+        return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)[ids]
+    radius = centre_radii(radius, n)
+    values, usable = _checked_values(faces, values, usable)
+    # the centres relabelled first, so that the kernel's range of rows is theirs
+    unique, inverse = np.unique(ids, return_inverse=True)
+    order = np.concatenate([unique, np.setdiff1d(np.arange(n), unique, assume_unique=True)])
+    relabel = np.empty(n, dtype=np.int64)
+    relabel[order] = np.arange(n)
+    radii = np.array([[radius]]) if np.ndim(radius) == 0 else radius[order][None, :]
+    summed = _connected_face_sums(kernels, vertices[order], relabel[faces], radii, values[None], usable, unique.size)
+    return summed[0, inverse.ravel()]
 
 
 def ball_face_sums_nested(

@@ -409,6 +409,53 @@ def _add_face(faces, f, first, low, high, ball, ball2, usable, values, total, v,
     return tail
 
 
+@nb.njit(inline="always", **_JIT)
+def _walk_face(
+    vertices, faces, centroids, reach, usable, values, f, v, radius, known, squared, total, mark, queue, tail
+):
+    """Face ``f`` reached by the walk of the ball ``B(x_v, radius)`` (:func:`connected_face_sums`): where it
+    meets the closed ball (a corner or its centroid inside, or a side crossing the sphere), ``share *
+    values[f]`` added to ``total`` (``usable`` faces) and its corners queued. Returns the queue's new tail."""
+    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+    radius2 = radius * radius
+    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
+    if d > (radius + reach[f]) ** 2:
+        return tail  # every point of the face is outside
+    low, high = _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared)
+    if high <= radius2:
+        share = 1.0
+    elif low >= radius2:  # corners and centroid outside: on through the face if an edge crosses
+        share = 0.0
+        crossed = False
+        for corner in range(3):
+            p = faces[f, corner]
+            q = faces[f, (corner + 1) % 3]
+            crossed = crossed or _segment_meets_ball(
+                vertices[p, 0] - cx,
+                vertices[p, 1] - cy,
+                vertices[p, 2] - cz,
+                vertices[q, 0] - cx,
+                vertices[q, 1] - cy,
+                vertices[q, 2] - cz,
+                radius2,
+            )
+        if not crossed:
+            return tail
+    else:
+        root = math.sqrt(low)
+        share = (radius - root) / (math.sqrt(high) - root)
+    if share != 0.0 and usable[f]:
+        for k in range(values.shape[1]):
+            total[k] += share * values[f, k]
+    for corner in range(3):
+        c = faces[f, corner]
+        if mark[c] != v:
+            mark[c] = v
+            queue[tail] = c
+            tail += 1
+    return tail
+
+
 @nb.njit(parallel=True, **_JIT)
 def connected_face_sums(
     vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
@@ -450,8 +497,6 @@ def connected_face_sums(
         total = np.empty(n_values)  # the centre's sums, in the order of the face visits, then stored once
         for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
             radius = radii[v if per_vertex else 0]
-            radius2 = radius * radius
-            cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
             for k in range(n_values):
                 total[k] = out[v, k]
             mark[v] = v
@@ -465,41 +510,23 @@ def connected_face_sums(
                     if seen[f] == v:
                         continue
                     seen[f] = v
-                    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
-                    if d > (radius + reach[f]) ** 2:
-                        continue  # every point of the face is outside
-                    low, high = _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared)
-                    if high <= radius2:
-                        share = 1.0
-                    elif low >= radius2:  # corners and centroid outside: on through the face if an edge crosses
-                        share = 0.0
-                        crossed = False
-                        for corner in range(3):
-                            p = faces[f, corner]
-                            q = faces[f, (corner + 1) % 3]
-                            crossed = crossed or _segment_meets_ball(
-                                vertices[p, 0] - cx,
-                                vertices[p, 1] - cy,
-                                vertices[p, 2] - cz,
-                                vertices[q, 0] - cx,
-                                vertices[q, 1] - cy,
-                                vertices[q, 2] - cz,
-                                radius2,
-                            )
-                        if not crossed:
-                            continue
-                    else:
-                        root = math.sqrt(low)
-                        share = (radius - root) / (math.sqrt(high) - root)
-                    if share != 0.0 and usable[f]:
-                        for k in range(n_values):
-                            total[k] += share * values[f, k]
-                    for corner in range(3):
-                        c = faces[f, corner]
-                        if mark[c] != v:
-                            mark[c] = v
-                            queue[tail] = c
-                            tail += 1
+                    tail = _walk_face(
+                        vertices,
+                        faces,
+                        centroids,
+                        reach,
+                        usable,
+                        values,
+                        f,
+                        v,
+                        radius,
+                        known,
+                        squared,
+                        total,
+                        mark,
+                        queue,
+                        tail,
+                    )
             for k in range(n_values):
                 out[v, k] = total[k]
 
@@ -758,3 +785,127 @@ def _cell_weight_sums(vertices, points, grid, values, radius, cutoff, v, members
         for k in range(values.shape[1]):
             out[v, k] += weight * values[c, k]
     return members
+
+
+@nb.njit(**_JIT)
+def _cluster_kind(centres, spans, c, cx, cy, cz, radius, slack):
+    """0 when every point of cluster ``c`` (its bounding sphere: ``centres[c]``, ``spans[c]``) is inside the
+    ball ``B((cx, cy, cz), radius)`` by more than ``slack``, 1 when every point is outside by more than
+    ``slack``, 2 otherwise (the sphere of the ball may cut it: its faces are taken one by one). The margin
+    keeps round-off out of the decision: a face of a cluster inside has every corner inside in the exact
+    tests of :func:`connected_face_sums` too, and one of a cluster outside meets the ball in none."""
+    d = math.sqrt((centres[c, 0] - cx) ** 2 + (centres[c, 1] - cy) ** 2 + (centres[c, 2] - cz) ** 2)
+    if d + spans[c] < radius - slack:
+        return 0
+    if d - spans[c] > radius + slack:
+        return 1
+    return 2
+
+
+@nb.njit(parallel=True, **_JIT)
+def clustered_face_sums(
+    vertices, faces, centroids, reach, usable, values, radii, indptr, indices, clusters, out, scratch, start, stop
+):
+    """:func:`connected_face_sums` with the faces grouped in clusters whose sums are added whole.
+
+    ``clusters``: ``(of, centres, spans, sums, links_indptr, links, shared_indptr, shared, slack)`` of
+    ``neighborhoods._face_clusters``: the cluster of each face (F,), each cluster's bounding sphere
+    (C, 3), (C,), the sums of its usable faces' ``values`` (C, k), its neighbour clusters (the clusters
+    that share a vertex with it, CSR over the C clusters), for each such link the shared vertices (CSR
+    over the links) and the margin ``slack`` of the inside and outside tests (round-off of the
+    coordinates). Every cluster is connected through the corners of its faces.
+
+    The walk is that of :func:`connected_face_sums`, over clusters where it can be: a cluster reached
+    (one of its faces met by the walk, or a neighbour of a cluster added whole) that lies inside the ball
+    adds its precomputed sums and leads the walk on to its neighbours (to the vertices it shares with
+    those the sphere cuts); one that lies outside the ball is skipped (none of its faces meets the ball);
+    the faces of one the sphere cuts are walked one by one, as :func:`connected_face_sums` does. The faces
+    added are those of :func:`connected_face_sums` (a connected cluster inside the ball is wholly reached
+    once one of its faces is, and its faces lead on to exactly the faces around its vertices); the sums
+    differ by round-off (another order of the additions). ``scratch``: ``neighborhoods._face_sum_scratch``
+    and then the clusters' ``(stamp, kind, queue)`` (n_chunks, C) each.
+    """
+    n = vertices.shape[0]
+    n_values = values.shape[1]
+    per_vertex = radii.shape[0] > 1
+    start = max(min(start, n), 0)
+    m = max(min(stop, n), start) - start
+    of, cluster_centres, spans, sums, links_indptr, links, shared_indptr, shared, slack = clusters
+    all_seen, all_mark, all_known, all_squared, all_queue, all_stamp, all_kind, all_waiting = scratch
+    n_chunks = all_seen.shape[0]
+    for chunk in nb.prange(n_chunks):
+        seen = all_seen[chunk]
+        mark = all_mark[chunk]  # queued for this centre
+        known = all_known[chunk]  # distance to this centre in `squared`
+        squared = all_squared[chunk]
+        queue = all_queue[chunk]  # a vertex is queued at most once per centre: never grown
+        stamp = all_stamp[chunk]  # the centre a cluster was last classified for
+        kind = all_kind[chunk]  # and its kind (_cluster_kind)
+        waiting = all_waiting[chunk]  # the clusters inside the ball, each queued once per centre
+        total = np.empty(n_values)  # the centre's sums, in the order of the visits, then stored once
+        for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
+            radius = radii[v if per_vertex else 0]
+            margin = 1e-9 * radius + slack
+            cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+            for k in range(n_values):
+                total[k] = out[v, k]
+            mark[v] = v
+            queue[0] = v
+            head, tail = 0, 1
+            first, last = 0, 0  # the queue of clusters
+            while head < tail or first < last:
+                while first < last:  # a cluster inside the ball: its sums, then its neighbours
+                    c = waiting[first]
+                    first += 1
+                    for k in range(n_values):
+                        total[k] += sums[c, k]
+                    for link in range(links_indptr[c], links_indptr[c + 1]):
+                        e = links[link]
+                        if stamp[e] != v:
+                            stamp[e] = v
+                            kind[e] = _cluster_kind(cluster_centres, spans, e, cx, cy, cz, radius, margin)
+                            if kind[e] == 0:
+                                waiting[last] = e
+                                last += 1
+                        if kind[e] == 2:  # cut by the sphere: its faces at the shared vertices, one by one
+                            for s in range(shared_indptr[link], shared_indptr[link + 1]):
+                                b = shared[s]
+                                if mark[b] != v:
+                                    mark[b] = v
+                                    queue[tail] = b
+                                    tail += 1
+                while head < tail:
+                    a = queue[head]
+                    head += 1
+                    for j in range(indptr[a], indptr[a + 1]):
+                        f = indices[j]
+                        if seen[f] == v:
+                            continue
+                        seen[f] = v
+                        c = of[f]
+                        if stamp[c] != v:
+                            stamp[c] = v
+                            kind[c] = _cluster_kind(cluster_centres, spans, c, cx, cy, cz, radius, margin)
+                            if kind[c] == 0:
+                                waiting[last] = c
+                                last += 1
+                        if kind[c] == 2:  # cut by the sphere: face by face
+                            tail = _walk_face(
+                                vertices,
+                                faces,
+                                centroids,
+                                reach,
+                                usable,
+                                values,
+                                f,
+                                v,
+                                radius,
+                                known,
+                                squared,
+                                total,
+                                mark,
+                                queue,
+                                tail,
+                            )
+            for k in range(n_values):
+                out[v, k] = total[k]
