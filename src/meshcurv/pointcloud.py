@@ -651,10 +651,8 @@ def _compute(points, given, radius, method, search=None):
             f"{_normals.LINE_BEND:g} times its radius of curvature: a lone ring's far side): no surface there, NaN"
         )
         usable &= ~lonely
-    if line.size:
-        indices = indices.copy()
+    if line.size:  # (in place: the arrays of this call's own search; a 1M-point sample holds a line point or two)
         indices[line] = line_neighbours
-        spacing = spacing.copy()
         spacing[line] = line_spacing
         median = float(np.median(spacing[usable]))
     if not usable.any():  # every point an outlier or on a line: nothing to measure
