@@ -12,6 +12,7 @@ import warnings
 import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
+from ._pointcloud_normals import NEIGHBOURS
 from ._tensors import principal_from_shape_operator
 from .measures import curvatures_from_measures, face_measures
 from .jets import fit_jets, jet_normals, shape_operators
@@ -80,6 +81,15 @@ FLAT_TURN = 0.05
 #: (:func:`erratic`): the median over them of the largest difference of a principal curvature within this share
 #: of the smaller largest |k|.
 NEIGHBOUR_AGREEMENT = 0.3
+
+#: A given radius below this share of the one the noise calls for is unsteady (:func:`small_balls`): the default
+#: rule's balls give median errors of 1-6% under noise; half their radius, about four times that, and tails beyond
+#: half of |k|.
+SMALL_BALL = 0.5
+
+#: The curvatures of the normals' jets (:func:`disagree`) are a reference where the normal turns by at most this
+#: many radians over their ball (a unit sphere of 1000 points under noise: balls of 0.5 and more).
+JET_TURN = 0.3
 
 #: The ball of the check of :func:`unsteady` is this many times the radius of the estimate.
 LARGER = 2.0**0.5
@@ -277,13 +287,56 @@ def unsteady(found, larger, centres, radius) -> np.ndarray:
     return out
 
 
+def small_balls(radius: float, spacing: np.ndarray, needed: float) -> tuple[np.ndarray, bool]:
+    """``(sparse, noisy)`` of balls of a given ``radius`` at points of local ``spacing`` (M,): (M,) bool, the
+    balls too small to hold the :data:`~meshcurv._pointcloud_normals.NEIGHBOURS` nearest points (a disc of
+    ``sqrt(10 / pi)`` spacings: the 10 coefficients of a degree-3 jet, triangles of more than a few points),
+    whose estimate is undefined; and whether ``radius`` is below :data:`SMALL_BALL` times the radius ``needed``
+    by the noise (:func:`meshcurv.radius.cloud_radius`), where the fits follow the noise (unsteady).
+
+    Given radii of 0.4-1.4 spacings left 1-10 valid points off by 50-5000% in balls that happened to hold 6
+    points; jets over 3 spacings under noise of 0.1-0.2 spacings (the noise calls for 7-9), 1-8 points in 150.
+    """
+    sparse = radius < np.sqrt(NEIGHBOURS / np.pi) * spacing
+    return sparse, bool(radius < SMALL_BALL * needed)
+
+
+def small_ball_problem(radius: float, needed: float) -> str:
+    """The phrase of the call's warning for a given ``radius`` below :data:`SMALL_BALL` times the one ``needed``."""
+    return (
+        f"the given radius {radius:.3g} is below {SMALL_BALL:g} times the {needed:.3g} that the noise calls for: "
+        "the fits follow the noise, the estimates are unsteady (NaN)"
+    )
+
+
+def disagree(found, jets, centres, radius) -> np.ndarray:
+    """(N,) bool: the ``centres`` whose measures ``found`` (``k_min, k_max, ...``) over balls of ``radius`` the
+    curvatures ``jets`` (``k_min, k_max, radii``) of their normals' jet fits (:func:`fitted_normals`) do not
+    reproduce, as :func:`unsteady` compares. Centres whose jet's normal turns by more than :data:`JET_TURN` over
+    its ball (``radius |k|``), or without a jet fit, are not compared: a jet over such a ball is no reference.
+
+    Two estimators of another kind over other balls (an integral of the normals' variation; a polynomial's second
+    fundamental form) agree where both resolve the surface. The measures alone drift where the curvature grows
+    steeply across the ball (the band by the rim of a plate 0.1-0.2 thick: k_max twice the exact one, with the
+    exact normals too, steady over a ball sqrt(2) larger), and follow the noise of normals fitted over balls shrunk
+    by a thin part; the jets did neither.
+    """
+    centres = np.asarray(centres, dtype=np.int64)
+    k_min, k_max, radii = jets
+    with np.errstate(invalid="ignore"):
+        turn = radii[centres] * np.maximum(np.abs(k_min[centres]), np.abs(k_max[centres]))
+    compared = centres[turn <= JET_TURN]  # (NaN where no fit: not compared)
+    return unsteady(found, (k_min, k_max), compared, radius)
+
+
 def fitted_normals(points, normals, radius, centres, usable, *, smallest: float, details: dict | None = None):
     """(N, 3) normals of degree-3 jets over balls of ``radius`` (``normals`` kept where a fit fails).
 
     Where a ball holds the other side of the surface (a part thinner than the
     ball) the fit is redone over a smaller one, down to ``smallest``
     (:func:`one_sided_fits`); ``details`` receives ``"radii"``, (N,) the
-    radius of each point's fit.
+    radius of each point's fit, and ``"jets"``, ``(k_min, k_max)`` (N,) of the
+    same jets (a second estimate of the curvatures, see :func:`disagree`).
     """
     logger.debug("point cloud: normal fits")
     coefficients, frame, radii = one_sided_fits(
@@ -291,6 +344,7 @@ def fitted_normals(points, normals, radius, centres, usable, *, smallest: float,
     )
     if details is not None:
         details["radii"] = radii
+        details["jets"] = (*_jet_curvatures(coefficients, frame, radii, normals)[:2], radii)
     logger.debug("point cloud: measures")
     fitted = jet_normals(coefficients, frame)
     ok = np.isfinite(fitted).all(axis=1)

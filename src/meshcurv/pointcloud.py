@@ -81,8 +81,14 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    estimate): a rim or part sharper than the ball, the other side of a thin
    part, or noise the fit follows
    (:func:`meshcurv._pointcloud_estimators.unsteady`,
-   :func:`meshcurv._pointcloud_estimators.erratic`). Clean samples keep every
-   point (``benchmarks/pointcloud.md``).
+   :func:`meshcurv._pointcloud_estimators.erratic`); so is a measure that the
+   curvatures of its normals' jets do not reproduce where those jets resolve
+   the surface (:func:`meshcurv._pointcloud_estimators.disagree`), and an
+   estimate over a given radius below half the one the noise calls for. A
+   given radius that cannot hold the 10 nearest points (``sqrt(10 / pi)``
+   spacings) leaves the estimate undefined
+   (:func:`meshcurv._pointcloud_estimators.small_balls`). Clean samples keep
+   every point (``benchmarks/pointcloud.md``).
 
 References
 ----------
@@ -811,6 +817,10 @@ def _compute(points, given, radius, method, search=None):
                 sheets=part_sheets,
                 details=details,
             )
+        if "jets" in details:  # (the measures over estimated normals: their jets' curvatures must agree)
+            details["unsteady"] = details["unsteady"] | _estimators.disagree(
+                found, details["jets"], part_members, group_radius
+            )
         if near is not None:
             one_sided[near] = part_one_sided
         if "radii" in details:
@@ -821,6 +831,12 @@ def _compute(points, given, radius, method, search=None):
         unsteady[members] = details["unsteady"][part_members]
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
             whole[members] = part[part_members]
+        if radius is not None:  # a given radius that the sampling, or the noise, cannot support
+            needed = cloud_radius(group_spacing, noise, method)
+            sparse, noisy_ball = _estimators.small_balls(radius, spacing[members], needed)
+            k_min[members[sparse]] = k_max[members[sparse]] = np.nan
+            unsteady[members] |= noisy_ball
+            problems.extend([_estimators.small_ball_problem(radius, needed)] if noisy_ball else [])
     if method == "jets" or given is None:
         parameters["shrunk"] = shrunk / max(centres.size, 1)
     if method == "jets" and radius is not None and shrunk:
