@@ -10,7 +10,8 @@ CPU microseconds per vertex, the stage that costs most (from the ``progress`` ca
 median H error).
 
 ``--profile`` adds where the CPU time of one default call on the first mesh goes, by function
-(``cProfile`` on CPU time; the pilot is the first pass of ``radius.voxel_surface_radius``).
+(``cProfile`` on CPU time; the pilot is the first pass of ``radius.voxel_surface_radius``, icc at 2
+voxels over about half of the vertices, ``icc.voxel_pilot``).
 
     python benchmarks/dense_voxel.py --repeats 3 --profile
 """
@@ -58,12 +59,14 @@ def _timed(vertices, faces, repeats):
 PROFILED = (
     ("radius.py", "voxel_surface_radius", "voxel pilot and per-vertex radii (before the stages)"),
     ("icc.py", "run", "  pilot: icc at 2 voxels"),
+    ("icc.py", "_spread_normals", "    its normals spread from its centres to the other vertices"),
     ("radius.py", "voxel_vertex_radii", "  per-vertex radii from the pilot"),
-    ("icc.py", "fitted_normals", "normal fits (pilot and main pass)"),
-    ("jets.py", "fit_jet_normals", "  fits over every vertex (pilot)"),
+    ("icc.py", "fitted_normals", "normal fits of the main pass"),
+    ("jets.py", "fit_jet_normals", "  fits over every vertex (none on a dense surface)"),
     ("icc.py", "_coarse_level", "  coarse level of the main fits"),
-    ("jets.py", "fit_jets", "  fits on the coarse level (main)"),
+    ("jets.py", "fit_jets", "jet fits (the pilot's centres and the main pass's coarse level)"),
     ("neighborhoods.py", "ball_face_sums", "sums over balls (pilot and main pass)"),
+    ("neighborhoods.py", "_face_clusters", "  clusters of faces (balls of 800 faces or more)"),
     ("neighborhoods.py", "check_ball_work", "  pair estimates (all ball computations)"),
     ("_kernels/neighborhoods.py", "vertex_face_lists", "  faces around each vertex (each sum)"),
     ("thread.py", "_adjust_thread_count", "threads started by run_chunks (a new pool per kernel call)"),

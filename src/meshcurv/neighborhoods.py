@@ -875,6 +875,117 @@ def _connected_face_sums(
     return out
 
 
+def coarse_face_sums(
+    vertices: np.ndarray, faces: np.ndarray, radius, values: np.ndarray, *, usable: np.ndarray | None = None
+) -> np.ndarray:
+    """(V, k) :func:`ball_face_sums` (``connected=True``) approximated on clusters of faces, in a time that does
+    not grow with the density of the faces in a ball.
+
+    The faces are grouped in connected clusters of about :data:`CLUSTER_FACES` (:func:`_face_clusters`); each
+    ball walks the clusters from those of the faces around its vertex through the clusters that share a
+    vertex, and each cluster adds its sums times its share of the ball, by its bounding sphere (1 inside, 0
+    outside, linear in between: :func:`face_in_ball_ratios` for a cluster); a cluster of share 0 leads the
+    walk no further. Where a ball holds many clusters the sums differ from the exact ones by the rim's
+    shares only. Balls of fewer than :data:`CLUSTER_MIN_FACES` faces on average take the exact sums. Both
+    backends compute the same clusters and shares (the NumPy path by connected components, as
+    :func:`_connected_face_sums_numpy`).
+    """
+    vertices, faces = _checked_cells(vertices, faces)
+    n = vertices.shape[0]
+    radius = centre_radii(radius, n)
+    values, usable = _checked_values(faces, values, usable)
+    kernels = numba_kernels("neighborhoods")
+    if faces.shape[0] == 0:
+        return np.zeros((n, values.shape[1]))
+    centres, reach = cell_centres(vertices, faces) if kernels is None else kernels.cell_centres(vertices, faces)
+    mean, _ = check_ball_work(centres, radius + float(reach.max()), n, centres=vertices)
+    if mean < CLUSTER_MIN_FACES:
+        return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, True)
+    usable = np.ones(faces.shape[0], dtype=bool) if usable is None else usable
+    clusters = _face_clusters(vertices, faces, centres, reach, values, usable)
+    if kernels is None:
+        return _coarse_face_sums_numpy(vertices, faces, radius, clusters)
+    indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
+    n_chunks = max(1, min(kernel_threads(), n))
+    index = np.int32 if max(n, faces.shape[0]) < np.iinfo(np.int32).max else np.int64
+    n_clusters = clusters[1].shape[0]
+    scratch = (
+        np.full((n_chunks, n_clusters), -1, index),
+        np.zeros((n_chunks, n_clusters)),
+        np.zeros((n_chunks, n_clusters), index),
+    )
+    out = np.zeros((n, values.shape[1]))
+    radii = np.array([radius]) if np.ndim(radius) == 0 else radius
+    kernels.coarse_face_sums(vertices, indptr, indices, radii, clusters, out, scratch, 0, n)
+    return out
+
+
+def _coarse_face_sums_numpy(vertices: np.ndarray, faces: np.ndarray, radius, clusters: tuple) -> np.ndarray:
+    """The compiled ``coarse_face_sums`` for all centres of a chunk at once: the (centre, cluster) pairs of
+    positive share (k-d tree pairs of centres and cluster middles, the kernel's share), joined through the
+    clusters' links; those connected to a cluster of a face around the centre are summed."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    of, middles, spans, sums, links_indptr, links, _, _, _ = clusters
+    n = vertices.shape[0]
+    n_clusters = middles.shape[0]
+    out = np.zeros((n, sums.shape[1]))
+    order = np.arange(n) if np.ndim(radius) == 0 else np.argsort(radius, kind="stable")
+    radii = np.broadcast_to(radius, (n,))[order]
+    # the clusters of the faces around each vertex: where its walk starts
+    starts = np.unique(faces.ravel() * n_clusters + np.repeat(of, 3))
+    start_vertex, start_cluster = starts // n_clusters, starts % n_clusters
+    for chunk, i, c in _candidate_pairs(
+        vertices[order], middles, spans, radii if np.ndim(radius) else radius, refuse=False
+    ):
+        ids = order[chunk][i]
+        ball = radii[chunk][i]
+        d = np.sqrt(_squared(*(middles[c] - vertices[ids]).T))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(
+                d + spans[c] <= ball,
+                1.0,
+                np.where(d - spans[c] < ball, (ball - (d - spans[c])) / (2.0 * spans[c]), 0.0),
+            )
+        positive = share > 0.0
+        i, c, share = i[positive], c[positive], share[positive]
+        keys = i * n_clusters + c  # the nodes (centre, cluster), sorted
+        node_order = np.argsort(keys, kind="stable")
+        keys, i, c, share = keys[node_order], i[node_order], c[node_order], share[node_order]
+        # links (centre, cluster) -> (centre, neighbour) between nodes
+        count = links_indptr[c + 1] - links_indptr[c]
+        tails = np.repeat(np.arange(keys.size), count)
+        firsts = np.repeat(links_indptr[c] - np.concatenate([[0], np.cumsum(count)[:-1]]), count)
+        heads_key = i[tails] * n_clusters + links[firsts + np.arange(tails.size)]
+        at = np.minimum(np.searchsorted(keys, heads_key), max(keys.size - 1, 0))
+        joined = keys[at] == heads_key if keys.size else np.zeros(0, dtype=bool)
+        # a root node per centre, joined to the nodes of the clusters around its vertex
+        centre_of = np.full(n, -1, dtype=np.int64)
+        centre_of[order[chunk]] = np.arange(chunk.stop - chunk.start)
+        owner = centre_of[start_vertex]
+        mine = owner >= 0
+        root_key = owner[mine] * n_clusters + start_cluster[mine]
+        found = np.minimum(np.searchsorted(keys, root_key), max(keys.size - 1, 0))
+        hit = keys[found] == root_key if keys.size else np.zeros(0, dtype=bool)
+        m = chunk.stop - chunk.start
+        size = keys.size + m
+        graph = coo_matrix(
+            (
+                np.ones(int(joined.sum()) + int(hit.sum()), dtype=np.int8),
+                (
+                    np.concatenate([tails[joined], keys.size + owner[mine][hit]]),
+                    np.concatenate([at[joined], found[hit]]),
+                ),
+            ),
+            shape=(size, size),
+        )
+        _, labels = connected_components(graph, directed=False)
+        reached = labels[: keys.size] == labels[keys.size + i]
+        out[order[chunk]] += _gathered(i[reached], c[reached], share[reached], chunk, sums)
+    return out
+
+
 def _face_clusters(
     vertices: np.ndarray, faces: np.ndarray, centres: np.ndarray, reach: np.ndarray, values: np.ndarray, usable
 ) -> tuple:
@@ -885,8 +996,8 @@ def _face_clusters(
     centroid, and each cube's faces split into the pieces connected through their corners (a cluster is
     connected: once the walk of a ball reaches one of its faces, and it lies inside the ball, the walk
     reaches all of them). ``of`` (F,): each face's cluster; ``centres`` (C, 3) and ``spans`` (C,): a sphere
-    holding every face of a cluster (the mean of its centroids, the largest distance to it plus the face's
-    reach); ``sums`` (C, k): the sums of the usable faces' ``values``; ``links``: the clusters that share a
+    holding every face of a cluster (the middle of its corners' bounding box, the largest distance from it to
+    a corner); ``sums`` (C, k): the sums of the usable faces' ``values``; ``links``: the clusters that share a
     vertex with each cluster (CSR over the clusters, each list increasing), ``shared``: the shared vertices of
     each link (CSR over the links, increasing); ``slack``: the round-off of the coordinates, a margin of the
     inside and outside tests.
@@ -916,12 +1027,13 @@ def _face_clusters(
     _, of = np.unique(label[:n_faces], return_inverse=True)
     of = of.ravel().astype(np.int64)
     n_clusters = int(of.max()) + 1
-    count = np.bincount(of, minlength=n_clusters)
-    middle = np.stack([np.bincount(of, weights=centres[:, k], minlength=n_clusters) for k in range(3)], axis=1)
-    middle /= count[:, None]
-    far = np.linalg.norm(centres - middle[of], axis=1) + reach
+    # each cluster's sphere: the middle of its corners' bounding box, to the farthest corner
     order = np.argsort(of, kind="stable")
-    spans = np.maximum.reduceat(far[order], np.concatenate([[0], np.cumsum(count)[:-1]]))
+    firsts = np.concatenate([[0], np.cumsum(np.bincount(of, minlength=n_clusters))[:-1]])
+    corners = vertices[faces[order]]
+    middle = 0.5 * (np.minimum.reduceat(corners.min(axis=1), firsts) + np.maximum.reduceat(corners.max(axis=1), firsts))
+    far = np.linalg.norm(corners - middle[of[order], None], axis=2).max(axis=1)
+    spans = np.maximum.reduceat(far, firsts)
     kept = np.ones(n_faces, dtype=bool) if usable is None else usable
     sums = np.stack(
         [np.bincount(of[kept], weights=values[kept, k], minlength=n_clusters) for k in range(values.shape[1])], axis=1

@@ -909,3 +909,65 @@ def clustered_face_sums(
                             )
             for k in range(n_values):
                 out[v, k] = total[k]
+
+
+@nb.njit(inline="always", **_JIT)
+def _cluster_share(centres, spans, c, cx, cy, cz, radius):
+    """The share of cluster ``c`` in the ball ``B((cx, cy, cz), radius)`` by its sphere (``centres[c]``,
+    ``spans[c]``): 1 inside, 0 outside, linear in between by the distances of its nearest and farthest
+    points (as ``neighborhoods.face_in_ball_ratios`` for a face)."""
+    d = math.sqrt((centres[c, 0] - cx) ** 2 + (centres[c, 1] - cy) ** 2 + (centres[c, 2] - cz) ** 2)
+    if d + spans[c] <= radius:
+        return 1.0
+    if not d - spans[c] < radius:
+        return 0.0
+    return (radius - (d - spans[c])) / (2.0 * spans[c])
+
+
+@nb.njit(parallel=True, **_JIT)
+def coarse_face_sums(vertices, indptr, indices, radii, clusters, out, scratch, start, stop):
+    """The sums of :func:`connected_face_sums` on the clusters of faces alone (an approximation): each cluster
+    reached adds its precomputed sums times its share of the ball (:func:`_cluster_share`, by its bounding
+    sphere), and leads the walk on to its neighbour clusters while that share is positive.
+
+    The walk starts from the clusters of the faces around each vertex (``indptr, indices``). ``clusters``
+    as :func:`clustered_face_sums`; ``scratch``: the clusters' stamps, shares (float) and queue, (n_chunks, C)
+    each. The work of a ball is the number of its clusters, whatever the density of its faces.
+    """
+    n = vertices.shape[0]
+    n_values = out.shape[1]
+    per_vertex = radii.shape[0] > 1
+    start = max(min(start, n), 0)
+    m = max(min(stop, n), start) - start
+    of, cluster_centres, spans, sums, links_indptr, links, _, _, _ = clusters
+    all_stamp, all_share, all_waiting = scratch
+    n_chunks = all_stamp.shape[0]
+    for chunk in nb.prange(n_chunks):
+        stamp = all_stamp[chunk]
+        share = all_share[chunk]
+        waiting = all_waiting[chunk]
+        for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
+            radius = radii[v if per_vertex else 0]
+            cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+            first, last = 0, 0
+            for j in range(indptr[v], indptr[v + 1]):
+                c = of[indices[j]]
+                if stamp[c] != v:
+                    stamp[c] = v
+                    share[c] = _cluster_share(cluster_centres, spans, c, cx, cy, cz, radius)
+                    if share[c] > 0.0:
+                        waiting[last] = c
+                        last += 1
+            while first < last:
+                c = waiting[first]
+                first += 1
+                for k in range(n_values):
+                    out[v, k] += share[c] * sums[c, k]
+                for link in range(links_indptr[c], links_indptr[c + 1]):
+                    e = links[link]
+                    if stamp[e] != v:
+                        stamp[e] = v
+                        share[e] = _cluster_share(cluster_centres, spans, e, cx, cy, cz, radius)
+                        if share[e] > 0.0:
+                            waiting[last] = e
+                            last += 1

@@ -29,7 +29,13 @@ marching cubes of fine voxels) the normals are fitted on clusters of vertices
 (:func:`fitted_normals`). On voxel surfaces each vertex takes the radius its
 pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
 ``2 sqrt(h_v R)`` for the voxel extent ``h_v`` along its normal, capped where
-the surface bends fast; ``parameters["scale"] == "voxel"``).
+the surface bends fast; ``parameters["scale"] == "voxel"``); the pilot runs at
+about half of the vertices (:func:`voxel_pilot`), and where the balls of such a
+surface hold 800 faces or more (fine voxels), each ball is summed on clusters
+of about 16 faces, the clusters on its rim by their share of the ball
+(:func:`meshcurv.neighborhoods.coarse_face_sums`: the cost of a ball no longer
+grows with the density of its faces; on a marching-cubes sphere of radius 6 at
+0.5 x 0.2 x 0.2 the median H error moves from 0.30 to 0.32%).
 
 The normals ``u_i`` are interpolated linearly over each triangle; the
 curvature measures ``mu_0`` (corrected area), ``mu_1`` (2H dA), ``mu_2`` (K dA)
@@ -79,8 +85,8 @@ import numpy as np
 
 from .._geometry import median_edge_length, robust_mean_edge_length
 from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
-from ..measures import curvatures_from_measures, face_measures, principal_from_measures
-from ..neighborhoods import ball_face_sums, ball_face_sums_nested, nested_jet_normals
+from .._measures import curvatures_from_measures, face_measures, principal_from_measures
+from ..neighborhoods import ball_face_sums, ball_face_sums_nested, coarse_face_sums, nested_jet_normals
 from ..radius import (
     VOXEL_SCALE_RULE,
     check_radius,
@@ -444,10 +450,12 @@ def _curvatures(
     areas: np.ndarray | None = None,
     weighted: bool = False,
     normal_radius=None,
+    coarse: bool = False,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid`` of the measures over balls of ``radius``.
 
     The normals are fitted over ``normal_radius`` (default: :data:`NORMAL_RADIUS_RATIO` times ``radius``).
+    ``coarse``: dense balls summed on clusters of faces (:func:`meshcurv.neighborhoods.coarse_face_sums`).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -481,9 +489,11 @@ def _curvatures(
     measures = face_measures(vertices, faces, normals)  # rows of the faces left out are not read
 
     start("sum over balls")
-    summed = ball_face_sums(
-        vertices, faces, radius, measures, usable=_usable_faces(faces, degenerate, normals), connected=True
-    )
+    usable = _usable_faces(faces, degenerate, normals)
+    if coarse:
+        summed = coarse_face_sums(vertices, faces, radius, measures, usable=usable)
+    else:
+        summed = ball_face_sums(vertices, faces, radius, measures, usable=usable, connected=True)
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
@@ -549,6 +559,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             adjacency=_adjacency(topology),
             areas=_vertex_areas(mesh),
             normal_radius=normal_radii,
+            coarse=True,
         )
         parameters = {
             **parameters,
