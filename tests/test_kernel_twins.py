@@ -1912,8 +1912,13 @@ TWINS = [
         MESHES,
     ),
     Twin("smoothing.smooth_over_neighbours", "smoothing.smooth_vertex_field", check_smooth_over_neighbours, MESHES),
-    Twin("icc.face_measures", "icc.face_measures", check_face_measures, MESHES),
-    Twin("icc.curvatures_from_measures", "icc.curvatures_from_measures", check_curvatures_from_measures, MESHES),
+    Twin("icc.face_measures", "_measures.face_measures", check_face_measures, MESHES),
+    Twin(
+        "icc.curvatures_from_measures",
+        "_measures.curvatures_from_measures",
+        check_curvatures_from_measures,
+        MESHES,
+    ),
     Twin("locality.morton_reordering", "_locality.morton_reordering", check_reordering, MESHES),
     Twin(
         "neighborhoods.vertex_face_lists",

@@ -49,7 +49,7 @@ import numpy as np
 from ._geometry import face_areas, vertex_normals
 from ._validation import check_choice, checked_indices, checked_mesh
 from .errors import InvalidMeshError, InvalidOptionError
-from .measures import face_measures
+from ._measures import face_measures
 
 __all__ = ["INTEGRALS", "vertex_integrals", "face_solid_angles", "weighted_percentiles", "weighted_statistics"]
 

@@ -31,11 +31,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels
-from ._tensors import principal_from_mean_gaussian, principal_from_shape_operator
-from ._validation import checked_indices
+from . import _measures
+from ._validation import checked_indices, checked_mesh
 from .errors import InvalidMeshError
-from .geometry import face_areas
 
 __all__ = ["face_measures", "corrected_areas", "curvatures_from_measures", "principal_from_measures"]
 
@@ -87,27 +85,9 @@ def face_measures(vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray) 
     vertices = _shaped(vertices, "vertices", (None, 3))
     normals = _shaped(normals, "normals", vertices.shape)
     faces = checked_indices(_shaped(faces, "faces", (None, 3), "iu"), vertices.shape[0])
-    kernels = numba_kernels("icc")
-    if kernels is not None:
-        return kernels.face_measures(
-            np.ascontiguousarray(vertices, dtype=np.float64),
-            np.ascontiguousarray(faces, dtype=np.int64),
-            np.ascontiguousarray(normals, dtype=np.float64),
-        )
-    x0, x1, x2 = (vertices[faces[:, k]] for k in range(3))
-    u0, u1, u2 = (normals[faces[:, k]] for k in range(3))
-    x01, x02 = x1 - x0, x2 - x0
-    u01, u02 = u1 - u0, u2 - u0
-    um = (u0 + u1 + u2) / 3
-    mu0 = 0.5 * np.einsum("ij,ij->i", um, np.cross(x01, x02))
-    mu1 = 0.5 * np.einsum("ij,ij->i", um, np.cross(u0 - u2, x01) + np.cross(u1 - u0, x02))
-    mu2 = 0.5 * np.einsum("ij,ij->i", u0, np.cross(u1, u2))
-    # mu^{X,Y} = X^T M Y with M = 1/2 [ (x01 x um) (u02)^T - (x02 x um) (u01)^T ]
-    a, b = np.cross(x01, um), np.cross(x02, um)
-    m = 0.5 * (a[:, :, None] * u02[:, None, :] - b[:, :, None] * u01[:, None, :])
-    rows, columns = [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]  # xx, yy, zz, xy, xz, yz
-    sym = 0.5 * (m[:, rows, columns] + m[:, columns, rows])
-    return np.column_stack([mu0, mu1, mu2, sym])
+    return _measures.face_measures(
+        np.ascontiguousarray(vertices, dtype=np.float64), faces, np.ascontiguousarray(normals, dtype=np.float64)
+    )
 
 
 def corrected_areas(vertices: np.ndarray, faces: np.ndarray, measures: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -128,10 +108,15 @@ def corrected_areas(vertices: np.ndarray, faces: np.ndarray, measures: np.ndarra
         The area of each triangle.
     corrected : ndarray of shape (F,)
         ``mu_0``, the triangle's area where ``mu_0`` is not finite.
+
+    Raises
+    ------
+    InvalidMeshError
+        Arrays of the wrong shape or dtype, coordinates not finite, indices out of range.
     """
-    triangle = face_areas(vertices, faces)
-    measures = _shaped(measures, "measures", (triangle.shape[0], None))
-    return triangle, np.where(np.isfinite(measures[:, 0]), measures[:, 0], triangle)
+    vertices, faces = checked_mesh(vertices, faces)
+    measures = _shaped(measures, "measures", (faces.shape[0], None))
+    return _measures.corrected_areas(vertices, faces, measures)
 
 
 def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
@@ -166,22 +151,9 @@ def curvatures_from_measures(summed: np.ndarray, normals: np.ndarray):
     """
     summed = _shaped(summed, "summed", (None, 9))
     normals = _shaped(normals, "normals", (summed.shape[0], 3))
-    kernels = numba_kernels("icc")
-    if kernels is not None:
-        return kernels.curvatures_from_measures(
-            np.ascontiguousarray(summed, dtype=np.float64), np.ascontiguousarray(normals, dtype=np.float64)
-        )
-    area = summed[:, 0]
-    good = (area > 0) & np.isfinite(normals).all(axis=1)
-    k_min, k_max = principal_from_measures(summed)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        shape_operator = -summed[:, 3:] / area[:, None]
-    _, _, dir_min, dir_max = principal_from_shape_operator(
-        np.where(good[:, None], shape_operator, 0.0), np.where(good[:, None], normals, [0.0, 0.0, 1.0])
+    return _measures.curvatures_from_measures(
+        np.ascontiguousarray(summed, dtype=np.float64), np.ascontiguousarray(normals, dtype=np.float64)
     )
-    for field in (k_min, k_max, dir_min, dir_max):
-        field[~good] = np.nan
-    return k_min, k_max, dir_min, dir_max
 
 
 def principal_from_measures(summed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -208,8 +180,4 @@ def principal_from_measures(summed: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     summed = np.asarray(summed)
     if summed.ndim == 0 or summed.shape[-1] < 3:
         raise InvalidMeshError(f"`summed` must have shape (..., 9) (at least mu_0, mu_1, mu_2); got {summed.shape}")
-    area = summed[..., 0]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.where(area > 0, summed[..., 1] / (2 * area), np.nan)
-        gaussian = np.where(area > 0, summed[..., 2] / area, np.nan)
-    return principal_from_mean_gaussian(mean, gaussian)
+    return _measures.principal_from_measures(summed)

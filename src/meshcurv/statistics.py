@@ -80,7 +80,7 @@ import numpy as np
 
 from .errors import InvalidOptionError, MeshQualityWarning
 from .integrals import _unit_normals, face_solid_angles
-from .measures import corrected_areas, face_measures
+from ._measures import corrected_areas, face_measures
 from .result import CurvatureResult, _first_rows, _where_mask
 
 __all__ = ["curvature_statistics", "FIELDS", "MOMENTS", "INTEGRALS", "COLUMNS"]
