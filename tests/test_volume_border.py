@@ -204,6 +204,22 @@ def test_a_sliver_cut_by_three_image_faces_has_nan_statistics_with_the_reason():
     assert "curvature columns NaN: the label is cut by the image border" in row.warnings
 
 
+def test_a_label_with_no_vertex_used_has_nan_statistics_with_the_reason():
+    # fuzz_labels seed 73, case 772: a plate of 3 x 3 voxels on the image face z = 0 (all within the cap's
+    # reach) and two voxels inside (every estimate undefined): n_used 0, but mean_weighted, total_mean and
+    # total_gaussian (4 pi) came from the faces between the undefined vertices
+    image = np.zeros((31, 30, 20), dtype=np.uint8)
+    image[2, 18:21, 0:3] = 7
+    image[22, 1, 13:15] = 7
+    spacing = (1.0, 0.4197468798350094, 0.3131280890338325)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshcurvWarning)
+        row = label_curvatures(image, spacing=spacing).iloc[0]
+    assert row.status == "ok" and row.touches_border and row.area > 0 and row.volume > 0
+    assert row.n_used == 0 and all(np.isnan(row[column]) for column in CURVATURE_COLUMNS)
+    assert "curvature columns NaN: no vertex of the label beyond the estimator's reach" in row.warnings
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("spacing", [(1.0, 1.0, 1.0), (1.0, 0.5, 0.5)])
 @pytest.mark.parametrize("faces, depth", [(1, 0.0), (1, 0.5), (2, 0.6), (2, 0.9), (3, 0.8), (3, 0.3)])

@@ -713,20 +713,32 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
     on_object = ~border[faces].any(axis=1)
     inside_faces = on_object & np.isfinite(measures[:, 1:]).all(axis=1)
     measured_area = float(measures[inside_faces, 0].sum())
+    reason = None
     if touching.any():  # too little surface out of reach of the cap: no statistic rather than a wrong one
         scale = float(parameters.get("radius", margin))
         needed = CUT_MIN_AREA_BALLS * np.pi * scale**2
         if not measured_area >= needed:
-            messages.append(
+            reason = (
                 f"curvature columns NaN: the label is cut by the image border and keeps an area of "
                 f"{measured_area:.3g} beyond the estimator's reach ({margin:.3g}) of the image faces it "
                 f"touches, less than the {needed:.3g} (pi r^2, r = {scale:.3g}) its statistics need; "
                 "area and volume are those of its part inside the image"
             )
-            used = np.zeros_like(used)
-            border = np.ones_like(border)
-            inside_faces = np.zeros_like(inside_faces)
-            measured_area = 0.0
+    if reason is None and not used.any():  # no vertex to stand for the surface: its integrals neither
+        # (issue 29, fuzz_labels seed 73 case 772: a label of 11 voxels cut by the border, its 10 vertices
+        # beyond the cap's reach all undefined, had finite totals from the faces between them)
+        reach = f" beyond the estimator's reach ({margin:.3g}) of the image faces it touches" if touching.any() else ""
+        reason = (
+            f"curvature columns NaN: no vertex of the label{reach} has a defined estimate "
+            f"({int((~np.asarray(result.valid)).sum())} of its {vertices.shape[0]} vertices undefined); "
+            "area and volume are measured all the same"
+        )
+    if reason is not None:
+        messages.append(reason)
+        used = np.zeros_like(used)
+        border = np.ones_like(border)
+        inside_faces = np.zeros_like(inside_faces)
+        measured_area = 0.0
     volume = _divergence_volume(vertices, faces)
     n_edges = result.diagnosis.n_edges if result.diagnosis is not None else 0
     mean = np.asarray(result.mean)
