@@ -1870,7 +1870,7 @@ TWINS = [
         ("random", "torus", "defects"),
     ),
     Twin("geometry.edge_lengths", "_geometry.edge_lengths", check_edge_lengths, MESHES),
-    Twin("geometry.vertex_edge_lengths", "geometry.vertex_edge_lengths", check_vertex_edge_lengths, MESHES),
+    Twin("geometry.vertex_edge_lengths", "_geometry.vertex_edge_lengths", check_vertex_edge_lengths, MESHES),
     Twin("geometry.mean_edge_length", "_geometry.mean_edge_length", check_mean_edge_length, MESHES),
     Twin("geometry.degenerate_faces", "geometry.degenerate_faces", check_degenerate_faces, MESHES),
     Twin("orient.patch_volumes", "orient._patch_volumes", check_patch_volumes, MESHES),
@@ -1911,7 +1911,7 @@ TWINS = [
         check_matgeom_finish,
         MESHES,
     ),
-    Twin("smoothing.smooth_over_neighbours", "smoothing.smooth_vertex_field", check_smooth_over_neighbours, MESHES),
+    Twin("smoothing.smooth_over_neighbours", "smoothing.smooth_over_neighbours", check_smooth_over_neighbours, MESHES),
     Twin("icc.face_measures", "_measures.face_measures", check_face_measures, MESHES),
     Twin(
         "icc.curvatures_from_measures",

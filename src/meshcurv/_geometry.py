@@ -91,12 +91,11 @@ def edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     return np.sqrt(np.einsum("ij,ij->i", d, d))
 
 
-def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """(V,) the mean length of the edges at each vertex, NaN at none (:func:`meshcurv.geometry.vertex_edge_lengths`)."""
-    n = vertices.shape[0]
-    kernels = numba_kernels("geometry")
-    if kernels is not None:
-        return kernels.vertex_edge_lengths(vertices, edges, n)
+@twin("geometry")
+def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray, n_vertices: int) -> np.ndarray:
+    """(V,) the mean length of the edges at each vertex, NaN at none (:func:`meshcurv.geometry.vertex_edge_lengths`);
+    ``n_vertices`` is ``vertices.shape[0]``."""
+    n = n_vertices
     flat = edges.ravel()
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.bincount(flat, weights=np.repeat(edge_lengths(vertices, edges), 2), minlength=n) / np.bincount(

@@ -269,7 +269,8 @@ def vertex_edge_lengths(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray:
     InvalidMeshError
         As :func:`edge_lengths`.
     """
-    return _geometry.vertex_edge_lengths(*checked_mesh(vertices, edges, columns=2, name="edges"))
+    points, edges = checked_mesh(vertices, edges, columns=2, name="edges")
+    return _geometry.vertex_edge_lengths(points, edges, points.shape[0])
 
 
 def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:

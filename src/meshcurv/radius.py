@@ -266,7 +266,7 @@ def noise_level(
     noisy spheres and tori; none above 0.02 h of noise), and a clean mesh needs
     half the fits. 0 when no jet could be fitted.
     """
-    local = vertex_edge_lengths(vertices, edges)
+    local = vertex_edge_lengths(vertices, edges, vertices.shape[0])
     centres = np.flatnonzero(valid & (local > 0))
     if centres.size > NOISE_SAMPLE:
         centres = centres[np.linspace(0, centres.size - 1, NOISE_SAMPLE).round().astype(np.int64)]
@@ -604,7 +604,7 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology, *, valid: n
     """
     n = topology.n_vertices
     edges = topology.edges if valid is None else topology.edges[valid[topology.edges].all(axis=1)]
-    local = vertex_edge_lengths(vertices, edges)
+    local = vertex_edge_lengths(vertices, edges, vertices.shape[0])
     scales = vertex_length_scales(vertices, topology)
     known = np.isfinite(local) & (local > 0) & (scales > 0)
     if not known.any():

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import twin
 from ._validation import check_int_option
 from .errors import InvalidMeshError, InvalidOptionError
 from .topology import MeshTopology
@@ -103,17 +103,36 @@ def smooth_vertex_field(values, topology: MeshTopology, steps: int) -> np.ndarra
         )
     if steps <= 0:
         return field
-    kernels = numba_kernels("smoothing")
-    if kernels is not None:
-        flat = np.ascontiguousarray(field.reshape(field.shape[0], -1))
-        indptr, indices = topology.neighbour_lists
-        for done in range(0, steps, STEPS_PER_CALL):
-            flat = kernels.smooth_over_neighbours(flat, indptr, indices, min(STEPS_PER_CALL, steps - done))
-        return flat.reshape(field.shape)
-    adjacency = topology.adjacency
-    scale = 1.0 / (topology.vertex_degrees + 1.0)
-    if field.ndim == 2:
-        scale = scale[:, None]
+    flat = np.ascontiguousarray(field.reshape(field.shape[0], -1))
+    indptr, indices = topology.neighbour_lists
+    for done in range(0, steps, STEPS_PER_CALL):
+        flat = smooth_over_neighbours(flat, indptr, indices, min(STEPS_PER_CALL, steps - done))
+    return flat.reshape(field.shape)
+
+
+@twin("smoothing")
+def smooth_over_neighbours(values: np.ndarray, indptr: np.ndarray, indices: np.ndarray, steps: int) -> np.ndarray:
+    """``steps`` passes of the 1-ring mean ``(value + sum of the neighbours') / (degree + 1)``.
+
+    Parameters
+    ----------
+    values : ndarray of shape (V, k), float64
+        The field, C-contiguous; not changed.
+    indptr, indices : ndarray of int64
+        The neighbours in CSR form (:attr:`meshcurv.topology.MeshTopology.neighbour_lists`).
+    steps : int
+        Number of passes, at least 1.
+
+    Returns
+    -------
+    ndarray of shape (V, k), float64
+    """
+    import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
+
+    n = values.shape[0]
+    adjacency = sp.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n))  # the topology's adjacency
+    scale = (1.0 / (np.diff(indptr) + 1.0))[:, None]
+    field = values
     for _ in range(steps):
         field = (adjacency @ field + field) * scale
     return field
