@@ -49,3 +49,21 @@ def test_a_given_topology_is_taken_once_its_vertex_count_matches():
     n = len(sphere.vertices)
     with pytest.raises(InvalidMeshError, match=f"is a MeshTopology of {n} vertices but `vertices` has {n - 1} rows"):
         _prepared.prepare_mesh(sphere.vertices[:-1], topology, orient="keep", weld=False)
+
+
+def test_a_welded_vertex_stands_on_the_first_of_its_rows():
+    # a triangle soup of an octahedron: every vertex given 4 times, welded into 6
+    octahedron = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+    faces = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    soup = octahedron[faces.ravel()]
+    with pytest.warns(meshcurv.MeshQualityWarning, match="welded 18 coincident vertices"):
+        result = meshcurv.principal_curvatures(soup, np.arange(24).reshape(8, 3), method="normal_cycle")
+    surface = result._surface
+    rows = np.asarray(surface.rows)
+    np.testing.assert_array_equal(surface.vertices, soup[rows])  # each welded vertex is its first row's
+    np.testing.assert_array_equal(surface.index[rows], np.arange(6))  # row rows[w] stands for vertex w ...
+    assert all(rows[w] == np.flatnonzero(surface.index == w).min() for w in range(6))  # ... and is its first
+    area = result.vertex_integrals("area")
+    # the octahedron's area, 8 equilateral triangles of side sqrt(2), once: on the first rows, 0 on copies
+    assert area.sum() == pytest.approx(8 * np.sqrt(3) / 4 * 2)
+    assert (area[np.setdiff1d(np.arange(24), rows)] == 0).all() and (area[rows] > 0).all()

@@ -401,9 +401,20 @@ class Surface:
                 view.flags.writeable = False
                 object.__setattr__(self, name, view)
 
+    @cached_property
+    def rows(self) -> slice | np.ndarray:
+        """The rows of a result on the caller's vertices that stand for the rows of ``vertices``: (W,) the
+        first row of each welded vertex, ``slice(None)`` when nothing was welded."""
+        if self.index is None:
+            return slice(None)
+        first = np.full(self.vertices.shape[0], self.index.shape[0], dtype=np.int64)
+        np.minimum.at(first, self.index, np.arange(self.index.shape[0]))
+        return first
+
     def shares(self, field: str, result: CurvatureResult) -> np.ndarray:
-        """(V,) per-row shares of ``field`` (see :func:`meshcurv.integrals.vertex_integrals`)."""
-        rows = slice(None) if self.index is None else _first_rows(self.index, self.vertices.shape[0])
+        """(V,) per-row shares of ``field`` (see :func:`meshcurv.integrals.vertex_integrals`): a welded
+        vertex's share on its first row, 0 on the rows of its copies."""
+        rows = self.rows
         normals = (
             None if result.method == "matgeom" else np.where(result.valid[rows, None], result.normals[rows], np.nan)
         )
@@ -430,13 +441,6 @@ def _where_mask(where, n_vertices: int) -> np.ndarray:
             f"`where` must be a bool array of shape ({n_vertices},); got {mask.dtype} of shape {mask.shape}"
         )
     return mask
-
-
-def _first_rows(index: np.ndarray, n_welded: int) -> np.ndarray:
-    """(W,) the first row of the result that stands for each welded vertex."""
-    first = np.full(n_welded, index.shape[0], dtype=np.int64)
-    np.minimum.at(first, index, np.arange(index.shape[0]))
-    return first
 
 
 _ARRAY_FIELDS = ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid")

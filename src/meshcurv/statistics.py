@@ -81,7 +81,7 @@ import numpy as np
 from .errors import InvalidOptionError, MeshQualityWarning
 from .integrals import _unit_normals, face_solid_angles
 from ._measures import corrected_areas, face_measures
-from .result import CurvatureResult, _first_rows, _where_mask
+from .result import CurvatureResult, _where_mask
 
 __all__ = ["curvature_statistics", "FIELDS", "MOMENTS", "INTEGRALS", "COLUMNS"]
 
@@ -290,7 +290,7 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
         )
     region = _where_mask(where, result.n_vertices)
     vertices, faces = np.asarray(surface.vertices), np.asarray(surface.faces)
-    rows = slice(None) if surface.index is None else _first_rows(surface.index, vertices.shape[0])
+    rows = surface.rows
     valid = np.asarray(result.valid)[rows]
     k_min, k_max = np.asarray(result.k_min)[rows], np.asarray(result.k_max)[rows]
     region = region[rows]
