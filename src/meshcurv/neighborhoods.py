@@ -1013,7 +1013,9 @@ def _face_clusters(
     side = np.sqrt(CLUSTER_FACES * area) if area > 0 else float(reach.max()) + 1.0
     corner = centres.min(axis=0)
     # cubes beyond 2^20 per axis share the last one (a face flung far away): the key fits in an int64
-    cube = np.minimum(np.floor((centres - corner) / side), 2.0**20).astype(np.int64)
+    # shifted by 1 / pi of a side: the centroids of a voxel surface lie on a lattice, and a cube boundary
+    # through lattice points would let round-off (a scaled mesh) make other clusters
+    cube = np.minimum(np.floor((centres - corner) / side + 1.0 / np.pi), 2.0**20).astype(np.int64)
     _, cell = np.unique(cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2], return_inverse=True)
     cell = cell.ravel()
     # faces linked through (vertex, cube) nodes: two faces of one cube that share a corner are connected

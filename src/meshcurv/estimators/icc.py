@@ -374,7 +374,10 @@ def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarr
     if not edge > 0:
         return members
     points = vertices[members]
-    cube = np.minimum(np.floor((points - points.min(axis=0)) / (PILOT_CELL_EDGES * edge)), 2.0**20).astype(np.int64)
+    # the cubes shifted by 1 / pi of a side: a voxel surface's vertices lie on a lattice, and a cube boundary
+    # through lattice points would let round-off (a scaled mesh) pick other centres
+    shifted = (points - points.min(axis=0)) / (PILOT_CELL_EDGES * edge) + 1.0 / np.pi
+    cube = np.minimum(np.floor(shifted), 2.0**20).astype(np.int64)
     _, first = np.unique(cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2], return_index=True)
     return members[np.sort(first)]
 
