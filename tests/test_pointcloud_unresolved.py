@@ -186,3 +186,31 @@ def test_disagree_compares_the_measures_with_their_normals_jets_where_those_reso
     # agrees; twice the k_max (0.05 x 4 = 0.2 rad over its ball); a jet whose normal turns by 0.5 x 4 = 2 rad over its
     # ball is no reference; no jet
     assert flagged.tolist() == [False, True, False, False]
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="open (issue 29): points without a one-sided normal fit keep a PCA normal below noise of 0.1 spacings",
+)
+@pytest.mark.parametrize("noise", [0.0, 0.1])
+def test_points_without_a_one_sided_normal_fit_are_not_measured(noise):
+    # the fuzzer's seeds 42 and 4242 (cases 34, 130, 214, 27, 54, 69): plates 0.2-0.4 thick (3 spacings), whose
+    # normal fits held the other face at every radius down to 4 spacings, kept the PCA normal of 10 neighbours
+    # below noise of 0.1 spacings, and the measures over it were off by 50-300% (k_max 1.7-2.3 for 1.0 at most).
+    # Leaving those points out of every ball and NaN passes this (0 and 4 wrong) and replays 6 of the 7 cases
+    # clean, but also leaves the faces of a clean 3 x 3 x 0.15 ellipsoid (3.6 spacings thick, fits failing
+    # everywhere) NaN and a clean thin torus at 0.907 cover: not yet a fix
+    from scipy.spatial import cKDTree
+
+    points, normals, mean, kmax = ellipsoid(4000, (1.0, 1.0, 0.2), seed=1)
+    # the spacing as the library and the fuzzer measure it: the 8th neighbour's distance times sqrt(pi / 8)
+    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+    points = points + np.random.default_rng(3).uniform(-noise, noise, (4000, 1)) * spacing * normals
+    r = quiet(points)
+    resolved = kmax * spacing <= 0.25  # as the fuzzer checks: radius of curvature of 4 spacings or more
+    side = np.sign(np.einsum("ij,ij->i", r.normals, normals))
+    wrong = r.valid & resolved & ~(np.abs(r.mean - side * mean) / kmax <= 0.5)
+    assert wrong.sum() <= 5  # (19 and 94 of about 2,700 before; 0 and 4, off by 50-57%, now)
+    assert r.valid[resolved].mean() > 0.5
+    two_sided = next(code for code, text in enumerate(INVALID_REASONS) if text.startswith("point cloud: every ball"))
+    assert (r.invalid_reason == two_sided).any()
