@@ -291,7 +291,7 @@ def test_rejects_what_is_not_a_curvature_result():
 
 def test_rejects_a_result_without_a_mesh():
     points = meshcurv.shapes.icosphere(subdivisions=6).vertices
-    result = meshcurv.point_cloud_curvatures(points, radius=0.3)
+    result = meshcurv.point_cloud_curvatures(points)
     with pytest.raises(InvalidOptionError, match="needs the triangles of a mesh"):
         curvature_statistics(result)
 
