@@ -572,7 +572,7 @@ def corrected_measures(
                 wide_index, wide_counts = _ball_indices(search, points, chunk[done], wide, k_wide)
                 wide_index, wide_counts = _own_side(normals, chunk[done], wide_index, wide_counts, sheets)
             _measured(larger, points, normals, chunk[done], wide_index, wide_counts, pattern, kernels)
-    if check:
+    if details is not None:  # (check)
         done = centres[np.isfinite(out[0][centres])]
         details["unsteady"] = unsteady(out, larger, done, radius)
     return (*out, normals)

@@ -1140,7 +1140,7 @@ def ball_face_sums(
     order = np.concatenate([unique, np.setdiff1d(np.arange(n), unique, assume_unique=True)])
     relabel = np.empty(n, dtype=np.int64)
     relabel[order] = np.arange(n)
-    radii = np.array([[radius]]) if np.ndim(radius) == 0 else radius[order][None, :]
+    radii = np.array([[radius]]) if np.ndim(radius) == 0 else np.asarray(radius)[order][None, :]
     summed = _connected_face_sums(kernels, vertices[order], relabel[faces], radii, values[None], usable, unique.size)
     return summed[0, inverse.ravel()]
 
