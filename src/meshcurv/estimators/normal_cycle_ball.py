@@ -18,8 +18,8 @@ with each face weighted by its approximate share instead
 (:func:`meshcurv.neighborhoods.face_in_ball_ratios`), a ball of one to one and a
 half edge lengths cutting a few long edges gave 10% of the vertices of a random
 sphere off by more than half the curvature and 1.3% off by half of H (issue 29;
-now 1.2% and none at one edge, none from 1.5; the median error of H at the default
-radius is 0.013 against 0.033). Cohen-Steiner and Morvan
+now 1.4% and none at one edge, none from 1.5; the median error of H at 2.5
+edges is 0.014 against 0.033). Cohen-Steiner and Morvan
 prove that this converges to the integral of the shape operator over the ball
 when the mesh is a fine enough, well-shaped sampling, at a rate of the edge
 length over the radius: the ball, unlike a fixed number of rings, keeps its
