@@ -215,3 +215,21 @@ def test_the_pilot_at_a_subset_keeps_the_radii_of_the_pilot_at_every_vertex(monk
     assert np.median(np.abs(subset.radius / every.radius - 1.0)) < 0.05
     error = [np.median(np.abs(r.mean - mesh.mean) / np.abs(mesh.mean)) for r in (subset, every)]
     assert error[0] < 1.1 * error[1]
+
+
+def test_the_default_radius_of_a_small_voxel_object_is_never_refused():
+    # the label fuzzer (seed 73, case 39): a row of 4 voxels in anisotropic voxels read a curvature radius of about
+    # 10 voxels, and its default radius, 4.66, was refused as larger than the object (diagonal 4.09): the whole
+    # table of 27 labels was lost. The default is at most half the diagonal; the surface is closed, of genus 0
+    pytest.importorskip("skimage")
+    pytest.importorskip("pandas")
+    image = np.zeros((3, 6, 3), np.uint8)
+    image[1, 1:5, 1] = 1
+    spacing = (0.5758719089057498, 1.0, 0.650750358252876)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        row = meshcurv.label_curvatures(image, spacing=spacing).iloc[0]
+    assert row["status"] == "ok"
+    diagonal = np.linalg.norm([0.5758719089057498, 4.0, 0.650750358252876])
+    assert row["radius"] <= 0.5 * diagonal
+    assert row["total_gaussian"] == pytest.approx(4 * np.pi)

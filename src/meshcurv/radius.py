@@ -327,6 +327,10 @@ def voxel_radius(spacing: np.ndarray, curvature_radius: float) -> float:
 VOXEL_GAIN = 1.5
 VOXEL_CAP = 0.5
 
+#: A voxel surface's default radius is at most this share of the diagonal of its bounding box (a ball of that
+#: radius round a compact object's vertex holds most of it; a larger one would be refused if given).
+VOXEL_EXTENT_CAP = 0.5
+
 #: The typical radius of curvature of a voxel surface is measured with a first pass at this many voxels:
 #: two, and half a percent, so that no ball boundary lies at a distance of the lattice (squared distances
 #: of a binary mask's vertices are whole numbers of quarter voxels: 2 voxels, then 2.06) where round-off
@@ -369,7 +373,11 @@ def voxel_surface_radius(
     if curvedness.size == 0:
         return None
     curvature_radius = 1.0 / float(np.percentile(curvedness, VOXEL_CURVEDNESS_PERCENTILE))
-    radius = voxel_radius(grid.spacing, curvature_radius)
+    # a default is never refused as a given radius would be: at most a share of the surface's own extent (a
+    # label of a few voxels in a row read a curvature radius of 10 voxels: 4.7 against a diagonal of 4.1)
+    used = vertices[referenced]
+    extent = VOXEL_EXTENT_CAP * float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    radius = min(voxel_radius(grid.spacing, curvature_radius), extent)
     found = {
         "surface": "voxel",
         "voxel_spacing": tuple(float(x) for x in grid.spacing),
@@ -381,7 +389,7 @@ def voxel_surface_radius(
             np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1).sum()
         )
         rings = int(np.clip(np.ceil(radius / median_edge_length(vertices, topology.edges)), 1, VOXEL_REGION_RINGS))
-        found["vertex_scale"] = voxel_vertex_radii(
+        radii, normal_radii = voxel_vertex_radii(
             grid.spacing,
             more[0],
             k_min,
@@ -393,6 +401,7 @@ def voxel_surface_radius(
             area=area,
             rings=rings,
         )
+        found["vertex_scale"] = (np.minimum(radii, extent), normal_radii)
     return radius, found
 
 
