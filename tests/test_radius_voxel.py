@@ -184,6 +184,7 @@ def test_a_smoothed_isosurface_sphere_is_within_half_a_percent_of_the_blurred_sp
 def test_the_pilot_runs_at_about_half_of_the_vertices_and_spreads_its_normals():
     # the pilot fits and sums at one vertex per cube of 1.25 median edges (issue 30: a dense voxel sphere's
     # pilot cost 0.36 s of its 1.06); the others get NaN curvatures and the normals of their neighbours
+    pytest.importorskip("skimage")
     from meshcurv._prepared import prepare_mesh
     from meshcurv.estimators import icc
 
@@ -206,6 +207,7 @@ def test_the_pilot_runs_at_about_half_of_the_vertices_and_spreads_its_normals():
 def test_the_pilot_at_a_subset_keeps_the_radii_of_the_pilot_at_every_vertex(monkeypatch):
     # against the pilot at every vertex (cubes of 0.01 edges): the radii move by a few percent and the
     # median H error by less than a tenth of itself (benchmarks/accuracy_voxel.md: within 6% on 19 meshes)
+    pytest.importorskip("skimage")
     from meshcurv.estimators import icc
 
     mesh = shapes.voxel_ellipsoid((5.0, 8.0, 12.0), (1.2, 0.4, 0.4), seed=16)
