@@ -235,3 +235,21 @@ def test_the_default_radius_of_a_small_voxel_object_is_never_refused():
     diagonal = np.linalg.norm([0.5758719089057498, 4.0, 0.650750358252876])
     assert row["radius"] <= 0.5 * diagonal
     assert row["total_gaussian"] == pytest.approx(4 * np.pi)
+
+
+@pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
+def test_the_voxel_default_does_not_depend_on_the_order_of_the_vertices(method):
+    # the API fuzzer (seed 91, cases 14214, 19363, 31657): the pilot took the first vertex of each cube, by
+    # index, so re-indexed vertices got other pilot centres, another radius, and k up to 82% apart (quadric)
+    pytest.importorskip("skimage")
+    mesh = shapes.voxel_sphere(5.0, (1.0, 1.0, 1.0))
+    vertices, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    order = np.random.default_rng(3).permutation(vertices.shape[0])
+    inverse = np.argsort(order)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        plain = meshcurv.principal_curvatures(vertices, faces, method=method)
+        permuted = meshcurv.principal_curvatures(vertices[order], inverse[faces], method=method)
+    assert plain.parameters["radius"] == pytest.approx(permuted.parameters["radius"], rel=1e-12)
+    np.testing.assert_array_equal(plain.valid, permuted.valid[inverse])
+    np.testing.assert_allclose(plain.k_max, permuted.k_max[inverse], rtol=1e-9, atol=1e-12)

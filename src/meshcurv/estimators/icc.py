@@ -364,9 +364,10 @@ PILOT_RINGS = 2
 
 
 def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray) -> np.ndarray:
-    """The vertices of :func:`voxel_pilot`'s fits and sums: the first valid referenced vertex of each cube of side
-    :data:`PILOT_CELL_EDGES` median edge lengths (the cubes of the coordinate axes: a rotated mesh gets other
-    centres)."""
+    """The vertices of :func:`voxel_pilot`'s fits and sums: in each cube of side :data:`PILOT_CELL_EDGES` median
+    edge lengths, the valid referenced vertex nearest the cube's middle, ties taken by the coordinates (never by
+    the index: re-indexed vertices give the same centres; the cubes of the coordinate axes: a rotated mesh gets
+    other centres)."""
     members = np.flatnonzero(valid & topology.referenced_vertices)
     if members.size == 0:
         return members
@@ -378,8 +379,18 @@ def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarr
     # through lattice points would let round-off (a scaled mesh) pick other centres
     shifted = (points - points.min(axis=0)) / (PILOT_CELL_EDGES * edge) + 1.0 / np.pi
     cube = np.minimum(np.floor(shifted), 2.0**20).astype(np.int64)
-    _, first = np.unique(cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2], return_index=True)
+    key = cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2]
+    # (rounded: a lattice holds many vertices at one distance from the middle, whose round-off would depend on
+    # the scale; their tie goes to the coordinates, whose order a scaling keeps)
+    off_middle = np.round(_squared_norms(shifted - cube - 0.5), 9)
+    order = np.lexsort((points[:, 2], points[:, 1], points[:, 0], off_middle, key))
+    first = order[np.r_[True, key[order][1:] != key[order][:-1]]]
     return members[np.sort(first)]
+
+
+def _squared_norms(x: np.ndarray) -> np.ndarray:
+    """(N,) squared lengths of the rows of ``x`` (N, 3), added in the order x, y, z."""
+    return x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2]
 
 
 def _spread_normals(neighbour_lists: tuple, centres: np.ndarray, fitted: np.ndarray, fallback, rings: int):
