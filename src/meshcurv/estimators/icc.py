@@ -86,7 +86,7 @@ import numpy as np
 from .._geometry import median_edge_length, robust_mean_edge_length
 from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
-from ..neighborhoods import ball_face_sums, ball_face_sums_nested, coarse_face_sums, nested_jet_normals
+from ..neighborhoods import _squared, ball_face_sums, ball_face_sums_nested, coarse_face_sums, nested_jet_normals
 from ..radius import (
     VOXEL_SCALE_RULE,
     check_radius,
@@ -382,15 +382,10 @@ def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarr
     key = cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2]
     # (rounded: a lattice holds many vertices at one distance from the middle, whose round-off would depend on
     # the scale; their tie goes to the coordinates, whose order a scaling keeps)
-    off_middle = np.round(_squared_norms(shifted - cube - 0.5), 9)
+    off_middle = np.round(_squared(*(shifted - cube - 0.5).T), 9)
     order = np.lexsort((points[:, 2], points[:, 1], points[:, 0], off_middle, key))
     first = order[np.r_[True, key[order][1:] != key[order][:-1]]]
     return members[np.sort(first)]
-
-
-def _squared_norms(x: np.ndarray) -> np.ndarray:
-    """(N,) squared lengths of the rows of ``x`` (N, 3), added in the order x, y, z."""
-    return x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2]
 
 
 def _spread_normals(neighbour_lists: tuple, centres: np.ndarray, fitted: np.ndarray, fallback, rings: int):
