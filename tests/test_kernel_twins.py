@@ -442,6 +442,22 @@ def check_degenerate_faces(name):
     )
 
 
+def check_cross_and_degenerate(name):
+    from meshcurv._geometry import DEGENERATE_AREA_RATIO, cross_and_degenerate, vertex_length_scales
+
+    vertices, _ = mesh(name)
+    top = topology(name)
+    with use_backend("numpy"):
+        scales = vertex_length_scales(vertices, top)
+        cross, degenerate = cross_and_degenerate(vertices, top.faces, scales, DEGENERATE_AREA_RATIO)
+    assert degenerate.sum() == (3 if name == "defects" else 0)
+    got = kernels("geometry").cross_and_degenerate(vertices, top.faces, scales, DEGENERATE_AREA_RATIO)
+    # the cross products as check_face_cross_products (the same products and differences); the zero-area test as
+    # check_degenerate_faces (the area's squares in another association, no area within an ulp of the threshold)
+    np.testing.assert_array_equal(got[0], cross)
+    np.testing.assert_array_equal(got[1], degenerate)
+
+
 def check_long_edges(name):
     from meshcurv.defects import NEEDLE_REACH
     from meshcurv.geometry import vertex_length_scales
@@ -1873,6 +1889,7 @@ TWINS = [
     Twin("geometry.vertex_edge_lengths", "_geometry.vertex_edge_lengths", check_vertex_edge_lengths, MESHES),
     Twin("geometry.mean_edge_length", "_geometry.mean_edge_length", check_mean_edge_length, MESHES),
     Twin("geometry.degenerate_faces", "geometry.degenerate_faces", check_degenerate_faces, MESHES),
+    Twin("geometry.cross_and_degenerate", "_geometry.cross_and_degenerate", check_cross_and_degenerate, MESHES),
     Twin("orient.patch_volumes", "orient._patch_volumes", check_patch_volumes, MESHES),
     Twin("topology.build_edges", "topology._build_edges", check_build_edges, MESHES),
     Twin("topology.bowtie_vertices", "topology._bowtie_vertices", check_bowtie_vertices, MESHES),

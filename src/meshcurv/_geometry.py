@@ -199,6 +199,20 @@ def degenerate_faces(
     return degenerate_face_mask(0.5 * double_areas, face_scale) | topology.degenerate_faces
 
 
+@twin("geometry")
+def cross_and_degenerate(
+    vertices: np.ndarray, faces: np.ndarray, scales: np.ndarray, area_ratio: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(cross, degenerate)``: the (F, 3) :func:`face_cross_products` and the (F,) bool zero-area faces, a repeated
+    corner or an area at most ``area_ratio`` x ``scales[a]^2`` at the first corner ``a`` (as
+    :func:`degenerate_faces` with ``scales``), from one pass over the faces."""
+    cross = face_cross_products(vertices, faces)
+    with np.errstate(over="ignore"):  # a scale beyond 1e154 squares to inf: every face is below it
+        small = 0.5 * np.sqrt(np.einsum("ij,ij->i", cross, cross)) <= area_ratio * scales[faces[:, 0]] ** 2
+    repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0])
+    return cross, small | repeated
+
+
 def edge_dihedral_angles(
     vertices: np.ndarray, topology, unit_normals: np.ndarray, usable_edges: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

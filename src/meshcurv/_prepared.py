@@ -19,12 +19,18 @@ from typing import Any
 import numpy as np
 
 from ._adapters import mesh_arrays
-from ._backend import numba_kernels
 from ._locality import local_topology
 from ._validation import as_faces, as_vertices, check_choice
 from .defects import BOUNDARY, VertexDefects, defect_codes
 from .errors import InvalidOptionError
-from ._geometry import degenerate_faces, face_cross_products, vertex_length_scales, vertex_normals
+from ._geometry import (
+    DEGENERATE_AREA_RATIO,
+    cross_and_degenerate,
+    degenerate_faces,
+    face_cross_products,
+    vertex_length_scales,
+    vertex_normals,
+)
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import CurvatureResult, Surface
 from .topology import MeshTopology
@@ -84,10 +90,16 @@ class PreparedMesh:
 
     @cached_property
     def degenerate(self) -> np.ndarray:
-        """(F,) bool: the zero-area faces (:func:`meshcurv.geometry.degenerate_faces`); read-only."""
-        # the compiled test computes the cross products inline: asking for self.cross would build them for nothing
-        cross = self.__dict__.get("cross") if numba_kernels("geometry") is not None else self.cross
-        return _read_only(degenerate_faces(self.vertices, self.topology, cross=cross, scales=self.length_scales))
+        """(F,) bool: the zero-area faces (:func:`meshcurv.geometry.degenerate_faces`); read-only. The face cross
+        products come with them (one pass over the faces) unless :attr:`cross` was built first."""
+        if "cross" in self.__dict__:
+            return _read_only(
+                degenerate_faces(self.vertices, self.topology, cross=self.cross, scales=self.length_scales)
+            )
+        faces = self.topology.faces
+        cross, degenerate = cross_and_degenerate(self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO)
+        self.__dict__["cross"] = _read_only(cross)
+        return _read_only(degenerate)
 
     def found_degenerate(self, degenerate: np.ndarray) -> None:
         """Keep (F,) ``degenerate``, found by a kernel with the test of :attr:`degenerate` (the same scales and

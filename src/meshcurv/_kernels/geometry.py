@@ -114,3 +114,18 @@ def degenerate_faces(vertices, faces, scales, area_ratio):
         threshold = area_ratio * scales[a] * scales[a]
         out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
     return out
+
+
+@nb.njit(parallel=True, **_JIT)
+def cross_and_degenerate(vertices, faces, scales, area_ratio):
+    """``(cross, degenerate)``: :func:`face_cross_products` and :func:`degenerate_faces` in one pass over the
+    faces (the degenerate test computes the cross products anyway; the prepared mesh wants both)."""
+    cross = np.empty((faces.shape[0], 3))
+    out = np.empty(faces.shape[0], np.bool_)
+    for f in nb.prange(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        nx, ny, nz = _face_cross(vertices, a, b, c)
+        cross[f, 0], cross[f, 1], cross[f, 2] = nx, ny, nz
+        threshold = area_ratio * scales[a] * scales[a]
+        out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
+    return cross, out
