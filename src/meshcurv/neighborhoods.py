@@ -110,7 +110,11 @@ def estimate_ball_pairs(points: np.ndarray, radius, centres: np.ndarray | None =
     looked for among them and the :data:`SAMPLE_CENTRES` centres of the largest radii.
     """
     points = checked_points(points, name="points")
-    centres = points if centres is None else centres
+    return _estimate_ball_pairs(points, radius, points if centres is None else centres)
+
+
+def _estimate_ball_pairs(points: np.ndarray, radius, centres: np.ndarray) -> tuple[float, float]:
+    """:func:`estimate_ball_pairs` of checked ``points`` (the library's own arrays: :func:`check_ball_work`)."""
     if centres.shape[0] == 0:
         return 0.0, 0.0
     sub = points[_sample(points.shape[0], SAMPLE_POINTS)]
@@ -139,7 +143,8 @@ def check_ball_work(
 ) -> tuple[float, float]:
     """Refuse a ball computation beyond :data:`MAX_BALL_PAIRS`; return :func:`estimate_ball_pairs`.
 
-    ``radius``: one for all centres, or an array of one per centre.
+    ``radius``: one for all centres, or an array of one per centre. ``points`` and ``centres`` are
+    the library's own float64 (N, 3) arrays, checked already: they are not checked again.
 
     Raises
     ------
@@ -147,7 +152,7 @@ def check_ball_work(
         The balls of ``radius`` around ``n_centres`` centres would hold more than
         :data:`MAX_BALL_PAIRS` (centre, point) pairs in all.
     """
-    mean, largest = estimate_ball_pairs(points, radius, centres)
+    mean, largest = _estimate_ball_pairs(points, radius, points if centres is None else centres)
     if mean * n_centres > MAX_BALL_PAIRS:
         named = f"{radius:g}" if np.ndim(radius) == 0 else f"up to {np.max(radius):g}"
         raise InvalidOptionError(
