@@ -390,12 +390,18 @@ def check_bowtie_vertices(name):
     np.testing.assert_array_equal(got, expected)
 
 
-def check_count_components(name):
-    top = topology(name)
-    with use_backend("numpy"):
-        expected = MeshTopology._build(top.faces, top.n_vertices).n_components
-    assert expected == (2 if name == "defects" else 1)
-    assert kernels("topology").count_components(top.edges, top.referenced_vertices, top.n_vertices) == expected
+def check_double_sided_suspects(name):
+    from meshcurv.weld import double_sided_suspects
+
+    _, faces = mesh(name)
+    # the mesh, and the mesh stored double-sided (every face again, reversed: each edge non-manifold)
+    for shown in (faces, np.vstack([faces, faces[:, ::-1]])):
+        top = MeshTopology.from_faces(shown, topology(name).n_vertices)
+        arrays = (top.faces, top.edge_faces, top.edge_face_counts, top._edge_forward_counts)
+        with use_backend("numpy"):
+            expected = double_sided_suspects(*arrays)
+        np.testing.assert_array_equal(kernels("topology").double_sided_suspects(*arrays), expected)
+        assert expected.all() if shown is not faces else not expected.any() or name == "defects"
 
 
 def check_component_labels(name):
@@ -1893,11 +1899,9 @@ TWINS = [
     Twin("orient.patch_volumes", "orient._patch_volumes", check_patch_volumes, MESHES),
     Twin("topology.build_edges", "topology._build_edges", check_build_edges, MESHES),
     Twin("topology.bowtie_vertices", "topology._bowtie_vertices", check_bowtie_vertices, MESHES),
-    Twin("topology.count_components", "MeshTopology.n_components", check_count_components, MESHES),
-    Twin("topology.component_labels", "MeshTopology.vertex_components", check_component_labels, MESHES),
-    Twin(
-        "topology.neighbour_lists", "MeshTopology.neighbour_lists (the adjacency matrix)", check_neighbour_lists, MESHES
-    ),
+    Twin("topology.component_labels", "topology.component_labels", check_component_labels, MESHES),
+    Twin("topology.double_sided_suspects", "weld.double_sided_suspects", check_double_sided_suspects, MESHES),
+    Twin("topology.neighbour_lists", "topology.neighbour_lists", check_neighbour_lists, MESHES),
     Twin("diagnosis.mesh_facts", "diagnosis.diagnose", check_mesh_facts, MESHES),
     Twin("diagnosis.long_edges", "defects.needle_vertices (its long edges)", check_long_edges, MESHES),
     Twin(
@@ -2008,7 +2012,6 @@ EXCEPTIONS: dict[str, str] = {
     "topology.build_edges_into": "the body of topology.build_topology, called by topology.build_edges (its row above)",
     "topology.bowtie_from_twins": "tests/test_topology.py::test_bowtie_vertices_from_the_twin_sides_are_those_of_the_"
     "definition: against the NumPy definition on random defective spheres",
-    "topology.double_sided_suspects": "tests/test_weld_suspects.py: against weld._suspect_edges's NumPy path",
     "topology.bowtie_walks": "the body of topology.bowtie_from_twins (its row above), which calls it; from the "
     "build's corner counts: tests/test_topology.py::test_bowtie_vertices_from_the_twin_sides_are_those_of_the_definition",
     "matgeom.matgeom_vertex_sums": "the body of matgeom.matgeom_vertex_tensors (its row above), which calls it; its "

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import numba_kernels, twin
 from ._validation import MAX_VERTICES, Ragged, check_vertex_count, checked_triangles, fan_triangles, polygon_arrays
 from .errors import InvalidMeshError
 
@@ -317,12 +317,7 @@ class MeshTopology:
 
         The neighbours of vertex ``v`` are ``indices[indptr[v]:indptr[v + 1]]``.
         """
-        kernels = numba_kernels("topology")
-        if kernels is not None:
-            indptr, indices = kernels.neighbour_lists(self.edges, self.n_vertices)
-        else:
-            adjacency = self.adjacency
-            indptr, indices = adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64)
+        indptr, indices = neighbour_lists(self.edges, self.n_vertices)
         return _readonly(indptr), _readonly(indices)
 
     def smoothing_lists(self, steps: int) -> tuple[np.ndarray, np.ndarray]:
@@ -368,21 +363,8 @@ class MeshTopology:
         numbered in the order of each component's first vertex, -1 for an
         unreferenced vertex.
         """
-        kernels = numba_kernels("topology")
-        referenced = self.referenced_vertices
-        if kernels is not None:
-            labels, count = kernels.component_labels(self.edges, referenced, self.n_vertices)
-            return int(count), _readonly(labels)
-        from scipy.sparse.csgraph import connected_components
-
-        _, raw = connected_components(self.adjacency, directed=False)
-        raw = np.where(referenced, raw, -1)
-        used, first = np.unique(raw[referenced], return_index=True)
-        rank = np.empty(used.size, dtype=np.int64)
-        rank[np.argsort(first, kind="stable")] = np.arange(used.size)
-        labels = np.full(self.n_vertices, -1, dtype=np.int64)
-        labels[referenced] = rank[np.searchsorted(used, raw[referenced])]
-        return int(used.size), _readonly(labels)
+        labels, count = component_labels(self.edges, self.referenced_vertices, self.n_vertices)
+        return int(count), _readonly(labels)
 
     @cached_property
     def n_components(self) -> int:
@@ -407,6 +389,36 @@ class MeshTopology:
         graph = sp.csr_matrix((np.ones(boundary.shape[0]), (boundary[:, 0], boundary[:, 1])), shape=(n, n))
         count, labels = connected_components(graph, directed=False)
         return int(np.unique(labels[boundary[:, 0]]).size)
+
+
+@twin("topology")
+def neighbour_lists(edges: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(indptr, indices)``, int64: the edge neighbours of every vertex in CSR form, each list in increasing
+    order (:attr:`MeshTopology.neighbour_lists`); ``edges`` (E, 2) unique, ``p < q``."""
+    rows = np.concatenate([edges[:, 0], edges[:, 1]]).astype(np.int64)
+    columns = np.concatenate([edges[:, 1], edges[:, 0]]).astype(np.int64)
+    order = np.lexsort((columns, rows))
+    indptr = np.zeros(n_vertices + 1, dtype=np.int64)
+    np.cumsum(np.bincount(rows, minlength=n_vertices), out=indptr[1:])
+    return indptr, columns[order]
+
+
+@twin("topology")
+def component_labels(edges: np.ndarray, referenced: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
+    """``(labels, count)``: the (V,) int64 component of each referenced vertex through ``edges`` (0, 1, ...
+    numbered in the order of each component's first vertex; -1 for an unreferenced vertex) and their number
+    (:attr:`MeshTopology.vertex_components`)."""
+    import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
+    from scipy.sparse.csgraph import connected_components
+
+    graph = sp.coo_matrix((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(n_vertices, n_vertices))
+    _, raw = connected_components(graph.tocsr(), directed=False)
+    used, first = np.unique(raw[referenced], return_index=True)
+    rank = np.empty(used.size, dtype=np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(used.size)
+    labels = np.full(n_vertices, -1, dtype=np.int64)
+    labels[referenced] = rank[np.searchsorted(used, raw[referenced])]
+    return labels, int(used.size)
 
 
 def index_dtype(n_vertices: int, n_faces: int) -> type[np.signedinteger]:

@@ -20,7 +20,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import twin
 from .orient import face_flips
 from .topology import MeshTopology
 
@@ -335,16 +335,20 @@ def drop_closed_copies(
 
 
 def _suspect_edges(topology: MeshTopology) -> np.ndarray:
-    """(E,) bool: the edges whose faces :func:`drop_double_sided` looks at (its Notes), compiled when numba is there."""
-    kernels = numba_kernels("topology")
-    if kernels is not None:
-        return kernels.double_sided_suspects(
-            topology.faces, topology.edge_faces, topology.edge_face_counts, topology._edge_forward_counts
-        )
-    # a lone triangle's two sides make a closed pillow of manifold edges: an edge whose two faces have the same
-    # third corner (the same corner sums, as both hold the edge's ends) is a candidate as well
-    faces = topology.faces
+    """(E,) bool: the edges whose faces :func:`drop_double_sided` looks at (its Notes)."""
+    return double_sided_suspects(
+        topology.faces, topology.edge_faces, topology.edge_face_counts, topology._edge_forward_counts
+    )
+
+
+@twin("topology")
+def double_sided_suspects(
+    faces: np.ndarray, edge_faces: np.ndarray, counts: np.ndarray, forward: np.ndarray
+) -> np.ndarray:
+    """(E,) bool: the non-manifold edges (``counts`` > 2), and the interior edges (two faces, ``forward`` 1:
+    consistently oriented) whose two faces have the same third corner: a lone triangle's two sides make a
+    closed pillow of manifold edges (the same corner sums, as both faces hold the edge's ends)."""
     corner_sums = faces[:, 0] + faces[:, 1] + faces[:, 2]
-    pairs = topology.edge_faces  # both >= 0 on an interior edge
-    pillow = topology.interior_edges & (corner_sums[pairs[:, 0]] == corner_sums[pairs[:, 1]])
-    return topology.nonmanifold_edges | pillow
+    pairs = np.maximum(edge_faces, 0)  # both >= 0 on an interior edge
+    pillow = (counts == 2) & (forward == 1) & (corner_sums[pairs[:, 0]] == corner_sums[pairs[:, 1]])
+    return (counts > 2) | pillow

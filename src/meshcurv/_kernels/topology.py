@@ -372,17 +372,6 @@ def _union_edges(edges, n_vertices):
 
 
 @nb.njit(**_JIT)
-def count_components(edges, referenced, n_vertices):
-    """Connected components of the vertex graph among the referenced vertices (union-find)."""
-    parent = _union_edges(edges, n_vertices)
-    count = 0
-    for v in range(n_vertices):
-        if referenced[v] and _find(parent, v) == v:
-            count += 1
-    return count
-
-
-@nb.njit(**_JIT)
 def component_labels(edges, referenced, n_vertices):
     """(V,) component of each vertex of the edge graph (0, 1, ... by first vertex; -1: unreferenced) and the count."""
     parent = _union_edges(edges, n_vertices)
