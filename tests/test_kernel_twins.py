@@ -258,7 +258,7 @@ def check_face_cross_products(name):
 
 
 def check_patch_volumes(name):
-    from meshcurv.orient import _patch_volumes
+    from meshcurv.orient import patch_volumes
 
     vertices, faces = mesh(name)
     n_labels, labels = topology(name).vertex_components
@@ -268,7 +268,7 @@ def check_patch_volumes(name):
         patch = np.ascontiguousarray(patch, dtype=np.int64)
         flip = rng.random(faces.shape[0]) < 0.3
         with use_backend("numpy"):
-            expected = _patch_volumes(vertices, faces, patch, flip, count)
+            expected = patch_volumes(vertices, faces, patch, flip, count)
         got = kernels("orient").patch_volumes(vertices, faces, patch, flip, count)
         # each face's triple product a . (b x c) grouped otherwise (np.cross and einsum against one
         # expression): a few eps |a||b||c| apart, then the same terms summed in another order
@@ -1896,7 +1896,7 @@ TWINS = [
     Twin("geometry.mean_edge_length", "_geometry.mean_edge_length", check_mean_edge_length, MESHES),
     Twin("geometry.degenerate_faces", "geometry.degenerate_faces", check_degenerate_faces, MESHES),
     Twin("geometry.cross_and_degenerate", "_geometry.cross_and_degenerate", check_cross_and_degenerate, MESHES),
-    Twin("orient.patch_volumes", "orient._patch_volumes", check_patch_volumes, MESHES),
+    Twin("orient.patch_volumes", "orient.patch_volumes", check_patch_volumes, MESHES),
     Twin("topology.build_edges", "topology._build_edges", check_build_edges, MESHES),
     Twin("topology.bowtie_vertices", "topology._bowtie_vertices", check_bowtie_vertices, MESHES),
     Twin("topology.component_labels", "topology.component_labels", check_component_labels, MESHES),

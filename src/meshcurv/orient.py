@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import twin
 from ._validation import as_vertices, check_choice
 from .errors import InvalidOptionError
 from .topology import MeshTopology, as_topology
@@ -175,18 +175,23 @@ def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
 def _patch_volumes(
     vertices: np.ndarray, faces: np.ndarray, patch: np.ndarray, flip: np.ndarray, n_labels: int
 ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`patch_volumes` of the arrays of :func:`face_flips` (csgraph's labels are int32)."""
+    patch = np.ascontiguousarray(patch, dtype=np.int64)
+    return patch_volumes(vertices, faces, patch, np.ascontiguousarray(flip, dtype=bool), int(n_labels))
+
+
+@twin("orient")
+def patch_volumes(
+    vertices: np.ndarray, faces: np.ndarray, patch: np.ndarray, flip: np.ndarray, n_labels: int
+) -> tuple[np.ndarray, np.ndarray]:
     """(P,) signed and (P,) absolute sums of six times the volume of each patch's faces.
 
     A face's volume is that of the tetrahedron of its corners and the mean of
     its patch's faces' first corners (a point near the patch: no cancellation
     between far-off coordinates); a face to ``flip`` counts reversed. The
-    inputs are the validated arrays of :func:`face_flips` (``patch`` (F,) int64
-    in ``[0, n_labels)``, ``flip`` (F,) bool).
+    inputs are checked arrays: ``patch`` (F,) int64 in ``[0, n_labels)``,
+    ``flip`` (F,) bool, both C-contiguous.
     """
-    kernels = numba_kernels("orient")
-    if kernels is not None:
-        patch = np.ascontiguousarray(patch, dtype=np.int64)  # csgraph's labels are int32
-        return kernels.patch_volumes(vertices, faces, patch, np.ascontiguousarray(flip, dtype=bool), int(n_labels))
     first = vertices[faces[:, 0]]
     weight = np.maximum(np.bincount(patch, minlength=n_labels), 1).astype(np.float64)
     centre = (
