@@ -165,7 +165,13 @@ def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
         open_patch = np.bincount(patch, weights=on_boundary.any(axis=1), minlength=n_labels) > 0
     else:
         open_patch = np.zeros(n_labels, dtype=bool)
-    signed, magnitude = _patch_volumes(vertices, faces, patch, flip, n_labels)
+    from ._geometry import vertex_length_scales
+    from .defects import needle_vertices
+
+    # a needle's slivers bound no solid (issue 29: a uv sphere's vertex flung 30 sizes inward turned it inside out)
+    needles = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
+    kept = ~needles[faces].any(axis=1) if needles.any() else slice(None)
+    signed, magnitude = _patch_volumes(vertices, faces[kept], patch[kept], flip[kept], n_labels)
     decided = ~open_patch & (np.abs(signed) > 1e-9 * magnitude)
     inverted = np.where(decided, signed < 0, invert)
     cavity = _nesting_depth(vertices, faces, patch, decided) % 2 == 1

@@ -83,17 +83,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._geometry import median_edge_length, robust_mean_edge_length
+from .._geometry import median_edge_length
 from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import _squared, ball_face_sums, ball_face_sums_nested, coarse_face_sums, nested_jet_normals
 from ..radius import (
     VOXEL_SCALE_RULE,
     check_radius,
-    component_radii,
     local_scale_ratios,
-    noise_level,
-    noise_radius,
+    noise_radii,
+    scale_centres,
     scale_ladder,
     stable_scales,
     vertex_radii,
@@ -313,6 +312,7 @@ def voxel_pilot(mesh: PreparedMesh):
     def run(radius: float):
         vertices, topology = mesh.vertices, mesh.topology
         _, valid = mesh.start(boundary=True)
+        valid = scale_centres(vertices, topology, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
         centres = _pilot_centres(vertices, topology, valid)
         coefficients, frame, _ = fit_jets(
@@ -526,20 +526,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
     stages.start("measure noise")
     referenced = topology.referenced_vertices
     if radius is None:  # each group of components of one scale (usually the whole mesh) at its own default
-        groups, levels = [], []
-        for _group_radius, members in component_radii(vertices, topology):
-            inside = valid if members is None else valid & np.isin(np.arange(vertices.shape[0]), members)
-            edges = topology.edges if members is None else topology.edges[inside[topology.edges[:, 0]]]
-            spike = defects.needle_cells(edges) if members is None else None  # a needle's edges measure nothing
-            edges = edges if spike is None else edges[~spike]
-            edge_length = robust_mean_edge_length(vertices, edges)
-            level = (
-                noise_level(vertices, normals, inside, edges, neighbours=referenced, adjacency=_adjacency(topology))
-                if edge_length > 0
-                else 0.0
-            )
-            groups.append((float(noise_radius(level, edge_length)), members))
-            levels.append(level)
+        groups, levels = noise_radii(vertices, topology, normals, valid, adjacency=_adjacency(topology))
         found = {"surface": "smooth", "noise": levels[0] if len(levels) == 1 else levels}
     else:
         groups, found = [(check_radius(radius, vertices, topology), None)], {}
@@ -579,7 +566,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         }
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor
-        ratios = local_scale_ratios(vertices, topology, valid=valid)
+        ratios = local_scale_ratios(vertices, topology)
         radii_v = vertex_radii(groups, vertices.shape[0]) * ratios
         if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not np.all(ratios == 1.0):
             k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
