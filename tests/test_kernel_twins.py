@@ -1272,6 +1272,39 @@ def compare_jets(got, expected, label, fit, adjacency=None):
     )
 
 
+def check_jet_curvatures(name):
+    from meshcurv import jets
+
+    points, normals, radius, _ = jet_inputs(name)
+    n = points.shape[0]
+    rng = np.random.default_rng(9)
+    coefficients, frame, _ = jets.fit_jets(points, normals, radius, degree=3)
+    coefficients[rng.random(n) < 0.05] = np.nan  # failed fits: NaN, and the given normals
+    radii = radius * rng.uniform(0.7, 1.4, n)
+    with use_backend("numpy"):
+        expected = jets.jet_curvatures(coefficients, frame, radii, normals)
+    got = kernels("jets").jet_curvatures(coefficients, frame, radii, normals)
+    # the normals: the same operations in the same order
+    np.testing.assert_array_equal(got[4], expected[4])
+    # the shape operator: NumPy's matmul adds its second product by a fused multiply-add here (its BLAS), as the
+    # kernel does (equal to the bit on this project's machines); another BLAS may round each of its products'
+    # entries otherwise, within 2 eps of |T|. The tangent eigen-problem: k within 8 eps of |T| and directions
+    # within 16 eps of |T| / (k_max - k_min) (check_principal_from_shape_operator)
+    six, _ = jets.shape_operators(coefficients, frame, 1.0)
+    magnitude = np.abs(six / radii[:, None]).max(axis=1)
+    for got_k, expected_k in zip(got[:2], expected[:2]):
+        np.testing.assert_array_equal(np.isnan(got_k), np.isnan(expected_k))
+        finite = ~np.isnan(expected_k)
+        assert (np.abs(got_k - expected_k)[finite] <= 16 * EPS * magnitude[finite]).all()
+    gap = expected[1] - expected[0]
+    finite = np.isfinite(gap)
+    atol = 32 * EPS * magnitude[finite] / np.where(gap[finite] == 0, 1.0, gap[finite])
+    branch = atan2_branch(expected[3][finite], expected[4][finite], atol)
+    for got_d, expected_d in zip(got[2:4], expected[2:4]):
+        np.testing.assert_array_equal(np.isnan(got_d), np.isnan(expected_d))
+        assert_directions_close(got_d[finite], expected_d[finite], atol, name, up_to_sign=branch)
+
+
 def check_fit_jets(name):
     from meshcurv import jets
 
@@ -1962,6 +1995,7 @@ TWINS = [
         MESHES + THIN,
     ),
     Twin("jets.fit_jets", "jets.fit_jets", check_fit_jets, CLEAN + CLOUDS),
+    Twin("jets.jet_curvatures", "jets.jet_curvatures", check_jet_curvatures, CLOUDS),
     Twin(
         "jets.fit_jets_connected",
         "jets.fit_jets(adjacency=) and jets.jet_normals",

@@ -13,9 +13,8 @@ import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
 from ._pointcloud_normals import NEIGHBOURS
-from ._tensors import principal_from_shape_operator
 from .measures import curvatures_from_measures, face_measures
-from .jets import fit_jets, jet_normals, shape_operators
+from .jets import fit_jets, jet_curvatures, jet_normals
 
 logger = logging.getLogger(__name__)
 
@@ -248,18 +247,8 @@ def unsteady_problem(flagged: np.ndarray) -> list[str]:
 
 def _jet_curvatures(coefficients, frame, radii, normals):
     """``(k_min, k_max, dir_min, dir_max, normals)`` of jets ``coefficients`` (N, 6) in units of their ``radii``
-    (N,), fitted in ``frame``; NaN (and the given ``normals``) where a fit failed."""
-    six, fitted = shape_operators(coefficients, frame, 1.0)
-    with np.errstate(invalid="ignore"):
-        six = six / radii[:, None]
-    ok = np.isfinite(coefficients).all(axis=1) & np.isfinite(fitted).all(axis=1)
-    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-        np.where(ok[:, None], six, 0.0), np.where(ok[:, None], fitted, [0.0, 0.0, 1.0])
-    )
-    out_normals = np.where(ok[:, None], fitted, normals)
-    for array in (k_min, k_max, dir_min, dir_max):
-        array[~ok] = np.nan
-    return k_min, k_max, dir_min, dir_max, out_normals
+    (N,), fitted in ``frame``; NaN (and the given ``normals``) where a fit failed (:func:`~meshcurv.jets.jet_curvatures`)."""
+    return jet_curvatures(coefficients, frame, radii, normals)
 
 
 def unsteady(found, larger, centres, radius) -> np.ndarray:

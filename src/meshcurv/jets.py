@@ -64,8 +64,8 @@ from math import comb
 
 import numpy as np
 
-from ._backend import kernel_threads, numba_kernels
-from ._tensors import tangent_basis
+from ._backend import kernel_threads, numba_kernels, twin
+from ._tensors import principal_from_shape_operator, tangent_basis
 from ._validation import checked_points
 from .errors import InvalidMeshError, InvalidOptionError
 from .neighborhoods import (
@@ -741,3 +741,48 @@ def shape_operators(coefficients: np.ndarray, frame: tuple, radius: float):
     tensor = jacobian @ middle @ jacobian.transpose(0, 2, 1)
     six = tensor[:, [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]
     return six, jet_normals(coefficients, frame)
+
+
+@twin("jets")
+def jet_curvatures(coefficients: np.ndarray, frame: tuple, radii: np.ndarray, normals: np.ndarray):
+    """Principal curvatures, directions and normals of jets fitted in units of their radii.
+
+    Parameters
+    ----------
+    coefficients : ndarray of shape (N, 6)
+        The constant, linear and quadratic coefficients of each jet (:func:`fit_jets`), in units of
+        its own radius; NaN where no fit.
+    frame : tuple of three ndarrays of shape (N, 3)
+        The frames ``t1, t2, n`` the jets were fitted in.
+    radii : ndarray of shape (N,)
+        The radius of each fit.
+    normals : ndarray of shape (N, 3)
+        The normals returned where a fit failed.
+
+    Returns
+    -------
+    k_min, k_max : ndarray of shape (N,)
+    dir_min, dir_max : ndarray of shape (N, 3)
+        The eigen-pairs of :func:`shape_operators` divided by ``radii`` in the tangent plane of the
+        fitted normal (:func:`meshcurv._tensors.principal_from_shape_operator`); NaN where a
+        coefficient or the fitted normal is not finite.
+    normals : ndarray of shape (N, 3)
+        The fitted jets' unit normals (:func:`jet_normals`), the given ``normals`` where NaN.
+
+    Notes
+    -----
+    The compiled twin (:func:`meshcurv._kernels.jets.jet_curvatures`) writes the 2 x 2 and 3 x 2
+    matrix products out as sums of two products: NumPy's ``matmul`` may round them otherwise, the
+    results agree to a few ulps (``tests/test_kernel_twins.py``).
+    """
+    six, fitted = shape_operators(coefficients, frame, 1.0)
+    with np.errstate(invalid="ignore"):
+        six = six / radii[:, None]
+    ok = np.isfinite(coefficients).all(axis=1) & np.isfinite(fitted).all(axis=1)
+    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
+        np.where(ok[:, None], six, 0.0), np.where(ok[:, None], fitted, [0.0, 0.0, 1.0])
+    )
+    out_normals = np.where(ok[:, None], fitted, normals)
+    for array in (k_min, k_max, dir_min, dir_max):
+        array[~ok] = np.nan
+    return k_min, k_max, dir_min, dir_max, out_normals

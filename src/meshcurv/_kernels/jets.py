@@ -6,11 +6,13 @@ import math
 
 import numba as nb
 import numpy as np
+from llvmlite import ir
 from numba.core import types
-from numba.extending import overload
+from numba.extending import intrinsic, overload
 
 from ._common import _JIT, _JIT_REASSOC, _TINY, _tangent_frame, run_chunks, threaded
 from .neighborhoods import _ball_members, _connected_members, pool_grid
+from .tensors import _tangent_eigen
 
 
 #: ``jets.PIVOT_FLOOR``: the smallest pivot for which the factorization goes on.
@@ -752,3 +754,109 @@ def _connected_chunk(
         width = np.sqrt(1 + p * p + q * q)
         for k in range(3):
             fitted[i, k] = (nn[0, k] - p * a[0, k] - q * b[0, k]) / width
+
+
+@threaded
+def jet_curvatures(coefficients, frame, radii, normals):
+    """``jets.jet_curvatures``: the principal curvatures, directions and normals of fitted jets.
+
+    Row by row on threads (:func:`~meshcurv._kernels._common.run_chunks`): the shape operator of
+    ``jets.shape_operators`` (its 2 x 2 and 3 x 2 products written out as sums of two products in the
+    order of the matrix products; NumPy's ``matmul`` may round differently, so the results agree to
+    a few ulps, not to the bit), divided by ``radii``, then restricted to the fitted normal's tangent
+    plane as ``tensors.principal_from_shape_operator`` does (:func:`~meshcurv._kernels.tensors._tangent_eigen`).
+    Returns ``(k_min, k_max, dir_min, dir_max, normals)``: NaN (and the given ``normals``) where a
+    coefficient or the fitted normal is not finite.
+    """
+    t1, t2, n = (np.ascontiguousarray(part, dtype=np.float64) for part in frame)
+    coefficients = np.ascontiguousarray(coefficients, dtype=np.float64)
+    rows = coefficients.shape[0]
+    outputs = (np.empty(rows), np.empty(rows), np.empty((rows, 3)), np.empty((rows, 3)), np.empty((rows, 3)))
+    run_chunks(
+        _curvatures_chunk,
+        rows,
+        8 * nb.get_num_threads(),
+        coefficients,
+        t1,
+        t2,
+        n,
+        np.ascontiguousarray(radii, dtype=np.float64),
+        np.ascontiguousarray(normals, dtype=np.float64),
+        *outputs,
+    )
+    return outputs
+
+
+@intrinsic
+def _fma(typingctx, x, y, z):
+    """``x * y + z`` rounded once (LLVM's ``llvm.fma.f64``; a library call where the processor has no such
+    instruction): how the matrix products of NumPy's ``matmul`` (its BLAS) add their second term."""
+    signature = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, sig, args):
+        double = ir.DoubleType()
+        function = builder.module.declare_intrinsic("llvm.fma", [double], ir.FunctionType(double, [double] * 3))
+        return builder.call(function, args)
+
+    return signature, codegen
+
+
+@nb.njit(**_JIT)
+def _curvatures_chunk(lo, hi, coefficients, t1, t2, n, radii, normals, k_min, k_max, dir_min, dir_max, out_normals):
+    """Rows ``lo:hi`` of :func:`jet_curvatures`."""
+    for i in range(lo, hi):
+        p, q = coefficients[i, 1], coefficients[i, 2]
+        width = math.sqrt(1 + p * p + q * q)
+        fx = (n[i, 0] - p * t1[i, 0] - q * t2[i, 0]) / width
+        fy = (n[i, 1] - p * t1[i, 1] - q * t2[i, 1]) / width
+        fz = (n[i, 2] - p * t1[i, 2] - q * t2[i, 2]) / width
+        ok = math.isfinite(fx) and math.isfinite(fy) and math.isfinite(fz)
+        for k in range(6):
+            ok = ok and math.isfinite(coefficients[i, k])
+        if not ok:
+            k_min[i] = k_max[i] = np.nan
+            for k in range(3):
+                dir_min[i, k] = dir_max[i, k] = np.nan
+                out_normals[i, k] = normals[i, k]
+            continue
+        # the first fundamental form's inverse and the second (meshcurv's sign), as jets.shape_operators
+        f0, f1, f2 = 1 + p * p, p * q, 1 + q * q
+        s0 = -(2 * coefficients[i, 3]) / width
+        s1 = -coefficients[i, 4] / width
+        s2 = -(2 * coefficients[i, 5]) / width
+        det = f0 * f2 - f1**2
+        i00, i01, i11 = f2 / det, -f1 / det, f0 / det
+        # (inverse @ second) @ inverse, then (jacobian @ middle) @ jacobian^T, each entry of a product
+        # rounded as NumPy's matmul rounds it here (a0 b0, then a1 b1 added by a fused multiply-add)
+        a00 = _fma(i01, s1, i00 * s0)
+        a01 = _fma(i01, s2, i00 * s1)
+        a10 = _fma(i11, s1, i01 * s0)
+        a11 = _fma(i11, s2, i01 * s1)
+        m00 = _fma(a01, i01, a00 * i00)
+        m01 = _fma(a01, i11, a00 * i01)
+        m10 = _fma(a11, i01, a10 * i00)
+        m11 = _fma(a11, i11, a10 * i01)
+        # the jacobian's columns t1 + p n and t2 + q n
+        ux, uy, uz = t1[i, 0] + p * n[i, 0], t1[i, 1] + p * n[i, 1], t1[i, 2] + p * n[i, 2]
+        vx, vy, vz = t2[i, 0] + q * n[i, 0], t2[i, 1] + q * n[i, 1], t2[i, 2] + q * n[i, 2]
+        lx0, lx1 = _fma(vx, m10, ux * m00), _fma(vx, m11, ux * m01)
+        ly0, ly1 = _fma(vy, m10, uy * m00), _fma(vy, m11, uy * m01)
+        lz0, lz1 = _fma(vz, m10, uz * m00), _fma(vz, m11, uz * m01)
+        radius = radii[i]
+        lo_k, hi_k, d0, d1, d2, d3, d4, d5 = _tangent_eigen(
+            _fma(lx1, vx, lx0 * ux) / radius,
+            _fma(ly1, vy, ly0 * uy) / radius,
+            _fma(lz1, vz, lz0 * uz) / radius,
+            _fma(lx1, vy, lx0 * uy) / radius,
+            _fma(lx1, vz, lx0 * uz) / radius,
+            _fma(ly1, vz, ly0 * uz) / radius,
+            fx,
+            fy,
+            fz,
+            False,
+            False,
+        )
+        k_min[i], k_max[i] = lo_k, hi_k
+        dir_min[i, 0], dir_min[i, 1], dir_min[i, 2] = d0, d1, d2
+        dir_max[i, 0], dir_max[i, 1], dir_max[i, 2] = d3, d4, d5
+        out_normals[i, 0], out_normals[i, 1], out_normals[i, 2] = fx, fy, fz
