@@ -427,41 +427,28 @@ def check_neighbour_lists(name):
 # -- geometry: degenerate faces, and diagnosis --------------------------------------------------
 
 
-def check_degenerate_faces(name):
-    from meshcurv import geometry
-    from meshcurv.geometry import DEGENERATE_AREA_RATIO, vertex_length_scales
-
-    vertices, _ = mesh(name)
-    top = topology(name)
-    with use_backend("numpy"):
-        scales = vertex_length_scales(vertices, top)
-        expected = geometry.degenerate_faces(vertices, top)
-        one_scale = geometry.degenerate_faces(vertices, top, mean_edge_length=0.5)
-    assert expected.sum() == (3 if name == "defects" else 0)
-    compiled = kernels("geometry").degenerate_faces
-    # the same cross product and threshold; the area's three squares are added in another association
-    # (einsum's), which could only matter for an area within an ulp of the threshold: none here
-    # (the zero-area faces are exactly 0, the others far above 1e-12 of the squared scale)
-    np.testing.assert_array_equal(compiled(vertices, top.faces, scales, DEGENERATE_AREA_RATIO), expected)
-    np.testing.assert_array_equal(
-        compiled(vertices, top.faces, np.full(top.n_vertices, 0.5), DEGENERATE_AREA_RATIO), one_scale
-    )
-
-
 def check_cross_and_degenerate(name):
+    from meshcurv import geometry
     from meshcurv._geometry import DEGENERATE_AREA_RATIO, cross_and_degenerate, vertex_length_scales
 
     vertices, _ = mesh(name)
     top = topology(name)
+    compiled = kernels("geometry").cross_and_degenerate
     with use_backend("numpy"):
         scales = vertex_length_scales(vertices, top)
         cross, degenerate = cross_and_degenerate(vertices, top.faces, scales, DEGENERATE_AREA_RATIO)
+        one_scale = geometry.degenerate_faces(vertices, top, mean_edge_length=0.5)
+        np.testing.assert_array_equal(geometry.degenerate_faces(vertices, top), degenerate)
     assert degenerate.sum() == (3 if name == "defects" else 0)
-    got = kernels("geometry").cross_and_degenerate(vertices, top.faces, scales, DEGENERATE_AREA_RATIO)
-    # the cross products as check_face_cross_products (the same products and differences); the zero-area test as
-    # check_degenerate_faces (the area's squares in another association, no area within an ulp of the threshold)
+    got = compiled(vertices, top.faces, scales, DEGENERATE_AREA_RATIO)
+    # the cross products as check_face_cross_products (the same products and differences); the area's three
+    # squares are added in another association (einsum's), which could only matter for an area within an ulp of
+    # the threshold: none here (the zero-area faces are exactly 0, the others far above 1e-12 of the squared scale)
     np.testing.assert_array_equal(got[0], cross)
     np.testing.assert_array_equal(got[1], degenerate)
+    np.testing.assert_array_equal(
+        compiled(vertices, top.faces, np.full(top.n_vertices, 0.5), DEGENERATE_AREA_RATIO)[1], one_scale
+    )
 
 
 def check_long_edges(name):
@@ -1927,7 +1914,6 @@ TWINS = [
     Twin("geometry.edge_lengths", "_geometry.edge_lengths", check_edge_lengths, MESHES),
     Twin("geometry.vertex_edge_lengths", "_geometry.vertex_edge_lengths", check_vertex_edge_lengths, MESHES),
     Twin("geometry.mean_edge_length", "_geometry.mean_edge_length", check_mean_edge_length, MESHES),
-    Twin("geometry.degenerate_faces", "geometry.degenerate_faces", check_degenerate_faces, MESHES),
     Twin("geometry.cross_and_degenerate", "_geometry.cross_and_degenerate", check_cross_and_degenerate, MESHES),
     Twin("orient.patch_volumes", "orient.patch_volumes", check_patch_volumes, MESHES),
     Twin("topology.build_edges", "topology._build_edges", check_build_edges, MESHES),

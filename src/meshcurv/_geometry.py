@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import numba_kernels, twin
+from ._backend import twin
 
 #: Faces with area below this fraction of the squared length scale of their component
 #: (:func:`vertex_length_scales`, the median edge length) count as degenerate.
@@ -183,20 +183,16 @@ def degenerate_faces(
 ) -> np.ndarray:
     """(F,) bool: faces with a repeated corner or an area below 1e-12 x (length scale)^2
     (:func:`meshcurv.geometry.degenerate_faces`); the optional arrays C-contiguous float64 of their shapes."""
-    kernels = numba_kernels("geometry")
-    if scales is None and mean_edge_length is None:
-        scales = vertex_length_scales(vertices, topology)
-    if kernels is not None and double_areas is None:
-        # the kernel computes the cross products inline: ``cross`` only spares the NumPy path that work
-        if scales is None and mean_edge_length is not None:  # always, when no scales were computed above
+    if scales is None:
+        if mean_edge_length is None:
+            scales = vertex_length_scales(vertices, topology)
+        else:
             scales = np.full(topology.n_vertices, float(mean_edge_length))
-        return kernels.degenerate_faces(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)
-    face_scale = scales[topology.faces[:, 0]] if scales is not None else mean_edge_length
+    if double_areas is None and cross is None:
+        return cross_and_degenerate(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)[1]
     if double_areas is None:
-        if cross is None:
-            cross = face_cross_products(vertices, topology.faces)
         double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
-    return degenerate_face_mask(0.5 * double_areas, face_scale) | topology.degenerate_faces
+    return degenerate_face_mask(0.5 * double_areas, scales[topology.faces[:, 0]]) | topology.degenerate_faces
 
 
 @twin("geometry")

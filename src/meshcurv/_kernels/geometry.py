@@ -101,25 +101,11 @@ def edge_lengths(vertices, edges):
 
 
 @nb.njit(parallel=True, **_JIT)
-def degenerate_faces(vertices, faces, scales, area_ratio):
-    """(F,) bool: faces that repeat a vertex or whose area is at most ``area_ratio`` x ``scales[a]^2``.
-
-    ``scales`` (V,) is the length scale at each vertex (``geometry.vertex_length_scales``),
-    read at the first corner ``a`` (the corners of a face share their component).
-    """
-    out = np.empty(faces.shape[0], np.bool_)
-    for f in nb.prange(faces.shape[0]):
-        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-        nx, ny, nz = _face_cross(vertices, a, b, c)
-        threshold = area_ratio * scales[a] * scales[a]
-        out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
-    return out
-
-
-@nb.njit(parallel=True, **_JIT)
 def cross_and_degenerate(vertices, faces, scales, area_ratio):
-    """``(cross, degenerate)``: :func:`face_cross_products` and :func:`degenerate_faces` in one pass over the
-    faces (the degenerate test computes the cross products anyway; the prepared mesh wants both)."""
+    """``(cross, degenerate)``: :func:`face_cross_products`, and (F,) bool the faces that repeat a vertex or whose
+    area is at most ``area_ratio`` x ``scales[a]^2`` (``scales`` (V,) the length scale at each vertex,
+    ``geometry.vertex_length_scales``, read at the first corner ``a``: the corners of a face share their
+    component), in one pass over the faces (``geometry.degenerate_faces``)."""
     cross = np.empty((faces.shape[0], 3))
     out = np.empty(faces.shape[0], np.bool_)
     for f in nb.prange(faces.shape[0]):
