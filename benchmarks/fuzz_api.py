@@ -1054,7 +1054,9 @@ def relation_check(args, kwargs, result, relation):
             tolerance = 0.1 if kwargs.get("method") == "icc" else 0.02
             if got.shape != expected.shape or not np.allclose(got, expected, rtol=tolerance):
                 broken.append(f"needle: default radius {got} where the clean shape has {expected}")
-        if clean is not None:
+        if clean is not None and kwargs.get("method") != "matgeom":
+            # (matgeom: matGeom divides the edge lengths by their mean, a needle's included: its numbers shrink
+            # with the needle's distance, as in matGeom itself; the compatibility mode keeps them)
             # the other vertices keep their values: those next to the needle lose the faces of its fan (a few
             # percent; 11% everywhere on the 16 x 8 torus, whose default balls hold most of it), a surface
             # turned inside out (its signed volume read with the needle's slivers) is off by 200%
@@ -1065,8 +1067,8 @@ def relation_check(args, kwargs, result, relation):
                 typical = float(np.median(np.abs(expected)))
                 if off > NEEDLE_VALUES_TOLERANCE * typical:
                     broken.append(
-                        f"needle: the other vertices' H moved by {off:.3g} (median) against a median |H| of "
-                        f"{typical:.3g} on the clean shape"
+                        f"needle: the other vertices' H moved (median {off:.3g} against a median |H| of "
+                        f"{typical:.3g} on the clean shape)"
                     )
         if not value["far"]:  # a vertex a few sizes away need not be a needle (a full fan of long edges)
             return broken
