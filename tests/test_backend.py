@@ -1,6 +1,8 @@
-"""The twins' registry of :mod:`meshcurv._backend`: a NumPy function decorated with ``@twin`` and its kernel."""
+"""The twins' registry of :mod:`meshcurv._backend` (a NumPy function decorated with ``@twin`` and its kernel), and the
+OpenMP wait policy it asks for."""
 
 import importlib
+import os
 import pkgutil
 
 import numpy as np
@@ -78,3 +80,19 @@ def test_a_twin_hands_its_kernel_every_argument_by_position_with_the_defaults(mo
             got = principal_from_shape_operator(tensor, normals, **given)
             for a, b in zip(got, kernel(tensor, normals, *positional)):
                 np.testing.assert_array_equal(a, b)
+
+
+def test_the_kernels_ask_for_a_passive_openmp_wait_unless_the_environment_names_a_policy(monkeypatch):
+    # GNU OpenMP's threads spin after each parallel region by default: on shared cores each short kernel
+    # launch then costs milliseconds of CPU (benchmarks/speed_profile.md); the policy is set before the
+    # kernels first run, and a policy the user gave is kept
+    pytest.importorskip("numba")
+    monkeypatch.setenv("OMP_WAIT_POLICY", "restored at teardown")
+    monkeypatch.delenv("OMP_WAIT_POLICY")
+    monkeypatch.setattr(_backend, "_imported", None)
+    _backend._import_kernels()
+    assert os.environ["OMP_WAIT_POLICY"] == _backend.WAIT_POLICY == "PASSIVE"
+    monkeypatch.setenv("OMP_WAIT_POLICY", "ACTIVE")
+    monkeypatch.setattr(_backend, "_imported", None)
+    _backend._import_kernels()
+    assert os.environ["OMP_WAIT_POLICY"] == "ACTIVE"

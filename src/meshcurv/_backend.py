@@ -114,11 +114,28 @@ MISSING_MESSAGE = (
 )
 
 
+#: The OpenMP wait policy asked for before the compiled kernels first run, unless the environment names one
+#: (see :func:`_import_kernels`).
+WAIT_POLICY = "PASSIVE"
+
+
 def _import_kernels() -> tuple[ModuleType, None] | tuple[None, ImportError]:
     """``(kernels package, None)``, imported once per process, or ``(None, ImportError)`` when numba (or the
-    package) cannot be imported."""
+    package) cannot be imported.
+
+    Before the first import, ``OMP_WAIT_POLICY`` is set to :data:`WAIT_POLICY` unless the environment
+    names a policy: numba runs its parallel kernels on OpenMP (``omp``) where it is installed, and GNU
+    OpenMP's threads spin for a while after each parallel region by default, waiting for the next one. A
+    call makes some 30 kernel launches, mostly short: on a machine whose cores are shared (a server, a
+    Dask worker beside others) each launch then cost 3-6 ms of CPU and wall time instead of 0.03-0.6 ms
+    (edge lengths of 16,000 to 300,000 edges, 2 threads, load average 4), the whole default call on a
+    100,000-vertex icosphere 0.58 s of CPU instead of 0.46 (``benchmarks/speed_profile.md``). The results do
+    not change. The policy is read when OpenMP starts, once per process: a program that ran OpenMP code
+    before keeps the policy it started with.
+    """
     global _imported
     if _imported is None:
+        os.environ.setdefault("OMP_WAIT_POLICY", WAIT_POLICY)
         try:
             from . import _kernels
         except ImportError as error:
