@@ -32,7 +32,7 @@ import logging
 import numpy as np
 
 from ._backend import twin
-from .topology import MeshTopology, as_topology
+from .topology import MeshTopology
 
 logger = logging.getLogger(__name__)
 
@@ -148,7 +148,7 @@ def local_topology(
     """
     n = vertices.shape[0]
     if isinstance(faces, MeshTopology):
-        topology = as_topology(faces, n)
+        topology = faces.for_vertices(n)
         triangles = topology.faces
     else:
         topology = None

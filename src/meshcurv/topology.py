@@ -24,7 +24,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ._backend import numba_kernels, twin
-from ._validation import MAX_VERTICES, Ragged, check_vertex_count, checked_triangles, fan_triangles, polygon_arrays
+from ._validation import (
+    MAX_VERTICES,
+    Ragged,
+    as_faces,
+    check_vertex_count,
+    checked_triangles,
+    fan_triangles,
+    polygon_arrays,
+)
 from .errors import InvalidMeshError
 
 if TYPE_CHECKING:
@@ -176,6 +184,31 @@ class MeshTopology:
             n_vertices = largest + 1
         triangles = checked_triangles(shaped, n_vertices, stacklevel=3)
         return cls._build(triangles, n_vertices)
+
+    def for_vertices(self, n_vertices: int) -> MeshTopology:
+        """This topology, given with ``n_vertices`` vertices: its vertex count checked, nothing else (its faces
+        were checked when it was built).
+
+        Parameters
+        ----------
+        n_vertices : int
+            The rows of the vertices it comes with.
+
+        Returns
+        -------
+        MeshTopology
+            ``self``.
+
+        Raises
+        ------
+        InvalidMeshError
+            The topology was built for another number of vertices.
+        """
+        if self.n_vertices != n_vertices:
+            raise InvalidMeshError(
+                f"`faces` is a MeshTopology of {self.n_vertices} vertices but `vertices` has {n_vertices} rows"
+            )
+        return self
 
     @classmethod
     def _build(cls, faces: np.ndarray, n_vertices: int) -> MeshTopology:
@@ -523,12 +556,6 @@ def as_topology(faces, n_vertices: int, *, stacklevel: int = 3) -> MeshTopology:
     InvalidMeshError
         ``faces`` unusable, or a MeshTopology of another vertex count.
     """
-    from ._validation import as_faces
-
     if isinstance(faces, MeshTopology):
-        if faces.n_vertices != n_vertices:
-            raise InvalidMeshError(
-                f"`faces` is a MeshTopology of {faces.n_vertices} vertices but `vertices` has {n_vertices} rows"
-            )
-        return faces
+        return faces.for_vertices(n_vertices)
     return MeshTopology._build(as_faces(faces, n_vertices, stacklevel=stacklevel + 1), n_vertices)
