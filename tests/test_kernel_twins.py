@@ -1259,6 +1259,52 @@ def compare_jets(got, expected, label, fit, adjacency=None):
     )
 
 
+def check_fit_jet_pairs(name):
+    from meshcurv import jets
+
+    points, normals, radius, _ = jet_inputs(name)
+    n = points.shape[0]
+    rng = np.random.default_rng(10)
+    pool_mask = rng.random(n) > 0.1  # some points stay out of every ball
+    pool = np.flatnonzero(pool_mask)
+    centres = np.flatnonzero(rng.random(n) > 0.5)
+    facing = normals.copy()
+    facing[rng.random(n) < 0.02] *= -1  # a few normals facing away: some balls refused
+    larger = radius * 2.0**0.5
+    for degree, check in ((3, True), (4, False)):
+        arguments = (jets._exponents(degree), jets.MIN_SPREAD, centres, 64 * kernel_threads(), pool)
+        options = (facing if check else points, check, jets.AWAY_FRACTION, 0.0, np.zeros(0))
+        got = kernels("jets").fit_jet_pairs(
+            points, normals, np.array([radius]), larger, degree, jets.ITERATIONS, *arguments, *options
+        )
+        label = f"degree {degree}, facing {check}"
+        # the smaller balls: the points of the larger walk within the radius, in the order of fit_jets' own walk
+        alone = kernels("jets").fit_jets(
+            points, normals, np.array([radius]), degree, jets.ITERATIONS, *arguments, *options
+        )
+        for got_part, expected_part in zip(got[:6], alone):
+            np.testing.assert_array_equal(got_part, expected_part, err_msg=f"{label}: smaller balls")
+        # both radii against the NumPy fits (the larger balls' sums in another order: compare_jets' tolerance)
+        for k, r in enumerate((radius, larger)):
+            with use_backend("numpy"):
+                expected = jets.fit_jets(
+                    points,
+                    normals,
+                    r,
+                    degree=degree,
+                    centres=centres,
+                    neighbours=pool_mask,
+                    facing=facing if check else None,
+                )
+            coefficients, t1, t2, normal, counts, _ = got[6 * k : 6 * k + 6]
+            compare_jets(
+                (coefficients, (t1, t2, normal), counts),
+                expected,
+                f"{label}, radius {r:g}",
+                (points, normals, r, centres, pool, degree),
+            )
+
+
 def check_jet_curvatures(name):
     from meshcurv import jets
 
@@ -1982,6 +2028,7 @@ TWINS = [
     ),
     Twin("jets.fit_jets", "jets.fit_jets", check_fit_jets, CLEAN + CLOUDS),
     Twin("jets.jet_curvatures", "jets.jet_curvatures", check_jet_curvatures, CLOUDS),
+    Twin("jets.fit_jet_pairs", "jets.fit_jets at both radii", check_fit_jet_pairs, CLEAN + CLOUDS),
     Twin(
         "jets.fit_jets_connected",
         "jets.fit_jets(adjacency=) and jets.jet_normals",

@@ -104,6 +104,7 @@ def one_sided_fits(
     smallest: float | None,
     degree: int = JET_DEGREE,
     iterations: int = JET_ITERATIONS,
+    first: tuple | None = None,
 ):
     """Jets over the largest ball, from ``radius`` down to ``smallest``, that holds one side of the surface.
 
@@ -115,7 +116,8 @@ def one_sided_fits(
     facing away, the ``facing`` check of :func:`~meshcurv.jets.fit_jets`)
     is redone over a ball :data:`SHRINK` times smaller, down to ``smallest``.
     Where the surface is thicker than ``radius`` every fit is the one over
-    ``radius``. ``smallest=None``: one fit over ``radius``, not checked.
+    ``radius``. ``smallest=None``: one fit over ``radius``, not checked. ``first``: the fits over ``radius`` at
+    ``centres`` (at least) already made, the ``(coefficients, frame, counts)`` of :func:`~meshcurv.jets.fit_jets`.
 
     Returns
     -------
@@ -127,7 +129,7 @@ def one_sided_fits(
     """
     n = points.shape[0]
     if smallest is None:
-        coefficients, frame, _ = fit_jets(
+        coefficients, frame, _ = first or fit_jets(
             points, normals, radius, degree=degree, iterations=iterations, centres=centres, neighbours=usable
         )
         return coefficients, frame, np.full(n, float(radius))
@@ -137,7 +139,7 @@ def one_sided_fits(
     todo = np.asarray(centres, dtype=np.int64)
     current = float(radius)
     while todo.size:
-        found, local, _ = fit_jets(
+        found, local, _ = first or fit_jets(
             points,
             normals,
             current,
@@ -147,6 +149,7 @@ def one_sided_fits(
             neighbours=usable,
             facing=normals,
         )
+        first = None
         done = todo[np.isfinite(found[todo]).all(axis=1)]
         coefficients[done] = found[done]
         for whole, part in zip(frame, local):
@@ -171,7 +174,25 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
     receives ``"radii"``: (N,) the radius of each point's fit.
     """
     logger.debug("point cloud: jet fits")
-    coefficients, frame, radii = one_sided_fits(points, normals, radius, centres, usable, smallest=smallest)
+    first = larger = None
+    if details is not None:  # the fits over the check's balls LARGER times larger too, in the same walk
+        both: dict = {}
+        first = fit_jets(
+            points,
+            normals,
+            radius,
+            degree=JET_DEGREE,
+            iterations=JET_ITERATIONS,
+            centres=centres,
+            neighbours=usable,
+            facing=None if smallest is None else normals,
+            details=both,
+            larger=radius * LARGER,
+        )
+        larger = both["larger"]
+    coefficients, frame, radii = one_sided_fits(
+        points, normals, radius, centres, usable, smallest=smallest, first=first
+    )
     logger.debug("point cloud: curvatures of the jets")
     if details is not None:
         details["radii"] = radii
@@ -181,7 +202,13 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
         done = np.asarray(centres, dtype=np.int64)
         done = done[np.isfinite(found[0][done])]
         wide_coefficients, wide_frame, wide_radii = one_sided_fits(
-            points, normals, radius * LARGER, done, usable, smallest=None if smallest is None else smallest * LARGER
+            points,
+            normals,
+            radius * LARGER,
+            done,
+            usable,
+            smallest=None if smallest is None else smallest * LARGER,
+            first=larger,
         )
         wide_found = _jet_curvatures(wide_coefficients, wide_frame, wide_radii, normals)
         details["unsteady"] = unsteady(found, wide_found, done, radius)

@@ -307,6 +307,7 @@ def fit_jets(
     compact: bool = False,
     areas: np.ndarray | None = None,
     min_spread: float = MIN_SPREAD,
+    larger: float | None = None,
 ):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
@@ -368,6 +369,15 @@ def fit_jets(
         Smallest spread of a ball's points that a degree is solved on (else
         the next lower degree): :data:`MIN_SPREAD` for curvatures,
         :data:`NORMAL_MIN_SPREAD` for fits that give normals only.
+    larger : float, optional
+        Also fit, with the same options, over balls of this radius (larger than
+        ``radius``) at the same centres: ``details["larger"]`` receives that
+        call's ``(coefficients, frame, counts)``. With the compiled kernels, one
+        radius and no ``adjacency``, each centre's larger ball is walked once for
+        both fits (the smaller ball's points are those of the larger one within
+        ``radius``, in the same order: the fits over ``radius`` are those of the
+        call without ``larger`` to the bit, those over ``larger`` within rounding
+        of a call of their own).
 
     Returns
     -------
@@ -387,7 +397,8 @@ def fit_jets(
         The balls would hold more than :data:`meshcurv.neighborhoods.MAX_BALL_PAIRS`
         pairs in all (a radius far too large for the mesh); ``radius`` is an
         array that does not hold one positive finite radius per centre, or that
-        gives a centre listed twice two radii.
+        gives a centre listed twice two radii; ``larger`` is given without
+        ``details``, or is not a number larger than ``radius``.
     """
     vertices = checked_points(vertices)
     n = vertices.shape[0]
@@ -413,10 +424,33 @@ def fit_jets(
         facing = np.ascontiguousarray(facing, dtype=np.float64)
         if facing.shape != vertices.shape:
             raise InvalidMeshError(f"`facing` must have shape {vertices.shape}; got {facing.shape}")
+    kernels = numba_kernels("jets")
+    paired = False  # both radii in one walk
+    if larger is not None:
+        larger = _checked_larger(larger, radius, details)
+        paired = kernels is not None and n > 0 and adjacency is None and not per_centre
+        if not paired:
+            details["larger"] = fit_jets(  # type: ignore[index]  # (details checked)
+                vertices,
+                normals,
+                larger,
+                degree=degree,
+                iterations=iterations,
+                centres=None if every_vertex else centres,
+                chunk_size=chunk_size,
+                neighbours=neighbours,
+                facing=facing,
+                adjacency=adjacency,
+                settled=settled,
+                compact=compact,
+                areas=areas,
+                min_spread=min_spread,
+            )
     pool_points = vertices[pool]
     areas = _checked_areas(areas, n)
     mean, _ = check_ball_work(pool_points, radius, centres.size, centres=vertices[centres])
-    kernels = numba_kernels("jets")
+    if paired:
+        mean += check_ball_work(pool_points, larger, centres.size, centres=vertices[centres])[0]
     if kernels is not None and n:
         if adjacency is not None:  # one row per centre
             rows = _connected_fits(
@@ -436,37 +470,29 @@ def fit_jets(
                 areas=areas,
                 min_spread=min_spread,
             )
+            if not compact and not every_vertex:
+                rows = [_all_rows(row, centres, n, 0.0 if k == 4 else np.nan) for k, row in enumerate(rows)]
         else:
             radii = _all_rows(radius, centres, n, 0.0) if per_centre else np.array([float(radius)])  # by vertex
+            ranges = call_ranges(centres.size, mean, radius * radius if per_centre else None)
+            # one call: its outputs (rows of all vertices, NaN and counts 0 but at the centres) are the result
+            whole = len(ranges) == 1 and not compact
+            kernel, extra = (kernels.fit_jet_pairs, (float(larger),)) if paired else (kernels.fit_jets, ())
+            fit = (degree, iterations, _exponents(degree), min_spread)
+            checks = (pool, facing if check else vertices, check, AWAY_FRACTION, float(settled), areas)
             pieces = []  # each call's outputs, one row per centre of its part
-            for lo, hi in call_ranges(centres.size, mean, radius * radius if per_centre else None):
+            for lo, hi in ranges:
                 part = centres[lo:hi]  # rows of all vertices: those of the part (a slice when the centres are all)
+                outputs = kernel(vertices, normals, radii, *extra, *fit, part, 64 * kernel_threads(), *checks)
                 pieces.append(
-                    tuple(
-                        output[lo:hi] if every_vertex else output[part]
-                        for output in kernels.fit_jets(
-                            vertices,
-                            normals,
-                            radii,
-                            degree,
-                            iterations,
-                            _exponents(degree),
-                            min_spread,
-                            part,
-                            64 * kernel_threads(),
-                            pool,
-                            facing if check else vertices,
-                            check,
-                            AWAY_FRACTION,
-                            float(settled),
-                            areas,
-                        )
-                    )
+                    outputs if whole else tuple(output[lo:hi] if every_vertex else output[part] for output in outputs)
                 )
             rows = _joined(pieces)
-        if not compact and not every_vertex:
-            rows = [_all_rows(row, centres, n, 0.0 if k == 4 else np.nan) for k, row in enumerate(rows)]
-        coefficients, t1, t2, normal, counts, away = rows
+            if not compact and not every_vertex and not whole:
+                rows = [_all_rows(row, centres, n, 0.0 if k % 6 == 4 else np.nan) for k, row in enumerate(rows)]
+        coefficients, t1, t2, normal, counts, away = rows[:6]
+        if paired:
+            details["larger"] = (rows[6], tuple(rows[7:10]), rows[10])  # type: ignore[index]  # (details checked)
         if details is not None:
             details["away"] = away
         return coefficients, (t1, t2, normal), counts
@@ -529,6 +555,25 @@ def fit_jets(
     if details is not None:
         details["away"] = away
     return coefficients, tuple(frame), counts
+
+
+def _checked_larger(larger, radius, details: dict | None) -> float:
+    """``larger`` of :func:`fit_jets` as a float, checked: a number above every ``radius``, and ``details`` given.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``details`` is None (the larger fits are returned in it), or ``larger`` is not a finite
+        number larger than ``radius``.
+    """
+    if details is None:
+        raise InvalidOptionError("`larger` needs `details`: the fits over the larger balls are returned in it")
+    value = float(larger) if isinstance(larger, (int, float, np.floating, np.integer)) else np.nan
+    if not (np.isfinite(value) and value > np.max(radius)):
+        raise InvalidOptionError(
+            f"`larger` must be a finite number larger than `radius` {np.max(radius):g}; got {larger!r}"
+        )
+    return value
 
 
 def _checked_areas(areas, n: int) -> np.ndarray:

@@ -91,6 +91,7 @@ def fit_jets(
     away_fraction,
     settled,
     areas,
+    larger=0.0,
 ):
     """``jets.fit_jets``: weighted jets over the balls of ``radii``, frame re-estimated from each fit.
 
@@ -109,10 +110,12 @@ def fit_jets(
     ``areas`` (V,): each point's weight is also its area (empty: none).
 
     The fits run in ``n_chunks`` ranges of the centres (:func:`_grid_chunk`)
-    on threads (:func:`~meshcurv._kernels._common.run_chunks`).
+    on threads (:func:`~meshcurv._kernels._common.run_chunks`). With ``larger``
+    > 0, the fits over balls of that radius too (:func:`fit_jet_pairs`).
     """
     points, ids, grid, centres = _grid_centres(vertices, pool, radii, centres)
     outputs = _jet_outputs.py_func(vertices.shape[0])  # NumPy's: one compiled function fewer to load
+    wider = _jet_outputs.py_func(vertices.shape[0] if larger > 0 else 1)  # (one row unused without larger)
     limits = np.array([away_fraction, settled])
     facing = facing[: facing.shape[0] if check_facing else 0]
     run_chunks(
@@ -134,9 +137,28 @@ def fit_jets(
         limits,
         areas,
         *outputs,
+        float(larger),
+        wider,
         _general(degree),
     )
-    return outputs
+    return outputs + wider if larger > 0 else outputs
+
+
+@threaded
+def fit_jet_pairs(vertices, normals, radii, larger, *options):
+    """``jets.fit_jets(larger=)``: the fits of :func:`fit_jets` over balls of ``radii[0]`` and of ``larger``
+    (one radius each, ``larger > radii[0]``) at the same centres, from one walk of the grid per centre.
+
+    ``options``: the arguments of :func:`fit_jets` after ``radii``. The grid is that of :func:`fit_jets` over
+    ``radii[0]`` (cells of that side); each centre's ball of ``larger`` is walked once
+    (:func:`~meshcurv._kernels.neighborhoods._ball_members`), and the ball of ``radii[0]`` is the subsequence
+    of its members within that radius: the same points in the same order as :func:`fit_jets` finds them (the
+    cells of the smaller walk, in the same column-major order, are a sub-block of the larger one's), so the
+    fits over ``radii[0]`` are those of :func:`fit_jets` to the bit. The fits over ``larger`` sum the same
+    points in another order than :func:`fit_jets` over a grid of cells of side ``larger`` (within rounding of
+    them). Returns the six outputs of :func:`fit_jets` over ``radii[0]``, then the six over ``larger``.
+    """
+    return fit_jets(vertices, normals, radii, *options, float(larger))
 
 
 @nb.njit(**_JIT)
@@ -187,16 +209,37 @@ def _grid_chunk(
     ns,
     counts,
     away,
+    larger,
+    wider,
     general,
 ):
-    """The fits of ``centres[lo:hi]`` of :func:`fit_jets`, written to their rows of the outputs."""
+    """The fits of ``centres[lo:hi]`` of :func:`fit_jets`, written to their rows of the outputs; with ``larger``
+    > 0, those over balls of that radius too, to the outputs ``wider`` (:func:`fit_jet_pairs`): one walk of the
+    larger ball, the smaller one its members within the radius. One call site of the inlined :func:`_fit_one`."""
     per_vertex = radii.shape[0] > 1
     members = np.empty(64, np.int64)
+    inner = np.empty(64, np.int64)  # the smaller ball of a pair
+    outer = np.empty(64, np.int64)  # the larger one
+    outer_size = 0
+    smaller = (coefficients, t1s, t2s, ns, counts, away)
     work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
-    for i in range(lo, hi):
-        v = centres[i]
+    steps = 2 if larger > 0 else 1  # fits per centre
+    for step in range(lo * steps, hi * steps):
+        v = centres[step // steps]
         radius = radii[v if per_vertex else 0]
-        members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius, members)
+        coefficients, t1s, t2s, ns, counts, away = smaller
+        if steps == 1:
+            members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius, members)
+        elif step % 2 == 0:  # the walk of the larger ball, its members within the radius the smaller one
+            outer, outer_size = _ball_members(
+                points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], larger, outer
+            )
+            if inner.shape[0] < outer_size:
+                inner = np.empty(outer.shape[0], np.int64)
+            members, size = inner, _nested_members(points, vertices[v], radius, outer, outer_size, inner)
+        else:
+            radius, members, size = larger, outer, outer_size
+            coefficients, t1s, t2s, ns, counts, away = wider
         work = _fit_one(
             vertices,
             points,
@@ -229,6 +272,23 @@ def _grid_chunk(
             areas,
             general,
         )
+
+
+@nb.njit(**_JIT)
+def _nested_members(points, centre, radius, outer, outer_size, members):
+    """The members of ``outer[:outer_size]`` within ``radius`` of ``centre``, in their order, written to
+    ``members`` (at least ``outer_size`` long); their count. Squared distances as
+    :func:`~meshcurv._kernels.neighborhoods._ball_members` forms them: the same points it finds."""
+    cutoff2 = radius * radius
+    count = 0
+    for a in range(outer_size):  # branch-free: every candidate written, the inside ones kept
+        j = outer[a]
+        dx = points[j, 0] - centre[0]
+        dy = points[j, 1] - centre[1]
+        dz = points[j, 2] - centre[2]
+        members[count] = j
+        count += dx * dx + dy * dy + dz * dz <= cutoff2
+    return count
 
 
 def _general(degree: int) -> bool | None:

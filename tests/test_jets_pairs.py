@@ -1,0 +1,90 @@
+"""``jets.fit_jets(larger=)``: the fits over two radii at the same centres, in one walk (issue 31).
+
+The point clouds' jets check each estimate against the same fit over balls sqrt(2) times larger; both are
+fitted in one walk of the larger ball. The oracle is the call of :func:`meshcurv.jets.fit_jets` at each radius
+alone: the smaller balls' fits must be those to the bit (the same points summed in the same order), the larger
+balls' within rounding (the same points in another order), on both backends.
+"""
+
+import importlib.util
+
+import numpy as np
+import pytest
+
+from meshcurv import jets
+from meshcurv._backend import use_backend
+from meshcurv.errors import InvalidOptionError
+
+BACKENDS = [
+    "numpy",
+    pytest.param(
+        "numba", marks=pytest.mark.skipif(importlib.util.find_spec("numba") is None, reason="numba is not installed")
+    ),
+]
+
+
+def _sphere_cloud(n=3000, seed=3):
+    """Random points of the unit sphere, their outward normals, and a few flipped (balls refused by ``facing``)."""
+    rng = np.random.default_rng(seed)
+    points = rng.normal(size=(n, 3))
+    points /= np.linalg.norm(points, axis=1, keepdims=True)
+    facing = points.copy()
+    facing[rng.random(n) < 0.03] *= -1
+    return points, points.copy(), facing
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_both_radii_are_the_fits_of_each_radius_alone(backend):
+    points, normals, facing = _sphere_cloud()
+    rng = np.random.default_rng(4)
+    centres = np.flatnonzero(rng.random(points.shape[0]) > 0.3)
+    usable = rng.random(points.shape[0]) > 0.05
+    radius, larger = 0.12, 0.12 * 2.0**0.5
+    options = {"degree": 3, "centres": centres, "neighbours": usable, "facing": facing}
+    with use_backend(backend):
+        details = {}
+        small = jets.fit_jets(points, normals, radius, details=details, larger=larger, **options)
+        alone_small = jets.fit_jets(points, normals, radius, **options)
+        alone_large = jets.fit_jets(points, normals, larger, **options)
+    large = details["larger"]
+    for got, expected in ((small, alone_small), (large, alone_large)):
+        np.testing.assert_array_equal(got[2], expected[2])  # the counts: the same balls
+        np.testing.assert_array_equal(np.isnan(got[0]), np.isnan(expected[0]))
+    np.testing.assert_array_equal(small[0], alone_small[0])  # the same sums in the same order
+    for got_part, expected_part in zip(small[1], alone_small[1]):
+        np.testing.assert_array_equal(got_part, expected_part)
+    # the larger balls' sums in another order: a well-conditioned fit (about 60 points on a sphere) moves by a
+    # few hundred eps of its coefficients (in units of the radius, of order 1)
+    np.testing.assert_allclose(large[0], alone_large[0], rtol=0, atol=1e-11)
+    for got_part, expected_part in zip(large[1], alone_large[1]):
+        np.testing.assert_allclose(got_part, expected_part, rtol=0, atol=1e-11)
+    # and the sphere's curvature from the fits (k = 1 on the unit sphere, up to the jets' bias, r^2 of k)
+    fitted = np.isfinite(small[0][:, 3])  # (a ball holding a flipped normal is refused: a third of them)
+    assert fitted[centres].mean() > 0.5
+    k = jets.jet_curvatures(small[0], small[1], np.full(points.shape[0], radius), normals)[:2]
+    assert np.nanmedian(np.abs(np.concatenate(k) - 1.0)) < 0.05
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_larger_with_a_radius_per_centre_is_a_second_call(backend):
+    points, normals, _ = _sphere_cloud(1500)
+    radii = np.linspace(0.15, 0.2, points.shape[0])
+    with use_backend(backend):
+        details = {}
+        jets.fit_jets(points, normals, radii, degree=3, details=details, larger=0.3)
+        expected = jets.fit_jets(points, normals, 0.3, degree=3)
+    for got_part, expected_part in zip(details["larger"][0:1] + details["larger"][2:], expected[0:1] + expected[2:]):
+        np.testing.assert_array_equal(got_part, expected_part)
+
+
+def test_larger_needs_details():
+    points, normals, _ = _sphere_cloud(200)
+    with pytest.raises(InvalidOptionError, match="`larger` needs `details`"):
+        jets.fit_jets(points, normals, 0.2, larger=0.3)
+
+
+@pytest.mark.parametrize("larger", [0.2, 0.1, np.nan, np.inf, "0.3"])
+def test_larger_must_exceed_the_radius(larger):
+    points, normals, _ = _sphere_cloud(200)
+    with pytest.raises(InvalidOptionError, match="`larger` must be a finite number larger than `radius` 0.2"):
+        jets.fit_jets(points, normals, 0.2, details={}, larger=larger)
