@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._backend import twin
-from ._validation import as_vertices, check_choice
+from ._validation import as_vertices
 from .errors import InvalidOptionError
 from .topology import MeshTopology, as_topology
 
@@ -262,8 +262,9 @@ def oriented_topology(vertices: np.ndarray, topology: MeshTopology, orient: str)
 
     ``'keep'`` returns ``topology`` untouched; otherwise the reversed faces get
     a new topology (the given one is returned when nothing had to change).
+    ``orient`` is one of :data:`ORIENT_CHOICES`, checked by the caller
+    (:func:`meshcurv._prepared.prepare_mesh`).
     """
-    check_choice(orient, "orient", ORIENT_CHOICES)
     if orient in ("keep", "auto"):  # 'auto' is resolved by the caller, which knows the method
         return topology, 0
     flip = face_flips(vertices, topology, outward=orient == "outward")
