@@ -813,26 +813,26 @@ def call_ranges(n: int, pairs_per_centre: float, weights: np.ndarray | None = No
 
 def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int, nested: bool = False) -> tuple[np.ndarray, ...]:
     """The per-thread scratch of the compiled ``connected_face_sums``:
-    ``(seen, mark, known, squared, queue, deferred, levels)`` (and of ``connected_face_sums_nested``).
+    ``(seen, mark, known, squared, queue, levels, spare)`` (and of ``connected_face_sums_nested``).
 
     ``seen`` (n_chunks, F), ``mark`` and ``known`` (n_chunks, V) filled with -1, ``squared``
     (n_chunks, V) float and ``queue`` (n_chunks, V). Allocated once for all the calls over
     one mesh: each array is stamped with the centre it was last written for, and every centre is
     summed once, so no call needs it cleared again. The stamps and the queue hold vertex
     indices: int32 while the vertex and face counts fit in it (half the memory: 40 bytes per vertex
-    on 2 threads), int64 beyond. ``deferred`` and ``levels``: (n_chunks, F) with ``nested``
-    (several radii in one walk: the faces met by a larger ball only), (n_chunks, 0) otherwise.
+    on 2 threads), int64 beyond. ``levels``: (n_chunks, V) with ``nested`` (several radii in one
+    walk: the smallest ball each queued vertex was reached through), (n_chunks, 0) otherwise; ``spare``:
+    (n_chunks, 0), the place of the clusters' scratch (``clustered_face_sums``).
     """
     index = np.int32 if max(n_vertices, n_faces) < np.iinfo(np.int32).max else np.int64
-    waiting = n_faces if nested else 0
     return (
         np.full((n_chunks, n_faces), -1, index),
         np.full((n_chunks, n_vertices), -1, index),
         np.full((n_chunks, n_vertices), -1, index),
         np.empty((n_chunks, n_vertices)),
         np.empty((n_chunks, n_vertices), index),
-        np.empty((n_chunks, waiting), index),
-        np.empty((n_chunks, waiting), index),
+        np.empty((n_chunks, n_vertices if nested else 0), index),
+        np.empty((n_chunks, 0), index),
     )
 
 
@@ -848,7 +848,7 @@ def _connected_face_sums(
     """(R, V, k) :func:`ball_face_sums` over the surface-connected piece of each ball (compiled kernel,
     breadth-first), at the R nested radii ``radii`` (R, 1) (one for all vertices) or (R, V) (one per vertex),
     of ``values`` (1, F, k) (the same for every radius) or (R, F, k) (one set per radius). One radius:
-    ``connected_face_sums``; several: ``connected_face_sums_nested`` (one walk per vertex, in passes).
+    ``connected_face_sums``; several: ``connected_face_sums_nested`` (one walk per vertex, that of the largest).
     ``n_centres``: only the balls of the first ``n_centres`` vertices (the other rows are 0)."""
     n = vertices.shape[0]
     m = n if n_centres is None else n_centres
@@ -1158,11 +1158,13 @@ def ball_face_sums_nested(
     Row ``r`` equals ``ball_face_sums(vertices, faces, radii[r], values,
     usable=usable, connected=True)`` (``values[r]`` when ``values`` holds one
     set per radius) to round-off (the same faces and shares,
-    added in another order). The compiled kernel walks the largest ball of
-    each vertex once, in passes: pass ``r`` extends the walk of ball ``r - 1``
-    by the faces that meet ball ``r``, and a face reached in pass ``r`` adds
-    its share to the sums of ball ``r`` and of every larger one. The NumPy
-    path computes each radius on its own.
+    added in another order; the largest radius's row to the bit). The compiled
+    kernel walks the largest ball of each vertex once and adds each face it
+    reaches to the rows of the smaller balls whose pieces the walk shows it is in
+    (it reached the face through faces that meet that ball); a smaller ball the
+    walk cannot vouch for (a face it meets reached only through a larger one) is
+    walked on its own, for that vertex alone. The NumPy path computes each radius
+    on its own.
 
     Parameters
     ----------

@@ -380,52 +380,15 @@ def _face_level(vertices, faces, f, d, low, high, reach, ball, ball2, cx, cy, cz
 
 
 @nb.njit(inline="always", **_JIT)
-def _add_face(faces, f, first, low, high, ball, ball2, usable, values, total, v, mark, queue, tail):
-    """Face ``f`` met by the balls ``first`` and up: ``share * values[., f]`` added to their rows of ``total``
-    (``share``: ``neighborhoods.face_in_ball_ratios``; ``values[r, f]``, or ``values[0, f]`` for every ball),
-    its corners queued. Returns the queue's new tail."""
-    if usable[f]:
-        per_ball = values.shape[0] > 1
-        for r in range(first, ball.shape[0]):
-            radius = ball[r]
-            radius2 = ball2[r]
-            if high <= radius2:
-                share = 1.0
-            elif low >= radius2:
-                share = 0.0  # a side crosses the sphere, no corner is inside
-            else:
-                root = math.sqrt(low)
-                share = (radius - root) / (math.sqrt(high) - root)
-            if share != 0.0:
-                row = r if per_ball else 0
-                for k in range(values.shape[2]):
-                    total[r, k] += share * values[row, f, k]
-    for corner in range(3):
-        c = faces[f, corner]
-        if mark[c] != v:
-            mark[c] = v
-            queue[tail] = c
-            tail += 1
-    return tail
-
-
-@nb.njit(inline="always", **_JIT)
-def _walk_face(
-    vertices, faces, centroids, reach, usable, values, f, v, radius, known, squared, total, mark, queue, tail
-):
-    """Face ``f`` reached by the walk of the ball ``B(x_v, radius)`` (:func:`connected_face_sums`): where it
-    meets the closed ball (a corner or its centroid inside, or a side crossing the sphere), ``share *
-    values[f]`` added to ``total`` (``usable`` faces) and its corners queued. Returns the queue's new tail."""
-    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
-    radius2 = radius * radius
-    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
-    if d > (radius + reach[f]) ** 2:
-        return tail  # every point of the face is outside
+def _met_share(vertices, faces, f, d, cx, cy, cz, v, radius, radius2, known, squared):
+    """``(met, share, low, high)`` of face ``f`` (centroid at squared distance ``d``) in the closed ball
+    ``B((cx, cy, cz), radius)``: whether it meets it (a corner or its centroid inside, or a side crossing the
+    sphere), its share (``neighborhoods.face_in_ball_ratios``) and the smallest and largest squared distances
+    of :func:`_face_extent`."""
     low, high = _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared)
     if high <= radius2:
-        share = 1.0
-    elif low >= radius2:  # corners and centroid outside: on through the face if an edge crosses
-        share = 0.0
+        return True, 1.0, low, high
+    if low >= radius2:  # corners and centroid outside: met if a side crosses the sphere
         crossed = False
         for corner in range(3):
             p = faces[f, corner]
@@ -439,18 +402,35 @@ def _walk_face(
                 vertices[q, 2] - cz,
                 radius2,
             )
-        if not crossed:
-            return tail
-    else:
-        root = math.sqrt(low)
-        share = (radius - root) / (math.sqrt(high) - root)
+        return crossed, 0.0, low, high
+    root = math.sqrt(low)
+    return True, (radius - root) / (math.sqrt(high) - root), low, high
+
+
+@nb.njit(inline="always", **_JIT)
+def _walk_face(
+    vertices, faces, centroids, reach, usable, values, f, v, stamp, radius, known, squared, total, mark, queue, tail
+):
+    """Face ``f`` reached by the walk of the ball ``B(x_v, radius)`` (:func:`connected_face_sums`): where it
+    meets the closed ball (a corner or its centroid inside, or a side crossing the sphere), ``share *
+    values[f]`` added to ``total`` (``usable`` faces) and its corners queued (``mark`` stamped with
+    ``stamp``: ``v``, or another number for a second walk around the same centre). Returns the queue's new
+    tail."""
+    cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+    radius2 = radius * radius
+    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
+    if d > (radius + reach[f]) ** 2:
+        return tail  # every point of the face is outside
+    met, share, _, _ = _met_share(vertices, faces, f, d, cx, cy, cz, v, radius, radius2, known, squared)
+    if not met:
+        return tail
     if share != 0.0 and usable[f]:
         for k in range(values.shape[1]):
             total[k] += share * values[f, k]
     for corner in range(3):
         c = faces[f, corner]
-        if mark[c] != v:
-            mark[c] = v
+        if mark[c] != stamp:
+            mark[c] = stamp
             queue[tail] = c
             tail += 1
     return tail
@@ -499,36 +479,47 @@ def connected_face_sums(
             radius = radii[v if per_vertex else 0]
             for k in range(n_values):
                 total[k] = out[v, k]
-            mark[v] = v
-            queue[0] = v
-            head, tail = 0, 1
-            while head < tail:
-                a = queue[head]
-                head += 1
-                for j in range(indptr[a], indptr[a + 1]):
-                    f = indices[j]
-                    if seen[f] == v:
-                        continue
-                    seen[f] = v
-                    tail = _walk_face(
-                        vertices,
-                        faces,
-                        centroids,
-                        reach,
-                        usable,
-                        values,
-                        f,
-                        v,
-                        radius,
-                        known,
-                        squared,
-                        total,
-                        mark,
-                        queue,
-                        tail,
-                    )
+            _face_walk(
+                vertices,
+                faces,
+                centroids,
+                reach,
+                usable,
+                values,
+                indptr,
+                indices,
+                v,
+                v,
+                radius,
+                (known, squared, seen, mark, queue),
+                total,
+            )
             for k in range(n_values):
                 out[v, k] = total[k]
+
+
+@nb.njit(inline="always", **_JIT)
+def _inner_rows(first, top, low, high, ball, ball2, values, f, total):
+    """``share * values[r, f]`` (``values[0, f]`` for every ball) added to the rows ``first`` to ``top - 1`` of
+    ``total``, the share in ball ``r`` as :func:`_walk_face` computes it (the roots taken once)."""
+    per_ball = values.shape[0] > 1
+    root = -1.0
+    span = 0.0
+    for r in range(first, top):
+        radius2 = ball2[r]
+        if high <= radius2:
+            share = 1.0
+        elif low >= radius2:
+            share = 0.0
+        else:
+            if root < 0.0:
+                root = math.sqrt(low)
+                span = math.sqrt(high) - root
+            share = (ball[r] - root) / span
+        if share != 0.0:
+            row = r if per_ball else 0
+            for k in range(values.shape[2]):
+                total[r, k] += share * values[row, f, k]
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -542,40 +533,40 @@ def connected_face_sums_nested(
 
     ``radii[r, 0]`` is the radius of ball ``r`` around every vertex, ``radii[r, v]``
     that around vertex ``v`` (one column per vertex); the balls of a vertex are
-    nested (``radii[r, v] <= radii[r + 1, v]``). ``share`` is
-    ``neighborhoods.face_in_ball_ratios`` (1 inside, 0 outside, linear in
-    between by the corners' and centroid's distances). The faces are found
-    breadth-first from the faces around each vertex (``indptr, indices``:
-    :func:`vertex_face_lists`), on through the corners of every face that has a
-    point of an edge, a corner or its centroid in the closed ball ``B(x_v, radius)``
-    (``centroids`` and ``reach`` of :func:`cell_centres`: a face whose centroid is
-    farther than ``radius + reach`` is outside, one distance; each vertex's
-    distance is computed once per centre): when the ball's part of the surface
-    is connected, every face of the Euclidean ball (a path inside the ball goes
-    from face to face across edges that meet it); another sheet of the surface
-    inside the ball is left out. Faces not ``usable`` (F,) lead the search on but
-    add nothing. The other rows of ``out`` are not touched: a caller that splits
-    the vertices into ranges sums them into one array. ``scratch``:
-    ``neighborhoods._face_sum_scratch``, one chunk of the vertices per row of its
-    arrays (reused from call to call).
+    nested (``radii[r, v] <= radii[r + 1, v]``). Row ``r`` holds what
+    :func:`connected_face_sums` gives at ball ``r``'s radius: the same faces and
+    shares (``neighborhoods.face_in_ball_ratios``), the largest ball's row to the
+    bit (the same walk, additions in the same order), the smaller ones to
+    round-off (another order). Faces not ``usable`` (F,) lead the walks on but add
+    nothing. The other rows of ``out`` are not touched: a caller that splits the
+    vertices into ranges sums them into one array. ``scratch``:
+    ``neighborhoods._face_sum_scratch`` with ``nested``, one chunk of the vertices per
+    row of its arrays (reused from call to call).
 
-    Nested balls share one walk, in passes: pass ``r`` walks the piece of ball
-    ``r``, starting from where pass ``r - 1`` stopped and from the faces it met
-    that meet ball ``r`` but not ball ``r - 1`` (kept in the scratch's
-    ``deferred``, with their ``levels``: the first ball they meet). A face
-    reached in pass ``p`` adds its share to the rows ``p`` and up: exactly the
-    faces of R separate walks (a face reached first in pass ``p`` touches no
-    vertex of the pieces of the smaller balls), summed in another order. With
-    one radius, the walk and the order of the additions are those of
-    :func:`connected_face_sums` (the deferred faces are the faces that meet no ball).
+    One walk per vertex, that of the largest ball (:func:`connected_face_sums`), certifies
+    the smaller balls' faces on the way: each queued vertex carries the smallest ball
+    ``tau`` that the walk reached it through (every face on its way meets ball ``tau``
+    or a smaller one; the centre: 0), and a face met first by ball ``met`` and reached
+    from a vertex of level ``tau`` belongs to the pieces of the balls ``max(met, tau)``
+    and up (a path of faces that meet each of them leads to it), whose rows it adds to.
+    Where a face meets a ball smaller than the level it was reached at, the walk does
+    not tell whether that ball's own walk reaches it (the piece of that ball may be
+    connected to it through other faces only, or not at all): the row of each such ball
+    is summed again by its own walk (:func:`_walk_face`), for that vertex alone. On a
+    surface whose balls are connected pieces, as breadth-first walks reach the nearer
+    faces first, that is rare (none on a 100k icosphere at h, 2 h, 4 h); the cost of the
+    smaller balls is then their faces' additions, not their walks.
     """
     n = vertices.shape[0]
     n_values = values.shape[2]
     n_radii = radii.shape[0]
+    top = n_radii - 1
     per_vertex = radii.shape[1] > 1
+    per_ball = values.shape[0] > 1
+    top_row = top if per_ball else 0
     start = max(min(start, n), 0)
     m = max(min(stop, n), start) - start
-    all_seen, all_mark, all_known, all_squared, all_queue, all_deferred, all_levels = scratch
+    all_seen, all_mark, all_known, all_squared, all_queue, all_level, _ = scratch
     n_chunks = all_seen.shape[0]
     for chunk in nb.prange(n_chunks):
         seen = all_seen[chunk]
@@ -583,64 +574,146 @@ def connected_face_sums_nested(
         known = all_known[chunk]  # distance to this centre in `squared`
         squared = all_squared[chunk]
         queue = all_queue[chunk]  # a vertex is queued at most once per centre: never grown
-        deferred = all_deferred[chunk]  # a face is deferred at most once per centre: never grown
-        levels = all_levels[chunk]
+        level = all_level[chunk]  # the smallest ball each queued vertex was reached through
         total = np.empty((n_radii, n_values))  # the centre's sums, in the order of the face visits, then stored once
         ball = np.empty(n_radii)  # the centre's radii
         ball2 = np.empty(n_radii)  # and their squares
+        unsure = np.zeros(n_radii, np.bool_)  # the balls to walk on their own
         for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
             w = v if per_vertex else 0
             for r in range(n_radii):
                 ball[r] = radii[r, w]
                 ball2[r] = ball[r] * ball[r]
-            outer = ball[n_radii - 1]
+                unsure[r] = False
+            outer = ball[top]
+            outer2 = ball2[top]
+            inner = ball[top - 1] if top > 0 else 0.0
             cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
             for r in range(n_radii):
                 for k in range(n_values):
                     total[r, k] = out[r, v, k]
             mark[v] = v
+            if top > 0:
+                level[v] = 0
             queue[0] = v
             head, tail = 0, 1
-            n_deferred = 0
-            for p in range(n_radii):
-                kept = 0
-                for e in range(n_deferred):  # the faces met first by this pass's ball lead it on
-                    f = deferred[e]
-                    if levels[e] != p:
-                        deferred[kept] = f
-                        levels[kept] = levels[e]
-                        kept += 1
+            while head < tail:
+                a = queue[head]
+                head += 1
+                through = level[a] if top > 0 else 0
+                for j in range(indptr[a], indptr[a + 1]):
+                    f = indices[j]
+                    if seen[f] == v:
                         continue
+                    seen[f] = v
                     d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
-                    low, high = _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared)
-                    tail = _add_face(faces, f, p, low, high, ball, ball2, usable, values, total, v, mark, queue, tail)
-                n_deferred = kept
-                while head < tail:
-                    a = queue[head]
-                    head += 1
-                    for j in range(indptr[a], indptr[a + 1]):
-                        f = indices[j]
-                        if seen[f] == v:
-                            continue
-                        seen[f] = v
-                        d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
-                        if d > (outer + reach[f]) ** 2:
-                            continue  # every point of the face is outside the largest ball
-                        low, high = _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared)
-                        level = _face_level(vertices, faces, f, d, low, high, reach[f], ball, ball2, cx, cy, cz)
-                        if level == n_radii:
-                            continue  # it meets no ball
-                        if level > p:  # met by a larger ball only: it leads that ball's pass on
-                            deferred[n_deferred] = f
-                            levels[n_deferred] = level
-                            n_deferred += 1
-                            continue
-                        tail = _add_face(
-                            faces, f, p, low, high, ball, ball2, usable, values, total, v, mark, queue, tail
-                        )
+                    if d > (outer + reach[f]) ** 2:
+                        continue  # every point of the face is outside
+                    met, share, low, high = _met_share(
+                        vertices, faces, f, d, cx, cy, cz, v, outer, outer2, known, squared
+                    )  # the largest ball: as _walk_face
+                    if not met:
+                        continue
+                    if share != 0.0 and usable[f]:
+                        for k in range(n_values):
+                            total[top, k] += share * values[top_row, f, k]
+                    reached = top
+                    if top > 0 and d <= (inner + reach[f]) ** 2:  # it may meet a smaller ball
+                        met = _face_level(vertices, faces, f, d, low, high, reach[f], ball, ball2, cx, cy, cz)
+                        reached = max(met, through)
+                        if usable[f]:
+                            _inner_rows(reached, top, low, high, ball, ball2, values, f, total)
+                            for r in range(met, through):  # met by ball r, reached through a larger one
+                                unsure[r] = True
+                    for corner in range(3):
+                        c = faces[f, corner]
+                        if mark[c] != v:
+                            mark[c] = v
+                            if top > 0:
+                                level[c] = reached
+                            queue[tail] = c
+                            tail += 1
+                        elif reached < top and reached < level[c]:  # a smaller ball's way to it (used if still queued)
+                            level[c] = reached
+            for r in range(top):
+                if unsure[r]:
+                    _walk_ball(
+                        vertices,
+                        faces,
+                        centroids,
+                        reach,
+                        usable,
+                        values[r if per_ball else 0],
+                        indptr,
+                        indices,
+                        v,
+                        ball[r],
+                        (known, squared, seen, mark, queue),
+                        total[r],
+                        out[r, v],
+                    )
             for r in range(n_radii):
                 for k in range(n_values):
                     out[r, v, k] = total[r, k]
+
+
+@nb.njit(inline="always", **_JIT)
+def _face_walk(vertices, faces, centroids, reach, usable, values, indptr, indices, v, stamp, radius, buffers, total):
+    """The walk of :func:`connected_face_sums` around vertex ``v``: the faces of the surface-connected piece of
+    ``B(x_v, radius)`` (:func:`_walk_face`) added to ``total``. ``buffers``: ``(known, squared, seen, mark,
+    queue)``, ``seen`` and ``mark`` stamped with ``stamp``. Returns the number of vertices queued
+    (``queue[:returned]``)."""
+    known, squared, seen, mark, queue = buffers
+    mark[v] = stamp
+    queue[0] = v
+    head, tail = 0, 1
+    while head < tail:
+        a = queue[head]
+        head += 1
+        for j in range(indptr[a], indptr[a + 1]):
+            f = indices[j]
+            if seen[f] == stamp:
+                continue
+            seen[f] = stamp
+            tail = _walk_face(
+                vertices,
+                faces,
+                centroids,
+                reach,
+                usable,
+                values,
+                f,
+                v,
+                stamp,
+                radius,
+                known,
+                squared,
+                total,
+                mark,
+                queue,
+                tail,
+            )
+    return tail
+
+
+@nb.njit(**_JIT)
+def _walk_ball(vertices, faces, centroids, reach, usable, values, indptr, indices, v, radius, buffers, total, first):
+    """``total`` set to ``first`` plus the sums of :func:`connected_face_sums` over the ball ``B(x_v, radius)``, by
+    its own walk (:func:`connected_face_sums_nested`'s balls it could not vouch for).
+
+    ``buffers``: the nested walk's ``(known, squared, seen, mark, queue)``. The walk (:func:`_face_walk`)
+    stamps ``seen`` and ``mark`` with -2 (no centre's number), reuses the distances to ``x_v`` in ``known``
+    and ``squared``, and sets the entries it stamped back to -1 when done, so that the next such walk starts
+    clean."""
+    for k in range(total.shape[0]):
+        total[k] = first[k]
+    tail = _face_walk(vertices, faces, centroids, reach, usable, values, indptr, indices, v, -2, radius, buffers, total)
+    _, _, seen, mark, queue = buffers
+    for i in range(tail):  # every face it saw is around a vertex it queued
+        a = queue[i]
+        mark[a] = -1
+        for j in range(indptr[a], indptr[a + 1]):
+            seen[indices[j]] = -1
 
 
 @threaded
@@ -898,6 +971,7 @@ def clustered_face_sums(
                                 usable,
                                 values,
                                 f,
+                                v,
                                 v,
                                 radius,
                                 known,
