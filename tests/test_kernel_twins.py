@@ -294,6 +294,21 @@ def check_vertex_normal_sums(name):
     np.testing.assert_array_equal(kernels("geometry").vertex_normal_sums(cross, faces, vertices.shape[0]), expected)
 
 
+def check_vertex_normal_and_area_sums(name):
+    from meshcurv import _geometry
+
+    vertices, faces = mesh(name)
+    cross = _geometry.face_cross_products(vertices, faces)
+    dropped = np.random.default_rng(4).random(faces.shape[0]) < 0.1
+    with use_backend("numpy"):
+        expected = _geometry.vertex_normal_and_area_sums(cross, faces, dropped, vertices.shape[0])
+    got = kernels("geometry").vertex_normal_and_area_sums(cross, faces, dropped, vertices.shape[0])
+    # the faces' rows in face order (np.bincount's), a dropped face adding nothing (NumPy: zeros); each area the
+    # same square root of the same three squares added left to right (np.linalg.norm over three columns)
+    np.testing.assert_array_equal(got[0], expected[0])
+    np.testing.assert_array_equal(got[1], expected[1])
+
+
 def check_normalize_normal_sums(name):
     from meshcurv import geometry
 
@@ -1949,6 +1964,12 @@ TWINS = [
         "geometry.vertex_normal_sums",
         "_geometry.vertex_normal_sums",
         check_vertex_normal_sums,
+        MESHES,
+    ),
+    Twin(
+        "geometry.vertex_normal_and_area_sums",
+        "_geometry.vertex_normal_and_area_sums",
+        check_vertex_normal_and_area_sums,
         MESHES,
     ),
     Twin(

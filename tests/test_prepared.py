@@ -5,6 +5,7 @@ import pytest
 
 import meshcurv
 from meshcurv import _prepared, _validation, shapes
+from meshcurv._backend import use_backend
 from meshcurv.errors import InvalidMeshError
 from meshcurv.topology import MeshTopology
 
@@ -67,3 +68,22 @@ def test_a_welded_vertex_stands_on_the_first_of_its_rows():
     # the octahedron's area, 8 equilateral triangles of side sqrt(2), once: on the first rows, 0 on copies
     assert area.sum() == pytest.approx(8 * np.sqrt(3) / 4 * 2)
     assert (area[np.setdiff1d(np.arange(24), rows)] == 0).all() and (area[rows] > 0).all()
+
+
+def test_the_vertex_areas_share_out_the_area_of_the_faces_that_weigh():
+    # each face gives a third of its area to each corner: the vertex areas add up to the area of the faces
+    # kept (an identity), a zero-area face gives nothing, and they come from the pass of the vertex normals
+    sphere = shapes.icosphere(6)
+    vertices = sphere.vertices.copy()
+    faces = np.asarray(sphere.faces)
+    vertices[faces[0, 1]] = vertices[faces[0, 0]]  # face 0 (and its neighbour across that side) of zero area
+    mesh = _prepared.prepare_mesh(vertices, faces, orient="keep", weld=False)
+    areas = np.linalg.norm(mesh.cross, axis=1) / 2
+    assert mesh.dropped.sum() == 2 and not mesh.vertex_areas.flags.writeable
+    np.testing.assert_allclose(mesh.vertex_areas.sum(), areas[~mesh.dropped].sum(), rtol=1e-12)
+    np.testing.assert_allclose(mesh.vertex_areas.sum(), 4 * np.pi, rtol=0.05)  # inscribed in the unit sphere
+    for backend in ("numpy", "numba"):
+        with use_backend(backend):
+            again = _prepared.prepare_mesh(vertices, faces, orient="keep", weld=False)
+            np.testing.assert_allclose(again.vertex_areas, mesh.vertex_areas, rtol=1e-14)
+            np.testing.assert_allclose(again.vertex_normals, mesh.vertex_normals, rtol=1e-14, equal_nan=True)

@@ -72,6 +72,20 @@ def vertex_normal_sums(cross: np.ndarray, faces: np.ndarray, n_vertices: int) ->
 
 
 @twin("geometry")
+def vertex_normal_and_area_sums(
+    cross: np.ndarray, faces: np.ndarray, dropped: np.ndarray, n_vertices: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(sums, areas)``: (V, 3) the sums of the (F, 3) face cross products ``cross`` at each vertex and (V,) a
+    third of the areas of the faces at each vertex, both over the faces not ``dropped`` ((F,) bool), in face
+    order: the vertex normals (:func:`normalize_normal_sums`) and the vertex areas of one pass."""
+    used = np.where(dropped[:, None], 0.0, cross)
+    third = np.linalg.norm(used, axis=1) / 6.0
+    return vertex_normal_sums(used, faces, n_vertices), np.bincount(
+        faces.ravel(), weights=np.repeat(third, 3), minlength=n_vertices
+    )
+
+
+@twin("geometry")
 def normalize_normal_sums(summed: np.ndarray) -> np.ndarray:
     """Unit vectors from (V, 3) sums of face cross products; NaN where a sum is 0.
 

@@ -28,8 +28,9 @@ from ._geometry import (
     cross_and_degenerate,
     degenerate_faces,
     face_cross_products,
+    normalize_normal_sums,
     vertex_length_scales,
-    vertex_normals,
+    vertex_normal_and_area_sums,
 )
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import CurvatureResult, Surface
@@ -107,15 +108,28 @@ class PreparedMesh:
         self.__dict__.setdefault("degenerate", _read_only(degenerate))
 
     @cached_property
-    def vertex_normals(self) -> np.ndarray:
-        """(V, 3) area-weighted unit normals of the faces that are not degenerate nor a needle's (NaN where none);
+    def dropped(self) -> np.ndarray:
+        """(F,) bool: the faces that weigh nothing in the vertex normals and areas, the zero-area faces and the
+        slivers of a needle (faces of a vertex flung away: huge areas, :meth:`VertexDefects.needle_cells`);
         read-only."""
-        dropped = self.degenerate
-        needle = self.defects().needle_cells(self.topology.faces)  # slivers of a vertex flung away: huge areas
-        if needle is not None:
-            dropped = dropped | needle
-        used = np.where(dropped[:, None], 0.0, self.cross) if dropped.any() else self.cross
-        return _read_only(vertex_normals(self.vertices, self.topology.faces, cross=used))
+        needle = self.defects().needle_cells(self.topology.faces)
+        return self.degenerate if needle is None else _read_only(self.degenerate | needle)
+
+    @cached_property
+    def _normal_and_area_sums(self) -> tuple[np.ndarray, np.ndarray]:
+        faces = self.topology.faces
+        return vertex_normal_and_area_sums(self.cross, faces, self.dropped, self.vertices.shape[0])
+
+    @cached_property
+    def vertex_normals(self) -> np.ndarray:
+        """(V, 3) area-weighted unit normals of the faces not :attr:`dropped` (NaN where none); read-only."""
+        return _read_only(normalize_normal_sums(self._normal_and_area_sums[0]))
+
+    @cached_property
+    def vertex_areas(self) -> np.ndarray:
+        """(V,) a third of the area of the faces not :attr:`dropped` at each vertex (from the pass of
+        :attr:`vertex_normals`); read-only."""
+        return _read_only(self._normal_and_area_sums[1])
 
     @cached_property
     def _codes(self) -> tuple[np.ndarray, dict]:

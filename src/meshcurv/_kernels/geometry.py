@@ -115,3 +115,24 @@ def cross_and_degenerate(vertices, faces, scales, area_ratio):
         threshold = area_ratio * scales[a] * scales[a]
         out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
     return cross, out
+
+
+@nb.njit(**_JIT)
+def vertex_normal_and_area_sums(cross, faces, dropped, n_vertices):
+    """``(sums, areas)``: (V, 3) the sums of the face cross products at each vertex and (V,) a third of the
+    faces' areas, both over the faces not ``dropped``, in face order (as ``np.bincount``). One thread: a
+    scatter bound by memory."""
+    sums = np.zeros((n_vertices, 3))
+    areas = np.zeros(n_vertices)
+    for f in range(faces.shape[0]):
+        if dropped[f]:
+            continue
+        x, y, z = cross[f, 0], cross[f, 1], cross[f, 2]
+        third = math.sqrt(x * x + y * y + z * z) / 6.0
+        for k in range(3):
+            v = faces[f, k]
+            sums[v, 0] += x
+            sums[v, 1] += y
+            sums[v, 2] += z
+            areas[v] += third
+    return sums, areas
