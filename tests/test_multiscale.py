@@ -105,6 +105,39 @@ def test_nested_fits_equal_the_fits_of_each_radius(name, backend):
     assert np.isnan(got[0]).sum() > np.isnan(got[2]).sum()  # the smallest balls: too few points at some vertices
 
 
+def test_nested_fits_keep_the_other_sheet_out_of_the_smaller_balls():
+    # a flat ellipsoid: the largest ball reaches the other side round the rim, so its walk reaches vertices
+    # of the other side that lie inside the smaller balls; those balls are walked on their own there and
+    # still leave the other side out (the fits equal those of each radius alone)
+    from meshcurv.jets import fit_jet_normals
+    from meshcurv.neighborhoods import ball_face_sums, nested_jet_normals
+
+    flat = shapes.ellipsoid((3.0, 3.0, 0.15), subdivisions=10)
+    vertices, faces = flat.vertices, flat.faces
+    topology = meshcurv.MeshTopology.from_faces(faces)
+    h = meshcurv.geometry.mean_edge_length(vertices, topology.edges)
+    normals = meshcurv.geometry.vertex_normals(vertices, faces)
+    radii = [2.0 * h, 3.0 * h, 9.0 * h]
+    ones = np.ones((faces.shape[0], 1))
+    other_side = ball_face_sums(vertices, faces, radii[0], ones)[:, 0] > (
+        ball_face_sums(vertices, faces, radii[0], ones, connected=True)[:, 0] + 0.5
+    )
+    reached = np.isclose(
+        ball_face_sums(vertices, faces, radii[2], ones, connected=True)[:, 0],
+        ball_face_sums(vertices, faces, radii[2], ones)[:, 0],
+        rtol=1e-12,
+    )
+    assert (other_side & reached).sum() > 10  # vertices whose smallest ball is walked on its own
+    got = nested_jet_normals(vertices, normals, radii, adjacency=topology.neighbour_lists, **_jet_options())
+    for radius, fitted in zip(radii, got):
+        alone = fit_jet_normals(vertices, normals, radius, adjacency=topology.neighbour_lists, **_jet_options())
+        np.testing.assert_array_equal(np.isnan(fitted), np.isnan(alone))
+        np.testing.assert_allclose(fitted, alone, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(
+        got[2], fit_jet_normals(vertices, normals, radii[2], adjacency=topology.neighbour_lists, **_jet_options())
+    )
+
+
 @pytest.mark.parametrize(
     "radii, message",
     [([], "non-empty sequence"), ([1.0, float("inf")], "positive finite"), ([2.0, 1.0], "must not decrease")],

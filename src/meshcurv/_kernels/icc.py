@@ -11,7 +11,7 @@ import numpy as np
 
 from ._common import _JIT, run_chunks, threaded
 from .jets import _fit_one, _general, _jet_outputs, _jet_scratch
-from .neighborhoods import _connected_walk_nested
+from .neighborhoods import _connected_members, _connected_walk_levels
 from .tensors import _principal_from_mean_gaussian, _tangent_eigen
 
 
@@ -135,12 +135,13 @@ def nested_jet_normals(
     ``centres`` (M,), one walk per centre for all of them (``icc.estimate_multiscale``'s fits).
 
     Row ``r`` is ``kernels.jets.fit_jets_connected(..., normals_only=True)`` at ``radii[r]`` (the same
-    points, frames and checks, no areas): each centre's balls are walked once, in passes
-    (:func:`~meshcurv._kernels.neighborhoods._connected_walk_nested`), and each fit takes the vertices
-    queued by its pass within its radius (``allowed`` ones). Ball 0 holds its points in the order of the
-    single walk (the same numbers); a larger ball holds them in the order of the passes (the same points,
-    moments summed in another order: round-off). NaN where no jet could be fitted. The centres run in
-    ``n_chunks`` ranges (:func:`_nested_fits_chunk`) on threads.
+    points, frames and checks, no areas). Each centre's largest ball is walked once
+    (:func:`~meshcurv._kernels.neighborhoods._connected_walk_levels`): its fit takes the points of the
+    single walk in the same order (the same numbers), and a smaller ball's fit takes the vertices within
+    its radius that the walk reached through edges meeting it (the same points, in another order:
+    round-off), unless a vertex within it was reached only through a larger ball, where that ball is
+    walked on its own (:func:`~meshcurv._kernels.neighborhoods._connected_members`). NaN where no jet
+    could be fitted. The centres run in ``n_chunks`` ranges (:func:`_nested_fits_chunk`) on threads.
     """
     fitted = np.full((radii.shape[0], centres.shape[0], 3), np.nan)
     limits = np.array([1.0, settled])  # no facing check: the away fraction is not read
@@ -188,27 +189,43 @@ def _nested_fits_chunk(
     """The fits of ``centres[lo:hi]`` of :func:`nested_jet_normals`, written to their columns of ``fitted``."""
     n = vertices.shape[0]
     n_radii = radii.shape[0]
+    top = n_radii - 1
     mark = np.full(n, -1, np.int64)
-    members = np.empty(n, np.int64)
-    queue = np.empty(n, np.int64)  # a vertex is queued at most once per centre: never grown
-    squared = np.empty(n)
-    deferred = np.empty((2, indices.shape[0]), np.int64)  # an edge is left out at most once per centre
-    ends = np.empty(n_radii, np.int64)
+    members = np.empty(n, np.int64)  # the largest ball's
+    smaller = np.empty(n, np.int64)  # a smaller ball's
+    # a vertex is queued at most once a walk: the queue, levels, inner positions and their squared distances
+    walk = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n))
+    spare = np.empty(n, np.int64)  # the queue of a smaller ball's own walk
     cutoffs2 = radii * radii
     ids = np.arange(n)
     facing = np.empty((0, 3))  # no facing check
     areas = np.empty(0)  # unweighted
     work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
     c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row, rewritten for each fit
+    queue, levels, inner, squared = walk
     for i in range(lo, hi):
         v = centres[i]
-        _connected_walk_nested(vertices, indptr, indices, v, cutoffs2, mark, queue, squared, deferred, ends)
+        stamp = i * (n_radii + 1)  # the walks of a centre: its largest ball's, then a smaller one's each
+        top_size, n_inner = _connected_walk_levels(
+            vertices, indptr, indices, allowed, v, cutoffs2, mark, stamp, walk, members
+        )
         for r in range(n_radii):
-            size = 0
-            for j in range(ends[r]):  # the vertices queued by pass r inside ball r: its members
-                if squared[j] <= cutoffs2[r] and allowed[queue[j]]:
-                    members[size] = queue[j]
-                    size += 1
+            size = top_size
+            ball = members
+            if r < top:
+                ball = smaller
+                size = 0
+                vouched = True
+                for j in range(n_inner):  # the queued vertices inside ball r: reached through it?
+                    at = inner[j]
+                    if squared[j] <= cutoffs2[r] and allowed[queue[at]]:
+                        vouched = vouched and levels[at] <= r
+                        smaller[size] = queue[at]
+                        size += 1
+                if not vouched:
+                    size = _connected_members(
+                        vertices, indptr, indices, allowed, v, radii[r], mark, stamp + 1 + r, smaller, spare
+                    )
             c[0, :] = np.nan
             # one call site (the fit is inlined): numba refuses *args there, hence the whole list
             work = _fit_one(
@@ -222,7 +239,7 @@ def _nested_fits_chunk(
                 min_spread,
                 v,
                 0,
-                members,
+                ball,
                 size,
                 work,
                 moments,

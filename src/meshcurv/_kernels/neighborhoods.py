@@ -265,69 +265,81 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, stam
     return size
 
 
-@nb.njit(**_JIT)
-def _connected_walk_nested(vertices, indptr, indices, v, cutoffs2, mark, queue, squared, deferred, ends):
-    """The surface-connected pieces of the nested balls ``B(x_v, sqrt(cutoffs2[r]))`` in one walk, in passes.
+@nb.njit(inline="always", **_JIT)
+def _edge_level(first, top, a2, b2, ax, ay, az, bx, by, bz, cutoffs2):
+    """The smallest ball ``r >= first`` (up to ``top``) that the edge from ``a`` to ``b`` meets (an end inside, or
+    the segment passing through it; ``a``, ``b`` relative to the centre, ``a2``, ``b2`` their squared
+    distances, ``cutoffs2`` the squared radii, non-decreasing); ``top + 1`` if none does."""
+    r = first
+    while r <= top and not (
+        b2 <= cutoffs2[r] or a2 <= cutoffs2[r] or _segment_meets_ball(ax, ay, az, bx, by, bz, cutoffs2[r])
+    ):
+        r += 1
+    return r
 
-    Pass ``r`` walks breadth-first from ``v`` over the edges ``indptr, indices`` (CSR) that meet ball ``r``
-    (an end inside, or the segment passing through it), as :func:`_connected_members`; the edges it leaves
-    out are kept in ``deferred`` (2, 2E: the ends each edge leads from and to) and tried again by the next,
-    larger ball, whose pass goes on from the vertices they reach. The vertices queued by the end of pass
-    ``r`` are ``queue[:ends[r]]`` (``squared``: their squared distances to ``x_v``, in the same order):
-    exactly the vertices :func:`_connected_members` queues for ball ``r`` alone (the closure of ``v`` over
-    the edges that meet it), so the members of ball ``r`` are those of them within its radius. Pass 0
-    is that walk itself, in the same order. ``mark`` (V,): stamped with ``v`` (one walk per centre: no
-    clearing). ``cutoffs2`` (R,): the squared radii, non-decreasing.
+
+@nb.njit(**_JIT)
+def _connected_walk_levels(vertices, indptr, indices, allowed, v, cutoffs2, mark, stamp, walk, members):
+    """The walk of :func:`_connected_members` for the largest ball ``B(x_v, sqrt(cutoffs2[-1]))``, each vertex it
+    queues with the smallest ball it was reached through. Returns ``(size, n_inner)``.
+
+    ``members[:size]``: the members of the largest ball, in the order of :func:`_connected_members` (the
+    same list). ``walk``: ``(queue, levels, inner, squared)``: the queued vertices and, per position in
+    the queue, the smallest ball ``r`` such that the walk reached the vertex over edges that each meet
+    ball ``r`` or a smaller one (the centre: 0); ``inner[:n_inner]`` the positions of the queued vertices
+    within the second largest ball, ``squared[:n_inner]`` their squared distances to ``x_v``. A vertex of
+    level ``r`` is in the surface-connected piece of ball ``r`` (a path of edges meeting it leads there); a
+    vertex within ball ``r`` reached at a larger level may or may not be (:func:`_nested_fits_chunk` then
+    walks that ball on its own). ``cutoffs2`` (R,): the squared radii, non-decreasing; ``mark`` stamped
+    with ``stamp``.
     """
+    queue, levels, inner, squared = walk
+    top = cutoffs2.shape[0] - 1
+    outer2 = cutoffs2[top]
+    inner2 = cutoffs2[top - 1] if top > 0 else -1.0
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
-    mark[v] = v
+    size = 0
+    n_inner = 0
+    mark[v] = stamp
     queue[0] = v
-    squared[0] = 0.0
+    levels[0] = 0
     head, tail = 0, 1
-    n_deferred = 0
-    for r in range(cutoffs2.shape[0]):
-        cutoff2 = cutoffs2[r]
-        kept = 0
-        for e in range(n_deferred):  # the edges the smaller balls left out: this ball may meet them
-            a, b = deferred[0, e], deferred[1, e]
-            if mark[b] == v:
-                continue  # queued since, over another edge
-            ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
+    if allowed[v]:
+        members[0] = v
+        size = 1
+    if top > 0:
+        inner[0] = 0
+        squared[0] = 0.0
+        n_inner = 1
+    while head < tail:
+        a = queue[head]
+        through = levels[head]
+        head += 1
+        ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
+        a2 = ax * ax + ay * ay + az * az
+        for j in range(indptr[a], indptr[a + 1]):
+            b = indices[j]
+            if mark[b] == stamp:
+                continue
             bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
             b2 = bx * bx + by * by + bz * bz
-            if (
-                b2 <= cutoff2
-                or ax * ax + ay * ay + az * az <= cutoff2
-                or _segment_meets_ball(ax, ay, az, bx, by, bz, cutoff2)
-            ):
-                mark[b] = v
-                queue[tail] = b
-                squared[tail] = b2
-                tail += 1
-            else:
-                deferred[0, kept], deferred[1, kept] = a, b
-                kept += 1
-        n_deferred = kept
-        while head < tail:
-            a = queue[head]
-            a2 = squared[head]
-            head += 1
-            ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
-            for j in range(indptr[a], indptr[a + 1]):
-                b = indices[j]
-                if mark[b] == v:
-                    continue
-                bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
-                b2 = bx * bx + by * by + bz * bz
-                if not b2 <= cutoff2 and not a2 <= cutoff2 and not _segment_meets_ball(ax, ay, az, bx, by, bz, cutoff2):
-                    deferred[0, n_deferred], deferred[1, n_deferred] = a, b  # each (a, b) once: a is queued once
-                    n_deferred += 1
-                    continue
-                mark[b] = v
-                queue[tail] = b
-                squared[tail] = b2
-                tail += 1
-        ends[r] = tail
+            if b2 <= outer2:
+                if allowed[b]:
+                    members[size] = b
+                    size += 1
+            elif not a2 <= outer2 and not _segment_meets_ball(ax, ay, az, bx, by, bz, outer2):
+                continue  # both ends outside, and the segment passes outside too
+            mark[b] = stamp
+            queue[tail] = b
+            levels[tail] = (
+                through if through == top else _edge_level(through, top, a2, b2, ax, ay, az, bx, by, bz, cutoffs2)
+            )
+            if b2 <= inner2:
+                inner[n_inner] = tail
+                squared[n_inner] = b2
+                n_inner += 1
+            tail += 1
+    return size, n_inner
 
 
 @nb.njit(inline="always", **_JIT)
