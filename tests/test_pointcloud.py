@@ -406,11 +406,15 @@ def test_noisy_flat_ellipsoid_normals_are_fitted_on_one_face():
     # where it holds more than 5% of the ball's points (the faces' middles, most of the area)
     assert r.parameters["shrunk"] > 0.5
     assert (np.einsum("ij,ij->i", r.normals, exact) > 0).all()
-    # the estimates a ball sqrt(2) times larger, or the neighbours', do not reproduce are NaN (unsteady): the
-    # band by the rim, where the curvature changes several times within a ball (21% of the points)
+    # the estimates a ball sqrt(2) times larger, the neighbours', or jets over the balls of the measures turning
+    # by more than 0.3 rad do not reproduce, and those whose ball's own side is mostly unresolved, are NaN
+    # (unsteady): the band by the rim, where the curvature changes several times within a ball (42% of the
+    # points; 21% before the last two checks, which left 61 valid points off by more than half of |k|, 0 now;
+    # the points they leave NaN were off by 20% of |k|, median)
     unsteady = INVALID_REASONS.index(next(t for t in INVALID_REASONS if t.startswith("point cloud: unsteady")))
-    assert r.valid.mean() > 0.7 and (r.invalid_reason[~r.valid] == unsteady).all()
+    assert r.valid.mean() > 0.5 and (r.invalid_reason[~r.valid] == unsteady).all()
     largest = np.abs(mean) + np.sqrt(np.maximum(mean**2 - gaussian, 0.0))  # max |k|: |H| + sqrt(H^2 - K)
+    assert not (r.valid & (np.abs(r.mean - mean) > 0.5 * largest)).any()
     assert np.median(np.abs(r.mean - mean)[r.valid] / largest[r.valid]) < 0.15
     assert np.median(np.abs(r.gaussian - gaussian)[r.valid] / largest[r.valid] ** 2) < 0.15
     angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", r.normals, exact), -1, 1)))

@@ -738,6 +738,7 @@ def _compute(points, given, radius, method, search=None):
     one_sided = np.ones(n, dtype=bool)  # points with a one-sided jet fit (or given normals)
     two_sided_mask = np.zeros(n, dtype=bool)
     unsteady = np.zeros(n, dtype=bool)  # estimates a larger ball does not reproduce
+    balls = np.full(n, np.nan)  # the radius of each point's estimate
     noisy = 0  # points whose fits the noise dominates (see NOISY_PCA)
     mixed = None
     compiled = numba_kernels("pointcloud") is not None
@@ -829,6 +830,7 @@ def _compute(points, given, radius, method, search=None):
             two_sided += int(np.isnan(fitted_radii).sum())
             two_sided_mask[members] = np.isnan(fitted_radii)
         unsteady[members] = details["unsteady"][part_members]
+        balls[members] = group_radius
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
             whole[members] = part[part_members]
         if radius is not None:  # a given radius that the sampling, or the noise, cannot support
@@ -885,6 +887,10 @@ def _compute(points, given, radius, method, search=None):
     problems.extend(_estimators.unsteady_problem(unsteady & valid))
     reason[unsteady & valid] = _UNSTEADY
     valid &= ~unsteady
+    beside = _estimators.beside_unresolved(points, out_normals, k_min, k_max, balls, valid & ~doubtful, tree)
+    problems.extend(_estimators.unsteady_problem(beside, beside=True))
+    reason[beside] = _UNSTEADY
+    valid &= ~beside
     if doubtful.any():
         found = []
         between = doubtful & ~unsettled & ~alike
