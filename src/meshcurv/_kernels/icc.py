@@ -191,10 +191,9 @@ def _nested_fits_chunk(
     n_radii = radii.shape[0]
     top = n_radii - 1
     mark = np.full(n, -1, np.int64)
-    members = np.empty(n, np.int64)  # the largest ball's
-    smaller = np.empty(n, np.int64)  # a smaller ball's
-    # a vertex is queued at most once a walk: the queue, levels, inner positions and their squared distances
-    walk = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n))
+    members = np.empty(n, np.int64)  # the largest ball's, then each smaller one's
+    # a vertex is queued at most once a walk: the queue and levels, the inner vertices, levels and distances
+    walk = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n))
     spare = np.empty(n, np.int64)  # the queue of a smaller ball's own walk
     cutoffs2 = radii * radii
     ids = np.arange(n)
@@ -202,29 +201,26 @@ def _nested_fits_chunk(
     areas = np.empty(0)  # unweighted
     work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
     c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row, rewritten for each fit
-    queue, levels, inner, squared = walk
+    _, _, inner, inner_levels, squared = walk
     for i in range(lo, hi):
         v = centres[i]
         stamp = i * (n_radii + 1)  # the walks of a centre: its largest ball's, then a smaller one's each
         top_size, n_inner = _connected_walk_levels(
             vertices, indptr, indices, allowed, v, cutoffs2, mark, stamp, walk, members
         )
-        for r in range(n_radii):
-            size = top_size
-            ball = members
+        size = top_size
+        for r in range(top, -1, -1):  # the largest ball first: the smaller ones' members then take its place
             if r < top:
-                ball = smaller
                 size = 0
                 vouched = True
                 for j in range(n_inner):  # the queued vertices inside ball r: reached through it?
-                    at = inner[j]
-                    if squared[j] <= cutoffs2[r] and allowed[queue[at]]:
-                        vouched = vouched and levels[at] <= r
-                        smaller[size] = queue[at]
+                    if squared[j] <= cutoffs2[r]:
+                        vouched = vouched and inner_levels[j] <= r
+                        members[size] = inner[j]
                         size += 1
                 if not vouched:
                     size = _connected_members(
-                        vertices, indptr, indices, allowed, v, radii[r], mark, stamp + 1 + r, smaller, spare
+                        vertices, indptr, indices, allowed, v, radii[r], mark, stamp + 1 + r, members, spare
                     )
             c[0, :] = np.nan
             # one call site (the fit is inlined): numba refuses *args there, hence the whole list
@@ -239,7 +235,7 @@ def _nested_fits_chunk(
                 min_spread,
                 v,
                 0,
-                ball,
+                members,
                 size,
                 work,
                 moments,

@@ -284,16 +284,16 @@ def _connected_walk_levels(vertices, indptr, indices, allowed, v, cutoffs2, mark
     queues with the smallest ball it was reached through. Returns ``(size, n_inner)``.
 
     ``members[:size]``: the members of the largest ball, in the order of :func:`_connected_members` (the
-    same list). ``walk``: ``(queue, levels, inner, squared)``: the queued vertices and, per position in
-    the queue, the smallest ball ``r`` such that the walk reached the vertex over edges that each meet
-    ball ``r`` or a smaller one (the centre: 0); ``inner[:n_inner]`` the positions of the queued vertices
-    within the second largest ball, ``squared[:n_inner]`` their squared distances to ``x_v``. A vertex of
+    same list). ``walk``: ``(queue, levels, inner, inner_levels, squared)``: the queued vertices and, per
+    position in the queue, the smallest ball ``r`` such that the walk reached the vertex over edges that
+    each meet ball ``r`` or a smaller one (the centre: 0); ``inner[:n_inner]`` the ``allowed`` queued
+    vertices within the second largest ball, with their levels and squared distances to ``x_v``. A vertex of
     level ``r`` is in the surface-connected piece of ball ``r`` (a path of edges meeting it leads there); a
     vertex within ball ``r`` reached at a larger level may or may not be (:func:`_nested_fits_chunk` then
     walks that ball on its own). ``cutoffs2`` (R,): the squared radii, non-decreasing; ``mark`` stamped
     with ``stamp``.
     """
-    queue, levels, inner, squared = walk
+    queue, levels, inner, inner_levels, squared = walk
     top = cutoffs2.shape[0] - 1
     outer2 = cutoffs2[top]
     inner2 = cutoffs2[top - 1] if top > 0 else -1.0
@@ -307,8 +307,9 @@ def _connected_walk_levels(vertices, indptr, indices, allowed, v, cutoffs2, mark
     if allowed[v]:
         members[0] = v
         size = 1
-    if top > 0:
-        inner[0] = 0
+    if top > 0 and allowed[v]:
+        inner[0] = v
+        inner_levels[0] = 0
         squared[0] = 0.0
         n_inner = 1
     while head < tail:
@@ -331,14 +332,14 @@ def _connected_walk_levels(vertices, indptr, indices, allowed, v, cutoffs2, mark
                 continue  # both ends outside, and the segment passes outside too
             mark[b] = stamp
             queue[tail] = b
-            levels[tail] = (
-                through if through == top else _edge_level(through, top, a2, b2, ax, ay, az, bx, by, bz, cutoffs2)
-            )
-            if b2 <= inner2:
-                inner[n_inner] = tail
+            level = through if through == top else _edge_level(through, top, a2, b2, ax, ay, az, bx, by, bz, cutoffs2)
+            levels[tail] = level
+            tail += 1
+            if b2 <= inner2 and allowed[b]:
+                inner[n_inner] = b
+                inner_levels[n_inner] = level
                 squared[n_inner] = b2
                 n_inner += 1
-            tail += 1
     return size, n_inner
 
 

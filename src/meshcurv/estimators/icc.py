@@ -290,13 +290,19 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
 def _dense(vertices: np.ndarray, radius: float, adjacency: tuple) -> bool:
     """Whether normal fits over ``radius`` run on the coarse level: wider than :data:`COARSE_EDGES` median
     edge lengths (taken over :data:`COARSE_SAMPLE` edges of the CSR lists ``adjacency``)."""
+    return bool(radius > COARSE_EDGES * _sampled_edge(vertices, adjacency))
+
+
+def _sampled_edge(vertices: np.ndarray, adjacency: tuple) -> float:
+    """:func:`_dense`'s median edge length over :data:`COARSE_SAMPLE` evenly spaced edges of ``adjacency``
+    (inf without edges: no radius is dense)."""
     indptr, indices = adjacency
     if indices.size == 0:
-        return False
+        return np.inf
     taken = np.linspace(0, indices.size - 1, min(indices.size, COARSE_SAMPLE)).round().astype(np.int64)
     tails = np.searchsorted(indptr, taken, side="right") - 1
     lengths = np.linalg.norm(vertices[indices[taken]] - vertices[tails], axis=1)
-    return bool(radius > COARSE_EDGES * float(np.median(lengths)))
+    return float(np.median(lengths))
 
 
 def voxel_pilot(mesh: PreparedMesh):
@@ -644,14 +650,18 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     degenerate, start_normals = _dropped(mesh), mesh.vertex_normals
     defects, valid = mesh.start(boundary=True)
     stages.start("measure noise")
-    radii = [check_radius(radius, vertices, topology) for radius in radii]
-    stages.start("fit normals")
-    areas = _vertex_areas(mesh)
-    failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
-    # the fits of the radii not fitted on the coarse level, from one walk per vertex (the radii increase)
-    fine = [
-        NORMAL_RADIUS_RATIO * r for r in radii if not _dense(vertices, NORMAL_RADIUS_RATIO * r, _adjacency(topology))
+    # the radii increase: the conditions of check_radius (neither below a sliver of an edge nor above the
+    # mesh's extent) hold for all of them when they hold for the first and the last
+    last = len(radii) - 1
+    radii = [
+        check_radius(radius, vertices, topology) if j in (0, last) else float(radius) for j, radius in enumerate(radii)
     ]
+    stages.start("fit normals")
+    failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
+    # the fits of the radii not fitted on the coarse level, from one walk per vertex (the radii increase, and
+    # so does _dense: the radii fitted so are the first ones)
+    edge = _sampled_edge(vertices, _adjacency(topology))
+    fine = [NORMAL_RADIUS_RATIO * r for r in radii if not NORMAL_RADIUS_RATIO * r > COARSE_EDGES * edge]
     fits = (
         nested_jet_normals(
             vertices,
@@ -667,6 +677,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         if fine
         else []
     )
+    areas = _vertex_areas(mesh) if len(fits) < len(radii) else None  # the coarse level's weights only
     normals = [
         fitted_normals(
             vertices,
@@ -675,7 +686,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             NORMAL_RADIUS_RATIO * radius,
             neighbours=topology.referenced_vertices,
             adjacency=_adjacency(topology),
-            areas=areas,
+            areas=areas if j >= len(fits) else None,  # fitted already: no coarse level to look for
             failed=failed[j],
             fits=fits[j] if j < len(fits) else None,
         )
