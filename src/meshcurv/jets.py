@@ -426,14 +426,15 @@ def fit_jets(
             raise InvalidMeshError(f"`facing` must have shape {vertices.shape}; got {facing.shape}")
     kernels = numba_kernels("jets")
     paired = False  # both radii in one walk
+    wide = 0.0  # the larger radius (0: none)
     if larger is not None:
-        larger = _checked_larger(larger, radius, details)
+        wide = _checked_larger(larger, radius, details)
         paired = kernels is not None and n > 0 and adjacency is None and not per_centre
         if not paired:
             details["larger"] = fit_jets(  # type: ignore[index]  # (details checked)
                 vertices,
                 normals,
-                larger,
+                wide,
                 degree=degree,
                 iterations=iterations,
                 centres=None if every_vertex else centres,
@@ -450,7 +451,7 @@ def fit_jets(
     areas = _checked_areas(areas, n)
     mean, _ = check_ball_work(pool_points, radius, centres.size, centres=vertices[centres])
     if paired:
-        mean += check_ball_work(pool_points, larger, centres.size, centres=vertices[centres])[0]
+        mean += check_ball_work(pool_points, wide, centres.size, centres=vertices[centres])[0]
     if kernels is not None and n:
         if adjacency is not None:  # one row per centre
             rows = _connected_fits(
@@ -477,7 +478,7 @@ def fit_jets(
             ranges = call_ranges(centres.size, mean, radius * radius if per_centre else None)
             # one call: its outputs (rows of all vertices, NaN and counts 0 but at the centres) are the result
             whole = len(ranges) == 1 and not compact
-            kernel, extra = (kernels.fit_jet_pairs, (float(larger),)) if paired else (kernels.fit_jets, ())
+            kernel, extra = (kernels.fit_jet_pairs, (wide,)) if paired else (kernels.fit_jets, ())
             fit = (degree, iterations, _exponents(degree), min_spread)
             checks = (pool, facing if check else vertices, check, AWAY_FRACTION, float(settled), areas)
             pieces = []  # each call's outputs, one row per centre of its part

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import cast
 
 import numba as nb
 import numpy as np
-from llvmlite import ir
+from llvmlite import ir  # type: ignore[import-untyped]
 from numba.core import types
 from numba.extending import intrinsic, overload
 
@@ -847,8 +849,7 @@ def jet_curvatures(coefficients, frame, radii, normals):
     return outputs
 
 
-@intrinsic
-def _fma(typingctx, x, y, z):
+def _fma_intrinsic(typingctx, x, y, z):
     """``x * y + z`` rounded once (LLVM's ``llvm.fma.f64``; a library call where the processor has no such
     instruction): how the matrix products of NumPy's ``matmul`` (its BLAS) add their second term."""
     signature = types.float64(types.float64, types.float64, types.float64)
@@ -859,6 +860,10 @@ def _fma(typingctx, x, y, z):
         return builder.call(function, args)
 
     return signature, codegen
+
+
+#: ``_fma(x, y, z)`` in compiled code (:func:`_fma_intrinsic`).
+_fma = cast(Callable[[float, float, float], float], intrinsic(_fma_intrinsic))
 
 
 @nb.njit(**_JIT)
