@@ -213,15 +213,47 @@ def test_the_band_by_the_rim_of_a_thin_plate_is_not_measured(noise, method):
 
 def test_turned_flags_measures_that_jets_over_the_same_balls_do_not_reproduce():
     # a unit sphere of 1,000 points, balls of 0.4 (0.4 rad of turning, checked): the exact curvatures agree with
-    # the jets, twice them does not; twice them over balls of 0.1 (0.2 rad) are not checked
+    # the jets; three times them on a cap (z > 0.8) do not where the ball also holds the exact ones (by the cap's
+    # edge); a curvature steady over the ball (the cap's middle) is not compared; twice the exact ones over balls
+    # of 0.1 (0.2 rad of turning) are not checked
     points, normals = sphere(1000, seed=2)
     n = points.shape[0]
     centres, usable = np.arange(n), np.ones(n, dtype=bool)
     exact = (np.ones(n), np.ones(n))
-    double = (np.full(n, 2.0), np.full(n, 2.0))
     assert not estimators.turned(points, normals, exact, 0.4, centres, usable).any()
-    assert estimators.turned(points, normals, double, 0.4, centres, usable).all()
-    assert not estimators.turned(points, normals, double, 0.1, centres, usable).any()
+    cap = points[:, 2] > 0.8
+    k = np.where(cap, 3.0, 1.0)
+    flagged = estimators.turned(points, normals, (k, k), 0.4, centres, usable)
+    assert not flagged[~cap].any()
+    assert flagged[cap & (points[:, 2] < 0.85)].all()
+    assert not flagged[points[:, 2] > 0.99].any()
+    twice = (np.full(n, 2.0), np.full(n, 2.0))
+    assert not estimators.turned(points, normals, twice, 0.1, centres, usable).any()
+
+
+def thin_torus(n, radii=(4.0, 0.6), seed=0):
+    """``(points, normals, mean)``: ``n`` samples of about uniform density on a torus (outward normals)."""
+    rng = np.random.default_rng(seed)
+    big, small = radii
+    u, v = rng.uniform(0, 2 * np.pi, (2, 4 * n))
+    keep = rng.random(4 * n) < (big + small * np.cos(v)) / (big + small)  # the area element
+    u, v = u[keep][:n], v[keep][:n]
+    normals = np.stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)], axis=1)
+    points = np.stack([big * np.cos(u), big * np.sin(u), np.zeros(n)], axis=1) + small * normals
+    mean = 0.5 * (1 / small + np.cos(v) / (big + small * np.cos(v)))
+    return points, normals, mean
+
+
+def test_a_noisy_thin_torus_keeps_its_points():
+    # held out in benchmarks/pointcloud_heldout.md: 5,000 points, noise 0.1 spacings, balls of 0.88 around a tube
+    # of 0.6 (1.5 rad of turning): the measures resolve the tube (H 0.8%), the jets over smaller balls follow the
+    # noise: comparing them left 13-17% of the points NaN until steady balls were no longer compared
+    points, normals, mean = thin_torus(5000)
+    spacing = np.sqrt(4 * np.pi**2 * 4.0 * 0.6 / 5000)
+    points = points + np.random.default_rng(1).uniform(-0.1, 0.1, (5000, 1)) * spacing * normals
+    r = quiet(points)
+    assert r.valid.mean() > 0.98
+    assert np.median(np.abs(r.mean - mean)[r.valid] / (1 / 0.6)) < 0.03
 
 
 def test_beside_unresolved_flags_a_ball_whose_own_side_is_mostly_unresolved():

@@ -107,6 +107,10 @@ TURN_AGREEMENT = 0.2
 #: check's own would turn more: a unit sphere of 400 points, balls of 0.77).
 REFERENCE_TURN = 0.8
 
+#: ... and are not needed where no estimate on the own side of the ball has a largest |k| below this share of the
+#: centre's (:func:`_uniform_balls`: a curvature steady over the ball).
+UNIFORM_SHARE = 0.5
+
 #: A resolved estimate whose ball turns the normal by more than :data:`UNRESOLVED_TURN` radians and whose own side
 #: holds more than :data:`UNRESOLVED_SHARE` of points without a resolved estimate is unsteady
 #: (:func:`beside_unresolved`).
@@ -327,6 +331,33 @@ def unsteady(found, larger, centres, radius, agreement: float = AGREEMENT) -> np
         scale = np.maximum(np.minimum(np.abs(a).max(axis=1), np.abs(b).max(axis=1)), FLAT_TURN / radius)
         close = np.abs(a - b).max(axis=1) <= agreement * scale
     out[centres] = ~close
+    return out
+
+
+def _uniform_balls(points, normals, found, radius, centres, usable) -> np.ndarray:
+    """(M,) bool: the ``centres`` (M,) whose ball of ``radius`` holds, on its own side (normals within 90 degrees
+    of the centre's), no estimate of ``found`` whose largest |k| is below :data:`UNIFORM_SHARE` of the centre's:
+    a curvature steady over the ball, which the measures resolve even where the ball is large against it (the
+    tube of a thin torus under noise, whose jets over smaller balls follow the noise)."""
+    from scipy.spatial import cKDTree
+
+    pool = np.flatnonzero(usable)
+    if pool.size == 0:
+        return np.zeros(centres.size, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        largest = np.maximum(np.abs(found[0]), np.abs(found[1]))
+    tree = cKDTree(points[pool])
+    out = np.zeros(centres.size, dtype=bool)
+    for start in range(0, centres.size, CHUNK):
+        chunk = centres[start : start + CHUNK]
+        _, index = tree.query(points[chunk], k=min(MAX_BALL_POINTS, pool.size), distance_upper_bound=radius)
+        index = np.asarray(index).reshape(chunk.size, -1)
+        member = index < pool.size
+        theirs = pool[np.where(member, index, 0)]
+        with np.errstate(invalid="ignore"):
+            own = member & (np.einsum("mkj,mj->mk", normals[theirs], normals[chunk]) > 0)
+            low = own & (largest[theirs] < UNIFORM_SHARE * largest[chunk][:, None])
+        out[start : start + chunk.size] = ~low.any(axis=1)
     return out
 
 
@@ -671,12 +702,16 @@ def turned(points, normals, found, radius, centres, usable) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         turn = radius * np.maximum(np.abs(found[0][centres]), np.abs(found[1][centres]))
     checked = centres[turn > BALL_TURN]  # (NaN: no estimate, nothing to check)
+    if checked.size:
+        uniform = _uniform_balls(points, normals, found, radius, checked, usable)
+        turn = turn[turn > BALL_TURN][~uniform]
+        checked = checked[~uniform]
     if checked.size == 0:
         return np.zeros(points.shape[0], dtype=bool)
     # the jets' own ball: the check's (LARGER times larger), or smaller ones (steps of SHRINK, down to half the
     # radius) where the normal would turn by more than REFERENCE_TURN over it (a jet's bias grows as its turn)
     reference = [np.full(points.shape[0], np.nan), np.full(points.shape[0], np.nan)]
-    steps = np.clip(np.ceil(np.log(turn[turn > BALL_TURN] * LARGER / REFERENCE_TURN) / -np.log(SHRINK)), 0, 3)
+    steps = np.clip(np.ceil(np.log(turn * LARGER / REFERENCE_TURN) / -np.log(SHRINK)), 0, 3)
     compared = []
     for step in np.unique(steps):
         group = checked[steps == step]
