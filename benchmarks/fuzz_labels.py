@@ -33,7 +33,10 @@ Tolerances (from the measurements in :mod:`meshcurv.volume` and
 ``tests/test_volume_border.py``): area 3% of the truth plus 0.5 h per unit length of
 the rim where a cut surface meets the image face (marching cubes' chamfer
 there, and the refit's extrapolation) plus, for boxes, 0.8 h per unit length
-of their edges inside (the corrected area rounds them: 0.42-0.52 h measured);
+of their edges inside (the corrected area rounds them: 0.42-0.52 h measured)
+plus two thirds of the digitisation's own volume error (``|n_voxels v - V| / V``
+of the area: the voxels of a ball of 4.4 voxels hold 2.5% less than the ball,
+and its area follows, 0.99 correlated over 30 centre offsets; seed 93 case 1322);
 volume 2% plus ``1.5 h / R`` (the half-voxel rounding of a digitised ball)
 plus ``h^2 / 8`` per unit length of rims and box edges (the chamfers).
 ``h`` is the largest voxel size. Areas are checked from ``R >= 4 h`` (boxes of
@@ -312,7 +315,11 @@ def check_table(kind, image, spacing, truth, table) -> list[str]:
             broken.append(f"{kind} volume {row.volume:.6g} for {truth['volume']:.6g} (tolerance {tolerance:.3g})")
     # the area of the surface inside the image
     if truth["check_area"] and truth["area"] > 0:
-        tolerance = 0.03 * truth["area"] + 0.5 * h * truth["rim"] + 0.8 * h * truth.get("edges", 0.0)
+        voxels = row.n_voxels * float(np.prod(spacing))
+        digitised = abs(voxels - truth["volume"]) / truth["volume"] if truth["volume"] > 0 else 0.0
+        tolerance = (
+            (0.03 + 2 / 3 * digitised) * truth["area"] + 0.5 * h * truth["rim"] + 0.8 * h * truth.get("edges", 0.0)
+        )
         if abs(row.area - truth["area"]) > tolerance:
             broken.append(
                 f"{kind} area {row.area:.6g} for {truth['area']:.6g} (tolerance {tolerance:.3g}; "
