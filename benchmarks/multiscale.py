@@ -9,7 +9,7 @@ that the ratios compare calls made under the same load; wall and CPU seconds,
 the ratios of CPU time (the machine is shared). ``--stages`` adds the CPU
 seconds of each stage (the ``progress`` callback) of the largest radius alone
 and of the multi-scale call. The multi-scale call fits the normals of the
-radii from one walk per vertex (:func:`meshcurv.neighborhoods.nested_jet_normals`);
+radii from one walk per vertex (:func:`meshcurv.jets.nested_jet_normals`);
 the row "fits per radius" runs it with one ``fitted_normals`` call per radius
 instead (the call before aae8001; the results are checked equal to round-off).
 

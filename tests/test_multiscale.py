@@ -81,7 +81,7 @@ def test_nested_fits_equal_the_fits_of_each_radius(name, backend):
     # walk of that radius alone, so the same normals up to the order of the moments' sums (round-off)
     from meshcurv._backend import use_backend
     from meshcurv.jets import fit_jet_normals
-    from meshcurv.neighborhoods import nested_jet_normals
+    from meshcurv.jets import nested_jet_normals
 
     if backend == "numba":
         pytest.importorskip("numba")
@@ -110,7 +110,8 @@ def test_nested_fits_keep_the_other_sheet_out_of_the_smaller_balls():
     # of the other side that lie inside the smaller balls; those balls are walked on their own there and
     # still leave the other side out (the fits equal those of each radius alone)
     from meshcurv.jets import fit_jet_normals
-    from meshcurv.neighborhoods import ball_face_sums, nested_jet_normals
+    from meshcurv.jets import nested_jet_normals
+    from meshcurv.neighborhoods import ball_face_sums
 
     flat = shapes.ellipsoid((3.0, 3.0, 0.15), subdivisions=10)
     vertices, faces = flat.vertices, flat.faces
@@ -143,7 +144,7 @@ def test_nested_fits_keep_the_other_sheet_out_of_the_smaller_balls():
     [([], "non-empty sequence"), ([1.0, float("inf")], "positive finite"), ([2.0, 1.0], "must not decrease")],
 )
 def test_nested_fits_refuse_bad_radii(radii, message):
-    from meshcurv.neighborhoods import nested_jet_normals
+    from meshcurv.jets import nested_jet_normals
 
     torus = shapes.torus()
     adjacency = meshcurv.MeshTopology.from_faces(torus.faces).neighbour_lists

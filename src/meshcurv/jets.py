@@ -61,6 +61,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from math import comb
+from typing import Any
 
 import numpy as np
 
@@ -832,3 +833,85 @@ def jet_curvatures(coefficients: np.ndarray, frame: tuple, radii: np.ndarray, no
     for array in (k_min, k_max, dir_min, dir_max):
         array[~ok] = np.nan
     return k_min, k_max, dir_min, dir_max, out_normals
+
+
+def nested_jet_normals(
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    radii,
+    *,
+    adjacency: tuple,
+    neighbours: np.ndarray | None = None,
+    degree: int,
+    iterations: int,
+    settled: float,
+    min_spread: float,
+) -> list[np.ndarray]:
+    """(V, 3) unit normals of :func:`fit_jet_normals` at each of the increasing ``radii``.
+
+    Element ``r`` equals ``fit_jet_normals(vertices, normals, radii[r], adjacency=adjacency, ...)``
+    with the same options (NaN where no jet could be fitted) to round-off: the compiled
+    kernel walks the surface-connected balls of every radius in one walk per vertex, the largest
+    leading (``_kernels.icc.nested_jet_normals``: the fits of the smaller balls cost their fits,
+    not their walks); the NumPy path fits each radius on its own.
+
+    Parameters
+    ----------
+    vertices, normals : ndarray of shape (V, 3)
+        The points and the first frames of the fits (checked by the caller).
+    radii : sequence of float
+        Positive radii, non-decreasing.
+    adjacency : tuple of ndarray
+        CSR neighbour lists ``(indptr, indices)`` of the vertices (:attr:`MeshTopology.neighbour_lists`).
+    neighbours : ndarray of bool of shape (V,), optional
+        The vertices that may enter the balls (default: all).
+    degree, iterations, settled, min_spread
+        As :func:`fit_jet_normals`.
+
+    Returns
+    -------
+    list of ndarray of shape (V, 3)
+
+    Raises
+    ------
+    InvalidOptionError
+        ``radii`` is empty, holds a radius that is not positive and finite, or decreases; or the
+        largest balls would hold more than :data:`MAX_BALL_PAIRS` pairs (:func:`check_ball_work`).
+    """
+    radii = np.array(radii, dtype=np.float64, ndmin=1)
+    if radii.ndim != 1 or radii.size == 0 or not (np.isfinite(radii).all() and (radii > 0).all()):
+        raise InvalidOptionError(f"`radii` must be a non-empty sequence of positive finite radii; got {radii}")
+    if (np.diff(radii) < 0).any():
+        raise InvalidOptionError("`radii` must not decrease from one radius to the next (nested balls)")
+    kernels = numba_kernels("icc")
+    n = vertices.shape[0]
+    options: dict[str, Any] = {"degree": degree, "iterations": iterations, "settled": settled, "min_spread": min_spread}
+    if kernels is None or n == 0:
+        return [
+            fit_jet_normals(vertices, normals, radius, adjacency=adjacency, neighbours=neighbours, **options)
+            for radius in radii
+        ]
+    allowed = np.ones(n, dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
+    mean, _ = check_ball_work(vertices[allowed], float(radii[-1]), n, centres=vertices)
+    indptr, indices = checked_adjacency(adjacency, n)
+    vertices, normals = (np.ascontiguousarray(a, dtype=np.float64) for a in (vertices, normals))
+    pieces = [
+        kernels.nested_jet_normals(
+            vertices,
+            normals,
+            radii,
+            degree,
+            iterations,
+            _exponents(degree),
+            min_spread,
+            np.arange(lo, hi),
+            kernel_threads(),
+            allowed,
+            indptr,
+            indices,
+            float(settled),
+        )
+        for lo, hi in call_ranges(n, mean)
+    ]
+    fitted = np.concatenate(pieces, axis=1)
+    return list(fitted)

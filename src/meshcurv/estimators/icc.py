@@ -84,9 +84,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._geometry import median_edge_length
-from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals
+from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals, nested_jet_normals
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
-from ..neighborhoods import _squared, ball_face_sums, ball_face_sums_nested, coarse_face_sums, nested_jet_normals
+from ..neighborhoods import _squared, ball_face_sums, ball_face_sums_nested, coarse_face_sums
 from ..radius import (
     VOXEL_SCALE_RULE,
     check_radius,
@@ -160,7 +160,7 @@ def fitted_normals(
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
     ``fits``: the (V, 3) jet normals at ``radius``, fitted already (:func:`estimate_multiscale`'s one
-    walk, :func:`meshcurv.neighborhoods.nested_jet_normals`): used where the surface is not fitted on its
+    walk, :func:`meshcurv.jets.nested_jet_normals`): used where the surface is not fitted on its
     coarse level.
 
     ``failed``: a (V,) bool array set True, in place, where no jet could be fitted (too few points, or a
