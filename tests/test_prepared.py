@@ -87,3 +87,49 @@ def test_the_vertex_areas_share_out_the_area_of_the_faces_that_weigh():
             again = _prepared.prepare_mesh(vertices, faces, orient="keep", weld=False)
             np.testing.assert_allclose(again.vertex_areas, mesh.vertex_areas, rtol=1e-14)
             np.testing.assert_allclose(again.vertex_normals, mesh.vertex_normals, rtol=1e-14, equal_nan=True)
+
+
+@pytest.mark.parametrize("method", ["icc", "normal_cycle", "matgeom"])
+def test_the_length_scales_and_needle_vertices_are_found_once_per_call(method, monkeypatch):
+    # the orientation, the defects, the radius rules and the diagnosis all read them (10 and 7 passes before)
+    sphere = shapes.icosphere(6)
+    vertices = sphere.vertices.copy()
+    vertices[5] *= 10.0  # a needle: the scale rules leave it out, the defects mark it
+    from meshcurv import _geometry, defects
+
+    needles = _counted(monkeypatch, defects, "_needle_vertices")
+    scales = _counted(monkeypatch, _geometry, "_vertex_length_scales")
+    with pytest.warns(meshcurv.MeshQualityWarning, match="1 needle vertices"):
+        result = meshcurv.principal_curvatures(vertices, sphere.faces, method=method)
+    assert (len(needles), len(scales)) == (1, 1)
+    assert result.invalid_reason[5] == defects.NEEDLE
+
+
+def test_a_derived_array_is_shared_only_for_the_adopted_vertices_topology_and_inputs():
+    from meshcurv import _once
+    from meshcurv._geometry import vertex_length_scales
+    from meshcurv.defects import needle_vertices
+
+    sphere = shapes.icosphere(4)
+    vertices = sphere.vertices.copy()
+    vertices[3] *= 10.0
+    topology = MeshTopology.from_faces(sphere.faces, len(vertices))
+    scales = vertex_length_scales(vertices, topology)
+    alone = needle_vertices(vertices, topology, scales)
+    assert np.flatnonzero(alone).tolist() == [3]
+    assert needle_vertices(vertices, topology, scales) is not alone  # no scope: computed each time
+    with _once.computed_once():
+        _once.adopt(vertices)
+        shared = vertex_length_scales(vertices, topology)
+        assert vertex_length_scales(vertices, topology) is shared and shared.flags.writeable  # kernels take it
+        first = needle_vertices(vertices, topology, shared)
+        assert needle_vertices(vertices, topology, shared) is first and not first.flags.writeable
+        np.testing.assert_array_equal(first, alone)
+        # other scales, another topology of the same faces, other vertices: not the remembered array
+        assert needle_vertices(vertices, topology, 1e3 * shared) is not first
+        assert not needle_vertices(vertices, topology, 1e3 * shared).any()  # every edge within reach
+        other = MeshTopology.from_faces(sphere.faces, len(vertices))
+        assert needle_vertices(vertices, other, vertex_length_scales(vertices, other)) is not first
+        moved = sphere.vertices.copy()
+        assert not needle_vertices(moved, topology, vertex_length_scales(moved, topology)).any()
+    assert needle_vertices(vertices, topology, shared) is not first  # the scope closed

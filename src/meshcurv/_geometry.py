@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._backend import twin
+from ._once import once
 
 #: Faces with area below this fraction of the squared length scale of their component
 #: (:func:`vertex_length_scales`, the median edge length) count as degenerate.
@@ -146,7 +147,14 @@ def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
 
 
 def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
-    """(V,) the median edge length of each vertex's component (:func:`meshcurv.geometry.vertex_length_scales`)."""
+    """(V,) the median edge length of each vertex's component (:func:`meshcurv.geometry.vertex_length_scales`);
+    found once per call for the prepared mesh (:func:`meshcurv._once.once`; writable: compiled kernels take it)."""
+    scales: np.ndarray = once("length_scales!", vertices, topology, lambda: _vertex_length_scales(vertices, topology))
+    return scales
+
+
+def _vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
+    """:func:`vertex_length_scales`, computed."""
     edges = topology.edges
     n = topology.n_vertices
     if edges.shape[0] == 0:
@@ -202,9 +210,9 @@ def degenerate_faces(
             scales = vertex_length_scales(vertices, topology)
         else:
             scales = np.full(topology.n_vertices, float(mean_edge_length))
-    if double_areas is None and cross is None:
-        return cross_and_degenerate(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)[1]
     if double_areas is None:
+        if cross is None:
+            return cross_and_degenerate(vertices, topology.faces, scales, DEGENERATE_AREA_RATIO)[1]
         double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
     return degenerate_face_mask(0.5 * double_areas, scales[topology.faces[:, 0]]) | topology.degenerate_faces
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from ._adapters import mesh_arrays
 from ._locality import local_topology
+from ._once import adopt
 from ._validation import as_faces, as_vertices, check_choice
 from .defects import BOUNDARY, VertexDefects, defect_codes
 from .errors import InvalidOptionError
@@ -85,7 +86,9 @@ class PreparedMesh:
     @cached_property
     def length_scales(self) -> np.ndarray:
         """(V,) the length scale of each vertex (:func:`meshcurv.geometry.vertex_length_scales`), found once
-        for the zero-area faces, the estimators and the diagnosis. Kept writable: the kernels it is passed to
+        for the orientation, the zero-area faces, the defects, the radius rules, the estimators and the diagnosis
+        (inside :func:`meshcurv._once.computed_once`, every caller of ``vertex_length_scales`` on these vertices
+        gets this array). Kept writable: the kernels it is passed to
         are compiled for writable arrays (a read-only one is another numba signature)."""
         return vertex_length_scales(self.vertices, self.topology)
 
@@ -223,6 +226,7 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
             copies.vertices, copies.topology, copies.index[first], (welded.n_welded if welded is not None else 0)
         )
         points, topology = welded.vertices, welded.topology
+    adopt(points)  # the call's derived arrays (length scales, needles) found once from here on
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
     topology, n_flipped = oriented_topology(points, one_sided.topology, orient)
     # the row computed for each of the caller's vertices (welded vertices, in the local order)

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ._once import computed_once
 from ._prepared import prepare_mesh
 from ._validation import check_choice, check_int_option, check_positive_float, trusting
 from .diagnosis import mesh_diagnosis, quality_message
@@ -185,7 +186,16 @@ def principal_curvatures(
     """
     estimator, options = _checked_options(method, smoothing_steps=smoothing_steps, radius=radius)
     orient, weld = _resolved(method, orient, weld)
-    mesh = prepare_mesh(vertices, faces, orient=orient, weld=weld, stacklevel=3)
+    with computed_once():  # the length scales and needle vertices found once, whoever asks (meshcurv._once)
+        result, message = _computed(vertices, faces, estimator, options, orient, weld, progress, radius)
+    if message:
+        warnings.warn(message, MeshQualityWarning, stacklevel=2)
+    return result
+
+
+def _computed(vertices, faces, estimator, options: dict, orient: str, weld, progress, radius) -> tuple:
+    """``(result, message)`` of :func:`principal_curvatures`, its options checked."""
+    mesh = prepare_mesh(vertices, faces, orient=orient, weld=weld, stacklevel=4)
     points, topology = mesh.vertices, mesh.topology
     with trusting(points, topology.faces, topology.edges):  # checked: the helpers below need not check again
         found: dict = {}
@@ -197,12 +207,9 @@ def principal_curvatures(
                 if estimator.name == "icc":
                     options["vertex_scale"] = vertex_scale
         result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
-        result, message = _finished(
+        return _finished(
             mesh, estimator, result, problems, found, given_radius=radius is not None and not options.get("adaptive")
         )
-    if message:
-        warnings.warn(message, MeshQualityWarning, stacklevel=2)
-    return result
 
 
 def multiscale_curvatures(
@@ -274,17 +281,9 @@ def multiscale_curvatures(
         raise InvalidOptionError(f"`radii` must be a non-empty sequence of radii; got {radii!r}")
     radii = [check_positive_float(radius, "radii") for radius in radii]
     orient, weld = _resolved(method, orient, weld)
-    mesh = prepare_mesh(vertices, faces, orient=orient, weld=weld, stacklevel=3)
+    with computed_once():
+        finished = _computed_at(vertices, faces, estimator, options, orient, weld, progress, radii)
     order = np.argsort(radii, kind="stable")
-    stages = Stages(estimator.stages, progress)
-    with trusting(mesh.vertices, mesh.topology.faces, mesh.topology.edges):
-        if estimator.multiscale is not None:
-            computed = estimator.multiscale(mesh, radii=[radii[i] for i in order], stages=stages)
-        else:
-            computed = [estimator.function(mesh, stages=stages, **{**options, "radius": radii[i]}) for i in order]
-        finished = [
-            _finished(mesh, estimator, result, problems, {}, given_radius=True) for result, problems in computed
-        ]
     results: list = [None] * len(radii)
     for rank, index in enumerate(order):
         results[index] = finished[rank][0]
@@ -296,6 +295,19 @@ def multiscale_curvatures(
         )
         warnings.warn(message, MeshQualityWarning, stacklevel=2)
     return results
+
+
+def _computed_at(vertices, faces, estimator, options: dict, orient: str, weld, progress, radii: list) -> list:
+    """``(result, message)`` of :func:`multiscale_curvatures` at each radius, in increasing order."""
+    mesh = prepare_mesh(vertices, faces, orient=orient, weld=weld, stacklevel=4)
+    order = np.argsort(radii, kind="stable")
+    stages = Stages(estimator.stages, progress)
+    with trusting(mesh.vertices, mesh.topology.faces, mesh.topology.edges):
+        if estimator.multiscale is not None:
+            computed = estimator.multiscale(mesh, radii=[radii[i] for i in order], stages=stages)
+        else:
+            computed = [estimator.function(mesh, stages=stages, **{**options, "radius": radii[i]}) for i in order]
+        return [_finished(mesh, estimator, result, problems, {}, given_radius=True) for result, problems in computed]
 
 
 def _checked_options(method, **given) -> tuple:

@@ -22,6 +22,7 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._geometry import degenerate_face_mask
+from ._once import once
 from .topology import MeshTopology
 
 __all__ = [
@@ -184,8 +185,14 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
     -------
     ndarray of shape (V,), bool
         The vertices of such clusters that have a face of non-zero area with
-        one corner in the cluster (the angles are summed over those faces).
+        one corner in the cluster (the angles are summed over those faces);
+        read-only when found once for the call's prepared mesh (:func:`meshcurv._once.once`).
     """
+    return once("needle_vertices", vertices, topology, lambda: _needle_vertices(vertices, topology, scales), scales)
+
+
+def _needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray:
+    """:func:`needle_vertices`, computed."""
     n = topology.n_vertices
     edges = topology.edges
     first, second = edges[:, 0], edges[:, 1]
