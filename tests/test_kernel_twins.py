@@ -1171,7 +1171,8 @@ def test_face_sum_scratch_takes_int64_only_beyond_int32_indices():
     assert [a.dtype for a in small] == [np.int32, np.int32, np.int32, np.float64, np.int32, np.int32, np.int32]
     assert [a.shape for a in small] == [(2, 16), (2, 10), (2, 10), (2, 10), (2, 10), (2, 0), (2, 0)]
     assert all((a == -1).all() for a in small[:3])
-    assert [a.shape for a in _face_sum_scratch(2, 10, 16, nested=True)[5:]] == [(2, 16), (2, 16)]
+    # nested: the level of each queued vertex (V); the clusters' spare stays empty
+    assert [a.shape for a in _face_sum_scratch(2, 10, 16, nested=True)[5:]] == [(2, 10), (2, 0)]
     # no chunks: the dtype is chosen without allocating a mesh of 2^31 faces
     large = _face_sum_scratch(0, 10, 2**31)
     assert [a.dtype for a in large] == [np.int64, np.int64, np.int64, np.float64, np.int64, np.int64, np.int64]
