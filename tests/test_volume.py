@@ -19,8 +19,14 @@ import pytest
 pytest.importorskip("skimage")
 pandas = pytest.importorskip("pandas")
 
-from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshFileError, MeshQualityWarning  # noqa: E402
-from meshcurv.volume import COLUMNS, label_curvatures  # noqa: E402
+from meshcurv.errors import (  # noqa: E402
+    InvalidMeshError,
+    InvalidOptionError,
+    MeshcurvWarning,
+    MeshFileError,
+    MeshQualityWarning,
+)
+from meshcurv.volume import COLUMNS, label_curvatures, label_surfaces  # noqa: E402
 
 UNIT = (1.0, 1.0, 1.0)  # the voxel size of the tests (a call without spacing warns)
 
@@ -220,9 +226,29 @@ def test_huge_label_values_keep_their_identity():
     assert table.n_voxels[0] == ball.sum()
 
 
-def test_no_label_gives_an_empty_table():
-    table = label_curvatures(np.zeros((8, 8, 8), dtype=np.uint8), spacing=UNIT)
+def test_no_label_gives_an_empty_table_with_one_warning():
+    with pytest.warns(MeshcurvWarning, match=r"label_curvatures: the image holds no object: every voxel is 0") as seen:
+        table = label_curvatures(np.zeros((8, 8, 8), dtype=np.uint8), spacing=UNIT)
     assert table.empty and list(table.columns) == list(COLUMNS)
+    assert len(seen) == 1
+
+
+def test_a_threshold_above_every_voxel_gives_an_empty_table_with_one_warning():
+    probability = np.full((8, 8, 8), 0.3)
+    probability[2:6, 2:6, 2:6] = 0.45
+    with pytest.warns(MeshcurvWarning, match=r"no voxel is greater than threshold=0\.5; the table has no row") as seen:
+        table = label_curvatures(probability, spacing=UNIT, threshold=0.5)
+    assert table.empty and len(seen) == 1
+    with pytest.warns(MeshcurvWarning, match=r"label_surfaces: the image holds no object"):
+        total, rows = label_surfaces(probability, spacing=UNIT, threshold=0.5)
+    assert total == 0 and list(rows) == []
+
+
+def test_no_label_asked_for_is_an_empty_table_without_a_warning():
+    image = np.zeros((8, 8, 8), dtype=np.uint8)
+    image[2:6, 2:6, 2:6] = 1
+    table = label_curvatures(image, spacing=UNIT, labels_to_use=[])  # the warnings are errors here
+    assert table.empty
 
 
 def test_boolean_mask_and_progress():

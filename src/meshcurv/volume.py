@@ -822,6 +822,20 @@ def _warn_spacing(caller: str, stacklevel: int) -> None:
     )
 
 
+def _warn_no_object(caller: str, threshold, stacklevel: int) -> None:
+    """The image holds no object: an empty table, said once (a wrong threshold or an empty mask)."""
+    what = (
+        "every voxel is 0 (the background)"
+        if threshold is None
+        else f"no voxel is greater than threshold={threshold:g}"
+    )
+    warnings.warn(
+        f"{caller}: the image holds no object: {what}; the table has no row",
+        MeshcurvWarning,
+        stacklevel=stacklevel + 1,
+    )
+
+
 def _plan(
     labels, spacing, labels_to_use, radius, threshold=None, *, caller: str = "label_curvatures", stacklevel: int = 2
 ):
@@ -1074,6 +1088,8 @@ def _label_surfaces(
     )
     if assumed:
         _warn_spacing(caller, stacklevel + 1)
+    if not objects and labels_to_use is None:
+        _warn_no_object(caller, threshold, stacklevel + 1)
     if (workers is None and client is None) or all(box is None for box in objects.values()):
         return len(objects), _iterate(image, spacing, objects, method, radius, keep_surfaces, smooth)
     return len(objects), _iterate_dask(image, spacing, objects, method, radius, keep_surfaces, client, workers, smooth)
@@ -1133,9 +1149,8 @@ def label_curvatures(
         or a binary mask (one object, label 1); with ``threshold``, a
         probability map; or the ``Image`` that
         ``meshcurv.io._images.read_image`` returns, whose spacing (from the
-        file) is used when ``spacing`` is not given. A float image of whole
-        numbers is read as labels (with a warning); another float image
-        needs ``threshold``. An array read by slicing, a ``zarr.Array``, a
+        file) is used when ``spacing`` is not given. A float image needs
+        ``threshold`` (labels stored as floats: cast them first). An array read by slicing, a ``zarr.Array``, a
         ``dask.array.Array`` or a :class:`meshcurv._lazy.LazyImage` (what
         ``read_image`` returns for a ``.zarr`` store), is never loaded
         whole: the objects' boxes are found a chunk at a time, then each
@@ -1210,9 +1225,9 @@ def label_curvatures(
     Raises
     ------
     InvalidMeshError
-        ``labels`` not a 3D integer or boolean array (or a float array of
-        whole numbers, or one with ``threshold``), empty, or with negative
-        labels; a float image of other values without ``threshold``.
+        ``labels`` not a 3D integer or boolean array (or, with ``threshold``,
+        an array of real numbers), empty, or with negative labels; a float
+        image without ``threshold``.
     InvalidOptionError
         ``spacing`` not 3 positive finite numbers; bad ``labels_to_use``,
         ``method``, ``radius``, ``workers``, ``threshold`` or ``smooth``;
@@ -1229,8 +1244,9 @@ def label_curvatures(
         failed, or have invalid vertices: the counts (the rows say which).
     MeshcurvWarning
         When no ``spacing`` was given and the image carries none: what was
-        assumed (1 x 1 x 1) and how to pass it. When a float image of whole
-        numbers is read as labels; when a thresholded image has NaN voxels.
+        assumed (1 x 1 x 1) and how to pass it. When the image holds no
+        object (no label, or no voxel above ``threshold``): the table is
+        empty. When a thresholded image has NaN voxels.
 
     Examples
     --------
