@@ -315,7 +315,7 @@ def agreement_rungs(estimates, lists, threshold, rings=2):
     return ok.shape[0] - 1 - np.argmax(ok[::-1], axis=0)
 
 
-def agreement_table(paths, base_index=1, thresholds=(0.5, 1.0, 2.0)):
+def agreement_table(paths, base_index=1, thresholds=(0.5, 1.0, 2.0), tubes=(0.5, 0.8)):
     """Per family: geometric means of the median H error of today (rung ``base_index``), each uniform factor, the
     least-change ladder and the agreement test from the base rung up, with the rows worse / better by a tenth."""
     for path in paths:
@@ -330,10 +330,12 @@ def agreement_table(paths, base_index=1, thresholds=(0.5, 1.0, 2.0)):
             mean = 0.5 * (exact[0] + exact[1])
 
             def error(k_min, k_max, scale=scale, mean=mean, exact=exact):
+                gauss = exact[0] * exact[1]
                 return (
                     _median(np.abs(0.5 * (k_min + k_max) - mean) / scale),
                     _median(np.abs(k_min - exact[0]) / scale),
                     _median(np.abs(k_max - exact[1]) / scale),
+                    _median(np.abs(k_min * k_max - gauss) / np.abs(gauss)),  # accuracy_voxel.md's K metric
                 )
 
             for j, f in enumerate(measures):
@@ -341,9 +343,20 @@ def agreement_table(paths, base_index=1, thresholds=(0.5, 1.0, 2.0)):
             every = np.arange(scale.size)
             rung = radius_rules.stable_scales(estimates[:, 0], estimates[:, 1], lists)
             rules.setdefault("least change", []).append(error(*estimates[rung, :2, every].T))
+            rung = np.minimum(rung, 1)  # the same choice, the upper rung at most f 1.41
+            rules.setdefault("least change, f <= 1.41", []).append(error(*estimates[rung, :2, every].T))
             for c in thresholds:
                 rung = agreement_rungs(estimates, lists, c)
                 rules.setdefault(f"agreement {c:g}", []).append(error(*estimates[rung, :2, every].T))
+            # tube-like vertices (curved one way: t = 1 - 2 sqrt|K| / c, of today's estimates over 2 rings, as the
+            # pilot's t_v of radius.voxel_vertex_radii) one rung up
+            curvedness = _ring_mean(lists, 2, np.maximum(np.abs(estimates[0, 0]), np.abs(estimates[0, 1])))
+            gauss = _ring_mean(lists, 2, np.abs(estimates[0, 0] * estimates[0, 1]))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                tube = np.clip(1 - 2 * np.sqrt(gauss) / curvedness, 0, 1)
+            for limit in tubes:
+                rung = np.where(tube > limit, 1, 0)
+                rules.setdefault(f"tube > {limit:g}", []).append(error(*estimates[rung, :2, every].T))
         today = np.array(rules[f"f {measures[base_index]:g}"])
         print(
             f"\n{path}: {len(names)} meshes; geometric mean of the median H / k_min / k_max error; rows (H) worse / better by a tenth"
@@ -353,7 +366,11 @@ def agreement_table(paths, base_index=1, thresholds=(0.5, 1.0, 2.0)):
             geo = np.exp(np.mean(np.log(np.maximum(values, 1e-6)), axis=0))
             worse = int(np.sum(values[:, 0] > 1.1 * today[:, 0]))
             better = int(np.sum(values[:, 0] < today[:, 0] / 1.1))
-            print(f"  {rule:14s} {_pct(geo[0])} / {_pct(geo[1])} / {_pct(geo[2])}  ({worse} / {better})")
+            worse_k = int(np.sum(values[:, 3] > 1.1 * today[:, 3]))
+            print(
+                f"  {rule:24s} {_pct(geo[0])} / {_pct(geo[1])} / {_pct(geo[2])}  ({worse} / {better});"
+                f"  K of |K| {_pct(geo[3])} ({worse_k} worse)"
+            )
         for index, name in enumerate(names):
             cells = " ".join(f"{rule}={100 * rules[rule][index][0]:.2f}" for rule in rules)
             print(f"    {name.split('|')[1]}: {cells}")
