@@ -28,7 +28,7 @@ from known points and faces, and one row is changed: a value dropped, one
 added, one moved to the next row (the total stays right), an empty value, a
 trailing separator (on one row or on all), a row split or joined with the
 next, a word that is not a number; or the file is changed harmlessly (a
-blank line, a comment, CRLF). The reader must return exactly the points and
+blank line, a comment, CRLF, a UTF-8 byte-order mark first). The reader must return exactly the points and
 faces written, or raise a MeshFileError naming a line the change touched (or
 the count line it contradicts). A different result (a re-cut), an error for
 a harmless change or one naming no line is a finding; an error naming another
@@ -231,7 +231,7 @@ def read_in_child(context, path: pathlib.Path, timeout: float, memory_bytes: int
 # other exception, a warning, a hang or a blow-up.
 
 #: changes that leave the file valid: the reader must read the intended points
-HARMLESS = ("none", "blank line", "crlf", "comment line")
+HARMLESS = ("none", "blank line", "crlf", "comment line", "byte-order mark")
 #: changes to one row (or two): the intended result, or an error naming a touched line
 DAMAGING = (
     "drop a value",
@@ -425,8 +425,9 @@ def mutate_rows(rows: list, change: str, rng: random.Random) -> tuple[str, set]:
         row.words += rows[i + 1].words
         del rows[i + 1]
         touched.add(i + 1)
+    lead = "\ufeff" if change == "byte-order mark" else ""  # what Excel and Notepad put first in UTF-8
     lines = [row.text() for row in rows]
-    text = newline.join(lines) + newline
+    text = lead + newline.join(lines) + newline
     applied = change in DAMAGING and text != before
     free = change in ("extra value", "join with the next row") and row.free
     return text, ({t + 1 for t in touched} if applied else set()), free

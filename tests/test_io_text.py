@@ -256,3 +256,52 @@ def test_reading_stays_vectorised(tmp_path):
     np.testing.assert_array_equal(read, points)
     # about 0.3 s on the 2-core VM under load; a Python loop over rows with a check each takes > 1 s
     assert elapsed < 3.0
+
+
+_BOM = "\ufeff"  # what Excel ("CSV UTF-8") and Notepad write first: b"\xef\xbb\xbf" in UTF-8
+
+
+@pytest.mark.parametrize(
+    "name, text",
+    [
+        ("cloud.csv", "x,y,z\n1.5,2,3\n4,5,6\n"),
+        ("cloud.csv", "x;y;z\n1,5;2;3\n4;5;6\n"),
+        ("cloud.csv", "1.5,2,3\n4,5,6\n"),
+        ("cloud.xyz", "1.5 2 3\n4 5 6\n"),
+        ("cloud.txt", "x\ty\tz\n1.5\t2\t3\n4\t5\t6\n"),
+        ("cloud.pts", "2\n1.5 2 3\n4 5 6\n"),
+        ("cloud.ply", _PLY_CLOUD.replace("3\n", "2\n", 1) + "1.5 2 3\n4 5 6\n"),
+        ("cloud.pcd", _PCD.replace("3\n", "2\n").replace("POINTS 3", "POINTS 2") + "1.5 2 3\n4 5 6\n"),
+    ],
+)
+def test_a_byte_order_mark_is_not_part_of_the_first_row(tmp_path, name, text):
+    points, _ = meshcurv.read_points(_write(tmp_path, name, _BOM + text))
+    np.testing.assert_array_equal(points, [[1.5, 2, 3], [4, 5, 6]])
+
+
+_FIVE = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]]
+
+
+@pytest.mark.parametrize(
+    "name, text",
+    [
+        # the BOM made the first `v` line unreadable: vertex 1 was dropped and faces 1-4 took vertices 2-5
+        ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3\nf 1 3 4\n"),
+        ("mesh.off", "OFF\n5 2 0\n" + _FOUR + "1 1 1\n3 0 1 2\n3 0 2 3\n"),
+        (
+            "mesh.ply",
+            _PLY_MESH.replace("vertex 4", "vertex 5") + _FOUR + "1 1 1\n3 0 1 2\n3 0 2 3\n",
+        ),
+    ],
+)
+def test_a_byte_order_mark_before_a_mesh_is_skipped(tmp_path, name, text):
+    vertices, faces = meshcurv.read_mesh(_write(tmp_path, name, _BOM + text))
+    np.testing.assert_array_equal(vertices, _FIVE)
+    np.testing.assert_array_equal(faces, [[0, 1, 2], [0, 2, 3]])
+
+
+def test_a_byte_order_mark_before_an_ascii_stl_is_skipped(tmp_path):
+    vertices, faces = meshcurv.read_mesh(_write(tmp_path, "mesh.stl", _BOM + _STL))
+    expected, expected_faces = meshcurv.read_mesh(_write(tmp_path, "plain.stl", _STL))
+    np.testing.assert_array_equal(vertices, expected)
+    np.testing.assert_array_equal(faces, expected_faces)

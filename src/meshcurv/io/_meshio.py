@@ -14,7 +14,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError, optional_module
-from ._text import line_of, line_of_match, not_a_number, numbers_per_line, row_error
+from ._text import line_of, line_of_match, not_a_number, numbers_per_line, row_error, without_bom
 
 __all__ = ["read_with_meshio", "write_with_meshio"]
 
@@ -60,13 +60,13 @@ def check_stl(path):
     size = path.stat().st_size
     if len(head) == 84 and 84 + 50 * int.from_bytes(head[80:84], "little") == size:
         return None
-    if not head.lstrip().startswith(b"solid"):
+    if not without_bom(head).lstrip().startswith(b"solid"):
         raise MeshFileError(
             f"{path}: not an STL file (not a binary STL: its size does not match its triangle count; "
             "not an ASCII STL: it does not start with 'solid')"
         )
     with open(path, "rb") as handle:
-        return read_ascii_stl(path, handle.read())
+        return read_ascii_stl(path, without_bom(handle.read()))
 
 
 def read_ascii_stl(path, data: bytes):

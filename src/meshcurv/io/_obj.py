@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import first_bad_line, line_of, line_of_match, numbers_per_line
+from ._text import first_bad_line, line_of, line_of_match, numbers_per_line, without_bom
 
 __all__ = ["read_obj", "write_obj"]
 
@@ -36,7 +36,7 @@ def read_obj(path):
         faces have different numbers of corners. 0-based.
     """
     with open(path, "rb") as handle:
-        data = handle.read()
+        data = without_bom(handle.read())
     if data[:1] in (b" ", b"\t") or b"\n " in data or b"\n\t" in data:
         data = _LEADING_BLANKS.sub(b"", data)
     vertex_lines = _VERTEX.findall(data)

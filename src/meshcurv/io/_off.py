@@ -11,7 +11,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import not_a_number, numbers_per_line, row_error
+from ._text import not_a_number, numbers_per_line, row_error, without_bom
 
 __all__ = ["read_off", "write_off"]
 
@@ -29,7 +29,7 @@ def read_off(path):
     after the declared faces is an error naming its line number.
     """
     with open(path, "rb") as handle:
-        data = _COMMENT.sub(b"", handle.read())
+        data = _COMMENT.sub(b"", without_bom(handle.read()))
     lines = [line for line in data.split(b"\n") if line.strip()]
     words = lines[0].split() if lines else []
     if not words or words[0] != b"OFF":

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import body_rows, fixed_rows, names_shown, row_error
+from ._text import body_rows, fixed_rows, names_shown, row_error, without_bom
 
 __all__ = ["read_ply", "HEADER_LIMIT"]
 
@@ -172,7 +172,7 @@ def read_ply(path):
         hold, the end of the file inside an element, float indices.
     """
     with open(path, "rb") as handle:
-        data = handle.read()
+        data = without_bom(handle.read())
     file_format, elements, offset = _header(data, path)
     vertex, face, corners = _roles(elements, path)
     if file_format == "ascii":
@@ -421,7 +421,7 @@ def ply_vertex_columns(path) -> dict[str, np.ndarray]:
     mesh alike. ASCII values are float64; binary ones keep their stored type.
     """
     path = pathlib.Path(path)
-    data = path.read_bytes()
+    data = without_bom(path.read_bytes())
     file_format, elements, offset = _header(data, path)
     vertex = next((e for e in elements if e.name == "vertex"), None)
     if vertex is None:

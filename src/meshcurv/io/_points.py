@@ -42,7 +42,16 @@ from ..errors import (
 )
 from ._files import atomic_output, check_input, check_output, format_key, named_fields
 from ._ply import HEADER_LIMIT, _header, _short, ply_vertex_columns
-from ._text import body_rows, fixed_rows, line_of, names_shown, not_a_number, numbers_by_line, row_error
+from ._text import (
+    body_rows,
+    fixed_rows,
+    line_of,
+    names_shown,
+    not_a_number,
+    numbers_by_line,
+    row_error,
+    without_bom,
+)
 from .fields import curvature_fields
 
 __all__ = ["read_points", "write_points", "write_point_curvatures", "is_point_cloud", "POINT_EXTENSIONS"]
@@ -120,7 +129,7 @@ def is_point_cloud(path) -> bool:
         return False
     try:
         with open(path, "rb") as handle:
-            _, elements, _ = _header(handle.read(HEADER_LIMIT + 64), path)
+            _, elements, _ = _header(without_bom(handle.read(HEADER_LIMIT + 64)), path)
     except (OSError, MeshFileError):
         return False
     return not any(e.name == "face" and e.count > 0 for e in elements)
@@ -221,7 +230,7 @@ def text_columns(path) -> dict[str, np.ndarray]:
     that is not a number is a :class:`~meshcurv.errors.MeshFileError` naming
     its line, never a shift of the values after it.
     """
-    data = pathlib.Path(path).read_bytes()
+    data = without_bom(pathlib.Path(path).read_bytes())
     if b"#" in data or b"//" in data:
         data = _COMMENT_LINES.sub(b"", data)  # the newlines stay: line numbers are the file's
     first = _FIRST_WORD.search(data)
@@ -349,7 +358,7 @@ _PCD_TYPES = {
 
 
 def _read_pcd(path):
-    data = path.read_bytes()
+    data = without_bom(path.read_bytes())
     header, position = {}, 0
     for _ in range(64):
         end = data.find(b"\n", position)

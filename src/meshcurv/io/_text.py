@@ -27,10 +27,21 @@ __all__ = [
     "names_shown",
     "body_rows",
     "fixed_rows",
+    "BYTE_ORDER_MARK",
+    "without_bom",
 ]
 
 _NEWLINE = 10
+#: The UTF-8 byte-order mark that Excel ("CSV UTF-8"), Notepad and other Windows tools write first
+#: in a text file: no part of the first line (kept, it made the first OBJ vertex line unreadable, so
+#: that every face pointed one vertex further, and refused every other text format).
+BYTE_ORDER_MARK = b"\xef\xbb\xbf"
 _CHUNK = 4096  # lines tried at once when looking for the one that is not numbers
+
+
+def without_bom(data: bytes) -> bytes:
+    """``data`` without a leading UTF-8 byte-order mark (:data:`BYTE_ORDER_MARK`); line numbers unchanged."""
+    return data[len(BYTE_ORDER_MARK) :] if data.startswith(BYTE_ORDER_MARK) else data
 
 
 def numbers(text: bytes) -> np.ndarray | None:

@@ -17,7 +17,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError
-from ._text import numbers
+from ._text import numbers, without_bom
 
 __all__ = ["is_polydata", "read_vtk_polydata"]
 
@@ -123,7 +123,7 @@ def read_vtk_polydata(path):
     faces : ndarray of shape (F, k), int64, or a list of int64 arrays
     """
     with open(path, "rb") as handle:
-        data = handle.read()
+        data = without_bom(handle.read())
     cursor = _Cursor(data, 0, False, path)
     first = cursor.line(skip_blank=False)
     if not first or first[:3] != ["#", "vtk", "DataFile"]:
