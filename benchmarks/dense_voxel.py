@@ -64,6 +64,11 @@ PROFILED = (
     ("icc.py", "fitted_normals", "normal fits of the main pass"),
     ("jets.py", "fit_jet_normals", "  fits over every vertex (none on a dense surface)"),
     ("icc.py", "_coarse_level", "  coarse level of the main fits"),
+    (
+        "jets.py",
+        "sampled_jet_normals",
+        "  fits at one centre per cube, the others interpolated (jets.sampled_jet_normals)",
+    ),
     ("jets.py", "fit_jets", "jet fits (the pilot's centres and the main pass's coarse level)"),
     ("neighborhoods.py", "ball_face_sums", "sums over balls, face by face (the pilot's; sparse balls)"),
     ("neighborhoods.py", "coarse_face_sums", "sums over balls on clusters of faces (main pass, dense balls)"),
