@@ -88,3 +88,40 @@ def test_larger_must_exceed_the_radius(larger):
     points, normals, _ = _sphere_cloud(200)
     with pytest.raises(InvalidOptionError, match="`larger` must be a finite number larger than `radius` 0.2"):
         jets.fit_jets(points, normals, 0.2, details={}, larger=larger)
+
+
+@pytest.mark.skipif(importlib.util.find_spec("numba") is None, reason="numba is not installed")
+@pytest.mark.parametrize("cloud", ["gaussian", "lattice", "far and small", "flat"])
+def test_the_walk_over_the_cells_a_ball_reaches_finds_what_the_whole_cube_finds(cloud):
+    """``_walk_members`` (the larger ball's walk of the pairs) skips the cells beyond the ball: the same members
+    in the same order as ``_ball_members``' walk of the whole cube of cells, at every ratio of radius to cell,
+    centres on the points, off them and outside the grid, on a lattice (points on the cells' bounds) and far from
+    the origin (rounding of the bounds)."""
+    from meshcurv._kernels.jets import _walk_members
+    from meshcurv._kernels.neighborhoods import _ball_members, pool_grid
+
+    rng = np.random.default_rng(7)
+    if cloud == "gaussian":
+        points = rng.normal(size=(3000, 3))
+    elif cloud == "lattice":
+        points = np.stack(np.meshgrid(*[np.arange(14.0)] * 3), axis=-1).reshape(-1, 3)
+    elif cloud == "far and small":
+        points = 1e6 + 1e-3 * rng.random((3000, 3))
+    else:
+        points = rng.random((3000, 3)) * [1.0, 1.0, 1e-3]
+    extent = float(np.ptp(points, axis=0).max())
+    walked = 0
+    for reach in (0.05 * extent, 0.2 * extent, 1.0 / 7.0 * 14.0 if cloud == "lattice" else 0.1 * extent):
+        pool_points, _, grid = pool_grid(points, np.arange(points.shape[0]), reach)
+        for ratio in (1.0, 2.0**0.5, 2.0, 2.7, 3.0):
+            cutoff = reach * ratio
+            centres = np.concatenate(
+                [points[rng.integers(0, points.shape[0], 60)], points[:20] + rng.normal(size=(20, 3)) * cutoff]
+            )
+            for centre in centres:
+                expected, count = _ball_members(pool_points, grid, *centre, cutoff, np.empty(8, np.int64))
+                got, got_count = _walk_members(pool_points, grid, *centre, cutoff, np.empty(8, np.int64))
+                assert got_count == count
+                np.testing.assert_array_equal(got[:got_count], expected[:count])
+                walked += count
+    assert walked > 0
