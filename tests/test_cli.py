@@ -472,3 +472,18 @@ def test_a_quad_mesh_is_triangulated_once_and_said_once(capsys, tmp_path):
     code, out, err = run(capsys, "compute", path, "-m", "normal_cycle")
     assert code == 0 and "8 vertices, 6 faces" in out
     assert err.count("forces triangulation") == 1, err
+
+
+def test_info_describes_a_point_cloud(capsys, tmp_path):
+    grid = np.stack(np.meshgrid(np.arange(4.0), np.arange(3.0), [0.0, 2.0], indexing="ij"), -1).reshape(-1, 3) * 0.5
+    rows = np.vstack([grid, grid[:2], [[np.nan, 0, 0]]])  # 24 grid points spaced 0.5 and 1, 2 copies, 1 NaN
+    path = tmp_path / "grid.xyz"
+    path.write_text("".join(f"{x} {y} {z}\n" for x, y, z in rows))
+    code, out, err = run(capsys, "info", path)
+    assert code == 0 and err == ""
+    facts = dict(line.split("  ", 1) for line in out.splitlines())
+    facts = {key.strip(): value.strip() for key, value in facts.items()}
+    assert facts["points"] == "27" and facts["non-finite points"] == "1"
+    assert facts["repeated points"].startswith("2 ") and facts["normals"].startswith("none")
+    assert facts["bounding box"] == "(0, 0, 0) to (1.5, 1, 1) (size (1.5, 1, 1))"
+    assert facts["spacing"].startswith("0.5 ")

@@ -23,7 +23,15 @@ from ..diagnosis import diagnose
 from ..errors import MeshFileError
 from ..estimators import ESTIMATORS
 from ..integrals import weighted_statistics
-from ..io import FORMATS, POINT_EXTENSIONS, is_point_cloud, read_mesh, write_curvatures, write_point_curvatures
+from ..io import (
+    FORMATS,
+    POINT_EXTENSIONS,
+    is_point_cloud,
+    read_mesh,
+    read_points,
+    write_curvatures,
+    write_point_curvatures,
+)
 from ..io._files import check_output
 from ..io.fields import FIELDS, VIEWERS, curvature_fields
 from ..plotting import _EXTRA_INCHES, _PANEL_INCHES, MAX_DPI, VIEWS, _pyplot, choose_up, plot_field, save_figure
@@ -380,7 +388,10 @@ def plot(
 @mesh_argument
 @common_options
 def info(mesh):
-    """What MESH is: sizes, topology, defects, bounding box, edge length."""
+    """What MESH is: sizes, topology, defects, bounding box, edge length (or, for a point cloud, its spacing)."""
+    if is_point_cloud(mesh):
+        click.echo(_cloud_info(mesh))
+        return
     vertices, faces = read_mesh(mesh)
     n_polygons = len(faces)
     triangles = as_faces(faces, len(vertices))
@@ -400,6 +411,29 @@ def info(mesh):
             value = "-"
         lines.append(f"{name:<22} {value}")
     click.echo("\n".join(lines))
+
+
+def _cloud_info(path: pathlib.Path) -> str:
+    """``meshcurv info`` of a point cloud: points, normals, non-finite and repeated points, box, spacing."""
+    from scipy.spatial import cKDTree
+
+    points, normals = read_points(path)
+    finite = np.isfinite(points).all(axis=1)
+    distinct = np.unique(points[finite], axis=0)
+    lines = [
+        f"file                   {path} (point cloud, {path.stat().st_size} bytes)",
+        f"points                 {len(points)}",
+        f"normals                {'given' if normals is not None else 'none (estimated when computing)'}",
+        f"non-finite points      {int((~finite).sum())}",
+        f"repeated points        {int(finite.sum()) - len(distinct)} (exact copies of another point)",
+    ]
+    if len(distinct):
+        low, high = distinct.min(axis=0), distinct.max(axis=0)
+        lines.append(f"bounding box           {_point(low)} to {_point(high)} (size {_point(high - low)})")
+    if len(distinct) > 1:
+        spacing = np.median(cKDTree(distinct).query(distinct, k=2)[0][:, 1])
+        lines.append(f"spacing                {spacing:.6g} (median distance to the nearest other point)")
+    return "\n".join(lines)
 
 
 def _point(values) -> str:
