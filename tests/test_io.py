@@ -288,6 +288,11 @@ def test_missing_directory_empty_and_unknown_files(tmp_path):
     (tmp_path / "folder.obj").mkdir()
     with pytest.raises(MeshFileError, match=r"folder\.obj: is a directory, not a mesh file"):
         meshcurv.read_mesh(tmp_path / "folder.obj")
+    (tmp_path / "scans").mkdir()  # no extension: was "unknown mesh file extension (none)"
+    with pytest.raises(MeshFileError, match=r"scans: is a directory, not a mesh file$"):
+        meshcurv.read_mesh(tmp_path / "scans")
+    with pytest.raises(MeshFileError, match=r"scans: is a directory"):
+        meshcurv.read_points(tmp_path / "scans")
     with pytest.raises(MeshFileError, match=r"empty\.ply: the file is empty"):
         meshcurv.read_mesh(write_text(tmp_path, "empty.ply", ""))
     with pytest.raises(

@@ -170,6 +170,8 @@ def format_key(path: pathlib.Path, file_format: str | None, known, what: str) ->
         raise InvalidOptionError(f"`file_format` must be an extension such as 'ply'; got {file_format!r}")
     key = file_format if file_format is None or file_format.startswith(".") else "." + file_format
     key = (key or path.suffix).lower()
+    if key not in known and file_format is None and path.is_dir():
+        raise MeshFileError(f"{path}: is a directory, not a {what}")
     if key not in known:
         given = f"extension {path.suffix!r}" if path.suffix else "extension (none)"
         given = f"format {file_format!r}" if file_format else given
