@@ -108,8 +108,9 @@ TURN_AGREEMENT = 0.2
 REFERENCE_TURN = 0.8
 
 #: ... and are not needed where no estimate on the own side of the ball has a largest |k| below this share of the
-#: centre's (:func:`_uniform_balls`: a curvature steady over the ball).
-UNIFORM_SHARE = 0.5
+#: centre's (:func:`_uniform_balls`: a curvature steady over the ball; at 0.5 a plate of 300 points beside three
+#: spheres, seed 42 case 214, kept 21 points off by 50-90%, its whole band biased alike).
+UNIFORM_SHARE = 0.7
 
 #: A resolved estimate whose ball turns the normal by more than :data:`UNRESOLVED_TURN` radians and whose own side
 #: holds more than :data:`UNRESOLVED_SHARE` of points without a resolved estimate is unsteady
