@@ -286,3 +286,52 @@ def test_unsteady_takes_its_agreement():
     larger = (np.array([1.0]), np.array([2.5]))
     assert not estimators.unsteady(found, larger, np.arange(1), 1.0)[0]  # 0.5 within 0.4 x 2
     assert estimators.unsteady(found, larger, np.arange(1), 1.0, 0.2)[0]  # 0.5 beyond 0.2 x 2
+
+
+def plate_beside_spheres(seed):
+    """``(points, normals, mean, kmax, spacing)``: the fuzzer's seed 42 case 214 drawn again: spheres of radii 1,
+    0.5 and 2 (76, 60 and 304 points) in a row, 10 and 3 of their spacings apart, and a plate (an ellipsoid 1 x 0.5 x
+    0.2 of 400 points) beside them, under noise of 0.05 spacings along the exact normals."""
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(seed)
+    parts, normals, mean, kmax = [], [], [], []
+    x = 0.0
+    for j, (radius, m, gap) in enumerate(((1.0, 76, 0.0), (0.5, 60, 10.0), (2.0, 304, 3.0))):
+        if j:
+            x += gap * radius * np.sqrt(4 * np.pi / m) + radius
+        u = rng.normal(size=(m, 3))
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        parts.append(radius * u + [x, 0.0, 0.0])
+        normals.append(u)
+        mean.append(np.full(m, 1 / radius))
+        kmax.append(np.full(m, 1 / radius))
+        x += radius
+    p, u, h, k = ellipsoid(400, (1.0, 0.5, 0.2), seed=seed)
+    parts.append(p + [0.0, 3.0, 0.0])
+    normals.append(u)
+    mean.append(h)
+    kmax.append(k)
+    points, normals, mean, kmax = (np.concatenate(a) for a in (parts, normals, mean, kmax))
+    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+    points = points + rng.uniform(-1, 1, (points.shape[0], 1)) * 0.05 * spacing * normals
+    return points, normals, mean, kmax, spacing
+
+
+@pytest.mark.parametrize(
+    "seed",
+    [0, 2, 4, 5, 6, pytest.param(7, marks=pytest.mark.xfail(strict=True, reason="3 valid points off, 398 valid"))],
+)
+def test_a_plate_beside_spheres_leaves_no_valid_wrong_point(seed):
+    # fuzz seed 42 case 214 (measures): a ball counted as steady when no estimate on its own side was below half of
+    # the centre's |k|, and was not compared with jets; by the plate's rim the whole band is biased alike (k_max
+    # twice the exact one), so a neighbour at 0.5-0.7 of the centre's |k| is that band, not a flatter part. With
+    # UNIFORM_SHARE 0.5 these seeds kept 14, 23, 3, 9, 19 and 11 valid points off by more than half of |k|; at 0.7
+    # 0, 0, 0, 0, 0 and 3 (seed 7: the class is not closed)
+    points, normals, mean, kmax, spacing = plate_beside_spheres(seed)
+    r = quiet(points)
+    resolved = kmax * spacing <= 0.25  # as the fuzzer checks: radius of curvature of 4 spacings or more
+    side = np.sign(np.einsum("ij,ij->i", r.normals, normals))
+    wrong = r.valid & resolved & ~(np.abs(r.mean - side * mean) / kmax <= 0.5)
+    assert r.valid.sum() > 300  # (398-454 of 840 valid; the spheres and the plate's faces)
+    assert wrong.sum() == 0
