@@ -29,7 +29,8 @@ fits of ``multiscale_curvatures`` at ``h, 2 h, 4 h``)::
 
 ``--preparation`` prints instead what the ball sums do besides their kernel (the checks,
 the face centroids, the faces around each vertex, the scratch), each piece timed alone on
-the default call's radius, and the cost of one ``run_chunks`` call (CPU and wall s)::
+the default call's radius, the cost of one ``run_chunks`` call, and of one computation of the length scales
+and of the needle vertices (found once per call, :mod:`meshcurv._once`) (CPU and wall s)::
 
     .venv/bin/python benchmarks/profile_call.py --sizes 1M --preparation --repeats 7
 """
@@ -312,8 +313,13 @@ def preparation(label: str, repeats: int) -> list[tuple[str, float, float]]:
     from meshcurv._kernels import neighborhoods as compiled
     from meshcurv.measures import face_measures
 
+    from meshcurv import _geometry, defects
+    from meshcurv.topology import MeshTopology
+
     mesh = meshcurv.shapes.icosphere(SIZES[label])
     v = np.ascontiguousarray(mesh.vertices)
+    topology = MeshTopology.from_faces(mesh.faces, v.shape[0])
+    scales = _geometry._vertex_length_scales(v, topology)
     f = np.ascontiguousarray(mesh.faces, dtype=np.int64)
     n = v.shape[0]
     result = meshcurv.principal_curvatures(v, f)
@@ -336,6 +342,9 @@ def preparation(label: str, repeats: int) -> list[tuple[str, float, float]]:
         "(normal fits) `checked_adjacency` of the neighbour lists": lambda: neighborhoods.checked_adjacency(
             adjacency, n
         ),
+        # computed once per call since 3745c02 (meshcurv._once); 7 and 10 times per default call before
+        "(call) one `vertex_length_scales`": lambda: _geometry._vertex_length_scales(v, topology),
+        "(call) one `needle_vertices`": lambda: defects._needle_vertices(v, topology, scales),
     }
     rows = [(f"{name}, icosphere({SIZES[label]})", *_median_cpu_wall(call, repeats)) for name, call in pieces.items()]
 
