@@ -1,9 +1,9 @@
-"""The ladder of icc's default on voxel surfaces (issue 30, round 5): each vertex at ``r_v`` or ``sqrt(2) r_v``.
+"""The ladder of icc's default on voxel surfaces (issue 30, round 5): each vertex's H at ``r_v`` or ``sqrt(2) r_v``.
 
 Oracles: the closed form of the rungs (:func:`meshcurv.radius.voxel_ladder`); the
 exact curvature of a voxelised sphere (``1 / r`` at every vertex); and the
 default with its ladder cut to the first rung (``icc.VOXEL_LADDER_TOP = 0``, the
-rule before the ladder), which must give the same normals and radii ``r_v``.
+rule before the ladder), which must give the same normals, radii ``r_v`` and Gaussian curvature.
 """
 
 from __future__ import annotations
@@ -52,8 +52,14 @@ def test_each_vertex_takes_its_radius_or_the_next_rung(sphere, monkeypatch):
     upper = np.isclose(ratio, np.sqrt(2.0), rtol=1e-12)
     assert np.all(upper | (ratio == 1.0))
     assert 0.1 < upper.mean() < 0.9  # both rungs are taken on this sphere
-    # where a vertex keeps its first rung, its curvatures are those of the rule without the ladder
-    np.testing.assert_array_equal(ladder.mean[~upper], first.mean[~upper])
+    # where a vertex keeps its first rung, its curvatures are those of the rule without the ladder (to
+    # round-off: its mu_1 is rescaled by mu_0 / mu_0)
+    np.testing.assert_allclose(ladder.mean[~upper], first.mean[~upper], rtol=1e-12)
+    # the Gaussian curvature stays that of r_v wherever both mean curvatures leave real principal curvatures
+    # (H^2 > K; otherwise k_min = k_max = H, and the K reported is H^2)
+    real = (ladder.k_max > ladder.k_min) & (first.k_max > first.k_min)
+    assert real.mean() > 0.3
+    np.testing.assert_allclose(ladder.gaussian[real], first.gaussian[real], rtol=1e-9, atol=1e-15)
 
 
 def test_the_ladder_brings_a_voxel_sphere_closer_to_its_curvature(sphere, monkeypatch):

@@ -518,17 +518,18 @@ VOXEL_LADDER_TOP = 1
 def voxel_ladder(radii: np.ndarray, cap: float) -> np.ndarray:
     """(J, V) the rungs of icc's scale on a voxel surface: ``radii`` times :data:`VOXEL_LADDER`, at most ``cap``.
 
-    Each vertex takes rung 0 (``r_v``, :func:`voxel_vertex_radii`) or rung :data:`VOXEL_LADDER_TOP`
-    (``sqrt(2) r_v``): the upper one where its estimates change less between rungs 1 and 2 than between 0 and
-    1 (:func:`stable_scales` over the three rungs, the choice capped at rung 1). The noise of the lattice falls
-    and the ball's bias grows along the ladder; a vertex whose estimates settle from rung 1 on is still in the
-    noise at rung 0. Measured (``benchmarks/smoothed_isosurfaces.md``, round 5; normals as fitted for ``r_v``):
-    median H error, geometric mean over each family, 1.31 -> 1.01% on the binary marching cubes of
-    ``accuracy.py --voxel`` (tuning; no row worse by a tenth, 6 better), held out 2.02 -> 1.48% (elongated
-    shapes), 1.09 -> 0.98% (smoothed masks), 3.34 -> 2.50% (the failing rows of ``accuracy_voxel.md``), the K
-    error of every family no worse by a tenth. Without the cap (rung 2 taken) H falls further on the tuning
-    family (0.90%), but the Gaussian curvature of thin tori in elongated voxels doubles (a ball of two tube
-    radii averages ``k_min`` round the tube).
+    Each vertex's mean curvature is taken at rung 0 (``r_v``, :func:`voxel_vertex_radii`) or rung
+    :data:`VOXEL_LADDER_TOP` (``sqrt(2) r_v``): the upper one where its estimates change less between rungs 1
+    and 2 than between 0 and 1 (:func:`stable_scales` over the three rungs, the choice capped at rung 1); its
+    Gaussian curvature and directions stay at ``r_v``. The noise of the lattice falls and the ball's bias grows
+    along the ladder; a vertex whose estimates settle from rung 1 on is still in the noise at rung 0.
+    Measured (``benchmarks/smoothed_isosurfaces.md``, round 5; normals as fitted for ``r_v``): median H error,
+    geometric mean over each family, 1.31 -> 1.01% on the binary marching cubes of ``accuracy.py --voxel``
+    (tuning; no row worse by a tenth, 6 better), held out 2.02 -> 1.48% (elongated shapes), 1.09 -> 0.98%
+    (smoothed masks), 3.34 -> 2.50% (the failing rows of ``accuracy_voxel.md``); k_min, k_max and K of every
+    family no worse by a tenth. K at the rung taken as well lowered its error on spheres but took the
+    integral of K+ of a torus under 2 x 1 x 1 voxels 6% below 4 pi (``tests/test_statistics.py``); without the
+    cap (rung 2 taken) the Gaussian curvature of thin tori in elongated voxels doubled.
     """
     radii = np.asarray(radii, dtype=np.float64)
     return np.minimum(np.multiply.outer(np.asarray(VOXEL_LADDER), radii), cap)
@@ -569,8 +570,8 @@ VOXEL_SCALE_RULE = (
     "extent along the pilot's normal, R the surface's curvature radius (a region flatter than 2 R: its "
     "own), c_v and K_v the pilot's "
     "curvedness and Gaussian curvature over 2 rings; normals over min(3 r_v, max(1.5 / c_v, 4 h_max)); "
-    "each vertex at r_v or sqrt(2) r_v, the upper where its estimates change less from sqrt(2) r_v to 2 r_v "
-    "than from r_v to sqrt(2) r_v (the ladder's least change)"
+    "the mean curvature of each vertex at r_v or sqrt(2) r_v, the upper where its estimates change less from "
+    "sqrt(2) r_v to 2 r_v than from r_v to sqrt(2) r_v (the ladder's least change); K and directions at r_v"
 )
 
 
