@@ -1001,14 +1001,16 @@ def clustered_face_sums(
 @nb.njit(inline="always", **_JIT)
 def _cluster_share(centres, spans, c, cx, cy, cz, radius):
     """The share of cluster ``c`` in the ball ``B((cx, cy, cz), radius)`` by its sphere (``centres[c]``,
-    ``spans[c]``): 1 inside, 0 outside, linear in between by the distances of its nearest and farthest
-    points (as ``neighborhoods.face_in_ball_ratios`` for a face)."""
+    ``spans[c]``): 1 inside, 0 outside, linear in between by the distances of its nearest and farthest points
+    from the sphere of radius ``sqrt(radius^2 - span^2 / 3)`` (``neighborhoods.coarse_share``)."""
     d = math.sqrt((centres[c, 0] - cx) ** 2 + (centres[c, 1] - cy) ** 2 + (centres[c, 2] - cz) ** 2)
-    if d + spans[c] <= radius:
+    span = spans[c]
+    middle = math.sqrt(max(radius * radius - span * span / 3.0, 0.0))
+    if d + span <= middle:
         return 1.0
-    if not d - spans[c] < radius:
+    if not d - span < middle:
         return 0.0
-    return (radius - (d - spans[c])) / (2.0 * spans[c])
+    return (middle - (d - span)) / (2.0 * span)
 
 
 @nb.njit(parallel=True, **_JIT)
