@@ -398,6 +398,14 @@ def _git_head():
         return "unknown"
 
 
+def _notes(text: str) -> tuple[str, str]:
+    """``(before, after)``: the text before the speed section, and the sections after it (``## `` headings
+    written by hand: the fuzz rounds), which a new speed table leaves in place."""
+    before, _, rest = text.partition("\n## Speed")
+    following = rest.find("\n## ")
+    return before.rstrip("\n"), "" if following < 0 else rest[following:].lstrip("\n").join(["\n", ""])
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="ellipsoid and torus, no peer")
@@ -430,8 +438,8 @@ def main(argv=None):
         print("\n".join(text))
         output = Path(args.output)
         if output.exists():
-            kept = output.read_text().split("\n## Speed")[0].rstrip("\n")
-            output.write_text(kept + "\n" + "\n".join(text) + "\n")
+            before, after = _notes(output.read_text())
+            output.write_text(before + "\n" + "\n".join(text) + "\n" + after)
         return 0
     if args.held_out:
         rows = []
@@ -457,7 +465,10 @@ def main(argv=None):
     rows = run(surfaces, NOISE, args.n, peer=not (args.quick or args.no_peer))
     text = markdown(rows, args.n, command.strip())
     if not args.quick:
-        Path(args.output).write_text(text)
+        output = Path(args.output)
+        # the sections written by hand after the tables (the speed table and its notes, the fuzz rounds) stay
+        _, heading, kept = output.read_text().partition("\n## Speed") if output.exists() else ("", "", "")
+        output.write_text(text.rstrip("\n") + "\n" + heading + kept if heading else text)
     print(text)
     return 0
 
