@@ -108,8 +108,8 @@ TURN_AGREEMENT = 0.2
 REFERENCE_TURN = 0.8
 
 #: ... and are not needed where no estimate on the own side of the ball has a largest |k| below this share of the
-#: centre's (:func:`_uniform_balls`: a curvature steady over the ball; at 0.5 a plate of 300 points beside three
-#: spheres, seed 42 case 214, kept 21 points off by 50-90%, its whole band biased alike).
+#: centre's (:func:`_uniform_balls`: a curvature steady over the ball; by a thin plate's rim the whole band is
+#: biased alike, so a neighbour within this share is that band: ``benchmarks/pointcloud.md``, Reliability).
 UNIFORM_SHARE = 0.7
 
 #: A resolved estimate whose ball turns the normal by more than :data:`UNRESOLVED_TURN` radians and whose own side
