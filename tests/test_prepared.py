@@ -133,3 +133,22 @@ def test_a_derived_array_is_shared_only_for_the_adopted_vertices_topology_and_in
         moved = sphere.vertices.copy()
         assert not needle_vertices(moved, topology, vertex_length_scales(moved, topology)).any()
     assert needle_vertices(vertices, topology, shared) is not first  # the scope closed
+
+
+def test_a_call_inside_another_keeps_the_outer_calls_derived_arrays():
+    from meshcurv import _once
+    from meshcurv._geometry import vertex_length_scales
+
+    sphere = shapes.icosphere(4)
+    topology = MeshTopology.from_faces(sphere.faces, len(sphere.vertices))
+    outer = sphere.vertices.copy()
+    with _once.computed_once():
+        _once.adopt(outer)
+        shared = vertex_length_scales(outer, topology)
+        inner = 2.0 * sphere.vertices
+        with _once.computed_once():
+            _once.adopt(inner)
+            doubled = vertex_length_scales(inner, topology)
+            assert vertex_length_scales(inner, topology) is doubled
+            np.testing.assert_allclose(doubled, 2.0 * shared, rtol=1e-15)  # lengths scale with the vertices
+        assert vertex_length_scales(outer, topology) is shared

@@ -42,11 +42,8 @@ _MEMO: ContextVar[_Memo | None] = ContextVar("meshcurv_once", default=None)
 
 @contextmanager
 def computed_once() -> Iterator[None]:
-    """A scope in which :func:`once` remembers what it computes for the adopted vertices (nested: the
-    outer scope's memo serves)."""
-    if _MEMO.get() is not None:
-        yield
-        return
+    """A scope in which :func:`once` remembers what it computes for the adopted vertices (a call made inside
+    another, e.g. on a pilot mesh, has its own; the outer one's comes back after it)."""
     token = _MEMO.set(_Memo())
     try:
         yield
