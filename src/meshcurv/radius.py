@@ -17,8 +17,8 @@ the user:
   noisy meshes, growing with the noise measured on the mesh;
 - :func:`voxel_radius`, :func:`voxel_surface_radius`: on voxel surfaces
   (marching cubes), about ``sqrt(h R)`` for voxels of size ``h`` and curvature
-  radius ``R``; :func:`voxel_vertex_radii`, :func:`voxel_ladder`: ``icc``'s
-  default there, each vertex at its own (below);
+  radius ``R``; :func:`voxel_vertex_radii`: ``icc``'s default there, each
+  vertex at its own (below);
 - :func:`scale_ladder`, :func:`stable_scales`: ``radius="adaptive"``, each
   vertex at the rung of a ladder of radii where its estimate is stable;
 - :func:`cloud_noise_level`, :func:`cloud_radius`: point clouds, growing with
@@ -52,8 +52,7 @@ whose lengths change with the orientation of the surface in anisotropic
 voxels (a factor 2 at 2:1) without any change of the noise: ``icc``'s default
 there gives each vertex ``2 sqrt(h_v R)`` with ``h_v`` the voxel's extent
 along its normal, capped where the pilot pass sees the surface bend fast
-(:func:`voxel_vertex_radii`; ``parameters["scale"] == "voxel"``), or ``sqrt(2)`` times that where
-its estimates settle along a short ladder of radii (:func:`voxel_ladder`); one radius
+(:func:`voxel_vertex_radii`; ``parameters["scale"] == "voxel"``); one radius
 per surface made a torus of tube radius 4 under 2 x 0.5 x 0.5 voxels 25% off
 (median H), now 14%, and halved the errors of thin tori in elongated voxels
 (``benchmarks/scale_default.md``). The other ball methods keep the one
@@ -93,7 +92,6 @@ __all__ = [
     "voxel_radius",
     "voxel_surface_radius",
     "voxel_vertex_radii",
-    "voxel_ladder",
     "check_radius",
     "resolve_radius",
     "small_radius_note",
@@ -505,34 +503,8 @@ def voxel_surface_radius(
             area=area,
             rings=rings,
         )
-        found["vertex_scale"] = (voxel_ladder(radii, extent), normal_radii)
+        found["vertex_scale"] = (np.minimum(radii, extent), normal_radii)
     return radius, found
-
-
-#: The rungs of each vertex of a voxel surface (:func:`voxel_ladder`): its radius ``r_v`` times these factors ...
-VOXEL_LADDER = (1.0, float(np.sqrt(2.0)), 2.0)
-#: ... of which a vertex takes at most this one (the last rung only tells whether the second is stable).
-VOXEL_LADDER_TOP = 1
-
-
-def voxel_ladder(radii: np.ndarray, cap: float) -> np.ndarray:
-    """(J, V) the rungs of icc's scale on a voxel surface: ``radii`` times :data:`VOXEL_LADDER`, at most ``cap``.
-
-    Each vertex's mean curvature is taken at rung 0 (``r_v``, :func:`voxel_vertex_radii`) or rung
-    :data:`VOXEL_LADDER_TOP` (``sqrt(2) r_v``): the upper one where its estimates change less between rungs 1
-    and 2 than between 0 and 1 (:func:`stable_scales` over the three rungs, the choice capped at rung 1); its
-    Gaussian curvature and directions stay at ``r_v``. The noise of the lattice falls and the ball's bias grows
-    along the ladder; a vertex whose estimates settle from rung 1 on is still in the noise at rung 0.
-    Measured (``benchmarks/smoothed_isosurfaces.md``, round 5; normals as fitted for ``r_v``): median H error,
-    geometric mean over each family, 1.31 -> 1.01% on the binary marching cubes of ``accuracy.py --voxel``
-    (tuning; no row worse by a tenth, 6 better), held out 2.02 -> 1.48% (elongated shapes), 1.09 -> 0.98%
-    (smoothed masks), 3.34 -> 2.50% (the failing rows of ``accuracy_voxel.md``); k_min, k_max and K of every
-    family no worse by a tenth. K at the rung taken as well lowered its error on spheres but took the
-    integral of K+ of a torus under 2 x 1 x 1 voxels 6% below 4 pi (``tests/test_statistics.py``); without the
-    cap (rung 2 taken) the Gaussian curvature of thin tori in elongated voxels doubled.
-    """
-    radii = np.asarray(radii, dtype=np.float64)
-    return np.minimum(np.multiply.outer(np.asarray(VOXEL_LADDER), radii), cap)
 
 
 #: The scale of each vertex of a voxel surface (:func:`voxel_vertex_radii`, ``icc``'s default):
@@ -569,9 +541,7 @@ VOXEL_SCALE_RULE = (
     "R / 2 + t_v (1 / c_v - R / 2)+)), t_v = clip(1 - 2 sqrt|K_v| / c_v, 0, 1), h_v the voxel "
     "extent along the pilot's normal, R the surface's curvature radius (a region flatter than 2 R: its "
     "own), c_v and K_v the pilot's "
-    "curvedness and Gaussian curvature over 2 rings; normals over min(3 r_v, max(1.5 / c_v, 4 h_max)); "
-    "the mean curvature of each vertex at r_v or sqrt(2) r_v, the upper where its estimates change less from "
-    "sqrt(2) r_v to 2 r_v than from r_v to sqrt(2) r_v (the ladder's least change); K and directions at r_v"
+    "curvedness and Gaussian curvature over 2 rings; normals over min(3 r_v, max(1.5 / c_v, 4 h_max))"
 )
 
 

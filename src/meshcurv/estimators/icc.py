@@ -29,12 +29,7 @@ marching cubes of fine voxels) the normals are fitted on clusters of vertices
 (:func:`fitted_normals`). On voxel surfaces each vertex takes the radius its
 pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
 ``2 sqrt(h_v R)`` for the voxel extent ``h_v`` along its normal, capped where
-the surface bends fast; ``parameters["scale"] == "voxel"``), or ``sqrt(2)`` times
-that where the estimates change less from ``sqrt(2) r_v`` to ``2 r_v`` than from
-``r_v`` to ``sqrt(2) r_v`` (:func:`meshcurv.radius.voxel_ladder`: the measures
-summed at the three radii with the same normals; the mean curvature is that
-of the radius taken, ``result.radius``, the Gaussian curvature and the
-directions those of ``r_v``); the pilot runs at
+the surface bends fast; ``parameters["scale"] == "voxel"``); the pilot runs at
 about half of the vertices (:func:`voxel_pilot`), and where the balls of such a
 surface hold 800 faces or more (fine voxels), each ball is summed on clusters
 of about 16 faces, the clusters on its rim by their share of the ball
@@ -93,7 +88,6 @@ from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, 
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import _squared, ball_face_sums, ball_face_sums_nested, coarse_face_sums
 from ..radius import (
-    VOXEL_LADDER_TOP,
     VOXEL_SCALE_RULE,
     check_radius,
     local_scale_ratios,
@@ -469,16 +463,11 @@ def _curvatures(
     weighted: bool = False,
     normal_radius=None,
     coarse: bool = False,
-    ladder: np.ndarray | None = None,
-    chosen: np.ndarray | None = None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid`` of the measures over balls of ``radius``.
 
     The normals are fitted over ``normal_radius`` (default: :data:`NORMAL_RADIUS_RATIO` times ``radius``).
     ``coarse``: dense balls summed on clusters of faces (:func:`meshcurv.neighborhoods.coarse_face_sums`).
-    ``ladder``: (J, V) radii (:func:`meshcurv.radius.voxel_ladder`, the first rung ``radius``): the measures
-    are summed at every rung and each vertex takes the mean curvature of the rung :func:`_ladder_rungs` picks
-    (its radius written into ``chosen`` (V,) in place), the Gaussian curvature and directions of the first.
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -513,23 +502,7 @@ def _curvatures(
 
     start("sum over balls")
     usable = _usable_faces(faces, degenerate, normals)
-    if ladder is not None:
-        summed = np.stack([coarse_face_sums(vertices, faces, rung, measures, usable=usable) for rung in ladder])
-        lists = (
-            adjacency if adjacency is not None else MeshTopology.from_faces(faces, vertices.shape[0]).neighbour_lists
-        )
-        rung = _ladder_rungs(summed, lists)
-        every = np.arange(vertices.shape[0])
-        upper, radius = summed[rung, every], ladder[rung, every]
-        # the mean curvature mu_1 / (2 mu_0) of the rung taken; the Gaussian curvature and the directions stay
-        # those of r_v (a ball of sqrt(2) r_v averages K across the lines where it changes sign: on a torus of
-        # tube radius 10 under 2 x 1 x 1 voxels the integral of K+ fell 6% below 4 pi)
-        summed = np.array(summed[0], copy=True)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            summed[:, 1] = np.where(upper[:, 0] > 0, upper[:, 1] * summed[:, 0] / upper[:, 0], np.nan)
-        if chosen is not None:
-            chosen[:] = radius
-    elif coarse:
+    if coarse:
         summed = coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
         summed = ball_face_sums(vertices, faces, radius, measures, usable=usable, connected=True)
@@ -538,12 +511,6 @@ def _curvatures(
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
     valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, failed)
     return k_min, k_max, dir_min, dir_max, normals, valid
-
-
-def _ladder_rungs(summed: np.ndarray, lists: tuple) -> np.ndarray:
-    """(V,) the rung of each vertex from the sums (J, V, k) over :func:`meshcurv.radius.voxel_ladder`'s rungs:
-    :func:`meshcurv.radius.stable_scales` over all of them, at most :data:`meshcurv.radius.VOXEL_LADDER_TOP`."""
-    return np.minimum(stable_scales(*principal_from_measures(summed), lists), VOXEL_LADDER_TOP)
 
 
 def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = False, vertex_scale=None):
@@ -578,8 +545,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
     if adaptive and len(groups) == 1:
         return _adaptive(mesh, groups[0][0], parameters, defects, valid, stages)
     if vertex_scale is not None:  # a voxel surface: each vertex at the scale its pilot calls for
-        ladder, normal_radii = vertex_scale
-        radii_v = np.array(ladder[0], dtype=np.float64, copy=True)  # the rung each vertex takes
+        radii_v, normal_radii = vertex_scale
         k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
             vertices,
             topology.faces,
@@ -593,8 +559,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             areas=_vertex_areas(mesh),
             normal_radius=normal_radii,
             coarse=True,
-            ladder=ladder,
-            chosen=radii_v,
         )
         parameters = {
             **parameters,
