@@ -3,6 +3,12 @@
     python benchmarks/scale_oracle.py                              # smoothed spheres and tori, R >= 10 voxels
     python benchmarks/scale_oracle.py --families smoothed failing  # every smoothed row, the failing voxel rows
     python benchmarks/scale_oracle.py --measure 1,1.41,2 --normal 0.71,1,1.41 --output /tmp/grid.json
+    python benchmarks/scale_oracle.py --lattice                    # the blurred masks' own level sets
+    python benchmarks/scale_oracle.py --dump /tmp/voxel.npz --families voxel --measure 0.71,1,1.41,2
+    python benchmarks/scale_oracle.py --rules /tmp/voxel.npz       # per-vertex rules along those factors
+
+``--families`` of the dumps: those of ``scale_families.py`` (``voxel``, ``elongated``, ``smoothed``,
+``failing``, ...). Tables and their reading: ``smoothed_isosurfaces.md``, round 5.
 
 Runs icc's default call with each vertex's measure radius and normal-fit radius
 (:func:`meshcurv.radius.voxel_vertex_radii`) multiplied by the factors ``f`` (``--measure``) and ``q``
