@@ -84,7 +84,15 @@ from __future__ import annotations
 import numpy as np
 
 from .._geometry import median_edge_length
-from ..jets import NORMAL_MIN_SPREAD, SETTLED_SLOPE, fit_jet_normals, fit_jets, jet_normals, nested_jet_normals
+from ..jets import (
+    NORMAL_MIN_SPREAD,
+    SETTLED_SLOPE,
+    fit_jet_normals,
+    fit_jets,
+    jet_normals,
+    nested_jet_normals,
+    sampled_jet_normals,
+)
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import _squared, ball_face_sums, ball_face_sums_nested, coarse_face_sums
 from ..radius import (
@@ -193,7 +201,7 @@ def fitted_normals(
         coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency)
     if coarse is not None:
         points, point_normals, allowed, lists, point_areas = coarse
-        coefficients, frame, _ = fit_jets(
+        fitted = sampled_jet_normals(
             points,
             point_normals,
             radius,
@@ -204,10 +212,8 @@ def fitted_normals(
             adjacency=lists,
             settled=NORMAL_SETTLED,
             areas=point_areas,
-            compact=True,
             min_spread=NORMAL_MIN_SPREAD,
         )
-        fitted = jet_normals(coefficients, frame)
     elif fits is not None:
         fitted = fits
     else:
