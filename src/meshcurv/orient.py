@@ -24,6 +24,8 @@ import numpy as np
 from ._backend import twin
 from ._validation import as_vertices
 from .errors import InvalidOptionError
+from .defects import needle_vertices
+from ._geometry import vertex_length_scales
 from .topology import MeshTopology, as_topology
 
 __all__ = ["orient_faces", "ORIENT_CHOICES"]
@@ -165,8 +167,6 @@ def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
         open_patch = np.bincount(patch, weights=on_boundary.any(axis=1), minlength=n_labels) > 0
     else:
         open_patch = np.zeros(n_labels, dtype=bool)
-    from ._geometry import vertex_length_scales
-    from .defects import needle_vertices
 
     # a needle's slivers bound no solid (issue 29: a uv sphere's vertex flung 30 sizes inward turned it inside out)
     needles = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))

@@ -70,6 +70,7 @@ import numpy as np
 
 from ._validation import check_positive_float, checked_points
 from .errors import InvalidOptionError
+from .defects import needle_corners, needle_vertices, scale_edges, scale_vertices
 from ._geometry import (
     COMPONENT_SCALE_SPREAD,
     median_edge_length,
@@ -116,7 +117,6 @@ def edge_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
     ordinary mesh; one spike vertex at 1e10 does not multiply it).
     """
     vertices = checked_points(vertices)
-    from .defects import scale_edges
 
     edges = scale_edges(vertices, topology, vertex_length_scales(vertices, topology))  # no needle's edge
     return DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, edges)
@@ -135,7 +135,6 @@ def component_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[
     fitted at their own scale.
     """
     vertices = checked_points(vertices)
-    from .defects import scale_edges, scale_vertices
 
     scales = vertex_length_scales(vertices, topology)
     all_edges = scale_edges(vertices, topology, scales)  # no spike's edges (issue 29: a spike raised it 2.6x)
@@ -176,8 +175,6 @@ def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
     radius = check_positive_float(radius, "radius")
     vertices = checked_points(vertices)
     if topology.n_faces:
-        from .defects import scale_vertices
-
         used = vertices[scale_vertices(vertices, topology, vertex_length_scales(vertices, topology))]
     else:
         used = vertices
@@ -340,7 +337,6 @@ def scale_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarra
     ndarray of shape (V,) of bool
         ``valid`` itself when the mesh has no needle vertex.
     """
-    from .defects import needle_corners, needle_vertices
 
     needles = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
     if not needles.any():
@@ -378,7 +374,6 @@ def noise_radii(
     levels : list of float
         The noise level of each group.
     """
-    from .defects import scale_edges, scale_vertices
 
     scales = vertex_length_scales(vertices, topology)
     usable = scale_vertices(vertices, topology, scales)
@@ -460,7 +455,6 @@ def voxel_surface_radius(
     that takes a radius, so that ``quadric`` and ``normal_cycle_ball`` average the staircase out as
     ``icc`` does.
     """
-    from .defects import needle_vertices
 
     # a spike is on no grid (issue 29: one flung to 1e22 made a voxel sphere an ordinary mesh, radius 1.4x), and
     # is in no extent, area or percentile below: the needles' vertices and faces are left out everywhere
@@ -713,7 +707,6 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarr
     Only the edges between two :func:`meshcurv.defects.scale_vertices` count (a needle's edges, 1e3 long
     beside edges of 0.1, would make its neighbours' radii 9 times larger).
     """
-    from .defects import scale_edges
 
     n = topology.n_vertices
     scales = vertex_length_scales(vertices, topology)
