@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import importlib.util
+
 import numpy as np
 import pytest
 
@@ -40,7 +42,16 @@ def _angles(normals, exact):
     return np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", normals, exact)), -1.0, 1.0))
 
 
-@pytest.mark.parametrize("backend", ["numba", "numpy"])
+@pytest.mark.parametrize(
+    "backend",
+    [
+        pytest.param(
+            "numba",
+            marks=pytest.mark.skipif(importlib.util.find_spec("numba") is None, reason="numba is not installed"),
+        ),
+        "numpy",
+    ],
+)
 def test_sampled_normals_of_a_sphere_are_radial(backend):
     vertices, _, topology, exact = _sphere()
     # cubes of 0.15 (2.5 edges): about one vertex in six is fitted
@@ -65,6 +76,7 @@ def test_samples_keep_their_own_fits():
 
 
 def test_dense_voxel_sphere_keeps_the_accuracy_of_fits_everywhere():
+    pytest.importorskip("skimage")  # the voxel sphere is marching cubes
     mesh = shapes.voxel_sphere(2.0, (0.2, 0.1, 0.1), seed=0)
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     topology = MeshTopology.from_faces(mesh.faces)
