@@ -264,9 +264,7 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
     cube = np.minimum(np.floor((vertices[members] - corner) / cell), 2.0**52).astype(np.int64)
     axis = np.argmax(np.abs(normals[members]), axis=1)
     side = 2 * axis + (normals[members, axis] < 0)
-    keys = np.column_stack([cube, side])
-    _, group = np.unique(keys, axis=0, return_inverse=True)
-    group = group.ravel()
+    group = _row_groups(np.column_stack([cube, side]), (20, 20, 20, 3))
     c = int(group.max()) + 1
     weight = areas[members]
     total = np.bincount(group, weights=weight, minlength=c)
@@ -281,7 +279,7 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
     of[members] = n + group
     a, b = of[tails], of[indices]
     joined = (a >= 0) & (b >= 0) & (a != b)
-    links = np.unique(np.column_stack([a[joined], b[joined]]), axis=0)
+    links = _unique_pairs(a[joined], b[joined], n + c)
     own = np.flatnonzero(of >= 0)
     heads = np.concatenate([own, links[:, 0]])
     ends = np.concatenate([of[own], links[:, 1]])
@@ -291,6 +289,26 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
     allowed = np.concatenate([np.zeros(n, dtype=bool), np.ones(c, dtype=bool)])
     point_areas = np.concatenate([np.zeros(n), total])
     return (np.concatenate([vertices, centroid]), np.concatenate([normals, group_normals]), allowed, lists, point_areas)
+
+
+def _row_groups(rows: np.ndarray, bits: tuple) -> np.ndarray:
+    """(N,) the index of each row of ``rows`` (N, k) of int >= 0 among the distinct rows in lexicographic order
+    (``np.unique(rows, axis=0, return_inverse=True)``), on one int64 key where column ``j`` fits ``bits[j]`` bits
+    (a sort of numbers instead of rows: several times faster)."""
+    if rows.shape[0] == 0 or sum(bits) > 63 or np.any(rows.max(axis=0) >= 2 ** np.array(bits)):
+        return np.unique(rows, axis=0, return_inverse=True)[1].ravel()
+    key = np.zeros(rows.shape[0], dtype=np.int64)
+    for j, width in enumerate(bits):
+        key = key << width | rows[:, j]
+    return np.unique(key, return_inverse=True)[1].ravel()
+
+
+def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
+    """(P, 2) the distinct pairs ``(a, b)`` of int in [0, n), sorted (``np.unique`` of the rows), on one int64 key."""
+    if n >= 2**31:
+        return np.unique(np.column_stack([a, b]), axis=0)
+    key = np.unique(a * np.int64(n) + b)
+    return np.column_stack([key // n, key % n])
 
 
 def _dense(vertices: np.ndarray, radius: float, adjacency: tuple) -> bool:

@@ -1,0 +1,60 @@
+"""The coarse level of icc's normal fits on dense surfaces (:func:`meshcurv.estimators.icc._coarse_level`).
+
+Oracles: NumPy's own ``unique`` over rows, which the packed keys of the coarse level replace (the same groups in
+the same order, so the fits are those of the rows' ``unique`` to the bit), and the definition of the coarse level
+(each group one point at the area-weighted centroid of its vertices, linked to the groups a mesh edge joins it to).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from meshcurv import shapes
+from meshcurv.estimators import icc
+from meshcurv.topology import MeshTopology
+
+
+@pytest.mark.parametrize("top", [5, 2**19, 2**21])
+def test_packed_row_groups_are_those_of_unique_over_rows(top):
+    # 2**21 exceeds the 20 bits of a column: the rows' own unique is taken, with the same answer
+    rng = np.random.default_rng(7)
+    rows = np.column_stack([rng.integers(0, top, 5000) for _ in range(3)] + [rng.integers(0, 6, 5000)])
+    rows[2500:] = rows[:2500]  # repeated rows: groups of several
+    expected = np.unique(rows, axis=0, return_inverse=True)[1].ravel()
+    np.testing.assert_array_equal(icc._row_groups(rows, (20, 20, 20, 3)), expected)
+
+
+def test_packed_pairs_are_those_of_unique_over_rows():
+    rng = np.random.default_rng(8)
+    a, b = rng.integers(0, 300, 4000), rng.integers(0, 300, 4000)
+    np.testing.assert_array_equal(icc._unique_pairs(a, b, 300), np.unique(np.column_stack([a, b]), axis=0))
+    assert icc._unique_pairs(a[:0], b[:0], 300).shape == (0, 2)
+
+
+def test_each_group_is_the_area_weighted_centroid_of_its_vertices_linked_along_the_edges():
+    pytest.importorskip("skimage")
+    mesh = shapes.voxel_sphere(4.0, (0.2, 0.2, 0.2), seed=1)
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    topology = MeshTopology.from_faces(mesh.faces, vertices.shape[0])
+    n = vertices.shape[0]
+    normals = np.asarray(mesh.normals, dtype=np.float64)
+    areas = np.ones(n)
+    radius = 2.0 * icc.COARSE_EDGES * icc._sampled_edge(vertices, topology.neighbour_lists)
+    points, _, allowed, (indptr, indices), weights = icc._coarse_level(
+        vertices, normals, radius, areas, None, topology.neighbour_lists
+    )
+    np.testing.assert_array_equal(points[:n], vertices)
+    assert not allowed[:n].any() and allowed[n:].all()
+    # each vertex links to its own group only; the groups' weights count their vertices (areas of 1)
+    own = indices[indptr[:n]]
+    np.testing.assert_array_equal(np.diff(indptr)[:n], 1)
+    np.testing.assert_array_equal(np.bincount(own - n, minlength=points.shape[0] - n), weights[n:])
+    centroid = np.stack([np.bincount(own - n, weights=vertices[:, k]) for k in range(3)], axis=1) / weights[n:, None]
+    np.testing.assert_allclose(points[n:], centroid, rtol=0, atol=1e-12 * np.abs(vertices).max())
+    # two groups are linked exactly when a mesh edge joins a vertex of one to a vertex of the other
+    edges = topology.edges
+    joined = {(int(x), int(y)) for x, y in zip(own[edges[:, 0]], own[edges[:, 1]]) if x != y}
+    joined |= {(y, x) for x, y in joined}
+    heads = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))[indptr[n] :]
+    assert {(int(x), int(y)) for x, y in zip(heads, indices[indptr[n] :])} == joined
