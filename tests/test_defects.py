@@ -73,7 +73,7 @@ def test_defect_codes_of_the_connectivity_alone_count_no_needle():
     degenerate = degenerate_faces(vertices, topology)
     codes, counts = defect_codes(topology, degenerate)
     assert counts["needle_vertices"] == 0 and not codes.any()
-    codes, counts = defect_codes(topology, degenerate, vertices, vertex_length_scales(vertices, topology))
+    codes, counts = defect_codes(topology, degenerate, _needles(vertices, faces))
     assert counts["needle_vertices"] == 1 and codes[12] == NEEDLE
 
 

@@ -31,7 +31,7 @@ import pytest
 import meshcurv
 from meshcurv import shapes
 from meshcurv._backend import use_backend
-from meshcurv.defects import INVALID_REASONS, NEEDLE, scale_vertices
+from meshcurv.defects import INVALID_REASONS, NEEDLE, needle_vertices, scale_vertices
 from meshcurv.errors import MeshQualityWarning
 from meshcurv.geometry import vertex_length_scales
 from meshcurv.orient import orient_faces
@@ -125,7 +125,7 @@ def test_the_scale_vertices_are_the_referenced_ones_but_the_needles():
     spiked = _flung(vertices, rows, distance)
     lonely = np.vstack([spiked, [[0.0, 0.0, 5.0]]])  # an unreferenced vertex
     topology = MeshTopology.from_faces(faces, n_vertices=lonely.shape[0])
-    used = scale_vertices(lonely, topology, vertex_length_scales(lonely, topology))
+    used = scale_vertices(topology, needle_vertices(lonely, topology, vertex_length_scales(lonely, topology)))
     expected = np.ones(lonely.shape[0], dtype=bool)
     expected[rows] = False
     expected[-1] = False

@@ -1,6 +1,7 @@
 """The prepared mesh: the caller's arrays checked once, then trusted (issue 33)."""
 
 import importlib.util
+import sys
 
 import numpy as np
 import pytest
@@ -92,66 +93,63 @@ def test_the_vertex_areas_share_out_the_area_of_the_faces_that_weigh():
             np.testing.assert_allclose(again.vertex_normals, mesh.vertex_normals, rtol=1e-14, equal_nan=True)
 
 
-@pytest.mark.parametrize("method", ["icc", "normal_cycle", "matgeom"])
-def test_the_length_scales_and_needle_vertices_are_found_once_per_call(method, monkeypatch):
+def _entered(code, call) -> int:
+    """How many times the function of ``code`` is entered during ``call()``, whoever holds it under which name."""
+    entries = []
+
+    def profile(frame, event, arg):
+        if event == "call" and frame.f_code is code:
+            entries.append(1)
+
+    sys.setprofile(profile)
+    try:
+        call()
+    finally:
+        sys.setprofile(None)
+    return len(entries)
+
+
+ICC_PENDING = pytest.mark.xfail(
+    strict=True, reason="until estimators/icc.py calls the radius cores with the prepared mesh (issue 33)"
+)
+
+
+@pytest.mark.parametrize("method", [pytest.param("icc", marks=ICC_PENDING), "normal_cycle", "matgeom", "quadric"])
+def test_the_length_scales_and_needle_vertices_are_found_once_per_call(method):
     # the orientation, the defects, the radius rules and the diagnosis all read them (10 and 7 passes before)
     sphere = shapes.icosphere(6)
     vertices = sphere.vertices.copy()
     vertices[5] *= 10.0  # a needle: the scale rules leave it out, the defects mark it
+    faces = np.asarray(sphere.faces)[:, ::-1]  # wound inward: the orientation reads the needles too
     from meshcurv import _geometry, defects
 
-    needles = _counted(monkeypatch, defects, "_needle_vertices")
-    scales = _counted(monkeypatch, _geometry, "_vertex_length_scales")
-    with pytest.warns(meshcurv.MeshQualityWarning, match="1 needle vertices"):
-        result = meshcurv.principal_curvatures(vertices, sphere.faces, method=method)
-    assert (len(needles), len(scales)) == (1, 1)
-    assert result.invalid_reason[5] == defects.NEEDLE
+    found = []
+
+    def call():
+        with pytest.warns(meshcurv.MeshQualityWarning, match="1 needle vertices"):
+            found.append(meshcurv.principal_curvatures(vertices, faces, method=method))
+
+    n_needles = _entered(defects.needle_vertices.__code__, call)
+    n_scales = _entered(_geometry.vertex_length_scales.__code__, call)
+    assert (n_needles, n_scales) == (1, 1)
+    assert found[0].invalid_reason[5] == defects.NEEDLE and found[0].diagnosis.n_needle_vertices == 1
 
 
-def test_a_derived_array_is_shared_only_for_the_adopted_vertices_topology_and_inputs():
-    from meshcurv import _once
-    from meshcurv._geometry import vertex_length_scales
+@pytest.mark.parametrize("orient", ["outward", "keep"])
+def test_the_prepared_length_scales_and_needles_are_those_of_the_mesh_computed_on(orient):
+    # found before the orientation, they are those of the oriented mesh too: reversing faces keeps the edges
     from meshcurv.defects import needle_vertices
+    from meshcurv.geometry import vertex_length_scales
 
     sphere = shapes.icosphere(4)
     vertices = sphere.vertices.copy()
     vertices[3] *= 10.0
-    topology = MeshTopology.from_faces(sphere.faces, len(vertices))
-    scales = vertex_length_scales(vertices, topology)
-    alone = needle_vertices(vertices, topology, scales)
-    assert np.flatnonzero(alone).tolist() == [3]
-    assert needle_vertices(vertices, topology, scales) is not alone  # no scope: computed each time
-    with _once.computed_once():
-        _once.adopt(vertices)
-        shared = vertex_length_scales(vertices, topology)
-        assert vertex_length_scales(vertices, topology) is shared and shared.flags.writeable  # kernels take it
-        first = needle_vertices(vertices, topology, shared)
-        assert needle_vertices(vertices, topology, shared) is first and not first.flags.writeable
-        np.testing.assert_array_equal(first, alone)
-        # other scales, another topology of the same faces, other vertices: not the remembered array
-        assert needle_vertices(vertices, topology, 1e3 * shared) is not first
-        assert not needle_vertices(vertices, topology, 1e3 * shared).any()  # every edge within reach
-        other = MeshTopology.from_faces(sphere.faces, len(vertices))
-        assert needle_vertices(vertices, other, vertex_length_scales(vertices, other)) is not first
-        moved = sphere.vertices.copy()
-        assert not needle_vertices(moved, topology, vertex_length_scales(moved, topology)).any()
-    assert needle_vertices(vertices, topology, shared) is not first  # the scope closed
-
-
-def test_a_call_inside_another_keeps_the_outer_calls_derived_arrays():
-    from meshcurv import _once
-    from meshcurv._geometry import vertex_length_scales
-
-    sphere = shapes.icosphere(4)
-    topology = MeshTopology.from_faces(sphere.faces, len(sphere.vertices))
-    outer = sphere.vertices.copy()
-    with _once.computed_once():
-        _once.adopt(outer)
-        shared = vertex_length_scales(outer, topology)
-        inner = 2.0 * sphere.vertices
-        with _once.computed_once():
-            _once.adopt(inner)
-            doubled = vertex_length_scales(inner, topology)
-            assert vertex_length_scales(inner, topology) is doubled
-            np.testing.assert_allclose(doubled, 2.0 * shared, rtol=1e-15)  # lengths scale with the vertices
-        assert vertex_length_scales(outer, topology) is shared
+    faces = np.asarray(sphere.faces).copy()
+    faces[::3] = faces[::3, ::-1]  # a third of the faces reversed
+    mesh = _prepared.prepare_mesh(vertices, faces, orient=orient, weld=False)
+    assert mesh.n_flipped == (len(faces[::3]) if orient == "outward" else 0)
+    scales = vertex_length_scales(mesh.vertices, mesh.topology)
+    np.testing.assert_array_equal(mesh.length_scales, scales)
+    np.testing.assert_array_equal(mesh.needles, needle_vertices(mesh.vertices, mesh.topology, scales))
+    assert np.flatnonzero(mesh.needles).tolist() == [3] and not mesh.needles.flags.writeable
+    assert mesh.length_scales.flags.writeable  # the compiled kernels are compiled for writable arrays

@@ -139,28 +139,18 @@ def test_every_entry_point_checks_its_input():
         orient_faces(QUAD_VERTICES, -TRI)
 
 
-def test_trusted_arrays_skip_the_helpers_checks_only_as_themselves_and_only_inside_the_block():
-    from meshcurv._validation import checked_indices, checked_points, trusting
-    from meshcurv.geometry import edge_lengths
+@pytest.mark.parametrize("rule", ["edge_radius", "component_radii", "local_scale_ratios", "scale_centres"])
+def test_the_public_radius_rules_check_their_vertices(rule):
+    # their cores trust a prepared mesh (principal_curvatures checks once); the public rules check what they get
+    from meshcurv import radius
 
-    vertices = QUAD_VERTICES.copy()
-    faces = TRI.astype(np.int64)
-    with trusting(vertices, faces):
-        assert checked_points(vertices) is vertices
-        assert checked_indices(faces, 4) is faces
-        vertices[1, 0] = np.nan  # not seen: the trusted array is not checked again (the point of the block)
-        assert checked_points(vertices) is vertices
-        vertices[1, 0] = 1.0
-        with pytest.raises(InvalidMeshError, match="NaN or infinite"):  # an equal array is not the trusted one
-            checked_points(np.where(np.arange(12).reshape(4, 3) == 4, np.nan, vertices))
-        with pytest.raises(InvalidMeshError, match="out of range"):  # checked for 4 vertices, not for 3
-            checked_indices(faces, 3)
-        with pytest.raises(InvalidMeshError, match=r"must have shape \(N, 2\)"):  # the shape is still checked
-            checked_indices(faces, 4, columns=2)
-        np.testing.assert_allclose(edge_lengths(vertices, np.array([[0, 1], [0, 2]])), [1.0, np.sqrt(2)])
-    vertices[1, 0] = np.nan  # after the block the same array is checked again
+    sphere = shapes.icosphere(2)
+    topology = meshcurv.MeshTopology.from_faces(sphere.faces)
+    vertices = sphere.vertices.copy()
+    vertices[3, 1] = np.nan
+    extra = (np.ones(len(vertices), dtype=bool), sphere.vertices) if rule == "scale_centres" else ()
     with pytest.raises(InvalidMeshError, match="NaN or infinite"):
-        checked_points(vertices)
+        getattr(radius, rule)(vertices, topology, *extra)
 
 
 # ------------------------------------------------------------- hints for faces given the wrong way (issue 29)

@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 
 from ._backend import twin
-from ._once import once
 
 #: Faces with area below this fraction of the squared length scale of their component
 #: (:func:`vertex_length_scales`, the median edge length) count as degenerate.
@@ -148,13 +147,7 @@ def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
 
 def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
     """(V,) the median edge length of each vertex's component (:func:`meshcurv.geometry.vertex_length_scales`);
-    found once per call for the prepared mesh (:func:`meshcurv._once.once`; writable: compiled kernels take it)."""
-    scales: np.ndarray = once("length_scales!", vertices, topology, lambda: _vertex_length_scales(vertices, topology))
-    return scales
-
-
-def _vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
-    """:func:`vertex_length_scales`, computed."""
+    a prepared mesh holds them (:attr:`meshcurv._prepared.PreparedMesh.length_scales`)."""
     edges = topology.edges
     n = topology.n_vertices
     if edges.shape[0] == 0:

@@ -4,9 +4,10 @@
 it checks and coerces the caller's arrays (or mesh object), puts a scattered
 vertex order into a local one, welds coincident vertices, keeps one side of a
 double-sided mesh and orients the faces. The estimators receive the
-:class:`PreparedMesh` and trust it; what they share (face cross products,
-zero-area faces, vertex normals, the defect codes) is computed once, on first
-use. :meth:`PreparedMesh.expand` puts a result back on the caller's vertices:
+:class:`PreparedMesh` and trust it; what they share is computed once: the
+length scales and needle vertices when the mesh is prepared (the orientation
+reads them too), the face cross products, zero-area faces, vertex normals and
+the defect codes on first use. :meth:`PreparedMesh.expand` puts a result back on the caller's vertices:
 one row per vertex given, copies of a welded vertex sharing its values.
 """
 
@@ -20,9 +21,8 @@ import numpy as np
 
 from ._adapters import mesh_arrays
 from ._locality import local_topology
-from ._once import adopt
 from ._validation import as_faces, as_vertices, check_choice
-from .defects import BOUNDARY, VertexDefects, defect_codes
+from .defects import BOUNDARY, VertexDefects, defect_codes, needle_vertices
 from .errors import InvalidOptionError
 from ._geometry import (
     DEGENERATE_AREA_RATIO,
@@ -57,6 +57,14 @@ class PreparedMesh:
         The mesh a result keeps for its integrals.
     orient : str
         The orientation applied (``'auto'`` resolved).
+    length_scales : ndarray of shape (V,), float64
+        The length scale of each vertex (:func:`meshcurv.geometry.vertex_length_scales`), for the
+        zero-area faces, the defects, the radius rules, the estimators and the diagnosis. Writable: the
+        kernels it is passed to are compiled for writable arrays (a read-only one is another numba signature).
+    needles : ndarray of shape (V,), bool
+        The needle vertices (:func:`meshcurv.defects.needle_vertices`), for the orientation, the defect codes,
+        the radius rules and the diagnosis; read-only. Both are found before the orientation, which changes
+        neither (it keeps the edges, sorted, and the corners of each face).
     n_welded, n_double_sided, n_flipped : int
         Vertices welded, faces of a second side dropped, faces reversed.
     n_copies : int
@@ -68,6 +76,8 @@ class PreparedMesh:
     index: np.ndarray | None
     surface: Surface
     orient: str
+    length_scales: np.ndarray
+    needles: np.ndarray
     n_welded: int = 0
     n_double_sided: int = 0
     n_flipped: int = 0
@@ -76,21 +86,13 @@ class PreparedMesh:
     @classmethod
     def as_given(cls, vertices: np.ndarray, topology: MeshTopology) -> PreparedMesh:
         """A mesh already checked, taken as it is: not welded, reordered or oriented."""
-        return cls(vertices, topology, None, Surface(vertices, topology.faces), "keep")
+        scales, needles = _scales_and_needles(vertices, topology)
+        return cls(vertices, topology, None, Surface(vertices, topology.faces), "keep", scales, needles)
 
     @cached_property
     def cross(self) -> np.ndarray:
         """(F, 3) cross products of the faces' sides (twice their area, along their normal); read-only."""
         return _read_only(face_cross_products(self.vertices, self.topology.faces))
-
-    @cached_property
-    def length_scales(self) -> np.ndarray:
-        """(V,) the length scale of each vertex (:func:`meshcurv.geometry.vertex_length_scales`), found once
-        for the orientation, the zero-area faces, the defects, the radius rules, the estimators and the diagnosis
-        (inside :func:`meshcurv._once.computed_once`, every caller of ``vertex_length_scales`` on these vertices
-        gets this array). Kept writable: the kernels it is passed to
-        are compiled for writable arrays (a read-only one is another numba signature)."""
-        return vertex_length_scales(self.vertices, self.topology)
 
     @cached_property
     def degenerate(self) -> np.ndarray:
@@ -136,7 +138,7 @@ class PreparedMesh:
 
     @cached_property
     def _codes(self) -> tuple[np.ndarray, dict]:
-        return defect_codes(self.topology, self.degenerate, self.vertices, self.length_scales)
+        return defect_codes(self.topology, self.degenerate, self.needles)
 
     def defects(self, *, boundary: bool = False) -> VertexDefects:
         """The defects as a method sees them: ``boundary=True`` for the methods that keep boundary vertices."""
@@ -190,6 +192,12 @@ def _read_only(array: np.ndarray) -> np.ndarray:
     return array
 
 
+def _scales_and_needles(vertices: np.ndarray, topology: MeshTopology) -> tuple[np.ndarray, np.ndarray]:
+    """(V,) the length scales and (V,) the needle vertices (read-only) of a checked mesh."""
+    scales = vertex_length_scales(vertices, topology)
+    return scales, _read_only(needle_vertices(vertices, topology, scales))
+
+
 def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: int = 3) -> PreparedMesh:
     """Check ``vertices`` and ``faces`` once and prepare them: :class:`PreparedMesh`.
 
@@ -226,9 +234,9 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
             copies.vertices, copies.topology, copies.index[first], (welded.n_welded if welded is not None else 0)
         )
         points, topology = welded.vertices, welded.topology
-    adopt(points)  # the call's derived arrays (length scales, needles) found once from here on
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
-    topology, n_flipped = oriented_topology(points, one_sided.topology, orient)
+    scales, needles = _scales_and_needles(points, one_sided.topology)
+    topology, n_flipped = oriented_topology(points, one_sided.topology, orient, needles)
     # the row computed for each of the caller's vertices (welded vertices, in the local order)
     index = None if welded is None else welded.index
     if local is not None:
@@ -246,6 +254,8 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         index,
         surface,
         orient,
+        scales,
+        needles,
         welded.n_welded if welded is not None else 0,
         one_sided.n_dropped,
         n_flipped,

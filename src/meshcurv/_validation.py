@@ -10,9 +10,7 @@ from __future__ import annotations
 import numbers
 import operator
 import warnings
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
-from contextvars import ContextVar
+from collections.abc import Sequence
 from itertools import chain
 from typing import NamedTuple
 
@@ -35,7 +33,6 @@ __all__ = [
     "checked_mesh",
     "checked_points",
     "checked_indices",
-    "trusting",
     "MAX_VERTICES",
 ]
 
@@ -389,42 +386,6 @@ def check_choice(value, name: str, choices) -> str:
 
 
 # -- cheap checks at the public helpers (geometry, neighborhoods, smoothing, diagnose) --------------
-#: Arrays checked by the entry point that is running: ``(array, n_vertices)``, where ``n_vertices``
-#: bounds the indices of an index array (None for vertices). Read by identity, per thread.
-_TRUSTED: ContextVar[tuple[tuple[np.ndarray, int | None], ...]] = ContextVar("meshcurv_trusted", default=())
-
-
-@contextmanager
-def trusting(vertices: np.ndarray, *indices: np.ndarray) -> Iterator[None]:
-    """Within the block, :func:`checked_points` and :func:`checked_indices` pass these very arrays unchecked.
-
-    For an entry point that has checked its vertices (:func:`as_vertices`) and
-    index arrays (in range for ``len(vertices)``) and then calls public helpers
-    on them: each helper would check them again, a ``min`` and a ``max`` over
-    the array per call. The geometry of the library runs on trusting cores
-    (:mod:`meshcurv._geometry`); the helpers still served here are those of
-    :mod:`meshcurv.jets`, :mod:`meshcurv.neighborhoods` and
-    :mod:`meshcurv.radius` that the ball methods call, until they too have
-    cores. Arrays are recognised by identity, not by value; the trust ends
-    with the block and does not cross threads.
-    """
-    n = vertices.shape[0]
-    checked = ((vertices, None),) + tuple((array, n) for array in indices)
-    token = _TRUSTED.set(_TRUSTED.get() + tuple((a, bound) for a, bound in checked if a.flags.c_contiguous))
-    try:
-        yield
-    finally:
-        _TRUSTED.reset(token)
-
-
-def _trusted(array, n_vertices: int | None) -> bool:
-    """Whether ``array`` is one that :func:`trusting` covers (an index array: in range for ``n_vertices``)."""
-    for known, bound in _TRUSTED.get():
-        if array is known:
-            return bound is None if n_vertices is None else bound is not None and bound <= n_vertices
-    return False
-
-
 def checked_points(vertices, *, name: str = "vertices") -> np.ndarray:
     """``vertices`` as a C-contiguous float64 (V, 3) array, checked finite.
 
@@ -444,8 +405,6 @@ def checked_points(vertices, *, name: str = "vertices") -> np.ndarray:
         and vertices.shape[0] > 0
     ):
         return as_vertices(vertices, name=name)
-    if _trusted(vertices, None):
-        return vertices
     largest = max(float(vertices.max()), -float(vertices.min()))  # NaN if any coordinate is NaN
     if not largest <= MAX_COORDINATE or 0.0 < largest < MIN_COORDINATE:
         return as_vertices(vertices, name=name)  # raises, naming the vertices and the problem
@@ -470,8 +429,6 @@ def checked_indices(indices, n_vertices: int, *, columns: int = 3, name: str = "
     array = indices if isinstance(indices, np.ndarray) else _as_array(indices, name)
     if array.ndim != 2 or array.shape[1] != columns:
         raise InvalidMeshError(f"`{name}` must have shape (N, {columns}); got {_shape_text(array)}")
-    if array.dtype == np.int64 and _trusted(array, n_vertices):
-        return array
     if array.dtype != np.int64:
         array = _integer_faces(array, name)
     if array.size:

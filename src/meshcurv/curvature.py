@@ -8,16 +8,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ._once import computed_once
 from ._prepared import prepare_mesh
-from ._validation import check_choice, check_int_option, check_positive_float, trusting
+from ._validation import check_choice, check_positive_float
 from .diagnosis import mesh_diagnosis, quality_message
 from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._support import ProgressCallback, Stages
 from .estimators.icc import voxel_pilot
-from .radius import small_radius_note, voxel_surface_radius
+from .radius import _voxel_surface_radius, small_radius_note
 from .result import CurvatureResult
+from .smoothing import check_smoothing_steps
 
 __all__ = ["principal_curvatures", "multiscale_curvatures", "METHODS"]
 
@@ -186,8 +186,7 @@ def principal_curvatures(
     """
     estimator, options = _checked_options(method, smoothing_steps=smoothing_steps, radius=radius)
     orient, weld = _resolved(method, orient, weld)
-    with computed_once():  # the length scales and needle vertices found once, whoever asks (meshcurv._once)
-        result, message = _computed(vertices, faces, estimator, options, orient, weld, progress, radius)
+    result, message = _computed(vertices, faces, estimator, options, orient, weld, progress, radius)
     if message:
         warnings.warn(message, MeshQualityWarning, stacklevel=2)
     return result
@@ -196,20 +195,18 @@ def principal_curvatures(
 def _computed(vertices, faces, estimator, options: dict, orient: str, weld, progress, radius) -> tuple:
     """``(result, message)`` of :func:`principal_curvatures`, its options checked."""
     mesh = prepare_mesh(vertices, faces, orient=orient, weld=weld, stacklevel=4)
-    points, topology = mesh.vertices, mesh.topology
-    with trusting(points, topology.faces, topology.edges):  # checked: the helpers below need not check again
-        found: dict = {}
-        if "radius" in options and options["radius"] is None:
-            voxel = voxel_surface_radius(points, topology, voxel_pilot(mesh))  # one default for every ball method
-            if voxel is not None:
-                options["radius"], found = voxel
-                vertex_scale = found.pop("vertex_scale", None)  # icc: each vertex at its own scale (issue 30)
-                if estimator.name == "icc":
-                    options["vertex_scale"] = vertex_scale
-        result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
-        return _finished(
-            mesh, estimator, result, problems, found, given_radius=radius is not None and not options.get("adaptive")
-        )
+    found: dict = {}
+    if "radius" in options and options["radius"] is None:
+        voxel = _voxel_surface_radius(mesh, voxel_pilot(mesh))  # one default for every ball method
+        if voxel is not None:
+            options["radius"], found = voxel
+            vertex_scale = found.pop("vertex_scale", None)  # icc: each vertex at its own scale (issue 30)
+            if estimator.name == "icc":
+                options["vertex_scale"] = vertex_scale
+    result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
+    return _finished(
+        mesh, estimator, result, problems, found, given_radius=radius is not None and not options.get("adaptive")
+    )
 
 
 def multiscale_curvatures(
@@ -281,8 +278,7 @@ def multiscale_curvatures(
         raise InvalidOptionError(f"`radii` must be a non-empty sequence of radii; got {radii!r}")
     radii = [check_positive_float(radius, "radii") for radius in radii]
     orient, weld = _resolved(method, orient, weld)
-    with computed_once():
-        finished = _computed_at(vertices, faces, estimator, options, orient, weld, progress, radii)
+    finished = _computed_at(vertices, faces, estimator, options, orient, weld, progress, radii)
     order = np.argsort(radii, kind="stable")
     results: list = [None] * len(radii)
     for rank, index in enumerate(order):
@@ -302,12 +298,11 @@ def _computed_at(vertices, faces, estimator, options: dict, orient: str, weld, p
     mesh = prepare_mesh(vertices, faces, orient=orient, weld=weld, stacklevel=4)
     order = np.argsort(radii, kind="stable")
     stages = Stages(estimator.stages, progress)
-    with trusting(mesh.vertices, mesh.topology.faces, mesh.topology.edges):
-        if estimator.multiscale is not None:
-            computed = estimator.multiscale(mesh, radii=[radii[i] for i in order], stages=stages)
-        else:
-            computed = [estimator.function(mesh, stages=stages, **{**options, "radius": radii[i]}) for i in order]
-        return [_finished(mesh, estimator, result, problems, {}, given_radius=True) for result, problems in computed]
+    if estimator.multiscale is not None:
+        computed = estimator.multiscale(mesh, radii=[radii[i] for i in order], stages=stages)
+    else:
+        computed = [estimator.function(mesh, stages=stages, **{**options, "radius": radii[i]}) for i in order]
+    return [_finished(mesh, estimator, result, problems, {}, given_radius=True) for result, problems in computed]
 
 
 def _checked_options(method, **given) -> tuple:
@@ -323,7 +318,7 @@ def _checked_options(method, **given) -> tuple:
             raise InvalidOptionError(f"method {method!r} does not take the option `{name}`")
         options[name] = value
     if "smoothing_steps" in options:
-        options["smoothing_steps"] = check_int_option(options["smoothing_steps"], "smoothing_steps")
+        options["smoothing_steps"] = check_smoothing_steps(options["smoothing_steps"])  # the estimators trust it
     if isinstance(options.get("radius"), str) and options["radius"] == "adaptive" and estimator.name == "icc":
         options["radius"], options["adaptive"] = None, True  # from the default radius upwards, per vertex
     elif options.get("radius") is not None:
@@ -346,7 +341,9 @@ def _finished(mesh, estimator, result: CurvatureResult, problems: list, found: d
     if given_radius and estimator.radius_warning_edges is not None:  # given, not a default
         note = small_radius_note(result.parameters["radius"], points, topology, estimator.radius_warning_edges)
         problems = [*problems, note] if note else problems
-    diagnosis = mesh_diagnosis(points, topology, mesh.n_flipped, mesh.length_scales)  # checked by prepare_mesh
+    diagnosis = mesh_diagnosis(
+        points, topology, mesh.n_flipped, mesh.length_scales, n_needle_vertices=int(mesh.needles.sum())
+    )
     reasons = mesh.defects(boundary=estimator.boundary).reasons(result.valid)
     parameters = {
         **result.parameters,

@@ -22,7 +22,6 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._geometry import degenerate_face_mask
-from ._once import once
 from .topology import MeshTopology
 
 __all__ = [
@@ -185,14 +184,9 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
     -------
     ndarray of shape (V,), bool
         The vertices of such clusters that have a face of non-zero area with
-        one corner in the cluster (the angles are summed over those faces);
-        read-only when found once for the call's prepared mesh (:func:`meshcurv._once.once`).
+        one corner in the cluster (the angles are summed over those faces).
+        A prepared mesh holds them (:attr:`meshcurv._prepared.PreparedMesh.needles`).
     """
-    return once("needle_vertices", vertices, topology, lambda: _needle_vertices(vertices, topology, scales), scales)
-
-
-def _needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray:
-    """:func:`needle_vertices`, computed."""
     n = topology.n_vertices
     edges = topology.edges
     first, second = edges[:, 0], edges[:, 1]
@@ -267,7 +261,7 @@ def _needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nd
     return candidates & flung[cluster]
 
 
-def scale_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray:
+def scale_vertices(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     """(V,) bool: the vertices that measure the mesh's scale: the referenced ones but the needle vertices.
 
     Every default-radius rule (:mod:`meshcurv.radius`) reads these vertices
@@ -282,19 +276,18 @@ def scale_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.ndar
 
     Parameters
     ----------
-    vertices : ndarray of shape (V, 3), float64
     topology : MeshTopology
-    scales : ndarray of shape (V,)
-        :func:`meshcurv.geometry.vertex_length_scales`.
+    needles : ndarray of shape (V,), bool
+        :func:`needle_vertices`.
 
     Returns
     -------
     ndarray of shape (V,), bool
     """
-    return topology.referenced_vertices & ~needle_vertices(vertices, topology, scales)
+    return topology.referenced_vertices & ~needles
 
 
-def scale_edges(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray:
+def scale_edges(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     """The edges that measure the mesh's scale: those between two :func:`scale_vertices` (no needle's edge).
 
     The default radii are multiples of the mean edge length; a spike's edges
@@ -304,7 +297,7 @@ def scale_edges(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray
 
     Parameters
     ----------
-    vertices, topology, scales
+    topology, needles
         As for :func:`scale_vertices`.
 
     Returns
@@ -312,7 +305,6 @@ def scale_edges(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray
     ndarray of shape (E', 2), int
         ``topology.edges`` itself when the mesh has no needle vertex.
     """
-    needles = needle_vertices(vertices, topology, scales)
     if not needles.any():
         return topology.edges
     return topology.edges[~needles[topology.edges].any(axis=1)]
@@ -341,7 +333,7 @@ def needle_corners(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
 
 
 def defect_codes(
-    topology: MeshTopology, degenerate: np.ndarray, vertices: np.ndarray | None = None, scales: np.ndarray | None = None
+    topology: MeshTopology, degenerate: np.ndarray, needles: np.ndarray | None = None
 ) -> tuple[np.ndarray, dict[str, int]]:
     """(V,) int8 code of the first defect at each vertex (0: none), and the count of each defect.
 
@@ -351,12 +343,9 @@ def defect_codes(
         The mesh's connectivity.
     degenerate : ndarray of shape (F,), bool
         The zero-area faces (:func:`meshcurv.geometry.degenerate_faces`).
-    vertices : ndarray of shape (V, 3), optional
-        The coordinates, for the needle vertices (:func:`needle_vertices`);
-        None: the defects of the connectivity and ``degenerate`` only.
-    scales : ndarray of shape (V,), optional
-        The length scale of each vertex (:func:`meshcurv.geometry.vertex_length_scales`),
-        with ``vertices``.
+    needles : ndarray of shape (V,), bool, optional
+        The needle vertices (:func:`needle_vertices`); None: the defects of
+        the connectivity and ``degenerate`` only.
 
     Returns
     -------
@@ -368,7 +357,6 @@ def defect_codes(
         (``needle_vertices``: the needle vertices themselves).
         A bow-tie vertex on a non-manifold edge is counted with that edge only.
     """
-    needles = None if vertices is None or scales is None else needle_vertices(vertices, topology, scales)
     needle_corners = None
     if needles is not None and needles.any():  # the corners of a needle's faces: each has a sliver in its ring
         needle_corners = np.zeros(topology.n_vertices, dtype=bool)

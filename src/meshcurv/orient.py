@@ -102,8 +102,11 @@ def orient_faces(vertices, faces, *, outward: bool = True) -> tuple[np.ndarray, 
     return oriented, int(flip.sum())
 
 
-def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = True) -> np.ndarray:
-    """(F,) bool: the faces :func:`orient_faces` reverses (validated inputs, no copy of the faces)."""
+def face_flips(
+    vertices: np.ndarray, topology: MeshTopology, *, outward: bool = True, needles: np.ndarray | None = None
+) -> np.ndarray:
+    """(F,) bool: the faces :func:`orient_faces` reverses (validated inputs, no copy of the faces); ``needles``:
+    the (V,) needle vertices when known (:func:`meshcurv.defects.needle_vertices`, found here otherwise)."""
     n_faces = topology.n_faces
     counts = topology.edge_face_counts
     pairs = topology.edge_faces
@@ -124,7 +127,7 @@ def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = 
             return flip
         n_labels, vertex_labels = topology.vertex_components
         patch = vertex_labels[topology.faces[:, 0]]
-        invert = _outward(vertices, topology, patch, flip, np.zeros(n_labels, dtype=bool), n_labels)
+        invert = _outward(vertices, topology, patch, flip, np.zeros(n_labels, dtype=bool), n_labels, needles)
         return invert[patch]
     linked = (counts == 2) & (pairs[:, 0] != pairs[:, 1])
     linked &= proper[np.maximum(pairs[:, 0], 0)] & proper[np.maximum(pairs[:, 1], 0)]
@@ -148,12 +151,12 @@ def face_flips(vertices: np.ndarray, topology: MeshTopology, *, outward: bool = 
     flipped = np.bincount(patch, weights=flip, minlength=n_labels)
     invert = 2 * flipped > size  # keep the majority orientation
     if outward:
-        invert = _outward(vertices, topology, patch, flip, invert, n_labels)
+        invert = _outward(vertices, topology, patch, flip, invert, n_labels, needles)
     flip ^= invert[patch] & orientable
     return flip & proper
 
 
-def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
+def _outward(vertices, topology, patch, flip, invert, n_labels, needles) -> np.ndarray:
     """Patch inversions that make every closed patch face out of the solid it bounds.
 
     A closed patch gets positive signed volume (normals away from what it
@@ -169,7 +172,8 @@ def _outward(vertices, topology, patch, flip, invert, n_labels) -> np.ndarray:
         open_patch = np.zeros(n_labels, dtype=bool)
 
     # a needle's slivers bound no solid (issue 29: a uv sphere's vertex flung 30 sizes inward turned it inside out)
-    needles = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
+    if needles is None:
+        needles = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
     kept = ~needles[faces].any(axis=1) if needles.any() else slice(None)
     signed, magnitude = _patch_volumes(vertices, faces[kept], patch[kept], flip[kept], n_labels)
     decided = ~open_patch & (np.abs(signed) > 1e-9 * magnitude)
@@ -257,17 +261,19 @@ def _nesting_depth(vertices, faces, patch, closed) -> np.ndarray:
     return depth
 
 
-def oriented_topology(vertices: np.ndarray, topology: MeshTopology, orient: str) -> tuple[MeshTopology, int]:
+def oriented_topology(
+    vertices: np.ndarray, topology: MeshTopology, orient: str, needles: np.ndarray | None = None
+) -> tuple[MeshTopology, int]:
     """Apply ``orient=`` of :func:`meshcurv.principal_curvatures`: ``(topology, n_flipped)``.
 
     ``'keep'`` returns ``topology`` untouched; otherwise the reversed faces get
     a new topology (the given one is returned when nothing had to change).
     ``orient`` is one of :data:`ORIENT_CHOICES`, checked by the caller
-    (:func:`meshcurv._prepared.prepare_mesh`).
+    (:func:`meshcurv._prepared.prepare_mesh`); ``needles`` as for :func:`face_flips`.
     """
     if orient in ("keep", "auto"):  # 'auto' is resolved by the caller, which knows the method
         return topology, 0
-    flip = face_flips(vertices, topology, outward=orient == "outward")
+    flip = face_flips(vertices, topology, outward=orient == "outward", needles=needles)
     n_flipped = int(flip.sum())
     if n_flipped == 0:
         return topology, 0

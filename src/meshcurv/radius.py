@@ -65,6 +65,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -81,6 +82,9 @@ from ._geometry import (
 from .jets import SETTLED_SLOPE, fit_jets
 from .lattice import voxel_grid
 from .topology import MeshTopology
+
+if TYPE_CHECKING:
+    from ._prepared import PreparedMesh
 
 __all__ = [
     "DEFAULT_RADIUS_FACTOR",
@@ -109,6 +113,29 @@ __all__ = [
 DEFAULT_RADIUS_FACTOR = 2.5
 
 
+class _Measured(NamedTuple):
+    """What the rules read of a mesh: a :class:`meshcurv._prepared.PreparedMesh` has these attributes.
+
+    Each public rule of a mesh checks ``vertices`` and finds the length scales
+    (:func:`meshcurv.geometry.vertex_length_scales`) and needle vertices
+    (:func:`meshcurv.defects.needle_vertices`), then calls its private core
+    (the same name with a leading underscore), which takes the prepared mesh
+    (or this tuple) and trusts it: the estimators call the cores.
+    """
+
+    vertices: np.ndarray
+    topology: MeshTopology
+    length_scales: np.ndarray
+    needles: np.ndarray
+
+
+def _measured(vertices, topology: MeshTopology) -> _Measured:
+    """``vertices`` checked, with their length scales and needle vertices: :class:`_Measured`."""
+    vertices = checked_points(vertices)
+    scales = vertex_length_scales(vertices, topology)
+    return _Measured(vertices, topology, scales, needle_vertices(vertices, topology, scales))
+
+
 def edge_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
     """``DEFAULT_RADIUS_FACTOR`` times the robust mean edge length (0 for a mesh without edges).
 
@@ -116,10 +143,12 @@ def edge_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
     without edges beyond 1000 median edge lengths (equal to the mean on any
     ordinary mesh; one spike vertex at 1e10 does not multiply it).
     """
-    vertices = checked_points(vertices)
+    return _edge_radius(_measured(vertices, topology))
 
-    edges = scale_edges(vertices, topology, vertex_length_scales(vertices, topology))  # no needle's edge
-    return DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, edges)
+
+def _edge_radius(mesh: _Measured | PreparedMesh) -> float:
+    edges = scale_edges(mesh.topology, mesh.needles)  # no needle's edge
+    return DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(mesh.vertices, edges)
 
 
 def component_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[float, np.ndarray | None]]:
@@ -134,11 +163,13 @@ def component_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[
     with the int64 ids of its vertices: a part at 1e-3 and one at 1e3 are each
     fitted at their own scale.
     """
-    vertices = checked_points(vertices)
+    return _component_radii(_measured(vertices, topology))
 
-    scales = vertex_length_scales(vertices, topology)
-    all_edges = scale_edges(vertices, topology, scales)  # no spike's edges (issue 29: a spike raised it 2.6x)
-    referenced = scale_vertices(vertices, topology, scales)
+
+def _component_radii(mesh: _Measured | PreparedMesh) -> list[tuple[float, np.ndarray | None]]:
+    vertices, scales = mesh.vertices, mesh.length_scales
+    all_edges = scale_edges(mesh.topology, mesh.needles)  # no spike's edges (issue 29: a spike raised it 2.6x)
+    referenced = scale_vertices(mesh.topology, mesh.needles)
     used = scales[referenced & (scales > 0)]
     if used.size == 0 or used.min() == used.max():
         return [(DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, all_edges), None)]
@@ -173,11 +204,12 @@ def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
         whole mesh (a unit mistake: mm for m).
     """
     radius = check_positive_float(radius, "radius")
-    vertices = checked_points(vertices)
-    if topology.n_faces:
-        used = vertices[scale_vertices(vertices, topology, vertex_length_scales(vertices, topology))]
-    else:
-        used = vertices
+    return _check_radius(radius, _measured(vertices, topology))
+
+
+def _check_radius(radius: float, mesh: _Measured | PreparedMesh) -> float:
+    vertices, topology = mesh.vertices, mesh.topology
+    used = vertices[scale_vertices(topology, mesh.needles)] if topology.n_faces else vertices
     if used.shape[0] == 0:
         return radius
     diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
@@ -228,6 +260,10 @@ def resolve_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> floa
     if radius is None:
         return edge_radius(vertices, topology)
     return check_radius(radius, vertices, topology)
+
+
+def _resolve_radius(radius: float | None, mesh: _Measured | PreparedMesh) -> float:
+    return _edge_radius(mesh) if radius is None else _check_radius(radius, mesh)
 
 
 #: The noise level is measured with degree-2 jets over balls of this many local edge lengths.
@@ -337,11 +373,14 @@ def scale_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarra
     ndarray of shape (V,) of bool
         ``valid`` itself when the mesh has no needle vertex.
     """
+    return _scale_centres(_measured(vertices, topology), valid, normals)
 
-    needles = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
+
+def _scale_centres(mesh: _Measured | PreparedMesh, valid: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    needles = mesh.needles
     if not needles.any():
         return valid
-    corners = needle_corners(topology, needles) & np.isfinite(normals).all(axis=1)
+    corners = needle_corners(mesh.topology, needles) & np.isfinite(normals).all(axis=1)
     return (valid | corners) & ~needles
 
 
@@ -374,14 +413,19 @@ def noise_radii(
     levels : list of float
         The noise level of each group.
     """
+    return _noise_radii(_measured(vertices, topology), normals, valid, adjacency=adjacency)
 
-    scales = vertex_length_scales(vertices, topology)
-    usable = scale_vertices(vertices, topology, scales)
-    all_edges = scale_edges(vertices, topology, scales)
-    centres = scale_centres(vertices, topology, valid, normals)
+
+def _noise_radii(
+    mesh: _Measured | PreparedMesh, normals: np.ndarray, valid: np.ndarray, *, adjacency=None
+) -> tuple[list[tuple[float, np.ndarray | None]], list[float]]:
+    vertices = mesh.vertices
+    usable = scale_vertices(mesh.topology, mesh.needles)
+    all_edges = scale_edges(mesh.topology, mesh.needles)
+    centres = _scale_centres(mesh, valid, normals)
     groups: list[tuple[float, np.ndarray | None]] = []
     levels: list[float] = []
-    for _group_radius, members in component_radii(vertices, topology):
+    for _group_radius, members in _component_radii(mesh):
         if members is None:
             inside, edges = centres, all_edges
         else:
@@ -455,10 +499,16 @@ def voxel_surface_radius(
     that takes a radius, so that ``quadric`` and ``normal_cycle_ball`` average the staircase out as
     ``icc`` does.
     """
+    return _voxel_surface_radius(_measured(vertices, topology), pilot)
 
+
+def _voxel_surface_radius(
+    mesh: _Measured | PreparedMesh, pilot: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+) -> tuple[float, dict] | None:
+    vertices, topology = mesh.vertices, mesh.topology
     # a spike is on no grid (issue 29: one flung to 1e22 made a voxel sphere an ordinary mesh, radius 1.4x), and
     # is in no extent, area or percentile below: the needles' vertices and faces are left out everywhere
-    spikes = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
+    spikes = mesh.needles
     referenced = topology.referenced_vertices & ~spikes
     grid = voxel_grid(vertices[referenced])
     if grid is None:
@@ -707,10 +757,13 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarr
     Only the edges between two :func:`meshcurv.defects.scale_vertices` count (a needle's edges, 1e3 long
     beside edges of 0.1, would make its neighbours' radii 9 times larger).
     """
+    return _local_scale_ratios(_measured(vertices, topology))
 
+
+def _local_scale_ratios(mesh: _Measured | PreparedMesh) -> np.ndarray:
+    vertices, topology, scales = mesh.vertices, mesh.topology, mesh.length_scales
     n = topology.n_vertices
-    scales = vertex_length_scales(vertices, topology)
-    edges = scale_edges(vertices, topology, scales)
+    edges = scale_edges(topology, mesh.needles)
     local = vertex_edge_lengths(vertices, edges, vertices.shape[0])
     known = np.isfinite(local) & (local > 0) & (scales > 0)
     if not known.any():

@@ -38,7 +38,7 @@ from .._backend import kernel_threads, numba_kernels
 from .._tensors import outer6
 from .._geometry import DEGENERATE_AREA_RATIO
 from ..result import CurvatureResult
-from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
+from ..smoothing import STEPS_PER_CALL, smooth_vertex_field
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages
@@ -191,7 +191,6 @@ def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages, 
 def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     """Run matGeom's algorithm. Returns ``(result, problems)``."""
     vertices, topology = mesh.vertices, mesh.topology
-    smoothing_steps = check_smoothing_steps(smoothing_steps)
     kernels = numba_kernels("matgeom")
     problems: list[str] = []
     if kernels is not None and smoothing_steps <= STEPS_PER_CALL:

@@ -51,7 +51,7 @@ from .._tensors import outer6, principal_from_shape_operator
 from .._backend import kernel_threads, numba_kernels
 from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles
 from ..result import CurvatureResult
-from ..smoothing import STEPS_PER_CALL, check_smoothing_steps, smooth_vertex_field
+from ..smoothing import STEPS_PER_CALL, smooth_vertex_field
 from .._prepared import PreparedMesh
 from ._support import Stages, nan_where, problems
 
@@ -61,7 +61,6 @@ STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors
 def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     """Normal-cycle tensor in true units. Returns ``(result, problems)``."""
     vertices, topology = mesh.vertices, mesh.topology
-    smoothing_steps = check_smoothing_steps(smoothing_steps)
     kernels = numba_kernels("normal_cycle")
     if kernels is not None:
         return _estimate_compiled(kernels, mesh, smoothing_steps, stages)

@@ -55,7 +55,7 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from .._geometry import edge_dihedral_angles
 from ..neighborhoods import ball_edge_sums
-from ..radius import component_radii, resolve_radius, vertex_radii
+from ..radius import _component_radii, _resolve_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, ball_holds_neighbours, finish
 
@@ -101,9 +101,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
     if radius is None:  # each group of components of one scale at its own default
-        groups = component_radii(vertices, topology)
+        groups = _component_radii(mesh)
     else:
-        groups = [(resolve_radius(radius, vertices, topology), None)]
+        groups = [(_resolve_radius(radius, mesh), None)]
     cross, degenerate, normals = mesh.cross, mesh.degenerate, mesh.vertex_normals
     defects, valid = mesh.start(boundary=True)
 

@@ -48,7 +48,7 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, MIN_POINTS, fit_jets, shape_operators
-from ..radius import component_radii, resolve_radius, vertex_radii
+from ..radius import _component_radii, _resolve_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 
@@ -72,9 +72,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
     if radius is None:
-        groups = component_radii(vertices, topology)
+        groups = _component_radii(mesh)
     else:
-        groups = [(resolve_radius(radius, vertices, topology), None)]
+        groups = [(_resolve_radius(radius, mesh), None)]
     normals = mesh.vertex_normals
     defects, valid = mesh.start(boundary=True)
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
