@@ -14,7 +14,8 @@ inward; the needle mesh wound inward) and ``multiscale_curvatures``, and keeps
 diagnosis, the parameters and the warnings. ``--count`` gives, for a default
 call on an icosphere of 642 vertices, the entries into
 :mod:`meshcurv._validation` from outside it (``sys.setprofile``) and the
-computations of the length scales and needle vertices.
+computations of the length scales and needle vertices (also for the icosphere
+wound inward, every face reversed by the orientation).
 """
 
 import argparse
@@ -146,11 +147,14 @@ def count() -> None:
                 key = f"_validation.{code.co_name} from {frame.f_back.f_code.co_name}"
                 entries[key] = entries.get(key, 0) + 1
 
-    for method in ("icc", "normal_cycle", "matgeom"):
+    inward = np.asarray(sphere.faces)[:, ::-1]  # every face reversed by the orientation
+    for method, faces in [(m, sphere.faces) for m in ("icc", "normal_cycle", "matgeom")] + [("icc inward", inward)]:
         entries.clear()
         sys.setprofile(profile)
         try:
-            meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                meshcurv.principal_curvatures(sphere.vertices, faces, method=method.split()[0])
         finally:
             sys.setprofile(None)
         checks = sum(n for key, n in entries.items() if key.startswith("_validation."))
