@@ -21,8 +21,8 @@ from .tensors import _tangent_eigen
 _PIVOT_FLOOR = 1e-12
 
 
-@nb.njit(**_JIT)
-def _cholesky_solve(a, b, low, m, min_spread, scale, total):
+@nb.njit(inline="always", **_JIT)
+def _cholesky_inline(a, b, low, m, min_spread, scale, total):
     """Solve ``a[:m, :m] x = b[:m]`` in place of ``b``; False if a pivot <= ``_PIVOT_FLOOR``
     or the points are not spread.
 
@@ -74,6 +74,19 @@ def _cholesky_solve(a, b, low, m, min_spread, scale, total):
             s -= low[j, i] * b[j]
         b[i] = s * low[i, i]
     return True
+
+
+@nb.njit(**_JIT)
+def _cholesky_solve(a, b, low, m, min_spread, scale, total):
+    """:func:`_cholesky_inline` of any size ``m``."""
+    return _cholesky_inline(a, b, low, m, min_spread, scale, total)
+
+
+@nb.njit(**_JIT)
+def _cholesky_solve_10(a, b, low, min_spread, scale, total):
+    """:func:`_cholesky_inline` of size 10 (the cubic jets of the normal fits): the loops' bounds are constants,
+    which the compiler unrolls (the same operations in the same order: the same numbers)."""
+    return _cholesky_inline(a, b, low, 10, min_spread, scale, total)
 
 
 @threaded
@@ -153,7 +166,7 @@ def fit_jet_pairs(vertices, normals, radii, larger, *options):
 
     ``options``: the arguments of :func:`fit_jets` after ``radii``. The grid is that of :func:`fit_jets` over
     ``radii[0]`` (cells of that side); each centre's ball of ``larger`` is walked once, over the cells it
-    reaches (:func:`_walk_members`), and the ball of ``radii[0]`` is the subsequence
+    reaches (:func:`~meshcurv._kernels.neighborhoods._ball_members`), and the ball of ``radii[0]`` is the subsequence
     of its members within that radius: the same points in the same order as :func:`fit_jets` finds them (the
     cells of the smaller walk, in the same column-major order, are a sub-block of the larger one's), so the
     fits over ``radii[0]`` are those of :func:`fit_jets` to the bit. The fits over ``larger`` sum the same
@@ -233,7 +246,7 @@ def _grid_chunk(
         if steps == 1:
             members, size = _ball_members(points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], radius, members)
         elif step % 2 == 0:  # the walk of the larger ball, its members within the radius the smaller one
-            outer, outer_size = _walk_members(
+            outer, outer_size = _ball_members(
                 points, grid, vertices[v, 0], vertices[v, 1], vertices[v, 2], larger, outer
             )
             if inner.shape[0] < outer_size:
@@ -274,74 +287,6 @@ def _grid_chunk(
             areas,
             general,
         )
-
-
-#: Cells nearer than this share of a cell to a ball's surface are walked (the rounding of the cells' bounds).
-_WALK_SLACK = 0.01
-
-
-@nb.njit(**_JIT)
-def _walk_members(points, grid, cx, cy, cz, cutoff, out):
-    """:func:`~meshcurv._kernels.neighborhoods._ball_members` without the cells the ball does not reach: the same
-    points in the same order, from fewer candidates.
-
-    That walk reads every cell of the cube of ``2 ceil(cutoff / cell) + 1`` cells a side around the centre's
-    cell; this one skips the columns whose ``x, y`` rectangle lies farther than ``cutoff`` from the centre, and
-    in each column the ``z`` cells beyond ``sqrt(cutoff^2 - d_xy^2)`` (each bound widened by
-    :data:`_WALK_SLACK` cells and by the rounding of the coordinates): a skipped point fails the distance test
-    there. The columns and, within each, the cells are walked in the same order, so the members (the ranks
-    that pass the same test) come in the same order, and sums over them round alike.
-    """
-    _, starts, levels, lo, cell, nx, ny = grid
-    fx = (cx - lo[0]) / cell
-    fy = (cy - lo[1]) / cell
-    fz = (cz - lo[2]) / cell
-    cutoff2 = cutoff * cutoff
-    count = 0
-    span = np.int64(math.ceil(cutoff / cell))  # cells each way from the centre's, as _ball_members walks them
-    if not (
-        fx > -1 - span and fy > -1 - span and fz > -1 - span and fx < nx + span and fy < ny + span and fz < 2.0**61
-    ):
-        return out, count
-    bx = np.int64(math.floor(fx))
-    by = np.int64(math.floor(fy))
-    bz = np.int64(math.floor(fz))
-    reach = cutoff / cell
-    slack = _WALK_SLACK + 1e-12 * (abs(fx) + abs(fy) + abs(fz) + (abs(cx) + abs(cy) + abs(cz)) / cell)
-    for ix in range(max(bx - span, np.int64(0)), min(bx + span + 1, nx)):
-        gx = max(max(ix - fx, fx - ix - 1.0) - slack, 0.0)  # from the centre to the column's x range, in cells
-        for iy in range(max(by - span, np.int64(0)), min(by + span + 1, ny)):
-            gy = max(max(iy - fy, fy - iy - 1.0) - slack, 0.0)
-            rest = reach * reach - gx * gx - gy * gy
-            if rest < 0.0:
-                continue
-            half = math.sqrt(rest) + slack
-            bottom = max(np.int64(math.floor(fz - half)), bz - span)
-            top = min(np.int64(math.floor(fz + half)), bz + span)
-            c = ix * ny + iy
-            k = starts[c]
-            last = starts[c + 1]
-            high = last
-            while k < high:  # first rank of the column at z cell `bottom` or above
-                middle = (k + high) // 2
-                if levels[middle] < bottom:
-                    k = middle + 1
-                else:
-                    high = middle
-            end = k
-            while end < last and levels[end] <= top:
-                end += 1
-            if count + end - k > out.shape[0]:
-                grown = np.empty(2 * (count + end - k), np.int64)
-                grown[:count] = out[:count]
-                out = grown
-            for j in range(k, end):  # branch-free: every candidate is written, the inside ones kept
-                dx = points[j, 0] - cx
-                dy = points[j, 1] - cy
-                dz = points[j, 2] - cz
-                out[count] = j
-                count += dx * dx + dy * dy + dz * dz <= cutoff2
-    return out, count
 
 
 @nb.njit(**_JIT)
@@ -693,7 +638,11 @@ def _fit_one(
                         * scale[c]
                     )
                 solution[r] = right[r] * scale[r]
-            if _cholesky_solve(matrix, solution, low, m, min_spread, scale, moments[0, 0]):
+            if (
+                _cholesky_solve_10(matrix, solution, low, min_spread, scale, moments[0, 0])
+                if m == 10
+                else _cholesky_solve(matrix, solution, low, m, min_spread, scale, moments[0, 0])
+            ):
                 for r in range(6):
                     solution[r] = solution[r] * scale[r]
                 fitted = True

@@ -13,6 +13,10 @@ from ._common import _JIT, run_chunks, threaded
 from .topology import _BUCKET_CHUNKS, _bucket_starts
 
 
+#: Indices known to be >= 0 cast to this type: numba indexes with them without the code for negative indices.
+_UNSIGNED = np.uint64
+_ONE = np.uint64(1)
+
 #: A ball grid has at most this many columns of cells per point (and at least 4096 in all).
 _GRID_COLUMNS_PER_POINT = 4
 
@@ -148,13 +152,26 @@ def pool_grid(points, pool, reach):
     return pool_points, ids, grid
 
 
+#: Cells nearer than this share of a cell to a ball's surface are walked (the rounding of the cells' bounds).
+_WALK_SLACK = 0.01
+
+
 @nb.njit(**_JIT)
 def _ball_members(points, grid, cx, cy, cz, cutoff, out):
     """Ranks of the points within ``cutoff`` of ``(cx, cy, cz)`` written to ``out`` (grown when full).
 
     ``points`` are in the order of ``grid`` (:func:`_grid`), so that the
-    cells of a column around the centre (``ceil(cutoff / cell)`` each way) are
-    one contiguous run of memory. Returns ``(out, count)``.
+    cells of a column around the centre are one contiguous run of memory.
+    Returns ``(out, count)``; the ranks come in increasing order (columns by
+    ``x`` cell, then ``y`` cell, each by ``z`` cell: the order of ``grid``).
+
+    The candidates are the cells of the cube of ``2 ceil(cutoff / cell) + 1``
+    cells a side around the centre's cell that the ball reaches: the columns
+    whose ``x, y`` rectangle lies within ``cutoff`` of the centre and, in each,
+    the ``z`` cells within ``sqrt(cutoff^2 - d_xy^2)`` (each bound widened by
+    :data:`_WALK_SLACK` cells and by the rounding of the coordinates: a point
+    skipped fails the distance test, so the members are those of the whole
+    cube, in the same order, from fewer candidates).
     """
     _, starts, levels, lo, cell, nx, ny = grid
     fx = (cx - lo[0]) / cell
@@ -170,20 +187,30 @@ def _ball_members(points, grid, cx, cy, cz, cutoff, out):
     bx = np.int64(math.floor(fx))
     by = np.int64(math.floor(fy))
     bz = np.int64(math.floor(fz))
+    reach = cutoff / cell
+    slack = _WALK_SLACK + 1e-12 * (abs(fx) + abs(fy) + abs(fz) + (abs(cx) + abs(cy) + abs(cz)) / cell)
     for ix in range(max(bx - span, np.int64(0)), min(bx + span + 1, nx)):
+        gx = max(max(ix - fx, fx - ix - 1.0) - slack, 0.0)  # from the centre to the column's x range, in cells
         for iy in range(max(by - span, np.int64(0)), min(by + span + 1, ny)):
+            gy = max(max(iy - fy, fy - iy - 1.0) - slack, 0.0)
+            rest = reach * reach - gx * gx - gy * gy
+            if rest < 0.0:
+                continue
+            half = math.sqrt(rest) + slack
+            bottom = max(np.int64(math.floor(fz - half)), bz - span)
+            top = min(np.int64(math.floor(fz + half)), bz + span)
             c = ix * ny + iy
             k = starts[c]
             last = starts[c + 1]
             high = last
-            while k < high:  # first rank of the column at z cell bz - span or above
+            while k < high:  # first rank of the column at z cell `bottom` or above
                 middle = (k + high) // 2
-                if levels[middle] < bz - span:
+                if levels[middle] < bottom:
                     k = middle + 1
                 else:
                     high = middle
             end = k
-            while end < last and levels[end] <= bz + span:
+            while end < last and levels[end] <= top:
                 end += 1
             if count + end - k > out.shape[0]:
                 grown = np.empty(2 * (count + end - k), np.int64)
@@ -243,24 +270,24 @@ def _connected_members(vertices, indptr, indices, allowed, v, cutoff, mark, stam
         members[0] = v
         size = 1
     while head < tail:
-        a = queue[head]
+        a = _UNSIGNED(queue[head])  # unsigned indices (here and below): no code for negative ones
         head += 1
         ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
         a2 = ax * ax + ay * ay + az * az
-        for j in range(indptr[a], indptr[a + 1]):
-            b = indices[j]
+        for j in range(_UNSIGNED(indptr[a]), _UNSIGNED(indptr[a + _ONE])):
+            b = _UNSIGNED(indices[j])
             if mark[b] == stamp:
                 continue
             bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
             b2 = bx * bx + by * by + bz * bz
             if b2 <= cutoff2:
                 if allowed[b]:
-                    members[size] = b
+                    members[_UNSIGNED(size)] = b
                     size += 1
             elif not a2 <= cutoff2 and not _segment_meets_ball(ax, ay, az, bx, by, bz, cutoff2):
                 continue  # both ends outside, and the segment passes outside too
             mark[b] = stamp
-            queue[tail] = b
+            queue[_UNSIGNED(tail)] = b
             tail += 1
     return size
 
@@ -351,7 +378,7 @@ def _face_extent(vertices, faces, f, d, cx, cy, cz, v, known, squared):
     low = d
     high = d
     for corner in range(3):
-        c = faces[f, corner]
+        c = _UNSIGNED(faces[f, corner])
         if known[c] != v:
             known[c] = v
             squared[c] = (vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2 + (vertices[c, 2] - cz) ** 2
@@ -404,8 +431,8 @@ def _met_share(vertices, faces, f, d, cx, cy, cz, v, radius, radius2, known, squ
     if low >= radius2:  # corners and centroid outside: met if a side crosses the sphere
         crossed = False
         for corner in range(3):
-            p = faces[f, corner]
-            q = faces[f, (corner + 1) % 3]
+            p = _UNSIGNED(faces[f, corner])
+            q = _UNSIGNED(faces[f, (corner + 1) % 3])
             crossed = crossed or _segment_meets_ball(
                 vertices[p, 0] - cx,
                 vertices[p, 1] - cy,
@@ -431,20 +458,21 @@ def _walk_face(
     tail."""
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
     radius2 = radius * radius
-    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
-    if d > (radius + reach[f]) ** 2:
+    g = _UNSIGNED(f)  # unsigned indices (here and below): no code for negative ones
+    d = (centroids[g, 0] - cx) ** 2 + (centroids[g, 1] - cy) ** 2 + (centroids[g, 2] - cz) ** 2
+    if d > (radius + reach[g]) ** 2:
         return tail  # every point of the face is outside
-    met, share, _, _ = _met_share(vertices, faces, f, d, cx, cy, cz, v, radius, radius2, known, squared)
+    met, share, _, _ = _met_share(vertices, faces, g, d, cx, cy, cz, v, radius, radius2, known, squared)
     if not met:
         return tail
-    if share != 0.0 and usable[f]:
+    if share != 0.0 and usable[g]:
         for k in range(values.shape[1]):
-            total[k] += share * values[f, k]
+            total[k] += share * values[g, k]
     for corner in range(3):
-        c = faces[f, corner]
+        c = _UNSIGNED(faces[g, corner])
         if mark[c] != stamp:
             mark[c] = stamp
-            queue[tail] = c
+            queue[_UNSIGNED(tail)] = c
             tail += 1
     return tail
 
@@ -681,10 +709,10 @@ def _face_walk(vertices, faces, centroids, reach, usable, values, indptr, indice
     queue[0] = v
     head, tail = 0, 1
     while head < tail:
-        a = queue[head]
+        a = _UNSIGNED(queue[head])  # unsigned indices: no code for negative ones
         head += 1
-        for j in range(indptr[a], indptr[a + 1]):
-            f = indices[j]
+        for j in range(_UNSIGNED(indptr[a]), _UNSIGNED(indptr[a + _ONE])):
+            f = _UNSIGNED(indices[j])
             if seen[f] == stamp:
                 continue
             seen[f] = stamp
