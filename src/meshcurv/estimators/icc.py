@@ -30,7 +30,8 @@ marching cubes of fine voxels) the normals are fitted on clusters of vertices
 pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
 ``2 sqrt(h_v R)`` for the voxel extent ``h_v`` along its normal, capped where
 the surface bends fast; ``parameters["scale"] == "voxel"``); the pilot runs at
-about half of the vertices (:func:`voxel_pilot`), and where the balls of such a
+about half of the vertices (:func:`voxel_pilot`; in anisotropic voxels its normals
+are fitted on a coarse level too, :func:`_pilot_normals`), and where the balls of such a
 surface hold 800 faces or more (fine voxels), each ball is summed on clusters
 of about 16 faces, the clusters on its rim by their share of the ball
 (:func:`meshcurv.neighborhoods.coarse_face_sums`: the cost of a ball no longer
@@ -236,11 +237,14 @@ def fitted_normals(
     return np.where(usable[:, None], fitted, normals)
 
 
-def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
+def _coarse_level(
+    vertices, normals, radius, areas, neighbours, adjacency, *, edges=COARSE_EDGES, cells=COARSE_CELLS, shift=0.0
+):
     """The points of the normal fits of a dense surface: clusters of vertices, or None for an ordinary mesh.
 
-    Used when the median ``radius`` exceeds :data:`COARSE_EDGES` median edge lengths. The vertices that may enter the balls are grouped by cube of side
-    ``median radius / COARSE_CELLS`` and by the axis and sign of their normal's largest component (the two
+    Used when the median ``radius`` exceeds ``edges`` median edge lengths. The vertices that may enter the balls are
+    grouped by cube of side ``median radius / cells`` (the cubes shifted by ``shift`` of a side) and by the axis and
+    sign of their normal's largest component (the two
     sides of a part thinner than a cube stay apart); each group is one point at its area-weighted centroid,
     weighing the group's area, linked to the groups that a mesh edge joins it to. Returns ``(points,
     normals, allowed, (indptr, indices), areas)`` over V + C points: the V vertices come first, each linked
@@ -254,14 +258,14 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency):
         return None
     typical = float(np.median(radius))
     indptr, indices = adjacency
-    if not _dense(vertices, typical, adjacency):
+    if not _dense(vertices, typical, adjacency, edges=edges):
         return None
     tails = np.repeat(np.arange(n), np.diff(indptr))
-    cell = typical / COARSE_CELLS
+    cell = typical / cells
     members = np.flatnonzero(inside)
     corner = vertices[members].min(axis=0)
     # cells beyond 2^52 (a vertex flung far away) share the last one: a cast of such a float is undefined
-    cube = np.minimum(np.floor((vertices[members] - corner) / cell), 2.0**52).astype(np.int64)
+    cube = np.minimum(np.floor((vertices[members] - corner) / cell + shift), 2.0**52).astype(np.int64)
     axis = np.argmax(np.abs(normals[members]), axis=1)
     side = 2 * axis + (normals[members, axis] < 0)
     group = _row_groups(np.column_stack([cube, side]), (20, 20, 20, 3))
@@ -311,10 +315,10 @@ def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
     return np.column_stack([key // n, key % n])
 
 
-def _dense(vertices: np.ndarray, radius: float, adjacency: tuple) -> bool:
-    """Whether normal fits over ``radius`` run on the coarse level: wider than :data:`COARSE_EDGES` median
+def _dense(vertices: np.ndarray, radius: float, adjacency: tuple, *, edges: float = COARSE_EDGES) -> bool:
+    """Whether normal fits over ``radius`` run on the coarse level: wider than ``edges`` median
     edge lengths (taken over :data:`COARSE_SAMPLE` edges of the CSR lists ``adjacency``)."""
-    return bool(radius > COARSE_EDGES * _sampled_edge(vertices, adjacency))
+    return bool(radius > edges * _sampled_edge(vertices, adjacency))
 
 
 def _sampled_edge(vertices: np.ndarray, adjacency: tuple) -> float:
@@ -345,20 +349,7 @@ def voxel_pilot(mesh: PreparedMesh):
         valid = scale_centres(vertices, topology, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
         centres = _pilot_centres(vertices, topology, valid)
-        coefficients, frame, _ = fit_jets(
-            vertices,
-            start,
-            NORMAL_RADIUS_RATIO * radius,
-            degree=NORMAL_DEGREE,
-            iterations=NORMAL_ITERATIONS,
-            centres=centres,
-            neighbours=topology.referenced_vertices,
-            adjacency=_adjacency(topology),
-            settled=NORMAL_SETTLED,
-            compact=True,
-            min_spread=NORMAL_MIN_SPREAD,
-        )
-        fitted = jet_normals(coefficients, frame)
+        fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres)
         with np.errstate(invalid="ignore"):
             agree = np.isfinite(fitted).all(axis=1) & (np.einsum("ij,ij->i", fitted, start[centres]) > NORMAL_AGREEMENT)
         normals = _spread_normals(
@@ -382,6 +373,59 @@ def voxel_pilot(mesh: PreparedMesh):
 
     return run
 
+
+def _pilot_normals(mesh: PreparedMesh, start: np.ndarray, radius: float, centres: np.ndarray) -> np.ndarray:
+    """(M, 3) the jet normals of :func:`voxel_pilot` at ``centres`` over balls of ``radius`` (``start``: the
+    first frames): fitted on a coarse level of the surface (:func:`_coarse_level`, cubes of ``radius /``
+    :data:`PILOT_COARSE_CELLS`) where ``radius`` exceeds :data:`PILOT_COARSE_EDGES` median edge lengths, else
+    over the vertices."""
+    vertices, topology = mesh.vertices, mesh.topology
+    adjacency = _adjacency(topology)
+    areas = _vertex_areas(mesh)
+    positive = areas[areas > 0]
+    coarse = (
+        _coarse_level(
+            vertices,
+            start,
+            radius,
+            areas / np.median(positive),
+            topology.referenced_vertices,
+            adjacency,
+            edges=PILOT_COARSE_EDGES,
+            cells=PILOT_COARSE_CELLS,
+            shift=1.0 / np.pi,  # the radius is a multiple of the voxel size: no cube boundary through the lattice
+        )
+        if positive.size
+        else None
+    )
+    points, normals, allowed, weights = vertices, start, topology.referenced_vertices, None
+    if coarse is not None:
+        points, normals, allowed, adjacency, weights = coarse
+    coefficients, frame, _ = fit_jets(
+        points,
+        normals,
+        radius,
+        degree=NORMAL_DEGREE,
+        iterations=NORMAL_ITERATIONS,
+        centres=centres,
+        neighbours=allowed,
+        adjacency=adjacency,
+        settled=NORMAL_SETTLED,
+        compact=True,
+        min_spread=NORMAL_MIN_SPREAD,
+        areas=weights,
+    )
+    return jet_normals(coefficients, frame)
+
+
+#: The pilot's normal fits run on a coarse level (:func:`_pilot_normals`) when wider than this many median edges
+#: (anisotropic voxels: 10.8 at 2 x 1 x 1, 11.2 on a sphere at 0.5 x 0.2 x 0.2; isotropic ones: 6.0) ...
+PILOT_COARSE_EDGES = 8.0
+#: ... of cubes of 1 / PILOT_COARSE_CELLS of their radius: on that sphere the pilot's fits cost 0.09 CPU s instead
+#: of 0.18-0.21 (0.07 s at 5 cells; 0.12 s at 10, whose groups of two or three vertices have as many links as
+#: the vertices), their normals as close to the sphere's; on the 8 meshes of ``benchmarks/accuracy_voxel.md``
+#: that take it (anisotropic voxels) the median H error moves by -4.6 to +4.0% of itself (5 cells: -8.3 to +6.6%).
+PILOT_COARSE_CELLS = 7.0
 
 #: The pilot of a voxel surface (:func:`voxel_pilot`) fits and sums at one vertex per cube of this many
 #: median edge lengths (45% of the vertices of a marching-cubes sphere; its values are only read through
