@@ -7,8 +7,9 @@ double-sided mesh and orients the faces. The estimators receive the
 :class:`PreparedMesh` and trust it; what they share is computed once: the
 length scales and needle vertices when the mesh is prepared (the orientation
 reads them too), the face cross products, zero-area faces, vertex normals and
-the defect codes on first use. :meth:`PreparedMesh.expand` puts a result back on the caller's vertices:
-one row per vertex given, copies of a welded vertex sharing its values.
+the defect codes on first use. :meth:`PreparedMesh.expand` puts a result back
+on the caller's vertices: one row per vertex given, copies of a welded vertex
+sharing its values.
 """
 
 from __future__ import annotations
