@@ -12,7 +12,7 @@ from llvmlite import ir  # type: ignore[import-untyped]
 from numba.core import types
 from numba.extending import intrinsic, overload
 
-from ._common import _JIT, _JIT_REASSOC, _TINY, _tangent_frame, run_chunks, threaded
+from ._common import _JIT, _JIT_REASSOC, _TINY, _UNSIGNED, _tangent_frame, run_chunks, threaded
 from .neighborhoods import _ball_members, _connected_members, pool_grid
 from .tensors import _tangent_eigen
 
@@ -591,17 +591,17 @@ def _fit_one(
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]  # read once (the stores below may alias)
     count = 0.0
     weighted = areas.shape[0] > 0
-    for a in range(size):
-        k = members[a]
-        x = (points[k, 0] - cx) * inverse
-        y = (points[k, 1] - cy) * inverse
-        z = (points[k, 2] - cz) * inverse
-        ox[a], oy[a], oz[a] = x, y, z
+    for slot in range(_UNSIGNED(size)):  # unsigned indices: no code for negative ones
+        member = _UNSIGNED(members[slot])
+        x = (points[member, 0] - cx) * inverse
+        y = (points[member, 1] - cy) * inverse
+        z = (points[member, 2] - cz) * inverse
+        ox[slot], oy[slot], oz[slot] = x, y, z
         w = max(1.0 - (x * x + y * y + z * z), 0.0)
         w = w * w
         if weighted:
-            w = w * areas[ids[k]]
-        weight[a] = w
+            w = w * areas[ids[member]]
+        weight[slot] = w
         count += w > 0
     counts[row] = count
     graph = True
@@ -633,7 +633,9 @@ def _fit_one(
             for r in range(m):  # the lower triangle: all the Cholesky factorization reads
                 for c in range(r + 1):
                     matrix[r, c] = (
-                        moments[exponents[r, 0] + exponents[c, 0], exponents[r, 1] + exponents[c, 1]]
+                        moments[
+                            _UNSIGNED(exponents[r, 0] + exponents[c, 0]), _UNSIGNED(exponents[r, 1] + exponents[c, 1])
+                        ]
                         * scale[r]
                         * scale[c]
                     )

@@ -9,13 +9,9 @@ import math
 import numba as nb
 import numpy as np
 
-from ._common import _JIT, run_chunks, threaded
+from ._common import _JIT, _ONE, _UNSIGNED, run_chunks, threaded
 from .topology import _BUCKET_CHUNKS, _bucket_starts
 
-
-#: Indices known to be >= 0 cast to this type: numba indexes with them without the code for negative indices.
-_UNSIGNED = np.uint64
-_ONE = np.uint64(1)
 
 #: A ball grid has at most this many columns of cells per point (and at least 4096 in all).
 _GRID_COLUMNS_PER_POINT = 4
