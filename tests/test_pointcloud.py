@@ -103,7 +103,9 @@ def test_given_inward_normals_flip_the_signs():
 def test_inconsistent_given_normals_are_reoriented_to_their_majority_side(outward_share, sign):
     points, exact = sphere_points()
     flips = np.where(np.random.default_rng(5).random(points.shape[0]) < outward_share, 1.0, -1.0)
-    r = point_cloud_curvatures(points, normals=exact * flips[:, None])
+    turned = int((flips != sign).sum())  # the minority, turned to the majority's side
+    with pytest.warns(MeshQualityWarning, match=f"{turned} of the given normals were turned to agree"):
+        r = point_cloud_curvatures(points, normals=exact * flips[:, None])
     assert r.parameters["normals"] == "given, reoriented"
     assert (sign * np.einsum("ij,ij->i", r.normals, exact) > 0.99).all()
     assert abs(np.median(r.mean) - sign * 0.5) < 0.01
@@ -201,6 +203,27 @@ def test_bad_normals_and_options_are_refused():
         point_cloud_curvatures(points, radius=-1.0)
     with pytest.raises(InvalidOptionError, match="larger than the point cloud itself"):
         point_cloud_curvatures(points, radius=100.0)
+
+
+def test_a_mesh_given_to_the_cloud_call_is_pointed_to_principal_curvatures():
+    from meshcurv import shapes
+
+    mesh = shapes.icosphere(subdivisions=2)
+    # a second argument (a mesh's faces): refused, with the function to call
+    with pytest.raises(InvalidOptionError, match=r"not a mesh's `faces`.*principal_curvatures\(vertices, faces\)"):
+        point_cloud_curvatures(mesh.vertices, mesh.faces)
+    # the faces alone, as points: measured as coordinates (nothing valid), with the hint in the one warning
+    last = mesh.vertices.shape[0] - 1
+    with pytest.warns(MeshQualityWarning, match=rf"look like a mesh's faces .*0\.\.{last}, .*principal_curv") as caught:
+        point_cloud_curvatures(mesh.faces)
+    assert len(caught) == 1
+    # integer coordinates (voxel centres of a sphere's shell) repeat a value within a row: no hint
+    cells = np.indices((21, 21, 21)).reshape(3, -1).T
+    grid = cells[np.abs(np.linalg.norm(cells - 10, axis=1) - 8) < 0.5]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        point_cloud_curvatures(grid)
+    assert not any("look like a mesh's faces" in str(w.message) for w in caught)
 
 
 def test_too_small_radius_gives_nan_and_the_warning():

@@ -318,16 +318,14 @@ def plate_beside_spheres(seed):
     return points, normals, mean, kmax, spacing
 
 
-@pytest.mark.parametrize(
-    "seed",
-    [0, 2, 4, 5, 6, pytest.param(7, marks=pytest.mark.xfail(strict=True, reason="3 valid points off, 398 valid"))],
-)
+@pytest.mark.parametrize("seed", [0, 2, 4, 5, 6, 7])
 def test_a_plate_beside_spheres_leaves_no_valid_wrong_point(seed):
     # fuzz seed 42 case 214 (measures): a ball counted as steady when no estimate on its own side was below half of
     # the centre's |k|, and was not compared with jets; by the plate's rim the whole band is biased alike (k_max
     # twice the exact one), so a neighbour at 0.5-0.7 of the centre's |k| is that band, not a flatter part. With
     # UNIFORM_SHARE 0.5 these seeds kept 14, 23, 3, 9, 19 and 11 valid points off by more than half of |k|; at 0.7
-    # 0, 0, 0, 0, 0 and 3 (seed 7: the class is not closed)
+    # 0, 0, 0, 0, 0 and 3. Seed 7's three (the top face by the rim, H 1.15-1.22 against 0.64-0.66, balls turning
+    # the normal by 1 rad) go with `blended`: their balls' normals are not those of their estimate (377 valid)
     points, normals, mean, kmax, spacing = plate_beside_spheres(seed)
     r = quiet(points)
     resolved = kmax * spacing <= 0.25  # as the fuzzer checks: radius of curvature of 4 spacings or more
@@ -335,3 +333,64 @@ def test_a_plate_beside_spheres_leaves_no_valid_wrong_point(seed):
     wrong = r.valid & resolved & ~(np.abs(r.mean - side * mean) / kmax <= 0.5)
     assert r.valid.sum() > 300  # (398-454 of 840 valid; the spheres and the plate's faces)
     assert wrong.sum() == 0
+
+
+def sphere_frames(normals):
+    """Two unit tangent directions at each unit normal (any orthonormal pair: a sphere's shape operator is k I)."""
+    helper = np.where(np.abs(normals[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+    first = np.cross(normals, helper)
+    first /= np.linalg.norm(first, axis=1, keepdims=True)
+    return first, np.cross(normals, first)
+
+
+def test_blended_flags_estimates_whose_ball_normals_their_shape_operator_does_not_predict():
+    # on a sphere the tangent part of the normal at an offset d is exactly k times that of d: the exact curvatures
+    # predict every normal of the ball; twice them (a blend of a sharper region, as by a plate's rim) predict the
+    # tangent parts twice as large, off by half the turn at every point
+    from scipy.spatial import cKDTree
+
+    points, normals = sphere(2000, seed=3)
+    tree = cKDTree(points)
+    first, second = sphere_frames(normals)
+    every = np.ones(2000, dtype=bool)
+    exact = (np.ones(2000), np.ones(2000), first, second)
+    wide = np.full(2000, 1.0)  # balls turning the normal by 1 rad: checked
+    assert not estimators.blended(points, normals, exact, wide, every, tree).any()
+    twice = (np.full(2000, 2.0), np.full(2000, 2.0), first, second)
+    assert estimators.blended(points, normals, twice, wide, every, tree).all()
+    # balls turning by 2 x 0.3 rad are not checked (their estimates are compared with larger balls and neighbours)
+    assert not estimators.blended(points, normals, twice, np.full(2000, 0.3), every, tree).any()
+    # only the resolved points are checked
+    assert not estimators.blended(points, normals, twice, wide, ~every, tree).any()
+    # a cylinder's normals are predicted too (k = 0 along the axis, 1 / r across it): exact, none flagged
+    phi, z = np.random.default_rng(4).uniform(0, 2 * np.pi, 3000), np.random.default_rng(5).uniform(-3, 3, 3000)
+    radial = np.stack([np.cos(phi), np.sin(phi), 0 * z], axis=1)
+    cylinder = radial + np.stack([0 * z, 0 * z, z], axis=1)
+    axis = np.tile([0.0, 0.0, 1.0], (3000, 1))
+    found = (np.zeros(3000), np.ones(3000), axis, np.cross(radial, axis))
+    inside = np.abs(z) < 2  # (away from the open ends)
+    flagged = estimators.blended(cylinder, radial, found, np.full(3000, 1.0), inside, cKDTree(cylinder))
+    assert not flagged.any()
+
+
+def test_consistent_inward_given_normals_on_a_noisy_thin_plate_beside_a_sphere_stay_given():
+    # the fuzzer's seed 42 case 314: a unit sphere and a plate 1 x 0.5 x 0.04 (2000 points each, 2 spacings apart)
+    # under noise of 0.1 spacings, the exact normals all inward: the plate's two faces join by edges that are
+    # neither back to back nor face to face, so the normals were re-oriented; the plate's points are all undecided
+    # (NaN), and there the user's normals were turned (848 of them) and the call said "given, reoriented". Where
+    # the side is undecided the user's normal is now kept: nothing was turned, "given"
+    from scipy.spatial import cKDTree
+
+    ball, ball_normals = sphere(2000, seed=11)
+    plate, plate_normals, _, _ = ellipsoid(2000, (1.0, 0.5, 0.02), seed=12)
+    plate = plate + [0.0, 1.0 + 0.5 + 2 * np.sqrt(4 * np.pi / 2000), 0.0]
+    points, exact = np.concatenate([ball, plate]), np.concatenate([ball_normals, plate_normals])
+    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+    points = points + np.random.default_rng(13).uniform(-0.1, 0.1, (4000, 1)) * spacing * exact
+    for method in ("jets", "corrected_measures"):
+        r = quiet(points, normals=-exact, method=method)
+        assert r.parameters["normals"] == "given"
+        assert np.all(np.einsum("ij,ij->i", r.normals, -exact) > 0)
+        # the sphere: inward, H = -1 (no valid point off by more than half of it, as the fuzzer checks)
+        assert r.valid[:2000].mean() > 0.9
+        assert np.all(np.abs(r.mean[:2000][r.valid[:2000]] + 1.0) <= 0.5)

@@ -118,6 +118,18 @@ UNIFORM_SHARE = 0.7
 UNRESOLVED_TURN = 0.2
 UNRESOLVED_SHARE = 0.5
 
+#: A resolved estimate whose ball turns the normal by more than :data:`BLEND_TURN` radians (``radius |k|``) and
+#: whose own side's normals are not those of the estimate's shape operator (the :data:`BLEND_QUANTILE` quantile of
+#: the differences above :data:`BLEND_RESIDUAL` times the turn out to the farthest of them) is unsteady
+#: (:func:`blended`). Seeds 42 and 4242 of ``benchmarks/fuzz_api.py`` (cases 91, 124, 168 and
+#: 189, the band by the rim of plates 0.02-0.2 thick, spheres in balls turning by 2 rad): the points off by more
+#: than half of |k| turn by 1-4 rad and differ by 0.31-0.85; the valid points of ``benchmarks/pointcloud.py``
+#: (both tables) that pass 0.3 turn by 0.2-0.4 rad, and at most 1% of a held-out flat ellipsoid's turn by more
+#: than 0.8 (its rim, jets: errors of 12-16% of |k| there).
+BLEND_TURN = 0.8
+BLEND_QUANTILE = 0.9
+BLEND_RESIDUAL = 0.3
+
 
 def one_sided_fits(
     points,
@@ -379,20 +391,95 @@ def beside_unresolved(points, normals, k_min, k_max, radii, resolved, tree) -> n
     with np.errstate(invalid="ignore"):
         turn = radii * np.maximum(np.abs(k_min), np.abs(k_max))
     candidates = np.flatnonzero(resolved & (turn > UNRESOLVED_TURN))
-    k = min(MAX_BALL_POINTS, n)
-    for radius in np.unique(radii[candidates]):
-        group = candidates[radii[candidates] == radius]
+    for chunk, safe, _, member, cosine in _balls(points, normals, radii, candidates, tree, MAX_BALL_POINTS):
+        own = member & (cosine > 0)
+        unresolved = (own & ~resolved[safe]).sum(axis=1)
+        out[chunk] = unresolved > UNRESOLVED_SHARE * np.maximum(own.sum(axis=1), 1)
+    return out
+
+
+def _balls(points, normals, radii, centres, tree, k):
+    """Per chunk of ``centres`` (by radius), ``(chunk, safe, distance, member, cosine)``: (M, k) the indices of the
+    ``k`` nearest points within ``radii`` (N,) of each centre (the centre first; 0 where none), their distances,
+    which are points, and the cosines of their ``normals`` with the centre's (NaN-free where not members)."""
+    n = points.shape[0]
+    k = min(k, n)
+    for radius in np.unique(radii[centres]):
+        group = centres[radii[centres] == radius]
         for start in range(0, group.size, CHUNK):
             chunk = group[start : start + CHUNK]
-            _, index = tree.query(points[chunk], k=k, distance_upper_bound=radius)
+            distance, index = tree.query(points[chunk], k=k, distance_upper_bound=radius)
             index = np.asarray(index).reshape(chunk.size, -1)
             member = index < n
             safe = np.where(member, index, 0)
             with np.errstate(invalid="ignore"):
-                own = member & (np.einsum("mkj,mj->mk", normals[safe], normals[chunk]) > 0)
-            unresolved = (own & ~resolved[safe]).sum(axis=1)
-            out[chunk] = unresolved > UNRESOLVED_SHARE * np.maximum(own.sum(axis=1), 1)
+                cosine = np.einsum("mkj,mj->mk", normals[safe], normals[chunk])
+            yield chunk, safe, np.asarray(distance).reshape(chunk.size, -1), member, cosine
+
+
+def blended(points, normals, found, radii, resolved, tree, sheets=None) -> np.ndarray:
+    """(N,) bool: the ``resolved`` points whose estimate is a blend of a region where the curvature changes.
+
+    On a surface whose curvature the ball resolves, the normals of the ball's own side (within 90 degrees of the
+    centre's ``normals``, of its sheet when ``sheets`` (N,) is given; the :data:`MAX_BALL_POINTS` nearest within
+    ``radii`` (N,)) are those of the estimate's shape operator: the tangent part of the normal at an offset ``d``
+    is ``k_min (d . e_min) e_min + k_max (d . e_max) e_max`` (exactly so on a sphere and a cylinder; to second
+    order elsewhere). Where the ball turns the normal by more than :data:`BLEND_TURN` radians (``radius |k|``) and
+    the :data:`BLEND_QUANTILE` quantile of the differences exceeds :data:`BLEND_RESIDUAL` times the turn out to
+    the farthest of those points, the curvature changes across the ball by about itself: the estimate averages
+    the band by the rim of a thin plate (whose curvature grows a hundredfold within the ball; every estimate of
+    the band alike, so neither a larger ball nor the neighbours tell), or a ball larger than a small part. ``found``: ``(k_min, k_max, dir_min,
+    dir_max)``; ``tree``: a :class:`scipy.spatial.cKDTree` of ``points``.
+    """
+    with np.errstate(invalid="ignore"):
+        turn = radii * np.maximum(np.abs(found[0]), np.abs(found[1]))
+    candidates = np.flatnonzero(resolved & (turn > BLEND_TURN))
+    out = np.zeros(points.shape[0], dtype=bool)
+    if candidates.size:
+        residual, reached = blend_residuals(points, normals, found, radii, candidates, tree, sheets)
+        out[candidates] = residual[candidates] > BLEND_RESIDUAL * reached[candidates]  # (NaN: too few, not flagged)
     return out
+
+
+def blend_residuals(points, normals, found, radii, centres, tree, sheets=None) -> tuple[np.ndarray, np.ndarray]:
+    """``(residual, turn)``: (N,) the :data:`BLEND_QUANTILE` quantile over each ball's own side of how far its
+    normals are from those the estimate predicts, and the normal's turn over it (NaN outside ``centres`` and at
+    balls of fewer than :data:`MIN_BALL_POINTS` points); see :func:`blended`."""
+    n = points.shape[0]
+    out, turns = np.full(n, np.nan), np.full(n, np.nan)
+    k_min, k_max, dir_min, dir_max = found[:4]
+    for chunk, safe, distance, member, cosine in _balls(points, normals, radii, centres, tree, MAX_BALL_POINTS + 1):
+        own = member & (safe != chunk[:, None]) & (cosine > 0)
+        if sheets is not None:
+            theirs, mine = sheets[safe], sheets[chunk][:, None]
+            own &= (theirs == mine) | (theirs < 0) | (mine < 0)
+        offsets = points[safe] - points[chunk][:, None, :]
+        # the tangent part of each normal, and the one the estimate's shape operator predicts (exact on a sphere
+        # and a cylinder: the tangent parts of normal and offset are proportional there)
+        tilt = normals[safe] - cosine[..., None] * normals[chunk][:, None, :]
+        along_min = np.einsum("mkj,mj->mk", offsets, dir_min[chunk])
+        along_max = np.einsum("mkj,mj->mk", offsets, dir_max[chunk])
+        predicted = (k_min[chunk][:, None] * along_min)[..., None] * dir_min[chunk][:, None, :] + (
+            k_max[chunk][:, None] * along_max
+        )[..., None] * dir_max[chunk][:, None, :]
+        residual = np.where(own, np.linalg.norm(tilt - predicted, axis=2), np.nan)
+        reach = np.where(own, distance, 0.0).max(axis=1)
+        enough = own.sum(axis=1) >= MIN_BALL_POINTS
+        if enough.any():
+            out[chunk[enough]] = np.nanquantile(residual[enough], BLEND_QUANTILE, axis=1)
+            turns[chunk[enough]] = (reach * np.maximum(np.abs(k_min[chunk]), np.abs(k_max[chunk])))[enough]
+    return out, turns
+
+
+def blended_problem(flagged: np.ndarray) -> list[str]:
+    """The phrase of the call's warning for the ``flagged`` (N,) points of :func:`blended`; none when none."""
+    if not flagged.any():
+        return []
+    return [
+        f"at {int(flagged.sum())} points the ball turns the normal by more than {BLEND_TURN:g} rad and its normals "
+        f"differ from those of the estimate by more than {BLEND_RESIDUAL:g} of that turn (the curvature changes "
+        "across the ball by about itself: the band by the rim of a thin part, or a ball larger than a small part): NaN"
+    ]
 
 
 def small_balls(radius: float, spacing: np.ndarray, needed: float) -> tuple[np.ndarray, bool]:

@@ -233,13 +233,18 @@ _ON_A_LINE = _reason_code("point cloud: on a line")
 _UNSTEADY = _reason_code("point cloud: unsteady estimate")
 
 
-def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | None = None) -> CurvatureResult:
+def point_cloud_curvatures(
+    points, faces=None, /, *, normals=None, radius=None, method: str | None = None
+) -> CurvatureResult:
     """Principal curvatures, directions and normals at every point of a point cloud.
 
     Parameters
     ----------
     points : array_like of shape (N, 3)
         Samples of a surface (N >= 10), not all on one line.
+    faces : None
+        Not accepted: a point cloud has no faces. A second argument (a mesh's
+        ``faces``) raises, pointing to :func:`meshcurv.principal_curvatures`.
     normals : array_like of shape (N, 3), optional
         Normals at the points, of any length (not zero) and any signs. Used
         when given: made unit; if their signs are not consistent they are
@@ -283,14 +288,15 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         zero normals.
     InvalidOptionError
         Unknown ``method``, ``radius`` not a positive number or larger than
-        the cloud.
+        the cloud, ``faces`` given.
 
     Warns
     -----
     MeshQualityWarning
         Once per call, listing what was found and done: duplicate points
         (computed once, copied), outliers (NaN), very uneven density (one
-        radius per class of density), points without an estimate.
+        radius per class of density), points without an estimate; points
+        that look like a mesh's faces (integer rows of three distinct indices).
 
     Examples
     --------
@@ -304,15 +310,23 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
     0.500 estimated
     """
     logger.info("point cloud: checks, duplicates and near copies")
+    if faces is not None:
+        raise InvalidOptionError(
+            "point_cloud_curvatures takes the points only, not a mesh's `faces` (a second argument was given): "
+            "for a mesh call meshcurv.principal_curvatures(vertices, faces); for its vertices as a cloud, "
+            "point_cloud_curvatures(vertices)"
+        )
     method = POINT_CLOUD_METHODS[0] if method is None else check_choice(method, "method", POINT_CLOUD_METHODS)
-    points = as_vertices(point_array(points), name="points")
+    points = point_array(points)
+    hint = _looks_like_faces(points)
+    points = as_vertices(points, name="points")
     given = None if normals is None else _checked_normals(normals, points.shape)
     if radius is not None:
         radius = check_positive_float(radius, "radius")
     n_all = points.shape[0]
     if n_all < MIN_POINTS:
         raise InvalidMeshError(f"`points` holds {n_all} points; at least {MIN_POINTS} are needed")
-    problems: list[str] = []
+    problems: list[str] = [hint] if hint else []
 
     # duplicates: computed once on the first of each group of coincident points, copied to the others;
     # the distinct points in Morton order (neighbours near in memory: the searches and fits run from cache)
@@ -382,6 +396,26 @@ def point_cloud_curvatures(points, *, normals=None, radius=None, method: str | N
         method=method,
         parameters=parameters,
         invalid_reason=reason,
+    )
+
+
+def _looks_like_faces(points) -> str:
+    """The warning's phrase when ``points`` look like a mesh's faces: an integer array of rows of three distinct
+    indices that use every index from 0 to the largest one, fewer than the rows (a closed mesh has about twice
+    as many faces as vertices); "" otherwise. Integer coordinates of a scan or of voxels repeat a value within a
+    row at many points."""
+    array = np.asarray(points) if isinstance(points, (np.ndarray, list, tuple)) else None
+    if array is None or not np.issubdtype(array.dtype, np.integer) or array.ndim != 2 or array.shape[1] != 3:
+        return ""
+    rows = array.shape[0]
+    if rows < MIN_POINTS or array.min() < 0 or array.max() >= rows:
+        return ""
+    a, b, c = array[:, 0], array[:, 1], array[:, 2]
+    if ((a == b) | (b == c) | (a == c)).any() or np.unique(array).size != int(array.max()) + 1:
+        return ""
+    return (
+        f"`points` look like a mesh's faces (integer rows of three distinct indices 0..{int(array.max())}, each "
+        "used): they are measured as coordinates; for a mesh call meshcurv.principal_curvatures(vertices, faces)"
     )
 
 
@@ -739,6 +773,7 @@ def _compute(points, given, radius, method, search=None):
     two_sided_mask = np.zeros(n, dtype=bool)
     unsteady = np.zeros(n, dtype=bool)  # estimates a larger ball does not reproduce
     balls = np.full(n, np.nan)  # the radius of each point's estimate
+    fitted = np.full(n, np.nan)  # ... shrunk as the jets' fits were
     noisy = 0  # points whose fits the noise dominates (see NOISY_PCA)
     mixed = None
     compiled = numba_kernels("pointcloud") is not None
@@ -831,6 +866,8 @@ def _compute(points, given, radius, method, search=None):
             two_sided_mask[members] = np.isnan(fitted_radii)
         unsteady[members] = details["unsteady"][part_members]
         balls[members] = group_radius
+        # the ball each estimate was taken over: the jets' own fits shrink where the ball held the other side
+        fitted[members] = fitted_radii if method == "jets" else group_radius
         for whole, part in zip((k_min, k_max, dir_min, dir_max, out_normals), found):
             whole[members] = part[part_members]
         if radius is not None:  # a given radius that the sampling, or the noise, cannot support
@@ -891,6 +928,13 @@ def _compute(points, given, radius, method, search=None):
     problems.extend(_estimators.unsteady_problem(beside, beside=True))
     reason[beside] = _UNSTEADY
     valid &= ~beside
+    # an estimate whose ball's normals its shape operator does not predict: the curvature changes across the ball
+    blend = _estimators.blended(
+        points, out_normals, (k_min, k_max, dir_min, dir_max), fitted, valid & ~doubtful, tree, sheets
+    )
+    problems.extend(_estimators.blended_problem(blend))
+    reason[blend] = _UNSTEADY
+    valid &= ~blend
     if doubtful.any():
         found = []
         between = doubtful & ~unsettled & ~alike
@@ -913,6 +957,19 @@ def _compute(points, given, radius, method, search=None):
         problems.append(" and ".join(found) + ": their normals' side is undecided, NaN")
         valid &= ~doubtful
         reason[doubtful] = _UNDECIDED
+    if how == "given, reoriented":
+        # where the side is undecided (NaN) the user's normal is kept: a consistent orientation that a thin noisy
+        # part made look inconsistent stays "given" (seed 42 case 314 of benchmarks/fuzz_api.py: 848 normals of a
+        # plate 0.04 thick under noise were turned, every one of them undecided)
+        out_normals[doubtful] = given[doubtful]
+        turned = int(((signs < 0) & ~doubtful).sum())
+        if turned:
+            problems.append(
+                f"{turned} of the given normals were turned to agree with their neighbours (their signs were not "
+                "consistent): parameters['normals'] is 'given, reoriented'"
+            )
+        else:
+            parameters["normals"] = "given"
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, *_ in groups)
     return k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, problems
