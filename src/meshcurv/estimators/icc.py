@@ -237,13 +237,12 @@ def fitted_normals(
     return np.where(usable[:, None], fitted, normals)
 
 
-def _coarse_level(
-    vertices, normals, radius, areas, neighbours, adjacency, *, edges=COARSE_EDGES, cells=COARSE_CELLS, shift=0.0
-):
+def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, edges=None, cells=None, shift=0.0):
     """The points of the normal fits of a dense surface: clusters of vertices, or None for an ordinary mesh.
 
-    Used when the median ``radius`` exceeds ``edges`` median edge lengths. The vertices that may enter the balls are
-    grouped by cube of side ``median radius / cells`` (the cubes shifted by ``shift`` of a side) and by the axis and
+    Used when the median ``radius`` exceeds ``edges`` (default :data:`COARSE_EDGES`) median edge lengths. The
+    vertices that may enter the balls are grouped by cube of side ``median radius / cells`` (default
+    :data:`COARSE_CELLS`; the cubes shifted by ``shift`` of a side) and by the axis and
     sign of their normal's largest component (the two
     sides of a part thinner than a cube stay apart); each group is one point at its area-weighted centroid,
     weighing the group's area, linked to the groups that a mesh edge joins it to. Returns ``(points,
@@ -261,7 +260,7 @@ def _coarse_level(
     if not _dense(vertices, typical, adjacency, edges=edges):
         return None
     tails = np.repeat(np.arange(n), np.diff(indptr))
-    cell = typical / cells
+    cell = typical / (COARSE_CELLS if cells is None else cells)
     members = np.flatnonzero(inside)
     corner = vertices[members].min(axis=0)
     # cells beyond 2^52 (a vertex flung far away) share the last one: a cast of such a float is undefined
@@ -315,10 +314,11 @@ def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
     return np.column_stack([key // n, key % n])
 
 
-def _dense(vertices: np.ndarray, radius: float, adjacency: tuple, *, edges: float = COARSE_EDGES) -> bool:
-    """Whether normal fits over ``radius`` run on the coarse level: wider than ``edges`` median
-    edge lengths (taken over :data:`COARSE_SAMPLE` edges of the CSR lists ``adjacency``)."""
-    return bool(radius > edges * _sampled_edge(vertices, adjacency))
+def _dense(vertices: np.ndarray, radius: float, adjacency: tuple, *, edges: float | None = None) -> bool:
+    """Whether normal fits over ``radius`` run on the coarse level: wider than ``edges`` (default
+    :data:`COARSE_EDGES`) median edge lengths (taken over :data:`COARSE_SAMPLE` edges of the CSR lists
+    ``adjacency``)."""
+    return bool(radius > (COARSE_EDGES if edges is None else edges) * _sampled_edge(vertices, adjacency))
 
 
 def _sampled_edge(vertices: np.ndarray, adjacency: tuple) -> float:
