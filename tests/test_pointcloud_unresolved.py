@@ -394,3 +394,29 @@ def test_consistent_inward_given_normals_on_a_noisy_thin_plate_beside_a_sphere_s
         # the sphere: inward, H = -1 (no valid point off by more than half of it, as the fuzzer checks)
         assert r.valid[:2000].mean() > 0.9
         assert np.all(np.abs(r.mean[:2000][r.valid[:2000]] + 1.0) <= 0.5)
+
+
+def test_a_plate_thinner_than_its_noise_has_no_valid_point_on_the_wrong_side():
+    # the fuzzer's seed 4242 case 200: a plate 1 x 1 x 0.04 (400 points) beside a sphere of radius 0.5 (ten of its
+    # spacings away), under noise of 0.2 spacings (0.055, more than the half thickness): the faces mix, no
+    # neighbourhood tells them apart, and 20 of the plate's 45 valid points faced inward. A point amid undecided
+    # sides is undecided too
+    from scipy.spatial import cKDTree
+
+    ball, ball_normals = sphere(400, radius=0.5, seed=21)
+    plate, plate_normals, _, _ = ellipsoid(400, (1.0, 1.0, 0.02), seed=22)
+    plate = plate + [0.0, 3.0, 0.0]
+    points, exact = np.concatenate([ball, plate]), np.concatenate([ball_normals, plate_normals])
+    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+    points = points + np.random.default_rng(23).uniform(-0.2, 0.2, (800, 1)) * spacing * exact
+    for seed_method in ("corrected_measures", "jets"):
+        r = quiet(points, method=seed_method)
+        outward = np.einsum("ij,ij->i", r.normals, exact) > 0
+        assert not (r.valid & ~outward).any()
+        assert r.valid[:400].mean() > 0.8  # (the sphere: H = 2)
+        assert (r.invalid_reason[400:][~r.valid[400:]] == UNDECIDED_SIDE).mean() > 0.5
+
+
+UNDECIDED_SIDE = next(
+    code for code, text in enumerate(INVALID_REASONS) if text.startswith("point cloud: side undecided")
+)
