@@ -503,24 +503,8 @@ def connected_face_sums(
     to compile (issue 31's first use); each chunk writes the rows of its own vertices, as before.
     """
     n_chunks = scratch[0].shape[0]
-    run_chunks(
-        _face_sums_chunk,
-        n_chunks,
-        n_chunks,
-        vertices,
-        faces,
-        centroids,
-        reach,
-        usable,
-        values,
-        radii,
-        indptr,
-        indices,
-        out,
-        scratch,
-        start,
-        stop,
-    )
+    ball = (vertices, faces, centroids, reach, usable, values, radii, indptr, indices)
+    run_chunks(_face_sums_chunk, n_chunks, n_chunks, *ball, out, scratch, start, stop)
 
 
 @nb.njit(**_JIT)
