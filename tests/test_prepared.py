@@ -109,12 +109,7 @@ def _entered(code, call) -> int:
     return len(entries)
 
 
-ICC_PENDING = pytest.mark.xfail(
-    strict=True, reason="until estimators/icc.py calls the radius cores with the prepared mesh (issue 33)"
-)
-
-
-@pytest.mark.parametrize("method", [pytest.param("icc", marks=ICC_PENDING), "normal_cycle", "matgeom", "quadric"])
+@pytest.mark.parametrize("method", ["icc", "normal_cycle", "matgeom", "quadric"])
 def test_the_length_scales_and_needle_vertices_are_found_once_per_call(method):
     # the orientation, the defects, the radius rules and the diagnosis all read them (10 and 7 passes before)
     sphere = shapes.icosphere(6)

@@ -98,10 +98,10 @@ from .._measures import curvatures_from_measures, face_measures, principal_from_
 from ..neighborhoods import _squared, ball_face_sums, ball_face_sums_nested, coarse_face_sums
 from ..radius import (
     VOXEL_SCALE_RULE,
-    check_radius,
-    local_scale_ratios,
-    noise_radii,
-    scale_centres,
+    _check_radius,
+    _local_scale_ratios,
+    _noise_radii,
+    _scale_centres,
     scale_ladder,
     stable_scales,
     vertex_radii,
@@ -346,7 +346,7 @@ def voxel_pilot(mesh: PreparedMesh):
     def run(radius: float):
         vertices, topology = mesh.vertices, mesh.topology
         _, valid = mesh.start(boundary=True)
-        valid = scale_centres(vertices, topology, valid, mesh.vertex_normals)  # a needle's corners: as without it
+        valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
         centres = _pilot_centres(vertices, topology, valid)
         fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres)
@@ -597,10 +597,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
     stages.start("measure noise")
     referenced = topology.referenced_vertices
     if radius is None:  # each group of components of one scale (usually the whole mesh) at its own default
-        groups, levels = noise_radii(vertices, topology, normals, valid, adjacency=_adjacency(topology))
+        groups, levels = _noise_radii(mesh, normals, valid, adjacency=_adjacency(topology))
         found = {"surface": "smooth", "noise": levels[0] if len(levels) == 1 else levels}
     else:
-        groups, found = [(check_radius(radius, vertices, topology), None)], {}
+        groups, found = [(_check_radius(radius, mesh), None)], {}
     # one radius; a list of them (one per group of components of one scale) when the scales differ
     radii = [group_radius for group_radius, _ in groups]
     parameters = {
@@ -637,7 +637,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         }
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor
-        ratios = local_scale_ratios(vertices, topology)
+        ratios = _local_scale_ratios(mesh)
         radii_v = vertex_radii(groups, vertices.shape[0]) * ratios
         if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not np.all(ratios == 1.0):
             k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
@@ -721,9 +721,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     # the radii increase: the conditions of check_radius (neither below a sliver of an edge nor above the
     # mesh's extent) hold for all of them when they hold for the first and the last
     last = len(radii) - 1
-    radii = [
-        check_radius(radius, vertices, topology) if j in (0, last) else float(radius) for j, radius in enumerate(radii)
-    ]
+    radii = [_check_radius(radius, mesh) if j in (0, last) else float(radius) for j, radius in enumerate(radii)]
     stages.start("fit normals")
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
     # the fits of the radii not fitted on the coarse level, from one walk per vertex (the radii increase, and
