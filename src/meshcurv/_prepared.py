@@ -23,7 +23,7 @@ import numpy as np
 from ._adapters import mesh_arrays
 from ._locality import local_topology
 from ._validation import as_faces, as_vertices, check_choice
-from .defects import BOUNDARY, VertexDefects, defect_codes, needle_vertices
+from .defects import BOUNDARY, VertexDefects, _needle_vertices, defect_codes
 from .errors import InvalidOptionError
 from ._geometry import (
     DEGENERATE_AREA_RATIO,
@@ -196,7 +196,7 @@ def _read_only(array: np.ndarray) -> np.ndarray:
 def _scales_and_needles(vertices: np.ndarray, topology: MeshTopology) -> tuple[np.ndarray, np.ndarray]:
     """(V,) the length scales and (V,) the needle vertices (read-only) of a checked mesh."""
     scales = vertex_length_scales(vertices, topology)
-    return scales, _read_only(needle_vertices(vertices, topology, scales))
+    return scales, _read_only(_needle_vertices(vertices, topology, scales))
 
 
 def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: int = 3) -> PreparedMesh:

@@ -33,6 +33,7 @@ __all__ = [
     "checked_mesh",
     "checked_points",
     "checked_indices",
+    "checked_mask",
     "MAX_VERTICES",
 ]
 
@@ -409,6 +410,19 @@ def checked_points(vertices, *, name: str = "vertices") -> np.ndarray:
     if not largest <= MAX_COORDINATE or 0.0 < largest < MIN_COORDINATE:
         return as_vertices(vertices, name=name)  # raises, naming the vertices and the problem
     return np.ascontiguousarray(vertices)
+
+
+def checked_mask(mask, length: int, *, name: str) -> np.ndarray:
+    """``mask`` as a bool array of shape ``(length,)``; InvalidMeshError naming it otherwise."""
+    try:
+        array = np.asarray(mask)
+    except (ValueError, TypeError):  # ragged lists
+        array = np.empty(0, dtype=object)
+    if array.dtype != bool or array.shape != (length,):
+        raise InvalidMeshError(
+            f"`{name}` must be a bool array of shape ({length},); got {array.dtype} {_shape_text(array)}"
+        )
+    return array
 
 
 def checked_indices(indices, n_vertices: int, *, columns: int = 3, name: str = "faces") -> np.ndarray:

@@ -15,7 +15,7 @@ from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._support import ProgressCallback, Stages
 from .estimators.icc import voxel_pilot
-from .radius import _voxel_surface_radius, small_radius_note
+from .radius import _small_radius_note, _voxel_surface_radius
 from .result import CurvatureResult
 from .smoothing import check_smoothing_steps
 
@@ -339,7 +339,7 @@ def _finished(mesh, estimator, result: CurvatureResult, problems: list, found: d
     """``(result, message)``: the result on the caller's vertices, and the text of the call's one warning."""
     points, topology = mesh.vertices, mesh.topology
     if given_radius and estimator.radius_warning_edges is not None:  # given, not a default
-        note = small_radius_note(result.parameters["radius"], points, topology, estimator.radius_warning_edges)
+        note = _small_radius_note(result.parameters["radius"], points, topology, estimator.radius_warning_edges)
         problems = [*problems, note] if note else problems
     diagnosis = mesh_diagnosis(
         points, topology, mesh.n_flipped, mesh.length_scales, n_needle_vertices=int(mesh.needles.sum())

@@ -22,6 +22,9 @@ import numpy as np
 
 from ._backend import numba_kernels
 from ._geometry import degenerate_face_mask
+from ._validation import checked_mask
+from .errors import InvalidMeshError
+from .geometry import _floats, checked_topology_points
 from .topology import MeshTopology
 
 __all__ = [
@@ -186,7 +189,19 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
         The vertices of such clusters that have a face of non-zero area with
         one corner in the cluster (the angles are summed over those faces).
         A prepared mesh holds them (:attr:`meshcurv._prepared.PreparedMesh.needles`).
+
+    Raises
+    ------
+    InvalidMeshError
+        ``topology`` not a MeshTopology, ``vertices`` unusable or not one row
+        per vertex of ``topology``, ``scales`` not a real (V,) array.
     """
+    vertices = checked_topology_points(vertices, topology)
+    return _needle_vertices(vertices, topology, _floats(scales, "scales", (topology.n_vertices,)))
+
+
+def _needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray:
+    """:func:`needle_vertices` of a checked mesh: (V, 3) float64 ``vertices`` and (V,) float64 ``scales``."""
     n = topology.n_vertices
     edges = topology.edges
     first, second = edges[:, 0], edges[:, 1]
@@ -261,6 +276,17 @@ def needle_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.nda
     return candidates & flung[cluster]
 
 
+def _checked_topology(topology) -> MeshTopology:
+    if not isinstance(topology, MeshTopology):
+        raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}")
+    return topology
+
+
+def _checked_needles(topology, needles) -> np.ndarray:
+    """``needles`` checked: a (V,) bool array for ``topology`` (:func:`needle_vertices`)."""
+    return checked_mask(needles, _checked_topology(topology).n_vertices, name="needles")
+
+
 def scale_vertices(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     """(V,) bool: the vertices that measure the mesh's scale: the referenced ones but the needle vertices.
 
@@ -284,6 +310,7 @@ def scale_vertices(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     -------
     ndarray of shape (V,), bool
     """
+    needles = _checked_needles(topology, needles)
     return topology.referenced_vertices & ~needles
 
 
@@ -305,6 +332,7 @@ def scale_edges(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     ndarray of shape (E', 2), int
         ``topology.edges`` itself when the mesh has no needle vertex.
     """
+    needles = _checked_needles(topology, needles)
     if not needles.any():
         return topology.edges
     return topology.edges[~needles[topology.edges].any(axis=1)]
@@ -326,6 +354,7 @@ def needle_corners(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     -------
     ndarray of shape (V,), bool
     """
+    needles = _checked_needles(topology, needles)
     corners = np.zeros(topology.n_vertices, dtype=bool)
     if needles.any():
         corners[topology.faces[needles[topology.faces].any(axis=1)].ravel()] = True
@@ -357,6 +386,8 @@ def defect_codes(
         (``needle_vertices``: the needle vertices themselves).
         A bow-tie vertex on a non-manifold edge is counted with that edge only.
     """
+    degenerate = checked_mask(degenerate, _checked_topology(topology).n_faces, name="degenerate")
+    needles = None if needles is None else _checked_needles(topology, needles)
     needle_corners = None
     if needles is not None and needles.any():  # the corners of a needle's faces: each has a sliver in its ring
         needle_corners = np.zeros(topology.n_vertices, dtype=bool)

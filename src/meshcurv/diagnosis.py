@@ -21,7 +21,7 @@ from ._geometry import (
     vertex_length_scales,
 )
 from ._validation import as_vertices, check_int_option
-from .defects import DEFECTS, NEEDLE, needle_vertices
+from .defects import DEFECTS, NEEDLE, _needle_vertices
 from .errors import InvalidMeshError
 from .geometry import checked_topology_points, degenerate_faces
 from .topology import MeshTopology, as_topology
@@ -259,7 +259,7 @@ def mesh_diagnosis(
     genus = (2 - chi) // 2 if closed and n_components == 1 and n_nonmanifold == 0 else None
     volume = float(six_volume) / 6.0 if closed and faces.shape[0] else None
     if n_needle_vertices is None:
-        n_needle_vertices = int(needle_vertices(vertices, topology, scales).sum())
+        n_needle_vertices = int(_needle_vertices(vertices, topology, scales).sum())
     bowties = bowtie_vertices(topology)
     if n_nonmanifold:
         bowties = bowties & ~topology.edge_vertices(nonmanifold)

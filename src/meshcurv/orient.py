@@ -24,7 +24,7 @@ import numpy as np
 from ._backend import twin
 from ._validation import as_vertices
 from .errors import InvalidOptionError
-from .defects import needle_vertices
+from .defects import _needle_vertices
 from ._geometry import vertex_length_scales
 from .topology import MeshTopology, as_topology
 
@@ -173,7 +173,7 @@ def _outward(vertices, topology, patch, flip, invert, n_labels, needles) -> np.n
 
     # a needle's slivers bound no solid (issue 29: a uv sphere's vertex flung 30 sizes inward turned it inside out)
     if needles is None:
-        needles = needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
+        needles = _needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
     kept = ~needles[faces].any(axis=1) if needles.any() else slice(None)
     signed, magnitude = _patch_volumes(vertices, faces[kept], patch[kept], flip[kept], n_labels)
     decided = ~open_patch & (np.abs(signed) > 1e-9 * magnitude)

@@ -69,9 +69,9 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ._validation import check_positive_float, checked_points
+from ._validation import check_positive_float, checked_indices, checked_mask, checked_points
 from .errors import InvalidOptionError
-from .defects import needle_corners, needle_vertices, scale_edges, scale_vertices
+from .defects import _needle_vertices, needle_corners, scale_edges, scale_vertices
 from ._geometry import (
     COMPONENT_SCALE_SPREAD,
     median_edge_length,
@@ -79,6 +79,7 @@ from ._geometry import (
     vertex_edge_lengths,
     vertex_length_scales,
 )
+from .geometry import _floats, checked_topology_points
 from .jets import SETTLED_SLOPE, fit_jets
 from .lattice import voxel_grid
 from .topology import MeshTopology
@@ -130,10 +131,10 @@ class _Measured(NamedTuple):
 
 
 def _measured(vertices, topology: MeshTopology) -> _Measured:
-    """``vertices`` checked, with their length scales and needle vertices: :class:`_Measured`."""
-    vertices = checked_points(vertices)
+    """``vertices`` checked, one row per vertex of ``topology``, with their length scales and needle vertices."""
+    vertices = checked_topology_points(vertices, topology)
     scales = vertex_length_scales(vertices, topology)
-    return _Measured(vertices, topology, scales, needle_vertices(vertices, topology, scales))
+    return _Measured(vertices, topology, scales, _needle_vertices(vertices, topology, scales))
 
 
 def edge_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
@@ -237,6 +238,10 @@ def small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopolog
     Each ball method states its own minimum (``RADIUS_WARNING_EDGES`` of its
     module), measured where its balls start holding too little of the surface.
     """
+    return _small_radius_note(radius, checked_topology_points(vertices, topology), topology, minimum_edges)
+
+
+def _small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopology, minimum_edges: float) -> str:
     if not topology.n_faces:
         return ""
     median = median_edge_length(vertices, topology.edges)
@@ -310,6 +315,18 @@ def noise_level(
     noisy spheres and tori; none above 0.02 h of noise), and a clean mesh needs
     half the fits. 0 when no jet could be fitted.
     """
+    vertices = checked_points(vertices)
+    n = vertices.shape[0]
+    edges = checked_indices(edges, n, columns=2, name="edges")
+    valid, normals = checked_mask(valid, n, name="valid"), _floats(normals, "normals", (n, 3))
+    if neighbours is not None:
+        neighbours = checked_mask(neighbours, n, name="neighbours")
+    return _noise_level(vertices, normals, valid, edges, neighbours=neighbours, adjacency=adjacency)
+
+
+def _noise_level(vertices, normals, valid, edges, *, neighbours=None, adjacency=None) -> float:
+    """:func:`noise_level` of checked arrays: (V, 3) float64 ``vertices`` and ``normals``, (V,) bool ``valid``
+    (and ``neighbours``), (E, 2) int64 ``edges`` in range."""
     local = vertex_edge_lengths(vertices, edges, vertices.shape[0])
     centres = np.flatnonzero(valid & (local > 0))
     if centres.size > NOISE_SAMPLE:
@@ -373,7 +390,8 @@ def scale_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarra
     ndarray of shape (V,) of bool
         ``valid`` itself when the mesh has no needle vertex.
     """
-    return _scale_centres(_measured(vertices, topology), valid, normals)
+    mesh = _measured(vertices, topology)
+    return _scale_centres(mesh, *_checked_fields(mesh, valid, normals))
 
 
 def _scale_centres(mesh: _Measured | PreparedMesh, valid: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -413,7 +431,15 @@ def noise_radii(
     levels : list of float
         The noise level of each group.
     """
-    return _noise_radii(_measured(vertices, topology), normals, valid, adjacency=adjacency)
+    mesh = _measured(vertices, topology)
+    valid, normals = _checked_fields(mesh, valid, normals)
+    return _noise_radii(mesh, normals, valid, adjacency=adjacency)
+
+
+def _checked_fields(mesh: _Measured, valid, normals) -> tuple[np.ndarray, np.ndarray]:
+    """``valid`` a (V,) bool array and ``normals`` a real (V, 3) one (NaN allowed: where there is none)."""
+    n = mesh.topology.n_vertices
+    return checked_mask(valid, n, name="valid"), _floats(normals, "normals", (n, 3))
 
 
 def _noise_radii(
@@ -434,7 +460,7 @@ def _noise_radii(
             inside, edges = centres & part, all_edges[part[all_edges[:, 0]]]
         edge_length = robust_mean_edge_length(vertices, edges)
         level = (
-            noise_level(vertices, normals, inside, edges, neighbours=usable, adjacency=adjacency)
+            _noise_level(vertices, normals, inside, edges, neighbours=usable, adjacency=adjacency)
             if edge_length > 0
             else 0.0
         )
