@@ -473,7 +473,7 @@ def _walk_face(
     return tail
 
 
-@threaded
+@nb.njit(parallel=True, **_JIT)
 def connected_face_sums(
     vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
 ):
@@ -497,22 +497,7 @@ def connected_face_sums(
     rows of ``out`` are not touched: a caller that splits the vertices into
     ranges sums them into one array. ``scratch``: ``neighborhoods._face_sum_scratch``, one
     chunk of the vertices per row of its arrays (reused from call to call).
-
-    The chunks run on threads (:func:`_face_sums_chunk`,
-    :func:`~meshcurv._kernels._common.run_chunks`) rather than in a ``prange``: no numba parallel pipeline
-    to compile (issue 31's first use); each chunk writes the rows of its own vertices, as before.
     """
-    n_chunks = scratch[0].shape[0]
-    ball = (vertices, faces, centroids, reach, usable, values, radii, indptr, indices)
-    run_chunks(_face_sums_chunk, n_chunks, n_chunks, *ball, out, scratch, start, stop)
-
-
-@nb.njit(**_JIT)
-def _face_sums_chunk(
-    lo, hi, vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
-):
-    """The chunks ``lo`` to ``hi - 1`` of :func:`connected_face_sums`: chunk ``c`` sums its range of the centres
-    with row ``c`` of each scratch array."""
     n = vertices.shape[0]
     n_values = values.shape[1]
     per_vertex = radii.shape[0] > 1
@@ -520,7 +505,7 @@ def _face_sums_chunk(
     m = max(min(stop, n), start) - start
     all_seen, all_mark, all_known, all_squared, all_queue, _, _ = scratch
     n_chunks = all_seen.shape[0]
-    for chunk in range(lo, hi):
+    for chunk in nb.prange(n_chunks):
         seen = all_seen[chunk]
         mark = all_mark[chunk]  # queued for this centre
         known = all_known[chunk]  # distance to this centre in `squared`
