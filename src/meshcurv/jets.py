@@ -401,7 +401,46 @@ def fit_jets(
         gives a centre listed twice two radii; ``larger`` is given without
         ``details``, or is not a number larger than ``radius``.
     """
-    vertices = checked_points(vertices)
+    return _fit_jets(
+        checked_points(vertices),
+        normals,
+        radius,
+        degree=degree,
+        iterations=iterations,
+        centres=centres,
+        chunk_size=chunk_size,
+        neighbours=neighbours,
+        facing=facing,
+        details=details,
+        adjacency=adjacency,
+        settled=settled,
+        compact=compact,
+        areas=areas,
+        min_spread=min_spread,
+        larger=larger,
+    )
+
+
+def _fit_jets(
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    radius,
+    *,
+    degree: int = DEGREE,
+    iterations: int = ITERATIONS,
+    centres: np.ndarray | None = None,
+    chunk_size: int = CHUNK_SIZE,
+    neighbours: np.ndarray | None = None,
+    facing: np.ndarray | None = None,
+    details: dict | None = None,
+    adjacency: tuple | None = None,
+    settled: float = 0.0,
+    compact: bool = False,
+    areas: np.ndarray | None = None,
+    min_spread: float = MIN_SPREAD,
+    larger: float | None = None,
+):
+    """:func:`fit_jets` on ``vertices`` already checked (:func:`checked_points`: C-contiguous float64 (V, 3), finite)."""
     n = vertices.shape[0]
     normals = np.ascontiguousarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
@@ -432,7 +471,7 @@ def fit_jets(
         wide = _checked_larger(larger, radius, details)
         paired = kernels is not None and n > 0 and adjacency is None and not per_centre
         if not paired:
-            details["larger"] = fit_jets(  # type: ignore[index]  # (details checked)
+            details["larger"] = _fit_jets(  # type: ignore[index]  # (details checked)
                 vertices,
                 normals,
                 wide,
@@ -716,11 +755,38 @@ def fit_jet_normals(
     ``areas``: the points weighted by their areas (:func:`fit_jets`); ``min_spread``: as :func:`fit_jets`
     (:data:`NORMAL_MIN_SPREAD` for normals that feed other estimates).
     """
+    return _fit_jet_normals(
+        checked_points(vertices),
+        normals,
+        radius,
+        degree=degree,
+        iterations=iterations,
+        neighbours=neighbours,
+        adjacency=adjacency,
+        settled=settled,
+        areas=areas,
+        min_spread=min_spread,
+    )
+
+
+def _fit_jet_normals(
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    radius,
+    *,
+    degree: int = DEGREE,
+    iterations: int = ITERATIONS,
+    neighbours: np.ndarray | None = None,
+    adjacency: tuple | None = None,
+    settled: float = 0.0,
+    areas: np.ndarray | None = None,
+    min_spread: float = MIN_SPREAD,
+) -> np.ndarray:
+    """:func:`fit_jet_normals` on ``vertices`` already checked (as :func:`_fit_jets`)."""
     kernels = numba_kernels("jets")
-    vertices = checked_points(vertices)
     n = vertices.shape[0]
     if kernels is None or adjacency is None or n == 0:
-        coefficients, frame, _ = fit_jets(
+        coefficients, frame, _ = _fit_jets(
             vertices,
             normals,
             radius,
@@ -982,9 +1048,24 @@ def sampled_jet_normals(
     InvalidOptionError
         ``spacing`` is not positive and finite, or ``width`` is below 1.
     """
+    return _sampled_jet_normals(
+        checked_points(points), normals, radius, centres=centres, spacing=spacing, width=width, **options
+    )
+
+
+def _sampled_jet_normals(
+    points: np.ndarray,
+    normals: np.ndarray,
+    radius,
+    *,
+    centres: np.ndarray,
+    spacing: float | None = None,
+    width: float = SAMPLED_WIDTH,
+    **options,
+) -> np.ndarray:
+    """:func:`sampled_jet_normals` on ``points`` already checked (as :func:`_fit_jets`)."""
     from scipy.spatial import cKDTree
 
-    points = checked_points(points)
     centres = np.asarray(centres, dtype=np.int64).ravel()
     radii = np.broadcast_to(np.asarray(radius, dtype=np.float64), centres.shape)
     if spacing is None:
@@ -999,7 +1080,7 @@ def sampled_jet_normals(
         return out
     at = points[centres]
     sampled = _cube_samples(at, spacing)
-    coefficients, frame, _ = fit_jets(
+    coefficients, frame, _ = _fit_jets(
         points, normals, radii[sampled], centres=centres[sampled], compact=True, **options
     )
     fitted = jet_normals(coefficients, frame)

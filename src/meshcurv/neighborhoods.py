@@ -332,11 +332,10 @@ def _ball_sums(
 ) -> np.ndarray:
     """(V, k) ``sum_c weight(c, B(x_v, r)) * values[c]`` over cells (faces or edges) given by corner indices.
 
+    ``vertices`` and ``cells`` checked (:func:`_checked_cells`), ``radius`` too (:func:`_trusted_radius`).
     ``connected`` (faces only): with the compiled kernels, the faces of the
     surface-connected piece of each ball (see :func:`ball_face_sums`).
     """
-    vertices, cells = _checked_cells(vertices, cells)
-    radius = centre_radii(radius, vertices.shape[0])
     values, usable = _checked_values(cells, values, usable)
     kernels = numba_kernels("neighborhoods")
     if connected and cells.shape[1] == 3 and cells.shape[0]:
@@ -816,8 +815,15 @@ def coarse_face_sums(
     :func:`_connected_face_sums_numpy`).
     """
     vertices, faces = _checked_cells(vertices, faces)
+    return _coarse_face_sums(vertices, faces, centre_radii(radius, vertices.shape[0]), values, usable=usable)
+
+
+def _coarse_face_sums(
+    vertices: np.ndarray, faces: np.ndarray, radius, values: np.ndarray, *, usable: np.ndarray | None = None
+) -> np.ndarray:
+    """:func:`coarse_face_sums` of checked ``vertices`` and ``faces`` (:func:`_checked_cells`) and ``radius``."""
     n = vertices.shape[0]
-    radius = centre_radii(radius, n)
+    radius = _trusted_radius(radius, n)
     values, usable = _checked_values(faces, values, usable)
     kernels = numba_kernels("neighborhoods")
     if faces.shape[0] == 0:
@@ -1018,6 +1024,12 @@ def _face_clusters(
     )
 
 
+def _trusted_radius(radius, n: int):
+    """A radius the caller checked (:func:`centre_radii`): a float as it is; a (n,) array through
+    :func:`centre_radii` (no entry into :mod:`meshcurv._validation`)."""
+    return float(radius) if np.ndim(radius) == 0 else centre_radii(radius, n)
+
+
 def _checked_cells(vertices, cells) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and (C, 3) faces or (C, 2) edges, checked (indices in range)."""
     vertices = checked_points(vertices)
@@ -1068,20 +1080,39 @@ def ball_face_sums(
     InvalidMeshError
         ``centres`` is not a 1-d array of vertex indices in range.
     """
+    if centres is not None and not connected:
+        raise InvalidOptionError("`centres` takes the surface-connected balls (`connected=True`)")
+    vertices, faces = _checked_cells(vertices, faces)
+    n = vertices.shape[0]
+    radius = centre_radii(radius, n)
+    ids = None if centres is None else _checked_ids(centres, n)
+    return _ball_face_sums(vertices, faces, radius, values, usable=usable, connected=connected, centres=ids)
+
+
+def _ball_face_sums(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    radius,
+    values: np.ndarray,
+    *,
+    usable: np.ndarray | None = None,
+    connected: bool = False,
+    centres: np.ndarray | None = None,
+) -> np.ndarray:
+    """:func:`ball_face_sums` of checked ``vertices`` and ``faces`` (:func:`_checked_cells`), ``radius`` and
+    ``centres`` ((M,) int64 vertex indices)."""
+    radius = _trusted_radius(radius, vertices.shape[0])
     if centres is None:
         return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)
     if not connected:
         raise InvalidOptionError("`centres` takes the surface-connected balls (`connected=True`)")
-    vertices, faces = _checked_cells(vertices, faces)
     n = vertices.shape[0]
-    ids = _checked_ids(centres, n)
     kernels = numba_kernels("neighborhoods")
     if kernels is None or faces.shape[0] == 0:
-        return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)[ids]
-    radius = centre_radii(radius, n)
+        return _ball_sums(vertices, faces, radius, values, usable, face_in_ball_ratios, connected)[centres]
     values, usable = _checked_values(faces, values, usable)
     # the centres relabelled first, so that the kernel's range of rows is theirs
-    unique, inverse = np.unique(ids, return_inverse=True)
+    unique, inverse = np.unique(centres, return_inverse=True)
     order = np.concatenate([unique, np.setdiff1d(np.arange(n), unique, assume_unique=True)])
     relabel = np.empty(n, dtype=np.int64)
     relabel[order] = np.arange(n)
@@ -1130,6 +1161,13 @@ def ball_face_sums_nested(
         positive and finite, or decreases.
     """
     vertices, faces = _checked_cells(vertices, faces)
+    return _ball_face_sums_nested(vertices, faces, radii, values, usable=usable)
+
+
+def _ball_face_sums_nested(
+    vertices: np.ndarray, faces: np.ndarray, radii, values: np.ndarray, *, usable: np.ndarray | None = None
+) -> np.ndarray:
+    """:func:`ball_face_sums_nested` of checked ``vertices`` and ``faces`` (:func:`_checked_cells`)."""
     n = vertices.shape[0]
     try:
         nested = np.array(radii, dtype=np.float64, ndmin=1)
@@ -1173,10 +1211,19 @@ def ball_edge_sums(
     vertices: np.ndarray, edges: np.ndarray, radius: float, values: np.ndarray, *, usable: np.ndarray | None = None
 ) -> np.ndarray:
     """(V, k) ``sum_e |e ∩ B(x_v, r)| * values[e]`` over the edges meeting each ball (exact lengths)."""
+    vertices, edges = _checked_cells(vertices, edges)
+    return _ball_edge_sums(vertices, edges, centre_radii(radius, vertices.shape[0]), values, usable=usable)
+
+
+def _ball_edge_sums(
+    vertices: np.ndarray, edges: np.ndarray, radius, values: np.ndarray, *, usable: np.ndarray | None = None
+) -> np.ndarray:
+    """:func:`ball_edge_sums` of checked ``vertices`` and ``radius``, and ``edges`` of vertex indices in range
+    (int64 as :func:`_checked_cells` makes them; :attr:`MeshTopology.edges` are int32)."""
     return _ball_sums(
         vertices,
-        edges,
-        radius,
+        np.ascontiguousarray(edges, dtype=np.int64),
+        _trusted_radius(radius, vertices.shape[0]),
         values,
         usable,
         lambda ends, centres, r: segment_in_ball_lengths(ends[:, 0], ends[:, 1], centres, r),

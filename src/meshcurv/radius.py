@@ -80,7 +80,7 @@ from ._geometry import (
     vertex_length_scales,
 )
 from .geometry import _floats, checked_topology_points
-from .jets import SETTLED_SLOPE, fit_jets
+from .jets import SETTLED_SLOPE, _fit_jets, fit_jets
 from .lattice import voxel_grid
 from .topology import MeshTopology
 
@@ -339,7 +339,7 @@ def _noise_level(vertices, normals, valid, edges, *, neighbours=None, adjacency=
     for k in np.unique(level):
         members = np.flatnonzero(level == k)
         radius = NOISE_FIT_RADIUS * scale[members].mean()
-        coefficients, _, _ = fit_jets(
+        coefficients, _, _ = _fit_jets(
             vertices,
             normals,
             radius,

@@ -88,14 +88,14 @@ from .._geometry import median_edge_length
 from ..jets import (
     NORMAL_MIN_SPREAD,
     SETTLED_SLOPE,
-    fit_jet_normals,
-    fit_jets,
+    _fit_jet_normals,
+    _fit_jets,
+    _sampled_jet_normals,
     jet_normals,
     nested_jet_normals,
-    sampled_jet_normals,
 )
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
-from ..neighborhoods import _squared, ball_face_sums, ball_face_sums_nested, coarse_face_sums
+from ..neighborhoods import _ball_face_sums, _ball_face_sums_nested, _coarse_face_sums, _squared
 from ..radius import (
     VOXEL_SCALE_RULE,
     _check_radius,
@@ -202,7 +202,7 @@ def fitted_normals(
         coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency)
     if coarse is not None:
         points, point_normals, allowed, lists, point_areas = coarse
-        fitted = sampled_jet_normals(
+        fitted = _sampled_jet_normals(
             points,
             point_normals,
             radius,
@@ -218,7 +218,7 @@ def fitted_normals(
     elif fits is not None:
         fitted = fits
     else:
-        fitted = fit_jet_normals(
+        fitted = _fit_jet_normals(
             vertices,
             start,
             radius,
@@ -357,7 +357,7 @@ def voxel_pilot(mesh: PreparedMesh):
         )
         normals[centres[~agree]] = mesh.vertex_normals[centres[~agree]]
         measures = face_measures(vertices, topology.faces, normals)
-        summed = ball_face_sums(
+        summed = _ball_face_sums(
             vertices,
             topology.faces,
             radius,
@@ -401,7 +401,7 @@ def _pilot_normals(mesh: PreparedMesh, start: np.ndarray, radius: float, centres
     points, normals, allowed, weights = vertices, start, topology.referenced_vertices, None
     if coarse is not None:
         points, normals, allowed, adjacency, weights = coarse
-    coefficients, frame, _ = fit_jets(
+    coefficients, frame, _ = _fit_jets(
         points,
         normals,
         radius,
@@ -571,9 +571,9 @@ def _curvatures(
     start("sum over balls")
     usable = _usable_faces(faces, degenerate, normals)
     if coarse:
-        summed = coarse_face_sums(vertices, faces, radius, measures, usable=usable)
+        summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
-        summed = ball_face_sums(vertices, faces, radius, measures, usable=usable, connected=True)
+        summed = _ball_face_sums(vertices, faces, radius, measures, usable=usable, connected=True)
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
@@ -764,11 +764,11 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     stages.start("sum over balls")
     if all(mask is None if kept[0] is None else mask is not None and np.array_equal(mask, kept[0]) for mask in kept):
         # the same faces at every scale: one walk
-        summed = ball_face_sums_nested(vertices, faces, radii, measures, usable=kept[0])
+        summed = _ball_face_sums_nested(vertices, faces, radii, measures, usable=kept[0])
     else:
         summed = np.stack(
             [
-                ball_face_sums(vertices, faces, radius, values, usable=mask, connected=True)
+                _ball_face_sums(vertices, faces, radius, values, usable=mask, connected=True)
                 for radius, values, mask in zip(radii, measures, kept)
             ]
         )
@@ -822,7 +822,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     stages.start("sum over balls")
     area = 0.5 * float(np.linalg.norm(mesh.cross[~_dropped(mesh)], axis=1).sum())
     radii = scale_ladder(base, median_edge_length(vertices, topology.edges), area)
-    summed = ball_face_sums_nested(
+    summed = _ball_face_sums_nested(
         vertices, faces, radii, measures, usable=_usable_faces(faces, _dropped(mesh), normals)
     )
     stages.start("retrieve curvatures")

@@ -54,7 +54,7 @@ import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
 from .._geometry import edge_dihedral_angles
-from ..neighborhoods import ball_edge_sums
+from ..neighborhoods import _ball_edge_sums
 from ..radius import _component_radii, _resolve_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, ball_holds_neighbours, finish
@@ -127,7 +127,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     measures = np.zeros((vertices.shape[0], 7))
     for group_radius, members in groups:
         rows = slice(None) if members is None else members
-        measures[rows] = ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
+        measures[rows] = _ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
     measures, areas = measures[:, :6], measures[:, 6]
 
     stages.start("retrieve curvatures")

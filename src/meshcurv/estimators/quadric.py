@@ -47,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import principal_from_shape_operator
-from ..jets import AWAY_FRACTION, MIN_POINTS, fit_jets, shape_operators
+from ..jets import AWAY_FRACTION, MIN_POINTS, _fit_jets, shape_operators
 from ..radius import _component_radii, _resolve_radius, vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
@@ -90,7 +90,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     for group_radius, members in groups:
         unit = group_radius if group_radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
         details: dict = {}
-        found, frame, _ = fit_jets(
+        found, frame, _ = _fit_jets(
             vertices, start, unit, centres=members, neighbours=referenced, facing=facing, details=details
         )
         part_six, part_fitted = shape_operators(found, frame, unit)
