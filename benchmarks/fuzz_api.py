@@ -69,7 +69,7 @@ import numpy as np  # noqa: E402
 from _forked import collect, vsize  # noqa: E402
 
 import meshcurv  # noqa: E402
-from meshcurv import geometry, shapes  # noqa: E402
+from meshcurv import defects, geometry, radius, shapes  # noqa: E402
 from meshcurv.errors import (  # noqa: E402
     InvalidMeshError,
     InvalidOptionError,
@@ -643,9 +643,41 @@ def make_case(seed: int, index: int):
         topo = _topology_or_raw(rng, f, len(v))
         steps = garbage(rng, "steps") if rng.random() < 0.5 else int(rng.integers(0, 30))
         return target, (values, topo, steps), {}, labels, None
-    names = list(geometry.__all__)
-    name = names[int(rng.integers(len(names)))]
-    return "geometry." + name, _geometry_args(rng, name, vv, ff, v, f), {}, labels, None
+    names = [f"geometry.{name}" for name in geometry.__all__] + RULES
+    target = names[int(rng.integers(len(names)))]
+    return target, _geometry_args(rng, target, vv, ff, v, f), {}, labels, None
+
+
+#: The public rules of meshcurv.radius and meshcurv.defects over a mesh's arrays, called as the geometry
+#: functions are: a topology for more vertices than given (or a raw face array), masks of another length
+#: (helper R7's review of cfb079e: vertices of another length than the topology read past them in compiled
+#: kernels, a silent answer or a crashed process, fixed in 485086a)
+RULES = [
+    "radius.edge_radius",
+    "radius.component_radii",
+    "radius.check_radius",
+    "radius.resolve_radius",
+    "radius.small_radius_note",
+    "radius.scale_centres",
+    "radius.noise_radii",
+    "radius.noise_level",
+    "radius.local_scale_ratios",
+    "defects.needle_vertices",
+    "defects.scale_vertices",
+    "defects.scale_edges",
+    "defects.needle_corners",
+    "defects.defect_codes",
+]
+MODULES = {"geometry": geometry, "radius": radius, "defects": defects}
+
+
+def _mask(rng, n):
+    """A (n,) bool mask, now and then of another length, dtype or kind."""
+    if rng.random() < 0.8:
+        return rng.random(n) < 0.1
+    return [rng.random(n + 1) < 0.5, (rng.random(max(n - 1, 0)) < 0.5), np.zeros(n, dtype=np.int64), garbage(rng, "m")][
+        int(rng.integers(4))
+    ]
 
 
 # ----------------------------------------------------------------------------- analytic point clouds
@@ -817,11 +849,14 @@ def _topology_or_raw(rng, f, n):
         return f
 
 
-def _geometry_args(rng, name, vv, ff, v, f):
+def _function(target):
+    module, name = target.split(".", 1)
+    return getattr(MODULES[module], name)
+
+
+def _geometry_args(rng, target, vv, ff, v, f):
     params = [
-        p.name
-        for p in inspect.signature(getattr(geometry, name)).parameters.values()
-        if p.kind == p.POSITIONAL_OR_KEYWORD
+        p.name for p in inspect.signature(_function(target)).parameters.values() if p.kind == p.POSITIONAL_OR_KEYWORD
     ]
     args = []
     for p in params:
@@ -847,6 +882,17 @@ def _geometry_args(rng, name, vv, ff, v, f):
             args.append(
                 topology.interior_edges.copy() if topology is not None and rng.random() < 0.8 else garbage(rng, "edges")
             )
+        elif p in ("valid", "needles", "neighbours"):
+            args.append(_mask(rng, len(v)))
+        elif p == "degenerate":
+            args.append(_mask(rng, len(f)))
+        elif p in ("normals", "scales"):
+            shape = (len(v), 3) if p == "normals" else (len(v),)
+            args.append(np.abs(rng.normal(size=shape)) if rng.random() < 0.8 else garbage(rng, p))
+        elif p == "radius":
+            args.append([None, 0.3, 1e-3, 1e9, -1.0, np.nan, "x"][int(rng.integers(7))])
+        elif p == "minimum_edges":
+            args.append(2.0)
         elif p in ("cross",):
             continue
         else:
@@ -872,7 +918,7 @@ def call(target, args, kwargs):
         return meshcurv.triangulate_faces(*args, **kwargs)
     if target == "smooth_vertex_field":
         return meshcurv.smooth_vertex_field(*args, **kwargs)
-    return getattr(geometry, target.split(".", 1)[1])(*args, **kwargs)
+    return _function(target)(*args, **kwargs)
 
 
 def _n_rows(value):

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from meshcurv import defects, radius, shapes
-from meshcurv.errors import InvalidMeshError
+from meshcurv.errors import InvalidMeshError, InvalidOptionError
 from meshcurv.geometry import vertex_length_scales
 from meshcurv.topology import MeshTopology
 
@@ -99,3 +99,10 @@ def test_the_checked_rules_answer_as_before_on_a_sound_mesh():
     assert np.array_equal(defects.scale_vertices(TOPOLOGY, needles), TOPOLOGY.referenced_vertices)
     assert defects.scale_edges(TOPOLOGY, needles) is TOPOLOGY.edges
     assert np.array_equal(radius.scale_centres(VERTICES, TOPOLOGY, VALID, NORMALS), VALID)
+
+
+@pytest.mark.parametrize("given", [None, "x", -1.0, np.nan])
+def test_small_radius_note_checks_its_radius(given):
+    # fuzz_api.py seed 135, case 1920: a TypeError from the comparison inside
+    with pytest.raises(InvalidOptionError, match="`radius` must be"):
+        radius.small_radius_note(given, VERTICES, TOPOLOGY, 2.0)

@@ -238,6 +238,7 @@ def small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopolog
     Each ball method states its own minimum (``RADIUS_WARNING_EDGES`` of its
     module), measured where its balls start holding too little of the surface.
     """
+    radius, minimum_edges = check_positive_float(radius, "radius"), check_positive_float(minimum_edges, "minimum_edges")
     return _small_radius_note(radius, checked_topology_points(vertices, topology), topology, minimum_edges)
 
 
