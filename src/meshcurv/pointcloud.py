@@ -41,7 +41,10 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    same way as a sheet stacked on theirs
    (:func:`meshcurv._pointcloud_normals.two_sheets`: one of the two is inside
    out, and nothing local tells which) are NaN (``invalid_reason``: side
-   undecided);
+   undecided), and so are the points amid them (a quarter of their 24 nearest
+   neighbours, or half of their part: a part thinner than its noise, whose
+   faces mix); given normals are re-oriented only where their signs are not
+   consistent, and keep their side where it is undecided;
 4. the noise level ``nu``: the median distance of the points to degree-2 jets
    fitted over :data:`meshcurv.radius.CLOUD_NOISE_FIT_RADIUS` spacings, in spacings;
 5. the radius: ``s (a + b sqrt(max(nu - 0.005, 0)))``, ``(a, b)`` = (3, 11)
@@ -87,8 +90,12 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    estimate over a given radius below half the one the noise calls for. A
    given radius that cannot hold the 10 nearest points (``sqrt(10 / pi)``
    spacings) leaves the estimate undefined
-   (:func:`meshcurv._pointcloud_estimators.small_balls`). Clean samples keep
-   every point (``benchmarks/pointcloud.md``).
+   (:func:`meshcurv._pointcloud_estimators.small_balls`). An estimate whose
+   ball turns the normal by more than 0.8 rad and whose ball's normals its
+   own shape operator does not predict is NaN too
+   (:func:`meshcurv._pointcloud_estimators.blended`: the band by the rim of a
+   thin part, a ball larger than a small part). Clean samples keep every
+   point (``benchmarks/pointcloud.md``).
 
 References
 ----------
