@@ -64,11 +64,12 @@ def _pilot_normals(mesh, monkeypatch=None, **constants):
     """The fitted normals of icc's voxel pilot at its centres (two voxels: its radius in the default), and the
     analytic normals there."""
     from meshcurv._prepared import prepare_mesh
+    from meshcurv.radius import scale_centres
 
     for name, value in constants.items():
         monkeypatch.setattr(icc, name, value)
     prepared = prepare_mesh(mesh.vertices, mesh.faces[:, ::-1], orient="outward", weld=False)
-    valid = icc.scale_centres(
+    valid = scale_centres(
         prepared.vertices, prepared.topology, prepared.start(boundary=True)[1], prepared.vertex_normals
     )
     start = np.where(valid[:, None], prepared.vertex_normals, [0.0, 0.0, 1.0])
