@@ -494,7 +494,7 @@ def _candidate_pairs(
             largest += (
                 check_ball_work(centroids[group], cutoff, n, centres=centre_points)
                 if refuse
-                else estimate_ball_pairs(centroids[group], cutoff, centre_points)
+                else _estimate_ball_pairs(centroids[group], cutoff, centre_points)
             )[1]
             searches.append((cKDTree(centroids[group]), index[group], group_reach))
     chunk_size = max(1, min(int(chunk_size), int(PAIRS_PER_CHUNK // max(4.0 * largest, 1.0))))
