@@ -21,6 +21,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ._backend import twin
+from ._geometry import vertex_length_scales
+from .defects import _needle_vertices
 from .orient import face_flips
 from .topology import MeshTopology
 
@@ -135,11 +137,17 @@ class OneSided(NamedTuple):
         The input faces that were dropped.
     n_dropped : int
         Their number.
+    length_scales, needles : ndarray of shape (V,), or None
+        When faces were dropped: the length scales (float64) and needle vertices (bool, read-only) of
+        ``topology`` (:func:`meshcurv.geometry.vertex_length_scales`, :func:`meshcurv.defects.needle_vertices`),
+        found to choose the side kept; a caller that needs them takes these. None when nothing was dropped.
     """
 
     topology: MeshTopology
     dropped: np.ndarray
     n_dropped: int
+    length_scales: np.ndarray | None = None
+    needles: np.ndarray | None = None
 
 
 def drop_double_sided(vertices: np.ndarray, topology: MeshTopology) -> OneSided:
@@ -224,16 +232,24 @@ def drop_double_sided(vertices: np.ndarray, topology: MeshTopology) -> OneSided:
         return none
     kept_faces = np.ascontiguousarray(faces[~dropped])
     kept = MeshTopology._build(kept_faces, topology.n_vertices)
+    # the length scales and needles of the kept faces, for the choice of their side and for the caller
+    scales = vertex_length_scales(vertices, kept)
+    needles = _needle_vertices(vertices, kept, scales)
+    needles.flags.writeable = False
     # the other copies where they make the kept faces consistent and outward, a whole group at a time
     flips = np.zeros(n_faces, dtype=bool)
-    flips[~dropped] = face_flips(vertices, kept, outward=True)
+    flips[~dropped] = face_flips(vertices, kept, outward=True, needles=needles)
     group_flips = flips[rows[order][starts]] & group_both
     other = np.zeros(n_faces, dtype=bool)
     other[rows[order]] = group_flips[group]
     other = other[~dropped]
     if other.any():
         kept = MeshTopology._build(np.where(other[:, None], kept_faces[:, ::-1], kept_faces), topology.n_vertices)
-    return OneSided(kept, dropped, n_dropped)
+        # the same edges (so the same scales), but the reversed faces' corner angles in another order of their
+        # corners: found again, to the last bit those of the faces returned
+        needles = _needle_vertices(vertices, kept, scales)
+        needles.flags.writeable = False
+    return OneSided(kept, dropped, n_dropped, scales, needles)
 
 
 def _tolerance(vertices: np.ndarray, topology: MeshTopology, tolerance_ratio: float) -> float:
