@@ -139,6 +139,33 @@ def test_nested_fits_keep_the_other_sheet_out_of_the_smaller_balls():
     )
 
 
+@pytest.mark.parametrize("name", ["icosphere", "noisy torus"])
+def test_nested_fits_on_numpy_call_the_trusting_core(name, monkeypatch):
+    # issue 33: the NumPy path fits each radius with the trusting core (the caller checked the vertices), not
+    # the public fit_jet_normals that checks them again per radius; the normals are those of the public call
+    from meshcurv import jets
+    from meshcurv._backend import use_backend
+    from meshcurv.jets import fit_jet_normals
+    from meshcurv.jets import nested_jet_normals
+
+    mesh = shapes.icosphere(4) if name == "icosphere" else shapes.with_normal_noise(shapes.torus(), 0.1, seed=5)
+    vertices, faces = np.asarray(mesh.vertices, dtype=np.float64), mesh.faces
+    topology = meshcurv.MeshTopology.from_faces(faces)
+    h = meshcurv.geometry.mean_edge_length(vertices, topology.edges)
+    normals = meshcurv.geometry.vertex_normals(vertices, faces)
+    radii = [3.0 * h, 5.0 * h]  # balls of about 30 and 80 vertices: a cubic jet (10 terms) fits everywhere
+    checked = []
+    checked_points = jets.checked_points
+    monkeypatch.setattr(jets, "checked_points", lambda points: checked.append(1) or checked_points(points))
+    with use_backend("numpy"):
+        got = nested_jet_normals(vertices, normals, radii, adjacency=topology.neighbour_lists, **_jet_options())
+        assert checked == []  # the public fit_jet_normals would check the vertices once per radius
+        for radius, fitted in zip(radii, got):
+            alone = fit_jet_normals(vertices, normals, radius, adjacency=topology.neighbour_lists, **_jet_options())
+            np.testing.assert_array_equal(fitted, alone)
+            assert np.isfinite(fitted).all()
+
+
 @pytest.mark.parametrize(
     "radii, message",
     [([], "non-empty sequence"), ([1.0, float("inf")], "positive finite"), ([2.0, 1.0], "must not decrease")],

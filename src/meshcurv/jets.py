@@ -919,7 +919,8 @@ def nested_jet_normals(
     with the same options (NaN where no jet could be fitted) to round-off: the compiled
     kernel walks the surface-connected balls of every radius in one walk per vertex, the largest
     leading (``_kernels.icc.nested_jet_normals``: the fits of the smaller balls cost their fits,
-    not their walks); the NumPy path fits each radius on its own.
+    not their walks); the NumPy path fits each radius on its own (the trusting core
+    :func:`_fit_jet_normals`: ``vertices`` are not checked again).
 
     Parameters
     ----------
@@ -954,7 +955,7 @@ def nested_jet_normals(
     options: dict[str, Any] = {"degree": degree, "iterations": iterations, "settled": settled, "min_spread": min_spread}
     if kernels is None or n == 0:
         return [
-            fit_jet_normals(vertices, normals, radius, adjacency=adjacency, neighbours=neighbours, **options)
+            _fit_jet_normals(vertices, normals, radius, adjacency=adjacency, neighbours=neighbours, **options)
             for radius in radii
         ]
     allowed = np.ones(n, dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
