@@ -97,6 +97,80 @@ def test_round_trip_of_a_mesh(tmp_path, torus):
     assert set(meta["fields"]) == set(VIEWER_FIELDS)
 
 
+def scaled_result(shape, radius: float, factor: float, *, invalid=()) -> CurvatureResult:
+    """The exact curvatures times ``factor``, as the result of a ball of ``radius`` (a stand-in for one scale)."""
+    exact = exact_result(shape, invalid=invalid)
+    return CurvatureResult(
+        k_min=exact.k_min * factor,
+        k_max=exact.k_max * factor,
+        dir_min=exact.dir_min,
+        dir_max=exact.dir_max,
+        normals=exact.normals,
+        valid=exact.valid,
+        method="exact",
+        radius=np.full(len(shape.vertices), radius),
+    )
+
+
+def test_round_trip_of_several_scales(tmp_path, torus):
+    results = [scaled_result(torus, 1.5, 1.0), scaled_result(torus, 3.0, 2.0, invalid=[7]), exact_result(torus)]
+    page = write_html(tmp_path / "t.html", torus.vertices, torus.faces, results, length_unit="mm")
+    meta, arrays = read_page_data(page)
+    assert [scale["label"] for scale in meta["scales"]] == ["radius 1.5 mm", "radius 3 mm", "3: exact"]
+    assert "3 scales" in meta["subtitle"] and meta["fields"] == meta["scales"][0]["fields"]
+    for index, result in enumerate(results):
+        suffix = f"_s{index}" if index else ""
+        np.testing.assert_array_equal(arrays["k_min" + suffix], result.k_min.astype(np.float32))
+        np.testing.assert_array_equal(arrays["k_max" + suffix], result.k_max.astype(np.float32))
+        np.testing.assert_array_equal(arrays["invalid_reason" + suffix] != 0, ~result.valid)
+        chosen = arrays["direction_vertices" + suffix]
+        np.testing.assert_array_equal(chosen, np.flatnonzero(result.valid))
+        np.testing.assert_array_equal(arrays["dir_max" + suffix], result.dir_max[chosen].astype(np.float32))
+    # twice the curvatures, twice the default limits of k_max (a percentile scales with the values)
+    first, second = (meta["scales"][i]["fields"]["k_max"]["limits"] for i in (0, 1))
+    np.testing.assert_allclose(second, 2 * np.array(first), rtol=1e-12)
+    one, _ = read_page_data(write_html(tmp_path / "one.html", torus.vertices, torus.faces, results[:1]))
+    assert "scales" not in one  # one result: no menu of scales
+
+
+def test_scale_label_of_a_radius_per_vertex(tmp_path, torus):
+    result = scaled_result(torus, 1.0, 1.0)
+    radius = np.linspace(1.0, 3.0, len(torus.vertices))
+    varying = CurvatureResult(
+        **{
+            **{
+                name: getattr(result, name)
+                for name in ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid", "method")
+            },
+            "radius": radius,
+        }
+    )
+    meta, _ = read_page_data(write_html(tmp_path / "t.html", torus.vertices, torus.faces, [result, varying]))
+    assert meta["scales"][1]["label"] == "radius 2 (median; 1 to 3)"
+
+
+@pytest.mark.parametrize(
+    "results, match",
+    [
+        ([], "a non-empty list"),
+        ("mean", "a CurvatureResult or a non-empty list"),
+        (["torus", None], r"`result\[1\]` must be a CurvatureResult; got NoneType"),
+    ],
+)
+def test_bad_results(tmp_path, torus, results, match):
+    results = (
+        [exact_result(torus) if item == "torus" else item for item in results] if isinstance(results, list) else results
+    )
+    with pytest.raises(InvalidOptionError, match=match):
+        write_html(tmp_path / "t.html", torus.vertices, torus.faces, results)
+    sphere = meshcurv.shapes.icosphere(subdivisions=2)
+    with pytest.raises(
+        InvalidOptionError, match=rf"`result\[1\]` has {len(sphere.vertices)} vertices; the mesh has 3600"
+    ):
+        write_html(tmp_path / "t.html", torus.vertices, torus.faces, [exact_result(torus), exact_result(sphere)])
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_round_trip_of_reasons_from_principal_curvatures(tmp_path):
     hemisphere = meshcurv.shapes.hemisphere(subdivisions=6)
     with warnings.catch_warnings():
@@ -286,7 +360,7 @@ def test_bad_inputs(tmp_path, torus):
         write_html(tmp_path / "t.html", torus.vertices, torus.faces + 1, result)  # 1-based
     with pytest.raises(InvalidOptionError, match="`result` has 3600 vertices; the mesh has 3599"):
         write_html(tmp_path / "t.html", torus.vertices[:-1], torus.faces[:10], result)
-    with pytest.raises(InvalidOptionError, match="`result` must be a CurvatureResult; got dict"):
+    with pytest.raises(InvalidOptionError, match="`result` must be a CurvatureResult or a non-empty list of them; got dict"):
         write_html(tmp_path / "t.html", torus.vertices, torus.faces, {"k_min": result.k_min})
     with pytest.raises(MeshFileError, match="not a meshcurv viewer page"):
         (tmp_path / "other.html").write_text("<html></html>")
@@ -365,6 +439,52 @@ def test_cli_usage_errors(tmp_path, torus_file, args, message):
     done = run_view([torus_file, *[tmp_path / arg if arg.endswith(".png") else arg for arg in args]])
     assert done.exit_code == 2 and message in done.output
     assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_several_radii_are_the_multiscale_results(tmp_path, torus_file):
+    done = run_view([torus_file, "-o", tmp_path / "t.html", "--radii", "6,3", "-f", "gaussian"])
+    assert done.exit_code == 0, done.output
+    meta, arrays = read_page_data(tmp_path / "t.html")
+    assert [scale["label"] for scale in meta["scales"]] == ["radius 6", "radius 3"]
+    vertices, faces = meshcurv.read_mesh(torus_file)
+    expected = meshcurv.multiscale_curvatures(vertices, faces, [6.0, 3.0])
+    for index, result in enumerate(expected):
+        suffix = f"_s{index}" if index else ""
+        np.testing.assert_array_equal(arrays["k_max" + suffix], result.k_max.astype(np.float32))
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--radii", "3,6", "--radius", "2"], "not both"),
+        (["--radii", "3,x"], "lengths > 0 separated by commas"),
+        (["--radii", "3,-1"], "lengths > 0 separated by commas"),
+        (["--radii", "3,6", "-m", "matgeom"], "--radii takes a method over balls"),
+        (["--radii", "3,6", "--smoothing-steps", "2"], "--radii takes a method over balls"),
+        (["--radius", "wide"], "neither a length > 0 nor 'adaptive'"),
+    ],
+)
+def test_cli_radii_usage_errors(tmp_path, torus_file, args, message):
+    done = run_view([torus_file, "-o", tmp_path / "t.html", *args])
+    assert done.exit_code == 2 and message in done.output, done.output
+    assert not (tmp_path / "t.html").exists()
+
+
+def test_cli_radii_refused_for_a_point_cloud(tmp_path):
+    cloud = tmp_path / "cloud.xyz"
+    np.savetxt(cloud, meshcurv.shapes.icosphere(subdivisions=3).vertices)
+    done = run_view([cloud, "-o", tmp_path / "c.html", "--radii", "0.1,0.2"])
+    assert done.exit_code == 2 and "--radii is for meshes" in done.output
+
+
+def test_cli_adaptive_radius_is_the_library_call(tmp_path, torus_file):
+    done = run_view([torus_file, "-o", tmp_path / "t.html", "--radius", "adaptive"])
+    assert done.exit_code == 0, done.output
+    meta, arrays = read_page_data(tmp_path / "t.html")
+    vertices, faces = meshcurv.read_mesh(torus_file)
+    expected = meshcurv.principal_curvatures(vertices, faces, radius="adaptive")
+    np.testing.assert_array_equal(arrays["k_max"], expected.k_max.astype(np.float32))
+    assert "scale=adaptive" in meta["details"]
 
 
 def test_cli_missing_mesh(tmp_path):
@@ -581,6 +701,43 @@ def test_browser_hash_sets_field_limits_directions_and_probe(tmp_path, browser, 
     meta, _ = read_page_data(page)
     assert (facts["field"], facts["directions"]) == ("mean", "none")
     assert [float(facts["low"]), float(facts["high"])] == meta["fields"]["mean"]["limits"]
+
+
+@pytest.mark.slow
+@needs_browser
+def test_browser_scales_menu_keeps_the_limits_and_probes_each_scale(tmp_path, browser):
+    sphere = meshcurv.shapes.icosphere(subdivisions=16, radius=2.0)
+    results = [
+        scaled_result(sphere, 0.1, 1.0),
+        scaled_result(sphere, 0.2, 3.0, invalid=range(0, len(sphere.vertices), 2)),
+    ]
+    page = write_html(tmp_path / "s.html", sphere.vertices, sphere.faces, results, field="mean")
+    facts, _ = browser.open(page.as_uri() + "#scale=1&lo=-2&hi=2")
+    assert facts["state"] == "ok", facts["text"]
+    assert (facts["scale"], facts["scales"], float(facts["low"]), float(facts["high"])) == ("1", "2", -2, 2)
+    assert browser.evaluate("getComputedStyle(document.getElementById('scale-choice')).display") != "none"
+    assert browser.evaluate("document.getElementById('scale').selectedOptions[0].textContent") == "radius 0.2"
+    found = set()
+    for x in range(560, 760, 7):  # vertices under a row of pixels: each read from the scale shown
+        for scale in (1, 0):
+            browser.evaluate(f"meshcurvViewer.setScale({scale})")
+            assert browser.evaluate("meshcurvViewer.state.limits") == [-2, 2]  # the limits stay
+            probe = browser.evaluate(f"meshcurvViewer.describe(meshcurvViewer.pickAt({x}, 350)).data")
+            if probe["probeVertex"] == "none":
+                continue
+            vertex, value = int(probe["probeVertex"]), probe["probeValue"]
+            if results[scale].valid[vertex]:
+                np.testing.assert_allclose(value, results[scale].mean[vertex], rtol=1e-6)
+                found.add((scale, round(value, 3)))
+            else:
+                assert value == "NaN"
+    assert found == {(0, 0.5), (1, 1.5)}
+    browser.evaluate("meshcurvViewer.setScale(1); document.getElementById('scale').dispatchEvent(new Event('change'))")
+    assert "scale=1" in browser.evaluate("window.location.hash")
+    one = write_html(tmp_path / "one.html", sphere.vertices, sphere.faces, results[0])
+    facts, _ = browser.open(one.as_uri() + "#scale=5")  # no scales: the menu hidden, the index ignored
+    assert (facts["state"], facts["scale"], facts["scales"]) == ("ok", "0", "1")
+    assert browser.evaluate("getComputedStyle(document.getElementById('scale-choice')).display") == "none"
 
 
 @pytest.mark.slow

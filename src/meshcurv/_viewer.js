@@ -291,6 +291,11 @@
     const meta = JSON.parse(document.getElementById("meshcurv-meta").textContent);
     const data = {};
     for (const [name, spec] of Object.entries(meta.arrays)) data[name] = await readArray(spec);
+    // the scales (one unless the page holds the results of several radii): their arrays are swapped into `data`
+    const scales = meta.scales ||
+      [{ label: "", fields: meta.fields, stroke_half_length: meta.stroke_half_length, details: meta.details }];
+    const SCALED = ["k_min", "k_max", "invalid_reason", "direction_vertices", "dir_min", "dir_max"];
+    const scaleArrays = scales.map((_, s) => Object.fromEntries(SCALED.map((name) => [name, data[s ? `${name}_s${s}` : name]])));
     const decodedAt = performance.now();
     const nVertices = meta.n_vertices;
     const isMesh = meta.kind === "mesh";
@@ -400,9 +405,12 @@
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
 
     // principal direction strokes, centred on a subsample of the vertices, lifted off the surface a little
-    const strokes = {};
-    if (data.direction_vertices) {
-      const h = meta.stroke_half_length, lift = 0.1 * h, ids = data.direction_vertices, p = data.positions;
+    let strokes = {};
+    function buildStrokes(h) {
+      for (const stroke of Object.values(strokes)) { gl.deleteBuffer(stroke.buffer); gl.deleteVertexArray(stroke.vao); }
+      strokes = {};
+      if (!data.direction_vertices) return;
+      const lift = 0.1 * h, ids = data.direction_vertices, p = data.positions;
       for (const name of ["dir_max", "dir_min"]) {
         const d = data[name], out = new Float32Array(ids.length * 6);
         for (let i = 0; i < ids.length; i++) {
@@ -413,11 +421,11 @@
             out[6 * i + 3 + c] = centre + h * d[3 * i + c];
           }
         }
-        const vao = gl.createVertexArray();
+        const vao = gl.createVertexArray(), strokeBuffer = buffer(gl, gl.ARRAY_BUFFER, out);
         gl.bindVertexArray(vao);
-        attribute(line.program, "a_position", buffer(gl, gl.ARRAY_BUFFER, out), 3, gl.FLOAT, false);
+        attribute(line.program, "a_position", strokeBuffer, 3, gl.FLOAT, false);
         gl.bindVertexArray(null);
-        strokes[name] = { vao, count: 2 * ids.length };
+        strokes[name] = { vao, buffer: strokeBuffer, count: 2 * ids.length };
       }
     }
 
@@ -444,6 +452,7 @@
       high: document.getElementById("high"),
       auto: document.getElementById("auto"),
       directions: document.getElementById("directions"),
+      scale: document.getElementById("scale"),
       probe: document.getElementById("probe"),
       bar: document.getElementById("bar"),
       barLow: document.getElementById("bar-low"),
@@ -461,15 +470,22 @@
       option.textContent = name;
       controls.field.appendChild(option);
     }
-    if (!data.direction_vertices) {
-      controls.directions.disabled = true;
-      controls.directions.title = "this method gives no principal directions";
-    }
+    scales.forEach((scale, index) => {
+      const option = document.createElement("option");
+      option.value = String(index);
+      option.textContent = scale.label;
+      controls.scale.appendChild(option);
+    });
+    document.getElementById("scale-choice").hidden = scales.length < 2;
+    const hashScale = Number(hash.scale);
+    const firstScale = Number.isInteger(hashScale) && hashScale >= 0 && hashScale < scales.length ? hashScale : 0;
 
     const state = {
       field: meta.fields[hash.field] ? hash.field : meta.field,
+      scale: firstScale,
       limits: null,
-      directions: data.direction_vertices && ["max", "min", "both"].includes(hash.directions) ? hash.directions : "none",
+      directions: scaleArrays[firstScale].direction_vertices && ["max", "min", "both"].includes(hash.directions)
+        ? hash.directions : "none",
       target: [0, 0, 0],
       distance: fitDistance(),
       rotation: UP_ROTATIONS[meta.up],
@@ -478,6 +494,24 @@
     const azimuth = Number(hash.azimuth ?? meta.azimuth) * Math.PI / 180;
     state.rotation = multiply3(rotationAbout([1, 0, 0], elevation), multiply3(rotationAbout([0, 1, 0], azimuth), state.rotation));
     const homeView = { target: state.target.slice(), distance: state.distance, rotation: state.rotation.slice() };
+
+    // a scale: its arrays into `data`, its fields' limits into `meta.fields`, its strokes; the limits stay
+    function useScale(index) {
+      state.scale = index;
+      Object.assign(data, scaleArrays[index]);
+      meta.fields = scales[index].fields;
+      buildStrokes(scales[index].stroke_half_length);
+      controls.scale.value = String(index);
+      controls.directions.disabled = !data.direction_vertices;
+      controls.directions.title = data.direction_vertices ? "" : "this method gives no principal directions";
+      if (!data.direction_vertices) { state.directions = "none"; controls.directions.value = "none"; }
+      document.getElementById("subtitle").title = scales[index].details;
+    }
+
+    function setScale(index) {
+      useScale(index);
+      setField(state.field, state.limits);
+    }
 
     let values = null;
     function setField(name, limits) {
@@ -681,12 +715,15 @@
       const reason = data.invalid_reason[vertex];
       const value = values[vertex];
       const spec = meta.fields[state.field];
-      let text = `vertex ${vertex}: `;
+      let text = `vertex ${vertex}${scales.length > 1 ? ` (${scales[state.scale].label})` : ""}: `;
       if (reason !== 0) text += `no value (${meta.invalid_reasons[reason] || "invalid"})`;
       else if (!Number.isFinite(value)) text += `${state.field} undefined here`;
       else text += `${state.field} = ${value.toPrecision(4)} ${spec.unit}; k_min = ${data.k_min[vertex].toPrecision(4)}, ` +
         `k_max = ${data.k_max[vertex].toPrecision(4)}`;
-      return { text, data: { probeVertex: vertex, probeField: state.field, probeValue: reason === 0 ? value : "NaN" } };
+      return {
+        text,
+        data: { probeVertex: vertex, probeField: state.field, probeScale: state.scale, probeValue: reason === 0 ? value : "NaN" },
+      };
     }
 
     // ---- mouse: left drag rotates, right or shift drag pans, wheel zooms, double click resets ----
@@ -730,10 +767,12 @@
     window.addEventListener("resize", requestDraw);
     // the choices go into the address (#field=...&lo=...), so that a copied address shows the same
     function keepInAddress() {
-      const hashed = `#field=${state.field}&lo=${state.limits[0]}&hi=${state.limits[1]}&directions=${state.directions}`;
+      const hashed = `#field=${state.field}&lo=${state.limits[0]}&hi=${state.limits[1]}&directions=${state.directions}` +
+        (scales.length > 1 ? `&scale=${state.scale}` : "");
       history.replaceState(null, "", hashed);
     }
     controls.field.addEventListener("change", () => { setField(controls.field.value); keepInAddress(); });
+    controls.scale.addEventListener("change", () => { setScale(Number(controls.scale.value)); keepInAddress(); });
     controls.low.addEventListener("change", () => { setLimits([controls.low.value, state.limits[1]]); keepInAddress(); });
     controls.high.addEventListener("change", () => { setLimits([state.limits[0], controls.high.value]); keepInAddress(); });
     controls.auto.addEventListener("click", () => { setLimits(meta.fields[state.field].limits); keepInAddress(); });
@@ -746,6 +785,8 @@
 
     // ---- first frame, drawn now (not on an animation frame) so that it is there when the page has loaded ----
     const hashLimits = "lo" in hash && "hi" in hash ? [hash.lo, hash.hi] : null;
+    useScale(state.scale);
+    controls.directions.value = state.directions;
     setField(state.field, hashLimits);
     // the panel has its contents now: fit the mesh beside it
     state.distance = fitDistance() / (hash.zoom && Number(hash.zoom) > 0 ? Number(hash.zoom) : 1);
@@ -760,7 +801,8 @@
       openMs: Math.round(drawnAt), scriptStartMs: Math.round(startedAt), decodeMs: Math.round(decodedAt - startedAt),
       normalsMs: Math.round(normalsAt - decodedAt), uploadMs: Math.round(uploadedAt - normalsAt),
       drawMs: Math.round(drawnAt - uploadedAt),
-      field: state.field, low: state.limits[0], high: state.limits[1], directions: state.directions,
+      field: state.field, scale: state.scale, scales: scales.length,
+      low: state.limits[0], high: state.limits[1], directions: state.directions,
       vertices: nVertices, renderer: rendererName(gl),
     };
     let text = `${nVertices} ${isMesh ? "vertices" : "points"}, first frame at ${facts.openMs} ms`;
@@ -774,7 +816,7 @@
 
     // for scripts and tests: the state, and frames drawn on demand
     window.meshcurvViewer = {
-      state, pickAt, describe, setField, setLimits,
+      state, pickAt, describe, setField, setLimits, setScale,
       setDirections(value) { state.directions = value; controls.directions.value = value; draw(); },
       rotate(dx, dy) {
         const length = Math.hypot(dx, dy);

@@ -457,3 +457,16 @@ def _keepable(array: np.ndarray, name: str) -> bool:
 def _readonly(array: np.ndarray) -> np.ndarray:
     array.flags.writeable = False
     return array
+
+
+def parameter_text(parameters) -> str:
+    """``key=value, ...`` of a result's parameters for people: numbers to 4 significant digits."""
+
+    def shown(value) -> str:
+        if isinstance(value, (float, np.floating)):
+            return f"{value:.4g}"
+        if isinstance(value, (tuple, list)) and value and all(isinstance(v, (float, np.floating)) for v in value):
+            return "(" + ", ".join(f"{v:.4g}" for v in value) + ")"
+        return str(value)
+
+    return ", ".join(f"{key}={shown(value)}" for key, value in parameters.items())

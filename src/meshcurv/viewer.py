@@ -7,7 +7,9 @@ forbids it). In the page: left drag rotates, right (or shift) drag pans, the
 wheel zooms, a double click resets the view; a menu picks the field (k_min,
 k_max, mean, gaussian, shape_index, curvedness), two boxes set the colour
 limits, another menu draws the principal directions, and the value under the
-cursor is shown.
+cursor is shown. Given the results of several radii (:func:`meshcurv.multiscale_curvatures`),
+a menu picks the scale; the colour limits stay when the scale changes, so that the
+scales compare.
 
 Per vertex the page stores the position (float32, relative to the bounding
 box's centre, recorded as ``offset``), ``k_min`` and ``k_max`` (float32; the
@@ -15,9 +17,11 @@ other fields are computed from them in the page) and the reason a vertex has
 no value (uint8); the triangles as deflated uint32 differences of consecutive
 indices (a point cloud: int8 normals instead); principal directions for a
 spatially even subsample of at most ``max_directions`` vertices; all base64.
+The curvatures, reasons and directions of the scales after the first are stored
+again under the same names with the suffix ``_s1``, ``_s2``, ...
 
 The address can set the page's state: ``page.html#field=gaussian&lo=-0.01&hi=0.01&directions=both``
-(also ``elevation``, ``azimuth``, ``zoom``, and ``probe=X,Y``, the vertex under that pixel). The
+(also ``scale`` (its index), ``elevation``, ``azimuth``, ``zoom``, and ``probe=X,Y``, the vertex under that pixel). The
 element ``#status`` says ``data-state="ok"`` (or ``"error"`` and why), with the time to the
 first frame and the probe's reading, so a page can be checked headless::
 
@@ -34,6 +38,7 @@ import logging
 import pathlib
 import re
 import zlib
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -44,7 +49,7 @@ from .io._files import atomic_output, check_output
 from .io.fields import FIELDS
 from .plotting import check_percentiles, choose_up
 from .pointcloud import point_cloud_curvatures
-from .result import INVALID_REASONS, CurvatureResult
+from .result import INVALID_REASONS, CurvatureResult, parameter_text
 
 __all__ = ["write_html", "VIEWER_FIELDS"]
 
@@ -70,7 +75,7 @@ def write_html(
     path,
     vertices,
     faces=None,
-    result: CurvatureResult | None = None,
+    result: CurvatureResult | Sequence[CurvatureResult] | None = None,
     *,
     field: str = "mean",
     title: str | None = None,
@@ -97,10 +102,13 @@ def write_html(
         0-based triangles (polygons are fan-triangulated, with a
         ``TriangulationWarning``). None (or an empty array) draws the
         vertices as points.
-    result : CurvatureResult, optional
+    result : CurvatureResult or sequence of CurvatureResult, optional
         The curvatures of these vertices; computed with the defaults of
         :func:`meshcurv.principal_curvatures` (or of
         :func:`meshcurv.point_cloud_curvatures` without faces) when not given.
+        Several results (of several radii, as
+        :func:`meshcurv.multiscale_curvatures` returns them) give the page a
+        menu of scales, each named by its radius; the first is shown first.
     field : {'k_min', 'k_max', 'mean', 'gaussian', 'shape_index', 'curvedness'}, default: 'mean'
         The field shown first; the page has a menu of all of them.
     title : str, optional
@@ -139,7 +147,7 @@ def write_html(
         Bad ``vertices`` or ``faces``.
     InvalidOptionError
         An unknown field or up axis, bad percentiles or ``max_directions``, or
-        a ``result`` of another number of vertices.
+        a ``result`` (or one of several) of another number of vertices.
     MeshFileError
         ``path`` is not ``.html``, exists (without ``overwrite``), is the
         input, or cannot be written.
@@ -172,16 +180,9 @@ def write_html(
     triangles = None
     if faces is not None and np.size(faces) > 0:
         triangles = as_faces(faces, len(points))
-    if result is None:
-        result = _compute(points, triangles)
-    elif not isinstance(result, CurvatureResult):
-        raise InvalidOptionError(f"`result` must be a CurvatureResult; got {type(result).__name__}")
-    if result.n_vertices != len(points):
-        raise InvalidOptionError(
-            f"`result` has {result.n_vertices} vertices; the mesh has {len(points)}: pass the result of these vertices"
-        )
+    results = _checked_results(_compute(points, triangles) if result is None else result, len(points))
     options = {"field": field, "percentiles": percentiles, "max_directions": max_directions, "length_unit": length_unit}
-    meta, arrays = _page_data(points, triangles, result, **options)
+    meta, arrays = _page_data(points, triangles, results, **options)
     meta.update(title=title or "meshcurv viewer", up=up, elevation=angles[0], azimuth=angles[1])
     with atomic_output(path, overwrite=overwrite) as temporary:
         with open(temporary, "wb") as handle:
@@ -194,6 +195,24 @@ def _compute(points: np.ndarray, triangles: np.ndarray | None) -> CurvatureResul
     if triangles is None:
         return point_cloud_curvatures(points)
     return principal_curvatures(points, triangles)
+
+
+def _checked_results(result, n_points: int) -> list[CurvatureResult]:
+    """``result`` as a non-empty list of results of ``n_points`` vertices."""
+    results = [result] if isinstance(result, CurvatureResult) else result
+    if not isinstance(results, (list, tuple)) or not results:
+        raise InvalidOptionError(
+            f"`result` must be a CurvatureResult or a non-empty list of them; got {type(result).__name__}"
+        )
+    for index, item in enumerate(results):
+        where = "`result`" if len(results) == 1 else f"`result[{index}]`"
+        if not isinstance(item, CurvatureResult):
+            raise InvalidOptionError(f"{where} must be a CurvatureResult; got {type(item).__name__}")
+        if item.n_vertices != n_points:
+            raise InvalidOptionError(
+                f"{where} has {item.n_vertices} vertices; the mesh has {n_points}: pass the result of these vertices"
+            )
+    return list(results)
 
 
 def _check_count(value, name: str) -> int:
@@ -303,28 +322,64 @@ def _spacing(points: np.ndarray) -> float:
     return float(np.median(positive)) if positive.size else 1.0
 
 
-def _page_data(points, triangles, result, *, field, percentiles, max_directions, length_unit):
+def _page_data(points, triangles, results, *, field, percentiles, max_directions, length_unit):
     """The page's JSON description and its arrays (little-endian, as the page reads them)."""
     low, high = points.min(axis=0), points.max(axis=0)
     offset = (low + high) / 2
     relative = points - offset
     radius = float(np.sqrt((relative**2).sum(axis=1).max())) or 1.0
+    arrays = {"positions": relative.astype("<f4")}
+    if triangles is not None:
+        arrays["faces"] = triangles.astype("<u4")
+    else:
+        normals = np.nan_to_num(np.asarray(results[0].normals, dtype=np.float64), nan=0.0)
+        arrays["normals"] = np.round(np.clip(normals, -1, 1) * 127).astype("i1")
+    scales = []
+    for index, result in enumerate(results):
+        scale, scale_arrays = _scale_data(points, result, percentiles, max_directions, length_unit)
+        scale["label"] = _scale_label(result, index, length_unit)
+        scales.append(scale)
+        suffix = f"_s{index}" if index else ""
+        arrays.update({name + suffix: array for name, array in scale_arrays.items()})
+    first = results[0]
+    size = f"{len(points)} vertices, {len(triangles)} triangles" if triangles is not None else f"{len(points)} points"
+    meta = {
+        "format": 1,
+        "kind": "mesh" if triangles is not None else "points",
+        "n_vertices": int(len(points)),
+        "n_faces": int(len(triangles)) if triangles is not None else 0,
+        "offset": [float(value) for value in offset],
+        "radius": radius,
+        "point_spacing": _spacing(points),
+        "stroke_half_length": scales[0]["stroke_half_length"],
+        "subtitle": f"{size}; method {first.method}" + (f"; {len(results)} scales" if len(results) > 1 else ""),
+        "details": scales[0]["details"],
+        "method": first.method,
+        "field": field,
+        "fields": scales[0]["fields"],
+        "invalid_reasons": {
+            **{str(code): text for code, text in enumerate(INVALID_REASONS) if code},
+            str(_UNKNOWN_REASON): "estimate undefined",
+        },
+        "percentiles": list(percentiles),
+    }
+    if len(results) > 1:
+        meta["scales"] = scales
+    return meta, arrays
+
+
+def _scale_data(points, result, percentiles, max_directions, length_unit) -> tuple[dict, dict]:
+    """One result's part of the page: its fields' limits and details, and its arrays (unsuffixed names)."""
     reason = np.where(result.valid, 0, _UNKNOWN_REASON).astype(np.uint8)
     if result.invalid_reason is not None:
         reason = np.where(
             result.valid, 0, np.where(result.invalid_reason > 0, result.invalid_reason, _UNKNOWN_REASON)
         ).astype(np.uint8)
     arrays = {
-        "positions": relative.astype("<f4"),
         "k_min": np.asarray(result.k_min, dtype="<f4"),
         "k_max": np.asarray(result.k_max, dtype="<f4"),
         "invalid_reason": reason,
     }
-    if triangles is not None:
-        arrays["faces"] = triangles.astype("<u4")
-    else:
-        normals = np.nan_to_num(np.asarray(result.normals, dtype=np.float64), nan=0.0)
-        arrays["normals"] = np.round(np.clip(normals, -1, 1) * 127).astype("i1")
     fields = {}
     for name in VIEWER_FIELDS:
         values = np.where(result.valid, getattr(result, name), np.nan)
@@ -339,32 +394,22 @@ def _page_data(points, triangles, result, *, field, percentiles, max_directions,
         arrays["dir_min"] = np.asarray(result.dir_min[chosen], dtype="<f4")
         arrays["dir_max"] = np.asarray(result.dir_max[chosen], dtype="<f4")
         stroke = 0.4 * _spacing(points[chosen])
-    parameters = ", ".join(
-        f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
-        for key, value in result.parameters.items()
-    )
-    size = f"{len(points)} vertices, {len(triangles)} triangles" if triangles is not None else f"{len(points)} points"
-    meta = {
-        "format": 1,
-        "kind": "mesh" if triangles is not None else "points",
-        "n_vertices": int(len(points)),
-        "n_faces": int(len(triangles)) if triangles is not None else 0,
-        "offset": [float(value) for value in offset],
-        "radius": radius,
-        "point_spacing": _spacing(points),
-        "stroke_half_length": stroke,
-        "subtitle": f"{size}; method {result.method}",
-        "details": f"method {result.method}" + (f" ({parameters})" if parameters else ""),
-        "method": result.method,
-        "field": field,
-        "fields": fields,
-        "invalid_reasons": {
-            **{str(code): text for code, text in enumerate(INVALID_REASONS) if code},
-            str(_UNKNOWN_REASON): "estimate undefined",
-        },
-        "percentiles": list(percentiles),
-    }
-    return meta, arrays
+    parameters = parameter_text(result.parameters)
+    details = f"method {result.method}" + (f" ({parameters})" if parameters else "")
+    return {"fields": fields, "stroke_half_length": stroke, "details": details}, arrays
+
+
+def _scale_label(result: CurvatureResult, index: int, length_unit: str | None) -> str:
+    """The scale menu's name of a result: its radius (the median where it varies by vertex)."""
+    radii = None if result.radius is None else np.asarray(result.radius, dtype=np.float64)
+    finite = radii[np.isfinite(radii)] if radii is not None else np.empty(0)
+    if finite.size == 0:
+        return f"{index + 1}: {result.method}"
+    unit = f" {length_unit}" if length_unit else ""
+    low, high = float(finite.min()), float(finite.max())
+    if high <= low * (1 + 1e-9):
+        return f"radius {low:.4g}{unit}"
+    return f"radius {float(np.median(finite)):.4g}{unit} (median; {low:.3g} to {high:.3g})"
 
 
 # No network at all: no fetch, no connection, no image or script from elsewhere.

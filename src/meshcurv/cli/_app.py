@@ -34,6 +34,7 @@ from ..io import (
 )
 from ..io._files import check_output
 from ..io.fields import FIELDS, VIEWERS, curvature_fields
+from ..result import parameter_text
 from ..plotting import _EXTRA_INCHES, _PANEL_INCHES, MAX_DPI, VIEWS, _pyplot, choose_up, plot_field, save_figure
 from ..topology import MeshTopology
 from ._batch import batch
@@ -201,10 +202,7 @@ def compute(mesh, output, fields, quality, ascii_, overwrite, **estimate):
 
 def _summary(path, vertices, n_faces: int, result, fields) -> str:
     """The summary table of ``meshcurv compute``: per-vertex and area-weighted statistics, then the integrals."""
-    parameters = ", ".join(
-        f"{key}={value:.4g}" if isinstance(value, float) else f"{key}={value}"
-        for key, value in result.parameters.items()
-    )
+    parameters = parameter_text(result.parameters)
     size = f"{len(vertices)} vertices, {n_faces} faces" if n_faces else f"{len(vertices)} points"
     lines = [f"{path}: {size}; method {result.method}" + (f" ({parameters})" if parameters else "")]
     values = curvature_fields(result, fields=[f for f in (fields or SCALAR_FIELDS) if f in SCALAR_FIELDS], quality=None)

@@ -20,7 +20,7 @@ import numpy as np
 from .. import _backend
 from .._validation import as_faces
 from ..batch import MAX_WORKERS
-from ..curvature import principal_curvatures
+from ..curvature import multiscale_curvatures, principal_curvatures
 from ..estimators import DEFAULT_METHOD, ESTIMATORS
 from ..io import is_point_cloud, read_mesh, read_points
 from ..io._files import check_output
@@ -55,6 +55,40 @@ def choice(names, choices, default, help_text: str, **settings):
 
 #: A length or a width: a float > 0 and finite (a value that parses to infinity, ``1e400``, is beyond it).
 POSITIVE = click.FloatRange(min=0, min_open=True, max=sys.float_info.max)
+
+
+class RadiusType(click.ParamType):
+    """``--radius``: a length (:data:`POSITIVE`) or ``adaptive`` (icc: each vertex its own rung of a ladder)."""
+
+    name = "radius"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str) and value.strip().lower() == "adaptive":
+            return "adaptive"
+        try:
+            return POSITIVE.convert(value, param, ctx)
+        except click.BadParameter:
+            self.fail(f"{value!r} is neither a length > 0 nor 'adaptive'", param, ctx)
+
+    def get_metavar(self, param, ctx=None):
+        return "LENGTH|adaptive"
+
+
+def radii_option(help_text: str):
+    """``--radii R1,R2,...``: several ball radii (:func:`meshcurv.multiscale_curvatures`)."""
+    return click.option("--radii", callback=_radii, default=None, metavar="R1,R2,...", help=help_text)
+
+
+def _radii(ctx, param, value):
+    if value is None:
+        return None
+    try:
+        radii = [float(part) for part in value.split(",") if part.strip()]
+    except ValueError:
+        radii = []
+    if not radii or not all(0 < radius <= sys.float_info.max for radius in radii):
+        raise click.BadParameter(f"expected lengths > 0 separated by commas (e.g. 1,2,4); got {value!r}")
+    return radii
 
 
 def mesh_argument(function):
@@ -227,10 +261,11 @@ def method_options(function):
         ),
         click.option(
             "--radius",
-            type=POSITIVE,
+            type=RadiusType(),
             default=None,
             help="Neighbourhood radius in mesh units (icc, quadric, normal_cycle_ball; "
-            "default from the mesh: see `meshcurv methods`).",
+            "default from the mesh: see `meshcurv methods`), or 'adaptive' (icc: each vertex at the "
+            "radius where its estimate is stable).",
         ),
         click.option(
             "--orient",
@@ -301,6 +336,17 @@ def report_failures(names, errors, where: str) -> None:
         click.echo(f"meshcurv: failed: {name}: {error}", err=True)
     if len(names) > _SHOWN_FAILURES:
         click.echo(f"meshcurv: ... and {len(names) - _SHOWN_FAILURES} more (see {where})", err=True)
+
+
+def _check_radii(path, method: str, *, cloud: bool, radius, smoothing_steps) -> None:
+    """``--radii`` needs a mesh and a method over balls, and neither ``--radius`` nor ``--smoothing-steps``."""
+    if cloud:
+        raise click.UsageError(f"--radii is for meshes; {path} is a point cloud (give one --radius)")
+    if radius is not None:
+        raise click.UsageError("give --radius (one scale) or --radii (several), not both")
+    if smoothing_steps is not None or method not in ESTIMATORS or "radius" not in ESTIMATORS[method].options:
+        with_balls = ", ".join(name for name, estimator in ESTIMATORS.items() if "radius" in estimator.options)
+        raise click.UsageError(f"--radii takes a method over balls ({with_balls}); got {method!r}")
 
 
 def _check_point_cloud_options(path, method, smoothing_steps, orient) -> None:
@@ -376,8 +422,11 @@ class Estimated(NamedTuple):
 
 
 @contextlib.contextmanager
-def estimated(path, session: Session, last_stage: str, *, method, smoothing_steps, radius, orient):
+def estimated(path, session: Session, last_stage: str, *, method, smoothing_steps, radius, orient, radii=None):
     """Read ``path`` (a mesh, or a point cloud: a file without faces) and compute its curvatures.
+
+    With ``radii`` (a mesh and a method over balls; not with ``radius``), the
+    result is the list of :func:`meshcurv.multiscale_curvatures`.
 
     A progress bar runs over the stages ``read``, the method's own and
     ``last_stage``, which is the block under the ``with`` (writing, drawing);
@@ -389,6 +438,8 @@ def estimated(path, session: Session, last_stage: str, *, method, smoothing_step
     context = click.get_current_context()
     given_method = context.get_parameter_source("method") != click.core.ParameterSource.DEFAULT
     cloud = is_point_cloud(path)
+    if radii is not None:
+        _check_radii(path, method, cloud=cloud, radius=radius, smoothing_steps=smoothing_steps)
     if cloud:
         _check_point_cloud_options(path, method if given_method else None, smoothing_steps, orient)
     elif method in POINT_CLOUD_METHODS:
@@ -398,6 +449,7 @@ def estimated(path, session: Session, last_stage: str, *, method, smoothing_step
     stages = ["read", *([] if cloud else ESTIMATORS[method].stages), last_stage]
     with session.bar(StageBar, stages) as bar:
         bar("read")
+        result: object
         if cloud:
             vertices, normals = read_points(path)
             faces = topology = None
@@ -409,6 +461,16 @@ def estimated(path, session: Session, last_stage: str, *, method, smoothing_step
             # triangulated (and warned about) once: the estimate takes the topology as it is
             topology = MeshTopology.from_faces(as_faces(faces, len(vertices)), len(vertices))
             options = {"smoothing_steps": smoothing_steps, "radius": radius, "orient": orient}
-            result = _estimate(vertices, topology, method, options, bar)
+            if radii is None:
+                result = _estimate(vertices, topology, method, options, bar)
+            else:
+                result = multiscale_curvatures(
+                    vertices,
+                    topology,
+                    radii,
+                    method=method,
+                    **({} if orient is None else {"orient": orient}),
+                    progress=lambda stage, index, total: bar(stage, index, total, offset=1),
+                )
         bar(last_stage, len(stages))
         yield Estimated(vertices, faces, topology, result, cloud)

@@ -7,7 +7,7 @@ import click
 from ..io._files import check_input
 from ..viewer import VIEWER_FIELDS, write_html
 from ._common import choice, common_options, current_session, estimated, mesh_argument, method_options
-from ._common import output_file, overwrite_option, path_option, percentiles_option, up_option
+from ._common import output_file, overwrite_option, path_option, percentiles_option, radii_option, up_option
 
 __all__ = ["view"]
 
@@ -17,6 +17,10 @@ __all__ = ["view"]
 @path_option(("-o", "--output"), "The page to write (default: MESH-NAME.html in the current folder).")
 @choice(("-f", "--field"), VIEWER_FIELDS, "mean", "The field shown first (the page has a menu of all of them).")
 @method_options
+@radii_option(
+    "Several ball radii in mesh units (icc, quadric, normal_cycle_ball): the page gets a menu of the scales "
+    "(computed in one pass: `meshcurv.multiscale_curvatures`)."
+)
 @up_option(
     "The axis drawn upwards at first; auto: z when the mesh is clearly taller along z than "
     "along y, else y (most OBJ and PLY files)."
@@ -50,6 +54,7 @@ def view(
     length_unit,
     title,
     overwrite,
+    radii,
     **estimate,
 ):
     """Write MESH (a mesh or a point cloud) and its curvatures as one interactive HTML page.
@@ -58,6 +63,7 @@ def view(
     meshcurv view bunny.ply                  bunny.html, open it in a browser
     meshcurv view scan.obj -o scan.html --field gaussian --unit mm
     meshcurv view cloud.xyz --radius 0.5     points, curvatures of the cloud
+    meshcurv view cell.ply --radii 0.5,1,2   three scales, a menu picks one
 
     The page needs no network and no installation (WebGL2 in any current
     browser): drag to rotate, right drag to pan, the wheel zooms; a menu
@@ -69,7 +75,7 @@ def view(
     page = "the page is an HTML file (.html)"
     output = output_file(output, f"{mesh.stem}.html", (".html", ".htm"), page, overwrite=overwrite, source=mesh)
     check_input(mesh)
-    with estimated(mesh, session, "page", **estimate) as got:
+    with estimated(mesh, session, "page", radii=radii, **estimate) as got:
         vertices, result = got.vertices, got.result
         faces = None if got.topology is None else got.topology.faces
         write_html(
