@@ -7,7 +7,9 @@ alike, so that a user's numbers do not depend on whether numba is installed.
 The meshes are those where the two kinds of ball differ: thin parts (a flat
 ellipsoid, a thin torus: a ball of the default radius reaches the other side),
 open ones (a hemisphere, a sphere with a hole), noisy ones and voxel surfaces
-(marching cubes), each small enough for the NumPy path to stay fast.
+(marching cubes, closed, and open as where an object is cut by the image's
+border), each small enough for the NumPy path to stay fast; and the label table
+of objects cut by the image's border (the voxel pilot, the refit at the rim).
 
 Tolerance: both sides fit the same points with the same operations; only the
 order of the sums differs (grid or breadth-first order against k-d tree
@@ -45,6 +47,16 @@ def _with_hole(mesh):
     return mesh.vertices, mesh.faces[keep]
 
 
+def _cut_open(mesh, fraction: float):
+    """``mesh`` without the faces whose centroids lie beyond the plane ``axis 0 = centre + fraction * half its
+    extent``: an open mesh, its boundary along the mesh's own edges (a voxel surface's staircase)."""
+    vertices = mesh.vertices
+    low, high = vertices[:, 0].min(), vertices[:, 0].max()
+    plane = (low + high) / 2 + fraction * (high - low) / 2
+    keep = vertices[mesh.faces][:, :, 0].mean(axis=1) < plane
+    return vertices, mesh.faces[keep]
+
+
 def meshes() -> dict:
     """name -> ``(vertices, faces)``: thin, open, noisy and voxel meshes of a few thousand vertices at most."""
     flat = shapes.ellipsoid((3.0, 3.0, 0.15), subdivisions=16)
@@ -53,6 +65,7 @@ def meshes() -> dict:
     noisy = shapes.with_normal_noise(shapes.icosphere(10), 0.3, seed=4)
     voxel = shapes.voxel_sphere(6.0, seed=1)
     voxel_flat = shapes.voxel_ellipsoid((8.0, 8.0, 2.0), seed=2)
+    voxel_open = shapes.voxel_ellipsoid((8.0, 6.0, 5.0), spacing=(0.7, 1.0, 1.3), seed=3)
     return {
         "flat_ellipsoid": (flat.vertices, flat.faces),
         "thin_torus": (thin_torus.vertices, thin_torus.faces),
@@ -61,6 +74,7 @@ def meshes() -> dict:
         "noisy_sphere": (noisy.vertices, noisy.faces),
         "voxel_sphere": (voxel.vertices, voxel.faces),
         "voxel_flat_ellipsoid": (voxel_flat.vertices, voxel_flat.faces),
+        "voxel_open_ellipsoid": _cut_open(voxel_open, 0.4),
     }
 
 
@@ -241,3 +255,39 @@ def test_edge_lists_that_are_not_the_meshs_are_refused(backend):
         wrong[5] = vertices.shape[0]
         with pytest.raises(InvalidMeshError, match=r"`adjacency` must hold vertex indices in 0\.\.881"):
             fit_jets(vertices, normals, 0.3, adjacency=(indptr, wrong))
+
+
+def _relative_mismatch(got: np.ndarray, expected: np.ndarray) -> float:
+    """The largest ``|got - expected| / |expected|`` over the finite values (0 where both are 0)."""
+    finite = np.isfinite(expected)
+    difference = np.abs(got[finite] - expected[finite])
+    return float(np.max(difference / np.maximum(np.abs(expected[finite]), 1e-300), initial=0.0, where=difference > 0))
+
+
+def test_backends_give_one_label_table_for_objects_cut_by_the_border():
+    # label_curvatures on both backends (issue 29, class 10, for the voxel path users run most): a ball cut by
+    # the image's first face, an ellipsoid cut by its last column face, a ball inside, in anisotropic voxels; the
+    # table's every column equal, its numbers to 1e-6 relative (measured at 778af2a: 1e-12)
+    pytest.importorskip("pandas")
+    from meshcurv.volume import label_curvatures
+
+    z, y, x = np.mgrid[:26, :30, :26]
+    image = np.zeros(z.shape, dtype=np.uint8)
+    image[(z - 2.3) ** 2 + (y - 14.6) ** 2 + (x - 9.2) ** 2 < 9.5**2] = 1
+    image[((z - 17.4) / 6.0) ** 2 + ((y - 8.3) / 5.0) ** 2 + ((x - 23.8) / 4.0) ** 2 < 1.0] = 2
+    image[(z - 18.2) ** 2 + (y - 21.7) ** 2 + (x - 10.1) ** 2 < 4.6**2] = 3
+    tables = {}
+    for backend in ("numba", "numpy"):
+        with use_backend(backend), warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshQualityWarning)
+            tables[backend] = label_curvatures(image, spacing=(0.7, 1.0, 1.3))
+    compiled, reference = tables["numba"], tables["numpy"]
+    assert list(compiled["label"]) == [1, 2, 3] and list(compiled["status"]) == ["ok"] * 3
+    assert list(compiled.columns) == list(reference.columns)
+    for column in compiled.columns:
+        got, expected = reference[column].to_numpy(), compiled[column].to_numpy()
+        if expected.dtype.kind == "f":
+            np.testing.assert_array_equal(np.isnan(got), np.isnan(expected), err_msg=f"{column}: NaN")
+            assert _relative_mismatch(got, expected) <= RTOL, column
+        else:
+            np.testing.assert_array_equal(got, expected, err_msg=column)
