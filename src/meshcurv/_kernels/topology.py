@@ -8,7 +8,7 @@ import numba as nb
 import numpy as np
 from numba.extending import overload
 
-from ._common import _JIT, run_chunks, threaded
+from ._common import _JIT, _ONE, _UNSIGNED, run_chunks, threaded
 
 
 #: :func:`meshcurv._kernels.neighborhoods.vertex_face_lists` counts the faces of at most this many ranges of
@@ -48,6 +48,9 @@ def _bucket_starts_compiled(cursor):
 
     return starts_of
 
+
+_TWO = _UNSIGNED(2)
+_THREE = _UNSIGNED(3)
 
 #: :func:`_bucket_starts` cuts the vertices into this many chunks per thread.
 _VERTEX_CHUNKS = 4
@@ -191,60 +194,70 @@ def build_edges_into(
                 side_of[slot] = 3 * f + k
     e = -1
     for v in range(n_vertices):
-        start, stop = bucket_start[v], bucket_start[v + 1]
-        for i in range(start + 1, stop):  # stable insertion sort of the (small) bucket
+        start, stop = _UNSIGNED(bucket_start[v]), _UNSIGNED(bucket_start[v + 1])  # unsigned: see _twin_walk
+        for i in range(start + _ONE, stop):  # stable insertion sort of the (small) bucket
             key = sort_key[i]
             side = side_of[i]
-            j = i - 1
-            while j >= start and sort_key[j] > key:
-                sort_key[j + 1] = sort_key[j]
-                side_of[j + 1] = side_of[j]
-                j -= 1
-            sort_key[j + 1] = key
-            side_of[j + 1] = side
+            j = i
+            while j > start and sort_key[j - _ONE] > key:
+                sort_key[j] = sort_key[j - _ONE]
+                side_of[j] = side_of[j - _ONE]
+                j -= _ONE
+            sort_key[j] = key
+            side_of[j] = side
         previous_high = -1
+        group = start  # the first side of the current edge: the sides of an edge are next to each other
         for i in range(start, stop):
             high = sort_key[i] >> 1
             backward = sort_key[i] & 1
             side = side_of[i]
-            face = side // 3
+            face = np.int64(_UNSIGNED(side) // _THREE)  # back to signed: -1 and a face share a type
             if high != previous_high:
+                if with_twins and i > start:
+                    _edge_twins(sort_key, side_of, twins, group, i)
+                group = i
                 e += 1
                 previous_high = high
-                edges[e, 0] = v
-                edges[e, 1] = high
-                edge_faces[e, 0] = -1 if backward else face
-                edge_faces[e, 1] = face if backward else -1
-                counts[e] = 1
-                forward[e] = 0 if backward else 1
+                edge = _UNSIGNED(e)
+                edges[edge, 0] = v
+                edges[edge, 1] = high
+                edge_faces[edge, 0] = -1 if backward else face
+                edge_faces[edge, 1] = face if backward else -1
+                counts[edge] = 1
+                forward[edge] = 0 if backward else 1
             else:
-                if counts[e] == 1:
-                    if edge_faces[e, 1] == -1:
-                        edge_faces[e, 1] = face
+                edge = _UNSIGNED(e)
+                if counts[edge] == 1:
+                    if edge_faces[edge, 1] == -1:
+                        edge_faces[edge, 1] = face
                     else:
-                        edge_faces[e, 0] = face
-                counts[e] += 1
+                        edge_faces[edge, 0] = face
+                counts[edge] += 1
                 if not backward:
-                    forward[e] += 1
-            face_edges[side] = e
-        if with_twins:  # the sides of each edge are next to each other in the sorted bucket
-            i = start
-            while i < stop:
-                j = i + 1
-                while j < stop and sort_key[j] >> 1 == sort_key[i] >> 1:
-                    j += 1
-                if j - i == 2 and side_of[i] // 3 != side_of[i + 1] // 3:
-                    if (sort_key[i] & 1) != (sort_key[i + 1] & 1):  # run both ways: consistently wound
-                        twins[side_of[i]] = side_of[i + 1]
-                        twins[side_of[i + 1]] = side_of[i]
-                    else:
-                        twins[side_of[i]] = -2 - side_of[i + 1]
-                        twins[side_of[i + 1]] = -2 - side_of[i]
-                else:
-                    for k in range(i, j):
-                        twins[side_of[k]] = -1
-                i = j
+                    forward[edge] += 1
+            face_edges[_UNSIGNED(side)] = e
+        if with_twins and stop > start:
+            _edge_twins(sort_key, side_of, twins, group, stop)
     return e + 1
+
+
+@nb.njit(inline="always", **_JIT)
+def _edge_twins(sort_key, side_of, twins, first, stop):
+    """:func:`build_edges_into`: the ``twins`` of the sides ``side_of[first:stop]`` of one edge (sorted slots
+    ``first`` to ``stop - 1``, unsigned): each other's when they are two, in two faces (``-2 - t`` where they
+    run the edge the same way), -1 otherwise."""
+    if stop - first == _TWO:
+        s, t = side_of[first], side_of[first + _ONE]
+        if _UNSIGNED(s) // _THREE != _UNSIGNED(t) // _THREE:
+            if (sort_key[first] & 1) != (sort_key[first + _ONE] & 1):  # run both ways: consistently wound
+                twins[_UNSIGNED(s)] = t
+                twins[_UNSIGNED(t)] = s
+            else:
+                twins[_UNSIGNED(s)] = -2 - t
+                twins[_UNSIGNED(t)] = -2 - s
+            return
+    for k in range(first, stop):
+        twins[_UNSIGNED(side_of[k])] = -1
 
 
 @nb.njit(inline="always", **_JIT)
@@ -331,24 +344,25 @@ def _twin_walk(twins, side, leaving):
     side. One read of ``twins`` a face, no read of the faces: crossing a consistently wound edge, the
     next side at the vertex is the one after the twin (``leaving``) or the one before it; crossing an
     inconsistent one swaps the two."""
-    start = side // 3
+    start = _UNSIGNED(side) // _THREE
     reached = 0
     while True:
-        t = twins[side]
-        if t == -1:
+        signed = twins[side]
+        if signed == -1:
             return reached, False
-        if t < -1:  # the two faces run the edge the same way
-            t = -2 - t
+        if signed < -1:  # the two faces run the edge the same way
+            signed = -2 - signed
             leaving = not leaving
-        g = t // 3
+        t = _UNSIGNED(signed)  # unsigned from here: no code for negative indices and quotients
+        g = t // _THREE
         if g == start:
             return reached, True
         reached += 1
-        k = t - 3 * g
+        k = t - _THREE * g
         if leaving:
-            side = t + 1 if k < 2 else t - 2
+            side = t + _ONE if k < _TWO else t - _TWO
         else:
-            side = t + 2 if k < 1 else t - 1
+            side = t + _TWO if k < _ONE else t - _ONE
 
 
 @nb.njit(**_JIT)
@@ -413,11 +427,12 @@ def _several_fans(twins, side, n_corners):
     corners."""
     if side < 0:
         return False
-    ahead, closed = _twin_walk(twins, side, True)
+    leaving = _UNSIGNED(side)
+    ahead, closed = _twin_walk(twins, leaving, True)
     reached = 1 + ahead
     if not closed:  # a chain: the other way too, from the side entering v
-        k = side % 3
-        reached += _twin_walk(twins, side + 2 if k < 1 else side - 1, False)[0]
+        k = leaving % _THREE
+        reached += _twin_walk(twins, leaving + _TWO if k < _ONE else leaving - _ONE, False)[0]
     return reached < n_corners
 
 
