@@ -1,7 +1,10 @@
 """The prepared mesh: the caller's arrays checked once, then trusted (issue 33)."""
 
+import collections
 import importlib.util
+import re
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -9,30 +12,102 @@ import pytest
 import meshcurv
 from meshcurv import _prepared, _validation, shapes
 from meshcurv._backend import use_backend
-from meshcurv.errors import InvalidMeshError
+from meshcurv.errors import InvalidMeshError, InvalidOptionError
 from meshcurv.topology import MeshTopology
 
 
-def _counted(monkeypatch, module, name: str) -> list:
-    calls: list = []
-    original = getattr(module, name)
+def _validation_entries(call) -> collections.Counter:
+    """``(function, caller's module)`` of each entry into :mod:`meshcurv._validation` from outside it during
+    ``call()``, and ``("coerced", name)`` for each run of :func:`~meshcurv._validation.as_vertices` and
+    :func:`~meshcurv._validation.polygon_arrays`, whoever calls them."""
+    found: collections.Counter = collections.Counter()
+    coercions = {_validation.as_vertices.__code__: "as_vertices", _validation.polygon_arrays.__code__: "faces"}
 
-    def spy(*args, **kwargs):
-        calls.append(name)
-        return original(*args, **kwargs)
+    def profile(frame, event, arg):
+        if event != "call" or frame.f_globals.get("__name__") != "meshcurv._validation":
+            return
+        if frame.f_code in coercions:
+            found["coerced", coercions[frame.f_code]] += 1
+        caller = frame.f_back
+        if caller is not None and caller.f_globals.get("__name__") != "meshcurv._validation":
+            module = caller.f_globals.get("__name__")
+            pending = module == "meshcurv.defects" or (module, caller.f_code.co_name) in PENDING_RADIUS
+            found[frame.f_code.co_name, "(pending)" if pending else module] += 1
 
-    monkeypatch.setattr(module, name, spy)
-    return calls
+    _profiled(profile, call)
+    return found
 
 
-@pytest.mark.parametrize("method", ["normal_cycle", "icc"])
-def test_the_vertices_and_faces_are_checked_once_per_call(method, monkeypatch):
-    sphere = shapes.icosphere(4)
-    vertices = _counted(monkeypatch, _prepared, "as_vertices")
-    faces = _counted(monkeypatch, _prepared, "as_faces")
-    again = _counted(monkeypatch, _validation, "as_vertices")  # a helper that would check them a second time
-    meshcurv.principal_curvatures(sphere.vertices, sphere.faces.tolist(), method=method)
-    assert (len(vertices), len(faces), len(again)) == (1, 1, 0)
+def _profiled(profile, call) -> None:
+    """``call()`` under ``sys.setprofile(profile)``."""
+    sys.setprofile(profile)
+    try:
+        call()
+    finally:
+        sys.setprofile(None)
+
+
+#: The public ``vertex_radii`` (checked) that ``icc``, ``quadric`` and ``normal_cycle_ball`` call with the groups of
+#: ``_component_radii``, until they call its core ``_vertex_radii``: entries marked pending, as those from
+#: ``meshcurv.defects`` (its public rules re-check the prepared needles, until its cores take them).
+PENDING_RADIUS = {("meshcurv.radius", "vertex_radii"), ("meshcurv.radius", "_length")}
+
+#: What a default call on an array mesh passes through ``_validation``: ``as_mesh``, once, at the door.
+THE_DOOR = {("as_mesh", "meshcurv._prepared"): 1, ("coerced", "as_vertices"): 1, ("coerced", "faces"): 1}
+
+
+@pytest.mark.parametrize("method", meshcurv.METHODS)
+def test_a_default_call_checks_the_vertices_and_faces_once_at_the_door(method):
+    # before (9840e16): as_vertices, as_faces and check_choice at the door, and for normal_cycle and matgeom
+    # check_int_option of the registry's default smoothing_steps; jets and neighborhoods: none since c1fe141.
+    # The pending entries (PENDING_RADIUS, meshcurv.defects) are left out here and pinned by the xfail below.
+    sphere = shapes.icosphere(3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # meyer: no directions
+        entries = _validation_entries(
+            lambda: meshcurv.principal_curvatures(sphere.vertices, sphere.faces.tolist(), method=method)
+        )
+    assert {key: n for key, n in entries.items() if key[1] != "(pending)"} == THE_DOOR
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="defects.defect_codes, scale_vertices, scale_edges and radius.vertex_radii (public, checked) are "
+    "called with the prepared arrays: their cores asked of the lead (benchmarks/prepared_mesh.md)",
+)
+@pytest.mark.parametrize("method", ["icc", "normal_cycle", "quadric"])
+def test_a_default_call_enters_validation_once(method):
+    sphere = shapes.icosphere(3)
+    entries = _validation_entries(lambda: meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method))
+    assert entries == THE_DOOR
+
+
+def test_a_given_topology_is_not_checked_again():
+    # its faces were checked when it was built: the door coerces the vertices only
+    sphere = shapes.icosphere(3)
+    topology = MeshTopology.from_faces(sphere.faces, len(sphere.vertices))
+    entries = _validation_entries(
+        lambda: meshcurv.principal_curvatures(sphere.vertices, topology, method="normal_cycle")
+    )
+    assert {key: n for key, n in entries.items() if key[1] != "(pending)"} == {
+        ("as_vertices", "meshcurv._prepared"): 1,
+        ("coerced", "as_vertices"): 1,
+    }
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"orient": "inward"}, "unknown orient 'inward'; choose one of 'auto', 'outward'"),
+        ({"orient": None}, "unknown orient None"),
+        ({"method": "normal_cycle", "smoothing_steps": -1}, "`smoothing_steps` must be an integer >= 0"),
+        ({"method": "matgeom", "smoothing_steps": 2.5}, "`smoothing_steps` must be an integer >= 0"),
+    ],
+)
+def test_the_options_the_door_no_longer_enters_validation_for_are_still_refused(options, message):
+    sphere = shapes.icosphere(1)
+    with pytest.raises(InvalidOptionError, match=re.escape(message)):
+        meshcurv.principal_curvatures(sphere.vertices, sphere.faces, **options)
 
 
 def test_a_prepared_mesh_holds_the_checked_arrays_and_leaves_the_callers_alone():
@@ -101,11 +176,7 @@ def _entered(code, call) -> int:
         if event == "call" and frame.f_code is code:
             entries.append(1)
 
-    sys.setprofile(profile)
-    try:
-        call()
-    finally:
-        sys.setprofile(None)
+    _profiled(profile, call)
     return len(entries)
 
 

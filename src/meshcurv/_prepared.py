@@ -22,7 +22,7 @@ import numpy as np
 
 from ._adapters import mesh_arrays
 from ._locality import local_topology
-from ._validation import as_faces, as_vertices, check_choice
+from ._validation import as_mesh, as_vertices, check_choice
 from .defects import BOUNDARY, VertexDefects, _needle_vertices, defect_codes
 from .errors import InvalidOptionError
 from ._geometry import (
@@ -215,11 +215,13 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     """
     if faces is None:
         vertices, faces = mesh_arrays(vertices)
-    callers = as_vertices(vertices)
-    if not isinstance(faces, MeshTopology):
-        faces = as_faces(faces, callers.shape[0], stacklevel=stacklevel + 1)
+    if isinstance(faces, MeshTopology):  # its faces were checked when it was built
+        callers = as_vertices(vertices)
+    else:
+        callers, faces = as_mesh(vertices, faces, stacklevel=stacklevel + 1)
     points, topology, local = local_topology(callers, faces)
-    check_choice(orient, "orient", ORIENT_CHOICES)
+    if not isinstance(orient, str) or orient not in ORIENT_CHOICES:
+        check_choice(orient, "orient", ORIENT_CHOICES)  # raises: not an orientation
     if not isinstance(weld, (bool, np.bool_)):
         raise InvalidOptionError(f"`weld` must be True or False; got {weld!r}")
     welding = weld_vertices(points, topology) if weld else None

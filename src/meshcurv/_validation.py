@@ -1,8 +1,9 @@
 """The one place where user input is checked and coerced.
 
 Every public entry point passes its arrays through :func:`as_vertices` and
-:func:`as_faces`; the core then trusts them (float64 (V, 3) finite vertices,
-int64 (F, 3) triangles with indices in range).
+:func:`as_faces` (a mesh: :func:`as_mesh`, both at once); the core then trusts
+them (float64 (V, 3) finite vertices, int64 (F, 3) triangles with indices in
+range).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from .errors import InvalidMeshError, InvalidOptionError, TriangulationWarning
 __all__ = [
     "as_vertices",
     "as_faces",
+    "as_mesh",
     "as_polygons",
     "polygon_arrays",
     "fan_triangles",
@@ -298,6 +300,23 @@ def as_faces(faces, n_vertices: int, *, name: str = "faces", stacklevel: int = 3
         negative or out-of-range indices (with a hint when they look 1-based).
     """
     return checked_triangles(polygon_arrays(faces, name=name), n_vertices, name=name, stacklevel=stacklevel + 1)
+
+
+def as_mesh(vertices, faces, *, stacklevel: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(as_vertices(vertices), as_faces(faces, V))``: a mesh checked and coerced, once.
+
+    The door of :func:`meshcurv.principal_curvatures` (:func:`meshcurv._prepared.prepare_mesh`):
+    the arrays it returns are new, float64 (V, 3) finite vertices and int64 (F, 3) triangles
+    with indices in ``[0, V)``, and nothing after it checks them again. Polygons are
+    fan-triangulated with a :class:`TriangulationWarning` attributed ``stacklevel`` frames up.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`as_vertices` (checked first), then as :func:`as_faces`.
+    """
+    points = as_vertices(vertices)
+    return points, as_faces(faces, points.shape[0], stacklevel=stacklevel + 1)
 
 
 def checked_triangles(

@@ -317,7 +317,7 @@ def _checked_options(method, **given) -> tuple:
         if name not in estimator.options:
             raise InvalidOptionError(f"method {method!r} does not take the option `{name}`")
         options[name] = value
-    if "smoothing_steps" in options:
+    if given.get("smoothing_steps") is not None:  # the registry's default is an int in range
         options["smoothing_steps"] = check_smoothing_steps(options["smoothing_steps"])  # the estimators trust it
     if isinstance(options.get("radius"), str) and options["radius"] == "adaptive" and estimator.name == "icc":
         options["radius"], options["adaptive"] = None, True  # from the default radius upwards, per vertex

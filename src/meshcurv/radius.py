@@ -63,13 +63,14 @@ cost; the local default costs one sparse product per ring.
 
 from __future__ import annotations
 
+import numbers
 import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ._validation import check_positive_float, checked_indices, checked_mask, checked_points
+from ._validation import check_positive_float, check_vertex_count, checked_indices, checked_mask, checked_points
 from .errors import InvalidOptionError
 from .defects import _needle_vertices, needle_corners, scale_edges, scale_vertices
 from ._geometry import (
@@ -80,8 +81,9 @@ from ._geometry import (
     vertex_length_scales,
 )
 from .geometry import _floats, checked_topology_points
-from .jets import SETTLED_SLOPE, _fit_jets, fit_jets
+from .jets import SETTLED_SLOPE, _fit_jets
 from .lattice import voxel_grid
+from .neighborhoods import _checked_ids
 from .topology import MeshTopology
 
 if TYPE_CHECKING:
@@ -812,8 +814,54 @@ def _local_scale_ratios(mesh: _Measured | PreparedMesh) -> np.ndarray:
 def vertex_radii(groups: list[tuple[float, np.ndarray | None]], n_vertices: int) -> np.ndarray:
     """(V,) the radius of each vertex from ``[(radius, members or None), ...]`` (:func:`component_radii`).
 
-    ``members`` None: every vertex (a mesh of one scale).
+    Parameters
+    ----------
+    groups : list of (float, ndarray or None)
+        Each group's radius (finite, >= 0: 0 for a mesh without edges) and the ids of its vertices
+        (1-d, in ``[0, n_vertices)``); ``members`` None: every vertex (a mesh of one scale, the only group).
+    n_vertices : int
+        V.
+
+    Returns
+    -------
+    ndarray of shape (V,)
+        NaN at the vertices of no group.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``groups`` is not a non-empty list of pairs, a radius is not a finite number >= 0, a group of every
+        vertex (None) is not the only group, ``n_vertices`` is not a positive integer.
+    InvalidMeshError
+        ``members`` that are not 1-d vertex ids in range.
     """
+    n_vertices = check_vertex_count(n_vertices)
+    if isinstance(groups, (str, bytes)) or not isinstance(groups, (list, tuple)) or not groups:
+        raise InvalidOptionError(f"`groups` must be a non-empty list of (radius, members) pairs; got {groups!r:.60}")
+    checked = []
+    for group in groups:
+        if not isinstance(group, (list, tuple)) or len(group) != 2:
+            raise InvalidOptionError(f"`groups` must hold (radius, members) pairs; got {group!r:.60}")
+        radius, members = group
+        if members is None and len(groups) > 1:
+            raise InvalidOptionError("`groups`: members None (every vertex) is only allowed in a list of one group")
+        ids = None if members is None else _checked_ids(members, n_vertices, name="members")
+        checked.append((_length(radius, "radius"), ids))
+    return _vertex_radii(checked, n_vertices)
+
+
+def _length(value, name: str) -> float:
+    """``value`` as a float, finite and >= 0 (:func:`check_positive_float`, 0 let through)."""
+    if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) and value == 0:
+        return 0.0
+    try:
+        return check_positive_float(value, name)
+    except InvalidOptionError:
+        raise InvalidOptionError(f"`{name}` must be a finite number >= 0; got {value!r:.40}") from None
+
+
+def _vertex_radii(groups: list[tuple[float, np.ndarray | None]], n_vertices: int) -> np.ndarray:
+    """:func:`vertex_radii` of checked ``groups`` (those of :func:`_component_radii`, :func:`_noise_radii`)."""
     radii = np.full(n_vertices, groups[0][0] if groups[0][1] is None else np.nan)
     for radius, members in groups:
         if members is not None:
@@ -893,13 +941,50 @@ def cloud_noise_level(points, normals, spacing, centres, usable) -> float:
     """Median distance of the points to degree-2 jets over :data:`CLOUD_NOISE_FIT_RADIUS` spacings, in spacings.
 
     ``centres`` are the usable points, of which at most :data:`CLOUD_NOISE_SAMPLE`, evenly spaced, are fitted.
+
+    Parameters
+    ----------
+    points : array_like of shape (P, 3)
+        Finite coordinates.
+    normals : array_like of shape (P, 3)
+        Unit normals of the fits' first frames (NaN where there is none: no fit there).
+    spacing : float
+        The cloud's median spacing, finite and >= 0 (0: coincident points, no noise measured: 0).
+    centres : array_like of shape (M,), int
+        The ids of the points to fit around.
+    usable : array_like of shape (P,), bool
+        The points that may enter the balls.
+
+    Returns
+    -------
+    float
+        0 when no jet could be fitted.
+
+    Raises
+    ------
+    InvalidMeshError
+        ``points``, ``normals``, ``centres`` or ``usable`` of the wrong shape, dtype or range; NaN or infinite
+        points.
+    InvalidOptionError
+        ``spacing`` is not a finite number >= 0.
     """
+    points = checked_points(points, name="points")
+    n = points.shape[0]
+    normals = _floats(normals, "normals", (n, 3))
+    spacing = _length(spacing, "spacing")
+    centres = _checked_ids(centres, n)
+    usable = checked_mask(usable, n, name="usable")
+    return _cloud_noise_level(points, normals, spacing, centres, usable)
+
+
+def _cloud_noise_level(points, normals, spacing: float, centres, usable) -> float:
+    """:func:`cloud_noise_level` of checked arrays."""
     taken = np.linspace(0, centres.size - 1, min(centres.size, CLOUD_NOISE_SAMPLE)).round().astype(np.int64)
     sample = centres[taken]
     if spacing <= 0 or sample.size == 0:
         return 0.0
     radius = CLOUD_NOISE_FIT_RADIUS * spacing
-    coefficients, _, _ = fit_jets(points, normals, radius, degree=2, iterations=1, centres=sample, neighbours=usable)
+    coefficients, _, _ = _fit_jets(points, normals, radius, degree=2, iterations=1, centres=sample, neighbours=usable)
     heights = np.abs(coefficients[sample, 0]) * CLOUD_NOISE_FIT_RADIUS  # c00 is in units of the radius
     heights = heights[np.isfinite(heights)]
     return float(np.median(heights)) if heights.size else 0.0
