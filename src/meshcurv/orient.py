@@ -126,6 +126,9 @@ def face_flips(
         if not outward:
             return flip
         n_labels, vertex_labels = topology.vertex_components
+        if n_labels == 1:  # one patch: labels of zeros never written (calloc's pages), a flag for every face
+            patch = np.zeros(n_faces, dtype=np.int64)
+            return np.full(n_faces, _outward(vertices, topology, patch, flip, np.zeros(1, dtype=bool), 1, needles)[0])
         patch = vertex_labels[topology.faces[:, 0]]
         invert = _outward(vertices, topology, patch, flip, np.zeros(n_labels, dtype=bool), n_labels, needles)
         return invert[patch]

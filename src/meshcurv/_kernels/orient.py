@@ -14,8 +14,11 @@ def patch_volumes(vertices, faces, patch, flip, n_labels):
 
     A face's volume is that of the tetrahedron of its corners and the mean of
     its patch's faces' first corners (near the patch: no cancellation); a face
-    to ``flip`` counts reversed. Two passes over the faces, no temporaries.
+    to ``flip`` counts reversed. Two passes over the faces, no temporaries;
+    one patch (``n_labels`` 1: every label is 0) without reading ``patch``.
     """
+    if n_labels == 1:
+        return _one_patch_volume(vertices, faces, flip)
     count = np.zeros(n_labels)
     centre = np.zeros((n_labels, 3))
     for f in range(faces.shape[0]):
@@ -40,3 +43,31 @@ def patch_volumes(vertices, faces, patch, flip, n_labels):
         signed[p] += -volume if flip[f] else volume
         magnitude[p] += abs(volume)
     return signed, magnitude
+
+
+@nb.njit(**_JIT)
+def _one_patch_volume(vertices, faces, flip):
+    """:func:`patch_volumes` of one patch, its sums in the same order: the labels (all 0) are not read (16 MB at
+    two million faces)."""
+    n_faces = faces.shape[0]
+    cx, cy, cz = 0.0, 0.0, 0.0
+    for f in range(n_faces):
+        a = faces[f, 0]
+        cx += vertices[a, 0]
+        cy += vertices[a, 1]
+        cz += vertices[a, 2]
+    weight = max(float(n_faces), 1.0)
+    cx /= weight
+    cy /= weight
+    cz /= weight
+    signed = 0.0
+    magnitude = 0.0
+    for f in range(n_faces):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
+        bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
+        qx, qy, qz = vertices[c, 0] - cx, vertices[c, 1] - cy, vertices[c, 2] - cz
+        volume = ax * (by * qz - bz * qy) + ay * (bz * qx - bx * qz) + az * (bx * qy - by * qx)
+        signed += -volume if flip[f] else volume
+        magnitude += abs(volume)
+    return np.full(1, signed), np.full(1, magnitude)
