@@ -73,9 +73,9 @@ import numpy as np
 from ._validation import check_positive_float, check_vertex_count, checked_indices, checked_mask, checked_points
 from .errors import InvalidOptionError
 from .defects import _needle_vertices, needle_corners, scale_edges, scale_vertices
+from . import _geometry  # _geometry.median_edge_length: the core, not the checked shell of geometry.py
 from ._geometry import (
     COMPONENT_SCALE_SPREAD,
-    median_edge_length,
     robust_mean_edge_length,
     vertex_edge_lengths,
     vertex_length_scales,
@@ -217,7 +217,7 @@ def _check_radius(radius: float, mesh: _Measured | PreparedMesh) -> float:
         return radius
     diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
     if topology.n_faces and radius < MIN_RADIUS_EDGES * diagonal:
-        median = median_edge_length(vertices, topology.edges)
+        median = _geometry.median_edge_length(vertices, topology.edges)
         if radius < MIN_RADIUS_EDGES * median:
             raise InvalidOptionError(
                 f"`radius` {radius:g} is below {MIN_RADIUS_EDGES:g} of the median edge length {median:g}: "
@@ -225,7 +225,7 @@ def _check_radius(radius: float, mesh: _Measured | PreparedMesh) -> float:
                 f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
             )
     if radius > diagonal:
-        median = median_edge_length(vertices, topology.edges)
+        median = _geometry.median_edge_length(vertices, topology.edges)
         raise InvalidOptionError(
             f"`radius` {radius:g} is larger than the mesh itself (bounding-box diagonal {diagonal:g}, median "
             f"edge length {median:g}): every ball would hold the whole mesh; pass a radius of a few edge "
@@ -247,7 +247,7 @@ def small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopolog
 def _small_radius_note(radius: float, vertices: np.ndarray, topology: MeshTopology, minimum_edges: float) -> str:
     if not topology.n_faces:
         return ""
-    median = median_edge_length(vertices, topology.edges)
+    median = _geometry.median_edge_length(vertices, topology.edges)
     if not radius < minimum_edges * median:
         return ""
     return (
@@ -563,7 +563,9 @@ def _voxel_surface_radius(
         area = 0.5 * float(
             np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1).sum()
         )
-        rings = int(np.clip(np.ceil(radius / median_edge_length(vertices, topology.edges)), 1, VOXEL_REGION_RINGS))
+        rings = int(
+            np.clip(np.ceil(radius / _geometry.median_edge_length(vertices, topology.edges)), 1, VOXEL_REGION_RINGS)
+        )
         radii, normal_radii = voxel_vertex_radii(
             grid.spacing,
             more[0],
