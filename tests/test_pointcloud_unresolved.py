@@ -420,3 +420,72 @@ def test_a_plate_thinner_than_its_noise_has_no_valid_point_on_the_wrong_side():
 UNDECIDED_SIDE = next(
     code for code, text in enumerate(INVALID_REASONS) if text.startswith("point cloud: side undecided")
 )
+
+
+UNSTEADY = next(code for code, text in enumerate(INVALID_REASONS) if text.startswith("point cloud: unsteady"))
+
+
+def sphere_beside_a_disc(seed, noise=0.1):
+    """``(points, normals, mean, kmax, spacing)``: the fuzzer's seed 142 cases drawn again: a unit sphere of 400
+    points and a flat ellipsoid 1 x 1 x 0.05 of 400 points (about a disc, 1.4 times denser) whose centre is 3 away,
+    under noise of ``noise`` spacings along the exact normals."""
+    from scipy.spatial import cKDTree
+
+    ball, ball_normals = sphere(400, seed=seed)
+    disc, disc_normals, disc_mean, disc_kmax = ellipsoid(400, (1.0, 1.0, 0.05), seed=seed + 1)
+    points = np.concatenate([ball, disc + [0.0, 3.0, 0.0]])
+    normals = np.concatenate([ball_normals, disc_normals])
+    mean, kmax = np.concatenate([np.ones(400), disc_mean]), np.concatenate([np.ones(400), disc_kmax])
+    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+    rng = np.random.default_rng(seed + 2)
+    points = points + rng.uniform(-noise, noise, (800, 1)) * spacing * normals
+    return points, normals, mean, kmax, spacing
+
+
+@pytest.mark.parametrize("seed", [0, 10, 20, 30])
+def test_jets_on_a_sphere_beside_a_flat_ellipsoid_leave_no_valid_wrong_point(seed):
+    # fuzz seed 142 cases 176, 270, 316, 541, 706, 732: the disc makes the density uneven and the noise level high,
+    # and the sphere's class gets a ball as large as its radius (1.06-1.44, or cut to a quarter of the cloud's
+    # extent): its jets' H is 1.5 (the degree-3 jet's bias), valid. Such balls turn the normal by r |H| > 1.6 rad
+    points, normals, mean, kmax, spacing = sphere_beside_a_disc(seed)
+    r = quiet(points, method="jets")
+    resolved = kmax * spacing <= 0.25  # as the fuzzer checks: radius of curvature of 4 spacings or more
+    side = np.sign(np.einsum("ij,ij->i", r.normals, normals))
+    error = np.abs(r.mean - side * mean) / kmax
+    assert not (r.valid & resolved & ~(error <= 0.5)).any()
+    assert r.valid.sum() > 100  # (the disc's faces, and the sphere where its ball resolves it)
+
+
+def test_jets_over_a_ball_as_large_as_the_radius_of_curvature_are_unsteady():
+    # a unit sphere, jets over given radii: H is 6% too large over balls of 0.6, 44% over balls of 1.4 (the degree-3
+    # jet's bias grows as the square of the turn), where r |H| is 2.0 rad
+    points, _ = sphere(2000, seed=40)
+    small = quiet(points, method="jets", radius=0.6)
+    assert small.valid.all()
+    assert np.all(np.abs(small.mean - 1.0) < 0.1)
+    large = quiet(points, method="jets", radius=1.4)
+    assert not np.any(large.valid & ~(np.abs(large.mean - 1.0) <= 0.3))
+    assert (large.invalid_reason[~large.valid] == UNSTEADY).all()
+    assert (~large.valid).mean() > 0.9
+
+
+def test_wide_jets_takes_the_mean_turn():
+    # r |H| against JET_MEAN_TURN: a sphere's jet (k_min = k_max) and a cylinder's (k_min = 0) over the same ball
+    # (the cylinder's turns by 3 rad across its tube but by 1.5 on average: its H takes half of the jet's bias)
+    k_min, k_max = np.array([1.0, 0.0, 1.0, np.nan]), np.array([1.0, 1.8, 1.0, np.nan])
+    radii = np.array([1.7, 1.7, 1.5, 1.7])
+    flagged = estimators.wide_jets(k_min, k_max, radii, np.ones(4, dtype=bool))
+    assert flagged.tolist() == [True, False, False, False]
+    assert not estimators.wide_jets(k_min, k_max, radii, np.zeros(4, dtype=bool)).any()
+    assert "1.6 rad" in estimators.wide_jets_problem(flagged)[0]
+    assert estimators.wide_jets_problem(np.zeros(4, dtype=bool)) == []
+
+
+def test_alone_flags_an_estimate_none_of_whose_neighbours_is_resolved():
+    # fuzz seed 142 case 366: one valid point amid 24 unsteady neighbours (a plate 3.7 spacings thick under noise,
+    # H -464 against 116); a point with one resolved neighbour, or itself unresolved, is not flagged
+    resolved = np.array([True, False, False, True, True, False])
+    indices = np.array([[1, 2], [0, 2], [0, 1], [4, 5], [3, 5], [3, 4]])
+    assert estimators.alone(resolved, indices).tolist() == [True, False, False, False, False, False]
+    assert "none of the nearest neighbours" in estimators.alone_problem(estimators.alone(resolved, indices))[0]
+    assert estimators.alone_problem(np.zeros(6, dtype=bool)) == []

@@ -130,6 +130,16 @@ BLEND_TURN = 0.8
 BLEND_QUANTILE = 0.9
 BLEND_RESIDUAL = 0.3
 
+#: A jet whose ball turns the normal by more than this many radians on average over the directions (``radius |H|``,
+#: the mean of the normal curvature over the directions being H) is unsteady (:func:`wide_jets`): a degree-3 jet's
+#: bias grows as the square of the turn. On a unit sphere (400 and 2,000 points, clean or under noise of 0.1-0.2
+#: spacings, given radii) the jets' H is 11% too large at ``radius |H|`` 0.9, 19% at 1.2, 30% at 1.57 and 44% at
+#: 2.04; seed 142 of ``benchmarks/fuzz_api.py`` (spheres beside flat ellipsoids, balls of a density class or cut to
+#: a quarter of the cloud's extent: 1.44 on a unit sphere) left points at 2.13-2.30, off by 0.50-0.54 of |k|. Where
+#: one principal curvature dominates (a thin torus's tube under noise, balls turning it by up to 2.4 rad) H takes
+#: half of that bias, and ``radius |H|`` stays below 1.3.
+JET_MEAN_TURN = 1.6
+
 
 def one_sided_fits(
     points,
@@ -471,15 +481,60 @@ def blend_residuals(points, normals, found, radii, centres, tree, sheets=None) -
     return out, turns
 
 
+def _nan_phrase(flagged: np.ndarray, what: str) -> list[str]:
+    """``["at <count> points <what>: NaN"]`` for the ``flagged`` (N,) points of a check; none when none."""
+    return [f"at {int(flagged.sum())} points {what}: NaN"] if flagged.any() else []
+
+
 def blended_problem(flagged: np.ndarray) -> list[str]:
     """The phrase of the call's warning for the ``flagged`` (N,) points of :func:`blended`; none when none."""
-    if not flagged.any():
-        return []
-    return [
-        f"at {int(flagged.sum())} points the ball turns the normal by more than {BLEND_TURN:g} rad and its normals "
-        f"differ from those of the estimate by more than {BLEND_RESIDUAL:g} of that turn (the curvature changes "
-        "across the ball by about itself: the band by the rim of a thin part, or a ball larger than a small part): NaN"
-    ]
+    return _nan_phrase(
+        flagged,
+        f"the ball turns the normal by more than {BLEND_TURN:g} rad and its normals differ from those of the "
+        f"estimate by more than {BLEND_RESIDUAL:g} of that turn (the curvature changes across the ball by about "
+        "itself: the band by the rim of a thin part, or a ball larger than a small part)",
+    )
+
+
+def wide_jets(k_min, k_max, radii, resolved) -> np.ndarray:
+    """(N,) bool: the ``resolved`` jets whose ball of ``radii`` (N,) turns the normal by more than
+    :data:`JET_MEAN_TURN` radians on average over the directions (``radius |H|``, from the estimate ``k_min``,
+    ``k_max`` (N,)): a ball about as large as the radius of curvature, where the degree-3 jet's bias on H exceeds
+    about 0.3 of |k| (a sphere in the ball of a sparser density class, or of a radius cut to the cloud's extent)."""
+    with np.errstate(invalid="ignore"):
+        turn = radii * np.abs(k_min + k_max) / 2
+    return resolved & (turn > JET_MEAN_TURN)  # (NaN: no estimate, not flagged)
+
+
+def wide_jets_problem(flagged: np.ndarray) -> list[str]:
+    """The phrase of the call's warning for the ``flagged`` (N,) points of :func:`wide_jets`; none when none."""
+    return _nan_phrase(
+        flagged,
+        f"the jet's ball turns the normal by more than {JET_MEAN_TURN:g} rad on average (radius |H|: a ball about "
+        "as large as the radius of curvature, where a degree-3 jet's H is off by 0.3 of |k| or more)",
+    )
+
+
+def alone(resolved, indices) -> np.ndarray:
+    """(N,) bool: the ``resolved`` points none of whose nearest neighbours ``indices`` (N, k) is resolved.
+
+    Their balls hold nearly the same points (a spacing or two apart): where every neighbour's estimate was found
+    unsteady, one-sided fits failed or the side is undecided, the estimator does not resolve the region, and the
+    one estimate that passed is the luck of the draw (seed 142 case 366 of ``benchmarks/fuzz_api.py``: a point of
+    a plate 3.7 spacings thick under noise, its fit shrunk to 3 spacings, H -464 against 116 amid 24 unsteady
+    neighbours whose estimates scatter from -250 to 1,560; its ball turns the normal by 0.14 rad, below the checks
+    of :func:`beside_unresolved` and :func:`blended`).
+    """
+    return resolved & ~resolved[indices].any(axis=1)
+
+
+def alone_problem(flagged: np.ndarray) -> list[str]:
+    """The phrase of the call's warning for the ``flagged`` (N,) points of :func:`alone`; none when none."""
+    return _nan_phrase(
+        flagged,
+        "none of the nearest neighbours has a resolved estimate (a region the estimator does not resolve; the one "
+        "estimate there is the luck of the draw)",
+    )
 
 
 def small_balls(radius: float, spacing: np.ndarray, needed: float) -> tuple[np.ndarray, bool]:

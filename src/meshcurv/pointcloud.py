@@ -94,7 +94,13 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    ball turns the normal by more than 0.8 rad and whose ball's normals its
    own shape operator does not predict is NaN too
    (:func:`meshcurv._pointcloud_estimators.blended`: the band by the rim of a
-   thin part, a ball larger than a small part). Clean samples keep every
+   thin part, a ball larger than a small part), and so is a jet whose ball
+   turns the normal by more than 1.6 rad on average over the directions
+   (``radius |H|``: a ball about as large as the radius of curvature, where
+   a degree-3 jet's H is off by 0.3 of |k| or more;
+   :func:`meshcurv._pointcloud_estimators.wide_jets`), and an estimate none of
+   whose 10 nearest neighbours has a resolved one
+   (:func:`meshcurv._pointcloud_estimators.alone`). Clean samples keep every
    point (``benchmarks/pointcloud.md``).
 
 References
@@ -957,6 +963,16 @@ def _compute(points, given, radius, method, search=None):
     problems.extend(_estimators.blended_problem(blend))
     reason[blend] = _UNSTEADY
     valid &= ~blend
+    if method == "jets":  # a jet over a ball about as large as the radius of curvature: its bias is about H
+        wide = _estimators.wide_jets(k_min, k_max, fitted, valid & ~doubtful)
+        problems.extend(_estimators.wide_jets_problem(wide))
+        reason[wide] = _UNSTEADY
+        valid &= ~wide
+    # an estimate none of whose nearest neighbours has one: alone in a region the estimator does not resolve
+    lone = _estimators.alone(valid & ~doubtful, indices)
+    problems.extend(_estimators.alone_problem(lone))
+    reason[lone] = _UNSTEADY
+    valid &= ~lone
     if doubtful.any():
         found = []
         between = doubtful & ~unsettled & ~alike & ~amid
