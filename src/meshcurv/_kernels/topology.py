@@ -198,7 +198,7 @@ def build_edges_into(
         for i in range(start + _ONE, stop):  # stable insertion sort of the (small) bucket
             key = sort_key[i]
             side = side_of[i]
-            j = i
+            j = _UNSIGNED(i)
             while j > start and sort_key[j - _ONE] > key:
                 sort_key[j] = sort_key[j - _ONE]
                 side_of[j] = side_of[j - _ONE]
@@ -215,7 +215,7 @@ def build_edges_into(
             if high != previous_high:
                 if with_twins and i > start:
                     _edge_twins(sort_key, side_of, twins, group, i)
-                group = i
+                group = _UNSIGNED(i)
                 e += 1
                 previous_high = high
                 edge = _UNSIGNED(e)
@@ -510,7 +510,7 @@ def double_sided_suspects(faces, edge_faces, counts, forward):
         if count > 2:
             out[e] = True
         elif count == 2 and forward[e] == 1:
-            f, g = edge_faces[e, 0], edge_faces[e, 1]
+            f, g = _UNSIGNED(edge_faces[e, 0]), _UNSIGNED(edge_faces[e, 1])  # both faces: >= 0
             out[e] = faces[f, 0] + faces[f, 1] + faces[f, 2] == faces[g, 0] + faces[g, 1] + faces[g, 2]
         else:
             out[e] = False
