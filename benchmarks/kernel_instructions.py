@@ -10,6 +10,8 @@ callgrind's instrumentation on (a three-line C helper built with the system's co
     valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file=/tmp/kernel.%p \\
         python benchmarks/kernel_instructions.py --size 100k --kernel fits --centres 20000 --dumps /tmp
 
+``--size voxel``: the dense voxel sphere of ``benchmarks/dense_voxel.py`` instead (its fits run twice, on coarse
+levels: ``--call 0`` the pilot's, ``--call -1`` (default) the main pass's sampled fits; issue 30).
 ``--centres``: the first centres only (the fits' ``centres``, the sums' range of vertices), for a shorter run;
 ``--dumps``: the directory of callgrind's output files (the newest ``*.1`` there is the measured call's).
 Outside valgrind the script runs too and prints 0 instructions.
@@ -23,6 +25,7 @@ import glob
 import os
 import subprocess
 import tempfile
+import warnings
 
 import numpy as np
 
@@ -30,7 +33,7 @@ import meshcurv
 from meshcurv import shapes
 from meshcurv._kernels import jets, neighborhoods
 
-SIZES = {"10k": 32, "100k": 100, "1M": 316}
+SIZES = {"10k": 32, "100k": 100, "1M": 316, "voxel": 0}
 
 HELPER = """#include <valgrind/callgrind.h>
 void start(void) { CALLGRIND_ZERO_STATS; CALLGRIND_START_INSTRUMENTATION; }
@@ -47,8 +50,20 @@ def _helper(directory: str) -> ctypes.CDLL:
     return ctypes.CDLL(library)
 
 
+def _mesh(size: str):
+    """``(vertices, faces, label)`` of the mesh of ``--size``: an icosphere, or ``voxel``, the dense voxel sphere of
+    ``benchmarks/dense_voxel.py`` (R 6 at 0.5 x 0.2 x 0.2, 10,172 vertices: its normal fits run on coarse levels)."""
+    if size == "voxel":
+        sphere = shapes.voxel_sphere(6.0, (0.5, 0.2, 0.2), seed=0)
+        return np.asarray(sphere.vertices, float), sphere.faces[:, ::-1], "voxel sphere R 6 at 0.5 x 0.2 x 0.2"
+    sphere = shapes.icosphere(SIZES[size])
+    return sphere.vertices, sphere.faces, f"icosphere({SIZES[size]})"
+
+
 def _recorded(size: str) -> dict:
-    """The arguments of the two kernels in one default call (copies taken before each call)."""
+    """The arguments of the two kernels in one default call (copies taken before each call): per kernel, a list
+    of the calls' arguments, in the order of the calls (the voxel sphere fits twice: its pilot, then its main
+    pass)."""
     calls: dict = {}
 
     def recording(module, name, keep):
@@ -56,10 +71,11 @@ def _recorded(size: str) -> dict:
 
         def wrapper(*args):
             if keep(args):
-                calls[name] = [a.copy() if isinstance(a, np.ndarray) else _copied(a) for a in args]
-                for copy, given in zip(calls[name], args):
+                copies = [a.copy() if isinstance(a, np.ndarray) else _copied(a) for a in args]
+                for copy, given in zip(copies, args):
                     if isinstance(given, np.ndarray):
                         copy.flags.writeable = given.flags.writeable
+                calls.setdefault(name, []).append(copies)
             return original(*args)
 
         setattr(module, name, wrapper)
@@ -70,8 +86,10 @@ def _recorded(size: str) -> dict:
         recording(neighborhoods, "connected_face_sums", lambda args: True),
     )
     try:
-        sphere = shapes.icosphere(SIZES[size])
-        meshcurv.principal_curvatures(sphere.vertices, sphere.faces)
+        vertices, faces, _ = _mesh(size)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            meshcurv.principal_curvatures(vertices, faces)
     finally:
         jets.fit_jets_connected, neighborhoods.connected_face_sums = originals
     return calls
@@ -93,8 +111,11 @@ def main(argv=None) -> None:
     parser.add_argument("--kernel", choices=["fits", "sums"], default="fits")
     parser.add_argument("--centres", type=int, default=0, help="the first centres only (0: all)")
     parser.add_argument("--dumps", default=".", help="where callgrind writes its files (--callgrind-out-file)")
+    parser.add_argument(
+        "--call", type=int, default=-1, help="which of the kernel's calls (0: the first; default -1, the last)"
+    )
     options = parser.parse_args(argv)
-    calls = _recorded(options.size)
+    calls = {name: recorded[options.call] for name, recorded in _recorded(options.size).items()}
     if options.kernel == "fits":
         args = calls["fit_jets_connected"]
         if options.centres:
@@ -129,7 +150,8 @@ def main(argv=None) -> None:
         with open(dump) as handle:
             instructions = next((int(line.split()[1]) for line in handle if line.startswith("totals:")), 0)
     print(
-        f"{options.kernel} on icosphere({SIZES[options.size]}), {n_centres} centres: {instructions:,} instructions, "
+        f"{options.kernel} on {_mesh(options.size)[2]} (call {options.call}), {n_centres} centres: "
+        f"{instructions:,} instructions, "
         f"{instructions / max(n_centres, 1):,.0f} per centre"
     )
 

@@ -985,12 +985,11 @@ def nested_jet_normals(
 
 
 #: :func:`sampled_jet_normals` fits one centre per cube of this many median radii of the fits (dense voxel
-#: surfaces, on their coarse level: half a cluster's side, ``COARSE_CELLS`` = 10 of icc; a third of the fits).
-#: icc's default on 20 voxel spheres (``benchmarks/dense_voxel.md``: 4 spacings, 5 seeds): median H errors
-#: moved by -7% to +8% of themselves (mean -1%) against fits at every centre; a cluster's side (0.1), up to
-#: +16%. On the 6 of the 19 meshes of ``benchmarks/accuracy_voxel.md`` that are fitted on a coarse level:
-#: -1.7% to +4.3%.
-SAMPLED_SPACING = 0.05
+#: surfaces, on their coarse level: a cluster's side, ``COARSE_CELLS`` = 10 of icc; a tenth of the fits).
+#: Against 0.05 (twice the fits, 0.07 CPU s more on the sphere R 6 of ``benchmarks/dense_voxel.py``): the 6 of
+#: the 19 meshes of ``benchmarks/accuracy_voxel.md`` fitted on a coarse level move by -6.0% to +2.6% of their
+#: median H error; 20 voxel spheres (4 spacings, 5 seeds) by -7% to +14% (mean +1%; ``benchmarks/dense_voxel.md``).
+SAMPLED_SPACING = 0.1
 #: The other centres interpolate the fitted samples within this many sample spacings: a weighted linear
 #: least-squares fit over the centre's tangent plane, weights ``(1 - d^2 / h^2)^2`` ...
 SAMPLED_WIDTH = 1.5
