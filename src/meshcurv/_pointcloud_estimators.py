@@ -525,7 +525,11 @@ def alone(resolved, indices) -> np.ndarray:
     neighbours whose estimates scatter from -250 to 1,560; its ball turns the normal by 0.14 rad, below the checks
     of :func:`beside_unresolved` and :func:`blended`).
     """
-    return resolved & ~resolved[indices].any(axis=1)
+    out = np.zeros(resolved.shape[0], dtype=bool)
+    # (only where the nearest neighbour is unresolved: at 1M random indices 10 ms of CPU instead of 44)
+    candidates = np.flatnonzero(resolved & ~resolved[indices[:, 0]])
+    out[candidates] = ~resolved[indices[candidates]].any(axis=1)
+    return out
 
 
 def alone_problem(flagged: np.ndarray) -> list[str]:
