@@ -12,7 +12,7 @@ two components at scales 1000 apart; a triangle soup; a voxel sphere wound
 inward; the needle mesh wound inward) and ``multiscale_curvatures``, and keeps
 ``k_min, k_max, dir_min, dir_max, normals, valid, invalid_reason, radius``, the
 diagnosis, the parameters and the warnings. ``--count`` gives, for a default
-call on an icosphere of 642 vertices, the entries into
+call of each method on an icosphere of 642 vertices, the entries into
 :mod:`meshcurv._validation` from outside it (``sys.setprofile``) and the
 computations of the length scales and needle vertices (also for the icosphere
 wound inward, every face reversed by the orientation).
@@ -148,7 +148,7 @@ def count() -> None:
                 entries[key] = entries.get(key, 0) + 1
 
     inward = np.asarray(sphere.faces)[:, ::-1]  # every face reversed by the orientation
-    for method, faces in [(m, sphere.faces) for m in ("icc", "normal_cycle", "matgeom")] + [("icc inward", inward)]:
+    for method, faces in [(m, sphere.faces) for m in METHODS] + [("icc inward", inward)]:
         entries.clear()
         sys.setprofile(profile)
         try:
