@@ -392,22 +392,26 @@ def defect_codes(
     if needles is not None and needles.any():  # the corners of a needle's faces: each has a sliver in its ring
         needle_corners = np.zeros(topology.n_vertices, dtype=bool)
         needle_corners[topology.faces[needles[topology.faces].any(axis=1)].ravel()] = True
-    nonmanifold = topology.edge_vertices(topology.nonmanifold_edges)
-    bowties = topology.bowtie_vertices & ~nonmanifold
-    corners = np.zeros(topology.n_vertices, dtype=bool)
-    corners[topology.faces[degenerate].ravel()] = True
+    # None: no vertex has the defect (no pass over the vertices for it; a clean mesh has none at all)
+    nonmanifold = _edge_ends(topology, topology.nonmanifold_edges)
+    bowties = topology.bowtie_vertices if nonmanifold is None else topology.bowtie_vertices & ~nonmanifold
+    corners = None
+    if degenerate.any():
+        corners = np.zeros(topology.n_vertices, dtype=bool)
+        corners[topology.faces[degenerate].ravel()] = True
     members = {
-        "unreferenced_vertices": ~topology.referenced_vertices,
+        "unreferenced_vertices": None if topology.referenced_vertices.all() else ~topology.referenced_vertices,
         "nonmanifold_edges": nonmanifold,
-        "bowtie_vertices": bowties,
-        "inconsistent_edges": topology.edge_vertices(topology.inconsistent_edges),
+        "bowtie_vertices": bowties if bowties.any() else None,
+        "inconsistent_edges": _edge_ends(topology, topology.inconsistent_edges),
         "degenerate_faces": corners,
-        "needle_vertices": np.zeros(topology.n_vertices, dtype=bool) if needle_corners is None else needle_corners,
-        "boundary_edges": topology.edge_vertices(topology.boundary_edges),
+        "needle_vertices": needle_corners,
+        "boundary_edges": _edge_ends(topology, topology.boundary_edges),
     }
     codes = np.zeros(topology.n_vertices, dtype=np.int8)
     for defect in reversed(DEFECTS):  # the first defect that applies is written last
-        codes[members[defect.name]] = defect.code
+        if members[defect.name] is not None:
+            codes[members[defect.name]] = defect.code
     counts = {
         "boundary_edges": int(topology.boundary_edges.sum()),
         "nonmanifold_edges": int(topology.nonmanifold_edges.sum()),
@@ -418,6 +422,11 @@ def defect_codes(
         "unreferenced_vertices": int((~topology.referenced_vertices).sum()),
     }
     return codes, counts
+
+
+def _edge_ends(topology: MeshTopology, edge_mask: np.ndarray) -> np.ndarray | None:
+    """:meth:`MeshTopology.edge_vertices` of ``edge_mask``, or None when it selects no edge."""
+    return topology.edge_vertices(edge_mask) if edge_mask.any() else None
 
 
 @dataclass(frozen=True, eq=False)
