@@ -30,9 +30,7 @@ def _validation_entries(call) -> collections.Counter:
             found["coerced", coercions[frame.f_code]] += 1
         caller = frame.f_back
         if caller is not None and caller.f_globals.get("__name__") != "meshcurv._validation":
-            module = caller.f_globals.get("__name__")
-            pending = module == "meshcurv.defects" or (module, caller.f_code.co_name) in PENDING_RADIUS
-            found[frame.f_code.co_name, "(pending)" if pending else module] += 1
+            found[frame.f_code.co_name, caller.f_globals.get("__name__")] += 1
 
     _profiled(profile, call)
     return found
@@ -47,11 +45,6 @@ def _profiled(profile, call) -> None:
         sys.setprofile(None)
 
 
-#: The public ``vertex_radii`` (checked) that ``icc``, ``quadric`` and ``normal_cycle_ball`` call with the groups of
-#: ``_component_radii``, until they call its core ``_vertex_radii``: entries marked pending, as those from
-#: ``meshcurv.defects`` (its public rules re-check the prepared needles, until its cores take them).
-PENDING_RADIUS = {("meshcurv.radius", "vertex_radii"), ("meshcurv.radius", "_length")}
-
 #: What a default call on an array mesh passes through ``_validation``: ``as_mesh``, once, at the door.
 THE_DOOR = {("as_mesh", "meshcurv._prepared"): 1, ("coerced", "as_vertices"): 1, ("coerced", "faces"): 1}
 
@@ -60,25 +53,14 @@ THE_DOOR = {("as_mesh", "meshcurv._prepared"): 1, ("coerced", "as_vertices"): 1,
 def test_a_default_call_checks_the_vertices_and_faces_once_at_the_door(method):
     # before (9840e16): as_vertices, as_faces and check_choice at the door, and for normal_cycle and matgeom
     # check_int_option of the registry's default smoothing_steps; jets and neighborhoods: none since c1fe141.
-    # The pending entries (PENDING_RADIUS, meshcurv.defects) are left out here and pinned by the xfail below.
+    # defects' public rules re-checked the prepared needles (2 entries, icc 7) and icc, quadric and
+    # normal_cycle_ball called the checked radius.vertex_radii (2 entries, icc 4): they call the cores now.
     sphere = shapes.icosphere(3)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # meyer: no directions
         entries = _validation_entries(
             lambda: meshcurv.principal_curvatures(sphere.vertices, sphere.faces.tolist(), method=method)
         )
-    assert {key: n for key, n in entries.items() if key[1] != "(pending)"} == THE_DOOR
-
-
-@pytest.mark.xfail(
-    strict=True,
-    reason="defects.defect_codes, scale_vertices, scale_edges and radius.vertex_radii (public, checked) are "
-    "called with the prepared arrays: their cores asked of the lead (benchmarks/prepared_mesh.md)",
-)
-@pytest.mark.parametrize("method", ["icc", "normal_cycle", "quadric"])
-def test_a_default_call_enters_validation_once(method):
-    sphere = shapes.icosphere(3)
-    entries = _validation_entries(lambda: meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method))
     assert entries == THE_DOOR
 
 
@@ -89,7 +71,7 @@ def test_a_given_topology_is_not_checked_again():
     entries = _validation_entries(
         lambda: meshcurv.principal_curvatures(sphere.vertices, topology, method="normal_cycle")
     )
-    assert {key: n for key, n in entries.items() if key[1] != "(pending)"} == {
+    assert entries == {
         ("as_vertices", "meshcurv._prepared"): 1,
         ("coerced", "as_vertices"): 1,
     }

@@ -23,7 +23,7 @@ import numpy as np
 from ._adapters import mesh_arrays
 from ._locality import local_topology
 from ._validation import as_mesh, as_vertices, check_choice
-from .defects import BOUNDARY, VertexDefects, _needle_vertices, defect_codes
+from .defects import BOUNDARY, VertexDefects, _defect_codes, _needle_vertices
 from .errors import InvalidOptionError
 from ._geometry import (
     DEGENERATE_AREA_RATIO,
@@ -139,7 +139,7 @@ class PreparedMesh:
 
     @cached_property
     def _codes(self) -> tuple[np.ndarray, dict]:
-        return defect_codes(self.topology, self.degenerate, self.needles)
+        return _defect_codes(self.topology, self.degenerate, self.needles)
 
     def defects(self, *, boundary: bool = False) -> VertexDefects:
         """The defects as a method sees them: ``boundary=True`` for the methods that keep boundary vertices."""

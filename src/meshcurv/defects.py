@@ -310,7 +310,11 @@ def scale_vertices(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     -------
     ndarray of shape (V,), bool
     """
-    needles = _checked_needles(topology, needles)
+    return _scale_vertices(topology, _checked_needles(topology, needles))
+
+
+def _scale_vertices(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
+    """:func:`scale_vertices` of checked ``needles`` (those of a prepared mesh)."""
     return topology.referenced_vertices & ~needles
 
 
@@ -332,7 +336,11 @@ def scale_edges(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     ndarray of shape (E', 2), int
         ``topology.edges`` itself when the mesh has no needle vertex.
     """
-    needles = _checked_needles(topology, needles)
+    return _scale_edges(topology, _checked_needles(topology, needles))
+
+
+def _scale_edges(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
+    """:func:`scale_edges` of checked ``needles``."""
     if not needles.any():
         return topology.edges
     return topology.edges[~needles[topology.edges].any(axis=1)]
@@ -354,7 +362,11 @@ def needle_corners(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
     -------
     ndarray of shape (V,), bool
     """
-    needles = _checked_needles(topology, needles)
+    return _needle_corners(topology, _checked_needles(topology, needles))
+
+
+def _needle_corners(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
+    """:func:`needle_corners` of checked ``needles``."""
     corners = np.zeros(topology.n_vertices, dtype=bool)
     if needles.any():
         corners[topology.faces[needles[topology.faces].any(axis=1)].ravel()] = True
@@ -387,7 +399,13 @@ def defect_codes(
         A bow-tie vertex on a non-manifold edge is counted with that edge only.
     """
     degenerate = checked_mask(degenerate, _checked_topology(topology).n_faces, name="degenerate")
-    needles = None if needles is None else _checked_needles(topology, needles)
+    return _defect_codes(topology, degenerate, None if needles is None else _checked_needles(topology, needles))
+
+
+def _defect_codes(
+    topology: MeshTopology, degenerate: np.ndarray, needles: np.ndarray | None
+) -> tuple[np.ndarray, dict[str, int]]:
+    """:func:`defect_codes` of checked ``degenerate`` and ``needles`` (those of a prepared mesh)."""
     needle_corners = None
     if needles is not None and needles.any():  # the corners of a needle's faces: each has a sliver in its ring
         needle_corners = np.zeros(topology.n_vertices, dtype=bool)

@@ -13,11 +13,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ._backend import numba_kernels
+from . import _geometry
 from ._geometry import (
     DEGENERATE_AREA_RATIO,
     degenerate_face_mask,
-    edge_lengths,
-    face_cross_products,
     vertex_length_scales,
 )
 from ._validation import as_vertices, check_int_option
@@ -238,8 +237,8 @@ def mesh_diagnosis(
     else:
         used = vertices if n_unreferenced == 0 else vertices[referenced]
         centre = used.mean(axis=0)
-        cross = face_cross_products(vertices, faces)
-        lengths = edge_lengths(vertices, topology.edges)
+        cross = _geometry.face_cross_products(vertices, faces)
+        lengths = _geometry.edge_lengths(vertices, topology.edges)
         double_areas = np.sqrt(np.einsum("ij,ij->i", cross, cross))
         area = float(0.5 * double_areas.sum())
         # the cross products are translation-invariant: a . (b x c) = (a - o) . cross(b - a, c - a)

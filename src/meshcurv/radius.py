@@ -72,7 +72,7 @@ import numpy as np
 
 from ._validation import check_positive_float, check_vertex_count, checked_indices, checked_mask, checked_points
 from .errors import InvalidOptionError
-from .defects import _needle_vertices, needle_corners, scale_edges, scale_vertices
+from .defects import _needle_corners, _needle_vertices, _scale_edges, _scale_vertices
 from . import _geometry  # _geometry.median_edge_length: the core, not the checked shell of geometry.py
 from ._geometry import (
     COMPONENT_SCALE_SPREAD,
@@ -150,7 +150,7 @@ def edge_radius(vertices: np.ndarray, topology: MeshTopology) -> float:
 
 
 def _edge_radius(mesh: _Measured | PreparedMesh) -> float:
-    edges = scale_edges(mesh.topology, mesh.needles)  # no needle's edge
+    edges = _scale_edges(mesh.topology, mesh.needles)  # no needle's edge
     return DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(mesh.vertices, edges)
 
 
@@ -171,8 +171,8 @@ def component_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[
 
 def _component_radii(mesh: _Measured | PreparedMesh) -> list[tuple[float, np.ndarray | None]]:
     vertices, scales = mesh.vertices, mesh.length_scales
-    all_edges = scale_edges(mesh.topology, mesh.needles)  # no spike's edges (issue 29: a spike raised it 2.6x)
-    referenced = scale_vertices(mesh.topology, mesh.needles)
+    all_edges = _scale_edges(mesh.topology, mesh.needles)  # no spike's edges (issue 29: a spike raised it 2.6x)
+    referenced = _scale_vertices(mesh.topology, mesh.needles)
     used = scales[referenced & (scales > 0)]
     if used.size == 0 or used.min() == used.max():
         return [(DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, all_edges), None)]
@@ -212,7 +212,7 @@ def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
 
 def _check_radius(radius: float, mesh: _Measured | PreparedMesh) -> float:
     vertices, topology = mesh.vertices, mesh.topology
-    used = vertices[scale_vertices(topology, mesh.needles)] if topology.n_faces else vertices
+    used = vertices[_scale_vertices(topology, mesh.needles)] if topology.n_faces else vertices
     if used.shape[0] == 0:
         return radius
     diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
@@ -401,7 +401,7 @@ def _scale_centres(mesh: _Measured | PreparedMesh, valid: np.ndarray, normals: n
     needles = mesh.needles
     if not needles.any():
         return valid
-    corners = needle_corners(mesh.topology, needles) & np.isfinite(normals).all(axis=1)
+    corners = _needle_corners(mesh.topology, needles) & np.isfinite(normals).all(axis=1)
     return (valid | corners) & ~needles
 
 
@@ -449,8 +449,8 @@ def _noise_radii(
     mesh: _Measured | PreparedMesh, normals: np.ndarray, valid: np.ndarray, *, adjacency=None
 ) -> tuple[list[tuple[float, np.ndarray | None]], list[float]]:
     vertices = mesh.vertices
-    usable = scale_vertices(mesh.topology, mesh.needles)
-    all_edges = scale_edges(mesh.topology, mesh.needles)
+    usable = _scale_vertices(mesh.topology, mesh.needles)
+    all_edges = _scale_edges(mesh.topology, mesh.needles)
     centres = _scale_centres(mesh, valid, normals)
     groups: list[tuple[float, np.ndarray | None]] = []
     levels: list[float] = []
@@ -794,7 +794,7 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarr
 def _local_scale_ratios(mesh: _Measured | PreparedMesh) -> np.ndarray:
     vertices, topology, scales = mesh.vertices, mesh.topology, mesh.length_scales
     n = topology.n_vertices
-    edges = scale_edges(topology, mesh.needles)
+    edges = _scale_edges(topology, mesh.needles)
     local = vertex_edge_lengths(vertices, edges, vertices.shape[0])
     known = np.isfinite(local) & (local > 0) & (scales > 0)
     if not known.any():

@@ -102,9 +102,9 @@ from ..radius import (
     _local_scale_ratios,
     _noise_radii,
     _scale_centres,
+    _vertex_radii,
     scale_ladder,
     stable_scales,
-    vertex_radii,
 )
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
@@ -638,7 +638,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor
         ratios = _local_scale_ratios(mesh)
-        radii_v = vertex_radii(groups, vertices.shape[0]) * ratios
+        radii_v = _vertex_radii(groups, vertices.shape[0]) * ratios
         if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not np.all(ratios == 1.0):
             k_min, k_max, dir_min, dir_max, normals, valid = _curvatures(
                 vertices,
@@ -699,7 +699,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         dir_min,
         dir_max,
         defects,
-        radius=vertex_radii(groups, vertices.shape[0]),
+        radius=_vertex_radii(groups, vertices.shape[0]),
     )
 
 

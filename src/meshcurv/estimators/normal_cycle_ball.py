@@ -55,7 +55,7 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from .._geometry import edge_dihedral_angles
 from ..neighborhoods import _ball_edge_sums
-from ..radius import _component_radii, _resolve_radius, vertex_radii
+from ..radius import _component_radii, _resolve_radius, _vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, ball_holds_neighbours, finish
 
@@ -134,7 +134,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     valid &= areas > 0
     # a ball that holds none of the vertex's neighbours holds only its own corner: the polyhedron's cone at
     # the vertex, not the surface (a given radius far below the edges; issue 29): undefined
-    radii = vertex_radii(groups, vertices.shape[0])
+    radii = _vertex_radii(groups, vertices.shape[0])
     valid &= ball_holds_neighbours(vertices, topology.edges, radii) & (radii >= MIN_RADIUS_SCALES * mesh.length_scales)
     with np.errstate(invalid="ignore", divide="ignore"):
         tensors = measures / areas[:, None]

@@ -48,7 +48,7 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, MIN_POINTS, _fit_jets, shape_operators
-from ..radius import _component_radii, _resolve_radius, vertex_radii
+from ..radius import _component_radii, _resolve_radius, _vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 
@@ -138,5 +138,5 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         dir_max,
         defects,
         extra,
-        radius=vertex_radii(groups, vertices.shape[0]),
+        radius=_vertex_radii(groups, vertices.shape[0]),
     )
