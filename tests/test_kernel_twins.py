@@ -2305,3 +2305,56 @@ def test_corrected_measures_on_two_threads_are_those_of_one():
     assert np.isfinite(one[1]).sum() > vertices.shape[0] // 4
     for a, b in zip(one, two):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("name", ["noisy", "defects"])
+def test_connected_face_sums_are_the_nested_walk_of_one_ball_on_one_or_two_threads(name):
+    """``connected_face_sums`` writes out the walk of ``_face_walk`` (issue 31: no reference counts per face);
+    with one radius, ``connected_face_sums_nested`` walks with the shared helpers (its largest ball: the same
+    faces, the same additions in the same order), so the two agree to the bit, per vertex radii too, and the
+    chunks on threads give the sums of one thread."""
+    import numba
+
+    vertices, faces, compiled, values, usable, centres, reach, n, indptr, indices = face_sum_inputs(name)
+    h = mean_edge(name)
+    threads = numba.get_num_threads()
+    for radii in (np.array([1.7 * h]), np.random.default_rng(2).uniform(0.9, 2.5, n) * h):
+        nested = np.zeros((1, n, values.shape[1]))
+        compiled.connected_face_sums_nested(
+            vertices,
+            faces,
+            centres,
+            reach,
+            usable,
+            values[None],
+            np.ascontiguousarray(radii[None, :]),
+            indptr,
+            indices,
+            nested,
+            _face_sum_scratch(2, n, faces.shape[0]),
+            0,
+            n,
+        )
+        assert np.count_nonzero(nested[0].any(axis=1)) > n // 2  # sums were made
+        for count in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            got = np.zeros((n, values.shape[1]))
+            try:
+                numba.set_num_threads(count)
+                compiled.connected_face_sums(
+                    vertices,
+                    faces,
+                    centres,
+                    reach,
+                    usable,
+                    values,
+                    radii,
+                    indptr,
+                    indices,
+                    got,
+                    _face_sum_scratch(2, n, faces.shape[0]),
+                    0,
+                    n,
+                )
+            finally:
+                numba.set_num_threads(threads)
+            np.testing.assert_array_equal(got, nested[0])

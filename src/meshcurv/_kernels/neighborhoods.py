@@ -473,7 +473,7 @@ def _walk_face(
     return tail
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def connected_face_sums(
     vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
 ):
@@ -497,7 +497,38 @@ def connected_face_sums(
     rows of ``out`` are not touched: a caller that splits the vertices into
     ranges sums them into one array. ``scratch``: ``neighborhoods._face_sum_scratch``, one
     chunk of the vertices per row of its arrays (reused from call to call).
+
+    The chunks (:func:`_face_sums_chunk`) run on threads (:func:`~meshcurv._kernels._common.run_chunks`), not in
+    a ``parallel=True`` kernel: numba's parallel pipeline compiled the inlined walk twice (issue 31: 6.2 of the
+    default's cold compile CPU s, 1.9 s as a plain function, the same machine code).
     """
+    n_chunks = scratch[0].shape[0]
+    run_chunks(
+        _face_sums_chunk,
+        n_chunks,
+        n_chunks,
+        vertices,
+        faces,
+        centroids,
+        reach,
+        usable,
+        values,
+        radii,
+        indptr,
+        indices,
+        out,
+        scratch,
+        start,
+        stop,
+    )
+
+
+@nb.njit(**_JIT)
+def _face_sums_chunk(
+    lo, hi, vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
+):
+    """Chunks ``lo`` to ``hi - 1`` of :func:`connected_face_sums` (chunk ``c``: its ``c``-th range of the
+    vertices ``start`` to ``stop``, with row ``c`` of each ``scratch`` array)."""
     n = vertices.shape[0]
     n_values = values.shape[1]
     per_vertex = radii.shape[0] > 1
@@ -505,7 +536,7 @@ def connected_face_sums(
     m = max(min(stop, n), start) - start
     all_seen, all_mark, all_known, all_squared, all_queue, _, _ = scratch
     n_chunks = all_seen.shape[0]
-    for chunk in nb.prange(n_chunks):
+    for chunk in range(lo, hi):
         seen = all_seen[chunk]
         mark = all_mark[chunk]  # queued for this centre
         known = all_known[chunk]  # distance to this centre in `squared`
@@ -514,23 +545,68 @@ def connected_face_sums(
         total = np.empty(n_values)  # the centre's sums, in the order of the face visits, then stored once
         for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
             radius = radii[v if per_vertex else 0]
+            radius2 = radius * radius
             for k in range(n_values):
                 total[k] = out[v, k]
-            _face_walk(
-                vertices,
-                faces,
-                centroids,
-                reach,
-                usable,
-                values,
-                indptr,
-                indices,
-                v,
-                v,
-                radius,
-                (known, squared, seen, mark, queue),
-                total,
-            )
+            # the walk of _face_walk and _walk_face written out: their arrays bound once, not once per face
+            # (inlined, each face's call took and dropped a reference to each of its arrays: 3x the walk's time)
+            cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+            mark[v] = v
+            queue[0] = v
+            head, tail = 0, 1
+            while head < tail:
+                a = _UNSIGNED(queue[head])  # unsigned indices: no code for negative ones
+                head += 1
+                for j in range(_UNSIGNED(indptr[a]), _UNSIGNED(indptr[a + _ONE])):
+                    f = _UNSIGNED(indices[j])
+                    if seen[f] == v:
+                        continue
+                    seen[f] = v
+                    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
+                    if d > (radius + reach[f]) ** 2:
+                        continue  # every point of the face is outside
+                    low = d  # _met_share written out: the corners' and centroid's distances
+                    high = d
+                    for corner in range(3):
+                        c = _UNSIGNED(faces[f, corner])
+                        if known[c] != v:
+                            known[c] = v
+                            squared[c] = (
+                                (vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2 + (vertices[c, 2] - cz) ** 2
+                            )
+                        low = min(low, squared[c])
+                        high = max(high, squared[c])
+                    if high <= radius2:
+                        share = 1.0
+                    elif low < radius2:
+                        root = math.sqrt(low)
+                        share = (radius - root) / (math.sqrt(high) - root)
+                    else:  # corners and centroid outside: met if a side crosses the sphere
+                        share = 0.0
+                        crossed = False
+                        for corner in range(3):
+                            p = _UNSIGNED(faces[f, corner])
+                            q = _UNSIGNED(faces[f, (corner + 1) % 3])
+                            crossed = crossed or _segment_meets_ball(
+                                vertices[p, 0] - cx,
+                                vertices[p, 1] - cy,
+                                vertices[p, 2] - cz,
+                                vertices[q, 0] - cx,
+                                vertices[q, 1] - cy,
+                                vertices[q, 2] - cz,
+                                radius2,
+                            )
+                        if not crossed:
+                            continue
+                    if share != 0.0 and usable[f]:
+                        for k in range(n_values):
+                            total[k] += share * values[f, k]
+                    for corner in range(3):
+                        c = _UNSIGNED(faces[f, corner])
+                        if mark[c] != v:
+                            mark[c] = v
+                            queue[_UNSIGNED(tail)] = c
+                            tail += 1
             for k in range(n_values):
                 out[v, k] = total[k]
 
