@@ -438,11 +438,14 @@ def _several_fans(twins, side, n_corners):
 
 @nb.njit(**_JIT)
 def _union_edges(edges, n_vertices):
-    """Union-find over the edges: (V,) parents whose roots are each component's smallest vertex."""
-    parent = np.arange(n_vertices)
+    """Union-find over the edges: (V,) parents whose roots are each component's smallest vertex (unsigned
+    indices: see :func:`_twin_walk`)."""
+    parent = np.empty(n_vertices, _UNSIGNED)
+    for v in range(n_vertices):
+        parent[v] = v
     for e in range(edges.shape[0]):
-        a = _find(parent, edges[e, 0])
-        b = _find(parent, edges[e, 1])
+        a = _find(parent, _UNSIGNED(edges[e, 0]))
+        b = _find(parent, _UNSIGNED(edges[e, 1]))
         if a != b:
             parent[max(a, b)] = min(a, b)
     return parent
@@ -457,7 +460,7 @@ def component_labels(edges, referenced, n_vertices):
     for v in range(n_vertices):
         if not referenced[v]:
             continue
-        root = _find(parent, v)
+        root = _find(parent, _UNSIGNED(v))
         if labels[root] < 0:
             labels[root] = count
             count += 1
