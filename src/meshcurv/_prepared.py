@@ -238,7 +238,10 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         )
         points, topology = welded.vertices, welded.topology
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
-    scales, needles = _scales_and_needles(points, one_sided.topology)
+    if one_sided.length_scales is not None and one_sided.needles is not None:  # found on these faces
+        scales, needles = one_sided.length_scales, one_sided.needles
+    else:
+        scales, needles = _scales_and_needles(points, one_sided.topology)
     topology, n_flipped = oriented_topology(points, one_sided.topology, orient, needles)
     # the row computed for each of the caller's vertices (welded vertices, in the local order)
     index = None if welded is None else welded.index
