@@ -2358,3 +2358,10 @@ def test_connected_face_sums_are_the_nested_walk_of_one_ball_on_one_or_two_threa
             finally:
                 numba.set_num_threads(threads)
             np.testing.assert_array_equal(got, nested[0])
+
+
+def test_the_smaller_solve_is_compiled_only():
+    from meshcurv._kernels.jets import _smaller_solve
+
+    with pytest.raises(NotImplementedError, match="compiled only"):
+        _smaller_solve(None, *([None] * 7))

@@ -89,6 +89,38 @@ def _cholesky_solve_10(a, b, low, min_spread, scale, total):
     return _cholesky_inline(a, b, low, 10, min_spread, scale, total)
 
 
+@nb.njit(**_JIT)
+def _cholesky_solve_6(a, b, low, min_spread, scale, total):
+    """:func:`_cholesky_inline` of size 6 (the quadratic jets a cubic fit falls back to), unrolled as
+    :func:`_cholesky_solve_10`: half the compile time of :func:`_cholesky_solve` (0.7 against 1.2 CPU s), which
+    the fits of degree 3 or less then do not compile (:func:`_smaller_solve`)."""
+    return _cholesky_inline(a, b, low, 6, min_spread, scale, total)
+
+
+def _smaller_solve(general, a, b, low, m, min_spread, scale, total):
+    """:func:`_fit_one`'s solve of the fits of ``m`` terms other than 10: :func:`_cholesky_solve_6` where
+    ``general`` is None (fits of degree 3 or less: ``m`` is 6), else :func:`_cholesky_solve`.
+
+    Compiled only (:func:`_smaller_solve_typed`).
+    """
+    raise NotImplementedError("compiled only: called from the compiled jet fits")
+
+
+@overload(_smaller_solve, jit_options=_JIT)  # type: ignore[arg-type]  # numba's stub types a TypedDict
+def _smaller_solve_typed(general, a, b, low, m, min_spread, scale, total):
+    if isinstance(general, types.NoneType):
+
+        def six(general, a, b, low, m, min_spread, scale, total):
+            return _cholesky_solve_6(a, b, low, min_spread, scale, total)
+
+        return six
+
+    def any_size(general, a, b, low, m, min_spread, scale, total):
+        return _cholesky_solve(a, b, low, m, min_spread, scale, total)
+
+    return any_size
+
+
 @threaded
 def fit_jets(
     vertices,
@@ -643,7 +675,7 @@ def _fit_one(
             if (
                 _cholesky_solve_10(matrix, solution, low, min_spread, scale, moments[0, 0])
                 if m == 10
-                else _cholesky_solve(matrix, solution, low, m, min_spread, scale, moments[0, 0])
+                else _smaller_solve(general, matrix, solution, low, m, min_spread, scale, moments[0, 0])
             ):
                 for r in range(6):
                     solution[r] = solution[r] * scale[r]
