@@ -62,3 +62,22 @@ def test_the_default_call_types_its_jet_fits_once(monkeypatch):
     assert len(seen) >= 2  # the noise fits and the normal fits
     assert len(set(seen)) == 1
     assert seen[0][-1] == "none"  # fits of degree 3 or less: no code of the general moments compiled
+
+
+def test_the_default_call_types_its_ball_sums_once(monkeypatch):
+    """The default's ball sums run their compiled chunk with one set of argument types (one compilation on a
+    cold cache), the one-ball kernel's, not the nested one's (issue 31)."""
+    from meshcurv._kernels import neighborhoods
+
+    original = neighborhoods._face_sums_chunk
+    seen = []
+
+    def recording(*args):
+        seen.append(tuple(str(numba.typeof(a)) for a in args[2:]))
+        return original(*args)
+
+    monkeypatch.setattr(neighborhoods, "_face_sums_chunk", recording)
+    sphere = shapes.icosphere(8)
+    principal_curvatures(sphere.vertices, sphere.faces)
+    assert seen  # the ball sums of the default ran the one-ball chunk
+    assert len(set(seen)) == 1
