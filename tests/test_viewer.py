@@ -360,7 +360,9 @@ def test_bad_inputs(tmp_path, torus):
         write_html(tmp_path / "t.html", torus.vertices, torus.faces + 1, result)  # 1-based
     with pytest.raises(InvalidOptionError, match="`result` has 3600 vertices; the mesh has 3599"):
         write_html(tmp_path / "t.html", torus.vertices[:-1], torus.faces[:10], result)
-    with pytest.raises(InvalidOptionError, match="`result` must be a CurvatureResult or a non-empty list of them; got dict"):
+    with pytest.raises(
+        InvalidOptionError, match="`result` must be a CurvatureResult or a non-empty list of them; got dict"
+    ):
         write_html(tmp_path / "t.html", torus.vertices, torus.faces, {"k_min": result.k_min})
     with pytest.raises(MeshFileError, match="not a meshcurv viewer page"):
         (tmp_path / "other.html").write_text("<html></html>")
@@ -470,11 +472,20 @@ def test_cli_radii_usage_errors(tmp_path, torus_file, args, message):
     assert not (tmp_path / "t.html").exists()
 
 
-def test_cli_radii_refused_for_a_point_cloud(tmp_path):
+def test_cli_radii_of_a_point_cloud(tmp_path):
     cloud = tmp_path / "cloud.xyz"
-    np.savetxt(cloud, meshcurv.shapes.icosphere(subdivisions=3).vertices)
-    done = run_view([cloud, "-o", tmp_path / "c.html", "--radii", "0.1,0.2"])
-    assert done.exit_code == 2 and "--radii is for meshes" in done.output
+    np.savetxt(cloud, meshcurv.shapes.icosphere(subdivisions=12, radius=2.0).vertices)
+    done = run_view([cloud, "-o", tmp_path / "c.html", "--radii", "0.5,0.8"])
+    assert done.exit_code == 0, done.output
+    meta, arrays = read_page_data(tmp_path / "c.html")
+    assert meta["kind"] == "points" and len(meta["scales"]) == 2
+    points = meshcurv.read_points(cloud)[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        expected = meshcurv.point_cloud_curvatures(points, radius=0.8)
+    np.testing.assert_array_equal(arrays["k_max_s1"], expected.k_max.astype(np.float32))
+    smoothing = run_view([cloud, "-o", tmp_path / "d.html", "--radii", "0.5,0.8", "--smoothing-steps", "2"])
+    assert smoothing.exit_code == 2 and "--smoothing-steps is for meshes" in smoothing.output
 
 
 def test_cli_adaptive_radius_is_the_library_call(tmp_path, torus_file):

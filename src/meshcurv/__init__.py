@@ -25,7 +25,7 @@ from .errors import (
     TriangulationWarning,
 )
 from .io import read_mesh, read_points, write_mesh, write_points
-from .pointcloud import point_cloud_curvatures
+from .pointcloud import multiscale_point_cloud_curvatures, point_cloud_curvatures
 from .orient import orient_faces
 from .result import CurvatureResult
 from .smoothing import smooth_vertex_field
@@ -37,6 +37,7 @@ __all__ = [
     "principal_curvatures",
     "multiscale_curvatures",
     "point_cloud_curvatures",
+    "multiscale_point_cloud_curvatures",
     "label_curvatures",
     "curvature_statistics",
     "volume",

@@ -127,6 +127,7 @@ from __future__ import annotations
 
 import logging
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 
@@ -139,7 +140,7 @@ from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
 from .radius import CLOUD_EXTENT_CAP, CLOUD_RADIUS_RULES, cloud_noise_level, cloud_radius, noise_rule
 from .result import INVALID_REASONS, CurvatureResult
 
-__all__ = ["point_cloud_curvatures", "POINT_CLOUD_METHODS", "MIN_POINTS"]
+__all__ = ["point_cloud_curvatures", "multiscale_point_cloud_curvatures", "POINT_CLOUD_METHODS", "MIN_POINTS"]
 
 logger = logging.getLogger(__name__)
 
@@ -330,6 +331,103 @@ def point_cloud_curvatures(
     >>> print(f"{np.median(r.mean):.3f}", r.parameters["normals"])
     0.500 estimated
     """
+    cloud = _prepared_cloud(points, faces, normals, method)
+    if radius is not None:
+        radius = _checked_cloud_radius(radius, cloud.points)
+    result, problems = _estimated(cloud, radius)
+    if problems:
+        warnings.warn("point cloud: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
+    return result
+
+
+def multiscale_point_cloud_curvatures(
+    points, radii, *, normals=None, method: str | None = None
+) -> list[CurvatureResult]:
+    """Curvatures of a point cloud at several scales: one :class:`CurvatureResult` per radius.
+
+    Each result equals ``point_cloud_curvatures(points, normals=normals,
+    radius=r, method=method)``; the points are checked, their duplicates and
+    near copies merged, and their nearest neighbours searched once for all
+    radii (the normals, their orientation and the noise level are computed
+    again at each radius, as the single call does: the line-scan search of a
+    radius depends on it).
+
+    Parameters
+    ----------
+    points
+        As for :func:`point_cloud_curvatures`.
+    radii : sequence of float
+        The ball radii, in the units of the points (positive, not larger than
+        the cloud; any order).
+    normals, method
+        As for :func:`point_cloud_curvatures`.
+
+    Returns
+    -------
+    list of CurvatureResult
+        One per radius, in the order of ``radii``.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`point_cloud_curvatures`.
+    InvalidOptionError
+        No radius, a radius that is not a positive finite number or is larger
+        than the cloud, an unknown ``method``.
+
+    Warns
+    -----
+    MeshQualityWarning
+        Once per call, as :func:`point_cloud_curvatures` (the notes of each
+        radius that differ are named with it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from meshcurv.pointcloud import multiscale_point_cloud_curvatures
+    >>> rng = np.random.default_rng(0)
+    >>> p = rng.normal(size=(5000, 3))
+    >>> p = 2.0 * p / np.linalg.norm(p, axis=1, keepdims=True)    # sphere of radius 2
+    >>> fine, coarse = multiscale_point_cloud_curvatures(p, [0.15, 0.3])
+    >>> print(f"{np.median(fine.mean):.2f} {np.median(coarse.mean):.2f}")
+    0.50 0.50
+    """
+    if isinstance(radii, (str, bytes)) or np.ndim(radii) != 1 or len(radii) == 0:
+        raise InvalidOptionError(f"`radii` must be a non-empty sequence of radii; got {radii!r}")
+    cloud = _prepared_cloud(points, None, normals, method)
+    radii = [_checked_cloud_radius(radius, cloud.points, name="radii") for radius in radii]
+    results, messages = [], {}
+    for radius in radii:
+        result, problems = _estimated(cloud, radius)
+        results.append(result)
+        messages[radius] = "; ".join(problems)
+    if any(messages.values()):
+        texts = set(messages.values())
+        message = (
+            texts.pop() if len(texts) == 1 else "; ".join(f"at radius {r:g}: {m}" for r, m in messages.items() if m)
+        )
+        warnings.warn("point cloud: " + message, MeshQualityWarning, stacklevel=2)
+    return results
+
+
+class _Cloud(NamedTuple):
+    """The checked, merged points of a call, before any radius (:func:`_prepared_cloud`)."""
+
+    #: The distinct points (duplicates and near copies merged), in Morton order.
+    points: np.ndarray
+    #: Their given normals (None: estimated).
+    given: np.ndarray | None
+    method: str
+    #: (N_all,) the row of ``points`` each input point takes its values from.
+    take: np.ndarray
+    #: ``(tree, distances, indices)`` of ``points``, or None (searched by :func:`_compute`).
+    search: tuple | None
+    #: What was found and done so far, for the call's warning.
+    problems: list
+
+
+def _prepared_cloud(points, faces, normals, method) -> _Cloud:
+    """Check the input, merge duplicates and near copies, search the nearest neighbours: what every radius shares."""
     logger.info("point cloud: checks, duplicates and near copies")
     if faces is not None:
         raise InvalidOptionError(
@@ -342,8 +440,6 @@ def point_cloud_curvatures(
     hint = _looks_like_faces(points)
     points = as_vertices(points, name="points")
     given = None if normals is None else _checked_normals(normals, points.shape)
-    if radius is not None:
-        radius = check_positive_float(radius, "radius")
     n_all = points.shape[0]
     if n_all < MIN_POINTS:
         raise InvalidMeshError(f"`points` holds {n_all} points; at least {MIN_POINTS} are needed")
@@ -379,23 +475,35 @@ def point_cloud_curvatures(
         raise InvalidMeshError(f"`points` holds {unique.size} distinct points; at least {MIN_POINTS} are needed")
     cloud = points[unique]
     _check_spread(cloud)
-    if radius is not None:
-        diagonal = float(np.linalg.norm(cloud.max(axis=0) - cloud.min(axis=0)))
-        if radius > diagonal:
-            raise InvalidOptionError(
-                f"`radius` {radius:g} is larger than the point cloud itself (bounding-box diagonal {diagonal:g}): "
-                "every ball would hold every point; pass a radius of a few point spacings, in the units of the points"
-            )
+    take = _position(unique, n_all)[representative]
+    return _Cloud(cloud, None if given is None else given[unique], method, take, search, problems)
 
+
+def _checked_cloud_radius(radius, cloud: np.ndarray, *, name: str = "radius") -> float:
+    """``radius`` a positive number no larger than the cloud's bounding-box diagonal."""
+    radius = check_positive_float(radius, name)
+    diagonal = float(np.linalg.norm(cloud.max(axis=0) - cloud.min(axis=0)))
+    if radius > diagonal:
+        raise InvalidOptionError(
+            f"`{name}` {radius:g} is larger than the point cloud itself (bounding-box diagonal {diagonal:g}): "
+            "every ball would hold every point; pass a radius of a few point spacings, in the units of the points"
+        )
+    return radius
+
+
+def _estimated(cloud: _Cloud, radius: float | None) -> tuple[CurvatureResult, list[str]]:
+    """The estimate at ``radius`` (None: the default) for every input point, and the problems for the warning."""
+    search = cloud.search
+    if search is not None:  # (the pipeline re-points the neighbours of line points in place: its own copy)
+        search = (search[0], search[1], search[2].copy())
     k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, found = _compute(
-        cloud, None if given is None else given[unique], radius, method, search
+        cloud.points, cloud.given, radius, cloud.method, search
     )
-    problems.extend(found)
+    problems = [*cloud.problems, *found]
     logger.info("point cloud: results")
 
     # back to all points: each duplicate takes its representative's values
-    take = _position(unique, n_all)[representative]
-    fields = [a[take] for a in (k_min, k_max, dir_min, dir_max, out_normals, valid, reason)]
+    fields = [a[cloud.take] for a in (k_min, k_max, dir_min, dir_max, out_normals, valid, reason)]
     k_min, k_max, dir_min, dir_max, out_normals, valid, reason = fields
     valid = valid & np.isfinite(k_min) & np.isfinite(k_max)
     for array in (k_min, k_max, dir_min, dir_max):
@@ -403,21 +511,20 @@ def point_cloud_curvatures(
     n_invalid = int((~valid).sum())
     if n_invalid:
         problems.append(f"{n_invalid} points are NaN with valid=False")
-    if problems:
-        warnings.warn("point cloud: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
     reason = np.where(valid, 0, np.where(reason > 0, reason, _UNDEFINED)).astype(np.int8)
     logger.info("point cloud: done")
-    return CurvatureResult._of_arrays(
+    result = CurvatureResult._of_arrays(
         k_min=k_min,
         k_max=k_max,
         dir_min=dir_min,
         dir_max=dir_max,
         normals=out_normals,
         valid=valid,
-        method=method,
+        method=cloud.method,
         parameters=parameters,
         invalid_reason=reason,
     )
+    return result, problems
 
 
 def _looks_like_faces(points) -> str:

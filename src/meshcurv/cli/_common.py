@@ -25,7 +25,7 @@ from ..estimators import DEFAULT_METHOD, ESTIMATORS
 from ..io import is_point_cloud, read_mesh, read_points
 from ..io._files import check_output
 from ..io.fields import FIELDS
-from ..pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
+from ..pointcloud import POINT_CLOUD_METHODS, multiscale_point_cloud_curvatures, point_cloud_curvatures
 from ..smoothing import MAX_SMOOTHING_STEPS
 from ..topology import MeshTopology
 
@@ -339,11 +339,11 @@ def report_failures(names, errors, where: str) -> None:
 
 
 def _check_radii(path, method: str, *, cloud: bool, radius, smoothing_steps) -> None:
-    """``--radii`` needs a mesh and a method over balls, and neither ``--radius`` nor ``--smoothing-steps``."""
-    if cloud:
-        raise click.UsageError(f"--radii is for meshes; {path} is a point cloud (give one --radius)")
+    """``--radii`` needs a method over balls (a point cloud's are), and neither ``--radius`` nor ``--smoothing-steps``."""
     if radius is not None:
         raise click.UsageError("give --radius (one scale) or --radii (several), not both")
+    if cloud:
+        return  # (the cloud's own checks follow: its methods all measure balls)
     if smoothing_steps is not None or method not in ESTIMATORS or "radius" not in ESTIMATORS[method].options:
         with_balls = ", ".join(name for name, estimator in ESTIMATORS.items() if "radius" in estimator.options)
         raise click.UsageError(f"--radii takes a method over balls ({with_balls}); got {method!r}")
@@ -453,9 +453,11 @@ def estimated(path, session: Session, last_stage: str, *, method, smoothing_step
         if cloud:
             vertices, normals = read_points(path)
             faces = topology = None
-            result = point_cloud_curvatures(
-                vertices, normals=normals, radius=radius, method=method if given_method else None
-            )
+            cloud_method = method if given_method else None
+            if radii is None:
+                result = point_cloud_curvatures(vertices, normals=normals, radius=radius, method=cloud_method)
+            else:
+                result = multiscale_point_cloud_curvatures(vertices, radii, normals=normals, method=cloud_method)
         else:
             vertices, faces = read_mesh(path)
             # triangulated (and warned about) once: the estimate takes the topology as it is
