@@ -19,11 +19,12 @@ import sys
 import textwrap
 import time
 
+import numpy as np
 import pytest
 
 import meshcurv
 from meshcurv import shapes
-from meshcurv.errors import MeshcurvWarning, MeshFileError
+from meshcurv.errors import InvalidOptionError, MeshcurvWarning, MeshFileError
 
 pytest.importorskip("distributed")
 pytest.importorskip("pandas")
@@ -611,3 +612,19 @@ def test_a_picture_written_meanwhile_by_another_process_is_not_replaced(tmp_path
     with pytest.raises(MeshFileError, match=r"t\.png: already exists"):
         plotting.save_figure(figure, path)
     assert path.read_bytes() == b"the other one"
+
+
+def test_adaptive_radius_is_taken_as_principal_curvatures_takes_it(tmp_path):
+    # the CLI's --radius offers 'adaptive' (icc): the batch options take it too, and the task computes what
+    # principal_curvatures(radius="adaptive") computes; other methods refuse it with the usual message
+    assert batch._inputs._options("icc", None, "adaptive", None) == {"method": "icc", "radius": "adaptive"}
+    with pytest.raises(InvalidOptionError, match="`radius` must be a positive"):
+        batch._inputs._options("quadric", None, "adaptive", None)
+    torus = meshcurv.shapes.torus()
+    source = tmp_path / "torus.ply"
+    meshcurv.write_mesh(source, torus.vertices, torus.faces)
+    row = batch.process_mesh(source, tmp_path / "torus.npz", tmp_path / "torus.json", radius="adaptive")
+    assert row["status"] == "computed", row["error"]
+    stored = np.load(tmp_path / "torus.npz")
+    expected = meshcurv.principal_curvatures(*meshcurv.read_mesh(source), radius="adaptive")
+    np.testing.assert_array_equal(stored["k_max"], expected.k_max)

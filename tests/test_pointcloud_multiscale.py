@@ -66,3 +66,8 @@ def test_one_warning_naming_the_radius_whose_notes_differ():
 def test_bad_radii(radii, match):
     with pytest.raises(InvalidOptionError, match=match):
         meshcurv.multiscale_point_cloud_curvatures(sphere_points(500), radii)
+
+
+def test_adaptive_is_for_meshes():
+    with pytest.raises(InvalidOptionError, match="'adaptive' is for meshes"):
+        meshcurv.point_cloud_curvatures(sphere_points(500), radius="adaptive")

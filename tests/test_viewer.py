@@ -462,7 +462,7 @@ def test_cli_several_radii_are_the_multiscale_results(tmp_path, torus_file):
         (["--radii", "3,x"], "lengths > 0 separated by commas"),
         (["--radii", "3,-1"], "lengths > 0 separated by commas"),
         (["--radii", "3,6", "-m", "matgeom"], "--radii takes a method over balls"),
-        (["--radii", "3,6", "--smoothing-steps", "2"], "--radii takes a method over balls"),
+        (["--radii", "3,6", "--smoothing-steps", "2"], "with --radii does not take --smoothing-steps"),
         (["--radius", "wide"], "neither a length > 0 nor 'adaptive'"),
     ],
 )

@@ -388,7 +388,7 @@ def multiscale_point_cloud_curvatures(
     >>> rng = np.random.default_rng(0)
     >>> p = rng.normal(size=(5000, 3))
     >>> p = 2.0 * p / np.linalg.norm(p, axis=1, keepdims=True)    # sphere of radius 2
-    >>> fine, coarse = multiscale_point_cloud_curvatures(p, [0.15, 0.3])
+    >>> fine, coarse = multiscale_point_cloud_curvatures(p, [0.4, 0.8])
     >>> print(f"{np.median(fine.mean):.2f} {np.median(coarse.mean):.2f}")
     0.50 0.50
     """
@@ -481,6 +481,10 @@ def _prepared_cloud(points, faces, normals, method) -> _Cloud:
 
 def _checked_cloud_radius(radius, cloud: np.ndarray, *, name: str = "radius") -> float:
     """``radius`` a positive number no larger than the cloud's bounding-box diagonal."""
+    if isinstance(radius, str) and radius == "adaptive":
+        raise InvalidOptionError(
+            f"`{name}` 'adaptive' is for meshes (method 'icc'); a point cloud takes a length (or None: from the data)"
+        )
     radius = check_positive_float(radius, name)
     diagonal = float(np.linalg.norm(cloud.max(axis=0) - cloud.min(axis=0)))
     if radius > diagonal:

@@ -225,6 +225,9 @@ def _options(method, smoothing_steps, radius, orient) -> dict:
             continue
         if name not in defaults:
             raise InvalidOptionError(f"method {method!r} does not take the option `{name}`")
+        if name == "radius" and isinstance(value, str) and value == "adaptive" and method == "icc":
+            options[name] = value  # each vertex its own radius, as principal_curvatures takes it
+            continue
         value = check_int_option(value, name) if name == "smoothing_steps" else check_positive_float(value, name)
         if value != defaults[name]:
             options[name] = value

@@ -344,7 +344,9 @@ def _check_radii(path, method: str, *, cloud: bool, radius, smoothing_steps) -> 
         raise click.UsageError("give --radius (one scale) or --radii (several), not both")
     if cloud:
         return  # (the cloud's own checks follow: its methods all measure balls)
-    if smoothing_steps is not None or method not in ESTIMATORS or "radius" not in ESTIMATORS[method].options:
+    if smoothing_steps is not None:
+        raise click.UsageError(f"method {method!r} with --radii does not take --smoothing-steps (no ball method does)")
+    if method not in ESTIMATORS or "radius" not in ESTIMATORS[method].options:
         with_balls = ", ".join(name for name, estimator in ESTIMATORS.items() if "radius" in estimator.options)
         raise click.UsageError(f"--radii takes a method over balls ({with_balls}); got {method!r}")
 
