@@ -525,14 +525,14 @@ def numpy_normal_cycle(name, monkeypatch, steps):
 
     vertices, _ = mesh(name)
     seen = []
-    original = normal_cycle.smooth_vertex_field
+    original = normal_cycle._smooth_vertex_field
 
     def record(values, top, n_steps):
         seen.append(np.array(values))
         return original(values, top, n_steps)
 
     with use_backend("numpy"), monkeypatch.context() as patch:
-        patch.setattr(normal_cycle, "smooth_vertex_field", record)
+        patch.setattr(normal_cycle, "_smooth_vertex_field", record)
         result, _ = normal_cycle.estimate(
             PreparedMesh.as_given(vertices, topology(name)), smoothing_steps=steps, stages=Stages(normal_cycle.STAGES)
         )

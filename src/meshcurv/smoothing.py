@@ -101,6 +101,12 @@ def smooth_vertex_field(values, topology: MeshTopology, steps: int) -> np.ndarra
             f"`values` must have shape (V,) or (V, k) with V = {topology.n_vertices} (the topology's "
             f"vertices); got {tuple(field.shape)}"
         )
+    return _smooth_vertex_field(field, topology, steps)
+
+
+def _smooth_vertex_field(field: np.ndarray, topology: MeshTopology, steps: int) -> np.ndarray:
+    """:func:`smooth_vertex_field` of checked arguments: ``field`` a float64 (V,) or (V, k) array of the
+    topology's vertices (a new array is returned; ``field`` itself when ``steps`` is 0), ``steps`` >= 0."""
     if steps <= 0:
         return field
     flat = np.ascontiguousarray(field.reshape(field.shape[0], -1))

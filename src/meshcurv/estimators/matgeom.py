@@ -38,7 +38,7 @@ from .._backend import kernel_threads, numba_kernels
 from .._tensors import outer6
 from .._geometry import DEGENERATE_AREA_RATIO
 from ..result import CurvatureResult
-from ..smoothing import STEPS_PER_CALL, smooth_vertex_field
+from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages
@@ -138,7 +138,7 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
     stages = stages or Stages(STAGES)
     tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = _edge_tensors(vertices, topology, stages)
     stages.start("average vertex tensors")
-    return smooth_vertex_field(tensors, topology, smoothing_steps), n_kept, n_wrong_face, n_out_of_range, mispaired
+    return _smooth_vertex_field(tensors, topology, smoothing_steps), n_kept, n_wrong_face, n_out_of_range, mispaired
 
 
 def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages, mesh: PreparedMesh | None = None):
@@ -225,7 +225,7 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     doubtful = mesh.defects().invalid_vertices | mispaired
     doubtful &= topology.referenced_vertices
     if doubtful.any() and smoothing_steps:
-        doubtful = smooth_vertex_field(doubtful.astype(np.float64), topology, smoothing_steps) > 0
+        doubtful = _smooth_vertex_field(doubtful.astype(np.float64), topology, smoothing_steps) > 0
     valid = topology.referenced_vertices & finite & ~doubtful
 
     n_boundary = int(topology.boundary_edges.sum())

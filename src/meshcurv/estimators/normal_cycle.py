@@ -51,7 +51,7 @@ from .._tensors import outer6, principal_from_shape_operator
 from .._backend import kernel_threads, numba_kernels
 from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles
 from ..result import CurvatureResult
-from ..smoothing import STEPS_PER_CALL, smooth_vertex_field
+from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
 from ._support import Stages, nan_where, problems
 
@@ -88,7 +88,7 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     stages.start("average vertex tensors")
     valid = ~defects.invalid_vertices
     weights = valid.astype(np.float64)
-    pooled = smooth_vertex_field(
+    pooled = _smooth_vertex_field(
         np.column_stack([measures * weights[:, None], areas * weights]), topology, smoothing_steps
     )
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -138,10 +138,10 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     stages.start("average vertex tensors")
     stages.start("retrieve curvatures")
     if smoothing_steps > STEPS_PER_CALL:
-        # a long smoothing in interruptible calls (smooth_vertex_field), the same passes the kernel makes
+        # a long smoothing in interruptible calls (_smooth_vertex_field), the same passes the kernel makes
         sums = sums.copy()
         sums[defects.invalid_vertices, :7] = 0.0
-        sums[:, :7] = smooth_vertex_field(sums[:, :7], topology, smoothing_steps)
+        sums[:, :7] = _smooth_vertex_field(sums[:, :7], topology, smoothing_steps)
         smoothing_left = 0
     else:
         smoothing_left = smoothing_steps
