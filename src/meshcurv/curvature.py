@@ -15,7 +15,7 @@ from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._support import ProgressCallback, Stages
 from .estimators.icc import voxel_pilot
-from .radius import _small_radius_note, _voxel_surface_radius
+from .radius import _checked_radii, _notes_by_radius, _small_radius_note, _voxel_surface_radius
 from .result import CurvatureResult
 from .smoothing import check_smoothing_steps
 
@@ -274,21 +274,15 @@ def multiscale_curvatures(
             f"method {method!r} measures no ball; multiscale_curvatures takes one of "
             + ", ".join(repr(name) for name, e in ESTIMATORS.items() if "radius" in e.options)
         )
-    if isinstance(radii, (str, bytes)) or np.ndim(radii) != 1 or len(radii) == 0:
-        raise InvalidOptionError(f"`radii` must be a non-empty sequence of radii; got {radii!r}")
-    radii = [check_positive_float(radius, "radii") for radius in radii]
+    radii = _checked_radii(radii)
     orient, weld = _resolved(method, orient, weld)
     finished = _computed_at(vertices, faces, estimator, options, orient, weld, progress, radii)
     order = np.argsort(radii, kind="stable")
     results: list = [None] * len(radii)
     for rank, index in enumerate(order):
         results[index] = finished[rank][0]
-    messages = {radii[i]: finished[rank][1] for rank, i in enumerate(order)}
-    if any(messages.values()):
-        texts = set(messages.values())
-        message = (
-            texts.pop() if len(texts) == 1 else "; ".join(f"at radius {r:g}: {m}" for r, m in messages.items() if m)
-        )
+    message = _notes_by_radius({radii[i]: finished[rank][1] for rank, i in enumerate(order)})
+    if message:
         warnings.warn(message, MeshQualityWarning, stacklevel=2)
     return results
 

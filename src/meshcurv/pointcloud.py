@@ -137,7 +137,15 @@ from ._adapters import point_array
 from ._backend import kernel_threads, numba_kernels
 from ._validation import MIN_COORDINATE, as_vertices, check_choice, check_positive_float
 from .errors import InvalidMeshError, InvalidOptionError, MeshQualityWarning
-from .radius import CLOUD_EXTENT_CAP, CLOUD_RADIUS_RULES, cloud_noise_level, cloud_radius, noise_rule
+from .radius import (
+    CLOUD_EXTENT_CAP,
+    CLOUD_RADIUS_RULES,
+    _checked_radii,
+    _notes_by_radius,
+    cloud_noise_level,
+    cloud_radius,
+    noise_rule,
+)
 from .result import INVALID_REASONS, CurvatureResult
 
 __all__ = ["point_cloud_curvatures", "multiscale_point_cloud_curvatures", "POINT_CLOUD_METHODS", "MIN_POINTS"]
@@ -392,20 +400,16 @@ def multiscale_point_cloud_curvatures(
     >>> print(f"{np.median(fine.mean):.2f} {np.median(coarse.mean):.2f}")
     0.50 0.50
     """
-    if isinstance(radii, (str, bytes)) or np.ndim(radii) != 1 or len(radii) == 0:
-        raise InvalidOptionError(f"`radii` must be a non-empty sequence of radii; got {radii!r}")
+    radii = _checked_radii(radii)
     cloud = _prepared_cloud(points, None, normals, method)
     radii = [_checked_cloud_radius(radius, cloud.points, name="radii") for radius in radii]
-    results, messages = [], {}
+    results, notes = [], {}
     for radius in radii:
         result, problems = _estimated(cloud, radius)
         results.append(result)
-        messages[radius] = "; ".join(problems)
-    if any(messages.values()):
-        texts = set(messages.values())
-        message = (
-            texts.pop() if len(texts) == 1 else "; ".join(f"at radius {r:g}: {m}" for r, m in messages.items() if m)
-        )
+        notes[radius] = "; ".join(problems)
+    message = _notes_by_radius(notes)
+    if message:
         warnings.warn("point cloud: " + message, MeshQualityWarning, stacklevel=2)
     return results
 

@@ -992,6 +992,24 @@ def _cloud_noise_level(points, normals, spacing: float, centres, usable) -> floa
     return float(np.median(heights)) if heights.size else 0.0
 
 
+def _checked_radii(radii) -> list[float]:
+    """The ``radii`` of a multi-scale call: a non-empty sequence of positive finite numbers, as floats."""
+    if isinstance(radii, (str, bytes)) or np.ndim(radii) != 1 or len(radii) == 0:
+        raise InvalidOptionError(f"`radii` must be a non-empty sequence of radii; got {radii!r}")
+    return [check_positive_float(radius, "radii") for radius in radii]
+
+
+def _notes_by_radius(notes: dict[float, str]) -> str:
+    """The one warning of a multi-scale call from each radius's notes (``""``: none has any): the note
+    they all share, or each radius's own, named with it."""
+    texts = set(notes.values())
+    if not any(texts):
+        return ""
+    if len(texts) == 1:
+        return texts.pop()
+    return "; ".join(f"at radius {radius:g}: {text}" for radius, text in notes.items() if text)
+
+
 def noise_rule(rule, spacing: float, noise: float) -> float:
     """``spacing (a + b sqrt(max(noise - NOISE_FLOOR, 0)))`` for ``rule = (a, b)``."""
     a, b = rule
