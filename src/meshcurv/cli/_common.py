@@ -75,7 +75,8 @@ class RadiusType(click.ParamType):
 
 
 def radii_option(help_text: str):
-    """``--radii R1,R2,...``: several ball radii (:func:`meshcurv.multiscale_curvatures`)."""
+    """``--radii R1,R2,...``: several ball radii (:func:`meshcurv.multiscale_curvatures`, and
+    :func:`meshcurv.multiscale_point_cloud_curvatures` for a point cloud)."""
     return click.option("--radii", callback=_radii, default=None, metavar="R1,R2,...", help=help_text)
 
 
@@ -427,8 +428,9 @@ class Estimated(NamedTuple):
 def estimated(path, session: Session, last_stage: str, *, method, smoothing_steps, radius, orient, radii=None):
     """Read ``path`` (a mesh, or a point cloud: a file without faces) and compute its curvatures.
 
-    With ``radii`` (a mesh and a method over balls; not with ``radius``), the
-    result is the list of :func:`meshcurv.multiscale_curvatures`.
+    With ``radii`` (not with ``radius``; a mesh's method over balls, or a
+    point cloud), the result is the list of :func:`meshcurv.multiscale_curvatures`
+    or :func:`meshcurv.multiscale_point_cloud_curvatures`.
 
     A progress bar runs over the stages ``read``, the method's own and
     ``last_stage``, which is the block under the ``with`` (writing, drawing);

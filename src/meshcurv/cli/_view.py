@@ -18,8 +18,8 @@ __all__ = ["view"]
 @choice(("-f", "--field"), VIEWER_FIELDS, "mean", "The field shown first (the page has a menu of all of them).")
 @method_options
 @radii_option(
-    "Several ball radii in mesh units (icc, quadric, normal_cycle_ball): the page gets a menu of the scales "
-    "(computed in one pass: `meshcurv.multiscale_curvatures`)."
+    "Several ball radii in mesh units (icc, quadric, normal_cycle_ball, or a point cloud's method): the page "
+    "gets a menu of the scales (`meshcurv.multiscale_curvatures`, `multiscale_point_cloud_curvatures`)."
 )
 @up_option(
     "The axis drawn upwards at first; auto: z when the mesh is clearly taller along z than "
