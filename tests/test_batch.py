@@ -292,6 +292,36 @@ def test_run_refuses_bad_options_before_any_work(tmp_path):
     assert not out_dir.exists()
 
 
+BAD_OPTIONS = [
+    {"method": "gauss"},
+    {"method": None},
+    {"method": "normal_cycle", "radius": 0.1, "smoothing_steps": -1},  # the option first, then its value
+    {"method": "normal_cycle", "smoothing_steps": 10**6},  # above MAX_SMOOTHING_STEPS
+    {"method": "matgeom", "smoothing_steps": True},
+    {"method": "matgeom", "smoothing_steps": 2.0},
+    {"radius": "0.5"},
+    {"radius": float("nan")},
+    {"radius": 1e-320},  # subnormal
+    {"method": "quadric", "radius": "adaptive"},  # icc only
+    {"orient": "inward"},
+]
+
+
+@pytest.mark.parametrize("options", BAD_OPTIONS, ids=lambda options: ",".join(f"{k}={v!r}" for k, v in options.items()))
+def test_run_refuses_exactly_what_principal_curvatures_refuses(tmp_path, options):
+    sphere = shapes.icosphere(2)
+    folder = tmp_path / "in"
+    folder.mkdir()
+    meshcurv.write_mesh(folder / "x.obj", sphere.vertices, sphere.faces)
+    with pytest.raises(InvalidOptionError) as call:
+        meshcurv.principal_curvatures(sphere.vertices, sphere.faces, **options)
+    dead = f"tcp://{LOOPBACK}:9"  # nothing listens there: any attempt to connect would fail the test
+    with pytest.raises(InvalidOptionError) as run:
+        batch.run(folder, tmp_path / "out", scheduler=dead, **options)
+    assert str(run.value) == str(call.value)
+    assert not (tmp_path / "out").exists()
+
+
 def test_run_refuses_inputs_that_would_share_a_result(tmp_path):
     sphere = shapes.icosphere(2)
     folder = tmp_path / "in"

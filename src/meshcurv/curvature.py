@@ -184,7 +184,7 @@ def principal_curvatures(
     >>> print(f"{np.mean(C1):.4f}")  # dimensionless, not 1/2: see the README
     0.0215
     """
-    estimator, options = _checked_options(method, smoothing_steps=smoothing_steps, radius=radius)
+    estimator, options, _ = _checked_options(method, smoothing_steps=smoothing_steps, radius=radius)
     orient, weld = _resolved(method, orient, weld)
     result, message = _computed(vertices, faces, estimator, options, orient, weld, progress, radius)
     if message:
@@ -268,7 +268,7 @@ def multiscale_curvatures(
     >>> print(f"{np.median(fine.mean):.3f} {np.median(coarse.mean):.3f} {coarse.radius[0]}")
     0.500 0.500 0.4
     """
-    estimator, options = _checked_options(method)
+    estimator, options, _ = _checked_options(method)
     if "radius" not in estimator.options:
         raise InvalidOptionError(
             f"method {method!r} measures no ball; multiscale_curvatures takes one of "
@@ -300,7 +300,14 @@ def _computed_at(vertices, faces, estimator, options: dict, orient: str, weld, p
 
 
 def _checked_options(method, **given) -> tuple:
-    """``(estimator, options)``: the registered method and its options, the given ones checked."""
+    """``(estimator, options, recorded)``: the registered method, its options with the given ones checked.
+
+    ``options`` are what the estimator takes (every option, its defaults
+    filled in, ``'adaptive'`` turned into ``radius=None, adaptive=True``);
+    ``recorded`` is the computation as a batch records it: the method and the
+    given options that differ from the defaults (``'adaptive'`` as given), so
+    that ``smoothing_steps=3`` and nothing record the same.
+    """
     if not isinstance(method, str) or method not in ESTIMATORS:
         check_choice(method, "method", METHODS)  # raises: not a registered method
     estimator = ESTIMATORS[method]
@@ -317,7 +324,13 @@ def _checked_options(method, **given) -> tuple:
         options["radius"], options["adaptive"] = None, True  # from the default radius upwards, per vertex
     elif options.get("radius") is not None:
         options["radius"] = check_positive_float(options["radius"], "radius")
-    return estimator, options
+    recorded = {"method": method}
+    for name, value in given.items():
+        if value is not None and options[name] != estimator.options[name]:
+            recorded[name] = options[name]
+    if options.get("adaptive"):
+        recorded["radius"] = "adaptive"
+    return estimator, options, recorded
 
 
 def _resolved(method: str, orient, weld) -> tuple:

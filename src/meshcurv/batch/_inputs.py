@@ -12,10 +12,9 @@ import pathlib
 import re
 from dataclasses import dataclass
 
-from .._validation import check_choice, check_int_option, check_positive_float
-from ..curvature import METHODS
+from .._validation import check_choice
+from ..curvature import _checked_options
 from ..errors import InvalidOptionError, MeshFileError
-from ..estimators import ESTIMATORS
 from ..io import FORMATS, POINT_EXTENSIONS
 from ..orient import ORIENT_CHOICES
 
@@ -216,21 +215,7 @@ def _options(method, smoothing_steps, radius, orient) -> dict:
     The same computation is then recorded the same way however it was asked
     (``smoothing_steps=3`` or nothing), and a bad option fails before any work.
     """
-
-    check_choice(method, "method", METHODS)
-    defaults = ESTIMATORS[method].options
-    options = {"method": method}
-    for name, value in (("smoothing_steps", smoothing_steps), ("radius", radius)):
-        if value is None:
-            continue
-        if name not in defaults:
-            raise InvalidOptionError(f"method {method!r} does not take the option `{name}`")
-        if name == "radius" and isinstance(value, str) and value == "adaptive" and method == "icc":
-            options[name] = value  # each vertex its own radius, as principal_curvatures takes it
-            continue
-        value = check_int_option(value, name) if name == "smoothing_steps" else check_positive_float(value, name)
-        if value != defaults[name]:
-            options[name] = value
+    _, _, options = _checked_options(method, smoothing_steps=smoothing_steps, radius=radius)
     if orient is not None and check_choice(orient, "orient", ORIENT_CHOICES) != "auto":
         options["orient"] = orient  # 'auto' is the default: recorded the same as nothing
     return options
