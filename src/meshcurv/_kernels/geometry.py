@@ -9,44 +9,64 @@ import math
 import numba as nb
 import numpy as np
 
-from ._common import _JIT, _degenerate, _edge_length, _face_cross, _unit
+from ._common import _JIT, _degenerate, _edge_length, _face_cross, _unit, run_chunks, threaded
 
 
 #: the fixed number of runs of a reduction that must not depend on the thread count
 _SUM_CHUNKS = 256
 
+#: The passes over faces, edges or vertices run in this many chunks per thread (:func:`~._common.run_chunks`):
+#: plain compiled chunks on threads, not ``parallel=True`` kernels (0.5-1 s of CPU each to compile, issue 31).
+_CHUNKS_PER_THREAD = 4
 
-@nb.njit(parallel=True, **_JIT)
+
+@threaded
 def _mean_edge_length(vertices, edges):
     """Mean length of the edges (0 when there are none), summed in a fixed order.
 
-    The edges are cut into :data:`_SUM_CHUNKS` runs whatever the thread count; each run is summed in order and the
-    runs' sums are added in order, so the result (and every radius derived from it) is the same bit for bit on any
-    number of threads (a ``prange`` reduction adds in the order the threads finish).
+    The edges are cut into :data:`_SUM_CHUNKS` runs whatever the thread count; each run is summed in order
+    (:func:`_run_length_sums`, on threads: :func:`~meshcurv._kernels._common.run_chunks`) and the runs' sums are
+    added in order, so the result (and every radius derived from it) is the same bit for bit on any number of
+    threads. A ``parallel=True`` kernel did the same in about a second more of compile time (issue 31).
     """
     n = edges.shape[0]
     if n == 0:
         return 0.0
     chunks = min(_SUM_CHUNKS, n)
     partial = np.zeros(chunks)
-    for c in nb.prange(chunks):
+    run_chunks(_run_length_sums, chunks, _CHUNKS_PER_THREAD * nb.get_num_threads(), vertices, edges, partial)
+    total = 0.0
+    for c in range(chunks):  # Python floats are IEEE doubles: the compiled loop's sum, bit for bit
+        total += float(partial[c])
+    return total / n
+
+
+@nb.njit(**_JIT)
+def _run_length_sums(lo, hi, vertices, edges, partial):
+    """:func:`_mean_edge_length`: ``partial[c]``, the sum in order of the lengths of run ``c`` of the edges, for
+    ``c`` in ``lo:hi``."""
+    n = edges.shape[0]
+    chunks = partial.shape[0]
+    for c in range(lo, hi):
         total = 0.0
         for e in range(c * n // chunks, (c + 1) * n // chunks):
             total += _edge_length(vertices, edges[e, 0], edges[e, 1])
         partial[c] = total
-    total = 0.0
-    for c in range(chunks):
-        total += partial[c]
-    return total / n
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def face_cross_products(vertices, faces):
     """``geometry.face_cross_products``: (F, 3) ``cross(b - a, c - a)`` of every face."""
     out = np.empty((faces.shape[0], 3))
-    for f in nb.prange(faces.shape[0]):
-        out[f, 0], out[f, 1], out[f, 2] = _face_cross(vertices, faces[f, 0], faces[f, 1], faces[f, 2])
+    run_chunks(_face_cross_chunk, faces.shape[0], _CHUNKS_PER_THREAD * nb.get_num_threads(), vertices, faces, out)
     return out
+
+
+@nb.njit(**_JIT)
+def _face_cross_chunk(lo, hi, vertices, faces, out):
+    """Faces ``lo:hi`` of :func:`face_cross_products`."""
+    for f in range(lo, hi):
+        out[f, 0], out[f, 1], out[f, 2] = _face_cross(vertices, faces[f, 0], faces[f, 1], faces[f, 2])
 
 
 @nb.njit(**_JIT)
@@ -61,13 +81,19 @@ def vertex_normal_sums(cross, faces, n_vertices):
     return out
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def normalize_normal_sums(summed):
     """``geometry.normalize_normal_sums``: unit rows of ``summed``, NaN where they (nearly) cancel."""
     out = np.empty_like(summed)
-    for v in nb.prange(summed.shape[0]):
-        out[v, 0], out[v, 1], out[v, 2], _ = _unit(summed[v, 0], summed[v, 1], summed[v, 2])
+    run_chunks(_normalize_chunk, summed.shape[0], _CHUNKS_PER_THREAD * nb.get_num_threads(), summed, out)
     return out
+
+
+@nb.njit(**_JIT)
+def _normalize_chunk(lo, hi, summed, out):
+    """Rows ``lo:hi`` of :func:`normalize_normal_sums`."""
+    for v in range(lo, hi):
+        out[v, 0], out[v, 1], out[v, 2], _ = _unit(summed[v, 0], summed[v, 1], summed[v, 2])
 
 
 @nb.njit(**_JIT)
@@ -91,30 +117,48 @@ def mean_edge_length(vertices, edges):
     return _mean_edge_length(vertices, edges)
 
 
-@nb.njit(parallel=True, **_JIT)
+@nb.njit(**_JIT)
 def edge_lengths(vertices, edges):
-    """``geometry.edge_lengths``: (E,) length of each edge."""
+    """``geometry.edge_lengths``: (E,) length of each edge. One thread: a ``parallel=True`` kernel took about
+    0.6 s more CPU to compile on a cold cache (issue 31) for a pass bound by memory."""
     out = np.empty(edges.shape[0])
-    for e in nb.prange(edges.shape[0]):
+    for e in range(edges.shape[0]):
         out[e] = _edge_length(vertices, edges[e, 0], edges[e, 1])
     return out
 
 
-@nb.njit(parallel=True, **_JIT)
+@threaded
 def cross_and_degenerate(vertices, faces, scales, area_ratio):
     """``(cross, degenerate)``: :func:`face_cross_products`, and (F,) bool the faces that repeat a vertex or whose
     area is at most ``area_ratio`` x ``scales[a]^2`` (``scales`` (V,) the length scale at each vertex,
     ``geometry.vertex_length_scales``, read at the first corner ``a``: the corners of a face share their
-    component), in one pass over the faces (``geometry.degenerate_faces``)."""
+    component), in one pass over the faces (``geometry.degenerate_faces``), in chunks of faces on threads
+    (:func:`~meshcurv._kernels._common.run_chunks`)."""
     cross = np.empty((faces.shape[0], 3))
     out = np.empty(faces.shape[0], np.bool_)
-    for f in nb.prange(faces.shape[0]):
+    run_chunks(
+        _cross_and_degenerate_chunk,
+        faces.shape[0],
+        _CHUNKS_PER_THREAD * nb.get_num_threads(),
+        vertices,
+        faces,
+        scales,
+        float(area_ratio),
+        cross,
+        out,
+    )
+    return cross, out
+
+
+@nb.njit(**_JIT)
+def _cross_and_degenerate_chunk(lo, hi, vertices, faces, scales, area_ratio, cross, out):
+    """Faces ``lo:hi`` of :func:`cross_and_degenerate`."""
+    for f in range(lo, hi):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         nx, ny, nz = _face_cross(vertices, a, b, c)
         cross[f, 0], cross[f, 1], cross[f, 2] = nx, ny, nz
         threshold = area_ratio * scales[a] * scales[a]
         out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
-    return cross, out
 
 
 @nb.njit(**_JIT)

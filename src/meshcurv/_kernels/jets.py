@@ -815,7 +815,10 @@ def _connected_chunk(
     members = np.empty(n, np.int64)
     queue = np.empty(n, np.int64)
     work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
-    c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row: unpacked once, not per vertex
+    # one row of each output, written by every fit (c and one_away set below): unpacked once, not per vertex; no
+    # call of _jet_outputs (its NaN fills compile 0.3-0.5 s of CPU more than these)
+    c, a, b, nn = np.empty((1, 6)), np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3))
+    one_count, one_away = np.empty(1), np.empty(1)
     for i in range(lo, hi):
         v = centres[i]
         radius = radii[i if per_centre else 0]

@@ -84,7 +84,6 @@ def _bucket_cursors(lo, hi, cursor, starts):
             at += count
 
 
-@nb.njit(**_JIT)
 def build_edges(faces, n_vertices, template):
     """Edges of the triangles, their faces and counts (see MeshTopology._build): :func:`build_topology`
     without the twins of the sides, ``(edges, face_edges, edge_faces, counts, forward)``."""
@@ -92,11 +91,16 @@ def build_edges(faces, n_vertices, template):
     return edges, face_edges, edge_faces, counts, forward
 
 
-@nb.njit(**_JIT)
 def build_topology(faces, n_vertices, template, with_twins):
     """:func:`build_edges_into` on arrays allocated here: ``(edges, face_edges, edge_faces, counts, forward,
     twins, corners, first)``, all in the integer type of ``template``; the last three only when ``with_twins``
-    (else empty arrays)."""
+    (else empty arrays).
+
+    The arrays are NumPy's (uninitialised where :func:`build_edges_into` writes every element it keeps; the rows
+    past the last edge are never touched, so never paged in), allocated here rather than in a compiled function:
+    numba's array constructors for the integer type of ``template`` cost a second of CPU to compile on a cold
+    cache (issue 31).
+    """
     n_faces = faces.shape[0]
     index = template.dtype
     face_edges = np.empty(3 * n_faces, index)
