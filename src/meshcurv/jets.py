@@ -1088,14 +1088,50 @@ def _sampled_jet_normals(
     if not usable.any():
         return out
     sampled, fitted = sampled[usable], fitted[usable]
-    reach = width * spacing
-    tree = cKDTree(at[sampled])
-    pairs = cKDTree(at).sparse_distance_matrix(tree, reach, output_type="coo_matrix")
-    row, col = pairs.row.astype(np.int64), pairs.col.astype(np.int64)
-    offsets = (at[sampled[col]] - at[row]) / reach
-    weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
     t1, t2 = tangent_basis(np.ascontiguousarray(np.asarray(normals, dtype=np.float64)[centres]))
-    basis = (np.ones(row.size), np.einsum("ij,ij->i", offsets, t1[row]), np.einsum("ij,ij->i", offsets, t2[row]))
+    kernels = numba_kernels("pilot")
+    interpolate = interpolated_normals if kernels is None else kernels.interpolated_normals
+    out, reached = interpolate(at, at[sampled], fitted, t1, t2, width * spacing, SAMPLED_SPREAD)
+    if not reached.all():
+        _, nearest = cKDTree(at[sampled]).query(at[~reached])
+        out[~reached] = fitted[nearest]
+    out /= np.linalg.norm(out, axis=1, keepdims=True)
+    out[sampled] = fitted
+    return out
+
+
+def interpolated_normals(
+    at: np.ndarray,
+    samples: np.ndarray,
+    fitted: np.ndarray,
+    tangent1: np.ndarray,
+    tangent2: np.ndarray,
+    reach: float,
+    spread: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`sampled_jet_normals`' interpolation: ``(normals, reached)`` at the centres ``at`` (M, 3).
+
+    Each centre takes the value at itself of a weighted linear least-squares fit of the ``fitted`` (S, 3) normals
+    of the ``samples`` (S, 3) within ``reach`` over its tangent plane ``(tangent1, tangent2)`` (M, 3), weights
+    ``(1 - d^2 / reach^2)^2``; where the weighted variances of the samples' two coordinates (in units of
+    ``reach``) multiplied do not exceed ``spread``, the weighted mean of their normals. Not normalised; NaN and
+    ``reached`` False where no sample is within ``reach``. The compiled twin
+    (:func:`meshcurv._kernels.pilot.interpolated_normals`) finds the samples by cubes instead of k-d trees and
+    solves by Cramer's rule: the results agree to round-off (``tests/test_jets_sampled.py``).
+    """
+    from scipy.spatial import cKDTree
+
+    m = at.shape[0]
+    out = np.full((m, 3), np.nan)
+    pairs = cKDTree(at).sparse_distance_matrix(cKDTree(samples), reach, output_type="coo_matrix")
+    row, col = pairs.row.astype(np.int64), pairs.col.astype(np.int64)
+    offsets = (samples[col] - at[row]) / reach
+    weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
+    basis = (
+        np.ones(row.size),
+        np.einsum("ij,ij->i", offsets, tangent1[row]),
+        np.einsum("ij,ij->i", offsets, tangent2[row]),
+    )
     gram = np.zeros((m, 3, 3))
     moments = np.zeros((m, 3, 3))
     for a in range(3):
@@ -1106,16 +1142,11 @@ def _sampled_jet_normals(
     total = gram[:, 0, 0]
     reached = total > 0
     planar = reached.copy()
-    planar[reached] = np.linalg.det(gram[reached]) > SAMPLED_SPREAD * total[reached] ** 3
+    planar[reached] = np.linalg.det(gram[reached]) > spread * total[reached] ** 3
     out[planar] = np.linalg.solve(gram[planar], moments[planar])[:, 0, :]
     mean = reached & ~planar
     out[mean] = moments[mean, 0, :] / total[mean, None]
-    if not reached.all():
-        _, nearest = tree.query(at[~reached])
-        out[~reached] = fitted[nearest]
-    out /= np.linalg.norm(out, axis=1, keepdims=True)
-    out[sampled] = fitted
-    return out
+    return out, reached
 
 
 def _cube_samples(points: np.ndarray, spacing: float) -> np.ndarray:
