@@ -1030,6 +1030,7 @@ def check_connected_face_sums(name):
     check_connected_face_sums_per_vertex(name)
 
 
+@functools.cache
 def face_sum_inputs(name):
     """``(vertices, faces, kernels, values, usable, centroids, reach, n, indptr, indices)`` of the walks' sums."""
     vertices, faces = mesh(name)
@@ -1049,26 +1050,45 @@ def face_sum_inputs(name):
     )
 
 
-def check_connected_face_sums_per_vertex(name):
-    """A radius per vertex: the NumPy path's sums at those radii (the same faces and shares, in another order)."""
-    vertices, faces, compiled, values, usable, centres, reach, n, indptr, indices = face_sum_inputs(name)
-    radii = np.random.default_rng(2).uniform(0.9, 2.5, n) * mean_edge(name)
-    got = np.zeros((n, values.shape[1]))
-    compiled.connected_face_sums(
+def walked_face_sums(name, values, radii, usable, *, scratch=None, into=None, start=0, stop=None):
+    """The compiled walks' sums of the mesh ``name`` for the vertices ``[start, stop)`` (all by default).
+
+    ``connected_face_sums`` for 1-D ``radii`` (one, or one per vertex), into ``into`` of shape (V, m);
+    ``connected_face_sums_nested`` for 2-D ``radii`` (one row per level, of 1 or V radii) and ``values`` of one
+    set or one per level, into (levels, V, m). ``into`` is new zeros when None; ``scratch`` by default one chunk a
+    kernel thread (:func:`meshcurv.neighborhoods._face_sum_scratch`).
+    """
+    vertices, faces, compiled, _, _, centres, reach, n, indptr, indices = face_sum_inputs(name)
+    nested = radii.ndim == 2
+    if into is None:
+        into = np.zeros(((radii.shape[0],) if nested else ()) + (n, values.shape[-1]))
+    if scratch is None:
+        scratch = _face_sum_scratch(kernel_threads(), n, faces.shape[0], nested and radii.shape[0] > 1)
+    walk = compiled.connected_face_sums_nested if nested else compiled.connected_face_sums
+    stop = n if stop is None else stop
+    walk(
         vertices,
         faces,
         centres,
         reach,
         usable,
         values,
-        radii,
+        np.ascontiguousarray(radii),
         indptr,
         indices,
-        got,
-        _face_sum_scratch(kernel_threads(), n, faces.shape[0]),
-        0,
-        n,
+        into,
+        scratch,
+        start,
+        stop,
     )
+    return into
+
+
+def check_connected_face_sums_per_vertex(name):
+    """A radius per vertex: the NumPy path's sums at those radii (the same faces and shares, in another order)."""
+    _, _, _, values, usable, _, _, n, _, _ = face_sum_inputs(name)
+    radii = np.random.default_rng(2).uniform(0.9, 2.5, n) * mean_edge(name)
+    got = walked_face_sums(name, values, radii, usable)
     expected, magnitude = numpy_ball_sums(name, "faces", values, radii, usable, connected=True)
     assert_sums_close(got, expected, magnitude, ball_terms(name, "faces", float(radii.max())), "a radius per vertex")
 
@@ -1076,7 +1096,7 @@ def check_connected_face_sums_per_vertex(name):
 def check_connected_face_sums_nested(name):
     """Nested radii (one for all, or per vertex; the same values or one set per radius) in one walk: each row
     against the NumPy path's sums at that row's radii (the same faces and shares, summed in another order)."""
-    vertices, faces, compiled, values, usable, centres, reach, n, indptr, indices = face_sum_inputs(name)
+    _, _, _, values, usable, _, _, n, _, _ = face_sum_inputs(name)
     h = mean_edge(name)
     per_vertex = np.random.default_rng(2).uniform(0.9, 2.5, n) * h
     sets = np.stack([values, -2.0 * values, values[::-1].copy()])  # one set of values per radius
@@ -1085,22 +1105,7 @@ def check_connected_face_sums_nested(name):
         (np.array([0.5, 1.0, 2.0])[:, None] * per_vertex, sets),
         (np.array([[0.95], [2.0], [4.0]]) * h, values[None]),
     ):
-        got = np.zeros((radii.shape[0], n, values.shape[1]))
-        compiled.connected_face_sums_nested(
-            vertices,
-            faces,
-            centres,
-            reach,
-            usable,
-            given,
-            np.ascontiguousarray(radii),
-            indptr,
-            indices,
-            got,
-            _face_sum_scratch(kernel_threads(), n, faces.shape[0], radii.shape[0] > 1),
-            0,
-            n,
-        )
+        got = walked_face_sums(name, given, radii, usable)
         for r, row in enumerate(radii):
             radius = row[0] if row.size == 1 else row
             expected, magnitude = numpy_ball_sums(
@@ -1116,53 +1121,27 @@ def check_connected_face_sums_nested(name):
 
 
 def check_connected_face_sums_at(name, radius):
-    vertices, faces = mesh(name)
-    compiled = kernels("neighborhoods")
-    values = ball_values(name, "faces")
-    usable = np.random.default_rng(4).random(faces.shape[0]) > 0.1
-    centres, reach = compiled.cell_centres(vertices, faces)
-    indptr, indices = compiled.vertex_face_lists(faces, vertices.shape[0], kernel_threads())
-    n = vertices.shape[0]
+    _, faces, _, values, usable, _, _, n, _, _ = face_sum_inputs(name)
     for mask in (None, usable):
         # the same faces as the NumPy path's connected pieces (the walk's, found by connected
         # components of all balls at once), summed in another order
         expected, magnitude = numpy_ball_sums(name, "faces", values, radius, mask, connected=True)
         allowed = np.ones(faces.shape[0], dtype=bool) if mask is None else mask
         radii = np.array([radius])  # one radius for all vertices
-        got = np.zeros_like(expected)
-        compiled.connected_face_sums(
-            vertices,
-            faces,
-            centres,
-            reach,
-            allowed,
-            values,
-            radii,
-            indptr,
-            indices,
-            got,
-            _face_sum_scratch(kernel_threads(), n, faces.shape[0]),
-            0,
-            n,
-        )
+        got = walked_face_sums(name, values, radii, allowed)
         assert_sums_close(
             got, expected, magnitude, ball_terms(name, "faces", radius), "all faces" if mask is None else "usable faces"
         )
         # ranges of centres, one scratch for all (as the calls of ball_face_sums): only their rows each time;
         # with the int64 scratch of meshes whose indices do not fit in int32 (this one's are int32)
-        part = np.zeros_like(got)
         scratch = tuple(
             a.astype(np.int64) if a.dtype == np.int32 else a for a in _face_sum_scratch(3, n, faces.shape[0])
         )
-        compiled.connected_face_sums(
-            vertices, faces, centres, reach, allowed, values, radii, indptr, indices, part, scratch, n // 3, n // 2
-        )
+        part = walked_face_sums(name, values, radii, allowed, scratch=scratch, start=n // 3, stop=n // 2)
         np.testing.assert_array_equal(part[n // 3 : n // 2], got[n // 3 : n // 2])
         assert not part[: n // 3].any() and not part[n // 2 :].any()
         for lo, hi in ((0, n // 3), (n // 2, n)):
-            compiled.connected_face_sums(
-                vertices, faces, centres, reach, allowed, values, radii, indptr, indices, part, scratch, lo, hi
-            )
+            walked_face_sums(name, values, radii, allowed, scratch=scratch, into=part, start=lo, stop=hi)
         np.testing.assert_array_equal(part, got)
 
 
@@ -2315,46 +2294,18 @@ def test_connected_face_sums_are_the_nested_walk_of_one_ball_on_one_or_two_threa
     chunks on threads give the sums of one thread."""
     import numba
 
-    vertices, faces, compiled, values, usable, centres, reach, n, indptr, indices = face_sum_inputs(name)
+    _, faces, _, values, usable, _, _, n, _, _ = face_sum_inputs(name)
     h = mean_edge(name)
     threads = numba.get_num_threads()
     for radii in (np.array([1.7 * h]), np.random.default_rng(2).uniform(0.9, 2.5, n) * h):
-        nested = np.zeros((1, n, values.shape[1]))
-        compiled.connected_face_sums_nested(
-            vertices,
-            faces,
-            centres,
-            reach,
-            usable,
-            values[None],
-            np.ascontiguousarray(radii[None, :]),
-            indptr,
-            indices,
-            nested,
-            _face_sum_scratch(2, n, faces.shape[0]),
-            0,
-            n,
+        nested = walked_face_sums(
+            name, values[None], radii[None, :], usable, scratch=_face_sum_scratch(2, n, faces.shape[0])
         )
         assert np.count_nonzero(nested[0].any(axis=1)) > n // 2  # sums were made
         for count in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
-            got = np.zeros((n, values.shape[1]))
             try:
                 numba.set_num_threads(count)
-                compiled.connected_face_sums(
-                    vertices,
-                    faces,
-                    centres,
-                    reach,
-                    usable,
-                    values,
-                    radii,
-                    indptr,
-                    indices,
-                    got,
-                    _face_sum_scratch(2, n, faces.shape[0]),
-                    0,
-                    n,
-                )
+                got = walked_face_sums(name, values, radii, usable, scratch=_face_sum_scratch(2, n, faces.shape[0]))
             finally:
                 numba.set_num_threads(threads)
             np.testing.assert_array_equal(got, nested[0])
