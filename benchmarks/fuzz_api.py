@@ -33,7 +33,15 @@ as CPU time (starved by the machine's load) runs once more with 5 times the limi
   referenced vertex; with every face given twice, the second wound the other
   way (a double-sided mesh, orient='outward'), the same values; with one
   vertex (or it and a neighbour) flung 1e3 to 1e40 times its size away (their
-  faces needles), those vertices invalid ("needle vertex" for one).
+  faces needles), those vertices invalid ("needle vertex" for one); computed
+  again on the other backend (numba or NumPy; 15% of the curvature calls, from
+  a random stream of their own), the same valid points, reasons and parameters
+  and the curvatures within 1e-6 of the largest |k| (issue 29, class 10); the
+  plain arrays given as a mesh or point object instead (trimesh, PyVista
+  PolyData and UnstructuredGrid, meshio, a duck type; 10%), the result of the
+  arrays (issue 29, class 8); faces given transposed, swapped with the vertices
+  or alone (4%): refused with the hint that names the slip (issue 29, "Also
+  seen as a new user would").
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -482,8 +490,136 @@ def make_mesh(rng):
 def make_case(seed: int, index: int):
     """``(target, args, kwargs, labels, clean)``, deterministic in ``(seed, index)``.
 
-    ``clean`` is None, or ``(relation, value)`` for :func:`relation_check`.
+    ``clean`` is None, or ``(relation, value)`` for :func:`relation_check`. The cases are drawn by
+    :func:`_drawn_case`; :func:`_with_twins` then adds, from a stream of its own (so that a seed draws the
+    same calls as before it), the backend and mesh-object relations.
     """
+    return _with_twins(_drawn_case(seed, index), np.random.default_rng([seed, index, TWIN_STREAM]))
+
+
+#: The random stream of :func:`_with_twins` (beside the case's own ``[seed, index]``).
+TWIN_STREAM = 29
+#: Share of the curvature calls computed again on the other backend (issue 29, class 10).
+BACKEND_SHARE = 0.15
+#: Share of the plain-array curvature calls given again as a mesh or point object (issue 29, class 8).
+OBJECT_SHARE = 0.1
+#: Share of the plain-array mesh calls made as a new user might get them wrong (issue 29, "Also seen"): faces
+#: transposed (3 x F), the two arrays swapped, the faces alone.
+MISUSE_SHARE = 0.04
+#: The hint each misuse's error must give.
+MISUSE_HINTS = {
+    "faces transposed": "looks transposed",
+    "vertices and faces swapped": "swapped",
+    "faces alone": "it looks like the faces",
+}
+#: The backend relation is left out above this many points (the NumPy paths of thin clouds: about 3 s of CPU
+#: per 1,000 points).
+BACKEND_MAX_POINTS = 4000
+#: Relative agreement of the two backends, in the largest |k| of the result (tests/test_backend_parity.py).
+BACKEND_RTOL = 1e-6
+
+
+def _plain(value) -> bool:
+    return (
+        type(value) is np.ndarray
+        and value.dtype == np.float64
+        or (type(value) is np.ndarray and value.dtype == np.int64)
+    )
+
+
+def _mesh_object(rng, v, f):
+    """``(object, label)``: the mesh ``v, f`` as another library's object, or ``(None, '')`` when it cannot be."""
+    if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3 or not len(f) or f.min() < 0:
+        return None, ""
+    if f.max() >= len(v):
+        return None, ""  # (VTK reads past its points on an index out of range: not ours to test)
+    kind = ["trimesh", "polydata", "unstructured", "meshio", "duck"][int(rng.integers(5))]
+    try:
+        if kind == "trimesh":
+            import trimesh
+
+            return trimesh.Trimesh(v, f, process=False), "trimesh.Trimesh"
+        if kind in ("polydata", "unstructured"):
+            import pyvista
+
+            if kind == "polydata":
+                return pyvista.PolyData(v, np.c_[np.full(len(f), 3), f].ravel()), "pyvista.PolyData"
+            grid = pyvista.UnstructuredGrid({pyvista.CellType.TRIANGLE: f}, v)
+            return grid, "pyvista.UnstructuredGrid"
+        if kind == "meshio":
+            import meshio
+
+            return meshio.Mesh(v, [("triangle", f)]), "meshio.Mesh"
+    except Exception:  # noqa: BLE001 - a library that cannot hold this mesh (or is not installed)
+        return None, ""
+    import types
+
+    return types.SimpleNamespace(vertices=v.tolist(), triangles=f.tolist()), "duck (.vertices, .triangles)"
+
+
+def _point_object(rng, points):
+    kind = ["polydata", "trimesh", "duck"][int(rng.integers(3))]
+    try:
+        if kind == "polydata":
+            import pyvista
+
+            return pyvista.PolyData(points), "pyvista.PolyData points"
+        if kind == "trimesh":
+            import trimesh
+
+            return trimesh.PointCloud(points), "trimesh.PointCloud"
+    except Exception:  # noqa: BLE001 - a library that cannot hold these points (or is not installed)
+        return None, ""
+    import types
+
+    return types.SimpleNamespace(points=points), "duck (.points)"
+
+
+def _with_twins(case, rng):
+    """``case`` with, now and then, the backend relation or its arrays given as an object (mesh or points)."""
+    target, args, kwargs, labels, clean = case
+    if target not in ("principal_curvatures", "point_cloud_curvatures"):
+        return case
+    roll = rng.random()
+    if roll < BACKEND_SHARE:
+        if (
+            target == "point_cloud_curvatures"
+            and _n_rows(args[0]) is not None
+            and _n_rows(args[0]) > BACKEND_MAX_POINTS
+        ):
+            return case
+        return target, args, kwargs, labels + ["relation backend"], ("backend", clean)
+    if (
+        BACKEND_SHARE + OBJECT_SHARE <= roll < BACKEND_SHARE + OBJECT_SHARE + MISUSE_SHARE
+        and target == "principal_curvatures"
+        and all(_plain(a) for a in args)
+    ):
+        v, f = args
+        if v.ndim != 2 or v.shape[1] != 3 or not v.size or not np.isfinite(v).all():
+            return case
+        if f.ndim != 2 or f.shape[1] != 3 or f.shape[0] <= 3 or f.min() < 0 or f.max() >= len(v):
+            return case
+        method = kwargs.get("method")
+        kwargs = {"method": method} if isinstance(method, str) and method in METHODS else {}  # the slip alone
+        choices = ["faces alone"]
+        if all(np.unique(row).size < row.size for row in f.T):  # else three polygons (documented)
+            choices.append("faces transposed")
+        if v.ndim == 2 and v.shape[1] == 3 and np.isfinite(v).all() and (v != np.round(v)).any():
+            choices.append("vertices and faces swapped")
+        misuse = choices[int(rng.integers(len(choices)))]
+        args = {"faces transposed": (v, f.T), "vertices and faces swapped": (f, v), "faces alone": (f,)}[misuse]
+        return target, args, kwargs, labels + [f"misuse {misuse}"], ("misuse", (misuse, (v, f)))
+    if roll < BACKEND_SHARE + OBJECT_SHARE and all(_plain(a) for a in args):
+        if target == "principal_curvatures":
+            obj, label = _mesh_object(rng, *args)
+        else:
+            obj, label = _point_object(rng, args[0]) if args[0].ndim == 2 and args[0].shape[1:] == (3,) else (None, "")
+        if obj is not None:
+            return target, (obj,), kwargs, labels + [f"relation object {label}"], ("object", (args, clean))
+    return case
+
+
+def _drawn_case(seed: int, index: int):
     rng = np.random.default_rng([seed, index])
     if ONLY_POINT_CLOUDS and pointcloud is not None and rng.random() < 0.7:
         return make_cloud_case(rng)
@@ -1052,18 +1188,131 @@ def run_case(target, args, kwargs, clean):
     for a, s in zip(args, snaps):
         if not _unchanged(a, s):
             broken.append("an input array was modified")
+    if clean is not None and clean[0] == "misuse":  # refused, with the hint that names the slip
+        misuse, right = clean[1]
+        hint = MISUSE_HINTS[misuse]
+        if result is not None:
+            broken.append(f"misuse: {misuse} accepted ({int(result.valid.sum())} valid vertices)")
+        elif outcome["status"] == "documented" and hint not in outcome["message"]:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                try:  # (a mesh refused for itself, as the right call refuses it, needs no hint)
+                    meshcurv.principal_curvatures(*right, **kwargs)
+                    broken.append(f"misuse: {misuse} refused without the hint {hint!r}: {outcome['message'][:150]}")
+                except DOCUMENTED:
+                    pass
+        result = None
+    arrays = clean[1][0] if clean is not None and clean[0] == "object" else args  # an object's own arrays
+    if result is None and outcome["status"] == "documented" and clean is not None and clean[0] == "object":
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                _curvature_call("mesh" if len(arrays) > 1 else "cloud")(*arrays, **kwargs)
+                broken.append(f"object: refused ({outcome['message'][:150]}) where its arrays succeed")
+            except DOCUMENTED:
+                pass
     if result is not None and target in ("principal_curvatures", "point_cloud_curvatures"):
-        n = _n_rows(args[0])
-        if isinstance(args[0], np.ndarray) and args[0].ndim != 2:
+        n = _n_rows(arrays[0])
+        if isinstance(arrays[0], np.ndarray) and arrays[0].ndim != 2:
             n = None
         if n is not None:
-            broken += check_result(result, n, getattr(result, "method", ""), _referenced(args, n))
+            broken += check_result(result, n, getattr(result, "method", ""), _referenced(arrays, n))
         if clean is not None:
             broken += relation_check(args, kwargs, result, clean)
     if broken:
         outcome["status"] = "invariant"
         outcome["broken"] = broken
     return outcome
+
+
+def _curvature_call(target):
+    return meshcurv.principal_curvatures if target == "mesh" else pointcloud.point_cloud_curvatures
+
+
+def compare_results(a, b, rtol, label, length=0.0) -> list[str]:
+    """How two results of one input differ beyond ``rtol`` of ``a``'s largest |k| (normals: ``rtol``).
+
+    The largest |k| is over every finite value (``matgeom`` keeps values at invalid vertices); the
+    parameters agree to 1e-9 relative, or 1e-12 of ``length`` (the input's extent: a noise level of 1e-16
+    on a flat cloud is round-off).
+    """
+    broken = []
+    if not np.array_equal(a.valid, b.valid):
+        broken.append(f"{label}: valid differs at {int((a.valid != b.valid).sum())} points")
+        return broken
+    if a.invalid_reason is not None and not np.array_equal(a.invalid_reason, b.invalid_reason):
+        broken.append(f"{label}: invalid_reason differs at {int((a.invalid_reason != b.invalid_reason).sum())} points")
+    for key, value in a.parameters.items():
+        other = b.parameters.get(key)
+        try:
+            same = (
+                np.allclose(
+                    np.asarray(value, float), np.asarray(other, float), rtol=1e-9, atol=1e-12 * length, equal_nan=True
+                )
+                if not isinstance(value, (str, bool)) and value is not None
+                else value == other
+            )
+        except (TypeError, ValueError):
+            same = repr(value) == repr(other)
+        if not same:
+            broken.append(f"{label}: parameter {key} {value!r} against {other!r}")
+    valid = a.valid
+    with np.errstate(all="ignore"):
+        finite = np.isfinite(a.k_min) & np.isfinite(a.k_max)
+        scale = max(float(np.abs(a.k_min[finite]).max(initial=0)), float(np.abs(a.k_max[finite]).max(initial=0)))
+        scale = scale or 1.0
+        for name, unit in (("k_min", scale), ("k_max", scale), ("mean", scale), ("gaussian", scale * scale)):
+            x, y = getattr(a, name), getattr(b, name)
+            if not np.array_equal(np.isnan(x), np.isnan(y)):
+                broken.append(f"{label}: {name} NaN at other points")
+                continue
+            error = np.abs(x - y)[~np.isnan(x)] / unit
+            if error.size and not (error <= rtol).all():
+                broken.append(f"{label}: {name} differs by up to {float(np.nanmax(error)):.3g} of the largest |k|")
+        na, nb = a.normals[valid], b.normals[valid]
+        if a.method == "matgeom":  # an eigenvector: up to sign
+            nb = nb * np.where(np.einsum("ij,ij->i", na, nb) < 0, -1.0, 1.0)[:, None]
+        if na.size and not (np.abs(na - nb) <= rtol).all():
+            broken.append(f"{label}: normals differ by up to {float(np.abs(na - nb).max()):.3g}")
+    return broken
+
+
+def backend_check(args, kwargs, result) -> list[str]:
+    """The call again on the other backend: the same valid points, reasons, parameters and values."""
+    from meshcurv._backend import backend_name, use_backend
+
+    here = backend_name()
+    other = "numpy" if here == "numba" else "numba"
+    target = "mesh" if len(args) > 1 or getattr(result, "method", "") in METHODS else "cloud"
+    with use_backend(other), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            again = _curvature_call(target)(*args, **kwargs)
+        except DOCUMENTED as error:
+            return [f"backend {other}: {type(error).__name__} where {here} succeeded: {str(error)[:150]}"]
+    return compare_results(result, again, BACKEND_RTOL, f"backend {here} vs {other}", _extent(args[0]))
+
+
+def object_check(arrays, kwargs, result) -> list[str]:
+    """The call on the plain arrays: the object's result must be theirs (to round-off)."""
+    target = "mesh" if len(arrays) > 1 else "cloud"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            plain = _curvature_call(target)(*arrays, **kwargs)
+        except DOCUMENTED as error:
+            return [f"object: the arrays give {type(error).__name__} where the object succeeded: {str(error)[:150]}"]
+    return compare_results(plain, result, 1e-9, "object vs arrays", _extent(arrays[0]))
+
+
+def _extent(points) -> float:
+    """The largest side of the bounding box of the finite ``points`` (0 if none or not an array of numbers)."""
+    try:
+        points = np.asarray(points, dtype=float)
+        finite = points[np.isfinite(points).all(axis=-1)] if points.ndim == 2 else points[:0]
+        return float(np.ptp(finite, axis=0).max()) if finite.size else 0.0
+    except (TypeError, ValueError):
+        return 0.0
 
 
 #: With needles, the median change of H at the vertices valid with and without them is at most this share of the
@@ -1080,6 +1329,11 @@ def relation_check(args, kwargs, result, relation):
     referenced vertex's values and validity unchanged.
     """
     kind, value = relation
+    if kind == "backend":  # the same call on the other backend: the same estimator (issue 29, class 10)
+        return backend_check(args, kwargs, result) + (relation_check(args, kwargs, result, value) if value else [])
+    if kind == "object":  # the arrays given as an object: the same result as the arrays (issue 29, class 8)
+        arrays, inner = value
+        return object_check(arrays, kwargs, result) + (relation_check(arrays, kwargs, result, inner) if inner else [])
     if kind == "cloud truth":
         return cloud_truth_check(args, kwargs, result, value)
     v, f = args
@@ -1393,6 +1647,11 @@ def main(argv=None) -> int:
             meshcurv.principal_curvatures(warm.vertices, warm.faces, method=method)
         if pointcloud is not None:
             pointcloud.point_cloud_curvatures(shapes.random_sphere(n_vertices=200).vertices)
+        for module in ("pyvista", "trimesh", "meshio"):  # the mesh objects' libraries, imported once
+            try:
+                __import__(module)
+            except ImportError:
+                pass
 
     guard = vsize() + 3 * 2**30  # the parent itself never needs more (it builds no case)
     resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
