@@ -334,3 +334,71 @@ def test_plot_field_of_a_point_cloud_is_shaded_by_the_given_normals():
     assert len(fig.axes) == 3
     with pytest.raises(InvalidOptionError, match="normals"):
         plot_field(points, None, points[:, 2], normals=points[:10])
+
+
+# --- what principal_curvatures takes: mesh objects, a MeshTopology, objects of points ------------------
+
+
+def image_of(*mesh, values, **options):
+    """The RGBA image of one view of ``plot_field(*mesh, values)``."""
+    fig = plot_field(*mesh, values, view="iso", pixels=80, **options)
+    return fig.axes[0].images[0].get_array()
+
+
+def torus_object(library: str):
+    """The small torus as a mesh object of ``library`` (the test skipped when it is not installed)."""
+    module = pytest.importorskip(library.split()[0])
+    if library == "trimesh":
+        return module.Trimesh(TORUS.vertices, TORUS.faces, process=False)
+    if library == "meshio":
+        return module.Mesh(TORUS.vertices, [("triangle", TORUS.faces)])
+    polydata = module.PolyData.from_regular_faces(TORUS.vertices, TORUS.faces)
+    return polydata.cast_to_unstructured_grid() if library == "pyvista grid" else polydata
+
+
+@pytest.mark.parametrize("library", ["trimesh", "pyvista", "pyvista grid", "meshio"])
+def test_plot_field_of_a_mesh_object_is_the_picture_of_its_arrays(library):
+    mesh = torus_object(library)
+    expected = image_of(TORUS.vertices, TORUS.faces, values=TORUS.mean)
+    np.testing.assert_array_equal(image_of(mesh, None, values=TORUS.mean), expected)
+    # principal_curvatures takes the same object alone and gives one row per vertex, as drawn
+    assert meshcurv.principal_curvatures(mesh).n_vertices == len(TORUS.vertices)
+
+
+def test_plot_field_takes_a_topology_and_empty_faces_as_points():
+    topology = meshcurv.MeshTopology.from_faces(TORUS.faces)
+    expected = image_of(TORUS.vertices, TORUS.faces, values=TORUS.mean)
+    np.testing.assert_array_equal(image_of(TORUS.vertices, topology, values=TORUS.mean), expected)
+    points = image_of(TORUS.vertices, None, values=TORUS.mean)
+    np.testing.assert_array_equal(image_of(TORUS.vertices, np.zeros((0, 3), dtype=int), values=TORUS.mean), points)
+
+
+def test_plot_field_of_a_pyvista_point_cloud_is_the_picture_of_its_points():
+    pyvista = pytest.importorskip("pyvista")
+    expected = image_of(TORUS.vertices, None, values=TORUS.mean)
+    for cloud in (pyvista.PolyData(TORUS.vertices), pyvista.PointSet(TORUS.vertices)):
+        np.testing.assert_array_equal(image_of(cloud, None, values=TORUS.mean), expected)
+
+
+@pytest.mark.parametrize(
+    "vertices",
+    [object(), "torus.obj", np.zeros((4, 2))],
+    ids=["object", "string", "array of 2 columns"],
+)
+def test_plot_field_refuses_what_principal_curvatures_refuses(vertices):
+    faces = None if not isinstance(vertices, np.ndarray) else [[0, 1, 2]]
+    with pytest.raises(InvalidMeshError) as call:
+        meshcurv.principal_curvatures(vertices, faces)
+    with pytest.raises(InvalidMeshError) as drawn:
+        plot_field(vertices, faces, np.zeros(4))
+    assert str(drawn.value) == str(call.value)
+
+
+def test_plot_field_refuses_a_volume_mesh_as_principal_curvatures_does():
+    pyvista = pytest.importorskip("pyvista")
+    grid = pyvista.UnstructuredGrid({pyvista.CellType.TETRA: np.array([[0, 1, 2, 3]])}, np.eye(4)[:, :3])
+    with pytest.raises(InvalidMeshError, match="cells that are not surface polygons") as call:
+        meshcurv.principal_curvatures(grid)
+    with pytest.raises(InvalidMeshError) as drawn:
+        plot_field(grid, None, np.zeros(4))
+    assert str(drawn.value) == str(call.value)

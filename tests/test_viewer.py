@@ -199,6 +199,55 @@ def test_polygons_are_fan_triangulated(tmp_path, torus):
     assert arrays["faces"].shape == (2 * len(torus.quads), 3)
 
 
+@pytest.mark.parametrize("library", ["trimesh", "pyvista", "meshio"])
+def test_a_mesh_object_is_the_page_of_its_arrays(tmp_path, torus, library):
+    pytest.importorskip(library)
+    result = exact_result(torus)
+    mesh = (torus.vertices, torus.faces)
+    # the result's own adapters build the objects; meshio has none
+    objects = {"trimesh": result.to_trimesh, "pyvista": result.to_pyvista}
+    if library == "meshio":
+        import meshio
+
+        objects["meshio"] = lambda mesh: meshio.Mesh(mesh[0], [("triangle", mesh[1])])
+    expected = read_page_data(write_html(tmp_path / "arrays.html", *mesh, result))
+    meta, arrays = read_page_data(write_html(tmp_path / "object.html", objects[library](mesh), result=result))
+    assert meta == expected[0]
+    assert arrays.keys() == expected[1].keys()
+    for name, array in arrays.items():
+        np.testing.assert_array_equal(array, expected[1][name], err_msg=name)
+
+
+def test_a_topology_is_taken_as_its_faces_and_a_pyvista_cloud_as_points(tmp_path, torus):
+    result = exact_result(torus)
+    _, expected = read_page_data(write_html(tmp_path / "arrays.html", torus.vertices, torus.faces, result))
+    topology = meshcurv.MeshTopology.from_faces(torus.faces)
+    _, arrays = read_page_data(write_html(tmp_path / "topology.html", torus.vertices, topology, result))
+    np.testing.assert_array_equal(arrays["faces"], expected["faces"])
+    pyvista = pytest.importorskip("pyvista")
+    meta, arrays = read_page_data(write_html(tmp_path / "cloud.html", pyvista.PolyData(torus.vertices), result=result))
+    assert meta["kind"] == "points" and meta["n_vertices"] == len(torus.vertices)
+
+
+def test_the_result_of_a_mesh_object_is_principal_curvatures_of_it(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    sphere = meshcurv.shapes.icosphere(subdivisions=4, radius=2.0)
+    mesh = trimesh.Trimesh(sphere.vertices, sphere.faces, process=False)
+    _, arrays = read_page_data(write_html(tmp_path / "s.html", mesh))
+    np.testing.assert_array_equal(arrays["k_min"], meshcurv.principal_curvatures(mesh).k_min.astype(np.float32))
+    np.testing.assert_allclose(arrays["k_min"], 0.5, rtol=0.05)  # 1 / radius
+
+
+@pytest.mark.parametrize("vertices", [object(), "torus.obj"], ids=["object", "string"])
+def test_refuses_what_principal_curvatures_refuses(tmp_path, vertices):
+    with pytest.raises(InvalidMeshError) as call:
+        meshcurv.principal_curvatures(vertices)
+    with pytest.raises(InvalidMeshError) as page:
+        write_html(tmp_path / "t.html", vertices)
+    assert str(page.value) == str(call.value)
+    assert not (tmp_path / "t.html").exists()
+
+
 def test_result_computed_when_not_given(tmp_path):
     sphere = meshcurv.shapes.icosphere(subdivisions=4, radius=2.0)
     meta, arrays = read_page_data(write_html(tmp_path / "s.html", sphere.vertices, sphere.faces))

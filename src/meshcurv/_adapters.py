@@ -22,7 +22,8 @@ boundary the user may want open or closed), and the one call says which.
 
 :func:`point_array` takes the points of the same objects and of point
 clouds (PyVista ``PointSet``, trimesh ``PointCloud``, Open3D ``PointCloud``):
-anything with a ``.points`` or ``.vertices`` array.
+anything with a ``.points`` or ``.vertices`` array. :func:`drawn_arrays` takes
+either, checked as the computations check them, for the pictures and the viewer.
 
 Out: :func:`to_pyvista`, :func:`to_trimesh` and :func:`to_dataframe` put the
 per-vertex fields of a :class:`~meshcurv.CurvatureResult` onto a
@@ -35,11 +36,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._validation import as_mesh, as_vertices
 from .errors import InvalidMeshError, optional_module
 from .io.fields import curvature_fields
-from .topology import triangulate_faces
+from .topology import MeshTopology, triangulate_faces
 
-__all__ = ["mesh_arrays", "point_array", "to_pyvista", "to_trimesh", "to_dataframe"]
+__all__ = ["mesh_arrays", "point_array", "drawn_arrays", "to_pyvista", "to_trimesh", "to_dataframe"]
 
 
 def _vtk_cells(flat: np.ndarray):
@@ -226,6 +228,60 @@ def point_array(points, *, name: str = "points"):
         "or `.vertices` array (pyvista.PolyData, PointSet or UnstructuredGrid, trimesh.Trimesh or PointCloud, "
         "open3d.geometry.PointCloud, meshio.Mesh)"
     )
+
+
+def _no_faces(faces) -> bool:
+    """True for None and for an empty face array or list (the points are drawn alone)."""
+    return faces is None or (not isinstance(faces, MeshTopology) and hasattr(faces, "__len__") and len(faces) == 0)
+
+
+def _is_point_cloud(thing) -> bool:
+    """True for points alone: an array or list, or an object of points without faces (PyVista ``PointSet``, ...)."""
+    if isinstance(thing, (np.ndarray, list, tuple)) or hasattr(thing, "__array__"):
+        return True
+    if hasattr(thing, "points") and hasattr(thing, "faces"):  # PyVista PolyData: of points when it has no faces
+        return np.asarray(thing.faces).size == 0
+    has_points = hasattr(thing, "points") or hasattr(thing, "vertices")  # else neither: the error of a mesh
+    return has_points and not any(hasattr(thing, name) for name in ("faces", "triangles", "cells", "celltypes"))
+
+
+def drawn_arrays(vertices, faces=None, *, stacklevel: int = 3) -> tuple[np.ndarray, np.ndarray | None]:
+    """``(points, triangles)`` of a mesh or a point cloud to draw, checked once at the door of the computations.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (V, 3), or a mesh or point cloud object
+        What :func:`meshcurv.principal_curvatures` takes as ``vertices``
+        (with ``faces`` left out: a mesh object, :func:`mesh_arrays`), or
+        what :func:`meshcurv.point_cloud_curvatures` takes (an array, or an
+        object of points alone, :func:`point_array`).
+    faces : array_like of shape (F, 3) or (F, k), list of index lists, or MeshTopology, optional
+        As for :func:`meshcurv.principal_curvatures`; None or empty: the
+        points alone (or the mesh object's faces).
+    stacklevel : int, default: 3
+        The frame a :class:`~meshcurv.errors.TriangulationWarning` is attributed
+        to (1: this function).
+
+    Returns
+    -------
+    points : (V, 3) float64 array
+        New, finite (:func:`meshcurv._validation.as_mesh`).
+    triangles : (F, 3) int64 array or None
+        Fan-triangulated, indices checked; None for points alone.
+
+    Raises
+    ------
+    InvalidMeshError
+        As :func:`meshcurv.principal_curvatures` (or
+        :func:`meshcurv.point_cloud_curvatures` for points alone).
+    """
+    if _no_faces(faces):
+        if _is_point_cloud(vertices):
+            return as_vertices(point_array(vertices, name="vertices")), None
+        vertices, faces = mesh_arrays(vertices)
+    if isinstance(faces, MeshTopology):  # its faces, checked against these vertices
+        faces = faces.faces
+    return as_mesh(vertices, faces, stacklevel=stacklevel + 1)
 
 
 # ------------------------------------------------------------------------------------------- out

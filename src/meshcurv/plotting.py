@@ -16,7 +16,8 @@ import textwrap
 
 import numpy as np
 
-from ._validation import as_faces, as_vertices, check_int_option
+from ._adapters import drawn_arrays
+from ._validation import check_int_option
 from .errors import InvalidMeshError, InvalidOptionError, optional_module
 from .io._files import atomic_output, check_output
 
@@ -398,11 +399,16 @@ def plot_field(
 
     Parameters
     ----------
-    vertices : array_like of shape (V, 3)
-    faces : array_like of shape (F, 3) or (F, k), or None
+    vertices : array_like of shape (V, 3), or a mesh or point cloud object
+        Or, with ``faces`` None, what :func:`meshcurv.principal_curvatures`
+        takes alone (a trimesh ``Trimesh``, PyVista ``PolyData``, meshio
+        ``Mesh`` or Open3D ``TriangleMesh``: its faces are drawn) or
+        :func:`meshcurv.point_cloud_curvatures` (an object of points alone).
+    faces : array_like of shape (F, 3) or (F, k), list of index lists, MeshTopology, or None
         0-based; polygons are fan-triangulated (with a ``TriangulationWarning``).
-        None draws a point cloud: each point a disc of about its spacing (the
-        median distance to its nearest neighbour), the nearest point per pixel.
+        None (or empty) with an array of vertices draws a point cloud: each
+        point a disc of about its spacing (the median distance to its nearest
+        neighbour), the nearest point per pixel.
     values : array_like of shape (V,)
     ax : matplotlib Axes, optional
         A 2D axes to draw one view into; by default a new figure is made, with
@@ -482,13 +488,9 @@ def plot_field(
     from matplotlib.colors import Normalize
     from matplotlib.lines import Line2D
 
-    points = as_vertices(vertices)
-    cloud = faces is None
-    triangles = (
-        np.repeat(np.arange(points.shape[0])[:, None], 3, axis=1)
-        if cloud
-        else as_faces(faces, points.shape[0], stacklevel=3)
-    )
+    points, drawn = drawn_arrays(vertices, faces, stacklevel=3)
+    cloud = drawn is None
+    triangles = np.repeat(np.arange(points.shape[0])[:, None], 3, axis=1) if drawn is None else drawn
     for text, name in ((title, "title"), (label, "label")):
         if text is not None and not isinstance(text, str):
             raise InvalidOptionError(f"`{name}` must be a string; got {type(text).__name__}")

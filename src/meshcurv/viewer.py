@@ -42,7 +42,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ._validation import as_faces, check_choice, checked_points
+from ._adapters import drawn_arrays
+from ._validation import check_choice
 from .curvature import principal_curvatures
 from .errors import InvalidMeshError, InvalidOptionError, MeshFileError
 from .io._files import atomic_output, check_output
@@ -96,9 +97,13 @@ def write_html(
         The page to write, ``.html`` or ``.htm``. Written atomically (a
         temporary file renamed when complete); an existing file is kept
         unless ``overwrite=True``.
-    vertices : array_like of shape (V, 3)
-        Mesh vertices, or the points of a point cloud.
-    faces : array_like of shape (F, 3) or (F, k), optional
+    vertices : array_like of shape (V, 3), or a mesh or point cloud object
+        Mesh vertices, or the points of a point cloud. Or, with ``faces``
+        left out, what :func:`meshcurv.principal_curvatures` takes alone (a
+        trimesh ``Trimesh``, PyVista ``PolyData``, meshio ``Mesh`` or Open3D
+        ``TriangleMesh``) or :func:`meshcurv.point_cloud_curvatures` (an
+        object of points alone).
+    faces : array_like of shape (F, 3) or (F, k), list of index lists, or MeshTopology, optional
         0-based triangles (polygons are fan-triangulated, with a
         ``TriangulationWarning``). None (or an empty array) draws the
         vertices as points.
@@ -166,8 +171,9 @@ def write_html(
         raise MeshFileError(f"{path}: the page must be named .html or .htm; got {path.suffix or 'no extension'!r}")
     check_output(path, overwrite=overwrite, source=source)
     field = check_choice(field, "field", VIEWER_FIELDS)
+    points, triangles = drawn_arrays(vertices, faces)
     if up is None:
-        up, why = choose_up(checked_points(vertices))
+        up, why = choose_up(points)
         logger.info("viewer: up axis %s (%s)", up, why)
     up = check_choice(up, "up", _UPS)
     percentiles = check_percentiles(percentiles)
@@ -176,10 +182,6 @@ def write_html(
         if text is not None and not isinstance(text, str):
             raise InvalidOptionError(f"`{name}` must be a string or None; got {type(text).__name__}")
     angles = [_check_angle(value, name) for value, name in ((elevation, "elevation"), (azimuth, "azimuth"))]
-    points = checked_points(vertices)
-    triangles = None
-    if faces is not None and np.size(faces) > 0:
-        triangles = as_faces(faces, len(points))
     results = _checked_results(_compute(points, triangles) if result is None else result, len(points))
     options = {"field": field, "percentiles": percentiles, "max_directions": max_directions, "length_unit": length_unit}
     meta, arrays = _page_data(points, triangles, results, **options)
