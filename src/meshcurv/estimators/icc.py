@@ -349,8 +349,9 @@ def voxel_pilot(mesh: PreparedMesh):
         _, valid = mesh.start(boundary=True)
         valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
-        centres = _pilot_centres(vertices, topology, valid)
-        fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres)
+        edge = median_edge_length(vertices, topology.edges)
+        centres = _pilot_centres(vertices, topology, valid, edge=edge)
+        fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres, edge=edge)
         with np.errstate(invalid="ignore"):
             agree = np.isfinite(fitted).all(axis=1) & (np.einsum("ij,ij->i", fitted, start[centres]) > NORMAL_AGREEMENT)
         normals = _spread_normals(
@@ -375,12 +376,15 @@ def voxel_pilot(mesh: PreparedMesh):
     return run
 
 
-def _pilot_normals(mesh: PreparedMesh, start: np.ndarray, radius: float, centres: np.ndarray) -> np.ndarray:
+def _pilot_normals(
+    mesh: PreparedMesh, start: np.ndarray, radius: float, centres: np.ndarray, *, edge: float | None = None
+) -> np.ndarray:
     """(M, 3) the jet normals of :func:`voxel_pilot` at ``centres`` over balls of ``radius`` (``start``: the
     first frames): fitted on a coarse level of the surface (:func:`_coarse_level`, cubes of ``radius /``
     :data:`PILOT_COARSE_CELLS`) where ``radius`` exceeds :data:`PILOT_COARSE_EDGES` median edge lengths, there
     at one centre per cube of :data:`PILOT_SAMPLE_EDGES` median edges and interpolated at the others
-    (:func:`meshcurv.jets.sampled_jet_normals`); else over the vertices at every centre."""
+    (:func:`meshcurv.jets.sampled_jet_normals`); else over the vertices at every centre. ``edge``: the median
+    edge length, when known."""
     vertices, topology = mesh.vertices, mesh.topology
     adjacency = _adjacency(topology)
     areas = _vertex_areas(mesh)
@@ -400,34 +404,38 @@ def _pilot_normals(mesh: PreparedMesh, start: np.ndarray, radius: float, centres
         if positive.size
         else None
     )
+    points, normals, allowed, weights = vertices, start, topology.referenced_vertices, None
     if coarse is not None:
         points, normals, allowed, adjacency, weights = coarse
-        return _sampled_jet_normals(
-            points,
-            normals,
-            radius,
-            centres=centres,
-            spacing=PILOT_SAMPLE_EDGES * median_edge_length(vertices, topology.edges),
-            degree=NORMAL_DEGREE,
-            iterations=NORMAL_ITERATIONS,
-            neighbours=allowed,
-            adjacency=adjacency,
-            settled=NORMAL_SETTLED,
-            min_spread=NORMAL_MIN_SPREAD,
-            areas=weights,
-        )
+        spacing = PILOT_SAMPLE_EDGES * (median_edge_length(vertices, topology.edges) if edge is None else edge)
+        if spacing > 0:  # (else edges of length zero: every centre fitted)
+            return _sampled_jet_normals(
+                points,
+                normals,
+                radius,
+                centres=centres,
+                spacing=spacing,
+                degree=NORMAL_DEGREE,
+                iterations=NORMAL_ITERATIONS,
+                neighbours=allowed,
+                adjacency=adjacency,
+                settled=NORMAL_SETTLED,
+                min_spread=NORMAL_MIN_SPREAD,
+                areas=weights,
+            )
     coefficients, frame, _ = _fit_jets(
-        vertices,
-        start,
+        points,
+        normals,
         radius,
         degree=NORMAL_DEGREE,
         iterations=NORMAL_ITERATIONS,
         centres=centres,
-        neighbours=topology.referenced_vertices,
+        neighbours=allowed,
         adjacency=adjacency,
         settled=NORMAL_SETTLED,
         compact=True,
         min_spread=NORMAL_MIN_SPREAD,
+        areas=weights,
     )
     return jet_normals(coefficients, frame)
 
@@ -460,15 +468,18 @@ PILOT_CELL_EDGES = 1.25
 PILOT_RINGS = 2
 
 
-def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray) -> np.ndarray:
+def _pilot_centres(
+    vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray, *, edge: float | None = None
+) -> np.ndarray:
     """The vertices of :func:`voxel_pilot`'s fits and sums: in each cube of side :data:`PILOT_CELL_EDGES` median
     edge lengths, the valid referenced vertex nearest the cube's middle, ties taken by the coordinates (never by
     the index: re-indexed vertices give the same centres; the cubes of the coordinate axes: a rotated mesh gets
-    other centres)."""
+    other centres). ``edge``: the median edge length, when known."""
     members = np.flatnonzero(valid & topology.referenced_vertices)
     if members.size == 0:
         return members
-    edge = median_edge_length(vertices, topology.edges)
+    if edge is None:
+        edge = median_edge_length(vertices, topology.edges)
     if not edge > 0:
         return members
     points = vertices[members]
