@@ -152,6 +152,7 @@ def one_sided_fits(
     degree: int = JET_DEGREE,
     iterations: int = JET_ITERATIONS,
     first: tuple | None = None,
+    facing: np.ndarray | None = None,
 ):
     """Jets over the largest ball, from ``radius`` down to ``smallest``, that holds one side of the surface.
 
@@ -165,6 +166,8 @@ def one_sided_fits(
     Where the surface is thicker than ``radius`` every fit is the one over
     ``radius``. ``smallest=None``: one fit over ``radius``, not checked. ``first``: the fits over ``radius`` at
     ``centres`` (at least) already made, the ``(coefficients, frame, counts)`` of :func:`~meshcurv.jets.fit_jets`.
+    ``facing`` (N, 3): the normals of the check (default: ``normals``; a zero row faces away from every centre: a
+    point whose side is undecided).
 
     Returns
     -------
@@ -194,7 +197,7 @@ def one_sided_fits(
             iterations=iterations,
             centres=todo,
             neighbours=usable,
-            facing=normals,
+            facing=normals if facing is None else facing,
         )
         first = None
         done = todo[np.isfinite(found[todo]).all(axis=1)]
@@ -209,7 +212,17 @@ def one_sided_fits(
     return coefficients, frame, radii
 
 
-def jets(points, normals, radius, centres, usable, *, smallest: float | None = None, details: dict | None = None):
+def jets(
+    points,
+    normals,
+    radius,
+    centres,
+    usable,
+    *,
+    smallest: float | None = None,
+    details: dict | None = None,
+    facing: np.ndarray | None = None,
+):
     """Principal curvatures of jets fitted over balls of ``radius`` around ``centres``.
 
     Where a ball holds the other side of the surface its fit is redone over a
@@ -218,9 +231,11 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
     Returns ``(k_min, k_max, dir_min, dir_max, normals)`` at every point, NaN
     where the fit failed and at points not in ``centres``; ``normals`` are those
     of the fitted jets (the given ones where the fit failed). ``details``
-    receives ``"radii"``: (N,) the radius of each point's fit.
+    receives ``"radii"``: (N,) the radius of each point's fit. ``facing``: the normals of the check of
+    :func:`one_sided_fits` (default: ``normals``).
     """
     logger.debug("point cloud: jet fits")
+    facing = normals if facing is None else facing
     first = larger = None
     if details is not None:  # the fits over the check's balls LARGER times larger too, in the same walk
         both: dict = {}
@@ -232,13 +247,13 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
             iterations=JET_ITERATIONS,
             centres=centres,
             neighbours=usable,
-            facing=None if smallest is None else normals,
+            facing=None if smallest is None else facing,
             details=both,
             larger=radius * LARGER,
         )
         larger = both["larger"]
     coefficients, frame, radii = one_sided_fits(
-        points, normals, radius, centres, usable, smallest=smallest, first=first
+        points, normals, radius, centres, usable, smallest=smallest, first=first, facing=facing
     )
     logger.debug("point cloud: curvatures of the jets")
     if details is not None:
@@ -256,6 +271,7 @@ def jets(points, normals, radius, centres, usable, *, smallest: float | None = N
             usable,
             smallest=None if smallest is None else smallest * LARGER,
             first=larger,
+            facing=facing,
         )
         wide_found = _jet_curvatures(wide_coefficients, wide_frame, wide_radii, normals)
         details["unsteady"] = unsteady(found, wide_found, done, radius)

@@ -171,6 +171,16 @@ UNEVEN_DENSITY = 2.0
 #: clean 3 x 3 x 0.15 ellipsoid at 8,000 points, inward by its rim: 18%).
 ALIKE_PART_SHARE = 0.5
 
+#: A part at least :data:`THIN_PART_SHARE` of whose points are undecided (two sheets, alike, amid undecided ones)
+#: and whose oriented normals sum to at least this share of its area (``|sum a n| / sum a``, ``a`` the squared local
+#: spacing; 0 on a closed part, whichever way it is oriented, 1 on a flat open sheet) is a closed part thinner than
+#: the spacing whose two faces were oriented as one sheet: every point's side is undecided. Seed 162 case 305 of
+#: ``benchmarks/fuzz_api.py`` (a 1 x 1 x 0.02 disc of 400 points under noise of 0.05 spacings: 33% undecided, 121
+#: of its 240 checked valid points inward) and four discs under noise of 0.1 spacings sum to 0.998-1.0 with 33-47%
+#: undecided; a clean 3 x 3 x 0.15 ellipsoid of 8,000 points (44% undecided, its rim) to 0.13, a 1 x 1 x 0.2 one
+#: to 0.04.
+ONE_SHEET_FLUX = 0.5
+
 #: Points whose local spacing is at most this are left out (NaN): the estimators form products of up to four
 #: lengths of the order of the spacing (squared areas of triangles; the cubed distances of the winding number,
 #: which read 0 below about 1e-103 and gave 0 / 0), which underflow float64's smallest normal number (2.2e-308)
@@ -884,6 +894,10 @@ def _compute(points, given, radius, method, search=None):
         start = given * signs[:, None]
         how = "given, reoriented" if reoriented else "given"
 
+    # the normals of the checks that refuse balls holding the other side: a point whose side the orientation left
+    # undecided faces away from every centre (its sign is a coin's toss: turned the same way as a neighbouring
+    # part's, it would let that part into the part's balls)
+    facing = np.where(doubtful[:, None], 0.0, start)
     logger.info("point cloud: noise level")
     noise = cloud_noise_level(points, start, median, centres, usable)
     groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems, least_radius)
@@ -937,7 +951,7 @@ def _compute(points, given, radius, method, search=None):
         # points within reach of it only: the same balls, without a search structure over the whole cloud
         near = _within_reach(points, members, reach)
         if near is None:
-            local = (points, start, usable, members, sheets, one_sided, mixed)
+            local = (points, start, usable, members, sheets, one_sided, mixed, facing)
         else:
             local = (
                 points[near],
@@ -947,14 +961,22 @@ def _compute(points, given, radius, method, search=None):
                 None if sheets is None else sheets[near],
                 one_sided[near],
                 None if mixed is None else mixed[near],
+                facing[near],
             )
-        part_points, part_start, part_usable, part_members, part_sheets, part_one_sided, part_mixed = local
+        part_points, part_start, part_usable, part_members, part_sheets, part_one_sided, part_mixed, part_facing = local
         if method == "jets":
             # a ball that holds the other side of a thin or small part shrinks, down to the clean-sample radius
             # (a given radius too: a jet through both sides is not the surface, H doubled on a small sphere)
             smallest = min(group_radius, max(CLOUD_RADIUS_RULES[method][0] * group_spacing, floor))
             found = _estimators.jets(
-                part_points, part_start, group_radius, part_members, part_usable, smallest=smallest, details=details
+                part_points,
+                part_start,
+                group_radius,
+                part_members,
+                part_usable,
+                smallest=smallest,
+                details=details,
+                facing=part_facing,
             )
             asked = group_radius
             noisy += _noise_dominated(details["radii"], part_members, asked, noise, part_one_sided)
@@ -1057,7 +1079,12 @@ def _compute(points, given, radius, method, search=None):
         amid = _amid_undecided(points, doubtful, usable, indices, tree)
         # ... and so on a part whose points' sides are mostly undecided
         undecided_share = np.bincount(labels, weights=doubtful | amid, minlength=count.size) / count
-        amid |= usable & ~doubtful & (undecided_share[labels] >= ALIKE_PART_SHARE)
+        whole = undecided_share >= ALIKE_PART_SHARE
+        # ... or a good share undecided on a part whose faces were oriented as one sheet (it looks open)
+        thin = np.flatnonzero(~whole & (undecided_share >= THIN_PART_SHARE))
+        if thin.size:
+            whole[thin] = _one_sheet(out_normals, spacing, usable, labels, thin)
+        amid |= usable & ~doubtful & whole[labels]
         doubtful |= amid
     reason = np.zeros(n, dtype=np.int8)
     reason[~one_sided | (two_sided_mask & usable)] = _TWO_SIDED
@@ -1111,7 +1138,9 @@ def _compute(points, given, radius, method, search=None):
             found.append(
                 f"{int(amid.sum())} points have at least {AMID_UNDECIDED:g} of their {AMID_NEIGHBOURS} nearest "
                 f"neighbours undecided, or are on a part at least {ALIKE_PART_SHARE:g} of whose points are (a part "
-                "thinner than its noise: its faces mix)"
+                f"thinner than its noise: its faces mix), or {THIN_PART_SHARE:g} on a part whose normals sum to "
+                f"{ONE_SHEET_FLUX:g} of its area or more (a closed part thinner than the spacing, its two faces "
+                "oriented as one sheet)"
             )
         problems.append(" and ".join(found) + ": their normals' side is undecided, NaN")
         valid &= ~doubtful
@@ -1149,6 +1178,17 @@ def _amid_undecided(points, doubtful, usable, indices, tree) -> np.ndarray:
     share = (doubtful[crowd] & counted).sum(axis=1) / np.maximum(counted.sum(axis=1), 1)
     out[near] = share >= AMID_UNDECIDED
     return out
+
+
+def _one_sheet(normals, spacing, usable, labels, parts) -> np.ndarray:
+    """(P,) bool: which of the ``parts`` (P,) (values of ``labels`` (N,)) have usable oriented ``normals`` (N, 3)
+    summing to at least :data:`ONE_SHEET_FLUX` of their area (each point's the square of its local ``spacing``)."""
+    areas = np.where(usable, spacing * spacing, 0.0)
+    weighted = np.where(usable[:, None] & np.isfinite(normals), normals, 0.0) * areas[:, None]
+    size = int(labels.max()) + 1
+    total = np.bincount(labels, weights=areas, minlength=size)[parts]
+    flux = np.stack([np.bincount(labels, weights=weighted[:, j], minlength=size)[parts] for j in range(3)])
+    return np.linalg.norm(flux, axis=0) >= ONE_SHEET_FLUX * np.maximum(total, np.finfo(float).tiny)
 
 
 def _within_reach(points: np.ndarray, members: np.ndarray, reach: float) -> np.ndarray | None:
