@@ -9,7 +9,7 @@ import math
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor, wait
-from typing import Literal, TypedDict
+from typing import Literal, NotRequired, TypedDict
 
 import numba as nb
 import numpy as np
@@ -22,10 +22,21 @@ class _JitOptions(TypedDict):
     nogil: bool
     fastmath: bool | set[str]
     error_model: Literal["python", "numpy"]
+    no_cfunc_wrapper: bool
+    no_cpython_wrapper: NotRequired[bool]
 
 
-#: The options of every kernel: cached on disk, no GIL, IEEE arithmetic (NaN and inf keep their meaning).
-_JIT: _JitOptions = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
+#: The options of every kernel: cached on disk, no GIL, IEEE arithmetic (NaN and inf keep their meaning), no C
+#: function wrapper (what lets a compiled function be passed to another as a first-class function, which no
+#: kernel does: numba builds one for every function it compiles otherwise, 10-20% of a small kernel's compile
+#: time on a cold cache, issue 31).
+_JIT: _JitOptions = {
+    "cache": True,
+    "nogil": True,
+    "fastmath": False,
+    "error_model": "numpy",
+    "no_cfunc_wrapper": True,
+}
 
 
 _TINY = np.finfo(np.float64).tiny
@@ -40,6 +51,11 @@ _ONE = np.uint64(1)
 
 #: Sums that may be reassociated (vectorized); no other fast-math assumption (NaN and inf stay meaningful).
 _JIT_REASSOC: _JitOptions = {**_JIT, "fastmath": {"reassoc", "contract"}}
+
+#: The options of a function called only from compiled kernels, never from Python: no Python wrapper either (the
+#: code that unboxes each argument and boxes the result, compiled for every function otherwise; issue 31).
+_JIT_INNER: _JitOptions = {**_JIT, "no_cpython_wrapper": True}
+_JIT_INNER_REASSOC: _JitOptions = {**_JIT_REASSOC, "no_cpython_wrapper": True}
 
 
 @nb.njit(inline="always", **_JIT)
@@ -82,7 +98,7 @@ def _unit(x, y, z):
     return np.nan, np.nan, np.nan, False
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _tangent_frame(nx, ny, nz):
     """Unit tangents ``t1, t2`` with ``(t1, t2, n)`` right-handed, ``t1 = cross(n, e)`` for the axis ``e``
     least aligned with ``n`` (the frame of ``_tensors.tangent_basis``)."""

@@ -12,7 +12,7 @@ from llvmlite import ir  # type: ignore[import-untyped]
 from numba.core import types
 from numba.extending import intrinsic, overload
 
-from ._common import _JIT, _JIT_REASSOC, _TINY, _UNSIGNED, _tangent_frame, run_chunks, threaded
+from ._common import _JIT, _JIT_INNER, _JIT_INNER_REASSOC, _TINY, _UNSIGNED, _tangent_frame, run_chunks, threaded
 from .neighborhoods import _ball_members, _connected_members, pool_grid
 from .tensors import _tangent_eigen
 
@@ -76,20 +76,20 @@ def _cholesky_inline(a, b, low, m, min_spread, scale, total):
     return True
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _cholesky_solve(a, b, low, m, min_spread, scale, total):
     """:func:`_cholesky_inline` of any size ``m``."""
     return _cholesky_inline(a, b, low, m, min_spread, scale, total)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _cholesky_solve_10(a, b, low, min_spread, scale, total):
     """:func:`_cholesky_inline` of size 10 (the cubic jets of the normal fits): the loops' bounds are constants,
     which the compiler unrolls (the same operations in the same order: the same numbers)."""
     return _cholesky_inline(a, b, low, 10, min_spread, scale, total)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _cholesky_solve_6(a, b, low, min_spread, scale, total):
     """:func:`_cholesky_inline` of size 6 (the quadratic jets a cubic fit falls back to), unrolled as
     :func:`_cholesky_solve_10`: half the compile time of :func:`_cholesky_solve` (0.7 against 1.2 CPU s), which
@@ -321,7 +321,7 @@ def _grid_chunk(
         )
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _nested_members(points, centre, radius, outer, outer_size, members):
     """The members of ``outer[:outer_size]`` within ``radius`` of ``centre``, in their order, written to
     ``members`` (at least ``outer_size`` long); their count. Squared distances as
@@ -360,7 +360,7 @@ def _jet_outputs(rows):
     )
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _jet_scratch(degree, n_terms):
     """The buffers of :func:`_fit_one` (once per chunk of vertices, not per vertex):
     ``work, moments, right, matrix, low, scale, solution``. The moments and the
@@ -390,7 +390,7 @@ def _jet_scratch(degree, n_terms):
     )
 
 
-@nb.njit(**_JIT_REASSOC)
+@nb.njit(**_JIT_INNER_REASSOC)
 def _dot(a, b, size):
     """``sum_i a[i] b[i]`` over the first ``size`` entries, reassociated (vectorized)."""
     total = 0.0
@@ -399,7 +399,7 @@ def _dot(a, b, size):
     return total
 
 
-@nb.njit(**_JIT_REASSOC)
+@nb.njit(**_JIT_INNER_REASSOC)
 def _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
     """:func:`_fit_one`'s moments of a degree-3 fit, summed member by member in scalars.
 
@@ -483,7 +483,7 @@ def _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny,
     right[5], right[6], right[7], right[8], right[9] = r02, r30, r21, r12, r03
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _general_jet_moments(work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
     """:func:`_fit_one`'s moments of a fit of degree 4 or more, from the rows of ``work`` (:func:`_jet_scratch`).
 

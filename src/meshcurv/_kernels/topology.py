@@ -8,7 +8,7 @@ import numba as nb
 import numpy as np
 from numba.extending import overload
 
-from ._common import _JIT, _ONE, _UNSIGNED, run_chunks, threaded
+from ._common import _JIT, _JIT_INNER, _ONE, _UNSIGNED, run_chunks, threaded
 
 
 #: :func:`meshcurv._kernels.neighborhoods.vertex_face_lists` counts the faces of at most this many ranges of
@@ -84,6 +84,7 @@ def _bucket_cursors(lo, hi, cursor, starts):
             at += count
 
 
+@nb.njit(**_JIT)
 def build_edges(faces, n_vertices, template):
     """Edges of the triangles, their faces and counts (see MeshTopology._build): :func:`build_topology`
     without the twins of the sides, ``(edges, face_edges, edge_faces, counts, forward)``."""
@@ -91,16 +92,11 @@ def build_edges(faces, n_vertices, template):
     return edges, face_edges, edge_faces, counts, forward
 
 
+@nb.njit(**_JIT)
 def build_topology(faces, n_vertices, template, with_twins):
     """:func:`build_edges_into` on arrays allocated here: ``(edges, face_edges, edge_faces, counts, forward,
     twins, corners, first)``, all in the integer type of ``template``; the last three only when ``with_twins``
-    (else empty arrays).
-
-    The arrays are NumPy's (uninitialised where :func:`build_edges_into` writes every element it keeps; the rows
-    past the last edge are never touched, so never paged in), allocated here rather than in a compiled function:
-    numba's array constructors for the integer type of ``template`` cost a second of CPU to compile on a cold
-    cache (issue 31).
-    """
+    (else empty arrays)."""
     n_faces = faces.shape[0]
     index = template.dtype
     face_edges = np.empty(3 * n_faces, index)
@@ -425,7 +421,7 @@ def _bowtie_chunk(lo, hi, twins, first, corners, several):
         several[v] = _several_fans(twins, first[v], corners[v])
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _several_fans(twins, side, n_corners):
     """Whether the fan of ``side`` (leaving its vertex; -1: none) reaches fewer than the vertex's ``n_corners``
     corners."""
@@ -440,7 +436,7 @@ def _several_fans(twins, side, n_corners):
     return reached < n_corners
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_INNER)
 def _union_edges(edges, n_vertices):
     """Union-find over the edges: (V,) parents whose roots are each component's smallest vertex (unsigned
     indices: see :func:`_twin_walk`)."""
