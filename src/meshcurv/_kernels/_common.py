@@ -9,7 +9,7 @@ import math
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor, wait
-from typing import Literal, NotRequired, TypedDict
+from typing import Literal, TypedDict, cast
 
 import numba as nb
 import numpy as np
@@ -22,21 +22,16 @@ class _JitOptions(TypedDict):
     nogil: bool
     fastmath: bool | set[str]
     error_model: Literal["python", "numpy"]
-    no_cfunc_wrapper: bool
-    no_cpython_wrapper: NotRequired[bool]
 
 
 #: The options of every kernel: cached on disk, no GIL, IEEE arithmetic (NaN and inf keep their meaning), no C
 #: function wrapper (what lets a compiled function be passed to another as a first-class function, which no
 #: kernel does: numba builds one for every function it compiles otherwise, 10-20% of a small kernel's compile
 #: time on a cold cache, issue 31).
-_JIT: _JitOptions = {
-    "cache": True,
-    "nogil": True,
-    "fastmath": False,
-    "error_model": "numpy",
-    "no_cfunc_wrapper": True,
-}
+_JIT: _JitOptions = cast(  # numba's stub of njit does not name no_cfunc_wrapper (numba.core.options has it)
+    _JitOptions,
+    {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy", "no_cfunc_wrapper": True},
+)
 
 
 _TINY = np.finfo(np.float64).tiny
@@ -54,8 +49,8 @@ _JIT_REASSOC: _JitOptions = {**_JIT, "fastmath": {"reassoc", "contract"}}
 
 #: The options of a function called only from compiled kernels, never from Python: no Python wrapper either (the
 #: code that unboxes each argument and boxes the result, compiled for every function otherwise; issue 31).
-_JIT_INNER: _JitOptions = {**_JIT, "no_cpython_wrapper": True}
-_JIT_INNER_REASSOC: _JitOptions = {**_JIT_REASSOC, "no_cpython_wrapper": True}
+_JIT_INNER: _JitOptions = cast(_JitOptions, {**_JIT, "no_cpython_wrapper": True})
+_JIT_INNER_REASSOC: _JitOptions = cast(_JitOptions, {**_JIT_REASSOC, "no_cpython_wrapper": True})
 
 
 @nb.njit(inline="always", **_JIT)
