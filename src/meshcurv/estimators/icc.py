@@ -96,7 +96,14 @@ from ..jets import (
     nested_jet_normals,
 )
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
-from ..neighborhoods import _ball_face_sums, _ball_face_sums_nested, _coarse_face_sums, _squared
+from ..neighborhoods import (
+    _ball_face_sums,
+    _ball_face_sums_nested,
+    _coarse_face_sums,
+    _squared,
+    _unique_inverse,
+    _unique_sorted,
+)
 from ..radius import (
     VOXEL_SCALE_RULE,
     _check_radius,
@@ -304,14 +311,14 @@ def _row_groups(rows: np.ndarray, bits: tuple) -> np.ndarray:
     key = np.zeros(rows.shape[0], dtype=np.int64)
     for j, width in enumerate(bits):
         key = key << width | rows[:, j]
-    return np.unique(key, return_inverse=True)[1].ravel()
+    return _unique_inverse(key)[1]
 
 
 def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
     """(P, 2) the distinct pairs ``(a, b)`` of int in [0, n), sorted (``np.unique`` of the rows), on one int64 key."""
     if n >= 2**31:
         return np.unique(np.column_stack([a, b]), axis=0)
-    key = np.unique(a * np.int64(n) + b)
+    key = _unique_sorted(a * np.int64(n) + b)
     return np.column_stack([key // n, key % n])
 
 
