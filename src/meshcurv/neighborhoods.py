@@ -991,8 +991,12 @@ def _face_clusters(
     order = np.argsort(of, kind="stable")
     firsts = np.concatenate([[0], np.cumsum(np.bincount(of, minlength=n_clusters))[:-1]])
     corners = vertices[faces[order]]
-    middle = 0.5 * (np.minimum.reduceat(corners.min(axis=1), firsts) + np.maximum.reduceat(corners.max(axis=1), firsts))
-    far = np.linalg.norm(corners - middle[of[order], None], axis=2).max(axis=1)
+    # (the three corners compared pairwise: a reduction over the middle axis of (F, 3, 3) is five times slower)
+    lowest = np.minimum(np.minimum(corners[:, 0], corners[:, 1]), corners[:, 2])
+    highest = np.maximum(np.maximum(corners[:, 0], corners[:, 1]), corners[:, 2])
+    middle = 0.5 * (np.minimum.reduceat(lowest, firsts) + np.maximum.reduceat(highest, firsts))
+    distance = np.linalg.norm(corners - middle[of[order], None], axis=2)
+    far = np.maximum(np.maximum(distance[:, 0], distance[:, 1]), distance[:, 2])
     spans = np.maximum.reduceat(far, firsts)
     kept = np.ones(n_faces, dtype=bool) if usable is None else usable
     sums = np.stack(
