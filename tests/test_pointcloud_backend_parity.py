@@ -128,19 +128,13 @@ def test_backends_compute_one_point_cloud_estimator(name, method):
             assert np.abs(compiled.mean[checked]).max() < 0.05, label
 
 
-#: R9's finding (fuzz_api.py seed 991 case 86): the NumPy twin of the ball search orders the points at equal
-#: distances as the k-d tree returns them, the compiled one by index; the corrected measures draw their triangles by
-#: rank in that order (the fix: ``_pointcloud_estimators._ball_indices`` sorted by (squared distance, index)).
-TIES = pytest.mark.xfail(strict=True, reason="ball_indices' NumPy twin orders tied distances as the k-d tree does")
-
-
-@pytest.mark.parametrize(
-    "method",
-    [pytest.param(m, marks=[TIES] if m == "corrected_measures" else []) for m in POINT_CLOUD_METHODS],
-)
+@pytest.mark.parametrize("method", POINT_CLOUD_METHODS)
 def test_backends_agree_on_a_lattice_cloud_whose_distances_tie(method):
     # the vertices of a regular cylinder mesh (48 around, 40 along: a gridded scan's lattice): every point has
-    # neighbours at equal distances; measured at 6b59a8f: H differs by 1.5e-4 (84 points of a 12 x 7 lattice: 4%)
+    # neighbours at equal distances; measured at 6b59a8f: H differs by 1.5e-4 (84 points of a 12 x 7 lattice: 4%):
+    # R9's finding (fuzz_api.py seed 991 case 86), the NumPy twin of the ball search ordered points at equal
+    # distances as the k-d tree returns them, the compiled one by index, and the corrected measures draw their
+    # triangles by rank in that order; fixed: _pointcloud_estimators._ball_indices sorts by (squared distance, index)
     from meshcurv import shapes
 
     cylinder = shapes.cylinder(n_around=48, n_along=40)

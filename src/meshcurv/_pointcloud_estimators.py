@@ -15,7 +15,7 @@ from ._backend import kernel_threads, numba_kernels
 from ._pointcloud_normals import NEIGHBOURS
 from .errors import InvalidOptionError
 from .measures import curvatures_from_measures, face_measures
-from .jets import fit_jets, jet_curvatures, jet_normals
+from .jets import _fit_jets, jet_curvatures, jet_normals
 
 logger = logging.getLogger(__name__)
 
@@ -179,7 +179,7 @@ def one_sided_fits(
     """
     n = points.shape[0]
     if smallest is None:
-        coefficients, frame, _ = first or fit_jets(
+        coefficients, frame, _ = first or _fit_jets(
             points, normals, radius, degree=degree, iterations=iterations, centres=centres, neighbours=usable
         )
         return coefficients, frame, np.full(n, float(radius))
@@ -189,7 +189,7 @@ def one_sided_fits(
     todo = np.asarray(centres, dtype=np.int64)
     current = float(radius)
     while todo.size:
-        found, local, _ = first or fit_jets(
+        found, local, _ = first or _fit_jets(
             points,
             normals,
             current,
@@ -239,7 +239,7 @@ def jets(
     first = larger = None
     if details is not None:  # the fits over the check's balls LARGER times larger too, in the same walk
         both: dict = {}
-        first = fit_jets(
+        first = _fit_jets(
             points,
             normals,
             radius,
@@ -679,14 +679,32 @@ def _ball_indices(search, points, chunk, radius, k):
 
     The NumPy path of :func:`meshcurv._kernels.pointcloud.ball_indices`: a
     query of the k-d tree of :func:`_usable_tree` (``search``); rows in
-    distance order, padded with ``N``.
+    the order of ``(squared distance, index)`` as the kernel's (the tree's own
+    order of equal distances is not the index's: a lattice's ties), padded
+    with ``N``.
     """
     tree, pool = search
-    _, index = tree.query(points[chunk], k=k, distance_upper_bound=radius, workers=-1)
-    index = index.reshape(chunk.size, -1)
-    if pool is not None:
-        index = pool[index]
-    return np.ascontiguousarray(index), (index < points.shape[0]).sum(axis=1)
+    n = points.shape[0]
+    asked = k
+    while True:  # the tree orders equal distances as it meets them: ask past the k-th, then sort as the kernel
+        wanted = max(k, min(asked + max(8, asked // 2), tree.n))  # (beyond tree.n: padded with tree.n)
+        _, index = tree.query(points[chunk], k=wanted, distance_upper_bound=radius, workers=-1)
+        index = index.reshape(chunk.size, -1)
+        if pool is not None:
+            index = pool[index]
+        inside = index < n
+        step = points[np.where(inside, index, 0)] - points[chunk][:, None, :]
+        squared = step[..., 0] * step[..., 0] + step[..., 1] * step[..., 1] + step[..., 2] * step[..., 2]
+        squared = np.where(inside & (squared < radius * radius), squared, np.inf)
+        order = np.lexsort((np.where(np.isfinite(squared), index, n), squared), axis=-1)
+        index = np.take_along_axis(np.where(np.isfinite(squared), index, n), order, axis=1)
+        squared = np.take_along_axis(squared, order, axis=1)
+        tied = np.isfinite(squared[:, -1]) & (squared[:, -1] == squared[:, min(k, wanted) - 1])
+        if wanted >= tree.n or not tied.any():  # (a tie across the last asked: more may follow)
+            break
+        asked = 2 * wanted
+    index = np.ascontiguousarray(index[:, :k])
+    return index, (index < n).sum(axis=1)
 
 
 def _own_side(normals, centres, index, counts, sheets=None):

@@ -142,7 +142,7 @@ from .radius import (
     CLOUD_RADIUS_RULES,
     _checked_radii,
     _notes_by_radius,
-    cloud_noise_level,
+    _cloud_noise_level,
     cloud_radius,
     noise_rule,
 )
@@ -901,7 +901,7 @@ def _compute(points, given, radius, method, search=None):
     # of cover.)
     facing = np.where(doubtful[:, None], 0.0, start) if how == "given, reoriented" else start
     logger.info("point cloud: noise level")
-    noise = cloud_noise_level(points, start, median, centres, usable)
+    noise = _cloud_noise_level(points, start, median, centres, usable)
     groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems, least_radius)
     if radius is None:
         extent = points[usable]
@@ -1220,11 +1220,11 @@ def _within_budget(points, radius, members, what, problems) -> float:
     """``radius``, or less: balls around ``members`` that hold :data:`BALL_PAIRS_SHARE` of
     :data:`meshcurv.neighborhoods.MAX_BALL_PAIRS` (centre, point) pairs at most (the count grows as the square
     of the radius on a surface). A cut is added to ``problems``."""
-    from .neighborhoods import MAX_BALL_PAIRS, estimate_ball_pairs
+    from .neighborhoods import MAX_BALL_PAIRS, _estimate_ball_pairs
 
     if members.size == 0:
         return radius
-    mean, _ = estimate_ball_pairs(points, radius, points[members])
+    mean, _ = _estimate_ball_pairs(points, radius, points[members])
     budget = BALL_PAIRS_SHARE * MAX_BALL_PAIRS
     if mean * members.size <= budget:
         return radius
