@@ -644,9 +644,19 @@ def _triangle_sums(points, normals, index, counts, pattern):
     m, n_triangles = index.shape[0], pattern.shape[0]
     ranks = _distinct_ranks(pattern, counts)
     triangles = np.take_along_axis(index[:, None, :], ranks.reshape(m, 1, -1), axis=2).reshape(m, n_triangles, 3)
-    # turn each triangle so that its normal agrees with the mean of its corners' normals
+    # turn each triangle so that its normal agrees with the mean of its corners' normals, the sign computed in the
+    # kernel's order of operations (_kernels.icc._triangle_measures): on a lattice many triangles are degenerate,
+    # the sign is that of round-off, and another order turned others (R9: one ball's sums 0.25 apart)
     x0, x1, x2 = (points[triangles[..., j]] for j in range(3))
-    facing = np.einsum("mtj,mtj->mt", np.cross(x1 - x0, x2 - x0), normals[triangles].sum(axis=2))
+    a, b = x1 - x0, x2 - x0
+    u = normals[triangles]
+    mean = (u[..., 0, :] + u[..., 1, :] + u[..., 2, :]) / 3
+    cross = (
+        a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+        a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+        a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
+    )
+    facing = mean[..., 0] * cross[0] + mean[..., 1] * cross[1] + mean[..., 2] * cross[2]
     flip = facing < 0
     triangles[flip, 1], triangles[flip, 2] = triangles[flip, 2], triangles[flip, 1]
     measures = face_measures(points, triangles.reshape(-1, 3), normals)
