@@ -1888,7 +1888,7 @@ def check_flat_balls(name):
 def check_own_side(name):
     from scipy.spatial import cKDTree
 
-    from meshcurv._pointcloud_estimators import _ball_indices, _own_side, _usable_tree
+    from meshcurv._pointcloud_estimators import FACING_MARGIN, _ball_indices, _own_side, _usable_tree
 
     points, normals = cloud(name)
     n = points.shape[0]
@@ -1908,6 +1908,7 @@ def check_own_side(name):
             index.copy(),
             counts.copy(),
             np.zeros(0, dtype=np.int64) if given is None else np.ascontiguousarray(given, dtype=np.int64),
+            FACING_MARGIN,
         )
         label = "sheets" if given is not None else "no sheets"
         np.testing.assert_array_equal(got_counts, expected_counts, err_msg=label)

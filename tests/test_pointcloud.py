@@ -490,7 +490,12 @@ def test_compiled_own_side_keeps_what_the_numpy_path_keeps():
     for given in (None, sheets):
         expected = estimators._own_side(normals, centres, index.copy(), counts, given)
         found = numba_kernels("pointcloud").own_side(
-            normals, centres, index.copy(), counts, np.zeros(0, dtype=np.int64) if given is None else given
+            normals,
+            centres,
+            index.copy(),
+            counts,
+            np.zeros(0, dtype=np.int64) if given is None else given,
+            estimators.FACING_MARGIN,
         )
         np.testing.assert_array_equal(found[0], expected[0])
         np.testing.assert_array_equal(found[1], expected[1])

@@ -391,11 +391,11 @@ def far_winding(points, normals, weights, soft, sources, queries, reach_squared)
 
 
 @nb.njit(parallel=True, **_JIT)
-def own_side(normals, centres, index, counts, sheets):
+def own_side(normals, centres, index, counts, sheets, margin):
     """``(index, counts)``: the balls ``index`` (M, k) less their points facing away from their centre, in place.
 
     The compiled :func:`meshcurv._pointcloud_estimators._own_side`: a point ``j`` of the ball of ``c`` (the first
-    ``counts`` of its row) goes when ``n_j . n_c < 0``, or when ``sheets`` (N,) is not empty and ``j`` and ``c`` are
+    ``counts`` of its row) goes when ``n_j . n_c < -margin``, or when ``sheets`` (N,) is not empty and ``j`` and ``c`` are
     on two sheets (both >= 0); the kept points stay in order, the row is padded with ``N``.
     """
     n = normals.shape[0]
@@ -409,7 +409,7 @@ def own_side(normals, centres, index, counts, sheets):
         found = 0
         for a in range(counts[row]):
             j = index[row, a]
-            if normals[j, 0] * cx + normals[j, 1] * cy + normals[j, 2] * cz < 0:
+            if normals[j, 0] * cx + normals[j, 1] * cy + normals[j, 2] * cz < -margin:
                 continue
             if own >= 0 and sheets[j] >= 0 and sheets[j] != own:
                 continue
