@@ -86,8 +86,7 @@ def test_the_pilot_fits_anisotropic_voxels_on_the_coarse_level_as_well_as_on_the
     # a sphere at 0.5 x 0.2 x 0.2 (the confocal spacing of benchmarks/dense_voxel.py): the pilot's normal fits span
     # 11 median edges, over PILOT_COARSE_EDGES; on cubes of a fifth of their radius the fitted normals are as close
     # to the sphere's as the fits over every vertex (median 0.56 against 0.57 degrees, 95th percentile 1.8
-    # against 2.2), at a third of the CPU time (benchmarks/dense_voxel.md); fitted at one centre per cube of
-    # PILOT_SAMPLE_EDGES (2) median edges, the others interpolated: median 0.56, 95th percentile 2.18 degrees
+    # against 2.2), at a third of the CPU time (benchmarks/dense_voxel.md)
     pytest.importorskip("skimage")
     mesh = shapes.voxel_sphere(4.0, (0.5, 0.2, 0.2), seed=3)
     coarse, exact = _pilot_normals(mesh)

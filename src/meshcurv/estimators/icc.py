@@ -31,10 +31,9 @@ pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
 ``2 sqrt(h_v R)`` for the voxel extent ``h_v`` along its normal, capped where
 the surface bends fast; ``parameters["scale"] == "voxel"``); the pilot runs at
 about half of the vertices (:func:`voxel_pilot`; in anisotropic voxels its normals
-are fitted on a coarse level too, at about one of its centres in 2.5,
-:func:`_pilot_normals`), and where the balls of such a surface hold 800 faces
-or more (fine voxels), each ball is summed on clusters of about 16 faces, the
-clusters on its rim by their share of the ball
+are fitted on a coarse level too, :func:`_pilot_normals`), and where the balls of such a
+surface hold 800 faces or more (fine voxels), each ball is summed on clusters
+of about 16 faces, the clusters on its rim by their share of the ball
 (:func:`meshcurv.neighborhoods.coarse_face_sums`: the cost of a ball no longer
 grows with the density of its faces; on a marching-cubes sphere of radius 6 at
 0.5 x 0.2 x 0.2 the median H error moves from 0.30 to 0.32%).
@@ -356,9 +355,8 @@ def voxel_pilot(mesh: PreparedMesh):
         _, valid = mesh.start(boundary=True)
         valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
-        edge = median_edge_length(vertices, topology.edges)
-        centres = _pilot_centres(vertices, topology, valid, edge=edge)
-        fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres, edge=edge)
+        centres = _pilot_centres(vertices, topology, valid)
+        fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres)
         with np.errstate(invalid="ignore"):
             agree = np.isfinite(fitted).all(axis=1) & (np.einsum("ij,ij->i", fitted, start[centres]) > NORMAL_AGREEMENT)
         normals = _spread_normals(
@@ -383,15 +381,11 @@ def voxel_pilot(mesh: PreparedMesh):
     return run
 
 
-def _pilot_normals(
-    mesh: PreparedMesh, start: np.ndarray, radius: float, centres: np.ndarray, *, edge: float | None = None
-) -> np.ndarray:
+def _pilot_normals(mesh: PreparedMesh, start: np.ndarray, radius: float, centres: np.ndarray) -> np.ndarray:
     """(M, 3) the jet normals of :func:`voxel_pilot` at ``centres`` over balls of ``radius`` (``start``: the
     first frames): fitted on a coarse level of the surface (:func:`_coarse_level`, cubes of ``radius /``
-    :data:`PILOT_COARSE_CELLS`) where ``radius`` exceeds :data:`PILOT_COARSE_EDGES` median edge lengths, there
-    at one centre per cube of :data:`PILOT_SAMPLE_EDGES` median edges and interpolated at the others
-    (:func:`meshcurv.jets.sampled_jet_normals`); else over the vertices at every centre. ``edge``: the median
-    edge length, when known."""
+    :data:`PILOT_COARSE_CELLS`) where ``radius`` exceeds :data:`PILOT_COARSE_EDGES` median edge lengths, else
+    over the vertices."""
     vertices, topology = mesh.vertices, mesh.topology
     adjacency = _adjacency(topology)
     areas = _vertex_areas(mesh)
@@ -414,22 +408,6 @@ def _pilot_normals(
     points, normals, allowed, weights = vertices, start, topology.referenced_vertices, None
     if coarse is not None:
         points, normals, allowed, adjacency, weights = coarse
-        spacing = PILOT_SAMPLE_EDGES * (median_edge_length(vertices, topology.edges) if edge is None else edge)
-        if spacing > 0:  # (else edges of length zero: every centre fitted)
-            return _sampled_jet_normals(
-                points,
-                normals,
-                radius,
-                centres=centres,
-                spacing=spacing,
-                degree=NORMAL_DEGREE,
-                iterations=NORMAL_ITERATIONS,
-                neighbours=allowed,
-                adjacency=adjacency,
-                settled=NORMAL_SETTLED,
-                min_spread=NORMAL_MIN_SPREAD,
-                areas=weights,
-            )
     coefficients, frame, _ = _fit_jets(
         points,
         normals,
@@ -455,15 +433,6 @@ PILOT_COARSE_EDGES = 8.0
 #: the vertices), their normals as close to the sphere's; on the 8 meshes of ``benchmarks/accuracy_voxel.md``
 #: that take it (anisotropic voxels) the median H error moves by -4.6 to +4.0% of itself (5 cells: -8.3 to +6.6%).
 PILOT_COARSE_CELLS = 7.0
-#: ... at one centre per cube of this many median edge lengths (:func:`meshcurv.jets.sampled_jet_normals`), the
-#: other centres interpolated from them over their tangent planes: on the sphere R 6 at 0.5 x 0.2 x 0.2 of
-#: ``benchmarks/dense_voxel.py`` 1,862 fits instead of 4,596, the pilot 0.18 -> 0.14 CPU s; on the 8 meshes of
-#: ``benchmarks/accuracy_voxel.md`` that take it the median H error moves by -3.5 to +3.4% of itself (2.5 edges:
-#: +6.6%, 3: +11.6%, 4: +26.8%, the ellipsoid (10, 7, 5) at 2 x 0.5 x 0.5). The pilot's other vertices keep the
-#: normals of the centres one or two rings away (:func:`_spread_normals`): interpolating at every vertex instead
-#: gives better normals but a larger curvature radius, whose radii then bias a small sphere (R 2 at 0.25 x 0.1 x
-#: 0.1, seed 1: 0.82 -> 1.00%; ``benchmarks/dense_voxel.md``).
-PILOT_SAMPLE_EDGES = 2.0
 
 #: The pilot of a voxel surface (:func:`voxel_pilot`) fits and sums at one vertex per cube of this many
 #: median edge lengths (45% of the vertices of a marching-cubes sphere; its values are only read through
@@ -475,18 +444,15 @@ PILOT_CELL_EDGES = 1.25
 PILOT_RINGS = 2
 
 
-def _pilot_centres(
-    vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray, *, edge: float | None = None
-) -> np.ndarray:
+def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray) -> np.ndarray:
     """The vertices of :func:`voxel_pilot`'s fits and sums: in each cube of side :data:`PILOT_CELL_EDGES` median
     edge lengths, the valid referenced vertex nearest the cube's middle, ties taken by the coordinates (never by
     the index: re-indexed vertices give the same centres; the cubes of the coordinate axes: a rotated mesh gets
-    other centres). ``edge``: the median edge length, when known."""
+    other centres)."""
     members = np.flatnonzero(valid & topology.referenced_vertices)
     if members.size == 0:
         return members
-    if edge is None:
-        edge = median_edge_length(vertices, topology.edges)
+    edge = median_edge_length(vertices, topology.edges)
     if not edge > 0:
         return members
     points = vertices[members]
