@@ -9,6 +9,8 @@ import pytest
 from meshcurv import jets, shapes
 from meshcurv._tensors import tangent_basis
 
+pytest.importorskip("skimage")  # (the marching-cubes sphere: shapes.voxel_sphere)
+
 
 def _sphere_case(reach):
     """A marching-cubes sphere's vertices with the sphere's exact normals, samples one per cube of 0.8."""

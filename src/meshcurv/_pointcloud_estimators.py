@@ -14,7 +14,8 @@ import numpy as np
 from ._backend import kernel_threads, numba_kernels
 from ._pointcloud_normals import NEIGHBOURS
 from .errors import InvalidOptionError
-from .measures import curvatures_from_measures, face_measures
+from . import _measures
+from .measures import curvatures_from_measures
 from .jets import _fit_jets, jet_curvatures, jet_normals
 
 logger = logging.getLogger(__name__)
@@ -659,7 +660,10 @@ def _triangle_sums(points, normals, index, counts, pattern):
     facing = mean[..., 0] * cross[0] + mean[..., 1] * cross[1] + mean[..., 2] * cross[2]
     flip = facing < 0
     triangles[flip, 1], triangles[flip, 2] = triangles[flip, 2], triangles[flip, 1]
-    measures = face_measures(points, triangles.reshape(-1, 3), normals)
+    # (the trusting core: the points and normals were checked at the door, the triangles are their own ranks)
+    measures = _measures.face_measures(
+        points, np.ascontiguousarray(triangles.reshape(-1, 3), dtype=np.int64), np.ascontiguousarray(normals)
+    )
     return measures.reshape(m, n_triangles, 9).sum(axis=1)
 
 
