@@ -343,6 +343,19 @@ def sphere_frames(normals):
     return first, np.cross(normals, first)
 
 
+def _sphere_beside_a_noisy_plate():
+    """A unit sphere's 2,000 points two spacings from a 1 x 0.5 x 0.02 plate's 2,000, both under noise of 0.1
+    spacings along their exact normals: ``(points, exact normals)``."""
+    from scipy.spatial import cKDTree
+
+    ball, ball_normals = sphere(2000, seed=11)
+    plate, plate_normals, _, _ = ellipsoid(2000, (1.0, 0.5, 0.02), seed=12)
+    plate = plate + [0.0, 1.0 + 0.5 + 2 * np.sqrt(4 * np.pi / 2000), 0.0]
+    points, exact = np.concatenate([ball, plate]), np.concatenate([ball_normals, plate_normals])
+    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+    return points + np.random.default_rng(13).uniform(-0.1, 0.1, (4000, 1)) * spacing * exact, exact
+
+
 def test_blended_flags_estimates_whose_ball_normals_their_shape_operator_does_not_predict():
     # on a sphere the tangent part of the normal at an offset d is exactly k times that of d: the exact curvatures
     # predict every normal of the ball; twice them (a blend of a sharper region, as by a plate's rim) predict the
@@ -379,14 +392,7 @@ def test_consistent_inward_given_normals_on_a_noisy_thin_plate_beside_a_sphere_s
     # neither back to back nor face to face, so the normals were re-oriented; the plate's points are all undecided
     # (NaN), and there the user's normals were turned (848 of them) and the call said "given, reoriented". Where
     # the side is undecided the user's normal is now kept: nothing was turned, "given"
-    from scipy.spatial import cKDTree
-
-    ball, ball_normals = sphere(2000, seed=11)
-    plate, plate_normals, _, _ = ellipsoid(2000, (1.0, 0.5, 0.02), seed=12)
-    plate = plate + [0.0, 1.0 + 0.5 + 2 * np.sqrt(4 * np.pi / 2000), 0.0]
-    points, exact = np.concatenate([ball, plate]), np.concatenate([ball_normals, plate_normals])
-    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
-    points = points + np.random.default_rng(13).uniform(-0.1, 0.1, (4000, 1)) * spacing * exact
+    points, exact = _sphere_beside_a_noisy_plate()
     for method in ("jets", "corrected_measures"):
         r = quiet(points, normals=-exact, method=method)
         assert r.parameters["normals"] == "given"
@@ -403,14 +409,7 @@ def test_jets_beside_a_part_whose_side_is_undecided_refuse_its_points(given_radi
     # 0.54 held 148 of the plate's points beside their 145 own, and with the plate's normals turned only 11 of
     # them faced away (under the 5% that makes the fit refuse the ball): H -0.43 against -1 at three valid points.
     # A point whose side the orientation left undecided faces away from every centre in that check
-    from scipy.spatial import cKDTree
-
-    ball, ball_normals = sphere(2000, seed=11)
-    plate, plate_normals, _, _ = ellipsoid(2000, (1.0, 0.5, 0.02), seed=12)
-    plate = plate + [0.0, 1.0 + 0.5 + 2 * np.sqrt(4 * np.pi / 2000), 0.0]
-    points, exact = np.concatenate([ball, plate]), np.concatenate([ball_normals, plate_normals])
-    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
-    points = points + np.random.default_rng(13).uniform(-0.1, 0.1, (4000, 1)) * spacing * exact
+    points, exact = _sphere_beside_a_noisy_plate()
     r = quiet(points, normals=-exact, method="jets", radius=given_radius)
     assert r.parameters["normals"] == "given"
     assert r.valid[:2000].mean() > 0.9
