@@ -1640,6 +1640,7 @@ def check_neighbour_differences(name):
 
 def check_ball_triangle_sums(name):
     from meshcurv._pointcloud_estimators import (
+        EDGE_ON,
         MIN_BALL_POINTS,
         TRIANGLES,
         _distinct_ranks,
@@ -1659,7 +1660,7 @@ def check_ball_triangle_sums(name):
     index, counts = np.ascontiguousarray(index[rows]), counts[rows]
     pattern = _rank_pattern(TRIANGLES)
     expected = _triangle_sums(points, normals, index, counts, pattern)
-    got = kernels("pointcloud").ball_triangle_sums(points, normals, index, counts.astype(np.int64), pattern)
+    got = kernels("pointcloud").ball_triangle_sums(points, normals, index, counts.astype(np.int64), pattern, EDGE_ON)
     # the same triangles (ranks drawn alike), each turned alike and measured with icc's operations;
     # the T measures of a ball summed in another order: within 2 T eps of the sum of |measures|
     ranks = _distinct_ranks(pattern, counts)

@@ -246,7 +246,10 @@ def test_compiled_triangle_sums_match_the_numpy_path():
     pattern = estimators._rank_pattern(16)
     expected = estimators._triangle_sums(points, normals, index, counts, pattern)
     np.testing.assert_allclose(
-        ball_triangle_sums(points, normals, index, counts, pattern), expected, rtol=1e-10, atol=1e-14
+        ball_triangle_sums(points, normals, index, counts, pattern, estimators.EDGE_ON),
+        expected,
+        rtol=1e-10,
+        atol=1e-14,
     )
     assert (expected[:, 0] > 0).all()  # every triangle turned to a positive corrected area
 

@@ -12,6 +12,7 @@ import pytest
 
 from meshcurv import shapes
 from meshcurv._pointcloud_estimators import (
+    EDGE_ON,
     MIN_BALL_POINTS,
     TRIANGLES,
     _distinct_ranks,
@@ -55,7 +56,7 @@ def test_flat_triangles_of_a_lattice_ball_are_turned_alike_on_both_backends(n_ar
     edge_on = np.abs(np.einsum("ij,ij->i", np.cross(a, b), mean)) < 1e-12
     assert edge_on.sum() > 10  # the case: triangles in a ring's plane, edge-on to their normals, their side round-off
     expected = _triangle_sums(points, normals, index, counts, pattern)
-    got = kernels("pointcloud").ball_triangle_sums(points, normals, index, counts.astype(np.int64), pattern)
+    got = kernels("pointcloud").ball_triangle_sums(points, normals, index, counts.astype(np.int64), pattern, EDGE_ON)
     magnitude = np.abs(face_measures(points, triangles, normals)).reshape(index.shape[0], pattern.shape[0], 9)
     assert_sums_close(got, expected, magnitude.sum(axis=1), pattern.shape[0] + 1)
 

@@ -16,12 +16,28 @@ from .icc import _triangle_measures
 from .neighborhoods import _ball_members
 
 
+@nb.njit(**_JIT)
+def _edge_on(points, normals, i, j, k, tolerance):
+    """Whether the triangle ``(i, j, k)`` holds the mean of its corners' normals in its plane, within
+    ``tolerance`` of the product of their (L1) lengths: its corrected area is round-off, and so is the sign that
+    turns it (:data:`meshcurv._pointcloud_estimators.EDGE_ON`)."""
+    ax, ay, az = points[j, 0] - points[i, 0], points[j, 1] - points[i, 1], points[j, 2] - points[i, 2]
+    bx, by, bz = points[k, 0] - points[i, 0], points[k, 1] - points[i, 1], points[k, 2] - points[i, 2]
+    mx = normals[i, 0] + normals[j, 0] + normals[k, 0]
+    my = normals[i, 1] + normals[j, 1] + normals[k, 1]
+    mz = normals[i, 2] + normals[j, 2] + normals[k, 2]
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    facing = abs(mx * cx + my * cy + mz * cz)
+    return facing <= tolerance * (abs(mx) + abs(my) + abs(mz)) * (abs(cx) + abs(cy) + abs(cz))
+
+
 @nb.njit(parallel=True, **_JIT)
-def ball_triangle_sums(points, normals, index, counts, pattern):
+def ball_triangle_sums(points, normals, index, counts, pattern, edge_on):
     """(M, 9) sums of ``mu_0, mu_1, mu_2, mu^{X,Y}`` (xx, yy, zz, xy, xz, yz) over the triangles of each ball.
 
     ``index`` (M, K): the ball's points first (``counts`` of them, >= 3);
-    ``pattern`` (T, 3): uniform numbers in [0, 1) that pick three distinct ranks.
+    ``pattern`` (T, 3): uniform numbers in [0, 1) that pick three distinct ranks; a triangle edge-on to its
+    corners' normals (:func:`_edge_on` within ``edge_on``) adds nothing.
     """
     m = index.shape[0]
     out = np.zeros((m, 9))
@@ -39,9 +55,10 @@ def ball_triangle_sums(points, normals, index, counts, pattern):
                 z += 1
             if z >= high:
                 z += 1
-            m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(
-                points, normals, index[row, a], index[row, b], index[row, z], True
-            )
+            i, j, k = index[row, a], index[row, b], index[row, z]
+            if _edge_on(points, normals, i, j, k, edge_on):
+                continue
+            m0, m1, m2, m3, m4, m5, m6, m7, m8 = _triangle_measures(points, normals, i, j, k, True)
             s0, s1, s2, s3, s4, s5 = s0 + m0, s1 + m1, s2 + m2, s3 + m3, s4 + m4, s5 + m5
             s6, s7, s8 = s6 + m6, s7 + m7, s8 + m8
         out[row, 0], out[row, 1], out[row, 2] = s0, s1, s2
