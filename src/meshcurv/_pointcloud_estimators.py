@@ -31,8 +31,8 @@ TRIANGLES = 32
 
 #: A random triangle of ``corrected_measures`` adds nothing when the mean of its corners' normals lies in its plane
 #: within this fraction of their lengths' product: its corrected area is round-off, and so is the sign that turns
-#: it. On a lattice (a mesh's vertices as a cloud) such triangles are common, and normals equal within 1e-15 on the
-#: two backends turned them apart (fuzz round 11, seed 202 cases 169 and 258: k 2e-4 apart on an icosphere).
+#: it. On a lattice (a mesh's vertices as a cloud) such triangles are common, and normals equal to round-off turned
+#: them apart on the two backends (``benchmarks/fuzz_api.md``, round 11).
 EDGE_ON = 1e-9
 
 #: Most points of a ball that ``corrected_measures`` draws its triangles from (the nearest ones).
@@ -736,9 +736,9 @@ def _ball_indices(search, points, chunk, radius, k):
 
 
 #: A point of a ball faces away from its centre when ``n_j . n_c < -FACING_MARGIN``. Not 0: on a lattice (a gridded
-#: scan, a mesh's vertices) points at right angles have ``n_j . n_c`` of round-off (1e-17 on a cylinder of 12
-#: around), whose sign the two backends' normals (equal within 1e-14) decide alike only by chance (R9's fuzz round 11,
-#: seed 201 case 2534: H 6% of |k| apart); such points are kept on both.
+#: scan, a mesh's vertices) points at right angles have ``n_j . n_c`` of round-off, whose sign the two backends'
+#: normals (equal to round-off) decide alike only by chance (``benchmarks/fuzz_api.md``, round 11); such points are
+#: kept on both.
 FACING_MARGIN = 1e-9
 
 
