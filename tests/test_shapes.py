@@ -169,8 +169,18 @@ def test_voxel_torus_exact_values(skimage):
 
 
 def test_voxel_shapes_reject_bad_options():
-    with pytest.raises(InvalidOptionError, match=r"`spacing` must be 3 positive numbers.*got \(1, 1\)"):
+    with pytest.raises(InvalidOptionError, match=r"`spacing` must be 3 numbers.*got \(1, 1\)"):
         shapes.voxel_sphere(5.0, (1, 1))
+    # what label_curvatures refuses, the voxel shapes refuse alike (before: a bare ValueError from numpy for a string)
+    for spacing, message in [
+        ("abc", r"`spacing` must be 3 numbers.*got 'abc'"),
+        (["1", "1", "1"], r"`spacing` must be 3 numbers"),
+        ((True, True, True), r"`spacing` must be 3 numbers"),
+        ((1, 0, 1), r"`spacing` must be positive and finite.*\(1.0, 0.0, 1.0\)"),
+        ((1, float("nan"), 1), r"`spacing` must be positive and finite"),
+    ]:
+        with pytest.raises(InvalidOptionError, match=message):
+            shapes.voxel_sphere(5.0, spacing)
     with pytest.raises(InvalidOptionError, match=r"`minor_radius` must be below `major_radius`"):
         shapes.voxel_torus(3.0, 4.0)
     with pytest.raises(InvalidOptionError, match=r"`semi_axes` must be 3 positive number"):

@@ -397,6 +397,29 @@ def check_positive_float(value, name: str) -> float:
     return number
 
 
+def checked_spacing(spacing) -> np.ndarray:
+    """``spacing`` as a (3,) float array: the voxel size along image axes 0, 1, 2 (z, y, x), each finite and > 0.
+
+    Real numbers only (a string or a boolean is refused rather than parsed); raises
+    :class:`InvalidOptionError` naming what was given.
+    """
+    try:
+        raw = np.asarray(spacing)
+    except (TypeError, ValueError):  # ragged sequences
+        raw = None
+    if raw is None or raw.dtype.kind not in "iuf" or raw.shape != (3,):
+        raise InvalidOptionError(
+            f"`spacing` must be 3 numbers, the voxel size along image axes 0, 1, 2 (z, y, x); got {_short_repr(spacing)}"
+        )
+    with np.errstate(over="ignore"):
+        values = raw.astype(float)
+    if not (np.isfinite(values).all() and (values > 0).all()):
+        raise InvalidOptionError(
+            f"`spacing` must be positive and finite along every axis (z, y, x); got {tuple(values.tolist())}"
+        )
+    return values
+
+
 def check_choice(value, name: str, choices) -> str:
     """Return ``value`` if it is one of ``choices`` or raise :class:`InvalidOptionError`."""
     if not isinstance(value, str) or value not in choices:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import check_int_option, check_positive_float
+from ._validation import check_int_option, check_positive_float, checked_spacing
 from .errors import InvalidMeshError, InvalidOptionError, optional_module
 from .geometry import mean_edge_length
 from .topology import MeshTopology
@@ -720,13 +720,6 @@ class VoxelMesh(AnalyticMesh):
     spacing: tuple | None = None
 
 
-def _check_spacing(spacing) -> np.ndarray:
-    values = np.asarray(spacing, dtype=float)
-    if values.shape != (3,) or not (np.isfinite(values).all() and (values > 0).all()):
-        raise InvalidOptionError(f"`spacing` must be 3 positive numbers (image axes 0, 1, 2); got {spacing!r}")
-    return values
-
-
 def _check_center(center) -> np.ndarray:
     try:
         values = np.asarray(center, dtype=float)
@@ -809,7 +802,7 @@ def voxel_sphere(radius: float = 10.0, spacing=(1.0, 1.0, 1.0), *, seed: int = 0
         Without scikit-image (``pip install 'meshcurv[volume]'``).
     """
     r = float(_check_lengths(radius, "radius", 1)[0])
-    s = _check_spacing(spacing)
+    s = checked_spacing(spacing)
     vertices, faces, center = _marching_cubes(
         lambda x, y, z: x * x + y * y + z * z <= r * r, np.full(3, r), s, seed, "voxel_sphere"
     )
@@ -889,7 +882,7 @@ def voxel_ellipsoid(semi_axes=(10.0, 7.0, 5.0), spacing=(1.0, 1.0, 1.0), *, seed
         Without scikit-image (``pip install 'meshcurv[volume]'``).
     """
     a = _check_lengths(semi_axes, "semi_axes", 3)
-    s = _check_spacing(spacing)
+    s = checked_spacing(spacing)
     inv2 = 1.0 / a**2
     vertices, faces, center = _marching_cubes(
         lambda x, y, z: x * x * inv2[0] + y * y * inv2[1] + z * z * inv2[2] <= 1, a, s, seed, "voxel_ellipsoid"
@@ -937,7 +930,7 @@ def voxel_torus(
     r = float(_check_lengths(minor_radius, "minor_radius", 1)[0])
     if r >= R:
         raise InvalidOptionError(f"`minor_radius` must be below `major_radius`; got {r!r} >= {R!r}")
-    s = _check_spacing(spacing)
+    s = checked_spacing(spacing)
 
     def inside(x, y, z):
         return x * x + (np.sqrt(y * y + z * z) - R) ** 2 <= r * r

@@ -208,7 +208,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._validation import check_int_option, check_positive_float
+from ._validation import check_int_option, check_positive_float, checked_spacing
 from .curvature import principal_curvatures
 from .errors import InvalidMeshError, InvalidOptionError, MeshcurvWarning, MeshQualityWarning, MissingDependencyError
 from .measures import corrected_areas, face_measures
@@ -355,22 +355,6 @@ def _check_labels(labels) -> np.ndarray:
     if image.dtype.kind == "i" and image.min() < 0:
         raise InvalidMeshError(f"`labels` must be >= 0 (0 is the background); got the value {int(image.min())}")
     return image
-
-
-def _check_spacing(spacing) -> np.ndarray:
-    try:
-        values = np.asarray(spacing, dtype=float)
-    except (TypeError, ValueError):
-        values = None
-    if values is None or values.shape != (3,):
-        raise InvalidOptionError(
-            f"`spacing` must be 3 numbers, the voxel size along image axes 0, 1, 2 (z, y, x); got {spacing!r}"
-        )
-    if not (np.isfinite(values).all() and (values > 0).all()):
-        raise InvalidOptionError(
-            f"`spacing` must be positive and finite along every axis (z, y, x); got {tuple(values.tolist())}"
-        )
-    return values
 
 
 def _check_labels_to_use(labels_to_use):
@@ -846,7 +830,7 @@ def _plan(
     into labels by ``threshold`` (:func:`meshcurv._masks.labels_from_image`).
     """
     threshold = check_threshold(threshold)
-    spacing = _check_spacing(spacing)
+    spacing = checked_spacing(spacing)
     wanted = _check_labels_to_use(labels_to_use)
     if radius is not None:
         radius = check_positive_float(radius, "radius")
