@@ -50,10 +50,9 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from .._backend import kernel_threads, numba_kernels
 from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles
-from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
-from ._support import Stages, nan_where, problems
+from ._support import Stages, finish
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
 
@@ -102,18 +101,9 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         rotate=True,
         mean_from_trace=True,
     )
-    nan_where(~valid, k_min, k_max, dir_min, dir_max)
-    result = CurvatureResult._of_arrays(
-        k_min=k_min,
-        k_max=k_max,
-        dir_min=dir_min,
-        dir_max=dir_max,
-        normals=normals,
-        valid=valid,
-        method="normal_cycle",
-        parameters={"smoothing_steps": smoothing_steps},
+    return finish(
+        "normal_cycle", {"smoothing_steps": smoothing_steps}, valid, normals, k_min, k_max, dir_min, dir_max, defects
     )
-    return result, problems(defects, valid)
 
 
 def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages: Stages):
@@ -148,14 +138,6 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     k_min, k_max, dir_min, dir_max, normals, valid = kernels.normal_cycle_finish(
         sums, defects.invalid_vertices, indptr, indices, smoothing_left
     )
-    result = CurvatureResult._of_arrays(
-        k_min=k_min,
-        k_max=k_max,
-        dir_min=dir_min,
-        dir_max=dir_max,
-        normals=normals,
-        valid=valid,
-        method="normal_cycle",
-        parameters={"smoothing_steps": smoothing_steps},
+    return finish(
+        "normal_cycle", {"smoothing_steps": smoothing_steps}, valid, normals, k_min, k_max, dir_min, dir_max, defects
     )
-    return result, problems(defects, valid)
