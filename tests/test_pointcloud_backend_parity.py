@@ -150,16 +150,12 @@ def test_backends_agree_on_a_lattice_cloud_whose_distances_tie(method):
     np.testing.assert_allclose(reference.mean, compiled.mean, rtol=0, atol=RTOL * 1.0)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="R9's finding: the plate's thickness is read as the cloud's noise (radius.cloud_noise_level, 0.28 "
-    "spacings), which inflates the sphere's default radius to 0.95-1.33 on a unit sphere: every ball holds its "
-    "far side (issue 29's open case 818 of seed 143 has the same cause)",
-)
 def test_a_clean_sphere_beside_a_thin_plate_keeps_its_points():
     # a clean unit sphere of 800 points alone: every point valid, median H 1.0004 (at 74566d8); 1.5 units (12 of
     # its spacings) beside a thin clean ellipsoid of 1200 points (1 x 0.5 x 0.05), none of its balls needs the
-    # plate's points: its estimates are as good as alone
+    # plate's points: its estimates are as good as alone. R9's finding (a strict xfail until the noise fits refused
+    # balls holding the other side): the plate's thickness was read as the cloud's noise (0.28 spacings), which
+    # inflated the sphere's default radius to 0.95-1.33: every ball held its far side
     points = CLOUDS["thin_ellipsoid_beside_a_sphere"][0]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshQualityWarning)

@@ -538,3 +538,44 @@ def test_alone_flags_an_estimate_none_of_whose_neighbours_is_resolved():
     assert estimators.alone(resolved, indices).tolist() == [True, False, False, False, False, False]
     assert "none of the nearest neighbours" in estimators.alone_problem(estimators.alone(resolved, indices))[0]
     assert estimators.alone_problem(np.zeros(6, dtype=bool)) == []
+
+
+def test_turned_below_ball_turn_flags_only_balls_no_jet_fits_on_one_side():
+    # a unit sphere of 20,000 points, balls of 0.08: three times the exact curvatures on a cap (z > 0.8) turn the
+    # normal by 0.24 rad there, below BALL_TURN: jets over the check's balls fit (their disagreement at such turns
+    # may be their noise: not flagged). The same sphere with a second face 0.01 inside it (inward normals, a shell
+    # thinner than the ball): no jet fits one side of the cap's edge, which is flagged (THIN_TURN)
+    points, normals = sphere(20000, seed=5)
+    n = points.shape[0]
+    cap = points[:, 2] > 0.8
+    k = np.where(cap, 3.0, 1.0)
+    edge = cap & (points[:, 2] < 0.83)
+    assert 0.08 * 3.0 <= estimators.BALL_TURN and 0.08 * 3.0 > estimators.THIN_TURN > 0.08 * 1.0
+    flagged = estimators.turned(points, normals, (k, k), 0.08, np.arange(n), np.ones(n, dtype=bool))
+    assert not flagged.any()
+    shell = np.concatenate([points, 0.99 * points])
+    shell_normals = np.concatenate([normals, -normals])
+    both = np.concatenate([k, k])
+    flagged = estimators.turned(shell, shell_normals, (both, both), 0.08, np.arange(n), np.ones(2 * n, dtype=bool))
+    assert flagged[:n][edge].mean() > 0.9
+    assert not flagged[:n][~cap].any()  # (turning by 0.08 rad: not checked)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_clean_thin_plate_leaves_no_valid_wrong_point(seed):
+    # fuzz seed 143 case 818: a clean 1 x 0.5 x 0.02 plate of 4,000 points (its faces 1.7 spacings apart), inward
+    # given normals, the default method. Its degree-2 noise fits went through both faces and read 0.36 spacings of
+    # noise (seed 2 here: 1 valid point off by 0.52 of |k|); fitted on one face they read 0-0.016, and balls of 3
+    # spacings left the band 0.88-0.94 of the way to the rim turning the normal by 0.12-0.19 rad, under BALL_TURN
+    # (seeds 0, 1, 2, 5: 2, 1, 5 and 1 valid points off by 0.50-0.83) until THIN_TURN: no jet fits one face there
+    from scipy.spatial import cKDTree
+
+    points, normals, mean, kmax = ellipsoid(4000, (1.0, 0.5, 0.02), seed=seed)
+    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+    r = quiet(points, normals=-normals)
+    assert r.parameters["noise"] < 0.05  # the points are on the ellipsoid: no noise (0.35-0.37 before)
+    resolved = kmax * spacing <= 0.25  # as the fuzzer checks: radius of curvature of 4 spacings or more
+    side = np.sign(np.einsum("ij,ij->i", r.normals, normals))
+    wrong = r.valid & resolved & ~(np.abs(r.mean - side * mean) / kmax <= 0.5)
+    assert wrong.sum() == 0
+    assert r.valid[resolved].mean() > 0.6  # (0.74-0.76 of all points: the faces stay)

@@ -25,8 +25,8 @@ USABLE = np.ones(N, dtype=bool)
 SPACING = 0.3
 
 
-def _noise(points=POINTS, normals=NORMALS, spacing=SPACING, centres=CENTRES, usable=USABLE) -> float:
-    return radius.cloud_noise_level(points, normals, spacing, centres, usable)
+def _noise(points=POINTS, normals=NORMALS, spacing=SPACING, centres=CENTRES, usable=USABLE, facing=None) -> float:
+    return radius.cloud_noise_level(points, normals, spacing, centres, usable, facing=facing)
 
 
 def _nan_point() -> np.ndarray:
@@ -49,6 +49,7 @@ def _nan_point() -> np.ndarray:
         ({"usable": USABLE[:10]}, r"`usable` must be a bool array of shape \(42,\); got bool \(10,\)"),
         ({"usable": USABLE.astype(np.int64)}, r"`usable` must be a bool array of shape \(42,\); got int64"),
         ({"usable": None}, r"`usable` must be a bool array of shape \(42,\)"),
+        ({"facing": NORMALS[:10]}, r"`facing` must be a real array of shape \(42, 3\); got float64 \(10, 3\)"),
     ],
     ids=[
         "nan-point",
@@ -62,6 +63,7 @@ def _nan_point() -> np.ndarray:
         "short-usable",
         "int-usable",
         "no-usable",
+        "short-facing",
     ],
 )
 def test_cloud_noise_level_refuses_arrays_that_do_not_fit(given, message):

@@ -46,7 +46,9 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    faces mix); given normals are re-oriented only where their signs are not
    consistent, and keep their side where it is undecided;
 4. the noise level ``nu``: the median distance of the points to degree-2 jets
-   fitted over :data:`meshcurv.radius.CLOUD_NOISE_FIT_RADIUS` spacings, in spacings;
+   fitted over :data:`meshcurv.radius.CLOUD_NOISE_FIT_RADIUS` spacings, in spacings
+   (a ball holding the other side of the surface is not fitted: through both
+   faces of a thin part a jet would read half its thickness as noise);
 5. the radius: ``s (a + b sqrt(max(nu - 0.005, 0)))``, ``(a, b)`` = (3, 11)
    for ``corrected_measures`` and (3, 22) for ``jets``
    (:data:`meshcurv.radius.CLOUD_RADIUS_RULES`, from a sweep of ``benchmarks/pointcloud.py``: three
@@ -84,7 +86,12 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    estimate): a rim or part sharper than the ball, the other side of a thin
    part, or noise the fit follows
    (:func:`meshcurv._pointcloud_estimators.unsteady`,
-   :func:`meshcurv._pointcloud_estimators.erratic`); so is a measure that the
+   :func:`meshcurv._pointcloud_estimators.erratic`); so is a measure whose
+   ball turns the normal by more than 0.3 rad that jets over the same balls do
+   not reproduce, or by more than 0.1 rad where no jet fits one side of the
+   surface (a part thinner than the ball, by whose rim the curvature grows a
+   hundredfold within it: :func:`meshcurv._pointcloud_estimators.turned`), a
+   measure that the
    curvatures of its normals' jets do not reproduce where those jets resolve
    the surface (:func:`meshcurv._pointcloud_estimators.disagree`), and an
    estimate over a given radius below half the one the noise calls for. A
@@ -901,7 +908,9 @@ def _compute(points, given, radius, method, search=None):
     # of cover.)
     facing = np.where(doubtful[:, None], 0.0, start) if how == "given, reoriented" else start
     logger.info("point cloud: noise level")
-    noise = _cloud_noise_level(points, start, median, centres, usable)
+    # (its fits refuse balls holding the other side too: through both faces of a plate thinner than the ball a jet
+    # reads half the thickness as noise, and the radius that noise calls for reaches across the whole cloud)
+    noise = _cloud_noise_level(points, start, median, centres, usable, facing)
     groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems, least_radius)
     if radius is None:
         extent = points[usable]

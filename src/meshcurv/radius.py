@@ -939,10 +939,15 @@ CLOUD_NOISE_SAMPLE = 16384
 CLOUD_EXTENT_CAP = 0.25
 
 
-def cloud_noise_level(points, normals, spacing, centres, usable) -> float:
+def cloud_noise_level(points, normals, spacing, centres, usable, *, facing=None) -> float:
     """Median distance of the points to degree-2 jets over :data:`CLOUD_NOISE_FIT_RADIUS` spacings, in spacings.
 
     ``centres`` are the usable points, of which at most :data:`CLOUD_NOISE_SAMPLE`, evenly spaced, are fitted.
+    A ball holding points that face away from its centre (more than :data:`meshcurv.jets.AWAY_FRACTION` of it,
+    the ``facing`` check of :func:`meshcurv.jets.fit_jets`: the other face of a part thinner than the ball, or
+    another part) is not fitted: a jet through both faces of a plate reads half its thickness as noise (seed 143
+    case 818 of ``benchmarks/fuzz_api.py``: 0.36 spacings on a clean plate 1.7 spacings thick, and a default radius
+    reaching the band by its rim).
 
     Parameters
     ----------
@@ -956,11 +961,14 @@ def cloud_noise_level(points, normals, spacing, centres, usable) -> float:
         The ids of the points to fit around.
     usable : array_like of shape (P,), bool
         The points that may enter the balls.
+    facing : array_like of shape (P, 3), optional
+        The normals of the check (default: ``normals``; a zero row faces away from every centre: a point whose side
+        is undecided).
 
     Returns
     -------
     float
-        0 when no jet could be fitted.
+        0 when no jet could be fitted (every ball held the other side).
 
     Raises
     ------
@@ -976,17 +984,20 @@ def cloud_noise_level(points, normals, spacing, centres, usable) -> float:
     spacing = _length(spacing, "spacing")
     centres = _checked_ids(centres, n)
     usable = checked_mask(usable, n, name="usable")
-    return _cloud_noise_level(points, normals, spacing, centres, usable)
+    facing = normals if facing is None else _floats(facing, "facing", (n, 3))
+    return _cloud_noise_level(points, normals, spacing, centres, usable, facing)
 
 
-def _cloud_noise_level(points, normals, spacing: float, centres, usable) -> float:
+def _cloud_noise_level(points, normals, spacing: float, centres, usable, facing) -> float:
     """:func:`cloud_noise_level` of checked arrays."""
     taken = np.linspace(0, centres.size - 1, min(centres.size, CLOUD_NOISE_SAMPLE)).round().astype(np.int64)
     sample = centres[taken]
     if spacing <= 0 or sample.size == 0:
         return 0.0
     radius = CLOUD_NOISE_FIT_RADIUS * spacing
-    coefficients, _, _ = _fit_jets(points, normals, radius, degree=2, iterations=1, centres=sample, neighbours=usable)
+    coefficients, _, _ = _fit_jets(
+        points, normals, radius, degree=2, iterations=1, centres=sample, neighbours=usable, facing=facing
+    )
     heights = np.abs(coefficients[sample, 0]) * CLOUD_NOISE_FIT_RADIUS  # c00 is in units of the radius
     heights = heights[np.isfinite(heights)]
     return float(np.median(heights)) if heights.size else 0.0
