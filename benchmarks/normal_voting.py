@@ -1,7 +1,9 @@
 """Normal vector voting against the jets on lattice surfaces (issue 30): ``python benchmarks/normal_voting.py``.
 
-    python benchmarks/normal_voting.py                          # smoothed, binary voxel and accuracy families
-    python benchmarks/normal_voting.py --families smoothed --factors 1 2 3
+    python benchmarks/normal_voting.py --families smoothed --factors 2 3 4 5 --jet-votes
+    python benchmarks/normal_voting.py --families smoothed --factors 2 3 4 --jet-votes --kernels taper far
+    python benchmarks/normal_voting.py --families voxel --factors 3 --jet-votes --kernels exp far --max-vertices 15000
+    python benchmarks/normal_voting.py --families accuracy --factors 3 --jet-votes --kernels exp far --refit
 
 Normal vector voting (Page, Sun, Koschan, Paik, Abidi 2002; step 1 of PyCurv's AVV, Salfer et al. 2020):
 vertex ``v`` collects from every face ``f`` whose centroid ``c_f`` lies within ``g`` of it a vote, the face's
@@ -24,9 +26,13 @@ against the blurred surface on the smoothed meshes, see ``smoothed_isosurfaces.p
 - ``default``: the default call's own result (its jets, and its own sums: coarse on dense voxel surfaces);
 - ``jets``: the default's fitted normals summed as the others (the same sums, so the rows compare normals);
 - ``vote g``: voting with ``g = factor * r_v`` (``r_v`` the default's per-vertex measure radius);
-- ``jets in vote frame``: icc's jets (degree 3 over the default's normal radius ``3 r_v``) fitted in the frame
-  of the voted normal at the largest factor (``--refit``) instead of that of the mean face normal;
-- ``vote of jets g``: the same voting with the jets' vertex normals as the votes (vertex areas as weights);
+- ``jets over 3 r_v, frame: ...`` (``--refit``): icc's jets (degree 3 over ``3 r_v``, every vertex, no coarse
+  level) fitted from the frame of the mean face normal and from that of the voted normal at the largest factor;
+- ``vote of jets g`` (``--jet-votes``): the same voting with the jets' vertex normals as the votes, cast from
+  the vertices (vertex areas as weights);
+- ``--kernels``: ``exp`` (Page's ``exp(-d / sigma)``), ``taper`` (``(1 - d^2 / g^2)^2``, the jets' kernel) and
+  ``far`` (``exp`` without the votes nearer than ``g / 4``: a vote from a chord of length ``d`` is turned by
+  about ``2 delta / d`` by a position error ``delta`` of the lattice's ripple);
 - ``analytic``: the exact normals (what the scale alone gives).
 
 On the binary voxel meshes (``accuracy.py --voxel``) the last column is ``accuracy_voxel.md``'s metric
@@ -52,8 +58,8 @@ from meshcurv.measures import curvatures_from_measures, face_measures  # noqa: E
 from meshcurv.neighborhoods import ball_face_sums  # noqa: E402
 from meshcurv.topology import MeshTopology  # noqa: E402
 
-#: The smoothed meshes of the brief (spheres R 10, 20; tori (25, 10), (16, 6); sigma 0.5, 1, 2).
-SMOOTHED_WANTED = ("sphere(10)", "sphere(20)", "torus(25, 10)", "torus(16, 6)")
+#: The smoothed meshes run: spheres R 10, 20, tori (25, 10), (16, 6) (sigma 0.5, 1, 2) and the ellipsoid (a bias check).
+SMOOTHED_WANTED = ("sphere(10)", "sphere(20)", "torus(25, 10)", "torus(16, 6)", "ellipsoid(24, 16, 10)")
 
 
 def voted_normals(vertices, faces, radius, start, *, votes=None, vote_areas=None, kernel="exp", chunk=128):
