@@ -151,7 +151,8 @@ def _analytic_cases(families):
             yield label, "accuracy", vertices, faces, mesh.k_min, mesh.k_max, np.asarray(mesh.normals), None
 
 
-def _errors(vertices, faces, radius, normals, k_min_exact, k_max_exact, h_reference):
+def _summed(vertices, faces, radius, normals):
+    """``(H, k_min, k_max)`` of icc's measures with ``normals``, summed over the connected balls of ``radius``."""
     sums = ball_face_sums(vertices, faces, radius, face_measures(vertices, faces, normals), connected=True)
     k_min, k_max, *_ = curvatures_from_measures(sums, normals)
     return 0.5 * (k_min + k_max), k_min, k_max
@@ -195,7 +196,7 @@ def main(argv=None):
 
         def row(label, normals, fields=None, cpu=float("nan")):
             if fields is None:
-                fields = _errors(vertices, faces, radius, normals, k_min_x, k_max_x, h_ref)
+                fields = _summed(vertices, faces, radius, normals)
             mean, k_min, k_max = fields
             angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", normals, exact), -1, 1)))
 
