@@ -88,7 +88,11 @@ def _unit(x, y, z):
     no direction.
     """
     norm = math.sqrt(x * x + y * y + z * z)
-    if norm > 1e-12 * max(max(abs(x), abs(y), abs(z)), _TINY):
+    # max(max(abs(x), abs(y), abs(z)), _TINY) written out: numba compiles max once per caller's options (issue 31)
+    largest = abs(x)
+    largest = abs(y) if abs(y) > largest else largest
+    largest = abs(z) if abs(z) > largest else largest
+    if norm > 1e-12 * (_TINY if _TINY > largest else largest):
         return x / norm, y / norm, z / norm, True
     return np.nan, np.nan, np.nan, False
 

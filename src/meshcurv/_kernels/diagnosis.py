@@ -22,9 +22,11 @@ def mesh_facts(vertices, faces, edges, referenced, scales, area_ratio, zero_leng
     than ``zero_length_ratio`` x ``scales`` at their first end (``scales``: the
     length scale of each vertex, ``geometry.vertex_length_scales``).
     """
-    lower = np.full(3, np.inf)
-    upper = np.full(3, -np.inf)
-    centre = np.zeros(3)
+    lower = np.empty(3)  # inf, -inf and zeros: numba's np.full and np.zeros compile more functions (issue 31)
+    upper = np.empty(3)
+    centre = np.empty(3)
+    for k in range(3):
+        lower[k], upper[k], centre[k] = np.inf, -np.inf, 0.0
     used = 0
     for v in range(vertices.shape[0]):
         if not referenced[v]:
@@ -33,10 +35,11 @@ def mesh_facts(vertices, faces, edges, referenced, scales, area_ratio, zero_leng
         for k in range(3):
             x = vertices[v, k]
             centre[k] += x
-            lower[k] = min(lower[k], x)
-            upper[k] = max(upper[k], x)
+            lower[k] = x if x < lower[k] else lower[k]  # min(lower[k], x): numba compiles min and max once per
+            upper[k] = x if x > upper[k] else upper[k]  # caller's options (issue 31)
     if used:
-        centre /= used
+        for k in range(3):  # not centre /= used: numba types and lowers the array operation as a ufunc
+            centre[k] /= used
     n_edges = edges.shape[0]
     total = 0.0
     n_zero_length = 0
@@ -65,10 +68,11 @@ def mesh_facts(vertices, faces, edges, referenced, scales, area_ratio, zero_leng
 def long_edges(vertices, edges, reach):
     """(E,) bool: the edges longer than the smaller ``reach`` of their two ends (the NumPy path of
     :func:`meshcurv.defects.needle_vertices`: the same squared lengths, x + y + z in that order)."""
-    out = np.empty(edges.shape[0], dtype=np.bool_)
+    out = np.empty(edges.shape[0], np.bool_)
     for e in range(edges.shape[0]):
         a, b = edges[e, 0], edges[e, 1]
         dx, dy, dz = vertices[b, 0] - vertices[a, 0], vertices[b, 1] - vertices[a, 1], vertices[b, 2] - vertices[a, 2]
-        r = min(reach[a], reach[b])
+        ra, rb = reach[a], reach[b]
+        r = rb if rb < ra else ra  # min(ra, rb)
         out[e] = dx * dx + dy * dy + dz * dz > r * r
     return out

@@ -99,8 +99,10 @@ def _normalize_chunk(lo, hi, summed, out):
 @nb.njit(**_JIT)
 def vertex_edge_lengths(vertices, edges, n_vertices):
     """``geometry.vertex_edge_lengths``: (V,) mean length of the edges at each vertex (NaN where none)."""
-    total = np.zeros(n_vertices)
-    count = np.zeros(n_vertices)
+    total = np.empty(n_vertices)
+    count = np.empty(n_vertices)
+    for v in range(n_vertices):  # zeros (numba's np.zeros compiles three functions more, issue 31)
+        total[v] = count[v] = 0.0
     for e in range(edges.shape[0]):
         length = _edge_length(vertices, edges[e, 0], edges[e, 1])
         for k in range(2):
@@ -166,8 +168,10 @@ def vertex_normal_and_area_sums(cross, faces, dropped, n_vertices):
     """``(sums, areas)``: (V, 3) the sums of the face cross products at each vertex and (V,) a third of the
     faces' areas, both over the faces not ``dropped``, in face order (as ``np.bincount``). One thread: a
     scatter bound by memory."""
-    sums = np.zeros((n_vertices, 3))
-    areas = np.zeros(n_vertices)
+    sums = np.empty((n_vertices, 3))
+    areas = np.empty(n_vertices)
+    for v in range(n_vertices):  # zeros (numba's np.zeros compiles three functions more, issue 31)
+        sums[v, 0] = sums[v, 1] = sums[v, 2] = areas[v] = 0.0
     for f in range(faces.shape[0]):
         if dropped[f]:
             continue

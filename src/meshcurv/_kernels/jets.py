@@ -83,23 +83,18 @@ def _cholesky_solve(a, b, low, m, min_spread, scale, total):
 
 
 @nb.njit(**_JIT_INNER)
-def _cholesky_solve_10(a, b, low, min_spread, scale, total):
-    """:func:`_cholesky_inline` of size 10 (the cubic jets of the normal fits): the loops' bounds are constants,
-    which the compiler unrolls (the same operations in the same order: the same numbers)."""
-    return _cholesky_inline(a, b, low, 10, min_spread, scale, total)
-
-
-@nb.njit(**_JIT_INNER)
-def _cholesky_solve_6(a, b, low, min_spread, scale, total):
-    """:func:`_cholesky_inline` of size 6 (the quadratic jets a cubic fit falls back to), unrolled as
-    :func:`_cholesky_solve_10`: half the compile time of :func:`_cholesky_solve` (0.7 against 1.2 CPU s), which
-    the fits of degree 3 or less then do not compile (:func:`_smaller_solve`)."""
+def _cholesky_solve_fixed(a, b, low, m, min_spread, scale, total):
+    """:func:`_cholesky_inline` of size 10 (the cubic jets of the normal fits) or 6 (the quadratic jets a cubic
+    fit falls back to; ``m`` is one of them): the loops' bounds are constants, which the compiler unrolls (the
+    same operations in the same order: the same numbers). One function for both sizes: one compilation."""
+    if m == 10:
+        return _cholesky_inline(a, b, low, 10, min_spread, scale, total)
     return _cholesky_inline(a, b, low, 6, min_spread, scale, total)
 
 
 def _smaller_solve(general, a, b, low, m, min_spread, scale, total):
-    """:func:`_fit_one`'s solve of the fits of ``m`` terms other than 10: :func:`_cholesky_solve_6` where
-    ``general`` is None (fits of degree 3 or less: ``m`` is 6), else :func:`_cholesky_solve`.
+    """:func:`_fit_one`'s solve of the fits of ``m`` terms: :func:`_cholesky_solve_fixed` where ``general`` is
+    None (fits of degree 3 or less: ``m`` is 10 or 6) or ``m`` is 10, else :func:`_cholesky_solve`.
 
     Compiled only (:func:`_smaller_solve_typed`).
     """
@@ -110,12 +105,14 @@ def _smaller_solve(general, a, b, low, m, min_spread, scale, total):
 def _smaller_solve_typed(general, a, b, low, m, min_spread, scale, total):
     if isinstance(general, types.NoneType):
 
-        def six(general, a, b, low, m, min_spread, scale, total):
-            return _cholesky_solve_6(a, b, low, min_spread, scale, total)
+        def fixed(general, a, b, low, m, min_spread, scale, total):
+            return _cholesky_solve_fixed(a, b, low, m, min_spread, scale, total)
 
-        return six
+        return fixed
 
     def any_size(general, a, b, low, m, min_spread, scale, total):
+        if m == 10:
+            return _cholesky_solve_fixed(a, b, low, m, min_spread, scale, total)
         return _cholesky_solve(a, b, low, m, min_spread, scale, total)
 
     return any_size
@@ -360,16 +357,19 @@ def _jet_outputs(rows):
     )
 
 
-@nb.njit(**_JIT_INNER)
+@nb.njit(inline="always", **_JIT)
 def _jet_scratch(degree, n_terms):
     """The buffers of :func:`_fit_one` (once per chunk of vertices, not per vertex):
     ``work, moments, right, matrix, low, scale, solution``. The moments and the
     right-hand side hold at least those of degree 3, which :func:`_cubic_jet_moments`
     writes for every fit of degree 3 or less. ``scale`` holds the scales of the
     monomials, then ``1 / C(i + k, i)`` for each exponent ``(i, k)`` (by total
-    degree, as ``jets._exponents``): the weights of :func:`_cholesky_solve`'s spread."""
+    degree, as ``jets._exponents``): the weights of :func:`_cholesky_solve`'s spread.
+
+    Inlined: its arrays are then allocated by its callers' own instances of ``np.empty``, which numba compiles
+    once per set of the caller's options (issue 31)."""
     work = np.empty((_JET_ROWS + 3 * (2 * degree + 1) + degree + 1, 64))
-    order = 2 * max(degree, 3) + 1
+    order = 2 * (3 if 3 > degree else degree) + 1  # max(degree, 3) (numba compiles max once per caller's options)
     scale = np.empty(2 * n_terms)
     t = n_terms
     for total in range(degree + 1):
@@ -382,7 +382,7 @@ def _jet_scratch(degree, n_terms):
     return (
         work,
         np.empty((order, order)),
-        np.empty(max(n_terms, 10)),
+        np.empty(10 if 10 > n_terms else n_terms),
         np.empty((n_terms, n_terms)),
         np.empty((n_terms, n_terms)),
         scale,
@@ -629,7 +629,8 @@ def _fit_one(
         y = (points[member, 1] - cy) * inverse
         z = (points[member, 2] - cz) * inverse
         ox[slot], oy[slot], oz[slot] = x, y, z
-        w = max(1.0 - (x * x + y * y + z * z), 0.0)
+        w = 1.0 - (x * x + y * y + z * z)
+        w = 0.0 if 0.0 > w else w  # max(w, 0.0)
         w = w * w
         if weighted:
             w = w * areas[ids[member]]
@@ -661,7 +662,8 @@ def _fit_one(
             if count < m:
                 continue
             for r in range(m):
-                scale[r] = 1.0 / math.sqrt(max(moments[2 * exponents[r, 0], 2 * exponents[r, 1]], _TINY))
+                even = moments[2 * exponents[r, 0], 2 * exponents[r, 1]]
+                scale[r] = 1.0 / math.sqrt(_TINY if _TINY > even else even)  # max(even, _TINY)
             for r in range(m):  # the lower triangle: all the Cholesky factorization reads
                 for c in range(r + 1):
                     matrix[r, c] = (
@@ -672,11 +674,7 @@ def _fit_one(
                         * scale[c]
                     )
                 solution[r] = right[r] * scale[r]
-            if (
-                _cholesky_solve_10(matrix, solution, low, min_spread, scale, moments[0, 0])
-                if m == 10
-                else _smaller_solve(general, matrix, solution, low, m, min_spread, scale, moments[0, 0])
-            ):
+            if _smaller_solve(general, matrix, solution, low, m, min_spread, scale, moments[0, 0]):
                 for r in range(6):
                     solution[r] = solution[r] * scale[r]
                 fitted = True
@@ -811,7 +809,9 @@ def _connected_chunk(
     (of ``fitted`` with ``normals_only``)."""
     n = vertices.shape[0]
     per_centre = radii.shape[0] > 1
-    mark = np.full(n, -1, np.int64)
+    mark = np.empty(n, np.int64)  # -1: np.full compiles two more functions (issue 31)
+    for k in range(n):
+        mark[k] = -1
     members = np.empty(n, np.int64)
     queue = np.empty(n, np.int64)
     work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])

@@ -532,8 +532,12 @@ def _face_sums_chunk(
     n = vertices.shape[0]
     n_values = values.shape[1]
     per_vertex = radii.shape[0] > 1
-    start = max(min(start, n), 0)
-    m = max(min(stop, n), start) - start
+    # start = max(min(start, n), 0), m = max(min(stop, n), start) - start: numba compiles min and max once per
+    # caller's options (issue 31)
+    start = n if n < start else start
+    start = 0 if 0 > start else start
+    stop = n if n < stop else stop
+    m = (start if start > stop else stop) - start
     all_seen, all_mark, all_known, all_squared, all_queue, _, _ = scratch
     n_chunks = all_seen.shape[0]
     for chunk in range(lo, hi):
@@ -574,8 +578,9 @@ def _face_sums_chunk(
                             squared[c] = (
                                 (vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2 + (vertices[c, 2] - cz) ** 2
                             )
-                        low = min(low, squared[c])
-                        high = max(high, squared[c])
+                        corner2 = squared[c]
+                        low = corner2 if corner2 < low else low  # min(low, corner2)
+                        high = corner2 if corner2 > high else high  # max(high, corner2)
                     if high <= radius2:
                         share = 1.0
                     elif low < radius2:
@@ -863,7 +868,8 @@ def _centres_chunk(lo, hi, vertices, cells, centres, reach):
         far = 0.0
         for k in range(corners):
             p = cells[c, k]
-            far = max(far, math.sqrt((vertices[p, 0] - x) ** 2 + (vertices[p, 1] - y) ** 2 + (vertices[p, 2] - z) ** 2))
+            length = math.sqrt((vertices[p, 0] - x) ** 2 + (vertices[p, 1] - y) ** 2 + (vertices[p, 2] - z) ** 2)
+            far = length if length > far else far  # max(far, length): numba compiles max once per caller's options
         centres[c, 0] = x
         centres[c, 1] = y
         centres[c, 2] = z

@@ -65,7 +65,8 @@ def _one_patch_volume(vertices, faces, flip):
         cx += vertices[a, 0]
         cy += vertices[a, 1]
         cz += vertices[a, 2]
-    weight = max(float(n_faces), 1.0)
+    weight = float(n_faces)
+    weight = 1.0 if 1.0 > weight else weight  # max(weight, 1.0): numba compiles max once per caller's options
     cx /= weight
     cy /= weight
     cz /= weight

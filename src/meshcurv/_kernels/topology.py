@@ -105,8 +105,11 @@ def build_topology(faces, n_vertices, template, with_twins):
     counts = np.empty(3 * n_faces, index)
     forward = np.empty(3 * n_faces, index)
     twins = np.empty(3 * n_faces if with_twins else 0, index)
-    corners = np.zeros(n_vertices if with_twins else 0, index)
-    first = np.full(n_vertices if with_twins else 0, -1, index)
+    corners = np.empty(n_vertices if with_twins else 0, index)  # zeros and -1, filled here: numba's np.zeros and
+    first = np.empty(n_vertices if with_twins else 0, index)  # np.full compile more functions (issue 31)
+    for v in range(corners.shape[0]):
+        corners[v] = 0
+        first[v] = -1
     n_edges = build_edges_into(
         faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins, corners, first
     )
@@ -157,7 +160,9 @@ def build_edges_into(
     """
     n_faces = faces.shape[0]
     with_twins = twins.shape[0] > 0
-    bucket_start = np.zeros(n_vertices + 1, template.dtype)
+    bucket_start = np.empty(n_vertices + 1, template.dtype)
+    for v in range(n_vertices + 1):  # zeros (numba's np.zeros compiles three functions more, issue 31)
+        bucket_start[v] = 0
     for f in range(n_faces):
         proper = faces[f, 0] != faces[f, 1] and faces[f, 1] != faces[f, 2] and faces[f, 2] != faces[f, 0]
         for k in range(3):
@@ -171,7 +176,7 @@ def build_edges_into(
                 elif first[a] == -1:
                     first[a] = -2
             if a != b:
-                bucket_start[min(a, b) + 1] += 1
+                bucket_start[(b if b < a else a) + 1] += 1  # min(a, b): numba compiles min once per caller's options
             else:  # a side from a vertex to itself: no edge
                 face_edges[3 * f + k] = -1
                 if with_twins:
@@ -180,17 +185,17 @@ def build_edges_into(
         bucket_start[v + 1] += bucket_start[v]
     n_sides = bucket_start[n_vertices]
     cursor = bucket_start[:-1].copy()
-    sort_key = np.empty(n_sides, template.dtype)  # 2 * larger vertex + backward
-    side_of = np.empty(n_sides, template.dtype)
+    sort_key = np.empty(np.int64(n_sides), template.dtype)  # 2 * larger vertex + backward (int64: the allocations
+    side_of = np.empty(np.int64(n_sides), template.dtype)  # of an int64 length, one compiled np.empty fewer, issue 31)
     for f in range(n_faces):
         for k in range(3):
             a = faces[f, k]
             b = faces[f, (k + 1) % 3]
             if a != b:
-                low = min(a, b)
+                low = b if b < a else a  # min(a, b)
                 slot = cursor[low]
                 cursor[low] += 1
-                sort_key[slot] = 2 * max(a, b) + (1 if a > b else 0)
+                sort_key[slot] = 2 * (b if b > a else a) + (1 if a > b else 0)  # max(a, b)
                 side_of[slot] = 3 * f + k
     e = -1
     for v in range(n_vertices):
@@ -447,7 +452,7 @@ def _union_edges(edges, n_vertices):
         a = _find(parent, _UNSIGNED(edges[e, 0]))
         b = _find(parent, _UNSIGNED(edges[e, 1]))
         if a != b:
-            parent[max(a, b)] = min(a, b)
+            parent[b if b > a else a] = b if b < a else a  # max(a, b), min(a, b)
     return parent
 
 
@@ -455,7 +460,9 @@ def _union_edges(edges, n_vertices):
 def component_labels(edges, referenced, n_vertices):
     """(V,) component of each vertex of the edge graph (0, 1, ... by first vertex; -1: unreferenced) and the count."""
     parent = _union_edges(edges, n_vertices)
-    labels = np.full(n_vertices, -1, np.int64)
+    labels = np.empty(n_vertices, np.int64)
+    for v in range(n_vertices):  # -1 (numba's np.full compiles two functions more, issue 31)
+        labels[v] = -1
     count = 0
     for v in range(n_vertices):
         if not referenced[v]:
@@ -476,7 +483,9 @@ def neighbour_lists(edges, n_vertices):
     list comes out in increasing order. One thread: two passes over the edges
     bound by memory (a parallel version read every edge once per thread).
     """
-    indptr = np.zeros(n_vertices + 1, np.int64)
+    indptr = np.empty(n_vertices + 1, np.int64)
+    for v in range(n_vertices + 1):  # zeros (numba's np.zeros compiles three functions more, issue 31)
+        indptr[v] = 0
     for e in range(edges.shape[0]):
         indptr[edges[e, 0] + 1] += 1
         indptr[edges[e, 1] + 1] += 1
