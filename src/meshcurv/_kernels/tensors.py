@@ -43,11 +43,13 @@ def _tangent_eigen(xx, yy, zz, xy, xz, yz, nx, ny, nz, rotate, mean_from_trace):
 @nb.njit(inline="always", **_JIT)
 def _principal_from_mean_gaussian(mean, gaussian):
     """``_tensors.principal_from_mean_gaussian`` of one vertex: ``k_min, k_max`` (the same operations)."""
-    size = max(abs(mean), math.sqrt(abs(gaussian)))
+    a, b = abs(mean), math.sqrt(abs(gaussian))
+    size = b if b > a else a  # max(a, b), written out: numba compiles its max once per caller's options
     exponent = math.frexp(size if math.isfinite(size) and size > 0 else 1.0)[1]
     scale = math.ldexp(1.0, exponent)
     h, k = mean / scale, gaussian / scale / scale
-    half = scale * math.sqrt(max(h * h - k, 0.0))
+    d = h * h - k
+    half = scale * math.sqrt(0.0 if 0.0 > d else d)  # max(d, 0.0)
     if not (math.isfinite(mean) and math.isfinite(gaussian)):
         half = math.nan
     return mean - half, mean + half
