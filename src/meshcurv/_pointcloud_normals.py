@@ -484,8 +484,16 @@ def local_spacing(distances: np.ndarray) -> np.ndarray:
     return distances[:, k - 1] * np.sqrt(np.pi / k)
 
 
+#: PCA normals are signed to face this direction (generic: no lattice normal is at right angles to it), on both
+#: backends alike. An eigenvector's sign is its solver's choice (the kernel's closed form and ``eigh`` differ), and
+#: the orientation's decisions on a noisy cloud depend on its input signs: seed 211 case 407 of
+#: ``benchmarks/fuzz_api.py`` (302 points, noise of a spacing, duplicates) oriented 24 normals apart.
+PCA_SIGN = np.array([1.0, np.sqrt(2.0), np.sqrt(3.0)]) / np.sqrt(6.0)
+
+
 def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
-    """(N, 3) unit normals (unoriented): the least-variance direction of each point and its neighbours.
+    """(N, 3) unit normals (unoriented: signed to face :data:`PCA_SIGN`): the least-variance direction of each point
+    and its neighbours.
 
     The compiled kernel (:func:`meshcurv._kernels.pointcloud.pca_normals`, a
     closed form) when the numba backend is in use, else :func:`numpy.linalg.eigh`
@@ -493,8 +501,10 @@ def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """
     kernels = numba_kernels("pointcloud")
     if kernels is not None:
-        return kernels.pca_normals(points, np.ascontiguousarray(indices))
-    return _pca_normals_numpy(points, indices)
+        normals = kernels.pca_normals(points, np.ascontiguousarray(indices))
+    else:
+        normals = _pca_normals_numpy(points, indices)
+    return normals * np.where(normals @ PCA_SIGN < 0, -1.0, 1.0)[:, None]
 
 
 def _pca_normals_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
