@@ -112,10 +112,10 @@ def assert_same(a, b, label: str) -> None:
         else:
             assert b.parameters[key] == value, f"{label}: {key}"
     # the largest |k| of the valid vertices (quadric refuses the balls that reach the other side of a thin part:
-    # few valid vertices there); 1 where none is valid. Not ``initial=1.0``: that made the unit at least 1, a
-    # tolerance 6 times looser than 1e-6 of |k|max on the voxel sphere of radius 6
+    # few valid vertices there); 1 where none is valid or all are flat. Not ``initial=1.0``: that made the unit
+    # at least 1, a tolerance 6 times looser than 1e-6 of |k|max on the voxel sphere of radius 6
     curvatures = np.abs(np.concatenate([a.k_min[a.valid], a.k_max[a.valid]]))
-    scale = float(np.nanmax(curvatures)) if curvatures.size else 1.0
+    scale = float(curvatures.max(initial=0.0)) or 1.0
     for field in ("k_min", "k_max", "mean", "gaussian"):
         got, expected = getattr(b, field), getattr(a, field)
         unit = scale * scale if field == "gaussian" else scale
