@@ -166,14 +166,10 @@ def test_a_voxel_surface_in_anisotropic_voxels_keeps_its_points():
     assert np.median(result.mean[result.valid]) == pytest.approx(np.median(mesh.mean[result.valid]), rel=0.15)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="R10's finding (fuzz_api.py seed 226 case 2901, a flattened random sphere): on an exactly flat cloud "
-    "_pointcloud_normals.outward_signs sums a flux of 0 (numba: exactly; NumPy: eigh's 1e-30 round-off), so the side "
-    "is the sign of round-off: -y compiled, +y NumPy on the plane y = 0 (z = 0 and x = 0 agree by chance)",
-)
 def test_a_flat_cloud_faces_one_way_on_both_backends():
-    # 2,000 random points of the plane y = 0: H = 0 on both backends, the normals +-y; one side on both
+    # 2,000 random points of the plane y = 0: H = 0 on both backends, the normals +-y; one side on both. R10's
+    # finding (fuzz_api.py seed 226 case 2901, a flattened random sphere): at f6f7892 -y compiled and +y NumPy (the
+    # PCA normals' signs apart, and outward_signs' flux 0 on a plane); fixed by 1fd4998 (PCA normals signed alike)
     g = np.random.default_rng(0).uniform(-1, 1, (2000, 2))
     points = np.c_[g[:, 0], np.zeros(2000), g[:, 1]]
     compiled = compute(points, "numba")
