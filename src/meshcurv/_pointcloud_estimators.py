@@ -108,11 +108,8 @@ BALL_TURN = 0.3
 #: Measures whose normal turns by more than this many radians over their ball (but at most :data:`BALL_TURN`) are
 #: checked too, against the same jets, but flagged only where none of them could be fitted on one side of the
 #: surface (down to half the radius): a part thinner than the ball, by whose rim the curvature grows a hundredfold
-#: within the ball (seed 143 case 818 of ``benchmarks/fuzz_api.py`` and clean 1 x 0.5 x 0.02 plates of 4,000
-#: points at their honest noise, balls of 3 spacings: points 0.88-0.94 of the way to the rim at turns of 0.12-0.19
-#: rad, H off by 0.50-0.83 of |k|). There a disagreement alone is no sign: under noise of 0.1-0.2 spacings the jets
-#: over such balls follow the noise (``benchmarks/pointcloud.py``: flagging it cost the noisy cylinder, saddle and
-#: flat ellipsoid 0.016-0.025 of cover, none of those points without a jet).
+#: within the ball. There a disagreement alone is no sign: under noise the jets over such balls follow the noise.
+#: Figures: ``benchmarks/pointcloud.md``, "a thin part read as noise".
 THIN_TURN = 0.1
 
 #: ... which must reproduce both principal curvatures within this share of |k| (as :func:`unsteady` compares):

@@ -486,8 +486,7 @@ def local_spacing(distances: np.ndarray) -> np.ndarray:
 
 #: PCA normals are signed to face this direction (generic: no lattice normal is at right angles to it), on both
 #: backends alike. An eigenvector's sign is its solver's choice (the kernel's closed form and ``eigh`` differ), and
-#: the orientation's decisions on a noisy cloud depend on its input signs: seed 211 case 407 of
-#: ``benchmarks/fuzz_api.py`` (302 points, noise of a spacing, duplicates) oriented 24 normals apart.
+#: the orientation's decisions on a noisy cloud depend on its input signs (``benchmarks/pointcloud.md``).
 PCA_SIGN = np.array([1.0, np.sqrt(2.0), np.sqrt(3.0)]) / np.sqrt(6.0)
 
 

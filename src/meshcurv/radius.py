@@ -945,9 +945,9 @@ def cloud_noise_level(points, normals, spacing, centres, usable, *, facing=None)
     ``centres`` are the usable points, of which at most :data:`CLOUD_NOISE_SAMPLE`, evenly spaced, are fitted.
     A ball holding points that face away from its centre (more than :data:`meshcurv.jets.AWAY_FRACTION` of it,
     the ``facing`` check of :func:`meshcurv.jets.fit_jets`: the other face of a part thinner than the ball, or
-    another part) is not fitted: a jet through both faces of a plate reads half its thickness as noise (seed 143
-    case 818 of ``benchmarks/fuzz_api.py``: 0.36 spacings on a clean plate 1.7 spacings thick, and a default radius
-    reaching the band by its rim).
+    another part) is not fitted: a jet through both faces of a plate reads half its thickness as noise, and the
+    radius that noise calls for reaches across the whole cloud (``benchmarks/pointcloud.md``, "a thin part read
+    as noise").
 
     Parameters
     ----------
