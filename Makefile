@@ -35,7 +35,7 @@ demo: $(DEMO_STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest
 
-# the suite without the tests marked slow (3 minutes on 2 cores at load 6-8, 1.8 minutes of CPU)
+# the suite without the tests marked slow (3 minutes on 2 cores, kernels cached)
 quick: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not slow"
 

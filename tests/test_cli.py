@@ -350,6 +350,7 @@ def png_size(path):
     return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
 
 
+@pytest.mark.slow  # 6 s: four pictures
 def test_plot_size_colour_map_limits_and_up(capsys, small_torus_file, tmp_path):
     pytest.importorskip("matplotlib")
     # --pixels: the width of the PNG, exactly; --dpi: (3.3 n + 1.2) x 4.2 inches for n views

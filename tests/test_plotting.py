@@ -38,6 +38,7 @@ def test_dpi_sets_the_size_of_the_picture(tmp_path):
     assert png_size(save_figure(fig, tmp_path / "override.png", dpi=40)) == (round(4.5 * 40), round(4.2 * 40))
 
 
+@pytest.mark.slow  # 3.5 s: pictures at several resolutions
 def test_the_view_images_follow_the_resolution():
     small = plot_field(TORUS.vertices, TORUS.faces, TORUS.mean, view="iso", dpi=50)
     large = plot_field(TORUS.vertices, TORUS.faces, TORUS.mean, view="iso", dpi=200)

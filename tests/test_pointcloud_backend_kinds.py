@@ -38,6 +38,9 @@ from test_backend_parity import assert_same
 
 pytest.importorskip("numba")
 
+# the two backends compared case by case (a minute or more per file): in make test (CI), not in make quick
+pytestmark = pytest.mark.slow
+
 
 def hemisphere(n: int, seed: int, noise: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """About ``n / 2`` random points of the unit sphere's upper half, moved radially by up to ``noise`` spacings;

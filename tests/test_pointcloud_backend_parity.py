@@ -37,6 +37,9 @@ from meshcurv.pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures
 
 pytest.importorskip("numba")
 
+# the two backends compared case by case (a minute or more per file): in make test (CI), not in make quick
+pytestmark = pytest.mark.slow
+
 #: Relative agreement of the two backends' curvatures and normals (of the largest |k|).
 RTOL = 1e-6
 
