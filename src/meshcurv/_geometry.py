@@ -240,7 +240,7 @@ def edge_dihedral_angles(
     n2 = unit_normals[faces[:, 1]]
     sine = np.einsum("ij,ij->i", np.cross(n1, n2), unit[usable_edges])
     cosine = np.einsum("ij,ij->i", n1, n2)
-    beta[usable_edges] = np.arctan2(sine, cosine)
+    beta[usable_edges] = np.arctan2(sine + 0.0, cosine)  # (+ 0.0: an exact fold, a sine of -0.0, reads pi)
     return beta, lengths, unit
 
 

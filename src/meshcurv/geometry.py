@@ -551,10 +551,11 @@ def edge_dihedral_angles(
     Returns
     -------
     beta : ndarray of shape (E,), float64
-        In radians, in ``[-pi, pi]``: positive where the surface is convex
+        In radians, in ``(-pi, pi]``: positive where the surface is convex
         across the edge on a consistently wound mesh (every edge of an
-        outward-wound sphere), negative where it is concave; 0 on edges that
-        are not usable.
+        outward-wound sphere), negative where it is concave; ``pi`` at an
+        exact fold (the two faces on each other, whatever the signs of the
+        zeros of their coordinates); 0 on edges that are not usable.
     lengths : ndarray of shape (E,), float64
         The edges' lengths.
     unit_edges : ndarray of shape (E, 3), float64

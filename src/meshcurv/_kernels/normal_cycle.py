@@ -79,7 +79,9 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, scale
             bx, by, bz = face_normals[f2, 0] / d2, face_normals[f2, 1] / d2, face_normals[f2, 2] / d2
             sine = (ay * bz - az * by) * ex + (az * bx - ax * bz) * ey + (ax * by - ay * bx) * ez
             cosine = ax * bx + ay * by + az * bz
-            weight = 0.5 * math.atan2(sine, cosine) * length
+            # + 0.0 turns a sine of -0.0 (an exact fold: the two faces on each other) into +0.0, so that the
+            # angle is pi as on the NumPy path (_geometry.edge_dihedral_angles), not -pi
+            weight = 0.5 * math.atan2(sine + 0.0, cosine) * length
             for v in (p, q):
                 if first <= v < last:
                     sums[v, 0] += weight * ex * ex
