@@ -932,8 +932,13 @@ CLOUD_RADIUS_RULES = {"corrected_measures": (3.0, 11.0), "jets": (3.0, 22.0)}
 #: A cloud's noise level is measured with degree-2 jets over balls of this many spacings ...
 CLOUD_NOISE_FIT_RADIUS = 3.0
 
-#: ... on at most this many points, evenly spaced in index order.
+#: ... on at most this many points, evenly spaced in index order ...
 CLOUD_NOISE_SAMPLE = 16384
+
+#: ... and is their median over the balls fitted on one side, when at least this many are (or half of the sample,
+#: when that is fewer); NaN otherwise: the few balls that noise leaves one-sided are no sample of the cloud
+#: (``benchmarks/pointcloud_diagnostics.md``).
+CLOUD_NOISE_LEAST_FITS = 10
 
 #: A default radius is at most this share of the cloud's extent (its bounding-box diagonal).
 CLOUD_EXTENT_CAP = 0.25
@@ -968,7 +973,9 @@ def cloud_noise_level(points, normals, spacing, centres, usable, *, facing=None)
     Returns
     -------
     float
-        0 when no jet could be fitted (every ball held the other side).
+        NaN when fewer than :data:`CLOUD_NOISE_LEAST_FITS` balls (or half of the sample) are fitted on one side:
+        no level is measured (noise of about a spacing or more, whose turned normals face away in every ball, or a
+        part thinner than the ball). 0 when ``spacing`` is 0.
 
     Raises
     ------
@@ -988,8 +995,9 @@ def cloud_noise_level(points, normals, spacing, centres, usable, *, facing=None)
     return _cloud_noise_level(points, normals, spacing, centres, usable, facing)
 
 
-def _cloud_noise_level(points, normals, spacing: float, centres, usable, facing) -> float:
-    """:func:`cloud_noise_level` of checked arrays."""
+def _cloud_noise_level(points, normals, spacing: float, centres, usable, facing, problems=None) -> float:
+    """:func:`cloud_noise_level` of checked arrays; where it is NaN, the note of the call is added to ``problems``
+    (a list)."""
     taken = np.linspace(0, centres.size - 1, min(centres.size, CLOUD_NOISE_SAMPLE)).round().astype(np.int64)
     sample = centres[taken]
     if spacing <= 0 or sample.size == 0:
@@ -1000,7 +1008,16 @@ def _cloud_noise_level(points, normals, spacing: float, centres, usable, facing)
     )
     heights = np.abs(coefficients[sample, 0]) * CLOUD_NOISE_FIT_RADIUS  # c00 is in units of the radius
     heights = heights[np.isfinite(heights)]
-    return float(np.median(heights)) if heights.size else 0.0
+    if heights.size and heights.size >= min(CLOUD_NOISE_LEAST_FITS, (sample.size + 1) // 2):
+        return float(np.median(heights))
+    if problems is not None:
+        problems.append(
+            f"the noise level was not measured (parameters['noise'] is NaN): {heights.size} of the {sample.size} "
+            f"balls of {CLOUD_NOISE_FIT_RADIUS:g} spacings sampled were fitted on one side, the others held points "
+            "facing the other way or too few (noise of about a spacing or more, which turns the normals, or a part "
+            "thinner than the ball); the default radius is that of a clean sample"
+        )
+    return np.nan
 
 
 def _checked_radii(radii) -> list[float]:
