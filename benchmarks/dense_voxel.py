@@ -74,6 +74,8 @@ PROFILED = (
     ("_kernels/jets.py", "fit_jets_connected", "  their kernel (walks, weights, moments, solves)"),
     ("/meshcurv/neighborhoods.py", "_ball_face_sums", "sums over balls, face by face (the pilot's; sparse balls)"),
     ("_kernels/neighborhoods.py", "connected_face_sums", "  their kernel"),
+    ("/icc.py", "_sampled_face_sums", "sums at a sample of the centres, the others interpolated (dense balls)"),
+    ("_kernels/pilot.py", "interpolated_normals", "  interpolations (the sampled fits' normals, the sampled sums)"),
     ("/meshcurv/neighborhoods.py", "_coarse_face_sums", "sums over balls on clusters of faces (main pass)"),
     ("/meshcurv/neighborhoods.py", "_face_clusters", "  clusters of faces (balls of 800 faces or more)"),
     ("_kernels/neighborhoods.py", "coarse_face_sums", "  their kernel"),

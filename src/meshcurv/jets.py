@@ -1108,23 +1108,31 @@ def interpolated_normals(
     tangent2: np.ndarray,
     reach: float,
     spread: float,
+    facing: np.ndarray | None = None,
+    sample_normals: np.ndarray | None = None,
+    agreement: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`sampled_jet_normals`' interpolation: ``(normals, reached)`` at the centres ``at`` (M, 3).
+    """:func:`sampled_jet_normals`' interpolation: ``(values, reached)`` at the centres ``at`` (M, 3).
 
-    Each centre takes the value at itself of a weighted linear least-squares fit of the ``fitted`` (S, 3) normals
-    of the ``samples`` (S, 3) within ``reach`` over its tangent plane ``(tangent1, tangent2)`` (M, 3), weights
-    ``(1 - d^2 / reach^2)^2``; where the weighted variances of the samples' two coordinates (in units of
-    ``reach``) multiplied do not exceed ``spread``, the weighted mean of their normals. Not normalised; NaN and
-    ``reached`` False where no sample is within ``reach``. The compiled twin
+    Each centre takes the value at itself of a weighted linear least-squares fit of the ``fitted`` (S, k) values
+    (unit normals, k = 3; or any fields: ``icc``'s sampled ball sums) of the ``samples`` (S, 3) within ``reach``
+    over its tangent plane ``(tangent1, tangent2)`` (M, 3), weights ``(1 - d^2 / reach^2)^2``; where the weighted
+    variances of the samples' two coordinates (in units of ``reach``) multiplied do not exceed ``spread``, the
+    weighted mean of their values. With ``facing`` (M, 3) and ``sample_normals`` (S, 3) unit normals, only the
+    samples whose normal's cosine with the centre's exceeds ``agreement`` count (the far side of a part thinner
+    than ``reach`` does not). Not normalised; NaN and ``reached`` False where no sample counts. The compiled twin
     (:func:`meshcurv._kernels.pilot.interpolated_normals`) finds the samples by cubes instead of k-d trees and
     solves by Cramer's rule: the results agree to round-off (``tests/test_jets_sampled.py``).
     """
     from scipy.spatial import cKDTree
 
-    m = at.shape[0]
-    out = np.full((m, 3), np.nan)
+    m, k = at.shape[0], fitted.shape[1]
+    out = np.full((m, k), np.nan)
     pairs = cKDTree(at).sparse_distance_matrix(cKDTree(samples), reach, output_type="coo_matrix")
     row, col = pairs.row.astype(np.int64), pairs.col.astype(np.int64)
+    if facing is not None and sample_normals is not None:
+        kept = np.einsum("ij,ij->i", facing[row], sample_normals[col]) > agreement
+        row, col = row[kept], col[kept]
     offsets = (samples[col] - at[row]) / reach
     weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
     basis = (
@@ -1133,11 +1141,12 @@ def interpolated_normals(
         np.einsum("ij,ij->i", offsets, tangent2[row]),
     )
     gram = np.zeros((m, 3, 3))
-    moments = np.zeros((m, 3, 3))
+    moments = np.zeros((m, 3, k))
     for a in range(3):
         weighted = weights * basis[a]
         for b in range(3):
             gram[:, a, b] = np.bincount(row, weights=weighted * basis[b], minlength=m)
+        for b in range(k):
             moments[:, a, b] = np.bincount(row, weights=weighted * fitted[col, b], minlength=m)
     total = gram[:, 0, 0]
     reached = total > 0

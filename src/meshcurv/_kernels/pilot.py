@@ -1,5 +1,6 @@
 """Compiled twin of the interpolation of :func:`meshcurv.jets.sampled_jet_normals`: each centre's normal from
-the fitted normals of the samples near it (dense voxel surfaces, issue 30).
+the fitted normals of the samples near it, or any field from its samples' values (the sampled ball sums of
+``icc``; dense voxel surfaces, issue 30).
 """
 
 from __future__ import annotations
@@ -15,12 +16,34 @@ _TOP = (1 << _BITS) - 1
 
 
 @nb.njit(**_JIT)
-def _interpolate_chunk(lo, hi, at, cubes, keys, order, samples, fitted, t1, t2, reach, spread, out, reached):
+def _interpolate_chunk(
+    lo,
+    hi,
+    at,
+    cubes,
+    keys,
+    order,
+    samples,
+    fitted,
+    t1,
+    t2,
+    facing,
+    sample_normals,
+    agreement,
+    reach,
+    spread,
+    out,
+    reached,
+):
     """Rows ``lo..hi`` of :func:`interpolated_normals` (``cubes``: (M, 3) the centres' cubes of side ``reach``;
-    ``keys``, ``order``: the samples' cube keys, sorted, and their rows)."""
+    ``keys``, ``order``: the samples' cube keys, sorted, and their rows; ``facing`` (M, 3) or (0, 3): without
+    rows, every sample in reach counts)."""
+    k = fitted.shape[1]
+    moments = np.zeros((3, k))
+    check = facing.shape[0] > 0
     for i in range(lo, hi):
         g00 = g01 = g02 = g11 = g12 = g22 = 0.0
-        m00 = m01 = m02 = m10 = m11 = m12 = m20 = m21 = m22 = 0.0
+        moments[:, :] = 0.0
         ax, ay, az = at[i, 0], at[i, 1], at[i, 2]
         ux, uy, uz = t1[i, 0], t1[i, 1], t1[i, 2]
         vx, vy, vz = t2[i, 0], t2[i, 1], t2[i, 2]
@@ -42,6 +65,13 @@ def _interpolate_chunk(lo, hi, at, cubes, keys, order, samples, fitted, t1, t2, 
                         if keys[p] != key:
                             break
                         s = order[p]
+                        if check and not (
+                            facing[i, 0] * sample_normals[s, 0]
+                            + facing[i, 1] * sample_normals[s, 1]
+                            + facing[i, 2] * sample_normals[s, 2]
+                            > agreement
+                        ):
+                            continue
                         ox = (samples[s, 0] - ax) / reach
                         oy = (samples[s, 1] - ay) / reach
                         oz = (samples[s, 2] - az) / reach
@@ -58,19 +88,14 @@ def _interpolate_chunk(lo, hi, at, cubes, keys, order, samples, fitted, t1, t2, 
                         g11 += w1 * b1
                         g12 += w1 * b2
                         g22 += w2 * b2
-                        fx, fy, fz = fitted[s, 0], fitted[s, 1], fitted[s, 2]
-                        m00 += w * fx
-                        m01 += w * fy
-                        m02 += w * fz
-                        m10 += w1 * fx
-                        m11 += w1 * fy
-                        m12 += w1 * fz
-                        m20 += w2 * fx
-                        m21 += w2 * fy
-                        m22 += w2 * fz
+                        for c in range(k):
+                            f = fitted[s, c]
+                            moments[0, c] += w * f
+                            moments[1, c] += w1 * f
+                            moments[2, c] += w2 * f
         if not g00 > 0.0:
             reached[i] = False
-            out[i, 0] = out[i, 1] = out[i, 2] = np.nan
+            out[i, :] = np.nan
             continue
         reached[i] = True
         # the cofactors of the first column of the symmetric gram matrix: its determinant and, by Cramer's rule,
@@ -80,32 +105,37 @@ def _interpolate_chunk(lo, hi, at, cubes, keys, order, samples, fitted, t1, t2, 
         c2 = g01 * g12 - g02 * g11
         det = g00 * c0 + g01 * c1 + g02 * c2
         if det > spread * g00 * g00 * g00:
-            nx = (m00 * c0 + m10 * c1 + m20 * c2) / det
-            ny = (m01 * c0 + m11 * c1 + m21 * c2) / det
-            nz = (m02 * c0 + m12 * c1 + m22 * c2) / det
+            for c in range(k):
+                out[i, c] = (moments[0, c] * c0 + moments[1, c] * c1 + moments[2, c] * c2) / det
         else:
-            nx, ny, nz = m00 / g00, m01 / g00, m02 / g00
-        out[i, 0], out[i, 1], out[i, 2] = nx, ny, nz  # normalised by the caller, as the twin's
+            for c in range(k):
+                out[i, c] = moments[0, c] / g00  # (normals: normalised by the caller, as the twin's)
 
 
 @threaded
-def interpolated_normals(at, samples, fitted, tangent1, tangent2, reach, spread):
-    """``jets.interpolated_normals``: ``(normals, reached)`` of the centres ``at`` (M, 3) from the ``fitted`` (S, 3)
-    unit normals of the ``samples`` (S, 3) within ``reach``.
+def interpolated_normals(
+    at, samples, fitted, tangent1, tangent2, reach, spread, facing=None, sample_normals=None, agreement=0.0
+):
+    """``jets.interpolated_normals``: ``(values, reached)`` of the centres ``at`` (M, 3) from the ``fitted`` (S, k)
+    values of the ``samples`` (S, 3) within ``reach`` (unit normals, k = 3; or any fields).
 
     The samples are found by cubes of side ``reach`` (a sorted int64 key each, 21 bits a coordinate; the 27
     cubes around each centre), each weighted ``(1 - d^2 / reach^2)^2``; the 3 x 3 weighted least-squares system
     over the tangent plane ``(tangent1, tangent2)`` is solved by Cramer's rule (the NumPy twin: LAPACK), its
-    determinant against ``spread`` as the twin's. The sums run in another order than the twin's bincounts: the
-    results agree to round-off. Not normalised; NaN and ``reached`` False where no sample is within ``reach``.
-    Rows on threads (:func:`~meshcurv._kernels._common.run_chunks`).
+    determinant against ``spread`` as the twin's. With ``facing`` (M, 3) and ``sample_normals`` (S, 3), only the
+    samples whose normal's cosine with the centre's exceeds ``agreement`` count. The sums run in
+    another order than the twin's bincounts: the results agree to round-off. Not normalised; NaN and ``reached``
+    False where no sample is within ``reach``. Rows on threads (:func:`~meshcurv._kernels._common.run_chunks`).
     """
     at = np.ascontiguousarray(at, dtype=np.float64)
     samples = np.ascontiguousarray(samples, dtype=np.float64)
+    fitted = np.ascontiguousarray(fitted, dtype=np.float64)
     m = at.shape[0]
-    out, reached = np.empty((m, 3)), np.empty(m, dtype=np.bool_)
+    out, reached = np.full((m, fitted.shape[1]), np.nan), np.zeros(m, dtype=np.bool_)
     if m == 0:
         return out, reached
+    if facing is None or sample_normals is None:
+        facing = sample_normals = np.zeros((0, 3))
     corner = np.minimum(at.min(axis=0), samples.min(axis=0)) if samples.shape[0] else at.min(axis=0)
     cubes = np.minimum(np.floor((at - corner) / reach), 2.0**20).astype(np.int64)
     of_samples = np.minimum(np.floor((samples - corner) / reach), 2.0**20).astype(np.int64)
@@ -120,9 +150,12 @@ def interpolated_normals(at, samples, fitted, tangent1, tangent2, reach, spread)
         np.ascontiguousarray(keys[order]),
         order.astype(np.int64),
         samples,
-        np.ascontiguousarray(fitted, dtype=np.float64),
+        fitted,
         np.ascontiguousarray(tangent1, dtype=np.float64),
         np.ascontiguousarray(tangent2, dtype=np.float64),
+        np.ascontiguousarray(facing, dtype=np.float64),
+        np.ascontiguousarray(sample_normals, dtype=np.float64),
+        float(agreement),
         float(reach),
         float(spread),
         out,

@@ -31,12 +31,15 @@ pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
 ``2 sqrt(h_v R)`` for the voxel extent ``h_v`` along its normal, capped where
 the surface bends fast; ``parameters["scale"] == "voxel"``); the pilot runs at
 about half of the vertices (:func:`voxel_pilot`; in anisotropic voxels its normals
-are fitted on a coarse level too, :func:`_pilot_normals`), and where the balls of such a
-surface hold 800 faces or more (fine voxels), each ball is summed on clusters
-of about 16 faces, the clusters on its rim by their share of the ball
-(:func:`meshcurv.neighborhoods.coarse_face_sums`: the cost of a ball no longer
-grows with the density of its faces; on a marching-cubes sphere of radius 6 at
-0.5 x 0.2 x 0.2 the median H error moves from 0.30 to 0.32%).
+are fitted on a coarse level too, and its sums taken at a sample of its centres,
+:func:`_pilot_normals`, :func:`_sampled_face_sums`).
+Where the balls of such a surface are wider than 8 median edges (fine voxels),
+the balls are summed at one vertex per cube of half the radius and their
+curvatures interpolated at the others (:func:`_sampled_face_sums`), and
+elsewhere on a voxel surface each ball is summed on clusters of about 32 faces,
+the clusters on its rim by their share of the ball
+(:func:`meshcurv.neighborhoods.coarse_face_sums`): the cost of a vertex no
+longer grows with the density of the faces (``benchmarks/dense_voxel.md``).
 
 The normals ``u_i`` are interpolated linearly over each triangle; the
 curvature measures ``mu_0`` (corrected area), ``mu_1`` (2H dA), ``mu_2`` (K dA)
@@ -85,12 +88,17 @@ from __future__ import annotations
 import numpy as np
 
 from .._geometry import median_edge_length
+from .._backend import numba_kernels
+from .._tensors import tangent_basis
 from ..jets import (
     NORMAL_MIN_SPREAD,
+    SAMPLED_SPREAD,
     SETTLED_SLOPE,
+    _cube_samples,
     _fit_jet_normals,
     _fit_jets,
     _sampled_jet_normals,
+    interpolated_normals,
     jet_normals,
     nested_jet_normals,
 )
@@ -172,6 +180,8 @@ def fitted_normals(
     weighted: bool = False,
     failed: np.ndarray | None = None,
     fits: np.ndarray | None = None,
+    edge: float | None = None,
+    spacing: float | None = None,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -191,6 +201,9 @@ def fitted_normals(
     describes neither. ``adjacency``: the mesh's edge lists, so that each ball
     is its surface-connected piece (:func:`meshcurv.jets.fit_jets`).
 
+    ``edge``: the median edge length of :func:`_sampled_edge`, when the caller has it. ``spacing``: the sampled
+    fits' on a coarse level, in median radii (default: :data:`meshcurv.jets.SAMPLED_SPACING`).
+
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
     more densely does not outweigh its neighbour). Where the balls are wider
@@ -206,7 +219,7 @@ def fitted_normals(
         positive = areas[areas > 0]
         areas = areas / np.median(positive) if positive.size else None
     if areas is not None and adjacency is not None:
-        coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency)
+        coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency, edge=edge)
     if coarse is not None:
         points, point_normals, allowed, lists, point_areas = coarse
         fitted = _sampled_jet_normals(
@@ -216,6 +229,7 @@ def fitted_normals(
             degree=NORMAL_DEGREE,
             iterations=NORMAL_ITERATIONS,
             centres=np.arange(vertices.shape[0]),
+            spacing=None if spacing is None else spacing * float(np.median(radius)),
             neighbours=allowed,
             adjacency=lists,
             settled=NORMAL_SETTLED,
@@ -244,7 +258,9 @@ def fitted_normals(
     return np.where(usable[:, None], fitted, normals)
 
 
-def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, edges=None, cells=None, shift=0.0):
+def _coarse_level(
+    vertices, normals, radius, areas, neighbours, adjacency, *, edges=None, cells=None, shift=0.0, edge=None
+):
     """The points of the normal fits of a dense surface: clusters of vertices, or None for an ordinary mesh.
 
     Used when the median ``radius`` exceeds ``edges`` (default :data:`COARSE_EDGES`) median edge lengths. The
@@ -264,7 +280,7 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, ed
         return None
     typical = float(np.median(radius))
     indptr, indices = adjacency
-    if not _dense(vertices, typical, adjacency, edges=edges):
+    if not _dense(vertices, typical, adjacency, edges=edges, edge=edge):
         return None
     tails = np.repeat(np.arange(n), np.diff(indptr))
     cell = typical / (COARSE_CELLS if cells is None else cells)
@@ -321,11 +337,15 @@ def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
     return np.column_stack([key // n, key % n])
 
 
-def _dense(vertices: np.ndarray, radius: float, adjacency: tuple, *, edges: float | None = None) -> bool:
+def _dense(
+    vertices: np.ndarray, radius: float, adjacency: tuple, *, edges: float | None = None, edge: float | None = None
+) -> bool:
     """Whether normal fits over ``radius`` run on the coarse level: wider than ``edges`` (default
-    :data:`COARSE_EDGES`) median edge lengths (taken over :data:`COARSE_SAMPLE` edges of the CSR lists
-    ``adjacency``)."""
-    return bool(radius > (COARSE_EDGES if edges is None else edges) * _sampled_edge(vertices, adjacency))
+    :data:`COARSE_EDGES`) median edge lengths (``edge``, or taken over :data:`COARSE_SAMPLE` edges of the CSR
+    lists ``adjacency``: :func:`_sampled_edge`)."""
+    if edge is None:
+        edge = _sampled_edge(vertices, adjacency)
+    return bool(radius > (COARSE_EDGES if edges is None else edges) * edge)
 
 
 def _sampled_edge(vertices: np.ndarray, adjacency: tuple) -> float:
@@ -334,9 +354,12 @@ def _sampled_edge(vertices: np.ndarray, adjacency: tuple) -> float:
     indptr, indices = adjacency
     if indices.size == 0:
         return np.inf
-    taken = np.linspace(0, indices.size - 1, min(indices.size, COARSE_SAMPLE)).round().astype(np.int64)
-    tails = np.searchsorted(indptr, taken, side="right") - 1
-    lengths = np.linalg.norm(vertices[indices[taken]] - vertices[tails], axis=1)
+    if indices.size <= COARSE_SAMPLE:  # every edge (the sample's own order: the same median)
+        heads, tails = indices, np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
+    else:
+        taken = np.linspace(0, indices.size - 1, COARSE_SAMPLE).round().astype(np.int64)
+        heads, tails = indices[taken], np.searchsorted(indptr, taken, side="right") - 1
+    lengths = np.linalg.norm(vertices[heads] - vertices[tails], axis=1)
     return float(np.median(lengths))
 
 
@@ -356,7 +379,8 @@ def voxel_pilot(mesh: PreparedMesh):
         valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
         centres = _pilot_centres(vertices, topology, valid)
-        fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres)
+        edge = _sampled_edge(vertices, _adjacency(topology))
+        fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres, edge=edge)
         with np.errstate(invalid="ignore"):
             agree = np.isfinite(fitted).all(axis=1) & (np.einsum("ij,ij->i", fitted, start[centres]) > NORMAL_AGREEMENT)
         normals = _spread_normals(
@@ -364,15 +388,16 @@ def voxel_pilot(mesh: PreparedMesh):
         )
         normals[centres[~agree]] = mesh.vertex_normals[centres[~agree]]
         measures = face_measures(vertices, topology.faces, normals)
-        summed = _ball_face_sums(
-            vertices,
-            topology.faces,
-            radius,
-            measures,
-            usable=_usable_faces(topology.faces, _dropped(mesh), normals),
-            connected=True,
-            centres=centres,
-        )
+        usable = _usable_faces(topology.faces, _dropped(mesh), normals)
+        if radius > PILOT_SUM_EDGES * edge and np.isfinite(normals[centres]).all():  # anisotropic voxels
+            radii = np.full(vertices.shape[0], radius)
+            summed = _sampled_face_sums(
+                vertices, topology.faces, radii, measures, usable, normals, centres, PILOT_SUM_SPACING * radius
+            )
+        else:
+            summed = _ball_face_sums(
+                vertices, topology.faces, radius, measures, usable=usable, connected=True, centres=centres
+            )
         k_min = np.full(vertices.shape[0], np.nan)
         k_max = np.full(vertices.shape[0], np.nan)
         k_min[centres], k_max[centres], _, _ = curvatures_from_measures(summed, normals[centres])
@@ -381,11 +406,13 @@ def voxel_pilot(mesh: PreparedMesh):
     return run
 
 
-def _pilot_normals(mesh: PreparedMesh, start: np.ndarray, radius: float, centres: np.ndarray) -> np.ndarray:
+def _pilot_normals(
+    mesh: PreparedMesh, start: np.ndarray, radius: float, centres: np.ndarray, *, edge: float | None = None
+) -> np.ndarray:
     """(M, 3) the jet normals of :func:`voxel_pilot` at ``centres`` over balls of ``radius`` (``start``: the
     first frames): fitted on a coarse level of the surface (:func:`_coarse_level`, cubes of ``radius /``
     :data:`PILOT_COARSE_CELLS`) where ``radius`` exceeds :data:`PILOT_COARSE_EDGES` median edge lengths, else
-    over the vertices."""
+    over the vertices (``edge``: :func:`_sampled_edge`, when given)."""
     vertices, topology = mesh.vertices, mesh.topology
     adjacency = _adjacency(topology)
     areas = _vertex_areas(mesh)
@@ -401,6 +428,7 @@ def _pilot_normals(mesh: PreparedMesh, start: np.ndarray, radius: float, centres
             edges=PILOT_COARSE_EDGES,
             cells=PILOT_COARSE_CELLS,
             shift=1.0 / np.pi,  # the radius is a multiple of the voxel size: no cube boundary through the lattice
+            edge=edge,
         )
         if positive.size
         else None
@@ -433,6 +461,13 @@ PILOT_COARSE_EDGES = 8.0
 #: the vertices), their normals as close to the sphere's; on the 8 meshes of ``benchmarks/accuracy_voxel.md``
 #: that take it (anisotropic voxels) the median H error moves by -4.6 to +4.0% of itself (5 cells: -8.3 to +6.6%).
 PILOT_COARSE_CELLS = 7.0
+
+#: The pilot's balls wider than this many median edge lengths (anisotropic voxels; isotropic ones are about 2
+#: edges wide and keep the sums at every centre) are summed at one of its centres per cube of ...
+PILOT_SUM_EDGES = 3.0
+#: ... this share of its radius and interpolated at the other centres (:func:`_sampled_face_sums`; the spacing
+#: and its alternatives measured in ``benchmarks/dense_voxel.md``).
+PILOT_SUM_SPACING = 0.6
 
 #: The pilot of a voxel surface (:func:`voxel_pilot`) fits and sums at one vertex per cube of this many
 #: median edge lengths (45% of the vertices of a marching-cubes sphere; its values are only read through
@@ -510,6 +545,62 @@ def _dropped(mesh: PreparedMesh) -> np.ndarray:
     return mesh.degenerate if needle is None else mesh.degenerate | needle
 
 
+#: A voxel surface's main normal fits on a coarse level run at one vertex per cube of this many median radii of
+#: the fits (other meshes: :data:`meshcurv.jets.SAMPLED_SPACING`): the sampled sums below average the jitter of
+#: sparser fits over half a measure radius (``benchmarks/dense_voxel.md``).
+VOXEL_FIT_SPACING = 0.15
+
+#: The balls of a voxel surface's main pass wider than this many median edge lengths (dense voxels, such as
+#: those of ``benchmarks/dense_voxel.py``) are summed at a sample of the vertices and interpolated at the others
+#: (:func:`_sampled_face_sums`) ...
+SAMPLED_SUM_EDGES = 8.0
+#: ... one vertex per cube of this share of the median radius ...
+SUM_SPACING = 0.5
+#: ... interpolated from the samples within this many spacings whose normals agree with the vertex's (cosine
+#: above NORMAL_AGREEMENT: the far side of a part thinner than the reach does not count).
+SUM_WIDTH = 1.5
+
+
+def _sampled_face_sums(vertices, faces, radius, values, usable, normals, centres, spacing) -> np.ndarray:
+    """(M, k) the sums over the balls of ``radius`` (V,) at the ``centres`` (M,) (distinct vertices with finite
+    ``normals``): summed at one centre per cube of side ``spacing`` (:func:`meshcurv.jets._cube_samples`) and
+    interpolated at the other centres.
+
+    A sample's sums divided by its corrected area ``mu_0`` (its H, K and shape operator) vary smoothly with the
+    centre of a ball of hundreds of faces; each other centre takes the value at itself of their weighted linear
+    least-squares fit over its tangent plane (:func:`meshcurv.jets.interpolated_normals`: the samples within
+    :data:`SUM_WIDTH` spacings whose normals agree with its own), with a corrected area of 1 (the curvatures
+    are ratios to it). A centre without such a sample is summed over its own ball. The sums then cost the
+    number of samples, not of centres."""
+    sampled = _cube_samples(vertices[centres], spacing)
+    others = np.setdiff1d(np.arange(centres.size), sampled, assume_unique=True)
+    at, facing = vertices[centres[others]], np.ascontiguousarray(normals[centres[others]])
+    t1, t2 = tangent_basis(facing)
+    kernels = numba_kernels("pilot")
+    interpolate = interpolated_normals if kernels is None else kernels.interpolated_normals
+
+    def interpolated(known: np.ndarray, fields: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        reach = SUM_WIDTH * spacing
+        known = centres[known]
+        return interpolate(
+            at, vertices[known], fields, t1, t2, reach, SAMPLED_SPREAD, facing, normals[known], NORMAL_AGREEMENT
+        )
+
+    # the centres without a sample in reach (the positions and normals decide) are summed with the samples
+    _, reached = interpolated(sampled, np.zeros((sampled.size, 1)))
+    exact = np.union1d(sampled, others[~reached])
+    summed = np.zeros((centres.size, values.shape[1]))
+    summed[exact] = _ball_face_sums(
+        vertices, faces, radius, values, usable=usable, connected=True, centres=centres[exact]
+    )
+    known = sampled[summed[sampled, 0] > 0]
+    ratios, reached = interpolated(known, summed[known, 1:] / summed[known, :1])
+    # (a centre that only a sample of no corrected area reached is left at 0: undefined, as that sample)
+    summed[others[reached], 0] = 1.0
+    summed[others[reached], 1:] = ratios[reached]
+    return summed
+
+
 def _adjacency(topology: MeshTopology) -> tuple:
     """The edge lists the ball searches walk (both backends: the surface-connected balls)."""
     return topology.neighbour_lists
@@ -557,6 +648,8 @@ def _curvatures(
 
     start("fit normals")
     failed = np.zeros(vertices.shape[0], dtype=bool)
+    # the median edge that decides the coarse levels and the sampled sums of a voxel surface, taken once
+    edge = _sampled_edge(vertices, adjacency) if coarse and adjacency is not None else None
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
@@ -570,6 +663,8 @@ def _curvatures(
             areas=areas,
             weighted=weighted,
             failed=failed,
+            edge=edge,
+            spacing=VOXEL_FIT_SPACING if coarse else None,
         )
 
     start("compute face measures")
@@ -577,7 +672,16 @@ def _curvatures(
 
     start("sum over balls")
     usable = _usable_faces(faces, degenerate, normals)
-    if coarse:
+    typical = float(np.median(radius))
+    if edge is not None and typical > SAMPLED_SUM_EDGES * edge:
+        inside = np.ones(vertices.shape[0], dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
+        members = np.flatnonzero(inside & np.isfinite(normals).all(axis=1))
+        radii = np.broadcast_to(np.asarray(radius, dtype=np.float64), (vertices.shape[0],))
+        summed = np.zeros((vertices.shape[0], measures.shape[1]))
+        summed[members] = _sampled_face_sums(
+            vertices, faces, radii, measures, usable, normals, members, SUM_SPACING * typical
+        )
+    elif coarse:
         summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
         summed = _ball_face_sums(vertices, faces, radius, measures, usable=usable, connected=True)
