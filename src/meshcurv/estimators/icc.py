@@ -31,8 +31,8 @@ pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
 ``2 sqrt(h_v R)`` for the voxel extent ``h_v`` along its normal, capped where
 the surface bends fast; ``parameters["scale"] == "voxel"``); the pilot runs at
 about half of the vertices (:func:`voxel_pilot`; in anisotropic voxels its normals
-are fitted on a coarse level too, and its sums taken at a sample of its centres,
-:func:`_pilot_normals`, :func:`_sampled_face_sums`).
+are fitted on a coarse level too, at about one of its centres in two, and its sums
+taken at a sample of its centres, :func:`_pilot_normals`, :func:`_sampled_face_sums`).
 Where the balls of such a surface are wider than 8 median edges (fine voxels),
 the balls are summed at one vertex per cube of half the radius and their
 curvatures interpolated at the others (:func:`_sampled_face_sums`), and
@@ -411,8 +411,10 @@ def _pilot_normals(
 ) -> np.ndarray:
     """(M, 3) the jet normals of :func:`voxel_pilot` at ``centres`` over balls of ``radius`` (``start``: the
     first frames): fitted on a coarse level of the surface (:func:`_coarse_level`, cubes of ``radius /``
-    :data:`PILOT_COARSE_CELLS`) where ``radius`` exceeds :data:`PILOT_COARSE_EDGES` median edge lengths, else
-    over the vertices (``edge``: :func:`_sampled_edge`, when given)."""
+    :data:`PILOT_COARSE_CELLS`) where ``radius`` exceeds :data:`PILOT_COARSE_EDGES` median edge lengths, there
+    at one centre per cube of :data:`PILOT_SAMPLE_EDGES` median edges (``edge``: :func:`_sampled_edge`, when
+    given) and interpolated at the others (:func:`meshcurv.jets.sampled_jet_normals`); else over the vertices
+    at every centre."""
     vertices, topology = mesh.vertices, mesh.topology
     adjacency = _adjacency(topology)
     areas = _vertex_areas(mesh)
@@ -436,6 +438,21 @@ def _pilot_normals(
     points, normals, allowed, weights = vertices, start, topology.referenced_vertices, None
     if coarse is not None:
         points, normals, allowed, adjacency, weights = coarse
+        if edge is not None and edge > 0:  # (else edges of length zero: every centre fitted)
+            return _sampled_jet_normals(
+                points,
+                normals,
+                radius,
+                centres=centres,
+                spacing=PILOT_SAMPLE_EDGES * edge,
+                degree=NORMAL_DEGREE,
+                iterations=NORMAL_ITERATIONS,
+                neighbours=allowed,
+                adjacency=adjacency,
+                settled=NORMAL_SETTLED,
+                min_spread=NORMAL_MIN_SPREAD,
+                areas=weights,
+            )
     coefficients, frame, _ = _fit_jets(
         points,
         normals,
@@ -461,6 +478,12 @@ PILOT_COARSE_EDGES = 8.0
 #: the vertices), their normals as close to the sphere's; on the 8 meshes of ``benchmarks/accuracy_voxel.md``
 #: that take it (anisotropic voxels) the median H error moves by -4.6 to +4.0% of itself (5 cells: -8.3 to +6.6%).
 PILOT_COARSE_CELLS = 7.0
+#: ... at one centre per cube of this many median edge lengths (:func:`meshcurv.jets.sampled_jet_normals`), the
+#: other centres interpolated from them over their tangent planes. The margin is thin: 1.8 and 2 edges fold the
+#: Gauss image of an anisotropic torus (``tests/test_statistics.py::test_folded_gauss_image_is_flagged``;
+#: ``benchmarks/dense_voxel.md``). Its other vertices keep the normals of the centres one or two rings away
+#: (:func:`_spread_normals`).
+PILOT_SAMPLE_EDGES = 1.6
 
 #: The pilot's balls wider than this many median edge lengths (anisotropic voxels; isotropic ones are about 2
 #: edges wide and keep the sums at every centre) are summed at one of its centres per cube of ...
