@@ -601,15 +601,20 @@ def _with_twins(case, rng):
             return case
         method = kwargs.get("method")
         kwargs = {"method": method} if isinstance(method, str) and method in METHODS else {}  # the slip alone
-        choices = ["faces alone"]
+        # float faces alone cannot be told from a lattice's vertices: the hint is for integer faces only
+        choices = ["faces alone"] if np.issubdtype(f.dtype, np.integer) else []
         if all(np.unique(row).size < row.size for row in f.T):  # else three polygons (documented)
             choices.append("faces transposed")
         if v.ndim == 2 and v.shape[1] == 3 and np.isfinite(v).all() and (v != np.round(v)).any():
             choices.append("vertices and faces swapped")
+        if not choices:
+            return case
         misuse = choices[int(rng.integers(len(choices)))]
         args = {"faces transposed": (v, f.T), "vertices and faces swapped": (f, v), "faces alone": (f,)}[misuse]
         return target, args, kwargs, labels + [f"misuse {misuse}"], ("misuse", (misuse, (v, f)))
-    if roll < BACKEND_SHARE + OBJECT_SHARE and all(_plain(a) for a in args):
+    # (float faces: a mesh object casts them to integers, which the arrays must not be; not a relation)
+    whole_faces = target != "principal_curvatures" or (len(args) > 1 and getattr(args[1], "dtype", None) == np.int64)
+    if roll < BACKEND_SHARE + OBJECT_SHARE and all(_plain(a) for a in args) and whole_faces:
         if target == "principal_curvatures":
             obj, label = _mesh_object(rng, *args)
         else:
@@ -821,6 +826,10 @@ def _mask(rng, n):
 #: ``--point-clouds``: every case calls point_cloud_curvatures (set by main).
 ONLY_POINT_CLOUDS = False
 
+#: Registration errors of near copies (``make_cloud_case``), in spacings: above the merge's round-off gap
+#: (``pointcloud.COPY_GAP``, 1e-3 of the next neighbour's distance) and below a noise the fits must cope with.
+REGISTRATION_SHIFTS = (0.002, 0.01, 0.05)
+
 #: A valid point of an analytic cloud is a lie when its mean curvature is off by more than this share of the
 #: largest exact |k| there (a sign error is off by 200%, a ball through both sides of a thin part by 100%).
 CLOUD_TRUTH_TOLERANCE = 0.5
@@ -901,9 +910,25 @@ def make_cloud_case(rng):
     if copies > 1:
         jitter = float(rng.choice([1e-15, 1e-13, 1e-11, 1e-9]))
         scale = np.abs(points).max()
-        points = np.concatenate([points + rng.normal(size=points.shape) * jitter * scale for _ in range(copies)])
+        # registration errors (merged scans, overlapping tiles) from a stream of their own, so that the
+        # cases of earlier rounds keep their points: each copy moved as a whole or each point on its own
+        side = rng.spawn(1)[0]
+        shift = float(side.choice(REGISTRATION_SHIFTS)) * area_spacing if side.random() < 0.5 else 0.0
+        whole = side.random() < 0.5
+        moved = []
+        for c in range(copies):
+            offset = rng.normal(size=points.shape) * jitter * scale
+            if shift and c:
+                direction = side.normal(size=(1, 3) if whole else points.shape)
+                offset += shift * direction / np.linalg.norm(direction, axis=1, keepdims=True)
+            moved.append(points + offset)
+        points = np.concatenate(moved)
         normals, mean, kmax = (np.concatenate([a] * copies) for a in (normals, mean, kmax))
         labels.append(f"{copies} copies, round-off {jitter:g}")
+        if shift:
+            labels.append(
+                f"registration {shift / area_spacing:g} spacings, {'whole copies' if whole else 'each point'}"
+            )
     kwargs = {}
     if rng.random() < 0.5:
         kwargs["method"] = pointcloud.POINT_CLOUD_METHODS[int(rng.integers(2))]
