@@ -18,7 +18,8 @@ reasons and parameters (these to 1e-9), the curvatures within 1e-6 of the
 largest |k| of the valid points (of k_min and k_max both; the Gaussian: its
 square), the normals within 1e-6. Each cloud has a coarse analytic check of
 the compiled result (median H of the valid points within 10% of the exact one,
-15% on the voxel surfaces; a least share of the points valid, each measured),
+15% on the voxel surfaces, 20% on the small open one; a least share of the
+points valid, each measured),
 so that both paths cannot agree on a wrong sign or scale; measured at 91f8573:
 1-4% (jets on the voxel sphere at radius 3.5: 4%, 255 of 664 points valid).
 """
@@ -78,8 +79,10 @@ def clouds() -> dict:
         # 2,968 points, 44% (corrected_measures) and 49% (jets) valid at 2e6f323, median H 0.2% and 7.5% off
         "voxel_ellipsoid": (large.vertices, large.mean, 0.25, 0.15),
         # measured at 91f8573: 0 (corrected_measures, default), 100 (radius 3), 188 (jets, default), 0 (radius 3)
-        # of 621 points valid, half of them "side undecided" on this convex cup: the parity of the reasons only
-        "voxel_open_ellipsoid": (*voxel_open_ellipsoid(), 0.0, 0.15),
+        # of 621 points valid, half of them "side undecided" on this convex cup: the parity of the reasons only.
+        # With its staircase read as one sheet (benchmarks/pointcloud_diagnostics.md), 182 and 288 by default; the
+        # jets' median H 15% high on these 1.3 voxels before (1.146) and after (1.150): 20%
+        "voxel_open_ellipsoid": (*voxel_open_ellipsoid(), 0.0, 0.2),
         # 18% (corrected_measures at radius 0.2) to 41% valid: the rim's balls hold the other side
         "thin_ellipsoid": (thin.vertices, thin.mean, 0.15, 0.1),
     }
@@ -152,21 +155,23 @@ def test_backends_compute_one_multiscale_estimate(name, radii, method):
         assert_near_the_truth(compiled, name, label)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a gap found at 2e6f323 (and at 6b59a8f): the vertices of a voxel surface in anisotropic voxels read as "
-    "a cloud are all 'side undecided (two sheets closer than the spacing)'; the staircase reads as noise of 0.066 "
-    "spacings, the normal fits span 13.5 (17 spacings) on a surface whose smallest radius of curvature is 6.25",
-)
 def test_a_voxel_surface_in_anisotropic_voxels_keeps_its_points():
-    # the same ellipsoid in 1 x 1 x 1 voxels: 1,314 of 2,968 points valid, median H 0.2% off (voxel_ellipsoid above);
-    # in 0.7 x 1 x 1.3 voxels (a microscope's stack): 0 of 3,402, every point with the reason of two sheets
+    # the same ellipsoid in 1 x 1 x 1 voxels: 1,314 of 2,968 points valid at 300b795, 2,867 (corrected_measures)
+    # with the staircase read as one sheet. In 0.7 x 1 x 1.3 voxels (a microscope's stack): 0 of 3,402 at 300b795,
+    # every point "side undecided (two sheets closer than the spacing)": the steps of the staircase, 1.3 against a
+    # spacing of 0.76, were read as stacked sheets oriented alike (benchmarks/pointcloud_diagnostics.md); now 2,905,
+    # median H 2% off. Each valid point within half the largest |k| of the exact ellipsoid's at its closest point
     mesh = shapes.voxel_ellipsoid((16.0, 12.0, 10.0), spacing=(0.7, 1.0, 1.3), seed=3)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshQualityWarning)
         result = point_cloud_curvatures(mesh.vertices)
-    assert result.valid.mean() > 0.25
-    assert np.median(result.mean[result.valid]) == pytest.approx(np.median(mesh.mean[result.valid]), rel=0.15)
+    assert result.valid.mean() > 0.75
+    assert np.median(result.mean[result.valid]) == pytest.approx(np.median(mesh.mean[result.valid]), rel=0.05)
+    largest = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))
+    assert np.all(np.abs(result.mean - mesh.mean)[result.valid] <= 0.5 * largest[result.valid])
+    assert result.parameters["normals"] == "estimated"
+    outward = np.einsum("ij,ij->i", result.normals, mesh.normals) > 0
+    assert outward[result.valid].all()
 
 
 def test_a_flat_cloud_faces_one_way_on_both_backends():

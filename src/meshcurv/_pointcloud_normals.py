@@ -169,8 +169,30 @@ ALIKE_MIN_OFFSET = 0.15
 #: neighbours off a tangent plane) ...
 STACKED_ALIKE_TILT = 2.0
 
-#: ... and a point with this many such neighbours oriented alike has a sheet inside out beside it.
+#: ... and a point with this many such neighbours oriented alike has a sheet inside out beside it ...
 STACKED_ALIKE_MIN = 2
+
+#: ... farther apart too, on a lattice (a voxel surface read as a cloud: the vertices of marching cubes, each on an
+#: edge of the voxels, their coordinates on a grid of ``h`` along each axis, :func:`lattice_steps`), than this many
+#: times ``max_k |n_k| h_k`` (``n`` the point's normal): a vertex lies up to ``h_k`` off the surface along its
+#: edge, and the two points of a pair on one staircase up to twice that along the normal (its steps are stacked
+#: sheets side by side). Only on a lattice whose largest ``h`` is at most :data:`LATTICE_RESOLVED` spacings:
+#: coarser steps are steeper than the orientation's flat edges, and patches of such a staircase are turned inside
+#: out (``benchmarks/pointcloud_diagnostics.md``).
+STACKED_ALIKE_LATTICE = 2.0
+LATTICE_RESOLVED = 1.0
+
+#: A cloud lies on a lattice along an axis when at least this share of its points share their coordinate along it
+#: with another point, on at least :data:`LATTICE_PLANES` planes whole multiples of the smallest distance between
+#: two of them apart (to :data:`LATTICE_TOLERANCE` of it).
+LATTICE_SHARE = 0.5
+LATTICE_PLANES = 3
+LATTICE_TOLERANCE = 1e-6
+
+#: On a lattice, a point is on a flat tread of the staircase (see :func:`lattice_treads`) when at least this share
+#: of its :data:`TREAD_NEIGHBOURS` nearest neighbours within its ball lie on its plane of the grid.
+TREAD_SHARE = 0.75
+TREAD_NEIGHBOURS = 48
 
 #: The winding number between two stacked sheets (see :func:`between_sides`) below which the part between them
 #: is inside out (-1; 1 inside a part, 0 in a gap between two).
@@ -1179,7 +1201,12 @@ def two_sheets(
     if noise is not None and np.isfinite(noise):
         offset = min(STACKED_ALIKE_OFFSET, max(ALIKE_MIN_OFFSET, ALIKE_NOISE * noise))
     sample = _evenly(candidates, WINDING_QUERIES)
+    lattice = None  # (measured where stacked neighbours oriented alike are found)
     found = _sheet_signs(points, normals, usable, spacing, step, tree, sample, offset=offset)
+    if found[0].any():
+        lattice = lattice_steps(points[candidates])
+        lattice = lattice if lattice.max() <= LATTICE_RESOLVED * step else np.zeros(3)
+        found = _off_the_steps(points, normals, sample, found, lattice)
     if sample.size < candidates.size and (found[0].any() or found[3].mean() >= INTERLEAVED_SAMPLE):
         # every point (the stacked sheets' 48 neighbours only when the sample has any: a thin sheet of 1M
         # points costs about 20 us a point with them)
@@ -1187,6 +1214,8 @@ def two_sheets(
             points, normals, usable, spacing, step, tree, candidates, with_alike=found[0].any(), offset=offset
         )
         sample = candidates
+        if lattice is not None:
+            found = _off_the_steps(points, normals, sample, found, lattice)
     hit, near, flags, two = found
     alike[sample[hit]] = True
     alike[near[hit][flags[hit]]] = True
@@ -1281,6 +1310,81 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool, offse
         (cosine >= FACING_COSINE) & (ahead * behind > 0) if alike else (cosine <= -FACING_COSINE) & (ahead * behind < 0)
     )
     return usable[near] & (near != queries[:, None]) & sides & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
+
+
+def lattice_steps(points: np.ndarray) -> np.ndarray:
+    """(3,) the step of the grid the coordinates of ``points`` (N, 3) lie on along each axis, 0 where they do not.
+
+    Along an axis, the coordinates that two points or more share (the planes of the grid) must hold
+    :data:`LATTICE_SHARE` of the points, be :data:`LATTICE_PLANES` at least, and lie whole multiples of the
+    smallest distance between two of them apart: the vertices of marching cubes over a voxel image (each on an
+    edge of the voxels: at its midpoint for a mask, every coordinate then on the grid of half voxels; two of its
+    three for a smooth image). A scan's points, or a rotated lattice, share no coordinates: 0.
+    """
+    steps = np.zeros(3)
+    for axis in range(3):
+        values, counts = np.unique(points[:, axis], return_counts=True)
+        planes = values[counts > 1]
+        if planes.size < LATTICE_PLANES or counts[counts > 1].sum() < LATTICE_SHARE * points.shape[0]:
+            continue
+        gaps = np.diff(planes)
+        multiples = gaps / gaps.min()
+        if gaps.min() > 0 and np.all(np.abs(multiples - np.round(multiples)) <= LATTICE_TOLERANCE * multiples):
+            steps[axis] = gaps.min()
+    return steps
+
+
+def _off_the_steps(points, normals, queries, found, lattice):
+    """``found`` of :func:`_sheet_signs` at ``queries`` (M,) with the stacked neighbours oriented alike kept only
+    where they and the query lie farther off each other's tangent plane than :data:`STACKED_ALIKE_LATTICE`
+    ``max_k |n_k| h_k`` (``lattice`` (3,): ``h``, all 0 for none; ``n`` the query's normal)."""
+    hit, near, flags, two = found
+    rows = np.flatnonzero(hit)
+    if rows.size == 0 or not lattice.any():
+        return found
+    offsets = points[near[rows]] - points[queries[rows]][:, None, :]
+    ahead = np.einsum("mkj,mj->mk", offsets, normals[queries[rows]])
+    behind = np.einsum("mkj,mkj->mk", offsets, normals[near[rows]])
+    steps = STACKED_ALIKE_LATTICE * np.max(np.abs(normals[queries[rows]]) * lattice, axis=1)
+    flags = flags.copy()
+    flags[rows] &= np.minimum(np.abs(ahead), np.abs(behind)) >= steps[:, None]
+    hit = hit.copy()
+    hit[rows] = flags[rows].sum(axis=1) >= STACKED_ALIKE_MIN
+    return hit, near, flags, two
+
+
+def lattice_treads(points: np.ndarray, normals: np.ndarray, radii: np.ndarray, candidates: np.ndarray, tree):
+    """``(tread, problems)``: (N,) bool, the ``candidates`` (N,) bool whose ball lies on a flat tread of a lattice.
+
+    A voxel surface read as a cloud (see :func:`lattice_steps`) is a staircase whose treads, where the surface is
+    nearly at right angles to an axis, are about ``sqrt(2 R h)`` wide (``R`` its radius of curvature, ``h`` the
+    voxel): a ball within one sees a plane, curvature 0, and nothing in it says that the surface curves. A point
+    whose ball of radius ``radii`` (N,) holds at least :data:`TREAD_SHARE` of its :data:`TREAD_NEIGHBOURS` nearest
+    neighbours on its own plane of the grid (across the axis most along its ``normals`` (N, 3)) is such a point (a
+    flat face of a box in voxels too: flat as far as the ball sees). ``problems``: the phrase of the call's warning
+    (none when no point is).
+    """
+    tread = np.zeros(points.shape[0], dtype=bool)
+    rows = np.flatnonzero(candidates)
+    lattice = lattice_steps(points[rows]) if rows.size else np.zeros(3)
+    if not lattice.any():
+        return tread, []
+    k = min(TREAD_NEIGHBOURS + 1, points.shape[0])
+    for start in range(0, rows.size, CHUNK):
+        chunk = rows[start : start + CHUNK]
+        distances, near = tree.query(points[chunk], k=k, workers=-1)
+        inside = distances[:, 1:] <= radii[chunk][:, None]  # (the point itself first)
+        axis = np.argmax(np.abs(normals[chunk]) * (lattice > 0), axis=1)
+        across = np.abs(points[near[:, 1:], axis[:, None]] - points[chunk, axis][:, None])
+        plane = inside & (across <= LATTICE_TOLERANCE * lattice[axis][:, None])
+        tread[chunk] = plane.sum(axis=1) >= TREAD_SHARE * np.maximum(inside.sum(axis=1), 1)
+    if not tread.any():
+        return tread, []
+    return tread, [
+        f"{int(tread.sum())} points lie on a flat tread of a voxel staircase (at least {TREAD_SHARE:g} of their ball "
+        "on one plane of the voxels' grid: the surface may curve there by less than the voxels resolve at this "
+        "radius): NaN"
+    ]
 
 
 def _two_heights(points, group, usable, step):
