@@ -1166,5 +1166,18 @@ def _cube_samples(points: np.ndarray, spacing: float) -> np.ndarray:
     cube = np.minimum(np.floor(shifted), 2.0**20).astype(np.int64)
     key = cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2]
     off_middle = np.round(np.einsum("ij,ij->i", shifted - cube - 0.5, shifted - cube - 0.5), 9)
-    order = np.lexsort((points[:, 2], points[:, 1], points[:, 0], off_middle, key))
-    return np.sort(order[np.r_[True, key[order][1:] != key[order][:-1]]])
+    return _nearest_in_cubes(points, key, off_middle)
+
+
+def _nearest_in_cubes(points: np.ndarray, key: np.ndarray, off_middle: np.ndarray) -> np.ndarray:
+    """Sorted indices into ``points`` (N, 3): of the points of each cube ``key`` (N,) int64, the first in the order
+    (``off_middle``, x, y, z): ``np.lexsort((z, y, x, off_middle, key))``'s first of each key, by one sort of the
+    keys and a sort of the points tied nearest their cube's middle."""
+    order = np.argsort(key, kind="stable")
+    sorted_keys = key[order]
+    starts = np.flatnonzero(np.r_[True, sorted_keys[1:] != sorted_keys[:-1]])
+    nearest = np.minimum.reduceat(off_middle[order], starts)
+    tied = order[off_middle[order] == np.repeat(nearest, np.diff(np.r_[starts, key.size]))]
+    ties = np.lexsort((points[tied, 2], points[tied, 1], points[tied, 0], key[tied]))
+    first = tied[ties][np.r_[True, key[tied][ties][1:] != key[tied][ties][:-1]]]
+    return np.sort(first)

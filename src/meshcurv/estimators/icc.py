@@ -97,6 +97,7 @@ from ..jets import (
     _cube_samples,
     _fit_jet_normals,
     _fit_jets,
+    _nearest_in_cubes,
     _sampled_jet_normals,
     interpolated_normals,
     jet_normals,
@@ -522,9 +523,7 @@ def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarr
     # (rounded: a lattice holds many vertices at one distance from the middle, whose round-off would depend on
     # the scale; their tie goes to the coordinates, whose order a scaling keeps)
     off_middle = np.round(_squared(*(shifted - cube - 0.5).T), 9)
-    order = np.lexsort((points[:, 2], points[:, 1], points[:, 0], off_middle, key))
-    first = order[np.r_[True, key[order][1:] != key[order][:-1]]]
-    return members[np.sort(first)]
+    return members[_nearest_in_cubes(points, key, off_middle)]
 
 
 def _spread_normals(neighbour_lists: tuple, centres: np.ndarray, fitted: np.ndarray, fallback, rings: int):
@@ -602,25 +601,30 @@ def _sampled_face_sums(vertices, faces, radius, values, usable, normals, centres
     kernels = numba_kernels("pilot")
     interpolate = interpolated_normals if kernels is None else kernels.interpolated_normals
 
-    def interpolated(known: np.ndarray, fields: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        reach = SUM_WIDTH * spacing
-        known = centres[known]
-        return interpolate(
-            at, vertices[known], fields, t1, t2, reach, SAMPLED_SPREAD, facing, normals[known], NORMAL_AGREEMENT
-        )
-
-    # the centres without a sample in reach (the positions and normals decide) are summed with the samples
-    _, reached = interpolated(sampled, np.zeros((sampled.size, 1)))
-    exact = np.union1d(sampled, others[~reached])
     summed = np.zeros((centres.size, values.shape[1]))
-    summed[exact] = _ball_face_sums(
-        vertices, faces, radius, values, usable=usable, connected=True, centres=centres[exact]
+    summed[sampled] = _ball_face_sums(
+        vertices, faces, radius, values, usable=usable, connected=True, centres=centres[sampled]
     )
     known = sampled[summed[sampled, 0] > 0]
-    ratios, reached = interpolated(known, summed[known, 1:] / summed[known, :1])
-    # (a centre that only a sample of no corrected area reached is left at 0: undefined, as that sample)
+    ratios, reached = interpolate(
+        at,
+        vertices[centres[known]],
+        summed[known, 1:] / summed[known, :1],
+        t1,
+        t2,
+        SUM_WIDTH * spacing,
+        SAMPLED_SPREAD,
+        facing,
+        normals[centres[known]],
+        NORMAL_AGREEMENT,
+    )
     summed[others[reached], 0] = 1.0
     summed[others[reached], 1:] = ratios[reached]
+    missing = others[~reached]  # (none on the meshes of benchmarks/dense_voxel.md: a second walk when some)
+    if missing.size:
+        summed[missing] = _ball_face_sums(
+            vertices, faces, radius, values, usable=usable, connected=True, centres=centres[missing]
+        )
     return summed
 
 
