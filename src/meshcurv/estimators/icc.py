@@ -591,9 +591,9 @@ def _sampled_face_sums(vertices, faces, radius, values, usable, normals, centres
     A sample's sums divided by its corrected area ``mu_0`` (its H, K and shape operator) vary smoothly with the
     centre of a ball of hundreds of faces; each other centre takes the value at itself of their weighted linear
     least-squares fit over its tangent plane (:func:`meshcurv.jets.interpolated_normals`: the samples within
-    :data:`SUM_WIDTH` spacings whose normals agree with its own), with a corrected area of 1 (the curvatures
-    are ratios to it). A centre without such a sample is summed over its own ball. The sums then cost the
-    number of samples, not of centres."""
+    :data:`SUM_WIDTH` spacings whose normals agree with its own, else within twice that), with a corrected area
+    of 1 (the curvatures are ratios to it). A centre without such a sample is summed over its own ball. The sums
+    then cost the number of samples, not of centres."""
     sampled = _cube_samples(vertices[centres], spacing)
     others = np.setdiff1d(np.arange(centres.size), sampled, assume_unique=True)
     at, facing = vertices[centres[others]], np.ascontiguousarray(normals[centres[others]])
@@ -606,24 +606,31 @@ def _sampled_face_sums(vertices, faces, radius, values, usable, normals, centres
         vertices, faces, radius, values, usable=usable, connected=True, centres=centres[sampled]
     )
     known = sampled[summed[sampled, 0] > 0]
-    ratios, reached = interpolate(
-        at,
-        vertices[centres[known]],
-        summed[known, 1:] / summed[known, :1],
-        t1,
-        t2,
-        SUM_WIDTH * spacing,
-        SAMPLED_SPREAD,
-        facing,
-        normals[centres[known]],
-        NORMAL_AGREEMENT,
-    )
-    summed[others[reached], 0] = 1.0
-    summed[others[reached], 1:] = ratios[reached]
-    missing = others[~reached]  # (none on the meshes of benchmarks/dense_voxel.md: a second walk when some)
+    fields = summed[known, 1:] / summed[known, :1]
+    missing = np.arange(others.size)
+    # the centres that no agreeing sample within SUM_WIDTH spacings reaches (a cube's sample near its corner
+    # leaves a gap) take those within twice that; the few left are summed over their own balls
+    for reach in (SUM_WIDTH * spacing, 2.0 * SUM_WIDTH * spacing):
+        ratios, reached = interpolate(
+            at[missing],
+            vertices[centres[known]],
+            fields,
+            t1[missing],
+            t2[missing],
+            reach,
+            SAMPLED_SPREAD,
+            facing[missing],
+            normals[centres[known]],
+            NORMAL_AGREEMENT,
+        )
+        summed[others[missing[reached]], 0] = 1.0
+        summed[others[missing[reached]], 1:] = ratios[reached]
+        missing = missing[~reached]
+        if not missing.size:
+            break
     if missing.size:
-        summed[missing] = _ball_face_sums(
-            vertices, faces, radius, values, usable=usable, connected=True, centres=centres[missing]
+        summed[others[missing]] = _ball_face_sums(
+            vertices, faces, radius, values, usable=usable, connected=True, centres=centres[others[missing]]
         )
     return summed
 
