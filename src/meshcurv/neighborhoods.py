@@ -739,7 +739,9 @@ def call_ranges(n: int, pairs_per_centre: float, weights: np.ndarray | None = No
     return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
 
 
-def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int, nested: bool = False) -> tuple[np.ndarray, ...]:
+def _face_sum_scratch(
+    n_chunks: int, n_vertices: int, n_faces: int, nested: bool = False, *, filled: bool = True
+) -> tuple[np.ndarray, ...]:
     """The per-thread scratch of the compiled ``connected_face_sums``:
     ``(seen, mark, known, squared, queue, levels, spare)`` (and of ``connected_face_sums_nested``).
 
@@ -750,18 +752,25 @@ def _face_sum_scratch(n_chunks: int, n_vertices: int, n_faces: int, nested: bool
     indices: int32 while the vertex and face counts fit in it (half the memory: 40 bytes per vertex
     on 2 threads), int64 beyond. ``levels``: (n_chunks, V) with ``nested`` (several radii in one
     walk: the smallest ball each queued vertex was reached through), (n_chunks, 0) otherwise; ``spare``:
-    (n_chunks, 0), the place of the clusters' scratch (``clustered_face_sums``).
+    (n_chunks, 0), the place of the clusters' scratch (``clustered_face_sums``). ``filled`` False: the three
+    stamps not filled here (``connected_face_sums`` with ``ready`` has each thread fill its own row, in parallel).
     """
     index = np.int32 if max(n_vertices, n_faces) < np.iinfo(np.int32).max else np.int64
+    stamps = np.full if filled else _unfilled
     return (
-        np.full((n_chunks, n_faces), -1, index),
-        np.full((n_chunks, n_vertices), -1, index),
-        np.full((n_chunks, n_vertices), -1, index),
+        stamps((n_chunks, n_faces), -1, index),
+        stamps((n_chunks, n_vertices), -1, index),
+        stamps((n_chunks, n_vertices), -1, index),
         np.empty((n_chunks, n_vertices)),
         np.empty((n_chunks, n_vertices), index),
         np.empty((n_chunks, n_vertices if nested else 0), index),
         np.empty((n_chunks, 0), index),
     )
+
+
+def _unfilled(shape: tuple[int, int], _fill: int, dtype: type) -> np.ndarray:
+    """``np.full`` without the fill: the kernel fills the rows (:func:`_face_sum_scratch`)."""
+    return np.empty(shape, dtype)
 
 
 def _connected_face_sums(
@@ -787,9 +796,14 @@ def _connected_face_sums(
     indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
     values = np.ascontiguousarray(values)
     out = np.zeros((radii.shape[0], n, values.shape[2]))
-    scratch = _face_sum_scratch(max(1, min(kernel_threads(), n)), n, faces.shape[0], radii.shape[0] > 1)
+    clustered = radii.shape[0] == 1 and mean >= CLUSTER_MIN_FACES  # dense balls: clusters inside a ball added whole
+    plain = radii.shape[0] == 1 and not clustered  # one ball: the kernel without the passes
+    rows = max(1, min(kernel_threads(), n))
+    # the plain kernel's threads fill their own rows of the stamps (``ready``): no serial fill of (rows, F + 2 V)
+    scratch = _face_sum_scratch(rows, n, faces.shape[0], radii.shape[0] > 1, filled=not plain)
+    ready = np.zeros(rows, dtype=bool)
     clusters = None
-    if radii.shape[0] == 1 and mean >= CLUSTER_MIN_FACES:  # dense balls: clusters inside a ball added whole
+    if clustered:
         clusters = _face_clusters(vertices, faces, centres, reach, values[0], usable)
         scratch = scratch[:5] + tuple(
             np.full((scratch[0].shape[0], clusters[1].shape[0]), -1, scratch[0].dtype) for _ in range(3)
@@ -801,8 +815,8 @@ def _connected_face_sums(
             )
             continue
         ball = (vertices, faces, centres, reach, usable, values[0], radii[0], indptr, indices)
-        if clusters is None:  # one ball: the kernel without the passes
-            kernels.connected_face_sums(*ball, out[0], scratch, start, stop)
+        if plain:
+            kernels.connected_face_sums(*ball, out[0], scratch, start, stop, ready)
         else:
             kernels.clustered_face_sums(*ball, clusters, out[0], scratch, start, stop)
     return out

@@ -1,6 +1,6 @@
 """The rules every kernel shares, each in one place: the JIT options, an edge's length, a face's cross
 product, the degenerate-face test, the cancellation of a normal sum, the tangent frame of a normal, and
-the threads that run a kernel's chunks (:func:`run_chunks`).
+the threads that run a kernel's chunks (:func:`run_chunks`, :func:`run_slots`).
 """
 
 from __future__ import annotations
@@ -141,20 +141,41 @@ def run_chunks(chunk, n_items, n_chunks, *args) -> None:
     4.7 of 9.6 s of CPU on a cold cache (issue 31), for the same machine code. The results do not depend
     on the number of threads: each range writes its own rows.
     """
+    _run_ranges(chunk, n_items, n_chunks, args)
+
+
+def run_slots(chunk, n_items, n_chunks, n_slots, *args) -> None:
+    """:func:`run_chunks` whose chunks also get the slot of the thread that runs them: ``chunk(lo, hi, slot,
+    *args)``, ``slot`` in ``range(n_slots)``, never that of two threads at once in one call (at most
+    ``n_slots`` threads run the call).
+
+    For kernels whose ranges need a scratch as large as the mesh (the stamps of a breadth-first walk): one
+    row of it per slot, reused by every range its thread takes, so that the ranges can be many (a thread
+    that finishes early takes more of them: on a busy machine, or where the work per item varies across the
+    mesh) without a scratch each.
+    """
+    _run_ranges(chunk, n_items, n_chunks, args, max(int(n_slots), 1))
+
+
+def _run_ranges(chunk, n_items, n_chunks, args, slots: int = 0) -> None:
+    """:func:`run_chunks` (``slots`` 0) and :func:`run_slots` (at most ``slots`` threads)."""
     n_chunks = max(min(int(n_items), int(n_chunks)), 1)
     bounds = iter([(c * n_items // n_chunks, (c + 1) * n_items // n_chunks) for c in range(n_chunks)])
-    threads = min(nb.get_num_threads(), n_chunks)
+    threads = min(nb.get_num_threads(), n_chunks, slots or n_chunks)
 
-    def work():
+    def work(slot):
         for lo, hi in bounds:  # a list iterator hands out each range once, whatever the thread
-            chunk(lo, hi, *args)
+            if slots:
+                chunk(lo, hi, slot, *args)
+            else:
+                chunk(lo, hi, *args)
 
     if threads <= 1:
-        work()
+        work(0)
         return
-    helpers = [_pool().submit(work) for _ in range(threads - 1)]
+    helpers = [_pool().submit(work, slot) for slot in range(1, threads)]
     try:
-        work()
+        work(0)
     finally:
         # a helper not started yet (the pool busy with another call's ranges) has nothing left to do: it is
         # cancelled rather than waited for, so that a call never waits on the queue of another; the others

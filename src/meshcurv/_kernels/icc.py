@@ -65,8 +65,14 @@ def _triangle_measures(points, normals, i, j, k, turn):
 def face_measures(vertices, faces, normals):
     """``measures.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
     out = np.zeros((faces.shape[0], 9))
-    run_chunks(_face_measures_chunk, faces.shape[0], nb.get_num_threads(), vertices, faces, normals, out)
+    chunks = _CHUNKS_PER_THREAD * nb.get_num_threads()
+    run_chunks(_face_measures_chunk, faces.shape[0], chunks, vertices, faces, normals, out)
     return out
+
+
+#: :func:`face_measures` and :func:`curvatures_from_measures` cut their rows into this many chunks per thread
+#: (:func:`~._common.run_chunks`): a thread that finishes its share early takes chunks of the others.
+_CHUNKS_PER_THREAD = 4
 
 
 @nb.njit(**_JIT)
@@ -84,18 +90,23 @@ def _face_measures_chunk(lo, hi, vertices, faces, normals, out):
 def curvatures_from_measures(summed, normals):
     """``measures.curvatures_from_measures``: (N,) k_min, k_max and (N, 3) dir_min, dir_max of summed measures."""
     n = summed.shape[0]
-    out = (np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan))
-    run_chunks(_curvatures_chunk, n, nb.get_num_threads(), summed, normals, *out)
+    # zeros (pages not touched here); each chunk writes every row of its own, NaN where undefined: no serial fill
+    out = (np.zeros(n), np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3)))
+    run_chunks(_curvatures_chunk, n, _CHUNKS_PER_THREAD * nb.get_num_threads(), summed, normals, *out)
     return out
 
 
 @nb.njit(**_JIT)
 def _curvatures_chunk(lo, hi, summed, normals, k_min, k_max, dir_min, dir_max):
-    """Rows ``lo:hi`` of :func:`curvatures_from_measures` (chunks on threads, as :func:`face_measures`)."""
+    """Rows ``lo:hi`` of :func:`curvatures_from_measures` (chunks on threads, as :func:`face_measures`); NaN in
+    the rows without a positive area or a finite normal."""
     for i in range(lo, hi):
         area = summed[i, 0]
         nx, ny, nz = normals[i, 0], normals[i, 1], normals[i, 2]
         if not (area > 0 and math.isfinite(nx) and math.isfinite(ny) and math.isfinite(nz)):
+            k_min[i], k_max[i] = np.nan, np.nan
+            for k in range(3):
+                dir_min[i, k], dir_max[i, k] = np.nan, np.nan
             continue
         k_min[i], k_max[i] = _principal_from_mean_gaussian(summed[i, 1] / (2 * area), summed[i, 2] / area)
         _, _, d0, d1, d2, d3, d4, d5 = _tangent_eigen(

@@ -12,7 +12,17 @@ from llvmlite import ir  # type: ignore[import-untyped]
 from numba.core import types
 from numba.extending import intrinsic, overload
 
-from ._common import _JIT, _JIT_INNER, _JIT_INNER_REASSOC, _TINY, _UNSIGNED, _tangent_frame, run_chunks, threaded
+from ._common import (
+    _JIT,
+    _JIT_INNER,
+    _JIT_INNER_REASSOC,
+    _TINY,
+    _UNSIGNED,
+    _tangent_frame,
+    run_chunks,
+    run_slots,
+    threaded,
+)
 from .neighborhoods import _ball_members, _connected_members, pool_grid
 from .tensors import _tangent_eigen
 
@@ -730,7 +740,7 @@ def fit_jets_connected(
     each ball found breadth-first over the mesh's edges (``indptr, indices``,
     CSR) instead of on a grid: no search structure over all the points is
     built, so a fit at a few centres costs only their balls. Only ``allowed``
-    (V,) vertices enter the balls. ``n_chunks``: three (V,) int64 arrays each.
+    (V,) vertices enter the balls. ``n_chunks``: the threads at most, three (V,) int64 arrays each.
     The outputs have one row per centre, in the order of ``centres`` (a fit at
     a few centres of a large mesh writes no row for the others).
     With ``normals_only``, returns ``(fitted, ...)``: the (M, 3) unit normals of
@@ -740,8 +750,9 @@ def fit_jets_connected(
     A fit whose slope ``c10^2 + c01^2`` is below ``settled`` ends the
     iterations of its vertex (its normal is within ``atan(sqrt(settled))`` of
     the frame's normal); with 0, every vertex has ``iterations`` fits.
-    ``areas``: as :func:`fit_jets`. The fits run in ``n_chunks`` ranges of the centres
-    (:func:`_connected_chunk`) on threads (:func:`~meshcurv._kernels._common.run_chunks`).
+    ``areas``: as :func:`fit_jets`. The fits run in ranges of the centres (:func:`_connected_chunk`),
+    :data:`_RANGES_PER_SLOT` per thread, on threads (:func:`~meshcurv._kernels._common.run_slots`), each with
+    the walk's scratch of its thread (the stamps are the centres' rows: one fill for all its ranges).
     """
     n = vertices.shape[0]
     m = centres.shape[0]
@@ -749,10 +760,17 @@ def fit_jets_connected(
     fitted = np.full((m if normals_only else 1, 3), np.nan)
     limits = np.array([away_fraction, settled])
     facing = facing[: facing.shape[0] if check_facing else 0]
-    run_chunks(
+    slots = max(1, min(int(n_chunks), m))
+    # each thread's walk scratch: the stamps (filled with -1 by the thread on its first range), members, queue
+    scratch = np.empty((3, slots, n), np.int64)
+    filled = np.zeros(slots, np.bool_)
+    run_slots(
         _connected_chunk,
         m,
-        n_chunks,
+        _RANGES_PER_SLOT * slots,
+        slots,
+        scratch,
+        filled,
         vertices,
         normals,
         radii,
@@ -776,10 +794,18 @@ def fit_jets_connected(
     return (fitted, *outputs[1:]) if normals_only else outputs
 
 
+#: :func:`fit_jets_connected` cuts its centres into this many ranges per thread (:func:`~._common.run_slots`): a
+#: thread that finishes its share early takes ranges of the others.
+_RANGES_PER_SLOT = 8
+
+
 @nb.njit(**_JIT)
 def _connected_chunk(
     lo,
     hi,
+    slot,
+    scratch,
+    filled,
     vertices,
     normals,
     radii,
@@ -806,14 +832,14 @@ def _connected_chunk(
     general,
 ):
     """The fits of ``centres[lo:hi]`` of :func:`fit_jets_connected`, written to their rows of the outputs
-    (of ``fitted`` with ``normals_only``)."""
-    n = vertices.shape[0]
+    (of ``fitted`` with ``normals_only``), with row ``slot`` of the (3, slots, V) ``scratch`` (the stamps of
+    the walk, its members, its queue), the stamps filled with -1 on the slot's first range (``filled``)."""
     per_centre = radii.shape[0] > 1
-    mark = np.empty(n, np.int64)  # -1: np.full compiles two more functions (issue 31)
-    for k in range(n):
-        mark[k] = -1
-    members = np.empty(n, np.int64)
-    queue = np.empty(n, np.int64)
+    mark, members, queue = scratch[0, slot], scratch[1, slot], scratch[2, slot]
+    if not filled[slot]:  # -1: np.full compiles two more functions (issue 31)
+        for k in range(mark.shape[0]):
+            mark[k] = -1
+        filled[slot] = True
     work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
     # one row of each output, written by every fit (c and one_away set below): unpacked once, not per vertex; no
     # call of _jet_outputs (its NaN fills compile 0.3-0.5 s of CPU more than these)

@@ -9,7 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ._common import _JIT, _ONE, _UNSIGNED, run_chunks, threaded
+from ._common import _JIT, _ONE, _UNSIGNED, run_chunks, run_slots, threaded
 from .topology import _BUCKET_CHUNKS, _bucket_starts
 
 
@@ -475,7 +475,7 @@ def _walk_face(
 
 @threaded
 def connected_face_sums(
-    vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
+    vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop, ready=None
 ):
     """Add to rows ``start`` to ``stop`` of ``out`` (V, k) the sums of ``share * values`` over the faces of the
     surface-connected piece of each vertex's ball, of radius ``radii[v]`` ((V,): one per vertex) or
@@ -496,17 +496,24 @@ def connected_face_sums(
     Faces not ``usable`` (F,) lead the search on but add nothing. The other
     rows of ``out`` are not touched: a caller that splits the vertices into
     ranges sums them into one array. ``scratch``: ``neighborhoods._face_sum_scratch``, one
-    chunk of the vertices per row of its arrays (reused from call to call).
+    thread per row of its arrays (reused from call to call); ``ready`` (rows,) bool, False where a row's
+    stamps (``seen``, ``mark``, ``known``) are still to be filled with -1, by the thread that takes the
+    row, then True (None: all filled).
 
-    The chunks (:func:`_face_sums_chunk`) run on threads (:func:`~meshcurv._kernels._common.run_chunks`), not in
-    a ``parallel=True`` kernel: numba's parallel pipeline compiled the inlined walk twice (issue 31: 6.2 of the
+    The ranges of vertices (:func:`_face_sums_chunk`) run on threads (:func:`~meshcurv._kernels._common.run_slots`),
+    each with the scratch row of its thread, not in a ``parallel=True`` kernel: numba's parallel pipeline compiled the inlined walk twice (issue 31: 6.2 of the
     default's cold compile CPU s, 1.9 s as a plain function, the same machine code).
     """
-    n_chunks = scratch[0].shape[0]
-    run_chunks(
+    n = vertices.shape[0]
+    start = max(min(start, n), 0)
+    m = max(min(stop, n), start) - start
+    slots = scratch[0].shape[0]
+    run_slots(
         _face_sums_chunk,
-        n_chunks,
-        n_chunks,
+        m,
+        _RANGES_PER_SLOT * slots,
+        slots,
+        np.ones(slots, np.bool_) if ready is None else ready,
         vertices,
         faces,
         centroids,
@@ -519,101 +526,103 @@ def connected_face_sums(
         out,
         scratch,
         start,
-        stop,
     )
+
+
+#: :func:`connected_face_sums` cuts its vertices into this many ranges per thread (:func:`~._common.run_slots`):
+#: a thread that finishes its share early takes ranges of the others.
+_RANGES_PER_SLOT = 8
 
 
 @nb.njit(**_JIT)
 def _face_sums_chunk(
-    lo, hi, vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop
+    lo, hi, slot, ready, vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start
 ):
-    """Chunks ``lo`` to ``hi - 1`` of :func:`connected_face_sums` (chunk ``c``: its ``c``-th range of the
-    vertices ``start`` to ``stop``, with row ``c`` of each ``scratch`` array)."""
-    n = vertices.shape[0]
+    """The vertices ``start + lo`` to ``start + hi - 1`` of :func:`connected_face_sums`, with row ``slot`` of each
+    ``scratch`` array (its stamps filled first unless ``ready[slot]``)."""
     n_values = values.shape[1]
     per_vertex = radii.shape[0] > 1
-    # start = max(min(start, n), 0), m = max(min(stop, n), start) - start: numba compiles min and max once per
-    # caller's options (issue 31)
-    start = n if n < start else start
-    start = 0 if 0 > start else start
-    stop = n if n < stop else stop
-    m = (start if start > stop else stop) - start
     all_seen, all_mark, all_known, all_squared, all_queue, _, _ = scratch
-    n_chunks = all_seen.shape[0]
-    for chunk in range(lo, hi):
-        seen = all_seen[chunk]
-        mark = all_mark[chunk]  # queued for this centre
-        known = all_known[chunk]  # distance to this centre in `squared`
-        squared = all_squared[chunk]
-        queue = all_queue[chunk]  # a vertex is queued at most once per centre: never grown
-        total = np.empty(n_values)  # the centre's sums, in the order of the face visits, then stored once
-        for v in range(start + chunk * m // n_chunks, start + (chunk + 1) * m // n_chunks):
-            radius = radii[v if per_vertex else 0]
-            radius2 = radius * radius
-            for k in range(n_values):
-                total[k] = out[v, k]
-            # the walk of _face_walk and _walk_face written out: their arrays bound once, not once per face
-            # (inlined, each face's call took and dropped a reference to each of its arrays: 3x the walk's time)
-            cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
-            mark[v] = v
-            queue[0] = v
-            head, tail = 0, 1
-            while head < tail:
-                a = _UNSIGNED(queue[head])  # unsigned indices: no code for negative ones
-                head += 1
-                for j in range(_UNSIGNED(indptr[a]), _UNSIGNED(indptr[a + _ONE])):
-                    f = _UNSIGNED(indices[j])
-                    if seen[f] == v:
+    seen = all_seen[slot]
+    mark = all_mark[slot]  # queued for this centre
+    known = all_known[slot]  # distance to this centre in `squared`
+    if not ready[slot]:  # (other names than the walk's unsigned f and c: one type per variable)
+        for item in range(seen.shape[0]):
+            seen[item] = -1
+        for item in range(mark.shape[0]):
+            mark[item] = -1
+            known[item] = -1
+        ready[slot] = True
+    squared = all_squared[slot]
+    queue = all_queue[slot]  # a vertex is queued at most once per centre: never grown
+    total = np.empty(n_values)  # the centre's sums, in the order of the face visits, then stored once
+    for v in range(start + lo, start + hi):
+        radius = radii[v if per_vertex else 0]
+        radius2 = radius * radius
+        for k in range(n_values):
+            total[k] = out[v, k]
+        # the walk of _face_walk and _walk_face written out: their arrays bound once, not once per face
+        # (inlined, each face's call took and dropped a reference to each of its arrays: 3x the walk's time)
+        cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
+        mark[v] = v
+        queue[0] = v
+        head, tail = 0, 1
+        while head < tail:
+            a = _UNSIGNED(queue[head])  # unsigned indices: no code for negative ones
+            head += 1
+            for j in range(_UNSIGNED(indptr[a]), _UNSIGNED(indptr[a + _ONE])):
+                f = _UNSIGNED(indices[j])
+                if seen[f] == v:
+                    continue
+                seen[f] = v
+                d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
+                if d > (radius + reach[f]) ** 2:
+                    continue  # every point of the face is outside
+                low = d  # _met_share written out: the corners' and centroid's distances
+                high = d
+                for corner in range(3):
+                    c = _UNSIGNED(faces[f, corner])
+                    if known[c] != v:
+                        known[c] = v
+                        squared[c] = (
+                            (vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2 + (vertices[c, 2] - cz) ** 2
+                        )
+                    corner2 = squared[c]
+                    low = corner2 if corner2 < low else low  # min(low, corner2)
+                    high = corner2 if corner2 > high else high  # max(high, corner2)
+                if high <= radius2:
+                    share = 1.0
+                elif low < radius2:
+                    root = math.sqrt(low)
+                    share = (radius - root) / (math.sqrt(high) - root)
+                else:  # corners and centroid outside: met if a side crosses the sphere
+                    share = 0.0
+                    crossed = False
+                    for corner in range(3):
+                        p = _UNSIGNED(faces[f, corner])
+                        q = _UNSIGNED(faces[f, (corner + 1) % 3])
+                        crossed = crossed or _segment_meets_ball(
+                            vertices[p, 0] - cx,
+                            vertices[p, 1] - cy,
+                            vertices[p, 2] - cz,
+                            vertices[q, 0] - cx,
+                            vertices[q, 1] - cy,
+                            vertices[q, 2] - cz,
+                            radius2,
+                        )
+                    if not crossed:
                         continue
-                    seen[f] = v
-                    d = (centroids[f, 0] - cx) ** 2 + (centroids[f, 1] - cy) ** 2 + (centroids[f, 2] - cz) ** 2
-                    if d > (radius + reach[f]) ** 2:
-                        continue  # every point of the face is outside
-                    low = d  # _met_share written out: the corners' and centroid's distances
-                    high = d
-                    for corner in range(3):
-                        c = _UNSIGNED(faces[f, corner])
-                        if known[c] != v:
-                            known[c] = v
-                            squared[c] = (
-                                (vertices[c, 0] - cx) ** 2 + (vertices[c, 1] - cy) ** 2 + (vertices[c, 2] - cz) ** 2
-                            )
-                        corner2 = squared[c]
-                        low = corner2 if corner2 < low else low  # min(low, corner2)
-                        high = corner2 if corner2 > high else high  # max(high, corner2)
-                    if high <= radius2:
-                        share = 1.0
-                    elif low < radius2:
-                        root = math.sqrt(low)
-                        share = (radius - root) / (math.sqrt(high) - root)
-                    else:  # corners and centroid outside: met if a side crosses the sphere
-                        share = 0.0
-                        crossed = False
-                        for corner in range(3):
-                            p = _UNSIGNED(faces[f, corner])
-                            q = _UNSIGNED(faces[f, (corner + 1) % 3])
-                            crossed = crossed or _segment_meets_ball(
-                                vertices[p, 0] - cx,
-                                vertices[p, 1] - cy,
-                                vertices[p, 2] - cz,
-                                vertices[q, 0] - cx,
-                                vertices[q, 1] - cy,
-                                vertices[q, 2] - cz,
-                                radius2,
-                            )
-                        if not crossed:
-                            continue
-                    if share != 0.0 and usable[f]:
-                        for k in range(n_values):
-                            total[k] += share * values[f, k]
-                    for corner in range(3):
-                        c = _UNSIGNED(faces[f, corner])
-                        if mark[c] != v:
-                            mark[c] = v
-                            queue[_UNSIGNED(tail)] = c
-                            tail += 1
-            for k in range(n_values):
-                out[v, k] = total[k]
+                if share != 0.0 and usable[f]:
+                    for k in range(n_values):
+                        total[k] += share * values[f, k]
+                for corner in range(3):
+                    c = _UNSIGNED(faces[f, corner])
+                    if mark[c] != v:
+                        mark[c] = v
+                        queue[_UNSIGNED(tail)] = c
+                        tail += 1
+        for k in range(n_values):
+            out[v, k] = total[k]
 
 
 @nb.njit(inline="always", **_JIT)
