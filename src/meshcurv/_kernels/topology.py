@@ -84,7 +84,6 @@ def _bucket_cursors(lo, hi, cursor, starts):
             at += count
 
 
-@nb.njit(**_JIT)
 def build_edges(faces, n_vertices, template):
     """Edges of the triangles, their faces and counts (see MeshTopology._build): :func:`build_topology`
     without the twins of the sides, ``(edges, face_edges, edge_faces, counts, forward)``."""
@@ -92,7 +91,7 @@ def build_edges(faces, n_vertices, template):
     return edges, face_edges, edge_faces, counts, forward
 
 
-@nb.njit(**_JIT)
+@threaded
 def build_topology(faces, n_vertices, template, with_twins):
     """:func:`build_edges_into` on arrays allocated here: ``(edges, face_edges, edge_faces, counts, forward,
     twins, corners, first)``, all in the integer type of ``template``; the last three only when ``with_twins``
@@ -105,11 +104,8 @@ def build_topology(faces, n_vertices, template, with_twins):
     counts = np.empty(3 * n_faces, index)
     forward = np.empty(3 * n_faces, index)
     twins = np.empty(3 * n_faces if with_twins else 0, index)
-    corners = np.empty(n_vertices if with_twins else 0, index)  # zeros and -1, filled here: numba's np.zeros and
-    first = np.empty(n_vertices if with_twins else 0, index)  # np.full compile more functions (issue 31)
-    for v in range(corners.shape[0]):
-        corners[v] = 0
-        first[v] = -1
+    corners = np.zeros(n_vertices if with_twins else 0, index)
+    first = np.full(n_vertices if with_twins else 0, -1, index)
     n_edges = build_edges_into(
         faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins, corners, first
     )
@@ -125,7 +121,6 @@ def build_topology(faces, n_vertices, template, with_twins):
     )
 
 
-@nb.njit(**_JIT)
 def build_edges_into(
     faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins, corners, first
 ):
@@ -148,16 +143,49 @@ def build_edges_into(
     whose faces all repeat a corner, -1 at an unreferenced vertex.
 
     Sides are bucketed by their smaller vertex (a counting sort: one pass
-    counts, one places, each in face order), each bucket is sorted by (larger
-    vertex, direction) with a stable insertion sort and its edges written
-    out at once, so the edges come out in lexicographic order, as
-    ``np.unique`` would give them. Every output element is written once (no
-    fill beforehand; the rows past the last edge are never touched, so never
-    paged in). The buckets are held in the integer type of ``template``
-    (``topology._bucket_template``). One thread: the passes are bound by
-    memory, and a parallel version took twice the CPU time for at best the
-    same wall time on 2 cores, and 5 s more to compile.
+    counts, one places, each in face order: :func:`_bucketed_sides`, one
+    thread, bound by memory); then, in ranges of vertices on threads
+    (:func:`~meshcurv._kernels._common.run_chunks`), each bucket is sorted by
+    (larger vertex, direction) with a stable insertion sort and its edges
+    counted (:func:`_sort_buckets`), and, each range's first edge known from
+    the counts of those before it, its edges written out
+    (:func:`_write_edges`): the edges come out in lexicographic order, as
+    ``np.unique`` would give them, numbered as one pass over the buckets
+    numbers them, whatever the number of threads. Every output element is
+    written once (no fill beforehand; the rows past the last edge are never
+    touched, so never paged in). The buckets are held in the integer type of
+    ``template`` (``topology._bucket_template``).
     """
+    starts, keys, sides = _bucketed_sides(faces, n_vertices, template, face_edges, twins, corners, first)
+    n_ranges = max(1, min(_VERTEX_CHUNKS * nb.get_num_threads(), n_vertices))
+    found = np.zeros(n_ranges + 1, np.int64)  # the edges of each range of buckets, then the first of each
+    run_chunks(_sort_buckets, n_ranges, n_ranges, starts, keys, sides, found)
+    np.cumsum(found, out=found)
+    run_chunks(
+        _write_edges,
+        n_ranges,
+        n_ranges,
+        starts,
+        keys,
+        sides,
+        found,
+        face_edges,
+        edges,
+        edge_faces,
+        counts,
+        forward,
+        twins,
+    )
+    return int(found[n_ranges])
+
+
+@nb.njit(**_JIT)
+def _bucketed_sides(faces, n_vertices, template, face_edges, twins, corners, first):
+    """:func:`build_edges_into`'s two passes over the faces: ``corners`` and ``first`` written (with the
+    ``twins``), -1 in ``face_edges`` and ``twins`` at the sides from a vertex to itself, and the other sides in
+    buckets by their smaller vertex: ``(starts, keys, sides)``, bucket ``v`` being ``starts[v]:starts[v + 1]``
+    of ``keys`` (2 * larger vertex + 1 where the side runs backward) and ``sides`` (``3 f + k``), in face
+    order."""
     n_faces = faces.shape[0]
     with_twins = twins.shape[0] > 0
     bucket_start = np.empty(n_vertices + 1, template.dtype)
@@ -197,53 +225,85 @@ def build_edges_into(
                 cursor[low] += 1
                 sort_key[slot] = 2 * (b if b > a else a) + (1 if a > b else 0)  # max(a, b)
                 side_of[slot] = 3 * f + k
-    e = -1
-    for v in range(n_vertices):
-        start, stop = _UNSIGNED(bucket_start[v]), _UNSIGNED(bucket_start[v + 1])  # unsigned: see _twin_walk
-        for i in range(start + _ONE, stop):  # stable insertion sort of the (small) bucket
-            key = sort_key[i]
-            side = side_of[i]
-            j = _UNSIGNED(i)
-            while j > start and sort_key[j - _ONE] > key:
-                sort_key[j] = sort_key[j - _ONE]
-                side_of[j] = side_of[j - _ONE]
-                j -= _ONE
-            sort_key[j] = key
-            side_of[j] = side
-        previous_high = -1
-        group = start  # the first side of the current edge: the sides of an edge are next to each other
-        for i in range(start, stop):
-            high = sort_key[i] >> 1
-            backward = sort_key[i] & 1
-            side = side_of[i]
-            face = np.int64(_UNSIGNED(side) // _THREE)  # back to signed: -1 and a face share a type
-            if high != previous_high:
-                if with_twins and i > start:
-                    _edge_twins(sort_key, side_of, twins, group, i)
-                group = _UNSIGNED(i)
-                e += 1
-                previous_high = high
-                edge = _UNSIGNED(e)
-                edges[edge, 0] = v
-                edges[edge, 1] = high
-                edge_faces[edge, 0] = -1 if backward else face
-                edge_faces[edge, 1] = face if backward else -1
-                counts[edge] = 1
-                forward[edge] = 0 if backward else 1
-            else:
-                edge = _UNSIGNED(e)
-                if counts[edge] == 1:
-                    if edge_faces[edge, 1] == -1:
-                        edge_faces[edge, 1] = face
-                    else:
-                        edge_faces[edge, 0] = face
-                counts[edge] += 1
-                if not backward:
-                    forward[edge] += 1
-            face_edges[_UNSIGNED(side)] = e
-        if with_twins and stop > start:
-            _edge_twins(sort_key, side_of, twins, group, stop)
-    return e + 1
+    return bucket_start, sort_key, side_of
+
+
+@nb.njit(**_JIT)
+def _sort_buckets(lo, hi, bucket_start, sort_key, side_of, found):
+    """:func:`build_edges_into`: the buckets of the vertex ranges ``lo`` to ``hi - 1`` (of ``found.shape[0] - 1``)
+    sorted in place by key (a stable insertion sort: the buckets are small), and the edges of range ``r`` (its
+    distinct larger vertices) counted in ``found[r + 1]``."""
+    n_vertices = bucket_start.shape[0] - 1
+    n_ranges = found.shape[0] - 1
+    for r in range(lo, hi):
+        n_edges = 0
+        for v in range(n_vertices * r // n_ranges, n_vertices * (r + 1) // n_ranges):
+            start, stop = _UNSIGNED(bucket_start[v]), _UNSIGNED(bucket_start[v + 1])  # unsigned: see _twin_walk
+            for i in range(start + _ONE, stop):
+                key = sort_key[i]
+                side = side_of[i]
+                j = _UNSIGNED(i)
+                while j > start and sort_key[j - _ONE] > key:
+                    sort_key[j] = sort_key[j - _ONE]
+                    side_of[j] = side_of[j - _ONE]
+                    j -= _ONE
+                sort_key[j] = key
+                side_of[j] = side
+            previous_high = -1
+            for i in range(start, stop):
+                high = sort_key[i] >> 1
+                if high != previous_high:
+                    n_edges += 1
+                    previous_high = high
+        found[r + 1] = n_edges
+
+
+@nb.njit(**_JIT)
+def _write_edges(
+    lo, hi, bucket_start, sort_key, side_of, first_edge, face_edges, edges, edge_faces, counts, forward, twins
+):
+    """:func:`build_edges_into`: the edges of the sorted buckets of the vertex ranges ``lo`` to ``hi - 1``, range
+    ``r``'s numbered from ``first_edge[r]``; ``twins`` empty: not wanted."""
+    n_vertices = bucket_start.shape[0] - 1
+    n_ranges = first_edge.shape[0] - 1
+    with_twins = twins.shape[0] > 0
+    for r in range(lo, hi):
+        e = first_edge[r] - 1
+        for v in range(n_vertices * r // n_ranges, n_vertices * (r + 1) // n_ranges):
+            start, stop = _UNSIGNED(bucket_start[v]), _UNSIGNED(bucket_start[v + 1])
+            previous_high = -1
+            group = start  # the first side of the current edge: the sides of an edge are next to each other
+            for i in range(start, stop):
+                high = sort_key[i] >> 1
+                backward = sort_key[i] & 1
+                side = side_of[i]
+                face = np.int64(_UNSIGNED(side) // _THREE)  # back to signed: -1 and a face share a type
+                if high != previous_high:
+                    if with_twins and i > start:
+                        _edge_twins(sort_key, side_of, twins, group, i)
+                    group = _UNSIGNED(i)
+                    e += 1
+                    previous_high = high
+                    edge = _UNSIGNED(e)
+                    edges[edge, 0] = v
+                    edges[edge, 1] = high
+                    edge_faces[edge, 0] = -1 if backward else face
+                    edge_faces[edge, 1] = face if backward else -1
+                    counts[edge] = 1
+                    forward[edge] = 0 if backward else 1
+                else:
+                    edge = _UNSIGNED(e)
+                    if counts[edge] == 1:
+                        if edge_faces[edge, 1] == -1:
+                            edge_faces[edge, 1] = face
+                        else:
+                            edge_faces[edge, 0] = face
+                    counts[edge] += 1
+                    if not backward:
+                        forward[edge] += 1
+                face_edges[_UNSIGNED(side)] = e
+            if with_twins and stop > start:
+                _edge_twins(sort_key, side_of, twins, group, stop)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -475,34 +535,58 @@ def component_labels(edges, referenced, n_vertices):
     return labels, count
 
 
-@nb.njit(**_JIT)
+@threaded
 def neighbour_lists(edges, n_vertices):
     """CSR lists of the edge neighbours of every vertex: ``(indptr, indices)``.
 
-    One pass counts, one places, scanning the (sorted) edges in order: each
-    list comes out in increasing order. One thread: two passes over the edges
-    bound by memory (a parallel version read every edge once per thread).
+    Each of a few ranges of the (sorted) edges, one per thread, counts, then
+    places, the ends of its own edges (:func:`_count_ends`, :func:`_place_ends`,
+    on threads: :func:`~meshcurv._kernels._common.run_chunks`), around the
+    counting sort's starts (:func:`_bucket_starts`): a vertex's list holds the
+    ends of the first range's edges, then of the next, each in edge order,
+    which is the order of one pass over all the edges (each list increasing),
+    whatever the number of threads.
     """
-    indptr = np.empty(n_vertices + 1, np.int64)
-    for v in range(n_vertices + 1):  # zeros (numba's np.zeros compiles three functions more, issue 31)
-        indptr[v] = 0
-    for e in range(edges.shape[0]):
-        indptr[edges[e, 0] + 1] += 1
-        indptr[edges[e, 1] + 1] += 1
-    for v in range(n_vertices):
-        indptr[v + 1] += indptr[v]
+    n_edges = edges.shape[0]
+    n_ranges = max(1, min(nb.get_num_threads(), _BUCKET_CHUNKS, n_edges))
+    # cursor[r, v]: ends at vertex v of edge range r, then where range r's next such end goes
+    cursor = np.zeros((n_ranges, n_vertices), np.int64)
+    run_chunks(_count_ends, n_ranges, n_ranges, edges, cursor)
+    indptr = _bucket_starts(cursor)
     indices = np.empty(indptr[n_vertices], np.int64)
-    fill = indptr[:-1].copy()
-    for e in range(edges.shape[0]):
-        p, q = edges[e, 0], edges[e, 1]
-        indices[fill[p]] = q
-        fill[p] += 1
-        indices[fill[q]] = p
-        fill[q] += 1
+    run_chunks(_place_ends, n_ranges, n_ranges, edges, cursor, indices)
     return indptr, indices
 
 
 @nb.njit(**_JIT)
+def _count_ends(lo, hi, edges, cursor):
+    """:func:`neighbour_lists`' counts of the edge ranges ``lo`` to ``hi - 1`` in ``cursor``."""
+    n_edges = edges.shape[0]
+    n_ranges = cursor.shape[0]
+    for r in range(lo, hi):
+        counts = cursor[r]
+        for e in range(n_edges * r // n_ranges, n_edges * (r + 1) // n_ranges):
+            counts[_UNSIGNED(edges[e, 0])] += 1
+            counts[_UNSIGNED(edges[e, 1])] += 1
+
+
+@nb.njit(**_JIT)
+def _place_ends(lo, hi, edges, cursor, indices):
+    """:func:`neighbour_lists`' placing of the ends of the edge ranges ``lo`` to ``hi - 1``."""
+    n_edges = edges.shape[0]
+    n_ranges = cursor.shape[0]
+    for r in range(lo, hi):
+        fill = cursor[r]
+        for e in range(n_edges * r // n_ranges, n_edges * (r + 1) // n_ranges):
+            a, b = edges[e, 0], edges[e, 1]
+            p, q = _UNSIGNED(a), _UNSIGNED(b)
+            indices[_UNSIGNED(fill[p])] = b
+            fill[p] += 1
+            indices[_UNSIGNED(fill[q])] = a
+            fill[q] += 1
+
+
+@threaded
 def double_sided_suspects(faces, edge_faces, counts, forward):
     """(E,) bool: the edges ``weld.drop_double_sided`` looks at, in one pass over the edges.
 
@@ -511,19 +595,23 @@ def double_sided_suspects(faces, edge_faces, counts, forward):
     the edge's ends, so their third corners are the same vertex: a lone
     triangle stored with both windings). The NumPy path builds the corner sums
     of every face and gathers them per edge (four temporaries of the size of
-    the edges or faces). One thread: a pass bound by memory, on the path of
-    every call (a parallel loop took the same CPU time and 0.3 s more to
-    compile).
+    the edges or faces). In chunks of edges on threads
+    (:func:`~meshcurv._kernels._common.run_chunks`, :func:`_suspects_chunk`):
+    a pass on the path of every call, each edge's answer its own.
     """
     n_edges = counts.shape[0]
-    out = np.empty(n_edges, np.bool_)
-    for e in range(n_edges):
+    out = np.zeros(n_edges, np.bool_)
+    run_chunks(_suspects_chunk, n_edges, _VERTEX_CHUNKS * nb.get_num_threads(), faces, edge_faces, counts, forward, out)
+    return out
+
+
+@nb.njit(**_JIT)
+def _suspects_chunk(lo, hi, faces, edge_faces, counts, forward, out):
+    """:func:`double_sided_suspects` of the edges ``lo`` to ``hi - 1``."""
+    for e in range(lo, hi):
         count = counts[e]
         if count > 2:
             out[e] = True
         elif count == 2 and forward[e] == 1:
             f, g = _UNSIGNED(edge_faces[e, 0]), _UNSIGNED(edge_faces[e, 1])  # both faces: >= 0
             out[e] = faces[f, 0] + faces[f, 1] + faces[f, 2] == faces[g, 0] + faces[g, 1] + faces[g, 2]
-        else:
-            out[e] = False
-    return out
