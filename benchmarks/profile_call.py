@@ -43,6 +43,7 @@ import os
 import platform
 import sys
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -107,23 +108,27 @@ class Timers:
     def __init__(self):
         self.wall: dict[str, float] = {}
         self.cpu: dict[str, float] = {}
-        self.stack: list[list[float]] = []  # [nested wall, nested cpu] of each open stage
+        self.main: dict[str, float] = {}  # CPU of the calling thread alone
+        self.stack: list[list[float]] = []  # [nested wall, nested cpu, nested main] of each open stage
 
     def wrap(self, stage, function):
         @functools.wraps(function)
         def timed(*args, **kwargs):
-            self.stack.append([0.0, 0.0])
-            wall, cpu = time.perf_counter(), time.process_time()
+            self.stack.append([0.0, 0.0, 0.0])
+            wall, cpu, main = time.perf_counter(), time.process_time(), time.thread_time()
             try:
                 return function(*args, **kwargs)
             finally:
                 wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+                main = time.thread_time() - main
                 nested = self.stack.pop()
                 self.wall[stage] = self.wall.get(stage, 0.0) + wall - nested[0]
                 self.cpu[stage] = self.cpu.get(stage, 0.0) + cpu - nested[1]
+                self.main[stage] = self.main.get(stage, 0.0) + main - nested[2]
                 if self.stack:
                     self.stack[-1][0] += wall
                     self.stack[-1][1] += cpu
+                    self.stack[-1][2] += main
 
         timed.__wrapped_stage__ = True
         return timed
@@ -131,6 +136,7 @@ class Timers:
     def reset(self):
         self.wall.clear()
         self.cpu.clear()
+        self.main.clear()
 
 
 def install(timers: Timers) -> None:
@@ -166,7 +172,7 @@ def load() -> str:
     return ", ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
-def profile(label: str, repeats: int) -> tuple[str, int, float, float, dict, dict]:
+def profile(label: str, repeats: int) -> tuple[str, int, Run]:
     n = SIZES[label]
     mesh = meshcurv.shapes.icosphere(n)
     v = np.ascontiguousarray(mesh.vertices)
@@ -175,31 +181,49 @@ def profile(label: str, repeats: int) -> tuple[str, int, float, float, dict, dic
     runs = []
     for _ in range(repeats):
         TIMERS.reset()
-        wall, cpu = time.perf_counter(), time.process_time()
+        wall, cpu, main = time.perf_counter(), time.process_time(), time.thread_time()
         meshcurv.principal_curvatures(v, f)
-        wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-        runs.append((wall, cpu, dict(TIMERS.wall), dict(TIMERS.cpu)))
-    runs.sort(key=lambda run: run[0])
-    wall, cpu, stage_wall, stage_cpu = runs[len(runs) // 2]
-    return f"icosphere({n})", v.shape[0], wall, cpu, stage_wall, stage_cpu
+        wall, cpu, main = time.perf_counter() - wall, time.process_time() - cpu, time.thread_time() - main
+        runs.append(Run(wall, cpu, main, dict(TIMERS.wall), dict(TIMERS.cpu), dict(TIMERS.main)))
+    runs.sort(key=lambda run: run.wall)
+    return f"icosphere({n})", v.shape[0], runs[len(runs) // 2]
+
+
+class Run(NamedTuple):
+    """One call: its wall, CPU and calling-thread CPU seconds, and the same per stage (exclusive)."""
+
+    wall: float
+    cpu: float
+    main: float
+    stage_wall: dict
+    stage_cpu: dict
+    stage_main: dict
 
 
 def table(results) -> str:
+    """The stage table. ``main CPU s``: the CPU seconds of the calling thread alone, the time the stage would take
+    on otherwise idle cores (the other threads work while it does); a stage whose ``main`` equals its ``CPU``
+    ran on one thread."""
     stages = list(dict.fromkeys(stage for stage, _, _ in STAGES))
-    head = "| stage | " + " | ".join(f"{name} wall s | CPU s | us/vertex (CPU)" for name, *_ in results) + " |"
-    rule = "|---|" + "--:|--:|--:|" * len(results)
-    lines = [head, rule]
+    head = "| stage | " + " | ".join(f"{name} wall s | CPU s | main CPU s | us/vertex (CPU)" for name, *_ in results)
+    rule = "|---|" + "--:|--:|--:|--:|" * len(results)
+    lines = [head + " |", rule]
     for stage in [*stages, "other (Python around the stages)"]:
         cells = []
-        for _name, n_vertices, wall, cpu, stage_wall, stage_cpu in results:
+        for _name, n_vertices, run in results:
             if stage.startswith("other"):
-                w, c = wall - sum(stage_wall.values()), cpu - sum(stage_cpu.values())
+                w = run.wall - sum(run.stage_wall.values())
+                c = run.cpu - sum(run.stage_cpu.values())
+                m = run.main - sum(run.stage_main.values())
             else:
-                w, c = stage_wall.get(stage), stage_cpu.get(stage)
-            cells.append("| | " if w is None else f"{w:.3f} | {c:.3f} | {1e6 * c / n_vertices:.2f}")
-        if any(cell != "| | " for cell in cells):
+                w, c, m = run.stage_wall.get(stage), run.stage_cpu.get(stage), run.stage_main.get(stage)
+            cells.append("| | | " if w is None else f"{w:.3f} | {c:.3f} | {m:.3f} | {1e6 * c / n_vertices:.2f}")
+        if any(cell != "| | | " for cell in cells):
             lines.append(f"| {stage} | " + " | ".join(cells) + " |")
-    totals = [f"**{wall:.3f}** | **{cpu:.3f}** | **{1e6 * cpu / n:.2f}**" for _, n, wall, cpu, _, _ in results]
+    totals = [
+        f"**{run.wall:.3f}** | **{run.cpu:.3f}** | **{run.main:.3f}** | **{1e6 * run.cpu / n:.2f}**"
+        for _, n, run in results
+    ]
     lines.append("| **whole call** | " + " | ".join(totals) + " |")
     return "\n".join(lines)
 
@@ -410,7 +434,11 @@ def main(argv=None) -> int:
     results = []
     for label in args.sizes.split(","):
         results.append(profile(label, args.repeats))
-        print(f"{label}: {results[-1][2]:.3f} s wall, {results[-1][3]:.3f} s CPU", file=sys.stderr)
+        run = results[-1][2]
+        print(
+            f"{label}: {run.wall:.3f} s wall, {run.cpu:.3f} s CPU, {run.main:.3f} s on the calling thread",
+            file=sys.stderr,
+        )
     names = ", ".join(f"{name} ({n:,} vertices)" for name, n, *_ in results)
     text = "\n".join(
         [
@@ -426,7 +454,9 @@ def main(argv=None) -> int:
             f"- meshcurv at commit {_commit()}",
             "",
             "Exclusive times: a stage's own time, without the stages it calls. `other`: the call's total minus "
-            "every stage (argument checks, dataclass copies, Python between the stages).",
+            "every stage (argument checks, dataclass copies, Python between the stages). `main CPU s`: the CPU "
+            "seconds of the calling thread alone, about the wall time on idle cores (it equals `CPU s` where a stage "
+            "runs on one thread).",
             "",
             table(results),
             "",
