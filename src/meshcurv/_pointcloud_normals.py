@@ -189,6 +189,10 @@ LATTICE_SHARE = 0.5
 LATTICE_PLANES = 3
 LATTICE_TOLERANCE = 1e-6
 
+#: A cloud none of whose coordinates repeats among this many of its points, evenly spaced, is on no lattice (the
+#: whole cloud is not read: a lattice of fewer than millions of planes along an axis repeats one there).
+LATTICE_PROBE = 4096
+
 #: On a lattice, a point is on a flat tread of the staircase (see :func:`lattice_treads`) when at least this share
 #: of its :data:`TREAD_NEIGHBOURS` nearest neighbours within its ball lie on its plane of the grid.
 TREAD_SHARE = 0.75
@@ -1322,6 +1326,9 @@ def lattice_steps(points: np.ndarray) -> np.ndarray:
     three for a smooth image). A scan's points, or a rotated lattice, share no coordinates: 0.
     """
     steps = np.zeros(3)
+    probe = points[:: max(1, points.shape[0] // LATTICE_PROBE)]
+    if all(np.unique(probe[:, axis]).size == probe.shape[0] for axis in range(3)):
+        return steps
     for axis in range(3):
         values, counts = np.unique(points[:, axis], return_counts=True)
         planes = values[counts > 1]
