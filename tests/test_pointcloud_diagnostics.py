@@ -65,8 +65,8 @@ def test_cloud_noise_level_is_nan_when_every_ball_faces_away_and_a_note_says_so(
     assert problems == [
         "the noise level was not measured (parameters['noise'] is NaN): 0 of the 800 balls of 3 spacings sampled "
         "were fitted on one side, the others held points facing the other way or too few (noise of about a spacing "
-        "or more, which turns the normals, or a part thinner than the ball); the default radius is that of a clean "
-        "sample"
+        "or more, which turns the normals, or a part thinner than the ball); the radius rules take the level of a "
+        "clean sample"
     ]
     assert np.isnan(radius.cloud_noise_level(points, normals, spacing, centres, usable, facing=np.zeros_like(normals)))
 

@@ -1015,7 +1015,7 @@ def _cloud_noise_level(points, normals, spacing: float, centres, usable, facing,
             f"the noise level was not measured (parameters['noise'] is NaN): {heights.size} of the {sample.size} "
             f"balls of {CLOUD_NOISE_FIT_RADIUS:g} spacings sampled were fitted on one side, the others held points "
             "facing the other way or too few (noise of about a spacing or more, which turns the normals, or a part "
-            "thinner than the ball); the default radius is that of a clean sample"
+            "thinner than the ball); the radius rules take the level of a clean sample"
         )
     return np.nan
 
