@@ -1,4 +1,4 @@
-"""The sampled ball sums of dense voxel surfaces (``icc._sampled_face_sums``, issue 30) and the interpolation of
+"""The voxel pilot's sampled ball sums (``icc._sampled_face_sums``, issue 30) and the interpolation of
 fields that they share with the sampled normal fits (``jets.interpolated_normals`` and its compiled twin)."""
 
 from __future__ import annotations

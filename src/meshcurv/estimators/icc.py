@@ -32,14 +32,11 @@ pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
 the surface bends fast; ``parameters["scale"] == "voxel"``); the pilot runs at
 about half of the vertices (:func:`voxel_pilot`; in anisotropic voxels its normals
 are fitted on a coarse level too, at about one of its centres in two, and its sums
-taken at a sample of its centres, :func:`_pilot_normals`, :func:`_sampled_face_sums`).
-Where the balls of such a surface are wider than 8 median edges (fine voxels),
-the balls are summed at one vertex per cube of half the radius and their
-curvatures interpolated at the others (:func:`_sampled_face_sums`), and
-elsewhere on a voxel surface each ball is summed on clusters of about 32 faces,
-the clusters on its rim by their share of the ball
-(:func:`meshcurv.neighborhoods.coarse_face_sums`): the cost of a vertex no
-longer grows with the density of the faces (``benchmarks/dense_voxel.md``).
+taken at a sample of its centres, :func:`_pilot_normals`, :func:`_sampled_face_sums`),
+and where the balls of such a surface hold 800 faces or more (fine voxels), each
+ball is summed on clusters of about 32 faces, the clusters on its rim by their
+share of the ball (:func:`meshcurv.neighborhoods.coarse_face_sums`): the cost of
+a ball no longer grows with the density of its faces (``benchmarks/dense_voxel.md``).
 
 The normals ``u_i`` are interpolated linearly over each triangle; the
 curvature measures ``mu_0`` (corrected area), ``mu_1`` (2H dA), ``mu_2`` (K dA)
@@ -182,7 +179,6 @@ def fitted_normals(
     failed: np.ndarray | None = None,
     fits: np.ndarray | None = None,
     edge: float | None = None,
-    spacing: float | None = None,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -202,8 +198,7 @@ def fitted_normals(
     describes neither. ``adjacency``: the mesh's edge lists, so that each ball
     is its surface-connected piece (:func:`meshcurv.jets.fit_jets`).
 
-    ``edge``: the median edge length of :func:`_sampled_edge`, when the caller has it. ``spacing``: the sampled
-    fits' on a coarse level, in median radii (default: :data:`meshcurv.jets.SAMPLED_SPACING`).
+    ``edge``: the median edge length of :func:`_sampled_edge`, when the caller has it.
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -230,7 +225,6 @@ def fitted_normals(
             degree=NORMAL_DEGREE,
             iterations=NORMAL_ITERATIONS,
             centres=np.arange(vertices.shape[0]),
-            spacing=None if spacing is None else spacing * float(np.median(radius)),
             neighbours=allowed,
             adjacency=lists,
             settled=NORMAL_SETTLED,
@@ -567,19 +561,9 @@ def _dropped(mesh: PreparedMesh) -> np.ndarray:
     return mesh.degenerate if needle is None else mesh.degenerate | needle
 
 
-#: A voxel surface's main normal fits on a coarse level run at one vertex per cube of this many median radii of
-#: the fits (other meshes: :data:`meshcurv.jets.SAMPLED_SPACING`): the sampled sums below average the jitter of
-#: sparser fits over half a measure radius (``benchmarks/dense_voxel.md``).
-VOXEL_FIT_SPACING = 0.15
-
-#: The balls of a voxel surface's main pass wider than this many median edge lengths (dense voxels, such as
-#: those of ``benchmarks/dense_voxel.py``) are summed at a sample of the vertices and interpolated at the others
-#: (:func:`_sampled_face_sums`) ...
-SAMPLED_SUM_EDGES = 8.0
-#: ... one vertex per cube of this share of the median radius ...
-SUM_SPACING = 0.5
-#: ... interpolated from the samples within this many spacings whose normals agree with the vertex's (cosine
-#: above NORMAL_AGREEMENT: the far side of a part thinner than the reach does not count).
+#: The pilot's sums (:func:`_sampled_face_sums`) are interpolated at the centres that are not samples from the
+#: samples within this many spacings whose normals agree with the centre's (cosine above NORMAL_AGREEMENT: the
+#: far side of a part thinner than the reach does not count).
 SUM_WIDTH = 1.5
 
 
@@ -588,12 +572,14 @@ def _sampled_face_sums(vertices, faces, radius, values, usable, normals, centres
     ``normals``): summed at one centre per cube of side ``spacing`` (:func:`meshcurv.jets._cube_samples`) and
     interpolated at the other centres.
 
-    A sample's sums divided by its corrected area ``mu_0`` (its H, K and shape operator) vary smoothly with the
-    centre of a ball of hundreds of faces; each other centre takes the value at itself of their weighted linear
+    The voxel pilot's (:func:`voxel_pilot`; its values are only read through averages over two rings). A sample's
+    sums divided by its corrected area ``mu_0`` (its H, K and shape operator) vary smoothly with the centre of a
+    ball of many faces; each other centre takes the value at itself of their weighted linear
     least-squares fit over its tangent plane (:func:`meshcurv.jets.interpolated_normals`: the samples within
     :data:`SUM_WIDTH` spacings whose normals agree with its own, else within twice that), with a corrected area
     of 1 (the curvatures are ratios to it). A centre without such a sample is summed over its own ball. The sums
-    then cost the number of samples, not of centres."""
+    then cost the number of samples, not of centres. (The main pass's sums so interpolated blur a curvature that
+    varies within half a radius: a dense voxel ellipsoid's median H error +26%, ``benchmarks/dense_voxel.md``.)"""
     sampled = _cube_samples(vertices[centres], spacing)
     others = np.setdiff1d(np.arange(centres.size), sampled, assume_unique=True)
     at, facing = vertices[centres[others]], np.ascontiguousarray(normals[centres[others]])
@@ -682,7 +668,7 @@ def _curvatures(
 
     start("fit normals")
     failed = np.zeros(vertices.shape[0], dtype=bool)
-    # the median edge that decides the coarse levels and the sampled sums of a voxel surface, taken once
+    # the median edge that decides the coarse level of a voxel surface, taken once
     edge = _sampled_edge(vertices, adjacency) if coarse and adjacency is not None else None
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
@@ -698,7 +684,6 @@ def _curvatures(
             weighted=weighted,
             failed=failed,
             edge=edge,
-            spacing=VOXEL_FIT_SPACING if coarse else None,
         )
 
     start("compute face measures")
@@ -706,16 +691,7 @@ def _curvatures(
 
     start("sum over balls")
     usable = _usable_faces(faces, degenerate, normals)
-    typical = float(np.median(radius))
-    if edge is not None and typical > SAMPLED_SUM_EDGES * edge:
-        inside = np.ones(vertices.shape[0], dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
-        members = np.flatnonzero(inside & np.isfinite(normals).all(axis=1))
-        radii = np.broadcast_to(np.asarray(radius, dtype=np.float64), (vertices.shape[0],))
-        summed = np.zeros((vertices.shape[0], measures.shape[1]))
-        summed[members] = _sampled_face_sums(
-            vertices, faces, radii, measures, usable, normals, members, SUM_SPACING * typical
-        )
-    elif coarse:
+    if coarse:
         summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
         summed = _ball_face_sums(vertices, faces, radius, measures, usable=usable, connected=True)
