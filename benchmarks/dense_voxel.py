@@ -11,7 +11,8 @@ median H error).
 
 ``--profile`` adds where the CPU time of one default call on the first mesh goes, by function
 (``cProfile`` on CPU time; the pilot is the first pass of ``radius.voxel_surface_radius``, icc at 2
-voxels over about half of the vertices, ``icc.voxel_pilot``).
+voxels over about half of the vertices, ``icc.voxel_pilot``). ``--shapes`` adds a dense torus and ellipsoid, whose
+curvature varies within a ball (an estimate interpolated over half a radius blurred them: ``dense_voxel.md``).
 
     python benchmarks/dense_voxel.py --repeats 3 --profile
 """
@@ -112,6 +113,12 @@ def main(argv=None):
         help="also a sphere R 10 at 0.25 x 0.1 x 0.1 (113,072 vertices; a minute a call before the coarse level)",
     )
     parser.add_argument("--profile", action="store_true", help="where one call's CPU time goes, by function")
+    parser.add_argument(
+        "--shapes",
+        action="store_true",
+        help="also a torus (3, 1) and an ellipsoid (4, 3, 2) at 0.1 x 0.04 x 0.04 (71,134 and 54,974 vertices): "
+        "curvatures that vary within a ball, which an interpolation over the surface blurs",
+    )
     args = parser.parse_args(argv)
     meshes = [
         ("voxel sphere R 6, 0.5 x 0.2 x 0.2", shapes.voxel_sphere(6.0, (0.5, 0.2, 0.2), seed=0), True),
@@ -120,6 +127,17 @@ def main(argv=None):
     if args.large:
         meshes.append(
             ("voxel sphere R 10, 0.25 x 0.1 x 0.1", shapes.voxel_sphere(10.0, (0.25, 0.1, 0.1), seed=1), True)
+        )
+    if args.shapes:
+        meshes.append(
+            ("voxel torus (3, 1), 0.1 x 0.04 x 0.04", shapes.voxel_torus(3.0, 1.0, (0.1, 0.04, 0.04), seed=0), True)
+        )
+        meshes.append(
+            (
+                "voxel ellipsoid (4, 3, 2), 0.1 x 0.04 x 0.04",
+                shapes.voxel_ellipsoid((4.0, 3.0, 2.0), (0.1, 0.04, 0.04), seed=1),
+                True,
+            )
         )
     meshes.append(("icosphere 100,002", shapes.icosphere(subdivisions=100, radius=1.0), False))
     rows = []
