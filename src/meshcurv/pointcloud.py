@@ -55,7 +55,8 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
    spacings on clean samples, about 4.3 and 5.9 under noise of 0.05 and 0.2
    spacings for the measures; jets need larger balls under noise); when the
    density varies by more than a factor 2 across the cloud, each class of
-   local spacing (powers of two) gets its own radius;
+   local spacing (powers of two) gets its own radius, with ``nu`` in its own
+   spacings where it is denser than the median (the noise is a length);
 6. the estimator (``method``):
 
    - ``"corrected_measures"`` (default): randomized corrected curvature
@@ -76,7 +77,9 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
      second fundamental form (:func:`meshcurv.jets.shape_operators`);
      a ball that holds the other side of the surface (the default radius or
      a given one) shrinks as the normal fits' do, down to ``3 s``, and is NaN
-     (``invalid_reason``: every ball held the other side) below;
+     (``invalid_reason``: every ball held the other side) below, or where it
+     shrank to half the radius the noise calls for or less (the fit follows
+     the noise);
      the lowest error on clean samples (ellipsoid H 0.2%) and the fastest.
 
 7. the check: an estimate that the same estimator over balls sqrt(2)
@@ -256,9 +259,14 @@ def _reason_code(start: str) -> int:
 #: of a third of a spacing, or a thin plate whose two faces both fall in each ball) is cut to fit, with a warning.
 BALL_PAIRS_SHARE = 0.5
 
-#: Noise level (in spacings, :func:`meshcurv.radius.cloud_noise_level`) from which a point whose one-sided fit
-#: (of the normals, or of ``"jets"``) took a ball below :data:`NOISY_SHRINK` times the radius asked for, or none
-#: (then its PCA normal is kept below this level: right at a sharp rim), is NaN: the noise dominates such a fit.
+#: Noise level (in spacings of the point's class of density, :func:`_class_noise`, of
+#: :func:`meshcurv.radius.cloud_noise_level`) from which a point whose one-sided normal fit (``corrected_measures``)
+#: took a ball of at most :data:`NOISY_SHRINK` times the radius asked for (two of the fits' shrinking steps, within
+#: :data:`SHRINK_ROUNDING`), or none (then its PCA normal is kept below this level: right at a sharp rim), is NaN:
+#: the noise dominates such a fit. The jets' own fits are held to :data:`NOISY_SHRINK` times the radius the noise
+#: calls for at any level (below it a given radius is unsteady too, ``_pointcloud_estimators.SMALL_BALL``): the band
+#: of a thin part under noise whose balls shrank off its other face (``benchmarks/pointcloud.md``, "a denser class
+#: under the cloud's noise").
 #: A plate 4 spacings thick under uniform noise of 1 (0.3) spacing measures 0.29 (0.15): before, 0.3% (7%) of
 #: its points were valid with H off by 100 times (3 times) its value. The clouds of ``benchmarks/pointcloud.py``
 #: under noise of 0.2 spacings measure about 0.08.
@@ -266,6 +274,10 @@ NOISY_PCA = 0.1
 
 #: See :data:`NOISY_PCA`.
 NOISY_SHRINK = 0.5
+
+#: Relative round-off of a radius shrunk in steps (``SHRINK ** 2`` is ``0.5000000000000001``): a fit two steps down
+#: is :data:`NOISY_SHRINK` times the radius asked for.
+SHRINK_ROUNDING = 1e-9
 
 #: Code of points whose normal's side could not be decided (between two sheets closer than the spacing).
 _UNDECIDED = _reason_code("point cloud: side undecided")
@@ -940,12 +952,13 @@ def _compute(points, given, radius, method, search=None):
     compiled = numba_kernels("pointcloud") is not None
     for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
+        seen = _class_noise(noise, median, group_spacing)  # the noise in this class's own spacings
         if method == "jets" and radius is None:
             group_radius = _within_budget(points, group_radius, members, "jet fits", problems)
         if method == "corrected_measures" and given is None:
             normal_radius = _within_budget(
                 points,
-                max(noise_rule(_estimators.NORMAL_RULE, group_spacing, noise), floor),
+                max(noise_rule(_estimators.NORMAL_RULE, group_spacing, seen), floor),
                 members,
                 "normal fits",
                 problems,
@@ -990,7 +1003,12 @@ def _compute(points, given, radius, method, search=None):
                 facing=part_facing,
             )
             asked = group_radius
-            noisy += _noise_dominated(details["radii"], part_members, asked, noise, part_one_sided)
+            # a fit over half the radius the noise calls for or less (a ball shrunk off the other side of a thin
+            # part) follows the noise, as a given radius below SMALL_BALL of it does: at any level of noise
+            needed = cloud_radius(group_spacing, seen, method)
+            noisy += _noise_dominated(
+                details["radii"], part_members, asked, part_one_sided, needed, undefined=seen >= NOISY_PCA
+            )
         else:
             if given is None:
                 asked = normal_radius
@@ -1008,7 +1026,8 @@ def _compute(points, given, radius, method, search=None):
                 failed = part_members[~np.isfinite(details["radii"][part_members])]
                 assert part_mixed is not None  # found above for corrected_measures without given normals
                 part_one_sided[failed] = ~part_mixed[failed]
-                noisy += _noise_dominated(details["radii"], part_members, asked, noise, part_one_sided)
+                if seen >= NOISY_PCA:
+                    noisy += _noise_dominated(details["radii"], part_members, asked, part_one_sided)
             else:
                 normals = part_start
             found = _estimators.corrected_measures(
@@ -1068,7 +1087,7 @@ def _compute(points, given, radius, method, search=None):
     if noisy:
         problems.append(
             f"{noisy} points under noise of {noise:.2g} spacings have a one-sided fit only over balls "
-            f"below {NOISY_SHRINK:g} times the radius the noise calls for, or none (a part thinner than "
+            f"of at most {NOISY_SHRINK:g} times the radius the noise calls for, or none (a part thinner than "
             "that): NaN"
         )
     valid = usable & np.isfinite(k_min) & np.isfinite(k_max)
@@ -1215,14 +1234,23 @@ def _within_reach(points: np.ndarray, members: np.ndarray, reach: float) -> np.n
     return inside if inside.size <= LOCAL_SHARE * n else None
 
 
-def _noise_dominated(radii, members, asked, noise, one_sided) -> int:
-    """Mark in ``one_sided`` the ``members`` whose fit ``radii`` (N,) is NaN or below :data:`NOISY_SHRINK` times
-    ``asked`` when ``noise`` is :data:`NOISY_PCA` or more; return how many had a (small) fit."""
-    if noise < NOISY_PCA:
-        return 0
-    small = members[~(radii[members] >= NOISY_SHRINK * asked)]
-    one_sided[small] = False
-    return int(np.isfinite(radii[small]).sum())  # (those without a fit are counted as such)
+def _noise_dominated(radii, members, asked, one_sided, needed: float | None = None, *, undefined: bool = True) -> int:
+    """Mark in ``one_sided`` the ``members`` whose fit ``radii`` (N,) shrank below ``asked`` to at most
+    :data:`NOISY_SHRINK` times ``needed`` (default: ``asked``; within :data:`SHRINK_ROUNDING`), or is NaN when
+    ``undefined``; return how many had a (small) fit. (A fit at the radius asked for is the caller's choice: a given
+    radius is checked against the noise by :func:`meshcurv._pointcloud_estimators.small_balls`.)"""
+    radii = radii[members]
+    bound = NOISY_SHRINK * (asked if needed is None else needed) * (1.0 + SHRINK_ROUNDING)
+    small = (radii < asked) & (radii <= bound)
+    one_sided[members[small | (undefined & np.isnan(radii))]] = False
+    return int(small.sum())  # (those without a fit are counted as such)
+
+
+def _class_noise(noise: float, median: float, spacing: float) -> float:
+    """The cloud's ``noise`` (in ``median`` spacings) in spacings of a class of density of ``spacing``: the noise is
+    a length, of which a denser class holds more of its own spacings (a sparser one keeps the cloud's level: its
+    radius rule was set on it). Figures: ``benchmarks/pointcloud.md``, "a denser class under the cloud's noise"."""
+    return noise * max(1.0, median / spacing)
 
 
 def _within_budget(points, radius, members, what, problems) -> float:
@@ -1266,7 +1294,8 @@ def _radius_groups(spacing, indices, usable, median, noise, radius, method, prob
             members = on_line[level == k]
             floor = float(least[members].max())
             group_spacing = float(np.median(spacing[members]))
-            lines.append((max(cloud_radius(group_spacing, noise, method), floor), group_spacing, members, floor))
+            seen = _class_noise(noise, median, group_spacing)
+            lines.append((max(cloud_radius(group_spacing, seen, method), floor), group_spacing, members, floor))
     if centres.size == 0:  # (no usable point: every point an outlier or on a line)
         return lines or [(cloud_radius(median, noise, method), median, centres, 0.0)]
     # the spacing averaged over the neighbours: one class per region, not per random gap
@@ -1280,7 +1309,15 @@ def _radius_groups(spacing, indices, usable, median, noise, radius, method, prob
     groups = []
     for k in np.unique(level):
         members = centres[level == k]
-        groups.append((cloud_radius(median * 2.0**k, noise, method), median * 2.0**k, members, 0.0))
+        group_spacing = median * 2.0**k
+        groups.append(
+            (
+                cloud_radius(group_spacing, _class_noise(noise, median, group_spacing), method),
+                group_spacing,
+                members,
+                0.0,
+            )
+        )
     problems.append(
         f"the density of the points is very uneven (local spacing from {low:.3g} to {high:.3g}, "
         f"5th to 95th percentile): each of {len(groups)} classes of spacing got its own radius"
