@@ -910,8 +910,9 @@ def make_cloud_case(rng):
     if copies > 1:
         jitter = float(rng.choice([1e-15, 1e-13, 1e-11, 1e-9]))
         scale = np.abs(points).max()
-        # registration errors (merged scans, overlapping tiles) from a stream of their own, so that the
-        # cases of earlier rounds keep their points: each copy moved as a whole or each point on its own
+        # registration errors (merged scans, overlapping tiles) from a stream of their own, so that the other
+        # draws of a case are those of earlier rounds (but half of the copy cases now get a shift: those change):
+        # each copy moved as a whole or each point on its own
         side = rng.spawn(1)[0]
         shift = float(side.choice(REGISTRATION_SHIFTS)) * area_spacing if side.random() < 0.5 else 0.0
         whole = side.random() < 0.5
