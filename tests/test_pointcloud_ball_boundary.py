@@ -38,11 +38,6 @@ def on_both(points: np.ndarray, **options):
     return results
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="jets.py's NumPy weights sum |d|^2 with numpy.einsum, the kernel x, y, z in order "
-    "(benchmarks/pointcloud.md, 'points on the ball's sphere')",
-)
 # (radius, least share of the points valid): at sqrt(2), beyond the radius of curvature, none is (the parameter
 # ``shrunk``, the share of balls that held the other side, is what differed there)
 @pytest.mark.parametrize(("radius", "least"), [(1.0, 0.9), (2.0**0.5, 0.0)])

@@ -573,7 +573,9 @@ def test_a_clean_thin_plate_leaves_no_valid_wrong_point(seed):
     points, normals, mean, kmax = ellipsoid(4000, (1.0, 0.5, 0.02), seed=seed)
     spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
     r = quiet(points, normals=-normals)
-    assert r.parameters["noise"] < 0.05  # the points are on the ellipsoid: no noise (0.35-0.37 before)
+    # the points are on the ellipsoid: no noise (0.35-0.37 before); every ball of the noise fits holds both faces, so
+    # no level is measured (NaN, and the radius of a clean sample)
+    assert not r.parameters["noise"] >= 0.05
     resolved = kmax * spacing <= 0.25  # as the fuzzer checks: radius of curvature of 4 spacings or more
     side = np.sign(np.einsum("ij,ij->i", r.normals, normals))
     wrong = r.valid & resolved & ~(np.abs(r.mean - side * mean) / kmax <= 0.5)

@@ -558,7 +558,9 @@ def _fit_jets(
         rows = centre - chunk.start
         inverse = (1.0 / radius)[centre][:, None] if per_centre else 1.0 / radius  # the kernels' operations
         offsets = (vertices[neighbour] - vertices[index[rows]]) * inverse
-        weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
+        # x, y and z summed in the kernel's order: a point exactly on the ball's sphere weighs 0 on both backends
+        squared = offsets[:, 0] * offsets[:, 0] + offsets[:, 1] * offsets[:, 1] + offsets[:, 2] * offsets[:, 2]
+        weights = np.maximum(1.0 - squared, 0.0) ** 2
         if areas.size:
             weights = weights * areas[neighbour]
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)

@@ -922,7 +922,8 @@ def _compute(points, given, radius, method, search=None):
     logger.info("point cloud: noise level")
     # (its fits refuse balls holding the other side too: through both faces of a plate thinner than the ball a jet
     # reads half the thickness as noise, and the radius that noise calls for reaches across the whole cloud)
-    noise = _cloud_noise_level(points, start, median, centres, usable, facing)
+    measured = _cloud_noise_level(points, start, median, centres, usable, facing, problems)
+    noise = measured if np.isfinite(measured) else 0.0  # not measured (NaN, a note in problems): a clean sample's rules
     groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems, least_radius)
     if radius is None:
         extent = points[usable]
@@ -939,7 +940,7 @@ def _compute(points, given, radius, method, search=None):
     dir_min, dir_max = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
     out_normals = start.copy()
     logger.info("point cloud: %s over %d radius class(es)", method, len(groups))
-    parameters = {"radius": groups[0][0], "spacing": median, "noise": noise, "normals": how}
+    parameters = {"radius": groups[0][0], "spacing": median, "noise": measured, "normals": how}
     shrunk = 0  # points whose jet fit took a smaller ball than asked for (its ball held the other side)
     two_sided = 0  # points whose every ball held the other side (or too few points)
     one_sided = np.ones(n, dtype=bool)  # points with a one-sided jet fit (or given normals)
@@ -1140,6 +1141,11 @@ def _compute(points, given, radius, method, search=None):
         problems.extend(_estimators.wide_jets_problem(wide))
         reason[wide] = _UNSTEADY
         valid &= ~wide
+    # a voxel surface read as a cloud: a ball on a flat tread of its staircase sees a plane
+    tread, found = _normals.lattice_treads(points, out_normals, balls, valid & ~doubtful, tree)
+    problems.extend(found)
+    reason[tread] = _UNSTEADY
+    valid &= ~tread
     # an estimate none of whose nearest neighbours has one: alone in a region the estimator does not resolve
     lone = _estimators.alone(valid & ~doubtful, indices)
     problems.extend(_estimators.alone_problem(lone))
