@@ -95,6 +95,7 @@ def test_where_no_ball_is_refused_the_noise_level_measures_the_noise(noise):
 
 
 def test_the_vertices_of_marching_cubes_lie_on_the_grid_of_half_voxels():
+    pytest.importorskip("skimage")  # the voxel shapes (marching cubes)
     # a mask's marching cubes put each vertex at the midpoint of a voxel edge: every coordinate k on the grid of half
     # voxels (spacing_k / 2), translated alike; a random sample, or the lattice turned, shares no coordinate
     from meshcurv._pointcloud_normals import lattice_steps
@@ -139,6 +140,7 @@ def test_two_grid_planes_stacked_with_normals_the_same_way_are_still_flagged():
     ids=["sphere-0.7x1x1.3", "torus-1x0.7x1.2"],
 )
 def test_voxel_surfaces_in_anisotropic_voxels_are_one_sheet_and_right(make):
+    pytest.importorskip("skimage")  # the voxel shapes (marching cubes)
     # the steps of the staircase (up to half a voxel off the surface each) are not stacked sheets: most points
     # valid (at 300b795 none: every point "side undecided"), each within half the largest |k| of the exact
     # surface's at its closest point, outward
@@ -155,6 +157,7 @@ def test_voxel_surfaces_in_anisotropic_voxels_are_one_sheet_and_right(make):
 
 
 def test_coarse_voxels_leave_no_wrong_valid_point():
+    pytest.importorskip("skimage")  # the voxel shapes (marching cubes)
     # voxels 2 x 0.5 x 0.5 (their half voxel 1.6 spacings): patches of the staircase are turned inside out (21% of
     # the torus's normals) and its flat treads, where the tube is at right angles to x, are wider than the balls
     # (curvature 0 there, valid: 71 points off by more than half of |k| at 300b795, jets). Nothing valid is wrong
