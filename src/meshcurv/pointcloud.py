@@ -13,8 +13,12 @@ backend, from a grid of the ball's radius; no O(N^2) memory):
 
 1. checks: shape, NaN, at least :data:`MIN_POINTS` points, not all on a line;
    duplicate points, and near copies (a point's nearest neighbours closer than
-   :data:`COPY_GAP` times the distance to the next one: merged scans,
-   overlapping tiles), are computed once and copied; points whose neighbours are
+   :data:`COPY_GAP` times the distance to the next one: round-off), are
+   computed once and copied; so are copies a registration error apart (merged
+   scans, overlapping tiles: a cloud where many points jump from their nearest
+   neighbours to the next by :data:`REGISTRATION_JUMP`; see
+   :func:`_registration_gap`), each group measured at its centroid, so that
+   the spacing is never read between the copies of one point; points whose neighbours are
    all far (outliers) stay out of every neighbourhood and are NaN; the
    distinct points are taken in Morton (Z-curve) order, so that neighbours
    are near in memory (the results do not depend on the input's order);
@@ -227,6 +231,29 @@ KNN_SAMPLE = 4096
 
 #: Most copies of one point found (see :data:`COPY_SUSPECT`).
 COPY_NEIGHBOURS = 64
+
+#: Copies a registration error apart (merged scans, overlapping tiles: each point several times, the copies a
+#: few thousandths to a tenth of a spacing apart, far above round-off; :func:`_registration_gap`): a point's
+#: nearest neighbours, before a jump of at least this factor to the next distance, are its copies...
+REGISTRATION_JUMP = 4.0
+#: ...when at least this share of a sample of the points shows such a jump. A random sample of a surface shows
+#: it at about 1 / REGISTRATION_JUMP^2 of its points (the squared ratio of the nearest two distances is uniform
+#: on a plane: 6.3-7% measured from 400 to 200,000 points), a cloud of copies at most of its points; a cloud
+#: of which a part was copied (two overlapping tiles) at about twice the part's share.
+REGISTRATION_SHARE = 0.15
+#: The points of a cloud of copies closer than this times the 90th percentile of the copies' spread (the
+#: largest distance before the jump) are merged, up to :data:`REGISTRATION_CAP` times the median distance
+#: beyond the jump (the spacing of the distinct points): what is merged stays well inside one spacing.
+REGISTRATION_SPREAD = 2.0
+REGISTRATION_CAP = 0.25
+#: Points along curves (a line, scan lines, fibres) jump too (on a line, about a third of them by 4): a sample
+#: whose groups before the jump hold fewer than this many points, and whose distances grow from the middle of
+#: the row to its end by more than this factor (sqrt 2 on a surface, 2 along a curve), is no cloud of copies.
+#: (Groups of more copies are copies: a curve's jumps are after its first neighbour or two.)
+REGISTRATION_CURVE_GROUP = 8
+REGISTRATION_CURVE_GROWTH = 1.7
+#: Points of the sample searched for the jump, and the distances looked at from each.
+REGISTRATION_SAMPLE = 2048
 
 #: A part of the cloud whose points are this share or more between two sheets closer than the spacing
 #: (:func:`meshcurv._pointcloud_normals.two_sheets`) is thinner than the spacing: every point's side is undecided.
@@ -484,29 +511,38 @@ def _prepared_cloud(points, faces, normals, method) -> _Cloud:
     unique = order[representative[order] == order]
     n_exact = n_all - unique.size
     search = None
+    registration, centres = 0.0, None
     if unique.size >= MIN_POINTS:
-        # near copies (round-off differences) are merged into the first of them in the Morton order
-        copy_of, search = _near_copies(points[unique])
+        # near copies (round-off differences, registration errors) are merged into the first of them in the
+        # Morton order
+        copy_of, search, registration = _near_copies(points[unique])
         keep = copy_of == np.arange(unique.size)
+        if registration:
+            # copies a registration error apart: each group measured at its centroid (the errors averaged out)
+            group = np.cumsum(keep)[copy_of] - 1
+            sums = np.stack([np.bincount(group, weights=points[unique, axis]) for axis in range(3)], axis=1)
+            centres = sums / np.bincount(group)[:, None]
         if not keep.all():
             representative = unique[copy_of][_position(unique, n_all)[representative]]
             unique = unique[keep]
-            search = _kept_search(points[unique], keep, *search[1:])
+            search = None if registration else _kept_search(points[unique], keep, *search[1:])
     if unique.size < n_all:
         near = n_all - unique.size - n_exact
         found = [f"{n_exact} points coincide with others (duplicates)"] if n_exact else []
-        found += (
-            [
+        if near and registration:
+            found.append(
+                f"{near} points are copies of others a registration error apart (within {registration:.2g} of "
+                "the spacing of the distinct points: merged scans or overlapping tiles)"
+            )
+        elif near:
+            found.append(
                 f"{near} points are near copies of others (closer to one than {COPY_GAP:g} times the distance "
                 "to their next neighbour: round-off differences)"
-            ]
-            if near
-            else []
-        )
+            )
         problems.append(" and ".join(found) + ": merged, each computed once and its values copied")
     if unique.size < MIN_POINTS:
         raise InvalidMeshError(f"`points` holds {unique.size} distinct points; at least {MIN_POINTS} are needed")
-    cloud = points[unique]
+    cloud = points[unique] if centres is None else centres
     _check_spread(cloud)
     take = _position(unique, n_all)[representative]
     return _Cloud(cloud, None if given is None else given[unique], method, take, search, problems)
@@ -592,12 +628,14 @@ def _position(unique: np.ndarray, n: int) -> np.ndarray:
 
 
 def _near_copies(cloud: np.ndarray):
-    """``(copy_of, search)``: (M,) the point each point of ``cloud`` is a copy of (itself when none), and
-    ``(tree, distances, indices)`` of ``cloud`` (:func:`_kept_search` makes them those of the points kept).
+    """``(copy_of, search, registration)``: (M,) the point each point of ``cloud`` is a copy of (itself when none),
+    ``(tree, distances, indices)`` of ``cloud`` (:func:`_kept_search` makes them those of the points kept), and
+    the registration error merged, in spacings of the distinct points (0.0 when the cloud is no cloud of copies).
 
     Point ``j`` is a copy of ``i`` when it is among ``i``'s nearest neighbours before a gap:
-    ``d_m <= COPY_GAP d_(m+1)`` for the ``m``-th and next distances (the largest such ``m``). Groups
-    of copies are the connected components of these pairs; each becomes its first point.
+    ``d_m <= COPY_GAP d_(m+1)`` for the ``m``-th and next distances (the largest such ``m``), or, in a cloud of
+    copies a registration error apart (:func:`_registration_gap`), when it lies within that error. Groups of
+    copies are the connected components of these pairs; each becomes its first point.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -609,22 +647,73 @@ def _near_copies(cloud: np.ndarray):
     rows, cols = _copy_pairs(np.arange(m), distances, indices)
     with np.errstate(over="ignore", invalid="ignore"):
         scale = float(np.linalg.norm(cloud.max(axis=0) - cloud.min(axis=0))) / np.sqrt(m)
-    # points whose every neighbour is (nearly) there may have more copies: a wider search for the gap
-    suspect = np.flatnonzero((distances[:, -1] < COPY_SUSPECT * scale) & ~np.isin(np.arange(m), rows))
+    gap, spacing = _registration_gap(tree, cloud)
+    if gap > 0.0:
+        # every pair within the error; a point whose every neighbour is within it may have more copies
+        near = distances <= gap
+        rows = np.concatenate([rows, np.repeat(np.arange(m), near.sum(axis=1))])
+        cols = np.concatenate([cols, indices[near]])
+        suspect = np.flatnonzero(near[:, -1])
+    else:
+        # points whose every neighbour is (nearly) there may have more copies: a wider search for the gap
+        suspect = np.flatnonzero((distances[:, -1] < COPY_SUSPECT * scale) & ~np.isin(np.arange(m), rows))
     if suspect.size and distances.shape[1] < m - 1:
         k = min(COPY_NEIGHBOURS, m - 1)
         d, i = tree.query(cloud[suspect], k=k + 1)
         wide_d, wide_i = np.zeros((suspect.size, k)), np.zeros((suspect.size, k), dtype=np.int64)
         _drop_rows(suspect, d, i, k, wide_d, wide_i)
-        more_rows, more_cols = _copy_pairs(suspect, wide_d, wide_i)
+        if gap > 0.0:
+            near = wide_d <= gap
+            more_rows, more_cols = np.repeat(suspect, near.sum(axis=1)), wide_i[near]
+        else:
+            more_rows, more_cols = _copy_pairs(suspect, wide_d, wide_i)
         rows, cols = np.concatenate([rows, more_rows]), np.concatenate([cols, more_cols])
+    registration = gap / spacing if gap > 0.0 else 0.0
     if rows.size == 0:
-        return np.arange(m), (tree, distances, indices)
+        return np.arange(m), (tree, distances, indices), registration
     graph = coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(m, m))
     _, labels = connected_components(graph, directed=False)
     first = np.full(int(labels.max()) + 1, m, dtype=np.int64)
     np.minimum.at(first, labels, np.arange(m))
-    return first[labels], (tree, distances, indices)
+    return first[labels], (tree, distances, indices), registration
+
+
+def _registration_gap(tree, cloud: np.ndarray) -> tuple[float, float]:
+    """``(gap, spacing)``: the distance within which the points of a cloud of copies a registration error apart
+    are copies of one point, and the spacing of its distinct points; ``(0.0, 0.0)`` for any other cloud.
+
+    On :data:`REGISTRATION_SAMPLE` points spread over the Morton order, the :data:`COPY_NEIGHBOURS` nearest
+    distances: the largest ratio of one to the next is the jump from a point's copies to the next point. When
+    :data:`REGISTRATION_SHARE` of the sample or more jump by :data:`REGISTRATION_JUMP` or more, the gap is
+    :data:`REGISTRATION_SPREAD` times the 90th percentile of the distances before the jump, at most
+    :data:`REGISTRATION_CAP` times the median distance after it (the spacing returned); a gap below
+    :data:`COPY_GAP` spacings is round-off, left to the merge by that gap. Points along curves are no copies
+    (:data:`REGISTRATION_CURVE_GROWTH`).
+    """
+    m = cloud.shape[0]
+    k = min(COPY_NEIGHBOURS, m - 1)
+    if k < 4:
+        return 0.0, 0.0
+    sample = np.unique(np.linspace(0, m - 1, min(REGISTRATION_SAMPLE, m)).astype(np.int64))
+    d = tree.query(cloud[sample], k=k + 1, workers=-1)[0][:, 1:]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        ratio = d[:, 1:] / d[:, :-1]
+    ratio[~np.isfinite(ratio) | (d[:, :-1] <= MIN_SPACING)] = 1.0
+    last = ratio.argmax(axis=1)
+    jumped = ratio[np.arange(sample.size), last] >= REGISTRATION_JUMP
+    if jumped.mean() < REGISTRATION_SHARE:
+        return 0.0, 0.0
+    rows = np.flatnonzero(jumped)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        growth = float(np.median(d[:, -1] / d[:, k // 2 - 1]))
+    if np.median(last[rows]) < REGISTRATION_CURVE_GROUP and not growth <= REGISTRATION_CURVE_GROWTH:
+        return 0.0, 0.0  # points along curves (a line, scan lines): their gaps are no copies
+    spread, beyond = d[rows, last[rows]], d[rows, last[rows] + 1]
+    spacing = float(np.median(beyond))
+    gap = min(REGISTRATION_SPREAD * float(np.quantile(spread, 0.9)), REGISTRATION_CAP * spacing)
+    if not (np.isfinite(gap) and gap > COPY_GAP * spacing and spacing > 0.0):
+        return 0.0, 0.0  # (copies within round-off: merged by the gap of COPY_GAP alone)
+    return gap, spacing
 
 
 def _knn(tree, cloud: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
