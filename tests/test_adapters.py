@@ -44,6 +44,27 @@ def test_pyvista_polydata_and_its_split_corners():
     np.testing.assert_allclose(r.k_max, reference().k_max[corners], rtol=1e-9)  # vertex order differs: round-off
 
 
+def test_pyvista_triangle_strips_are_their_triangles():
+    # `PolyData.strip()` (and VTK files written from it) hold triangle strips and no polygons: the same surface
+    pv = pytest.importorskip("pyvista")
+    flat = np.c_[np.full(SPHERE.faces.shape[0], 3), SPHERE.faces].ravel()
+    stripped = pv.PolyData(SPHERE.vertices, flat).strip()
+    assert stripped.n_strips > 0 and np.asarray(stripped.faces).size == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the joins of strips are no faces: no warning about degenerate faces
+        result = meshcurv.principal_curvatures(stripped)
+    np.testing.assert_allclose(result.k_min, reference().k_min, rtol=1e-9)  # the faces in another order
+    np.testing.assert_allclose(result.k_max, reference().k_max, rtol=1e-9)
+    # a strip's triangles face its side: every other one wound the other way round, as VTK's
+    ours = meshcurv._adapters._strip_triangles(np.array([5, 0, 1, 2, 3, 4]))
+    np.testing.assert_array_equal(ours, [[0, 1, 2], [2, 1, 3], [2, 3, 4]])
+    # strips beside polygons: both kept
+    half = SPHERE.faces.shape[0] // 2
+    mixed = pv.PolyData(SPHERE.vertices, np.c_[np.full(half, 3), SPHERE.faces[:half]].ravel())
+    mixed.strips = np.c_[np.full(SPHERE.faces.shape[0] - half, 3), SPHERE.faces[half:]].ravel()
+    np.testing.assert_allclose(meshcurv.principal_curvatures(mixed).k_max, reference().k_max, rtol=1e-9)
+
+
 def test_meshio_mesh_with_triangles_and_quads():
     meshio = pytest.importorskip("meshio")
     same(meshcurv.principal_curvatures(meshio.Mesh(SPHERE.vertices, [("triangle", SPHERE.faces)])))

@@ -6,7 +6,7 @@ In: :func:`mesh_arrays` takes the vertices and faces of
 library                        recognised by                               faces from
 =============================  ==========================================  ==================================
 trimesh ``Trimesh``            ``.vertices`` and ``.faces`` arrays         ``faces``
-PyVista ``PolyData``           ``.points`` and ``.faces`` (flat, counted)  the flat VTK cell array
+PyVista ``PolyData``           ``.points``, ``.faces`` and ``.strips``     the flat VTK cell arrays
 PyVista ``UnstructuredGrid``   ``.points`` and ``.celltypes``              triangle, quad, pixel, polygon cells
 meshio ``Mesh``                ``.points`` and ``.cells`` (cell blocks)    "triangle" (and "quad") blocks
 Open3D ``TriangleMesh``        ``.vertices`` and ``.triangles``            ``triangles``
@@ -62,6 +62,35 @@ def _vtk_cells(flat: np.ndarray):
         faces.append(flat[position + 1 : position + 1 + count])
         position += 1 + count
     return faces
+
+
+def _strip_triangles(flat: np.ndarray) -> np.ndarray:
+    """(T, 3) the triangles of a VTK flat array of triangle strips ``[n0, i.., n1, j.., ...]``.
+
+    A strip's points ``p0, p1, p2, ...`` make the triangles ``(p_j, p_j+1, p_j+2)``, every other one wound the
+    other way round (``(p_j+1, p_j, p_j+2)`` for odd ``j``), so that all face the strip's side, as VTK's
+    ``vtkTriangleStrip`` makes them; the triangles with a repeated point (joins of two strips) are left out.
+    """
+    flat = np.asarray(flat, dtype=np.int64).ravel()
+    triangles, position = [np.zeros((0, 3), dtype=np.int64)], 0
+    while position < flat.size:  # a loop over strips (each strip's triangles at once)
+        count = int(flat[position])
+        if count < 0 or position + 1 + count > flat.size:
+            raise InvalidMeshError("the PyVista mesh's strip array is malformed (a count runs past its end)")
+        ids = flat[position + 1 : position + 1 + count]
+        j = np.arange(max(count - 2, 0))
+        odd = j % 2 == 1
+        first, second, third = ids[j], ids[j + 1], ids[j + 2]
+        triangles.append(np.stack([np.where(odd, second, first), np.where(odd, first, second), third], axis=1))
+        position += 1 + count
+    triangles = np.concatenate(triangles)
+    # a repeated point joins two strips (a triangle of no area by construction, not a face of the surface)
+    joins = (
+        (triangles[:, 0] == triangles[:, 1])
+        | (triangles[:, 1] == triangles[:, 2])
+        | (triangles[:, 0] == triangles[:, 2])
+    )
+    return triangles[~joins]
 
 
 #: VTK cell types (``vtkCellType.h``) taken as faces; a pixel's corners run 0, 1, 3, 2 around it.
@@ -176,9 +205,16 @@ def mesh_arrays(mesh) -> tuple[np.ndarray, object]:
         polygons = faces[0] if len(faces) == 1 else [face for block in faces for face in block]
         return np.asarray(mesh.points), polygons
     if hasattr(mesh, "points") and hasattr(mesh, "faces"):  # PyVista PolyData
-        if np.asarray(mesh.faces).size == 0:
-            raise InvalidMeshError(f"the {kind} has no polygon faces (lines, vertices or strips only?)")
-        return np.asarray(mesh.points), _vtk_cells(mesh.faces)
+        polygons, strips = np.asarray(mesh.faces), np.asarray(getattr(mesh, "strips", np.zeros(0)))
+        if polygons.size == 0 and strips.size == 0:
+            raise InvalidMeshError(f"the {kind} has no polygon faces and no triangle strips (lines or vertices only?)")
+        if strips.size == 0:
+            return np.asarray(mesh.points), _vtk_cells(polygons)
+        triangles = _strip_triangles(strips)  # triangle strips (``PolyData.strip()``, some VTK files): their triangles
+        faces = _vtk_cells(polygons)
+        if isinstance(faces, np.ndarray) and faces.shape[1] == 3:
+            return np.asarray(mesh.points), np.concatenate([faces, triangles])
+        return np.asarray(mesh.points), [*faces, *triangles]
     if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):  # trimesh (and alike)
         return np.asarray(mesh.vertices), np.asarray(mesh.faces)
     if hasattr(mesh, "points") or hasattr(mesh, "vertices"):  # PyVista PointSet, trimesh or Open3D PointCloud
