@@ -72,7 +72,7 @@ def _strip_triangles(flat: np.ndarray) -> np.ndarray:
     ``vtkTriangleStrip`` makes them; the triangles with a repeated point (joins of two strips) are left out.
     """
     flat = np.asarray(flat, dtype=np.int64).ravel()
-    triangles, position = [np.zeros((0, 3), dtype=np.int64)], 0
+    parts, position = [np.zeros((0, 3), dtype=np.int64)], 0
     while position < flat.size:  # a loop over strips (each strip's triangles at once)
         count = int(flat[position])
         if count < 0 or position + 1 + count > flat.size:
@@ -81,9 +81,9 @@ def _strip_triangles(flat: np.ndarray) -> np.ndarray:
         j = np.arange(max(count - 2, 0))
         odd = j % 2 == 1
         first, second, third = ids[j], ids[j + 1], ids[j + 2]
-        triangles.append(np.stack([np.where(odd, second, first), np.where(odd, first, second), third], axis=1))
+        parts.append(np.stack([np.where(odd, second, first), np.where(odd, first, second), third], axis=1))
         position += 1 + count
-    triangles = np.concatenate(triangles)
+    triangles = np.concatenate(parts)
     # a repeated point joins two strips (a triangle of no area by construction, not a face of the surface)
     joins = (
         (triangles[:, 0] == triangles[:, 1])
