@@ -92,6 +92,61 @@ def _legacy_polydata(binary: bool, version: str) -> bytes:
     return b"".join(parts)
 
 
+def _strip_files() -> list[tuple[str, str, bytes]]:
+    """Triangle strips beside polygons: legacy VTK (ASCII, binary) and .vtp, half the torus's faces each way.
+
+    One strip per face, and two faces in one strip joined through repeated points (``a b c c d d d e f``: the
+    triangles between have no area), as ``vtkStripper`` joins them.
+    """
+    torus = shapes.torus(n_major=6, n_minor=4)
+    vertices, faces = torus.vertices, torus.faces
+    half = len(faces) // 2
+    strips = [list(face) for face in faces[half:-2].tolist()]
+    (a, b, c), (d, e, f) = faces[-2].tolist(), faces[-1].tolist()
+    strips.append([a, b, c, c, d, d, d, e, f])
+    flat = [value for strip in strips for value in [len(strip), *strip]]
+    out = []
+    for binary in (False, True):
+
+        def array(values, code, binary=binary):
+            if binary:
+                return np.asarray(values).astype(">" + code).tobytes() + b"\n"
+            return (" ".join(map(str, np.asarray(values).ravel().tolist())) + "\n").encode()
+
+        cells = np.column_stack([np.full(half, 3), faces[:half]])
+        out.append(
+            (
+                f"vtk-strips-{'bin' if binary else 'ascii'}",
+                ".vtk",
+                f"# vtk DataFile Version 4.2\nfuzz\n{'BINARY' if binary else 'ASCII'}\nDATASET POLYDATA\n".encode()
+                + f"POINTS {len(vertices)} double\n".encode()
+                + array(vertices, "f8")
+                + f"POLYGONS {half} {cells.size}\n".encode()
+                + array(cells, "i4")
+                + f"TRIANGLE_STRIPS {len(strips)} {len(flat)}\n".encode()
+                + array(flat, "i4"),
+            )
+        )
+
+    def data_array(values, name, kind="Int64", components=1):
+        text = " ".join(map(str, np.asarray(values).ravel().tolist()))
+        return (
+            f'<DataArray type="{kind}" Name="{name}" NumberOfComponents="{components}" format="ascii">'
+            f"{text}</DataArray>"
+        )
+
+    ends = np.cumsum([len(strip) for strip in strips])
+    polys = data_array(faces[:half], "connectivity") + data_array(3 * np.arange(1, half + 1), "offsets")
+    vtp = (
+        f'<VTKFile type="PolyData"><PolyData><Piece NumberOfPoints="{len(vertices)}">'
+        f"<Points>{data_array(vertices, 'points', 'Float64', 3)}</Points><Polys>{polys}</Polys>"
+        f"<Strips>{data_array(sum(strips, []), 'connectivity')}{data_array(ends, 'offsets')}</Strips>"
+        "</Piece></PolyData></VTKFile>\n"
+    )
+    out.append(("vtp-strips-ascii", ".vtp", vtp.encode()))
+    return out
+
+
 def seeds(directory: pathlib.Path) -> list[tuple[str, str, bytes]]:
     """``(label, extension, bytes)``: valid small files of every readable format and layout."""
     torus = shapes.torus(n_major=6, n_minor=4)
@@ -116,6 +171,7 @@ def seeds(directory: pathlib.Path) -> list[tuple[str, str, bytes]]:
             found.append(
                 (f"vtk-polydata{version}-{'bin' if binary else 'ascii'}", ".vtk", _legacy_polydata(binary, version))
             )
+    found += _strip_files()
     unique = {}
     for label, extension, data in found:
         unique.setdefault((extension, data), label)

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import MeshFileError
 from ._text import numbers
+from ._vtk import strip_triangles
 
 __all__ = ["read_vtp", "read_vtp_point_data", "read_vtp_cell_data", "write_vtp", "PieceWriter"]
 
@@ -246,19 +247,19 @@ def read_vtp_cell_data(path) -> dict[str, np.ndarray]:
     return _arrays(path, "CellData")
 
 
+#: The cell elements of a piece read, and what they are called in messages.
+_CELLS = {"Polys": "polygon", "Strips": "triangle strip"}
+
+
 def _read_piece(piece, path, options):
-    """``(vertices, connectivity, offsets)`` of one ``<Piece>``."""
+    """``(vertices, connectivity, offsets)`` of one ``<Piece>``: its polygons, then the triangles of its triangle
+    strips (``<Strips>``, as VTK's ``vtkStripper`` and PyVista's ``strip()`` write them)."""
     points = piece.find("Points/DataArray")
-    polys = piece.find("Polys")
-    if points is None or polys is None:
-        raise MeshFileError(f"{path}: the PolyData has no points or no polygons")
-    arrays = {element.get("Name"): element for element in polys.findall("DataArray")}
-    if "connectivity" not in arrays or "offsets" not in arrays:
-        raise MeshFileError(f"{path}: the polygons lack a connectivity or an offsets array")
+    cells = [piece.find(tag) for tag in _CELLS]
+    if points is None or all(element is None for element in cells):
+        raise MeshFileError(f"{path}: the PolyData has no points or no polygons (nor triangle strips)")
     try:
         vertices = _decode(points, path, **options).astype(np.float64).reshape(-1, 3)
-        connectivity = _decode(arrays["connectivity"], path, **options).astype(np.int64)
-        offsets = _decode(arrays["offsets"], path, **options).astype(np.int64)
     except MeshFileError:
         raise
     except (ValueError, zlib.error, binascii.Error) as exc:
@@ -268,10 +269,34 @@ def _read_piece(piece, path, options):
         raise MeshFileError(
             f"{path}: the PolyData declares {declared.strip()[:20]} points but holds {vertices.shape[0]}"
         )
-    sizes = np.diff(offsets, prepend=0)
-    if (offsets.size and offsets[-1] != connectivity.size) or (sizes < 3).any():
+    polys, strips = (_cell_arrays(element, path, options) for element in cells)
+    connectivity, offsets = polys
+    if (np.diff(offsets, prepend=0) < 3).any():
         raise MeshFileError(f"{path}: the polygon offsets do not match the connectivity")
+    if strips[1].size:
+        triangles = strip_triangles(*strips)
+        offsets = np.concatenate([offsets, connectivity.size + 3 * np.arange(1, triangles.shape[0] + 1)])
+        connectivity = np.concatenate([connectivity, triangles.ravel()])
     return vertices, connectivity, offsets
+
+
+def _cell_arrays(element, path, options) -> tuple[np.ndarray, np.ndarray]:
+    """``(connectivity, offsets)`` of a ``<Polys>`` or ``<Strips>`` element (empty when there is none)."""
+    if element is None:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    arrays = {array.get("Name"): array for array in element.findall("DataArray")}
+    if "connectivity" not in arrays or "offsets" not in arrays:
+        raise MeshFileError(f"{path}: the {_CELLS[element.tag]}s lack a connectivity or an offsets array")
+    try:
+        connectivity = _decode(arrays["connectivity"], path, **options).astype(np.int64)
+        offsets = _decode(arrays["offsets"], path, **options).astype(np.int64)
+    except MeshFileError:
+        raise
+    except (ValueError, zlib.error, binascii.Error) as exc:
+        raise MeshFileError(f"{path}: a data array cannot be decoded ({exc})") from exc
+    if (offsets.size and offsets[-1] != connectivity.size) or (np.diff(offsets, prepend=0) < 0).any():
+        raise MeshFileError(f"{path}: the {_CELLS[element.tag]} offsets do not match the connectivity")
+    return connectivity.ravel(), offsets.ravel()
 
 
 def read_vtp(path):
