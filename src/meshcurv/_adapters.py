@@ -39,7 +39,7 @@ import numpy as np
 from ._validation import as_mesh, as_vertices
 from .errors import InvalidMeshError, optional_module
 from .io.fields import curvature_fields
-from .topology import MeshTopology, triangulate_faces
+from .topology import MeshTopology, strip_triangles, triangulate_faces
 
 __all__ = ["mesh_arrays", "point_array", "drawn_arrays", "to_pyvista", "to_trimesh", "to_dataframe"]
 
@@ -65,32 +65,21 @@ def _vtk_cells(flat: np.ndarray):
 
 
 def _strip_triangles(flat: np.ndarray) -> np.ndarray:
-    """(T, 3) the triangles of a VTK flat array of triangle strips ``[n0, i.., n1, j.., ...]``.
-
-    A strip's points ``p0, p1, p2, ...`` make the triangles ``(p_j, p_j+1, p_j+2)``, every other one wound the
-    other way round (``(p_j+1, p_j, p_j+2)`` for odd ``j``), so that all face the strip's side, as VTK's
-    ``vtkTriangleStrip`` makes them; the triangles with a repeated point (joins of two strips) are left out.
-    """
+    """(T, 3) the triangles of a VTK flat array of triangle strips ``[n0, i.., n1, j.., ...]``
+    (:func:`meshcurv.topology.strip_triangles`)."""
     flat = np.asarray(flat, dtype=np.int64).ravel()
-    parts, position = [np.zeros((0, 3), dtype=np.int64)], 0
-    while position < flat.size:  # a loop over strips (each strip's triangles at once)
+    counts, position = [], 0
+    while position < flat.size:  # a walk over the strips' counts (each strip's triangles are made at once)
         count = int(flat[position])
         if count < 0 or position + 1 + count > flat.size:
             raise InvalidMeshError("the PyVista mesh's strip array is malformed (a count runs past its end)")
-        ids = flat[position + 1 : position + 1 + count]
-        j = np.arange(max(count - 2, 0))
-        odd = j % 2 == 1
-        first, second, third = ids[j], ids[j + 1], ids[j + 2]
-        parts.append(np.stack([np.where(odd, second, first), np.where(odd, first, second), third], axis=1))
+        counts.append(count)
         position += 1 + count
-    triangles = np.concatenate(parts)
-    # a repeated point joins two strips (a triangle of no area by construction, not a face of the surface)
-    joins = (
-        (triangles[:, 0] == triangles[:, 1])
-        | (triangles[:, 1] == triangles[:, 2])
-        | (triangles[:, 0] == triangles[:, 2])
-    )
-    return triangles[~joins]
+    sizes = np.asarray(counts, dtype=np.int64)
+    heads = np.cumsum(sizes + 1) - sizes - 1  # the place of each count in ``flat``
+    keep = np.ones(flat.size, dtype=bool)
+    keep[heads] = False
+    return strip_triangles(flat[keep], np.cumsum(sizes))
 
 
 #: VTK cell types (``vtkCellType.h``) taken as faces; a pixel's corners run 0, 1, 3, 2 around it.

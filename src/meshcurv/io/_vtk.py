@@ -17,6 +17,7 @@ import re
 import numpy as np
 
 from ..errors import MeshFileError
+from ..topology import strip_triangles
 from ._text import numbers, without_bom
 
 __all__ = ["is_polydata", "read_vtk_polydata"]
@@ -233,23 +234,3 @@ def _strip_triangles(cells):
         return []
     sizes = [np.full(block.shape[0], block.shape[1]) if block.ndim == 2 else [block.size] for block in cells]
     return [strip_triangles(np.concatenate([block.ravel() for block in cells]), np.cumsum(np.concatenate(sizes)))]
-
-
-def strip_triangles(connectivity: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """(T, 3) the triangles of triangle strips, strip ``s`` being ``connectivity[ends[s - 1]:ends[s]]``.
-
-    A strip's points ``p0, p1, p2, ...`` make the triangles ``(p_j, p_j+1, p_j+2)``, every other one wound the
-    other way round (``(p_j+1, p_j, p_j+2)`` for odd ``j``) so that all face the strip's side, as VTK's
-    ``vtkTriangleStrip`` makes them; a triangle with a repeated point (the join of two strips in one) is none.
-    """
-    connectivity, ends = np.asarray(connectivity, dtype=np.int64).ravel(), np.asarray(ends, dtype=np.int64).ravel()
-    starts = np.concatenate([[0], ends])[:-1]
-    counts = np.maximum(ends - starts - 2, 0)  # a strip of n points holds n - 2 triangles
-    strip = np.repeat(np.arange(ends.size), counts)
-    j = np.arange(strip.size) - np.repeat(np.cumsum(counts) - counts, counts)  # the triangle's place in its strip
-    first = starts[strip] + j
-    corners = np.stack([connectivity[first], connectivity[first + 1], connectivity[first + 2]], axis=1)
-    odd = j % 2 == 1
-    corners[odd, :2] = corners[odd, 1::-1]
-    joins = (corners[:, 0] == corners[:, 1]) | (corners[:, 1] == corners[:, 2]) | (corners[:, 0] == corners[:, 2])
-    return corners[~joins]

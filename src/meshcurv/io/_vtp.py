@@ -19,8 +19,8 @@ import zlib
 import numpy as np
 
 from ..errors import MeshFileError
+from ..topology import strip_triangles
 from ._text import numbers
-from ._vtk import strip_triangles
 
 __all__ = ["read_vtp", "read_vtp_point_data", "read_vtp_cell_data", "write_vtp", "PieceWriter"]
 
