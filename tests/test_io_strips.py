@@ -11,7 +11,7 @@ import pytest
 
 import meshcurv
 from meshcurv import shapes
-from meshcurv.io._vtk import strip_triangles
+from meshcurv.topology import strip_triangles
 
 # five points of the plane: a quad, a triangle beside it, and a strip over the quad (fuzz_readers.md, round 14)
 POINTS = "0 0 0 1 0 0 1 1 0 0 1 0 2 0 0"
