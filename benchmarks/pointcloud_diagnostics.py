@@ -5,6 +5,7 @@ Usage::
 
     python benchmarks/pointcloud_diagnostics.py --noise    # noise level, radius, valid points per family
     python benchmarks/pointcloud_diagnostics.py --voxels   # voxel surfaces (anisotropic voxels) read as clouds
+    python benchmarks/pointcloud_diagnostics.py --staircase  # voxel surfaces of 6-40 voxels: tuned, held out
 
 ``--noise`` prints, per cloud and method, the noise level (``parameters["noise"]``), the default radius, the valid
 points, a hash of the results and whether the call noted an unmeasured noise level: run it on two trees and compare
@@ -15,7 +16,8 @@ surfaces (``benchmarks/pointcloud.py``: 5,000 points, noise 0-1 mean spacings).
 ``--voxels`` prints, per marching-cubes surface (spheres, tori, ellipsoids in isotropic and anisotropic voxels) and
 method, the share of points valid, the median relative error of H of the valid points, the points off (valid, with a
 radius of curvature of 4 spacings or more, as ``benchmarks/fuzz_api.py`` judges, H off by more than half the largest
-|k|) and the valid points whose normal is inward.
+|k|) and the valid points whose normal is inward. ``--staircase``: the same over voxel surfaces of radii 6-40
+voxels, every point counted, on the shapes the staircase's constants were tuned on, then on held-out ones.
 """
 
 from __future__ import annotations
@@ -129,15 +131,57 @@ VOXEL_SURFACES = {
     ),
 }
 
+#: ``--staircase``: the jets' staircase bias (``LATTICE_AGREEMENT``, ``TREAD_SHARE``), radii 6-40 voxels.
+STAIRCASE_TUNED = {
+    "ellipsoid (16, 12, 10), 1 x 1 x 1, seed 3": lambda: shapes.voxel_ellipsoid((16.0, 12.0, 10.0), seed=3),
+    "ellipsoid (16, 12, 10), 0.7 x 1 x 1.3, seed 3": lambda: shapes.voxel_ellipsoid(
+        (16.0, 12.0, 10.0), spacing=(0.7, 1.0, 1.3), seed=3
+    ),
+    "sphere 6, 1 x 1 x 1, seed 1": lambda: shapes.voxel_sphere(6.0, seed=1),
+    "sphere 20, 1 x 1 x 2.5, seed 1": lambda: shapes.voxel_sphere(20.0, spacing=(1.0, 1.0, 2.5), seed=1),
+    "torus (12, 4), 1 x 1 x 1, seed 0": lambda: shapes.voxel_torus(12.0, 4.0, seed=0),
+    "ellipsoid (24, 16, 10), 1 x 1 x 1, seed 1": lambda: shapes.voxel_ellipsoid((24.0, 16.0, 10.0), seed=1),
+    "torus (16, 6), 2 x 0.5 x 0.5, seed 2": lambda: shapes.voxel_torus(16.0, 6.0, spacing=(2.0, 0.5, 0.5), seed=2),
+    "ellipsoid (20, 14, 9), 1 x 1 x 1, seed 7": lambda: shapes.voxel_ellipsoid((20.0, 14.0, 9.0), seed=7),
+    "ellipsoid (30, 20, 31.25), 1 x 1 x 2.5, seed 8": lambda: shapes.voxel_ellipsoid(
+        (30.0, 20.0, 31.25), spacing=(1.0, 1.0, 2.5), seed=8
+    ),
+    "sphere 14, 1 x 1 x 1, seed 9": lambda: shapes.voxel_sphere(14.0, seed=9),
+    "sphere 35, 1 x 1 x 1, seed 9": lambda: shapes.voxel_sphere(35.0, seed=9),
+    "torus (18, 7), 1 x 1 x 2.5, seed 5": lambda: shapes.voxel_torus(18.0, 7.0, spacing=(1.0, 1.0, 2.5), seed=5),
+    "ellipsoid (12, 9, 7), 1.2 x 1 x 0.8, seed 6": lambda: shapes.voxel_ellipsoid(
+        (12.0, 9.0, 7.0), spacing=(1.2, 1.0, 0.8), seed=6
+    ),
+    "sphere 40, 1 x 1 x 1, seed 4": lambda: shapes.voxel_sphere(40.0, seed=4),
+    "ellipsoid (36, 28, 20), 1 x 1 x 1, seed 2": lambda: shapes.voxel_ellipsoid((36.0, 28.0, 20.0), seed=2),
+    "torus (28, 10), 1 x 1 x 1, seed 3": lambda: shapes.voxel_torus(28.0, 10.0, seed=3),
+    "sphere 9, 1 x 1 x 1, seed 5": lambda: shapes.voxel_sphere(9.0, seed=5),
+}
 
-def run_voxels() -> None:
+#: ... and held out (no constant looked at): other radii, axes and voxels.
+STAIRCASE_HELD_OUT = {
+    "sphere 30, 1 x 1 x 1, seed 11": lambda: shapes.voxel_sphere(30.0, seed=11),
+    "sphere 38, 1 x 1 x 1, seed 12": lambda: shapes.voxel_sphere(38.0, seed=12),
+    "ellipsoid (40, 25, 18), 1 x 1 x 1, seed 13": lambda: shapes.voxel_ellipsoid((40.0, 25.0, 18.0), seed=13),
+    "ellipsoid (28, 22, 14), 1 x 1 x 1, seed 14": lambda: shapes.voxel_ellipsoid((28.0, 22.0, 14.0), seed=14),
+    "ellipsoid (22, 17, 12), 0.8 x 1 x 1.2, seed 15": lambda: shapes.voxel_ellipsoid(
+        (22.0, 17.0, 12.0), spacing=(0.8, 1.0, 1.2), seed=15
+    ),
+    "torus (24, 9), 1 x 1 x 1, seed 16": lambda: shapes.voxel_torus(24.0, 9.0, seed=16),
+    "sphere 7.5, 1 x 1 x 1, seed 17": lambda: shapes.voxel_sphere(7.5, seed=17),
+}
+
+
+def run_voxels(surfaces=None, *, every: bool = False) -> None:
+    """The table of ``--voxels`` over ``surfaces`` (name -> a function returning a ``VoxelMesh``; default
+    :data:`VOXEL_SURFACES`); ``every``: the points off counted over every point, not only the resolved ones."""
     print("| surface | points | method | valid | median H error | points off | valid inward | CPU s |")
     print("|---|---|---|---|---|---|---|---|")
-    for name, make in VOXEL_SURFACES.items():
+    for name, make in (VOXEL_SURFACES if surfaces is None else surfaces).items():
         mesh = make()
         points = mesh.vertices
         largest = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))
-        resolved = largest * cloud_spacing(points) <= 0.25
+        resolved = every | (largest * cloud_spacing(points) <= 0.25)
         for method in ("corrected_measures", "jets"):
             start = time.process_time()
             with warnings.catch_warnings():
@@ -159,11 +203,15 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--noise", action="store_true", help="noise level, radius and valid points per family")
     parser.add_argument("--voxels", action="store_true", help="voxel surfaces read as clouds")
+    parser.add_argument("--staircase", action="store_true", help="voxel surfaces, radii 6-40 voxels: tuned, held out")
     args = parser.parse_args(argv)
     if args.noise:
         run_noise()
     if args.voxels:
         run_voxels()
+    if args.staircase:
+        run_voxels(STAIRCASE_TUNED, every=True)
+        run_voxels(STAIRCASE_HELD_OUT, every=True)
 
 
 if __name__ == "__main__":

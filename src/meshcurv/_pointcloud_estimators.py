@@ -12,7 +12,7 @@ import warnings
 import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
-from ._pointcloud_normals import NEIGHBOURS
+from ._pointcloud_normals import NEIGHBOURS, lattice_steps
 from .errors import InvalidOptionError
 from . import _measures
 from .measures import curvatures_from_measures
@@ -79,6 +79,15 @@ SHRINK = 2.0**-0.5
 #: the two balls by about itself, and the fuzzer calls a valid H a lie beyond 0.5 of |k|; a fit that follows
 #: noise differs from the larger ball's by about its own error.
 AGREEMENT = 0.4
+
+#: ... and within this share on a lattice (a voxel surface read as a cloud: :func:`lattice_steps`). A jet fitted to
+#: a staircase of steps ``h`` over a ball of radius ``r`` is biased by about ``h / r^2`` (the steps are coherent, no
+#: noise that the ball averages out), a bias that falls fast from one ball to the next: the two estimates differ by
+#: most of the smaller ball's bias, and bounding the difference bounds that bias below half of |k| (``AGREEMENT``
+#: does not, at the poles of voxel spheres and ellipsoids of 15 voxels and more). Only where the largest |k| falls
+#: from the ball to the larger one, as that bias does (a jet's bias from a curvature grows with the ball: small voxel
+#: spheres stay measured). Figures: ``benchmarks/pointcloud_diagnostics.md``, "Jets on a staircase".
+LATTICE_AGREEMENT = 0.2
 
 #: ... where a change of the curvature by this many radians of normal turning over the ball (``0.05 / r``)
 #: counts as none: a flat region's two estimates agree within it.
@@ -288,8 +297,25 @@ def jets(
             facing=facing,
         )
         wide_found = _jet_curvatures(wide_coefficients, wide_frame, wide_radii, normals)
-        details["unsteady"] = unsteady(found, wide_found, done, radius)
+        details["unsteady"] = unsteady(
+            found, wide_found, done, radius, _agreement(points, usable, found, wide_found, done)
+        )
     return found
+
+
+def _agreement(points, usable, found, larger, centres):
+    """(M,) the share of |k| within which the jets over balls of two sizes must agree at ``centres`` (M,):
+    :data:`LATTICE_AGREEMENT` on a lattice where the largest |k| falls from the ball (``found``) to the larger one
+    (``larger``), the staircase's bias (a curvature's own bias grows with the ball); :data:`AGREEMENT` elsewhere."""
+    agreement = np.full(centres.size, AGREEMENT)
+    if centres.size == 0 or not lattice_steps(points[np.asarray(usable, dtype=bool)]).any():
+        return agreement
+    with np.errstate(invalid="ignore"):
+        falls = np.maximum(np.abs(found[0][centres]), np.abs(found[1][centres])) > np.maximum(
+            np.abs(larger[0][centres]), np.abs(larger[1][centres])
+        )
+    agreement[falls] = LATTICE_AGREEMENT
+    return agreement
 
 
 def erratic(k_min, k_max, indices, valid, spacing) -> np.ndarray:
@@ -348,7 +374,9 @@ def unsteady_problem(flagged: np.ndarray, *, beside: bool = False) -> list[str]:
         f"more than {UNRESOLVED_TURN:g} rad over it (the band by a rim sharper than the ball, whose curvature the "
         "ball takes in)"
         if beside
-        else f"the estimate changed by more than {AGREEMENT:g} of |k| over a ball {LARGER:.3g} times larger, "
+        else f"the estimate changed by more than {AGREEMENT:g} of |k| over a ball {LARGER:.3g} times larger (jets: "
+        f"{LATTICE_AGREEMENT:g} on a voxel surface read as a cloud where |k| falls with the ball, its staircase's "
+        "bias), "
         f"differs from its neighbours' by more than {NEIGHBOUR_AGREEMENT:g} of |k|, or from jets over the same "
         f"balls by more than {TURN_AGREEMENT:g} of |k| where they turn by more than {BALL_TURN:g} rad (a rim or "
         "part sharper than the ball, the other side of a thin part, or noise the fit follows), or no jet fits one "
@@ -363,11 +391,11 @@ def _jet_curvatures(coefficients, frame, radii, normals):
     return jet_curvatures(coefficients, frame, radii, normals)
 
 
-def unsteady(found, larger, centres, radius, agreement: float = AGREEMENT) -> np.ndarray:
+def unsteady(found, larger, centres, radius, agreement: float | np.ndarray = AGREEMENT) -> np.ndarray:
     """(N,) bool: the ``centres`` whose estimate ``found`` (``k_min, k_max, ...``) over balls of ``radius`` is
     not reproduced by the estimate ``larger`` over balls :data:`LARGER` times larger: a principal curvature off by
-    more than :data:`AGREEMENT` times the smaller largest |k| of the two (and at least ``FLAT_TURN / radius``),
-    or no estimate there.
+    more than ``agreement`` (a share, or one per centre) times the smaller largest |k| of the two (and at least
+    ``FLAT_TURN / radius``), or no estimate there.
 
     An estimate over a ball is a measurement of the surface when it does not depend on the ball: where the ball
     resolves the surface (radius of curvature, thickness and features larger than the ball, noise averaged out)

@@ -194,7 +194,12 @@ LATTICE_TOLERANCE = 1e-6
 LATTICE_PROBE = 4096
 
 #: On a lattice, a point is on a flat tread of the staircase (see :func:`lattice_treads`) when at least this share
-#: of its :data:`TREAD_NEIGHBOURS` nearest neighbours within its ball lie on its plane of the grid.
+#: of its :data:`TREAD_NEIGHBOURS` nearest neighbours within its ball lie on its plane of the grid. The share ``s``
+#: is the step over the rise of the surface across the ball (a tread is the disc within one step ``h`` of the top,
+#: radius ``sqrt(2 h / k)``, in a ball of radius ``r``: ``s = h / (k r^2 / 2)``): the ball sees fewer than ``1 / s``
+#: steps, and only the points off the tread say that the surface curves: the jets' error grows with ``s``, and this
+#: share is where it stays below half of |k| with a margin over voxel spheres, ellipsoids and tori of 6-40 voxels
+#: (``benchmarks/pointcloud_diagnostics.md``, "Jets on a staircase").
 TREAD_SHARE = 0.75
 TREAD_NEIGHBOURS = 48
 
