@@ -234,6 +234,25 @@ def m_soup(rng, v, f):
     return v[f.ravel()].copy(), np.arange(f.size, dtype=np.int64).reshape(-1, 3), "soup"
 
 
+def m_detached(rng, v, f):
+    """A share of the faces given corners of their own, each moved 1e-4 to 1e-2 mean edge lengths in a random
+    direction: detached faces, cracks wider than the weld tolerance (issue 29). The copies come after the
+    vertices, which keep their rows (the truth relation finds each copy's corner as its nearest vertex)."""
+    if not len(v) or not len(f):
+        return v, f, "detached faces(noop)"
+    share = float(rng.choice([0.05, 0.2, 0.5, 1.0]))
+    gap = 10.0 ** float(rng.uniform(-4.0, -2.0))
+    with np.errstate(all="ignore"):
+        edge = float(np.mean(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))
+    picked = rng.random(len(f)) < share
+    corners = v[f[picked]].reshape(-1, 3)
+    directions = rng.normal(size=corners.shape)
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    f = f.copy()
+    f[picked] = len(v) + np.arange(corners.shape[0]).reshape(-1, 3)
+    return np.concatenate([v, corners + directions * gap * edge]), f, f"detached faces {share:g} by {gap:.2g}"
+
+
 def m_collapse(rng, v, f):
     v = v.copy()
     if len(f):
@@ -372,6 +391,7 @@ MUTATIONS = [
     m_nonfinite,
     m_duplicate,
     m_soup,
+    m_detached,
     m_collapse,
     m_all_same,
     m_flat,
@@ -390,7 +410,7 @@ MUTATIONS = [
     m_indices,
 ]
 # the rarer, more destructive mutations get lower weight
-WEIGHTS = np.array([3, 1, 2, 1, 2, 2, 2, 0.5, 1, 0.5, 1, 2, 2, 1, 1, 1, 1, 2, 2, 1, 0.5, 1.5])
+WEIGHTS = np.array([3, 1, 2, 1, 2, 2, 2, 2, 0.5, 1, 0.5, 1, 2, 2, 1, 1, 1, 1, 2, 2, 1, 0.5, 1.5])
 WEIGHTS = WEIGHTS / WEIGHTS.sum()
 
 
@@ -665,10 +685,25 @@ def _drawn_case(seed: int, index: int):
         vv, vlabel = wrap_vertices(rng, v) if rng.random() < 0.3 else (v, "array")
         ff, flabel = wrap_faces(rng, f) if rng.random() < 0.3 else (f, "array")
         labels += [f"vertices:{vlabel}", f"faces:{flabel}"]
+        detached = len(labels) == 4 and labels[1].startswith("detached faces ")  # the only mutation: same truth
         if (
             vlabel == "array"
             and flabel == "array"
-            and len(labels) == 3
+            and (detached or len(labels) == 3)
+            and isinstance(method, str)
+            and method in METHODS
+            and kwargs.get("weld", True) is True
+            and rng.random() < (0.7 if detached else 0.15)
+        ):
+            if not detached:  # a clean shape: faces detached now (the strategy of issue 29's detached faces)
+                vv, ff, label = m_detached(rng, v, f)
+                labels.insert(1, label)
+            labels.append(f"relation detached {labels[0]}")
+            return target, (vv, ff), kwargs, labels, ("detached", labels[0])
+        if (
+            vlabel == "array"
+            and flabel == "array"
+            and (len(labels) == 3 or detached)
             and labels[0] in TRUTH
             and isinstance(method, str)
             and method in BALL_METHODS
@@ -1363,6 +1398,8 @@ def relation_check(args, kwargs, result, relation):
     if kind == "cloud truth":
         return cloud_truth_check(args, kwargs, result, value)
     v, f = args
+    if kind == "detached":  # faces detached from the clean shape: its values at their corners (issue 29)
+        return detached_check(v, kwargs, result, value)
     if kind == "needle":  # the flung vertex: invalid, for its needle faces, whatever the method and radius
         # (beyond about 1e16 edge lengths its faces' sides lose the width of their base in float64: zero-area faces)
         broken = []
@@ -1412,6 +1449,12 @@ def relation_check(args, kwargs, result, relation):
         return broken
     if kind == "truth":  # valid estimates on a clean closed analytic shape: within half the largest curvature
         k_min, k_max = TRUTH[value]
+        if len(v) > len(k_min):  # detached faces: a corner's copies (after the vertices) get its curvatures
+            from scipy.spatial import cKDTree
+
+            base = next(vertices for name, vertices, _ in BASES if name == value)
+            nearest = np.r_[np.arange(len(base)), cKDTree(base).query(v[len(base) :])[1]]
+            k_min, k_max = k_min[nearest], k_max[nearest]
         edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))
         if kwargs.get("radius") is None or float(result.parameters.get("radius", 0.0)) > edge:
             # default options on these coarse shapes (a 16 x 8 torus, a 200-point random sphere) are
@@ -1477,6 +1520,35 @@ def relation_check(args, kwargs, result, relation):
         if a.size and not (err < 1e-6).all():
             broken.append(f"{kind} {value:g}: {name} differs by up to {float(np.nanmax(err)):.3g} (relative)")
     return broken
+
+
+#: A valid vertex of a mesh with detached faces is a lie when its H is off the clean shape's by more than this
+#: share of the clean shape's largest |k| (a crack read as flat gives H = 0 on a sphere: off by 100%).
+DETACHED_TOLERANCE = 0.5
+
+
+def detached_check(v, kwargs, result, name):
+    """The clean shape ``name`` with the same options: every vertex valid in both within
+    :data:`DETACHED_TOLERANCE` of the clean value at its corner (the nearest clean vertex)."""
+    from scipy.spatial import cKDTree
+
+    base, base_faces = next((vertices, faces) for label, vertices, faces in BASES if label == name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        clean = meshcurv.principal_curvatures(base, base_faces, **kwargs)
+    nearest = cKDTree(base).query(v)[1]
+    both = result.valid & clean.valid[nearest]
+    size = max(np.abs(clean.k_min[clean.valid]).max(initial=0), np.abs(clean.k_max[clean.valid]).max(initial=0))
+    if not both.any() or size == 0:
+        return []
+    error = np.abs(result.mean[both] - clean.mean[nearest][both]) / size
+    if (error <= DETACHED_TOLERANCE).all():
+        return []
+    return [
+        f"detached {name}: H off the clean shape's by more than {DETACHED_TOLERANCE:g} of its largest |k| at "
+        f"{int((error > DETACHED_TOLERANCE).sum())} of {int(both.sum())} vertices valid in both (up to "
+        f"{float(error.max()):.3g})"
+    ]
 
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

@@ -37,7 +37,7 @@ from ._geometry import (
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import CurvatureResult, Surface
 from .topology import MeshTopology
-from .weld import Welding, drop_closed_copies, drop_double_sided, weld_vertices
+from .weld import CRACK_TOLERANCE_RATIO, Welding, drop_closed_copies, drop_double_sided, weld_vertices
 
 __all__ = ["PreparedMesh", "prepare_mesh"]
 
@@ -68,6 +68,9 @@ class PreparedMesh:
         neither (it keeps the edges, sorted, and the corners of each face).
     n_welded, n_double_sided, n_flipped : int
         Vertices welded, faces of a second side dropped, faces reversed.
+    n_cracked : int
+        Of the vertices welded, those welded across cracks between detached faces
+        (:data:`meshcurv.weld.CRACK_TOLERANCE_RATIO`).
     n_copies : int
         Vertices of closed parts stored twice, measured once (:func:`meshcurv.weld.drop_closed_copies`).
     """
@@ -83,6 +86,7 @@ class PreparedMesh:
     n_double_sided: int = 0
     n_flipped: int = 0
     n_copies: int = 0
+    n_cracked: int = 0
 
     @classmethod
     def as_given(cls, vertices: np.ndarray, topology: MeshTopology) -> PreparedMesh:
@@ -156,8 +160,14 @@ class PreparedMesh:
         """What was done to the mesh before the computation, for the call's warning."""
         notes = []
         if self.n_welded:
+            cracks = (
+                f", of which {self.n_cracked} across cracks up to {CRACK_TOLERANCE_RATIO:g} edge lengths wide "
+                "(faces detached from their neighbours: boundary edges on top of each other),"
+                if self.n_cracked
+                else ""
+            )
             notes.append(
-                f"welded {self.n_welded} coincident vertices (a triangle soup or split seams) "
+                f"welded {self.n_welded} coincident vertices (a triangle soup or split seams){cracks} "
                 "before the computation; copies share their values"
             )
         if self.n_copies:
@@ -234,7 +244,11 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         n_copies = copies.n_welded
         first = welded.index if welded is not None else np.arange(points.shape[0])
         welded = Welding(
-            copies.vertices, copies.topology, copies.index[first], (welded.n_welded if welded is not None else 0)
+            copies.vertices,
+            copies.topology,
+            copies.index[first],
+            (welded.n_welded if welded is not None else 0),
+            (welded.n_cracked if welded is not None else 0),
         )
         points, topology = welded.vertices, welded.topology
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
@@ -266,4 +280,5 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         one_sided.n_dropped,
         n_flipped,
         n_copies,
+        welded.n_cracked if welded is not None else 0,
     )

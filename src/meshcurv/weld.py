@@ -12,6 +12,12 @@ of them. Only vertices on boundary edges are candidates: a split always leaves
 boundary edges on both sides, while coincident vertices inside a surface (two
 sheets touching, a point cloud stored with the mesh) are not seams and stay
 apart. A closed mesh therefore costs nothing here.
+
+Faces detached from their neighbours by more than that tolerance (a mesh whose
+faces were moved one by one, a soup written with rounding) leave cracks: pairs
+of boundary edges lying on top of each other. Their ends are welded too, up to
+:data:`CRACK_TOLERANCE_RATIO` of the edges' length; a real boundary has no
+second edge on it and is left alone.
 """
 
 from __future__ import annotations
@@ -23,13 +29,29 @@ import numpy as np
 from ._backend import twin
 from ._geometry import vertex_length_scales
 from .defects import _needle_vertices
+from .errors import InvalidOptionError
 from .orient import face_flips
 from .topology import MeshTopology
 
-__all__ = ["Welding", "weld_vertices", "WELD_TOLERANCE_RATIO", "OneSided", "drop_double_sided", "drop_closed_copies"]
+__all__ = [
+    "Welding",
+    "weld_vertices",
+    "WELD_TOLERANCE_RATIO",
+    "CRACK_TOLERANCE_RATIO",
+    "OneSided",
+    "drop_double_sided",
+    "drop_closed_copies",
+]
 
 #: Vertices closer than this times the median edge length are copies of one point.
 WELD_TOLERANCE_RATIO = 1e-5
+
+#: Two boundary edges sharing no vertex whose ends lie pairwise within this times the shorter edge's length are
+#: the two sides of a crack between detached faces, and their ends are welded. A crack this narrow is far below
+#: any curvature the faces resolve (a corner moved by it moves the normals by about as many radians), and far
+#: above the round-off of exported coordinates; a real boundary has no second edge on it. Kept well below 1/2 so
+#: that an edge is never paired with its neighbours along a boundary. Tests: tests/test_unwelded_faces.py.
+CRACK_TOLERANCE_RATIO = 0.05
 
 
 class Welding(NamedTuple):
@@ -47,18 +69,26 @@ class Welding(NamedTuple):
         field ``x`` of the welded mesh is ``x[index]`` on the input.
     n_welded : int
         Input vertices merged into another one (``V - W``).
+    n_cracked : int, default: 0
+        Of those, the vertices merged only across cracks (the ends of boundary edges on top of each other,
+        :data:`CRACK_TOLERANCE_RATIO`), farther apart than the weld tolerance.
     """
 
     vertices: np.ndarray
     topology: MeshTopology
     index: np.ndarray  # type: ignore[assignment]  # a field that shadows tuple.index (public name, kept)
     n_welded: int
+    n_cracked: int = 0
 
 
 def weld_vertices(
-    vertices: np.ndarray, topology: MeshTopology, *, tolerance_ratio: float = WELD_TOLERANCE_RATIO
+    vertices: np.ndarray,
+    topology: MeshTopology,
+    *,
+    tolerance_ratio: float = WELD_TOLERANCE_RATIO,
+    crack_ratio: float = CRACK_TOLERANCE_RATIO,
 ) -> Welding:
-    """Merge coincident boundary vertices of a mesh (soups, seams).
+    """Merge coincident boundary vertices of a mesh (soups, seams), and the ends of cracks between detached faces.
 
     Parameters
     ----------
@@ -69,6 +99,16 @@ def weld_vertices(
     tolerance_ratio : float, default: 1e-5
         Two boundary vertices closer than ``tolerance_ratio`` times the median
         length of the mesh's edges of non-zero length are one point.
+    crack_ratio : float, default: 0.05
+        Two boundary edges that share no vertex, whose ends lie pairwise within
+        ``crack_ratio`` times the shorter edge's length, are the sides of a
+        crack: their ends are welded (:data:`CRACK_TOLERANCE_RATIO`). 0 welds
+        no crack.
+
+    Raises
+    ------
+    InvalidOptionError
+        ``crack_ratio`` is not in [0, 0.5).
 
     Returns
     -------
@@ -81,8 +121,13 @@ def weld_vertices(
     Candidates are the vertices on boundary edges. Their pairs within the
     tolerance (:meth:`scipy.spatial.cKDTree.query_pairs`) are joined by
     connected components, so that a chain of near copies becomes one vertex.
-    Faces that collapse (two corners welded together) are kept as they are:
-    they were of (near) zero area before and are reported as such.
+    The boundary edges left then are matched by their midpoints, in classes of
+    edge lengths within a factor 2 (the two sides of a crack differ in length
+    by at most twice the crack), so that the search radius follows the local
+    resolution; either pairing of the ends is accepted (consistent or opposite
+    windings), and the pairs are joined by connected components again. Faces
+    that collapse (two corners welded together) are kept as they are: they
+    were of (near) zero area before and are reported as such.
 
     Examples
     --------
@@ -95,7 +140,34 @@ def weld_vertices(
     >>> welded = weld_vertices(soup, MeshTopology.from_faces(np.arange(soup.shape[0]).reshape(-1, 3)))
     >>> welded.vertices.shape == sphere.vertices.shape, int(welded.topology.boundary_edges.sum())
     (True, 0)
+
+    Its faces moved apart by a thousandth of their edges are welded across the cracks:
+
+    >>> rng = np.random.default_rng(0)
+    >>> moved = soup + rng.normal(scale=1e-3 * 0.07, size=soup.shape)
+    >>> welded = weld_vertices(moved, MeshTopology.from_faces(np.arange(soup.shape[0]).reshape(-1, 3)))
+    >>> welded.vertices.shape == sphere.vertices.shape, welded.n_cracked == welded.n_welded
+    (True, True)
     """
+    if not 0.0 <= crack_ratio < 0.5:  # a wider "crack" would take an edge for its neighbour along a boundary
+        raise InvalidOptionError(f"`crack_ratio` must be in [0, 0.5); got {crack_ratio!r}")
+    strict = _weld_coincident(vertices, topology, tolerance_ratio)
+    if crack_ratio <= 0.0 or not strict.topology.boundary_edges.any():
+        return strict
+    cracks = _weld_cracks(strict.vertices, strict.topology, crack_ratio)
+    if cracks.n_welded == 0:
+        return strict
+    return Welding(
+        cracks.vertices,
+        cracks.topology,
+        cracks.index[strict.index],
+        strict.n_welded + cracks.n_welded,
+        cracks.n_welded,
+    )
+
+
+def _weld_coincident(vertices: np.ndarray, topology: MeshTopology, tolerance_ratio: float) -> Welding:
+    """The boundary vertices within ``tolerance_ratio`` times the median edge length welded (:func:`weld_vertices`)."""
     n_vertices = vertices.shape[0]
     unchanged = Welding(vertices, topology, np.arange(n_vertices), 0)
     if not topology.boundary_edges.any():
@@ -104,15 +176,82 @@ def weld_vertices(
     tolerance = _tolerance(vertices, topology, tolerance_ratio)
     if candidates.size < 2 or tolerance == 0.0:
         return unchanged
-    from scipy.sparse import coo_matrix  # imported on use: keeps `import meshcurv` fast
-    from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
 
     pairs = cKDTree(vertices[candidates]).query_pairs(tolerance, output_type="ndarray")
     if pairs.size == 0:
         return unchanged
+    return _merge(vertices, topology, candidates[pairs])
+
+
+def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: float) -> Welding:
+    """The ends of boundary edges on top of each other welded (:func:`weld_vertices`); ``n_cracked`` = ``n_welded``."""
+    n_vertices = vertices.shape[0]
+    unchanged = Welding(vertices, topology, np.arange(n_vertices), 0)
+    ends = topology.edges[topology.boundary_edges]
+    first, second = vertices[ends[:, 0]], vertices[ends[:, 1]]
+    lengths = np.linalg.norm(second - first, axis=1)
+    usable = np.isfinite(lengths) & (lengths > 0)
+    if np.count_nonzero(usable) < 2:
+        return unchanged
+    ends, first, second, lengths = ends[usable], first[usable], second[usable], lengths[usable]
+    midpoints = 0.5 * (first + second)
+    if not np.isfinite(midpoints).all():  # overflow of huge coordinates: those edges take no part
+        finite = np.isfinite(midpoints).all(axis=1)
+        ends, first, second, lengths, midpoints = (a[finite] for a in (ends, first, second, lengths, midpoints))
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    # the two sides of a crack differ in length by at most twice the crack (far below a factor 2): the pairs of
+    # each class of lengths [2^c, 2^(c+1)) and the next are within crack_ratio * 2^(c+1) of each other
+    _, exponent = np.frexp(lengths)
+    classes = np.unique(exponent)
+    found = []
+    for c in classes.tolist():  # one query per octave of edge lengths, not per edge
+        members = np.flatnonzero((exponent == c) | (exponent == c + 1))
+        if members.size < 2:
+            continue
+        pairs = cKDTree(midpoints[members]).query_pairs(crack_ratio * np.ldexp(1.0, c), output_type="ndarray")
+        if pairs.size:
+            found.append(members[pairs])
+    if not found:
+        return unchanged
+    i, j = np.unique(np.sort(np.concatenate(found), axis=1), axis=0).T
+    a, b, c_, d = ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1]
+    apart = (a != c_) & (a != d) & (b != c_) & (b != d)  # sharing no vertex (so no face: a face's edges do)
+    limit = crack_ratio * np.minimum(lengths[i], lengths[j])
+    same = np.maximum(_distance(first[i], first[j]), _distance(second[i], second[j])) <= limit
+    crossed = np.maximum(_distance(first[i], second[j]), _distance(second[i], first[j])) <= limit
+    same &= apart
+    crossed &= apart & ~same
+    if not (same.any() or crossed.any()):
+        return unchanged
+    pairs = np.concatenate(
+        [
+            np.column_stack([a[same], c_[same]]),
+            np.column_stack([b[same], d[same]]),
+            np.column_stack([a[crossed], d[crossed]]),
+            np.column_stack([b[crossed], c_[crossed]]),
+        ]
+    )
+    welding = _merge(vertices, topology, pairs)
+    return welding._replace(n_cracked=welding.n_welded)
+
+
+def _distance(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """(N,) the distances between the rows of ``p`` and ``q``."""
+    return np.linalg.norm(p - q, axis=1)
+
+
+def _merge(vertices: np.ndarray, topology: MeshTopology, pairs: np.ndarray) -> Welding:
+    """The mesh with the vertices joined by ``pairs`` ((P, 2) vertex indices) and their chains made one vertex each."""
+    from scipy.sparse import coo_matrix  # imported on use: keeps `import meshcurv` fast
+    from scipy.sparse.csgraph import connected_components
+
+    n_vertices = vertices.shape[0]
+    candidates, inverse = np.unique(pairs, return_inverse=True)
+    local = np.reshape(inverse, (-1, 2))
     n = candidates.size
-    graph = coo_matrix((np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    graph = coo_matrix((np.ones(local.shape[0], dtype=np.int8), (local[:, 0], local[:, 1])), shape=(n, n))
     _, labels = connected_components(graph, directed=False)
     # the first (lowest-index) candidate of each group stands for the group
     _, first = np.unique(labels, return_index=True)
