@@ -181,7 +181,7 @@ def _weld_coincident(vertices: np.ndarray, topology: MeshTopology, tolerance_rat
     pairs = cKDTree(vertices[candidates]).query_pairs(tolerance, output_type="ndarray")
     if pairs.size == 0:
         return unchanged
-    return _merge(vertices, topology, candidates[pairs])
+    return _merge(vertices, topology, pairs, candidates)
 
 
 def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: float) -> Welding:
@@ -215,7 +215,9 @@ def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: floa
             found.append(members[pairs])
     if not found:
         return unchanged
-    i, j = np.unique(np.sort(np.concatenate(found), axis=1), axis=0).T
+    ordered = np.sort(np.concatenate(found), axis=1)
+    key = np.unique(ordered[:, 0].astype(np.int64) * lengths.size + ordered[:, 1])  # each pair once
+    i, j = np.divmod(key, lengths.size)
     a, b, c_, d = ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1]
     apart = (a != c_) & (a != d) & (b != c_) & (b != d)  # sharing no vertex (so no face: a face's edges do)
     limit = crack_ratio * np.minimum(lengths[i], lengths[j])
@@ -242,14 +244,20 @@ def _distance(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.linalg.norm(p - q, axis=1)
 
 
-def _merge(vertices: np.ndarray, topology: MeshTopology, pairs: np.ndarray) -> Welding:
-    """The mesh with the vertices joined by ``pairs`` ((P, 2) vertex indices) and their chains made one vertex each."""
+def _merge(
+    vertices: np.ndarray, topology: MeshTopology, pairs: np.ndarray, candidates: np.ndarray | None = None
+) -> Welding:
+    """The mesh with the vertices joined by ``pairs`` ((P, 2) indices into ``candidates``, sorted vertex indices;
+    None: vertex indices) and their chains made one vertex each."""
     from scipy.sparse import coo_matrix  # imported on use: keeps `import meshcurv` fast
     from scipy.sparse.csgraph import connected_components
 
     n_vertices = vertices.shape[0]
-    candidates, inverse = np.unique(pairs, return_inverse=True)
-    local = np.reshape(inverse, (-1, 2))
+    if candidates is None:
+        candidates, inverse = np.unique(pairs, return_inverse=True)
+        local = np.reshape(inverse, (-1, 2))
+    else:
+        local = pairs
     n = candidates.size
     graph = coo_matrix((np.ones(local.shape[0], dtype=np.int8), (local[:, 0], local[:, 1])), shape=(n, n))
     _, labels = connected_components(graph, directed=False)
