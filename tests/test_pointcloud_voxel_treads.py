@@ -3,8 +3,9 @@
 Found by helper V12's voxel-cloud fuzz strategy (``fuzz_api.py --point-clouds``, seed 29, case 429): the
 marching-cubes torus (26.2, 8.87) in voxels of 0.7 x 1 x 1.3, read as a point cloud, keeps 9 points of its flat
 top tread valid with their normal inward (H 0 where the exact torus has 0.028, the sign of the normal wrong).
-Present before this stop's changes. Likely mechanism, not yet shown: two treads of the staircase a step of
-1.3 apart look like two stacked sheets to the orientation, whose sign passes reversed across stacked edges.
+Present before this stop's changes. Mechanism not found yet: it is not the orientation's stacked edges (the
+sign passed reversed between two treads a step apart): with ``_pointcloud_normals.STACKED_OFFSET`` at 100 the
+same 9 points stay inward (163 inward points in all, NaN ones included; 122 then).
 The truth: the analytic torus's outward normal at each vertex (``shapes.voxel_torus``).
 """
 
