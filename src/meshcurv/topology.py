@@ -55,6 +55,18 @@ def strip_triangles(connectivity: np.ndarray, ends: np.ndarray) -> np.ndarray:
     A strip's points ``p0, p1, p2, ...`` make the triangles ``(p_j, p_j+1, p_j+2)``, every other one wound the
     other way round (``(p_j+1, p_j, p_j+2)`` for odd ``j``) so that all face the strip's side, as VTK's
     ``vtkTriangleStrip`` makes them; a triangle with a repeated point (the join of two strips in one) is none.
+
+    Parameters
+    ----------
+    connectivity : array_like of int, shape (P,)
+        The strips' points, one strip after the other.
+    ends : array_like of int, shape (S,)
+        The end (exclusive) of each strip in ``connectivity``.
+
+    Returns
+    -------
+    ndarray of shape (T, 3), int64
+        The triangles, strip by strip, without the joins.
     """
     connectivity, ends = np.asarray(connectivity, dtype=np.int64).ravel(), np.asarray(ends, dtype=np.int64).ravel()
     starts = np.concatenate([[0], ends])[:-1]

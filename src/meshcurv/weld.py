@@ -105,16 +105,16 @@ def weld_vertices(
         crack: their ends are welded (:data:`CRACK_TOLERANCE_RATIO`). 0 welds
         no crack.
 
-    Raises
-    ------
-    InvalidOptionError
-        ``crack_ratio`` is not in [0, 0.5).
-
     Returns
     -------
     Welding
         ``vertices``, ``topology`` and ``index`` of the welded mesh; the
         inputs themselves when nothing was welded (``n_welded == 0``).
+
+    Raises
+    ------
+    InvalidOptionError
+        ``crack_ratio`` is not in [0, 0.5).
 
     Notes
     -----
