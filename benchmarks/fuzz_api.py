@@ -532,6 +532,8 @@ MISUSE_HINTS = {
     "vertices and faces swapped": "swapped",
     "faces alone": "it looks like the faces",
 }
+#: Share of the PyVista PolyData objects given with triangle strips (``_strips_object``).
+STRIPS_SHARE = 0.5
 #: The backend relation is left out above this many points (the NumPy paths of thin clouds: about 3 s of CPU
 #: per 1,000 points).
 BACKEND_MAX_POINTS = 4000
@@ -563,6 +565,11 @@ def _mesh_object(rng, v, f):
             import pyvista
 
             if kind == "polydata":
+                # half of them with triangle strips, drawn from a stream of the mesh's own (the draws of the
+                # earlier rounds' cases are unchanged)
+                own = np.random.default_rng([len(v), len(f), int(f.sum()) % 2**32])
+                if own.random() < STRIPS_SHARE and not _repeated_corner(f).any():
+                    return _strips_object(pyvista, own, v, f), "pyvista.PolyData strips"
                 return pyvista.PolyData(v, np.c_[np.full(len(f), 3), f].ravel()), "pyvista.PolyData"
             grid = pyvista.UnstructuredGrid({pyvista.CellType.TRIANGLE: f}, v)
             return grid, "pyvista.UnstructuredGrid"
@@ -575,6 +582,30 @@ def _mesh_object(rng, v, f):
     import types
 
     return types.SimpleNamespace(vertices=v.tolist(), triangles=f.tolist()), "duck (.vertices, .triangles)"
+
+
+def _repeated_corner(f):
+    return (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
+
+
+def _strips_object(pyvista, rng, v, f):
+    """A PolyData of the first faces as polygons and the rest as triangle strips, their triangles ``f`` in order.
+
+    Runs of up to 5 faces share a strip, joined through repeated points (``a b c c d d d e f``: the triangles
+    between have no area, the winding's parity kept), as ``vtkStripper`` joins strips. (A face with a repeated
+    corner is no face of a strip: such meshes are not drawn here.)
+    """
+    split = int(rng.integers(len(f) + 1))
+    mesh = pyvista.PolyData(v, np.c_[np.full(split, 3), f[:split]].ravel()) if split else pyvista.PolyData(v)
+    strips, rest, run = [], f[split:].tolist(), int(rng.integers(1, 6))
+    for start in range(0, len(rest), run):
+        points = list(rest[start])
+        for a, b, c in rest[start + 1 : start + run]:
+            points += [points[-1], a, a, a, b, c]
+        strips.append([len(points), *points])
+    if strips:
+        mesh.strips = np.concatenate(strips)
+    return mesh
 
 
 def _point_object(rng, points):
@@ -876,6 +907,38 @@ def _sphere_cloud(rng, n, radius, centre):
     return radius * u + centre, u
 
 
+#: Share of the cloud cases that are voxel surfaces (:func:`_voxel_cloud`).
+VOXEL_SHARE = 1 / 6
+
+#: Voxel sizes of ``_voxel_cloud`` (isotropic, anisotropic, coarse along one axis).
+VOXEL_SPACINGS = ((1.0, 1.0, 1.0), (1.0, 1.0, 2.5), (0.7, 1.0, 1.3), (1.2, 1.0, 0.8), (2.0, 1.0, 1.0))
+
+
+def _voxel_cloud(rng):
+    """The vertices of a marching-cubes surface (a sphere, an ellipsoid or a torus of radii 6-40 voxels), read as
+    a cloud: ``(points, exact outward normals, exact H, largest exact |k|, label)`` at each vertex's closest point
+    of the analytic surface (``meshcurv.shapes.voxel_*``)."""
+    spacing = VOXEL_SPACINGS[int(rng.integers(len(VOXEL_SPACINGS)))]
+    voxel = float(np.mean(spacing))
+    seed = int(rng.integers(1000))
+    shape = ["sphere", "ellipsoid", "torus"][int(rng.integers(3))]
+    if shape == "sphere":
+        radius = float(rng.uniform(6.0, 40.0)) * voxel
+        mesh = shapes.voxel_sphere(radius, spacing=spacing, seed=seed)
+        label = f"voxel sphere {radius:.3g}"
+    elif shape == "ellipsoid":
+        axes = np.sort(rng.uniform(6.0, 32.0, size=3))[::-1] * voxel
+        mesh = shapes.voxel_ellipsoid(tuple(axes), spacing=spacing, seed=seed)
+        label = f"voxel ellipsoid {np.round(axes, 2).tolist()}"
+    else:
+        minor = float(rng.uniform(6.0, 12.0)) * voxel
+        major = minor * float(rng.uniform(2.0, 3.0))
+        mesh = shapes.voxel_torus(major, minor, spacing=spacing, seed=seed)
+        label = f"voxel torus ({major:.3g}, {minor:.3g})"
+    largest = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))
+    return [mesh.vertices], [mesh.normals], [mesh.mean], [largest], f"{label}, voxels {spacing}, seed {seed}"
+
+
 def make_cloud_case(rng):
     """An analytic point cloud with its exact mean curvature and outward normals at every point.
 
@@ -885,15 +948,22 @@ def make_cloud_case(rng):
     Strategies (issue 29): closed parts a spacing or two apart (two or three spheres of different radii),
     near-duplicate copies (2-20 copies with round-off differences of 1e-15 to 1e-9 relative), thin parts
     (ellipsoids with one axis 0.02-0.3 of the others), given radii (3 to 12 spacings, up to 0.9 times the
-    smallest radius of curvature), noise along the normal (up to 0.2 spacings), given normals (exact, flipped
+    smallest radius of curvature), voxel surfaces read as clouds (spheres, ellipsoids and tori of radii 6-40
+    voxels, isotropic and anisotropic voxels: :func:`_voxel_cloud`), noise along the normal (up to 0.2 spacings), given normals (exact, flipped
     at random or all inward), both methods, rigid motions and scales. The truth check
     (:func:`cloud_truth_check`): every valid point within :data:`CLOUD_TRUTH_TOLERANCE` of the exact H
     with the sign of the normals used, and its normal on the exact side (estimated normals).
     """
     kind = ["gap", "copies", "thin", "radius", "mixed"][int(rng.integers(5))]
+    # voxel surfaces from a stream of their own (the other cases keep the draws of earlier rounds)
+    voxels = np.random.default_rng(np.random.SeedSequence(rng.bit_generator.seed_seq.entropy, spawn_key=(29,)))
+    kind = "voxels" if voxels.random() < VOXEL_SHARE else kind
     labels = [f"cloud {kind}"]
     n = int(rng.choice([400, 1000, 2000, 4000]))
     points, normals, mean, kmax = [], [], [], []
+    if kind == "voxels":  # a voxel surface read as a cloud: the vertices of marching cubes, a staircase
+        points, normals, mean, kmax, label = _voxel_cloud(voxels)
+        labels.append(label)
     if kind in ("gap", "mixed", "copies", "radius"):
         radii = [1.0] + [float(rng.choice([0.5, 1.0, 2.0])) for _ in range(int(rng.integers(0, 3)))]
         x = 0.0
