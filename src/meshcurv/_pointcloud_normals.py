@@ -84,6 +84,12 @@ TRUSTED_SLOPE = 0.2
 #: A part of the flat graph of at least this many points is oriented on its own (see :func:`oriented_signs`).
 PART_MIN_POINTS = 32
 
+#: A part of less than this share of the area of a part beside it ...
+FRAGMENT_SHARE = 0.25
+#: ... whose flux about its centroid is at most this share of its absolute flux has no side of its own
+#: (:func:`undecided_fragments`).
+FRAGMENT_FLUX = 0.5
+
 #: Rounds of attaching small parts to their neighbours (each round reaches one part further).
 SMALL_PART_ROUNDS = 8
 
@@ -732,6 +738,45 @@ def outward_signs(points: np.ndarray, normals: np.ndarray, labels: np.ndarray, a
         labels, weights=areas * np.einsum("ij,ij->i", normals, points - centroid[labels]), minlength=n_labels
     )
     return np.where(flux[labels] < 0, -1.0, 1.0)
+
+
+def undecided_fragments(
+    points: np.ndarray, normals: np.ndarray, labels: np.ndarray, areas: np.ndarray, indices: np.ndarray
+) -> np.ndarray:
+    """(N,) bool: the points of fragments of a larger part whose outward side nothing decides.
+
+    A part that the orientation's graph cut off from a larger part beside it (a neighbour of one of its points
+    on a part at least 1 / :data:`FRAGMENT_SHARE` times its area), not closed as far as its flux tells
+    (``|sum a_i n_i . (p_i - c)|`` below :data:`FRAGMENT_FLUX` times ``sum a_i |n_i . (p_i - c)|``, ``c`` its
+    centroid: 1 on a sphere), took its side in :func:`outward_signs` from its own shape, which on a piece of a
+    saddle or of a flat tread says nothing, and the winding number does not correct it (a patch adds little to
+    the winding number at its own points). Such a piece: treads of a voxel staircase cut off from the rest by
+    their risers (``benchmarks/fuzz_api.py --point-clouds``, voxel surfaces).
+
+    Parameters
+    ----------
+    points, normals : ndarray of shape (N, 3)
+        The points and their oriented normals.
+    labels : ndarray of shape (N,), int
+        The part of each point (:func:`oriented_signs`).
+    areas : ndarray of shape (N,)
+        Each point's area (0 for the points that do not count).
+    indices : ndarray of shape (N, k)
+        The nearest neighbours of each point.
+    """
+    n_labels = int(labels.max()) + 1 if labels.size else 0
+    if n_labels < 2:
+        return np.zeros(labels.shape[0], dtype=bool)
+    counts = np.bincount(labels, minlength=n_labels).astype(float)
+    sums = np.stack([np.bincount(labels, weights=points[:, j], minlength=n_labels) for j in range(3)], axis=1)
+    centroid = sums / np.maximum(counts, 1.0)[:, None]
+    height = np.einsum("ij,ij->i", normals, points - centroid[labels]) * areas
+    flux = np.abs(np.bincount(labels, weights=height, minlength=n_labels))
+    spread = np.bincount(labels, weights=np.abs(height), minlength=n_labels)
+    area = np.bincount(labels, weights=areas, minlength=n_labels)
+    beside = np.zeros(n_labels, dtype=bool)  # a neighbour of one of its points on a part that much larger
+    beside[labels[(area[labels[indices]] * FRAGMENT_SHARE > area[labels][:, None]).any(axis=1)]] = True
+    return ((flux <= FRAGMENT_FLUX * spread) & beside & (area > 0))[labels]
 
 
 def oriented_signs(

@@ -111,7 +111,8 @@ NEEDLE = 7
 #: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the
 #: defects of meshes: the codes after theirs (8, 9, 10, 11).
 POINT_CLOUD_REASONS = (
-    "point cloud: side undecided (two sheets closer than the spacing, or stacked with normals the same way)",
+    "point cloud: side undecided (two sheets closer than the spacing, stacked with normals the same way, or a "
+    "piece cut off a larger part)",
     "point cloud: every ball held the other side of a thin part or a neighbouring part",
     "point cloud: on a line (its neighbours lie on a line with no surface around it)",
     "point cloud: unsteady estimate (changed over a larger ball or against its neighbours': a rim or part "

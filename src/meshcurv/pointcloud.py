@@ -982,9 +982,12 @@ def _compute(points, given, radius, method, search=None):
             points, start, indices, usable, spacing, tree
         )
         start = start * signs[:, None]
+        # a piece the orientation cut off a larger part (a tread of a voxel staircase) has no side of its own
+        cut_off = _normals.undecided_fragments(points, start, labels, np.where(usable, spacing**2, 0.0), indices)
+        doubtful = doubtful | cut_off
         how = "estimated"
     else:
-        doubtful = unsettled = np.zeros(n, dtype=bool)
+        doubtful = unsettled = cut_off = np.zeros(n, dtype=bool)
         signs, labels = _normals.orientation_signs(given, indices, usable, given=True, points=points)
         sheets = np.where(np.bincount(labels)[labels] >= _normals.PART_MIN_POINTS, labels, -1)
         # each component keeps the side most of its given normals point to
@@ -1242,7 +1245,13 @@ def _compute(points, given, radius, method, search=None):
     valid &= ~lone
     if doubtful.any():
         found = []
-        between = doubtful & ~unsettled & ~alike & ~amid
+        between = doubtful & ~unsettled & ~alike & ~amid & ~cut_off
+        if (cut_off & ~alike & ~amid).any():
+            found.append(
+                f"{int((cut_off & ~alike & ~amid).sum())} points are on pieces that the orientation cut off a "
+                "larger part beside them and whose own shape gives no side (a tread of a voxel staircase, a "
+                "patch between creases)"
+            )
         if between.any():
             found.append(
                 f"{int(between.sum())} points lie between two sheets closer than the spacing (two parts "
