@@ -6,7 +6,7 @@ tread near its top valid with their normal inward (H 0 where the exact torus has
 Present before this stop's changes. The 9 points belong to a part of 124 points (two treads and their riser)
 that the orientation's graph cut off from the rest; :func:`meshcurv._pointcloud_normals.outward_signs` turned it
 by the flux about its own centroid, which on a piece of a saddle or a tread says nothing, and the winding number
-did not correct it. Such fragments now have no side of their own (``_undecided_fragments``): NaN.
+did not correct it. Such fragments now have no side of their own (``undecided_fragments``): NaN.
 The truth: the analytic torus's outward normal at each vertex (``shapes.voxel_torus``).
 """
 
@@ -15,12 +15,14 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 from meshcurv import shapes
 from meshcurv.pointcloud import point_cloud_curvatures
 
 
 def test_every_valid_normal_of_a_voxel_torus_faces_out():
+    pytest.importorskip("skimage")  # (marching cubes: the volume extra)
     mesh = shapes.voxel_torus(26.2, 8.87, spacing=(0.7, 1.0, 1.3), seed=436)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the staircase's notes: one warning, not what is tested

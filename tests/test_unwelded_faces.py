@@ -178,6 +178,7 @@ def test_a_real_boundary_is_left_alone(mesh):
 
 
 def test_the_voxel_meshes_are_left_alone():
+    pytest.importorskip("skimage")  # (marching cubes: the volume extra)
     mesh = shapes.voxel_sphere(radius=6.0)
     vertices, faces = np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces)
     keep = vertices[faces].mean(axis=1)[:, 2] > mesh.vertices[:, 2].mean()  # an open cap: a stepped boundary

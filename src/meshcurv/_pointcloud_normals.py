@@ -526,6 +526,11 @@ def local_spacing(distances: np.ndarray) -> np.ndarray:
 #: the orientation's decisions on a noisy cloud depend on its input signs (``benchmarks/pointcloud.md``).
 PCA_SIGN = np.array([1.0, np.sqrt(2.0), np.sqrt(3.0)]) / np.sqrt(6.0)
 
+#: A part whose flux about its centroid is at most this share of its area-weighted size has no volume (a flat
+#: part: the flux is round-off, of either sign on the two backends): its side is :data:`PCA_SIGN`'s
+#: (:func:`outward_signs`).
+FLAT_FLUX = 1e-9
+
 
 def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """(N, 3) unit normals (unoriented: signed to face :data:`PCA_SIGN`): the least-variance direction of each point
@@ -729,15 +734,20 @@ def outward_signs(points: np.ndarray, normals: np.ndarray, labels: np.ndarray, a
 
     ``sum_i areas_i n_i . (p_i - c)`` over a component (``c`` its centroid) is
     three times the enclosed volume for outward normals (divergence theorem).
+    A component with no volume (that sum at most :data:`FLAT_FLUX` times
+    ``sum_i areas_i |p_i - c|``: a flat part, whose sum is round-off) has no
+    outside: its normals face :data:`PCA_SIGN`, on both backends alike.
     """
     n_labels = int(labels.max()) + 1 if labels.size else 0
     counts = np.bincount(labels, minlength=n_labels).astype(float)
     sums = np.stack([np.bincount(labels, weights=points[:, j], minlength=n_labels) for j in range(3)], axis=1)
     centroid = sums / np.maximum(counts, 1.0)[:, None]
-    flux = np.bincount(
-        labels, weights=areas * np.einsum("ij,ij->i", normals, points - centroid[labels]), minlength=n_labels
-    )
-    return np.where(flux[labels] < 0, -1.0, 1.0)
+    offsets = points - centroid[labels]
+    flux = np.bincount(labels, weights=areas * np.einsum("ij,ij->i", normals, offsets), minlength=n_labels)
+    size = np.bincount(labels, weights=areas * np.linalg.norm(offsets, axis=1), minlength=n_labels)
+    facing = np.bincount(labels, weights=areas * (normals @ PCA_SIGN), minlength=n_labels)
+    flat = np.abs(flux) <= FLAT_FLUX * size
+    return np.where(np.where(flat, facing, flux)[labels] < 0, -1.0, 1.0)
 
 
 def undecided_fragments(
