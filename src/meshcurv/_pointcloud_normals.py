@@ -729,6 +729,13 @@ def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.nd
     return signs, labels
 
 
+def _part_centroids(points: np.ndarray, labels: np.ndarray, n_labels: int) -> np.ndarray:
+    """(n_labels, 3) the centroid of each part's points (0 for a part of none)."""
+    counts = np.bincount(labels, minlength=n_labels).astype(float)
+    sums = np.stack([np.bincount(labels, weights=points[:, j], minlength=n_labels) for j in range(3)], axis=1)
+    return sums / np.maximum(counts, 1.0)[:, None]
+
+
 def outward_signs(points: np.ndarray, normals: np.ndarray, labels: np.ndarray, areas: np.ndarray) -> np.ndarray:
     """(N,) +1 or -1 per point: -1 on the components whose normals point inward.
 
@@ -739,9 +746,7 @@ def outward_signs(points: np.ndarray, normals: np.ndarray, labels: np.ndarray, a
     outside: its normals face :data:`PCA_SIGN`, on both backends alike.
     """
     n_labels = int(labels.max()) + 1 if labels.size else 0
-    counts = np.bincount(labels, minlength=n_labels).astype(float)
-    sums = np.stack([np.bincount(labels, weights=points[:, j], minlength=n_labels) for j in range(3)], axis=1)
-    centroid = sums / np.maximum(counts, 1.0)[:, None]
+    centroid = _part_centroids(points, labels, n_labels)
     offsets = points - centroid[labels]
     flux = np.bincount(labels, weights=areas * np.einsum("ij,ij->i", normals, offsets), minlength=n_labels)
     size = np.bincount(labels, weights=areas * np.linalg.norm(offsets, axis=1), minlength=n_labels)
@@ -777,9 +782,7 @@ def undecided_fragments(
     n_labels = int(labels.max()) + 1 if labels.size else 0
     if n_labels < 2:
         return np.zeros(labels.shape[0], dtype=bool)
-    counts = np.bincount(labels, minlength=n_labels).astype(float)
-    sums = np.stack([np.bincount(labels, weights=points[:, j], minlength=n_labels) for j in range(3)], axis=1)
-    centroid = sums / np.maximum(counts, 1.0)[:, None]
+    centroid = _part_centroids(points, labels, n_labels)
     height = np.einsum("ij,ij->i", normals, points - centroid[labels]) * areas
     flux = np.abs(np.bincount(labels, weights=height, minlength=n_labels))
     spread = np.bincount(labels, weights=np.abs(height), minlength=n_labels)
