@@ -54,32 +54,31 @@ def _vtk_cells(flat: np.ndarray):
         table = flat.reshape(-1, size + 1)
         if (table[:, 0] == size).all():
             return table[:, 1:]
-    faces, position = [], 0
-    while position < flat.size:  # ragged polygons: a loop over faces only for mixed polygon sizes
+    ids, sizes = _counted(flat, "face", least=1)  # ragged polygons: mixed polygon sizes
+    return np.split(ids, np.cumsum(sizes)[:-1])
+
+
+def _counted(flat: np.ndarray, what: str, *, least: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(ids, sizes)``: a VTK flat counted array ``[n0, i.., n1, j.., ...]`` without its counts, and the counts
+    (each at least ``least``); a walk over the counts only."""
+    counts, position = [], 0
+    while position < flat.size:
         count = int(flat[position])
-        if count < 1 or position + 1 + count > flat.size:
-            raise InvalidMeshError("the PyVista mesh's face array is malformed (a count runs past its end)")
-        faces.append(flat[position + 1 : position + 1 + count])
+        if count < least or position + 1 + count > flat.size:
+            raise InvalidMeshError(f"the PyVista mesh's {what} array is malformed (a count runs past its end)")
+        counts.append(count)
         position += 1 + count
-    return faces
+    sizes = np.asarray(counts, dtype=np.int64)
+    keep = np.ones(flat.size, dtype=bool)
+    keep[np.cumsum(sizes + 1) - sizes - 1] = False  # the place of each count in ``flat``
+    return flat[keep], sizes
 
 
 def _strip_triangles(flat: np.ndarray) -> np.ndarray:
     """(T, 3) the triangles of a VTK flat array of triangle strips ``[n0, i.., n1, j.., ...]``
     (:func:`meshcurv.topology.strip_triangles`)."""
-    flat = np.asarray(flat, dtype=np.int64).ravel()
-    counts, position = [], 0
-    while position < flat.size:  # a walk over the strips' counts (each strip's triangles are made at once)
-        count = int(flat[position])
-        if count < 0 or position + 1 + count > flat.size:
-            raise InvalidMeshError("the PyVista mesh's strip array is malformed (a count runs past its end)")
-        counts.append(count)
-        position += 1 + count
-    sizes = np.asarray(counts, dtype=np.int64)
-    heads = np.cumsum(sizes + 1) - sizes - 1  # the place of each count in ``flat``
-    keep = np.ones(flat.size, dtype=bool)
-    keep[heads] = False
-    return strip_triangles(flat[keep], np.cumsum(sizes))
+    ids, sizes = _counted(np.asarray(flat, dtype=np.int64).ravel(), "strip", least=0)
+    return strip_triangles(ids, np.cumsum(sizes))
 
 
 #: VTK cell types (``vtkCellType.h``) taken as faces; a pixel's corners run 0, 1, 3, 2 around it.
