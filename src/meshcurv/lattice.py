@@ -78,9 +78,12 @@ def _plane_lattice(planes: np.ndarray, candidates: np.ndarray, share: float):
     smallest = float(np.min(gaps))
     near = gaps[gaps < 1.5 * smallest]
     spacing = float(np.median(near if near.size >= 0.5 * gaps.size else gaps))
+    # one candidate at a time: no (candidates, planes) temporaries (64 rows of a large mesh's planes each)
+    held = np.zeros(candidates.size)
     with np.errstate(over="ignore", invalid="ignore"):  # a subnormal spacing (coordinates of 1e-310): no grid
-        steps = (planes[None, :] - candidates[:, None]) / spacing
-        held = (np.abs(steps - np.round(steps)) <= 1e3 * _ON_GRID).mean(axis=1)
+        for j, candidate in enumerate(candidates):
+            steps = (planes - candidate) / spacing
+            held[j] = np.count_nonzero(np.abs(steps - np.round(steps)) <= 1e3 * _ON_GRID) / planes.size
     if held.max() < share:
         return None  # the repeated values are not evenly spaced: not a grid (a symmetric height field, say)
     return spacing, float(candidates[np.argmax(held)])

@@ -170,22 +170,29 @@ def component_radii(vertices: np.ndarray, topology: MeshTopology) -> list[tuple[
 
 
 def _component_radii(mesh: _Measured | PreparedMesh) -> list[tuple[float, np.ndarray | None]]:
+    return [(DEFAULT_RADIUS_FACTOR * edge_length, members) for edge_length, members, _, _ in _component_edges(mesh)]
+
+
+def _component_edges(mesh: _Measured | PreparedMesh) -> list[tuple]:
+    """``(edge_length, members, inside, edges)`` of each group of :func:`component_radii`: the robust mean length
+    of its edges ``edges`` (E, 2) between :func:`meshcurv.defects.scale_vertices`, its vertices ``members``
+    (None: the whole mesh) and ``inside`` (V,) bool (None: the whole mesh)."""
     vertices, scales = mesh.vertices, mesh.length_scales
     all_edges = _scale_edges(mesh.topology, mesh.needles)  # no spike's edges (issue 29: a spike raised it 2.6x)
     referenced = _scale_vertices(mesh.topology, mesh.needles)
     used = scales[referenced & (scales > 0)]
     if used.size == 0 or used.min() == used.max():
-        return [(DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, all_edges), None)]
+        return [(robust_mean_edge_length(vertices, all_edges), None, None, all_edges)]
     level = np.full(scales.shape, np.iinfo(np.int64).min)
     positive = referenced & (scales > 0)
     level[positive] = np.round(np.log2(scales[positive])).astype(np.int64)
-    groups: list[tuple[float, np.ndarray | None]] = []
+    groups = []
     for k in np.unique(level[positive]):
         members = np.flatnonzero(level == k)
         inside = np.zeros(scales.shape, dtype=bool)
         inside[members] = True
         edges = all_edges[inside[all_edges[:, 0]]]
-        groups.append((DEFAULT_RADIUS_FACTOR * robust_mean_edge_length(vertices, edges), members))
+        groups.append((robust_mean_edge_length(vertices, edges), members, inside, edges))
     return groups
 
 
@@ -450,18 +457,11 @@ def _noise_radii(
 ) -> tuple[list[tuple[float, np.ndarray | None]], list[float]]:
     vertices = mesh.vertices
     usable = _scale_vertices(mesh.topology, mesh.needles)
-    all_edges = _scale_edges(mesh.topology, mesh.needles)
     centres = _scale_centres(mesh, valid, normals)
     groups: list[tuple[float, np.ndarray | None]] = []
     levels: list[float] = []
-    for _group_radius, members in _component_radii(mesh):
-        if members is None:
-            inside, edges = centres, all_edges
-        else:
-            part = np.zeros(vertices.shape[0], dtype=bool)
-            part[members] = True
-            inside, edges = centres & part, all_edges[part[all_edges[:, 0]]]
-        edge_length = robust_mean_edge_length(vertices, edges)
+    for edge_length, members, part, edges in _component_edges(mesh):  # each group's edges measured once
+        inside = centres if part is None else centres & part
         level = (
             _noise_level(vertices, normals, inside, edges, neighbours=usable, adjacency=adjacency)
             if edge_length > 0
@@ -539,7 +539,7 @@ def _voxel_surface_radius(
     # is in no extent, area or percentile below: the needles' vertices and faces are left out everywhere
     spikes = mesh.needles
     referenced = topology.referenced_vertices & ~spikes
-    grid = voxel_grid(vertices[referenced])
+    grid = voxel_grid(vertices if referenced.all() else vertices[referenced])  # (no copy of a whole mesh)
     if grid is None:
         return None
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
