@@ -487,7 +487,7 @@ def _fit_jets(
                 areas=areas,
                 min_spread=min_spread,
             )
-    pool_points = vertices[pool]
+    pool_points = vertices if pool.size == n else vertices[pool]  # (pool sorted: all of them is every vertex)
     areas = _checked_areas(areas, n)
     mean, _ = check_ball_work(pool_points, radius, centres.size, centres=vertices[centres])
     if paired:
@@ -810,7 +810,8 @@ def _fit_jet_normals(
             raise InvalidMeshError(f"`neighbours` must have shape ({n},); got {neighbours.shape}")
     if np.ndim(radius):
         radius = centre_radii(radius, n)
-    mean, _ = check_ball_work(vertices if neighbours is None else vertices[neighbours], radius, n, centres=vertices)
+    every = neighbours is None or bool(neighbours.all())  # (no copy of a whole mesh for a sample of it)
+    mean, _ = check_ball_work(vertices if every else vertices[neighbours], radius, n, centres=vertices)
     return _connected_fits(
         kernels,
         vertices,
@@ -961,7 +962,8 @@ def nested_jet_normals(
             for radius in radii
         ]
     allowed = np.ones(n, dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
-    mean, _ = check_ball_work(vertices[allowed], float(radii[-1]), n, centres=vertices)
+    pool = vertices if allowed.all() else vertices[allowed]  # (no copy of a whole mesh for a sample of it)
+    mean, _ = check_ball_work(pool, float(radii[-1]), n, centres=vertices)
     indptr, indices = checked_adjacency(adjacency, n)
     vertices, normals = (np.ascontiguousarray(a, dtype=np.float64) for a in (vertices, normals))
     pieces = [
