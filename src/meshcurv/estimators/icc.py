@@ -211,10 +211,14 @@ def fitted_normals(
     """
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     coarse = None
-    if areas is not None:  # in units of their median: weights of order 1 whatever the units of the mesh
+    dense = False  # the coarse level's test first: an ordinary mesh's fits read no areas unless weighted
+    if areas is not None and adjacency is not None:
+        edge = _sampled_edge(vertices, adjacency) if edge is None else edge
+        dense = _dense(vertices, float(np.median(radius)), adjacency, edge=edge)
+    if areas is not None and (dense or weighted):  # in units of their median: weights of order 1 whatever the units
         positive = areas[areas > 0]
         areas = areas / np.median(positive) if positive.size else None
-    if areas is not None and adjacency is not None:
+    if dense and areas is not None:
         coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency, edge=edge)
     if coarse is not None:
         points, point_normals, allowed, lists, point_areas = coarse
