@@ -6,6 +6,8 @@ Usage::
     python benchmarks/pointcloud_diagnostics.py --noise    # noise level, radius, valid points per family
     python benchmarks/pointcloud_diagnostics.py --voxels   # voxel surfaces (anisotropic voxels) read as clouds
     python benchmarks/pointcloud_diagnostics.py --staircase  # voxel surfaces of 6-40 voxels: tuned, held out
+    python benchmarks/pointcloud_diagnostics.py --facets --seed 1  # given radii on random voxel surfaces (7: held out)
+    python benchmarks/pointcloud_diagnostics.py --flat --seed 11  # flat voxel ellipsoids (17: held out)
 
 ``--noise`` prints, per cloud and method, the noise level (``parameters["noise"]``), the default radius, the valid
 points, a hash of the results and whether the call noted an unmeasured noise level: run it on two trees and compare
@@ -18,6 +20,14 @@ method, the share of points valid, the median relative error of H of the valid p
 radius of curvature of 4 spacings or more, as ``benchmarks/fuzz_api.py`` judges, H off by more than half the largest
 |k|) and the valid points whose normal is inward. ``--staircase``: the same over voxel surfaces of radii 6-40
 voxels, every point counted, on the shapes the staircase's constants were tuned on, then on held-out ones.
+
+``--facets``: voxel spheres, ellipsoids and tori of 6-40 voxels drawn at random (``--seed``: 1 the draw the facet and
+staircase constants were set on, 7 a held-out draw) in six voxel shapes, as ``benchmarks/fuzz_api.py``'s voxel
+clouds; jets at the default radius and at 0.55-1.3 times it, corrected_measures at the default and 0.6 times the
+jets' default; per method and radius over all surfaces: points, share valid, points off (valid, H off by more than
+half of the point's own largest exact |k|), median and 95th percentile of that error, CPU seconds. ``--flat``: the
+same over 12 flat voxel ellipsoids (axes a, 0.7-1 a, 0.2-0.4 a; a 20-32 voxels), corrected_measures and jets at their
+defaults, at 0.55 and 0.85 times the jets' default.
 """
 
 from __future__ import annotations
@@ -199,11 +209,85 @@ def run_voxels(surfaces=None, *, every: bool = False) -> None:
             )
 
 
+#: ``--facets``: the voxel shapes of the random surfaces (those of ``benchmarks/fuzz_api.py`` and one finer).
+FACET_SPACINGS = ((1.0, 1.0, 1.0), (0.7, 1.0, 1.3), (1.2, 1.0, 0.8), (1.0, 1.0, 2.5), (2.0, 1.0, 1.0), (0.5, 0.8, 1.0))
+
+#: ... the method and the share of the jets' default radius of each call (None: the method's default).
+FACET_CALLS = (
+    ("jets", None),
+    ("jets", 0.55),
+    ("jets", 0.7),
+    ("jets", 0.85),
+    ("jets", 1.3),
+    ("corrected_measures", None),
+    ("corrected_measures", 0.6),
+)
+
+
+#: ``--flat``: the calls on the flat ellipsoids.
+FLAT_CALLS = (("corrected_measures", None), ("jets", None), ("corrected_measures", 0.55), ("jets", 0.85))
+
+
+def run_facets(seed: int, *, flat: bool = False) -> None:
+    """The table of ``--facets`` for the draw ``seed``; ``flat``: the table of ``--flat`` (flat ellipsoids)."""
+    rng = np.random.default_rng(seed)
+    totals: dict = {}
+    for shape in ("flat", "flat") if flat else ("sphere", "ellipsoid", "torus"):
+        for spacing in FACET_SPACINGS:
+            voxel = float(np.mean(spacing))
+            draw = int(rng.integers(1000))
+            if shape == "flat":
+                a = rng.uniform(20, 32)
+                axes = np.array([a, a * rng.uniform(0.7, 1.0), a * rng.uniform(0.2, 0.4)]) * voxel
+                mesh = shapes.voxel_ellipsoid(tuple(axes), spacing=spacing, seed=draw)
+            elif shape == "sphere":
+                mesh = shapes.voxel_sphere(float(rng.uniform(6, 40)) * voxel, spacing=spacing, seed=draw)
+            elif shape == "ellipsoid":
+                axes = np.sort(rng.uniform(6, 32, 3))[::-1] * voxel
+                mesh = shapes.voxel_ellipsoid(tuple(axes), spacing=spacing, seed=draw)
+            else:
+                minor = float(rng.uniform(6, 12)) * voxel
+                mesh = shapes.voxel_torus(minor * float(rng.uniform(2, 3)), minor, spacing=spacing, seed=draw)
+            points = mesh.vertices
+            if points.shape[0] > 40000:
+                continue
+            largest = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                default = point_cloud_curvatures(points, method="jets").parameters["radius"]
+                for method, share in FLAT_CALLS if flat else FACET_CALLS:
+                    start = time.process_time()
+                    radius = None if share is None else share * default
+                    r = point_cloud_curvatures(points, method=method, radius=radius)
+                    seconds = time.process_time() - start
+                    side = np.sign(np.einsum("ij,ij->i", r.normals, mesh.normals))
+                    error = np.abs(r.mean - side * mesh.mean) / largest
+                    total = totals.setdefault((method, share), [0, 0, 0, 0.0, []])
+                    total[0] += points.shape[0]
+                    total[1] += int(r.valid.sum())
+                    total[2] += int((r.valid & (error > 0.5)).sum())
+                    total[3] += seconds
+                    total[4].append(error[r.valid])
+    print("| method | radius | points | valid | points off | median error | 95th percentile | CPU s |")
+    print("|---|---|---|---|---|---|---|---|")
+    for (method, share), (n, valid, off, seconds, errors) in totals.items():
+        errors = np.concatenate(errors)
+        what = "default" if share is None else f"{share:g} x the jets' default"
+        print(
+            f"| {method} | {what} | {n} | {valid / n:.3f} | {off} | {np.median(errors):.3f} | "
+            f"{np.percentile(errors, 95):.3f} | {seconds:.1f} |",
+            flush=True,
+        )
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--noise", action="store_true", help="noise level, radius and valid points per family")
     parser.add_argument("--voxels", action="store_true", help="voxel surfaces read as clouds")
     parser.add_argument("--staircase", action="store_true", help="voxel surfaces, radii 6-40 voxels: tuned, held out")
+    parser.add_argument("--facets", action="store_true", help="given radii on random voxel surfaces")
+    parser.add_argument("--flat", action="store_true", help="flat voxel ellipsoids (c / a 0.2-0.4)")
+    parser.add_argument("--seed", type=int, default=1, help="--facets, --flat: the draw (1 tuned, 7 held out)")
     args = parser.parse_args(argv)
     if args.noise:
         run_noise()
@@ -212,6 +296,10 @@ def main(argv=None) -> None:
     if args.staircase:
         run_voxels(STAIRCASE_TUNED, every=True)
         run_voxels(STAIRCASE_HELD_OUT, every=True)
+    if args.facets:
+        run_facets(args.seed)
+    if args.flat:
+        run_facets(args.seed, flat=True)
 
 
 if __name__ == "__main__":

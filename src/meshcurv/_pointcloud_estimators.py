@@ -98,6 +98,13 @@ FLAT_TURN = 0.05
 #: of the smaller largest |k|.
 NEIGHBOUR_AGREEMENT = 0.3
 
+#: On a lattice the jets must agree with the corrected measures over the same balls (:func:`staircase_disagree`)
+#: within this share of the smaller largest |k|: the measures' own error there stays below 0.13 of |k| at 99% of
+#: the valid points of the voxel spheres, ellipsoids and tori of ``benchmarks/pointcloud_diagnostics.md``, so that
+#: an agreeing jet is off by less than half of |k| (at :data:`AGREEMENT`, 0.4, jets 1.5 times |k| agreed with
+#: measures 1.1 times it).
+STAIRCASE_AGREEMENT = 0.3
+
 #: A given radius below this share of the one the noise calls for is unsteady (:func:`small_balls`): the default
 #: rule's balls give median errors of 1-6% under noise; half their radius, about four times that, and tails beyond
 #: half of |k|.
@@ -353,7 +360,8 @@ def _neighbour_differences(k_min, k_max, indices, valid, spacing) -> np.ndarray:
     :func:`meshcurv._kernels.pointcloud.neighbour_differences`."""
     estimated = np.isfinite(k_min) & np.isfinite(k_max)
     safe = np.where(valid[:, None] & estimated[indices], indices, -1)
-    with np.errstate(invalid="ignore"):
+    # (a point left out of the estimate has spacing 0: its scale is infinite; it has no estimate to keep)
+    with np.errstate(invalid="ignore", divide="ignore"):
         own = np.stack([k_min, k_max], axis=1)
         theirs = np.where((safe >= 0)[..., None], own[np.maximum(safe, 0)], np.nan)
         largest = np.minimum(np.abs(own).max(axis=1)[:, None], np.abs(theirs).max(axis=2))
@@ -640,6 +648,26 @@ def disagree(found, jets, centres, radius) -> np.ndarray:
         turn = radii[centres] * np.maximum(np.abs(k_min[centres]), np.abs(k_max[centres]))
     compared = centres[turn <= JET_TURN]  # (NaN where no fit: not compared)
     return unsteady(found, (k_min, k_max), compared, radius)
+
+
+def staircase_disagree(tree, points, normals, found, radius, centres, usable, *, normal_radius, spacing, sheets):
+    """(N,) bool: on a lattice, the ``centres`` whose jets ``found`` (``k_min, k_max, ...``) over balls of
+    ``radius`` the corrected measures over the same balls do not reproduce within :data:`STAIRCASE_AGREEMENT`, as
+    :func:`unsteady` compares; a centre with no measure is flagged. The measures take the normals of jets over balls of ``normal_radius`` from the
+    oriented ``normals`` (``None``: the ``normals`` themselves, given by the caller).
+
+    A voxel surface read as a cloud is a staircase: the jets fit the positions, and the steps bias neighbouring
+    balls alike (a ball on one facet of a diagonal slope reads 0, a ball over a tread's edge up to 1.7 times |k|),
+    so that the check over a larger ball and the neighbours' agree with a wrong value. The measures integrate the
+    normals' variation, which the steps bias little (on the voxel spheres, ellipsoids and tori of
+    ``benchmarks/pointcloud_diagnostics.md``, "Jets against the measures on a staircase"): the converse of
+    :func:`disagree`.
+    """
+    centres = np.asarray(centres, dtype=np.int64)
+    if normal_radius is not None:
+        normals = fitted_normals(points, normals, normal_radius, centres, usable, smallest=normal_radius)
+    measured = corrected_measures(tree, points, normals, radius, centres, usable, spacing=spacing, sheets=sheets)
+    return unsteady(found, measured, centres[np.isfinite(found[0][centres])], radius, STAIRCASE_AGREEMENT)
 
 
 def fitted_normals(points, normals, radius, centres, usable, *, smallest: float, details: dict | None = None):

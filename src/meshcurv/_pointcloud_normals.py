@@ -195,6 +195,10 @@ LATTICE_SHARE = 0.5
 LATTICE_PLANES = 3
 LATTICE_TOLERANCE = 1e-6
 
+#: Coordinates along an axis closer than this share of its largest |coordinate| are one plane of a lattice (their
+#: difference is round-off: the same coordinate computed two ways).
+LATTICE_ROUND_OFF = 1e-12
+
 #: A cloud none of whose coordinates repeats among this many of its points, evenly spaced, is on no lattice (the
 #: whole cloud is not read: a lattice of fewer than millions of planes along an axis repeats one there).
 LATTICE_PROBE = 4096
@@ -208,6 +212,22 @@ LATTICE_PROBE = 4096
 #: (``benchmarks/pointcloud_diagnostics.md``, "Jets on a staircase").
 TREAD_SHARE = 0.75
 TREAD_NEIGHBOURS = 48
+
+#: On a lattice, a ball whose points (its :data:`STEP_NEIGHBOURS` nearest, the most that the measures draw from) lie
+#: on at most this many planes of the grid along the axis most along the normal sees one step of the staircase at
+#: most (a tread, its riser and the next tread: the grid of half voxels of marching cubes over a mask): the curvature
+#: it reads is the step's, whatever the surface's (at the rims of the wide treads of a flat face, 1.6-2 times its
+#: |k|); its estimate is NaN (see :func:`lattice_treads`; ``benchmarks/pointcloud_diagnostics.md``, "One step").
+STEP_PLANES = 3
+STEP_NEIGHBOURS = 96
+
+#: On a lattice, an estimate whose surface rises over its ball by less than this share of the staircase's own
+#: relief along the normal (``max(|k|) r^2 / 2 < FACET_SAGITTA * max_k |n_k| h_k``, ``h`` the grid's steps) sees
+#: no curvature the grid resolves (see :func:`lattice_treads`): a ball on one facet of the staircase (a plane of
+#: the grid of any slope: the tread of an axis, the digital planes of slopes such as (1, 1, 1) and (2, 1, 1) of
+#: the voxels). Jets over such balls read exactly 0 (a sagitta of round-off); estimates that resolve the
+#: surface read a tenth or more of the relief (``benchmarks/pointcloud_diagnostics.md``, "Facets of a staircase").
+FACET_SAGITTA = 0.1
 
 #: The winding number between two stacked sheets (see :func:`between_sides`) below which the part between them
 #: is inside out (-1; 1 inside a part, 0 in a gap between two).
@@ -1393,14 +1413,21 @@ def lattice_steps(points: np.ndarray) -> np.ndarray:
     if all(np.unique(probe[:, axis]).size == probe.shape[0] for axis in range(3)):
         return steps
     for axis in range(3):
-        values, counts = np.unique(points[:, axis], return_counts=True)
-        planes = values[counts > 1]
+        # the coordinates within round-off of each other are one plane (a coordinate computed two ways)
+        values = np.sort(points[:, axis])
+        round_off = LATTICE_ROUND_OFF * max(float(np.abs(values).max()), np.finfo(float).tiny)
+        first = np.flatnonzero(np.r_[True, np.diff(values) > round_off])
+        counts = np.diff(np.r_[first, values.size])
+        planes = values[first[counts > 1]]
         if planes.size < LATTICE_PLANES or counts[counts > 1].sum() < LATTICE_SHARE * points.shape[0]:
             continue
         gaps = np.diff(planes)
-        multiples = gaps / gaps.min()
-        if gaps.min() > 0 and np.all(np.abs(multiples - np.round(multiples)) <= LATTICE_TOLERANCE * multiples):
-            steps[axis] = gaps.min()
+        step = gaps.min()
+        # whole multiples of the step to LATTICE_TOLERANCE of it, each plane known to its round-off: not relative
+        # to the multiple (a gap a million steps long is a whole multiple of any step to a millionth of itself)
+        off = np.abs(gaps - np.round(gaps / step) * step)
+        if np.all(off <= LATTICE_TOLERANCE * step + 2 * round_off):
+            steps[axis] = step
     return steps
 
 
@@ -1423,37 +1450,67 @@ def _off_the_steps(points, normals, queries, found, lattice):
     return hit, near, flags, two
 
 
-def lattice_treads(points: np.ndarray, normals: np.ndarray, radii: np.ndarray, candidates: np.ndarray, tree):
-    """``(tread, problems)``: (N,) bool, the ``candidates`` (N,) bool whose ball lies on a flat tread of a lattice.
+def lattice_treads(
+    points: np.ndarray,
+    normals: np.ndarray,
+    radii: np.ndarray,
+    candidates: np.ndarray,
+    tree,
+    estimate: tuple[np.ndarray, np.ndarray, np.ndarray],
+):
+    """``(tread, problems)``: (N,) bool, the ``candidates`` (N,) bool whose ball does not resolve a lattice's steps.
 
     A voxel surface read as a cloud (see :func:`lattice_steps`) is a staircase whose treads, where the surface is
     nearly at right angles to an axis, are about ``sqrt(2 R h)`` wide (``R`` its radius of curvature, ``h`` the
-    voxel): a ball within one sees a plane, curvature 0, and nothing in it says that the surface curves. A point
-    whose ball of radius ``radii`` (N,) holds at least :data:`TREAD_SHARE` of its :data:`TREAD_NEIGHBOURS` nearest
-    neighbours on its own plane of the grid (across the axis most along its ``normals`` (N, 3)) is such a point (a
-    flat face of a box in voxels too: flat as far as the ball sees). ``problems``: the phrase of the call's warning
-    (none when no point is).
+    voxel): a ball within one sees a plane, curvature 0, and nothing in it says that the surface curves. Such are:
+
+    - a point whose ball of radius ``radii`` (N,) holds at least :data:`TREAD_SHARE` of its
+      :data:`TREAD_NEIGHBOURS` nearest neighbours on its own plane of the grid, across the axis most along its
+      ``normals`` (N, 3) (a flat face of a box in voxels too: flat as far as the ball sees);
+    - a point whose ball spans at most :data:`STEP_PLANES` planes of the grid across that axis: one step, whose
+      curvature is what the ball reads, whatever the surface's;
+    - a point whose ``estimate`` ``(k_min, k_max, fitted)`` (N,) each, the principal curvatures and the radius of
+      the ball they were taken over, rises over that ball by less than :data:`FACET_SAGITTA` of the staircase's
+      relief along the normal: a ball on a facet of another slope, where the surface is nearly at right angles to
+      a diagonal of the grid.
+
+    ``problems``: the phrase of the call's warning (none when no point is).
     """
     tread = np.zeros(points.shape[0], dtype=bool)
     rows = np.flatnonzero(candidates)
-    lattice = lattice_steps(points[rows]) if rows.size else np.zeros(3)
+    # (the grid of the whole cloud: the candidates alone may lie on too few of its planes, two treads at the poles)
+    lattice = lattice_steps(points) if rows.size else np.zeros(3)
     if not lattice.any():
         return tread, []
-    k = min(TREAD_NEIGHBOURS + 1, points.shape[0])
+    k_min, k_max, fitted = estimate
+    with np.errstate(invalid="ignore"):
+        sagitta = np.maximum(np.abs(k_min[rows]), np.abs(k_max[rows])) * fitted[rows] ** 2 / 2
+        tread[rows] = sagitta < FACET_SAGITTA * np.max(np.abs(normals[rows]) * lattice, axis=1)
+    k = min(STEP_NEIGHBOURS + 1, points.shape[0])
     for start in range(0, rows.size, CHUNK):
         chunk = rows[start : start + CHUNK]
         distances, near = tree.query(points[chunk], k=k, workers=-1)
         inside = distances[:, 1:] <= radii[chunk][:, None]  # (the point itself first)
-        axis = np.argmax(np.abs(normals[chunk]) * (lattice > 0), axis=1)
-        across = np.abs(points[near[:, 1:], axis[:, None]] - points[chunk, axis][:, None])
-        plane = inside & (across <= LATTICE_TOLERANCE * lattice[axis][:, None])
-        tread[chunk] = plane.sum(axis=1) >= TREAD_SHARE * np.maximum(inside.sum(axis=1), 1)
+        # the axis most along the normal: a point facing an axis off the grid (a cylinder's side, its rings on a
+        # grid along the axis) is on no tread
+        axis = np.argmax(np.abs(normals[chunk]), axis=1)
+        step = np.where(lattice[axis] > 0, lattice[axis], np.nan)[:, None]
+        height = points[near[:, 1:], axis[:, None]] - points[chunk, axis][:, None]
+        nearest = inside[:, :TREAD_NEIGHBOURS]
+        plane = nearest & (np.abs(height[:, :TREAD_NEIGHBOURS]) <= LATTICE_TOLERANCE * step)
+        tread[chunk] |= plane.sum(axis=1) >= TREAD_SHARE * np.maximum(nearest.sum(axis=1), 1)
+        # the planes of the grid the ball spans along the axis (the centre's own included)
+        span = np.maximum(np.where(inside, height, -np.inf).max(axis=1), 0.0) - np.minimum(
+            np.where(inside, height, np.inf).min(axis=1), 0.0
+        )
+        tread[chunk] |= span <= (STEP_PLANES - 1 + LATTICE_TOLERANCE) * step[:, 0]
     if not tread.any():
         return tread, []
     return tread, [
-        f"{int(tread.sum())} points lie on a flat tread of a voxel staircase (at least {TREAD_SHARE:g} of their ball "
-        "on one plane of the voxels' grid: the surface may curve there by less than the voxels resolve at this "
-        "radius): NaN"
+        f"{int(tread.sum())} points see a flat facet or a single step of a voxel staircase (at least "
+        f"{TREAD_SHARE:g} of their ball on one plane of the voxels' grid, a ball spanning {STEP_PLANES} planes of "
+        f"it or fewer, or an estimate rising over the ball by less than {FACET_SAGITTA:g} of the steps: the "
+        "surface may curve there by less than the voxels resolve at this radius): NaN"
     ]
 
 

@@ -1043,6 +1043,7 @@ def _compute(points, given, radius, method, search=None):
     noisy = 0  # points whose fits the noise dominates (see NOISY_PCA)
     mixed = None
     compiled = numba_kernels("pointcloud") is not None
+    on_lattice = method == "jets" and bool(_normals.lattice_steps(points[usable]).any())
     for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
         seen = _class_noise(noise, median, group_spacing)  # the noise in this class's own spacings
@@ -1102,6 +1103,22 @@ def _compute(points, given, radius, method, search=None):
             noisy += _noise_dominated(
                 details["radii"], part_members, asked, part_one_sided, needed, undefined=seen >= NOISY_PCA
             )
+            if on_lattice:  # a staircase biases neighbouring jets alike: the measures over the same balls must agree
+                logger.info("point cloud: jets against the measures on a staircase")
+                details["unsteady"] = details["unsteady"] | _estimators.staircase_disagree(
+                    tree if near is None else None if compiled else cKDTree(part_points),  # (as corrected_measures)
+                    part_points,
+                    part_start,
+                    found,
+                    group_radius,
+                    part_members,
+                    part_usable & part_one_sided,
+                    normal_radius=None
+                    if given is not None
+                    else max(noise_rule(_estimators.NORMAL_RULE, group_spacing, seen), floor),
+                    spacing=group_spacing,
+                    sheets=part_sheets,
+                )
         else:
             if given is None:
                 asked = normal_radius
@@ -1233,8 +1250,8 @@ def _compute(points, given, radius, method, search=None):
         problems.extend(_estimators.wide_jets_problem(wide))
         reason[wide] = _UNSTEADY
         valid &= ~wide
-    # a voxel surface read as a cloud: a ball on a flat tread of its staircase sees a plane
-    tread, found = _normals.lattice_treads(points, out_normals, balls, valid & ~doubtful, tree)
+    # a voxel surface read as a cloud: a ball on a flat facet of its staircase sees a plane
+    tread, found = _normals.lattice_treads(points, out_normals, balls, valid & ~doubtful, tree, (k_min, k_max, fitted))
     problems.extend(found)
     reason[tread] = _UNSTEADY
     valid &= ~tread
