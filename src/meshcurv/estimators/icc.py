@@ -222,13 +222,17 @@ def fitted_normals(
         coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency, edge=edge)
     if coarse is not None:
         points, point_normals, allowed, lists, point_areas = coarse
-        fitted = _sampled_jet_normals(
+        # the vertices measured only: the cubes of the samples start at their corner, which a vertex in no face
+        # (no valid normal) would move
+        centres = np.flatnonzero(valid)
+        fitted = np.full((vertices.shape[0], 3), np.nan)
+        fitted[centres] = _sampled_jet_normals(
             points,
             point_normals,
-            radius,
+            radius if np.ndim(radius) == 0 else np.asarray(radius)[centres],
             degree=NORMAL_DEGREE,
             iterations=NORMAL_ITERATIONS,
-            centres=np.arange(vertices.shape[0]),
+            centres=centres,
             neighbours=allowed,
             adjacency=lists,
             settled=NORMAL_SETTLED,
