@@ -28,3 +28,17 @@ def test_a_subnormal_part_beside_a_large_one_gives_one_warning(backend):
     assert len(caught) == 1 and "left out" in str(caught[0].message)
     assert not result.valid[: tiny.shape[0]].any()
     assert result.valid[tiny.shape[0] :].mean() > 0.8
+
+
+def test_jets_on_a_voxel_surface_beside_a_part_left_out():
+    # fuzz round 15, seed 258 case 1061: the check of the jets against the corrected measures on a voxel surface
+    # fitted normals over a class of points all left out (a part spaced below what a float resolves), and
+    # divided by the size of its empty pool (ZeroDivisionError)
+    pytest.importorskip("skimage")
+    voxels = shapes.voxel_sphere(radius=4.0).vertices
+    tiny = shapes.ellipsoid(subdivisions=5).vertices * 1e-15 + 5e-15
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshcurvWarning)
+        result = point_cloud_curvatures(np.concatenate([voxels, tiny]), method="jets")
+    assert not result.valid[voxels.shape[0] :].any()
+    assert result.valid[: voxels.shape[0]].any()

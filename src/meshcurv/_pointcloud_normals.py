@@ -1467,12 +1467,13 @@ def lattice_treads(
     - a point whose ball of radius ``radii`` (N,) holds at least :data:`TREAD_SHARE` of its
       :data:`TREAD_NEIGHBOURS` nearest neighbours on its own plane of the grid, across the axis most along its
       ``normals`` (N, 3) (a flat face of a box in voxels too: flat as far as the ball sees);
-    - a point whose ball spans at most :data:`STEP_PLANES` planes of the grid across that axis: one step, whose
-      curvature is what the ball reads, whatever the surface's;
-    - a point whose ``estimate`` ``(k_min, k_max, fitted)`` (N,) each, the principal curvatures and the radius of
-      the ball they were taken over, rises over that ball by less than :data:`FACET_SAGITTA` of the staircase's
-      relief along the normal: a ball on a facet of another slope, where the surface is nearly at right angles to
-      a diagonal of the grid.
+    - on a grid of all three axes, a point whose ball spans at most :data:`STEP_PLANES` planes of the grid across
+      that axis: one step, whose curvature is what the ball reads, whatever the surface's;
+    - on a grid of all three axes, a point whose ``estimate`` ``(k_min, k_max, fitted)`` (N,) each, the principal
+      curvatures and the radius of the ball they were taken over, rises over that ball by less than
+      :data:`FACET_SAGITTA` of the staircase's relief along the normal: a ball on a facet of another slope, where
+      the surface is nearly at right angles to a diagonal of the grid (a plane of rational slope sampled on such a
+      grid is one too; a plane sampled on a grid of two axes, a range image, is not).
 
     ``problems``: the phrase of the call's warning (none when no point is).
     """
@@ -1483,9 +1484,11 @@ def lattice_treads(
     if not lattice.any():
         return tread, []
     k_min, k_max, fitted = estimate
-    with np.errstate(invalid="ignore"):
-        sagitta = np.maximum(np.abs(k_min[rows]), np.abs(k_max[rows])) * fitted[rows] ** 2 / 2
-        tread[rows] = sagitta < FACET_SAGITTA * np.max(np.abs(normals[rows]) * lattice, axis=1)
+    if lattice.all():  # (every coordinate on the grid, a mask's marching cubes: a plane sampled on a grid of two
+        # axes, a range image, is flat)
+        with np.errstate(invalid="ignore"):
+            sagitta = np.maximum(np.abs(k_min[rows]), np.abs(k_max[rows])) * fitted[rows] ** 2 / 2
+            tread[rows] = sagitta < FACET_SAGITTA * np.max(np.abs(normals[rows]) * lattice, axis=1)
     k = min(STEP_NEIGHBOURS + 1, points.shape[0])
     for start in range(0, rows.size, CHUNK):
         chunk = rows[start : start + CHUNK]
@@ -1503,7 +1506,8 @@ def lattice_treads(
         span = np.maximum(np.where(inside, height, -np.inf).max(axis=1), 0.0) - np.minimum(
             np.where(inside, height, np.inf).min(axis=1), 0.0
         )
-        tread[chunk] |= span <= (STEP_PLANES - 1 + LATTICE_TOLERANCE) * step[:, 0]
+        if lattice.all():  # (a steep plane sampled on a grid of two axes spans few planes of it between samples)
+            tread[chunk] |= span <= (STEP_PLANES - 1 + LATTICE_TOLERANCE) * step[:, 0]
     if not tread.any():
         return tread, []
     return tread, [

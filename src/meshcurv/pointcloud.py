@@ -1043,7 +1043,8 @@ def _compute(points, given, radius, method, search=None):
     noisy = 0  # points whose fits the noise dominates (see NOISY_PCA)
     mixed = None
     compiled = numba_kernels("pointcloud") is not None
-    on_lattice = method == "jets" and bool(_normals.lattice_steps(points[usable]).any())
+    # (a staircase: every coordinate on a grid, as marching cubes over a mask puts them; not a range image's two)
+    on_lattice = method == "jets" and bool(_normals.lattice_steps(points[usable]).all())
     for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
         seen = _class_noise(noise, median, group_spacing)  # the noise in this class's own spacings
