@@ -1484,8 +1484,10 @@ def lattice_treads(
     if not lattice.any():
         return tread, []
     k_min, k_max, fitted = estimate
-    if lattice.all():  # (every coordinate on the grid, a mask's marching cubes: a plane sampled on a grid of two
-        # axes, a range image, is flat)
+    # every coordinate on the grid, as marching cubes over a mask puts them (a plane sampled on a grid of two axes,
+    # a range image, is flat; a steep one spans few planes of it between samples)
+    staircase = bool(lattice.all())
+    if staircase:
         with np.errstate(invalid="ignore"):
             sagitta = np.maximum(np.abs(k_min[rows]), np.abs(k_max[rows])) * fitted[rows] ** 2 / 2
             tread[rows] = sagitta < FACET_SAGITTA * np.max(np.abs(normals[rows]) * lattice, axis=1)
@@ -1502,11 +1504,10 @@ def lattice_treads(
         nearest = inside[:, :TREAD_NEIGHBOURS]
         plane = nearest & (np.abs(height[:, :TREAD_NEIGHBOURS]) <= LATTICE_TOLERANCE * step)
         tread[chunk] |= plane.sum(axis=1) >= TREAD_SHARE * np.maximum(nearest.sum(axis=1), 1)
-        # the planes of the grid the ball spans along the axis (the centre's own included)
-        span = np.maximum(np.where(inside, height, -np.inf).max(axis=1), 0.0) - np.minimum(
-            np.where(inside, height, np.inf).min(axis=1), 0.0
-        )
-        if lattice.all():  # (a steep plane sampled on a grid of two axes spans few planes of it between samples)
+        if staircase:  # the planes of the grid the ball spans along the axis (the centre's own included)
+            span = np.maximum(np.where(inside, height, -np.inf).max(axis=1), 0.0) - np.minimum(
+                np.where(inside, height, np.inf).min(axis=1), 0.0
+            )
             tread[chunk] |= span <= (STEP_PLANES - 1 + LATTICE_TOLERANCE) * step[:, 0]
     if not tread.any():
         return tread, []

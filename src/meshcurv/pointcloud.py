@@ -1048,16 +1048,12 @@ def _compute(points, given, radius, method, search=None):
     for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
         seen = _class_noise(noise, median, group_spacing)  # the noise in this class's own spacings
+        # the radius of the normal fits (corrected_measures' own; the jets' reference on a staircase)
+        normal_rule = max(noise_rule(_estimators.NORMAL_RULE, group_spacing, seen), floor)
         if method == "jets" and radius is None:
             group_radius = _within_budget(points, group_radius, members, "jet fits", problems)
         if method == "corrected_measures" and given is None:
-            normal_radius = _within_budget(
-                points,
-                max(noise_rule(_estimators.NORMAL_RULE, group_spacing, seen), floor),
-                members,
-                "normal fits",
-                problems,
-            )
+            normal_radius = _within_budget(points, normal_rule, members, "normal fits", problems)
             reach = max(normal_radius, group_radius)
         else:
             reach = group_radius
@@ -1114,9 +1110,7 @@ def _compute(points, given, radius, method, search=None):
                     group_radius,
                     part_members,
                     part_usable & part_one_sided,
-                    normal_radius=None
-                    if given is not None
-                    else max(noise_rule(_estimators.NORMAL_RULE, group_spacing, seen), floor),
+                    normal_radius=None if given is not None else normal_rule,
                     spacing=group_spacing,
                     sheets=part_sheets,
                 )
