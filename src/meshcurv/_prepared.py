@@ -96,8 +96,11 @@ class PreparedMesh:
 
     @cached_property
     def cross(self) -> np.ndarray:
-        """(F, 3) cross products of the faces' sides (twice their area, along their normal); read-only."""
-        return _read_only(face_cross_products(self.vertices, self.topology.faces))
+        """(F, 3) cross products of the faces' sides (twice their area, along their normal); read-only. Kept from
+        the first time they are asked for (those :attr:`degenerate` builds on its way serve the vertex normals and
+        areas, then go: the default method reads no more of them, and they are 24 bytes a face)."""
+        spare = self.__dict__.pop("_spare_cross", None)
+        return spare if spare is not None else _read_only(face_cross_products(self.vertices, self.topology.faces))
 
     @cached_property
     def degenerate(self) -> np.ndarray:
@@ -109,7 +112,7 @@ class PreparedMesh:
             )
         faces = self.topology.faces
         cross, degenerate = cross_and_degenerate(self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO)
-        self.__dict__["cross"] = _read_only(cross)
+        self.__dict__["_spare_cross"] = _read_only(cross)
         return _read_only(degenerate)
 
     def found_degenerate(self, degenerate: np.ndarray) -> None:
@@ -126,20 +129,26 @@ class PreparedMesh:
         return self.degenerate if needle is None else _read_only(self.degenerate | needle)
 
     @cached_property
-    def _normal_and_area_sums(self) -> tuple[np.ndarray, np.ndarray]:
-        faces = self.topology.faces
-        return vertex_normal_and_area_sums(self.cross, faces, self.dropped, self.vertices.shape[0])
+    def _normals_and_areas(self) -> tuple[np.ndarray, np.ndarray]:
+        """:attr:`vertex_normals` and :attr:`vertex_areas`, from one pass over the faces (the sums of the cross
+        products are not kept); the cross products :attr:`degenerate` built on its way are let go here."""
+        dropped = self.dropped  # the zero-area faces, and with them the cross products unless asked for before
+        cross = self.__dict__.get("cross", self.__dict__.pop("_spare_cross", None))
+        if cross is None:  # the zero-area faces were given (:meth:`found_degenerate`)
+            cross = face_cross_products(self.vertices, self.topology.faces)
+        sums, areas = vertex_normal_and_area_sums(cross, self.topology.faces, dropped, self.vertices.shape[0])
+        return _read_only(normalize_normal_sums(sums)), _read_only(areas)
 
     @cached_property
     def vertex_normals(self) -> np.ndarray:
         """(V, 3) area-weighted unit normals of the faces not :attr:`dropped` (NaN where none); read-only."""
-        return _read_only(normalize_normal_sums(self._normal_and_area_sums[0]))
+        return self._normals_and_areas[0]
 
     @cached_property
     def vertex_areas(self) -> np.ndarray:
         """(V,) a third of the area of the faces not :attr:`dropped` at each vertex (from the pass of
         :attr:`vertex_normals`); read-only."""
-        return _read_only(self._normal_and_area_sums[1])
+        return self._normals_and_areas[1]
 
     @cached_property
     def _codes(self) -> tuple[np.ndarray, dict]:
