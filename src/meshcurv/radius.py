@@ -510,6 +510,11 @@ VOXEL_PILOT = 2.01
 #: of curvature (median H error of a flat ellipsoid 33% against 11%); the tori
 #: lose at most 2 points (benchmarks/accuracy_voxel.md).
 VOXEL_CURVEDNESS_PERCENTILE = 75.0
+#: A pilot curvedness below this over the largest voxel size is read as 0 (a flat vertex: a radius of curvature of
+#: a million voxels is the fit's round-off, which differs between the backends where the exact value is 0). The
+#: percentile and the regions of :func:`voxel_vertex_radii` leave flat vertices out, so a test against 0 let a
+#: round-off shift the default radius of one backend (``benchmarks/fuzz_api.md``, round 15, seed 264 case 5890).
+VOXEL_FLAT_CURVEDNESS = 1e-6
 
 
 def voxel_surface_radius(
@@ -544,7 +549,8 @@ def _voxel_surface_radius(
         return None
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
     curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
-    curvedness = curvedness[referenced & valid & np.isfinite(curvedness) & (curvedness > 0)]
+    curved = np.isfinite(curvedness) & (curvedness > VOXEL_FLAT_CURVEDNESS / float(np.max(grid.spacing)))
+    curvedness = curvedness[referenced & valid & curved]
     if curvedness.size == 0:
         return None
     curvature_radius = 1.0 / float(np.percentile(curvedness, VOXEL_CURVEDNESS_PERCENTILE))
@@ -653,7 +659,8 @@ def voxel_vertex_radii(
     normals : ndarray of shape (V, 3)
         The pilot's unit normals.
     k_min, k_max : ndarray of shape (V,)
-        The pilot's principal curvatures (``icc`` at :data:`VOXEL_PILOT` voxels).
+        The pilot's principal curvatures (``icc`` at :data:`VOXEL_PILOT` voxels); a vertex whose curvedness is
+        below :data:`VOXEL_FLAT_CURVEDNESS` over the largest voxel size is flat (0).
     valid : ndarray of shape (V,) of bool
         The vertices whose pilot values are used.
     curvature_radius : float
@@ -711,6 +718,8 @@ def voxel_vertex_radii(
         extent = np.sqrt(np.sum((normals * spacing) ** 2, axis=1))
         curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
         gauss = np.abs(k_min * k_max)
+    flat = curvedness <= VOXEL_FLAT_CURVEDNESS / largest  # round-off: 0, on both backends
+    curvedness, gauss = np.where(flat, 0.0, curvedness), np.where(flat, 0.0, gauss)
     known = valid & np.isfinite(curvedness) & np.isfinite(gauss)
     extent = np.where(np.isfinite(extent) & (extent > 0), extent, largest)
     curvedness, gauss, weights = _ring_sums(
