@@ -26,6 +26,8 @@ def vertex_face_lists(faces, n_vertices, n_chunks):
     :func:`_place_corners`, :func:`~meshcurv._kernels._common.run_chunks`): a vertex's list holds the
     faces of the first range, then of the next, each in face order (the order of one pass
     over all faces, whatever the number of threads), as ``topology.build_edges`` places its sides.
+    The faces are int32 while their count fits in it (half the memory of the lists, which the walks read for
+    every vertex they queue), int64 beyond.
     """
     n_faces = faces.shape[0]
     n_chunks = max(1, min(int(n_chunks), _BUCKET_CHUNKS, n_faces))
@@ -33,7 +35,7 @@ def vertex_face_lists(faces, n_vertices, n_chunks):
     cursor = np.zeros((n_chunks, n_vertices), np.int64)
     run_chunks(_count_corners, n_chunks, n_chunks, faces, cursor)
     indptr = _bucket_starts(cursor)
-    indices = np.empty(indptr[n_vertices], np.int64)
+    indices = np.empty(indptr[n_vertices], np.int32 if n_faces < np.iinfo(np.int32).max else np.int64)
     run_chunks(_place_corners, n_chunks, n_chunks, faces, cursor, indices)
     return indptr, indices
 
