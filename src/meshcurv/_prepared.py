@@ -152,7 +152,9 @@ class PreparedMesh:
 
     @cached_property
     def _codes(self) -> tuple[np.ndarray, dict]:
-        return _defect_codes(self.topology, self.degenerate, self.needles)
+        codes = _defect_codes(self.topology, self.degenerate, self.needles)
+        self.topology._release_side_twins()  # the bow-tie vertices are found: no estimator reads the twins
+        return codes
 
     def defects(self, *, boundary: bool = False) -> VertexDefects:
         """The defects as a method sees them: ``boundary=True`` for the methods that keep boundary vertices."""

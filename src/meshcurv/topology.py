@@ -166,7 +166,8 @@ class MeshTopology:
     edge_face_counts: np.ndarray
     _edge_forward_counts: np.ndarray = field(repr=False)
     #: (3 F,) the other side ``3 g + j`` of the edge of each side ``3 f + k`` where the edge joins exactly two
-    #: faces, -1 elsewhere (``_kernels.topology.build_edges_into``); None when not built (the NumPy path)
+    #: faces, -1 elsewhere (``_kernels.topology.build_edges_into``); None when not built (the NumPy path) or let go
+    #: (:meth:`_release_side_twins`)
     _side_twins: np.ndarray | None = field(default=None, repr=False)
     #: (V,) corners of the faces without a repeated corner at each vertex, and (V,) the side leaving each vertex of
     #: its first such face (-1: unreferenced, -2: only in faces with a repeated corner), from the compiled build's
@@ -354,6 +355,11 @@ class MeshTopology:
                 self.faces, self.face_edges, self.edge_faces, linked, ~self.degenerate_faces, self.n_vertices
             )
         )
+
+    def _release_side_twins(self) -> None:
+        """Let go of the twin sides (12 bytes a face) once :attr:`bowtie_vertices`, their one reader, is found."""
+        if "bowtie_vertices" in self.__dict__:
+            object.__setattr__(self, "_side_twins", None)
 
     @cached_property
     def degenerate_faces(self) -> np.ndarray:
