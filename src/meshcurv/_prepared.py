@@ -23,7 +23,7 @@ import numpy as np
 from ._adapters import mesh_arrays
 from ._locality import local_topology
 from ._validation import as_mesh, as_vertices, check_choice
-from .defects import BOUNDARY, VertexDefects, _defect_codes, _needle_vertices
+from .defects import BOUNDARY, VertexDefects, _defect_codes, _needle_vertices, _scale_edges
 from .errors import InvalidOptionError
 from ._geometry import (
     DEGENERATE_AREA_RATIO,
@@ -31,6 +31,7 @@ from ._geometry import (
     degenerate_faces,
     face_cross_products,
     normalize_normal_sums,
+    vertex_edge_lengths,
     vertex_length_scales,
     vertex_normal_and_area_sums,
 )
@@ -114,6 +115,13 @@ class PreparedMesh:
         cross, degenerate = cross_and_degenerate(self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO)
         self.__dict__["_spare_cross"] = _read_only(cross)
         return _read_only(degenerate)
+
+    @cached_property
+    def scale_edge_means(self) -> np.ndarray:
+        """(V,) the mean length of the :func:`~meshcurv.defects.scale_edges` at each vertex (NaN where none): the
+        local edge length of the noise fits and of the local scale ratios (:mod:`meshcurv.radius`); read-only."""
+        edges = _scale_edges(self.topology, self.needles)
+        return _read_only(vertex_edge_lengths(self.vertices, edges, self.vertices.shape[0]))
 
     def found_degenerate(self, degenerate: np.ndarray) -> None:
         """Keep (F,) ``degenerate``, found by a kernel with the test of :attr:`degenerate` (the same scales and

@@ -131,6 +131,11 @@ class _Measured(NamedTuple):
     length_scales: np.ndarray
     needles: np.ndarray
 
+    @property
+    def scale_edge_means(self) -> np.ndarray:
+        """(V,) the mean length of the :func:`~meshcurv.defects.scale_edges` at each vertex (NaN where none)."""
+        return vertex_edge_lengths(self.vertices, _scale_edges(self.topology, self.needles), self.vertices.shape[0])
+
 
 def _measured(vertices, topology: MeshTopology) -> _Measured:
     """``vertices`` checked, one row per vertex of ``topology``, with their length scales and needle vertices."""
@@ -334,10 +339,11 @@ def noise_level(
     return _noise_level(vertices, normals, valid, edges, neighbours=neighbours, adjacency=adjacency)
 
 
-def _noise_level(vertices, normals, valid, edges, *, neighbours=None, adjacency=None) -> float:
+def _noise_level(vertices, normals, valid, edges, *, neighbours=None, adjacency=None, local=None) -> float:
     """:func:`noise_level` of checked arrays: (V, 3) float64 ``vertices`` and ``normals``, (V,) bool ``valid``
-    (and ``neighbours``), (E, 2) int64 ``edges`` in range."""
-    local = vertex_edge_lengths(vertices, edges, vertices.shape[0])
+    (and ``neighbours``), (E, 2) int64 ``edges`` in range; ``local``: the (V,) mean length of the ``edges`` at
+    each vertex, when the caller has it."""
+    local = vertex_edge_lengths(vertices, edges, vertices.shape[0]) if local is None else local
     centres = np.flatnonzero(valid & (local > 0))
     if centres.size > NOISE_SAMPLE:
         centres = centres[np.linspace(0, centres.size - 1, NOISE_SAMPLE).round().astype(np.int64)]
@@ -463,7 +469,15 @@ def _noise_radii(
     for edge_length, members, part, edges in _component_edges(mesh):  # each group's edges measured once
         inside = centres if part is None else centres & part
         level = (
-            _noise_level(vertices, normals, inside, edges, neighbours=usable, adjacency=adjacency)
+            _noise_level(
+                vertices,
+                normals,
+                inside,
+                edges,
+                neighbours=usable,
+                adjacency=adjacency,
+                local=mesh.scale_edge_means if part is None else None,  # every scale edge: the mesh's own means
+            )
             if edge_length > 0
             else 0.0
         )
@@ -801,10 +815,9 @@ def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarr
 
 
 def _local_scale_ratios(mesh: _Measured | PreparedMesh) -> np.ndarray:
-    vertices, topology, scales = mesh.vertices, mesh.topology, mesh.length_scales
+    topology, scales = mesh.topology, mesh.length_scales
     n = topology.n_vertices
-    edges = _scale_edges(topology, mesh.needles)
-    local = vertex_edge_lengths(vertices, edges, vertices.shape[0])
+    local = mesh.scale_edge_means
     known = np.isfinite(local) & (local > 0) & (scales > 0)
     if not known.any():
         return np.ones(n)
