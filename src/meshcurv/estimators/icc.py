@@ -258,7 +258,10 @@ def fitted_normals(
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     if failed is not None:
         failed |= valid & ~np.isfinite(fitted).all(axis=1)
-    return np.where(usable[:, None], fitted, normals)
+    if fitted is fits:  # the caller's array: not written
+        return np.where(usable[:, None], fitted, normals)
+    np.copyto(fitted, normals, where=~usable[:, None])  # the fits' own array: no second (V, 3) one
+    return fitted
 
 
 def _coarse_level(
