@@ -81,6 +81,12 @@ PARALLEL_COSINE = 0.9
 #: A flat edge steeper than this must close a triangle of flat edges to join two points in one sheet.
 TRUSTED_SLOPE = 0.2
 
+#: The orientation takes its edges in the order of their slopes rounded to this: equal ones are taken in the order
+#: of the edges. Both backends' normals agree to round-off, not bit for bit, and on a lattice many edges tie
+#: exactly: without it a tie decided by round-off turned a few points on one backend (``benchmarks/fuzz_api.md``,
+#: round 15, seed 256 case 104).
+TIE_RESOLUTION = 1e-9
+
 #: A part of the flat graph of at least this many points is oriented on its own (see :func:`oriented_signs`).
 PART_MIN_POINTS = 32
 
@@ -699,6 +705,13 @@ def _graph_edges(indices: np.ndarray, usable: np.ndarray):
     return rows[keep], cols[keep], keep
 
 
+def _tie_order(values: np.ndarray) -> np.ndarray:
+    """(E,) the order of ``values`` (E,) rounded to :data:`TIE_RESOLUTION`, equal ones (and NaN, last) in their order."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        key = np.rint(np.nan_to_num(values, nan=np.inf, posinf=np.inf) / TIE_RESOLUTION)
+    return np.argsort(key, kind="stable")
+
+
 def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.ndarray, weights: np.ndarray):
     """``(signs, labels)``: signs propagated along the minimum spanning forest of the edges ``(rows, cols)``.
 
@@ -906,7 +919,7 @@ def oriented_signs(
     doubtful = np.zeros(n, dtype=bool)
     # the other edges in both directions, the flattest first
     other = np.flatnonzero(~used)
-    other = other[np.argsort(np.nan_to_num(slope[other], nan=np.inf), kind="stable")]
+    other = other[_tie_order(slope[other])]  # (slopes equal to round-off: in the order of the edges)
     a = np.stack([rows[other], cols[other]], axis=1).ravel()
     b = np.stack([cols[other], rows[other]], axis=1).ravel()
     c = np.repeat(cosine[other], 2)
