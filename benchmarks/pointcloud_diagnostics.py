@@ -8,6 +8,8 @@ Usage::
     python benchmarks/pointcloud_diagnostics.py --staircase  # voxel surfaces of 6-40 voxels: tuned, held out
     python benchmarks/pointcloud_diagnostics.py --facets --seed 1  # given radii on random voxel surfaces (7: held out)
     python benchmarks/pointcloud_diagnostics.py --flat --seed 11  # flat voxel ellipsoids (17: held out)
+    python benchmarks/pointcloud_diagnostics.py --facets --seed 31 --off-grid "noise 0.1"  # moved off the grid
+    python benchmarks/pointcloud_diagnostics.py --lattice --seed 5  # the grid read on and off it, and on none
 
 ``--noise`` prints, per cloud and method, the noise level (``parameters["noise"]``), the default radius, the valid
 points, a hash of the results and whether the call noted an unmeasured noise level: run it on two trees and compare
@@ -27,7 +29,11 @@ clouds; jets at the default radius and at 0.55-1.3 times it, corrected_measures 
 jets' default; per method and radius over all surfaces: points, share valid, points off (valid, H off by more than
 half of the point's own largest exact |k|), median and 95th percentile of that error, CPU seconds. ``--flat``: the
 same over 12 flat voxel ellipsoids (axes a, 0.7-1 a, 0.2-0.4 a; a 20-32 voxels), corrected_measures and jets at their
-defaults, at 0.55 and 0.85 times the jets' default.
+defaults, at 0.55 and 0.85 times the jets' default. ``--off-grid``: the same surfaces moved off their grid (every
+point by 0.001 voxel, Gaussian noise of 0.05 or 0.1 voxel along each axis, or a random rotation; the exact normals
+turned with them). ``--lattice``: whether the call reads a grid, and its steps over the half voxels, on voxel
+ellipsoids in each voxel shape on and off their grid, on the surfaces of ``benchmarks/pointcloud.py`` (clean and
+noisy, 2,000-80,000 points) and on the vertices of ``../shared/meshes`` (when present).
 """
 
 from __future__ import annotations
@@ -42,7 +48,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from meshcurv import point_cloud_curvatures, shapes
+from meshcurv import point_cloud_curvatures, read_mesh, shapes
 
 sys.path.insert(0, str(Path(__file__).parent))
 import pointcloud as benchmark  # noqa: E402  (benchmarks/pointcloud.py: the surfaces and their noise)
@@ -228,9 +234,30 @@ FACET_CALLS = (
 FLAT_CALLS = (("corrected_measures", None), ("jets", None), ("corrected_measures", 0.55), ("jets", 0.85))
 
 
-def run_facets(seed: int, *, flat: bool = False) -> None:
-    """The table of ``--facets`` for the draw ``seed``; ``flat``: the table of ``--flat`` (flat ellipsoids)."""
+#: ``--off-grid``: how each voxel surface leaves its grid (in voxels: a registration error, noise; a rotation).
+OFF_GRID = {"moved": 1e-3, "noise 0.05": 0.05, "noise 0.1": 0.1, "rotated": None}
+
+
+def _off_grid(mesh, spacing, how: str, rng):
+    """``(points, normals)`` of the voxel surface ``mesh`` moved off its grid as :data:`OFF_GRID` ``how`` says."""
+    points, normals = mesh.vertices, mesh.normals
+    if how == "none":
+        return points, normals
+    if OFF_GRID[how] is None:
+        turn, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        return points @ turn.T, normals @ turn.T
+    if how == "moved":  # every point by the same small distance in a random direction
+        step = rng.normal(size=points.shape)
+        step /= np.linalg.norm(step, axis=1, keepdims=True)
+        return points + OFF_GRID[how] * np.mean(spacing) * step, normals
+    return points + rng.normal(size=points.shape) * OFF_GRID[how] * np.asarray(spacing), normals
+
+
+def run_facets(seed: int, *, flat: bool = False, how: str = "none") -> None:
+    """The table of ``--facets`` for the draw ``seed``; ``flat``: the table of ``--flat`` (flat ellipsoids);
+    ``how``: the surfaces moved off their grid (:data:`OFF_GRID`)."""
     rng = np.random.default_rng(seed)
+    moves = np.random.default_rng(seed + 1000)
     totals: dict = {}
     for shape in ("flat", "flat") if flat else ("sphere", "ellipsoid", "torus"):
         for spacing in FACET_SPACINGS:
@@ -248,7 +275,7 @@ def run_facets(seed: int, *, flat: bool = False) -> None:
             else:
                 minor = float(rng.uniform(6, 12)) * voxel
                 mesh = shapes.voxel_torus(minor * float(rng.uniform(2, 3)), minor, spacing=spacing, seed=draw)
-            points = mesh.vertices
+            points, exact_normals = _off_grid(mesh, spacing, how, moves)
             if points.shape[0] > 40000:
                 continue
             largest = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))
@@ -260,7 +287,7 @@ def run_facets(seed: int, *, flat: bool = False) -> None:
                     radius = None if share is None else share * default
                     r = point_cloud_curvatures(points, method=method, radius=radius)
                     seconds = time.process_time() - start
-                    side = np.sign(np.einsum("ij,ij->i", r.normals, mesh.normals))
+                    side = np.sign(np.einsum("ij,ij->i", r.normals, exact_normals))
                     error = np.abs(r.mean - side * mesh.mean) / largest
                     total = totals.setdefault((method, share), [0, 0, 0, 0.0, []])
                     total[0] += points.shape[0]
@@ -280,6 +307,70 @@ def run_facets(seed: int, *, flat: bool = False) -> None:
         )
 
 
+def run_lattice(seed: int) -> None:
+    """The table of ``--lattice``: the grid :func:`meshcurv._pointcloud_normals.read_lattice` reads (as the call does:
+    the median spacing, each point's 10 nearest) on voxel surfaces on and off their grid, and on clouds on none."""
+    from meshcurv._pointcloud_normals import read_lattice
+
+    def read(points):
+        distances, indices = cKDTree(points).query(points, k=11)
+        start = time.process_time()
+        lattice = read_lattice(points, float(np.median(distances[:, 1])), neighbours=indices[:, 1:])
+        return lattice, time.process_time() - start
+
+    rng = np.random.default_rng(seed)
+    print("| cloud | how | points | grid read | steps / half voxel | CPU s |")
+    print("|---|---|---|---|---|---|")
+    for spacing in FACET_SPACINGS:
+        voxel = float(np.mean(spacing))
+        axes = np.sort(rng.uniform(6, 32, 3))[::-1] * voxel
+        mesh = shapes.voxel_ellipsoid(tuple(axes), spacing=spacing, seed=int(rng.integers(1000)))
+        for how in ("none", *OFF_GRID):
+            turn = np.eye(3)
+            points, _ = _off_grid(mesh, spacing, how, rng)
+            if OFF_GRID.get(how, 0.0) is None:  # the turn, from the points (a rigid motion about the origin)
+                turn = np.linalg.lstsq(mesh.vertices, points, rcond=None)[0].T
+            lattice, seconds = read(points)
+            if lattice.steps.all():
+                frame = np.eye(3) if lattice.frame is None else lattice.frame
+                axis = np.abs(frame @ turn).argmax(axis=1)
+                ratio = " ".join(f"{r:.4f}" for r in lattice.steps / (np.array(spacing)[axis] / 2))
+            else:
+                ratio = "-"
+            print(
+                f"| voxel ellipsoid {np.round(axes, 1).tolist()}, voxels {spacing} | {how} | {points.shape[0]} | "
+                f"{'yes' if lattice.steps.all() else 'no'}{' (turned)' if lattice.frame is not None else ''} | "
+                f"{ratio} | {seconds:.3f} |",
+                flush=True,
+            )
+    found = 0
+    slowest = 0.0
+    clouds = 0
+    for surface in benchmark.SURFACES:
+        for uniform in (True, False):
+            for n in (2_000, 20_000, 80_000):
+                for level in (0.0, 0.05, 0.3):
+                    points, normals, *_, area = benchmark.sample(surface, n, uniform=uniform, seed=seed)
+                    if level:
+                        points = benchmark.noisy(points, normals, area, level, seed=seed + 1)
+                    lattice, seconds = read(points)
+                    found += bool(lattice.steps.any())
+                    slowest = max(slowest, seconds)
+                    clouds += 1
+    print(
+        f"| benchmarks/pointcloud.py's surfaces | noise 0, 0.05, 0.3 spacings | {clouds} clouds | {found} | - | "
+        f"{slowest:.3f} (slowest) |"
+    )
+    root = Path(__file__).resolve().parents[2] / "shared" / "meshes"
+    for path in sorted(root.glob("*.obj")):
+        vertices = np.unique(np.asarray(read_mesh(path).vertices, dtype=float), axis=0)
+        lattice, seconds = read(vertices)
+        print(
+            f"| {path.name}'s vertices | - | {vertices.shape[0]} | {'yes' if lattice.steps.any() else 'no'} | - | "
+            f"{seconds:.3f} |"
+        )
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--noise", action="store_true", help="noise level, radius and valid points per family")
@@ -287,7 +378,14 @@ def main(argv=None) -> None:
     parser.add_argument("--staircase", action="store_true", help="voxel surfaces, radii 6-40 voxels: tuned, held out")
     parser.add_argument("--facets", action="store_true", help="given radii on random voxel surfaces")
     parser.add_argument("--flat", action="store_true", help="flat voxel ellipsoids (c / a 0.2-0.4)")
+    parser.add_argument("--lattice", action="store_true", help="the grid read on voxel surfaces on and off it")
     parser.add_argument("--seed", type=int, default=1, help="--facets, --flat: the draw (1 tuned, 7 held out)")
+    parser.add_argument(
+        "--off-grid",
+        choices=["none", *OFF_GRID],
+        default="none",
+        help="--facets, --flat: surfaces moved off their grid",
+    )
     args = parser.parse_args(argv)
     if args.noise:
         run_noise()
@@ -297,9 +395,11 @@ def main(argv=None) -> None:
         run_voxels(STAIRCASE_TUNED, every=True)
         run_voxels(STAIRCASE_HELD_OUT, every=True)
     if args.facets:
-        run_facets(args.seed)
+        run_facets(args.seed, how=args.off_grid)
     if args.flat:
-        run_facets(args.seed, flat=True)
+        run_facets(args.seed, flat=True, how=args.off_grid)
+    if args.lattice:
+        run_lattice(args.seed)
 
 
 if __name__ == "__main__":

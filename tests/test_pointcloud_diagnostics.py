@@ -98,21 +98,21 @@ def test_the_vertices_of_marching_cubes_lie_on_the_grid_of_half_voxels():
     pytest.importorskip("skimage")  # the voxel shapes (marching cubes)
     # a mask's marching cubes put each vertex at the midpoint of a voxel edge: every coordinate k on the grid of half
     # voxels (spacing_k / 2), translated alike; a random sample, or the lattice turned, shares no coordinate
-    from meshcurv._pointcloud_normals import lattice_steps
+    from meshcurv._pointcloud_normals import read_lattice
 
     mesh = shapes.voxel_ellipsoid((8.0, 6.0, 5.0), spacing=(0.7, 1.0, 1.3), seed=3)
-    np.testing.assert_allclose(lattice_steps(mesh.vertices), [0.35, 0.5, 0.65], rtol=1e-12)
-    np.testing.assert_allclose(lattice_steps(mesh.vertices + [0.1, -7.3, 2.9]), [0.35, 0.5, 0.65], rtol=1e-9)
+    np.testing.assert_allclose(read_lattice(mesh.vertices).steps, [0.35, 0.5, 0.65], rtol=1e-12)
+    np.testing.assert_allclose(read_lattice(mesh.vertices + [0.1, -7.3, 2.9]).steps, [0.35, 0.5, 0.65], rtol=1e-9)
     c, s = np.cos(0.3), np.sin(0.3)  # (a turn of rational cosine and sine keeps a finer grid)
     turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    np.testing.assert_array_equal(lattice_steps(mesh.vertices @ turn.T)[:2], [0.0, 0.0])
-    np.testing.assert_array_equal(lattice_steps(shapes.random_sphere(500, seed=1).vertices), [0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(read_lattice(mesh.vertices @ turn.T).steps[:2], [0.0, 0.0])
+    np.testing.assert_array_equal(read_lattice(shapes.random_sphere(500, seed=1).vertices).steps, [0.0, 0.0, 0.0])
     # two planes of a grid stacked are no staircase (fewer than three planes along z)
     x, y = np.meshgrid(np.arange(20.0), np.arange(20.0))
     planes = np.concatenate(
         [np.c_[x.ravel(), y.ravel(), np.zeros(400)], np.c_[x.ravel(), y.ravel(), np.full(400, 0.7)]]
     )
-    np.testing.assert_array_equal(lattice_steps(planes), [1.0, 1.0, 0.0])
+    np.testing.assert_array_equal(read_lattice(planes).steps, [1.0, 1.0, 0.0])
 
 
 def test_two_grid_planes_stacked_with_normals_the_same_way_are_still_flagged():

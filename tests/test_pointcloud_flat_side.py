@@ -20,7 +20,7 @@ from meshcurv.pointcloud import point_cloud_curvatures
 pytest.importorskip("numba")
 
 
-# (onto x = 0 too: its y and z coordinates repeat with round-off differences, which lattice_steps read as a grid of
+# (onto x = 0 too: its y and z coordinates repeat with round-off differences, which the grid reader read as a grid of
 # step 2.8e-17, and every point was NaN "on a flat tread of a voxel staircase")
 @pytest.mark.parametrize("axis", [0, 1, 2])
 def test_a_flat_cloud_faces_the_same_side_on_both_backends(axis):

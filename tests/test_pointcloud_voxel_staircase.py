@@ -18,7 +18,7 @@ import pytest
 
 from meshcurv import point_cloud_curvatures, shapes
 from meshcurv._backend import use_backend
-from meshcurv._pointcloud_normals import lattice_steps
+from meshcurv._pointcloud_normals import read_lattice
 from meshcurv.errors import MeshcurvWarning
 from meshcurv.result import INVALID_REASONS
 
@@ -123,13 +123,13 @@ def test_the_grid_of_a_voxel_surface_is_its_half_voxels():
     # marching cubes over a mask puts each vertex at the midpoint of a voxel edge: coordinates on half voxels
     spacing = np.array([1.2, 1.0, 0.8])
     mesh = shapes.voxel_sphere(12.0, spacing=tuple(spacing), seed=3)
-    np.testing.assert_allclose(lattice_steps(mesh.vertices), spacing / 2, rtol=1e-9)
+    np.testing.assert_allclose(read_lattice(mesh.vertices).steps, spacing / 2, rtol=1e-9)
     # moved off the origin and scaled, the grid moves with it
-    np.testing.assert_allclose(lattice_steps(mesh.vertices * 1e-3 + 1000.0), spacing / 2 * 1e-3, rtol=1e-6)
+    np.testing.assert_allclose(read_lattice(mesh.vertices * 1e-3 + 1000.0).steps, spacing / 2 * 1e-3, rtol=1e-6)
     # a flattened icosphere repeats its coordinates up to round-off: no grid
     points = np.array(shapes.icosphere(6).vertices, dtype=float)
     points[:, 0] = 0.0
-    np.testing.assert_array_equal(lattice_steps(points), 0.0)
+    np.testing.assert_array_equal(read_lattice(points).steps, 0.0)
 
 
 @pytest.mark.parametrize("spacing", [(0.7, 1.0, 1.3), (1.0, 1.0, 2.5)])

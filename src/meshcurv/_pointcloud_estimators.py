@@ -12,7 +12,7 @@ import warnings
 import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
-from ._pointcloud_normals import NEIGHBOURS, lattice_steps
+from ._pointcloud_normals import NEIGHBOURS, NO_LATTICE, Lattice
 from .errors import InvalidOptionError
 from . import _measures
 from .measures import curvatures_from_measures
@@ -80,7 +80,7 @@ SHRINK = 2.0**-0.5
 #: noise differs from the larger ball's by about its own error.
 AGREEMENT = 0.4
 
-#: ... and within this share on a lattice (a voxel surface read as a cloud: :func:`lattice_steps`). A jet fitted to
+#: ... and within this share on a lattice (a voxel surface read as a cloud: :func:`~meshcurv._pointcloud_normals.read_lattice`). A jet fitted to
 #: a staircase of steps ``h`` over a ball of radius ``r`` is biased by about ``h / r^2`` (the steps are coherent, no
 #: noise that the ball averages out), a bias that falls fast from one ball to the next: the two estimates differ by
 #: most of the smaller ball's bias, and bounding the difference bounds that bias below half of |k| (``AGREEMENT``
@@ -251,6 +251,7 @@ def jets(
     smallest: float | None = None,
     details: dict | None = None,
     facing: np.ndarray | None = None,
+    lattice: Lattice = NO_LATTICE,
 ):
     """Principal curvatures of jets fitted over balls of ``radius`` around ``centres``.
 
@@ -261,7 +262,8 @@ def jets(
     where the fit failed and at points not in ``centres``; ``normals`` are those
     of the fitted jets (the given ones where the fit failed). ``details``
     receives ``"radii"``: (N,) the radius of each point's fit. ``facing``: the normals of the check of
-    :func:`one_sided_fits` (default: ``normals``).
+    :func:`one_sided_fits` (default: ``normals``). ``lattice``: the grid of the cloud's coordinates
+    (:func:`~meshcurv._pointcloud_normals.read_lattice`), read by the check of ``details["unsteady"]``.
     """
     logger.debug("point cloud: jet fits")
     facing = normals if facing is None else facing
@@ -303,18 +305,16 @@ def jets(
             facing=facing,
         )
         wide_found = _jet_curvatures(wide_coefficients, wide_frame, wide_radii, normals)
-        details["unsteady"] = unsteady(
-            found, wide_found, done, radius, _agreement(points, usable, found, wide_found, done)
-        )
+        details["unsteady"] = unsteady(found, wide_found, done, radius, _agreement(found, wide_found, done, lattice))
     return found
 
 
-def _agreement(points, usable, found, larger, centres):
+def _agreement(found, larger, centres, lattice):
     """(M,) the share of |k| within which the jets over balls of two sizes must agree at ``centres`` (M,):
-    :data:`LATTICE_AGREEMENT` on a lattice where the largest |k| falls from the ball (``found``) to the larger one
-    (``larger``), the staircase's bias (a curvature's own bias grows with the ball); :data:`AGREEMENT` elsewhere."""
+    :data:`LATTICE_AGREEMENT` on a ``lattice`` where the largest |k| falls from the ball (``found``) to the larger
+    one (``larger``), the staircase's bias (a curvature's own bias grows with the ball); :data:`AGREEMENT` elsewhere."""
     agreement = np.full(centres.size, AGREEMENT)
-    if centres.size == 0 or not lattice_steps(points[np.asarray(usable, dtype=bool)]).any():
+    if centres.size == 0 or not lattice.steps.any():
         return agreement
     with np.errstate(invalid="ignore"):
         falls = np.maximum(np.abs(found[0][centres]), np.abs(found[1][centres])) > np.maximum(

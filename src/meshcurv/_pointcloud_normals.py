@@ -39,6 +39,9 @@ https://doi.org/10.1145/133994.134011
 
 from __future__ import annotations
 
+import itertools
+from typing import NamedTuple
+
 import numpy as np
 
 from ._backend import numba_kernels
@@ -185,7 +188,7 @@ STACKED_ALIKE_TILT = 2.0
 STACKED_ALIKE_MIN = 2
 
 #: ... farther apart too, on a lattice (a voxel surface read as a cloud: the vertices of marching cubes, each on an
-#: edge of the voxels, their coordinates on a grid of ``h`` along each axis, :func:`lattice_steps`), than this many
+#: edge of the voxels, their coordinates on a grid of ``h`` along each axis, :func:`read_lattice`), than this many
 #: times ``max_k |n_k| h_k`` (``n`` the point's normal): a vertex lies up to ``h_k`` off the surface along its
 #: edge, and the two points of a pair on one staircase up to twice that along the normal (its steps are stacked
 #: sheets side by side). Only on a lattice whose largest ``h`` is at most :data:`LATTICE_RESOLVED` spacings:
@@ -208,6 +211,76 @@ LATTICE_ROUND_OFF = 1e-12
 #: A cloud none of whose coordinates repeats among this many of its points, evenly spaced, is on no lattice (the
 #: whole cloud is not read: a lattice of fewer than millions of planes along an axis repeats one there).
 LATTICE_PROBE = 4096
+
+#: A cloud whose coordinates share none is on a lattice along an axis whose planes they were moved off (noise, a
+#: motion or a registration error of a fraction of a voxel): when the coordinates along it are periodic, the
+#: modulus of the mean of ``exp(2 pi i x / s)`` at least this for a step ``s`` within :data:`LATTICE_BAND` spacings
+#: (1 on the planes, ``exp(-2 pi^2 sigma^2 / s^2)`` under noise ``sigma``: 0.45 at a tenth of a voxel on the half
+#: voxels' grid of marching cubes; a scan's, a mesh's or a rotated lattice's coordinates 0.02-0.2, ``benchmarks/
+#: pointcloud_diagnostics.md``, "A staircase off its grid") ...
+LATTICE_PERIODIC = 0.3
+LATTICE_BAND = (0.25, 6.0)
+
+#: Of the peaks of the modulus (at most :data:`LATTICE_PEAKS`, the strongest), the grid's is the lowest frequency within
+#: this share of the strongest (see :func:`_periodic_planes`) ...
+LATTICE_HARMONIC = 0.9
+LATTICE_PEAKS = 8
+
+#: ... and the grid full, its planes alike: where the modulus at ``2 / s`` is at least :data:`LATTICE_PERIODIC`,
+#: the one at ``1 / s`` at least this share of its power 1/4 (a grid of noise ``sigma``: ``m(1 / s) = m(2 / s) **
+#: (1 / 4)``; the grid of every second plane of a finer one holds its points on planes of two kinds, and the modulus
+#: falls with their imbalance).
+LATTICE_FULL = 0.9
+
+#: ... and a coordinate is on its plane of such a grid within this many times the noise of the coordinates about
+#: their planes (a robust standard deviation), at most half a step.
+LATTICE_SNAP = 4.0
+
+#: A lattice turned off the coordinate axes (a voxel image with a direction matrix) is read in the frame of its flat
+#: facets: the least-variance directions of the neighbourhoods of at most :data:`LATTICE_FRAME_PROBE` points whose
+#: least variance is below :data:`LATTICE_FLAT` of the next (coplanar to round-off or a motion of a few thousandths of
+#: a voxel: the treads and the diagonal facets of a staircase), grouped within :data:`LATTICE_FRAME_ANGLE` radians
+#: (the :data:`LATTICE_FRAME_GROUPS` largest, of :data:`LATTICE_FRAME_GROUP` at least); of those at right angles to
+#: each other (to that angle), the three whose coordinates are periodic (:func:`_periodic_planes`) with the coarsest
+#: grid (the axes, not the diagonals, whose planes are closer). Where no three are, the other two axes about one of
+#: them (:func:`_frame_about`: :data:`LATTICE_FRAME_ANGLES` directions of a quarter turn, the
+#: :data:`LATTICE_FRAME_PEAKS` most periodic refined).
+LATTICE_FRAME_PROBE = 1024
+LATTICE_FLAT = 1e-4
+LATTICE_FRAME_ANGLE = 0.01
+LATTICE_FRAME_GROUP = 3
+LATTICE_FRAME_GROUPS = 24
+LATTICE_FRAME_ANGLES = 320
+LATTICE_FRAME_PEAKS = 4
+LATTICE_FRAME_TRIES = 3
+
+
+class Lattice(NamedTuple):
+    """The grid a cloud's coordinates lie on (see :func:`read_lattice`): along each of its axes its ``steps`` (3,)
+    (0 on none), a plane's coordinate ``offsets`` (3,) and the ``tolerance`` (3,) within which a coordinate is on a
+    plane; the axes are the rows of ``frame`` (3, 3), the coordinate axes when None."""
+
+    steps: np.ndarray
+    offsets: np.ndarray
+    tolerance: np.ndarray
+    frame: np.ndarray | None = None
+
+    def along(self, vectors: np.ndarray) -> np.ndarray:
+        """(..., 3) ``vectors`` (points, normals) in the grid's axes."""
+        return vectors if self.frame is None else vectors @ self.frame.T
+
+    def snap(self, points: np.ndarray) -> np.ndarray:
+        """(N, 3) ``points`` in the grid's axes, each coordinate within the tolerance of a plane moved onto it."""
+        snapped = np.array(self.along(points), dtype=float)
+        for axis in np.flatnonzero(self.steps > 0):
+            step, offset = self.steps[axis], self.offsets[axis]
+            plane = offset + np.round((snapped[:, axis] - offset) / step) * step
+            near = np.abs(snapped[:, axis] - plane) <= self.tolerance[axis]
+            snapped[near, axis] = plane[near]
+        return snapped
+
+
+NO_LATTICE = Lattice(np.zeros(3), np.zeros(3), np.zeros(3))
 
 #: On a lattice, a point is on a flat tread of the staircase (see :func:`lattice_treads`) when at least this share
 #: of its :data:`TREAD_NEIGHBOURS` nearest neighbours within its ball lie on its plane of the grid. The share ``s``
@@ -1257,7 +1330,13 @@ def _nearest_queries(points, normals, usable, queries, rows, cols) -> np.ndarray
 
 
 def two_sheets(
-    points: np.ndarray, normals: np.ndarray, usable: np.ndarray, spacing: np.ndarray, tree, noise: float | None = None
+    points: np.ndarray,
+    normals: np.ndarray,
+    usable: np.ndarray,
+    spacing: np.ndarray,
+    tree,
+    noise: float | None = None,
+    lattice: Lattice = NO_LATTICE,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(alike, interleaved)``: (N,) bool, points beside a second sheet whose side cannot be trusted.
 
@@ -1301,11 +1380,10 @@ def two_sheets(
     if noise is not None and np.isfinite(noise):
         offset = min(STACKED_ALIKE_OFFSET, max(ALIKE_MIN_OFFSET, ALIKE_NOISE * noise))
     sample = _evenly(candidates, WINDING_QUERIES)
-    lattice = None  # (measured where stacked neighbours oriented alike are found)
+    # (a lattice coarser than the spacing is steeper than the orientation's flat edges)
+    lattice = lattice if lattice.steps.max() <= LATTICE_RESOLVED * step else NO_LATTICE
     found = _sheet_signs(points, normals, usable, spacing, step, tree, sample, offset=offset)
     if found[0].any():
-        lattice = lattice_steps(points[candidates])
-        lattice = lattice if lattice.max() <= LATTICE_RESOLVED * step else np.zeros(3)
         found = _off_the_steps(points, normals, sample, found, lattice)
     if sample.size < candidates.size and (found[0].any() or found[3].mean() >= INTERLEAVED_SAMPLE):
         # every point (the stacked sheets' 48 neighbours only when the sample has any: a thin sheet of 1M
@@ -1314,8 +1392,7 @@ def two_sheets(
             points, normals, usable, spacing, step, tree, candidates, with_alike=found[0].any(), offset=offset
         )
         sample = candidates
-        if lattice is not None:
-            found = _off_the_steps(points, normals, sample, found, lattice)
+        found = _off_the_steps(points, normals, sample, found, lattice)
     hit, near, flags, two = found
     alike[sample[hit]] = True
     alike[near[hit][flags[hit]]] = True
@@ -1412,50 +1489,273 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool, offse
     return usable[near] & (near != queries[:, None]) & sides & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
 
 
-def lattice_steps(points: np.ndarray) -> np.ndarray:
-    """(3,) the step of the grid the coordinates of ``points`` (N, 3) lie on along each axis, 0 where they do not.
+def read_lattice(
+    points: np.ndarray,
+    spacing: float | None = None,
+    *,
+    usable: np.ndarray | None = None,
+    neighbours: np.ndarray | None = None,
+) -> Lattice:
+    """The grid the coordinates of the ``usable`` (N,) bool (default: all) of ``points`` (N, 3) lie on.
 
     Along an axis, the coordinates that two points or more share (the planes of the grid) must hold
     :data:`LATTICE_SHARE` of the points, be :data:`LATTICE_PLANES` at least, and lie whole multiples of the
     smallest distance between two of them apart: the vertices of marching cubes over a voxel image (each on an
     edge of the voxels: at its midpoint for a mask, every coordinate then on the grid of half voxels; two of its
-    three for a smooth image). A scan's points, or a rotated lattice, share no coordinates: 0.
+    three for a smooth image). Given the cloud's ``spacing``, coordinates that share none are on a grid when they
+    are periodic along all three axes (:func:`_periodic_planes`: the same surface moved off its planes by noise or
+    a motion of a fraction of a voxel); given each point's ``neighbours`` (N, k) too, a lattice turned off the
+    coordinate axes is read in its own (:func:`_lattice_frame`). A scan's points are on none.
     """
-    steps = np.zeros(3)
-    probe = points[:: max(1, points.shape[0] // LATTICE_PROBE)]
-    if all(np.unique(probe[:, axis]).size == probe.shape[0] for axis in range(3)):
-        return steps
+    points = np.asarray(points, dtype=float)
+    rows = points if usable is None else points[usable]
+    if rows.shape[0] == 0:
+        return NO_LATTICE
+    lattice = _lattice_in(rows, spacing)
+    if lattice.steps.any() or spacing is None or neighbours is None:
+        return lattice
+    frame = _lattice_frame(points, neighbours, usable, spacing)
+    if frame is None:
+        return lattice
+    turned = _lattice_in(rows @ frame.T, spacing)
+    if not turned.steps.all():
+        return lattice
+    # the axes to the planes' own precision (the frame's search is to a thousandth of a radian): along each, the
+    # plane index of every coordinate near its plane is a linear function of the point, w . x + c, whose gradient w
+    # is the axis over its step; least squares, then the nearest orthonormal axes
+    scaled = np.empty((3, 3))
     for axis in range(3):
-        # the coordinates within round-off of each other are one plane (a coordinate computed two ways)
-        values = np.sort(points[:, axis])
-        round_off = LATTICE_ROUND_OFF * max(float(np.abs(values).max()), np.finfo(float).tiny)
-        first = np.flatnonzero(np.r_[True, np.diff(values) > round_off])
-        counts = np.diff(np.r_[first, values.size])
-        planes = values[first[counts > 1]]
-        if planes.size < LATTICE_PLANES or counts[counts > 1].sum() < LATTICE_SHARE * points.shape[0]:
+        step, offset = turned.steps[axis], turned.offsets[axis]
+        along = rows @ frame[axis]
+        index = np.round((along - offset) / step)
+        near = np.abs(along - offset - index * step) <= step / 4
+        scaled[axis] = np.linalg.lstsq(np.c_[rows[near], np.ones(near.sum())], index[near], rcond=None)[0][:3]
+    left, _, right = np.linalg.svd(scaled / np.linalg.norm(scaled, axis=1, keepdims=True))
+    refined = left @ right
+    exact = _lattice_in(rows @ refined.T, spacing)
+    return exact._replace(frame=refined) if exact.steps.all() else turned._replace(frame=frame)
+
+
+def _lattice_in(points, spacing):
+    """The :class:`Lattice` of ``points`` (N, 3) along the coordinate axes (see :func:`read_lattice`)."""
+    probe = points[:: max(1, points.shape[0] // LATTICE_PROBE)]
+    shared = not all(np.unique(probe[:, axis]).size == probe.shape[0] for axis in range(3))
+    exact = [_shared_planes(points[:, axis]) if shared else None for axis in range(3)]
+    found = exact
+    if spacing is not None and spacing > 0.0 and not all(exact):
+        # periodic planes only on all three axes, as marching cubes over a mask puts them (the two faces of a
+        # plate, on two planes along one axis, are periodic at any step that divides their distance)
+        periodic = [e or _periodic_planes(points[:, axis], probe[:, axis], spacing) for axis, e in enumerate(exact)]
+        found = periodic if all(periodic) else exact
+    steps, offsets, tolerance = (np.array([f[j] if f else 0.0 for f in found]) for j in range(3))
+    return Lattice(steps, offsets, tolerance)
+
+
+def _lattice_frame(points, neighbours, usable, spacing):
+    """(3, 3) the axes (rows) of a lattice turned off the coordinate axes, or None (see :data:`LATTICE_FRAME_PROBE`)."""
+    candidates = np.arange(points.shape[0]) if usable is None else np.flatnonzero(usable)
+    probe = _evenly(candidates, LATTICE_FRAME_PROBE)
+    group = np.concatenate([points[probe, None, :], points[neighbours[probe]]], axis=1)
+    group = group - group.mean(axis=1, keepdims=True)
+    values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", group, group))
+    normals = vectors[values[:, 0] <= LATTICE_FLAT * values[:, 1], :, 0]
+    close = np.abs(normals @ normals.T) >= np.cos(LATTICE_FRAME_ANGLE)
+    left = np.ones(normals.shape[0], dtype=bool)
+    directions: list[np.ndarray] = []
+    while left.any() and len(directions) < LATTICE_FRAME_GROUPS:  # the largest group of facets left, its direction
+        counts = (close & left).sum(axis=1) * left
+        best = int(np.argmax(counts))
+        if counts[best] < LATTICE_FRAME_GROUP:
+            break
+        members = close[best] & left
+        direction = (normals[members] * np.sign(normals[members] @ normals[best])[:, None]).sum(axis=0)
+        directions.append(direction / np.linalg.norm(direction))
+        left &= ~members
+    rows = points if usable is None else points[usable]
+    sample = rows[:: max(1, rows.shape[0] // LATTICE_PROBE)]
+    steps = []
+    for direction in directions:
+        found = _periodic_planes(rows @ direction, sample @ direction, spacing)
+        steps.append(0.0 if found is None else found[0])
+    # the coarsest grid (its axes, not its diagonals: their planes are closer) of three of the facets' directions at
+    # right angles to each other, or of the one of the coarsest grid and the two others at right angles to it
+    # (anisotropic voxels: the facets facing them are seldom flat over ten neighbours), found from every probed normal;
+    # then the same about the other axes of the best frame (up to LATTICE_FRAME_TRIES axes in all)
+    largest, frame = 0.0, None
+    triple: tuple[int, ...] = ()
+    right = np.sin(LATTICE_FRAME_ANGLE)
+    for a, b, c in itertools.combinations(range(len(directions)), 3):
+        axes = np.array([directions[a], directions[b], directions[c]])
+        cell = steps[a] * steps[b] * steps[c]
+        if cell > largest and np.all(np.abs(axes @ axes.T - np.eye(3)) <= right):
+            largest, frame, triple = cell, axes, (a, b, c)
+    coarsest = sorted([k for k, step in enumerate(steps) if step > 0], key=lambda k: -steps[k])
+    queue = [directions[k] for k in [*sorted(triple, key=lambda k: -steps[k]), *coarsest[:1]]]
+    tried: list[np.ndarray] = []
+    while queue and len(tried) < LATTICE_FRAME_TRIES:  # (a diagonal's frame holds an axis: then that axis')
+        axis = queue.pop(0)
+        own = _grid_frequency(sample @ axis, spacing)
+        if own is None or any(abs(axis @ other) >= np.cos(LATTICE_FRAME_ANGLE) for other in tried):
             continue
-        gaps = np.diff(planes)
-        step = gaps.min()
-        # whole multiples of the step to LATTICE_TOLERANCE of it, each plane known to its round-off: not relative
-        # to the multiple (a gap a million steps long is a whole multiple of any step to a millionth of itself)
-        off = np.abs(gaps - np.round(gaps / step) * step)
-        if np.all(off <= LATTICE_TOLERANCE * step + 2 * round_off):
-            steps[axis] = step
-    return steps
+        tried.append(axis)
+        found = _frame_about(axis, sample, spacing)
+        if found is not None and found[1] / own[0] > largest:
+            frame, largest = found[0], found[1] / own[0]
+            queue.extend(found[0][1:])
+    if frame is None:
+        return None
+    turn, _ = np.linalg.qr(frame.T)  # (exactly orthonormal, the axes' signs as found)
+    return (turn * np.sign(np.diag(turn.T @ frame.T))).T
+
+
+def _frame_about(axis, sample, spacing):
+    """``(frame, area)``: the axes (rows, (3, 3)) of a lattice one of whose axes is ``axis`` (3,) and the product of
+    the two others' steps, or None.
+
+    The two others lie in the plane at right angles to it, a quarter turn apart: of the directions of a quarter turn
+    there, :data:`LATTICE_FRAME_ANGLES` evenly spaced, the :data:`LATTICE_FRAME_PEAKS` along which the ``sample``
+    (S, 3) is most periodic (the strongest peak of :func:`_spectrum`), each refined to a fortieth of that spacing
+    and completed by the direction at right angles: of those periodic along both (:func:`_grid_frequency`), the
+    coarsest grid (the axes, not the diagonals between them).
+    """
+    first = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
+    first /= np.linalg.norm(first)
+    second = np.cross(axis, first)
+
+    def direction(angle):
+        return np.cos(angle) * first + np.sin(angle) * second
+
+    def strongest(angle):
+        modulus, _, band, _ = _spectrum(sample @ direction(angle), spacing)
+        return 0.0 if band.size == 0 else float(modulus[band].max())
+
+    coarse = np.arange(LATTICE_FRAME_ANGLES) * (np.pi / 2 / LATTICE_FRAME_ANGLES)
+    strength = np.array([strongest(t) for t in coarse])
+    tops = np.flatnonzero((strength >= np.roll(strength, 1)) & (strength >= np.roll(strength, -1)))
+    frame, largest = None, 0.0
+    for start in coarse[tops[np.argsort(-strength[tops])][:LATTICE_FRAME_PEAKS]]:
+        fine = start + np.linspace(-1, 1, 41) * (np.pi / 2 / LATTICE_FRAME_ANGLES)
+        along = direction(fine[int(np.argmax([strongest(t) for t in fine]))])
+        found = _grid_frequency(sample @ along, spacing)
+        third = _grid_frequency(sample @ np.cross(axis, along), spacing)
+        if found is None or third is None:
+            continue
+        cell = 1 / (found[0] * third[0])
+        if cell > largest:
+            frame, largest = np.array([axis, along, np.cross(axis, along)]), cell
+    return None if frame is None else (frame, largest)
+
+
+def _shared_planes(values):
+    """``(step, offset, tolerance)`` of the planes that ``values`` (N,) share (see :func:`read_lattice`), or None."""
+    # the coordinates within round-off of each other are one plane (a coordinate computed two ways)
+    values = np.sort(values)
+    round_off = LATTICE_ROUND_OFF * max(float(np.abs(values).max()), np.finfo(float).tiny)
+    first = np.flatnonzero(np.r_[True, np.diff(values) > round_off])
+    counts = np.diff(np.r_[first, values.size])
+    planes = values[first[counts > 1]]
+    if planes.size < LATTICE_PLANES or counts[counts > 1].sum() < LATTICE_SHARE * values.size:
+        return None
+    gaps = np.diff(planes)
+    step = gaps.min()
+    # whole multiples of the step to LATTICE_TOLERANCE of it, each plane known to its round-off: not relative
+    # to the multiple (a gap a million steps long is a whole multiple of any step to a millionth of itself)
+    off = np.abs(gaps - np.round(gaps / step) * step)
+    tolerance = LATTICE_TOLERANCE * step + 2 * round_off
+    if not np.all(off <= tolerance):
+        return None
+    return float(step), float(planes[0]), float(tolerance)
+
+
+def _periodic_planes(values, probe, spacing):
+    """``(step, offset, tolerance)`` of the grid whose planes ``values`` (N,) lie about, or None.
+
+    The modulus ``m(f)`` of the mean of ``exp(2 pi i f x)`` over the ``probe`` values (M,): its peaks within
+    :data:`LATTICE_BAND` over every frequency at once (the Fourier transform of their histogram in bins of 1/32 of
+    the ``spacing``), the :data:`LATTICE_PEAKS` strongest of at least :data:`LATTICE_PERIODIC` each measured at its
+    top (the mean at 17 frequencies across its bin) and kept unless ``m(f) < LATTICE_FULL m(2 f) ** (1 / 4)`` where
+    ``m(2 f)`` is at least that (see :data:`LATTICE_FULL`). The grid's frequency is the lowest of those within
+    :data:`LATTICE_HARMONIC` of the strongest (an exact grid's harmonics are as strong as its fundamental; two planes
+    that hold many points, the treads at the poles, make peaks at every multiple of the inverse of their distance,
+    weaker than the grid's). Its step and a plane are then fitted by least squares to the coordinates within a
+    quarter step of the planes, and the tolerance is :data:`LATTICE_SNAP` times the coordinates' spread about them.
+    """
+    found = _grid_frequency(probe, spacing)
+    if found is None:
+        return None
+    frequency, mean, low = found
+    step = 1 / frequency
+    offset = low + np.angle(mean) / (2 * np.pi) * step
+    for _ in range(2):  # least squares over the coordinates near the planes
+        index = np.round((values - offset) / step)
+        close = np.abs(values - offset - index * step) <= step / 4
+        if close.sum() < LATTICE_SHARE * values.size or np.ptp(index[close]) < LATTICE_PLANES - 1:
+            return None
+        step, offset = np.polyfit(index[close], values[close], 1)
+    residual = values - offset - np.round((values - offset) / step) * step
+    spread = 1.4826 * float(np.median(np.abs(residual)))
+    return float(step), float(offset), min(LATTICE_SNAP * spread, step / 2)
+
+
+def _spectrum(probe, spacing):
+    """``(modulus, frequency, band, low)``: the modulus of the mean of ``exp(2 pi i f (x - low))`` over the ``probe``
+    (M,) at every ``frequency`` of the Fourier transform of their histogram in bins of 1/32 of the ``spacing``, the
+    indices of those within :data:`LATTICE_BAND` (none when the probe spans too few or too many bins) and ``low``,
+    the least value."""
+    low, high = float(probe.min()), float(probe.max())
+    width = spacing / 32
+    bins = int((high - low) / width) + 1 if np.isfinite(high - low) else 0
+    if not 8 * 32 <= bins <= 1 << 18:
+        return np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64), low
+    histogram = np.bincount(((probe - low) / width).astype(np.int64), minlength=bins)
+    size = 1 << int(np.ceil(np.log2(2 * bins)))
+    modulus = np.abs(np.fft.rfft(histogram, size)) / probe.size
+    frequency = np.arange(modulus.size) / (size * width)
+    band = np.flatnonzero(
+        (frequency >= 1 / (LATTICE_BAND[1] * spacing)) & (frequency <= 1 / (LATTICE_BAND[0] * spacing))
+    )
+    return modulus, frequency, band, low
+
+
+def _grid_frequency(probe, spacing):
+    """``(frequency, mean, low)``: the grid's frequency, the mean of ``exp(2 pi i f (x - low))`` over the ``probe``
+    (M,) there and their least value ``low``, or None (see :func:`_periodic_planes`)."""
+    modulus, frequency, band, low = _spectrum(probe, spacing)
+    if band.size < 3:
+        return None
+    width = spacing / 32
+    size = 2 * (modulus.size - 1)
+    inner = modulus[band[1:-1]]
+    peaks = band[1:-1][(inner >= modulus[band[:-2]]) & (inner >= modulus[band[2:]]) & (inner >= LATTICE_PERIODIC)]
+    centred = probe - low
+    tops = []  # (frequency, mean) at the top of each peak kept
+    for peak in peaks[np.argsort(-modulus[peaks], kind="stable")[:LATTICE_PEAKS]]:
+        near = frequency[peak] + np.linspace(-1, 1, 17) / (size * width)
+        means = np.exp(2j * np.pi * np.outer(near, centred)).mean(axis=1)
+        top = int(np.argmax(np.abs(means)))
+        double = abs(np.exp(4j * np.pi * near[top] * centred).mean())
+        if double >= LATTICE_PERIODIC and abs(means[top]) < LATTICE_FULL * double**0.25:
+            continue  # (every second plane of a grid at 2 f; tested only where m(2 f) is above the sampling's floor)
+        tops.append((near[top], means[top]))
+    if not tops:
+        return None
+    strongest = max(abs(mean) for _, mean in tops)
+    found, mean = min((f, mean) for f, mean in tops if abs(mean) >= LATTICE_HARMONIC * strongest)
+    return found, mean, low
 
 
 def _off_the_steps(points, normals, queries, found, lattice):
     """``found`` of :func:`_sheet_signs` at ``queries`` (M,) with the stacked neighbours oriented alike kept only
     where they and the query lie farther off each other's tangent plane than :data:`STACKED_ALIKE_LATTICE`
-    ``max_k |n_k| h_k`` (``lattice`` (3,): ``h``, all 0 for none; ``n`` the query's normal)."""
+    ``max_k |n_k| h_k`` (``h`` the steps of the :class:`Lattice` ``lattice``, ``n`` the query's normal in its axes)."""
     hit, near, flags, two = found
     rows = np.flatnonzero(hit)
-    if rows.size == 0 or not lattice.any():
+    if rows.size == 0 or not lattice.steps.any():
         return found
     offsets = points[near[rows]] - points[queries[rows]][:, None, :]
     ahead = np.einsum("mkj,mj->mk", offsets, normals[queries[rows]])
     behind = np.einsum("mkj,mkj->mk", offsets, normals[near[rows]])
-    steps = STACKED_ALIKE_LATTICE * np.max(np.abs(normals[queries[rows]]) * lattice, axis=1)
+    steps = STACKED_ALIKE_LATTICE * np.max(np.abs(lattice.along(normals[queries[rows]])) * lattice.steps, axis=1)
     flags = flags.copy()
     flags[rows] &= np.minimum(np.abs(ahead), np.abs(behind)) >= steps[:, None]
     hit = hit.copy()
@@ -1470,10 +1770,11 @@ def lattice_treads(
     candidates: np.ndarray,
     tree,
     estimate: tuple[np.ndarray, np.ndarray, np.ndarray],
+    lattice: Lattice,
 ):
     """``(tread, problems)``: (N,) bool, the ``candidates`` (N,) bool whose ball does not resolve a lattice's steps.
 
-    A voxel surface read as a cloud (see :func:`lattice_steps`) is a staircase whose treads, where the surface is
+    A voxel surface read as a cloud (its grid ``lattice``, see :func:`read_lattice`) is a staircase whose treads, where the surface is
     nearly at right angles to an axis, are about ``sqrt(2 R h)`` wide (``R`` its radius of curvature, ``h`` the
     voxel): a ball within one sees a plane, curvature 0, and nothing in it says that the surface curves. Such are:
 
@@ -1493,17 +1794,18 @@ def lattice_treads(
     tread = np.zeros(points.shape[0], dtype=bool)
     rows = np.flatnonzero(candidates)
     # (the grid of the whole cloud: the candidates alone may lie on too few of its planes, two treads at the poles)
-    lattice = lattice_steps(points) if rows.size else np.zeros(3)
-    if not lattice.any():
+    if rows.size == 0 or not lattice.steps.any():
         return tread, []
+    snapped = lattice.snap(points)
+    steps = lattice.steps
     k_min, k_max, fitted = estimate
     # every coordinate on the grid, as marching cubes over a mask puts them (a plane sampled on a grid of two axes,
     # a range image, is flat; a steep one spans few planes of it between samples)
-    staircase = bool(lattice.all())
+    staircase = bool(steps.all())
     if staircase:
         with np.errstate(invalid="ignore"):
             sagitta = np.maximum(np.abs(k_min[rows]), np.abs(k_max[rows])) * fitted[rows] ** 2 / 2
-            tread[rows] = sagitta < FACET_SAGITTA * np.max(np.abs(normals[rows]) * lattice, axis=1)
+            tread[rows] = sagitta < FACET_SAGITTA * np.max(np.abs(lattice.along(normals[rows])) * steps, axis=1)
     k = min(STEP_NEIGHBOURS + 1, points.shape[0])
     for start in range(0, rows.size, CHUNK):
         chunk = rows[start : start + CHUNK]
@@ -1511,9 +1813,9 @@ def lattice_treads(
         inside = distances[:, 1:] <= radii[chunk][:, None]  # (the point itself first)
         # the axis most along the normal: a point facing an axis off the grid (a cylinder's side, its rings on a
         # grid along the axis) is on no tread
-        axis = np.argmax(np.abs(normals[chunk]), axis=1)
-        step = np.where(lattice[axis] > 0, lattice[axis], np.nan)[:, None]
-        height = points[near[:, 1:], axis[:, None]] - points[chunk, axis][:, None]
+        axis = np.argmax(np.abs(lattice.along(normals[chunk])), axis=1)
+        step = np.where(steps[axis] > 0, steps[axis], np.nan)[:, None]
+        height = snapped[near[:, 1:], axis[:, None]] - snapped[chunk, axis][:, None]
         nearest = inside[:, :TREAD_NEIGHBOURS]
         plane = nearest & (np.abs(height[:, :TREAD_NEIGHBOURS]) <= LATTICE_TOLERANCE * step)
         tread[chunk] |= plane.sum(axis=1) >= TREAD_SHARE * np.maximum(nearest.sum(axis=1), 1)

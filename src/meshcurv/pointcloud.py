@@ -1044,7 +1044,8 @@ def _compute(points, given, radius, method, search=None):
     mixed = None
     compiled = numba_kernels("pointcloud") is not None
     # (a staircase: every coordinate on a grid, as marching cubes over a mask puts them; not a range image's two)
-    on_lattice = method == "jets" and bool(_normals.lattice_steps(points[usable]).all())
+    lattice = _normals.read_lattice(points, median, usable=usable, neighbours=indices)
+    on_lattice = method == "jets" and bool(lattice.steps.all())
     for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
         seen = _class_noise(noise, median, group_spacing)  # the noise in this class's own spacings
@@ -1092,6 +1093,7 @@ def _compute(points, given, radius, method, search=None):
                 smallest=smallest,
                 details=details,
                 facing=part_facing,
+                lattice=lattice,
             )
             asked = group_radius
             # a fit over half the radius the noise calls for or less (a ball shrunk off the other side of a thin
@@ -1201,7 +1203,9 @@ def _compute(points, given, radius, method, search=None):
         logger.info("point cloud: stacked sheets")
         # a sheet stacked on another with normals the same way (one of the two is inside out), and two sheets
         # closer than the spacing, whose points mix (the faces of a part thinner than that)
-        alike, interleaved = _normals.two_sheets(points, out_normals, usable, spacing, tree, noise=noise)
+        alike, interleaved = _normals.two_sheets(
+            points, out_normals, usable, spacing, tree, noise=noise, lattice=lattice
+        )
         # a part whose faces mix over a good share of it, or face the same way over most of it, is thinner than
         # the spacing: its sides are a coin's toss
         count = np.maximum(np.bincount(labels, weights=usable, minlength=int(labels.max()) + 1), 1.0)
@@ -1246,7 +1250,9 @@ def _compute(points, given, radius, method, search=None):
         reason[wide] = _UNSTEADY
         valid &= ~wide
     # a voxel surface read as a cloud: a ball on a flat facet of its staircase sees a plane
-    tread, found = _normals.lattice_treads(points, out_normals, balls, valid & ~doubtful, tree, (k_min, k_max, fitted))
+    tread, found = _normals.lattice_treads(
+        points, out_normals, balls, valid & ~doubtful, tree, (k_min, k_max, fitted), lattice
+    )
     problems.extend(found)
     reason[tread] = _UNSTEADY
     valid &= ~tread
