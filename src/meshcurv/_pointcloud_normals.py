@@ -216,8 +216,7 @@ LATTICE_PROBE = 4096
 #: motion or a registration error of a fraction of a voxel): when the coordinates along it are periodic, the
 #: modulus of the mean of ``exp(2 pi i x / s)`` at least this for a step ``s`` within :data:`LATTICE_BAND` spacings
 #: (1 on the planes, ``exp(-2 pi^2 sigma^2 / s^2)`` under noise ``sigma``: 0.45 at a tenth of a voxel on the half
-#: voxels' grid of marching cubes; a scan's, a mesh's or a rotated lattice's coordinates 0.02-0.2, ``benchmarks/
-#: pointcloud_diagnostics.md``, "A staircase off its grid") ...
+#: voxels' grid of marching cubes; ``benchmarks/pointcloud_diagnostics.md``, "A staircase off its grid") ...
 LATTICE_PERIODIC = 0.3
 LATTICE_BAND = (0.25, 6.0)
 
@@ -1614,7 +1613,7 @@ def _frame_about(axis, sample, spacing):
 
     The two others lie in the plane at right angles to it, a quarter turn apart: of the directions of a quarter turn
     there, :data:`LATTICE_FRAME_ANGLES` evenly spaced, the :data:`LATTICE_FRAME_PEAKS` along which the ``sample``
-    (S, 3) is most periodic (the strongest peak of :func:`_spectrum`), each refined to a fortieth of that spacing
+    (S, 3) is most periodic (the strongest peak of :func:`_spectrum`), each refined to a twentieth of that spacing
     and completed by the direction at right angles: of those periodic along both (:func:`_grid_frequency`), the
     coarsest grid (the axes, not the diagonals between them).
     """
