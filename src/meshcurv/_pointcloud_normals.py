@@ -1703,9 +1703,10 @@ def _spectrum(probe, spacing):
     the least value."""
     low, high = float(probe.min()), float(probe.max())
     width = spacing / 32
-    bins = int((high - low) / width) + 1 if np.isfinite(high - low) else 0
-    if not 8 * 32 <= bins <= 1 << 18:
+    span = (high - low) / width if width > 0.0 else np.inf
+    if not (np.isfinite(span) and 8 * 32 <= span + 1 <= 1 << 18):
         return np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64), low
+    bins = int(span) + 1
     histogram = np.bincount(((probe - low) / width).astype(np.int64), minlength=bins)
     size = 1 << int(np.ceil(np.log2(2 * bins)))
     modulus = np.abs(np.fft.rfft(histogram, size)) / probe.size
