@@ -80,13 +80,14 @@ SHRINK = 2.0**-0.5
 #: noise differs from the larger ball's by about its own error.
 AGREEMENT = 0.4
 
-#: ... and within this share on a lattice (a voxel surface read as a cloud: :func:`~meshcurv._pointcloud_normals.read_lattice`). A jet fitted to
-#: a staircase of steps ``h`` over a ball of radius ``r`` is biased by about ``h / r^2`` (the steps are coherent, no
-#: noise that the ball averages out), a bias that falls fast from one ball to the next: the two estimates differ by
-#: most of the smaller ball's bias, and bounding the difference bounds that bias below half of |k| (``AGREEMENT``
-#: does not, at the poles of voxel spheres and ellipsoids of 15 voxels and more). Only where the largest |k| falls
-#: from the ball to the larger one, as that bias does (a jet's bias from a curvature grows with the ball: small voxel
-#: spheres stay measured). Figures: ``benchmarks/pointcloud_diagnostics.md``, "Jets on a staircase".
+#: ... and within this share on a lattice (a voxel surface read as a cloud:
+#: :func:`~meshcurv._pointcloud_normals.read_lattice`). A jet fitted to a staircase of steps ``h`` over a ball of
+#: radius ``r`` is biased by about ``h / r^2`` (the steps are coherent, no noise that the ball averages out), a bias
+#: that falls fast from one ball to the next: the two estimates differ by most of the smaller ball's bias, and
+#: bounding the difference bounds that bias below half of |k| (``AGREEMENT`` does not, at the poles of voxel spheres
+#: and ellipsoids of 15 voxels and more). Only where the largest |k| falls from the ball to the larger one, as that
+#: bias does (a jet's bias from a curvature grows with the ball: small voxel spheres stay measured). Figures:
+#: ``benchmarks/pointcloud_diagnostics.md``, "Jets on a staircase".
 LATTICE_AGREEMENT = 0.2
 
 #: ... where a change of the curvature by this many radians of normal turning over the ball (``0.05 / r``)

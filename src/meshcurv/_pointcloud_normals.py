@@ -1513,7 +1513,7 @@ def read_lattice(
     lattice = _lattice_in(rows, spacing)
     if lattice.steps.any() or spacing is None or neighbours is None:
         return lattice
-    frame = _lattice_frame(points, neighbours, usable, spacing)
+    frame = _lattice_frame(points, rows, neighbours, usable, spacing)
     if frame is None:
         return lattice
     turned = _lattice_in(rows @ frame.T, spacing)
@@ -1525,9 +1525,8 @@ def read_lattice(
     scaled = np.empty((3, 3))
     for axis in range(3):
         step, offset = turned.steps[axis], turned.offsets[axis]
-        along = rows @ frame[axis]
-        index = np.round((along - offset) / step)
-        near = np.abs(along - offset - index * step) <= step / 4
+        index, off = _nearest_planes(rows @ frame[axis], step, offset)
+        near = np.abs(off) <= step / 4
         scaled[axis] = np.linalg.lstsq(np.c_[rows[near], np.ones(near.sum())], index[near], rcond=None)[0][:3]
     left, _, right = np.linalg.svd(scaled / np.linalg.norm(scaled, axis=1, keepdims=True))
     refined = left @ right
@@ -1550,8 +1549,9 @@ def _lattice_in(points, spacing):
     return Lattice(steps, offsets, tolerance)
 
 
-def _lattice_frame(points, neighbours, usable, spacing):
-    """(3, 3) the axes (rows) of a lattice turned off the coordinate axes, or None (see :data:`LATTICE_FRAME_PROBE`)."""
+def _lattice_frame(points, rows, neighbours, usable, spacing):
+    """(3, 3) the axes (rows) of a lattice turned off the coordinate axes, or None (see :data:`LATTICE_FRAME_PROBE`):
+    the ``rows`` (M, 3) the ``usable`` of ``points`` (N, 3), ``neighbours`` (N, k) each point's nearest."""
     candidates = np.arange(points.shape[0]) if usable is None else np.flatnonzero(usable)
     probe = _evenly(candidates, LATTICE_FRAME_PROBE)
     group = np.concatenate([points[probe, None, :], points[neighbours[probe]]], axis=1)
@@ -1570,7 +1570,6 @@ def _lattice_frame(points, neighbours, usable, spacing):
         direction = (normals[members] * np.sign(normals[members] @ normals[best])[:, None]).sum(axis=0)
         directions.append(direction / np.linalg.norm(direction))
         left &= ~members
-    rows = points if usable is None else points[usable]
     sample = rows[:: max(1, rows.shape[0] // LATTICE_PROBE)]
     steps = []
     for direction in directions:
@@ -1686,14 +1685,20 @@ def _periodic_planes(values, probe, spacing):
     step = 1 / frequency
     offset = low + np.angle(mean) / (2 * np.pi) * step
     for _ in range(2):  # least squares over the coordinates near the planes
-        index = np.round((values - offset) / step)
-        close = np.abs(values - offset - index * step) <= step / 4
+        index, off = _nearest_planes(values, step, offset)
+        close = np.abs(off) <= step / 4
         if close.sum() < LATTICE_SHARE * values.size or np.ptp(index[close]) < LATTICE_PLANES - 1:
             return None
         step, offset = np.polyfit(index[close], values[close], 1)
-    residual = values - offset - np.round((values - offset) / step) * step
-    spread = 1.4826 * float(np.median(np.abs(residual)))
+    spread = 1.4826 * float(np.median(np.abs(_nearest_planes(values, step, offset)[1])))
     return float(step), float(offset), min(LATTICE_SNAP * spread, step / 2)
+
+
+def _nearest_planes(values, step, offset):
+    """``(index, off)``: the plane of the grid of ``step`` through ``offset`` nearest each of ``values`` (N,), and
+    how far off it each lies."""
+    index = np.round((values - offset) / step)
+    return index, values - offset - index * step
 
 
 def _spectrum(probe, spacing):
