@@ -1777,6 +1777,7 @@ def summary_table(path) -> str:
 
 
 def main(argv=None) -> int:
+    global ONLY_POINT_CLOUDS, VOXEL_SHARE
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -1793,9 +1794,18 @@ def main(argv=None) -> int:
         help="only point_cloud_curvatures: the mutated meshes' vertices and the analytic clouds "
         "of make_cloud_case (gaps, copies, thin parts, given radii) with their truth",
     )
+    parser.add_argument(
+        "--voxel-share",
+        type=float,
+        default=VOXEL_SHARE,
+        help="share of the analytic cloud cases that are voxel surfaces (default: %(default).3g; "
+        "1 for a voxel-only run)",
+    )
     options = parser.parse_args(argv)
-    global ONLY_POINT_CLOUDS
+    if not 0 <= options.voxel_share <= 1:
+        parser.error(f"--voxel-share must lie in [0, 1], got {options.voxel_share}")
     ONLY_POINT_CLOUDS = options.point_clouds
+    VOXEL_SHARE = options.voxel_share
 
     if options.summary:
         print(summary_table(options.summary))
@@ -1846,6 +1856,7 @@ def main(argv=None) -> int:
                     "timeout": options.timeout,
                     "memory": options.memory,
                     "factor": options.factor,
+                    "voxel_share": options.voxel_share,
                 }
             )
             + "\n"
