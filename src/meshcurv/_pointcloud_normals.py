@@ -99,6 +99,16 @@ FRAGMENT_SHARE = 0.25
 #: (:func:`undecided_fragments`).
 FRAGMENT_FLUX = 0.5
 
+#: A part of several (after :func:`winding_sides`) whose side the rest of the cloud settles: the mean winding number
+#: of the rest at its points at least this far from 0 (it wraps the part: a piece of a larger closed surface, as
+#: on a closed surface about a hole in it, 1/2) ...
+FRAGMENT_WRAPPED = 0.25
+#: ... must come this much closer to 1/2 in the mean (the whole cloud's winding number at the part's points) on the
+#: part's side than turned, or its side is undecided (:func:`unconfirmed_parts`) ...
+FRAGMENT_MARGIN = 0.1
+#: ... evaluated at this many points of each part at least (all when fewer), besides the evenly spaced ones.
+FRAGMENT_QUERIES = 16
+
 #: Rounds of attaching small parts to their neighbours (each round reaches one part further).
 SMALL_PART_ROUNDS = 8
 
@@ -861,7 +871,7 @@ def outward_signs(points: np.ndarray, normals: np.ndarray, labels: np.ndarray, a
 
 
 def undecided_fragments(
-    points: np.ndarray, normals: np.ndarray, labels: np.ndarray, areas: np.ndarray, indices: np.ndarray
+    points: np.ndarray, normals: np.ndarray, labels: np.ndarray, areas: np.ndarray, indices: np.ndarray, tree=None
 ) -> np.ndarray:
     """(N,) bool: the points of fragments of a larger part whose outward side nothing decides.
 
@@ -871,7 +881,8 @@ def undecided_fragments(
     centroid: 1 on a sphere), took its side in :func:`outward_signs` from its own shape, which on a piece of a
     saddle or of a flat tread says nothing, and the winding number does not correct it (a patch adds little to
     the winding number at its own points). Such a piece: treads of a voxel staircase cut off from the rest by
-    their risers (``benchmarks/fuzz_api.py --point-clouds``, voxel surfaces).
+    their risers (``benchmarks/fuzz_api.py --point-clouds``, voxel surfaces). So are the parts that the rest of
+    the cloud wraps and whose side its winding number does not confirm (:func:`unconfirmed_parts`).
 
     Parameters
     ----------
@@ -883,6 +894,8 @@ def undecided_fragments(
         Each point's area (0 for the points that do not count).
     indices : ndarray of shape (N, k)
         The nearest neighbours of each point.
+    tree : scipy.spatial.cKDTree, optional
+        The points' tree (default: built when needed).
     """
     n_labels = int(labels.max()) + 1 if labels.size else 0
     if n_labels < 2:
@@ -894,7 +907,65 @@ def undecided_fragments(
     area = np.bincount(labels, weights=areas, minlength=n_labels)
     beside = np.zeros(n_labels, dtype=bool)  # a neighbour of one of its points on a part that much larger
     beside[labels[(area[labels[indices]] * FRAGMENT_SHARE > area[labels][:, None]).any(axis=1)]] = True
-    return ((flux <= FRAGMENT_FLUX * spread) & beside & (area > 0))[labels]
+    return ((flux <= FRAGMENT_FLUX * spread) & beside & (area > 0))[labels] | unconfirmed_parts(
+        points, normals, labels, areas, tree
+    )
+
+
+def unconfirmed_parts(
+    points: np.ndarray, normals: np.ndarray, labels: np.ndarray, areas: np.ndarray, tree=None
+) -> np.ndarray:
+    """(N,) bool: the points of parts that the rest of the cloud wraps and whose side it does not confirm.
+
+    A part's side comes from its own shape (:func:`outward_signs`), right on a closed part. On a piece of a larger
+    closed surface that the orientation's graph cut off the rest (a voxel staircase's steps carry no sign), the
+    flux about the piece's centroid can be as clear as a closed part's and wrong: the inner wall of a torus, a band
+    about the hole, has its centroid in the hole, and its normals, pointing into the hole, give a negative flux:
+    turned, the whole band is inside out (``benchmarks/fuzz_api.py --point-clouds``, voxel clouds). The winding
+    number of the whole cloud at the part's points (:func:`winding_numbers`) is the sum of the part's own, ``o``,
+    and the rest's, ``r``: ``r + o`` as it is, ``r - o`` turned, ``1/2`` on a consistent closed cloud. Where the
+    rest wraps the part (mean ``|r|`` at least :data:`FRAGMENT_WRAPPED`), its side is confirmed only when ``r + o``
+    is closer to 1/2 in the mean than ``r - o`` by :data:`FRAGMENT_MARGIN` (the band: ``o`` near 0 at its own
+    points, ``r`` near 1/2 about the hole: either side fits, and the side is undecided). A closed part has ``o``
+    1/2 (or -1/2 as a cavity's wall): confirmed; a part alone (``r`` 0) keeps its side. The arguments are those of
+    :func:`undecided_fragments` (the tree built here when the cloud has two parts or more and none is given).
+    """
+    n = points.shape[0]
+    unsure = np.zeros(n, dtype=bool)
+    usable = areas > 0
+    candidates = np.flatnonzero(usable)
+    if candidates.size < 2 or np.unique(labels[candidates]).size < 2:
+        return unsure
+    if tree is None:
+        from scipy.spatial import cKDTree
+
+        tree = cKDTree(points)
+    queries = _part_queries(candidates, labels)
+    sources = _evenly(candidates, WINDING_SOURCES)
+    total, own = _winding(points, normals, areas, usable, tree, points[queries], queries, sources, labels)
+    part = labels[queries]
+    count = np.maximum(np.bincount(part, minlength=int(labels.max()) + 1), 1)
+    own = np.bincount(part, weights=own, minlength=count.size) / count
+    rest = np.bincount(part, weights=total, minlength=count.size) / count - own
+    away = rest - 0.5
+    confirmed = np.abs(away - own) - np.abs(away + own) >= FRAGMENT_MARGIN
+    unsure[candidates] = ((np.abs(rest) >= FRAGMENT_WRAPPED) & ~confirmed)[labels[candidates]]
+    return unsure
+
+
+def _part_queries(candidates: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """(M,) sorted: :data:`WINDING_QUERIES` of the ``candidates`` evenly spaced, and of each part's (``labels``)
+    candidates :data:`FRAGMENT_QUERIES` at least (all when fewer), evenly spaced in their order."""
+    part = labels[candidates]
+    order = np.argsort(part, kind="stable")
+    sizes = np.bincount(part)
+    first = np.cumsum(sizes) - sizes
+    rank = np.empty(candidates.size, dtype=np.int64)
+    rank[order] = np.arange(candidates.size) - first[part[order]]
+    size = sizes[part]
+    most = np.minimum(size, FRAGMENT_QUERIES)
+    picked = (rank + 1) * most // size > rank * most // size  # ``most`` of each part's ``size``, evenly
+    return np.union1d(_evenly(candidates, WINDING_QUERIES), candidates[picked])
 
 
 def oriented_signs(
@@ -1168,20 +1239,41 @@ def winding_at(
     return _winding(points, normals, areas, usable, tree, positions, None, sources)
 
 
-def _winding(points, normals, areas, usable, tree, q, queries, sources):
+def _winding(points, normals, areas, usable, tree, q, queries, sources, labels=None):
     """:func:`winding_numbers` at the positions ``q`` (M, 3); ``queries`` (M,): the points there (left out of
-    their own sums), or None."""
+    their own sums), or None. Given the points' part ``labels`` (N,) (with ``queries``): ``(total, own)``, the
+    winding numbers and the shares of them of the part of each query (:func:`unconfirmed_parts`)."""
     k = min(WINDING_NEAR + 1, points.shape[0])
     distances, near = tree.query(q, k=k, workers=-1)
     offsets = points[near] - q[:, None, :]
     counted = usable[near] if queries is None else (near != queries[:, None]) & usable[near]
     softened = np.where(counted, np.einsum("mkj,mkj->mk", offsets, offsets) + areas[near] / np.pi, 1.0)
-    total = np.where(
+    terms = np.where(
         counted, areas[near] * np.einsum("mkj,mkj->mk", offsets, normals[near]) / (softened * np.sqrt(softened)), 0.0
-    ).sum(axis=1)
+    )
+    total = terms.sum(axis=1)
     reach_squared = distances[:, -1] ** 2
     weights = areas[sources] * (np.count_nonzero(usable) / sources.size)
     soft = areas[sources] / np.pi
+    total += _far_winding(points, normals, weights, soft, sources, q, queries, reach_squared)
+    if labels is None:
+        return total / (4.0 * np.pi)
+    own = np.where(labels[near] == labels[queries][:, None], terms, 0.0).sum(axis=1)
+    part = labels[queries]
+    for label in np.unique(part):  # the far sum over each part's own sources
+        mine, theirs = np.flatnonzero(part == label), labels[sources] == label
+        own[mine] += _far_winding(
+            points, normals, weights[theirs], soft[theirs], sources[theirs], q[mine], queries[mine], reach_squared[mine]
+        )
+    return total / (4.0 * np.pi), own / (4.0 * np.pi)
+
+
+def _far_winding(points, normals, weights, soft, sources, q, queries, reach_squared):
+    """(M,) ``4 pi`` times the far part of :func:`_winding` at ``q`` (M, 3): the sum over the ``sources`` (S,)
+    (``weights`` and ``soft`` (S,) per source) beyond ``reach_squared`` (M,) of each; ``queries`` as there."""
+    total = np.zeros(q.shape[0])
+    if sources.size == 0:
+        return total
     compiled = numba_kernels("pointcloud")
     if compiled is not None:
         if queries is None:  # the positions appended to the points: the kernel reads its queries by index
@@ -1209,7 +1301,7 @@ def _winding(points, normals, areas, usable, tree, q, queries, sources):
             squared = squared + soft
             term = weights * (dx * nx + dy * ny + dz * nz) / (squared * np.sqrt(squared))
             total[rows] += np.where(far, term, 0.0).sum(axis=1)
-    return total / (4.0 * np.pi)
+    return total
 
 
 def winding_sides(
