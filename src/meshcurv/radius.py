@@ -559,7 +559,7 @@ def _voxel_surface_radius(
     spikes = mesh.needles
     referenced = topology.referenced_vertices & ~spikes
     grid = voxel_grid(vertices if referenced.all() else vertices[referenced])  # (no copy of a whole mesh)
-    if grid is None:
+    if grid is None or _off_grid_scale(mesh.length_scales[referenced], grid.spacing):
         return None
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
     curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
@@ -600,6 +600,23 @@ def _voxel_surface_radius(
         )
         found["vertex_scale"] = (np.minimum(radii, extent), normal_radii)
     return radius, found
+
+
+def _off_grid_scale(scales: np.ndarray, spacing: np.ndarray) -> bool:
+    """Whether a part of the mesh (``scales``: the length scales of its vertices) is of another scale than the
+    voxel grid found, beyond :data:`meshcurv.geometry.COMPONENT_SCALE_SPREAD` of its voxel sizes.
+
+    Such a part lies "on" the grid only within the grid's tolerance (a part of 2 units beside a voxel surface of
+    1e12 units, issue 29), and a voxel radius (at least a voxel) would measure it whole: the mesh is then taken
+    as an ordinary one, each group of components of one scale at its own radius.
+    """
+    scales = scales[scales > 0]  # (a part whose edges all have length 0 has no scale)
+    if scales.size == 0:
+        return False
+    return bool(
+        scales.min() * COMPONENT_SCALE_SPREAD < np.min(spacing)
+        or scales.max() > COMPONENT_SCALE_SPREAD * np.max(spacing)
+    )
 
 
 #: The scale of each vertex of a voxel surface (:func:`voxel_vertex_radii`, ``icc``'s default):

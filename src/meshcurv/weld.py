@@ -43,7 +43,8 @@ __all__ = [
     "drop_closed_copies",
 ]
 
-#: Vertices closer than this times the median edge length are copies of one point.
+#: Vertices closer than this times the median edge length are copies of one point (of their own part's edges
+#: where the parts of a mesh differ in scale: :func:`meshcurv.geometry.vertex_length_scales`).
 WELD_TOLERANCE_RATIO = 1e-5
 
 #: Two boundary edges sharing no vertex whose ends lie pairwise within this times the shorter edge's length are
@@ -61,7 +62,9 @@ class Welding(NamedTuple):
     ----------
     vertices : ndarray of shape (W, 3)
         The welded mesh's vertices: each group of copies becomes its first
-        member (lowest index); the other vertices are kept in their order.
+        member (lowest index), a group joined across cracks the mean of its
+        members (the corners of detached faces, each moved its own way); the
+        other vertices are kept in their order.
     topology : MeshTopology
         The welded mesh's connectivity (faces re-indexed into ``vertices``).
     index : ndarray of shape (V,), int64
@@ -98,7 +101,11 @@ def weld_vertices(
         The mesh's connectivity.
     tolerance_ratio : float, default: 1e-5
         Two boundary vertices closer than ``tolerance_ratio`` times the median
-        length of the mesh's edges of non-zero length are one point.
+        length of the mesh's edges of non-zero length are one point; where the
+        mesh's components differ in scale
+        (:func:`meshcurv.geometry.vertex_length_scales`), each vertex's tolerance
+        is that times its component's median edge length, and a pair within
+        the smaller of its two.
     crack_ratio : float, default: 0.05
         Two boundary edges that share no vertex, whose ends lie pairwise within
         ``crack_ratio`` times the shorter edge's length, are the sides of a
@@ -167,21 +174,57 @@ def weld_vertices(
 
 
 def _weld_coincident(vertices: np.ndarray, topology: MeshTopology, tolerance_ratio: float) -> Welding:
-    """The boundary vertices within ``tolerance_ratio`` times the median edge length welded (:func:`weld_vertices`)."""
+    """The boundary vertices within ``tolerance_ratio`` times the median edge length (their parts' where the
+    parts differ in scale) welded (:func:`weld_vertices`)."""
     n_vertices = vertices.shape[0]
     unchanged = Welding(vertices, topology, np.arange(n_vertices), 0)
     if not topology.boundary_edges.any():
         return unchanged
     candidates = np.flatnonzero(topology.boundary_vertices)
-    tolerance = _tolerance(vertices, topology, tolerance_ratio)
-    if candidates.size < 2 or tolerance == 0.0:
+    if candidates.size < 2:
         return unchanged
-    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+    scales = vertex_length_scales(vertices, topology)
+    used = scales[topology.referenced_vertices]
+    if used.min() < used.max():  # parts of different scales: each within its own tolerance
+        pairs = _pairs_within(vertices[candidates], tolerance_ratio * scales[candidates])
+    else:
+        tolerance = _tolerance(vertices, topology, tolerance_ratio)
+        if tolerance == 0.0:
+            return unchanged
+        from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
 
-    pairs = cKDTree(vertices[candidates]).query_pairs(tolerance, output_type="ndarray")
+        pairs = cKDTree(vertices[candidates]).query_pairs(tolerance, output_type="ndarray")
     if pairs.size == 0:
         return unchanged
     return _merge(vertices, topology, pairs, candidates)
+
+
+def _pairs_within(points: np.ndarray, tolerances: np.ndarray) -> np.ndarray:
+    """(P, 2) sorted index pairs of ``points`` closer than the smaller of their two ``tolerances`` (>= 0).
+
+    A mesh of parts at different scales (a part of 2 units beside one of 1e12) welds each part within its own
+    tolerance: one taken from the largest part's edges would merge a whole small part into a point (issue 29).
+    One search per octave of tolerances, each against the points of that octave and above, so that no search
+    is wider than the smaller tolerance of the pairs it finds.
+    """
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    found = [np.empty((0, 2), dtype=np.int64)]
+    if (tolerances <= 0).any():  # a part whose edges all have length 0: its exact copies only
+        found.append(cKDTree(points).query_pairs(0.0, output_type="ndarray").astype(np.int64))
+    positive = np.flatnonzero(tolerances > 0)
+    _, octave = np.frexp(tolerances[positive])
+    for c in np.unique(octave).tolist():
+        these = positive[octave == c]
+        wider = positive[octave >= c]
+        matrix = cKDTree(points[these]).sparse_distance_matrix(
+            cKDTree(points[wider]), np.ldexp(1.0, c), output_type="ndarray"
+        )
+        i, j = these[matrix["i"]], wider[matrix["j"]]
+        keep = (i != j) & (matrix["v"] <= np.minimum(tolerances[i], tolerances[j]))
+        found.append(np.column_stack([i[keep], j[keep]]))
+    pairs = np.sort(np.concatenate(found), axis=1)
+    return np.unique(pairs, axis=0)
 
 
 def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: float) -> Welding:
@@ -235,7 +278,7 @@ def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: floa
             np.column_stack([b[crossed], c_[crossed]]),
         ]
     )
-    welding = _merge(vertices, topology, pairs)
+    welding = _merge(vertices, topology, pairs, average=True)
     return welding._replace(n_cracked=welding.n_welded)
 
 
@@ -245,10 +288,16 @@ def _distance(p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def _merge(
-    vertices: np.ndarray, topology: MeshTopology, pairs: np.ndarray, candidates: np.ndarray | None = None
+    vertices: np.ndarray,
+    topology: MeshTopology,
+    pairs: np.ndarray,
+    candidates: np.ndarray | None = None,
+    *,
+    average: bool = False,
 ) -> Welding:
     """The mesh with the vertices joined by ``pairs`` ((P, 2) indices into ``candidates``, sorted vertex indices;
-    None: vertex indices) and their chains made one vertex each."""
+    None: vertex indices) and their chains made one vertex each: at its first member, or (``average``) at the
+    mean of its members."""
     from scipy.sparse import coo_matrix  # imported on use: keeps `import meshcurv` fast
     from scipy.sparse.csgraph import connected_components
 
@@ -270,7 +319,12 @@ def _merge(
     index = compact[representative]
     faces = index[topology.faces]
     welded_topology = MeshTopology._build(np.ascontiguousarray(faces), int(kept.sum()))
-    return Welding(vertices[kept], welded_topology, index, int(n_vertices - kept.sum()))
+    points = vertices[kept]
+    if average:  # the corners of detached faces, each moved its own way: their mean is the closest to the corner
+        n_kept = points.shape[0]
+        counts = np.bincount(index, minlength=n_kept)[:, None]
+        points = np.column_stack([np.bincount(index, vertices[:, k], minlength=n_kept) for k in range(3)]) / counts
+    return Welding(points, welded_topology, index, int(n_vertices - kept.sum()))
 
 
 class OneSided(NamedTuple):
@@ -426,7 +480,8 @@ def drop_closed_copies(
         The mesh's connectivity (after welding).
     tolerance_ratio : float, default: 1e-5
         A vertex of a copy lies within ``tolerance_ratio`` times the median
-        edge length of a vertex of the part it repeats.
+        edge length (the two parts' smaller one, where the mesh's components
+        differ in scale) of a vertex of the part it repeats.
 
     Returns
     -------
@@ -458,7 +513,12 @@ def drop_closed_copies(
     closed = np.flatnonzero(~open_parts & repeated_size & (sizes >= 4))
     if closed.size < 2:
         return unchanged
-    tolerance = _tolerance(vertices, topology, tolerance_ratio)
+    # each part within its own tolerance when the parts differ in scale (a small part beside a huge one is
+    # no copy of another small part a few of its edges away)
+    scales = vertex_length_scales(vertices, topology)
+    part_tolerance = np.full(n_components, _tolerance(vertices, topology, tolerance_ratio))
+    if scales[referenced].min() < scales[referenced].max():
+        part_tolerance[labels[referenced]] = tolerance_ratio * scales[referenced]
     from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
 
     members = referenced & np.isin(labels, closed)
@@ -468,7 +528,7 @@ def drop_closed_copies(
         ]
         / sizes[closed, None]
     )
-    pairs = cKDTree(centroids).query_pairs(max(tolerance, 0.0), output_type="ndarray")
+    pairs = cKDTree(centroids).query_pairs(max(float(part_tolerance[closed].max()), 0.0), output_type="ndarray")
     if pairs.size == 0:
         return unchanged
     order = np.argsort(labels, kind="stable")
@@ -484,7 +544,7 @@ def drop_closed_copies(
         part_a = order[first + starts[a] : first + starts[a + 1]]
         part_b = order[first + starts[b] : first + starts[b + 1]]
         distance, nearest = cKDTree(vertices[part_a]).query(vertices[part_b])
-        if np.all(distance <= tolerance) and np.unique(nearest).size == nearest.size:
+        if np.all(distance <= min(part_tolerance[a], part_tolerance[b])) and np.unique(nearest).size == nearest.size:
             representative[part_b] = part_a[nearest]
             copy_of[b] = a
     if not copy_of:
