@@ -7,8 +7,8 @@ the rest of the orientation's graph; :func:`meshcurv._pointcloud_normals.outward
 its own centroid, which lies in the hole: its normals, pointing into the hole, give a negative flux. Neither the
 winding number at its points (the band adds little to it at its own points) nor the check of fragments beside a
 much larger part (``undecided_fragments``: the band is a third of the torus, its flux that of a closed part) caught
-it. A part that the rest of the cloud wraps and whose side the winding number does not confirm now has no side:
-NaN. The truth: the analytic torus's and spheres' outward normals.
+it. A part beside another that the rest of the cloud wraps and whose side the winding number does not confirm now
+has no side: NaN. The truth: the analytic torus's and spheres' outward normals.
 """
 
 from __future__ import annotations
@@ -25,8 +25,10 @@ from meshcurv.pointcloud import point_cloud_curvatures
 
 
 def _fragments(points, normals, labels):
-    """:func:`undecided_fragments` of the parts ``labels`` of the cloud ``points`` with oriented ``normals``."""
+    """:func:`undecided_fragments` of the parts ``labels`` of the cloud ``points`` with oriented ``normals``; the
+    parts must be beside each other (a neighbour of one's point on the other: what the check asks for)."""
     distances, indices = knn(cKDTree(points), points)
+    assert (labels[indices] != labels[:, None]).any(axis=1).any()
     return undecided_fragments(points, normals, labels, local_spacing(distances) ** 2, indices)
 
 
@@ -48,13 +50,14 @@ def test_a_band_about_the_hole_turned_inward_is_undecided():
 
 
 def test_closed_parts_keep_their_sides():
-    # two spheres 1 apart, and a sphere in a cavity of a larger one (its normals into the cavity, as for meshes)
-    a, b = shapes.icosphere(4, 1.0), shapes.icosphere(4, 1.0, center=(3.0, 0.0, 0.0))
+    # two spheres 0.04 apart (a spacing about 0.07), and a sphere in a cavity 0.1 wider (its normals into the
+    # cavity, as for meshes)
+    a, b = shapes.icosphere(16, 1.0), shapes.icosphere(16, 1.0, center=(2.04, 0.0, 0.0))
     points = np.concatenate([a.vertices, b.vertices])
     normals = np.concatenate([a.normals, b.normals])
     labels = np.repeat([0, 1], a.vertices.shape[0])
     assert not _fragments(points, normals, labels).any()
-    outer, inner = shapes.icosphere(5, 3.0), shapes.icosphere(4, 1.0)
+    outer, inner = shapes.icosphere(18, 1.1), shapes.icosphere(16, 1.0)
     points = np.concatenate([outer.vertices, inner.vertices])
     normals = np.concatenate([outer.normals, -inner.normals])
     labels = np.repeat([0, 1], [outer.vertices.shape[0], inner.vertices.shape[0]])

@@ -99,7 +99,7 @@ FRAGMENT_SHARE = 0.25
 #: (:func:`undecided_fragments`).
 FRAGMENT_FLUX = 0.5
 
-#: A part of several (after :func:`winding_sides`) whose side the rest of the cloud settles: the mean winding number
+#: A part beside another (after :func:`winding_sides`) whose side the rest of the cloud settles: the mean winding number
 #: of the rest at its points at least this far from 0 (it wraps the part: a piece of a larger closed surface, as
 #: on a closed surface about a hole in it, 1/2) ...
 FRAGMENT_WRAPPED = 0.25
@@ -908,48 +908,56 @@ def undecided_fragments(
     beside = np.zeros(n_labels, dtype=bool)  # a neighbour of one of its points on a part that much larger
     beside[labels[(area[labels[indices]] * FRAGMENT_SHARE > area[labels][:, None]).any(axis=1)]] = True
     return ((flux <= FRAGMENT_FLUX * spread) & beside & (area > 0))[labels] | unconfirmed_parts(
-        points, normals, labels, areas, tree
+        points, normals, labels, areas, indices, tree
     )
 
 
 def unconfirmed_parts(
-    points: np.ndarray, normals: np.ndarray, labels: np.ndarray, areas: np.ndarray, tree=None
+    points: np.ndarray, normals: np.ndarray, labels: np.ndarray, areas: np.ndarray, indices: np.ndarray, tree=None
 ) -> np.ndarray:
-    """(N,) bool: the points of parts that the rest of the cloud wraps and whose side it does not confirm.
+    """(N,) bool: the points of parts beside another that the rest of the cloud wraps and whose side it does not
+    confirm.
 
     A part's side comes from its own shape (:func:`outward_signs`), right on a closed part. On a piece of a larger
     closed surface that the orientation's graph cut off the rest (a voxel staircase's steps carry no sign), the
     flux about the piece's centroid can be as clear as a closed part's and wrong: the inner wall of a torus, a band
     about the hole, has its centroid in the hole, and its normals, pointing into the hole, give a negative flux:
     turned, the whole band is inside out (``benchmarks/fuzz_api.py --point-clouds``, voxel clouds). The winding
-    number of the whole cloud at the part's points (:func:`winding_numbers`) is the sum of the part's own, ``o``,
+    number of the whole cloud at the points of a part beside another (a neighbour of one of its points, of
+    ``indices``, on another part) is the sum of the part's own, ``o``,
     and the rest's, ``r``: ``r + o`` as it is, ``r - o`` turned, ``1/2`` on a consistent closed cloud. Where the
     rest wraps the part (mean ``|r|`` at least :data:`FRAGMENT_WRAPPED`), its side is confirmed only when ``r + o``
     is closer to 1/2 in the mean than ``r - o`` by :data:`FRAGMENT_MARGIN` (the band: ``o`` near 0 at its own
     points, ``r`` near 1/2 about the hole: either side fits, and the side is undecided). A closed part has ``o``
-    1/2 (or -1/2 as a cavity's wall): confirmed; a part alone (``r`` 0) keeps its side. The arguments are those of
-    :func:`undecided_fragments` (the tree built here when the cloud has two parts or more and none is given).
+    1/2 (or -1/2 as a cavity's wall): confirmed; a part alone (``r`` 0) keeps its side, and so does a part
+    beside no other (two flat plates several spacings apart: the other adds up to 1/2 near a wide one, as the rest
+    of a closed surface about a hole does). The arguments are those of :func:`undecided_fragments` (the tree built
+    here when a part is beside another and none is given).
     """
     n = points.shape[0]
     unsure = np.zeros(n, dtype=bool)
     usable = areas > 0
     candidates = np.flatnonzero(usable)
-    if candidates.size < 2 or np.unique(labels[candidates]).size < 2:
+    # the parts beside another: a usable neighbour of one of their usable points on another part
+    beside = np.zeros(int(labels.max()) + 1 if labels.size else 0, dtype=bool)
+    near = indices[candidates]
+    beside[labels[candidates[((labels[near] != labels[candidates][:, None]) & usable[near]).any(axis=1)]]] = True
+    if not beside.any():
         return unsure
     if tree is None:
         from scipy.spatial import cKDTree
 
         tree = cKDTree(points)
-    queries = _part_queries(candidates, labels)
+    queries = _part_queries(candidates[beside[labels[candidates]]], labels)
     sources = _evenly(candidates, WINDING_SOURCES)
     total, own = _winding(points, normals, areas, usable, tree, points[queries], queries, sources, labels)
     part = labels[queries]
-    count = np.maximum(np.bincount(part, minlength=int(labels.max()) + 1), 1)
+    count = np.maximum(np.bincount(part, minlength=beside.size), 1)
     own = np.bincount(part, weights=own, minlength=count.size) / count
     rest = np.bincount(part, weights=total, minlength=count.size) / count - own
     away = rest - 0.5
     confirmed = np.abs(away - own) - np.abs(away + own) >= FRAGMENT_MARGIN
-    unsure[candidates] = ((np.abs(rest) >= FRAGMENT_WRAPPED) & ~confirmed)[labels[candidates]]
+    unsure[candidates] = (beside & (np.abs(rest) >= FRAGMENT_WRAPPED) & ~confirmed)[labels[candidates]]
     return unsure
 
 
