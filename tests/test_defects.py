@@ -14,6 +14,7 @@ from meshcurv.defects import (
     INVALID_REASONS,
     NEEDLE_ANGLE,
     NEEDLE_REACH,
+    POINT_CLOUD_REASONS,
     UNDEFINED,
     defect_codes,
     needle_vertices,
@@ -59,7 +60,9 @@ def test_each_defect_reads_its_own_reason():
     assert all(INVALID_REASONS[defect.code] == defect.reason for defect in DEFECTS)
     assert INVALID_REASONS[0] == "valid" and UNDEFINED == len(INVALID_REASONS) - 1
     assert INVALID_REASONS[UNDEFINED].startswith("estimate undefined")
-    assert sorted(defect.code for defect in DEFECTS) == list(range(1, len(DEFECTS) + 1))
+    # every code once: the defects of meshes, the point clouds' reasons (8-11) and the undefined estimate
+    codes = [defect.code for defect in DEFECTS] + list(range(8, 8 + len(POINT_CLOUD_REASONS))) + [UNDEFINED]
+    assert sorted(codes) == list(range(1, len(INVALID_REASONS)))
 
 
 def test_a_needle_on_the_boundary_is_a_needle_not_a_boundary_vertex():

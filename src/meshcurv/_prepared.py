@@ -23,7 +23,7 @@ import numpy as np
 from ._adapters import mesh_arrays
 from ._locality import local_topology
 from ._validation import as_mesh, as_vertices, check_choice
-from .defects import BOUNDARY, VertexDefects, _defect_codes, _needle_vertices, _scale_edges
+from .defects import BOUNDARY, FRAGMENT, VertexDefects, _defect_codes, _needle_vertices, _scale_edges
 from .errors import InvalidOptionError
 from ._geometry import (
     DEGENERATE_AREA_RATIO,
@@ -164,14 +164,17 @@ class PreparedMesh:
         self.topology._release_side_twins()  # the bow-tie vertices are found: no estimator reads the twins
         return codes
 
-    def defects(self, *, boundary: bool = False) -> VertexDefects:
-        """The defects as a method sees them: ``boundary=True`` for the methods that keep boundary vertices."""
+    def defects(self, *, boundary: bool = False, fragments: bool = False) -> VertexDefects:
+        """The defects as a method sees them: ``boundary=True`` for the methods that keep boundary vertices,
+        ``fragments=True`` for those that keep the vertices of parts with no interior vertex (fits over
+        Euclidean neighbours: :data:`meshcurv.defects.FRAGMENT`)."""
         codes, counts = self._codes
-        return VertexDefects(codes, counts, frozenset({BOUNDARY}) if boundary else frozenset())
+        tolerated = ({BOUNDARY} if boundary else set()) | ({FRAGMENT} if fragments else set())
+        return VertexDefects(codes, counts, frozenset(tolerated))
 
-    def start(self, *, boundary: bool = False) -> tuple[VertexDefects, np.ndarray]:
+    def start(self, *, boundary: bool = False, fragments: bool = False) -> tuple[VertexDefects, np.ndarray]:
         """``(defects, valid)``: the defects, and the vertices with neither a defect nor a missing normal."""
-        defects = self.defects(boundary=boundary)
+        defects = self.defects(boundary=boundary, fragments=fragments)
         valid = ~defects.invalid_vertices & np.isfinite(self.vertex_normals).all(axis=1)
         return defects, valid
 

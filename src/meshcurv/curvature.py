@@ -351,7 +351,7 @@ def _finished(mesh, estimator, result: CurvatureResult, problems: list, found: d
     diagnosis = mesh_diagnosis(
         points, topology, mesh.n_flipped, mesh.length_scales, n_needle_vertices=int(mesh.needles.sum())
     )
-    reasons = mesh.defects(boundary=estimator.boundary).reasons(result.valid)
+    reasons = mesh.defects(boundary=estimator.boundary, fragments=estimator.fragments).reasons(result.valid)
     parameters = {
         **result.parameters,
         **found,

@@ -34,6 +34,7 @@ __all__ = [
     "INVALID_REASONS",
     "UNDEFINED",
     "BOUNDARY",
+    "FRAGMENT",
     "VertexDefects",
     "NEEDLE",
     "NEEDLE_ANGLE",
@@ -95,6 +96,14 @@ DEFECTS = (
     ),
     Defect(5, "degenerate_faces", "corner of a zero-area face", "zero-area faces"),
     Defect(
+        12,
+        "fragment_vertices",
+        "on a part with no interior vertex (isolated faces or a strip of faces: no vertex there has a ring of faces "
+        "around it)",
+        "vertices on parts with no interior vertex (isolated faces or strips: a triangle soup whose faces do not "
+        "touch; weld it, or measure its vertices with point_cloud_curvatures)",
+    ),
+    Defect(
         6,
         "boundary_edges",
         "on a boundary edge (this method needs a closed neighbourhood)",
@@ -108,6 +117,10 @@ BOUNDARY = 6
 #: The code of a needle vertex and of the corners of its faces (:func:`needle_vertices`).
 NEEDLE = 7
 
+#: The code of a vertex on a part with no interior vertex (:func:`_fragment_vertices`): a defect for the
+#: methods that walk the surface, not for the fits over Euclidean neighbours.
+FRAGMENT = 12
+
 #: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the
 #: defects of meshes: the codes after theirs (8, 9, 10, 11).
 POINT_CLOUD_REASONS = (
@@ -119,20 +132,24 @@ POINT_CLOUD_REASONS = (
     "sharper than the ball, the other side of a thin part, or noise)",
 )
 
-#: The code of a vertex invalid for no defect of the mesh: its estimate itself is undefined.
-UNDEFINED = len(DEFECTS) + len(POINT_CLOUD_REASONS) + 1
-
-#: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``.
+#: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``: the defects of
+#: meshes (1-7), the reasons of point clouds (8-11), the defects of meshes found since (12), then an estimate
+#: undefined (:data:`UNDEFINED`, the last).
 INVALID_REASONS = (
     "valid",
-    *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code)),
+    *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code) if defect.code <= NEEDLE),
     *POINT_CLOUD_REASONS,
+    *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code) if defect.code > NEEDLE),
     "estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)",
 )
+
+#: The code of a vertex invalid for no defect of the mesh: its estimate itself is undefined.
+UNDEFINED = len(INVALID_REASONS) - 1
 
 #: The order of the phrases in the warning.
 _WARNING_ORDER = (
     "boundary_edges",
+    "fragment_vertices",
     "nonmanifold_edges",
     "bowtie_vertices",
     "inconsistent_edges",
@@ -414,6 +431,7 @@ def _defect_codes(
     # None: no vertex has the defect (no pass over the vertices for it; a clean mesh has none at all)
     nonmanifold = _edge_ends(topology, topology.nonmanifold_edges)
     bowties = topology.bowtie_vertices if nonmanifold is None else topology.bowtie_vertices & ~nonmanifold
+    fragments = _fragment_vertices(topology)
     corners = None
     if degenerate.any():
         corners = np.zeros(topology.n_vertices, dtype=bool)
@@ -425,6 +443,7 @@ def _defect_codes(
         "inconsistent_edges": _edge_ends(topology, topology.inconsistent_edges),
         "degenerate_faces": corners,
         "needle_vertices": needle_corners,
+        "fragment_vertices": fragments,
         "boundary_edges": _edge_ends(topology, topology.boundary_edges),
     }
     codes = np.zeros(topology.n_vertices, dtype=np.int8)
@@ -439,8 +458,29 @@ def _defect_codes(
         "degenerate_faces": int(degenerate.sum()),
         "needle_vertices": 0 if needles is None else int(needles.sum()),
         "unreferenced_vertices": int((~topology.referenced_vertices).sum()),
+        "fragment_vertices": 0 if fragments is None else int(fragments.sum()),
     }
     return codes, counts
+
+
+def _fragment_vertices(topology: MeshTopology) -> np.ndarray | None:
+    """(V,) bool: the vertices of the components none of whose vertices is interior (off every boundary edge),
+    or None when there are none.
+
+    Such a part is a face alone or a strip of faces: no vertex of it has a ring of faces around it, and the
+    methods that walk the surface measure it as flat whatever it samples (issue 29: a hemisphere whose faces
+    were all detached by 0.05 edge lengths, beyond the weld across cracks, came out with H = 0 at every vertex
+    of rusinkiewicz and normal_cycle_ball, valid, for 1). The fits over Euclidean neighbours (``quadric``) see
+    the other parts and are not concerned (:meth:`VertexDefects` ``tolerated``).
+    """
+    if not topology.boundary_edges.any():  # a closed mesh: every vertex interior (one pass over the edges)
+        return None
+    n_components, labels = topology.vertex_components
+    interior = topology.referenced_vertices & ~topology.boundary_vertices
+    has_interior = np.zeros(n_components, dtype=bool)
+    has_interior[labels[interior]] = True
+    fragments = topology.referenced_vertices & ~has_interior[np.maximum(labels, 0)]
+    return fragments if fragments.any() else None
 
 
 def _edge_ends(topology: MeshTopology, edge_mask: np.ndarray) -> np.ndarray | None:

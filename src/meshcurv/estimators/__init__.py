@@ -43,6 +43,10 @@ class Estimator:
     boundary : bool
         Whether its boundary vertices can be valid (a boundary is not a defect
         for it: :data:`meshcurv.defects.BOUNDARY`).
+    fragments : bool
+        Whether the vertices of a part with no interior vertex (isolated faces,
+        strips) can be valid: its fits take Euclidean neighbours, the other
+        parts' too (:data:`meshcurv.defects.FRAGMENT`).
     """
 
     name: str
@@ -52,6 +56,7 @@ class Estimator:
     stages: tuple
     radius_warning_edges: float | None = None
     boundary: bool = False
+    fragments: bool = False
     multiscale: Callable | None = None
 
 
@@ -89,6 +94,7 @@ ESTIMATORS: dict[str, Estimator] = {
         stages=quadric.STAGES,
         radius_warning_edges=quadric.RADIUS_WARNING_EDGES,
         boundary=True,
+        fragments=True,
     ),
     "rusinkiewicz": Estimator(
         name="rusinkiewicz",

@@ -99,7 +99,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     else:
         groups = [(_resolve_radius(radius, mesh), None)]
     normals = mesh.vertex_normals
-    defects, valid = mesh.start(boundary=True)
+    defects, valid = mesh.start(boundary=True, fragments=True)  # its balls are Euclidean: parts alike
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     facing = np.where(valid[:, None], normals, np.nan)
     referenced = topology.referenced_vertices
