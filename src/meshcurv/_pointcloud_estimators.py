@@ -464,16 +464,59 @@ def beside_unresolved(points, normals, k_min, k_max, radii, resolved, tree) -> n
     the exact one for both estimators, steady over a larger ball, each neighbour's alike). ``tree``: a
     :class:`scipy.spatial.cKDTree` of ``points``.
     """
-    n = points.shape[0]
-    out = np.zeros(n, dtype=bool)
     with np.errstate(invalid="ignore"):
         turn = radii * np.maximum(np.abs(k_min), np.abs(k_max))
-    candidates = np.flatnonzero(resolved & (turn > UNRESOLVED_TURN))
-    for chunk, safe, _, member, cosine in _balls(points, normals, radii, candidates, tree, MAX_BALL_POINTS):
+    return _unresolved_balls(
+        points, normals, radii, resolved, resolved & (turn > UNRESOLVED_TURN), tree, UNRESOLVED_SHARE
+    )
+
+
+def _unresolved_balls(points, normals, radii, resolved, candidates, tree, share: float) -> np.ndarray:
+    """(N,) bool: the ``candidates`` (N,) bool more than ``share`` of whose ball's own side (the
+    :data:`MAX_BALL_POINTS` nearest within ``radii`` (N,) whose ``normals`` are within 90 degrees of the centre's)
+    is not ``resolved`` (N,) bool."""
+    out = np.zeros(points.shape[0], dtype=bool)
+    for chunk, safe, _, member, cosine in _balls(
+        points, normals, radii, np.flatnonzero(candidates), tree, MAX_BALL_POINTS
+    ):
         own = member & (cosine > 0)
         unresolved = (own & ~resolved[safe]).sum(axis=1)
-        out[chunk] = unresolved > UNRESOLVED_SHARE * np.maximum(own.sum(axis=1), 1)
+        out[chunk] = unresolved > share * np.maximum(own.sum(axis=1), 1)
     return out
+
+
+#: On a staircase (a lattice of three axes), a resolved estimate whose ball's own side holds more than this share of
+#: points without a resolved estimate is unsteady (:func:`amid_unresolved`).
+LATTICE_UNRESOLVED_SHARE = 0.7
+
+
+def amid_unresolved(points, normals, radii, resolved, tree, lattice: Lattice) -> np.ndarray:
+    """(N,) bool: on a staircase (a ``lattice`` of three axes), the ``resolved`` (N,) points more than
+    :data:`LATTICE_UNRESOLVED_SHARE` of whose ball's own side (the points within ``radii`` (N,) whose ``normals``
+    are within 90 degrees of the centre's, the :data:`MAX_BALL_POINTS` nearest) have no resolved estimate.
+
+    On a voxel surface the staircase biases neighbouring estimates alike (its steps are coherent, no noise that
+    averages out): where the checks left most of a ball unresolved (treads, single steps, facets, estimates that a
+    larger ball or the neighbours do not reproduce), the staircase is what the estimator sees there, and the
+    estimates that passed are a band of the same region, biased alike (the ring left on the flat faces of voxel
+    ellipsoids 10-12 voxels thick, whose normal fits shrink to their half thickness:
+    ``tests/test_pointcloud_staircase_regions.py``). The converse of :func:`alone` over the whole ball, on a
+    staircase only (elsewhere, under noise, neighbours fail at random). ``tree``: a
+    :class:`scipy.spatial.cKDTree` of ``points``.
+    """
+    if not lattice.steps.all():
+        return np.zeros(points.shape[0], dtype=bool)
+    return _unresolved_balls(points, normals, radii, resolved, resolved, tree, LATTICE_UNRESOLVED_SHARE)
+
+
+def amid_unresolved_problem(flagged: np.ndarray) -> list[str]:
+    """The phrase of the call's warning for the ``flagged`` (N,) points of :func:`amid_unresolved`; none when none."""
+    return _nan_phrase(
+        flagged,
+        f"more than {LATTICE_UNRESOLVED_SHARE:g} of the ball's own side has no resolved estimate on a voxel "
+        "surface read as a cloud (its staircase is what the estimator sees there; the estimates that passed are "
+        "biased alike)",
+    )
 
 
 def _balls(points, normals, radii, centres, tree, k):

@@ -302,6 +302,14 @@ NOISY_PCA = 0.1
 #: See :data:`NOISY_PCA`.
 NOISY_SHRINK = 0.5
 
+#: On a staircase (a voxel surface read as a cloud), under a given radius below the default one, an estimate of
+#: ``corrected_measures`` whose normal fit shrank (its ball held the other side) and turns the normal by less than
+#: this many radians over the fit's ball (``radius |k|``) is unsteady: the other face of a thin part shrank it, and
+#: the normals carry the steps' error of the smaller fits, which the default radius averages out and a smaller one
+#: does not. A small part's fits shrink for its far side and turn the normal by about a radian; there the curvature
+#: dominates that error (``tests/test_pointcloud_staircase_regions.py``).
+STAIRCASE_FIT_TURN = 0.75
+
 #: Relative round-off of a radius shrunk in steps (``SHRINK ** 2`` is ``0.5000000000000001``): a fit two steps down
 #: is :data:`NOISY_SHRINK` times the radius asked for.
 SHRINK_ROUNDING = 1e-9
@@ -1045,7 +1053,9 @@ def _compute(points, given, radius, method, search=None):
     compiled = numba_kernels("pointcloud") is not None
     # (a staircase: every coordinate on a grid, as marching cubes over a mask puts them; not a range image's two)
     lattice = _normals.read_lattice(points, median, usable=usable, neighbours=indices)
-    on_lattice = method == "jets" and bool(lattice.steps.all())
+    staircase = bool(lattice.steps.all())
+    on_lattice = method == "jets" and staircase
+    below = 0  # points of a staircase whose normal fits shrank, under a given radius below the default one
     for group_radius, group_spacing, members, floor in groups:
         details: dict[str, np.ndarray] = {}
         seen = _class_noise(noise, median, group_spacing)  # the noise in this class's own spacings
@@ -1156,6 +1166,7 @@ def _compute(points, given, radius, method, search=None):
             one_sided[near] = part_one_sided
         if "radii" in details:
             fitted_radii = details["radii"][part_members]
+            fitted_normal_radii = np.where(np.isnan(fitted_radii), 0.0, fitted_radii)  # (no fit: shrank to none)
             shrunk += int((fitted_radii < asked).sum())
             two_sided += int(np.isnan(fitted_radii).sum())
             two_sided_mask[members] = np.isnan(fitted_radii)
@@ -1171,6 +1182,22 @@ def _compute(points, given, radius, method, search=None):
             k_min[members[sparse]] = k_max[members[sparse]] = np.nan
             unsteady[members] |= noisy_ball
             problems.extend([_estimators.small_ball_problem(radius, needed)] if noisy_ball else [])
+            if staircase and method == "corrected_measures" and given is None and radius < needed:
+                # on a staircase, normals fitted over balls that the other face of a thin part shrank (where they
+                # turn the normal by little: not the far side of a small part) carry the steps' error of those
+                # smaller balls, which only the default radius averages out
+                with np.errstate(invalid="ignore"):
+                    turn = fitted_normal_radii * np.maximum(np.abs(k_min[members]), np.abs(k_max[members]))
+                held = members[(fitted_normal_radii < normal_radius) & ~(turn >= STAIRCASE_FIT_TURN)]
+                unsteady[held] = True
+                below += held.size
+    if below:
+        problems.append(
+            f"at {below} points of a voxel surface read as a cloud the normals were fitted over balls shrunk by the "
+            f"other side of a thin part (turning the normal by less than {STAIRCASE_FIT_TURN:g} rad), and the given "
+            f"radius {radius:g} is below the default one: the staircase's error of those normals dominates the "
+            "measures (NaN; the default radius averages it out)"
+        )
     if method == "jets" or given is None:
         parameters["shrunk"] = shrunk / max(centres.size, 1)
     if method == "jets" and radius is not None and shrunk:
@@ -1256,6 +1283,11 @@ def _compute(points, given, radius, method, search=None):
     problems.extend(found)
     reason[tread] = _UNSTEADY
     valid &= ~tread
+    # ... and amid a region of the staircase that the checks above left unresolved
+    amid_staircase = _estimators.amid_unresolved(points, out_normals, balls, valid & ~doubtful, tree, lattice)
+    problems.extend(_estimators.amid_unresolved_problem(amid_staircase))
+    reason[amid_staircase] = _UNSTEADY
+    valid &= ~amid_staircase
     # an estimate none of whose nearest neighbours has one: alone in a region the estimator does not resolve
     lone = _estimators.alone(valid & ~doubtful, indices)
     problems.extend(_estimators.alone_problem(lone))
