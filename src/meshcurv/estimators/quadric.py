@@ -29,10 +29,11 @@ number of rings, keeps its size in length units across resolutions.
 A fit needs at least six points with non-zero weight, spread enough for a
 quadric: vertices with fewer (or a degenerate set, for example collinear
 points) are NaN with ``valid=False`` (use a larger ``radius``). Boundary vertices are fitted on their one-sided
-neighbourhood and kept. The higher terms of a one-sided fit are extrapolated to the vertex, where a small
-noise moves them far: a boundary vertex whose jet departs from a quadric fitted on the same ball
-(:data:`RIM_DEGREE`, :data:`RIM_AGREEMENT`) takes the quadric's curvatures, and one whose ball's points are
-too little spread for a stable quadric (:data:`RIM_MIN_SPREAD`) is NaN with ``valid=False``.
+neighbourhood and kept. The higher terms of a jet are poorly held by the points of a one-sided ball, or of
+a ball of few or irregularly placed points, where a noise of a small fraction of an edge length moves them
+far: a vertex whose jet departs from a quadric fitted on the same ball (:data:`STEADY_DEGREE`,
+:data:`STEADY_AGREEMENT`) takes the quadric's curvatures, and one whose ball's points are too little spread
+for a stable quadric (:data:`STEADY_MIN_SPREAD`) is NaN with ``valid=False``.
 
 References
 ----------
@@ -50,7 +51,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import principal_from_shape_operator
-from ..jets import AWAY_FRACTION, MIN_POINTS, _fit_jets, shape_operators
+from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, _fit_jets, shape_operators
 from ..radius import _component_radii, _resolve_radius, _vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
@@ -62,25 +63,27 @@ STAGES = ("compute normals", "fit jets", "retrieve curvatures")
 #: with too few points): a degree-4 jet needs 15 points, which a ball of one edge length rarely holds.
 RADIUS_WARNING_EDGES = 1.0
 
-#: The degree of the steadier fit of boundary vertices. Their balls are one-sided: a jet of degree 4 (or 3)
-#: extrapolates its higher terms to the vertex at the edge of the points it fits, where a noise of a hundredth
+#: The degree of the steadier fit that every jet is checked against. A jet of degree 4 (or 3) holds its
+#: higher terms on few points: on a one-sided ball (a boundary vertex) it extrapolates them to the vertex,
+#: and on a ball of few or irregularly placed points they are poorly conditioned; there a noise of a hundredth
 #: of an edge length (faces detached and welded across their cracks, a scan) moved the mean curvature by
-#: several times the shape's (issue 29). A quadric is stable there, but biased on clean meshes: it is taken
-#: where the jet departs from it (:data:`RIM_AGREEMENT`; ``benchmarks/rim_fits.md``).
-RIM_DEGREE = 2
+#: several times the shape's (issue 29). A quadric is stable, but biased on clean meshes: it is taken where
+#: the jet departs from it (:data:`STEADY_AGREEMENT`; ``benchmarks/rim_fits.md``, ``benchmarks/noisy_jets.md``).
+STEADY_DEGREE = 2
 
-#: The smallest spread (:data:`meshcurv.jets.MIN_SPREAD`) of a boundary vertex's ball for its quadric: below
-#: it the vertex is NaN with ``valid=False``. A one-sided ball of six points in a sliver (an irregular mesh's
+#: The smallest spread (:data:`meshcurv.jets.MIN_SPREAD`) of a vertex's ball for its quadric: below it the
+#: vertex is NaN with ``valid=False``. A one-sided ball of six points in a sliver (an irregular mesh's
 #: rim) holds a spread of a few 1e-7 and amplifies a noise of a thousandth of an edge length into errors of
-#: several times the curvature, where the rims of the benchmark meshes hold 1e-5 and more
+#: several times the curvature, where the balls of the benchmark meshes hold 1e-5 and more
 #: (``benchmarks/rim_fits.md``).
-RIM_MIN_SPREAD = 1e-5
+STEADY_MIN_SPREAD = 1e-5
 
-#: A boundary vertex keeps its jet (of degree 4, or 3) while its principal curvatures are within this over the
-#: radius of its quadric's (:data:`RIM_DEGREE`), and takes the quadric's beyond: on clean meshes the two differ
-#: by the quadric's bias (about ``(r k)^2 / r``), under noise the jet's extrapolated terms by several times
-#: the curvature. 0.1 and 0.2 kept more of the noisy jets (``benchmarks/rim_fits.md``).
-RIM_AGREEMENT = 0.05
+#: A vertex keeps its jet (of degree 4, or 3) while its principal curvatures are within this over the radius
+#: of its quadric's (:data:`STEADY_DEGREE`), and takes the quadric's beyond: on clean meshes the two differ
+#: by the quadric's bias (about ``(r k)^2 / r``), under noise the jet's poorly held terms by several times
+#: the curvature. 0.1 and 0.2 kept more of the noisy jets (``benchmarks/rim_fits.md``,
+#: ``benchmarks/noisy_jets.md``).
+STEADY_AGREEMENT = 0.05
 
 
 def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
@@ -103,6 +106,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     facing = np.where(valid[:, None], normals, np.nan)
     referenced = topology.referenced_vertices
+    rim = topology.boundary_vertices
 
     stages.start("fit jets")
     n = vertices.shape[0]
@@ -110,7 +114,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     fitted = np.full((n, 3), np.nan)
     coefficients = np.full((n, 6), np.nan)
     away = np.zeros(n)
-    rim = topology.boundary_vertices
     for group_radius, members in groups:
         unit = group_radius if group_radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
         details: dict = {}
@@ -121,9 +124,11 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         rows = slice(None) if members is None else members
         six[rows], fitted[rows], coefficients[rows] = part_six[rows], part_fitted[rows], found[rows]
         away[rows] = np.nan_to_num(details["away"][rows])
-        edge_rows = np.flatnonzero(rim) if members is None else members[rim[members]]
-        if edge_rows.size:
-            _steady_rim(vertices, start, unit, edge_rows, referenced, facing, (six, fitted, coefficients))
+        for steady_degree, side in ((STEADY_DEGREE, rim), (DEGREE, referenced & ~rim)):
+            rows_fitted = np.flatnonzero(side) if members is None else members[side[members]]
+            if rows_fitted.size:
+                steady = (vertices, start, unit, rows_fitted, steady_degree)
+                _steady_fits(steady, referenced, facing, (six, fitted, coefficients))
 
     stages.start("retrieve curvatures")
     fitted = np.where(np.isfinite(fitted).all(axis=1, keepdims=True), fitted, normals)
@@ -169,31 +174,33 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     )
 
 
-def _steady_rim(vertices, start, unit: float, rows: np.ndarray, referenced, facing, fields: tuple) -> None:
-    """The fits of the boundary vertices ``rows`` in ``fields`` (``six, fitted, coefficients``, changed in place)
-    made stable: a quadric (:data:`RIM_DEGREE`) where the jet differs from it by more than
-    :data:`RIM_AGREEMENT` over the radius ``unit``, NaN where the quadric's points are too little spread
-    (:data:`RIM_MIN_SPREAD`)."""
+def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
+    """The fits in ``fields`` (``six, fitted, coefficients``, changed in place) made stable at the vertices
+    ``rows`` of ``steady = (vertices, start, unit, rows, degree)``: the fit of at most ``degree`` over the
+    same ball whose points are spread by :data:`STEADY_MIN_SPREAD` (:data:`STEADY_DEGREE` at the rim,
+    :data:`meshcurv.jets.DEGREE` inside) where the jet differs from it by more than :data:`STEADY_AGREEMENT`
+    over the radius ``unit``; NaN where no degree is spread enough."""
+    vertices, start, unit, rows, degree = steady
     six, fitted, coefficients = fields
     found, frame, _ = _fit_jets(
         vertices,
         start,
         unit,
-        degree=RIM_DEGREE,
+        degree=degree,
         centres=rows,
         neighbours=referenced,
         facing=facing,
-        min_spread=RIM_MIN_SPREAD,
+        min_spread=STEADY_MIN_SPREAD,
     )
     low_six, low_fitted = shape_operators(found[rows], tuple(axis[rows] for axis in frame), unit)
-    steady = np.isfinite(found[rows]).all(axis=1)
+    spread = np.isfinite(found[rows]).all(axis=1)
     high = np.isfinite(coefficients[rows]).all(axis=1)
-    both = steady & high
+    both = spread & high
     apart = np.full(rows.size, np.inf)
     if both.any():
         high_k = principal_from_shape_operator(six[rows][both], fitted[rows][both])[:2]
         low_k = principal_from_shape_operator(low_six[both], low_fitted[both])[:2]
         apart[both] = unit * np.maximum(np.abs(high_k[0] - low_k[0]), np.abs(high_k[1] - low_k[1]))
-    swap = steady & ~(apart <= RIM_AGREEMENT)
+    swap = spread & ~(apart <= STEADY_AGREEMENT)
     six[rows[swap]], fitted[rows[swap]], coefficients[rows[swap]] = low_six[swap], low_fitted[swap], found[rows][swap]
-    coefficients[rows[~steady]] = np.nan
+    coefficients[rows[~spread]] = np.nan
