@@ -284,19 +284,31 @@ def face_in_ball_ratios(corners: np.ndarray, centers: np.ndarray, radius: float)
 
 
 def segment_in_ball_lengths(starts: np.ndarray, ends: np.ndarray, centers: np.ndarray, radius: float) -> np.ndarray:
-    """(P,) exact length of each segment ``[start, end]`` inside the ball around its centre."""
-    d = ends - starts
-    f = starts - centers
-    a = np.einsum("ij,ij->i", d, d)
-    b = 2 * np.einsum("ij,ij->i", d, f)
-    c = np.einsum("ij,ij->i", f, f) - radius * radius
-    disc = b * b - 4 * a * c
-    root = np.sqrt(np.maximum(disc, 0.0))
+    """(P,) exact length of each segment ``[start, end]`` inside the ball around its centre.
+
+    From the end nearer the centre: the distance ``t`` along the segment to the
+    point closest to the centre, that point's squared distance ``h2`` to the
+    centre (the point itself, not ``|f|^2 - t^2``), then the chord
+    ``[t - s, t + s]`` with ``s = sqrt(r^2 - h2)`` clipped to the segment. The
+    quadratic formula ``b^2 - 4ac`` cancels on a segment far longer than the
+    ball (a spike's edge through a ball of one edge length: every digit lost,
+    so that each backend's rounding gave its own chord; issue 29). The
+    operations of the compiled ``_segment_length``, in the same order.
+    """
+    first = _columns(np.asarray(starts, dtype=np.float64) - centers)
+    second = _columns(np.asarray(ends, dtype=np.float64) - centers)
+    swap = _squared(*second) < _squared(*first)
+    near = tuple(np.where(swap, b, a) for a, b in zip(first, second))
+    d = tuple(np.where(swap, a, b) - p for a, b, p in zip(first, second, near))
+    length2 = _squared(*d)
     with np.errstate(invalid="ignore", divide="ignore"):
-        t0 = np.clip((-b - root) / (2 * a), 0.0, 1.0)
-        t1 = np.clip((-b + root) / (2 * a), 0.0, 1.0)
-    inside = np.where((disc > 0) & (a > 0), t1 - t0, 0.0)
-    return inside * np.sqrt(a)
+        length = np.sqrt(length2)
+        along = -((near[0] * d[0] + near[1] * d[1]) + near[2] * d[2]) / length
+        share = along / length
+        h2 = _squared(*(p + share * q for p, q in zip(near, d)))
+        half = np.sqrt(np.maximum(radius * radius - h2, 0.0))
+        inside = np.minimum(along + half, length) - np.maximum(along - half, 0.0)
+    return np.where((length2 > 0) & (h2 < radius * radius) & (inside > 0), inside, 0.0)
 
 
 def _size_groups(reach: np.ndarray, radius: float) -> list[np.ndarray | slice]:

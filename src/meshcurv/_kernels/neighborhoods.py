@@ -951,23 +951,34 @@ def _face_share(points, f, cx, cy, cz, radius, radius2):
 
 @nb.njit(inline="always", **_JIT)
 def _segment_length(points, e, cx, cy, cz, radius2):
-    """``segment_in_ball_lengths`` of edge ``e`` (its ends in ``points[e, :2]``)."""
-    dx = points[e, 1, 0] - points[e, 0, 0]
-    dy = points[e, 1, 1] - points[e, 0, 1]
-    dz = points[e, 1, 2] - points[e, 0, 2]
-    fx = points[e, 0, 0] - cx
-    fy = points[e, 0, 1] - cy
-    fz = points[e, 0, 2] - cz
-    a = dx * dx + dy * dy + dz * dz
-    b = 2 * (dx * fx + dy * fy + dz * fz)
-    c = fx * fx + fy * fy + fz * fz - radius2
-    disc = b * b - 4 * a * c
-    if not (disc > 0 and a > 0):
+    """``segment_in_ball_lengths`` of edge ``e`` (its ends in ``points[e, :2]``): the same operations, in the
+    same order (from the end nearer the centre; no quadratic formula, which cancels on long edges)."""
+    ax = points[e, 0, 0] - cx
+    ay = points[e, 0, 1] - cy
+    az = points[e, 0, 2] - cz
+    bx = points[e, 1, 0] - cx
+    by = points[e, 1, 1] - cy
+    bz = points[e, 1, 2] - cz
+    if (bx * bx + by * by) + bz * bz < (ax * ax + ay * ay) + az * az:
+        ax, ay, az, bx, by, bz = bx, by, bz, ax, ay, az
+    dx = bx - ax
+    dy = by - ay
+    dz = bz - az
+    length2 = (dx * dx + dy * dy) + dz * dz
+    if not length2 > 0:
         return 0.0
-    root = math.sqrt(disc)
-    t0 = min(max((-b - root) / (2 * a), 0.0), 1.0)
-    t1 = min(max((-b + root) / (2 * a), 0.0), 1.0)
-    return (t1 - t0) * math.sqrt(a)
+    length = math.sqrt(length2)
+    along = -((ax * dx + ay * dy) + az * dz) / length
+    share = along / length
+    hx = ax + share * dx
+    hy = ay + share * dy
+    hz = az + share * dz
+    h2 = (hx * hx + hy * hy) + hz * hz
+    if not h2 < radius2:
+        return 0.0
+    half = math.sqrt(max(radius2 - h2, 0.0))
+    inside = min(along + half, length) - max(along - half, 0.0)
+    return inside if inside > 0 else 0.0
 
 
 @nb.njit(**_JIT)
