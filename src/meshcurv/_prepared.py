@@ -23,7 +23,15 @@ import numpy as np
 from ._adapters import mesh_arrays
 from ._locality import local_topology
 from ._validation import as_mesh, as_vertices, check_choice
-from .defects import BOUNDARY, FRAGMENT, VertexDefects, _defect_codes, _needle_vertices, _scale_edges
+from .defects import (
+    BOUNDARY,
+    FRAGMENT,
+    VertexDefects,
+    _defect_codes,
+    _needle_corners,
+    _needle_vertices,
+    _scale_edges,
+)
 from .errors import InvalidOptionError
 from ._geometry import (
     DEGENERATE_AREA_RATIO,
@@ -170,7 +178,14 @@ class PreparedMesh:
         Euclidean neighbours: :data:`meshcurv.defects.FRAGMENT`)."""
         codes, counts = self._codes
         tolerated = ({BOUNDARY} if boundary else set()) | ({FRAGMENT} if fragments else set())
-        return VertexDefects(codes, counts, frozenset(tolerated))
+        return VertexDefects(codes, counts, frozenset(tolerated), self._needle_members)
+
+    @cached_property
+    def _needle_members(self) -> np.ndarray | None:
+        """(V,) bool: the needle vertices and the corners of their faces (None: the mesh has no needle)."""
+        if not self.needles.any():
+            return None
+        return self.needles | _needle_corners(self.topology, self.needles)
 
     def start(self, *, boundary: bool = False, fragments: bool = False) -> tuple[VertexDefects, np.ndarray]:
         """``(defects, valid)``: the defects, and the vertices with neither a defect nor a missing normal."""

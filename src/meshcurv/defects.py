@@ -500,14 +500,18 @@ class VertexDefects:
         The count of each defect.
     tolerated : frozenset of int
         The codes the method copes with (their vertices stay valid).
+    needle_members : ndarray of shape (V,), bool, or None
+        The needle vertices and the corners of their faces, whatever their code (a corner on a non-manifold
+        edge carries that code, which comes first); None: those carrying the needle code.
     """
 
     codes: np.ndarray
     counts: dict
     tolerated: frozenset = frozenset()
+    needle_members: np.ndarray | None = None
 
     def needle_cells(self, cells: np.ndarray) -> np.ndarray | None:
-        """The edges or faces all of whose vertices carry the needle code.
+        """The edges or faces all of whose vertices are a needle or the corners of its faces (:attr:`needle_members`).
 
         Parameters
         ----------
@@ -520,7 +524,7 @@ class VertexDefects:
             (C,) bool: a needle's faces, and the edges between its corners (whose dihedral angles are those
             of its slivers); None when the mesh has no needle vertex.
         """
-        needle = self.codes == NEEDLE
+        needle = self.codes == NEEDLE if self.needle_members is None else self.needle_members
         if not needle.any():
             return None
         return needle[cells].all(axis=1)

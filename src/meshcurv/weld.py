@@ -28,7 +28,7 @@ import numpy as np
 
 from ._backend import twin
 from ._geometry import vertex_length_scales
-from .defects import _needle_vertices
+from .defects import NEEDLE_REACH, _needle_vertices
 from .errors import InvalidOptionError
 from .orient import face_flips
 from .topology import MeshTopology
@@ -278,7 +278,11 @@ def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: floa
             np.column_stack([b[crossed], c_[crossed]]),
         ]
     )
-    welding = _merge(vertices, topology, pairs, average=True)
+    # a group's mean moves its corner at most the widest crack along an edge of NEEDLE_REACH length scales: the
+    # edges of a vertex flung far away (a spike's, 1e10 long) are "cracked" within 5e8 and may pair copies far
+    # apart, whose mean would fling the mesh's own vertex (issue 29, fuzz 296/119): such a group stays at its first
+    reach = crack_ratio * NEEDLE_REACH * vertex_length_scales(vertices, topology)
+    welding = _merge(vertices, topology, pairs, average=True, reach=reach)
     return welding._replace(n_cracked=welding.n_welded)
 
 
@@ -294,10 +298,11 @@ def _merge(
     candidates: np.ndarray | None = None,
     *,
     average: bool = False,
+    reach: np.ndarray | None = None,
 ) -> Welding:
     """The mesh with the vertices joined by ``pairs`` ((P, 2) indices into ``candidates``, sorted vertex indices;
     None: vertex indices) and their chains made one vertex each: at its first member, or (``average``) at the
-    mean of its members."""
+    mean of its members where that lies within ``reach`` ((V,) distances, None: any) of the first member."""
     from scipy.sparse import coo_matrix  # imported on use: keeps `import meshcurv` fast
     from scipy.sparse.csgraph import connected_components
 
@@ -323,7 +328,9 @@ def _merge(
     if average:  # the corners of detached faces, each moved its own way: their mean is the closest to the corner
         n_kept = points.shape[0]
         counts = np.bincount(index, minlength=n_kept)[:, None]
-        points = np.column_stack([np.bincount(index, vertices[:, k], minlength=n_kept) for k in range(3)]) / counts
+        means = np.column_stack([np.bincount(index, vertices[:, k], minlength=n_kept) for k in range(3)]) / counts
+        near = np.ones(n_kept, dtype=bool) if reach is None else _distance(means, points) <= reach[kept]
+        points = np.where(near[:, None], means, points)
     return Welding(points, welded_topology, index, int(n_vertices - kept.sum()))
 
 
