@@ -1,15 +1,15 @@
 """``quadric`` at the boundary of open meshes: the jets steadied by a quadric (issue 29), before and after.
 
 Before: every boundary vertex keeps its jet (degree 4, or 3 or 2 where its ball's points call for it). After:
-a boundary vertex whose jet departs from a quadric fitted on the same ball (``quadric.RIM_AGREEMENT``) takes
+a boundary vertex whose jet departs from a quadric fitted on the same ball (``quadric.STEADY_AGREEMENT``) takes
 the quadric's curvatures, and one whose ball is too little spread for a stable quadric is invalid
-(``quadric.RIM_MIN_SPREAD``). For each open mesh, clean and with every vertex moved by a noise of a given share of the mean edge length
+(``quadric.STEADY_MIN_SPREAD``). For each open mesh, clean and with every vertex moved by a noise of a given share of the mean edge length
 (a random direction, several seeds), the error of ``quadric`` at the boundary vertices and at those within
 half a radius of them ("band", not changed) against the exact curvatures:
 ``max(|dk_min|, |dk_max|)`` over the larger of the vertex's largest |k| and a tenth of the shape's, and the
 count of valid boundary vertices whose H is off by more than half the shape's largest |k| (the fuzzer's
 bar), and the share of boundary vertices valid. The hemisphere (subdivisions 6) and the regular saddle are
-the meshes the change was found and tuned on (and the irregular hemisphere for ``RIM_MIN_SPREAD``: its two
+the meshes the change was found and tuned on (and the irregular hemisphere for ``STEADY_MIN_SPREAD``: its two
 six-point rim balls); the others are held out.
 
     python benchmarks/rim_fits.py [--output benchmarks/rim_fits.md]
@@ -41,7 +41,7 @@ SEEDS = 4
 
 
 def _unsteadied(*args) -> None:
-    """``quadric._steady_rim`` before issue 29's round 16: the jets as fitted."""
+    """``quadric._steady_fits`` before issue 29's round 16: the jets as fitted."""
 
 
 def measure(mesh, noise: float, steady: bool) -> tuple[float, float, float, int, float]:
@@ -53,8 +53,8 @@ def measure(mesh, noise: float, steady: bool) -> tuple[float, float, float, int,
     size = float(largest.max())
     exact_mean = 0.5 * (mesh.k_min + mesh.k_max)
     rim_errors, band_errors, off, shares = [], [], 0, []
-    saved = quadric._steady_rim
-    quadric._steady_rim = saved if steady else _unsteadied
+    saved = quadric._steady_fits
+    quadric._steady_fits = saved if steady else _unsteadied
     try:
         for seed in range(SEEDS if noise else 1):
             d = np.random.default_rng(seed).normal(size=vertices.shape)
@@ -70,7 +70,7 @@ def measure(mesh, noise: float, steady: bool) -> tuple[float, float, float, int,
             off += int((r.valid & rim & (np.abs(r.mean - exact_mean) > 0.5 * size)).sum())
             shares.append(r.valid[rim].mean())
     finally:
-        quadric._steady_rim = saved
+        quadric._steady_fits = saved
     rims, bands = np.concatenate(rim_errors), np.concatenate(band_errors)
     return float(np.median(rims)), float(rims.max()), float(np.median(bands)), off, float(np.mean(shares))
 

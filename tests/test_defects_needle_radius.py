@@ -104,8 +104,10 @@ def test_needles_leave_the_default_radius_and_the_other_values_as_without_them(n
     assert both.sum() > 0.7 * vertices.shape[0]
     mean, clean_mean = (0.5 * (r.k_min[both] + r.k_max[both]) for r in (spiked, clean))
     assert np.median(np.abs(mean - clean_mean)) <= VALUES_TOLERANCE * np.median(np.abs(clean_mean))
-    # outward: about the sphere's 1 / R, not -1 / R (quadric on the voxel sphere of 4 voxels: 0.31 clean)
-    assert np.median(mean) == pytest.approx(1.0 / sphere_radius, rel=0.35)
+    # outward: about the sphere's 1 / R, not -1 / R. quadric on the voxel sphere of 4 voxels gives 0.34-0.355
+    # (exact 0.25) since its jets are steadied at every vertex (987129d: balls of a few staircase points take a
+    # fit of degree 2 or 3; 0.31 before; benchmarks/noisy_jets.md): 0.5 for it, a bound that still tells the signs
+    assert np.median(mean) == pytest.approx(1.0 / sphere_radius, rel=0.5 if method == "quadric" else 0.35)
 
 
 @pytest.mark.parametrize("name", sorted(CASES))

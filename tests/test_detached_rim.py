@@ -4,8 +4,8 @@ A hemisphere whose faces were each given their own corners, moved by 0.0079 mean
 across cracks rebuilt the intact topology, but each corner sat at one of its copies, and ``quadric``'s
 degree-4 jets on the one-sided balls of the rim extrapolated that noise: rim corners valid with H 3.41
 and 0.31 where the exact H is 1. A rim vertex whose jet departs from a quadric on the same ball now takes
-the quadric's curvatures (``quadric.RIM_AGREEMENT``), one whose ball is too little spread for a stable
-quadric is invalid (``quadric.RIM_MIN_SPREAD``), and a corner welded across cracks sits at the mean of its
+the quadric's curvatures (``quadric.STEADY_AGREEMENT``), one whose ball is too little spread for a stable
+quadric is invalid (``quadric.STEADY_MIN_SPREAD``), and a corner welded across cracks sits at the mean of its
 copies.
 """
 
