@@ -524,11 +524,17 @@ def _candidate_pairs(
 def _segments_meet_ball(a: tuple, b: tuple, radius2: float) -> np.ndarray:
     """(P,) whether each segment ``[a, b]`` (ends relative to the ball's centre, three coordinate arrays
     each) passes through the ball of squared radius ``radius2`` between its ends: its closest point to the
-    centre is inside and not an end. The operations of the compiled ``_segment_meets_ball``."""
-    d = [q - p for p, q in zip(a, b)]
-    along = -((a[0] * d[0] + a[1] * d[1]) + a[2] * d[2])
+    centre is inside and not an end, found from the end nearer the centre. The operations of the compiled
+    ``_segment_meets_ball``."""
+    swap = _squared(*b) < _squared(*a)
+    near = tuple(np.where(swap, q, p) for p, q in zip(a, b))
+    d = tuple(np.where(swap, p, q) - n for p, q, n in zip(a, b, near))
+    along = -((near[0] * d[0] + near[1] * d[1]) + near[2] * d[2])
     length2 = _squared(*d)
-    return (along > 0) & (along < length2) & (_squared(*a) * length2 - along * along <= radius2 * length2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = along / length2
+        h2 = _squared(*(n + share * q for n, q in zip(near, d)))
+    return (along > 0) & (along < length2) & (h2 <= radius2)
 
 
 def _unique_sorted(keys: np.ndarray) -> np.ndarray:

@@ -226,15 +226,23 @@ def _ball_members(points, grid, cx, cy, cz, cutoff, out):
 @nb.njit(inline="always", **_JIT)
 def _segment_meets_ball(ax, ay, az, bx, by, bz, radius2):
     """Whether the segment from ``a`` to ``b`` (relative to the ball's centre, both ends outside
-    the ball) passes through it: its closest point to the centre is inside, without a division."""
+    the ball) passes through it: its closest point to the centre is inside and not an end. From the
+    end nearer the centre, the closest point itself (``|a|^2 |d|^2 - (a.d)^2`` cancels on a segment far
+    longer than the ball: a spike's edge; issue 29)."""
+    if (bx * bx + by * by) + bz * bz < (ax * ax + ay * ay) + az * az:
+        ax, ay, az, bx, by, bz = bx, by, bz, ax, ay, az
     dx, dy, dz = bx - ax, by - ay, bz - az
-    along = -(ax * dx + ay * dy + az * dz)  # the closest point is a + (along / |d|^2) d, clamped to the segment
+    along = -((ax * dx + ay * dy) + az * dz)  # the closest point is a + (along / |d|^2) d, clamped to the segment
     if not along > 0:
         return False  # the segment leads away from the centre: a is its closest point
-    length2 = dx * dx + dy * dy + dz * dz
+    length2 = (dx * dx + dy * dy) + dz * dz
     if not along < length2:
         return False  # b is its closest point
-    return (ax * ax + ay * ay + az * az) * length2 - along * along <= radius2 * length2
+    share = along / length2
+    hx = ax + share * dx
+    hy = ay + share * dy
+    hz = az + share * dz
+    return (hx * hx + hy * hy) + hz * hz <= radius2
 
 
 @nb.njit(**_JIT)
