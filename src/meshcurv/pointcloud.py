@@ -990,8 +990,9 @@ def _compute(points, given, radius, method, search=None):
             points, start, indices, usable, spacing, tree
         )
         start = start * signs[:, None]
-        # a piece the orientation cut off a larger part (a tread of a voxel staircase) has no side of its own
-        cut_off = _normals.undecided_fragments(points, start, labels, np.where(usable, spacing**2, 0.0), indices)
+        # a piece the orientation cut off a larger part (a tread of a voxel staircase), or that the rest wraps and
+        # whose side the winding number does not confirm (the inner wall of a voxel torus), has no side of its own
+        cut_off = _normals.undecided_fragments(points, start, labels, np.where(usable, spacing**2, 0.0), indices, tree)
         doubtful = doubtful | cut_off
         how = "estimated"
     else:
@@ -1300,7 +1301,8 @@ def _compute(points, given, radius, method, search=None):
             found.append(
                 f"{int((cut_off & ~alike & ~amid).sum())} points are on pieces that the orientation cut off a "
                 "larger part beside them and whose own shape gives no side (a tread of a voxel staircase, a "
-                "patch between creases)"
+                "patch between creases), or that the rest of the cloud wraps and whose side its winding number "
+                "does not confirm (the inner wall of a voxel torus)"
             )
         if between.any():
             found.append(
