@@ -31,9 +31,10 @@ quadric: vertices with fewer (or a degenerate set, for example collinear
 points) are NaN with ``valid=False`` (use a larger ``radius``). Boundary vertices are fitted on their one-sided
 neighbourhood and kept. The higher terms of a jet are poorly held by the points of a one-sided ball, or of
 a ball of few or irregularly placed points, where a noise of a small fraction of an edge length moves them
-far: a vertex whose jet departs from a quadric fitted on the same ball (:data:`STEADY_DEGREE`,
-:data:`STEADY_AGREEMENT`) takes the quadric's curvatures, and one whose ball's points are too little spread
-for a stable quadric (:data:`STEADY_MIN_SPREAD`) is NaN with ``valid=False``.
+far: a vertex whose jet departs from a steadier fit on the same ball (a quadric at the boundary,
+:data:`STEADY_DEGREE`; inside, the highest degree whose points are spread by :data:`STEADY_MIN_SPREAD`) by
+more than :data:`STEADY_AGREEMENT` takes the steadier fit's curvatures, and one whose ball's points are too
+little spread for any such fit is NaN with ``valid=False``.
 
 References
 ----------
@@ -63,7 +64,8 @@ STAGES = ("compute normals", "fit jets", "retrieve curvatures")
 #: with too few points): a degree-4 jet needs 15 points, which a ball of one edge length rarely holds.
 RADIUS_WARNING_EDGES = 1.0
 
-#: The degree of the steadier fit that every jet is checked against. A jet of degree 4 (or 3) holds its
+#: The degree of the steadier fit that the jets of boundary vertices are checked against (inside, the highest
+#: degree whose points are spread by :data:`STEADY_MIN_SPREAD`). A jet of degree 4 (or 3) holds its
 #: higher terms on few points: on a one-sided ball (a boundary vertex) it extrapolates them to the vertex,
 #: and on a ball of few or irregularly placed points they are poorly conditioned; there a noise of a hundredth
 #: of an edge length (faces detached and welded across their cracks, a scan) moved the mean curvature by
@@ -71,17 +73,18 @@ RADIUS_WARNING_EDGES = 1.0
 #: the jet departs from it (:data:`STEADY_AGREEMENT`; ``benchmarks/rim_fits.md``, ``benchmarks/noisy_jets.md``).
 STEADY_DEGREE = 2
 
-#: The smallest spread (:data:`meshcurv.jets.MIN_SPREAD`) of a vertex's ball for its quadric: below it the
-#: vertex is NaN with ``valid=False``. A one-sided ball of six points in a sliver (an irregular mesh's
+#: The smallest spread (:data:`meshcurv.jets.MIN_SPREAD`) of a vertex's ball for its steadier fit: below it
+#: (for every degree) the vertex is NaN with ``valid=False``. A one-sided ball of six points in a sliver (an irregular mesh's
 #: rim) holds a spread of a few 1e-7 and amplifies a noise of a thousandth of an edge length into errors of
 #: several times the curvature, where the balls of the benchmark meshes hold 1e-5 and more
 #: (``benchmarks/rim_fits.md``).
 STEADY_MIN_SPREAD = 1e-5
 
 #: A vertex keeps its jet (of degree 4, or 3) while its principal curvatures are within this over the radius
-#: of its quadric's (:data:`STEADY_DEGREE`), and takes the quadric's beyond: on clean meshes the two differ
-#: by the quadric's bias (about ``(r k)^2 / r``), under noise the jet's poorly held terms by several times
-#: the curvature. 0.1 and 0.2 kept more of the noisy jets (``benchmarks/rim_fits.md``,
+#: of its steadier fit's, and takes the steadier fit's beyond: on clean meshes the two differ by the
+#: quadric's bias at the boundary (about ``(r k)^2 / r``) and not at all inside where the jet's points are
+#: spread by :data:`STEADY_MIN_SPREAD` (the same fit), under noise by the jet's poorly held terms, several
+#: times the curvature. 0.1 and 0.2 kept more of the noisy jets (``benchmarks/rim_fits.md``,
 #: ``benchmarks/noisy_jets.md``).
 STEADY_AGREEMENT = 0.05
 
