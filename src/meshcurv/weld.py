@@ -63,8 +63,9 @@ class Welding(NamedTuple):
     vertices : ndarray of shape (W, 3)
         The welded mesh's vertices: each group of copies becomes its first
         member (lowest index), a group joined across cracks the mean of its
-        members (the corners of detached faces, each moved its own way); the
-        other vertices are kept in their order.
+        members (the corners of detached faces, each moved its own way) where
+        that lies within a few crack widths of the first; the other vertices
+        are kept in their order.
     topology : MeshTopology
         The welded mesh's connectivity (faces re-indexed into ``vertices``).
     index : ndarray of shape (V,), int64
