@@ -28,7 +28,7 @@ import numpy as np
 
 from ._backend import twin
 from ._geometry import vertex_length_scales
-from .defects import NEEDLE_REACH, _needle_vertices
+from .defects import _needle_vertices
 from .errors import InvalidOptionError
 from .orient import face_flips
 from .topology import MeshTopology
@@ -62,10 +62,7 @@ class Welding(NamedTuple):
     ----------
     vertices : ndarray of shape (W, 3)
         The welded mesh's vertices: each group of copies becomes its first
-        member (lowest index), a group joined across cracks the mean of its
-        members (the corners of detached faces, each moved its own way) where
-        that lies within a few crack widths of the first; the other vertices
-        are kept in their order.
+        member (lowest index); the other vertices are kept in their order.
     topology : MeshTopology
         The welded mesh's connectivity (faces re-indexed into ``vertices``).
     index : ndarray of shape (V,), int64
@@ -279,11 +276,11 @@ def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: floa
             np.column_stack([b[crossed], c_[crossed]]),
         ]
     )
-    # a group's mean moves its corner at most the widest crack along an edge of NEEDLE_REACH length scales: the
-    # edges of a vertex flung far away (a spike's, 1e10 long) are "cracked" within 5e8 and may pair copies far
-    # apart, whose mean would fling the mesh's own vertex (issue 29, fuzz 296/119): such a group stays at its first
-    reach = crack_ratio * NEEDLE_REACH * vertex_length_scales(vertices, topology)
-    welding = _merge(vertices, topology, pairs, average=True, reach=reach)
+    # each group at its first member, as a weld of coincident copies: the mean of the copies (d4e1e6a) moved the
+    # corners of a voxel surface off its grid (no longer read as one: another radius, H off by 0.57 of |k|) and
+    # flung a vertex whose copies the crack search paired along a needle's long edges (issue 29, fuzz round 17,
+    # 312/2774 and 312/4373, 296/119); quadric's rims are steadied by their fits instead (quadric.STEADY_*)
+    welding = _merge(vertices, topology, pairs)
     return welding._replace(n_cracked=welding.n_welded)
 
 
@@ -297,13 +294,9 @@ def _merge(
     topology: MeshTopology,
     pairs: np.ndarray,
     candidates: np.ndarray | None = None,
-    *,
-    average: bool = False,
-    reach: np.ndarray | None = None,
 ) -> Welding:
     """The mesh with the vertices joined by ``pairs`` ((P, 2) indices into ``candidates``, sorted vertex indices;
-    None: vertex indices) and their chains made one vertex each: at its first member, or (``average``) at the
-    mean of its members where that lies within ``reach`` ((V,) distances, None: any) of the first member."""
+    None: vertex indices) and their chains made one vertex each, at its first member."""
     from scipy.sparse import coo_matrix  # imported on use: keeps `import meshcurv` fast
     from scipy.sparse.csgraph import connected_components
 
@@ -325,14 +318,7 @@ def _merge(
     index = compact[representative]
     faces = index[topology.faces]
     welded_topology = MeshTopology._build(np.ascontiguousarray(faces), int(kept.sum()))
-    points = vertices[kept]
-    if average:  # the corners of detached faces, each moved its own way: their mean is the closest to the corner
-        n_kept = points.shape[0]
-        counts = np.bincount(index, minlength=n_kept)[:, None]
-        means = np.column_stack([np.bincount(index, vertices[:, k], minlength=n_kept) for k in range(3)]) / counts
-        near = np.ones(n_kept, dtype=bool) if reach is None else _distance(means, points) <= reach[kept]
-        points = np.where(near[:, None], means, points)
-    return Welding(points, welded_topology, index, int(n_vertices - kept.sum()))
+    return Welding(vertices[kept], welded_topology, index, int(n_vertices - kept.sum()))
 
 
 class OneSided(NamedTuple):
