@@ -949,6 +949,10 @@ def _voxel_cloud(rng):
         mesh = shapes.voxel_torus(major, minor, spacing=spacing, seed=seed)
         label = f"voxel torus ({major:.3g}, {minor:.3g})"
     largest = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))
+    if shape == "ellipsoid":
+        # relative to the part's size at least, as the analytic thin ellipsoids of make_cloud_case (the flat
+        # poles' own |k| falls to c / a^2, below what a staircase of voxels resolves)
+        largest = np.maximum(largest, 1.0 / float(axes.max()))
     return [mesh.vertices], [mesh.normals], [mesh.mean], [largest], f"{label}, voxels {spacing}, seed {seed}"
 
 
