@@ -1,4 +1,4 @@
-"""Recognising meshes of voxel images: the grid their vertices lie on.
+"""Grids that coordinates lie on: voxel surfaces read as meshes and as point clouds.
 
 A mesh extracted from a 3D image by marching cubes (scikit-image's
 ``measure.marching_cubes``, VTK's ``vtkMarchingCubes`` / flying edges,
@@ -7,20 +7,30 @@ coordinates are grid coordinates ``origin + i * spacing``, the third is
 interpolated. A blocky (cuberille) surface built from voxel faces has all three
 on the grid. Such surfaces carry a staircase of the grid's size that a
 curvature estimator must average out over a few voxels; :func:`voxel_grid`
-finds the grid so that the default radius can take it into account.
+finds the grid so that the default radius can take it into account, and
+:func:`read_lattice` finds it in a point cloud (the vertices of such a surface
+read as points).
 
-The test is exact, not statistical: grid coordinates come from the same
-``i * spacing`` (plus the same offset) for every vertex on a grid plane, so they
-repeat bit for bit, while interpolated coordinates are almost all distinct.
+Two readings, one after the other. The exact one: grid coordinates come from
+the same ``i * spacing`` (plus the same offset) for every vertex on a grid
+plane, so they repeat bit for bit, while interpolated coordinates are almost
+all distinct. The periodic one, where no coordinate repeats (the surface
+moved off its planes: a triangle soup whose copies of a vertex differ by
+round-off, faces detached by a fraction of an edge, noise): the coordinates
+along each axis crowd about evenly spaced planes, which the modulus of the mean
+of ``exp(2 pi i x / s)`` finds (:func:`_periodic_planes`); a mesh is then a voxel
+surface when nearly all its vertices have two coordinates within
+:data:`VOXEL_SNAP` of a plane.
 """
 
 from __future__ import annotations
 
+import itertools
 from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["VoxelGrid", "voxel_grid", "GRID_FRACTION"]
+__all__ = ["GRID_FRACTION", "NO_LATTICE", "VOXEL_SNAP", "Lattice", "VoxelGrid", "read_lattice", "voxel_grid"]
 
 #: Share of the vertices that must have at least two coordinates on the grid.
 GRID_FRACTION = 0.95
@@ -43,6 +53,116 @@ _ORIGIN_CANDIDATES = 64
 _ON_GRID = 1e-6
 
 
+#: A cloud lies on a lattice along an axis when at least this share of its points share their coordinate along it
+#: with another point, on at least :data:`LATTICE_PLANES` planes whole multiples of the smallest distance between
+#: two of them apart (to :data:`LATTICE_TOLERANCE` of it).
+LATTICE_SHARE = 0.5
+LATTICE_PLANES = 3
+LATTICE_TOLERANCE = 1e-6
+
+#: Coordinates along an axis closer than this share of its largest |coordinate| are one plane of a lattice (their
+#: difference is round-off: the same coordinate computed two ways).
+LATTICE_ROUND_OFF = 1e-12
+
+#: A cloud none of whose coordinates repeats among this many of its points, evenly spaced, is on no lattice (the
+#: whole cloud is not read: a lattice of fewer than millions of planes along an axis repeats one there).
+LATTICE_PROBE = 4096
+
+#: A cloud whose coordinates share none is on a lattice along an axis whose planes they were moved off (noise, a
+#: motion or a registration error of a fraction of a voxel): when the coordinates along it are periodic, the
+#: modulus of the mean of ``exp(2 pi i x / s)`` at least this for a step ``s`` within :data:`LATTICE_BAND` spacings
+#: (1 on the planes, ``exp(-2 pi^2 sigma^2 / s^2)`` under noise ``sigma``: 0.45 at a tenth of a voxel on the half
+#: voxels' grid of marching cubes; ``benchmarks/pointcloud_diagnostics.md``, "A staircase off its grid") ...
+LATTICE_PERIODIC = 0.3
+LATTICE_BAND = (0.25, 6.0)
+
+#: Of the peaks of the modulus (at most :data:`LATTICE_PEAKS`, the strongest), the grid's is the lowest frequency within
+#: this share of the strongest (see :func:`_periodic_planes`) ...
+LATTICE_HARMONIC = 0.9
+LATTICE_PEAKS = 8
+
+#: ... and the grid full, its planes alike: where the modulus at ``2 / s`` is at least :data:`LATTICE_PERIODIC`,
+#: the one at ``1 / s`` at least this share of its power 1/4 (a grid of noise ``sigma``: ``m(1 / s) = m(2 / s) **
+#: (1 / 4)``; the grid of every second plane of a finer one holds its points on planes of two kinds, and the modulus
+#: falls with their imbalance).
+LATTICE_FULL = 0.9
+
+#: ... and a coordinate is on its plane of such a grid within this many times the noise of the coordinates about
+#: their planes (a robust standard deviation), at most half a step.
+LATTICE_SNAP = 4.0
+
+#: A lattice turned off the coordinate axes (a voxel image with a direction matrix) is read in the frame of its flat
+#: facets: the least-variance directions of the neighbourhoods of at most :data:`LATTICE_FRAME_PROBE` points whose
+#: least variance is below :data:`LATTICE_FLAT` of the next (coplanar to round-off or a motion of a few thousandths of
+#: a voxel: the treads and the diagonal facets of a staircase), grouped within :data:`LATTICE_FRAME_ANGLE` radians
+#: (the :data:`LATTICE_FRAME_GROUPS` largest, of :data:`LATTICE_FRAME_GROUP` at least); of those at right angles to
+#: each other (to that angle), the three whose coordinates are periodic (:func:`_periodic_planes`) with the coarsest
+#: grid (the axes, not the diagonals, whose planes are closer). Where no three are, the other two axes about one of
+#: them (:func:`_frame_about`: :data:`LATTICE_FRAME_ANGLES` directions of a quarter turn, the
+#: :data:`LATTICE_FRAME_PEAKS` most periodic refined).
+LATTICE_FRAME_PROBE = 1024
+LATTICE_FLAT = 1e-4
+LATTICE_FRAME_ANGLE = 0.01
+LATTICE_FRAME_GROUP = 3
+LATTICE_FRAME_GROUPS = 24
+LATTICE_FRAME_ANGLES = 320
+LATTICE_FRAME_PEAKS = 4
+LATTICE_FRAME_TRIES = 3
+
+
+class Lattice(NamedTuple):
+    """The grid a cloud's coordinates lie on (see :func:`read_lattice`): along each of its axes its ``steps`` (3,)
+    (0 on none), a plane's coordinate ``offsets`` (3,) and the ``tolerance`` (3,) within which a coordinate is on a
+    plane; the axes are the rows of ``frame`` (3, 3), the coordinate axes when None."""
+
+    steps: np.ndarray
+    offsets: np.ndarray
+    tolerance: np.ndarray
+    frame: np.ndarray | None = None
+
+    def along(self, vectors: np.ndarray) -> np.ndarray:
+        """(..., 3) ``vectors`` (points, normals) in the grid's axes."""
+        return vectors if self.frame is None else vectors @ self.frame.T
+
+    def snap(self, points: np.ndarray) -> np.ndarray:
+        """(N, 3) ``points`` in the grid's axes, each coordinate within the tolerance of a plane moved onto it."""
+        snapped = np.array(self.along(points), dtype=float)
+        for axis in np.flatnonzero(self.steps > 0):
+            step, offset = self.steps[axis], self.offsets[axis]
+            plane = offset + np.round((snapped[:, axis] - offset) / step) * step
+            near = np.abs(snapped[:, axis] - plane) <= self.tolerance[axis]
+            snapped[near, axis] = plane[near]
+        return snapped
+
+
+NO_LATTICE = Lattice(np.zeros(3), np.zeros(3), np.zeros(3))
+
+
+def _evenly(candidates: np.ndarray, most: int) -> np.ndarray:
+    """``candidates`` (sorted), or ``most`` of them evenly spaced in their order when there are more."""
+    if candidates.size <= most:
+        return candidates
+    return candidates[np.linspace(0, candidates.size - 1, most).round().astype(np.int64)]
+
+
+#: Off the exact grid (:func:`voxel_grid`'s periodic reading), a coordinate is on a plane of the grid read when it
+#: lies within this share of the distance between its planes (the half voxels of a mask's isosurface: a fortieth of
+#: a voxel). Smooth meshes are read as voxel surfaces from about 0.3 of the distance on (the icosphere of 8
+#: subdivisions: 0.72 of its vertices with two coordinates within 0.2, 0.95 at 0.3), a voxel sphere of radius 4
+#: with every vertex moved by 0.03 edge lengths (a hundredth of a voxel along each axis) is read from 0.05 on
+#: (``benchmarks/lattice_perturbed.md``).
+VOXEL_SNAP = 0.05
+
+#: ... and every axis holds at least this share of its coordinates on the planes (three times what chance puts
+#: within :data:`VOXEL_SNAP`: a height field sampled on a grid has two coordinates of every vertex on one, and the
+#: third is periodic where the heights crowd at two levels, a sine's crests and troughs, but seldom near its planes).
+VOXEL_AXIS_SHARE = 1.0 / 3.0
+
+
+_EXACT = np.zeros(3)
+_EXACT.flags.writeable = False
+
+
 class VoxelGrid(NamedTuple):
     """The grid found by :func:`voxel_grid`.
 
@@ -54,11 +174,16 @@ class VoxelGrid(NamedTuple):
         One grid coordinate per axis.
     fraction : float
         Share of the vertices with at least two coordinates on the grid.
+    tolerance : ndarray of shape (3,)
+        How far off its plane a coordinate on the grid may lie along each axis: 0 for the exact reading (the
+        coordinates repeat bit for bit), :data:`VOXEL_SNAP` of the distance between the planes read for the
+        periodic one.
     """
 
     spacing: np.ndarray
     origin: np.ndarray
     fraction: float
+    tolerance: np.ndarray = _EXACT
 
 
 def _plane_lattice(planes: np.ndarray, candidates: np.ndarray, share: float):
@@ -118,13 +243,17 @@ def _axis_lattice(values: np.ndarray):
     return spacing, origin, on_grid, whole.astype(np.int64) % 2
 
 
-def voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
+def voxel_grid(vertices: np.ndarray, *, spacing: float | None = None) -> VoxelGrid | None:
     """The voxel grid a mesh's vertices lie on, or None.
 
     Parameters
     ----------
     vertices : ndarray of shape (V, 3)
         Vertex coordinates (of the referenced vertices).
+    spacing : float, optional
+        The distance between neighbouring vertices (the median edge length): given, a mesh whose coordinates
+        repeat too little is read from their periodicity, at steps within :data:`LATTICE_BAND` of it (see Notes);
+        without it, only the exact reading is made.
 
     Returns
     -------
@@ -132,6 +261,18 @@ def voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
         The spacing and origin of the grid when at least :data:`GRID_FRACTION`
         of the vertices have two or more coordinates on it along every axis
         (marching cubes: exactly two; voxel faces: three); None otherwise.
+
+    Notes
+    -----
+    The grid is read from the coordinates that repeat (the exact reading), or,
+    where that finds none and ``spacing`` is given, from the coordinates' periodicity along each axis
+    (:func:`_periodic_planes`, as for point clouds: :func:`read_lattice`): a
+    voxel surface whose vertices were moved off the grid by a little (up to a
+    hundredth of a voxel or so, see :data:`VOXEL_SNAP`), each coordinate then
+    on the grid within :data:`VOXEL_SNAP` of the distance between its planes,
+    and each axis with :data:`VOXEL_AXIS_SHARE` of its coordinates on them. A
+    surface moved by a translation is on a grid of another origin; a rotated
+    one is on none (its grid is not along the coordinate axes).
 
     Examples
     --------
@@ -142,12 +283,44 @@ def voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
     """
     if vertices.shape[0] < 16:
         return None
+    exact = _exact_voxel_grid(vertices)
+    return exact if exact is not None else _periodic_voxel_grid(vertices, spacing)
+
+
+def _exact_voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
+    """:func:`voxel_grid` on the coordinates that repeat bit for bit."""
     found = []
     for k in range(3):  # an axis without a lattice settles it: the others are not sorted (most meshes)
         axis = _axis_lattice(vertices[:, k])
         if axis is None:
             return None
         found.append(axis)
+    return _on_voxel_grid(found, _EXACT)
+
+
+def _periodic_voxel_grid(vertices: np.ndarray, spacing: float | None) -> VoxelGrid | None:
+    """:func:`voxel_grid` on the coordinates' periodicity (see :data:`VOXEL_SNAP`)."""
+    if spacing is None or not (np.isfinite(spacing) and spacing > 0.0):
+        return None
+    probe = vertices[:: max(1, vertices.shape[0] // LATTICE_PROBE)]
+    found = []
+    for k in range(3):  # (most meshes: no periodic axis, settled by the first)
+        planes = _periodic_planes(vertices[:, k], probe[:, k], spacing)
+        if planes is None:
+            return None
+        step, offset, _ = planes
+        index, off = _nearest_planes(vertices[:, k], step, offset)
+        on_grid = np.abs(off) <= VOXEL_SNAP * step
+        if on_grid.mean() < VOXEL_AXIS_SHARE:
+            return None
+        found.append((step, offset, on_grid, index.astype(np.int64) % 2))
+    return _on_voxel_grid(found, VOXEL_SNAP * np.array([axis[0] for axis in found]))
+
+
+def _on_voxel_grid(found: list, tolerance: np.ndarray) -> VoxelGrid | None:
+    """The :class:`VoxelGrid` of the lattices ``found`` along the three axes (each ``(step, origin, on_grid,
+    parity)``, the last two (V,)), or None when fewer than :data:`GRID_FRACTION` of the vertices have two
+    coordinates on them."""
     on_grid = np.column_stack([axis[2] for axis in found])
     fraction = float((on_grid.sum(axis=1) >= 2).mean())
     if fraction < GRID_FRACTION:
@@ -162,5 +335,266 @@ def voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
         on_voxel_grid = on_grid & (parity == np.array(pattern))
         voxel_fraction = float((on_voxel_grid.sum(axis=1) >= 2).mean())
         if voxel_fraction >= GRID_FRACTION:
-            return VoxelGrid(2 * spacing, origin + np.array(pattern) * spacing, voxel_fraction)
-    return VoxelGrid(spacing, origin, fraction)
+            return VoxelGrid(2 * spacing, origin + np.array(pattern) * spacing, voxel_fraction, tolerance)
+    return VoxelGrid(spacing, origin, fraction, tolerance)
+
+
+def read_lattice(
+    points: np.ndarray,
+    spacing: float | None = None,
+    *,
+    usable: np.ndarray | None = None,
+    neighbours: np.ndarray | None = None,
+) -> Lattice:
+    """The grid the coordinates of the ``usable`` (N,) bool (default: all) of ``points`` (N, 3) lie on.
+
+    Along an axis, the coordinates that two points or more share (the planes of the grid) must hold
+    :data:`LATTICE_SHARE` of the points, be :data:`LATTICE_PLANES` at least, and lie whole multiples of the
+    smallest distance between two of them apart: the vertices of marching cubes over a voxel image (each on an
+    edge of the voxels: at its midpoint for a mask, every coordinate then on the grid of half voxels; two of its
+    three for a smooth image). Given the cloud's ``spacing``, coordinates that share none are on a grid when they
+    are periodic along all three axes (:func:`_periodic_planes`: the same surface moved off its planes by noise or
+    a motion of a fraction of a voxel); given each point's ``neighbours`` (N, k) too, a lattice turned off the
+    coordinate axes is read in its own (:func:`_lattice_frame`). A scan's points are on none.
+    """
+    points = np.asarray(points, dtype=float)
+    rows = points if usable is None else points[usable]
+    if rows.shape[0] == 0:
+        return NO_LATTICE
+    lattice = _lattice_in(rows, spacing)
+    if lattice.steps.any() or spacing is None or neighbours is None:
+        return lattice
+    frame = _lattice_frame(points, rows, neighbours, usable, spacing)
+    if frame is None:
+        return lattice
+    turned = _lattice_in(rows @ frame.T, spacing)
+    if not turned.steps.all():
+        return lattice
+    # the axes to the planes' own precision (the frame's search is to a thousandth of a radian): along each, the
+    # plane index of every coordinate near its plane is a linear function of the point, w . x + c, whose gradient w
+    # is the axis over its step; least squares, then the nearest orthonormal axes
+    scaled = np.empty((3, 3))
+    for axis in range(3):
+        step, offset = turned.steps[axis], turned.offsets[axis]
+        index, off = _nearest_planes(rows @ frame[axis], step, offset)
+        near = np.abs(off) <= step / 4
+        scaled[axis] = np.linalg.lstsq(np.c_[rows[near], np.ones(near.sum())], index[near], rcond=None)[0][:3]
+    left, _, right = np.linalg.svd(scaled / np.linalg.norm(scaled, axis=1, keepdims=True))
+    refined = left @ right
+    exact = _lattice_in(rows @ refined.T, spacing)
+    return exact._replace(frame=refined) if exact.steps.all() else turned._replace(frame=frame)
+
+
+def _lattice_in(points, spacing):
+    """The :class:`Lattice` of ``points`` (N, 3) along the coordinate axes (see :func:`read_lattice`)."""
+    probe = points[:: max(1, points.shape[0] // LATTICE_PROBE)]
+    shared = not all(np.unique(probe[:, axis]).size == probe.shape[0] for axis in range(3))
+    exact = [_shared_planes(points[:, axis]) if shared else None for axis in range(3)]
+    found = exact
+    if spacing is not None and spacing > 0.0 and not all(exact):
+        # periodic planes only on all three axes, as marching cubes over a mask puts them (the two faces of a
+        # plate, on two planes along one axis, are periodic at any step that divides their distance)
+        periodic = [e or _periodic_planes(points[:, axis], probe[:, axis], spacing) for axis, e in enumerate(exact)]
+        found = periodic if all(periodic) else exact
+    steps, offsets, tolerance = (np.array([f[j] if f else 0.0 for f in found]) for j in range(3))
+    return Lattice(steps, offsets, tolerance)
+
+
+def _lattice_frame(points, rows, neighbours, usable, spacing):
+    """(3, 3) the axes (rows) of a lattice turned off the coordinate axes, or None (see :data:`LATTICE_FRAME_PROBE`):
+    the ``rows`` (M, 3) the ``usable`` of ``points`` (N, 3), ``neighbours`` (N, k) each point's nearest."""
+    candidates = np.arange(points.shape[0]) if usable is None else np.flatnonzero(usable)
+    probe = _evenly(candidates, LATTICE_FRAME_PROBE)
+    group = np.concatenate([points[probe, None, :], points[neighbours[probe]]], axis=1)
+    group = group - group.mean(axis=1, keepdims=True)
+    values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", group, group))
+    normals = vectors[values[:, 0] <= LATTICE_FLAT * values[:, 1], :, 0]
+    close = np.abs(normals @ normals.T) >= np.cos(LATTICE_FRAME_ANGLE)
+    left = np.ones(normals.shape[0], dtype=bool)
+    directions: list[np.ndarray] = []
+    while left.any() and len(directions) < LATTICE_FRAME_GROUPS:  # the largest group of facets left, its direction
+        counts = (close & left).sum(axis=1) * left
+        best = int(np.argmax(counts))
+        if counts[best] < LATTICE_FRAME_GROUP:
+            break
+        members = close[best] & left
+        direction = (normals[members] * np.sign(normals[members] @ normals[best])[:, None]).sum(axis=0)
+        directions.append(direction / np.linalg.norm(direction))
+        left &= ~members
+    sample = rows[:: max(1, rows.shape[0] // LATTICE_PROBE)]
+    steps = []
+    for direction in directions:
+        found = _periodic_planes(rows @ direction, sample @ direction, spacing)
+        steps.append(0.0 if found is None else found[0])
+    # the coarsest grid (its axes, not its diagonals: their planes are closer) of three of the facets' directions at
+    # right angles to each other, or of the one of the coarsest grid and the two others at right angles to it
+    # (anisotropic voxels: the facets facing them are seldom flat over ten neighbours), found from every probed normal;
+    # then the same about the other axes of the best frame (up to LATTICE_FRAME_TRIES axes in all)
+    largest, frame = 0.0, None
+    triple: tuple[int, ...] = ()
+    right = np.sin(LATTICE_FRAME_ANGLE)
+    for a, b, c in itertools.combinations(range(len(directions)), 3):
+        axes = np.array([directions[a], directions[b], directions[c]])
+        cell = steps[a] * steps[b] * steps[c]
+        if cell > largest and np.all(np.abs(axes @ axes.T - np.eye(3)) <= right):
+            largest, frame, triple = cell, axes, (a, b, c)
+    coarsest = sorted([k for k, step in enumerate(steps) if step > 0], key=lambda k: -steps[k])
+    queue = [directions[k] for k in [*sorted(triple, key=lambda k: -steps[k]), *coarsest[:1]]]
+    tried: list[np.ndarray] = []
+    while queue and len(tried) < LATTICE_FRAME_TRIES:  # (a diagonal's frame holds an axis: then that axis')
+        axis = queue.pop(0)
+        own = _grid_frequency(sample @ axis, spacing)
+        if own is None or any(abs(axis @ other) >= np.cos(LATTICE_FRAME_ANGLE) for other in tried):
+            continue
+        tried.append(axis)
+        found = _frame_about(axis, sample, spacing)
+        if found is not None and found[1] / own[0] > largest:
+            frame, largest = found[0], found[1] / own[0]
+            queue.extend(found[0][1:])
+    if frame is None:
+        return None
+    turn, _ = np.linalg.qr(frame.T)  # (exactly orthonormal, the axes' signs as found)
+    return (turn * np.sign(np.diag(turn.T @ frame.T))).T
+
+
+def _frame_about(axis, sample, spacing):
+    """``(frame, area)``: the axes (rows, (3, 3)) of a lattice one of whose axes is ``axis`` (3,) and the product of
+    the two others' steps, or None.
+
+    The two others lie in the plane at right angles to it, a quarter turn apart: of the directions of a quarter turn
+    there, :data:`LATTICE_FRAME_ANGLES` evenly spaced, the :data:`LATTICE_FRAME_PEAKS` along which the ``sample``
+    (S, 3) is most periodic (the strongest peak of :func:`_spectrum`), each refined to a twentieth of that spacing
+    and completed by the direction at right angles: of those periodic along both (:func:`_grid_frequency`), the
+    coarsest grid (the axes, not the diagonals between them).
+    """
+    first = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
+    first /= np.linalg.norm(first)
+    second = np.cross(axis, first)
+
+    def direction(angle):
+        return np.cos(angle) * first + np.sin(angle) * second
+
+    def strongest(angle):
+        modulus, _, band, _ = _spectrum(sample @ direction(angle), spacing)
+        return 0.0 if band.size == 0 else float(modulus[band].max())
+
+    coarse = np.arange(LATTICE_FRAME_ANGLES) * (np.pi / 2 / LATTICE_FRAME_ANGLES)
+    strength = np.array([strongest(t) for t in coarse])
+    tops = np.flatnonzero((strength >= np.roll(strength, 1)) & (strength >= np.roll(strength, -1)))
+    frame, largest = None, 0.0
+    for start in coarse[tops[np.argsort(-strength[tops])][:LATTICE_FRAME_PEAKS]]:
+        fine = start + np.linspace(-1, 1, 41) * (np.pi / 2 / LATTICE_FRAME_ANGLES)
+        along = direction(fine[int(np.argmax([strongest(t) for t in fine]))])
+        found = _grid_frequency(sample @ along, spacing)
+        third = _grid_frequency(sample @ np.cross(axis, along), spacing)
+        if found is None or third is None:
+            continue
+        cell = 1 / (found[0] * third[0])
+        if cell > largest:
+            frame, largest = np.array([axis, along, np.cross(axis, along)]), cell
+    return None if frame is None else (frame, largest)
+
+
+def _shared_planes(values):
+    """``(step, offset, tolerance)`` of the planes that ``values`` (N,) share (see :func:`read_lattice`), or None."""
+    # the coordinates within round-off of each other are one plane (a coordinate computed two ways)
+    values = np.sort(values)
+    round_off = LATTICE_ROUND_OFF * max(float(np.abs(values).max()), np.finfo(float).tiny)
+    first = np.flatnonzero(np.r_[True, np.diff(values) > round_off])
+    counts = np.diff(np.r_[first, values.size])
+    planes = values[first[counts > 1]]
+    if planes.size < LATTICE_PLANES or counts[counts > 1].sum() < LATTICE_SHARE * values.size:
+        return None
+    gaps = np.diff(planes)
+    step = gaps.min()
+    # whole multiples of the step to LATTICE_TOLERANCE of it, each plane known to its round-off: not relative
+    # to the multiple (a gap a million steps long is a whole multiple of any step to a millionth of itself)
+    off = np.abs(gaps - np.round(gaps / step) * step)
+    tolerance = LATTICE_TOLERANCE * step + 2 * round_off
+    if not np.all(off <= tolerance):
+        return None
+    return float(step), float(planes[0]), float(tolerance)
+
+
+def _periodic_planes(values, probe, spacing):
+    """``(step, offset, tolerance)`` of the grid whose planes ``values`` (N,) lie about, or None.
+
+    The modulus ``m(f)`` of the mean of ``exp(2 pi i f x)`` over the ``probe`` values (M,): its peaks within
+    :data:`LATTICE_BAND` over every frequency at once (the Fourier transform of their histogram in bins of 1/32 of
+    the ``spacing``), the :data:`LATTICE_PEAKS` strongest of at least :data:`LATTICE_PERIODIC` each measured at its
+    top (the mean at 17 frequencies across its bin) and kept unless ``m(f) < LATTICE_FULL m(2 f) ** (1 / 4)`` where
+    ``m(2 f)`` is at least that (see :data:`LATTICE_FULL`). The grid's frequency is the lowest of those within
+    :data:`LATTICE_HARMONIC` of the strongest (an exact grid's harmonics are as strong as its fundamental; two planes
+    that hold many points, the treads at the poles, make peaks at every multiple of the inverse of their distance,
+    weaker than the grid's). Its step and a plane are then fitted by least squares to the coordinates within a
+    quarter step of the planes, and the tolerance is :data:`LATTICE_SNAP` times the coordinates' spread about them.
+    """
+    found = _grid_frequency(probe, spacing)
+    if found is None:
+        return None
+    frequency, mean, low = found
+    step = 1 / frequency
+    offset = low + np.angle(mean) / (2 * np.pi) * step
+    for _ in range(2):  # least squares over the coordinates near the planes
+        index, off = _nearest_planes(values, step, offset)
+        close = np.abs(off) <= step / 4
+        if close.sum() < LATTICE_SHARE * values.size or np.ptp(index[close]) < LATTICE_PLANES - 1:
+            return None
+        step, offset = np.polyfit(index[close], values[close], 1)
+    spread = 1.4826 * float(np.median(np.abs(_nearest_planes(values, step, offset)[1])))
+    return float(step), float(offset), min(LATTICE_SNAP * spread, step / 2)
+
+
+def _nearest_planes(values, step, offset):
+    """``(index, off)``: the plane of the grid of ``step`` through ``offset`` nearest each of ``values`` (N,), and
+    how far off it each lies."""
+    index = np.round((values - offset) / step)
+    return index, values - offset - index * step
+
+
+def _spectrum(probe, spacing):
+    """``(modulus, frequency, band, low)``: the modulus of the mean of ``exp(2 pi i f (x - low))`` over the ``probe``
+    (M,) at every ``frequency`` of the Fourier transform of their histogram in bins of 1/32 of the ``spacing``, the
+    indices of those within :data:`LATTICE_BAND` (none when the probe spans too few or too many bins) and ``low``,
+    the least value."""
+    low, high = float(probe.min()), float(probe.max())
+    width = spacing / 32
+    span = (high - low) / width if width > 0.0 else np.inf
+    if not (np.isfinite(span) and 8 * 32 <= span + 1 <= 1 << 18):
+        return np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64), low
+    bins = int(span) + 1
+    histogram = np.bincount(((probe - low) / width).astype(np.int64), minlength=bins)
+    size = 1 << int(np.ceil(np.log2(2 * bins)))
+    modulus = np.abs(np.fft.rfft(histogram, size)) / probe.size
+    frequency = np.arange(modulus.size) / (size * width)
+    band = np.flatnonzero(
+        (frequency >= 1 / (LATTICE_BAND[1] * spacing)) & (frequency <= 1 / (LATTICE_BAND[0] * spacing))
+    )
+    return modulus, frequency, band, low
+
+
+def _grid_frequency(probe, spacing):
+    """``(frequency, mean, low)``: the grid's frequency, the mean of ``exp(2 pi i f (x - low))`` over the ``probe``
+    (M,) there and their least value ``low``, or None (see :func:`_periodic_planes`)."""
+    modulus, frequency, band, low = _spectrum(probe, spacing)
+    if band.size < 3:
+        return None
+    width = spacing / 32
+    size = 2 * (modulus.size - 1)
+    inner = modulus[band[1:-1]]
+    peaks = band[1:-1][(inner >= modulus[band[:-2]]) & (inner >= modulus[band[2:]]) & (inner >= LATTICE_PERIODIC)]
+    centred = probe - low
+    tops = []  # (frequency, mean) at the top of each peak kept
+    for peak in peaks[np.argsort(-modulus[peaks], kind="stable")[:LATTICE_PEAKS]]:
+        near = frequency[peak] + np.linspace(-1, 1, 17) / (size * width)
+        means = np.exp(2j * np.pi * np.outer(near, centred)).mean(axis=1)
+        top = int(np.argmax(np.abs(means)))
+        double = abs(np.exp(4j * np.pi * near[top] * centred).mean())
+        if double >= LATTICE_PERIODIC and abs(means[top]) < LATTICE_FULL * double**0.25:
+            continue  # (every second plane of a grid at 2 f; tested only where m(2 f) is above the sampling's floor)
+        tops.append((near[top], means[top]))
+    if not tops:
+        return None
+    strongest = max(abs(mean) for _, mean in tops)
+    found, mean = min((f, mean) for f, mean in tops if abs(mean) >= LATTICE_HARMONIC * strongest)
+    return found, mean, low

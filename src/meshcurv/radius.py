@@ -558,7 +558,10 @@ def _voxel_surface_radius(
     # is in no extent, area or percentile below: the needles' vertices and faces are left out everywhere
     spikes = mesh.needles
     referenced = topology.referenced_vertices & ~spikes
-    grid = voxel_grid(vertices if referenced.all() else vertices[referenced])  # (no copy of a whole mesh)
+    # (no copy of a whole mesh); a mesh whose vertices left the grid by a little is read from the periodicity of
+    # its coordinates, at steps of a few of its edge lengths (the median edge of its parts: their length scales)
+    scale = float(np.median(mesh.length_scales[referenced])) if referenced.any() else 0.0
+    grid = voxel_grid(vertices if referenced.all() else vertices[referenced], spacing=scale)
     if grid is None or _off_grid_scale(mesh.length_scales[referenced], grid.spacing):
         return None
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
