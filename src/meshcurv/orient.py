@@ -45,9 +45,10 @@ def orient_faces(vertices, faces, *, outward: bool = True) -> tuple[np.ndarray, 
         0-based triangles (polygons are fan-triangulated with a warning).
     outward : bool, default: True
         Turn every closed patch so that its signed volume is positive (normals
-        outward). With ``outward=False``, and on open patches in any case, the
-        orientation of the majority of a patch's faces is kept (the fewest
-        faces are reversed).
+        outward), and every nearly closed one (small holes: see Notes). With
+        ``outward=False``, and on wide open patches (a hemisphere, a saddle, a
+        tube as long as it is wide) in any case, the orientation of the majority
+        of a patch's faces is kept (the fewest faces are reversed).
 
     Returns
     -------
@@ -72,11 +73,26 @@ def orient_faces(vertices, faces, *, outward: bool = True) -> tuple[np.ndarray, 
     its majority orientation. Non-orientable patches are left as given: some of
     their edges stay inconsistently oriented.
 
+    An open patch is closed for the purpose by a fan over each of its boundary
+    loops (holes meeting at a vertex are told apart by the order of their edges
+    around it) and turned outward like a closed one when that volume is more
+    than :data:`FILLED_MARGIN` times what the fans could be wrong by (a half
+    ball on a disc of each fan's area): a sphere or torus with small holes is
+    turned outward whichever way it was wound; a hemisphere (its volume is the
+    bound) keeps its majority. Pieces that are not decided on their own take the
+    side of decided patches whose face normals they follow at shared vertices;
+    pieces that touch only each other (a sphere with half of its faces removed)
+    are oriented from their largest and decided together, as one patch. A piece
+    that touches nothing decided and is wide open keeps its majority.
+
     The cost is one :func:`~scipy.sparse.csgraph.connected_components` call on
     a graph of ``2 F`` nodes and about ``3 F`` links (none when the mesh is
     manifold and consistently wound already), and a few passes over the
     faces; there is no Python loop over faces or edges, and a loop over pairs
     of closed patches only where one's bounding box holds a corner of the other.
+    Open patches add a few passes over the faces and a sort of their boundary
+    edges, and up to :data:`NEIGHBOUR_ROUNDS` (:data:`GROUP_ROUNDS`) passes where
+    pieces take their side from their neighbours.
 
     Examples
     --------
@@ -180,9 +196,272 @@ def _outward(vertices, topology, patch, flip, invert, n_labels, needles) -> np.n
     kept = ~needles[faces].any(axis=1) if needles.any() else slice(None)
     signed, magnitude = _patch_volumes(vertices, faces[kept], patch[kept], flip[kept], n_labels)
     decided = ~open_patch & (np.abs(signed) > 1e-9 * magnitude)
+    if open_patch.any():  # a nearly closed patch (small holes): the side of its volume with the holes filled
+        filled, doubt = _filled_volumes(
+            vertices, topology, patch, flip, face_kept_mask(kept, faces) & open_patch[patch], n_labels
+        )
+        signed = np.where(open_patch, signed + filled, signed)
+        decided |= open_patch & (np.abs(signed) > FILLED_MARGIN * doubt)
     inverted = np.where(decided, signed < 0, invert)
     cavity = _nesting_depth(vertices, faces, patch, decided) % 2 == 1
-    return np.where(decided & cavity, ~inverted, inverted)
+    inverted = np.where(decided & cavity, ~inverted, inverted)
+    pending = open_patch & ~decided
+    if decided.any() and pending.any():  # small pieces beside a decided patch (between its holes) take its side
+        inverted, pending = _sides_from_neighbours(vertices, faces, patch, flip, inverted, decided, pending)
+    if pending.any():  # pieces of one surface (half its faces gone) that touch only each other: decided together
+        inverted = _sides_of_groups(vertices, topology, patch, flip, inverted, pending, face_kept_mask(kept, faces))
+    return inverted
+
+
+def face_kept_mask(kept, faces) -> np.ndarray:
+    """(F,) bool of ``kept`` (a mask, or ``slice(None)``: every face)."""
+    return np.ones(faces.shape[0], dtype=bool) if isinstance(kept, slice) else kept
+
+
+def _sides_of_groups(vertices, topology, patch, flip, inverted, pending, kept) -> np.ndarray:
+    """``inverted`` with each group of ``pending`` patches joined through shared vertices turned outward together.
+
+    In each group the largest patch keeps its side and the others take theirs from it
+    (:func:`_sides_from_neighbours`); the group is then one patch of :func:`_filled_volumes`, turned outward when
+    its volume with the holes filled is decided, as a nearly closed patch's is. A sphere with half of its faces
+    removed falls apart into patches of a few faces (each undecided), which together are a sphere with small holes.
+    """
+    import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
+    from scipy.sparse.csgraph import connected_components
+
+    faces = topology.faces
+    n_vertices, n_labels = vertices.shape[0], inverted.shape[0]
+    asked = pending[patch]
+    corners = faces[asked]
+    links = sp.csr_matrix(
+        (
+            np.ones(2 * corners.shape[0], dtype=np.int8),
+            (np.r_[corners[:, 0], corners[:, 0]], np.r_[corners[:, 1], corners[:, 2]]),
+        ),
+        shape=(n_vertices, n_vertices),
+    )
+    _, vertex_group = connected_components(links, directed=False)
+    group_of_patch = np.full(n_labels, -1, dtype=np.int64)
+    group_of_patch[patch[asked]] = vertex_group[corners[:, 0]]
+    _, group_of_patch[pending] = np.unique(group_of_patch[pending], return_inverse=True)
+    n_groups = int(group_of_patch.max()) + 1
+    size = np.bincount(patch, minlength=n_labels).astype(np.float64)
+    # the largest patch of each group: sort by (group, size) and take each group's last
+    members = np.flatnonzero(pending)
+    order = members[np.lexsort((size[members], group_of_patch[members]))]
+    ends = np.searchsorted(group_of_patch[order], np.arange(n_groups), side="right") - 1
+    seeds = np.zeros(n_labels, dtype=bool)
+    seeds[order[ends]] = True
+    inverted, left = _sides_from_neighbours(
+        vertices, faces, patch, flip, inverted, seeds, pending & ~seeds, rounds=GROUP_ROUNDS
+    )
+    joined = pending & ~left  # the patches whose side follows their group's seed
+    label = np.where(joined, group_of_patch, n_groups)[patch]  # the others: one label past the groups, not counted
+    counted = kept & joined[patch]
+    wound = flip ^ inverted[patch]
+    signed, _ = _patch_volumes(vertices, faces[counted], label[counted], wound[counted], n_groups + 1)
+    filled, doubt = _filled_volumes(vertices, topology, label, wound, counted, n_groups + 1)
+    total = (signed + filled)[:n_groups]
+    turn = (np.abs(total) > FILLED_MARGIN * doubt[:n_groups]) & (total < 0)
+    return np.where(joined & turn[np.maximum(group_of_patch, 0)], ~inverted, inverted)
+
+
+#: Angles about a vertex closer than this (radians) are ties (:func:`_next_boundary_edges`).
+ANGLE_TIE = 1e-9
+
+#: Two directions along no edge of a lattice (irrational ratios), from which :func:`_next_boundary_edges` measures
+#: angles: the first, or the second where the vertex's normal is near the first.
+SLANTED = np.array([[np.sqrt(2.0), np.sqrt(3.0), np.sqrt(5.0)], [np.sqrt(7.0), -np.sqrt(11.0), np.sqrt(13.0)]])
+SLANTED /= np.linalg.norm(SLANTED, axis=1)[:, None]
+
+#: :func:`_sides_from_neighbours` passes the side on through at most this many patches in a row: from decided
+#: patches, and from the seed of a group of undecided ones (:func:`_sides_of_groups`).
+NEIGHBOUR_ROUNDS = 8
+GROUP_ROUNDS = 32
+
+
+def _sides_from_neighbours(
+    vertices, faces, patch, flip, inverted, decided, pending, rounds: int = NEIGHBOUR_ROUNDS
+) -> tuple[np.ndarray, np.ndarray]:
+    """``inverted`` with the ``pending`` patches that share vertices with decided ones turned to agree with them.
+
+    A pending patch (open, its side not decided on its own: a few faces between the holes of a decided
+    patch) takes the side whose face normals point along those of the decided faces at their shared
+    vertices (the sum of their dot products), when that sum is at least half of the sum of their magnitudes
+    (the two sides clearly differ); it is then decided, and passes its side on, for at most
+    ``rounds`` rounds. Patches that touch no decided one keep their majority orientation. Returns ``inverted``
+    and the patches still pending.
+    """
+    inverted = inverted.copy()
+    decided = decided.copy()
+    pending = pending.copy()
+    n_vertices, n_labels = vertices.shape[0], inverted.shape[0]
+    normal = np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]])
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
+    for _ in range(rounds):
+        anchor = decided[patch]
+        sign = np.where(flip ^ inverted[patch], -1.0, 1.0)[:, None]
+        around = np.stack(
+            [
+                sum(np.bincount(faces[anchor, k], (sign * normal)[anchor, j], n_vertices) for k in range(3))
+                for j in range(3)
+            ],
+            axis=1,
+        )
+        asked = pending[patch]
+        seen = around[faces[asked]].sum(axis=1)  # (F', 3): the decided normals at each asked face's corners
+        mine = (sign * normal)[asked]
+        owner = patch[asked]
+        score = np.bincount(owner, np.einsum("ij,ij->i", mine, seen), n_labels)
+        scale = np.bincount(owner, np.linalg.norm(seen, axis=1), n_labels)
+        adopt = pending & (np.abs(score) >= 0.5 * scale) & (scale > 0)
+        if not adopt.any():
+            break
+        inverted[adopt & (score < 0)] ^= True
+        decided |= adopt
+        pending &= ~adopt
+    return inverted, pending
+
+
+#: An open patch is turned outward when its volume with the holes filled is more than this many times the
+#: volume its fills could be wrong by (:func:`_filled_volumes`): a sphere with a few small holes is, a hemisphere
+#: (its volume is a third of the bound) or a saddle is not, and keeps its majority orientation.
+FILLED_MARGIN = 2.0
+
+#: The volume of a half ball on a disc of area 1: ``2 / (3 sqrt(pi))``.
+BULGE = 2.0 / (3.0 * np.sqrt(np.pi))
+
+
+def _filled_volumes(
+    vertices: np.ndarray, topology: MeshTopology, patch: np.ndarray, flip: np.ndarray, counted: np.ndarray, n_labels
+) -> tuple[np.ndarray, np.ndarray]:
+    """(P,) six times the volume of the fills that close each patch's holes, and (P,) six times their doubt.
+
+    The boundary of the ``counted`` faces of each patch, oriented as in :func:`_patch_volumes` (a face to
+    ``flip`` reversed), is split into loops (its edges joined through their ends), and each loop is closed by a
+    fan to the mean of its vertices, each fan triangle running the loop's edge backwards: the patch and its fans
+    bound a solid, whose volume (that of :func:`_patch_volumes` plus the fans', about the same centre) no longer
+    depends on the centre, as for a closed patch (a torus's centre is outside its solid). A fan is a guess of
+    the missing surface: it could bulge by up to its loop's radius, so the doubt is the sum over the loops of the
+    fan's area times the loop's radius. A sphere with small holes is decided many times over; a hemisphere (fan
+    area pi r^2, radius r, volume 2/3 pi r^3) is not. Arrays over the boundary only, no loop over faces.
+    """
+    faces, face_edges = topology.faces, topology.face_edges
+    # a side is inside its patch when its edge joins exactly two counted faces of that patch (they cancel)
+    pairs = topology.edge_faces[np.maximum(face_edges, 0)]  # (F, 3, 2)
+    own = np.arange(faces.shape[0])[:, None]
+    other = np.where(pairs[..., 0] == own, pairs[..., 1], pairs[..., 0])
+    other = np.maximum(other, 0)
+    inner = (topology.edge_face_counts[np.maximum(face_edges, 0)] == 2) & (patch[other] == patch[:, None])
+    inner &= counted[other] & (other != own)
+    rows, sides = np.nonzero(counted[:, None] & (face_edges >= 0) & ~inner)
+    empty = np.zeros(n_labels)
+    if rows.size == 0:
+        return empty, empty
+    start, end = faces[rows, sides], faces[rows, (sides + 1) % 3]
+    reversed_ = flip[rows]
+    tail, head = np.where(reversed_, end, start), np.where(reversed_, start, end)
+    owner = patch[rows].astype(np.int64)
+    n_edges = topology.edges.shape[0]
+    # sides of one edge in one patch cancel when they run it both ways: the net count per (patch, edge)
+    _, first, inverse = np.unique(owner * n_edges + face_edges[rows, sides], return_index=True, return_inverse=True)
+    net = np.bincount(inverse, weights=np.where(tail < head, 1.0, -1.0))
+    low, high = np.minimum(tail, head)[first], np.maximum(tail, head)[first]
+    remaining = net != 0
+    times = np.abs(net[remaining])
+    tail = np.where(net > 0, low, high)[remaining]
+    head = np.where(net > 0, high, low)[remaining]
+    owner = owner[first][remaining]
+    if tail.size == 0:
+        return empty, empty
+    # loops: each boundary edge followed by the one leaving its head into the same hole
+    import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
+    from scipy.sparse.csgraph import connected_components
+
+    successor = _next_boundary_edges(vertices, faces, patch, flip, counted, tail, head, owner)
+    m = tail.size
+    graph = sp.csr_matrix((np.ones(m, dtype=np.int8), (np.arange(m), successor)), shape=(m, m))
+    n_loops, loop = connected_components(graph, directed=False)
+    node_count = np.maximum(np.bincount(loop, minlength=n_loops), 1)
+    apex = np.stack([np.bincount(loop, vertices[tail, k], n_loops) for k in range(3)], axis=1) / node_count[:, None]
+    # each patch's centre as in _patch_volumes: the mean of its counted faces' first corners
+    counted_first = vertices[faces[counted, 0]]
+    counted_patch = patch[counted]
+    weight = np.maximum(np.bincount(counted_patch, minlength=n_labels), 1).astype(np.float64)
+    centre = np.stack([np.bincount(counted_patch, counted_first[:, k], n_labels) for k in range(3)], axis=1)
+    centre = (centre / weight[:, None])[owner]
+    a, b, c = vertices[head] - centre, vertices[tail] - centre, apex[loop] - centre  # the fan runs head -> tail
+    volume6 = np.einsum("ij,ij->i", a, np.cross(b, c)) * times
+    area = 0.5 * np.linalg.norm(np.cross(vertices[tail] - apex[loop], vertices[head] - apex[loop]), axis=1) * times
+    loop_owner = np.zeros(n_loops, dtype=np.int64)
+    loop_owner[loop] = owner
+    bulge = BULGE * np.bincount(loop, area, n_loops) ** 1.5  # a half ball on a disc of the fan's area
+    doubt = np.bincount(loop_owner, weights=6.0 * bulge, minlength=n_labels)
+    return np.bincount(owner, weights=volume6, minlength=n_labels), doubt
+
+
+def _next_boundary_edges(vertices, faces, patch, flip, counted, tail, head, owner) -> np.ndarray:
+    """(B,) for each boundary edge ``tail -> head`` of :func:`_filled_volumes`, the boundary edge of the same
+    patch that leaves ``head`` into the same hole.
+
+    Where one edge of the patch leaves ``head`` it is that one. Where several do (holes meeting at a vertex: the
+    patch's faces around it form several fans), the edges at the vertex are ordered by their angle about the
+    vertex's normal (the sum of the patch's face normals there): a fan runs counter-clockwise from an edge
+    leaving the vertex to one arriving at it, and the hole after the arriving edge ends at the next edge
+    counter-clockwise, one leaving into the next fan.
+    """
+    n_vertices = np.int64(vertices.shape[0])
+    out_key = owner * n_vertices + tail
+    in_key = owner * n_vertices + head
+    order = np.argsort(out_key, kind="stable")
+    lo = np.searchsorted(out_key[order], in_key)
+    hi = np.searchsorted(out_key[order], in_key, side="right")
+    successor = order[np.minimum(lo, order.size - 1)]
+    successor = np.where(hi > lo, successor, np.arange(tail.size))  # no edge leaves (never on a boundary chain)
+    crowded = np.unique(in_key[hi - lo > 1])
+    if crowded.size == 0:
+        return successor
+    # the patch's normal at each crowded vertex: the sum of its counted faces' normals there
+    corners = faces[counted]
+    corner_keys = patch[counted].astype(np.int64)[:, None] * n_vertices + corners
+    normal = np.cross(
+        vertices[corners[:, 1]] - vertices[corners[:, 0]], vertices[corners[:, 2]] - vertices[corners[:, 0]]
+    )
+    normal = np.where(flip[counted][:, None], -normal, normal)
+    at = np.searchsorted(crowded, corner_keys)
+    hit = crowded[np.minimum(at, crowded.size - 1)] == corner_keys
+    rows, _ = np.nonzero(hit)
+    normals = np.zeros((crowded.size, 3))
+    np.add.at(normals, at[hit], normal[rows])
+    magnitudes = np.bincount(at[hit], np.linalg.norm(normal[rows], axis=1), crowded.size)
+    # the edges at each crowded vertex: leaving (towards their head) and arriving (towards their tail)
+    leaving = np.flatnonzero(np.isin(out_key, crowded))
+    arriving = np.flatnonzero(np.isin(in_key, crowded))
+    node = np.concatenate([np.searchsorted(crowded, out_key[leaving]), np.searchsorted(crowded, in_key[arriving])])
+    centre = vertices[np.concatenate([tail[leaving], head[arriving]])]
+    direction = vertices[np.concatenate([head[leaving], tail[arriving]])] - centre
+    n = normals[node] / np.maximum(np.linalg.norm(normals[node], axis=1), np.finfo(float).tiny)[:, None]
+    # the angles start from a direction along no lattice edge (the cut of (-pi, pi] on no edge)
+    axis = np.where((np.abs(n @ SLANTED[0]) < 0.9 * np.linalg.norm(n, axis=1))[:, None], SLANTED[0], SLANTED[1])
+    u = np.cross(n, axis)
+    u /= np.maximum(np.linalg.norm(u, axis=1), np.finfo(float).tiny)[:, None]
+    w = np.cross(n, u)
+    angle = np.arctan2(np.einsum("ij,ij->i", direction, w), np.einsum("ij,ij->i", direction, u))
+    # ties (a lattice's right angles) and a normal lost in round-off (fans facing apart) ordered by the other
+    # vertex, not by round-off: the same loops after any scaling or motion of the mesh
+    unsure = np.linalg.norm(normals, axis=1) <= 1e-6 * magnitudes
+    angle = np.where(unsure[node], 0.0, np.round(angle / ANGLE_TIE))
+    other = np.concatenate([head[leaving], tail[arriving]])
+    edge = np.concatenate([leaving, arriving])
+    is_leaving = np.arange(edge.size) < leaving.size
+    ring = np.lexsort((other, angle, node))
+    node, edge, is_leaving = node[ring], edge[ring], is_leaving[ring]
+    first = np.searchsorted(node, node)  # the start of each vertex's run
+    last = np.searchsorted(node, node, side="right") - 1
+    following = np.where(np.arange(node.size) == last, first, np.arange(node.size) + 1)  # cyclically next
+    pick = ~is_leaving & is_leaving[following]
+    successor[edge[pick]] = edge[following[pick]]
+    return successor
 
 
 def _patch_volumes(
