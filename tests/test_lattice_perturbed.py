@@ -17,7 +17,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 import meshcurv
-from meshcurv import shapes
+from meshcurv import lattice, shapes
 from meshcurv.errors import MeshQualityWarning
 from meshcurv.io import read_mesh
 from meshcurv.lattice import VOXEL_SNAP, voxel_grid
@@ -106,6 +106,30 @@ def test_a_perturbed_voxel_mesh_is_measured_as_the_clean_one(shape, perturbation
     assert np.max(np.abs(moved.mean[kept] - clean.mean[corner[kept]])) < 0.05 * largest
 
 
+def smoothed_solid(semi_axes, sigma):
+    """Marching cubes at 0.5 of an ellipsoid's mask blurred by a Gaussian of ``sigma`` voxels (the biology pipeline):
+    two coordinates of every vertex on the grid of 1 voxel, the third anywhere between its planes."""
+    skimage_measure = pytest.importorskip("skimage.measure")
+    from scipy.ndimage import gaussian_filter
+
+    axes = [np.arange(-int(a) - 7, int(a) + 8, dtype=float) + 0.37 for a in semi_axes]
+    x, y, z = np.meshgrid(*axes, indexing="ij", sparse=True)
+    mask = ((x / semi_axes[0]) ** 2 + (y / semi_axes[1]) ** 2 + (z / semi_axes[2]) ** 2 <= 1).astype(float)
+    vertices, faces, _, _ = skimage_measure.marching_cubes(gaussian_filter(mask, sigma), 0.5)
+    return vertices.astype(float), faces
+
+
+@pytest.mark.parametrize("semi_axes", [(20.0, 20.0, 20.0), (20.0, 20.0, 5.0), (30.0, 8.0, 8.0), (6.0, 6.0, 6.0)])
+def test_a_perturbed_smooth_image_mesh_is_on_the_grid_of_its_image(semi_axes):
+    # its interpolated coordinates are evenly spread between the planes (no full grid of half voxels as a mask's),
+    # and crowd at one level on a flat face (the grid of half voxels along that axis only): 1 x 1 x 1 voxels
+    vertices, faces = smoothed_solid(semi_axes, 1.0)
+    moved = vertices + np.random.default_rng(4).normal(size=vertices.shape) * 3e-3
+    grid = voxel_grid(moved, spacing=mean_edge(vertices, faces))
+    assert grid is not None
+    np.testing.assert_allclose(grid.spacing, 1.0, rtol=1e-3)
+
+
 SMOOTH_MESHES = {
     "icosphere(8)": lambda: shapes.icosphere(8),
     "icosphere(16)": lambda: shapes.icosphere(16),
@@ -136,12 +160,14 @@ def test_a_smooth_mesh_is_measured_as_smooth_when_perturbed():
     assert quiet(vertices, faces).parameters["surface"] == "smooth"
 
 
-def test_a_height_field_on_a_grid_with_periodic_heights_is_on_no_grid():
-    # x and y on a grid of 0.05, every vertex: z = 0.04 sin(..) crowds at its crests and troughs, periodic at a
-    # step in the band of the edge length, but few heights lie near its planes (VOXEL_AXIS_SHARE)
+def test_a_height_field_on_a_grid_with_periodic_heights_is_on_no_grid(monkeypatch):
+    # x and y on a grid of 0.05 at every vertex; z = 0.5 sin(3 x) takes the 41 values of the sine at the grid's x,
+    # periodic at a step in the band of the edge length, but few of them near its planes (VOXEL_AXIS_SHARE)
     x, y = np.meshgrid(np.arange(-1, 1.0001, 0.05), np.arange(-1, 1.0001, 0.05), indexing="ij")
-    z = 0.04 * np.sin(7.0 * x + 3.0 * y)
-    assert voxel_grid(np.c_[x.ravel(), y.ravel(), z.ravel()], spacing=0.05) is None
+    vertices = np.c_[x.ravel(), y.ravel(), 0.5 * np.sin(3.0 * x.ravel())]
+    assert voxel_grid(vertices, spacing=0.05) is None
+    monkeypatch.setattr(lattice, "VOXEL_AXIS_SHARE", 0.0)
+    assert voxel_grid(vertices, spacing=0.05) is not None  # (what the share rules out)
 
 
 def test_the_perturbation_read_is_bounded():

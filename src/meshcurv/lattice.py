@@ -147,15 +147,16 @@ def _evenly(candidates: np.ndarray, most: int) -> np.ndarray:
 
 #: Off the exact grid (:func:`voxel_grid`'s periodic reading), a coordinate is on a plane of the grid read when it
 #: lies within this share of the distance between its planes (the half voxels of a mask's isosurface: a fortieth of
-#: a voxel). Smooth meshes are read as voxel surfaces from about 0.3 of the distance on (the icosphere of 8
-#: subdivisions: 0.72 of its vertices with two coordinates within 0.2, 0.95 at 0.3), a voxel sphere of radius 4
-#: with every vertex moved by 0.03 edge lengths (a hundredth of a voxel along each axis) is read from 0.05 on
-#: (``benchmarks/lattice_perturbed.md``).
+#: a voxel). Voxel meshes whose every coordinate got Gaussian noise are read up to a hundredth of a voxel (0.975 to
+#: 0.997 of their vertices with two coordinates on the grid), not at two hundredths. Smooth meshes would be read from
+#: between 0.3 and 0.4 on (the periodic ones: the icosphere of 8 subdivisions 0.72 of its vertices at 0.2, 0.89 at
+#: 0.3, all at 0.4; ``shapes.cylinder()`` 0.875 at 0.2 and 0.3), a margin of 6 (``benchmarks/lattice_perturbed.md``).
 VOXEL_SNAP = 0.05
 
 #: ... and every axis holds at least this share of its coordinates on the planes (three times what chance puts
-#: within :data:`VOXEL_SNAP`: a height field sampled on a grid has two coordinates of every vertex on one, and the
-#: third is periodic where the heights crowd at two levels, a sine's crests and troughs, but seldom near its planes).
+#: within :data:`VOXEL_SNAP`): a height field sampled on a grid has two coordinates of every vertex on it, and the
+#: few values of a height that changes along one axis only are periodic, but seldom near their planes
+#: (``z = 0.5 sin(3 x)`` on a grid of 0.05: 0.17 to 0.27 of them).
 VOXEL_AXIS_SHARE = 1.0 / 3.0
 
 
@@ -272,7 +273,9 @@ def voxel_grid(vertices: np.ndarray, *, spacing: float | None = None) -> VoxelGr
     on the grid within :data:`VOXEL_SNAP` of the distance between its planes,
     and each axis with :data:`VOXEL_AXIS_SHARE` of its coordinates on them. A
     surface moved by a translation is on a grid of another origin; a rotated
-    one is on none (its grid is not along the coordinate axes).
+    one only while the rotation moves its vertices by less than about a
+    hundredth of a voxel (1e-3 radians on a sphere of radius 10 voxels; its
+    grid is then not along the coordinate axes).
 
     Examples
     --------
@@ -295,30 +298,64 @@ def _exact_voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
         if axis is None:
             return None
         found.append(axis)
-    return _on_voxel_grid(found, _EXACT)
+    return _on_voxel_grid(found)
 
 
 def _periodic_voxel_grid(vertices: np.ndarray, spacing: float | None) -> VoxelGrid | None:
-    """:func:`voxel_grid` on the coordinates' periodicity (see :data:`VOXEL_SNAP`)."""
+    """:func:`voxel_grid` on the coordinates' periodicity (see :data:`VOXEL_SNAP`).
+
+    Along each axis the planes read are refitted (least squares) to the coordinates within :data:`VOXEL_SNAP` of
+    them (the fit of :func:`_periodic_planes` takes those within a quarter step, where a smooth image's interpolated
+    coordinates pull the step off by a few thousandths: a few hundredths of a voxel across 25 planes). The voxel
+    grid is then every plane or every other one (one of the two kinds) along each axis, the coarsest choice
+    that keeps two coordinates of :data:`GRID_FRACTION` of the vertices on it: a mask's isosurface has every
+    coordinate on the half voxels' grid along every axis, a smooth image's where the surface crosses the voxels'
+    edges at one height (a flat face: its interpolated coordinates crowd at one level between the planes).
+    """
     if spacing is None or not (np.isfinite(spacing) and spacing > 0.0):
         return None
     probe = vertices[:: max(1, vertices.shape[0] // LATTICE_PROBE)]
-    found = []
+    axes = []
     for k in range(3):  # (most meshes: no periodic axis, settled by the first)
-        planes = _periodic_planes(vertices[:, k], probe[:, k], spacing)
+        values = vertices[:, k]
+        planes = _periodic_planes(values, probe[:, k], spacing, full=False)
         if planes is None:
             return None
         step, offset, _ = planes
-        index, off = _nearest_planes(vertices[:, k], step, offset)
+        for _ in range(2):
+            index, off = _nearest_planes(values, step, offset)
+            near = np.abs(off) <= VOXEL_SNAP * step
+            if not near.any() or np.ptp(index[near]) < LATTICE_PLANES - 1:
+                return None
+            step, offset = np.polyfit(index[near], values[near], 1)
+        index, off = _nearest_planes(values, step, offset)
         on_grid = np.abs(off) <= VOXEL_SNAP * step
         if on_grid.mean() < VOXEL_AXIS_SHARE:
             return None
-        found.append((step, offset, on_grid, index.astype(np.int64) % 2))
-    return _on_voxel_grid(found, VOXEL_SNAP * np.array([axis[0] for axis in found]))
+        even = index.astype(np.int64) % 2 == 0
+        # the choices along this axis: (spacing, origin, the coordinates on those planes)
+        axes.append(
+            [
+                (step, offset, on_grid),
+                (2 * step, offset, on_grid & even),
+                (2 * step, offset + step, on_grid & ~even),
+            ]
+        )
+    best: tuple = (0.0, 0.0, None)  # (voxel volume, fraction, choice)
+    for choice in itertools.product(*axes):
+        fraction = float((sum(on.astype(np.int64) for _, _, on in choice) >= 2).mean())
+        volume = float(np.prod([spacing for spacing, _, _ in choice]))
+        if fraction >= GRID_FRACTION and (volume, fraction) > best[:2]:
+            best = (volume, fraction, choice)
+    _, fraction, choice = best
+    if choice is None:
+        return None
+    tolerance = VOXEL_SNAP * np.array([axis[0][0] for axis in axes])
+    return VoxelGrid(np.array([c[0] for c in choice]), np.array([c[1] for c in choice]), fraction, tolerance)
 
 
-def _on_voxel_grid(found: list, tolerance: np.ndarray) -> VoxelGrid | None:
-    """The :class:`VoxelGrid` of the lattices ``found`` along the three axes (each ``(step, origin, on_grid,
+def _on_voxel_grid(found: list) -> VoxelGrid | None:
+    """The :class:`VoxelGrid` of the exact lattices ``found`` along the three axes (each ``(step, origin, on_grid,
     parity)``, the last two (V,)), or None when fewer than :data:`GRID_FRACTION` of the vertices have two
     coordinates on them."""
     on_grid = np.column_stack([axis[2] for axis in found])
@@ -335,8 +372,8 @@ def _on_voxel_grid(found: list, tolerance: np.ndarray) -> VoxelGrid | None:
         on_voxel_grid = on_grid & (parity == np.array(pattern))
         voxel_fraction = float((on_voxel_grid.sum(axis=1) >= 2).mean())
         if voxel_fraction >= GRID_FRACTION:
-            return VoxelGrid(2 * spacing, origin + np.array(pattern) * spacing, voxel_fraction, tolerance)
-    return VoxelGrid(spacing, origin, fraction, tolerance)
+            return VoxelGrid(2 * spacing, origin + np.array(pattern) * spacing, voxel_fraction, _EXACT)
+    return VoxelGrid(spacing, origin, fraction, _EXACT)
 
 
 def read_lattice(
@@ -516,20 +553,21 @@ def _shared_planes(values):
     return float(step), float(planes[0]), float(tolerance)
 
 
-def _periodic_planes(values, probe, spacing):
+def _periodic_planes(values, probe, spacing, *, full=True):
     """``(step, offset, tolerance)`` of the grid whose planes ``values`` (N,) lie about, or None.
 
     The modulus ``m(f)`` of the mean of ``exp(2 pi i f x)`` over the ``probe`` values (M,): its peaks within
     :data:`LATTICE_BAND` over every frequency at once (the Fourier transform of their histogram in bins of 1/32 of
     the ``spacing``), the :data:`LATTICE_PEAKS` strongest of at least :data:`LATTICE_PERIODIC` each measured at its
     top (the mean at 17 frequencies across its bin) and kept unless ``m(f) < LATTICE_FULL m(2 f) ** (1 / 4)`` where
-    ``m(2 f)`` is at least that (see :data:`LATTICE_FULL`). The grid's frequency is the lowest of those within
+    ``m(2 f)`` is at least that (see :data:`LATTICE_FULL`; not ``full``: a mesh of a smooth image has a third of its
+    coordinates between the planes, evenly spread, and ``m(f) = m(2 f)``). The grid's frequency is the lowest of those within
     :data:`LATTICE_HARMONIC` of the strongest (an exact grid's harmonics are as strong as its fundamental; two planes
     that hold many points, the treads at the poles, make peaks at every multiple of the inverse of their distance,
     weaker than the grid's). Its step and a plane are then fitted by least squares to the coordinates within a
     quarter step of the planes, and the tolerance is :data:`LATTICE_SNAP` times the coordinates' spread about them.
     """
-    found = _grid_frequency(probe, spacing)
+    found = _grid_frequency(probe, spacing, full=full)
     if found is None:
         return None
     frequency, mean, low = found
@@ -573,9 +611,9 @@ def _spectrum(probe, spacing):
     return modulus, frequency, band, low
 
 
-def _grid_frequency(probe, spacing):
+def _grid_frequency(probe, spacing, *, full=True):
     """``(frequency, mean, low)``: the grid's frequency, the mean of ``exp(2 pi i f (x - low))`` over the ``probe``
-    (M,) there and their least value ``low``, or None (see :func:`_periodic_planes`)."""
+    (M,) there and their least value ``low``, or None (see :func:`_periodic_planes`, ``full`` too)."""
     modulus, frequency, band, low = _spectrum(probe, spacing)
     if band.size < 3:
         return None
@@ -590,7 +628,7 @@ def _grid_frequency(probe, spacing):
         means = np.exp(2j * np.pi * np.outer(near, centred)).mean(axis=1)
         top = int(np.argmax(np.abs(means)))
         double = abs(np.exp(4j * np.pi * near[top] * centred).mean())
-        if double >= LATTICE_PERIODIC and abs(means[top]) < LATTICE_FULL * double**0.25:
+        if full and double >= LATTICE_PERIODIC and abs(means[top]) < LATTICE_FULL * double**0.25:
             continue  # (every second plane of a grid at 2 f; tested only where m(2 f) is above the sampling's floor)
         tops.append((near[top], means[top]))
     if not tops:
