@@ -11,6 +11,9 @@ import numpy as np
 
 from ._common import _JIT, _degenerate, _face_cross
 
+#: ``estimators.matgeom.NORMAL_GAP`` (the estimator passes it; the default for the direct calls of the twin tests).
+NORMAL_GAP = 1e-8
+
 
 @nb.njit(inline="always", **_JIT)
 def _rotation(app, aqq, apq, sweep):
@@ -105,14 +108,14 @@ def _magnitude_order(w0, w1, w2):
 
 @nb.njit(inline="always", **_JIT)
 def _ring_sums6(current, indptr, indices, i):
-    """Columns 0 to 5 of row ``i`` of ``current`` plus those of its neighbours (in list order, each
+    """Columns 0 to 5 of row ``i``'s neighbours (in list order) plus those of row ``i`` itself (each
     column's sum in registers), and ``1 / (degree + 1)``: one pass of ``smoothing.smooth_over_neighbours``
-    at ``i`` before its scaling, the same sums in the same order."""
+    at ``i`` before its scaling, the same sums in the same order (the sparse product from 0, then the
+    vertex's own value)."""
     start, stop = indptr[i], indptr[i + 1]
-    t0, t1, t2 = current[i, 0], current[i, 1], current[i, 2]
-    t3, t4, t5 = current[i, 3], current[i, 4], current[i, 5]
-    for j in range(start, stop):
-        w = indices[j]
+    t0 = t1 = t2 = t3 = t4 = t5 = 0.0
+    for j in range(start, stop + 1):  # the neighbours in list order, then the vertex itself
+        w = np.int64(indices[j]) if j < stop else np.int64(i)  # prange's i is unsigned: both int64
         t0 += current[w, 0]
         t1 += current[w, 1]
         t2 += current[w, 2]
@@ -123,8 +126,13 @@ def _ring_sums6(current, indptr, indices, i):
 
 
 @nb.njit(inline="always", **_JIT)
-def _principal_row(i, t0, t1, t2, t3, t4, t5, c1, c2, u1, u2, normal):
-    """Row ``i`` of :func:`matgeom_principal` from the tensor ``(t0, ..., t5)`` (xx, yy, zz, xy, xz, yz)."""
+def _principal_row(i, t0, t1, t2, t3, t4, t5, outputs, gap):
+    """Row ``i`` of :func:`matgeom_principal` from the tensor ``(t0, ..., t5)`` (xx, yy, zz, xy, xz, yz).
+
+    As ``estimators.matgeom._principal``: magnitudes within ``gap`` x the largest of each other give the
+    smaller value to the normal; eigenvalues within that of the normal's leave it undefined (NaN).
+    ``outputs`` is ``(c1, c2, u1, u2, normal)``, written at row ``i``."""
+    c1, c2, u1, u2, normal = outputs
     if not (
         math.isfinite(t0)
         and math.isfinite(t1)
@@ -140,6 +148,10 @@ def _principal_row(i, t0, t1, t2, t3, t4, t5, c1, c2, u1, u2, normal):
     w0, w1, w2, v00, v01, v02, v10, v11, v12, v20, v21, v22 = _jacobi3(t0, t1, t2, t3, t4, t5)
     o0, o1, o2 = _magnitude_order(w0, w1, w2)
     w = (w0, w1, w2)
+    tolerance = gap * abs(w[o2])
+    if abs(w[o1]) - abs(w[o0]) <= tolerance and w[o0] > w[o1]:  # a tie of magnitudes: matGeom's exact-tie order
+        o0, o1 = o1, o0
+    undefined = abs(w[o1] - w[o0]) <= tolerance  # the normal's eigenspace is a plane (or all of space)
     columns = ((v00, v10, v20), (v01, v11, v21), (v02, v12, v22))
     small, middle, large = columns[o0], columns[o1], columns[o2]
     a, b = w[o1], w[o2]
@@ -152,52 +164,42 @@ def _principal_row(i, t0, t1, t2, t3, t4, t5, c1, c2, u1, u2, normal):
     for k in range(3):
         u1[i, k] = first[k]
         u2[i, k] = second[k]
-        normal[i, k] = small[k]
+        normal[i, k] = np.nan if undefined else small[k]
 
 
 @nb.njit(parallel=True, **_JIT)
-def matgeom_principal(tensors):
+def matgeom_principal(tensors, gap=NORMAL_GAP):
     """matGeom's step 7 per vertex: eigenpairs by magnitude, the two largest as curvatures, swapped so c1 <= c2.
 
     Returns ``(c1, c2, u1, u2, normal)``: the eigenvalues of middle and largest
     magnitude (ordered), their eigenvectors (the curvature directions) and the
     eigenvector of the smallest magnitude (the normal); NaN rows where a
-    component is not finite. As ``estimators._eigen.sorted_by_magnitude`` and the
-    swap of ``estimators.matgeom.estimate``.
+    component is not finite, a NaN normal where it is undefined (``gap``: see
+    ``estimators.matgeom.NORMAL_GAP``). As ``estimators.matgeom._principal``.
     """
     n = tensors.shape[0]
-    c1, c2, u1, u2, normal = np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+    outputs = (np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)))
     for i in nb.prange(n):
-        _principal_row(
-            i,
-            tensors[i, 0],
-            tensors[i, 1],
-            tensors[i, 2],
-            tensors[i, 3],
-            tensors[i, 4],
-            tensors[i, 5],
-            c1,
-            c2,
-            u1,
-            u2,
-            normal,
-        )
-    return c1, c2, u1, u2, normal
+        row = tensors[i]
+        _principal_row(i, row[0], row[1], row[2], row[3], row[4], row[5], outputs, gap)
+    return outputs
 
 
 @nb.njit(parallel=True, **_JIT)
-def matgeom_finish(tensors, indptr, indices, steps):
+def matgeom_finish(tensors, indptr, indices, steps, gap=NORMAL_GAP):
     """matGeom's steps 6 and 7 in one kernel: ``steps`` passes of the 1-ring mean over the (V, 6)
     ``tensors`` (overwritten), then :func:`matgeom_principal` of the result.
 
     Each pass is ``smoothing.smooth_over_neighbours``'s, its sums in the same
-    order (the vertex's own value, then its neighbours in list order, times
+    order (the neighbours in list order, then the vertex's own value, times
     ``1 / (degree + 1)``), the six of a row in registers; the last pass goes
     straight into the eigen-decomposition, so that only one (V, 6) buffer is
     added to ``tensors``.
     """
+    if steps == 0:
+        return matgeom_principal(tensors, gap)
     n = tensors.shape[0]
-    c1, c2, u1, u2, normal = np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+    outputs = (np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)))
     current = tensors
     following = np.empty((n, 6)) if steps > 1 else tensors
     for step in range(steps):
@@ -205,30 +207,12 @@ def matgeom_finish(tensors, indptr, indices, steps):
         for i in nb.prange(n):
             t0, t1, t2, t3, t4, t5, scale = _ring_sums6(current, indptr, indices, i)
             if last:
-                _principal_row(
-                    i, t0 * scale, t1 * scale, t2 * scale, t3 * scale, t4 * scale, t5 * scale, c1, c2, u1, u2, normal
-                )
+                _principal_row(i, t0 * scale, t1 * scale, t2 * scale, t3 * scale, t4 * scale, t5 * scale, outputs, gap)
             else:
                 following[i, 0], following[i, 1], following[i, 2] = t0 * scale, t1 * scale, t2 * scale
                 following[i, 3], following[i, 4], following[i, 5] = t3 * scale, t4 * scale, t5 * scale
         current, following = following, current
-    if steps == 0:
-        for i in nb.prange(n):
-            _principal_row(
-                i,
-                tensors[i, 0],
-                tensors[i, 1],
-                tensors[i, 2],
-                tensors[i, 3],
-                tensors[i, 4],
-                tensors[i, 5],
-                c1,
-                c2,
-                u1,
-                u2,
-                normal,
-            )
-    return c1, c2, u1, u2, normal
+    return outputs
 
 
 @nb.njit(**_JIT)

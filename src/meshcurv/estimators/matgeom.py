@@ -17,6 +17,17 @@ itself adapted from G. Peyre's toolbox_graph ``compute_curvature``:
    largest are the curvatures, the smallest one's vector is the "normal";
    swapped so that ``C1 <= C2``.
 
+Where the normal's eigenvalue equals another one (to :data:`NORMAL_GAP` of the
+largest magnitude), its eigenvector is any vector of a plane (or of space), and
+matGeom's choice is that of its eigen-solver's round-off: flat or exactly
+coplanar neighbourhoods (a zero tensor), a cube's edge (a rank-1 tensor), a
+staircase of coordinates quantised at round-off, and every vertex of a closed
+mesh after thousands of smoothing passes (the mean tensor of a sphere is a
+multiple of the identity). There the normal is NaN and the vertex is
+``valid=False``, on both backends; the curvatures are kept (eigenvalues are
+defined, and a tie of magnitudes gives the smaller value to the normal, as
+matGeom's sort does for exact ties).
+
 The outputs are dimensionless (see the README: not curvatures in 1/length).
 
 References
@@ -43,6 +54,13 @@ from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages
 from ._eigen import sorted_by_magnitude
+
+#: Relative gap (of the tensor's largest eigenvalue magnitude) within which two eigenvalues are taken as
+#: equal in step 7. Both solvers (LAPACK, the compiled Jacobi) are within some 16 eps of |T| per
+#: eigenvalue and an eigenvector within that over its gap: at 1e-8 the normals of the two backends are
+#: within some 1e-6 of each other, while the meshes measured (matGeom's reference cases, thin, open,
+#: noisy and voxel meshes) have gaps either 0 (below 1e-14) or above 1e-7.
+NORMAL_GAP = 1e-8
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
 
@@ -188,6 +206,31 @@ def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages, 
     return tensors, ev1.size, int(wrong_face.sum()), int(out_of_range.sum()), mispaired
 
 
+def _principal(tensors: np.ndarray):
+    """NumPy path of matGeom's step 7: ``(c1, c2, u1, u2, normal)`` of (V, 6) tensors.
+
+    Eigenpairs by magnitude (:func:`sorted_by_magnitude`); magnitudes within
+    :data:`NORMAL_GAP` x the largest give the smaller value to the normal (matGeom's
+    order of exact ties); the normal is NaN where its eigenvalue is within that
+    of the middle one (its eigenspace then a plane); the two others are the
+    curvatures, swapped so that ``c1 <= c2``.
+    """
+    values, vectors = sorted_by_magnitude(tensors)
+    with np.errstate(invalid="ignore"):
+        tolerance = NORMAL_GAP * np.abs(values[:, 2])
+        tie = (np.abs(values[:, 1]) - np.abs(values[:, 0]) <= tolerance) & (values[:, 0] > values[:, 1])
+        values[tie] = values[tie][:, [1, 0, 2]]
+        vectors[tie] = vectors[tie][:, :, [1, 0, 2]]
+        undefined = np.abs(values[:, 1] - values[:, 0]) <= tolerance
+    c1, c2 = values[:, 1].copy(), values[:, 2].copy()
+    u1, u2, normal = vectors[:, :, 2].copy(), vectors[:, :, 1].copy(), vectors[:, :, 0].copy()
+    normal[undefined] = np.nan
+    swap = c1 > c2
+    c1[swap], c2[swap] = c2[swap], c1[swap]
+    u1[swap], u2[swap] = u2[swap], u1[swap]
+    return c1, c2, u1, u2, normal
+
+
 def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     """Run matGeom's algorithm. Returns ``(result, problems)``."""
     vertices, topology = mesh.vertices, mesh.topology
@@ -200,23 +243,21 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         stages.start("average vertex tensors")
         indptr, indices = topology.smoothing_lists(smoothing_steps)
         stages.start("retrieve curvatures")
-        c1, c2, u1, u2, normal = kernels.matgeom_finish(np.ascontiguousarray(tensors), indptr, indices, smoothing_steps)
+        c1, c2, u1, u2, normal = kernels.matgeom_finish(
+            np.ascontiguousarray(tensors), indptr, indices, smoothing_steps, NORMAL_GAP
+        )
     else:
         tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = matgeom_tensors(
             vertices, topology, smoothing_steps, stages
         )
         stages.start("retrieve curvatures")
         if kernels is not None:
-            c1, c2, u1, u2, normal = kernels.matgeom_principal(np.ascontiguousarray(tensors))
+            c1, c2, u1, u2, normal = kernels.matgeom_principal(np.ascontiguousarray(tensors), NORMAL_GAP)
         else:
-            values, vectors = sorted_by_magnitude(tensors)
-            c1, c2 = values[:, 1].copy(), values[:, 2].copy()
-            u1, u2, normal = vectors[:, :, 2].copy(), vectors[:, :, 1].copy(), vectors[:, :, 0].copy()
-            swap = c1 > c2
-            c1[swap], c2[swap] = c2[swap], c1[swap]
-            u1[swap], u2[swap] = u2[swap], u1[swap]
+            c1, c2, u1, u2, normal = _principal(tensors)
 
     finite = ~np.isnan(c1)  # NaN exactly where a tensor component is not finite
+    no_normal = finite & np.isnan(normal[:, 0])  # the normal's eigenvalue not apart from the middle one
     # matGeom's numbers are kept everywhere it computes them; valid=False marks
     # where they are not an estimate: vertices whose tensor drew on a defect
     # (boundary, non-manifold, bow-tie, flipped or zero-area neighbourhood, or an
@@ -226,7 +267,7 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     doubtful &= topology.referenced_vertices
     if doubtful.any() and smoothing_steps:
         doubtful = _smooth_vertex_field(doubtful.astype(np.float64), topology, smoothing_steps) > 0
-    valid = topology.referenced_vertices & finite & ~doubtful
+    valid = topology.referenced_vertices & finite & ~doubtful & ~no_normal
 
     n_boundary = int(topology.boundary_edges.sum())
     if n_boundary:
@@ -249,6 +290,15 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
             f"{n_nan_vertices} vertices have undefined tensors (zero-area faces, zero-length edges "
             "or the index errors above; matGeom stops with 'EIG: matrix contains Inf or NaN values'): "
             "they are NaN and valid=False"
+        )
+    n_no_normal = int((no_normal & topology.referenced_vertices & ~doubtful).sum())  # not counted below
+    if n_no_normal:
+        problems.append(
+            f"{n_no_normal} vertices have no normal: their tensor's smallest eigenvalue equals the next one "
+            f"(to {NORMAL_GAP:g} of the largest; a flat or coplanar neighbourhood, a crease, coordinates "
+            f"quantised at round-off, or a tensor smoothed into a multiple of the identity: "
+            f"{smoothing_steps} smoothing passes), so the eigenvector matGeom calls the normal is any vector "
+            "of a plane, decided by round-off: normal NaN and valid=False (the curvatures kept)"
         )
     n_unreferenced = int((~topology.referenced_vertices).sum())
     if n_unreferenced:
