@@ -75,7 +75,7 @@ def shares(vertices, spacing):
     probe = vertices[:: max(1, vertices.shape[0] // LATTICE_PROBE)]
     steps, offs = [], []
     for k in range(3):
-        planes = _periodic_planes(vertices[:, k], probe[:, k], spacing)
+        planes = _periodic_planes(vertices[:, k], probe[:, k], spacing, full=False)
         if planes is None:
             return None
         step, offset, _ = planes
