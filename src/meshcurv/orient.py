@@ -293,33 +293,38 @@ def _sides_from_neighbours(
     and the patches still pending.
     """
     inverted = inverted.copy()
-    decided = decided.copy()
     pending = pending.copy()
     n_vertices, n_labels = vertices.shape[0], inverted.shape[0]
-    normal = np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]])
-    normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
+    asked = np.flatnonzero(pending[patch])  # the faces of pending patches, and the decided ones at their corners
+    touched = np.zeros(n_vertices, dtype=bool)
+    touched[faces[asked]] = True
+    near = np.flatnonzero(decided[patch] & touched[faces].any(axis=1))
+    around = np.zeros((n_vertices, 3))  # the sum of the decided faces' unit normals at each vertex
+
+    def normals(rows):
+        corners = vertices[faces[rows]]
+        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
+        return np.where((flip[rows] ^ inverted[patch[rows]])[:, None], -normal, normal)
+
+    def add(rows):
+        normal = normals(rows)
+        for j in range(3):
+            around[:, j] += np.bincount(faces[rows].ravel(), np.repeat(normal[:, j], 3), n_vertices)
+
+    add(near)
     for _ in range(rounds):
-        anchor = decided[patch]
-        sign = np.where(flip ^ inverted[patch], -1.0, 1.0)[:, None]
-        around = np.stack(
-            [
-                sum(np.bincount(faces[anchor, k], (sign * normal)[anchor, j], n_vertices) for k in range(3))
-                for j in range(3)
-            ],
-            axis=1,
-        )
-        asked = pending[patch]
+        asked = asked[pending[patch[asked]]]
         seen = around[faces[asked]].sum(axis=1)  # (F', 3): the decided normals at each asked face's corners
-        mine = (sign * normal)[asked]
         owner = patch[asked]
-        score = np.bincount(owner, np.einsum("ij,ij->i", mine, seen), n_labels)
+        score = np.bincount(owner, np.einsum("ij,ij->i", normals(asked), seen), n_labels)
         scale = np.bincount(owner, np.linalg.norm(seen, axis=1), n_labels)
         adopt = pending & (np.abs(score) >= 0.5 * scale) & (scale > 0)
         if not adopt.any():
             break
         inverted[adopt & (score < 0)] ^= True
-        decided |= adopt
         pending &= ~adopt
+        add(asked[adopt[owner]])
     return inverted, pending
 
 
@@ -347,14 +352,12 @@ def _filled_volumes(
     area pi r^2, radius r, volume 2/3 pi r^3) is not. Arrays over the boundary only, no loop over faces.
     """
     faces, face_edges = topology.faces, topology.face_edges
-    # a side is inside its patch when its edge joins exactly two counted faces of that patch (they cancel)
-    pairs = topology.edge_faces[np.maximum(face_edges, 0)]  # (F, 3, 2)
-    own = np.arange(faces.shape[0])[:, None]
-    other = np.where(pairs[..., 0] == own, pairs[..., 1], pairs[..., 0])
-    other = np.maximum(other, 0)
-    inner = (topology.edge_face_counts[np.maximum(face_edges, 0)] == 2) & (patch[other] == patch[:, None])
-    inner &= counted[other] & (other != own)
-    rows, sides = np.nonzero(counted[:, None] & (face_edges >= 0) & ~inner)
+    # an edge is inside a patch when it joins exactly two counted faces of that patch (their sides cancel)
+    one, two = topology.edge_faces[:, 0], topology.edge_faces[:, 1]
+    inner = (topology.edge_face_counts == 2) & (one >= 0) & (two >= 0) & (one != two)
+    one, two = np.maximum(one, 0), np.maximum(two, 0)
+    inner &= (patch[one] == patch[two]) & counted[one] & counted[two]
+    rows, sides = np.nonzero(counted[:, None] & (face_edges >= 0) & ~inner[np.maximum(face_edges, 0)])
     empty = np.zeros(n_labels)
     if rows.size == 0:
         return empty, empty
@@ -422,12 +425,15 @@ def _next_boundary_edges(vertices, faces, patch, flip, counted, tail, head, owne
     if crowded.size == 0:
         return successor
     # the patch's normal at each crowded vertex: the sum of its counted faces' normals there
-    corners = faces[counted]
-    corner_keys = patch[counted].astype(np.int64)[:, None] * n_vertices + corners
+    at_crowded = np.zeros(vertices.shape[0], dtype=bool)
+    at_crowded[crowded % n_vertices] = True
+    near = counted & at_crowded[faces].any(axis=1)
+    corners = faces[near]
+    corner_keys = patch[near].astype(np.int64)[:, None] * n_vertices + corners
     normal = np.cross(
         vertices[corners[:, 1]] - vertices[corners[:, 0]], vertices[corners[:, 2]] - vertices[corners[:, 0]]
     )
-    normal = np.where(flip[counted][:, None], -normal, normal)
+    normal = np.where(flip[near][:, None], -normal, normal)
     at = np.searchsorted(crowded, corner_keys)
     hit = crowded[np.minimum(at, crowded.size - 1)] == corner_keys
     rows, _ = np.nonzero(hit)
