@@ -15,7 +15,8 @@ from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._support import ProgressCallback, Stages
 from .estimators.icc import voxel_pilot
-from .radius import _checked_radii, _notes_by_radius, _small_radius_note, _voxel_surface_radius
+from .lattice import voxel_grid
+from .radius import _checked_radii, _notes_by_radius, _off_grid_scale, _small_radius_note, _voxel_surface_radius
 from .result import CurvatureResult
 from .smoothing import check_smoothing_steps
 
@@ -23,6 +24,15 @@ __all__ = ["principal_curvatures", "multiscale_curvatures", "METHODS"]
 
 #: The names accepted by ``method=``.
 METHODS = tuple(ESTIMATORS)
+
+#: The methods that measure over a ring of faces, with no length scale: on a voxel surface (marching cubes)
+#: they read the staircase of the voxels as curvature, and the call's warning says so (issue 29: on a voxel
+#: sphere of radius 4 voxels, ``rusinkiewicz`` had 114 of 255 valid vertices off by more than half the
+#: curvature, ``quadric`` at the voxel default radius 192; the median H errors on the voxel spheres,
+#: ellipsoids and tori of ``benchmarks/accuracy_voxel.md``: ``normal_cycle`` 26-100%, ``rusinkiewicz``
+#: 100-434%, ``meyer`` 100-1130%, ``quadric`` 29-227%, against 0.5-25% for ``icc``). ``matgeom`` is left
+#: out: its values are matGeom's, dimensionless.
+RING_METHODS = ("normal_cycle", "rusinkiewicz", "meyer")
 
 
 def principal_curvatures(
@@ -204,9 +214,67 @@ def _computed(vertices, faces, estimator, options: dict, orient: str, weld, prog
             if estimator.name == "icc":
                 options["vertex_scale"] = vertex_scale
     result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
+    note = _staircase_note(mesh, estimator.name, found, result.parameters)
     return _finished(
-        mesh, estimator, result, problems, found, given_radius=radius is not None and not options.get("adaptive")
+        mesh,
+        estimator,
+        result,
+        [*problems, note] if note else problems,
+        found,
+        given_radius=radius is not None and not options.get("adaptive"),
     )
+
+
+def _staircase_note(mesh, method: str, found: dict, parameters: dict) -> str:
+    """The warning's sentence for a method that reads the staircase of a voxel surface, else ''.
+
+    The methods over a ring of faces (:data:`RING_METHODS`) on a mesh whose vertices lie on a voxel grid (read
+    as for the default radius, :func:`meshcurv.radius.voxel_surface_radius`), and ``quadric`` at the default
+    radius of a voxel surface (``found``: what that default was derived from), whose jets of degree 4 follow
+    the staircase there.
+    """
+    if method == "quadric" and found.get("surface") == "voxel":
+        return (
+            f"this mesh is a voxel surface (marching cubes, voxel {_shown(found['voxel_spacing'])}): method "
+            f"'quadric' fits jets of degree 4 that follow the staircase of the voxels at the default radius "
+            f"{parameters['radius']:.4g}, and many of its curvatures are off by a large share of the curvature "
+            f"itself; use the default method 'icc', which measures over balls scaled to the voxels, or pass a "
+            f"larger `radius`"
+        )
+    if method not in RING_METHODS:
+        return ""
+    spacing = _voxel_spacing(mesh)
+    if spacing is None:
+        return ""
+    return (
+        f"this mesh is a voxel surface (marching cubes, voxel {_shown(spacing)}): method {method!r} measures over "
+        f"a ring of faces, with no scale, and reads the staircase of the voxels as curvature (many of its "
+        f"curvatures are off by a large share of the curvature itself); use the default method 'icc', which "
+        f"measures over balls scaled to the voxels"
+    )
+
+
+def _voxel_spacing(mesh) -> tuple | None:
+    """The voxel size of a mesh whose vertices (but the needle vertices) lie on a voxel grid, else None.
+
+    The grid is read as for the default radius of a voxel surface (:func:`meshcurv.radius.voxel_surface_radius`:
+    :func:`meshcurv.lattice.voxel_grid` at the median length scale, a part far off the grid's scale not on it),
+    without its pilot pass.
+    """
+    referenced = mesh.topology.referenced_vertices & ~mesh.needles
+    if not referenced.any():
+        return None
+    scale = float(np.median(mesh.length_scales[referenced]))
+    grid = voxel_grid(mesh.vertices if referenced.all() else mesh.vertices[referenced], spacing=scale)
+    if grid is None or _off_grid_scale(mesh.length_scales[referenced], grid.spacing):
+        return None
+    return tuple(float(x) for x in grid.spacing)
+
+
+def _shown(spacing) -> str:
+    """A voxel size as the warning gives it: ``1`` or ``2 x 1 x 1``."""
+    values = [f"{x:.4g}" for x in spacing]
+    return values[0] if len(set(values)) == 1 else " x ".join(values)
 
 
 def multiscale_curvatures(
