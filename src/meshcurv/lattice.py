@@ -244,17 +244,22 @@ def _axis_lattice(values: np.ndarray):
     return spacing, origin, on_grid, whole.astype(np.int64) % 2
 
 
-def voxel_grid(vertices: np.ndarray, *, spacing: float | None = None) -> VoxelGrid | None:
+def voxel_grid(
+    vertices: np.ndarray, faces: np.ndarray | None = None, *, spacing: float | None = None
+) -> VoxelGrid | None:
     """The voxel grid a mesh's vertices lie on, or None.
 
     Parameters
     ----------
     vertices : ndarray of shape (V, 3)
         Vertex coordinates (of the referenced vertices).
+    faces : ndarray of shape (F, 3) of int, optional
+        The triangles (indices into ``vertices``): given, a mesh whose coordinates repeat too little is read from
+        their periodicity, at steps within :data:`LATTICE_BAND` of its median edge length, each face within one
+        voxel (see Notes); without them, only the exact reading is made.
     spacing : float, optional
-        The distance between neighbouring vertices (the median edge length): given, a mesh whose coordinates
-        repeat too little is read from their periodicity, at steps within :data:`LATTICE_BAND` of it (see Notes);
-        without it, only the exact reading is made.
+        The mesh's typical edge length for the periodic reading; default: the median length of the faces' first
+        edges (their corners 0 and 1).
 
     Returns
     -------
@@ -266,12 +271,15 @@ def voxel_grid(vertices: np.ndarray, *, spacing: float | None = None) -> VoxelGr
     Notes
     -----
     The grid is read from the coordinates that repeat (the exact reading), or,
-    where that finds none and ``spacing`` is given, from the coordinates' periodicity along each axis
+    where that finds none and ``faces`` are given, from the coordinates' periodicity along each axis
     (:func:`_periodic_planes`, as for point clouds: :func:`read_lattice`): a
     voxel surface whose vertices were moved off the grid by a little (up to a
     hundredth of a voxel or so, see :data:`VOXEL_SNAP`), each coordinate then
     on the grid within :data:`VOXEL_SNAP` of the distance between its planes,
-    and each axis with :data:`VOXEL_AXIS_SHARE` of its coordinates on them. A
+    each axis with :data:`VOXEL_AXIS_SHARE` of its coordinates on them, and
+    :data:`GRID_FRACTION` of the faces within one voxel (as marching cubes
+    makes them: a height field sampled on a grid has its x and y there, and
+    its faces across the planes of its heights). A
     surface moved by a translation is on a grid of another origin; a rotated
     one only while the rotation moves its vertices by less than about a
     hundredth of a voxel (1e-3 radians on a sphere of radius 10 voxels; its
@@ -287,7 +295,21 @@ def voxel_grid(vertices: np.ndarray, *, spacing: float | None = None) -> VoxelGr
     if vertices.shape[0] < 16:
         return None
     exact = _exact_voxel_grid(vertices)
-    return exact if exact is not None else _periodic_voxel_grid(vertices, spacing)
+    if exact is not None or faces is None or len(faces) == 0:
+        return exact
+    if spacing is None:
+        spacing = float(np.median(np.linalg.norm(vertices[faces[:, 1]] - vertices[faces[:, 0]], axis=1)))
+    grid = _periodic_voxel_grid(vertices, spacing)
+    if grid is None:
+        return None
+    # every face of marching cubes lies within one voxel (its corners on the edges of one cube): along each axis
+    # its coordinates within one cell of the grid, to twice the tolerance (nine coordinates, a third of them on
+    # the cell's faces)
+    cells = (vertices[faces] - grid.origin) / grid.spacing
+    slack = 2 * grid.tolerance / grid.spacing
+    low = np.floor(cells.min(axis=1) + slack)
+    within = (cells.max(axis=1) <= low + 1 + slack).all(axis=1)
+    return grid if within.mean() >= GRID_FRACTION else None
 
 
 def _exact_voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
@@ -301,7 +323,7 @@ def _exact_voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
     return _on_voxel_grid(found)
 
 
-def _periodic_voxel_grid(vertices: np.ndarray, spacing: float | None) -> VoxelGrid | None:
+def _periodic_voxel_grid(vertices: np.ndarray, spacing: float) -> VoxelGrid | None:
     """:func:`voxel_grid` on the coordinates' periodicity (see :data:`VOXEL_SNAP`).
 
     Along each axis the planes read are refitted (least squares) to the coordinates within :data:`VOXEL_SNAP` of
@@ -312,7 +334,7 @@ def _periodic_voxel_grid(vertices: np.ndarray, spacing: float | None) -> VoxelGr
     coordinate on the half voxels' grid along every axis, a smooth image's where the surface crosses the voxels'
     edges at one height (a flat face: its interpolated coordinates crowd at one level between the planes).
     """
-    if spacing is None or not (np.isfinite(spacing) and spacing > 0.0):
+    if not (np.isfinite(spacing) and spacing > 0.0):
         return None
     probe = vertices[:: max(1, vertices.shape[0] // LATTICE_PROBE)]
     axes = []

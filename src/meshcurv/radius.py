@@ -559,9 +559,13 @@ def _voxel_surface_radius(
     spikes = mesh.needles
     referenced = topology.referenced_vertices & ~spikes
     # (no copy of a whole mesh); a mesh whose vertices left the grid by a little is read from the periodicity of
-    # its coordinates, at steps of a few of its edge lengths (the median edge of its parts: their length scales)
+    # its coordinates and its faces (each within one voxel): those without a needle's vertex
+    faces = topology.faces[~spikes[topology.faces].any(axis=1)]
     scale = float(np.median(mesh.length_scales[referenced])) if referenced.any() else 0.0
-    grid = voxel_grid(vertices if referenced.all() else vertices[referenced], spacing=scale)
+    if referenced.all():
+        grid = voxel_grid(vertices, faces, spacing=scale)
+    else:
+        grid = voxel_grid(vertices[referenced], (np.cumsum(referenced) - 1)[faces], spacing=scale)
     if grid is None or _off_grid_scale(mesh.length_scales[referenced], grid.spacing):
         return None
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
