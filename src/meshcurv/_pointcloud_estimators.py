@@ -794,15 +794,15 @@ def _triangle_sums(points, normals, index, counts, pattern):
     return measures.sum(axis=1)
 
 
-def ball_size(radius: float, spacing: float) -> int:
-    """Neighbours to query for balls of ``radius`` at this spacing: 1.3 times the expected count, capped.
+def ball_size(radius: float, spacing: float, most: int = MAX_BALL_POINTS) -> int:
+    """Neighbours to query for balls of ``radius`` at this spacing: 1.3 times the expected count, at most ``most``.
 
     A fuller ball is cut to its nearest points (the error did not change
     between 1.2 and 2 times the expected count in ``benchmarks/pointcloud.py``,
     and the query's time grows with it).
     """
-    expected = np.pi * (radius / spacing) ** 2 if spacing > 0 else MAX_BALL_POINTS
-    return int(min(MAX_BALL_POINTS, max(2 * MIN_BALL_POINTS, np.ceil(1.3 * expected))))
+    expected = np.pi * (radius / spacing) ** 2 if spacing > 0 else most
+    return int(min(most, max(2 * MIN_BALL_POINTS, np.ceil(1.3 * expected))))
 
 
 def _usable_tree(tree, points, usable):
@@ -971,7 +971,8 @@ def corrected_measures(
     # the check of unsteady: the same measures over balls LARGER times larger, from the same search
     check = details is not None
     wide = radius * LARGER
-    k_wide = min(ball_size(wide, spacing), n)
+    # (a ball cut to its nearest points is cut LARGER^2 times wider for the check, else both are the same points)
+    k_wide = min(ball_size(wide, spacing, most=round(MAX_BALL_POINTS * LARGER**2)), n)
     larger = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)] if check else []
     if kernels is not None:  # the grid of the compiled ball searches, once for all the chunks
         grid = numba_kernels("neighborhoods").pool_grid(
