@@ -82,7 +82,7 @@ from ._geometry import (
 )
 from .geometry import _floats, checked_topology_points
 from .jets import SETTLED_SLOPE, _fit_jets
-from .lattice import voxel_grid
+from .lattice import VoxelGrid, voxel_grid
 from .neighborhoods import _checked_ids
 from .topology import MeshTopology
 
@@ -558,15 +558,8 @@ def _voxel_surface_radius(
     # is in no extent, area or percentile below: the needles' vertices and faces are left out everywhere
     spikes = mesh.needles
     referenced = topology.referenced_vertices & ~spikes
-    # (no copy of a whole mesh); a mesh whose vertices left the grid by a little is read from the periodicity of
-    # its coordinates and its faces (each within one voxel): those without a needle's vertex
-    faces = topology.faces[~spikes[topology.faces].any(axis=1)]
-    scale = float(np.median(mesh.length_scales[referenced])) if referenced.any() else 0.0
-    if referenced.all():
-        grid = voxel_grid(vertices, faces, spacing=scale)
-    else:
-        grid = voxel_grid(vertices[referenced], (np.cumsum(referenced) - 1)[faces], spacing=scale)
-    if grid is None or _off_grid_scale(mesh.length_scales[referenced], grid.spacing):
+    grid = _mesh_voxel_grid(mesh)
+    if grid is None:
         return None
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
     curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
@@ -607,6 +600,28 @@ def _voxel_surface_radius(
         )
         found["vertex_scale"] = (np.minimum(radii, extent), normal_radii)
     return radius, found
+
+
+def _mesh_voxel_grid(mesh: _Measured | PreparedMesh) -> VoxelGrid | None:
+    """The voxel grid of a mesh (:func:`meshcurv.lattice.voxel_grid`) but its needles' vertices and faces, or None,
+    also where a part is of another scale than the grid (:func:`_off_grid_scale`).
+
+    A mesh whose vertices left the grid by a little is read from the periodicity of its coordinates, at steps about
+    the median of its length scales, and from its faces (each within one voxel).
+    """
+    topology, spikes = mesh.topology, mesh.needles
+    referenced = topology.referenced_vertices & ~spikes
+    if not referenced.any():
+        return None
+    faces = topology.faces[~spikes[topology.faces].any(axis=1)]
+    scale = float(np.median(mesh.length_scales[referenced]))
+    if referenced.all():  # (no copy of a whole mesh)
+        grid = voxel_grid(mesh.vertices, faces, spacing=scale)
+    else:
+        grid = voxel_grid(mesh.vertices[referenced], (np.cumsum(referenced) - 1)[faces], spacing=scale)
+    if grid is None or _off_grid_scale(mesh.length_scales[referenced], grid.spacing):
+        return None
+    return grid
 
 
 def _off_grid_scale(scales: np.ndarray, spacing: np.ndarray) -> bool:
