@@ -91,8 +91,8 @@ def orient_faces(vertices, faces, *, outward: bool = True) -> tuple[np.ndarray, 
     faces; there is no Python loop over faces or edges, and a loop over pairs
     of closed patches only where one's bounding box holds a corner of the other.
     Open patches add a few passes over the faces and a sort of their boundary
-    edges, and up to :data:`NEIGHBOUR_ROUNDS` (:data:`GROUP_ROUNDS`) passes where
-    pieces take their side from their neighbours.
+    edges, and a breadth-first walk over the patches that share vertices
+    where pieces take their side from their neighbours.
 
     Examples
     --------
@@ -206,10 +206,10 @@ def _outward(vertices, topology, patch, flip, invert, n_labels, needles) -> np.n
     cavity = _nesting_depth(vertices, faces, patch, decided) % 2 == 1
     inverted = np.where(decided & cavity, ~inverted, inverted)
     pending = open_patch & ~decided
-    if decided.any() and pending.any():  # small pieces beside a decided patch (between its holes) take its side
-        inverted, pending = _sides_from_neighbours(vertices, faces, patch, flip, inverted, decided, pending)
-    if pending.any():  # pieces of one surface (half its faces gone) that touch only each other: decided together
-        inverted = _sides_of_groups(vertices, topology, patch, flip, inverted, pending, face_kept_mask(kept, faces))
+    if pending.any():  # pieces between the holes of a decided patch, or of a surface with half its faces gone
+        inverted = _sides_of_pieces(
+            vertices, topology, patch, flip, inverted, decided, pending, face_kept_mask(kept, faces)
+        )
     return inverted
 
 
@@ -218,53 +218,98 @@ def face_kept_mask(kept, faces) -> np.ndarray:
     return np.ones(faces.shape[0], dtype=bool) if isinstance(kept, slice) else kept
 
 
-def _sides_of_groups(vertices, topology, patch, flip, inverted, pending, kept) -> np.ndarray:
-    """``inverted`` with each group of ``pending`` patches joined through shared vertices turned outward together.
+def _sides_of_pieces(vertices, topology, patch, flip, inverted, decided, pending, kept) -> np.ndarray:
+    """``inverted`` with the ``pending`` patches (open, undecided on their own) given the side of their neighbours.
 
-    In each group the largest patch keeps its side and the others take theirs from it
-    (:func:`_sides_from_neighbours`); the group is then one patch of :func:`_filled_volumes`, turned outward when
-    its volume with the holes filled is decided, as a nearly closed patch's is. A sphere with half of its faces
-    removed falls apart into patches of a few faces (each undecided), which together are a sphere with small holes.
+    Two patches that share vertices are linked when their face normals there clearly agree or clearly disagree
+    (the sum of the dot products of their unit normals at the shared vertices is at least half of the sum of
+    the magnitudes): a piece between the holes of a sphere follows its neighbours. The links of a spanning tree
+    of the clearest ones (:func:`scipy.sparse.csgraph.minimum_spanning_tree`) are walked from the decided
+    patches, whose sides are kept, and from the largest pending patch of each set of linked patches that holds no decided one; each
+    such set (the pieces of a sphere with half of its faces removed) is then one patch of
+    :func:`_filled_volumes`, turned outward when its volume with the holes filled is decided, as a nearly
+    closed patch's is. Patches with no clear link keep their majority orientation.
     """
     import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
-    from scipy.sparse.csgraph import connected_components
+    from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
 
     faces = topology.faces
-    n_vertices, n_labels = vertices.shape[0], inverted.shape[0]
+    n_vertices, n_labels = np.int64(vertices.shape[0]), inverted.shape[0]
     asked = pending[patch]
-    corners = faces[asked]
-    links = sp.csr_matrix(
-        (
-            np.ones(2 * corners.shape[0], dtype=np.int8),
-            (np.r_[corners[:, 0], corners[:, 0]], np.r_[corners[:, 1], corners[:, 2]]),
-        ),
-        shape=(n_vertices, n_vertices),
-    )
-    _, vertex_group = connected_components(links, directed=False)
-    group_of_patch = np.full(n_labels, -1, dtype=np.int64)
-    group_of_patch[patch[asked]] = vertex_group[corners[:, 0]]
-    _, group_of_patch[pending] = np.unique(group_of_patch[pending], return_inverse=True)
-    n_groups = int(group_of_patch.max()) + 1
-    size = np.bincount(patch, minlength=n_labels).astype(np.float64)
-    # the largest patch of each group: sort by (group, size) and take each group's last
-    members = np.flatnonzero(pending)
-    order = members[np.lexsort((size[members], group_of_patch[members]))]
-    ends = np.searchsorted(group_of_patch[order], np.arange(n_groups), side="right") - 1
-    seeds = np.zeros(n_labels, dtype=bool)
-    seeds[order[ends]] = True
-    inverted, left = _sides_from_neighbours(
-        vertices, faces, patch, flip, inverted, seeds, pending & ~seeds, rounds=GROUP_ROUNDS
-    )
-    joined = pending & ~left  # the patches whose side follows their group's seed
-    label = np.where(joined, group_of_patch, n_groups)[patch]  # the others: one label past the groups, not counted
-    counted = kept & joined[patch]
+    touched = np.zeros(vertices.shape[0], dtype=bool)
+    touched[faces[asked]] = True
+    rows = np.flatnonzero(asked | (decided[patch] & touched[faces].any(axis=1)))
+    corners = vertices[faces[rows]]
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
+    normal = np.where((flip[rows] ^ inverted[patch[rows]])[:, None], -normal, normal)
+    # nodes: (patch, vertex) with the sum of the patch's unit normals there; links between the patches at a vertex
+    nodes, node_of = np.unique(patch[rows].astype(np.int64)[:, None] * n_vertices + faces[rows], return_inverse=True)
+    node_of = node_of.reshape(-1)
+    sums = np.stack([np.bincount(node_of, np.repeat(normal[:, j], 3), nodes.size) for j in range(3)], axis=1)
+    owner, vertex = nodes // n_vertices, nodes % n_vertices
+    order = np.lexsort((owner, vertex))
+    # every pair of patches at a vertex where up to PAIRED_PATCHES meet (the next ones in order elsewhere)
+    one = np.concatenate([order[:-step] for step in range(1, PAIRED_PATCHES)])
+    two = np.concatenate([order[step:] for step in range(1, PAIRED_PATCHES)])
+    same = vertex[one] == vertex[two]
+    one, two = one[same], two[same]
+    pair, pair_of = np.unique(owner[one] * n_labels + owner[two], return_inverse=True)
+    score = np.bincount(pair_of, np.einsum("ij,ij->i", sums[one], sums[two]), pair.size)
+    scale = np.bincount(pair_of, np.linalg.norm(sums[one], axis=1) * np.linalg.norm(sums[two], axis=1), pair.size)
+    # rounded: a lattice's exact ratios (a half, at right angles) decided alike after any scaling, not by round-off
+    ratio = np.round(np.abs(score) / np.maximum(scale, np.finfo(float).tiny), 9)
+    clear = (ratio >= 0.5) & (scale > 0)
+    first, second = pair[clear] // n_labels, pair[clear] % n_labels
+    against = (score[clear] < 0).astype(np.int8) + 1  # 1: the same side, 2: opposite sides
+    linked = sp.csr_matrix((against, (first, second)), shape=(n_labels, n_labels))
+    n_sets, set_of = connected_components(linked, directed=False)
+    # the roots: every decided patch, and the largest pending patch of each set with no decided patch
+    has_decided = np.bincount(set_of, weights=decided, minlength=n_sets) > 0
+    size = np.bincount(patch, minlength=n_labels)
+    members = np.flatnonzero(pending & ~has_decided[set_of])
+    seeds = members[np.lexsort((size[members], set_of[members]))]
+    if seeds.size:
+        seeds = seeds[np.r_[set_of[seeds][1:] != set_of[seeds][:-1], True]]  # the last (largest) of each set
+    roots = np.flatnonzero(decided & has_decided[set_of])
+    roots = np.concatenate([roots, seeds])
+    root = n_labels  # one more node, joined to the roots
+    ends = (np.r_[first, np.full(roots.size, root)], np.r_[second, roots])
+    shape = (n_labels + 1, n_labels + 1)
+    graph = sp.csr_matrix((np.r_[against, np.ones(roots.size, dtype=np.int8)], ends), shape=shape)
+    graph = (graph + graph.T).tocsr()  # both directions (a pair is listed once)
+    # the clearest links first: a spanning tree of the least doubt (the roots' links cheapest), walked from the root
+    doubt = np.r_[1.5 - ratio[clear], np.full(roots.size, 0.1)]
+    tree = minimum_spanning_tree(sp.csr_matrix((doubt, ends), shape=shape))
+    reached, parent = breadth_first_order(tree, root, directed=False, return_predecessors=True)
+    # the side of each reached patch relative to its root: the parity of the opposite links on its way there
+    parent = np.where(parent < 0, np.arange(n_labels + 1), parent)
+    turned = np.zeros(n_labels + 1, dtype=bool)
+    step = reached[reached != root]
+    turned[step] = np.asarray(graph[parent[step], step]).reshape(-1) == 2
+    for _ in range(int(np.ceil(np.log2(n_labels + 2))) + 1):  # pointer doubling: each pass doubles the reach
+        turned ^= turned[parent]
+        parent = parent[parent]
+    joined = np.zeros(n_labels + 1, dtype=bool)
+    joined[step] = True
+    joined = joined[:n_labels] & pending
+    inverted = np.where(joined, inverted ^ turned[:n_labels], inverted)
+    # the sets grown from a seed: one patch each, turned outward when its volume with the holes filled is decided
+    grown = joined & ~has_decided[set_of]
+    if not grown.any():
+        return inverted
+    label = np.where(grown, set_of, n_sets)[patch]  # the others: one label past the sets, not counted
+    counted = kept & grown[patch]
     wound = flip ^ inverted[patch]
-    signed, _ = _patch_volumes(vertices, faces[counted], label[counted], wound[counted], n_groups + 1)
-    filled, doubt = _filled_volumes(vertices, topology, label, wound, counted, n_groups + 1)
-    total = (signed + filled)[:n_groups]
-    turn = (np.abs(total) > FILLED_MARGIN * doubt[:n_groups]) & (total < 0)
-    return np.where(joined & turn[np.maximum(group_of_patch, 0)], ~inverted, inverted)
+    signed, _ = _patch_volumes(vertices, faces[counted], label[counted], wound[counted], n_sets + 1)
+    filled, doubt = _filled_volumes(vertices, topology, label, wound, counted, n_sets + 1)
+    total = (signed + filled)[:n_sets]
+    turn = (np.abs(total) > FILLED_MARGIN * doubt[:n_sets]) & (total < 0)
+    return np.where(grown & turn[set_of], ~inverted, inverted)
 
+
+#: :func:`_sides_of_pieces` links every two of the patches at a vertex where at most this many meet.
+PAIRED_PATCHES = 5
 
 #: Angles about a vertex closer than this (radians) are ties (:func:`_next_boundary_edges`).
 ANGLE_TIE = 1e-9
@@ -273,60 +318,6 @@ ANGLE_TIE = 1e-9
 #: angles: the first, or the second where the vertex's normal is near the first.
 SLANTED = np.array([[np.sqrt(2.0), np.sqrt(3.0), np.sqrt(5.0)], [np.sqrt(7.0), -np.sqrt(11.0), np.sqrt(13.0)]])
 SLANTED /= np.linalg.norm(SLANTED, axis=1)[:, None]
-
-#: :func:`_sides_from_neighbours` passes the side on through at most this many patches in a row: from decided
-#: patches, and from the seed of a group of undecided ones (:func:`_sides_of_groups`).
-NEIGHBOUR_ROUNDS = 8
-GROUP_ROUNDS = 32
-
-
-def _sides_from_neighbours(
-    vertices, faces, patch, flip, inverted, decided, pending, rounds: int = NEIGHBOUR_ROUNDS
-) -> tuple[np.ndarray, np.ndarray]:
-    """``inverted`` with the ``pending`` patches that share vertices with decided ones turned to agree with them.
-
-    A pending patch (open, its side not decided on its own: a few faces between the holes of a decided
-    patch) takes the side whose face normals point along those of the decided faces at their shared
-    vertices (the sum of their dot products), when that sum is at least half of the sum of their magnitudes
-    (the two sides clearly differ); it is then decided, and passes its side on, for at most
-    ``rounds`` rounds. Patches that touch no decided one keep their majority orientation. Returns ``inverted``
-    and the patches still pending.
-    """
-    inverted = inverted.copy()
-    pending = pending.copy()
-    n_vertices, n_labels = vertices.shape[0], inverted.shape[0]
-    asked = np.flatnonzero(pending[patch])  # the faces of pending patches, and the decided ones at their corners
-    touched = np.zeros(n_vertices, dtype=bool)
-    touched[faces[asked]] = True
-    near = np.flatnonzero(decided[patch] & touched[faces].any(axis=1))
-    around = np.zeros((n_vertices, 3))  # the sum of the decided faces' unit normals at each vertex
-
-    def normals(rows):
-        corners = vertices[faces[rows]]
-        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
-        return np.where((flip[rows] ^ inverted[patch[rows]])[:, None], -normal, normal)
-
-    def add(rows):
-        normal = normals(rows)
-        for j in range(3):
-            around[:, j] += np.bincount(faces[rows].ravel(), np.repeat(normal[:, j], 3), n_vertices)
-
-    add(near)
-    for _ in range(rounds):
-        asked = asked[pending[patch[asked]]]
-        seen = around[faces[asked]].sum(axis=1)  # (F', 3): the decided normals at each asked face's corners
-        owner = patch[asked]
-        score = np.bincount(owner, np.einsum("ij,ij->i", normals(asked), seen), n_labels)
-        scale = np.bincount(owner, np.linalg.norm(seen, axis=1), n_labels)
-        adopt = pending & (np.abs(score) >= 0.5 * scale) & (scale > 0)
-        if not adopt.any():
-            break
-        inverted[adopt & (score < 0)] ^= True
-        pending &= ~adopt
-        add(asked[adopt[owner]])
-    return inverted, pending
-
 
 #: An open patch is turned outward when its volume with the holes filled is more than this many times the
 #: volume its fills could be wrong by (:func:`_filled_volumes`): a sphere with a few small holes is, a hemisphere
