@@ -82,3 +82,13 @@ def test_a_rotated_voxel_surface_is_on_no_grid_and_not_warned_of(voxel_sphere):
     rotation = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
     _, messages = _messages(vertices @ rotation.T, faces, method="rusinkiewicz")
     assert not any("voxel surface" in message for message in messages)
+
+
+def test_a_voxel_surface_slightly_off_its_grid_is_named_too(voxel_sphere):
+    """The grid is read as the default radius reads it: coordinates moved by 1e-9 (a soup's copies, a
+    round trip through single precision) leave it a voxel surface (``radius._mesh_voxel_grid``)."""
+    vertices, faces = voxel_sphere
+    moved = vertices * (1 + 1e-9 * np.random.default_rng(0).uniform(-1, 1, size=vertices.shape))
+    result, messages = _messages(moved, faces, method="rusinkiewicz")
+    assert len(messages) == 1 and "voxel surface (marching cubes, voxel 1)" in messages[0]
+    assert _off_sphere(result, moved).sum() > 0.05 * result.valid.sum()

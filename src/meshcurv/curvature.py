@@ -15,8 +15,13 @@ from .errors import InvalidOptionError, MeshQualityWarning
 from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._support import ProgressCallback, Stages
 from .estimators.icc import voxel_pilot
-from .lattice import voxel_grid
-from .radius import _checked_radii, _notes_by_radius, _off_grid_scale, _small_radius_note, _voxel_surface_radius
+from .radius import (
+    _checked_radii,
+    _mesh_voxel_grid,
+    _notes_by_radius,
+    _small_radius_note,
+    _voxel_surface_radius,
+)
 from .result import CurvatureResult
 from .smoothing import check_smoothing_steps
 
@@ -257,18 +262,11 @@ def _staircase_note(mesh, method: str, found: dict, parameters: dict) -> str:
 def _voxel_spacing(mesh) -> tuple | None:
     """The voxel size of a mesh whose vertices (but the needle vertices) lie on a voxel grid, else None.
 
-    The grid is read as for the default radius of a voxel surface (:func:`meshcurv.radius.voxel_surface_radius`:
-    :func:`meshcurv.lattice.voxel_grid` at the median length scale, a part far off the grid's scale not on it),
+    The grid is read as for the default radius of a voxel surface (:func:`meshcurv.radius._mesh_voxel_grid`),
     without its pilot pass.
     """
-    referenced = mesh.topology.referenced_vertices & ~mesh.needles
-    if not referenced.any():
-        return None
-    scale = float(np.median(mesh.length_scales[referenced]))
-    grid = voxel_grid(mesh.vertices if referenced.all() else mesh.vertices[referenced], spacing=scale)
-    if grid is None or _off_grid_scale(mesh.length_scales[referenced], grid.spacing):
-        return None
-    return tuple(float(x) for x in grid.spacing)
+    grid = _mesh_voxel_grid(mesh)
+    return None if grid is None else tuple(float(x) for x in grid.spacing)
 
 
 def _shown(spacing) -> str:
