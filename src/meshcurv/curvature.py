@@ -118,7 +118,9 @@ def principal_curvatures(
         Face orientation before the computation (:func:`meshcurv.orient.orient_faces`):
         ``'outward'`` reverses the fewest faces that make each patch (faces
         joined by manifold edges) consistently oriented, and turns every closed
-        patch outward (positive volume), so that a convex solid gets positive
+        patch outward (positive volume), and every nearly closed one (small
+        holes: its volume with the holes filled; a hemisphere or a saddle keeps
+        its majority), so that a convex solid gets positive
         curvature however its faces were wound (marching cubes winds them
         inward); ``'consistent'`` does the same but keeps the majority
         orientation of closed patches too; ``'keep'`` uses the faces as given
