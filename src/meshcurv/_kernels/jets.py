@@ -18,6 +18,7 @@ from ._common import (
     _JIT_INNER_REASSOC,
     _TINY,
     _UNSIGNED,
+    _JitOptions,
     _tangent_frame,
     run_chunks,
     run_slots,
@@ -92,19 +93,91 @@ def _cholesky_solve(a, b, low, m, min_spread, scale, total):
     return _cholesky_inline(a, b, low, m, min_spread, scale, total)
 
 
-@nb.njit(**_JIT_INNER)
-def _cholesky_solve_fixed(a, b, low, m, min_spread, scale, total):
-    """:func:`_cholesky_inline` of size 10 (the cubic jets of the normal fits) or 6 (the quadratic jets a cubic
-    fit falls back to; ``m`` is one of them): the loops' bounds are constants, which the compiler unrolls (the
-    same operations in the same order: the same numbers). One function for both sizes: one compilation."""
-    if m == 10:
-        return _cholesky_inline(a, b, low, 10, min_spread, scale, total)
-    return _cholesky_inline(a, b, low, 6, min_spread, scale, total)
+def _straight_solve_source(m: int) -> str:
+    """The source of ``solve(moments, right, solution, min_spread)``: :func:`_fit_one`'s scaling and
+    :func:`_cholesky_inline` of the first ``m`` (10 or 6) exponents of ``jets._exponents(3)``, written out.
+
+    The loops of :func:`_fit_one` (the scales ``1 / sqrt(max(moments[2 i, 2 k], tiny))``, the lower triangle of
+    the scaled normal matrix read from ``moments``) and of :func:`_cholesky_inline` (the factor, the spread from
+    the columns of its inverse, the two substitutions) are unrolled here, each quantity a local variable: the
+    same operations in the same order (the same numbers, the same decisions: False where a pivot is not above
+    :data:`_PIVOT_FLOOR` or the points are not spread), with no loads and stores of scratch arrays between them
+    and no index arithmetic (issue 31: the 10 x 10 solve took about a quarter of the normal fits' instructions).
+    Writes ``solution[:6]``, the coefficients in the monomials' own units (scaled back), when it returns True.
+    """
+    exponents = [(total - k, k) for total in range(4) for k in range(total + 1)][:m]
+    lines = ["def solve(moments, right, solution, min_spread):"]
+    add = lines.append
+    used = sorted({(i + p, k + q) for i, k in exponents for p, q in exponents})
+    for i, k in used:
+        add(f"    q{i}_{k} = moments[{i}, {k}]")
+    for r, (i, k) in enumerate(exponents):
+        add(f"    s{r} = 1.0 / math.sqrt(_TINY if _TINY > q{2 * i}_{2 * k} else q{2 * i}_{2 * k})")
+    for r, (i, k) in enumerate(exponents):
+        for c, (p, q) in enumerate(exponents[: r + 1]):
+            add(f"    a{r}_{c} = q{i + p}_{k + q} * s{r} * s{c}")
+    for k in range(m):  # the factor: l{i}_{k} below the diagonal, the inverse of the pivot's root on it
+        add(f"    d = a{k}_{k}")
+        for j in range(k):
+            add(f"    d -= l{k}_{j} * l{k}_{j}")
+        add("    if not d > _PIVOT_FLOOR:")
+        add("        return False")
+        add(f"    l{k}_{k} = 1.0 / math.sqrt(d)")
+        for i in range(k + 1, m):
+            add(f"    s = a{i}_{k}")
+            for j in range(k):
+                add(f"    s -= l{i}_{j} * l{k}_{j}")
+            add(f"    l{i}_{k} = s * l{k}_{k}")
+    add("    trace = 0.0")
+    for j, (i, k) in enumerate(exponents):  # column j of the factor's inverse: x{j}_{i}, i > j
+        add(f"    norm = l{j}_{j} * l{j}_{j}")
+        for i_ in range(j + 1, m):
+            add(f"    s = l{i_}_{j} * l{j}_{j}")
+            for k_ in range(j + 1, i_):
+                add(f"    s += l{i_}_{k_} * x{j}_{k_}")
+            add(f"    x{j}_{i_} = -s * l{i_}_{i_}")
+            add(f"    norm += x{j}_{i_} * x{j}_{i_}")
+        add(f"    trace += norm * (q0_0 * s{j} * s{j} * {1.0 / math.comb(i + k, i)!r})")
+    add("    if not trace * min_spread < 1.0:")
+    add("        return False")
+    for i in range(m):
+        add(f"    s = right[{i}] * s{i}")
+        for j in range(i):
+            add(f"    s -= l{i}_{j} * y{j}")
+        add(f"    y{i} = s * l{i}_{i}")
+    for i in range(m - 1, -1, -1):
+        add(f"    s = y{i}")
+        for j in range(i + 1, m):
+            add(f"    s -= l{j}_{i} * z{j}")
+        add(f"    z{i} = s * l{i}_{i}")
+    for r in range(6):
+        add(f"    solution[{r}] = z{r} * s{r}")
+    add("    return True")
+    return "\n".join(lines) + "\n"
 
 
-def _smaller_solve(general, a, b, low, m, min_spread, scale, total):
-    """:func:`_fit_one`'s solve of the fits of ``m`` terms: :func:`_cholesky_solve_fixed` where ``general`` is
-    None (fits of degree 3 or less: ``m`` is 10 or 6) or ``m`` is 10, else :func:`_cholesky_solve`.
+def _straight_solve(m: int) -> Callable[..., bool]:
+    """:func:`_straight_solve_source` of ``m`` terms, compiled (called from compiled code only; not cached on its
+    own: its callers' cached code holds it)."""
+    namespace = {"math": math, "_TINY": _TINY, "_PIVOT_FLOOR": _PIVOT_FLOOR}
+    exec(compile(_straight_solve_source(m), f"<meshcurv jets: the solve of {m} terms>", "exec"), namespace)
+    options = cast(_JitOptions, {**_JIT_INNER, "cache": False})
+    return cast(Callable[..., bool], nb.njit(**options)(namespace["solve"]))
+
+
+#: The solves of the cubic jets (10 terms) and of the quadratic ones (6) a cubic fit falls back to.
+_solve_10 = _straight_solve(10)
+_solve_6 = _straight_solve(6)
+
+
+def _smaller_solve(general, degree, count, moments, right, solution, min_spread, scratch):
+    """:func:`_fit_one`'s solve: the fit of the highest degree ``<= degree`` with at least as many points
+    (``count``) as terms whose solve succeeds; its 6 coefficients (constant, linear, quadratic; in the
+    monomials' units) to ``solution[:6]``; False if none.
+
+    ``moments`` and ``right`` are those of :func:`_jet_moments`. Fits of 10 and 6 terms are solved by
+    :func:`_solve_10` and :func:`_solve_6`; where ``general`` is not None (degree 4 or more), the larger ones by
+    :func:`_cholesky_solve` in ``scratch = (exponents, matrix, low, scale)`` (:func:`_jet_scratch`).
 
     Compiled only (:func:`_smaller_solve_typed`).
     """
@@ -112,18 +185,46 @@ def _smaller_solve(general, a, b, low, m, min_spread, scale, total):
 
 
 @overload(_smaller_solve, jit_options=_JIT)  # type: ignore[arg-type]  # numba's stub types a TypedDict
-def _smaller_solve_typed(general, a, b, low, m, min_spread, scale, total):
+def _smaller_solve_typed(general, degree, count, moments, right, solution, min_spread, scratch):
     if isinstance(general, types.NoneType):
 
-        def fixed(general, a, b, low, m, min_spread, scale, total):
-            return _cholesky_solve_fixed(a, b, low, m, min_spread, scale, total)
+        def fixed(general, degree, count, moments, right, solution, min_spread, scratch):
+            if degree >= 3 and count >= 10 and _solve_10(moments, right, solution, min_spread):
+                return True
+            return degree >= 2 and count >= 6 and _solve_6(moments, right, solution, min_spread)
 
         return fixed
 
-    def any_size(general, a, b, low, m, min_spread, scale, total):
-        if m == 10:
-            return _cholesky_solve_fixed(a, b, low, m, min_spread, scale, total)
-        return _cholesky_solve(a, b, low, m, min_spread, scale, total)
+    def any_size(general, degree, count, moments, right, solution, min_spread, scratch):
+        exponents, matrix, low, scale = scratch
+        for d in range(degree, 1, -1):
+            m = (d + 1) * (d + 2) // 2
+            if count < m:
+                continue
+            if m == 10:
+                if _solve_10(moments, right, solution, min_spread):
+                    return True
+                continue
+            if m == 6:
+                return _solve_6(moments, right, solution, min_spread)
+            for r in range(m):
+                even = moments[2 * exponents[r, 0], 2 * exponents[r, 1]]
+                scale[r] = 1.0 / math.sqrt(_TINY if _TINY > even else even)  # max(even, _TINY)
+            for r in range(m):  # the lower triangle: all the Cholesky factorization reads
+                for c in range(r + 1):
+                    matrix[r, c] = (
+                        moments[
+                            _UNSIGNED(exponents[r, 0] + exponents[c, 0]), _UNSIGNED(exponents[r, 1] + exponents[c, 1])
+                        ]
+                        * scale[r]
+                        * scale[c]
+                    )
+                solution[r] = right[r] * scale[r]
+            if _cholesky_solve(matrix, solution, low, m, min_spread, scale, moments[0, 0]):
+                for r in range(6):
+                    solution[r] = solution[r] * scale[r]
+                return True
+        return False
 
     return any_size
 
@@ -666,29 +767,9 @@ def _fit_one(
     fitted = False
     for step in range(iterations):
         _jet_moments(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right)
-        fitted = False
-        for d in range(degree, 1, -1):
-            m = (d + 1) * (d + 2) // 2
-            if count < m:
-                continue
-            for r in range(m):
-                even = moments[2 * exponents[r, 0], 2 * exponents[r, 1]]
-                scale[r] = 1.0 / math.sqrt(_TINY if _TINY > even else even)  # max(even, _TINY)
-            for r in range(m):  # the lower triangle: all the Cholesky factorization reads
-                for c in range(r + 1):
-                    matrix[r, c] = (
-                        moments[
-                            _UNSIGNED(exponents[r, 0] + exponents[c, 0]), _UNSIGNED(exponents[r, 1] + exponents[c, 1])
-                        ]
-                        * scale[r]
-                        * scale[c]
-                    )
-                solution[r] = right[r] * scale[r]
-            if _smaller_solve(general, matrix, solution, low, m, min_spread, scale, moments[0, 0]):
-                for r in range(6):
-                    solution[r] = solution[r] * scale[r]
-                fitted = True
-                break
+        fitted = _smaller_solve(
+            general, degree, count, moments, right, solution, min_spread, (exponents, matrix, low, scale)
+        )
         if step + 1 < iterations and fitted:
             p, q = solution[1], solution[2]
             if p * p + q * q < settled:
