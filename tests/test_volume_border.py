@@ -99,7 +99,13 @@ def test_box_in_a_corner_has_the_area_of_its_three_inner_faces():
     full = label_curvatures(whole, spacing=UNIT).iloc[0]
     assert row.touches_border and row.area > 0  # was 0: every vertex within reach of the cap
     assert relative(row.area, 3 * side**2) < 0.06
-    assert relative(row.area, full.area / 8) < 0.02
+    # the mirrored box at the same radius (the default radius of a box cut by the image's faces is not that of the
+    # whole box): the corrected area takes in part of the chamfer along the cap's rim (below: +4.1% of mesh area),
+    # between none of it and all of it as the normals follow it (+2.2% at radii of 1.1 to 2 voxels)
+    at = {"spacing": UNIT, "radius": 2.0}
+    assert (
+        0 <= label_curvatures(corner, **at).iloc[0].area / (label_curvatures(whole, **at).iloc[0].area / 8) - 1 < 0.041
+    )
     # the raw triangles: the cap's rim is chamfered (6 edges of 10 voxels, each half a voxel of wall drawn at
     # 45 degrees: +0.21 voxel^2 per voxel of edge, +4.1%), where the mirrored box's faces run straight on
     assert relative(row.area_mesh, full.area_mesh / 8) < 0.05
