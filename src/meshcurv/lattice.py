@@ -111,9 +111,19 @@ LATTICE_FRAME_TRIES = 3
 
 
 class Lattice(NamedTuple):
-    """The grid a cloud's coordinates lie on (see :func:`read_lattice`): along each of its axes its ``steps`` (3,)
-    (0 on none), a plane's coordinate ``offsets`` (3,) and the ``tolerance`` (3,) within which a coordinate is on a
-    plane; the axes are the rows of ``frame`` (3, 3), the coordinate axes when None."""
+    """The grid a cloud's coordinates lie on (see :func:`read_lattice`).
+
+    Parameters
+    ----------
+    steps : ndarray of shape (3,)
+        The distance between two planes of the grid along each of its axes (0: no grid along that axis).
+    offsets : ndarray of shape (3,)
+        The coordinate of one plane along each axis.
+    tolerance : ndarray of shape (3,)
+        The distance within which a coordinate is on a plane.
+    frame : ndarray of shape (3, 3), optional
+        The grid's axes as rows; None: the coordinate axes.
+    """
 
     steps: np.ndarray
     offsets: np.ndarray
@@ -121,11 +131,33 @@ class Lattice(NamedTuple):
     frame: np.ndarray | None = None
 
     def along(self, vectors: np.ndarray) -> np.ndarray:
-        """(..., 3) ``vectors`` (points, normals) in the grid's axes."""
+        """Vectors in the grid's axes.
+
+        Parameters
+        ----------
+        vectors : ndarray of shape (..., 3)
+            Points or normals, in the coordinate axes.
+
+        Returns
+        -------
+        ndarray of shape (..., 3)
+            The same vectors in the grid's axes (``vectors`` itself when the grid has no frame).
+        """
         return vectors if self.frame is None else vectors @ self.frame.T
 
     def snap(self, points: np.ndarray) -> np.ndarray:
-        """(N, 3) ``points`` in the grid's axes, each coordinate within the tolerance of a plane moved onto it."""
+        """Points in the grid's axes, moved onto the planes they are near.
+
+        Parameters
+        ----------
+        points : ndarray of shape (N, 3)
+            Points in the coordinate axes.
+
+        Returns
+        -------
+        ndarray of shape (N, 3)
+            The points in the grid's axes, each coordinate within the tolerance of a plane moved onto it.
+        """
         snapped = np.array(self.along(points), dtype=float)
         for axis in np.flatnonzero(self.steps > 0):
             step, offset = self.steps[axis], self.offsets[axis]
@@ -415,6 +447,22 @@ def read_lattice(
     are periodic along all three axes (:func:`_periodic_planes`: the same surface moved off its planes by noise or
     a motion of a fraction of a voxel); given each point's ``neighbours`` (N, k) too, a lattice turned off the
     coordinate axes is read in its own (:func:`_lattice_frame`). A scan's points are on none.
+
+    Parameters
+    ----------
+    points : ndarray of shape (N, 3)
+        The points.
+    spacing : float, optional
+        The cloud's spacing: with it, coordinates moved off their planes are read from their periodicity.
+    usable : ndarray of shape (N,) of bool, optional
+        The points to read the grid from (default: all).
+    neighbours : ndarray of shape (N, k) of int, optional
+        Each point's nearest neighbours: with ``spacing``, a grid turned off the coordinate axes is read too.
+
+    Returns
+    -------
+    Lattice
+        The grid (:data:`NO_LATTICE` when there is none).
     """
     points = np.asarray(points, dtype=float)
     rows = points if usable is None else points[usable]
