@@ -193,13 +193,14 @@ def _outward(vertices, topology, patch, flip, invert, n_labels, needles) -> np.n
     # a needle's slivers bound no solid (issue 29: a uv sphere's vertex flung 30 sizes inward turned it inside out)
     if needles is None:
         needles = _needle_vertices(vertices, topology, vertex_length_scales(vertices, topology))
-    kept = ~needles[faces].any(axis=1) if needles.any() else slice(None)
+    if needles.any():
+        kept = kept_faces = ~needles[faces].any(axis=1)
+    else:  # (no copy of the arrays for the volumes)
+        kept, kept_faces = slice(None), np.ones(faces.shape[0], dtype=bool)
     signed, magnitude = _patch_volumes(vertices, faces[kept], patch[kept], flip[kept], n_labels)
     decided = ~open_patch & (np.abs(signed) > 1e-9 * magnitude)
     if open_patch.any():  # a nearly closed patch (small holes): the side of its volume with the holes filled
-        filled, doubt = _filled_volumes(
-            vertices, topology, patch, flip, face_kept_mask(kept, faces) & open_patch[patch], n_labels
-        )
+        filled, doubt = _filled_volumes(vertices, topology, patch, flip, kept_faces & open_patch[patch], n_labels)
         signed = np.where(open_patch, signed + filled, signed)
         decided |= open_patch & (np.abs(signed) > FILLED_MARGIN * doubt)
     inverted = np.where(decided, signed < 0, invert)
@@ -207,15 +208,8 @@ def _outward(vertices, topology, patch, flip, invert, n_labels, needles) -> np.n
     inverted = np.where(decided & cavity, ~inverted, inverted)
     pending = open_patch & ~decided
     if pending.any():  # pieces between the holes of a decided patch, or of a surface with half its faces gone
-        inverted = _sides_of_pieces(
-            vertices, topology, patch, flip, inverted, decided, pending, face_kept_mask(kept, faces)
-        )
+        inverted = _sides_of_pieces(vertices, topology, patch, flip, inverted, decided, pending, kept_faces)
     return inverted
-
-
-def face_kept_mask(kept, faces) -> np.ndarray:
-    """(F,) bool of ``kept`` (a mask, or ``slice(None)``: every face)."""
-    return np.ones(faces.shape[0], dtype=bool) if isinstance(kept, slice) else kept
 
 
 def _sides_of_pieces(vertices, topology, patch, flip, inverted, decided, pending, kept) -> np.ndarray:
