@@ -46,6 +46,7 @@ from .._tensors import principal_from_shape_operator
 from .._geometry import mixed_voronoi_corner_areas
 from ..jets import _fit_jets, jet_normals
 from .._prepared import PreparedMesh
+from ..defects import DEFECTS
 from ._support import Stages, finish
 
 #: Per-face systems whose determinant, with the matrix scaled to a largest entry of 1, is at
@@ -63,6 +64,16 @@ BOUNDARY_NORMAL_DEGREE = 2
 #: ``benchmarks/accuracy.py --quick`` has a lower median H error than with the faces' normals but the
 #: clean cylinder's (0.036% -> 0.39%, its k_min 3.6% -> 0.96%).
 BOUNDARY_NORMAL_RADIUS = 4.0
+
+#: The defect codes (:data:`meshcurv.defects.DEFECTS`) of vertices whose fan of faces is not one disk: fans
+#: meeting at a point (a bow-tie), a non-manifold edge, inconsistently oriented faces. Such a vertex is
+#: invalid, but the face tensors of its valid neighbours read its normal, and the mean of its faces' normals
+#: leans like a boundary vertex's: it takes a fitted normal too (issue 29: faces detached by cracks wider
+#: than the weld, some welded back by one corner, left valid vertices with one or two faces whose other
+#: corners were bow-ties: H off by up to twice the largest curvature).
+OPEN_FAN_DEFECTS = tuple(
+    defect.code for defect in DEFECTS if defect.name in ("nonmanifold_edges", "bowtie_vertices", "inconsistent_edges")
+)
 
 STAGES = ("compute normals", "fit face tensors", "average vertex tensors", "retrieve curvatures")
 
@@ -131,18 +142,29 @@ def rotations_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.eye(3) + skew + factor[:, None, None] * (skew @ skew)
 
 
-def boundary_normals(mesh: PreparedMesh, normals: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """(V, 3) ``normals`` with those of the ``valid`` boundary vertices fitted (NaN where no fit was possible).
+def boundary_normals(mesh: PreparedMesh, normals: np.ndarray, valid: np.ndarray, codes: np.ndarray) -> np.ndarray:
+    """(V, 3) ``normals`` with those of the open fans that the ``valid`` vertices read fitted (NaN where no fit
+    was possible).
 
-    The fits are quadrics (:data:`BOUNDARY_NORMAL_DEGREE`) over the referenced vertices within
-    :data:`BOUNDARY_NORMAL_RADIUS` length scales, started from ``normals`` and refused where the
-    ball holds the other side of the surface (``facing`` of :func:`meshcurv.jets.fit_jets`).
+    An open fan is that of a boundary vertex or of a vertex with a defect of its fan (:data:`OPEN_FAN_DEFECTS`:
+    fans meeting at a point, a non-manifold edge, inconsistently oriented faces); its normal is fitted where
+    the vertex is ``valid`` or a corner of a face with a ``valid`` corner (the face tensors of a valid vertex
+    read the normals of all its faces' corners). The fits are quadrics (:data:`BOUNDARY_NORMAL_DEGREE`) over
+    the referenced vertices within :data:`BOUNDARY_NORMAL_RADIUS` length scales, started from ``normals`` and
+    refused where the ball holds the other side of the surface (``facing`` of :func:`meshcurv.jets.fit_jets`).
+    ``codes`` are the vertices' defect codes (:attr:`meshcurv.defects.VertexDefects.codes`).
     """
     topology = mesh.topology
-    rows = np.flatnonzero(topology.boundary_vertices & valid & (mesh.length_scales > 0))
+    faces = topology.faces
+    read = np.zeros(len(normals), dtype=bool)
+    read[faces[valid[faces].any(axis=1)]] = True
+    open_fan = topology.boundary_vertices | np.isin(codes, OPEN_FAN_DEFECTS)
+    rows = np.flatnonzero(open_fan & read & np.isfinite(normals).all(axis=1) & (mesh.length_scales > 0))
     if rows.size == 0:
         return normals
-    start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
+    known = valid.copy()
+    known[rows] = True
+    start = np.where(known[:, None], normals, [0.0, 0.0, 1.0])
     found, frame, _ = _fit_jets(
         mesh.vertices,
         start,
@@ -150,7 +172,7 @@ def boundary_normals(mesh: PreparedMesh, normals: np.ndarray, valid: np.ndarray)
         degree=BOUNDARY_NORMAL_DEGREE,
         centres=rows,
         neighbours=topology.referenced_vertices,
-        facing=np.where(valid[:, None], normals, np.nan),
+        facing=np.where(known[:, None], normals, np.nan),
     )
     fitted = normals.copy()
     fitted[rows] = jet_normals(found[rows], tuple(axis[rows] for axis in frame))
@@ -164,7 +186,7 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
     n = vertices.shape[0]
     cross, degenerate, normals = mesh.cross, mesh.degenerate, mesh.vertex_normals
     defects, valid = mesh.start(boundary=True)
-    normals = boundary_normals(mesh, normals, valid)
+    normals = boundary_normals(mesh, normals, valid, defects.codes)
     valid &= np.isfinite(normals).all(axis=1)
     usable = ~degenerate & np.isfinite(normals[topology.faces]).all(axis=(1, 2))
     faces = topology.faces[usable]
