@@ -52,7 +52,10 @@ parallel region ran, so this script selects the ``workqueue`` layer unless
 
 Output: one JSON line per finding in ``--log`` (default
 ``benchmarks/fuzz_api.jsonl``), a summary on stdout. ``--replay I --seed S``
-runs case ``I`` in this process and prints its inputs and traceback.
+runs case ``I`` in this process and prints its inputs and traceback, under the
+cap the run gave that call (the same ``--memory`` and ``--factor``, counted
+from this process's size after the same warm-up), so that a memory finding
+replays as ``memory``.
 """
 
 from __future__ import annotations
@@ -1665,6 +1668,65 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
+def case_cap(base: int, memory_mib: int, factor: int, args) -> int:
+    """The address-space cap of a call, in bytes: ``base`` plus ``memory_mib`` MiB plus ``factor`` per input byte."""
+    return base + memory_mib * 2**20 + factor * sum(_nbytes(a) for a in args)
+
+
+def warm_up() -> None:
+    """Load the compiled kernels and the mesh objects' libraries, as a run does before its first case.
+
+    A run's cap of a call counts from the parent's size after this (the
+    children fork with it loaded); ``--replay`` does the same before its cap,
+    so that a call over the run's cap is over the replay's too, and no other.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        warm = shapes.icosphere(subdivisions=3)
+        for method in METHODS:
+            meshcurv.principal_curvatures(warm.vertices, warm.faces, method=method)
+        if pointcloud is not None:
+            pointcloud.point_cloud_curvatures(shapes.random_sphere(n_vertices=200).vertices)
+        for module in ("pyvista", "trimesh", "meshio"):  # the mesh objects' libraries, imported once
+            try:
+                __import__(module)
+            except ImportError:
+                pass
+
+
+def replay(seed: int, index: int, memory_mib: int, factor: int) -> int:
+    """Run case ``index`` in this process under the run's cap of that case and print its outcome.
+
+    As in :func:`run_forked`: the kernels loaded first, the case built under
+    this process's size plus 2 GiB, the call and its checks under
+    :func:`case_cap` (``--memory`` and ``--factor``, the run's defaults), every
+    fourth case on the NumPy paths; a ``MemoryError`` is the status
+    ``memory``, as the run reports it.
+    """
+    warm_up()
+    base = vsize()
+    resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, base + 2**31))
+    if index % 4 == 3:
+        os.environ["MESHCURV_BACKEND"] = "numpy"
+    target, args, kwargs, labels, clean = make_case(seed, index)
+    limit = case_cap(base, memory_mib, factor, args)
+    print(f"case {index} seed {seed}: {target}({describe(args, kwargs)})")
+    print("mutations:", "; ".join(labels), "| backend:", os.environ.get("MESHCURV_BACKEND", "auto"))
+    print(f"cap: {round((limit - base) / 2**20)} MiB above this process's {base / 2**20:.0f} MiB", flush=True)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, base + 2**31))  # the soft cap; raised again to print
+    try:
+        outcome = run_case(target, args, kwargs, clean)
+    except MemoryError:
+        outcome = {"status": "memory", "type": "MemoryError", "message": "checking ran out of memory"}
+    resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, base + 2**31))
+    if outcome.get("type") == "MemoryError":
+        outcome["status"] = "memory"
+        outcome["message"] = f"MemoryError under a cap of {round((limit - base) / 2**20)} MiB above the parent"
+    for key, value in outcome.items():
+        print(f"{key}: {value}")
+    return 0
+
+
 def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
     """Make case ``index`` and run it in a forked child: ``(head, outcome, elapsed, cpu)``.
 
@@ -1687,8 +1749,7 @@ def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
             if numpy_backend:
                 os.environ["MESHCURV_BACKEND"] = "numpy"
             target, args, kwargs, labels, clean = make_case(seed, index)
-            input_bytes = sum(_nbytes(a) for a in args)
-            limit = base + memory_mib * 2**20 + factor * input_bytes
+            limit = case_cap(base, memory_mib, factor, args)
             resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
             head = {
                 "target": target,
@@ -1800,7 +1861,9 @@ def main(argv=None) -> int:
     parser.add_argument("--factor", type=int, default=200, help="bytes allowed per byte of input, beyond --memory")
     parser.add_argument("--start", type=int, default=0, help="first case index")
     parser.add_argument("--log", default=os.path.join(ROOT, "benchmarks", "fuzz_api.jsonl"))
-    parser.add_argument("--replay", type=int, default=None, help="run case I in this process and show it")
+    parser.add_argument(
+        "--replay", type=int, default=None, help="run case I in this process, under the run's cap of it, and show it"
+    )
     parser.add_argument("--summary", metavar="LOG", help="print a markdown table of the findings in LOG and exit")
     parser.add_argument(
         "--point-clouds",
@@ -1835,32 +1898,9 @@ def main(argv=None) -> int:
         return 0
 
     if options.replay is not None:
-        guard = vsize() + 4 * 2**30
-        resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
-        if options.replay % 4 == 3:  # as in the run: every fourth case on the NumPy paths
-            os.environ["MESHCURV_BACKEND"] = "numpy"
-        case = make_case(options.seed, options.replay)
-        target, args, kwargs, labels, clean = case
-        print(f"case {options.replay} seed {options.seed}: {target}({describe(args, kwargs)})")
-        print("mutations:", "; ".join(labels), "| backend:", os.environ.get("MESHCURV_BACKEND", "auto"))
-        outcome = run_case(target, args, kwargs, clean)
-        for key, value in outcome.items():
-            print(f"{key}: {value}")
-        return 0
+        return replay(options.seed, options.replay, options.memory, options.factor)
 
-    # warm the compiled kernels once so the children fork with them loaded
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        warm = shapes.icosphere(subdivisions=3)
-        for method in METHODS:
-            meshcurv.principal_curvatures(warm.vertices, warm.faces, method=method)
-        if pointcloud is not None:
-            pointcloud.point_cloud_curvatures(shapes.random_sphere(n_vertices=200).vertices)
-        for module in ("pyvista", "trimesh", "meshio"):  # the mesh objects' libraries, imported once
-            try:
-                __import__(module)
-            except ImportError:
-                pass
+    warm_up()  # once, so that the children fork with the kernels loaded
 
     guard = vsize() + 3 * 2**30  # the parent itself never needs more (it builds no case)
     resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
