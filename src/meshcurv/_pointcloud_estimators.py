@@ -66,8 +66,19 @@ BALL_SUPPORT = 3
 #: ball of a surface (trimmed by :func:`_own_side`, at a rim) has, a line with a few points beside it has not.
 BALL_SHARE = 0.25
 
-#: Centres per chunk of ``corrected_measures`` (bounds memory: chunk x TRIANGLES triangles).
+#: Centres per chunk of the ball searches (bounds memory: chunk x the points of a ball).
 CHUNK = 32768
+
+#: Centres per chunk of ``corrected_measures`` on the compiled path and of the checks over balls
+#: (:func:`_balls`, :func:`_uniform_balls`): bounds memory, their balls of up to 2 :data:`MAX_BALL_POINTS`
+#: points holding some 6 KiB per centre (chunks of :data:`CHUNK` held 0.3 GiB at 32,000 points) ...
+MEASURE_CHUNK = 4096
+
+#: ... and triangles per chunk of its NumPy path (some 1 KiB per triangle: a chunk of
+#: ``TRIANGLE_CHUNK // TRIANGLES`` centres; all the balls' triangles at once held 1 GiB at 32,000 points,
+#: ``benchmarks/memory_pointcloud.md``). Each centre's sums are those of its own triangles, in the same order:
+#: the chunks change no number.
+TRIANGLE_CHUNK = 65536
 
 #: A jet fit whose ball reaches the other side of the surface is redone over a ball this many times
 #: smaller (:func:`one_sided_fits`): sqrt(2) halves the ball's area per step.
@@ -439,8 +450,8 @@ def _uniform_balls(points, normals, found, radius, centres, usable) -> np.ndarra
         largest = np.maximum(np.abs(found[0]), np.abs(found[1]))
     tree = cKDTree(points[pool])
     out = np.zeros(centres.size, dtype=bool)
-    for start in range(0, centres.size, CHUNK):
-        chunk = centres[start : start + CHUNK]
+    for start in range(0, centres.size, MEASURE_CHUNK):
+        chunk = centres[start : start + MEASURE_CHUNK]
         _, index = tree.query(points[chunk], k=min(MAX_BALL_POINTS, pool.size), distance_upper_bound=radius)
         index = np.asarray(index).reshape(chunk.size, -1)
         member = index < pool.size
@@ -527,8 +538,8 @@ def _balls(points, normals, radii, centres, tree, k):
     k = min(k, n)
     for radius in np.unique(radii[centres]):
         group = centres[radii[centres] == radius]
-        for start in range(0, group.size, CHUNK):
-            chunk = group[start : start + CHUNK]
+        for start in range(0, group.size, MEASURE_CHUNK):
+            chunk = group[start : start + MEASURE_CHUNK]
             distance, index = tree.query(points[chunk], k=k, distance_upper_bound=radius)
             index = np.asarray(index).reshape(chunk.size, -1)
             member = index < n
@@ -981,8 +992,9 @@ def corrected_measures(
         own_sheets = np.zeros(0, dtype=np.int64) if sheets is None else np.ascontiguousarray(sheets, dtype=np.int64)
     else:
         search = _usable_tree(tree, points, usable)
-    for start in range(0, centres.size, CHUNK):
-        chunk = centres[start : start + CHUNK]
+    size = MEASURE_CHUNK if kernels is not None else max(1, TRIANGLE_CHUNK // pattern.shape[0])
+    for start in range(0, centres.size, size):
+        chunk = centres[start : start + size]
         logger.debug("point cloud: ball search")
         if kernels is not None:
             threads = 64 * kernel_threads()
