@@ -65,7 +65,10 @@ of H). There a ball that meets the edge of a hole
 (:func:`meshcurv.estimators.normal_cycle_ball.hole_edges`) and holds less than
 :data:`HOLE_SHARE` of its disc's corrected area is grown by ``HOLE_SHARE /
 share`` (at most :data:`HOLE_GROWTH`); a vertex whose grown ball still holds
-less than :data:`HOLE_MIN_SHARE` (a small piece between holes) is undefined.
+less than :data:`HOLE_MIN_SHARE` (a small piece between holes) is undefined, and
+so is one whose ball holds pieces of both orientations (:data:`HOLE_FACING`:
+holes split a surface into patches, each oriented on its own, and a small patch
+of a marching-cubes mesh keeps its inward winding).
 
 Every ball (of the noise fits, the normal fits and the sums) is the piece of
 the Euclidean ball connected to its vertex on the mesh through the edges and
@@ -177,6 +180,13 @@ HOLE_GROWTH = 2.0
 #: (a piece of a few faces between holes: off by up to the whole curvature; at 0.1 a holed voxel torus read errors
 #: of 0.45 of its largest curvature, at 0.2 and 0.25 0.35).
 HOLE_MIN_SHARE = 0.2
+#: ... or where the area vectors of the ball's faces, summed, along the vertex's normal are below this share of
+#: the ball's corrected area (about 0.85 to 0.95 where the ball's faces are oriented alike): the ball holds
+#: patches of both orientations (a patch between holes oriented on its own: its faces' ``mu_1`` of the other sign),
+#: and H comes out of a sum that cancels (a voxel sphere in 2 x 1 x 1 voxels with 30% of its faces removed: 4 of
+#: 1,549 valid vertices read H of the wrong sign, at -0.33 to -0.85 here; no other below 0.82; at 0.7, 200 more
+#: vertices of a holed voxel torus undefined, none of them off).
+HOLE_FACING = 0.5
 
 
 STAGES = (
@@ -745,16 +755,18 @@ def _curvatures(
 
     start("sum over balls")
     usable = _usable_faces(faces, degenerate, normals)
-    if hole_faces is not None:  # one more column: whether a ball meets the edge of a hole
-        measures = np.column_stack([measures, hole_faces.astype(np.float64)])
+    if hole_faces is not None:  # four more columns: the faces' area vectors, and whether a ball meets a hole
+        corners = vertices[faces]
+        sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        measures = np.column_stack([measures, sides, hole_faces.astype(np.float64)])
     if coarse:
         summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
         summed = _ball_face_sums(vertices, faces, radius, measures, usable=usable, connected=True)
     sparse = None
     if hole_faces is not None:
-        summed, radius, sparse = _holed_balls(vertices, faces, radius, measures, summed, usable, valid)
-        summed = summed[:, :-1]
+        summed, radius, sparse = _holed_balls(vertices, faces, radius, measures, summed, usable, valid, normals)
+        summed = summed[:, :-4]
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
@@ -764,36 +776,41 @@ def _curvatures(
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
 
 
-def _holed_balls(vertices, faces, radius, values, summed, usable, valid):
+def _holed_balls(vertices, faces, radius, values, summed, usable, valid, normals):
     """``(summed, radii, sparse)``: the sums of the balls that holes emptied, taken again over larger balls.
 
-    ``values`` (F, k): the face measures and, last, 1 at the faces on the edge of a hole (0 elsewhere);
-    ``summed`` (V, k): their sums over the balls of ``radius`` (a float or (V,)). The ``valid`` vertices whose
-    ball meets a hole and holds a corrected area ``mu_0(B)`` below :data:`HOLE_SHARE` of ``pi r^2`` take
-    the sums of a ball of ``r min(HOLE_SHARE / share, HOLE_GROWTH)``; ``sparse`` (V,) bool: those whose grown
-    ball still holds less than :data:`HOLE_MIN_SHARE` of its disc. ``radii`` (V,): each ball's radius.
+    ``values`` (F, k): the face measures, then the faces' area vectors (3 columns) and, last, 1 at the faces
+    on the edge of a hole (0 elsewhere); ``summed`` (V, k): their sums over the balls of ``radius`` (a float
+    or (V,)). The ``valid`` vertices whose ball meets a hole and holds a corrected area ``mu_0(B)`` below
+    :data:`HOLE_SHARE` of ``pi r^2`` take the sums of a ball of ``r min(HOLE_SHARE / share, HOLE_GROWTH)``;
+    ``sparse`` (V,) bool: those whose grown ball still holds less than :data:`HOLE_MIN_SHARE` of its disc, and
+    those whose ball meets a hole and holds faces of both orientations (the area vectors' sum along
+    ``normals``, (V, 3), below :data:`HOLE_FACING` of ``mu_0(B)``). ``radii`` (V,): each ball's radius.
 
     A face of a staircase does not lie along the surface: its measures carry the surface's curvature only
     summed with its neighbours' (the sum over a patch depends on the patch's rim), and a hole takes some of
     them away. With half of the faces of ``shapes.voxel_sphere(4)`` removed at random (seeds 0-2), 14 of 421
     valid vertices were off by more than half of H (the holed mesh's default radius 1.45 against 1.78 intact, a
-    third of the intact ball's faces); grown, none of 417 (the median error 0.16 -> 0.09 of H), 4 undefined.
+    third of the intact ball's faces); grown, none of 419 (the median error 0.16 -> 0.09 of H), 2 undefined.
     """
     n = vertices.shape[0]
     radii = np.array(np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,)), copy=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         share = summed[:, 0] / (np.pi * radii**2)
-    ids = np.flatnonzero(valid & (summed[:, -1] > 0) & ~(share >= HOLE_SHARE))
+    holed = valid & (summed[:, -1] > 0)
+    ids = np.flatnonzero(holed & ~(share >= HOLE_SHARE))
     sparse = np.zeros(n, dtype=bool)
-    if ids.size == 0:
-        return summed, radii, sparse
+    if ids.size:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            factor = HOLE_SHARE / share[ids]
+        radii[ids] *= np.where(np.isfinite(factor) & (factor < HOLE_GROWTH), factor, HOLE_GROWTH)
+        summed = np.array(summed, copy=True)
+        summed[ids] = _ball_face_sums(vertices, faces, radii, values, usable=usable, connected=True, centres=ids)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sparse[ids] = ~(summed[ids, 0] / (np.pi * radii[ids] ** 2) >= HOLE_MIN_SHARE)
     with np.errstate(invalid="ignore", divide="ignore"):
-        factor = HOLE_SHARE / share[ids]
-    radii[ids] *= np.where(np.isfinite(factor) & (factor < HOLE_GROWTH), factor, HOLE_GROWTH)
-    summed = np.array(summed, copy=True)
-    summed[ids] = _ball_face_sums(vertices, faces, radii, values, usable=usable, connected=True, centres=ids)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        sparse[ids] = ~(summed[ids, 0] / (np.pi * radii[ids] ** 2) >= HOLE_MIN_SHARE)
+        facing = np.einsum("ij,ij->i", normals, summed[:, -4:-1]) / summed[:, 0]
+    sparse |= holed & ~(facing >= HOLE_FACING)
     return summed, radii, sparse
 
 
