@@ -970,7 +970,9 @@ def oriented_signs(
         rows, cols, kept, ahead, behind, cosine, slope = _graph_geometry(points, normals, graph, usable)
     flat = slope <= SHEET_SLOPE  # NaN (a zero offset) is not flat
     flat = _supported(flat, slope, rows, cols, kept, graph)
-    sheets = _sheets(n, rows[flat], cols[flat])
+    forest = numba_kernels("pointcloud_graph")
+    if forest is None:
+        sheets = _sheets(n, rows[flat], cols[flat])
     # flat edges first, by 1 - |cos| and their slope (a tree of one sheet is grown before edges that leave it a
     # little); stacked edges after them all: they only join sheets that no flat path joins (taken first, an
     # accidental stacked edge inside a sphere of 1000 points turned half of it)
@@ -980,13 +982,24 @@ def oriented_signs(
         )
     else:
         stacked, weights, opposite = _edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols)
-    used = flat | stacked
-    signs, labels = _spanning_forest(n, rows[used], cols[used], opposite[used], weights[used])
+    if forest is not None:
+        used_rows, used_cols, used_opposite, used_weights, used_flat, other = forest.used_edges(
+            flat, stacked, rows, cols, opposite, weights
+        )
+        # the sheets read off the forest's union-find once its flat edges are taken: every flat edge weighs less
+        # than 3 (1 - |cos| + a slope of at most SHEET_SLOPE), every stacked one at least 3
+        signs, roots, sheets = forest.spanning_sheets(
+            n, used_rows, used_cols, used_opposite, np.argsort(used_weights), used_flat, PART_MIN_POINTS
+        )
+        labels = _dense_labels(roots)
+    else:
+        used = flat | stacked
+        signs, labels = _spanning_forest(n, rows[used], cols[used], opposite[used], weights[used])
+        other = np.flatnonzero(~used)
     sizes = np.bincount(labels)
     part = np.where((sizes >= PART_MIN_POINTS)[labels] & usable, labels, -1)
     doubtful = np.zeros(n, dtype=bool)
     # the other edges in both directions, the flattest first
-    other = np.flatnonzero(~used)
     other = other[_tie_order(slope[other])]  # (slopes equal to round-off: in the order of the edges)
     a = np.stack([rows[other], cols[other]], axis=1).ravel()
     b = np.stack([cols[other], rows[other]], axis=1).ravel()
@@ -1017,9 +1030,12 @@ def oriented_signs(
         signs = signs * flips
         signs = signs * between_sides(points, normals * signs[:, None], usable, spacing, tree, indices)
     # flat edges of (near) parallel normals left opposite: two sheets closer than the spacing
-    torn = flat & (np.abs(cosine) >= PARALLEL_COSINE) & (signs[rows] * signs[cols] * cosine < 0)
-    doubtful[rows[torn]] = True
-    doubtful[cols[torn]] = True
+    if forest is not None:
+        doubtful = forest.torn_ends(flat, cosine, signs, rows, cols, PARALLEL_COSINE, doubtful)
+    else:
+        torn = flat & (np.abs(cosine) >= PARALLEL_COSINE) & (signs[rows] * signs[cols] * cosine < 0)
+        doubtful[rows[torn]] = True
+        doubtful[cols[torn]] = True
     return signs, labels, doubtful | unsettled, sheets, unsettled
 
 
@@ -1087,21 +1103,15 @@ def _dense_labels(roots: np.ndarray) -> np.ndarray:
 def _sheets(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """(N,) the components of the edges ``(rows, cols)``; -1 for those of fewer than :data:`PART_MIN_POINTS`.
 
-    Compiled: the union-find of :func:`meshcurv._kernels.pointcloud.spanning_signs` over the edges in any order
-    (no sign passed); else :func:`scipy.sparse.csgraph.connected_components`.
+    Numbered by their first point (:func:`scipy.sparse.csgraph.connected_components`). Compiled: read off the
+    union-find of the orientation's forest (:func:`meshcurv._kernels.pointcloud_graph.spanning_sheets`).
     """
-    compiled = numba_kernels("pointcloud")
-    if compiled is not None:
-        labels = _dense_labels(
-            compiled.spanning_signs(n, rows, cols, np.zeros(rows.size, dtype=np.int8), np.arange(rows.size))[1]
-        )
-    else:
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import connected_components
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
 
-        _, labels = connected_components(
-            coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n)), directed=False
-        )
+    _, labels = connected_components(
+        coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n)), directed=False
+    )
     return np.where(np.bincount(labels)[labels] >= PART_MIN_POINTS, labels, -1)
 
 

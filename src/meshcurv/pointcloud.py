@@ -520,20 +520,21 @@ def _prepared_cloud(points, faces, normals, method) -> _Cloud:
     n_exact = n_all - unique.size
     search = None
     registration, centres = 0.0, None
+    distinct = points[unique]  # (gathered once: the near copies' search, the kept points' and the cloud's)
     if unique.size >= MIN_POINTS:
         # near copies (round-off differences, registration errors) are merged into the first of them in the
         # Morton order
-        copy_of, search, registration = _near_copies(points[unique])
+        copy_of, search, registration = _near_copies(distinct)
         keep = copy_of == np.arange(unique.size)
         if registration:
             # copies a registration error apart: each group measured at its centroid (the errors averaged out)
             group = np.cumsum(keep)[copy_of] - 1
-            sums = np.stack([np.bincount(group, weights=points[unique, axis]) for axis in range(3)], axis=1)
+            sums = np.stack([np.bincount(group, weights=distinct[:, axis]) for axis in range(3)], axis=1)
             centres = sums / np.bincount(group)[:, None]
         if not keep.all():
             representative = unique[copy_of][_position(unique, n_all)[representative]]
-            unique = unique[keep]
-            search = None if registration else _kept_search(points[unique], keep, *search[1:])
+            unique, distinct = unique[keep], distinct[keep]
+            search = None if registration else _kept_search(distinct, keep, *search[1:])
     if unique.size < n_all:
         near = n_all - unique.size - n_exact
         found = [f"{n_exact} points coincide with others (duplicates)"] if n_exact else []
@@ -550,7 +551,7 @@ def _prepared_cloud(points, faces, normals, method) -> _Cloud:
         problems.append(" and ".join(found) + ": merged, each computed once and its values copied")
     if unique.size < MIN_POINTS:
         raise InvalidMeshError(f"`points` holds {unique.size} distinct points; at least {MIN_POINTS} are needed")
-    cloud = points[unique] if centres is None else centres
+    cloud = distinct if centres is None else centres
     _check_spread(cloud)
     take = _position(unique, n_all)[representative]
     return _Cloud(cloud, None if given is None else given[unique], method, take, search, problems)
@@ -846,8 +847,30 @@ def _spatial_order(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if not (np.isfinite(extent) and np.isfinite(scale) and scale > 0):
         # a cloud beyond float64's range or of one point repeated: the input's order, every point compared
         return np.arange(n), _representatives(points)
+    kernels = numba_kernels("pointcloud_graph")
+    if kernels is not None:  # (the same codes and order: a stable order is unique)
+        order, ordered = kernels.stable_order(kernels.morton_codes(points, low, scale, np.uint64(2**MORTON_BITS - 1)))
+    else:
+        code = _morton_codes(points, low, scale)
+        order = np.argsort(code, kind="stable")
+        ordered = code[order]
+    same = ordered[1:] == ordered[:-1]
+    representative = np.arange(n)
+    if same.any():
+        runs = np.zeros(n, dtype=bool)
+        runs[1:] |= same
+        runs[:-1] |= same
+        subset = np.sort(order[runs])
+        representative[subset] = subset[_representatives(points[subset])]
+    return order, representative
+
+
+def _morton_codes(points: np.ndarray, low: np.ndarray, scale: float) -> np.ndarray:
+    """(N,) uint64 the Morton codes of ``points`` (N, 3): ``(points - low) * scale`` truncated to integers of
+    :data:`MORTON_BITS` bits, their bits interleaved (x lowest). Compiled:
+    :func:`meshcurv._kernels.pointcloud_graph.morton_codes`."""
     cells = np.minimum(((points - low) * scale).astype(np.uint64), np.uint64(2**MORTON_BITS - 1))
-    code = np.zeros(n, dtype=np.uint64)
+    code = np.zeros(points.shape[0], dtype=np.uint64)
     for axis in range(3):
         spread = cells[:, axis]
         # spread the 21 bits two apart (bit b goes to bit 3 b)
@@ -860,17 +883,7 @@ def _spatial_order(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ):
             spread = (spread | (spread << np.uint64(shift))) & np.uint64(mask)
         code |= spread << np.uint64(axis)
-    order = np.argsort(code, kind="stable")
-    ordered = code[order]
-    same = ordered[1:] == ordered[:-1]
-    representative = np.arange(n)
-    if same.any():
-        runs = np.zeros(n, dtype=bool)
-        runs[1:] |= same
-        runs[:-1] |= same
-        subset = np.sort(order[runs])
-        representative[subset] = subset[_representatives(points[subset])]
-    return order, representative
+    return code
 
 
 def _representatives(points: np.ndarray) -> np.ndarray:
