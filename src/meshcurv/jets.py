@@ -111,9 +111,10 @@ MIN_SPREAD = 1e-7
 #: between two poses).
 NORMAL_MIN_SPREAD = 1e-8
 
-#: Smallest Cholesky pivot of a diagonally scaled normal matrix (unit diagonal) for which
-#: the factorization goes on (a matrix numerically singular). Never decisive: a pivot is
-#: at least the smallest eigenvalue, itself at least ``MIN_SPREAD / 6``, on a fit kept.
+#: Smallest pivot of the ``L D L^T`` factorization of a normal matrix, relative to its diagonal
+#: entry (the pivot of the matrix scaled to a unit diagonal), for which the factorization goes on
+#: (a matrix numerically singular). Never decisive: a pivot of the scaled matrix is at least its
+#: smallest eigenvalue, itself at least ``MIN_SPREAD / 6``, on a fit kept.
 PIVOT_FLOOR = 1e-12
 
 #: Centres per chunk of pair queries (bounds the memory of the per-pair arrays; fewer
@@ -200,56 +201,57 @@ def _binomials(degree: int) -> np.ndarray:
 
 
 def _cholesky_solve(
-    matrix: np.ndarray, right: np.ndarray, factors: np.ndarray, min_spread: float = MIN_SPREAD
+    matrix: np.ndarray, right: np.ndarray, factors: np.ndarray, total: np.ndarray, min_spread: float = MIN_SPREAD
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Solve the (N, m, m) symmetric systems of unit diagonal by Cholesky, where their points are spread.
+    """Solve the (N, m, m) symmetric systems by an ``L D L^T`` factorization, where their points are spread.
 
-    Returns the (N, m) solutions and (N,) whether every pivot exceeded
-    :data:`PIVOT_FLOOR` and ``sum_j factors[:, j] (matrix^-1)_jj < 1 / min_spread``
-    (:data:`MIN_SPREAD`; the solutions of the others are meaningless).
-    ``(matrix^-1)_jj`` is the squared norm of column ``j`` of the inverse of
-    the Cholesky factor, found by forward substitution. A loop over the
-    m <= 15 columns, vectorized over the systems; the compiled kernel does the
-    same operations in the same order.
+    Returns the (N, m) solutions and (N,) whether every pivot ``d_k`` exceeded :data:`PIVOT_FLOOR`
+    ``max(matrix_kk, tiny)`` and ``total sum_j factors[j] (matrix^-1)_jj < 1 / min_spread``
+    (:data:`MIN_SPREAD`; ``total`` (N,): the sums of the weights; the solutions of the others are
+    meaningless). ``L`` is unit lower triangular, no square roots are taken;
+    ``(matrix^-1)_jj = sum_i (L^-1)_ij^2 / d_i`` from column ``j`` of ``L^-1``, found by forward
+    substitution, and the solution ``L^-T D^-1 L^-1 right`` from the same columns. A loop over the
+    m <= 15 columns, vectorized over the systems; the compiled kernel does the same operations in
+    the same order.
     """
     n, m = right.shape
-    low = np.zeros_like(matrix)  # the factor below the diagonal, the inverse of each pivot's root on it
+    low = np.zeros_like(matrix)  # L below the diagonal, 1 / d on it, column j of L^-1 (negated) in row j above it
+    unscaled = np.zeros_like(matrix)  # L times the pivots
     ok = np.ones(n, dtype=bool)
+    tiny = np.finfo(float).tiny
     for k in range(m):
         d = matrix[:, k, k].copy()
         for j in range(k):
-            d -= low[:, k, j] * low[:, k, j]
-        ok &= d > PIVOT_FLOOR
-        inverse = 1.0 / np.sqrt(np.where(ok, d, 1.0))
+            d -= unscaled[:, k, j] * low[:, k, j]
+        ok &= d > np.maximum(matrix[:, k, k], tiny) * PIVOT_FLOOR
+        inverse = 1.0 / np.where(ok, d, 1.0)
         low[:, k, k] = inverse
         for i in range(k + 1, m):
             t = matrix[:, i, k].copy()
             for j in range(k):
-                t -= low[:, i, j] * low[:, k, j]
+                t -= unscaled[:, i, j] * low[:, k, j]
+            unscaled[:, i, k] = t
             low[:, i, k] = t * inverse
     trace = np.zeros(n)
     with np.errstate(over="ignore", invalid="ignore"):  # inf or NaN traces: not spread (as the kernel)
-        for j in range(m):  # column j of the inverse of the factor: zero above the diagonal
-            column = np.zeros((n, m))
-            column[:, j] = low[:, j, j]
-            total = column[:, j] * column[:, j]
+        for j in range(m):
+            norm = low[:, j, j].copy()
             for i in range(j + 1, m):
-                t = low[:, i, j] * column[:, j]
+                t = low[:, i, j].copy()
                 for k in range(j + 1, i):
-                    t += low[:, i, k] * column[:, k]
-                column[:, i] = -t * low[:, i, i]
-                total += column[:, i] * column[:, i]
-            trace += total * factors[:, j]
-        ok &= trace * min_spread < 1.0
+                    t -= low[:, i, k] * low[:, j, k]
+                low[:, j, i] = t
+                norm += t * t * low[:, i, i]
+            trace += norm * factors[j]
+        ok &= trace * total * min_spread < 1.0
     x = right.copy()
-    for i in range(m):
+    for i in range(m - 1, -1, -1):  # D^-1 L^-1 right (row i reads the rows above it, not yet replaced)
         for j in range(i):
-            x[:, i] -= low[:, i, j] * x[:, j]
-        x[:, i] *= low[:, i, i]
-    for i in range(m - 1, -1, -1):
-        for j in range(i + 1, m):
             x[:, i] -= low[:, j, i] * x[:, j]
         x[:, i] *= low[:, i, i]
+    for j in range(m):  # L^-T (row j reads the rows below it, not yet replaced)
+        for i in range(j + 1, m):
+            x[:, j] -= low[:, j, i] * x[:, i]
     return x, ok
 
 
@@ -257,13 +259,12 @@ def _solve_block(
     block: np.ndarray, right: np.ndarray, degree: int, min_spread: float = MIN_SPREAD
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The (N, m) solutions of the (N, m, m) normal equations ``block`` of ``degree``, whether each is
-    kept (its points spread, ``min_spread``) and the (N, m, m) diagonally scaled matrices solved."""
+    kept (its points spread, ``min_spread``) and the (N, m, m) diagonally scaled matrices (unit diagonal:
+    their condition numbers bound the solutions' round-off)."""
     scale = 1.0 / np.sqrt(np.maximum(np.einsum("nii->ni", block), np.finfo(float).tiny))
     scaled = block * scale[:, :, None] * scale[:, None, :]
-    with np.errstate(over="ignore"):  # a monomial zero on every point (a flat ball): inf, not spread, as the kernel
-        factors = block[:, :1, 0] * scale * scale * (1.0 / _binomials(degree))  # sum(w) s_j^2 / C_j
-    solution, ok = _cholesky_solve(scaled, right * scale, factors, min_spread)
-    return solution * scale, ok, scaled
+    solution, ok = _cholesky_solve(block, right, 1.0 / _binomials(degree), block[:, 0, 0], min_spread)
+    return solution, ok, scaled
 
 
 def _solve(

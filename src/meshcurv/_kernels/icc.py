@@ -210,7 +210,7 @@ def _nested_fits_chunk(
     ids = np.arange(n)
     facing = np.empty((0, 3))  # no facing check
     areas = np.empty(0)  # unweighted
-    work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
+    work, moments, right, matrix, low, inverse_binomials, solution = _jet_scratch(degree, exponents.shape[0])
     c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row, rewritten for each fit
     _, _, inner, inner_levels, squared = walk
     for i in range(lo, hi):
@@ -253,7 +253,7 @@ def _nested_fits_chunk(
                 right,
                 matrix,
                 low,
-                scale,
+                inverse_binomials,
                 solution,
                 c,
                 a,

@@ -32,79 +32,82 @@ _PIVOT_FLOOR = 1e-12
 
 
 @nb.njit(inline="always", **_JIT)
-def _cholesky_inline(a, b, low, m, min_spread, scale, total):
-    """Solve ``a[:m, :m] x = b[:m]`` in place of ``b``; False if a pivot <= ``_PIVOT_FLOOR``
-    or the points are not spread.
+def _cholesky_inline(a, b, low, m, min_spread, inverse_binomials, total):
+    """Solve ``a[:m, :m] x = b[:m]`` in place of ``b``; False if a pivot is not above ``_PIVOT_FLOOR`` times its
+    diagonal entry or the points are not spread.
 
-    ``a`` is symmetric with a unit diagonal (the normal matrix scaled by the first
-    half of ``scale``); only its lower triangle is read. The points are spread where
-    ``sum_j total scale_j^2 / C(i_j + k_j, i_j) (a^-1)_jj < 1 / min_spread``
-    (``jets.MIN_SPREAD``; ``total``: the sum of the weights, ``(i_j, k_j)`` the
-    exponents; the second half of ``scale`` holds the ``1 / C``, :func:`_jet_scratch`). The same operations in the same order as ``jets._cholesky_solve``;
-    ``low`` is scratch (the factor below its diagonal, the inverse of each pivot's
-    root on it: m divisions instead of m (m + 3) / 2, the slowest operations of a
-    fit; above it, row ``j`` holds column ``j`` of the factor's inverse in turn).
+    ``a`` is the symmetric normal matrix (only its lower triangle is read; it is overwritten with the factor's
+    entries times their pivots). The factorization is ``a = L D L^T``, ``L`` unit lower triangular: no square
+    roots, no scaling (issue 31: the square roots and divisions of Cholesky's factor of the matrix scaled to a
+    unit diagonal were most of the solve's time, one after the other). Pivot ``d_k`` must be above
+    ``_PIVOT_FLOOR max(a_kk, tiny)`` (the pivot of the scaled matrix above ``_PIVOT_FLOOR``). The points are
+    spread where ``total sum_j (a^-1)_jj / C(i_j + k_j, i_j) < 1 / min_spread`` (``jets.MIN_SPREAD``; ``total``:
+    the sum of the weights, ``(i_j, k_j)`` the exponents, ``inverse_binomials`` the ``1 / C``,
+    :func:`_jet_scratch`), ``(a^-1)_jj = sum_i (L^-1)_ij^2 / d_i``; the solution ``L^-T D^-1 L^-1 b`` is taken
+    from the same columns of ``L^-1`` (no substitutions). The same operations in the same order as
+    ``jets._cholesky_solve`` and :func:`_solve_steps`. ``low`` is scratch: ``L`` below its diagonal, ``1 / d_k``
+    on it, and in row ``j`` above it column ``j`` of ``L^-1``, negated.
     """
     for k in range(m):
         d = a[k, k]
         for j in range(k):
-            d -= low[k, j] * low[k, j]
-        if not d > _PIVOT_FLOOR:
+            d -= a[k, j] * low[k, j]
+        floor = a[k, k]
+        floor = _TINY if _TINY > floor else floor  # max(a_kk, tiny)
+        if not d > floor * _PIVOT_FLOOR:
             return False
-        inverse = 1.0 / math.sqrt(d)
+        inverse = 1.0 / d
         low[k, k] = inverse
         for i in range(k + 1, m):
             s = a[i, k]
             for j in range(k):
-                s -= low[i, j] * low[k, j]
+                s -= a[i, j] * low[k, j]
+            a[i, k] = s  # read no more: the factor's entry times pivot k
             low[i, k] = s * inverse
     trace = 0.0
-    half = scale.shape[0] // 2
-    for j in range(m):  # column j of the factor's inverse (zero above the diagonal), in row j above the diagonal
-        first = low[j, j]
-        norm = first * first
+    for j in range(m):  # column j of the unit factor's inverse below its diagonal, negated, in row j
+        norm = low[j, j]
         for i in range(j + 1, m):
-            s = low[i, j] * first
+            s = low[i, j]
             for k in range(j + 1, i):
-                s += low[i, k] * low[j, k]
-            x = -s * low[i, i]
-            low[j, i] = x
-            norm += x * x
-        trace += norm * (total * scale[j] * scale[j] * scale[half + j])
-    if not trace * min_spread < 1.0:
+                s -= low[i, k] * low[j, k]
+            low[j, i] = s
+            norm += s * s * low[i, i]
+        trace += norm * inverse_binomials[j]
+    if not trace * total * min_spread < 1.0:
         return False
-    for i in range(m):
+    for i in range(m - 1, -1, -1):  # D^-1 L^-1 b (each row reads the rows of b above it, not yet replaced)
         s = b[i]
         for j in range(i):
-            s -= low[i, j] * b[j]
-        b[i] = s * low[i, i]
-    for i in range(m - 1, -1, -1):
-        s = b[i]
-        for j in range(i + 1, m):
             s -= low[j, i] * b[j]
         b[i] = s * low[i, i]
+    for j in range(m):  # L^-T (each row reads the rows of b below it, not yet replaced)
+        s = b[j]
+        for i in range(j + 1, m):
+            s -= low[j, i] * b[i]
+        b[j] = s
     return True
 
 
 @nb.njit(**_JIT_INNER)
-def _cholesky_solve(a, b, low, m, min_spread, scale, total):
+def _cholesky_solve(a, b, low, m, min_spread, inverse_binomials, total):
     """:func:`_cholesky_inline` of any size ``m``."""
-    return _cholesky_inline(a, b, low, m, min_spread, scale, total)
+    return _cholesky_inline(a, b, low, m, min_spread, inverse_binomials, total)
 
 
 def _solve_steps(m, steps):
     """:func:`_fit_one`'s solve of the first ``m`` (10 or 6) exponents of ``jets._exponents(3)``, written out as
     calls on ``steps`` (:class:`_IRSteps`: one LLVM instruction each).
 
-    The loops of :func:`_fit_one` (the scales ``1 / sqrt(max(moments[2 i, 2 k], tiny))``, the lower triangle of
-    the scaled normal matrix read from ``moments``) and of :func:`_cholesky_inline` (the factor, the spread from
-    the columns of its inverse, the two substitutions) unrolled, each quantity a value of its own: the same
-    operations in the same order (the same numbers, the same decisions: False where a pivot is not above
-    :data:`_PIVOT_FLOOR` or the points are not spread), with no loads and stores of scratch arrays between them and
-    no index arithmetic (issue 31: the loops' 10 x 10 solve took about a quarter of the normal fits'
-    instructions). Written as LLVM instructions, not as generated Python: numba types and lowers some 1,500
-    scalar operations in about 2 s of CPU, LLVM takes 0.2 s. Stores the 6 coefficients, in the monomials' own
-    units (scaled back), to ``solution[:6]`` when it succeeds.
+    The loops of :func:`_smaller_solve` (the lower triangle of the normal matrix read from ``moments``) and of
+    :func:`_cholesky_inline` (the ``L D L^T`` factor, the spread from the columns of ``L^-1``, the solution from
+    the same columns) unrolled, each quantity a value of its own: the same operations in the same order (the same
+    numbers, the same decisions: False where a pivot is not above :data:`_PIVOT_FLOOR` times its diagonal entry or
+    the points are not spread), with no loads and stores of scratch arrays between them and no index arithmetic
+    (issue 31: the loops' 10 x 10 solve took about a quarter of the normal fits' instructions). Written as LLVM
+    instructions, not as generated Python: numba types and lowers some 1,500 scalar operations in about 2 s of
+    CPU, LLVM takes 0.2 s. Stores the 6 coefficients (constant, linear, quadratic: the last 4 rows of ``L^-T``
+    are not formed) to ``solution[:6]`` when it succeeds.
     """
     exponents = [(total - k, k) for total in range(4) for k in range(total + 1)][:m]
     loaded = {}
@@ -115,51 +118,47 @@ def _solve_steps(m, steps):
         return loaded[i, k]
 
     one = steps.constant(1.0)
-    scale = [steps.div(one, steps.sqrt(steps.at_least_tiny(moment(2 * i, 2 * k)))) for i, k in exponents]
-    a = [
-        [steps.mul(steps.mul(moment(i + p, k + q), scale[r]), scale[c]) for c, (p, q) in enumerate(exponents[: r + 1])]
-        for r, (i, k) in enumerate(exponents)
-    ]
-    low = [[None] * m for _ in range(m)]
+    a = [[moment(i + p, k + q) for p, q in exponents[: r + 1]] for r, (i, k) in enumerate(exponents)]
+    low = [[None] * m for _ in range(m)]  # the unit factor below its diagonal
+    unscaled = [[None] * m for _ in range(m)]  # low[i][k] times pivot k
+    inverse = [None] * m  # 1 / each pivot
     for k in range(m):
         d = a[k][k]
         for j in range(k):
-            d = steps.sub(d, steps.mul(low[k][j], low[k][j]))
-        steps.require_above(d, _PIVOT_FLOOR)
-        low[k][k] = steps.div(one, steps.sqrt(d))
+            d = steps.sub(d, steps.mul(unscaled[k][j], low[k][j]))
+        steps.require_above(d, steps.mul(steps.at_least_tiny(a[k][k]), steps.constant(_PIVOT_FLOOR)))
+        inverse[k] = steps.div(one, d)
         for i in range(k + 1, m):
             s = a[i][k]
             for j in range(k):
-                s = steps.sub(s, steps.mul(low[i][j], low[k][j]))
-            low[i][k] = steps.mul(s, low[k][k])
-    trace = steps.constant(0.0)  # column j of the factor's inverse below its diagonal, each squared norm
-    total = moment(0, 0)
+                s = steps.sub(s, steps.mul(unscaled[i][j], low[k][j]))
+            unscaled[i][k] = s
+            low[i][k] = steps.mul(s, inverse[k])
+    trace = steps.constant(0.0)  # column j of the unit factor's inverse below its diagonal (negated), its norm
+    columns = [[None] * m for _ in range(m)]
     for j, (i, k) in enumerate(exponents):
-        column = [None] * m
-        norm = steps.mul(low[j][j], low[j][j])
+        column = columns[j]
+        norm = inverse[j]
         for row in range(j + 1, m):
-            s = steps.mul(low[row][j], low[j][j])
+            s = low[row][j]
             for c in range(j + 1, row):
-                s = steps.add(s, steps.mul(low[row][c], column[c]))
-            column[row] = steps.mul(steps.neg(s), low[row][row])
-            norm = steps.add(norm, steps.mul(column[row], column[row]))
-        factor = steps.mul(steps.mul(steps.mul(total, scale[j]), scale[j]), steps.constant(1.0 / math.comb(i + k, i)))
-        trace = steps.add(trace, steps.mul(norm, factor))
-    steps.require_below(steps.mul(trace, steps.min_spread), 1.0)
-    y = [None] * m
-    for i in range(m):
-        s = steps.mul(steps.right(i), scale[i])
-        for j in range(i):
-            s = steps.sub(s, steps.mul(low[i][j], y[j]))
-        y[i] = steps.mul(s, low[i][i])
+                s = steps.sub(s, steps.mul(low[row][c], column[c]))
+            column[row] = s
+            norm = steps.add(norm, steps.mul(steps.mul(s, s), inverse[row]))
+        trace = steps.add(trace, steps.mul(norm, steps.constant(1.0 / math.comb(i + k, i))))
+    steps.require_below(steps.mul(steps.mul(trace, moment(0, 0)), steps.min_spread), 1.0)
+    right = [steps.right(i) for i in range(m)]
     z = [None] * m
-    for i in range(m - 1, -1, -1):
-        s = y[i]
-        for j in range(i + 1, m):
-            s = steps.sub(s, steps.mul(low[j][i], z[j]))
-        z[i] = steps.mul(s, low[i][i])
-    for r in range(6):
-        steps.store(r, steps.mul(z[r], scale[r]))
+    for i in range(m):
+        s = right[i]
+        for j in range(i):
+            s = steps.sub(s, steps.mul(columns[j][i], right[j]))
+        z[i] = steps.mul(s, inverse[i])
+    for j in range(6):
+        s = z[j]
+        for i in range(j + 1, m):
+            s = steps.sub(s, steps.mul(columns[j][i], z[i]))
+        steps.store(j, s)
 
 
 class _IRSteps:
@@ -222,7 +221,7 @@ class _IRSteps:
         self.builder.position_at_end(go_on)
 
     def require_above(self, x, floor):  # not x > floor: fail (NaN fails)
-        self._require(self.builder.fcmp_ordered(">", x, self.constant(floor)))
+        self._require(self.builder.fcmp_ordered(">", x, floor))
 
     def require_below(self, x, ceiling):  # not x < ceiling: fail
         self._require(self.builder.fcmp_ordered("<", x, self.constant(ceiling)))
@@ -266,7 +265,7 @@ def _smaller_solve(general, degree, count, moments, right, solution, min_spread,
 
     ``moments`` and ``right`` are those of :func:`_jet_moments`. Fits of 10 and 6 terms are solved by
     :func:`_solve_10` and :func:`_solve_6`; where ``general`` is not None (degree 4 or more), the larger ones by
-    :func:`_cholesky_solve` in ``scratch = (exponents, matrix, low, scale)`` (:func:`_jet_scratch`).
+    :func:`_cholesky_solve` in ``scratch = (exponents, matrix, low, inverse_binomials)`` (:func:`_jet_scratch`).
 
     Compiled only (:func:`_smaller_solve_typed`).
     """
@@ -285,7 +284,7 @@ def _smaller_solve_typed(general, degree, count, moments, right, solution, min_s
         return fixed
 
     def any_size(general, degree, count, moments, right, solution, min_spread, scratch):
-        exponents, matrix, low, scale = scratch
+        exponents, matrix, low, inverse_binomials = scratch
         for d in range(degree, 1, -1):
             m = (d + 1) * (d + 2) // 2
             if count < m:
@@ -296,22 +295,13 @@ def _smaller_solve_typed(general, degree, count, moments, right, solution, min_s
                 continue
             if m == 6:
                 return _solve_6(moments, right, solution, min_spread)
-            for r in range(m):
-                even = moments[2 * exponents[r, 0], 2 * exponents[r, 1]]
-                scale[r] = 1.0 / math.sqrt(_TINY if _TINY > even else even)  # max(even, _TINY)
-            for r in range(m):  # the lower triangle: all the Cholesky factorization reads
+            for r in range(m):  # the lower triangle: all the factorization reads
                 for c in range(r + 1):
-                    matrix[r, c] = (
-                        moments[
-                            _UNSIGNED(exponents[r, 0] + exponents[c, 0]), _UNSIGNED(exponents[r, 1] + exponents[c, 1])
-                        ]
-                        * scale[r]
-                        * scale[c]
-                    )
-                solution[r] = right[r] * scale[r]
-            if _cholesky_solve(matrix, solution, low, m, min_spread, scale, moments[0, 0]):
-                for r in range(6):
-                    solution[r] = solution[r] * scale[r]
+                    matrix[r, c] = moments[
+                        _UNSIGNED(exponents[r, 0] + exponents[c, 0]), _UNSIGNED(exponents[r, 1] + exponents[c, 1])
+                    ]
+                solution[r] = right[r]
+            if _cholesky_solve(matrix, solution, low, m, min_spread, inverse_binomials, moments[0, 0]):
                 return True
         return False
 
@@ -466,7 +456,7 @@ def _grid_chunk(
     outer = np.empty(64, np.int64)  # the larger one
     outer_size = 0
     smaller = (coefficients, t1s, t2s, ns, counts, away)
-    work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
+    work, moments, right, matrix, low, inverse_binomials, solution = _jet_scratch(degree, exponents.shape[0])
     steps = 2 if larger > 0 else 1  # fits per centre
     for step in range(lo * steps, hi * steps):
         v = centres[step // steps]
@@ -502,7 +492,7 @@ def _grid_chunk(
             right,
             matrix,
             low,
-            scale,
+            inverse_binomials,
             solution,
             coefficients,
             t1s,
@@ -560,24 +550,24 @@ def _jet_outputs(rows):
 @nb.njit(inline="always", **_JIT)
 def _jet_scratch(degree, n_terms):
     """The buffers of :func:`_fit_one` (once per chunk of vertices, not per vertex):
-    ``work, moments, right, matrix, low, scale, solution``. The moments and the
+    ``work, moments, right, matrix, low, inverse_binomials, solution``. The moments and the
     right-hand side hold at least those of degree 3, which :func:`_cubic_jet_moments`
-    writes for every fit of degree 3 or less. ``scale`` holds the scales of the
-    monomials, then ``1 / C(i + k, i)`` for each exponent ``(i, k)`` (by total
-    degree, as ``jets._exponents``): the weights of :func:`_cholesky_solve`'s spread.
+    writes for every fit of degree 3 or less. ``inverse_binomials`` holds
+    ``1 / C(i + k, i)`` for each exponent ``(i, k)`` (by total degree, as
+    ``jets._exponents``): the weights of :func:`_cholesky_solve`'s spread.
 
     Inlined: its arrays are then allocated by its callers' own instances of ``np.empty``, which numba compiles
     once per set of the caller's options (issue 31)."""
     work = np.empty((_JET_ROWS + 3 * (2 * degree + 1) + degree + 1, 64))
     order = 2 * (3 if 3 > degree else degree) + 1  # max(degree, 3) (numba compiles max once per caller's options)
-    scale = np.empty(2 * n_terms)
-    t = n_terms
+    inverse_binomials = np.empty(n_terms)
+    t = 0
     for total in range(degree + 1):
         for k in range(total + 1):
             binomial = 1
             for step in range(total - k):  # C(total, i), i = total - k, in integers
                 binomial = binomial * (total - step) // (step + 1)
-            scale[t] = 1.0 / binomial
+            inverse_binomials[t] = 1.0 / binomial
             t += 1
     return (
         work,
@@ -585,7 +575,7 @@ def _jet_scratch(degree, n_terms):
         np.empty(10 if 10 > n_terms else n_terms),
         np.empty((n_terms, n_terms)),
         np.empty((n_terms, n_terms)),
-        scale,
+        inverse_binomials,
         np.empty(n_terms),
     )
 
@@ -774,7 +764,7 @@ def _fit_one(
     right,
     matrix,
     low,
-    scale,
+    inverse_binomials,
     solution,
     coefficients,
     t1s,
@@ -857,7 +847,7 @@ def _fit_one(
     for step in range(iterations):
         _jet_moments(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right)
         fitted = _smaller_solve(
-            general, degree, count, moments, right, solution, min_spread, (exponents, matrix, low, scale)
+            general, degree, count, moments, right, solution, min_spread, (exponents, matrix, low, inverse_binomials)
         )
         if step + 1 < iterations and fitted:
             p, q = solution[1], solution[2]
@@ -1010,7 +1000,7 @@ def _connected_chunk(
         for k in range(mark.shape[0]):
             mark[k] = -1
         filled[slot] = True
-    work, moments, right, matrix, low, scale, solution = _jet_scratch(degree, exponents.shape[0])
+    work, moments, right, matrix, low, inverse_binomials, solution = _jet_scratch(degree, exponents.shape[0])
     # one row of each output, written by every fit (c and one_away set below): unpacked once, not per vertex; no
     # call of _jet_outputs (its NaN fills compile 0.3-0.5 s of CPU more than these)
     c, a, b, nn = np.empty((1, 6)), np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3))
@@ -1041,7 +1031,7 @@ def _connected_chunk(
             right,
             matrix,
             low,
-            scale,
+            inverse_binomials,
             solution,
             c,
             a,
