@@ -36,6 +36,13 @@ far: a vertex whose jet departs from a steadier fit on the same ball (a quadric 
 more than :data:`STEADY_AGREEMENT` takes the steadier fit's curvatures, and one whose ball's points are too
 little spread for any such fit is NaN with ``valid=False``.
 
+The balls of two vertices an edge apart hold nearly the same points, so their fits differ by the change of
+the curvature over an edge; a fit that follows noise (points off the surface by a share of the radius: a
+noisy scan, faces detached by cracks wider than the weld) does not. A vertex whose principal curvatures
+depart from its edge neighbours' by more than :data:`ERRATIC_AGREEMENT` of the smaller largest |k| (median
+over the neighbours) takes its steady quadric where that agrees better with them, and is NaN with
+``valid=False`` where neither does (counted in the warning: pass a larger ``radius``).
+
 References
 ----------
 F. Cazals and M. Pouget (2005). Estimating differential quantities using

@@ -30,6 +30,14 @@ vertex takes the normal of a quadric (a jet of degree
 :data:`BOUNDARY_NORMAL_RADIUS` length scales around it (:func:`meshcurv.jets.fit_jets`,
 over Euclidean neighbours: across a hole too); a vertex whose ball holds too few
 points for the fit, or the other side of the surface, is NaN with ``valid=False``.
+The vertices whose fan is not one disk (bow-ties, non-manifold edges,
+inconsistently oriented faces: :data:`OPEN_FAN_DEFECTS`) are invalid, but their
+valid neighbours' face tensors read their normals: those take the same fitted
+normal (issue 29: faces detached by cracks wider than the weld, some welded back
+by one corner, left valid vertices whose faces' other corners were such bow-ties,
+whose mean normal leaned towards the tilted face: H off by up to twice the
+largest curvature). A face with a corner whose fit failed is left out of the
+averages.
 
 References
 ----------
