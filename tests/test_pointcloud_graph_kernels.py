@@ -193,3 +193,22 @@ def test_used_edges_are_numpys():
     for value, reference in zip(got, expected):
         assert value.dtype == reference.dtype
         np.testing.assert_array_equal(value, reference)
+
+
+def test_gathered_results_are_numpys():
+    from meshcurv.pointcloud import _UNDEFINED, _gathered_results
+
+    rng = np.random.default_rng(10)
+    n, m = 400, 1000
+    take = rng.integers(0, n, m)
+    k_min, k_max = rng.normal(size=n), rng.normal(size=n)
+    k_min[rng.random(n) < 0.1] = np.nan  # (a valid point with a NaN curvature becomes invalid)
+    k_max[rng.random(n) < 0.05] = np.inf
+    dir_min, dir_max, normals = rng.normal(size=(n, 3)), rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    valid = rng.random(n) < 0.8
+    reason = rng.integers(0, 4, n).astype(np.int8)
+    expected = _gathered_results(take, k_min, k_max, dir_min, dir_max, normals, valid, reason)
+    got = pointcloud_graph.gathered_results(take, k_min, k_max, dir_min, dir_max, normals, valid, reason, _UNDEFINED)
+    for value, reference in zip(got, expected):
+        assert value.dtype == reference.dtype and value.shape == reference.shape
+        np.testing.assert_array_equal(value, reference)

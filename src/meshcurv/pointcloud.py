@@ -585,15 +585,19 @@ def _estimated(cloud: _Cloud, radius: float | None) -> tuple[CurvatureResult, li
     logger.info("point cloud: results")
 
     # back to all points: each duplicate takes its representative's values
-    fields = [a[cloud.take] for a in (k_min, k_max, dir_min, dir_max, out_normals, valid, reason)]
-    k_min, k_max, dir_min, dir_max, out_normals, valid, reason = fields
-    valid = valid & np.isfinite(k_min) & np.isfinite(k_max)
-    for array in (k_min, k_max, dir_min, dir_max):
-        array[~valid] = np.nan
+    kernels = numba_kernels("pointcloud_graph")
+    if kernels is not None:
+        codes = np.asarray(reason, dtype=np.int8)
+        k_min, k_max, dir_min, dir_max, out_normals, valid, reason = kernels.gathered_results(
+            cloud.take, k_min, k_max, dir_min, dir_max, out_normals, valid, codes, _UNDEFINED
+        )
+    else:
+        k_min, k_max, dir_min, dir_max, out_normals, valid, reason = _gathered_results(
+            cloud.take, k_min, k_max, dir_min, dir_max, out_normals, valid, reason
+        )
     n_invalid = int((~valid).sum())
     if n_invalid:
         problems.append(f"{n_invalid} points are NaN with valid=False")
-    reason = np.where(valid, 0, np.where(reason > 0, reason, _UNDEFINED)).astype(np.int8)
     logger.info("point cloud: done")
     result = CurvatureResult._of_arrays(
         k_min=k_min,
@@ -607,6 +611,21 @@ def _estimated(cloud: _Cloud, radius: float | None) -> tuple[CurvatureResult, li
         invalid_reason=reason,
     )
     return result, problems
+
+
+def _gathered_results(take, k_min, k_max, dir_min, dir_max, normals, valid, reason):
+    """The fields of the distinct points at the rows ``take`` (M,) (every input point's representative): a row
+    is valid when ``valid`` and both curvatures are finite; an invalid row's curvatures and directions are NaN,
+    its reason ``reason`` when above 0, else ``_UNDEFINED``. Compiled:
+    :func:`meshcurv._kernels.pointcloud_graph.gathered_results`."""
+    k_min, k_max, dir_min, dir_max, normals, valid, reason = (
+        a[take] for a in (k_min, k_max, dir_min, dir_max, normals, valid, reason)
+    )
+    valid = valid & np.isfinite(k_min) & np.isfinite(k_max)
+    for array in (k_min, k_max, dir_min, dir_max):
+        array[~valid] = np.nan
+    reason = np.where(valid, 0, np.where(reason > 0, reason, _UNDEFINED)).astype(np.int8)
+    return k_min, k_max, dir_min, dir_max, normals, valid, reason
 
 
 def _looks_like_faces(points) -> str:

@@ -184,3 +184,31 @@ def used_edges(flat, stacked, rows, cols, opposite, weights):
         else:
             other[i - m] = i
     return used_rows, used_cols, used_opposite, used_weights, used_flat, other
+
+
+@nb.njit(parallel=True, **_JIT)
+def gathered_results(take, k_min, k_max, dir_min, dir_max, normals, valid, reason, undefined):
+    """The fields of the distinct points back to every input point, in one pass on every core.
+
+    Row ``i`` takes row ``take[i]`` (M,) of ``k_min, k_max`` (N,), ``dir_min, dir_max, normals`` (N, 3),
+    ``valid`` (N,) bool and ``reason`` (N,) int8; a row is valid when ``valid`` and both curvatures are finite,
+    and an invalid row's curvatures and directions are NaN, its reason ``reason`` when above 0, else
+    ``undefined`` (:func:`meshcurv.pointcloud._estimated`). Returns the seven (M,) and (M, 3) fields.
+    """
+    m = take.shape[0]
+    out_min, out_max = np.full(m, np.nan), np.full(m, np.nan)
+    out_dir_min, out_dir_max = np.full((m, 3), np.nan), np.full((m, 3), np.nan)
+    out_normals, out_valid = np.zeros((m, 3)), np.zeros(m, dtype=np.bool_)
+    out_reason = np.zeros(m, dtype=np.int8)
+    for i in nb.prange(m):
+        t = take[i]
+        for j in range(3):
+            out_normals[i, j] = normals[t, j]
+        if valid[t] and np.isfinite(k_min[t]) and np.isfinite(k_max[t]):
+            out_valid[i] = True
+            out_min[i], out_max[i] = k_min[t], k_max[t]
+            for j in range(3):
+                out_dir_min[i, j], out_dir_max[i, j] = dir_min[t, j], dir_max[t, j]
+        else:
+            out_reason[i] = reason[t] if reason[t] > 0 else undefined
+    return out_min, out_max, out_dir_min, out_dir_max, out_normals, out_valid, out_reason
