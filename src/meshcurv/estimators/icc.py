@@ -56,19 +56,19 @@ tangent planes turn inside the ball), several times larger than that of
 
 Boundaries need no special case beyond the fitted normals: the measures and
 the corrected area both stop at the boundary, so boundary vertices are valid.
-Holes in a voxel surface are the exception (:func:`_holed_balls`): a face of
-the staircase does not lie along the surface, and its measures are the
-surface's curvature only summed with those of its neighbours; with a hole's
-faces gone from the ball the sum is noise (issue 29: ``shapes.voxel_sphere(4)``
-with half of its faces removed, 14 of 421 valid vertices off by more than half
-of H). There a ball that meets the edge of a hole
-(:func:`meshcurv.estimators.normal_cycle_ball.hole_edges`) and holds less than
-:data:`HOLE_SHARE` of its disc's corrected area is grown by ``HOLE_SHARE /
-share`` (at most :data:`HOLE_GROWTH`); a vertex whose grown ball still holds
-less than :data:`HOLE_MIN_SHARE` (a small piece between holes) is undefined, and
-so is one whose ball holds pieces of both orientations (:data:`HOLE_FACING`:
-holes split a surface into patches, each oriented on its own, and a small patch
-of a marching-cubes mesh keeps its inward winding).
+The boundaries of voxel surfaces (holes, rims) are the exception
+(:func:`_holed_balls`): a face of the staircase does not lie along the
+surface, and its measures are the surface's curvature only summed with those
+of its neighbours; with faces gone from the ball the sum is noise (issue 29:
+``shapes.voxel_sphere(4)`` with half of its faces removed, 14 of 421 valid
+vertices off by more than half of H). There a ball that meets a boundary edge
+and holds less than :data:`HOLE_SHARE` of its disc's corrected area is grown
+by ``HOLE_SHARE / share`` (at most :data:`HOLE_GROWTH`); a vertex whose grown
+ball still holds less than :data:`HOLE_MIN_SHARE` (a small piece between
+holes) is undefined, and so is one whose ball holds pieces of both
+orientations (:data:`HOLE_FACING`: holes split a surface into patches, each
+oriented on its own, and a small patch of a marching-cubes mesh keeps its
+inward winding).
 
 Every ball (of the noise fits, the normal fits and the sums) is the piece of
 the Euclidean ball connected to its vertex on the mesh through the edges and
@@ -135,7 +135,6 @@ from ..radius import (
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages, failed_fits_undefined, finish
-from .normal_cycle_ball import hole_edges
 
 #: Degree of the jets whose normals the measures interpolate.
 NORMAL_DEGREE = 3
@@ -169,8 +168,10 @@ NORMAL_AGREEMENT = 0.5
 #: 0.5, none from 0.7 (the default is one mean edge on a clean mesh).
 RADIUS_WARNING_EDGES = 0.6
 
-#: On a voxel surface, a ball that meets the edge of a hole and whose corrected area is below this share of its
-#: disc's ``pi r^2`` (an intact ball: 0.8 to 1) is grown (:func:`_holed_balls`) ...
+#: On a voxel surface, a ball that meets a boundary edge (a hole's or a rim's) and whose corrected area is below
+#: this share of its disc's ``pi r^2`` (an intact ball: 0.8 to 1) is grown (:func:`_holed_balls`; the edges of
+#: holes alone, :func:`meshcurv.estimators.normal_cycle_ball.hole_edges`, gave the same errors on holed voxel
+#: spheres, at twice the time: a voxel rim's teeth read as holes) ...
 HOLE_SHARE = 0.8
 #: ... by ``HOLE_SHARE / share``, at most this factor (the noise of a holed staircase falls with the ball's
 #: radius, not only with its area: growing to the intact ball's area, ``sqrt(HOLE_SHARE / share)``, left 13 of
@@ -665,17 +666,12 @@ def _sampled_face_sums(vertices, faces, radius, values, usable, normals, centres
     return summed
 
 
-def _hole_faces(mesh: PreparedMesh, radii: np.ndarray) -> np.ndarray | None:
-    """(F,) bool: the faces on the edge of a hole (:func:`meshcurv.estimators.normal_cycle_ball.hole_edges` within
-    the balls of ``radii`` (V,): the surface lies beyond the edge), or None where there is none (a closed
-    surface, a rim)."""
-    topology = mesh.topology
-    if not topology.boundary_edges.any():
+def _boundary_faces(topology: MeshTopology) -> np.ndarray | None:
+    """(F,) bool: the faces on a boundary edge, or None where there is none (a closed surface)."""
+    boundary = topology.boundary_edges
+    if not boundary.any():
         return None
-    holes = hole_edges(mesh.vertices, topology, np.asarray(radii, dtype=np.float64), topology.referenced_vertices)
-    if not holes.any():
-        return None
-    faces = topology.edge_faces[holes].ravel()
+    faces = topology.edge_faces[boundary].ravel()
     marked = np.zeros(topology.faces.shape[0], dtype=bool)
     marked[faces[faces >= 0]] = True
     return marked
@@ -709,15 +705,15 @@ def _curvatures(
     weighted: bool = False,
     normal_radius=None,
     coarse: bool = False,
-    hole_faces: np.ndarray | None = None,
+    boundary_faces: np.ndarray | None = None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
     The normals are fitted over ``normal_radius`` (default: :data:`NORMAL_RADIUS_RATIO` times ``radius``).
     ``coarse``: dense balls summed on clusters of faces (:func:`meshcurv.neighborhoods.coarse_face_sums`).
-    ``hole_faces`` (F,) bool: the faces on the edge of a hole of a voxel surface (:func:`_hole_faces`), whose
-    balls are grown or left undefined (:func:`_holed_balls`); the returned ``radius`` is then (V,) the radius
-    of each ball summed (``radius`` as given otherwise).
+    ``boundary_faces`` (F,) bool: the faces on a boundary edge of a voxel surface (:func:`_boundary_faces`),
+    whose balls are grown or left undefined (:func:`_holed_balls`); the returned ``radius`` is then (V,) the
+    radius of each ball summed (``radius`` as given otherwise).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -755,16 +751,16 @@ def _curvatures(
 
     start("sum over balls")
     usable = _usable_faces(faces, degenerate, normals)
-    if hole_faces is not None:  # four more columns: the faces' area vectors, and whether a ball meets a hole
+    if boundary_faces is not None:  # four more columns: the faces' area vectors, and whether a ball meets the boundary
         corners = vertices[faces]
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        measures = np.column_stack([measures, sides, hole_faces.astype(np.float64)])
+        measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
     if coarse:
         summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
         summed = _ball_face_sums(vertices, faces, radius, measures, usable=usable, connected=True)
     sparse = None
-    if hole_faces is not None:
+    if boundary_faces is not None:
         summed, radius, sparse = _holed_balls(vertices, faces, radius, measures, summed, usable, valid, normals)
         summed = summed[:, :-4]
 
@@ -780,11 +776,11 @@ def _holed_balls(vertices, faces, radius, values, summed, usable, valid, normals
     """``(summed, radii, sparse)``: the sums of the balls that holes emptied, taken again over larger balls.
 
     ``values`` (F, k): the face measures, then the faces' area vectors (3 columns) and, last, 1 at the faces
-    on the edge of a hole (0 elsewhere); ``summed`` (V, k): their sums over the balls of ``radius`` (a float
-    or (V,)). The ``valid`` vertices whose ball meets a hole and holds a corrected area ``mu_0(B)`` below
+    on a boundary edge (0 elsewhere); ``summed`` (V, k): their sums over the balls of ``radius`` (a float or
+    (V,)). The ``valid`` vertices whose ball meets the boundary and holds a corrected area ``mu_0(B)`` below
     :data:`HOLE_SHARE` of ``pi r^2`` take the sums of a ball of ``r min(HOLE_SHARE / share, HOLE_GROWTH)``;
     ``sparse`` (V,) bool: those whose grown ball still holds less than :data:`HOLE_MIN_SHARE` of its disc, and
-    those whose ball meets a hole and holds faces of both orientations (the area vectors' sum along
+    those whose ball meets the boundary and holds faces of both orientations (the area vectors' sum along
     ``normals``, (V, 3), below :data:`HOLE_FACING` of ``mu_0(B)``). ``radii`` (V,): each ball's radius.
 
     A face of a staircase does not lie along the surface: its measures carry the surface's curvature only
@@ -860,7 +856,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             areas=_vertex_areas(mesh),
             normal_radius=normal_radii,
             coarse=True,
-            hole_faces=_hole_faces(mesh, radii_v),
+            boundary_faces=_boundary_faces(topology),
         )
         parameters = {
             **parameters,
