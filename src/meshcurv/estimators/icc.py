@@ -123,6 +123,7 @@ from ..neighborhoods import (
     _unique_sorted,
 )
 from ..radius import (
+    VOXEL_EXTENT_CAP,
     VOXEL_SCALE_RULE,
     _check_radius,
     _local_scale_ratios,
@@ -778,7 +779,8 @@ def _holed_balls(vertices, faces, radius, values, summed, usable, valid, normals
     ``values`` (F, k): the face measures, then the faces' area vectors (3 columns) and, last, 1 at the faces
     on a boundary edge (0 elsewhere); ``summed`` (V, k): their sums over the balls of ``radius`` (a float or
     (V,)). The ``valid`` vertices whose ball meets the boundary and holds a corrected area ``mu_0(B)`` below
-    :data:`HOLE_SHARE` of ``pi r^2`` take the sums of a ball of ``r min(HOLE_SHARE / share, HOLE_GROWTH)``;
+    :data:`HOLE_SHARE` of ``pi r^2`` take the sums of a ball of ``r min(HOLE_SHARE / share, HOLE_GROWTH)``
+    (at most :data:`meshcurv.radius.VOXEL_EXTENT_CAP` of the diagonal of the faces' box, the voxel default's cap);
     ``sparse`` (V,) bool: those whose grown ball still holds less than :data:`HOLE_MIN_SHARE` of its disc, and
     those whose ball meets the boundary and holds faces of both orientations (the area vectors' sum along
     ``normals``, (V, 3), below :data:`HOLE_FACING` of ``mu_0(B)``). ``radii`` (V,): each ball's radius.
@@ -799,7 +801,11 @@ def _holed_balls(vertices, faces, radius, values, summed, usable, valid, normals
     if ids.size:
         with np.errstate(invalid="ignore", divide="ignore"):
             factor = HOLE_SHARE / share[ids]
-        radii[ids] *= np.where(np.isfinite(factor) & (factor < HOLE_GROWTH), factor, HOLE_GROWTH)
+        grown = radii[ids] * np.where(np.isfinite(factor) & (factor < HOLE_GROWTH), factor, HOLE_GROWTH)
+        # at most the voxel default's own cap, a share of the extent of the faces (a ball beyond it holds it all)
+        corners = vertices[faces].reshape(-1, 3)
+        extent = VOXEL_EXTENT_CAP * float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0)))
+        radii[ids] = np.maximum(radii[ids], np.minimum(grown, extent))
         summed = np.array(summed, copy=True)
         summed[ids] = _ball_face_sums(vertices, faces, radii, values, usable=usable, connected=True, centres=ids)
         with np.errstate(invalid="ignore", divide="ignore"):
