@@ -36,8 +36,8 @@ valid neighbours' face tensors read their normals: those take the same fitted
 normal (issue 29: faces detached by cracks wider than the weld, some welded back
 by one corner, left valid vertices whose faces' other corners were such bow-ties,
 whose mean normal leaned towards the tilted face: H off by up to twice the
-largest curvature). A face with a corner whose fit failed is left out of the
-averages.
+largest curvature). Where such a fit fails (a part thinner than its ball), the
+vertex keeps the mean of its faces' normals.
 
 References
 ----------
@@ -152,7 +152,7 @@ def rotations_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def boundary_normals(mesh: PreparedMesh, normals: np.ndarray, valid: np.ndarray, codes: np.ndarray) -> np.ndarray:
     """(V, 3) ``normals`` with those of the open fans that the ``valid`` vertices read fitted (NaN where no fit
-    was possible).
+    was possible at a valid vertex; an invalid one then keeps its normal).
 
     An open fan is that of a boundary vertex or of a vertex with a defect of its fan (:data:`OPEN_FAN_DEFECTS`:
     fans meeting at a point, a non-manifold edge, inconsistently oriented faces); its normal is fitted where
@@ -170,20 +170,29 @@ def boundary_normals(mesh: PreparedMesh, normals: np.ndarray, valid: np.ndarray,
     rows = np.flatnonzero(open_fan & read & np.isfinite(normals).all(axis=1) & (mesh.length_scales > 0))
     if rows.size == 0:
         return normals
-    known = valid.copy()
-    known[rows] = True
-    start = np.where(known[:, None], normals, [0.0, 0.0, 1.0])
-    found, frame, _ = _fit_jets(
-        mesh.vertices,
-        start,
-        BOUNDARY_NORMAL_RADIUS * mesh.length_scales[rows],
-        degree=BOUNDARY_NORMAL_DEGREE,
-        centres=rows,
-        neighbours=topology.referenced_vertices,
-        facing=np.where(known[:, None], normals, np.nan),
-    )
     fitted = normals.copy()
-    fitted[rows] = jet_normals(found[rows], tuple(axis[rows] for axis in frame))
+    # the valid vertices' fits first, checked against the valid normals alone (as before the open fans were
+    # fitted: an open fan's leaning normal must not refuse them); then the invalid ones', each also against
+    # its own normal
+    for centres in (rows[valid[rows]], rows[~valid[rows]]):
+        if centres.size == 0:
+            continue
+        known = valid.copy()
+        known[centres] = True
+        found, frame, _ = _fit_jets(
+            mesh.vertices,
+            np.where(known[:, None], normals, [0.0, 0.0, 1.0]),
+            BOUNDARY_NORMAL_RADIUS * mesh.length_scales[centres],
+            degree=BOUNDARY_NORMAL_DEGREE,
+            centres=centres,
+            neighbours=topology.referenced_vertices,
+            facing=np.where(known[:, None], normals, np.nan),
+        )
+        fitted[centres] = jet_normals(found[centres], tuple(axis[centres] for axis in frame))
+    # an invalid vertex whose fit failed (its ball holds the other side of a part thinner than 4 length scales)
+    # keeps the mean of its faces' normals: its faces stay in its valid neighbours' averages, as before the fits
+    kept = rows[~valid[rows] & ~np.isfinite(fitted[rows]).all(axis=1)]
+    fitted[kept] = normals[kept]
     return fitted
 
 
