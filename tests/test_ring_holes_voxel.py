@@ -103,6 +103,37 @@ def test_holed_voxel_sphere_no_valid_vertex_off_the_sphere(method, share, seed):
     assert not off.any(), f"{int(off.sum())} of {int(result.valid.sum())} valid vertices off the sphere's H"
 
 
+def _detached(vertices, faces, share, gap, seed):
+    """``faces`` with ``share`` of them given corners of their own, moved ``gap`` mean edge lengths in random
+    directions (beyond the weld: cracks, and a triangle soup off the voxel grid; fuzz_api's detached faces)."""
+    rng = np.random.default_rng(seed)
+    edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
+    picked = rng.random(len(faces)) < share
+    corners = vertices[faces[picked]].reshape(-1, 3)
+    directions = rng.normal(size=corners.shape)
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    moved = faces.copy()
+    moved[picked] = len(vertices) + np.arange(corners.shape[0]).reshape(-1, 3)
+    return np.concatenate([vertices, corners + directions * gap * edge]), moved
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_detached_faces_of_a_voxel_sphere_leave_no_valid_vertex_off_the_intact_one(seed):
+    # fuzz_api seed 322, case 407: 20% of the faces detached by 0.067 edge lengths; the mesh as a whole is off
+    # the grid, the faces around its valid vertices are on it
+    pytest.importorskip("skimage")
+    mesh = shapes.voxel_sphere(radius=4.0)
+    vertices, faces = mesh.vertices, mesh.faces[:, ::-1]
+    intact, _ = _curvatures(vertices, faces, "normal_cycle")
+    moved, detached = _detached(vertices, faces, 0.2, 0.067, seed)
+    result, _ = _curvatures(moved, detached, "normal_cycle")
+    n = len(vertices)
+    both = result.valid[:n] & intact.valid
+    largest = np.nanmax(np.abs([intact.k_min, intact.k_max]))
+    off = both & (np.abs(result.mean[:n] - intact.mean) > OFF * largest)
+    assert not off.any(), f"{int(off.sum())} of {int(both.sum())} valid vertices off the intact sphere's H"
+
+
 @pytest.mark.parametrize("method", METHODS)
 def test_smooth_holed_sphere_keeps_its_vertices_next_to_the_holes(method):
     mesh = shapes.icosphere(subdivisions=3)
