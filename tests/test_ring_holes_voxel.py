@@ -108,13 +108,13 @@ def _detached(vertices, faces, share, gap, seed):
     directions (beyond the weld: cracks, and a triangle soup off the voxel grid; fuzz_api's detached faces)."""
     rng = np.random.default_rng(seed)
     edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
-    picked = rng.random(len(faces)) < share
-    corners = vertices[faces[picked]].reshape(-1, 3)
-    directions = rng.normal(size=corners.shape)
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    picked = np.flatnonzero(rng.random(len(faces)) < share)
+    copies = faces[picked].ravel()
+    shift = rng.normal(size=(copies.size, 3))
+    shift *= gap * edge / np.linalg.norm(shift, axis=1, keepdims=True)
     moved = faces.copy()
-    moved[picked] = len(vertices) + np.arange(corners.shape[0]).reshape(-1, 3)
-    return np.concatenate([vertices, corners + directions * gap * edge]), moved
+    moved[picked] = (len(vertices) + np.arange(copies.size)).reshape(-1, 3)
+    return np.vstack([vertices, vertices[copies] + shift]), moved
 
 
 @pytest.mark.parametrize("seed", range(4))
