@@ -982,20 +982,21 @@ def oriented_signs(
         )
     else:
         stacked, weights, opposite = _edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols)
+    used = flat | stacked
     if forest is not None:
-        used_rows, used_cols, used_opposite, used_weights, used_flat, other = forest.used_edges(
-            flat, stacked, rows, cols, opposite, weights
-        )
         # the sheets read off the forest's union-find once its flat edges are taken: every flat edge weighs less
         # than 3 (1 - |cos| + a slope of at most SHEET_SLOPE), every stacked one at least 3
+        used_weights, n_flat = weights[used], int(np.count_nonzero(flat))
+        order = np.argsort(used_weights)
+        assert n_flat == 0 or used_weights[order[n_flat - 1]] < 3.0
+        assert n_flat == order.size or used_weights[order[n_flat]] >= 3.0
         signs, roots, sheets = forest.spanning_sheets(
-            n, used_rows, used_cols, used_opposite, np.argsort(used_weights), used_flat, PART_MIN_POINTS
+            n, rows[used], cols[used], opposite[used].astype(np.int8), order, n_flat, PART_MIN_POINTS
         )
         labels = _dense_labels(roots)
     else:
-        used = flat | stacked
         signs, labels = _spanning_forest(n, rows[used], cols[used], opposite[used], weights[used])
-        other = np.flatnonzero(~used)
+    other = np.flatnonzero(~used)
     sizes = np.bincount(labels)
     part = np.where((sizes >= PART_MIN_POINTS)[labels] & usable, labels, -1)
     doubtful = np.zeros(n, dtype=bool)

@@ -6,8 +6,10 @@
 and reads the flat edges' components (the sheets) off the same union-find
 when the last flat edge is taken: every flat edge weighs less than every
 stacked one, so the flat edges are a prefix of the order. :func:`torn_ends`
-marks the ends of the flat edges left opposite; :func:`morton_order` is the
-Morton code and its stable order of :func:`meshcurv.pointcloud._spatial_order`.
+marks the ends of the flat edges left opposite; :func:`morton_codes` and
+:func:`stable_order` are the Morton codes and their stable order of
+:func:`meshcurv.pointcloud._spatial_order`; :func:`gathered_results` takes the
+fields of the distinct points back to every input point.
 Each returns what its NumPy twin returns, to the bit.
 """
 
@@ -21,37 +23,35 @@ from .pointcloud import _root
 
 
 @nb.njit(**_JIT)
-def spanning_sheets(n, rows, cols, opposite, order, flat, least):
+def spanning_sheets(n, rows, cols, opposite, order, n_flat, least):
     """``(signs, roots, sheets)``: :func:`meshcurv._kernels.pointcloud.spanning_signs` and the sheets on the way.
 
     Kruskal's algorithm over the edges ``(rows, cols)`` taken in ``order``
     (E,), the same union-find and the same unions as ``spanning_signs``:
-    ``signs`` (N,) and ``roots`` (N,) are its outputs to the bit. The edges
-    ``flat`` (E,) (int8, 1 for a flat edge) come first in ``order`` (a flat
-    edge taken after another raises ``ValueError``); when the last of them is
-    taken, the components of the union-find are those of the flat edges:
-    ``sheets`` (N,) numbers them 0, 1, ... in the order of their first point
-    (as :func:`scipy.sparse.csgraph.connected_components` does), -1 for those
-    of fewer than ``least`` points (:func:`meshcurv._pointcloud_normals._sheets`).
+    ``signs`` (N,) and ``roots`` (N,) are its outputs to the bit. The first
+    ``n_flat`` edges of ``order`` are the flat ones (the caller checks it);
+    when the last of them is taken, the components of the union-find are
+    those of the flat edges: ``sheets`` (N,) numbers them 0, 1, ... in the
+    order of their first point (as
+    :func:`scipy.sparse.csgraph.connected_components` does), -1 for those of
+    fewer than ``least`` points (:func:`meshcurv._pointcloud_normals._sheets`).
     """
     parent, flip, size = np.arange(n), np.zeros(n, dtype=np.int8), np.ones(n, dtype=np.int64)
-    n_flat = 0
-    for e in range(flat.shape[0]):
-        n_flat += flat[e]
     sheets = np.full(n, -1, dtype=np.int64)
-    for position in range(order.shape[0] + 1):
-        if position == n_flat:
-            _number_sheets(parent, flip, least, sheets)
-        if position == order.shape[0]:
-            break
+    for position in range(order.shape[0]):
+        if position == n_flat:  # (stacked edges follow: the sheets are the components now)
+            for i in range(n):
+                sheets[i] = _root(parent, flip, i)[0]
+            _number_sheets(sheets, least)
         e = order[position]
-        if (position < n_flat) != (flat[e] != 0):
-            raise ValueError("spanning_sheets: the flat edges must come first in the order")
         _join(parent, flip, size, rows[e], cols[e], opposite[e])
     signs, roots = np.ones(n), np.zeros(n, dtype=np.int64)
     for i in range(n):
         roots[i], flipped = _root(parent, flip, i)
         signs[i] = -1.0 if flipped else 1.0
+    if n_flat >= order.shape[0]:  # every edge flat: the sheets are the forest's components
+        sheets[:] = roots
+        _number_sheets(sheets, least)
     return signs, roots, sheets
 
 
@@ -70,14 +70,15 @@ def _join(parent, flip, size, i, j, opposite):
 
 
 @nb.njit(**_JIT)
-def _number_sheets(parent, flip, least, sheets):
-    """``sheets`` (N,): the components of the union-find numbered by their first point, -1 below ``least``."""
-    n = parent.shape[0]
+def _number_sheets(sheets, least):
+    """``sheets`` (N,), each point's root in the union-find, in place: the components numbered by their first
+    point, -1 for those of fewer than ``least`` points."""
+    n = sheets.shape[0]
     label = np.full(n, -1, dtype=np.int64)
     counts = np.zeros(n, dtype=np.int64)
     found = 0
     for i in range(n):
-        r = _root(parent, flip, i)[0]
+        r = sheets[i]
         if label[r] < 0:
             label[r] = found
             found += 1
@@ -158,32 +159,6 @@ def stable_order(code):
         order, spare_order = spare_order, order
         keys, spare_keys = spare_keys, keys
     return order, keys
-
-
-@nb.njit(**_JIT)
-def used_edges(flat, stacked, rows, cols, opposite, weights):
-    """The edges of :func:`meshcurv._pointcloud_normals.oriented_signs`'s forest in one pass: of the
-    ``used = flat | stacked`` (E,) edges, ``(rows[used], cols[used], opposite[used] as int8, weights[used],
-    flat[used] as int8, np.flatnonzero(~used))``."""
-    e = rows.shape[0]
-    m = 0
-    for i in range(e):
-        if flat[i] or stacked[i]:
-            m += 1
-    used_rows, used_cols = np.zeros(m, dtype=rows.dtype), np.zeros(m, dtype=cols.dtype)
-    used_opposite, used_weights = np.zeros(m, dtype=np.int8), np.zeros(m)
-    used_flat, other = np.zeros(m, dtype=np.int8), np.zeros(e - m, dtype=np.int64)
-    m = 0
-    for i in range(e):
-        if flat[i] or stacked[i]:
-            used_rows[m], used_cols[m] = rows[i], cols[i]
-            used_opposite[m] = 1 if opposite[i] else 0
-            used_weights[m] = weights[i]
-            used_flat[m] = 1 if flat[i] else 0
-            m += 1
-        else:
-            other[i - m] = i
-    return used_rows, used_cols, used_opposite, used_weights, used_flat, other
 
 
 @nb.njit(parallel=True, **_JIT)
