@@ -2088,6 +2088,16 @@ EXCEPTIONS: dict[str, str] = {
     "build's corner counts: tests/test_topology.py::test_bowtie_vertices_from_the_twin_sides_are_those_of_the_definition",
     "matgeom.matgeom_vertex_sums": "the body of matgeom.matgeom_vertex_tensors (its row above), which calls it; its "
     "zero-area faces: tests/test_topology.py::test_the_zero_area_faces_a_kernel_found_are_kept",
+    "pointcloud_graph.morton_codes": "tests/test_pointcloud_graph_kernels.py::test_morton_codes_and_their_order_are_"
+    "numpys: against pointcloud._morton_codes, to the bit",
+    "pointcloud_graph.stable_order": "tests/test_pointcloud_graph_kernels.py::test_stable_order_of_any_codes: "
+    'against np.argsort(kind="stable"), to the bit',
+    "pointcloud_graph.spanning_sheets": "tests/test_pointcloud_graph_kernels.py::test_spanning_sheets_is_spanning_"
+    "signs_and_the_sheets: against pointcloud.spanning_signs (its row above) and _pointcloud_normals._sheets",
+    "pointcloud_graph.torn_ends": "tests/test_pointcloud_graph_kernels.py::test_torn_ends_are_numpys: against the "
+    "NumPy lines of _pointcloud_normals.oriented_signs",
+    "pointcloud_graph.gathered_results": "tests/test_pointcloud_graph_kernels.py::test_gathered_results_are_numpys: "
+    "against pointcloud._gathered_results, to the bit",
 }
 
 #: Cases where a kernel and its twin disagree: ``(kernel, input) -> reason`` (strict xfail). Empty: the one

@@ -116,6 +116,10 @@ SMALL_PART_ROUNDS = 8
 #: Points per chunk of the neighbour query and the PCA (bounds memory: about 100 MB).
 CHUNK = 131072
 
+#: Points per chunk of :func:`lattice_treads` (bounds memory: its :data:`STEP_NEIGHBOURS` nearest neighbours
+#: and their heights, some 2.5 KiB per point; chunks of :data:`CHUNK` held 0.3 GiB at 100,000 points).
+TREAD_CHUNK = 8192
+
 #: A point's nearest neighbours lie on a line when their spread across their main direction (the square root
 #: of the second eigenvalue of their covariance) is below this share of the spread along it (see
 #: :func:`scan_lines`); a random sample of a surface has no such neighbourhood.
@@ -1572,8 +1576,8 @@ def lattice_treads(
             sagitta = np.maximum(np.abs(k_min[rows]), np.abs(k_max[rows])) * fitted[rows] ** 2 / 2
             tread[rows] = sagitta < FACET_SAGITTA * np.max(np.abs(lattice.along(normals[rows])) * steps, axis=1)
     k = min(STEP_NEIGHBOURS + 1, points.shape[0])
-    for start in range(0, rows.size, CHUNK):
-        chunk = rows[start : start + CHUNK]
+    for start in range(0, rows.size, TREAD_CHUNK):
+        chunk = rows[start : start + TREAD_CHUNK]
         distances, near = tree.query(points[chunk], k=k, workers=-1)
         inside = distances[:, 1:] <= radii[chunk][:, None]  # (the point itself first)
         # the axis most along the normal: a point facing an axis off the grid (a cylinder's side, its rings on a
