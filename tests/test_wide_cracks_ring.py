@@ -7,15 +7,9 @@ face, so the valid vertices next to such a corner (often left with one or two fa
 curvature: on ``fuzz_api.py --wide-cracks 0.3 --seed 322 --replay 1539`` H was off by up to twice the
 largest curvature. The open fans' normals are fitted (``rusinkiewicz.OPEN_FAN_DEFECTS``).
 
-``quadric`` at a given radius of about two edges: the copies of the detached faces' corners stand a tenth of
-an edge off the surface in every ball; a degree-4 jet follows that noise (``fuzz_api.py --wide-cracks 1 --seed
-296 --replay 1682``: H 1.58 where the clean mesh gives 0.99). A fit that its edge neighbours' fits (over
-nearly the same ball) do not reproduce takes its steady quadric where that agrees better with them, and is
-NaN where neither does (``quadric.ERRATIC_AGREEMENT``).
-
-The meshes are unit spheres (exact H = 1) with a share of their faces given corners of their own (two of
-them: hanging by the third; all three: detached), each moved a tenth of the mean edge length in a random
-direction (beyond the weld across cracks: nothing is welded back).
+The meshes are unit spheres (exact H = 1) with a share of their faces given two corners of their own, each
+moved a tenth of the mean edge length in a random direction (beyond the weld across cracks: nothing is
+welded back); the third corner stays shared.
 """
 
 from __future__ import annotations
@@ -49,24 +43,6 @@ def hanging_faces(vertices, faces, share: float, seed: int):
     faces = faces.copy()
     faces[picked[rows], columns] = len(vertices) + np.arange(corners.size)
     return np.concatenate([vertices, vertices[corners] + GAP * edge * directions]), faces
-
-
-def detached_faces(vertices, faces, share: float, seed: int):
-    """``(vertices, faces)``: ``share`` of the faces given three corners of their own, each moved :data:`GAP`
-    mean edge lengths in a random direction; the copies come after the vertices."""
-    rng = np.random.default_rng(seed)
-    edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
-    picked = rng.random(len(faces)) < share
-    corners = faces[picked].ravel()
-    directions = rng.normal(size=(corners.size, 3))
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    faces = faces.copy()
-    faces[picked] = len(vertices) + np.arange(corners.size).reshape(-1, 3)
-    return np.concatenate([vertices, vertices[corners] + GAP * edge * directions]), faces
-
-
-def median_edge(mesh) -> float:
-    return float(np.median(np.linalg.norm(mesh.vertices[mesh.faces[:, 0]] - mesh.vertices[mesh.faces[:, 1]], axis=1)))
 
 
 def rusinkiewicz(vertices, faces):
@@ -112,52 +88,3 @@ def test_bow_tie_corners_stay_invalid():
     assert flagged.any()
     assert not result.valid[flagged].any()
     assert INVALID_REASONS[bowtie.code].startswith("bow-tie vertex")
-
-
-def quadric(vertices, faces, radius):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the defects' warning and the noisy fits' phrase: counted below
-        return meshcurv.principal_curvatures(vertices, faces, method="quadric", radius=radius)
-
-
-@pytest.mark.parametrize("seed", range(6))
-def test_quadric_detached_faces_few_lies(seed):
-    # a random sphere of 500 vertices, 20% of its faces detached by a tenth of an edge, balls of 2.2 edges
-    # (296/1682's): the valid vertices (copies included: each lies by its corner) off H = 1 by more than half
-    # the curvature (the fuzzer's bar) were 1.1% to 3.1% of them; at most 0.35% now. Noise of a tenth of an
-    # edge in balls of two edges is beyond what the fits resolve (benchmarks/noisy_jets.md): a share, not none
-    mesh = shapes.random_sphere(500)
-    vertices, faces = detached_faces(mesh.vertices, mesh.faces, 0.2, seed)
-    result = quadric(vertices, faces, 2.2 * median_edge(mesh))
-    off = np.abs(result.mean[result.valid] - 1.0) > 0.5
-    assert result.valid.sum() > 0.6 * len(vertices)  # 73% before (the balls with too few points, the copies')
-    assert off.mean() < 0.005
-
-
-def test_quadric_noisy_fits_are_nan_with_a_reason_and_counted():
-    mesh = shapes.random_sphere(500)
-    vertices, faces = detached_faces(mesh.vertices, mesh.faces, 0.2, 0)
-    with pytest.warns(meshcurv.MeshQualityWarning, match="the fit follows noise") as caught:
-        result = meshcurv.principal_curvatures(vertices, faces, method="quadric", radius=1.5 * median_edge(mesh))
-    assert caught
-    undefined = INVALID_REASONS.index(
-        "estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)"
-    )
-    noisy = ~result.valid & (result.invalid_reason == undefined)
-    assert noisy.any()
-    assert np.isnan(result.mean[noisy]).all()
-
-
-@pytest.mark.parametrize("radius_edges", [1.5, 2.2, 3.0])
-def test_quadric_clean_sphere_unchanged_by_the_check(radius_edges):
-    # on the clean random sphere every fit agrees with its neighbours': none is NaN for following noise (some
-    # balls of 1.5 edges hold too few points: those are NaN, as before), the valid ones within a tenth of H = 1
-    mesh = shapes.random_sphere(500)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = meshcurv.principal_curvatures(
-            mesh.vertices, mesh.faces, method="quadric", radius=radius_edges * median_edge(mesh)
-        )
-    assert not any("follows noise" in str(warning.message) for warning in caught)
-    assert result.valid.mean() > 0.85
-    np.testing.assert_allclose(result.mean[result.valid], 1.0, atol=0.1)

@@ -36,13 +36,6 @@ far: a vertex whose jet departs from a steadier fit on the same ball (a quadric 
 more than :data:`STEADY_AGREEMENT` takes the steadier fit's curvatures, and one whose ball's points are too
 little spread for any such fit is NaN with ``valid=False``.
 
-The balls of two vertices an edge apart hold nearly the same points, so their fits differ by the change of
-the curvature over an edge; a fit that follows noise (points off the surface by a share of the radius: a
-noisy scan, faces detached by cracks wider than the weld) does not. A vertex whose principal curvatures
-depart from its edge neighbours' by more than :data:`ERRATIC_AGREEMENT` of the smaller largest |k| (median
-over the neighbours) takes its steady quadric where that agrees better with them, and is NaN with
-``valid=False`` where neither does (counted in the warning: pass a larger ``radius``).
-
 References
 ----------
 F. Cazals and M. Pouget (2005). Estimating differential quantities using
@@ -58,7 +51,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._pointcloud_estimators import FLAT_TURN
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, _fit_jets, shape_operators
 from ..radius import _component_radii, _resolve_radius, _vertex_radii
@@ -95,25 +87,6 @@ STEADY_MIN_SPREAD = 1e-5
 #: times the curvature. 0.1 and 0.2 kept more of the noisy jets (``benchmarks/rim_fits.md``,
 #: ``benchmarks/noisy_jets.md``).
 STEADY_AGREEMENT = 0.05
-
-#: A vertex whose principal curvatures depart from its edge neighbours' by more than this share of the smaller
-#: largest |k| (the median over at most :data:`ERRATIC_NEIGHBOURS` of them, at least ``FLAT_TURN / (3 h)``:
-#: :func:`meshcurv._pointcloud_estimators.erratic`'s measure) is checked against its steady quadric
-#: (:data:`STEADY_DEGREE` on the same ball), and takes it where the quadric agrees better with the
-#: neighbours. The balls of neighbours an edge apart hold nearly the same points: their estimates differ by
-#: the change of the curvature over an edge, unless the fit follows noise (issue 29: faces detached by
-#: cracks wider than the weld leave copies of vertices a tenth of an edge off the surface in the ball, where
-#: a degree-4 jet read H 1.58 on a unit sphere whose clean mesh gives 0.99). The clean meshes' jets depart
-#: by up to 0.55 (coarse ellipsoids, default radius) but at the tips of the coarsest irregular ellipsoids;
-#: point clouds use 0.3 (``NEIGHBOUR_AGREEMENT``), with 10 neighbours.
-ERRATIC_AGREEMENT = 0.6
-
-#: A quadric that departs less than this share below the jet's departure ties with it (the jet is kept): the
-#: same fit (a rim's steady fit, a ball too little spread for more) must not swap on round-off.
-TIE = 1e-6
-
-#: The edge neighbours of a vertex read by that check (the first of its list): a bounded table.
-ERRATIC_NEIGHBOURS = 10
 
 
 def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
@@ -166,18 +139,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
         np.where(valid[:, None], six, 0.0), np.where(valid[:, None], fitted, [0.0, 0.0, 1.0])
     )
-    erratic = _erratic_rows(mesh, k_min, k_max, valid)
-    unsteady = np.zeros(0, dtype=np.int64)
-    if erratic.size:
-        around = (vertices, start, groups, erratic)
-        fields = (six, fitted, coefficients)
-        unsteady = _steadier_among_neighbours(around, mesh, referenced, facing, fields, (k_min, k_max), valid)
-        valid[unsteady] = False
-        k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-            np.where(valid[:, None], six, 0.0), np.where(valid[:, None], fitted, [0.0, 0.0, 1.0])
-        )
     failed = ~valid & ~defects.invalid_vertices
-    failed[unsteady] = False
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     few = int(failed.sum()) - two_sided
     shown = ", ".join(f"{r:g}" for r, _ in groups)
@@ -194,13 +156,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             "pass a smaller `radius`"
         )
         if two_sided
-        else "",
-        (
-            f"{unsteady.size} vertices have a fit that their edge neighbours' fits (over nearly the same ball) do "
-            f"not reproduce, nor does a quadric: the fit follows noise (points off the surface by a share of the "
-            f"radius {shown}); pass a larger `radius`"
-        )
-        if unsteady.size
         else "",
     )
     normals_out = np.where(valid[:, None], fitted, normals)
@@ -252,85 +207,3 @@ def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
     swap = spread & ~(apart <= STEADY_AGREEMENT)
     six[rows[swap]], fitted[rows[swap]], coefficients[rows[swap]] = low_six[swap], low_fitted[swap], found[rows][swap]
     coefficients[rows[~spread]] = np.nan
-
-
-def _neighbour_table(mesh: PreparedMesh, rows: np.ndarray) -> np.ndarray:
-    """(len(rows), k) the first :data:`ERRATIC_NEIGHBOURS` edge neighbours of the vertices ``rows``, padded
-    with V (no vertex: :func:`_departures` reads it as a neighbour with no estimate)."""
-    n = mesh.vertices.shape[0]
-    indptr, indices = mesh.topology.neighbour_lists
-    counts = np.minimum(indptr[rows + 1] - indptr[rows], ERRATIC_NEIGHBOURS)
-    table = np.full((rows.size, max(int(counts.max(initial=0)), 1)), n, dtype=np.int64)
-    at = np.repeat(np.arange(rows.size), counts)
-    columns = np.arange(at.size) - np.repeat(np.cumsum(counts) - counts, counts)
-    table[at, columns] = indices[indptr[rows[at]] + columns]
-    return table
-
-
-def _departures(mesh: PreparedMesh, k: tuple, valid: np.ndarray, rows: np.ndarray, own: tuple | None = None):
-    """(len(rows),) the median departure of the principal curvatures ``own`` (default: theirs in ``k``) of the
-    vertices ``rows`` from those ``k = (k_min, k_max)`` of their ``valid`` edge neighbours, in the smaller
-    largest |k| of the two, at least ``FLAT_TURN / (3 h)`` (the measure of
-    :func:`meshcurv._pointcloud_estimators.erratic`); NaN where no neighbour has an estimate."""
-    table = _neighbour_table(mesh, rows)
-    mine = np.stack(own if own is not None else (k[0][rows], k[1][rows]), axis=1)
-    known = np.append(valid, False)[table]
-    theirs = np.where(known[..., None], np.stack([np.append(side, np.nan)[table] for side in k], axis=2), np.nan)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        largest = np.minimum(np.abs(mine).max(axis=1)[:, None], np.abs(theirs).max(axis=2))
-        scale = np.maximum(largest, FLAT_TURN / (3.0 * mesh.length_scales[rows])[:, None])
-        apart = np.abs(theirs - mine[:, None, :]).max(axis=2) / scale
-    out = np.full(rows.size, np.nan)
-    some = known.any(axis=1)
-    out[some] = np.nanmedian(apart[some], axis=1)
-    return out
-
-
-def _erratic_rows(mesh: PreparedMesh, k_min, k_max, valid) -> np.ndarray:
-    """The ``valid`` vertices whose curvatures depart from their edge neighbours' by more than
-    :data:`ERRATIC_AGREEMENT` (:func:`_departures`)."""
-    rows = np.flatnonzero(valid)
-    if rows.size == 0:
-        return rows
-    return rows[_departures(mesh, (k_min, k_max), valid, rows) > ERRATIC_AGREEMENT]
-
-
-def _steadier_among_neighbours(
-    steady: tuple, mesh: PreparedMesh, referenced, facing, fields: tuple, k: tuple, valid: np.ndarray
-) -> np.ndarray:
-    """The fits in ``fields`` (``six, fitted, coefficients``, changed in place) of the erratic vertices ``rows``
-    of ``steady = (vertices, start, groups, rows)`` replaced by their steady quadric's (:data:`STEADY_DEGREE`,
-    spread by :data:`STEADY_MIN_SPREAD`, over the same ball) where its curvatures depart less from the
-    ``valid`` neighbours' ``k = (k_min, k_max)`` (the jets': each row is compared with its own quadric).
-    Returns the rows that neither fit makes agree within :data:`ERRATIC_AGREEMENT`: their fits follow noise."""
-    vertices, start, groups, rows = steady
-    six, fitted, coefficients = fields
-    low_six, low_fitted, low_found = (np.full((rows.size, width), np.nan) for width in (6, 3, 6))
-    for group_radius, members in groups:
-        mine = np.arange(rows.size) if members is None else np.flatnonzero(np.isin(rows, members))
-        if mine.size == 0:
-            continue
-        unit = group_radius if group_radius > 0 else 1.0
-        found, frame, _ = _fit_jets(
-            vertices,
-            start,
-            unit,
-            degree=STEADY_DEGREE,
-            centres=rows[mine],
-            neighbours=referenced,
-            facing=facing,
-            min_spread=STEADY_MIN_SPREAD,
-        )
-        centres = rows[mine]
-        low_six[mine], low_fitted[mine] = shape_operators(found[centres], tuple(axis[centres] for axis in frame), unit)
-        low_found[mine] = found[centres]
-    spread = np.asarray(np.isfinite(low_found).all(axis=1))
-    low_k = principal_from_shape_operator(
-        np.where(spread[:, None], low_six, 0.0), np.where(spread[:, None], low_fitted, [0.0, 0.0, 1.0])
-    )[:2]
-    before = _departures(mesh, k, valid, rows)
-    after = _departures(mesh, k, valid, rows, own=low_k)
-    # (a quadric that is the jet itself, a rim's steady fit or a ball too little spread for more, ties: kept)
-    swap = spread & (after < (1.0 - TIE) * before)
-    six[rows[swap]], fitted[rows[swap]], coefficients[rows[swap]] = low_six[swap], low_fitted[swap], low_found[swap]
-    return rows[np.where(swap, after, before) > ERRATIC_AGREEMENT]
