@@ -65,8 +65,7 @@ from .._backend import kernel_threads, numba_kernels
 from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
-from ..lattice import voxel_grid
-from ..radius import _mesh_voxel_grid, _off_grid_scale, _ring_max
+from ..radius import _ring_max, _voxel_surface
 from ._support import Stages, finish
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
@@ -127,7 +126,7 @@ def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: i
     cells reads a part of the staircase, not the surface (the module's Notes). Other meshes: unchanged.
     """
     invalid, note = defects.invalid_vertices, ""
-    if smoothing_steps > 0 and invalid.any() and valid.any() and staircase(mesh, invalid):
+    if smoothing_steps > 0 and invalid.any() and valid.any() and _voxel_surface(mesh, invalid):
         cut = valid & (_ring_max(mesh.topology.neighbour_lists, smoothing_steps, invalid.astype(np.float64)) > 0)
         if cut.any():
             valid = valid & ~cut
@@ -139,22 +138,6 @@ def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: i
     k_min, k_max, dir_min, dir_max = curvatures
     parameters = {"smoothing_steps": smoothing_steps}
     return finish("normal_cycle", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra=(note,))
-
-
-def staircase(mesh: PreparedMesh, invalid: np.ndarray) -> bool:
-    """Whether the mesh is a voxel surface (:func:`meshcurv.radius._mesh_voxel_grid`), or its faces with a corner
-    not ``invalid`` ((V,) bool) are: the cells of the valid vertices, where faces detached off the grid (a
-    triangle soup beside it, cracks beyond the weld: fuzz_api seed 322, case 407) leave the rest on it."""
-    if _mesh_voxel_grid(mesh) is not None:
-        return True
-    faces = mesh.topology.faces[~invalid[mesh.topology.faces].all(axis=1)]
-    if faces.shape[0] == 0:
-        return False
-    used = np.zeros(mesh.vertices.shape[0], dtype=bool)
-    used[faces] = True
-    scales = mesh.length_scales[used]
-    grid = voxel_grid(mesh.vertices[used], (np.cumsum(used) - 1)[faces], spacing=float(np.median(scales)))
-    return grid is not None and not _off_grid_scale(scales, grid.spacing)
 
 
 def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages: Stages):

@@ -67,10 +67,9 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from .._geometry import edge_dihedral_angles
 from ..neighborhoods import _ball_edge_sums, _candidate_pairs
-from ..radius import _component_radii, _resolve_radius, _vertex_radii
+from ..radius import _component_radii, _resolve_radius, _vertex_radii, _voxel_surface
 from .._prepared import PreparedMesh
 from ._support import Stages, ball_holds_neighbours, finish
-from .normal_cycle import staircase
 
 STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve curvatures")
 
@@ -252,10 +251,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
 def _voxel_holed_balls(mesh: PreparedMesh, holes: np.ndarray, groups: list) -> np.ndarray:
     """(V,) bool: on a voxel surface, the vertices whose ball holds a part of an edge of a hole (``holes``, (E,)
     bool, :func:`hole_edges`); all False on other meshes (the module's Notes). A voxel surface: the mesh, or the
-    faces around its vertices free of defects and boundaries (:func:`meshcurv.estimators.normal_cycle.staircase`)."""
+    faces around its vertices free of defects and boundaries (:func:`meshcurv.radius._voxel_surface`)."""
     vertices, edges = mesh.vertices, mesh.topology.edges
     holed = np.zeros(vertices.shape[0], dtype=bool)
-    if not holes.any() or not staircase(mesh, mesh.defects().invalid_vertices):
+    if not holes.any() or not _voxel_surface(mesh, mesh.defects().invalid_vertices):
         return holed
     ones = np.ones((edges.shape[0], 1))
     for group_radius, members in groups:
