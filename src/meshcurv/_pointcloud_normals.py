@@ -1076,7 +1076,9 @@ def _edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols):
         & (np.minimum(np.abs(ahead), np.abs(behind)) >= reach)
         & (ahead * behind * cosine > 0)
     )
-    weights = np.where(stacked, 3.0 + (1.0 - np.abs(cosine)), 1.0 - np.abs(cosine) + np.nan_to_num(slope) + 1e-6)
+    weights = np.where(
+        stacked, 3.0 + (1.0 - np.minimum(np.abs(cosine), 1.0)), 1.0 - np.abs(cosine) + np.nan_to_num(slope) + 1e-6
+    )
     return stacked, weights, (cosine < 0) ^ stacked
 
 

@@ -532,7 +532,7 @@ def edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols, offset
         up = (not flat[t]) and abs(c) >= facing and near >= reach and a * b * c > 0
         stacked[t] = up
         if up:
-            weights[t] = 3.0 + (1.0 - abs(c))
+            weights[t] = 3.0 + (1.0 - min(abs(c), 1.0))  # |cos| rounds up to 1 + 4e-16: stacked stays >= 3
         else:
             s = slope[t]
             if s != s:
