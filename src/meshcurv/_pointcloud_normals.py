@@ -991,7 +991,7 @@ def oriented_signs(
     if forest is not None:
         # the sheets read off the forest's union-find once its flat edges are taken, where the flat edges come
         # first in the order (a flat edge weighs 1 - |cos| + a slope of at most SHEET_SLOPE, below 3; a stacked
-        # one mostly 3 or more, but not always: a voxel cloud of 11.6 voxels in 2 x 1 x 1 holds lighter ones)
+        # one 3 or more, its |cos| clipped to 1); else, as a guard, the NumPy forest
         used_weights, n_flat = weights[used], int(np.count_nonzero(flat))
         order = np.argsort(used_weights)
         separated = (n_flat == 0 or used_weights[order[n_flat - 1]] < 3.0) and (
