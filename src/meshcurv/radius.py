@@ -15,6 +15,8 @@ the user:
   around the vertex (below);
 - :func:`noise_level`, :func:`noise_radius`: ``icc``'s radius on smooth and
   noisy meshes, growing with the noise measured on the mesh;
+- :func:`local_noise`, :func:`jet_vertex_radii`: ``quadric``'s default, each
+  vertex's radius growing with the noise measured around it (:func:`noise_rule`);
 - :func:`voxel_radius`, :func:`voxel_surface_radius`: on voxel surfaces
   (marching cubes), about ``sqrt(h R)`` for voxels of size ``h`` and curvature
   radius ``R``; :func:`voxel_vertex_radii`: ``icc``'s default there, each
@@ -110,6 +112,8 @@ __all__ = [
     "cloud_noise_level",
     "cloud_radius",
     "noise_rule",
+    "local_noise",
+    "jet_vertex_radii",
 ]
 
 #: The default ``radius`` is this many mean edge lengths.
@@ -349,9 +353,19 @@ def _noise_level(vertices, normals, valid, edges, *, neighbours=None, adjacency=
         centres = centres[np.linspace(0, centres.size - 1, NOISE_SAMPLE).round().astype(np.int64)]
     if centres.size == 0:
         return 0.0
-    scale = local[centres]
+    distances, _ = _noise_fits(vertices, normals, centres, local[centres], neighbours=neighbours, adjacency=adjacency)
+    distances = distances[np.isfinite(distances)]
+    return float(np.median(distances)) if distances.size else 0.0
+
+
+def _noise_fits(vertices, normals, centres, scale, *, neighbours=None, adjacency=None, facing=None):
+    """``(distances, curvedness)`` (M,): the fits of :func:`noise_level` at ``centres`` (M,) of local edge lengths
+    ``scale`` (M,): each vertex's distance to its degree-2 jet in the mean edge length of its class, and the jet's
+    ``sqrt(k_1^2 + k_2^2)`` (the norm of its Hessian); NaN where no jet was fitted (``facing``: the check of
+    :func:`meshcurv.jets.fit_jets`)."""
     level = np.round(np.log2(scale / np.median(scale))).astype(np.int64)
     distances = np.full(centres.size, np.nan)
+    curvedness = np.full(centres.size, np.nan)
     for k in np.unique(level):
         members = np.flatnonzero(level == k)
         radius = NOISE_FIT_RADIUS * scale[members].mean()
@@ -365,11 +379,13 @@ def _noise_level(vertices, normals, valid, edges, *, neighbours=None, adjacency=
             adjacency=adjacency,
             compact=True,
             settled=SETTLED_SLOPE,
+            facing=facing,
         )
         # the constant term is in units of the radius: NOISE_FIT_RADIUS class mean edge lengths
         distances[members] = np.abs(coefficients[:, 0]) * NOISE_FIT_RADIUS
-    distances = distances[np.isfinite(distances)]
-    return float(np.median(distances)) if distances.size else 0.0
+        a, b, c = coefficients[:, 3], coefficients[:, 4], coefficients[:, 5]
+        curvedness[members] = np.sqrt(4.0 * a * a + 2.0 * b * b + 4.0 * c * c) / radius
+    return distances, curvedness
 
 
 def noise_radius(noise: float, edge_length: float) -> float:
@@ -484,6 +500,113 @@ def _noise_radii(
         groups.append((float(noise_radius(level, edge_length)), members))
         levels.append(level)
     return groups, levels
+
+
+#: ``quadric``'s default radius (:func:`jet_vertex_radii`): ``h (a + b sqrt(max(nu_v - NOISE_FLOOR, 0)))``
+#: (:func:`noise_rule`) for ``(a, b)`` this, ``h`` the group's mean edge length and ``nu_v`` the vertex's own noise
+#: level (:func:`local_noise`): :data:`DEFAULT_RADIUS_FACTOR` edge lengths on a clean mesh, as before. A jet of
+#: degree 4 amplifies noise far more than icc's sums (noise of 0.1 h: median H error 56-108% at 2.5 h on the
+#: spheres of ``benchmarks/accuracy.py``), so its radius grows faster with the noise (``benchmarks/quadric_noise.md``).
+JET_RADIUS_RULE = (DEFAULT_RADIUS_FACTOR, 20.0)
+
+#: ... at most ``JET_CURVATURE_CAP / c_v`` (``c_v`` the norm of the vertex's Hessian, :func:`local_noise`: a ball
+#: wider than the radius of curvature reaches round the shape, where no height function describes it), never
+#: below :data:`DEFAULT_RADIUS_FACTOR` edge lengths.
+JET_CURVATURE_CAP = 1.0
+
+#: ... with ``c_v^2`` less ``JET_NOISE_HESSIAN (nu_v / h)^2``, the share of the noise in the fits' squared Hessian
+#: norm (noise of 0.3 h read 3.7 on the unit sphere of ``benchmarks/accuracy.py`` whose exact norm is 1.41: the
+#: share is 150-300 ``(nu_v h)^2 / r_fit^4`` over its spheres and tori, ``r_fit = 2 h``); the largest ``c_v``
+#: within the ball's rings, which the noise's tail sets, capped the 0.3 h rows twice as tight as they need.
+JET_NOISE_HESSIAN = 10.0
+
+
+def local_noise(
+    vertices: np.ndarray, topology: MeshTopology, normals: np.ndarray, valid: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(levels, curvedness)`` (V,): the noise level of each vertex and the curvedness of the surface there.
+
+    The fits of :func:`noise_level` (degree-2 jets over balls of :data:`NOISE_FIT_RADIUS` local edge lengths,
+    Euclidean balls of the vertices of ``topology``'s faces, a ball holding the other side refused) at every
+    ``valid`` vertex, each vertex's distance to its jet (in local edge lengths) and the norm of the jet's Hessian
+    ``sqrt(k_1^2 + k_2^2)``, averaged over :data:`LOCAL_RINGS` rings (the root of the mean square for the
+    curvedness). The median of the levels is about the mesh's :func:`noise_level`; a patch of the mesh that is
+    noisy (faces detached off the surface, a scanned region) reads as noisy where the median does not.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+    topology : MeshTopology
+    normals : ndarray of shape (V, 3)
+        Unit normals of the fits' first frames (also those of the check of a ball's other side).
+    valid : ndarray of shape (V,) of bool
+        The vertices fitted.
+
+    Returns
+    -------
+    levels, curvedness : ndarray of shape (V,)
+        NaN where no fit is within reach.
+    """
+    mesh = _measured(vertices, topology)
+    valid, normals = _checked_fields(mesh, valid, normals)
+    return _local_noise(mesh, normals, valid)
+
+
+def _local_noise(
+    mesh: _Measured | PreparedMesh, normals: np.ndarray, valid: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    n = mesh.vertices.shape[0]
+    local = mesh.scale_edge_means
+    centres = np.flatnonzero(valid & np.isfinite(local) & (local > 0))
+    if centres.size == 0:
+        return np.full(n, np.nan), np.full(n, np.nan)
+    facing = np.where(valid[:, None], normals, np.nan)
+    distances, curvedness = _noise_fits(
+        mesh.vertices,
+        normals,
+        centres,
+        local[centres],
+        neighbours=mesh.topology.referenced_vertices,
+        facing=facing,
+    )
+    fitted = np.isfinite(distances) & np.isfinite(curvedness)
+    values = np.zeros((n, 2))
+    known = np.zeros(n)
+    values[centres[fitted]] = np.stack([distances[fitted], curvedness[fitted] ** 2], axis=1)
+    known[centres[fitted]] = 1.0
+    sums, weights = _ring_sums(mesh.topology.neighbour_lists, LOCAL_RINGS, values, known)
+    reached = weights > 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        averages = sums / np.where(reached, weights, 1.0)[:, None]
+    averages[~reached] = np.nan
+    return averages[:, 0], np.sqrt(averages[:, 1])
+
+
+def jet_vertex_radii(
+    groups: list[tuple[float, np.ndarray | None]], levels: np.ndarray, curvedness: np.ndarray
+) -> np.ndarray:
+    """(V,) ``quadric``'s default radius at each vertex: :data:`JET_RADIUS_RULE` of its noise level.
+
+    ``groups``: :func:`component_radii` (:data:`DEFAULT_RADIUS_FACTOR` times each group's mean edge length ``h``);
+    ``levels``, ``curvedness``: :func:`local_noise`. The radius is ``h (a + b sqrt(max(nu_v - NOISE_FLOOR, 0)))``,
+    at most :data:`JET_CURVATURE_CAP` ``/ c_v`` and at least the group's radius (where the level is NaN: the
+    group's radius).
+    """
+    levels = np.asarray(levels, dtype=np.float64)
+    curvedness = np.asarray(curvedness, dtype=np.float64)
+    base = vertex_radii(groups, levels.size)
+    return _jet_vertex_radii(base, levels, curvedness)
+
+
+def _jet_vertex_radii(base: np.ndarray, levels: np.ndarray, curvedness: np.ndarray) -> np.ndarray:
+    edge = base / DEFAULT_RADIUS_FACTOR
+    noise = np.where(np.isfinite(levels), levels, 0.0)
+    grown = _noise_rule(JET_RADIUS_RULE, edge, noise)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        squared = curvedness**2 - JET_NOISE_HESSIAN * (noise / edge) ** 2  # the noise's share taken out
+        bent = np.where(np.isfinite(squared), np.sqrt(np.maximum(squared, 0.0)), 0.0)
+        cap = np.where(bent > 0, JET_CURVATURE_CAP / bent, np.inf)
+    return np.where(np.isfinite(base), np.maximum(base, np.minimum(grown, cap)), base)
 
 
 def voxel_radius(spacing: np.ndarray, curvature_radius: float) -> float:
@@ -1122,8 +1245,13 @@ def _notes_by_radius(notes: dict[float, str]) -> str:
 
 def noise_rule(rule, spacing: float, noise: float) -> float:
     """``spacing (a + b sqrt(max(noise - NOISE_FLOOR, 0)))`` for ``rule = (a, b)``."""
+    return float(_noise_rule(rule, spacing, noise))
+
+
+def _noise_rule(rule, spacing, noise):
+    """:func:`noise_rule` of numbers or arrays (elementwise)."""
     a, b = rule
-    return float(spacing * (a + b * np.sqrt(max(noise - NOISE_FLOOR, 0.0))))
+    return spacing * (a + b * np.sqrt(np.maximum(noise - NOISE_FLOOR, 0.0)))
 
 
 def cloud_radius(spacing: float, noise: float, method: str = "corrected_measures") -> float:

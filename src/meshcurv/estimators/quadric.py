@@ -36,6 +36,22 @@ far: a vertex whose jet departs from a steadier fit on the same ball (a quadric 
 more than :data:`STEADY_AGREEMENT` takes the steadier fit's curvatures, and one whose ball's points are too
 little spread for any such fit is NaN with ``valid=False``.
 
+Noise. A jet of degree 4 amplifies noise far more than a quadric: at 2.5 edge lengths, noise of a tenth of an
+edge along the normal gave median H errors of 56-108% of the curvature on the noisy spheres of
+``benchmarks/accuracy.py`` (a quadric over the same balls 11-20%). Each vertex's noise level is read as the
+default method reads the mesh's (:func:`meshcurv.radius.local_noise`: its distance to a degree-2 jet over two
+edge lengths, averaged over two rings), and
+
+- the default radius grows with it (:func:`meshcurv.radius.jet_vertex_radii`:
+  ``h (2.5 + 20 sqrt(max(nu_v - 0.005, 0)))``, at most the inverse of the surface's curvedness there, at least
+  2.5 h; ``parameters["scale"] == "noise"``, ``result.radius`` per vertex), a grown ball that holds the other
+  side of the surface falling back to 2.5 h; a clean mesh keeps 2.5 h;
+- at any radius, a vertex whose level exceeds :data:`NOISE_GATE` has its jet checked against a quadric over the
+  same ball, as at the rim (faces detached off the surface by a tenth of an edge make such balls: issue 29, fuzz
+  296/1682).
+
+``benchmarks/quadric_noise.md`` gives the errors before and after.
+
 References
 ----------
 F. Cazals and M. Pouget (2005). Estimating differential quantities using
@@ -53,7 +69,7 @@ import numpy as np
 
 from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, _fit_jets, shape_operators
-from ..radius import _component_radii, _resolve_radius, _vertex_radii
+from ..radius import _component_radii, _jet_vertex_radii, _local_noise, _resolve_radius, _vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 
@@ -88,6 +104,13 @@ STEADY_MIN_SPREAD = 1e-5
 #: ``benchmarks/noisy_jets.md``).
 STEADY_AGREEMENT = 0.05
 
+#: A vertex whose noise level (:func:`meshcurv.radius.local_noise`, in edge lengths) exceeds this has its jet
+#: checked against a quadric (:data:`STEADY_DEGREE`) over the same ball, as at the rim: the clean meshes of
+#: ``benchmarks/accuracy.py`` read at most 0.006 (the fit's bias on the coarsest torus), noise of 0.1 h about 0.02;
+#: a degree-4 jet over a ball of 2.5 edge lengths follows such noise (median H error 56-108% on the noisy spheres,
+#: a quadric's 11-20%; issue 29, fuzz 296/1682: faces detached by 0.087 edge lengths).
+NOISE_GATE = 0.016
+
 
 def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     """Weighted jet fits over balls of radius ``radius``. Returns ``(result, problems)``.
@@ -95,43 +118,44 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     Only referenced vertices enter the balls. A fit whose ball holds the other
     side of the surface (``facing`` of :func:`fit_jets`: a ball across a needle,
     or over a whole small closed part) is NaN with ``valid=False`` and counted
-    in the warning. With the default radius, each group of components of one
-    scale gets its own (:func:`meshcurv.radius.component_radii`).
+    in the warning. With the default radius, each vertex gets its own
+    (:func:`meshcurv.radius.jet_vertex_radii`: its group's, grown with its noise level).
     """
     vertices, topology = mesh.vertices, mesh.topology
     stages.start("compute normals")
-    if radius is None:
-        groups = _component_radii(mesh)
-    else:
-        groups = [(_resolve_radius(radius, mesh), None)]
     normals = mesh.vertex_normals
     defects, valid = mesh.start(boundary=True, fragments=True)  # its balls are Euclidean: parts alike
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     facing = np.where(valid[:, None], normals, np.nan)
     referenced = topology.referenced_vertices
     rim = topology.boundary_vertices
+    levels, curvedness = _local_noise(mesh, start, valid)
+    noisy = np.isfinite(levels) & (levels > NOISE_GATE)
+    if radius is None:
+        groups = _component_radii(mesh)
+        radii = _jet_vertex_radii(_vertex_radii(groups, vertices.shape[0]), levels, curvedness)
+        radii = np.where(np.isfinite(radii) & (radii > 0), radii, 1.0)  # coincident points: any unit (all fail)
+        parts: list = [(radii, None)]
+    else:
+        groups = [(_resolve_radius(radius, mesh), None)]
+        radii = _vertex_radii(groups, vertices.shape[0])
+        parts = [(group_radius if group_radius > 0 else 1.0, members) for group_radius, members in groups]
 
     stages.start("fit jets")
     n = vertices.shape[0]
-    six = np.full((n, 6), np.nan)
-    fitted = np.full((n, 3), np.nan)
-    coefficients = np.full((n, 6), np.nan)
+    fields = tuple(np.full((n, width), np.nan) for width in (6, 3, 6))  # six, fitted, coefficients
     away = np.zeros(n)
-    for group_radius, members in groups:
-        unit = group_radius if group_radius > 0 else 1.0  # a mesh of coincident points: any unit (every fit fails)
-        details: dict = {}
-        found, frame, _ = _fit_jets(
-            vertices, start, unit, centres=members, neighbours=referenced, facing=facing, details=details
-        )
-        part_six, part_fitted = shape_operators(found, frame, unit)
-        rows = slice(None) if members is None else members
-        six[rows], fitted[rows], coefficients[rows] = part_six[rows], part_fitted[rows], found[rows]
-        away[rows] = np.nan_to_num(details["away"][rows])
-        for steady_degree, side in ((STEADY_DEGREE, rim), (DEGREE, referenced & ~rim)):
-            rows_fitted = np.flatnonzero(side) if members is None else members[side[members]]
-            if rows_fitted.size:
-                steady = (vertices, start, unit, rows_fitted, steady_degree)
-                _steady_fits(steady, referenced, facing, (six, fitted, coefficients))
+    sides = (rim, noisy & referenced)
+    for unit, members in parts:
+        centres = np.flatnonzero(referenced) if np.ndim(unit) else members
+        _fit_part((vertices, start, unit, centres), referenced, facing, sides, fields, away)
+    if radius is None:  # a grown ball that holds the other side: the group's own radius
+        base = _vertex_radii(groups, n)
+        again = np.flatnonzero(referenced & (away > AWAY_FRACTION) & (radii > base) & np.isfinite(base) & (base > 0))
+        if again.size:
+            radii[again] = base[again]
+            _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
+    six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
     fitted = np.where(np.isfinite(fitted).all(axis=1, keepdims=True), fitted, normals)
@@ -142,7 +166,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     failed = ~valid & ~defects.invalid_vertices
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     few = int(failed.sum()) - two_sided
-    shown = ", ".join(f"{r:g}" for r, _ in groups)
+    shown = ", ".join(f"{r:g}" for r, _ in groups) if radius is not None else _shown_radii(radii, referenced)
     extra = (
         (
             f"{few} vertices have fewer than {MIN_POINTS} vertices (or a degenerate set) within "
@@ -160,7 +184,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     )
     normals_out = np.where(valid[:, None], fitted, normals)
     parameters: dict[str, object] = {"radius": groups[0][0]}
-    if len(groups) > 1:
+    if radius is None:
+        used = radii[referenced]
+        parameters = {"radius": float(np.median(used)) if used.size else groups[0][0], "scale": "noise"}
+    elif len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
     return finish(
         "quadric",
@@ -173,13 +200,51 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         dir_max,
         defects,
         extra,
-        radius=_vertex_radii(groups, vertices.shape[0]),
+        radius=radii,
     )
+
+
+def _fit_part(part: tuple, referenced, facing, sides: tuple, fields: tuple, away: np.ndarray) -> None:
+    """The jets of ``part = (vertices, start, unit, centres)`` (``unit``: one radius, or (V,) one per vertex;
+    ``centres`` None: every vertex) fitted into ``fields = (six, fitted, coefficients)`` and ``away`` (changed in
+    place), each made stable (:func:`_steady_fits`): against a quadric at the vertices of ``sides = (rim,
+    noisy)``, else against the highest degree spread by :data:`STEADY_MIN_SPREAD`."""
+    vertices, start, unit, centres = part
+    six, fitted, coefficients = fields
+    per_vertex = np.ndim(unit) > 0
+    details: dict = {}
+    found, frame, _ = _fit_jets(
+        vertices,
+        start,
+        unit[centres] if per_vertex else unit,
+        centres=centres,
+        neighbours=referenced,
+        facing=facing,
+        details=details,
+    )
+    part_six, part_fitted = shape_operators(found, frame, unit)
+    rows = slice(None) if centres is None else centres
+    six[rows], fitted[rows], coefficients[rows] = part_six[rows], part_fitted[rows], found[rows]
+    away[rows] = np.nan_to_num(details["away"][rows])
+    rim, noisy = sides
+    for steady_degree, side in ((STEADY_DEGREE, rim | noisy), (DEGREE, referenced & ~rim & ~noisy)):
+        rows_fitted = np.flatnonzero(side) if centres is None else centres[side[centres]]
+        if rows_fitted.size:
+            steady = (vertices, start, unit[rows_fitted] if per_vertex else unit, rows_fitted, steady_degree)
+            _steady_fits(steady, referenced, facing, fields)
+
+
+def _shown_radii(radii: np.ndarray, referenced: np.ndarray) -> str:
+    """The default radii of a warning: one, or their range."""
+    used = radii[referenced]
+    if used.size == 0 or used.min() == used.max():
+        return f"{used[0] if used.size else radii[0]:g}"
+    return f"{used.min():g} to {used.max():g}"
 
 
 def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
     """The fits in ``fields`` (``six, fitted, coefficients``, changed in place) made stable at the vertices
-    ``rows`` of ``steady = (vertices, start, unit, rows, degree)``: the fit of at most ``degree`` over the
+    ``rows`` of ``steady = (vertices, start, unit, rows, degree)`` (``unit``: one radius, or one per row): the fit of at most ``degree`` over the
     same ball whose points are spread by :data:`STEADY_MIN_SPREAD` (:data:`STEADY_DEGREE` at the rim,
     :data:`meshcurv.jets.DEGREE` inside) where the jet differs from it by more than :data:`STEADY_AGREEMENT`
     over the radius ``unit``; NaN where no degree is spread enough."""
@@ -203,7 +268,8 @@ def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
     if both.any():
         high_k = principal_from_shape_operator(six[rows][both], fitted[rows][both])[:2]
         low_k = principal_from_shape_operator(low_six[both], low_fitted[both])[:2]
-        apart[both] = unit * np.maximum(np.abs(high_k[0] - low_k[0]), np.abs(high_k[1] - low_k[1]))
+        scale = unit[both] if np.ndim(unit) else unit
+        apart[both] = scale * np.maximum(np.abs(high_k[0] - low_k[0]), np.abs(high_k[1] - low_k[1]))
     swap = spread & ~(apart <= STEADY_AGREEMENT)
     six[rows[swap]], fitted[rows[swap]], coefficients[rows[swap]] = low_six[swap], low_fitted[swap], found[rows][swap]
     coefficients[rows[~spread]] = np.nan
