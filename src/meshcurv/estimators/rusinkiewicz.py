@@ -28,8 +28,12 @@ curvature, and a hemisphere's rim had a median H error of 21%). Each boundary
 vertex takes the normal of a quadric (a jet of degree
 :data:`BOUNDARY_NORMAL_DEGREE`) fitted to the referenced vertices of a ball of
 :data:`BOUNDARY_NORMAL_RADIUS` length scales around it (:func:`meshcurv.jets.fit_jets`,
-over Euclidean neighbours: across a hole too); a vertex whose ball holds too few
-points for the fit, or the other side of the surface, is NaN with ``valid=False``.
+over Euclidean neighbours: across a hole too), a smaller ball where the quadric
+bends across it by more than :data:`BOUNDARY_NORMAL_BEND` (a ball wrapped around a
+bend tilts the quadric at a rim: up to 25 degrees where the radius of curvature is
+an edge, fuzz 402/396), down to :data:`BOUNDARY_NORMAL_MIN_RADIUS` length scales; a
+vertex whose ball holds too few points for the fit, or the other side of the
+surface, is NaN with ``valid=False``.
 The vertices whose fan is not one disk (bow-ties, non-manifold edges,
 inconsistently oriented faces: :data:`OPEN_FAN_DEFECTS`) are invalid, but their
 valid neighbours' face tensors read their normals: those take the same fitted
@@ -72,6 +76,24 @@ BOUNDARY_NORMAL_DEGREE = 2
 #: ``benchmarks/accuracy.py --quick`` has a lower median H error than with the faces' normals but the
 #: clean cylinder's (0.036% -> 0.39%, its k_min 3.6% -> 0.96%).
 BOUNDARY_NORMAL_RADIUS = 4.0
+
+#: The most a boundary normal's quadric may bend across its ball: ``|k| r``, the ball's radius over the
+#: radius of curvature its fit reads. A fit that bends more is made again over the ball that would bend by
+#: this much (:func:`_bounded_normals`). A one-sided ball wrapped around a bend tilts the quadric: on the
+#: rim of the lower half of a coarse ellipsoid (3, 2, 1) (its equator, whose radius of curvature across the
+#: rim is one or two edges) the fitted normals were off by up to 12-25 degrees and H by 51-59% of its own
+#: value, by 1.4-3.5 degrees and 16-29% now (``tests/test_wide_cracks_R18.py``); on a cylinder's one-sided
+#: ball the normal's error stays below a degree up to a bend of 2 (fuzz 402/396: a rim vertex's normal 25
+#: degrees off at a bend of 5.3).
+BOUNDARY_NORMAL_BEND = 1.5
+
+#: The smallest ball of those fits, in length scales. Below two, a rim's one-sided ball holds about ten
+#: points for the quadric's six coefficients, and its slope leans again (the tip of a half ellipsoid's rim:
+#: 0.1 degrees off at 2 length scales, 7 at 1.75 and 1.5).
+BOUNDARY_NORMAL_MIN_RADIUS = 2.0
+
+#: How many times a fit is made again over a smaller ball (the bend read over the smaller ball differs).
+BOUNDARY_NORMAL_PASSES = 3
 
 #: The defect codes (:data:`meshcurv.defects.DEFECTS`) of vertices whose fan of faces is not one disk: fans
 #: meeting at a point (a bow-tie), a non-manifold edge, inconsistently oriented faces. Such a vertex is
@@ -158,8 +180,9 @@ def boundary_normals(mesh: PreparedMesh, normals: np.ndarray, valid: np.ndarray,
     fans meeting at a point, a non-manifold edge, inconsistently oriented faces); its normal is fitted where
     the vertex is ``valid`` or a corner of a face with a ``valid`` corner (the face tensors of a valid vertex
     read the normals of all its faces' corners). The fits are quadrics (:data:`BOUNDARY_NORMAL_DEGREE`) over
-    the referenced vertices within :data:`BOUNDARY_NORMAL_RADIUS` length scales, started from ``normals`` and
-    refused where the ball holds the other side of the surface (``facing`` of :func:`meshcurv.jets.fit_jets`).
+    the referenced vertices within :data:`BOUNDARY_NORMAL_RADIUS` length scales, or fewer where the quadric
+    bends across that ball (:func:`_bounded_normals`), started from ``normals`` and refused where the ball
+    holds the other side of the surface (``facing`` of :func:`meshcurv.jets.fit_jets`).
     ``codes`` are the vertices' defect codes (:attr:`meshcurv.defects.VertexDefects.codes`).
     """
     topology = mesh.topology
@@ -179,21 +202,53 @@ def boundary_normals(mesh: PreparedMesh, normals: np.ndarray, valid: np.ndarray,
             continue
         known = valid.copy()
         known[centres] = True
-        found, frame, _ = _fit_jets(
-            mesh.vertices,
-            np.where(known[:, None], normals, [0.0, 0.0, 1.0]),
-            BOUNDARY_NORMAL_RADIUS * mesh.length_scales[centres],
-            degree=BOUNDARY_NORMAL_DEGREE,
-            centres=centres,
-            neighbours=topology.referenced_vertices,
-            facing=np.where(known[:, None], normals, np.nan),
-        )
-        fitted[centres] = jet_normals(found[centres], tuple(axis[centres] for axis in frame))
+        fitted[centres] = _bounded_normals(mesh, np.where(known[:, None], normals, [0.0, 0.0, 1.0]), known, centres)
     # an invalid vertex whose fit failed (its ball holds the other side of a part thinner than 4 length scales)
     # keeps the mean of its faces' normals: its faces stay in its valid neighbours' averages, as before the fits
     kept = rows[~valid[rows] & ~np.isfinite(fitted[rows]).all(axis=1)]
     fitted[kept] = normals[kept]
     return fitted
+
+
+def _bounded_normals(mesh: PreparedMesh, normals: np.ndarray, known: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    """(M, 3) the normals of quadrics fitted at ``centres``, over balls that the surface bends across by at most
+    :data:`BOUNDARY_NORMAL_BEND` (NaN where a fit failed).
+
+    Each fit starts over :data:`BOUNDARY_NORMAL_RADIUS` length scales; one whose quadric bends more (``|k| r``
+    from its coefficients) is fitted again over the ball that would bend by the limit, not below
+    :data:`BOUNDARY_NORMAL_MIN_RADIUS` length scales, up to :data:`BOUNDARY_NORMAL_PASSES` times. ``normals``
+    start the fits; the balls' points of ``known`` normals check them (``facing``).
+    """
+    scales = mesh.length_scales[centres]
+    radii = BOUNDARY_NORMAL_RADIUS * scales
+    floor = BOUNDARY_NORMAL_MIN_RADIUS * scales
+    result = np.full((centres.size, 3), np.nan)
+    todo = np.arange(centres.size)
+    for _ in range(BOUNDARY_NORMAL_PASSES):
+        found, frame, _ = _fit_jets(
+            mesh.vertices,
+            normals,
+            radii[todo],
+            degree=BOUNDARY_NORMAL_DEGREE,
+            centres=centres[todo],
+            neighbours=mesh.topology.referenced_vertices,
+            facing=np.where(known[:, None], normals, np.nan),
+            compact=True,
+        )
+        result[todo] = jet_normals(found, frame)
+        # |k| r of the quadric c20 x^2 + c11 x y + c02 y^2 in units of r: twice its largest |eigenvalue|
+        half_sum, half_difference = (
+            (found[:, 3] + found[:, 5]) / 2,
+            np.hypot((found[:, 3] - found[:, 5]) / 2, found[:, 4] / 2),
+        )
+        with np.errstate(invalid="ignore"):
+            bend = 2 * (np.abs(half_sum) + half_difference)
+            over = (bend > BOUNDARY_NORMAL_BEND) & (radii[todo] > floor[todo] * (1 + 1e-9))
+        todo, bend = todo[over], bend[over]
+        if todo.size == 0:
+            break
+        radii[todo] = np.maximum(radii[todo] * BOUNDARY_NORMAL_BEND / bend, floor[todo])
+    return result
 
 
 def estimate(mesh: PreparedMesh, *, stages: Stages):
