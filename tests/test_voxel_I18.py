@@ -13,11 +13,14 @@ against the returned one.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from test_icc_holed_voxel import OFF, _holed, _icc
 
 from meshcurv import principal_curvatures, shapes
+from meshcurv.defects import UNDEFINED
 
 
 def _signed_errors(mesh, result) -> np.ndarray:
@@ -52,3 +55,38 @@ def test_voxel_surface_left_in_strips_in_anisotropic_voxels_is_measured_without_
         result = principal_curvatures(torus.vertices, faces, method="icc")
     assert result.mean.shape == (len(torus.vertices),)
     assert np.all(np.isnan(result.mean[~result.valid]))
+
+
+def _normal_cycle(vertices, faces, **options):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = principal_curvatures(vertices, faces, method="normal_cycle", **options)
+    return result, " ".join(str(w.message) for w in caught)
+
+
+def test_normal_cycle_on_a_voxel_sphere_is_undefined_where_its_smoothing_is_too_short():
+    # before: every vertex valid, 20% of them off the sphere's H by more than half of it (median error 26%)
+    pytest.importorskip("skimage")
+    sphere = shapes.voxel_sphere(radius=10.0)
+    result, message = _normal_cycle(sphere.vertices, sphere.faces)
+    error = _signed_errors(sphere, result)
+    assert not (np.abs(error[result.valid]) > OFF).any()
+    assert not result.valid.any()
+    assert set(result.invalid_reason) == {UNDEFINED}
+    assert "smoothing_steps=15 or more" in message and "'icc'" in message and "'normal_cycle_ball'" in message
+
+
+def test_normal_cycle_on_a_voxel_sphere_with_the_steps_it_names_is_right():
+    # (1.2 sqrt(h R) / e)^2 = 1.44 x 10 voxels: 15 steps; none off the sphere's 1 / R by more than half of it
+    pytest.importorskip("skimage")
+    sphere = shapes.voxel_sphere(radius=10.0)
+    result, _ = _normal_cycle(sphere.vertices, sphere.faces, smoothing_steps=15)
+    assert result.valid.all()
+    assert np.abs(_signed_errors(sphere, result)).max() < OFF
+
+
+def test_normal_cycle_on_a_smooth_sphere_keeps_every_vertex():
+    sphere = shapes.icosphere(subdivisions=3)
+    result, _ = _normal_cycle(sphere.vertices, sphere.faces)
+    assert result.valid.all()
+    np.testing.assert_allclose(result.mean, 1.0, rtol=0.05)
