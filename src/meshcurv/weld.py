@@ -22,6 +22,7 @@ second edge on it and is left alone.
 
 from __future__ import annotations
 
+import itertools
 from typing import NamedTuple
 
 import numpy as np
@@ -173,7 +174,13 @@ def weld_vertices(
 
 def _weld_coincident(vertices: np.ndarray, topology: MeshTopology, tolerance_ratio: float) -> Welding:
     """The boundary vertices within ``tolerance_ratio`` times the median edge length (their parts' where the
-    parts differ in scale) welded (:func:`weld_vertices`)."""
+    parts differ in scale) welded (:func:`weld_vertices`).
+
+    Exact copies of a point are joined first, and the search runs on one copy each (the largest tolerance of
+    its copies stands for it: a point within the tolerance of one copy joins them all); the pairs within the
+    tolerance are taken in chunks (:func:`_pairs_near`) and kept as the components they join
+    (:class:`_Components`): a collapsed soup (18,000 corners at one point, another apart) made 160 M pairs.
+    """
     n_vertices = vertices.shape[0]
     unchanged = Welding(vertices, topology, np.arange(n_vertices), 0)
     if not topology.boundary_edges.any():
@@ -184,49 +191,152 @@ def _weld_coincident(vertices: np.ndarray, topology: MeshTopology, tolerance_rat
     scales = vertex_length_scales(vertices, topology)
     used = scales[topology.referenced_vertices]
     if used.min() < used.max():  # parts of different scales: each within its own tolerance
-        pairs = _pairs_within(vertices[candidates], tolerance_ratio * scales[candidates])
+        tolerances = tolerance_ratio * scales[candidates]
     else:
         tolerance = _tolerance(vertices, topology, tolerance_ratio)
         if tolerance == 0.0:
             return unchanged
-        from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
-
-        pairs = cKDTree(vertices[candidates]).query_pairs(tolerance, output_type="ndarray")
+        tolerances = np.full(candidates.size, tolerance)
+    points = vertices[candidates]
+    components = _Components(candidates.size)
+    single, copies = _exact_copies(points)
+    components.add(copies)
+    widest = tolerances.copy()
+    np.maximum.at(widest, copies[:, 0], tolerances[copies[:, 1]])  # a copy's tolerance reaches its first's
+    if used.min() < used.max():
+        for i, j in _pairs_within(points[single], widest[single]):
+            components.add(np.column_stack([single[i], single[j]]))
+    else:
+        for i, j in _pairs_near(points[single], tolerance):
+            components.add(np.column_stack([single[i], single[j]]))
+    pairs = components.links()
     if pairs.size == 0:
         return unchanged
     return _merge(vertices, topology, pairs, candidates)
 
 
-def _pairs_within(points: np.ndarray, tolerances: np.ndarray) -> np.ndarray:
-    """(P, 2) sorted index pairs of ``points`` closer than the smaller of their two ``tolerances`` (>= 0).
+def _exact_copies(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of ``points`` ((N, 3)) that are the first of their exact copies (or the only one, or not
+    finite), and (C, 2) each later copy paired with its first."""
+    finite = np.flatnonzero(np.isfinite(points).all(axis=1))
+    values = points[finite]
+    order = np.lexsort((values[:, 2], values[:, 1], values[:, 0]))  # stable: each run of copies by index
+    ordered = values[order]
+    starts = np.r_[True, (ordered[1:] != ordered[:-1]).any(axis=1)]
+    first = order[starts][np.cumsum(starts) - 1]
+    copies = np.column_stack([finite[first[~starts]], finite[order[~starts]]])
+    single = np.ones(points.shape[0], dtype=bool)
+    single[copies[:, 1]] = False
+    return np.flatnonzero(single), copies
+
+
+def _pairs_near(points: np.ndarray, radius: float):
+    """Yield ``(i, j)``: the index pairs ``i < j`` of ``points`` within ``radius`` of each other, at once
+    (:meth:`scipy.spatial.cKDTree.query_pairs`) when they are few (:func:`_few_pairs`), in chunks
+    (:func:`_near_pairs`) otherwise."""
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    tree = cKDTree(points)
+    if _few_pairs(points, radius, tree=tree):
+        pairs = tree.query_pairs(radius, output_type="ndarray")
+        yield pairs[:, 0], pairs[:, 1]
+        return
+    for i, j, _ in _near_pairs(tree, points, radius):
+        keep = i < j
+        yield i[keep], j[keep]
+
+
+#: The pairs of points within a weld's radius found at once are at most this many per point (and
+#: :data:`PAIR_CHUNK` in all): 16 bytes each; more are taken in chunks.
+PAIRS_PER_POINT = 16
+
+
+def _few_pairs(points: np.ndarray, radius: float, others: np.ndarray | None = None, *, tree=None) -> bool:
+    """Whether the ordered pairs of ``points`` and ``others`` (default: ``points``, each with itself too) within
+    ``radius`` are at most :data:`PAIRS_PER_POINT` per point or :data:`PAIR_CHUNK`.
+
+    First by a bound, linear in time and memory: a pair within ``radius`` shares a cell of side ``2 radius`` in
+    one of the 8 grids shifted by ``radius`` along the axes, so the sum over those grids of each cell's count of
+    ``points`` times its count of ``others`` (cells hashed into buckets, which only adds) is at least the
+    number of pairs. Where the bound is larger, the pairs are counted (a search as long as finding them, no
+    memory): ``tree`` is ``others``' ``cKDTree`` when given.
+    """
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    other = points if others is None else others
+    n = points.shape[0] + other.shape[0]
+    limit = max(PAIR_CHUNK, PAIRS_PER_POINT * n)
+    size = 1 << int(np.ceil(np.log2(2 * n + 1)))
+    cells = [_cell_keys(p, radius) for p in ((points,) if others is None else (points, other))]
+    bound = 0
+    for x, y, z in itertools.product((0, 1), repeat=3):
+        counts = [np.bincount(_bucket(k[0][x] + k[1][y] + k[2][z], size), minlength=size) for k in cells]
+        bound += int(np.dot(counts[0], counts[-1]))
+        if bound > limit:
+            break
+    else:
+        return True
+    tree = cKDTree(other) if tree is None else tree
+    queries = tree if others is None else cKDTree(points)
+    return int(queries.count_neighbors(tree, radius)) <= limit
+
+
+#: Odd 64-bit multipliers mixing a cell's three integer coordinates into one key (:func:`_cell_keys`).
+_MIXERS = (np.int64(-7046029254386353131), np.int64(-4658895280553007687), np.int64(1))
+
+
+def _cell_keys(points: np.ndarray, radius: float) -> list[list[np.ndarray]]:
+    """For each axis, the cells of side ``2 radius`` holding ``points`` on it, unshifted and shifted by half a
+    cell, each times its axis' mixer (cells beyond 2^62 clipped: such points only share more cells)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        scaled = np.clip(points / (2.0 * radius), -(2.0**62), 2.0**62)
+        return [
+            [np.floor(scaled[:, axis] + shift).astype(np.int64) * _MIXERS[axis] for shift in (0.0, 0.5)]
+            for axis in range(3)
+        ]
+
+
+def _bucket(keys: np.ndarray, size: int) -> np.ndarray:
+    """(N,) the buckets in [0, size) (a power of 2) of cell ``keys``."""
+    return (keys ^ (keys >> 29)) & (size - 1)
+
+
+def _pairs_within(points: np.ndarray, tolerances: np.ndarray):
+    """Yield ``(i, j)``: index pairs of ``points`` (distinct) closer than the smaller of their two ``tolerances``
+    (>= 0), in chunks (:func:`_near_pairs`); a pair may come more than once.
 
     A mesh of parts at different scales (a part of 2 units beside one of 1e12) welds each part within its own
     tolerance: one taken from the largest part's edges would merge a whole small part into a point (issue 29).
     One search per octave of tolerances, each against the points of that octave and above, so that no search
-    is wider than the smaller tolerance of the pairs it finds.
+    is wider than the smaller tolerance of the pairs it finds. A tolerance of 0 (a part whose edges all have
+    length 0) joins exact copies only, which ``points`` holds no more (:func:`_exact_copies`).
     """
     from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
 
-    found = [np.empty((0, 2), dtype=np.int64)]
-    if (tolerances <= 0).any():  # a part whose edges all have length 0: its exact copies only
-        found.append(cKDTree(points).query_pairs(0.0, output_type="ndarray").astype(np.int64))
     positive = np.flatnonzero(tolerances > 0)
     _, octave = np.frexp(tolerances[positive])
     for c in np.unique(octave).tolist():
         these = positive[octave == c]
         wider = positive[octave >= c]
-        matrix = cKDTree(points[these]).sparse_distance_matrix(
-            cKDTree(points[wider]), np.ldexp(1.0, c), output_type="ndarray"
-        )
-        i, j = these[matrix["i"]], wider[matrix["j"]]
-        keep = (i != j) & (matrix["v"] <= np.minimum(tolerances[i], tolerances[j]))
-        found.append(np.column_stack([i[keep], j[keep]]))
-    pairs = np.sort(np.concatenate(found), axis=1)
-    return np.unique(pairs, axis=0)
+        for rows, columns, distances in _near_pairs(cKDTree(points[wider]), points[these], np.ldexp(1.0, c)):
+            i, j = these[rows], wider[columns]
+            keep = (i != j) & (distances <= np.minimum(tolerances[i], tolerances[j]))
+            yield i[keep], j[keep]
 
 
 def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: float) -> Welding:
-    """The ends of boundary edges on top of each other welded (:func:`weld_vertices`); ``n_cracked`` = ``n_welded``."""
+    """The ends of boundary edges on top of each other welded (:func:`weld_vertices`); ``n_cracked`` = ``n_welded``.
+
+    The candidates are the pairs of edges whose midpoints are within the largest ``limit`` of their class. Where
+    they are many more than the edges (edges on top of each other in bulk: a collapsed soup, its vertices
+    collinear, fuzz 342/923, had 8.6 M pairs for 17,795 edges and took 1.3 GiB), they are searched among the
+    edges' pairs of ends instead, as points ``(first, second)`` of 6-D space against the edges' ``(first,
+    second)`` and ``(second, first)`` (two ends each within ``limit`` of the other edge's are within
+    ``sqrt(2) * limit`` there: a fifth of the candidates on that soup, but a slower search on any mesh), taken in
+    chunks (:func:`_near_pairs`); the pairs found are kept as the components they join (:class:`_Components`).
+    Both searches find every pair of the rule, so the welds are the same; the memory is bounded by the mesh's
+    size.
+    """
     n_vertices = vertices.shape[0]
     unchanged = Welding(vertices, topology, np.arange(n_vertices), 0)
     ends = topology.edges[topology.boundary_edges]
@@ -243,45 +353,133 @@ def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: floa
     from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
 
     # the two sides of a crack differ in length by at most twice the crack (far below a factor 2): the pairs of
-    # each class of lengths [2^c, 2^(c+1)) and the next are within crack_ratio * 2^(c+1) of each other
+    # each class of lengths [2^(c-1), 2^c) and the next are within crack_ratio * 2^c of each other, end by end
     _, exponent = np.frexp(lengths)
-    classes = np.unique(exponent)
-    found = []
-    for c in classes.tolist():  # one query per octave of edge lengths, not per edge
+    components = _Components(n_vertices)
+    for c in np.unique(exponent).tolist():  # one search per octave of edge lengths, not per edge
         members = np.flatnonzero((exponent == c) | (exponent == c + 1))
         if members.size < 2:
             continue
-        pairs = cKDTree(midpoints[members]).query_pairs(crack_ratio * np.ldexp(1.0, c), output_type="ndarray")
-        if pairs.size:
-            found.append(members[pairs])
-    if not found:
+        radius = crack_ratio * np.ldexp(1.0, c)
+        tree = cKDTree(midpoints[members])
+        if _few_pairs(midpoints[members], radius, tree=tree):
+            found = members[tree.query_pairs(radius, output_type="ndarray")]
+            for k in range(0, found.shape[0], PAIR_CHUNK):
+                i, j = found[k : k + PAIR_CHUNK].T
+                components.add(_crack_links(ends, first, second, lengths, i, j, crack_ratio))
+            continue
+        forward = np.hstack([first[members], second[members]])
+        queries = np.vstack([forward, np.hstack([second[members], first[members]])])
+        for rows, columns, _ in _near_pairs(cKDTree(forward), queries, np.sqrt(2.0) * radius):
+            i, j = members[rows % members.size], members[columns]
+            keep = i < j  # each pair once (as the same and the crossed pairing's query: either finds it)
+            components.add(_crack_links(ends, first, second, lengths, i[keep], j[keep], crack_ratio))
+    pairs = components.links()
+    if pairs.size == 0:
         return unchanged
-    ordered = np.sort(np.concatenate(found), axis=1)
-    key = np.unique(ordered[:, 0].astype(np.int64) * lengths.size + ordered[:, 1])  # each pair once
-    i, j = np.divmod(key, lengths.size)
-    a, b, c_, d = ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1]
-    apart = (a != c_) & (a != d) & (b != c_) & (b != d)  # sharing no vertex (so no face: a face's edges do)
-    limit = crack_ratio * np.minimum(lengths[i], lengths[j])
-    same = np.maximum(_distance(first[i], first[j]), _distance(second[i], second[j])) <= limit
-    crossed = np.maximum(_distance(first[i], second[j]), _distance(second[i], first[j])) <= limit
-    same &= apart
-    crossed &= apart & ~same
-    if not (same.any() or crossed.any()):
-        return unchanged
-    pairs = np.concatenate(
-        [
-            np.column_stack([a[same], c_[same]]),
-            np.column_stack([b[same], d[same]]),
-            np.column_stack([a[crossed], d[crossed]]),
-            np.column_stack([b[crossed], c_[crossed]]),
-        ]
-    )
     # each group at its first member, as a weld of coincident copies: the mean of the copies (d4e1e6a) moved the
     # corners of a voxel surface off its grid (no longer read as one: another radius, H off by 0.57 of |k|) and
     # flung a vertex whose copies the crack search paired along a needle's long edges (issue 29, fuzz round 17,
     # 312/2774 and 312/4373, 296/119); quadric's rims are steadied by their fits instead (quadric.STEADY_*)
     welding = _merge(vertices, topology, pairs)
     return welding._replace(n_cracked=welding.n_welded)
+
+
+def _crack_links(
+    ends: np.ndarray,
+    first: np.ndarray,
+    second: np.ndarray,
+    lengths: np.ndarray,
+    i: np.ndarray,
+    j: np.ndarray,
+    crack_ratio: float,
+) -> np.ndarray:
+    """(P, 2) the vertex pairs welded by the edge pairs ``(i, j)`` that are the two sides of a crack: their ends
+    pairwise within ``crack_ratio`` times the shorter edge's length, in either pairing (the same pairing first),
+    and sharing no vertex (so no face: a face's edges do)."""
+    a, b, c, d = ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1]
+    apart = (a != c) & (a != d) & (b != c) & (b != d)
+    limit = crack_ratio * np.minimum(lengths[i], lengths[j])
+    same = np.maximum(_distance(first[i], first[j]), _distance(second[i], second[j])) <= limit
+    crossed = np.maximum(_distance(first[i], second[j]), _distance(second[i], first[j])) <= limit
+    same &= apart
+    crossed &= apart & ~same
+    return np.concatenate(
+        [
+            np.column_stack([a[same], c[same]]),
+            np.column_stack([b[same], d[same]]),
+            np.column_stack([a[crossed], d[crossed]]),
+            np.column_stack([b[crossed], c[crossed]]),
+        ]
+    )
+
+
+#: The candidate pairs of a weld's search taken at once (:func:`_near_pairs`), beside one query's own: a few tens of
+#: MiB of coordinates, whatever the number of points on top of each other.
+PAIR_CHUNK = 1 << 18
+
+
+def _near_pairs(tree, queries: np.ndarray, radius: float, chunk: int = PAIR_CHUNK):
+    """Yield ``(rows, columns, distances)``: the ``queries`` and the points of ``tree`` (a ``cKDTree``) within
+    ``radius`` of each other, in chunks of consecutive queries holding at most ``chunk`` pairs each, beyond a
+    single query's own (at most the tree's size): memory bounded by the points', not by their pairs."""
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    if _few_pairs(queries, radius, tree.data, tree=tree):
+        found = cKDTree(queries).sparse_distance_matrix(tree, radius, output_type="ndarray")
+        yield found["i"].astype(np.int64), found["j"].astype(np.int64), found["v"]
+        return
+    counts = np.asarray(tree.query_ball_point(queries, radius, return_length=True), dtype=np.int64)
+    total = np.cumsum(counts)
+    if total.size == 0 or total[-1] == 0:
+        return
+    starts = np.unique(np.r_[0, np.searchsorted(total, np.arange(chunk, total[-1], chunk), side="left") + 1])
+    stops = np.r_[starts[1:], queries.shape[0]]
+    for start, stop in zip(starts.tolist(), stops.tolist()):
+        if start >= stop or total[stop - 1] == (total[start - 1] if start else 0):
+            continue
+        found = cKDTree(queries[start:stop]).sparse_distance_matrix(tree, radius, output_type="ndarray")
+        yield found["i"].astype(np.int64) + start, found["j"].astype(np.int64), found["v"]
+
+
+class _Components:
+    """The vertices joined by pairs given in chunks, kept as the components they make (a forest of links to each
+    component's first vertex) whenever the links held exceed twice the forest's and the larger of the vertices'
+    number and :data:`PAIR_CHUNK`: memory bounded by the vertices, and each reduction, linear in the vertices and
+    links, comes after at least as many new links (linear time in all)."""
+
+    def __init__(self, n_vertices: int) -> None:
+        self.n_vertices = n_vertices
+        self.held: list[np.ndarray] = []
+        self.size = 0
+        self.forest = 0
+
+    def add(self, pairs: np.ndarray) -> None:
+        """Join the vertices of ``pairs`` ((P, 2) vertex indices)."""
+        if pairs.size == 0:
+            return
+        self.held.append(pairs.astype(np.int64, copy=False))
+        self.size += pairs.shape[0]
+        if self.size > 2 * self.forest + max(self.n_vertices, PAIR_CHUNK) and len(self.held) > 1:
+            self.held = [self._forest()]
+            self.size = self.forest = self.held[0].shape[0]
+
+    def links(self) -> np.ndarray:
+        """(L, 2) pairs joining the same components as all the pairs added."""
+        return np.concatenate(self.held) if self.held else np.empty((0, 2), dtype=np.int64)
+
+    def _forest(self) -> np.ndarray:
+        """(L, 2) each joined vertex and its component's first (lowest-index) vertex."""
+        from scipy.sparse import coo_matrix  # imported on use: keeps `import meshcurv` fast
+        from scipy.sparse.csgraph import connected_components
+
+        pairs, n = self.links(), self.n_vertices
+        graph = coo_matrix((np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+        _, labels = connected_components(graph, directed=False)
+        _, first = np.unique(labels, return_index=True)
+        root = first[labels]
+        joined = np.flatnonzero(root != np.arange(n))
+        return np.column_stack([root[joined], joined])
 
 
 def _distance(p: np.ndarray, q: np.ndarray) -> np.ndarray:
