@@ -1,4 +1,4 @@
-"""Rims where the surface bends sharply within the ball of a boundary normal's fit (issue 29, fuzz round 19).
+"""Wide cracks (issue 29, fuzz round 19): rims bent within a normal's fit, holes in a voxel staircase's balls.
 
 ``rusinkiewicz`` gives each boundary vertex (and each open fan its valid vertices read) the normal of a
 quadric fitted over a ball of 4 length scales. Where the surface's radius of curvature is about one edge
@@ -8,6 +8,11 @@ face tensors read that lean as curvature (``fuzz_api.py --wide-cracks 1 --seed 4
 boundary vertex left with two faces, H = -0.20 where the clean mesh gives 1.18). The fits now shrink their
 ball until the quadric bends across it by at most ``rusinkiewicz.BOUNDARY_NORMAL_BEND``, down to
 ``rusinkiewicz.BOUNDARY_NORMAL_MIN_RADIUS`` length scales.
+
+``normal_cycle_ball`` on a voxel surface leaves a ball that holds a hole undefined (the staircase's dihedral
+angles left in it do not average out); with half of the faces detached and some welded to each other, the
+grid was not read (too many valid vertices off it: fuzz 480/968), and the balls around the holes were valid
+and off by up to twice the curvature.
 
 Oracles: the exact normals and curvatures of the ellipsoid (``shapes.ellipsoid``); a detached corner takes
 those of the vertex it was copied from.
@@ -22,19 +27,21 @@ import pytest
 
 import meshcurv
 from meshcurv import shapes
+from meshcurv.defects import INVALID_REASONS, UNDEFINED
+from meshcurv.errors import MeshQualityWarning
 
 
 #: The move of the detached corners, in mean edge lengths (the fuzzer's wide cracks: 0.05 to 0.1; 396: 0.078).
 GAP = 0.1
 
 
-def half_detached(mesh, seed: int):
+def half_detached(mesh, seed: int, gap: float = GAP):
     """``(vertices, faces, source)``: half of the faces of ``mesh`` given three corners of their own, each moved
-    :data:`GAP` mean edge lengths in a random direction (the copies after the vertices); vertex ``i`` copies
+    ``gap`` mean edge lengths in a random direction (the copies after the vertices); vertex ``i`` copies
     vertex ``source[i]`` (itself for the mesh's own)."""
     rng = np.random.default_rng(seed)
     sides = mesh.vertices[mesh.faces[:, 1]] - mesh.vertices[mesh.faces[:, 0]]
-    step = GAP * float(np.mean(np.linalg.norm(sides, axis=1)))
+    step = gap * float(np.mean(np.linalg.norm(sides, axis=1)))
     picked = rng.random(len(mesh.faces)) < 0.5
     source = np.concatenate([np.arange(len(mesh.vertices)), mesh.faces[picked].ravel()])
     offsets = rng.normal(size=(source.size - len(mesh.vertices), 3))
@@ -80,3 +87,25 @@ def test_coarse_ellipsoid_half_detached_stays_within_half_the_curvature(seed):
     largest = float(np.max(np.abs(np.concatenate([mesh.k_min, mesh.k_max]))))
     assert result.valid.sum() > 0.3 * len(mesh.vertices)
     assert np.all(np.abs(result.mean - exact)[result.valid] <= 0.5 * largest)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_voxel_sphere_half_detached_balls_with_holes_undefined(seed):
+    # fuzz 480/968 (the fuzzer's calls restricted to rusinkiewicz and normal_cycle_ball): half of the faces of
+    # a voxel sphere of radius 4 detached by 0.06 voxels; copies of neighbouring faces' corners closer than the
+    # weld's reach are welded to each other, and 97 of the 258 valid vertices lie off the grid: the mesh was no
+    # voxel surface for normal_cycle_ball's holed balls, and the staircase's dihedral angles left in balls
+    # around the holes were read as curvature (169-185 of 356-364 valid vertices off the exact H = 1/4 by more
+    # than half the curvature, up to 1.9 times it). Now the grid is read on the valid vertices whose
+    # coordinates repeat, and those balls are undefined, with their reason
+    pytest.importorskip("skimage")
+    mesh = shapes.voxel_sphere(4.0)
+    vertices, faces, source = half_detached(mesh, seed, gap=0.06)
+    with pytest.warns(MeshQualityWarning, match="their ball holds a hole"):
+        result = meshcurv.principal_curvatures(vertices, faces, method="normal_cycle_ball")
+    exact = ((mesh.k_min + mesh.k_max) / 2)[source]
+    largest = float(np.max(np.abs(np.concatenate([mesh.k_min, mesh.k_max]))))
+    assert np.all(np.abs(result.mean - exact)[result.valid] <= 0.5 * largest)
+    undefined = ~result.valid & (result.invalid_reason == UNDEFINED)
+    assert undefined.sum() > 0.2 * len(mesh.vertices)
+    assert INVALID_REASONS[UNDEFINED].startswith("estimate undefined")
