@@ -1,8 +1,9 @@
 """Voxel surfaces with holes and rims: icc's valid vertices off the exact H (issue 29).
 
-``python benchmarks/holed_voxel.py [--method icc] [--seeds 3] [--shares 0,0.1,0.3,0.5]``
+``python benchmarks/holed_voxel.py [--method icc] [--seeds 3] [--shares 0,0.1,0.3,0.5,0.6]``
 
-Marching-cubes spheres (radius 4 to 12 voxels, and 8 voxels in 2 x 1 x 1 voxels) and tori (``shapes.voxel_torus``)
+Marching-cubes spheres (radius 4 to 12 voxels, and 8 voxels in 2 x 1 x 1, 1 x 2 x 1, 3 x 1 x 1 and 1 x 1 x 2
+voxels) and tori (``shapes.voxel_torus``)
 with a share of their faces removed at random, and the same surfaces cut across an axis (a rim, no hole). The
 exact mean curvature is that of the closest point of the analytic surface, with the sign of its outward normal
 against the returned one (an open mesh is oriented patch by patch). A valid vertex is off where
@@ -59,13 +60,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--method", default="icc")
     parser.add_argument("--seeds", type=int, default=3)
-    parser.add_argument("--shares", default="0,0.1,0.3,0.5", help="shares of the faces removed")
+    parser.add_argument("--shares", default="0,0.1,0.3,0.5,0.6", help="shares of the faces removed")
     options = parser.parse_args()
     meshes = [
         ("voxel_sphere(4)", shapes.voxel_sphere(radius=4.0)),
         ("voxel_sphere(8)", shapes.voxel_sphere(radius=8.0)),
         ("voxel_sphere(12)", shapes.voxel_sphere(radius=12.0)),
         ("voxel_sphere(8), 2 x 1 x 1 voxels", shapes.voxel_sphere(radius=8.0, spacing=(2.0, 1.0, 1.0))),
+        ("voxel_sphere(8), 1 x 2 x 1 voxels", shapes.voxel_sphere(radius=8.0, spacing=(1.0, 2.0, 1.0))),
+        ("voxel_sphere(8), 3 x 1 x 1 voxels", shapes.voxel_sphere(radius=8.0, spacing=(3.0, 1.0, 1.0))),
+        ("voxel_sphere(8), 1 x 1 x 2 voxels", shapes.voxel_sphere(radius=8.0, spacing=(1.0, 1.0, 2.0))),
         ("voxel_torus(8, 3)", shapes.voxel_torus(8.0, 3.0)),
         ("voxel_torus(12, 4)", shapes.voxel_torus(12.0, 4.0)),
     ]
