@@ -44,8 +44,10 @@ edge lengths, averaged over two rings), and
 
 - the default radius grows with it (:func:`meshcurv.radius.jet_vertex_radii`:
   ``h (2.5 + 20 sqrt(max(nu_v - 0.005, 0)))``, at most the inverse of the surface's curvedness there, at least
-  2.5 h; ``parameters["scale"] == "noise"``, ``result.radius`` per vertex), a grown ball that holds the other
-  side of the surface falling back to 2.5 h; a clean mesh keeps 2.5 h;
+  2.5 h; at the rim the median curvedness inside, as its one-sided fits read noise as curvature;
+  ``parameters["scale"] == "noise"``,
+  ``result.radius`` per vertex), a grown ball that holds the other side of the surface falling back to 2.5 h;
+  a clean mesh keeps 2.5 h;
 - at any radius, a vertex whose level, or its mesh's median level, exceeds :data:`NOISE_GATE` has its jet
   checked against a quadric over the same ball, as at the rim (faces detached off the surface by a tenth of an edge make such balls: issue 29, fuzz
   296/1682).
@@ -134,7 +136,12 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     noisy = _noisy_balls(levels, scales)
     if radius is None:
         groups = scales
-        radii = _jet_vertex_radii(_vertex_radii(groups, vertices.shape[0]), levels, curvedness)
+        # the rim capped by the median curvedness inside: its one-sided noise fits read noise as curvature (a noisy
+        # saddle's rim 30x its curvedness), and its own cap kept it at 2.5 h (median H error 128-201% under noise
+        # of 0.3 h); a detached face's corners are rim too, whose balls of the surface need the cap
+        inside = curvedness[~rim & np.isfinite(curvedness)]
+        bent = np.where(rim, np.median(inside) if inside.size else np.nan, curvedness)
+        radii = _jet_vertex_radii(_vertex_radii(groups, vertices.shape[0]), levels, bent)
         radii = np.where(np.isfinite(radii) & (radii > 0), radii, 1.0)  # coincident points: any unit (all fail)
         parts: list = [(radii, None)]
     else:
