@@ -266,6 +266,8 @@ def _few_pairs(points: np.ndarray, radius: float, others: np.ndarray | None = No
     other = points if others is None else others
     n = points.shape[0] + other.shape[0]
     limit = max(PAIR_CHUNK, PAIRS_PER_POINT * n)
+    if points.shape[0] * other.shape[0] <= limit:  # however close
+        return True
     size = 1 << int(np.ceil(np.log2(2 * n + 1)))
     cells = [_cell_keys(p, radius) for p in ((points,) if others is None else (points, other))]
     bound = 0
