@@ -11,7 +11,7 @@ import numpy as np
 
 from ._common import _JIT, run_chunks, threaded
 from .jets import _fit_one, _general, _jet_outputs, _jet_scratch
-from .neighborhoods import _connected_members, _connected_walk_levels
+from .neighborhoods import _connected_members, _connected_walk_levels, _vertex_spans
 from .tensors import _principal_from_mean_gaussian, _tangent_eigen
 
 
@@ -174,6 +174,7 @@ def nested_jet_normals(
         limits,
         fitted,
         _general(degree),
+        _vertex_spans(vertices, indptr, indices),
     )
     return fitted
 
@@ -196,8 +197,10 @@ def _nested_fits_chunk(
     limits,
     fitted,
     general,
+    spans,
 ):
-    """The fits of ``centres[lo:hi]`` of :func:`nested_jet_normals`, written to their columns of ``fitted``."""
+    """The fits of ``centres[lo:hi]`` of :func:`nested_jet_normals`, written to their columns of ``fitted``
+    (``spans``: :func:`~meshcurv._kernels.neighborhoods._vertex_spans`, which the walks skip far vertices with)."""
     n = vertices.shape[0]
     n_radii = radii.shape[0]
     top = n_radii - 1
@@ -217,7 +220,7 @@ def _nested_fits_chunk(
         v = centres[i]
         stamp = i * (n_radii + 1)  # the walks of a centre: its largest ball's, then a smaller one's each
         top_size, n_inner = _connected_walk_levels(
-            vertices, indptr, indices, allowed, v, cutoffs2, mark, stamp, walk, members
+            vertices, indptr, indices, allowed, v, cutoffs2, mark, stamp, walk, members, spans
         )
         size = top_size
         for r in range(top, -1, -1):  # the largest ball first: the smaller ones' members then take its place
@@ -231,7 +234,7 @@ def _nested_fits_chunk(
                         size += 1
                 if not vouched:
                     size = _connected_members(
-                        vertices, indptr, indices, allowed, v, radii[r], mark, stamp + 1 + r, members, spare
+                        vertices, indptr, indices, allowed, v, radii[r], mark, stamp + 1 + r, members, spare, spans
                     )
             c[0, :] = np.nan
             # one call site (the fit is inlined): numba refuses *args there, hence the whole list
