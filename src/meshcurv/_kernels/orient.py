@@ -1,6 +1,8 @@
-"""Compiled twin of :mod:`meshcurv.orient`: the signed volume of each patch of faces."""
+"""Compiled twins of :mod:`meshcurv.orient`: the signed volume of each patch of faces, the fast winding numbers."""
 
 from __future__ import annotations
+
+import math
 
 import numba as nb
 import numpy as np
@@ -118,3 +120,91 @@ def _volume_chunk(lo, hi, stage, vertices, faces, flip, centre, sums):
             signed += -volume if flip[f] else volume
             magnitude += abs(volume)
         sums[r, 0], sums[r, 1] = signed, magnitude
+
+
+@threaded
+def face_winding_numbers(corners, centres, dipoles, moments, radii, positions, own, depth, beta):
+    """``orient.face_winding_numbers``: (M,) the fast winding number of the triangles ``corners`` (S, 3, 3) at
+    ``positions`` (M, 3), the face ``own[m]`` left out at ``positions[m]``.
+
+    A walk of the tree from its root per query (a stack of at most ``depth + 1`` nodes), the queries in chunks on
+    threads (:func:`~._common.run_chunks`); the same terms as the NumPy twin, summed in the walk's order.
+    """
+    total = np.zeros(positions.shape[0])
+    limit = (beta * radii) ** 2
+    chunks = _CHUNKS_PER_THREAD * nb.get_num_threads()
+    run_chunks(
+        _winding_chunk,
+        positions.shape[0],
+        chunks,
+        corners,
+        centres,
+        dipoles,
+        moments,
+        limit,
+        positions,
+        own,
+        depth,
+        total,
+    )
+    return total / (4.0 * np.pi)
+
+
+@nb.njit(**_JIT)
+def _winding_chunk(lo, hi, corners, centres, dipoles, moments, limit, positions, own, depth, total):
+    """The queries ``lo`` to ``hi - 1`` of :func:`face_winding_numbers`: ``4 pi`` times their winding numbers."""
+    n_faces = corners.shape[0]
+    n_leaves = 1 << depth
+    first_leaf = n_leaves - 1
+    stack = np.zeros(depth + 2, dtype=np.int64)
+    for m in range(lo, hi):
+        qx, qy, qz = positions[m, 0], positions[m, 1], positions[m, 2]
+        skip = own[m]
+        sum_ = 0.0
+        stack[0] = 0
+        top = 1
+        while top > 0:
+            top -= 1
+            k = stack[top]
+            rx, ry, rz = centres[k, 0] - qx, centres[k, 1] - qy, centres[k, 2] - qz
+            squared = rx * rx + ry * ry + rz * rz
+            if squared > limit[k]:
+                cubed = squared * math.sqrt(squared)
+                trace = moments[k, 0, 0] + moments[k, 1, 1] + moments[k, 2, 2]
+                mx = moments[k, 0, 0] * rx + moments[k, 0, 1] * ry + moments[k, 0, 2] * rz
+                my = moments[k, 1, 0] * rx + moments[k, 1, 1] * ry + moments[k, 1, 2] * rz
+                mz = moments[k, 2, 0] * rx + moments[k, 2, 1] * ry + moments[k, 2, 2] * rz
+                dot = dipoles[k, 0] * rx + dipoles[k, 1] * ry + dipoles[k, 2] * rz
+                sum_ += (dot + trace) / cubed - 3.0 * (rx * mx + ry * my + rz * mz) / (cubed * squared)
+            elif k >= first_leaf:
+                leaf = k - first_leaf
+                for f in range(leaf * n_faces // n_leaves, (leaf + 1) * n_faces // n_leaves):
+                    if f != skip:
+                        sum_ += _solid_angle(corners, f, qx, qy, qz)
+            else:
+                stack[top] = 2 * k + 2
+                stack[top + 1] = 2 * k + 1
+                top += 2
+        total[m] = sum_
+
+
+@nb.njit(inline="always", **_JIT)
+def _solid_angle(corners, f, qx, qy, qz):
+    """The solid angle of the face ``f`` of ``corners`` at ``(qx, qy, qz)`` (Van Oosterom and Strackee 1983); 0 in
+    its plane (``|a . (b x c)|`` at most ``1e-12 |a||b||c|``)."""
+    ax, ay, az = corners[f, 0, 0] - qx, corners[f, 0, 1] - qy, corners[f, 0, 2] - qz
+    bx, by, bz = corners[f, 1, 0] - qx, corners[f, 1, 1] - qy, corners[f, 1, 2] - qz
+    cx, cy, cz = corners[f, 2, 0] - qx, corners[f, 2, 1] - qy, corners[f, 2, 2] - qz
+    la = math.sqrt(ax * ax + ay * ay + az * az)
+    lb = math.sqrt(bx * bx + by * by + bz * bz)
+    lc = math.sqrt(cx * cx + cy * cy + cz * cz)
+    numerator = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)
+    if abs(numerator) <= 1e-12 * la * lb * lc:
+        return 0.0
+    denominator = (
+        la * lb * lc
+        + (ax * bx + ay * by + az * bz) * lc
+        + (ax * cx + ay * cy + az * cz) * lb
+        + (bx * cx + by * cy + bz * cz) * la
+    )
+    return 2.0 * math.atan2(numerator, denominator)
