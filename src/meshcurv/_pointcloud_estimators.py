@@ -145,8 +145,11 @@ THIN_TURN = 0.1
 TURN_AGREEMENT = 0.2
 
 #: A jet fit that shrank off the other side of a thin part must be reproduced by the jets over balls :data:`SHRINK`
-#: times smaller within this share of |k| (:func:`_rim_unsteady`, as :func:`unsteady` compares).
-RIM_AGREEMENT = 0.2
+#: times smaller within this share of |k| (:func:`_rim_unsteady`, as :func:`unsteady` compares). Fuzz 350/15
+#: (a plate 0.2 thick under noise of 0.1 spacings, radius 0.233): errors up to 0.536 of |k| -> 0.259 with 0.2 or 0.3
+#: (:data:`AGREEMENT` 0.4 left 3 points at 0.53); the held-out flat ellipsoid (5,000 points, noise 0.1, jets) keeps
+#: 61-62% of its points with 0.3 (66-67% before the check, 58-60% with 0.2), its median and largest H errors unchanged.
+RIM_AGREEMENT = 0.3
 
 #: The jets of :func:`turned` are fitted over balls turning the normal by at most this many radians (where the
 #: check's own would turn more: a unit sphere of 400 points, balls of 0.77).
