@@ -42,8 +42,13 @@ def _curvatures(vertices, faces, method, backend="auto", **options):
     return result, " ".join(str(w.message) for w in caught)
 
 
+#: ``normal_cycle``'s smoothing steps on these voxel spheres (radius 4 and 8 voxels): at least what the staircase
+#: needs (``normal_cycle.voxel_steps_needed``: 6 and 13); at the default 3 every vertex is undefined.
+STEPS = 13
+
+
 def _options(method):
-    return {"radius": RADIUS} if method == "normal_cycle_ball" else {}
+    return {"radius": RADIUS} if method == "normal_cycle_ball" else {"smoothing_steps": STEPS}
 
 
 def _boundary_vertices(faces, n_vertices):
@@ -77,7 +82,8 @@ def test_a_valid_vertex_next_to_a_hole_on_a_voxel_surface_is_the_intact_one(smal
     result, message = _curvatures(vertices, holed, method, **_options(method))
     largest = np.nanmax(np.abs([intact.k_min, intact.k_max]))
     both = result.valid & intact.valid
-    assert both.sum() > 0.8 * intact.valid.sum()  # the hole takes a neighbourhood, not the sphere
+    # the hole takes a neighbourhood, not the sphere (normal_cycle's: its 13 rings, half of this small sphere)
+    assert both.sum() > (0.4 if method == "normal_cycle" else 0.8) * intact.valid.sum()
     np.testing.assert_allclose(result.mean[both], intact.mean[both], rtol=0, atol=1e-9 * largest)
     # the vertices next to the hole: undefined, with the reason and the warning's phrase
     on_boundary, _ = _boundary_vertices(holed, len(vertices))
@@ -96,7 +102,7 @@ def test_holed_voxel_sphere_no_valid_vertex_off_the_sphere(method, share, seed):
     mesh = shapes.voxel_sphere(radius=4.0)
     vertices, faces = mesh.vertices, mesh.faces[:, ::-1]
     holed = faces[np.random.default_rng(seed).random(len(faces)) >= share]
-    result, _ = _curvatures(vertices, holed, method)
+    result, _ = _curvatures(vertices, holed, method, **({} if method == "normal_cycle_ball" else _options(method)))
     inverse = 1.0 / _sphere_radius(vertices)
     sign = np.sign(np.einsum("ij,ij->i", result.normals, vertices - vertices.mean(axis=0)))
     off = result.valid & (np.abs(result.mean - sign * inverse) > OFF * inverse)
@@ -124,9 +130,9 @@ def test_detached_faces_of_a_voxel_sphere_leave_no_valid_vertex_off_the_intact_o
     pytest.importorskip("skimage")
     mesh = shapes.voxel_sphere(radius=4.0)
     vertices, faces = mesh.vertices, mesh.faces[:, ::-1]
-    intact, _ = _curvatures(vertices, faces, "normal_cycle")
+    intact, _ = _curvatures(vertices, faces, "normal_cycle", **_options("normal_cycle"))
     moved, detached = _detached(vertices, faces, 0.2, 0.067, seed)
-    result, _ = _curvatures(moved, detached, "normal_cycle")
+    result, _ = _curvatures(moved, detached, "normal_cycle", **_options("normal_cycle"))
     n = len(vertices)
     both = result.valid[:n] & intact.valid
     largest = np.nanmax(np.abs([intact.k_min, intact.k_max]))
@@ -159,8 +165,9 @@ def test_smooth_holed_sphere_keeps_its_vertices_next_to_the_holes(method):
 def test_both_backends_agree_next_to_a_hole_on_a_voxel_surface(small_hole, method):
     pytest.importorskip("numba")
     vertices, _, holed = small_hole
-    compiled, _ = _curvatures(vertices, holed, method, "numba")
-    reference, _ = _curvatures(vertices, holed, method, "numpy")
+    steps = {} if method == "normal_cycle_ball" else _options(method)
+    compiled, _ = _curvatures(vertices, holed, method, "numba", **steps)
+    reference, _ = _curvatures(vertices, holed, method, "numpy", **steps)
     np.testing.assert_array_equal(compiled.valid, reference.valid)
     largest = np.nanmax(np.abs([reference.k_min, reference.k_max]))
     for name in ("k_min", "k_max"):

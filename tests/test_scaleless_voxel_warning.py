@@ -48,6 +48,10 @@ def test_a_method_that_reads_the_staircase_says_so_once(voxel_sphere, method):
     assert len(messages) == 1
     assert "voxel surface (marching cubes, voxel 1)" in messages[0]
     assert "staircase" in messages[0] and "use the default method 'icc'" in messages[0]
+    if method == "normal_cycle":  # its smoothing too short for the staircase: every vertex undefined, and why
+        assert not result.valid.any()
+        assert "smoothing_steps=" in messages[0] and "'normal_cycle_ball'" in messages[0]
+        return
     # what it warns of: a share of the valid vertices off the sphere's H by more than half of it
     assert _off_sphere(result, vertices).sum() > 0.05 * result.valid.sum()
 
