@@ -221,7 +221,7 @@ def _computed(vertices, faces, estimator, options: dict, orient: str, weld, prog
             if estimator.name == "icc":
                 options["vertex_scale"] = vertex_scale
     result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
-    note = _staircase_note(mesh, estimator.name, found, result.parameters)
+    note = _staircase_note(mesh, estimator.name, found, result)
     return _finished(
         mesh,
         estimator,
@@ -232,14 +232,16 @@ def _computed(vertices, faces, estimator, options: dict, orient: str, weld, prog
     )
 
 
-def _staircase_note(mesh, method: str, found: dict, parameters: dict) -> str:
+def _staircase_note(mesh, method: str, found: dict, result: CurvatureResult) -> str:
     """The warning's sentence for a method that reads the staircase of a voxel surface, else ''.
 
     The methods over a ring of faces (:data:`RING_METHODS`) on a mesh whose vertices lie on a voxel grid (read
     as for the default radius, :func:`meshcurv.radius.voxel_surface_radius`), and ``quadric`` at the default
     radius of a voxel surface (``found``: what that default was derived from), whose jets of degree 4 follow
-    the staircase there.
+    the staircase there. A ring method that left every vertex undefined there (``rusinkiewicz`` and ``meyer``
+    always, ``normal_cycle`` below the smoothing the staircase needs) is said to have done so.
     """
+    parameters = result.parameters
     if method == "quadric" and found.get("surface") == "voxel":
         return (
             f"this mesh is a voxel surface (marching cubes, voxel {_shown(found['voxel_spacing'])}): method "
@@ -253,11 +255,15 @@ def _staircase_note(mesh, method: str, found: dict, parameters: dict) -> str:
     spacing = _voxel_spacing(mesh)
     if spacing is None:
         return ""
+    effect = (
+        "so every vertex is left undefined"
+        if not result.valid.any()
+        else "many of its curvatures are off by a large share of the curvature itself"
+    )
     return (
         f"this mesh is a voxel surface (marching cubes, voxel {_shown(spacing)}): method {method!r} measures over "
-        f"a ring of faces, with no scale, and reads the staircase of the voxels as curvature (many of its "
-        f"curvatures are off by a large share of the curvature itself); use the default method 'icc', which "
-        f"measures over balls scaled to the voxels"
+        f"a ring of faces, with no scale, and reads the staircase of the voxels as curvature ({effect}); use the "
+        f"default method 'icc' or 'normal_cycle_ball', which measure over balls scaled to the voxels"
     )
 
 

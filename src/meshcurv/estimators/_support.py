@@ -8,6 +8,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..defects import VertexDefects
+from ..radius import _voxel_surface
 from ..result import CurvatureResult
 
 logger = logging.getLogger("meshcurv")
@@ -151,6 +152,21 @@ def finish(
         radius=radius,
     )
     return result, problems(defects, valid, extra)
+
+
+def staircase_undefined(mesh, defects: VertexDefects, valid: np.ndarray) -> tuple[np.ndarray, tuple[str, ...]]:
+    """``(valid, extra)`` of a method over a ring of faces with no scale (``rusinkiewicz``, ``meyer``): on a voxel
+    surface (:func:`meshcurv.radius._voxel_surface`) every vertex undefined, with the phrase that counts them.
+
+    A marching-cubes staircase is a pattern of one voxel that a ring of faces reads as curvature: on the intact
+    voxel meshes of ``benchmarks/voxel_ring_methods.md`` 55-95% of ``rusinkiewicz``'s valid vertices and 80-100%
+    of ``meyer``'s were off the exact H by more than half of the largest ``|k|`` (median errors 77-1130%), every
+    one of them valid (issue 29: never a valid wrong number). Neither has a scale to grow; the call's warning
+    names the methods whose balls are scaled to the voxels (:func:`meshcurv.curvature._staircase_note`).
+    """
+    if not valid.any() or not _voxel_surface(mesh, defects.invalid_vertices):
+        return valid, ()
+    return np.zeros_like(valid), (f"{int(valid.sum())} vertices of this voxel surface are NaN (estimate undefined)",)
 
 
 def problems(defects: VertexDefects, valid: np.ndarray, extra=()) -> list[str]:

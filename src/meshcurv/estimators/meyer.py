@@ -33,7 +33,7 @@ import numpy as np
 from .._tensors import principal_from_mean_gaussian
 from .._geometry import corner_angles, corner_cotangents, mixed_voronoi_corner_areas, vertex_normals
 from .._prepared import PreparedMesh
-from ._support import Stages, finish
+from ._support import Stages, finish, staircase_undefined
 
 STAGES = ("compute angles", "compute cotangent Laplacian", "retrieve curvatures")
 
@@ -85,4 +85,7 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
         if needles.any()
         else ()
     )
-    return finish("meyer", {}, valid, normals, k_min, k_max, directions, directions.copy(), defects, extra)
+    valid, staircase = staircase_undefined(mesh, defects, valid)
+    return finish(
+        "meyer", {}, valid, normals, k_min, k_max, directions, directions.copy(), defects, (*extra, *staircase)
+    )

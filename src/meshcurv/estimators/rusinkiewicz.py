@@ -59,7 +59,7 @@ from .._geometry import mixed_voronoi_corner_areas
 from ..jets import _fit_jets, jet_normals
 from .._prepared import PreparedMesh
 from ..defects import DEFECTS
-from ._support import Stages, finish
+from ._support import Stages, finish, staircase_undefined
 
 #: Per-face systems whose determinant, with the matrix scaled to a largest entry of 1, is at
 #: most this are not solved (the face's tensor is NaN): a collapsed or sliver face.
@@ -286,4 +286,5 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
         np.where(valid[:, None], shape_operator, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     )
-    return finish("rusinkiewicz", {}, valid, normals, k_min, k_max, dir_min, dir_max, defects)
+    valid, staircase = staircase_undefined(mesh, defects, valid)
+    return finish("rusinkiewicz", {}, valid, normals, k_min, k_max, dir_min, dir_max, defects, staircase)
