@@ -66,10 +66,10 @@ def test_large_half_open_sphere_wound_inward_is_turned_outward(name, detach):
     corners = points[oriented]
     normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     centre = vertices.mean(axis=0)
-    # every face of the sphere faces away from its centre (the sphere is centred; its faces are small). Left as
-    # they were below 20,000 faces (not the winding step): with the faces removed, a few single faces that touch
-    # the rest only at corners (they enclose nothing on their own: orient.WINDING_OPEN), and on the voxel sphere
-    # about 5 of 21,736 detached faces. Before, the detached half stayed inward: a share of 0.5.
+    # every face of the sphere faces away from its centre (the sphere is centred; its faces are small), but: with
+    # the faces removed, a few single faces that touch the rest only at corners (they enclose nothing on their
+    # own: orient.WINDING_OPEN; so below 20,000 faces too), and on the voxel sphere about 5 of 21,736 detached
+    # faces (open: not traced). Before, the detached half stayed inward: a share of 0.5.
     outward = np.einsum("ij,ij->i", normals, corners.mean(axis=1) - centre) > 0
     assert outward.mean() > (1.0 - 1e-12 if name.startswith("icosphere") and detach else 0.999)
 
