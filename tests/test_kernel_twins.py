@@ -257,6 +257,25 @@ def check_face_cross_products(name):
     np.testing.assert_array_equal(kernels("geometry").face_cross_products(vertices, faces), expected)
 
 
+def check_face_winding_numbers(name):
+    from meshcurv.orient import WINDING_BETA, _winding_tree, face_winding_numbers
+
+    vertices, faces = mesh(name)
+    rng = np.random.default_rng(6)
+    # half of the faces (the undecided pieces of a holey mesh), each seen from its centroid as in orient
+    tree = _winding_tree(vertices[faces[rng.random(faces.shape[0]) < 0.5]])
+    positions = tree.corners.mean(axis=1)
+    own = np.arange(positions.shape[0], dtype=np.int64)
+    arguments = (tree.corners, tree.centres, tree.dipoles, tree.moments, tree.radii, positions, own, tree.depth)
+    with use_backend("numpy"):
+        expected = face_winding_numbers(*arguments, WINDING_BETA)
+    got = kernels("orient").face_winding_numbers(*arguments, WINDING_BETA)
+    # the same nodes and faces counted (the far test on the same squared distances), the terms summed in another
+    # order (a walk against levels) and each term's products grouped otherwise: a few hundred terms of at most
+    # 2 pi each, a few eps of 4 pi apart per term
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
+
+
 def check_patch_volumes(name):
     from meshcurv.orient import patch_volumes
 
@@ -1965,6 +1984,7 @@ TWINS = [
     Twin("geometry.mean_edge_length", "_geometry.mean_edge_length", check_mean_edge_length, MESHES),
     Twin("geometry.cross_and_degenerate", "_geometry.cross_and_degenerate", check_cross_and_degenerate, MESHES),
     Twin("orient.patch_volumes", "orient.patch_volumes", check_patch_volumes, MESHES),
+    Twin("orient.face_winding_numbers", "orient.face_winding_numbers", check_face_winding_numbers, MESHES),
     Twin("topology.build_edges", "topology._build_edges", check_build_edges, MESHES),
     Twin("topology.bowtie_vertices", "topology._bowtie_vertices", check_bowtie_vertices, MESHES),
     Twin("topology.component_labels", "topology.component_labels", check_component_labels, MESHES),
