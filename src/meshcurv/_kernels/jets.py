@@ -23,7 +23,7 @@ from ._common import (
     run_slots,
     threaded,
 )
-from .neighborhoods import _ball_members, _connected_members, pool_grid
+from .neighborhoods import _ball_members, _connected_members, _vertex_spans, pool_grid
 from .tensors import _tangent_eigen
 
 
@@ -950,6 +950,7 @@ def fit_jets_connected(
         *outputs,
         fitted,
         _general(degree),
+        _vertex_spans(vertices, indptr, indices),
     )
     return (fitted, *outputs[1:]) if normals_only else outputs
 
@@ -990,10 +991,13 @@ def _connected_chunk(
     away,
     fitted,
     general,
+    spans,
 ):
     """The fits of ``centres[lo:hi]`` of :func:`fit_jets_connected`, written to their rows of the outputs
     (of ``fitted`` with ``normals_only``), with row ``slot`` of the (3, slots, V) ``scratch`` (the stamps of
-    the walk, its members, its queue), the stamps filled with -1 on the slot's first range (``filled``)."""
+    the walk, its members, its queue), the stamps filled with -1 on the slot's first range (``filled``);
+    ``spans``: each vertex's longest edge, which the walk skips far vertices with
+    (:func:`~meshcurv._kernels.neighborhoods._vertex_spans`)."""
     per_centre = radii.shape[0] > 1
     mark, members, queue = scratch[0, slot], scratch[1, slot], scratch[2, slot]
     if not filled[slot]:  # -1: np.full compiles two more functions (issue 31)
@@ -1008,7 +1012,7 @@ def _connected_chunk(
     for i in range(lo, hi):
         v = centres[i]
         radius = radii[i if per_centre else 0]
-        size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, i, members, queue)
+        size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, i, members, queue, spans)
         # the fit into one row, then copied: one call site (the fit is inlined, and a second call
         # site would double its compile time)
         c[0, :] = np.nan  # a failed fit leaves the row as it finds it
