@@ -585,12 +585,25 @@ def _local_noise(
 def jet_vertex_radii(
     groups: list[tuple[float, np.ndarray | None]], levels: np.ndarray, curvedness: np.ndarray
 ) -> np.ndarray:
-    """(V,) ``quadric``'s default radius at each vertex: :data:`JET_RADIUS_RULE` of its noise level.
+    """``quadric``'s default radius at each vertex: :data:`JET_RADIUS_RULE` of its noise level.
 
-    ``groups``: :func:`component_radii` (:data:`DEFAULT_RADIUS_FACTOR` times each group's mean edge length ``h``);
-    ``levels``, ``curvedness``: :func:`local_noise`. The radius is ``h (a + b sqrt(max(nu_v - NOISE_FLOOR, 0)))``,
-    at most :data:`JET_CURVATURE_CAP` ``/ c_v`` and at least the group's radius (where the level is NaN: the
-    group's radius).
+    The radius is ``h (a + b sqrt(max(nu_v - NOISE_FLOOR, 0)))``, at most :data:`JET_CURVATURE_CAP` ``/ c_v``
+    and at least the group's radius (where the level is NaN: the group's radius).
+
+    Parameters
+    ----------
+    groups : list of (float, ndarray or None)
+        :func:`component_radii`: :data:`DEFAULT_RADIUS_FACTOR` times each group's mean edge length ``h``, and
+        the int64 ids of its vertices (None: every vertex).
+    levels : array_like of shape (V,)
+        Each vertex's noise level ``nu_v`` (:func:`local_noise`); NaN where none was measured.
+    curvedness : array_like of shape (V,)
+        Each vertex's curvedness ``c_v`` (:func:`local_noise`).
+
+    Returns
+    -------
+    ndarray of shape (V,)
+        The radius of each vertex's ball.
     """
     levels = np.asarray(levels, dtype=np.float64)
     curvedness = np.asarray(curvedness, dtype=np.float64)
