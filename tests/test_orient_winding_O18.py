@@ -138,3 +138,40 @@ def test_fast_winding_number_on_a_closed_sphere_is_a_half():
     sphere = shapes.icosphere(30)
     w = _fast_winding_numbers(sphere.vertices[sphere.faces])
     np.testing.assert_allclose(w, 0.5, atol=0.02)
+
+
+@pytest.mark.parametrize("scale", [2.0**-260, 2.0**250])  # powers of two: the same tree to the bit
+def test_fast_winding_numbers_do_not_change_with_the_scale(scale):
+    """The winding number is scale-free: a mesh at 1e75 overflowed in the NumPy twin (fuzz_api seed 361, case 111:
+    a RuntimeWarning out of the call); far below 1 nothing may underflow to a different answer. (Other scales
+    build another tree, whose expansions differ within their error of a few thousandths.)"""
+    sphere = shapes.icosphere(subdivisions=6)
+    corners = sphere.vertices[sphere.faces]
+    for backend in ("numpy", "auto"):
+        with use_backend(backend), warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
+            unit = _fast_winding_numbers(corners)
+            scaled = _fast_winding_numbers(corners * scale)
+        np.testing.assert_array_equal(scaled, unit)
+        assert np.all(np.abs(unit - 0.5) < 0.02)  # a face's centroid on a closed sphere: half inside
+
+
+def test_numpy_winding_numbers_of_a_soup_across_the_shape_stay_bounded():
+    """Faces with corners anywhere on a sphere (a soup of random faces: fuzz_api seed 366, case 5935) are near
+    every node of the tree: the NumPy walk took all (query, face) pairs of a chunk at once, 2,048 queries times
+    every face, out of memory under 800 MiB. Its pairs are now halved past ``WINDING_PAIRS``."""
+    import tracemalloc
+
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(9000, 3))
+    points /= np.linalg.norm(points, axis=1, keepdims=True)
+    corners = points.reshape(-1, 3, 3)
+    with use_backend("numpy"):
+        tracemalloc.start()
+        try:
+            winding = _fast_winding_numbers(corners)
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+    assert np.all(np.isfinite(winding))
+    assert peak < 400 * 2**20

@@ -279,7 +279,15 @@ def _winding_sides(vertices, faces, patch, flip, inverted, undecided, group, kep
 
 def _fast_winding_numbers(corners: np.ndarray) -> np.ndarray:
     """(S,) the generalized winding number of the triangles ``corners`` (S, 3, 3) at each one's centroid, the
-    triangle itself left out (:func:`_winding_tree`, :func:`face_winding_numbers`)."""
+    triangle itself left out (:func:`_winding_tree`, :func:`face_winding_numbers`).
+
+    The winding number does not change with a shift or a scale: the corners are taken about their mean, in units
+    of their largest coordinate, so that the solid angles' products stay finite (fuzz_api seed 361, case 111: a
+    mesh at 1e75 overflowed in the NumPy twin)."""
+    corners = corners - corners.reshape(-1, 3).mean(axis=0)
+    extent = float(np.max(np.abs(corners))) if corners.size else 0.0
+    if extent > 0 and np.isfinite(extent):
+        corners = corners / extent
     tree = _winding_tree(corners)
     positions = tree.corners.mean(axis=1)  # (in the tree's order and frame)
     own = np.arange(corners.shape[0], dtype=np.int64)  # each query is the centroid of the face at its place
@@ -402,24 +410,34 @@ def face_winding_numbers(
     first_leaf = n_leaves - 1
     total = np.zeros(positions.shape[0])
     limit = (beta * radii) ** 2
-    for lo in range(0, positions.shape[0], WINDING_CHUNK):
+    # (first query of the chunk, queries, their nodes, level): a stack, so that a chunk whose queries are near many
+    # nodes (a soup of faces across the whole shape) is halved instead of growing past WINDING_PAIRS pairs
+    stack: list[tuple[int, np.ndarray, np.ndarray, int]] = []
+    for lo in range(0, positions.shape[0], WINDING_CHUNK)[::-1]:
         query = np.arange(lo, min(lo + WINDING_CHUNK, positions.shape[0]))
-        part = total[lo : lo + query.size]  # a view: this chunk's sums
-        node = np.zeros(query.size, dtype=np.int64)
-        for level in range(depth + 1):
-            r = centres[node] - positions[query]
-            squared = np.einsum("ij,ij->i", r, r)
-            far = squared > limit[node]
-            rf, mf, qf = r[far], moments[node[far]], squared[far]
-            cubed = qf * np.sqrt(qf)
-            term = (
-                np.einsum("ij,ij->i", dipoles[node[far]], rf) + np.trace(mf, axis1=1, axis2=2)
-            ) / cubed - 3.0 * np.einsum("ij,ijk,ik->i", rf, mf, rf) / (cubed * qf)
-            part[:] += np.bincount(query[far] - lo, weights=term, minlength=part.size)
-            query, node = query[~far], node[~far]
-            if level < depth:
-                query = np.repeat(query, 2)
-                node = (2 * node[:, None] + np.array([1, 2])).ravel()
+        stack.append((lo, query, np.zeros(query.size, dtype=np.int64), 0))
+    while stack:
+        lo, query, node, level = stack.pop()
+        if query.size > WINDING_PAIRS:
+            half = query.size // 2
+            stack.append((lo, query[half:], node[half:], level))
+            stack.append((lo, query[:half], node[:half], level))
+            continue
+        part = total[lo : lo + WINDING_CHUNK]  # a view: this chunk's sums
+        r = centres[node] - positions[query]
+        squared = np.einsum("ij,ij->i", r, r)
+        far = squared > limit[node]
+        rf, mf, qf = r[far], moments[node[far]], squared[far]
+        cubed = qf * np.sqrt(qf)
+        term = (
+            np.einsum("ij,ij->i", dipoles[node[far]], rf) + np.trace(mf, axis1=1, axis2=2)
+        ) / cubed - 3.0 * np.einsum("ij,ijk,ik->i", rf, mf, rf) / (cubed * qf)
+        part[:] += np.bincount(query[far] - lo, weights=term, minlength=part.size)
+        query, node = query[~far], node[~far]
+        if level < depth:
+            if query.size:
+                stack.append((lo, np.repeat(query, 2), (2 * node[:, None] + np.array([1, 2])).ravel(), level + 1))
+            continue
         leaf = node - first_leaf
         start, stop = leaf * n_faces // n_leaves, (leaf + 1) * n_faces // n_leaves
         count = stop - start
@@ -563,8 +581,13 @@ WINDING_BETA = 3.0
 WINDING_LEAF = 8
 
 #: The NumPy :func:`face_winding_numbers` walks the tree for this many queries at a time (its arrays are about a few
-#: hundred faces and nodes per query).
+#: hundred faces and nodes per query) ...
 WINDING_CHUNK = 2048
+
+#: ... and halves a chunk's (query, node) pairs of one level beyond this many, so that its memory stays bounded
+#: where each query is near most nodes (fuzz_api seed 366, case 5935: a voxel sphere's faces as a soup of random
+#: faces, out of memory under 800 MiB).
+WINDING_PAIRS = 65536
 
 #: :func:`_winding_sides` turns nothing when the undecided faces' summed area vectors exceed this share of their
 #: area (they enclose nothing: a hemisphere has a half, a saddle nearly 1; a sphere with holes nearly 0).
