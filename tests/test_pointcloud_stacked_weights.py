@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from meshcurv import _pointcloud_normals as normals_module
-from meshcurv._kernels import pointcloud as kernels
 
 ABOVE_ONE = np.nextafter(np.nextafter(1.0, 2.0), 2.0)  # 1 + 4.4e-16, as fuzz 340/14 read
 
@@ -35,6 +34,8 @@ def test_numpy_stacked_weight_not_below_three():
 
 def test_compiled_stacked_weight_not_below_three():
     pytest.importorskip("numba")
+    from meshcurv._kernels import pointcloud as kernels
+
     stacked, weights, _ = kernels.edge_weights(
         *_stacked_edge_inputs(), normals_module.STACKED_OFFSET, normals_module.FACING_COSINE
     )
