@@ -19,9 +19,9 @@ SHARE = 0.5
 OFFSET = 0.054
 
 
-def _holey(vertices, faces, *, seed, detach):
+def _holey(vertices, faces, *, seed, detach, offset=OFFSET):
     """The mesh with a random half of its faces removed, or detached (each given its own three corners, moved by
-    ``OFFSET`` mean edge lengths in random directions)."""
+    ``offset`` mean edge lengths in random directions)."""
     rng = np.random.default_rng(seed)
     edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
     picked = rng.random(len(faces)) < SHARE
@@ -32,7 +32,7 @@ def _holey(vertices, faces, *, seed, detach):
     direction /= np.linalg.norm(direction, axis=1, keepdims=True)
     moved = faces.copy()
     moved[picked] = len(vertices) + np.arange(corners.shape[0]).reshape(-1, 3)
-    return np.concatenate([vertices, corners + direction * OFFSET * edge]), moved
+    return np.concatenate([vertices, corners + direction * offset * edge]), moved
 
 
 def _mean_curvatures(vertices, faces):

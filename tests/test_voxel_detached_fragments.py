@@ -11,22 +11,15 @@ import numpy as np
 import pytest
 
 from meshcurv import principal_curvatures, shapes
+from test_orient_holey_inward import _holey
 
 RADIUS = 4.0
 
 
-def _detached(seed: int, share: float = 0.5, gap: float = 0.091):
+def _detached(seed: int, gap: float = 0.091):
     mesh = shapes.voxel_sphere(radius=RADIUS)
     vertices, faces = np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)
-    edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
-    rng = np.random.default_rng(seed)
-    picked = rng.random(len(faces)) < share
-    corners = vertices[faces[picked]].reshape(-1, 3)
-    directions = rng.normal(size=corners.shape)
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    moved = faces.copy()
-    moved[picked] = len(vertices) + np.arange(corners.shape[0]).reshape(-1, 3)
-    return np.concatenate([vertices, corners + directions * gap * edge]), moved
+    return _holey(vertices, faces, seed=seed, detach=True, offset=gap)  # half of the faces, as there
 
 
 @pytest.mark.parametrize("seed", [20, 25])

@@ -781,18 +781,27 @@ def _subset_voxel_grid(mesh: _Measured | PreparedMesh, faces: np.ndarray, used: 
     return grid
 
 
-def _voxel_surface(mesh: PreparedMesh, invalid: np.ndarray) -> bool:
-    """Whether the mesh is a voxel surface (:func:`_mesh_voxel_grid`), or its faces with a corner not ``invalid``
-    ((V,) bool) are: the cells of the valid vertices, where faces detached off the grid (a triangle soup beside
-    it, cracks beyond the weld: fuzz_api seed 322, case 407) leave the rest on it."""
-    if _mesh_voxel_grid(mesh) is not None:
-        return True
+def _valid_voxel_grid(mesh: PreparedMesh, invalid: np.ndarray) -> tuple[VoxelGrid, np.ndarray] | None:
+    """``(grid, used)``: the voxel grid of the mesh (:func:`_mesh_voxel_grid`; ``used`` its referenced vertices), or
+    that of its faces with a corner not ``invalid`` ((V,) bool; ``used`` their corners): the cells of the valid
+    vertices, where faces detached off the grid (a triangle soup beside it, cracks beyond the weld: fuzz_api seed
+    322, case 407) leave the rest on it; None where neither is on a grid."""
+    grid = _mesh_voxel_grid(mesh)
+    if grid is not None:
+        return grid, mesh.topology.referenced_vertices
     faces = mesh.topology.faces[~invalid[mesh.topology.faces].all(axis=1)]
     if faces.shape[0] == 0:
-        return False
+        return None
     used = np.zeros(mesh.vertices.shape[0], dtype=bool)
     used[faces] = True
-    return _subset_voxel_grid(mesh, faces, used) is not None
+    grid = _subset_voxel_grid(mesh, faces, used)
+    return None if grid is None else (grid, used)
+
+
+def _voxel_surface(mesh: PreparedMesh, invalid: np.ndarray) -> bool:
+    """Whether the mesh is a voxel surface, or its faces with a corner not ``invalid`` are
+    (:func:`_valid_voxel_grid`)."""
+    return _valid_voxel_grid(mesh, invalid) is not None
 
 
 def _off_grid_scale(scales: np.ndarray, spacing: np.ndarray) -> bool:

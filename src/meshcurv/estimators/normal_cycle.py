@@ -74,7 +74,7 @@ from .._backend import kernel_threads, numba_kernels
 from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles, median_edge_length
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
-from ..radius import _mesh_voxel_grid, _ring_max, _subset_voxel_grid, _voxel_surface
+from ..radius import _ring_max, _valid_voxel_grid, _voxel_surface
 from ._support import Stages, finish
 
 #: On a voxel surface the smoothing must reach ``VOXEL_RING_GAIN sqrt(h R)`` (:func:`voxel_steps_needed`).
@@ -176,20 +176,13 @@ def voxel_steps_needed(mesh: PreparedMesh, invalid: np.ndarray) -> int:
     ``voxel_sphere(20)`` in 4 x 1 x 1 voxels 63 / 34 / 17 / 5.3 / 0.9% (needed: 231).
 
     The grid is the mesh's, or that of its faces with a corner not ``invalid`` ((V,) bool; faces detached off the
-    grid leave the rest on it, as in :func:`meshcurv.radius._voxel_surface`).
+    grid leave the rest on it: :func:`meshcurv.radius._valid_voxel_grid`).
     """
     topology = mesh.topology
-    grid = _mesh_voxel_grid(mesh)
-    on_grid = topology.referenced_vertices
-    if grid is None:
-        faces = topology.faces[~invalid[topology.faces].all(axis=1)]
-        if faces.shape[0] == 0:
-            return 0
-        on_grid = np.zeros(mesh.vertices.shape[0], dtype=bool)
-        on_grid[faces] = True
-        grid = _subset_voxel_grid(mesh, faces, on_grid)
-        if grid is None:
-            return 0
+    found = _valid_voxel_grid(mesh, invalid)
+    if found is None:
+        return 0
+    grid, on_grid = found
     spacing = np.asarray(grid.spacing, dtype=np.float64)
     used = mesh.vertices[on_grid]
     edge = median_edge_length(mesh.vertices, topology.edges)
