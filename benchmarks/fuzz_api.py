@@ -43,6 +43,11 @@ as CPU time (starved by the machine's load) runs once more with 5 times the limi
   or alone (4%): refused with the hint that names the slip (issue 29, "Also
   seen as a new user would").
 
+``--thin-shapes P`` draws the base of a share ``P`` of the mesh cases from thin closed shapes instead (the
+issue's 3 x 3 x 0.15 ellipsoid, a thin torus, a plate of 1 x 0.6 x 0.03, a flat voxel ellipsoid: balls that reach
+the other side), with the same mutations and relations and the backend relation on 40% of their curvature calls
+(issue 29, class 10: the backends agree on thin meshes); 0 by default, so that earlier seeds draw as before.
+
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
 numba's default ``omp`` layer (GNU OpenMP) aborts a child forked after a
@@ -120,13 +125,29 @@ def base_meshes():
     ]
 
 
+def thin_meshes():
+    """Thin closed shapes, ``(name, mesh)``: a ball of the default radius reaches the other side (issue 29,
+    class 10: the backends must agree on thin meshes; tests/test_backend_parity.py's shapes, coarser)."""
+    return [
+        ("thin_ellipsoid", shapes.ellipsoid((3.0, 3.0, 0.15), subdivisions=10)),  # the issue's 3 x 3 x 0.15
+        ("thin_torus", shapes.torus(major_radius=3.0, minor_radius=0.12, n_major=90, n_minor=12)),
+        ("thin_plate", shapes.ellipsoid((1.0, 0.6, 0.03), subdivisions=8)),
+        ("voxel_flat_ellipsoid", shapes.voxel_ellipsoid((8.0, 8.0, 2.0), seed=2)),
+    ]
+
+
 _SHAPES = base_meshes()
 BASES = [(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)) for name, m in _SHAPES]
+_THIN_SHAPES = thin_meshes()
+#: The bases of ``--thin-shapes`` (drawn from a stream of their own: ``BASES`` keeps its draws).
+THIN_BASES = [(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)) for name, m in _THIN_SHAPES]
+THIN_NAMES = frozenset(name for name, _, _ in THIN_BASES)
+ALL_BASES = BASES + THIN_BASES
 #: Exact (k_min, k_max) of the closed analytic shapes, for the "truth" relation.
 TRUTH = {
     name: (np.asarray(m.k_min, float), np.asarray(m.k_max, float))
-    for name, m in _SHAPES
-    if name in ("icosphere", "torus", "ellipsoid", "random_sphere")
+    for name, m in _SHAPES + _THIN_SHAPES
+    if name in ("icosphere", "torus", "ellipsoid", "random_sphere", "thin_ellipsoid", "thin_torus", "thin_plate")
 }
 
 # ----------------------------------------------------------------------------- garbage values
@@ -506,8 +527,19 @@ def wrap_faces(rng, f):
 # ----------------------------------------------------------------------------- cases
 
 
+#: Share of the mesh cases whose base is a thin closed shape of :data:`THIN_BASES` (``--thin-shapes``; 0 by
+#: default, so that the cases of earlier rounds replay as drawn: the choice comes from a stream of its own).
+THIN_SHARE = 0.0
+#: Share of the curvature calls on a thin base computed again on the other backend (issue 29, class 10: thin
+#: meshes).
+THIN_BACKEND_SHARE = 0.4
+
+
 def make_mesh(rng):
     name, v, f = BASES[int(rng.integers(len(BASES)))]
+    thin = np.random.default_rng(np.random.SeedSequence(rng.bit_generator.seed_seq.entropy, spawn_key=(41,)))
+    if THIN_SHARE and thin.random() < THIN_SHARE:
+        name, v, f = THIN_BASES[int(thin.integers(len(THIN_BASES)))]
     labels = [name]
     n_mut = int(rng.choice([0, 1, 1, 2, 2, 3]))
     for mutation in rng.choice(len(MUTATIONS), size=n_mut, p=WEIGHTS):
@@ -645,7 +677,8 @@ def _with_twins(case, rng):
     if target not in ("principal_curvatures", "point_cloud_curvatures"):
         return case
     roll = rng.random()
-    if roll < BACKEND_SHARE:
+    backend_share = THIN_BACKEND_SHARE if labels and labels[0] in THIN_NAMES else BACKEND_SHARE
+    if roll < backend_share:
         if (
             target == "point_cloud_curvatures"
             and _n_rows(args[0]) is not None
@@ -654,7 +687,7 @@ def _with_twins(case, rng):
             return case
         return target, args, kwargs, labels + ["relation backend"], ("backend", clean)
     if (
-        BACKEND_SHARE + OBJECT_SHARE <= roll < BACKEND_SHARE + OBJECT_SHARE + MISUSE_SHARE
+        backend_share + OBJECT_SHARE <= roll < backend_share + OBJECT_SHARE + MISUSE_SHARE
         and target == "principal_curvatures"
         and all(_plain(a) for a in args)
     ):
@@ -678,7 +711,7 @@ def _with_twins(case, rng):
         return target, args, kwargs, labels + [f"misuse {misuse}"], ("misuse", (misuse, (v, f)))
     # (float faces: a mesh object casts them to integers, which the arrays must not be; not a relation)
     whole_faces = target != "principal_curvatures" or (len(args) > 1 and getattr(args[1], "dtype", None) == np.int64)
-    if roll < BACKEND_SHARE + OBJECT_SHARE and all(_plain(a) for a in args) and whole_faces:
+    if roll < backend_share + OBJECT_SHARE and all(_plain(a) for a in args) and whole_faces:
         if target == "principal_curvatures":
             obj, label = _mesh_object(rng, *args)
         else:
@@ -1555,7 +1588,7 @@ def relation_check(args, kwargs, result, relation):
         if len(v) > len(k_min):  # detached faces: a corner's copies (after the vertices) get its curvatures
             from scipy.spatial import cKDTree
 
-            base = next(vertices for name, vertices, _ in BASES if name == value)
+            base = next(vertices for name, vertices, _ in ALL_BASES if name == value)
             nearest = np.r_[np.arange(len(base)), cKDTree(base).query(v[len(base) :])[1]]
             k_min, k_max = k_min[nearest], k_max[nearest]
         edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))
@@ -1635,7 +1668,7 @@ def detached_check(v, kwargs, result, name):
     :data:`DETACHED_TOLERANCE` of the clean value at its corner (the nearest clean vertex)."""
     from scipy.spatial import cKDTree
 
-    base, base_faces = next((vertices, faces) for label, vertices, faces in BASES if label == name)
+    base, base_faces = next((vertices, faces) for label, vertices, faces in ALL_BASES if label == name)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         clean = meshcurv.principal_curvatures(base, base_faces, **kwargs)
@@ -1860,7 +1893,7 @@ def summary_table(path) -> str:
 
 
 def main(argv=None) -> int:
-    global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS
+    global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -1893,11 +1926,20 @@ def main(argv=None) -> int:
         help="share of the detached-faces cases with cracks of 0.05-0.1 edge lengths, beyond the weld "
         "(default: %(default)g: the draws of earlier rounds)",
     )
+    parser.add_argument(
+        "--thin-shapes",
+        type=float,
+        default=THIN_SHARE,
+        help="share of the mesh cases on a thin closed shape (a 3 x 3 x 0.15 ellipsoid, a thin torus, a plate, a "
+        "flat voxel ellipsoid), 40%% of their curvature calls also on the other backend (default: %(default)g: "
+        "the draws of earlier rounds)",
+    )
     options = parser.parse_args(argv)
-    for name in ("voxel_share", "wide_cracks"):
+    for name in ("voxel_share", "wide_cracks", "thin_shapes"):
         if not 0 <= getattr(options, name) <= 1:
             parser.error(f"--{name.replace('_', '-')} must lie in [0, 1], got {getattr(options, name)}")
     WIDE_CRACKS = options.wide_cracks
+    THIN_SHARE = options.thin_shapes
     ONLY_POINT_CLOUDS = options.point_clouds
     VOXEL_SHARE = options.voxel_share
 
@@ -1929,6 +1971,7 @@ def main(argv=None) -> int:
                     "factor": options.factor,
                     "voxel_share": options.voxel_share,
                     "wide_cracks": options.wide_cracks,
+                    "thin_shapes": options.thin_shapes,
                 }
             )
             + "\n"
