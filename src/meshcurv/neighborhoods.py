@@ -707,7 +707,8 @@ def connected_ball_pairs(
 
 
 def checked_adjacency(adjacency, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(indptr, indices)``: CSR neighbour lists of ``n`` vertices, as contiguous int64 arrays.
+    """``(indptr, indices)``: CSR neighbour lists of ``n`` vertices, as contiguous arrays: ``indptr`` int64,
+    ``indices`` int32 when given so (:attr:`MeshTopology.neighbour_lists` of a mesh that fits), else int64.
 
     Raises
     ------
@@ -715,7 +716,10 @@ def checked_adjacency(adjacency, n: int) -> tuple[np.ndarray, np.ndarray]:
         ``indptr`` does not hold ``n + 1`` offsets ending at the length of
         ``indices``, or an index is not a vertex.
     """
-    indptr, indices = (np.ascontiguousarray(a, dtype=np.int64) for a in adjacency)
+    indptr, indices = adjacency
+    indptr = np.ascontiguousarray(indptr, dtype=np.int64)
+    indices = np.asarray(indices)
+    indices = np.ascontiguousarray(indices, dtype=np.int32 if indices.dtype == np.int32 else np.int64)
     if indptr.shape != (n + 1,) or indices.ndim != 1 or indptr[-1] != indices.shape[0]:
         raise InvalidMeshError(f"`adjacency` must be CSR lists of {n} vertices; got indptr {indptr.shape}")
     if indices.size and (indices.min() < 0 or indices.max() >= n):

@@ -386,7 +386,9 @@ class MeshTopology:
     def neighbour_lists(self) -> tuple[np.ndarray, np.ndarray]:
         """Edge neighbours of every vertex in CSR form: ``(indptr, indices)``.
 
-        The neighbours of vertex ``v`` are ``indices[indptr[v]:indptr[v + 1]]``.
+        The neighbours of vertex ``v`` are ``indices[indptr[v]:indptr[v + 1]]``. ``indptr`` is int64;
+        ``indices`` has the type of :attr:`edges` (int32 where the mesh fits: half the memory that the walks
+        of the balls read).
         """
         indptr, indices = neighbour_lists(self.edges, self.n_vertices)
         return _readonly(indptr), _readonly(indices)
@@ -464,10 +466,11 @@ class MeshTopology:
 
 @twin("topology")
 def neighbour_lists(edges: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(indptr, indices)``, int64: the edge neighbours of every vertex in CSR form, each list in increasing
-    order (:attr:`MeshTopology.neighbour_lists`); ``edges`` (E, 2) unique, ``p < q``."""
+    """``(indptr, indices)``: the edge neighbours of every vertex in CSR form, each list in increasing order
+    (:attr:`MeshTopology.neighbour_lists`); ``edges`` (E, 2) unique, ``p < q``. ``indptr`` is int64, ``indices``
+    of the type of ``edges``."""
     rows = np.concatenate([edges[:, 0], edges[:, 1]]).astype(np.int64)
-    columns = np.concatenate([edges[:, 1], edges[:, 0]]).astype(np.int64)
+    columns = np.concatenate([edges[:, 1], edges[:, 0]])
     order = np.lexsort((columns, rows))
     indptr = np.zeros(n_vertices + 1, dtype=np.int64)
     np.cumsum(np.bincount(rows, minlength=n_vertices), out=indptr[1:])

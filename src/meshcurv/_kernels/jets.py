@@ -900,7 +900,8 @@ def fit_jets_connected(
     each ball found breadth-first over the mesh's edges (``indptr, indices``,
     CSR) instead of on a grid: no search structure over all the points is
     built, so a fit at a few centres costs only their balls. Only ``allowed``
-    (V,) vertices enter the balls. ``n_chunks``: the threads at most, three (V,) int64 arrays each.
+    (V,) vertices enter the balls. ``n_chunks``: the threads at most, three (V,) int32 arrays each
+    (int64 beyond 2**31 vertices or centres).
     The outputs have one row per centre, in the order of ``centres`` (a fit at
     a few centres of a large mesh writes no row for the others).
     With ``normals_only``, returns ``(fitted, ...)``: the (M, 3) unit normals of
@@ -921,8 +922,9 @@ def fit_jets_connected(
     limits = np.array([away_fraction, settled])
     facing = facing[: facing.shape[0] if check_facing else 0]
     slots = max(1, min(int(n_chunks), m))
-    # each thread's walk scratch: the stamps (filled with -1 by the thread on its first range), members, queue
-    scratch = np.empty((3, slots, n), np.int64)
+    # each thread's walk scratch: the stamps (filled with -1 by the thread on its first range), members, queue;
+    # int32 where the vertices and the centres' positions (the stamps) fit: half the memory the walks touch
+    scratch = np.empty((3, slots, n), np.int32 if max(n, m) < 2**31 else np.int64)
     filled = np.zeros(slots, np.bool_)
     run_slots(
         _connected_chunk,

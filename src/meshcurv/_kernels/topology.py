@@ -545,7 +545,9 @@ def neighbour_lists(edges, n_vertices):
     counting sort's starts (:func:`_bucket_starts`): a vertex's list holds the
     ends of the first range's edges, then of the next, each in edge order,
     which is the order of one pass over all the edges (each list increasing),
-    whatever the number of threads.
+    whatever the number of threads. ``indices`` has the type of ``edges`` (int32
+    where the mesh fits, :func:`meshcurv.topology.index_dtype`): half the memory
+    that the walks of the balls read.
     """
     n_edges = edges.shape[0]
     n_ranges = max(1, min(nb.get_num_threads(), _BUCKET_CHUNKS, n_edges))
@@ -553,7 +555,7 @@ def neighbour_lists(edges, n_vertices):
     cursor = np.zeros((n_ranges, n_vertices), np.int64)
     run_chunks(_count_ends, n_ranges, n_ranges, edges, cursor)
     indptr = _bucket_starts(cursor)
-    indices = np.empty(indptr[n_vertices], np.int64)
+    indices = np.empty(indptr[n_vertices], edges.dtype)
     run_chunks(_place_ends, n_ranges, n_ranges, edges, cursor, indices)
     return indptr, indices
 
