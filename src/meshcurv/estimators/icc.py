@@ -68,8 +68,15 @@ ball still holds less than :data:`HOLE_MIN_SHARE` (a small piece between
 holes) is undefined, and so is one whose ball holds pieces of both
 orientations (:data:`HOLE_FACING`: holes split a surface into patches, each
 oriented on its own, and a small patch of a marching-cubes mesh keeps its
-inward winding). The normals of a voxel surface are fitted at every corner of
-a face summed (:func:`_corners_fitted`), not only at the vertices measured:
+inward winding). Near the holes of other meshes (cracks, faces detached
+beyond the weld: :func:`_near_holes`), a normal fit whose ball wraps around the surface (it holds
+points facing away: three radii on a coarse sphere reach past its equator) is
+made again over half of it, and a cubic over a dozen points of a strip gives
+way to the quadric over them where the two disagree (:func:`_unwrapped_normals`):
+the points left there are lopsided and tilted the fits by up to 56 degrees
+(issue 29, fuzz 366/3537: H 0.35 for 1). The normals of a voxel surface, and
+of any surface with boundary edges, are fitted at every corner of a face
+summed (:func:`_corners_fitted`), not only at the vertices measured:
 holes leave many vertices on bow-ties and strips, undefined as centres but
 corners of their neighbours' faces, and the mean of their face normals (18 to
 40 degrees off on a staircase) made H low by 0.1 to 0.18 of the curvature on
@@ -106,6 +113,7 @@ from .._geometry import median_edge_length
 from .._backend import numba_kernels
 from .._tensors import tangent_basis
 from ..jets import (
+    AWAY_FRACTION,
     NORMAL_MIN_SPREAD,
     SAMPLED_SPREAD,
     SETTLED_SLOPE,
@@ -219,6 +227,7 @@ def fitted_normals(
     failed: np.ndarray | None = None,
     fits: np.ndarray | None = None,
     edge: float | None = None,
+    unwrap: np.ndarray | None = None,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -239,6 +248,9 @@ def fitted_normals(
     is its surface-connected piece (:func:`meshcurv.jets.fit_jets`).
 
     ``edge``: the median edge length of :func:`_sampled_edge`, when the caller has it.
+
+    ``unwrap`` (V,) bool: the vertices whose fits are checked for balls holding points that face away, and made
+    again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes).
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -294,6 +306,17 @@ def fitted_normals(
             areas=areas if weighted else None,
             min_spread=NORMAL_MIN_SPREAD,
         )
+        if unwrap is not None and adjacency is not None:
+            fitted = _unwrapped_normals(
+                vertices,
+                start,
+                np.where(valid[:, None], fitted, normals),
+                radius,
+                valid & unwrap,
+                neighbours,
+                adjacency,
+                areas if weighted else None,
+            )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     if failed is not None:
@@ -301,6 +324,86 @@ def fitted_normals(
     if fitted is fits:  # the caller's array: not written
         return np.where(usable[:, None], fitted, normals)
     np.copyto(fitted, normals, where=~usable[:, None])  # the fits' own array: no second (V, 3) one
+    return fitted
+
+
+#: Near a hole (:func:`_near_holes`), a normal fit whose ball holds more than :data:`meshcurv.jets.AWAY_FRACTION` of
+#: its points facing away from its centre (the ball wraps around a bend of the surface: three measure radii on a
+#: coarse mesh reach past the equator of a sphere of two edge lengths) is made again over a ball this many times
+#: smaller (:func:`_unwrapped_normals`) ...
+UNWRAP_SHRINK = 0.5
+#: ... at most this many times (a ball still wrapped keeps its first fit). There, a fit over fewer points than
+#: this (twice the ten coefficients of a cubic jet) ...
+UNWRAP_STEPS = 1
+FEW_POINTS = 20
+#: ... is made of this degree too (a quadric: on ``shapes.uv_sphere()`` with half of its faces detached, cubics
+#: over 12 points of a strip between cracks were 56 degrees off the sphere's normal, the quadric over them 2.5) ...
+FEW_DEGREE = 2
+#: ... whose normal replaces the cubic's where the two turn apart by more than this (the cosine of 8 degrees: at
+#: the rim of an irregular hemisphere, whose one-sided balls hold 10-19 points too, they agree, and the rows of
+#: ``benchmarks/accuracy.py`` are those without this; replaced everywhere, the rim's median H error went from
+#: 0.40% to 0.49%; at 15 degrees 1 of 11,767 valid vertices of the cracked ``uv_sphere()`` stayed off, at 8 none).
+FEW_AGREEMENT = float(np.cos(np.radians(8.0)))
+
+
+def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjacency, areas) -> np.ndarray:
+    """(V, 3) :func:`fitted_normals`' jet normals near holes: ``fitted`` (V, 3), the normals of the fits over
+    ``radius`` (the mean of the face normals where none was made), made again at the ``valid`` vertices whose ball
+    wrapped or held few points.
+
+    A ball of the normal fits (three measure radii) that holds points facing away from its centre (by ``fitted``;
+    more than :data:`meshcurv.jets.AWAY_FRACTION` of its points: the fitted normals, not the faces', whose mean
+    turns by up to 90 degrees between the vertices of a staircase) wraps around the surface, and a jet over the
+    tangent plane describes no height function there. Where the surface around is whole such a ball is about
+    symmetric and its normal comes out right (a coarse sphere, a cylinder under noise: smaller balls there are
+    only noisier, so only the vertices near holes are checked); with holes, cracks or faces detached beyond the
+    weld the points left are lopsided and tilt the fit (issue 29: ``shapes.uv_sphere(12, 8)``, half of its faces
+    detached by 0.065 edge lengths: fitted normals 13.5 degrees off the sphere's at the median, 2.5 intact, and H
+    of 0.35-0.85 for 1 at 10 of 59 valid vertices; with the exact normals the same sums give 1 to 0.004). Those
+    fits are made again over balls :data:`UNWRAP_SHRINK` times smaller, at most :data:`UNWRAP_STEPS` times (one
+    still wrapped keeps its first fit). A cubic over fewer than :data:`FEW_POINTS` points (a strip between
+    cracks) gives way to the quadric over them where the two disagree (:data:`FEW_AGREEMENT`).
+    """
+    n = vertices.shape[0]
+    facing, fitted = fitted, np.array(fitted, copy=True)
+    centres = np.flatnonzero(valid & np.isfinite(facing).all(axis=1))
+    radii = np.array(np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,))[centres], copy=True)
+
+    def fit(at, over, degree):
+        details: dict = {}
+        coefficients, frame, counts = _fit_jets(
+            vertices,
+            start,
+            over,
+            degree=degree,
+            iterations=NORMAL_ITERATIONS,
+            centres=at,
+            neighbours=neighbours,
+            facing=facing,
+            details=details,
+            adjacency=adjacency,
+            settled=NORMAL_SETTLED,
+            compact=True,
+            areas=areas,
+            min_spread=NORMAL_MIN_SPREAD,
+        )
+        return jet_normals(coefficients, frame), counts, details["away"]
+
+    for step in range(UNWRAP_STEPS + 1):
+        if not centres.size:
+            break
+        found, counts, away = fit(centres, radii, NORMAL_DEGREE)
+        with np.errstate(invalid="ignore"):
+            wrapped = away > AWAY_FRACTION
+        few = ~wrapped & (counts < FEW_POINTS)
+        if step:  # (the first fits are those given; a ball still wrapped keeps them)
+            fitted[centres[~wrapped]] = found[~wrapped]
+        if few.any():  # a cubic through a dozen points of a lopsided ball: its slope can be the noise of the fit
+            lower = fit(centres[few], radii[few], FEW_DEGREE)[0]
+            with np.errstate(invalid="ignore"):
+                unsteady = np.einsum("ij,ij->i", lower, fitted[centres[few]]) < FEW_AGREEMENT
+            fitted[centres[few][unsteady]] = lower[unsteady]
+        centres, radii = centres[wrapped], radii[wrapped] * UNWRAP_SHRINK
     return fitted
 
 
@@ -714,6 +817,7 @@ def _curvatures(
     normal_radius=None,
     coarse: bool = False,
     boundary_faces: np.ndarray | None = None,
+    topology: MeshTopology | None = None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -721,7 +825,10 @@ def _curvatures(
     ``coarse``: dense balls summed on clusters of faces (:func:`meshcurv.neighborhoods.coarse_face_sums`).
     ``boundary_faces`` (F,) bool: the faces on a boundary edge of a voxel surface (:func:`_boundary_faces`),
     whose balls are grown or left undefined (:func:`_holed_balls`); the returned ``radius`` is then (V,) the
-    radius of each ball summed (``radius`` as given otherwise).
+    radius of each ball summed (``radius`` as given otherwise). ``topology``: the mesh's, given where it has
+    boundary edges and is not a voxel surface: the normals are fitted at every corner of a face summed
+    (:func:`_corners_fitted`) and, near holes (:func:`_near_holes`), the fits whose balls wrap are made again
+    (:func:`_unwrapped_normals`).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -741,7 +848,11 @@ def _curvatures(
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
-        start_normals, fit = normals, _corners_fitted(faces, degenerate, normals, valid) if coarse else valid
+        start_normals, fit = (
+            normals,
+            _corners_fitted(faces, degenerate, normals, valid) if coarse or topology is not None else valid,
+        )
+        near = None if topology is None else _near_holes(vertices, topology, radius, normal_radius, fit)
         normals = fitted_normals(
             vertices,
             normals,
@@ -753,6 +864,7 @@ def _curvatures(
             weighted=weighted,
             failed=failed,
             edge=edge,
+            unwrap=near,
         )
 
         if boundary_faces is not None and adjacency is not None:
@@ -782,6 +894,28 @@ def _curvatures(
     if sparse is not None:
         valid &= ~sparse
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
+
+
+def _near_holes(vertices, topology: MeshTopology, radius, normal_radius, centres: np.ndarray) -> np.ndarray | None:
+    """(V,) bool: the ``centres`` whose normal-fit ball (of ``normal_radius``) reaches the middle of an edge of a
+    hole (:func:`meshcurv.estimators.normal_cycle_ball.hole_edges` over balls of ``radius``: a boundary edge with
+    the surface beyond it, a crack or faces detached beyond the weld, not a rim), or None where there is none."""
+    from scipy.spatial import cKDTree
+
+    from .normal_cycle_ball import hole_edges
+
+    n = vertices.shape[0]
+    radii = np.ascontiguousarray(np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,)))
+    holes = hole_edges(vertices, topology, radii, topology.referenced_vertices)
+    if not holes.any():
+        return None
+    ends = topology.edges[holes]
+    reach = np.broadcast_to(np.asarray(normal_radius, dtype=np.float64), (n,))
+    rows = np.flatnonzero(centres)
+    distance, _ = cKDTree(0.5 * (vertices[ends[:, 0]] + vertices[ends[:, 1]])).query(vertices[rows])
+    near = np.zeros(n, dtype=bool)
+    near[rows] = distance <= reach[rows]
+    return near
 
 
 def _corners_fitted(faces: np.ndarray, dropped: np.ndarray, normals: np.ndarray, valid: np.ndarray) -> np.ndarray:
@@ -861,6 +995,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
 
     stages.start("measure noise")
     referenced = topology.referenced_vertices
+    bounded = topology if topology.boundary_edges.any() else None  # (a voxel surface's holes: _holed_balls)
     if radius is None:  # each group of components of one scale (usually the whole mesh) at its own default
         groups, levels = _noise_radii(mesh, normals, valid, adjacency=_adjacency(topology))
         found = {"surface": "smooth", "noise": levels[0] if len(levels) == 1 else levels}
@@ -918,6 +1053,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 adjacency=_adjacency(topology),
                 areas=_vertex_areas(mesh),
                 weighted=True,
+                topology=bounded,
             )
             return finish(
                 "icc",
@@ -944,6 +1080,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             neighbours=referenced,
             adjacency=_adjacency(topology),
             areas=_vertex_areas(mesh),
+            topology=bounded,
         )[:-1]
         if members is None:
             fields = computed
