@@ -50,7 +50,15 @@ edge lengths, averaged over two rings), and
   a clean mesh keeps 2.5 h;
 - at any radius, a vertex whose level, or its mesh's median level, exceeds :data:`NOISE_GATE` has its jet
   checked against a quadric over the same ball, as at the rim (faces detached off the surface by a tenth of an edge make such balls: issue 29, fuzz
-  296/1682).
+  296/1682);
+- at any radius, the noise's reach (:func:`_noise_reach`): the spread of a fit's curvatures under the noise of
+  its ball, from the level (as a standard deviation, :data:`NOISE_SIGMA_FACTOR`) and the weighted normal matrix of
+  the ball's points (``sigma^2 G^-1 M G^-1``, :func:`_noise_spreads`), against the median curvedness of the
+  surface: a jet spread beyond :data:`JET_NOISE_REACH` of it takes a quadric over the same ball, and a vertex
+  whose quadric spreads beyond :data:`NOISE_REACH` is NaN with ``valid=False``. A given radius of one or two edge
+  lengths holds 6-15 points, which every fit, the quadric too, follows (issue 29: faces detached by 0.08 edge
+  lengths, H valid and off a unit sphere's by up to 1.65: fuzz 362/3, 366/5687); the jet and the quadric then
+  agree, which the check against each other cannot see. Such balls are NaN with a warning that names them.
 
 ``benchmarks/quadric_noise.md`` gives the errors before and after.
 
@@ -70,7 +78,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._tensors import principal_from_shape_operator
-from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, _fit_jets, shape_operators
+from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, PIVOT_FLOOR, _exponents, _fit_chunk, _fit_jets, shape_operators
+from ..neighborhoods import _ball_pairs
+from .._tensors import tangent_basis
 from ..radius import _component_radii, _jet_vertex_radii, _local_noise, _resolve_radius, _vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
@@ -112,6 +122,34 @@ STEADY_AGREEMENT = 0.05
 #: a degree-4 jet over a ball of 2.5 edge lengths follows such noise (median H error 56-108% on the noisy spheres,
 #: a quadric's 11-20%; issue 29, fuzz 296/1682: faces detached by 0.087 edge lengths).
 NOISE_GATE = 0.016
+
+#: A vertex at a given radius whose quadric's curvatures spread under the noise of its ball (the root of the
+#: expected squared change of its shape operator) by more than this share of its surface's curvature (the median
+#: curvedness) is NaN with ``valid=False`` (:func:`_noise_reach`): about a third, so that an error of half the
+#: curvature (the fuzzer's tolerance) is some three spreads of the mean curvature away. Looser values left valid
+#: wrong numbers: on a sphere with noise of 0.05 edge lengths at a radius of 1.5 (``tests/test_quadric_cracks_W19.py``)
+#: 0.4 kept an H off by 0.86, 0.5-0.7 one off by 1.02; fuzz 362/3 at 0.7 two vertices off by 0.55. The cost: on
+#: random spheres with a fifth of their faces detached by 0.1 edge lengths, at 2.2 edge lengths
+#: (``tests/test_quadric_noise_Q18.py``, four draws) 31-40% of the vertices stay valid (73-83% before, 20 of them
+#: off by more than half of H, now none; 0.6: 70-78% and one).
+NOISE_REACH = 0.3
+
+#: A jet whose spread under the noise of its ball exceeds this share of the surface's curvature gives way to a
+#: quadric over the same ball (:func:`_noise_reach`).
+JET_NOISE_REACH = 0.1
+
+#: The noise's standard deviation per unit of noise level (:func:`meshcurv.radius.local_noise`: a mean distance
+#: to degree-2 fits over about 13 points, which absorb part of it): on the spheres, tori and ellipsoids with
+#: uniform noise of 0.05-0.3 edge lengths along the normal, the standard deviation drawn over the level read
+#: (less :data:`meshcurv.radius.NOISE_FLOOR` in quadrature) was 2.0-2.8 (``sqrt(pi / 2) / sqrt(1 - 6 / 13) = 1.7``
+#: for a Gaussian noise that the fits absorb as their six terms would on average).
+NOISE_SIGMA_FACTOR = 2.5
+
+#: Noise levels up to this read as a clean mesh in :func:`_noise_sigmas`: twice
+#: :data:`meshcurv.radius.NOISE_FLOOR`, as the vertices of a clean irregular mesh read up to 0.006 (a random
+#: ellipsoid of 2,562 points, whose degree-4 jets a noise read from the floor alone sent to quadrics 1.2
+#: degrees off the normal).
+CLEAN_LEVEL = 0.007
 
 
 def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
@@ -163,6 +201,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         if again.size:
             radii[again] = base[again]
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
+    sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
+    reach = (vertices, start, radii, referenced, facing)
+    curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
+    unsure = _noise_reach(reach, sigmas, curvatures, fields, given=radius is not None)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -173,7 +215,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     )
     failed = ~valid & ~defects.invalid_vertices
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
-    few = int(failed.sum()) - two_sided
+    noisy_balls = int((failed & unsure & ~(away > AWAY_FRACTION)).sum())
+    few = int(failed.sum()) - two_sided - noisy_balls
     shown = ", ".join(f"{r:g}" for r, _ in groups) if radius is not None else _shown_radii(radii, referenced)
     extra = (
         (
@@ -188,6 +231,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             "pass a smaller `radius`"
         )
         if two_sided
+        else "",
+        (
+            f"{noisy_balls} vertices have a ball of radius {shown} too small for the noise of their surface: "
+            f"any fit over it moves the curvatures by more than {NOISE_REACH:g} of the surface's; pass a larger "
+            "`radius` (or none)"
+        )
+        if noisy_balls
         else "",
     )
     normals_out = np.where(valid[:, None], fitted, normals)
@@ -296,3 +346,127 @@ def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
     swap = spread & ~(apart <= STEADY_AGREEMENT)
     six[rows[swap]], fitted[rows[swap]], coefficients[rows[swap]] = low_six[swap], low_fitted[swap], found[rows][swap]
     coefficients[rows[~spread]] = np.nan
+
+
+def _noise_spreads(ball: tuple, rows: np.ndarray, radii: np.ndarray, sigmas: np.ndarray, degree: int) -> np.ndarray:
+    """(len(rows),) how far the noise ``sigmas`` moves the shape operator of a fit of ``degree`` over each ball.
+
+    ``ball = (vertices, normals, referenced)``. The ball of vertex ``rows[i]`` is that of its fit (the
+    ``referenced`` vertices within ``radii[i]``, weights ``w = (1 - d^2 / r^2)^2``), in the tangent plane of
+    ``normals[rows[i]]``, in units of the radius. Independent noise of standard deviation ``sigmas[j]`` (V,) on
+    the heights of the points ``j`` moves the coefficients by the covariance ``G^-1 M G^-1`` (``G``: the
+    weighted normal matrix, ``M = sum_j w_j^2 (sigma_j / r)^2 b_j b_j^T``), and the shape operator
+    ``[[2 c20, c11], [c11, 2 c02]] / r`` by ``sqrt(4 var c20 + 2 var c11 + 4 var c02) / r`` (the root of its
+    expected squared Frobenius norm, which no turn of the tangent frame changes), in units of curvature; inf
+    where the normal matrix is singular (fewer points than terms, or points along a curve)."""
+    vertices, normals, referenced = ball
+    ids = np.flatnonzero(referenced)
+    exponents = _exponents(degree)
+    second = [int(np.flatnonzero((exponents == pair).all(axis=1))[0]) for pair in ((2, 0), (1, 1), (0, 2))]
+    factor = np.array([4.0, 2.0, 4.0])
+    t1, t2 = tangent_basis(normals[rows])
+    out = np.full(rows.size, np.inf)
+    centres = vertices[rows]
+    for chunk, i, j in _ball_pairs(vertices[ids], centres, radii):
+        local = i - chunk.start
+        offsets = (vertices[ids[j]] - centres[i]) / radii[i][:, None]
+        weights = np.clip(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0, None) ** 2
+        size = chunk.stop - chunk.start
+        frame = (t1[chunk], t2[chunk], normals[rows][chunk])
+        gram = _fit_chunk(offsets, local, size, frame, weights, degree)[0]
+        noise = _fit_chunk(offsets, local, size, frame, (weights * sigmas[ids[j]] / radii[i]) ** 2, degree)[0]
+        values, vectors = np.linalg.eigh(gram)
+        solid = values[:, 0] > PIVOT_FLOOR * np.maximum(values[:, -1], 1e-300)
+        inverse = np.where(solid[:, None], 1.0 / np.where(values > 0, values, 1.0), 0.0)
+        # the rows of G^-1 = Q diag(1 / l) Q^T for the second-order terms
+        rows_inverse = np.einsum("nkm,nm,nlm->nkl", vectors[:, second, :], inverse, vectors)
+        covariance = np.einsum("nkl,nlm,nkm->nk", rows_inverse, noise, rows_inverse)
+        spread = np.sqrt(np.clip(covariance, 0.0, None) @ factor) / radii[chunk]
+        out[chunk] = np.where(solid, spread, np.inf)
+    return out
+
+
+def _noise_sigmas(levels: np.ndarray, groups: list, edge_lengths: np.ndarray) -> np.ndarray:
+    """(V,) the standard deviation of the noise on the heights at each vertex, in length units (0: clean).
+
+    Its noise level ``levels`` (:func:`meshcurv.radius.local_noise`, a mean distance in local edge lengths
+    ``edge_lengths``), or the median level of its group (``groups``), whichever is larger (as
+    :func:`_noisy_balls`), less :data:`CLEAN_LEVEL` (the noise fits' own bias on a clean mesh; in quadrature),
+    times :data:`NOISE_SIGMA_FACTOR`. NaN levels take the group's median; 0 where nothing is known."""
+    known = np.isfinite(levels)
+    medians = np.zeros_like(levels)
+    for _, members in groups:
+        rows = slice(None) if members is None else members
+        part = levels[rows][known[rows]]
+        medians[rows] = np.median(part) if part.size else 0.0
+    level = np.fmax(np.where(known, levels, medians), medians)
+    sigmas = NOISE_SIGMA_FACTOR * np.sqrt(np.clip(level**2 - CLEAN_LEVEL**2, 0.0, None)) * edge_lengths
+    return np.where(np.isfinite(sigmas), sigmas, 0.0)
+
+
+def _curvature_scales(curvedness: np.ndarray, groups: list, vertices: np.ndarray, referenced) -> np.ndarray:
+    """(V,) the curvature that a vertex's estimate is held to: the median curvedness of its group (``groups``;
+    :func:`meshcurv.radius.local_noise`), at least ``2 / d`` (``d``: the diagonal of the bounding box of the
+    referenced vertices: a sphere's curvedness is ``2.4 / d``; a noisy plane is held to the curvature of its
+    extent)."""
+    points = vertices[referenced]
+    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if points.size else 0.0
+    floor = 2.0 / diagonal if diagonal > 0 else np.inf
+    scales = np.full(curvedness.shape, floor)
+    for _, members in groups:
+        rows = slice(None) if members is None else members
+        part = curvedness[rows][np.isfinite(curvedness[rows]) & referenced[rows]]
+        if part.size:
+            scales[rows] = max(float(np.median(part)), floor)
+    return scales
+
+
+def _noise_reach(reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, fields: tuple, given: bool) -> np.ndarray:
+    """(V,) bool: the vertices whose ball cannot hold a fit against its noise (their coefficients made NaN).
+
+    ``reach = (vertices, start, radii, referenced, facing)``; ``fields = (six, fitted, coefficients)``, changed in
+    place. At each fitted vertex the spread of its jet's shape operator under the noise of its ball's points
+    (``sigmas``, :func:`_noise_sigmas`; :func:`_noise_spreads`, :data:`meshcurv.jets.DEGREE`: a fit of lower degree over
+    the same ball spreads less) is held to :data:`JET_NOISE_REACH` of ``curvatures`` (:func:`_curvature_scales`):
+    beyond it the vertex takes a quadric's fit over the same ball (:data:`STEADY_DEGREE`) if that one's spread is
+    within :data:`NOISE_REACH` of them, else (``given``: a radius given by the caller) is NaN with
+    ``valid=False``; at the default radius, grown with the noise (:func:`meshcurv.radius.jet_vertex_radii`),
+    the quadric is kept. A ball of few points (a given radius of an edge length or two)
+    lets every fit follow the noise, the quadric as well as the jet, so that the two agree and the check of
+    :func:`_steady_fits` passes them (issue 29: faces detached by 0.08 edge lengths, H off by up to 1.65 on a
+    unit sphere at a radius of one edge length)."""
+    vertices, start, radii, referenced, facing = reach
+    six, fitted, coefficients = fields
+    unsure = np.zeros(vertices.shape[0], dtype=bool)
+    rows = np.flatnonzero(np.isfinite(coefficients).all(axis=1) & referenced)
+    if rows.size == 0 or not (sigmas > 0).any():
+        return unsure
+    unit = radii[rows]
+    ball = (vertices, fitted, referenced)
+    high = _noise_spreads(ball, rows, unit, sigmas, DEGREE)
+    loose = high > JET_NOISE_REACH * curvatures[rows]
+    rows, unit = rows[loose], unit[loose]
+    if rows.size == 0:
+        return unsure
+    if given:
+        low = _noise_spreads(ball, rows, unit, sigmas, STEADY_DEGREE)
+        steady = low <= NOISE_REACH * curvatures[rows]
+        unsure[rows[~steady]] = True
+    else:
+        steady = np.ones(rows.size, dtype=bool)
+    rows, unit = rows[steady], unit[steady]
+    if rows.size:
+        found, frame, _ = _fit_jets(
+            vertices,
+            start,
+            unit,
+            degree=STEADY_DEGREE,
+            centres=rows,
+            neighbours=referenced,
+            facing=facing,
+            min_spread=STEADY_MIN_SPREAD,
+        )
+        six[rows], fitted[rows] = shape_operators(found[rows], tuple(axis[rows] for axis in frame), unit)
+        coefficients[rows] = found[rows]
+    coefficients[unsure] = np.nan
+    return unsure
