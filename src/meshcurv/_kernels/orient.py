@@ -176,6 +176,7 @@ def _winding_chunk(lo, hi, corners, centres, dipoles, moments, limit, positions,
                 mz = moments[k, 2, 0] * rx + moments[k, 2, 1] * ry + moments[k, 2, 2] * rz
                 dot = dipoles[k, 0] * rx + dipoles[k, 1] * ry + dipoles[k, 2] * rz
                 sum_ += (dot + trace) / cubed - 3.0 * (rx * mx + ry * my + rz * mz) / (cubed * squared)
+                sum_ += _second_order(moments, k, rx, ry, rz, squared, cubed)
             elif k >= first_leaf:
                 leaf = k - first_leaf
                 for f in range(leaf * n_faces // n_leaves, (leaf + 1) * n_faces // n_leaves):
@@ -186,6 +187,23 @@ def _winding_chunk(lo, hi, corners, centres, dipoles, moments, limit, positions,
                 stack[top + 1] = 2 * k + 1
                 top += 2
         total[m] = sum_
+
+
+@nb.njit(inline="always", **_JIT)
+def _second_order(moments, k, rx, ry, rz, squared, cubed):
+    """The third term of node ``k``'s expansion at ``r`` (its second moments ``T``, columns 3 to 11 of
+    ``moments``): ``15 / 2 T[r, r, r] / |r|^7 - 3 / 2 (2 T_aab r_b + T_abb r_a) / |r|^5``."""
+    r = (rx, ry, rz)
+    cubic = 0.0
+    traces = 0.0
+    for a in range(3):
+        for b in range(3):
+            tr = moments[k, a, 3 + 3 * b] * rx + moments[k, a, 4 + 3 * b] * ry + moments[k, a, 5 + 3 * b] * rz
+            cubic += r[a] * r[b] * tr
+            if a == b:
+                traces += 2.0 * tr
+        traces += (moments[k, a, 3] + moments[k, a, 7] + moments[k, a, 11]) * r[a]
+    return 7.5 * cubic / (cubed * squared * squared) - 1.5 * traces / (cubed * squared)
 
 
 @nb.njit(inline="always", **_JIT)
