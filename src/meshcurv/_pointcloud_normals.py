@@ -992,14 +992,17 @@ def oriented_signs(
         # the sheets read off the forest's union-find once its flat edges are taken, where the flat edges come
         # first in the order (a flat edge weighs 1 - |cos| + a slope of at most SHEET_SLOPE, below 3; a stacked
         # one 3 or more, its |cos| clipped to 1); else, as a guard, the NumPy forest
-        used_weights, n_flat = weights[used], int(np.count_nonzero(flat))
+        every = bool(used.all())  # (a smooth sample's edges all are: no copies of them)
+        used_weights, n_flat = weights if every else weights[used], int(np.count_nonzero(flat))
         order = np.argsort(used_weights)
         separated = (n_flat == 0 or used_weights[order[n_flat - 1]] < 3.0) and (
             n_flat == order.size or used_weights[order[n_flat]] >= 3.0
         )
     if separated:
+        # the kernel gathers the edges in their order itself: `order` over the used edges, as edges of the graph
+        taken = order if every else np.flatnonzero(used)[order]
         signs, roots, sheets = forest.spanning_sheets(
-            n, rows[used], cols[used], opposite[used].astype(np.int8), order, n_flat, PART_MIN_POINTS
+            n, rows, cols, opposite.view(np.int8), taken, n_flat, PART_MIN_POINTS
         )
         labels = _dense_labels(roots)
     else:

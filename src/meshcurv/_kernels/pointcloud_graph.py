@@ -22,7 +22,7 @@ from ._common import _JIT
 from .pointcloud import _root
 
 
-@nb.njit(**_JIT)
+@nb.njit(parallel=True, **_JIT)
 def spanning_sheets(n, rows, cols, opposite, order, n_flat, least):
     """``(signs, roots, sheets)``: :func:`meshcurv._kernels.pointcloud.spanning_signs` and the sheets on the way.
 
@@ -35,16 +35,23 @@ def spanning_sheets(n, rows, cols, opposite, order, n_flat, least):
     order of their first point (as
     :func:`scipy.sparse.csgraph.connected_components` does), -1 for those of
     fewer than ``least`` points (:func:`meshcurv._pointcloud_normals._sheets`).
+
+    The edges are gathered in ``order`` first, on every core: Kruskal's walk then reads them in sequence, and
+    only its union-find jumps in memory (1M points, 6M edges: 1.07-1.19 -> 0.60-0.62 CPU s, the gather included).
     """
+    m = order.shape[0]
+    edge_rows, edge_cols, edge_opposite = np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8)
+    for position in nb.prange(m):
+        e = order[position]
+        edge_rows[position], edge_cols[position], edge_opposite[position] = rows[e], cols[e], opposite[e]
     parent, flip, size = np.arange(n), np.zeros(n, dtype=np.int8), np.ones(n, dtype=np.int64)
     sheets = np.full(n, -1, dtype=np.int64)
-    for position in range(order.shape[0]):
+    for position in range(m):
         if position == n_flat:  # (stacked edges follow: the sheets are the components now)
             for i in range(n):
                 sheets[i] = _root(parent, flip, i)[0]
             _number_sheets(sheets, least)
-        e = order[position]
-        _join(parent, flip, size, rows[e], cols[e], opposite[e])
+        _join(parent, flip, size, edge_rows[position], edge_cols[position], edge_opposite[position])
     signs, roots = np.ones(n), np.zeros(n, dtype=np.int64)
     for i in range(n):
         roots[i], flipped = _root(parent, flip, i)
