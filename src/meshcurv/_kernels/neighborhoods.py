@@ -46,9 +46,10 @@ def _count_corners(lo, hi, faces, cursor):
     n_faces, corners = faces.shape
     n_chunks = cursor.shape[0]
     for c in range(lo, hi):
+        counts = cursor[c]
         for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
             for k in range(corners):
-                cursor[c, faces[f, k]] += 1
+                counts[_UNSIGNED(faces[f, k])] += 1  # unsigned: no code for negative indices
 
 
 @nb.njit(**_JIT)
@@ -57,11 +58,12 @@ def _place_corners(lo, hi, faces, cursor, indices):
     n_faces, corners = faces.shape
     n_chunks = cursor.shape[0]
     for c in range(lo, hi):
+        fill = cursor[c]
         for f in range(n_faces * c // n_chunks, n_faces * (c + 1) // n_chunks):
             for k in range(corners):
-                a = faces[f, k]
-                indices[cursor[c, a]] = f
-                cursor[c, a] += 1
+                a = _UNSIGNED(faces[f, k])  # unsigned: no code for negative indices
+                indices[_UNSIGNED(fill[a])] = f
+                fill[a] += 1
 
 
 @nb.njit(**_JIT)
@@ -968,15 +970,18 @@ def _centres_chunk(lo, hi, vertices, cells, centres, reach):
         x /= corners
         y /= corners
         z /= corners
-        far = 0.0
+        # the largest squared distance, then one square root: the square root is correctly rounded and so
+        # non-decreasing, hence the root of the largest square is the largest root (the same number, one root
+        # instead of one per corner; a NaN is skipped by both comparisons alike)
+        far2 = 0.0
         for k in range(corners):
             p = cells[c, k]
-            length = math.sqrt((vertices[p, 0] - x) ** 2 + (vertices[p, 1] - y) ** 2 + (vertices[p, 2] - z) ** 2)
-            far = length if length > far else far  # max(far, length): numba compiles max once per caller's options
+            squared = (vertices[p, 0] - x) ** 2 + (vertices[p, 1] - y) ** 2 + (vertices[p, 2] - z) ** 2
+            far2 = squared if squared > far2 else far2  # max(far2, squared): numba compiles max once per options
         centres[c, 0] = x
         centres[c, 1] = y
         centres[c, 2] = z
-        reach[c] = far
+        reach[c] = math.sqrt(far2)
 
 
 @nb.njit(parallel=True, **_JIT)
