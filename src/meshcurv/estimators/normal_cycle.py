@@ -127,41 +127,17 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         rotate=True,
         mean_from_trace=True,
     )
-    return _finished(mesh, defects, valid, smoothing_steps, areas, normals, k_min, k_max, dir_min, dir_max)
+    return _finished(mesh, defects, valid, smoothing_steps, normals, k_min, k_max, dir_min, dir_max)
 
 
-#: A region (the vertices within ``smoothing_steps`` edges) whose valid vertices' cells hold less than this share
-#: of its area (the same smoothing of the cells' areas, with and without the invalid vertices') reads a few cells,
-#: not the region: its vertex is undefined (:func:`_thin_regions`). Faces detached by cracks beyond the weld (fuzz
-#: ``--wide-cracks``, issue 29) leave valid vertices whose neighbours are all boundary vertices: a vertex of
-#: three faces of the 200-point random sphere kept its own cell alone, H 3.04 against 0.99 (fuzz_api seed 366,
-#: case 6945). On the fuzzer's shapes with 30% and 50% of their faces detached by 0.05-0.1 edges (12 draws
-#: each, smoothing 1, 3 and 6 steps) the 68 valid vertices off their clean shape's H by more than half its
-#: largest ``|k|`` held shares of 0.02-0.22; on the clean shapes the smallest share was 0.58 (a saddle's corner at
-#: 1 step; a hemisphere's rim 0.68, a cylinder's 0.83).
-MIN_REGION_SHARE = 0.3
-
-
-def _thin_regions(mesh: PreparedMesh, invalid: np.ndarray, valid: np.ndarray, areas: np.ndarray, steps: int):
-    """(V,) bool: the ``valid`` vertices whose smoothing region holds less than :data:`MIN_REGION_SHARE` of
-    its area in the cells of valid vertices (``invalid``: (V,) bool, the defects' vertices, whose cells the
-    smoothing leaves out; ``areas``: (V,) the cells' areas). All False without invalid vertices or smoothing."""
-    if steps <= 0 or not invalid.any() or not valid.any():
-        return np.zeros_like(valid)
-    pooled = _smooth_vertex_field(np.column_stack([np.where(invalid, 0.0, areas), areas]), mesh.topology, steps)
-    return valid & (pooled[:, 0] < MIN_REGION_SHARE * pooled[:, 1])
-
-
-def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: int, areas, normals, *curvatures):
-    """:func:`finish` of the result without the vertices whose smoothing region (the vertices within
-    ``smoothing_steps`` edges) lost most of its cells (:func:`_thin_regions`) and, on a voxel surface, those whose
-    region holds an invalid vertex at all, with the warning's phrases for them.
+def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: int, normals, *curvatures):
+    """:func:`finish` of the result, but on a voxel surface without the vertices whose smoothing region (the
+    vertices within ``smoothing_steps`` edges) holds an invalid vertex, with the warning's phrase for them.
 
     The smoothing sums the cells of the valid vertices only; on a voxel staircase a region without some of its
-    cells reads a part of the staircase, not the surface (the module's Notes); elsewhere a region left with a
-    few cells reads them, not the region.
+    cells reads a part of the staircase, not the surface (the module's Notes). Other meshes: unchanged.
     """
-    invalid, note, thin_note = defects.invalid_vertices, "", ""
+    invalid, note = defects.invalid_vertices, ""
     needed = voxel_steps_needed(mesh, invalid) if valid.any() else 0
     if smoothing_steps < needed:
         note = (
@@ -180,18 +156,9 @@ def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: i
                 f"region ({smoothing_steps} rings) holds a boundary or a defect, and a part of the staircase does "
                 f"not average out"
             )
-    thin = _thin_regions(mesh, invalid, valid, areas, smoothing_steps)
-    if thin.any():
-        valid = valid & ~thin
-        thin_note = (
-            f"{int(thin.sum())} vertices are NaN (estimate undefined): their smoothing region ({smoothing_steps} "
-            f"rings) has less than {MIN_REGION_SHARE:.0%} of its area in the cells of valid vertices (the rest on "
-            f"boundaries, loose faces or defects)"
-        )
     k_min, k_max, dir_min, dir_max = curvatures
     parameters = {"smoothing_steps": smoothing_steps}
-    extra = (note, thin_note)
-    return finish("normal_cycle", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra=extra)
+    return finish("normal_cycle", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra=(note,))
 
 
 def voxel_steps_needed(mesh: PreparedMesh, invalid: np.ndarray) -> int:
@@ -245,7 +212,6 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     )
     mesh.found_degenerate(degenerate)  # the same test as mesh.degenerate (the twin tests): not made twice
     defects = mesh.defects()
-    areas = sums[:, 6].copy()
     stages.start("average vertex tensors")
     stages.start("retrieve curvatures")
     if smoothing_steps > STEPS_PER_CALL:
@@ -259,4 +225,4 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     k_min, k_max, dir_min, dir_max, normals, valid = kernels.normal_cycle_finish(
         sums, defects.invalid_vertices, indptr, indices, smoothing_left
     )
-    return _finished(mesh, defects, valid, smoothing_steps, areas, normals, k_min, k_max, dir_min, dir_max)
+    return _finished(mesh, defects, valid, smoothing_steps, normals, k_min, k_max, dir_min, dir_max)

@@ -121,18 +121,6 @@ def edge_area_densities(topology, face_areas: np.ndarray, lengths: np.ndarray) -
 #: default radius beyond its edges: the holed and detached meshes of issue 29 came out the same from 0.25 to 0.55).
 BEYOND_RADII = 0.4
 
-#: A ball with less than this share of its area (measured on the edges, :func:`edge_area_densities`) on edges
-#: between two faces, the rest on boundary edges (of holes, rims, faces detached off the surface), reads the few
-#: edges with a dihedral angle in it, not the surface: its vertex is undefined. Faces detached by cracks beyond the
-#: weld (fuzz ``--wide-cracks``, issue 29) leave valid vertices of one face whose ball holds mostly loose faces:
-#: on the 12 x 8 uv sphere with half its faces detached by 0.081 edges, at a radius of 1.5 edges, two such
-#: vertices held a share of 0.13 and read H 0.36-0.38 against 1.02-1.07 (fuzz_api seed 357, case 680). On the
-#: fuzzer's shapes with 30% and 50% of their faces detached by 0.05-0.1 edges (4 draws each, radii of 1, 1.5 and
-#: 2.5 edges, 0.1 and 0.3 of the size) the valid vertices off their clean shape's H by more than half its largest
-#: ``|k|`` with a share below 0.25 all held 0.2 or less; on the clean shapes the smallest share was 0.70 (a
-#: saddle's corner at one edge; a hemisphere's rim 0.75).
-MIN_CARRIED_SHARE = 0.2
-
 #: Relative margin of :func:`hole_edges`' three tests: far above round-off, far below any measured effect.
 LATTICE_TIE = 1e-7
 
@@ -224,22 +212,17 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     radii = _vertex_radii(groups, vertices.shape[0])
     # the edges of holes: no curvature, no area
     holes = hole_edges(vertices, topology, radii, topology.edge_vertices(usable | (density > 0)))
-    # on a mesh with boundaries, the area on edges with a dihedral angle and the whole area (the edges of holes'
-    # too): their ratio in each ball (MIN_CARRIED_SHARE)
-    shares = np.column_stack([np.where(usable, density, 0.0), density]) if topology.boundary_edges.any() else None
-    density = np.where(holes, 0.0, density)
+    density[holes] = 0.0
 
     stages.start("sum over balls")
-    # the tensor and the area on the same support, the edges inside the ball: one sum of seven columns (nine with
-    # the shares where no edge is a hole's: the same support)
-    apart = shares is not None and bool(holes.any())
-    edge_values = np.column_stack([outer6(unit, beta), density, *([] if shares is None or apart else [shares])])
+    # the tensor and the area on the same support, the edges inside the ball: one sum of seven columns
+    edge_values = np.column_stack([outer6(unit, beta), density])
     measured = usable | (density > 0)
-    measures = _grouped_ball_sums(vertices, topology.edges, groups, edge_values, measured)
-    if shares is not None and apart:
-        whole = usable | (shares[:, 1] > 0)
-        measures = np.column_stack([measures, _grouped_ball_sums(vertices, topology.edges, groups, shares, whole)])
-    measures, areas, carried = measures[:, :6], measures[:, 6], measures[:, 7:]
+    measures = np.zeros((vertices.shape[0], 7))
+    for group_radius, members in groups:
+        rows = slice(None) if members is None else members
+        measures[rows] = _ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
+    measures, areas = measures[:, :6], measures[:, 6]
 
     stages.start("retrieve curvatures")
     valid &= areas > 0
@@ -248,9 +231,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     valid &= ball_holds_neighbours(vertices, topology.edges, radii) & (radii >= MIN_RADIUS_SCALES * mesh.length_scales)
     holed = _voxel_holed_balls(mesh, holes, groups, valid) & valid
     valid &= ~holed
-    # a ball whose area lies mostly on loose faces, holes and boundaries reads the few edges left (issue 29)
-    loose = valid & (carried[:, 0] < MIN_CARRIED_SHARE * carried[:, 1]) if carried.size else np.zeros_like(valid)
-    valid &= ~loose
     with np.errstate(invalid="ignore", divide="ignore"):
         tensors = measures / areas[:, None]
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
@@ -268,25 +248,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         if holed.any()
         else ""
     )
-    loose_note = (
-        f"{int(loose.sum())} vertices are NaN (estimate undefined): less than {MIN_CARRIED_SHARE:.0%} of the area in "
-        f"their ball lies on edges between two faces (the rest: loose faces, holes, boundaries)"
-        if loose.any()
-        else ""
-    )
     curvatures = (k_min, k_max, dir_min, dir_max)
-    extra = (note, loose_note)
-    return finish("normal_cycle_ball", parameters, valid, normals, *curvatures, defects, extra=extra, radius=radii)
-
-
-def _grouped_ball_sums(vertices, edges, groups: list, values: np.ndarray, usable: np.ndarray) -> np.ndarray:
-    """(V, k) sums of ``values`` ((E, k)) over the part of each ``usable`` edge inside each vertex's ball, each
-    group of vertices (``groups``: ``(radius, members)``, members None for all) at its own radius."""
-    sums = np.zeros((vertices.shape[0], values.shape[1]))
-    for group_radius, members in groups:
-        rows = slice(None) if members is None else members
-        sums[rows] = _ball_edge_sums(vertices, edges, group_radius, values, usable=usable)[rows]
-    return sums
+    return finish("normal_cycle_ball", parameters, valid, normals, *curvatures, defects, extra=(note,), radius=radii)
 
 
 def _voxel_holed_balls(mesh: PreparedMesh, holes: np.ndarray, groups: list, valid: np.ndarray) -> np.ndarray:
@@ -300,7 +263,11 @@ def _voxel_holed_balls(mesh: PreparedMesh, holes: np.ndarray, groups: list, vali
         return holed
     if not _voxel_surface(mesh, mesh.defects().invalid_vertices) and not _grid_part(mesh, valid):
         return holed
-    return _grouped_ball_sums(vertices, edges, groups, np.ones((edges.shape[0], 1)), holes)[:, 0] > 0
+    ones = np.ones((edges.shape[0], 1))
+    for group_radius, members in groups:
+        rows = slice(None) if members is None else members
+        holed[rows] = _ball_edge_sums(vertices, edges, group_radius, ones, usable=holes)[rows, 0] > 0
+    return holed
 
 
 #: A coordinate repeated by this many vertices is a plane of a grid (``meshcurv.lattice``'s reading).
