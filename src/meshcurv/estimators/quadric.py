@@ -51,7 +51,7 @@ edge lengths, averaged over two rings), and
 - at any radius, a vertex whose level, or its mesh's median level, exceeds :data:`NOISE_GATE` has its jet
   checked against a quadric over the same ball, as at the rim (faces detached off the surface by a tenth of an edge make such balls: issue 29, fuzz
   296/1682);
-- at any radius, the noise's reach (:func:`_noise_reach`): the spread of a fit's curvatures under the noise of
+- at a given radius, the noise's reach (:func:`_noise_reach`): the spread of a fit's curvatures under the noise of
   its ball, from the level (as a standard deviation, :data:`NOISE_SIGMA_FACTOR`) and the weighted normal matrix of
   the ball's points (``sigma^2 G^-1 M G^-1``, :func:`_noise_spreads`), against the median curvedness of the
   surface: a jet spread beyond :data:`JET_NOISE_REACH` of it takes a quadric over the same ball, and a vertex
@@ -203,8 +203,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
     sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
     reach = (vertices, start, radii, referenced, facing)
-    curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
-    unsure = _noise_reach(reach, sigmas, curvatures, fields, given=radius is not None)
+    unsure = np.zeros(n, dtype=bool)
+    if radius is not None:  # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate
+        curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
+        unsure = _noise_reach(reach, sigmas, curvatures, fields)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -421,7 +423,7 @@ def _curvature_scales(curvedness: np.ndarray, groups: list, vertices: np.ndarray
     return scales
 
 
-def _noise_reach(reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, fields: tuple, given: bool) -> np.ndarray:
+def _noise_reach(reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, fields: tuple) -> np.ndarray:
     """(V,) bool: the vertices whose ball cannot hold a fit against its noise (their coefficients made NaN).
 
     ``reach = (vertices, start, radii, referenced, facing)``; ``fields = (six, fitted, coefficients)``, changed in
@@ -429,9 +431,10 @@ def _noise_reach(reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, field
     (``sigmas``, :func:`_noise_sigmas`; :func:`_noise_spreads`, :data:`meshcurv.jets.DEGREE`: a fit of lower degree over
     the same ball spreads less) is held to :data:`JET_NOISE_REACH` of ``curvatures`` (:func:`_curvature_scales`):
     beyond it the vertex takes a quadric's fit over the same ball (:data:`STEADY_DEGREE`) if that one's spread is
-    within :data:`NOISE_REACH` of them, else (``given``: a radius given by the caller) is NaN with
-    ``valid=False``; at the default radius, grown with the noise (:func:`meshcurv.radius.jet_vertex_radii`),
-    the quadric is kept. A ball of few points (a given radius of an edge length or two)
+    within :data:`NOISE_REACH` of them, else is NaN with ``valid=False``. Called at a given radius only: the
+    default one grows with the noise (:func:`meshcurv.radius.jet_vertex_radii`), and on the coarsest clean
+    ellipsoid of ``benchmarks/accuracy.py --quick`` (levels of its fits' bias up to 0.02) the swap doubled the
+    median H error (1.9% -> 3.6%). A ball of few points (a given radius of an edge length or two)
     lets every fit follow the noise, the quadric as well as the jet, so that the two agree and the check of
     :func:`_steady_fits` passes them (issue 29: faces detached by 0.08 edge lengths, H off by up to 1.65 on a
     unit sphere at a radius of one edge length)."""
@@ -448,12 +451,9 @@ def _noise_reach(reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, field
     rows, unit = rows[loose], unit[loose]
     if rows.size == 0:
         return unsure
-    if given:
-        low = _noise_spreads(ball, rows, unit, sigmas, STEADY_DEGREE)
-        steady = low <= NOISE_REACH * curvatures[rows]
-        unsure[rows[~steady]] = True
-    else:
-        steady = np.ones(rows.size, dtype=bool)
+    low = _noise_spreads(ball, rows, unit, sigmas, STEADY_DEGREE)
+    steady = low <= NOISE_REACH * curvatures[rows]
+    unsure[rows[~steady]] = True
     rows, unit = rows[steady], unit[steady]
     if rows.size:
         found, frame, _ = _fit_jets(
