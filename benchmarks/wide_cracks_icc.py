@@ -70,18 +70,19 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", default="0-9", help="seeds, as 0-9 or 1,5,7 (default: %(default)s)")
     parser.add_argument("--wide", type=float, default=1.0, help="share of the draws with wide cracks")
-    parser.add_argument("--shapes", default=None, help="comma-separated names of bases() (default: all)")
+    parser.add_argument("--shapes", default=None, help="names of bases() separated by ';' (default: all)")
     parser.add_argument("--share", type=float, default=None, help="the share of the faces detached (default: drawn)")
     parser.add_argument("--radius-edges", type=float, default=None, help="a given radius, in median edge lengths")
     parser.add_argument("--list", action="store_true", help="list every valid vertex off (draw, row, H, exact)")
     options = parser.parse_args(argv)
     chosen = bases()
     if options.shapes:
-        chosen = {name: chosen[name] for name in options.shapes.split(",")}
+        chosen = {name: chosen[name] for name in options.shapes.split(";")}
     print("| mesh | draws | valid | off exact | off clean | max error / max abs k | CPU s |")
     print("|---|--:|--:|--:|--:|--:|--:|")
     totals = np.zeros(4, dtype=np.int64)
-    for index, (name, make) in enumerate(chosen.items()):
+    for name, make in chosen.items():
+        index = list(bases()).index(name)  # (the draws of a shape do not depend on the others chosen)
         mesh = make()
         base, base_faces = np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)
         exact_h = 0.5 * (np.asarray(mesh.k_min) + np.asarray(mesh.k_max))

@@ -361,7 +361,9 @@ def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjac
     detached by 0.065 edge lengths: fitted normals 13.5 degrees off the sphere's at the median, 2.5 intact, and H
     of 0.35-0.85 for 1 at 10 of 59 valid vertices; with the exact normals the same sums give 1 to 0.004). Those
     fits are made again over balls :data:`UNWRAP_SHRINK` times smaller, at most :data:`UNWRAP_STEPS` times (one
-    still wrapped keeps its first fit). A cubic over fewer than :data:`FEW_POINTS` points (a strip between
+    still wrapped keeps its first fit, and so does one left with fewer than :data:`FEW_POINTS` points unless the
+    quadric over them disagrees: on the coarse torus of ``benchmarks/wide_cracks_icc.py``, 16 edges around its
+    tube, cubics over half of a wrapped ball read H 0.007 for 0.06 at vertices left with one or two faces). A cubic over fewer than :data:`FEW_POINTS` points (a strip between
     cracks) gives way to the quadric over them where the two disagree (:data:`FEW_AGREEMENT`).
     """
     n = vertices.shape[0]
@@ -396,8 +398,8 @@ def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjac
         with np.errstate(invalid="ignore"):
             wrapped = away > AWAY_FRACTION
         few = ~wrapped & (counts < FEW_POINTS)
-        if step:  # (the first fits are those given; a ball still wrapped keeps them)
-            fitted[centres[~wrapped]] = found[~wrapped]
+        if step:  # (the first fits are those given; a ball still wrapped, or left with few points, keeps them)
+            fitted[centres[~wrapped & ~few]] = found[~wrapped & ~few]
         if few.any():  # a cubic through a dozen points of a lopsided ball: its slope can be the noise of the fit
             lower = fit(centres[few], radii[few], FEW_DEGREE)[0]
             with np.errstate(invalid="ignore"):
