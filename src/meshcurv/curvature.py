@@ -16,10 +16,11 @@ from .estimators import DEFAULT_METHOD, ESTIMATORS
 from .estimators._support import ProgressCallback, Stages
 from .estimators.icc import voxel_pilot
 from .radius import (
+    VoxelReading,
     _checked_radii,
-    _mesh_voxel_grid,
     _notes_by_radius,
     _small_radius_note,
+    _voxel_surface_grid,
     _voxel_surface_radius,
 )
 from .result import CurvatureResult
@@ -213,15 +214,16 @@ def _computed(vertices, faces, estimator, options: dict, orient: str, weld, prog
     """``(result, message)`` of :func:`principal_curvatures`, its options checked."""
     mesh = prepare_mesh(vertices, faces, orient=orient, weld=weld, stacklevel=4)
     found: dict = {}
+    stages = Stages(estimator.stages, progress)  # stages.voxel: the mesh's voxel grid, read once for the call
     if "radius" in options and options["radius"] is None:
-        voxel = _voxel_surface_radius(mesh, voxel_pilot(mesh))  # one default for every ball method
+        voxel = _voxel_surface_radius(mesh, voxel_pilot(mesh), stages.voxel)  # one default for every ball method
         if voxel is not None:
             options["radius"], found = voxel
             vertex_scale = found.pop("vertex_scale", None)  # icc: each vertex at its own scale (issue 30)
             if estimator.name == "icc":
                 options["vertex_scale"] = vertex_scale
-    result, problems = estimator.function(mesh, stages=Stages(estimator.stages, progress), **options)
-    note = _staircase_note(mesh, estimator.name, found, result)
+    result, problems = estimator.function(mesh, stages=stages, **options)
+    note = _staircase_note(mesh, estimator.name, found, result, stages.voxel)
     return _finished(
         mesh,
         estimator,
@@ -232,14 +234,15 @@ def _computed(vertices, faces, estimator, options: dict, orient: str, weld, prog
     )
 
 
-def _staircase_note(mesh, method: str, found: dict, result: CurvatureResult) -> str:
+def _staircase_note(mesh, method: str, found: dict, result: CurvatureResult, reading: VoxelReading) -> str:
     """The warning's sentence for a method that reads the staircase of a voxel surface, else ''.
 
     The methods over a ring of faces (:data:`RING_METHODS`) on a mesh whose vertices lie on a voxel grid (read
     as for the default radius, :func:`meshcurv.radius.voxel_surface_radius`), and ``quadric`` at the default
     radius of a voxel surface (``found``: what that default was derived from), whose jets of degree 4 follow
     the staircase there. A ring method that left every vertex undefined there (``rusinkiewicz`` and ``meyer``
-    always, ``normal_cycle`` below the smoothing the staircase needs) is said to have done so.
+    always, ``normal_cycle`` below the smoothing the staircase needs) is said to have done so. ``reading``: the
+    call's grid (:class:`meshcurv.radius.VoxelReading`), read by the estimator or now.
     """
     parameters = result.parameters
     if method == "quadric" and found.get("surface") == "voxel":
@@ -252,7 +255,7 @@ def _staircase_note(mesh, method: str, found: dict, result: CurvatureResult) -> 
         )
     if method not in RING_METHODS:
         return ""
-    spacing = _voxel_spacing(mesh)
+    spacing = _voxel_spacing(mesh, reading)
     if spacing is None:
         return ""
     effect = (
@@ -267,14 +270,14 @@ def _staircase_note(mesh, method: str, found: dict, result: CurvatureResult) -> 
     )
 
 
-def _voxel_spacing(mesh) -> tuple | None:
+def _voxel_spacing(mesh, reading: VoxelReading) -> tuple | None:
     """The voxel size of a mesh whose vertices (but the needle vertices) lie on a voxel grid, else None.
 
-    The grid is read as for the default radius of a voxel surface (:func:`meshcurv.radius._mesh_voxel_grid`),
-    without its pilot pass.
+    The grid is read as for the default radius of a voxel surface (:func:`meshcurv.radius._voxel_surface_grid`,
+    the mesh's own), without its pilot pass.
     """
-    grid = _mesh_voxel_grid(mesh)
-    return None if grid is None else tuple(float(x) for x in grid.spacing)
+    found = _voxel_surface_grid(mesh, reading=reading)
+    return None if found is None else tuple(float(x) for x in found[0].spacing)
 
 
 def _shown(spacing) -> str:

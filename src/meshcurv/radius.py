@@ -689,16 +689,21 @@ def voxel_surface_radius(
 
 
 def _voxel_surface_radius(
-    mesh: _Measured | PreparedMesh, pilot: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+    mesh: _Measured | PreparedMesh,
+    pilot: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]],
+    reading: VoxelReading | None = None,
 ) -> tuple[float, dict] | None:
+    """:func:`voxel_surface_radius` of a measured or prepared mesh; ``reading``: the call's
+    :class:`VoxelReading`, which keeps the mesh's grid for the later readers of the call."""
     vertices, topology = mesh.vertices, mesh.topology
     # a spike is on no grid (issue 29: one flung to 1e22 made a voxel sphere an ordinary mesh, radius 1.4x), and
     # is in no extent, area or percentile below: the needles' vertices and faces are left out everywhere
     spikes = mesh.needles
     referenced = topology.referenced_vertices & ~spikes
-    grid = _mesh_voxel_grid(mesh)
-    if grid is None:
+    on_grid = _voxel_surface_grid(mesh, reading=reading)
+    if on_grid is None:
         return None
+    grid = on_grid[0]
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
     curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
     curved = np.isfinite(curvedness) & (curvedness > VOXEL_FLAT_CURVEDNESS / float(np.max(grid.spacing)))
@@ -781,27 +786,98 @@ def _subset_voxel_grid(mesh: _Measured | PreparedMesh, faces: np.ndarray, used: 
     return grid
 
 
-def _valid_voxel_grid(mesh: PreparedMesh, invalid: np.ndarray) -> tuple[VoxelGrid, np.ndarray] | None:
-    """``(grid, used)``: the voxel grid of the mesh (:func:`_mesh_voxel_grid`; ``used`` its referenced vertices), or
-    that of its faces with a corner not ``invalid`` ((V,) bool; ``used`` their corners): the cells of the valid
-    vertices, where faces detached off the grid (a triangle soup beside it, cracks beyond the weld: fuzz_api seed
-    322, case 407) leave the rest on it; None where neither is on a grid."""
-    grid = _mesh_voxel_grid(mesh)
+#: A coordinate repeated by this many vertices is a plane of a grid (``meshcurv.lattice``'s reading), for
+#: :func:`_grid_part`.
+GRID_PLANE_VERTICES = 3
+
+#: The share of the valid vertices that must have two coordinates on such planes for :func:`_grid_part`.
+GRID_PART_SHARE = 0.5
+
+
+class VoxelReading:
+    """The voxel grid of one call's mesh (:func:`_mesh_voxel_grid`), read at its first use and kept for the call's
+    later readers (the default radius, the estimator, the warning's sentence on the staircase): one reading a call.
+
+    :class:`meshcurv.estimators._support.Stages` carries one (``stages.voxel``) from
+    :func:`meshcurv.curvature.principal_curvatures` to the estimator and back.
+    """
+
+    def __init__(self) -> None:
+        self._mesh: object = None
+        self._grid: VoxelGrid | None = None
+
+    def mesh_grid(self, mesh: _Measured | PreparedMesh) -> VoxelGrid | None:
+        """The grid of ``mesh`` (:func:`_mesh_voxel_grid`), read once (again for another mesh)."""
+        if self._mesh is not mesh:
+            self._grid, self._mesh = _mesh_voxel_grid(mesh), mesh
+        return self._grid
+
+
+def _voxel_surface_grid(
+    mesh: _Measured | PreparedMesh,
+    *,
+    invalid: np.ndarray | None = None,
+    valid: np.ndarray | None = None,
+    reading: VoxelReading | None = None,
+) -> tuple[VoxelGrid, np.ndarray] | None:
+    """``(grid, used)``: the one reading of "this mesh is a voxel surface" that every method makes, or None.
+
+    The grid is, in this order, the first found of:
+
+    1. the mesh's (:func:`_mesh_voxel_grid`: but its needles, or without its fragments; ``used`` its referenced
+       vertices), kept by ``reading`` (:class:`VoxelReading`) for the call's other readers;
+    2. with ``invalid`` ((V,) bool): that of its faces with a corner not ``invalid`` (``used`` their corners): the
+       cells of the valid vertices, where faces detached off the grid (a triangle soup beside it, cracks beyond
+       the weld: fuzz_api seed 322, case 407) leave the rest on it;
+    3. with ``valid`` ((V,) bool): that of the ``valid`` vertices on the grid's planes (:func:`_grid_part`): faces
+       detached off a voxel surface and welded to each other, whose faces read no grid.
+
+    The default radius and the staircase's warning read 1; the ring methods' staircase rules 1-2;
+    ``normal_cycle_ball``'s holes in the staircase 1-3.
+    """
+    grid = _mesh_voxel_grid(mesh) if reading is None else reading.mesh_grid(mesh)
     if grid is not None:
         return grid, mesh.topology.referenced_vertices
-    faces = mesh.topology.faces[~invalid[mesh.topology.faces].all(axis=1)]
-    if faces.shape[0] == 0:
+    if invalid is not None:
+        faces = mesh.topology.faces[~invalid[mesh.topology.faces].all(axis=1)]
+        if faces.shape[0]:
+            used = np.zeros(mesh.vertices.shape[0], dtype=bool)
+            used[faces] = True
+            grid = _subset_voxel_grid(mesh, faces, used)
+            if grid is not None:
+                return grid, used
+    return None if valid is None else _grid_part(mesh.vertices, valid)
+
+
+def _grid_part(vertices: np.ndarray, valid: np.ndarray) -> tuple[VoxelGrid, np.ndarray] | None:
+    """``(grid, on_planes)``: the grid (:func:`meshcurv.lattice.voxel_grid`) of the ``valid`` vertices ((V,) bool)
+    with two coordinates repeated by :data:`GRID_PLANE_VERTICES` vertices or more, where they are at least
+    :data:`GRID_PART_SHARE` of them; else None. Faces detached off a voxel surface by cracks beyond the weld and
+    welded to each other leave valid vertices off the grid, too many for the mesh's reading (fuzz_api seed
+    480, case 968: 97 of 258 valid vertices; a voxel sphere of radius 4 with half its faces detached by 0.06
+    voxels: 71 of 326 valid vertices off the clean surface's H by more than half its largest curvature).
+    """
+    repeated = np.zeros(vertices.shape[0], dtype=int)
+    for k in range(3):
+        _, inverse, counts = np.unique(vertices[:, k], return_inverse=True, return_counts=True)
+        repeated += counts[inverse] >= GRID_PLANE_VERTICES
+    on_planes = valid & (repeated >= 2)
+    if on_planes.sum() < GRID_PART_SHARE * valid.sum():
         return None
-    used = np.zeros(mesh.vertices.shape[0], dtype=bool)
-    used[faces] = True
-    grid = _subset_voxel_grid(mesh, faces, used)
-    return None if grid is None else (grid, used)
+    grid = voxel_grid(vertices[on_planes])
+    return None if grid is None else (grid, on_planes)
 
 
-def _voxel_surface(mesh: PreparedMesh, invalid: np.ndarray) -> bool:
-    """Whether the mesh is a voxel surface, or its faces with a corner not ``invalid`` are
-    (:func:`_valid_voxel_grid`)."""
-    return _valid_voxel_grid(mesh, invalid) is not None
+def _voxel_surface(
+    mesh: PreparedMesh,
+    invalid: np.ndarray,
+    *,
+    valid: np.ndarray | None = None,
+    reading: VoxelReading | None = None,
+) -> bool:
+    """Whether the mesh is a voxel surface, or its faces with a corner not ``invalid`` are, or (with ``valid``)
+    most of its valid vertices lie on a grid (:func:`_voxel_surface_grid`)."""
+    return _voxel_surface_grid(mesh, invalid=invalid, valid=valid, reading=reading) is not None
 
 
 def _off_grid_scale(scales: np.ndarray, spacing: np.ndarray) -> bool:

@@ -8,7 +8,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..defects import VertexDefects
-from ..radius import _voxel_surface
+from ..radius import VoxelReading, _voxel_surface
 from ..result import CurvatureResult
 
 logger = logging.getLogger("meshcurv")
@@ -26,11 +26,18 @@ class Stages:
         The stages, in order.
     progress : callable, optional
         Called as ``progress(stage, index, total)`` when each stage starts.
+
+    Attributes
+    ----------
+    voxel : VoxelReading
+        The call's reading of its mesh's voxel grid (:class:`meshcurv.radius.VoxelReading`), made once and handed
+        from the default radius to the estimator and to the warning's sentence on the staircase.
     """
 
     def __init__(self, names, progress: ProgressCallback | None = None):
         self.names = tuple(names)
         self.progress = progress
+        self.voxel = VoxelReading()
 
     def start(self, name: str) -> None:
         index = self.names.index(name) + 1
@@ -154,7 +161,9 @@ def finish(
     return result, problems(defects, valid, extra)
 
 
-def staircase_undefined(mesh, defects: VertexDefects, valid: np.ndarray) -> tuple[np.ndarray, tuple[str, ...]]:
+def staircase_undefined(
+    mesh, defects: VertexDefects, valid: np.ndarray, *, stages: Stages | None = None
+) -> tuple[np.ndarray, tuple[str, ...]]:
     """``(valid, extra)`` of a method over a ring of faces with no scale (``rusinkiewicz``, ``meyer``): on a voxel
     surface (:func:`meshcurv.radius._voxel_surface`) every vertex undefined, with the phrase that counts them.
 
@@ -162,9 +171,11 @@ def staircase_undefined(mesh, defects: VertexDefects, valid: np.ndarray) -> tupl
     voxel meshes of ``benchmarks/voxel_ring_methods.md`` 55-95% of ``rusinkiewicz``'s valid vertices and 80-100%
     of ``meyer``'s were off the exact H by more than half of the largest ``|k|`` (median errors 77-1130%), every
     one of them valid (issue 29: never a valid wrong number). Neither has a scale to grow; the call's warning
-    names the methods whose balls are scaled to the voxels (:func:`meshcurv.curvature._staircase_note`).
+    names the methods whose balls are scaled to the voxels (:func:`meshcurv.curvature._staircase_note`), which
+    takes the grid read here from ``stages`` (:class:`Stages`; read again without it).
     """
-    if not valid.any() or not _voxel_surface(mesh, defects.invalid_vertices):
+    reading = None if stages is None else stages.voxel
+    if not valid.any() or not _voxel_surface(mesh, defects.invalid_vertices, reading=reading):
         return valid, ()
     return np.zeros_like(valid), (f"{int(valid.sum())} vertices of this voxel surface are NaN (estimate undefined)",)
 

@@ -74,7 +74,7 @@ from .._backend import kernel_threads, numba_kernels
 from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles, median_edge_length
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
-from ..radius import _ring_max, _valid_voxel_grid, _voxel_surface
+from ..radius import VoxelReading, _ring_max, _voxel_surface_grid
 from ._support import Stages, finish
 
 #: On a voxel surface the smoothing must reach ``VOXEL_RING_GAIN sqrt(h R)`` (:func:`voxel_steps_needed`).
@@ -127,18 +127,22 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         rotate=True,
         mean_from_trace=True,
     )
-    return _finished(mesh, defects, valid, smoothing_steps, normals, k_min, k_max, dir_min, dir_max)
+    curvatures = (k_min, k_max, dir_min, dir_max)
+    return _finished(mesh, defects, valid, smoothing_steps, stages.voxel, normals, *curvatures)
 
 
-def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: int, normals, *curvatures):
+def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: int, reading: VoxelReading, *fields):
     """:func:`finish` of the result, but on a voxel surface without the vertices whose smoothing region (the
     vertices within ``smoothing_steps`` edges) holds an invalid vertex, with the warning's phrase for them.
 
     The smoothing sums the cells of the valid vertices only; on a voxel staircase a region without some of its
-    cells reads a part of the staircase, not the surface (the module's Notes). Other meshes: unchanged.
+    cells reads a part of the staircase, not the surface (the module's Notes). Other meshes: unchanged. The grid is
+    read once (:func:`meshcurv.radius._voxel_surface_grid`, the mesh's own kept by ``reading`` for the call's
+    warning); ``fields``: the normals and the curvatures.
     """
     invalid, note = defects.invalid_vertices, ""
-    needed = voxel_steps_needed(mesh, invalid) if valid.any() else 0
+    grid = _voxel_surface_grid(mesh, invalid=invalid, reading=reading) if valid.any() else None
+    needed = _steps_on_grid(mesh, grid)
     if smoothing_steps < needed:
         note = (
             f"{int(valid.sum())} vertices of this voxel surface are NaN (estimate undefined): normal_cycle measures "
@@ -147,7 +151,7 @@ def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: i
             f"'normal_cycle_ball', whose balls are scaled to the voxels, or smoothing_steps={needed} or more"
         )
         valid = np.zeros_like(valid)
-    elif smoothing_steps > 0 and invalid.any() and valid.any() and _voxel_surface(mesh, invalid):
+    elif smoothing_steps > 0 and invalid.any() and grid is not None:
         cut = valid & (_ring_max(mesh.topology.neighbour_lists, smoothing_steps, invalid.astype(np.float64)) > 0)
         if cut.any():
             valid = valid & ~cut
@@ -156,7 +160,7 @@ def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: i
                 f"region ({smoothing_steps} rings) holds a boundary or a defect, and a part of the staircase does "
                 f"not average out"
             )
-    k_min, k_max, dir_min, dir_max = curvatures
+    normals, k_min, k_max, dir_min, dir_max = fields
     parameters = {"smoothing_steps": smoothing_steps}
     return finish("normal_cycle", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra=(note,))
 
@@ -176,12 +180,17 @@ def voxel_steps_needed(mesh: PreparedMesh, invalid: np.ndarray) -> int:
     ``voxel_sphere(20)`` in 4 x 1 x 1 voxels 63 / 34 / 17 / 5.3 / 0.9% (needed: 231).
 
     The grid is the mesh's, or that of its faces with a corner not ``invalid`` ((V,) bool; faces detached off the
-    grid leave the rest on it: :func:`meshcurv.radius._valid_voxel_grid`).
+    grid leave the rest on it: :func:`meshcurv.radius._voxel_surface_grid`).
     """
-    topology = mesh.topology
-    found = _valid_voxel_grid(mesh, invalid)
+    return _steps_on_grid(mesh, _voxel_surface_grid(mesh, invalid=invalid))
+
+
+def _steps_on_grid(mesh: PreparedMesh, found) -> int:
+    """:func:`voxel_steps_needed` of the grid found (``(grid, used)`` of
+    :func:`meshcurv.radius._voxel_surface_grid`, or None: 0)."""
     if found is None:
         return 0
+    topology = mesh.topology
     grid, on_grid = found
     spacing = np.asarray(grid.spacing, dtype=np.float64)
     used = mesh.vertices[on_grid]
@@ -225,4 +234,5 @@ def _estimate_compiled(kernels, mesh: PreparedMesh, smoothing_steps: int, stages
     k_min, k_max, dir_min, dir_max, normals, valid = kernels.normal_cycle_finish(
         sums, defects.invalid_vertices, indptr, indices, smoothing_left
     )
-    return _finished(mesh, defects, valid, smoothing_steps, normals, k_min, k_max, dir_min, dir_max)
+    curvatures = (k_min, k_max, dir_min, dir_max)
+    return _finished(mesh, defects, valid, smoothing_steps, stages.voxel, normals, *curvatures)

@@ -70,8 +70,7 @@ import numpy as np
 from .._tensors import outer6, principal_from_shape_operator
 from .._geometry import edge_dihedral_angles
 from ..neighborhoods import _ball_edge_sums, _candidate_pairs
-from ..lattice import voxel_grid
-from ..radius import _component_radii, _resolve_radius, _vertex_radii, _voxel_surface
+from ..radius import VoxelReading, _component_radii, _resolve_radius, _vertex_radii, _voxel_surface
 from .._prepared import PreparedMesh
 from ._support import Stages, ball_holds_neighbours, finish
 
@@ -229,7 +228,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # a ball that holds none of the vertex's neighbours holds only its own corner: the polyhedron's cone at
     # the vertex, not the surface (a given radius far below the edges; issue 29): undefined
     valid &= ball_holds_neighbours(vertices, topology.edges, radii) & (radii >= MIN_RADIUS_SCALES * mesh.length_scales)
-    holed = _voxel_holed_balls(mesh, holes, groups, valid) & valid
+    holed = _voxel_holed_balls(mesh, holes, groups, valid, stages.voxel) & valid
     valid &= ~holed
     with np.errstate(invalid="ignore", divide="ignore"):
         tensors = measures / areas[:, None]
@@ -252,45 +251,21 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     return finish("normal_cycle_ball", parameters, valid, normals, *curvatures, defects, extra=(note,), radius=radii)
 
 
-def _voxel_holed_balls(mesh: PreparedMesh, holes: np.ndarray, groups: list, valid: np.ndarray) -> np.ndarray:
+def _voxel_holed_balls(
+    mesh: PreparedMesh, holes: np.ndarray, groups: list, valid: np.ndarray, reading: VoxelReading
+) -> np.ndarray:
     """(V,) bool: on a voxel surface, the vertices whose ball holds a part of an edge of a hole (``holes``, (E,)
     bool, :func:`hole_edges`); all False on other meshes (the module's Notes). A voxel surface: the mesh, or the
-    faces around its vertices free of defects and boundaries (:func:`meshcurv.radius._voxel_surface`), or the
-    ``valid`` vertices whose coordinates repeat (:func:`_grid_part`)."""
+    faces around its vertices free of defects and boundaries, or most of the ``valid`` vertices, on a grid
+    (:func:`meshcurv.radius._voxel_surface_grid`, the mesh's grid kept by ``reading``)."""
     vertices, edges = mesh.vertices, mesh.topology.edges
     holed = np.zeros(vertices.shape[0], dtype=bool)
     if not holes.any():
         return holed
-    if not _voxel_surface(mesh, mesh.defects().invalid_vertices) and not _grid_part(mesh, valid):
+    if not _voxel_surface(mesh, mesh.defects().invalid_vertices, valid=valid, reading=reading):
         return holed
     ones = np.ones((edges.shape[0], 1))
     for group_radius, members in groups:
         rows = slice(None) if members is None else members
         holed[rows] = _ball_edge_sums(vertices, edges, group_radius, ones, usable=holes)[rows, 0] > 0
     return holed
-
-
-#: A coordinate repeated by this many vertices is a plane of a grid (``meshcurv.lattice``'s reading).
-GRID_PLANE_VERTICES = 3
-
-#: The share of the valid vertices that must have two coordinates on such planes for :func:`_grid_part`.
-GRID_PART_SHARE = 0.5
-
-
-def _grid_part(mesh: PreparedMesh, valid: np.ndarray) -> bool:
-    """Whether most ``valid`` vertices ((V,) bool) lie on a voxel grid: those with two coordinates repeated by
-    :data:`GRID_PLANE_VERTICES` vertices or more, at least :data:`GRID_PART_SHARE` of them, on one grid
-    (:func:`meshcurv.lattice.voxel_grid`). Faces detached off a voxel surface by cracks beyond the weld and
-    welded to each other leave valid vertices off the grid, too many for the mesh's reading (fuzz_api seed
-    480, case 968: 97 of 258 valid vertices; a voxel sphere of radius 4 with half its faces detached by 0.06
-    voxels: 71 of 326 valid vertices off the clean surface's H by more than half its largest curvature).
-    """
-    vertices = mesh.vertices
-    repeated = np.zeros(vertices.shape[0], dtype=int)
-    for k in range(3):
-        _, inverse, counts = np.unique(vertices[:, k], return_inverse=True, return_counts=True)
-        repeated += counts[inverse] >= GRID_PLANE_VERTICES
-    on_planes = valid & (repeated >= 2)
-    if on_planes.sum() < GRID_PART_SHARE * valid.sum():
-        return False
-    return voxel_grid(vertices[on_planes]) is not None
