@@ -85,7 +85,7 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
         if needles.any()
         else ()
     )
-    valid, staircase = staircase_undefined(mesh, defects, valid)
+    valid, staircase = staircase_undefined(mesh, defects, valid, stages=stages)
     return finish(
         "meyer", {}, valid, normals, k_min, k_max, directions, directions.copy(), defects, (*extra, *staircase)
     )

@@ -286,5 +286,5 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
     k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
         np.where(valid[:, None], shape_operator, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     )
-    valid, staircase = staircase_undefined(mesh, defects, valid)
+    valid, staircase = staircase_undefined(mesh, defects, valid, stages=stages)
     return finish("rusinkiewicz", {}, valid, normals, k_min, k_max, dir_min, dir_max, defects, staircase)
