@@ -139,7 +139,8 @@ def test_detached_faces_given_radius():
     # the same meshes at a given radius of 2.2 median edge lengths (296/1682's): the radius stays, the balls of
     # the noisy mesh are checked against a quadric (also those whose own level reads below the gate: 296/1682's
     # vertex, H 1.58 for 0.99, read 0.012 where the mesh's median is 0.023): 67 valid vertices off H = 1 by more
-    # than half of it in the four draws before (up to 1.83), 20 now (up to 1.31), cover unchanged
+    # than half of it in the four draws before (up to 1.83), 20 after the gate (up to 1.31); since W19's noise
+    # reach (quadric.NOISE_REACH) none, the balls too small for their noise NaN (cover 73-83% -> 31-40%)
     mesh = shapes.random_sphere(500)
     edge = float(np.median(np.linalg.norm(mesh.vertices[mesh.faces[:, 0]] - mesh.vertices[mesh.faces[:, 1]], axis=1)))
     off = 0
@@ -148,8 +149,8 @@ def test_detached_faces_given_radius():
         result = quadric(vertices, faces, radius=2.2 * edge)
         np.testing.assert_array_equal(result.radius, 2.2 * edge)
         off += int((np.abs(result.mean[result.valid] - 1.0) > 0.5).sum())
-        assert result.valid.mean() > 0.7
-    assert off <= 35
+        assert result.valid.mean() > 0.25
+    assert off == 0
 
 
 def test_local_noise_reads_a_noisy_patch():
