@@ -52,7 +52,8 @@ def test_each_scale_equals_the_single_call(name, method):
         np.testing.assert_array_equal(result.valid, single.valid)
         np.testing.assert_array_equal(result.invalid_reason, single.invalid_reason)
         assert result.parameters == single.parameters
-        scale = np.nanmax(np.abs(single.k_max))
+        # (quadric at 1.5 h on the noisy sphere: every ball too small for its noise, all NaN on both)
+        scale = np.nanmax(np.abs(single.k_max)) if np.isfinite(single.k_max).any() else 1.0
         # the same faces and shares summed in another order (one walk for every radius): round-off
         for field in ("k_min", "k_max", "mean", "gaussian"):
             np.testing.assert_allclose(

@@ -219,6 +219,7 @@ def _computed(vertices, faces, estimator, options: dict, orient: str, weld, prog
         voxel = _voxel_surface_radius(mesh, voxel_pilot(mesh), stages.voxel)  # one default for every ball method
         if voxel is not None:
             options["radius"], found = voxel
+            stages.voxel_default = True
             vertex_scale = found.pop("vertex_scale", None)  # icc: each vertex at its own scale (issue 30)
             if estimator.name == "icc":
                 options["vertex_scale"] = vertex_scale

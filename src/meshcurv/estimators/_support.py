@@ -32,12 +32,16 @@ class Stages:
     voxel : VoxelReading
         The call's reading of its mesh's voxel grid (:class:`meshcurv.radius.VoxelReading`), made once and handed
         from the default radius to the estimator and to the warning's sentence on the staircase.
+    voxel_default : bool
+        True when the ``radius`` handed to the estimator is the default of a voxel surface
+        (:func:`meshcurv.radius.voxel_surface_radius`), not one the caller gave.
     """
 
     def __init__(self, names, progress: ProgressCallback | None = None):
         self.names = tuple(names)
         self.progress = progress
         self.voxel = VoxelReading()
+        self.voxel_default = False
 
     def start(self, name: str) -> None:
         index = self.names.index(name) + 1

@@ -204,7 +204,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
     reach = (vertices, start, radii, referenced, facing)
     unsure = np.zeros(n, dtype=bool)
-    if radius is not None:  # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate
+    # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate; a voxel surface's
+    # default (stages.voxel_default) is not checked either: its staircase reads as noise at every ball of the voxel
+    # default (two voxel spheres and a quantised ellipsoid left with no valid vertex; the warning names 'icc')
+    if radius is not None and not stages.voxel_default:
         curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
         unsure = _noise_reach(reach, sigmas, curvatures, fields)
     six, fitted, coefficients = fields
