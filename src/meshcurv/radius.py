@@ -343,26 +343,34 @@ def noise_level(
     return _noise_level(vertices, normals, valid, edges, neighbours=neighbours, adjacency=adjacency)
 
 
-def _noise_level(vertices, normals, valid, edges, *, neighbours=None, adjacency=None, local=None) -> float:
+def _noise_level(
+    vertices, normals, valid, edges, *, neighbours=None, adjacency=None, local=None, fits: list | None = None
+) -> float:
     """:func:`noise_level` of checked arrays: (V, 3) float64 ``vertices`` and ``normals``, (V,) bool ``valid``
     (and ``neighbours``), (E, 2) int64 ``edges`` in range; ``local``: the (V,) mean length of the ``edges`` at
-    each vertex, when the caller has it."""
+    each vertex, when the caller has it; ``fits``: a list to which ``(centres, offsets, curvedness)`` (M,) of the
+    fits are appended (:func:`_noise_fits`, signed; NaN where no jet was fitted)."""
     local = vertex_edge_lengths(vertices, edges, vertices.shape[0]) if local is None else local
     centres = np.flatnonzero(valid & (local > 0))
     if centres.size > NOISE_SAMPLE:
         centres = centres[np.linspace(0, centres.size - 1, NOISE_SAMPLE).round().astype(np.int64)]
     if centres.size == 0:
         return 0.0
-    distances, _ = _noise_fits(vertices, normals, centres, local[centres], neighbours=neighbours, adjacency=adjacency)
-    distances = distances[np.isfinite(distances)]
+    offsets, curvedness = _noise_fits(
+        vertices, normals, centres, local[centres], neighbours=neighbours, adjacency=adjacency, signed=True
+    )
+    if fits is not None:  # each centre's own offset and curvedness, for the noisy patches (:func:`_patch_radii`)
+        fits.append((centres, offsets, curvedness))
+    distances = np.abs(offsets[np.isfinite(offsets)])
     return float(np.median(distances)) if distances.size else 0.0
 
 
-def _noise_fits(vertices, normals, centres, scale, *, neighbours=None, adjacency=None, facing=None):
+def _noise_fits(vertices, normals, centres, scale, *, neighbours=None, adjacency=None, facing=None, signed=False):
     """``(distances, curvedness)`` (M,): the fits of :func:`noise_level` at ``centres`` (M,) of local edge lengths
     ``scale`` (M,): each vertex's distance to its degree-2 jet in the mean edge length of its class, and the jet's
     ``sqrt(k_1^2 + k_2^2)`` (the norm of its Hessian); NaN where no jet was fitted (``facing``: the check of
-    :func:`meshcurv.jets.fit_jets`)."""
+    :func:`meshcurv.jets.fit_jets`); ``signed``: the distances signed along the normals (the vertex above its jet:
+    positive)."""
     level = np.round(np.log2(scale / np.median(scale))).astype(np.int64)
     distances = np.full(centres.size, np.nan)
     curvedness = np.full(centres.size, np.nan)
@@ -382,7 +390,7 @@ def _noise_fits(vertices, normals, centres, scale, *, neighbours=None, adjacency
             facing=facing,
         )
         # the constant term is in units of the radius: NOISE_FIT_RADIUS class mean edge lengths
-        distances[members] = np.abs(coefficients[:, 0]) * NOISE_FIT_RADIUS
+        distances[members] = (coefficients[:, 0] if signed else np.abs(coefficients[:, 0])) * NOISE_FIT_RADIUS
         a, b, c = coefficients[:, 3], coefficients[:, 4], coefficients[:, 5]
         curvedness[members] = np.sqrt(4.0 * a * a + 2.0 * b * b + 4.0 * c * c) / radius
     return distances, curvedness
@@ -475,8 +483,10 @@ def _checked_fields(mesh: _Measured, valid, normals) -> tuple[np.ndarray, np.nda
 
 
 def _noise_radii(
-    mesh: _Measured | PreparedMesh, normals: np.ndarray, valid: np.ndarray, *, adjacency=None
+    mesh: _Measured | PreparedMesh, normals: np.ndarray, valid: np.ndarray, *, adjacency=None, fits=None
 ) -> tuple[list[tuple[float, np.ndarray | None]], list[float]]:
+    """:func:`noise_radii` of a measured mesh; ``fits``: a list to which each group's ``(centres, offsets,
+    curvedness)`` of its noise fits are appended (:func:`_noise_level`)."""
     vertices = mesh.vertices
     usable = _scale_vertices(mesh.topology, mesh.needles)
     centres = _scale_centres(mesh, valid, normals)
@@ -493,6 +503,7 @@ def _noise_radii(
                 neighbours=usable,
                 adjacency=adjacency,
                 local=mesh.scale_edge_means if part is None else None,  # every scale edge: the mesh's own means
+                fits=fits,
             )
             if edge_length > 0
             else 0.0
@@ -1369,3 +1380,131 @@ def _noise_rule(rule, spacing, noise):
 def cloud_radius(spacing: float, noise: float, method: str = "corrected_measures") -> float:
     """The default radius of a point cloud's ``method`` at this median ``spacing`` and ``noise`` (in spacings)."""
     return noise_rule(CLOUD_RADIUS_RULES[method], spacing, noise)
+
+
+#: A patch of a group of components noisier than the group (:func:`_patch_radii`): each vertex's noise level is
+#: the spread (standard deviation) of the noise fits' signed offsets over this many rings ...
+PATCH_RINGS = 2
+#: ... and its radius is :func:`noise_radius` of that level where it exceeds the group's by more than this factor
+#: (every clean mesh of ``benchmarks/accuracy.py --quick`` stays below it; at 1.25 the coarse irregular
+#: ellipsoid, whose fits' bias changes from vertex to vertex, grew at 59% of its vertices, p95 H error 7 -> 24%) ...
+PATCH_MARGIN = 2.0
+#: ... passing from the group's radius to it over this factor beyond the margin (continuous).
+PATCH_RAMP = 1.25
+#: ... and at most this many of its radii of curvature (``1 / c_v``, the fits' curvedness over the same vertices,
+#: noise included): a coarse clean surface's fits are biased where it bends fast, where no larger ball helps.
+PATCH_CAP = 1.0
+#: A vertex takes the largest growth within this many rings of it (its ball holds the patch's noise).
+PATCH_REACH = 1
+
+
+#: ... or, where the rings are smaller than this (walks along them: 9 at the corners of a face alone, 16 or more
+#: inside a closed mesh of valence 3 or more), over the Euclidean ball of :data:`NOISE_FIT_RADIUS` edge lengths
+#: (the noise fits' own ball).
+PATCH_LEAST = 12
+
+
+def _patch_levels(
+    vertices: np.ndarray, neighbour_lists: tuple, fits: list, edge: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(levels, curvedness)`` (V,): each vertex's noise level, the standard deviation of the signed offsets of
+    the noise fits ``fits`` (``[(centres, offsets, curvedness), ...]``, :func:`_noise_level`) within
+    :data:`PATCH_RINGS` rings, or within
+    :data:`NOISE_FIT_RADIUS` times ``edge`` (V,) of the vertex where its rings are small (:data:`PATCH_LEAST`),
+    and the root mean square of the fits' curvedness over the same vertices; NaN where no fit is.
+
+    The spread of the signed offsets, not the median distance of :func:`noise_level`: a jet's bias on a clean
+    surface (the third-order terms at a coarse ellipsoid's tips) has one sign over a region and leaves it, while
+    noise changes sign from vertex to vertex; and a noisy patch is seen where its vertices are a minority of a
+    vertex's rings (the corners of faces detached among intact ones), whose offsets the median would leave out."""
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    n_vertices = vertices.shape[0]
+    values, known = np.zeros((n_vertices, 3)), np.zeros(n_vertices)
+    for centres, offsets, curvedness in fits:
+        fitted = np.isfinite(offsets) & np.isfinite(curvedness)
+        values[centres[fitted]] = np.stack([offsets[fitted], offsets[fitted] ** 2, curvedness[fitted] ** 2], axis=1)
+        known[centres[fitted]] = 1.0
+    sums, weights, walks = _ring_sums(neighbour_lists, PATCH_RINGS, values, known, np.ones(n_vertices))
+    # (the mesh's rings, not its fits': on a mesh of more than NOISE_SAMPLE vertices few vertices are fitted)
+    sparse_rows = np.flatnonzero((walks < PATCH_LEAST) & np.isfinite(edge) & (edge > 0))
+    fitted = np.flatnonzero(known > 0)
+    if sparse_rows.size and fitted.size:
+        reach = NOISE_FIT_RADIUS * edge[sparse_rows]
+        balls = cKDTree(vertices[fitted]).query_ball_point(vertices[sparse_rows], reach)
+        counts = np.fromiter(map(len, balls), dtype=np.int64, count=sparse_rows.size)
+        members = fitted[np.concatenate(balls).astype(np.int64)] if counts.sum() else np.zeros(0, dtype=np.int64)
+        rows = np.repeat(np.arange(sparse_rows.size), counts)
+        for k in range(3):
+            sums[sparse_rows, k] = np.bincount(rows, values[members, k], minlength=sparse_rows.size)
+        weights[sparse_rows] = counts
+    with np.errstate(invalid="ignore", divide="ignore"):
+        means = sums / np.where(weights > 0, weights, 1.0)[:, None]
+        spread = np.sqrt(np.maximum(means[:, 1] - means[:, 0] ** 2, 0.0))
+    reached = weights > 0
+    return np.where(reached, spread, np.nan), np.where(reached, np.sqrt(means[:, 2]), np.nan)
+
+
+def _patch_factor(mesh: _Measured | PreparedMesh, fits: list, edge: np.ndarray, base: np.ndarray) -> np.ndarray:
+    """(V,) the factor of each vertex's radius over ``base`` (V,) from the noise ``fits`` (:func:`_patch_radii`)."""
+    local, curvedness = _patch_levels(mesh.vertices, mesh.topology.neighbour_lists, fits, edge)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wanted = edge * (1.0 + NOISE_GAIN * np.sqrt(np.maximum(local - NOISE_FLOOR, 0.0)))
+        # at most PATCH_CAP radii of curvature (the fits' curvedness, the noise's share left in: a clean surface's
+        # bias read as noise would take its own curvature away)
+        wanted = np.minimum(wanted, np.where(curvedness > 0, PATCH_CAP / curvedness, np.inf))
+        q = np.where(np.isfinite(wanted) & (base > 0), wanted / base, 1.0)
+        share = np.clip(np.log(np.maximum(q, 1.0) / PATCH_MARGIN) / np.log(PATCH_RAMP), 0.0, 1.0)
+    factor = np.where(q > PATCH_MARGIN, q**share, 1.0)
+    # a vertex beside the patch holds its noise in its ball: the largest factor within PATCH_REACH rings
+    return _ring_max(mesh.topology.neighbour_lists, PATCH_REACH, factor)
+
+
+def _patch_radii(
+    mesh: _Measured | PreparedMesh,
+    groups: list[tuple[float, np.ndarray | None]],
+    levels: list[float],
+    fits: list,
+    ratios: np.ndarray,
+    normals: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(base, radii)`` (V,): icc's default radius of each vertex without and with its noisy patch.
+
+    ``base`` is the group's radius (:func:`_noise_radii`: ``groups``, their noise ``levels`` and ``fits``) times
+    the vertex's local factor ``ratios`` (:func:`local_scale_ratios`), ``normals`` (V, 3) the vertex normals (NaN
+    where none); ``radii`` is at least ``base``: where the
+    vertex's own level (:func:`_patch_levels`) calls for a radius ``r_v`` (:func:`noise_radius`, in the group's
+    edge lengths times the local factor, at most :data:`PATCH_CAP` over the fits' curvedness; the fits within reach
+    of a patch made again without the balls that hold the other side of the surface) of ``q = r_v / base``
+    more than ``m =`` :data:`PATCH_MARGIN`, it is ``base q^t`` with ``t = clip(log(q / m) / log(p), 0, 1)``
+    (``p =`` :data:`PATCH_RAMP`: ``r_v`` from ``q = m p`` on, continuous).
+    """
+    n = mesh.vertices.shape[0]
+    base = _vertex_radii(groups, n) * ratios
+    edges = [
+        (group_radius / (1.0 + NOISE_GAIN * np.sqrt(max(level - NOISE_FLOOR, 0.0))), members)
+        for (group_radius, members), level in zip(groups, levels)
+    ]
+    edge = _vertex_radii(edges, n) * ratios
+    factor = _patch_factor(mesh, fits, edge, base)
+    if np.any(factor > 1.0):
+        # the fits within reach of a patch again, refusing a ball that holds the other side of the surface (a part
+        # thinner than the ball, whose two sides the fits read as noise: the rim of a 3 x 3 x 0.15 ellipsoid)
+        reach = _ring_max(mesh.topology.neighbour_lists, PATCH_RINGS + PATCH_REACH, (factor > 1.0).astype(np.float64))
+        refitted = []
+        for centres, offsets, curvedness in fits:
+            near = reach[centres] > 0
+            if near.any():
+                offsets, curvedness = offsets.copy(), curvedness.copy()
+                offsets[near], curvedness[near] = _noise_fits(
+                    mesh.vertices,
+                    normals,
+                    centres[near],
+                    mesh.scale_edge_means[centres[near]],
+                    neighbours=_scale_vertices(mesh.topology, mesh.needles),
+                    facing=normals,
+                    signed=True,
+                )
+            refitted.append((centres, offsets, curvedness))
+        factor = _patch_factor(mesh, refitted, edge, base)
+    return base, base * factor
