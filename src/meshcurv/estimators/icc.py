@@ -1125,9 +1125,13 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     that radius to round-off (the same faces and shares, added in another
     order): the normals are fitted at each scale (over three times each radius)
     and the balls of every radius summed in one walk of the largest
-    (:func:`meshcurv.neighborhoods.ball_face_sums_nested`).
+    (:func:`meshcurv.neighborhoods.ball_face_sums_nested`). A mesh with boundary edges is computed by
+    :func:`estimate` at each radius: its normals are fitted at every corner of a face summed and made again
+    near holes (:func:`_unwrapped_normals`), which the shared walk does not do.
     """
     vertices, topology = mesh.vertices, mesh.topology
+    if topology.boundary_edges.any():
+        return [estimate(mesh, radius=radius, stages=stages) for radius in radii]
     faces = topology.faces
     stages.start("compute normals")
     degenerate, start_normals = _dropped(mesh), mesh.vertex_normals
