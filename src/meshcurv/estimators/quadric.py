@@ -201,15 +201,14 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         if again.size:
             radii[again] = base[again]
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
-    sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
-    reach = (vertices, start, radii, referenced, facing)
     unsure = np.zeros(n, dtype=bool)
     # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate; a voxel surface's
     # default (stages.voxel_default) is not checked either: its staircase reads as noise at every ball of the voxel
     # default (two voxel spheres and a quantised ellipsoid left with no valid vertex; the warning names 'icc')
     if radius is not None and not stages.voxel_default:
+        sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
         curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
-        unsure = _noise_reach(reach, sigmas, curvatures, fields)
+        unsure = _noise_reach((vertices, start, radii, referenced, facing), sigmas, curvatures, fields)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -273,13 +272,20 @@ def _noisy_balls(levels: np.ndarray, groups: list) -> np.ndarray:
     exceeds :data:`NOISE_GATE`. A ball of a noisy mesh whose own level reads lower is no less noisy: on fuzz
     296/1682 (faces detached by 0.087 edge lengths, median level 0.023) the vertex whose jet read H 1.58 for 0.99
     read 0.012."""
-    noisy = np.isfinite(levels) & (levels > NOISE_GATE)
+    with np.errstate(invalid="ignore"):
+        return (levels > NOISE_GATE) | (_group_medians(levels, groups, np.isfinite(levels)) > NOISE_GATE)
+
+
+def _group_medians(values: np.ndarray, groups: list, usable: np.ndarray) -> np.ndarray:
+    """(V,) the median of the ``usable`` ``values`` of each vertex's group (``groups``: ``[(radius, members),
+    ...]`` of :func:`meshcurv.radius.component_radii`), NaN where its group has none."""
+    medians = np.full(values.shape, np.nan)
     for _, members in groups:
-        part = levels if members is None else levels[members]
-        part = part[np.isfinite(part)]
-        if part.size and np.median(part) > NOISE_GATE:
-            noisy[slice(None) if members is None else members] = True
-    return noisy
+        rows = slice(None) if members is None else members
+        part = values[rows][usable[rows]]
+        if part.size:
+            medians[rows] = np.median(part)
+    return medians
 
 
 def _fit_part(part: tuple, referenced, facing, sides: tuple, fields: tuple, away: np.ndarray) -> None:
@@ -399,11 +405,7 @@ def _noise_sigmas(levels: np.ndarray, groups: list, edge_lengths: np.ndarray) ->
     :func:`_noisy_balls`), less :data:`CLEAN_LEVEL` (the noise fits' own bias on a clean mesh; in quadrature),
     times :data:`NOISE_SIGMA_FACTOR`. NaN levels take the group's median; 0 where nothing is known."""
     known = np.isfinite(levels)
-    medians = np.zeros_like(levels)
-    for _, members in groups:
-        rows = slice(None) if members is None else members
-        part = levels[rows][known[rows]]
-        medians[rows] = np.median(part) if part.size else 0.0
+    medians = np.nan_to_num(_group_medians(levels, groups, known), nan=0.0)
     level = np.fmax(np.where(known, levels, medians), medians)
     sigmas = NOISE_SIGMA_FACTOR * np.sqrt(np.clip(level**2 - CLEAN_LEVEL**2, 0.0, None)) * edge_lengths
     return np.where(np.isfinite(sigmas), sigmas, 0.0)
@@ -417,13 +419,7 @@ def _curvature_scales(curvedness: np.ndarray, groups: list, vertices: np.ndarray
     points = vertices[referenced]
     diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if points.size else 0.0
     floor = 2.0 / diagonal if diagonal > 0 else np.inf
-    scales = np.full(curvedness.shape, floor)
-    for _, members in groups:
-        rows = slice(None) if members is None else members
-        part = curvedness[rows][np.isfinite(curvedness[rows]) & referenced[rows]]
-        if part.size:
-            scales[rows] = max(float(np.median(part)), floor)
-    return scales
+    return np.fmax(_group_medians(curvedness, groups, np.isfinite(curvedness) & referenced), floor)
 
 
 def _noise_reach(reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, fields: tuple) -> np.ndarray:
