@@ -47,6 +47,11 @@ as CPU time (starved by the machine's load) runs once more with 5 times the limi
 issue's 3 x 3 x 0.15 ellipsoid, a thin torus, a plate of 1 x 0.6 x 0.03, a flat voxel ellipsoid: balls that reach
 the other side), with the same mutations and relations and the backend relation on 40% of their curvature calls
 (issue 29, class 10: the backends agree on thin meshes); 0 by default, so that earlier seeds draw as before.
+``--fine-cracks P`` makes a share ``P`` of the mesh cases (from a stream of their own; 0 by default) a fine closed
+shape (icospheres of 5,762 and 16,002 vertices, a 64 x 32 uv sphere, ellipsoids of 2,562 and 5,762 vertices, a voxel
+sphere of radius 10; each either wound outward or inward) with 20-100% of its faces (mostly half) detached by 0.03 to
+0.1 mean edge lengths, any method at its default or a given ball of 1 to 6 edges, under the detached relation; these
+cases have ``FINE_TIMEOUT_FACTOR`` times ``--timeout`` and are counted apart in the summary ("(fine cracks)").
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -136,6 +141,19 @@ def thin_meshes():
     ]
 
 
+def fine_meshes():
+    """Fine closed shapes, ``(name, mesh)``, for ``--fine-cracks``: 2,000 to 16,000 vertices, as users measure
+    (the coarse bases' 42 to 252 vertices put a handful of vertices in a ball)."""
+    return [
+        ("fine_icosphere_24", shapes.icosphere(subdivisions=24)),
+        ("fine_icosphere_40", shapes.icosphere(subdivisions=40)),
+        ("fine_uv_sphere", shapes.uv_sphere(n_longitude=64, n_latitude=32)),
+        ("fine_ellipsoid_16", shapes.ellipsoid(subdivisions=16)),
+        ("fine_ellipsoid_24", shapes.ellipsoid(subdivisions=24)),
+        ("fine_voxel_sphere", shapes.voxel_sphere(radius=10.0)),
+    ]
+
+
 _SHAPES = base_meshes()
 BASES = [(name, np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)) for name, m in _SHAPES]
 _THIN_SHAPES = thin_meshes()
@@ -149,6 +167,22 @@ TRUTH = {
     for name, m in _SHAPES + _THIN_SHAPES
     if name in ("icosphere", "torus", "ellipsoid", "random_sphere", "thin_ellipsoid", "thin_torus", "thin_plate")
 }
+
+#: The bases of ``--fine-cracks``, each also wound inward (``_reversed``); built by :func:`add_fine_bases` when the
+#: option is given (and then in :data:`ALL_BASES`, where the detached relation finds its clean shape).
+FINE_BASES: list = []
+
+
+def add_fine_bases() -> None:
+    """Build :data:`FINE_BASES` (once) and add them to :data:`ALL_BASES`."""
+    if FINE_BASES:
+        return
+    for name, mesh in fine_meshes():
+        vertices, faces = np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)
+        FINE_BASES.append((name, vertices, faces))
+        FINE_BASES.append((f"{name}_reversed", vertices, faces[:, [0, 2, 1]]))
+    ALL_BASES.extend(FINE_BASES)
+
 
 # ----------------------------------------------------------------------------- garbage values
 
@@ -276,6 +310,13 @@ def m_detached(rng, v, f):
     wide = np.random.default_rng(np.random.SeedSequence(rng.bit_generator.seed_seq.entropy, spawn_key=(237,)))
     if WIDE_CRACKS and wide.random() < WIDE_CRACKS:
         gap = 10.0 ** float(wide.uniform(np.log10(0.05), -1.0))
+    v, f = _detach(rng, v, f, share, gap)
+    return v, f, f"detached faces {share:g} by {gap:.2g}"
+
+
+def _detach(rng, v, f, share, gap):
+    """``(vertices, faces)``: a random ``share`` of the faces given corners of their own (after the vertices), each
+    moved ``gap`` mean edge lengths in a random direction (tests/test_orient_holey_inward.py's half-open spheres)."""
     with np.errstate(all="ignore"):
         edge = float(np.mean(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))
     picked = rng.random(len(f)) < share
@@ -284,7 +325,7 @@ def m_detached(rng, v, f):
     directions /= np.linalg.norm(directions, axis=1, keepdims=True)
     f = f.copy()
     f[picked] = len(v) + np.arange(corners.shape[0]).reshape(-1, 3)
-    return np.concatenate([v, corners + directions * gap * edge]), f, f"detached faces {share:g} by {gap:.2g}"
+    return np.concatenate([v, corners + directions * gap * edge]), f
 
 
 def m_collapse(rng, v, f):
@@ -685,6 +726,8 @@ def _with_twins(case, rng):
             and _n_rows(args[0]) > BACKEND_MAX_POINTS
         ):
             return case
+        if labels and labels[0].startswith("fine_") and _n_rows(args[0]) > FINE_BACKEND_MAX_VERTICES:
+            return case
         return target, args, kwargs, labels + ["relation backend"], ("backend", clean)
     if (
         backend_share + OBJECT_SHARE <= roll < backend_share + OBJECT_SHARE + MISUSE_SHARE
@@ -721,7 +764,58 @@ def _with_twins(case, rng):
     return case
 
 
+#: Share of the mesh cases drawn from :data:`FINE_BASES` with a share of their faces detached by 0.03 to 0.1 mean
+#: edge lengths, under the detached relation (``--fine-cracks``: the wide cracks at a user's resolution); 0 by
+#: default, so that the cases of earlier rounds replay as drawn (the choice comes from a stream of its own).
+FINE_CRACKS = 0.0
+#: The random stream of the fine-cracks cases (beside the case's own ``[seed, index]``).
+FINE_STREAM = 43
+#: The wall-clock limit of a fine-cracks case, in ``--timeout`` s: two to three calls on up to 112,000 vertices
+#: (numba: at most 3 s of CPU each).
+FINE_TIMEOUT_FACTOR = 4
+#: The largest fine base of the cases on the NumPy paths (every fourth case): ``quadric`` takes 16 s of CPU on
+#: the 5,762-vertex icosphere half detached (23,051 vertices), 44 s on the 16,002-vertex one.
+FINE_NUMPY_MAX_VERTICES = 6000
+#: The backend relation is left out of the fine-cracks cases above this many vertices (its NumPy call).
+FINE_BACKEND_MAX_VERTICES = 25000
+
+
+def _fine_stream(seed: int, index: int):
+    return np.random.default_rng([seed, index, FINE_STREAM])
+
+
+def is_fine(seed: int, index: int) -> bool:
+    """Whether case ``index`` of ``seed`` is a fine-cracks case (:data:`FINE_CRACKS`)."""
+    return bool(FINE_CRACKS) and not ONLY_POINT_CLOUDS and _fine_stream(seed, index).random() < FINE_CRACKS
+
+
+def fine_crack_case(rng, numpy_backend):
+    """A fine closed shape with a share of its faces detached by 0.03 to 0.1 mean edge lengths (mostly half, as in
+    tests/test_orient_holey_inward.py), any method, a default or given ball (1 to 6 edges), under the detached
+    relation: every vertex valid on both within :data:`DETACHED_TOLERANCE` of the clean shape's H. On the NumPy
+    paths the bases of at most :data:`FINE_NUMPY_MAX_VERTICES` vertices."""
+    bases = [base for base in FINE_BASES if not numpy_backend or len(base[1]) <= FINE_NUMPY_MAX_VERTICES]
+    name, v, f = bases[int(rng.integers(len(bases)))]
+    share = float(rng.choice([0.2, 0.5, 0.5, 1.0]))
+    gap = 10.0 ** float(rng.uniform(np.log10(0.03), -1.0))
+    edge = float(np.mean(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))
+    vv, ff = _detach(rng, v, f, share, gap)
+    method = METHODS[int(rng.integers(len(METHODS)))]
+    kwargs = {"method": method}
+    if method in BALL_METHODS and rng.random() < 0.5:
+        kwargs["radius"] = float(rng.uniform(1.0, 6.0)) * edge
+    if method in SMOOTHING_METHODS and rng.random() < 0.3:
+        kwargs["smoothing_steps"] = int(rng.integers(0, 6))
+    if rng.random() < 0.2:
+        kwargs["orient"] = str(rng.choice(["auto", "outward", "consistent", "keep"]))
+    labels = [name, f"detached faces {share:g} by {gap:.2g}", "vertices:array", "faces:array"]
+    return "principal_curvatures", (vv, ff), kwargs, labels + [f"relation detached {name}"], ("detached", name)
+
+
 def _drawn_case(seed: int, index: int):
+    fine = _fine_stream(seed, index)
+    if FINE_CRACKS and not ONLY_POINT_CLOUDS and fine.random() < FINE_CRACKS:
+        return fine_crack_case(fine, numpy_backend=index % 4 == 3)  # (run_forked's and replay's NumPy cases)
     rng = np.random.default_rng([seed, index])
     if ONLY_POINT_CLOUDS and pointcloud is not None and rng.random() < 0.7:
         return make_cloud_case(rng)
@@ -1893,7 +1987,7 @@ def summary_table(path) -> str:
 
 
 def main(argv=None) -> int:
-    global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE
+    global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE, FINE_CRACKS
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -1934,12 +2028,24 @@ def main(argv=None) -> int:
         "flat voxel ellipsoid), 40%% of their curvature calls also on the other backend (default: %(default)g: "
         "the draws of earlier rounds)",
     )
+    parser.add_argument(
+        "--fine-cracks",
+        type=float,
+        default=FINE_CRACKS,
+        help="share of the mesh cases on a fine closed shape (icospheres of 5,762 and 16,002 vertices, a 64 x 32 uv "
+        "sphere, ellipsoids, a voxel sphere of radius 10, either winding) with 20-100%% of its faces detached by "
+        f"0.03-0.1 edge lengths, against the clean shape; their limit is {FINE_TIMEOUT_FACTOR} times --timeout "
+        "(default: %(default)g: the draws of earlier rounds)",
+    )
     options = parser.parse_args(argv)
-    for name in ("voxel_share", "wide_cracks", "thin_shapes"):
+    for name in ("voxel_share", "wide_cracks", "thin_shapes", "fine_cracks"):
         if not 0 <= getattr(options, name) <= 1:
             parser.error(f"--{name.replace('_', '-')} must lie in [0, 1], got {getattr(options, name)}")
     WIDE_CRACKS = options.wide_cracks
     THIN_SHARE = options.thin_shapes
+    FINE_CRACKS = options.fine_cracks
+    if FINE_CRACKS:
+        add_fine_bases()
     ONLY_POINT_CLOUDS = options.point_clouds
     VOXEL_SHARE = options.voxel_share
 
@@ -1972,22 +2078,27 @@ def main(argv=None) -> int:
                     "voxel_share": options.voxel_share,
                     "wide_cracks": options.wide_cracks,
                     "thin_shapes": options.thin_shapes,
+                    "fine_cracks": options.fine_cracks,
                 }
             )
             + "\n"
         )
         while time.monotonic() < deadline:
             numpy_backend = index % 4 == 3
+            fine = is_fine(options.seed, index)
+            timeout = options.timeout * (FINE_TIMEOUT_FACTOR if fine else 1)
             head, outcome, elapsed, cpu = run_forked(
-                options.seed, index, options.timeout, options.memory, options.factor, numpy_backend
+                options.seed, index, timeout, options.memory, options.factor, numpy_backend
             )
-            if outcome["status"] == "timeout" and cpu < options.timeout / 2:
+            if outcome["status"] == "timeout" and cpu < timeout / 2:
                 counts[(head["target"], "timeout under load, rerun")] += 1
                 head, outcome, elapsed, cpu = run_forked(
-                    options.seed, index, STARVED_WALL * options.timeout, options.memory, options.factor, numpy_backend
+                    options.seed, index, STARVED_WALL * timeout, options.memory, options.factor, numpy_backend
                 )
             target = head["target"]
             counts[(target, outcome["status"])] += 1
+            if fine:
+                counts[(f"{target} (fine cracks)", outcome["status"])] += 1
             slowest.append((elapsed, index))
             if outcome["status"] not in ("ok", "documented") or outcome.get("warnings"):
                 key = (
