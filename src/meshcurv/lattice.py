@@ -236,12 +236,21 @@ def _plane_lattice(planes: np.ndarray, candidates: np.ndarray, share: float):
     smallest = float(np.min(gaps))
     near = gaps[gaps < 1.5 * smallest]
     spacing = float(np.median(near if near.size >= 0.5 * gaps.size else gaps))
-    # one candidate at a time: no (candidates, planes) temporaries (64 rows of a large mesh's planes each)
+    # one candidate at a time: no (candidates, planes) temporaries (64 rows of a large mesh's planes each); the
+    # operations of `abs(steps - round(steps)) <= tolerance`, steps = (planes - candidate) / spacing, in two
+    # buffers made once (a million planes: 0.03 CPU s in fresh temporaries per call)
     held = np.zeros(candidates.size)
+    steps, off = np.zeros(planes.size), np.zeros(planes.size)
+    near = np.zeros(planes.size, dtype=bool)
     with np.errstate(over="ignore", invalid="ignore"):  # a subnormal spacing (coordinates of 1e-310): no grid
         for j, candidate in enumerate(candidates):
-            steps = (planes - candidate) / spacing
-            held[j] = np.count_nonzero(np.abs(steps - np.round(steps)) <= 1e3 * _ON_GRID) / planes.size
+            np.subtract(planes, candidate, out=steps)
+            np.divide(steps, spacing, out=steps)
+            np.round(steps, out=off)
+            np.subtract(steps, off, out=off)
+            np.abs(off, out=off)
+            np.less_equal(off, 1e3 * _ON_GRID, out=near)
+            held[j] = np.count_nonzero(near) / planes.size
     if held.max() < share:
         return None  # the repeated values are not evenly spaced: not a grid (a symmetric height field, say)
     return spacing, float(candidates[np.argmax(held)])

@@ -56,6 +56,8 @@ __all__ = [
     "ball_edge_sums",
     "face_in_ball_ratios",
     "segment_in_ball_lengths",
+    "ring_sums",
+    "ring_max",
 ]
 
 #: Centres per chunk of a ball query (bounds the memory of the pair lists).
@@ -1275,3 +1277,104 @@ def _ball_edge_sums(
         usable,
         lambda ends, centres, r: segment_in_ball_lengths(ends[:, 0], ends[:, 1], centres, r),
     )
+
+
+def ring_sums(neighbour_lists: tuple, rings: int, *arrays: np.ndarray) -> list[np.ndarray]:
+    """Each of ``arrays`` summed ``rings`` times over every vertex and its edge neighbours.
+
+    Parameters
+    ----------
+    neighbour_lists : tuple of ndarray
+        ``(indptr, indices)``: the edge neighbours of every vertex in CSR form, each list increasing and without
+        the vertex itself (:attr:`meshcurv.topology.MeshTopology.neighbour_lists`).
+    rings : int
+        How many times the sums are taken (0: the arrays as float64).
+    *arrays : ndarray of shape (V,) or (V, k)
+        The values per vertex.
+
+    Returns
+    -------
+    list of ndarray
+        One float64 array per array given, of its shape: ``S^rings x`` with ``S`` the matrix of the lists plus
+        the identity.
+
+    Notes
+    -----
+    Both backends give the same numbers to the bit: each sum runs from 0 over the vertex and its neighbours in
+    increasing order (what SciPy's product of ``x`` by the CSR matrix ``S`` does, the NumPy path's). The
+    compiled one runs on threads, without the (V, V) matrix.
+    """
+    indptr, indices = neighbour_lists
+    n = indptr.size - 1
+    kernels = numba_kernels("neighborhoods")
+    if kernels is None:
+        from scipy import sparse  # imported on use: keeps `import meshcurv` fast
+
+        ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n)) + sparse.identity(n)
+        sums = [np.asarray(array, dtype=np.float64) for array in arrays]
+        for _ in range(rings):
+            sums = [ring @ array for array in sums]
+        return sums
+    # one pass per ring over all the arrays' columns side by side: the lists are read once, not once per array
+    columns = [np.asarray(array, dtype=np.float64).reshape(n, -1) for array in arrays]
+    if not columns:
+        return []
+    summed = _ring_passes(kernels, indptr, indices, np.concatenate(columns, axis=1), rings, False)
+    bounds = np.cumsum([0] + [block.shape[1] for block in columns])
+    return [
+        np.ascontiguousarray(summed[:, lo:hi]).reshape(np.shape(array))
+        for lo, hi, array in zip(bounds[:-1], bounds[1:], arrays)
+    ]
+
+
+def ring_max(neighbour_lists: tuple, rings: int, values: np.ndarray) -> np.ndarray:
+    """(V,) the largest of ``values`` over each vertex and the vertices within ``rings`` edges of it.
+
+    Parameters
+    ----------
+    neighbour_lists : tuple of ndarray
+        ``(indptr, indices)``: the edge neighbours of every vertex in CSR form
+        (:attr:`meshcurv.topology.MeshTopology.neighbour_lists`).
+    rings : int
+        How many rings of neighbours are read.
+    values : ndarray of shape (V,)
+        The values per vertex.
+
+    Returns
+    -------
+    ndarray of shape (V,)
+        float64; NaN where any value within the rings is NaN (as ``np.maximum``); a largest value 0 is 0.0,
+        never -0.0.
+
+    Notes
+    -----
+    Both backends give the same numbers to the bit: each ring takes ``np.maximum`` of a vertex's own value and
+    of the running largest of its neighbours' in their order (``np.maximum.reduceat``, the NumPy path's).
+    """
+    indptr, indices = neighbour_lists
+    kernels = numba_kernels("neighborhoods")
+    if kernels is None:
+        rows = np.flatnonzero(np.diff(indptr) > 0)
+        out = np.array(values, dtype=np.float64, copy=True)
+        for _ in range(rings if rows.size else 0):
+            # the rows without neighbours are skipped: each start then ends where the next row with any begins
+            out[rows] = np.maximum(out[rows], np.maximum.reduceat(out[indices], indptr[rows]))
+        out += 0.0  # -0.0 -> 0.0: which of two equal zeros np.maximum keeps depends on its loop (SIMD or not)
+        return out
+    return _ring_passes(kernels, indptr, indices, values, rings, True)
+
+
+def _ring_passes(kernels, indptr, indices, array, rings: int, largest: bool) -> np.ndarray:
+    """``rings`` passes of the compiled :func:`ring_sums` (``largest`` False) or :func:`ring_max` over ``array``
+    (V,) or (V, k), float64 in two buffers taken in turn."""
+    values = np.array(array, dtype=np.float64, copy=True)
+    shape = values.shape
+    if rings > 0:
+        values = values.reshape(shape[0], -1)
+        spare = np.zeros_like(values)
+        for _ in range(rings):
+            kernels._ring_pass(indptr, indices, values, spare, largest)
+            values, spare = spare, values
+    if largest:
+        values += 0.0  # -0.0 -> 0.0, as the NumPy path
+    return values.reshape(shape)

@@ -1285,3 +1285,81 @@ def coarse_face_sums(vertices, indptr, indices, radii, clusters, out, scratch, s
                         if share[e] > 0.0:
                             waiting[last] = e
                             last += 1
+
+
+#: :func:`_ring_pass` cuts the vertices into this many ranges per thread (:func:`~._common.run_chunks`).
+_RING_CHUNKS_PER_THREAD = 4
+
+
+@threaded
+def _ring_pass(indptr, indices, values, out, largest):
+    """One ring of :func:`meshcurv.neighborhoods.ring_sums` (``largest`` False) or of
+    :func:`meshcurv.neighborhoods.ring_max` (``largest`` True): ``out`` (V, k) receives, for each vertex, the sum
+    (the largest) of ``values`` (V, k) over the vertex and its neighbours ``indices[indptr[v]:indptr[v + 1]]``
+    (each list increasing, without the vertex itself).
+
+    The sum runs from 0 over the vertex and its neighbours in increasing order, the vertex in its place (what the
+    product of ``values`` by the CSR matrix of the lists plus the identity computes, row by row, in SciPy); the
+    largest is the vertex's own against the running largest of its neighbours in their order (what
+    ``np.maximum`` of it and ``np.maximum.reduceat`` of theirs gives: NaN if any is), the vertex's own where it
+    has none. The same numbers to the bit as those NumPy forms but the sign of a zero (which of 0.0 and -0.0
+    NumPy keeps depends on its loop; the caller makes zeros 0.0), on any number of threads (each range writes
+    its own rows).
+    """
+    chunks = _RING_CHUNKS_PER_THREAD * nb.get_num_threads()
+    if largest:
+        run_chunks(_ring_max_chunk, values.shape[0], chunks, indptr, indices, values, out)
+    else:
+        run_chunks(_ring_sum_chunk, values.shape[0], chunks, indptr, indices, values, out)
+
+
+@nb.njit(**_JIT)
+def _ring_sum_chunk(lo, hi, indptr, indices, values, out):
+    """Vertices ``lo:hi`` of :func:`_ring_pass`'s sums (each column's in the order of the NumPy form)."""
+    width = values.shape[1]
+    for v in range(lo, hi):
+        for k in range(width):
+            out[v, k] = 0.0
+        own = False
+        for j in range(indptr[v], indptr[v + 1]):
+            u = indices[j]
+            if not own and u > v:
+                for k in range(width):
+                    out[v, k] += values[v, k]
+                own = True
+            for k in range(width):
+                out[v, k] += values[u, k]
+        if not own:
+            for k in range(width):
+                out[v, k] += values[v, k]
+
+
+@nb.njit(inline="always", **_JIT)
+def _numpy_maximum(a, b):
+    """``np.maximum(a, b)``: NaN if either is, else the larger, ``b`` of two equal ones (0.0 and -0.0)."""
+    if a != a:
+        return a
+    if b != b:
+        return b
+    return a if a > b else b
+
+
+@nb.njit(**_JIT)
+def _ring_max_chunk(lo, hi, indptr, indices, values, out):
+    """Vertices ``lo:hi`` of :func:`_ring_pass`'s largest values."""
+    width = values.shape[1]
+    for v in range(lo, hi):
+        start, stop = indptr[v], indptr[v + 1]
+        if stop == start:
+            for k in range(width):
+                out[v, k] = values[v, k]
+            continue
+        u = indices[start]
+        for k in range(width):
+            out[v, k] = values[u, k]
+        for j in range(start + 1, stop):
+            u = indices[j]
+            for k in range(width):
+                out[v, k] = _numpy_maximum(out[v, k], values[u, k])
+        for k in range(width):
+            out[v, k] = _numpy_maximum(values[v, k], out[v, k])
