@@ -219,6 +219,11 @@ class VoxelGrid(NamedTuple):
     tolerance: np.ndarray = _EXACT
 
 
+#: :func:`_plane_lattice` reads each candidate's lattice on this many planes more than 1.25 times the share it may
+#: miss before it may give it up (0.25 of a smooth mesh's repeated coordinates against all of them before).
+_HEAD_PLANES = 4096
+
+
 def _plane_lattice(planes: np.ndarray, candidates: np.ndarray, share: float):
     """``(spacing, origin)`` of the lattice that holds ``share`` of the sorted ``planes``, or None.
 
@@ -237,20 +242,30 @@ def _plane_lattice(planes: np.ndarray, candidates: np.ndarray, share: float):
     near = gaps[gaps < 1.5 * smallest]
     spacing = float(np.median(near if near.size >= 0.5 * gaps.size else gaps))
     # one candidate at a time: no (candidates, planes) temporaries (64 rows of a large mesh's planes each); the
-    # operations of `abs(steps - round(steps)) <= tolerance`, steps = (planes - candidate) / spacing, in two
-    # buffers made once (a million planes: 0.03 CPU s in fresh temporaries per call)
+    # operations of `abs(steps - round(steps)) <= tolerance`, steps = (planes - candidate) / spacing, in buffers
+    # made once. A candidate is read first on a head of the planes a little longer than the share it may miss:
+    # where even all the planes after it held could not reach `share`, its lattice is not the one (its held
+    # share stays 0, below `share` as its own; the largest, and its candidate, are those of every plane read)
+    size = planes.size
+    head = min(size, _HEAD_PLANES + int(np.ceil(1.25 * (1.0 - share) * size)))
     held = np.zeros(candidates.size)
-    steps, off = np.zeros(planes.size), np.zeros(planes.size)
-    near = np.zeros(planes.size, dtype=bool)
+    steps, off = np.zeros(size), np.zeros(size)
+    near = np.zeros(size, dtype=bool)
     with np.errstate(over="ignore", invalid="ignore"):  # a subnormal spacing (coordinates of 1e-310): no grid
         for j, candidate in enumerate(candidates):
-            np.subtract(planes, candidate, out=steps)
-            np.divide(steps, spacing, out=steps)
-            np.round(steps, out=off)
-            np.subtract(steps, off, out=off)
-            np.abs(off, out=off)
-            np.less_equal(off, 1e3 * _ON_GRID, out=near)
-            held[j] = np.count_nonzero(near) / planes.size
+            count = 0
+            for lo, hi in ((0, head), (head, size)):
+                np.subtract(planes[lo:hi], candidate, out=steps[lo:hi])
+                np.divide(steps[lo:hi], spacing, out=steps[lo:hi])
+                np.round(steps[lo:hi], out=off[lo:hi])
+                np.subtract(steps[lo:hi], off[lo:hi], out=off[lo:hi])
+                np.abs(off[lo:hi], out=off[lo:hi])
+                np.less_equal(off[lo:hi], 1e3 * _ON_GRID, out=near[lo:hi])
+                count += int(np.count_nonzero(near[lo:hi]))
+                if (count + size - hi) / size < share:
+                    break  # (its share is at most this, below `share`)
+            else:
+                held[j] = count / size
     if held.max() < share:
         return None  # the repeated values are not evenly spaced: not a grid (a symmetric height field, say)
     return spacing, float(candidates[np.argmax(held)])
