@@ -654,8 +654,8 @@ def orientation_signs(
         compiled = numba_kernels("pointcloud")
         if compiled is not None:  # every kept edge's cosine without (E, 3) gathers
             cosine = compiled.edge_cosines(normals, np.ascontiguousarray(indices)).ravel()[keep]
-        else:
-            cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
+        else:  # (the kernel's products, left to right: the same weights to the bit)
+            cosine = _dot(normals[rows], normals[cols])
         # weight 1 - |cos| (1 - cos for given signs), plus a floor so that parallel pairs stay edges of the sparse graph
         weights = (1.0 - cosine if given else 1.0 - np.abs(cosine)) + 1e-6
         return _spanning_forest(n, rows, cols, cosine < 0, weights)
@@ -715,6 +715,46 @@ def _tie_order(values: np.ndarray) -> np.ndarray:
     return np.argsort(key, kind="stable")
 
 
+def _forest_order(weights: np.ndarray) -> np.ndarray:
+    """(E,) the order in which the orientation's forest takes the edges of ``weights`` (E,), finite and >= 0: by
+    their weights rounded to :data:`TIE_RESOLUTION`, equal ones in the order of the edges.
+
+    A strict order makes the minimum spanning forest unique, so that both backends grow the same one (the
+    sorts of NumPy and scipy order equal weights each their own way, and a symmetric cloud's edges tie by the
+    thousand: two copies of a thin ellipsoid side by side were oriented differently at 68 points,
+    ``benchmarks/fuzz_api.md``, round 21, seed 387 case 882). The rounded weights and the edges' indices are
+    packed in one int64 key (one sort, as fast as the weights' own); a key too large for that is sorted by
+    :func:`numpy.lexsort`.
+    """
+    m = weights.size
+    key = np.multiply(weights, 1.0 / TIE_RESOLUTION)
+    np.rint(key, out=key)
+    shift = max(int(m - 1).bit_length(), 1)
+    if m == 0 or key.max() < 2.0 ** (62 - shift):
+        packed = key.astype(np.int64)
+        np.left_shift(packed, shift, out=packed)
+        packed |= np.arange(m, dtype=np.int64)
+        return np.argsort(packed)  # (distinct keys: the order is the stable one)
+    return np.lexsort((np.arange(m), key))
+
+
+def _first_point_parts(signs: np.ndarray, roots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(signs, labels)`` of the compiled forest (``roots`` (N,) of its union-find) as the NumPy path gives them:
+    the components numbered in the order of their first point, whose sign is +1."""
+    n = roots.size
+    first = np.full(n, n, dtype=np.int64)
+    np.minimum.at(first, roots, np.arange(n))
+    first = first[roots]
+    return signs * signs[first], _dense_labels(first)
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(E,) the dot products of the rows of ``a`` and ``b`` (E, 3), added left to right as the compiled kernels
+    add them (:func:`numpy.einsum` adds them in another order: the weights of the orientation's edges, whose ties
+    decide its forest, would differ in their last bits between the backends)."""
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
+
+
 def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.ndarray, weights: np.ndarray):
     """``(signs, labels)``: signs propagated along the minimum spanning forest of the edges ``(rows, cols)``.
 
@@ -725,11 +765,16 @@ def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.nd
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
 
+    order = _forest_order(weights)
     compiled = numba_kernels("pointcloud")
     if compiled is not None:
-        signs, roots = compiled.spanning_signs(n, rows, cols, np.asarray(opposite).astype(np.int8), np.argsort(weights))
-        return signs, _dense_labels(roots)
-    graph = coo_matrix((weights, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
+        signs, roots = compiled.spanning_signs(n, rows, cols, np.asarray(opposite).astype(np.int8), order)
+        return _first_point_parts(signs, roots)
+    # the edges weighed by their rank in ``order``: distinct weights, whose minimum spanning forest is the one
+    # Kruskal's algorithm grows taking the edges in ``order`` (the compiled path's)
+    ranks = np.zeros(order.size)
+    ranks[order] = np.arange(1, order.size + 1)
+    graph = coo_matrix((ranks, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
     # both searches treat the graph as undirected: (i, j) is an edge when either is among the other's neighbours
     n_components, labels = connected_components(graph[:n, :n], directed=False)
     # one virtual node n joined to the first point of each component: one tree for every component
@@ -994,7 +1039,7 @@ def oriented_signs(
         # one 3 or more, its |cos| clipped to 1); else, as a guard, the NumPy forest
         every = bool(used.all())  # (a smooth sample's edges all are: no copies of them)
         used_weights, n_flat = weights if every else weights[used], int(np.count_nonzero(flat))
-        order = np.argsort(used_weights)
+        order = _forest_order(used_weights)
         separated = (n_flat == 0 or used_weights[order[n_flat - 1]] < 3.0) and (
             n_flat == order.size or used_weights[order[n_flat]] >= 3.0
         )
@@ -1004,7 +1049,7 @@ def oriented_signs(
         signs, roots, sheets = forest.spanning_sheets(
             n, rows, cols, opposite.view(np.int8), taken, n_flat, PART_MIN_POINTS
         )
-        labels = _dense_labels(roots)
+        signs, labels = _first_point_parts(signs, roots)
     else:
         if forest is not None:
             sheets = _sheets(n, rows[flat], cols[flat])
@@ -1060,10 +1105,11 @@ def _graph_geometry(points, normals, indices, usable):
     :func:`meshcurv._kernels.pointcloud.graph_edges`."""
     rows, cols, kept = _graph_edges(indices, usable)
     offsets = points[cols] - points[rows]
-    length = np.linalg.norm(offsets, axis=1)
-    ahead = np.einsum("ij,ij->i", offsets, normals[rows])
-    behind = np.einsum("ij,ij->i", offsets, normals[cols])
-    cosine = np.einsum("ij,ij->i", normals[rows], normals[cols])
+    # (the kernel's operations in its order: the same weights, to the bit)
+    length = np.sqrt(_dot(offsets, offsets))
+    ahead = _dot(offsets, normals[rows])
+    behind = _dot(offsets, normals[cols])
+    cosine = _dot(normals[rows], normals[cols])
     with np.errstate(invalid="ignore", divide="ignore"):
         slope = np.maximum(np.abs(ahead), np.abs(behind)) / length
     return rows, cols, kept, ahead, behind, cosine, slope
