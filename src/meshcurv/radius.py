@@ -85,7 +85,7 @@ from ._geometry import (
 from .geometry import _floats, checked_topology_points
 from .jets import SETTLED_SLOPE, _fit_jets
 from .lattice import VoxelGrid, voxel_grid
-from .neighborhoods import _checked_ids
+from .neighborhoods import _ball_face_sums, _checked_ids, face_in_ball_ratios
 from .topology import MeshTopology
 
 if TYPE_CHECKING:
@@ -1477,7 +1477,8 @@ def _patch_radii(
     edge lengths times the local factor, at most :data:`PATCH_CAP` over the fits' curvedness; the fits within reach
     of a patch made again without the balls that hold the other side of the surface) of ``q = r_v / base``
     more than ``m =`` :data:`PATCH_MARGIN`, it is ``base q^t`` with ``t = clip(log(q / m) / log(p), 0, 1)``
-    (``p =`` :data:`PATCH_RAMP`: ``r_v`` from ``q = m p`` on, continuous).
+    (``p =`` :data:`PATCH_RAMP`: ``r_v`` from ``q = m p`` on, continuous); and at least ``base`` times
+    :func:`_holed_factor` where its ball misses the surface beside a crack or detached faces.
     """
     n = mesh.vertices.shape[0]
     base = _vertex_radii(groups, n) * ratios
@@ -1507,4 +1508,78 @@ def _patch_radii(
                 )
             refitted.append((centres, offsets, curvedness))
         factor = _patch_factor(mesh, refitted, edge, base)
-    return base, base * factor
+    return base, base * np.maximum(factor, _holed_factor(mesh, base, normals))
+
+
+#: A vertex's ball beside a crack or detached faces (:func:`_holed_factor`): where its surface-connected part holds
+#: less than this share of the disc ``pi r^2`` (an intact ball: 0.8 to 1; icc's ``HOLE_SHARE`` for a voxel
+#: surface's holes) ...
+HOLED_SHARE = 0.8
+#: ... and the faces of the Euclidean ball that the surface-connected walk does not reach (faces detached beyond the
+#: weld, the other side of a crack) hold at least this share of it (a rim: none; a hanging face's free corner:
+#: 0.3-0.8; the welded corners of half-detached faces: 0.14 and more) ...
+HOLED_BEYOND = 0.1
+#: ... the radius grows by ``HOLED_SHARE / share``, at most this factor (icc's ``HOLE_GROWTH``) ...
+HOLED_GROWTH = 2.0
+#: ... and each vertex takes the largest growth within this many rings of it (a cracked region at one scale: the
+#: welded corners beside a hanging face hold a full disc of kinked faces, off by half of H at the group's radius).
+HOLED_REACH = 1
+
+
+def _holed_factor(mesh: _Measured | PreparedMesh, base: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(V,) the factor of each vertex's radius over ``base`` (V,) where its ball misses the surface around it.
+
+    A face detached beyond the weld, or a crack, leaves a vertex a ball that holds a piece of one or two faces while
+    the surface goes on beyond its boundary edges: its estimate is that of a few faces, whose corners' normals and
+    kinks it amplifies (a unit icosphere(40) with half of its faces detached by 0.054 edge lengths: 20-60 valid
+    vertices off by more than half of H at one edge length, none at 1.5). Such a vertex (finite ``normals``, on no
+    fragment, within ``base`` of a boundary vertex) whose surface-connected ball holds a share ``s`` of its disc below
+    :data:`HOLED_SHARE`, and whose Euclidean ball holds faces the connected one does not (at least
+    :data:`HOLED_BEYOND` of the disc), grows by ``min(HOLED_SHARE / s, HOLED_GROWTH)``; then the largest factor
+    within :data:`HOLED_REACH` rings. A rim (nothing beyond: a hemisphere, a saddle, a cylinder) and a closed mesh
+    (no boundary edge: nothing computed) keep their radii. The shares are those of
+    :func:`meshcurv.neighborhoods.face_in_ball_ratios` (needles' faces left out).
+    """
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    topology, vertices = mesh.topology, mesh.vertices
+    n = vertices.shape[0]
+    factor = np.ones(n)
+    if not topology.boundary_edges.any():
+        return factor
+    finite = np.isfinite(normals).all(axis=1) & np.isfinite(base) & (base > 0)
+    fragments = _fragment_vertices(topology)
+    if fragments is not None:
+        finite &= ~fragments
+    rims = np.flatnonzero(topology.boundary_vertices)
+    rows = np.flatnonzero(finite)
+    if rows.size == 0 or rims.size == 0:
+        return factor
+    distance, _ = cKDTree(vertices[rims]).query(vertices[rows])
+    ids = rows[distance <= base[rows]]
+    if ids.size == 0:
+        return factor
+    faces = topology.faces
+    corners = vertices[faces]
+    areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    usable = ~mesh.needles[faces].any(axis=1) if mesh.needles.any() else np.ones(faces.shape[0], dtype=bool)
+    radii = np.where(finite, base, np.max(base[ids]))  # the walks' radii (only those of ``ids`` are read)
+    own = _ball_face_sums(vertices, faces, radii, areas[:, None], usable=usable, connected=True, centres=ids)[:, 0]
+    disc = np.pi * base[ids] ** 2
+    sparse = own < HOLED_SHARE * disc
+    ids, own, disc = ids[sparse], own[sparse], disc[sparse]
+    if ids.size == 0:
+        return factor
+    kept = np.flatnonzero(usable)
+    centroids = corners[kept].mean(axis=1)
+    reach = float(np.max(np.linalg.norm(corners[kept] - centroids[:, None, :], axis=2))) if kept.size else 0.0
+    balls = cKDTree(centroids).query_ball_point(vertices[ids], base[ids] + reach)
+    counts = np.fromiter(map(len, balls), dtype=np.int64, count=ids.size)
+    members = kept[np.concatenate(balls).astype(np.int64)] if counts.sum() else np.zeros(0, dtype=np.int64)
+    row = np.repeat(np.arange(ids.size), counts)
+    shares = face_in_ball_ratios(corners[members], vertices[ids[row]], base[ids[row]])
+    every = np.bincount(row, shares * areas[members], minlength=ids.size)
+    holed = every - own >= HOLED_BEYOND * disc
+    with np.errstate(divide="ignore"):
+        factor[ids[holed]] = np.minimum(HOLED_SHARE * disc[holed] / own[holed], HOLED_GROWTH)
+    return _ring_max(topology.neighbour_lists, HOLED_REACH, factor)
