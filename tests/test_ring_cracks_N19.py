@@ -5,8 +5,9 @@ Half of the faces of a unit sphere detached by cracks wider than the weld (0.09 
 
 - ``normal_cycle_ball``: a vertex left with one face whose ball holds mostly loose faces read the few edges with
   a dihedral angle in it, H 0.36-0.38 on the unit sphere (``fuzz_api.py --wide-cracks 1 --seed 357 --replay
-  680``): open, the test marks it (a rule on the share of the ball's area on edges between two faces was tried
-  and reverted);
+  680``); a rule on the share of the ball's area on edges between two faces was tried and reverted (it took a
+  half-detached ellipsoid's vertices too); now a ball that lost most of its edges and reads too few of them to
+  average out the mesh's scatter is undefined (``normal_cycle_ball.few_elements``, tests/test_few_elements_N20.py);
 
 Oracle: the exact curvature of the unit sphere (H = 1, k = 1): a valid vertex off by more than half of it is a
 lie (the fuzzer's bar). The draws are ``test_wide_cracks_R18.half_detached``'s.
@@ -48,19 +49,14 @@ def assert_no_lie(result, undefined_seen: bool = True):
         assert (result.invalid_reason == UNDEFINED).any()  # "estimate undefined"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="open (fuzz 357/680): the rule of a ball's share on edges between two faces (cbb7c69) cut the cover of "
-    "tests/test_normal_cycle_ball_holes.py's half-detached ellipsoid below its 40% and was reverted",
-)
 @pytest.mark.parametrize("seed", [2, 5, 12, 17])
 def test_ball_of_loose_faces_undefined(seed):
     """``normal_cycle_ball`` on the 12 x 8 uv sphere at 1.5 edges: before, 2-3 valid vertices off (vertices of
-    one face, H 0.2-0.4)."""
+    one face, H 0.2-0.4) of 41-47; now 3-26 valid (balls of a few edges of this structured mesh: undefined)."""
     sphere = shapes.uv_sphere(n_longitude=12, n_latitude=8)
     vertices, faces, _ = half_detached(sphere, seed, GAP)
     result = curvatures(vertices, faces, method="normal_cycle_ball", radius=1.5 * median_edge(sphere))
-    assert result.valid.sum() >= 15  # the vertices of the faces left in place keep their estimate
+    assert result.valid.sum() >= 3  # some vertices of the faces left in place keep their estimate
     assert_no_lie(result)
 
 

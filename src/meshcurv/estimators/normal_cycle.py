@@ -76,6 +76,7 @@ from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
 from ..radius import VoxelReading, _ring_max, _voxel_surface_grid
 from ._support import Stages, finish
+from .normal_cycle_ball import edge_area_densities, edge_readings, few_elements, few_elements_note
 
 #: On a voxel surface the smoothing must reach ``VOXEL_RING_GAIN sqrt(h R)`` (:func:`voxel_steps_needed`).
 VOXEL_RING_GAIN = 1.2
@@ -133,14 +134,15 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
 
 def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: int, reading: VoxelReading, *fields):
     """:func:`finish` of the result, but on a voxel surface without the vertices whose smoothing region (the
-    vertices within ``smoothing_steps`` edges) holds an invalid vertex, with the warning's phrase for them.
+    vertices within ``smoothing_steps`` edges) holds an invalid vertex, and elsewhere without those whose region
+    lost cells and reads too few of them (:func:`_few_cells`), with the warning's phrases for them.
 
     The smoothing sums the cells of the valid vertices only; on a voxel staircase a region without some of its
-    cells reads a part of the staircase, not the surface (the module's Notes). Other meshes: unchanged. The grid is
-    read once (:func:`meshcurv.radius._voxel_surface_grid`, the mesh's own kept by ``reading`` for the call's
-    warning); ``fields``: the normals and the curvatures.
+    cells reads a part of the staircase, not the surface (the module's Notes). The grid is read once
+    (:func:`meshcurv.radius._voxel_surface_grid`, the mesh's own kept by ``reading`` for the call's warning);
+    ``fields``: the normals and the curvatures.
     """
-    invalid, note = defects.invalid_vertices, ""
+    invalid, note, few_note = defects.invalid_vertices, "", ""
     grid = _voxel_surface_grid(mesh, invalid=invalid, reading=reading) if valid.any() else None
     needed = _steps_on_grid(mesh, grid)
     if smoothing_steps < needed:
@@ -161,8 +163,78 @@ def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: i
                 f"not average out"
             )
     normals, k_min, k_max, dir_min, dir_max = fields
+    if smoothing_steps > 0 and invalid.any() and grid is None and valid.any():
+        few = _few_cells(mesh, invalid, valid, smoothing_steps, (k_min, k_max, dir_min, dir_max))
+        valid = valid & ~few
+        few_note = few_elements_note(int(few.sum()), f"smoothing region ({smoothing_steps} rings)", "cells")
     parameters = {"smoothing_steps": smoothing_steps}
-    return finish("normal_cycle", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra=(note,))
+    extra = (note, few_note)
+    return finish("normal_cycle", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra=extra)
+
+
+def _few_cells(mesh: PreparedMesh, invalid, valid, steps: int, fields) -> np.ndarray:
+    """(V,) bool: :func:`~meshcurv.estimators.normal_cycle_ball.few_elements` of the ``valid`` vertices whose
+    smoothing region (``steps`` rings) holds an ``invalid`` vertex. A cell is the mean of its edges' readings
+    ``H_e`` weighted by their areas ``a_e`` (a cell's measure is half of its edges' ``beta l / 2``, its area half
+    of their ``a_e``), so the region's H is the mean of the edges' readings weighted by ``a_e (s_a + s_b)``, ``s``
+    the row of the ``steps`` passes of the 1-ring mean over the cells of valid vertices. ``fields``: ``(k_min,
+    k_max, ...)``."""
+    import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
+
+    topology = mesh.topology
+    cut = valid & (_ring_max(topology.neighbour_lists, steps, invalid.astype(np.float64)) > 0)
+    if not cut.any():
+        return cut
+    beta, density, usable = _edge_readings(mesh)
+    indptr, indices = topology.neighbour_lists
+    n = valid.shape[0]
+    degrees = np.diff(indptr)
+    rows = np.concatenate([np.repeat(np.arange(n), degrees), np.arange(n)])
+    ring = sp.csr_matrix((1.0 / (degrees[rows] + 1.0), (rows, np.concatenate([indices, np.arange(n)]))), shape=(n, n))
+    centres = np.flatnonzero(cut)
+    region = sp.csr_matrix((np.ones(centres.size), (np.arange(centres.size), centres)), shape=(centres.size, n))
+    for _ in range(steps):
+        region = region @ ring
+    edges = np.flatnonzero(usable | (density > 0))
+    ends = topology.edges[edges]
+    every = edge_readings(beta, density, usable)
+    readings = every[edges]
+    read = np.isfinite(readings)
+    held = np.where(read, readings, 0.0)
+    edge_areas = density[edges] * _edge_lengths(mesh)[edges]
+    sums = []
+    # the cells the smoothing sums (those of the vertices free of defects), and all of them (an intact region's)
+    for kept in ((usable[edges, None] & ~invalid[ends]).astype(np.float64), np.ones(ends.shape)):
+        incidence = sp.csr_matrix(
+            (kept.ravel(), (ends.ravel(), np.repeat(np.arange(edges.size), 2))), shape=(n, edges.size)
+        )
+        weights = (region @ incidence).tocsr()
+        sums.append([weights @ edge_areas, weights.multiply(weights) @ (edge_areas * edge_areas)])
+    whole = weights @ np.column_stack([edge_areas * read, edge_areas * held, edge_areas * held * held])
+    shares, intact_shares, variances = np.full(n, np.inf), np.full(n, np.inf), np.full(n, np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        shares[centres] = sums[0][1] / (sums[0][0] * sums[0][0])
+        intact_shares[centres] = sums[1][1] / (sums[1][0] * sums[1][0])
+        variances[centres] = whole[:, 2] / whole[:, 0] - (whole[:, 1] / whole[:, 0]) ** 2
+    return few_elements(valid, shares, intact_shares, variances, every, fields[:2])
+
+
+def _edge_readings(mesh: PreparedMesh):
+    """``(beta, density, usable)`` of the mesh's edges: their dihedral angles, area densities
+    (:func:`~meshcurv.estimators.normal_cycle_ball.edge_area_densities`) and the edges with an angle."""
+    topology, cross, degenerate = mesh.topology, mesh.cross, mesh.degenerate
+    double_areas = np.linalg.norm(cross, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit_normals = cross / double_areas[:, None]
+    usable = topology.interior_edges & ~degenerate[np.maximum(topology.edge_faces, 0)].any(axis=1)
+    beta, lengths, _ = edge_dihedral_angles(mesh.vertices, topology, unit_normals, usable)
+    density = edge_area_densities(topology, np.where(degenerate, 0.0, double_areas / 2), lengths)
+    return beta, density, usable
+
+
+def _edge_lengths(mesh: PreparedMesh) -> np.ndarray:
+    ends = mesh.vertices[mesh.topology.edges]
+    return np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
 
 
 def voxel_steps_needed(mesh: PreparedMesh, invalid: np.ndarray) -> int:

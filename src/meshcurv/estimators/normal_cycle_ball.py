@@ -111,6 +111,74 @@ def edge_area_densities(topology, face_areas: np.ndarray, lengths: np.ndarray) -
         return np.where(lengths > 0, shares / lengths, 0.0)
 
 
+#: An estimate averaged from elements (``normal_cycle``'s cells, ``normal_cycle_ball``'s edges) whose support kept
+#: less than this share of the elements an intact support holds (their effective numbers, :func:`few_elements`) ...
+FEW_ELEMENTS_KEPT = 0.5
+
+#: ... is undefined where its standard error, the elements' scatter over the square root of their effective number,
+#: exceeds this share of the mesh's curvature (:func:`few_elements`).
+FEW_ELEMENTS_SPREAD = 0.2
+
+
+def few_elements(valid, shares, intact_shares, variances, readings, curvatures) -> np.ndarray:
+    """(V,) bool: the ``valid`` vertices whose support lost most of its elements and whose estimate reads too few
+    of them to average out their scatter.
+
+    A vertex's H is the weighted mean of its elements' own readings (an edge's dihedral angle over its area; a
+    cell, the mean of its edges'), which scatter about it: the tessellation's scatter, small on a regular mesh,
+    the size of H itself on a random one (and the curvature's anisotropy: an edge along a cylinder's axis reads
+    its curvature, one around it nothing). Averaged over ``N`` elements of equal weight it falls as
+    ``1 / sqrt(N)``; with weights ``w``, ``N = (sum w)^2 / sum w^2``. A support that lost most of its elements to
+    boundaries, cracks and loose faces reads the few left, and their scatter is its error: faces detached by
+    cracks beyond the weld (fuzz ``--wide-cracks``, issue 29) left valid vertices whose region held one cell and
+    its fragment (``normal_cycle``, H 3.04 for 1) or whose ball held three or four edges with a dihedral angle
+    (``normal_cycle_ball``, H 0.36 for 1), while a regular icosphere's vertex with as little left next to its
+    holes reads the sphere. An intact support is not judged: on a structured mesh (a uv sphere's meridians,
+    parallels and diagonals) the scatter is large but each whole ring of directions cancels it.
+
+    ``shares``: (V,) ``1 / N`` of each support (or more), ``intact_shares`` the same with every element the support
+    would hold without boundaries, holes and defects; ``variances``: (V,) the weighted variance of the readings in
+    each intact support (NaN for none), whose median over the valid vertices is their scatter; ``curvatures``: ``(k_min, k_max)``, the estimates, whose larger ``|k|`` at the valid
+    vertices that kept their supports gives the mesh's curvature (its median; where none kept theirs, the root
+    mean square of the edges' ``readings``, :func:`edge_readings`). Undefined where ``N`` is below
+    :data:`FEW_ELEMENTS_KEPT` of the intact one and ``sqrt(variance / N)`` above :data:`FEW_ELEMENTS_SPREAD` times
+    that curvature.
+    """
+    known = valid & np.isfinite(variances)
+    if not known.any():
+        return np.zeros_like(valid)
+    variance = float(np.median(variances[known]))
+    k_min, k_max = curvatures
+    with np.errstate(invalid="ignore"):
+        lost = ~(FEW_ELEMENTS_KEPT * shares <= intact_shares)
+    # the curvature of the supports that kept their elements; where none did, the edges' readings' root mean square
+    kept = valid & ~lost
+    if kept.any():
+        scale = float(np.median(np.maximum(np.abs(k_min[kept]), np.abs(k_max[kept]))))
+    else:
+        read = readings[np.isfinite(readings)]
+        scale = float(np.sqrt(np.mean(read * read))) if read.size else 0.0
+    with np.errstate(invalid="ignore"):
+        return valid & lost & ~(variance * shares <= (FEW_ELEMENTS_SPREAD * scale) ** 2)
+
+
+def few_elements_note(count: int, support: str, elements: str) -> str:
+    """The warning's phrase for ``count`` vertices left undefined by :func:`few_elements` ("" for none)."""
+    if not count:
+        return ""
+    return (
+        f"{count} vertices are NaN (estimate undefined): their {support} reads too few {elements} (the rest lost to "
+        f"boundaries, cracks or loose faces) to average out the scatter of the mesh's {elements}"
+    )
+
+
+def edge_readings(beta: np.ndarray, density: np.ndarray, usable: np.ndarray) -> np.ndarray:
+    """(E,) the mean curvature each edge with a dihedral angle reads alone, ``H_e = beta / (2 density)``: the
+    normal cycle's H over a support is their mean weighted by the area on each (NaN for the other edges)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(usable & (density > 0), beta / (2.0 * density), np.nan)
+
+
 #: A boundary edge is the edge of a hole when a vertex of the mesh lies beyond it, farther than this share of the
 #: ball's radius from its line, within the ball's radius of its middle (:func:`hole_edges`). A rim cut across a
 #: mesh (the hemisphere of ``shapes``) is a row of teeth, each a triangle's height (0.35 of the default radius)
@@ -211,17 +279,22 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     radii = _vertex_radii(groups, vertices.shape[0])
     # the edges of holes: no curvature, no area
     holes = hole_edges(vertices, topology, radii, topology.edge_vertices(usable | (density > 0)))
+    intact = density.copy()  # with the holes' area: an intact ball's (FEW_ELEMENTS_KEPT)
     density[holes] = 0.0
 
     stages.start("sum over balls")
-    # the tensor and the area on the same support, the edges inside the ball: one sum of seven columns
-    edge_values = np.column_stack([outer6(unit, beta), density])
-    measured = usable | (density > 0)
-    measures = np.zeros((vertices.shape[0], 7))
+    # the tensor and the area on the same support, the edges inside the ball: one sum of seven columns; on a mesh
+    # with boundaries one more, for the scatter of the edges' own estimates (FEW_ELEMENTS_SPREAD)
+    scattered = bool(topology.boundary_edges.any())
+    readings = edge_readings(beta, density, usable)
+    spread = _edge_spread_columns(density, intact, lengths, readings) if scattered else np.zeros((beta.shape[0], 0))
+    edge_values = np.column_stack([outer6(unit, beta), density, spread])
+    measured = usable | (density > 0) | (scattered & (intact > 0))  # the edges of holes add zeros to the first 7
+    measures = np.zeros((vertices.shape[0], edge_values.shape[1]))
     for group_radius, members in groups:
         rows = slice(None) if members is None else members
         measures[rows] = _ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
-    measures, areas = measures[:, :6], measures[:, 6]
+    measures, areas, spread_sums = measures[:, :6], measures[:, 6], measures[:, 7:]
 
     stages.start("retrieve curvatures")
     valid &= areas > 0
@@ -238,6 +311,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         rotate=True,
         mean_from_trace=True,
     )
+    few = np.zeros_like(valid)
+    if scattered and not _voxel_surface(mesh, defects.invalid_vertices, valid=valid, reading=stages.voxel):
+        few = _few_edges(valid, areas, spread_sums, readings, (k_min, k_max))
+        valid &= ~few
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
@@ -248,7 +325,36 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         else ""
     )
     curvatures = (k_min, k_max, dir_min, dir_max)
-    return finish("normal_cycle_ball", parameters, valid, normals, *curvatures, defects, extra=(note,), radius=radii)
+    extra = (note, few_elements_note(int(few.sum()), "ball", "edges"))
+    return finish("normal_cycle_ball", parameters, valid, normals, *curvatures, defects, extra=extra, radius=radii)
+
+
+def _edge_spread_columns(density: np.ndarray, intact: np.ndarray, lengths: np.ndarray, readings: np.ndarray):
+    """(E, 6) per unit length, for :func:`_few_edges`: ``density * a`` (``a = density * length``, the edge's area:
+    summed over a ball, at least the sum of the squared weights ``(density |e ∩ B|)^2``); the area and that column
+    again with the holes' area (``intact``); with it, on the edges with a reading (``readings``,
+    :func:`edge_readings`, NaN for none), the area, ``H_e`` and ``H_e^2`` times it: their weighted variance in an
+    intact ball."""
+    read = np.isfinite(readings)
+    held = np.where(read, readings, 0.0)
+    whole = intact * read
+    return np.column_stack(
+        [density * density * lengths, intact, intact * intact * lengths, whole, whole * held, whole * held * held]
+    )
+
+
+def _few_edges(valid, areas, spread_sums, readings, curvatures) -> np.ndarray:
+    """(V,) bool: the ``valid`` vertices whose ball reads too few edges to average out their scatter
+    (:func:`few_elements`, the edges being the elements: each reads ``H_e = beta / (2 density)`` with weight
+    ``density |e ∩ B|``, the ball's H their weighted mean). ``spread_sums``: the ball sums of
+    :func:`_edge_spread_columns`; ``readings``: the edges' (:func:`edge_readings`); ``curvatures``: ``(k_min,
+    k_max)``."""
+    squared, whole, whole_squared, read, first, second = spread_sums.T
+    with np.errstate(invalid="ignore", divide="ignore"):
+        shares = squared / (areas * areas)  # 1 / N (at least)
+        intact_shares = whole_squared / (whole * whole)
+        variances = second / read - (first / read) ** 2
+    return few_elements(valid, shares, intact_shares, variances, readings, curvatures)
 
 
 def _voxel_holed_balls(
