@@ -447,6 +447,9 @@ THIN_WIDEN = 3.0
 #: ... over the points whose first-fit normal has a cosine above this with the centre's (46 degrees: the other
 #: side and the rim are left out; 0.5 and a ball twice as wide left more vertices off, ``benchmarks/flat_voxel_normals.py``).
 THIN_AGREEMENT = 0.7
+#: The test is made first at one centre per cube of this many normal-fit radii, then at the centres within two
+#: cubes of those that passed (the wrapped fits round a tube or a tip, which fail it, cost a sample's test).
+THIN_SAMPLE = 0.5
 
 
 def _thin_part_normals(vertices, fitted, radius, valid, neighbours, adjacency, areas) -> np.ndarray:
@@ -481,28 +484,39 @@ def _thin_part_normals(vertices, fitted, radius, valid, neighbours, adjacency, a
             **extra,
         )
 
-    details: dict = {}
-    fit(centres, radii, 2, facing=facing, details=details)  # (the share facing away only: a quadric will do)
-    with np.errstate(invalid="ignore"):
-        wrapped = details["away"] > AWAY_FRACTION
-    if not wrapped.any():
+    def thin_flat(at, over):  # the centres `at` whose ball wraps while their own jet hardly bends
+        details: dict = {}
+        fit(at, over, 1, facing=facing, details=details)  # (the share facing away only: no jet is solved)
+        with np.errstate(invalid="ignore"):
+            wrapped = details["away"] > AWAY_FRACTION
+        flat = np.zeros(at.size, dtype=bool)
+        if not wrapped.any():
+            return flat
+        coefficients, frame, _ = fit(at[wrapped], over[wrapped], NORMAL_DEGREE, min_spread=NORMAL_MIN_SPREAD)
+        k_min, k_max = jet_curvatures(coefficients, frame, over[wrapped], facing[at[wrapped]])[:2]
+        with np.errstate(invalid="ignore"):
+            flat[wrapped] = np.maximum(np.abs(k_min), np.abs(k_max)) * over[wrapped] < THIN_BEND
+        return flat
+
+    # first at one centre per cube of THIN_SAMPLE normal radii, then at the centres near those that passed
+    side = THIN_SAMPLE * float(np.median(radii))
+    sampled = _cube_samples(vertices[centres], side)
+    passed = sampled[thin_flat(centres[sampled], radii[sampled])]
+    if not passed.size:
         return fitted
-    centres, radii = centres[wrapped], radii[wrapped]
-    coefficients, frame, _ = fit(centres, radii, NORMAL_DEGREE, min_spread=NORMAL_MIN_SPREAD)
-    k_min, k_max = jet_curvatures(coefficients, frame, radii, facing[centres])[:2]
-    with np.errstate(invalid="ignore"):
-        flat = np.maximum(np.abs(k_min), np.abs(k_max)) * radii < THIN_BEND
-    if not flat.any():
-        return fitted
+    from scipy.spatial import cKDTree
+
+    distance, _ = cKDTree(vertices[centres[passed]]).query(vertices[centres], distance_upper_bound=2.0 * side)
+    near = np.flatnonzero(np.isfinite(distance))
+    flat = near[thin_flat(centres[near], radii[near])]
+    centres, radii = centres[flat], radii[flat]
     if areas is not None:
         positive = areas[areas > 0]
         areas = areas / np.median(positive) if positive.size else None
-    refitted = _agreeing_jet_normals(
-        vertices, facing, THIN_WIDEN * radii[flat], centres[flat], neighbours, adjacency, areas
-    )
+    refitted = _agreeing_jet_normals(vertices, facing, THIN_WIDEN * radii, centres, neighbours, adjacency, areas)
     out = np.array(fitted, copy=True)
     found = np.isfinite(refitted).all(axis=1)
-    out[centres[flat][found]] = refitted[found]
+    out[centres[found]] = refitted[found]
     return out
 
 
