@@ -881,13 +881,15 @@ def test_browser_point_cloud(tmp_path, browser):
 
 @pytest.mark.slow
 @needs_browser
-def test_browser_million_vertices_open_within_10_seconds(tmp_path, browser):
+def test_browser_million_vertices_open(tmp_path, browser):
+    """A 1M-vertex page opens and draws both signs of K. The time is printed, not asserted: a timed assertion fails on
+    a loaded machine without telling anything about the page (2-8 s measured unloaded, docs/guide/files.md); the
+    browser's own 60 s timeout catches a page that hangs."""
     torus = meshcurv.shapes.torus(n_major=1000, n_minor=1000)
     page = write_html(tmp_path / "big.html", torus.vertices, torus.faces, exact_result(torus), field="gaussian", up="z")
     size = page.stat().st_size
     facts, seconds = browser.open(page.as_uri())
     assert facts["state"] == "ok", facts["text"]
-    assert seconds < 10, (seconds, facts)
     red, blue = colour_fractions(beside_panel(browser, browser.screenshot(tmp_path / "big.png")))
     assert red > 0.03 and blue > 0.01
     frame = browser.evaluate("meshcurvViewer.timeFrames(2)")
