@@ -142,6 +142,8 @@ from ..jets import (
 )
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import (
+    MAX_BALL_PAIRS,
+    _estimate_ball_pairs,
     connected_ball_pairs,
     _ball_face_sums,
     _ball_face_sums_nested,
@@ -510,6 +512,11 @@ def _thin_part_normals(vertices, fitted, radius, valid, neighbours, adjacency, a
     near = np.flatnonzero(np.isfinite(distance))
     flat = near[thin_flat(centres[near], radii[near])]
     centres, radii = centres[flat], radii[flat]
+    if not centres.size:
+        return fitted
+    mean, _ = _estimate_ball_pairs(vertices, THIN_WIDEN * radii, vertices[centres])
+    if mean * centres.size > MAX_BALL_PAIRS:  # (the first fits' own bound: beyond it they are kept as they are)
+        return fitted
     if areas is not None:
         positive = areas[areas > 0]
         areas = areas / np.median(positive) if positive.size else None
