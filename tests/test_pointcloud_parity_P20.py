@@ -177,12 +177,19 @@ def test_the_orientation_forest_is_one_tree_on_both_backends():
     assert ((signs[rows] * signs[cols] < 0) != opposite).any()
 
 
-def test_the_forest_takes_tied_edges_in_their_order():
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_the_forest_takes_tied_edges_in_their_order(backend):
     from meshcurv._pointcloud_normals import TIE_RESOLUTION, _forest_order
 
     weights = np.array([0.5, 0.25, 0.5 + 0.1 * TIE_RESOLUTION, 0.25 - 0.1 * TIE_RESOLUTION, 0.0, 3.0, 0.5])
-    np.testing.assert_array_equal(_forest_order(weights), [4, 1, 3, 0, 2, 6, 5])
-    # beyond the packed key's range: the same order by lexsort
-    big = np.array([1e12, 2.0, 1e12, 0.0])
-    np.testing.assert_array_equal(_forest_order(big), [3, 1, 0, 2])
-    assert _forest_order(np.zeros(0)).size == 0
+    with use_backend(backend):
+        np.testing.assert_array_equal(_forest_order(weights), [4, 1, 3, 0, 2, 6, 5])
+        # beyond an unsigned 64-bit integer's range, or NaN (last): the same order by lexsort
+        np.testing.assert_array_equal(_forest_order(np.array([1e12, 2.0, 1e12, 0.0])), [3, 1, 0, 2])
+        np.testing.assert_array_equal(_forest_order(np.array([np.nan, 2.0, np.nan, 0.0])), [3, 1, 0, 2])
+        assert _forest_order(np.zeros(0)).size == 0
+        # many weights, a few thousand ties: the stable order of the rounded weights
+        many = np.random.default_rng(4).uniform(0.0, 4.0, 200_000)
+        many[::50] = many[1::50]
+        key = np.rint(many / TIE_RESOLUTION)
+        np.testing.assert_array_equal(_forest_order(many), np.lexsort((np.arange(many.size), key)))
