@@ -15,7 +15,8 @@ Families (each at ``method="quadric"``, the default radius unless a radius is na
   0.3 mean edge lengths (``numpy.random.default_rng(seed)``); held out: random_sphere, random_ellipsoid, the
   cylinder, other seeds;
 - ``saddle``: ``z = (x^2 - y^2) / 2`` over the unit disc (a triangular lattice of step h, jittered by ``seed``
-  inside), clean, at a given radius of 1.5 h and at the default.
+  inside) and ``shapes.saddle`` (``z = x^2 - y^2`` over ``[-1, 1]^2``; steps 0.1 and 0.05, held out: 0.08 and
+  0.125 jittered by 0.3), clean, at a given radius of 1.5 h and at the default.
 
 A vertex is *off* when its H is off the exact one by more than half of the largest exact ``|k|`` at the vertex
 (unit sphere: ``|H - 1| > 0.5``). Each row: valid vertices, the valid ones off, their share of the referenced
@@ -125,14 +126,24 @@ def rows(family, seeds, held_out):
                 yield f"{name} gauss {NOISE}h seed {seed}", count(vertices, mesh.faces, mesh.k_min, mesh.k_max)
     elif family == "saddle":
         steps = (0.04, 0.07) if held_out else (0.05, 0.1)
-        for step in steps:
-            for seed in seeds:
+        meshes = [(f"disc saddle h {step:g} seed {seed}", step, seed) for step in steps for seed in seeds]
+        squares = [(0.08, 0.3), (0.125, 0.3)] if held_out else [(0.1, 0.0), (0.05, 0.0)]
+        meshes += [
+            (f"square saddle h {step:g} jitter {jitter:g} seed {seed}", step, (jitter, seed))
+            for step, jitter in squares
+            for seed in (seeds if jitter else seeds[:1])
+        ]
+        for label, step, seed in meshes:
+            if isinstance(seed, tuple):
+                mesh = shapes.saddle(1.0, step, jitter=seed[0], seed=seed[1])
+                vertices, faces, k_min, k_max = mesh.vertices, mesh.faces, mesh.k_min, mesh.k_max
+            else:
                 vertices, faces, k_min, k_max = disc_saddle(step, seed)
-                edge = _mean_edge(vertices, faces)
-                for factor in (1.5, None):
-                    radius = None if factor is None else factor * edge
-                    label = "default" if factor is None else f"{factor:g} h"
-                    yield f"disc saddle h {step:g} seed {seed} {label}", count(vertices, faces, k_min, k_max, radius)
+            edge = _mean_edge(vertices, faces)
+            for factor in (1.5, None):
+                radius = None if factor is None else factor * edge
+                shown = "default" if factor is None else f"{factor:g} h"
+                yield f"{label} {shown}", count(vertices, faces, k_min, k_max, radius)
 
 
 def main(argv=None) -> int:
