@@ -22,6 +22,12 @@ from meshcurv import shapes
 
 pytest.importorskip("skimage")  # marching cubes
 
+#: Open (issue 29/30): I20's wider refits (fb435ca, 0441813, a07c121) passed these tests but were reverted by the lead
+#: the same day: NumPy refits over balls 3 times wider made thin flat voxel parts 20-30 times slower
+#: (voxel_ellipsoid((20, 20, 5)): 0.20 -> 5.73 CPU s) and still left 169 of 371 flat vertices off. The fix needs the
+#: compiled normal fits to drop the points facing away (benchmarks/flat_voxel_normals.md).
+pytestmark = pytest.mark.xfail(strict=True, reason="open: flat voxel faces' normals (refits reverted for their cost)")
+
 
 def _flat_faces(semi_axes, seed):
     mesh = shapes.voxel_ellipsoid(semi_axes, seed=seed)

@@ -85,7 +85,7 @@ from ._geometry import (
 from .geometry import _floats, checked_topology_points
 from .jets import SETTLED_SLOPE, _fit_jets
 from .lattice import VoxelGrid, voxel_grid
-from .neighborhoods import _ball_face_sums, _checked_ids, face_in_ball_ratios
+from .neighborhoods import _ball_face_sums, _checked_ids, face_in_ball_ratios, ring_max, ring_sums
 from .topology import MeshTopology
 
 if TYPE_CHECKING:
@@ -771,15 +771,17 @@ def _mesh_voxel_grid(mesh: _Measured | PreparedMesh) -> VoxelGrid | None:
     referenced = topology.referenced_vertices & ~spikes
     if not referenced.any():
         return None
-    kept = ~spikes[topology.faces].any(axis=1)
-    grid = _subset_voxel_grid(mesh, topology.faces[kept], referenced)
+    # (no needle, most meshes: the faces themselves, no (F,) gather of the needles and no copy of the faces)
+    kept = ~spikes[topology.faces].any(axis=1) if spikes.any() else None
+    grid = _subset_voxel_grid(mesh, topology.faces if kept is None else topology.faces[kept], referenced)
     fragments = _fragment_vertices(topology) if grid is None else None
     if fragments is None:
         return grid
     on_surface = referenced & ~fragments
     if not on_surface.any():
         return None
-    return _subset_voxel_grid(mesh, topology.faces[kept & on_surface[topology.faces].all(axis=1)], on_surface)
+    surface_faces = on_surface[topology.faces].all(axis=1)
+    return _subset_voxel_grid(mesh, topology.faces[surface_faces if kept is None else kept & surface_faces], on_surface)
 
 
 def _subset_voxel_grid(mesh: _Measured | PreparedMesh, faces: np.ndarray, used: np.ndarray) -> VoxelGrid | None:
@@ -947,14 +949,9 @@ VOXEL_SCALE_RULE = (
 
 
 def _ring_max(neighbour_lists: tuple, rings: int, values: np.ndarray) -> np.ndarray:
-    """(V,) the largest of ``values`` over each vertex and the vertices within ``rings`` edges of it."""
-    indptr, indices = neighbour_lists
-    rows = np.flatnonzero(np.diff(indptr) > 0)
-    out = np.array(values, dtype=np.float64, copy=True)
-    for _ in range(rings if rows.size else 0):
-        # the rows without neighbours are skipped: each start then ends where the next row with any begins
-        out[rows] = np.maximum(out[rows], np.maximum.reduceat(out[indices], indptr[rows]))
-    return out
+    """(V,) the largest of ``values`` over each vertex and the vertices within ``rings`` edges of it
+    (:func:`meshcurv.neighborhoods.ring_max`: compiled, on threads, with numba)."""
+    return ring_max(neighbour_lists, rings, values)
 
 
 def voxel_vertex_radii(
@@ -1089,16 +1086,9 @@ LOCAL_FOLLOW = 4.0
 
 def _ring_sums(neighbour_lists: tuple, rings: int, *arrays: np.ndarray) -> list[np.ndarray]:
     """Each of ``arrays`` (V, ...) summed ``rings`` times over every vertex and its edge neighbours
-    (``neighbour_lists``: :attr:`meshcurv.topology.MeshTopology.neighbour_lists`)."""
-    from scipy import sparse  # imported on use: keeps `import meshcurv` fast
-
-    indptr, indices = neighbour_lists
-    n = indptr.size - 1
-    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n)) + sparse.identity(n)
-    sums = list(arrays)
-    for _ in range(rings):
-        sums = [ring @ array for array in sums]
-    return sums
+    (``neighbour_lists``: :attr:`meshcurv.topology.MeshTopology.neighbour_lists`;
+    :func:`meshcurv.neighborhoods.ring_sums`: compiled, on threads, with numba)."""
+    return ring_sums(neighbour_lists, rings, *arrays)
 
 
 def local_scale_ratios(vertices: np.ndarray, topology: MeshTopology) -> np.ndarray:

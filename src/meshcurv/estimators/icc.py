@@ -30,7 +30,9 @@ their own noise (:func:`meshcurv.radius._patch_radii`: the spread of the noise
 fits' signed offsets over two rings, at least twice the group's radius to
 count; ``parameters["scale"] == "local"``): a unit icosphere with Gaussian
 noise of 0.19 h on a cap had 1,248 of 5,762 vertices off by more than half of
-H at one edge length, 2 now. On dense surfaces (normal-fit balls wider than 16 edge lengths,
+H at one edge length, 2 now; beside cracks and faces detached beyond the weld,
+where a ball holds less than 0.8 of its disc while faces it cannot reach lie
+within it, up to twice the radius (:func:`meshcurv.radius._holed_factor`). On dense surfaces (normal-fit balls wider than 16 edge lengths,
 marching cubes of fine voxels) the normals are fitted on clusters of vertices
 (:func:`fitted_normals`). On voxel surfaces each vertex takes the radius its
 pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
@@ -43,11 +45,6 @@ and where the balls of such a surface hold 800 faces or more (fine voxels), each
 ball is summed on clusters of about 32 faces, the clusters on its rim by their
 share of the ball (:func:`meshcurv.neighborhoods.coarse_face_sums`): the cost of
 a ball no longer grows with the density of its faces (``benchmarks/dense_voxel.md``).
-On the flat faces of a thin voxel part (a normal-fit ball that reaches the other side round the rim while
-its own jet hardly bends) the normals are fitted again over balls three times wider, of the points that face
-the centre's way (:func:`_thin_part_normals`): the terraces of such a staircase are wider than the first ball,
-whose fits their edges tilted (``voxel_ellipsoid((8, 8, 2))``: 13.8 degrees off the exact normals at the median
-on its flat faces, 4.8 now; 236 of their 371 vertices off by more than half of their own curvature, 169 now).
 
 The normals ``u_i`` are interpolated linearly over each triangle; the
 curvature measures ``mu_0`` (corrected area), ``mu_1`` (2H dA), ``mu_2`` (K dA)
@@ -129,22 +126,16 @@ from ..jets import (
     SAMPLED_SPREAD,
     SETTLED_SLOPE,
     _cube_samples,
-    _fit_chunk,
     _fit_jet_normals,
     _fit_jets,
-    _solve,
     _nearest_in_cubes,
     _sampled_jet_normals,
     interpolated_normals,
-    jet_curvatures,
     jet_normals,
     nested_jet_normals,
 )
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import (
-    MAX_BALL_PAIRS,
-    _estimate_ball_pairs,
-    connected_ball_pairs,
     _ball_face_sums,
     _ball_face_sums_nested,
     _coarse_face_sums,
@@ -246,7 +237,6 @@ def fitted_normals(
     fits: np.ndarray | None = None,
     edge: float | None = None,
     unwrap: np.ndarray | None = None,
-    thin: bool = False,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -270,9 +260,6 @@ def fitted_normals(
 
     ``unwrap`` (V,) bool: the vertices whose fits are checked for balls holding points that face away, and made
     again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes).
-
-    ``thin``: a voxel surface; the fits whose ball wraps around a thin flat part are made again over wider balls
-    of the points that face the centre's way (:func:`_thin_part_normals`; not on the coarse level).
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -338,10 +325,6 @@ def fitted_normals(
                 neighbours,
                 adjacency,
                 areas if weighted else None,
-            )
-        if thin and adjacency is not None:
-            fitted = _thin_part_normals(
-                vertices, np.where(valid[:, None], fitted, normals), radius, valid, neighbours, adjacency, areas
             )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
@@ -433,128 +416,6 @@ def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjac
             fitted[centres[few][unsteady]] = lower[unsteady]
         centres, radii = centres[wrapped], radii[wrapped] * UNWRAP_SHRINK
     return fitted
-
-
-#: On a voxel surface, a normal fit whose ball wraps around the surface (holds more than
-#: :data:`meshcurv.jets.AWAY_FRACTION` of points facing away from its centre, by the first fits) while its own jet
-#: bends less than this over the ball (the largest ``|k|`` of a cubic over the same ball times its radius) is on a
-#: flat part thinner than the ball: the wrap is its other side, through a rim, not the centre's own bend (the
-#: wrapped fits at the tips of ``voxel_ellipsoid((10, 7, 5))`` and round the tube of ``voxel_torus(12, 4)`` read
-#: 1.3 to 3; those on the flat faces of ``voxel_ellipsoid((8, 8, 2))`` 0.1 to 1.0, median 0.6) ...
-THIN_BEND = 1.0
-#: ... and its normal is fitted again over a ball this many times wider (the terraces of a flat part's staircase
-#: are about ``sqrt(2 h R)`` wide, 8 voxels at the pole of that ellipsoid, wider than the first ball of 3.2: its
-#: normals were tilted by the edges of the terraces, 13.8 degrees off the exact ones at the median) ...
-THIN_WIDEN = 3.0
-#: ... over the points whose first-fit normal has a cosine above this with the centre's (46 degrees: the other
-#: side and the rim are left out; 0.5 and a ball twice as wide left more vertices off, ``benchmarks/flat_voxel_normals.py``).
-THIN_AGREEMENT = 0.7
-#: The test is made first at one centre per cube of this many normal-fit radii, then at the centres within two
-#: cubes of those that passed (the wrapped fits round a tube or a tip, which fail it, cost a sample's test).
-THIN_SAMPLE = 0.5
-
-
-def _thin_part_normals(vertices, fitted, radius, valid, neighbours, adjacency, areas) -> np.ndarray:
-    """(V, 3) ``fitted`` (the normals of the fits over ``radius``, float or (V,)) with the fits on thin flat parts of
-    a voxel surface made again (:data:`THIN_BEND`): over balls :data:`THIN_WIDEN` times wider, of the points whose
-    fitted normals agree with the centre's (:data:`THIN_AGREEMENT`), each weighing its area (``areas`` (V,) or None).
-
-    Issue 29/30: on ``shapes.voxel_ellipsoid((8, 8, 2), seed=2)`` 236 of the 371 vertices of the flat faces (their
-    own ``|k|`` below a tenth of the rim's) were off by more than half of it at the default radius; with the exact
-    normals at the same radii none. Leaving the other side out at the same radius changed nothing (the fits are
-    tilted by the terraces' edges, not by the far side alone); a wider ball of the near side alone did.
-    The refits are made by NumPy on both backends (the points of each ball chosen by its centre's normal).
-    """
-    n = vertices.shape[0]
-    centres = np.flatnonzero(valid & np.isfinite(fitted).all(axis=1))
-    if not centres.size:
-        return fitted
-    facing = np.where(np.isfinite(fitted), fitted, 0.0)
-    radii = np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,))[centres]
-
-    def fit(at, over, degree, **extra):
-        return _fit_jets(
-            vertices,
-            facing,
-            over,
-            degree=degree,
-            iterations=1,
-            centres=at,
-            neighbours=neighbours,
-            adjacency=adjacency,
-            compact=True,
-            **extra,
-        )
-
-    def thin_flat(at, over):  # the centres `at` whose ball wraps while their own jet hardly bends
-        details: dict = {}
-        fit(at, over, 1, facing=facing, details=details)  # (the share facing away only: no jet is solved)
-        with np.errstate(invalid="ignore"):
-            wrapped = details["away"] > AWAY_FRACTION
-        flat = np.zeros(at.size, dtype=bool)
-        if not wrapped.any():
-            return flat
-        coefficients, frame, _ = fit(at[wrapped], over[wrapped], NORMAL_DEGREE, min_spread=NORMAL_MIN_SPREAD)
-        k_min, k_max = jet_curvatures(coefficients, frame, over[wrapped], facing[at[wrapped]])[:2]
-        with np.errstate(invalid="ignore"):
-            flat[wrapped] = np.maximum(np.abs(k_min), np.abs(k_max)) * over[wrapped] < THIN_BEND
-        return flat
-
-    # first at one centre per cube of THIN_SAMPLE normal radii, then at the centres near those that passed
-    side = THIN_SAMPLE * float(np.median(radii))
-    sampled = _cube_samples(vertices[centres], side)
-    passed = sampled[thin_flat(centres[sampled], radii[sampled])]
-    if not passed.size:
-        return fitted
-    from scipy.spatial import cKDTree
-
-    distance, _ = cKDTree(vertices[centres[passed]]).query(vertices[centres], distance_upper_bound=2.0 * side)
-    near = np.flatnonzero(np.isfinite(distance))
-    flat = near[thin_flat(centres[near], radii[near])]
-    centres, radii = centres[flat], radii[flat]
-    if not centres.size:
-        return fitted
-    mean, _ = _estimate_ball_pairs(vertices, THIN_WIDEN * radii, vertices[centres])
-    if mean * centres.size > MAX_BALL_PAIRS:  # (the first fits' own bound: beyond it they are kept as they are)
-        return fitted
-    if areas is not None:
-        positive = areas[areas > 0]
-        areas = areas / np.median(positive) if positive.size else None
-    refitted = _agreeing_jet_normals(vertices, facing, THIN_WIDEN * radii, centres, neighbours, adjacency, areas)
-    out = np.array(fitted, copy=True)
-    found = np.isfinite(refitted).all(axis=1)
-    out[centres[found]] = refitted[found]
-    return out
-
-
-def _agreeing_jet_normals(vertices, facing, radii, centres, neighbours, adjacency, areas) -> np.ndarray:
-    """(M, 3) the unit normals of degree-:data:`NORMAL_DEGREE` jets at ``centres`` (M,) over their surface-connected
-    balls of ``radii`` (M,), of the points whose ``facing`` (V, 3) normal has a cosine above :data:`THIN_AGREEMENT`
-    with the centre's, in the frame of the centre's, refitted once in that of the first fit (NaN: no fit).
-
-    NumPy on both backends (the compiled fits take one set of points for all centres)."""
-    order = np.argsort(radii, kind="stable")
-    ordered, ordered_radii = centres[order], radii[order]
-    normals = np.full((centres.size, 3), np.nan)
-    for chunk, centre, neighbour in connected_ball_pairs(vertices, ordered, ordered_radii, adjacency, neighbours):
-        index = ordered[chunk]
-        rows = centre - chunk.start
-        keep = np.einsum("ij,ij->i", facing[neighbour], facing[index[rows]]) > THIN_AGREEMENT
-        rows, neighbour = rows[keep], neighbour[keep]
-        offsets = (vertices[neighbour] - vertices[index[rows]]) / ordered_radii[chunk][rows][:, None]
-        weights = np.maximum(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0) ** 2
-        if areas is not None:
-            weights = weights * areas[neighbour]
-        count = np.bincount(rows, weights=(weights > 0).astype(np.float64), minlength=index.size)
-        normal = facing[index]
-        for _ in range(NORMAL_ITERATIONS):  # (a fit that fails keeps the frame it was made in)
-            frame = [*tangent_basis(normal), normal]
-            matrix, right = _fit_chunk(offsets, rows, index.size, frame, weights, NORMAL_DEGREE)
-            found = jet_normals(_solve(matrix, right, count, NORMAL_DEGREE, NORMAL_MIN_SPREAD), tuple(frame))
-            ok = np.isfinite(found).all(axis=1, keepdims=True)
-            normal = np.where(ok, found, normal)
-        normals[order[chunk]] = np.where(ok, normal, np.nan)
-    return normals
 
 
 def _coarse_level(
@@ -1015,7 +876,6 @@ def _curvatures(
             failed=failed,
             edge=edge,
             unwrap=near,
-            thin=coarse,
         )
 
         if boundary_faces is not None and adjacency is not None:

@@ -212,7 +212,7 @@ def _few_cells(mesh: PreparedMesh, invalid, valid, steps: int, fields) -> np.nda
         sums.append([weights @ edge_areas, weights.multiply(weights) @ (edge_areas * edge_areas)])
     whole = weights @ np.column_stack([edge_areas * read, edge_areas * held, edge_areas * held * held])
     shares, intact_shares, variances = np.full(n, np.inf), np.full(n, np.inf), np.full(n, np.nan)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         shares[centres] = sums[0][1] / (sums[0][0] * sums[0][0])
         intact_shares[centres] = sums[1][1] / (sums[1][0] * sums[1][0])
         variances[centres] = whole[:, 2] / whole[:, 0] - (whole[:, 1] / whole[:, 0]) ** 2

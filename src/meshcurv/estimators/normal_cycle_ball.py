@@ -149,7 +149,7 @@ def few_elements(valid, shares, intact_shares, variances, readings, curvatures) 
         return np.zeros_like(valid)
     variance = float(np.median(variances[known]))
     k_min, k_max = curvatures
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", over="ignore"):
         lost = ~(FEW_ELEMENTS_KEPT * shares <= intact_shares)
     # the curvature of the supports that kept their elements; where none did, the edges' readings' root mean square
     kept = valid & ~lost
@@ -157,8 +157,9 @@ def few_elements(valid, shares, intact_shares, variances, readings, curvatures) 
         scale = float(np.median(np.maximum(np.abs(k_min[kept]), np.abs(k_max[kept]))))
     else:
         read = readings[np.isfinite(readings)]
-        scale = float(np.sqrt(np.mean(read * read))) if read.size else 0.0
-    with np.errstate(invalid="ignore"):
+        with np.errstate(over="ignore"):
+            scale = float(np.sqrt(np.mean(read * read))) if read.size else 0.0
+    with np.errstate(invalid="ignore", over="ignore"):
         return valid & lost & ~(variance * shares <= (FEW_ELEMENTS_SPREAD * scale) ** 2)
 
 
@@ -350,7 +351,7 @@ def _few_edges(valid, areas, spread_sums, readings, curvatures) -> np.ndarray:
     :func:`_edge_spread_columns`; ``readings``: the edges' (:func:`edge_readings`); ``curvatures``: ``(k_min,
     k_max)``."""
     squared, whole, whole_squared, read, first, second = spread_sums.T
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         shares = squared / (areas * areas)  # 1 / N (at least)
         intact_shares = whole_squared / (whole * whole)
         variances = second / read - (first / read) ** 2
