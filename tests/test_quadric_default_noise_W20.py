@@ -51,6 +51,13 @@ def _off(result, k_min, k_max):
         return result.valid & (np.abs(result.mean - (k_min + k_max) / 2) > 0.5 * scale)
 
 
+#: Open (issue 29): W20's checks (d19e8f4) passed these but were reverted by the lead the same day: they broke three
+#: tests of the suite (a hole and fan-triangulated polygons warned or lost cover, detached faces' cover 0.945 < 0.95),
+#: cost 2-4.7x CPU on real meshes and read creases as noise (fandisk 80 -> 57% valid). Kept as the open defect.
+OPEN = pytest.mark.xfail(strict=True, reason="open: quadric at its default radius and at steep rims (W20 reverted)")
+
+
+@OPEN
 @pytest.mark.parametrize(
     ("name", "cover"),
     [
@@ -67,6 +74,7 @@ def test_gaussian_noise_default_radius(name, cover):
     assert result.valid.mean() > cover
 
 
+@OPEN
 def test_half_detached_icosphere_default_radius():
     # icosphere(32): 10,242 vertices and 30,720 detached corners; before, 11 of 35,468 valid vertices off (up to
     # 0.67), none off at icosphere(24), whose curvature is larger against the corners' offset of 0.054 edge lengths
@@ -84,6 +92,7 @@ def test_half_detached_icosphere_default_radius():
     assert result.valid[referenced].mean() > 0.75
 
 
+@OPEN
 def test_steep_saddle_rim_given_radius():
     # z = x^2 - y^2 on [-1, 1]^2, step 0.1, a radius of 1.5 mean edge lengths: the balls of the rims at y = +-1
     # (slope 2 across them) held two rows of points; 16 vertices read k_min -1.09 for -0.50 (off by 0.66-1.0 of
@@ -94,6 +103,7 @@ def test_steep_saddle_rim_given_radius():
     assert result.valid.mean() > 0.75
 
 
+@OPEN
 def test_steep_saddle_rim_warns():
     mesh = shapes.saddle(1.0, 0.1)
     with pytest.warns(UserWarning, match="departs from a 2 times wider ball"):

@@ -51,7 +51,7 @@ edge lengths, averaged over two rings), and
 - at any radius, a vertex whose level, or its mesh's median level, exceeds :data:`NOISE_GATE` has its jet
   checked against a quadric over the same ball, as at the rim (faces detached off the surface by a tenth of an edge make such balls: issue 29, fuzz
   296/1682);
-- at any radius, the noise's reach (:func:`_noise_reach`; at the default radius without the swap): the spread of a fit's curvatures under the noise of
+- at a given radius, the noise's reach (:func:`_noise_reach`): the spread of a fit's curvatures under the noise of
   its ball, from the level (as a standard deviation, :data:`NOISE_SIGMA_FACTOR`) and the weighted normal matrix of
   the ball's points (``sigma^2 G^-1 M G^-1``, :func:`_noise_spreads`), against the median curvedness of the
   surface: a jet spread beyond :data:`JET_NOISE_REACH` of it takes a quadric over the same ball, and a vertex
@@ -81,14 +81,7 @@ from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, PIVOT_FLOOR, _exponents, _fit_chunk, _fit_jets, shape_operators
 from ..neighborhoods import _ball_pairs
 from .._tensors import tangent_basis
-from ..radius import (
-    JET_CURVATURE_CAP,
-    _component_radii,
-    _jet_vertex_radii,
-    _local_noise,
-    _resolve_radius,
-    _vertex_radii,
-)
+from ..radius import _component_radii, _jet_vertex_radii, _local_noise, _resolve_radius, _vertex_radii
 from .._prepared import PreparedMesh
 from ._support import Stages, finish
 
@@ -152,25 +145,6 @@ JET_NOISE_REACH = 0.1
 #: for a Gaussian noise that the fits absorb as their six terms would on average).
 NOISE_SIGMA_FACTOR = 2.5
 
-#: A vertex at the default radius whose quadric spreads beyond :data:`NOISE_REACH` under the noise of its ball is
-#: fitted again over a ball this much larger than the one the spread's fall as ``r^-3`` asks for (and at least
-#: this much larger than its own, else it stays NaN), within the curvature's cap (:func:`_grown_radii`).
-GROWTH_MARGIN = 1.1
-
-#: A rim vertex's fit is checked against a quadric over a ball this many times wider (:func:`_rim_scales`).
-RIM_SCALE = 2.0
-
-#: ... at most this over the surface's curvature (``curvatures`` of :func:`_rim_scales`: a wider ball's bias
-#: ``(r k)^2`` would reach :data:`NOISE_REACH`; at 1.3 times the radius of curvature a clean cylinder's rim at 2.5 edge
-#: lengths was off it, every vertex) ...
-RIM_CAP = 0.5
-
-#: ... and not checked where that leaves it less than this many times the vertex's radius.
-RIM_SCALE_MARGIN = 1.25
-
-#: The rounds of :func:`_grown_radii` (each fits again the vertices still beyond the noise's reach).
-GROWTH_ROUNDS = 3
-
 #: Noise levels up to this read as a clean mesh in :func:`_noise_sigmas`: twice
 #: :data:`meshcurv.radius.NOISE_FLOOR`, as the vertices of a clean irregular mesh read up to 0.006 (a random
 #: ellipsoid of 2,562 points, whose degree-4 jets a noise read from the floor alone sent to quadrics 1.2
@@ -228,26 +202,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             radii[again] = base[again]
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
     unsure = np.zeros(n, dtype=bool)
-    apart = np.zeros(n, dtype=bool)
-    # a voxel surface's default (stages.voxel_default) is not checked: its staircase reads as noise at every ball of
-    # the voxel default (two voxel spheres and a quantised ellipsoid left with no valid vertex; the warning names
-    # 'icc'); the default radius, grown with the noise (jet_vertex_radii), is held to the noise's reach without the
-    # swap to a quadric (_noise_reach)
-    if not stages.voxel_default:
+    # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate; a voxel surface's
+    # default (stages.voxel_default) is not checked either: its staircase reads as noise at every ball of the voxel
+    # default (two voxel spheres and a quantised ellipsoid left with no valid vertex; the warning names 'icc')
+    if radius is not None and not stages.voxel_default:
         sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
-        own = fields if radius is None else None  # a given ball's fits read the noise as the noise fits do
-        curvatures = _curvature_scales(curvedness, scales, vertices, referenced, own)
-        reach = (vertices, start, radii, referenced, facing)
-        unsure, spreads = _noise_reach(reach, sigmas, curvatures, fields, swap=radius is not None)
-        if radius is not None:  # the default's rim: 2.5 edge lengths at least, capped by the curvature inside
-            apart = _rim_scales(reach, rim, curvatures, fields)
-        for _ in range(GROWTH_ROUNDS if radius is None else 0):  # a larger ball within the curvature's cap
-            again = _grown_radii(radii, spreads, curvatures, fields, unsure)
-            if again.size == 0:
-                break
-            _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
-            checked, spreads = _noise_reach(reach, sigmas, curvatures, fields, swap=False, rows=again)
-            unsure[again] = checked[again]
+        curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
+        unsure = _noise_reach((vertices, start, radii, referenced, facing), sigmas, curvatures, fields)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -259,8 +220,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     failed = ~valid & ~defects.invalid_vertices
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     noisy_balls = int((failed & unsure & ~(away > AWAY_FRACTION)).sum())
-    one_sided = int((failed & apart & ~unsure & ~(away > AWAY_FRACTION)).sum())
-    few = int(failed.sum()) - two_sided - noisy_balls - one_sided
+    few = int(failed.sum()) - two_sided - noisy_balls
     shown = ", ".join(f"{r:g}" for r, _ in groups) if radius is not None else _shown_radii(radii, referenced)
     extra = (
         (
@@ -278,21 +238,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         else "",
         (
             f"{noisy_balls} vertices have a ball of radius {shown} too small for the noise of their surface: "
-            f"any fit over it moves the curvatures by more than {NOISE_REACH:g} of the surface's; "
-            + (
-                "pass a larger `radius` (or none)"
-                if radius is not None
-                else "a larger ball would average the curvature"
-            )
+            f"any fit over it moves the curvatures by more than {NOISE_REACH:g} of the surface's; pass a larger "
+            "`radius` (or none)"
         )
         if noisy_balls
-        else "",
-        (
-            f"{one_sided} boundary vertices have a one-sided ball of radius {shown} whose fit departs from a "
-            f"{RIM_SCALE:g} times wider ball's by more than {NOISE_REACH:g} of the surface's curvature (too few rows "
-            "of points across the boundary); pass a larger `radius`"
-        )
-        if one_sided
         else "",
     )
     normals_out = np.where(valid[:, None], fitted, normals)
@@ -385,8 +334,18 @@ def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
     over the radius ``unit``; NaN where no degree is spread enough."""
     vertices, start, unit, rows, degree = steady
     six, fitted, coefficients = fields
-    low_six, low_fitted, found = _quadrics((vertices, start, unit, rows), referenced, facing, degree)
-    spread = np.isfinite(found).all(axis=1)
+    found, frame, _ = _fit_jets(
+        vertices,
+        start,
+        unit,
+        degree=degree,
+        centres=rows,
+        neighbours=referenced,
+        facing=facing,
+        min_spread=STEADY_MIN_SPREAD,
+    )
+    low_six, low_fitted = shape_operators(found[rows], tuple(axis[rows] for axis in frame), unit)
+    spread = np.isfinite(found[rows]).all(axis=1)
     high = np.isfinite(coefficients[rows]).all(axis=1)
     both = spread & high
     apart = np.full(rows.size, np.inf)
@@ -396,7 +355,7 @@ def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
         scale = unit[both] if np.ndim(unit) else unit
         apart[both] = scale * np.maximum(np.abs(high_k[0] - low_k[0]), np.abs(high_k[1] - low_k[1]))
     swap = spread & ~(apart <= STEADY_AGREEMENT)
-    six[rows[swap]], fitted[rows[swap]], coefficients[rows[swap]] = low_six[swap], low_fitted[swap], found[swap]
+    six[rows[swap]], fitted[rows[swap]], coefficients[rows[swap]] = low_six[swap], low_fitted[swap], found[rows][swap]
     coefficients[rows[~spread]] = np.nan
 
 
@@ -452,105 +411,18 @@ def _noise_sigmas(levels: np.ndarray, groups: list, edge_lengths: np.ndarray) ->
     return np.where(np.isfinite(sigmas), sigmas, 0.0)
 
 
-def _curvature_scales(
-    curvedness: np.ndarray, groups: list, vertices: np.ndarray, referenced, fields: tuple | None
-) -> np.ndarray:
-    """(V,) the curvature that a vertex's estimate is held to: the median curvedness of its group (``groups``),
-    that of the noise fits (:func:`meshcurv.radius.local_noise`) or, if smaller, that of the fits in ``fields``
-    (``six, fitted, coefficients``; their valid vertices; None: not read, as at a given radius, whose balls of an
-    edge length or two read the noise as the noise fits do), at least ``2 / d`` (``d``: the diagonal of the bounding
-    box of the referenced vertices: a sphere's curvedness is ``2.4 / d``; a noisy plane is held to the curvature of
-    its extent). The noise fits (over two edge lengths) read noise as curvature: a unit sphere with Gaussian noise
-    of 0.3 edge lengths along its normals read a median curvedness of 4.9 (its fits at the default radius 1.1),
-    which let spreads of three times its curvature pass."""
+def _curvature_scales(curvedness: np.ndarray, groups: list, vertices: np.ndarray, referenced) -> np.ndarray:
+    """(V,) the curvature that a vertex's estimate is held to: the median curvedness of its group (``groups``;
+    :func:`meshcurv.radius.local_noise`), at least ``2 / d`` (``d``: the diagonal of the bounding box of the
+    referenced vertices: a sphere's curvedness is ``2.4 / d``; a noisy plane is held to the curvature of its
+    extent)."""
     points = vertices[referenced]
     diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if points.size else 0.0
     floor = 2.0 / diagonal if diagonal > 0 else np.inf
-    scales = _group_medians(curvedness, groups, np.isfinite(curvedness) & referenced)
-    if fields is not None:
-        six, fitted, coefficients = fields
-        usable = np.isfinite(coefficients).all(axis=1) & referenced
-        own = np.full(vertices.shape[0], np.nan)
-        if usable.any():
-            k_min, k_max = principal_from_shape_operator(six[usable], fitted[usable])[:2]
-            own[usable] = np.sqrt((k_min**2 + k_max**2) / 2)
-        scales = np.fmin(scales, _group_medians(own, groups, np.isfinite(own)))
-    return np.fmax(scales, floor)
+    return np.fmax(_group_medians(curvedness, groups, np.isfinite(curvedness) & referenced), floor)
 
 
-def _quadrics(part: tuple, referenced, facing, degree: int = STEADY_DEGREE) -> tuple:
-    """``(six, fitted, coefficients)`` of the fits of at most ``degree`` (a quadric: :data:`STEADY_DEGREE`) whose
-    points are spread by :data:`STEADY_MIN_SPREAD`, of ``part = (vertices, start, unit, rows)`` (``unit``: one
-    radius, or one per row), one row each (NaN coefficients where no degree is spread enough)."""
-    vertices, start, unit, rows = part
-    found, frame, _ = _fit_jets(
-        vertices,
-        start,
-        unit,
-        degree=degree,
-        centres=rows,
-        neighbours=referenced,
-        facing=facing,
-        min_spread=STEADY_MIN_SPREAD,
-    )
-    six, fitted = shape_operators(found[rows], tuple(axis[rows] for axis in frame), unit)
-    return six, fitted, found[rows]
-
-
-def _rim_scales(reach: tuple, rim: np.ndarray, curvatures: np.ndarray, fields: tuple) -> np.ndarray:
-    """(V,) bool: the ``rim`` vertices whose fit departs from a quadric over a ball of :data:`RIM_SCALE` times its
-    radius (:data:`RIM_SCALE_MARGIN`) by more than :data:`NOISE_REACH` of ``curvatures`` (their coefficients in ``fields``, changed in place,
-    made NaN). ``reach = (vertices, start, radii, referenced, facing)``. A one-sided ball of a few points holds
-    as few rows of them as the quadric has terms across the rim, which the surface's own higher terms then set:
-    on ``z = x^2 - y^2`` over ``[-1, 1]^2`` with a step of 0.1 at a radius of 1.5 edge lengths, the steep rims'
-    balls held two rows, and 16 of their vertices read k_min -1.09 for -0.50 (off by half of H and more, clean);
-    a ball twice as wide holds enough rows, and a smooth surface's fits at two scales agree within the bias
-    ``(r k)^2`` of the larger. A larger ball whose fit fails leaves the vertex as it was."""
-    vertices, start, radii, referenced, facing = reach
-    six, fitted, coefficients = fields
-    unsure = np.zeros(vertices.shape[0], dtype=bool)
-    rows = np.flatnonzero(rim & np.isfinite(coefficients).all(axis=1) & referenced)
-    unit = np.minimum(RIM_SCALE * radii[rows], RIM_CAP / curvatures[rows])
-    wider = unit > RIM_SCALE_MARGIN * radii[rows]
-    rows, unit = rows[wider], unit[wider]
-    if rows.size == 0:
-        return unsure
-    wide_six, wide_fitted, found = _quadrics((vertices, start, unit, rows), referenced, facing)
-    known = np.isfinite(found).all(axis=1)
-    own = principal_from_shape_operator(six[rows], fitted[rows])[:2]
-    wide = principal_from_shape_operator(
-        np.where(known[:, None], wide_six, 0.0), np.where(known[:, None], wide_fitted, [0.0, 0.0, 1.0])
-    )[:2]
-    apart = np.maximum(np.abs(own[0] - wide[0]), np.abs(own[1] - wide[1]))
-    unsure[rows[known & (apart > NOISE_REACH * curvatures[rows])]] = True
-    coefficients[unsure] = np.nan
-    return unsure
-
-
-def _grown_radii(radii: np.ndarray, spreads: np.ndarray, curvatures: np.ndarray, fields: tuple, unsure) -> np.ndarray:
-    """The ``unsure`` vertices (:func:`_noise_reach` at the default radius) whose ball can grow until their fit's
-    spread under the noise (``spreads``) is within :data:`NOISE_REACH` of ``curvatures``: their ``radii`` (changed
-    in place) times ``(spread / reach)^(1/3)`` (the spread of a fit falls as ``r^-3``: ``sigma / r^2`` over
-    ``sqrt(N)``, ``N ~ r^2`` points) and :data:`GROWTH_MARGIN`, at most
-    ``meshcurv.radius.JET_CURVATURE_CAP`` over the curvedness of the vertex's own fit (``fields = (six, fitted,
-    coefficients)``; a noisy fit reads more, which keeps the ball smaller). Returns the vertices grown."""
-    six, fitted = fields[:2]
-    rows = np.flatnonzero(unsure & np.isfinite(spreads) & np.isfinite(six).all(axis=1))  # NaN coefficients: unsure
-    if rows.size == 0:
-        return rows
-    k_min, k_max = principal_from_shape_operator(six[rows], fitted[rows])[:2]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cap = JET_CURVATURE_CAP / np.fmax(np.sqrt((k_min**2 + k_max**2) / 2), curvatures[rows])
-        factor = GROWTH_MARGIN * np.cbrt(spreads[rows] / (NOISE_REACH * curvatures[rows]))
-    grown = np.minimum(radii[rows] * factor, cap)
-    keep = np.isfinite(grown) & (grown > radii[rows] * GROWTH_MARGIN)
-    radii[rows[keep]] = grown[keep]
-    return rows[keep]
-
-
-def _noise_reach(
-    reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, fields: tuple, *, swap: bool, rows=None
-) -> tuple[np.ndarray, np.ndarray]:
+def _noise_reach(reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, fields: tuple) -> np.ndarray:
     """(V,) bool: the vertices whose ball cannot hold a fit against its noise (their coefficients made NaN).
 
     ``reach = (vertices, start, radii, referenced, facing)``; ``fields = (six, fitted, coefficients)``, changed in
@@ -558,40 +430,42 @@ def _noise_reach(
     (``sigmas``, :func:`_noise_sigmas`; :func:`_noise_spreads`, :data:`meshcurv.jets.DEGREE`: a fit of lower degree over
     the same ball spreads less) is held to :data:`JET_NOISE_REACH` of ``curvatures`` (:func:`_curvature_scales`):
     beyond it the vertex takes a quadric's fit over the same ball (:data:`STEADY_DEGREE`) if that one's spread is
-    within :data:`NOISE_REACH` of them, else is NaN with ``valid=False``. With ``swap`` False (the default
-    radius, grown with the noise: :func:`meshcurv.radius.jet_vertex_radii`) no fit is swapped (on the coarsest
-    clean ellipsoid of ``benchmarks/accuracy.py --quick``, levels of its fits' bias up to 0.02, the swap doubled
-    the median H error: 1.9% -> 3.6%): a vertex whose ball holds noise (``sigmas`` > 0) and whose quadric spreads
-    beyond :data:`NOISE_REACH` is NaN (the default radius is capped by the curvature, and a ball of that size on
-    noise of 0.3 edge lengths left a fifth of the vertices of the noisy spheres, tori and ellipsoids off by more
-    than half of H: ``benchmarks/quadric_default_off.py``). A ball of few points (a given radius of an edge length or two)
+    within :data:`NOISE_REACH` of them, else is NaN with ``valid=False``. Called at a given radius only: the
+    default one grows with the noise (:func:`meshcurv.radius.jet_vertex_radii`), and on the coarsest clean
+    ellipsoid of ``benchmarks/accuracy.py --quick`` (levels of its fits' bias up to 0.02) the swap doubled the
+    median H error (1.9% -> 3.6%). A ball of few points (a given radius of an edge length or two)
     lets every fit follow the noise, the quadric as well as the jet, so that the two agree and the check of
     :func:`_steady_fits` passes them (issue 29: faces detached by 0.08 edge lengths, H off by up to 1.65 on a
     unit sphere at a radius of one edge length)."""
     vertices, start, radii, referenced, facing = reach
     six, fitted, coefficients = fields
     unsure = np.zeros(vertices.shape[0], dtype=bool)
-    spreads = np.full(vertices.shape[0], np.nan)
-    usable = np.isfinite(coefficients).all(axis=1) & referenced
-    rows = np.flatnonzero(usable) if rows is None else rows[usable[rows]]
+    rows = np.flatnonzero(np.isfinite(coefficients).all(axis=1) & referenced)
     if rows.size == 0 or not (sigmas > 0).any():
-        return unsure, spreads
-    if not swap:  # only balls with noise
-        rows = rows[sigmas[rows] > 0]
+        return unsure
     unit = radii[rows]
     ball = (vertices, fitted, referenced)
-    if swap:
-        high = _noise_spreads(ball, rows, unit, sigmas, DEGREE)
-        loose = high > JET_NOISE_REACH * curvatures[rows]
-        rows, unit = rows[loose], unit[loose]
+    high = _noise_spreads(ball, rows, unit, sigmas, DEGREE)
+    loose = high > JET_NOISE_REACH * curvatures[rows]
+    rows, unit = rows[loose], unit[loose]
     if rows.size == 0:
-        return unsure, spreads
+        return unsure
     low = _noise_spreads(ball, rows, unit, sigmas, STEADY_DEGREE)
-    spreads[rows] = low
     steady = low <= NOISE_REACH * curvatures[rows]
     unsure[rows[~steady]] = True
     rows, unit = rows[steady], unit[steady]
-    if swap and rows.size:
-        six[rows], fitted[rows], coefficients[rows] = _quadrics((vertices, start, unit, rows), referenced, facing)
+    if rows.size:
+        found, frame, _ = _fit_jets(
+            vertices,
+            start,
+            unit,
+            degree=STEADY_DEGREE,
+            centres=rows,
+            neighbours=referenced,
+            facing=facing,
+            min_spread=STEADY_MIN_SPREAD,
+        )
+        six[rows], fitted[rows] = shape_operators(found[rows], tuple(axis[rows] for axis in frame), unit)
+        coefficients[rows] = found[rows]
     coefficients[unsure] = np.nan
-    return unsure, spreads
+    return unsure
