@@ -256,15 +256,11 @@ def _sides_by_decided(vertices, faces, patch, flip, inverted, settled, undecided
     the fast ones of the settled faces (:func:`face_winding_numbers`).
     """
     rows = np.flatnonzero(kept)
-    wound = flip[rows] ^ inverted[patch[rows]]
     known = settled[patch[rows]]
     asked = undecided[patch[rows]]
     if not known.any() or not asked.any():
         return inverted, settled
-    corners = vertices[faces[rows]]
-    corners = np.where(wound[:, None, None], corners[:, [0, 2, 1]], corners)
-    vector = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    areas = np.linalg.norm(vector, axis=1)
+    corners, vector, areas = _wound_corners(vertices, faces[rows], flip[rows] ^ inverted[patch[rows]])
     asked &= areas > 0
     if not asked.any():
         return inverted, settled
@@ -301,17 +297,12 @@ def _winding_sides(vertices, faces, patch, flip, inverted, undecided, group, kep
     ``O(F log F)`` for ``F`` undecided faces.
     """
     rows = np.flatnonzero(kept)
-    corners = vertices[faces[rows]]
-    vector = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    turned = flip[rows] ^ inverted[patch[rows]]
-    vector = np.where(turned[:, None], -vector, vector)
-    areas = np.linalg.norm(vector, axis=1)
+    corners, vector, areas = _wound_corners(vertices, faces[rows], flip[rows] ^ inverted[patch[rows]])
     asked = undecided[patch[rows]] & (areas > 0)
     if not asked.any() or np.linalg.norm(vector[asked].sum(axis=0)) > WINDING_OPEN * areas[asked].sum():
         return inverted
     queries = np.flatnonzero(asked)
-    oriented = np.where(turned[queries, None, None], corners[queries][:, [0, 2, 1]], corners[queries])
-    w = _fast_winding_numbers(oriented)
+    w = _fast_winding_numbers(corners[queries])
     n_labels, tiny = inverted.shape[0], np.finfo(float).tiny
     patch_area = np.bincount(patch[rows[queries]], weights=areas[queries], minlength=n_labels)
     n_groups = int(group.max()) + 1
@@ -324,6 +315,15 @@ def _winding_sides(vertices, faces, patch, flip, inverted, undecided, group, kep
         return inverted
     turn = (weight > 0) & (score < -WINDING_MARGIN)
     return np.where(undecided & turn[group], ~inverted, inverted)
+
+
+def _wound_corners(vertices: np.ndarray, faces: np.ndarray, reversed_: np.ndarray) -> tuple:
+    """``(corners, vector, areas)`` of the triangles ``faces`` (S, 3) as they are wound: each one ``reversed_`` (S,)
+    taken in the order (0, 2, 1). ``corners`` (S, 3, 3), ``vector`` (S, 3) their area vectors, ``areas`` (S,)."""
+    corners = vertices[faces]
+    corners = np.where(reversed_[:, None, None], corners[:, [0, 2, 1]], corners)
+    vector = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    return corners, vector, np.linalg.norm(vector, axis=1)
 
 
 def _fast_winding_numbers(corners: np.ndarray, positions: np.ndarray | None = None) -> np.ndarray:
