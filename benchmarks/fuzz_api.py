@@ -52,6 +52,11 @@ shape (icospheres of 5,762 and 16,002 vertices, a 64 x 32 uv sphere, ellipsoids 
 sphere of radius 10; each either wound outward or inward) with 20-100% of its faces (mostly half) detached by 0.03 to
 0.1 mean edge lengths, any method at its default or a given ball of 1 to 6 edges, under the detached relation; these
 cases have ``FINE_TIMEOUT_FACTOR`` times ``--timeout`` and are counted apart in the summary ("(fine cracks)").
+``--real-meshes P`` makes a share ``P`` of the mesh cases (a stream of their own; 0 by default) a real mesh of
+``../shared/meshes`` beside the repository (none without it: scans, a CAD part with creases, an unclean mesh of 44
+parts), any method at its default or a given ball, under an invariance: a rigid motion (a random rotation and a
+shift), a scale, a permutation, a translation, unreferenced points, every face twice, the other backend (30%, on
+meshes of at most ``REAL_NUMPY_MAX_VERTICES`` vertices) or a mesh object; counted apart ("(real meshes)").
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -719,6 +724,8 @@ def _with_twins(case, rng):
         return case
     roll = rng.random()
     backend_share = THIN_BACKEND_SHARE if labels and labels[0] in THIN_NAMES else BACKEND_SHARE
+    if labels[1:2] == ["real mesh"]:
+        backend_share = REAL_BACKEND_SHARE
     if roll < backend_share:
         if (
             target == "point_cloud_curvatures"
@@ -727,6 +734,8 @@ def _with_twins(case, rng):
         ):
             return case
         if labels and labels[0].startswith("fine_") and _n_rows(args[0]) > FINE_BACKEND_MAX_VERTICES:
+            return case
+        if labels[1:2] == ["real mesh"] and _n_rows(args[0]) > REAL_NUMPY_MAX_VERTICES:
             return case
         return target, args, kwargs, labels + ["relation backend"], ("backend", clean)
     if (
@@ -812,10 +821,108 @@ def fine_crack_case(rng, numpy_backend):
     return "principal_curvatures", (vv, ff), kwargs, labels + [f"relation detached {name}"], ("detached", name)
 
 
+#: Share of the mesh cases that are a real mesh of :data:`REAL_FOLDER` under a relation (``--real-meshes``): a rigid
+#: motion, a scale, a permutation, a translation, unreferenced points, both sides, the other backend or a mesh object;
+#: 0 by default, so that the cases of earlier rounds replay as drawn (the choice comes from a stream of its own).
+REAL_MESHES = 0.0
+#: The random stream of the real-mesh cases (beside the case's own ``[seed, index]``).
+REAL_STREAM = 47
+#: The real meshes' folder, relative to the repository: ``../shared/meshes`` beside it (the OBJ files of
+#: alecjacobson/common-3d-test-models); without it ``--real-meshes`` draws no case.
+REAL_FOLDER = os.path.join("..", "shared", "meshes")
+#: The wall-clock limit of a real-mesh case, in ``--timeout`` s: two or three calls on up to 134,000 vertices.
+REAL_TIMEOUT_FACTOR = 4
+#: The largest real mesh of the cases on the NumPy paths (every fourth case) and of the backend relation (its NumPy
+#: call): rocker-arm's 10,044 vertices, not nefertiti's 49,971.
+REAL_NUMPY_MAX_VERTICES = 12000
+#: Share of the real-mesh curvature calls computed again on the other backend (issue 29, class 10: the backends
+#: agree on noisy meshes, as scans are), where the mesh is small enough.
+REAL_BACKEND_SHARE = 0.3
+#: The bases of ``--real-meshes``: ``(name, vertices, faces)`` of the triangle meshes of :data:`REAL_FOLDER`, read by
+#: :func:`add_real_bases`.
+REAL_BASES: list = []
+
+
+def add_real_bases() -> None:
+    """Read the real meshes (once) into :data:`REAL_BASES`: every ``.obj`` of :data:`REAL_FOLDER`, by name."""
+    if REAL_BASES:
+        return
+    folder = os.path.join(ROOT, REAL_FOLDER)
+    if not os.path.isdir(folder):
+        print(f"--real-meshes: no folder {os.path.normpath(folder)}; no real-mesh case is drawn", flush=True)
+        return
+    for filename in sorted(os.listdir(folder)):
+        if filename.endswith(".obj"):
+            mesh = meshcurv.read_mesh(os.path.join(folder, filename))
+            faces = np.asarray(mesh.faces)
+            if faces.dtype != object and faces.ndim == 2 and faces.shape[1] == 3:
+                REAL_BASES.append((filename[:-4], np.asarray(mesh.vertices, float), faces.astype(np.int64)))
+
+
+def _real_stream(seed: int, index: int):
+    return np.random.default_rng([seed, index, REAL_STREAM])
+
+
+def is_real(seed: int, index: int) -> bool:
+    """Whether case ``index`` of ``seed`` is a real-mesh case (:data:`REAL_MESHES`; a fine-cracks case is not)."""
+    return (
+        bool(REAL_MESHES)
+        and bool(REAL_BASES)
+        and not ONLY_POINT_CLOUDS
+        and not is_fine(seed, index)
+        and _real_stream(seed, index).random() < REAL_MESHES
+    )
+
+
+def _rotation(seed: int):
+    """A random proper rotation (3 x 3, determinant 1) of the stream ``seed``."""
+    q, r = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    q = q * np.sign(np.diag(r))
+    return q if np.linalg.det(q) > 0 else q[:, [1, 0, 2]]
+
+
+def real_mesh_case(rng, numpy_backend):
+    """A real mesh (a scan, a CAD part with creases, an unclean mesh of many parts) as read, any method at its
+    default or a given ball (1 to 6 edges), under an invariance: a rigid motion (a random rotation and a shift of up
+    to 10 sizes), a scale (the given ball scaled with it), a permutation of the vertices, a translation,
+    unreferenced points near the surface or every face given twice (:func:`relation_check`); :func:`_with_twins`
+    adds the other backend (:data:`REAL_BACKEND_SHARE`) and mesh objects. On the NumPy paths the meshes of at most
+    :data:`REAL_NUMPY_MAX_VERTICES` vertices."""
+    bases = [base for base in REAL_BASES if not numpy_backend or len(base[1]) <= REAL_NUMPY_MAX_VERTICES]
+    if not bases:
+        bases = REAL_BASES[:1]
+    name, v, f = bases[int(rng.integers(len(bases)))]
+    method = METHODS[int(rng.integers(len(METHODS)))]
+    kwargs = {"method": method}
+    if method in BALL_METHODS and rng.random() < 0.3:
+        edge = float(np.mean(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1)))
+        kwargs["radius"] = float(rng.uniform(1.0, 6.0)) * edge
+    if method in SMOOTHING_METHODS and rng.random() < 0.3:
+        kwargs["smoothing_steps"] = int(rng.integers(0, 6))
+    if rng.random() < 0.2:
+        kwargs["orient"] = str(rng.choice(["auto", "outward", "consistent", "keep"]))
+    relation = ["rigid", "rigid", "scale", "permute", "translate", "unreferenced", "double-sided"][int(rng.integers(7))]
+    if relation == "permute" and method == "matgeom":  # (as for the drawn shapes: matGeom's pairing follows the order)
+        relation = "rigid"
+    if relation == "double-sided" and (method == "matgeom" or kwargs.get("orient", "auto") not in ("auto", "outward")):
+        relation = "rigid"
+    if relation == "scale":
+        value = float(rng.choice([2.0**-30, 2.0**20, 1e-8, 1e8, 1e30]))
+    elif relation == "translate":
+        value = float(rng.choice([2.0**10, -(2.0**20), 1e3 + 0.1]))
+    else:
+        value = int(rng.integers(2**31))
+    labels = [name, "real mesh", "vertices:array", "faces:array", f"relation {relation} {value:g}"]
+    return "principal_curvatures", (v, f), kwargs, labels, (relation, value)
+
+
 def _drawn_case(seed: int, index: int):
     fine = _fine_stream(seed, index)
     if FINE_CRACKS and not ONLY_POINT_CLOUDS and fine.random() < FINE_CRACKS:
         return fine_crack_case(fine, numpy_backend=index % 4 == 3)  # (run_forked's and replay's NumPy cases)
+    real = _real_stream(seed, index)
+    if REAL_MESHES and REAL_BASES and not ONLY_POINT_CLOUDS and real.random() < REAL_MESHES:
+        return real_mesh_case(real, numpy_backend=index % 4 == 3)
     rng = np.random.default_rng([seed, index])
     if ONLY_POINT_CLOUDS and pointcloud is not None and rng.random() < 0.7:
         return make_cloud_case(rng)
@@ -1614,8 +1721,9 @@ NEEDLE_VALUES_TOLERANCE = 0.25
 def relation_check(args, kwargs, result, relation):
     """The same call on a transformed mesh: curvatures must transform as the documentation says.
 
-    ``scale`` s: the same valid mask, curvatures / s (matgeom: unchanged);
-    ``translate``: the same values; ``permute``: the same values, permuted;
+    ``scale`` s: the same valid mask, curvatures / s (matgeom: unchanged; a
+    given ball scaled by s); ``translate`` and ``rigid`` (a rotation and a
+    shift): the same values; ``permute``: the same values, permuted;
     ``unreferenced``: points added near the surface (in no face) leave every
     referenced vertex's values and validity unchanged.
     """
@@ -1710,6 +1818,9 @@ def relation_check(args, kwargs, result, relation):
         factor = 1.0 if result.method == "matgeom" else value
     elif kind == "translate":
         v2, f2 = v + value * max(float(np.ptp(v)), 1.0), f
+    elif kind == "rigid":  # a rotation and a shift of up to 10 sizes (--real-meshes): curvatures are invariant
+        shift = np.random.default_rng(value).uniform(-10.0, 10.0, size=3) * float(np.ptp(v))
+        v2, f2 = v @ _rotation(value).T + shift, f
     elif kind == "permute":
         perm = np.random.default_rng(value).permutation(n)  # new vertex i is old perm[i]
         inverse = np.argsort(perm)
@@ -1722,6 +1833,8 @@ def relation_check(args, kwargs, result, relation):
         edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1))) if len(f) else 1.0
         extra = v[rng.integers(n, size=max(1, n // 10))] + rng.normal(size=(max(1, n // 10), 3)) * 0.3 * edge
         v2, f2 = np.concatenate([v, extra]), f
+    if kind == "scale" and isinstance(kwargs.get("radius"), float):  # a given ball scales with the mesh
+        kwargs = {**kwargs, "radius": kwargs["radius"] * value}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
@@ -1940,7 +2053,7 @@ def signature(target, method, outcome):
         return f"{target} | {outcome['type']} at {outcome['where']}"
     if status == "invariant":
         first = outcome["broken"][0]
-        if first.split(" ")[0] in ("scale", "translate", "permute", "unreferenced", "truth") and ": " in first:
+        if first.split(" ")[0] in ("scale", "translate", "permute", "unreferenced", "truth", "rigid") and ": " in first:
             first = first.split(" ")[0] + ": " + first.split(": ", 1)[1]  # without the relation's value
         first = first.split(" at ")[0].split(" by up to")[0].split(" (")[0]
         return f"{target} [{method}] | {first}"
@@ -1987,7 +2100,7 @@ def summary_table(path) -> str:
 
 
 def main(argv=None) -> int:
-    global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE, FINE_CRACKS
+    global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE, FINE_CRACKS, REAL_MESHES
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -2037,8 +2150,17 @@ def main(argv=None) -> int:
         f"0.03-0.1 edge lengths, against the clean shape; their limit is {FINE_TIMEOUT_FACTOR} times --timeout "
         "(default: %(default)g: the draws of earlier rounds)",
     )
+    parser.add_argument(
+        "--real-meshes",
+        type=float,
+        default=REAL_MESHES,
+        help="share of the mesh cases on a real mesh of ../shared/meshes (beside the repository; none drawn without "
+        "it) under an invariance: a rigid motion, a scale, a permutation, a translation, unreferenced points, both "
+        f"sides, the other backend, a mesh object; their limit is {REAL_TIMEOUT_FACTOR} times --timeout (default: "
+        "%(default)g: the draws of earlier rounds)",
+    )
     options = parser.parse_args(argv)
-    for name in ("voxel_share", "wide_cracks", "thin_shapes", "fine_cracks"):
+    for name in ("voxel_share", "wide_cracks", "thin_shapes", "fine_cracks", "real_meshes"):
         if not 0 <= getattr(options, name) <= 1:
             parser.error(f"--{name.replace('_', '-')} must lie in [0, 1], got {getattr(options, name)}")
     WIDE_CRACKS = options.wide_cracks
@@ -2046,6 +2168,9 @@ def main(argv=None) -> int:
     FINE_CRACKS = options.fine_cracks
     if FINE_CRACKS:
         add_fine_bases()
+    REAL_MESHES = options.real_meshes
+    if REAL_MESHES:
+        add_real_bases()
     ONLY_POINT_CLOUDS = options.point_clouds
     VOXEL_SHARE = options.voxel_share
 
@@ -2079,6 +2204,7 @@ def main(argv=None) -> int:
                     "wide_cracks": options.wide_cracks,
                     "thin_shapes": options.thin_shapes,
                     "fine_cracks": options.fine_cracks,
+                    "real_meshes": options.real_meshes,
                 }
             )
             + "\n"
@@ -2086,7 +2212,8 @@ def main(argv=None) -> int:
         while time.monotonic() < deadline:
             numpy_backend = index % 4 == 3
             fine = is_fine(options.seed, index)
-            timeout = options.timeout * (FINE_TIMEOUT_FACTOR if fine else 1)
+            real = is_real(options.seed, index)
+            timeout = options.timeout * (FINE_TIMEOUT_FACTOR if fine else REAL_TIMEOUT_FACTOR if real else 1)
             head, outcome, elapsed, cpu = run_forked(
                 options.seed, index, timeout, options.memory, options.factor, numpy_backend
             )
@@ -2099,6 +2226,8 @@ def main(argv=None) -> int:
             counts[(target, outcome["status"])] += 1
             if fine:
                 counts[(f"{target} (fine cracks)", outcome["status"])] += 1
+            if real:
+                counts[(f"{target} (real meshes)", outcome["status"])] += 1
             slowest.append((elapsed, index))
             if outcome["status"] not in ("ok", "documented") or outcome.get("warnings"):
                 key = (
