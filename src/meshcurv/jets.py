@@ -310,6 +310,7 @@ def fit_jets(
     areas: np.ndarray | None = None,
     min_spread: float = MIN_SPREAD,
     larger: float | None = None,
+    agreement: float | None = None,
 ):
     """Fit a weighted jet at every vertex (or at ``centres``), re-estimating its frame from each fit.
 
@@ -380,6 +381,10 @@ def fit_jets(
         ``radius``, in the same order: the fits over ``radius`` are those of the
         call without ``larger`` to the bit, those over ``larger`` within rounding
         of a call of their own).
+    agreement : float, optional
+        With ``facing``: the points whose ``facing`` normal has a cosine below this with the
+        centre's are left out of its fit (weight 0; the same side of a thin part, whose other side
+        and rim the ball reaches, :func:`thin_part_normals`). Default: every point of the ball.
 
     Returns
     -------
@@ -419,6 +424,7 @@ def fit_jets(
         areas=areas,
         min_spread=min_spread,
         larger=larger,
+        agreement=agreement,
     )
 
 
@@ -440,6 +446,7 @@ def _fit_jets(
     areas: np.ndarray | None = None,
     min_spread: float = MIN_SPREAD,
     larger: float | None = None,
+    agreement: float | None = None,
 ):
     """:func:`fit_jets` on ``vertices`` already checked (:func:`checked_points`: C-contiguous float64 (V, 3), finite)."""
     n = vertices.shape[0]
@@ -465,12 +472,15 @@ def _fit_jets(
         facing = np.ascontiguousarray(facing, dtype=np.float64)
         if facing.shape != vertices.shape:
             raise InvalidMeshError(f"`facing` must have shape {vertices.shape}; got {facing.shape}")
+    if agreement is not None and not (facing is not None and -1.0 <= agreement <= 1.0):
+        raise InvalidOptionError(f"`agreement` needs `facing` and must lie in [-1, 1]; got {agreement!r}")
+    select = -2.0 if agreement is None else float(agreement)  # (the kernels' none: below every cosine)
     kernels = numba_kernels("jets")
     paired = False  # both radii in one walk
     wide = 0.0  # the larger radius (0: none)
     if larger is not None:
         wide = _checked_larger(larger, radius, details)
-        paired = kernels is not None and n > 0 and adjacency is None and not per_centre
+        paired = kernels is not None and n > 0 and adjacency is None and not per_centre and agreement is None
         if not paired:
             details["larger"] = _fit_jets(  # type: ignore[index]  # (details checked)
                 vertices,
@@ -487,6 +497,7 @@ def _fit_jets(
                 compact=compact,
                 areas=areas,
                 min_spread=min_spread,
+                agreement=agreement,
             )
     pool_points = vertices if pool.size == n else vertices[pool]  # (pool sorted: all of them is every vertex)
     areas = _checked_areas(areas, n)
@@ -511,6 +522,7 @@ def _fit_jets(
                 normals_only=False,
                 areas=areas,
                 min_spread=min_spread,
+                agreement=select,
             )
             if not compact and not every_vertex:
                 rows = [_all_rows(row, centres, n, 0.0 if k == 4 else np.nan) for k, row in enumerate(rows)]
@@ -522,10 +534,13 @@ def _fit_jets(
             kernel, extra = (kernels.fit_jet_pairs, (wide,)) if paired else (kernels.fit_jets, ())
             fit = (degree, iterations, _exponents(degree), min_spread)
             checks = (pool, facing if check else vertices, check, AWAY_FRACTION, float(settled), areas)
+            selected = () if agreement is None else (0.0, select)  # (the kernel's larger: none; then agreement)
             pieces = []  # each call's outputs, one row per centre of its part
             for lo, hi in ranges:
                 part = centres[lo:hi]  # rows of all vertices: those of the part (a slice when the centres are all)
-                outputs = kernel(vertices, normals, radii, *extra, *fit, part, 64 * kernel_threads(), *checks)
+                outputs = kernel(
+                    vertices, normals, radii, *extra, *fit, part, 64 * kernel_threads(), *checks, *selected
+                )
                 pieces.append(
                     outputs if whole else tuple(output[lo:hi] if every_vertex else output[part] for output in outputs)
                 )
@@ -564,6 +579,8 @@ def _fit_jets(
         weights = np.maximum(1.0 - squared, 0.0) ** 2
         if areas.size:
             weights = weights * areas[neighbour]
+        if agreement is not None and facing is not None:  # the same side only
+            weights = np.where(np.einsum("ij,ij->i", facing[neighbour], facing[index[rows]]) < select, 0.0, weights)
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
         local = [*tangent_basis(normals[index]), normals[index]]
         settle = np.zeros((size, 1), dtype=bool)  # the centres whose iterations have ended (``settled``)
@@ -680,6 +697,7 @@ def _connected_fits(
     normals_only: bool,
     areas: np.ndarray,
     min_spread: float,
+    agreement: float = -2.0,
 ) -> list[np.ndarray]:
     """The compiled fits over the surface-connected balls of ``centres``, in calls of about
     :data:`~meshcurv.neighborhoods.PAIRS_PER_CALL` pairs (checked inputs; ``neighbours`` a (V,) bool
@@ -716,6 +734,7 @@ def _connected_fits(
             normals_only,
             float(settled),
             _read_only_view(areas),
+            float(agreement),
         )
         pieces.append(outputs[:1] if normals_only else outputs)
     return _joined(pieces)
@@ -1186,3 +1205,124 @@ def _nearest_in_cubes(points: np.ndarray, key: np.ndarray, off_middle: np.ndarra
     ties = np.lexsort((points[tied, 2], points[tied, 1], points[tied, 0], key[tied]))
     first = tied[ties][np.r_[True, key[tied][ties][1:] != key[tied][ties][:-1]]]
     return np.sort(first)
+
+
+#: On a voxel surface, a normal fit whose ball wraps round a thin part (more than :data:`AWAY_FRACTION` of its
+#: points facing away from its centre, by the fitted normals) while a cubic over the same ball bends less than this
+#: (its largest ``|k|`` times the radius) is on a flat part thinner than the ball: the wrap is the other side, not
+#: the centre's own bend (the far side of a part curved all round is within a ball only where ``k r`` reaches
+#: ``sqrt(2)``; the wrapped fits at the tips of ``voxel_ellipsoid((10, 7, 5))`` and round the tube of
+#: ``voxel_torus(12, 4)`` read 1.3 to 3, those on the flat faces of ``voxel_ellipsoid((8, 8, 2))`` 0.1 to 1) ...
+THIN_BEND = 1.0
+#: ... and its normal is fitted again over a ball this many times wider (the terraces of a flat part's staircase
+#: are about ``sqrt(2 h R)`` wide, 8 voxels at the pole of that ellipsoid, wider than the first ball: their edges
+#: tilted its fits, 13.8 degrees off the exact normals at the median) ...
+THIN_WIDEN = 3.0
+#: ... of the points whose fitted normal has a cosine above this with the centre's (46 degrees: the other side and
+#: the rim are left out of the fit, ``fit_jets(agreement=)``).
+THIN_AGREEMENT = 0.7
+#: The test and the wider fits are made at one centre per cube of this many median normal-fit radii
+#: (:func:`_cube_samples`); the other centres take the samples' flags and normals interpolated over their tangent
+#: planes (:func:`interpolated_normals`, the samples within :data:`SAMPLED_WIDTH` spacings that face their way).
+THIN_SPACING = 0.5
+
+
+def _thin_part_normals(
+    vertices: np.ndarray,
+    fitted: np.ndarray,
+    radius,
+    centres: np.ndarray,
+    *,
+    neighbours: np.ndarray | None,
+    adjacency: tuple,
+    degree: int,
+    iterations: int,
+    settled: float,
+    min_spread: float,
+    areas: np.ndarray | None = None,
+) -> np.ndarray:
+    """(V, 3) ``fitted`` (unit normals of the fits over balls of ``radius``, float or (V,)) with those of the
+    ``centres`` (M,) on thin flat parts of a voxel surface fitted again over wider balls of their own side.
+
+    At one centre per cube of :data:`THIN_SPACING` median radii (:func:`_cube_samples`), fits over the same ball
+    tell whether it wraps round a thin part while its cubic hardly bends (:data:`THIN_BEND`); those that do are
+    fitted again over balls :data:`THIN_WIDEN` times wider, of the points whose ``fitted`` normals face the
+    centre's way (:data:`THIN_AGREEMENT`, :func:`fit_jets` ``agreement=``; ``degree``, ``iterations``,
+    ``settled``, ``min_spread``, ``areas`` as there). Each centre takes the flags of the samples near it that
+    face its way, interpolated over its tangent plane (:func:`interpolated_normals`), and where they say thin,
+    the wider fits' normals interpolated the same way. The fits then cost the samples, not the centres.
+
+    Issue 29/30: on ``shapes.voxel_ellipsoid((8, 8, 2), seed=2)`` the normal fits on the flat faces were 13.8 degrees
+    off the exact normals at the median (the edges of the terraces tilt a cubic over a ball narrower than them, and
+    the ball reaches the other side round the rim), and 236 of their 371 vertices off by more than half of their
+    own ``|k|``; with the exact normals at the same radii none.
+    """
+    out = np.array(fitted, copy=True)
+    finite = np.isfinite(fitted).all(axis=1)
+    centres = np.asarray(centres, dtype=np.int64)
+    centres = centres[finite[centres]]
+    if not centres.size:
+        return out
+    facing = np.where(finite[:, None], fitted, 0.0)  # (a row of no normal faces no way: left out of every fit)
+    radii = np.broadcast_to(np.asarray(radius, dtype=np.float64), (vertices.shape[0],))[centres]
+    spacing = THIN_SPACING * float(np.median(radii))
+    sampled = _cube_samples(vertices[centres], spacing)
+    at, over = centres[sampled], radii[sampled]
+    common: dict[str, Any] = {"neighbours": neighbours, "adjacency": adjacency, "compact": True}
+    details: dict = {}
+    # the share facing away (a fit of degree 1 solves nothing: the share is all that is read)
+    _fit_jets(vertices, facing, over, degree=1, iterations=1, centres=at, facing=facing, details=details, **common)
+    with np.errstate(invalid="ignore"):
+        wrapped = np.flatnonzero(details["away"] > AWAY_FRACTION)
+    if not wrapped.size:
+        return out
+    coefficients, frame, _ = _fit_jets(
+        vertices, facing, over[wrapped], degree=3, iterations=1, centres=at[wrapped], min_spread=min_spread, **common
+    )
+    k_min, k_max = jet_curvatures(coefficients, frame, over[wrapped], facing[at[wrapped]])[:2]
+    with np.errstate(invalid="ignore"):
+        flat = np.maximum(np.abs(k_min), np.abs(k_max)) * over[wrapped] < THIN_BEND  # (no fit: NaN, not flat)
+    if not flat.any():
+        return out
+    thin = np.zeros(at.size, dtype=bool)
+    thin[wrapped[flat]] = True
+    coefficients, frame, _ = _fit_jets(
+        vertices,
+        facing,
+        THIN_WIDEN * over[thin],
+        degree=degree,
+        iterations=iterations,
+        centres=at[thin],
+        facing=facing,
+        agreement=THIN_AGREEMENT,
+        settled=settled,
+        areas=areas,
+        min_spread=min_spread,
+        **common,
+    )
+    wide = jet_normals(coefficients, frame)
+    kept = np.isfinite(wide).all(axis=1)
+    if not kept.any():
+        return out
+    kernels = numba_kernels("pilot")
+    interpolate = interpolated_normals if kernels is None else kernels.interpolated_normals
+    reach = SAMPLED_WIDTH * spacing
+    own = np.ascontiguousarray(facing[centres])
+    t1, t2 = tangent_basis(own)
+    flags, reached = interpolate(
+        vertices[centres], vertices[at], thin[:, None].astype(np.float64), t1, t2, reach, SAMPLED_SPREAD,
+        own, np.ascontiguousarray(facing[at]), THIN_AGREEMENT,
+    )  # fmt: skip
+    chosen = np.flatnonzero(reached & (flags[:, 0] > 0.5))
+    if not chosen.size:
+        return out
+    wide = np.ascontiguousarray(wide[kept])
+    values, reached = interpolate(
+        vertices[centres[chosen]], vertices[at[thin][kept]], wide, t1[chosen], t2[chosen], reach,
+        SAMPLED_SPREAD, own[chosen], wide, THIN_AGREEMENT,
+    )  # fmt: skip
+    with np.errstate(invalid="ignore", divide="ignore"):
+        values = values / np.linalg.norm(values, axis=1, keepdims=True)
+    usable = reached & np.isfinite(values).all(axis=1)
+    out[centres[chosen[usable]]] = values[usable]
+    return out

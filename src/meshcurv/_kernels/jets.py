@@ -326,6 +326,7 @@ def fit_jets(
     settled,
     areas,
     larger=0.0,
+    agreement=-2.0,
 ):
     """``jets.fit_jets``: weighted jets over the balls of ``radii``, frame re-estimated from each fit.
 
@@ -345,12 +346,13 @@ def fit_jets(
 
     The fits run in ``n_chunks`` ranges of the centres (:func:`_grid_chunk`)
     on threads (:func:`~meshcurv._kernels._common.run_chunks`). With ``larger``
-    > 0, the fits over balls of that radius too (:func:`fit_jet_pairs`).
+    > 0, the fits over balls of that radius too (:func:`fit_jet_pairs`). With ``agreement`` above -1 (and
+    ``check_facing``), the points whose ``facing`` normal has a cosine below it with the centre's weigh 0.
     """
     points, ids, grid, centres = _grid_centres(vertices, pool, radii, centres)
     outputs = _jet_outputs.py_func(vertices.shape[0])  # NumPy's: one compiled function fewer to load
     wider = _jet_outputs.py_func(vertices.shape[0] if larger > 0 else 1)  # (one row unused without larger)
-    limits = np.array([away_fraction, settled])
+    limits = np.array([away_fraction, settled, agreement])
     facing = facing[: facing.shape[0] if check_facing else 0]
     run_chunks(
         _grid_chunk,
@@ -783,8 +785,10 @@ def _fit_one(
     Inlined into its callers: a call per vertex passing thirty arrays cost a
     quarter of the normal fits' time (reference counts of the arguments).
     numba inlines no function of more than 31 arguments: the scalar options
-    come in ``limits = (away_fraction, settled)``, and the facing check is
-    on when ``facing`` has rows (an empty ``facing``: no check).
+    come in ``limits = (away_fraction, settled[, agreement])``, and the facing check is
+    on when ``facing`` has rows (an empty ``facing``: no check). With an ``agreement`` above -1 and
+    ``facing`` rows, a point whose ``facing`` normal has a cosine below it with the centre's weighs 0
+    (the same-side fits of ``jets.fit_jets(agreement=)``).
 
     The ball's points are ``points[members[:size]]`` (vertex ``ids[members[a]]``);
     the fit is written to row ``row`` of the outputs. ``work`` holds one column per ball member: its offset from the centre in
@@ -806,6 +810,12 @@ def _fit_one(
     """
     away_fraction, settled = limits[0], limits[1]
     check_facing = facing.shape[0] > 0
+    # the same-side selection (limits[2], the cosine bound; callers with two limits select nothing)
+    agreement = limits[2] if limits.shape[0] > 2 else -2.0
+    select = check_facing and agreement > -1.0
+    sx = sy = sz = 0.0
+    if select:
+        sx, sy, sz = facing[v, 0], facing[v, 1], facing[v, 2]
     if size > work.shape[1]:
         work = np.empty((work.shape[0], 2 * size))
     ox, oy, oz, weight = work[0], work[1], work[2], work[3]
@@ -824,6 +834,10 @@ def _fit_one(
         w = w * w
         if weighted:
             w = w * areas[ids[member]]
+        if select:  # a point facing another way than the centre is no part of its fit
+            k = ids[member]
+            if sx * facing[k, 0] + sy * facing[k, 1] + sz * facing[k, 2] < agreement:
+                w = 0.0
         weight[slot] = w
         count += w > 0
     counts[row] = count
@@ -890,6 +904,7 @@ def fit_jets_connected(
     normals_only,
     settled,
     areas,
+    agreement=-2.0,
 ):
     """:func:`fit_jets` over the surface-connected piece of each ball (:func:`_connected_members`).
 
@@ -910,7 +925,7 @@ def fit_jets_connected(
     A fit whose slope ``c10^2 + c01^2`` is below ``settled`` ends the
     iterations of its vertex (its normal is within ``atan(sqrt(settled))`` of
     the frame's normal); with 0, every vertex has ``iterations`` fits.
-    ``areas``: as :func:`fit_jets`. The fits run in ranges of the centres (:func:`_connected_chunk`),
+    ``areas``, ``agreement``: as :func:`fit_jets`. The fits run in ranges of the centres (:func:`_connected_chunk`),
     :data:`_RANGES_PER_SLOT` per thread, on threads (:func:`~meshcurv._kernels._common.run_slots`), each with
     the walk's scratch of its thread (the stamps are the centres' rows: one fill for all its ranges).
     """
@@ -918,7 +933,7 @@ def fit_jets_connected(
     m = centres.shape[0]
     outputs = _jet_outputs.py_func(1 if normals_only else m)  # NumPy's: one compiled function fewer to load
     fitted = np.full((m if normals_only else 1, 3), np.nan)
-    limits = np.array([away_fraction, settled])
+    limits = np.array([away_fraction, settled, agreement])
     facing = facing[: facing.shape[0] if check_facing else 0]
     slots = max(1, min(int(n_chunks), m))
     # each thread's walk scratch: the stamps (filled with -1 by the thread on its first range), members, queue;
