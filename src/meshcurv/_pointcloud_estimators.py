@@ -12,7 +12,7 @@ import warnings
 import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
-from ._pointcloud_normals import NEIGHBOURS, NO_LATTICE, Lattice
+from ._pointcloud_normals import NEIGHBOURS, NO_LATTICE, Lattice, _dot
 from .errors import InvalidOptionError
 from . import _measures
 from .measures import curvatures_from_measures
@@ -920,7 +920,7 @@ def _own_side(normals, centres, index, counts, sheets=None):
     n = normals.shape[0]
     member = np.arange(index.shape[1])[None, :] < counts[:, None]
     safe = np.where(member, index, 0)
-    away = member & (np.einsum("mkj,mj->mk", normals[safe], normals[centres]) < -FACING_MARGIN)
+    away = member & (_dot(normals[safe], normals[centres][:, None, :]) < -FACING_MARGIN)  # (the kernel's sum)
     if sheets is not None:
         theirs, own = sheets[safe], sheets[centres][:, None]
         away |= member & (theirs != own) & (theirs >= 0) & (own >= 0)
@@ -972,13 +972,18 @@ def _flat_balls(points, centres, index, counts) -> np.ndarray:
     offsets = points[np.where(member, index[:, column], centres[:, None])] - points[centres][:, None, :]
     scale = np.abs(offsets).max(axis=(1, 2))  # each ball in units of its extent: no overflow at 1e75, no underflow
     offsets /= np.where(scale > 0, scale, 1.0)[:, None, None]
-    covariance = np.einsum("mki,mkj->mij", offsets, offsets)
-    direction = offsets[np.arange(index.shape[0]), np.argmax(np.einsum("mkj,mkj->mk", offsets, offsets), axis=1)]
+    # (the kernel's operations in its order, member by member: the same decisions to the bit)
+    squared = _dot(offsets, offsets)
+    xx, xy, xz, yy, yz, zz = (np.zeros(index.shape[0]) for _ in range(6))
+    for c in range(column.size):
+        dx, dy, dz = offsets[:, c, 0], offsets[:, c, 1], offsets[:, c, 2]
+        xx, xy, xz, yy, yz, zz = xx + dx * dx, xy + dx * dy, xz + dx * dz, yy + dy * dy, yz + dy * dz, zz + dz * dz
+    ux, uy, uz = offsets[np.arange(index.shape[0]), np.argmax(squared, axis=1)].T
     for _ in range(SUPPORT_ITERATIONS):
-        direction = np.einsum("mij,mj->mi", covariance, direction)
-        direction /= np.maximum(np.linalg.norm(direction, axis=1), np.finfo(float).tiny)[:, None]
-    along = np.einsum("mkj,mj->mk", offsets, direction)
-    squared = np.einsum("mkj,mkj->mk", offsets, offsets)
+        vx, vy, vz = xx * ux + xy * uy + xz * uz, xy * ux + yy * uy + yz * uz, xz * ux + yz * uy + zz * uz
+        length = np.maximum(np.sqrt(vx * vx + vy * vy + vz * vz), np.finfo(float).tiny)
+        ux, uy, uz = vx / length, vy / length, vz / length
+    along = offsets[..., 0] * ux[:, None] + offsets[..., 1] * uy[:, None] + offsets[..., 2] * uz[:, None]
     across = squared - along * along
     far = squared.max(axis=1)
     beside = (across > BALL_OFFSET**2 * far[:, None]).sum(axis=1)

@@ -362,23 +362,24 @@ def line_spread(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
 
 
 def _line_spread_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
-    """The NumPy path of :func:`line_spread`."""
-    n = points.shape[0]
+    """The NumPy path of :func:`line_spread`: the kernel's operations in its order (the same ratios to the bit:
+    they are compared with :data:`LINE_SPREAD` and :data:`CURVE_CANDIDATE`)."""
+    n, k = indices.shape
     ratio = np.ones(n)
     for start in range(0, n, CHUNK):
         stop = min(n, start + CHUNK)
-        group = np.concatenate([points[start:stop, None, :], points[indices[start:stop]]], axis=1)
-        group = group - group.mean(axis=1, keepdims=True)
-        covariance = np.einsum("nki,nkj->nij", group, group)
-        mean = np.trace(covariance, axis1=1, axis2=2) / 3.0
-        shifted = covariance - mean[:, None, None] * np.eye(3)
-        spread = np.sqrt(np.einsum("nij,nij->n", shifted, shifted) / 6.0)
+        xx, xy, xz, yy, yz, zz = _covariances(points, indices, start, stop, k)
+        mean = (xx + yy + zz) / 3
+        sxx, syy, szz = xx - mean, yy - mean, zz - mean
+        spread = np.sqrt((sxx * sxx + syy * syy + szz * szz + 2 * (xy * xy + xz * xz + yz * yz)) / 6)
+        scale = np.where(spread > 0, spread, 1.0)
+        bxx, byy, bzz, bxy, bxz, byz = sxx / scale, syy / scale, szz / scale, xy / scale, xz / scale, yz / scale
+        half = 0.5 * (bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz) + bxz * (bxy * byz - byy * bxz))
         with np.errstate(invalid="ignore", divide="ignore"):
-            half = np.linalg.det(shifted / np.where(spread > 0, spread, 1.0)[:, None, None]) / 2.0
-            angle = np.arccos(np.clip(half, -1.0, 1.0)) / 3.0
-            largest = mean + 2.0 * spread * np.cos(angle)
-            smallest = mean + 2.0 * spread * np.cos(angle + 2.0 * np.pi / 3.0)
-            second = np.maximum(3.0 * mean - largest - smallest, 0.0)
+            angle = np.arccos(np.minimum(1.0, np.maximum(-1.0, half))) / 3
+            largest = mean + 2 * spread * np.cos(angle)
+            smallest = mean + 2 * spread * np.cos(angle + 2 * np.pi / 3)
+            second = np.maximum(3 * mean - largest - smallest, 0.0)
             ratio[start:stop] = np.where(largest > 0, np.sqrt(second / np.where(largest > 0, largest, 1.0)), 1.0)
     return ratio
 
@@ -561,13 +562,19 @@ PCA_SIGN = np.array([1.0, np.sqrt(2.0), np.sqrt(3.0)]) / np.sqrt(6.0)
 FLAT_FLUX = 1e-9
 
 
+#: ``A - lambda I`` has rank 1 (a collinear neighbourhood) where its rows' largest squared cross product is at most
+#: this times its longest row's squared length, squared (:data:`meshcurv._kernels.pointcloud.RANK_ONE`, the same).
+RANK_ONE = 1e-24
+
+
 def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """(N, 3) unit normals (unoriented: signed to face :data:`PCA_SIGN`): the least-variance direction of each point
     and its neighbours.
 
     The compiled kernel (:func:`meshcurv._kernels.pointcloud.pca_normals`, a
-    closed form) when the numba backend is in use, else :func:`numpy.linalg.eigh`
-    on chunks of covariances.
+    closed form) when the numba backend is in use, else the same closed form
+    with arrays (:func:`_pca_normals_numpy`), its operations in the kernel's
+    order: the two agree to the last bits.
     """
     kernels = numba_kernels("pointcloud")
     if kernels is not None:
@@ -578,17 +585,121 @@ def pca_normals(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
 
 
 def _pca_normals_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
-    """The NumPy path of :func:`pca_normals`."""
-    n = points.shape[0]
+    """The NumPy path of :func:`pca_normals`: the kernel's closed form, its operations in its order.
+
+    The same formula as :func:`meshcurv._kernels.pointcloud.pca_normals` (the covariance summed neighbour by
+    neighbour, the smallest eigenvalue by Smith's trigonometric root, the longest cross product of two rows of
+    ``A - lambda I``), each product and sum as the kernel takes them, so that the two backends' normals agree
+    to the last bits (``numpy.linalg.eigh`` gave vectors 6e-12 apart at the rim of a thin part, which tipped
+    the orientation's tied weights, ``tests/test_pointcloud_parity_P20.py``). Vectorised over chunks of
+    :data:`CHUNK` points, a loop over the ``k`` neighbours.
+    """
+    n, k = indices.shape
     normals = np.zeros((n, 3))
     for start in range(0, n, CHUNK):
         stop = min(n, start + CHUNK)
-        group = np.concatenate([points[start:stop, None, :], points[indices[start:stop]]], axis=1)
-        group = group - group.mean(axis=1, keepdims=True)
-        covariance = np.einsum("nki,nkj->nij", group, group)
-        _, vectors = np.linalg.eigh(covariance)
-        normals[start:stop] = vectors[:, :, 0]
+        normals[start:stop] = _closed_form_normals(points, indices, start, stop, k)
     return normals
+
+
+def _closed_form_normals(points: np.ndarray, indices: np.ndarray, start: int, stop: int, k: int) -> np.ndarray:
+    """(M, 3) :func:`_pca_normals_numpy` of the points ``start:stop``."""
+    xx, xy, xz, yy, yz, zz = _covariances(points, indices, start, stop, k)
+    trace = xx + yy + zz
+    positive = trace > 0
+    divisor = np.where(positive, trace, 1.0)  # (x / 1.0 is x: the kernel's "if trace > 0")
+    xx, xy, xz, yy, yz, zz = xx / divisor, xy / divisor, xz / divisor, yy / divisor, yz / divisor, zz / divisor
+    off = xy * xy + xz * xz + yz * yz
+    mean = (xx + yy + zz) / 3
+    spread = np.sqrt(((xx - mean) ** 2 + (yy - mean) ** 2 + (zz - mean) ** 2 + 2 * off) / 6)
+    spread_ok = spread > 0
+    divisor = np.where(spread_ok, spread, 1.0)
+    bxx, byy, bzz = (xx - mean) / divisor, (yy - mean) / divisor, (zz - mean) / divisor
+    bxy, bxz, byz = xy / divisor, xz / divisor, yz / divisor
+    half = 0.5 * (bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz) + bxz * (bxy * byz - byy * bxz))
+    with np.errstate(invalid="ignore"):
+        angle = np.arccos(np.minimum(1.0, np.maximum(-1.0, half))) / 3
+    smallest = mean + 2 * spread * np.cos(angle + 2 * np.pi / 3)
+    r0 = np.stack([xx - smallest, xy, xz], axis=1)
+    r1 = np.stack([xy, yy - smallest, yz], axis=1)
+    r2 = np.stack([xz, yz, zz - smallest], axis=1)
+    a, b, e = _cross(r0, r1), _cross(r0, r2), _cross(r1, r2)
+    la, lb, le = _squared(a), _squared(b), _squared(e)
+    pick_b = (lb > la) & (lb >= le)
+    pick_e = ~pick_b & (le > la)
+    best = np.where(pick_b[:, None], b, np.where(pick_e[:, None], e, a))
+    longest = np.where(pick_b, lb, np.where(pick_e, le, la))
+    s0, s1, s2 = _squared(r0), _squared(r1), _squared(r2)
+    row_1 = (s1 > s0) & (s1 >= s2)
+    row_2 = ~row_1 & (s2 > s0)
+    row = np.where(row_1[:, None], r1, np.where(row_2[:, None], r2, r0))
+    row_length = np.where(row_1, s1, np.where(row_2, s2, s0))
+    out = np.zeros((stop - start, 3))
+    out[:, 2] = 1.0  # isotropic, a single repeated point or a zero matrix: every direction is as good
+    rank_two = spread_ok & (longest > RANK_ONE * row_length * row_length)
+    length = np.sqrt(np.where(rank_two, longest, 1.0))
+    out[rank_two] = best[rank_two] / length[rank_two, None]
+    # rank 1 (a collinear neighbourhood): a direction orthogonal to the longest row (the frame of the line)
+    line = spread_ok & ~rank_two & (row_length > 0)
+    if line.any():
+        root = np.sqrt(row_length[line])
+        out[line] = _first_tangent(row[line] / root[:, None])
+    return out
+
+
+def _covariances(points: np.ndarray, indices: np.ndarray, start: int, stop: int, k: int):
+    """``xx, xy, xz, yy, yz, zz`` (M,) each: the (unnormalised) covariance of the points ``start:stop`` with their
+    ``k`` neighbours ``indices``, summed neighbour by neighbour as :func:`meshcurv._kernels.pointcloud._covariance`
+    sums them (to the bit; ``numpy.sum`` adds pairwise, ``einsum`` in its own order)."""
+    own = points[start:stop]
+    near = indices[start:stop]
+    cx, cy, cz = own[:, 0].copy(), own[:, 1].copy(), own[:, 2].copy()
+    for j in range(k):
+        q = points[near[:, j]]
+        cx += q[:, 0]
+        cy += q[:, 1]
+        cz += q[:, 2]
+    cx, cy, cz = cx / (k + 1), cy / (k + 1), cz / (k + 1)
+    dx, dy, dz = own[:, 0] - cx, own[:, 1] - cy, own[:, 2] - cz
+    xx, xy, xz, yy, yz, zz = dx * dx, dx * dy, dx * dz, dy * dy, dy * dz, dz * dz
+    for j in range(k):
+        q = points[near[:, j]]
+        dx, dy, dz = q[:, 0] - cx, q[:, 1] - cy, q[:, 2] - cz
+        xx, xy, xz, yy, yz, zz = xx + dx * dx, xy + dx * dy, xz + dx * dz, yy + dy * dy, yz + dy * dz, zz + dz * dz
+    return xx, xy, xz, yy, yz, zz
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(M, 3) the cross products of the rows of ``a`` and ``b`` (M, 3), each term as the kernels take it."""
+    return np.stack(
+        [
+            a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
+            a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+            a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0],
+        ],
+        axis=1,
+    )
+
+
+def _squared(a: np.ndarray) -> np.ndarray:
+    """(M,) the squared lengths of the rows of ``a`` (M, 3), added left to right."""
+    return a[:, 0] * a[:, 0] + a[:, 1] * a[:, 1] + a[:, 2] * a[:, 2]
+
+
+def _first_tangent(unit: np.ndarray) -> np.ndarray:
+    """(M, 3) the first tangent of the kernels' frame of the unit vectors ``unit`` (M, 3): ``cross(n, e)``
+    for the axis ``e`` least aligned with ``n`` (:func:`meshcurv._kernels._common._tangent_frame`)."""
+    nx, ny, nz = unit[:, 0], unit[:, 1], unit[:, 2]
+    ax, ay, az = np.abs(nx), np.abs(ny), np.abs(nz)
+    first = (ax <= ay) & (ax <= az)
+    second = ~first & (ay <= az)
+    zero = np.zeros(unit.shape[0])
+    tangent = np.where(
+        first[:, None],
+        np.stack([zero, nz, -ny], axis=1),
+        np.where(second[:, None], np.stack([-nz, zero, nx], axis=1), np.stack([ny, -nx, zero], axis=1)),
+    )
+    return tangent / np.sqrt(_squared(tangent))[:, None]
 
 
 def orientation_signs(
@@ -750,10 +861,10 @@ def _first_point_parts(signs: np.ndarray, roots: np.ndarray) -> tuple[np.ndarray
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(E,) the dot products of the rows of ``a`` and ``b`` (E, 3), added left to right as the compiled kernels
+    """(...) the dot products of the vectors of ``a`` and ``b`` (..., 3) (broadcast), added left to right as the compiled kernels
     add them (:func:`numpy.einsum` adds them in another order: the weights of the orientation's edges, whose ties
     decide its forest, would differ in their last bits between the backends)."""
-    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
 def _spanning_forest(n: int, rows: np.ndarray, cols: np.ndarray, opposite: np.ndarray, weights: np.ndarray):
@@ -1189,7 +1300,7 @@ def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:
         return (compiled.edge_cosines(normals, np.ascontiguousarray(indices)) < 0).any(axis=1)
     away = np.zeros(normals.shape[0], dtype=bool)
     for column in range(indices.shape[1]):
-        away |= np.einsum("ij,ij->i", normals, normals[indices[:, column]]) < 0
+        away |= _dot(normals, normals[indices[:, column]]) < 0  # (the kernel's sum: the same signs)
     return away
 
 
@@ -1556,15 +1667,15 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool, offse
             FACING_COSINE,
             alike,
         )
+    # (the kernel's products, left to right: the same decisions to the bit)
     offsets = points[near] - points[queries][:, None, :]
-    ahead = np.einsum("mkj,mj->mk", offsets, normals[queries])
-    behind = np.einsum("mkj,mkj->mk", offsets, normals[near])
-    cosine = np.einsum("mj,mkj->mk", normals[queries], normals[near])
-    ring = near[:, 1 : GRAPH_NEIGHBOURS + 1]
-    tilt = np.median(
-        np.arccos(np.minimum(np.abs(np.einsum("mj,mkj->mk", normals[queries], normals[ring])), 1.0)), axis=1
-    )
-    reach = offset * step + STACKED_ALIKE_TILT * tilt[:, None] * np.linalg.norm(offsets, axis=2)
+    own = normals[queries][:, None, :]
+    ahead = _dot(offsets, own)
+    behind = _dot(offsets, normals[near])
+    cosine = _dot(own, normals[near])
+    ring = near[:, 1 : min(GRAPH_NEIGHBOURS, near.shape[1] - 1) + 1]
+    tilt = np.median(np.arccos(np.minimum(np.abs(_dot(own, normals[ring])), 1.0)), axis=1)
+    reach = offset * step + STACKED_ALIKE_TILT * tilt[:, None] * np.sqrt(_dot(offsets, offsets))
     sides = (
         (cosine >= FACING_COSINE) & (ahead * behind > 0) if alike else (cosine <= -FACING_COSINE) & (ahead * behind < 0)
     )
