@@ -75,11 +75,17 @@ from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles, median_edge
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
 from ..radius import VoxelReading, _ring_max, _voxel_surface_grid
+from ._ring_noise import noisy_rings, noisy_rings_note
 from ._support import Stages, finish
 from .normal_cycle_ball import edge_area_densities, edge_readings, few_elements, few_elements_note
 
 #: On a voxel surface the smoothing must reach ``VOXEL_RING_GAIN sqrt(h R)`` (:func:`voxel_steps_needed`).
 VOXEL_RING_GAIN = 1.2
+
+#: The noise gain of the edges' dihedral angles summed over a ring (:func:`~meshcurv.estimators._ring_noise.noisy_rings`):
+#: H moves by about ``NOISE_GAIN sigma / l^2`` for vertices scattered by ``sigma`` along the normal without
+#: smoothing, less over the smoothing's rings (``pooled_steps`` there; measured on welded soups of icospheres).
+NOISE_GAIN = 2.0
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
 
@@ -167,8 +173,10 @@ def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: i
         few = _few_cells(mesh, invalid, valid, smoothing_steps, (k_min, k_max, dir_min, dir_max))
         valid = valid & ~few
         few_note = few_elements_note(int(few.sum()), f"smoothing region ({smoothing_steps} rings)", "cells")
+    noisy = noisy_rings(mesh, valid, NOISE_GAIN, pooled_steps=smoothing_steps)
+    valid = valid & ~noisy
     parameters = {"smoothing_steps": smoothing_steps}
-    extra = (note, few_note)
+    extra = (note, few_note, noisy_rings_note(int(noisy.sum())))
     return finish("normal_cycle", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra=extra)
 
 

@@ -59,6 +59,7 @@ from .._geometry import mixed_voronoi_corner_areas
 from ..jets import _fit_jets, jet_normals
 from .._prepared import PreparedMesh
 from ..defects import DEFECTS
+from ._ring_noise import noisy_rings, noisy_rings_note
 from ._support import Stages, finish, staircase_undefined
 
 #: Per-face systems whose determinant, with the matrix scaled to a largest entry of 1, is at
@@ -108,6 +109,12 @@ OPEN_FAN_DEFECTS = tuple(
 STAGES = ("compute normals", "fit face tensors", "average vertex tensors", "retrieve curvatures")
 
 _SIX = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))  # 3x3 -> (xx, yy, zz, xy, xz, yz)
+
+
+#: The noise gain of the face tensors averaged at a vertex (:func:`~meshcurv.estimators._ring_noise.noisy_rings`):
+#: H moves by about ``NOISE_GAIN sigma / l^2`` for vertices scattered by ``sigma`` along the normal (measured on
+#: welded soups of icospheres: 0.37 against meyer's 2.0, the normals fitted over 2-rings).
+NOISE_GAIN = 0.4
 
 
 def face_second_fundamental_forms(
@@ -287,4 +294,7 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
         np.where(valid[:, None], shape_operator, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     )
     valid, staircase = staircase_undefined(mesh, defects, valid, stages=stages)
-    return finish("rusinkiewicz", {}, valid, normals, k_min, k_max, dir_min, dir_max, defects, staircase)
+    noisy = noisy_rings(mesh, valid, NOISE_GAIN)
+    valid &= ~noisy
+    extra = (*staircase, noisy_rings_note(int(noisy.sum())))
+    return finish("rusinkiewicz", {}, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra)

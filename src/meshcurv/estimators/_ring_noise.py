@@ -1,0 +1,157 @@
+"""Rings noisier than their curvature on a mesh welded across cracks: the ring methods leave them undefined.
+
+A mesh whose faces were detached (a triangle soup whose corners were moved,
+written with rounding, or faces moved one by one) is welded across its cracks
+(:func:`meshcurv.weld.weld_vertices`): each group of copies becomes one of
+them, so the welded vertices keep the scatter of the copies. On a fine mesh
+that scatter is larger than what a ring of faces bends by: a vertex moved
+``delta`` off the surface changes a 1-ring estimate of ``H`` by about ``2
+delta / l^2`` (``l`` the ring's edge length), while the ring itself bends by
+``k l^2 / 2``. At ``delta = 0.034 l`` on an icosphere of 16,002 vertices (``l
+= 0.03`` on the unit sphere) that is more than ``H`` itself: ``meyer`` gave
+108 of its 138 valid vertices off by more than half (issue 29, fuzz 400/109).
+
+The scatter is read from the geometry: a quadric ``h = a u^2 + b u v + c
+v^2 + d u + e v + f`` fitted by least squares over the vertex's closed
+2-ring, in the frame of its normal, gives the noise ``sigma`` (its residual
+per degree of freedom) and the curvature the ring should show (the largest
+``|k|`` of the quadric, at least the mesh's scale: :data:`SIGNAL_QUANTILE`).
+The ring estimate's noise is ``gain * sigma / l^2`` (``l^2`` from the
+vertex's area); where it exceeds :data:`NOISE_SHARE` of that curvature the
+vertex is undefined. Only meshes welded across cracks
+are read, and on them only the vertices within two rings of a welded
+vertex: a clean mesh (its creases fit no quadric) costs nothing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._prepared import PreparedMesh
+
+__all__ = ["NOISE_SHARE", "noisy_rings", "noisy_rings_note"]
+
+#: A ring whose estimate's noise is more than this share of the curvature its 2-ring's quadric shows is
+#: undefined: an error above half of ``|k|`` is then more than three standard deviations away.
+NOISE_SHARE = 0.15
+
+#: The least number of points beyond the quadric's six coefficients that a 2-ring must hold to tell its noise
+#: (fewer: the vertex is undefined on a mesh welded across cracks, as its ring cannot be checked).
+SPARE_POINTS = 3
+
+#: The share of the checked rings whose curvature is at most the one a flat ring is judged against: the
+#: mesh's curvature scale (the fuzzer's relation judges an error against the shape's largest ``|k|``).
+SIGNAL_QUANTILE = 0.9
+
+#: A method pooling ``N`` vertices' readings divides its noise gain by ``1 + POOLING (N - 1)``
+#: (:func:`noisy_rings`'s ``pooled_steps``).
+POOLING = 0.4
+
+
+def noisy_rings(mesh: PreparedMesh, valid: np.ndarray, gain: float, *, pooled_steps: int = 0) -> np.ndarray:
+    """(V,) bool: the ``valid`` vertices whose ring estimate is noisier than :data:`NOISE_SHARE` of the curvature.
+
+    Parameters
+    ----------
+    mesh : PreparedMesh
+        The mesh computed on.
+    valid : ndarray of shape (V,), bool
+        The vertices the method has an estimate for.
+    gain : float
+        The method's noise gain: its estimate of ``H`` moves by about ``gain * sigma / l^2`` for vertices
+        scattered by ``sigma`` along the normal (``l^2`` the vertex's area times ``2 / sqrt(3)``).
+    pooled_steps : int, default: 0
+        The rings of ``valid`` vertices whose estimates the method pools (normal_cycle's smoothing): the gain is
+        divided by ``1 + 0.4 (N - 1)``, ``N`` the ``valid`` vertices within that many rings (the noise of
+        dihedral angles summed over a region partly cancels: measured 2.0, 0.40, 0.08, 0.04 times ``sigma / l^2``
+        over 0, 1, 3, 5 rings of an icosphere soup).
+
+    Returns
+    -------
+    ndarray of shape (V,), bool
+        All False unless the mesh was welded across cracks (``mesh.n_cracked``).
+    """
+    n = mesh.vertices.shape[0]
+    noisy = np.zeros(n, dtype=bool)
+    if not mesh.n_cracked or mesh.index is None or not valid.any():
+        return noisy
+    import scipy.sparse as sp  # imported on use: keeps `import meshcurv` fast
+
+    indptr, indices = mesh.topology.neighbour_lists
+    own = np.arange(n)
+    ring = sp.csr_matrix(  # the closed 1-rings
+        (
+            np.ones(indices.size + n),
+            (np.concatenate([np.repeat(own, np.diff(indptr)), own]), np.concatenate([indices, own])),
+        ),
+        shape=(n, n),
+    )
+    welded = np.bincount(mesh.index, minlength=n) > 1  # copies joined here (exact or across a crack)
+    near = ring @ (ring @ welded.astype(np.float64)) > 0  # within two rings of a welded vertex
+    centres = np.flatnonzero(valid & near)
+    if centres.size == 0:
+        return noisy
+    if pooled_steps > 0:  # the valid vertices within pooled_steps rings of each centre
+        reach = ring[centres]
+        for _ in range(pooled_steps - 1):
+            reach = reach @ ring
+            reach.data[:] = 1.0
+        pooled = reach @ valid.astype(np.float64)
+        gain = gain / (1.0 + POOLING * np.maximum(pooled - 1.0, 0.0))
+    region = ring[centres] @ ring  # each centre's closed 2-ring
+    region = region.tocoo()
+    rows, columns = region.row.astype(np.int64), region.col.astype(np.int64)
+    inner = np.asarray(ring[centres[rows], columns]).ravel() > 0  # in the closed 1-ring: what the estimate reads
+    vertices = mesh.vertices
+    normals = mesh.vertex_normals[centres]
+    lengths_squared = mesh.vertex_areas[centres] * (2.0 / np.sqrt(3.0))
+    first = np.cross(normals, np.where(np.abs(normals[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        first /= np.linalg.norm(first, axis=1, keepdims=True)
+        scale = 1.0 / np.sqrt(lengths_squared)
+    second = np.cross(normals, first)
+    offsets = vertices[columns] - vertices[centres[rows]]
+    u = np.einsum("ij,ij->i", offsets, first[rows]) * scale[rows]
+    v = np.einsum("ij,ij->i", offsets, second[rows]) * scale[rows]
+    h = np.einsum("ij,ij->i", offsets, normals[rows]) * scale[rows]  # heights in units of l
+    monomials = np.column_stack([u * u, u * v, v * v, u, v, np.ones_like(u)])
+    m = centres.size
+    products = monomials[:, :, None] * monomials[:, None, :]
+    normal_matrix = np.stack(
+        [np.bincount(rows, weights=products[:, a, b], minlength=m) for a in range(6) for b in range(6)], axis=1
+    ).reshape(m, 6, 6)
+    right = np.stack([np.bincount(rows, weights=monomials[:, a] * h, minlength=m) for a in range(6)], axis=1)
+    counts = np.bincount(rows, minlength=m)
+    usable = np.isfinite(normal_matrix).all(axis=(1, 2)) & np.isfinite(right).all(axis=1)
+    usable &= counts >= 6 + SPARE_POINTS
+    usable &= np.abs(np.linalg.det(np.where(usable[:, None, None], normal_matrix, np.eye(6)))) > 1e-12
+    coefficients = np.zeros((m, 6))
+    coefficients[usable] = np.linalg.solve(normal_matrix[usable], right[usable][:, :, None])[:, :, 0]
+    residuals = h - np.einsum("ij,ij->i", monomials, coefficients[rows])
+    spread = np.bincount(rows, weights=np.where(inner, residuals * residuals, 0.0), minlength=m)
+    inner_counts = np.bincount(rows, weights=inner, minlength=m)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # the closed 1-ring's scatter off the 2-ring's quadric (its residuals shrunk by the fit's 6 coefficients)
+        sigma = np.sqrt(spread / (inner_counts * np.maximum(1.0 - 6.0 / counts, 1.0 / counts)))  # in units of l
+    a, b, c = coefficients[:, 0], coefficients[:, 1], coefficients[:, 2]
+    length = np.sqrt(lengths_squared)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        curvature = (np.abs(a + c) + np.sqrt((a - c) ** 2 + b * b)) / length  # the quadric's largest |k|
+        # a flat part's rings are judged against the mesh's curvature (its rings' SIGNAL_QUANTILE): an error
+        # small beside that is small, as on a plane of a CAD part
+        known = curvature[usable & np.isfinite(curvature)]
+        floor = float(np.quantile(known, SIGNAL_QUANTILE)) if known.size else 0.0
+        # the estimate's noise gain * sigma / l^2 against NOISE_SHARE of the curvature
+        noisy[centres] = ~usable | ~(gain * sigma / length <= NOISE_SHARE * np.maximum(curvature, floor))
+    return noisy
+
+
+def noisy_rings_note(count: int) -> str:
+    """The warning's phrase for ``count`` vertices of :func:`noisy_rings` ('' for none)."""
+    if not count:
+        return ""
+    return (
+        f"{count} vertices are NaN (estimate undefined): the mesh was welded across cracks between detached faces, "
+        "and their rings are scattered by more than the curvature they resolve (a ring method reads the scatter as "
+        "curvature; the methods over balls, 'icc' or 'quadric', average it out)"
+    )
