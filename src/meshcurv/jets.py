@@ -1208,12 +1208,15 @@ def _nearest_in_cubes(points: np.ndarray, key: np.ndarray, off_middle: np.ndarra
 
 
 #: On a voxel surface, a normal fit whose ball wraps round a thin part (more than :data:`AWAY_FRACTION` of its
-#: points facing away from its centre, by the fitted normals) while a cubic over the same ball bends less than this
-#: (its largest ``|k|`` times the radius) is on a flat part thinner than the ball: the wrap is the other side, not
-#: the centre's own bend (the far side of a part curved all round is within a ball only where ``k r`` reaches
-#: ``sqrt(2)``; the wrapped fits at the tips of ``voxel_ellipsoid((10, 7, 5))`` and round the tube of
-#: ``voxel_torus(12, 4)`` read 1.3 to 3, those on the flat faces of ``voxel_ellipsoid((8, 8, 2))`` 0.1 to 1) ...
-THIN_BEND = 1.0
+#: points facing away from its centre, by the fitted normals) while the cubic over the same ball's points that face
+#: the centre's way (:data:`THIN_AGREEMENT`) bends less than this (its largest ``|k|`` times the radius) is on a flat
+#: part thinner than the ball: the wrap is the other side, not the centre's own bend (the far side of a part curved
+#: all round is within a ball only where ``k r`` reaches about ``sqrt(2)``). On the wrapped samples of the voxel
+#: spheres, tori and ellipsoids of ``accuracy.py --voxel --quick`` the same-side cubics read 0.73 and more; on the
+#: flat faces of ``voxel_ellipsoid((8, 8, 2))`` half of them 0.5 or less. (The cubic over the whole ball, both
+#: sides, reads 0.1 to 1.6 on those flat faces and fell below 1 at one to three samples of four of those
+#: ellipsoids.) ...
+THIN_BEND = 0.7
 #: ... and its normal is fitted again over a ball this many times wider (the terraces of a flat part's staircase
 #: are about ``sqrt(2 h R)`` wide, 8 voxels at the pole of that ellipsoid, wider than the first ball: their edges
 #: tilted its fits, 13.8 degrees off the exact normals at the median) ...
@@ -1245,9 +1248,9 @@ def _thin_part_normals(
     ``centres`` (M,) on thin flat parts of a voxel surface fitted again over wider balls of their own side.
 
     At one centre per cube of :data:`THIN_SPACING` median radii (:func:`_cube_samples`), fits over the same ball
-    tell whether it wraps round a thin part while its cubic hardly bends (:data:`THIN_BEND`); those that do are
-    fitted again over balls :data:`THIN_WIDEN` times wider, of the points whose ``fitted`` normals face the
-    centre's way (:data:`THIN_AGREEMENT`, :func:`fit_jets` ``agreement=``; ``degree``, ``iterations``,
+    tell whether it wraps round a thin part while the cubic of its own side hardly bends (:data:`THIN_BEND`); those
+    that do are fitted again over balls :data:`THIN_WIDEN` times wider, of the points whose ``fitted`` normals face
+    the centre's way (:data:`THIN_AGREEMENT`, :func:`fit_jets` ``agreement=``; ``degree``, ``iterations``,
     ``settled``, ``min_spread``, ``areas`` as there). Each centre takes the flags of the samples near it that
     face its way, interpolated over its tangent plane (:func:`interpolated_normals`), and where they say thin,
     the wider fits' normals interpolated the same way. The fits then cost the samples, not the centres.
@@ -1277,7 +1280,16 @@ def _thin_part_normals(
     if not wrapped.size:
         return out
     coefficients, frame, _ = _fit_jets(
-        vertices, facing, over[wrapped], degree=3, iterations=1, centres=at[wrapped], min_spread=min_spread, **common
+        vertices,
+        facing,
+        over[wrapped],
+        degree=3,
+        iterations=1,
+        centres=at[wrapped],
+        facing=facing,
+        agreement=THIN_AGREEMENT,
+        min_spread=min_spread,
+        **common,
     )
     k_min, k_max = jet_curvatures(coefficients, frame, over[wrapped], facing[at[wrapped]])[:2]
     with np.errstate(invalid="ignore"):
