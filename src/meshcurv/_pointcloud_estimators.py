@@ -14,7 +14,6 @@ import numpy as np
 from ._backend import kernel_threads, numba_kernels
 from ._pointcloud_normals import NEIGHBOURS, NO_LATTICE, Lattice, _dot
 from .errors import InvalidOptionError
-from . import _measures
 from .measures import curvatures_from_measures
 from .jets import _fit_jets, jet_curvatures, jet_normals
 
@@ -809,38 +808,71 @@ def _distinct_ranks(pattern: np.ndarray, counts: np.ndarray) -> np.ndarray:
 
 
 def _triangle_sums(points, normals, index, counts, pattern):
-    """(M, 9) summed measures of the triangles of each ball: the NumPy path of the compiled kernel."""
+    """(M, 9) summed measures of the triangles of each ball: the NumPy path of the compiled kernel.
+
+    Each triangle's measures as :func:`meshcurv._kernels.icc._triangle_measures` computes them, term by term in
+    its order, and summed triangle after triangle as the kernel sums them: the same sums to the bit (the
+    closed forms of :func:`meshcurv.measures.face_measures` in another order gave sums an ulp apart, and a
+    ball's ``k = H -/+ sqrt(H^2 - K)`` near an umbilic takes the square root of that: 2.6e-9 apart on an
+    icosphere).
+    """
     m, n_triangles = index.shape[0], pattern.shape[0]
     ranks = _distinct_ranks(pattern, counts)
     triangles = np.take_along_axis(index[:, None, :], ranks.reshape(m, 1, -1), axis=2).reshape(m, n_triangles, 3)
-    # turn each triangle so that its normal agrees with the mean of its corners' normals, the sign computed in the
-    # kernel's order of operations (_kernels.icc._triangle_measures): on a lattice many triangles are degenerate,
-    # the sign is that of round-off, and another order turned others (R9: one ball's sums 0.25 apart)
-    x0, x1, x2 = (points[triangles[..., j]] for j in range(3))
-    a, b = x1 - x0, x2 - x0
-    u = normals[triangles]
-    mean = (u[..., 0, :] + u[..., 1, :] + u[..., 2, :]) / 3
-    cross = (
-        a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-        a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-        a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
-    )
-    facing = mean[..., 0] * cross[0] + mean[..., 1] * cross[1] + mean[..., 2] * cross[2]
-    flip = facing < 0
+    i, j, k = triangles[..., 0], triangles[..., 1], triangles[..., 2]
+    p0, p1, p2 = points[i], points[j], points[k]
+    ax, ay, az = p1[..., 0] - p0[..., 0], p1[..., 1] - p0[..., 1], p1[..., 2] - p0[..., 2]
+    bx, by, bz = p2[..., 0] - p0[..., 0], p2[..., 1] - p0[..., 1], p2[..., 2] - p0[..., 2]
+    u0, u1, u2 = normals[i], normals[j], normals[k]
+    u0x, u0y, u0z = u0[..., 0], u0[..., 1], u0[..., 2]
+    u1x, u1y, u1z = u1[..., 0], u1[..., 1], u1[..., 2]
+    u2x, u2y, u2z = u2[..., 0], u2[..., 1], u2[..., 2]
+    sx, sy, sz = u0x + u1x + u2x, u0y + u1y + u2y, u0z + u1z + u2z
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
     # a triangle edge-on to its corners' normals adds nothing: its sign would be round-off (EDGE_ON)
-    summed = u[..., 0, :] + u[..., 1, :] + u[..., 2, :]
-    length = np.abs(cross[0]) + np.abs(cross[1]) + np.abs(cross[2])
-    edge_on = np.abs(summed[..., 0] * cross[0] + summed[..., 1] * cross[1] + summed[..., 2] * cross[2]) <= (
-        EDGE_ON * np.abs(summed).sum(axis=-1) * length
+    edge_on = np.abs(sx * cx + sy * cy + sz * cz) <= (
+        EDGE_ON * (np.abs(sx) + np.abs(sy) + np.abs(sz)) * (np.abs(cx) + np.abs(cy) + np.abs(cz))
     )
-    triangles[flip, 1], triangles[flip, 2] = triangles[flip, 2], triangles[flip, 1]
-    # (the trusting core: the points and normals were checked at the door, the triangles are their own ranks)
-    measures = _measures.face_measures(
-        points, np.ascontiguousarray(triangles.reshape(-1, 3), dtype=np.int64), np.ascontiguousarray(normals)
+    mx, my, mz = sx / 3, sy / 3, sz / 3
+    # turned so that its normal agrees with the mean of its corners' normals: (i, j, k) -> (i, k, j)
+    flip = mx * cx + my * cy + mz * cz < 0
+    ax, bx = np.where(flip, bx, ax), np.where(flip, ax, bx)
+    ay, by = np.where(flip, by, ay), np.where(flip, ay, by)
+    az, bz = np.where(flip, bz, az), np.where(flip, az, bz)
+    u1x, u2x = np.where(flip, u2x, u1x), np.where(flip, u1x, u2x)
+    u1y, u2y = np.where(flip, u2y, u1y), np.where(flip, u1y, u2y)
+    u1z, u2z = np.where(flip, u2z, u1z), np.where(flip, u1z, u2z)
+    cx, cy, cz = np.where(flip, -cx, cx), np.where(flip, -cy, cy), np.where(flip, -cz, cz)
+    mu0 = 0.5 * (mx * cx + my * cy + mz * cz)
+    px, py, pz = u0x - u2x, u0y - u2y, u0z - u2z
+    qx, qy, qz = u1x - u0x, u1y - u0y, u1z - u0z
+    tx = (py * az - pz * ay) + (qy * bz - qz * by)
+    ty = (pz * ax - px * az) + (qz * bx - qx * bz)
+    tz = (px * ay - py * ax) + (qx * by - qy * bx)
+    mu1 = 0.5 * (mx * tx + my * ty + mz * tz)
+    mu2 = 0.5 * (u0x * (u1y * u2z - u1z * u2y) + u0y * (u1z * u2x - u1x * u2z) + u0z * (u1x * u2y - u1y * u2x))
+    gx, gy, gz = ay * mz - az * my, az * mx - ax * mz, ax * my - ay * mx
+    hx, hy, hz = by * mz - bz * my, bz * mx - bx * mz, bx * my - by * mx
+    ex, ey, ez = u2x - u0x, u2y - u0y, u2z - u0z
+    measures = np.stack(
+        [
+            mu0,
+            mu1,
+            mu2,
+            0.5 * (gx * ex - hx * qx),
+            0.5 * (gy * ey - hy * qy),
+            0.5 * (gz * ez - hz * qz),
+            0.25 * ((gx * ey - hx * qy) + (gy * ex - hy * qx)),
+            0.25 * ((gx * ez - hx * qz) + (gz * ex - hz * qx)),
+            0.25 * ((gy * ez - hy * qz) + (gz * ey - hz * qy)),
+        ],
+        axis=2,
     )
-    measures = measures.reshape(m, n_triangles, 9)
     measures[edge_on] = 0.0
-    return measures.sum(axis=1)
+    summed = np.zeros((m, 9))
+    for t in range(n_triangles):  # triangle after triangle, as the kernel adds them
+        summed += measures[:, t]
+    return summed
 
 
 def ball_size(radius: float, spacing: float, most: int = MAX_BALL_POINTS) -> int:
