@@ -51,6 +51,12 @@ edge lengths, averaged over two rings), and
 - at any radius, a vertex whose level, or its mesh's median level, exceeds :data:`NOISE_GATE` has its jet
   checked against a quadric over the same ball, as at the rim (faces detached off the surface by a tenth of an edge make such balls: issue 29, fuzz
   296/1682);
+- at the default radius, a crease told from scatter (:func:`_scatter_check`): the residuals of a quadric over
+  each noisy ball (:func:`residual_spreads`, compiled) give the noise's spread of its curvatures, held to
+  :data:`NOISE_REACH` of its curvature; beyond it, residuals that grow over a wider ball are structure (a crease,
+  relief: the fit stays), those that keep their size scatter, fitted over a grown ball within the curvature, else
+  NaN with ``valid=False``; a jet that departs from its ball's quadric by more than the quadric's spread takes it
+  (W20's check of the default radius, reverted, read fandisk's creases as noise: ``benchmarks/quadric_noise.md``);
 - at a given radius, the noise's reach (:func:`_noise_reach`): the spread of a fit's curvatures under the noise of
   its ball, from the level (as a standard deviation, :data:`NOISE_SIGMA_FACTOR`) and the weighted normal matrix of
   the ball's points (``sigma^2 G^-1 M G^-1``, :func:`_noise_spreads`), against the median curvedness of the
@@ -81,8 +87,16 @@ from .._tensors import principal_from_shape_operator
 from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, PIVOT_FLOOR, _exponents, _fit_chunk, _fit_jets, shape_operators
 from ..neighborhoods import _ball_pairs
 from .._tensors import tangent_basis
-from ..radius import _component_radii, _jet_vertex_radii, _local_noise, _resolve_radius, _vertex_radii
+from ..radius import (
+    JET_CURVATURE_CAP,
+    _component_radii,
+    _jet_vertex_radii,
+    _local_noise,
+    _resolve_radius,
+    _vertex_radii,
+)
 from .._prepared import PreparedMesh
+from .._backend import kernel_threads, numba_kernels
 from ._support import Stages, finish
 
 STAGES = ("compute normals", "fit jets", "retrieve curvatures")
@@ -145,6 +159,22 @@ JET_NOISE_REACH = 0.1
 #: for a Gaussian noise that the fits absorb as their six terms would on average).
 NOISE_SIGMA_FACTOR = 2.5
 
+#: The ball that tells scatter from structure at the default radius is this many times wider
+#: (:func:`_scatter_check`): the residuals of a crease grow by as much, those of scatter not at all.
+SCATTER_SCALE = 2.0
+
+#: A ball of scatter is grown this much beyond the size at which its fit's spread (falling as ``r^-3``) would meet
+#: :data:`NOISE_REACH` (:func:`_scatter_check`).
+GROWTH_MARGIN = 1.1
+
+#: The growth of the residuals of structure over a ball :data:`SCATTER_SCALE` times wider, at the least
+#: (:func:`_scatter_check`): the noise left in residuals that grew by ``g`` is their share
+#: ``sqrt((G^2 - g^2) / (G^2 - 1))`` (the rest grown by ``G``). A crease centred in the ball grows as the ball
+#: (2), a smooth surface's higher terms as its cube; fandisk's clean creases off the centre of their balls grew by
+#: 1.44-1.85, scatter by 1 +- 0.15 (20 points), 1.8 where the wider ball reaches the curvature of a noisy torus.
+STRUCTURE_GROWTH = SCATTER_SCALE**0.75
+
+
 #: Noise levels up to this read as a clean mesh in :func:`_noise_sigmas`: twice
 #: :data:`meshcurv.radius.NOISE_FLOOR`, as the vertices of a clean irregular mesh read up to 0.006 (a random
 #: ellipsoid of 2,562 points, whose degree-4 jets a noise read from the floor alone sent to quadrics 1.2
@@ -205,10 +235,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate; a voxel surface's
     # default (stages.voxel_default) is not checked either: its staircase reads as noise at every ball of the voxel
     # default (two voxel spheres and a quantised ellipsoid left with no valid vertex; the warning names 'icc')
-    if radius is not None and not stages.voxel_default:
+    if not stages.voxel_default:
         sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
-        curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
-        unsure = _noise_reach((vertices, start, radii, referenced, facing), sigmas, curvatures, fields)
+        if radius is not None:
+            curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
+            unsure = _noise_reach((vertices, start, radii, referenced, facing), sigmas, curvatures, fields)
+        else:  # the default radius: scatter told from structure by the residuals at two scales
+            unsure = _scatter_check((vertices, radii, referenced, scales), sigmas > 0, fields)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -238,8 +271,12 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         else "",
         (
             f"{noisy_balls} vertices have a ball of radius {shown} too small for the noise of their surface: "
-            f"any fit over it moves the curvatures by more than {NOISE_REACH:g} of the surface's; pass a larger "
-            "`radius` (or none)"
+            f"any fit over it moves the curvatures by more than {NOISE_REACH:g} of the surface's; "
+            + (
+                "pass a larger `radius` (or none)"
+                if radius is not None
+                else "no ball within their curvature averages it"
+            )
         )
         if noisy_balls
         else "",
@@ -395,6 +432,221 @@ def _noise_spreads(ball: tuple, rows: np.ndarray, radii: np.ndarray, sigmas: np.
         spread = np.sqrt(np.clip(covariance, 0.0, None) @ factor) / radii[chunk]
         out[chunk] = np.where(solid, spread, np.inf)
     return out
+
+
+def residual_spreads(vertices, pool, radii, normals, centres) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A quadric fitted over the ball of each centre, the noise of its residuals and how far it moves the fit.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+        The points.
+    pool : ndarray of shape (P,)
+        The ids (int64) of the points that enter the balls.
+    radii : ndarray of shape (V,)
+        Each vertex's radius.
+    normals : ndarray of shape (V, 3)
+        Unit normals: each fit's frame (:func:`meshcurv._tensors.tangent_basis`).
+    centres : ndarray of shape (M,)
+        The vertices fitted.
+
+    Returns
+    -------
+    coefficients : ndarray of shape (M, 6)
+        The quadric ``z = c0 + c1 x + c2 y + c3 x^2 + c4 x y + c5 y^2``, in units of the radius, weights
+        ``(1 - d^2 / r^2)^2``.
+    sigmas : ndarray of shape (M,)
+        The residuals' standard deviation, in length units: ``sum w e^2 / (sum w - tr(G^-1 M))`` (``G = sum w b
+        b^T``, ``M = sum w^2 b b^T``: unbiased for independent noise of one standard deviation).
+    spreads : ndarray of shape (M,)
+        ``sqrt(4 var c3 + 2 var c4 + 4 var c5) / r`` under that noise (``sigma^2 G^-1 M G^-1``), in units of
+        curvature: the root of the expected squared change of the shape operator. NaN, NaN and inf where the ball
+        holds fewer than six points or a singular normal matrix.
+    """
+    kernels = numba_kernels("quadric")
+    centres = np.ascontiguousarray(centres, dtype=np.int64)
+    if kernels is not None:
+        return kernels.residual_spreads(
+            np.ascontiguousarray(vertices, dtype=np.float64),
+            np.ascontiguousarray(pool, dtype=np.int64),
+            np.ascontiguousarray(radii, dtype=np.float64),
+            np.ascontiguousarray(normals, dtype=np.float64),
+            centres,
+            64 * kernel_threads(),
+        )
+    m = centres.size
+    coefficients = np.full((m, 6), np.nan)
+    sigmas = np.full(m, np.nan)
+    spreads = np.full(m, np.inf)
+    if m == 0 or np.size(pool) == 0:
+        return coefficients, sigmas, spreads
+    t1, t2 = tangent_basis(normals[centres])
+    frame = (t1, t2, normals[centres])
+    unit = radii[centres]
+    for chunk, i, j in _ball_pairs(vertices[pool], vertices[centres], unit):
+        size = chunk.stop - chunk.start
+        local = i - chunk.start
+        offsets = (vertices[pool[j]] - vertices[centres[i]]) / unit[i][:, None]
+        weights = 1.0 - (offsets[:, 0] * offsets[:, 0] + offsets[:, 1] * offsets[:, 1] + offsets[:, 2] * offsets[:, 2])
+        inside = weights > 0
+        offsets, local, weights = offsets[inside], local[inside], weights[inside] ** 2
+        x, y, z = (np.einsum("ij,ij->i", offsets, axis[chunk][local]) for axis in frame)
+        basis = np.stack([np.ones_like(x), x, y, x * x, x * y, y * y], axis=1)
+        outer = basis[:, :, None] * basis[:, None, :]
+        gram = np.zeros((size, 6, 6))
+        moments = np.zeros((size, 6, 6))
+        right = np.zeros((size, 6))
+        np.add.at(gram, local, weights[:, None, None] * outer)
+        np.add.at(moments, local, (weights * weights)[:, None, None] * outer)
+        np.add.at(right, local, (weights * z)[:, None] * basis)
+        count = np.bincount(local, minlength=size)
+        total = np.bincount(local, weights=weights, minlength=size)
+        diagonal = np.einsum("nii->ni", gram)
+        values = np.linalg.eigvalsh(gram)
+        solid = (count >= 6) & (values[:, 0] > PIVOT_FLOOR * np.maximum(diagonal.max(axis=1), 1e-300))
+        inverse = np.zeros_like(gram)
+        inverse[solid] = np.linalg.inv(gram[solid])
+        found = np.einsum("nij,nj->ni", inverse, right)
+        residuals = z - np.einsum("ij,ij->i", basis, found[local])
+        squares = np.bincount(local, weights=weights * residuals * residuals, minlength=size)
+        dof = total - np.einsum("nij,nji->n", inverse, moments)
+        second = np.einsum("nkr,nrc,nkc->nk", inverse[:, 3:, :], moments, inverse[:, 3:, :]) @ [4.0, 2.0, 4.0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sigma2 = squares / dof
+        usable = solid & (dof > 0)
+        coefficients[chunk][usable] = found[usable]
+        sigmas[chunk] = np.where(usable, np.sqrt(sigma2) * unit[chunk], np.nan)
+        spreads[chunk] = np.where(usable, np.sqrt(np.clip(sigma2 * second, 0.0, None)) / unit[chunk], np.inf)
+    return coefficients, sigmas, spreads
+
+
+def _scatter_check(ball: tuple, checked: np.ndarray, fields: tuple) -> np.ndarray:
+    """(V,) bool: the vertices at the default radius whose fit the scatter of their ball's points moves beyond
+    :data:`NOISE_REACH` of their curvature, at their radius and over a grown ball (their coefficients made NaN).
+
+    ``ball = (vertices, radii, referenced, groups)`` (``radii``: each vertex's default radius, changed in place where
+    a grown ball's fit is taken); ``checked``: the vertices whose ball reads noise (:func:`_noise_sigmas` above 0);
+    ``fields = (six, fitted, coefficients)``, changed in place. A crease is told from scatter by its residuals:
+
+    1. at each checked vertex, a quadric over its ball in the frame of its fit (:func:`residual_spreads`, compiled)
+       gives its residuals' standard deviation ``s`` and the spread of its curvatures under a noise of that size; a
+       jet that departs from it by more than that spread takes it (:func:`_follow_quadrics`);
+    2. a spread within :data:`NOISE_REACH` of the quadric's curvedness (at least the median curvedness of the fits
+       of its group, :func:`_fitted_curvedness`) passes: a crease is a large curvature whose residuals, small beside
+       it, read as noise;
+    3. beyond it, a quadric over a ball :data:`SCATTER_SCALE` times wider: the residuals of scatter keep their size
+       there, those of a crease or relief that the quadric cannot follow grow with the ball. If they grew by ``g``,
+       the noise in them is the share ``sqrt((G^2 - g^2) / (G^2 - 1))`` (``G``: :data:`STRUCTURE_GROWTH`, the
+       slowest growth of structure) of ``s``, and its spread within the reach passes (W20's check of the spread
+       alone, against the noise fits' level, lost fandisk's creases: 80 -> 57% valid);
+    4. scatter takes the quadric over a ball grown until its spread (as ``r^-3``) is within the reach, at most
+       :data:`meshcurv.radius.JET_CURVATURE_CAP` over its curvedness, if it is; else it is NaN with
+       ``valid=False``."""
+    vertices, radii, referenced, groups = ball
+    six, fitted, coefficients = fields
+    frames = fitted.copy()  # the frames of the quadrics (the fits' normals as they were)
+    unsure = np.zeros(vertices.shape[0], dtype=bool)
+    rows = np.flatnonzero(checked & referenced & np.isfinite(coefficients).all(axis=1))
+    if rows.size == 0:
+        return unsure
+    pool = np.flatnonzero(referenced)
+    floor = _fitted_curvedness(fields, groups, vertices, referenced)
+    found, sigmas, spreads = residual_spreads(vertices, pool, radii, frames, rows)
+    _follow_quadrics((rows, found, frames[rows], radii[rows], spreads), fields)
+    bent = _curvedness(found, frames[rows], radii[rows])
+    loose = ~(spreads <= NOISE_REACH * np.fmax(bent, floor[rows]))
+    rows, sigmas, spreads_near = rows[loose], sigmas[loose], spreads
+    if rows.size == 0:
+        return unsure
+    wide = SCATTER_SCALE * radii[rows]
+    found, wide_sigmas, spreads = residual_spreads(vertices, pool, _at(radii, rows, wide), frames, rows)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        growth = wide_sigmas / sigmas
+    # the noise the two scales leave if the rest grows as STRUCTURE_GROWTH
+    share = np.sqrt(np.clip((STRUCTURE_GROWTH**2 - growth * growth) / (STRUCTURE_GROWTH**2 - 1.0), 0.0, 1.0))
+    held = NOISE_REACH * np.fmax(bent[loose], floor[rows])
+    with np.errstate(invalid="ignore"):
+        structure = spreads_near[loose] * share <= held
+    rows, found, spreads, wide = rows[~structure], found[~structure], spreads[~structure], wide[~structure]
+    if rows.size == 0:
+        return unsure
+    # scatter: a ball grown until the spread (as r^-3) is within the reach, within the curvature's cap
+    held = np.fmax(_curvedness(found, frames[rows], wide), floor[rows])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        grown = wide * np.cbrt(spreads / (NOISE_REACH * held)) * GROWTH_MARGIN
+        grown = np.fmin(np.fmax(grown, radii[rows]), JET_CURVATURE_CAP / held)
+    again = np.isfinite(grown) & (np.abs(grown - wide) > 0.01 * wide)
+    if again.any():
+        refit = residual_spreads(vertices, pool, _at(radii, rows[again], grown[again]), frames, rows[again])
+        found[again], spreads[again], wide[again] = refit[0], refit[2], grown[again]
+    bent = _curvedness(found, frames[rows], wide)
+    with np.errstate(invalid="ignore"):
+        steady = (spreads <= NOISE_REACH * np.fmax(bent, floor[rows])) & (wide * bent <= JET_CURVATURE_CAP * 1.01)
+    taken = rows[steady]
+    frame = tangent_basis(frames[taken])
+    six[taken], fitted[taken] = shape_operators(found[steady], (*frame, frames[taken]), wide[steady])
+    coefficients[taken] = found[steady]
+    radii[taken] = wide[steady]
+    unsure[rows[~steady]] = True
+    coefficients[unsure] = np.nan
+    return unsure
+
+
+def _follow_quadrics(quadrics: tuple, fields: tuple) -> None:
+    """The fits in ``fields = (six, fitted, coefficients)`` (changed in place) replaced by the quadrics of
+    ``quadrics = (rows, coefficients, normals, radii, spreads)`` (:func:`residual_spreads`, in the frames of
+    ``normals``) where their principal curvatures depart from the quadric's by more than its spread under the noise of
+    its residuals: the jet's higher terms then follow the scatter (issue 29, fuzz 395/82: every face of
+    ``icosphere(24)`` detached by 0.055 edge lengths, jets off the unit sphere's H by 0.5-0.64 over quadrics off by
+    0.16-0.27, spreads 0.15-0.21)."""
+    rows, found, normals, radii, spreads = quadrics
+    six, fitted, coefficients = fields
+    known = np.isfinite(found).all(axis=1) & np.isfinite(spreads)
+    rows, found, normals, radii, spreads = rows[known], found[known], normals[known], radii[known], spreads[known]
+    if rows.size == 0:
+        return
+    frame = tangent_basis(normals)
+    low_six, low_fitted = shape_operators(found, (*frame, normals), radii)
+    high_k = principal_from_shape_operator(six[rows], fitted[rows])[:2]
+    low_k = principal_from_shape_operator(low_six, low_fitted)[:2]
+    apart = np.maximum(np.abs(high_k[0] - low_k[0]), np.abs(high_k[1] - low_k[1]))
+    swap = apart > spreads
+    six[rows[swap]], fitted[rows[swap]], coefficients[rows[swap]] = low_six[swap], low_fitted[swap], found[swap]
+
+
+def _at(radii: np.ndarray, rows: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """A copy of ``radii`` with ``values`` at ``rows``."""
+    out = radii.copy()
+    out[rows] = values
+    return out
+
+
+def _curvedness(coefficients: np.ndarray, normals: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """(N,) ``sqrt((k_min^2 + k_max^2) / 2)`` of quadrics fitted in the frames of ``normals``
+    (:func:`residual_spreads`, in units of their ``radii``); NaN where no fit."""
+    known = np.isfinite(coefficients).all(axis=1)
+    out = np.full(coefficients.shape[0], np.nan)
+    if known.any():
+        frame = tangent_basis(normals[known])
+        six, tilted = shape_operators(coefficients[known], (*frame, normals[known]), radii[known])
+        k_min, k_max = principal_from_shape_operator(six, tilted)[:2]
+        out[known] = np.sqrt((k_min * k_min + k_max * k_max) / 2)
+    return out
+
+
+def _fitted_curvedness(fields: tuple, groups: list, vertices: np.ndarray, referenced: np.ndarray) -> np.ndarray:
+    """(V,) the median curvedness ``sqrt((k_min^2 + k_max^2) / 2)`` of the fits in ``fields = (six, fitted,
+    coefficients)`` over each group of components (``groups``), at least ``2 / d`` (``d``: the diagonal of the
+    bounding box of the referenced vertices, as :func:`_curvature_scales`)."""
+    six, fitted, coefficients = fields
+    usable = np.isfinite(coefficients).all(axis=1) & referenced
+    own = np.full(vertices.shape[0], np.nan)
+    if usable.any():
+        k_min, k_max = principal_from_shape_operator(six[usable], fitted[usable])[:2]
+        own[usable] = np.sqrt((k_min * k_min + k_max * k_max) / 2)
+    points = vertices[referenced]
+    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if points.size else 0.0
+    return np.fmax(_group_medians(own, groups, np.isfinite(own)), 2.0 / diagonal if diagonal > 0 else np.inf)
 
 
 def _noise_sigmas(levels: np.ndarray, groups: list, edge_lengths: np.ndarray) -> np.ndarray:
