@@ -178,3 +178,27 @@ def test_a_rotated_thin_torus_is_one_estimate_on_both_backends(method):
     scale = float(np.nanmax(np.abs(reference.k_max), initial=1.0))
     for field in ("k_min", "k_max"):
         np.testing.assert_allclose(getattr(compiled, field), getattr(reference, field), rtol=0, atol=1e-6 * scale)
+
+
+def test_the_far_winding_sums_are_the_kernels_to_the_bit():
+    # before: the NumPy path summed each query's far terms pairwise (numpy.sum), the kernel source after source;
+    # the winding numbers are compared with thresholds (a part inside out, a cavity, a fragment's side)
+    from meshcurv import _pointcloud_normals
+
+    points = clouds()["thin_pair"]
+    tree, distances, indices = neighbours(points)
+    normals = _pointcloud_normals._pca_normals_numpy(points, indices)
+    areas = _pointcloud_normals.local_spacing(distances) ** 2
+    usable = np.ones(points.shape[0], dtype=bool)
+    queries, sources = np.arange(0, points.shape[0], 5), np.arange(0, points.shape[0], 3)
+    found = {}
+    for backend in ("numba", "numpy"):
+        with use_backend(backend):
+            found[backend] = (
+                _pointcloud_normals._winding(points, normals, areas, usable, tree, points[queries], queries, sources),
+                _pointcloud_normals.winding_at(
+                    points, normals, areas, usable, tree, points[queries] + 0.01 * normals[queries], sources
+                ),
+            )
+    for compiled, reference in zip(found["numba"], found["numpy"]):
+        np.testing.assert_array_equal(reference, compiled)

@@ -1409,7 +1409,8 @@ def _far_winding(points, normals, weights, soft, sources, q, queries, reach_squa
             far = squared > reach_squared[rows, None]
             squared = squared + soft
             term = weights * (dx * nx + dy * ny + dz * nz) / (squared * np.sqrt(squared))
-            total[rows] += np.where(far, term, 0.0).sum(axis=1)
+            # added source after source as the kernel adds them (sum() adds pairwise): the same sums to the bit
+            total[rows] += np.cumsum(np.where(far, term, 0.0), axis=1)[:, -1]
     return total
 
 
