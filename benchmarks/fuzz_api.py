@@ -1916,6 +1916,10 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
+#: The run's address-space guard above its size after the warm-up, in bytes: the hard limit of it and its children.
+GUARD = 3 * 2**30
+
+
 def case_cap(base: int, memory_mib: int, factor: int, args) -> int:
     """The address-space cap of a call, in bytes: ``base`` plus ``memory_mib`` MiB plus ``factor`` per input byte."""
     return base + memory_mib * 2**20 + factor * sum(_nbytes(a) for a in args)
@@ -1953,20 +1957,21 @@ def replay(seed: int, index: int, memory_mib: int, factor: int) -> int:
     """
     warm_up()
     base = vsize()
-    resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, base + 2**31))
+    hard = base + GUARD  # as a run's children inherit it from the run's guard
+    resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, hard))
     if index % 4 == 3:
         os.environ["MESHCURV_BACKEND"] = "numpy"
     target, args, kwargs, labels, clean = make_case(seed, index)
-    limit = case_cap(base, memory_mib, factor, args)
+    limit = min(case_cap(base, memory_mib, factor, args), hard)
     print(f"case {index} seed {seed}: {target}({describe(args, kwargs)})")
     print("mutations:", "; ".join(labels), "| backend:", os.environ.get("MESHCURV_BACKEND", "auto"))
     print(f"cap: {round((limit - base) / 2**20)} MiB above this process's {base / 2**20:.0f} MiB", flush=True)
-    resource.setrlimit(resource.RLIMIT_AS, (limit, base + 2**31))  # the soft cap; raised again to print
+    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))  # the soft cap; raised again to print
     try:
         outcome = run_case(target, args, kwargs, clean)
     except MemoryError:
         outcome = {"status": "memory", "type": "MemoryError", "message": "checking ran out of memory"}
-    resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, base + 2**31))
+    resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, hard))
     if outcome.get("type") == "MemoryError":
         outcome["status"] = "memory"
         outcome["message"] = f"MemoryError under a cap of {round((limit - base) / 2**20)} MiB above the parent"
@@ -1993,11 +1998,15 @@ def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
         code = 0
         try:
             resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-            resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, base + 2**31))
+            # (the hard limit stays the run's guard: a call's cap may lie above the case's first one, as for a
+            # real mesh of 134,000 vertices, but no process can raise its hard limit again)
+            hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+            hard = base + GUARD if hard == resource.RLIM_INFINITY else hard
+            resource.setrlimit(resource.RLIMIT_AS, (base + 2**31, hard))
             if numpy_backend:
                 os.environ["MESHCURV_BACKEND"] = "numpy"
             target, args, kwargs, labels, clean = make_case(seed, index)
-            limit = case_cap(base, memory_mib, factor, args)
+            limit = min(case_cap(base, memory_mib, factor, args), hard)
             resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
             head = {
                 "target": target,
@@ -2183,7 +2192,7 @@ def main(argv=None) -> int:
 
     warm_up()  # once, so that the children fork with the kernels loaded
 
-    guard = vsize() + 3 * 2**30  # the parent itself never needs more (it builds no case)
+    guard = vsize() + GUARD  # the parent itself never needs more (it builds no case)
     resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
     deadline = time.monotonic() + options.minutes * 60
     counts = collections.Counter()
