@@ -93,7 +93,8 @@ Near such holes, a vertex whose normal fit held few points (a piece of a triangl
 whose fit sees only its own corners) and whose faces scatter off its corners' fitted normals is undefined
 (:func:`_scattered_pieces`): the scatter of a few points drives its normal, and the cracks around its small ball
 carry that into H (issue 29: every face of ``icosphere(24)`` detached by 0.03 edges, 191 of 9,834 valid vertices
-off the sphere's H by more than half of it).
+off the sphere's H by more than half of it); so is a vertex whose ball holds a small piece of a staircase
+(:func:`_stair_pieces`: a voxel surface's soup, fuzz 395/99).
 
 Every ball (of the noise fits, the normal fits and the sums) is the piece of
 the Euclidean ball connected to its vertex on the mesh through the edges and
@@ -905,6 +906,15 @@ def _curvatures(
         corners = vertices[faces]
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
+    areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
+    if areas_column:
+        corners = vertices[faces]
+        measures = np.column_stack(
+            [
+                measures,
+                0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1),
+            ]
+        )
     if coarse:
         summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
@@ -913,6 +923,9 @@ def _curvatures(
     if boundary_faces is not None:
         summed, radius, sparse = _holed_balls(vertices, faces, radius, measures, summed, usable, valid, normals)
         summed = summed[:, :-4]
+    ball_areas = None
+    if areas_column:
+        summed, ball_areas = summed[:, :-1], summed[:, -1]
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
@@ -921,33 +934,37 @@ def _curvatures(
         valid &= ~sparse
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, adjacency)
+        if ball_areas is not None:
+            valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts))
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
 
 
-#: Near holes (:func:`_near_holes`), a vertex whose normal fit held fewer points than this (a piece of a soup
-#: between cracks: its fit sees its own few corners) ...
-SCATTER_POINTS = 35
-#: ... is undefined where the faces around it scatter: their normals tilt off the mean of their corners' fitted
-#: normals (the root mean square of the sine, weighted by area) by more than this share of the curvature signal
-#: of an edge (``h`` times the surface's median curvedness). The scatter of its few points then drives its fitted
-#: normal, and through the cracks around its small ball its H: every face of ``icosphere(24)`` detached by 0.03
-#: edges (issue 29, fuzz round 22; 395/99 on a voxel sphere) left 135 of 9,141 valid vertices off the clean
-#: shape's H by more than half of it, all fitted over fewer than 35 points, their faces tilted by 0.3 to 0.5
-#: signals; the corners' exact normals over the same balls gave none. Rules that let the tilt grow with the
-#: points (``n^1.5``, ``n^3``) cost a quarter more of the soup's cover for the same result; at 0.1 signals
-#: 11 vertices stayed off, at 30 points 2. On a clean mesh the faces tilt by about the square of the signal:
-#: intact pieces between cracks keep their values.
+#: Near holes (:func:`_near_holes`), a vertex is undefined where its faces scatter by more than
+#: :data:`SCATTER_TILT` of the curvature signal of an edge (the tilt of the faces' normals off the mean of their
+#: corners' fitted normals, the root mean square of the sine weighted by area, over ``h`` times the surface's
+#: median curvedness) and its normal fit held fewer points than this many times that scatter ...
+SCATTER_POINTS = 100.0
+#: ... or fewer than this many. A piece of a soup between cracks fits its normal over its own corners, whose
+#: scatter then drives the normal and, through the cracks around its small ball, its H; a normal's noise falls
+#: about as ``1 / n`` for ``n`` points spread over ``sqrt(n)`` edges, hence the linear term. Every face of
+#: ``icosphere(24)`` detached by 0.03 edges (issue 29, fuzz round 22): 135 of 9,141 valid vertices off the clean
+#: shape's H by more than half of it, fitted over fewer than 40 points, their faces tilted by 0.3 to 0.5 signals
+#: (the corners' exact normals over the same balls: none off); 35 points alone left none of them, but 50 and 94
+#: of ``icosphere(40)``'s (an edge's signal 0.6 times smaller, tilts of 0.5 to 1 signals, up to 70 points) ...
+SCATTER_FEW = 35
+#: ... where the faces tilt by more than this share of the signal. On a clean mesh they tilt by about the square
+#: of the signal (a few hundredths of it): intact pieces between cracks keep their values.
 SCATTER_TILT = 0.05
 
 
 def _scattered_pieces(vertices, faces, dropped, normals, valid, counts, k_min, k_max, adjacency) -> np.ndarray:
-    """(V,) bool: the ``valid`` vertices near holes whose normal fit held fewer than :data:`SCATTER_POINTS` points
-    (``counts`` (V,); inf where not counted) and whose faces scatter beyond :data:`SCATTER_TILT` of the curvature
-    signal of an edge: the tilt of each face's normal off the normalised mean of its corners' ``normals``, its root
-    mean square over the faces at the vertex weighted by area, against the median edge length times the median
-    curvedness ``sqrt((k_min^2 + k_max^2) / 2)`` of the ``valid`` vertices."""
+    """(V,) bool: the ``valid`` vertices near holes (``counts`` (V,) the points of their normal fits; inf where not
+    counted) whose faces scatter by ``s`` above :data:`SCATTER_TILT` and whose fit held fewer points than
+    :data:`SCATTER_FEW` or :data:`SCATTER_POINTS` ``s``. ``s``: the tilt of each face's normal off the normalised
+    mean of its corners' ``normals``, its root mean square over the faces at the vertex weighted by area, over the
+    median edge length times the median curvedness ``sqrt((k_min^2 + k_max^2) / 2)`` of the ``valid`` vertices."""
     n = vertices.shape[0]
-    near = valid & (counts < SCATTER_POINTS)
+    near = valid & np.isfinite(counts)
     if not near.any():
         return near
     kept = ~dropped & np.isfinite(normals[faces]).all(axis=(1, 2))
@@ -967,7 +984,33 @@ def _scattered_pieces(vertices, faces, dropped, normals, valid, counts, k_min, k
         tilt = np.sqrt(summed / total)
         curvedness = np.sqrt(0.5 * (k_min * k_min + k_max * k_max))
     signal = _sampled_edge(vertices, adjacency) * float(np.median(curvedness[valid]))
-    return near & ~(tilt <= SCATTER_TILT * signal)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = tilt / signal
+    scattered = ~(ratio <= SCATTER_TILT)
+    return near & scattered & (counts < np.maximum(SCATTER_FEW, SCATTER_POINTS * np.where(scattered, ratio, 0.0)))
+
+
+#: Near holes, a ball whose corrected area ``mu_0(B)`` is below this share of its faces' area (the faces tilt off
+#: the fitted normals by 18 degrees on average: a staircase; a smooth mesh's balls hold 0.99 and more, a coarse
+#: one's 0.97) ...
+STAIR_TILT = 0.99
+#: ... and below this share of its disc ``pi r^2`` holds a piece of a staircase cut by cracks, whose sum is noise
+#: (a face of a staircase carries the surface's curvature only summed with its neighbours', as in
+#: :func:`_holed_balls`): its vertex is undefined. ``voxel_sphere(10)`` with every face detached by 0.03 edges (the
+#: weld joins some corners; no voxel surface to the default, its corners left the grid; issue 29, fuzz 395/99):
+#: 61 of 172 and 82 of 530 valid vertices off the sphere's H by more than half of it, all in balls holding 0.1 to
+#: 0.6 of their disc (the others 0.1 to 0.76); half of ``voxel_sphere(6)``'s faces detached by 0.065 edges: 0 of
+#: 472 off, every ball above 0.4.
+STAIR_SHARE = 0.4
+
+
+def _stair_pieces(corrected, areas, radius, near) -> np.ndarray:
+    """(V,) bool: the ``near`` vertices whose ball's corrected area ``corrected`` (V,) is below :data:`STAIR_TILT`
+    of its faces' area ``areas`` (V,) and below :data:`STAIR_SHARE` of its disc (``radius``, a float or (V,))."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        stair = corrected < STAIR_TILT * areas
+        sparse = corrected < STAIR_SHARE * np.pi * np.asarray(radius, dtype=np.float64) ** 2
+    return near & stair & sparse
 
 
 def _near_holes(vertices, topology: MeshTopology, radius, normal_radius, centres: np.ndarray) -> np.ndarray | None:
