@@ -119,8 +119,24 @@ FEW_ELEMENTS_KEPT = 0.5
 #: exceeds this share of the mesh's curvature (:func:`few_elements`).
 FEW_ELEMENTS_SPREAD = 0.2
 
+#: A ball that kept less than this share of the elements of its intact ball (holes or cracks in it) is judged by the
+#: scatter of its own readings as well (:func:`few_elements`' ``local_variances``): faces detached by cracks and
+#: welded back across them (:data:`meshcurv.weld.CRACK_TOLERANCE_RATIO`) are tilted by the crack's width over their
+#: own height, and the edges between them read that tilt (fuzz_api 400/31: -3.2 for H = 1 on icosphere(24),
+#: 400/89: 30 to 400 by a uv sphere's poles) where a regular mesh's edges scatter little; half-detached uv spheres
+#: (64 x 32) and icosphere(24), default and given balls of 1.5 and 2.9 edges, both windings, seeds 0-1: 2,492 valid
+#: vertices off by more than half of H -> 30, at 0.5 and 0.8 alike (tests/test_ncb_cracks_N21.py).
+FEW_ELEMENTS_HOLED = 0.8
 
-def few_elements(valid, shares, intact_shares, variances, readings, curvatures) -> np.ndarray:
+#: A ball that lost most of its elements (:data:`FEW_ELEMENTS_KEPT`) and holds fewer than this effective number
+#: of them has no scatter to judge: one or two edges' readings are the estimate (a ball of 1.5 edges on a
+#: half-detached icosphere(24): one edge left of 48, H -5.8 for 1, their variance 0).
+FEW_ELEMENTS_LEAST = 2.0
+
+FEW_ELEMENTS_NOISE = 2.0
+
+
+def few_elements(valid, shares, intact_shares, variances, readings, curvatures, *, local_variances=None) -> np.ndarray:
     """(V,) bool: the ``valid`` vertices whose support lost most of its elements and whose estimate reads too few
     of them to average out their scatter.
 
@@ -143,6 +159,13 @@ def few_elements(valid, shares, intact_shares, variances, readings, curvatures) 
     mean square of the edges' ``readings``, :func:`edge_readings`). Undefined where ``N`` is below
     :data:`FEW_ELEMENTS_KEPT` of the intact one and ``sqrt(variance / N)`` above :data:`FEW_ELEMENTS_SPREAD` times
     that curvature.
+
+    ``local_variances``: (V,) the weighted variance of the readings each support kept (``normal_cycle_ball``'s
+    balls; None: not judged). The median scatter of the intact supports misses the few supports where cracks
+    welded back tilted faces (their edges read the tilt) or folded them: with it, a support that lost most of its
+    elements is judged by the larger of the two scatters, one that kept less than :data:`FEW_ELEMENTS_HOLED` of
+    them by its own, one that lost most and kept fewer than :data:`FEW_ELEMENTS_LEAST` is undefined, and where
+    no support kept its elements the curvature is the median of the estimates.
     """
     known = valid & np.isfinite(variances)
     if not known.any():
@@ -153,14 +176,25 @@ def few_elements(valid, shares, intact_shares, variances, readings, curvatures) 
         lost = ~(FEW_ELEMENTS_KEPT * shares <= intact_shares)
     # the curvature of the supports that kept their elements; where none did, the edges' readings' root mean square
     kept = valid & ~lost
+    largest = np.maximum(np.abs(k_min), np.abs(k_max))
     if kept.any():
-        scale = float(np.median(np.maximum(np.abs(k_min[kept]), np.abs(k_max[kept]))))
+        scale = float(np.median(largest[kept]))
+    elif local_variances is not None:  # the estimates' median: a few folded edges' readings outweigh a mean square
+        scale = float(np.median(largest[valid]))
     else:
         read = readings[np.isfinite(readings)]
         with np.errstate(over="ignore"):
             scale = float(np.sqrt(np.mean(read * read))) if read.size else 0.0
+    bound = (FEW_ELEMENTS_SPREAD * scale) ** 2
     with np.errstate(invalid="ignore", over="ignore"):
-        return valid & lost & ~(variance * shares <= (FEW_ELEMENTS_SPREAD * scale) ** 2)
+        if local_variances is None:
+            return valid & lost & ~(variance * shares <= bound)
+        holed = ~(FEW_ELEMENTS_HOLED * shares <= intact_shares)
+        few = lost & ~(np.fmax(variance, local_variances) * shares <= bound)
+        noisy = holed & ~(local_variances <= FEW_ELEMENTS_NOISE * variance)
+        few |= noisy & ~(local_variances * shares <= bound)
+        few |= lost & ~(shares * FEW_ELEMENTS_LEAST <= 1.0)
+        return valid & few
 
 
 def few_elements_note(count: int, support: str, elements: str) -> str:
@@ -339,8 +373,19 @@ def _edge_spread_columns(density: np.ndarray, intact: np.ndarray, lengths: np.nd
     read = np.isfinite(readings)
     held = np.where(read, readings, 0.0)
     whole = intact * read
+    kept = density * read
     return np.column_stack(
-        [density * density * lengths, intact, intact * intact * lengths, whole, whole * held, whole * held * held]
+        [
+            density * density * lengths,
+            intact,
+            intact * intact * lengths,
+            whole,
+            whole * held,
+            whole * held * held,
+            kept,
+            kept * held,
+            kept * held * held,
+        ]
     )
 
 
@@ -350,12 +395,13 @@ def _few_edges(valid, areas, spread_sums, readings, curvatures) -> np.ndarray:
     ``density |e ∩ B|``, the ball's H their weighted mean). ``spread_sums``: the ball sums of
     :func:`_edge_spread_columns`; ``readings``: the edges' (:func:`edge_readings`); ``curvatures``: ``(k_min,
     k_max)``."""
-    squared, whole, whole_squared, read, first, second = spread_sums.T
+    squared, whole, whole_squared, read, first, second, kept, kept_first, kept_second = spread_sums.T
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         shares = squared / (areas * areas)  # 1 / N (at least)
         intact_shares = whole_squared / (whole * whole)
         variances = second / read - (first / read) ** 2
-    return few_elements(valid, shares, intact_shares, variances, readings, curvatures)
+        local = kept_second / kept - (kept_first / kept) ** 2
+    return few_elements(valid, shares, intact_shares, variances, readings, curvatures, local_variances=local)
 
 
 def _voxel_holed_balls(
