@@ -241,7 +241,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
             unsure = _noise_reach((vertices, start, radii, referenced, facing), sigmas, curvatures, fields)
         else:  # the default radius: scatter told from structure by the residuals at two scales
-            unsure = _scatter_check((vertices, radii, referenced, scales), sigmas > 0, fields)
+            unsure = _scatter_check((vertices, radii, referenced, scales), (sigmas > 0, noisy), fields)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -520,17 +520,20 @@ def residual_spreads(vertices, pool, radii, normals, centres) -> tuple[np.ndarra
     return coefficients, sigmas, spreads
 
 
-def _scatter_check(ball: tuple, checked: np.ndarray, fields: tuple) -> np.ndarray:
+def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     """(V,) bool: the vertices at the default radius whose fit the scatter of their ball's points moves beyond
     :data:`NOISE_REACH` of their curvature, at their radius and over a grown ball (their coefficients made NaN).
 
     ``ball = (vertices, radii, referenced, groups)`` (``radii``: each vertex's default radius, changed in place where
-    a grown ball's fit is taken); ``checked``: the vertices whose ball reads noise (:func:`_noise_sigmas` above 0);
+    a grown ball's fit is taken); ``checks = (checked, noisy)``: the vertices whose ball reads noise
+    (:func:`_noise_sigmas` above 0), and those above :data:`NOISE_GATE` (:func:`_noisy_balls`);
     ``fields = (six, fitted, coefficients)``, changed in place. A crease is told from scatter by its residuals:
 
     1. at each checked vertex, a quadric over its ball in the frame of its fit (:func:`residual_spreads`, compiled)
-       gives its residuals' standard deviation ``s`` and the spread of its curvatures under a noise of that size; a
-       jet that departs from it by more than that spread takes it (:func:`_follow_quadrics`);
+       gives its residuals' standard deviation ``s`` and the spread of its curvatures under a noise of that size; at
+       the ``noisy`` vertices a jet that departs from it by more than that spread takes it (:func:`_follow_quadrics`;
+       elsewhere a clean surface's higher terms make the departure: the coarse ellipsoid of ``accuracy.py --quick``,
+       H 1.9 -> 3.1% with the swap everywhere);
     2. a spread within :data:`NOISE_REACH` of the quadric's curvedness (at least the median curvedness of the fits
        of its group, :func:`_fitted_curvedness`) passes: a crease is a large curvature whose residuals, small beside
        it, read as noise;
@@ -543,6 +546,7 @@ def _scatter_check(ball: tuple, checked: np.ndarray, fields: tuple) -> np.ndarra
        :data:`meshcurv.radius.JET_CURVATURE_CAP` over its curvedness, if it is; else it is NaN with
        ``valid=False``."""
     vertices, radii, referenced, groups = ball
+    checked, noisy = checks
     six, fitted, coefficients = fields
     frames = fitted.copy()  # the frames of the quadrics (the fits' normals as they were)
     unsure = np.zeros(vertices.shape[0], dtype=bool)
@@ -552,7 +556,8 @@ def _scatter_check(ball: tuple, checked: np.ndarray, fields: tuple) -> np.ndarra
     pool = np.flatnonzero(referenced)
     floor = _fitted_curvedness(fields, groups, vertices, referenced)
     found, sigmas, spreads = residual_spreads(vertices, pool, radii, frames, rows)
-    _follow_quadrics((rows, found, frames[rows], radii[rows], spreads), fields)
+    gated = noisy[rows]
+    _follow_quadrics((rows[gated], found[gated], frames[rows[gated]], radii[rows[gated]], spreads[gated]), fields)
     bent = _curvedness(found, frames[rows], radii[rows])
     loose = ~(spreads <= NOISE_REACH * np.fmax(bent, floor[rows]))
     rows, sigmas, spreads_near = rows[loose], sigmas[loose], spreads
