@@ -36,7 +36,8 @@ __all__ = ["NOISE_SHARE", "noisy_rings", "noisy_rings_note"]
 NOISE_SHARE = 0.15
 
 #: The least number of points beyond the quadric's six coefficients that a 2-ring must hold to tell its noise
-#: (fewer: the vertex is undefined on a mesh welded across cracks, as its ring cannot be checked).
+#: (fewer, or fewer points beyond the 1-ring than in it: the vertex is undefined on a mesh welded across cracks,
+#: as its ring cannot be checked).
 SPARE_POINTS = 3
 
 #: The share of the checked rings whose curvature is at most the one a flat ring is judged against: the
@@ -48,7 +49,15 @@ SIGNAL_QUANTILE = 0.9
 POOLING = 0.4
 
 
-def noisy_rings(mesh: PreparedMesh, valid: np.ndarray, gain: float, *, pooled_steps: int = 0) -> np.ndarray:
+def noisy_rings(
+    mesh: PreparedMesh,
+    valid: np.ndarray,
+    gain: float,
+    *,
+    pooled_steps: int = 0,
+    normals: np.ndarray | None = None,
+    normal_gain: float = 0.0,
+) -> np.ndarray:
     """(V,) bool: the ``valid`` vertices whose ring estimate is noisier than :data:`NOISE_SHARE` of the curvature.
 
     Parameters
@@ -65,6 +74,11 @@ def noisy_rings(mesh: PreparedMesh, valid: np.ndarray, gain: float, *, pooled_st
         divided by ``1 + 0.4 (N - 1)``, ``N`` the ``valid`` vertices within that many rings (the noise of
         dihedral angles summed over a region partly cancels: measured 2.0, 0.40, 0.08, 0.04 times ``sigma / l^2``
         over 0, 1, 3, 5 rings of an icosphere soup).
+    normals : ndarray of shape (V, 3), optional
+        The vertex normals the method reads (rusinkiewicz: fitted ones at open fans). Their angles off the
+        quadric's normals over the closed 1-ring, RMS ``theta``, add ``normal_gain * theta / l`` to the noise.
+    normal_gain : float, default: 0
+        The method's gain for the normals' noise.
 
     Returns
     -------
@@ -103,17 +117,17 @@ def noisy_rings(mesh: PreparedMesh, valid: np.ndarray, gain: float, *, pooled_st
     rows, columns = region.row.astype(np.int64), region.col.astype(np.int64)
     inner = np.asarray(ring[centres[rows], columns]).ravel() > 0  # in the closed 1-ring: what the estimate reads
     vertices = mesh.vertices
-    normals = mesh.vertex_normals[centres]
+    frame = mesh.vertex_normals[centres]
     lengths_squared = mesh.vertex_areas[centres] * (2.0 / np.sqrt(3.0))
-    first = np.cross(normals, np.where(np.abs(normals[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
+    first = np.cross(frame, np.where(np.abs(frame[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
     with np.errstate(invalid="ignore", divide="ignore"):
         first /= np.linalg.norm(first, axis=1, keepdims=True)
         scale = 1.0 / np.sqrt(lengths_squared)
-    second = np.cross(normals, first)
+    second = np.cross(frame, first)
     offsets = vertices[columns] - vertices[centres[rows]]
     u = np.einsum("ij,ij->i", offsets, first[rows]) * scale[rows]
     v = np.einsum("ij,ij->i", offsets, second[rows]) * scale[rows]
-    h = np.einsum("ij,ij->i", offsets, normals[rows]) * scale[rows]  # heights in units of l
+    h = np.einsum("ij,ij->i", offsets, frame[rows]) * scale[rows]  # heights in units of l
     monomials = np.column_stack([u * u, u * v, v * v, u, v, np.ones_like(u)])
     m = centres.size
     products = monomials[:, :, None] * monomials[:, None, :]
@@ -122,19 +136,25 @@ def noisy_rings(mesh: PreparedMesh, valid: np.ndarray, gain: float, *, pooled_st
     ).reshape(m, 6, 6)
     right = np.stack([np.bincount(rows, weights=monomials[:, a] * h, minlength=m) for a in range(6)], axis=1)
     counts = np.bincount(rows, minlength=m)
-    usable = np.isfinite(normal_matrix).all(axis=(1, 2)) & np.isfinite(right).all(axis=1)
-    usable &= counts >= 6 + SPARE_POINTS
+    usable = np.asarray(np.isfinite(normal_matrix).all(axis=(1, 2)) & np.isfinite(right).all(axis=1))
     usable &= np.abs(np.linalg.det(np.where(usable[:, None, None], normal_matrix, np.eye(6)))) > 1e-12
     coefficients = np.zeros((m, 6))
     coefficients[usable] = np.linalg.solve(normal_matrix[usable], right[usable][:, :, None])[:, :, 0]
     residuals = h - np.einsum("ij,ij->i", monomials, coefficients[rows])
     spread = np.bincount(rows, weights=np.where(inner, residuals * residuals, 0.0), minlength=m)
     inner_counts = np.bincount(rows, weights=inner, minlength=m)
+    # the quadric needs the 2-ring's outer points (at least as many as the 1-ring's neighbours: a fan welded alone,
+    # among open fans, fits its own scatter as curvature) and spare ones to tell its scatter
+    usable &= (counts >= 6 + SPARE_POINTS) & (counts - inner_counts >= inner_counts - 1)
     with np.errstate(invalid="ignore", divide="ignore"):
         # the closed 1-ring's scatter off the 2-ring's quadric (its residuals shrunk by the fit's 6 coefficients)
         sigma = np.sqrt(spread / (inner_counts * np.maximum(1.0 - 6.0 / counts, 1.0 / counts)))  # in units of l
     a, b, c = coefficients[:, 0], coefficients[:, 1], coefficients[:, 2]
     length = np.sqrt(lengths_squared)
+    noise = gain * sigma / length
+    if normals is not None and normal_gain > 0:
+        theta = _normal_scatter(normals, columns, rows, inner, u, v, (first, second, frame), coefficients, m)
+        noise = np.hypot(noise, normal_gain * theta / length)
     with np.errstate(invalid="ignore", divide="ignore"):
         curvature = (np.abs(a + c) + np.sqrt((a - c) ** 2 + b * b)) / length  # the quadric's largest |k|
         # a flat part's rings are judged against the mesh's curvature (its rings' SIGNAL_QUANTILE): an error
@@ -142,8 +162,27 @@ def noisy_rings(mesh: PreparedMesh, valid: np.ndarray, gain: float, *, pooled_st
         known = curvature[usable & np.isfinite(curvature)]
         floor = float(np.quantile(known, SIGNAL_QUANTILE)) if known.size else 0.0
         # the estimate's noise gain * sigma / l^2 against NOISE_SHARE of the curvature
-        noisy[centres] = ~usable | ~(gain * sigma / length <= NOISE_SHARE * np.maximum(curvature, floor))
+        noisy[centres] = ~usable | ~(noise <= NOISE_SHARE * np.maximum(curvature, floor))
     return noisy
+
+
+def _normal_scatter(normals, columns, rows, inner, u, v, axes, coefficients, m) -> np.ndarray:
+    """(M,) the RMS angle (radians) between ``normals`` at the closed 1-rings' vertices and the normals of their
+    centres' quadrics there (either sign: the frames' normals are the mesh's)."""
+    first, second, frame = axes
+    slope_u = 2 * coefficients[rows, 0] * u + coefficients[rows, 1] * v + coefficients[rows, 3]
+    slope_v = coefficients[rows, 1] * u + 2 * coefficients[rows, 2] * v + coefficients[rows, 4]
+    fitted = frame[rows] - slope_u[:, None] * first[rows] - slope_v[:, None] * second[rows]
+    given = normals[columns]
+    across = np.linalg.norm(np.cross(fitted, given), axis=1)
+    along = np.abs(np.einsum("ij,ij->i", fitted, given))
+    with np.errstate(invalid="ignore"):
+        angles = np.arctan2(across, along)
+    angles = np.where(inner, angles, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.sqrt(
+            np.bincount(rows, weights=angles * angles, minlength=m) / np.bincount(rows, weights=inner, minlength=m)
+        )
 
 
 def noisy_rings_note(count: int) -> str:

@@ -117,6 +117,13 @@ _SIX = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))  # 3x3 -> (x
 NOISE_GAIN = 0.4
 
 
+#: Its gain for the noise of the normals it reads (fitted ones at open fans): ``H`` moves by about
+#: ``NORMAL_NOISE_GAIN theta / l`` for normals off by ``theta`` (RMS over the ring; 0.3-1 caught the case below,
+#: 1 cost a fifth of a fine soup's cover at gap 0.01) (issue 29, fuzz 395/37: a
+#: uv sphere's pole, half its fan detached, lent its fitted normal to its neighbours, H off by 1.0).
+NORMAL_NOISE_GAIN = 0.5
+
+
 def face_second_fundamental_forms(
     vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray, face_unit_normals: np.ndarray
 ) -> np.ndarray:
@@ -294,7 +301,7 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
         np.where(valid[:, None], shape_operator, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     )
     valid, staircase = staircase_undefined(mesh, defects, valid, stages=stages)
-    noisy = noisy_rings(mesh, valid, NOISE_GAIN)
+    noisy = noisy_rings(mesh, valid, NOISE_GAIN, normals=normals, normal_gain=NORMAL_NOISE_GAIN)
     valid &= ~noisy
     extra = (*staircase, noisy_rings_note(int(noisy.sum())))
     return finish("rusinkiewicz", {}, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra)
