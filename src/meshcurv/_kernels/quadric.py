@@ -33,10 +33,7 @@ def residual_spreads(vertices, pool, radii, normals, centres, n_chunks):
     spreads = np.full(m, np.inf)
     if m == 0 or pool.shape[0] == 0:
         return coefficients, sigmas, spreads
-    largest = 0.0
-    for k in range(m):
-        largest = max(largest, float(radii[centres[k]]))
-    points, _, grid = pool_grid(vertices, pool, largest)
+    points, _, grid = pool_grid(vertices, pool, float(radii[centres].max()))  # cells as wide as the largest ball
     run_chunks(
         _spread_chunk, m, n_chunks, vertices, points, grid, radii, normals, centres, coefficients, sigmas, spreads
     )
