@@ -584,6 +584,7 @@ def _fit_jets(
         count = np.bincount(rows, weights=(weights > 0).astype(float), minlength=size)
         local = [*tangent_basis(normals[index]), normals[index]]
         settle = np.zeros((size, 1), dtype=bool)  # the centres whose iterations have ended (``settled``)
+        fitted = np.full((size, 6), np.nan)  # (no iteration: the facing check alone)
         for step in range(iterations):
             matrix, right = _fit_chunk(offsets, rows, size, local, weights, degree)
             found = _solve(matrix, right, count, degree, min_spread)
@@ -1273,8 +1274,8 @@ def _thin_part_normals(
     at, over = centres[sampled], radii[sampled]
     common: dict[str, Any] = {"neighbours": neighbours, "adjacency": adjacency, "compact": True}
     details: dict = {}
-    # the share facing away (a fit of degree 1 solves nothing: the share is all that is read)
-    _fit_jets(vertices, facing, over, degree=1, iterations=1, centres=at, facing=facing, details=details, **common)
+    # the share facing away (no iteration: the walk and the check alone, no moments summed)
+    _fit_jets(vertices, facing, over, degree=1, iterations=0, centres=at, facing=facing, details=details, **common)
     with np.errstate(invalid="ignore"):
         wrapped = np.flatnonzero(details["away"] > AWAY_FRACTION)
     if not wrapped.size:
