@@ -52,7 +52,7 @@ POOLING = 0.4
 def noisy_rings(
     mesh: PreparedMesh,
     valid: np.ndarray,
-    gain: float,
+    gain: float | np.ndarray,
     *,
     pooled_steps: int = 0,
     normals: np.ndarray | None = None,
@@ -66,8 +66,8 @@ def noisy_rings(
         The mesh computed on.
     valid : ndarray of shape (V,), bool
         The vertices the method has an estimate for.
-    gain : float
-        The method's noise gain: its estimate of ``H`` moves by about ``gain * sigma / l^2`` for vertices
+    gain : float or ndarray of shape (V,)
+        The method's noise gain (each vertex's): its estimate of ``H`` moves by about ``gain * sigma / l^2`` for vertices
         scattered by ``sigma`` along the normal (``l^2`` the vertex's area times ``2 / sqrt(3)``).
     pooled_steps : int, default: 0
         The rings of ``valid`` vertices whose estimates the method pools (normal_cycle's smoothing): the gain is
@@ -105,6 +105,7 @@ def noisy_rings(
     centres = np.flatnonzero(valid & near)
     if centres.size == 0:
         return noisy
+    gain = np.broadcast_to(np.asarray(gain, dtype=np.float64), (n,))[centres]
     if pooled_steps > 0:  # the valid vertices within pooled_steps rings of each centre
         reach = ring[centres]
         for _ in range(pooled_steps - 1):

@@ -93,7 +93,24 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
         else ()
     )
     valid, staircase = staircase_undefined(mesh, defects, valid, stages=stages)
-    noisy = noisy_rings(mesh, valid, NOISE_GAIN)
+    noisy = noisy_rings(mesh, valid, _noise_gains(mesh, good, cot, areas)) if mesh.n_cracked else np.zeros_like(valid)
     valid &= ~noisy
     extra = (*extra, *staircase, noisy_rings_note(int(noisy.sum())))
     return finish("meyer", {}, valid, normals, k_min, k_max, directions, directions.copy(), defects, extra)
+
+
+def _noise_gains(mesh: PreparedMesh, good: np.ndarray, cot: np.ndarray, areas: np.ndarray) -> np.ndarray:
+    """(V,) each vertex's :data:`NOISE_GAIN` for its own ring: the spread ``sqrt(2 sum c^2 + (sum c)^2) / (4 A)``
+    of its cotangent weights ``c`` (each face's share of an edge's: twice their squares bound the edges'), in units
+    of ``l^2`` (the vertex's area times ``2 / sqrt(3)``), over that of a regular ring (``sqrt(56) / (2 sqrt(3))``):
+    the fans of a uv sphere's poles, their cotangents large, amplify the scatter more than their area says."""
+    n = mesh.vertices.shape[0]
+    total, squares = np.zeros(n), np.zeros(n)
+    for k in range(3):  # the weight cot at corner k of edge (j, m), at both ends
+        for end in ((k + 1) % 3, (k + 2) % 3):
+            total += np.bincount(good[:, end], weights=cot[:, k], minlength=n)
+            squares += np.bincount(good[:, end], weights=cot[:, k] ** 2, minlength=n)
+    regular = np.sqrt(56.0) / (2.0 * np.sqrt(3.0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        spread = np.sqrt(2.0 * squares + total**2) / (4.0 * areas) * (mesh.vertex_areas * 2.0 / np.sqrt(3.0))
+    return NOISE_GAIN * np.where(np.isfinite(spread), np.maximum(spread / regular, 1.0), 1.0)
