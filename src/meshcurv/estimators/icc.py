@@ -89,12 +89,6 @@ holes leave many vertices on bow-ties and strips, undefined as centres but
 corners of their neighbours' faces, and the mean of their face normals (18 to
 40 degrees off on a staircase) made H low by 0.1 to 0.18 of the curvature on
 average (a voxel sphere in 2 x 1 x 1 voxels with half of its faces removed).
-Near such holes, a vertex whose normal fit held few points (a piece of a triangle soup between cracks,
-whose fit sees only its own corners) and whose faces scatter off its corners' fitted normals is undefined
-(:func:`_scattered_pieces`): the scatter of a few points drives its normal, and the cracks around its small ball
-carry that into H (issue 29: every face of ``icosphere(24)`` detached by 0.03 edges, 191 of 9,834 valid vertices
-off the sphere's H by more than half of it); so is a vertex whose ball holds a small piece of a staircase
-(:func:`_stair_pieces`: a voxel surface's soup, fuzz 395/99).
 
 Every ball (of the noise fits, the normal fits and the sums) is the piece of
 the Euclidean ball connected to its vertex on the mesh through the edges and
@@ -243,7 +237,6 @@ def fitted_normals(
     fits: np.ndarray | None = None,
     edge: float | None = None,
     unwrap: np.ndarray | None = None,
-    counts: np.ndarray | None = None,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -266,8 +259,7 @@ def fitted_normals(
     ``edge``: the median edge length of :func:`_sampled_edge`, when the caller has it.
 
     ``unwrap`` (V,) bool: the vertices whose fits are checked for balls holding points that face away, and made
-    again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes); ``counts`` (V,)
-    float, when given, is set in place to the number of points of their first fits (unchanged elsewhere).
+    again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes).
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -333,7 +325,6 @@ def fitted_normals(
                 neighbours,
                 adjacency,
                 areas if weighted else None,
-                counts=counts,
             )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
@@ -364,9 +355,7 @@ FEW_DEGREE = 2
 FEW_AGREEMENT = float(np.cos(np.radians(8.0)))
 
 
-def _unwrapped_normals(
-    vertices, start, fitted, radius, valid, neighbours, adjacency, areas, *, counts=None
-) -> np.ndarray:
+def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjacency, areas) -> np.ndarray:
     """(V, 3) :func:`fitted_normals`' jet normals near holes: ``fitted`` (V, 3), the normals of the fits over
     ``radius`` (the mean of the face normals where none was made), made again at the ``valid`` vertices whose ball
     wrapped or held few points.
@@ -384,8 +373,7 @@ def _unwrapped_normals(
     still wrapped keeps its first fit, and so does one left with fewer than :data:`FEW_POINTS` points unless the
     quadric over them disagrees: on the coarse torus of ``benchmarks/wide_cracks_icc.py``, 16 edges around its
     tube, cubics over half of a wrapped ball read H 0.007 for 0.06 at vertices left with one or two faces). A cubic over fewer than :data:`FEW_POINTS` points (a strip between
-    cracks) gives way to the quadric over them where the two disagree (:data:`FEW_AGREEMENT`). ``counts`` (V,),
-    when given, takes the number of points of each first fit (:func:`_scattered_pieces` reads them).
+    cracks) gives way to the quadric over them where the two disagree (:data:`FEW_AGREEMENT`).
     """
     n = vertices.shape[0]
     facing, fitted = fitted, np.array(fitted, copy=True)
@@ -394,7 +382,7 @@ def _unwrapped_normals(
 
     def fit(at, over, degree):
         details: dict = {}
-        coefficients, frame, held = _fit_jets(
+        coefficients, frame, counts = _fit_jets(
             vertices,
             start,
             over,
@@ -410,17 +398,15 @@ def _unwrapped_normals(
             areas=areas,
             min_spread=NORMAL_MIN_SPREAD,
         )
-        return jet_normals(coefficients, frame), held, details["away"]
+        return jet_normals(coefficients, frame), counts, details["away"]
 
     for step in range(UNWRAP_STEPS + 1):
         if not centres.size:
             break
-        found, held, away = fit(centres, radii, NORMAL_DEGREE)
-        if not step and counts is not None:
-            counts[centres] = held
+        found, counts, away = fit(centres, radii, NORMAL_DEGREE)
         with np.errstate(invalid="ignore"):
             wrapped = away > AWAY_FRACTION
-        few = ~wrapped & (held < FEW_POINTS)
+        few = ~wrapped & (counts < FEW_POINTS)
         if step:  # (the first fits are those given; a ball still wrapped, or left with few points, keeps them)
             fitted[centres[~wrapped & ~few]] = found[~wrapped & ~few]
         if few.any():  # a cubic through a dozen points of a lopsided ball: its slope can be the noise of the fit
@@ -878,7 +864,6 @@ def _curvatures(
             _corners_fitted(faces, degenerate, normals, valid) if coarse or topology is not None else valid,
         )
         near = None if topology is None else _near_holes(vertices, topology, radius, normal_radius, fit)
-        counts = None if near is None else np.full(vertices.shape[0], np.inf)
         normals = fitted_normals(
             vertices,
             normals,
@@ -891,7 +876,6 @@ def _curvatures(
             failed=failed,
             edge=edge,
             unwrap=near,
-            counts=counts,
         )
 
         if boundary_faces is not None and adjacency is not None:
@@ -906,15 +890,6 @@ def _curvatures(
         corners = vertices[faces]
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
-    areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
-    if areas_column:
-        corners = vertices[faces]
-        measures = np.column_stack(
-            [
-                measures,
-                0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1),
-            ]
-        )
     if coarse:
         summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
@@ -923,94 +898,13 @@ def _curvatures(
     if boundary_faces is not None:
         summed, radius, sparse = _holed_balls(vertices, faces, radius, measures, summed, usable, valid, normals)
         summed = summed[:, :-4]
-    ball_areas = None
-    if areas_column:
-        summed, ball_areas = summed[:, :-1], summed[:, -1]
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
     valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, failed)
     if sparse is not None:
         valid &= ~sparse
-    if counts is not None:
-        valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, adjacency)
-        if ball_areas is not None:
-            valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts))
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
-
-
-#: Near holes (:func:`_near_holes`), a vertex is undefined where its faces scatter by more than
-#: :data:`SCATTER_TILT` of the curvature signal of an edge (the tilt of the faces' normals off the mean of their
-#: corners' fitted normals, the root mean square of the sine weighted by area, over ``h`` times the surface's
-#: median curvedness) and its normal fit held fewer points than this many times that scatter ...
-SCATTER_POINTS = 100.0
-#: ... or fewer than this many. A piece of a soup between cracks fits its normal over its own corners, whose
-#: scatter then drives the normal and, through the cracks around its small ball, its H; a normal's noise falls
-#: about as ``1 / n`` for ``n`` points spread over ``sqrt(n)`` edges, hence the linear term. Every face of
-#: ``icosphere(24)`` detached by 0.03 edges (issue 29, fuzz round 22): 135 of 9,141 valid vertices off the clean
-#: shape's H by more than half of it, fitted over fewer than 40 points, their faces tilted by 0.3 to 0.5 signals
-#: (the corners' exact normals over the same balls: none off); 35 points alone left none of them, but 50 and 94
-#: of ``icosphere(40)``'s (an edge's signal 0.6 times smaller, tilts of 0.5 to 1 signals, up to 70 points) ...
-SCATTER_FEW = 35
-#: ... where the faces tilt by more than this share of the signal. On a clean mesh they tilt by about the square
-#: of the signal (a few hundredths of it): intact pieces between cracks keep their values.
-SCATTER_TILT = 0.05
-
-
-def _scattered_pieces(vertices, faces, dropped, normals, valid, counts, k_min, k_max, adjacency) -> np.ndarray:
-    """(V,) bool: the ``valid`` vertices near holes (``counts`` (V,) the points of their normal fits; inf where not
-    counted) whose faces scatter by ``s`` above :data:`SCATTER_TILT` and whose fit held fewer points than
-    :data:`SCATTER_FEW` or :data:`SCATTER_POINTS` ``s``. ``s``: the tilt of each face's normal off the normalised
-    mean of its corners' ``normals``, its root mean square over the faces at the vertex weighted by area, over the
-    median edge length times the median curvedness ``sqrt((k_min^2 + k_max^2) / 2)`` of the ``valid`` vertices."""
-    n = vertices.shape[0]
-    near = valid & np.isfinite(counts)
-    if not near.any():
-        return near
-    kept = ~dropped & np.isfinite(normals[faces]).all(axis=(1, 2))
-    corners = faces[kept]
-    points = vertices[corners]
-    cross = np.cross(points[:, 1] - points[:, 0], points[:, 2] - points[:, 0])
-    area = np.linalg.norm(cross, axis=1)
-    middle = normals[corners].sum(axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        middle /= np.linalg.norm(middle, axis=1, keepdims=True)
-        turned = np.cross(cross / area[:, None], middle)
-    sine2 = np.einsum("ij,ij->i", turned, turned)
-    usable = np.isfinite(sine2) & (area > 0)
-    total = np.bincount(corners.ravel(), weights=np.repeat(np.where(usable, area, 0.0), 3), minlength=n)
-    summed = np.bincount(corners.ravel(), weights=np.repeat(np.where(usable, area * sine2, 0.0), 3), minlength=n)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        tilt = np.sqrt(summed / total)
-        curvedness = np.sqrt(0.5 * (k_min * k_min + k_max * k_max))
-    signal = _sampled_edge(vertices, adjacency) * float(np.median(curvedness[valid]))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = tilt / signal
-    scattered = ~(ratio <= SCATTER_TILT)
-    return near & scattered & (counts < np.maximum(SCATTER_FEW, SCATTER_POINTS * np.where(scattered, ratio, 0.0)))
-
-
-#: Near holes, a ball whose corrected area ``mu_0(B)`` is below this share of its faces' area (the faces tilt off
-#: the fitted normals by 18 degrees on average: a staircase; a smooth mesh's balls hold 0.99 and more, a coarse
-#: one's 0.97) ...
-STAIR_TILT = 0.99
-#: ... and below this share of its disc ``pi r^2`` holds a piece of a staircase cut by cracks, whose sum is noise
-#: (a face of a staircase carries the surface's curvature only summed with its neighbours', as in
-#: :func:`_holed_balls`): its vertex is undefined. ``voxel_sphere(10)`` with every face detached by 0.03 edges (the
-#: weld joins some corners; no voxel surface to the default, its corners left the grid; issue 29, fuzz 395/99):
-#: 61 of 172 and 82 of 530 valid vertices off the sphere's H by more than half of it, all in balls holding 0.1 to
-#: 0.6 of their disc (the others 0.1 to 0.76); half of ``voxel_sphere(6)``'s faces detached by 0.065 edges: 0 of
-#: 472 off, every ball above 0.4.
-STAIR_SHARE = 0.4
-
-
-def _stair_pieces(corrected, areas, radius, near) -> np.ndarray:
-    """(V,) bool: the ``near`` vertices whose ball's corrected area ``corrected`` (V,) is below :data:`STAIR_TILT`
-    of its faces' area ``areas`` (V,) and below :data:`STAIR_SHARE` of its disc (``radius``, a float or (V,))."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        stair = corrected < STAIR_TILT * areas
-        sparse = corrected < STAIR_SHARE * np.pi * np.asarray(radius, dtype=np.float64) ** 2
-    return near & stair & sparse
 
 
 def _near_holes(vertices, topology: MeshTopology, radius, normal_radius, centres: np.ndarray) -> np.ndarray | None:
