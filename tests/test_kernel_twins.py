@@ -2090,6 +2090,8 @@ TWINS = [
 #: Public kernels checked here only through another path, each with the reason. Empty: every
 #: public kernel has a row in TWINS.
 EXCEPTIONS: dict[str, str] = {
+    "quadric.residual_spreads": "tests/test_quadric_scatter_Q21.py::test_residual_spreads_backends_agree: against "
+    "estimators.quadric.residual_spreads (its NumPy body) within 1e-9: the same sums in another order",
     "pilot.interpolated_normals": "tests/test_jets_sampled.py::test_the_compiled_interpolation_is_the_numpy_one: "
     "against jets.interpolated_normals (its NumPy twin) to round-off",
     "neighborhoods.clustered_face_sums": "tests/test_neighborhoods_clusters.py::test_cluster_sums_equal_the_walk_face_"

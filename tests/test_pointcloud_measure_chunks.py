@@ -18,7 +18,6 @@ import warnings
 import numpy as np
 import pytest
 
-import meshcurv._measures
 import meshcurv._pointcloud_estimators as estimators
 from meshcurv._backend import use_backend
 from meshcurv.pointcloud import point_cloud_curvatures
@@ -55,13 +54,13 @@ def test_numpy_triangles_in_bounded_chunks_same_numbers(monkeypatch):
         monkeypatch.setattr(estimators, "TRIANGLE_CHUNK", 10**9, raising=False)
         whole = _measured(points)
         sizes: list[int] = []
-        face_measures = meshcurv._measures.face_measures
+        triangle_sums = estimators._triangle_sums
 
-        def recording(vertices, faces, normals):
-            sizes.append(faces.shape[0])
-            return face_measures(vertices, faces, normals)
+        def recording(points, normals, index, counts, pattern):
+            sizes.append(index.shape[0] * pattern.shape[0])  # the triangles drawn at once
+            return triangle_sums(points, normals, index, counts, pattern)
 
-        monkeypatch.setattr(meshcurv._measures, "face_measures", recording)
+        monkeypatch.setattr(estimators, "_triangle_sums", recording)
         monkeypatch.setattr(estimators, "TRIANGLE_CHUNK", FEW * estimators.TRIANGLES, raising=False)
         chunked = _measured(points)
     # never more than the chunk's triangles at once (before: every ball's, 1500 x 32 and more)
