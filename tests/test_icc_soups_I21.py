@@ -4,9 +4,9 @@ Issue 29 (fuzz 395/99 and the minimised soup of ``benchmarks/fuzz_api.md``, roun
 into fans and leaves cracks between most; a piece of a few fans fits its normals over its own few corners, whose
 scatter (a fiftieth of an edge) tilts them by as much as the curvature turns over an edge, and the cracks around
 its small ball carry that tilt into H. ``icosphere(24)`` with every face detached by 0.03 edges had 191 of 9,834
-valid vertices off the unit sphere's H by more than half of it. Open: the rules of e75a1de and daa8d55 (such a
-vertex undefined) were reverted for what they cost at the rims of clean hemispheres; the cases that fail on main
-are strict xfails.
+valid vertices off the unit sphere's H by more than half of it. Such a vertex is now undefined where the mesh was
+welded across cracks (``icc._scattered_pieces``: a quadric's residuals over three edges against the curvature
+signal; ``icc._stair_pieces``: a ball holding a small piece of a staircase). These tests fail on 1faca50.
 
 Oracles: the exact H of the unit sphere (the fuzzer's bar: a valid vertex off by more than half of the largest
 ``|k|`` is a wrong number marked valid) and the agreement of the two backends.
@@ -56,10 +56,6 @@ def _sphere_errors(vertices, result) -> np.ndarray:
 
 #: The fix (e75a1de, daa8d55) was reverted (2dbcf74): its rules undefined the rims of clean hemispheres
 #: (``benchmarks/accuracy.py --quick``); these cases stay open until a rule tells a soup's pieces from a rim.
-OPEN = pytest.mark.xfail(strict=True, reason="open: icc on soups (issue 29, fuzz 395/99); the fix was reverted")
-
-
-@OPEN
 @pytest.mark.parametrize(
     ("subdivisions", "seed", "inward"),
     [(16, 1, False), (16, 2, True), (12, 0, False)],
@@ -108,7 +104,6 @@ def test_the_backends_agree_on_a_soup():
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-6)
 
 
-@OPEN
 @pytest.mark.parametrize(("seed", "inward"), [(11, False), (11, True)])
 def test_a_voxel_soup_marks_no_wrong_mean_curvature_valid(seed, inward):
     # fuzz 395/99's class (voxel_sphere(10) inward, every face detached by 0.03 edges): the weld joins some corners

@@ -89,6 +89,12 @@ holes leave many vertices on bow-ties and strips, undefined as centres but
 corners of their neighbours' faces, and the mean of their face normals (18 to
 40 degrees off on a staircase) made H low by 0.1 to 0.18 of the curvature on
 average (a voxel sphere in 2 x 1 x 1 voxels with half of its faces removed).
+Near such holes, a vertex whose normal fit held few points (a piece of a triangle soup between cracks,
+whose fit sees only its own corners) and whose faces scatter off its corners' fitted normals is undefined
+(:func:`_scattered_pieces`): the scatter of a few points drives its normal, and the cracks around its small ball
+carry that into H (issue 29: every face of ``icosphere(24)`` detached by 0.03 edges, 191 of 9,834 valid vertices
+off the sphere's H by more than half of it); so is a vertex whose ball holds a small piece of a staircase
+(:func:`_stair_pieces`: a voxel surface's soup, fuzz 395/99).
 
 Every ball (of the noise fits, the normal fits and the sums) is the piece of
 the Euclidean ball connected to its vertex on the mesh through the edges and
@@ -130,6 +136,7 @@ from ..jets import (
     _fit_jets,
     _nearest_in_cubes,
     _sampled_jet_normals,
+    _thin_part_normals,
     interpolated_normals,
     jet_normals,
     nested_jet_normals,
@@ -237,6 +244,8 @@ def fitted_normals(
     fits: np.ndarray | None = None,
     edge: float | None = None,
     unwrap: np.ndarray | None = None,
+    counts: np.ndarray | None = None,
+    thin: bool = False,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -259,7 +268,12 @@ def fitted_normals(
     ``edge``: the median edge length of :func:`_sampled_edge`, when the caller has it.
 
     ``unwrap`` (V,) bool: the vertices whose fits are checked for balls holding points that face away, and made
-    again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes).
+    again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes); ``counts`` (V,)
+    float, when given, is set in place to the number of points of their first fits (unchanged elsewhere).
+
+    ``thin``: a voxel surface; the fits on its thin flat parts (balls that wrap round a part thinner than them while
+    their jets hardly bend) are made again over wider balls of the points that face the centre's way
+    (:func:`meshcurv.jets._thin_part_normals`; not on the coarse level).
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -325,6 +339,20 @@ def fitted_normals(
                 neighbours,
                 adjacency,
                 areas if weighted else None,
+                counts=counts,
+            )
+        if thin and adjacency is not None:
+            fitted = _thin_part_normals(
+                vertices,
+                np.where(valid[:, None], fitted, normals),
+                radius,
+                np.flatnonzero(valid),
+                neighbours=neighbours,
+                adjacency=adjacency,
+                degree=NORMAL_DEGREE,
+                iterations=NORMAL_ITERATIONS,
+                settled=NORMAL_SETTLED,
+                min_spread=NORMAL_MIN_SPREAD,
             )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
@@ -355,7 +383,9 @@ FEW_DEGREE = 2
 FEW_AGREEMENT = float(np.cos(np.radians(8.0)))
 
 
-def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjacency, areas) -> np.ndarray:
+def _unwrapped_normals(
+    vertices, start, fitted, radius, valid, neighbours, adjacency, areas, *, counts=None
+) -> np.ndarray:
     """(V, 3) :func:`fitted_normals`' jet normals near holes: ``fitted`` (V, 3), the normals of the fits over
     ``radius`` (the mean of the face normals where none was made), made again at the ``valid`` vertices whose ball
     wrapped or held few points.
@@ -373,7 +403,8 @@ def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjac
     still wrapped keeps its first fit, and so does one left with fewer than :data:`FEW_POINTS` points unless the
     quadric over them disagrees: on the coarse torus of ``benchmarks/wide_cracks_icc.py``, 16 edges around its
     tube, cubics over half of a wrapped ball read H 0.007 for 0.06 at vertices left with one or two faces). A cubic over fewer than :data:`FEW_POINTS` points (a strip between
-    cracks) gives way to the quadric over them where the two disagree (:data:`FEW_AGREEMENT`).
+    cracks) gives way to the quadric over them where the two disagree (:data:`FEW_AGREEMENT`). ``counts`` (V,),
+    when given, takes the number of points of each first fit (:func:`_scattered_pieces` reads them).
     """
     n = vertices.shape[0]
     facing, fitted = fitted, np.array(fitted, copy=True)
@@ -382,7 +413,7 @@ def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjac
 
     def fit(at, over, degree):
         details: dict = {}
-        coefficients, frame, counts = _fit_jets(
+        coefficients, frame, held = _fit_jets(
             vertices,
             start,
             over,
@@ -398,15 +429,17 @@ def _unwrapped_normals(vertices, start, fitted, radius, valid, neighbours, adjac
             areas=areas,
             min_spread=NORMAL_MIN_SPREAD,
         )
-        return jet_normals(coefficients, frame), counts, details["away"]
+        return jet_normals(coefficients, frame), held, details["away"]
 
     for step in range(UNWRAP_STEPS + 1):
         if not centres.size:
             break
-        found, counts, away = fit(centres, radii, NORMAL_DEGREE)
+        found, held, away = fit(centres, radii, NORMAL_DEGREE)
+        if not step and counts is not None:
+            counts[centres] = held
         with np.errstate(invalid="ignore"):
             wrapped = away > AWAY_FRACTION
-        few = ~wrapped & (counts < FEW_POINTS)
+        few = ~wrapped & (held < FEW_POINTS)
         if step:  # (the first fits are those given; a ball still wrapped, or left with few points, keeps them)
             fitted[centres[~wrapped & ~few]] = found[~wrapped & ~few]
         if few.any():  # a cubic through a dozen points of a lopsided ball: its slope can be the noise of the fit
@@ -829,6 +862,7 @@ def _curvatures(
     coarse: bool = False,
     boundary_faces: np.ndarray | None = None,
     topology: MeshTopology | None = None,
+    cracked: bool = False,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -839,7 +873,9 @@ def _curvatures(
     radius of each ball summed (``radius`` as given otherwise). ``topology``: the mesh's, given where it has
     boundary edges and is not a voxel surface: the normals are fitted at every corner of a face summed
     (:func:`_corners_fitted`) and, near holes (:func:`_near_holes`), the fits whose balls wrap are made again
-    (:func:`_unwrapped_normals`).
+    (:func:`_unwrapped_normals`). ``cracked``: the mesh was welded across cracks (``PreparedMesh.n_cracked``): near
+    holes, the pieces whose fits scatter (:func:`_scattered_pieces`) or whose balls hold a small piece of a staircase
+    (:func:`_stair_pieces`) are undefined.
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -864,6 +900,10 @@ def _curvatures(
             _corners_fitted(faces, degenerate, normals, valid) if coarse or topology is not None else valid,
         )
         near = None if topology is None else _near_holes(vertices, topology, radius, normal_radius, fit)
+        # the pieces' scatter is read where cracks were welded (a soup's copies joined into fans between cracks);
+        # a mesh whose holes were cut keeps its pieces intact (half of icosphere(4)'s faces removed: its coarse
+        # balls' quadrics depart from the sphere by the scatter rule's bound, and no vertex was wrong)
+        counts = None if near is None or not cracked else np.full(vertices.shape[0], np.inf)
         normals = fitted_normals(
             vertices,
             normals,
@@ -876,6 +916,8 @@ def _curvatures(
             failed=failed,
             edge=edge,
             unwrap=near,
+            counts=counts,
+            thin=coarse,
         )
 
         if boundary_faces is not None and adjacency is not None:
@@ -890,6 +932,15 @@ def _curvatures(
         corners = vertices[faces]
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
+    areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
+    if areas_column:
+        corners = vertices[faces]
+        measures = np.column_stack(
+            [
+                measures,
+                0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1),
+            ]
+        )
     if coarse:
         summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
@@ -898,13 +949,89 @@ def _curvatures(
     if boundary_faces is not None:
         summed, radius, sparse = _holed_balls(vertices, faces, radius, measures, summed, usable, valid, normals)
         summed = summed[:, :-4]
+    ball_areas = None
+    if areas_column:
+        summed, ball_areas = summed[:, :-1], summed[:, -1]
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
     valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, failed)
     if sparse is not None:
         valid &= ~sparse
+    if counts is not None:
+        valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, adjacency)
+        if ball_areas is not None:
+            valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts))
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
+
+
+#: Near holes (:func:`_near_holes`), a vertex is undefined where its points scatter by more than
+#: :data:`SCATTER_TILT` of the curvature signal (the residuals of a quadric over three edge lengths, over ``h^2``
+#: times the surface's median curvedness: :func:`_scattered_pieces`) and its normal fit held fewer points than this
+#: many times that scatter ...
+SCATTER_POINTS = 100.0
+#: ... or fewer than this many. A piece of a soup between cracks fits its normal over its own corners, whose
+#: scatter then drives the normal and, through the cracks around its small ball, its H; a normal's noise falls
+#: about as ``1 / n`` for ``n`` points spread over ``sqrt(n)`` edges, hence the linear term. Every face of
+#: ``icosphere(24)`` detached by 0.03 edges (issue 29, fuzz round 22): 135 of 9,141 valid vertices off the clean
+#: shape's H by more than half of it, fitted over fewer than 40 points, their faces tilted by 0.3 to 0.5 signals
+#: (the corners' exact normals over the same balls: none off); 35 points alone left none of them, but 50 and 94
+#: of ``icosphere(40)``'s (an edge's signal 0.6 times smaller, tilts of 0.5 to 1 signals, up to 70 points) ...
+SCATTER_FEW = 35
+#: ... where the points scatter by more than this share of the signal (clean meshes, irregular ones and their
+#: rims: 0.003 to 0.03; the face tilts of the first version read 0.3 to 0.5 at an irregular hemisphere's rim, as
+#: on a soup, and undefined it): intact pieces between cracks keep their values.
+SCATTER_TILT = 0.05
+
+
+def _scattered_pieces(vertices, faces, dropped, normals, valid, counts, k_min, k_max, adjacency) -> np.ndarray:
+    """(V,) bool: the ``valid`` vertices near holes (``counts`` (V,) the points of their normal fits; inf where not
+    counted) whose points scatter by ``s`` above :data:`SCATTER_TILT` and whose fit held fewer points than
+    :data:`SCATTER_FEW` or :data:`SCATTER_POINTS` ``s``. ``s``: the standard deviation of the residuals of a
+    quadric over the Euclidean ball of three median edge lengths ``h`` (:func:`meshcurv.estimators.quadric.
+    residual_spreads`: the ball crosses the cracks, so it sees the scatter of the pieces around) over ``h^2`` times
+    the median curvedness ``sqrt((k_min^2 + k_max^2) / 2)`` of the ``valid`` vertices (clean meshes, irregular
+    ones and their rims included: 0.003 to 0.03; soups of ``icosphere(24)`` and ``icosphere(40)`` by 0.03 edges:
+    0.31 to 0.39 and 0.52 to 0.66)."""
+    from .quadric import residual_spreads
+
+    near = valid & np.isfinite(counts)
+    if not near.any():
+        return near
+    edge = _sampled_edge(vertices, adjacency)
+    ids = np.flatnonzero(near)
+    pool = np.unique(faces[~dropped].ravel())
+    radii = np.full(vertices.shape[0], 3.0 * edge)
+    _, sigma, _ = residual_spreads(vertices, pool, radii, np.ascontiguousarray(np.nan_to_num(normals)), ids)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        curvedness = np.sqrt(0.5 * (k_min * k_min + k_max * k_max))
+        scatter = np.full(vertices.shape[0], np.nan)
+        scatter[ids] = sigma / (edge * edge * float(np.median(curvedness[valid])))
+    noisy = ~(scatter <= SCATTER_TILT)  # (NaN: a scatter that could not be measured counts as noisy)
+    return near & noisy & (counts < np.maximum(SCATTER_FEW, SCATTER_POINTS * np.where(noisy, scatter, 0.0)))
+
+
+#: Near holes, a ball whose corrected area ``mu_0(B)`` is below this share of its faces' area (the faces tilt off
+#: the fitted normals by 18 degrees on average: a staircase; a smooth mesh's balls hold 0.99 and more, a coarse
+#: one's 0.97) ...
+STAIR_TILT = 0.99
+#: ... and below this share of its disc ``pi r^2`` holds a piece of a staircase cut by cracks, whose sum is noise
+#: (a face of a staircase carries the surface's curvature only summed with its neighbours', as in
+#: :func:`_holed_balls`): its vertex is undefined. ``voxel_sphere(10)`` with every face detached by 0.03 edges (the
+#: weld joins some corners; no voxel surface to the default, its corners left the grid; issue 29, fuzz 395/99):
+#: 61 of 172 and 82 of 530 valid vertices off the sphere's H by more than half of it, all in balls holding 0.1 to
+#: 0.6 of their disc (the others 0.1 to 0.76); half of ``voxel_sphere(6)``'s faces detached by 0.065 edges: 0 of
+#: 472 off, every ball above 0.4.
+STAIR_SHARE = 0.4
+
+
+def _stair_pieces(corrected, areas, radius, near) -> np.ndarray:
+    """(V,) bool: the ``near`` vertices whose ball's corrected area ``corrected`` (V,) is below :data:`STAIR_TILT`
+    of its faces' area ``areas`` (V,) and below :data:`STAIR_SHARE` of its disc (``radius``, a float or (V,))."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        stair = corrected < STAIR_TILT * areas
+        sparse = corrected < STAIR_SHARE * np.pi * np.asarray(radius, dtype=np.float64) ** 2
+    return near & stair & sparse
 
 
 def _near_holes(vertices, topology: MeshTopology, radius, normal_radius, centres: np.ndarray) -> np.ndarray | None:
@@ -1068,6 +1195,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 areas=_vertex_areas(mesh),
                 weighted=not even,
                 topology=bounded,
+                cracked=bool(mesh.n_cracked),
             )
             return finish(
                 "icc",
@@ -1095,6 +1223,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             adjacency=_adjacency(topology),
             areas=_vertex_areas(mesh),
             topology=bounded,
+            cracked=bool(mesh.n_cracked),
         )[:-1]
         if members is None:
             fields = computed
