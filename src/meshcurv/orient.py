@@ -896,6 +896,16 @@ def _nesting_depth(vertices, faces, patch, closed) -> np.ndarray:
     meets = np.asarray(((lower[:, None, :] <= upper[None]) & (upper[:, None, :] >= lower[None])).all(axis=2))
     np.fill_diagonal(meets, False)
     points = [np.unique(faces[rows[starts[i] : ends[i]]]) for i in range(ids.size)]
+    # a vertex outside the other's box (grown by the touching distance) is outside it and counted: a patch with
+    # at least 1 - NESTED_SHARE of its vertices there is inside neither, without its winding numbers (the touching
+    # ones lie inside the grown box, so the vertices counted outnumber those outside it)
+    slack = 1e-6 * np.linalg.norm(upper - lower, axis=1)[:, None]
+    low, high = lower - slack, upper + slack
+    for i in np.flatnonzero(meets.any(axis=1)).tolist():
+        others = np.flatnonzero(meets[i])
+        at = vertices[points[i]]
+        inside_box = ((at[:, None, :] >= low[others][None]) & (at[:, None, :] <= high[others][None])).all(axis=2)
+        meets[i, others] = np.count_nonzero(~inside_box, axis=0) < (1.0 - NESTED_SHARE) * points[i].size
     for j in np.flatnonzero(meets.any(axis=0)).tolist():  # patch j, the candidate that encloses
         inner = np.flatnonzero(meets[:, j])
         own = corners[starts[j] : ends[j]]
