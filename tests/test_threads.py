@@ -1,5 +1,7 @@
 """The numbers do not depend on the thread count: every reduction adds in a fixed order."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -25,8 +27,13 @@ def test_results_are_the_same_on_one_and_two_threads(method):
     # a noisy irregular sphere: its default radius comes from the mean edge length (a sum over all edges), and a
     # face on a ball's rim goes in or out with the radius's last bit
     mesh = shapes.with_normal_noise(shapes.random_sphere(3000, seed=3), level=0.1, seed=4)
-    one = _with_threads(1, lambda: meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method=method))
-    two = _with_threads(2, lambda: meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method=method))
+
+    def call():
+        with warnings.catch_warnings():  # the noise is the point: quadric reports the balls too small for it
+            warnings.simplefilter("ignore", meshcurv.MeshQualityWarning)
+            return meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method=method)
+
+    one, two = _with_threads(1, call), _with_threads(2, call)
     np.testing.assert_array_equal(one.valid, two.valid)
     for name in ("k_min", "k_max", "normals"):
         np.testing.assert_array_equal(getattr(one, name), getattr(two, name), err_msg=name)

@@ -136,7 +136,6 @@ from ..jets import (
     _fit_jets,
     _nearest_in_cubes,
     _sampled_jet_normals,
-    _thin_part_normals,
     interpolated_normals,
     jet_normals,
     nested_jet_normals,
@@ -245,7 +244,6 @@ def fitted_normals(
     edge: float | None = None,
     unwrap: np.ndarray | None = None,
     counts: np.ndarray | None = None,
-    thin: bool = False,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -270,10 +268,6 @@ def fitted_normals(
     ``unwrap`` (V,) bool: the vertices whose fits are checked for balls holding points that face away, and made
     again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes); ``counts`` (V,)
     float, when given, is set in place to the number of points of their first fits (unchanged elsewhere).
-
-    ``thin``: a voxel surface; the fits on its thin flat parts (balls that wrap round a part thinner than them while
-    their jets hardly bend) are made again over wider balls of the points that face the centre's way
-    (:func:`meshcurv.jets._thin_part_normals`; not on the coarse level).
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -340,19 +334,6 @@ def fitted_normals(
                 adjacency,
                 areas if weighted else None,
                 counts=counts,
-            )
-        if thin and adjacency is not None:
-            fitted = _thin_part_normals(
-                vertices,
-                np.where(valid[:, None], fitted, normals),
-                radius,
-                np.flatnonzero(valid),
-                neighbours=neighbours,
-                adjacency=adjacency,
-                degree=NORMAL_DEGREE,
-                iterations=NORMAL_ITERATIONS,
-                settled=NORMAL_SETTLED,
-                min_spread=NORMAL_MIN_SPREAD,
             )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
@@ -890,6 +871,7 @@ def _curvatures(
 
     start("fit normals")
     failed = np.zeros(vertices.shape[0], dtype=bool)
+    counts = None  # the points of the normal fits near holes, where cracks were welded (below)
     # the median edge that decides the coarse level of a voxel surface, taken once
     edge = _sampled_edge(vertices, adjacency) if coarse and adjacency is not None else None
     if np.all(np.asarray(radius) > 0):
@@ -917,7 +899,6 @@ def _curvatures(
             edge=edge,
             unwrap=near,
             counts=counts,
-            thin=coarse,
         )
 
         if boundary_faces is not None and adjacency is not None:
