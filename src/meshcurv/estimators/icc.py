@@ -123,7 +123,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._geometry import median_edge_length
+from .._geometry import face_areas, median_edge_length
 from .._backend import numba_kernels
 from .._tensors import tangent_basis
 from ..jets import (
@@ -915,13 +915,7 @@ def _curvatures(
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
     areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
     if areas_column:
-        corners = vertices[faces]
-        measures = np.column_stack(
-            [
-                measures,
-                0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1),
-            ]
-        )
+        measures = np.column_stack([measures, face_areas(vertices, faces)])
     if coarse:
         summed = _coarse_face_sums(vertices, faces, radius, measures, usable=usable)
     else:
