@@ -17,6 +17,9 @@ _TERMS = 6
 #: ``jets.PIVOT_FLOOR``: the smallest pivot (relative to its diagonal entry) of a solvable normal matrix.
 _PIVOT_FLOOR = 1e-12
 
+#: ``quadric.RESIDUAL_DOF_FLOOR``: the residuals' degrees of freedom, relative to the ball's weight, that give a noise.
+_DOF_FLOOR = 1e-6
+
 
 @threaded
 def residual_spreads(vertices, pool, radii, normals, centres, n_chunks):
@@ -25,7 +28,7 @@ def residual_spreads(vertices, pool, radii, normals, centres, n_chunks):
     ``vertices`` (V, 3), ``pool`` (int64 ids of the points that enter the balls), ``radii`` (V,) one per vertex,
     ``normals`` (V, 3) unit (the frame of each fit), ``centres`` (M,) int64. Returns ``(coefficients (M, 6), sigmas
     (M,), spreads (M,))`` in the order of ``centres`` (NaN, NaN, inf where the ball holds fewer than six points or
-    a singular normal matrix).
+    a singular normal matrix; sigma NaN and spread inf where its residuals hold no degree of freedom: six points).
     """
     m = centres.shape[0]
     coefficients = np.full((m, _TERMS), np.nan)
@@ -111,7 +114,7 @@ def _spread_chunk(lo, hi, vertices, points, grid, radii, normals, centres, coeff
             for c in range(_TERMS):
                 trace += inverse[r, c] * moments[c, r]
         dof = total - trace
-        if not dof > 0:
+        if not dof > _DOF_FLOOR * total:  # six points: an exact fit, its dof 0 up to round-off
             continue
         sigma2 = max(squares, 0.0) / dof
         spread2 = 0.0
