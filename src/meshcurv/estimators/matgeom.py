@@ -26,7 +26,12 @@ mesh after thousands of smoothing passes (the mean tensor of a sphere is a
 multiple of the identity). There the normal is NaN and the vertex is
 ``valid=False``, on both backends; the curvatures are kept (eigenvalues are
 defined, and a tie of magnitudes gives the smaller value to the normal, as
-matGeom's sort does for exact ties).
+matGeom's sort does for exact ties). Where the magnitudes of the two smallest
+eigenvalues are apart by less than the round-off of the dihedral angles
+(:data:`ANGLE_NOISE`), the choice of the normal depends on the mesh's pose (a
+flat patch is a zero tensor in the axes, round-off in another pose): the vertex
+is ``valid=False`` too (matGeom's normal kept), so that the valid mask is the
+same in every pose.
 
 The outputs are dimensionless (see the README: not curvatures in 1/length).
 
@@ -61,6 +66,14 @@ from ._eigen import sorted_by_magnitude
 #: within some 1e-6 of each other, while the meshes measured (matGeom's reference cases, thin, open,
 #: noisy and voxel meshes) have gaps either 0 (below 1e-14) or above 1e-7.
 NORMAL_GAP = 1e-8
+
+#: Bound of the round-off of matGeom's dihedral angle ``arccos(n1 . n2)`` between coplanar faces (radians).
+#: ``arccos`` is ill-conditioned at 1: a dot product ``k`` ulps below 1 gives ``1.49e-8 sqrt(k)``, so two
+#: faces coplanar to round-off get an angle of 0 in one pose (normals along an axis: the dot exactly 1)
+#: and up to 3e-8 in another (measured on fandisk, rocker-arm, igea under 10 rigid motions each; 1e-7 is
+#: 45 ulps). Eigenvalues of a vertex's tensor that differ by less than this noise (times its edges'
+#: weights, :func:`_noise_floors`) are equal: whether they tie must not depend on the mesh's pose.
+ANGLE_NOISE = 1e-7
 
 STAGES = ("compute adjacencies", "compute edge tensors", "average vertex tensors", "retrieve curvatures")
 
@@ -154,7 +167,7 @@ def matgeom_tensors(vertices: np.ndarray, topology: MeshTopology, smoothing_step
         Ends of the edges paired with a face that does not contain them.
     """
     stages = stages or Stages(STAGES)
-    tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = _edge_tensors(vertices, topology, stages)
+    tensors, n_kept, n_wrong_face, n_out_of_range, mispaired, _ = _edge_tensors(vertices, topology, stages)
     stages.start("average vertex tensors")
     return _smooth_vertex_field(tensors, topology, smoothing_steps), n_kept, n_wrong_face, n_out_of_range, mispaired
 
@@ -203,7 +216,32 @@ def _edge_tensors(vertices: np.ndarray, topology: MeshTopology, stages: Stages, 
     mispaired = np.zeros(n_vertices, dtype=bool)
     mispaired[ev1[wrong_face]] = True
     mispaired[ev2[wrong_face]] = True
-    return tensors, ev1.size, int(wrong_face.sum()), int(out_of_range.sum()), mispaired
+    return (
+        tensors,
+        ev1.size,
+        int(wrong_face.sum()),
+        int(out_of_range.sum()),
+        mispaired,
+        _noise_floors(vertices, ev1, ev2),
+    )
+
+
+def _noise_floors(vertices: np.ndarray, ev1: np.ndarray, ev2: np.ndarray) -> np.ndarray:
+    """(V,) bound of the round-off of each vertex's tensor before the smoothing, in its eigenvalues.
+
+    The tensor is the mean over the vertex's edges of ``(d_e / mean d) beta_e e e^T``;
+    ``beta_e`` carries up to :data:`ANGLE_NOISE` of round-off and ``e e^T`` has norm 1, so the
+    eigenvalues move by at most ``ANGLE_NOISE`` x the mean of ``d_e / mean d``, and the gap between
+    two of them (or between their magnitudes) by twice that. Edge lengths only: the same in every pose.
+    """
+    n_vertices = vertices.shape[0]
+    lengths = _row_norms(vertices[ev2] - vertices[ev1])
+    ends = np.concatenate([ev1, ev2])
+    counts = np.bincount(ends, minlength=n_vertices).astype(np.float64)
+    counts[counts < 1.0] = 1.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        relative = lengths / (lengths.mean() if lengths.size else 1.0)
+    return 2.0 * ANGLE_NOISE * np.bincount(ends, weights=np.tile(relative, 2), minlength=n_vertices) / counts
 
 
 def _principal(tensors: np.ndarray):
@@ -231,33 +269,55 @@ def _principal(tensors: np.ndarray):
     return c1, c2, u1, u2, normal
 
 
+def _tied_to_round_off(c1: np.ndarray, c2: np.ndarray, traces: np.ndarray, floors: np.ndarray) -> np.ndarray:
+    """(V,) bool: the normal's eigenvalue within ``floors`` of the middle one in magnitude.
+
+    The normal's eigenvalue is ``trace - c1 - c2``; ``c1`` and ``c2`` are the eigenvalues of middle and
+    largest magnitude. Where the magnitudes of the two smallest are closer than the round-off of the
+    dihedral angles (``floors``, :func:`_noise_floors` smoothed), which of them is the normal (and whether
+    they tie to :data:`NORMAL_GAP`) depends on the pose of the mesh: a flat patch is a zero tensor in
+    the axes and round-off in any other pose, a crease a rank-1 tensor plus round-off.
+    """
+    with np.errstate(invalid="ignore"):
+        smallest = np.abs(traces - c1 - c2)
+        middle = np.minimum(np.abs(c1), np.abs(c2))
+        return middle - smallest <= floors
+
+
 def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     """Run matGeom's algorithm. Returns ``(result, problems)``."""
     vertices, topology = mesh.vertices, mesh.topology
     kernels = numba_kernels("matgeom")
     problems: list[str] = []
+    tensors, n_kept, n_wrong_face, n_out_of_range, mispaired, floors = _edge_tensors(
+        vertices, topology, stages, mesh if kernels is not None else None
+    )
+    # the trace and the round-off bound, smoothed as the tensors are: the third eigenvalue (the normal's)
+    # is the trace minus the two curvatures, to be compared with the round-off (:func:`_tied_to_round_off`)
+    stages.start("average vertex tensors")
+    traces_and_floors = _smooth_vertex_field(
+        np.stack([(tensors[:, 0] + tensors[:, 1]) + tensors[:, 2], floors], axis=1), topology, smoothing_steps
+    )
     if kernels is not None and smoothing_steps <= STEPS_PER_CALL:
         # the smoothing and the eigen-decomposition in one kernel (the same sums in the same order as
         # smooth_vertex_field's kernel): no copy of the tensors, the last pass straight into the eigen-solver
-        tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = _edge_tensors(vertices, topology, stages, mesh)
-        stages.start("average vertex tensors")
         indptr, indices = topology.smoothing_lists(smoothing_steps)
         stages.start("retrieve curvatures")
         c1, c2, u1, u2, normal = kernels.matgeom_finish(
             np.ascontiguousarray(tensors), indptr, indices, smoothing_steps, NORMAL_GAP
         )
     else:
-        tensors, n_kept, n_wrong_face, n_out_of_range, mispaired = matgeom_tensors(
-            vertices, topology, smoothing_steps, stages
-        )
+        tensors = _smooth_vertex_field(tensors, topology, smoothing_steps)
         stages.start("retrieve curvatures")
         if kernels is not None:
             c1, c2, u1, u2, normal = kernels.matgeom_principal(np.ascontiguousarray(tensors), NORMAL_GAP)
         else:
             c1, c2, u1, u2, normal = _principal(tensors)
+    # matGeom's normal is kept there (it is the one matGeom computes in this pose), the vertex invalid
+    tied = _tied_to_round_off(c1, c2, traces_and_floors[:, 0], traces_and_floors[:, 1])
 
     finite = ~np.isnan(c1)  # NaN exactly where a tensor component is not finite
-    no_normal = finite & np.isnan(normal[:, 0])  # the normal's eigenvalue not apart from the middle one
+    no_normal = finite & (np.isnan(normal[:, 0]) | tied)  # the normal's eigenvalue not apart from the middle one
     # matGeom's numbers are kept everywhere it computes them; valid=False marks
     # where they are not an estimate: vertices whose tensor drew on a defect
     # (boundary, non-manifold, bow-tie, flipped or zero-area neighbourhood, or an
@@ -295,10 +355,11 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     if n_no_normal:
         problems.append(
             f"{n_no_normal} vertices have no normal: their tensor's smallest eigenvalue equals the next one "
-            f"(to {NORMAL_GAP:g} of the largest; a flat or coplanar neighbourhood, a crease, coordinates "
+            f"(to {NORMAL_GAP:g} of the largest, or their magnitudes to the round-off of the dihedral angles; a flat or coplanar neighbourhood, a crease, coordinates "
             f"quantised at round-off, or a tensor smoothed into a multiple of the identity: "
             f"{smoothing_steps} smoothing passes), so the eigenvector matGeom calls the normal is any vector "
-            "of a plane, decided by round-off: normal NaN and valid=False (the curvatures kept)"
+            "of a plane, decided by round-off: valid=False (the curvatures kept; the normal NaN where the "
+            "eigenvalues tie, matGeom's where only the round-off of the angles could part them)"
         )
     n_unreferenced = int((~topology.referenced_vertices).sum())
     if n_unreferenced:
