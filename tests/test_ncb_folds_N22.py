@@ -51,17 +51,26 @@ def test_fold_angles_read_a_fold_within_the_band_as_pi():
     assert FOLD_ANGLE < 1e-3
 
 
+#: ``normal_cycle`` reads the same angles (``_geometry.edge_dihedral_angles`` and its compiled twin in
+#: ``_kernels/normal_cycle.py``): ogre.obj turned and shifted, 51 vertices apart by up to 0.57 of the largest |k|.
+#: N22's patch (the same band in both) is in its report; strict until it is applied.
+NORMAL_CYCLE_FOLDS = pytest.mark.xfail(
+    strict=True, reason="normal_cycle's dihedral angles read a fold's last bits (N22's patch not applied)"
+)
+
+
+@pytest.mark.parametrize("method", ["normal_cycle_ball", pytest.param("normal_cycle", marks=NORMAL_CYCLE_FOLDS)])
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
 @pytest.mark.parametrize("seed", range(4))
-def test_a_fold_turned_and_shifted_keeps_its_curvatures(seed, backend):
+def test_a_fold_turned_and_shifted_keeps_its_curvatures(seed, backend, method):
     if backend == "numba":
         pytest.importorskip("numba")
     vertices, faces = folded_sheet()
     moved = vertices @ _rotation(seed).T + np.random.default_rng(seed).uniform(-10.0, 10.0, size=3)
     with use_backend(backend), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        before = meshcurv.principal_curvatures(vertices, faces, method="normal_cycle_ball", orient="keep")
-        after = meshcurv.principal_curvatures(moved, faces, method="normal_cycle_ball", orient="keep")
+        before = meshcurv.principal_curvatures(vertices, faces, method=method, orient="keep")
+        after = meshcurv.principal_curvatures(moved, faces, method=method, orient="keep")
     np.testing.assert_array_equal(before.valid, after.valid)
     valid = before.valid
     assert valid.sum() == len(vertices)  # the sheet is one part, every ball holds its neighbours
