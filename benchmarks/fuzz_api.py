@@ -57,6 +57,12 @@ cases have ``FINE_TIMEOUT_FACTOR`` times ``--timeout`` and are counted apart in 
 parts), any method at its default or a given ball, under an invariance: a rigid motion (a random rotation and a
 shift), a scale, a permutation, a translation, unreferenced points, every face twice, the other backend (30%, on
 meshes of at most ``REAL_NUMPY_MAX_VERTICES`` vertices) or a mesh object; counted apart ("(real meshes)").
+``--cloud-relations P`` (with ``--point-clouds``) makes a share ``P`` of the cases (a stream of their own; 0 by
+default) a point cloud under an invariance of the cloud itself: an analytic cloud of ``make_cloud_case`` (its truth
+checked too) or, with ``--real-meshes``, a real mesh's vertices read as a scan, computed again after a rigid motion
+(given normals turned with it), a scale (a given radius scaled), a permutation of the points or a translation: the
+same valid points and reasons, curvatures within 1e-6 of the largest |k| (divided by the scale) and the same
+normals, turned back (:func:`cloud_relation_check`); counted apart ("(cloud relations)").
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -881,6 +887,15 @@ def _rotation(seed: int):
     return q if np.linalg.det(q) > 0 else q[:, [1, 0, 2]]
 
 
+def _relation_value(rng, relation):
+    """The value of a real mesh's or a moved cloud's ``relation``: a scale, a shift in sizes or a stream's seed."""
+    if relation == "scale":
+        return float(rng.choice([2.0**-30, 2.0**20, 1e-8, 1e8, 1e30]))
+    if relation == "translate":
+        return float(rng.choice([2.0**10, -(2.0**20), 1e3 + 0.1]))
+    return int(rng.integers(2**31))
+
+
 def real_mesh_case(rng, numpy_backend):
     """A real mesh (a scan, a CAD part with creases, an unclean mesh of many parts) as read, any method at its
     default or a given ball (1 to 6 edges), under an invariance: a rigid motion (a random rotation and a shift of up
@@ -906,12 +921,7 @@ def real_mesh_case(rng, numpy_backend):
         relation = "rigid"
     if relation == "double-sided" and (method == "matgeom" or kwargs.get("orient", "auto") not in ("auto", "outward")):
         relation = "rigid"
-    if relation == "scale":
-        value = float(rng.choice([2.0**-30, 2.0**20, 1e-8, 1e8, 1e30]))
-    elif relation == "translate":
-        value = float(rng.choice([2.0**10, -(2.0**20), 1e3 + 0.1]))
-    else:
-        value = int(rng.integers(2**31))
+    value = _relation_value(rng, relation)
     labels = [name, "real mesh", "vertices:array", "faces:array", f"relation {relation} {value:g}"]
     return "principal_curvatures", (v, f), kwargs, labels, (relation, value)
 
@@ -923,6 +933,10 @@ def _drawn_case(seed: int, index: int):
     real = _real_stream(seed, index)
     if REAL_MESHES and REAL_BASES and not ONLY_POINT_CLOUDS and real.random() < REAL_MESHES:
         return real_mesh_case(real, numpy_backend=index % 4 == 3)
+    if CLOUD_RELATIONS and ONLY_POINT_CLOUDS and pointcloud is not None:
+        relations = _cloud_relation_stream(seed, index)
+        if relations.random() < CLOUD_RELATIONS:
+            return cloud_relation_case(relations, numpy_backend=index % 4 == 3)
     rng = np.random.default_rng([seed, index])
     if ONLY_POINT_CLOUDS and pointcloud is not None and rng.random() < 0.7:
         return make_cloud_case(rng)
@@ -1735,6 +1749,10 @@ def relation_check(args, kwargs, result, relation):
         return object_check(arrays, kwargs, result) + (relation_check(arrays, kwargs, result, inner) if inner else [])
     if kind == "cloud truth":
         return cloud_truth_check(args, kwargs, result, value)
+    if kind == "cloud relation":  # the cloud moved (--cloud-relations): its truth, if any, and the invariance
+        relation, number, truth = value
+        broken = [] if truth is None else cloud_truth_check(args, kwargs, result, truth)
+        return broken + cloud_relation_check(args[0], kwargs, result, relation, number)
     v, f = args
     if kind == "detached":  # faces detached from the clean shape: its values at their corners (issue 29)
         return detached_check(v, kwargs, result, value)
@@ -1920,6 +1938,130 @@ def _children_cpu() -> float:
 GUARD = 3 * 2**30
 
 
+#: Share of the ``--point-clouds`` cases that are a point cloud under an invariance of the cloud (``--cloud-relations``):
+#: 0 by default, so that the cases of earlier rounds replay as drawn (the choice comes from a stream of its own).
+CLOUD_RELATIONS = 0.0
+#: The random stream of the cloud-relation cases (beside the case's own ``[seed, index]``).
+CLOUD_RELATION_STREAM = 53
+#: Relative agreement of a cloud and its moved copy, in the largest |k| of the result (as the meshes' relations).
+CLOUD_RELATION_RTOL = 1e-6
+
+
+def _cloud_relation_stream(seed: int, index: int):
+    return np.random.default_rng([seed, index, CLOUD_RELATION_STREAM])
+
+
+def is_cloud_relation(seed: int, index: int) -> bool:
+    """Whether case ``index`` of ``seed`` is a cloud-relation case (:data:`CLOUD_RELATIONS`, ``--point-clouds``)."""
+    return (
+        bool(CLOUD_RELATIONS)
+        and ONLY_POINT_CLOUDS
+        and pointcloud is not None
+        and _cloud_relation_stream(seed, index).random() < CLOUD_RELATIONS
+    )
+
+
+def cloud_relation_case(rng, numpy_backend):
+    """A point cloud under an invariance of the cloud itself (:func:`cloud_relation_check`): an analytic cloud of
+    :func:`make_cloud_case` with its truth, or (with ``--real-meshes``, a share :data:`REAL_MESHES`) the vertices of
+    a real mesh read as a scan (OBJ seams give exact and near copies), either method, now and then a given radius
+    (3 to 12 spacings); a rigid motion, a scale, a permutation or a translation. On the NumPy paths the real clouds
+    of at most :data:`REAL_NUMPY_MAX_VERTICES` points."""
+    if REAL_BASES and rng.random() < REAL_MESHES:
+        bases = [base for base in REAL_BASES if not numpy_backend or len(base[1]) <= REAL_NUMPY_MAX_VERTICES]
+        name, points, _ = (bases or REAL_BASES[:1])[int(rng.integers(len(bases or REAL_BASES[:1])))]
+        kwargs = {}
+        labels = [name, "real cloud"]
+        if rng.random() < 0.5:
+            kwargs["method"] = pointcloud.POINT_CLOUD_METHODS[int(rng.integers(2))]
+        if rng.random() < 0.2:
+            from scipy.spatial import cKDTree
+
+            spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+            kwargs["radius"] = float(rng.choice([3.0, 5.0, 8.0, 12.0])) * spacing
+            labels.append(f"radius {kwargs['radius'] / spacing:.3g} spacings")
+        truth = None
+        args = (points,)
+    else:
+        _, args, kwargs, labels, (_, truth) = make_cloud_case(rng)
+        labels = labels[:-1]  # (its "relation cloud truth": checked with the relation)
+    relation = ["rigid", "rigid", "scale", "permute", "translate"][int(rng.integers(5))]
+    value = _relation_value(rng, relation)
+    labels.append(f"relation cloud {relation} {value:g}")
+    return "point_cloud_curvatures", args, kwargs, labels, ("cloud relation", (relation, value, truth))
+
+
+def cloud_relation_check(points, kwargs, result, relation, value) -> list[str]:
+    """The cloud moved (``rigid``: a rotation and a shift of up to 10 sizes; ``scale`` s; ``translate``;
+    ``permute``): the same valid points and reasons, ``k / s`` within :data:`CLOUD_RELATION_RTOL` of the largest
+    |k|, the normals turned back within it."""
+    points = np.asarray(points, float)
+    n = len(points)
+    size = max(float(np.ptp(points)) if points.size else 1.0, 1e-300)
+    take, factor, turn = np.arange(n), 1.0, np.eye(3)
+    kwargs = dict(kwargs)
+    given = kwargs.get("normals")
+    if relation == "scale":
+        moved, factor = points * value, value
+        if isinstance(kwargs.get("radius"), float):
+            kwargs["radius"] = kwargs["radius"] * value
+    elif relation == "translate":
+        moved = points + value * max(size, 1.0)
+    elif relation == "rigid":
+        turn = _rotation(value)
+        moved = points @ turn.T + np.random.default_rng(value).uniform(-10.0, 10.0, size=3) * size
+        if given is not None:
+            kwargs["normals"] = np.asarray(given, float) @ turn.T
+    else:
+        perm = np.random.default_rng(value).permutation(n)  # new point i is old perm[i]
+        take = np.argsort(perm)  # old point j is new take[j]
+        moved = points[perm]
+        if given is not None:
+            kwargs["normals"] = np.asarray(given)[perm]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            other = pointcloud.point_cloud_curvatures(moved, **kwargs)
+        except DOCUMENTED as error:
+            return [
+                f"cloud {relation} {value:g}: {type(error).__name__} where the original succeeded: {str(error)[:150]}"
+            ]
+    label = f"cloud {relation} {value:g}"
+    valid, moved_valid = result.valid, other.valid[take]
+    if not np.array_equal(valid, moved_valid):
+        return [
+            f"{label}: valid changed at {int((valid != moved_valid).sum())} points "
+            f"({int(valid.sum())} -> {int(moved_valid.sum())} valid)"
+        ]
+    broken = []
+    if result.invalid_reason is not None and not np.array_equal(result.invalid_reason, other.invalid_reason[take]):
+        broken.append(
+            f"{label}: invalid_reason differs at {int((result.invalid_reason != other.invalid_reason[take]).sum())} points"
+        )
+    with np.errstate(all="ignore"):
+        largest = max(
+            float(np.abs(result.k_min[valid]).max(initial=0)),
+            float(np.abs(result.k_max[valid]).max(initial=0)),
+            1e-6 / size,
+        )
+        for name in ("k_min", "k_max"):
+            error = np.abs(getattr(result, name)[valid] - getattr(other, name)[take][valid] * factor) / largest
+            if error.size and not (error <= CLOUD_RELATION_RTOL).all():
+                broken.append(
+                    f"{label}: {name} differs by up to {float(np.nanmax(error)):.3g} of the largest |k| at "
+                    f"{int((~(error <= CLOUD_RELATION_RTOL)).sum())} of {int(valid.sum())} valid points"
+                )
+        normals = other.normals[take][valid] @ turn  # turned back
+        error = np.abs(result.normals[valid] - normals).max(axis=1) if normals.size else np.zeros(0)
+        if error.size and not (error <= CLOUD_RELATION_RTOL).all():
+            flipped = int((np.einsum("ij,ij->i", result.normals[valid], normals) < 0).sum())
+            broken.append(
+                f"{label}: normals differ by up to {float(np.nanmax(error)):.3g} at "
+                f"{int((~(error <= CLOUD_RELATION_RTOL)).sum())} of {int(valid.sum())} valid points ({flipped} flipped)"
+            )
+    return broken
+
+
 def case_cap(base: int, memory_mib: int, factor: int, args) -> int:
     """The address-space cap of a call, in bytes: ``base`` plus ``memory_mib`` MiB plus ``factor`` per input byte."""
     return base + memory_mib * 2**20 + factor * sum(_nbytes(a) for a in args)
@@ -2064,6 +2206,8 @@ def signature(target, method, outcome):
         first = outcome["broken"][0]
         if first.split(" ")[0] in ("scale", "translate", "permute", "unreferenced", "truth", "rigid") and ": " in first:
             first = first.split(" ")[0] + ": " + first.split(": ", 1)[1]  # without the relation's value
+        elif first.startswith(("cloud rigid ", "cloud scale ", "cloud permute ", "cloud translate ")) and ": " in first:
+            first = " ".join(first.split(" ")[:2]) + ": " + first.split(": ", 1)[1]
         first = first.split(" at ")[0].split(" by up to")[0].split(" (")[0]
         return f"{target} [{method}] | {first}"
     return f"{target} [{method}] | {status}"
@@ -2109,7 +2253,7 @@ def summary_table(path) -> str:
 
 
 def main(argv=None) -> int:
-    global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE, FINE_CRACKS, REAL_MESHES
+    global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE, FINE_CRACKS, REAL_MESHES, CLOUD_RELATIONS
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -2168,8 +2312,16 @@ def main(argv=None) -> int:
         f"sides, the other backend, a mesh object; their limit is {REAL_TIMEOUT_FACTOR} times --timeout (default: "
         "%(default)g: the draws of earlier rounds)",
     )
+    parser.add_argument(
+        "--cloud-relations",
+        type=float,
+        default=CLOUD_RELATIONS,
+        help="with --point-clouds: share of the cases that are a cloud (an analytic one, or with --real-meshes a real "
+        "mesh's vertices) under an invariance: a rigid motion, a scale, a permutation, a translation; their limit is "
+        f"{REAL_TIMEOUT_FACTOR} times --timeout (default: %(default)g: the draws of earlier rounds)",
+    )
     options = parser.parse_args(argv)
-    for name in ("voxel_share", "wide_cracks", "thin_shapes", "fine_cracks", "real_meshes"):
+    for name in ("voxel_share", "wide_cracks", "thin_shapes", "fine_cracks", "real_meshes", "cloud_relations"):
         if not 0 <= getattr(options, name) <= 1:
             parser.error(f"--{name.replace('_', '-')} must lie in [0, 1], got {getattr(options, name)}")
     WIDE_CRACKS = options.wide_cracks
@@ -2182,6 +2334,7 @@ def main(argv=None) -> int:
         add_real_bases()
     ONLY_POINT_CLOUDS = options.point_clouds
     VOXEL_SHARE = options.voxel_share
+    CLOUD_RELATIONS = options.cloud_relations
 
     if options.summary:
         print(summary_table(options.summary))
@@ -2214,6 +2367,7 @@ def main(argv=None) -> int:
                     "thin_shapes": options.thin_shapes,
                     "fine_cracks": options.fine_cracks,
                     "real_meshes": options.real_meshes,
+                    "cloud_relations": options.cloud_relations,
                 }
             )
             + "\n"
@@ -2222,7 +2376,8 @@ def main(argv=None) -> int:
             numpy_backend = index % 4 == 3
             fine = is_fine(options.seed, index)
             real = is_real(options.seed, index)
-            timeout = options.timeout * (FINE_TIMEOUT_FACTOR if fine else REAL_TIMEOUT_FACTOR if real else 1)
+            moved = is_cloud_relation(options.seed, index)
+            timeout = options.timeout * (FINE_TIMEOUT_FACTOR if fine else REAL_TIMEOUT_FACTOR if real or moved else 1)
             head, outcome, elapsed, cpu = run_forked(
                 options.seed, index, timeout, options.memory, options.factor, numpy_backend
             )
@@ -2237,6 +2392,8 @@ def main(argv=None) -> int:
                 counts[(f"{target} (fine cracks)", outcome["status"])] += 1
             if real:
                 counts[(f"{target} (real meshes)", outcome["status"])] += 1
+            if moved:
+                counts[(f"{target} (cloud relations)", outcome["status"])] += 1
             slowest.append((elapsed, index))
             if outcome["status"] not in ("ok", "documented") or outcome.get("warnings"):
                 key = (
