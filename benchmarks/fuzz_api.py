@@ -72,7 +72,8 @@ parallel region ran, so this script selects the ``workqueue`` layer unless
 ``MESHCURV_BACKEND=numpy`` (the NumPy paths).
 
 Output: one JSON line per finding in ``--log`` (default
-``benchmarks/fuzz_api.jsonl``), a summary on stdout. ``--replay I --seed S``
+``benchmarks/fuzz_api.jsonl``), a summary on stdout (also when the run is
+stopped by SIGTERM or Ctrl-C: the case under way is killed and not counted). ``--replay I --seed S``
 runs case ``I`` in this process and prints its inputs and traceback, under the
 cap the run gave that call (the same ``--memory`` and ``--factor``, counted
 from this process's size after the same warm-up), so that a memory finding
@@ -92,6 +93,7 @@ import inspect  # noqa: E402
 import json  # noqa: E402
 import pickle  # noqa: E402
 import resource  # noqa: E402
+import signal  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 import traceback  # noqa: E402
@@ -2122,6 +2124,23 @@ def replay(seed: int, index: int, memory_mib: int, factor: int) -> int:
     return 0
 
 
+#: Set by a SIGTERM (:func:`_stop`): the run ends after the case under way, killed and not counted.
+_STOPPED = False
+#: The pid of the child of the case under way (0: none).
+_CHILD = 0
+
+
+def _stop(signum, frame) -> None:
+    """A SIGTERM's handler: the run stops; the child of the case under way is killed (the case is not counted)."""
+    global _STOPPED
+    _STOPPED = True
+    if _CHILD:
+        try:
+            os.kill(_CHILD, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+
 def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
     """Make case ``index`` and run it in a forked child: ``(head, outcome, elapsed, cpu)``.
 
@@ -2170,7 +2189,10 @@ def run_forked(seed, index, timeout, memory_mib, factor, numpy_backend):
             code = 3
         os._exit(code)
     os.close(write_end)
+    global _CHILD
+    _CHILD = pid
     data, status, timed_out, elapsed = collect(pid, read_end, timeout)
+    _CHILD = 0
     cpu = _children_cpu() - cpu_before
     head = {"target": "?", "call": "?", "mutations": [], "method": None}
     if len(data) >= 8:
@@ -2344,6 +2366,7 @@ def main(argv=None) -> int:
         return replay(options.seed, options.replay, options.memory, options.factor)
 
     warm_up()  # once, so that the children fork with the kernels loaded
+    signal.signal(signal.SIGTERM, _stop)  # a run stopped by kill prints the summary of the cases done
 
     guard = vsize() + GUARD  # the parent itself never needs more (it builds no case)
     resource.setrlimit(resource.RLIMIT_AS, (guard, guard))
@@ -2372,53 +2395,64 @@ def main(argv=None) -> int:
             )
             + "\n"
         )
-        while time.monotonic() < deadline:
-            numpy_backend = index % 4 == 3
-            fine = is_fine(options.seed, index)
-            real = is_real(options.seed, index)
-            moved = is_cloud_relation(options.seed, index)
-            timeout = options.timeout * (FINE_TIMEOUT_FACTOR if fine else REAL_TIMEOUT_FACTOR if real or moved else 1)
-            head, outcome, elapsed, cpu = run_forked(
-                options.seed, index, timeout, options.memory, options.factor, numpy_backend
-            )
-            if outcome["status"] == "timeout" and cpu < timeout / 2:
-                counts[(head["target"], "timeout under load, rerun")] += 1
+        try:
+            while time.monotonic() < deadline and not _STOPPED:
+                numpy_backend = index % 4 == 3
+                fine = is_fine(options.seed, index)
+                real = is_real(options.seed, index)
+                moved = is_cloud_relation(options.seed, index)
+                timeout = options.timeout * (
+                    FINE_TIMEOUT_FACTOR if fine else REAL_TIMEOUT_FACTOR if real or moved else 1
+                )
                 head, outcome, elapsed, cpu = run_forked(
-                    options.seed, index, STARVED_WALL * timeout, options.memory, options.factor, numpy_backend
+                    options.seed, index, timeout, options.memory, options.factor, numpy_backend
                 )
-            target = head["target"]
-            counts[(target, outcome["status"])] += 1
-            if fine:
-                counts[(f"{target} (fine cracks)", outcome["status"])] += 1
-            if real:
-                counts[(f"{target} (real meshes)", outcome["status"])] += 1
-            if moved:
-                counts[(f"{target} (cloud relations)", outcome["status"])] += 1
-            slowest.append((elapsed, index))
-            if outcome["status"] not in ("ok", "documented") or outcome.get("warnings"):
-                key = (
-                    signature(target, head["method"], outcome)
-                    if outcome["status"] not in ("ok", "documented")
-                    else f"{target} | warning {outcome['warnings'][0][:60]}"
-                )
-                record = {
-                    "index": index,
-                    "seed": options.seed,
-                    "key": key,
-                    "backend": "numpy" if numpy_backend else "auto",
-                    **head,
-                    "elapsed": round(elapsed, 2),
-                    **outcome,
-                }
-                log.write(json.dumps(record, default=str) + "\n")
-                log.flush()
-                if key not in first_seen:
-                    first_seen[key] = index
-                    print(f"[{index}] NEW {key}: {outcome.get('message', '')[:120]}", flush=True)
-                counts[("finding", key)] += 1
-            index += 1
-            if index % 500 == 0:
-                print(f"... {index} cases, {len(first_seen)} distinct findings", flush=True)
+                if _STOPPED:
+                    break
+                if outcome["status"] == "timeout" and cpu < timeout / 2:
+                    counts[(head["target"], "timeout under load, rerun")] += 1
+                    head, outcome, elapsed, cpu = run_forked(
+                        options.seed, index, STARVED_WALL * timeout, options.memory, options.factor, numpy_backend
+                    )
+                    if _STOPPED:
+                        break
+                target = head["target"]
+                counts[(target, outcome["status"])] += 1
+                if fine:
+                    counts[(f"{target} (fine cracks)", outcome["status"])] += 1
+                if real:
+                    counts[(f"{target} (real meshes)", outcome["status"])] += 1
+                if moved:
+                    counts[(f"{target} (cloud relations)", outcome["status"])] += 1
+                slowest.append((elapsed, index))
+                if outcome["status"] not in ("ok", "documented") or outcome.get("warnings"):
+                    key = (
+                        signature(target, head["method"], outcome)
+                        if outcome["status"] not in ("ok", "documented")
+                        else f"{target} | warning {outcome['warnings'][0][:60]}"
+                    )
+                    record = {
+                        "index": index,
+                        "seed": options.seed,
+                        "key": key,
+                        "backend": "numpy" if numpy_backend else "auto",
+                        **head,
+                        "elapsed": round(elapsed, 2),
+                        **outcome,
+                    }
+                    log.write(json.dumps(record, default=str) + "\n")
+                    log.flush()
+                    if key not in first_seen:
+                        first_seen[key] = index
+                        print(f"[{index}] NEW {key}: {outcome.get('message', '')[:120]}", flush=True)
+                    counts[("finding", key)] += 1
+                index += 1
+                if index % 500 == 0:
+                    print(f"... {index} cases, {len(first_seen)} distinct findings", flush=True)
+        except KeyboardInterrupt:  # (Ctrl-C: the summary of the cases done; the one under way is not counted)
+            print(f"\nstopped by an interrupt at case {index} (not counted)", flush=True)
+        if _STOPPED:
+            print(f"\nstopped by SIGTERM at case {index} (not counted)", flush=True)
     print(f"\n{index - options.start} cases in {options.minutes:g} min (seed {options.seed})")
     for (target, status), n in sorted(counts.items()):
         if target != "finding":
