@@ -75,7 +75,7 @@ from .._geometry import DEGENERATE_AREA_RATIO, edge_dihedral_angles, median_edge
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
 from ..radius import VoxelReading, _ring_max, _voxel_surface_grid
-from ._ring_noise import noisy_rings, noisy_rings_note
+from ._ring_noise import welded_grid, welded_staircase_note, noisy_rings, noisy_rings_note
 from ._support import Stages, finish
 from .normal_cycle_ball import edge_area_densities, edge_readings, few_elements, few_elements_note
 
@@ -173,10 +173,14 @@ def _finished(mesh: PreparedMesh, defects, valid: np.ndarray, smoothing_steps: i
         few = _few_cells(mesh, invalid, valid, smoothing_steps, (k_min, k_max, dir_min, dir_max))
         valid = valid & ~few
         few_note = few_elements_note(int(few.sum()), f"smoothing region ({smoothing_steps} rings)", "cells")
+    welded: tuple[str, ...] = ()
+    if grid is None and valid.any() and smoothing_steps < _steps_on_grid(mesh, welded_grid(mesh, valid)):
+        welded = (welded_staircase_note(int(valid.sum())),)  # the staircase welded back across cracks
+        valid = np.zeros_like(valid)
     noisy = noisy_rings(mesh, valid, NOISE_GAIN, pooled_steps=smoothing_steps)
     valid = valid & ~noisy
     parameters = {"smoothing_steps": smoothing_steps}
-    extra = (note, few_note, noisy_rings_note(int(noisy.sum())))
+    extra = (note, few_note, *welded, noisy_rings_note(int(noisy.sum())))
     return finish("normal_cycle", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, extra=extra)
 
 
