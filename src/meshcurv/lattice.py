@@ -191,6 +191,17 @@ VOXEL_SNAP = 0.05
 #: (``z = 0.5 sin(3 x)`` on a grid of 0.05: 0.17 to 0.27 of them).
 VOXEL_AXIS_SHARE = 1.0 / 3.0
 
+#: A voxel surface whose vertices were moved further (a soup whose corners moved by up to a tenth of a voxel, issue
+#: 29, fuzz 415/108) has its coordinates spread about the planes: along an axis whose robust spread about them
+#: (1.4826 times the median distance) is at most this share of the planes' distance, a coordinate is on a plane
+#: within :data:`VOXEL_NOISE_SNAP` spreads (at least :data:`VOXEL_SNAP`). Corners moved by 0.1 voxel in random
+#: directions spread by 0.15 of the half voxels' distance; a smooth mesh's coordinates, evenly between the planes,
+#: by 0.37 (``benchmarks/lattice_noisy_L21.md``).
+VOXEL_NOISE = 0.2
+
+#: ... see :data:`VOXEL_NOISE`: 98.8% of the coordinates of a Gaussian spread, all of a uniform one.
+VOXEL_NOISE_SNAP = 2.5
+
 
 _EXACT = np.zeros(3)
 _EXACT.flags.writeable = False
@@ -210,13 +221,17 @@ class VoxelGrid(NamedTuple):
     tolerance : ndarray of shape (3,)
         How far off its plane a coordinate on the grid may lie along each axis: 0 for the exact reading (the
         coordinates repeat bit for bit), :data:`VOXEL_SNAP` of the distance between the planes read for the
-        periodic one.
+        periodic one, or more where the vertices were moved off the grid (:data:`VOXEL_NOISE`).
+    noise : float
+        The spread of the coordinates about their planes for which that tolerance was widened (a length: 1.4826
+        times their median distance to them, the least of the three axes'); 0 where it was not.
     """
 
     spacing: np.ndarray
     origin: np.ndarray
     fraction: float
     tolerance: np.ndarray = _EXACT
+    noise: float = 0.0
 
 
 #: :func:`_plane_lattice` reads each candidate's lattice on this many planes more than 1.25 times the share it may
@@ -393,25 +408,29 @@ def _periodic_voxel_grid(vertices: np.ndarray, spacing: float) -> VoxelGrid | No
     if not (np.isfinite(spacing) and spacing > 0.0):
         return None
     probe = vertices[:: max(1, vertices.shape[0] // LATTICE_PROBE)]
-    axes = []
+    found = []
     for k in range(3):  # (most meshes: no periodic axis, settled by the first)
-        values = vertices[:, k]
-        planes = _periodic_planes(values, probe[:, k], spacing, full=False)
+        planes = _periodic_planes(vertices[:, k], probe[:, k], spacing, full=False)
         if planes is None:
             return None
-        step, offset, _ = planes
+        found.append(planes[:2])
+    snaps, noise = _voxel_snaps(vertices, found)
+    axes, tolerances = [], []
+    for k, ((step, offset), snap) in enumerate(zip(found, snaps)):
+        values = vertices[:, k]
         for _ in range(2):
             index, off = _nearest_planes(values, step, offset)
-            near = np.abs(off) <= VOXEL_SNAP * step
+            near = np.abs(off) <= snap * step
             if not near.any() or np.ptp(index[near]) < LATTICE_PLANES - 1:
                 return None
             step, offset = np.polyfit(index[near], values[near], 1)
         index, off = _nearest_planes(values, step, offset)
-        on_grid = np.abs(off) <= VOXEL_SNAP * step
+        on_grid = np.abs(off) <= snap * step
         if on_grid.mean() < VOXEL_AXIS_SHARE:
             return None
         even = index.astype(np.int64) % 2 == 0
         # the choices along this axis: (spacing, origin, the coordinates on those planes)
+        tolerances.append(snap * step)
         axes.append(
             [
                 (step, offset, on_grid),
@@ -428,8 +447,26 @@ def _periodic_voxel_grid(vertices: np.ndarray, spacing: float) -> VoxelGrid | No
     _, fraction, choice = best
     if choice is None:
         return None
-    tolerance = VOXEL_SNAP * np.array([axis[0][0] for axis in axes])
-    return VoxelGrid(np.array([c[0] for c in choice]), np.array([c[1] for c in choice]), fraction, tolerance)
+    steps, origin = np.array([c[0] for c in choice]), np.array([c[1] for c in choice])
+    return VoxelGrid(steps, origin, fraction, np.array(tolerances), noise)
+
+
+def _voxel_snaps(vertices: np.ndarray, found: list) -> tuple[list, float]:
+    """``(snaps, noise)``: how far off its plane (a share of the planes' distance) a coordinate is on the grid
+    along each axis, the planes ``found`` (``(step, offset)`` along x, y and z): :data:`VOXEL_SNAP`, or, where the
+    vertices were moved off a voxel grid (in every direction: the least of the three axes' spreads about their
+    planes, at most :data:`VOXEL_NOISE` of each axis' step), :data:`VOXEL_NOISE_SNAP` times that spread; ``noise``
+    that spread (a length) where it widened some axis' snap, else 0. A grid along some axes only (a cylinder's
+    axis, a height field's x and y) is no noisy voxel surface: its least spread is 0."""
+    spreads = [
+        1.4826 * float(np.median(np.abs(_nearest_planes(vertices[:, k], step, offset)[1])))
+        for k, (step, offset) in enumerate(found)
+    ]
+    noise = min(spreads)
+    if any(noise > VOXEL_NOISE * step for step, _ in found):
+        return [VOXEL_SNAP] * 3, 0.0
+    snaps = [max(VOXEL_SNAP, VOXEL_NOISE_SNAP * noise / step) for step, _ in found]
+    return snaps, (noise if max(snaps) > VOXEL_SNAP else 0.0)
 
 
 def _on_voxel_grid(found: list) -> VoxelGrid | None:
