@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._backend import twin
+from ._backend import numba_kernels, twin
 
 #: Faces with area below this fraction of the squared length scale of their component
 #: (:func:`vertex_length_scales`, the median edge length) count as degenerate.
@@ -29,6 +29,19 @@ MEDIAN_SAMPLE = 65536
 #: Components whose typical edge (geometric mean) is within this factor of the mesh's median
 #: edge length share that median as their scale (one pass, no sort); others get their own.
 COMPONENT_SCALE_SPREAD = 16.0
+
+
+def finite_rows(array: np.ndarray) -> np.ndarray:
+    """(N,) bool: the rows of the (N, k) ``array`` whose entries are all finite.
+
+    ``np.isfinite(array).all(axis=1)`` column by column: a reduction along the short axis of an (N, 3) array
+    walks it in steps of a few elements (20 ms at a million rows); ``k`` passes over the columns take 3 ms, the
+    same booleans (issue 31).
+    """
+    out = np.ones(array.shape[0], dtype=bool)
+    for k in range(array.shape[1]):
+        out &= np.isfinite(array[:, k])
+    return out
 
 
 @twin("geometry")
@@ -134,13 +147,21 @@ def median_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
 def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     """Mean length of the edges within :data:`OUTLIER_EDGE_RATIO` medians
     (:func:`meshcurv.geometry.robust_mean_edge_length`)."""
-    lengths = edge_lengths(vertices, edges)
-    if lengths.size == 0:
+    if edges.shape[0] == 0:
         return 0.0
-    median = float(np.median(lengths[:: max(1, lengths.size // MEDIAN_SAMPLE)]))  # a threshold: a sample will do
-    longest = float(lengths.max())
-    if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean, to the last bit
-        return mean_edge_length(vertices, edges)
+    step = max(1, edges.shape[0] // MEDIAN_SAMPLE)
+    kernels = numba_kernels("geometry")
+    if kernels is not None:  # the sample's lengths alone, then the mean and the longest in one pass (issue 31)
+        median = float(np.median(edge_lengths(vertices, np.ascontiguousarray(edges[::step]))))
+        mean, longest = kernels._mean_and_longest_edge(vertices, edges)
+        if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean (mean_edge_length's, to the bit)
+            return float(mean)
+        lengths = edge_lengths(vertices, edges)
+    else:
+        lengths = edge_lengths(vertices, edges)
+        median = float(np.median(lengths[::step]))  # a threshold: a sample will do
+        if float(lengths.max()) <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean, to the last bit
+            return mean_edge_length(vertices, edges)
     kept = lengths[lengths <= OUTLIER_EDGE_RATIO * median]
     return float(kept.mean())
 

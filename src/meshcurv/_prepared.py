@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ._adapters import mesh_arrays
+from ._backend import numba_kernels
 from ._locality import local_topology
 from ._validation import as_mesh, as_vertices, check_choice
 from .defects import (
@@ -38,6 +39,7 @@ from ._geometry import (
     cross_and_degenerate,
     degenerate_faces,
     face_cross_products,
+    finite_rows,
     normalize_normal_sums,
     vertex_edge_lengths,
     vertex_length_scales,
@@ -114,12 +116,24 @@ class PreparedMesh:
     @cached_property
     def degenerate(self) -> np.ndarray:
         """(F,) bool: the zero-area faces (:func:`meshcurv.geometry.degenerate_faces`); read-only. The face cross
-        products come with them (one pass over the faces) unless :attr:`cross` was built first."""
+        products come with them (one pass over the faces) unless :attr:`cross` was built first; on a mesh without
+        needles the compiled pass sums the vertex normals and areas instead (:attr:`vertex_normals`, the same
+        sums in the same order)."""
         if "cross" in self.__dict__:
             return _read_only(
                 degenerate_faces(self.vertices, self.topology, cross=self.cross, scales=self.length_scales)
             )
         faces = self.topology.faces
+        kernels = numba_kernels("geometry")
+        if kernels is not None and not self.needles.any():  # the faces dropped are the zero-area ones (:attr:`dropped`)
+            # their test and the normal and area sums in one pass, no cross products kept (issue 31)
+            n = self.vertices.shape[0]
+            degenerate, sums, areas = np.zeros(faces.shape[0], dtype=bool), np.zeros((n, 3)), np.zeros(n)
+            kernels._degenerate_normal_and_area_sums(
+                self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO, degenerate, sums, areas
+            )
+            self.__dict__["_normals_and_areas"] = (_read_only(normalize_normal_sums(sums)), _read_only(areas))
+            return _read_only(degenerate)
         cross, degenerate = cross_and_degenerate(self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO)
         self.__dict__["_spare_cross"] = _read_only(cross)
         return _read_only(degenerate)
@@ -190,7 +204,7 @@ class PreparedMesh:
     def start(self, *, boundary: bool = False, fragments: bool = False) -> tuple[VertexDefects, np.ndarray]:
         """``(defects, valid)``: the defects, and the vertices with neither a defect nor a missing normal."""
         defects = self.defects(boundary=boundary, fragments=fragments)
-        valid = ~defects.invalid_vertices & np.isfinite(self.vertex_normals).all(axis=1)
+        valid = ~defects.invalid_vertices & finite_rows(self.vertex_normals)
         return defects, valid
 
     def notes(self) -> list[str]:

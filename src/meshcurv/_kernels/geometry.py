@@ -55,6 +55,46 @@ def _run_length_sums(lo, hi, vertices, edges, partial):
 
 
 @threaded
+def _mean_and_longest_edge(vertices, edges):
+    """``(mean, longest)``: :func:`_mean_edge_length` (the same runs, summed in the same order: the same number)
+    and the length of the longest edge, in one pass over the edges without an (E,) array of their lengths
+    (``_geometry.robust_mean_edge_length``, issue 31). ``edges`` not empty."""
+    n = edges.shape[0]
+    chunks = min(_SUM_CHUNKS, n)
+    partial = np.zeros(chunks)
+    longest = np.zeros(chunks)
+    run_chunks(
+        _run_length_sums_longest,
+        chunks,
+        _CHUNKS_PER_THREAD * nb.get_num_threads(),
+        vertices,
+        edges,
+        partial,
+        longest,
+    )
+    total = 0.0
+    for c in range(chunks):  # in order, as _mean_edge_length
+        total += float(partial[c])
+    return total / n, float(longest.max())
+
+
+@nb.njit(**_JIT)
+def _run_length_sums_longest(lo, hi, vertices, edges, partial, longest):
+    """:func:`_run_length_sums` of the runs ``lo:hi``, and the longest edge of each run in ``longest``."""
+    n = edges.shape[0]
+    chunks = partial.shape[0]
+    for c in range(lo, hi):
+        total = 0.0
+        far = 0.0
+        for e in range(c * n // chunks, (c + 1) * n // chunks):
+            length = _edge_length(vertices, edges[e, 0], edges[e, 1])
+            total += length
+            far = length if length > far else far  # max(far, length): numba compiles max once per options
+        partial[c] = total
+        longest[c] = far
+
+
+@threaded
 def face_cross_products(vertices, faces):
     """``geometry.face_cross_products``: (F, 3) ``cross(b - a, c - a)`` of every face."""
     out = np.empty((faces.shape[0], 3))
@@ -163,6 +203,17 @@ def _cross_and_degenerate_chunk(lo, hi, vertices, faces, scales, area_ratio, cro
         out[f] = _degenerate(a, b, c, 0.5 * math.sqrt(nx * nx + ny * ny + nz * nz), threshold)
 
 
+@nb.njit(inline="always", **_JIT)
+def _add_to_corners(faces, f, x, y, z, third, sums, areas):
+    """Face ``f``'s cross product ``(x, y, z)`` added to ``sums`` and ``third`` to ``areas`` at its three corners."""
+    for k in range(3):
+        v = faces[f, k]
+        sums[v, 0] += x
+        sums[v, 1] += y
+        sums[v, 2] += z
+        areas[v] += third
+
+
 @nb.njit(**_JIT)
 def vertex_normal_and_area_sums(cross, faces, dropped, n_vertices):
     """``(sums, areas)``: (V, 3) the sums of the face cross products at each vertex and (V,) a third of the
@@ -176,11 +227,23 @@ def vertex_normal_and_area_sums(cross, faces, dropped, n_vertices):
         if dropped[f]:
             continue
         x, y, z = cross[f, 0], cross[f, 1], cross[f, 2]
-        third = math.sqrt(x * x + y * y + z * z) / 6.0
-        for k in range(3):
-            v = faces[f, k]
-            sums[v, 0] += x
-            sums[v, 1] += y
-            sums[v, 2] += z
-            areas[v] += third
+        _add_to_corners(faces, f, x, y, z, math.sqrt(x * x + y * y + z * z) / 6.0, sums, areas)
     return sums, areas
+
+
+@nb.njit(**_JIT)
+def _degenerate_normal_and_area_sums(vertices, faces, scales, area_ratio, degenerate, sums, areas):
+    """:func:`cross_and_degenerate`'s zero-area faces and :func:`vertex_normal_and_area_sums` over the faces not
+    degenerate, in one pass over the faces (``PreparedMesh`` of a mesh without needles, where the faces dropped
+    from the vertex normals are the zero-area ones): the same test, the same cross products and the same sums in
+    face order, written into ``degenerate`` (F,) and ``sums`` (V, 3), ``areas`` (V,) (zeros on entry), without the
+    (F, 3) cross products in memory. One thread: a scatter bound by memory (issue 31)."""
+    for f in range(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        x, y, z = _face_cross(vertices, a, b, c)
+        length = math.sqrt(x * x + y * y + z * z)
+        dropped = _degenerate(a, b, c, 0.5 * length, area_ratio * scales[a] * scales[a])
+        degenerate[f] = dropped
+        if dropped:
+            continue
+        _add_to_corners(faces, f, x, y, z, length / 6.0, sums, areas)
