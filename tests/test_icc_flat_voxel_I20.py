@@ -13,7 +13,6 @@ The truth is the analytic ellipsoid's curvature at each vertex's closest point (
 
 from __future__ import annotations
 
-import inspect
 import warnings
 
 import numpy as np
@@ -21,18 +20,14 @@ import pytest
 
 import meshcurv
 from meshcurv import shapes
-from meshcurv.estimators import icc
 
 pytest.importorskip("skimage")  # marching cubes
 
 #: I20's wider refits (fb435ca, 0441813, a07c121) passed these tests but were reverted by the lead the same day: NumPy
 #: refits over balls 3 times wider made thin flat voxel parts 20-30 times slower (voxel_ellipsoid((20, 20, 5)):
 #: 0.20 -> 5.73 CPU s). J21's same-side compiled fits at a sample of the centres (jets._thin_part_normals, 705af25)
-#: pass them at 1.1-1.6 times the CPU; they are open (a strict xfail) until icc.fitted_normals calls them (``thin=``).
-WIRED = "thin" in inspect.signature(icc.fitted_normals).parameters
-pytestmark = pytest.mark.xfail(
-    not WIRED, strict=True, reason="open: flat voxel faces' normals (jets._thin_part_normals not called by icc yet)"
-)
+#: pass them at 1.1-1.6 times the CPU; wired into icc.fitted_normals(thin=) by J22 once the NumPy twin computed the
+#: kernel's numbers (a flag of one half to round-off had chosen by the last bits: jets.THIN_TIE).
 
 
 def _flat_faces(semi_axes, seed, spacing=(1.0, 1.0, 1.0)):

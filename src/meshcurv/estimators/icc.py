@@ -136,6 +136,7 @@ from ..jets import (
     _fit_jets,
     _nearest_in_cubes,
     _sampled_jet_normals,
+    _thin_part_normals,
     interpolated_normals,
     jet_normals,
     nested_jet_normals,
@@ -185,7 +186,8 @@ COARSE_EDGES = 16.0
 #: 6 and 8 made the marching-cubes sphere r 1 at voxel 0.05 of ``benchmarks/accuracy.py`` 13% worse, 10 is
 #: within 4% of the fits over every vertex on each binary marching-cubes mesh there, ``benchmarks/scale_default.py``).
 COARSE_CELLS = 10.0
-#: The median edge length that decides is taken over this many edges, evenly spaced (a threshold: a sample will do).
+#: The median edge length that decides is taken over about this many edges (a threshold: a sample will do), a sample
+#: that the vertices' order does not choose (:func:`_sampled_edge`; fuzz 419/58: an index-spaced one did).
 COARSE_SAMPLE = 65536
 
 #: A fitted normal is kept where its cosine with the mean of the face normals exceeds this (60 degrees).
@@ -244,6 +246,7 @@ def fitted_normals(
     edge: float | None = None,
     unwrap: np.ndarray | None = None,
     counts: np.ndarray | None = None,
+    thin: bool = False,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -268,6 +271,10 @@ def fitted_normals(
     ``unwrap`` (V,) bool: the vertices whose fits are checked for balls holding points that face away, and made
     again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes); ``counts`` (V,)
     float, when given, is set in place to the number of points of their first fits (unchanged elsewhere).
+
+    ``thin``: a voxel surface; the fits on its thin flat parts (balls that wrap round a part thinner than them while
+    their jets hardly bend) are made again over wider balls of the points that face the centre's way
+    (:func:`meshcurv.jets._thin_part_normals`; not on the coarse level).
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -334,6 +341,19 @@ def fitted_normals(
                 adjacency,
                 areas if weighted else None,
                 counts=counts,
+            )
+        if thin and adjacency is not None:
+            fitted = _thin_part_normals(
+                vertices,
+                np.where(valid[:, None], fitted, normals),
+                radius,
+                np.flatnonzero(valid),
+                neighbours=neighbours,
+                adjacency=adjacency,
+                degree=NORMAL_DEGREE,
+                iterations=NORMAL_ITERATIONS,
+                settled=NORMAL_SETTLED,
+                min_spread=NORMAL_MIN_SPREAD,
             )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
@@ -515,7 +535,7 @@ def _dense(
     vertices: np.ndarray, radius: float, adjacency: tuple, *, edges: float | None = None, edge: float | None = None
 ) -> bool:
     """Whether normal fits over ``radius`` run on the coarse level: wider than ``edges`` (default
-    :data:`COARSE_EDGES`) median edge lengths (``edge``, or taken over :data:`COARSE_SAMPLE` edges of the CSR
+    :data:`COARSE_EDGES`) median edge lengths (``edge``, or taken over about :data:`COARSE_SAMPLE` edges of the CSR
     lists ``adjacency``: :func:`_sampled_edge`)."""
     if edge is None:
         edge = _sampled_edge(vertices, adjacency)
@@ -523,18 +543,37 @@ def _dense(
 
 
 def _sampled_edge(vertices: np.ndarray, adjacency: tuple) -> float:
-    """:func:`_dense`'s median edge length over :data:`COARSE_SAMPLE` evenly spaced edges of ``adjacency``
-    (inf without edges: no radius is dense)."""
+    """:func:`_dense`'s median edge length over about :data:`COARSE_SAMPLE` edges of the CSR lists ``adjacency``
+    (inf without edges: no radius is dense): every edge of a smaller mesh; otherwise the edges of the vertices
+    whose coordinates hash to one class of ``ceil(E / COARSE_SAMPLE)`` (:func:`_coordinate_classes`), the same
+    sample in any order of the vertices."""
     indptr, indices = adjacency
     if indices.size == 0:
         return np.inf
-    if indices.size <= COARSE_SAMPLE:  # every edge (the sample's own order: the same median)
-        heads, tails = indices, np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
-    else:
-        taken = np.linspace(0, indices.size - 1, COARSE_SAMPLE).round().astype(np.int64)
-        heads, tails = indices[taken], np.searchsorted(indptr, taken, side="right") - 1
-    lengths = np.linalg.norm(vertices[heads] - vertices[tails], axis=1)
-    return float(np.median(lengths))
+    rows = np.arange(indptr.size - 1)
+    degrees = np.diff(indptr)
+    if indices.size > COARSE_SAMPLE:
+        chosen = _coordinate_classes(vertices[: rows.size], -(-indices.size // COARSE_SAMPLE)) == 0
+        if degrees[chosen].any():  # (a mesh of a few vertices of many edges may miss the class: then every edge)
+            rows, degrees = rows[chosen], degrees[chosen]
+    tails = np.repeat(rows, degrees)
+    ends = np.cumsum(degrees)
+    heads = indices[np.arange(ends[-1]) + np.repeat(indptr[rows] - (ends - degrees), degrees)]
+    offsets = vertices[heads] - vertices[tails]
+    return float(np.median(np.sqrt(np.einsum("ij,ij->i", offsets, offsets))))
+
+
+def _coordinate_classes(points: np.ndarray, classes: int) -> np.ndarray:
+    """(N,) int64 in ``[0, classes)``: a hash of each row of ``points`` (N, 3) float64 from the bits of its
+    coordinates alone (the three 64-bit words mixed, wrapping): a row falls in one class whatever its index."""
+    bits = np.ascontiguousarray(points, dtype=np.float64).view(np.uint64)
+    mixed = bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
+    mixed ^= bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
+    mixed ^= bits[:, 2] * np.uint64(0x165667B19E3779F9)
+    mixed ^= mixed >> np.uint64(31)
+    mixed *= np.uint64(0xBF58476D1CE4E5B9)
+    mixed ^= mixed >> np.uint64(29)
+    return (mixed % np.uint64(classes)).astype(np.int64)
 
 
 def voxel_pilot(mesh: PreparedMesh):
@@ -899,6 +938,7 @@ def _curvatures(
             edge=edge,
             unwrap=near,
             counts=counts,
+            thin=coarse,
         )
 
         if boundary_faces is not None and adjacency is not None:
