@@ -27,13 +27,6 @@ from meshcurv.topology import MeshTopology
 #: ``vertex_length_scales`` took every edge up to twice its sample's 65,536, then every ``E // 65536``-th edge.
 SAMPLED = 2 * 65536
 
-#: ``geometry.vertex_length_scales`` is another helper's (S22's) file: the patch of J22's report takes its median
-#: over every edge. Until then the tests that need it are strict xfails (to remove with the patch).
-needs_scales = pytest.mark.xfail(
-    strict=True,
-    reason="open: geometry.vertex_length_scales' sampled median follows the vertex order (J22's patch)",
-)
-
 
 def _permuted(vertices, faces, seed):
     """The mesh with its vertices in another order, and ``inverse`` (old vertex ``j`` is new ``inverse[j]``):
@@ -89,7 +82,6 @@ def test_the_coarse_levels_median_edge_is_the_same_in_every_order():
         assert icc._sampled_edge(moved, _adjacency(moved_faces, len(moved))) == edge
 
 
-@needs_scales
 def test_local_scale_ratios_are_the_same_in_every_order():
     vertices, faces = _two_resolutions()
     topology = MeshTopology.from_faces(faces, len(vertices))
@@ -117,7 +109,6 @@ def _assert_same_estimates(vertices, faces, seeds):
                 np.testing.assert_allclose(getattr(other, name)[inverse], getattr(result, name), atol=1e-6 * scale)
 
 
-@needs_scales
 def test_icc_on_two_resolutions_is_the_same_in_every_order():
     _assert_same_estimates(*_two_resolutions(), seeds=(None, 1))
 
@@ -125,9 +116,10 @@ def test_icc_on_two_resolutions_is_the_same_in_every_order():
 MESHES = os.path.join(os.path.dirname(__file__), "..", "..", "shared", "meshes")
 
 
-@needs_scales
+@pytest.mark.slow
 @pytest.mark.skipif(not os.path.exists(os.path.join(MESHES, "nefertiti.obj")), reason="no ../shared/meshes")
 def test_icc_on_nefertiti_is_the_same_in_every_order():
+    pytest.importorskip("numba")  # (50k vertices twice: minutes on the NumPy backend)
     # fuzz 419/58: 2,485 vertices apart by up to 0.0047 of the largest |k|, worst by the flat base
     mesh = meshcurv.read_mesh(os.path.join(MESHES, "nefertiti.obj"))
     _assert_same_estimates(np.asarray(mesh[0], dtype=np.float64), np.asarray(mesh[1]), seeds=(None,))

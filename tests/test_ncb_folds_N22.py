@@ -42,7 +42,7 @@ def folded_sheet(n: int = 12) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_fold_angles_read_a_fold_within_the_band_as_pi():
-    from meshcurv.estimators.normal_cycle_ball import FOLD_ANGLE, fold_angles
+    from meshcurv._geometry import FOLD_ANGLE, fold_angles
 
     beta = np.array([np.pi, -np.pi, np.pi - 1e-11, -np.pi + 2e-11, -(np.pi - 1e-3), np.pi - 1e-3, 0.5, -0.5])
     got = fold_angles(beta)
@@ -51,15 +51,7 @@ def test_fold_angles_read_a_fold_within_the_band_as_pi():
     assert FOLD_ANGLE < 1e-3
 
 
-#: ``normal_cycle`` reads the same angles (``_geometry.edge_dihedral_angles`` and its compiled twin in
-#: ``_kernels/normal_cycle.py``): ogre.obj turned and shifted, 51 vertices apart by up to 0.57 of the largest |k|.
-#: N22's patch (the same band in both) is in its report; strict until it is applied.
-NORMAL_CYCLE_FOLDS = pytest.mark.xfail(
-    strict=True, reason="normal_cycle's dihedral angles read a fold's last bits (N22's patch not applied)"
-)
-
-
-@pytest.mark.parametrize("method", ["normal_cycle_ball", pytest.param("normal_cycle", marks=NORMAL_CYCLE_FOLDS)])
+@pytest.mark.parametrize("method", ["normal_cycle_ball", "normal_cycle"])
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
 @pytest.mark.parametrize("seed", range(4))
 def test_a_fold_turned_and_shifted_keeps_its_curvatures(seed, backend, method):

@@ -353,10 +353,10 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
     """(V,) the length scale at each vertex: the median edge length of its connected component.
 
     The scale of every tolerance in the core (zero-area faces, zero-length
-    edges). On a connected mesh it is the median of at most about
-    :data:`MEDIAN_SAMPLE` edges evenly spaced in index order (a tolerance
-    needs no more; how close to the median of all and how fast:
-    ``benchmarks/docstring_figures.md``). On a mesh whose components are of
+    edges, the local scale ratios of the radius rules). On a connected mesh
+    it is the median of every edge (not a sample by index: the vertex order
+    chose it, and with it the radii); about 70 ms per million vertices
+    (``benchmarks/docstring_figures.md``). On a mesh whose components are of
     one scale (each component's
     geometric-mean edge within :data:`COMPONENT_SCALE_SPREAD` of the mesh's
     median edge) it is the mesh's median edge length everywhere, found in one

@@ -9,6 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
+from .._geometry import FOLD_ANGLE
 from ._common import _JIT, _degenerate, _face_cross, _unit
 from .tensors import _tangent_eigen
 
@@ -81,7 +82,10 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, scale
             cosine = ax * bx + ay * by + az * bz
             # + 0.0 turns a sine of -0.0 (an exact fold: the two faces on each other) into +0.0, so that the
             # angle is pi as on the NumPy path (_geometry.edge_dihedral_angles), not -pi
-            weight = 0.5 * math.atan2(sine + 0.0, cosine) * length
+            angle = math.atan2(sine + 0.0, cosine)
+            if math.pi - abs(angle) <= FOLD_ANGLE:  # a fold turned by a rigid motion: pi, whatever its last bits
+                angle = math.pi
+            weight = 0.5 * angle * length
             for v in (p, q):
                 if first <= v < last:
                     sums[v, 0] += weight * ex * ex

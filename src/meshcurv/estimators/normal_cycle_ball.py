@@ -93,22 +93,6 @@ RADIUS_WARNING_EDGES = 1.5
 MIN_RADIUS_SCALES = 1.0
 
 
-#: An edge whose two faces lie on each other within this angle (radians) is a fold, whose dihedral angle reads pi: the
-#: sign of ``pi - epsilon`` (a fin) against ``-(pi - epsilon)`` (a slit) is decided by the last bits of the coordinates
-#: there. ogre.obj's four exact folds (sine 0: pi) read -pi at two edges once turned and shifted by 5.7 sizes
-#: (epsilon 5e-12 to 2e-11), and 181 vertices' balls moved by up to 0.11 of the largest |k| (fuzz_api 421/64). Far
-#: above the round-off of a mesh moved by 2^20 sizes (1e-16 x 1e6 x its size over a face's height), far below the
-#: sharpest knife edge that is not a fold (0.001 degrees is 2e-5).
-FOLD_ANGLE = 1e-6
-
-
-def fold_angles(beta: np.ndarray) -> np.ndarray:
-    """(E,) the dihedral angles ``beta`` in ``(-pi, pi]`` with those within :data:`FOLD_ANGLE` of ``+-pi`` read as
-    ``pi``: an exact fold reads pi on both backends (tests/test_exact_folds.py), and so does one that round-off
-    turned by a few last bits either way (a rigid motion of the mesh)."""
-    return np.where(np.pi - np.abs(beta) <= FOLD_ANGLE, np.pi, beta)
-
-
 def edge_area_densities(topology, face_areas: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     """(E,) area per unit length of each edge: a third of the area of each of its faces, over its length.
 
@@ -330,7 +314,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         usable &= ~needle_edges
     kept_faces = ~degenerate if needle_faces is None else ~degenerate & ~needle_faces
     beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
-    beta = fold_angles(beta)
     density = edge_area_densities(topology, np.where(kept_faces, double_areas / 2, 0.0), lengths)
     radii = _vertex_radii(groups, vertices.shape[0])
     # the edges of holes: no curvature, no area
