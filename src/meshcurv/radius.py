@@ -78,6 +78,7 @@ from .defects import _fragment_vertices, _needle_corners, _needle_vertices, _sca
 from . import _geometry  # _geometry.median_edge_length: the core, not the checked shell of geometry.py
 from ._geometry import (
     COMPONENT_SCALE_SPREAD,
+    finite_rows,
     robust_mean_edge_length,
     vertex_edge_lengths,
     vertex_length_scales,
@@ -438,7 +439,7 @@ def _scale_centres(mesh: _Measured | PreparedMesh, valid: np.ndarray, normals: n
     needles = mesh.needles
     if not needles.any():
         return valid
-    corners = _needle_corners(mesh.topology, needles) & np.isfinite(normals).all(axis=1)
+    corners = _needle_corners(mesh.topology, needles) & finite_rows(normals)
     return (valid | corners) & ~needles
 
 
@@ -1578,7 +1579,7 @@ def _holed_factor(mesh: _Measured | PreparedMesh, base: np.ndarray, normals: np.
     factor = np.ones(n)
     if not topology.boundary_edges.any():
         return factor
-    finite = np.isfinite(normals).all(axis=1) & np.isfinite(base) & (base > 0)
+    finite = finite_rows(normals) & np.isfinite(base) & (base > 0)
     fragments = _fragment_vertices(topology)
     if fragments is not None:
         finite &= ~fragments

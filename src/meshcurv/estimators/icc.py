@@ -123,7 +123,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._geometry import face_areas, median_edge_length
+from .._geometry import face_areas, finite_rows, median_edge_length
 from .._backend import numba_kernels
 from .._tensors import tangent_basis
 from ..jets import (
@@ -358,7 +358,7 @@ def fitted_normals(
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     if failed is not None:
-        failed |= valid & ~np.isfinite(fitted).all(axis=1)
+        failed |= valid & ~finite_rows(fitted)
     if fitted is fits:  # the caller's array: not written
         return np.where(usable[:, None], fitted, normals)
     np.copyto(fitted, normals, where=~usable[:, None])  # the fits' own array: no second (V, 3) one
@@ -409,7 +409,7 @@ def _unwrapped_normals(
     """
     n = vertices.shape[0]
     facing, fitted = fitted, np.array(fitted, copy=True)
-    centres = np.flatnonzero(valid & np.isfinite(facing).all(axis=1))
+    centres = np.flatnonzero(valid & finite_rows(facing))
     radii = np.array(np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,))[centres], copy=True)
 
     def fit(at, over, degree):
@@ -860,7 +860,7 @@ def _adjacency(topology: MeshTopology) -> tuple:
 def _usable_faces(faces: np.ndarray, degenerate: np.ndarray, normals: np.ndarray) -> np.ndarray | None:
     """(F,) bool: the faces whose measures enter the sums (not degenerate, finite normals at their corners), or
     None when all do."""
-    finite = np.isfinite(normals).all(axis=1)
+    finite = finite_rows(normals)
     kept = ~degenerate if finite.all() else ~degenerate & finite[faces].all(axis=1)
     return None if kept.all() else kept
 
@@ -1077,7 +1077,7 @@ def _corners_fitted(faces: np.ndarray, dropped: np.ndarray, normals: np.ndarray,
     but their normals enter the measures of their faces)."""
     corners = np.zeros(valid.shape[0], dtype=bool)
     corners[faces[~dropped].ravel()] = True
-    return valid | (corners & np.isfinite(normals).all(axis=1))
+    return valid | (corners & finite_rows(normals))
 
 
 def _unfitted_spread(normals: np.ndarray, start: np.ndarray, fit: np.ndarray, adjacency: tuple) -> np.ndarray:
