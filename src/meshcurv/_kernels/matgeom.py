@@ -9,6 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
+from .._geometry import FOLD_ANGLE
 from ._common import _JIT, _degenerate, _face_cross
 
 #: ``estimators.matgeom.NORMAL_GAP`` (the estimator passes it; the default for the direct calls of the twin tests).
@@ -288,6 +289,8 @@ def matgeom_vertex_sums(vertices, faces, ev1, ev2, ef1, ef2, n_chunks, scales, a
                 bx, by, bz = normals[f2, 0], normals[f2, 1], normals[f2, 2]
                 dot = (ax * bx + ay * by) + az * bz
                 beta = math.acos(min(max(dot, -1.0), 1.0)) if math.isfinite(dot) else np.nan
+                if beta >= math.pi - FOLD_ANGLE:  # a fold: 0 in every pose, as an exact one (side 0) reads
+                    beta = 0.0
                 side = ((ay * bz - by * az) * ex + (az * bx - bz * ax) * ey) + (ax * by - bx * ay) * ez
                 if side > 0:
                     weight = (d / mean) * beta

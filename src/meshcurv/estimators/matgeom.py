@@ -9,7 +9,8 @@ itself adapted from G. Peyre's toolbox_graph ``compute_curvature``:
    meshes and drifts on open ones; reproduced literally);
 2. edge lengths divided by their mean; unit edge vectors;
 3. signed angle between the two face normals,
-   ``beta = arccos(n1 . n2) * sign((n1 x n2) . e)``;
+   ``beta = arccos(n1 . n2) * sign((n1 x n2) . e)`` (0 at a fold, within
+   :data:`~meshcurv._geometry.FOLD_ANGLE` of pi, as at an exact one, whose side is 0: in every pose);
 4. edge tensor ``T_e = d_e * beta_e * e e^T``;
 5. vertex tensor = sum of the tensors of its edges divided by their number;
 6. ``smoothing_steps`` passes of a plain 1-ring mean of every tensor component;
@@ -52,7 +53,7 @@ import numpy as np
 
 from .._backend import kernel_threads, numba_kernels
 from .._tensors import outer6
-from .._geometry import DEGENERATE_AREA_RATIO
+from .._geometry import DEGENERATE_AREA_RATIO, FOLD_ANGLE
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
@@ -136,6 +137,9 @@ def _vertex_tensors(vertices, faces, ev1, ev2, ef1, ef2, out_of_range):
     n2 = normals[ef2]
     with np.errstate(invalid="ignore"):
         beta = np.arccos(np.clip(_row_dots(n1, n2), -1.0, 1.0))
+        # a fold (two faces on each other) reads 0 in every pose, as matGeom reads an exact one (a side of 0): turned,
+        # its side is a few last bits of either sign and the angle jumped to +-pi (ogre.obj, fuzz_api 433/68)
+        beta[beta >= np.pi - FOLD_ANGLE] = 0.0
         beta *= np.sign(_row_dots(np.cross(n1, n2), edge_vectors))
     weight = lengths * beta
     weight[out_of_range] = np.nan  # where matGeom stops with an index error
