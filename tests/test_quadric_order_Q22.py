@@ -95,3 +95,11 @@ def test_nefertiti_quadric_invariant_to_reindexing():
     for name in ("k_min", "k_max"):
         a, b = getattr(first, name)[first.valid], getattr(second, name)[back][first.valid]
         np.testing.assert_allclose(a, b, rtol=0.0, atol=1e-9 * largest)
+
+
+def test_the_kernels_dof_floor_is_the_estimators():
+    pytest.importorskip("numba")
+    from meshcurv._kernels import quadric as compiled
+    from meshcurv.estimators.quadric import RESIDUAL_DOF_FLOOR
+
+    assert compiled._DOF_FLOOR == RESIDUAL_DOF_FLOOR  # (the kernel keeps its own copy: both backends decide alike)
