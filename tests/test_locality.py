@@ -16,6 +16,7 @@ import pytest
 import meshcurv
 from meshcurv import _locality, shapes
 from meshcurv._backend import use_backend
+from meshcurv.errors import MeshQualityWarning
 
 try:
     import numba  # noqa: F401
@@ -49,6 +50,9 @@ def shuffle(vertices, faces, seed, block=None):
 def run(vertices, faces, method, **options):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        if method == "matgeom":  # (the jittered torus's circles of K = 0: a tangent eigenvalue ties the normal's, and
+            # matGeom's normal there is round-off's choice: a few vertices undefined, with a warning)
+            warnings.filterwarnings("ignore", category=MeshQualityWarning, message="matgeom: .* have no normal")
         return meshcurv.principal_curvatures(vertices, faces, method=method, **options)
 
 
