@@ -10,6 +10,7 @@ import numpy as np
 from ..defects import VertexDefects
 from ..radius import VoxelReading, _voxel_surface
 from ..result import CurvatureResult
+from ._ring_noise import welded_staircase
 
 logger = logging.getLogger("meshcurv")
 
@@ -176,11 +177,15 @@ def staircase_undefined(
     of ``meyer``'s were off the exact H by more than half of the largest ``|k|`` (median errors 77-1130%), every
     one of them valid (issue 29: never a valid wrong number). Neither has a scale to grow; the call's warning
     names the methods whose balls are scaled to the voxels (:func:`meshcurv.curvature._staircase_note`), which
-    takes the grid read here from ``stages`` (:class:`Stages`; read again without it).
+    takes the grid read here from ``stages`` (:class:`Stages`; read again without it). A voxel surface welded back
+    across cracks, no longer read as one, is undefined the same way where its vertices away from the welds lie on a
+    grid (:func:`._ring_noise.welded_staircase`).
     """
     reading = None if stages is None else stages.voxel
-    if not valid.any() or not _voxel_surface(mesh, defects.invalid_vertices, reading=reading):
+    if not valid.any():
         return valid, ()
+    if not _voxel_surface(mesh, defects.invalid_vertices, reading=reading):
+        return welded_staircase(mesh, valid)
     return np.zeros_like(valid), (f"{int(valid.sum())} vertices of this voxel surface are NaN (estimate undefined)",)
 
 

@@ -33,7 +33,7 @@ import numpy as np
 from .._tensors import principal_from_mean_gaussian
 from .._geometry import corner_angles, corner_cotangents, mixed_voronoi_corner_areas, vertex_normals
 from .._prepared import PreparedMesh
-from ._ring_noise import welded_staircase, noisy_rings, noisy_rings_note
+from ._ring_noise import noisy_rings, noisy_rings_note
 from ._support import Stages, finish, staircase_undefined
 
 #: The cotangent Laplacian's noise gain (:func:`~meshcurv.estimators._ring_noise.noisy_rings`): on a regular
@@ -93,8 +93,6 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
         else ()
     )
     valid, staircase = staircase_undefined(mesh, defects, valid, stages=stages)
-    if not staircase:
-        valid, staircase = welded_staircase(mesh, valid)
     noisy = noisy_rings(mesh, valid, _noise_gains(mesh, good, cot, areas)) if mesh.n_cracked else np.zeros_like(valid)
     valid &= ~noisy
     extra = (*extra, *staircase, noisy_rings_note(int(noisy.sum())))

@@ -59,7 +59,7 @@ from .._geometry import mixed_voronoi_corner_areas
 from ..jets import _fit_jets, jet_normals
 from .._prepared import PreparedMesh
 from ..defects import DEFECTS
-from ._ring_noise import welded_staircase, noisy_rings, noisy_rings_note
+from ._ring_noise import noisy_rings, noisy_rings_note
 from ._support import Stages, finish, staircase_undefined
 
 #: Per-face systems whose determinant, with the matrix scaled to a largest entry of 1, is at
@@ -301,8 +301,6 @@ def estimate(mesh: PreparedMesh, *, stages: Stages):
         np.where(valid[:, None], shape_operator, 0.0), np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
     )
     valid, staircase = staircase_undefined(mesh, defects, valid, stages=stages)
-    if not staircase:
-        valid, staircase = welded_staircase(mesh, valid)
     noisy = noisy_rings(mesh, valid, NOISE_GAIN, normals=normals, normal_gain=NORMAL_NOISE_GAIN)
     valid &= ~noisy
     extra = (*staircase, noisy_rings_note(int(noisy.sum())))
