@@ -183,9 +183,9 @@ STRUCTURE_GROWTH = SCATTER_SCALE**0.75
 RESIDUAL_DOF_FLOOR = 1e-6
 
 
-#: A quadric at the default radius whose principal curvatures depart from those of the quadric over a ball
-#: :data:`SCATTER_SCALE` times wider by more than this many of its noise spreads, while the residuals grew less than
-#: :data:`STRUCTURE_GROWTH`, follows its scatter (:func:`_scatter_check`): the spread assumes independent noise,
+#: A quadric at the default radius over a crack (:func:`_cracked_balls`) whose principal curvatures depart from those
+#: of the quadric over a ball :data:`SCATTER_SCALE` times wider by more than this many of its noise spreads follows
+#: its scatter (:func:`_scatter_check`, step 5): the spread assumes independent noise,
 #: and a staircase's steps (a voxel surface whose faces are detached: issue 29, fuzz 415/108) pull a fit by three
 #: times as much (a quadric over 2.4 voxels of ``voxel_sphere(10)`` detached by 0.042 edge lengths: H off by 0.16
 #: for spreads of 0.06; off the wider ball's by 2.6-6.7 spreads, where the near fits within a fifth of the
@@ -259,7 +259,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
             unsure = _noise_reach((vertices, start, radii, referenced, facing), sigmas, curvatures, fields)
         else:  # the default radius: scatter told from structure by the residuals at two scales
-            unsure = _scatter_check((vertices, radii, referenced, scales), (sigmas > 0, noisy), fields)
+            cracked = _cracked_balls(vertices, radii, rim & referenced)
+            unsure = _scatter_check((vertices, radii, referenced, scales), (sigmas > 0, noisy, cracked), fields)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -565,13 +566,16 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     4. scatter takes the quadric over a ball grown until its spread (as ``r^-3``) is within the reach, at most
        :data:`meshcurv.radius.JET_CURVATURE_CAP` over its curvedness, if it is; else it is NaN with
        ``valid=False``;
-    5. a quadric that passed 2 or 3 but departs from the wider ball's by more than :data:`DEPARTURE_SPREADS` of its
-       spreads while its residuals grew less than :data:`STRUCTURE_GROWTH` follows its scatter (a staircase's steps
-       pull it more than independent noise would): it takes the quadric of 4, and keeps its own fit where that one
-       is not steady (fandisk's creases: their cover as before; made NaN, 79.98 -> 76.2-79.1% valid). The grown ball
-       at least the wider one pulled a detached hemisphere's median H from 1.04 to 1.12 (the quadric's bias)."""
+    5. at the vertices whose ball holds a crack's corner (:func:`_cracked_balls`: a soup's detached faces), a
+       quadric that departs from the wider ball's by more than :data:`DEPARTURE_SPREADS` of its spreads follows the
+       steps (the spread of independent noise underestimates their pull) whatever its residuals did: one that bent
+       to follow a step absorbed its own residuals, and the wider ball's then grew as a crease's would (fuzz
+       415/108: 264 of the 286 vertices left off grew 1.7-3.0 times). It takes the quadric of 4 if steady, else it is
+       NaN with ``valid=False``. Elsewhere (a closed mesh) the wider ball is fitted at the rows 2 failed only: the
+       check at every row cost nefertiti 1.43x its CPU and changed only 14 of fandisk's and 12 of rocker-arm's
+       crease vertices."""
     vertices, radii, referenced, groups = ball
-    checked, noisy = checks
+    checked, noisy, cracked = checks
     six, fitted, coefficients = fields
     frames = fitted.copy()  # the frames of the quadrics (the fits' normals as they were)
     unsure = np.zeros(vertices.shape[0], dtype=bool)
@@ -585,31 +589,52 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     _follow_quadrics((rows[gated], found[gated], frames[rows[gated]], radii[rows[gated]], spreads[gated]), fields)
     bent = _curvedness(found, frames[rows], radii[rows])
     loose = ~(spreads <= NOISE_REACH * np.fmax(bent, floor[rows]))
-    near = (found, frames[rows], radii[rows])
+    passed = ~loose  # as the noise's spread alone reads them
+    # the wider ball where it can change the outcome: the rows the spread failed, and the balls over cracks (a
+    # soup's steps), whose passed fits it checks (step 5); elsewhere a passed fit stays, as it did without step 5
+    # (nefertiti 1.43x the CPU with the wider ball at every passed row, and the same results)
+    steps = cracked[rows]
+    wider = loose | steps
+    near = (found[steps], frames[rows[steps]], radii[rows[steps]])
+    rows, sigmas, spreads_near, bent, passed, steps = (
+        rows[wider],
+        sigmas[wider],
+        spreads[wider],
+        bent[wider],
+        passed[wider],
+        steps[wider],
+    )
+    if rows.size == 0:
+        return unsure
     wide = SCATTER_SCALE * radii[rows]
-    found, wide_sigmas, spreads_wide = residual_spreads(vertices, pool, _at(radii, rows, wide), frames, rows)
+    found, wide_sigmas, spreads = residual_spreads(vertices, pool, _at(radii, rows, wide), frames, rows)
     with np.errstate(divide="ignore", invalid="ignore"):
         growth = wide_sigmas / sigmas
-    # a fit that departs from the wider ball's beyond its noise while the residuals keep their size follows scatter
-    # (a staircase's steps: the spread of independent noise underestimates its pull)
+    # a fit over cracks that departs from the wider ball's by more than its noise follows the steps, whatever its
+    # residuals did: the spread of independent noise underestimates their pull, and a fit that bent to follow a
+    # step absorbed its own residuals, so that the wider ball's grew as a crease's would (fuzz 415/108: 264 of the
+    # 286 vertices left off by more than half the largest |k| grew 1.7-3.0 times, departing by 2.7-7.9 spreads)
+    following = np.zeros(rows.size, dtype=bool)
     with np.errstate(invalid="ignore"):
-        following = (_departure(near, (found, frames[rows], wide)) > DEPARTURE_SPREADS * spreads) & (
-            growth < STRUCTURE_GROWTH
-        )
-    passed = ~loose  # as the noise's spread alone reads them
-    loose |= following
-    rows, sigmas, spreads_near, growth = rows[loose], sigmas[loose], spreads, growth[loose]
-    found, spreads, wide, following = found[loose], spreads_wide[loose], wide[loose], following[loose]
+        far = (found[steps], frames[rows[steps]], wide[steps])
+        following[steps] = _departure(near, far) > DEPARTURE_SPREADS * spreads_near[steps]
+    loose = ~passed | following
+    rows, sigmas, spreads_near, growth, passed = (
+        rows[loose],
+        sigmas[loose],
+        spreads_near[loose],
+        growth[loose],
+        passed[loose],
+    )
+    found, spreads, wide, following, bent = found[loose], spreads[loose], wide[loose], following[loose], bent[loose]
     if rows.size == 0:
         return unsure
     # the noise the two scales leave if the rest grows as STRUCTURE_GROWTH
     share = np.sqrt(np.clip((STRUCTURE_GROWTH**2 - growth * growth) / (STRUCTURE_GROWTH**2 - 1.0), 0.0, 1.0))
-    held = NOISE_REACH * np.fmax(bent[loose], floor[rows])
+    held = NOISE_REACH * np.fmax(bent, floor[rows])
     with np.errstate(invalid="ignore"):
-        grew = passed[loose] | (spreads_near[loose] * share <= held)
+        grew = passed | (spreads_near * share <= held)
     structure = grew & ~following
-    # a fit that the spread passed but follows its scatter takes a steady wider ball's, and keeps its own without one
-    spared = (following & grew)[~structure]
     rows, found, spreads, wide = rows[~structure], found[~structure], spreads[~structure], wide[~structure]
     if rows.size == 0:
         return unsure
@@ -630,9 +655,24 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     six[taken], fitted[taken] = shape_operators(found[steady], (*frame, frames[taken]), wide[steady])
     coefficients[taken] = found[steady]
     radii[taken] = wide[steady]
-    unsure[rows[~steady & ~spared]] = True
+    unsure[rows[~steady]] = True
     coefficients[unsure] = np.nan
     return unsure
+
+
+def _cracked_balls(vertices: np.ndarray, radii: np.ndarray, rim: np.ndarray) -> np.ndarray:
+    """(V,) bool: the vertices whose ball (``radii``, one per vertex) holds a vertex of ``rim`` (a crack's, or a
+    detached face's, corner): where a soup's steps can pull a quadric (:func:`_scatter_check`, step 5). None on a
+    closed mesh."""
+    out = np.zeros(vertices.shape[0], dtype=bool)
+    if not rim.any():
+        return out
+    from scipy.spatial import cKDTree  # imported on use: scipy.spatial costs import time
+
+    finite = np.isfinite(radii)
+    reach = float(radii[finite].max()) if finite.any() else 0.0
+    distances = cKDTree(vertices[rim]).query(vertices, distance_upper_bound=reach)[0]
+    return distances < radii
 
 
 def _departure(near: tuple, far: tuple) -> np.ndarray:
