@@ -63,6 +63,11 @@ checked too) or, with ``--real-meshes``, a real mesh's vertices read as a scan, 
 (given normals turned with it), a scale (a given radius scaled), a permutation of the points or a translation: the
 same valid points and reasons, curvatures within 1e-6 of the largest |k| (divided by the scale) and the same
 normals, turned back (:func:`cloud_relation_check`); counted apart ("(cloud relations)").
+``--radius-forms P`` (a stream of its own; 0 by default) gives the radius of a share ``P`` of the real-mesh and
+cloud-relation cases in another form: a given radius as a NumPy float64, a 0-d array or a float32 (every relation
+scales it, whatever its type: :func:`scaled_radius`), ``icc`` at its default with the rule ``radius="adaptive"``
+(its scale relation: the rule's radii scale with the mesh), or a cloud's given radius also through
+``multiscale_point_cloud_curvatures``, whose first result must be the single call's (:func:`multiscale_check`).
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -928,7 +933,49 @@ def real_mesh_case(rng, numpy_backend):
     return "principal_curvatures", (v, f), kwargs, labels, (relation, value)
 
 
+#: Share of the real-mesh and cloud-relation cases whose radius takes another form (``--radius-forms``): 0 by
+#: default, so that the cases of earlier rounds replay as drawn (the form comes from a stream of its own).
+RADIUS_FORMS = 0.0
+#: The random stream of the radius forms (beside the case's own ``[seed, index]``).
+RADIUS_FORM_STREAM = 59
+
+
+def with_radius_form(case, seed: int, index: int):
+    """``case`` (a real-mesh or cloud-relation case) with its radius in another form (:data:`RADIUS_FORMS`): a
+    given radius as a NumPy float64, a 0-d array or a float32 (the relation scales it: :func:`scaled_radius`);
+    ``icc`` at its default on a real mesh with the rule ``radius="adaptive"`` (each vertex at its own scale); a
+    cloud's given radius also through :func:`meshcurv.pointcloud.multiscale_point_cloud_curvatures` (the first of
+    its results must equal the single call's: ``"multiscale"``, :func:`multiscale_check`)."""
+    target, args, kwargs, labels, clean = case
+    if not RADIUS_FORMS or not ("real mesh" in labels or (clean is not None and clean[0] == "cloud relation")):
+        return case
+    rng = np.random.default_rng([seed, index, RADIUS_FORM_STREAM])
+    if rng.random() >= RADIUS_FORMS:
+        return case
+    kwargs = dict(kwargs)
+    radius = kwargs.get("radius")
+    if target == "principal_curvatures" and radius is None and kwargs.get("method") == "icc":
+        kwargs["radius"] = "adaptive"
+        labels = [*labels, "radius 'adaptive'"]
+    elif isinstance(radius, float):
+        form = ["float64", "0-d array", "float32", "multiscale"][
+            int(rng.integers(4 if target != "principal_curvatures" else 3))
+        ]
+        if form == "multiscale":
+            clean = (clean[0], (*clean[1], "multiscale"))
+        else:
+            kwargs["radius"] = {"float64": np.float64, "0-d array": np.array, "float32": np.float32}[form](radius)
+        labels = [*labels, f"radius as {form}"]
+    else:
+        return case
+    return target, args, kwargs, labels, clean
+
+
 def _drawn_case(seed: int, index: int):
+    return with_radius_form(_drawn_form(seed, index), seed, index)
+
+
+def _drawn_form(seed: int, index: int):
     fine = _fine_stream(seed, index)
     if FINE_CRACKS and not ONLY_POINT_CLOUDS and fine.random() < FINE_CRACKS:
         return fine_crack_case(fine, numpy_backend=index % 4 == 3)  # (run_forked's and replay's NumPy cases)
@@ -1752,8 +1799,10 @@ def relation_check(args, kwargs, result, relation):
     if kind == "cloud truth":
         return cloud_truth_check(args, kwargs, result, value)
     if kind == "cloud relation":  # the cloud moved (--cloud-relations): its truth, if any, and the invariance
-        relation, number, truth = value
+        relation, number, truth, *forms = value
         broken = [] if truth is None else cloud_truth_check(args, kwargs, result, truth)
+        if "multiscale" in forms:
+            broken += multiscale_check(args[0], kwargs, result)
         return broken + cloud_relation_check(args[0], kwargs, result, relation, number)
     v, f = args
     if kind == "detached":  # faces detached from the clean shape: its values at their corners (issue 29)
@@ -1853,8 +1902,8 @@ def relation_check(args, kwargs, result, relation):
         edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1))) if len(f) else 1.0
         extra = v[rng.integers(n, size=max(1, n // 10))] + rng.normal(size=(max(1, n // 10), 3)) * 0.3 * edge
         v2, f2 = np.concatenate([v, extra]), f
-    if kind == "scale" and isinstance(kwargs.get("radius"), float):  # a given ball scales with the mesh
-        kwargs = {**kwargs, "radius": kwargs["radius"] * value}
+    if kind == "scale" and "radius" in kwargs:  # a given ball scales with the mesh
+        kwargs = {**kwargs, "radius": scaled_radius(kwargs["radius"], value)}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
@@ -1993,6 +2042,54 @@ def cloud_relation_case(rng, numpy_backend):
     return "point_cloud_curvatures", args, kwargs, labels, ("cloud relation", (relation, value, truth))
 
 
+def scaled_radius(radius, factor: float):
+    """A given ``radius`` for the coordinates times ``factor``: a number of any type (int, float, a NumPy scalar or
+    0-d array) or radii per point times ``factor``; a rule (``"adaptive"``, relative to the mesh) and anything that is
+    not a radius (the garbage the call refuses either way) as given."""
+    if isinstance(radius, (bool, np.bool_, str, bytes)):
+        return radius
+    # (in float64: a float32 radius times 1e30 would overflow where the points do not)
+    if isinstance(radius, np.ndarray) and np.issubdtype(radius.dtype, np.number):
+        return np.asarray(radius, np.float64) * factor
+    if isinstance(radius, (int, float, np.number)):
+        return float(radius) * factor
+    if isinstance(radius, (list, tuple)) and radius and all(isinstance(r, (int, float, np.number)) for r in radius):
+        return type(radius)(float(r) * factor for r in radius)
+    return radius
+
+
+#: The radii of :func:`multiscale_check` over the given one: the given first, then a smaller ball.
+MULTISCALE_RATIOS = (1.0, 0.8)
+
+
+def multiscale_check(points, kwargs, result) -> list[str]:
+    """``multiscale_point_cloud_curvatures`` at the given radius and a smaller one: its first result is the single
+    call's (its documentation: each result equals ``point_cloud_curvatures`` at that radius), to the last bits."""
+    options = {key: kwargs[key] for key in ("normals", "method") if key in kwargs}
+    radii = [float(kwargs["radius"]) * ratio for ratio in MULTISCALE_RATIOS]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            first = pointcloud.multiscale_point_cloud_curvatures(points, radii, **options)[0]
+        except DOCUMENTED as error:
+            return [f"multiscale: {type(error).__name__} where the single call succeeded: {str(error)[:150]}"]
+    broken = []
+    if not np.array_equal(first.valid, result.valid):
+        return [
+            f"multiscale: valid differs from the single call's at {int((first.valid != result.valid).sum())} points"
+        ]
+    valid = result.valid
+    largest = max(float(np.abs(result.k_min[valid]).max(initial=0)), float(np.abs(result.k_max[valid]).max(initial=0)))
+    for name in ("k_min", "k_max", "normals"):
+        a, b = getattr(result, name)[valid], getattr(first, name)[valid]
+        scale = 1.0 if name == "normals" else max(largest, 1e-300)
+        with np.errstate(all="ignore"):
+            error = float(np.nanmax(np.abs(a - b))) / scale if a.size else 0.0
+        if not error <= 1e-12:
+            broken.append(f"multiscale: {name} differs from the single call's by up to {error:.3g}")
+    return broken
+
+
 def cloud_relation_check(points, kwargs, result, relation, value) -> list[str]:
     """The cloud moved (``rigid``: a rotation and a shift of up to 10 sizes; ``scale`` s; ``translate``;
     ``permute``): the same valid points and reasons, ``k / s`` within :data:`CLOUD_RELATION_RTOL` of the largest
@@ -2005,8 +2102,8 @@ def cloud_relation_check(points, kwargs, result, relation, value) -> list[str]:
     given = kwargs.get("normals")
     if relation == "scale":
         moved, factor = points * value, value
-        if isinstance(kwargs.get("radius"), float):
-            kwargs["radius"] = kwargs["radius"] * value
+        if "radius" in kwargs:
+            kwargs["radius"] = scaled_radius(kwargs["radius"], value)
     elif relation == "translate":
         moved = points + value * max(size, 1.0)
     elif relation == "rigid":
@@ -2276,6 +2373,7 @@ def summary_table(path) -> str:
 
 def main(argv=None) -> int:
     global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE, FINE_CRACKS, REAL_MESHES, CLOUD_RELATIONS
+    global RADIUS_FORMS
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -2342,8 +2440,25 @@ def main(argv=None) -> int:
         "mesh's vertices) under an invariance: a rigid motion, a scale, a permutation, a translation; their limit is "
         f"{REAL_TIMEOUT_FACTOR} times --timeout (default: %(default)g: the draws of earlier rounds)",
     )
+    parser.add_argument(
+        "--radius-forms",
+        type=float,
+        default=RADIUS_FORMS,
+        help="share of the real-mesh and cloud-relation cases whose radius takes another form: a given radius as a "
+        "NumPy float64, a 0-d array or a float32 (scaled by the scale relation); icc at its default with "
+        "radius='adaptive' on a real mesh; a cloud's given radius also through multiscale_point_cloud_curvatures, "
+        "whose first result must be the single call's (default: %(default)g: the draws of earlier rounds)",
+    )
     options = parser.parse_args(argv)
-    for name in ("voxel_share", "wide_cracks", "thin_shapes", "fine_cracks", "real_meshes", "cloud_relations"):
+    for name in (
+        "voxel_share",
+        "wide_cracks",
+        "thin_shapes",
+        "fine_cracks",
+        "real_meshes",
+        "cloud_relations",
+        "radius_forms",
+    ):
         if not 0 <= getattr(options, name) <= 1:
             parser.error(f"--{name.replace('_', '-')} must lie in [0, 1], got {getattr(options, name)}")
     WIDE_CRACKS = options.wide_cracks
@@ -2357,6 +2472,7 @@ def main(argv=None) -> int:
     ONLY_POINT_CLOUDS = options.point_clouds
     VOXEL_SHARE = options.voxel_share
     CLOUD_RELATIONS = options.cloud_relations
+    RADIUS_FORMS = options.radius_forms
 
     if options.summary:
         print(summary_table(options.summary))

@@ -52,6 +52,20 @@ CPU time (starved by the machine's load) runs once more with 5 times the limit. 
 ones, a crash, a timeout, or a broken check. One JSON line per finding in
 ``--log``; a summary on stdout (counts per kind and outcome).
 ``--replay I --seed S`` runs case ``I`` in this process and prints it.
+
+``--relations P`` (default 0: the draws of earlier rounds): a share ``P`` of
+the cases (drawn from a stream of their own) is computed again under an
+invariance of the image, and every row must agree with its related row within
+1e-6 of ``max(|value|, R^e)`` (``R`` the label's equivalent radius, ``e`` the
+column's power of length), with the same status, counts and Euler
+characteristic: ``scale`` (the spacing times 2^-8, 2^8, 1e-3, 1e3 or 0.7, given
+as an array or a list: areas by s^2, volumes by s^3, curvatures by 1/s, ...),
+``pad`` (1-3 zero voxels on each face: the labels off the border unchanged,
+their centroids shifted), ``relabel`` (the label values renumbered at random in
+their dtype), ``flip`` (mirrored along an axis) and ``transpose`` (the axes
+permuted with the spacing): these two within 2% (:data:`MIRROR_RTOL`: marching
+cubes draws other diagonals on the same staircase), their volume and triangle
+area within 1e-6.
 """
 
 from __future__ import annotations
@@ -240,6 +254,47 @@ def _many_case(rng, unit):
 
 CASES = {"ball": _ball_case, "box": _box_case, "cylinder": _cylinder_case, "many": _many_case}
 
+#: Share of the cases computed again under an invariance of the image (``--relations``): 0 by default, so that the
+#: cases of earlier rounds replay as drawn (the relation comes from a stream of its own).
+RELATIONS = 0.0
+#: The random stream of the relations (beside the case's own ``[seed, index]``).
+RELATION_STREAM = 61
+#: The invariances: the spacing scaled (areas by s^2, volumes by s^3, curvatures by 1/s, ...), zeros padded around
+#: the image (the rows of the labels off the border unchanged), the label values renumbered, the image mirrored
+#: along an axis, its axes permuted with the spacing.
+RELATION_KINDS = ("scale", "scale", "pad", "relabel", "flip", "transpose")
+#: Relative agreement of a row and its related row, in ``max(|value|, R^e)`` (``R`` the label's equivalent radius,
+#: ``e`` the column's power of length): the last bits of a change of units, not a change of the estimate.
+RELATION_RTOL = 1e-6
+#: ... for a mirrored or transposed image: marching cubes triangulates the same staircase with other diagonals
+#: (seed 7 case 0 with ``--relations 1``: a box's vertices the same, the fitted normals of its edges apart by
+#: 0.16, the corrected area by 1.7e-5), so its counts of vertices used and its values move with them; within this
+#: share (a pose that reads another surface, as the turned voxel surfaces did: 100-200% of H, is far beyond it),
+#: the volume and the triangles' area within :data:`RELATION_RTOL`.
+MIRROR_RTOL = 0.02
+
+
+def _relation(seed: int, index: int, image, give_spacing: bool):
+    """``(name, value)`` of case ``index``'s relation, or None (:data:`RELATIONS`)."""
+    if not RELATIONS:
+        return None
+    rng = np.random.default_rng([seed, index, RELATION_STREAM])
+    if rng.random() >= RELATIONS:
+        return None
+    name = RELATION_KINDS[int(rng.integers(len(RELATION_KINDS)))]
+    if name == "relabel" and image.dtype == bool:
+        name = "flip"
+    if name == "scale":
+        # (given as a NumPy array or a list, the unit spacing of a call without one as the scale itself)
+        return name, (float(rng.choice([2.0**-8, 2.0**8, 1e-3, 1e3, 0.7])), ["array", "list"][int(rng.integers(2))])
+    if name == "pad":
+        return name, rng.integers(1, 4, size=(3, 2))
+    if name == "flip":
+        return name, int(rng.integers(3))
+    if name == "transpose":
+        return name, [(1, 0, 2), (2, 1, 0), (0, 2, 1), (1, 2, 0), (2, 0, 1)][int(rng.integers(5))]
+    return name, int(rng.integers(2**31))
+
 
 def make_case(seed: int, index: int):
     """``(kind, image, spacing, give_spacing, truth, twin)`` of case ``index``: a quarter without spacing (1 x 1 x 1)."""
@@ -249,6 +304,108 @@ def make_case(seed: int, index: int):
     image, spacing, truth = CASES[kind](rng, unit=not give_spacing)
     twin = bool(rng.random() < 0.125)
     return kind, image, spacing, give_spacing, truth, twin
+
+
+def _length_power(column: str) -> int | None:
+    """The power of length of a numeric column of the table (None: not compared, a count or a text)."""
+    if column in ("area", "area_mesh"):
+        return 2
+    if column == "volume":
+        return 3
+    if column in ("equivalent_radius", "radius", "total_mean") or column.startswith(("centroid_", "mean_integral")):
+        return 1
+    if column.startswith(("gaussian_integral", "shape_index", "ici_")) or column in (
+        "total_gaussian",
+        "willmore",
+        "bending_energy",
+        "folding_index",
+    ):
+        return 0
+    if column.startswith(("mean_", "k_min_", "k_max_", "curvedness_")):
+        return -1
+    if column.startswith("gaussian_"):
+        return -2
+    return None
+
+
+def related_image(image, spacing, relation):
+    """``(image, spacing, rows)`` of the related call; ``rows(table)`` maps its table back to the original's labels."""
+    name, value = relation
+    spacing = np.asarray(spacing, float)
+    if name == "scale":
+        factor, form = value
+        scaled = spacing * factor
+        return image, (scaled if form == "array" else scaled.tolist()), None
+    if name == "pad":
+        return np.pad(image, value), spacing, None
+    if name == "flip":
+        return np.flip(image, axis=value), spacing, None
+    if name == "transpose":
+        return np.transpose(image, value), spacing[list(value)], None
+    present = np.unique(image)
+    present = present[present != 0]
+    top = int(np.iinfo(image.dtype).max)
+    rng = np.random.default_rng(value)
+    new = (
+        np.sort(rng.choice(np.arange(1, top + 1, dtype=np.uint64), size=len(present), replace=False))
+        if top < 2**20
+        else None
+    )
+    if new is None:  # (a wide dtype: distinct values drawn until there are enough)
+        drawn = set()
+        while len(drawn) < len(present):
+            drawn.add(int(rng.integers(1, top, endpoint=True, dtype=np.uint64)))
+        new = np.array(sorted(drawn), dtype=np.uint64)
+    new = rng.permutation(new).astype(image.dtype)
+    lookup = dict(zip((int(v) for v in present), (int(v) for v in new)))
+    renumbered = np.zeros_like(image)
+    for old, value_new in lookup.items():
+        renumbered[image == old] = value_new
+    return renumbered, spacing, lookup
+
+
+def relation_broken(table, other, image, spacing, relation, lookup) -> list[str]:
+    """The rows of ``table`` and of the related call's ``other`` that should agree and do not."""
+    name, value = relation
+    label = f"relation {name}"
+    spacing = np.asarray(spacing, float)
+    by_label = {int(row.label): row for row in other.itertuples()}
+    factor = value[0] if name == "scale" else 1.0
+    broken = []
+    for row in table.itertuples():
+        if name == "pad" and row.touches_border:  # (padded, the label is closed there: another surface)
+            continue
+        twin = by_label.get(lookup[int(row.label)] if lookup else int(row.label))
+        if twin is None:
+            broken.append(f"{label}: label {row.label} has no row")
+            continue
+        mirror = name in ("flip", "transpose")
+        for column in ("status", "n_voxels", "n_vertices", "n_faces", "n_used", "n_invalid", "euler_characteristic"):
+            if not (mirror and column in ("n_used", "n_invalid")) and getattr(row, column) != getattr(twin, column):
+                broken.append(f"{label}: label {row.label} {column} {getattr(row, column)} -> {getattr(twin, column)}")
+        if name in ("pad", "flip", "transpose") and row.touches_border != twin.touches_border:
+            broken.append(f"{label}: label {row.label} touches_border {row.touches_border} -> {twin.touches_border}")
+        radius = row.equivalent_radius if np.isfinite(row.equivalent_radius) and row.equivalent_radius > 0 else 1.0
+        centroid = np.array([row.centroid_0, row.centroid_1, row.centroid_2])
+        if name == "pad":
+            centroid = centroid + value[:, 0] * spacing
+        elif name == "flip":
+            centroid[value] = (image.shape[value] - 1) * spacing[value] - centroid[value]
+        elif name == "transpose":
+            centroid = centroid[list(value)]
+        for column in table.columns:
+            power = _length_power(column)
+            if power is None:
+                continue
+            mine = centroid[int(column[-1])] if column.startswith("centroid_") else getattr(row, column)
+            theirs = getattr(twin, column) / factor**power
+            if np.isnan(mine) != np.isnan(theirs) and not (mirror and column not in ("volume", "area_mesh")):
+                broken.append(f"{label}: label {row.label} {column} {mine:.6g} -> {theirs:.6g} (NaN in one)")
+            elif np.isfinite(mine) and abs(mine - theirs) > (
+                MIRROR_RTOL if mirror and column not in ("volume", "area_mesh") else RELATION_RTOL
+            ) * max(abs(mine), radius**power):
+                broken.append(f"{label}: label {row.label} {column} {mine:.9g} -> {theirs:.9g}")
+    return broken
 
 
 # ---- the checks ------------------------------------------------------------------------------------------------------
@@ -373,8 +530,22 @@ def run_case(seed, index) -> dict:
         numbers = [c for c in table.columns if table[c].dtype.kind == "f"]
         if not np.allclose(table[numbers].to_numpy(), again[numbers].to_numpy(), rtol=1e-9, atol=0, equal_nan=True):
             broken.append("a Fortran-ordered read-only copy gives another table")
+    relation = _relation(seed, index, image, give_spacing)
+    if relation is not None:
+        other_image, other_spacing, lookup = related_image(image, spacing, relation)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                other = label_curvatures(other_image, spacing=other_spacing)
+        except DOCUMENTED as exc:
+            broken.append(
+                f"relation {relation[0]}: {type(exc).__name__} where the original succeeded: {str(exc)[:150]}"
+            )
+        else:
+            broken += relation_broken(table, other, image, spacing, relation, lookup)
     return {
         "kind": kind,
+        "relation": relation[0] if relation is not None else None,
         "status": "invariant" if broken else "ok",
         "broken": broken,
         "labels": len(table),
@@ -451,6 +622,7 @@ def _key(outcome) -> str:
 
 
 def main(argv=None) -> int:
+    global RELATIONS
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -459,7 +631,16 @@ def main(argv=None) -> int:
     parser.add_argument("--start", type=int, default=0, help="first case index")
     parser.add_argument("--log", default=os.path.join(tempfile.gettempdir(), "fuzz_labels.jsonl"))
     parser.add_argument("--replay", type=int, default=None, help="run case I in this process and show it")
+    parser.add_argument(
+        "--relations",
+        type=float,
+        default=RELATIONS,
+        help="share of the cases computed again under an invariance of the image: the spacing scaled (given as an "
+        "array or a list), zeros padded around it, the labels renumbered, mirrored along an axis, its axes permuted "
+        "(default: 0: the draws of earlier rounds)",
+    )
     options = parser.parse_args(argv)
+    RELATIONS = options.relations
 
     if options.replay is not None:
         kind, image, spacing, give_spacing, truth, twin = make_case(options.seed, options.replay)
@@ -467,6 +648,9 @@ def main(argv=None) -> int:
             f"case {options.replay} seed {options.seed}: {kind}, image {image.shape} {image.dtype}, spacing "
             f"{tuple(spacing.tolist())} ({'given' if give_spacing else 'not given'}), truth {truth}"
         )
+        relation = _relation(options.seed, options.replay, image, give_spacing)
+        if relation is not None:
+            print(f"relation: {relation[0]} {relation[1]}")
         for key, value in run_case(options.seed, options.replay).items():
             print(f"{key}: {value}")
         return 0
@@ -493,6 +677,8 @@ def main(argv=None) -> int:
                 counts[("?", "timeout under load, rerun")] += 1
                 outcome, elapsed, cpu = run_forked(options.seed, index, STARVED_WALL * options.timeout, options.memory)
             counts[(outcome["kind"], outcome["status"])] += 1
+            if outcome.get("relation"):
+                counts[(outcome["kind"], f"relation {outcome['relation']}: {outcome['status']}")] += 1
             if outcome["status"] == "ok" and outcome.get("touches_border"):
                 counts[(outcome["kind"], "ok, cut by the border")] += 1
             slowest.append((elapsed, index))
