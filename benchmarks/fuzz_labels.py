@@ -64,7 +64,8 @@ as an array or a list: areas by s^2, volumes by s^3, curvatures by 1/s, ...),
 their centroids shifted), ``relabel`` (the label values renumbered at random in
 their dtype), ``flip`` (mirrored along an axis) and ``transpose`` (the axes
 permuted with the spacing): these two within 2% (:data:`MIRROR_RTOL`: marching
-cubes draws other diagonals on the same staircase), their volume and triangle
+cubes draws other diagonals on the same staircase) on the balls, boxes and
+cylinders of 4 voxels of equivalent radius or more, their volume and triangle
 area within 1e-6.
 """
 
@@ -272,6 +273,12 @@ RELATION_RTOL = 1e-6
 #: share (a pose that reads another surface, as the turned voxel surfaces did: 100-200% of H, is far beyond it),
 #: the volume and the triangles' area within :data:`RELATION_RTOL`.
 MIRROR_RTOL = 0.02
+#: ... on the single solids (ball, box, cylinder) of an equivalent radius of this many voxels (of the largest size)
+#: at least; on smaller ones, and on the blobs of ``many`` (a label of many blobs of a few voxels has a large
+#: equivalent radius), the other diagonals are a share of the surface (seed 444 case 21: a blob transposed, its
+#: median k_min 4.6% apart; case 45: a label of several blobs mirrored, its k_max_p95 5.7%), and only the counts,
+#: the volume and the triangles' area are compared.
+MIRROR_MIN_RADIUS = 4.0
 
 
 def _relation(seed: int, index: int, image, give_spacing: bool):
@@ -364,7 +371,7 @@ def related_image(image, spacing, relation):
     return renumbered, spacing, lookup
 
 
-def relation_broken(table, other, image, spacing, relation, lookup) -> list[str]:
+def relation_broken(kind, table, other, image, spacing, relation, lookup) -> list[str]:
     """The rows of ``table`` and of the related call's ``other`` that should agree and do not."""
     name, value = relation
     label = f"relation {name}"
@@ -386,6 +393,8 @@ def relation_broken(table, other, image, spacing, relation, lookup) -> list[str]
         if name in ("pad", "flip", "transpose") and row.touches_border != twin.touches_border:
             broken.append(f"{label}: label {row.label} touches_border {row.touches_border} -> {twin.touches_border}")
         radius = row.equivalent_radius if np.isfinite(row.equivalent_radius) and row.equivalent_radius > 0 else 1.0
+        exact = ("volume", "area_mesh") + (("area",) if not mirror else ())
+        small = mirror and (kind == "many" or radius < MIRROR_MIN_RADIUS * float(spacing.max()))
         centroid = np.array([row.centroid_0, row.centroid_1, row.centroid_2])
         if name == "pad":
             centroid = centroid + value[:, 0] * spacing
@@ -395,14 +404,14 @@ def relation_broken(table, other, image, spacing, relation, lookup) -> list[str]
             centroid = centroid[list(value)]
         for column in table.columns:
             power = _length_power(column)
-            if power is None:
+            if power is None or (small and column not in exact):
                 continue
             mine = centroid[int(column[-1])] if column.startswith("centroid_") else getattr(row, column)
             theirs = getattr(twin, column) / factor**power
-            if np.isnan(mine) != np.isnan(theirs) and not (mirror and column not in ("volume", "area_mesh")):
+            if np.isnan(mine) != np.isnan(theirs) and not (mirror and column not in exact):
                 broken.append(f"{label}: label {row.label} {column} {mine:.6g} -> {theirs:.6g} (NaN in one)")
             elif np.isfinite(mine) and abs(mine - theirs) > (
-                MIRROR_RTOL if mirror and column not in ("volume", "area_mesh") else RELATION_RTOL
+                MIRROR_RTOL if mirror and column not in exact else RELATION_RTOL
             ) * max(abs(mine), radius**power):
                 broken.append(f"{label}: label {row.label} {column} {mine:.9g} -> {theirs:.9g}")
     return broken
@@ -542,7 +551,7 @@ def run_case(seed, index) -> dict:
                 f"relation {relation[0]}: {type(exc).__name__} where the original succeeded: {str(exc)[:150]}"
             )
         else:
-            broken += relation_broken(table, other, image, spacing, relation, lookup)
+            broken += relation_broken(kind, table, other, image, spacing, relation, lookup)
     return {
         "kind": kind,
         "relation": relation[0] if relation is not None else None,
