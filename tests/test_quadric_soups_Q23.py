@@ -67,16 +67,19 @@ def test_voxel_soup_steps_never_valid_and_far_off(share, gap, seed):
 
 
 def test_closed_mesh_skips_the_wider_ball_of_passed_fits(monkeypatch):
-    """On a closed mesh (no crack) the passed fits stay as the spread read them: the wider ball is fitted only at
-    the rows whose spread failed (the cost of c714c1c's step at every row: nefertiti 1.43x)."""
+    """On a closed mesh of a scan's noise (no crack; a median noise level below ``ROUGH_LEVEL``, as the real meshes of
+    ``../shared/meshes``) the passed fits stay as the spread read them: the wider ball is fitted only at the rows
+    whose spread failed (at every row, c714c1c cost nefertiti 1.43x its CPU for the same valid vertices)."""
     from meshcurv.estimators import quadric
 
-    sphere = shapes.icosphere(subdivisions=8)
+    sphere = shapes.icosphere(subdivisions=16)
     vertices = np.asarray(sphere.vertices, float)
-    rng = np.random.default_rng(5)
     faces = np.asarray(sphere.faces)
     edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
-    vertices = vertices + 0.1 * edge * rng.normal(size=vertices.shape)  # noise of a tenth of an edge
+    # uniform noise of 0.05 edge lengths along the normal: a median level of about 0.012, above the clean level
+    # (the scatter check runs) and below ROUGH_LEVEL
+    offsets = np.random.default_rng(5).uniform(-0.05, 0.05, len(vertices)) * edge
+    vertices = vertices * (1.0 + offsets / np.linalg.norm(vertices, axis=1))[:, None]
     calls = []
     real = quadric.residual_spreads
 
@@ -87,6 +90,6 @@ def test_closed_mesh_skips_the_wider_ball_of_passed_fits(monkeypatch):
     monkeypatch.setattr(quadric, "residual_spreads", counted)
     result = _quadric(vertices, faces)
     assert calls, "the scatter check did not run: no noise read"
-    # the first call fits every checked row; the second (the wider ball) only the rows the spread failed
+    # the first call fits every checked row; a second (the wider ball) only the rows the spread failed
     assert len(calls) == 1 or calls[1] < calls[0]
-    assert result.valid.mean() > 0.9
+    assert result.valid.all()

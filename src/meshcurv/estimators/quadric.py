@@ -193,6 +193,24 @@ RESIDUAL_DOF_FLOOR = 1e-6
 DEPARTURE_SPREADS = 2.0
 
 
+#: A mesh (a group of components of one scale) whose median noise level (:func:`meshcurv.radius.local_noise`) exceeds
+#: this is noisy: its fits that the noise's spread passed are checked against the wider ball's too
+#: (:func:`_scatter_check`, step 5, off cracks). Uniform noise of a tenth of an edge length along the normal reads
+#: 0.022-0.024 (icospheres of 642 and 2,562 vertices), the real meshes of ``../shared/meshes`` 0.004-0.017
+#: (nefertiti 0.0173, rocker-arm 0.0164), which the check cost 1.43x their CPU and changed at a dozen crease
+#: vertices (fandisk, rocker-arm), where ``accuracy.py --quick``'s noisy rows took its gains (a noisy sphere's
+#: median H error 9.8 -> 9.3%).
+ROUGH_LEVEL = 0.02
+
+
+#: The corners of a crack (:func:`_crack_corners`) have another rim vertex within this many local edge lengths: a
+#: face detached by a gap ``g`` (in edge lengths) leaves its corners up to ``2 g`` from its neighbours' (the
+#: fuzzer's 0.03-0.1: 0.06-0.2), where the rim vertices of an open surface lie an edge length apart (its default
+#: ball over a cylinder's or a saddle's rim: 100 -> 33% valid on the noisy coarse cylinder of ``accuracy.py
+#: --quick`` with every rim taken for a crack).
+CRACK_WIDTH = 0.5
+
+
 #: Noise levels up to this read as a clean mesh in :func:`_noise_sigmas`: twice
 #: :data:`meshcurv.radius.NOISE_FLOOR`, as the vertices of a clean irregular mesh read up to 0.006 (a random
 #: ellipsoid of 2,562 points, whose degree-4 jets a noise read from the floor alone sent to quadrics 1.2
@@ -259,8 +277,12 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             curvatures = _curvature_scales(curvedness, scales, vertices, referenced)
             unsure = _noise_reach((vertices, start, radii, referenced, facing), sigmas, curvatures, fields)
         else:  # the default radius: scatter told from structure by the residuals at two scales
-            cracked = _cracked_balls(vertices, radii, rim & referenced)
-            unsure = _scatter_check((vertices, radii, referenced, scales), (sigmas > 0, noisy, cracked), fields)
+            corners = _crack_corners(vertices, rim & referenced, mesh.scale_edge_means)
+            cracked = _cracked_balls(vertices, radii, corners)
+            with np.errstate(invalid="ignore"):  # a noisy mesh: its group's median level above ROUGH_LEVEL
+                rough = _group_medians(levels, scales, np.isfinite(levels)) > ROUGH_LEVEL
+            checks = (sigmas > 0, noisy, cracked, rough)
+            unsure = _scatter_check((vertices, radii, referenced, scales), checks, fields)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -546,8 +568,9 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     :data:`NOISE_REACH` of their curvature, at their radius and over a grown ball (their coefficients made NaN).
 
     ``ball = (vertices, radii, referenced, groups)`` (``radii``: each vertex's default radius, changed in place where
-    a grown ball's fit is taken); ``checks = (checked, noisy)``: the vertices whose ball reads noise
-    (:func:`_noise_sigmas` above 0), and those above :data:`NOISE_GATE` (:func:`_noisy_balls`);
+    a grown ball's fit is taken); ``checks = (checked, noisy, cracked, rough)``: the vertices whose ball reads noise
+    (:func:`_noise_sigmas` above 0), those above :data:`NOISE_GATE` (:func:`_noisy_balls`), those whose ball holds a
+    crack's corner (:func:`_cracked_balls`) and those of a group whose median level exceeds :data:`ROUGH_LEVEL`;
     ``fields = (six, fitted, coefficients)``, changed in place. A crease is told from scatter by its residuals:
 
     1. at each checked vertex, a quadric over its ball in the frame of its fit (:func:`residual_spreads`, compiled)
@@ -566,16 +589,18 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     4. scatter takes the quadric over a ball grown until its spread (as ``r^-3``) is within the reach, at most
        :data:`meshcurv.radius.JET_CURVATURE_CAP` over its curvedness, if it is; else it is NaN with
        ``valid=False``;
-    5. at the vertices whose ball holds a crack's corner (:func:`_cracked_balls`: a soup's detached faces), a
-       quadric that departs from the wider ball's by more than :data:`DEPARTURE_SPREADS` of its spreads follows the
-       steps (the spread of independent noise underestimates their pull) whatever its residuals did: one that bent
-       to follow a step absorbed its own residuals, and the wider ball's then grew as a crease's would (fuzz
-       415/108: 264 of the 286 vertices left off grew 1.7-3.0 times). It takes the quadric of 4 if steady, else it is
-       NaN with ``valid=False``. Elsewhere (a closed mesh) the wider ball is fitted at the rows 2 failed only: the
-       check at every row cost nefertiti 1.43x its CPU and changed only 14 of fandisk's and 12 of rocker-arm's
-       crease vertices."""
+    5. at the vertices whose ball holds a crack's corner (``cracked``, :func:`_cracked_balls`: a soup's detached
+       faces), a quadric that departs from the wider ball's by more than :data:`DEPARTURE_SPREADS` of its spreads
+       follows the steps (the spread of independent noise underestimates their pull) whatever its residuals did:
+       one that bent to follow a step absorbed its own residuals, and the wider ball's then grew as a crease's would
+       (fuzz 415/108: 264 of the 286 vertices left off grew 1.7-3.0 times). It takes the quadric of 4 if steady,
+       else it is NaN with ``valid=False``. On a noisy mesh (``rough``: its median level above
+       :data:`ROUGH_LEVEL`) off cracks, only while its residuals grew less than :data:`STRUCTURE_GROWTH`, and it
+       keeps its own fit where the grown one is not steady (fandisk's creases: made NaN, 79.98 -> 76.2-79.1%
+       valid). Elsewhere the wider ball is fitted at the rows 2 failed only: at every row it cost nefertiti 1.43x
+       its CPU and changed a dozen crease vertices of fandisk and rocker-arm."""
     vertices, radii, referenced, groups = ball
-    checked, noisy, cracked = checks
+    checked, noisy, cracked, rough = checks
     six, fitted, coefficients = fields
     frames = fitted.copy()  # the frames of the quadrics (the fits' normals as they were)
     unsure = np.zeros(vertices.shape[0], dtype=bool)
@@ -593,7 +618,7 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     # the wider ball where it can change the outcome: the rows the spread failed, and the balls over cracks (a
     # soup's steps), whose passed fits it checks (step 5); elsewhere a passed fit stays, as it did without step 5
     # (nefertiti 1.43x the CPU with the wider ball at every passed row, and the same results)
-    steps = cracked[rows]
+    steps = (cracked | rough)[rows]
     wider = loose | steps
     near = (found[steps], frames[rows[steps]], radii[rows[steps]])
     rows, sigmas, spreads_near, bent, passed, steps = (
@@ -604,6 +629,7 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
         passed[wider],
         steps[wider],
     )
+    over_cracks = cracked[rows]
     if rows.size == 0:
         return unsure
     wide = SCATTER_SCALE * radii[rows]
@@ -614,17 +640,20 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     # residuals did: the spread of independent noise underestimates their pull, and a fit that bent to follow a
     # step absorbed its own residuals, so that the wider ball's grew as a crease's would (fuzz 415/108: 264 of the
     # 286 vertices left off by more than half the largest |k| grew 1.7-3.0 times, departing by 2.7-7.9 spreads)
+    # (on a noisy mesh without cracks, only while its residuals keep their size: a crease's grow)
     following = np.zeros(rows.size, dtype=bool)
     with np.errstate(invalid="ignore"):
         far = (found[steps], frames[rows[steps]], wide[steps])
         following[steps] = _departure(near, far) > DEPARTURE_SPREADS * spreads_near[steps]
+        following &= over_cracks | (growth < STRUCTURE_GROWTH)
     loose = ~passed | following
-    rows, sigmas, spreads_near, growth, passed = (
+    rows, sigmas, spreads_near, growth, passed, over_cracks = (
         rows[loose],
         sigmas[loose],
         spreads_near[loose],
         growth[loose],
         passed[loose],
+        over_cracks[loose],
     )
     found, spreads, wide, following, bent = found[loose], spreads[loose], wide[loose], following[loose], bent[loose]
     if rows.size == 0:
@@ -635,6 +664,9 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         grew = passed | (spreads_near * share <= held)
     structure = grew & ~following
+    # off cracks, a fit that the spread passed but follows its scatter takes a steady wider ball's, and keeps its own
+    # without one (fandisk's creases; NaN gave 76.2-79.1% valid for 79.98)
+    spared = (following & grew & ~over_cracks)[~structure]
     rows, found, spreads, wide = rows[~structure], found[~structure], spreads[~structure], wide[~structure]
     if rows.size == 0:
         return unsure
@@ -655,23 +687,38 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
     six[taken], fitted[taken] = shape_operators(found[steady], (*frame, frames[taken]), wide[steady])
     coefficients[taken] = found[steady]
     radii[taken] = wide[steady]
-    unsure[rows[~steady]] = True
+    unsure[rows[~steady & ~spared]] = True
     coefficients[unsure] = np.nan
     return unsure
 
 
-def _cracked_balls(vertices: np.ndarray, radii: np.ndarray, rim: np.ndarray) -> np.ndarray:
-    """(V,) bool: the vertices whose ball (``radii``, one per vertex) holds a vertex of ``rim`` (a crack's, or a
-    detached face's, corner): where a soup's steps can pull a quadric (:func:`_scatter_check`, step 5). None on a
+def _crack_corners(vertices: np.ndarray, rim: np.ndarray, edge_lengths: np.ndarray) -> np.ndarray:
+    """(V,) bool: the ``rim`` vertices with another rim vertex within :data:`CRACK_WIDTH` of their local edge length
+    (``edge_lengths``, (V,)): the corners of a crack, whose two sides run close (faces detached from their
+    neighbours), not those of an open surface's boundary, whose rim vertices are an edge length apart. None on a
     closed mesh."""
     out = np.zeros(vertices.shape[0], dtype=bool)
-    if not rim.any():
+    ids = np.flatnonzero(rim)
+    if ids.size < 2:
         return out
     from scipy.spatial import cKDTree  # imported on use: scipy.spatial costs import time
 
+    distances = cKDTree(vertices[ids]).query(vertices[ids], k=2)[0][:, 1]  # the nearest other rim vertex
+    out[ids] = distances < CRACK_WIDTH * edge_lengths[ids]
+    return out
+
+
+def _cracked_balls(vertices: np.ndarray, radii: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """(V,) bool: the vertices whose ball (``radii``, one per vertex) holds a crack's corner (``corners``,
+    :func:`_crack_corners`): where a soup's steps can pull a quadric (:func:`_scatter_check`, step 5)."""
+    out = np.zeros(vertices.shape[0], dtype=bool)
+    if not corners.any():
+        return out
+    from scipy.spatial import cKDTree
+
     finite = np.isfinite(radii)
     reach = float(radii[finite].max()) if finite.any() else 0.0
-    distances = cKDTree(vertices[rim]).query(vertices, distance_upper_bound=reach)[0]
+    distances = cKDTree(vertices[corners]).query(vertices, distance_upper_bound=reach)[0]
     return distances < radii
 
 
