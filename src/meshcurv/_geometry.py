@@ -149,38 +149,53 @@ def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     (:func:`meshcurv.geometry.robust_mean_edge_length`)."""
     if edges.shape[0] == 0:
         return 0.0
-    step = max(1, edges.shape[0] // MEDIAN_SAMPLE)
+    step = max(1, edges.shape[0] // MEDIAN_SAMPLE)  # the median is a threshold: a sample will do
     kernels = numba_kernels("geometry")
     if kernels is not None:  # the sample's lengths alone, then the mean and the longest in one pass (issue 31)
         median = float(np.median(edge_lengths(vertices, np.ascontiguousarray(edges[::step]))))
-        mean, longest = kernels._mean_and_longest_edge(vertices, edges)
-        if longest <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean (mean_edge_length's, to the bit)
-            return float(mean)
+        mean, longest = kernels._mean_and_longest_edge(vertices, edges)  # mean_edge_length's mean, to the bit
+        return _mean_within(vertices, edges, OUTLIER_EDGE_RATIO * median, mean, longest)
+    lengths = edge_lengths(vertices, edges)
+    median = float(np.median(lengths[::step]))
+    # lengths.mean(): the NumPy mean_edge_length's, to the bit (the same lengths, the same reduction)
+    return _mean_within(vertices, edges, OUTLIER_EDGE_RATIO * median, lengths.mean(), lengths.max(), lengths)
+
+
+def _mean_within(
+    vertices: np.ndarray, edges: np.ndarray, bound: float, mean, longest, lengths: np.ndarray | None = None
+) -> float:
+    """:func:`robust_mean_edge_length` from the plain ``mean`` and the ``longest`` length of ``edges``: the plain
+    mean where no edge is longer than ``bound``, else the mean of the ``lengths`` (computed here when None) within
+    it."""
+    if longest <= bound:
+        return float(mean)
+    if lengths is None:
         lengths = edge_lengths(vertices, edges)
-    else:
-        lengths = edge_lengths(vertices, edges)
-        median = float(np.median(lengths[::step]))  # a threshold: a sample will do
-        if float(lengths.max()) <= OUTLIER_EDGE_RATIO * median:  # no outlier: the plain mean, to the last bit
-            return mean_edge_length(vertices, edges)
-    kept = lengths[lengths <= OUTLIER_EDGE_RATIO * median]
-    return float(kept.mean())
+    return float(lengths[lengths <= bound].mean())
 
 
 def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
     """(V,) the median edge length of each vertex's component (:func:`meshcurv.geometry.vertex_length_scales`);
     a prepared mesh holds them (:attr:`meshcurv._prepared.PreparedMesh.length_scales`)."""
+    return length_scales_and_median(vertices, topology)[0]
+
+
+def length_scales_and_median(vertices: np.ndarray, topology) -> tuple[np.ndarray, float]:
+    """``(scales, median)``: :func:`vertex_length_scales` and the median length of every edge
+    (:func:`median_edge_length` of ``topology.edges``, to the bit; 0 without edges), which the scales are taken
+    from: a prepared mesh keeps both (:attr:`meshcurv._prepared.PreparedMesh.median_edge_length`)."""
     edges = topology.edges
     n = topology.n_vertices
     if edges.shape[0] == 0:
-        return np.zeros(n)
+        return np.zeros(n), 0.0
     referenced = topology.referenced_vertices
     n_components, labels = topology.vertex_components
     if n_components <= 1:  # one scale: the median of every edge (a sample by index follows the vertex order, and
         # so did the radii that divide local edge lengths by it: nefertiti.obj, fuzz 419/58)
-        overall = float(np.median(edge_lengths(vertices, edges)))
-        return np.where(referenced, overall, 0.0)
+        overall = median_edge_length(vertices, edges)
+        return np.where(referenced, overall, 0.0), overall
     lengths = edge_lengths(vertices, edges)
-    overall = float(np.median(lengths))
+    overall = float(np.median(lengths))  # median_edge_length's
     edge_label = labels[edges[:, 0]]
     positive = lengths > 0
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -188,7 +203,7 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
         typical = log_sums / np.bincount(edge_label[positive], minlength=n_components)
     spread = np.abs(typical[np.isfinite(typical)] - np.log2(overall)) if overall > 0 else np.array([np.inf])
     if spread.size and spread.max() <= np.log2(COMPONENT_SCALE_SPREAD):
-        return np.where(referenced, overall, 0.0)
+        return np.where(referenced, overall, 0.0), overall
     order = np.lexsort((lengths, edge_label))
     counts = np.bincount(edge_label, minlength=n_components)
     starts = np.cumsum(counts) - counts
@@ -198,7 +213,7 @@ def vertex_length_scales(vertices: np.ndarray, topology) -> np.ndarray:
     low = ranked[starts[some] + (counts[some] - 1) // 2]
     high = ranked[starts[some] + counts[some] // 2]
     medians[some] = 0.5 * (low + high)
-    return np.where(referenced, medians[np.maximum(labels, 0)], 0.0)
+    return np.where(referenced, medians[np.maximum(labels, 0)], 0.0), overall
 
 
 def degenerate_face_mask(areas: np.ndarray, length_scale) -> np.ndarray:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 from functools import cached_property
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -40,9 +40,10 @@ from ._geometry import (
     degenerate_faces,
     face_cross_products,
     finite_rows,
+    length_scales_and_median,
+    median_edge_length,
     normalize_normal_sums,
     vertex_edge_lengths,
-    vertex_length_scales,
     vertex_normal_and_area_sums,
 )
 from .orient import ORIENT_CHOICES, oriented_topology
@@ -51,6 +52,15 @@ from .topology import MeshTopology
 from .weld import CRACK_TOLERANCE_RATIO, Welding, drop_closed_copies, drop_double_sided, weld_vertices
 
 __all__ = ["PreparedMesh", "prepare_mesh"]
+
+
+class _FacePass(NamedTuple):
+    """:attr:`PreparedMesh._face_pass`: the (F,) zero-area faces, and what the pass that found them gave on its way:
+    the vertex normals and areas (V, 3) and (V,), or the (F, 3) face cross products (None: not given)."""
+
+    degenerate: np.ndarray
+    normals_and_areas: tuple[np.ndarray, np.ndarray] | None = None
+    cross: np.ndarray | None = None
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -84,6 +94,9 @@ class PreparedMesh:
         (:data:`meshcurv.weld.CRACK_TOLERANCE_RATIO`).
     n_copies : int
         Vertices of closed parts stored twice, measured once (:func:`meshcurv.weld.drop_closed_copies`).
+    known_median : float or None
+        The median length of every edge when the length scales were found with it (None: found on first use,
+        :attr:`median_edge_length`).
     """
 
     vertices: np.ndarray
@@ -98,45 +111,69 @@ class PreparedMesh:
     n_flipped: int = 0
     n_copies: int = 0
     n_cracked: int = 0
+    known_median: float | None = None
 
     @classmethod
     def as_given(cls, vertices: np.ndarray, topology: MeshTopology) -> PreparedMesh:
         """A mesh already checked, taken as it is: not welded, reordered or oriented."""
-        scales, needles = _scales_and_needles(vertices, topology)
-        return cls(vertices, topology, None, Surface(vertices, topology.faces), "keep", scales, needles)
+        scales, needles, median = _scales_and_needles(vertices, topology)
+        return cls(
+            vertices, topology, None, Surface(vertices, topology.faces), "keep", scales, needles, known_median=median
+        )
+
+    @cached_property
+    def median_edge_length(self) -> float:
+        """The median length of every edge (:func:`meshcurv.geometry.median_edge_length`, 0 without edges): the
+        number the length scales of a mesh of one scale are, kept from their computation (the ball widths of icc's
+        coarse level read it: not taken again over 3 E lengths, issue 31)."""
+        if self.known_median is not None:
+            return self.known_median
+        return median_edge_length(self.vertices, self.topology.edges)
 
     @cached_property
     def cross(self) -> np.ndarray:
         """(F, 3) cross products of the faces' sides (twice their area, along their normal); read-only. Kept from
-        the first time they are asked for (those :attr:`degenerate` builds on its way serve the vertex normals and
+        the first time they are asked for (those :attr:`_face_pass` builds on its way serve the vertex normals and
         areas, then go: the default method reads no more of them, and they are 24 bytes a face)."""
-        spare = self.__dict__.pop("_spare_cross", None)
+        spare = self._spare_cross()
         return spare if spare is not None else _read_only(face_cross_products(self.vertices, self.topology.faces))
 
     @cached_property
-    def degenerate(self) -> np.ndarray:
-        """(F,) bool: the zero-area faces (:func:`meshcurv.geometry.degenerate_faces`); read-only. The face cross
-        products come with them (one pass over the faces) unless :attr:`cross` was built first; on a mesh without
-        needles the compiled pass sums the vertex normals and areas instead (:attr:`vertex_normals`, the same
-        sums in the same order)."""
-        if "cross" in self.__dict__:
-            return _read_only(
-                degenerate_faces(self.vertices, self.topology, cross=self.cross, scales=self.length_scales)
-            )
+    def _face_pass(self) -> _FacePass:
+        """The one pass over the faces that finds the zero-area faces (:attr:`degenerate`), and what it gives on
+        its way: on a mesh without needles, the compiled pass sums the vertex normals and areas too (no cross
+        products kept: :attr:`vertex_normals`, the same sums in the same order, issue 31); otherwise the face
+        cross products, unless :attr:`cross` was built first."""
         faces = self.topology.faces
+        if "cross" in self.__dict__:
+            degenerate = degenerate_faces(self.vertices, self.topology, cross=self.cross, scales=self.length_scales)
+            return _FacePass(_read_only(degenerate))
         kernels = numba_kernels("geometry")
         if kernels is not None and not self.needles.any():  # the faces dropped are the zero-area ones (:attr:`dropped`)
-            # their test and the normal and area sums in one pass, no cross products kept (issue 31)
             n = self.vertices.shape[0]
             degenerate, sums, areas = np.zeros(faces.shape[0], dtype=bool), np.zeros((n, 3)), np.zeros(n)
             kernels._degenerate_normal_and_area_sums(
                 self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO, degenerate, sums, areas
             )
-            self.__dict__["_normals_and_areas"] = (_read_only(normalize_normal_sums(sums)), _read_only(areas))
-            return _read_only(degenerate)
+            summed = (_read_only(normalize_normal_sums(sums)), _read_only(areas))
+            return _FacePass(_read_only(degenerate), normals_and_areas=summed)
         cross, degenerate = cross_and_degenerate(self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO)
-        self.__dict__["_spare_cross"] = _read_only(cross)
-        return _read_only(degenerate)
+        return _FacePass(_read_only(degenerate), cross=_read_only(cross))
+
+    def _spare_cross(self) -> np.ndarray | None:
+        """The cross products :attr:`_face_pass` built, handed over once and let go (None: none built, or handed
+        over already)."""
+        made = self.__dict__.get("_face_pass")
+        if made is None or made.cross is None:
+            return None
+        self.__dict__["_face_pass"] = made._replace(cross=None)
+        return made.cross
+
+    @cached_property
+    def degenerate(self) -> np.ndarray:
+        """(F,) bool: the zero-area faces (:func:`meshcurv.geometry.degenerate_faces`); read-only (from
+        :attr:`_face_pass`)."""
+        return self._face_pass.degenerate
 
     @cached_property
     def scale_edge_means(self) -> np.ndarray:
@@ -160,10 +197,16 @@ class PreparedMesh:
 
     @cached_property
     def _normals_and_areas(self) -> tuple[np.ndarray, np.ndarray]:
-        """:attr:`vertex_normals` and :attr:`vertex_areas`, from one pass over the faces (the sums of the cross
-        products are not kept); the cross products :attr:`degenerate` built on its way are let go here."""
-        dropped = self.dropped  # the zero-area faces, and with them the cross products unless asked for before
-        cross = self.__dict__.get("cross", self.__dict__.pop("_spare_cross", None))
+        """:attr:`vertex_normals` and :attr:`vertex_areas`: those :attr:`_face_pass` summed, or one pass over the
+        faces' cross products (their sums not kept); the cross products :attr:`_face_pass` built are let go here."""
+        if "_face_pass" in self.__dict__ or "degenerate" not in self.__dict__:  # not given (:meth:`found_degenerate`)
+            summed = self._face_pass.normals_and_areas
+            if summed is not None:  # the face pass summed them (no needle: the faces dropped are its zero-area ones)
+                return summed
+        dropped = self.dropped
+        cross = self.__dict__.get("cross")
+        if cross is None:
+            cross = self._spare_cross()
         if cross is None:  # the zero-area faces were given (:meth:`found_degenerate`)
             cross = face_cross_products(self.vertices, self.topology.faces)
         sums, areas = vertex_normal_and_area_sums(cross, self.topology.faces, dropped, self.vertices.shape[0])
@@ -254,10 +297,11 @@ def _read_only(array: np.ndarray) -> np.ndarray:
     return array
 
 
-def _scales_and_needles(vertices: np.ndarray, topology: MeshTopology) -> tuple[np.ndarray, np.ndarray]:
-    """(V,) the length scales and (V,) the needle vertices (read-only) of a checked mesh."""
-    scales = vertex_length_scales(vertices, topology)
-    return scales, _read_only(_needle_vertices(vertices, topology, scales))
+def _scales_and_needles(vertices: np.ndarray, topology: MeshTopology) -> tuple[np.ndarray, np.ndarray, float]:
+    """(V,) the length scales, (V,) the needle vertices (read-only) and the median length of every edge of a
+    checked mesh."""
+    scales, median = length_scales_and_median(vertices, topology)
+    return scales, _read_only(_needle_vertices(vertices, topology, scales)), median
 
 
 def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: int = 3) -> PreparedMesh:
@@ -303,10 +347,11 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         )
         points, topology = welded.vertices, welded.topology
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
+    median = None  # the median edge: found with the length scales, else on first use
     if one_sided.length_scales is not None and one_sided.needles is not None:  # found on these faces
         scales, needles = one_sided.length_scales, one_sided.needles
     else:
-        scales, needles = _scales_and_needles(points, one_sided.topology)
+        scales, needles, median = _scales_and_needles(points, one_sided.topology)
     topology, n_flipped = oriented_topology(points, one_sided.topology, orient, needles)
     # the row computed for each of the caller's vertices (welded vertices, in the local order)
     index = None if welded is None else welded.index
@@ -332,4 +377,5 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         n_flipped,
         n_copies,
         welded.n_cracked if welded is not None else 0,
+        median,
     )

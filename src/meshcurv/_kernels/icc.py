@@ -64,7 +64,7 @@ def _triangle_measures(points, normals, i, j, k, turn):
 @threaded
 def face_measures(vertices, faces, normals):
     """``measures.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
-    out = np.zeros((faces.shape[0], 9))
+    out = np.empty((faces.shape[0], 9))  # every element written by its chunk: no fill (calloc's memset on reused pages)
     chunks = _CHUNKS_PER_THREAD * nb.get_num_threads()
     run_chunks(_face_measures_chunk, faces.shape[0], chunks, vertices, faces, normals, out)
     return out
@@ -90,8 +90,8 @@ def _face_measures_chunk(lo, hi, vertices, faces, normals, out):
 def curvatures_from_measures(summed, normals):
     """``measures.curvatures_from_measures``: (N,) k_min, k_max and (N, 3) dir_min, dir_max of summed measures."""
     n = summed.shape[0]
-    # zeros (pages not touched here); each chunk writes every row of its own, NaN where undefined: no serial fill
-    out = (np.zeros(n), np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3)))
+    # each chunk writes every row of its own, NaN where undefined: no fill, serial or calloc's (issue 31)
+    out = (np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)))
     run_chunks(_curvatures_chunk, n, _CHUNKS_PER_THREAD * nb.get_num_threads(), summed, normals, *out)
     return out
 
