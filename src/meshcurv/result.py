@@ -180,16 +180,26 @@ class CurvatureResult:
         ``arctan2`` so that umbilics give +-1. With meshcurv's signs (convex
         outward = positive curvature): +1 a cap (sphere seen from outside),
         +1/2 a ridge (cylinder), 0 a symmetric saddle, -1/2 a rut, -1 a cup.
-        Flipping the faces negates it. NaN where the surface is flat
-        (``curvedness == 0``) or the estimate is invalid.
+        Flipping the faces negates it. NaN where the estimate is invalid and
+        where the surface is flat: its curvedness times the scale of the
+        estimate (``radius``, or the square root of the vertex's area on a mesh
+        without one) below :data:`FLAT_CURVEDNESS`, where the curvatures are the
+        round-off of their sums and their ratio any number (the flat sides of a
+        voxel blob: 1e-14 of 1/h, whose shape index took any value in [-1, 1]
+        and moved a label's shape-index columns under a change of spacing).
+        Without a scale (a result built directly), flat is ``curvedness == 0``.
 
         J. J. Koenderink and A. J. van Doorn (1992). Surface shape and curvature
         scales. Image and Vision Computing 10(8), 557-564.
         https://doi.org/10.1016/0262-8856(92)90076-F
         """
-        with np.errstate(invalid="ignore"):
-            index = (2 / np.pi) * np.arctan2(self.k_max + self.k_min, self.k_max - self.k_min)
-        return _readonly(np.where(self.curvedness > 0, index, np.nan))
+        if self.radius is not None:
+            scale = self.radius
+        elif self._surface is not None:
+            scale = np.sqrt(self.vertex_areas)
+        else:
+            scale = None
+        return _readonly(shape_index(self.k_min, self.k_max, scale))
 
     @cached_property
     def curvedness(self) -> np.ndarray:
@@ -427,6 +437,31 @@ class Surface:
         out = np.zeros(result.n_vertices, dtype=np.float64)
         out[rows] = shares
         return out
+
+
+#: A vertex is flat where its curvedness times the scale of its estimate is below this: a radius of curvature
+#: a billion times the ball's, which no estimate in double precision tells from a plane (:func:`shape_index`).
+FLAT_CURVEDNESS = 1e-9
+
+
+def shape_index(k_min, k_max, scale=None) -> np.ndarray:
+    """(V,) the shape index of principal curvatures ``k_min, k_max`` (V,), NaN where flat or NaN.
+
+    Flat: the curvedness times ``scale`` (V,), the length over which each vertex was measured, below
+    :data:`FLAT_CURVEDNESS` (or where it is 0 exactly, wherever the scale is not a positive finite number,
+    and everywhere when ``scale`` is None). One definition for :attr:`CurvatureResult.shape_index` and the
+    statistics' columns (:mod:`meshcurv.statistics`, :func:`meshcurv.label_curvatures`).
+    """
+    k_min, k_max = np.asarray(k_min, dtype=np.float64), np.asarray(k_max, dtype=np.float64)
+    curvedness = np.sqrt((k_min**2 + k_max**2) / 2)
+    floor = np.zeros_like(curvedness)
+    if scale is not None:
+        scale = np.broadcast_to(np.asarray(scale, dtype=np.float64), curvedness.shape)
+        usable = np.isfinite(scale) & (scale > 0)
+        np.divide(FLAT_CURVEDNESS, scale, out=floor, where=usable)
+    with np.errstate(invalid="ignore"):
+        index = (2 / np.pi) * np.arctan2(k_max + k_min, k_max - k_min)
+        return np.where((curvedness > floor) & (curvedness > 0), index, np.nan)
 
 
 def _rebuild(cls, fields):

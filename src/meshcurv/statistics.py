@@ -133,11 +133,12 @@ def _split(masses: np.ndarray, signs: np.ndarray) -> tuple[float, float, float, 
 
 
 def _region_statistics(
-    k_min, k_max, used, weights, face_measures_in, face_mean_sign, gaussian_shares, gaussian_sign
+    k_min, k_max, shape_index, used, weights, face_measures_in, face_mean_sign, gaussian_shares, gaussian_sign
 ) -> dict[str, float]:
     """The :data:`COLUMNS` of one region of a surface, from its pieces (shared by the mesh and the label table).
 
-    ``k_min, k_max`` (V,) pointwise, NaN where invalid; ``used`` (V,) the
+    ``k_min, k_max`` (V,) pointwise, NaN where invalid, and ``shape_index`` (V,) theirs
+    (:attr:`meshcurv.CurvatureResult.shape_index`: NaN where flat); ``used`` (V,) the
     vertices of the moments, ``weights`` (V,) their areas; ``face_measures_in``
     (F', 2) ``mu_0, mu_1`` of the faces of the region, ``face_mean_sign`` (F',)
     the pointwise H averaged over their corners; ``gaussian_shares`` (V',) the
@@ -148,8 +149,7 @@ def _region_statistics(
     k_max = np.asarray(k_max, dtype=np.float64)
     mean, gaussian = (k_min + k_max) / 2, k_min * k_max
     curvedness = np.sqrt((k_min**2 + k_max**2) / 2)
-    with np.errstate(invalid="ignore"):
-        shape_index = np.where(curvedness > 0, (2 / np.pi) * np.arctan2(k_max + k_min, k_max - k_min), np.nan)
+    shape_index = np.asarray(shape_index, dtype=np.float64)
     fields = dict(zip(FIELDS, (mean, gaussian, k_min, k_max, shape_index, curvedness), strict=True))
     row: dict[str, float] = {}
     for name in FIELDS:
@@ -293,6 +293,7 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
     rows = surface.rows
     valid = np.asarray(result.valid)[rows]
     k_min, k_max = np.asarray(result.k_min)[rows], np.asarray(result.k_max)[rows]
+    shape_index = np.asarray(result.shape_index)[rows]
     region = region[rows]
     normals = None if result.method == "matgeom" else np.where(valid[:, None], np.asarray(result.normals)[rows], np.nan)
     normals = _unit_normals(vertices, faces, normals)
@@ -313,7 +314,7 @@ def curvature_statistics(result, *, where=None) -> dict[str, float]:
     )
     mean_integrand = (measures[inside], _face_average((k_min + k_max) / 2, faces[inside]))
     gaussian_integrand = (gaussian_shares[region], (k_min * k_max)[region])
-    row = _region_statistics(k_min, k_max, used, weights, *mean_integrand, *gaussian_integrand)
+    row = _region_statistics(k_min, k_max, shape_index, used, weights, *mean_integrand, *gaussian_integrand)
     note = _fold_note(row, k_min, k_max, used, weights)
     if note:
         warnings.warn(f"curvature_statistics: {note}", MeshQualityWarning, stacklevel=2)

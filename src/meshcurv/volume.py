@@ -737,6 +737,7 @@ def _crop_label(label, padded, starts, stops, image_shape, spacing, method, radi
     statistics = _region_statistics(
         result.k_min,
         result.k_max,
+        result.shape_index,
         used,
         vertex_areas,
         measures[inside_faces, :2],
