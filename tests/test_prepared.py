@@ -178,7 +178,8 @@ def test_the_length_scales_and_needle_vertices_are_found_once_per_call(method):
             found.append(meshcurv.principal_curvatures(vertices, faces, method=method))
 
     n_needles = _entered(defects._needle_vertices.__code__, call)  # the core: the checked shell is not called
-    n_scales = _entered(_geometry.vertex_length_scales.__code__, call)
+    # every computation of the scales enters their core (prepare_mesh keeps the median edge found with them)
+    n_scales = _entered(_geometry.length_scales_and_median.__code__, call)
     assert (n_needles, n_scales) == (1, 1)
     assert found[0].invalid_reason[5] == defects.NEEDLE and found[0].diagnosis.n_needle_vertices == 1
 
