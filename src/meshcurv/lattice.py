@@ -20,7 +20,10 @@ round-off, faces detached by a fraction of an edge, noise): the coordinates
 along each axis crowd about evenly spaced planes, which the modulus of the mean
 of ``exp(2 pi i x / s)`` finds (:func:`_periodic_planes`); a mesh is then a voxel
 surface when nearly all its vertices have two coordinates within
-:data:`VOXEL_SNAP` of a plane.
+:data:`VOXEL_SNAP` of a plane. A grid turned off the coordinate axes is read
+in its own: for a mesh, the frame its triangles' sides lie in
+(:func:`_turned_frame`), for a cloud, that of its flat facets
+(:func:`_lattice_frame`).
 """
 
 from __future__ import annotations
@@ -225,6 +228,9 @@ class VoxelGrid(NamedTuple):
     noise : float
         The spread of the coordinates about their planes for which that tolerance was widened (a length: 1.4826
         times their median distance to them, the least of the three axes'); 0 where it was not.
+    frame : ndarray of shape (3, 3), optional
+        The grid's axes as rows (an image turned off the coordinate axes, see :func:`_turned_frame`); None: x, y
+        and z. ``spacing``, ``origin`` and ``tolerance`` are along these axes.
     """
 
     spacing: np.ndarray
@@ -232,6 +238,22 @@ class VoxelGrid(NamedTuple):
     fraction: float
     tolerance: np.ndarray = _EXACT
     noise: float = 0.0
+    frame: np.ndarray | None = None
+
+    def along(self, vectors: np.ndarray) -> np.ndarray:
+        """The ``vectors`` turned into the grid's axes (its ``frame``), those its ``spacing`` is read along.
+
+        Parameters
+        ----------
+        vectors : ndarray of shape (..., 3)
+            Points or normals in x, y and z.
+
+        Returns
+        -------
+        ndarray of shape (..., 3)
+            ``vectors @ frame.T``; ``vectors`` itself for a grid along x, y and z (no ``frame``).
+        """
+        return Lattice.along(self, vectors)  # type: ignore[arg-type]  # (it reads the frame only)
 
 
 #: :func:`_plane_lattice` reads each candidate's lattice on this many planes more than 1.25 times the share it may
@@ -337,7 +359,8 @@ def voxel_grid(
     VoxelGrid or None
         The spacing and origin of the grid when at least :data:`GRID_FRACTION`
         of the vertices have two or more coordinates on it along every axis
-        (marching cubes: exactly two; voxel faces: three); None otherwise.
+        (marching cubes: exactly two; voxel faces: three); None otherwise. Its
+        ``frame`` is None unless the grid is turned off the coordinate axes.
 
     Notes
     -----
@@ -351,10 +374,17 @@ def voxel_grid(
     :data:`GRID_FRACTION` of the faces within one voxel (as marching cubes
     makes them: a height field sampled on a grid has its x and y there, and
     its faces across the planes of its heights). A
-    surface moved by a translation is on a grid of another origin; a rotated
-    one only while the rotation moves its vertices by less than about a
-    hundredth of a voxel (1e-3 radians on a sphere of radius 10 voxels; its
-    grid is then not along the coordinate axes).
+    surface moved by a translation is on a grid of another origin. A turned
+    one (an image whose affine has a rotation) is read, where given its
+    ``faces`` and on no grid along the coordinate axes, in the frame of the
+    sides of its triangles (:func:`_turned_frame`: a marching-cubes triangle's
+    sides lie in the voxels' faces, at right angles to an axis of the grid),
+    by the same two readings: the exact one on its coordinates rounded to
+    :data:`VOXEL_ROUNDING` of their largest, then the periodic one. Its
+    ``frame`` holds the grid's axes, along which ``spacing`` is read; the
+    frame of the image's own axes turned, to round-off on an exact grid
+    (``tests/test_turned_voxel.py``). Smooth meshes find no frame (most of
+    them: within 2 ms for a few thousand vertices) or no grid in it.
 
     Examples
     --------
@@ -370,6 +400,22 @@ def voxel_grid(
         return exact
     if spacing is None:
         spacing = float(np.median(np.linalg.norm(vertices[faces[:, 1]] - vertices[faces[:, 0]], axis=1)))
+    grid = _faces_voxel_grid(vertices, faces, spacing)
+    if grid is not None:
+        return grid
+    # a grid turned off the coordinate axes (an image whose affine has a rotation): read in its own axes, the same
+    # two readings; the exact one on the coordinates rounded to their round-off (a plane's coordinates, turned, agree
+    # to a few last bits)
+    frame = _turned_frame(vertices, faces)
+    if frame is None:
+        return None
+    turned = vertices @ frame.T
+    grid = _exact_voxel_grid(_rounded(turned)) or _faces_voxel_grid(turned, faces, spacing)
+    return None if grid is None else grid._replace(frame=frame)
+
+
+def _faces_voxel_grid(vertices: np.ndarray, faces: np.ndarray, spacing: float) -> VoxelGrid | None:
+    """:func:`voxel_grid`'s periodic reading along the coordinate axes, with its faces' test (see its Notes)."""
     grid = _periodic_voxel_grid(vertices, spacing)
     if grid is None:
         return None
@@ -381,6 +427,160 @@ def voxel_grid(
     low = np.floor(cells.min(axis=1) + slack)
     within = (cells.max(axis=1) <= low + 1 + slack).all(axis=1)
     return grid if within.mean() >= GRID_FRACTION else None
+
+
+#: A mesh's grid turned off the coordinate axes is read in the frame of its edges (:func:`_turned_frame`): each side
+#: of a marching-cubes triangle joins two edges of one voxel's face but the few across a voxel, so that it lies in a
+#: plane at right angles to an axis of the grid (a binary mask's isosurface: 80-90% of them; a smooth image's, a
+#: signed distance: 65%). Of the sides of at most :data:`VOXEL_FRAME_FACES` faces, evenly spaced,
+#: :data:`VOXEL_FRAME_PAIRS` pairs (drawn with a fixed seed) give the directions at right angles to both (their
+#: sides at least :data:`VOXEL_FRAME_SINE` apart) ...
+VOXEL_FRAME_FACES = 512
+VOXEL_FRAME_PAIRS = 384
+VOXEL_FRAME_SINE = 0.1
+
+#: ... grouped within this angle (radians; the sides of a grid moved by a hundredth of a voxel turn by 0.02): two sides
+#: in one voxel face give the axis at right angles to it ...
+VOXEL_FRAME_ANGLE = 0.05
+
+#: ... the mesh is on no turned grid unless its largest group holds this share of the pairs (each axis of a grid: about
+#: the square of the share of sides at right angles to it, 0.05 to 0.13 on the marching cubes of spheres and
+#: ellipsoids; the icospheres, ``spot``, ``rocker-arm``, ``nefertiti``, ``igea``: 0.02 at most, most none: the quick
+#: reject) ...
+VOXEL_FRAME_GROUP = 0.03
+
+#: ... each of the :data:`VOXEL_FRAME_AXES` largest groups' direction is refitted to the sides at right angles to it
+#: (least squares, within the angle, then within :data:`VOXEL_FRAME_SPREAD` robust spreads of their angles, at least
+#: round-off), and the frame is the three of them at right angles to each other (within the angle; or two and their
+#: cross product) at right angles to which the most sides are, at least :data:`VOXEL_FRAME_SHARE` of them (the grid's
+#: axes, not its diagonals: the planes through two axes' diagonals hold the sides across voxels only). Its axes are
+#: then refitted over the sides of every face.
+VOXEL_FRAME_AXES = 6
+VOXEL_FRAME_SPREAD = 8.0
+VOXEL_FRAME_SHARE = 0.5
+
+#: ... each fit over sides that span the plane (see :func:`_refitted_axis`).
+VOXEL_FRAME_SPAN = 0.05
+
+
+def _turned_frame(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray | None:
+    """(3, 3) the axes (rows, orthonormal) of a grid turned off the coordinate axes that the sides of the ``faces``
+    (F, 3) over ``vertices`` (V, 3) lie at right angles to (see :data:`VOXEL_FRAME_FACES`), or None.
+
+    The frame is a proposal: the mesh is a voxel surface only where the grid is read in it (:func:`voxel_grid`).
+    Its rows are ordered and signed to lie nearest x, y and z.
+    """
+    sides = _unit_sides(vertices, faces[_evenly(np.arange(len(faces)), VOXEL_FRAME_FACES)])
+    if sides.shape[0] < 16:
+        return None
+    first, second = np.random.default_rng(0).integers(0, sides.shape[0], (2, VOXEL_FRAME_PAIRS))
+    across = np.cross(sides[first], sides[second])
+    sines = np.linalg.norm(across, axis=1)
+    across = across[sines >= VOXEL_FRAME_SINE] / sines[sines >= VOXEL_FRAME_SINE, None]
+    # (the products of the three components summed: no BLAS call for a few hundred rows, whose threads cost more)
+    gram = sum(np.multiply.outer(across[:, k], across[:, k]) for k in range(3))
+    close = np.abs(gram) >= np.cos(VOXEL_FRAME_ANGLE)
+    left = np.ones(across.shape[0], dtype=bool)
+    axes: list[tuple[np.ndarray, float]] = []
+    while len(axes) < VOXEL_FRAME_AXES and left.any():  # the largest group of directions left, its axis
+        counts = (close & left).sum(axis=1) * left
+        best = int(np.argmax(counts))
+        if counts[best] < VOXEL_FRAME_GROUP * VOXEL_FRAME_PAIRS:
+            break
+        members = close[best] & left
+        left &= ~members
+        axis = (across[members] * np.sign(across[members] @ across[best])[:, None]).sum(axis=0)
+        found = _refitted_axis(sides, axis / np.linalg.norm(axis), np.sin(VOXEL_FRAME_ANGLE))
+        if found is not None:
+            axes.append(found)
+    frame, bounds = _orthogonal_axes(sides, axes)
+    if frame is None:
+        return None
+    every = _unit_sides(vertices, faces)
+    for k in range(3):  # (a few thousand sides fit an axis to a thousandth of their scatter; every side, finer)
+        found = _refitted_axis(every, frame[k], bounds[k])
+        frame[k] = frame[k] if found is None else found[0]
+    left_vectors, _, right_vectors = np.linalg.svd(frame)  # the nearest orthonormal axes
+    frame = left_vectors @ right_vectors
+    order = [int(np.argmax(np.abs(frame[:, k]))) for k in range(3)]
+    if sorted(order) != [0, 1, 2]:
+        order = [0, 1, 2]  # (no row nearest each axis: their order as found)
+    frame = frame[order]
+    return frame * np.where(np.diag(frame) < 0, -1.0, 1.0)[:, None]
+
+
+def _unit_sides(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(M, 3) the unit directions of the sides of ``faces`` (F, 3) but those of length 0."""
+    corners = vertices[faces]
+    sides = np.concatenate(
+        [corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 1], corners[:, 0] - corners[:, 2]]
+    )
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        sides = sides / np.linalg.norm(sides, axis=1, keepdims=True)
+    return sides[np.isfinite(sides).all(axis=1)]
+
+
+def _orthogonal_axes(sides: np.ndarray, axes: list) -> tuple:
+    """``(frame, bounds)``: of the ``axes`` (``(axis, bound)`` each, :func:`_refitted_axis`), the three at right angles
+    to each other (or two and their cross product) at right angles to which the most of the unit ``sides`` (N, 3)
+    are (each within its bound), at least :data:`VOXEL_FRAME_SHARE` of them; ``(None, None)`` where none are."""
+    right = np.sin(VOXEL_FRAME_ANGLE)
+    best = VOXEL_FRAME_SHARE
+    found: tuple = (None, None)
+    for a, b in itertools.combinations(range(len(axes)), 2):
+        (first, first_bound), (second, second_bound) = axes[a], axes[b]
+        if abs(first @ second) > right:
+            continue
+        third = np.cross(first, second)
+        third /= np.linalg.norm(third)
+        # the cross product, or a group's axis along it (fitted, as the two others)
+        aligned = np.cos(VOXEL_FRAME_ANGLE)
+        thirds = [
+            (third, right),
+            *(axes[c] for c in range(len(axes)) if c not in (a, b) and abs(axes[c][0] @ third) >= aligned),
+        ]
+        for last, last_bound in thirds:
+            frame, bounds = np.array([first, second, last]), np.array([first_bound, second_bound, last_bound])
+            share = float((np.abs(sides @ frame.T) <= bounds).any(axis=1).mean())
+            if share > best:
+                best, found = share, (frame, bounds)
+    return found
+
+
+def _refitted_axis(sides: np.ndarray, axis: np.ndarray, bound: float, *, steps: int = 3):
+    """``(axis, bound)``: the direction (3,) at right angles to most of the unit ``sides`` (N, 3) within ``bound`` (the
+    sine of an angle) of right angles to ``axis`` (3,), by least squares over them, then (``steps`` fits in all) over
+    those within :data:`VOXEL_FRAME_SPREAD` robust spreads of its own, at least round-off; None when fewer than three
+    sides are held, or they lie along one direction (the smaller of their two spreads in the plane below
+    :data:`VOXEL_FRAME_SPAN` of their number: no plane; a later fit's: the previous one kept)."""
+    found = None
+    for _ in range(steps):
+        held = np.abs(sides @ axis) <= bound
+        if held.sum() < 3:
+            break
+        values, vectors = np.linalg.eigh(sides[held].T @ sides[held])
+        if values[1] < VOXEL_FRAME_SPAN * held.sum():
+            break
+        axis = vectors[:, 0] * (1.0 if vectors[:, 0] @ axis >= 0 else -1.0)
+        off = np.abs(sides[held] @ axis)
+        bound = min(bound, max(VOXEL_FRAME_SPREAD * 1.4826 * float(np.median(off)), 64 * np.finfo(float).eps))
+        found = (axis, bound)
+    return found
+
+
+def _rounded(points: np.ndarray) -> np.ndarray:
+    """``points`` (N, 3) rounded to a power of two near :data:`VOXEL_ROUNDING` of their largest |coordinate|:
+    the coordinates of one plane of a grid, turned into its axes, equal again (they differed by round-off)."""
+    largest = float(np.abs(points).max())
+    if not (np.isfinite(largest) and largest > 0.0):
+        return points
+    quantum = 2.0 ** np.ceil(np.log2(VOXEL_ROUNDING * largest))
+    return np.round(points / quantum) * quantum
+
+
+#: See :func:`_rounded`: far above the round-off of a turn (a few units of 1e-16), far below the distance between two
+#: interpolated coordinates (1e-10 of the extent would take a billion voxels across).
+VOXEL_ROUNDING = 1e-11
 
 
 def _exact_voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:

@@ -277,7 +277,7 @@ def _steps_on_grid(mesh: PreparedMesh, found) -> int:
     topology = mesh.topology
     grid, on_grid = found
     spacing = np.asarray(grid.spacing, dtype=np.float64)
-    used = mesh.vertices[on_grid]
+    used = grid.along(mesh.vertices[on_grid])  # (the bounding box in the grid's axes: the same in every pose)
     edge = median_edge_length(mesh.vertices, topology.edges)
     if used.shape[0] == 0 or not edge > 0 or not np.all(spacing > 0):
         return 0
