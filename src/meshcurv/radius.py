@@ -301,8 +301,74 @@ NOISE_FLOOR = 0.005
 #: Growth of the default radius, in edge lengths, with the square root of the noise above the floor.
 NOISE_GAIN = 9.0
 
-#: The noise level of a larger mesh is measured on this many of its vertices, evenly spaced in index order.
+#: The noise level of a larger mesh is measured on about this many of its vertices, chosen by an intrinsic key
+#: (:func:`_intrinsic_sample`).
 NOISE_SAMPLE = 65536
+
+#: The grids of :func:`_intrinsic_sample`'s keys: the local length in its mean, rounded to ``2^-10`` ...
+SAMPLE_LOCAL_STEP = 2.0**-10
+#: ... and the squared distance to the centroid in its mean, rounded to ``2^-16``. A key changes under a motion only
+#: for a value within its round-off of the middle of two steps. A shift far from the origin makes that round-off
+#: far larger than ``1e-16``: igea (134,345 vertices, edges of 5e-4) shifted by 14 units has edge lengths good to
+#: 4e-12 of themselves, and with the first steps (``2^-16``, ``2^-20``) one vertex changed class, the noise fits
+#: changed, and 32,008 vertices' noisy-patch radii with them; at these a class changes for about one vertex in
+#: 1e8 (local lengths: ``2 * 4e-12 / 2^-10``; distances, good to 4e-14: ``1e-9``).
+SAMPLE_DISTANCE_STEP = 2.0**-16
+
+
+def _intrinsic_sample(points: np.ndarray, local: np.ndarray, size: int) -> np.ndarray:
+    """(M,) bool: about ``size`` of the rows of ``points`` (M, 3), chosen by what rigid motions, uniform scaling and
+    re-indexing keep; ``local`` (M,): a positive length of each point that the motions carry with it (a vertex's
+    mean edge length, a point's spacing). All of them when there are no more than ``size``.
+
+    Each point's key is its ``local`` length in their mean, rounded to :data:`SAMPLE_LOCAL_STEP`, and its squared
+    distance to the points' centroid in their mean, rounded to :data:`SAMPLE_DISTANCE_STEP`; the points are taken
+    by whole classes of one key, in the order of a hash of the key (splitmix64's finalizer: the classes taken are
+    spread over the surface and over the scales), until at least ``size`` are.
+
+    Why: the median of a sample "evenly spaced in index order" changed with the index, and the index with the
+    pose (the vertices are reordered along a Morton curve of their coordinates): nefertiti's vertices as a point
+    cloud, turned, read a noise level of 0.01929 instead of 0.01891 and a default radius 0.5% larger at every
+    point. A hash of the coordinates' bits was free of the order but not of the pose. Both quantities of the key
+    are invariant to round-off (means, not a sample's); a point changes class only when one lies within round-off
+    of the middle of two steps of its grid (:data:`SAMPLE_DISTANCE_STEP`). Both are needed:
+    a clean sphere's points are all at one distance from the centroid (the local lengths split them), a voxel
+    surface's have one of a few edge lengths or spacings (the distances split them). A symmetric shape ties whole
+    orbits (an icosphere's 60 or 120 vertices alike): they are taken or left together, so the sample exceeds
+    ``size`` by less than the largest class; a sample of some of them would be chosen by their index again. The
+    key costs 0.03 s of CPU on a million points (the 65,536 fits it chooses: 0.25 s).
+    """
+    m = points.shape[0]
+    if m <= size:
+        return np.ones(m, dtype=bool)
+    # the centroid refined by the mean offset from a first guess: a shifted cloud's sum of coordinates far from the
+    # origin (igea moved by 14 units) is good to 1e-9 of its extent, the offsets' pairwise sum (a column at a time:
+    # no (M, 3) temporary) to 1e-15
+    guess = np.einsum("ij->j", points) / m
+    squared = np.zeros(m)
+    for axis in range(3):
+        offsets = points[:, axis] - guess[axis]
+        offsets -= offsets.sum() / m
+        squared += offsets * offsets
+    spread = squared.mean()
+    # (capped at 2^40 steps: a cast of a larger float is undefined; such outliers share a class)
+    first = np.rint(np.minimum(local / (local.mean() * SAMPLE_LOCAL_STEP), 2.0**40)).astype(np.int64)
+    second = np.rint(np.minimum(squared / (spread * SAMPLE_DISTANCE_STEP), 2.0**40)) if spread > 0 else np.zeros(m)
+    with np.errstate(over="ignore"):
+        keys = _mixed(first.view(np.uint64) * np.uint64(0x9E3779B97F4A7C15) + second.astype(np.uint64))
+    last = np.partition(keys, size - 1)[size - 1]
+    return keys <= last
+
+
+def _mixed(values: np.ndarray) -> np.ndarray:
+    """splitmix64's finalizer of (M,) uint64 ``values``, wrapping (in place): nearby keys land far apart."""
+    with np.errstate(over="ignore"):
+        values ^= values >> np.uint64(30)
+        values *= np.uint64(0xBF58476D1CE4E5B9)
+        values ^= values >> np.uint64(27)
+        values *= np.uint64(0x94D049BB133111EB)
+        values ^= values >> np.uint64(31)
+    return values
 
 
 def noise_level(
@@ -327,9 +393,11 @@ def noise_level(
     resolution varies (a decimated model, 40x between its shortest and longest
     edges) from reading its fine detail as noise at the scale of its mean edge.
     On a mesh of more than :data:`NOISE_SAMPLE` valid vertices, the median is
-    taken over that many of them, evenly spaced in index order (the median of
-    65536 draws is within about 1% of that of all vertices; a re-indexing then
-    changes the level, and the default radius, by that much). A fit whose first
+    taken over about that many of them, chosen by a key that neither the pose
+    nor the index changes (:func:`_intrinsic_sample`; the median of 65536 draws
+    is within about 1% of that of all vertices, and a sample evenly spaced in
+    index order moved the level, and the default radius, by that much under a
+    rotation, whose Morton order re-indexes the vertices). A fit whose first
     frame is settled (:data:`NORMAL_SETTLED`) is not refitted in its own frame, as
     for the normals: the level moves by less than 0.1% (7e-4 at most on clean and
     noisy spheres and tori; none above 0.02 h of noise), and a clean mesh needs
@@ -354,7 +422,11 @@ def _noise_level(
     local = vertex_edge_lengths(vertices, edges, vertices.shape[0]) if local is None else local
     centres = np.flatnonzero(valid & (local > 0))
     if centres.size > NOISE_SAMPLE:
-        centres = centres[np.linspace(0, centres.size - 1, NOISE_SAMPLE).round().astype(np.int64)]
+        every = centres.size == vertices.shape[0]  # (no copy of a million rows to key them all)
+        chosen = _intrinsic_sample(
+            vertices if every else vertices[centres], local if every else local[centres], NOISE_SAMPLE
+        )
+        centres = centres[chosen]
     if centres.size == 0:
         return 0.0
     offsets, curvedness = _noise_fits(
@@ -1268,7 +1340,8 @@ CLOUD_RADIUS_RULES = {"corrected_measures": (3.0, 11.0), "jets": (3.0, 22.0)}
 #: A cloud's noise level is measured with degree-2 jets over balls of this many spacings ...
 CLOUD_NOISE_FIT_RADIUS = 3.0
 
-#: ... on at most this many points, evenly spaced in index order ...
+#: ... on about this many points (at least), chosen by a key that neither the pose nor the index changes
+#: (:func:`_intrinsic_sample`) ...
 CLOUD_NOISE_SAMPLE = 16384
 
 #: ... and is their median over the balls fitted on one side, when at least this many are (or half of the sample,
@@ -1283,7 +1356,9 @@ CLOUD_EXTENT_CAP = 0.25
 def cloud_noise_level(points, normals, spacing, centres, usable, *, facing=None) -> float:
     """Median distance of the points to degree-2 jets over :data:`CLOUD_NOISE_FIT_RADIUS` spacings, in spacings.
 
-    ``centres`` are the usable points, of which at most :data:`CLOUD_NOISE_SAMPLE`, evenly spaced, are fitted.
+    ``centres`` are the usable points, of which about :data:`CLOUD_NOISE_SAMPLE` are fitted, chosen by their
+    spacing (the distance to their nearest neighbour among ``usable``) and their distance to the centres'
+    centroid (:func:`_intrinsic_sample`): the level is the same in every pose and order of the points.
     A ball holding points that face away from its centre (more than :data:`meshcurv.jets.AWAY_FRACTION` of it,
     the ``facing`` check of :func:`meshcurv.jets.fit_jets`: the other face of a part thinner than the ball, or
     another part) is not fitted: a jet through both faces of a plate reads half its thickness as noise, and the
@@ -1331,13 +1406,17 @@ def cloud_noise_level(points, normals, spacing, centres, usable, *, facing=None)
     return _cloud_noise_level(points, normals, spacing, centres, usable, facing)
 
 
-def _cloud_noise_level(points, normals, spacing: float, centres, usable, facing, problems=None) -> float:
+def _cloud_noise_level(points, normals, spacing: float, centres, usable, facing, problems=None, *, local=None) -> float:
     """:func:`cloud_noise_level` of checked arrays; where it is NaN, the note of the call is added to ``problems``
-    (a list)."""
-    taken = np.linspace(0, centres.size - 1, min(centres.size, CLOUD_NOISE_SAMPLE)).round().astype(np.int64)
-    sample = centres[taken]
-    if spacing <= 0 or sample.size == 0:
+    (a list). ``local`` (P,): each point's own spacing, the key of the sample (:func:`_intrinsic_sample`; default:
+    the distance to its nearest neighbour among ``usable``)."""
+    if spacing <= 0 or centres.size == 0:
         return 0.0
+    sample = centres
+    if centres.size > CLOUD_NOISE_SAMPLE:
+        lengths = _nearest_distances(points, centres, usable) if local is None else local[centres]
+        positive = lengths > 0  # (a point on another has no spacing to key it by: left out of the sample)
+        sample = centres[positive][_intrinsic_sample(points[centres[positive]], lengths[positive], CLOUD_NOISE_SAMPLE)]
     radius = CLOUD_NOISE_FIT_RADIUS * spacing
     coefficients, _, _ = _fit_jets(
         points, normals, radius, degree=2, iterations=1, centres=sample, neighbours=usable, facing=facing
@@ -1354,6 +1433,17 @@ def _cloud_noise_level(points, normals, spacing: float, centres, usable, facing,
             "thinner than the ball); the radius rules take the level of a clean sample"
         )
     return np.nan
+
+
+def _nearest_distances(points, centres, usable) -> np.ndarray:
+    """(M,) the distance of each of ``centres`` to its nearest other point among ``usable``."""
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    pool = np.flatnonzero(usable)
+    if pool.size < 2:
+        return np.zeros(centres.size)
+    distances, found = cKDTree(points[pool]).query(points[centres], k=2)
+    return np.where(pool[found[:, 0]] == centres, distances[:, 1], distances[:, 0])
 
 
 def _checked_radii(radii) -> list[float]:

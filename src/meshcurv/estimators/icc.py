@@ -186,8 +186,8 @@ COARSE_EDGES = 16.0
 #: 6 and 8 made the marching-cubes sphere r 1 at voxel 0.05 of ``benchmarks/accuracy.py`` 13% worse, 10 is
 #: within 4% of the fits over every vertex on each binary marching-cubes mesh there, ``benchmarks/scale_default.py``).
 COARSE_CELLS = 10.0
-#: The median edge length that decides is taken over about this many edges (a threshold: a sample will do), a sample
-#: that the vertices' order does not choose (:func:`_sampled_edge`; fuzz 419/58: an index-spaced one did).
+#: The number of adjacency entries above which :func:`_sampled_edge` once took a sample (every edge since: a sample
+#: was chosen by the pose or the index); tests name it for a mesh that was sampled.
 COARSE_SAMPLE = 65536
 
 #: A fitted normal is kept where its cosine with the mean of the face normals exceeds this (60 degrees).
@@ -542,38 +542,20 @@ def _dense(
     return bool(radius > (COARSE_EDGES if edges is None else edges) * edge)
 
 
-def _sampled_edge(vertices: np.ndarray, adjacency: tuple) -> float:
-    """:func:`_dense`'s median edge length over about :data:`COARSE_SAMPLE` edges of the CSR lists ``adjacency``
-    (inf without edges: no radius is dense): every edge of a smaller mesh; otherwise the edges of the vertices
-    whose coordinates hash to one class of ``ceil(E / COARSE_SAMPLE)`` (:func:`_coordinate_classes`), the same
-    sample in any order of the vertices."""
-    indptr, indices = adjacency
-    if indices.size == 0:
-        return np.inf
-    rows = np.arange(indptr.size - 1)
-    degrees = np.diff(indptr)
-    if indices.size > COARSE_SAMPLE:
-        chosen = _coordinate_classes(vertices[: rows.size], -(-indices.size // COARSE_SAMPLE)) == 0
-        if degrees[chosen].any():  # (a mesh of a few vertices of many edges may miss the class: then every edge)
-            rows, degrees = rows[chosen], degrees[chosen]
-    tails = np.repeat(rows, degrees)
-    ends = np.cumsum(degrees)
-    heads = indices[np.arange(ends[-1]) + np.repeat(indptr[rows] - (ends - degrees), degrees)]
-    offsets = vertices[heads] - vertices[tails]
-    return float(np.median(np.sqrt(np.einsum("ij,ij->i", offsets, offsets))))
+def _sampled_edge(vertices: np.ndarray, adjacency: tuple, edges: np.ndarray | None = None) -> float:
+    """:func:`_dense`'s median edge length: over every edge of the CSR lists ``adjacency`` (inf without edges: no
+    radius is dense), or of ``edges`` (E, 2), the same edges, when the caller has them (the compiled lengths).
 
-
-def _coordinate_classes(points: np.ndarray, classes: int) -> np.ndarray:
-    """(N,) int64 in ``[0, classes)``: a hash of each row of ``points`` (N, 3) float64 from the bits of its
-    coordinates alone (the three 64-bit words mixed, wrapping): a row falls in one class whatever its index."""
-    bits = np.ascontiguousarray(points, dtype=np.float64).view(np.uint64)
-    mixed = bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
-    mixed ^= bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
-    mixed ^= bits[:, 2] * np.uint64(0x165667B19E3779F9)
-    mixed ^= mixed >> np.uint64(31)
-    mixed *= np.uint64(0xBF58476D1CE4E5B9)
-    mixed ^= mixed >> np.uint64(29)
-    return (mixed % np.uint64(classes)).astype(np.int64)
+    Every edge, not a sample: a median over all of them moves by round-off under a motion or a re-indexing, as each
+    length does, while any sample was chosen by the pose or the index (evenly spaced in index order: fuzz 419/58; a
+    hash of the coordinates' bits: a random sphere's 0.031245, 0.031113 turned, 0.031103 shifted). It costs 0.05 s
+    of CPU on the 3M edges of a 1M-vertex icosphere (the sample: 0.03 s), 1% of the call."""
+    if edges is None:
+        indptr, indices = adjacency
+        tails = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
+        upper = indices > tails  # each edge once (its two directions have one length)
+        edges = np.column_stack([tails[upper], indices[upper]])
+    return median_edge_length(vertices, edges) if edges.shape[0] else np.inf
 
 
 def voxel_pilot(mesh: PreparedMesh):
@@ -592,7 +574,7 @@ def voxel_pilot(mesh: PreparedMesh):
         valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
         centres = _pilot_centres(vertices, topology, valid)
-        edge = _sampled_edge(vertices, _adjacency(topology))
+        edge = _sampled_edge(vertices, _adjacency(topology), topology.edges)
         fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres, edge=edge)
         with np.errstate(invalid="ignore"):
             agree = np.isfinite(fitted).all(axis=1) & (np.einsum("ij,ij->i", fitted, start[centres]) > NORMAL_AGREEMENT)
@@ -883,6 +865,7 @@ def _curvatures(
     boundary_faces: np.ndarray | None = None,
     topology: MeshTopology | None = None,
     cracked: bool = False,
+    edges: np.ndarray | None = None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -895,7 +878,8 @@ def _curvatures(
     (:func:`_corners_fitted`) and, near holes (:func:`_near_holes`), the fits whose balls wrap are made again
     (:func:`_unwrapped_normals`). ``cracked``: the mesh was welded across cracks (``PreparedMesh.n_cracked``): near
     holes, the pieces whose fits scatter (:func:`_scattered_pieces`) or whose balls hold a small piece of a staircase
-    (:func:`_stair_pieces`) are undefined.
+    (:func:`_stair_pieces`) are undefined. ``edges`` (E, 2): the mesh's edges, those of ``adjacency``, when the
+    caller has them (:func:`_sampled_edge`).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -912,7 +896,7 @@ def _curvatures(
     failed = np.zeros(vertices.shape[0], dtype=bool)
     counts = None  # the points of the normal fits near holes, where cracks were welded (below)
     # the median edge that decides the coarse level of a voxel surface, taken once
-    edge = _sampled_edge(vertices, adjacency) if coarse and adjacency is not None else None
+    edge = _sampled_edge(vertices, adjacency, edges) if coarse and adjacency is not None else None
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
@@ -974,7 +958,7 @@ def _curvatures(
     if sparse is not None:
         valid &= ~sparse
     if counts is not None:
-        valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, adjacency)
+        valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, adjacency, edges)
         if ball_areas is not None:
             valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts))
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
@@ -999,7 +983,9 @@ SCATTER_FEW = 35
 SCATTER_TILT = 0.05
 
 
-def _scattered_pieces(vertices, faces, dropped, normals, valid, counts, k_min, k_max, adjacency) -> np.ndarray:
+def _scattered_pieces(
+    vertices, faces, dropped, normals, valid, counts, k_min, k_max, adjacency, edges=None
+) -> np.ndarray:
     """(V,) bool: the ``valid`` vertices near holes (``counts`` (V,) the points of their normal fits; inf where not
     counted) whose points scatter by ``s`` above :data:`SCATTER_TILT` and whose fit held fewer points than
     :data:`SCATTER_FEW` or :data:`SCATTER_POINTS` ``s``. ``s``: the standard deviation of the residuals of a
@@ -1013,7 +999,7 @@ def _scattered_pieces(vertices, faces, dropped, normals, valid, counts, k_min, k
     near = valid & np.isfinite(counts)
     if not near.any():
         return near
-    edge = _sampled_edge(vertices, adjacency)
+    edge = _sampled_edge(vertices, adjacency, edges)
     ids = np.flatnonzero(near)
     pool = np.unique(faces[~dropped].ravel())
     radii = np.full(vertices.shape[0], 3.0 * edge)
@@ -1178,6 +1164,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             stages,
             neighbours=referenced,
             adjacency=_adjacency(topology),
+            edges=topology.edges,
             areas=_vertex_areas(mesh),
             normal_radius=normal_radii,
             coarse=True,
@@ -1207,6 +1194,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 stages,
                 neighbours=referenced,
                 adjacency=_adjacency(topology),
+                edges=topology.edges,
                 areas=_vertex_areas(mesh),
                 weighted=not even,
                 topology=bounded,
@@ -1236,6 +1224,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             stages if fields is None else None,
             neighbours=referenced,
             adjacency=_adjacency(topology),
+            edges=topology.edges,
             areas=_vertex_areas(mesh),
             topology=bounded,
             cracked=bool(mesh.n_cracked),
@@ -1291,7 +1280,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
     # the fits of the radii not fitted on the coarse level, from one walk per vertex (the radii increase, and
     # so does _dense: the radii fitted so are the first ones)
-    edge = _sampled_edge(vertices, _adjacency(topology))
+    edge = _sampled_edge(vertices, _adjacency(topology), topology.edges)
     fine = [NORMAL_RADIUS_RATIO * r for r in radii if not NORMAL_RADIUS_RATIO * r > COARSE_EDGES * edge]
     fits = (
         nested_jet_normals(
@@ -1318,6 +1307,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             neighbours=topology.referenced_vertices,
             adjacency=_adjacency(topology),
             areas=areas if j >= len(fits) else None,  # fitted already: no coarse level to look for
+            edge=edge,
             failed=failed[j],
             fits=fits[j] if j < len(fits) else None,
         )
