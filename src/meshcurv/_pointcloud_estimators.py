@@ -247,15 +247,26 @@ def one_sided_fits(
         )
         first = None
         done = todo[np.isfinite(found[todo]).all(axis=1)]
-        if fits is None:
-            if own and done.size == n:  # every point fitted over `radius` (the common case): no copies of the fits
+        if fits is None and own:
+            if done.size == n:  # every point fitted over `radius` (the common case): no copies of the fits
                 return found, tuple(local), np.full(n, current)
-            fits = _no_fits(n)
-        coefficients, frame, radii = fits
-        coefficients[done] = found[done]
-        for whole, part in zip(frame, local):
-            whole[done] = part[done]
-        radii[done] = current
+            # the first fits made here are the fits' own arrays, the rows not fitted NaN (1M points: no (N, 15)
+            # NaN arrays and copies of the rows, 0.25 CPU s)
+            missed = np.ones(n, dtype=bool)
+            missed[done] = False
+            found[missed] = np.nan
+            for part in local:
+                part[missed] = np.nan
+            fits = (found, tuple(local), np.full(n, np.nan))
+            fits[2][done] = current
+        else:
+            if fits is None:
+                fits = _no_fits(n)
+            coefficients, frame, radii = fits
+            coefficients[done] = found[done]
+            for whole, part in zip(frame, local):
+                whole[done] = part[done]
+            radii[done] = current
         todo = np.setdiff1d(todo, done, assume_unique=True)
         if current <= smallest:
             break

@@ -406,7 +406,7 @@ def point_cloud_curvatures(
     cloud = _prepared_cloud(points, faces, normals, method)
     if radius is not None:
         radius = _checked_cloud_radius(radius, cloud.points)
-    result, problems = _estimated(cloud, radius)
+    result, problems = _estimated(cloud, radius, reused=False)
     if problems:
         warnings.warn("point cloud: " + "; ".join(problems), MeshQualityWarning, stacklevel=2)
     return result
@@ -573,10 +573,15 @@ def _checked_cloud_radius(radius, cloud: np.ndarray, *, name: str = "radius") ->
     return radius
 
 
-def _estimated(cloud: _Cloud, radius: float | None) -> tuple[CurvatureResult, list[str]]:
-    """The estimate at ``radius`` (None: the default) for every input point, and the problems for the warning."""
+def _estimated(cloud: _Cloud, radius: float | None, *, reused: bool = True) -> tuple[CurvatureResult, list[str]]:
+    """The estimate at ``radius`` (None: the default) for every input point, and the problems for the warning.
+
+    ``reused``: ``cloud`` serves other radii after this one; else its neighbours are this call's own.
+    """
     search = cloud.search
-    if search is not None:  # (the pipeline re-points the neighbours of line points in place: its own copy)
+    if search is not None and reused:
+        # (the pipeline re-points the neighbours of line points in place: each radius its own copy; a single call
+        # skips it: 1M points' (N, 10) indices, 0.18 CPU s of page faults)
         search = (search[0], search[1], search[2].copy())
     k_min, k_max, dir_min, dir_max, out_normals, valid, reason, parameters, found = _compute(
         cloud.points, cloud.given, radius, cloud.method, search
@@ -1488,8 +1493,13 @@ def _radius_groups(spacing, indices, usable, median, noise, radius, method, prob
         return lines or [(cloud_radius(median, noise, method), median, centres, 0.0)]
     # the spacing averaged over the neighbours: one class per region, not per random gap
     # (over the usable neighbours of usable points only: a row of outliers alone would have no mean)
-    values, rows = np.where(usable, spacing, 0.0), indices[centres]
-    smooth = (values[centres] + values[rows].sum(axis=1)) / (1.0 + np.count_nonzero(usable[rows], axis=1))
+    values = np.where(usable, spacing, 0.0)
+    kernels = numba_kernels("pointcloud")
+    if kernels is not None and indices.shape[1] <= 128:  # (the same numbers, without (M, k) gathers)
+        smooth = kernels._neighbour_spacing(values, usable, indices, centres)
+    else:
+        rows = indices[centres]
+        smooth = (values[centres] + values[rows].sum(axis=1)) / (1.0 + np.count_nonzero(usable[rows], axis=1))
     low, high = np.percentile(smooth, [5, 95])
     if high <= UNEVEN_DENSITY * low:
         return [(cloud_radius(median, noise, method), median, centres, 0.0), *lines]

@@ -596,6 +596,47 @@ def edge_geometry(points, normals, indices):
 
 
 @nb.njit(parallel=True, **_JIT)
+def _neighbour_spacing(values, usable, indices, centres):
+    """(M,) ``(values[c] + values[indices[c]].sum()) / (1 + count_nonzero(usable[indices[c]]))`` of the
+    ``centres`` (M,) (``indices`` (N, k), k at most 128): the mean spacing of :func:`meshcurv.pointcloud._radius_groups`
+    on every core, without its (M, k) gathers (1M points: 0.24 CPU s on one core). The row's sum as NumPy's
+    ``sum(axis=1)`` adds it (its pairwise sum: below 8 terms left to right, else eight running sums of every
+    eighth term, added in pairs, then the terms left over): the same numbers to the bit."""
+    m = centres.shape[0]
+    k = indices.shape[1]
+    out = np.zeros(m)
+    for row in nb.prange(m):
+        c = centres[row]
+        count = 0
+        for j in range(k):
+            count += usable[indices[c, j]]
+        if k < 8:
+            total = 0.0 if k == 0 else values[indices[c, 0]]
+            for j in range(1, k):
+                total += values[indices[c, j]]
+        else:
+            r0, r1, r2, r3 = values[indices[c, 0]], values[indices[c, 1]], values[indices[c, 2]], values[indices[c, 3]]
+            r4, r5, r6, r7 = values[indices[c, 4]], values[indices[c, 5]], values[indices[c, 6]], values[indices[c, 7]]
+            j = 8
+            while j + 8 <= k:
+                r0 += values[indices[c, j]]
+                r1 += values[indices[c, j + 1]]
+                r2 += values[indices[c, j + 2]]
+                r3 += values[indices[c, j + 3]]
+                r4 += values[indices[c, j + 4]]
+                r5 += values[indices[c, j + 5]]
+                r6 += values[indices[c, j + 6]]
+                r7 += values[indices[c, j + 7]]
+                j += 8
+            total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+            while j < k:
+                total += values[indices[c, j]]
+                j += 1
+        out[row] = (values[c] + total) / (1.0 + count)
+    return out
+
+
+@nb.njit(parallel=True, **_JIT)
 def graph_edges(points, normals, indices, usable):
     """The edges of the graph ``indices`` (N, k) between ``usable`` points, and their geometry, in one pass.
 

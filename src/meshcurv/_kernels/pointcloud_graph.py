@@ -62,6 +62,46 @@ def spanning_sheets(n, rows, cols, opposite, order, n_flat, least):
     return signs, roots, sheets
 
 
+@nb.njit(parallel=True, **_JIT)
+def _single_edges(indices, kept, used, weights):
+    """(E,) bool: the ``used`` edges of the graph ``indices`` (N, k) (``kept`` (N k,): which entries are the edges,
+    :func:`meshcurv._kernels.pointcloud.graph_edges`) less each edge ``i -> j`` with ``j < i`` whose reverse
+    ``j -> i`` is used and weighs the same (``weights`` (E,)).
+
+    Such a reverse edge comes first in the forest's stable order of the weights (an earlier row): when Kruskal's
+    walk of :func:`spanning_sheets` reaches ``i -> j``, ``i`` and ``j`` are one tree and it is skipped. Without
+    it the walk makes the same unions in the same order (the same signs, roots and sheets) over fewer edges, and
+    fewer weights are sorted (a k nearest graph holds most of its edges both ways).
+    """
+    n, k = indices.shape
+    starts = np.zeros(n + 1, dtype=np.int64)
+    for i in nb.prange(n):
+        found = 0
+        for c in range(k):
+            found += kept[i * k + c]
+        starts[i + 1] = found
+    for i in range(n):
+        starts[i + 1] += starts[i]
+    single = used.copy()
+    for i in nb.prange(n):
+        e = starts[i]
+        for c in range(k):
+            if not kept[i * k + c]:
+                continue
+            j = indices[i, c]
+            if j < i and used[e]:
+                f = starts[j]
+                for d in range(k):
+                    if kept[j * k + d]:
+                        if indices[j, d] == i:
+                            if used[f] and weights[f] == weights[e]:
+                                single[e] = False
+                            break
+                        f += 1
+            e += 1
+    return single
+
+
 @nb.njit(inline="always", **_JIT)
 def _join(parent, flip, size, i, j, opposite):
     """Kruskal's step of ``spanning_signs``: the trees of ``i`` and ``j`` joined (the smaller under the larger,
