@@ -78,6 +78,7 @@ STAGES = (
     ("defects", "meshcurv.defects", "defect_codes"),
     ("needle vertices (every caller)", "meshcurv.defects", "needle_vertices"),
     ("length scales (every caller)", "meshcurv._geometry", "vertex_length_scales"),
+    ("length scales (every caller)", "meshcurv._geometry", "length_scales_and_median"),  # prepare_mesh's (ee8878f)
     ("radius: components", "meshcurv.radius", "component_radii"),
     ("radius: noise fits", "meshcurv.radius", "noise_level"),
     ("radius: voxel rule (lattice, pilot)", "meshcurv.radius", "voxel_surface_radius"),
