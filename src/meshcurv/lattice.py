@@ -407,8 +407,8 @@ def voxel_grid(
     # two readings; the exact one on the coordinates rounded to their round-off (a plane's coordinates, turned, agree
     # to a few last bits)
     frame = _turned_frame(vertices, faces)
-    if frame is None:
-        return None
+    if frame is None or np.abs(frame - np.eye(3)).max() <= VOXEL_ROUNDING:
+        return None  # (no frame, or x, y and z, read already: a CAD part's flats, a grid's rows, a cylinder's rings)
     turned = vertices @ frame.T
     grid = _exact_voxel_grid(_rounded(turned)) or _faces_voxel_grid(turned, faces, spacing)
     return None if grid is None else grid._replace(frame=frame)
