@@ -40,7 +40,7 @@ def test_each_group_is_the_area_weighted_centroid_of_its_vertices_linked_along_t
     n = vertices.shape[0]
     normals = np.asarray(mesh.normals, dtype=np.float64)
     areas = np.ones(n)
-    radius = 2.0 * icc.COARSE_EDGES * icc._sampled_edge(vertices, topology.neighbour_lists)
+    radius = 2.0 * icc.COARSE_EDGES * icc._median_edge(vertices, topology.neighbour_lists)
     points, _, allowed, (indptr, indices), weights = icc._coarse_level(
         vertices, normals, radius, areas, None, topology.neighbour_lists
     )

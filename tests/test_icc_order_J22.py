@@ -5,7 +5,7 @@ numbered otherwise: k apart by up to 0.0047 of the largest ``|k|`` at 2,485 vert
 normals are the same for the same inputs; their radii were not: each vertex's radius follows its local sampling
 over the component's median edge length (``radius.local_scale_ratios``), and that median was taken over the edges
 ``[::step]`` of the edge list (``geometry.vertex_length_scales``: a sample of ``MEDIAN_SAMPLE`` edges by index), so
-the numbering chose the sample. ``icc._sampled_edge`` (the median edge that decides the coarse level of a voxel
+the numbering chose the sample. ``icc._median_edge`` (the median edge that decides the coarse level of a voxel
 surface) sampled the same way. Re-indexing is an invariance: the expected values are the estimates in the other
 order, re-indexed.
 """
@@ -73,13 +73,13 @@ def test_the_coarse_levels_median_edge_is_the_same_in_every_order():
     mesh = shapes.random_sphere(15_000, seed=1)  # irregular edges; 90,000 adjacency entries: a sample
     vertices, faces = mesh.vertices, mesh.faces
     adjacency = _adjacency(faces, len(vertices))
-    assert adjacency[1].size > icc.COARSE_SAMPLE
-    edge = icc._sampled_edge(vertices, adjacency)
+    assert adjacency[1].size > 65536  # a sample of 65,536 entries once (J22); every edge since I23
+    edge = icc._median_edge(vertices, adjacency)
     lengths = np.linalg.norm(vertices[faces] - vertices[np.roll(faces, 1, axis=1)], axis=2)
-    assert edge == pytest.approx(np.median(lengths), rel=0.03)  # a sample of the edges: about their median
+    assert edge == pytest.approx(np.median(lengths), rel=1e-12)  # every edge: their median
     for seed in (None, 1, 2):
         moved, moved_faces, _ = _permuted(vertices, faces, seed)
-        assert icc._sampled_edge(moved, _adjacency(moved_faces, len(moved))) == edge
+        assert icc._median_edge(moved, _adjacency(moved_faces, len(moved))) == edge
 
 
 def test_local_scale_ratios_are_the_same_in_every_order():

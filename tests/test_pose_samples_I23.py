@@ -93,15 +93,15 @@ def test_a_meshs_noise_level_is_the_same_in_every_pose_scale_and_order():
 def test_iccs_median_edge_is_the_same_in_every_pose_scale_and_order():
     mesh = shapes.random_sphere(15_000, seed=1)  # irregular edges; 90,000 adjacency entries: once a sample
     topology = MeshTopology.from_faces(mesh.faces, len(mesh.vertices))
-    edge = icc._sampled_edge(mesh.vertices, topology.neighbour_lists)
+    edge = icc._median_edge(mesh.vertices, topology.neighbour_lists)
     for name, linear, shift, scale, shuffle in MOTIONS:
         moved, order = _moved(mesh.vertices, linear, shift, shuffle)
         moved_topology = MeshTopology.from_faces(np.argsort(order)[mesh.faces], len(moved))
-        got = icc._sampled_edge(moved, moved_topology.neighbour_lists)
+        got = icc._median_edge(moved, moved_topology.neighbour_lists)
         assert got / scale == pytest.approx(edge, rel=ROUND_OFF), name
     lengths = np.linalg.norm(mesh.vertices[topology.edges[:, 0]] - mesh.vertices[topology.edges[:, 1]], axis=1)
     assert edge == pytest.approx(np.median(lengths), rel=1e-12)  # the median of every edge
-    assert icc._sampled_edge(mesh.vertices, topology.neighbour_lists, topology.edges) == edge
+    assert icc._median_edge(mesh.vertices, topology.neighbour_lists, topology.edges) == edge
 
 
 def test_an_intrinsic_sample_takes_whole_classes_of_a_symmetric_shape():

@@ -186,9 +186,6 @@ COARSE_EDGES = 16.0
 #: 6 and 8 made the marching-cubes sphere r 1 at voxel 0.05 of ``benchmarks/accuracy.py`` 13% worse, 10 is
 #: within 4% of the fits over every vertex on each binary marching-cubes mesh there, ``benchmarks/scale_default.py``).
 COARSE_CELLS = 10.0
-#: The number of adjacency entries above which :func:`_sampled_edge` once took a sample (every edge since: a sample
-#: was chosen by the pose or the index); tests name it for a mesh that was sampled.
-COARSE_SAMPLE = 65536
 
 #: A fitted normal is kept where its cosine with the mean of the face normals exceeds this (60 degrees).
 NORMAL_AGREEMENT = 0.5
@@ -266,7 +263,7 @@ def fitted_normals(
     describes neither. ``adjacency``: the mesh's edge lists, so that each ball
     is its surface-connected piece (:func:`meshcurv.jets.fit_jets`).
 
-    ``edge``: the median edge length of :func:`_sampled_edge`, when the caller has it.
+    ``edge``: the median edge length of :func:`_median_edge`, when the caller has it.
 
     ``unwrap`` (V,) bool: the vertices whose fits are checked for balls holding points that face away, and made
     again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes); ``counts`` (V,)
@@ -289,7 +286,7 @@ def fitted_normals(
     coarse = None
     dense = False  # the coarse level's test first: an ordinary mesh's fits read no areas unless weighted
     if areas is not None and adjacency is not None:
-        edge = _sampled_edge(vertices, adjacency) if edge is None else edge
+        edge = _median_edge(vertices, adjacency) if edge is None else edge
         dense = _dense(vertices, float(np.median(radius)), adjacency, edge=edge)
     if areas is not None and (dense or weighted):  # in units of their median: weights of order 1 whatever the units
         positive = areas[areas > 0]
@@ -535,14 +532,14 @@ def _dense(
     vertices: np.ndarray, radius: float, adjacency: tuple, *, edges: float | None = None, edge: float | None = None
 ) -> bool:
     """Whether normal fits over ``radius`` run on the coarse level: wider than ``edges`` (default
-    :data:`COARSE_EDGES`) median edge lengths (``edge``, or taken over about :data:`COARSE_SAMPLE` edges of the CSR
-    lists ``adjacency``: :func:`_sampled_edge`)."""
+    :data:`COARSE_EDGES`) median edge lengths (``edge``, or that of every edge of the CSR lists ``adjacency``:
+    :func:`_median_edge`)."""
     if edge is None:
-        edge = _sampled_edge(vertices, adjacency)
+        edge = _median_edge(vertices, adjacency)
     return bool(radius > (COARSE_EDGES if edges is None else edges) * edge)
 
 
-def _sampled_edge(vertices: np.ndarray, adjacency: tuple, edges: np.ndarray | None = None) -> float:
+def _median_edge(vertices: np.ndarray, adjacency: tuple, edges: np.ndarray | None = None) -> float:
     """:func:`_dense`'s median edge length: over every edge of the CSR lists ``adjacency`` (inf without edges: no
     radius is dense), or of ``edges`` (E, 2), the same edges, when the caller has them (the compiled lengths).
 
@@ -556,6 +553,13 @@ def _sampled_edge(vertices: np.ndarray, adjacency: tuple, edges: np.ndarray | No
         upper = indices > tails  # each edge once (its two directions have one length)
         edges = np.column_stack([tails[upper], indices[upper]])
     return median_edge_length(vertices, edges) if edges.shape[0] else np.inf
+
+
+def _mesh_edge(mesh: PreparedMesh) -> float:
+    """:func:`_median_edge` of a prepared mesh's edges, kept from its length scales
+    (:attr:`~meshcurv._prepared.PreparedMesh.median_edge_length`: the same median of the same lengths, to the bit;
+    0.045 s of CPU at 1M vertices not spent again, issue 31)."""
+    return mesh.median_edge_length if mesh.topology.n_edges else np.inf
 
 
 def voxel_pilot(mesh: PreparedMesh):
@@ -574,7 +578,7 @@ def voxel_pilot(mesh: PreparedMesh):
         valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
         centres = _pilot_centres(vertices, topology, valid)
-        edge = _sampled_edge(vertices, _adjacency(topology), topology.edges)
+        edge = _median_edge(vertices, _adjacency(topology), topology.edges)
         fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres, edge=edge)
         with np.errstate(invalid="ignore"):
             agree = np.isfinite(fitted).all(axis=1) & (np.einsum("ij,ij->i", fitted, start[centres]) > NORMAL_AGREEMENT)
@@ -607,7 +611,7 @@ def _pilot_normals(
     """(M, 3) the jet normals of :func:`voxel_pilot` at ``centres`` over balls of ``radius`` (``start``: the
     first frames): fitted on a coarse level of the surface (:func:`_coarse_level`, cubes of ``radius /``
     :data:`PILOT_COARSE_CELLS`) where ``radius`` exceeds :data:`PILOT_COARSE_EDGES` median edge lengths, there
-    at one centre per cube of :data:`PILOT_SAMPLE_EDGES` median edges (``edge``: :func:`_sampled_edge`, when
+    at one centre per cube of :data:`PILOT_SAMPLE_EDGES` median edges (``edge``: :func:`_median_edge`, when
     given) and interpolated at the others (:func:`meshcurv.jets.sampled_jet_normals`); else over the vertices
     at every centre."""
     vertices, topology = mesh.vertices, mesh.topology
@@ -866,6 +870,7 @@ def _curvatures(
     topology: MeshTopology | None = None,
     cracked: bool = False,
     edges: np.ndarray | None = None,
+    edge: float | None = None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -879,7 +884,8 @@ def _curvatures(
     (:func:`_unwrapped_normals`). ``cracked``: the mesh was welded across cracks (``PreparedMesh.n_cracked``): near
     holes, the pieces whose fits scatter (:func:`_scattered_pieces`) or whose balls hold a small piece of a staircase
     (:func:`_stair_pieces`) are undefined. ``edges`` (E, 2): the mesh's edges, those of ``adjacency``, when the
-    caller has them (:func:`_sampled_edge`).
+    caller has them (:func:`_median_edge`); ``edge``: their median length (:func:`_mesh_edge`), when the caller has
+    it.
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -896,7 +902,8 @@ def _curvatures(
     failed = np.zeros(vertices.shape[0], dtype=bool)
     counts = None  # the points of the normal fits near holes, where cracks were welded (below)
     # the median edge that decides the coarse level of a voxel surface, taken once
-    edge = _sampled_edge(vertices, adjacency, edges) if coarse and adjacency is not None else None
+    if edge is None and coarse and adjacency is not None:
+        edge = _median_edge(vertices, adjacency, edges)
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
@@ -999,7 +1006,7 @@ def _scattered_pieces(
     near = valid & np.isfinite(counts)
     if not near.any():
         return near
-    edge = _sampled_edge(vertices, adjacency, edges)
+    edge = _median_edge(vertices, adjacency, edges)
     ids = np.flatnonzero(near)
     pool = np.unique(faces[~dropped].ravel())
     radii = np.full(vertices.shape[0], 3.0 * edge)
@@ -1165,6 +1172,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             neighbours=referenced,
             adjacency=_adjacency(topology),
             edges=topology.edges,
+            edge=_mesh_edge(mesh),
             areas=_vertex_areas(mesh),
             normal_radius=normal_radii,
             coarse=True,
@@ -1195,6 +1203,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 neighbours=referenced,
                 adjacency=_adjacency(topology),
                 edges=topology.edges,
+                edge=_mesh_edge(mesh),
                 areas=_vertex_areas(mesh),
                 weighted=not even,
                 topology=bounded,
@@ -1225,6 +1234,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             neighbours=referenced,
             adjacency=_adjacency(topology),
             edges=topology.edges,
+            edge=_mesh_edge(mesh),
             areas=_vertex_areas(mesh),
             topology=bounded,
             cracked=bool(mesh.n_cracked),
@@ -1280,7 +1290,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
     # the fits of the radii not fitted on the coarse level, from one walk per vertex (the radii increase, and
     # so does _dense: the radii fitted so are the first ones)
-    edge = _sampled_edge(vertices, _adjacency(topology), topology.edges)
+    edge = _median_edge(vertices, _adjacency(topology), topology.edges)
     fine = [NORMAL_RADIUS_RATIO * r for r in radii if not NORMAL_RADIUS_RATIO * r > COARSE_EDGES * edge]
     fits = (
         nested_jet_normals(
