@@ -39,6 +39,8 @@ https://doi.org/10.1145/133994.134011
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ._backend import numba_kernels
@@ -361,6 +363,17 @@ def line_spread(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     return _line_spread_numpy(points, indices)
 
 
+#: The C library's ``acos`` and ``cos``, elementwise: those the kernel calls. NumPy's own (its SIMD loops: SVML on
+#: AVX-512 machines) differ from them in the last bit, and the two backends' normals with them (366 of 34,572
+#: components one ulp apart on a thin pair of sheets, where ties of the orientation's weights may turn).
+_ACOS, _COS = np.frompyfunc(math.acos, 1, 1), np.frompyfunc(math.cos, 1, 1)
+
+
+def _libm(function, values: np.ndarray) -> np.ndarray:
+    """``function`` (:data:`_ACOS`, :data:`_COS`) of each of ``values`` (M,) float64, NaN kept (a NaN input)."""
+    return function(values).astype(np.float64)
+
+
 def _line_spread_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """The NumPy path of :func:`line_spread`: the kernel's operations in its order (the same ratios to the bit:
     they are compared with :data:`LINE_SPREAD` and :data:`CURVE_CANDIDATE`)."""
@@ -376,9 +389,9 @@ def _line_spread_numpy(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
         bxx, byy, bzz, bxy, bxz, byz = sxx / scale, syy / scale, szz / scale, xy / scale, xz / scale, yz / scale
         half = 0.5 * (bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz) + bxz * (bxy * byz - byy * bxz))
         with np.errstate(invalid="ignore", divide="ignore"):
-            angle = np.arccos(np.minimum(1.0, np.maximum(-1.0, half))) / 3
-            largest = mean + 2 * spread * np.cos(angle)
-            smallest = mean + 2 * spread * np.cos(angle + 2 * np.pi / 3)
+            angle = _libm(_ACOS, np.minimum(1.0, np.maximum(-1.0, half))) / 3
+            largest = mean + 2 * spread * _libm(_COS, angle)
+            smallest = mean + 2 * spread * _libm(_COS, angle + 2 * np.pi / 3)
             second = np.maximum(3 * mean - largest - smallest, 0.0)
             ratio[start:stop] = np.where(largest > 0, np.sqrt(second / np.where(largest > 0, largest, 1.0)), 1.0)
     return ratio
@@ -620,8 +633,8 @@ def _closed_form_normals(points: np.ndarray, indices: np.ndarray, start: int, st
     bxy, bxz, byz = xy / divisor, xz / divisor, yz / divisor
     half = 0.5 * (bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz) + bxz * (bxy * byz - byy * bxz))
     with np.errstate(invalid="ignore"):
-        angle = np.arccos(np.minimum(1.0, np.maximum(-1.0, half))) / 3
-    smallest = mean + 2 * spread * np.cos(angle + 2 * np.pi / 3)
+        angle = _libm(_ACOS, np.minimum(1.0, np.maximum(-1.0, half))) / 3
+    smallest = mean + 2 * spread * _libm(_COS, angle + 2 * np.pi / 3)
     r0 = np.stack([xx - smallest, xy, xz], axis=1)
     r1 = np.stack([xy, yy - smallest, yz], axis=1)
     r2 = np.stack([xz, yz, zz - smallest], axis=1)
