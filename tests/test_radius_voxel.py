@@ -35,7 +35,7 @@ def _lists(n):
 
 def test_the_rule_in_closed_form():
     # isolated vertices (each its own ring) in 2 x 0.5 x 0.5 voxels, surface curvature radius R = 32:
-    # r_v = max(2, min(2 sqrt(h_v R), 1 / c_v, 0.5 / sqrt(K_v), sqrt(area / (18 pi)), R / 2 + t_v (1 / c_v - R / 2)))
+    # r_v = max(2.02, min(2 sqrt(h_v R), 1 / c_v, 0.5 / sqrt(K_v), sqrt(area / (18 pi)), R / 2 + t_v (1 / c_v - R / 2)))
     spacing = np.array([2.0, 0.5, 0.5])
     x, y = [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]
     normals = np.array([x, y, x, y, x])
@@ -44,14 +44,14 @@ def test_the_rule_in_closed_form():
     radii, normal_radii = voxel_vertex_radii(spacing, normals, k_min, k_max, np.ones(5, bool), 32.0, _lists(5), 3.0)
     # sphere-like at R_v 20: 0.5 / sqrt(K) = 10 below 2 sqrt(2 * 32) = 16 (h_v 2 along x); 2 sqrt(0.5 * 32) = 8
     # (h_v 0.5 along y); a tube of radius 24 (t_v = 1): the cap R / 2 = 16 rises to 24, above 16 and 8;
-    # a small sphere (R_v 4): 0.5 / sqrt(K) = 2, the largest voxel size
-    np.testing.assert_allclose(radii, [10.0, 8.0, 16.0, 8.0, 2.0], rtol=1e-12)
+    # a small sphere (R_v 4): 0.5 / sqrt(K) = 2, the largest voxel size, raised to the floor 1.01 h_max = 2.02
+    np.testing.assert_allclose(radii, [10.0, 8.0, 16.0, 8.0, 2.02], rtol=1e-12)
     # min(3 r_v, max(1.5 / c_v, 4 h_max)): the tube's 48 capped at 1.5 / c_v = 36; elsewhere 3 r_v
-    np.testing.assert_allclose(normal_radii, [30.0, 24.0, 36.0, 24.0, 6.0], rtol=1e-12)
+    np.testing.assert_allclose(normal_radii, [30.0, 24.0, 36.0, 24.0, 6.06], rtol=1e-12)
     capped, _ = voxel_vertex_radii(
         spacing, normals, k_min, k_max, np.ones(5, bool), 32.0, _lists(5), 3.0, area=18 * np.pi * 25.0
     )
-    np.testing.assert_allclose(capped, [5.0, 5.0, 5.0, 5.0, 2.0], rtol=1e-12)  # sqrt(area / (18 pi)) = 5
+    np.testing.assert_allclose(capped, [5.0, 5.0, 5.0, 5.0, 2.02], rtol=1e-12)  # sqrt(area / (18 pi)) = 5
 
 
 def test_vertices_without_pilot_values_take_the_fallback():

@@ -80,14 +80,15 @@ def test_a_mesh_off_any_grid_is_not_a_voxel_surface(method):
     assert not messages
 
 
-def test_a_rotated_voxel_surface_is_on_no_grid_and_not_warned_of(voxel_sphere):
-    # the grid is read along the coordinate axes: turned, the staircase is still there but not read as a grid
-    # (the default radius is then the smooth rule too; documented in meshcurv.lattice.voxel_grid)
+def test_a_rotated_voxel_surface_is_read_on_its_grid_and_warned_of(voxel_sphere):
+    # the grid is read in its own axes (meshcurv.lattice.voxel_grid, tests/test_turned_voxel.py): turned, the
+    # staircase is read as in the image's axes, undefined with the same sentence (it was a valid wrong number)
     vertices, faces = voxel_sphere
     angle = 0.3
     rotation = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
-    _, messages = _messages(vertices @ rotation.T, faces, method="rusinkiewicz")
-    assert not any("voxel surface" in message for message in messages)
+    result, messages = _messages(vertices @ rotation.T, faces, method="rusinkiewicz")
+    assert len(messages) == 1 and "voxel surface (marching cubes, voxel 1)" in messages[0]
+    assert not result.valid.any()
 
 
 def test_a_voxel_surface_slightly_off_its_grid_is_named_too(voxel_sphere):

@@ -709,7 +709,7 @@ def _jet_vertex_radii(base: np.ndarray, levels: np.ndarray, curvedness: np.ndarr
 
 
 def voxel_radius(spacing: np.ndarray, curvature_radius: float) -> float:
-    """The default measure radius of a voxel surface: ``min(1.5 sqrt(h R), R / 2)``, at least ``h``.
+    """The default measure radius of a voxel surface: ``min(1.5 sqrt(h R), R / 2)``, at least ``1.01 h``.
 
     ``h`` is the largest voxel size, ``R`` the typical radius of curvature of
     the surface. The staircase of the voxels is noise of amplitude ``h`` that
@@ -722,12 +722,18 @@ def voxel_radius(spacing: np.ndarray, curvature_radius: float) -> float:
     4:1:1, ``python benchmarks/accuracy.py --voxel-sweep``).
     """
     h = float(np.max(spacing))
-    return float(max(h, min(VOXEL_GAIN * np.sqrt(h * curvature_radius), VOXEL_CAP * curvature_radius)))
+    return float(max(VOXEL_FLOOR * h, min(VOXEL_GAIN * np.sqrt(h * curvature_radius), VOXEL_CAP * curvature_radius)))
 
 
 #: The voxel radius rule ``min(VOXEL_GAIN sqrt(h R), VOXEL_CAP R)`` (see :func:`voxel_radius`).
 VOXEL_GAIN = 1.5
 VOXEL_CAP = 0.5
+#: The least radius of a voxel surface, in its largest voxel size: just above it, never on it. A binary
+#: marching-cubes surface has vertices exactly one voxel apart, and a ball of that radius had its rim on them:
+#: whether they were in the ball was decided by the last bits of the scale (a 52-vertex label surface scaled by
+#: 30: normals 0.4 and curvatures 10-14% of the largest apart; fuzz_labels round 25). 1% off every lattice
+#: distance, whose squares are quarters of whole numbers of voxels squared (4.08 is none).
+VOXEL_FLOOR = 1.01
 
 #: A voxel surface's default radius is at most this share of the diagonal of its bounding box (a ball of that
 #: radius round a compact object's vertex holds most of it; a larger one would be refused if given).
@@ -809,7 +815,7 @@ def _voxel_surface_radius(
     curvature_radius = 1.0 / float(np.percentile(curvedness, VOXEL_CURVEDNESS_PERCENTILE))
     # a default is never refused as a given radius would be: at most a share of the surface's own extent (a
     # label of a few voxels in a row read a curvature radius of 10 voxels: 4.7 against a diagonal of 4.1)
-    used = vertices[referenced]
+    used = grid.along(vertices[referenced])  # (its bounding box in the grid's axes: the same in every pose)
     extent = VOXEL_EXTENT_CAP * float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
     radius = min(voxel_radius(grid.spacing, curvature_radius), extent)
     found = {
@@ -827,7 +833,7 @@ def _voxel_surface_radius(
         )
         radii, normal_radii = voxel_vertex_radii(
             grid.spacing,
-            more[0],
+            grid.along(more[0]),  # the normals in the grid's axes, as its spacing (a turned image)
             k_min,
             k_max,
             referenced & valid,
@@ -1110,7 +1116,7 @@ def voxel_vertex_radii(
     rises towards ``1 / c_v``, which a tube needs in elongated voxels (a torus
     of tube radius 4 under 2 x 0.5 x 0.5 voxels: median H error of 25% of
     ``|H|`` at one radius for the surface). The radius is at least the largest voxel size (the
-    staircase's period along the coarse axis). The normals are fitted over
+    staircase's period along the coarse axis; :data:`VOXEL_FLOOR` times it, off the lattice's distances). The normals are fitted over
     ``min(3 r_v, max(1.5 / c_v, 4 h_max))`` (:data:`VOXEL_NORMAL_CAP`,
     :data:`VOXEL_NORMAL_VOXELS`): a ball of three radii round a tube reaches
     its far side, where a jet no longer describes it (the isotropic tori of the
@@ -1156,10 +1162,11 @@ def voxel_vertex_radii(
         tube = np.clip(1.0 - VOXEL_TUBE * np.sqrt(gauss) / np.where(curvedness > 0, curvedness, np.inf), 0.0, 1.0)
         general = VOXEL_CAP * curvature_radius
         radii = np.minimum(radii, general + tube * np.maximum(1.0 / curvedness - general, 0.0))
-    radii = np.maximum(radii, largest)
+    radii = np.maximum(radii, VOXEL_FLOOR * largest)
     with np.errstate(divide="ignore"):
         normal_radii = np.minimum(
-            VOXEL_NORMAL_RATIO * radii, np.maximum(VOXEL_NORMAL_CAP / curvedness, VOXEL_NORMAL_VOXELS * largest)
+            VOXEL_NORMAL_RATIO * radii,
+            np.maximum(VOXEL_NORMAL_CAP / curvedness, VOXEL_NORMAL_VOXELS * VOXEL_FLOOR * largest),
         )
     unknown = ~reached | ~np.isfinite(radii)
     radii[unknown], normal_radii[unknown] = fallback, VOXEL_NORMAL_RATIO * fallback
