@@ -1060,7 +1060,7 @@ def _compute(points, given, radius, method, search=None):
     logger.info("point cloud: noise level")
     # (its fits refuse balls holding the other side too: through both faces of a plate thinner than the ball a jet
     # reads half the thickness as noise, and the radius that noise calls for reaches across the whole cloud)
-    measured = _cloud_noise_level(points, start, median, centres, usable, facing, problems)
+    measured = _cloud_noise_level(points, start, median, centres, usable, facing, problems, local=spacing)
     noise = measured if np.isfinite(measured) else 0.0  # not measured (NaN, a note in problems): a clean sample's rules
     groups = _radius_groups(spacing, indices, usable, median, noise, radius, method, problems, least_radius)
     if radius is None:
