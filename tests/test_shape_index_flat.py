@@ -22,9 +22,10 @@ pytest.importorskip("skimage")
 
 
 def _box_image() -> np.ndarray:
-    """The fuzzer's blob: a plate of 4 x 1 x 4 voxels (two flat sides, rounded rims) in a zero margin."""
-    image = np.zeros((7, 5, 8), dtype=np.uint8)
-    image[2:6, 2, 2:6] = 1
+    """A plate of 6 x 1 x 6 voxels (two flat sides, rounded rims) in a zero margin: the fuzzer's 4 x 1 x 4 blob has
+    no vertex farther than the least radius (``radius.VOXEL_FLOOR`` voxels) from its rims."""
+    image = np.zeros((10, 5, 10), dtype=np.uint8)
+    image[2:8, 2, 2:8] = 1
     return image
 
 

@@ -59,7 +59,9 @@ rectified, positive and negative integrals ``mean_integral*`` and
 ``ici_positive``, ``ici_negative``), computed by the same code over the same
 vertices and faces as the columns above, then the area fractions of the nine
 shape-index categories of Koenderink and van Doorn
-(``shape_index_fraction_cup`` ... ``_cap``) and ``warnings``. See
+(``shape_index_fraction_cup`` ... ``_cap``: of the area of the vertices that
+have a shape index, the flat ones left out, :attr:`meshcurv.CurvatureResult.shape_index`)
+and ``warnings``. See
 :data:`COLUMNS`. ``<field>_mean`` is ``<field>_weighted`` and
 ``mean_integral``, ``gaussian_integral`` are ``total_mean``,
 ``total_gaussian``, under FreeSurfer's names.
@@ -535,11 +537,14 @@ def _area_inside(vertices, faces, cap, border, normals, triangle, corrected, opt
 #: of about one voxel (1.1-1.3 h where the same balls whole get 3-5 h), which does not average the staircase
 #: out. Measured on the 660 balls of radius 4-14 voxels cut by 1-3 image faces of ``benchmarks/fuzz_labels.py``
 #: (seed 7): the radius is 0.81 (median; 5th percentile 0.54) of the rule's radius for the true curvature.
-CUT_PILOT_RIM = 2.0
+#: 2.01, not 2: off the lattice's distances (marching cubes' vertices lie at whole and half voxels from the image
+#: faces; at 2.0 the last bits of the spacing decided which vertices the pilot read: a cut ball's radius 3.9987 at
+#: unit spacing, 3.9155 at 1e-3; fuzz_labels round 25, seed 452 case 190).
+CUT_PILOT_RIM = 2.01
 
 #: The smallest default radius of a cut voxel label, in voxels (of the largest voxel size): what the voxel
 #: rule gives a ball of radius 4 voxels; a sliver whose pilot sees little but its rim gets at least this.
-CUT_RADIUS_FLOOR = 2.0
+CUT_RADIUS_FLOOR = 2.01  # (off the lattice's distances, as CUT_PILOT_RIM and radius.VOXEL_FLOOR)
 
 #: A label cut by the border must keep this much surface beyond the estimator's reach of the image faces it
 #: touches, in areas of one ball (``pi r^2``, ``r`` the ball radius), for its curvature statistics; with less

@@ -703,8 +703,8 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple) -> np.ndarray:
 def _crack_corners(vertices: np.ndarray, rim: np.ndarray, edge_lengths: np.ndarray) -> np.ndarray:
     """(V,) bool: the ``rim`` vertices with another rim vertex within :data:`CRACK_WIDTH` of their local edge length
     (``edge_lengths``, (V,)): the corners of a crack, whose two sides run close (faces detached from their
-    neighbours), not those of an open surface's boundary, whose rim vertices are an edge length apart. None on a
-    closed mesh."""
+    neighbours), not those of an open surface's boundary, whose rim vertices are an edge length apart. All False
+    on a closed mesh."""
     out = np.zeros(vertices.shape[0], dtype=bool)
     ids = np.flatnonzero(rim)
     if ids.size < 2:
