@@ -148,7 +148,9 @@ def test_other_ball_methods_keep_one_radius_on_a_voxel_surface(torus_2x):
     assert topology.n_faces
     r = quiet(mesh.vertices, mesh.faces, method="quadric")
     assert r.parameters["surface"] == "voxel" and "scale" not in r.parameters
-    assert np.ptp(r.radius[r.valid]) == 0
+    # one default radius; a vertex whose fit departs from a ball twice as wide's takes a grown ball (issue 29)
+    assert np.ndim(r.parameters["radius"]) == 0
+    assert np.min(r.radius[np.isfinite(r.radius)]) == pytest.approx(r.parameters["radius"], rel=1e-12)
 
 
 def _smoothed_sphere(radius, sigma):

@@ -54,8 +54,10 @@ def test_a_method_that_reads_the_staircase_says_so_once(voxel_sphere, method):
         if method == "normal_cycle":  # its smoothing too short for the staircase: the steps it needs
             assert "smoothing_steps=" in messages[0]
         return
-    # what it warns of: a share of the valid vertices off the sphere's H by more than half of it
-    assert _off_sphere(result, vertices).sum() > 0.05 * result.valid.sum()
+    # quadric: a fit that departs from a ball twice as wide's takes a grown ball or is undefined (issue 29: 95 of
+    # its 1,192 valid vertices were off the sphere's H by more than half of it; 4 now, tests/test_quadric_voxel_Q24.py)
+    assert "twice as wide" in messages[0]
+    assert _off_sphere(result, vertices).sum() <= 0.01 * result.valid.sum()
 
 
 @pytest.mark.parametrize("method", ["icc", "normal_cycle_ball"])

@@ -250,9 +250,9 @@ def _staircase_note(mesh, method: str, found: dict, result: CurvatureResult, rea
         return (
             f"this mesh is a voxel surface (marching cubes, voxel {_shown(found['voxel_spacing'])}): method "
             f"'quadric' fits jets of degree 4 that follow the staircase of the voxels at the default radius "
-            f"{parameters['radius']:.4g}, and many of its curvatures are off by a large share of the curvature "
-            f"itself; use the default method 'icc', which measures over balls scaled to the voxels, or pass a "
-            f"larger `radius`"
+            f"{parameters['radius']:.4g}, so only the vertices whose fit agrees with one over a ball twice as wide "
+            f"are kept ({int(result.valid.sum())} of {result.valid.size}); use the default method 'icc', which "
+            f"measures over balls scaled to the voxels, or pass a larger `radius`"
         )
     if method not in RING_METHODS:
         return ""
