@@ -578,7 +578,7 @@ def voxel_pilot(mesh: PreparedMesh):
         valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
         start = np.where(valid[:, None], mesh.vertex_normals, [0.0, 0.0, 1.0])
         centres = _pilot_centres(vertices, topology, valid)
-        edge = _median_edge(vertices, _adjacency(topology), topology.edges)
+        edge = _mesh_edge(mesh)
         fitted = _pilot_normals(mesh, start, NORMAL_RADIUS_RATIO * radius, centres, edge=edge)
         with np.errstate(invalid="ignore"):
             agree = np.isfinite(fitted).all(axis=1) & (np.einsum("ij,ij->i", fitted, start[centres]) > NORMAL_AGREEMENT)
@@ -869,8 +869,7 @@ def _curvatures(
     boundary_faces: np.ndarray | None = None,
     topology: MeshTopology | None = None,
     cracked: bool = False,
-    edges: np.ndarray | None = None,
-    edge: float | None = None,
+    edge: float,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -883,9 +882,8 @@ def _curvatures(
     (:func:`_corners_fitted`) and, near holes (:func:`_near_holes`), the fits whose balls wrap are made again
     (:func:`_unwrapped_normals`). ``cracked``: the mesh was welded across cracks (``PreparedMesh.n_cracked``): near
     holes, the pieces whose fits scatter (:func:`_scattered_pieces`) or whose balls hold a small piece of a staircase
-    (:func:`_stair_pieces`) are undefined. ``edges`` (E, 2): the mesh's edges, those of ``adjacency``, when the
-    caller has them (:func:`_median_edge`); ``edge``: their median length (:func:`_mesh_edge`), when the caller has
-    it.
+    (:func:`_stair_pieces`) are undefined. ``edge``: the median length of every edge (:func:`_mesh_edge`: the
+    coarse level's test and the scatter's ball).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -901,9 +899,6 @@ def _curvatures(
     start("fit normals")
     failed = np.zeros(vertices.shape[0], dtype=bool)
     counts = None  # the points of the normal fits near holes, where cracks were welded (below)
-    # the median edge that decides the coarse level of a voxel surface, taken once
-    if edge is None and coarse and adjacency is not None:
-        edge = _median_edge(vertices, adjacency, edges)
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
@@ -965,7 +960,7 @@ def _curvatures(
     if sparse is not None:
         valid &= ~sparse
     if counts is not None:
-        valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, adjacency, edges)
+        valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
         if ball_areas is not None:
             valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts))
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
@@ -990,13 +985,11 @@ SCATTER_FEW = 35
 SCATTER_TILT = 0.05
 
 
-def _scattered_pieces(
-    vertices, faces, dropped, normals, valid, counts, k_min, k_max, adjacency, edges=None
-) -> np.ndarray:
+def _scattered_pieces(vertices, faces, dropped, normals, valid, counts, k_min, k_max, edge: float) -> np.ndarray:
     """(V,) bool: the ``valid`` vertices near holes (``counts`` (V,) the points of their normal fits; inf where not
     counted) whose points scatter by ``s`` above :data:`SCATTER_TILT` and whose fit held fewer points than
     :data:`SCATTER_FEW` or :data:`SCATTER_POINTS` ``s``. ``s``: the standard deviation of the residuals of a
-    quadric over the Euclidean ball of three median edge lengths ``h`` (:func:`meshcurv.estimators.quadric.
+    quadric over the Euclidean ball of three median edge lengths ``h`` (``edge``, :func:`meshcurv.estimators.quadric.
     residual_spreads`: the ball crosses the cracks, so it sees the scatter of the pieces around) over ``h^2`` times
     the median curvedness ``sqrt((k_min^2 + k_max^2) / 2)`` of the ``valid`` vertices (clean meshes, irregular
     ones and their rims included: 0.003 to 0.03; soups of ``icosphere(24)`` and ``icosphere(40)`` by 0.03 edges:
@@ -1006,7 +999,6 @@ def _scattered_pieces(
     near = valid & np.isfinite(counts)
     if not near.any():
         return near
-    edge = _median_edge(vertices, adjacency, edges)
     ids = np.flatnonzero(near)
     pool = np.unique(faces[~dropped].ravel())
     radii = np.full(vertices.shape[0], 3.0 * edge)
@@ -1171,7 +1163,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             stages,
             neighbours=referenced,
             adjacency=_adjacency(topology),
-            edges=topology.edges,
             edge=_mesh_edge(mesh),
             areas=_vertex_areas(mesh),
             normal_radius=normal_radii,
@@ -1202,7 +1193,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 stages,
                 neighbours=referenced,
                 adjacency=_adjacency(topology),
-                edges=topology.edges,
                 edge=_mesh_edge(mesh),
                 areas=_vertex_areas(mesh),
                 weighted=not even,
@@ -1233,7 +1223,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             stages if fields is None else None,
             neighbours=referenced,
             adjacency=_adjacency(topology),
-            edges=topology.edges,
             edge=_mesh_edge(mesh),
             areas=_vertex_areas(mesh),
             topology=bounded,
@@ -1290,7 +1279,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
     # the fits of the radii not fitted on the coarse level, from one walk per vertex (the radii increase, and
     # so does _dense: the radii fitted so are the first ones)
-    edge = _median_edge(vertices, _adjacency(topology), topology.edges)
+    edge = _mesh_edge(mesh)
     fine = [NORMAL_RADIUS_RATIO * r for r in radii if not NORMAL_RADIUS_RATIO * r > COARSE_EDGES * edge]
     fits = (
         nested_jet_normals(
