@@ -183,9 +183,10 @@ STRUCTURE_GROWTH = SCATTER_SCALE**0.75
 RESIDUAL_DOF_FLOOR = 1e-6
 
 
-#: A quadric at the default radius over a crack (:func:`_cracked_balls`) whose principal curvatures depart from those
-#: of the quadric over a ball :data:`SCATTER_SCALE` times wider by more than this many of its noise spreads follows
-#: its scatter (:func:`_scatter_check`, step 5): the spread assumes independent noise,
+#: A quadric at the default radius on a noisy mesh off cracks (:data:`ROUGH_LEVEL`; over cracks
+#: :data:`CRACK_DEPARTURE_SPREADS`) whose principal curvatures depart from those of the quadric over a ball
+#: :data:`SCATTER_SCALE` times wider by more than this many of its noise spreads, while its residuals grew less than
+#: :data:`STRUCTURE_GROWTH`, follows its scatter (:func:`_scatter_check`, step 5): the spread assumes independent noise,
 #: and a staircase's steps (a voxel surface whose faces are detached: issue 29, fuzz 415/108) pull a fit by three
 #: times as much (a quadric over 2.4 voxels of ``voxel_sphere(10)`` detached by 0.042 edge lengths: H off by 0.16
 #: for spreads of 0.06; off the wider ball's by 2.6-6.7 spreads, where the near fits within a fifth of the
@@ -604,12 +605,13 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool
        :data:`meshcurv.radius.JET_CURVATURE_CAP` over its curvedness, if it is; else it is NaN with
        ``valid=False``;
     5. at the vertices whose ball holds a crack's corner (``cracked``, :func:`_cracked_balls`: a soup's detached
-       faces), a quadric that departs from the wider ball's by more than :data:`DEPARTURE_SPREADS` of its spreads
-       follows the steps (the spread of independent noise underestimates their pull) whatever its residuals did:
+       faces), a quadric that departs from the wider ball's by more than :data:`CRACK_DEPARTURE_SPREADS` of its
+       spreads follows the steps (the spread of independent noise underestimates their pull) whatever its residuals did:
        one that bent to follow a step absorbed its own residuals, and the wider ball's then grew as a crease's would
        (fuzz 415/108: 264 of the 286 vertices left off grew 1.7-3.0 times). It takes the quadric of 4 if steady,
        else it is NaN with ``valid=False``. On a noisy mesh (``rough``: its median level above
-       :data:`ROUGH_LEVEL`) off cracks, only while its residuals grew less than :data:`STRUCTURE_GROWTH`, and it
+       :data:`ROUGH_LEVEL`) off cracks, by more than :data:`DEPARTURE_SPREADS` of its spreads and only while its
+       residuals grew less than :data:`STRUCTURE_GROWTH`, and it
        keeps its own fit where the grown one is not steady (fandisk's creases: made NaN, 79.98 -> 76.2-79.1%
        valid). Elsewhere the wider ball is fitted at the rows 2 failed only: at every row it cost nefertiti 1.43x
        its CPU and changed a dozen crease vertices of fandisk and rocker-arm.
