@@ -181,12 +181,21 @@ def staircase_undefined(
     across cracks, no longer read as one, is undefined the same way where its vertices away from the welds lie on a
     grid (:func:`._ring_noise.welded_staircase`).
     """
-    reading = None if stages is None else stages.voxel
     if not valid.any():
         return valid, ()
-    if not _voxel_surface(mesh, defects.invalid_vertices, reading=reading):
+    if not _voxel_surface(mesh, defects.invalid_vertices, reading=None if stages is None else stages.voxel):
         return welded_staircase(mesh, valid)
     return np.zeros_like(valid), (f"{int(valid.sum())} vertices of this voxel surface are NaN (estimate undefined)",)
+
+
+def on_staircase(mesh, defects: VertexDefects, valid: np.ndarray, *, stages: Stages | None = None) -> bool:
+    """True where :func:`staircase_undefined` leaves every vertex undefined: a voxel surface, or a mesh welded
+    across cracks whose faces away from the welds lie on a voxel grid (and ``valid`` has a vertex to lose).
+
+    ``matgeom`` reads it to mark its vertices ``valid=False`` while keeping matGeom's numbers
+    (:func:`meshcurv.estimators.matgeom.estimate`)."""
+    undefined, _ = staircase_undefined(mesh, defects, valid, stages=stages)
+    return bool(valid.any()) and not undefined.any()
 
 
 def problems(defects: VertexDefects, valid: np.ndarray, extra=()) -> list[str]:

@@ -58,7 +58,7 @@ from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
-from ._support import Stages
+from ._support import Stages, on_staircase
 from ._eigen import sorted_by_magnitude
 
 #: Relative gap (of the tensor's largest eigenvalue magnitude) within which two eigenvalues are taken as
@@ -370,6 +370,15 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         problems.append(f"{n_unreferenced} unreferenced vertices: matGeom's zeros, valid=False")
     if problems:
         problems.append("method='normal_cycle' handles such meshes correctly")
+    if on_staircase(mesh, mesh.defects(), valid, stages=stages):
+        # a ring of faces reads the voxels' steps as curvature (on voxel_sphere(10) every vertex off the exact H
+        # by some 120%): matGeom's numbers are kept, as matGeom computes them, but none is marked an estimate
+        problems.append(
+            f"{int(valid.sum())} vertices of this voxel surface are valid=False: matGeom's ring of faces reads the "
+            "voxels' staircase as curvature (its numbers kept, as matGeom computes them; method='icc' scales its "
+            "balls to the voxels)"
+        )
+        valid = np.zeros_like(valid)
     result = CurvatureResult._of_arrays(
         k_min=c1,
         k_max=c2,
