@@ -68,6 +68,10 @@ cloud-relation cases in another form: a given radius as a NumPy float64, a 0-d a
 scales it, whatever its type: :func:`scaled_radius`), ``icc`` at its default with the rule ``radius="adaptive"``
 (its scale relation: the rule's radii scale with the mesh), or a cloud's given radius also through
 ``multiscale_point_cloud_curvatures``, whose first result must be the single call's (:func:`multiscale_check`).
+``--cloud-shapes P`` (a stream of its own; 0 by default) makes a share ``P`` of the analytic clouds (not the voxel
+ones) a part the others miss (:func:`_shape_cloud`): a sphere inside a sphere 1 to 5 spacings below it (a cavity's
+wall, facing into it), a torus whose tube is 5 to 8 spacings thick, or an open cylinder, whole or half (either side,
+one for the whole sheet), with their exact H and normals.
 
 Warnings are allowed (numpy ``RuntimeWarning`` s are counted in the report).
 
@@ -1256,6 +1260,70 @@ def _voxel_cloud(rng):
     return [mesh.vertices], [mesh.normals], [mesh.mean], [largest], f"{label}, voxels {spacing}, seed {seed}"
 
 
+#: Share of the analytic cloud cases that are a nested, tubular or open part (:func:`_shape_cloud`; default 0: the
+#: draws of earlier rounds).
+CLOUD_SHAPES = 0.0
+
+
+def _shape_cloud(rng, kind):
+    """A cloud the other cases miss, with the exact outward normals, H and largest |k| at each point:
+
+    - ``nested``: a sphere inside a unit sphere, 1 to 5 spacings below it: the wall of a cavity, whose normals face
+      into the cavity (toward the centre: the documented side, as for meshes), so its H is ``-1 / r``;
+    - ``tube``: a torus of major radius 1 whose tube is 5 to 8 spacings in radius (thin parts in the other sense:
+      the ball reaches a good share around the tube); ``k = 1 / r`` around it, ``cos v / (1 + r cos v)`` along it;
+    - ``open``: a cylinder of radius 1 and height 2, open at both ends, whole or half (a sheet with a rim): H = 1/2
+      on the side of its normals, either side.
+
+    Returns ``([points], [normals], [H], [largest |k|], label)`` as :func:`_voxel_cloud`.
+    """
+    if kind == "nested":
+        n = int(rng.choice([1000, 2000, 4000]))
+        spacing = np.sqrt(4 * np.pi / n)
+        gap = float(rng.choice([1.0, 1.5, 2.0, 3.0, 5.0]))
+        inner = max(1.0 - gap * spacing, 0.4)
+        outer_points, outer_normals = _sphere_cloud(rng, n, 1.0, np.zeros(3))
+        inner_points, inner_normals = _sphere_cloud(rng, max(60, int(n * inner**2)), inner, np.zeros(3))
+        m = inner_points.shape[0]
+        return (
+            [outer_points, inner_points],
+            [outer_normals, -inner_normals],
+            [np.ones(n), np.full(m, -1.0 / inner)],
+            [np.ones(n), np.full(m, 1.0 / inner)],
+            f"sphere of radius {inner:.3g} inside the unit sphere, {(1 - inner) / spacing:.3g} spacings below it",
+        )
+    if kind == "tube":
+        minor = float(rng.choice([0.1, 0.2, 0.3]))
+        thick = float(rng.choice([5.0, 6.0, 8.0]))
+        while 4 * np.pi**2 * thick**2 / minor > 20_000:  # at most 20,000 points
+            thick -= 1.0
+        n = int(4 * np.pi**2 * thick**2 / minor)
+        u = rng.uniform(0, 2 * np.pi, size=4 * n)
+        v = rng.uniform(0, 2 * np.pi, size=4 * n)
+        # uniform by area: the area element is r (1 + r cos v) du dv
+        keep = rng.random(4 * n) < (1 + minor * np.cos(v)) / (1 + minor)
+        u, v = u[keep][:n], v[keep][:n]
+        ring = 1 + minor * np.cos(v)
+        points = np.column_stack([ring * np.cos(u), ring * np.sin(u), minor * np.sin(v)])
+        normals = np.column_stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)])
+        mean = 0.5 * (1 / minor + np.cos(v) / ring)
+        return (
+            [points],
+            [normals],
+            [mean],
+            [np.full(len(u), 1 / minor)],
+            f"torus (1, {minor:g}), tube {thick:g} spacings",
+        )
+    n = int(rng.choice([1000, 2000, 4000]))
+    span = float(rng.choice([np.pi, 2 * np.pi]))
+    u = rng.uniform(0, span, size=n)
+    z = rng.uniform(-1.0, 1.0, size=n)
+    normals = np.column_stack([np.cos(u), np.sin(u), np.zeros(n)])
+    points = normals + z[:, None] * np.array([0.0, 0.0, 1.0])
+    shown = "whole" if span > 4 else "half"
+    return [points], [normals], [np.full(n, 0.5)], [np.ones(n)], f"open cylinder ({shown}), radius 1, height 2"
+
+
 def make_cloud_case(rng):
     """An analytic point cloud with its exact mean curvature and outward normals at every point.
 
@@ -1275,12 +1343,21 @@ def make_cloud_case(rng):
     # voxel surfaces from a stream of their own (the other cases keep the draws of earlier rounds)
     voxels = np.random.default_rng(np.random.SeedSequence(rng.bit_generator.seed_seq.entropy, spawn_key=(29,)))
     kind = "voxels" if voxels.random() < VOXEL_SHARE else kind
+    # nested parts, thin tubes and open sheets from a stream of their own, drawn only when asked for
+    other = np.random.default_rng(np.random.SeedSequence(rng.bit_generator.seed_seq.entropy, spawn_key=(31,)))
+    if CLOUD_SHAPES and kind != "voxels" and other.random() < CLOUD_SHAPES:
+        kind = ["nested", "tube", "open"][int(other.integers(3))]
     labels = [f"cloud {kind}"]
     n = int(rng.choice([400, 1000, 2000, 4000]))
     points, normals, mean, kmax = [], [], [], []
+    sided = True
     if kind == "voxels":  # a voxel surface read as a cloud: the vertices of marching cubes, a staircase
         points, normals, mean, kmax, label = _voxel_cloud(voxels)
         labels.append(label)
+    if kind in ("nested", "tube", "open"):
+        points, normals, mean, kmax, label = _shape_cloud(other, kind)
+        labels.append(label)
+        sided = kind != "open"
     if kind in ("gap", "mixed", "copies", "radius"):
         radii = [1.0] + [float(rng.choice([0.5, 1.0, 2.0])) for _ in range(int(rng.integers(0, 3)))]
         x = 0.0
@@ -1396,6 +1473,7 @@ def make_cloud_case(rng):
         "sign": sign,
         "given": "normals" in kwargs,
         "resolved": kmax * area_spacing * (s if labels[-1].startswith("moved") else 1.0) <= 0.25,
+        "sided": sided,
     }
     labels.append("relation cloud truth")
     return "point_cloud_curvatures", (points,), kwargs, labels, ("cloud truth", truth)
@@ -1416,7 +1494,13 @@ def cloud_truth_check(args, kwargs, result, truth):
             f"cloud truth: H off by more than {CLOUD_TRUTH_TOLERANCE:g} of the largest |k| at "
             f"{int(wrong.sum())} of {int(valid.sum())} valid points (up to {float(np.nanmax(error[wrong])):.3g})"
         )
-    if not truth["given"]:
+    if not truth.get("sided", True):  # an open sheet: either side, but one side for the whole sheet
+        if not truth["given"] and (valid & (side > 0)).any() and (valid & (side < 0)).any():
+            broken.append(
+                f"cloud truth: an open sheet oriented both ways ({int((valid & (side > 0)).sum())} and "
+                f"{int((valid & (side < 0)).sum())} valid points)"
+            )
+    elif not truth["given"]:
         inward = valid & (side < 0)
         if inward.any():
             broken.append(
@@ -2373,7 +2457,7 @@ def summary_table(path) -> str:
 
 def main(argv=None) -> int:
     global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE, FINE_CRACKS, REAL_MESHES, CLOUD_RELATIONS
-    global RADIUS_FORMS
+    global RADIUS_FORMS, CLOUD_SHAPES
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -2398,6 +2482,14 @@ def main(argv=None) -> int:
         default=VOXEL_SHARE,
         help="share of the analytic cloud cases that are voxel surfaces (default: %(default).3g; "
         "1 for a voxel-only run)",
+    )
+    parser.add_argument(
+        "--cloud-shapes",
+        type=float,
+        default=CLOUD_SHAPES,
+        help="share of the analytic cloud cases that are a sphere inside a sphere 1-5 spacings below it (a "
+        "cavity's wall, facing into it), a torus whose tube is 5-8 spacings thick, or an open cylinder, whole or "
+        "half (either side, one for the sheet) (default: %(default)g: the draws of earlier rounds)",
     )
     parser.add_argument(
         "--wide-cracks",
@@ -2452,6 +2544,7 @@ def main(argv=None) -> int:
     options = parser.parse_args(argv)
     for name in (
         "voxel_share",
+        "cloud_shapes",
         "wide_cracks",
         "thin_shapes",
         "fine_cracks",
@@ -2471,6 +2564,7 @@ def main(argv=None) -> int:
         add_real_bases()
     ONLY_POINT_CLOUDS = options.point_clouds
     VOXEL_SHARE = options.voxel_share
+    CLOUD_SHAPES = options.cloud_shapes
     CLOUD_RELATIONS = options.cloud_relations
     RADIUS_FORMS = options.radius_forms
 
@@ -2502,6 +2596,7 @@ def main(argv=None) -> int:
                     "memory": options.memory,
                     "factor": options.factor,
                     "voxel_share": options.voxel_share,
+                    "cloud_shapes": options.cloud_shapes,
                     "wide_cracks": options.wide_cracks,
                     "thin_shapes": options.thin_shapes,
                     "fine_cracks": options.fine_cracks,

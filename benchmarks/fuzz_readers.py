@@ -38,6 +38,17 @@ is a value added to a row the format lets hold more (``another valid file``:
 OBJ ``v x y z w`` and polygons, an OFF face's colour, a PLY face row that
 starts with a new whole number: a polygon), which no reader can tell from
 the file written.
+
+Wide rows (``--wide P``, a share of the text cases from a stream of their
+own; 0 by default, the draws of earlier rounds): the same changes on files
+whose rows hold more than x, y and z, as scanners write them: CSV with a
+header naming normals and other columns in any order, XYZ of six columns
+(unit normals, read as normals without a header; or colours, which are not),
+Leica .pts (a count line, then ``x y z intensity r g b``), ASCII PLY clouds
+whose vertex properties come in any order with normals, colours and an
+intensity, and ASCII PLY meshes with such vertices, a face property beside
+the corner list and an element after the faces. The points (and the faces)
+must be those written and the normals too, where the file names them.
 """
 
 from __future__ import annotations
@@ -423,6 +434,79 @@ def text_case(kind: str, rng: random.Random):
     raise ValueError(kind)
 
 
+def _unit(rng: random.Random, n: int) -> np.ndarray:
+    """``n`` unit vectors whose written digits are read back as the same floats (and still unit)."""
+    vectors = np.array([[rng.gauss(0.0, 1.0) for _ in range(3)] for _ in range(n)])
+    return vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
+
+
+def _colour(rng: random.Random) -> list[str]:
+    return [str(rng.randint(2, 255)) for _ in range(3)]  # never a unit vector (read as normals)
+
+
+def wide_case(kind: str, rng: random.Random):
+    """``(extension, reader, rows, points, faces, extra_lines, normals)``: a file of ``kind`` in
+    :data:`WIDE_KINDS`, whose rows hold more than x, y and z; ``normals`` None when the file names none."""
+    if kind == "ply-mesh-props":
+        points, faces = _surface(rng)
+    else:
+        points = _cloud(rng)
+        faces = None
+    normals = _unit(rng, len(points))
+    columns = {"x": points[:, 0], "y": points[:, 1], "z": points[:, 2]}
+    columns.update({"nx": normals[:, 0], "ny": normals[:, 1], "nz": normals[:, 2]})
+    if kind in ("csv-normals", "txt-normals"):
+        names = ["x", "y", "z", "nx", "ny", "nz", "intensity"]
+        rng.shuffle(names)  # any order: the header says which column is which
+        columns["intensity"] = np.array([rng.uniform(0, 1) for _ in range(len(points))])
+        separator = "," if kind == "csv-normals" else " "
+        rows = [Row(names, separator, data=False)]
+        rows += [Row(_words([columns[name][i] for name in names]), separator) for i in range(len(points))]
+        return (".csv" if kind == "csv-normals" else ".txt"), "points", rows, points, None, [], normals
+    if kind in ("xyz-normals", "xyz-rgb"):
+        rows = []
+        for i, point in enumerate(points):
+            tail = _words(normals[i]) if kind == "xyz-normals" else _colour(rng)
+            rows.append(Row(_words(point) + tail))
+        return ".xyz", "points", rows, points, None, [], (normals if kind == "xyz-normals" else None)
+    if kind == "pts-leica":  # a count line, then x y z intensity r g b (Leica's scanners)
+        rows = [Row([str(len(points))], data=False)]
+        rows += [Row(_words(point) + [str(rng.randint(-2047, 2047)), *_colour(rng)]) for point in points]
+        return ".pts", "points", rows, points, None, [0], None
+    # PLY: the vertex properties in any order, with normals, colours and an intensity
+    types = {"x": "double", "y": "double", "z": "double", "nx": "double", "ny": "double", "nz": "double"}
+    types.update({"red": "uchar", "green": "uchar", "blue": "uchar", "intensity": "float"})
+    names = list(types)
+    rng.shuffle(names)
+    colours = np.array([[rng.randint(2, 255) for _ in range(3)] for _ in range(len(points))])
+    columns.update({"red": colours[:, 0], "green": colours[:, 1], "blue": colours[:, 2]})
+    columns["intensity"] = np.array([float(rng.randint(0, 100)) / 4 for _ in range(len(points))])
+    header = ["ply", "format ascii 1.0", "comment wide rows", f"element vertex {len(points)}"]
+    header += [f"property {types[name]} {name}" for name in names]
+    extra = [3]
+    if faces is not None:
+        header += [f"element face {len(faces)}"]
+        extra.append(len(header) - 1)
+        face_properties = ["property list uchar int vertex_indices", "property uchar flags"]
+        if rng.random() < 0.5:
+            face_properties.reverse()  # the corner list after a scalar
+        header += face_properties
+        header += ["element edge 2", "property int vertex1", "property int vertex2"]
+        extra.append(len(header) - 3)
+    header.append("end_header")
+    rows = [Row([line], data=False) for line in header]
+    rows += [Row([_words([columns[name][i]])[0] for name in names]) for i in range(len(points))]
+    if faces is not None:
+        for face in faces:
+            words = ["3", *map(str, face)]
+            flags = str(rng.randint(0, 9))
+            words = [*words, flags] if face_properties[0].endswith("vertex_indices") else [flags, *words]
+            rows.append(Row(words, free=True))  # a whole number added before the corners: a polygon
+        rows += [Row(map(str, faces[0][:2])), Row(map(str, faces[-1][:2]))]
+        return ".ply", "mesh", rows, points, faces, extra, None
+    return ".ply", "points", rows, points, None, extra, normals
+
+
 TEXT_KINDS = (
     "csv",
     "csv-header",
@@ -438,6 +522,9 @@ TEXT_KINDS = (
     "off",
     "stl",
 )
+
+#: Files whose rows hold more than x, y and z (``--wide``): :func:`wide_case`.
+WIDE_KINDS = ("csv-normals", "txt-normals", "xyz-normals", "xyz-rgb", "pts-leica", "ply-cloud-props", "ply-mesh-props")
 
 
 def mutate_rows(rows: list, change: str, rng: random.Random) -> tuple[str, set]:
@@ -497,13 +584,14 @@ def _text_child(path: str, reader: str, memory_bytes: int, queue) -> None:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error")
+            normals = None
             if reader == "points":
-                points, _ = io.read_points(path)
+                points, normals = io.read_points(path)
                 faces = None
             else:
                 points, faces = io.read_mesh(path)
                 faces = np.asarray(faces) if isinstance(faces, np.ndarray) else [list(f) for f in faces]
-        queue.put(("read", (points, faces)))
+        queue.put(("read", (points, faces, normals)))
     except MeshFileError as exc:
         queue.put(("error", str(exc)))
     except MissingDependencyError as exc:
@@ -518,7 +606,10 @@ def _text_child(path: str, reader: str, memory_bytes: int, queue) -> None:
 
 def judge_text(context, directory, kind, rng, timeout, memory_bytes) -> tuple[str, str, str, bytes]:
     """One text case: ``(outcome, change, detail, content)``; outcome ``correct``, ``named`` or a finding."""
-    extension, reader, rows, points, faces, extra = text_case(kind, rng)
+    if kind in WIDE_KINDS:
+        extension, reader, rows, points, faces, extra, normals = wide_case(kind, rng)
+    else:
+        (extension, reader, rows, points, faces, extra), normals = text_case(kind, rng), None
     change = rng.choice(HARMLESS + DAMAGING + DAMAGING)
     text, touched, free = mutate_rows(rows, change, rng)
     content = text.encode()
@@ -537,9 +628,11 @@ def judge_text(context, directory, kind, rng, timeout, memory_bytes) -> tuple[st
     except Exception:  # noqa: BLE001 - the child died without a word
         return "memory", change, f"child ended with code {process.exitcode}", content
     if outcome == "read":
-        got_points, got_faces = payload
+        got_points, got_faces, got_normals = payload
         if faces is None:
             same = got_points.shape == points.shape and np.array_equal(got_points, points)
+            if kind in WIDE_KINDS:  # the normals the file names, or none (colours are not normals)
+                same &= (got_normals is None) if normals is None else np.array_equal(got_normals, normals)
         else:  # the corners' coordinates, face by face (STL readers merge the repeated corners)
             same = (
                 isinstance(got_faces, np.ndarray)
@@ -550,6 +643,13 @@ def judge_text(context, directory, kind, rng, timeout, memory_bytes) -> tuple[st
             return "correct", change, "", content
         if free:  # `v x y z` -> `v x y a z`: a valid vertex with w; a face of 4 corners; an OFF face's colour
             return "another valid file", change, "", content
+        if got_points.shape == points.shape and np.array_equal(got_points, points):
+            return (
+                "wrong normals",
+                change,
+                f"normals read: {got_normals is not None}, written: {normals is not None}",
+                content,
+            )
         return "re-cut", change, f"read {got_points.shape[0]} points, not the {len(points)} written", content
     if outcome != "error":
         return outcome, change, payload, content
@@ -563,10 +663,15 @@ def judge_text(context, directory, kind, rng, timeout, memory_bytes) -> tuple[st
     return "named", change, "", content
 
 
-def run_text_rows(context, directory, rng, stop, timeout, memory_bytes, counts, findings, keep) -> None:
-    """Text cases until ``stop``; counts per kind: ``correct`` / ``named`` / each finding."""
+def run_text_rows(context, directory, rng, stop, timeout, memory_bytes, counts, findings, keep, wide=0.0) -> None:
+    """Text cases until ``stop``; counts per kind: ``correct`` / ``named`` / each finding.
+
+    A share ``wide`` of the cases is of :data:`WIDE_KINDS`, decided by a stream of its own (seeded by
+    the first draw of ``rng`` only when ``wide`` is not 0, so that the default draws those of earlier rounds).
+    """
+    widen = random.Random(rng.random() if wide else 0)
     while time.monotonic() < stop:
-        kind = rng.choice(TEXT_KINDS)
+        kind = rng.choice(WIDE_KINDS) if wide and widen.random() < wide else rng.choice(TEXT_KINDS)
         outcome, change, detail, content = judge_text(context, directory, kind, rng, timeout, memory_bytes)
         row = counts.setdefault(f"rows {kind}", {})
         row[outcome] = row.get(outcome, 0) + 1
@@ -591,6 +696,14 @@ def main(argv=None) -> int:
         help="byte mutations of every format, text rows changed in every text format, or both "
         "(half the time each; default)",
     )
+    parser.add_argument(
+        "--wide",
+        type=float,
+        default=0.0,
+        help="share of the text-row cases whose rows hold more than x, y and z: normals, colours, an intensity, "
+        "PLY properties in any order, a face property and an element after the faces (default: 0: the draws of "
+        "earlier rounds)",
+    )
     args = parser.parse_args(argv)
     rng = random.Random(args.seed)
     context = multiprocessing.get_context("fork")
@@ -606,7 +719,9 @@ def main(argv=None) -> int:
         directory = pathlib.Path(tmp)
         if args.mode != "bytes":
             middle = stop if args.mode == "rows" else time.monotonic() + 30 * args.minutes
-            run_text_rows(context, directory, rng, middle, args.timeout, memory_bytes, counts, findings, args.keep)
+            run_text_rows(
+                context, directory, rng, middle, args.timeout, memory_bytes, counts, findings, args.keep, args.wide
+            )
         corpus = seeds(directory)
         while args.mode != "rows" and time.monotonic() < stop:
             label, extension, data = rng.choice(corpus)
