@@ -20,6 +20,31 @@ _SUM_CHUNKS = 256
 _CHUNKS_PER_THREAD = 4
 
 
+@nb.njit(**_JIT)
+def _unadvised_empty(shape, dtype):
+    """An unfilled array of ``shape`` and ``dtype`` (a numpy scalar type: ``np.float64``) from numba's allocator
+    (glibc's ``malloc``) rather than numpy's.
+
+    NumPy asks the kernel to back every array of 4 MB or more with huge pages (``madvise(MADV_HUGEPAGE)``).
+    Where transparent huge pages are given to advised memory only (``/sys/kernel/mm/transparent_hugepage``
+    ``enabled`` and ``defrag`` both ``madvise``, the default of many distributions), the first write to each
+    2 MB of a fresh buffer then waits while the kernel compacts memory to find one. The large arrays of a call
+    are fresh on every call (glibc maps buffers above 32 MB afresh and hands them back when freed); those the
+    kernels write whole, in order (the face measures, the curvatures of ``icc``), are taken here. Issue 31, at
+    1M vertices (``benchmarks/faults_S24.py``): the face measures' (F, 9) took 0.15-0.29 s of system time on
+    numpy's pages, 0.05-0.06 s on these, the same user time there and in the ball sums that read them. Where
+    huge pages are given to all memory (``enabled`` ``always``), both are alike.
+    """
+    return np.empty(shape, dtype)
+
+
+@nb.njit(**_JIT)
+def _unadvised_zeros(shape):
+    """float64 zeros of ``shape`` from numba's allocator (:func:`_unadvised_empty`; numba's ``memset``, on the
+    calling thread)."""
+    return np.zeros(shape)
+
+
 @threaded
 def _mean_edge_length(vertices, edges):
     """Mean length of the edges (0 when there are none), summed in a fixed order.

@@ -10,6 +10,7 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, run_chunks, threaded
+from .geometry import _unadvised_empty
 from .jets import _fit_one, _general, _jet_outputs, _jet_scratch
 from .neighborhoods import _connected_members, _connected_walk_levels, _vertex_spans
 from .tensors import _principal_from_mean_gaussian, _tangent_eigen
@@ -64,7 +65,8 @@ def _triangle_measures(points, normals, i, j, k, turn):
 @threaded
 def face_measures(vertices, faces, normals):
     """``measures.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
-    out = np.empty((faces.shape[0], 9))  # every element written by its chunk: no fill (calloc's memset on reused pages)
+    # every element written by its chunk: no fill (calloc's memset on reused pages); no huge pages (_unadvised_empty)
+    out = _unadvised_empty((faces.shape[0], 9), np.float64)
     chunks = _CHUNKS_PER_THREAD * nb.get_num_threads()
     run_chunks(_face_measures_chunk, faces.shape[0], chunks, vertices, faces, normals, out)
     return out
@@ -91,7 +93,7 @@ def curvatures_from_measures(summed, normals):
     """``measures.curvatures_from_measures``: (N,) k_min, k_max and (N, 3) dir_min, dir_max of summed measures."""
     n = summed.shape[0]
     # each chunk writes every row of its own, NaN where undefined: no fill, serial or calloc's (issue 31)
-    out = (np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 3)))
+    out = tuple(_unadvised_empty(shape, np.float64) for shape in ((n,), (n,), (n, 3), (n, 3)))
     run_chunks(_curvatures_chunk, n, _CHUNKS_PER_THREAD * nb.get_num_threads(), summed, normals, *out)
     return out
 
