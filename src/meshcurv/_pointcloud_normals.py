@@ -46,12 +46,24 @@ import numpy as np
 from ._backend import numba_kernels
 
 # the lattice reader, shared with the meshes' voxel reading, lives in meshcurv.lattice (imported from here too)
-from .lattice import LATTICE_TOLERANCE, NO_LATTICE, Lattice, _evenly
+from .lattice import LATTICE_TOLERANCE, NO_LATTICE, Lattice, _spread
 from .lattice import read_lattice as read_lattice
 
 #: Neighbours (the point itself not counted) of the k-nearest-neighbour query that
 #: gives the spacing, the PCA normals and the orientation graph.
 NEIGHBOURS = 10
+
+#: Two distances from a point within this share of the larger are one distance (:func:`whole_ties`): the
+#: neighbours at the cut of a k-nearest-neighbour query are taken or dropped as a whole group, whatever round-off
+#: a rigid motion or a scaling of the cloud gives them (a few units of 1e-16 times the cloud's extent over the
+#: spacing: about 1e-13 at 1M points, 1e-10 moved 1,000 extents away). Distances this close are one distance to
+#: the estimates too: the geometry decides the neighbours, not the pose, the input's order or the search's.
+TIE_TOLERANCE = 1e-9
+
+#: ... unless fewer than this many neighbours would be left (no plane through them): the query's cut is kept
+#: there. Such a point's nearest are all at one distance, a ring about it (the pole of a grid of latitude and
+#: longitude, the apex of a cone of revolution), any three of which span the ring's plane.
+TIE_LEAST = 3
 
 #: The local spacing is measured at this neighbour (see :func:`local_spacing`).
 SPACING_NEIGHBOUR = 8
@@ -275,7 +287,8 @@ WINDING_CHUNK = 256
 
 
 def knn(tree, points: np.ndarray, k: int = NEIGHBOURS) -> tuple[np.ndarray, np.ndarray]:
-    """(N, k) distances and indices of the ``k`` nearest other points of each point (chunked, all cores).
+    """(N, k) distances and indices of the ``k`` nearest other points of each point (chunked, all cores), the
+    neighbours tied at the cut taken or dropped together (:func:`whole_ties`).
 
     The point itself is dropped from its row (when duplicates make it not the
     first, the first column is dropped instead: a duplicate at distance 0 is
@@ -283,12 +296,45 @@ def knn(tree, points: np.ndarray, k: int = NEIGHBOURS) -> tuple[np.ndarray, np.n
     """
     n = points.shape[0]
     k = min(k, n - 1)
-    distances = np.zeros((n, k))
-    indices = np.zeros((n, k), dtype=np.int64)
+    wide = min(k + 1, n - 1)  # (the next one too: is the cut through a tie?)
+    distances = np.zeros((n, wide))
+    indices = np.zeros((n, wide), dtype=np.int64)
     for start in range(0, n, CHUNK):
         rows = np.arange(start, min(n, start + CHUNK))
-        d, i = tree.query(points[rows], k=k + 1, workers=-1)
-        _drop_self(rows, d, i, k, distances, indices)
+        d, i = tree.query(points[rows], k=wide + 1, workers=-1)
+        _drop_self(rows, d, i, wide, distances, indices)
+    return whole_ties(distances, indices, k)
+
+
+def whole_ties(distances: np.ndarray, indices: np.ndarray, k: int, centres=None) -> tuple[np.ndarray, np.ndarray]:
+    """(N, k) the nearest neighbours ``distances, indices`` (N, k + 1) (the ``k`` nearest and the next) cut to
+    ``k``, the neighbours tied with the next dropped: a row's neighbours are decided by the geometry alone.
+
+    A query cuts a group of neighbours at one distance (within :data:`TIE_TOLERANCE`) by the order in which
+    the search met them: the input's order, the tree's, the grid's, which a rigid motion changes by round-off
+    (fandisk's vertices: 43 points with their 10th and 11th neighbours at one distance; turned, 16 of them got
+    another set of neighbours, and other normals, ``tests/test_knn_ties_K24.py``). A group tied with the
+    first neighbour beyond the cut is dropped whole; its slots hold the point itself, at the group's distance
+    (the distances along the row are those of any cut: the spacing read from them is unchanged; the graph of
+    the orientation leaves such slots out, the PCA counts the point once more). Rows with no tie at the cut
+    are the query's ``k`` nearest, and so are those where fewer than :data:`TIE_LEAST` would be left. ``k + 1``
+    columns or fewer than ``k``: returned as they are (a cloud of
+    ``k + 1`` points or fewer, every other point a neighbour). ``centres``: (N,) the point of each row (by
+    default row ``i`` is point ``i``).
+    """
+    if distances.shape[1] != k + 1:
+        return distances[:, :k], indices[:, :k]
+    cut = distances[:, k]
+    with np.errstate(invalid="ignore"):
+        rows = np.flatnonzero(distances[:, k - 1] >= cut * (1.0 - TIE_TOLERANCE))
+        tied = distances[rows, :k] >= cut[rows, None] * (1.0 - TIE_TOLERANCE)  # a suffix of each row: rows ascend
+    left = k - tied.sum(axis=1) >= min(TIE_LEAST, k)
+    rows, tied = rows[left], tied[left]
+    distances, indices = distances[:, :k].copy(), indices[:, :k].copy()
+    if rows.size:
+        own = rows if centres is None else centres[rows]
+        indices[rows] = np.where(tied, own[:, None], indices[rows])
+        distances[rows] = np.where(tied, cut[rows, None], distances[rows])
     return distances, indices
 
 
@@ -1041,8 +1087,9 @@ def unconfirmed_parts(
         from scipy.spatial import cKDTree
 
         tree = cKDTree(points)
-    queries = _part_queries(candidates[beside[labels[candidates]]], labels)
-    sources = _evenly(candidates, WINDING_SOURCES)
+    local = np.sqrt(areas)  # (each point's spacing)
+    queries = _part_queries(candidates[beside[labels[candidates]]], labels, points, local)
+    sources = _spread(candidates, WINDING_SOURCES, points, local)
     total, own = _winding(points, normals, areas, usable, tree, points[queries], queries, sources, labels)
     part = labels[queries]
     count = np.maximum(np.bincount(part, minlength=beside.size), 1)
@@ -1054,9 +1101,10 @@ def unconfirmed_parts(
     return unsure
 
 
-def _part_queries(candidates: np.ndarray, labels: np.ndarray) -> np.ndarray:
-    """(M,) sorted: :data:`WINDING_QUERIES` of the ``candidates`` evenly spaced, and of each part's (``labels``)
-    candidates :data:`FRAGMENT_QUERIES` at least (all when fewer), evenly spaced in their order."""
+def _part_queries(candidates: np.ndarray, labels: np.ndarray, points: np.ndarray, local: np.ndarray) -> np.ndarray:
+    """(M,) sorted: :data:`WINDING_QUERIES` of the ``candidates`` or more (:func:`meshcurv.lattice._spread` of
+    ``points`` (N, 3) and their spacings ``local`` (N,)), and of each part's (``labels``) candidates
+    :data:`FRAGMENT_QUERIES` at least (all when fewer), evenly spaced in their order."""
     part = labels[candidates]
     order = np.argsort(part, kind="stable")
     sizes = np.bincount(part)
@@ -1066,7 +1114,7 @@ def _part_queries(candidates: np.ndarray, labels: np.ndarray) -> np.ndarray:
     size = sizes[part]
     most = np.minimum(size, FRAGMENT_QUERIES)
     picked = (rank + 1) * most // size > rank * most // size  # ``most`` of each part's ``size``, evenly
-    return np.union1d(_evenly(candidates, WINDING_QUERIES), candidates[picked])
+    return np.union1d(_spread(candidates, WINDING_QUERIES, points, local), candidates[picked])
 
 
 def oriented_signs(
@@ -1488,8 +1536,8 @@ def winding_sides(
     candidates = np.flatnonzero(usable)
     if candidates.size < 2:
         return flips, np.zeros(n, dtype=bool)
-    queries = _evenly(candidates, WINDING_QUERIES)
-    sources = _evenly(candidates, WINDING_SOURCES)
+    queries = _spread(candidates, WINDING_QUERIES, points, spacing)
+    sources = _spread(candidates, WINDING_SOURCES, points, spacing)
     areas = np.where(usable, spacing**2, 0.0)
     nearest = None
     for evaluation in range(WINDING_ROUNDS):
@@ -1591,7 +1639,7 @@ def two_sheets(
     offset = STACKED_ALIKE_OFFSET
     if noise is not None and np.isfinite(noise):
         offset = min(STACKED_ALIKE_OFFSET, max(ALIKE_MIN_OFFSET, ALIKE_NOISE * noise))
-    sample = _evenly(candidates, WINDING_QUERIES)
+    sample = _spread(candidates, WINDING_QUERIES, points, spacing)
     # (a lattice coarser than the spacing is steeper than the orientation's flat edges)
     lattice = lattice if lattice.steps.max() <= LATTICE_RESOLVED * step else NO_LATTICE
     found = _sheet_signs(points, normals, usable, spacing, step, tree, sample, offset=offset)
@@ -1844,7 +1892,7 @@ def between_sides(
     if candidates.size <= INTERLEAVED_NEIGHBOURS:
         return flips
     step = float(np.median(spacing[candidates]))
-    queries = _evenly(candidates, WINDING_QUERIES)
+    queries = _spread(candidates, WINDING_QUERIES, points, spacing)
     k = min(WINDING_NEAR + 1, n)
     _, near = tree.query(points[queries], k=k, workers=-1)
     stacked = _stacked(points, normals, usable, step, queries, near, alike=False)
@@ -1854,7 +1902,9 @@ def between_sides(
     first = np.argmax(stacked[rows], axis=1)  # the nearest stacked neighbour (the rows are in distance order)
     middle = 0.5 * (points[queries[rows]] + points[near[rows, first]])
     areas = np.where(usable, _sheet_areas(points, normals, indices), 0.0)
-    winding = winding_at(points, normals, areas, usable, tree, middle, _evenly(candidates, WINDING_SOURCES))
+    winding = winding_at(
+        points, normals, areas, usable, tree, middle, _spread(candidates, WINDING_SOURCES, points, spacing)
+    )
     wrong_rows = rows[winding < BETWEEN_WRONG]
     if wrong_rows.size == 0:
         return flips

@@ -157,6 +157,7 @@ from .radius import (
     _checked_radii,
     _notes_by_radius,
     _cloud_noise_level,
+    _intrinsic_sample,
     cloud_radius,
     noise_rule,
 )
@@ -680,7 +681,7 @@ def _near_copies(cloud: np.ndarray):
     rows, cols = _copy_pairs(np.arange(m), distances, indices)
     with np.errstate(over="ignore", invalid="ignore"):
         scale = float(np.linalg.norm(cloud.max(axis=0) - cloud.min(axis=0))) / np.sqrt(m)
-    gap, spacing = _registration_gap(tree, cloud)
+    gap, spacing = _registration_gap(tree, cloud, distances)
     if gap > 0.0:
         # every pair within the error; a point whose every neighbour is within it may have more copies
         near = distances <= gap
@@ -711,11 +712,15 @@ def _near_copies(cloud: np.ndarray):
     return first[labels], (tree, distances, indices), registration
 
 
-def _registration_gap(tree, cloud: np.ndarray) -> tuple[float, float]:
+def _registration_gap(tree, cloud: np.ndarray, distances: np.ndarray) -> tuple[float, float]:
     """``(gap, spacing)``: the distance within which the points of a cloud of copies a registration error apart
     are copies of one point, and the spacing of its distinct points; ``(0.0, 0.0)`` for any other cloud.
+    ``distances``: (M, k) the nearest neighbours' distances of each point of ``cloud`` (M, 3).
 
-    On :data:`REGISTRATION_SAMPLE` points spread over the Morton order, the :data:`COPY_NEIGHBOURS` nearest
+    On a sample of :data:`REGISTRATION_SAMPLE` points or more that the pose and the order of the points do not
+    choose (:func:`meshcurv.radius._intrinsic_sample`, keyed by the spacing read from ``distances``: 5 registered
+    copies of a 4,000-point cloud, turned, read a spacing 4e-4 apart when the sample was spread over the Morton
+    order, and curvatures up to 0.016 of the largest apart), the :data:`COPY_NEIGHBOURS` nearest
     distances: the largest ratio of one to the next is the jump from a point's copies to the next point. When
     :data:`REGISTRATION_SHARE` of the sample or more jump by :data:`REGISTRATION_JUMP` or more, the gap is
     :data:`REGISTRATION_SPREAD` times the 90th percentile of the distances before the jump, at most
@@ -727,7 +732,10 @@ def _registration_gap(tree, cloud: np.ndarray) -> tuple[float, float]:
     k = min(COPY_NEIGHBOURS, m - 1)
     if k < 4:
         return 0.0, 0.0
-    sample = np.unique(np.linspace(0, m - 1, min(REGISTRATION_SAMPLE, m)).astype(np.int64))
+    local = _normals.local_spacing(distances)
+    if not local.mean() > 0:  # (points within round-off of one another: no length of their own)
+        local = np.ones(m)
+    sample = np.flatnonzero(_intrinsic_sample(cloud, local, REGISTRATION_SAMPLE))
     d = tree.query(cloud[sample], k=k + 1, workers=-1)[0][:, 1:]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         ratio = d[:, 1:] / d[:, :-1]
@@ -756,25 +764,27 @@ def _knn(tree, cloud: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     over a reach that holds the neighbours of :data:`KNN_REACH_SHARE` of a sample of the points (times
     :data:`KNN_REACH_FACTOR`); the rows it does not settle (fewer neighbours within the reach, or two at the
     same distance, whose order is the k-d tree's) are queried from ``tree``. The same arrays to the bit, in
-    about a third of the k-d tree's CPU time.
+    about a third of the k-d tree's CPU time. Both search one neighbour more: a group tied at the cut is
+    taken or dropped whole (:func:`meshcurv._pointcloud_normals.whole_ties`).
     """
     kernels = numba_kernels("pointcloud")
     m = cloud.shape[0]
     k = min(_normals.NEIGHBOURS, m - 1)
+    wide = min(k + 1, m - 1)
     if kernels is None or m < KNN_GRID_POINTS:
         return _normals.knn(tree, cloud)
     probe = cloud[np.linspace(0, m - 1, KNN_SAMPLE).astype(np.int64)]
-    far = tree.query(probe, k=k + 2, workers=-1)[0][:, -1]  # (the point itself, its k nearest and the next)
+    far = tree.query(probe, k=wide + 2, workers=-1)[0][:, -1]  # (the point itself, its neighbours and the next)
     reach = KNN_REACH_FACTOR * float(np.quantile(far, KNN_REACH_SHARE))
     if not (np.isfinite(reach) and reach > 0):
         return _normals.knn(tree, cloud)
     grid = numba_kernels("neighborhoods").pool_grid(cloud, np.arange(m), reach)
-    distances, indices, exact = kernels.nearest_neighbours(cloud, k, reach, *grid, 64 * kernel_threads())
+    distances, indices, exact = kernels.nearest_neighbours(cloud, wide, reach, *grid, 64 * kernel_threads())
     again = np.flatnonzero(~exact)
     if again.size:
-        d, i = tree.query(cloud[again], k=k + 1, workers=-1)
-        _normals._drop_self(again, d, i, k, distances, indices)
-    return distances, indices
+        d, i = tree.query(cloud[again], k=wide + 1, workers=-1)
+        _normals._drop_self(again, d, i, wide, distances, indices)
+    return _normals.whole_ties(distances, indices, k)
 
 
 def _kept_search(kept: np.ndarray, keep: np.ndarray, distances: np.ndarray, indices: np.ndarray):
@@ -790,17 +800,22 @@ def _kept_search(kept: np.ndarray, keep: np.ndarray, distances: np.ndarray, indi
         return None
     tree = cKDTree(kept)
     kernels = numba_kernels("pointcloud")
+    # a row with a tied group dropped at its cut (slots holding the point itself) may lose the tie with the point
+    # that went: searched again too
+    padded = (indices == np.arange(keep.size)[:, None]).any(axis=1)[keep]
     if kernels is not None:  # in place, in one pass (1M points: 0.4 CPU s of (M, k) copies in NumPy)
         m, again = kernels.kept_rows(distances, indices, keep)
-        distances, indices, again = distances[:m], indices[:m], np.flatnonzero(again)
+        distances, indices, again = distances[:m], indices[:m], np.flatnonzero(again | padded)
     else:
         distances, indices, again = _kept_rows(distances, indices, keep)
+        again = np.union1d(again, np.flatnonzero(padded))
     if again.size:
         k = distances.shape[1]
-        d, i = tree.query(kept[again], k=k + 1, workers=-1)
-        found_distances, found_indices = np.zeros((again.size, k)), np.zeros((again.size, k), dtype=np.int64)
-        _drop_rows(again, d, i, k, found_distances, found_indices)
-        distances[again], indices[again] = found_distances, found_indices
+        wide = min(k + 1, kept.shape[0] - 1)
+        d, i = tree.query(kept[again], k=wide + 1, workers=-1)
+        found_distances, found_indices = np.zeros((again.size, wide)), np.zeros((again.size, wide), dtype=np.int64)
+        _drop_rows(again, d, i, wide, found_distances, found_indices)
+        distances[again], indices[again] = _normals.whole_ties(found_distances, found_indices, k, again)
     return tree, distances, indices
 
 
