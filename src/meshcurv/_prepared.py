@@ -49,7 +49,7 @@ from ._geometry import (
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import CurvatureResult, Surface
 from .topology import MeshTopology
-from .weld import CRACK_TOLERANCE_RATIO, Welding, drop_closed_copies, drop_double_sided, weld_vertices
+from .weld import CRACK_TOLERANCE_RATIO, OneSided, Welding, _closed_copies, drop_double_sided, weld_vertices
 
 __all__ = ["PreparedMesh", "prepare_mesh"]
 
@@ -304,6 +304,85 @@ def _scales_and_needles(vertices: np.ndarray, topology: MeshTopology) -> tuple[n
     return scales, _read_only(_needle_vertices(vertices, topology, scales)), median
 
 
+def _welded(points: np.ndarray, topology: MeshTopology) -> tuple[Welding | None, int, np.ndarray | None]:
+    """``(welding, n_copies, copy_faces)``: the coincident vertices and cracks welded
+    (:func:`meshcurv.weld.weld_vertices`), then the closed parts stored twice dropped
+    (:func:`meshcurv.weld.drop_closed_copies`), as one welding of the given vertices (None: nothing welded or
+    dropped); ``n_copies`` the vertices of the copies (not in its ``n_welded``), ``copy_faces`` the (F,) bool faces
+    of the copies (None: none)."""
+    welding = weld_vertices(points, topology)
+    welded = welding if welding.n_welded else None
+    if welded is not None:
+        points, topology = welded.vertices, welded.topology
+    copies, copy_faces = _closed_copies(points, topology)
+    if not copies.n_welded:
+        return welded, 0, None
+    # one welding: the caller's vertices onto the surface measured once
+    first = welded.index if welded is not None else np.arange(points.shape[0])
+    counts = (welded.n_welded, welded.n_cracked) if welded is not None else (0, 0)
+    return Welding(copies.vertices, copies.topology, copies.index[first], *counts), copies.n_welded, copy_faces
+
+
+def _welded_one_side(
+    points: np.ndarray,
+    topology: MeshTopology,
+    first: Welding | None,
+    copy_faces: np.ndarray | None,
+    one_sided: OneSided,
+) -> tuple[Welding | None, int, OneSided]:
+    """``(welding, n_copies, one_sided)`` of :func:`_welded` and :func:`meshcurv.weld.drop_double_sided` on the faces
+    of ``points`` and ``topology`` that the drop ``one_sided`` kept after the weld ``first`` (``copy_faces``: the
+    faces of its closed copies): the one side welded from the start, as if it had been given alone. ``welding``
+    maps ``points`` onto the one side's vertices; None when nothing was welded, before or now (``one_sided`` is
+    then the drop's own: nothing more dropped).
+
+    The weld sees both sides otherwise, where the edges of a doubled face have a second face (its other side) and
+    are no boundary: the seams and cracks of the one side stayed open (issue 29, fuzz 450/125: ogre, every face
+    twice, kept its 9 seams; a sphere a third of whose faces were detached kept 96% of its vertices undefined), and
+    welded in a second pass, the cracks between vertices the first pass had joined were no longer found. The
+    vertices of the dropped faces alone (a second side with corners of its own) go to the vertex of the kept side
+    the first weld joined them to, and count as welded.
+    """
+    seen = first.topology if first is not None else topology  # the faces the drop saw
+    rows = np.flatnonzero(~copy_faces) if copy_faces is not None else np.arange(topology.n_faces)
+    kept_rows = rows[~one_sided.dropped]
+    if first is None:  # the drop saw the given faces: its kept ones, of the side it chose, are the one side
+        side, kept_points = one_sided.topology, points
+        index, dropped_only = np.arange(points.shape[0]), None
+    else:
+        faces = topology.faces.copy()
+        flipped = kept_rows[(one_sided.topology.faces != seen.faces[~one_sided.dropped]).any(axis=1)]
+        faces[flipped] = faces[flipped, ::-1]  # the side the drop chose (outward)
+        keep = np.ones(topology.n_faces, dtype=bool)
+        keep[rows[one_sided.dropped]] = False
+        faces = faces[keep]
+        referenced = np.zeros(points.shape[0], dtype=bool)
+        referenced[topology.faces.ravel()] = True
+        on_side = np.zeros(points.shape[0], dtype=bool)
+        on_side[faces.ravel()] = True
+        # each vertex of the first weld at one of its copies on the kept side (a dropped face repeats a kept
+        # face's welded corners: every corner of it has one)
+        owner = np.full(first.vertices.shape[0], -1)
+        corners = faces.ravel()
+        owner[first.index[corners]] = corners
+        dropped_only = referenced & ~on_side & (owner[first.index] >= 0)
+        remaining = np.flatnonzero(~dropped_only)
+        index = np.full(points.shape[0], -1)
+        index[remaining] = np.arange(remaining.size)
+        kept_points = points[remaining]
+        side = MeshTopology._build(np.ascontiguousarray(index[faces]), remaining.size)
+        dropped_only = np.flatnonzero(dropped_only)
+        index[dropped_only] = index[owner[first.index[dropped_only]]]
+    second, n_copies, _ = _welded(kept_points, side)
+    if second is not None:
+        kept_points, side, index = second.vertices, second.topology, second.index[index]
+    elif first is None:  # nothing welded, before or now: the drop's side as it was (its length scales and needles)
+        return None, 0, one_sided
+    n_welded = (second.n_welded if second is not None else 0) + (0 if dropped_only is None else dropped_only.size)
+    welding = Welding(kept_points, side, index, n_welded, second.n_cracked if second is not None else 0)
+    return welding, n_copies, drop_double_sided(kept_points, side)
+
+
 def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: int = 3) -> PreparedMesh:
     """Check ``vertices`` and ``faces`` once and prepare them: :class:`PreparedMesh`.
 
@@ -329,24 +408,17 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         check_choice(orient, "orient", ORIENT_CHOICES)  # raises: not an orientation
     if not isinstance(weld, (bool, np.bool_)):
         raise InvalidOptionError(f"`weld` must be True or False; got {weld!r}")
-    welding = weld_vertices(points, topology) if weld else None
-    welded = welding if welding is not None and welding.n_welded else None
+    welded, n_copies, copy_faces = _welded(points, topology) if weld else (None, 0, None)
+    given = points, topology  # the mesh before the weld, in the local order
     if welded is not None:
         points, topology = welded.vertices, welded.topology
-    copies = drop_closed_copies(points, topology) if weld else None
-    n_copies = 0
-    if copies is not None and copies.n_welded:  # one welding: the caller's vertices onto the surface measured once
-        n_copies = copies.n_welded
-        first = welded.index if welded is not None else np.arange(points.shape[0])
-        welded = Welding(
-            copies.vertices,
-            copies.topology,
-            copies.index[first],
-            (welded.n_welded if welded is not None else 0),
-            (welded.n_cracked if welded is not None else 0),
-        )
-        points, topology = welded.vertices, welded.topology
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
+    n_double_sided = one_sided.n_dropped
+    if weld and one_sided.n_dropped:  # the weld saw both sides: again on the one kept (:func:`_welded_one_side`)
+        again, n_copies, one_sided = _welded_one_side(*given, welded, copy_faces, one_sided)
+        if again is not None:  # else nothing was welded, before or now: the side as the drop left it
+            welded, points = again, again.vertices
+            n_double_sided += one_sided.n_dropped
     median = None  # the median edge: found with the length scales, else on first use
     if one_sided.length_scales is not None and one_sided.needles is not None:  # found on these faces
         scales, needles = one_sided.length_scales, one_sided.needles
@@ -360,7 +432,7 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     if local is not None and welded is None:  # the mesh the caller gave, its faces oriented (and one-sided)
         surface = Surface(
             callers,
-            np.take(local.order, topology.faces) if one_sided.n_dropped else local.original_faces(topology.faces),
+            np.take(local.order, topology.faces) if n_double_sided else local.original_faces(topology.faces),
         )
     else:
         surface = Surface(points, topology.faces, index)
@@ -373,7 +445,7 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         scales,
         needles,
         welded.n_welded if welded is not None else 0,
-        one_sided.n_dropped,
+        n_double_sided,
         n_flipped,
         n_copies,
         welded.n_cracked if welded is not None else 0,

@@ -725,8 +725,15 @@ def drop_closed_copies(
     of the vertices and faces and the winding. Only meshes with two closed
     components or more cost more than a look at their component sizes.
     """
+    return _closed_copies(vertices, topology, tolerance_ratio)[0]
+
+
+def _closed_copies(
+    vertices: np.ndarray, topology: MeshTopology, tolerance_ratio: float = WELD_TOLERANCE_RATIO
+) -> tuple[Welding, np.ndarray | None]:
+    """:func:`drop_closed_copies`, and the (F,) bool faces of the copies it dropped (None: none dropped)."""
     n_vertices = vertices.shape[0]
-    unchanged = Welding(vertices, topology, np.arange(n_vertices), 0)
+    unchanged = Welding(vertices, topology, np.arange(n_vertices), 0), None
     n_components, labels = topology.vertex_components
     if n_components < 2:
         return unchanged
@@ -779,7 +786,8 @@ def drop_closed_copies(
     index = compact[representative]
     dropped_faces = np.isin(labels[topology.faces[:, 0]], list(copy_of))
     faces = np.ascontiguousarray(compact[topology.faces[~dropped_faces]])
-    return Welding(vertices[kept], MeshTopology._build(faces, int(kept.sum())), index, int(n_vertices - kept.sum()))
+    welding = Welding(vertices[kept], MeshTopology._build(faces, int(kept.sum())), index, int(n_vertices - kept.sum()))
+    return welding, dropped_faces
 
 
 def _suspect_edges(topology: MeshTopology) -> np.ndarray:
