@@ -7,6 +7,7 @@ before it). Run old and new code in turns (``PYTHONPATH=<snapshot>/src`` for the
 
     .venv/bin/python benchmarks/cpu_S24.py --size 1M --repeats 5
     .venv/bin/python benchmarks/cpu_S24.py --size 4M --peak
+    .venv/bin/python benchmarks/cpu_S24.py --size 1M --repeats 5 --trueform
 """
 
 from __future__ import annotations
@@ -37,6 +38,11 @@ def main(argv=None) -> int:
     parser.add_argument("--size", default="1M", choices=sorted(SIZES))
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--peak", action="store_true", help="one call without a warm-up: its peak memory")
+    parser.add_argument(
+        "--trueform",
+        action="store_true",
+        help="also time trueform.principal_curvatures(k=2, directions=True) in turns with each call (the peer of issue 31)",
+    )
     args = parser.parse_args(argv)
     mesh = meshcurv.shapes.icosphere(SIZES[args.size])
     v = np.ascontiguousarray(mesh.vertices)
@@ -51,22 +57,34 @@ def main(argv=None) -> int:
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         print(f"{args.size}: {n:,} vertices, peak RSS {peak / 1024:.0f} MB, {1024 * (peak - base) / n:.0f} B/vertex")
         return 0
-    meshcurv.principal_curvatures(v, f)
-    user, system = [], []
+    calls = {"meshcurv": lambda: meshcurv.principal_curvatures(v, f)}
+    if args.trueform:
+        import trueform  # a benchmark peer only (non-commercial licence), as in benchmarks/speed.py
+
+        calls["trueform"] = lambda: trueform.principal_curvatures((f, v), k=2, directions=True)
+    for call in calls.values():
+        call()  # warm-up
+    spent: dict[str, list] = {name: [] for name in calls}
     for _ in range(args.repeats):
-        start = resource.getrusage(resource.RUSAGE_SELF)
-        wall = time.perf_counter()
-        meshcurv.principal_curvatures(v, f)
-        wall = time.perf_counter() - wall
-        end = resource.getrusage(resource.RUSAGE_SELF)
-        user.append(end.ru_utime - start.ru_utime)
-        system.append(end.ru_stime - start.ru_stime)
-        print(f"  user {user[-1]:.3f} sys {system[-1]:.3f} total {user[-1] + system[-1]:.3f} wall {wall:.3f}")
-    total = np.add(user, system)
-    print(
-        f"{args.size}: median user {np.median(user):.3f} sys {np.median(system):.3f} "
-        f"user+sys {np.median(total):.3f} s ({os.getloadavg()[0]:.1f} load)"
-    )
+        for name, call in calls.items():
+            start = resource.getrusage(resource.RUSAGE_SELF)
+            wall = time.perf_counter()
+            call()
+            wall = time.perf_counter() - wall
+            end = resource.getrusage(resource.RUSAGE_SELF)
+            spent[name].append((end.ru_utime - start.ru_utime, end.ru_stime - start.ru_stime))
+            user, system = spent[name][-1]
+            print(f"  {name}: user {user:.3f} sys {system:.3f} total {user + system:.3f} wall {wall:.3f}")
+    medians = {}
+    for name, pairs in spent.items():
+        user, system = np.median(pairs, axis=0)
+        medians[name] = float(np.median(np.sum(pairs, axis=1)))
+        print(
+            f"{args.size} {name}: median user {user:.3f} sys {system:.3f} user+sys {medians[name]:.3f} s "
+            f"({os.getloadavg()[0]:.1f} load)"
+        )
+    if args.trueform:
+        print(f"{args.size}: meshcurv / trueform (user+sys medians) {medians['meshcurv'] / medians['trueform']:.2f}")
     return 0
 
 
