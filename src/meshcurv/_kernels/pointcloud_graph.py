@@ -22,7 +22,7 @@ from ._common import _JIT
 from .pointcloud import _root
 
 
-@nb.njit(parallel=True, **_JIT)
+@nb.njit(**_JIT)
 def spanning_sheets(n, rows, cols, opposite, order, n_flat, least):
     """``(signs, roots, sheets)``: :func:`meshcurv._kernels.pointcloud.spanning_signs` and the sheets on the way.
 
@@ -36,33 +36,67 @@ def spanning_sheets(n, rows, cols, opposite, order, n_flat, least):
     :func:`scipy.sparse.csgraph.connected_components` does), -1 for those of
     fewer than ``least`` points (:func:`meshcurv._pointcloud_normals._sheets`).
 
-    The edges are gathered in ``order`` first, on every core: Kruskal's walk then reads them in sequence, and
-    only its union-find jumps in memory (1M points, 6M edges: 1.07-1.19 -> 0.60-0.62 CPU s, the gather included).
+    The union-find holds 32-bit indices below 2**31 points (half the memory its jumps touch; 1M points:
+    0.32-0.35 -> 0.24-0.28 s of the walk with :func:`_flattened`).
     """
-    m = order.shape[0]
-    edge_rows, edge_cols, edge_opposite = np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8)
-    for position in nb.prange(m):
-        e = order[position]
-        edge_rows[position], edge_cols[position], edge_opposite[position] = rows[e], cols[e], opposite[e]
-    parent, flip, size = np.arange(n), np.zeros(n, dtype=np.int8), np.ones(n, dtype=np.int64)
-    sheets = np.full(n, -1, dtype=np.int64)
-    for position in range(m):
-        if position == n_flat:  # (stacked edges follow: the sheets are the components now)
-            for i in range(n):
-                sheets[i] = _root(parent, flip, i)[0]
-            _number_sheets(sheets, least)
-        _join(parent, flip, size, edge_rows[position], edge_cols[position], edge_opposite[position])
-    signs, roots = np.ones(n), np.zeros(n, dtype=np.int64)
-    for i in range(n):
-        roots[i], flipped = _root(parent, flip, i)
-        signs[i] = -1.0 if flipped else 1.0
-    if n_flat >= order.shape[0]:  # every edge flat: the sheets are the forest's components
-        sheets[:] = roots
-        _number_sheets(sheets, least)
-    return signs, roots, sheets
+    if n < 2**31:
+        return _spanning_walk(np.arange(n).astype(np.int32), rows, cols, opposite, order, n_flat, least)
+    return _spanning_walk(np.arange(n), rows, cols, opposite, order, n_flat, least)
 
 
 @nb.njit(parallel=True, **_JIT)
+def _spanning_walk(parent, rows, cols, opposite, order, n_flat, least):
+    """:func:`spanning_sheets` over the union-find ``parent`` (N,) (``np.arange(N)``, of the indices' type).
+
+    The edges are gathered in ``order`` first, on every core: Kruskal's walk then reads them in sequence, and
+    only its union-find jumps in memory (1M points, 6M edges: 1.07-1.19 -> 0.60-0.62 CPU s, the gather included).
+    Each point's root is read on every core (:func:`_flattened`), for the sheets and at the end: which trees are
+    joined and how depends on the roots and sizes only, not on the paths to the roots, so the unions after are
+    the same.
+    """
+    n, m = parent.shape[0], order.shape[0]
+    edge_rows, edge_cols = np.empty(m, parent.dtype), np.empty(m, parent.dtype)
+    edge_opposite = np.empty(m, np.int8)
+    for position in nb.prange(m):
+        e = order[position]
+        edge_rows[position], edge_cols[position], edge_opposite[position] = rows[e], cols[e], opposite[e]
+    flip, size = np.zeros(n, dtype=np.int8), np.ones(n, dtype=parent.dtype)
+    roots, flips = np.zeros(n, dtype=parent.dtype), np.zeros(n, dtype=np.int8)
+    sheets = np.full(n, -1, dtype=np.int64)
+    for position in range(m):
+        if position == n_flat:  # (stacked edges follow: the sheets are the components now)
+            _flattened(parent, flip, roots, flips)
+            sheets[:] = roots
+            _number_sheets(sheets, least)
+        _join(parent, flip, size, edge_rows[position], edge_cols[position], edge_opposite[position])
+    _flattened(parent, flip, roots, flips)
+    signs = np.ones(n)
+    for i in nb.prange(n):
+        if flips[i]:
+            signs[i] = -1.0
+    if n_flat >= m:  # every edge flat: the sheets are the forest's components
+        sheets[:] = roots
+        _number_sheets(sheets, least)
+    return signs, roots.astype(np.int64), sheets
+
+
+@nb.njit(parallel=True, **_JIT)
+def _flattened(parent, flip, roots, flips):
+    """Each point's root ``roots`` (N,) and flip relative to it ``flips`` (N,) of the union-find, on every core
+    (the walks read ``parent`` and ``flip`` only), then every point hung under its root (in a second pass: no
+    walk sees a point's new parent with its old flip)."""
+    n = parent.shape[0]
+    for i in nb.prange(n):
+        j, flipped = np.int64(i), 0
+        while parent[j] != j:
+            flipped ^= flip[j]
+            j = np.int64(parent[j])
+        roots[i], flips[i] = j, flipped
+    for i in nb.prange(n):
+        parent[i], flip[i] = roots[i], flips[i]
+
+
+@nb.njit(**_JIT)
 def _single_edges(indices, kept, used, weights):
     """(E,) bool: the ``used`` edges of the graph ``indices`` (N, k) (``kept`` (N k,): which entries are the edges,
     :func:`meshcurv._kernels.pointcloud.graph_edges`) less each edge ``i -> j`` with ``j < i`` whose reverse
@@ -73,7 +107,13 @@ def _single_edges(indices, kept, used, weights):
     it the walk makes the same unions in the same order (the same signs, roots and sheets) over fewer edges, and
     fewer weights are sorted (a k nearest graph holds most of its edges both ways).
     """
-    n, k = indices.shape
+    return _singles(indices, kept, used, weights, _row_starts(kept, indices.shape[0], indices.shape[1]))
+
+
+@nb.njit(parallel=True, **_JIT)
+def _row_starts(kept, n, k):
+    """(N + 1,) the first edge of each row of a graph of ``n`` rows of ``k`` entries, ``kept`` (N k,) of them the
+    edges, in order (:func:`meshcurv._kernels.pointcloud.graph_edges`); the edges' count last."""
     starts = np.zeros(n + 1, dtype=np.int64)
     for i in nb.prange(n):
         found = 0
@@ -82,6 +122,13 @@ def _single_edges(indices, kept, used, weights):
         starts[i + 1] = found
     for i in range(n):
         starts[i + 1] += starts[i]
+    return starts
+
+
+@nb.njit(parallel=True, **_JIT)
+def _singles(indices, kept, used, weights, starts):
+    """:func:`_single_edges` of the graph whose rows' first edges are ``starts`` (:func:`_row_starts`)."""
+    n, k = indices.shape
     single = used.copy()
     for i in nb.prange(n):
         e = starts[i]
@@ -100,6 +147,48 @@ def _single_edges(indices, kept, used, weights):
                         f += 1
             e += 1
     return single
+
+
+@nb.njit(parallel=True, **_JIT)
+def _single_edge_keys(indices, kept, used, flat, weights, scale):
+    """``(positions, codes, n_flat, fits)``: the edges :func:`_single_edges` keeps, compacted, with the keys of
+    :func:`meshcurv._pointcloud_normals._forest_order`, in one pass on every core.
+
+    ``positions`` (S,) int64 are the kept edges of ``used`` (E,) in increasing order (``np.flatnonzero`` of
+    :func:`_single_edges`), ``codes`` (S,) uint64 their ``weights`` (E,) times ``scale`` rounded to the nearest
+    integer (half to even, as ``np.rint``), ``n_flat`` how many of them are ``flat`` (E,) and ``fits`` whether
+    every rounded weight lies in ``[0, 2**63)`` (NaN does not: then ``codes`` is not to be used). The caller's
+    ``weights[single]``, ``flat[single]``, ``flatnonzero(single)`` and the keys' multiply, round, ``min``,
+    ``max`` and conversion were each a serial pass over the edges (1M points: about 0.35 CPU s).
+    """
+    n = indices.shape[0]
+    starts = _row_starts(kept, n, indices.shape[1])
+    single = _singles(indices, kept, used, weights, starts)
+    found = np.zeros(n + 1, dtype=np.int64)
+    for i in nb.prange(n):
+        count = 0
+        for e in range(starts[i], starts[i + 1]):
+            count += single[e]
+        found[i + 1] = count
+    for i in range(n):
+        found[i + 1] += found[i]
+    m = found[n]
+    positions, codes = np.zeros(m, dtype=np.int64), np.zeros(m, dtype=np.uint64)
+    flats, misfits = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+    top = 2.0**63
+    for i in nb.prange(n):
+        s = found[i]
+        for e in range(starts[i], starts[i + 1]):
+            if single[e]:
+                key = np.rint(weights[e] * scale)
+                positions[s] = e
+                if key >= 0.0 and key < top:
+                    codes[s] = np.uint64(key)
+                else:
+                    misfits[i] += 1
+                flats[i] += flat[e]
+                s += 1
+    return positions, codes, flats.sum(), misfits.sum() == 0
 
 
 @nb.njit(inline="always", **_JIT)
@@ -174,35 +263,61 @@ def _spread(cell):
     return (cell | (cell << np.uint64(2))) & np.uint64(0x1249249249249249)
 
 
-@nb.njit(**_JIT)
+#: The ranges of the codes :func:`stable_order` counts and places on every core: a fixed number, so that the
+#: ranges (and the work of each pass) do not depend on the threads; a stable order is unique anyway.
+SORT_RANGES = 64
+
+
+@nb.njit(parallel=True, **_JIT)
 def stable_order(code):
     """``(order, ordered)``: (N,) int64 ``np.argsort(code, kind="stable")`` of ``code`` (N,) uint64 and (N,)
     ``code[order]``: a least-significant-digit radix sort, 8 bits a pass, the passes over bytes every code holds
-    as 0 skipped. A stable order is unique."""
+    as 0 skipped. A stable order is unique.
+
+    Each pass counts the digits of :data:`SORT_RANGES` consecutive ranges of the codes on every core, then
+    places each range's codes on every core: a digit's codes of range ``r`` after those of the ranges before
+    it, each range's in their order, which is the order of one serial pass (1M points, 3.5M edge weights, 4
+    passes: 0.115 -> about 0.06 s of wall on two cores).
+    """
     n = code.shape[0]
     order, keys = np.arange(n), code.copy()
     spare_order, spare_keys = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.uint64)
+    ranges = max(min(SORT_RANGES, n), 1)
+    bounds = np.zeros(ranges + 1, dtype=np.int64)
+    for r in range(ranges + 1):
+        bounds[r] = r * n // ranges
+    held = np.zeros(ranges, dtype=np.uint64)
+    for r in nb.prange(ranges):
+        value = np.uint64(0)
+        for i in range(bounds[r], bounds[r + 1]):
+            value |= code[i]
+        held[r] = value
     used = np.uint64(0)
-    for i in range(n):
-        used |= code[i]
-    counts = np.zeros(256, dtype=np.int64)
+    for r in range(ranges):
+        used |= held[r]
+    counts = np.zeros((ranges, 256), dtype=np.int64)
     for byte in range(8):
         shift = np.uint64(8 * byte)
         if ((used >> shift) & np.uint64(255)) == 0:
             continue
-        counts[:] = 0
-        for i in range(n):
-            counts[(keys[i] >> shift) & np.uint64(255)] += 1
+        for r in nb.prange(ranges):
+            for digit in range(256):
+                counts[r, digit] = 0
+            for i in range(bounds[r], bounds[r + 1]):
+                counts[r, (keys[i] >> shift) & np.uint64(255)] += 1
         total = 0
         for digit in range(256):
-            count = counts[digit]
-            counts[digit] = total
-            total += count
-        for i in range(n):
-            digit = (keys[i] >> shift) & np.uint64(255)
-            spare_order[counts[digit]] = order[i]
-            spare_keys[counts[digit]] = keys[i]
-            counts[digit] += 1
+            for r in range(ranges):
+                count = counts[r, digit]
+                counts[r, digit] = total
+                total += count
+        for r in nb.prange(ranges):
+            for i in range(bounds[r], bounds[r + 1]):
+                digit = (keys[i] >> shift) & np.uint64(255)
+                place = counts[r, digit]
+                spare_order[place] = order[i]
+                spare_keys[place] = keys[i]
+                counts[r, digit] = place + 1
         order, spare_order = spare_order, order
         keys, spare_keys = spare_keys, keys
     return order, keys

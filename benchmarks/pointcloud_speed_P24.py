@@ -1,0 +1,132 @@
+"""Paired speed runs of two trees on torus clouds (issue 31), with the calling thread's CPU time.
+
+Each run is one process per tree (``PYTHONPATH=<tree>/src``), the trees taken alternately (A, B, A, B, ...),
+each process warmed on 70k points first (as ``benchmarks/pointcloud_speed.py``), then timing
+``point_cloud_curvatures`` (default method) at each size: the wall time, the CPU time of the process (every
+thread) and that of the calling thread. The kernels run on the calling thread and on helper threads; every
+serial part runs on the calling thread, which also takes its share of the parallel ones: its CPU time is the
+wall time the call would take on idle cores (what a shared machine's wall time no longer tells). Stages as
+``benchmarks/pointcloud_speed.py`` (the log messages), with the calling thread's CPU too.
+
+Usage::
+
+    python benchmarks/pointcloud_speed_P24.py --trees <before> <after> --sizes 100000 1000000 --runs 3
+    python benchmarks/pointcloud_speed_P24.py --trees <tree> --runs 1 --stages   # stage table too
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import json
+import logging
+import os
+import statistics
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+
+class StageClock(logging.Handler):
+    """The wall, process CPU and calling-thread CPU time between consecutive log messages."""
+
+    def __init__(self):
+        super().__init__(level=logging.DEBUG)
+        self.marks = []
+
+    def emit(self, record):
+        label = record.msg.replace("%d ", "").replace("%s ", "").replace("point cloud: ", "")
+        self.marks.append((label, time.perf_counter(), time.process_time(), time.thread_time()))
+
+    def stages(self, end):
+        totals: dict = collections.OrderedDict()
+        for (label, *start), (_, *stop) in zip(self.marks, [*self.marks[1:], ("end", *end)]):
+            old = totals.get(label, (0.0, 0.0, 0.0))
+            totals[label] = tuple(o + b - a for o, a, b in zip(old, start, stop))
+        return totals
+
+
+def child(sizes) -> None:
+    """Time each size in this process; print one JSON line per size."""
+    sys.path.insert(0, str(HERE))
+    from pointcloud import sample
+
+    from meshcurv.pointcloud import point_cloud_curvatures
+
+    def timed(points):
+        clock = StageClock()
+        loggers = [logging.getLogger(name) for name in ("meshcurv.pointcloud", "meshcurv._pointcloud_estimators")]
+        for logger in loggers:
+            logger.addHandler(clock)
+            logger.setLevel(logging.DEBUG)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                start = (time.perf_counter(), time.process_time(), time.thread_time())
+                point_cloud_curvatures(points)
+                end = (time.perf_counter(), time.process_time(), time.thread_time())
+        finally:
+            for logger in loggers:
+                logger.removeHandler(clock)
+        return [b - a for a, b in zip(start, end)], clock.stages(end)
+
+    warm = sample("torus", 70_000)[0]
+    warm[1] = warm[0] + 1e-9
+    timed(warm)
+    for n in sizes:
+        (wall, cpu, main), stages = timed(sample("torus", n)[0])
+        print(
+            json.dumps({"n": n, "wall": wall, "cpu": cpu, "main": main, "load": os.getloadavg()[0], "stages": stages})
+        )
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--trees", nargs="+", help="trees (each with a src/ directory), run alternately")
+    parser.add_argument("--sizes", type=int, nargs="+", default=[100_000, 1_000_000])
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--stages", action="store_true", help="the stages of each tree's median run too")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.child:
+        child(args.sizes)
+        return 0
+    found: dict = collections.defaultdict(list)
+    for run in range(args.runs):
+        for tree in args.trees:
+            env = {**os.environ, "PYTHONPATH": str(Path(tree).resolve() / "src")}
+            command = [sys.executable, __file__, "--child", "--sizes", *map(str, args.sizes)]
+            output = subprocess.run(command, env=env, check=True, capture_output=True, text=True).stdout
+            for line in output.splitlines():
+                if line.startswith("{"):
+                    row = json.loads(line)
+                    found[tree, row["n"]].append(row)
+                    print(
+                        f"| {tree} | run {run + 1} | {row['n']} | {row['wall']:.2f} | {row['cpu']:.2f} | "
+                        f"{row['main']:.2f} | {row['load']:.1f} |",
+                        flush=True,
+                    )
+    print(
+        "\n| tree | points | wall s | CPU s | calling thread CPU s (median of runs; min-max) |\n|---|---|---|---|---|"
+    )
+    for (tree, n), rows in found.items():
+        parts = [f"{statistics.median(r[key] for r in rows):.2f}" for key in ("wall", "cpu")]
+        main_times = [r["main"] for r in rows]
+        spread = f"{statistics.median(main_times):.2f} ({min(main_times):.2f}-{max(main_times):.2f})"
+        print(f"| {tree} | {n} | {' | '.join(parts)} | {spread} |")
+    if args.stages:
+        for (tree, n), rows in found.items():
+            middle = sorted(rows, key=lambda r: r["main"])[len(rows) // 2]
+            detail = "; ".join(
+                f"{label} {c:.2f} ({m:.2f})" for label, (w, c, m) in middle["stages"].items() if c >= 0.005
+            )
+            print(f"\n{tree}, {n} points, stages: CPU s (calling thread CPU s): {detail}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
