@@ -531,11 +531,6 @@ def test_edge_area_densities_spread_each_face_over_its_edges():
 # --- a closed part's vertex far beyond the part around it (fuzz_api seed 480, case 75) ----------
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="orient._fast_winding_numbers: the NumPy twin's expansion overflows (|r|^7) at a query 1e45 sizes from "
-    "the faces, or underflows near a spike 1e74 sizes long; a patch is with the lead (fuzz round 26)",
-)
 @pytest.mark.parametrize("far", [1e45, 1e74])
 def test_winding_numbers_of_a_far_spike_raise_no_overflow_warning(far):
     from meshcurv._backend import use_backend
@@ -553,3 +548,32 @@ def test_winding_numbers_of_a_far_spike_raise_no_overflow_warning(far):
     assert n_flipped == n_faces
     assert np.array_equal(oriented[:n_faces], faces[:n_faces])
     assert np.array_equal(oriented[n_faces:], faces[n_faces:][:, [0, 2, 1]])
+
+
+# --- jets at the rim of a noisy open sheet (fuzz_api --cloud-shapes, seed 483, case 50) -----------
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="point clouds, jets: at the rim of an open sheet under noise (0.05-0.2 spacings) the ball is one-sided "
+    "and the fit's extrapolation is kept valid: 19 of 3,741 valid points off by up to 1.07 of |k| here, all within "
+    "2.5 spacings of the rim (fuzz round 26, open)",
+)
+def test_jets_at_the_rim_of_a_noisy_open_cylinder_keep_the_sign_of_h():
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(1)
+    n = 4000
+    angle, height = rng.uniform(0, np.pi, n), rng.uniform(-1.0, 1.0, n)  # half a cylinder of radius 1, open
+    normals = np.column_stack([np.cos(angle), np.sin(angle), np.zeros(n)])
+    points = normals + height[:, None] * np.array([0.0, 0.0, 1.0])
+    spacing = float(np.median(cKDTree(points).query(points, k=9)[0][:, 8]) * np.sqrt(np.pi / 8))
+    points = points + rng.uniform(-0.2 * spacing, 0.2 * spacing, size=(n, 1)) * normals  # noise along the normal
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshcurvWarning)
+        result = point_cloud_curvatures(points, method="jets")
+    # H = 1/2 on the side of the normals used (k = 1 around, 0 along); the fuzzer's tolerance: half the largest |k|
+    side = np.sign(np.einsum("ij,ij->i", result.normals, normals))
+    error = np.abs(result.mean - side * 0.5)
+    assert result.valid.sum() > 0.8 * n
+    assert (error[result.valid] <= 0.5).all()
