@@ -383,6 +383,39 @@ def _welded_one_side(
     return welding, n_copies, drop_double_sided(kept_points, side)
 
 
+def _folded(welding: Welding) -> bool:
+    """Whether two faces on an edge the weld made (both ends welded) have their third corners at the same point: a
+    face and its copy on a second side, glued by the weld along their boundary (the second side of an open or
+    cracked mesh stored with corners of its own). Only the edges between welded vertices are looked at: on an edge
+    of two faces, the third corners from the faces' corner sums; on an edge of more, every pair of its faces."""
+    topology, points = welding.topology, welding.vertices
+    joined = np.bincount(welding.index, minlength=points.shape[0]) > 1
+    edges, counts = topology.edges, topology.edge_face_counts
+    on_weld = joined[edges[:, 0]] & joined[edges[:, 1]]
+    sums = topology.faces.sum(axis=1)
+    pairs = np.flatnonzero(on_weld & (counts == 2))
+    ends = edges[pairs].sum(axis=1)
+    third = sums[topology.edge_faces[pairs]] - ends[:, None]
+    if (points[third[:, 0]] == points[third[:, 1]]).all(axis=1).any():
+        return True
+    crowded = on_weld & (counts > 2)
+    if not crowded.any():
+        return False
+    sides = topology.face_edges
+    face, side = np.nonzero((sides >= 0) & crowded[np.maximum(sides, 0)])
+    keys = np.column_stack([sides[face, side].astype(float), points[topology.faces[face, (side + 2) % 3]]])
+    return bool(np.unique(keys, axis=0).shape[0] < keys.shape[0])
+
+
+def _coincident(welding: Welding) -> Welding:
+    """``welding`` with its vertices at the same point (the same coordinates) made one."""
+    _, first, inverse = np.unique(welding.vertices, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    faces = np.ascontiguousarray(inverse[welding.topology.faces])
+    n_welded = welding.n_welded + welding.vertices.shape[0] - first.size
+    return Welding(welding.vertices[first], MeshTopology._build(faces, first.size), inverse[welding.index], n_welded)
+
+
 def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: int = 3) -> PreparedMesh:
     """Check ``vertices`` and ``faces`` once and prepare them: :class:`PreparedMesh`.
 
@@ -413,9 +446,16 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     if welded is not None:
         points, topology = welded.vertices, welded.topology
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
+    seen = welded  # the weld whose vertices the drop saw
+    if weld and welded is not None and welded.n_welded and _folded(welded):
+        # a second side with corners of its own: its faces repeat the first's points, not their vertices
+        coincident = _coincident(welded)
+        on_points = drop_double_sided(coincident.vertices, coincident.topology)
+        if on_points.n_dropped:
+            seen, one_sided = coincident, on_points
     n_double_sided = one_sided.n_dropped
     if weld and one_sided.n_dropped:  # the weld saw both sides: again on the one kept (:func:`_welded_one_side`)
-        again, n_copies, one_sided = _welded_one_side(*given, welded, copy_faces, one_sided)
+        again, n_copies, one_sided = _welded_one_side(*given, seen, copy_faces, one_sided)
         if again is not None:  # else nothing was welded, before or now: the side as the drop left it
             welded, points = again, again.vertices
             n_double_sided += one_sided.n_dropped
