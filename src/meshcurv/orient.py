@@ -346,10 +346,21 @@ def _fast_winding_numbers(corners: np.ndarray, positions: np.ndarray | None = No
         positions = tree.corners.mean(axis=1)  # (in the tree's order and frame)
         own = np.arange(corners.shape[0], dtype=np.int64)  # each query is the centroid of the face at its place
     else:  # in the tree's frame: about its corners' mean
-        positions = (positions - origin) / extent - corners.reshape(-1, 3).mean(axis=0)
+        with np.errstate(over="ignore"):  # a query beyond float64 in this frame is far: 0 below
+            positions = (positions - origin) / extent - corners.reshape(-1, 3).mean(axis=0)
         own = np.full(positions.shape[0], -1, dtype=np.int64)
-    w = face_winding_numbers(
-        tree.corners, tree.centres, tree.dipoles, tree.moments, tree.radii, positions, own, tree.depth, WINDING_BETA
+    near = np.abs(positions).max(axis=1, initial=0.0) <= WINDING_FAR
+    w = np.zeros(positions.shape[0])
+    w[near] = face_winding_numbers(
+        tree.corners,
+        tree.centres,
+        tree.dipoles,
+        tree.moments,
+        tree.radii,
+        positions[near],
+        own[near],
+        tree.depth,
+        WINDING_BETA,
     )
     if given:
         return w
@@ -507,13 +518,17 @@ def face_winding_numbers(
         far = squared > limit[node]
         rf, mf, qf = r[far], moments[node[far]], squared[far]
         first, second = mf[:, :, :3], mf[:, :, 3:].reshape(-1, 3, 3, 3)
-        cubed = qf * np.sqrt(qf)
-        term = (
-            np.einsum("ij,ij->i", dipoles[node[far]], rf) + np.trace(first, axis1=1, axis2=2)
-        ) / cubed - 3.0 * np.einsum("ij,ijk,ik->i", rf, first, rf) / (cubed * qf)
-        traces = 2.0 * np.einsum("iaab,ib->i", second, rf) + np.einsum("iabb,ia->i", second, rf)
-        cubic = np.einsum("ia,iabc,ib,ic->i", rf, second, rf, rf)
-        term += 7.5 * cubic / (cubed * qf * qf) - 1.5 * traces / (cubed * qf)
+        # |r|^7 leaves float64 where the tree's faces span more than 1e44 of each other's sizes (fuzz_api seed 480,
+        # case 75's kind: a spike 1e74 sizes long, the other faces' queries near them): the compiled twin computes the
+        # same IEEE values without a word, so here too
+        with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+            cubed = qf * np.sqrt(qf)
+            term = (
+                np.einsum("ij,ij->i", dipoles[node[far]], rf) + np.trace(first, axis1=1, axis2=2)
+            ) / cubed - 3.0 * np.einsum("ij,ijk,ik->i", rf, first, rf) / (cubed * qf)
+            traces = 2.0 * np.einsum("iaab,ib->i", second, rf) + np.einsum("iabb,ia->i", second, rf)
+            cubic = np.einsum("ia,iabc,ib,ic->i", rf, second, rf, rf)
+            term += 7.5 * cubic / (cubed * qf * qf) - 1.5 * traces / (cubed * qf)
         part[:] += np.bincount(query[far] - lo, weights=term, minlength=part.size)
         query, node = query[~far], node[~far]
         if level < depth:
@@ -678,6 +693,12 @@ WINDING_CHUNK = 2048
 #: where each query is near most nodes (fuzz_api seed 366, case 5935: a voxel sphere's faces as a soup of random
 #: faces, out of memory under 800 MiB).
 WINDING_PAIRS = 65536
+
+#: :func:`_fast_winding_numbers` gives 0 without the tree at a query farther than this from the faces' mean, in units
+#: of their largest coordinate: there ``|w|`` is below their area over ``4 pi (1e6 - sqrt 3)^2`` (about 1e-13 of it),
+#: and the expansion's ``|r|^7`` overflowed (fuzz_api seed 480, case 75: a closed part's vertex 1e45 sizes from the
+#: part enclosing it, a RuntimeWarning of the NumPy twin).
+WINDING_FAR = 1e6
 
 #: :func:`_winding_sides` turns nothing when the undecided faces' summed area vectors exceed this share of their
 #: area (they enclose nothing: a hemisphere has a half, a saddle nearly 1; a sphere with holes nearly 0).
