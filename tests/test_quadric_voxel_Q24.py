@@ -1,11 +1,13 @@
-"""``quadric`` at the default radius of a voxel surface (issue 29; helper Q24's measurement).
+"""``quadric`` at the default radius of a voxel surface (issue 29; helpers Q24 and Q25).
 
 At a voxel surface's default radius (1.86 voxels on ``voxel_torus()``) every ball holds the staircase, and the
 noise checks were skipped there: the degree-4 jets followed the steps and were valid. ``voxel_torus()``: 1,564 of
 its 2,710 valid vertices off the exact H by more than half of the largest ``|k|`` (median error 103%), in every
 pose. Each fit is now checked against one over a ball twice as wide, as over a crack, and a ball on a
-staircase takes no fit as structure (residuals that grow over the wider ball are the steps'): the sphere and the
-ellipsoid have no valid vertex that far off; the torus 21 (see :data:`OPEN`).
+staircase takes no fit as structure (residuals that grow over the wider ball are the steps'): Q24 left the sphere
+and the ellipsoid with no valid vertex that far off, the torus with 21, the 2 x 1 x 1 sphere 6 and the
+2 x 0.5 x 0.5 ellipsoid 3 (strict xfails on 8a9367a); the fits kept are now checked against a quadric over twice
+the default ball and held within the radius of curvature of their largest ``|k|`` (Q25: none).
 """
 
 from __future__ import annotations
@@ -30,21 +32,9 @@ MESHES = {
     "ellipsoid_2x05x05": lambda: shapes.voxel_ellipsoid(spacing=(2.0, 0.5, 0.5)),
 }
 
-#: Still off (strict xfail): the grown balls the wider-ball check takes (about 3 voxels on the torus) follow the
-#: steps too. Before / now: torus 1,564 / 21 of 2,177 valid, the 2 x 1 x 1 sphere 119 / 6, the 2 x 0.5 x 0.5
-#: ellipsoid 182 / 3. Taking no grown ball on a staircase leaves 0-3 off but the torus and ellipsoids undefined
-#: and 32% of the sphere valid (tests/test_noisy_voxel_L21.py asks for 95%): not chosen.
-OPEN = {"torus", "sphere_2x1x1", "ellipsoid_2x05x05"}
-
-
-def _cases():
-    for name in sorted(MESHES):
-        marks = [pytest.mark.xfail(strict=True, reason="open: grown balls on the staircase")] if name in OPEN else []
-        yield pytest.param(name, marks=marks, id=name)
-
 
 @pytest.mark.parametrize("turned", [False, True])
-@pytest.mark.parametrize("name", list(_cases()))
+@pytest.mark.parametrize("name", sorted(MESHES))
 def test_no_valid_vertex_is_off_by_half_of_the_largest_curvature(name, turned):
     mesh = MESHES[name]()
     vertices = np.asarray(mesh.vertices, dtype=np.float64)

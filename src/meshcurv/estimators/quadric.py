@@ -219,6 +219,35 @@ ROUGH_LEVEL = 0.02
 CRACK_WIDTH = 0.5
 
 
+#: On a staircase (a voxel surface at its default radius), the departure from the wider ball's quadric, in noise
+#: spreads, beyond which a fit follows the steps (:func:`_scatter_check`, step 5; over cracks
+#: :data:`CRACK_DEPARTURE_SPREADS`): the steps are not independent noise, and their pull on a fit is coherent over the
+#: ball. At one spread, fits within 0.8-1.0 spreads of the wider ball's stayed, off the exact H by just over half of
+#: the largest ``|k|`` (``voxel_sphere(8)``, a 1 x 1 x 2 voxel sphere; issue 29).
+STAIRCASE_DEPARTURE_SPREADS = 0.5
+
+#: On a staircase, a ball of scatter is grown as if its fit's spread were this many times larger
+#: (:func:`_scatter_check`, step 4): the steps pull a fit further than independent noise of its residuals' size
+#: (:data:`DEPARTURE_SPREADS`), and balls sized for that noise alone were left following them (``voxel_sphere(15)``:
+#: 24 of 4,229 valid vertices off the exact H by more than half of the largest ``|k|``, saddles on a sphere; median H
+#: error 9.6%, now 6.3%). 2 lost a fifth of the anisotropic ellipsoid's valid vertices more (the grown balls reached
+#: beyond :data:`STAIRCASE_CURVATURE_CAP`).
+STAIRCASE_PULL = 1.5
+
+#: On a staircase, a kept fit whose mean curvature departs from that of a quadric over a ball twice its default
+#: radius (in the frame of its normal) by more than this share of its own largest ``|k|`` is NaN with
+#: ``valid=False`` (:func:`_staircase_check`): on a smooth surface the two differ by the quadric's bias, a fit that
+#: the steps bent departs (a zero fit on a flat terrace of ``voxel_sphere(3)``, saddles on ``voxel_torus()``).
+STAIRCASE_AGREEMENT = 0.3
+
+#: On a staircase, a kept fit over a ball wider than this many times the radius of curvature of its own largest
+#: ``|k|`` is NaN with ``valid=False`` (:func:`_staircase_check`): the ball reaches round the surface, where a
+#: quadric overestimates the curvature (``voxel_torus()``'s tube of 4 voxels: k 0.41-0.44 for 0.25 over balls of 3.0-3.2
+#: voxels). :data:`meshcurv.radius.JET_CURVATURE_CAP` holds the curvedness, up to ``sqrt(2)`` times below the largest
+#: ``|k|`` on a tube; 1.0 here lost a quarter of the torus' valid vertices, 1.3 kept 2 off.
+STAIRCASE_CURVATURE_CAP = 1.2
+
+
 #: Noise levels up to this read as a clean mesh in :func:`_noise_sigmas`: twice
 #: :data:`meshcurv.radius.NOISE_FLOOR`, as the vertices of a clean irregular mesh read up to 0.006 (a random
 #: ellipsoid of 2,562 points, whose degree-4 jets a noise read from the floor alone sent to quadrics 1.2
@@ -281,11 +310,14 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # the residuals' growth over the wider ball is theirs, not a crease's, so every fit is checked against the wider
     # ball's (step 5 of _scatter_check) and none passes as structure (issue 29: voxel_torus() 1,564 of 2,710 valid
     # vertices off the exact H by more than half of the largest |k| at its voxel default of 1.86 voxels, now 21 of
-    # 2,177; voxel_sphere(10) 25 -> 0 of 1,882; the noise gate alone: no valid vertex on the torus)
+    # 2,177; voxel_sphere(10) 25 -> 0 of 1,882; the noise gate alone: no valid vertex on the torus); the fits kept
+    # there are then checked against a quadric over twice the default ball (_staircase_check: the torus 21 -> 0)
     if stages.voxel_default:
         steps = referenced.copy()
         checks = (steps, steps, steps, np.zeros(n, dtype=bool))
+        default = radii.copy()  # the wider ball of the check below: twice the default, as step 3's
         unsure = _scatter_check((vertices, radii, referenced, scales), checks, fields, staircase=True)
+        unsure |= _staircase_check((vertices, default, radii, referenced), fields)
     else:
         sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
         if radius is not None:
@@ -619,7 +651,9 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool
     ``staircase``: a voxel surface at its default radius, every ball over the steps of the voxels (``checks`` all
     set but ``rough``): residuals that grow over the wider ball are the steps' and the ball's reach round the
     surface, not a crease's, so step 3 passes no fit as structure (on ``voxel_torus()`` 103 fits kept so were off
-    the exact H by more than half of the largest ``|k|``)."""
+    the exact H by more than half of the largest ``|k|``); step 5 reads a departure beyond
+    :data:`STAIRCASE_DEPARTURE_SPREADS` and step 4 grows a ball as for :data:`STAIRCASE_PULL` times its spread (the
+    steps' pull is coherent over the ball). :func:`_staircase_check` then checks the fits kept."""
     vertices, radii, referenced, groups = ball
     checked, noisy, cracked, rough = checks
     six, fitted, coefficients = fields
@@ -666,6 +700,8 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool
     with np.errstate(invalid="ignore"):
         far = (found[steps], frames[rows[steps]], wide[steps])
         reach = np.where(cracked[rows[steps]], CRACK_DEPARTURE_SPREADS, DEPARTURE_SPREADS)
+        if staircase:
+            reach = np.full(reach.shape, STAIRCASE_DEPARTURE_SPREADS)
         following[steps] = _departure(near, far) > reach * spreads_near[steps]
         following &= over_cracks | (growth < STRUCTURE_GROWTH)
     loose = ~passed | following
@@ -695,7 +731,8 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool
     # scatter: a ball grown until the spread (as r^-3) is within the reach, within the curvature's cap
     held = np.fmax(_curvedness(found, frames[rows], wide), floor[rows])
     with np.errstate(divide="ignore", invalid="ignore"):
-        grown = wide * np.cbrt(spreads / (NOISE_REACH * held)) * GROWTH_MARGIN
+        pull = STAIRCASE_PULL if staircase else 1.0
+        grown = wide * np.cbrt(pull * spreads / (NOISE_REACH * held)) * GROWTH_MARGIN
         grown = np.fmin(np.fmax(grown, radii[rows]), JET_CURVATURE_CAP / held)
     again = np.isfinite(grown) & (np.abs(grown - wide) > 0.01 * wide)
     if again.any():
@@ -712,6 +749,49 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool
     unsure[rows[~steady & ~spared]] = True
     coefficients[unsure] = np.nan
     return unsure
+
+
+def _staircase_check(ball: tuple, fields: tuple) -> np.ndarray:
+    """(V,) bool: the fits kept on a staircase that the steps bent (their coefficients made NaN).
+
+    ``ball = (vertices, default, radii, referenced)``: each vertex's default radius and that of its kept fit
+    (:func:`_scatter_check` grows some); ``fields = (six, fitted, coefficients)``, changed in place. A fit is
+    unsure where its mean curvature departs from that of a quadric over twice its default ball (in the frame of its
+    normal, :func:`residual_spreads`) by more than :data:`STAIRCASE_AGREEMENT` of its own largest ``|k|`` (a fit of
+    zero is unsure unless the wider quadric is flat too), or where its ball is wider than
+    :data:`STAIRCASE_CURVATURE_CAP` times the radius of curvature of that ``|k|``. The wider quadric and the grown balls
+    of :func:`_scatter_check` follow the steps too, but not in the same way: where they disagree, neither is the
+    surface's (issue 29: off the exact H by more than half of the largest ``|k|``, valid, ``voxel_torus()`` 21 and the
+    voxel spheres of radius 3-15 57)."""
+    vertices, default, radii, referenced = ball
+    six, fitted, coefficients = fields
+    unsure = np.zeros(vertices.shape[0], dtype=bool)
+    rows = np.flatnonzero(referenced & np.isfinite(coefficients).all(axis=1))
+    if rows.size == 0:
+        return unsure
+    k_min, k_max = principal_from_shape_operator(six[rows], fitted[rows])[:2]
+    largest = np.maximum(np.abs(k_min), np.abs(k_max))
+    wide = 2.0 * default
+    found = residual_spreads(vertices, np.flatnonzero(referenced), wide, fitted, rows)[0]
+    wide_min, wide_max = _quadric_curvatures(found, fitted[rows], wide[rows])
+    with np.errstate(invalid="ignore"):  # NaN: no wider fit, unsure
+        apart = np.abs((k_min + k_max) - (wide_min + wide_max)) / 2
+        bent = ~(apart <= STAIRCASE_AGREEMENT * largest) | (radii[rows] * largest > STAIRCASE_CURVATURE_CAP)
+    unsure[rows[bent]] = True
+    coefficients[rows[bent]] = np.nan
+    return unsure
+
+
+def _quadric_curvatures(coefficients: np.ndarray, normals: np.ndarray, radii: np.ndarray) -> tuple:
+    """``(k_min, k_max)``, each (N,), of quadrics fitted in the frames of ``normals`` (:func:`residual_spreads`, in
+    units of their ``radii``); NaN where no fit."""
+    known = np.isfinite(coefficients).all(axis=1)
+    k_min, k_max = np.full(coefficients.shape[0], np.nan), np.full(coefficients.shape[0], np.nan)
+    if known.any():
+        frame = tangent_basis(normals[known])
+        six, tilted = shape_operators(coefficients[known], (*frame, normals[known]), radii[known])
+        k_min[known], k_max[known] = principal_from_shape_operator(six, tilted)[:2]
+    return k_min, k_max
 
 
 def _crack_corners(vertices: np.ndarray, rim: np.ndarray, edge_lengths: np.ndarray) -> np.ndarray:
@@ -788,14 +868,8 @@ def _at(radii: np.ndarray, rows: np.ndarray, values: np.ndarray) -> np.ndarray:
 def _curvedness(coefficients: np.ndarray, normals: np.ndarray, radii: np.ndarray) -> np.ndarray:
     """(N,) ``sqrt((k_min^2 + k_max^2) / 2)`` of quadrics fitted in the frames of ``normals``
     (:func:`residual_spreads`, in units of their ``radii``); NaN where no fit."""
-    known = np.isfinite(coefficients).all(axis=1)
-    out = np.full(coefficients.shape[0], np.nan)
-    if known.any():
-        frame = tangent_basis(normals[known])
-        six, tilted = shape_operators(coefficients[known], (*frame, normals[known]), radii[known])
-        k_min, k_max = principal_from_shape_operator(six, tilted)[:2]
-        out[known] = np.sqrt((k_min * k_min + k_max * k_max) / 2)
-    return out
+    k_min, k_max = _quadric_curvatures(coefficients, normals, radii)
+    return np.sqrt((k_min * k_min + k_max * k_max) / 2)
 
 
 def _fitted_curvedness(fields: tuple, groups: list, vertices: np.ndarray, referenced: np.ndarray) -> np.ndarray:
