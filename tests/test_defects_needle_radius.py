@@ -102,8 +102,9 @@ def test_needles_leave_the_default_radius_and_the_other_values_as_without_them(n
     assert all(INVALID_REASONS[code] == INVALID_REASONS[NEEDLE] for code in spiked.invalid_reason[rows])
     both = spiked.valid & clean.valid
     # quadric's default fits on a staircase are undefined where a ball twice as wide disagrees (issue 29: 176 of
-    # the 300 valid vertices of this voxel sphere were off its H by more than half of it; 32 valid now)
-    assert both.sum() > (0.1 if method == "quadric" and name.startswith("voxel") else 0.7) * vertices.shape[0]
+    # the 300 valid vertices of this voxel sphere were off its H by more than half of it; 32 valid after Q24, 12 of
+    # them off; 13 now, none off: the fits that the steps bent, Q25)
+    assert both.sum() > (0.03 if method == "quadric" and name.startswith("voxel") else 0.7) * vertices.shape[0]
     mean, clean_mean = (0.5 * (r.k_min[both] + r.k_max[both]) for r in (spiked, clean))
     assert np.median(np.abs(mean - clean_mean)) <= VALUES_TOLERANCE * np.median(np.abs(clean_mean))
     # outward: about the sphere's 1 / R, not -1 / R. quadric on the voxel sphere of 4 voxels gives 0.34-0.355
