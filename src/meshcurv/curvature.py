@@ -182,6 +182,10 @@ def principal_curvatures(
     the opposite winding are dropped (:func:`meshcurv.weld.drop_double_sided`;
     the side kept is the outward one of closed parts), their number is
     ``result.parameters["n_double_sided_faces"]`` and is given in the warning.
+    The side kept is then welded as if it had been given alone (its seams and
+    cracks are boundaries only once the other side is gone), and a second side
+    stored with vertices of its own (at the same points) is found too: the
+    result is the one side's, each copy of a vertex with its twin's values.
     Without this every edge would have four faces (every vertex NaN) and the
     integrals would count the surface twice.
 
