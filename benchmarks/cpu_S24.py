@@ -51,7 +51,8 @@ def main(argv=None) -> int:
     if args.peak:
         del mesh
         before = _rss_kb()
-        meshcurv.principal_curvatures(v[:100], f[:10])  # kernels loaded (a small call): not the big call's memory
+        small = meshcurv.shapes.icosphere(4)
+        meshcurv.principal_curvatures(small.vertices, small.faces)  # kernels loaded: not the big call's memory
         base = max(_rss_kb(), before)
         meshcurv.principal_curvatures(v, f)
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
