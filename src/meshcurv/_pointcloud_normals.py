@@ -1213,17 +1213,15 @@ def oriented_signs(
         # first in the order (a flat edge weighs 1 - |cos| + a slope of at most SHEET_SLOPE, below 3; a stacked
         # one 3 or more, its |cos| clipped to 1); else, as a guard, the NumPy forest
         # (each edge taken both ways once: the later way is one Kruskal skips; 1M torus points: 5.9M -> 3.5M edges)
-        single = forest._single_edges(graph, kept, used, weights)
-        every = bool(single.all())
-        used_weights = weights if every else weights[single]
-        n_flat = int(np.count_nonzero(flat)) if every else int(np.count_nonzero(flat[single]))
-        order = _forest_order(used_weights)
-        separated = (n_flat == 0 or used_weights[order[n_flat - 1]] < 3.0) and (
-            n_flat == order.size or used_weights[order[n_flat]] >= 3.0
+        # (the single edges' positions, their count of flat ones and the order's keys in one pass on every core)
+        single, code, n_flat, fits = forest._single_edge_keys(graph, kept, used, flat, weights, 1.0 / TIE_RESOLUTION)
+        order = forest.stable_order(code)[0] if fits else _forest_order(weights[single])
+        taken = single[order]  # `order` over the single edges, as edges of the graph
+        separated = (n_flat == 0 or weights[taken[n_flat - 1]] < 3.0) and (
+            n_flat == taken.size or weights[taken[n_flat]] >= 3.0
         )
     if separated:
-        # the kernel gathers the edges in their order itself: `order` over the used edges, as edges of the graph
-        taken = order if every else np.flatnonzero(single)[order]
+        # the kernel gathers the edges in their order itself
         signs, roots, sheets = forest.spanning_sheets(
             n, rows, cols, opposite.view(np.int8), taken, n_flat, PART_MIN_POINTS
         )
