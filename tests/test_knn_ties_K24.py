@@ -75,6 +75,8 @@ def _assert_same_sets(points: np.ndarray) -> None:
 @pytest.mark.parametrize("backend", ["numba", "numpy"])
 @pytest.mark.parametrize("cloud", ["fandisk", "torus", "sphere"])
 def test_neighbour_sets_follow_the_geometry(backend, cloud):
+    if backend == "numba":
+        pytest.importorskip("numba")
     points = {"fandisk": _fandisk, "torus": lambda: _torus_grid(48, 20), "sphere": lambda: _sphere_grid(30)}[cloud]()
     with use_backend(backend):
         _assert_same_sets(points)
@@ -85,6 +87,7 @@ def test_neighbour_sets_follow_the_geometry_on_the_grid_search():
     # 65,536 points: at KNN_GRID_POINTS, the compiled grid search (its tied rows from the k-d tree)
     from meshcurv import pointcloud
 
+    pytest.importorskip("numba")
     points = _torus_grid(512, 128)
     assert points.shape[0] >= pointcloud.KNN_GRID_POINTS
     with use_backend("numba"):

@@ -46,6 +46,8 @@ def _poses(points: np.ndarray):
     [("numba", 1), pytest.param("numba", 3, marks=pytest.mark.slow), pytest.param("numpy", 3, marks=pytest.mark.slow)],
 )
 def test_normals_and_noise_follow_the_geometry(backend, poses):
+    if backend == "numba":
+        pytest.importorskip("numba")
     points = _fandisk()
     with use_backend(backend):
         reference = _curvatures(points)

@@ -38,6 +38,8 @@ def _curvatures(points: np.ndarray):
 
 @pytest.mark.parametrize("backend", ["numba", pytest.param("numpy", marks=pytest.mark.slow)])
 def test_registered_copies_read_alike_in_every_pose(backend):
+    if backend == "numba":
+        pytest.importorskip("numba")
     points = _copies()
     permutation = np.random.default_rng(5).permutation(points.shape[0])
     with use_backend(backend):
