@@ -55,6 +55,10 @@ def test_no_valid_vertex_is_off_by_half_of_the_largest_curvature(name, pose):
     largest = np.max(np.abs(np.column_stack([mesh.k_min, mesh.k_max])))
     off = result.valid & (np.abs(result.mean - mesh.mean) > 0.5 * largest)
     assert off.sum() == 0, (int(off.sum()), int(result.valid.sum()))
+    # and not by leaving everything undefined: a ball of 6 voxels or more is resolved at most of its vertices (the
+    # balls of 3 and 4 voxels are left undefined, their fits no steadier than the steps)
+    if name not in ("sphere_3", "sphere_4"):
+        assert result.valid.mean() > 0.6
 
 
 @pytest.mark.parametrize(
