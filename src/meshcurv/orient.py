@@ -333,7 +333,8 @@ def _fast_winding_numbers(corners: np.ndarray, positions: np.ndarray | None = No
 
     The winding number does not change with a shift or a scale: the corners (and positions) are taken about the
     corners' mean, in units of their largest coordinate, so that the solid angles' products stay finite (fuzz_api
-    seed 361, case 111: a mesh at 1e75 overflowed in the NumPy twin)."""
+    seed 361, case 111: a mesh at 1e75 overflowed in the NumPy twin). A position farther than :data:`WINDING_FAR`
+    of those units gets 0 without the tree."""
     origin = corners.reshape(-1, 3).mean(axis=0)
     corners = corners - origin
     extent = float(np.max(np.abs(corners))) if corners.size else 0.0

@@ -34,6 +34,10 @@ flat patch is a zero tensor in the axes, round-off in another pose): the vertex
 is ``valid=False`` too (matGeom's normal kept), so that the valid mask is the
 same in every pose.
 
+On a voxel surface (a marching-cubes staircase, or a mesh on a voxel grid:
+:func:`._support.on_staircase`) every vertex is ``valid=False``, matGeom's numbers
+kept: a ring of faces reads the one-voxel steps as curvature.
+
 The outputs are dimensionless (see the README: not curvatures in 1/length).
 
 References
