@@ -1037,8 +1037,8 @@ def sampled_jet_normals(
 
     Normal fits over balls of thousands of points (a dense voxel surface) then cost the number of samples,
     which ``spacing`` sets, not the number of centres. The samples: in each cube of side ``spacing`` (the
-    coordinate axes' cubes, :func:`mirrored_cubes`), the centre nearest the cube's middle (:func:`_cube_samples`:
-    re-indexed or mirrored points give the same samples). Each is fitted by :func:`fit_jets` with ``options`` at its own radius and keeps
+    coordinate axes' cubes), the centre nearest the cube's middle (:func:`_cube_samples`: re-indexed points
+    give the same samples). Each is fitted by :func:`fit_jets` with ``options`` at its own radius and keeps
     its :func:`jet_normals`. Every other centre takes the value at itself of a weighted linear
     least-squares fit of the samples' normals over its tangent plane (the plane of its ``normals`` row):
     the samples within ``h = width * spacing``, weights ``(1 - d^2 / h^2)^2``; where those do not span the
@@ -1183,83 +1183,29 @@ def interpolated_normals(
     return out, reached
 
 
-#: The cells of :func:`mirrored_cubes` start this share of a side from the middle of the points' bounding box, on
-#: either side of it: an irrational share, so that no boundary runs through a lattice of points (a voxel surface's
-#: vertices, at whole and half voxels: the box's middle lies on the quarter voxels, and round-off would choose).
-CUBE_SHIFT = 1.0 / np.pi
-
-
-def mirrored_cubes(points: np.ndarray, side: float, limit: int = 2**20) -> tuple[np.ndarray, np.ndarray]:
-    """The cube of side ``side`` that holds each point, on a grid that a mirror of the points mirrors.
-
-    The cubes are laid out from the middle of the points' bounding box in both directions alike: along each axis,
-    with ``u`` the coordinate less the box's middle in sides, the cube ``sign(u) floor(|u| + s)``, ``s``
-    :data:`CUBE_SHIFT` (the central one ``2 (1 - s)`` sides wide, the others one side). A mirror of the points (an
-    image flipped along an axis) mirrors the cubes and the offsets; a translation and a permutation of the axes
-    keep them. Anchored at the lowest corner, as it was, the grid met the surface of a flipped image elsewhere
-    (issue 29, fuzz_labels seed 460 case 30: a voxel ball's k_min p5 0.0386 and 0.0491 on one mesh and its
-    mirror image, ``icc``'s default). No boundary passes through a lattice of points (:data:`CUBE_SHIFT`).
-
-    Parameters
-    ----------
-    points : ndarray of shape (N, 3)
-        Finite coordinates.
-    side : float
-        The cubes' side, positive.
-    limit : int, default: 2**20
-        Largest cube index per axis: the cubes beyond it (a point flung far away) share the last one (a cast of
-        such a float is undefined).
-
-    Returns
-    -------
-    cubes : ndarray of int64 of shape (N, 3)
-        Each point's cube, 0 to ``limit`` per axis.
-    offsets : ndarray of shape (N, 3)
-        Each point's offset from its cube's middle, in sides, along each axis turned towards the points' mean (as
-        given where the mean is the box's middle): a mirror of the points keeps them.
-    """
-    middle = 0.5 * (points.min(axis=0) + points.max(axis=0))
-    u = (points - middle) / side
-    magnitude = np.floor(np.abs(u) + CUBE_SHIFT)
-    cell = np.where(u < 0, -magnitude, magnitude)
-    centre = np.where(magnitude > 0, np.sign(u) * (magnitude + 0.5 - CUBE_SHIFT), 0.0)
-    low = cell.min(axis=0) if cell.size else np.zeros(3)
-    # each axis turned towards the points' mean (none where it is the box's middle, to 1e-9 of a side): a mirror
-    # turns it back, so the offsets' signs tell mirror images apart the same way in both (_nearest_in_cubes)
-    lean = np.mean(u, axis=0) if u.size else np.zeros(3)
-    towards = np.where(np.abs(lean) > 1e-9, np.sign(lean), 1.0)
-    return np.minimum(cell - low, float(limit)).astype(np.int64), (u - centre) * towards
-
-
 def _cube_samples(points: np.ndarray, spacing: float) -> np.ndarray:
-    """Sorted indices into ``points``: in each cube of side ``spacing`` (:func:`mirrored_cubes`), the point nearest
-    its middle (distances rounded to 1e-9 of a side, ties as :func:`_nearest_in_cubes`)."""
-    cube, offset = mirrored_cubes(points, spacing)
+    """Sorted indices into ``points``: in each cube of side ``spacing`` (shifted by ``spacing / pi``: a cube
+    boundary through a lattice of points would let round-off choose), the point nearest its middle (distances
+    rounded to 1e-9 of a side, ties taken by the coordinates, never by the index)."""
+    shifted = (points - points.min(axis=0)) / spacing + 1.0 / np.pi
+    cube = np.minimum(np.floor(shifted), 2.0**20).astype(np.int64)
     key = cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2]
-    off_middle = np.round(np.einsum("ij,ij->i", offset, offset), 9)
-    return _nearest_in_cubes(offset, key, off_middle)
+    off_middle = np.round(np.einsum("ij,ij->i", shifted - cube - 0.5, shifted - cube - 0.5), 9)
+    return _nearest_in_cubes(points, key, off_middle)
 
 
-def _nearest_in_cubes(offsets: np.ndarray, key: np.ndarray, off_middle: np.ndarray) -> np.ndarray:
-    """Sorted indices into the points of ``offsets`` (N, 3), their offsets from their cube's middle
-    (:func:`mirrored_cubes`): of the points of each cube ``key`` (N,) int64, the first in the order (``off_middle``,
-    ``|x|``, ``|y|``, ``|z|``, ``x``, ``y``, ``z``) of their offsets (rounded to 1e-9 of a side), all of them where
-    several tie in every one.
-
-    A point and its mirror image about a plane through a cube's middle tie in ``off_middle`` (the central cubes of
-    :func:`mirrored_cubes`, whose middles lie on the lattice of a voxel surface): chosen by the coordinates, as
-    before, one was the other one in the mirrored surface (a voxel ball of radius 7.3 voxels and its mirror image:
-    default radii 2.3826 and 2.4109 voxels); :func:`mirrored_cubes`' offsets lean towards the points' mean, which a
-    mirror moves with them, so their signs choose the same one in both. Points whose offsets are permuted (on the
-    diagonals of a cube) go to the magnitudes."""
-    rounded = np.round(offsets, 9)
-    magnitudes = np.abs(rounded)
-    columns = (rounded[:, 2], rounded[:, 1], rounded[:, 0], magnitudes[:, 2], magnitudes[:, 1], magnitudes[:, 0])
-    ranked = np.lexsort((*columns, off_middle, key))
-    rows = np.column_stack([key[ranked], off_middle[ranked], rounded[ranked], magnitudes[ranked]])
-    first = np.r_[True, key[ranked][1:] != key[ranked][:-1]]
-    leader = np.maximum.accumulate(np.where(first, np.arange(ranked.size), 0))  # each cube's first row
-    return np.sort(ranked[(rows == rows[leader]).all(axis=1)])
+def _nearest_in_cubes(points: np.ndarray, key: np.ndarray, off_middle: np.ndarray) -> np.ndarray:
+    """Sorted indices into ``points`` (N, 3): of the points of each cube ``key`` (N,) int64, the first in the order
+    (``off_middle``, x, y, z): ``np.lexsort((z, y, x, off_middle, key))``'s first of each key, by one sort of the
+    keys and a sort of the points tied nearest their cube's middle."""
+    order = np.argsort(key, kind="stable")
+    sorted_keys = key[order]
+    starts = np.flatnonzero(np.r_[True, sorted_keys[1:] != sorted_keys[:-1]])
+    nearest = np.minimum.reduceat(off_middle[order], starts)
+    tied = order[off_middle[order] == np.repeat(nearest, np.diff(np.r_[starts, key.size]))]
+    ties = np.lexsort((points[tied, 2], points[tied, 1], points[tied, 0], key[tied]))
+    first = tied[ties][np.r_[True, key[tied][ties][1:] != key[tied][ties][:-1]]]
+    return np.sort(first)
 
 
 #: On a voxel surface, a normal fit whose ball wraps round a thin part (more than :data:`AWAY_FRACTION` of its

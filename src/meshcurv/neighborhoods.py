@@ -819,7 +819,7 @@ def _connected_face_sums(
     mean, _ = check_ball_work(centres, outer + float(reach.max()), m, centres=vertices[:m])
     indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
     values = np.ascontiguousarray(values)
-    out = kernels._unadvised_zeros((radii.shape[0], n, values.shape[2]))
+    out = np.zeros((radii.shape[0], n, values.shape[2]))
     clustered = radii.shape[0] == 1 and mean >= CLUSTER_MIN_FACES  # dense balls: clusters inside a ball added whole
     plain = radii.shape[0] == 1 and not clustered  # one ball: the kernel without the passes
     rows = max(1, min(kernel_threads(), n))
@@ -1009,12 +1009,11 @@ def _face_clusters(
     )
     area = 0.5 * float(np.median(twice))
     side = np.sqrt(size * area) if area > 0 else float(reach.max()) + 1.0
-    from .jets import mirrored_cubes  # (jets imports this module)
-
-    # cubes beyond 2^20 per axis share the last one (a face flung far away): the key fits in an int64; no cube
-    # boundary through a voxel surface's lattice of centroids, where round-off (a scaled mesh) would make other
-    # clusters; a mirrored mesh gets the mirrored cubes (mirrored_cubes)
-    cube = mirrored_cubes(centres, side)[0]
+    corner = centres.min(axis=0)
+    # cubes beyond 2^20 per axis share the last one (a face flung far away): the key fits in an int64
+    # shifted by 1 / pi of a side: the centroids of a voxel surface lie on a lattice, and a cube boundary
+    # through lattice points would let round-off (a scaled mesh) make other clusters
+    cube = np.minimum(np.floor((centres - corner) / side + 1.0 / np.pi), 2.0**20).astype(np.int64)
     _, cell = _unique_inverse(cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2])
     # faces linked through (vertex, cube) nodes: two faces of one cube that share a corner are connected
     _, node = _unique_inverse(faces.ravel() * (int(cell.max()) + 1) + np.repeat(cell, 3))

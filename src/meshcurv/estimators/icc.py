@@ -139,7 +139,6 @@ from ..jets import (
     _thin_part_normals,
     interpolated_normals,
     jet_normals,
-    mirrored_cubes,
     nested_jet_normals,
 )
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
@@ -187,9 +186,6 @@ COARSE_EDGES = 16.0
 #: 6 and 8 made the marching-cubes sphere r 1 at voxel 0.05 of ``benchmarks/accuracy.py`` 13% worse, 10 is
 #: within 4% of the fits over every vertex on each binary marching-cubes mesh there, ``benchmarks/scale_default.py``).
 COARSE_CELLS = 10.0
-#: Components of a unit normal within this of its largest count as the largest (:func:`_coarse_level`'s side of a
-#: cluster): exact ties differ by round-off (1e-16); the normals of a lattice that differ at all, by far more.
-AXIS_TIE = 1e-9
 
 #: A fitted normal is kept where its cosine with the mean of the face normals exceeds this (60 degrees).
 NORMAL_AGREEMENT = 0.5
@@ -453,21 +449,20 @@ def _unwrapped_normals(
     return fitted
 
 
-def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, edges=None, cells=None, edge=None):
+def _coarse_level(
+    vertices, normals, radius, areas, neighbours, adjacency, *, edges=None, cells=None, shift=0.0, edge=None
+):
     """The points of the normal fits of a dense surface: clusters of vertices, or None for an ordinary mesh.
 
     Used when the median ``radius`` exceeds ``edges`` (default :data:`COARSE_EDGES`) median edge lengths. The
     vertices that may enter the balls are grouped by cube of side ``median radius / cells`` (default
-    :data:`COARSE_CELLS`; :func:`meshcurv.jets.mirrored_cubes`: from the middle of the vertices' box, no boundary
-    through a voxel surface's lattice, where a given radius of 10 voxels put 378 vertices of a ball of 8.3 voxels
-    when the cubes started at the lowest vertex, and round-off chose their cubes, 1,532 clusters at unit spacing
-    and 1,533 at 0.7; a mirror image of the surface gets the mirrored cubes) and by the axis and
-    sign of their normal's largest component (the two sides of a part thinner than a cube stay apart; the components
-    tied with it, :data:`AXIS_TIE`, with theirs); each group is one point at its area-weighted centroid, weighing the
-    group's area, linked to the groups that a mesh edge joins it to. Returns ``(points, normals, allowed, (indptr,
-    indices), areas)`` over V + C points: the V vertices come first, each linked to its own group only and not
-    allowed in a ball (the fit of vertex ``v`` is centred on it and walks the groups from its own), the C groups
-    after them.
+    :data:`COARSE_CELLS`; the cubes shifted by ``shift`` of a side) and by the axis and
+    sign of their normal's largest component (the two
+    sides of a part thinner than a cube stay apart); each group is one point at its area-weighted centroid,
+    weighing the group's area, linked to the groups that a mesh edge joins it to. Returns ``(points,
+    normals, allowed, (indptr, indices), areas)`` over V + C points: the V vertices come first, each linked
+    to its own group only and not allowed in a ball (the fit of vertex ``v`` is centred on it and walks the
+    groups from its own), the C groups after them.
     """
     n = vertices.shape[0]
     inside = np.ones(n, dtype=bool) if neighbours is None else np.asarray(neighbours, dtype=bool)
@@ -481,16 +476,12 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, ed
     tails = np.repeat(np.arange(n), np.diff(indptr))
     cell = typical / (COARSE_CELLS if cells is None else cells)
     members = np.flatnonzero(inside)
-    cube = mirrored_cubes(vertices[members], cell, limit=2**52)[0]
-    # the side: the axes within round-off of the largest component, with their signs (one of 26 codes). At a voxel
-    # surface's edges and corners two or three components tie exactly ((-3, 3, 1) / sqrt(19) at a slab's corner);
-    # argmax let the last bits of a scaled mesh choose one (issue 29, fuzz_labels seed 460 case 313: a slab's area
-    # 0.05% and H 0.1% apart between the spacings x1 and x0.7), and a first axis of the tied ones would change with
-    # a permutation of the axes (a transposed image): the tied set is its own side
-    magnitude = np.abs(normals[members])
-    dominant = magnitude >= magnitude.max(axis=1, keepdims=True) - AXIS_TIE
-    side = (dominant * (1 + (normals[members] < 0)) * np.array([1, 3, 9])).sum(axis=1)
-    group = _row_groups(np.column_stack([cube, side]), (20, 20, 20, 5))
+    corner = vertices[members].min(axis=0)
+    # cells beyond 2^52 (a vertex flung far away) share the last one: a cast of such a float is undefined
+    cube = np.minimum(np.floor((vertices[members] - corner) / cell + shift), 2.0**52).astype(np.int64)
+    axis = np.argmax(np.abs(normals[members]), axis=1)
+    side = 2 * axis + (normals[members, axis] < 0)
+    group = _row_groups(np.column_stack([cube, side]), (20, 20, 20, 3))
     c = int(group.max()) + 1
     weight = areas[members]
     total = np.bincount(group, weights=weight, minlength=c)
@@ -637,6 +628,7 @@ def _pilot_normals(
             adjacency,
             edges=PILOT_COARSE_EDGES,
             cells=PILOT_COARSE_CELLS,
+            shift=1.0 / np.pi,  # the radius is a multiple of the voxel size: no cube boundary through the lattice
             edge=edge,
         )
         if positive.size
@@ -711,9 +703,9 @@ PILOT_RINGS = 2
 
 def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray) -> np.ndarray:
     """The vertices of :func:`voxel_pilot`'s fits and sums: in each cube of side :data:`PILOT_CELL_EDGES` median
-    edge lengths (:func:`meshcurv.jets.mirrored_cubes`), the valid referenced vertices nearest the cube's middle
-    (:func:`meshcurv.jets._nearest_in_cubes`; never chosen by the index: re-indexed or mirrored vertices give the
-    same centres; the cubes of the coordinate axes: a rotated mesh gets other centres)."""
+    edge lengths, the valid referenced vertex nearest the cube's middle, ties taken by the coordinates (never by
+    the index: re-indexed vertices give the same centres; the cubes of the coordinate axes: a rotated mesh gets
+    other centres)."""
     members = np.flatnonzero(valid & topology.referenced_vertices)
     if members.size == 0:
         return members
@@ -721,14 +713,15 @@ def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarr
     if not edge > 0:
         return members
     points = vertices[members]
-    # (meshcurv.jets.mirrored_cubes: no cube boundary through a voxel surface's lattice, where round-off (a scaled
-    # mesh) would pick other centres; a mirrored mesh gets the mirrored cubes)
-    cube, offset = mirrored_cubes(points, PILOT_CELL_EDGES * edge)
+    # the cubes shifted by 1 / pi of a side: a voxel surface's vertices lie on a lattice, and a cube boundary
+    # through lattice points would let round-off (a scaled mesh) pick other centres
+    shifted = (points - points.min(axis=0)) / (PILOT_CELL_EDGES * edge) + 1.0 / np.pi
+    cube = np.minimum(np.floor(shifted), 2.0**20).astype(np.int64)
     key = cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2]
     # (rounded: a lattice holds many vertices at one distance from the middle, whose round-off would depend on
-    # the scale; their ties go to the offsets' magnitudes, meshcurv.jets._nearest_in_cubes)
-    off_middle = np.round(_squared(*offset.T), 9)
-    return members[_nearest_in_cubes(offset, key, off_middle)]
+    # the scale; their tie goes to the coordinates, whose order a scaling keeps)
+    off_middle = np.round(_squared(*(shifted - cube - 0.5).T), 9)
+    return members[_nearest_in_cubes(points, key, off_middle)]
 
 
 def _spread_normals(neighbour_lists: tuple, centres: np.ndarray, fitted: np.ndarray, fallback, rings: int):
