@@ -70,9 +70,8 @@ def test_quantised_mesh_with_duplicate_faces_gives_one_default_radius(seed):
     faces = np.concatenate([faces, faces[twice]])
     results = _both(lambda: meshcurv.principal_curvatures(vertices, faces, method="quadric"))
     assert results["numpy"].parameters["surface"] == "voxel"
-    # few vertices of quadric are valid on this staircase of 2 to 6 voxels, or none (22, 0, 0 by seed; 1-7 valid
-    # before the staircase check, issue 29, Q25, 49-95% off the ellipsoid's H): the validity, the radius and the
-    # pilot agree, and the values where valid (seed 0)
+    # few vertices of quadric are valid on this staircase of 2 to 6 voxels, or none (none on these seeds; 1-7 before
+    # the staircase check, issue 29, Q25, 49-95% off the ellipsoid's H): the validity, the radius and the pilot agree
     _assert_agree(results, ("radius", "curvature_radius"))
 
 
