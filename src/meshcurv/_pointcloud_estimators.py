@@ -420,22 +420,6 @@ def _rim_balls(points, normals, radius, centres, usable) -> tuple[np.ndarray, np
         apart = np.where(member[rows], np.einsum("mkj,mkj->mk", gap, gap), np.inf)
         inner[start + rows] = theirs[rows, np.argmin(apart, axis=1)]
     return rim, inner
-    tree = cKDTree(points[pool])
-    for start in range(0, centres.size, MEASURE_CHUNK):
-        chunk = centres[start : start + MEASURE_CHUNK]
-        distance, index = tree.query(points[chunk], k=min(MAX_BALL_POINTS, pool.size), distance_upper_bound=radius)
-        index, distance = np.asarray(index).reshape(chunk.size, -1), np.asarray(distance).reshape(chunk.size, -1)
-        member = index < pool.size
-        theirs = pool[np.where(member, index, 0)]
-        reach = np.where(member, distance, 0.0).max(axis=1)
-        step = np.where(member[..., None], points[theirs] - points[chunk][:, None, :], 0.0)
-        mean = step.sum(axis=1) / np.maximum(member.sum(axis=1), 1)[:, None]
-        across = mean - np.einsum("mj,mj->m", mean, normals[chunk])[:, None] * normals[chunk]
-        rim[start : start + chunk.size] = np.sqrt(np.einsum("mj,mj->m", across, across)) > RIM_OFFSET * reach
-        apart = np.where(member, np.einsum("mkj,mkj->mk", step - mean[:, None, :], step - mean[:, None, :]), np.inf)
-        nearest = np.argmin(apart, axis=1)
-        inner[start : start + chunk.size] = np.where(member.any(axis=1), theirs[np.arange(chunk.size), nearest], chunk)
-    return rim, inner
 
 
 def _agreement(found, larger, centres, lattice):
