@@ -192,10 +192,7 @@ def _spread(candidates: np.ndarray, most: int, points: np.ndarray, local: np.nda
         return candidates
     from .radius import _intrinsic_sample  # (radius reads voxel grids from here)
 
-    length = np.asarray(local, dtype=np.float64)[candidates]
-    if not length.mean() > 0:  # (no length of their own: the distances to the centroid alone)
-        length = np.ones(candidates.size)
-    return candidates[_intrinsic_sample(points[candidates], length, most)]
+    return candidates[_intrinsic_sample(points[candidates], np.asarray(local, dtype=np.float64)[candidates], most)]
 
 
 #: Off the exact grid (:func:`voxel_grid`'s periodic reading), a coordinate is on a plane of the grid read when it

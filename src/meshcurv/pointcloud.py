@@ -732,10 +732,7 @@ def _registration_gap(tree, cloud: np.ndarray, distances: np.ndarray) -> tuple[f
     k = min(COPY_NEIGHBOURS, m - 1)
     if k < 4:
         return 0.0, 0.0
-    local = _normals.local_spacing(distances)
-    if not local.mean() > 0:  # (points within round-off of one another: no length of their own)
-        local = np.ones(m)
-    sample = np.flatnonzero(_intrinsic_sample(cloud, local, REGISTRATION_SAMPLE))
+    sample = np.flatnonzero(_intrinsic_sample(cloud, _normals.local_spacing(distances), REGISTRATION_SAMPLE))
     d = tree.query(cloud[sample], k=k + 1, workers=-1)[0][:, 1:]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         ratio = d[:, 1:] / d[:, :-1]

@@ -319,7 +319,8 @@ SAMPLE_DISTANCE_STEP = 2.0**-16
 def _intrinsic_sample(points: np.ndarray, local: np.ndarray, size: int) -> np.ndarray:
     """(M,) bool: about ``size`` of the rows of ``points`` (M, 3), chosen by what rigid motions, uniform scaling and
     re-indexing keep; ``local`` (M,): a positive length of each point that the motions carry with it (a vertex's
-    mean edge length, a point's spacing). All of them when there are no more than ``size``.
+    mean edge length, a point's spacing; where their mean is not positive, the distances alone). All of them when
+    there are no more than ``size``.
 
     Each point's key is its ``local`` length in their mean, rounded to :data:`SAMPLE_LOCAL_STEP`, and its squared
     distance to the points' centroid in their mean, rounded to :data:`SAMPLE_DISTANCE_STEP`; the points are taken
@@ -341,6 +342,8 @@ def _intrinsic_sample(points: np.ndarray, local: np.ndarray, size: int) -> np.nd
     m = points.shape[0]
     if m <= size:
         return np.ones(m, dtype=bool)
+    if not local.mean() > 0:  # (points within round-off of one another, no length of their own: the distances alone)
+        local = np.ones(m)
     # the centroid refined by the mean offset from a first guess: a shifted cloud's sum of coordinates far from the
     # origin (igea moved by 14 units) is good to 1e-9 of its extent, the offsets' pairwise sum (a column at a time:
     # no (M, 3) temporary) to 1e-15
