@@ -16,6 +16,7 @@ from meshcurv.defects import (
     NEEDLE_REACH,
     POINT_CLOUD_REASONS,
     UNDEFINED,
+    METHOD_REASONS,
     defect_codes,
     needle_vertices,
 )
@@ -60,8 +61,10 @@ def test_each_defect_reads_its_own_reason():
     assert all(INVALID_REASONS[defect.code] == defect.reason for defect in DEFECTS)
     assert INVALID_REASONS[0] == "valid" and UNDEFINED == len(INVALID_REASONS) - 1
     assert INVALID_REASONS[UNDEFINED].startswith("estimate undefined")
-    # every code once: the defects of meshes, the point clouds' reasons (8-11) and the undefined estimate
-    codes = [defect.code for defect in DEFECTS] + list(range(8, 8 + len(POINT_CLOUD_REASONS))) + [UNDEFINED]
+    # every code once: the defects of meshes, the point clouds' reasons (8-11), the methods' limits and the
+    # undefined estimate
+    codes = [defect.code for defect in DEFECTS] + list(range(8, 8 + len(POINT_CLOUD_REASONS)))
+    codes += [INVALID_REASONS.index(reason) for reason in METHOD_REASONS] + [UNDEFINED]
     assert sorted(codes) == list(range(1, len(INVALID_REASONS)))
 
 

@@ -11,6 +11,7 @@ import pytest
 
 import meshcurv
 from meshcurv import principal_curvatures, shapes
+from meshcurv.defects import INVALID_REASONS, STAIRCASE
 
 RADIUS = 10.0
 
@@ -27,6 +28,9 @@ def test_voxel_sphere_none_valid_numbers_kept(monkeypatch):
     result, message = _matgeom(mesh)
     assert not result.valid.any()
     assert "valid=False" in message and "matGeom" in message
+    # each vertex says why: the staircase, not an undefined estimate (its numbers are finite)
+    assert set(result.invalid_counts()) == {INVALID_REASONS[STAIRCASE]}
+    assert INVALID_REASONS[STAIRCASE].startswith("voxel staircase")
     # the numbers are there, and they are why nothing is valid: far from the sphere's H (matGeom's outputs are
     # dimensionless: H relative to the mean edge; the median of |H - H_exact| / |H_exact| over the vertices)
     k_min, k_max = result.k_min, result.k_max

@@ -433,7 +433,8 @@ def _finished(mesh, estimator, result: CurvatureResult, problems: list, found: d
     diagnosis = mesh_diagnosis(
         points, topology, mesh.n_flipped, mesh.length_scales, n_needle_vertices=int(mesh.needles.sum())
     )
-    reasons = mesh.defects(boundary=estimator.boundary, fragments=estimator.fragments).reasons(result.valid)
+    defects = mesh.defects(boundary=estimator.boundary, fragments=estimator.fragments)
+    reasons = defects.reasons(result.valid, result.invalid_reason)  # the estimator's codes: its limits
     parameters = {
         **result.parameters,
         **found,

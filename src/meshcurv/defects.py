@@ -31,7 +31,9 @@ __all__ = [
     "Defect",
     "DEFECTS",
     "POINT_CLOUD_REASONS",
+    "METHOD_REASONS",
     "INVALID_REASONS",
+    "STAIRCASE",
     "UNDEFINED",
     "BOUNDARY",
     "FRAGMENT",
@@ -132,16 +134,27 @@ POINT_CLOUD_REASONS = (
     "sharper than the ball, the other side of a thin part, or noise)",
 )
 
+#: Why a vertex is invalid for a limit of the method on this surface, not for a defect of the mesh: the
+#: codes after the defects of meshes found since (13).
+METHOD_REASONS = (
+    "voxel staircase: this method reads the voxels' steps as curvature (its numbers kept, not an estimate; "
+    "method='icc' scales its balls to the voxels)",
+)
+
 #: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``: the defects of
-#: meshes (1-7), the reasons of point clouds (8-11), the defects of meshes found since (12), then an estimate
-#: undefined (:data:`UNDEFINED`, the last).
+#: meshes (1-7), the reasons of point clouds (8-11), the defects of meshes found since (12), the method's
+#: limits (13), then an estimate undefined (:data:`UNDEFINED`, the last).
 INVALID_REASONS = (
     "valid",
     *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code) if defect.code <= NEEDLE),
     *POINT_CLOUD_REASONS,
     *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code) if defect.code > NEEDLE),
+    *METHOD_REASONS,
     "estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)",
 )
+
+#: The code of a vertex whose method reads a voxel staircase as curvature (:data:`METHOD_REASONS`).
+STAIRCASE = INVALID_REASONS.index(METHOD_REASONS[0])
 
 #: The code of a vertex invalid for no defect of the mesh: its estimate itself is undefined.
 UNDEFINED = len(INVALID_REASONS) - 1
@@ -544,11 +557,13 @@ class VertexDefects:
             f"{self.counts[name]} {_COUNTED[name]}" for name in _WARNING_ORDER if name in shown and self.counts[name]
         ]
 
-    def reasons(self, valid: np.ndarray) -> np.ndarray:
+    def reasons(self, valid: np.ndarray, method_codes: np.ndarray | None = None) -> np.ndarray:
         """(V,) int8 :data:`INVALID_REASONS` codes of the vertices not ``valid`` (0 where valid).
 
-        An invalid vertex takes its defect's code, or :data:`UNDEFINED` when it
-        has none the method does not cope with.
+        An invalid vertex takes its defect's code; without one the method does
+        not cope with, the method's own code (``method_codes``, where non-zero:
+        a limit of the method, :data:`METHOD_REASONS`), else :data:`UNDEFINED`.
         """
-        codes = np.where(self.invalid_vertices, self.codes, UNDEFINED).astype(np.int8)
+        undefined = UNDEFINED if method_codes is None else np.where(method_codes > 0, method_codes, UNDEFINED)
+        codes = np.where(self.invalid_vertices, self.codes, undefined).astype(np.int8)
         return np.where(valid, 0, codes).astype(np.int8)

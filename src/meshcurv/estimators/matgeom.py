@@ -58,6 +58,7 @@ import numpy as np
 from .._backend import kernel_threads, numba_kernels
 from .._tensors import outer6
 from .._geometry import DEGENERATE_AREA_RATIO, FOLD_ANGLE
+from ..defects import STAIRCASE
 from ..result import CurvatureResult
 from ..smoothing import STEPS_PER_CALL, _smooth_vertex_field
 from .._prepared import PreparedMesh
@@ -382,7 +383,10 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
             "voxels' staircase as curvature (its numbers kept, as matGeom computes them; method='icc' scales its "
             "balls to the voxels)"
         )
+        method_codes = np.where(valid, STAIRCASE, 0).astype(np.int8)  # the others keep their own reason
         valid = np.zeros_like(valid)
+    else:
+        method_codes = None
     result = CurvatureResult._of_arrays(
         k_min=c1,
         k_max=c2,
@@ -390,6 +394,7 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         dir_max=u2,
         normals=normal,
         valid=valid,
+        invalid_reason=method_codes,
         method="matgeom",
         parameters={"smoothing_steps": smoothing_steps},
     )
