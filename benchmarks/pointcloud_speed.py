@@ -35,7 +35,11 @@ from meshcurv.pointcloud import POINT_CLOUD_METHODS, point_cloud_curvatures  # n
 
 
 class StageClock(logging.Handler):
-    """Collects the wall and CPU time between consecutive log messages of the point-cloud modules."""
+    """The wall, process CPU and calling-thread CPU time between consecutive log messages of the point-cloud modules.
+
+    The calling thread runs every serial part and its share of the parallel ones: its CPU time is the wall time
+    the call would take on idle cores (what a shared machine's wall time no longer tells).
+    """
 
     def __init__(self):
         super().__init__(level=logging.DEBUG)
@@ -43,33 +47,35 @@ class StageClock(logging.Handler):
 
     def emit(self, record):
         label = record.msg.replace("%d ", "").replace("%s ", "")
-        self.marks.append((label, time.perf_counter(), time.process_time()))
+        self.marks.append((label, time.perf_counter(), time.process_time(), time.thread_time()))
 
-    def stages(self, end_wall, end_cpu):
-        totals = collections.OrderedDict()
-        ends = self.marks[1:] + [("end", end_wall, end_cpu)]
-        for (label, wall, cpu), (_, next_wall, next_cpu) in zip(self.marks, ends):
-            old = totals.get(label, (0.0, 0.0))
-            totals[label] = (old[0] + next_wall - wall, old[1] + next_cpu - cpu)
+    def stages(self, end):
+        """Label -> (wall, process CPU, calling-thread CPU) seconds, up to the clocks' readings ``end``."""
+        totals: dict = collections.OrderedDict()
+        for (label, *start), (_, *stop) in zip(self.marks, [*self.marks[1:], ("end", *end)]):
+            old = totals.get(label, (0.0, 0.0, 0.0))
+            totals[label] = tuple(o + b - a for o, a, b in zip(old, start, stop))
         return totals
 
 
-def timed(points, method):
+def timed(points, method=None):
+    """``(result, (wall, cpu, thread), stages)`` of one ``point_cloud_curvatures`` call (its default method if None)."""
     clock = StageClock()
     loggers = [logging.getLogger(name) for name in ("meshcurv.pointcloud", "meshcurv._pointcloud_estimators")]
     for logger in loggers:
         logger.addHandler(clock)
         logger.setLevel(logging.DEBUG)
+    options = {} if method is None else {"method": method}
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            start, start_cpu = time.perf_counter(), time.process_time()
-            result = point_cloud_curvatures(points, method=method)
-            wall, cpu = time.perf_counter() - start, time.process_time() - start_cpu
+            start = (time.perf_counter(), time.process_time(), time.thread_time())
+            result = point_cloud_curvatures(points, **options)
+            end = (time.perf_counter(), time.process_time(), time.thread_time())
     finally:
         for logger in loggers:
             logger.removeHandler(clock)
-    return result, wall, cpu, clock.stages(start + wall, start_cpu + cpu)
+    return result, tuple(b - a for a, b in zip(start, end)), clock.stages(end)
 
 
 def main(argv=None):
@@ -87,11 +93,11 @@ def main(argv=None):
     for n in args.sizes:
         points = sample("torus", n)[0]
         for method in args.methods:
-            runs = sorted((timed(points, method) for _ in range(args.repeat)), key=lambda run: run[1])
-            result, wall, cpu, stages = runs[len(runs) // 2]  # the run of median wall time
+            runs = sorted((timed(points, method) for _ in range(args.repeat)), key=lambda run: run[1][0])
+            result, (wall, cpu, _), stages = runs[len(runs) // 2]  # the run of median wall time
             detail = "; ".join(
                 f"{label.replace('point cloud: ', '')} {w:.2f} ({c:.2f})"
-                for label, (w, c) in stages.items()
+                for label, (w, c, _) in stages.items()
                 if w >= 0.005
             )
             lines.append(f"| {n} | {method} | {wall:.2f} | {cpu:.2f} | {result.valid.mean():.4f} | {detail} |")

@@ -19,35 +19,13 @@ from __future__ import annotations
 import argparse
 import collections
 import json
-import logging
 import os
 import statistics
 import subprocess
 import sys
-import time
-import warnings
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-
-
-class StageClock(logging.Handler):
-    """The wall, process CPU and calling-thread CPU time between consecutive log messages."""
-
-    def __init__(self):
-        super().__init__(level=logging.DEBUG)
-        self.marks = []
-
-    def emit(self, record):
-        label = record.msg.replace("%d ", "").replace("%s ", "").replace("point cloud: ", "")
-        self.marks.append((label, time.perf_counter(), time.process_time(), time.thread_time()))
-
-    def stages(self, end):
-        totals: dict = collections.OrderedDict()
-        for (label, *start), (_, *stop) in zip(self.marks, [*self.marks[1:], ("end", *end)]):
-            old = totals.get(label, (0.0, 0.0, 0.0))
-            totals[label] = tuple(o + b - a for o, a, b in zip(old, start, stop))
-        return totals
 
 
 def child(sizes) -> None:
@@ -55,30 +33,14 @@ def child(sizes) -> None:
     sys.path.insert(0, str(HERE))
     from pointcloud import sample
 
-    from meshcurv.pointcloud import point_cloud_curvatures
-
-    def timed(points):
-        clock = StageClock()
-        loggers = [logging.getLogger(name) for name in ("meshcurv.pointcloud", "meshcurv._pointcloud_estimators")]
-        for logger in loggers:
-            logger.addHandler(clock)
-            logger.setLevel(logging.DEBUG)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                start = (time.perf_counter(), time.process_time(), time.thread_time())
-                point_cloud_curvatures(points)
-                end = (time.perf_counter(), time.process_time(), time.thread_time())
-        finally:
-            for logger in loggers:
-                logger.removeHandler(clock)
-        return [b - a for a, b in zip(start, end)], clock.stages(end)
+    from pointcloud_speed import timed  # the same clocks and stages as the older script
 
     warm = sample("torus", 70_000)[0]
     warm[1] = warm[0] + 1e-9
     timed(warm)
     for n in sizes:
-        (wall, cpu, main), stages = timed(sample("torus", n)[0])
+        _, (wall, cpu, main), stages = timed(sample("torus", n)[0])
+        stages = {label.replace("point cloud: ", ""): times for label, times in stages.items()}
         print(
             json.dumps({"n": n, "wall": wall, "cpu": cpu, "main": main, "load": os.getloadavg()[0], "stages": stages})
         )
