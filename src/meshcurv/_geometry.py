@@ -141,7 +141,8 @@ def mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
 def median_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
     """Median length of the edges, 0 without edges (:func:`meshcurv.geometry.median_edge_length`)."""
     lengths = edge_lengths(vertices, edges)
-    return float(np.median(lengths)) if lengths.size else 0.0
+    # partitioned in place: the lengths are this function's own (no copy of 3 V lengths, issue 31)
+    return float(np.median(lengths, overwrite_input=True)) if lengths.size else 0.0
 
 
 def robust_mean_edge_length(vertices: np.ndarray, edges: np.ndarray) -> float:
