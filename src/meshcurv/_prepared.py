@@ -151,11 +151,15 @@ class PreparedMesh:
         kernels = numba_kernels("geometry")
         if kernels is not None and not self.needles.any():  # the faces dropped are the zero-area ones (:attr:`dropped`)
             n = self.vertices.shape[0]
-            degenerate, sums, areas = np.zeros(faces.shape[0], dtype=bool), np.zeros((n, 3)), np.zeros(n)
+            # numba's memory, not numpy's: no huge-page advice (_kernels.geometry._unadvised_empty, issue 31); every
+            # face's flag written by the pass
+            degenerate = kernels._unadvised_array(faces.shape[0], np.bool_)
+            sums = kernels._unadvised_array((n, 3), np.float64, zero=True)
+            areas = kernels._unadvised_array(n, np.float64, zero=True)
             kernels._degenerate_normal_and_area_sums(
                 self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO, degenerate, sums, areas
             )
-            summed = (_read_only(normalize_normal_sums(sums)), _read_only(areas))
+            summed = (_read_only(_unit_rows(sums)), _read_only(areas))
             return _FacePass(_read_only(degenerate), normals_and_areas=summed)
         cross, degenerate = cross_and_degenerate(self.vertices, faces, self.length_scales, DEGENERATE_AREA_RATIO)
         return _FacePass(_read_only(degenerate), cross=_read_only(cross))
@@ -210,7 +214,7 @@ class PreparedMesh:
         if cross is None:  # the zero-area faces were given (:meth:`found_degenerate`)
             cross = face_cross_products(self.vertices, self.topology.faces)
         sums, areas = vertex_normal_and_area_sums(cross, self.topology.faces, dropped, self.vertices.shape[0])
-        return _read_only(normalize_normal_sums(sums)), _read_only(areas)
+        return _read_only(_unit_rows(sums)), _read_only(areas)
 
     @cached_property
     def vertex_normals(self) -> np.ndarray:
@@ -289,6 +293,13 @@ class PreparedMesh:
             if getattr(result, name) is not None
         }
         return dataclasses.replace(result, **fields)
+
+
+def _unit_rows(sums: np.ndarray) -> np.ndarray:
+    """:func:`meshcurv.geometry.normalize_normal_sums` of (V, 3) ``sums``: by its compiled twin where the backend is
+    numba (the same values, ``tests/test_kernel_twins.py``; one pass, no (V, 3) temporaries of numpy's)."""
+    kernels = numba_kernels("geometry")
+    return normalize_normal_sums(sums) if kernels is None else kernels.normalize_normal_sums(sums)
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:

@@ -45,6 +45,25 @@ def _unadvised_zeros(shape):
     return np.zeros(shape)
 
 
+@nb.njit(**_JIT)
+def _unadvised_bytes(n_bytes, zero):
+    """``n_bytes`` bytes from numba's allocator (:func:`_unadvised_empty`), zeroed when ``zero`` (numba's
+    ``memset``, on the calling thread). 32-byte aligned (numba aligns every array it allocates so)."""
+    if zero:
+        return np.zeros(n_bytes, np.uint8)
+    return np.empty(n_bytes, np.uint8)
+
+
+def _unadvised_array(shape, dtype, *, zero: bool = False) -> np.ndarray:
+    """A C-contiguous array of ``shape`` and ``dtype`` from numba's allocator, unfilled (or zeros where ``zero``):
+    :func:`_unadvised_empty` for any shape and type, through one compiled function (:func:`_unadvised_bytes`, a
+    byte array viewed as ``dtype``), not one per shape and type (each a compilation on a cold cache). For the
+    large arrays of a call outside the icc kernels (the topology's, the zero-area pass's, issue 31)."""
+    dtype = np.dtype(dtype)
+    shape = (int(shape),) if np.ndim(shape) == 0 else tuple(int(n) for n in shape)
+    return _unadvised_bytes(math.prod(shape) * dtype.itemsize, zero).view(dtype).reshape(shape)
+
+
 @threaded
 def _mean_edge_length(vertices, edges):
     """Mean length of the edges (0 when there are none), summed in a fixed order.
@@ -122,7 +141,7 @@ def _run_length_sums_longest(lo, hi, vertices, edges, partial, longest):
 @threaded
 def face_cross_products(vertices, faces):
     """``geometry.face_cross_products``: (F, 3) ``cross(b - a, c - a)`` of every face."""
-    out = np.empty((faces.shape[0], 3))
+    out = _unadvised_array((faces.shape[0], 3), np.float64)  # every row written by its chunk
     run_chunks(_face_cross_chunk, faces.shape[0], _CHUNKS_PER_THREAD * nb.get_num_threads(), vertices, faces, out)
     return out
 
@@ -149,7 +168,7 @@ def vertex_normal_sums(cross, faces, n_vertices):
 @threaded
 def normalize_normal_sums(summed):
     """``geometry.normalize_normal_sums``: unit rows of ``summed``, NaN where they (nearly) cancel."""
-    out = np.empty_like(summed)
+    out = _unadvised_array(summed.shape, np.float64)  # every row written by its chunk
     run_chunks(_normalize_chunk, summed.shape[0], _CHUNKS_PER_THREAD * nb.get_num_threads(), summed, out)
     return out
 
@@ -201,8 +220,8 @@ def cross_and_degenerate(vertices, faces, scales, area_ratio):
     ``geometry.vertex_length_scales``, read at the first corner ``a``: the corners of a face share their
     component), in one pass over the faces (``geometry.degenerate_faces``), in chunks of faces on threads
     (:func:`~meshcurv._kernels._common.run_chunks`)."""
-    cross = np.empty((faces.shape[0], 3))
-    out = np.empty(faces.shape[0], np.bool_)
+    cross = _unadvised_array((faces.shape[0], 3), np.float64)  # every row written by its chunk
+    out = _unadvised_array(faces.shape[0], np.bool_)
     run_chunks(
         _cross_and_degenerate_chunk,
         faces.shape[0],

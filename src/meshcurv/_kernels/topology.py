@@ -9,6 +9,7 @@ import numpy as np
 from numba.extending import overload
 
 from ._common import _JIT, _JIT_INNER, _ONE, _UNSIGNED, run_chunks, threaded
+from .geometry import _unadvised_array
 
 
 #: :func:`meshcurv._kernels.neighborhoods.vertex_face_lists` counts the faces of at most this many ranges of
@@ -98,14 +99,16 @@ def build_topology(faces, n_vertices, template, with_twins):
     (else empty arrays)."""
     n_faces = faces.shape[0]
     index = template.dtype
-    face_edges = np.empty(3 * n_faces, index)
-    edges = np.empty((3 * n_faces, 2), index)
-    edge_faces = np.empty((3 * n_faces, 2), index)
-    counts = np.empty(3 * n_faces, index)
-    forward = np.empty(3 * n_faces, index)
-    twins = np.empty(3 * n_faces if with_twins else 0, index)
-    corners = np.zeros(n_vertices if with_twins else 0, index)
-    first = np.full(n_vertices if with_twins else 0, -1, index)
+    # numba's memory, not numpy's (no huge-page advice: geometry._unadvised_empty); every element read is written
+    face_edges = _unadvised_array(3 * n_faces, index)
+    edges = _unadvised_array((3 * n_faces, 2), index)
+    edge_faces = _unadvised_array((3 * n_faces, 2), index)
+    counts = _unadvised_array(3 * n_faces, index)
+    forward = _unadvised_array(3 * n_faces, index)
+    twins = _unadvised_array(3 * n_faces if with_twins else 0, index)
+    corners = _unadvised_array(n_vertices if with_twins else 0, index, zero=True)
+    first = _unadvised_array(n_vertices if with_twins else 0, index)
+    first.fill(-1)
     n_edges = build_edges_into(
         faces, n_vertices, template, face_edges, edges, edge_faces, counts, forward, twins, corners, first
     )
