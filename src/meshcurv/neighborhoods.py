@@ -819,7 +819,7 @@ def _connected_face_sums(
     mean, _ = check_ball_work(centres, outer + float(reach.max()), m, centres=vertices[:m])
     indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
     values = np.ascontiguousarray(values)
-    out = np.zeros((radii.shape[0], n, values.shape[2]))
+    out = kernels._unadvised_zeros((radii.shape[0], n, values.shape[2]))
     clustered = radii.shape[0] == 1 and mean >= CLUSTER_MIN_FACES  # dense balls: clusters inside a ball added whole
     plain = radii.shape[0] == 1 and not clustered  # one ball: the kernel without the passes
     rows = max(1, min(kernel_threads(), n))

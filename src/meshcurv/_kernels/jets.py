@@ -23,6 +23,7 @@ from ._common import (
     run_slots,
     threaded,
 )
+from .geometry import _unadvised_empty
 from .neighborhoods import _ball_members, _connected_members, _vertex_spans, pool_grid
 from .tensors import _tangent_eigen
 
@@ -939,7 +940,7 @@ def fit_jets_connected(
     # each thread's walk scratch: the stamps (filled with -1 by the thread on its first range), members, queue;
     # int64: in int32 the walk compared each stamp to its centre's int64 position after a widening load (+6% of
     # the fits' instructions, callgrind, icosphere(32); no CPU seconds gained at 1M)
-    scratch = np.empty((3, slots, n), np.int64)
+    scratch = _unadvised_empty((3, slots, n), np.int64)  # no huge pages (geometry._unadvised_empty)
     filled = np.zeros(slots, np.bool_)
     run_slots(
         _connected_chunk,

@@ -10,6 +10,7 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, _ONE, _UNSIGNED, run_chunks, run_slots, threaded
+from .geometry import _unadvised_empty, _unadvised_zeros  # noqa: F401 (the ball sums' output, for ..neighborhoods)
 from .topology import _BUCKET_CHUNKS, _bucket_starts
 
 
@@ -949,8 +950,9 @@ def cell_centres(vertices, cells):
     in the same order whatever the ranges.
     """
     n = cells.shape[0]
-    centres = np.zeros((n, 3))
-    reach = np.zeros(n)
+    # every row written by its chunk; no huge pages (geometry._unadvised_empty)
+    centres = _unadvised_empty((n, 3), np.float64)
+    reach = _unadvised_empty((n,), np.float64)
     run_chunks(_centres_chunk, n, 4 * nb.get_num_threads(), vertices, cells, centres, reach)
     return centres, reach
 
