@@ -1651,15 +1651,16 @@ def two_sheets(
         )
         sample = candidates
         found = _off_the_steps(points, normals, sample, found, lattice)
-    hit, near, flags, two = found
+    hit, near, flags, two, group = found
     alike[sample[hit]] = True
     alike[near[hit][flags[hit]]] = True
     if two.any():
         # the share of each point's nearest neighbours with two sheets (a region, not a point that noise split)
         mark = np.zeros(n)
         mark[sample[two]] = 1.0
-        crowd = near[:, 1 : INTERLEAVED_NEIGHBOURS + 1]  # (the point itself first)
-        share = (mark[sample] + (mark[crowd] * usable[crowd]).sum(axis=1)) / (1.0 + usable[crowd].sum(axis=1))
+        crowd = group[:, 1:]  # (the point itself first, and in the slots of neighbours tied at the cut)
+        counted = usable[crowd] & (crowd != sample[:, None])
+        share = (mark[sample] + (mark[crowd] * counted).sum(axis=1)) / (1.0 + counted.sum(axis=1))
         interleaved[sample[share >= INTERLEAVED_SHARE]] = True
     return alike & usable, interleaved & usable
 
@@ -1676,32 +1677,49 @@ def _sheet_signs(
     with_alike: bool = True,
     offset: float = STACKED_ALIKE_OFFSET,
 ):
-    """``(hit, near, alike, two)`` of :func:`two_sheets` at ``queries`` (M,), in chunks of :data:`CHUNK`.
+    """``(hit, near, alike, two, group)`` of :func:`two_sheets` at ``queries`` (M,), in chunks of :data:`CHUNK`.
 
     ``hit`` (M,): stacked neighbours oriented alike; ``near`` (M, k): the
     nearest neighbours (the query itself first); ``alike`` (M, k): which of
-    them; ``two`` (M,): two sheets closer than :data:`STACKED_OFFSET` spacings.
+    them; ``two`` (M,): two sheets closer than :data:`STACKED_OFFSET` spacings,
+    read from the ``group`` (M, :data:`INTERLEAVED_NEIGHBOURS` + 1) of the nearest.
     ``with_alike=False``: ``hit`` and ``alike`` all False, and ``near`` the
-    :data:`INTERLEAVED_NEIGHBOURS` nearest only.
+    ``group``. In ``near`` and ``group`` the neighbours tied at the cut are
+    dropped whole (:func:`_whole_rows`).
     """
     k = min((WINDING_NEAR if with_alike else INTERLEAVED_NEIGHBOURS) + 1, points.shape[0])
+    width = min(INTERLEAVED_NEIGHBOURS + 1, k)
     hit, two = np.zeros(queries.size, dtype=bool), np.zeros(queries.size, dtype=bool)
     near = np.zeros((queries.size, k), dtype=np.int64)
+    groups = np.zeros((queries.size, width), dtype=np.int64)
     flags = np.zeros((queries.size, k), dtype=bool)
     for start in range(0, queries.size, CHUNK):
         rows = slice(start, start + CHUNK)
         q = queries[rows]
-        _, ball = tree.query(points[q], k=k, workers=-1)
+        distances, found = tree.query(points[q], k=min(k + 1, points.shape[0]), workers=-1)
+        ball = _whole_rows(distances, found, q, k)
         near[rows] = ball
         if with_alike:
             alike = _stacked(points, normals, usable, step, q, ball, alike=True, offset=offset)
             hit[rows] = alike.sum(axis=1) >= STACKED_ALIKE_MIN
             flags[rows] = alike
-        group = ball[:, : INTERLEAVED_NEIGHBOURS + 1]
+        group = groups[rows] = _whole_rows(distances, found, q, width)
         # the spacing of the neighbourhood (the median over the cloud is another part's in a cloud of two densities)
         local = np.median(np.where(usable[group], spacing[group], np.nan), axis=1)
         two[rows] = _two_heights(points, group, usable, np.where(np.isfinite(local), local, step))
-    return hit, near, flags, two
+    return hit, near, flags, two, groups
+
+
+def _whole_rows(distances: np.ndarray, found: np.ndarray, queries: np.ndarray, k: int) -> np.ndarray:
+    """(M, k) the nearest points ``found`` (M, j), at ``distances`` (M, j), of the ``queries`` (M,) (each itself
+    first) cut to ``k``, the neighbours tied with the next beyond the cut dropped whole (:func:`whole_ties`: their
+    slots hold the query). On a lattice (a voxel surface read as a cloud) a query's cut falls through a ring of
+    neighbours at one distance, and the search's order, which a rigid motion changes by round-off, chose among
+    them: the two-sheets reading of a turned voxel sphere's points changed at 24 of its 14,778 points."""
+    if found.shape[1] <= k:
+        return found
+    _, rest = whole_ties(distances[:, 1 : k + 1], found[:, 1 : k + 1], k - 1, centres=queries)
+    return np.concatenate([found[:, :1], rest], axis=1)
 
 
 def _stacked(points, normals, usable, step, queries, near, *, alike: bool, offset: float = STACKED_ALIKE_OFFSET):
@@ -1751,7 +1769,7 @@ def _off_the_steps(points, normals, queries, found, lattice):
     """``found`` of :func:`_sheet_signs` at ``queries`` (M,) with the stacked neighbours oriented alike kept only
     where they and the query lie farther off each other's tangent plane than :data:`STACKED_ALIKE_LATTICE`
     ``max_k |n_k| h_k`` (``h`` the steps of the :class:`Lattice` ``lattice``, ``n`` the query's normal in its axes)."""
-    hit, near, flags, two = found
+    hit, near, flags, two, group = found
     rows = np.flatnonzero(hit)
     if rows.size == 0 or not lattice.steps.any():
         return found
@@ -1763,7 +1781,7 @@ def _off_the_steps(points, normals, queries, found, lattice):
     flags[rows] &= np.minimum(np.abs(ahead), np.abs(behind)) >= steps[:, None]
     hit = hit.copy()
     hit[rows] = flags[rows].sum(axis=1) >= STACKED_ALIKE_MIN
-    return hit, near, flags, two
+    return hit, near, flags, two, group
 
 
 def lattice_treads(
@@ -1840,29 +1858,41 @@ def lattice_treads(
 def _two_heights(points, group, usable, step):
     """(M,) bool: the heights of the points ``group`` (M, k) (the centre first) across their least-variance
     direction, within :data:`INTERLEAVED_REACH` of the centre along it, fall into two groups (see :func:`two_sheets`).
-    ``step`` (M,): the spacing of each group."""
+    ``step`` (M,): the spacing of each group. Slots after the first that hold the centre (neighbours tied at the cut
+    dropped, :func:`_whole_rows`) are left out."""
     cloud = points[group]
-    centred = cloud - cloud.mean(axis=1, keepdims=True)
+    kept = np.ones(group.shape, dtype=bool)
+    kept[:, 1:] = group[:, 1:] != group[:, :1]
+    weights = kept[:, :, None].astype(float)
+    centred = (cloud - (cloud * weights).sum(axis=1, keepdims=True) / kept.sum(axis=1)[:, None, None]) * weights
     _, vectors = np.linalg.eigh(np.einsum("mki,mkj->mij", centred, centred))
     offsets = cloud - cloud[:, :1]
     height = np.einsum("mkj,mj->mk", offsets, vectors[:, :, 0])
     across = np.einsum("mkj,mkj->mk", offsets, offsets) - height * height
-    inside = (across <= (INTERLEAVED_REACH * step[:, None]) ** 2) & usable[group]
+    inside = (across <= (INTERLEAVED_REACH * step[:, None]) ** 2) & usable[group] & kept
     height = np.sort(np.where(inside, height, np.inf), axis=1)
     count = inside.sum(axis=1)
     with np.errstate(invalid="ignore"):
         gaps = np.where(np.isfinite(height[:, 1:]), np.diff(height, axis=1), -np.inf)
-    widest = np.argmax(gaps, axis=1)
     rows = np.arange(gaps.shape[0])
-    gap = gaps[rows, widest]
-    below = widest + 1
-    # the spread of each group: two clean sheets closer than the noise of a noisy one are two sheets too
-    lower = height[rows, widest] - height[:, 0]
-    upper = height[rows, np.maximum(count - 1, 0)] - height[rows, np.minimum(widest + 1, height.shape[1] - 1)]
-    apart = (gap >= INTERLEAVED_GAP * step) | (
-        (gap >= INTERLEAVED_SPREAD * np.maximum(lower, upper)) & (gap >= INTERLEAVED_MIN_GAP * step)
-    )
-    return apart & (gap <= STACKED_OFFSET * step) & (below >= INTERLEAVED_GROUP) & (count - below >= INTERLEAVED_GROUP)
+    # the widest gap: on a lattice, planes evenly spaced give several, equal to round-off, of which the pose chose
+    # one (and the sign of the direction, which end comes first): the heights fall into two groups at each of them
+    largest = gaps.max(axis=1, initial=-np.inf)
+    tied = gaps >= largest[:, None] - TIE_TOLERANCE * step[:, None]
+    split = np.ones(rows.size, dtype=bool)
+    for widest in (np.argmax(tied, axis=1), gaps.shape[1] - 1 - np.argmax(tied[:, ::-1], axis=1)):
+        gap = gaps[rows, widest]
+        below = widest + 1
+        # the spread of each group: two clean sheets closer than the noise of a noisy one are two sheets too
+        lower = height[rows, widest] - height[:, 0]
+        upper = height[rows, np.maximum(count - 1, 0)] - height[rows, np.minimum(widest + 1, height.shape[1] - 1)]
+        apart = (gap >= INTERLEAVED_GAP * step) | (
+            (gap >= INTERLEAVED_SPREAD * np.maximum(lower, upper)) & (gap >= INTERLEAVED_MIN_GAP * step)
+        )
+        split &= (
+            apart & (gap <= STACKED_OFFSET * step) & (below >= INTERLEAVED_GROUP) & (count - below >= INTERLEAVED_GROUP)
+        )
+    return split
 
 
 def between_sides(

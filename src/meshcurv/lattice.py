@@ -67,6 +67,16 @@ LATTICE_TOLERANCE = 1e-6
 #: difference is round-off: the same coordinate computed two ways).
 LATTICE_ROUND_OFF = 1e-12
 
+#: ... and the step between two planes is at least this many times that round-off: below, one plane whose coordinates
+#: round-off spread (a turned grid's coordinates, read in axes off by 2e-10 rad ten sizes from the origin) is split
+#: into planes whose gaps are all whole multiples of the smallest to within round-off (fuzz_api 491/8: steps of
+#: 6e-7 read on a grid of 500).
+LATTICE_ABOVE_ROUND_OFF = 1000.0
+
+#: A turned grid read again in its refined axes is the same grid when its steps agree with the first reading's to
+#: this share.
+LATTICE_SAME_STEP = 0.01
+
 #: A cloud none of whose coordinates repeats among this many of its points, evenly spaced, is on no lattice (the
 #: whole cloud is not read: a lattice of fewer than millions of planes along an axis repeats one there).
 LATTICE_PROBE = 4096
@@ -755,17 +765,22 @@ def read_lattice(
         return lattice
     # the axes to the planes' own precision (the frame's search is to a thousandth of a radian): along each, the
     # plane index of every coordinate near its plane is a linear function of the point, w . x + c, whose gradient w
-    # is the axis over its step; least squares, then the nearest orthonormal axes
+    # is the axis over its step; least squares, then the nearest orthonormal axes. The points are taken from their
+    # centroid: a cloud ten sizes from the origin gave a system of condition about 1e9 whose axes were off by 2e-10
+    # rad, which spread each plane over 1e-5 and split it into planes 6e-7 apart (fuzz_api 491/8)
+    centred = rows - rows.mean(axis=0)
     scaled = np.empty((3, 3))
     for axis in range(3):
         step, offset = turned.steps[axis], turned.offsets[axis]
         index, off = _nearest_planes(rows @ frame[axis], step, offset)
         near = np.abs(off) <= step / 4
-        scaled[axis] = np.linalg.lstsq(np.c_[rows[near], np.ones(near.sum())], index[near], rcond=None)[0][:3]
+        scaled[axis] = np.linalg.lstsq(np.c_[centred[near], np.ones(near.sum())], index[near], rcond=None)[0][:3]
     left, _, right = np.linalg.svd(scaled / np.linalg.norm(scaled, axis=1, keepdims=True))
     refined = left @ right
     exact = _lattice_in(rows @ refined.T, spacing)
-    return exact._replace(frame=refined) if exact.steps.all() else turned._replace(frame=frame)
+    # (the same grid, read to the planes' precision: not another one that round-off made)
+    same = exact.steps.all() and np.allclose(exact.steps, turned.steps, rtol=LATTICE_SAME_STEP)
+    return exact._replace(frame=refined) if same else turned._replace(frame=frame)
 
 
 def _lattice_in(points, spacing):
@@ -891,6 +906,8 @@ def _shared_planes(values):
         return None
     gaps = np.diff(planes)
     step = gaps.min()
+    if step < LATTICE_ABOVE_ROUND_OFF * round_off:
+        return None  # (planes that round-off split: any gap is a whole multiple of such a step)
     # whole multiples of the step to LATTICE_TOLERANCE of it, each plane known to its round-off: not relative
     # to the multiple (a gap a million steps long is a whole multiple of any step to a millionth of itself)
     off = np.abs(gaps - np.round(gaps / step) * step)

@@ -1407,9 +1407,10 @@ def _amid_undecided(points, doubtful, usable, indices, tree) -> np.ndarray:
     if near.size == 0:
         return out
     k = min(AMID_NEIGHBOURS + 1, points.shape[0])
-    _, crowd = tree.query(points[near], k=k, workers=-1)
-    crowd = crowd[:, 1:]  # (the point itself first)
-    counted = usable[crowd]
+    distances, crowd = tree.query(points[near], k=min(k + 1, points.shape[0]), workers=-1)
+    # (the point itself first, and in the slots of a lattice's neighbours tied at the cut: the pose ordered them)
+    crowd = _normals._whole_rows(distances, crowd, near, k)[:, 1:]
+    counted = usable[crowd] & (crowd != near[:, None])
     share = (doubtful[crowd] & counted).sum(axis=1) / np.maximum(counted.sum(axis=1), 1)
     out[near] = share >= AMID_UNDECIDED
     return out
