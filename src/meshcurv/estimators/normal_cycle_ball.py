@@ -56,6 +56,15 @@ of its valid vertices lie on a grid (faces detached off it and welded to each
 other: a voxel sphere with half of its faces detached by 0.06 voxels had half
 of its valid vertices off by more than half the curvature, fuzz 480/968).
 
+Faces detached by a few hundredths of an edge and welded back across their cracks
+(:data:`meshcurv.weld.CRACK_TOLERANCE_RATIO`) are tilted by the cracks' width over their height: on a fine
+mesh, whose dihedral angles are as small, each edge reads that tilt as curvature. Where such welds are a
+sizeable share of the mesh (:data:`CRACKED_SHARE`), every ball is judged by the standard error of its own
+edges' readings (:data:`FEW_ELEMENTS_CRACKED_SPREAD`); at the default radius a ball that fails is grown once
+(:data:`CRACK_GROWTH`) and judged again. A voxel surface welded back so, no longer read as one
+(:func:`._ring_noise.welded_grid`), is undefined: a ball of the default of other meshes reads the plateaus of
+its staircase as flat.
+
 References
 ----------
 D. Cohen-Steiner and J.-M. Morvan (2003). Restricted Delaunay triangulations and
@@ -65,6 +74,8 @@ https://doi.org/10.1145/777792.777839
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .._tensors import outer6, principal_from_shape_operator
@@ -72,6 +83,7 @@ from .._geometry import edge_dihedral_angles
 from ..neighborhoods import _ball_edge_sums, _candidate_pairs
 from ..radius import VoxelReading, _component_radii, _resolve_radius, _vertex_radii, _voxel_surface
 from .._prepared import PreparedMesh
+from ._ring_noise import welded_grid
 from ._support import Stages, ball_holds_neighbours, finish
 
 STAGES = ("compute normals", "compute edge tensors", "sum over balls", "retrieve curvatures")
@@ -134,6 +146,33 @@ FEW_ELEMENTS_HOLED = 0.8
 #: half-detached icosphere(24): one edge left of 48, H -5.8 for 1, their variance 0).
 FEW_ELEMENTS_LEAST = 2.0
 
+#: On a mesh welded across cracks (:data:`meshcurv.weld.CRACK_TOLERANCE_RATIO`, ``PreparedMesh.n_cracked``), a
+#: ball whose own readings' standard error (the local scatter over the square root of their effective number,
+#: :func:`few_elements`) exceeds this share of the mesh's curvature is undefined, whether or not it lost elements
+#: and however the mesh's median scatters. A crack weld moves a corner by up to 0.05 of its edges' length, which
+#: tilts a well-shaped face by about as many radians and a sliver (a uv sphere's pole: 0.01 wide for 0.1 long) by
+#: ten times more; on a fine mesh (icosphere(40): edges of 0.03 on the unit sphere, dihedral angles of 0.03) that
+#: tilt is the size of the curvature each edge reads, and the balls' estimates scatter by up to 0.2 of it (the
+#: previous bound, :data:`FEW_ELEMENTS_SPREAD`), where the fuzzer's tolerance, half the largest ``|k|``, was 2.5
+#: standard errors away: of some 50,000 valid vertices a few were beyond it (fuzz 440/25, 480/2: up to 0.57; measured
+#: errors reach 3.7 standard errors). At an eighth the tolerance is four standard errors away. Those faces' scatter is
+#: noise, not the structure of a regular mesh, so the mesh's median (:data:`FEW_ELEMENTS_NOISE`) excuses none: a uv
+#: sphere's pole ring whose slivers the weld folded read H -1.2 for 1 at 1.07 edges while the mesh's balls scatter
+#: alike there (fuzz 500/36: 63 of 4,196 valid vertices off by up to 0.70). Numbers: tests/test_ncb_fine_soups_N25.py.
+FEW_ELEMENTS_CRACKED_SPREAD = 0.125
+
+#: ... and at the default radius such a ball is grown this many times (its standard error falling as the radius)
+#: and judged again, with the same reference (the scatter and curvature of the first balls): on icosphere(40)
+#: half detached by 0.044 edges (three draws), 78-80% of the vertices valid with 8-22 off by more than half of the
+#: largest ``|k|`` before, 64-66% and none with the bound alone, 81-82% and none grown twice (1.5 times: 78-80%).
+CRACK_GROWTH = 2.0
+
+#: The two rules above hold on a mesh whose vertices welded across cracks (``PreparedMesh.n_cracked``) are at least
+#: this share of its vertices: there the mesh's median scatter is the cracks' own. A few welds among wide cracks
+#: (the 12 x 8 uv sphere half detached by 0.09 edges: 2 of 338, tests/test_ring_cracks_N19.py) leave the median
+#: the mesh's structure, which the rules of :data:`FEW_ELEMENTS_NOISE` read.
+CRACKED_SHARE = 0.05
+
 #: ... where their own readings scatter more than this many times the median of the intact balls' (a structured
 #: mesh's holed balls scatter as its intact ones: the 12 x 8 uv sphere's vertices of tests/test_ring_cracks_N19.py
 #: keep theirs; at 1 the sweep above left 30 off instead of 44, and one more of those vertices undefined).
@@ -171,34 +210,69 @@ def few_elements(valid, shares, intact_shares, variances, readings, curvatures, 
     them by its own, one that lost most and kept fewer than :data:`FEW_ELEMENTS_LEAST` is undefined, and where
     no support kept its elements the curvature is the median of the estimates.
     """
+    return _few_elements(
+        valid, shares, intact_shares, variances, readings, curvatures, local_variances=local_variances
+    )[0]
+
+
+class _Reference(NamedTuple):
+    """What :func:`_few_elements` judged its supports against: the median ``variance`` of the intact supports'
+    readings and the mesh's curvature ``scale``."""
+
+    variance: float
+    scale: float
+
+
+def _few_elements(
+    valid,
+    shares,
+    intact_shares,
+    variances,
+    readings,
+    curvatures,
+    *,
+    local_variances=None,
+    cracked=False,
+    reference=None,
+):
+    """``(few, reference)``: :func:`few_elements` and the :class:`_Reference` it judged against (None where no
+    support was known). ``cracked``: the mesh was welded across cracks (:data:`FEW_ELEMENTS_CRACKED_SPREAD`);
+    ``reference``: judge against this one (a second pass over grown balls, whose own medians would be those of the
+    noisiest balls alone)."""
     known = valid & np.isfinite(variances)
-    if not known.any():
-        return np.zeros_like(valid)
-    variance = float(np.median(variances[known]))
+    if reference is None and not known.any():
+        return np.zeros_like(valid), None
     k_min, k_max = curvatures
     with np.errstate(invalid="ignore", over="ignore"):
         lost = ~(FEW_ELEMENTS_KEPT * shares <= intact_shares)
-    # the curvature of the supports that kept their elements; where none did, the edges' readings' root mean square
-    kept = valid & ~lost
-    largest = np.maximum(np.abs(k_min), np.abs(k_max))
-    if kept.any():
-        scale = float(np.median(largest[kept]))
-    elif local_variances is not None:  # the estimates' median: a few folded edges' readings outweigh a mean square
-        scale = float(np.median(largest[valid]))
-    else:
-        read = readings[np.isfinite(readings)]
-        with np.errstate(over="ignore"):
-            scale = float(np.sqrt(np.mean(read * read))) if read.size else 0.0
+    if reference is None:
+        variance = float(np.median(variances[known]))
+        # the curvature of the supports that kept their elements; where none did, the edges' readings' root mean
+        # square
+        kept = valid & ~lost
+        largest = np.maximum(np.abs(k_min), np.abs(k_max))
+        if kept.any():
+            scale = float(np.median(largest[kept]))
+        elif local_variances is not None:  # the estimates' median: a few folded edges' readings outweigh a mean square
+            scale = float(np.median(largest[valid]))
+        else:
+            read = readings[np.isfinite(readings)]
+            with np.errstate(over="ignore"):
+                scale = float(np.sqrt(np.mean(read * read))) if read.size else 0.0
+        reference = _Reference(variance, scale)
+    variance, scale = reference
     bound = (FEW_ELEMENTS_SPREAD * scale) ** 2
     with np.errstate(invalid="ignore", over="ignore"):
         if local_variances is None:
-            return valid & lost & ~(variance * shares <= bound)
+            return valid & lost & ~(variance * shares <= bound), reference
         holed = ~(FEW_ELEMENTS_HOLED * shares <= intact_shares)
         few = lost & ~(np.fmax(variance, local_variances) * shares <= bound)
         noisy = holed & ~(local_variances <= FEW_ELEMENTS_NOISE * variance)
         few |= noisy & ~(local_variances * shares <= bound)
+        if cracked:  # faces welded across cracks scatter as noise, the mesh's median too: every ball by its own
+            few |= ~(local_variances * shares <= (FEW_ELEMENTS_CRACKED_SPREAD * scale) ** 2)
         few |= lost & ~(shares * FEW_ELEMENTS_LEAST <= 1.0)
-        return valid & few
+        return valid & few, reference
 
 
 def few_elements_note(count: int, support: str, elements: str) -> str:
@@ -302,6 +376,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         groups = [(_resolve_radius(radius, mesh), None)]
     cross, degenerate, normals = mesh.cross, mesh.degenerate, mesh.vertex_normals
     defects, valid = mesh.start(boundary=True)
+    sound = valid.copy()  # the vertices free of defects, before the balls' checks
 
     stages.start("compute edge tensors")
     double_areas = np.linalg.norm(cross, axis=1)
@@ -314,26 +389,14 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         usable &= ~needle_edges
     kept_faces = ~degenerate if needle_faces is None else ~degenerate & ~needle_faces
     beta, lengths, unit = edge_dihedral_angles(vertices, topology, unit_normals, usable)
-    density = edge_area_densities(topology, np.where(kept_faces, double_areas / 2, 0.0), lengths)
+    intact = edge_area_densities(topology, np.where(kept_faces, double_areas / 2, 0.0), lengths)
     radii = _vertex_radii(groups, vertices.shape[0])
-    # the edges of holes: no curvature, no area
-    holes = hole_edges(vertices, topology, radii, topology.edge_vertices(usable | (density > 0)))
-    intact = density.copy()  # with the holes' area: an intact ball's (FEW_ELEMENTS_KEPT)
-    density[holes] = 0.0
 
     stages.start("sum over balls")
-    # the tensor and the area on the same support, the edges inside the ball: one sum of seven columns; on a mesh
-    # with boundaries one more, for the scatter of the edges' own estimates (FEW_ELEMENTS_SPREAD)
+    # on a mesh with boundaries the sums carry the scatter of the edges' own estimates too (FEW_ELEMENTS_SPREAD)
     scattered = bool(topology.boundary_edges.any())
-    readings = edge_readings(beta, density, usable)
-    spread = _edge_spread_columns(density, intact, lengths, readings) if scattered else np.zeros((beta.shape[0], 0))
-    edge_values = np.column_stack([outer6(unit, beta), density, spread])
-    measured = usable | (density > 0) | (scattered & (intact > 0))  # the edges of holes add zeros to the first 7
-    measures = np.zeros((vertices.shape[0], edge_values.shape[1]))
-    for group_radius, members in groups:
-        rows = slice(None) if members is None else members
-        measures[rows] = _ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
-    measures, areas, spread_sums = measures[:, :6], measures[:, 6], measures[:, 7:]
+    terms = (beta, unit, lengths, intact, usable)
+    measures, areas, spread_sums, holes, readings = _ball_sums(vertices, topology, groups, radii, terms, scattered)
 
     stages.start("retrieve curvatures")
     valid &= areas > 0
@@ -342,18 +405,29 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     valid &= ball_holds_neighbours(vertices, topology.edges, radii) & (radii >= MIN_RADIUS_SCALES * mesh.length_scales)
     holed = _voxel_holed_balls(mesh, holes, groups, valid, stages.voxel) & valid
     valid &= ~holed
-    with np.errstate(invalid="ignore", divide="ignore"):
-        tensors = measures / areas[:, None]
-    k_min, k_max, dir_min, dir_max = principal_from_shape_operator(
-        np.where(valid[:, None], tensors, 0.0),
-        np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
-        rotate=True,
-        mean_from_trace=True,
-    )
+    k_min, k_max, dir_min, dir_max = _principal(measures, areas, normals, valid)
     few = np.zeros_like(valid)
-    if scattered and not _voxel_surface(mesh, defects.invalid_vertices, valid=valid, reading=stages.voxel):
-        few = _few_edges(valid, areas, spread_sums, readings, (k_min, k_max))
+    on_voxels = _voxel_surface(mesh, defects.invalid_vertices, valid=valid, reading=stages.voxel)
+    if scattered and not on_voxels:
+        cracked = mesh.n_cracked >= CRACKED_SHARE * vertices.shape[0]
+        few, reference = _few_edges(valid, areas, spread_sums, readings, (k_min, k_max), cracked=cracked)
+        if cracked and radius is None and few.any():  # the default's balls over welded cracks: grown once
+            grown = few
+            radii = np.where(grown, CRACK_GROWTH * radii, radii)
+            wide = [(CRACK_GROWTH * r, grown if m is None else grown & _member_mask(m, grown.size)) for r, m in groups]
+            sums = _ball_sums(vertices, topology, wide, radii, terms, scattered)
+            curvatures = _principal(sums[0], sums[1], normals, grown)
+            again, _ = _few_edges(grown, sums[1], sums[2], sums[4], curvatures[:2], cracked=True, reference=reference)
+            kept = grown & ~again
+            for old, new in zip((k_min, k_max, dir_min, dir_max), curvatures):
+                old[kept] = new[kept]
+            few &= ~kept
         valid &= ~few
+    # a voxel surface welded across cracks, no longer read as one, has the default of other meshes, whose balls
+    # read a plateau of its staircase as flat with no scatter (fuzz 500/28: H 0 for 0.1, valid)
+    staircase = 0
+    if not on_voxels and valid.any() and welded_grid(mesh, sound) is not None:
+        staircase, valid = int(valid.sum()), np.zeros_like(valid)
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
@@ -364,8 +438,49 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         else ""
     )
     curvatures = (k_min, k_max, dir_min, dir_max)
-    extra = (note, few_elements_note(int(few.sum()), "ball", "edges"))
+    extra = (note, few_elements_note(int(few.sum()), "ball", "edges"), _staircase_note(staircase))
     return finish("normal_cycle_ball", parameters, valid, normals, *curvatures, defects, extra=extra, radius=radii)
+
+
+def _ball_sums(vertices, topology, groups, radii, terms, scattered):
+    """``(measures, areas, spread_sums, holes, readings)`` of the balls of ``groups`` (``(radius, members)``; a
+    radius may be one per vertex): the tensor's six columns, the area and the scatter's columns
+    (:func:`_edge_spread_columns`, none without ``scattered``), each vertex's sums over its ball, with the edges of
+    holes (:func:`hole_edges`, read within ``radii``, (V,)) taking neither curvature nor area. ``terms``: ``(beta,
+    unit, lengths, intact, usable)`` of the edges, ``intact`` their area densities with the holes'."""
+    beta, unit, lengths, intact, usable = terms
+    holes = hole_edges(vertices, topology, radii, topology.edge_vertices(usable | (intact > 0)))
+    density = np.where(holes, 0.0, intact)
+    readings = edge_readings(beta, density, usable)
+    spread = _edge_spread_columns(density, intact, lengths, readings) if scattered else np.zeros((beta.shape[0], 0))
+    # the tensor and the area on the same support, the edges inside the ball: one sum
+    edge_values = np.column_stack([outer6(unit, beta), density, spread])
+    measured = usable | (density > 0) | (scattered & (intact > 0))  # the edges of holes add zeros to the first 7
+    measures = np.zeros((vertices.shape[0], edge_values.shape[1]))
+    for group_radius, members in groups:
+        rows = slice(None) if members is None else members
+        measures[rows] = _ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
+    return measures[:, :6], measures[:, 6], measures[:, 7:], holes, readings
+
+
+def _member_mask(members, n: int) -> np.ndarray:
+    """(n,) bool of a group's ``members`` (a mask or indices)."""
+    mask = np.zeros(n, dtype=bool)
+    mask[members] = True
+    return mask
+
+
+def _principal(measures, areas, normals, valid):
+    """``(k_min, k_max, dir_min, dir_max)`` of the ball sums ``measures`` (V, 6) over ``areas`` at the ``valid``
+    vertices (the others: whatever the zero tensor gives, made NaN by :func:`finish`)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tensors = measures / areas[:, None]
+    return principal_from_shape_operator(
+        np.where(valid[:, None], tensors, 0.0),
+        np.where(valid[:, None], normals, [0.0, 0.0, 1.0]),
+        rotate=True,
+        mean_from_trace=True,
+    )
 
 
 def _edge_spread_columns(density: np.ndarray, intact: np.ndarray, lengths: np.ndarray, readings: np.ndarray):
@@ -393,19 +508,33 @@ def _edge_spread_columns(density: np.ndarray, intact: np.ndarray, lengths: np.nd
     )
 
 
-def _few_edges(valid, areas, spread_sums, readings, curvatures) -> np.ndarray:
-    """(V,) bool: the ``valid`` vertices whose ball reads too few edges to average out their scatter
-    (:func:`few_elements`, the edges being the elements: each reads ``H_e = beta / (2 density)`` with weight
-    ``density |e ∩ B|``, the ball's H their weighted mean). ``spread_sums``: the ball sums of
-    :func:`_edge_spread_columns`; ``readings``: the edges' (:func:`edge_readings`); ``curvatures``: ``(k_min,
-    k_max)``."""
+def _few_edges(valid, areas, spread_sums, readings, curvatures, **options):
+    """``(few, reference)``: (V,) bool, the ``valid`` vertices whose ball reads too few edges to average out their
+    scatter (:func:`_few_elements`, the edges being the elements: each reads ``H_e = beta / (2 density)`` with
+    weight ``density |e ∩ B|``, the ball's H their weighted mean), and the scatter and curvature they were judged
+    against. ``spread_sums``: the ball sums of :func:`_edge_spread_columns`; ``readings``: the edges'
+    (:func:`edge_readings`); ``curvatures``: ``(k_min, k_max)``; ``options``: ``cracked`` and ``reference`` of
+    :func:`_few_elements`."""
     squared, whole, whole_squared, read, first, second, kept, kept_first, kept_second = spread_sums.T
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         shares = squared / (areas * areas)  # 1 / N (at least)
         intact_shares = whole_squared / (whole * whole)
         variances = second / read - (first / read) ** 2
         local = kept_second / kept - (kept_first / kept) ** 2
-    return few_elements(valid, shares, intact_shares, variances, readings, curvatures, local_variances=local)
+    return _few_elements(
+        valid, shares, intact_shares, variances, readings, curvatures, local_variances=local, **options
+    )
+
+
+def _staircase_note(count: int) -> str:
+    """The warning's phrase for ``count`` vertices of a welded voxel surface (:func:`._ring_noise.welded_grid`)."""
+    if not count:
+        return ""
+    return (
+        f"{count} vertices of this voxel surface are NaN (estimate undefined): it was welded across cracks between "
+        "detached faces, and its faces away from the cracks lie on a voxel grid, whose steps a ball of a few edges "
+        "reads as flat or as curvature"
+    )
 
 
 def _voxel_holed_balls(
