@@ -72,6 +72,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from ._backend import numba_kernels
 from ._validation import check_positive_float, check_vertex_count, checked_indices, checked_mask, checked_points
 from .errors import InvalidOptionError
 from .defects import _fragment_vertices, _needle_corners, _needle_vertices, _scale_edges, _scale_vertices
@@ -348,29 +349,49 @@ def _intrinsic_sample(points: np.ndarray, local: np.ndarray, size: int) -> np.nd
     # origin (igea moved by 14 units) is good to 1e-9 of its extent, the offsets' pairwise sum (a column at a time:
     # no (M, 3) temporary) to 1e-15
     guess = np.einsum("ij->j", points) / m
-    squared = np.zeros(m)
+    # the same operations as written out, into four (M,) buffers (no fresh temporary per operation: 18 of them,
+    # each an array of numpy's huge-page advice from 4 MB, issue 31)
+    squared, scratch = _scratch(m, np.float64), _scratch(m, np.float64)
+    squared.fill(0.0)
     for axis in range(3):
-        offsets = points[:, axis] - guess[axis]
+        offsets = np.subtract(points[:, axis], guess[axis], out=scratch)
         offsets -= offsets.sum() / m
-        squared += offsets * offsets
+        squared += np.multiply(offsets, offsets, out=offsets)
     spread = squared.mean()
     # (capped at 2^40 steps: a cast of a larger float is undefined; such outliers share a class)
-    first = np.rint(np.minimum(local / (local.mean() * SAMPLE_LOCAL_STEP), 2.0**40)).astype(np.int64)
-    second = np.rint(np.minimum(squared / (spread * SAMPLE_DISTANCE_STEP), 2.0**40)) if spread > 0 else np.zeros(m)
+    keys, spare = _scratch(m, np.uint64), _scratch(m, np.uint64)
+    first = np.rint(np.minimum(np.divide(local, local.mean() * SAMPLE_LOCAL_STEP, out=scratch), 2.0**40, out=scratch))
+    np.copyto(keys.view(np.int64), first, casting="unsafe")  # first.astype(np.int64), viewed as uint64
+    if spread > 0:
+        second = np.divide(squared, spread * SAMPLE_DISTANCE_STEP, out=scratch)
+        np.copyto(spare, np.rint(np.minimum(second, 2.0**40, out=second), out=second), casting="unsafe")
+    else:
+        spare.fill(0)
     with np.errstate(over="ignore"):
-        keys = _mixed(first.view(np.uint64) * np.uint64(0x9E3779B97F4A7C15) + second.astype(np.uint64))
-    last = np.partition(keys, size - 1)[size - 1]
-    return keys <= last
+        keys *= np.uint64(0x9E3779B97F4A7C15)
+        keys += spare
+        keys = _mixed(keys, spare)
+    spare[...] = keys
+    spare.partition(size - 1)
+    return keys <= spare[size - 1]
 
 
-def _mixed(values: np.ndarray) -> np.ndarray:
-    """splitmix64's finalizer of (M,) uint64 ``values``, wrapping (in place): nearby keys land far apart."""
+def _scratch(m: int, dtype) -> np.ndarray:
+    """An unfilled (M,) array of ``dtype``: numba's memory where its kernels run (no huge-page advice,
+    ``_kernels.geometry._unadvised_array``), numpy's otherwise."""
+    kernels = numba_kernels("geometry")
+    return np.empty(m, dtype) if kernels is None else kernels._unadvised_array(m, dtype)
+
+
+def _mixed(values: np.ndarray, scratch: np.ndarray | None = None) -> np.ndarray:
+    """splitmix64's finalizer of (M,) uint64 ``values``, wrapping (in place): nearby keys land far apart.
+    ``scratch``: an (M,) uint64 array for the shifts (overwritten; None: temporaries)."""
     with np.errstate(over="ignore"):
-        values ^= values >> np.uint64(30)
+        values ^= np.right_shift(values, np.uint64(30), out=scratch)
         values *= np.uint64(0xBF58476D1CE4E5B9)
-        values ^= values >> np.uint64(27)
+        values ^= np.right_shift(values, np.uint64(27), out=scratch)
         values *= np.uint64(0x94D049BB133111EB)
-        values ^= values >> np.uint64(31)
+        values ^= np.right_shift(values, np.uint64(31), out=scratch)
     return values
 
 
@@ -888,7 +909,7 @@ def _subset_voxel_grid(mesh: _Measured | PreparedMesh, faces: np.ndarray, used: 
     of ``faces``, read at the median of their length scales, or None, also where they are of another scale than
     the grid (:func:`_off_grid_scale`)."""
     scales = mesh.length_scales[used]
-    scale = float(np.median(scales))
+    scale = float(np.median(scales, overwrite_input=True))  # (a copy of its own; _off_grid_scale reads no order)
     if used.all():  # (no copy of a whole mesh)
         grid = voxel_grid(mesh.vertices, faces, spacing=scale)
     else:

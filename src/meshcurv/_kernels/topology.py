@@ -27,7 +27,8 @@ def _bucket_starts(cursor):
     same whatever the threads. A ``parallel=True`` kernel did the same in 0.5 s more compile time.
     """
     n_vertices = cursor.shape[1]
-    starts = np.zeros(n_vertices + 1, np.int64)
+    starts = _unadvised_array(n_vertices + 1, np.int64)  # every element written (_bucket_totals, starts[0])
+    starts[0] = 0
     n_chunks = _VERTEX_CHUNKS * nb.get_num_threads()
     run_chunks(_bucket_totals, n_vertices, n_chunks, cursor, starts)
     _running_sum(starts)
@@ -555,10 +556,11 @@ def neighbour_lists(edges, n_vertices):
     n_edges = edges.shape[0]
     n_ranges = max(1, min(nb.get_num_threads(), _BUCKET_CHUNKS, n_edges))
     # cursor[r, v]: ends at vertex v of edge range r, then where range r's next such end goes
-    cursor = np.zeros((n_ranges, n_vertices), np.int64)
+    # numba's memory, not numpy's (no huge-page advice: geometry._unadvised_empty, issue 31)
+    cursor = _unadvised_array((n_ranges, n_vertices), np.int64, zero=True)
     run_chunks(_count_ends, n_ranges, n_ranges, edges, cursor)
     indptr = _bucket_starts(cursor)
-    indices = np.empty(indptr[n_vertices], edges.dtype)
+    indices = _unadvised_array(indptr[n_vertices], edges.dtype)  # every slot placed once
     run_chunks(_place_ends, n_ranges, n_ranges, edges, cursor, indices)
     return indptr, indices
 
