@@ -56,7 +56,6 @@ def test_both_backends_compute_the_same_estimate_on_a_half_detached_uv_sphere():
         assert gap <= RTOL, field  # the unit sphere: its largest |k| is about 1
 
 
-@pytest.mark.xfail(reason="open (N22): holed balls read a direction-biased subset of the welded edges", strict=True)
 def test_no_valid_vertex_of_a_half_detached_uv_sphere_is_off_by_half_of_h():
     vertices, faces = half_detached_uv_sphere(6)
     with warnings.catch_warnings():
