@@ -12,7 +12,7 @@ import warnings
 import numpy as np
 
 from ._backend import kernel_threads, numba_kernels
-from ._pointcloud_normals import NEIGHBOURS, NO_LATTICE, Lattice, _dot
+from ._pointcloud_normals import NEIGHBOURS, NO_LATTICE, TIE_TOLERANCE, Lattice, _dot
 from .errors import InvalidOptionError
 from .measures import curvatures_from_measures
 from .jets import _fit_jets, jet_curvatures, jet_normals
@@ -31,7 +31,11 @@ TRIANGLES = 32
 #: A random triangle of ``corrected_measures`` adds nothing when the mean of its corners' normals lies in its plane
 #: within this fraction of their lengths' product: its corrected area is round-off, and so is the sign that turns
 #: it. On a lattice (a mesh's vertices as a cloud) such triangles are common, and normals equal to round-off turned
-#: them apart on the two backends (``benchmarks/fuzz_api.md``, round 11).
+#: them apart on the two backends (``benchmarks/fuzz_api.md``, round 11). So does a flat triangle (three points of a
+#: lattice's line: the cross product of its edges within this fraction of their L1 lengths' product), whose area is
+#: round-off once the cloud is turned, in a direction of its own: its measures of the normals' turning (mu_1, mu_2,
+#: not small) came with the sign of that round-off (a voxel sphere turned: 680 of 3,706 estimates 1e-3 of the
+#: largest |k| apart, up to 1.3e-2).
 EDGE_ON = 1e-9
 
 #: Most points of a ball that ``corrected_measures`` draws its triangles from (the nearest ones).
@@ -405,8 +409,7 @@ def _rim_balls(points, normals, radius, centres, usable) -> tuple[np.ndarray, np
     tree = cKDTree(points[pool])
     for start in range(0, centres.size, MEASURE_CHUNK):
         chunk = centres[start : start + MEASURE_CHUNK]
-        distance, index = tree.query(points[chunk], k=min(MAX_BALL_POINTS, pool.size), distance_upper_bound=radius)
-        index, distance = np.asarray(index).reshape(chunk.size, -1), np.asarray(distance).reshape(chunk.size, -1)
+        distance, index = _whole_query(tree, points[chunk], radius, min(MAX_BALL_POINTS, pool.size))
         member = index < pool.size
         theirs = pool[np.where(member, index, 0)]
         reach = np.where(member, distance, 0.0).max(axis=1)
@@ -553,8 +556,7 @@ def _uniform_balls(points, normals, found, radius, centres, usable) -> np.ndarra
     out = np.zeros(centres.size, dtype=bool)
     for start in range(0, centres.size, MEASURE_CHUNK):
         chunk = centres[start : start + MEASURE_CHUNK]
-        _, index = tree.query(points[chunk], k=min(MAX_BALL_POINTS, pool.size), distance_upper_bound=radius)
-        index = np.asarray(index).reshape(chunk.size, -1)
+        _, index = _whole_query(tree, points[chunk], radius, min(MAX_BALL_POINTS, pool.size))
         member = index < pool.size
         theirs = pool[np.where(member, index, 0)]
         with np.errstate(invalid="ignore"):
@@ -641,13 +643,31 @@ def _balls(points, normals, radii, centres, tree, k):
         group = centres[radii[centres] == radius]
         for start in range(0, group.size, MEASURE_CHUNK):
             chunk = group[start : start + MEASURE_CHUNK]
-            distance, index = tree.query(points[chunk], k=k, distance_upper_bound=radius)
-            index = np.asarray(index).reshape(chunk.size, -1)
+            distance, index = _whole_query(tree, points[chunk], radius, k)
             member = index < n
             safe = np.where(member, index, 0)
             with np.errstate(invalid="ignore"):
                 cosine = np.einsum("mkj,mj->mk", normals[safe], normals[chunk])
-            yield chunk, safe, np.asarray(distance).reshape(chunk.size, -1), member, cosine
+            yield chunk, safe, distance, member, cosine
+
+
+def _whole_query(tree, queries, radius: float, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """(M, k) distances and indices of the ``k`` nearest points of the k-d ``tree`` closer than ``radius`` to each
+    of ``queries`` (M, 3), padded as :meth:`scipy.spatial.cKDTree.query` pads them (inf, ``tree.n``), less the
+    points tied (within :data:`~meshcurv._pointcloud_normals.TIE_TOLERANCE`) with ``radius`` or with the ``k +
+    1``-th nearest (unless fewer than :data:`MIN_BALL_POINTS` would be left): the balls of the checks, decided by
+    the geometry, not by the order in which the tree met a lattice's points at one distance (see
+    :func:`_whole_ties`)."""
+    m = queries.shape[0]
+    wanted = min(k + 1, tree.n)
+    distance, index = tree.query(queries, k=wanted, distance_upper_bound=radius)
+    distance, index = np.asarray(distance).reshape(m, -1), np.asarray(index).reshape(m, -1)
+    drop = distance >= radius * (1.0 - TIE_TOLERANCE)  # (the padding too)
+    if wanted > k:
+        tied = distance[:, :k] >= distance[:, k:] * (1.0 - TIE_TOLERANCE)
+        enough = (~tied & ~drop[:, :k]).sum(axis=1) >= MIN_BALL_POINTS
+        distance, index, drop = distance[:, :k], index[:, :k], drop[:, :k] | (tied & enough[:, None])
+    return np.where(drop, np.inf, distance), np.where(drop, tree.n, index)
 
 
 def blended(points, normals, found, radii, resolved, tree, sheets=None) -> np.ndarray:
@@ -893,10 +913,10 @@ def _triangle_sums(points, normals, index, counts, pattern):
     u2x, u2y, u2z = u2[..., 0], u2[..., 1], u2[..., 2]
     sx, sy, sz = u0x + u1x + u2x, u0y + u1y + u2y, u0z + u1z + u2z
     cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-    # a triangle edge-on to its corners' normals adds nothing: its sign would be round-off (EDGE_ON)
-    edge_on = np.abs(sx * cx + sy * cy + sz * cz) <= (
-        EDGE_ON * (np.abs(sx) + np.abs(sy) + np.abs(sz)) * (np.abs(cx) + np.abs(cy) + np.abs(cz))
-    )
+    # a triangle edge-on to its corners' normals, or flat, adds nothing: its sign would be round-off (EDGE_ON)
+    area = np.abs(cx) + np.abs(cy) + np.abs(cz)
+    edge_on = np.abs(sx * cx + sy * cy + sz * cz) <= EDGE_ON * (np.abs(sx) + np.abs(sy) + np.abs(sz)) * area
+    edge_on |= area <= EDGE_ON * (np.abs(ax) + np.abs(ay) + np.abs(az)) * (np.abs(bx) + np.abs(by) + np.abs(bz))
     mx, my, mz = sx / 3, sy / 3, sz / 3
     # turned so that its normal agrees with the mean of its corners' normals: (i, j, k) -> (i, k, j)
     flip = mx * cx + my * cy + mz * cz < 0
@@ -991,6 +1011,92 @@ def _ball_indices(search, points, chunk, radius, k):
         asked = 2 * wanted
     index = np.ascontiguousarray(index[:, :k])
     return index, (index < n).sum(axis=1)
+
+
+#: Two squared distances from a centre within this share of the larger are one distance (twice
+#: :data:`~meshcurv._pointcloud_normals.TIE_TOLERANCE`, of the distances): the points of a ball at one distance
+#: (a lattice's) are taken or dropped whole at its cuts and ordered among themselves by the geometry
+#: (:func:`_whole_ties`), not by the round-off of a pose or by their index.
+SQUARED_TIE = 2 * TIE_TOLERANCE
+
+#: Weights of the cosines of :func:`_tie_keys` (their ratios irrational: distinct points rarely share a key).
+TIE_WEIGHTS = (0.6180339887498949, 0.41421356237309515, 0.3247179572447460)
+
+
+def _whole_ties(points, normals, centres, index, counts, radius, k):
+    """(M, k) the balls ``index`` (M, K) of the ``centres`` (M,) (rows in the order of ``(squared distance,
+    index)``, ``counts`` points first, padded with N; ``K > k``: the next point after the ``k``-th when there is
+    one) as the estimate's balls of ``radius`` and at most ``k`` points, and (M,) their counts.
+
+    The triangles of :func:`corrected_measures` and the points that :func:`flat_balls` checks are ranks in the
+    ball's distance order. On a lattice (a voxel surface, a mesh's vertices read as a cloud) many points of a
+    ball lie at one distance, and round-off (a rotation, a shift: a few units of 1e-16 of the cloud's extent)
+    or the index decided their order and which of them a cut kept: a voxel sphere of radius 14 turned by a
+    rigid motion moved every estimate, by 0.9% of the largest |k| at the median and 5.4% at most. Here
+    distances within :data:`SQUARED_TIE` (squared) are one distance: points tied with ``radius`` go; a row of
+    more than ``k`` points loses its points tied with the ``k + 1``-th (unless fewer than
+    :data:`MIN_BALL_POINTS` would be left: then its first ``k``); and each run of points tied with the one
+    before is ordered by :func:`_tie_keys` (cosines of the offset and the normals, which rigid motions, shifts,
+    scaling and re-indexing keep), keys within :data:`SQUARED_TIE` of the one before by index (points that even
+    these cannot tell apart, a symmetry of the ball, whose keys round-off orders: the normals of the two backends,
+    1e-15 apart, ordered an icosphere's vertices apart, 2e-4 of |k|). Compiled:
+    :func:`meshcurv._kernels.pointcloud.whole_ties` (the same operations, to the bit).
+    """
+    n = points.shape[0]
+    member = np.arange(index.shape[1])[None, :] < counts[:, None]
+    safe = np.where(member, index, centres[:, None])
+    step = points[safe] - points[centres][:, None, :]
+    squared = step[..., 0] * step[..., 0] + step[..., 1] * step[..., 1] + step[..., 2] * step[..., 2]
+    inside = member & (squared < radius * radius * (1.0 - SQUARED_TIE))  # (a prefix: the rows ascend)
+    found = inside.sum(axis=1)
+    full = np.flatnonzero(found > k)
+    if full.size:
+        cut = squared[full, k] * (1.0 - SQUARED_TIE)
+        keep = (squared[full, :k] < cut[:, None]).sum(axis=1)
+        found[full] = np.where(keep >= MIN_BALL_POINTS, keep, k)
+    inside = np.arange(index.shape[1])[None, :] < found[:, None]
+    # runs of points tied with the one before, sorted by their keys (singletons keep their place)
+    starts = np.ones(index.shape, dtype=bool)
+    starts[:, 1:] = squared[:, :-1] < squared[:, 1:] * (1.0 - SQUARED_TIE)
+    starts |= ~inside
+    ends = np.ones(index.shape, dtype=bool)
+    ends[:, :-1] = starts[:, 1:]
+    tied = inside & ~(starts & ends)
+    if tied.any():
+        keys = np.zeros(index.shape)
+        rows, cols = np.nonzero(tied)
+        keys[rows, cols] = _tie_keys(points, normals, index[rows, cols], centres[rows])
+        run = np.cumsum(starts, axis=1)
+        order = np.lexsort((np.where(inside, index, n), keys, run), axis=-1)
+        index, keys = np.take_along_axis(index, order, axis=1), np.take_along_axis(keys, order, axis=1)
+        # keys within SQUARED_TIE of the one before (chains: a symmetry of the ball, its keys round-off apart) by index
+        with np.errstate(invalid="ignore"):  # (inf - inf: NaN keys, one chain)
+            chain = np.ones(index.shape, dtype=bool)
+            chain[:, 1:] = starts[:, 1:] | (keys[:, 1:] - keys[:, :-1] > SQUARED_TIE)
+        order = np.lexsort((np.where(inside, index, n), np.cumsum(chain, axis=1)), axis=-1)
+        index = np.take_along_axis(index, order, axis=1)
+    out = np.where(inside, index, n)[:, :k]
+    return np.ascontiguousarray(out), found
+
+
+def _tie_keys(points, normals, members, centres) -> np.ndarray:
+    """(P,) the keys of :func:`meshcurv._kernels.pointcloud._tie_key` of the points ``members`` (P,) in the balls of
+    ``centres`` (P,), the same operations: ``n_c . u + w_1 n_j . u + w_2 n_c . n_j + w_3 n_c . (u x n_j)``
+    (:data:`TIE_WEIGHTS`) of the unit offset ``u`` from ``c`` to ``j`` (0 where they coincide), +inf where NaN."""
+    step = points[members] - points[centres]
+    dx, dy, dz = step[:, 0], step[:, 1], step[:, 2]
+    length = np.sqrt(dx * dx + dy * dy + dz * dz)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        safe = np.where(length > 0.0, length, 1.0)
+        ux, uy, uz = (np.where(length > 0.0, d / safe, 0.0) for d in (dx, dy, dz))
+    a, b = normals[centres], normals[members]
+    ax, ay, az, bx, by, bz = a[:, 0], a[:, 1], a[:, 2], b[:, 0], b[:, 1], b[:, 2]
+    height = ax * ux + ay * uy + az * uz
+    slope = bx * ux + by * uy + bz * uz
+    cosine = ax * bx + ay * by + az * bz
+    twist = ax * (uy * bz - uz * by) + ay * (uz * bx - ux * bz) + az * (ux * by - uy * bx)
+    key = height + TIE_WEIGHTS[0] * slope + TIE_WEIGHTS[1] * cosine + TIE_WEIGHTS[2] * twist
+    return np.where(np.isnan(key), np.inf, key)
 
 
 #: A point of a ball faces away from its centre when ``n_j . n_c < -FACING_MARGIN``. Not 0: on a lattice (a gridded
@@ -1109,8 +1215,9 @@ def corrected_measures(
     ``K = mu_2 / mu_0``, ``k = H -/+ sqrt(max(H^2 - K, 0))``, the directions
     those of ``-sym(mu^{X,Y}) / mu_0`` in the tangent plane of the centre's
     normal. The draws are ranks in the ball's distance order from one fixed
-    pattern: the result does not depend on the order of the points, and moves
-    with them under rigid motions and scaling. ``details`` receives
+    pattern (points at one distance taken whole and ordered by the geometry:
+    :func:`_whole_ties`): the result does not depend on the order of the
+    points, and moves with them under rigid motions and scaling. ``details`` receives
     ``"unsteady"`` (:func:`unsteady`: the estimates that the same measures
     over balls :data:`LARGER` times larger do not reproduce).
     """
@@ -1142,28 +1249,48 @@ def corrected_measures(
         logger.debug("point cloud: ball search")
         if kernels is not None:
             threads = 64 * kernel_threads()
+            # (one point more than the balls hold: is a cut through points at one distance? _whole_ties)
             if check:  # one search for both balls: the smaller is the prefix of the larger closer than radius
                 wide_index, squared, wide_counts = kernels.ball_indices(
-                    points, chunk, float(wide), k_wide, *grid, threads
+                    points, chunk, float(wide), k_wide + 1, *grid, threads
                 )
-                index, counts = kernels.inner_balls(wide_index, squared, wide_counts, float(radius), k, n)
+                index, counts = kernels.inner_balls(wide_index, squared, wide_counts, float(radius), k + 1, n)
             else:
-                index, _, counts = kernels.ball_indices(points, chunk, float(radius), k, *grid, threads)
+                index, squared, counts = kernels.ball_indices(points, chunk, float(radius), k + 1, *grid, threads)
+            index, counts = kernels.whole_ties(  # (the inner balls' rows: prefixes of the larger balls')
+                points, normals, chunk, index, squared, counts, float(radius), k, SQUARED_TIE, MIN_BALL_POINTS
+            )
             index, counts = kernels.own_side(normals, chunk, index, counts, own_sheets, FACING_MARGIN)
         else:
-            index, counts = _ball_indices(search, points, chunk, radius, k)
+            index, counts = _ball_indices(search, points, chunk, radius, k + 1)
+            index, counts = _whole_ties(points, normals, chunk, index, counts, radius, k)
             index, counts = _own_side(normals, chunk, index, counts, sheets)
         logger.debug("point cloud: triangle sums")
         done = _measured(out, points, normals, chunk, index, counts, pattern, kernels)
         if check and done.size:
             logger.debug("point cloud: larger balls")
             if kernels is not None:  # (every row's, in place: `done` is nearly all of them, and no copies)
+                wide_index, wide_counts = kernels.whole_ties(
+                    points,
+                    normals,
+                    chunk,
+                    wide_index,
+                    squared,
+                    wide_counts,
+                    float(wide),
+                    k_wide,
+                    SQUARED_TIE,
+                    MIN_BALL_POINTS,
+                )
                 wide_index, wide_counts = kernels.own_side(
                     normals, chunk, wide_index, wide_counts, own_sheets, FACING_MARGIN
                 )
                 _measured(larger, points, normals, chunk, wide_index, wide_counts, pattern, kernels, done)
             else:
-                wide_index, wide_counts = _ball_indices(search, points, chunk[done], wide, k_wide)
+                wide_index, wide_counts = _ball_indices(search, points, chunk[done], wide, k_wide + 1)
+                wide_index, wide_counts = _whole_ties(
+                    points, normals, chunk[done], wide_index, wide_counts, wide, k_wide
+                )
                 wide_index, wide_counts = _own_side(normals, chunk[done], wide_index, wide_counts, sheets)
                 _measured(larger, points, normals, chunk[done], wide_index, wide_counts, pattern, kernels)
     if details is not None:  # (check)

@@ -19,16 +19,20 @@ from .neighborhoods import _ball_members
 @nb.njit(**_JIT)
 def _edge_on(points, normals, i, j, k, tolerance):
     """Whether the triangle ``(i, j, k)`` holds the mean of its corners' normals in its plane, within
-    ``tolerance`` of the product of their (L1) lengths: its corrected area is round-off, and so is the sign that
-    turns it (:data:`meshcurv._pointcloud_estimators.EDGE_ON`)."""
+    ``tolerance`` of the product of their (L1) lengths, or is flat (the L1 length of the cross product of its two
+    edges from ``i`` within ``tolerance`` of the product of theirs): its corrected area is round-off, and so is the
+    sign that turns it (:data:`meshcurv._pointcloud_estimators.EDGE_ON`)."""
     ax, ay, az = points[j, 0] - points[i, 0], points[j, 1] - points[i, 1], points[j, 2] - points[i, 2]
     bx, by, bz = points[k, 0] - points[i, 0], points[k, 1] - points[i, 1], points[k, 2] - points[i, 2]
     mx = normals[i, 0] + normals[j, 0] + normals[k, 0]
     my = normals[i, 1] + normals[j, 1] + normals[k, 1]
     mz = normals[i, 2] + normals[j, 2] + normals[k, 2]
     cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    area = abs(cx) + abs(cy) + abs(cz)
+    if area <= tolerance * (abs(ax) + abs(ay) + abs(az)) * (abs(bx) + abs(by) + abs(bz)):
+        return True
     facing = abs(mx * cx + my * cy + mz * cz)
-    return facing <= tolerance * (abs(mx) + abs(my) + abs(mz)) * (abs(cx) + abs(cy) + abs(cz))
+    return facing <= tolerance * (abs(mx) + abs(my) + abs(mz)) * area
 
 
 @nb.njit(**_JIT)
@@ -451,6 +455,103 @@ def inner_balls(index, squared, counts, radius, k, n):
         for a in range(c, k):
             out[row, a] = n
     return out, found
+
+
+@nb.njit(inline="always", **_JIT)
+def _tie_key(points, normals, j, c):
+    """The place of point ``j`` among the points of the ball of ``c`` at its distance: a sum of four cosines of
+    the unit offset ``u`` from ``c`` to ``j`` and the two normals (``n_c . u``, ``n_j . u``, ``n_c . n_j`` and
+    ``n_c . (u x n_j)``) with weights of no common ratio, which rigid motions keep (the last one tells mirror images
+    apart); +inf where it is NaN. The NumPy twin: :func:`meshcurv._pointcloud_estimators._tie_keys`."""
+    dx, dy, dz = points[j, 0] - points[c, 0], points[j, 1] - points[c, 1], points[j, 2] - points[c, 2]
+    length = np.sqrt(dx * dx + dy * dy + dz * dz)
+    if length > 0.0:
+        ux, uy, uz = dx / length, dy / length, dz / length
+    else:
+        ux, uy, uz = 0.0, 0.0, 0.0
+    ax, ay, az = normals[c, 0], normals[c, 1], normals[c, 2]
+    bx, by, bz = normals[j, 0], normals[j, 1], normals[j, 2]
+    height = ax * ux + ay * uy + az * uz
+    slope = bx * ux + by * uy + bz * uz
+    cosine = ax * bx + ay * by + az * bz
+    twist = ax * (uy * bz - uz * by) + ay * (uz * bx - ux * bz) + az * (ux * by - uy * bx)
+    key = height + 0.6180339887498949 * slope + 0.41421356237309515 * cosine + 0.3247179572447460 * twist
+    return key if key == key else np.inf
+
+
+@nb.njit(parallel=True, **_JIT)
+def whole_ties(points, normals, centres, index, squared, counts, radius, k, tie, least):
+    """(M, k) the balls ``index`` (M, K) (rows in the order of ``(squared distance, index)``, ``counts`` points
+    first, their ``squared`` distances (M, K) as :func:`ball_indices` gives them, ``K > k``) cut to ``radius`` and
+    ``k`` points with the points tied in distance taken or dropped whole, and ordered among themselves by the
+    geometry; and (M,) their counts.
+
+    The compiled :func:`meshcurv._pointcloud_estimators._whole_ties` (see there): the points at ``radius`` within
+    ``tie`` (of the squared distance) go; a row holding more than ``k`` loses the points tied with its ``k + 1``-th
+    (unless fewer than ``least`` would be left: then its first ``k``); each run of points tied with the one before
+    is sorted by :func:`_tie_key` (keys within ``tie``: by index, :func:`_sort_tied`). Padded with N. The rows of :func:`inner_balls` are prefixes of
+    those of its larger balls: their squared distances are those of the larger balls' rows.
+    """
+    m = index.shape[0]
+    n = points.shape[0]
+    out = np.empty((m, k), dtype=np.int64)  # (each row written whole by its thread, as in ball_indices)
+    kept = np.zeros(m, dtype=np.int64)
+    limit = radius * radius * (1.0 - tie)
+    for row in nb.prange(m):
+        count = counts[row]
+        while count > 0 and squared[row, count - 1] >= limit:
+            count -= 1
+        if count > k:
+            cut = squared[row, k] * (1.0 - tie)
+            keep = k
+            while keep > 0 and squared[row, keep - 1] >= cut:
+                keep -= 1
+            count = keep if keep >= least else k
+        for a in range(count):
+            out[row, a] = index[row, a]
+        for a in range(count, k):
+            out[row, a] = n
+        kept[row] = count
+        start = 0
+        for a in range(1, count + 1):
+            if a == count or squared[row, a - 1] < squared[row, a] * (1.0 - tie):  # a run [start, a) ends
+                if a - start > 1:
+                    _sort_tied(points, normals, centres[row], out, row, start, a, tie)
+                start = a
+    return out, kept
+
+
+@nb.njit(**_JIT)
+def _sort_tied(points, normals, c, out, row, start, end, tie):
+    """Sort ``out[row, start:end]`` by :func:`_tie_key`, keys within ``tie`` of the one before (a chain) by index:
+    an insertion sort by ``(key, index)`` (a few points), then one by index over each chain. Points whose keys
+    differ by round-off alone (a symmetry of the ball: the same geometry) keep one order on both backends."""
+    for a in range(start + 1, end):
+        q = out[row, a]
+        key = _tie_key(points, normals, q, c)
+        j = a
+        while j > start:
+            p = out[row, j - 1]
+            other = _tie_key(points, normals, p, c)
+            if not (other > key or (other == key and p > q)):
+                break
+            out[row, j] = p
+            j -= 1
+        out[row, j] = q
+    first = start
+    before = _tie_key(points, normals, out[row, start], c)
+    for a in range(start + 1, end + 1):
+        key = _tie_key(points, normals, out[row, a], c) if a < end else np.inf
+        if a == end or key - before > tie:  # a chain [first, a) ends
+            for b in range(first + 1, a):
+                q = out[row, b]
+                j = b
+                while j > first and out[row, j - 1] > q:
+                    out[row, j] = out[row, j - 1]
+                    j -= 1
+                out[row, j] = q
+            first = a
+        before = key
 
 
 @nb.njit(**_JIT)
