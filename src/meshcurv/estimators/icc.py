@@ -186,6 +186,9 @@ COARSE_EDGES = 16.0
 #: 6 and 8 made the marching-cubes sphere r 1 at voxel 0.05 of ``benchmarks/accuracy.py`` 13% worse, 10 is
 #: within 4% of the fits over every vertex on each binary marching-cubes mesh there, ``benchmarks/scale_default.py``).
 COARSE_CELLS = 10.0
+#: Components of a unit normal within this of its largest count as the largest (:func:`_coarse_level`'s side of a
+#: cluster): exact ties differ by round-off (1e-16); the normals of a lattice that differ at all, by far more.
+AXIS_TIE = 1e-9
 
 #: A fitted normal is kept where its cosine with the mean of the face normals exceeds this (60 degrees).
 NORMAL_AGREEMENT = 0.5
@@ -458,7 +461,8 @@ def _coarse_level(
     vertices that may enter the balls are grouped by cube of side ``median radius / cells`` (default
     :data:`COARSE_CELLS`; the cubes shifted by ``shift`` of a side) and by the axis and
     sign of their normal's largest component (the two
-    sides of a part thinner than a cube stay apart); each group is one point at its area-weighted centroid,
+    sides of a part thinner than a cube stay apart; the components tied with it, :data:`AXIS_TIE`, with theirs);
+    each group is one point at its area-weighted centroid,
     weighing the group's area, linked to the groups that a mesh edge joins it to. Returns ``(points,
     normals, allowed, (indptr, indices), areas)`` over V + C points: the V vertices come first, each linked
     to its own group only and not allowed in a ball (the fit of vertex ``v`` is centred on it and walks the
@@ -479,9 +483,15 @@ def _coarse_level(
     corner = vertices[members].min(axis=0)
     # cells beyond 2^52 (a vertex flung far away) share the last one: a cast of such a float is undefined
     cube = np.minimum(np.floor((vertices[members] - corner) / cell + shift), 2.0**52).astype(np.int64)
-    axis = np.argmax(np.abs(normals[members]), axis=1)
-    side = 2 * axis + (normals[members, axis] < 0)
-    group = _row_groups(np.column_stack([cube, side]), (20, 20, 20, 3))
+    # the side: the axes within round-off of the largest component, with their signs (one of 26 codes). At a voxel
+    # surface's edges and corners two or three components tie exactly ((-3, 3, 1) / sqrt(19) at a slab's corner);
+    # argmax let the last bits of a scaled mesh choose one (issue 29, fuzz_labels seed 460 case 313: a slab's area
+    # 0.05% and H 0.1% apart between the spacings x1 and x0.7), and a first axis of the tied ones would change with
+    # a permutation of the axes (a transposed image): the tied set is its own side
+    magnitude = np.abs(normals[members])
+    dominant = magnitude >= magnitude.max(axis=1, keepdims=True) - AXIS_TIE
+    side = (dominant * (1 + (normals[members] < 0)) * np.array([1, 3, 9])).sum(axis=1)
+    group = _row_groups(np.column_stack([cube, side]), (20, 20, 20, 5))
     c = int(group.max()) + 1
     weight = areas[members]
     total = np.bincount(group, weights=weight, minlength=c)
