@@ -1604,6 +1604,47 @@ def check_inner_balls(name):
         np.testing.assert_array_equal(index, expected_index)
 
 
+def check_whole_ties(name):
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_estimators import MIN_BALL_POINTS, SQUARED_TIE, _ball_indices, _usable_tree, _whole_ties
+
+    points, normals = cloud(name)
+    # and a square lattice beside it (its balls' points at one distance in fours: cuts through them, runs to order
+    # by their keys), its normals varying, some NaN (keys of +inf)
+    x, y = (grid.ravel() for grid in np.meshgrid(np.arange(16.0), np.arange(16.0)))
+    lattice = np.column_stack([x, y, np.zeros(x.size)]) * 0.02 + 5.0
+    lattice_normals = np.column_stack([0.1 * np.sin(x), 0.05 * y, np.ones(x.size)])
+    lattice_normals /= np.linalg.norm(lattice_normals, axis=1, keepdims=True)
+    lattice_normals[::9] = np.nan
+    points, normals = (
+        np.concatenate([points, lattice]),
+        np.ascontiguousarray(np.concatenate([normals, lattice_normals])),
+    )
+    n = points.shape[0]
+    radius = 0.4 if name == "ellipsoid_cloud" else 0.12
+    centres = np.arange(0, n, 3)
+    on_lattice = centres >= n - lattice.shape[0]
+    tree = cKDTree(points)
+    for k in (11, 24, 96):
+        index, counts = _ball_indices(
+            _usable_tree(tree, points, np.ones(n, dtype=bool)), points, centres, radius, k + 1
+        )
+        expected_index, expected_counts = _whole_ties(points, normals, centres, index, counts, radius, k)
+        inside = index < n
+        step = points[np.where(inside, index, 0)] - points[centres][:, None, :]
+        squared = step[..., 0] * step[..., 0] + step[..., 1] * step[..., 1] + step[..., 2] * step[..., 2]
+        squared = np.where(inside, squared, np.inf)  # (as ball_indices gives them)
+        got_index, got_counts = kernels("pointcloud").whole_ties(
+            points, normals, centres, index, squared, counts, float(radius), k, SQUARED_TIE, MIN_BALL_POINTS
+        )
+        # the same squared distances, tests and keys: to the bit
+        np.testing.assert_array_equal(got_counts, expected_counts, err_msg=f"k={k}")
+        np.testing.assert_array_equal(got_index, expected_index, err_msg=f"k={k}")
+        assert (expected_counts[on_lattice] < np.minimum(counts[on_lattice], k)).any(), k  # (some cut whole)
+        assert (expected_index[on_lattice] != index[on_lattice, :k]).any(), k  # (some runs ordered by their keys)
+
+
 def check_nearest_neighbours(name):
     from scipy.spatial import cKDTree
 
@@ -2066,6 +2107,7 @@ TWINS = [
     ),
     Twin("pointcloud.ball_indices", "_pointcloud_estimators._ball_indices", check_ball_indices, CLOUDS),
     Twin("pointcloud.inner_balls", "_pointcloud_estimators._ball_indices (smaller radius)", check_inner_balls, CLOUDS),
+    Twin("pointcloud.whole_ties", "_pointcloud_estimators._whole_ties", check_whole_ties, CLOUDS),
     Twin("pointcloud.nearest_neighbours", "_pointcloud_normals.knn", check_nearest_neighbours, CLOUDS),
     Twin(
         "pointcloud.neighbour_differences",
