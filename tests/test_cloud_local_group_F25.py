@@ -45,7 +45,6 @@ def spheres_and_disc(seed):
     return points, np.vstack([small_normals, large_normals, disc_normals])
 
 
-@pytest.mark.xfail(strict=True, reason="open (issue 29, fuzz_api 510/42): a small group's box misses its wider balls")
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
 @pytest.mark.parametrize("seed", [1, 4])
 def test_a_small_group_computed_alone_keeps_the_whole_clouds_valid_points(seed, backend, monkeypatch):

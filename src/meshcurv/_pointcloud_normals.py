@@ -1186,7 +1186,7 @@ def oriented_signs(
         (:func:`winding_sides`).
     """
     n = points.shape[0]
-    graph = indices[:, :GRAPH_NEIGHBOURS]  # (a view: the kernel reads it in place)
+    graph = _graph_cut(points, indices)
     compiled = numba_kernels("pointcloud")
     if compiled is not None:  # the edges and their products in one pass on every core, without (E, 3) gathers
         rows, cols, kept, ahead, behind, cosine, slope = compiled.graph_edges(points, normals, graph, usable)
@@ -1272,6 +1272,39 @@ def oriented_signs(
         doubtful[rows[torn]] = True
         doubtful[cols[torn]] = True
     return signs, labels, doubtful | unsettled, sheets, unsettled
+
+
+def _graph_cut(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """The graph of the orientation: the first :data:`GRAPH_NEIGHBOURS` columns of the nearest neighbours
+    ``indices`` (N, k), and in a row whose neighbours tie across that cut (within :data:`TIE_TOLERANCE`) the whole
+    tied group (columns up to ``k``; the slots after it hold the point itself: no edge). On a lattice a ring of
+    neighbours at one distance crosses the cut, and the search's order, which a rigid motion changes by round-off,
+    chose the edges: a voxel torus (12, 5) turned had two points joined by a stacked edge only and turned inside out
+    (the noise level's fits then refused their balls, and the default radius moved). A view of ``indices`` where
+    no row has such a tie; else as wide as the widest group needs."""
+    k = GRAPH_NEIGHBOURS
+    if indices.shape[1] <= k:
+        return indices
+    own = np.arange(indices.shape[0])
+    cut = np.linalg.norm(points[indices[:, k]] - points, axis=1)
+    # (a slot beyond the cut holding the point itself: a group tied farther out was dropped, none crosses this cut)
+    cut[indices[:, k] == own] = np.inf
+    last = np.linalg.norm(points[indices[:, k - 1]] - points, axis=1)
+    rows = np.flatnonzero(last >= cut * (1.0 - TIE_TOLERANCE))
+    if rows.size == 0:
+        return indices[:, :k]  # (a view: the kernels read it in place)
+    wide = indices[rows, k:]
+    distances = np.linalg.norm(points[wide] - points[rows, None, :], axis=2)
+    # the group: the columns from k on at the distance of column k - 1 (the point itself ends it)
+    tied = (distances <= last[rows, None] * (1.0 + TIE_TOLERANCE)) & (wide != rows[:, None])
+    tied = np.cumprod(tied, axis=1).astype(bool)
+    width = k + int(tied.sum(axis=1).max())
+    if width == k:
+        return indices[:, :k]
+    graph = np.repeat(own[:, None], width, axis=1)
+    graph[:, :k] = indices[:, :k]
+    graph[rows, k:] = np.where(tied, wide, rows[:, None])[:, : width - k]
+    return graph
 
 
 def _graph_geometry(points, normals, indices, usable):

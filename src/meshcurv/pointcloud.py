@@ -1125,7 +1125,9 @@ def _compute(points, given, radius, method, search=None):
             mixed = _normals.facing_away(start, indices)
         # a small group (a few points of a scan line, a class of density in one corner) is computed on the
         # points within reach of it only: the same balls, without a search structure over the whole cloud
-        near = _within_reach(points, members, reach)
+        # (its reach: every ball of the group's checks, the steadiness check's LARGER one included; a box of the
+        # ball's radius alone held points of a larger ball or not by the pose: fuzz_api 510/42)
+        near = _within_reach(points, members, reach * _estimators.LARGER)
         if near is None:
             local = (points, start, usable, members, sheets, one_sided, mixed, facing)
         else:
