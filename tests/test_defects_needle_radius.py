@@ -139,8 +139,10 @@ def test_the_scale_vertices_are_the_referenced_ones_but_the_needles():
 
 @pytest.mark.parametrize("method", BALL_METHODS)
 def test_the_extent_cap_of_a_small_voxel_object_leaves_a_needle_out(method):
-    # a row of 4 voxels: its default radius is capped at half its bounding-box diagonal
-    # (radius.VOXEL_EXTENT_CAP); the extent was measured with the needle, and a needle lifted the cap
+    # a row of 4 voxels: its default radius is at most half its bounding-box diagonal (radius.VOXEL_EXTENT_CAP);
+    # the extent was measured with the needle, and a needle lifted the cap (the pilot with the needle reads a
+    # curvature radius of 97 voxels). Without the needle the pilot reads the rod's own (0.32, about its half
+    # thickness: radius 1.01) since the cube grids turn with the mesh (issue 29, L25; 6.8 before, capped)
     measure = pytest.importorskip("skimage.measure")
     image = np.zeros((3, 6, 3))
     image[1, 1:5, 1] = 1.0
@@ -151,7 +153,5 @@ def test_the_extent_cap_of_a_small_voxel_object_leaves_a_needle_out(method):
     for distance in (0.0, 30.0, 1e6):
         result = _computed(_flung(vertices, [3], distance), faces, method, "numpy")
         assert result.parameters["surface"] == "voxel"
-        if method != "icc":  # icc's one figure is the median of its vertices' radii, each capped
-            assert result.parameters["radius"] == pytest.approx(cap, rel=1e-12)
-        else:
-            assert result.parameters["radius"] <= cap * (1 + 1e-12)
+        # (icc's one figure is the median of its vertices' radii, each capped)
+        assert result.parameters["radius"] <= cap * (1 + 1e-12)

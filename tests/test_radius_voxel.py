@@ -208,7 +208,7 @@ def test_the_pilot_runs_at_about_half_of_the_vertices_and_spreads_its_normals():
 
 def test_the_pilot_at_a_subset_keeps_the_radii_of_the_pilot_at_every_vertex(monkeypatch):
     # against the pilot at every vertex (cubes of 0.01 edges): the radii move by a few percent and the
-    # median H error by less than a tenth of itself (benchmarks/accuracy_voxel.md: within 6% on 19 meshes)
+    # median H error by about a tenth of itself (benchmarks/accuracy_voxel.md: within 6% on 19 meshes)
     pytest.importorskip("skimage")
     from meshcurv.estimators import icc
 
@@ -218,7 +218,9 @@ def test_the_pilot_at_a_subset_keeps_the_radii_of_the_pilot_at_every_vertex(monk
     every = quiet(mesh.vertices, mesh.faces)
     assert np.median(np.abs(subset.radius / every.radius - 1.0)) < 0.05
     error = [np.median(np.abs(r.mean - mesh.mean) / np.abs(mesh.mean)) for r in (subset, every)]
-    assert error[0] < 1.1 * error[1]
+    # (1.1 until the cube grids turned with the mesh, issue 29, L25: both errors fell, 0.0785 -> 0.0778 and
+    # 0.0722 -> 0.0705, their ratio rose 1.086 -> 1.104: where the cubes fall is a lottery of a few percent)
+    assert error[0] < 1.12 * error[1]
 
 
 def test_the_default_radius_of_a_small_voxel_object_is_never_refused():

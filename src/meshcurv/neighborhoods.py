@@ -1009,11 +1009,12 @@ def _face_clusters(
     )
     area = 0.5 * float(np.median(twice))
     side = np.sqrt(size * area) if area > 0 else float(reach.max()) + 1.0
-    corner = centres.min(axis=0)
-    # cubes beyond 2^20 per axis share the last one (a face flung far away): the key fits in an int64
-    # shifted by 1 / pi of a side: the centroids of a voxel surface lie on a lattice, and a cube boundary
-    # through lattice points would let round-off (a scaled mesh) make other clusters
-    cube = np.minimum(np.floor((centres - corner) / side + 1.0 / np.pi), 2.0**20).astype(np.int64)
+    from .jets import turned_cubes  # (jets imports this module)
+
+    # cubes beyond 2^20 per axis share the last one (a face flung far away): the key fits in an int64; no cube
+    # boundary through a voxel surface's lattice of centroids, where round-off (a scaled mesh) would make other
+    # clusters; a mirror image of the mesh gets the mirrored clusters (turned_cubes)
+    cube = turned_cubes(centres, side)[0]
     _, cell = _unique_inverse(cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2])
     # faces linked through (vertex, cube) nodes: two faces of one cube that share a corner are connected
     _, node = _unique_inverse(faces.ravel() * (int(cell.max()) + 1) + np.repeat(cell, 3))

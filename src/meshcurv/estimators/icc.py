@@ -140,6 +140,7 @@ from ..jets import (
     interpolated_normals,
     jet_normals,
     nested_jet_normals,
+    turned_cubes,
 )
 from .._measures import curvatures_from_measures, face_measures, principal_from_measures
 from ..neighborhoods import (
@@ -452,15 +453,15 @@ def _unwrapped_normals(
     return fitted
 
 
-def _coarse_level(
-    vertices, normals, radius, areas, neighbours, adjacency, *, edges=None, cells=None, shift=0.0, edge=None
-):
+def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, edges=None, cells=None, edge=None):
     """The points of the normal fits of a dense surface: clusters of vertices, or None for an ordinary mesh.
 
     Used when the median ``radius`` exceeds ``edges`` (default :data:`COARSE_EDGES`) median edge lengths. The
     vertices that may enter the balls are grouped by cube of side ``median radius / cells`` (default
-    :data:`COARSE_CELLS`; the cubes shifted by ``shift`` of a side) and by the axis and
-    sign of their normal's largest component (the two
+    :data:`COARSE_CELLS`; :func:`meshcurv.jets.turned_cubes`: no boundary through a voxel surface's lattice, where
+    a given radius of 10 voxels put 378 vertices of a ball of 8.3 voxels when the cubes started at the lowest
+    vertex, and round-off chose their cubes, 1,532 clusters at unit spacing and 1,533 at 0.7; a mirror image of the
+    surface gets the mirrored cubes) and by the axis and sign of their normal's largest component (the two
     sides of a part thinner than a cube stay apart; the components tied with it, :data:`AXIS_TIE`, with theirs);
     each group is one point at its area-weighted centroid,
     weighing the group's area, linked to the groups that a mesh edge joins it to. Returns ``(points,
@@ -480,9 +481,9 @@ def _coarse_level(
     tails = np.repeat(np.arange(n), np.diff(indptr))
     cell = typical / (COARSE_CELLS if cells is None else cells)
     members = np.flatnonzero(inside)
-    corner = vertices[members].min(axis=0)
-    # cells beyond 2^52 (a vertex flung far away) share the last one: a cast of such a float is undefined
-    cube = np.minimum(np.floor((vertices[members] - corner) / cell + shift), 2.0**52).astype(np.int64)
+    # cells beyond 2^52 (a vertex flung far away) share the last one: a cast of such a float is undefined; the
+    # cubes of meshcurv.jets.turned_cubes (a mirror image of the mesh gets the mirrored clusters)
+    cube = turned_cubes(vertices[members], cell, limit=2.0**52)[0]
     # the side: the axes within round-off of the largest component, with their signs (one of 26 codes). At a voxel
     # surface's edges and corners two or three components tie exactly ((-3, 3, 1) / sqrt(19) at a slab's corner);
     # argmax let the last bits of a scaled mesh choose one (issue 29, fuzz_labels seed 460 case 313: a slab's area
@@ -638,7 +639,6 @@ def _pilot_normals(
             adjacency,
             edges=PILOT_COARSE_EDGES,
             cells=PILOT_COARSE_CELLS,
-            shift=1.0 / np.pi,  # the radius is a multiple of the voxel size: no cube boundary through the lattice
             edge=edge,
         )
         if positive.size
@@ -713,25 +713,23 @@ PILOT_RINGS = 2
 
 def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarray) -> np.ndarray:
     """The vertices of :func:`voxel_pilot`'s fits and sums: in each cube of side :data:`PILOT_CELL_EDGES` median
-    edge lengths, the valid referenced vertex nearest the cube's middle, ties taken by the coordinates (never by
-    the index: re-indexed vertices give the same centres; the cubes of the coordinate axes: a rotated mesh gets
-    other centres)."""
+    edge lengths (:func:`meshcurv.jets.turned_cubes`), the valid referenced vertex nearest the cube's middle, ties
+    taken by the turned coordinates (never by the index: re-indexed vertices give the same centres, and a mirror
+    image of the mesh the mirrored ones; the cubes of the coordinate axes: a rotated mesh gets other centres)."""
     members = np.flatnonzero(valid & topology.referenced_vertices)
     if members.size == 0:
         return members
     edge = median_edge_length(vertices, topology.edges)
     if not edge > 0:
         return members
-    points = vertices[members]
-    # the cubes shifted by 1 / pi of a side: a voxel surface's vertices lie on a lattice, and a cube boundary
-    # through lattice points would let round-off (a scaled mesh) pick other centres
-    shifted = (points - points.min(axis=0)) / (PILOT_CELL_EDGES * edge) + 1.0 / np.pi
-    cube = np.minimum(np.floor(shifted), 2.0**20).astype(np.int64)
+    # (meshcurv.jets.turned_cubes: no cube boundary through a voxel surface's lattice, where round-off (a scaled
+    # mesh) would pick other centres; a mirror image of the mesh gets the mirrored cubes)
+    cube, offset, turned = turned_cubes(vertices[members], PILOT_CELL_EDGES * edge)
     key = cube[:, 0] << 42 | cube[:, 1] << 21 | cube[:, 2]
     # (rounded: a lattice holds many vertices at one distance from the middle, whose round-off would depend on
-    # the scale; their tie goes to the coordinates, whose order a scaling keeps)
-    off_middle = np.round(_squared(*(shifted - cube - 0.5).T), 9)
-    return members[_nearest_in_cubes(points, key, off_middle)]
+    # the scale; their tie goes to the turned coordinates, whose order a scaling and a mirror keep)
+    off_middle = np.round(_squared(*offset.T), 9)
+    return members[_nearest_in_cubes(turned, key, off_middle)]
 
 
 def _spread_normals(neighbour_lists: tuple, centres: np.ndarray, fitted: np.ndarray, fallback, rings: int):
