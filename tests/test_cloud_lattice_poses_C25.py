@@ -54,21 +54,27 @@ def test_voxel_cloud_moved_keeps_its_valid_points_and_values(name, seed):
     # the decisions of the points' side (the orientation, two sheets, the lattice's steps): the same points
     np.testing.assert_array_equal(turned.invalid_reason == UNDECIDED, axes.invalid_reason == UNDECIDED)
     assert axes.valid.mean() > 0.5
-    # the estimates over balls whose points tie in distance are another class (the measures' triangles, held to
-    # round-off by tests/test_ball_ties_T25.py; their checks flip a few percent of the valid points): here, the
-    # same valid points but for those, and estimates a few percent of the largest |k| apart (a voxel ellipsoid: 1.3%
-    # at the median, 12% at most; fuzz_api 491/8: 5.6% at most), not a point's side apart
-    both = axes.valid & turned.valid
-    assert both.sum() >= 0.9 * axes.valid.sum()
-    largest = np.abs(np.r_[axes.k_min[both], axes.k_max[both]]).max()
+    _assert_same_estimates(axes, turned, scale)
+
+
+def _assert_same_estimates(axes, turned, scale):
+    """The same valid points, and their curvatures to round-off of the largest |k| (after undoing the scale).
+
+    The balls' ties (tests/test_ball_ties_T25.py) and the orientation graph's (tests/test_cloud_graph_ties_C25.py)
+    are taken whole: nothing left for the pose to decide (a voxel torus turned and scaled by 0.037 on 8463b2a: 25
+    points valid in one pose only and k 12% of the largest apart).
+    """
+    np.testing.assert_array_equal(turned.valid, axes.valid)
+    largest = np.abs(np.r_[axes.k_min[axes.valid], axes.k_max[axes.valid]]).max()
     for field in ("k_min", "k_max"):
-        off = np.abs(getattr(turned, field)[both] * scale - getattr(axes, field)[both])
-        assert np.median(off) <= 0.03 * largest
-        assert off.max() <= 0.25 * largest
+        off = np.abs(getattr(turned, field)[axes.valid] * scale - getattr(axes, field)[axes.valid])
+        assert off.max() <= 1e-9 * largest
 
 
-@pytest.mark.parametrize("name", ["sphere", "ellipsoid"])
-@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize(
+    ("name", "seed"),
+    [(name, seed) for name in ("sphere", "ellipsoid") for seed in range(3)] + [("torus", 0), ("anisotropic sphere", 0)],
+)
 def test_voxel_cloud_valid_in_any_pose(name, seed):
     # any scale (not only powers of two: ties of the axes' pose become round-off) and any rigid motion: the valid
     # points of the image's axes stay valid (the ellipsoid scaled by 1.18, turned and shifted had none on 27c2539),
@@ -78,8 +84,7 @@ def test_voxel_cloud_valid_in_any_pose(name, seed):
     scale = 10.0 ** rng.uniform(-3.0, 3.0)
     moved = (points * scale) @ _rotation(rng).T + rng.uniform(-10.0, 10.0, size=3) * float(np.ptp(points)) * scale
     axes, turned = _curvatures(points), _curvatures(moved)
-    assert turned.valid.sum() >= 0.9 * axes.valid.sum()
-    assert (axes.valid & turned.valid).sum() >= 0.9 * axes.valid.sum()
+    _assert_same_estimates(axes, turned, scale)
     if name == "sphere":
         assert turned.valid.mean() > 0.9
         h = 0.5 * (turned.k_min + turned.k_max)[turned.valid]
