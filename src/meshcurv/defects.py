@@ -137,7 +137,7 @@ POINT_CLOUD_REASONS = (
 #: Why a vertex is invalid for a limit of the method on this surface, not for a defect of the mesh: the
 #: codes after the defects of meshes found since (13).
 METHOD_REASONS = (
-    "voxel staircase: this method reads the voxels' steps as curvature (its numbers kept, not an estimate; "
+    "voxel staircase: this method reads the voxels' steps as curvature (not an estimate; "
     "method='icc' scales its balls to the voxels)",
 )
 
