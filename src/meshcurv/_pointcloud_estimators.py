@@ -1013,6 +1013,26 @@ def _ball_indices(search, points, chunk, radius, k):
     return index, (index < n).sum(axis=1)
 
 
+def _measured_balls(search, points, normals, chunk, radius, k, wide, k_wide, sheets=None):
+    """``(index, counts, wide_index, wide_counts)``: the balls of :func:`corrected_measures` of the centres
+    ``chunk`` (M,), (M, k) and (M,) those of ``radius``, (M, k_wide) and (M,) those of ``wide`` (``k_wide`` 0: none).
+
+    Each is searched with one point more than it holds (:func:`_ball_indices` over the k-d tree ``search`` of
+    :func:`_usable_tree`), its ties cut whole (:func:`_whole_ties`) and its points facing away or on another of
+    the ``sheets`` dropped (:func:`_own_side`). Compiled: :func:`meshcurv._kernels.pointcloud.measured_balls`
+    (one search for both radii, each row cut in its thread's buffers: the same arrays to the bit).
+    """
+    index, counts = _ball_indices(search, points, chunk, radius, k + 1)
+    index, counts = _whole_ties(points, normals, chunk, index, counts, radius, k)
+    index, counts = _own_side(normals, chunk, index, counts, sheets)
+    if k_wide == 0:
+        return index, counts, np.full((chunk.size, 0), points.shape[0]), np.zeros(chunk.size, dtype=np.int64)
+    wide_index, wide_counts = _ball_indices(search, points, chunk, wide, k_wide + 1)
+    wide_index, wide_counts = _whole_ties(points, normals, chunk, wide_index, wide_counts, wide, k_wide)
+    wide_index, wide_counts = _own_side(normals, chunk, wide_index, wide_counts, sheets)
+    return index, counts, wide_index, wide_counts
+
+
 #: Two squared distances from a centre within this share of the larger are one distance (twice
 #: :data:`~meshcurv._pointcloud_normals.TIE_TOLERANCE`, of the distances): the points of a ball at one distance
 #: (a lattice's) are taken or dropped whole at its cuts and ordered among themselves by the geometry
@@ -1247,52 +1267,32 @@ def corrected_measures(
     for start in range(0, centres.size, size):
         chunk = centres[start : start + size]
         logger.debug("point cloud: ball search")
+        # one search for both balls (the smaller: the prefix of the larger closer than radius), cut and turned
         if kernels is not None:
-            threads = 64 * kernel_threads()
-            # (one point more than the balls hold: is a cut through points at one distance? _whole_ties)
-            if check:  # one search for both balls: the smaller is the prefix of the larger closer than radius
-                wide_index, squared, wide_counts = kernels.ball_indices(
-                    points, chunk, float(wide), k_wide + 1, *grid, threads
-                )
-                index, counts = kernels.inner_balls(wide_index, squared, wide_counts, float(radius), k + 1, n)
-            else:
-                index, squared, counts = kernels.ball_indices(points, chunk, float(radius), k + 1, *grid, threads)
-            index, counts = kernels.whole_ties(  # (the inner balls' rows: prefixes of the larger balls')
-                points, normals, chunk, index, squared, counts, float(radius), k, SQUARED_TIE, MIN_BALL_POINTS
+            index, counts, wide_index, wide_counts = kernels.measured_balls(
+                points,
+                normals,
+                chunk,
+                float(radius),
+                k,
+                float(wide),
+                k_wide if check else 0,
+                *grid,
+                own_sheets,
+                SQUARED_TIE,
+                MIN_BALL_POINTS,
+                FACING_MARGIN,
+                64 * kernel_threads(),
             )
-            index, counts = kernels.own_side(normals, chunk, index, counts, own_sheets, FACING_MARGIN)
         else:
-            index, counts = _ball_indices(search, points, chunk, radius, k + 1)
-            index, counts = _whole_ties(points, normals, chunk, index, counts, radius, k)
-            index, counts = _own_side(normals, chunk, index, counts, sheets)
+            index, counts, wide_index, wide_counts = _measured_balls(
+                search, points, normals, chunk, radius, k, wide, k_wide if check else 0, sheets
+            )
         logger.debug("point cloud: triangle sums")
         done = _measured(out, points, normals, chunk, index, counts, pattern, kernels)
         if check and done.size:
             logger.debug("point cloud: larger balls")
-            if kernels is not None:  # (every row's, in place: `done` is nearly all of them, and no copies)
-                wide_index, wide_counts = kernels.whole_ties(
-                    points,
-                    normals,
-                    chunk,
-                    wide_index,
-                    squared,
-                    wide_counts,
-                    float(wide),
-                    k_wide,
-                    SQUARED_TIE,
-                    MIN_BALL_POINTS,
-                )
-                wide_index, wide_counts = kernels.own_side(
-                    normals, chunk, wide_index, wide_counts, own_sheets, FACING_MARGIN
-                )
-                _measured(larger, points, normals, chunk, wide_index, wide_counts, pattern, kernels, done)
-            else:
-                wide_index, wide_counts = _ball_indices(search, points, chunk[done], wide, k_wide + 1)
-                wide_index, wide_counts = _whole_ties(
-                    points, normals, chunk[done], wide_index, wide_counts, wide, k_wide
-                )
-                wide_index, wide_counts = _own_side(normals, chunk[done], wide_index, wide_counts, sheets)
-                _measured(larger, points, normals, chunk[done], wide_index, wide_counts, pattern, kernels)
+            _measured(larger, points, normals, chunk, wide_index, wide_counts, pattern, kernels, done)
     if details is not None:  # (check)
         done = centres[np.isfinite(out[0][centres])]
         details["unsteady"] = unsteady(out, larger, done, radius) | turned(points, normals, out, radius, done, usable)

@@ -324,6 +324,22 @@ def whole_ties(distances: np.ndarray, indices: np.ndarray, k: int, centres=None)
     """
     if distances.shape[1] != k + 1:
         return distances[:, :k], indices[:, :k]
+    compiled = numba_kernels("pointcloud")
+    if compiled is not None and k >= 1:  # (in one pass on every core: 1M points' (N, k) copies, 0.36 CPU s serial)
+        return compiled.cut_neighbours(
+            np.ascontiguousarray(distances, dtype=np.float64),
+            np.ascontiguousarray(indices, dtype=np.int64),
+            k,
+            np.zeros(0, dtype=np.int64) if centres is None else np.ascontiguousarray(centres, dtype=np.int64),
+            TIE_TOLERANCE,
+            TIE_LEAST,
+        )
+    return _cut_neighbours(distances, indices, k, centres)
+
+
+def _cut_neighbours(distances: np.ndarray, indices: np.ndarray, k: int, centres=None) -> tuple[np.ndarray, np.ndarray]:
+    """The NumPy path of :func:`whole_ties` (``k + 1`` columns). Compiled:
+    :func:`meshcurv._kernels.pointcloud.cut_neighbours` (the same comparisons: the same arrays to the bit)."""
     cut = distances[:, k]
     with np.errstate(invalid="ignore"):
         rows = np.flatnonzero(distances[:, k - 1] >= cut * (1.0 - TIE_TOLERANCE))

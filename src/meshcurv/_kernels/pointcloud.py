@@ -353,29 +353,11 @@ def _chunk_balls(lo, hi, points, centres, radius, pool_points, ids, grid, index,
     share them)."""
     n = points.shape[0]
     k = index.shape[1]
-    limit = radius * radius
-    members = np.empty(256, np.int64)
-    # the members' squared distances and ids as found, then in order, and the buckets' starts
-    found_squared, found_ids = np.empty(256), np.empty(256, np.int64)
-    sorted_squared, sorted_ids = np.empty(256), np.empty(256, np.int64)
-    starts = np.empty(257, np.int64)
+    buffers = _ball_buffers(256)
     for row in range(lo, hi):
         c = centres[row]
-        px, py, pz = points[c, 0], points[c, 1], points[c, 2]
-        members, size = _ball_members(pool_points, grid, px, py, pz, radius, members)
-        if size > found_squared.shape[0]:
-            found_squared, found_ids = np.empty(members.shape[0]), np.empty(members.shape[0], np.int64)
-            sorted_squared, sorted_ids = np.empty(members.shape[0]), np.empty(members.shape[0], np.int64)
-            starts = np.empty(members.shape[0] + 1, np.int64)
-        found = 0
-        for a in range(size):  # (branch-free: every member written, the inside ones kept)
-            t = members[a]
-            dx, dy, dz = pool_points[t, 0] - px, pool_points[t, 1] - py, pool_points[t, 2] - pz
-            d = dx * dx + dy * dy + dz * dz
-            found_squared[found] = d
-            found_ids[found] = ids[t]
-            found += d < limit
-        _sort_ball(found_squared, found_ids, found, limit, sorted_squared, sorted_ids, starts)
+        buffers, found = _search_ball(pool_points, ids, grid, points[c, 0], points[c, 1], points[c, 2], radius, buffers)
+        sorted_squared, sorted_ids = buffers[3], buffers[4]
         kept = min(found, k)
         for a in range(kept):
             index[row, a] = sorted_ids[a]
@@ -384,6 +366,43 @@ def _chunk_balls(lo, hi, points, centres, radius, pool_points, ids, grid, index,
         for a in range(kept, k):
             index[row, a] = n
             squared[row, a] = np.inf
+
+
+@nb.njit(**_JIT)
+def _ball_buffers(size):
+    """Scratch buffers of :func:`_search_ball` for balls of up to ``size`` candidates: the members, their squared
+    distances and ids as found, then in order, and the buckets' starts."""
+    return (
+        np.empty(size, np.int64),
+        np.empty(size),
+        np.empty(size, np.int64),
+        np.empty(size),
+        np.empty(size, np.int64),
+        np.empty(size + 1, np.int64),
+    )
+
+
+@nb.njit(**_JIT)
+def _search_ball(pool_points, ids, grid, px, py, pz, radius, buffers):
+    """``(buffers, found)``: the ``found`` points of the pool strictly closer than ``radius`` to ``(px, py, pz)``,
+    their squared distances ``buffers[3][:found]`` and ids ``buffers[4][:found]`` in the order of ``(squared
+    distance, id)`` (:func:`_ball_members`' candidates, :func:`_sort_ball`); the buffers (:func:`_ball_buffers`)
+    grown when a ball needs more."""
+    members, found_squared, found_ids, sorted_squared, sorted_ids, starts = buffers
+    limit = radius * radius
+    members, size = _ball_members(pool_points, grid, px, py, pz, radius, members)
+    if size > found_squared.shape[0]:
+        _, found_squared, found_ids, sorted_squared, sorted_ids, starts = _ball_buffers(members.shape[0])
+    found = 0
+    for a in range(size):  # (branch-free: every member written, the inside ones kept)
+        t = members[a]
+        dx, dy, dz = pool_points[t, 0] - px, pool_points[t, 1] - py, pool_points[t, 2] - pz
+        d = dx * dx + dy * dy + dz * dz
+        found_squared[found] = d
+        found_ids[found] = ids[t]
+        found += d < limit
+    _sort_ball(found_squared, found_ids, found, limit, sorted_squared, sorted_ids, starts)
+    return (members, found_squared, found_ids, sorted_squared, sorted_ids, starts), found
 
 
 @nb.njit(inline="always", **_JIT)
@@ -498,27 +517,146 @@ def whole_ties(points, normals, centres, index, squared, counts, radius, k, tie,
     kept = np.zeros(m, dtype=np.int64)
     limit = radius * radius * (1.0 - tie)
     for row in nb.prange(m):
-        count = counts[row]
-        while count > 0 and squared[row, count - 1] >= limit:
-            count -= 1
-        if count > k:
-            cut = squared[row, k] * (1.0 - tie)
-            keep = k
-            while keep > 0 and squared[row, keep - 1] >= cut:
-                keep -= 1
-            count = keep if keep >= least else k
-        for a in range(count):
-            out[row, a] = index[row, a]
-        for a in range(count, k):
-            out[row, a] = n
-        kept[row] = count
-        start = 0
-        for a in range(1, count + 1):
-            if a == count or squared[row, a - 1] < squared[row, a] * (1.0 - tie):  # a run [start, a) ends
-                if a - start > 1:
-                    _sort_tied(points, normals, centres[row], out, row, start, a, tie)
-                start = a
+        kept[row] = _whole_row(
+            points, normals, centres[row], index[row], squared[row], counts[row], limit, tie, least, out, row, n
+        )
     return out, kept
+
+
+@nb.njit(**_JIT)
+def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, row, n):
+    """Row ``row`` of :func:`whole_ties` (``out`` (M, k)) from the ball of point ``c``: its ``count`` points
+    ``ids`` (K,) in the order of ``(squared distance, index)`` and their ``squared`` distances; returns its count.
+    ``limit``: the squared radius less the tie. The row of the search itself or one of its buffers."""
+    k = out.shape[1]
+    while count > 0 and squared[count - 1] >= limit:
+        count -= 1
+    if count > k:
+        cut = squared[k] * (1.0 - tie)
+        keep = k
+        while keep > 0 and squared[keep - 1] >= cut:
+            keep -= 1
+        count = keep if keep >= least else k
+    for a in range(count):
+        out[row, a] = ids[a]
+    for a in range(count, k):
+        out[row, a] = n
+    start = 0
+    for a in range(1, count + 1):
+        if a == count or squared[a - 1] < squared[a] * (1.0 - tie):  # a run [start, a) ends
+            if a - start > 1:
+                _sort_tied(points, normals, c, out, row, start, a, tie)
+            start = a
+    return count
+
+
+@nb.njit(parallel=True, **_JIT)
+def measured_balls(
+    points, normals, centres, radius, k, wide, k_wide, pool_points, ids, grid, sheets, tie, least, margin, n_chunks
+):
+    """The balls of :func:`meshcurv._pointcloud_estimators.corrected_measures` in one pass: ``(index, counts,
+    wide_index, wide_counts)``, (M, k) and (M,) the balls of ``radius`` of the ``centres`` (M,), (M, k_wide) and
+    (M,) those of ``wide`` (``k_wide`` 0: none, (M, 0)).
+
+    Each ball is what :func:`ball_indices` (one point more than the ball holds), :func:`whole_ties` and
+    :func:`own_side` give in turn, to the bit: the search over ``wide`` (``radius`` when ``k_wide`` is 0; the
+    smaller balls: the prefix of each row closer than ``radius``, as :func:`inner_balls`), the ties cut whole
+    and ordered (``tie``, ``least``), the points facing away (``margin``) or on another of the ``sheets`` dropped.
+    Each row is found, cut and written by its thread from its own buffers: no (M, K) squared distances and
+    rows of the search written and read again (four passes over (M, K) arrays). ``k_wide >= k``; the pool:
+    :func:`~meshcurv._kernels.neighborhoods.pool_grid` with a reach of the search's radius or more.
+    """
+    m = centres.shape[0]
+    index = np.empty((m, k), dtype=np.int64)  # (each row written whole by its thread)
+    counts = np.zeros(m, dtype=np.int64)
+    wide_index = np.empty((m, k_wide), dtype=np.int64)
+    wide_counts = np.zeros(m, dtype=np.int64)
+    n_chunks = max(min(m, n_chunks), 1)
+    for chunk in nb.prange(n_chunks):  # (flat arguments: a parallel loop takes no tuples of arrays)
+        lo, hi = chunk * m // n_chunks, (chunk + 1) * m // n_chunks
+        _chunk_measured_balls(
+            lo,
+            hi,
+            points,
+            normals,
+            centres,
+            sheets,
+            pool_points,
+            ids,
+            grid,
+            radius,
+            wide,
+            tie,
+            least,
+            margin,
+            index,
+            counts,
+            wide_index,
+            wide_counts,
+        )
+    return index, counts, wide_index, wide_counts
+
+
+@nb.njit(**_JIT)
+def _chunk_measured_balls(
+    lo,
+    hi,
+    points,
+    normals,
+    centres,
+    sheets,
+    pool_points,
+    ids,
+    grid,
+    radius,
+    wide,
+    tie,
+    least,
+    margin,
+    index,
+    counts,
+    wide_index,
+    wide_counts,
+):
+    """The rows ``lo:hi`` of :func:`measured_balls`, with buffers of their own (as :func:`_chunk_balls`)."""
+    n = points.shape[0]
+    k, k_wide = index.shape[1], wide_index.shape[1]
+    search = wide if k_wide > 0 else radius
+    inner = radius * radius
+    by_sheet = sheets.shape[0] == n
+    buffers = _ball_buffers(256)
+    for row in range(lo, hi):
+        c = centres[row]
+        buffers, found = _search_ball(pool_points, ids, grid, points[c, 0], points[c, 1], points[c, 2], search, buffers)
+        sorted_squared, sorted_ids = buffers[3], buffers[4]
+        own = sheets[c] if by_sheet else -1
+        # the smaller ball: ball_indices' row of k + 1 points (inner_balls: the prefix closer than radius)
+        held = min(found, k + 1)
+        if k_wide > 0:
+            held = min(held, k_wide + 1)
+        count = 0
+        while count < held and sorted_squared[count] < inner:
+            count += 1
+        count = _whole_row(
+            points, normals, c, sorted_ids, sorted_squared, count, inner * (1.0 - tie), tie, least, index, row, n
+        )
+        counts[row] = _own_row(normals, c, index, row, count, sheets, own, margin, n)
+        if k_wide > 0:
+            count = _whole_row(
+                points,
+                normals,
+                c,
+                sorted_ids,
+                sorted_squared,
+                min(found, k_wide + 1),
+                wide * wide * (1.0 - tie),
+                tie,
+                least,
+                wide_index,
+                row,
+                n,
+            )
+            wide_counts[row] = _own_row(normals, c, wide_index, row, count, sheets, own, margin, n)
 
 
 @nb.njit(**_JIT)
@@ -653,26 +791,32 @@ def own_side(normals, centres, index, counts, sheets, margin):
     on two sheets (both >= 0); the kept points stay in order, the row is padded with ``N``.
     """
     n = normals.shape[0]
-    m, k = index.shape
+    m = index.shape[0]
     kept = np.zeros(m, dtype=np.int64)
     by_sheet = sheets.shape[0] == n
     for row in nb.prange(m):
         c = centres[row]
-        cx, cy, cz = normals[c, 0], normals[c, 1], normals[c, 2]
-        own = sheets[c] if by_sheet else -1
-        found = 0
-        for a in range(counts[row]):
-            j = index[row, a]
-            if normals[j, 0] * cx + normals[j, 1] * cy + normals[j, 2] * cz < -margin:
-                continue
-            if own >= 0 and sheets[j] >= 0 and sheets[j] != own:
-                continue
-            index[row, found] = j
-            found += 1
-        for a in range(found, k):
-            index[row, a] = n
-        kept[row] = found
+        kept[row] = _own_row(normals, c, index, row, counts[row], sheets, sheets[c] if by_sheet else -1, margin, n)
     return index, kept
+
+
+@nb.njit(**_JIT)
+def _own_row(normals, c, index, row, count, sheets, own, margin, n):
+    """Row ``row`` of :func:`own_side` in place (the ball of point ``c``, ``count`` points, ``own`` its sheet or -1
+    for none); returns its count."""
+    cx, cy, cz = normals[c, 0], normals[c, 1], normals[c, 2]
+    found = 0
+    for a in range(count):
+        j = index[row, a]
+        if normals[j, 0] * cx + normals[j, 1] * cy + normals[j, 2] * cz < -margin:
+            continue
+        if own >= 0 and sheets[j] >= 0 and sheets[j] != own:
+            continue
+        index[row, found] = j
+        found += 1
+    for a in range(found, index.shape[1]):
+        index[row, a] = n
+    return found
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -916,6 +1060,41 @@ def nearest_neighbours(points, k, reach, pool_points, ids, grid, n_chunks):
                 indices[c, j] = which[j]
             exact[c] = ok
     return distances, indices, exact
+
+
+@nb.njit(parallel=True, **_JIT)
+def cut_neighbours(distances, indices, k, centres, tolerance, least):
+    """(N, k) distances and indices: the nearest neighbours ``distances, indices`` (N, k + 1) cut to ``k``, a
+    group tied (within ``tolerance``) with the ``k + 1``-th dropped whole unless fewer than ``least`` would be
+    left, its slots holding the row's point (``centres`` (N,), or the row's number when empty) at the cut's
+    distance.
+
+    The compiled :func:`meshcurv._pointcloud_normals._cut_neighbours` (see
+    :func:`meshcurv._pointcloud_normals.whole_ties`): the same products and comparisons, each row copied and cut
+    by its thread (no serial copies of the (N, k) columns, no gathered rows).
+    """
+    n = distances.shape[0]
+    out_distances = np.empty((n, k))
+    out_indices = np.empty((n, k), dtype=np.int64)
+    shrink = 1.0 - tolerance
+    least = min(least, k)
+    by_centre = centres.shape[0] == n
+    for row in nb.prange(n):
+        cut = distances[row, k]
+        bound = cut * shrink
+        tied = 0
+        for a in range(k):
+            out_distances[row, a] = distances[row, a]
+            out_indices[row, a] = indices[row, a]
+            tied += distances[row, a] >= bound
+        if not distances[row, k - 1] >= bound or k - tied < least:
+            continue
+        own = centres[row] if by_centre else row
+        for a in range(k):
+            if distances[row, a] >= bound:
+                out_distances[row, a] = cut
+                out_indices[row, a] = own
+    return out_distances, out_indices
 
 
 @nb.njit(**_JIT)
