@@ -26,7 +26,10 @@ the user:
 - :func:`cloud_noise_level`, :func:`cloud_radius`: point clouds, growing with
   their noise in units of their spacing;
 - :func:`check_radius`, :func:`resolve_radius`, :func:`small_radius_note`:
-  a radius given by the user.
+  a radius given by the user;
+- :func:`enclosing_ball`, :func:`rigid_extent`: the size of a set of points
+  that no rigid motion changes (the bound of a given radius, the cap of a
+  cloud's default).
 
 The scale of each vertex (issue 30). The rules above set one radius per
 surface: the noise rule in units of the mean edge length, the voxel rule in
@@ -106,6 +109,8 @@ __all__ = [
     "voxel_vertex_radii",
     "check_radius",
     "resolve_radius",
+    "enclosing_ball",
+    "rigid_extent",
     "small_radius_note",
     "vertex_radii",
     "local_scale_ratios",
@@ -213,6 +218,172 @@ def _component_edges(mesh: _Measured | PreparedMesh) -> list[tuple]:
 MIN_RADIUS_EDGES = 1e-3
 
 
+#: The smallest enclosing ball (:func:`enclosing_ball`) holds every point within this share of its radius: the
+#: radius found is the exact one to this share, whatever the pose.
+ENCLOSING_TOLERANCE = 1e-12
+
+#: :func:`enclosing_ball` finds the ball of about this many points of a larger set first, then of the points
+#: outside it.
+ENCLOSING_SAMPLE = 4096
+
+#: A point within this share of its distance (the sine of its angle) of the affine hull of the points already on
+#: the sphere of :func:`enclosing_ball`'s ball adds no new sphere (round-off: Gärtner's test).
+ENCLOSING_HULL = 1e-10
+
+#: The extent of a set of points is this times the radius of its smallest enclosing ball: the diagonal of the
+#: cube around that ball, which is the diagonal of the bounding box of a round cloud (a sphere, a ball) in every
+#: pose, and at least the bounding box's diagonal of any set in any pose (the box's sides are at most the
+#: ball's diameter).
+EXTENT_FACTOR = float(2.0 * np.sqrt(3.0))
+
+
+def enclosing_ball(points) -> tuple[np.ndarray, float]:
+    """The smallest ball that holds every point: its centre and radius.
+
+    Unlike the bounding box along the coordinate axes, the ball is the same for the set in every pose (a rigid
+    motion moves it with the points) and whatever the density of the sampling: it rests on 2 to 4 of the
+    outermost points.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 3)
+        Finite coordinates; N >= 1.
+
+    Returns
+    -------
+    centre : ndarray of shape (3,)
+    radius : float
+        Every point lies within ``(1 + ENCLOSING_TOLERANCE) * radius`` of ``centre``; no smaller ball holds them.
+
+    Notes
+    -----
+    Welzl's move-to-front recursion (Gärtner's form) over a support set, grown from the extreme points of a sample
+    by the points outside its ball: the ball of the support set, the points outside it gathered in one pass, the
+    ball of the support set and (a sample of) those, until none is outside. At 1M points: 2 passes over the
+    points, about twice the cost of their bounding box.
+
+    References
+    ----------
+    E. Welzl, "Smallest enclosing disks (balls and ellipsoids)", New Results and New Trends in Computer Science,
+    LNCS 555 (1991), 359-370. doi:10.1007/BFb0038202. B. Gärtner, "Fast and robust smallest enclosing balls",
+    ESA 1999, LNCS 1643, 325-338. doi:10.1007/3-540-48481-7_29.
+
+    Examples
+    --------
+    >>> from meshcurv import shapes
+    >>> centre, radius = enclosing_ball(shapes.icosphere(subdivisions=2).vertices)
+    >>> print(f"{radius:.6f}")
+    1.000000
+    """
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    # coordinates far from 1 scaled by a power of two (exact): no square overflows or underflows
+    largest = float(max(points.max(), -points.min()))
+    scale = 1.0
+    if largest > 0.0 and not 2.0**-400 < largest < 2.0**400:
+        scale = float(np.ldexp(1.0, np.frexp(largest)[1] - 1))
+        points = points / scale
+    step = max(1, points.shape[0] // ENCLOSING_SAMPLE)
+    sample = points[::step]
+    origin = sample[0]
+    local = sample - origin
+    start = [*np.argmin(local, axis=0), *np.argmax(local, axis=0)]
+    centre, squared, support = _enclosing(local, np.asarray(start))
+    if step > 1:
+        origin = origin + centre
+        centre, squared, support = _enclosing(points - origin, support * step)
+    return (origin + centre) * scale, float(np.sqrt(squared) * scale)
+
+
+def rigid_extent(points) -> float:
+    """The size of a set of points that no rigid motion changes: :data:`EXTENT_FACTOR` times the radius of its
+    smallest enclosing ball (:func:`enclosing_ball`), the diagonal of the cube around that ball; 0.0 for no points.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 3)
+        Finite coordinates.
+
+    Returns
+    -------
+    float
+        At least the diagonal of the points' bounding box along the axes of any pose; equal to it on a sphere.
+    """
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return EXTENT_FACTOR * enclosing_ball(points)[1] if points.shape[0] else 0.0
+
+
+def _enclosing(local: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
+    """``(centre, squared radius, support)``: the smallest ball around the points ``local`` (N, 3), from the ball of
+    the points ``start`` (indices); ``support`` the indices whose ball it is."""
+    squares = np.einsum("ij,ij->i", local, local)
+    support = np.unique(start)
+    while True:
+        centre, squared = _small_enclosing_ball(local[support])
+        # |p - c|^2 - |c|^2 (the coordinates are within a diameter of the origin: round-off of ~1e-16 of r^2)
+        excess = squares - 2.0 * (local @ centre)
+        limit = squared * (1.0 + ENCLOSING_TOLERANCE) ** 2 - float(centre @ centre)
+        outside = np.flatnonzero(excess > limit)
+        if outside.size == 0:
+            return centre, squared, support
+        worst = outside[np.argmax(excess[outside])]
+        if np.isin(worst, support):
+            # a point of the support set outside its ball: pushes refused as round-off; the ball through the
+            # farthest point holds every one
+            return centre, float(excess[worst] + centre @ centre), support
+        some = np.unique(np.concatenate([support, outside[:: max(1, outside.size // ENCLOSING_SAMPLE)], [worst]]))
+        if some.size <= local.shape[0] // 2:
+            # the ball of the support set and of (a sample of) the points outside it first: a smaller problem
+            inner = _enclosing(local[some], np.searchsorted(some, np.append(support, worst)))[2]
+            support = some[inner]
+        else:
+            support = np.append(support, worst)
+
+
+def _small_enclosing_ball(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """``(centre, squared radius)`` of the smallest ball around a few ``points`` (m, 3): Welzl's recursion with
+    Gärtner's move to front, the boundary at most 4 points (each new one off the others' affine hull)."""
+    order = list(range(points.shape[0]))
+    boundary: list[int] = []
+    ball = [points[0], 0.0]
+
+    def recurse(end: int) -> None:
+        if len(boundary) == 4:
+            return
+        k = 0
+        while k < end:
+            i = order[k]
+            offset = points[i] - ball[0]
+            if float(offset @ offset) > ball[1] * (1.0 + 4.0 * np.finfo(float).eps):
+                sphere = _sphere_through(points[boundary + [i]])
+                if sphere is not None:
+                    ball[:] = sphere
+                    boundary.append(i)
+                    recurse(k)
+                    boundary.pop()
+                    order.insert(0, order.pop(k))
+            k += 1
+
+    recurse(len(order))
+    return np.asarray(ball[0], dtype=np.float64), float(ball[1])
+
+
+def _sphere_through(boundary: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """``(centre, squared radius)`` of the smallest sphere through the points ``boundary`` (m, 3), m of 1 to 4; None
+    where the last lies on the affine hull of the others within :data:`ENCLOSING_HULL` (no new sphere)."""
+    origin = boundary[0]
+    spans = boundary[1:] - origin
+    if spans.shape[0] == 0:
+        return origin, 0.0
+    last, others = spans[-1], spans[:-1]
+    off = last - np.linalg.lstsq(others.T, last, rcond=None)[0] @ others if others.shape[0] else last
+    if not float(off @ off) > ENCLOSING_HULL**2 * float(last @ last):
+        return None
+    # the centre origin + w @ spans, as far from each point: 2 spans @ spans.T w = |spans|^2
+    gram = spans @ spans.T
+    centre = origin + np.linalg.solve(gram, 0.5 * np.diag(gram)) @ spans
+    return centre, float(((boundary - centre) ** 2).sum(axis=1).max())
+
+
 def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
     """``radius`` checked: a positive finite number between a sliver of an edge and the mesh's extent.
 
@@ -220,9 +391,10 @@ def check_radius(radius, vertices: np.ndarray, topology: MeshTopology) -> float:
     ------
     InvalidOptionError
         ``radius`` is not a positive finite real number (strings are refused),
-        it is below :data:`MIN_RADIUS_EDGES` median edge lengths, or it exceeds the diagonal of the bounding box of the referenced
-        vertices but the needle vertices (:func:`meshcurv.defects.scale_vertices`): every ball would hold the
-        whole mesh (a unit mistake: mm for m).
+        it is below :data:`MIN_RADIUS_EDGES` median edge lengths, or it exceeds the :func:`rigid_extent` (the diagonal of
+        the cube around the smallest enclosing ball, the same in every pose) of the referenced vertices but the
+        needle vertices (:func:`meshcurv.defects.scale_vertices`): every ball would hold the whole mesh (a unit
+        mistake: mm for m).
     """
     radius = check_positive_float(radius, "radius")
     return _check_radius(radius, _measured(vertices, topology))
@@ -233,8 +405,8 @@ def _check_radius(radius: float, mesh: _Measured | PreparedMesh) -> float:
     used = vertices[_scale_vertices(topology, mesh.needles)] if topology.n_faces else vertices
     if used.shape[0] == 0:
         return radius
-    diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
-    if topology.n_faces and radius < MIN_RADIUS_EDGES * diagonal:
+    size = rigid_extent(used)
+    if topology.n_faces and radius < MIN_RADIUS_EDGES * size:
         median = _geometry.median_edge_length(vertices, topology.edges)
         if radius < MIN_RADIUS_EDGES * median:
             raise InvalidOptionError(
@@ -242,12 +414,13 @@ def _check_radius(radius: float, mesh: _Measured | PreparedMesh) -> float:
                 f"every ball would hold its centre only and give no curvature; pass a radius of a few edge "
                 f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
             )
-    if radius > diagonal:
+    if radius > size:
         median = _geometry.median_edge_length(vertices, topology.edges)
         raise InvalidOptionError(
-            f"`radius` {radius:g} is larger than the mesh itself (bounding-box diagonal {diagonal:g}, median "
-            f"edge length {median:g}): every ball would hold the whole mesh; pass a radius of a few edge "
-            f"lengths (the default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
+            f"`radius` {radius:g} is larger than the mesh itself (bounding-box diagonal {size:g} of the cube around "
+            f"its smallest enclosing ball, of radius {size / EXTENT_FACTOR:g}: the same in every pose; median edge "
+            f"length {median:g}): every ball would hold the whole mesh; pass a radius of a few edge lengths (the "
+            f"default is {DEFAULT_RADIUS_FACTOR:g} mean edge lengths), in the units of the vertices"
         )
     return radius
 
@@ -1380,7 +1553,8 @@ CLOUD_NOISE_SAMPLE = 16384
 #: (``benchmarks/pointcloud_diagnostics.md``).
 CLOUD_NOISE_LEAST_FITS = 10
 
-#: A default radius is at most this share of the cloud's extent (its bounding-box diagonal).
+#: A default radius is at most this share of the cloud's :func:`rigid_extent` (the diagonal of the cube around its
+#: smallest enclosing ball: a round cloud's bounding-box diagonal, in every pose).
 CLOUD_EXTENT_CAP = 0.25
 
 
