@@ -25,6 +25,7 @@ Candidates (``rho`` = ``q`` times the default's normal-fit radius ``icc.NORMAL_R
   sym(oint W (x - p) n^T dA) - I int_D W dV``; the isotropic term does not move the eigenvectors. About the
   centroid, ``M - m m^T / V`` with ``V`` the half-ball's weighted volume (first order); the normal is the
   eigenvector of the least eigenvalue, on the side of ``m``.
+- ``... bA`` (last): ``rho`` bounded by ``A`` times the default's radius of curvature ``1 / max(|k_min|, |k_max|)``.
 - ``jet deg q``: V23's prototype jets of degree ``deg`` (two fits, the second in the first's frame, every vertex,
   no coarse level, the kernel ``(1 - d^2 / rho^2)^2`` times the vertex areas).
 """
@@ -135,6 +136,9 @@ def candidate_normals(name, vertices, faces, default, fitter):
     power = float(power)
     rho = float(q) * icc.NORMAL_RADIUS_RATIO * np.asarray(default.radius, dtype=float)
     start = default.normals
+    if rest and rest[-1].startswith("b"):  # "bA": rho bounded by A / max(|k_min|, |k_max|) of the default's estimate
+        bound = float(rest.pop()[1:]) / np.maximum(np.abs(default.k_min), np.abs(default.k_max))
+        rho = np.where(np.isfinite(bound), np.minimum(rho, bound), rho)
     if kind == "jet":  # "jet deg q": V23's fits of degree deg
         return fitter(vertices, faces, start, rho, power)
     if kind == "ii":
