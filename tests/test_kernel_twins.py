@@ -1977,6 +1977,83 @@ def check_own_side(name):
         assert (expected_counts < counts).any(), label  # points were dropped
 
 
+def check_measured_balls(name):
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_estimators import (
+        FACING_MARGIN,
+        LARGER,
+        MIN_BALL_POINTS,
+        SQUARED_TIE,
+        _measured_balls,
+        _usable_tree,
+    )
+
+    points, normals = cloud(name)
+    # and a square lattice beside it (rings of points at one distance: cuts through them), some normals NaN
+    x, y = (grid.ravel() for grid in np.meshgrid(np.arange(16.0), np.arange(16.0)))
+    lattice = np.column_stack([x, y, np.zeros(x.size)]) * 0.04 + 5.0
+    lattice_normals = np.column_stack([0.1 * np.sin(x), 0.05 * y, np.ones(x.size)])
+    lattice_normals /= np.linalg.norm(lattice_normals, axis=1, keepdims=True)
+    lattice_normals[::9] = np.nan
+    rng = np.random.default_rng(26)
+    points = np.concatenate([points, lattice])
+    normals = np.concatenate([normals, lattice_normals])
+    normals = np.ascontiguousarray(np.where((rng.random(points.shape[0]) < 0.1)[:, None], -normals, normals))
+    n = points.shape[0]
+    radius = 0.4 if name == "ellipsoid_cloud" else 0.12
+    wide = radius * LARGER
+    centres, usable = np.flatnonzero(rng.random(n) > 0.4), rng.random(n) > 0.15
+    search = _usable_tree(cKDTree(points), points, usable)
+    for k, k_wide, sheets in ((11, 0, None), (24, 48, rng.integers(-1, 3, n)), (40, 96, None)):
+        grid = kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(wide if k_wide else radius))
+        got = kernels("pointcloud").measured_balls(
+            points,
+            normals,
+            centres,
+            float(radius),
+            k,
+            float(wide),
+            k_wide,
+            *grid,
+            np.zeros(0, dtype=np.int64) if sheets is None else sheets.astype(np.int64),
+            SQUARED_TIE,
+            MIN_BALL_POINTS,
+            FACING_MARGIN,
+            64 * kernel_threads(),
+        )
+        expected = _measured_balls(search, points, normals, centres, radius, k, wide, k_wide, sheets)
+        for label, a, b in zip(("index", "counts", "wide_index", "wide_counts"), got, expected):
+            np.testing.assert_array_equal(a, b, err_msg=f"{label}, k={k}, k_wide={k_wide}")
+        assert (got[1] < k).any() and (got[1] > 0).any(), k
+
+
+def check_cut_neighbours(name):
+    from scipy.spatial import cKDTree
+
+    from meshcurv._pointcloud_normals import TIE_LEAST, TIE_TOLERANCE, _cut_neighbours
+
+    points, _ = cloud(name)
+    x, y = (grid.ravel() for grid in np.meshgrid(np.arange(12.0), np.arange(12.0)))
+    points = np.concatenate([points, np.column_stack([x, y, np.zeros(x.size)]) * 0.05 + 5.0])  # rings of ties
+    distances, indices = cKDTree(points).query(points, k=12)
+    distances, indices = np.ascontiguousarray(distances[:, 1:]), np.ascontiguousarray(indices[:, 1:])
+    centres = np.random.default_rng(4).permutation(points.shape[0])
+    for given in (None, centres):
+        expected = _cut_neighbours(distances, indices, 10, given)
+        got = kernels("pointcloud").cut_neighbours(
+            distances,
+            indices,
+            10,
+            np.zeros(0, dtype=np.int64) if given is None else given.astype(np.int64),
+            TIE_TOLERANCE,
+            TIE_LEAST,
+        )
+        np.testing.assert_array_equal(got[0], expected[0])
+        np.testing.assert_array_equal(got[1], expected[1])
+        assert (expected[1] != indices[:, :10]).any()  # (groups dropped whole)
+
+
 def check_stacked(name):
     from meshcurv._pointcloud_normals import _stacked
 
@@ -2124,6 +2201,13 @@ TWINS = [
     Twin("pointcloud.edge_weights", "_pointcloud_normals._edge_weights", check_edge_weights, CLOUDS),
     Twin("pointcloud.kept_rows", "pointcloud._kept_rows", check_kept_rows, CLOUDS),
     Twin("pointcloud.own_side", "_pointcloud_estimators._own_side", check_own_side, CLOUDS),
+    Twin(
+        "pointcloud.measured_balls",
+        "_pointcloud_estimators._measured_balls",
+        check_measured_balls,
+        CLOUDS,
+    ),
+    Twin("pointcloud.cut_neighbours", "_pointcloud_normals._cut_neighbours", check_cut_neighbours, CLOUDS),
     Twin("pointcloud.line_spread", "_pointcloud_normals._line_spread_numpy", check_line_spread, CLOUDS),
     Twin("pointcloud.flat_balls", "_pointcloud_estimators._flat_balls", check_flat_balls, CLOUDS),
     Twin("pointcloud.stacked", "_pointcloud_normals._stacked", check_stacked, CLOUDS),
