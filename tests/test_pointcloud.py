@@ -367,7 +367,9 @@ def test_a_very_sparse_cloud_gets_a_bounded_radius_and_the_warning():
     points, _ = sphere_points(12)
     with pytest.warns(MeshQualityWarning, match="too sparse or too noisy for its size"):
         r = point_cloud_curvatures(points)
-    assert r.parameters["radius"] <= 0.25 * np.linalg.norm(np.ptp(points, axis=0)) + 1e-12
+    # the cap: a quarter of the diagonal of the cube around the points' smallest enclosing ball, which is at most
+    # the sphere of radius 2 they lie on (radius.rigid_extent, the same in every pose: 2 sqrt(3) 2)
+    assert r.parameters["radius"] <= 0.25 * 2.0 * np.sqrt(3.0) * 2.0 + 1e-12
 
 
 def test_consistent_given_normals_of_a_thin_plate_are_kept():
