@@ -74,6 +74,7 @@ https://doi.org/10.1145/777792.777839
 
 from __future__ import annotations
 
+import dataclasses
 from typing import NamedTuple
 
 import numpy as np
@@ -83,6 +84,7 @@ from .._geometry import edge_dihedral_angles
 from ..neighborhoods import _ball_edge_sums, _candidate_pairs
 from ..radius import VoxelReading, _component_radii, _resolve_radius, _vertex_radii, _voxel_surface
 from .._prepared import PreparedMesh
+from ..defects import STAIRCASE
 from ._ring_noise import welded_grid
 from ._support import Stages, ball_holds_neighbours, finish
 
@@ -425,9 +427,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         valid &= ~few
     # a voxel surface welded across cracks, no longer read as one, has the default of other meshes, whose balls
     # read a plateau of its staircase as flat with no scatter (fuzz 500/28: H 0 for 0.1, valid)
-    staircase = 0
+    staircase = np.zeros_like(valid)
     if not on_voxels and valid.any() and welded_grid(mesh, sound) is not None:
-        staircase, valid = int(valid.sum()), np.zeros_like(valid)
+        staircase, valid = valid, np.zeros_like(valid)
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
@@ -438,8 +440,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         else ""
     )
     curvatures = (k_min, k_max, dir_min, dir_max)
-    extra = (note, few_elements_note(int(few.sum()), "ball", "edges"), _staircase_note(staircase))
-    return finish("normal_cycle_ball", parameters, valid, normals, *curvatures, defects, extra=extra, radius=radii)
+    extra = (note, few_elements_note(int(few.sum()), "ball", "edges"), _staircase_note(int(staircase.sum())))
+    result, problems = finish(
+        "normal_cycle_ball", parameters, valid, normals, *curvatures, defects, extra=extra, radius=radii
+    )
+    if staircase.any():  # the vertex's reason: the staircase, a limit of the method (a defect's code comes first)
+        result = dataclasses.replace(result, invalid_reason=np.where(staircase, STAIRCASE, 0).astype(np.int8))
+    return result, problems
 
 
 def _ball_sums(vertices, topology, groups, radii, terms, scattered):
@@ -531,7 +538,7 @@ def _staircase_note(count: int) -> str:
     if not count:
         return ""
     return (
-        f"{count} vertices of this voxel surface are NaN (estimate undefined): it was welded across cracks between "
+        f"{count} vertices of this voxel surface are NaN (voxel staircase): it was welded across cracks between "
         "detached faces, and its faces away from the cracks lie on a voxel grid, whose steps a ball of a few edges "
         "reads as flat or as curvature"
     )

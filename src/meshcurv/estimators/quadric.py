@@ -55,8 +55,10 @@ edge lengths, averaged over two rings), and
   each noisy ball (:func:`residual_spreads`, compiled) give the noise's spread of its curvatures, held to
   :data:`NOISE_REACH` of its curvature; beyond it, residuals that grow over a wider ball are structure (a crease,
   relief: the fit stays), those that keep their size scatter, fitted over a grown ball within the curvature, else
-  NaN with ``valid=False``; a jet that departs from its ball's quadric by more than the quadric's spread takes it
-  (W20's check of the default radius, reverted, read fandisk's creases as noise: ``benchmarks/quadric_noise.md``);
+  NaN with ``valid=False``; a jet that departs from its ball's quadric by more than the quadric's spread takes it,
+  on a noisy ball or one by a crack of a soup, whose level may read clean (W20's check of the default radius,
+  reverted, read fandisk's creases as noise: ``benchmarks/quadric_noise.md``); on a voxel surface the fits that
+  follow the steps are NaN with the reason "voxel staircase" (``meshcurv.defects.STAIRCASE``);
 - at a given radius, the noise's reach (:func:`_noise_reach`): the spread of a fit's curvatures under the noise of
   its ball, from the level (as a standard deviation, :data:`NOISE_SIGMA_FACTOR`) and the weighted normal matrix of
   the ball's points (``sigma^2 G^-1 M G^-1``, :func:`_noise_spreads`), against the median curvedness of the
@@ -86,6 +88,8 @@ https://doi.org/10.1111/j.1467-8659.2010.01797.x
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from .._tensors import principal_from_shape_operator
@@ -101,6 +105,7 @@ from ..radius import (
     _vertex_radii,
 )
 from .._prepared import PreparedMesh
+from ..defects import STAIRCASE
 from .._backend import kernel_threads, numba_kernels
 from ._support import Stages, finish
 
@@ -310,6 +315,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             radii[again] = base[again]
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
     unsure = np.zeros(n, dtype=bool)
+    steps = np.zeros(n, dtype=bool)
     # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate. A voxel surface's
     # default (stages.voxel_default) is a staircase under every ball: its steps pull a fit as a crack's do, and
     # the residuals' growth over the wider ball is theirs, not a crease's, so every fit is checked against the wider
@@ -318,11 +324,12 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # 2,177; voxel_sphere(10) 25 -> 0 of 1,882; the noise gate alone: no valid vertex on the torus); the fits kept
     # there are then checked against a quadric over twice the default ball (_staircase_check: the torus 21 -> 0)
     if stages.voxel_default:
-        steps = referenced.copy()
-        checks = (steps, steps, steps, np.zeros(n, dtype=bool))
+        every = referenced.copy()
+        checks = (every, every, every, np.zeros(n, dtype=bool))
         default = radii.copy()  # the wider ball of the check below: twice the default, as step 3's
         unsure = _scatter_check((vertices, radii, referenced, scales), checks, fields, staircase=True)
         unsure |= _staircase_check((vertices, default, radii, referenced), fields)
+        steps = unsure.copy()  # the fits the steps bent: a limit of the method on this surface, not an undefined fit
     else:
         sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
         if radius is not None:
@@ -336,7 +343,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             with np.errstate(invalid="ignore"):  # a noisy mesh: its group's median level above ROUGH_LEVEL
                 rough = _group_medians(levels, scales, np.isfinite(levels)) > ROUGH_LEVEL
             checks = (sigmas > 0, noisy, cracked, rough)
-            unsure = _scatter_check((vertices, radii, referenced, scales), checks, fields)
+            soup = cracked if mesh.n_cracked else None  # welded across cracks (an irregular rim's close vertices: no)
+            unsure = _scatter_check((vertices, radii, referenced, scales), checks, fields, soup=soup)
     six, fitted, coefficients = fields
 
     stages.start("retrieve curvatures")
@@ -349,6 +357,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     noisy_balls = int((failed & unsure & ~(away > AWAY_FRACTION)).sum())
     few = int(failed.sum()) - two_sided - noisy_balls
+    steps &= failed & ~(away > AWAY_FRACTION)  # on a staircase the unsure balls are its steps' (noisy_balls)
     shown = ", ".join(f"{r:g}" for r, _ in groups) if radius is not None else _shown_radii(radii, referenced)
     extra = (
         (
@@ -364,17 +373,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         )
         if two_sided
         else "",
-        (
-            f"{noisy_balls} vertices have a ball of radius {shown} too small for the noise of their surface: "
-            f"any fit over it moves the curvatures by more than {NOISE_REACH:g} of the surface's; "
-            + (
-                "pass a larger `radius` (or none)"
-                if radius is not None
-                else "no ball within their curvature averages it"
-            )
-        )
-        if noisy_balls
-        else "",
+        _unsure_phrase(noisy_balls, shown, given=radius is not None, staircase=bool(steps.any())),
     )
     normals_out = np.where(valid[:, None], fitted, normals)
     parameters: dict[str, object] = {"radius": groups[0][0]}
@@ -383,7 +382,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         parameters = {"radius": float(np.median(used)) if used.size else groups[0][0], "scale": "noise"}
     elif len(groups) > 1:
         parameters["radii"] = tuple(r for r, _ in groups)
-    return finish(
+    result, problems = finish(
         "quadric",
         parameters,
         valid,
@@ -395,6 +394,26 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         defects,
         extra,
         radius=radii,
+    )
+    if steps.any():  # their reason: the staircase, a limit of the method (a defect's code still comes first)
+        result = dataclasses.replace(result, invalid_reason=np.where(steps, STAIRCASE, 0).astype(np.int8))
+    return result, problems
+
+
+def _unsure_phrase(count: int, shown: str, *, given: bool, staircase: bool) -> str:
+    """The warning's phrase for ``count`` vertices whose fits the noise's checks dropped (``shown``: their radii):
+    on a voxel surface's default (``staircase``) the fits that followed the voxels' steps."""
+    if not count:
+        return ""
+    if staircase:
+        return (
+            f"{count} vertices of this voxel surface are NaN (voxel staircase): every fit over their ball, of radius "
+            f"{shown}, or over a ball grown within their curvature, follows the voxels' steps"
+        )
+    advice = "pass a larger `radius` (or none)" if given else "no ball within their curvature averages it"
+    return (
+        f"{count} vertices have a ball of radius {shown} too small for the noise of their surface: any fit over it "
+        f"moves the curvatures by more than {NOISE_REACH:g} of the surface's; {advice}"
     )
 
 
@@ -617,7 +636,9 @@ def residual_spreads(vertices, pool, radii, normals, centres) -> tuple[np.ndarra
     return coefficients, sigmas, spreads
 
 
-def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool = False) -> np.ndarray:
+def _scatter_check(
+    ball: tuple, checks: tuple, fields: tuple, *, staircase: bool = False, soup: np.ndarray | None = None
+) -> np.ndarray:
     """(V,) bool: the vertices at the default radius whose fit the scatter of their ball's points moves beyond
     :data:`NOISE_REACH` of their curvature, at their radius and over a grown ball (their coefficients made NaN).
 
@@ -627,11 +648,15 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool
     crack's corner (:func:`_cracked_balls`) and those of a group whose median level exceeds :data:`ROUGH_LEVEL`;
     ``fields = (six, fitted, coefficients)``, changed in place. A crease is told from scatter by its residuals:
 
-    1. at each checked vertex, a quadric over its ball in the frame of its fit (:func:`residual_spreads`, compiled)
+    1. at each checked vertex (and each ``soup`` one, whose level may read clean: most points of a soup are in
+       place), a quadric over its ball in the frame of its fit (:func:`residual_spreads`, compiled)
        gives its residuals' standard deviation ``s`` and the spread of its curvatures under a noise of that size; at
-       the ``noisy`` vertices a jet that departs from it by more than that spread takes it (:func:`_follow_quadrics`;
-       elsewhere a clean surface's higher terms make the departure: the coarse ellipsoid of ``accuracy.py --quick``,
-       H 1.9 -> 3.1% with the swap everywhere);
+       the ``noisy`` vertices a jet that departs from it by more than that spread takes it, at the ``soup`` ones it
+       takes it whatever (:func:`_follow_quadrics`; elsewhere a clean surface's higher terms make the departure: the
+       coarse ellipsoid of ``accuracy.py --quick``, H 1.9 -> 3.1% with the swap everywhere). Over cracks whose level
+       read below :data:`NOISE_GATE` the jet of degree 4 followed the copies' offsets while steps 2-5 checked only its
+       quadric (fuzz 490/29: ``icosphere(40)`` half detached by 0.049 edges, H 0.18-1.94 for 1 where the ball's
+       quadric read 0.74-1.26, 296 of 56,125 valid vertices off by more than half of the largest ``|k|``; none now);
     2. a spread within :data:`NOISE_REACH` of the quadric's curvedness (at least the median curvedness of the fits
        of its group, :func:`_fitted_curvedness`) passes: a crease is a large curvature whose residuals, small beside
        it, read as noise;
@@ -655,6 +680,10 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool
        valid). Elsewhere the wider ball is fitted at the rows 2 failed only: at every row it cost nefertiti 1.43x
        its CPU and changed a dozen crease vertices of fandisk and rocker-arm.
 
+    ``soup``: on a mesh welded across cracks (``PreparedMesh.n_cracked``), the ``cracked`` vertices (None elsewhere: an
+    irregular rim's close vertices are no crack, and the swap moved the irregular open meshes of ``accuracy.py
+    --quick``).
+
     ``staircase``: a voxel surface at its default radius, every ball over the steps of the voxels (``checks`` all
     set but ``rough``): residuals that grow over the wider ball are the steps' and the ball's reach round the
     surface, not a crease's, so step 3 passes no fit as structure (on ``voxel_torus()`` 103 fits kept so were off
@@ -663,17 +692,22 @@ def _scatter_check(ball: tuple, checks: tuple, fields: tuple, *, staircase: bool
     steps' pull is coherent over the ball). :func:`_staircase_check` then checks the fits kept."""
     vertices, radii, referenced, groups = ball
     checked, noisy, cracked, rough = checks
+    soup = np.zeros_like(cracked) if soup is None else soup
     six, fitted, coefficients = fields
     frames = fitted.copy()  # the frames of the quadrics (the fits' normals as they were)
     unsure = np.zeros(vertices.shape[0], dtype=bool)
-    rows = np.flatnonzero(checked & referenced & np.isfinite(coefficients).all(axis=1))
+    rows = np.flatnonzero((checked | soup) & referenced & np.isfinite(coefficients).all(axis=1))
     if rows.size == 0:
         return unsure
     pool = np.flatnonzero(referenced)
     floor = _fitted_curvedness(fields, groups, vertices, referenced)
     found, sigmas, spreads = residual_spreads(vertices, pool, radii, frames, rows)
-    gated = noisy[rows]
-    _follow_quadrics((rows[gated], found[gated], frames[rows[gated]], radii[rows[gated]], spreads[gated]), fields)
+    gated = (noisy | soup)[rows]
+    # over a crack the fit kept is the quadric that the steps below hold to the crack: a jet within its spread of it
+    # still followed the copies' offsets (H 1.57 for 1 over a quadric of 1.32, spread 0.36; every face of
+    # icosphere(24) detached by 0.1 edges)
+    held = np.where(soup[rows] & np.isfinite(spreads), 0.0, spreads)
+    _follow_quadrics((rows[gated], found[gated], frames[rows[gated]], radii[rows[gated]], held[gated]), fields)
     bent = _curvedness(found, frames[rows], radii[rows])
     loose = ~(spreads <= NOISE_REACH * np.fmax(bent, floor[rows]))
     passed = ~loose  # as the noise's spread alone reads them
