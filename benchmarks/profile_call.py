@@ -350,7 +350,7 @@ def preparation(label: str, repeats: int) -> list[tuple[str, float, float]]:
     mesh = meshcurv.shapes.icosphere(SIZES[label])
     v = np.ascontiguousarray(mesh.vertices)
     topology = MeshTopology.from_faces(mesh.faces, v.shape[0])
-    scales = _geometry._vertex_length_scales(v, topology)
+    scales = _geometry.vertex_length_scales(v, topology)
     f = np.ascontiguousarray(mesh.faces, dtype=np.int64)
     n = v.shape[0]
     result = meshcurv.principal_curvatures(v, f)
@@ -374,7 +374,7 @@ def preparation(label: str, repeats: int) -> list[tuple[str, float, float]]:
             adjacency, n
         ),
         # computed once per call since 3745c02 (meshcurv._once); 7 and 10 times per default call before
-        "(call) one `vertex_length_scales`": lambda: _geometry._vertex_length_scales(v, topology),
+        "(call) one `vertex_length_scales`": lambda: _geometry.vertex_length_scales(v, topology),
         "(call) one `needle_vertices`": lambda: defects._needle_vertices(v, topology, scales),
     }
     rows = [(f"{name}, icosphere({SIZES[label]})", *_median_cpu_wall(call, repeats)) for name, call in pieces.items()]
