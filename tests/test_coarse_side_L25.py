@@ -11,23 +11,16 @@ by ``1 / s``.
 
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 import pytest
 
-from meshcurv._backend import use_backend
-from meshcurv.volume import label_curvatures
+from conftest import assert_label_row_scaled, label_row
+
 
 pytest.importorskip("skimage")
 
 SCALES = [0.7, 1e-3, 3.0]
-
-
-def _backend(name: str):
-    if name == "numba":
-        pytest.importorskip("numba")
-    return use_backend(name)
 
 
 def _slab() -> np.ndarray:
@@ -39,22 +32,7 @@ def _slab() -> np.ndarray:
     return image
 
 
-def _row(image, scale: float, backend: str, radius=None):
-    with _backend(backend), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        options = {} if radius is None else {"radius": radius * scale}
-        return label_curvatures(image, spacing=[scale] * 3, **options).iloc[0]
-
-
-def _assert_scaled(row, scaled, scale):
-    assert scaled["radius"] == pytest.approx(row["radius"] * scale, rel=1e-9)
-    assert scaled["area"] == pytest.approx(row["area"] * scale**2, rel=1e-9)
-    assert scaled["n_used"] == row["n_used"]
-    for column, power in (("mean_weighted", 1), ("mean_median", 1), ("k_min_p5", 1), ("gaussian_weighted", 2)):
-        assert scaled[column] * scale**power == pytest.approx(row[column], rel=1e-9), column
-
-
 @pytest.mark.parametrize("backend", ["numpy", "numba"])
 @pytest.mark.parametrize("scale", SCALES)
 def test_a_slabs_tied_normals_pick_one_side_at_every_spacing(scale, backend):
-    _assert_scaled(_row(_slab(), 1.0, backend), _row(_slab(), scale, backend), scale)
+    assert_label_row_scaled(label_row(_slab(), 1.0, backend), label_row(_slab(), scale, backend), scale)

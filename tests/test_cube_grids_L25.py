@@ -28,34 +28,12 @@ import numpy as np
 import pytest
 
 from meshcurv import principal_curvatures, shapes
-from meshcurv._backend import use_backend
-from meshcurv.volume import label_curvatures
+from conftest import assert_label_row_scaled, chosen_backend, label_row
 
 pytest.importorskip("skimage")
 
 RADIUS = 7.3
 SPACING = np.array([1.0, 0.8, 1.3])
-
-
-def _backend(name: str):
-    if name == "numba":
-        pytest.importorskip("numba")
-    return use_backend(name)
-
-
-def _row(image, scale: float, backend: str, radius=None):
-    with _backend(backend), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        options = {} if radius is None else {"radius": radius * scale}
-        return label_curvatures(image, spacing=[scale] * 3, **options).iloc[0]
-
-
-def _assert_scaled(row, scaled, scale):
-    assert scaled["radius"] == pytest.approx(row["radius"] * scale, rel=1e-9)
-    assert scaled["area"] == pytest.approx(row["area"] * scale**2, rel=1e-9)
-    assert scaled["n_used"] == row["n_used"]
-    for column, power in (("mean_weighted", 1), ("mean_median", 1), ("k_min_p5", 1), ("gaussian_weighted", 2)):
-        assert scaled[column] * scale**power == pytest.approx(row[column], rel=1e-9), column
 
 
 @pytest.mark.slow
@@ -65,7 +43,7 @@ def test_a_radius_of_whole_voxels_puts_no_cube_boundary_on_the_lattice(backend):
     # ran through 378 of its vertices when the coarse level's grid started at the lowest vertex
     offsets = np.indices((21, 21, 21)) - 10.2
     ball = (np.einsum("i...,i...->...", offsets, offsets) <= 8.3**2).astype(np.uint8)
-    _assert_scaled(_row(ball, 1.0, backend, radius=10.0), _row(ball, 0.7, backend, radius=10.0), 0.7)
+    assert_label_row_scaled(label_row(ball, 1.0, backend, radius=10.0), label_row(ball, 0.7, backend, radius=10.0), 0.7)
 
 
 def _ball():
@@ -85,7 +63,7 @@ def test_a_voxel_ball_and_its_mirror_image_read_the_same(axis, backend):
     index, faces, n = _ball()
     mirrored = index.copy()
     mirrored[:, axis] = (n - 1) - mirrored[:, axis]  # (the image flipped: a mirror turns the faces inside out)
-    with _backend(backend), warnings.catch_warnings():
+    with chosen_backend(backend), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = principal_curvatures(index * SPACING, faces, orient="consistent")
         image = principal_curvatures(mirrored * SPACING, np.ascontiguousarray(faces[:, ::-1]), orient="consistent")
