@@ -81,6 +81,8 @@ PROFILED = (
     ("/meshcurv/neighborhoods.py", "_face_clusters", "  clusters of faces (balls of 800 faces or more)"),
     ("_kernels/neighborhoods.py", "coarse_face_sums", "  their kernel"),
     ("/meshcurv/neighborhoods.py", "check_ball_work", "pair estimates (all ball computations)"),
+    ("/radius.py", "enclosing_ball", "smallest enclosing balls (the check of a given radius)"),
+    ("/jets.py", "turned_cubes", "cube grids (pilot centres, coarse levels, samples)"),
     ("_kernels/neighborhoods.py", "vertex_face_lists", "faces around each vertex (each sum)"),
     ("thread.py", "_adjust_thread_count", "threads started by run_chunks (a new pool per kernel call)"),
 )

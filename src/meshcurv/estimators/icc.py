@@ -492,7 +492,7 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, ed
     magnitude = np.abs(normals[members])
     dominant = magnitude >= magnitude.max(axis=1, keepdims=True) - AXIS_TIE
     side = (dominant * (1 + (normals[members] < 0)) * np.array([1, 3, 9])).sum(axis=1)
-    group = _row_groups(np.column_stack([cube, side]), (20, 20, 20, 5))
+    group = _row_groups(np.column_stack([cube, side]))
     c = int(group.max()) + 1
     weight = areas[members]
     total = np.bincount(group, weights=weight, minlength=c)
@@ -519,11 +519,18 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, ed
     return (np.concatenate([vertices, centroid]), np.concatenate([normals, group_normals]), allowed, lists, point_areas)
 
 
-def _row_groups(rows: np.ndarray, bits: tuple) -> np.ndarray:
+def _row_groups(rows: np.ndarray, bits: tuple | None = None) -> np.ndarray:
     """(N,) the index of each row of ``rows`` (N, k) of int >= 0 among the distinct rows in lexicographic order
     (``np.unique(rows, axis=0, return_inverse=True)``), on one int64 key where column ``j`` fits ``bits[j]`` bits
-    (a sort of numbers instead of rows: several times faster)."""
-    if rows.shape[0] == 0 or sum(bits) > 63 or np.any(rows.max(axis=0) >= 2 ** np.array(bits)):
+    (default: the bits of the column's largest value; a sort of numbers instead of rows: 0.3 ms instead of 6 on a
+    10,172-vertex voxel sphere's coarse level, whose fixed widths of 20 bits a cube and 5 a side, 65 in all, never
+    fitted one key)."""
+    if rows.shape[0] == 0:
+        return np.unique(rows, axis=0, return_inverse=True)[1].ravel()
+    top = rows.max(axis=0)
+    if bits is None:
+        bits = tuple(max(1, int(value).bit_length()) for value in top)
+    if sum(bits) > 63 or np.any(top >= 2 ** np.array(bits)):
         return np.unique(rows, axis=0, return_inverse=True)[1].ravel()
     key = np.zeros(rows.shape[0], dtype=np.int64)
     for j, width in enumerate(bits):
@@ -1146,6 +1153,11 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
     if radius is None:  # each group of components of one scale (usually the whole mesh) at its own default
         groups, levels = _noise_radii(mesh, normals, valid, adjacency=_adjacency(topology), fits=fits)
         found = {"surface": "smooth", "noise": levels[0] if len(levels) == 1 else levels}
+    elif vertex_scale is not None:
+        # the voxel default's radius, never refused (at most half the diagonal of the surface's box in the grid's
+        # axes, more than any edge): the check's smallest enclosing ball cost 29 ms of a 10,172-vertex voxel
+        # sphere's 250 (its lattice's many co-spherical points; issue 30)
+        groups, found = [(float(radius), None)], {}
     else:
         groups, found = [(_check_radius(radius, mesh), None)], {}
     # one radius; a list of them (one per group of components of one scale) when the scales differ
