@@ -15,6 +15,7 @@ sharing its values.
 from __future__ import annotations
 
 import dataclasses
+import logging
 from functools import cached_property
 from typing import Any, NamedTuple
 
@@ -22,7 +23,7 @@ import numpy as np
 
 from ._adapters import mesh_arrays
 from ._backend import numba_kernels
-from ._locality import local_topology
+from ._locality import MIN_VERTICES, is_scattered, local_topology
 from ._validation import as_mesh, as_vertices, check_choice
 from .defects import (
     BOUNDARY,
@@ -52,6 +53,20 @@ from .topology import MeshTopology
 from .weld import CRACK_TOLERANCE_RATIO, OneSided, Welding, _closed_copies, drop_double_sided, weld_vertices
 
 __all__ = ["PreparedMesh", "prepare_mesh"]
+
+logger = logging.getLogger(__name__)
+
+#: A large mesh (:data:`meshcurv._locality.MIN_VERTICES` vertices or more) whose vertices come in a local order
+#: is computed with its faces sorted by their smallest corner (:func:`_local_faces`) when the faces around a
+#: vertex lie farther apart than this in its face order (the median, over the vertices of :func:`_face_spans`, of
+#: the last row of a vertex's faces minus the first): an icosphere numbers them about F / 40 apart (its up and
+#: down triangles; 50,218 at 1M vertices, 142-448 once sorted), and every stage that reads per-face arrays
+#: around the vertices (the topology, the face measures, the ball sums) read a new cache line for each face:
+#: the default call at 1M vertices took 3.04 CPU s instead of 2.60 (issue 31, ``benchmarks/speed_profile_M26.md``).
+FACE_SPAN_LIMIT = 4096
+
+#: ... measured at about this many vertices, evenly spaced (every ``2**k``-th).
+FACE_SPAN_SAMPLE = 1024
 
 
 class _FacePass(NamedTuple):
@@ -447,7 +462,8 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         callers = as_vertices(vertices)
     else:
         callers, faces = as_mesh(vertices, faces, stacklevel=stacklevel + 1)
-    points, topology, local = local_topology(callers, faces)
+    triangles, face_order = _local_faces(callers.shape[0], faces)
+    points, topology, local = local_topology(callers, triangles)
     if not isinstance(orient, str) or orient not in ORIENT_CHOICES:
         check_choice(orient, "orient", ORIENT_CHOICES)  # raises: not an orientation
     if not isinstance(weld, (bool, np.bool_)):
@@ -483,8 +499,12 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     if local is not None and welded is None:  # the mesh the caller gave, its faces oriented (and one-sided)
         surface = Surface(
             callers,
-            np.take(local.order, topology.faces) if n_double_sided else local.original_faces(topology.faces),
+            np.take(local.order, topology.faces)
+            if n_double_sided
+            else _caller_rows(local.original_faces(topology.faces), face_order),
         )
+    elif face_order is not None and welded is None and not n_double_sided:  # the caller's faces, in their rows
+        surface = Surface(points, faces if n_flipped == 0 else _caller_rows(topology.faces, face_order))
     else:
         surface = Surface(points, topology.faces, index)
     return PreparedMesh(
@@ -502,3 +522,64 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         welded.n_cracked if welded is not None else 0,
         median,
     )
+
+
+def _face_spans(faces: np.ndarray, n_vertices: int, shift: int) -> np.ndarray:
+    """(S,) for the vertices ``0, 2**shift, 2 * 2**shift, ...`` below ``n_vertices``: the last row of the (F, 3)
+    ``faces`` around each minus the first, -1 where no face holds it."""
+    kernels = numba_kernels("topology")
+    if kernels is not None:  # one pass over the faces, no (F, 3) temporaries
+        return kernels._sampled_face_spans(faces, n_vertices, shift)
+    rows, corners = np.nonzero((faces & ((1 << shift) - 1)) == 0)
+    slots = faces[rows, corners] >> shift
+    n_sampled = ((n_vertices - 1) >> shift) + 1
+    first = np.full(n_sampled, faces.shape[0], dtype=np.int64)
+    last = np.full(n_sampled, -1, dtype=np.int64)
+    np.minimum.at(first, slots, rows)
+    np.maximum.at(last, slots, rows)
+    return np.where(last >= 0, last - first, -1)
+
+
+def _faces_apart(n_vertices: int, faces: np.ndarray) -> bool:
+    """Whether the (F, 3) ``faces`` of a mesh of ``n_vertices`` lie far apart around its vertices: at least
+    :data:`meshcurv._locality.MIN_VERTICES` vertices, and the median of :func:`_face_spans` over about
+    :data:`FACE_SPAN_SAMPLE` of them above :data:`FACE_SPAN_LIMIT`."""
+    if n_vertices < MIN_VERTICES or faces.shape[0] == 0:
+        return False
+    shift = max(0, (n_vertices // FACE_SPAN_SAMPLE).bit_length() - 1)  # every 2**shift-th vertex
+    spans = _face_spans(faces, n_vertices, shift)
+    spans = spans[spans >= 0]
+    return bool(spans.size) and float(np.median(spans)) > FACE_SPAN_LIMIT
+
+
+def _local_faces(
+    n_vertices: int, faces: np.ndarray | MeshTopology
+) -> tuple[np.ndarray | MeshTopology, np.ndarray | None]:
+    """``(faces, order)``: the checked (F, 3) ``faces`` of a mesh of ``n_vertices`` whose vertices are in a local
+    order (not :func:`meshcurv._locality.is_scattered`, which reorders the faces with the vertices) and whose
+    faces lie apart (:func:`_faces_apart`) sorted by their smallest corner (stable), ``order`` (F,) the caller's
+    row of each; ``faces`` as given and None otherwise (a :class:`MeshTopology` is kept as built).
+
+    The curvatures do not depend on the faces' order beyond the order of floating-point sums (the sums over the
+    faces of a vertex or of a ball): up to round-off, and where ``k_max`` and ``k_min`` nearly meet (a sphere's
+    umbilics) up to the square root of the round-off of ``H^2 - K`` (``tests/test_face_order_M27.py``)."""
+    if isinstance(faces, MeshTopology) or is_scattered(n_vertices, faces) or not _faces_apart(n_vertices, faces):
+        return faces, None
+    kernels = numba_kernels("topology")
+    if kernels is not None:  # a counting sort, its faces in numba's memory (_kernels.geometry._unadvised_array)
+        order, ordered = kernels._faces_by_smallest_corner(faces, n_vertices)
+    else:
+        order = np.argsort(faces.min(axis=1), kind="stable")
+        ordered = np.take(faces, order, axis=0)
+    logger.info("the faces around each vertex lie far apart in their order: computed sorted by their smallest corner")
+    return ordered, order
+
+
+def _caller_rows(faces: np.ndarray, order: np.ndarray | None) -> np.ndarray:
+    """The (F, 3) ``faces`` in the order :func:`_local_faces` sorted (row ``j`` the caller's row ``order[j]``) put
+    back in the caller's rows (``faces`` itself when ``order`` is None)."""
+    if order is None:
+        return faces
+    rows = np.zeros_like(order)
+    rows[order] = np.arange(order.size)
+    return np.take(faces, rows, axis=0)

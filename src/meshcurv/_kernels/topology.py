@@ -622,3 +622,44 @@ def _suspects_chunk(lo, hi, faces, edge_faces, counts, forward, out):
         elif count == 2 and forward[e] == 1:
             f, g = _UNSIGNED(edge_faces[e, 0]), _UNSIGNED(edge_faces[e, 1])  # both faces: >= 0
             out[e] = faces[f, 0] + faces[f, 1] + faces[f, 2] == faces[g, 0] + faces[g, 1] + faces[g, 2]
+
+
+@nb.njit(**_JIT)
+def _sampled_face_spans(faces, n_vertices, shift):
+    """(S,) for the vertices ``0, 2**shift, 2 * 2**shift, ...``: the last row of ``faces`` (F, 3) around each minus
+    the first, -1 where no face holds it (``_prepared._face_spans``, in one pass over the faces)."""
+    n_sampled = ((n_vertices - 1) >> shift) + 1
+    first = np.full(n_sampled, -1, np.int64)
+    spans = np.full(n_sampled, -1, np.int64)
+    mask = (1 << shift) - 1
+    for f in range(faces.shape[0]):
+        for k in range(3):
+            v = faces[f, k]
+            if v & mask == 0:
+                s = _UNSIGNED(v >> shift)
+                if first[s] < 0:
+                    first[s] = f
+                spans[s] = f - first[s]  # the rows come in order: the last one seen is the last
+    return spans
+
+
+@nb.njit(**_JIT)
+def _faces_by_smallest_corner(faces, n_vertices):
+    """``(order, sorted_faces)``: the (F,) rows of ``faces`` (F, 3) in the order of their smallest corner, stable
+    (a counting sort: ``np.argsort(faces.min(axis=1), kind="stable")``), and the (F, 3) faces in that order
+    (numba's memory: ``_kernels.geometry._unadvised_array``'s reason)."""
+    n_faces = faces.shape[0]
+    starts = np.zeros(n_vertices + 1, np.int64)
+    for f in range(n_faces):
+        starts[_UNSIGNED(min(faces[f, 0], faces[f, 1], faces[f, 2])) + _ONE] += 1
+    for v in range(n_vertices):
+        starts[v + 1] += starts[v]
+    order = np.empty(n_faces, np.int64)
+    out = np.empty((n_faces, 3), np.int64)
+    for f in range(n_faces):
+        low = _UNSIGNED(min(faces[f, 0], faces[f, 1], faces[f, 2]))
+        row = starts[low]
+        starts[low] = row + 1
+        order[row] = f
+        out[row, 0], out[row, 1], out[row, 2] = faces[f, 0], faces[f, 1], faces[f, 2]
+    return order, out
