@@ -99,6 +99,14 @@ PARALLEL_COSINE = 0.9
 #: A flat edge steeper than this must close a triangle of flat edges to join two points in one sheet.
 TRUSTED_SLOPE = 0.2
 
+#: An edge of the orientation graph whose normals' cosine is at most this in magnitude passes no sign: at right
+#: angles ``sign(n_i . n_j)`` is the sign of round-off, which a motion of the cloud decides (ogre's vertices as a
+#: cloud, shifted by 1024 sizes: a point joined to its part only by two flat edges across a right-angled crease,
+#: cosine -0.0 in one pose and -2.4e-16 in the other, was turned; the winding numbers around it moved by 0.15, the
+#: noise level by 0.14%, and 49 points changed validity: fuzz_api 540/33). The normals of a cloud shifted by 2^20
+#: sizes carry errors of about 1e-7 (its coordinates rounded to 2^-32 of its size, a millionth of it apart).
+SIGN_COSINE = 1e-4
+
 #: The orientation takes its edges in the order of their slopes rounded to this: equal ones are taken in the order
 #: of the edges. Both backends' normals agree to round-off, not bit for bit, and on a lattice many edges tie
 #: exactly: without it a tie decided by round-off turned a few points on one backend (``benchmarks/fuzz_api.md``,
@@ -1208,7 +1216,9 @@ def oriented_signs(
         rows, cols, kept, ahead, behind, cosine, slope = compiled.graph_edges(points, normals, graph, usable)
     else:
         rows, cols, kept, ahead, behind, cosine, slope = _graph_geometry(points, normals, graph, usable)
-    flat = slope <= SHEET_SLOPE  # NaN (a zero offset) is not flat
+    # (NaN, a zero offset, is not flat; nor is an edge at right angles: it passes no sign, SIGN_COSINE)
+    signed = np.abs(cosine) > SIGN_COSINE
+    flat = (slope <= SHEET_SLOPE) & signed
     flat = _supported(flat, slope, rows, cols, kept, graph)
     forest = numba_kernels("pointcloud_graph")
     if forest is None:
@@ -1246,7 +1256,7 @@ def oriented_signs(
         if forest is not None:
             sheets = _sheets(n, rows[flat], cols[flat])
         signs, labels = _spanning_forest(n, rows[used], cols[used], opposite[used], weights[used])
-    other = np.flatnonzero(~used)
+    other = np.flatnonzero(~used & signed)
     sizes = np.bincount(labels)
     part = np.where((sizes >= PART_MIN_POINTS)[labels] & usable, labels, -1)
     doubtful = np.zeros(n, dtype=bool)
@@ -1406,14 +1416,16 @@ def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """(N,) bool: points with a neighbour (of ``indices``, (N, k)) whose oriented normal faces away from theirs.
 
     Such a point's nearest neighbours hold another sheet (a neighbouring part, the other face of a thin
-    part): its PCA normal may mix the two.
+    part): its PCA normal may mix the two. A neighbour at right angles (cosine below :data:`SIGN_COSINE`: its sign
+    is round-off, which the pose decides) counts as facing away, as in the jets' check
+    (:data:`meshcurv.jets.AWAY_DOT`).
     """
     compiled = numba_kernels("pointcloud")
     if compiled is not None:  # the cosines without (N, 3) gathers
-        return (compiled.edge_cosines(normals, np.ascontiguousarray(indices)) < 0).any(axis=1)
+        return (compiled.edge_cosines(normals, np.ascontiguousarray(indices)) < SIGN_COSINE).any(axis=1)
     away = np.zeros(normals.shape[0], dtype=bool)
     for column in range(indices.shape[1]):
-        away |= _dot(normals, normals[indices[:, column]]) < 0  # (the kernel's sum: the same signs)
+        away |= _dot(normals, normals[indices[:, column]]) < SIGN_COSINE  # (the kernel's sum: the same signs)
     return away
 
 
@@ -1466,15 +1478,22 @@ def _winding(points, normals, areas, usable, tree, q, queries, sources, labels=N
     their own sums), or None. Given the points' part ``labels`` (N,) (with ``queries``): ``(total, own)``, the
     winding numbers and the shares of them of the part of each query (:func:`unconfirmed_parts`)."""
     k = min(WINDING_NEAR + 1, points.shape[0])
-    distances, near = tree.query(q, k=k, workers=-1)
+    near = tree.query(q, k=k, workers=-1)[1]
     offsets = points[near] - q[:, None, :]
+    # (formed as the far sum forms them, left to right: the near points are exactly those it leaves out)
+    squared = _dot(offsets, offsets)
     counted = usable[near] if queries is None else (near != queries[:, None]) & usable[near]
-    softened = np.where(counted, np.einsum("mkj,mkj->mk", offsets, offsets) + areas[near] / np.pi, 1.0)
+    softened = np.where(counted, squared + areas[near] / np.pi, 1.0)
     terms = np.where(
         counted, areas[near] * np.einsum("mkj,mkj->mk", offsets, normals[near]) / (softened * np.sqrt(softened)), 0.0
     )
     total = terms.sum(axis=1)
-    reach_squared = distances[:, -1] ** 2
+    # the far sum takes the sources beyond the farthest near point. The tree's distance squared again
+    # (sqrt, then squared: a unit of the last place either way of the far sum's own) left the farthest near point
+    # among the far ones at about 2% of the queries, which the pose chose: its term counted a second time, weighed
+    # by the points per source (ogre as a cloud, shifted by 1024 sizes: winding numbers 0.15 apart, 34 points
+    # turned at the next evaluation)
+    reach_squared = squared.max(axis=1)
     weights = areas[sources] * (np.count_nonzero(usable) / sources.size)
     soft = areas[sources] / np.pi
     total += _far_winding(points, normals, weights, soft, sources, q, queries, reach_squared)
