@@ -469,7 +469,8 @@ def multiscale_point_cloud_curvatures(
     """
     radii = _checked_radii(radii)
     cloud = _prepared_cloud(points, None, normals, method)
-    radii = [_checked_cloud_radius(radius, cloud.points, name="radii") for radius in radii]
+    size = rigid_extent(cloud.points)  # (once for every radius: 70 ms of CPU at 1M points)
+    radii = [_checked_cloud_radius(radius, cloud.points, name="radii", size=size) for radius in radii]
     results, notes = [], {}
     for radius in radii:
         result, problems = _estimated(cloud, radius)
@@ -583,14 +584,16 @@ def _merged_normals(given: np.ndarray, unique: np.ndarray, take: np.ndarray) -> 
     return mean * np.where(votes < 0.0, -1.0, 1.0)[:, None]
 
 
-def _checked_cloud_radius(radius, cloud: np.ndarray, *, name: str = "radius") -> float:
-    """``radius`` a positive number no larger than the cloud's :func:`meshcurv.radius.rigid_extent`."""
+def _checked_cloud_radius(radius, cloud: np.ndarray, *, name: str = "radius", size: float | None = None) -> float:
+    """``radius`` a positive number no larger than the cloud's :func:`meshcurv.radius.rigid_extent` (``size``:
+    that extent, when known)."""
     if isinstance(radius, str) and radius == "adaptive":
         raise InvalidOptionError(
             f"`{name}` 'adaptive' is for meshes (method 'icc'); a point cloud takes a length (or None: from the data)"
         )
     radius = check_positive_float(radius, name)
-    size = rigid_extent(cloud)
+    if size is None:
+        size = rigid_extent(cloud)
     if radius > size:
         raise InvalidOptionError(
             f"`{name}` {radius:g} is larger than the point cloud itself (bounding-box diagonal {size:g} of the cube "
