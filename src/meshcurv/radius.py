@@ -905,6 +905,99 @@ def _jet_vertex_radii(base: np.ndarray, levels: np.ndarray, curvedness: np.ndarr
     return np.where(np.isfinite(base), np.maximum(base, np.minimum(grown, cap)), base)
 
 
+#: A default ball whose normals turn from its centre's by more than this (radians) reaches round the surface
+#: (:func:`_ball_turns`): a height function over its tangent plane is steep at its rim, which no polynomial of the
+#: fits follows. On a circle of curvature ``k`` the normal turns by ``2 asin(d k / 2)`` at the distance ``d``: 1.3 rad
+#: is a ball of radius ``1.21 / k``. ``quadric`` over well-sampled spheres, cylinders and tori at a given radius of
+#: ``r k`` 1.0 / 1.2 / 1.4 (``k`` the largest ``|k|``): the largest principal curvature off by 3-6% / 8-15% / 16-33%;
+#: at its default on ``torus(10, 3, 30, 30)`` (a ball of 4.09 set by the ring's long edges, 1.5 rad) by 27%, valid,
+#: on the coarse torus of ``benchmarks/accuracy.py`` (``torus(3, 1, 48, 16)``, 1.15 rad) by 1.7% (1.0 here: 13%,
+#: its smaller balls' fits fell to quadrics).
+BALL_TURN_CAP = 1.3
+
+#: ... unless an edge in the ball turns its vertex normals by more than this (radians): a crease, sharper than any
+#: ball, whose fits are the ball's reading of it (``fandisk``: no ball of its default turns past
+#: :data:`BALL_TURN_CAP` without one), where a smooth surface sampled with 10 edges to a circle turns by 0.63 per edge.
+CREASE_TURN = 0.6
+
+
+def _edge_turns(normals: np.ndarray, edges: np.ndarray, n_vertices: int) -> np.ndarray:
+    """(V,) the largest angle (radians) between the unit ``normals`` of each vertex and of its edge neighbours.
+
+    Parameters
+    ----------
+    normals : ndarray of shape (V, 3)
+        Unit vertex normals (rows of NaN add nothing).
+    edges : ndarray of shape (E, 2)
+        The edges (int64 vertex ids).
+    n_vertices : int
+
+    Returns
+    -------
+    ndarray of shape (V,)
+        0 at a vertex with no edge.
+    """
+    out = np.zeros(n_vertices)
+    if edges.shape[0] == 0:
+        return out
+    cosines = np.einsum("ij,ij->i", normals[edges[:, 0]], normals[edges[:, 1]])
+    with np.errstate(invalid="ignore"):
+        angles = np.arccos(np.clip(cosines, -1.0, 1.0))
+    np.fmax.at(out, edges[:, 0], angles)
+    np.fmax.at(out, edges[:, 1], angles)
+    return out
+
+
+def _ball_turns(
+    vertices: np.ndarray, normals: np.ndarray, radii: np.ndarray, centres: np.ndarray, pool: np.ndarray, creases
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """How far the normals turn across the ball of each centre: its reach round the surface.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3)
+    normals : ndarray of shape (V, 3)
+        Unit vertex normals (rows of NaN add nothing).
+    radii : ndarray of shape (V,)
+        Each vertex's radius.
+    centres : ndarray of shape (M,)
+        The int64 ids of the balls' centres.
+    pool : ndarray of shape (P,)
+        The int64 ids of the points that enter the balls.
+    creases : ndarray of shape (V,)
+        Each vertex's :func:`_edge_turns`.
+
+    Returns
+    -------
+    turns : ndarray of shape (M,)
+        The largest angle (radians) between the centre's normal and a point's of its ball.
+    bends : ndarray of shape (M,)
+        The largest ``|n_j - n_v| / |x_j - x_v|`` over the points of the ball's outer half (``|x_j - x_v| >= r / 2``):
+        the curvature of the circle through the two points with those normals (exact on a sphere and on a
+        cylinder's circles, whatever the radius; a fit over the ball reads less), 0 where none.
+    sharpest : ndarray of shape (M,)
+        The largest :func:`_edge_turns` ``creases`` of the ball's points.
+    """
+    m = centres.shape[0]
+    turns, bends, sharpest = np.zeros(m), np.zeros(m), np.zeros(m)
+    if m == 0 or pool.shape[0] == 0:
+        return turns, bends, sharpest
+    from .neighborhoods import _ball_pairs
+
+    unit = radii[centres]
+    for _, i, j in _ball_pairs(vertices[pool], vertices[centres], unit):
+        ids, own = pool[j], centres[i]
+        with np.errstate(invalid="ignore"):
+            angles = np.arccos(np.clip(np.einsum("ij,ij->i", normals[ids], normals[own]), -1.0, 1.0))
+            apart = np.linalg.norm(vertices[ids] - vertices[own], axis=1)
+            chords = np.linalg.norm(normals[ids] - normals[own], axis=1) / apart
+        np.fmax.at(turns, i, angles)
+        outer = apart >= 0.5 * unit[i]
+        np.fmax.at(bends, i[outer], chords[outer])
+        np.fmax.at(sharpest, i, creases[ids])
+    return turns, bends, sharpest
+
+
 def voxel_radius(spacing: np.ndarray, curvature_radius: float) -> float:
     """The default measure radius of a voxel surface: ``min(1.5 sqrt(h R), R / 2)``, at least ``1.01 h``.
 

@@ -36,6 +36,13 @@ far: a vertex whose jet departs from a steadier fit on the same ball (a quadric 
 more than :data:`STEADY_AGREEMENT` takes the steadier fit's curvatures, and one whose ball's points are too
 little spread for any such fit is NaN with ``valid=False``.
 
+Reach. The default radius is 2.5 mean edge lengths, which on a mesh of long and short edges reaches round a part
+curved along the short ones (``torus(10, 3, 30, 30)``: a ball of 4.09 for a tube of radius 3, every vertex valid and
+``k_max`` 27% off; issue 29). A default ball whose normals (the fits') turn from its centre's by more than
+:data:`meshcurv.radius.BALL_TURN_CAP` with no crease in it (no edge turning the vertex normals by more than
+:data:`meshcurv.radius.CREASE_TURN`) is made smaller and fitted again; the default fit stays where the smaller ball
+reproduces it, and a vertex with no smaller fit is NaN with ``valid=False`` (:func:`_round_balls`).
+
 Noise. A jet of degree 4 amplifies noise far more than a quadric: at 2.5 edge lengths, noise of a tenth of an
 edge along the normal gave median H errors of 56-108% of the curvature on the noisy spheres of
 ``benchmarks/accuracy.py`` (a quadric over the same balls 11-20%). Each vertex's noise level is read as the
@@ -97,8 +104,12 @@ from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, PIVOT_FLOOR, _exponents, _
 from ..neighborhoods import _ball_pairs
 from .._tensors import tangent_basis
 from ..radius import (
+    BALL_TURN_CAP,
+    CREASE_TURN,
     JET_CURVATURE_CAP,
+    _ball_turns,
     _component_radii,
+    _edge_turns,
     _jet_vertex_radii,
     _local_noise,
     _resolve_radius,
@@ -308,12 +319,17 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     for unit, members in parts:
         centres = np.flatnonzero(referenced) if np.ndim(unit) else members
         _fit_part((vertices, start, unit, centres), referenced, facing, sides, fields, away)
+    base = _vertex_radii(groups, n)
     if radius is None:  # a grown ball that holds the other side: the group's own radius
-        base = _vertex_radii(groups, n)
         again = np.flatnonzero(referenced & (away > AWAY_FRACTION) & (radii > base) & np.isfinite(base) & (base > 0))
         if again.size:
             radii[again] = base[again]
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
+    round_balls = np.zeros(n, dtype=bool)
+    if radius is None and not stages.voxel_default:  # a default ball that reaches round the surface: made smaller
+        with np.errstate(invalid="ignore"):  # its own level: a group's median may be read off its curved parts
+            ball = (vertices, facing, start, radii, base, referenced, levels > NOISE_GATE)
+        round_balls = _round_balls(ball, topology.edges, sides, fields, away)
     unsure = np.zeros(n, dtype=bool)
     steps = np.zeros(n, dtype=bool)
     # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate. A voxel surface's
@@ -356,7 +372,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     failed = ~valid & ~defects.invalid_vertices
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     noisy_balls = int((failed & unsure & ~(away > AWAY_FRACTION)).sum())
-    few = int(failed.sum()) - two_sided - noisy_balls
+    round_count = int((failed & round_balls & ~unsure & ~(away > AWAY_FRACTION)).sum())
+    few = int(failed.sum()) - two_sided - noisy_balls - round_count
     steps &= failed & ~(away > AWAY_FRACTION)  # on a staircase the unsure balls are its steps' (noisy_balls)
     shown = ", ".join(f"{r:g}" for r, _ in groups) if radius is not None else _shown_radii(radii, referenced)
     extra = (
@@ -374,6 +391,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         if two_sided
         else "",
         _unsure_phrase(noisy_balls, shown, given=radius is not None, staircase=bool(steps.any())),
+        (
+            f"{round_count} vertices have a default ball that reaches round the surface (its normals turn by more "
+            f"than {BALL_TURN_CAP:g} rad) and no smaller ball holds a fit: the mesh is too coarse there for this "
+            "method (refine it)"
+        )
+        if round_count
+        else "",
     )
     normals_out = np.where(valid[:, None], fitted, normals)
     parameters: dict[str, object] = {"radius": groups[0][0]}
@@ -398,6 +422,119 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     if steps.any():  # their reason: the staircase, a limit of the method (a defect's code still comes first)
         result = dataclasses.replace(result, invalid_reason=np.where(steps, STAIRCASE, 0).astype(np.int8))
     return result, problems
+
+
+#: A default ball is checked for its reach round the surface (:func:`_round_balls`) where its fit's largest ``|k|``
+#: times its radius exceeds this: a ball turning by :data:`meshcurv.radius.BALL_TURN_CAP` spans ``r k`` of 1.2 on a
+#: circle, and its fits read the curvature high there (1.27-1.47 times on ``torus(10, 3, 30, 30)``,
+#: ``torus(10, 3, 24, 64)`` and ``torus(4, 1, 40, 12)``), or a few percent low (a fit of degree 4 over a clean sphere).
+ROUND_CANDIDATE = 0.5
+
+#: A ball that reaches round the surface is made smaller and refitted at most this many times
+#: (:func:`_round_balls`): each time to where the normals of a circle through its rim would turn by
+#: :data:`meshcurv.radius.BALL_TURN_CAP`, at most :data:`ROUND_SHRINK` of its radius.
+ROUND_STEPS = 3
+
+#: ... the margin of each step (:func:`_round_balls`).
+ROUND_SHRINK = 0.95
+
+#: A ball that reaches round the surface is made smaller to where the normals of a circle through its rim would turn
+#: by this (radians; :func:`_round_balls`): well within :data:`meshcurv.radius.BALL_TURN_CAP`, where a fit of degree
+#: 4 reads a circle's curvature within 3-6%; a smaller ball holds fewer points, whose fit falls to a quadric (biased
+#: as ``(r k)^2``) where the points along one direction are too few for the higher terms.
+ROUND_TURN = 1.0
+
+#: A default fit whose principal curvatures a smaller ball's fit (:func:`_round_balls`, its first step) reproduces
+#: within this share of its largest ``|k|`` is kept: its ball turns past the cap where the curvature is high at one
+#: side only (the tips of ``ellipsoid((3, 2, 1), 8)``, whose smaller balls, of fewer points, read H 1.9 -> 3.1% off).
+ROUND_AGREEMENT = 0.1
+
+
+def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, away: np.ndarray) -> np.ndarray:
+    """(V,) bool: the vertices whose default ball reaches round the surface and no smaller ball holds a fit (their
+    coefficients made NaN).
+
+    ``ball = (vertices, normals, start, radii, base, referenced)``: ``normals`` the vertex normals (NaN rows: none),
+    ``radii`` each vertex's default radius (changed in place where a ball is made smaller), ``base`` its group's (a
+    ball grown for the noise, :func:`meshcurv.radius.jet_vertex_radii`, is not checked: its radius is capped by the
+    curvature already); ``edges`` (E, 2); ``sides``, ``fields`` and ``away`` as :func:`_fit_part` takes them
+    (changed in place). The default radius is :data:`meshcurv.radius.DEFAULT_RADIUS_FACTOR` mean edge lengths,
+    which on a mesh of long and short edges (a torus of 30 x 30 quads, its ring's edges four times its tube's) reaches
+    round a part curved along the short edges: the ball of ``torus(10, 3, 30, 30)`` (4.09 for a tube of radius 3)
+    turns the normals by 1.5 rad, and its fits read the largest curvature 27% low, valid (issue 29). A ball whose
+    normals turn from its centre's by more than :data:`meshcurv.radius.BALL_TURN_CAP` with no edge in it turning by
+    more than :data:`meshcurv.radius.CREASE_TURN` (:func:`meshcurv.radius._ball_turns`; a crease is the ball's
+    reading at any radius) is made smaller, to where a circle through its rim would turn by :data:`ROUND_TURN`, and
+    fitted again (:data:`ROUND_STEPS` times at most); where the first smaller ball reproduces the default fit
+    (:data:`ROUND_AGREEMENT`) the default stays. A vertex whose smaller ball holds no fit, or one whose quadric's
+    spread under the noise of its residuals exceeds :data:`NOISE_REACH` of its curvature, or that still turns past
+    the cap, is NaN with ``valid=False``; so is a noisy one (its own level above :data:`NOISE_GATE`: it needs a wider
+    ball, not a smaller one). Checked where the fit's largest ``|k|`` times its radius exceeds
+    :data:`ROUND_CANDIDATE`: the fits of such balls read the curvature high (``torus(10, 3, 30, 30)``: 1.27 times)."""
+    vertices, normals, start, radii, base, referenced, rough = ball
+    six, fitted, coefficients = fields
+    out = np.zeros(vertices.shape[0], dtype=bool)
+    # the shape operators' Frobenius norm sqrt(k_min^2 + k_max^2) first (no eigenvalues at every vertex of a mesh)
+    norms = np.sqrt(np.einsum("ij,ij->i", six[:, :3], six[:, :3]) + 2.0 * np.einsum("ij,ij->i", six[:, 3:], six[:, 3:]))
+    with np.errstate(invalid="ignore"):
+        bent = radii * norms > ROUND_CANDIDATE
+    rows = np.flatnonzero(referenced & np.isfinite(coefficients).all(axis=1) & (radii <= base) & bent)
+    if rows.size == 0:
+        return out
+    k_min, k_max = principal_from_shape_operator(six[rows], fitted[rows])[:2]
+    with np.errstate(invalid="ignore"):
+        rows = rows[radii[rows] * np.maximum(np.abs(k_min), np.abs(k_max)) > ROUND_CANDIDATE]
+    if rows.size == 0:
+        return out
+    pool = np.flatnonzero(referenced)
+    creases = _edge_turns(normals, edges, vertices.shape[0])  # the mesh's own normals: a crease is sharp there
+    # the turns read on the fits' normals, which average the noise of the vertex normals (noise of 0.1 edge lengths
+    # turned those of the coarse ellipsoid's balls past the cap where the surface's turn by 0.8 rad)
+    smooth = np.where(np.isfinite(fitted).all(axis=1, keepdims=True), fitted, normals)
+    reach = 2.0 * np.sin(ROUND_TURN / 2.0)  # the chord of a unit circle whose ends' normals turn by ROUND_TURN
+    default = tuple(field[rows] for field in (radii, six, fitted, coefficients))  # in the order of rows
+    checked = rows
+    for step in range(ROUND_STEPS + 1):
+        turns, bends, sharpest = _ball_turns(vertices, smooth, radii, rows, pool, creases)
+        over = (turns > BALL_TURN_CAP) & ~(sharpest > CREASE_TURN)
+        rows, bends = rows[over], bends[over]
+        noisy = rough[rows]  # a noisy ball needs a wider one, not a smaller one
+        out[rows[noisy]] = True
+        rows, bends = rows[~noisy], bends[~noisy]
+        if rows.size == 0 or step == ROUND_STEPS:
+            break
+        with np.errstate(divide="ignore"):
+            radii[rows] = np.fmin(ROUND_SHRINK * radii[rows], ROUND_SHRINK * reach / bends)
+        _fit_part((vertices, start, radii, rows), referenced, normals, sides, fields, away)
+        if step == 0:  # a default fit that a smaller ball reproduces is the surface's, not its reach's: kept
+            at = np.searchsorted(checked, rows)
+            same = _agreeing((six[rows], fitted[rows]), (default[1][at], default[2][at]))
+            for field, kept in zip((radii, six, fitted, coefficients), default):
+                field[rows[same]] = kept[at[same]]
+            rows, bends = rows[~same], bends[~same]
+        # the smaller ball's quadric, whose spread under the noise of its residuals is held to NOISE_REACH of its
+        # curvature (as _scatter_check's step 2): a mesh of noise below the gate may hold no fit over fewer points
+        lost = ~np.isfinite(coefficients[rows]).all(axis=1)
+        out[rows[lost]] = True
+        rows = rows[~lost]
+        found, _, spreads = residual_spreads(vertices, pool, radii, fitted, rows)
+        with np.errstate(invalid="ignore"):
+            lost = ~(spreads <= NOISE_REACH * _curvedness(found, fitted[rows], radii[rows]))
+        out[rows[lost]] = True
+        rows = rows[~lost]
+    out[rows] = True
+    coefficients[out] = np.nan
+    return out
+
+
+def _agreeing(smaller: tuple, wider: tuple) -> np.ndarray:
+    """(N,) bool: the fits ``(six, normals)`` over smaller balls whose principal curvatures are within
+    :data:`ROUND_AGREEMENT` of the largest ``|k|`` of the fits over the wider ones (NaN: not)."""
+    near = principal_from_shape_operator(*smaller)[:2]
+    far = principal_from_shape_operator(*wider)[:2]
+    with np.errstate(invalid="ignore"):
+        apart = np.maximum(np.abs(near[0] - far[0]), np.abs(near[1] - far[1]))
+        return apart <= ROUND_AGREEMENT * np.maximum(np.abs(far[0]), np.abs(far[1]))
 
 
 def _unsure_phrase(count: int, shown: str, *, given: bool, staircase: bool) -> str:
