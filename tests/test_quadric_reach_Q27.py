@@ -4,7 +4,7 @@ The default radius is 2.5 mean edge lengths. On a mesh of long and short edges (
 edges up to four times the tube's) the long edges set a ball wider than the radius of curvature along the short ones:
 on ``torus(10, 3, 30, 30)`` a ball of 4.09 for a tube of radius 3, whose normals turn by 1.5 rad across it. A height
 function over the tangent plane is steep at such a ball's rim, no polynomial follows it, and every vertex came out
-valid with ``k_max`` 27-30% low (H 13.5% of the largest ``|k|``); ``torus(10, 3, 24, 64)`` 35-42%,
+valid with ``k_max`` 27-30% off (H 13.5% of the largest ``|k|``); ``torus(10, 3, 24, 64)`` 35-42%,
 ``torus(4, 1, 40, 12)`` 47% at its 200 valid vertices. A ball that turns past ``meshcurv.radius.BALL_TURN_CAP`` with
 no crease in it is now made smaller and fitted again, or NaN with a reason where no smaller ball holds a fit.
 
@@ -22,17 +22,14 @@ import numpy as np
 import pytest
 
 import meshcurv
+from conftest import chosen_backend
 from meshcurv import shapes
 
 BACKENDS = ["numba", "numpy"]
 
 
 def _quadric(mesh, backend):
-    if backend == "numba":
-        pytest.importorskip("numba")
-    from meshcurv._backend import use_backend
-
-    with use_backend(backend), warnings.catch_warnings(record=True) as caught:
+    with chosen_backend(backend), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method="quadric")
     return result, " ".join(str(w.message) for w in caught)
@@ -65,12 +62,27 @@ def test_a_ball_wider_than_the_tube_is_made_smaller(backend, counts):
 
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_no_valid_vertex_of_a_coarse_tube_is_far_off(backend):
-    # 12 quads round a tube of radius 1, a ball of 1.63: 200 valid vertices with k_max 47% low before
+    # 12 quads round a tube of radius 1, a ball of 1.63: 200 valid vertices with k_max 47% off before; no smaller
+    # ball holds a fit there, so every vertex is NaN, with its reason, and the warning names the class
     torus = shapes.torus(4.0, 1.0, 40, 12)
+    result, message = _quadric(torus, backend)
+    assert not result.valid.any()
+    assert (result.invalid_reason > 0).all()
+    assert "reaches round the surface" in message
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="open (issue 29, stop 61 review): on a jittered coarse torus 64-71 of ~875 valid vertices stay more than "
+    "15% of the largest |k| off (up to 53%; 197 before e5d7996); quadric.ROUND_AGREEMENT (0.1, 0.05, 0.03) does not "
+    "move them: the mechanism is not traced",
+)
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_jittered_coarse_torus_is_not_far_off(backend):
+    torus = shapes.torus(10.0, 3.0, 30, 30, jitter=0.1, seed=1)
     result, _ = _quadric(torus, backend)
     k_max, k_min, _ = _errors(result, torus)
-    assert not (k_max > 0.15).any() and not (k_min > 0.15).any()
-    assert (result.invalid_reason[~result.valid] > 0).all()
+    assert k_max.max() < 0.15 and k_min.max() < 0.15, (k_max.max(), k_min.max())
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
