@@ -1417,15 +1417,15 @@ def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:
 
     Such a point's nearest neighbours hold another sheet (a neighbouring part, the other face of a thin
     part): its PCA normal may mix the two. A neighbour at right angles (cosine below :data:`SIGN_COSINE`: its sign
-    is round-off, which the pose decides) counts as facing away, as in the jets' check
-    (:data:`meshcurv.jets.AWAY_DOT`).
+    is round-off, which the pose decides) counts as facing away, as the jets' check counts one below its own
+    margin (:data:`meshcurv.jets.AWAY_DOT`).
     """
     compiled = numba_kernels("pointcloud")
     if compiled is not None:  # the cosines without (N, 3) gathers
         return (compiled.edge_cosines(normals, np.ascontiguousarray(indices)) < SIGN_COSINE).any(axis=1)
     away = np.zeros(normals.shape[0], dtype=bool)
     for column in range(indices.shape[1]):
-        away |= _dot(normals, normals[indices[:, column]]) < SIGN_COSINE  # (the kernel's sum: the same signs)
+        away |= _dot(normals, normals[indices[:, column]]) < SIGN_COSINE  # (the kernel's sum: the same cosines)
     return away
 
 
