@@ -24,6 +24,7 @@ import pytest
 import meshcurv
 from conftest import chosen_backend
 from meshcurv import shapes
+from meshcurv.defects import REACH
 
 BACKENDS = ["numba", "numpy"]
 
@@ -68,6 +69,7 @@ def test_no_valid_vertex_of_a_coarse_tube_is_far_off(backend):
     result, message = _quadric(torus, backend)
     assert not result.valid.any()
     assert (result.invalid_reason > 0).all()
+    assert (result.invalid_reason == REACH).sum() > 100  # the class's own code (the others: balls over both sides)
     assert "reaches round the surface" in message
 
 

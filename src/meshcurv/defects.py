@@ -34,6 +34,7 @@ __all__ = [
     "METHOD_REASONS",
     "INVALID_REASONS",
     "STAIRCASE",
+    "REACH",
     "UNDEFINED",
     "BOUNDARY",
     "FRAGMENT",
@@ -139,11 +140,13 @@ POINT_CLOUD_REASONS = (
 METHOD_REASONS = (
     "voxel staircase: this method reads the voxels' steps as curvature (not an estimate; "
     "method='icc' scales its balls to the voxels)",
+    "ball reaches round the surface: the mesh is too coarse there for this method's ball (its normals turn by more "
+    "than about a radian across it, and no smaller ball holds a fit; refine the mesh)",
 )
 
 #: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``: the defects of
 #: meshes (1-7), the reasons of point clouds (8-11), the defects of meshes found since (12), the method's
-#: limits (13), then an estimate undefined (:data:`UNDEFINED`, the last).
+#: limits (13-14), then an estimate undefined (:data:`UNDEFINED`, the last).
 INVALID_REASONS = (
     "valid",
     *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code) if defect.code <= NEEDLE),
@@ -155,6 +158,9 @@ INVALID_REASONS = (
 
 #: The code of a vertex whose method reads a voxel staircase as curvature (:data:`METHOD_REASONS`).
 STAIRCASE = INVALID_REASONS.index(METHOD_REASONS[0])
+
+#: The code of a vertex whose ball reaches round the surface at the method's default (:data:`METHOD_REASONS`).
+REACH = INVALID_REASONS.index(METHOD_REASONS[1])
 
 #: The code of a vertex invalid for no defect of the mesh: its estimate itself is undefined.
 UNDEFINED = len(INVALID_REASONS) - 1

@@ -116,7 +116,7 @@ from ..radius import (
     _vertex_radii,
 )
 from .._prepared import PreparedMesh
-from ..defects import STAIRCASE
+from ..defects import REACH, STAIRCASE
 from .._backend import kernel_threads, numba_kernels
 from ._support import Stages, finish
 
@@ -419,8 +419,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         extra,
         radius=radii,
     )
-    if steps.any():  # their reason: the staircase, a limit of the method (a defect's code still comes first)
-        result = dataclasses.replace(result, invalid_reason=np.where(steps, STAIRCASE, 0).astype(np.int8))
+    reached = failed & round_balls & ~unsure & ~(away > AWAY_FRACTION)
+    if steps.any() or reached.any():  # their reason: a limit of the method (a defect's code still comes first)
+        codes = np.where(steps, STAIRCASE, np.where(reached, REACH, 0)).astype(np.int8)
+        result = dataclasses.replace(result, invalid_reason=codes)
     return result, problems
 
 
@@ -454,10 +456,11 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
     """(V,) bool: the vertices whose default ball reaches round the surface and no smaller ball holds a fit (their
     coefficients made NaN).
 
-    ``ball = (vertices, normals, start, radii, base, referenced)``: ``normals`` the vertex normals (NaN rows: none),
-    ``radii`` each vertex's default radius (changed in place where a ball is made smaller), ``base`` its group's (a
+    ``ball = (vertices, normals, start, radii, base, referenced, rough)``: ``normals`` the vertex normals (NaN rows:
+    none), ``radii`` each vertex's default radius (changed in place where a ball is made smaller), ``base`` its group's (a
     ball grown for the noise, :func:`meshcurv.radius.jet_vertex_radii`, is not checked: its radius is capped by the
-    curvature already); ``edges`` (E, 2); ``sides``, ``fields`` and ``away`` as :func:`_fit_part` takes them
+    curvature already), ``rough`` (V,) bool the vertices whose own noise level is above :data:`NOISE_GATE`;
+    ``edges`` (E, 2); ``sides``, ``fields`` and ``away`` as :func:`_fit_part` takes them
     (changed in place). The default radius is :data:`meshcurv.radius.DEFAULT_RADIUS_FACTOR` mean edge lengths,
     which on a mesh of long and short edges (a torus of 30 x 30 quads, its ring's edges four times its tube's) reaches
     round a part curved along the short edges: the ball of ``torus(10, 3, 30, 30)`` (4.09 for a tube of radius 3)
@@ -492,7 +495,8 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
     # turned those of the coarse ellipsoid's balls past the cap where the surface's turn by 0.8 rad)
     smooth = np.where(np.isfinite(fitted).all(axis=1, keepdims=True), fitted, normals)
     reach = 2.0 * np.sin(ROUND_TURN / 2.0)  # the chord of a unit circle whose ends' normals turn by ROUND_TURN
-    default = tuple(field[rows] for field in (radii, six, fitted, coefficients))  # in the order of rows
+    kept_fields = (radii, six, fitted, coefficients, away)  # what a smaller fit overwrites, the default's restored
+    default = tuple(field[rows] for field in kept_fields)  # in the order of rows
     checked = rows
     for step in range(ROUND_STEPS + 1):
         turns, bends, sharpest = _ball_turns(vertices, smooth, radii, rows, pool, creases)
@@ -509,7 +513,7 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
         if step == 0:  # a default fit that a smaller ball reproduces is the surface's, not its reach's: kept
             at = np.searchsorted(checked, rows)
             same = _agreeing((six[rows], fitted[rows]), (default[1][at], default[2][at]))
-            for field, kept in zip((radii, six, fitted, coefficients), default):
+            for field, kept in zip(kept_fields, default):
                 field[rows[same]] = kept[at[same]]
             rows, bends = rows[~same], bends[~same]
         # the smaller ball's quadric, whose spread under the noise of its residuals is held to NOISE_REACH of its
