@@ -527,18 +527,20 @@ def _prepared_cloud(points, faces, normals, method) -> _Cloud:
     distinct = points[unique]  # (gathered once: the near copies' search, the kept points' and the cloud's)
     if unique.size >= MIN_POINTS:
         # near copies (round-off differences, registration errors) are merged into the first of them in the
-        # Morton order
+        # Morton order, each group measured at its centroid: the first's position is the pose's choice (the pose
+        # orders the points), and a copy 1e-3 spacings from it moved the balls of its neighbours (fuzz_api 550/60:
+        # two copies 2.8e-5 apart, turned: k 1.2e-4 of the largest |k| apart at 46 points); registration errors
+        # are averaged out
         copy_of, search, registration = _near_copies(distinct)
         keep = copy_of == np.arange(unique.size)
-        if registration:
-            # copies a registration error apart: each group measured at its centroid (the errors averaged out)
-            group = np.cumsum(keep)[copy_of] - 1
-            sums = np.stack([np.bincount(group, weights=distinct[:, axis]) for axis in range(3)], axis=1)
-            centres = sums / np.bincount(group)[:, None]
         if not keep.all():
+            group = np.cumsum(keep)[copy_of] - 1
+            sizes = np.bincount(group)
+            sums = np.stack([np.bincount(group, weights=distinct[:, axis]) for axis in range(3)], axis=1)
+            centres = sums / sizes[:, None]
             representative = unique[copy_of][_position(unique, n_all)[representative]]
             unique, distinct = unique[keep], distinct[keep]
-            search = None if registration else _kept_search(distinct, keep, *search[1:])
+            search = None if registration else _kept_search(centres, keep, *search[1:], moved=sizes > 1)
     if unique.size < n_all:
         near = n_all - unique.size - n_exact
         found = [f"{n_exact} points coincide with others (duplicates)"] if n_exact else []
@@ -698,7 +700,8 @@ def _near_copies(cloud: np.ndarray):
     Point ``j`` is a copy of ``i`` when it is among ``i``'s nearest neighbours before a gap:
     ``d_m <= COPY_GAP d_(m+1)`` for the ``m``-th and next distances (the largest such ``m``), or, in a cloud of
     copies a registration error apart (:func:`_registration_gap`), when it lies within that error. Groups of
-    copies are the connected components of these pairs; each becomes its first point.
+    copies are the connected components of these pairs; each becomes its first point (measured at the group's
+    centroid: :func:`_prepared_cloud`).
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -813,11 +816,14 @@ def _knn(tree, cloud: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return _normals.whole_ties(distances, indices, k)
 
 
-def _kept_search(kept: np.ndarray, keep: np.ndarray, distances: np.ndarray, indices: np.ndarray):
-    """``(tree, distances, indices)`` of the points ``kept`` (M,), those of ``keep`` of a cloud whose neighbours
+def _kept_search(
+    kept: np.ndarray, keep: np.ndarray, distances: np.ndarray, indices: np.ndarray, moved: np.ndarray | None = None
+):
+    """``(tree, distances, indices)`` of the points ``kept`` (M, 3), those of ``keep`` of a cloud whose neighbours
     were ``distances, indices`` (overwritten); or None when more than :data:`KEPT_SEARCH_SHARE` of its points went.
 
-    A kept point whose nearest neighbours were all kept has the same nearest neighbours among the kept points
+    A kept point whose nearest neighbours were all kept, and none of them ``moved`` ((M,) bool: kept points not
+    where they were, the centroids of merged copies), has the same nearest neighbours among the kept points
     (:func:`_kept_rows`); the others are searched again.
     """
     from scipy.spatial import cKDTree
@@ -835,6 +841,8 @@ def _kept_search(kept: np.ndarray, keep: np.ndarray, distances: np.ndarray, indi
     else:
         distances, indices, again = _kept_rows(distances, indices, keep)
         again = np.union1d(again, np.flatnonzero(padded))
+    if moved is not None and moved.any():
+        again = np.union1d(again, np.flatnonzero(moved | moved[indices].any(axis=1)))
     if again.size:
         k = distances.shape[1]
         wide = min(k + 1, kept.shape[0] - 1)
