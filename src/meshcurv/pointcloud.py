@@ -540,7 +540,7 @@ def _prepared_cloud(points, faces, normals, method) -> _Cloud:
             centres = sums / sizes[:, None]
             representative = unique[copy_of][_position(unique, n_all)[representative]]
             unique, distinct = unique[keep], distinct[keep]
-            search = None if registration else _kept_search(centres, keep, *search[1:], moved=sizes > 1)
+            search = None if registration else _kept_search(centres, keep, search[1], search[2], moved=sizes > 1)
     if unique.size < n_all:
         near = n_all - unique.size - n_exact
         found = [f"{n_exact} points coincide with others (duplicates)"] if n_exact else []
