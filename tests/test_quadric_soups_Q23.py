@@ -64,7 +64,10 @@ def test_voxel_soup_steps_never_valid_and_far_off(share, gap, seed):
     # bias on the staircase, at most 0.9% of the valid)
     assert (error > 2 * OFF).sum() == 0
     assert (error > OFF).sum() < 0.025 * result.valid.sum()
-    assert result.valid.mean() > 0.8
+    # 0.8 until stop 61 (0.802 on (0.5, 0.068, 420)); quadric's check of default balls that reach round the surface
+    # (e5d7996, a lie of 27-47% on coarse tori) made 35 of its 7,557 vertices NaN (0.797): their H errors before,
+    # median 14% of H (10 within 10%), no worse than the vertices kept (median 20%): a cost of that check, decided
+    assert result.valid.mean() > 0.79
 
 
 def test_closed_mesh_skips_the_wider_ball_of_passed_fits(monkeypatch):
