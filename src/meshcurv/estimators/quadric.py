@@ -319,17 +319,17 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     for unit, members in parts:
         centres = np.flatnonzero(referenced) if np.ndim(unit) else members
         _fit_part((vertices, start, unit, centres), referenced, facing, sides, fields, away)
-    base = _vertex_radii(groups, n)
+    round_balls = np.zeros(n, dtype=bool)
     if radius is None:  # a grown ball that holds the other side: the group's own radius
+        base = _vertex_radii(groups, n)
         again = np.flatnonzero(referenced & (away > AWAY_FRACTION) & (radii > base) & np.isfinite(base) & (base > 0))
         if again.size:
             radii[again] = base[again]
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
-    round_balls = np.zeros(n, dtype=bool)
-    if radius is None and not stages.voxel_default:  # a default ball that reaches round the surface: made smaller
-        with np.errstate(invalid="ignore"):  # its own level: a group's median may be read off its curved parts
-            ball = (vertices, facing, start, radii, base, referenced, levels > NOISE_GATE)
-        round_balls = _round_balls(ball, topology.edges, sides, fields, away)
+        if not stages.voxel_default:  # a default ball that reaches round the surface: made smaller
+            with np.errstate(invalid="ignore"):  # its own level: a group's median may be read off its curved parts
+                ball = (vertices, facing, start, radii, base, referenced, levels > NOISE_GATE)
+            round_balls = _round_balls(ball, topology.edges, sides, fields, away)
     unsure = np.zeros(n, dtype=bool)
     steps = np.zeros(n, dtype=bool)
     # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate. A voxel surface's
@@ -372,7 +372,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     failed = ~valid & ~defects.invalid_vertices
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     noisy_balls = int((failed & unsure & ~(away > AWAY_FRACTION)).sum())
-    round_count = int((failed & round_balls & ~unsure & ~(away > AWAY_FRACTION)).sum())
+    reached = failed & round_balls & ~unsure & ~(away > AWAY_FRACTION)
+    round_count = int(reached.sum())
     few = int(failed.sum()) - two_sided - noisy_balls - round_count
     steps &= failed & ~(away > AWAY_FRACTION)  # on a staircase the unsure balls are its steps' (noisy_balls)
     shown = ", ".join(f"{r:g}" for r, _ in groups) if radius is not None else _shown_radii(radii, referenced)
@@ -419,7 +420,6 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         extra,
         radius=radii,
     )
-    reached = failed & round_balls & ~unsure & ~(away > AWAY_FRACTION)
     if steps.any() or reached.any():  # their reason: a limit of the method (a defect's code still comes first)
         codes = np.where(steps, STAIRCASE, np.where(reached, REACH, 0)).astype(np.int8)
         result = dataclasses.replace(result, invalid_reason=codes)
@@ -457,14 +457,14 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
     coefficients made NaN).
 
     ``ball = (vertices, normals, start, radii, base, referenced, rough)``: ``normals`` the vertex normals (NaN rows:
-    none), ``radii`` each vertex's default radius (changed in place where a ball is made smaller), ``base`` its group's (a
-    ball grown for the noise, :func:`meshcurv.radius.jet_vertex_radii`, is not checked: its radius is capped by the
+    none), ``radii`` each vertex's default radius (changed in place where a ball is made smaller), ``base`` its
+    group's (a ball grown for the noise, :func:`meshcurv.radius.jet_vertex_radii`, is not checked: its radius is capped by the
     curvature already), ``rough`` (V,) bool the vertices whose own noise level is above :data:`NOISE_GATE`;
     ``edges`` (E, 2); ``sides``, ``fields`` and ``away`` as :func:`_fit_part` takes them
     (changed in place). The default radius is :data:`meshcurv.radius.DEFAULT_RADIUS_FACTOR` mean edge lengths,
     which on a mesh of long and short edges (a torus of 30 x 30 quads, its ring's edges four times its tube's) reaches
     round a part curved along the short edges: the ball of ``torus(10, 3, 30, 30)`` (4.09 for a tube of radius 3)
-    turns the normals by 1.5 rad, and its fits read the largest curvature 27% low, valid (issue 29). A ball whose
+    turns the normals by 1.5 rad, and its fits read the largest curvature 27% high, valid (issue 29). A ball whose
     normals turn from its centre's by more than :data:`meshcurv.radius.BALL_TURN_CAP` with no edge in it turning by
     more than :data:`meshcurv.radius.CREASE_TURN` (:func:`meshcurv.radius._ball_turns`; a crease is the ball's
     reading at any radius) is made smaller, to where a circle through its rim would turn by :data:`ROUND_TURN`, and
@@ -515,7 +515,7 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
             same = _agreeing((six[rows], fitted[rows]), (default[1][at], default[2][at]))
             for field, kept in zip(kept_fields, default):
                 field[rows[same]] = kept[at[same]]
-            rows, bends = rows[~same], bends[~same]
+            rows = rows[~same]  # (their bends are read again at the next step)
         # the smaller ball's quadric, whose spread under the noise of its residuals is held to NOISE_REACH of its
         # curvature (as _scatter_check's step 2): a mesh of noise below the gate may hold no fit over fewer points
         lost = ~np.isfinite(coefficients[rows]).all(axis=1)
