@@ -50,7 +50,15 @@ from ._geometry import (
 from .orient import ORIENT_CHOICES, oriented_topology
 from .result import CurvatureResult, Surface
 from .topology import MeshTopology
-from .weld import CRACK_TOLERANCE_RATIO, OneSided, Welding, _closed_copies, drop_double_sided, weld_vertices
+from .weld import (
+    CRACK_TOLERANCE_RATIO,
+    OneSided,
+    Welding,
+    _closed_copies,
+    _tangled_vertices,
+    drop_double_sided,
+    weld_vertices,
+)
 
 __all__ = ["PreparedMesh", "prepare_mesh"]
 
@@ -112,6 +120,9 @@ class PreparedMesh:
     known_median : float or None
         The median length of every edge when the length scales were found with it (None: found on first use,
         :attr:`median_edge_length`).
+    unwelded : bool
+        Not welded (``weld=False``, or taken as given): its coincident boundary vertices are looked at for tangles
+        (:func:`meshcurv.weld.tangled_vertices`); a welded mesh has none left.
     """
 
     vertices: np.ndarray
@@ -127,13 +138,22 @@ class PreparedMesh:
     n_copies: int = 0
     n_cracked: int = 0
     known_median: float | None = None
+    unwelded: bool = False
 
     @classmethod
     def as_given(cls, vertices: np.ndarray, topology: MeshTopology) -> PreparedMesh:
         """A mesh already checked, taken as it is: not welded, reordered or oriented."""
         scales, needles, median = _scales_and_needles(vertices, topology)
         return cls(
-            vertices, topology, None, Surface(vertices, topology.faces), "keep", scales, needles, known_median=median
+            vertices,
+            topology,
+            None,
+            Surface(vertices, topology.faces),
+            "keep",
+            scales,
+            needles,
+            known_median=median,
+            unwelded=True,
         )
 
     @cached_property
@@ -253,7 +273,8 @@ class PreparedMesh:
 
     @cached_property
     def _codes(self) -> tuple[np.ndarray, dict]:
-        codes = _defect_codes(self.topology, self.degenerate, self.needles)
+        tangled = _tangled_vertices(self.vertices, self.topology, self.length_scales) if self.unwelded else None
+        codes = _defect_codes(self.topology, self.degenerate, self.needles, tangled)
         self.topology._release_side_twins()  # the bow-tie vertices are found: no estimator reads the twins
         return codes
 
@@ -530,6 +551,7 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         n_copies,
         welded.n_cracked if welded is not None else 0,
         median,
+        not weld,
     )
 
 

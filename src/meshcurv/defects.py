@@ -38,6 +38,7 @@ __all__ = [
     "UNDEFINED",
     "BOUNDARY",
     "FRAGMENT",
+    "TANGLE",
     "VertexDefects",
     "NEEDLE",
     "NEEDLE_ANGLE",
@@ -92,6 +93,14 @@ DEFECTS = (
         "edges between inconsistently oriented faces",
     ),
     Defect(
+        15,
+        "tangled_vertices",
+        "coincident with other vertices of its part, not welded, whose faces overlap there (the copies joined "
+        "would be on a non-manifold edge or fans meeting at a point: a tangle, no sheet)",
+        "vertices coincident with others of their part, not welded (weld=False), in a tangle of overlapping faces "
+        "(joined, they would be on non-manifold edges or fans meeting at a point: no sheet to measure)",
+    ),
+    Defect(
         7,
         "needle_vertices",
         "needle vertex, or a corner of its faces: slivers reaching far beyond the neighbourhood (a vertex flung away)",
@@ -124,6 +133,10 @@ NEEDLE = 7
 #: methods that walk the surface, not for the fits over Euclidean neighbours.
 FRAGMENT = 12
 
+#: The code of a vertex in a tangle of unwelded copies of its part (:func:`meshcurv.weld.tangled_vertices`): a
+#: defect found after the methods' limits, hence after their codes (the codes given before keep their meaning).
+TANGLE = 15
+
 #: Why a point of a point cloud (:func:`meshcurv.point_cloud_curvatures`) is invalid, beyond the
 #: defects of meshes: the codes after theirs (8, 9, 10, 11).
 POINT_CLOUD_REASONS = (
@@ -144,15 +157,19 @@ METHOD_REASONS = (
     "than about a radian across it, and no smaller ball holds a fit; refine the mesh)",
 )
 
+_BY_CODE = sorted(DEFECTS, key=lambda defect: defect.code)
+
 #: What ``CurvatureResult.invalid_reason`` codes mean: code ``c`` is ``INVALID_REASONS[c]``: the defects of
-#: meshes (1-7), the reasons of point clouds (8-11), the defects of meshes found since (12), the method's
-#: limits (13-14), then an estimate undefined (:data:`UNDEFINED`, the last).
+#: meshes (1-7), the reasons of point clouds (8-11), a defect of meshes found since (12), the method's
+#: limits (13-14), the defects of meshes found after those (15), then an estimate undefined
+#: (:data:`UNDEFINED`, the last). Each new code comes before that one: the others keep their meaning.
 INVALID_REASONS = (
     "valid",
-    *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code) if defect.code <= NEEDLE),
+    *(defect.reason for defect in _BY_CODE if defect.code <= NEEDLE),
     *POINT_CLOUD_REASONS,
-    *(defect.reason for defect in sorted(DEFECTS, key=lambda defect: defect.code) if defect.code > NEEDLE),
+    *(defect.reason for defect in _BY_CODE if NEEDLE < defect.code <= FRAGMENT),
     *METHOD_REASONS,
+    *(defect.reason for defect in _BY_CODE if defect.code > FRAGMENT),
     "estimate undefined (too few neighbours in the ball, a failed fit, or a non-finite value)",
 )
 
@@ -169,6 +186,7 @@ UNDEFINED = len(INVALID_REASONS) - 1
 _WARNING_ORDER = (
     "boundary_edges",
     "fragment_vertices",
+    "tangled_vertices",
     "nonmanifold_edges",
     "bowtie_vertices",
     "inconsistent_edges",
@@ -411,7 +429,11 @@ def _needle_corners(topology: MeshTopology, needles: np.ndarray) -> np.ndarray:
 
 
 def defect_codes(
-    topology: MeshTopology, degenerate: np.ndarray, needles: np.ndarray | None = None
+    topology: MeshTopology,
+    degenerate: np.ndarray,
+    needles: np.ndarray | None = None,
+    *,
+    tangled: np.ndarray | None = None,
 ) -> tuple[np.ndarray, dict[str, int]]:
     """(V,) int8 code of the first defect at each vertex (0: none), and the count of each defect.
 
@@ -424,6 +446,9 @@ def defect_codes(
     needles : ndarray of shape (V,), bool, optional
         The needle vertices (:func:`needle_vertices`); None: the defects of
         the connectivity and ``degenerate`` only.
+    tangled : ndarray of shape (V,), bool, optional
+        The vertices in tangles of unwelded copies
+        (:func:`meshcurv.weld.tangled_vertices`); None: none looked for.
 
     Returns
     -------
@@ -436,13 +461,17 @@ def defect_codes(
         A bow-tie vertex on a non-manifold edge is counted with that edge only.
     """
     degenerate = checked_mask(degenerate, _checked_topology(topology).n_faces, name="degenerate")
-    return _defect_codes(topology, degenerate, None if needles is None else _checked_needles(topology, needles))
+    if tangled is not None:
+        tangled = checked_mask(tangled, topology.n_vertices, name="tangled")
+    return _defect_codes(
+        topology, degenerate, None if needles is None else _checked_needles(topology, needles), tangled
+    )
 
 
 def _defect_codes(
-    topology: MeshTopology, degenerate: np.ndarray, needles: np.ndarray | None
+    topology: MeshTopology, degenerate: np.ndarray, needles: np.ndarray | None, tangled: np.ndarray | None = None
 ) -> tuple[np.ndarray, dict[str, int]]:
-    """:func:`defect_codes` of checked ``degenerate`` and ``needles`` (those of a prepared mesh)."""
+    """:func:`defect_codes` of checked ``degenerate``, ``needles`` and ``tangled`` (those of a prepared mesh)."""
     needle_corners = None
     if needles is not None and needles.any():  # the corners of a needle's faces: each has a sliver in its ring
         needle_corners = np.zeros(topology.n_vertices, dtype=bool)
@@ -460,6 +489,7 @@ def _defect_codes(
         "nonmanifold_edges": nonmanifold,
         "bowtie_vertices": bowties if bowties.any() else None,
         "inconsistent_edges": _edge_ends(topology, topology.inconsistent_edges),
+        "tangled_vertices": tangled if tangled is not None and tangled.any() else None,
         "degenerate_faces": corners,
         "needle_vertices": needle_corners,
         "fragment_vertices": fragments,
@@ -478,6 +508,7 @@ def _defect_codes(
         "needle_vertices": 0 if needles is None else int(needles.sum()),
         "unreferenced_vertices": int((~topology.referenced_vertices).sum()),
         "fragment_vertices": 0 if fragments is None else int(fragments.sum()),
+        "tangled_vertices": 0 if tangled is None else int(tangled.sum()),
     }
     return codes, counts
 
@@ -491,11 +522,17 @@ def _fragment_vertices(topology: MeshTopology) -> np.ndarray | None:
     were all detached by 0.05 edge lengths, beyond the weld across cracks, came out with H = 0 at every vertex
     of rusinkiewicz and normal_cycle_ball, valid, for 1). The fits over Euclidean neighbours (``quadric``) see
     the other parts and are not concerned (:meth:`VertexDefects` ``tolerated``).
+
+    A vertex off the boundary with two faces only is no interior vertex: its two faces are one face given twice
+    (the only two faces that close a ring: ``(v, a, b)`` and ``(v, b, a)``), a pillow of no area (issue 29: the
+    faces of a sphere's soup chained in threes by faces across two of them, one face in four given twice, kept
+    vertices of such parts valid with ``icc``, H = 0 for 1).
     """
     if not topology.boundary_edges.any():  # a closed mesh: every vertex interior (one pass over the edges)
         return None
     n_components, labels = topology.vertex_components
-    interior = topology.referenced_vertices & ~topology.boundary_vertices
+    rings = np.bincount(topology.faces.ravel(), minlength=topology.n_vertices) > 2
+    interior = topology.referenced_vertices & ~topology.boundary_vertices & rings
     has_interior = np.zeros(n_components, dtype=bool)
     has_interior[labels[interior]] = True
     fragments = topology.referenced_vertices & ~has_interior[np.maximum(labels, 0)]

@@ -30,7 +30,8 @@ import numpy as np
 from ._backend import twin
 from ._geometry import vertex_length_scales
 from .defects import _needle_vertices
-from .errors import InvalidOptionError
+from .errors import InvalidMeshError, InvalidOptionError
+from .geometry import checked_topology_points
 from .orient import face_flips
 from .topology import MeshTopology
 
@@ -42,6 +43,7 @@ __all__ = [
     "OneSided",
     "drop_double_sided",
     "drop_closed_copies",
+    "tangled_vertices",
 ]
 
 #: Vertices closer than this times the median edge length are copies of one point (of their own part's edges
@@ -170,6 +172,109 @@ def weld_vertices(
         strict.n_welded + cracks.n_welded,
         cracks.n_welded,
     )
+
+
+def tangled_vertices(vertices: np.ndarray, topology: MeshTopology) -> np.ndarray:
+    """(V,) bool: the vertices in a tangle of copies of one part left unwelded (:data:`meshcurv.defects.TANGLE`).
+
+    The copies the weld would join (:func:`weld_vertices`: coincident boundary
+    vertices, and the ends of cracks) are joined within each connected part:
+    where the joined faces make a sheet, the copies were a seam split open (a
+    texture seam of a file read unwelded), and each copy has half a
+    neighbourhood, measured as a boundary vertex. Where the joined vertex, or
+    a corner of a face of a copy, is on a non-manifold edge or a bow-tie (more
+    than one fan of faces), the faces of the copies overlap there: no sheet,
+    and a curvature measured over them is undefined. The methods over balls
+    read every face the ball holds, from any copy: issue 29, fuzz 557/23, a
+    thin plate given as a triangle soup whose faces were chained into one part
+    by polygons of corners of two faces (6 copies at each point),
+    ``weld=False``: ``icc`` kept 839 boundary vertices valid, a third of them
+    more than 50% off in H, and its two backends' numbers apart. Copies in
+    different parts (a closed surface stored twice, the faces of a soup each
+    alone) are left alone: each part is measured on its own.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (V, 3), float64
+    topology : MeshTopology
+        Their faces' connectivity (a welded mesh has no copies left to join).
+
+    Returns
+    -------
+    ndarray of shape (V,), bool
+        The copies and the corners of their faces whose joined vertex is on a
+        non-manifold edge or a bow-tie vertex (those already such before the
+        join included: their own defect comes first,
+        :data:`meshcurv.defects.DEFECTS`).
+
+    Raises
+    ------
+    InvalidMeshError
+        ``topology`` not a MeshTopology, ``vertices`` unusable or not one row
+        per vertex of ``topology``.
+
+    Examples
+    --------
+    A sphere's triangle soup whose faces are chained into one part by faces across two of them:
+
+    >>> from meshcurv import shapes, MeshTopology
+    >>> sphere = shapes.icosphere(3)
+    >>> soup = sphere.vertices[sphere.faces.ravel()]
+    >>> faces = np.arange(soup.shape[0]).reshape(-1, 3)
+    >>> chained = np.concatenate([faces, np.column_stack([faces[:-1, 0], faces[:-1, 2], faces[1:, 0]])])
+    >>> int(tangled_vertices(soup, MeshTopology.from_faces(chained, soup.shape[0])).sum())
+    540
+    >>> int(tangled_vertices(soup, MeshTopology.from_faces(faces, soup.shape[0])).sum())  # faces apart
+    0
+    """
+    if not isinstance(topology, MeshTopology):
+        raise InvalidMeshError(f"`topology` must be a MeshTopology; got {type(topology).__name__}")
+    vertices = checked_topology_points(vertices, topology)
+    tangled = _tangled_vertices(vertices, topology, vertex_length_scales(vertices, topology))
+    return np.zeros(topology.n_vertices, dtype=bool) if tangled is None else tangled
+
+
+def _tangled_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.ndarray) -> np.ndarray | None:
+    """:func:`tangled_vertices` of a checked mesh whose vertices have the length scales ``scales``, None where there
+    is none: a closed mesh (no pass at all), or no boundary vertex as near another as the weld joins (one query of
+    their nearest neighbours, not the weld: its median edges cost 0.1 s of CPU at 200,000 vertices)."""
+    if not topology.boundary_edges.any():
+        return None
+    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
+
+    candidates = np.flatnonzero(topology.boundary_vertices)
+    points = vertices[candidates]
+    ends = topology.edges[topology.boundary_edges]
+    longest = float(np.linalg.norm(vertices[ends[:, 0]] - vertices[ends[:, 1]], axis=1).max())
+    reach = max(CRACK_TOLERANCE_RATIO * longest, WELD_TOLERANCE_RATIO * float(scales[candidates].max()))
+    if candidates.size < 2 or not (cKDTree(points).query(points, k=2)[0][:, 1] <= reach).any():
+        return None
+    welding = weld_vertices(vertices, topology)
+    if not welding.n_welded:
+        return None
+    n = topology.n_vertices
+    _, parts = topology.vertex_components
+    # the weld's groups split by part, each standing on its first (lowest-index) member
+    _, group, sizes = np.unique(
+        np.column_stack([welding.index, parts]), axis=0, return_inverse=True, return_counts=True
+    )
+    group = group.reshape(-1)
+    first = np.full(sizes.size, n, dtype=np.int64)
+    np.minimum.at(first, group, np.arange(n))
+    copies = (sizes[group] > 1) & topology.referenced_vertices
+    if not copies.any():  # no copies in one part (the faces of a soup each alone)
+        return None
+    representative = first[group]
+    # the faces at the copies and at the corners of their faces: every face at such a vertex holds it, so the
+    # joined edges and fans there are those of the whole mesh joined
+    faces = topology.faces
+    near = np.zeros(n, dtype=bool)
+    near[faces[copies[faces].any(axis=1)].ravel()] = True
+    around = representative[faces[near[faces].any(axis=1)]]
+    joined = MeshTopology._build(np.ascontiguousarray(around), n)
+    broken = joined.edge_vertices(joined.nonmanifold_edges) | joined.bowtie_vertices
+    tangled = near & broken[representative]
+    return tangled if tangled.any() else None
 
 
 def _weld_coincident(vertices: np.ndarray, topology: MeshTopology, tolerance_ratio: float) -> Welding:
