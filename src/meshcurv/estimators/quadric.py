@@ -40,8 +40,9 @@ Reach. The default radius is 2.5 mean edge lengths, which on a mesh of long and 
 curved along the short ones (``torus(10, 3, 30, 30)``: a ball of 4.09 for a tube of radius 3, every vertex valid and
 ``k_max`` 27% off; issue 29). A default ball whose normals (the fits') turn from its centre's by more than
 :data:`meshcurv.radius.BALL_TURN_CAP` with no crease in it (no edge turning the vertex normals by more than
-:data:`meshcurv.radius.CREASE_TURN`) is made smaller and fitted again; the default fit stays where the smaller ball
-reproduces it, and a vertex with no smaller fit is NaN with ``valid=False`` (:func:`_round_balls`).
+:data:`meshcurv.radius.CREASE_TURN`) is made smaller and fitted again, by a fit whose points are spread by
+:data:`ROUND_MIN_SPREAD` (a quadric, mostly); the default fit stays where the smaller ball reproduces it, and a vertex
+with no smaller fit is NaN with ``valid=False`` (:func:`_round_balls`).
 
 Noise. A jet of degree 4 amplifies noise far more than a quadric: at 2.5 edge lengths, noise of a tenth of an
 edge along the normal gave median H errors of 56-108% of the curvature on the noisy spheres of
@@ -100,7 +101,17 @@ import dataclasses
 import numpy as np
 
 from .._tensors import principal_from_shape_operator
-from ..jets import AWAY_FRACTION, DEGREE, MIN_POINTS, PIVOT_FLOOR, _exponents, _fit_chunk, _fit_jets, shape_operators
+from ..jets import (
+    AWAY_FRACTION,
+    DEGREE,
+    MIN_POINTS,
+    MIN_SPREAD,
+    PIVOT_FLOOR,
+    _exponents,
+    _fit_chunk,
+    _fit_jets,
+    shape_operators,
+)
 from ..neighborhoods import _ball_pairs
 from .._tensors import tangent_basis
 from ..radius import (
@@ -319,7 +330,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     for unit, members in parts:
         centres = np.flatnonzero(referenced) if np.ndim(unit) else members
         _fit_part((vertices, start, unit, centres), referenced, facing, sides, fields, away)
-    round_balls = np.zeros(n, dtype=bool)
+    round_balls = rough_round = np.zeros(n, dtype=bool)
     if radius is None:  # a grown ball that holds the other side: the group's own radius
         base = _vertex_radii(groups, n)
         again = np.flatnonzero(referenced & (away > AWAY_FRACTION) & (radii > base) & np.isfinite(base) & (base > 0))
@@ -329,7 +340,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         if not stages.voxel_default:  # a default ball that reaches round the surface: made smaller
             with np.errstate(invalid="ignore"):  # its own level: a group's median may be read off its curved parts
                 ball = (vertices, facing, start, radii, base, referenced, levels > NOISE_GATE)
-            round_balls = _round_balls(ball, topology.edges, sides, fields, away)
+            round_balls, rough_round = _round_balls(ball, topology.edges, sides, fields, away)
     unsure = np.zeros(n, dtype=bool)
     steps = np.zeros(n, dtype=bool)
     # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate. A voxel surface's
@@ -373,8 +384,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     noisy_balls = int((failed & unsure & ~(away > AWAY_FRACTION)).sum())
     reached = failed & round_balls & ~unsure & ~(away > AWAY_FRACTION)
-    round_count = int(reached.sum())
-    few = int(failed.sum()) - two_sided - noisy_balls - round_count
+    rough_count = int((reached & rough_round).sum())  # a noisy ball reaching round: no smaller one tried
+    round_count = int(reached.sum()) - rough_count
+    few = int(failed.sum()) - two_sided - noisy_balls - round_count - rough_count
     steps &= failed & ~(away > AWAY_FRACTION)  # on a staircase the unsure balls are its steps' (noisy_balls)
     shown = ", ".join(f"{r:g}" for r, _ in groups) if radius is not None else _shown_radii(radii, referenced)
     extra = (
@@ -398,6 +410,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             "method (refine it)"
         )
         if round_count
+        else "",
+        (
+            f"{rough_count} vertices have a default ball that reaches round the surface (its normals turn by more "
+            f"than {BALL_TURN_CAP:g} rad) on a noisy surface (their noise level above {NOISE_GATE:g} edge lengths): "
+            "a smaller ball would fit the noise; smooth the mesh, or pass a `radius`"
+        )
+        if rough_count
         else "",
     )
     normals_out = np.where(valid[:, None], fitted, normals)
@@ -434,27 +453,39 @@ ROUND_CANDIDATE = 0.5
 
 #: A ball that reaches round the surface is made smaller and refitted at most this many times
 #: (:func:`_round_balls`): each time to where the normals of a circle through its rim would turn by
-#: :data:`meshcurv.radius.BALL_TURN_CAP`, at most :data:`ROUND_SHRINK` of its radius.
+#: :data:`ROUND_TURN`, at most :data:`ROUND_SHRINK` of its radius.
 ROUND_STEPS = 3
 
 #: ... the margin of each step (:func:`_round_balls`).
 ROUND_SHRINK = 0.95
 
 #: A ball that reaches round the surface is made smaller to where the normals of a circle through its rim would turn
-#: by this (radians; :func:`_round_balls`): well within :data:`meshcurv.radius.BALL_TURN_CAP`, where a fit of degree
-#: 4 reads a circle's curvature within 3-6%; a smaller ball holds fewer points, whose fit falls to a quadric (biased
-#: as ``(r k)^2``) where the points along one direction are too few for the higher terms.
-ROUND_TURN = 1.0
+#: by this (radians; :func:`_round_balls`; a ball of ``0.83 / k`` with :data:`ROUND_SHRINK`), well within
+#: :data:`meshcurv.radius.BALL_TURN_CAP`. A smaller ball holds fewer points, whose fit is a quadric
+#: (:data:`ROUND_MIN_SPREAD`), biased as ``(r k)^2``: at 1.0 rad (``r k`` 0.91) it read the tube of
+#: ``torus(10, 3, 30, 30)`` 10-13% high, and up to 19% on the jittered ones; at 0.9 rad 8-9% (up to 14%; jitter of a
+#: fifth of an edge up to 19%). 0.85 lost a tenth of the jittered torus' valid vertices more (536 -> 483).
+ROUND_TURN = 0.9
 
 #: A default fit whose principal curvatures a smaller ball's fit (:func:`_round_balls`, its first step) reproduces
 #: within this share of its largest ``|k|`` is kept: its ball turns past the cap where the curvature is high at one
 #: side only (the tips of ``ellipsoid((3, 2, 1), 8)``, whose smaller balls, of fewer points, read H 1.9 -> 3.1% off).
 ROUND_AGREEMENT = 0.1
 
+#: The fits over a smaller ball (:func:`_round_balls`) are solved at the highest degree whose points are spread by this
+#: (:data:`meshcurv.jets.MIN_SPREAD`; below it for every degree the vertex is NaN with ``valid=False``): a fifth of
+#: the quadric's spread over the default balls of clean meshes (4.6e-3 to 6.8e-3 on icospheres, tori and ellipsoids,
+#: jittered or not; degree 3 holds 5e-4 to 9e-4 there, degree 4 1e-4), so that the smaller balls take quadrics over
+#: points spread in both directions. With the spread of the default fits (1e-7, and 1e-5 for the steadier fit) a
+#: smaller ball of ``torus(10, 3, 30, 30, jitter=0.1)``, its neighbours along the ring near its rim, kept a fit of
+#: degree 3 over points hardly spread across the tube (1e-5 to 1e-4): 71 of 874 valid vertices more than 15% of the
+#: largest ``|k|`` off, up to 53% (issue 29); 5e-4 kept a few at 15%.
+ROUND_MIN_SPREAD = 1e-3
 
-def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, away: np.ndarray) -> np.ndarray:
-    """(V,) bool: the vertices whose default ball reaches round the surface and no smaller ball holds a fit (their
-    coefficients made NaN).
+
+def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, away: np.ndarray) -> tuple:
+    """``(reached, rough)``, (V,) bool each: the vertices whose default ball reaches round the surface and no smaller
+    ball holds a fit (their coefficients made NaN), and those of them whose ball is noisy (no smaller ball tried).
 
     ``ball = (vertices, normals, start, radii, base, referenced, rough)``: ``normals`` the vertex normals (NaN rows:
     none), ``radii`` each vertex's default radius (changed in place where a ball is made smaller), ``base`` its
@@ -468,7 +499,8 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
     normals turn from its centre's by more than :data:`meshcurv.radius.BALL_TURN_CAP` with no edge in it turning by
     more than :data:`meshcurv.radius.CREASE_TURN` (:func:`meshcurv.radius._ball_turns`; a crease is the ball's
     reading at any radius) is made smaller, to where a circle through its rim would turn by :data:`ROUND_TURN`, and
-    fitted again (:data:`ROUND_STEPS` times at most); where the first smaller ball reproduces the default fit
+    fitted again (:data:`ROUND_STEPS` times at most) at the degrees its points are spread for (:data:`ROUND_MIN_SPREAD`:
+    a quadric, mostly); where the first smaller ball reproduces the default fit
     (:data:`ROUND_AGREEMENT`) the default stays. A vertex whose smaller ball holds no fit, or one whose quadric's
     spread under the noise of its residuals exceeds :data:`NOISE_REACH` of its curvature, or that still turns past
     the cap, is NaN with ``valid=False``; so is a noisy one (its own level above :data:`NOISE_GATE`: it needs a wider
@@ -477,18 +509,19 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
     vertices, normals, start, radii, base, referenced, rough = ball
     six, fitted, coefficients = fields
     out = np.zeros(vertices.shape[0], dtype=bool)
+    noisy_out = np.zeros(vertices.shape[0], dtype=bool)
     # the shape operators' Frobenius norm sqrt(k_min^2 + k_max^2) first (no eigenvalues at every vertex of a mesh)
     norms = np.sqrt(np.einsum("ij,ij->i", six[:, :3], six[:, :3]) + 2.0 * np.einsum("ij,ij->i", six[:, 3:], six[:, 3:]))
     with np.errstate(invalid="ignore"):
         bent = radii * norms > ROUND_CANDIDATE
     rows = np.flatnonzero(referenced & np.isfinite(coefficients).all(axis=1) & (radii <= base) & bent)
     if rows.size == 0:
-        return out
+        return out, noisy_out
     k_min, k_max = principal_from_shape_operator(six[rows], fitted[rows])[:2]
     with np.errstate(invalid="ignore"):
         rows = rows[radii[rows] * np.maximum(np.abs(k_min), np.abs(k_max)) > ROUND_CANDIDATE]
     if rows.size == 0:
-        return out
+        return out, noisy_out
     pool = np.flatnonzero(referenced)
     creases = _edge_turns(normals, edges, vertices.shape[0])  # the mesh's own normals: a crease is sharp there
     # the turns read on the fits' normals, which average the noise of the vertex normals (noise of 0.1 edge lengths
@@ -503,13 +536,13 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
         over = (turns > BALL_TURN_CAP) & ~(sharpest > CREASE_TURN)
         rows, bends = rows[over], bends[over]
         noisy = rough[rows]  # a noisy ball needs a wider one, not a smaller one
-        out[rows[noisy]] = True
+        out[rows[noisy]] = noisy_out[rows[noisy]] = True
         rows, bends = rows[~noisy], bends[~noisy]
         if rows.size == 0 or step == ROUND_STEPS:
             break
         with np.errstate(divide="ignore"):
             radii[rows] = np.fmin(ROUND_SHRINK * radii[rows], ROUND_SHRINK * reach / bends)
-        _fit_part((vertices, start, radii, rows), referenced, normals, sides, fields, away)
+        _fit_part((vertices, start, radii, rows), referenced, normals, sides, fields, away, min_spread=ROUND_MIN_SPREAD)
         if step == 0:  # a default fit that a smaller ball reproduces is the surface's, not its reach's: kept
             at = np.searchsorted(checked, rows)
             same = _agreeing((six[rows], fitted[rows]), (default[1][at], default[2][at]))
@@ -528,7 +561,7 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
         rows = rows[~lost]
     out[rows] = True
     coefficients[out] = np.nan
-    return out
+    return out, noisy_out
 
 
 def _agreeing(smaller: tuple, wider: tuple) -> np.ndarray:
@@ -580,11 +613,15 @@ def _group_medians(values: np.ndarray, groups: list, usable: np.ndarray) -> np.n
     return medians
 
 
-def _fit_part(part: tuple, referenced, facing, sides: tuple, fields: tuple, away: np.ndarray) -> None:
+def _fit_part(
+    part: tuple, referenced, facing, sides: tuple, fields: tuple, away: np.ndarray, *, min_spread: float = MIN_SPREAD
+) -> None:
     """The jets of ``part = (vertices, start, unit, centres)`` (``unit``: one radius, or (V,) one per vertex;
     ``centres`` None: every vertex) fitted into ``fields = (six, fitted, coefficients)`` and ``away`` (changed in
     place), each made stable (:func:`_steady_fits`): against a quadric at the vertices of ``sides = (rim,
-    noisy)``, else against the highest degree spread by :data:`STEADY_MIN_SPREAD`."""
+    noisy)``, else against the highest degree spread by :data:`STEADY_MIN_SPREAD`; every degree solved where its
+    points are spread by ``min_spread`` (:data:`meshcurv.jets.MIN_SPREAD`; the steadier fits by
+    :data:`STEADY_MIN_SPREAD` at least)."""
     vertices, start, unit, centres = part
     six, fitted, coefficients = fields
     per_vertex = np.ndim(unit) > 0
@@ -597,6 +634,7 @@ def _fit_part(part: tuple, referenced, facing, sides: tuple, fields: tuple, away
         neighbours=referenced,
         facing=facing,
         details=details,
+        min_spread=min_spread,
     )
     part_six, part_fitted = shape_operators(found, frame, unit)
     rows = slice(None) if centres is None else centres
@@ -607,7 +645,7 @@ def _fit_part(part: tuple, referenced, facing, sides: tuple, fields: tuple, away
         rows_fitted = np.flatnonzero(side) if centres is None else centres[side[centres]]
         if rows_fitted.size:
             steady = (vertices, start, unit[rows_fitted] if per_vertex else unit, rows_fitted, steady_degree)
-            _steady_fits(steady, referenced, facing, fields)
+            _steady_fits(steady, referenced, facing, fields, min_spread=max(min_spread, STEADY_MIN_SPREAD))
 
 
 def _shown_radii(radii: np.ndarray, referenced: np.ndarray) -> str:
@@ -618,12 +656,12 @@ def _shown_radii(radii: np.ndarray, referenced: np.ndarray) -> str:
     return f"{used.min():g} to {used.max():g}"
 
 
-def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
+def _steady_fits(steady: tuple, referenced, facing, fields: tuple, *, min_spread: float = STEADY_MIN_SPREAD) -> None:
     """The fits in ``fields`` (``six, fitted, coefficients``, changed in place) made stable at the vertices
     ``rows`` of ``steady = (vertices, start, unit, rows, degree)`` (``unit``: one radius, or one per row): the fit of at most ``degree`` over the
     same ball whose points are spread by :data:`STEADY_MIN_SPREAD` (:data:`STEADY_DEGREE` at the rim,
     :data:`meshcurv.jets.DEGREE` inside) where the jet differs from it by more than :data:`STEADY_AGREEMENT`
-    over the radius ``unit``; NaN where no degree is spread enough."""
+    over the radius ``unit``; NaN where no degree is spread enough (``min_spread``)."""
     vertices, start, unit, rows, degree = steady
     six, fitted, coefficients = fields
     found, frame, _ = _fit_jets(
@@ -634,7 +672,7 @@ def _steady_fits(steady: tuple, referenced, facing, fields: tuple) -> None:
         centres=rows,
         neighbours=referenced,
         facing=facing,
-        min_spread=STEADY_MIN_SPREAD,
+        min_spread=min_spread,
     )
     low_six, low_fitted = shape_operators(found[rows], tuple(axis[rows] for axis in frame), unit)
     spread = np.isfinite(found[rows]).all(axis=1)
