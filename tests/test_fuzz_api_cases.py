@@ -575,3 +575,28 @@ def test_jets_at_the_rim_of_a_noisy_open_cylinder_keep_the_sign_of_h():
     error = np.abs(result.mean - side * 0.5)
     assert result.valid.sum() > 0.8 * n
     assert (error[result.valid] <= 0.5).all()
+
+
+# --- coincident unwelded copies tangled into one part: valid numbers, the backends apart (seed 557, 23) ---
+
+
+@pytest.mark.parametrize("method", ["icc", "normal_cycle_ball"])
+@pytest.mark.parametrize("backend", ["auto", "numpy"])
+def test_unwelded_copies_tangled_into_one_part_are_not_valid(monkeypatch, method, backend):
+    # a thin plate as a triangle soup, a quarter of its faces given twice, as quads of one face's corners and
+    # the next face's first (fan-triangulated: a face across the two chains the soup into one part), weld=False:
+    # six copies at each point, their faces overlapping; icc kept 839 vertices valid, H median 0.012 (NumPy)
+    # and 0.031 (numba) for the plate's 1.27
+    monkeypatch.setenv("MESHCURV_BACKEND", backend)
+    plate = shapes.ellipsoid((1.0, 0.6, 0.03), subdivisions=8)
+    soup = plate.vertices[plate.faces.ravel()]
+    faces = np.arange(len(soup)).reshape(-1, 3)
+    faces = np.concatenate([faces, faces[::4]])
+    quads = np.concatenate([faces[:-1], faces[1:, :1]], axis=1)
+    context = _only_documented_warnings()
+    try:
+        result = meshcurv.principal_curvatures(soup, quads, method=method, weld=False)
+    finally:
+        context.__exit__(None, None, None)
+    assert not result.valid.any()
+    assert (result.invalid_reason == meshcurv.defects.TANGLE).sum() > len(soup) // 2

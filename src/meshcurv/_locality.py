@@ -136,11 +136,12 @@ def morton_reordering(
 
 
 def local_topology(
-    vertices: np.ndarray, faces: np.ndarray | MeshTopology
+    vertices: np.ndarray, faces: np.ndarray | MeshTopology, *, scattered: bool | None = None
 ) -> tuple[np.ndarray, MeshTopology, Reordering | None]:
     """``(vertices, topology, reordering)``: the topology of the checked (F, 3) triangles ``faces`` (or the
     given :class:`MeshTopology`, its vertex count checked), in a local order (:func:`reordering`) when the
-    mesh is scattered (:func:`is_scattered`).
+    mesh is scattered (:func:`is_scattered`; ``scattered``: its answer when the caller found it, None: found
+    here).
 
     ``reordering`` is None, and ``vertices`` the caller's, for a mesh in a local order; otherwise
     ``vertices`` and the topology are those of the new order (a given :class:`MeshTopology` is
@@ -153,7 +154,9 @@ def local_topology(
     else:
         topology = None
         triangles = faces
-    local = reordering(vertices, triangles) if is_scattered(n, triangles) else None
+    if scattered is None:
+        scattered = is_scattered(n, triangles)
+    local = reordering(vertices, triangles) if scattered else None
     if local is None:  # a local order (or a bounding box wider than the float range): as given
         return vertices, topology if topology is not None else MeshTopology._build(triangles, n), None
     logger.info(
