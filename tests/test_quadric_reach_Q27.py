@@ -9,8 +9,8 @@ valid with ``k_max`` 27-30% off (H 13.5% of the largest ``|k|``); ``torus(10, 3,
 no crease in it is now made smaller and fitted again, or NaN with a reason where no smaller ball holds a fit.
 
 Oracle: the exact curvatures of the torus (``meshcurv.shapes``). The bounds: a valid ``k_max`` within 15% of the
-largest exact ``|k|`` (the quadric's bias over the smaller balls, whose fits fall to degree 2 along the long edges:
-11-12% measured) and H within 8%; the vertices not valid carry a reason, and the warning names the class. A well-sampled
+largest exact ``|k|`` (the quadric's bias over the smaller balls, whose fits are quadrics: 9-10% measured) and H
+within 8%; the vertices not valid carry a reason, and the warning names the class. A well-sampled
 torus (``benchmarks/accuracy.py``'s coarse one, whose ball turns by 1.15 rad) keeps every vertex, within 2%.
 """
 
@@ -52,7 +52,10 @@ def test_a_ball_wider_than_the_tube_is_made_smaller(backend, counts):
     torus = shapes.torus(10.0, 3.0, *counts)
     result, message = _quadric(torus, backend)
     k_max, k_min, mean = _errors(result, torus)
-    assert result.valid.mean() > 0.4  # 83% and 48%: the balls made smaller hold fits
+    # 50% and 27% (83% and 48% before the smaller balls took quadrics over points spread across the tube and turning by
+    # 0.9 rad, not 1.0: the balls whose ring neighbours sit near their rim lost, right on this regular mesh by its
+    # symmetry only, up to 31-49% off once jittered; tests/test_quadric_coarse_Q28.py)
+    assert result.valid.mean() > 0.25
     assert k_max.max() < 0.15 and k_min.max() < 0.15, (k_max.max(), k_min.max())  # before: up to 30% and 42%
     assert mean.max() < 0.08, mean.max()  # before: up to 15% and 22%
     assert (np.asarray(result.radius)[result.valid] < 3.0).all()  # within the tube's radius (before: 4.09, 4.61)
@@ -73,14 +76,10 @@ def test_no_valid_vertex_of_a_coarse_tube_is_far_off(backend):
     assert "reaches round the surface" in message
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="open (issue 29, stop 61 review): on a jittered coarse torus 64-71 of ~875 valid vertices stay more than "
-    "15% of the largest |k| off (up to 53%; 197 before e5d7996); quadric.ROUND_AGREEMENT (0.1, 0.05, 0.03) does not "
-    "move them: the mechanism is not traced",
-)
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_a_jittered_coarse_torus_is_not_far_off(backend):
+    # 71 of 874 valid vertices more than 15% off (up to 53%) before the smaller balls took fits over points spread
+    # by quadric.ROUND_MIN_SPREAD (degree 3 over points hardly spread across the tube; tests/test_quadric_coarse_Q28.py)
     torus = shapes.torus(10.0, 3.0, 30, 30, jitter=0.1, seed=1)
     result, _ = _quadric(torus, backend)
     k_max, k_min, _ = _errors(result, torus)

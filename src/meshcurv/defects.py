@@ -154,7 +154,8 @@ METHOD_REASONS = (
     "voxel staircase: this method reads the voxels' steps as curvature (not an estimate; "
     "method='icc' scales its balls to the voxels)",
     "ball reaches round the surface: the mesh is too coarse there for this method's ball (its normals turn by more "
-    "than about a radian across it, and no smaller ball holds a fit; refine the mesh)",
+    "than about a radian across it, and no smaller ball holds a fit; refine the mesh), or too noisy for a smaller "
+    "ball (smooth it)",
 )
 
 _BY_CODE = sorted(DEFECTS, key=lambda defect: defect.code)

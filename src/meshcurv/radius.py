@@ -998,7 +998,7 @@ def _ball_turns(
     unit = radii[centres]
     for _, i, j in _ball_pairs(vertices[pool], vertices[centres], unit):
         ids, own = pool[j], centres[i]
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", divide="ignore"):  # a coincident copy (weld=False): apart 0, not outer
             angles = np.arccos(np.clip(np.einsum("ij,ij->i", normals[ids], normals[own]), -1.0, 1.0))
             apart = np.linalg.norm(vertices[ids] - vertices[own], axis=1)
             chords = np.linalg.norm(normals[ids] - normals[own], axis=1) / apart
