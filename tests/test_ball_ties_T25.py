@@ -121,24 +121,42 @@ def _lattice_patch():
 
 
 def _balls(points, normals, centres, radius, k, backend):
-    """The estimate's balls of :func:`~meshcurv._pointcloud_estimators.corrected_measures` on ``backend``."""
+    """The estimate's balls of :func:`~meshcurv._pointcloud_estimators.corrected_measures` on ``backend`` (its
+    balls' search, the ties cut whole and ordered, no point facing away here: the normals of a gentle patch)."""
     from scipy.spatial import cKDTree
 
-    from meshcurv._pointcloud_estimators import _ball_indices, _usable_tree, _whole_ties
+    from meshcurv._pointcloud_estimators import (
+        FACING_MARGIN,
+        MIN_BALL_POINTS,
+        SQUARED_TIE,
+        _measured_balls,
+        _usable_tree,
+    )
 
     n = points.shape[0]
     if backend == "numpy":
         search = _usable_tree(cKDTree(points), points, np.ones(n, dtype=bool))
-        index, counts = _ball_indices(search, points, centres, radius, k + 1)
-        return _whole_ties(points, normals, centres, index, counts, radius, k)
+        return _measured_balls(search, points, normals, centres, radius, k, radius, 0)[:2]
     from meshcurv._backend import numba_kernels
-    from meshcurv._pointcloud_estimators import MIN_BALL_POINTS, SQUARED_TIE
 
     grid = numba_kernels("neighborhoods").pool_grid(points, np.arange(n), float(radius))
-    index, squared, counts = numba_kernels("pointcloud").ball_indices(points, centres, float(radius), k + 1, *grid, 8)
-    return numba_kernels("pointcloud").whole_ties(
-        points, normals, centres, index, squared, counts, float(radius), k, SQUARED_TIE, MIN_BALL_POINTS
+    none = np.zeros(0, dtype=np.int64)
+    found = numba_kernels("pointcloud").measured_balls(
+        points,
+        normals,
+        centres,
+        float(radius),
+        k,
+        float(radius),
+        0,
+        *grid,
+        none,
+        SQUARED_TIE,
+        MIN_BALL_POINTS,
+        FACING_MARGIN,
+        8,
     )
+    return found[:2]
 
 
 @pytest.mark.parametrize("backend", ["numba", "numpy"])

@@ -186,6 +186,36 @@ def knn_indices(points: np.ndarray, k: int = 10) -> np.ndarray:
     return knn(cKDTree(points), points, k)[1]
 
 
+def searched_balls(points, centres, radius, k, usable=None, wide=0.0, k_wide=0):
+    """The rows of the compiled search of the measures' balls alone: ``(index, counts, wide_index, wide_counts)`` of
+    :func:`meshcurv._kernels.pointcloud.measured_balls` with no normals (every tie key and ``n_j . n_c`` 0: nothing
+    faces away, tied points stay in index order), no tie tolerance and no least count (``least`` above any count:
+    a full row keeps its first ``k``). Each row: the ``k`` nearest ``usable`` points strictly closer than the radius
+    in the order of ``(squared distance, index)``, padded with N (what the k-d tree's
+    :func:`meshcurv._pointcloud_estimators._ball_indices` gives); the smaller balls the prefixes of the wide ones'
+    search (``k_wide`` > 0)."""
+    from meshcurv._pointcloud_estimators import FACING_MARGIN
+
+    n = points.shape[0]
+    usable = np.ones(n, dtype=bool) if usable is None else usable
+    grid = kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(wide if k_wide else radius))
+    return kernels("pointcloud").measured_balls(
+        np.ascontiguousarray(points),
+        np.zeros((n, 3)),
+        np.ascontiguousarray(centres, dtype=np.int64),
+        float(radius),
+        k,
+        float(wide),
+        k_wide,
+        *grid,
+        np.zeros(0, dtype=np.int64),
+        0.0,
+        n + 2,
+        FACING_MARGIN,
+        64 * kernel_threads(),
+    )
+
+
 # -- comparison helpers -------------------------------------------------------------------------
 
 
@@ -1541,110 +1571,6 @@ def check_pca_normals(name):
         )
 
 
-def check_ball_indices(name):
-    from scipy.spatial import cKDTree
-
-    from meshcurv._pointcloud_estimators import _ball_indices, _usable_tree
-
-    points, _ = cloud(name)
-    n = points.shape[0]
-    rng = np.random.default_rng(12)
-    radius = 0.4 if name == "ellipsoid_cloud" else 0.12
-    centres = np.flatnonzero(rng.random(n) > 0.5)
-    tree = cKDTree(points)
-    for usable, k in ((np.ones(n, dtype=bool), 24), (rng.random(n) > 0.2, 96)):
-        expected_index, expected_counts = _ball_indices(_usable_tree(tree, points, usable), points, centres, radius, k)
-        grid = kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(radius))
-        index, squared, counts = kernels("pointcloud").ball_indices(
-            points, centres, float(radius), k, *grid, 64 * kernel_threads()
-        )
-        # continuous random points: no two distances tie, so the nearest k are the same in the same order
-        label = f"k={k}, {'all' if usable.all() else 'some'} usable"
-        np.testing.assert_array_equal(counts, expected_counts, err_msg=label)
-        np.testing.assert_array_equal(index, expected_index, err_msg=label)
-        assert (counts < k).any() and ((counts == k).any() or k > 24), label  # full balls (cut to k) and partial
-        inside = index < n
-        exact = ((points[np.where(inside, index, 0)] - points[centres][:, None, :]) ** 2).sum(axis=2)
-        np.testing.assert_array_equal(squared[inside], exact[inside])  # three squares added in order
-        assert np.isinf(squared[~inside]).all()
-
-
-def check_inner_balls(name):
-    from scipy.spatial import cKDTree
-
-    from meshcurv._pointcloud_estimators import LARGER, _ball_indices, _usable_tree
-
-    points, _ = cloud(name)
-    n, radius = points.shape[0], (0.4 if name == "ellipsoid_cloud" else 0.12)
-    centres, usable = np.arange(0, n, 2), np.random.default_rng(13).random(n) > 0.2
-    lattice = np.stack(np.meshgrid(*[np.arange(12.0)] * 2, [0.0]), axis=-1).reshape(-1, 3)  # distances tie
-    for k, wide_k in ((24, 48), (40, 96), (96, 96)):
-        grid = kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(radius * LARGER))
-        wide = kernels("pointcloud").ball_indices(
-            points, centres, float(radius * LARGER), wide_k, *grid, 64 * kernel_threads()
-        )
-        index, counts = kernels("pointcloud").inner_balls(*wide, float(radius), k, n)
-        # the k-d tree's balls of the smaller radius: no two distances of continuous random points tie
-        expected_index, expected_counts = _ball_indices(
-            _usable_tree(cKDTree(points), points, usable), points, centres, radius, k
-        )
-        np.testing.assert_array_equal(counts, expected_counts, err_msg=f"k={k}")
-        np.testing.assert_array_equal(index, expected_index, err_msg=f"k={k}")
-        assert (counts < k).any() and (k > 24 or (counts == k).any())  # partial balls, and full ones cut to k
-        # ties (a lattice): the search over the smaller radius itself, to the bit
-        everything = np.arange(lattice.shape[0])
-        grid = kernels("neighborhoods").pool_grid(lattice, everything, 2.5 * LARGER)
-        wide = kernels("pointcloud").ball_indices(lattice, everything, 2.5 * LARGER, wide_k, *grid, 4)
-        index, counts = kernels("pointcloud").inner_balls(*wide, 2.5, min(k, 20), lattice.shape[0])
-        grid = kernels("neighborhoods").pool_grid(lattice, everything, 2.5)
-        expected_index, _, expected_counts = kernels("pointcloud").ball_indices(
-            lattice, everything, 2.5, min(k, 20), *grid, 4
-        )
-        np.testing.assert_array_equal(counts, expected_counts)
-        np.testing.assert_array_equal(index, expected_index)
-
-
-def check_whole_ties(name):
-    from scipy.spatial import cKDTree
-
-    from meshcurv._pointcloud_estimators import MIN_BALL_POINTS, SQUARED_TIE, _ball_indices, _usable_tree, _whole_ties
-
-    points, normals = cloud(name)
-    # and a square lattice beside it (its balls' points at one distance in fours: cuts through them, runs to order
-    # by their keys), its normals varying, some NaN (keys of +inf)
-    x, y = (grid.ravel() for grid in np.meshgrid(np.arange(16.0), np.arange(16.0)))
-    lattice = np.column_stack([x, y, np.zeros(x.size)]) * 0.02 + 5.0
-    lattice_normals = np.column_stack([0.1 * np.sin(x), 0.05 * y, np.ones(x.size)])
-    lattice_normals /= np.linalg.norm(lattice_normals, axis=1, keepdims=True)
-    lattice_normals[::9] = np.nan
-    points, normals = (
-        np.concatenate([points, lattice]),
-        np.ascontiguousarray(np.concatenate([normals, lattice_normals])),
-    )
-    n = points.shape[0]
-    radius = 0.4 if name == "ellipsoid_cloud" else 0.12
-    centres = np.arange(0, n, 3)
-    on_lattice = centres >= n - lattice.shape[0]
-    tree = cKDTree(points)
-    for k in (11, 24, 96):
-        index, counts = _ball_indices(
-            _usable_tree(tree, points, np.ones(n, dtype=bool)), points, centres, radius, k + 1
-        )
-        expected_index, expected_counts = _whole_ties(points, normals, centres, index, counts, radius, k)
-        inside = index < n
-        step = points[np.where(inside, index, 0)] - points[centres][:, None, :]
-        squared = step[..., 0] * step[..., 0] + step[..., 1] * step[..., 1] + step[..., 2] * step[..., 2]
-        squared = np.where(inside, squared, np.inf)  # (as ball_indices gives them)
-        got_index, got_counts = kernels("pointcloud").whole_ties(
-            points, normals, centres, index, squared, counts, float(radius), k, SQUARED_TIE, MIN_BALL_POINTS
-        )
-        # the same squared distances, tests and keys: to the bit
-        np.testing.assert_array_equal(got_counts, expected_counts, err_msg=f"k={k}")
-        np.testing.assert_array_equal(got_index, expected_index, err_msg=f"k={k}")
-        assert (expected_counts[on_lattice] < np.minimum(counts[on_lattice], k)).any(), k  # (some cut whole)
-        assert (expected_index[on_lattice] != index[on_lattice, :k]).any(), k  # (some runs ordered by their keys)
-
-
 def check_nearest_neighbours(name):
     from scipy.spatial import cKDTree
 
@@ -1712,10 +1638,7 @@ def check_ball_triangle_sums(name):
     points, normals = cloud(name)
     n = points.shape[0]
     radius = 0.4 if name == "ellipsoid_cloud" else 0.12
-    grid = kernels("neighborhoods").pool_grid(points, np.arange(n), float(radius))
-    index, _, counts = kernels("pointcloud").ball_indices(
-        points, np.arange(n), float(radius), 48, *grid, 64 * kernel_threads()
-    )
+    index, counts, _, _ = searched_balls(points, np.arange(n), radius, 48)
     rows = counts >= MIN_BALL_POINTS
     index, counts = np.ascontiguousarray(index[rows]), counts[rows]
     pattern = _rank_pattern(TRIANGLES)
@@ -1770,10 +1693,6 @@ def check_graph_edges(name):
     ):
         assert_sums_close(a, b, magnitude, 3, err_msg=label)
     assert_sums_close(got[6], expected[6], 1.0, 3, err_msg="slope", relative=4 * EPS)
-    # the products as the kernel of the other edge products forms them, to the bit
-    geometry = kernels("pointcloud").edge_geometry(points, normals, indices)
-    for label, a, b in zip(("ahead", "behind", "cosine"), got[3:6], geometry[1:]):
-        np.testing.assert_array_equal(a, b.ravel()[got[2]], err_msg=label)
 
 
 def check_edge_weights(name):
@@ -1861,6 +1780,28 @@ def check_spanning_signs(name):
         assert (expected < 0).any() and (expected > 0).any(), label  # the normals' random signs are turned
 
 
+def check_first_point_parts(name):
+    n = orientation_inputs(name)[0].shape[0]
+    rng = np.random.default_rng(29)
+    # a union-find's roots: components of random sizes (singletons among them), each rooted at any of its points
+    labels = np.minimum(rng.integers(0, n // 7, n), rng.integers(0, n // 3, n))
+    shuffled = rng.permutation(n)
+    root_of = np.zeros(labels.max() + 1, dtype=np.int64)
+    root_of[labels[shuffled]] = shuffled  # (some member of each component: whichever NumPy writes last)
+    roots = root_of[labels]
+    signs = np.where(rng.random(n) < 0.5, -1.0, 1.0)
+    got_signs, got_labels = kernels("pointcloud_graph").first_point_parts(signs, roots.astype(np.int64))
+    # the definition: each component's first point (np.minimum.at), its sign +1, the components numbered in
+    # the order of their first points
+    first = np.full(n, n, dtype=np.int64)
+    np.minimum.at(first, roots, np.arange(n))
+    first = first[roots]
+    np.testing.assert_array_equal(got_signs, signs * signs[first])
+    np.testing.assert_array_equal(got_labels, np.unique(first, return_inverse=True)[1].reshape(-1))
+    assert np.unique(got_labels).size > 10 and (got_signs[first] == 1.0).all()
+
+
+# -- the table ----------------------------------------------------------------------------------
 # -- the table ----------------------------------------------------------------------------------
 
 
@@ -1872,22 +1813,6 @@ class Twin:
     twin: str
     check: Callable
     inputs: tuple
-
-
-def check_edge_geometry(name):
-    points, normals = cloud(name)
-    indices = knn_indices(points)
-    got = kernels("pointcloud").edge_geometry(points, normals, np.ascontiguousarray(indices))
-    # the NumPy path of _pointcloud_normals.oriented_signs: the same products over the (E, 3) gathers
-    offsets = points[indices] - points[:, None, :]
-    expected = (
-        np.linalg.norm(offsets, axis=2),
-        np.einsum("nkj,nj->nk", offsets, normals),
-        np.einsum("nkj,nkj->nk", offsets, normals[indices]),
-        np.einsum("nj,nkj->nk", normals, normals[indices]),
-    )
-    for label, a, b in zip(("length", "ahead", "behind", "cosine"), got, expected):
-        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14, err_msg=label)
 
 
 def check_line_spread(name):
@@ -1946,38 +1871,54 @@ def check_flat_balls(name):
         assert expected[:n].mean() > 0.9 and not expected[n : n + 200].any()  # (the line's own balls)
 
 
-def check_own_side(name):
+def check_measured_balls(name):
+    _check_the_search(name)
+    _check_the_cuts(name)
+
+
+def _check_the_search(name):
+    """The search of :func:`check_measured_balls` alone (:func:`searched_balls`): the k-d tree's rows."""
     from scipy.spatial import cKDTree
 
-    from meshcurv._pointcloud_estimators import FACING_MARGIN, _ball_indices, _own_side, _usable_tree
+    from meshcurv._pointcloud_estimators import LARGER, _ball_indices, _usable_tree
 
-    points, normals = cloud(name)
+    points, _ = cloud(name)
     n = points.shape[0]
-    rng = np.random.default_rng(5)
-    flipped = np.where((rng.random(n) < 0.2)[:, None], -normals, normals)  # some points facing away
-    centres = np.flatnonzero(rng.random(n) > 0.5)
+    rng = np.random.default_rng(12)
     radius = 0.4 if name == "ellipsoid_cloud" else 0.12
-    index, counts = _ball_indices(
-        _usable_tree(cKDTree(points), points, np.ones(n, dtype=bool)), points, centres, radius, 32
-    )
-    sheets = rng.integers(-1, 3, n)
-    for given in (None, sheets):
-        expected_index, expected_counts = _own_side(flipped, centres, index.copy(), counts.copy(), given)
-        got_index, got_counts = kernels("pointcloud").own_side(
-            flipped,
-            centres,
-            index.copy(),
-            counts.copy(),
-            np.zeros(0, dtype=np.int64) if given is None else np.ascontiguousarray(given, dtype=np.int64),
-            FACING_MARGIN,
+    centres = np.flatnonzero(rng.random(n) > 0.5)
+    tree = cKDTree(points)
+    for usable, k, k_wide in ((np.ones(n, dtype=bool), 24, 0), (rng.random(n) > 0.2, 96, 0), (None, 24, 48)):
+        usable = rng.random(n) > 0.2 if usable is None else usable
+        search = _usable_tree(tree, points, usable)
+        index, counts, wide_index, wide_counts = searched_balls(
+            points, centres, radius, k, usable, radius * LARGER, k_wide
         )
-        label = "sheets" if given is not None else "no sheets"
-        np.testing.assert_array_equal(got_counts, expected_counts, err_msg=label)
-        np.testing.assert_array_equal(got_index, expected_index, err_msg=label)
-        assert (expected_counts < counts).any(), label  # points were dropped
+        # continuous random points: no two distances tie, so the nearest k are the same in the same order
+        label = f"k={k}, k_wide={k_wide}, {'all' if usable.all() else 'some'} usable"
+        expected_index, expected_counts = _ball_indices(search, points, centres, radius, k)
+        np.testing.assert_array_equal(counts, expected_counts, err_msg=label)
+        np.testing.assert_array_equal(index, expected_index, err_msg=label)
+        assert (counts < k).any() and ((counts == k).any() or k > 24), label  # full balls (cut to k) and partial
+        assert usable[index[index < n]].all(), label
+        if k_wide:  # the smaller balls the prefixes of the larger ones' search: both the k-d tree's
+            expected_index, expected_counts = _ball_indices(search, points, centres, radius * LARGER, k_wide)
+            np.testing.assert_array_equal(wide_counts, expected_counts, err_msg=label)
+            np.testing.assert_array_equal(wide_index, expected_index, err_msg=label)
+    # ties (a lattice): the smaller balls of the wide search are those of the search over the smaller radius itself
+    lattice = np.stack(np.meshgrid(*[np.arange(12.0)] * 2, [0.0]), axis=-1).reshape(-1, 3)
+    everything = np.arange(lattice.shape[0])
+    for k, k_wide in ((20, 48), (20, 96), (12, 96)):
+        index, counts, _, _ = searched_balls(lattice, everything, 2.5, k, None, 2.5 * LARGER, k_wide)
+        expected_index, expected_counts, _, _ = searched_balls(lattice, everything, 2.5, k)
+        np.testing.assert_array_equal(counts, expected_counts)
+        np.testing.assert_array_equal(index, expected_index)
+        assert (counts == k).any() and (counts < k).any()  # (rows cut through a ring of ties, and partial rows)
 
 
-def check_measured_balls(name):
+def _check_the_cuts(name):
+    """The balls of :func:`check_measured_balls` with their ties cut whole and ordered and their points facing away
+    or on another sheet dropped: its NumPy twin's, to the bit (the same squared distances, tests and keys)."""
     from scipy.spatial import cKDTree
 
     from meshcurv._pointcloud_estimators import (
@@ -2004,6 +1945,7 @@ def check_measured_balls(name):
     radius = 0.4 if name == "ellipsoid_cloud" else 0.12
     wide = radius * LARGER
     centres, usable = np.flatnonzero(rng.random(n) > 0.4), rng.random(n) > 0.15
+    on_lattice = centres >= n - lattice.shape[0]
     search = _usable_tree(cKDTree(points), points, usable)
     for k, k_wide, sheets in ((11, 0, None), (24, 48, rng.integers(-1, 3, n)), (40, 96, None)):
         grid = kernels("neighborhoods").pool_grid(points, np.flatnonzero(usable), float(wide if k_wide else radius))
@@ -2026,6 +1968,16 @@ def check_measured_balls(name):
         for label, a, b in zip(("index", "counts", "wide_index", "wide_counts"), got, expected):
             np.testing.assert_array_equal(a, b, err_msg=f"{label}, k={k}, k_wide={k_wide}")
         assert (got[1] < k).any() and (got[1] > 0).any(), k
+        # the inputs meant something: against the search alone, rows less points (cut whole, facing away, on
+        # another sheet) on the lattice and off it, and the lattice's runs of ties ordered by their keys, not by index
+        counts = searched_balls(points, centres, radius, k, usable)[1]
+        assert (got[1][on_lattice] < counts[on_lattice]).any() and (got[1][~on_lattice] < counts[~on_lattice]).any()
+        reordered = 0
+        for row in np.flatnonzero(on_lattice):
+            members = got[0][row, : got[1][row]]
+            squared = ((points[members] - points[centres[row]]) ** 2).sum(axis=1)
+            reordered += (members[np.lexsort((members, squared))] != members).any()
+        assert reordered > 0, k
 
 
 def check_cut_neighbours(name):
@@ -2182,9 +2134,6 @@ TWINS = [
         check_pca_normals,
         CLOUDS + ("degenerate_cloud",),
     ),
-    Twin("pointcloud.ball_indices", "_pointcloud_estimators._ball_indices", check_ball_indices, CLOUDS),
-    Twin("pointcloud.inner_balls", "_pointcloud_estimators._ball_indices (smaller radius)", check_inner_balls, CLOUDS),
-    Twin("pointcloud.whole_ties", "_pointcloud_estimators._whole_ties", check_whole_ties, CLOUDS),
     Twin("pointcloud.nearest_neighbours", "_pointcloud_normals.knn", check_nearest_neighbours, CLOUDS),
     Twin(
         "pointcloud.neighbour_differences",
@@ -2196,11 +2145,15 @@ TWINS = [
     Twin("pointcloud.edge_cosines", "the cosines of _pointcloud_normals.orientation_signs", check_edge_cosines, CLOUDS),
     Twin("pointcloud.far_winding", "_pointcloud_normals.winding_numbers", check_far_winding, CLOUDS),
     Twin("pointcloud.spanning_signs", "_pointcloud_normals.orientation_signs", check_spanning_signs, CLOUDS),
-    Twin("pointcloud.edge_geometry", "the products of _pointcloud_normals.oriented_signs", check_edge_geometry, CLOUDS),
+    Twin(
+        "pointcloud_graph.first_point_parts",
+        "np.minimum.at and np.unique (the NumPy forest's numbering)",
+        check_first_point_parts,
+        CLOUDS,
+    ),
     Twin("pointcloud.graph_edges", "_pointcloud_normals._graph_geometry", check_graph_edges, CLOUDS),
     Twin("pointcloud.edge_weights", "_pointcloud_normals._edge_weights", check_edge_weights, CLOUDS),
     Twin("pointcloud.kept_rows", "pointcloud._kept_rows", check_kept_rows, CLOUDS),
-    Twin("pointcloud.own_side", "_pointcloud_estimators._own_side", check_own_side, CLOUDS),
     Twin(
         "pointcloud.measured_balls",
         "_pointcloud_estimators._measured_balls",
@@ -2225,7 +2178,7 @@ EXCEPTIONS: dict[str, str] = {
     "to round-off",
     "neighborhoods.coarse_face_sums": "tests/test_neighborhoods_clusters.py::test_coarse_sums_do_not_depend_on_the_"
     "backend: against neighborhoods._coarse_face_sums_numpy",
-    "neighborhoods.pool_grid": "a search structure, not a result: the twins of pointcloud.ball_indices and "
+    "neighborhoods.pool_grid": "a search structure, not a result: the twins of pointcloud.measured_balls and "
     "jets.fit_jets, which search it, find the same balls with k-d trees",
     "icc.nested_jet_normals": "tests/test_multiscale.py: against jets.fit_jet_normals at each radius, on both backends",
     "topology.build_topology": "the body of topology.build_edges (its row above), which calls it",

@@ -1,12 +1,10 @@
-"""The measures' balls in one pass (issue 31): ``pointcloud.measured_balls`` against its NumPy twin and the kernels
-it replaces.
+"""The measures' balls in one pass (issue 31): ``pointcloud.measured_balls`` against its NumPy twin.
 
 :func:`meshcurv._kernels.pointcloud.measured_balls` searches each centre's ball once for both radii of
 :func:`meshcurv._pointcloud_estimators.corrected_measures` (the estimate and its check) and cuts the ties and the
 points facing away in the thread that found the row. Its balls must be those of the search, the tie cut and the
 side filter run one after the other: the NumPy twin (``_measured_balls``: k-d tree queries, ``_whole_ties``,
-``_own_side``) and the compiled kernels of the same steps (``ball_indices``, ``inner_balls``, ``whole_ties``,
-``own_side``), to the bit. The clouds: an ellipsoid with noise (no ties) beside a square lattice (its points at
+``_own_side``), to the bit. The clouds: an ellipsoid with noise (no ties) beside a square lattice (its points at
 one distance in fours and eights: cuts through tied runs, runs ordered by their keys), some normals turned (points
 facing away), some NaN, and sheets.
 """
@@ -38,29 +36,6 @@ def _cloud():
     turned = rng.random(points.shape[0]) < 0.1
     normals[turned] *= -1.0
     return np.ascontiguousarray(points), np.ascontiguousarray(normals), rng
-
-
-def _compiled_steps(points, normals, chunk, radius, k, wide, k_wide, grid, sheets):
-    """The balls as ``corrected_measures`` computed them before ``measured_balls``: one kernel per step."""
-    from meshcurv._kernels import pointcloud
-    from meshcurv._pointcloud_estimators import FACING_MARGIN, MIN_BALL_POINTS, SQUARED_TIE
-
-    n = points.shape[0]
-    cut = (SQUARED_TIE, MIN_BALL_POINTS)
-    if k_wide:
-        wide_index, squared, wide_counts = pointcloud.ball_indices(points, chunk, wide, k_wide + 1, *grid, 8)
-        index, counts = pointcloud.inner_balls(wide_index, squared, wide_counts, radius, k + 1, n)
-    else:
-        index, squared, counts = pointcloud.ball_indices(points, chunk, radius, k + 1, *grid, 8)
-    index, counts = pointcloud.whole_ties(points, normals, chunk, index, squared, counts, radius, k, *cut)
-    index, counts = pointcloud.own_side(normals, chunk, index, counts, sheets, FACING_MARGIN)
-    if not k_wide:
-        return index, counts, None, None
-    wide_index, wide_counts = pointcloud.whole_ties(
-        points, normals, chunk, wide_index, squared, wide_counts, wide, k_wide, *cut
-    )
-    wide_index, wide_counts = pointcloud.own_side(normals, chunk, wide_index, wide_counts, sheets, FACING_MARGIN)
-    return index, counts, wide_index, wide_counts
 
 
 @pytest.mark.parametrize("with_sheets", [False, True])
@@ -106,13 +81,9 @@ def test_measured_balls_are_the_steps_to_the_bit(k, k_wide, with_sheets):
     twin = _measured_balls(
         _usable_tree(cKDTree(points), points, usable), points, normals, chunk, radius, k, wide, k_wide, sheets
     )
-    steps = _compiled_steps(points, normals, chunk, radius, k, wide, k_wide, grid, own_sheets)
     names = ("index", "counts", "wide_index", "wide_counts")
     for name, a, b in zip(names, got, twin):
         np.testing.assert_array_equal(a, b, err_msg=f"{name} against the NumPy twin")
-    for name, a, b in zip(names, got, steps):
-        if b is not None:
-            np.testing.assert_array_equal(a, b, err_msg=f"{name} against the kernels of the steps")
     assert got[0].shape == (chunk.size, k) and got[2].shape == (chunk.size, k_wide)
     # the inputs meant something: cuts and balls less points facing away
     assert (got[1] < k).any() and (got[1] > 0).any()

@@ -273,12 +273,11 @@ def test_compiled_pca_normals_match_eigh():
 
 
 def test_compiled_ball_search_matches_the_k_d_tree():
-    # the same rows (nearest usable points in distance order, padded with N) and counts
+    # the same rows (nearest usable points in distance order, padded with N) and counts: the search of the
+    # measures' balls (pointcloud.measured_balls) alone, without normals or tie tolerance
     pytest.importorskip("numba")
     from scipy.spatial import cKDTree
-
-    from meshcurv._kernels.neighborhoods import pool_grid
-    from meshcurv._kernels.pointcloud import ball_indices
+    from test_kernel_twins import searched_balls
 
     points, _ = sphere_points(3000)
     usable = np.random.default_rng(3).random(3000) > 0.05
@@ -289,19 +288,16 @@ def test_compiled_ball_search_matches_the_k_d_tree():
     apart = np.where(np.arange(3000)[:, None] % 2 == 0, points, points + [1e4, 1e4, 0.0])
     for cloud, cases in ((points, ((0.3, 12), (0.5, 60))), (apart, ((0.3, 6), (0.5, 30)))):
         for radius, k in cases:
-            index, squared, counts = ball_indices(
-                cloud, centres, radius, k, *pool_grid(cloud, np.flatnonzero(usable), radius), 64
-            )
+            index, counts, _, _ = searched_balls(cloud, centres, radius, k, usable)
             expected, expected_counts = estimators._ball_indices(
                 estimators._usable_tree(cKDTree(cloud), cloud, usable), cloud, centres, radius, k
             )
             np.testing.assert_array_equal(index, expected)
             np.testing.assert_array_equal(counts, expected_counts)
             assert usable[index[index < 3000]].all() and (counts == k).any() and (counts < k).any()
-            inside = np.isfinite(squared)
-            assert np.allclose(
-                squared[inside], np.sum((cloud[index[inside]] - cloud[np.repeat(centres, counts)]) ** 2, axis=1)
-            )
+            inside = index < 3000
+            squared = np.sum((cloud[np.where(inside, index, 0)] - cloud[centres][:, None, :]) ** 2, axis=2)
+            assert (squared[inside] < radius * radius).all()
 
 
 def test_compiled_spanning_signs_orient_as_the_scipy_tree():
@@ -480,33 +476,47 @@ def _random_cloud(n, seed):
     return points, normals, rng
 
 
-def test_compiled_own_side_keeps_what_the_numpy_path_keeps():
+def test_compiled_balls_keep_what_the_numpy_path_keeps():
+    # points facing away (10% of the normals turned) and on other sheets dropped alike: the balls of
+    # pointcloud.measured_balls and of its NumPy twin (a k-d tree, _whole_ties, _own_side)
     pytest.importorskip("numba")
+    from scipy.spatial import cKDTree
+
     from meshcurv._backend import numba_kernels
 
     points, normals, rng = _random_cloud(3000, 1)
-    from scipy.spatial import cKDTree
-
-    _, index = cKDTree(points).query(points[:500], k=40)
-    counts = rng.integers(3, 41, size=500)
-    index = np.where(np.arange(40)[None, :] < counts[:, None], index, 3000)
     centres = np.arange(500)
     sheets = rng.integers(-1, 3, size=3000)
+    usable = np.ones(3000, dtype=bool)
+    grid = numba_kernels("neighborhoods").pool_grid(points, np.arange(3000), 0.25)
     for given in (None, sheets):
-        expected = estimators._own_side(normals, centres, index.copy(), counts, given)
-        found = numba_kernels("pointcloud").own_side(
+        expected = estimators._measured_balls(
+            estimators._usable_tree(cKDTree(points), points, usable), points, normals, centres, 0.25, 40, 0.25, 0, given
+        )
+        found = numba_kernels("pointcloud").measured_balls(
+            points,
             normals,
             centres,
-            index.copy(),
-            counts,
+            0.25,
+            40,
+            0.25,
+            0,
+            *grid,
             np.zeros(0, dtype=np.int64) if given is None else given,
+            estimators.SQUARED_TIE,
+            estimators.MIN_BALL_POINTS,
             estimators.FACING_MARGIN,
+            8,
         )
         np.testing.assert_array_equal(found[0], expected[0])
         np.testing.assert_array_equal(found[1], expected[1])
+        # the balls less what faces away (or is on another sheet): every kept point on the centre's side
+        kept = found[0] < 3000
+        facing = np.einsum("mkj,mj->mk", normals[np.where(kept, found[0], 0)], normals[centres])
+        assert (facing[kept] >= -estimators.FACING_MARGIN).all()
 
 
-def test_compiled_edge_geometry_is_that_of_the_gathers():
+def test_compiled_edge_products_are_those_of_the_gathers():
     pytest.importorskip("numba")
     from meshcurv._backend import numba_kernels
 
@@ -514,13 +524,14 @@ def test_compiled_edge_geometry_is_that_of_the_gathers():
     from scipy.spatial import cKDTree
 
     _, indices = normals_module.knn(cKDTree(points), points, k=6)
-    length, ahead, behind, cosine = numba_kernels("pointcloud").edge_geometry(points, normals, indices)
-    offsets = points[indices] - points[:, None, :]
+    usable = np.ones(2000, dtype=bool)
+    rows, cols, _, ahead, behind, cosine, _ = numba_kernels("pointcloud").graph_edges(points, normals, indices, usable)
+    assert rows.size == indices.size  # (distinct random points: every edge kept)
+    offsets = points[cols] - points[rows]
     # sums of three products of numbers of size <= 2: round-off of a few units of 2e-16
-    np.testing.assert_allclose(length, np.linalg.norm(offsets, axis=2), rtol=0, atol=1e-15)
-    np.testing.assert_allclose(ahead, np.einsum("nkj,nj->nk", offsets, normals), rtol=0, atol=1e-15)
-    np.testing.assert_allclose(behind, np.einsum("nkj,nkj->nk", offsets, normals[indices]), rtol=0, atol=1e-15)
-    np.testing.assert_allclose(cosine, np.einsum("nj,nkj->nk", normals, normals[indices]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(ahead, np.einsum("ej,ej->e", offsets, normals[rows]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(behind, np.einsum("ej,ej->e", offsets, normals[cols]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(cosine, np.einsum("ej,ej->e", normals[rows], normals[cols]), rtol=0, atol=1e-15)
 
 
 def test_the_neighbours_kept_after_merging_near_copies_are_those_of_a_new_search():

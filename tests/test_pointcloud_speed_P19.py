@@ -1,7 +1,7 @@
 """What the point-cloud speed changes of issue 31 (P19) must keep: the same balls, sums and checks.
 
-The ball search sorts each ball's points by a bucket sort and one insertion pass instead of inserting them one
-by one: the rows must be those of the definition, the points closer than the radius in the order of
+The ball search (of ``pointcloud.measured_balls``) sorts each ball's points by a bucket sort and one insertion
+pass instead of inserting them one by one: the rows must be those of the definition, the points closer than the radius in the order of
 ``(squared distance, index)`` (ties by index: a lattice's), cut to the ``k`` nearest. The measures' kernels
 read the balls' rows in place (``rows``) instead of gathered copies: the same sums and flat-ball tests as over
 the copies. The check of unsteady estimates compares the pairs of curvatures without stacking them: NaN on
@@ -43,23 +43,28 @@ def brute_balls(points, centres, radius, k):
 @pytest.mark.parametrize(("radius", "k"), [(3.0, 40), (3.0, 12), (4.5, 96), (0.5, 8)])
 def test_ball_search_rows_are_the_definitions(radius, k):
     pytest.importorskip("numba")
-    from meshcurv._backend import numba_kernels
+    from test_kernel_twins import searched_balls
 
     points = lattice_dome()
     rng = np.random.default_rng(7)
     points = np.concatenate([points, rng.uniform(0, 29, size=(300, 3))])  # and points at distinct distances
     centres = np.arange(0, points.shape[0], 7)
-    grid = numba_kernels("neighborhoods").pool_grid(points, np.arange(points.shape[0]), radius)
-    got = numba_kernels("pointcloud").ball_indices(points, centres, radius, k, *grid, 8)
+    # the search of the measures' balls (pointcloud.measured_balls) alone: no normals, no tie tolerance
+    got = searched_balls(points, centres, radius, k)
     expected = brute_balls(points, centres, radius, k)
-    for found, wanted in zip(got, expected):
-        np.testing.assert_array_equal(found, wanted)
+    np.testing.assert_array_equal(got[0], expected[0])
+    np.testing.assert_array_equal(got[1], expected[2])
+    # and smaller balls than the search's: the prefixes of its rows closer than the radius
+    got = searched_balls(points, centres, radius, k, wide=1.5 * radius, k_wide=2 * k)
+    np.testing.assert_array_equal(got[0], expected[0])
+    np.testing.assert_array_equal(got[1], expected[2])
 
 
 def test_measures_kernels_read_the_rows_in_place():
     pytest.importorskip("numba")
     from meshcurv._backend import numba_kernels
     from meshcurv._pointcloud_estimators import EDGE_ON, TRIANGLES, _rank_pattern, flat_balls
+    from test_kernel_twins import searched_balls
 
     kernels = numba_kernels("pointcloud")
     rng = np.random.default_rng(3)
@@ -68,8 +73,7 @@ def test_measures_kernels_read_the_rows_in_place():
     normals = points.copy()
     centres = np.arange(0, 3000, 3)
     radius = 0.2
-    grid = numba_kernels("neighborhoods").pool_grid(points, np.arange(3000), radius)
-    index, _, counts = kernels.ball_indices(points, centres, radius, 40, *grid, 8)
+    index, counts, _, _ = searched_balls(points, centres, radius, 40)
     counts[::5] = 2  # rows too small to measure, and rows left out, in the selection or not
     rows = np.flatnonzero(np.arange(centres.size) % 3 != 1)
     pattern = _rank_pattern(TRIANGLES)

@@ -23,7 +23,7 @@ from meshcurv.estimators.icc import face_measures
 
 pytest.importorskip("numba")
 
-from test_kernel_twins import assert_sums_close, kernel_threads, kernels  # noqa: E402
+from test_kernel_twins import assert_sums_close, kernels, searched_balls  # noqa: E402
 
 
 def _lattice_cylinder(n_around, n_along):
@@ -44,8 +44,7 @@ def test_flat_triangles_of_a_lattice_ball_are_turned_alike_on_both_backends(n_ar
     points, normals = _lattice_cylinder(n_around, n_along)
     n = points.shape[0]
     radius = 2.0
-    grid = kernels("neighborhoods").pool_grid(points, np.arange(n), radius)
-    index, _, counts = kernels("pointcloud").ball_indices(points, np.arange(n), radius, n, *grid, 4 * kernel_threads())
+    index, counts, _, _ = searched_balls(points, np.arange(n), radius, n)  # (every point of the ball, by distance)
     rows = counts >= MIN_BALL_POINTS
     index, counts = np.ascontiguousarray(index[rows]), counts[rows]
     pattern = _rank_pattern(TRIANGLES)

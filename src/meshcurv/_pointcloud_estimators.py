@@ -983,11 +983,11 @@ def _usable_tree(tree, points, usable):
 def _ball_indices(search, points, chunk, radius, k):
     """(M, k) the ``k`` nearest usable points within ``radius`` of each centre of ``chunk`` and (M,) their count.
 
-    The NumPy path of :func:`meshcurv._kernels.pointcloud.ball_indices`: a
-    query of the k-d tree of :func:`_usable_tree` (``search``); rows in
-    the order of ``(squared distance, index)`` as the kernel's (the tree's own
-    order of equal distances is not the index's: a lattice's ties), padded
-    with ``N``.
+    The search of :func:`_measured_balls` (compiled: the grid search of
+    :func:`meshcurv._kernels.pointcloud.measured_balls`): a query of the k-d
+    tree of :func:`_usable_tree` (``search``); rows in the order of
+    ``(squared distance, index)`` as the kernel's (the tree's own order of
+    equal distances is not the index's: a lattice's ties), padded with ``N``.
     """
     tree, pool = search
     n = points.shape[0]
@@ -1059,8 +1059,8 @@ def _whole_ties(points, normals, centres, index, counts, radius, k):
     before is ordered by :func:`_tie_keys` (cosines of the offset and the normals, which rigid motions, shifts,
     scaling and re-indexing keep), keys within :data:`SQUARED_TIE` of the one before by index (points that even
     these cannot tell apart, a symmetry of the ball, whose keys round-off orders: the normals of the two backends,
-    1e-15 apart, ordered an icosphere's vertices apart, 2e-4 of |k|). Compiled:
-    :func:`meshcurv._kernels.pointcloud.whole_ties` (the same operations, to the bit).
+    1e-15 apart, ordered an icosphere's vertices apart, 2e-4 of |k|). Compiled: each row of
+    :func:`meshcurv._kernels.pointcloud.measured_balls` (``_whole_row``: the same operations, to the bit).
     """
     n = points.shape[0]
     member = np.arange(index.shape[1])[None, :] < counts[:, None]
@@ -1255,7 +1255,8 @@ def corrected_measures(
     wide = radius * LARGER
     # (a ball cut to its nearest points is cut LARGER^2 times wider for the check, else both are the same points)
     k_wide = min(ball_size(wide, spacing, most=round(MAX_BALL_POINTS * LARGER**2)), n)
-    larger = [np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan), np.full((n, 3), np.nan)] if check else []
+    # (the check reads the curvatures only: no (N, 3) directions of the larger balls, 48 MB at 1M points)
+    larger = [np.full(n, np.nan), np.full(n, np.nan), None, None] if check else []
     if kernels is not None:  # the grid of the compiled ball searches, once for all the chunks
         grid = numba_kernels("neighborhoods").pool_grid(
             points, np.flatnonzero(usable), float(wide if check else radius)
@@ -1345,9 +1346,9 @@ def turned(points, normals, found, radius, centres, usable) -> np.ndarray:
 
 
 def _measured(out, points, normals, chunk, index, counts, pattern, kernels, among=None) -> np.ndarray:
-    """Write into ``out`` (``k_min, k_max, dir_min, dir_max``) the measures of the balls ``index`` (M, k) of the
-    centres ``chunk`` (M,) (``counts`` points first) that hold a surface, of the rows ``among`` only when given;
-    return the rows measured (finite). The compiled kernels read the rows in place (no gathered copies of the
+    """Write into ``out`` (``k_min, k_max, dir_min, dir_max``; directions None: not written) the measures of the
+    balls ``index`` (M, k) of the centres ``chunk`` (M,) (``counts`` points first) that hold a surface, of the
+    rows ``among`` only when given; return the rows measured (finite). The compiled kernels read the rows in place (no gathered copies of the
     balls: 0.4-0.5 CPU s at 1M points)."""
     rows = np.flatnonzero(counts >= MIN_BALL_POINTS) if among is None else among[counts[among] >= MIN_BALL_POINTS]
     rows = rows[flat_balls(points, chunk, index, counts, rows)]
@@ -1364,6 +1365,7 @@ def _measured(out, points, normals, chunk, index, counts, pattern, kernels, amon
     target = chunk[rows]
     out[0][target] = k_min
     out[1][target] = k_max
-    out[2][target] = dir_min
-    out[3][target] = dir_max
+    if out[2] is not None:
+        out[2][target] = dir_min
+        out[3][target] = dir_max
     return rows[np.isfinite(k_min)]

@@ -937,12 +937,9 @@ def _forest_order(weights: np.ndarray) -> np.ndarray:
 
 def _first_point_parts(signs: np.ndarray, roots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(signs, labels)`` of the compiled forest (``roots`` (N,) of its union-find) as the NumPy path gives them:
-    the components numbered in the order of their first point, whose sign is +1."""
-    n = roots.size
-    first = np.full(n, n, dtype=np.int64)
-    np.minimum.at(first, roots, np.arange(n))
-    first = first[roots]
-    return signs * signs[first], _dense_labels(first)
+    the components numbered in the order of their first point, whose sign is +1
+    (:func:`meshcurv._kernels.pointcloud_graph.first_point_parts`; the compiled path only)."""
+    return numba_kernels("pointcloud_graph").first_point_parts(signs, np.ascontiguousarray(roots, dtype=np.int64))
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -1217,7 +1214,7 @@ def oriented_signs(
     else:
         rows, cols, kept, ahead, behind, cosine, slope = _graph_geometry(points, normals, graph, usable)
     # (NaN, a zero offset, is not flat; nor is an edge at right angles: it passes no sign, SIGN_COSINE)
-    signed = np.abs(cosine) > SIGN_COSINE
+    signed = (cosine > SIGN_COSINE) | (cosine < -SIGN_COSINE)  # (|cos| > SIGN_COSINE without an (E,) temporary)
     flat = (slope <= SHEET_SLOPE) & signed
     flat = _supported(flat, slope, rows, cols, kept, graph)
     forest = numba_kernels("pointcloud_graph")
@@ -1241,8 +1238,8 @@ def oriented_signs(
         # (each edge taken both ways once: the later way is one Kruskal skips; 1M torus points: 5.9M -> 3.5M edges)
         # (the single edges' positions, their count of flat ones and the order's keys in one pass on every core)
         single, code, n_flat, fits = forest._single_edge_keys(graph, kept, used, flat, weights, 1.0 / TIE_RESOLUTION)
-        order = forest.stable_order(code)[0] if fits else _forest_order(weights[single])
-        taken = single[order]  # `order` over the single edges, as edges of the graph
+        # `order` over the single edges, as edges of the graph (the sort carries them: no gather after it)
+        taken = forest.stable_order(code, single)[0] if fits else single[_forest_order(weights[single])]
         separated = (n_flat == 0 or weights[taken[n_flat - 1]] < 3.0) and (
             n_flat == taken.size or weights[taken[n_flat]] >= 3.0
         )
@@ -1387,14 +1384,6 @@ def _supported(flat, slope, rows, cols, kept, indices):
     flat = flat.copy()
     flat[check[~common]] = False
     return flat
-
-
-def _dense_labels(roots: np.ndarray) -> np.ndarray:
-    """(N,) ``roots`` (N,) (indices below N) numbered 0, 1, ... in increasing order: ``np.unique``'s inverse
-    without its sort."""
-    mark = np.zeros(roots.size, dtype=bool)
-    mark[roots] = True
-    return (np.cumsum(mark) - 1)[roots]
 
 
 def _sheets(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:

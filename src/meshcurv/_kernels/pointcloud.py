@@ -309,65 +309,6 @@ def pca_normals(points, indices):
     return out
 
 
-@nb.njit(parallel=True, **_JIT)
-def ball_indices(points, centres, radius, k, pool_points, ids, grid, n_chunks):
-    """(M, k) the ``k`` nearest points of the pool closer than ``radius`` to each centre, (M, k) their
-    squared distances (inf past the count) and (M,) their count.
-
-    The pool is :func:`~meshcurv._kernels.neighborhoods.pool_grid` ``(pool_points, ids, grid)`` (with a reach of
-    ``radius`` or more): each ball's candidates are the grid's
-    (:func:`meshcurv._kernels.neighborhoods._ball_members`), kept when strictly
-    closer than ``radius``. Rows are in distance order (equal distances: lower
-    index first), padded with ``points.shape[0]``, as
-    :meth:`scipy.spatial.cKDTree.query` with ``distance_upper_bound`` gives them.
-    ``n_chunks``: runs of centres shared out to the threads (a member buffer each).
-    """
-    m = centres.shape[0]
-    # each row written whole by its thread (its members, then the padding): no serial fill of (M, k) arrays first
-    # (1M balls of 74: 0.5 CPU s of page faults in one thread)
-    index = np.empty((m, k), dtype=np.int64)
-    squared = np.empty((m, k))
-    counts = np.zeros(m, dtype=np.int64)
-    n_chunks = max(min(m, n_chunks), 1)
-    for chunk in nb.prange(n_chunks):
-        _chunk_balls(
-            chunk * m // n_chunks,
-            (chunk + 1) * m // n_chunks,
-            points,
-            centres,
-            radius,
-            pool_points,
-            ids,
-            grid,
-            index,
-            squared,
-            counts,
-        )
-    return index, squared, counts
-
-
-@nb.njit(**_JIT)
-def _chunk_balls(lo, hi, points, centres, radius, pool_points, ids, grid, index, squared, counts):
-    """The rows ``lo:hi`` of :func:`ball_indices`, with scratch buffers of their own (a function of its own, not
-    the parallel loop's body: numba hoists allocations of a fixed size out of that loop, and the threads would
-    share them)."""
-    n = points.shape[0]
-    k = index.shape[1]
-    buffers = _ball_buffers(256)
-    for row in range(lo, hi):
-        c = centres[row]
-        buffers, found = _search_ball(pool_points, ids, grid, points[c, 0], points[c, 1], points[c, 2], radius, buffers)
-        sorted_squared, sorted_ids = buffers[3], buffers[4]
-        kept = min(found, k)
-        for a in range(kept):
-            index[row, a] = sorted_ids[a]
-            squared[row, a] = sorted_squared[a]
-        counts[row] = kept
-        for a in range(kept, k):
-            index[row, a] = n
-            squared[row, a] = np.inf
-
-
 @nb.njit(**_JIT)
 def _ball_buffers(size):
     """Scratch buffers of :func:`_search_ball` for balls of up to ``size`` candidates: the members, their squared
@@ -450,32 +391,6 @@ def _sort_ball(squared, ids, found, limit, sorted_squared, sorted_ids, starts):
         sorted_ids[j] = q
 
 
-@nb.njit(parallel=True, **_JIT)
-def inner_balls(index, squared, counts, radius, k, n):
-    """(M, k) the balls of ``radius`` inside the balls ``index`` (M, K) of a larger radius, and (M,) their counts.
-
-    ``index``, ``squared``, ``counts``: :func:`ball_indices` over a radius larger than ``radius``, with ``K >= k``
-    points a ball. Its rows are in the order of ``(squared distance, index)``: the points strictly closer than
-    ``radius`` are a prefix of each row, and its first ``k`` (or fewer) are what :func:`ball_indices` over
-    ``radius`` with ``k`` points a ball gives, to the bit (the same squared distances, the same test), padded
-    with ``n`` (the number of points) as there. One search serves both balls of
-    :func:`meshcurv._pointcloud_estimators.corrected_measures` (the estimate and its check).
-    """
-    m = index.shape[0]
-    out = np.empty((m, k), dtype=np.int64)  # (each row written whole by its thread, as in ball_indices)
-    found = np.zeros(m, dtype=np.int64)
-    limit = radius * radius
-    for row in nb.prange(m):
-        c = 0
-        while c < k and c < counts[row] and squared[row, c] < limit:
-            out[row, c] = index[row, c]
-            c += 1
-        found[row] = c
-        for a in range(c, k):
-            out[row, a] = n
-    return out, found
-
-
 @nb.njit(inline="always", **_JIT)
 def _tie_key(points, normals, j, c):
     """The place of point ``j`` among the points of the ball of ``c`` at its distance: a sum of four cosines of
@@ -498,36 +413,17 @@ def _tie_key(points, normals, j, c):
     return key if key == key else np.inf
 
 
-@nb.njit(parallel=True, **_JIT)
-def whole_ties(points, normals, centres, index, squared, counts, radius, k, tie, least):
-    """(M, k) the balls ``index`` (M, K) (rows in the order of ``(squared distance, index)``, ``counts`` points
-    first, their ``squared`` distances (M, K) as :func:`ball_indices` gives them, ``K > k``) cut to ``radius`` and
-    ``k`` points with the points tied in distance taken or dropped whole, and ordered among themselves by the
-    geometry; and (M,) their counts.
-
-    The compiled :func:`meshcurv._pointcloud_estimators._whole_ties` (see there): the points at ``radius`` within
-    ``tie`` (of the squared distance) go; a row holding more than ``k`` loses the points tied with its ``k + 1``-th
-    (unless fewer than ``least`` would be left: then its first ``k``); each run of points tied with the one before
-    is sorted by :func:`_tie_key` (keys within ``tie``: by index, :func:`_sort_tied`). Padded with N. The rows of :func:`inner_balls` are prefixes of
-    those of its larger balls: their squared distances are those of the larger balls' rows.
-    """
-    m = index.shape[0]
-    n = points.shape[0]
-    out = np.empty((m, k), dtype=np.int64)  # (each row written whole by its thread, as in ball_indices)
-    kept = np.zeros(m, dtype=np.int64)
-    limit = radius * radius * (1.0 - tie)
-    for row in nb.prange(m):
-        kept[row] = _whole_row(
-            points, normals, centres[row], index[row], squared[row], counts[row], limit, tie, least, out, row, n
-        )
-    return out, kept
-
-
 @nb.njit(**_JIT)
 def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, row, n):
-    """Row ``row`` of :func:`whole_ties` (``out`` (M, k)) from the ball of point ``c``: its ``count`` points
-    ``ids`` (K,) in the order of ``(squared distance, index)`` and their ``squared`` distances; returns its count.
-    ``limit``: the squared radius less the tie. The row of the search itself or one of its buffers."""
+    """Row ``row`` of ``out`` (M, k) from the ball of point ``c``: its ``count`` points ``ids`` (K,) in the order of
+    ``(squared distance, index)`` and their ``squared`` distances, cut to the radius and to ``k`` points with the
+    points tied in distance taken or dropped whole and ordered among themselves by the geometry; returns its count.
+
+    The compiled :func:`meshcurv._pointcloud_estimators._whole_ties` (see there): the points at the radius within
+    ``tie`` (of the squared distance: ``limit`` is the squared radius less the tie) go; a row holding more than
+    ``k`` loses the points tied with its ``k + 1``-th (unless fewer than ``least`` would be left: then its first
+    ``k``); each run of points tied with the one before is sorted by :func:`_tie_key` (keys within ``tie``: by
+    index, :func:`_sort_tied`). Padded with ``n``. ``ids`` and ``squared``: the search's buffers."""
     k = out.shape[1]
     while count > 0 and squared[count - 1] >= limit:
         count -= 1
@@ -558,10 +454,11 @@ def measured_balls(
     wide_index, wide_counts)``, (M, k) and (M,) the balls of ``radius`` of the ``centres`` (M,), (M, k_wide) and
     (M,) those of ``wide`` (``k_wide`` 0: none, (M, 0)).
 
-    Each ball is what :func:`ball_indices` (one point more than the ball holds), :func:`whole_ties` and
-    :func:`own_side` give in turn, to the bit: the search over ``wide`` (``radius`` when ``k_wide`` is 0; the
-    smaller balls: the prefix of each row closer than ``radius``, as :func:`inner_balls`), the ties cut whole
-    and ordered (``tie``, ``least``), the points facing away (``margin``) or on another of the ``sheets`` dropped.
+    Each ball is what the NumPy twin's steps give in turn, to the bit: the search (the ``k + 1`` nearest points
+    strictly closer than the radius, in the order of ``(squared distance, index)``) over ``wide`` (``radius`` when
+    ``k_wide`` is 0; the smaller balls: the prefix of each row closer than ``radius``), the ties cut whole and
+    ordered (``tie``, ``least``: :func:`_whole_row`), the points facing away (``margin``) or on another of the
+    ``sheets`` dropped (:func:`_own_row`).
     Each row is found, cut and written by its thread from its own buffers: no (M, K) squared distances and
     rows of the search written and read again (four passes over (M, K) arrays). ``k_wide >= k``; the pool:
     :func:`~meshcurv._kernels.neighborhoods.pool_grid` with a reach of the search's radius or more.
@@ -618,7 +515,9 @@ def _chunk_measured_balls(
     wide_index,
     wide_counts,
 ):
-    """The rows ``lo:hi`` of :func:`measured_balls`, with buffers of their own (as :func:`_chunk_balls`)."""
+    """The rows ``lo:hi`` of :func:`measured_balls`, with scratch buffers of their own (a function of its own, not
+    the parallel loop's body: numba hoists allocations of a fixed size out of that loop, and the threads would
+    share them)."""
     n = points.shape[0]
     k, k_wide = index.shape[1], wide_index.shape[1]
     search = wide if k_wide > 0 else radius
@@ -630,7 +529,7 @@ def _chunk_measured_balls(
         buffers, found = _search_ball(pool_points, ids, grid, points[c, 0], points[c, 1], points[c, 2], search, buffers)
         sorted_squared, sorted_ids = buffers[3], buffers[4]
         own = sheets[c] if by_sheet else -1
-        # the smaller ball: ball_indices' row of k + 1 points (inner_balls: the prefix closer than radius)
+        # the smaller ball: the search's first k + 1 points, the prefix closer than radius
         held = min(found, k + 1)
         if k_wide > 0:
             held = min(held, k_wide + 1)
@@ -782,28 +681,12 @@ def far_winding(points, normals, weights, soft, sources, queries, reach_squared)
     return out
 
 
-@nb.njit(parallel=True, **_JIT)
-def own_side(normals, centres, index, counts, sheets, margin):
-    """``(index, counts)``: the balls ``index`` (M, k) less their points facing away from their centre, in place.
-
-    The compiled :func:`meshcurv._pointcloud_estimators._own_side`: a point ``j`` of the ball of ``c`` (the first
-    ``counts`` of its row) goes when ``n_j . n_c < -margin``, or when ``sheets`` (N,) is not empty and ``j`` and ``c`` are
-    on two sheets (both >= 0); the kept points stay in order, the row is padded with ``N``.
-    """
-    n = normals.shape[0]
-    m = index.shape[0]
-    kept = np.zeros(m, dtype=np.int64)
-    by_sheet = sheets.shape[0] == n
-    for row in nb.prange(m):
-        c = centres[row]
-        kept[row] = _own_row(normals, c, index, row, counts[row], sheets, sheets[c] if by_sheet else -1, margin, n)
-    return index, kept
-
-
 @nb.njit(**_JIT)
 def _own_row(normals, c, index, row, count, sheets, own, margin, n):
-    """Row ``row`` of :func:`own_side` in place (the ball of point ``c``, ``count`` points, ``own`` its sheet or -1
-    for none); returns its count."""
+    """Row ``row`` of ``index`` less its points facing away from point ``c``, in place: the compiled
+    :func:`meshcurv._pointcloud_estimators._own_side` (the ball of ``c``, ``count`` points; a point ``j`` goes when
+    ``n_j . n_c < -margin``, or when ``sheets`` is not empty and ``j`` and ``c`` (``own``: its sheet, -1 for none)
+    are on two sheets, both >= 0); the kept points stay in order, the row padded with ``n``. Returns its count."""
     cx, cy, cz = normals[c, 0], normals[c, 1], normals[c, 2]
     found = 0
     for a in range(count):
@@ -817,27 +700,6 @@ def _own_row(normals, c, index, row, count, sheets, own, margin, n):
     for a in range(found, index.shape[1]):
         index[row, a] = n
     return found
-
-
-@nb.njit(parallel=True, **_JIT)
-def edge_geometry(points, normals, indices):
-    """(N, k) four times: ``|d|``, ``n_i . d``, ``n_j . d`` and ``n_i . n_j`` of each edge ``d = p_j - p_i``,
-    ``j = indices[i, c]`` (the edges of :func:`meshcurv._pointcloud_normals.oriented_signs`, without (E, 3)
-    gathers)."""
-    n, k = indices.shape
-    length, ahead, behind, cosine = np.zeros((n, k)), np.zeros((n, k)), np.zeros((n, k)), np.zeros((n, k))
-    for i in nb.prange(n):
-        px, py, pz = points[i, 0], points[i, 1], points[i, 2]
-        ax, ay, az = normals[i, 0], normals[i, 1], normals[i, 2]
-        for c in range(k):
-            j = indices[i, c]
-            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
-            bx, by, bz = normals[j, 0], normals[j, 1], normals[j, 2]
-            length[i, c] = np.sqrt(dx * dx + dy * dy + dz * dz)
-            ahead[i, c] = dx * ax + dy * ay + dz * az
-            behind[i, c] = dx * bx + dy * by + dz * bz
-            cosine[i, c] = ax * bx + ay * by + az * bz
-    return length, ahead, behind, cosine
 
 
 @nb.njit(parallel=True, **_JIT)
@@ -889,8 +751,8 @@ def graph_edges(points, normals, indices, usable):
     of the rows of ``indices``), ``kept`` (N k,) (which entries of ``indices`` they are), and (E,) ``ahead`` =
     ``n_i . d``, ``behind`` = ``n_j . d``, ``cosine`` = ``n_i . n_j`` and ``slope`` = ``max(|ahead|, |behind|) /
     |d|`` of ``d = p_j - p_i`` (NaN where ``|d|`` is 0): the compiled
-    :func:`meshcurv._pointcloud_normals._graph_geometry`, on every core instead of NumPy over (E,) arrays (the
-    products as :func:`edge_geometry` forms them, left to right).
+    :func:`meshcurv._pointcloud_normals._graph_geometry`, on every core instead of NumPy over (E,) arrays (each
+    product's three terms added left to right).
     """
     n, k = indices.shape
     kept = np.zeros(n * k, dtype=np.bool_)
