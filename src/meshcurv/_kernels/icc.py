@@ -239,8 +239,10 @@ def _nested_fits_chunk(
                         vertices, indptr, indices, allowed, v, radii[r], mark, stamp + 1 + r, members, spare, spans
                     )
             c[0, :] = np.nan
-            # one call site (the fit is inlined): numba refuses *args there, hence the whole list
-            work = _fit_one(
+            if size > work.shape[1]:  # grown by the caller: the fit allocates nothing (_JIT_LEAF)
+                work = np.empty((work.shape[0], 2 * size))
+            # numba refuses *args there, hence the whole list
+            _fit_one(
                 vertices,
                 vertices,
                 normals,

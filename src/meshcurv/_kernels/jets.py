@@ -18,6 +18,7 @@ from ._common import (
     _JIT_INNER_REASSOC,
     _TINY,
     _UNSIGNED,
+    _JitOptions,
     _tangent_frame,
     run_chunks,
     run_slots,
@@ -30,6 +31,14 @@ from .tensors import _tangent_eigen
 
 #: ``jets.PIVOT_FLOOR``: the smallest pivot for which the factorization goes on.
 _PIVOT_FLOOR = 1e-12
+
+#: The options of :func:`_fit_one` and of the functions it calls: compiled without numba's reference counts
+#: (``_nrt``): they allocate nothing, and each of their array arguments was otherwise counted up and down once per
+#: fit (two atomic operations each, some 50 per vertex of the inlined fit: a third of the normal fits' CPU on a 1M
+#: icosphere, issue 31). Their callers allocate, and keep the counts.
+_JIT_LEAF: _JitOptions = cast(_JitOptions, {**_JIT_INNER, "_nrt": False})
+_JIT_LEAF_REASSOC: _JitOptions = cast(_JitOptions, {**_JIT_INNER_REASSOC, "_nrt": False})
+_JIT_LEAF_OVERLOAD: _JitOptions = cast(_JitOptions, {**_JIT, "_nrt": False})
 
 
 @nb.njit(inline="always", **_JIT)
@@ -90,7 +99,7 @@ def _cholesky_inline(a, b, low, m, min_spread, inverse_binomials, total):
     return True
 
 
-@nb.njit(**_JIT_INNER)
+@nb.njit(**_JIT_LEAF)
 def _cholesky_solve(a, b, low, m, min_spread, inverse_binomials, total):
     """:func:`_cholesky_inline` of any size ``m``."""
     return _cholesky_inline(a, b, low, m, min_spread, inverse_binomials, total)
@@ -273,7 +282,7 @@ def _smaller_solve(general, degree, count, moments, right, solution, min_spread,
     raise NotImplementedError("compiled only: called from the compiled jet fits")
 
 
-@overload(_smaller_solve, jit_options=_JIT)  # type: ignore[arg-type]  # numba's stub types a TypedDict
+@overload(_smaller_solve, jit_options=_JIT_LEAF_OVERLOAD)  # type: ignore[arg-type]  # numba's stub types a TypedDict
 def _smaller_solve_typed(general, degree, count, moments, right, solution, min_spread, scratch):
     if isinstance(general, types.NoneType):
 
@@ -452,7 +461,7 @@ def _grid_chunk(
 ):
     """The fits of ``centres[lo:hi]`` of :func:`fit_jets`, written to their rows of the outputs; with ``larger``
     > 0, those over balls of that radius too, to the outputs ``wider`` (:func:`fit_jet_pairs`): one walk of the
-    larger ball, the smaller one its members within the radius. One call site of the inlined :func:`_fit_one`."""
+    larger ball, the smaller one its members within the radius. One call site of :func:`_fit_one`."""
     per_vertex = radii.shape[0] > 1
     members = np.empty(64, np.int64)
     inner = np.empty(64, np.int64)  # the smaller ball of a pair
@@ -477,7 +486,9 @@ def _grid_chunk(
         else:
             radius, members, size = larger, outer, outer_size
             coefficients, t1s, t2s, ns, counts, away = wider
-        work = _fit_one(
+        if size > work.shape[1]:  # grown by the caller: the fit allocates nothing (_JIT_LEAF)
+            work = np.empty((work.shape[0], 2 * size))
+        _fit_one(
             vertices,
             points,
             normals,
@@ -583,7 +594,7 @@ def _jet_scratch(degree, n_terms):
     )
 
 
-@nb.njit(**_JIT_INNER_REASSOC)
+@nb.njit(**_JIT_LEAF_REASSOC)
 def _dot(a, b, size):
     """``sum_i a[i] b[i]`` over the first ``size`` entries, reassociated (vectorized)."""
     total = 0.0
@@ -592,7 +603,7 @@ def _dot(a, b, size):
     return total
 
 
-@nb.njit(**_JIT_INNER_REASSOC)
+@nb.njit(**_JIT_LEAF_REASSOC)
 def _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
     """:func:`_fit_one`'s moments of a degree-3 fit, summed member by member in scalars.
 
@@ -676,7 +687,7 @@ def _cubic_jet_moments(ox, oy, oz, weight, size, ax, ay, az, bx, by, bz, nx, ny,
     right[5], right[6], right[7], right[8], right[9] = r02, r30, r21, r12, r03
 
 
-@nb.njit(**_JIT_INNER)
+@nb.njit(**_JIT_LEAF)
 def _general_jet_moments(work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
     """:func:`_fit_one`'s moments of a fit of degree 4 or more, from the rows of ``work`` (:func:`_jet_scratch`).
 
@@ -726,7 +737,7 @@ def _jet_moments(general, work, size, degree, exponents, ax, ay, az, bx, by, bz,
     raise NotImplementedError("compiled only: called from the compiled jet fits")
 
 
-@overload(_jet_moments, jit_options=_JIT)  # type: ignore[arg-type]  # numba's stub types a TypedDict
+@overload(_jet_moments, jit_options=_JIT_LEAF_OVERLOAD)  # type: ignore[arg-type]  # numba's stub types a TypedDict
 def _jet_moments_typed(general, work, size, degree, exponents, ax, ay, az, bx, by, bz, nx, ny, nz, moments, right):
     if isinstance(general, types.NoneType):
 
@@ -748,7 +759,7 @@ def _jet_moments_typed(general, work, size, degree, exponents, ax, ay, az, bx, b
     return either
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(**_JIT_LEAF)
 def _fit_one(
     vertices,
     points,
@@ -781,12 +792,13 @@ def _fit_one(
     areas,
     general,
 ):
-    """One vertex of :func:`fit_jets` in the caller's buffers; returns ``work`` (grown when too small).
+    """One vertex of :func:`fit_jets` in the caller's buffers (``work`` holds at least ``size`` columns: the
+    caller grows it).
 
-    Inlined into its callers: a call per vertex passing thirty arrays cost a
-    quarter of the normal fits' time (reference counts of the arguments).
-    numba inlines no function of more than 31 arguments: the scalar options
-    come in ``limits = (away_fraction, settled[, agreement])``, and the facing check is
+    A call per vertex, compiled without reference counts (:data:`_JIT_LEAF`): inlined into its callers, as it was,
+    each of its thirty arguments was counted up and down per vertex all the same (numba's pruning of the counts
+    misses them across the fit's loops), and a call counting them cost a quarter of the normal fits' time. The
+    scalar options come in ``limits = (away_fraction, settled[, agreement])``, and the facing check is
     on when ``facing`` has rows (an empty ``facing``: no check). With an ``agreement`` above -1 and
     ``facing`` rows, a point whose ``facing`` normal has a cosine below it with the centre's weighs 0
     (the same-side fits of ``jets.fit_jets(agreement=)``).
@@ -817,8 +829,6 @@ def _fit_one(
     sx = sy = sz = 0.0
     if select:
         sx, sy, sz = facing[v, 0], facing[v, 1], facing[v, 2]
-    if size > work.shape[1]:
-        work = np.empty((work.shape[0], 2 * size))
     ox, oy, oz, weight = work[0], work[1], work[2], work[3]
     inverse = 1.0 / radius
     cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]  # read once (the stores below may alias)
@@ -882,7 +892,6 @@ def _fit_one(
     t1s[row, 0], t1s[row, 1], t1s[row, 2] = ax, ay, az
     t2s[row, 0], t2s[row, 1], t2s[row, 2] = bx, by, bz
     ns[row, 0], ns[row, 1], ns[row, 2] = nx, ny, nz
-    return work
 
 
 @threaded
@@ -933,7 +942,8 @@ def fit_jets_connected(
     n = vertices.shape[0]
     m = centres.shape[0]
     outputs = _jet_outputs.py_func(1 if normals_only else m)  # NumPy's: one compiled function fewer to load
-    fitted = np.full((m if normals_only else 1, 3), np.nan)
+    # every row written by its centre's fit (NaN where none): no NaN fill of (M, 3) beforehand; no huge pages
+    fitted = _unadvised_empty((m, 3), np.float64) if normals_only else np.full((1, 3), np.nan)
     limits = np.array([away_fraction, settled, agreement])
     facing = facing[: facing.shape[0] if check_facing else 0]
     slots = max(1, min(int(n_chunks), m))
@@ -1032,11 +1042,12 @@ def _connected_chunk(
         v = centres[i]
         radius = radii[i if per_centre else 0]
         size = _connected_members(vertices, indptr, indices, allowed, v, radius, mark, i, members, queue, spans)
-        # the fit into one row, then copied: one call site (the fit is inlined, and a second call
-        # site would double its compile time)
+        # the fit into one row, then copied (one call site)
         c[0, :] = np.nan  # a failed fit leaves the row as it finds it
         one_away[0] = np.nan  # written only when the facing is checked
-        work = _fit_one(
+        if size > work.shape[1]:  # grown by the caller: the fit allocates nothing (_JIT_LEAF)
+            work = np.empty((work.shape[0], 2 * size))
+        _fit_one(
             vertices,
             vertices,
             normals,
