@@ -136,7 +136,8 @@ def pool_grid(points, pool, reach):
     """``(pool_points, ids, grid)``: the points ``pool`` (int64 ids) sorted into a grid of cells of side ``reach``
     or more (:func:`_grid`), their coordinates in that order and their ids.
 
-    The search structure of ``pointcloud.ball_indices`` and of ``jets.fit_jets`` (balls on a grid),
+    The search structure of ``pointcloud.measured_balls``, ``pointcloud.nearest_neighbours`` and ``jets.fit_jets``
+    (balls on a grid),
     built once for all the centres of a computation.
     """
     m = pool.shape[0]
