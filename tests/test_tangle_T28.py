@@ -156,3 +156,35 @@ def test_copies_a_rounding_apart_are_copies():
     topology = MeshTopology.from_faces(faces, len(vertices))
     moved = vertices + np.random.default_rng(0).normal(scale=1e-7 * 0.4, size=vertices.shape)  # edges 0.4
     np.testing.assert_array_equal(tangled_vertices(moved, topology), tangled_vertices(vertices, topology))
+
+
+def _grid_sphere(n_longitude: int = 32, n_latitude: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """MATLAB's ``sphere`` through ``surf2patch`` (matGeom's own input): a (latitude + 1) x (longitude + 1) grid
+    of points, its seam column and its pole rows copies, its quads split in two, so that each pole quad gives one
+    zero-area face (two corners copies of the pole)."""
+    polar = np.pi * np.arange(n_latitude + 1) / n_latitude
+    azimuth = 2.0 * np.pi * np.arange(n_longitude + 1) / n_longitude
+    theta, phi = np.meshgrid(polar, azimuth, indexing="ij")
+    vertices = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], -1).reshape(-1, 3)
+    vertices[np.abs(vertices) < 1e-15] = 0.0  # the pole rows exact copies
+    grid = np.arange(len(vertices)).reshape(n_latitude + 1, n_longitude + 1)
+    a, b, c, d = grid[:-1, :-1], grid[1:, :-1], grid[1:, 1:], grid[:-1, 1:]
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    return vertices, faces
+
+
+def test_a_grid_sphere_with_zero_area_pole_faces_is_no_tangle():
+    # R28: its zero-area pole faces, their corners joined, stood as third faces on the pole's edges: 130 corners
+    # read as a tangle (not "corner of a zero-area face"), 2 right seam vertices lost
+    vertices, faces = _grid_sphere()
+    topology = MeshTopology.from_faces(faces, len(vertices))
+    assert not tangled_vertices(vertices, topology).any()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshQualityWarning)
+        result = meshcurv.principal_curvatures(vertices, faces, method="icc", weld=False)
+    assert TANGLE not in result.invalid_reason
+    area = np.linalg.norm(np.cross(*(vertices[faces[:, i]] - vertices[faces[:, 0]] for i in (1, 2))), axis=1)
+    degenerate = np.zeros(len(vertices), dtype=bool)
+    degenerate[faces[area == 0].ravel()] = True
+    assert result.valid[~degenerate].all()  # every vertex off the zero-area faces, the seam's copies too
+    np.testing.assert_allclose(result.mean[result.valid], 1.0, atol=0.05)

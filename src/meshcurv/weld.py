@@ -271,6 +271,10 @@ def _tangled_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.n
     near = np.zeros(n, dtype=bool)
     near[faces[copies[faces].any(axis=1)].ravel()] = True
     around = representative[faces[near[faces].any(axis=1)]]
+    # a face whose corners join (a zero-area face at a grid sphere's pole, given between copies of the pole) is no
+    # face of the joined surface: kept, it would stand as a third face on its edge (R28: 130 of a MATLAB grid
+    # sphere's vertices were read as a tangle, 2 right ones lost)
+    around = around[(around[:, 0] != around[:, 1]) & (around[:, 1] != around[:, 2]) & (around[:, 2] != around[:, 0])]
     joined = MeshTopology._build(np.ascontiguousarray(around), n)
     broken = joined.edge_vertices(joined.nonmanifold_edges) | joined.bowtie_vertices
     tangled = near & broken[representative]
