@@ -413,8 +413,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         else "",
         (
             f"{rough_count} vertices have a default ball that reaches round the surface (its normals turn by more "
-            f"than {BALL_TURN_CAP:g} rad) on a noisy surface (their noise level above {NOISE_GATE:g} edge lengths): "
-            "a smaller ball would fit the noise; smooth the mesh, or pass a `radius`"
+            f"than {BALL_TURN_CAP:g} rad) where the fits' residuals are above {NOISE_GATE:g} edge lengths: a coarse "
+            "mesh there, or a noisy one, whose smaller balls would fit the noise (the residual of a ball that reaches "
+            "round does not tell them apart); refine or smooth the mesh, or pass a `radius`"
         )
         if rough_count
         else "",
