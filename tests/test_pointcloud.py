@@ -481,6 +481,7 @@ def test_compiled_balls_keep_what_the_numpy_path_keeps():
     # pointcloud.measured_balls and of its NumPy twin (a k-d tree, _whole_ties, _own_side)
     pytest.importorskip("numba")
     from scipy.spatial import cKDTree
+    from test_kernel_twins import searched_balls
 
     from meshcurv._backend import numba_kernels
 
@@ -510,6 +511,9 @@ def test_compiled_balls_keep_what_the_numpy_path_keeps():
         )
         np.testing.assert_array_equal(found[0], expected[0])
         np.testing.assert_array_equal(found[1], expected[1])
+        # something was dropped (a filter that drops nothing would pass the equalities): the search alone keeps more
+        searched = searched_balls(points, centres, 0.25, 40)[1]
+        assert (found[1] <= searched).all() and (found[1] < searched).any()
         # the balls less what faces away (or is on another sheet): every kept point on the centre's side
         kept = found[0] < 3000
         facing = np.einsum("mkj,mj->mk", normals[np.where(kept, found[0], 0)], normals[centres])

@@ -21,7 +21,7 @@ import meshcurv
 from meshcurv import shapes
 from meshcurv._backend import use_backend
 from meshcurv.defects import FRAGMENT, INVALID_REASONS, TANGLE, UNDEFINED, defect_codes
-from meshcurv.errors import MeshQualityWarning
+from meshcurv.errors import InvalidMeshError, MeshQualityWarning
 from meshcurv.topology import MeshTopology
 from meshcurv.weld import tangled_vertices
 
@@ -188,3 +188,14 @@ def test_a_grid_sphere_with_zero_area_pole_faces_is_no_tangle():
     degenerate[faces[area == 0].ravel()] = True
     assert result.valid[~degenerate].all()  # every vertex off the zero-area faces, the seam's copies too
     np.testing.assert_allclose(result.mean[result.valid], 1.0, atol=0.05)
+
+
+def test_bad_arguments_are_named():
+    sphere = shapes.icosphere(1)
+    topology = MeshTopology.from_faces(sphere.faces, len(sphere.vertices))
+    with pytest.raises(InvalidMeshError, match="`topology` must be a MeshTopology; got ndarray"):
+        tangled_vertices(sphere.vertices, sphere.faces)
+    with pytest.raises(InvalidMeshError, match="`vertices` has 11 rows but the topology has 12 vertices"):
+        tangled_vertices(sphere.vertices[:-1], topology)
+    with pytest.raises(InvalidMeshError, match="tangled"):
+        defect_codes(topology, np.zeros(len(sphere.faces), dtype=bool), tangled=np.zeros(3, dtype=bool))
