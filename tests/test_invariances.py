@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import meshcurv
+from meshcurv.errors import MeshQualityWarning
 from meshcurv import shapes
 from meshcurv.estimators import ESTIMATORS
 
@@ -24,9 +25,16 @@ def mesh():
     return shapes.torus(3.0, 1.0, 36, 18, jitter=0.3, seed=5)
 
 
+#: quadric's warning on this torus since its smaller balls take quadrics over points spread across the tube
+#: (e459c2c): 6 default balls reach round the tube, no smaller one holds a fit, NaN (10-33% of the largest |k| off
+#: before); the vertices' NaN and reasons are part of what the invariances compare
+REACH_WARNING = r"quadric: 6 vertices have a default ball that reaches round the surface"
+
+
 def run(vertices, faces, method, **options):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        warnings.filterwarnings("ignore", REACH_WARNING, MeshQualityWarning)
         return meshcurv.principal_curvatures(vertices, faces, method=method, **options)
 
 

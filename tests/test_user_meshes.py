@@ -147,7 +147,13 @@ def seam_split(mesh):
 @pytest.mark.parametrize("method", METHODS)
 def test_soups_and_seams_give_the_welded_mesh_values(method, split):
     mesh = shapes.torus(3.0, 1.0, 36, 18, jitter=0.3, seed=5)
-    welded = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method=method)
+    with warnings.catch_warnings():
+        # quadric: 6 default balls reach round the tube, NaN since e459c2c (10-33% of the largest |k| off before);
+        # the split mesh's one warning names them beside the weld
+        warnings.filterwarnings(
+            "ignore", "quadric: 6 vertices have a default ball that reaches round", MeshQualityWarning
+        )
+        welded = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method=method)
     vertices, faces, origin = split(mesh)
     with pytest.warns(MeshQualityWarning, match=r"welded \d+ coincident vertices") as record:
         r = meshcurv.principal_curvatures(vertices, faces, method=method)
