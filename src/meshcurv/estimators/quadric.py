@@ -330,7 +330,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     for unit, members in parts:
         centres = np.flatnonzero(referenced) if np.ndim(unit) else members
         _fit_part((vertices, start, unit, centres), referenced, facing, sides, fields, away)
-    round_balls = rough_round = np.zeros(n, dtype=bool)
+    round_balls = noisy_levels = np.zeros(n, dtype=bool)
     if radius is None:  # a grown ball that holds the other side: the group's own radius
         base = _vertex_radii(groups, n)
         again = np.flatnonzero(referenced & (away > AWAY_FRACTION) & (radii > base) & np.isfinite(base) & (base > 0))
@@ -339,8 +339,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
         if not stages.voxel_default:  # a default ball that reaches round the surface: made smaller
             with np.errstate(invalid="ignore"):  # its own level: a group's median may be read off its curved parts
-                ball = (vertices, facing, start, radii, base, referenced, levels > NOISE_GATE)
-            round_balls, rough_round = _round_balls(ball, topology.edges, sides, fields, away)
+                noisy_levels = levels > NOISE_GATE
+            ball = (vertices, facing, start, radii, base, referenced, noisy_levels)
+            round_balls = _round_balls(ball, topology.edges, sides, fields, away)
     unsure = np.zeros(n, dtype=bool)
     steps = np.zeros(n, dtype=bool)
     # the default radius is grown with the noise (jet_vertex_radii) and checked by the gate. A voxel surface's
@@ -384,7 +385,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     two_sided = int((failed & (away > AWAY_FRACTION)).sum())
     noisy_balls = int((failed & unsure & ~(away > AWAY_FRACTION)).sum())
     reached = failed & round_balls & ~unsure & ~(away > AWAY_FRACTION)
-    rough_count = int((reached & rough_round).sum())  # a noisy ball reaching round: no smaller one tried
+    rough_count = int((reached & noisy_levels).sum())  # a noisy ball reaching round: no smaller one tried
     round_count = int(reached.sum()) - rough_count
     few = int(failed.sum()) - two_sided - noisy_balls - round_count - rough_count
     steps &= failed & ~(away > AWAY_FRACTION)  # on a staircase the unsure balls are its steps' (noisy_balls)
@@ -484,9 +485,9 @@ ROUND_AGREEMENT = 0.1
 ROUND_MIN_SPREAD = 1e-3
 
 
-def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, away: np.ndarray) -> tuple:
-    """``(reached, rough)``, (V,) bool each: the vertices whose default ball reaches round the surface and no smaller
-    ball holds a fit (their coefficients made NaN), and those of them whose ball is noisy (no smaller ball tried).
+def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, away: np.ndarray) -> np.ndarray:
+    """(V,) bool: the vertices whose default ball reaches round the surface and no smaller ball holds a fit (their
+    coefficients made NaN); those of them that are ``rough`` (below) are the noisy balls, no smaller one tried.
 
     ``ball = (vertices, normals, start, radii, base, referenced, rough)``: ``normals`` the vertex normals (NaN rows:
     none), ``radii`` each vertex's default radius (changed in place where a ball is made smaller), ``base`` its
@@ -510,19 +511,18 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
     vertices, normals, start, radii, base, referenced, rough = ball
     six, fitted, coefficients = fields
     out = np.zeros(vertices.shape[0], dtype=bool)
-    noisy_out = np.zeros(vertices.shape[0], dtype=bool)
     # the shape operators' Frobenius norm sqrt(k_min^2 + k_max^2) first (no eigenvalues at every vertex of a mesh)
     norms = np.sqrt(np.einsum("ij,ij->i", six[:, :3], six[:, :3]) + 2.0 * np.einsum("ij,ij->i", six[:, 3:], six[:, 3:]))
     with np.errstate(invalid="ignore"):
         bent = radii * norms > ROUND_CANDIDATE
     rows = np.flatnonzero(referenced & np.isfinite(coefficients).all(axis=1) & (radii <= base) & bent)
     if rows.size == 0:
-        return out, noisy_out
+        return out
     k_min, k_max = principal_from_shape_operator(six[rows], fitted[rows])[:2]
     with np.errstate(invalid="ignore"):
         rows = rows[radii[rows] * np.maximum(np.abs(k_min), np.abs(k_max)) > ROUND_CANDIDATE]
     if rows.size == 0:
-        return out, noisy_out
+        return out
     pool = np.flatnonzero(referenced)
     creases = _edge_turns(normals, edges, vertices.shape[0])  # the mesh's own normals: a crease is sharp there
     # the turns read on the fits' normals, which average the noise of the vertex normals (noise of 0.1 edge lengths
@@ -537,7 +537,7 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
         over = (turns > BALL_TURN_CAP) & ~(sharpest > CREASE_TURN)
         rows, bends = rows[over], bends[over]
         noisy = rough[rows]  # a noisy ball needs a wider one, not a smaller one
-        out[rows[noisy]] = noisy_out[rows[noisy]] = True
+        out[rows[noisy]] = True
         rows, bends = rows[~noisy], bends[~noisy]
         if rows.size == 0 or step == ROUND_STEPS:
             break
@@ -562,7 +562,7 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
         rows = rows[~lost]
     out[rows] = True
     coefficients[out] = np.nan
-    return out, noisy_out
+    return out
 
 
 def _agreeing(smaller: tuple, wider: tuple) -> np.ndarray:
