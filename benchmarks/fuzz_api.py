@@ -2029,10 +2029,15 @@ def relation_check(args, kwargs, result, relation):
         warnings.simplefilter("ignore")
         try:
             other = meshcurv.principal_curvatures(v2, f2, **kwargs)
-            if back is not None:  # the moved input brought back exactly is the reference (:func:`translated`)
-                result = meshcurv.principal_curvatures(back, f2, **kwargs)
         except DOCUMENTED as error:
             return [f"{kind} {value:g}: {type(error).__name__} where the original succeeded: {str(error)[:150]}"]
+        if back is not None:  # the moved input brought back exactly is the reference (:func:`translated`)
+            try:
+                result = meshcurv.principal_curvatures(back, f2, **kwargs)
+            except DOCUMENTED as error:
+                return [
+                    f"{kind} {value:g}: {type(error).__name__} on the input brought back exactly: {str(error)[:150]}"
+                ]
     label = f"{kind} {value:g}" + ("" if back is None else " (against its input brought back exactly)")
     referenced = _referenced(args, n)
     old_valid, new_valid = result.valid, other.valid[take]
@@ -2288,12 +2293,18 @@ def cloud_relation_check(points, kwargs, result, relation, value) -> list[str]:
         warnings.simplefilter("ignore")
         try:
             other = pointcloud.point_cloud_curvatures(moved, **kwargs)
-            if back is not None:  # the moved input brought back exactly is the reference (:func:`translated`)
-                result = pointcloud.point_cloud_curvatures(back, **kwargs)
         except DOCUMENTED as error:
             return [
                 f"cloud {relation} {value:g}: {type(error).__name__} where the original succeeded: {str(error)[:150]}"
             ]
+        if back is not None:  # the moved input brought back exactly is the reference (:func:`translated`)
+            try:
+                result = pointcloud.point_cloud_curvatures(back, **kwargs)
+            except DOCUMENTED as error:
+                return [
+                    f"cloud {relation} {value:g}: {type(error).__name__} on the input brought back exactly: "
+                    f"{str(error)[:150]}"
+                ]
     label = f"cloud {relation} {value:g}" + ("" if back is None else " (against its input brought back exactly)")
     valid, moved_valid = result.valid, other.valid[take]
     if not np.array_equal(valid, moved_valid):
