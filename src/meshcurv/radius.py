@@ -75,7 +75,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ._backend import numba_kernels
+from ._backend import numba_kernels, twin
 from ._validation import check_positive_float, check_vertex_count, checked_indices, checked_mask, checked_points
 from .errors import InvalidOptionError
 from .defects import _fragment_vertices, _needle_corners, _needle_vertices, _scale_edges, _scale_vertices
@@ -90,7 +90,15 @@ from ._geometry import (
 from .geometry import _floats, checked_topology_points
 from .jets import SETTLED_SLOPE, _fit_jets
 from .lattice import VoxelGrid, voxel_grid
-from .neighborhoods import _ball_face_sums, _checked_ids, face_in_ball_ratios, ring_max, ring_sums
+from .neighborhoods import (
+    _ball_face_sums,
+    _ball_pairs,
+    _checked_ids,
+    check_ball_work,
+    face_in_ball_ratios,
+    ring_max,
+    ring_sums,
+)
 from .topology import MeshTopology
 
 if TYPE_CHECKING:
@@ -990,23 +998,47 @@ def _ball_turns(
         The largest :func:`_edge_turns` ``creases`` of the ball's points.
     """
     m = centres.shape[0]
-    turns, bends, sharpest = np.zeros(m), np.zeros(m), np.zeros(m)
     if m == 0 or pool.shape[0] == 0:
-        return turns, bends, sharpest
-    from .neighborhoods import _ball_pairs
+        return np.zeros(m), np.zeros(m), np.zeros(m)
+    check_ball_work(vertices[pool], radii[centres], m, centres=vertices[centres])  # both backends refuse alike
+    cosines, bends, sharpest = ball_turn_extremes(vertices, normals, radii, centres, pool, creases)
+    # the largest angle is that of the smallest cosine (arccos decreases): one arccos per ball, NumPy's on both
+    return np.arccos(cosines), bends, sharpest
 
+
+@twin("turns")
+def ball_turn_extremes(
+    vertices: np.ndarray, normals: np.ndarray, radii: np.ndarray, centres: np.ndarray, pool: np.ndarray, creases
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(cosines, bends, sharpest)`` of the ball of each centre, :func:`_ball_turns`' extremes: the smallest
+    cosine between the centre's normal and a point's of its ball (clipped to [-1, 1]; 1 where none), and
+    ``bends`` and ``sharpest`` as :func:`_ball_turns` returns them.
+
+    Parameters
+    ----------
+    vertices, normals, radii, centres, pool, creases
+        As :func:`_ball_turns` takes them (``centres`` and ``pool`` not empty).
+
+    Returns
+    -------
+    cosines, bends, sharpest : ndarray of shape (M,)
+    """
+    m = centres.shape[0]
+    cosines, bends, sharpest = np.ones(m), np.zeros(m), np.zeros(m)
     unit = radii[centres]
     for _, i, j in _ball_pairs(vertices[pool], vertices[centres], unit):
         ids, own = pool[j], centres[i]
+        # each sum of three products x, y, z in that order, as the kernel adds them (einsum pairs them otherwise)
         with np.errstate(invalid="ignore", divide="ignore"):  # a coincident copy (weld=False): apart 0, not outer
-            angles = np.arccos(np.clip(np.einsum("ij,ij->i", normals[ids], normals[own]), -1.0, 1.0))
             apart = np.linalg.norm(vertices[ids] - vertices[own], axis=1)
             chords = np.linalg.norm(normals[ids] - normals[own], axis=1) / apart
-        np.fmax.at(turns, i, angles)
+            products = normals[ids] * normals[own]
+            dots = (products[:, 0] + products[:, 1]) + products[:, 2]
+        np.fmin.at(cosines, i, np.clip(dots, -1.0, 1.0))
         outer = apart >= 0.5 * unit[i]
         np.fmax.at(bends, i[outer], chords[outer])
         np.fmax.at(sharpest, i, creases[ids])
-    return turns, bends, sharpest
+    return cosines, bends, sharpest
 
 
 def voxel_radius(spacing: np.ndarray, curvature_radius: float) -> float:

@@ -443,7 +443,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # on a mesh with boundaries the sums carry the scatter of the edges' own estimates too (FEW_ELEMENTS_SPREAD)
     scattered = bool(topology.boundary_edges.any())
     terms = (beta, unit, lengths, intact, usable)
-    measures, areas, spread_sums, holes, readings = _ball_sums(vertices, topology, groups, radii, terms, scattered)
+    measures, areas, spread_sums, holes, readings, summed = _ball_sums(
+        vertices, topology, groups, radii, terms, scattered
+    )
 
     stages.start("retrieve curvatures")
     valid &= areas > 0
@@ -456,7 +458,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     reached = np.zeros_like(valid)
     if radius is None and not stages.voxel_default:  # a default ball that reaches round the surface: made smaller
         sums = (measures, areas, spread_sums)
-        reached = _round_balls(mesh, (radii, valid), (terms, scattered), sums, (k_min, k_max, dir_min, dir_max))
+        reached = _round_balls(mesh, (radii, valid), summed, sums, (k_min, k_max, dir_min, dir_max))
         valid &= ~reached
     few = np.zeros_like(valid)
     on_voxels = _voxel_surface(mesh, defects.invalid_vertices, valid=valid, reading=stages.voxel)
@@ -509,16 +511,16 @@ def _round_balls(mesh: PreparedMesh, balls: tuple, edges: tuple, sums: tuple, cu
     """(V,) bool: the vertices whose default ball reaches round the surface and no smaller ball holds the surface.
 
     ``balls = (radii, valid)``: each vertex's default radius (changed in place where a ball is made smaller) and the
-    vertices estimated; ``edges = (terms, scattered)`` as :func:`_ball_sums` takes them; ``sums = (measures, areas,
-    spread_sums)`` of the balls and ``curvatures = (k_min, k_max, dir_min, dir_max)`` (changed in place at the balls
-    made smaller). A ball of the default radius (2.5 mean edge lengths) reaches round a part curved along its short
-    edges: on ``torus(2, 1, 16, 16)`` a ball of 1.71 for a tube of radius 1, whose tensor, the mean of the shape
-    operator over the ball, mixes the tube's outer and inner sides (``k_min`` up to 82% of the largest ``|k|``
+    vertices estimated; ``edges = (edge_values, measured)``, what :func:`_ball_sums` summed; ``sums = (measures,
+    areas, spread_sums)`` of the balls and ``curvatures = (k_min, k_max, dir_min, dir_max)`` (changed in place at
+    the balls made smaller). A ball of the default radius (2.5 mean edge lengths) reaches round a part curved along
+    its short edges: on ``torus(2, 1, 16, 16)`` a ball of 1.71 for a tube of radius 1, whose tensor, the mean of the
+    shape operator over the ball, mixes the tube's outer and inner sides (``k_min`` up to 82% of the largest ``|k|``
     off, valid; issue 29). A ball whose vertex normals turn from its centre's by more than
     :data:`meshcurv.radius.BALL_TURN_CAP` with no edge in it turning by more than
     :data:`meshcurv.radius.CREASE_TURN` (a crease is the ball's reading at any radius) is made smaller, to where a
-    circle through its rim would turn by :data:`ROUND_TURN`, and summed again (:data:`ROUND_STEPS` times at most);
-    a vertex whose smaller ball holds none of its neighbours, or is below :data:`MIN_RADIUS_SCALES` length scales, or
+    circle through its rim would turn by :data:`ROUND_TURN`, and summed again (:data:`ROUND_STEPS` times at most); a
+    vertex whose smaller ball holds none of its neighbours, or is below :data:`MIN_RADIUS_SCALES` length scales, or
     that still turns past the cap, is returned (NaN with ``valid=False``, the reason
     :data:`meshcurv.defects.REACH`). Checked where the largest ``|k|`` times the radius exceeds
     :data:`ROUND_CANDIDATE`."""
@@ -534,7 +536,7 @@ def _round_balls(mesh: PreparedMesh, balls: tuple, edges: tuple, sums: tuple, cu
     pool = np.flatnonzero(topology.referenced_vertices)
     creases = _edge_turns(normals, topology.edges, vertices.shape[0])
     reach = 2.0 * np.sin(ROUND_TURN / 2.0)  # the chord of a unit circle whose ends' normals turn by ROUND_TURN
-    values, measured = _edge_values(vertices, topology, radii, *edges)[:2]  # the holes read within the default
+    values, measured = edges  # the holes read within the default
     ends, values = np.ascontiguousarray(topology.edges[measured], dtype=np.int64), values[measured]
     for step in range(ROUND_STEPS + 1):
         turns, bends, sharpest = _ball_turns(vertices, normals, radii, rows, pool, creases)
@@ -585,17 +587,18 @@ def _reach_note(count: int) -> str:
 
 
 def _ball_sums(vertices, topology, groups, radii, terms, scattered):
-    """``(measures, areas, spread_sums, holes, readings)`` of the balls of ``groups`` (``(radius, members)``; a
-    radius may be one per vertex): the tensor's six columns, the area and the scatter's columns
-    (:func:`_edge_spread_columns`, none without ``scattered``), each vertex's sums over its ball, with the edges of
-    holes (:func:`hole_edges`, read within ``radii``, (V,)) taking neither curvature nor area. ``terms``: ``(beta,
+    """``(measures, areas, spread_sums, holes, readings, (edge_values, measured))`` of the balls of ``groups``
+    (``(radius, members)``; a radius may be one per vertex): the tensor's six columns, the area and the scatter's
+    columns (:func:`_edge_spread_columns`, none without ``scattered``), each vertex's sums over its ball, with the
+    edges of holes (:func:`hole_edges`, read within ``radii``, (V,)) taking neither curvature nor area; last, what
+    was summed (:func:`_edge_values`: :func:`_round_balls` sums it again over smaller balls). ``terms``: ``(beta,
     unit, lengths, intact, usable)`` of the edges, ``intact`` their area densities with the holes'."""
     edge_values, measured, holes, readings = _edge_values(vertices, topology, radii, terms, scattered)
     measures = np.zeros((vertices.shape[0], edge_values.shape[1]))
     for group_radius, members in groups:
         rows = slice(None) if members is None else members
         measures[rows] = _ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
-    return measures[:, :6], measures[:, 6], measures[:, 7:], holes, readings
+    return measures[:, :6], measures[:, 6], measures[:, 7:], holes, readings, (edge_values, measured)
 
 
 def _edge_values(vertices, topology, radii, terms, scattered):
