@@ -2029,6 +2029,26 @@ def check_stacked(name):
     assert expected.any() or got.any()
 
 
+def check_ball_turn_extremes(name):
+    from meshcurv import radius
+
+    vertices, _ = mesh(name)
+    normals = numpy_normals(name)  # NaN rows (the defects' unreferenced and cancelled vertices) add nothing
+    edges = topology(name).edges.astype(np.int64)
+    n = vertices.shape[0]
+    radii = 2.5 * mean_edge(name) * np.random.default_rng(5).uniform(0.5, 1.5, n)  # one radius per centre
+    centres = np.arange(0, n, 3, dtype=np.int64)
+    pool = np.flatnonzero(topology(name).referenced_vertices).astype(np.int64)
+    creases = radius._edge_turns(normals, edges, n)
+    expected = radius.ball_turn_extremes.numpy(vertices, normals, radii, centres, pool, creases)
+    # the same pairs (squared distances summed x, y, z against r^2), each pair's products summed x, y, z, and
+    # extremes that do not depend on the pairs' order: to the bit
+    got = kernels("turns").ball_turn_extremes(vertices, normals, radii, centres, pool, creases)
+    for a, b in zip(got, expected):
+        np.testing.assert_array_equal(a, b)
+    assert (expected[0] < 1).any() and (expected[1] > 0).any()
+
+
 TWINS = [
     Twin("geometry.face_cross_products", "_geometry.face_cross_products", check_face_cross_products, MESHES),
     Twin(
@@ -2164,6 +2184,7 @@ TWINS = [
     Twin("pointcloud.line_spread", "_pointcloud_normals._line_spread_numpy", check_line_spread, CLOUDS),
     Twin("pointcloud.flat_balls", "_pointcloud_estimators._flat_balls", check_flat_balls, CLOUDS),
     Twin("pointcloud.stacked", "_pointcloud_normals._stacked", check_stacked, CLOUDS),
+    Twin("turns.ball_turn_extremes", "radius.ball_turn_extremes", check_ball_turn_extremes, MESHES + THIN),
 ]
 
 #: Public kernels checked here only through another path, each with the reason. Empty: every
