@@ -121,6 +121,8 @@ corrected curvature measures for polygonal surfaces. Computer Graphics Forum
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from .._geometry import face_areas, finite_rows, median_edge_length
@@ -163,7 +165,8 @@ from ..radius import (
     scale_ladder,
     stable_scales,
 )
-from .._prepared import PreparedMesh
+from .._prepared import PreparedMesh, _scales_and_needles
+from ..result import Surface
 from ..topology import MeshTopology
 from ._support import Stages, failed_fits_undefined, finish
 
@@ -588,7 +591,17 @@ def voxel_pilot(mesh: PreparedMesh):
     percentile (:func:`meshcurv.radius.voxel_vertex_radii`), so the curvatures of the other vertices are
     NaN; their normals are the mean of the fitted normals of the nearest centres (:func:`_spread_normals`)
     (the voxel extent along each vertex's normal sets its radius).
+
+    A mesh with needle vertices (:func:`meshcurv.defects.needle_vertices`) is read with each needle put back at
+    the mean of its other neighbours, its faces kept (:func:`_needles_put_back`). Without them the pilot's balls
+    at a needle's base held the hole of its faces (a voxel surface's staircase left unbalanced: curvedness up to
+    44% off), and the grids of its samples and fits, which the vertex set anchors, were other ones: a small voxel
+    surface's default radius moved by more than 2% in 11 of 128 draws of one vertex or two moved 1e3-1e6 sizes
+    away (up to 12%; fuzz_api 575/106: 3.7%), none after (up to 1.4%). The needles themselves stay out of every
+    reading (:func:`meshcurv.radius.voxel_surface_radius`).
     """
+    if mesh.needles.any():
+        mesh = _needles_put_back(mesh)
 
     def run(radius: float):
         vertices, topology = mesh.vertices, mesh.topology
@@ -621,6 +634,27 @@ def voxel_pilot(mesh: PreparedMesh):
         return k_min, k_max, valid, normals
 
     return run
+
+
+def _needles_put_back(mesh: PreparedMesh) -> PreparedMesh:
+    """``mesh`` with each needle vertex at the mean of its neighbours that are no needles (where it has any): the
+    same topology and vertex order, its scales and needles found again."""
+    vertices, needles = mesh.vertices.copy(), mesh.needles
+    indptr, indices = mesh.topology.neighbour_lists
+    ends = np.repeat(np.arange(needles.size), np.diff(indptr))
+    kept = needles[ends] & ~needles[indices]  # each needle's edges to a neighbour that is no needle
+    counts = np.bincount(ends[kept], minlength=needles.size)
+    sums = np.stack(
+        [np.bincount(ends[kept], weights=vertices[indices[kept], axis], minlength=needles.size) for axis in range(3)],
+        axis=1,
+    )
+    moved = counts > 0
+    vertices[moved] = sums[moved] / counts[moved, None]
+    scales, left, median = _scales_and_needles(vertices, mesh.topology)
+    surface = Surface(vertices, mesh.topology.faces)
+    return dataclasses.replace(
+        mesh, vertices=vertices, surface=surface, length_scales=scales, needles=left, known_median=median
+    )
 
 
 def _pilot_normals(
