@@ -764,7 +764,7 @@ def call_ranges(n: int, pairs_per_centre: float, weights: np.ndarray | None = No
 
 
 def _face_sum_scratch(
-    n_chunks: int, n_vertices: int, n_faces: int, nested: bool = False, *, filled: bool = True
+    n_chunks: int, n_vertices: int, n_faces: int, nested: bool = False, *, filled: bool = True, kernels=None
 ) -> tuple[np.ndarray, ...]:
     """The per-thread scratch of the compiled ``connected_face_sums``:
     ``(seen, mark, known, squared, queue, levels, spare)`` (and of ``connected_face_sums_nested``).
@@ -778,23 +778,30 @@ def _face_sum_scratch(
     walk: the smallest ball each queued vertex was reached through), (n_chunks, 0) otherwise; ``spare``:
     (n_chunks, 0), the place of the clusters' scratch (``clustered_face_sums``). ``filled`` False: the three
     stamps not filled here (``connected_face_sums`` with ``ready`` has each thread fill its own row, in parallel).
+
+    ``kernels`` (the compiled modules' ``neighborhoods``): the arrays from numba's allocator, not numpy's
+    (``kernels._unadvised_array``): numpy advises huge pages for them, and where the kernel gives huge pages to
+    advised memory only, the first write to each 2 MB of a fresh array waits while it compacts memory (issue
+    31, at 1M vertices: 0.2-0.36 s of system time in the ball sums' threads, for 56 MB of scratch).
     """
     index = np.int32 if max(n_vertices, n_faces) < np.iinfo(np.int32).max else np.int64
-    stamps = np.full if filled else _unfilled
+    empty = np.empty if kernels is None else kernels._unadvised_array
+
+    def stamps(shape: tuple[int, int]) -> np.ndarray:
+        array = empty(shape, index)
+        if filled:
+            array.fill(-1)
+        return array
+
     return (
-        stamps((n_chunks, n_faces), -1, index),
-        stamps((n_chunks, n_vertices), -1, index),
-        stamps((n_chunks, n_vertices), -1, index),
-        np.empty((n_chunks, n_vertices)),
-        np.empty((n_chunks, n_vertices), index),
-        np.empty((n_chunks, n_vertices if nested else 0), index),
-        np.empty((n_chunks, 0), index),
+        stamps((n_chunks, n_faces)),
+        stamps((n_chunks, n_vertices)),
+        stamps((n_chunks, n_vertices)),
+        empty((n_chunks, n_vertices), np.float64),
+        empty((n_chunks, n_vertices), index),
+        empty((n_chunks, n_vertices if nested else 0), index),
+        empty((n_chunks, 0), index),
     )
-
-
-def _unfilled(shape: tuple[int, int], _fill: int, dtype: type) -> np.ndarray:
-    """``np.full`` without the fill: the kernel fills the rows (:func:`_face_sum_scratch`)."""
-    return np.empty(shape, dtype)
 
 
 def _connected_face_sums(
@@ -819,12 +826,14 @@ def _connected_face_sums(
     mean, _ = check_ball_work(centres, outer + float(reach.max()), m, centres=vertices[:m])
     indptr, indices = kernels.vertex_face_lists(faces, n, kernel_threads())
     values = np.ascontiguousarray(values)
-    out = kernels._unadvised_zeros((radii.shape[0], n, values.shape[2]))
     clustered = radii.shape[0] == 1 and mean >= CLUSTER_MIN_FACES  # dense balls: clusters inside a ball added whole
     plain = radii.shape[0] == 1 and not clustered  # one ball: the kernel without the passes
+    shape = (radii.shape[0], n, values.shape[2])
+    # the plain kernel writes each of its rows (every row when m == n): no zeros first (a memset of 72 MB at 1M)
+    out = kernels._unadvised_array(shape, np.float64, zero=not (plain and m == n))
     rows = max(1, min(kernel_threads(), n))
     # the plain kernel's threads fill their own rows of the stamps (``ready``): no serial fill of (rows, F + 2 V)
-    scratch = _face_sum_scratch(rows, n, faces.shape[0], radii.shape[0] > 1, filled=not plain)
+    scratch = _face_sum_scratch(rows, n, faces.shape[0], radii.shape[0] > 1, filled=not plain, kernels=kernels)
     ready = np.zeros(rows, dtype=bool)
     clusters = None
     if clustered:

@@ -10,8 +10,8 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, run_chunks, threaded
-from .geometry import _unadvised_empty
-from .jets import _fit_one, _general, _jet_outputs, _jet_scratch
+from .geometry import _unadvised_array
+from .jets import _fit_one, _general, _grown_work, _jet_outputs, _jet_scratch
 from .neighborhoods import _connected_members, _connected_walk_levels, _vertex_spans
 from .tensors import _principal_from_mean_gaussian, _tangent_eigen
 
@@ -65,8 +65,8 @@ def _triangle_measures(points, normals, i, j, k, turn):
 @threaded
 def face_measures(vertices, faces, normals):
     """``measures.face_measures``: (F, 9) ``mu_0, mu_1, mu_2`` and the symmetrized ``mu^{X,Y}`` per face."""
-    # every element written by its chunk: no fill (calloc's memset on reused pages); no huge pages (_unadvised_empty)
-    out = _unadvised_empty((faces.shape[0], 9), np.float64)
+    # every element written by its chunk: no fill (calloc's memset on reused pages); no huge pages (geometry._unadvised_array)
+    out = _unadvised_array((faces.shape[0], 9), np.float64)
     chunks = _CHUNKS_PER_THREAD * nb.get_num_threads()
     run_chunks(_face_measures_chunk, faces.shape[0], chunks, vertices, faces, normals, out)
     return out
@@ -93,7 +93,7 @@ def curvatures_from_measures(summed, normals):
     """``measures.curvatures_from_measures``: (N,) k_min, k_max and (N, 3) dir_min, dir_max of summed measures."""
     n = summed.shape[0]
     # each chunk writes every row of its own, NaN where undefined: no fill, serial or calloc's (issue 31)
-    out = tuple(_unadvised_empty(shape, np.float64) for shape in ((n,), (n,), (n, 3), (n, 3)))
+    out = tuple(_unadvised_array(shape, np.float64) for shape in ((n,), (n,), (n, 3), (n, 3)))
     run_chunks(_curvatures_chunk, n, _CHUNKS_PER_THREAD * nb.get_num_threads(), summed, normals, *out)
     return out
 
@@ -217,6 +217,7 @@ def _nested_fits_chunk(
     areas = np.empty(0)  # unweighted
     work, moments, right, matrix, low, inverse_binomials, solution = _jet_scratch(degree, exponents.shape[0])
     c, a, b, nn, one_count, one_away = _jet_outputs(1)  # one row, rewritten for each fit
+    only_row = np.int64(0)  # an int64 as jets._grid_chunk's rows: one compiled _fit_one (not one for a literal 0)
     _, _, inner, inner_levels, squared = walk
     for i in range(lo, hi):
         v = centres[i]
@@ -239,8 +240,7 @@ def _nested_fits_chunk(
                         vertices, indptr, indices, allowed, v, radii[r], mark, stamp + 1 + r, members, spare, spans
                     )
             c[0, :] = np.nan
-            if size > work.shape[1]:  # grown by the caller: the fit allocates nothing (_JIT_LEAF)
-                work = np.empty((work.shape[0], 2 * size))
+            work = _grown_work(work, size)
             # numba refuses *args there, hence the whole list
             _fit_one(
                 vertices,
@@ -252,7 +252,7 @@ def _nested_fits_chunk(
                 exponents,
                 min_spread,
                 v,
-                0,
+                only_row,
                 members,
                 size,
                 work,

@@ -24,7 +24,7 @@ from ._common import (
     run_slots,
     threaded,
 )
-from .geometry import _unadvised_empty
+from .geometry import _unadvised_array
 from .neighborhoods import _ball_members, _connected_members, _vertex_spans, pool_grid
 from .tensors import _tangent_eigen
 
@@ -360,6 +360,11 @@ def fit_jets(
     ``check_facing``), the points whose ``facing`` normal has a cosine below it with the centre's weigh 0.
     """
     points, ids, grid, centres = _grid_centres(vertices, pool, radii, centres)
+    # read-only views, as jets._connected_fits passes its arrays to fit_jets_connected: one compiled _fit_one
+    # for both paths (a writable array among them made numba compile it a second time: 0.7 s, issue 31)
+    vertices, points, normals, facing, areas = (
+        _read_only(array) for array in (vertices, points, normals, facing, areas)
+    )
     outputs = _jet_outputs.py_func(vertices.shape[0])  # NumPy's: one compiled function fewer to load
     wider = _jet_outputs.py_func(vertices.shape[0] if larger > 0 else 1)  # (one row unused without larger)
     limits = np.array([away_fraction, settled, agreement])
@@ -390,6 +395,13 @@ def fit_jets(
     return outputs + wider if larger > 0 else outputs
 
 
+def _read_only(array: np.ndarray) -> np.ndarray:
+    """A read-only view of ``array`` (no copy)."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
+
 @threaded
 def fit_jet_pairs(vertices, normals, radii, larger, *options):
     """``jets.fit_jets(larger=)``: the fits of :func:`fit_jets` over balls of ``radii[0]`` and of ``larger``
@@ -413,7 +425,10 @@ def _grid_centres(vertices, pool, radii, centres):
     in grid order (consecutive balls share cells: cache), the centres outside the pool last."""
     n = vertices.shape[0]
     n_pool = pool.shape[0]
-    points, ids, grid = pool_grid(vertices, pool, radii.max())
+    widest = radii[0]  # radii.max() (NaN if any is), without compiling numba's max
+    for k in range(1, radii.shape[0]):
+        widest = radii[k] if radii[k] > widest or radii[k] != radii[k] else widest
+    points, ids, grid = pool_grid(vertices, pool, widest)
     chosen = np.zeros(n, np.bool_)
     chosen[centres] = True
     sorted_centres = np.empty(centres.shape[0], np.int64)
@@ -486,8 +501,7 @@ def _grid_chunk(
         else:
             radius, members, size = larger, outer, outer_size
             coefficients, t1s, t2s, ns, counts, away = wider
-        if size > work.shape[1]:  # grown by the caller: the fit allocates nothing (_JIT_LEAF)
-            work = np.empty((work.shape[0], 2 * size))
+        work = _grown_work(work, size)
         _fit_one(
             vertices,
             points,
@@ -559,6 +573,17 @@ def _jet_outputs(rows):
         np.zeros(rows),
         np.full(rows, np.nan),
     )
+
+
+@nb.njit(inline="always", **_JIT)
+def _grown_work(work, size):
+    """``work`` of :func:`_jet_scratch`, or a new one twice as wide when a ball of ``size`` points does not fit:
+    grown by the callers of :func:`_fit_one` (``_grid_chunk``, ``_connected_chunk``, ``icc._nested_fits_chunk``),
+    as the fit allocates nothing (:data:`~._common._JIT_LEAF`). Inlined: a call per vertex would count the
+    array's references up and down."""
+    if size > work.shape[1]:
+        return np.empty((work.shape[0], 2 * size))
+    return work
 
 
 @nb.njit(inline="always", **_JIT)
@@ -941,16 +966,18 @@ def fit_jets_connected(
     """
     n = vertices.shape[0]
     m = centres.shape[0]
+    # read-only views, as fit_jets passes them: one compiled _fit_one whatever the callers' flags (issue 31)
+    vertices, normals, facing, areas = (_read_only(array) for array in (vertices, normals, facing, areas))
     outputs = _jet_outputs.py_func(1 if normals_only else m)  # NumPy's: one compiled function fewer to load
     # every row written by its centre's fit (NaN where none): no NaN fill of (M, 3) beforehand; no huge pages
-    fitted = _unadvised_empty((m, 3), np.float64) if normals_only else np.full((1, 3), np.nan)
+    fitted = _unadvised_array((m, 3), np.float64) if normals_only else np.full((1, 3), np.nan)
     limits = np.array([away_fraction, settled, agreement])
     facing = facing[: facing.shape[0] if check_facing else 0]
     slots = max(1, min(int(n_chunks), m))
     # each thread's walk scratch: the stamps (filled with -1 by the thread on its first range), members, queue;
     # int64: in int32 the walk compared each stamp to its centre's int64 position after a widening load (+6% of
     # the fits' instructions, callgrind, icosphere(32); no CPU seconds gained at 1M)
-    scratch = _unadvised_empty((3, slots, n), np.int64)  # no huge pages (geometry._unadvised_empty)
+    scratch = _unadvised_array((3, slots, n), np.int64)  # no huge pages (geometry._unadvised_array)
     filled = np.zeros(slots, np.bool_)
     run_slots(
         _connected_chunk,
@@ -1038,6 +1065,8 @@ def _connected_chunk(
     # call of _jet_outputs (its NaN fills compile 0.3-0.5 s of CPU more than these)
     c, a, b, nn = np.empty((1, 6)), np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3))
     one_count, one_away = np.empty(1), np.empty(1)
+    # the fit's row: an int64 as _grid_chunk's (a literal 0 made numba compile _fit_one a second time)
+    only_row = np.int64(0)
     for i in range(lo, hi):
         v = centres[i]
         radius = radii[i if per_centre else 0]
@@ -1045,8 +1074,7 @@ def _connected_chunk(
         # the fit into one row, then copied (one call site)
         c[0, :] = np.nan  # a failed fit leaves the row as it finds it
         one_away[0] = np.nan  # written only when the facing is checked
-        if size > work.shape[1]:  # grown by the caller: the fit allocates nothing (_JIT_LEAF)
-            work = np.empty((work.shape[0], 2 * size))
+        work = _grown_work(work, size)
         _fit_one(
             vertices,
             vertices,
@@ -1057,7 +1085,7 @@ def _connected_chunk(
             exponents,
             min_spread,
             v,
-            0,
+            only_row,
             members,
             size,
             work,

@@ -10,7 +10,7 @@ import numba as nb
 import numpy as np
 
 from ._common import _JIT, _ONE, _UNSIGNED, run_chunks, run_slots, threaded
-from .geometry import _unadvised_empty, _unadvised_zeros  # noqa: F401 (the ball sums' output, for ..neighborhoods)
+from .geometry import _unadvised_array  # (also the ball sums' arrays, for ..neighborhoods)
 from .topology import _BUCKET_CHUNKS, _bucket_starts
 
 
@@ -68,6 +68,37 @@ def _place_corners(lo, hi, faces, cursor, indices):
 
 
 @nb.njit(**_JIT)
+def _merge_sort_column(levels, order, first, last):
+    """``levels[first:last]`` sorted, stably, and ``order[first:last]`` moved with them: a bottom-up merge sort
+    (what ``np.argsort(kind="mergesort")`` and two fancy-indexed assignments gave, the same order: a stable sort
+    has one result). Written out: numba's argsort and the assignments' shape checks (their error messages)
+    compiled 2.5-3 s of the default's cold compile (issue 31)."""
+    n = last - first
+    keys, values = np.empty(n, np.int64), np.empty(n, np.int64)
+    spare_keys, spare_values = np.empty(n, np.int64), np.empty(n, np.int64)
+    for k in range(n):
+        keys[k], values[k] = levels[first + k], order[first + k]
+    width = 1
+    while width < n:
+        for start in range(0, n, 2 * width):
+            middle = start + width if start + width < n else n
+            end = start + 2 * width if start + 2 * width < n else n
+            i, j = start, middle
+            for k in range(start, end):
+                if j >= end or (i < middle and keys[i] <= keys[j]):  # ties: the left run's first (stable)
+                    spare_keys[k], spare_values[k] = keys[i], values[i]
+                    i += 1
+                else:
+                    spare_keys[k], spare_values[k] = keys[j], values[j]
+                    j += 1
+        keys, spare_keys = spare_keys, keys
+        values, spare_values = spare_values, values
+        width *= 2
+    for k in range(n):
+        levels[first + k], order[first + k] = keys[k], values[k]
+
+
+@nb.njit(**_JIT)
 def _grid(points, reach):
     """Points sorted into a grid of cubic cells: ``(order, starts, levels, lo, cell, nx, ny)``.
 
@@ -83,10 +114,14 @@ def _grid(points, reach):
     n = points.shape[0]
     lo = np.zeros(3)
     hi = np.zeros(3)
-    for a in range(3):
+    for a in range(3):  # the bounds as points[:, a].min() and .max() (NaN if any is), without compiling them
         if n:
-            lo[a] = points[:, a].min()
-            hi[a] = points[:, a].max()
+            low = high = points[0, a]
+            for i in range(1, n):
+                x = points[i, a]
+                low = x if x < low or x != x else low  # (a NaN bound stays NaN: no comparison is true)
+                high = x if x > high or x != x else high
+            lo[a], hi[a] = low, high
     extent = max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2])
     cell = max(reach, extent / 2.0**60)  # z cells fit in an int64
     if not cell > 0:  # every point in one place and a zero reach: any side
@@ -115,9 +150,7 @@ def _grid(points, reach):
     for c in range(nx * ny):  # within a column, by z cell (stable)
         first, last = starts[c], starts[c + 1]
         if last - first > 32:
-            by_level = np.argsort(levels[first:last], kind="mergesort")
-            order[first:last] = order[first:last][by_level]
-            levels[first:last] = levels[first:last][by_level]
+            _merge_sort_column(levels, order, first, last)
             continue
         for i in range(first + 1, last):  # insertion sort of a short column
             level, point = levels[i], order[i]
@@ -142,14 +175,17 @@ def pool_grid(points, pool, reach):
     """
     m = pool.shape[0]
     gathered = np.empty((m, 3))
+    # coordinate by coordinate: a row assigned whole compiles numba's shape checks and their messages (1.9 s)
     for k in range(m):
-        gathered[k] = points[pool[k]]
+        for a in range(3):
+            gathered[k, a] = points[pool[k], a]
     grid = _grid(gathered, reach)
     order = grid[0]
     pool_points = np.empty((m, 3))
     ids = np.empty(m, np.int64)
     for k in range(m):
-        pool_points[k] = gathered[order[k]]
+        for a in range(3):
+            pool_points[k, a] = gathered[order[k], a]
         ids[k] = pool[order[k]]
     return pool_points, ids, grid
 
@@ -216,7 +252,8 @@ def _ball_members(points, grid, cx, cy, cz, cutoff, out):
                 end += 1
             if count + end - k > out.shape[0]:
                 grown = np.empty(2 * (count + end - k), np.int64)
-                grown[:count] = out[:count]
+                for rank in range(count):  # (a slice assigned compiles numba's shape checks: 1.9 s)
+                    grown[rank] = out[rank]
                 out = grown
             for j in range(k, end):  # branch-free: every candidate is written, the inside ones kept
                 dx = points[j, 0] - cx
@@ -552,7 +589,7 @@ def _walk_face(
 def connected_face_sums(
     vertices, faces, centroids, reach, usable, values, radii, indptr, indices, out, scratch, start, stop, ready=None
 ):
-    """Add to rows ``start`` to ``stop`` of ``out`` (V, k) the sums of ``share * values`` over the faces of the
+    """Write to rows ``start`` to ``stop`` of ``out`` (V, k) the sums of ``share * values`` over the faces of the
     surface-connected piece of each vertex's ball, of radius ``radii[v]`` ((V,): one per vertex) or
     ``radii[0]`` ((1,): one for all). :func:`connected_face_sums_nested` sums several nested balls in one walk;
     this kernel is its one-ball case without the passes (15% faster, measured at 400k vertices on one thread).
@@ -570,7 +607,8 @@ def connected_face_sums(
     that meet it); another sheet of the surface inside the ball is left out.
     Faces not ``usable`` (F,) lead the search on but add nothing. The other
     rows of ``out`` are not touched: a caller that splits the vertices into
-    ranges sums them into one array. ``scratch``: ``neighborhoods._face_sum_scratch``, one
+    ranges fills one array, unfilled before (no zeros to write first: 72 MB at 1M
+    vertices, issue 31). ``scratch``: ``neighborhoods._face_sum_scratch``, one
     thread per row of its arrays (reused from call to call); ``ready`` (rows,) bool, False where a row's
     stamps (``seen``, ``mark``, ``known``) are still to be filled with -1, by the thread that takes the
     row, then True (None: all filled).
@@ -638,12 +676,9 @@ def _face_sums_chunk(
         radius = radii[v if per_vertex else 0]
         radius2 = radius * radius
         s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = 0.0
-        if nine:
-            s0, s1, s2, s3, s4, s5 = out[v, 0], out[v, 1], out[v, 2], out[v, 3], out[v, 4], out[v, 5]
-            s6, s7, s8 = out[v, 6], out[v, 7], out[v, 8]
-        else:
+        if not nine:
             for k in range(n_values):
-                total[k] = out[v, k]
+                total[k] = 0.0
         # the walk of _face_walk and _walk_face written out: their arrays bound once, not once per face
         # (inlined, each face's call took and dropped a reference to each of its arrays: 3x the walk's time)
         cx, cy, cz = vertices[v, 0], vertices[v, 1], vertices[v, 2]
@@ -951,9 +986,9 @@ def cell_centres(vertices, cells):
     in the same order whatever the ranges.
     """
     n = cells.shape[0]
-    # every row written by its chunk; no huge pages (geometry._unadvised_empty)
-    centres = _unadvised_empty((n, 3), np.float64)
-    reach = _unadvised_empty((n,), np.float64)
+    # every row written by its chunk; no huge pages (geometry._unadvised_array)
+    centres = _unadvised_array((n, 3), np.float64)
+    reach = _unadvised_array((n,), np.float64)
     run_chunks(_centres_chunk, n, 4 * nb.get_num_threads(), vertices, cells, centres, reach)
     return centres, reach
 
