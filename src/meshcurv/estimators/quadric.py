@@ -66,7 +66,9 @@ edge lengths, averaged over two rings), and
   NaN with ``valid=False``; a jet that departs from its ball's quadric by more than the quadric's spread takes it,
   on a noisy ball or one by a crack of a soup, whose level may read clean (W20's check of the default radius,
   reverted, read fandisk's creases as noise: ``benchmarks/quadric_noise.md``); on a voxel surface the fits that
-  follow the steps are NaN with the reason "voxel staircase" (``meshcurv.defects.STAIRCASE``);
+  follow the steps are NaN with the reason "voxel staircase" (``meshcurv.defects.STAIRCASE``), also on a voxel
+  surface stored as a soup, which the default radius reads as an ordinary mesh: its balls are grown to the voxel
+  rule's (:func:`_soup_voxel_size`, :func:`_staircase_radius`; issue 29, fuzz 415/108);
 - at a given radius, the noise's reach (:func:`_noise_reach`): the spread of a fit's curvatures under the noise of
   its ball, from the level (as a standard deviation, :data:`NOISE_SIGMA_FACTOR`) and the weighted normal matrix of
   the ball's points (``sigma^2 G^-1 M G^-1``, :func:`_noise_spreads`), against the median curvedness of the
@@ -118,6 +120,10 @@ from ..radius import (
     BALL_TURN_CAP,
     CREASE_TURN,
     JET_CURVATURE_CAP,
+    VOXEL_CURVEDNESS_PERCENTILE,
+    VOXEL_EXTENT_CAP,
+    VOXEL_FLAT_CURVEDNESS,
+    VoxelReading,
     _ball_turns,
     _component_radii,
     _edge_turns,
@@ -125,10 +131,13 @@ from ..radius import (
     _local_noise,
     _resolve_radius,
     _vertex_radii,
+    _voxel_surface_grid,
+    voxel_radius,
 )
 from .._prepared import PreparedMesh
 from ..defects import REACH, STAIRCASE
 from .._backend import kernel_threads, numba_kernels
+from ._ring_noise import welded_grid
 from ._support import Stages, finish
 
 STAGES = ("compute normals", "fit jets", "retrieve curvatures")
@@ -280,6 +289,13 @@ STAIRCASE_AGREEMENT = 0.3
 STAIRCASE_CURVATURE_CAP = 1.2
 
 
+#: A voxel soup's typical radius of curvature (:func:`_staircase_radius`) is read from quadrics over balls this many
+#: times its noise rule's default radius: twice, as the wider ball of :func:`_staircase_check`, which averages the
+#: steps (``voxel_sphere(10)`` with every face detached by 0.042 edges: H within 6% at the median over balls of 6
+#: voxels, 38% over 3), while the quadrics over the noise rule's balls read the curvature up to twice too high.
+STAIRCASE_PILOT_SCALE = 2.0
+
+
 #: Noise levels up to this read as a clean mesh in :func:`_noise_sigmas`: twice
 #: :data:`meshcurv.radius.NOISE_FLOOR`, as the vertices of a clean irregular mesh read up to 0.006 (a random
 #: ellipsoid of 2,562 points, whose degree-4 jets a noise read from the floor alone sent to quadrics 1.2
@@ -316,8 +332,14 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         bent = np.where(rim, np.median(inside) if inside.size else np.nan, curvedness)
         radii = _jet_vertex_radii(_vertex_radii(groups, vertices.shape[0]), levels, bent)
         radii = np.where(np.isfinite(radii) & (radii > 0), radii, 1.0)  # coincident points: any unit (all fail)
+        # a voxel surface the default radius did not read as one (a soup: issue 29, fuzz 415/108): its staircase
+        # needs the voxel rule's ball, and the checks of the voxel default below
+        voxel_size = None if stages.voxel_default else _soup_voxel_size(mesh, defects, valid, stages.voxel)
+        if voxel_size is not None:
+            radii = np.fmax(radii, _staircase_radius((vertices, start, radii, referenced), voxel_size))
         parts: list = [(radii, None)]
     else:
+        voxel_size = None
         groups = [(_resolve_radius(radius, mesh), None)]
         radii = _vertex_radii(groups, vertices.shape[0])
         parts = [(group_radius if group_radius > 0 else 1.0, members) for group_radius, members in groups]
@@ -334,7 +356,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     if radius is None:  # a grown ball that holds the other side: the group's own radius
         base = _vertex_radii(groups, n)
         again = np.flatnonzero(referenced & (away > AWAY_FRACTION) & (radii > base) & np.isfinite(base) & (base > 0))
-        if again.size:
+        if again.size and voxel_size is None:  # (on a soup's staircase the smaller ball follows the steps: NaN)
             radii[again] = base[again]
             _fit_part((vertices, start, radii, again), referenced, facing, sides, fields, away)
         if not stages.voxel_default:  # a default ball that reaches round the surface: made smaller
@@ -350,8 +372,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # ball's (step 5 of _scatter_check) and none passes as structure (issue 29: voxel_torus() 1,564 of 2,710 valid
     # vertices off the exact H by more than half of the largest |k| at its voxel default of 1.86 voxels, now 21 of
     # 2,177; voxel_sphere(10) 25 -> 0 of 1,882; the noise gate alone: no valid vertex on the torus); the fits kept
-    # there are then checked against a quadric over twice the default ball (_staircase_check: the torus 21 -> 0)
-    if stages.voxel_default:
+    # there are then checked against a quadric over twice the default ball (_staircase_check: the torus 21 -> 0).
+    # So is a voxel soup's (voxel_size: _soup_voxel_size), at the voxel rule's radius (_staircase_radius)
+    if stages.voxel_default or voxel_size is not None:
         every = referenced.copy()
         checks = (every, every, every, np.zeros(n, dtype=bool))
         default = radii.copy()  # the wider ball of the check below: twice the default, as step 3's
@@ -563,6 +586,56 @@ def _round_balls(ball: tuple, edges: np.ndarray, sides: tuple, fields: tuple, aw
     out[rows] = True
     coefficients[out] = np.nan
     return out
+
+
+def _soup_voxel_size(mesh: PreparedMesh, defects, valid: np.ndarray, reading: VoxelReading) -> float | None:
+    """The largest voxel size of the grid that a mesh not measured at the voxel default lies on, or None.
+
+    A voxel surface stored as a triangle soup (faces with corners of their own, moved by a few hundredths of an edge,
+    welded in part) is not measured at the voxel default radius (:func:`meshcurv.radius.voxel_surface_radius`): its
+    corners read a grid only within a tolerance widened for noise, where the pilot's balls hold pieces of the surface,
+    or read none where half of the faces stayed on it. Its grid is read here as the other methods read a voxel
+    surface's (:func:`meshcurv.radius._voxel_surface_grid`: the mesh's, or its faces' with a corner not ``defects``'
+    invalid), else, on a mesh welded across cracks, that of the ``valid`` vertices ((V,) bool) on a grid's planes
+    (:func:`._ring_noise.welded_grid`), also without the corners of its cracks (:func:`_crack_corners`: the copies the
+    weld joined, off the grid by the cracks' width, are half of the vertices of ``voxel_sphere(10)`` half detached by
+    0.04 edges; fuzz 559/137). ``reading``: the call's grid (:class:`meshcurv.radius.VoxelReading`)."""
+    found = _voxel_surface_grid(mesh, invalid=defects.invalid_vertices, reading=reading)
+    if found is None and mesh.n_cracked:
+        found = welded_grid(mesh, valid)
+        if found is None:
+            rim = mesh.topology.boundary_vertices & mesh.topology.referenced_vertices
+            found = welded_grid(mesh, valid & ~_crack_corners(mesh.vertices, rim, mesh.scale_edge_means))
+    return None if found is None else float(np.max(found[0].spacing))
+
+
+def _staircase_radius(ball: tuple, voxel_size: float) -> float:
+    """The default radius of a voxel soup (:func:`_soup_voxel_size`): the voxel rule's
+    (:func:`meshcurv.radius.voxel_radius`), at most :data:`meshcurv.radius.VOXEL_EXTENT_CAP` of the diagonal of its
+    bounding box, as the voxel default's; 0 where no curvature is read.
+
+    ``ball = (vertices, normals, radii, referenced)``: the quadrics over balls :data:`STAIRCASE_PILOT_SCALE` times
+    ``radii`` (in the frames of ``normals``) give the typical radius of curvature ``R``, the inverse of the
+    :data:`meshcurv.radius.VOXEL_CURVEDNESS_PERCENTILE` th percentile of their largest ``|k|``, as the voxel default
+    reads it from its pilot. The noise rule's radius of such a soup (2.5 edge lengths, grown with the noise of its
+    corners: 3.0 voxels on ``voxel_sphere(10)`` with every face detached) is a smooth mesh's: the steps bend every fit
+    there (median H error 36%, 1,283 of 11,196 valid vertices off the clean surface's by more than half its largest
+    ``|k|``: issue 29, fuzz 415/108), where the voxel rule gives 4.1 voxels for ``R`` 8.2 (the clean sphere's default
+    4.2, its median error 7%)."""
+    vertices, normals, radii, referenced = ball
+    ids = np.flatnonzero(referenced)
+    wide = STAIRCASE_PILOT_SCALE * radii
+    found = residual_spreads(vertices, ids, wide, normals, ids)[0]
+    k_min, k_max = _quadric_curvatures(found, normals[ids], wide[ids])
+    largest = np.maximum(np.abs(k_min), np.abs(k_max))
+    with np.errstate(invalid="ignore"):
+        largest = largest[largest > VOXEL_FLAT_CURVEDNESS / voxel_size]  # (NaN: no fit)
+    if largest.size == 0:
+        return 0.0
+    curvature_radius = 1.0 / float(np.percentile(largest, VOXEL_CURVEDNESS_PERCENTILE))
+    points = vertices[ids]
+    extent = VOXEL_EXTENT_CAP * float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+    return min(voxel_radius(np.array([voxel_size]), curvature_radius), extent)
 
 
 def _agreeing(smaller: tuple, wider: tuple) -> np.ndarray:
@@ -789,13 +862,11 @@ def residual_spreads(vertices, pool, radii, normals, centres) -> tuple[np.ndarra
         offsets, local, weights = offsets[inside], local[inside], weights[inside] ** 2
         x, y, z = (np.einsum("ij,ij->i", offsets, axis[chunk][local]) for axis in frame)
         basis = np.stack([np.ones_like(x), x, y, x * x, x * y, y * y], axis=1)
-        outer = basis[:, :, None] * basis[:, None, :]
-        gram = np.zeros((size, 6, 6))
-        moments = np.zeros((size, 6, 6))
-        right = np.zeros((size, 6))
-        np.add.at(gram, local, weights[:, None, None] * outer)
-        np.add.at(moments, local, (weights * weights)[:, None, None] * outer)
-        np.add.at(right, local, (weights * z)[:, None] * basis)
+        terms = np.ascontiguousarray(basis.T)  # (6, N): each term in a row of its own, for the sums
+        outer = (terms[:, None, :] * terms[None, :, :]).reshape(36, -1)
+        gram = _summed(local, weights * outer, size).reshape(size, 6, 6)
+        moments = _summed(local, (weights * weights) * outer, size).reshape(size, 6, 6)
+        right = _summed(local, (weights * z) * terms, size)
         count = np.bincount(local, minlength=size)
         total = np.bincount(local, weights=weights, minlength=size)
         diagonal = np.einsum("nii->ni", gram)
@@ -814,6 +885,12 @@ def residual_spreads(vertices, pool, radii, normals, centres) -> tuple[np.ndarra
         sigmas[chunk] = np.where(usable, np.sqrt(sigma2) * unit[chunk], np.nan)
         spreads[chunk] = np.where(usable, np.sqrt(np.clip(sigma2 * second, 0.0, None)) / unit[chunk], np.inf)
     return coefficients, sigmas, spreads
+
+
+def _summed(rows: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
+    """(size, K) the sums of the columns of ``values`` (K, N) by ``rows`` (N,) in their order, as ``np.add.at`` sums
+    them (the same numbers), by :func:`numpy.bincount`: ``np.add.at`` took half of the NumPy path's time on soups."""
+    return np.stack([np.bincount(rows, weights=row, minlength=size) for row in values], axis=1)
 
 
 def _scatter_check(
