@@ -61,13 +61,18 @@ def test_voxel_soup_steps_never_valid_and_far_off(share, gap, seed):
     error = np.abs(result.mean - 0.1)[result.valid]
     # before (c714c1c): 9-110 valid vertices off the sphere's H by more than 2 OFF (up to 0.46), 41-414 by more than
     # OFF (3.7% of the valid on 415); after: none beyond 2 OFF (up to 0.19), 8-103 beyond OFF (the grown quadric's
-    # bias on the staircase, at most 0.9% of the valid)
+    # bias on the staircase, at most 0.9% of the valid); since V29 (the voxel rule's radius on a soup on a voxel
+    # grid) none beyond OFF (up to 0.071)
     assert (error > 2 * OFF).sum() == 0
     assert (error > OFF).sum() < 0.025 * result.valid.sum()
     # 0.8 until stop 61 (0.802 on (0.5, 0.068, 420)); quadric's check of default balls that reach round the surface
     # (e5d7996, a lie of 27-47% on coarse tori) made 35 of its 7,557 vertices NaN (0.797): their H errors before,
-    # median 14% of H (10 within 10%), no worse than the vertices kept (median 20%): a cost of that check, decided
-    assert result.valid.mean() > 0.79
+    # median 14% of H (10 within 10%), no worse than the vertices kept (median 20%): a cost of that check, decided.
+    # 0.79 until stop 63: a soup on a voxel grid is measured at the voxel rule's radius and checked as a voxel
+    # surface's default (V29: 0.855/0.853/0.797 -> 0.703/0.696/0.646, a share of every vertex, the 1,890 unreferenced
+    # originals of the full soups included); the vertices made NaN read H off by 60% (415) and 35% (420) at the median
+    # before, 110 and 151 of them within 10%; those kept 32% -> 12% and 18% -> 10%, none off by more than OFF now
+    assert result.valid.mean() > 0.6
 
 
 def test_closed_mesh_skips_the_wider_ball_of_passed_fits(monkeypatch):
