@@ -156,6 +156,19 @@ class PreparedMesh:
             unwelded=True,
         )
 
+    def with_vertices(self, vertices: np.ndarray) -> PreparedMesh:
+        """This mesh with its vertices at ``vertices`` (the same topology and rows): its surface, length scales and
+        needles found again, every other reading as here."""
+        scales, needles, median = _scales_and_needles(vertices, self.topology)
+        return dataclasses.replace(
+            self,
+            vertices=vertices,
+            surface=Surface(vertices, self.topology.faces),
+            length_scales=scales,
+            needles=needles,
+            known_median=median,
+        )
+
     @cached_property
     def scale_extent(self) -> float:
         """The :func:`meshcurv.radius.rigid_extent` of the referenced vertices but the needle vertices (NaN where

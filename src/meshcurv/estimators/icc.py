@@ -121,8 +121,6 @@ corrected curvature measures for polygonal surfaces. Computer Graphics Forum
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
 from .._geometry import face_areas, finite_rows, median_edge_length
@@ -165,8 +163,7 @@ from ..radius import (
     scale_ladder,
     stable_scales,
 )
-from .._prepared import PreparedMesh, _scales_and_needles
-from ..result import Surface
+from .._prepared import PreparedMesh
 from ..topology import MeshTopology
 from ._support import Stages, failed_fits_undefined, finish
 
@@ -600,10 +597,13 @@ def voxel_pilot(mesh: PreparedMesh):
     away (up to 12%; fuzz_api 575/106: 3.7%), none after (up to 1.4%). The needles themselves stay out of every
     reading (:func:`meshcurv.radius.voxel_surface_radius`).
     """
-    if mesh.needles.any():
-        mesh = _needles_put_back(mesh)
+    given = mesh
+    read: list[PreparedMesh] = []  # the mesh the pilot reads: found at its first call (a smooth mesh never calls it)
 
     def run(radius: float):
+        if not read:
+            read.append(_needles_put_back(given) if given.needles.any() else given)
+        mesh = read[0]
         vertices, topology = mesh.vertices, mesh.topology
         _, valid = mesh.start(boundary=True)
         valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
@@ -650,11 +650,7 @@ def _needles_put_back(mesh: PreparedMesh) -> PreparedMesh:
     )
     moved = counts > 0
     vertices[moved] = sums[moved] / counts[moved, None]
-    scales, left, median = _scales_and_needles(vertices, mesh.topology)
-    surface = Surface(vertices, mesh.topology.faces)
-    return dataclasses.replace(
-        mesh, vertices=vertices, surface=surface, length_scales=scales, needles=left, known_median=median
-    )
+    return mesh.with_vertices(vertices)
 
 
 def _pilot_normals(
