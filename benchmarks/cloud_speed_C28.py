@@ -18,7 +18,6 @@ import collections
 import json
 import os
 import statistics
-import subprocess
 import sys
 import time
 import warnings
@@ -68,21 +67,19 @@ def main(argv=None):
     if args.child:
         child(args.size)
         return 0
+    sys.path.insert(0, str(HERE))
+    from _tree_children_P29 import alternate_rows
+
     found: dict = collections.defaultdict(list)
     print("| tree | run | wall s | CPU s | calling thread CPU s | peak above the call's start, B/point | load |")
     print("|---|---|---|---|---|---|---|")
-    for run in range(args.runs):
-        for tree in args.trees:
-            env = {**os.environ, "PYTHONPATH": str(Path(tree).resolve() / "src")}
-            command = [sys.executable, __file__, "--child", "--size", str(args.size)]
-            output = subprocess.run(command, env=env, check=True, capture_output=True, text=True).stdout
-            row = json.loads([line for line in output.splitlines() if line.startswith("{")][-1])
-            found[tree].append(row)
-            print(
-                f"| {tree} | {run + 1} | {row['wall']:.2f} | {row['cpu']:.2f} | {row['main']:.2f} | "
-                f"{row['peak'] / args.size:.0f} | {row['load']:.1f} |",
-                flush=True,
-            )
+    for tree, run, row in alternate_rows(__file__, args.trees, args.runs, ["--size", args.size]):
+        found[tree].append(row)
+        print(
+            f"| {tree} | {run} | {row['wall']:.2f} | {row['cpu']:.2f} | {row['main']:.2f} | "
+            f"{row['peak'] / args.size:.0f} | {row['load']:.1f} |",
+            flush=True,
+        )
     print("\n| tree | wall s | CPU s | calling thread CPU s | peak B/point (medians of runs) |\n|---|---|---|---|---|")
     for tree, rows in found.items():
         medians = [statistics.median(r[key] for r in rows) for key in ("wall", "cpu", "main", "peak")]

@@ -21,7 +21,6 @@ import collections
 import json
 import os
 import statistics
-import subprocess
 import sys
 from pathlib import Path
 
@@ -57,21 +56,17 @@ def main(argv=None):
     if args.child:
         child(args.sizes)
         return 0
+    sys.path.insert(0, str(HERE))
+    from _tree_children_P29 import alternate_rows
+
     found: dict = collections.defaultdict(list)
-    for run in range(args.runs):
-        for tree in args.trees:
-            env = {**os.environ, "PYTHONPATH": str(Path(tree).resolve() / "src")}
-            command = [sys.executable, __file__, "--child", "--sizes", *map(str, args.sizes)]
-            output = subprocess.run(command, env=env, check=True, capture_output=True, text=True).stdout
-            for line in output.splitlines():
-                if line.startswith("{"):
-                    row = json.loads(line)
-                    found[tree, row["n"]].append(row)
-                    print(
-                        f"| {tree} | run {run + 1} | {row['n']} | {row['wall']:.2f} | {row['cpu']:.2f} | "
-                        f"{row['main']:.2f} | {row['load']:.1f} |",
-                        flush=True,
-                    )
+    for tree, run, row in alternate_rows(__file__, args.trees, args.runs, ["--sizes", *args.sizes]):
+        found[tree, row["n"]].append(row)
+        print(
+            f"| {tree} | run {run} | {row['n']} | {row['wall']:.2f} | {row['cpu']:.2f} | "
+            f"{row['main']:.2f} | {row['load']:.1f} |",
+            flush=True,
+        )
     print(
         "\n| tree | points | wall s | CPU s | calling thread CPU s (median of runs; min-max) |\n|---|---|---|---|---|"
     )
