@@ -1262,6 +1262,7 @@ def oriented_signs(
     a = np.stack([rows[other], cols[other]], axis=1).ravel()
     b = np.stack([cols[other], rows[other]], axis=1).ravel()
     c = np.repeat(cosine[other], 2)
+    steep = np.repeat(slope[other], 2)
     for _ in range(SMALL_PART_ROUNDS):
         joins = (part[a] < 0) & (part[b] >= 0)  # from a point of a small, unattached component to an attached one
         if not joins.any():
@@ -1270,9 +1271,17 @@ def oriented_signs(
         small = labels[ja]
         pairs = np.unique(np.stack([small, part[jb]], axis=1), axis=0)
         between = np.bincount(pairs[:, 0], minlength=sizes.size) > 1  # joined to two large parts
-        first = np.unique(small, return_index=True)[1]  # its flattest edge gives its side and its part
+        unique_small, first = np.unique(small, return_index=True)  # its flattest edge gives its side and its part
+        sides = np.where(signs[ja] * signs[jb] * jc < 0, -1.0, 1.0)
         flip = np.ones(sizes.size)
-        flip[small[first]] = np.where(signs[ja[first]] * signs[jb[first]] * jc[first] < 0, -1.0, 1.0)
+        flip[small[first]] = sides[first]
+        # ... unless an edge as flat (equal to round-off) gives the other side: which is first is the order of the
+        # edges, the pose's (fuzz_api 590/4: ogre's mirror-symmetric pair of edges, slopes equal in one pose and
+        # 3e-13 apart turned, three points turned over with it)
+        head = first[np.searchsorted(unique_small, small)]
+        js = steep[joins]
+        torn = (np.abs(js - js[head]) <= TIE_RESOLUTION) & (sides != sides[head])
+        between[small[torn]] = True
         target = np.full(sizes.size, -1)
         target[small[first]] = part[jb[first]]
         taken = target[labels] >= 0
