@@ -25,6 +25,8 @@ from meshcurv import shapes
 from meshcurv._backend import use_backend
 from meshcurv.defects import NEEDLE
 
+pytest.importorskip("skimage")  # the voxel shapes (a minimal install has no scikit-image)
+
 CASES = {
     # (shape, flung rows, direction, distance): 575/106 and the draws that moved most before
     "575/106": ("flat", [286, 326], (-33.94648326, -45.44660574, -125.82817432), None),
