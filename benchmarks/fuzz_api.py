@@ -70,6 +70,10 @@ cloud-relation cases in another form: a given radius as a NumPy float64, a 0-d a
 scales it, whatever its type: :func:`scaled_radius`), ``icc`` at its default with the rule ``radius="adaptive"``
 (its scale relation: the rule's radii scale with the mesh), or a cloud's given radius also through
 ``multiscale_point_cloud_curvatures``, whose first result must be the single call's (:func:`multiscale_check`).
+``--double-sided P`` (0 by default) puts the second side of a share ``P`` of the double-sided relations on vertices
+of its own, copies of the first side's at the same points (a soup of both sides, as an STL file stores it), and lets
+``matgeom`` keep its drawn double-sided relations; every double-sided relation also compares the integrals
+(``result.integral`` of the area, H and K: issue 29, class 7) with the one side's, and each copy with its twin.
 ``--cloud-shapes P`` (a stream of its own; 0 by default) makes a share ``P`` of the analytic clouds (not the voxel
 ones) a part the others miss (:func:`_shape_cloud`): a sphere inside a sphere 1 to 5 spacings below it (a cavity's
 wall, facing into it), a torus whose tube is 5 to 8 spacings thick, or an open cylinder, whole or half (either side,
@@ -932,7 +936,9 @@ def real_mesh_case(rng, numpy_backend):
     relation = ["rigid", "rigid", "scale", "permute", "translate", "unreferenced", "double-sided"][int(rng.integers(7))]
     if relation == "permute" and method == "matgeom":  # (as for the drawn shapes: matGeom's pairing follows the order)
         relation = "rigid"
-    if relation == "double-sided" and (method == "matgeom" or kwargs.get("orient", "auto") not in ("auto", "outward")):
+    if relation == "double-sided" and (
+        (method == "matgeom" and not DOUBLE_COPIES) or kwargs.get("orient", "auto") not in ("auto", "outward")
+    ):
         relation = "rigid"
     value = _relation_value(rng, relation)
     labels = [name, "real mesh", "vertices:array", "faces:array", f"relation {relation} {value:g}"]
@@ -944,6 +950,16 @@ def real_mesh_case(rng, numpy_backend):
 RADIUS_FORMS = 0.0
 #: The random stream of the radius forms (beside the case's own ``[seed, index]``).
 RADIUS_FORM_STREAM = 59
+#: Share of the double-sided relations whose second side has vertices of its own (``--double-sided``): copies of
+#: the first side's, at the same points, as a soup of both sides stores them (issue 29, class 7). 0 by default, so
+#: that the cases of earlier rounds replay as drawn (the choice comes from the relation's own value); when it is not
+#: 0, ``matgeom`` keeps its drawn double-sided relations too (its one side may be either winding: ``orient='keep'``).
+DOUBLE_COPIES = 0.0
+#: The random stream of the double-sided relations' copies (beside the relation's value).
+DOUBLE_COPY_STREAM = 61
+#: The integrals a double-sided relation compares (:func:`double_sided_integrals`), with the size each is held to
+#: 1e-6 of: the area's own, ``sqrt(area)`` for the total mean curvature (H dA is a length), 4 pi for the Gaussian.
+DOUBLE_INTEGRALS = ("area", "mean", "gaussian")
 
 
 def with_radius_form(case, seed: int, index: int):
@@ -1097,7 +1113,7 @@ def _drawn_form(seed: int, index: int):
                 relation = "translate"
             if relation == "double-sided" and (
                 not isinstance(method, str)
-                or method == "matgeom"
+                or (method == "matgeom" and not DOUBLE_COPIES)
                 or str(kwargs.get("orient", "auto")) not in ("auto", "outward")
                 or kwargs.get("weld", True) is not True
             ):
@@ -2017,7 +2033,11 @@ def relation_check(args, kwargs, result, relation):
         v2, f2 = v[perm], inverse[f]
         take = inverse  # old vertex j is new inverse[j]
     elif kind == "double-sided":  # every face twice, the second with the opposite winding: one side measured
-        v2, f2 = v, np.concatenate([f, f[:, ::-1]])
+        copies = bool(DOUBLE_COPIES) and np.random.default_rng([value, DOUBLE_COPY_STREAM]).random() < DOUBLE_COPIES
+        if copies:  # the second side on vertices of its own, at the same points (a soup of both sides)
+            v2, f2 = np.concatenate([v, v]), np.concatenate([f, f[:, ::-1] + n])
+        else:
+            v2, f2 = v, np.concatenate([f, f[:, ::-1]])
     else:
         rng = np.random.default_rng(value)
         edge = float(np.median(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1))) if len(f) else 1.0
@@ -2039,6 +2059,23 @@ def relation_check(args, kwargs, result, relation):
                     f"{kind} {value:g}: {type(error).__name__} on the input brought back exactly: {str(error)[:150]}"
                 ]
     label = f"{kind} {value:g}" + ("" if back is None else " (against its input brought back exactly)")
+    if kind == "double-sided":
+        if copies:
+            label += " (the second side on copies of the vertices)"
+        matgeom = result.method == "matgeom"
+        if matgeom:  # (orient='keep': the side kept may be the other winding: k negated)
+            other = _one_side_as(other, result, n)
+        broken = double_sided_integrals(result, other, label, either_sign=matgeom)
+        if copies:  # each copy of a vertex with its twin's values
+            twins = other.valid[n:] != other.valid[:n]
+            with np.errstate(all="ignore"):
+                apart = ~np.isclose(other.mean[n:], other.mean[:n], rtol=1e-9, atol=0.0, equal_nan=True)
+            if (twins | apart).any():
+                broken.append(
+                    f"{label}: {int((twins | apart).sum())} of {n} copies read otherwise than the vertex they repeat"
+                )
+        if broken:
+            return broken
     referenced = _referenced(args, n)
     old_valid, new_valid = result.valid, other.valid[take]
     changed = (old_valid != new_valid) & referenced
@@ -2061,6 +2098,55 @@ def relation_check(args, kwargs, result, relation):
         if a.size and not (err < 1e-6).all():
             broken.append(f"{label}: {name} differs by up to {float(np.nanmax(err)):.3g} (relative)")
     return broken
+
+
+def double_sided_integrals(result, other, label, either_sign=False) -> list[str]:
+    """The integrals of :data:`DOUBLE_INTEGRALS` of a double-sided mesh's result ``other`` against the one side's
+    ``result`` (issue 29, class 7: ``integral("gaussian")`` counted both sides, 15.5 x 4 pi on a sphere);
+    ``either_sign``: the total mean curvature of either winding (``matgeom``: the faces as given, and the side
+    kept of a closed part the outward one, where the one side alone may be wound inward)."""
+    broken = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        area = float(result.integral("area"))
+        for field in DOUBLE_INTEGRALS:
+            one, two = float(result.integral(field)), float(other.integral(field))
+            if either_sign and field == "mean" and abs(two + one) < abs(two - one):
+                two = -two
+            size = {"area": abs(area), "mean": np.sqrt(abs(area)), "gaussian": 4 * np.pi}[field]
+            if not (np.isfinite(one) and np.isfinite(two)):
+                if np.isfinite(one) != np.isfinite(two):
+                    broken.append(f"{label}: integral({field!r}) {two:.6g} where one side gives {one:.6g}")
+            elif abs(two - one) > 1e-6 * max(abs(one), size):
+                broken.append(f"{label}: integral({field!r}) {two:.6g} where one side gives {one:.6g}")
+    return broken
+
+
+def _one_side_as(other, result, n):
+    """``other`` (a double-sided mesh's ``matgeom`` result, faces as given) with its curvatures negated when it
+    kept the other winding than ``result`` (``orient='keep'``: one side, either one), else as it is."""
+    both = result.valid & other.valid[:n]
+    if not both.any():
+        return other
+    same = np.abs(other.mean[:n][both] - result.mean[both]).max()
+    flipped = np.abs(other.mean[:n][both] + result.mean[both]).max()
+    if flipped >= same:
+        return other
+    return _Negated(other)
+
+
+class _Negated:
+    """A result seen from its other side: ``k_min = -k_max``, ``k_max = -k_min``, ``mean`` negated; the integrals
+    of the total mean curvature negated, the others as they are."""
+
+    def __init__(self, result):
+        self._result = result
+        self.valid, self.invalid_reason, self.method = result.valid, result.invalid_reason, result.method
+        self.k_min, self.k_max, self.mean = -result.k_max, -result.k_min, -result.mean
+
+    def integral(self, field):
+        value = self._result.integral(field)
+        return -value if field == "mean" else value
 
 
 #: A valid vertex of a mesh with detached faces is a lie when its H is off the clean shape's by more than this
@@ -2575,7 +2661,7 @@ def summary_table(path) -> str:
 
 def main(argv=None) -> int:
     global ONLY_POINT_CLOUDS, VOXEL_SHARE, WIDE_CRACKS, THIN_SHARE, FINE_CRACKS, REAL_MESHES, CLOUD_RELATIONS
-    global RADIUS_FORMS, CLOUD_SHAPES
+    global RADIUS_FORMS, CLOUD_SHAPES, DOUBLE_COPIES
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -2659,8 +2745,17 @@ def main(argv=None) -> int:
         "radius='adaptive' on a real mesh; a cloud's given radius also through multiscale_point_cloud_curvatures, "
         "whose first result must be the single call's (default: %(default)g: the draws of earlier rounds)",
     )
+    parser.add_argument(
+        "--double-sided",
+        type=float,
+        default=DOUBLE_COPIES,
+        help="share of the double-sided relations (every face twice, the second wound the other way) whose second "
+        "side has vertices of its own, copies of the first side's (a soup of both sides); any value but 0 also "
+        "lets matgeom keep the relation (default: %(default)g: the draws of earlier rounds)",
+    )
     options = parser.parse_args(argv)
     for name in (
+        "double_sided",
         "voxel_share",
         "cloud_shapes",
         "wide_cracks",
@@ -2685,6 +2780,7 @@ def main(argv=None) -> int:
     CLOUD_SHAPES = options.cloud_shapes
     CLOUD_RELATIONS = options.cloud_relations
     RADIUS_FORMS = options.radius_forms
+    DOUBLE_COPIES = options.double_sided
 
     if options.summary:
         print(summary_table(options.summary))

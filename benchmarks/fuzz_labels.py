@@ -22,6 +22,16 @@ against analytic geometry:
   fewer than 16 vertices, the volume within half a voxel layer of the voxel
   count's.
 
+- ``shell`` and ``torus`` (``--shapes P``, a share of the cases from a stream of
+  their own; 0 by default, the draws of earlier rounds): a hollow ball (a cavity
+  of radius 5-12 voxels inside a wall of 3-8, its wall facing into it) or a solid
+  torus turned at random (tube 4-8 voxels), inside the image. Truths: area,
+  volume, the Euler characteristic (4, 0), ``total_gaussian`` ``2 pi chi``
+  (within 0.1 of 4 pi), ``total_mean`` (``4 pi (R1 - R2)``, ``2 pi^2 R``: 15%),
+  ``mean_median`` ``1 / R1`` (the outer sphere's, the larger area) and the
+  torus's ``mean_weighted`` ``1 / (2 r)``: a cavity's wall read with the outer
+  sphere's sign, or a handle closed, is far beyond them.
+
 Every case also checks: finite area and volume on ``ok`` rows; the curvature
 columns NaN exactly when no vertex was used (and then, for a label cut by the
 border, the reason in ``warnings``); ``area <= area_mesh`` up to the
@@ -253,7 +263,95 @@ def _many_case(rng, unit):
     return image, spacing, {"h": spacing.max(), "many": True}
 
 
-CASES = {"ball": _ball_case, "box": _box_case, "cylinder": _cylinder_case, "many": _many_case}
+def _rotation(rng) -> np.ndarray:
+    """A random rotation (the QR of a Gaussian matrix, its determinant made 1)."""
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = q * np.sign(np.diag(r))
+    return q if np.linalg.det(q) > 0 else -q
+
+
+def _shell_case(rng, unit):
+    """A hollow ball (a cavity of radius ``R2`` inside a ball of radius ``R1``, inside the image): two closed
+    surfaces, the inner one facing into the cavity (H = -1 / R2 with the label's outward normals)."""
+    spacing = _spacing(rng, unit)
+    h = spacing.max()
+    inner = rng.uniform(5.0, 12.0) * h
+    outer = inner + rng.uniform(3.0, 8.0) * h
+    extent = np.ceil((2 * outer + rng.uniform(3, 8) * h) / spacing).astype(int)
+    center = (extent - 1) * spacing / 2 + rng.uniform(-0.3, 0.3, 3) * spacing
+    axes = np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(extent, spacing, center)], indexing="ij", sparse=True)
+    distance = sum(a**2 for a in axes)
+    image = (distance <= outer**2) & (distance > inner**2)
+    area = 4 * np.pi * (outer**2 + inner**2)
+    volume = 4 / 3 * np.pi * (outer**3 - inner**3)
+    total_mean = 4 * np.pi * (outer - inner)  # the cavity's wall counts -1 / R2 over 4 pi R2^2
+    truth = {
+        "area": area,
+        "volume": volume,
+        "volume_tolerance": 0.02 * volume + 0.5 * h * area,  # the half-voxel rounding on both walls
+        "rim": 0.0,
+        "radius": inner,
+        "h": h,
+        "check_area": True,
+        "euler": 4,
+        # a cavity's wall read with the outer sphere's sign (turned outward) gives 4 pi (R1 + R2): 2 R2 / (R1 + R2)
+        # of the scale away; a mean weighted by area is the outer sphere's value (its share 0.5-0.85)
+        "expect": {
+            "total_mean": (total_mean, 0.15 * 4 * np.pi * (outer + inner)),
+            "mean_median": (1 / outer, 0.15 / outer),
+        },
+    }
+    return image.astype(np.uint8), spacing, truth
+
+
+def _torus_case(rng, unit):
+    """A solid torus turned at random, inside the image (genus 1: Euler characteristic 0, total K 0); its
+    ``total_mean`` is ``2 pi^2 R`` and ``mean_weighted`` ``1 / (2 r)`` exactly."""
+    spacing = _spacing(rng, unit)
+    h = spacing.max()
+    tube = rng.uniform(4.0, 8.0) * h
+    ring = tube + rng.uniform(3.0, 12.0) * h
+    extent = np.ceil((2 * (ring + tube) + rng.uniform(3, 8) * h) / spacing).astype(int)
+    center = (extent - 1) * spacing / 2 + rng.uniform(-0.3, 0.3, 3) * spacing
+    turn = _rotation(rng)
+    grid = np.stack(
+        np.meshgrid(*[np.arange(n) * s - c for n, s, c in zip(extent, spacing, center)], indexing="ij"), axis=-1
+    )
+    local = grid @ turn  # the torus's own frame: its axis along the third coordinate
+    image = (np.hypot(local[..., 0], local[..., 1]) - ring) ** 2 + local[..., 2] ** 2 <= tube**2
+    area = 4 * np.pi**2 * ring * tube
+    volume = 2 * np.pi**2 * ring * tube**2
+    truth = {
+        "area": area,
+        "volume": volume,
+        "volume_tolerance": 0.02 * volume + 0.5 * h * area,
+        "rim": 0.0,
+        "radius": tube,
+        "h": h,
+        "check_area": True,
+        "euler": 0,
+        "expect": {
+            "total_mean": (2 * np.pi**2 * ring, 0.15 * 2 * np.pi**2 * ring),
+            "mean_weighted": (1 / (2 * tube), 0.15 / (2 * tube)),
+        },
+    }
+    return image.astype(np.uint8), spacing, truth
+
+
+CASES = {
+    "ball": _ball_case,
+    "box": _box_case,
+    "cylinder": _cylinder_case,
+    "many": _many_case,
+    "shell": _shell_case,
+    "torus": _torus_case,
+}
+
+#: Share of the cases that are a hollow ball (a cavity inside, its wall facing into it) or a turned solid torus
+#: (``--shapes``; a stream of its own; 0 by default, so that the cases of earlier rounds replay as drawn).
+SHAPES = 0.0
+#: The random stream of the shapes (beside the case's own ``[seed, index]``).
+SHAPE_STREAM = 67
 
 #: Share of the cases computed again under an invariance of the image (``--relations``): 0 by default, so that the
 #: cases of earlier rounds replay as drawn (the relation comes from a stream of its own).
@@ -312,6 +410,9 @@ def make_case(seed: int, index: int):
     """``(kind, image, spacing, give_spacing, truth, twin)`` of case ``index``: a quarter without spacing (1 x 1 x 1)."""
     rng = np.random.default_rng([seed, index])
     kind = KINDS[int(rng.choice(4, p=[0.4, 0.25, 0.15, 0.2]))]
+    shapes = np.random.default_rng([seed, index, SHAPE_STREAM])
+    if SHAPES and shapes.random() < SHAPES:
+        kind = ["shell", "torus"][int(shapes.integers(2))]
     give_spacing = bool(rng.random() >= 0.25)
     image, spacing, truth = CASES[kind](rng, unit=not give_spacing)
     twin = bool(rng.random() < 0.125)
@@ -482,7 +583,9 @@ def check_table(kind, image, spacing, truth, table) -> list[str]:
                 f"box volume {row.volume:.6g} for {truth['volume']:.6g} (chamfers {truth['chamfer_volume']:.3g})"
             )
     else:
-        tolerance = (0.02 + 1.5 * h / truth["radius"]) * truth["volume"] + h * h / 8 * truth["rim"]
+        tolerance = truth.get(
+            "volume_tolerance", (0.02 + 1.5 * h / truth["radius"]) * truth["volume"] + h * h / 8 * truth["rim"]
+        )
         if abs(row.volume - truth["volume"]) > tolerance:
             broken.append(f"{kind} volume {row.volume:.6g} for {truth['volume']:.6g} (tolerance {tolerance:.3g})")
     # the area of the surface inside the image
@@ -496,6 +599,19 @@ def check_table(kind, image, spacing, truth, table) -> list[str]:
             broken.append(
                 f"{kind} area {row.area:.6g} for {truth['area']:.6g} (tolerance {tolerance:.3g}; "
                 f"touches_border {row.touches_border})"
+            )
+    # the topology, Gauss-Bonnet and the columns whose exact value is known (shell, torus: inside the image)
+    if "euler" in truth:
+        if row.euler_characteristic != truth["euler"]:
+            broken.append(f"{kind} euler_characteristic {row.euler_characteristic} for {truth['euler']}")
+        elif np.isfinite(row.total_gaussian) and abs(row.total_gaussian - 2 * np.pi * truth["euler"]) > 0.1 * 4 * np.pi:
+            broken.append(f"{kind} total_gaussian {row.total_gaussian:.6g} for {2 * np.pi * truth['euler']:.6g}")
+    for column, (value, tolerance) in truth.get("expect", {}).items():
+        mine = getattr(row, column)
+        if np.isfinite(mine) and abs(mine - value) > tolerance:
+            broken.append(
+                f"{kind} {column} {mine:.6g} for {value:.6g} (tolerance {tolerance:.3g}; {row.n_used} vertices used "
+                f"of {row.n_vertices})"
             )
     # H wherever it is given (not NaN), on the curved solids
     if "mean" in truth and truth["radius"] >= 5 * h:
@@ -636,7 +752,7 @@ def _key(outcome) -> str:
 
 
 def main(argv=None) -> int:
-    global RELATIONS
+    global RELATIONS, SHAPES
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -653,8 +769,17 @@ def main(argv=None) -> int:
         "array or a list), zeros padded around it, the labels renumbered, mirrored along an axis, its axes permuted "
         "(default: 0: the draws of earlier rounds)",
     )
+    parser.add_argument(
+        "--shapes",
+        type=float,
+        default=SHAPES,
+        help="share of the cases that are a hollow ball (a cavity inside, its wall facing into it) or a turned solid "
+        "torus, inside the image, checked against their area, volume, Euler characteristic, total Gaussian and "
+        "mean curvature (default: 0: the draws of earlier rounds)",
+    )
     options = parser.parse_args(argv)
     RELATIONS = options.relations
+    SHAPES = options.shapes
 
     if options.replay is not None:
         kind, image, spacing, give_spacing, truth, twin = make_case(options.seed, options.replay)
