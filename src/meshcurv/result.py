@@ -113,10 +113,11 @@ class CurvatureResult:
             array.flags.writeable = False
             object.__setattr__(self, name, array)
         object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
-        if self.invalid_reason is not None:
-            object.__setattr__(self, "invalid_reason", _readonly(np.array(self.invalid_reason, dtype=np.int8)))
-        if self.radius is not None:
-            object.__setattr__(self, "radius", _readonly(np.array(self.radius, dtype=np.float64)))
+        for name, dtype in (("invalid_reason", np.int8), ("radius", np.float64)):
+            value = getattr(self, name)
+            if value is None or (isinstance(value, np.ndarray) and not value.flags.writeable and _kept(value, dtype)):
+                continue  # read-only and owning its data: taken as it is (each replace() copied it, issue 31)
+            object.__setattr__(self, name, _readonly(np.array(value, dtype=dtype)))
 
     def __reduce__(self):
         # the parameters' MappingProxyType does not pickle: rebuilt from a dict
@@ -482,7 +483,10 @@ _ARRAY_FIELDS = ("k_min", "k_max", "dir_min", "dir_max", "normals", "valid")
 
 
 def _keepable(array: np.ndarray, name: str) -> bool:
-    dtype = np.bool_ if name == "valid" else np.float64
+    return _kept(array, np.bool_ if name == "valid" else np.float64)
+
+
+def _kept(array: np.ndarray, dtype) -> bool:
     # owning its data, or over a buffer a compiled kernel allocated for it (a numba MemInfo): kept without a
     # copy (what a copy costs: benchmarks/docstring_figures.md)
     sole = array.flags.owndata or type(array.base).__name__ == "_MemInfo"
