@@ -15,6 +15,22 @@ _BITS = 21
 _TOP = (1 << _BITS) - 1
 
 
+#: A cube is beyond the reach when its squared distance from the centre, in sides, exceeds this: 1 and a margin
+#: far above the round-off of the cubes' coordinates (a sample on a cube's face may be filed on either side).
+_REACH_SLACK = 1.0 + 1e-6
+
+
+@nb.njit(inline="always", **_JIT)
+def _cube_gap(x, low, reach, cube, step):
+    """The squared distance, in sides, from the coordinate ``x`` in cube ``cube`` (of side ``reach`` from ``low``) to
+    the neighbour cube ``cube + step`` (``step`` -1, 0 or 1) along its axis."""
+    if step == 0:
+        return 0.0
+    inside = (x - low) / reach - cube  # 0 to 1 in its cube
+    gap = inside if step < 0 else 1.0 - inside
+    return gap * gap if gap > 0.0 else 0.0
+
+
 @nb.njit(**_JIT)
 def _interpolate_chunk(
     lo,
@@ -34,8 +50,10 @@ def _interpolate_chunk(
     spread,
     out,
     reached,
+    corner,
 ):
-    """Rows ``lo..hi`` of :func:`interpolated_normals` (``cubes``: (M, 3) the centres' cubes of side ``reach``;
+    """Rows ``lo..hi`` of :func:`interpolated_normals` (``cubes``: (M, 3) the centres' cubes of side ``reach``
+    from ``corner``;
     ``keys``, ``order``: the samples' cube keys, sorted, and their rows; ``facing`` (M, 3) or (0, 3): without
     rows, every sample in reach counts)."""
     k = fitted.shape[1]
@@ -51,14 +69,23 @@ def _interpolate_chunk(
             cx = cubes[i, 0] + dx
             if cx < 0 or cx > _TOP:
                 continue
+            gap_x = _cube_gap(ax, corner[0], reach, cubes[i, 0], dx)
             for dy in range(-1, 2):
                 cy = cubes[i, 1] + dy
                 if cy < 0 or cy > _TOP:
                     continue
+                # a column of cubes whose nearest point is beyond the reach holds no sample of positive weight
+                # (skipped, as each of its samples would be: the same sums)
+                across = gap_x + _cube_gap(ay, corner[1], reach, cubes[i, 1], dy)
+                if across > _REACH_SLACK:
+                    continue
                 # the three cubes along z are consecutive keys (z is the lowest bits): one search, then the
                 # samples of the three in key order, as three searches visited them (27 searches a centre cost
-                # about half of the interpolation)
-                low_z, high_z = max(cubes[i, 2] - 1, 0), min(cubes[i, 2] + 1, _TOP)
+                # about half of the interpolation); a cube beyond the reach left out
+                below = across + _cube_gap(az, corner[2], reach, cubes[i, 2], -1) > _REACH_SLACK
+                above = across + _cube_gap(az, corner[2], reach, cubes[i, 2], 1) > _REACH_SLACK
+                low_z = cubes[i, 2] if below else max(cubes[i, 2] - 1, 0)
+                high_z = cubes[i, 2] if above else min(cubes[i, 2] + 1, _TOP)
                 row = (cx << 42) | (cy << 21)
                 last = row | high_z
                 first = np.searchsorted(keys, row | low_z)
@@ -161,5 +188,6 @@ def interpolated_normals(
         float(spread),
         out,
         reached,
+        corner,
     )
     return out, reached
