@@ -11,8 +11,9 @@ surface's, its balls grown to the voxel rule's radius (4.1 voxels for the sphere
 voxel default: a value within the staircase's error, or NaN with the reason "voxel staircase".
 
 Expected values: the exact curvature of the sphere of radius ``R`` voxels, ``H = 1 / R``. A valid vertex off it by
-more than ``1 / R`` (twice the sphere's H, or of the wrong sign) is a lie whatever the staircase; the fuzzer's bar is
-half the clean estimate's largest ``|k|`` (about 1.5 / R) from the clean estimate.
+more than ``0.6 / R`` is a lie whatever the staircase (the soups' tail reaches 0.54 / R since V30's agreement check,
+``quadric.SOUP_AGREEMENT``; R29's F4: the bar was ``1 / R``, with 76 vertices of the R 6 soup between 0.5 / R and it);
+the fuzzer's bar is half the clean estimate's largest ``|k|`` (about 1.5 / R) from the clean estimate.
 """
 
 import warnings
@@ -69,7 +70,7 @@ def test_voxel_soup_default_no_lie(share, gap, seed, inward):
     vertices, faces = _soup(shapes.voxel_sphere(10.0), share, gap, seed, inward=inward)
     result, message = _quadric(vertices, faces)
     errors = _errors(result, 10.0)
-    assert errors.max() < 1.0
+    assert errors.max() < 0.6
     assert np.median(errors) < 0.14
     assert result.valid.mean() > 0.6  # the share kept: 0.70 (every face detached) to 0.92 (a fifth)
     assert "voxel staircase" in message
@@ -84,7 +85,7 @@ def test_small_voxel_soup_both_backends(backend):
     vertices, faces = _soup(shapes.voxel_sphere(6.0), 1.0, 0.05, 3)
     result, _ = _quadric(vertices, faces, backend)
     errors = _errors(result, 6.0)
-    assert errors.max() < 1.0
+    assert errors.max() < 0.6  # (before V30: 76 of 3,489 valid vertices beyond 0.5 / R)
     assert np.median(errors) < 0.15
 
 
@@ -93,7 +94,7 @@ def test_smooth_soups_read_no_voxel_grid():
     grown-ball check, on every soup, lost right values of a random sphere with a fifth of its faces detached)."""
     from meshcurv._prepared import prepare_mesh
     from meshcurv.estimators._support import Stages
-    from meshcurv.estimators.quadric import STAGES, _soup_voxel_size
+    from meshcurv.estimators.quadric import STAGES, _soup_grid
 
     for mesh, share, gap in (
         (shapes.icosphere(24), 0.5, 0.04),
@@ -105,10 +106,11 @@ def test_smooth_soups_read_no_voxel_grid():
             warnings.simplefilter("ignore")
             prepared = prepare_mesh(vertices, faces, orient="auto", weld=True)
         defects, valid = prepared.start(boundary=True, fragments=True)
-        assert _soup_voxel_size(prepared, defects, valid, Stages(STAGES).voxel) is None
+        assert _soup_grid(prepared, defects, valid, Stages(STAGES)) is None
     vertices, faces = _soup(shapes.voxel_sphere(10.0), 0.5, 0.041, 559)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         prepared = prepare_mesh(vertices, faces, orient="auto", weld=True)
     defects, valid = prepared.start(boundary=True, fragments=True)
-    assert _soup_voxel_size(prepared, defects, valid, Stages(STAGES).voxel) == pytest.approx(1.0)
+    grid = _soup_grid(prepared, defects, valid, Stages(STAGES))
+    assert grid is not None and np.max(grid.spacing) == pytest.approx(1.0)

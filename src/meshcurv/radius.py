@@ -89,7 +89,7 @@ from ._geometry import (
 )
 from .geometry import _floats, checked_topology_points
 from .jets import SETTLED_SLOPE, _fit_jets
-from .lattice import VoxelGrid, voxel_grid
+from .lattice import VoxelGrid, _refitted_axis, _turned_frame, _unit_sides, voxel_grid
 from .neighborhoods import (
     _ball_face_sums,
     _ball_pairs,
@@ -1102,6 +1102,32 @@ VOXEL_CURVEDNESS_PERCENTILE = 75.0
 VOXEL_FLAT_CURVEDNESS = 1e-6
 
 
+def voxel_curvature_radius(curvedness: np.ndarray, grid: VoxelGrid) -> float | None:
+    """The typical radius of curvature ``R`` of a surface on ``grid`` (:class:`meshcurv.lattice.VoxelGrid`), or None.
+
+    ``curvedness`` (N,): ``max(|k_min|, |k_max|)`` of a first pass at its vertices (NaN: no fit); ``R`` is the
+    inverse of the :data:`VOXEL_CURVEDNESS_PERCENTILE` th percentile of those above :data:`VOXEL_FLAT_CURVEDNESS`
+    over the largest voxel size (None where none is). The voxel default's (:func:`voxel_surface_radius`) and a
+    voxel soup's (``quadric``'s default on a voxel surface stored as a triangle soup: :func:`soup_voxel_grid`)."""
+    with np.errstate(invalid="ignore"):  # (NaN: no fit, left out)
+        curved = curvedness[
+            np.isfinite(curvedness) & (curvedness > VOXEL_FLAT_CURVEDNESS / float(np.max(grid.spacing)))
+        ]
+    if curved.size == 0:
+        return None
+    return 1.0 / float(np.percentile(curved, VOXEL_CURVEDNESS_PERCENTILE))
+
+
+def voxel_rule_radius(grid: VoxelGrid, curvature_radius: float, points: np.ndarray) -> tuple[float, float]:
+    """``(radius, extent)``: the default radius of a surface on ``grid`` whose typical radius of curvature is
+    ``curvature_radius`` (:func:`voxel_curvature_radius`), :func:`voxel_radius`, at most ``extent``,
+    :data:`VOXEL_EXTENT_CAP` of the diagonal of the bounding box of its ``points`` (N, 3) in the grid's axes (the same
+    in every pose). The voxel default's and a voxel soup's (:func:`soup_voxel_grid`)."""
+    used = grid.along(points)
+    extent = VOXEL_EXTENT_CAP * float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    return min(voxel_radius(grid.spacing, curvature_radius), extent), extent
+
+
 def voxel_surface_radius(
     vertices: np.ndarray, topology: MeshTopology, pilot: Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
 ) -> tuple[float, dict] | None:
@@ -1140,17 +1166,12 @@ def _voxel_surface_radius(
     k_min, k_max, valid, *more = pilot(VOXEL_PILOT * float(np.max(grid.spacing)))  # type: ignore[var-annotated]
     if grid.noise > 0 and np.count_nonzero(referenced & valid) < VOXEL_PILOT_COVER * np.count_nonzero(referenced):
         return None  # a noisy soup, its copies welded in part: the pilot's balls hold pieces of the surface, no R
-    curvedness = np.maximum(np.abs(k_min), np.abs(k_max))
-    curved = np.isfinite(curvedness) & (curvedness > VOXEL_FLAT_CURVEDNESS / float(np.max(grid.spacing)))
-    curvedness = curvedness[referenced & valid & curved]
-    if curvedness.size == 0:
+    curvature_radius = voxel_curvature_radius(np.maximum(np.abs(k_min), np.abs(k_max))[referenced & valid], grid)
+    if curvature_radius is None:
         return None
-    curvature_radius = 1.0 / float(np.percentile(curvedness, VOXEL_CURVEDNESS_PERCENTILE))
     # a default is never refused as a given radius would be: at most a share of the surface's own extent (a
     # label of a few voxels in a row read a curvature radius of 10 voxels: 4.7 against a diagonal of 4.1)
-    used = grid.along(vertices[referenced])  # (its bounding box in the grid's axes: the same in every pose)
-    extent = VOXEL_EXTENT_CAP * float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
-    radius = min(voxel_radius(grid.spacing, curvature_radius), extent)
+    radius, extent = voxel_rule_radius(grid, curvature_radius, vertices[referenced])
     found = {
         "surface": "voxel",
         "voxel_spacing": tuple(float(x) for x in grid.spacing),
@@ -1293,10 +1314,12 @@ def _voxel_surface_grid(
     return None if valid is None else _grid_part(mesh.vertices, valid)
 
 
-def _grid_part(vertices: np.ndarray, valid: np.ndarray) -> tuple[VoxelGrid, np.ndarray] | None:
+def _grid_part(
+    vertices: np.ndarray, valid: np.ndarray, share: float = GRID_PART_SHARE
+) -> tuple[VoxelGrid, np.ndarray] | None:
     """``(grid, on_planes)``: the grid (:func:`meshcurv.lattice.voxel_grid`) of the ``valid`` vertices ((V,) bool)
     with two coordinates repeated by :data:`GRID_PLANE_VERTICES` vertices or more, where they are at least
-    :data:`GRID_PART_SHARE` of them; else None. Faces detached off a voxel surface by cracks beyond the weld and
+    ``share`` of them (:data:`GRID_PART_SHARE`); else None. Faces detached off a voxel surface by cracks beyond the weld and
     welded to each other leave valid vertices off the grid, too many for the mesh's reading (fuzz_api seed
     480, case 968: 97 of 258 valid vertices; a voxel sphere of radius 4 with half its faces detached by 0.06
     voxels: 71 of 326 valid vertices off the clean surface's H by more than half its largest curvature).
@@ -1306,10 +1329,142 @@ def _grid_part(vertices: np.ndarray, valid: np.ndarray) -> tuple[VoxelGrid, np.n
         _, inverse, counts = np.unique(vertices[:, k], return_inverse=True, return_counts=True)
         repeated += counts[inverse] >= GRID_PLANE_VERTICES
     on_planes = valid & (repeated >= 2)
-    if on_planes.sum() < GRID_PART_SHARE * valid.sum():
+    if on_planes.sum() < share * valid.sum():
         return None
     grid = voxel_grid(vertices[on_planes])
     return None if grid is None else (grid, on_planes)
+
+
+#: A voxel soup's grid turned off the coordinate axes (:func:`soup_voxel_grid`): its faces' sides are read for the
+#: grid's axes at right angles to them within this angle (radians), where :func:`meshcurv.lattice.voxel_grid`'s
+#: proposal groups them within 0.05: every face moved by 0.05 edge lengths turns the sides by about 0.07, and that
+#: proposal found no frame for ``voxel_sphere(6)`` so detached and turned by (0.3, 0.5, 0.7) (issue 29, R29's F6) ...
+SOUP_FRAME_ANGLE = 0.15
+#: ... from this many pairs of sides, their cross products at least this sine apart ...
+SOUP_FRAME_PAIRS = 1024
+SOUP_FRAME_SINE = 0.3
+#: ... each axis then refitted over every side in this many steps (:func:`meshcurv.lattice._refitted_axis`), to
+#: round-off on the faces that kept their place (half of them detached: the frame to 1e-16, where the lattice's
+#: three steps left 1e-13, enough to part a plane's coordinates) ...
+SOUP_FRAME_STEPS = 12
+#: ... and the turned coordinates within this share of their largest of each other taken as one plane's
+#: (:func:`_snapped`: a plane's coordinates, turned, differ by round-off; 1e-9 is far from both).
+GRID_SNAP = 1e-9
+#: ... and the vertices that kept their place on its planes (:func:`_grid_part`) need be only this share of the valid
+#: ones, the exact reading of their grid (:func:`meshcurv.lattice.voxel_grid`) deciding: half of the faces detached
+#: by 0.05 edges leave 23% of them there (the weld joins the copies off it), and the vertices but the cracks' corners
+#: were too few for that reading (62 of ``voxel_sphere(6)``'s).
+SOUP_PART_SHARE = 0.15
+
+
+def soup_voxel_grid(
+    mesh: PreparedMesh,
+    *,
+    invalid: np.ndarray,
+    valid: np.ndarray,
+    corners: np.ndarray,
+    reading: VoxelReading | None = None,
+) -> VoxelGrid | None:
+    """The voxel grid of a voxel surface stored as a triangle soup, in any pose, or None.
+
+    A soup's faces have corners of their own, moved by a few hundredths of an edge (a mesh exported face by face),
+    welded in part (:func:`meshcurv._prepared.prepare_mesh`). Its grid is, in this order, the first found of:
+
+    1. the reading of every method (:func:`_voxel_surface_grid`: the mesh's, or that of its faces with a corner not
+       ``invalid``), kept by ``reading`` (:class:`VoxelReading`);
+    2. on a mesh welded across cracks: that of the ``valid`` vertices ((V,) bool) on a grid's planes
+       (:func:`_grid_part`: the vertices that kept their place), also without the ``corners`` of its cracks ((V,)
+       bool: the copies the weld joined, off the grid by the cracks' width, are half of the vertices of
+       ``voxel_sphere(10)`` half detached by 0.04 edges; fuzz 559/137), along the coordinate axes, then in the axes
+       of its faces' sides (:func:`_soup_frame`);
+    3. every face moved (none kept its place): its periodic reading (:func:`meshcurv.lattice.voxel_grid`, widened
+       for noise) in those axes.
+
+    The grid's ``frame`` holds its axes (None: x, y and z). A default radius that reads no grid here measures the soup
+    as a smooth mesh, whose balls the steps bend; the pose must not decide it (issue 29: ``voxel_sphere(6)`` with
+    every face detached, turned by (0.3, 0.5, 0.7), read no grid where unturned it did: 433 valid vertices off its H
+    by more than half of it against 76).
+    """
+    found = _voxel_surface_grid(mesh, invalid=invalid, reading=reading)
+    if found is not None:
+        return found[0]
+    if not mesh.n_cracked or not valid.any():
+        return None
+    vertices, faces = mesh.vertices, mesh.topology.faces
+    parts = (valid, valid & ~corners)
+    for part in parts:
+        found = _grid_part(vertices, part, SOUP_PART_SHARE)
+        if found is not None:
+            return found[0]
+    frame = _soup_frame(vertices, faces)
+    if frame is None:
+        return None
+    turned = vertices @ frame.T
+    snapped = _snapped(turned)
+    for part in parts:
+        found = _grid_part(snapped, part, SOUP_PART_SHARE)
+        if found is not None:
+            return found[0]._replace(frame=frame)
+    used = mesh.topology.referenced_vertices & ~mesh.needles
+    kept = faces[used[faces].all(axis=1)]
+    if not kept.shape[0]:
+        return None
+    scales = mesh.length_scales[used]
+    grid = voxel_grid(turned[used], (np.cumsum(used) - 1)[kept], spacing=float(np.median(scales)))
+    if grid is None or _off_grid_scale(scales, grid.spacing):
+        return None
+    return grid._replace(frame=frame if grid.frame is None else grid.frame @ frame)
+
+
+def _soup_frame(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray | None:
+    """(3, 3) the axes (rows, orthonormal) that the sides of the ``faces`` (F, 3) over ``vertices`` (V, 3) lie at
+    right angles to, read for a voxel soup (:func:`soup_voxel_grid`), or None: the proposal of
+    :func:`meshcurv.lattice.voxel_grid` (:func:`meshcurv.lattice._turned_frame`), else the direction at right angles
+    to the most sides (within :data:`SOUP_FRAME_ANGLE`) among the cross products of pairs of sides, then the one at
+    right angles to it and to the most sides; each axis refitted over every side (:data:`SOUP_FRAME_STEPS`). A
+    proposal: the grid must then be read in it."""
+    sides = _unit_sides(vertices, faces)
+    if sides.shape[0] < 16:
+        return None
+    bound = float(np.sin(SOUP_FRAME_ANGLE))
+    frame = _turned_frame(vertices, faces)
+    if frame is None:
+        first, second = np.random.default_rng(0).integers(0, sides.shape[0], (3, SOUP_FRAME_PAIRS))[:2]
+        across = np.cross(sides[first], sides[second])
+        sines = np.linalg.norm(across, axis=1)
+        across = across[sines >= SOUP_FRAME_SINE] / sines[sines >= SOUP_FRAME_SINE, None]
+        sample = sides[np.random.default_rng(1).integers(0, sides.shape[0], SOUP_FRAME_PAIRS)]
+        if across.shape[0] < 16:
+            return None
+        counts = (np.abs(across @ sample.T) <= bound).sum(axis=1)
+        axis = across[int(np.argmax(counts))]
+        counts *= np.abs(across @ axis) <= bound  # (then the densest at right angles to it)
+        if not counts.any():
+            return None
+        other = across[int(np.argmax(counts))]
+        other = other - (other @ axis) * axis
+        frame = np.stack([axis, other / np.linalg.norm(other), np.cross(axis, other / np.linalg.norm(other))])
+    for k in range(3):
+        found = _refitted_axis(sides, frame[k], bound, steps=SOUP_FRAME_STEPS)
+        if found is None:
+            return None
+        frame[k] = found[0]
+    left_vectors, _, right_vectors = np.linalg.svd(frame)
+    return left_vectors @ right_vectors  # (the nearest orthonormal axes)
+
+
+def _snapped(points: np.ndarray) -> np.ndarray:
+    """``points`` (N, 3) with each coordinate within :data:`GRID_SNAP` of their largest ``|coordinate|`` of the one
+    before it (in sorted order, along each axis) replaced by the first of its run: a plane's coordinates, turned
+    into the grid's axes, equal again (they differed by round-off)."""
+    tolerance = GRID_SNAP * float(np.abs(points).max())
+    snapped = points.copy()
+    for k in range(3):
+        order = np.argsort(points[:, k], kind="stable")
+        values = points[order, k]
+        starts = np.concatenate([[True], np.diff(values) > tolerance])
+        snapped[order, k] = values[starts][np.cumsum(starts) - 1]
+    return snapped
 
 
 def _voxel_surface(
