@@ -1303,7 +1303,29 @@ def oriented_signs(
         torn = flat & (np.abs(cosine) >= PARALLEL_COSINE) & (signs[rows] * signs[cols] * cosine < 0)
         doubtful[rows[torn]] = True
         doubtful[cols[torn]] = True
+    signs = _settled_sides(normals, signs, doubtful & ~unsettled, indices, usable)
     return signs, labels, doubtful | unsettled, sheets, unsettled
+
+
+def _settled_sides(normals, signs, doubtful, indices, usable):
+    """``signs`` (N,) with each of the ``doubtful`` (N,) bool points on the side of the sum of its decided usable
+    neighbours' oriented normals (``indices`` (N, k)); where they sum to none across it, as it was.
+
+    The orientation leaves an undecided point the sign of whichever edge reached it, and on a lattice edges tie:
+    the pose's order chose (fuzz_api 522/23: two such points of a voxel torus in opposite signs in two poses; the
+    noise level's fits, which refuse balls holding the other side by the normals, then read 0.05843 and 0.05851,
+    and the default radius moved with it). Their neighbours' normals turn with the pose.
+    """
+    rows = np.flatnonzero(doubtful)
+    if rows.size == 0:
+        return signs
+    near = indices[rows]
+    decided = (usable[near] & ~doubtful[near] & (near != rows[:, None]))[:, :, None]
+    oriented = normals[near] * signs[near][:, :, None]
+    side = np.einsum("mj,mj->m", (oriented * decided).sum(axis=1), normals[rows] * signs[rows, None])
+    signs = signs.copy()
+    signs[rows[side < 0]] *= -1
+    return signs
 
 
 def _graph_cut(points: np.ndarray, indices: np.ndarray) -> np.ndarray:
@@ -1893,17 +1915,23 @@ def lattice_treads(
         with np.errstate(invalid="ignore"):
             sagitta = np.maximum(np.abs(k_min[rows]), np.abs(k_max[rows])) * fitted[rows] ** 2 / 2
             tread[rows] = sagitta < FACET_SAGITTA * np.max(np.abs(lattice.along(normals[rows])) * steps, axis=1)
-    k = min(STEP_NEIGHBOURS + 1, points.shape[0])
+    # (the point itself, its STEP_NEIGHBOURS nearest and the next: on a lattice many neighbours tie at a cut, and
+    # which of them the search returned was the pose's order; the neighbours tied with the first left out at either
+    # cut, or with the ball's radius, are left out: fuzz_api 572/2, 3 points read on one tread in one pose only)
+    k = min(STEP_NEIGHBOURS + 2, points.shape[0])
     for start in range(0, rows.size, TREAD_CHUNK):
         chunk = rows[start : start + TREAD_CHUNK]
         distances, near = tree.query(points[chunk], k=k, workers=-1)
-        inside = distances[:, 1:] <= radii[chunk][:, None]  # (the point itself first)
+        distances, near = distances[:, 1:], near[:, 1:]  # (the point itself first)
+        tied = _tied_at(distances, STEP_NEIGHBOURS)
+        distances, near = distances[:, :STEP_NEIGHBOURS], near[:, :STEP_NEIGHBOURS]
+        inside = (distances <= radii[chunk][:, None] * (1.0 - TIE_TOLERANCE)) & ~tied
         # the axis most along the normal: a point facing an axis off the grid (a cylinder's side, its rings on a
         # grid along the axis) is on no tread
         axis = np.argmax(np.abs(lattice.along(normals[chunk])), axis=1)
         step = np.where(steps[axis] > 0, steps[axis], np.nan)[:, None]
-        height = snapped[near[:, 1:], axis[:, None]] - snapped[chunk, axis][:, None]
-        nearest = inside[:, :TREAD_NEIGHBOURS]
+        height = snapped[near, axis[:, None]] - snapped[chunk, axis][:, None]
+        nearest = inside[:, :TREAD_NEIGHBOURS] & ~_tied_at(distances, TREAD_NEIGHBOURS)
         plane = nearest & (np.abs(height[:, :TREAD_NEIGHBOURS]) <= LATTICE_TOLERANCE * step)
         tread[chunk] |= plane.sum(axis=1) >= TREAD_SHARE * np.maximum(nearest.sum(axis=1), 1)
         if staircase:  # the planes of the grid the ball spans along the axis (the centre's own included)
@@ -1919,6 +1947,14 @@ def lattice_treads(
         f"it or fewer, or an estimate rising over the ball by less than {FACET_SAGITTA:g} of the steps: the "
         "surface may curve there by less than the voxels resolve at this radius): NaN"
     ]
+
+
+def _tied_at(distances: np.ndarray, cut: int) -> np.ndarray:
+    """(M, min(cut, K)) bool: of the sorted ``distances`` (M, K), those of the first ``cut`` columns within
+    :data:`TIE_TOLERANCE` of the first column after the cut (none where there is no such column)."""
+    if distances.shape[1] <= cut:
+        return np.zeros(distances.shape, dtype=bool)
+    return distances[:, :cut] >= distances[:, cut : cut + 1] * (1.0 - TIE_TOLERANCE)
 
 
 def _two_heights(points, group, usable, step):

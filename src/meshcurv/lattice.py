@@ -800,27 +800,100 @@ def _lattice_in(points, spacing):
 
 def _lattice_frame(points, rows, neighbours, usable, spacing):
     """(3, 3) the axes (rows) of a lattice turned off the coordinate axes, or None (see :data:`LATTICE_FRAME_PROBE`):
-    the ``rows`` (M, 3) the ``usable`` of ``points`` (N, 3), ``neighbours`` (N, k) each point's nearest."""
+    the ``rows`` (M, 3) the ``usable`` of ``points`` (N, 3), ``neighbours`` (N, k) each point's nearest. Where no
+    facet is flat to :data:`LATTICE_FLAT` (a turned voxel surface under noise), the facets of
+    :data:`LATTICE_NOISY_FLAT` (see there)."""
     candidates = np.arange(points.shape[0]) if usable is None else np.flatnonzero(usable)
     reach = np.linalg.norm(points[neighbours[:, -1]] - points, axis=1)  # (a length the motions carry)
     probe = _spread(candidates, LATTICE_FRAME_PROBE, points, reach)
     group = np.concatenate([points[probe, None, :], points[neighbours[probe]]], axis=1)
     group = group - group.mean(axis=1, keepdims=True)
     values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", group, group))
+    sample = rows[:: max(1, rows.shape[0] // LATTICE_PROBE)]
     normals = vectors[values[:, 0] <= LATTICE_FLAT * values[:, 1], :, 0]
-    close = np.abs(normals @ normals.T) >= np.cos(LATTICE_FRAME_ANGLE)
+    directions = _facet_directions(normals, LATTICE_FRAME_ANGLE, LATTICE_FRAME_GROUP, LATTICE_FRAME_GROUPS)
+    frame = _frame_of(directions, rows, sample, spacing, every=False)
+    if frame is not None:
+        return frame
+    normals = vectors[values[:, 0] <= LATTICE_NOISY_FLAT * values[:, 1], :, 0]
+    least = max(LATTICE_FRAME_GROUP, int(np.ceil(LATTICE_NOISY_GROUP * probe.size)))
+    directions = _facet_directions(normals, LATTICE_NOISY_ANGLE, least, LATTICE_NOISY_GROUPS)
+    sharpened = (_sharpened(direction, sample, spacing) for direction in directions)
+    return _frame_of([found for found in sharpened if found is not None], rows, sample, spacing, every=True)
+
+
+def _facet_directions(normals, angle, least, most):
+    """The directions (unit (3,) each) of the largest groups of the unit ``normals`` (M, 3) within ``angle`` (radians)
+    of one of them, up to sign: at most ``most`` groups of ``least`` normals or more, largest first."""
+    close = np.abs(normals @ normals.T) >= np.cos(angle)
     left = np.ones(normals.shape[0], dtype=bool)
     directions: list[np.ndarray] = []
-    while left.any() and len(directions) < LATTICE_FRAME_GROUPS:  # the largest group of facets left, its direction
+    while left.any() and len(directions) < most:  # the largest group of facets left, its direction
         counts = (close & left).sum(axis=1) * left
         best = int(np.argmax(counts))
-        if counts[best] < LATTICE_FRAME_GROUP:
+        if counts[best] < least:
             break
         members = close[best] & left
         direction = (normals[members] * np.sign(normals[members] @ normals[best])[:, None]).sum(axis=0)
         directions.append(direction / np.linalg.norm(direction))
         left &= ~members
-    sample = rows[:: max(1, rows.shape[0] // LATTICE_PROBE)]
+    return directions
+
+
+#: A turned voxel surface under noise (a twentieth of a voxel or more along the normal: fuzz_api 510/77, 608/15) has
+#: no facet coplanar to :data:`LATTICE_FLAT`: its frame is then sought among the facets whose least variance is below
+#: this share of the next (a tread under noise of a tenth of a voxel over ten neighbours: 0.002-0.01), grouped within
+#: :data:`LATTICE_NOISY_ANGLE` radians (their normals scatter by 0.02-0.04), the :data:`LATTICE_NOISY_GROUPS`
+#: largest of at least :data:`LATTICE_NOISY_GROUP` of the probed points; each group's direction (off its axis by a
+#: few thousandths of a radian) is sharpened to the one along which the coordinates are most periodic
+#: (:func:`_sharpened`), and up to :data:`LATTICE_FRAME_TRIES` of them are tried as an axis of the frame (the
+#: coarsest grid first, then the largest groups).
+LATTICE_NOISY_FLAT = 0.01
+LATTICE_NOISY_ANGLE = 0.05
+LATTICE_NOISY_GROUP = 0.01
+LATTICE_NOISY_GROUPS = 4
+
+#: :func:`_sharpened`'s search: the tilts of a direction (radians) of a square grid of 7 x 7 about the best so far,
+#: each level's half-width a quarter of the previous one's (the first level's spacing, 0.004, is about the width of
+#: the modulus's peak on a grid of a hundred planes). A direction along which the coordinates are not periodic
+#: (:data:`LATTICE_PERIODIC`) after the first level is dropped: a smooth cloud's facets (most clouds reach here)
+#: cost 49 spectra each.
+LATTICE_SHARPEN = (0.012, 0.003, 0.00075, 0.0002)
+
+
+def _strength(values, spacing):
+    """The strongest modulus of :func:`_spectrum` of ``values`` (M,) within :data:`LATTICE_BAND` (0: none)."""
+    modulus, _, band, _ = _spectrum(values, spacing)
+    return 0.0 if band.size == 0 else float(modulus[band].max())
+
+
+def _sharpened(direction, sample, spacing):
+    """The unit direction near ``direction`` (3,) along which the ``sample`` (S, 3) is most periodic
+    (:func:`_strength`), by the tilts of :data:`LATTICE_SHARPEN`; None where it is not periodic."""
+    first = np.cross(direction, np.eye(3)[int(np.argmin(np.abs(direction)))])
+    first /= np.linalg.norm(first)
+    second = np.cross(direction, first)
+    along, across, other = sample @ direction, sample @ first, sample @ second
+    best, at = _strength(along, spacing), (0.0, 0.0)
+    for width in LATTICE_SHARPEN:
+        centre = at
+        for a in centre[0] + np.linspace(-width, width, 7):
+            for b in centre[1] + np.linspace(-width, width, 7):
+                strength = _strength(along + a * across + b * other, spacing)
+                if strength > best:
+                    best, at = strength, (float(a), float(b))
+        if best < LATTICE_PERIODIC:
+            return None
+    tilted = direction + at[0] * first + at[1] * second
+    return tilted / np.linalg.norm(tilted)
+
+
+def _frame_of(directions, rows, sample, spacing, *, every):
+    """(3, 3) the frame (rows) of a lattice of the facets' ``directions`` (unit, largest group first), or None (see
+    :func:`_lattice_frame`): the coarsest grid of three at right angles, or the frames about up to
+    :data:`LATTICE_FRAME_TRIES` of them (:func:`_frame_about`): those of the three and the coarsest grid's, and with
+    ``every`` then every other periodic one in order (the coarsest grid of a noisy turned surface may be a diagonal's
+    facets: fuzz_api 510/77)."""
     steps = []
     for direction in directions:
         found = _periodic_planes(rows @ direction, sample @ direction, spacing)
@@ -838,7 +911,8 @@ def _lattice_frame(points, rows, neighbours, usable, spacing):
         if cell > largest and np.all(np.abs(axes @ axes.T - np.eye(3)) <= right):
             largest, frame, triple = cell, axes, (a, b, c)
     coarsest = sorted([k for k, step in enumerate(steps) if step > 0], key=lambda k: -steps[k])
-    queue = [directions[k] for k in [*sorted(triple, key=lambda k: -steps[k]), *coarsest[:1]]]
+    others = [k for k in range(len(directions)) if steps[k] > 0 and k not in coarsest[:1]] if every else []
+    queue = [directions[k] for k in [*sorted(triple, key=lambda k: -steps[k]), *coarsest[:1], *others]]
     tried: list[np.ndarray] = []
     while queue and len(tried) < LATTICE_FRAME_TRIES:  # (a diagonal's frame holds an axis: then that axis')
         axis = queue.pop(0)
@@ -874,8 +948,7 @@ def _frame_about(axis, sample, spacing):
         return np.cos(angle) * first + np.sin(angle) * second
 
     def strongest(angle):
-        modulus, _, band, _ = _spectrum(sample @ direction(angle), spacing)
-        return 0.0 if band.size == 0 else float(modulus[band].max())
+        return _strength(sample @ direction(angle), spacing)
 
     coarse = np.arange(LATTICE_FRAME_ANGLES) * (np.pi / 2 / LATTICE_FRAME_ANGLES)
     strength = np.array([strongest(t) for t in coarse])
