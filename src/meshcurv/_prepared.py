@@ -487,6 +487,71 @@ def _coincident(welding: Welding) -> Welding:
     return Welding(welding.vertices[first], MeshTopology._build(faces, first.size), inverse[welding.index], n_welded)
 
 
+# vertices looked at for a coincident copy before a mesh that is not welded is searched for a second side stored
+# with vertices of its own (:func:`_second_side_apart`): every vertex of such a side has one
+SECOND_SIDE_PROBES = 3
+
+
+def _second_side_apart(points: np.ndarray, topology: MeshTopology) -> tuple[Welding, OneSided] | None:
+    """A second side of ``points`` and ``topology`` (not welded) stored with vertices of its own: ``(welding,
+    one_sided)``, the faces of one side kept as given (their corners, in ``points``' order) and each vertex of the
+    dropped side mapped onto the kept vertex at its point; None when there is none.
+
+    Without a weld, the two sides share no vertex and :func:`meshcurv.weld.drop_double_sided` sees none: it is asked
+    again of the vertices at the same point made one. Only when :data:`SECOND_SIDE_PROBES` vertices spread over the
+    faces each have a copy at their point (one pass over the coordinates each): a mesh whose every face is stored
+    twice has one for every vertex. The kept side's faces and vertices are the given ones, so that the kept side's
+    values are those of the side given alone (``method='matgeom'``: matGeom's)."""
+    faces = topology.faces
+    n_faces = faces.shape[0]
+    if n_faces < 2 or points.shape[0] < 6:
+        return None
+    probes = faces[np.linspace(0, n_faces - 1, SECOND_SIDE_PROBES).astype(np.int64), 0]
+    for probe in probes:
+        if np.count_nonzero((points == points[probe]).all(axis=1)) < 2:
+            return None
+    coincident = _coincident(Welding(points, topology, np.arange(points.shape[0]), 0))
+    on_points = drop_double_sided(coincident.vertices, coincident.topology)
+    if not on_points.n_dropped:
+        return None
+    # of each pair, the face whose own corners wind as the side kept (the drop keeps a pair's first face, turned
+    # where the other winding is the outward one): the kept side's faces on their own vertices, none turned
+    kept_keys = _rotated(on_points.topology.faces)
+    keys = _rotated(coincident.topology.faces)
+    wanted = _rows_in(keys, kept_keys, coincident.vertices.shape[0])
+    if np.count_nonzero(wanted) != kept_keys.shape[0]:  # faces repeated with one winding too: left as they are
+        return None
+    kept_faces = faces[wanted]
+    used = np.zeros(points.shape[0], dtype=bool)
+    used[kept_faces] = True
+    # each vertex at the kept vertex of its point (a vertex the kept faces hold is its own)
+    point_of = coincident.index
+    kept_of_point = np.full(coincident.vertices.shape[0], -1, dtype=np.int64)
+    kept_of_point[point_of[used]] = np.flatnonzero(used)
+    twin = kept_of_point[point_of]
+    own = used | (twin < 0)  # a vertex no kept face holds stays where no kept vertex is at its point
+    new_row = np.cumsum(own) - 1
+    index = new_row[np.where(own, np.arange(points.shape[0]), twin)]
+    side = MeshTopology._build(np.ascontiguousarray(new_row[kept_faces]), int(own.sum()))
+    kept = OneSided(side, ~wanted, on_points.n_dropped)
+    return Welding(points[own], side, index, 0), kept
+
+
+def _rotated(faces: np.ndarray) -> np.ndarray:
+    """The (F, 3) ``faces`` each rotated to start at its smallest corner (the winding kept)."""
+    start = np.argmin(faces, axis=1)
+    return np.take_along_axis(faces, (start[:, None] + np.arange(3)) % 3, axis=1)
+
+
+def _rows_in(rows: np.ndarray, among: np.ndarray, n_vertices: int) -> np.ndarray:
+    """(R,) bool: each row of the (R, 3) ``rows`` (indices below ``n_vertices``) among the rows of ``among``."""
+    if n_vertices < 2**21:  # three corners in one integer
+        packed = [(r[:, 0].astype(np.int64) << 42) | (r[:, 1].astype(np.int64) << 21) | r[:, 2] for r in (rows, among)]
+        return np.isin(packed[0], packed[1])
+    codes = np.unique(np.vstack([rows, among]), axis=0, return_inverse=True)[1].reshape(-1)
+    return np.isin(codes[: rows.shape[0]], codes[rows.shape[0] :])
+
+
 def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: int = 3) -> PreparedMesh:
     """Check ``vertices`` and ``faces`` once and prepare them: :class:`PreparedMesh`.
 
@@ -520,6 +585,11 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
     if welded is not None:
         points, topology = welded.vertices, welded.topology
     one_sided = drop_double_sided(points, topology)  # a double-sided mesh: its faces of one winding
+    if not weld and not one_sided.n_dropped:  # a second side with vertices of its own, found without a weld
+        own_side = _second_side_apart(points, topology)
+        if own_side is not None:
+            welded, one_sided = own_side
+            points, topology = welded.vertices, welded.topology
     seen = welded  # the weld whose vertices the drop saw
     if weld and welded is not None and welded.n_welded and _folded(welded):
         # a second side with corners of its own: its faces repeat the first's points, not their vertices
