@@ -71,8 +71,12 @@ def test_voxel_soup_steps_never_valid_and_far_off(share, gap, seed):
     # 0.79 until stop 63: a soup on a voxel grid is measured at the voxel rule's radius and checked as a voxel
     # surface's default (V29: 0.855/0.853/0.797 -> 0.703/0.696/0.646, a share of every vertex, the 1,890 unreferenced
     # originals of the full soups included); the vertices made NaN read H off by 60% (415) and 35% (420) at the median
-    # before, 110 and 151 of them within 10%; those kept 32% -> 12% and 18% -> 10%, none off by more than OFF now
-    assert result.valid.mean() > 0.6
+    # before, 110 and 151 of them within 10%; those kept 32% -> 12% and 18% -> 10%, none off by more than OFF now.
+    # 0.6 until stop 64: a soup's fit also agrees with the wider quadric within a fifth of the soup's typical curvature
+    # (V30, quadric.SOUP_AGREEMENT: voxel_sphere(10)'s soups kept 59 and 10 valid vertices off the exact H by more
+    # than half of it, now none; the voxel soups' grid of benchmarks/quadric_voxel_soups_V30.py 7,299 -> 22):
+    # 0.599 (432) and 0.553 (420) here
+    assert result.valid.mean() > 0.5
 
 
 def test_closed_mesh_skips_the_wider_ball_of_passed_fits(monkeypatch):

@@ -44,7 +44,10 @@ def test_voxel_soup_quadric_mostly_right(gap, seed):
     # valid vertices; the steps whose residuals grow over the wider ball (read as structure) stay: 4.6-5.9%
     off = result.valid & (np.abs(result.mean - 0.1) > 0.1)
     assert off.sum() < 0.1 * result.valid.sum()
-    assert result.valid.mean() > 0.8
+    # the share kept: 0.818 after V29; since V30 a soup's fit also agrees with the wider quadric within a fifth of its
+    # typical curvature (quadric.SOUP_AGREEMENT: the lies beyond half of the largest |k| on the voxel soups' grid,
+    # 7,299 -> 22 of some 200,000 valid vertices, benchmarks/quadric_voxel_soups_V30.py): 0.71 and 0.69 here
+    assert result.valid.mean() > 0.65
 
 
 def test_voxel_soup_quadric_never_lies():
