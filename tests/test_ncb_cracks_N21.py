@@ -67,13 +67,16 @@ def test_icosphere_cracks_welded_back_at_a_given_ball(backend, seed):
     assert_no_lie(result)
 
 
-@pytest.mark.parametrize(("gap", "reverse", "least"), [(0.044, True, 4500), (0.063, True, 20)])
+@pytest.mark.parametrize(("gap", "reverse", "least"), [(0.044, True, 4000), (0.063, True, 20)])
 def test_uv_sphere_poles_welded_back(gap, reverse, least):
     """fuzz 400/89's class: the 64 x 32 uv sphere wound inward, half detached, default ball. By the poles the
     faces are a tenth of an edge high: the cracks welded back tilt them (0.044 edges: 557 valid vertices off, H up
     to 2.4) or fold them (0.063: 534 off, H up to 9.4). Now none off, the equator's vertices keep theirs (0.044:
     4,645 of 8,031 valid since every ball of a mesh welded across cracks is judged by its own scatter,
-    normal_cycle_ball.FEW_ELEMENTS_CRACKED_SPREAD; 5,115 before, the largest error 0.44 -> 0.24)."""
+    normal_cycle_ball.FEW_ELEMENTS_CRACKED_SPREAD; 5,115 before, the largest error 0.44 -> 0.24). Since the grown balls
+    that lost much of their area to open cracks are undefined (normal_cycle_ball.CRACKED_LOST_BIAS, fuzz 602/100)
+    4,112 (the 533 made NaN: 407 of them more than 0.1 off H; valid vertices more than 0.1 off 961 -> 554), and at
+    0.063 23 of 343 (179 of the 343 were more than 0.25 off H)."""
     vertices, faces, _ = half_detached(shapes.uv_sphere(n_longitude=64, n_latitude=32), 0, gap, reverse=reverse)
     result = curvatures(vertices, faces)
     assert result.valid.sum() > least

@@ -50,7 +50,9 @@ def test_both_backends_compute_the_same_estimate_on_a_half_detached_uv_sphere():
     compiled, reference = results["numba"], results["numpy"]
     np.testing.assert_array_equal(compiled.valid, reference.valid)
     valid = reference.valid
-    assert valid.sum() > len(vertices) / 2
+    # a share that makes the comparison mean something (3,661 of 7,905 since the grown balls that lost much of their
+    # area to open cracks are undefined, normal_cycle_ball.CRACKED_LOST_BIAS; more than half before)
+    assert valid.sum() > 0.4 * len(vertices)
     for field in ("k_min", "k_max", "mean"):
         gap = float(np.abs(getattr(compiled, field)[valid] - getattr(reference, field)[valid]).max())
         assert gap <= RTOL, field  # the unit sphere: its largest |k| is about 1
