@@ -134,6 +134,30 @@ def test_soup_grid_in_any_pose():
         np.testing.assert_allclose(np.sort(np.abs(grid.frame @ rotation), axis=1)[:, -1], 1.0, atol=1e-4)
 
 
+@pytest.mark.parametrize("shift", [1e4, 1e5, 2.0**20])
+def test_soup_grid_wherever_the_soup_sits(shift):
+    """The same grid far from the origin (R30, session 64): the coordinates of a plane, turned into the grid's axes,
+    were made one within a tolerance that grew with their distance from the origin, not with the mesh: at 1e5 sizes
+    no grid was read (the default radius 3.27 for 3.86 at the origin, H off by 0.76 / R), at 2**20 (the fuzzer's
+    translation) a grid of spacing (0, 0, 0.5). Expected: translation invariance (the grid read at the origin)."""
+    from meshcurv._prepared import prepare_mesh
+    from meshcurv.estimators._support import Stages
+    from meshcurv.estimators.quadric import STAGES, _soup_grid
+
+    sphere = shapes.voxel_sphere(6.0)
+    rotation = _rotation(TURN)
+    vertices, faces = _soup(np.asarray(sphere.vertices) @ rotation.T, sphere.faces, 0.5, 0.05, 3)
+    vertices = vertices + shift * 12.0 * np.array([0.6, -0.48, 0.64])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        prepared = prepare_mesh(vertices, faces, orient="outward", weld=True)
+    defects, valid = prepared.start(boundary=True, fragments=True)
+    grid = _soup_grid(prepared, defects, valid, Stages(STAGES))
+    assert grid is not None and grid.frame is not None
+    np.testing.assert_allclose(grid.spacing, 1.0, rtol=1e-3)
+    np.testing.assert_allclose(np.sort(np.abs(grid.frame @ rotation), axis=1)[:, -1], 1.0, atol=1e-4)
+
+
 @pytest.mark.parametrize("backend", ["numba", pytest.param("numpy", marks=pytest.mark.slow)])
 def test_turned_half_soup_both_backends(backend):
     sphere = shapes.voxel_sphere(6.0)

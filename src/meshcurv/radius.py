@@ -1454,10 +1454,13 @@ def _soup_frame(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray | None:
 
 
 def _snapped(points: np.ndarray) -> np.ndarray:
-    """``points`` (N, 3) with each coordinate within :data:`GRID_SNAP` of their largest ``|coordinate|`` of the one
-    before it (in sorted order, along each axis) replaced by the first of its run: a plane's coordinates, turned
-    into the grid's axes, equal again (they differed by round-off)."""
-    tolerance = GRID_SNAP * float(np.abs(points).max())
+    """``points`` (N, 3) with each coordinate within :data:`GRID_SNAP` of their extent (plus their round-off) of the
+    one before it (in sorted order, along each axis) replaced by the first of its run: a plane's coordinates, turned
+    into the grid's axes, equal again (they differed by round-off). The extent, not the largest ``|coordinate|``:
+    the same wherever the mesh sits (a tolerance growing with the distance from the origin read no grid at 1e5
+    sizes away, and a grid of spacing 0 at 2**20)."""
+    extent = float(np.ptp(points, axis=0).max())
+    tolerance = GRID_SNAP * extent + 8.0 * np.finfo(float).eps * float(np.abs(points).max())
     snapped = points.copy()
     for k in range(3):
         order = np.argsort(points[:, k], kind="stable")

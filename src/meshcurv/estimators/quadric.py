@@ -387,7 +387,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         checks = (every, every, every, np.zeros(n, dtype=bool))
         default = radii.copy()  # the wider ball of the check below: twice the default, as step 3's
         unsure = _scatter_check((vertices, radii, referenced, scales), checks, fields, staircase=True)
-        typical = soup_curvature if soup_grid is not None else None
+        typical = soup_curvature if soup_grid is not None and soup_curvature > 0 else None  # 0: none read
         unsure |= _staircase_check((vertices, default, radii, referenced), fields, soup_curvature=typical)
         steps = unsure.copy()  # the fits the steps bent: a limit of the method on this surface, not an undefined fit
     else:
