@@ -18,15 +18,7 @@ import meshcurv
 from meshcurv import shapes
 
 from conftest import chosen_backend
-
-
-def _one_warning(vertices, faces, **options):
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = meshcurv.principal_curvatures(vertices, faces, **options)
-    assert len(caught) == 1, [str(w.message) for w in caught]
-    assert issubclass(caught[0].category, meshcurv.MeshQualityWarning)
-    return result, str(caught[0].message)
+from test_double_sided import one_warning as _one_warning
 
 
 def _second_side_apart(vertices, faces, seed=None):

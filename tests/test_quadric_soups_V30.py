@@ -115,39 +115,20 @@ def test_turned_voxel_soup_reads_its_grid(share, turned_first):
 
 def test_soup_grid_in_any_pose():
     """The grid read on a turned soup is the voxel grid: unit voxels, its axes the image's turned."""
-    from meshcurv._prepared import prepare_mesh
-    from meshcurv.estimators._support import Stages
-    from meshcurv.estimators.quadric import STAGES, _soup_grid
-
     sphere = shapes.voxel_sphere(6.0)
     rotation = _rotation(TURN)
     for share, seed in ((1.0, 3), (0.5, 3), (0.5, 5)):
         vertices, faces = _soup(np.asarray(sphere.vertices) @ rotation.T, sphere.faces, share, 0.05, seed)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            prepared = prepare_mesh(vertices, faces, orient="outward", weld=True)
-        defects, valid = prepared.start(boundary=True, fragments=True)
-        grid = _soup_grid(prepared, defects, valid, Stages(STAGES))
-        assert grid is not None and grid.frame is not None
-        np.testing.assert_allclose(grid.spacing, 1.0, rtol=1e-3)
-        # each axis of the grid along one of the image's axes, turned (to the detached faces' scatter)
-        np.testing.assert_allclose(np.sort(np.abs(grid.frame @ rotation), axis=1)[:, -1], 1.0, atol=1e-4)
+        _assert_turned_unit_grid(vertices, faces, rotation)
 
 
-@pytest.mark.parametrize("shift", [1e4, 1e5, 2.0**20])
-def test_soup_grid_wherever_the_soup_sits(shift):
-    """The same grid far from the origin (R30, session 64): the coordinates of a plane, turned into the grid's axes,
-    were made one within a tolerance that grew with their distance from the origin, not with the mesh: at 1e5 sizes
-    no grid was read (the default radius 3.27 for 3.86 at the origin, H off by 0.76 / R), at 2**20 (the fuzzer's
-    translation) a grid of spacing (0, 0, 0.5). Expected: translation invariance (the grid read at the origin)."""
+def _assert_turned_unit_grid(vertices, faces, rotation) -> None:
+    """The grid quadric reads on the soup: unit voxels, each axis along one of the image's axes ``rotation`` turned
+    (to the detached faces' scatter)."""
     from meshcurv._prepared import prepare_mesh
     from meshcurv.estimators._support import Stages
     from meshcurv.estimators.quadric import STAGES, _soup_grid
 
-    sphere = shapes.voxel_sphere(6.0)
-    rotation = _rotation(TURN)
-    vertices, faces = _soup(np.asarray(sphere.vertices) @ rotation.T, sphere.faces, 0.5, 0.05, 3)
-    vertices = vertices + shift * 12.0 * np.array([0.6, -0.48, 0.64])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         prepared = prepare_mesh(vertices, faces, orient="outward", weld=True)
@@ -156,6 +137,18 @@ def test_soup_grid_wherever_the_soup_sits(shift):
     assert grid is not None and grid.frame is not None
     np.testing.assert_allclose(grid.spacing, 1.0, rtol=1e-3)
     np.testing.assert_allclose(np.sort(np.abs(grid.frame @ rotation), axis=1)[:, -1], 1.0, atol=1e-4)
+
+
+@pytest.mark.parametrize("shift", [1e4, 1e5, 2.0**20])
+def test_soup_grid_wherever_the_soup_sits(shift):
+    """The same grid far from the origin (R30, session 64): the coordinates of a plane, turned into the grid's axes,
+    were made one within a tolerance that grew with their distance from the origin, not with the mesh: at 1e5 sizes
+    no grid was read (the default radius 3.27 for 3.86 at the origin, H off by 0.76 / R), at 2**20 (the fuzzer's
+    translation) a grid of spacing (0, 0, 0.5). Expected: translation invariance (the grid read at the origin)."""
+    sphere = shapes.voxel_sphere(6.0)
+    rotation = _rotation(TURN)
+    vertices, faces = _soup(np.asarray(sphere.vertices) @ rotation.T, sphere.faces, 0.5, 0.05, 3)
+    _assert_turned_unit_grid(vertices + shift * 12.0 * np.array([0.6, -0.48, 0.64]), faces, rotation)
 
 
 @pytest.mark.parametrize("backend", ["numba", pytest.param("numpy", marks=pytest.mark.slow)])
