@@ -524,8 +524,12 @@ def _second_side_apart(points: np.ndarray, topology: MeshTopology) -> tuple[Weld
     kept_faces = faces[wanted]
     used = np.zeros(points.shape[0], dtype=bool)
     used[kept_faces] = True
-    # each vertex at the kept vertex of its point (a vertex the kept faces hold is its own)
     point_of = coincident.index
+    if np.unique(point_of[used]).size != np.count_nonzero(used):
+        # the side kept is no surface alone either (a soup, or copies tangled into one part: their vertices are
+        # looked at as such, meshcurv.weld.tangled_vertices): left as given
+        return None
+    # each vertex at the kept vertex of its point (a vertex the kept faces hold is its own)
     kept_of_point = np.full(coincident.vertices.shape[0], -1, dtype=np.int64)
     kept_of_point[point_of[used]] = np.flatnonzero(used)
     twin = kept_of_point[point_of]
