@@ -120,7 +120,7 @@ def batch_summary():
 def speed():
     """speed.md: seconds per call at 1M vertices, from the last run of benchmarks/speed.md."""
     names = ["icc (default)", "normal_cycle", "matgeom", "libigl", "MeshLab quadric", "VTK (H, K)", "trueform"]
-    seconds = [3.26, 0.876, 0.909, 14.6, 5.05, 0.786, 0.981]  # CPU s, benchmarks/speed.md at 1733770
+    seconds = [4.31, 1.34, 1.8, 30.6, 8.47, 1.35, 1.8]  # CPU s, benchmarks/speed.md at 2d31b96
     fig = _figure(6.4, 3.4)
     axis = fig.add_subplot()
     colours = ["tab:blue"] * 3 + ["tab:grey"] * 4
