@@ -32,10 +32,11 @@ def _defects():
 
 
 def _inputs(name):
-    pytest.importorskip("skimage")
     if name == "defects":
         vertices, faces = _defects()
     else:
+        if name.startswith("voxel"):  # (marching cubes: scikit-image; the other meshes need no extra)
+            pytest.importorskip("skimage")
         mesh = {
             "voxel sphere": lambda: shapes.voxel_sphere(3.0, (0.25, 0.1, 0.1), seed=2),
             "voxel torus": lambda: shapes.voxel_torus(3.0, 1.0, (0.3, 0.2, 0.2), seed=0),
