@@ -16,8 +16,8 @@ apart. A closed mesh therefore costs nothing here.
 Faces detached from their neighbours by more than that tolerance (a mesh whose
 faces were moved one by one, a soup written with rounding) leave cracks: pairs
 of boundary edges lying on top of each other. Their ends are welded too, up to
-:data:`CRACK_TOLERANCE_RATIO` of the local edge length (that of the faces about them);
-a real boundary has no second edge on it and is left alone.
+:data:`CRACK_TOLERANCE_RATIO` of the edges' length; a real boundary has no
+second edge on it and is left alone.
 """
 
 from __future__ import annotations
@@ -50,30 +50,12 @@ __all__ = [
 #: where the parts of a mesh differ in scale: :func:`meshcurv.geometry.vertex_length_scales`).
 WELD_TOLERANCE_RATIO = 1e-5
 
-#: Two boundary edges sharing no vertex whose ends lie pairwise within this times the local length scale (the
-#: median mean edge of the :data:`CRACK_SCALE_FACES` faces with a boundary edge nearest each edge's face, the smaller
-#: of the two) are the two sides of a crack between detached faces, and their ends are welded. A crack this narrow is
-#: far below any curvature the faces resolve (a corner moved by it moves the normals by about as many radians), and
-#: far above the round-off of exported coordinates; a real boundary has no second edge on it. The local scale, not
-#: each edge's own length: the gap of a crack is a share of the mesh's resolution there, the same along short and
-#: long edges, and a tolerance of the shorter edge welded a crack near it along the long edges only (the 64 x 32 uv
-#: sphere half detached by 0.048 mean edges: 816 of the 840 edges welded back were the quads' diagonals, which bend
-#: nothing; issue 29, fuzz 602/100 and 647/28). Tests: tests/test_unwelded_faces.py, tests/test_crack_weld_W31.py.
+#: Two boundary edges sharing no vertex whose ends lie pairwise within this times the shorter edge's length are
+#: the two sides of a crack between detached faces, and their ends are welded. A crack this narrow is far below
+#: any curvature the faces resolve (a corner moved by it moves the normals by about as many radians), and far
+#: above the round-off of exported coordinates; a real boundary has no second edge on it. Kept well below 1/2 so
+#: that an edge is never paired with its neighbours along a boundary. Tests: tests/test_unwelded_faces.py.
 CRACK_TOLERANCE_RATIO = 0.05
-
-#: ... the faces whose mean edge lengths' median is a crack's local length scale (:func:`_crack_scales`): enough to
-#: hold faces of every kind of a structured mesh around it (a voxel surface's plateaus and steps), few enough to
-#: follow a mesh whose resolution changes.
-CRACK_SCALE_FACES = 16
-
-#: ... of them, those within this many times a face's own mean edge of its centroid (:func:`_crack_scales`): a part of
-#: another scale beside it, or a needle's faces, are not its neighbourhood.
-CRACK_SCALE_REACH = 4.0
-
-#: ... and within this times either edge's own length (the caller's ``crack_ratio`` where it is larger): kept well
-#: below 1/2, so that an edge is never paired with its neighbours along a boundary, whatever its faces (a fan of
-#: needles at a rim, whose faces' mean edge is many times the rim's edges).
-CRACK_EDGE_SHARE = 0.25
 
 
 class Welding(NamedTuple):
@@ -127,11 +109,9 @@ def weld_vertices(
         the smaller of its two.
     crack_ratio : float, default: 0.05
         Two boundary edges that share no vertex, whose ends lie pairwise within
-        ``crack_ratio`` times the local length scale (the median mean edge of
-        the :data:`CRACK_SCALE_FACES` faces nearest each one's face, the
-        smaller of the two; at most ``max(crack_ratio, CRACK_EDGE_SHARE)``
-        times the shorter edge's length), are the sides of a crack: their ends
-        are welded (:data:`CRACK_TOLERANCE_RATIO`). 0 welds no crack.
+        ``crack_ratio`` times the shorter edge's length, are the sides of a
+        crack: their ends are welded (:data:`CRACK_TOLERANCE_RATIO`). 0 welds
+        no crack.
 
     Returns
     -------
@@ -150,7 +130,8 @@ def weld_vertices(
     tolerance (:meth:`scipy.spatial.cKDTree.query_pairs`) are joined by
     connected components, so that a chain of near copies becomes one vertex.
     The boundary edges left then are matched by their midpoints, in classes of
-    tolerances within a factor 2, so that the search radius follows the local
+    edge lengths within a factor 2 (the two sides of a crack differ in length
+    by at most twice the crack), so that the search radius follows the local
     resolution; either pairing of the ends is accepted (consistent or opposite
     windings), and the pairs are joined by connected components again. Faces
     that collapse (two corners welded together) are kept as they are: they
@@ -263,10 +244,9 @@ def _tangled_vertices(vertices: np.ndarray, topology: MeshTopology, scales: np.n
 
     candidates = np.flatnonzero(topology.boundary_vertices)
     points = vertices[candidates]
-    tolerances = _crack_sides(vertices, topology, CRACK_TOLERANCE_RATIO)[3]
-    reach = max(
-        float(tolerances.max()) if tolerances.size else 0.0, WELD_TOLERANCE_RATIO * float(scales[candidates].max())
-    )
+    ends = topology.edges[topology.boundary_edges]
+    longest = float(np.linalg.norm(vertices[ends[:, 0]] - vertices[ends[:, 1]], axis=1).max())
+    reach = max(CRACK_TOLERANCE_RATIO * longest, WELD_TOLERANCE_RATIO * float(scales[candidates].max()))
     if candidates.size < 2 or not (cKDTree(points).query(points, k=2)[0][:, 1] <= reach).any():
         return None
     welding = weld_vertices(vertices, topology)
@@ -469,127 +449,68 @@ def _pairs_within(points: np.ndarray, tolerances: np.ndarray):
             yield i[keep], j[keep]
 
 
-def _crack_sides(
-    vertices: np.ndarray, topology: MeshTopology, crack_ratio: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(ends, first, second, tolerances)``: the boundary edges that may be a side of a crack, as their (B, 2)
-    vertices, (B, 3) first and second ends and (B,) tolerances (:func:`_weld_cracks`); those of zero or unusable
-    length, tolerance or midpoint left out.
-
-    An edge's tolerance is ``crack_ratio`` times the local length scale (:func:`_crack_scales`: the same for every
-    edge of a neighbourhood, whatever its length, direction or face), at most ``max(crack_ratio,
-    CRACK_EDGE_SHARE)`` times its own length.
-    """
-    boundary = np.flatnonzero(topology.boundary_edges)
-    ends = topology.edges[boundary]
-    first, second = vertices[ends[:, 0]], vertices[ends[:, 1]]
-    held, face = np.unique(np.max(topology.edge_faces[boundary], axis=1), return_inverse=True)
-    local = _crack_scales(vertices, topology.faces[held])[face.reshape(-1)]
-    with np.errstate(over="ignore", invalid="ignore"):
-        lengths = _distance(second, first)
-        tolerances = np.minimum(crack_ratio * local, max(crack_ratio, CRACK_EDGE_SHARE) * lengths)
-        midpoints = 0.5 * (first + second)
-    usable = (lengths > 0) & (tolerances > 0) & np.isfinite(tolerances) & np.isfinite(midpoints).all(axis=1)
-    return ends[usable], first[usable], second[usable], tolerances[usable]
-
-
-def _crack_scales(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F,) the local length scale of each of ``faces`` (F, 3) (those with a boundary edge): the median, over the
-    :data:`CRACK_SCALE_FACES` of them nearest its centroid (itself included), of their mean edge length, each of
-    them farther than :data:`CRACK_SCALE_REACH` times the face's own mean edge counted as the face itself (NaN for a
-    face of no finite centroid or scale).
-
-    Over a neighbourhood, not the face alone: a voxel surface's faces on its plateaus and at its steps differ in
-    size by half, and a tolerance of each face's own would weld a crack near it along one kind of face only, as one
-    of each edge's own length welded the long edges (:data:`CRACK_TOLERANCE_RATIO`). The median, and the reach: a
-    needle's faces (edges of 1e10 beside a sphere's 0.1: tests/test_needle_cracks.py) and a part of another scale
-    far away are not the scale of the faces about them.
-    """
-    corners = vertices[faces]
-    with np.errstate(over="ignore", invalid="ignore"):
-        means = (
-            _distance(corners[:, 0], corners[:, 1])
-            + _distance(corners[:, 1], corners[:, 2])
-            + _distance(corners[:, 2], corners[:, 0])
-        ) / 3.0
-        centroids = corners.mean(axis=1)
-    scales = np.full(faces.shape[0], np.nan)
-    usable = np.flatnonzero(np.isfinite(centroids).all(axis=1) & np.isfinite(means))
-    if usable.size == 0:
-        return scales
-    from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
-
-    own = means[usable]
-    k = min(CRACK_SCALE_FACES, usable.size)
-    distances, near = cKDTree(centroids[usable]).query(centroids[usable], k=list(range(1, k + 1)))
-    with np.errstate(over="ignore", invalid="ignore"):
-        around = np.where(distances <= CRACK_SCALE_REACH * own[:, None], own[near], own[:, None])
-    scales[usable] = np.median(around, axis=1)
-    return scales
-
-
 def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: float) -> Welding:
     """The ends of boundary edges on top of each other welded (:func:`weld_vertices`); ``n_cracked`` = ``n_welded``.
 
-    Two boundary edges are the sides of a crack where their ends lie pairwise within the smaller of their
-    tolerances (:func:`_crack_sides`: ``crack_ratio`` of the local length scale, :func:`_crack_scales`), not of
-    their own lengths: the gap of a crack is a share of the mesh's local resolution, and a tolerance of each edge's
-    own length welded a crack near it along the long edges only (a uv sphere's or a voxel surface's quad diagonals,
-    which bend nothing), the short ones left open (issue 29, fuzz 602/100 and 647/28).
-
-    The candidates are the pairs of edges whose midpoints are within the larger tolerance: all in one search
-    within the largest when :func:`_few_pairs` finds those pairs few (one check and one search per weld, the
-    common case), otherwise one search per octave of tolerances, each against the edges of that octave and above.
-    Where they are many more than the edges (edges on top of each other in bulk: a collapsed soup, its vertices
+    The candidates are the pairs of edges whose midpoints are within the largest ``limit`` of their class: all
+    classes in one search within the largest class's when :func:`_few_pairs` finds those pairs few (one check
+    and one search per weld, the common case), one search per class otherwise. Where they are
+    many more than the edges (edges on top of each other in bulk: a collapsed soup, its vertices
     collinear, fuzz 342/923, had 8.6 M pairs for 17,795 edges and took 1.3 GiB), they are searched among the
     edges' pairs of ends instead, as points ``(first, second)`` of 6-D space against the edges' ``(first,
-    second)`` (queried as ``(first, second)`` and ``(second, first)``: two ends each within ``limit`` of the
-    other edge's are within ``sqrt(2) * limit`` there: a fifth of the candidates on that soup, but a slower search
-    on any mesh), taken in chunks (:func:`_near_pairs`); the pairs found are kept as the components they join
-    (:class:`_Components`). Every search finds every pair of the rule, so the welds are the same; the memory is
-    bounded by the mesh's size.
+    second)`` and ``(second, first)`` (two ends each within ``limit`` of the other edge's are within
+    ``sqrt(2) * limit`` there: a fifth of the candidates on that soup, but a slower search on any mesh), taken in
+    chunks (:func:`_near_pairs`); the pairs found are kept as the components they join (:class:`_Components`).
+    Both searches find every pair of the rule, so the welds are the same; the memory is bounded by the mesh's
+    size.
     """
     n_vertices = vertices.shape[0]
     unchanged = Welding(vertices, topology, np.arange(n_vertices), 0)
-    ends, first, second, tolerances = _crack_sides(vertices, topology, crack_ratio)
-    if tolerances.size < 2:
+    ends = topology.edges[topology.boundary_edges]
+    first, second = vertices[ends[:, 0]], vertices[ends[:, 1]]
+    lengths = np.linalg.norm(second - first, axis=1)
+    usable = np.isfinite(lengths) & (lengths > 0)
+    if np.count_nonzero(usable) < 2:
         return unchanged
+    ends, first, second, lengths = ends[usable], first[usable], second[usable], lengths[usable]
     midpoints = 0.5 * (first + second)
+    if not np.isfinite(midpoints).all():  # overflow of huge coordinates: those edges take no part
+        finite = np.isfinite(midpoints).all(axis=1)
+        ends, first, second, lengths, midpoints = (a[finite] for a in (ends, first, second, lengths, midpoints))
+        if lengths.size < 2:
+            return unchanged
     from scipy.spatial import cKDTree  # imported on use: keeps `import meshcurv` fast
 
+    # the two sides of a crack differ in length by at most twice the crack (far below a factor 2): the pairs of
+    # each class of lengths [2^(c-1), 2^c) and the next are within crack_ratio * 2^c of each other, end by end
+    _, exponent = np.frexp(lengths)
     components = _Components(n_vertices)
-    widest = float(tolerances.max())
+    widest = crack_ratio * np.ldexp(1.0, int(exponent.max()))
     tree = cKDTree(midpoints)
-    if _few_pairs(midpoints, widest, tree=tree):  # one bound (or count) and one search for all the octaves
+    if _few_pairs(midpoints, widest, tree=tree):  # one bound (or count) and one search for all the classes
         found = tree.query_pairs(widest, output_type="ndarray")
         for k in range(0, found.shape[0], PAIR_CHUNK):
             i, j = found[k : k + PAIR_CHUNK].T
-            components.add(_crack_links(ends, first, second, tolerances, i, j))
+            components.add(_crack_links(ends, first, second, lengths, i, j, crack_ratio))
         return _merge_cracks(vertices, topology, components)
-    # a pair's limit is its smaller tolerance: the edges of the octave [2^(c-1), 2^c) find their partners of that
-    # octave and above within 2^c
-    _, exponent = np.frexp(tolerances)
-    for c in np.unique(exponent).tolist():
-        these = np.flatnonzero(exponent == c)
-        wider = np.flatnonzero(exponent >= c)
-        radius = float(np.ldexp(1.0, c))
-        wider_tree = cKDTree(midpoints[wider])
-        if _few_pairs(midpoints[these], radius, midpoints[wider], tree=wider_tree):
-            found = cKDTree(midpoints[these]).sparse_distance_matrix(wider_tree, radius, output_type="ndarray")
-            i, j = these[found["i"]], wider[found["j"]]
-            keep = (i < j) | (exponent[j] > c)  # each pair once (one within the octave comes twice)
-            i, j = i[keep], j[keep]
-            for k in range(0, i.size, PAIR_CHUNK):
-                components.add(
-                    _crack_links(ends, first, second, tolerances, i[k : k + PAIR_CHUNK], j[k : k + PAIR_CHUNK])
-                )
+    for c in np.unique(exponent).tolist():  # one search per octave of edge lengths, not per edge
+        members = np.flatnonzero((exponent == c) | (exponent == c + 1))
+        if members.size < 2:
             continue
-        forward = np.hstack([first[wider], second[wider]])
-        queries = np.vstack([np.hstack([first[these], second[these]]), np.hstack([second[these], first[these]])])
+        radius = crack_ratio * np.ldexp(1.0, c)
+        tree = cKDTree(midpoints[members])
+        if _few_pairs(midpoints[members], radius, tree=tree):
+            found = members[tree.query_pairs(radius, output_type="ndarray")]
+            for k in range(0, found.shape[0], PAIR_CHUNK):
+                i, j = found[k : k + PAIR_CHUNK].T
+                components.add(_crack_links(ends, first, second, lengths, i, j, crack_ratio))
+            continue
+        forward = np.hstack([first[members], second[members]])
+        queries = np.vstack([forward, np.hstack([second[members], first[members]])])
         for rows, columns, _ in _near_pairs(cKDTree(forward), queries, np.sqrt(2.0) * radius):
-            i, j = these[rows % these.size], wider[columns]
-            keep = (i < j) | (exponent[j] > c)  # each pair once (either pairing's query finds it)
-            components.add(_crack_links(ends, first, second, tolerances, i[keep], j[keep]))
+            i, j = members[rows % members.size], members[columns]
+            keep = i < j  # each pair once (as the same and the crossed pairing's query: either finds it)
+            components.add(_crack_links(ends, first, second, lengths, i[keep], j[keep], crack_ratio))
     return _merge_cracks(vertices, topology, components)
 
 
@@ -610,16 +531,17 @@ def _crack_links(
     ends: np.ndarray,
     first: np.ndarray,
     second: np.ndarray,
-    tolerances: np.ndarray,
+    lengths: np.ndarray,
     i: np.ndarray,
     j: np.ndarray,
+    crack_ratio: float,
 ) -> np.ndarray:
     """(P, 2) the vertex pairs welded by the edge pairs ``(i, j)`` that are the two sides of a crack: their ends
-    pairwise within the smaller of their ``tolerances`` (:func:`_crack_sides`), in either pairing (the same pairing
-    first), and sharing no vertex (so no face: a face's edges do)."""
+    pairwise within ``crack_ratio`` times the shorter edge's length, in either pairing (the same pairing first),
+    and sharing no vertex (so no face: a face's edges do)."""
     a, b, c, d = ends[i, 0], ends[i, 1], ends[j, 0], ends[j, 1]
     apart = (a != c) & (a != d) & (b != c) & (b != d)
-    limit = np.minimum(tolerances[i], tolerances[j])
+    limit = crack_ratio * np.minimum(lengths[i], lengths[j])
     same = np.maximum(_distance(first[i], first[j]), _distance(second[i], second[j])) <= limit
     crossed = np.maximum(_distance(first[i], second[j]), _distance(second[i], first[j])) <= limit
     same &= apart

@@ -62,11 +62,11 @@ mesh, whose dihedral angles are as small, each edge reads that tilt as curvature
 sizeable share of the mesh (:data:`CRACKED_SHARE`), every ball is judged by the standard error of its own
 edges' readings (:data:`FEW_ELEMENTS_CRACKED_SPREAD`); at the default radius a ball that fails is grown once
 (:data:`CRACK_GROWTH`) and judged again; a grown ball that lost much of its area to cracks left open is undefined
-too (:data:`CRACKED_LOST_BIAS`): what the ball kept need not be a fair sample of its edges (fuzz 602/100: H 0.6 for 1
-at every valid vertex, when the weld closed a crack near its tolerance along long edges only; its tolerance now
-follows the local length scale, :data:`meshcurv.weld.CRACK_SCALE_FACES`, and the rule stays as a guard). A
-voxel surface welded back so, no longer read as one (:func:`._ring_noise.welded_grid`), is undefined: a ball of the
-default of other meshes reads the plateaus of its staircase as flat.
+too (:data:`CRACKED_LOST_BIAS`): the weld closes a crack near its tolerance along long edges only, and on a
+structured mesh the edges of one length read alike (a uv sphere's diagonals bend nothing), so what the ball kept
+need not be a fair sample of its edges (fuzz 602/100: H 0.6 for 1 at every valid vertex). A voxel surface welded
+back so, no longer read as one (:func:`._ring_noise.welded_grid`), is undefined: a ball of the default of other
+meshes reads the plateaus of its staircase as flat.
 
 Reach. The default radius is 2.5 mean edge lengths, which on a mesh of long and short edges reaches round a part
 curved along the short ones (``torus(2, 1, 16, 16)``: a ball of 1.71 for a tube of radius 1), where the ball's
@@ -234,10 +234,10 @@ FEW_ELEMENTS_NOISE = 2.0
 #: of the edges' readings in the intact balls (:func:`_crack_biased`). The ball's H is the mean of the readings it
 #: kept; the edges it lost would have read ``(1 - p)`` of it, and where they are not a fair sample of the ball's edges
 #: its H is off by ``(1 - p)`` times the difference of the two groups' means, up to about ``2 sigma``: this bound
-#: keeps that bias within half of the curvature (the fuzzer's bar for a lie). The weld across cracks picked its
+#: keeps that bias within half of the curvature (the fuzzer's bar for a lie). The weld across cracks picks its
 #: edges by their length (:data:`meshcurv.weld.CRACK_TOLERANCE_RATIO` of the shorter edge): a crack near the
-#: tolerance was welded along long edges and left open along short ones, and on a structured mesh the edges of one
-#: length read alike (now the local length scale, :data:`meshcurv.weld.CRACK_SCALE_FACES`: the rule stays a guard). The 64 x 32 uv sphere half detached by 0.048 mean edges: 816 of the 840 edges welded back were
+#: tolerance is welded along long edges and left open along short ones, and on a structured mesh the edges of one
+#: length read alike. The 64 x 32 uv sphere half detached by 0.048 mean edges: 816 of the 840 edges welded back were
 #: its quads' diagonals, which bend nothing (the quads are planar), while its parallels and meridians (H 1.5) stayed
 #: open; every valid vertex, each a grown ball, read H 0.42-0.79 for 1 (fuzz 602/100). Half detached by 0.045-0.052 (four draws each): 36-2,702 valid
 #: vertices, median H 0.62-0.95, up to 1,232 off by more than a quarter of H; now 2-83, median H 0.90-1.01, none. The
