@@ -1,6 +1,6 @@
 """``quadric`` at its default radius on voxel soups (issue 29): a grid of cases, the lies counted.
 
-``python benchmarks/quadric_voxel_soups_V30.py [--set tune|held-out] [--numpy] [--cases N]``
+``python benchmarks/quadric_voxel_soups_V30.py [--set tune|held-out] [--numpy] [--cases N] [--match TEXT]``
 
 A case is a marching-cubes surface (:mod:`meshcurv.shapes`' ``voxel_sphere``, ``voxel_torus``, ``voxel_ellipsoid``,
 at a voxel spacing), turned by a rotation, with a share of its faces given corners of their own moved by a gap of
@@ -91,6 +91,7 @@ def main(argv=None) -> None:
     parser.add_argument("--set", default="tune", choices=["tune", "held-out"])
     parser.add_argument("--numpy", action="store_true", help="the NumPy backend")
     parser.add_argument("--cases", type=int, default=0, help="only the first N cases (0: all)")
+    parser.add_argument("--match", default="", help="only the cases whose label holds this text (each: TEXT|TEXT)")
     args = parser.parse_args(argv)
     if args.numpy:
         from meshcurv._backend import use_backend
@@ -103,6 +104,10 @@ def main(argv=None) -> None:
     for index, (label, v, f, exact, largest, corner) in enumerate(cases(args.set)):
         if args.cases and index >= args.cases:
             break
+        parts = args.match.split("|") if args.match else []
+        clean_of = " share 0.0 " in label and any(label.split(" (")[0] in part for part in parts)
+        if parts and not (clean_of or any(part in label for part in parts)):
+            continue  # (the clean surface of a shape matched is kept: the fuzzer's reference)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             result = meshcurv.principal_curvatures(v, f, method="quadric")
@@ -114,7 +119,7 @@ def main(argv=None) -> None:
         if " share 0.0 " in label:  # the clean surface in this pose: the fuzzer's reference
             clean = result
         fuzz = 0
-        if clean is not None:  # the fuzzer's bar: half of the clean estimate's largest |k| from its H, valid in both
+        if clean is not None and clean.valid.any():  # the fuzzer's bar: half of the clean estimate's largest |k|
             size = float(np.nanmax(np.abs(np.concatenate([clean.k_min[clean.valid], clean.k_max[clean.valid]]))))
             both = valid & clean.valid[corner]
             fuzz = int((np.abs(result.mean - clean.mean[corner])[both] > 0.5 * size).sum())

@@ -534,6 +534,58 @@ def _turned_frame(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray | None:
     return frame * np.where(np.diag(frame) < 0, -1.0, 1.0)[:, None]
 
 
+#: A voxel soup's grid turned off the coordinate axes (:func:`soup_frame`, for :func:`meshcurv.radius.soup_voxel_grid`):
+#: its faces' sides are read for the grid's axes at right angles to them within this angle (radians), where
+#: :func:`voxel_grid`'s proposal groups them within 0.05 (:data:`VOXEL_FRAME_ANGLE`): every face moved by 0.05 edge
+#: lengths turns the sides by about 0.07, and that proposal found no frame for ``voxel_sphere(6)`` so detached and
+#: turned by (0.3, 0.5, 0.7) (issue 29, R29's F6) ...
+SOUP_FRAME_ANGLE = 0.15
+#: ... from this many pairs of sides, their cross products at least this sine apart ...
+SOUP_FRAME_PAIRS = 1024
+SOUP_FRAME_SINE = 0.3
+#: ... each axis then refitted over every side in this many steps (:func:`_refitted_axis`), to round-off on the faces
+#: that kept their place (half of them detached: the frame to 1e-16, where the lattice's three steps left 1e-13,
+#: enough to part a plane's coordinates).
+SOUP_FRAME_STEPS = 12
+
+
+def soup_frame(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray | None:
+    """(3, 3) the axes (rows, orthonormal) that the sides of the ``faces`` (F, 3) over ``vertices`` (V, 3) lie at
+    right angles to, read for a voxel soup (:func:`meshcurv.radius.soup_voxel_grid`), or None: the proposal of
+    :func:`voxel_grid` (:func:`_turned_frame`), else the direction at right angles
+    to the most sides (within :data:`SOUP_FRAME_ANGLE`) among the cross products of pairs of sides, then the one at
+    right angles to it and to the most sides; each axis refitted over every side (:data:`SOUP_FRAME_STEPS`). A
+    proposal: the grid must then be read in it."""
+    sides = _unit_sides(vertices, faces)
+    if sides.shape[0] < 16:
+        return None
+    bound = float(np.sin(SOUP_FRAME_ANGLE))
+    frame = _turned_frame(vertices, faces)
+    if frame is None:
+        first, second = np.random.default_rng(0).integers(0, sides.shape[0], (3, SOUP_FRAME_PAIRS))[:2]
+        across = np.cross(sides[first], sides[second])
+        sines = np.linalg.norm(across, axis=1)
+        across = across[sines >= SOUP_FRAME_SINE] / sines[sines >= SOUP_FRAME_SINE, None]
+        sample = sides[np.random.default_rng(1).integers(0, sides.shape[0], SOUP_FRAME_PAIRS)]
+        if across.shape[0] < 16:
+            return None
+        counts = (np.abs(across @ sample.T) <= bound).sum(axis=1)
+        axis = across[int(np.argmax(counts))]
+        counts *= np.abs(across @ axis) <= bound  # (then the densest at right angles to it)
+        if not counts.any():
+            return None
+        other = across[int(np.argmax(counts))]
+        other = other - (other @ axis) * axis
+        frame = np.stack([axis, other / np.linalg.norm(other), np.cross(axis, other / np.linalg.norm(other))])
+    for k in range(3):
+        found = _refitted_axis(sides, frame[k], bound, steps=SOUP_FRAME_STEPS)
+        if found is None:
+            return None
+        frame[k] = found[0]
+    left_vectors, _, right_vectors = np.linalg.svd(frame)
+    return left_vectors @ right_vectors  # (the nearest orthonormal axes)
+
+
 def _unit_sides(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(M, 3) the unit directions of the sides of ``faces`` (F, 3) but those of length 0."""
     corners = vertices[faces]

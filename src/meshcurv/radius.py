@@ -89,7 +89,7 @@ from ._geometry import (
 )
 from .geometry import _floats, checked_topology_points
 from .jets import SETTLED_SLOPE, _fit_jets
-from .lattice import VoxelGrid, _refitted_axis, _turned_frame, _unit_sides, voxel_grid
+from .lattice import VoxelGrid, soup_frame, voxel_grid
 from .neighborhoods import (
     _ball_face_sums,
     _ball_pairs,
@@ -1335,26 +1335,21 @@ def _grid_part(
     return None if grid is None else (grid, on_planes)
 
 
-#: A voxel soup's grid turned off the coordinate axes (:func:`soup_voxel_grid`): its faces' sides are read for the
-#: grid's axes at right angles to them within this angle (radians), where :func:`meshcurv.lattice.voxel_grid`'s
-#: proposal groups them within 0.05: every face moved by 0.05 edge lengths turns the sides by about 0.07, and that
-#: proposal found no frame for ``voxel_sphere(6)`` so detached and turned by (0.3, 0.5, 0.7) (issue 29, R29's F6) ...
-SOUP_FRAME_ANGLE = 0.15
-#: ... from this many pairs of sides, their cross products at least this sine apart ...
-SOUP_FRAME_PAIRS = 1024
-SOUP_FRAME_SINE = 0.3
-#: ... each axis then refitted over every side in this many steps (:func:`meshcurv.lattice._refitted_axis`), to
-#: round-off on the faces that kept their place (half of them detached: the frame to 1e-16, where the lattice's
-#: three steps left 1e-13, enough to part a plane's coordinates) ...
-SOUP_FRAME_STEPS = 12
-#: ... and the turned coordinates within this share of their largest of each other taken as one plane's
-#: (:func:`_snapped`: a plane's coordinates, turned, differ by round-off; 1e-9 is far from both).
+#: A voxel soup's grid turned off the coordinate axes (:func:`soup_voxel_grid`) is read in the axes of its faces'
+#: sides (:func:`meshcurv.lattice.soup_frame`), the turned coordinates within this share of their extent of each other
+#: taken as one plane's (:func:`_snapped`: a plane's coordinates, turned, differ by round-off; 1e-9 is far from both).
 GRID_SNAP = 1e-9
 #: ... and the vertices that kept their place on its planes (:func:`_grid_part`) need be only this share of the valid
 #: ones, the exact reading of their grid (:func:`meshcurv.lattice.voxel_grid`) deciding: half of the faces detached
 #: by 0.05 edges leave 23% of them there (the weld joins the copies off it), and the vertices but the cracks' corners
 #: were too few for that reading (62 of ``voxel_sphere(6)``'s).
 SOUP_PART_SHARE = 0.15
+#: ... and, every face moved, its periodic reading (:func:`meshcurv.lattice.voxel_grid`) is made again at this share
+#: of the soup's length scale where it finds none there: the reading needs 8 of its steps across the surface along
+#: each axis, and a tube of 2.5 voxels (``voxel_torus(12, 2.5)``: 5 voxels along its axis, edges of 0.99) spans
+#: fewer (issue 29, R29's F3: read on no grid in any pose, 180, 124 and 187 valid vertices off its H by more than
+#: half of its largest ``|k|`` at the noise rule's radius).
+SOUP_FINE_SCALE = 0.5
 
 
 def soup_voxel_grid(
@@ -1376,9 +1371,9 @@ def soup_voxel_grid(
        (:func:`_grid_part`: the vertices that kept their place), also without the ``corners`` of its cracks ((V,)
        bool: the copies the weld joined, off the grid by the cracks' width, are half of the vertices of
        ``voxel_sphere(10)`` half detached by 0.04 edges; fuzz 559/137), along the coordinate axes, then in the axes
-       of its faces' sides (:func:`_soup_frame`);
+       of its faces' sides (:func:`planes_voxel_grid`);
     3. every face moved (none kept its place): its periodic reading (:func:`meshcurv.lattice.voxel_grid`, widened
-       for noise) in those axes.
+       for noise) in those axes, at the soup's length scale, else at :data:`SOUP_FINE_SCALE` of it (a thin tube).
 
     The grid's ``frame`` holds its axes (None: x, y and z). A default radius that reads no grid here measures the soup
     as a smooth mesh, whose balls the steps bend; the pose must not decide it (issue 29: ``voxel_sphere(6)`` with
@@ -1391,66 +1386,49 @@ def soup_voxel_grid(
     if not mesh.n_cracked or not valid.any():
         return None
     vertices, faces = mesh.vertices, mesh.topology.faces
-    parts = (valid, valid & ~corners)
-    for part in parts:
-        found = _grid_part(vertices, part, SOUP_PART_SHARE)
-        if found is not None:
-            return found[0]
-    frame = _soup_frame(vertices, faces)
+    found, frame = planes_voxel_grid(vertices, faces, (valid, valid & ~corners), SOUP_PART_SHARE)
+    if found is not None:
+        return found[0]
     if frame is None:
         return None
     turned = vertices @ frame.T
-    snapped = _snapped(turned)
-    for part in parts:
-        found = _grid_part(snapped, part, SOUP_PART_SHARE)
-        if found is not None:
-            return found[0]._replace(frame=frame)
     used = mesh.topology.referenced_vertices & ~mesh.needles
     kept = faces[used[faces].all(axis=1)]
     if not kept.shape[0]:
         return None
     scales = mesh.length_scales[used]
-    grid = voxel_grid(turned[used], (np.cumsum(used) - 1)[kept], spacing=float(np.median(scales)))
+    points, faces = turned[used], (np.cumsum(used) - 1)[kept]
+    scale = float(np.median(scales))
+    grid = voxel_grid(points, faces, spacing=scale) or voxel_grid(points, faces, spacing=SOUP_FINE_SCALE * scale)
     if grid is None or _off_grid_scale(scales, grid.spacing):
         return None
     return grid._replace(frame=frame if grid.frame is None else grid.frame @ frame)
 
 
-def _soup_frame(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray | None:
-    """(3, 3) the axes (rows, orthonormal) that the sides of the ``faces`` (F, 3) over ``vertices`` (V, 3) lie at
-    right angles to, read for a voxel soup (:func:`soup_voxel_grid`), or None: the proposal of
-    :func:`meshcurv.lattice.voxel_grid` (:func:`meshcurv.lattice._turned_frame`), else the direction at right angles
-    to the most sides (within :data:`SOUP_FRAME_ANGLE`) among the cross products of pairs of sides, then the one at
-    right angles to it and to the most sides; each axis refitted over every side (:data:`SOUP_FRAME_STEPS`). A
-    proposal: the grid must then be read in it."""
-    sides = _unit_sides(vertices, faces)
-    if sides.shape[0] < 16:
-        return None
-    bound = float(np.sin(SOUP_FRAME_ANGLE))
-    frame = _turned_frame(vertices, faces)
+def planes_voxel_grid(
+    vertices: np.ndarray, faces: np.ndarray, parts: tuple, share: float = GRID_PART_SHARE
+) -> tuple[tuple[VoxelGrid, np.ndarray] | None, np.ndarray | None]:
+    """``(found, frame)``: ``found`` the ``(grid, on_planes)`` (:func:`_grid_part`) of the first of the ``parts``
+    ((V,) bool each) of ``vertices`` (V, 3) at least ``share`` of whose vertices lie on a grid's planes, along the
+    coordinate axes, else in the axes of the sides of the ``faces`` (F, 3) (:func:`meshcurv.lattice.soup_frame`; the
+    grid's ``frame``), or None; ``frame`` those axes where they were read (None: not read, or none found).
+
+    A voxel surface whose faces were detached and welded back across the cracks keeps the vertices that kept their
+    place on its grid's planes, in any pose: the reading of :func:`soup_voxel_grid` (``quadric``) and of
+    :func:`meshcurv.estimators._ring_noise.welded_grid` (the ring methods, ``normal_cycle_ball``)."""
+    for part in parts:
+        found = _grid_part(vertices, part, share)
+        if found is not None:
+            return found, None
+    frame = soup_frame(vertices, faces)
     if frame is None:
-        first, second = np.random.default_rng(0).integers(0, sides.shape[0], (3, SOUP_FRAME_PAIRS))[:2]
-        across = np.cross(sides[first], sides[second])
-        sines = np.linalg.norm(across, axis=1)
-        across = across[sines >= SOUP_FRAME_SINE] / sines[sines >= SOUP_FRAME_SINE, None]
-        sample = sides[np.random.default_rng(1).integers(0, sides.shape[0], SOUP_FRAME_PAIRS)]
-        if across.shape[0] < 16:
-            return None
-        counts = (np.abs(across @ sample.T) <= bound).sum(axis=1)
-        axis = across[int(np.argmax(counts))]
-        counts *= np.abs(across @ axis) <= bound  # (then the densest at right angles to it)
-        if not counts.any():
-            return None
-        other = across[int(np.argmax(counts))]
-        other = other - (other @ axis) * axis
-        frame = np.stack([axis, other / np.linalg.norm(other), np.cross(axis, other / np.linalg.norm(other))])
-    for k in range(3):
-        found = _refitted_axis(sides, frame[k], bound, steps=SOUP_FRAME_STEPS)
-        if found is None:
-            return None
-        frame[k] = found[0]
-    left_vectors, _, right_vectors = np.linalg.svd(frame)
-    return left_vectors @ right_vectors  # (the nearest orthonormal axes)
+        return None, None
+    snapped = _snapped(vertices @ frame.T)
+    for part in parts:
+        found = _grid_part(snapped, part, share)
+        if found is not None:
+            return (found[0]._replace(frame=frame), found[1]), frame
+    return None, frame
 
 
 def _snapped(points: np.ndarray) -> np.ndarray:

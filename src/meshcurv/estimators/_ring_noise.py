@@ -28,8 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._prepared import PreparedMesh
-from ..lattice import _rounded, _turned_frame
-from ..radius import _grid_part
+from ..radius import planes_voxel_grid
 
 __all__ = ["NOISE_SHARE", "noisy_rings", "noisy_rings_note", "welded_grid", "welded_staircase", "welded_staircase_note"]
 
@@ -190,7 +189,8 @@ def _normal_scatter(normals, columns, rows, inner, u, v, axes, coefficients, m) 
 
 def welded_grid(mesh: PreparedMesh, valid: np.ndarray):
     """``(grid, on_planes)`` of the ``valid`` vertices ((V,) bool) of a mesh welded across cracks, where most of them
-    lie on a voxel grid (:func:`meshcurv.radius._grid_part`), else None.
+    lie on a voxel grid's planes in any pose (:func:`meshcurv.radius.planes_voxel_grid`, as ``quadric`` reads a voxel
+    soup), else None.
 
     A voxel surface with faces detached by a few hundredths of an edge and welded back across the cracks keeps
     its staircase, but the vertices welded from detached copies only are off the grid by the cracks' width, so
@@ -202,15 +202,10 @@ def welded_grid(mesh: PreparedMesh, valid: np.ndarray):
     """
     if not mesh.n_cracked or not valid.any():
         return None
-    found = _grid_part(mesh.vertices, valid)
-    if found is not None:
-        return found
-    # a grid turned off the coordinate axes (:func:`meshcurv.lattice.voxel_grid`): the frame of the faces' sides (the
-    # intact faces' lie in the voxels' faces), where the coordinates of a plane, rounded, repeat again (turned by a
-    # rotation, ``voxel_sphere(10)`` half detached by 0.03 edges: ``rusinkiewicz`` 2,199 of 3,698 valid vertices off)
-    frame = _turned_frame(mesh.vertices, mesh.topology.faces)
-    found = None if frame is None else _grid_part(_rounded(mesh.vertices @ frame.T), valid)
-    return None if found is None else (found[0]._replace(frame=frame), found[1])
+    # a grid turned off the coordinate axes: in the frame of the faces' sides (the intact faces' lie in the voxels'
+    # faces), where the coordinates of a plane repeat again (turned by a rotation, ``voxel_sphere(10)`` half detached
+    # by 0.03 edges: ``rusinkiewicz`` 2,199 of 3,698 valid vertices off)
+    return planes_voxel_grid(mesh.vertices, mesh.topology.faces, (valid,))[0]
 
 
 def welded_staircase(mesh: PreparedMesh, valid: np.ndarray) -> tuple[np.ndarray, tuple[str, ...]]:
