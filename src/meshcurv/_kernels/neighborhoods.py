@@ -468,34 +468,34 @@ def _connected_walk_levels(vertices, indptr, indices, allowed, v, cutoffs2, mark
         squared[0] = 0.0
         n_inner = 1
     while head < tail:
-        a = queue[head]
-        through = levels[head]
+        a = _UNSIGNED(queue[head])  # unsigned indices (here and below), as _connected_members: no code for negative
+        through = levels[head]  # ones (the walk took 2.2 s of CPU instead of 1.6 at 3, 6, 12 h on a 100k icosphere)
         head += 1
         ax, ay, az = vertices[a, 0] - cx, vertices[a, 1] - cy, vertices[a, 2] - cz
         a2 = ax * ax + ay * ay + az * az
-        for j in range(indptr[a], indptr[a + 1]):
-            b = indices[j]
+        for j in range(_UNSIGNED(indptr[a]), _UNSIGNED(indptr[a + _ONE])):
+            b = _UNSIGNED(indices[j])
             if mark[b] == stamp:
                 continue
             bx, by, bz = vertices[b, 0] - cx, vertices[b, 1] - cy, vertices[b, 2] - cz
             b2 = bx * bx + by * by + bz * bz
             if b2 <= outer2:
                 if allowed[b]:
-                    members[size] = b
+                    members[_UNSIGNED(size)] = b
                     size += 1
             elif not a2 <= outer2 and not _outside_edge_meets(
                 spans, b, b2, outer, mark, stamp, ax, ay, az, bx, by, bz, outer2
             ):
                 continue  # both ends outside, and the segment passes outside too
             mark[b] = stamp
-            queue[tail] = b
+            queue[_UNSIGNED(tail)] = b
             level = through if through == top else _edge_level(through, top, a2, b2, ax, ay, az, bx, by, bz, cutoffs2)
-            levels[tail] = level
+            levels[_UNSIGNED(tail)] = level
             tail += 1
             if b2 <= inner2 and allowed[b]:
-                inner[n_inner] = b
-                inner_levels[n_inner] = level
-                squared[n_inner] = b2
+                inner[_UNSIGNED(n_inner)] = b
+                inner_levels[_UNSIGNED(n_inner)] = level
+                squared[_UNSIGNED(n_inner)] = b2
                 n_inner += 1
     return size, n_inner
 
