@@ -42,10 +42,13 @@ def normal_cycle_sums(vertices, faces, edges, edge_faces, counts, forward, scale
         face_normals[f, 0], face_normals[f, 1], face_normals[f, 2], face_normals[f, 3] = nx, ny, nz, double_area
         degenerate[f] = _degenerate(a, b, c, 0.5 * double_area, area_ratio * scales[a] * scales[a])
     n_chunks = max(1, min(n_chunks, n_vertices))
-    sums = np.zeros((n_vertices, 10))
+    sums = np.empty((n_vertices, 10))  # each chunk zeroes its own rows: the pages first touched on its thread
     for chunk in nb.prange(n_chunks):
         first = (n_vertices * chunk) // n_chunks
         last = (n_vertices * (chunk + 1)) // n_chunks
+        for v in range(first, last):
+            for c in range(10):
+                sums[v, c] = 0.0
         for f in range(n_faces):
             if degenerate[f]:
                 continue

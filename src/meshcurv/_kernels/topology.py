@@ -147,8 +147,8 @@ def build_edges_into(
     whose faces all repeat a corner, -1 at an unreferenced vertex.
 
     Sides are bucketed by their smaller vertex (a counting sort: one pass
-    counts, one places, each in face order: :func:`_bucketed_sides`, one
-    thread, bound by memory); then, in ranges of vertices on threads
+    counts, one places, each in face order, in ranges of faces on threads:
+    :func:`_sides_in_buckets`); then, in ranges of vertices on threads
     (:func:`~meshcurv._kernels._common.run_chunks`), each bucket is sorted by
     (larger vertex, direction) with a stable insertion sort and its edges
     counted (:func:`_sort_buckets`), and, each range's first edge known from
@@ -160,7 +160,7 @@ def build_edges_into(
     touched, so never paged in). The buckets are held in the integer type of
     ``template`` (``topology._bucket_template``).
     """
-    starts, keys, sides = _bucketed_sides(faces, n_vertices, template, face_edges, twins, corners, first)
+    starts, keys, sides = _sides_in_buckets(faces, n_vertices, template, face_edges, twins, corners, first)
     n_ranges = max(1, min(_VERTEX_CHUNKS * nb.get_num_threads(), n_vertices))
     found = np.zeros(n_ranges + 1, np.int64)  # the edges of each range of buckets, then the first of each
     run_chunks(_sort_buckets, n_ranges, n_ranges, starts, keys, sides, found)
@@ -183,19 +183,54 @@ def build_edges_into(
     return int(found[n_ranges])
 
 
-@nb.njit(**_JIT)
-def _bucketed_sides(faces, n_vertices, template, face_edges, twins, corners, first):
+def _sides_in_buckets(faces, n_vertices, template, face_edges, twins, corners, first):
     """:func:`build_edges_into`'s two passes over the faces: ``corners`` and ``first`` written (with the
     ``twins``), -1 in ``face_edges`` and ``twins`` at the sides from a vertex to itself, and the other sides in
     buckets by their smaller vertex: ``(starts, keys, sides)``, bucket ``v`` being ``starts[v]:starts[v + 1]``
     of ``keys`` (2 * larger vertex + 1 where the side runs backward) and ``sides`` (``3 f + k``), in face
-    order."""
+    order.
+
+    Each of a few ranges of the faces, one per thread, counts its sides at each vertex
+    (:func:`_count_sides`), then places them (:func:`_place_sides`) around the counting sort's starts
+    (:func:`_bucket_starts`): a bucket holds the first range's sides, then the next's, each in face order,
+    the order of one pass over all the faces whatever the number of threads. The first range writes
+    ``corners`` and ``first`` itself, the others their own rows of a scratch that :func:`_merge_corners`
+    adds to them. (One serial pass took 0.08 CPU s of the 0.19 of the build at 1M vertices, issue 31, S32.)
+    """
     n_faces = faces.shape[0]
+    n_ranges = max(1, min(nb.get_num_threads(), _BUCKET_CHUNKS, n_faces))
     with_twins = twins.shape[0] > 0
-    bucket_start = np.empty(n_vertices + 1, template.dtype)
-    for v in range(n_vertices + 1):  # zeros (numba's np.zeros compiles three functions more, issue 31)
-        bucket_start[v] = 0
-    for f in range(n_faces):
+    cursor = _unadvised_array((n_ranges, n_vertices), np.int64, zero=True)
+    n_more = n_ranges - 1 if with_twins else 0
+    more_corners = _unadvised_array((n_more, n_vertices if n_more else 0), template.dtype, zero=True)
+    more_first = _unadvised_array((n_more, n_vertices if n_more else 0), template.dtype)
+    more_first.fill(-1)
+    run_chunks(
+        _count_sides, n_ranges, n_ranges, faces, cursor, face_edges, twins, corners, first, more_corners, more_first
+    )
+    if n_more:
+        run_chunks(
+            _merge_corners, n_vertices, _VERTEX_CHUNKS * nb.get_num_threads(), corners, first, more_corners, more_first
+        )
+    starts = _bucket_starts(cursor).astype(template.dtype)
+    n_sides = int(starts[n_vertices])
+    sort_key = _unadvised_array(n_sides, template.dtype)  # every slot placed once
+    side_of = _unadvised_array(n_sides, template.dtype)
+    run_chunks(_place_sides, n_ranges, n_ranges, faces, cursor, sort_key, side_of)
+    return starts, sort_key, side_of
+
+
+@nb.njit(inline="always", **_JIT)
+def _range_of(n_items, r, n_ranges):
+    """``(start, stop)`` of range ``r`` of ``n_items`` cut into ``n_ranges`` (those of ``run_chunks``)."""
+    return n_items * r // n_ranges, n_items * (r + 1) // n_ranges
+
+
+@nb.njit(inline="always", **_JIT)
+def _count_range(faces, lo, hi, counts, face_edges, twins, corners, first):
+    """:func:`_count_sides` of the faces ``lo:hi``, their corners and first sides in ``corners`` and ``first``."""
+    with_twins = twins.shape[0] > 0
+    for f in range(lo, hi):
         proper = faces[f, 0] != faces[f, 1] and faces[f, 1] != faces[f, 2] and faces[f, 2] != faces[f, 0]
         for k in range(3):
             a = faces[f, k]
@@ -208,28 +243,61 @@ def _bucketed_sides(faces, n_vertices, template, face_edges, twins, corners, fir
                 elif first[a] == -1:
                     first[a] = -2
             if a != b:
-                bucket_start[(b if b < a else a) + 1] += 1  # min(a, b): numba compiles min once per caller's options
+                counts[_UNSIGNED(b if b < a else a)] += 1  # min(a, b): numba compiles min once per caller's options
             else:  # a side from a vertex to itself: no edge
                 face_edges[3 * f + k] = -1
                 if with_twins:
                     twins[3 * f + k] = -1
-    for v in range(n_vertices):
-        bucket_start[v + 1] += bucket_start[v]
-    n_sides = bucket_start[n_vertices]
-    cursor = bucket_start[:-1].copy()
-    sort_key = np.empty(np.int64(n_sides), template.dtype)  # 2 * larger vertex + backward (int64: the allocations
-    side_of = np.empty(np.int64(n_sides), template.dtype)  # of an int64 length, one compiled np.empty fewer, issue 31)
-    for f in range(n_faces):
-        for k in range(3):
-            a = faces[f, k]
-            b = faces[f, (k + 1) % 3]
-            if a != b:
-                low = b if b < a else a  # min(a, b)
-                slot = cursor[low]
-                cursor[low] += 1
-                sort_key[slot] = 2 * (b if b > a else a) + (1 if a > b else 0)  # max(a, b)
-                side_of[slot] = 3 * f + k
-    return bucket_start, sort_key, side_of
+
+
+@nb.njit(**_JIT)
+def _count_sides(lo, hi, faces, cursor, face_edges, twins, corners, first, more_corners, more_first):
+    """:func:`_sides_in_buckets`' counts of the face ranges ``lo`` to ``hi - 1`` in ``cursor``: range 0's
+    corners and first sides in ``corners`` and ``first``, range ``r``'s in row ``r - 1`` of ``more_corners`` and
+    ``more_first`` (empty: no twins wanted)."""
+    for r in range(lo, hi):
+        start, stop = _range_of(faces.shape[0], r, cursor.shape[0])
+        if r == 0 or more_corners.shape[0] == 0:
+            _count_range(faces, start, stop, cursor[r], face_edges, twins, corners, first)
+        else:
+            _count_range(faces, start, stop, cursor[r], face_edges, twins, more_corners[r - 1], more_first[r - 1])
+
+
+@nb.njit(**_JIT)
+def _merge_corners(lo, hi, corners, first, more_corners, more_first):
+    """:func:`_sides_in_buckets`: the corners and first sides of the face ranges after the first added to
+    ``corners`` and ``first`` at the vertices ``lo:hi``, as one pass over all the faces would have found them
+    (the first side of a face without a repeated corner, else -2 where a face repeating one holds the vertex)."""
+    for v in range(lo, hi):
+        total = corners[v]
+        found = first[v]
+        for r in range(more_corners.shape[0]):
+            total += more_corners[r, v]
+            side = more_first[r, v]
+            if found < 0 and side >= 0:
+                found = side
+            elif found == -1 and side == -2:
+                found = -2
+        corners[v] = total
+        first[v] = found
+
+
+@nb.njit(**_JIT)
+def _place_sides(lo, hi, faces, cursor, sort_key, side_of):
+    """:func:`_sides_in_buckets`' placing of the sides of the face ranges ``lo`` to ``hi - 1``."""
+    for r in range(lo, hi):
+        fill = cursor[r]
+        start, stop = _range_of(faces.shape[0], r, cursor.shape[0])
+        for f in range(start, stop):
+            for k in range(3):
+                a = faces[f, k]
+                b = faces[f, (k + 1) % 3]
+                if a != b:
+                    low = _UNSIGNED(b if b < a else a)  # min(a, b)
+                    slot = _UNSIGNED(fill[low])
+                    fill[low] += 1
+                    sort_key[slot] = 2 * (b if b > a else a) + (1 if a > b else 0)  # max(a, b)
+                    side_of[slot] = 3 * f + k
 
 
 @nb.njit(**_JIT)
@@ -643,23 +711,50 @@ def _sampled_face_spans(faces, n_vertices, shift):
     return spans
 
 
-@nb.njit(**_JIT)
+@threaded
 def _faces_by_smallest_corner(faces, n_vertices):
     """``(order, sorted_faces)``: the (F,) rows of ``faces`` (F, 3) in the order of their smallest corner, stable
     (a counting sort: ``np.argsort(faces.min(axis=1), kind="stable")``), and the (F, 3) faces in that order
-    (numba's memory: ``_kernels.geometry._unadvised_array``'s reason)."""
+    (numba's memory: ``_kernels.geometry._unadvised_array``'s reason).
+
+    Each of a few ranges of the faces, one per thread, counts, then places, its own faces
+    (:func:`_count_smallest`, :func:`_place_smallest`, on threads:
+    :func:`~meshcurv._kernels._common.run_chunks`) around the counting sort's starts (:func:`_bucket_starts`):
+    a bucket holds the first range's faces, then the next's, each in face order, which is the order of one
+    pass over all the faces, whatever the number of threads (issue 31, S32: the serial pass took 0.06 CPU s
+    of a normal_cycle call at 1M vertices, all of it on the call's critical path).
+    """
     n_faces = faces.shape[0]
-    starts = np.zeros(n_vertices + 1, np.int64)
-    for f in range(n_faces):
-        starts[_UNSIGNED(min(faces[f, 0], faces[f, 1], faces[f, 2])) + _ONE] += 1
-    for v in range(n_vertices):
-        starts[v + 1] += starts[v]
-    order = np.empty(n_faces, np.int64)
-    out = np.empty((n_faces, 3), np.int64)
-    for f in range(n_faces):
-        low = _UNSIGNED(min(faces[f, 0], faces[f, 1], faces[f, 2]))
-        row = starts[low]
-        starts[low] = row + 1
-        order[row] = f
-        out[row, 0], out[row, 1], out[row, 2] = faces[f, 0], faces[f, 1], faces[f, 2]
+    n_ranges = max(1, min(nb.get_num_threads(), _BUCKET_CHUNKS, n_faces))
+    cursor = _unadvised_array((n_ranges, n_vertices), np.int64, zero=True)
+    run_chunks(_count_smallest, n_ranges, n_ranges, faces, cursor)
+    _bucket_starts(cursor)
+    order = _unadvised_array(n_faces, np.int64)  # every row placed once
+    out = _unadvised_array((n_faces, 3), np.int64)
+    run_chunks(_place_smallest, n_ranges, n_ranges, faces, cursor, order, out)
     return order, out
+
+
+@nb.njit(**_JIT)
+def _count_smallest(lo, hi, faces, cursor):
+    """:func:`_faces_by_smallest_corner`'s counts of the face ranges ``lo`` to ``hi - 1`` in ``cursor``."""
+    for r in range(lo, hi):
+        counts = cursor[r]
+        start, stop = _range_of(faces.shape[0], r, cursor.shape[0])
+        for f in range(start, stop):
+            counts[_UNSIGNED(min(faces[f, 0], faces[f, 1], faces[f, 2]))] += 1
+
+
+@nb.njit(**_JIT)
+def _place_smallest(lo, hi, faces, cursor, order, out):
+    """:func:`_faces_by_smallest_corner`'s placing of the face ranges ``lo`` to ``hi - 1``."""
+    for r in range(lo, hi):
+        fill = cursor[r]
+        start, stop = _range_of(faces.shape[0], r, cursor.shape[0])
+        for f in range(start, stop):
+            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+            low = _UNSIGNED(min(a, b, c))
+            row = _UNSIGNED(fill[low])
+            fill[low] += 1
+            order[row] = f
+            out[row, 0], out[row, 1], out[row, 2] = a, b, c

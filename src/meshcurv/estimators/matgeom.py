@@ -307,18 +307,18 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
     # the trace and the round-off bound, smoothed as the tensors are: the third eigenvalue (the normal's)
     # is the trace minus the two curvatures, to be compared with the round-off (:func:`_tied_to_round_off`)
     stages.start("average vertex tensors")
-    traces_and_floors = _smooth_vertex_field(
-        np.stack([(tensors[:, 0] + tensors[:, 1]) + tensors[:, 2], floors], axis=1), topology, smoothing_steps
-    )
+    traces_and_floors = np.stack([(tensors[:, 0] + tensors[:, 1]) + tensors[:, 2], floors], axis=1)
     if kernels is not None and smoothing_steps <= STEPS_PER_CALL:
         # the smoothing and the eigen-decomposition in one kernel (the same sums in the same order as
-        # smooth_vertex_field's kernel): no copy of the tensors, the last pass straight into the eigen-solver
+        # smooth_vertex_field's kernel): no copy of the tensors, the last pass straight into the eigen-solver,
+        # the traces and floors smoothed in place in the same passes (one read of the lists)
         indptr, indices = topology.smoothing_lists(smoothing_steps)
         stages.start("retrieve curvatures")
-        c1, c2, u1, u2, normal = kernels.matgeom_finish(
-            np.ascontiguousarray(tensors), indptr, indices, smoothing_steps, NORMAL_GAP
+        c1, c2, u1, u2, normal = kernels._matgeom_finish_fields(
+            np.ascontiguousarray(tensors), traces_and_floors, indptr, indices, smoothing_steps, NORMAL_GAP
         )
     else:
+        traces_and_floors = _smooth_vertex_field(traces_and_floors, topology, smoothing_steps)
         tensors = _smooth_vertex_field(tensors, topology, smoothing_steps)
         stages.start("retrieve curvatures")
         if kernels is not None:
