@@ -117,9 +117,7 @@ def test_matgeom_smooths_its_fields_in_the_finish_kernel_to_the_bit(steps):
     for threads in (1, 2):
         got_fields = fields.copy()
         got = _on_threads(
-            lambda: kernels._matgeom_finish_fields(
-                tensors.copy(), got_fields, indptr, indices, steps, kernels.NORMAL_GAP
-            ),
+            lambda: kernels.matgeom_finish(tensors.copy(), indptr, indices, steps, kernels.NORMAL_GAP, got_fields),
             threads,
         )
         np.testing.assert_array_equal(got_fields, expected_fields)

@@ -186,18 +186,11 @@ def matgeom_principal(tensors, gap=NORMAL_GAP):
     return outputs
 
 
-@nb.njit(**_JIT)
-def matgeom_finish(tensors, indptr, indices, steps, gap=NORMAL_GAP):
-    """matGeom's steps 6 and 7 in one kernel: ``steps`` passes of the 1-ring mean over the (V, 6)
-    ``tensors`` (overwritten), then :func:`matgeom_principal` of the result (:func:`_matgeom_finish_fields`
-    without fields to smooth beside them)."""
-    return _matgeom_finish_fields(tensors, np.empty((tensors.shape[0], 0)), indptr, indices, steps, gap)
-
-
 @nb.njit(parallel=True, **_JIT)
-def _matgeom_finish_fields(tensors, fields, indptr, indices, steps, gap):
-    """:func:`matgeom_finish`, smoothing the columns of ``fields`` (V, k) in the same passes (the estimator's
-    traces and round-off floors), in place.
+def matgeom_finish(tensors, indptr, indices, steps, gap=NORMAL_GAP, fields=None):
+    """matGeom's steps 6 and 7 in one kernel: ``steps`` passes of the 1-ring mean over the (V, 6)
+    ``tensors`` (overwritten), then :func:`matgeom_principal` of the result; with ``fields`` (V, k), its
+    columns smoothed in the same passes, in place (the estimator's traces and round-off floors).
 
     Each pass is ``smoothing.smooth_over_neighbours``'s, its sums in the same
     order (the neighbours in list order, then the vertex's own value, times
@@ -208,6 +201,8 @@ def _matgeom_finish_fields(tensors, fields, indptr, indices, steps, gap):
     of passes): the lists are read once for both, not in a second kernel
     (issue 31, S32: 0.1 CPU s of matgeom's 1.7 at 1M vertices).
     """
+    if fields is None:
+        fields = np.empty((tensors.shape[0], 0))
     if steps == 0:
         return matgeom_principal(tensors, gap)
     n = tensors.shape[0]

@@ -314,8 +314,8 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         # the traces and floors smoothed in place in the same passes (one read of the lists)
         indptr, indices = topology.smoothing_lists(smoothing_steps)
         stages.start("retrieve curvatures")
-        c1, c2, u1, u2, normal = kernels._matgeom_finish_fields(
-            np.ascontiguousarray(tensors), traces_and_floors, indptr, indices, smoothing_steps, NORMAL_GAP
+        c1, c2, u1, u2, normal = kernels.matgeom_finish(
+            np.ascontiguousarray(tensors), indptr, indices, smoothing_steps, NORMAL_GAP, traces_and_floors
         )
     else:
         traces_and_floors = _smooth_vertex_field(traces_and_floors, topology, smoothing_steps)
