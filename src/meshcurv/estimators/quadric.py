@@ -284,6 +284,15 @@ STAIRCASE_AGREEMENT = 0.3
 #: ``|k|`` on a tube; 1.0 here lost a quarter of the torus' valid vertices, 1.3 kept 2 off.
 STAIRCASE_CURVATURE_CAP = 1.2
 
+#: On a staircase, a kept fit whose normal makes with its vertex's normal an angle whose cosine is below this (a right
+#: angle) is NaN with ``valid=False`` (:func:`_staircase_check`): its tangent plane stands across the surface (the
+#: steps read edge-on), and once its normal faces into the solid the signs of its curvatures are reversed. On
+#: ``voxel_torus(12, 4)`` at 1 x 0.5 x 0.5 voxels with every face detached (issue 29), the vertex normals lie within
+#: 69 degrees of the surface's and the right fits within 16; at the caps of the tube along the long voxels, fits over
+#: the soup's default ball turned 81-98 degrees from their vertex's normal, and the balls grown in their frame
+#: (:func:`_scatter_check`) 132-141: H -0.12 for 0.14, valid (31 vertices of the welded soup, 35 given).
+STAIRCASE_FACING = 0.0
+
 #: On a voxel soup (:func:`_soup_grid`), a kept fit whose mean curvature departs from the wider quadric's of
 #: :func:`_staircase_check` by more than this share of the soup's typical curvature (``1 / R``,
 #: :func:`_staircase_radius`) is NaN with ``valid=False`` too: the detached faces' offsets add to the steps, and a
@@ -388,7 +397,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         default = radii.copy()  # the wider ball of the check below: twice the default, as step 3's
         unsure = _scatter_check((vertices, radii, referenced, scales), checks, fields, staircase=True)
         typical = soup_curvature if soup_grid is not None and soup_curvature > 0 else None  # 0: none read
-        unsure |= _staircase_check((vertices, default, radii, referenced), fields, soup_curvature=typical)
+        unsure |= _staircase_check((vertices, default, radii, referenced, facing), fields, soup_curvature=typical)
         steps = unsure.copy()  # the fits the steps bent: a limit of the method on this surface, not an undefined fit
     else:
         sigmas = _noise_sigmas(levels, scales, mesh.scale_edge_means)
@@ -1050,9 +1059,10 @@ def _scatter_check(
 def _staircase_check(ball: tuple, fields: tuple, *, soup_curvature: float | None = None) -> np.ndarray:
     """(V,) bool: the fits kept on a staircase that the steps bent (their coefficients made NaN).
 
-    ``ball = (vertices, default, radii, referenced)``: each vertex's default radius and that of its kept fit
-    (:func:`_scatter_check` grows some); ``fields = (six, fitted, coefficients)``, changed in place. A fit is
-    unsure where its mean curvature departs from that of a quadric over twice its default ball (in the frame of its
+    ``ball = (vertices, default, radii, referenced, facing)``: each vertex's default radius and that of its kept fit
+    (:func:`_scatter_check` grows some), ``facing`` the vertex normals (NaN rows: none); ``fields = (six, fitted,
+    coefficients)``, changed in place. A fit is unsure where its normal faces away from its vertex's (beyond a right
+    angle: :data:`STAIRCASE_FACING`), where its mean curvature departs from that of a quadric over twice its default ball (in the frame of its
     normal, :func:`residual_spreads`) by more than :data:`STAIRCASE_AGREEMENT` of its own largest ``|k|`` (a fit of
     zero is unsure unless the wider quadric is flat too), or where its ball is wider than
     :data:`STAIRCASE_CURVATURE_CAP` times the radius of curvature of that ``|k|``. The wider quadric and the grown balls
@@ -1060,10 +1070,17 @@ def _staircase_check(ball: tuple, fields: tuple, *, soup_curvature: float | None
     surface's (issue 29: off the exact H by more than half of the largest ``|k|``, valid, ``voxel_torus()`` 21 and the
     voxel spheres of radius 3-15 57). On a voxel soup (``soup_curvature``: its typical curvature, ``1 / R`` of
     :func:`_staircase_radius`) the two also agree within :data:`SOUP_AGREEMENT` of it."""
-    vertices, default, radii, referenced = ball
+    vertices, default, radii, referenced, facing = ball
     six, fitted, coefficients = fields
     unsure = np.zeros(vertices.shape[0], dtype=bool)
     rows = np.flatnonzero(referenced & np.isfinite(coefficients).all(axis=1))
+    if rows.size == 0:
+        return unsure
+    with np.errstate(invalid="ignore"):  # (NaN: no vertex normal, not checked here)
+        turned = np.einsum("ij,ij->i", fitted[rows], facing[rows]) < STAIRCASE_FACING
+    unsure[rows[turned]] = True
+    coefficients[rows[turned]] = np.nan
+    rows = rows[~turned]
     if rows.size == 0:
         return unsure
     k_min, k_max = principal_from_shape_operator(six[rows], fitted[rows])[:2]
