@@ -34,9 +34,11 @@ def test_the_geometry_chunks_give_the_same_bits_on_one_and_two_threads(sphere):
         pytest.skip("one thread only")
     mesh, topology = sphere
     geometry = numba_kernels("geometry")
+    if geometry is None:  # MESHCURV_BACKEND=numpy: no compiled kernels to compare
+        pytest.skip("the NumPy backend is forced")
     vertices, faces, edges = mesh.vertices, np.ascontiguousarray(mesh.faces, dtype=np.int64), topology.edges
     scales = np.full(vertices.shape[0], 0.05)
-    summed = numba_kernels("geometry").face_cross_products(vertices, faces)[: vertices.shape[0]] * 1e-3
+    summed = geometry.face_cross_products(vertices, faces)[: vertices.shape[0]] * 1e-3
 
     def every_pass():
         cross, degenerate = geometry.cross_and_degenerate(vertices, faces, scales, 0.1)
