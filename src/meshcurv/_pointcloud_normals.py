@@ -1826,8 +1826,10 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool, offse
 
     Each of the two points at least :data:`STACKED_ALIKE_OFFSET` times ``step``
     (the spacing), plus :data:`STACKED_ALIKE_TILT` times their distance times
-    the tilt of the query's normal (the median angle to its nearest
-    neighbours' normals: noise tilts them and lifts far neighbours), off the
+    the tilt of the query's normal (the median angle to its
+    :data:`GRAPH_NEIGHBOURS` nearest neighbours' normals, those tied with the
+    next dropped whole as :func:`whole_ties` drops them: noise tilts them and
+    lifts far neighbours), off the
     other's tangent plane, on the sides that parallel planes give; their
     normals the same way (``alike``: ``n_i . n_j >=`` :data:`FACING_COSINE`,
     ``(n_i . d)(n_j . d) > 0``) or opposite ones (``n_i . n_j <= -FACING_COSINE``,
@@ -1848,6 +1850,8 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool, offse
             STACKED_ALIKE_TILT,
             FACING_COSINE,
             alike,
+            TIE_TOLERANCE,
+            TIE_LEAST,
         )
     # (the kernel's products, left to right: the same decisions to the bit)
     offsets = points[near] - points[queries][:, None, :]
@@ -1855,8 +1859,16 @@ def _stacked(points, normals, usable, step, queries, near, *, alike: bool, offse
     ahead = _dot(offsets, own)
     behind = _dot(offsets, normals[near])
     cosine = _dot(own, normals[near])
-    ring = near[:, 1 : min(GRAPH_NEIGHBOURS, near.shape[1] - 1) + 1]
-    tilt = np.median(np.arccos(np.minimum(np.abs(_dot(own, normals[ring])), 1.0)), axis=1)
+    size = min(GRAPH_NEIGHBOURS, near.shape[1] - 1)
+    angles = np.arccos(np.minimum(np.abs(_dot(own, normals[near[:, 1 : size + 1]])), 1.0))
+    if size + 1 < near.shape[1]:
+        # (the ring's neighbours tied with the next beyond it dropped whole, as :func:`whole_ties`: the pose ordered
+        # them; fuzz_api 660/37, ogre's cloud: its 6th and 7th neighbours at one distance, tilts 0.449 and 0.046)
+        distances = np.sqrt(_dot(offsets[:, 1 : size + 2], offsets[:, 1 : size + 2]))
+        tied = distances[:, :size] >= distances[:, size:] * (1.0 - TIE_TOLERANCE)
+        tied &= (near[:, size + 1] != queries)[:, None]
+        angles = np.where(tied & (size - tied.sum(axis=1) >= min(TIE_LEAST, size))[:, None], np.nan, angles)
+    tilt = np.nanmedian(angles, axis=1)
     reach = offset * step + STACKED_ALIKE_TILT * tilt[:, None] * np.sqrt(_dot(offsets, offsets))
     sides = (
         (cosine >= FACING_COSINE) & (ahead * behind > 0) if alike else (cosine <= -FACING_COSINE) & (ahead * behind < 0)

@@ -831,13 +831,14 @@ def edge_weights(flat, ahead, behind, cosine, slope, spacing, rows, cols, offset
 
 
 @nb.njit(parallel=True, **_JIT)
-def stacked(points, normals, usable, queries, near, ring, offset, tilt_factor, facing, alike):
+def stacked(points, normals, usable, queries, near, ring, offset, tilt_factor, facing, alike, tie, least):
     """(M, k) bool: the compiled :func:`meshcurv._pointcloud_normals._stacked` (its constants as arguments).
 
     ``near`` (M, k) the neighbours of ``queries`` (M,), ``ring``: how many of them after the first give the tilt
-    (the median angle of the query's normal to theirs); ``offset``: the reach at distance 0; ``tilt_factor``: its
-    growth per unit of distance and of tilt; ``facing``: the cosine; ``alike``: normals the same way (else
-    opposite).
+    (the median angle of the query's normal to theirs; those tied within ``tie`` with the next beyond dropped whole
+    unless fewer than ``least`` would be left, as :func:`cut_neighbours`); ``offset``: the reach at distance 0;
+    ``tilt_factor``: its growth per unit of distance and of tilt; ``facing``: the cosine; ``alike``: normals the
+    same way (else opposite).
     """
     m, k = near.shape
     out = np.zeros((m, k), dtype=np.bool_)
@@ -845,13 +846,27 @@ def stacked(points, normals, usable, queries, near, ring, offset, tilt_factor, f
         q = queries[row]
         px, py, pz = points[q, 0], points[q, 1], points[q, 2]
         ax, ay, az = normals[q, 0], normals[q, 1], normals[q, 2]
-        angles = np.empty(ring)
-        for c in range(ring):
+        used = ring
+        if ring + 1 < k and near[row, ring + 1] != q:
+            j = near[row, ring + 1]
+            dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+            cut = np.sqrt(dx * dx + dy * dy + dz * dz) * (1.0 - tie)
+            kept = ring
+            while kept > 0:
+                j = near[row, kept]
+                dx, dy, dz = points[j, 0] - px, points[j, 1] - py, points[j, 2] - pz
+                if np.sqrt(dx * dx + dy * dy + dz * dz) < cut:
+                    break
+                kept -= 1
+            if kept >= min(least, ring):
+                used = kept
+        angles = np.empty(used)
+        for c in range(used):
             j = near[row, c + 1]
             angles[c] = np.arccos(min(abs(ax * normals[j, 0] + ay * normals[j, 1] + az * normals[j, 2]), 1.0))
         angles.sort()
-        half = ring // 2
-        tilt = angles[half] if ring % 2 else 0.5 * (angles[half - 1] + angles[half])
+        half = used // 2
+        tilt = angles[half] if used % 2 else 0.5 * (angles[half - 1] + angles[half])
         for c in range(k):
             j = near[row, c]
             if j == q or not usable[j]:
