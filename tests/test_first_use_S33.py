@@ -24,11 +24,11 @@ def _imports_during(call) -> list[str]:
     seen: list[str] = []
     original = builtins.__import__
 
-    def recording(name, globals=None, locals=None, fromlist=(), level=0):
-        caller = (globals or {}).get("__name__", "")
+    def recording(name, module_globals=None, module_locals=None, fromlist=(), level=0):
+        caller = (module_globals or {}).get("__name__", "")
         if caller.startswith("meshcurv") and level == 0:
             seen.append(name)
-        return original(name, globals, locals, fromlist, level)
+        return original(name, module_globals, module_locals, fromlist, level)
 
     builtins.__import__ = recording
     try:
