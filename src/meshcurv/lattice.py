@@ -646,12 +646,16 @@ def _refitted_axis(sides: np.ndarray, axis: np.ndarray, bound: float, *, steps: 
 
 
 def _rounded(points: np.ndarray) -> np.ndarray:
-    """``points`` (N, 3) rounded to a power of two near :data:`VOXEL_ROUNDING` of their largest |coordinate|:
-    the coordinates of one plane of a grid, turned into its axes, equal again (they differed by round-off)."""
+    """``points`` (N, 3) rounded to a power of two near :data:`VOXEL_ROUNDING` of their extent plus their round-off
+    (8 eps of the largest |coordinate|): the coordinates of one plane of a grid, turned into its axes, equal again
+    (they differed by round-off). The extent, not the largest |coordinate| (as radius._snapped): 1e-11 of the
+    coordinates of a unit grid 1.2e6 away is 2**-16, a lattice of its own that the exact reading read as the grid
+    (``voxel_sphere(6)``'s turned soup 1e5 sizes away: spacing (2**-16, 0.5, 2**-16); W32)."""
     largest = float(np.abs(points).max())
     if not (np.isfinite(largest) and largest > 0.0):
         return points
-    quantum = 2.0 ** np.ceil(np.log2(VOXEL_ROUNDING * largest))
+    extent = float(np.ptp(points, axis=0).max())
+    quantum = 2.0 ** np.ceil(np.log2(VOXEL_ROUNDING * extent + 8.0 * np.finfo(float).eps * largest))
     return np.round(points / quantum) * quantum
 
 

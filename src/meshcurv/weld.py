@@ -65,7 +65,9 @@ class Welding(NamedTuple):
     ----------
     vertices : ndarray of shape (W, 3)
         The welded mesh's vertices: each group of copies becomes its first
-        member (lowest index); the other vertices are kept in their order.
+        member (lowest index), a group joined across cracks at the point of
+        the member :func:`_crack_representatives` chooses (not by the
+        order); the other vertices are kept in their order.
     topology : MeshTopology
         The welded mesh's connectivity (faces re-indexed into ``vertices``).
     index : ndarray of shape (V,), int64
@@ -515,16 +517,97 @@ def _weld_cracks(vertices: np.ndarray, topology: MeshTopology, crack_ratio: floa
 
 
 def _merge_cracks(vertices: np.ndarray, topology: MeshTopology, components: _Components) -> Welding:
-    """The mesh with the crack ends joined in ``components`` welded (:func:`_weld_cracks`)."""
+    """The mesh with the crack ends joined in ``components`` welded (:func:`_weld_cracks`), each group at the point
+    of the member :func:`_crack_representatives` chooses (in the place of its first member in the vertices' order)."""
     pairs = components.links()
     if pairs.size == 0:
         return Welding(vertices, topology, np.arange(vertices.shape[0]), 0)
-    # each group at its first member, as a weld of coincident copies: the mean of the copies (d4e1e6a) moved the
+    # each group at one of its members, as a weld of coincident copies: the mean of the copies (d4e1e6a) moved the
     # corners of a voxel surface off its grid (no longer read as one: another radius, H off by 0.57 of |k|) and
     # flung a vertex whose copies the crack search paired along a needle's long edges (issue 29, fuzz round 17,
     # 312/2774 and 312/4373, 296/119); quadric's rims are steadied by their fits instead (quadric.STEADY_*)
     welding = _merge(vertices, topology, pairs)
-    return welding._replace(n_cracked=welding.n_welded)
+    return welding._replace(vertices=_crack_representatives(vertices, topology, welding), n_cracked=welding.n_welded)
+
+
+#: Of a group of crack ends welded into one vertex (:func:`_crack_representatives`), the members whose squared distances
+#: to the group's mean are within this share of the least are as near as it.
+CRACK_MEAN_TIE = 1e-9
+
+#: ... and within this many units of round-off of the group's largest coordinate (times the distance, or the root
+#: of the area, compared): far from the origin the rounding of the coordinates alone parts two ends equally near the
+#: mean (``voxel_sphere(6)``'s soup moved 1e5 sizes away: 2 to 29 groups at another end than at the origin).
+CRACK_ROUNDING = 64.0
+
+
+def _crack_representatives(vertices: np.ndarray, topology: MeshTopology, welding: Welding) -> np.ndarray:
+    """The welded vertices of ``welding`` (a weld of crack ends, :func:`_merge`), each group of two or more ends at
+    the point of the member that the order of the vertices does not choose: the one in the most faces, then the
+    one whose faces' corners are in the most faces, then the one nearest the group's mean (within :data:`CRACK_MEAN_TIE`), then the one whose faces have the largest area,
+    then the first.
+
+    The group's first member chose its point, and so the surface measured, by the order of the vertices: a soup's
+    copies lie a few hundredths of an edge apart, and every method's numbers on it changed with a permutation of
+    its vertices (``quadric`` on ``voxel_sphere(6)`` turned, every face detached by 0.05 edges: 12 vertices valid in
+    one order only, H 0.19 of ``|k|`` apart; issue 29, R30). The member in the most faces is the corner that kept its
+    place where a share of the faces was detached (on the grid of a voxel surface), and where it is left in as many
+    faces as a copy (one), its faces share their corners with their neighbours, a detached face's copies are in that
+    face alone; the one nearest the mean of copies moved at random, the least moved; the area decides between two
+    copies equally near (a pair's).
+    """
+    index, points = welding.index, welding.vertices
+    sizes = np.bincount(index, minlength=points.shape[0])
+    members = np.flatnonzero(sizes[index] > 1)
+    if members.size == 0:
+        return points
+    slots, groups = np.unique(index[members], return_inverse=True)
+    n = slots.size
+    ends = vertices[members]
+    every = np.bincount(topology.faces.ravel(), minlength=vertices.shape[0])
+    counts = every[members]
+    corners = vertices[topology.faces]
+    areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    area = np.bincount(topology.faces.ravel(), weights=np.repeat(areas, 3), minlength=vertices.shape[0])[members]
+    # the mean summed in the order of the coordinates within each group (the same sum in any order of the vertices),
+    # of the ends less the group's first end in that order: the differences of nearby coordinates are exact wherever
+    # the mesh sits, so the two ends of a pair are equally near their mean far from the origin too (absolute
+    # coordinates' round-off at 1e5 mesh sizes chose either end, and another surface than at the origin: R30's
+    # translated soup, tests/test_quadric_soups_V30.py, read no grid)
+    order = np.lexsort((ends[:, 2], ends[:, 1], ends[:, 0], groups))
+    starts = np.flatnonzero(np.diff(groups[order], prepend=-1))  # each group's first end in that order
+    # the round-off of a group's coordinates (the ties below hold within it: a group's ends equally near their mean
+    # or of equal areas in exact arithmetic, as the copies of one corner moved by one gap, stay tied wherever it sits)
+    rounding = np.zeros(n)
+    np.maximum.at(rounding, groups, np.abs(ends).max(axis=1))
+    rounding *= CRACK_ROUNDING * np.finfo(float).eps
+    ends = ends - ends[order[starts]][groups]
+    sums = np.column_stack([np.bincount(groups[order], weights=ends[order, k], minlength=n) for k in range(3)])
+    mean = sums / np.bincount(groups, minlength=n)[:, None]
+    apart = np.einsum("ij,ij->i", ends - mean[groups], ends - mean[groups])
+    most = np.zeros(n, dtype=np.int64)
+    np.maximum.at(most, groups, counts)
+    held = counts == most[groups]
+    # of members in as many faces, the one whose faces' corners are in the most faces: the corner left in place shares
+    # its faces' corners with their neighbours, a detached face's copies are in its face alone (a soup's pair ties
+    # on the mean exactly and the area chose a moved copy over the clean corner: 63-91 of about 1,900 groups on N21's
+    # uv sphere, 442 of 15,038 on N25's icosphere(40); ncb valid 4-6% fewer; W33)
+    reach = np.bincount(
+        topology.faces.ravel(), weights=np.repeat(every[topology.faces].sum(axis=1), 3), minlength=vertices.shape[0]
+    )[members]
+    widest = np.zeros(n)
+    np.maximum.at(widest, groups[held], reach[held])
+    held &= reach == widest[groups]
+    least = np.full(n, np.inf)
+    np.minimum.at(least, groups[held], apart[held])
+    held &= apart <= least[groups] * (1.0 + CRACK_MEAN_TIE) + rounding[groups] * np.sqrt(least[groups])
+    largest = np.full(n, -np.inf)
+    np.maximum.at(largest, groups[held], area[held])
+    held &= area >= largest[groups] * (1.0 - CRACK_MEAN_TIE) - rounding[groups] * np.sqrt(largest[groups])
+    chosen = np.full(n, vertices.shape[0], dtype=np.int64)
+    np.minimum.at(chosen, groups[held], members[held])
+    points = points.copy()
+    points[slots] = vertices[chosen]
+    return points
 
 
 def _crack_links(
