@@ -88,8 +88,8 @@ logger = logging.getLogger(__name__)
 
 #: Logged once per process (WARNING) when a kernel is compiled rather than loaded from the disk cache.
 COMPILE_MESSAGE = (
-    "compiling meshcurv's numba kernels for first use (once per installation: 10 to 20 s of CPU for the "
-    "default method, up to a minute for all methods); they are cached on disk for later processes (%s)"
+    "compiling meshcurv's numba kernels for first use (once per installation: 10 to 30 s of CPU for the "
+    "default method, one to two minutes for all methods, by machine); they are cached on disk for later processes (%s)"
 )
 
 

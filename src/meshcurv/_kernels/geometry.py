@@ -48,10 +48,14 @@ def _unadvised_zeros(shape):
 @nb.njit(**_JIT)
 def _unadvised_bytes(n_bytes, zero):
     """``n_bytes`` bytes from numba's allocator (:func:`_unadvised_empty`), zeroed when ``zero`` (numba's
-    ``memset``, on the calling thread). 32-byte aligned (numba aligns every array it allocates so)."""
+    ``memset``, on the calling thread). 32-byte aligned (numba aligns every array it allocates so). The zeros as a
+    loop (LLVM makes it the same ``memset``), not ``np.zeros``: numba compiles that and its fill beside the
+    ``np.empty`` (issue 31)."""
+    out = np.empty(n_bytes, np.uint8)
     if zero:
-        return np.zeros(n_bytes, np.uint8)
-    return np.empty(n_bytes, np.uint8)
+        for i in range(n_bytes):
+            out[i] = 0
+    return out
 
 
 def _unadvised_array(shape, dtype, *, zero: bool = False) -> np.ndarray:

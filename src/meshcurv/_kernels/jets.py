@@ -429,7 +429,9 @@ def _grid_centres(vertices, pool, radii, centres):
     for k in range(1, radii.shape[0]):
         widest = radii[k] if radii[k] > widest or radii[k] != radii[k] else widest
     points, ids, grid = pool_grid(vertices, pool, widest)
-    chosen = np.zeros(n, np.bool_)
+    chosen = np.empty(n, np.bool_)  # False (without numba's np.zeros and its fill: issue 31)
+    for k in range(n):
+        chosen[k] = False
     chosen[centres] = True
     sorted_centres = np.empty(centres.shape[0], np.int64)
     m = 0

@@ -112,9 +112,10 @@ def _grid(points, reach):
     ``_GRID_COLUMNS_PER_POINT`` per point (a sparse or very flat cloud).
     """
     n = points.shape[0]
-    lo = np.zeros(3)
-    hi = np.zeros(3)
+    lo = np.empty(3)  # zeros (without numba's np.zeros and its fill: issue 31)
+    hi = np.empty(3)
     for a in range(3):  # the bounds as points[:, a].min() and .max() (NaN if any is), without compiling them
+        lo[a] = hi[a] = 0.0
         if n:
             low = high = points[0, a]
             for i in range(1, n):
@@ -132,7 +133,9 @@ def _grid(points, reach):
     nx = np.int64((hi[0] - lo[0]) / cell) + 1
     ny = np.int64((hi[1] - lo[1]) / cell) + 1
     column = np.empty(n, np.int64)
-    starts = np.zeros(nx * ny + 1, np.int64)
+    starts = np.empty(nx * ny + 1, np.int64)
+    for c in range(nx * ny + 1):  # zeros, as above
+        starts[c] = 0
     for i in range(n):
         here = np.int64((points[i, 0] - lo[0]) / cell) * ny + np.int64((points[i, 1] - lo[1]) / cell)
         column[i] = here
