@@ -155,6 +155,20 @@ ROUND_TURN = 0.9
 ROUND_AGREEMENT = 0.1
 
 
+#: At the voxel default radius (a voxel surface, ``Stages.voxel_default``) the ball sums are taken over these
+#: multiples of the radius and added (:func:`_ball_sums`): a shell of balls instead of one. A staircase is flat on
+#: its plateaus, so a ball whose rim lies on a plateau (the normals along its rim those of the ball's centre) reads
+#: the surface as flat, whatever its curvature: its sum of dihedral angles is the step's convex edges less its
+#: concave ones, which nearly cancel (the integrated mean curvature of a patch is the flux of its slope across its
+#: rim). Where the steps are widest (the poles and axes of a sphere, its 45-degree diagonals) one radius cuts every
+#: step at the same phase: the clean ``voxel_sphere(10)`` at its default (4.225) had 5 valid vertices off the exact
+#: H by more than half of 1/R, 105 by more than 0.3 (the poles read H 0.015 for 0.1). Radii spread over a step
+#: average the rim's phase out: 0, 0 (benchmarks/ncb_plateaus_M33.py: voxel spheres of 6 to 20 voxels, a torus,
+#: an ellipsoid, tuned; other shapes and spacings held out). A sum over each ball (its area grows as its radius
+#: squared) gives the outer balls their share of the surface.
+VOXEL_SHELL = (0.7, 0.85, 1.0, 1.15, 1.3)
+
+
 def edge_area_densities(topology, face_areas: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     """(E,) area per unit length of each edge: a third of the area of each of its faces, over its length.
 
@@ -465,8 +479,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # on a mesh with boundaries the sums carry the scatter of the edges' own estimates too (FEW_ELEMENTS_SPREAD)
     scattered = bool(topology.boundary_edges.any())
     terms = (beta, unit, lengths, intact, usable)
+    # at the voxel default a shell of balls (VOXEL_SHELL): one ball's rim on a plateau reads the staircase as flat
+    shell = VOXEL_SHELL if stages.voxel_default else (1.0,)
     measures, areas, spread_sums, holes, readings, summed = _ball_sums(
-        vertices, topology, groups, radii, terms, scattered
+        vertices, topology, groups, radii, terms, scattered, shell
     )
 
     stages.start("retrieve curvatures")
@@ -474,7 +490,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # a ball that holds none of the vertex's neighbours holds only its own corner: the polyhedron's cone at
     # the vertex, not the surface (a given radius far below the edges; issue 29): undefined
     valid &= ball_holds_neighbours(vertices, topology.edges, radii) & (radii >= MIN_RADIUS_SCALES * mesh.length_scales)
-    holed = _voxel_holed_balls(mesh, holes, groups, valid, stages.voxel) & valid
+    outer = [(max(shell) * np.asarray(r, dtype=np.float64), m) for r, m in groups]  # the shell's reach
+    holed = _voxel_holed_balls(mesh, holes, outer, valid, stages.voxel) & valid
     valid &= ~holed
     k_min, k_max, dir_min, dir_max = _principal(measures, areas, normals, valid)
     reached = np.zeros_like(valid)
@@ -611,18 +628,21 @@ def _reach_note(count: int) -> str:
     )
 
 
-def _ball_sums(vertices, topology, groups, radii, terms, scattered):
+def _ball_sums(vertices, topology, groups, radii, terms, scattered, shell=(1.0,)):
     """``(measures, areas, spread_sums, holes, readings, (edge_values, measured))`` of the balls of ``groups``
     (``(radius, members)``; a radius may be one per vertex): the tensor's six columns, the area and the scatter's
     columns (:func:`_edge_spread_columns`, none without ``scattered``), each vertex's sums over its ball, with the
     edges of holes (:func:`hole_edges`, read within ``radii``, (V,)) taking neither curvature nor area; last, what
     was summed (:func:`_edge_values`: :func:`_round_balls` sums it again over smaller balls). ``terms``: ``(beta,
-    unit, lengths, intact, usable)`` of the edges, ``intact`` their area densities with the holes'."""
+    unit, lengths, intact, usable)`` of the edges, ``intact`` their area densities with the holes'. ``shell``: the
+    multiples of each radius whose balls' sums are added (:data:`VOXEL_SHELL`; one ball by default)."""
     edge_values, measured, holes, readings = _edge_values(vertices, topology, radii, terms, scattered)
     measures = np.zeros((vertices.shape[0], edge_values.shape[1]))
     for group_radius, members in groups:
         rows = slice(None) if members is None else members
-        measures[rows] = _ball_edge_sums(vertices, topology.edges, group_radius, edge_values, usable=measured)[rows]
+        for factor in shell:
+            ball = group_radius if factor == 1.0 else factor * np.asarray(group_radius, dtype=np.float64)
+            measures[rows] += _ball_edge_sums(vertices, topology.edges, ball, edge_values, usable=measured)[rows]
     return measures[:, :6], measures[:, 6], measures[:, 7:], holes, readings, (edge_values, measured)
 
 
