@@ -1443,14 +1443,19 @@ def _sheets(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     return np.where(np.bincount(labels)[labels] >= PART_MIN_POINTS, labels, -1)
 
 
-def facing_away(normals: np.ndarray, indices: np.ndarray) -> np.ndarray:
+def facing_away(normals: np.ndarray, indices: np.ndarray, usable: np.ndarray | None = None) -> np.ndarray:
     """(N,) bool: points with a neighbour (of ``indices``, (N, k)) whose oriented normal faces away from theirs.
 
     Such a point's nearest neighbours hold another sheet (a neighbouring part, the other face of a thin
     part): its PCA normal may mix the two. A neighbour at right angles (cosine below :data:`SIGN_COSINE`: its sign
     is round-off, which the pose decides) counts as facing away, as the jets' check counts one below its own
-    margin (:data:`meshcurv.jets.AWAY_DOT`).
+    margin (:data:`meshcurv.jets.AWAY_DOT`). A neighbour that is not ``usable`` (N,) bool (an outlier, a point on
+    a line) does not count: the orientation gives it no side (each is a part of its own, whose sign is the one
+    the eigensolver gave its PCA normal, which the pose decides: fuzz_api 721/2, nine outliers of ogre's cloud
+    turned over by a rigid motion, and 8 points beside them with other reasons, 11 <-> 9).
     """
+    if usable is not None and not usable.all():  # (NaN cosines face nowhere)
+        normals = np.where(usable[:, None], normals, np.nan)
     compiled = numba_kernels("pointcloud")
     if compiled is not None:  # the cosines without (N, 3) gathers
         return (compiled.edge_cosines(normals, np.ascontiguousarray(indices)) < SIGN_COSINE).any(axis=1)

@@ -1189,7 +1189,7 @@ def _compute(points, given, radius, method, search=None):
             # a point whose every normal fit held the other side, and whose nearest neighbours hold
             # it too, keeps a PCA normal that may mix the two sheets: it is left out (NaN, and out of
             # the balls, where its triangles would bend the measures of its neighbours)
-            mixed = _normals.facing_away(start, indices)
+            mixed = _normals.facing_away(start, indices, usable)
         # a small group (a few points of a scan line, a class of density in one corner) is computed on the
         # points within reach of it only: the same balls, without a search structure over the whole cloud
         # (its reach: every ball of the group's checks, the steadiness check's LARGER one included; a box of the
