@@ -6,22 +6,14 @@ that sum (cosines -7e-16 in the file's pose, +3e-12 turned): the sign of the rou
 the fits' check of the side of their neighbours' balls then gave 5 points other reasons (9 <-> 11). A normal within
 ``SIGN_COSINE`` of right angles to the sum is now left as it was, as an edge at right angles passes no sign.
 
-Oracles: the contract (no side: as it was), the invariance under a rotation (the same reasons in every pose).
+Oracles: the contract (no side: as it was); the invariance under a rotation (the same reasons in every pose: ogre
+turned by 660/28's motion) is tested in ``test_pointcloud_unusable_sides_F33.py``.
 """
 
 from __future__ import annotations
 
-import os
-import pathlib
-import warnings
-
 import numpy as np
 import pytest
-
-SHARED = pathlib.Path(
-    os.environ.get("MESHCURV_SHARED_MESHES", pathlib.Path(__file__).resolve().parents[2] / "shared" / "meshes")
-)
-OGRE = SHARED / "ogre.obj"
 
 
 def _star(cosine: float):
@@ -64,26 +56,3 @@ def test_undecided_neighbours_do_not_vote():
     undecided[4:] = True
     assert _settled_sides(normals, signs, settle, indices, usable)[0] == -1.0  # (all vote: five against three)
     assert _settled_sides(normals, signs, settle, indices, usable, undecided=undecided)[0] == 1.0
-
-
-@pytest.mark.slow
-@pytest.mark.skipif(not OGRE.exists(), reason="../shared/meshes/ogre.obj is not here")
-def test_turned_ogre_keeps_its_reasons():
-    pytest.importorskip("numba")  # (fuzz_api 660/28's backend)
-    import meshcurv
-    from meshcurv.pointcloud import point_cloud_curvatures
-
-    points = np.asarray(meshcurv.read_mesh(str(OGRE)).vertices, float)
-    seed = 1077282963  # (fuzz_api 660/28's rotation and shift)
-    q, r = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
-    q = q * np.sign(np.diag(r))
-    turn = q if np.linalg.det(q) > 0 else q[:, [1, 0, 2]]
-    moved = points @ turn.T + np.random.default_rng(seed).uniform(-10.0, 10.0, size=3) * float(np.ptp(points))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        here, there = point_cloud_curvatures(points), point_cloud_curvatures(moved)
-    assert here.valid.sum() > 2000
-    np.testing.assert_array_equal(here.valid, there.valid)
-    np.testing.assert_array_equal(here.invalid_reason, there.invalid_reason)
-    largest = np.abs(here.k_max[here.valid]).max()
-    assert np.abs(here.k_max[here.valid] - there.k_max[there.valid]).max() <= 1e-6 * largest
