@@ -315,7 +315,14 @@ def _tied_to_round_off(c1, c2, traces, floors, exact_gaps):
     return tied
 
 
-def _exact_gaps(vertices, topology, smoothing_steps, pairing, band):
+def _neighbours(indptr: np.ndarray, indices: np.ndarray, rows: np.ndarray):
+    """``(owners, neighbours)``: each of the ``rows``' edge neighbours (CSR ``indptr, indices``) and its row."""
+    starts, degrees = indptr[rows], indptr[rows + 1] - indptr[rows]
+    offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(degrees)[:-1]]), degrees)
+    return np.repeat(rows, degrees), indices[np.arange(int(degrees.sum())) + offsets].astype(np.int64)
+
+
+def _exact_gaps(vertices, topology, smoothing_steps, pairing, band, mean):
     """``(gap, largest)`` at the ``band`` vertices: matGeom's smoothed tensor with exact dihedral angles.
 
     The tensor of steps 2 to 6 on the same edges and faces (``pairing``: ``ev1, ev2, ef1, ef2, out_of_range``
@@ -325,15 +332,17 @@ def _exact_gaps(vertices, topology, smoothing_steps, pairing, band):
     ``largest`` the largest magnitude.
     """
     ev1, ev2, ef1, ef2, out_of_range = pairing
-    # the band's smoothed tensors read the vertex tensors within smoothing_steps rings, which read their edges
-    reach = (
-        band if not smoothing_steps else _smooth_vertex_field(band.astype(np.float64), topology, smoothing_steps) > 0
-    )
-    near = reach[ev1] | reach[ev2]
-    all_lengths = _row_norms(vertices[ev2] - vertices[ev1])
-    mean = all_lengths.mean() if all_lengths.size else 1.0
+    n_vertices = vertices.shape[0]
+    indptr, indices = topology.neighbour_lists
+    # the band's smoothed tensors read the vertex tensors within smoothing_steps rings, which read their edges:
+    # everything below on those rings only (a few vertices of a large mesh: no pass over the whole mesh)
+    reach = band.copy()
+    for _ in range(smoothing_steps):
+        reach[_neighbours(indptr, indices, np.flatnonzero(reach))[1]] = True
+    rows = np.flatnonzero(reach)
+    near = np.flatnonzero(reach[ev1] | reach[ev2])
     p, q = ev1[near], ev2[near]
-    lengths = all_lengths[near]
+    lengths = _row_norms(vertices[q] - vertices[p])
     faces = topology.faces
     lost = out_of_range[near]
     f1, f2 = np.where(lost, 0, ef1[near]), np.where(lost, 0, ef2[near])
@@ -347,14 +356,41 @@ def _exact_gaps(vertices, topology, smoothing_steps, pairing, band):
         weight = (lengths / mean) * beta * np.sign(_row_dots(cross, units))
     weight[lost] = np.nan
     edge_tensors = outer6(units, weight)
-    n_vertices = vertices.shape[0]
-    ends = np.concatenate([p, q])
-    counts = np.bincount(ends, minlength=n_vertices).astype(np.float64)  # all the edges of a reached vertex
+    local = np.full(n_vertices, -1, dtype=np.int64)
+    local[rows] = np.arange(rows.size)
+    ends = local[np.concatenate([p, q])]
+    keep = ends >= 0
+    counts = np.bincount(ends[keep], minlength=rows.size).astype(np.float64)  # all the edges of a reached vertex
     counts[counts == 0] = 1.0
-    tensors = np.stack(
-        [np.bincount(ends, weights=np.tile(edge_tensors[:, k], 2), minlength=n_vertices) for k in range(6)], axis=1
+    tensors = (
+        np.stack(
+            [
+                np.bincount(
+                    ends[keep],
+                    weights=np.tile(edge_tensors[:, k], 2)[keep],
+                    minlength=rows.size,
+                )
+                for k in range(6)
+            ],
+            axis=1,
+        )
+        / counts[:, None]
     )
-    tensors = _smooth_vertex_field(tensors / counts[:, None], topology, smoothing_steps)[band]
+    # smoothing_steps passes of the 1-ring mean on the reached vertices (each with its whole degree): a vertex at
+    # the reach's edge misses neighbours, an error that moves one ring a pass and stops short of the band
+    owners, neighbours = _neighbours(indptr, indices, rows)
+    inside = local[neighbours] >= 0
+    owners, neighbours = local[owners[inside]], local[neighbours[inside]]
+    scale = 1.0 / (np.diff(indptr)[rows] + 1.0)
+    for _ in range(smoothing_steps):
+        tensors = (
+            tensors
+            + np.stack(
+                [np.bincount(owners, weights=tensors[neighbours, k], minlength=rows.size) for k in range(6)],
+                1,
+            )
+        ) * scale[:, None]
+    tensors = tensors[local[np.flatnonzero(band)]]
     xx, yy, zz, xy, xz, yz = tensors.T
     matrices = np.stack([xx, xy, xz, xy, yy, yz, xz, yz, zz], axis=1).reshape(-1, 3, 3)
     finite = np.isfinite(matrices).all(axis=(1, 2))
@@ -398,7 +434,14 @@ def estimate(mesh: PreparedMesh, *, smoothing_steps: int, stages: Stages):
         c2,
         traces_and_floors[:, 0],
         traces_and_floors[:, 1],
-        lambda band: _exact_gaps(vertices, topology, smoothing_steps, pairing, band),
+        lambda band: _exact_gaps(
+            vertices,
+            topology,
+            smoothing_steps,
+            pairing,
+            band,
+            mean_edge_length(vertices, np.stack(pairing[:2], axis=1)),
+        ),
     )
 
     finite = ~np.isnan(c1)  # NaN exactly where a tensor component is not finite
