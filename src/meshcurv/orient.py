@@ -904,6 +904,7 @@ def _nesting_depth(vertices, faces, patch, closed) -> np.ndarray:
     if ids.size < 2:
         return depth
     from scipy.spatial import cKDTree  # imported on use, past the one-part return: scipy.spatial costs 0.13 s CPU
+
     face_closed = closed[patch]
     rows = np.flatnonzero(face_closed)
     owner = patch[rows]
