@@ -543,8 +543,8 @@ CRACK_ROUNDING = 64.0
 def _crack_representatives(vertices: np.ndarray, topology: MeshTopology, welding: Welding) -> np.ndarray:
     """The welded vertices of ``welding`` (a weld of crack ends, :func:`_merge`), each group of two or more ends at
     the point of the member that the order of the vertices does not choose: the one in the most faces, then the
-    one whose faces' corners are in the most faces, then the one nearest the group's mean (within :data:`CRACK_MEAN_TIE`), then the one whose faces have the largest area,
-    then the first.
+    one whose faces' corners are in the most faces, then the one nearest the group's mean (within
+    :data:`CRACK_MEAN_TIE`), then the one whose faces have the largest area, then the first.
 
     The group's first member chose its point, and so the surface measured, by the order of the vertices: a soup's
     copies lie a few hundredths of an edge apart, and every method's numbers on it changed with a permutation of

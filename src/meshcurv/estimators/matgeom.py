@@ -53,6 +53,8 @@ https://doi.org/10.1145/882262.882296
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from .._backend import kernel_threads, numba_kernels
@@ -282,7 +284,13 @@ def _principal(tensors: np.ndarray):
     return c1, c2, u1, u2, normal
 
 
-def _tied_to_round_off(c1, c2, traces, floors, exact_gaps):
+def _tied_to_round_off(
+    c1: np.ndarray,
+    c2: np.ndarray,
+    traces: np.ndarray,
+    floors: np.ndarray,
+    exact_gaps: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+) -> np.ndarray:
     """(V,) bool: the normal's eigenvalue may be the middle one's, or tie with it, in some pose of the mesh.
 
     The normal's eigenvalue is ``trace - c1 - c2``; ``c1`` and ``c2`` are the eigenvalues of middle and
