@@ -32,9 +32,10 @@ count; ``parameters["scale"] == "local"``): a unit icosphere with Gaussian
 noise of 0.19 h on a cap had 1,248 of 5,762 vertices off by more than half of
 H at one edge length, 2 now; beside cracks and faces detached beyond the weld,
 where a ball holds less than 0.8 of its disc while faces it cannot reach lie
-within it, up to twice the radius (:func:`meshcurv.radius._holed_factor`). On dense surfaces (normal-fit balls wider than 16 edge lengths,
-marching cubes of fine voxels) the normals are fitted on clusters of vertices
-(:func:`fitted_normals`). On voxel surfaces each vertex takes the radius its
+within it, up to twice the radius (:func:`meshcurv.radius._holed_factor`). On dense voxel surfaces
+(normal-fit balls wider than 16 edge lengths, marching cubes of fine voxels) the normals are fitted
+on clusters of vertices (:func:`fitted_normals`); on other meshes at every vertex over the vertices, whatever the
+radius (clusters in cubes of the coordinate axes made the numbers depend on the pose: issue 29, fuzz_api 690/40). On voxel surfaces each vertex takes the radius its
 pilot pass calls for (:func:`meshcurv.radius.voxel_vertex_radii`:
 ``2 sqrt(h_v R)`` for the voxel extent ``h_v`` along its normal, capped where
 the surface bends fast; ``parameters["scale"] == "voxel"``); the pilot runs at
@@ -160,6 +161,7 @@ from ..radius import (
     _patch_radii,
     _scale_centres,
     _vertex_radii,
+    _voxel_surface,
     scale_ladder,
     stable_scales,
 )
@@ -179,9 +181,9 @@ NORMAL_SETTLED = SETTLED_SLOPE
 #: Fits per normal: the first in the frame of the mean of the face normals, the next in that of the first fit.
 NORMAL_ITERATIONS = 2
 
-#: Normal fits over balls wider than this many median edge lengths are fitted on a coarser level of the
-#: surface (dense voxel surfaces: 20-40 edge lengths, balls of thousands of vertices; the default on a clean
-#: mesh is 3 edge lengths, under noise of 0.3 edge lengths 10) ...
+#: On a voxel surface, normal fits over balls wider than this many median edge lengths are fitted
+#: on a coarser level of the surface (dense voxel surfaces: 20-40 edge lengths, balls of thousands of vertices;
+#: other meshes are fitted over their vertices at any radius: :func:`fitted_normals`) ...
 COARSE_EDGES = 16.0
 #: ... of clusters in cubes of 1 / COARSE_CELLS of the normal-fit radius (a ball then holds about 300 of them;
 #: 6 and 8 made the marching-cubes sphere r 1 at voxel 0.05 of ``benchmarks/accuracy.py`` 13% worse, 10 is
@@ -248,6 +250,7 @@ def fitted_normals(
     unwrap: np.ndarray | None = None,
     counts: np.ndarray | None = None,
     thin: bool = False,
+    coarse: bool = False,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -279,26 +282,31 @@ def fitted_normals(
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
-    more densely does not outweigh its neighbour). Where the balls are wider
-    than :data:`COARSE_EDGES` edge lengths (dense voxel surfaces: balls of
-    thousands of vertices), the jets are fitted on a coarser level of the
-    surface (:func:`_coarse_level`), so that a fit costs about the same whatever
-    the density. The clusters are cubes of the coordinate axes: a rotated mesh
-    gets other clusters, and normals that differ within the fits' precision.
+    more densely does not outweigh its neighbour). With ``coarse`` (a voxel
+    surface, :func:`_coarse_fits`, whose balls are wider than :data:`COARSE_EDGES`
+    edge lengths: thousands of vertices), the jets are fitted on a coarser level
+    of the surface (:func:`_coarse_level`), so that a fit costs about the same
+    whatever the density. Its clusters and samples lie in cubes of the coordinate axes (a rotated
+    surface gets other ones, and normals that differ within the fits' precision); on any other mesh the
+    fits run over the vertices at every centre, whatever the radius: a given radius of 7.8 median edges on
+    ``ogre.obj`` (fuzz_api 690/40, normal fits over 23 edges) put k apart by up to 16% of the largest
+    ``|k|`` (median 1.1%) between two poses on the coarse level (issue 29), mostly from the samples'
+    interpolation (fitted at every centre of the clusters: median 0.03%, largest 9-18%), at three times the
+    CPU time now (6 -> 19 s; ``benchmarks/coarse_pose_C68.py``).
     """
     start = np.where(valid[:, None], normals, [0.0, 0.0, 1.0])
-    coarse = None
+    level = None
     dense = False  # the coarse level's test first: an ordinary mesh's fits read no areas unless weighted
-    if areas is not None and adjacency is not None:
+    if coarse and areas is not None and adjacency is not None:
         edge = _median_edge(vertices, adjacency) if edge is None else edge
         dense = _dense(vertices, float(np.median(radius)), adjacency, edge=edge)
     if areas is not None and (dense or weighted):  # in units of their median: weights of order 1 whatever the units
         positive = areas[areas > 0]
         areas = areas / np.median(positive) if positive.size else None
     if dense and areas is not None:
-        coarse = _coarse_level(vertices, start, radius, areas, neighbours, adjacency, edge=edge)
-    if coarse is not None:
-        points, point_normals, allowed, lists, point_areas = coarse
+        level = _coarse_level(vertices, start, radius, areas, neighbours, adjacency, edge=edge)
+    if level is not None:
+        points, point_normals, allowed, lists, point_areas = level
         # the vertices measured only: the cubes of the samples start at their corner, which a vertex in no face
         # (no valid normal) would move
         centres = np.flatnonzero(valid)
@@ -555,6 +563,20 @@ def _dense(
     if edge is None:
         edge = _median_edge(vertices, adjacency)
     return bool(radius > (COARSE_EDGES if edges is None else edges) * edge)
+
+
+def _coarse_fits(mesh: PreparedMesh, normal_radius, invalid: np.ndarray, stages: Stages) -> bool:
+    """Whether normal fits over ``normal_radius`` (its median) may run on the coarse level (:func:`fitted_normals`):
+    wider than :data:`COARSE_EDGES` median edges on a voxel surface (:func:`meshcurv.radius._voxel_surface`, the
+    grid read once a call: ``stages.voxel``; ``invalid`` the vertices its faces may leave out). At a given radius of
+    two default radii on ``voxel_sphere(6, (0.5, 0.2, 0.2))`` (normal fits over 20 median edges) the fits over the
+    vertices cost 4.6 times the CPU of the coarse level's and read H 2.4 times further off (0.046 of H at the
+    median against 0.019): its clusters average the staircase. Any other mesh is fitted over its vertices."""
+    if not np.all(np.isfinite(normal_radius)) or not _dense(
+        mesh.vertices, float(np.median(normal_radius)), _adjacency(mesh.topology), edge=_mesh_edge(mesh)
+    ):
+        return False
+    return _voxel_surface(mesh, invalid, reading=stages.voxel)
 
 
 def _median_edge(vertices: np.ndarray, adjacency: tuple, edges: np.ndarray | None = None) -> float:
@@ -911,6 +933,7 @@ def _curvatures(
     weighted: bool = False,
     normal_radius=None,
     coarse: bool = False,
+    coarse_fits: bool = False,
     boundary_faces: np.ndarray | None = None,
     topology: MeshTopology | None = None,
     cracked: bool = False,
@@ -919,7 +942,9 @@ def _curvatures(
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
     The normals are fitted over ``normal_radius`` (default: :data:`NORMAL_RADIUS_RATIO` times ``radius``).
-    ``coarse``: dense balls summed on clusters of faces (:func:`meshcurv.neighborhoods.coarse_face_sums`).
+    ``coarse`` (a voxel surface at its default radii): dense balls summed on clusters of faces
+    (:func:`meshcurv.neighborhoods.coarse_face_sums`), wide normal fits on the coarse level (:func:`fitted_normals`);
+    ``coarse_fits`` (a voxel surface at a given radius, :func:`_coarse_fits`): the latter only.
     ``boundary_faces`` (F,) bool: the faces on a boundary edge of a voxel surface (:func:`_boundary_faces`),
     whose balls are grown or left undefined (:func:`_holed_balls`); the returned ``radius`` is then (V,) the
     radius of each ball summed (``radius`` as given otherwise). ``topology``: the mesh's, given where it has
@@ -970,6 +995,7 @@ def _curvatures(
             unwrap=near,
             counts=counts,
             thin=coarse,
+            coarse=coarse or coarse_fits,
         )
 
         if boundary_faces is not None and adjacency is not None:
@@ -1248,6 +1274,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 weighted=not even,
                 topology=bounded,
                 cracked=bool(mesh.n_cracked),
+                coarse_fits=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * radii_v, defects.invalid_vertices, stages),
             )
             return finish(
                 "icc",
@@ -1277,6 +1304,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             areas=_vertex_areas(mesh),
             topology=bounded,
             cracked=bool(mesh.n_cracked),
+            coarse_fits=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * group_radius, defects.invalid_vertices, stages),
         )[:-1]
         if members is None:
             fields = computed
@@ -1327,10 +1355,12 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     radii = [_check_radius(radius, mesh) if j in (0, last) else float(radius) for j, radius in enumerate(radii)]
     stages.start("fit normals")
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
-    # the fits of the radii not fitted on the coarse level, from one walk per vertex (the radii increase, and
-    # so does _dense: the radii fitted so are the first ones)
+    # the fits of the radii not fitted on the coarse level (a voxel surface's wider than COARSE_EDGES median edges:
+    # _coarse_fits; any other mesh's none), from one walk per vertex (the radii increase, and so does _dense: the
+    # radii fitted so are the first ones)
     edge = _mesh_edge(mesh)
-    fine = [NORMAL_RADIUS_RATIO * r for r in radii if not NORMAL_RADIUS_RATIO * r > COARSE_EDGES * edge]
+    voxel = _coarse_fits(mesh, NORMAL_RADIUS_RATIO * radii[-1], defects.invalid_vertices, stages)
+    fine = [NORMAL_RADIUS_RATIO * r for r in radii if not (voxel and NORMAL_RADIUS_RATIO * r > COARSE_EDGES * edge)]
     fits = (
         nested_jet_normals(
             vertices,
@@ -1359,6 +1389,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             edge=edge,
             failed=failed[j],
             fits=fits[j] if j < len(fits) else None,
+            coarse=voxel,
         )
         for j, radius in enumerate(radii)
     ]
@@ -1420,6 +1451,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
         neighbours=topology.referenced_vertices,
         adjacency=_adjacency(topology),
         areas=_vertex_areas(mesh),
+        coarse=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * base, defects.invalid_vertices, stages),
     )
     stages.start("compute face measures")
     measures = face_measures(vertices, faces, normals)
