@@ -14,6 +14,11 @@ from typing import Literal, TypedDict, cast
 import numba as nb
 import numpy as np
 
+from . import load_numba_registries
+
+
+load_numba_registries()  # before the first kernel: numba's registries without scipy.linalg (see there)
+
 
 class _JitOptions(TypedDict):
     """The keywords of ``numba.njit`` the kernels set (typed, so that ``njit(**_JIT)`` type-checks)."""
