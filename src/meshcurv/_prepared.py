@@ -525,20 +525,63 @@ def _second_side_apart(points: np.ndarray, topology: MeshTopology) -> tuple[Weld
     used = np.zeros(points.shape[0], dtype=bool)
     used[kept_faces] = True
     point_of = coincident.index
-    if np.unique(point_of[used]).size != np.count_nonzero(used):
-        # the side kept is no surface alone either (a soup, or copies tangled into one part: their vertices are
-        # looked at as such, meshcurv.weld.tangled_vertices): left as given
-        return None
-    # each vertex at the kept vertex of its point (a vertex the kept faces hold is its own)
-    kept_of_point = np.full(coincident.vertices.shape[0], -1, dtype=np.int64)
-    kept_of_point[point_of[used]] = np.flatnonzero(used)
-    twin = kept_of_point[point_of]
+    if np.unique(point_of[used]).size == np.count_nonzero(used):
+        # each vertex at the kept vertex of its point (a vertex the kept faces hold is its own)
+        kept_of_point = np.full(coincident.vertices.shape[0], -1, dtype=np.int64)
+        kept_of_point[point_of[used]] = np.flatnonzero(used)
+        twin = kept_of_point[point_of]
+    else:
+        # the side kept has coincident vertices of its own (a seam of copies, as ogre.obj's 9: fuzz_api 730/156),
+        # so a point does not name one kept vertex: each dropped face's corners at the corners of the kept face it
+        # repeats; None where that is not one vertex each (copies tangled into one part: left as given)
+        twin = _twins_by_faces(faces, wanted, point_of)
+        if twin is None:
+            return None
     own = used | (twin < 0)  # a vertex no kept face holds stays where no kept vertex is at its point
     new_row = np.cumsum(own) - 1
     index = new_row[np.where(own, np.arange(points.shape[0]), twin)]
     side = MeshTopology._build(np.ascontiguousarray(new_row[kept_faces]), int(own.sum()))
     kept = OneSided(side, ~wanted, on_points.n_dropped)
     return Welding(points[own], side, index, 0), kept
+
+
+def _twins_by_faces(faces: np.ndarray, wanted: np.ndarray, point_of: np.ndarray) -> np.ndarray | None:
+    """(V,) int64: each vertex's twin on the side kept (``wanted`` faces of ``faces``, their vertices their own), -1
+    for a vertex of no face; None where a dropped face repeats no kept face or a vertex would have two twins.
+
+    A dropped face is a kept face's points in the other winding (``point_of``: each vertex's point): its corner at
+    a point is the twin of the kept face's corner at that point."""
+    n_vertices = point_of.shape[0]
+    twin = np.full(n_vertices, -1, dtype=np.int64)
+    kept, dropped = faces[wanted], faces[~wanted]
+    used = np.unique(kept)
+    twin[used] = used
+    if dropped.shape[0] == 0:
+        return twin
+    # both as point triples starting at their smallest point, the dropped ones turned to the kept winding
+    kept_order = np.argmin(point_of[kept], axis=1)[:, None] + np.arange(3)
+    kept = np.take_along_axis(kept, kept_order % 3, axis=1)
+    dropped = dropped[:, ::-1]
+    dropped_order = np.argmin(point_of[dropped], axis=1)[:, None] + np.arange(3)
+    dropped = np.take_along_axis(dropped, dropped_order % 3, axis=1)
+    keys = np.unique(np.vstack([point_of[kept], point_of[dropped]]), axis=0, return_inverse=True)[1].reshape(-1)
+    kept_keys, dropped_keys = keys[: kept.shape[0]], keys[kept.shape[0] :]
+    order = np.argsort(kept_keys, kind="stable")
+    at = np.searchsorted(kept_keys[order], dropped_keys)
+    found = at < order.size
+    found[found] = kept_keys[order[at[found]]] == dropped_keys[found]
+    if not found.all() or np.unique(kept_keys).size != kept_keys.size:  # a face of no twin, or two kept faces alike
+        return None
+    partners = kept[order[at]]
+    ends, starts = dropped.reshape(-1), partners.reshape(-1)
+    claimed = np.full(n_vertices, -1, dtype=np.int64)
+    claimed[ends] = starts
+    shared = twin[ends] >= 0  # a vertex of both sides: its own twin
+    if (claimed[ends] != starts).any() or (starts[shared] != ends[shared]).any():
+        return None
+    free = twin < 0
+    twin[free] = claimed[free]
+    return twin
 
 
 def _rotated(faces: np.ndarray) -> np.ndarray:
