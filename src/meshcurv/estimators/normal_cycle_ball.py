@@ -168,6 +168,42 @@ ROUND_AGREEMENT = 0.1
 #: squared) gives the outer balls their share of the surface.
 VOXEL_SHELL = (0.7, 0.85, 1.0, 1.15, 1.3)
 
+#: ... and the shell is widened (:func:`_voxel_shell`) where its balls' rims would cross fewer than this many terraces
+#: of the staircase round a point whose normal is along a grid axis: where the voxel default is capped at half the
+#: radius of curvature (a surface of few voxels, anisotropic voxels), the shell of :data:`VOXEL_SHELL` read the
+#: coarse axis's poles as flat or as a step (``voxel_sphere(9)`` at 1 x 1 x 2.5: 8 valid vertices at its pole off
+#: by more than half of 1/R, H 0.015 for 0.111; ``voxel_torus(14, 5)`` at 1 x 1 x 2.5: 70). Tuned on anisotropic
+#: spheres, tori and ellipsoids at 1 x 1 x 1.5, 1 x 1 x 2, 1 x 2 x 2 and 0.5 x 0.2 x 0.2 and M33's isotropic
+#: shapes (valid vertices off by more than half the largest ``|k|``: 54 -> 0; 5 at 0.5 terraces, 4 at 0.65, 1 at
+#: 0.9); held out at 1 x 1 x 2.5, 1 x 1 x 3, 1 x 1.5 x 2.5 and M33's held-out shapes: 89 -> 0, the valid vertices' ``k`` off by more
+#: than half 595 -> 140 (``benchmarks/ncb_plateaus_M33.py --anisotropic``). Wider balls reach further round a
+#: part thinner than a voxel: ``voxel_ellipsoid((8, 8, 2))``'s rim (its radius of curvature half a voxel) 1 -> 24.
+VOXEL_SHELL_TERRACES = 1.0
+
+
+def _voxel_shell(radius: float, step: float) -> tuple[float, ...]:
+    """The multiples of a voxel default ``radius`` whose balls' sums are added: :data:`VOXEL_SHELL`, widened to the
+    terraces of a staircase of largest voxel size ``step`` (:data:`VOXEL_SHELL_TERRACES`).
+
+    Round a point where the surface's normal is along a grid axis (a sphere's pole, a torus's equator along the
+    coarse axis of anisotropic voxels) the staircase's terraces are rings about the point, the ``j`` th ring's rim
+    about ``sqrt(2 R j h)`` from it on a surface of radius of curvature ``R`` and voxel size ``h`` along the axis:
+    balls from ``s0 r`` to ``s1 r`` cross ``n = (s1^2 - s0^2) r^2 / (2 R h)`` terraces. Where ``n`` is below one,
+    every ball's rim reads the same terrace's phase, and the shell reads the surface as flat or as a step. The
+    voxel default (:func:`meshcurv.radius.voxel_radius`) is ``1.5 sqrt(h R)`` (``n = 1.125`` per unit of ``s1^2 -
+    s0^2``: :data:`VOXEL_SHELL` crosses 1.35) or, on a surface of few voxels, ``R / 2``: there ``n = (s1^2 -
+    s0^2) r / (4 h)``, and the shell reaches ``s1 = sqrt(s0^2 + 4 n h / r)`` for ``n`` =
+    :data:`VOXEL_SHELL_TERRACES` (more where the floor of one voxel holds the radius: ``R`` is then below ``2 r``).
+    ``h`` is the largest voxel size: its axis's poles have the widest terraces.
+    """
+    inner, outer = VOXEL_SHELL[0], VOXEL_SHELL[-1]
+    if not (np.isfinite(step) and step > 0 and np.isfinite(radius) and radius > 0):
+        return VOXEL_SHELL
+    wide = float(np.sqrt(inner * inner + 4.0 * VOXEL_SHELL_TERRACES * step / radius))
+    if wide <= outer:
+        return VOXEL_SHELL
+    return tuple(float(x) for x in np.linspace(inner, wide, len(VOXEL_SHELL)))
+
 
 def edge_area_densities(topology, face_areas: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     """(E,) area per unit length of each edge: a third of the area of each of its faces, over its length.
@@ -480,9 +516,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     scattered = bool(topology.boundary_edges.any())
     terms = (beta, unit, lengths, intact, usable)
     # at the voxel default a shell of balls (VOXEL_SHELL): one ball's rim on a plateau reads the staircase as flat
-    shell = VOXEL_SHELL if stages.voxel_default else (1.0,)
+    shells: list[tuple[float, ...]] = [(1.0,)] * len(groups)
+    if stages.voxel_default:
+        grid = stages.voxel.mesh_grid(mesh)
+        step = float(np.max(grid.spacing)) if grid is not None else np.nan
+        shells = [_voxel_shell(float(np.max(r)), step) for r, _ in groups]
     measures, areas, spread_sums, holes, readings, summed = _ball_sums(
-        vertices, topology, groups, radii, terms, scattered, shell
+        vertices, topology, groups, radii, terms, scattered, shells
     )
 
     stages.start("retrieve curvatures")
@@ -490,7 +530,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     # a ball that holds none of the vertex's neighbours holds only its own corner: the polyhedron's cone at
     # the vertex, not the surface (a given radius far below the edges; issue 29): undefined
     valid &= ball_holds_neighbours(vertices, topology.edges, radii) & (radii >= MIN_RADIUS_SCALES * mesh.length_scales)
-    outer = [(max(shell) * np.asarray(r, dtype=np.float64), m) for r, m in groups]  # the shell's reach
+    outer = [(max(shell) * np.asarray(r, dtype=np.float64), m) for (r, m), shell in zip(groups, shells)]  # its reach
     holed = _voxel_holed_balls(mesh, holes, outer, valid, stages.voxel) & valid
     valid &= ~holed
     k_min, k_max, dir_min, dir_max = _principal(measures, areas, normals, valid)
@@ -519,9 +559,14 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             few &= ~kept
         valid &= ~few
     # a voxel surface welded across cracks, no longer read as one, has the default of other meshes, whose balls
-    # read a plateau of its staircase as flat with no scatter (fuzz 500/28: H 0 for 0.1, valid)
+    # read a plateau of its staircase as flat with no scatter (fuzz 500/28: H 0 for 0.1, valid); so has one read as
+    # a voxel surface only by its vertices on the grid's planes (its holes' rule), whose default radius is not the
+    # voxel default (no grid read for it) and is one ball, no shell (fuzz 647/28: voxel_sphere(10) a fifth detached
+    # by 0.045 edges, balls of 2.41 for the voxel default's 4.23: 12 of 97 valid vertices off by more than half of
+    # H, 8 of them H 0 for 0.1 at a pole)
     staircase = np.zeros_like(valid)
-    if not on_voxels and valid.any() and welded_grid(mesh, sound) is not None:
+    plain_default = radius is None  # (the voxel default is handed to the estimator as a radius)
+    if (not on_voxels or plain_default) and valid.any() and welded_grid(mesh, sound) is not None:
         staircase, valid = valid, np.zeros_like(valid)
     parameters: dict[str, object] = {"radius": groups[0][0]}
     if len(groups) > 1:
@@ -628,17 +673,17 @@ def _reach_note(count: int) -> str:
     )
 
 
-def _ball_sums(vertices, topology, groups, radii, terms, scattered, shell=(1.0,)):
+def _ball_sums(vertices, topology, groups, radii, terms, scattered, shells=None):
     """``(measures, areas, spread_sums, holes, readings, (edge_values, measured))`` of the balls of ``groups``
     (``(radius, members)``; a radius may be one per vertex): the tensor's six columns, the area and the scatter's
     columns (:func:`_edge_spread_columns`, none without ``scattered``), each vertex's sums over its ball, with the
     edges of holes (:func:`hole_edges`, read within ``radii``, (V,)) taking neither curvature nor area; last, what
     was summed (:func:`_edge_values`: :func:`_round_balls` sums it again over smaller balls). ``terms``: ``(beta,
-    unit, lengths, intact, usable)`` of the edges, ``intact`` their area densities with the holes'. ``shell``: the
-    multiples of each radius whose balls' sums are added (:data:`VOXEL_SHELL`; one ball by default)."""
+    unit, lengths, intact, usable)`` of the edges, ``intact`` their area densities with the holes'. ``shells``: per group,
+    the multiples of its radius whose balls' sums are added (:func:`_voxel_shell`; None: one ball each)."""
     edge_values, measured, holes, readings = _edge_values(vertices, topology, radii, terms, scattered)
     measures = np.zeros((vertices.shape[0], edge_values.shape[1]))
-    for group_radius, members in groups:
+    for (group_radius, members), shell in zip(groups, shells or [(1.0,)] * len(groups)):
         rows = slice(None) if members is None else members
         for factor in shell:
             ball = group_radius if factor == 1.0 else factor * np.asarray(group_radius, dtype=np.float64)
