@@ -26,6 +26,7 @@ import numpy as np
 
 import meshcurv
 from meshcurv import shapes
+from noisy_patches_icc import holey, patch  # the noisy patches' draws
 
 BASES = {
     "e15s16": lambda: shapes.ellipsoid((3.0, 3.0, 0.15), 16),
@@ -35,37 +36,6 @@ BASES = {
     "e10s24": lambda: shapes.ellipsoid((3.0, 2.0, 0.1), 24),
     "t15": lambda: shapes.torus(3.0, 0.15, 192, 12),
 }
-
-
-def _edge(vertices, faces):
-    return float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
-
-
-def _cap(mesh, amplitude, seed, share):
-    """The vertices of a cap (``share`` of them along a random axis) moved along their normals by Gaussian noise of
-    ``amplitude`` mean edge lengths."""
-    vertices, faces = mesh.vertices, mesh.faces
-    rng = np.random.default_rng(seed)
-    axis = rng.normal(size=3)
-    axis /= np.linalg.norm(axis)
-    x = vertices @ axis
-    inside = x > np.percentile(x, 100 * (1 - share))
-    heights = rng.normal(size=(len(vertices), 1)) * amplitude * _edge(vertices, faces)
-    return vertices + inside[:, None] * mesh.normals * heights, faces, np.arange(len(vertices))
-
-
-def _detach(mesh, share, offset, seed):
-    """A ``share`` of the faces given corners of their own, moved ``offset`` edge lengths; each corner's source."""
-    vertices, faces = mesh.vertices, mesh.faces
-    rng = np.random.default_rng(seed)
-    picked = rng.random(len(faces)) < share
-    corners = vertices[faces[picked]].reshape(-1, 3)
-    directions = rng.normal(size=corners.shape)
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    moved = faces.copy()
-    moved[picked] = len(vertices) + np.arange(corners.shape[0]).reshape(-1, 3)
-    source = np.concatenate([np.arange(len(vertices)), faces[picked].reshape(-1)])
-    return np.concatenate([vertices, corners + directions * offset * _edge(vertices, faces)]), moved, source
 
 
 def _cases():
@@ -80,7 +50,12 @@ def run(tag: str, folder: str) -> None:
     os.makedirs(folder, exist_ok=True)
     for base, kind, args in _cases():
         mesh = BASES[base]()
-        vertices, faces, source = _cap(mesh, *args) if kind == "cap" else _detach(mesh, *args)
+        if kind == "cap":  # a cap of 30% of the vertices, noise of `amplitude` edge lengths along the normals
+            amplitude, seed, _ = args
+            vertices, faces, source, _ = patch(mesh, seed, amplitude)
+        else:  # a `share` of the faces detached by `offset` edge lengths
+            share, offset, seed = args
+            vertices, faces, source, _ = holey(mesh, seed, share, offset)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             result = meshcurv.principal_curvatures(vertices, faces)
