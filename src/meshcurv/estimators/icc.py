@@ -814,7 +814,8 @@ def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarr
     """The vertices of :func:`voxel_pilot`'s fits and sums: in each cube of side :data:`PILOT_CELL_EDGES` median
     edge lengths (:func:`meshcurv.jets.turned_cubes`), the valid referenced vertex nearest the cube's middle, ties
     taken by the turned coordinates (never by the index: re-indexed vertices give the same centres, and a mirror
-    image of the mesh the mirrored ones; the cubes of the coordinate axes: a rotated mesh gets other centres)."""
+    image of the mesh the mirrored ones; the cubes of the vertices' axes: :func:`voxel_pilot` turns the vertices of
+    a turned grid into its axes, :func:`_grid_axes`, so that a rotated voxel surface gets the same centres)."""
     members = np.flatnonzero(valid & topology.referenced_vertices)
     if members.size == 0:
         return members
