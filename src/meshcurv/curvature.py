@@ -220,7 +220,8 @@ def _computed(vertices, faces, estimator, options: dict, orient: str, weld, prog
     found: dict = {}
     stages = Stages(estimator.stages, progress)  # stages.voxel: the mesh's voxel grid, read once for the call
     if "radius" in options and options["radius"] is None:
-        voxel = _voxel_surface_radius(mesh, voxel_pilot(mesh), stages.voxel)  # one default for every ball method
+        # one default for every ball method (the pilot reads a turned grid in its axes: the reading)
+        voxel = _voxel_surface_radius(mesh, voxel_pilot(mesh, reading=stages.voxel), stages.voxel)
         if voxel is not None:
             options["radius"], found = voxel
             stages.voxel_default = True

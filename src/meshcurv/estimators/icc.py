@@ -161,6 +161,7 @@ from ..radius import (
     _patch_radii,
     _scale_centres,
     _vertex_radii,
+    VoxelReading,
     _voxel_surface,
     scale_ladder,
     stable_scales,
@@ -602,7 +603,7 @@ def _mesh_edge(mesh: PreparedMesh) -> float:
     return mesh.median_edge_length if mesh.topology.n_edges else np.inf
 
 
-def voxel_pilot(mesh: PreparedMesh):
+def voxel_pilot(mesh: PreparedMesh, *, reading: VoxelReading | None = None):
     """The first pass of :func:`meshcurv.radius.voxel_surface_radius`: ``radius -> (k_min, k_max, valid, normals)``.
 
     icc over balls of ``radius`` at the centres of :func:`_pilot_centres` (about one vertex in two):
@@ -618,14 +619,20 @@ def voxel_pilot(mesh: PreparedMesh):
     surface's default radius moved by more than 2% in 11 of 128 draws of one vertex or two moved 1e3-1e6 sizes
     away (up to 12%; fuzz_api 575/106: 3.7%), none after (up to 1.4%). The needles themselves stay out of every
     reading (:func:`meshcurv.radius.voxel_surface_radius`).
+
+    ``reading``: the call's :class:`meshcurv.radius.VoxelReading`; a grid turned off x, y and z is read in its
+    own axes (:func:`_grid_axes`).
     """
     given = mesh
     read: list[PreparedMesh] = []  # the mesh the pilot reads: found at its first call (a smooth mesh never calls it)
+    turns: list = []  # ... and the grid's axes it is turned into (None: as given)
 
     def run(radius: float):
         if not read:
-            read.append(_needles_put_back(given) if given.needles.any() else given)
-        mesh = read[0]
+            kept = _needles_put_back(given) if given.needles.any() else given
+            turns.append(_grid_axes(given, reading))
+            read.append(kept if turns[0] is None else kept.with_vertices(kept.vertices @ turns[0].T))
+        mesh, axes = read[0], turns[0]
         vertices, topology = mesh.vertices, mesh.topology
         _, valid = mesh.start(boundary=True)
         valid = _scale_centres(mesh, valid, mesh.vertex_normals)  # a needle's corners: as without it
@@ -653,9 +660,42 @@ def voxel_pilot(mesh: PreparedMesh):
         k_min = np.full(vertices.shape[0], np.nan)
         k_max = np.full(vertices.shape[0], np.nan)
         k_min[centres], k_max[centres], _, _ = curvatures_from_measures(summed, normals[centres])
-        return k_min, k_max, valid, normals
+        return k_min, k_max, valid, normals if axes is None else normals @ axes
 
     return run
+
+
+def _grid_axes(mesh: PreparedMesh, reading: VoxelReading | None) -> np.ndarray | None:
+    """(3, 3) the axes (rows) of the voxel grid of ``mesh`` that ``reading`` holds where it is turned off x, y and
+    z (:attr:`meshcurv.lattice.VoxelGrid.frame`), as a rotation (the last row flipped where they are a mirror's
+    axes: a mirror image would flip the faces' winding); else None.
+
+    The voxel default's cube grids (the pilot's centres, the samples of its fits and sums, the coarse level and
+    the clusters of the coarse sums: :func:`meshcurv.jets.turned_cubes`) are laid along the axes of the points
+    they are given: the vertices turned into these axes get the cubes a mesh along them would (issue 29: a
+    turned ``voxel_torus(10, 4)``'s k moved by up to 7.7% of its largest ``|k|``, its default radius by 0.3%).
+    """
+    grid = None if reading is None else reading.mesh_grid(mesh)
+    if grid is None or grid.frame is None:
+        return None
+    axes = np.array(grid.frame, dtype=np.float64)
+    if np.linalg.det(axes) < 0:
+        axes[2] = -axes[2]
+    return axes
+
+
+def _along(vectors: np.ndarray, axes: np.ndarray | None) -> np.ndarray:
+    """``vectors`` (..., 3) in the ``axes`` of :func:`_grid_axes` (rows; None: as given)."""
+    return vectors if axes is None else vectors @ axes.T
+
+
+def _turned_back(fields: tuple, axes: np.ndarray | None) -> tuple:
+    """:func:`_curvatures`' ``fields`` of vertices turned into ``axes`` (:func:`_along`), their directions and normals
+    turned back to x, y and z."""
+    if axes is None:
+        return fields
+    k_min, k_max, dir_min, dir_max, normals, *rest = fields
+    return (k_min, k_max, dir_min @ axes, dir_max @ axes, normals @ axes, *rest)
 
 
 def _needles_put_back(mesh: PreparedMesh) -> PreparedMesh:
@@ -774,7 +814,8 @@ def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarr
     """The vertices of :func:`voxel_pilot`'s fits and sums: in each cube of side :data:`PILOT_CELL_EDGES` median
     edge lengths (:func:`meshcurv.jets.turned_cubes`), the valid referenced vertex nearest the cube's middle, ties
     taken by the turned coordinates (never by the index: re-indexed vertices give the same centres, and a mirror
-    image of the mesh the mirrored ones; the cubes of the coordinate axes: a rotated mesh gets other centres)."""
+    image of the mesh the mirrored ones; the cubes of the vertices' axes: :func:`voxel_pilot` turns the vertices of
+    a turned grid into its axes, :func:`_grid_axes`, so that a rotated voxel surface gets the same centres)."""
     members = np.flatnonzero(valid & topology.referenced_vertices)
     if members.size == 0:
         return members
@@ -1229,11 +1270,12 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         return _adaptive(mesh, groups[0][0], parameters, defects, valid, stages)
     if vertex_scale is not None:  # a voxel surface: each vertex at the scale its pilot calls for
         radii_v, normal_radii = vertex_scale
-        k_min, k_max, dir_min, dir_max, normals, valid, radii_v = _curvatures(
-            vertices,
+        axes = _grid_axes(mesh, stages.voxel)  # (its cube grids along the grid's axes)
+        computed = _curvatures(
+            _along(vertices, axes),
             topology.faces,
             degenerate,
-            normals,
+            _along(normals, axes),
             valid,
             radii_v,
             stages,
@@ -1245,6 +1287,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             coarse=True,
             boundary_faces=_boundary_faces(topology),
         )
+        k_min, k_max, dir_min, dir_max, normals, valid, radii_v = _turned_back(computed, axes)
         parameters = {
             **parameters,
             "radius": float(np.median(radii_v)),
@@ -1259,11 +1302,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         base, radii_v = _patch_radii(mesh, groups, levels, fits, ratios, normals)
         even = np.all(ratios == 1.0)
         if np.all(np.isfinite(radii_v) & (radii_v > 0)) and not (even and np.array_equal(radii_v, base)):
-            k_min, k_max, dir_min, dir_max, normals, valid, _ = _curvatures(
-                vertices,
+            wide = _coarse_fits(mesh, NORMAL_RADIUS_RATIO * radii_v, defects.invalid_vertices, stages)
+            axes = _grid_axes(mesh, stages.voxel) if wide else None  # (the coarse level along the grid's axes)
+            computed = _curvatures(
+                _along(vertices, axes),
                 topology.faces,
                 degenerate,
-                normals,
+                _along(normals, axes),
                 valid,
                 radii_v,
                 stages,
@@ -1274,8 +1319,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 weighted=not even,
                 topology=bounded,
                 cracked=bool(mesh.n_cracked),
-                coarse_fits=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * radii_v, defects.invalid_vertices, stages),
+                coarse_fits=wide,
             )
+            k_min, k_max, dir_min, dir_max, normals, valid, _ = _turned_back(computed, axes)
             return finish(
                 "icc",
                 {**parameters, "scale": "local"},
@@ -1290,11 +1336,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             )
     fields: tuple[np.ndarray, ...] | None = None
     for group_radius, members in groups:
+        wide = _coarse_fits(mesh, NORMAL_RADIUS_RATIO * group_radius, defects.invalid_vertices, stages)
+        axes = _grid_axes(mesh, stages.voxel) if wide else None  # (the coarse level along the grid's axes)
         computed = _curvatures(
-            vertices,
+            _along(vertices, axes),
             topology.faces,
             degenerate,
-            normals,
+            _along(normals, axes),
             valid,
             group_radius,
             stages if fields is None else None,
@@ -1304,8 +1352,9 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             areas=_vertex_areas(mesh),
             topology=bounded,
             cracked=bool(mesh.n_cracked),
-            coarse_fits=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * group_radius, defects.invalid_vertices, stages),
-        )[:-1]
+            coarse_fits=wide,
+        )
+        computed = _turned_back(computed, axes)[:-1]
         if members is None:
             fields = computed
             continue
@@ -1377,10 +1426,11 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         else []
     )
     areas = _vertex_areas(mesh) if len(fits) < len(radii) else None  # the coarse level's weights only
+    axes = _grid_axes(mesh, stages.voxel) if voxel else None  # (the coarse level along the grid's axes)
     normals = [
         fitted_normals(
-            vertices,
-            start_normals,
+            _along(vertices, axes),
+            _along(start_normals, axes),
             valid,
             NORMAL_RADIUS_RATIO * radius,
             neighbours=topology.referenced_vertices,
@@ -1388,11 +1438,12 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             areas=areas if j >= len(fits) else None,  # fitted already: no coarse level to look for
             edge=edge,
             failed=failed[j],
-            fits=fits[j] if j < len(fits) else None,
+            fits=_along(fits[j], axes) if j < len(fits) else None,
             coarse=voxel,
         )
         for j, radius in enumerate(radii)
     ]
+    normals = [rung if axes is None else rung @ axes for rung in normals]
     stages.start("compute face measures")
     measures = np.stack([face_measures(vertices, faces, rung) for rung in normals])
     kept = [_usable_faces(faces, degenerate, rung) for rung in normals]
@@ -1443,16 +1494,19 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     vertices, topology = mesh.vertices, mesh.topology
     faces = topology.faces
     stages.start("fit normals")
+    wide = _coarse_fits(mesh, NORMAL_RADIUS_RATIO * base, defects.invalid_vertices, stages)
+    axes = _grid_axes(mesh, stages.voxel) if wide else None  # (the coarse level along the grid's axes)
     normals = fitted_normals(
-        vertices,
-        mesh.vertex_normals,
+        _along(vertices, axes),
+        _along(mesh.vertex_normals, axes),
         valid,
         NORMAL_RADIUS_RATIO * base,
         neighbours=topology.referenced_vertices,
         adjacency=_adjacency(topology),
         areas=_vertex_areas(mesh),
-        coarse=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * base, defects.invalid_vertices, stages),
+        coarse=wide,
     )
+    normals = normals if axes is None else normals @ axes
     stages.start("compute face measures")
     measures = face_measures(vertices, faces, normals)
     stages.start("sum over balls")
