@@ -7,9 +7,10 @@ vertices, and a ball on such a piece holds a part of the staircase cut by cracks
 curvature only with the steps around, so a piece of the flat top plateau read H -0.018 for -0.1 (12 valid vertices,
 all off the clean shape's H by more than half of its largest ``|k|``). ``icc._stair_pieces`` left them valid: their
 balls held 0.403 to 0.407 of their disc, just above its bar of 0.4, and a plateau's faces lie along their normals,
-so the per-ball tilt test does not see a staircase there. The staircase is now read on the mesh (the median tilt of
-the balls near holes, ``icc.STAIR_MESH_TILT``), and on a staircase a ball near holes must hold
-``icc.STAIR_MESH_SHARE`` of its disc. These tests fail on c578a21.
+so the per-ball tilt test does not see a staircase there. Now a mesh welded across cracks that reads a voxel grid as
+a soup (``quadric``'s reading, ``meshcurv.radius.soup_voxel_grid``) leaves undefined the balls near holes on a piece
+smaller than two of their discs (``icc.STAIR_PIECE_DISCS``): the piece cannot hold the steps around. These tests
+fail on c578a21.
 
 Oracles: the exact mean curvature of the voxelised ball (``1 / R``, signed by the returned normal against the
 outward one), with the fuzzer's bar (a valid vertex off by more than half of it is a wrong number marked valid);
