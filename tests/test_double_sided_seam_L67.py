@@ -5,8 +5,9 @@ points its vertices share (:func:`meshcurv._prepared._second_side_apart`); each 
 vertex at its point, so a side with coincident vertices of its own (a seam of copies: ogre.obj has 9) was given
 up and computed as two surfaces: area twice, H summed to 0, no warning (fuzz_api 730/156, ogre doubled). The
 oracles: the one-sided mesh's own result (the same faces and vertices: matGeom's numbers, bit for bit), on both
-halves, and its area counted once. Open (strict xfail): a seamed side kept while the second side, on copies, has
-no seam: a dropped vertex then twins two kept copies and the second side is left as given (area twice).
+halves, and its area counted once. A seamed side kept while the second side, on copies, has no seam: a dropped
+vertex repeats the corners of two kept copies and the second side was left as given (area twice, G68's strict
+xfail); its twin is now the copy most of its faces repeat (``_prepared._twins_by_faces``).
 """
 
 import warnings
@@ -58,17 +59,7 @@ def test_a_seamed_side_stored_twice_apart_is_measured_once(mesh, options, seed, 
 @pytest.mark.parametrize("backend", ["numba", "numpy"])
 @pytest.mark.parametrize(
     "seamed_first",
-    [
-        pytest.param(
-            True,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="open (G68, stop 68): a seamed side kept, the second side on copies without the seam: a dropped "
-                "vertex twins two kept copies, the second side is left as given (area twice)",
-            ),
-        ),
-        False,
-    ],
+    [True, False],
 )
 def test_a_second_side_without_the_seam_is_measured_once(seamed_first, backend):
     # the same surface, one side with a seam of copies, the other side on copies of the vertices without it: the
@@ -87,3 +78,11 @@ def test_a_second_side_without_the_seam_is_measured_once(seamed_first, backend):
         both, message = _computed(vertices, faces, method="matgeom")
     assert both.parameters["n_double_sided_faces"] == plain_faces.shape[0], message
     assert both.integral("area") == pytest.approx(one.integral("area"), rel=1e-12)
+    # the side kept is the first, measured as given alone (matGeom's numbers bit for bit); each row of the second
+    # takes the values of a copy of its point on the first (a seam's copies differ: the one most of its faces repeat)
+    with chosen_backend(backend):
+        first, _ = _computed(first_vertices, first_faces, method="matgeom")
+    n = first_vertices.shape[0]
+    np.testing.assert_array_equal(both.mean[:n], first.mean)
+    at_point = (second_vertices[:, None, :] == first_vertices[None, :, :]).all(axis=2)
+    assert (at_point & (both.mean[n:, None] == first.mean[None, :])).any(axis=1).all()

@@ -574,10 +574,16 @@ def _twins_by_faces(faces: np.ndarray, wanted: np.ndarray, point_of: np.ndarray)
         return None
     partners = kept[order[at]]
     ends, starts = dropped.reshape(-1), partners.reshape(-1)
+    # a dropped vertex at a seam of the kept side (copies of one point, each in some of the kept faces) repeats the
+    # corners of several copies: its twin is the copy the most of its faces repeat, then the first (G68's open case:
+    # a seamed side kept, the second side on copies without the seam, was left as given: area twice)
+    pairs, counts = np.unique(np.column_stack([ends, starts]), axis=0, return_counts=True)
+    pairs = pairs[np.lexsort((pairs[:, 1], -counts, pairs[:, 0]))]
+    first = np.r_[True, pairs[1:, 0] != pairs[:-1, 0]]
     claimed = np.full(n_vertices, -1, dtype=np.int64)
-    claimed[ends] = starts
+    claimed[pairs[first, 0]] = pairs[first, 1]
     shared = twin[ends] >= 0  # a vertex of both sides: its own twin
-    if (claimed[ends] != starts).any() or (starts[shared] != ends[shared]).any():
+    if (point_of[starts] != point_of[claimed[ends]]).any() or (starts[shared] != ends[shared]).any():
         return None
     free = twin < 0
     twin[free] = claimed[free]

@@ -978,6 +978,7 @@ def _curvatures(
     boundary_faces: np.ndarray | None = None,
     topology: MeshTopology | None = None,
     cracked: bool = False,
+    pieces: np.ndarray | None = None,
     edge: float,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
@@ -993,8 +994,8 @@ def _curvatures(
     (:func:`_corners_fitted`) and, near holes (:func:`_near_holes`), the fits whose balls wrap are made again
     (:func:`_unwrapped_normals`). ``cracked``: the mesh was welded across cracks (``PreparedMesh.n_cracked``): near
     holes, the pieces whose fits scatter (:func:`_scattered_pieces`) or whose balls hold a small piece of a staircase
-    (:func:`_stair_pieces`) are undefined. ``edge``: the median length of every edge (:func:`_mesh_edge`: the
-    coarse level's test and the scatter's ball).
+    (:func:`_stair_pieces`; ``pieces``: a voxel surface's soup's, :func:`_soup_pieces`) are undefined.
+    ``edge``: the median length of every edge (:func:`_mesh_edge`: the coarse level's test and the scatter's ball).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -1074,7 +1075,7 @@ def _curvatures(
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
         if ball_areas is not None:
-            valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts))
+            valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts), pieces)
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
 
 
@@ -1135,15 +1136,51 @@ STAIR_TILT = 0.99
 #: 0.6 of their disc (the others 0.1 to 0.76); half of ``voxel_sphere(6)``'s faces detached by 0.065 edges: 0 of
 #: 472 off, every ball above 0.4.
 STAIR_SHARE = 0.4
+#: On a voxel surface's soup (:func:`_soup_pieces`), a ball near holes on a piece (a component of the welded mesh)
+#: whose area is below this many times its disc's ``pi r^2`` is undefined: the piece is smaller than the ball, which
+#: cannot hold the steps around it, whatever share of its disc the piece fills (a flat piece of a plateau: its faces
+#: lie along their normals, no tilt). Every face of ``voxel_sphere(10)`` detached by 0.031 edges (issue 29, fuzz
+#: 750/289) kept 12 valid vertices off the clean shape's H by more than half of its largest ``|k|`` (a 42-face piece
+#: of its top plateau: H -0.018 for 0.1), in balls of 0.403 to 0.407 of their disc, just above :data:`STAIR_SHARE`;
+#: the valid vertices of such soups lie on pieces of 0.43 to 0.72 discs (seeds 0 and 3: 89 of 116 and 6 of 67 off),
+#: those of soups of half of the faces on pieces of 4.3 discs and more (none off: ``voxel_sphere(6)`` by 0.065
+#: edges, ``voxel_sphere(10)`` by 0.031).
+STAIR_PIECE_DISCS = 2.0
 
 
-def _stair_pieces(corrected, areas, radius, near) -> np.ndarray:
+def _stair_pieces(corrected, areas, radius, near, pieces: np.ndarray | None = None) -> np.ndarray:
     """(V,) bool: the ``near`` vertices whose ball's corrected area ``corrected`` (V,) is below :data:`STAIR_TILT`
-    of its faces' area ``areas`` (V,) and below :data:`STAIR_SHARE` of its disc (``radius``, a float or (V,))."""
+    of its faces' area ``areas`` (V,) and below :data:`STAIR_SHARE` of its disc (``radius``, a float or (V,)); and
+    those on a piece of area ``pieces`` (V,) (a voxel surface's soup, :func:`_soup_pieces`) below
+    :data:`STAIR_PIECE_DISCS` discs."""
     with np.errstate(invalid="ignore", divide="ignore"):
+        disc = np.pi * np.asarray(radius, dtype=np.float64) ** 2
         stair = corrected < STAIR_TILT * areas
-        sparse = corrected < STAIR_SHARE * np.pi * np.asarray(radius, dtype=np.float64) ** 2
+        sparse = corrected < STAIR_SHARE * disc
+        if pieces is not None:
+            return near & ((stair & sparse) | ~(pieces >= STAIR_PIECE_DISCS * disc))
     return near & stair & sparse
+
+
+def _soup_pieces(mesh: PreparedMesh, defects, valid: np.ndarray) -> np.ndarray | None:
+    """(V,) the area of each vertex's piece (its component) where ``mesh`` was welded across cracks and reads a voxel
+    grid as a soup (:func:`meshcurv.radius.soup_voxel_grid`, ``quadric``'s reading: its corners left the grid by the
+    cracks, so the default measures it as a smooth mesh, :func:`_stair_pieces`), else None."""
+    if not mesh.n_cracked:
+        return None
+    from ..radius import soup_voxel_grid
+    from .quadric import _crack_corners
+
+    topology = mesh.topology
+    rim = topology.boundary_vertices & topology.referenced_vertices
+    corners = _crack_corners(mesh.vertices, rim, mesh.scale_edge_means)
+    if soup_voxel_grid(mesh, invalid=defects.invalid_vertices, valid=valid, corners=corners) is None:
+        return None
+    _, labels = topology.face_components
+    piece_areas = np.bincount(labels, weights=face_areas(mesh.vertices, topology.faces))
+    out = np.zeros(mesh.vertices.shape[0])
+    out[topology.faces.ravel()] = np.repeat(piece_areas[labels], 3)
+    return out
 
 
 def _near_holes(vertices, topology: MeshTopology, radius, normal_radius, centres: np.ndarray) -> np.ndarray | None:
@@ -1296,6 +1333,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             "scale_rule": VOXEL_SCALE_RULE,
         }
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
+    pieces = _soup_pieces(mesh, defects, valid)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor,
         # more where its own noise calls for more (a noisy patch)
         ratios = _local_scale_ratios(mesh)
@@ -1319,6 +1357,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 weighted=not even,
                 topology=bounded,
                 cracked=bool(mesh.n_cracked),
+                pieces=pieces,
                 coarse_fits=wide,
             )
             k_min, k_max, dir_min, dir_max, normals, valid, _ = _turned_back(computed, axes)
@@ -1352,6 +1391,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             areas=_vertex_areas(mesh),
             topology=bounded,
             cracked=bool(mesh.n_cracked),
+            pieces=pieces,
             coarse_fits=wide,
         )
         computed = _turned_back(computed, axes)[:-1]
