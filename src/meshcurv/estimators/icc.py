@@ -122,12 +122,16 @@ corrected curvature measures for polygonal surfaces. Computer Graphics Forum
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from .._geometry import face_areas, finite_rows, median_edge_length
 from .._backend import numba_kernels
 from .._tensors import tangent_basis
 from ..jets import (
+    THIN_BEND,
+    THIN_WIDEN,
     AWAY_FRACTION,
     NORMAL_MIN_SPREAD,
     SAMPLED_SPREAD,
@@ -167,6 +171,7 @@ from ..radius import (
 )
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
+from ..defects import REACH
 from ._support import Stages, failed_fits_undefined, finish
 
 #: Degree of the jets whose normals the measures interpolate.
@@ -222,6 +227,20 @@ HOLE_MIN_SHARE = 0.2
 #: 1,549 valid vertices read H of the wrong sign, at -0.33 to -0.85 here; no other below 0.82; at 0.7, 200 more
 #: vertices of a holed voxel torus undefined, none of them off).
 HOLE_FACING = 0.5
+#: A ball of the sums on a mesh (not a voxel surface at its default) holds the other side of a part thinner than it
+#: where its faces' area vectors, summed, have a component along the centre's normal (over its corrected area: its
+#: facing ``f``) below what a ball of its own curvatures would have by more than this: ``f < 1 - r^2 (k_1^2 +
+#: k_2^2) / 8 - THIN_FACING`` (a sphere's ball: ``1 - (r k)^2 / 4`` exactly). Its sums then hold both sides, and
+#: the vertex is undefined (reason :data:`meshcurv.defects.REACH`). Issue 29 (T68): the clean ellipsoid (3, 3, 0.15)
+#: at 16 subdivisions, balls of 0.18 at its rim 0.06 to 0.13 thick: 0.72-0.86 below (H of the wrong sign at valid
+#: vertices); the coarse closed meshes whose balls wrap round their own bend (an icosahedron, ``torus(3, 1, 8, 4)``,
+#: ``icosphere(2)``) within 0.03, the coarse ellipsoid (3, 2, 1) at 4 subdivisions (162 vertices) up to 0.46.
+THIN_FACING = 0.5
+#: On a mesh other than a voxel surface at its default, a normal fit whose ball wraps round a part thinner than it
+#: is fitted again over its own side where the same-side cubic's largest ``|k| r`` is below this
+#: (:func:`meshcurv.jets._thin_part_normals`; a voxel surface's: :data:`meshcurv.jets.THIN_BEND`, its terraces'):
+#: a ball wraps round its own bend only where ``k r`` reaches about ``sqrt(2)``.
+SMOOTH_THIN_BEND = 1.0
 
 
 STAGES = (
@@ -250,6 +269,7 @@ def fitted_normals(
     unwrap: np.ndarray | None = None,
     counts: np.ndarray | None = None,
     thin: bool = False,
+    widen: float = THIN_WIDEN,
     coarse: bool = False,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
@@ -276,9 +296,13 @@ def fitted_normals(
     again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes); ``counts`` (V,)
     float, when given, is set in place to the number of points of their first fits (unchanged elsewhere).
 
-    ``thin``: a voxel surface; the fits on its thin flat parts (balls that wrap round a part thinner than them while
-    their jets hardly bend) are made again over wider balls of the points that face the centre's way
-    (:func:`meshcurv.jets._thin_part_normals`; not on the coarse level).
+    ``thin``: the fits on thin flat parts (balls that wrap round a part thinner than them while their jets hardly
+    bend) are made again over balls ``widen`` times wider of the points that face the centre's way
+    (:func:`meshcurv.jets._thin_part_normals`; not on the coarse level): a voxel surface's over wider balls
+    (:data:`meshcurv.jets.THIN_WIDEN`, its terraces; at samples of the centres), a smooth mesh's over the same balls
+    at every centre (1: the other side of a
+    thin rim tilted the fits of a clean ellipsoid (3, 3, 0.15) by 3.6-7 degrees over a band 0.8-0.95 of its radius,
+    and H took the wrong sign there; issue 29, T68).
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -363,6 +387,9 @@ def fitted_normals(
                 iterations=NORMAL_ITERATIONS,
                 settled=NORMAL_SETTLED,
                 min_spread=NORMAL_MIN_SPREAD,
+                widen=widen,
+                sampled=widen != 1.0,
+                bend=THIN_BEND if widen != 1.0 else SMOOTH_THIN_BEND,
             )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
@@ -938,6 +965,7 @@ def _curvatures(
     topology: MeshTopology | None = None,
     cracked: bool = False,
     edge: float,
+    reached: np.ndarray | None = None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -954,6 +982,11 @@ def _curvatures(
     holes, the pieces whose fits scatter (:func:`_scattered_pieces`) or whose balls hold a small piece of a staircase
     (:func:`_stair_pieces`) are undefined. ``edge``: the median length of every edge (:func:`_mesh_edge`: the
     coarse level's test and the scatter's ball).
+
+    The normal fits on thin flat parts are made again over their own side (:func:`fitted_normals` ``thin``).
+    ``reached`` (V,) bool, when given (not on a voxel surface at its default): set True, in place, at the vertices
+    whose ball of the sums holds the other side of a thin part (:data:`THIN_FACING`), left out of the ``valid``
+    returned.
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -994,7 +1027,8 @@ def _curvatures(
             edge=edge,
             unwrap=near,
             counts=counts,
-            thin=coarse,
+            thin=True,
+            widen=THIN_WIDEN if coarse else 1.0,
             coarse=coarse or coarse_fits,
         )
 
@@ -1010,6 +1044,12 @@ def _curvatures(
         corners = vertices[faces]
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
+    facing_columns = reached is not None and boundary_faces is None and not coarse
+    if facing_columns:  # three more columns: the faces' area vectors (the other side of a thin part: THIN_FACING)
+        corners = vertices[faces]
+        measures = np.column_stack(
+            [measures, 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])]
+        )
     areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
     if areas_column:
         measures = np.column_stack([measures, face_areas(vertices, faces)])
@@ -1024,12 +1064,22 @@ def _curvatures(
     ball_areas = None
     if areas_column:
         summed, ball_areas = summed[:, :-1], summed[:, -1]
+    facing = None
+    if facing_columns:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            facing = np.einsum("ij,ij->i", normals, summed[:, -3:]) / summed[:, 0]
+        summed = summed[:, :-3]
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
     valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, failed)
     if sparse is not None:
         valid &= ~sparse
+    if facing is not None and reached is not None:
+        with np.errstate(invalid="ignore", over="ignore"):
+            bent = 1.0 - np.asarray(radius) ** 2 * (k_min**2 + k_max**2) / 8.0  # a ball of its own curvatures'
+            reached |= valid & (facing < bent - THIN_FACING)
+        valid &= ~reached
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
         if ball_areas is not None:
@@ -1253,6 +1303,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             "scale_rule": VOXEL_SCALE_RULE,
         }
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
+    reached = np.zeros(vertices.shape[0], dtype=bool)  # balls holding a thin part's other side (THIN_FACING)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor,
         # more where its own noise calls for more (a noisy patch)
         ratios = _local_scale_ratios(mesh)
@@ -1275,21 +1326,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 topology=bounded,
                 cracked=bool(mesh.n_cracked),
                 coarse_fits=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * radii_v, defects.invalid_vertices, stages),
+                reached=reached,
             )
-            return finish(
-                "icc",
-                {**parameters, "scale": "local"},
-                valid,
-                normals,
-                k_min,
-                k_max,
-                dir_min,
-                dir_max,
-                defects,
-                radius=radii_v,
-            )
+            local = (k_min, k_max, dir_min, dir_max, normals, valid)
+            return _finished({**parameters, "scale": "local"}, local, defects, radii_v, reached)
     fields: tuple[np.ndarray, ...] | None = None
     for group_radius, members in groups:
+        group_reached = np.zeros_like(reached)
         computed = _curvatures(
             vertices,
             topology.faces,
@@ -1305,6 +1348,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             topology=bounded,
             cracked=bool(mesh.n_cracked),
             coarse_fits=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * group_radius, defects.invalid_vertices, stages),
+            reached=reached if members is None else group_reached,
         )[:-1]
         if members is None:
             fields = computed
@@ -1313,21 +1357,22 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             fields = tuple(np.array(field, copy=True) for field in computed)
         for field, values in zip(fields, computed):
             field[members] = values[members]
+        reached[members] = group_reached[members]
     if fields is None:
         raise RuntimeError("default_radii gave no group")
+    return _finished(parameters, fields, defects, _vertex_radii(groups, vertices.shape[0]), reached)
+
+
+def _finished(parameters: dict, fields: tuple, defects, radius: np.ndarray, reached: np.ndarray) -> tuple:
+    """:func:`finish`'s ``(result, problems)`` of ``fields`` (``k_min, k_max, dir_min, dir_max, normals, valid``)
+    with the reason :data:`meshcurv.defects.REACH` at the ``reached`` (V,) vertices (balls holding a thin part's
+    other side, :data:`THIN_FACING`; a defect's code still comes first)."""
     k_min, k_max, dir_min, dir_max, normals, valid = fields
-    return finish(
-        "icc",
-        parameters,
-        valid,
-        normals,
-        k_min,
-        k_max,
-        dir_min,
-        dir_max,
-        defects,
-        radius=_vertex_radii(groups, vertices.shape[0]),
-    )
+    result, problems = finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radius)
+    if not reached.any():
+        return result, problems
+    codes = np.where(reached & ~result.valid, REACH, 0).astype(np.int8)
+    return dataclasses.replace(result, invalid_reason=codes), problems
 
 
 def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tuple]:
