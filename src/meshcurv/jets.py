@@ -804,8 +804,10 @@ def _fit_jet_normals(
     settled: float = 0.0,
     areas: np.ndarray | None = None,
     min_spread: float = MIN_SPREAD,
+    facing: np.ndarray | None = None,
 ) -> np.ndarray:
-    """:func:`fit_jet_normals` on ``vertices`` already checked (as :func:`_fit_jets`)."""
+    """:func:`fit_jet_normals` on ``vertices`` already checked (as :func:`_fit_jets`); with ``facing`` (V, 3), the
+    fits whose balls hold more than :data:`AWAY_FRACTION` of their points facing away are refused (NaN), as there."""
     kernels = numba_kernels("jets")
     n = vertices.shape[0]
     if kernels is None or adjacency is None or n == 0:
@@ -820,8 +822,13 @@ def _fit_jet_normals(
             settled=settled,
             areas=areas,
             min_spread=min_spread,
+            facing=facing,
         )
         return jet_normals(coefficients, frame)
+    if facing is not None:
+        facing = np.ascontiguousarray(facing, dtype=np.float64)
+        if facing.shape != vertices.shape:
+            raise InvalidMeshError(f"`facing` must have shape {vertices.shape}; got {facing.shape}")
     normals = np.ascontiguousarray(normals, dtype=np.float64)
     if normals.shape != vertices.shape:
         raise InvalidMeshError(f"`normals` must have shape {vertices.shape}; got {normals.shape}")
@@ -844,7 +851,7 @@ def _fit_jet_normals(
         mean,
         neighbours,
         adjacency,
-        None,
+        facing,
         settled,
         normals_only=True,
         areas=_checked_areas(areas, n),

@@ -351,6 +351,7 @@ def fitted_normals(
     elif fits is not None:
         fitted = fits
     else:
+        smooth = thin and widen == 1.0 and adjacency is not None  # (a smooth mesh's thin parts: below)
         fitted = _fit_jet_normals(
             vertices,
             start,
@@ -362,7 +363,27 @@ def fitted_normals(
             settled=NORMAL_SETTLED,
             areas=areas if weighted else None,
             min_spread=NORMAL_MIN_SPREAD,
+            facing=start if smooth else None,
         )
+        wrapped = None
+        if smooth:  # the fits refused for holding points facing away (or failed), made again without the check
+            wrapped = np.flatnonzero(valid & ~finite_rows(fitted))
+            if wrapped.size:
+                coefficients, frame, _ = _fit_jets(
+                    vertices,
+                    start,
+                    radius if np.ndim(radius) == 0 else np.asarray(radius)[wrapped],
+                    degree=NORMAL_DEGREE,
+                    iterations=NORMAL_ITERATIONS,
+                    centres=wrapped,
+                    neighbours=neighbours,
+                    adjacency=adjacency,
+                    settled=NORMAL_SETTLED,
+                    compact=True,
+                    areas=areas if weighted else None,
+                    min_spread=NORMAL_MIN_SPREAD,
+                )
+                fitted[wrapped] = jet_normals(coefficients, frame)
         if unwrap is not None and adjacency is not None:
             fitted = _unwrapped_normals(
                 vertices,
@@ -375,12 +396,12 @@ def fitted_normals(
                 areas if weighted else None,
                 counts=counts,
             )
-        if thin and adjacency is not None:
+        if thin and adjacency is not None and (wrapped is None or wrapped.size):
             fitted = _thin_part_normals(
                 vertices,
                 np.where(valid[:, None], fitted, normals),
                 radius,
-                np.flatnonzero(valid),
+                np.flatnonzero(valid) if wrapped is None else wrapped,
                 neighbours=neighbours,
                 adjacency=adjacency,
                 degree=NORMAL_DEGREE,
