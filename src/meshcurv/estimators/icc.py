@@ -109,6 +109,22 @@ so the default radius and the curvatures do not depend on whether numba is
 installed (issue 29: a 3 x 3 x 0.15 ellipsoid had a default radius of 0.118
 with numba and 0.538 without).
 
+Where the part is thinner than the ball and its rim lies within it, the connected
+ball holds the other side, round the rim, on one side of the centre. A normal fit
+whose ball holds points facing away (by the vertex normals, in the fit's own walk)
+is made again without that check, and where the cubic over its own side hardly
+bends (:data:`SMOOTH_THIN_BEND`; a ball wraps round its own bend only where ``k r``
+reaches about ``sqrt(2)``) over its own side (:func:`meshcurv.jets._thin_part_normals`;
+on a voxel surface over wider balls, its terraces); a ball of the sums whose
+faces' area vectors face the centre's way far less than a ball of its own
+curvatures would (:data:`THIN_FACING`) holds both sides, and its vertex is
+undefined with the reason "ball reaches round the surface". (Issue 29: the clean
+ellipsoid (3, 3, 0.15) at 16 subdivisions, every vertex valid and H of the wrong
+sign over 0.8-0.95 of its radius, 1,048 vertices off by more than half of the
+largest ``|k|``; none now, 844 undefined at the rim; ``benchmarks/thin_band_T68.md``.)
+A coarse closed mesh whose balls wrap round its own bend (an icosahedron, a torus
+of 8 x 4 vertices) keeps its values: those balls are symmetric and their fits right.
+
 References
 ----------
 F. Cazals and M. Pouget (2005). Estimating differential quantities using
@@ -453,7 +469,8 @@ def _unwrapped_normals(
     turns by up to 90 degrees between the vertices of a staircase) wraps around the surface, and a jet over the
     tangent plane describes no height function there. Where the surface around is whole such a ball is about
     symmetric and its normal comes out right (a coarse sphere, a cylinder under noise: smaller balls there are
-    only noisier, so only the vertices near holes are checked); with holes, cracks or faces detached beyond the
+    only noisier, so only the vertices near holes are checked here; the rim of a part thinner than the ball is
+    the exception, :func:`fitted_normals` ``thin``); with holes, cracks or faces detached beyond the
     weld the points left are lopsided and tilt the fit (issue 29: ``shapes.uv_sphere(12, 8)``, half of its faces
     detached by 0.065 edge lengths: fitted normals 13.5 degrees off the sphere's at the median, 2.5 intact, and H
     of 0.35-0.85 for 1 at 10 of 59 valid vertices; with the exact normals the same sums give 1 to 0.004). Those
