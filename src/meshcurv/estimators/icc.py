@@ -252,6 +252,23 @@ HOLE_FACING = 0.5
 #: vertices); the coarse closed meshes whose balls wrap round their own bend (an icosahedron, ``torus(3, 1, 8, 4)``,
 #: ``icosphere(2)``) within 0.03, the coarse ellipsoid (3, 2, 1) at 4 subdivisions (162 vertices) up to 0.46.
 THIN_FACING = 0.5
+#: ... but only where the ball's area vectors ``a`` cancel too, as the two sides of a thin part do: the length of
+#: their sum ``S`` over the corrected area lies more than this below the same ``1 - r^2 (k_1^2 + k_2^2) / 8`` ...
+THIN_CANCEL = 0.3
+#: ... and more than this of ``(n^T T n - n . S) / trace T`` (``T = sum a a^T / |a|`` the faces' sign-blind normal
+#: tensor: a face at cosine ``c`` to the centre's normal ``n`` adds ``(c^2 - c)`` times its area, 2 facing away, 0
+#: at right angles, at most 1/4 less facing ``n``'s way: ``g``, twice the share of the area facing away) says
+#: that area faces away from ``n``. A low facing alone comes from a fold of one surface as well: the 90-degree
+#: crease between a label's closing cap and its wall where the image border cuts it (T69: a hemisphere of radius 9
+#: voxels cut on its equator, 19 vertices 0.5-1.5 voxels from the cap, their normals 23-57 degrees off the sphere's)
+#: has ``f`` 0.11-0.41 for a ball of its curvatures' 0.88-0.93, but ``|S|`` only 0.17-0.26 below it (a fold's
+#: faces at right angles, a share ``w`` of the area: ``f = 1 - w``, ``|S| = sqrt((1 - w)^2 + w^2)``, 0.71 at
+#: ``w = 1/2``) and ``g`` 0.16-0.30 (0.38 at the vertex whose normal is 57 degrees off): each test alone leaves
+#: a margin of 0.03-0.05 at most (the ellipsoid (1, 1, 0.08): ``g`` from 0.385; ``|S|`` alone at 0.35 let valid
+#: vertices off by more than half of the largest ``|k|`` back, 288 -> 364), the two together none of the 19 and
+#: the same vertices off on ``benchmarks/thin_band_T68.py`` as the facing alone. The label path leaves those
+#: crease vertices out of its statistics anyway (:mod:`meshcurv.volume`).
+THIN_OPPOSITE = 0.25
 #: On a mesh other than a voxel surface at its default, a normal fit whose ball wraps round a part thinner than it
 #: is fitted again over its own side where the same-side cubic's largest ``|k| r`` is below this
 #: (:func:`meshcurv.jets._thin_part_normals`; a voxel surface's: :data:`meshcurv.jets.THIN_BEND`, its terraces'):
@@ -1083,11 +1100,8 @@ def _curvatures(
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
     facing_columns = reached is not None and boundary_faces is None and not coarse
-    if facing_columns:  # three more columns: the faces' area vectors (the other side of a thin part: THIN_FACING)
-        corners = vertices[faces]
-        measures = np.column_stack(
-            [measures, 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])]
-        )
+    if facing_columns:  # nine more columns: the faces' area vectors and normal tensors (THIN_FACING)
+        measures = np.column_stack([measures, _facing_measures(vertices, faces)])
     areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
     if areas_column:
         measures = np.column_stack([measures, face_areas(vertices, faces)])
@@ -1104,9 +1118,7 @@ def _curvatures(
         summed, ball_areas = summed[:, :-1], summed[:, -1]
     facing = None
     if facing_columns:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            facing = np.einsum("ij,ij->i", normals, summed[:, -3:]) / summed[:, 0]
-        summed = summed[:, :-3]
+        summed, facing = summed[:, :-FACING_COLUMNS], summed[:, -FACING_COLUMNS:]
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
@@ -1114,15 +1126,57 @@ def _curvatures(
     if sparse is not None:
         valid &= ~sparse
     if facing is not None and reached is not None:
-        with np.errstate(invalid="ignore", over="ignore"):
-            bent = 1.0 - np.asarray(radius) ** 2 * (k_min**2 + k_max**2) / 8.0  # a ball of its own curvatures'
-            reached |= valid & (facing < bent - THIN_FACING)
+        reached |= _reaching(facing, summed[:, 0], normals, radius, k_min, k_max, valid)
         valid &= ~reached
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
         if ball_areas is not None:
             valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts))
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
+
+
+#: The columns of :func:`_facing_measures`.
+FACING_COLUMNS = 9
+
+
+def _facing_measures(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, :data:`FACING_COLUMNS`) each face's area vector ``a`` and its sign-blind normal tensor ``a a^T / |a|``
+    (xx, yy, zz, xy, xz, yz): summed over a ball, what :func:`_reaching` reads (a degenerate face adds 0)."""
+    corners = vertices[faces]
+    sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    size = np.linalg.norm(sides, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(size[:, None] > 0, sides / size[:, None], 0.0)
+    rows, columns = [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]
+    return np.column_stack([sides, size[:, None] * unit[:, rows] * unit[:, columns]])
+
+
+def _reaching(facing, area, normals, radius, k_min, k_max, valid) -> np.ndarray:
+    """(V,) bool: the ``valid`` vertices whose ball of the sums holds the other side of a thin part.
+
+    ``facing`` (V, :data:`FACING_COLUMNS`): the sums over each ball of :func:`_facing_measures` (``S`` the area
+    vectors', ``T`` the tensors'); ``area`` (V,) its corrected area; ``normals`` ``n``, ``radius`` (float or (V,)),
+    ``k_min``, ``k_max`` those of the vertex. Where the ball holds the other side, its facing ``f = n . S / area``
+    lies more than :data:`THIN_FACING` below a ball of its own curvatures' (``1 - r^2 (k_1^2 + k_2^2) / 8``),
+    its area vectors cancel (``|S| / area`` more than :data:`THIN_CANCEL` below the same) and a share of its area
+    faces away from ``n`` (:data:`THIN_OPPOSITE`); a fold of one surface tilts ``S`` off ``n`` (``f`` low) but
+    cancels little.
+    """
+    n = normals
+    tensor = facing[:, 3:]
+    squared = (
+        tensor[:, 0] * n[:, 0] ** 2
+        + tensor[:, 1] * n[:, 1] ** 2
+        + tensor[:, 2] * n[:, 2] ** 2
+        + 2.0 * (tensor[:, 3] * n[:, 0] * n[:, 1] + tensor[:, 4] * n[:, 0] * n[:, 2] + tensor[:, 5] * n[:, 1] * n[:, 2])
+    )
+    along = np.einsum("ij,ij->i", n, facing[:, :3])
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        bent = 1.0 - np.asarray(radius) ** 2 * (k_min**2 + k_max**2) / 8.0  # a ball of its own curvatures'
+        tilted = along / area < bent - THIN_FACING
+        cancelled = np.linalg.norm(facing[:, :3], axis=1) / area < bent - THIN_CANCEL
+        opposite = (squared - along) / (tensor[:, 0] + tensor[:, 1] + tensor[:, 2]) > THIN_OPPOSITE
+    return valid & tilted & cancelled & opposite
 
 
 #: Near holes (:func:`_near_holes`), a vertex is undefined where its points scatter by more than
