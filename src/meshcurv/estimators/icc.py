@@ -383,6 +383,42 @@ def fitted_normals(
         )
     elif fits is not None:
         fitted = fits
+        if thin and widen == 1.0 and adjacency is not None:  # the fits a first fit would refuse, as below
+            fitted = np.array(fits, copy=True)
+            wrapped = np.flatnonzero(valid & ~finite_rows(fitted))
+            centres = np.flatnonzero(valid & finite_rows(fitted))
+            details: dict = {}
+            _fit_jets(  # the share facing away alone (the walk and the check, no moments: _thin_part_normals)
+                vertices,
+                start,
+                radius if np.ndim(radius) == 0 else np.asarray(radius)[centres],
+                degree=1,
+                iterations=0,
+                centres=centres,
+                neighbours=neighbours,
+                adjacency=adjacency,
+                compact=True,
+                facing=start,
+                details=details,
+            )
+            with np.errstate(invalid="ignore"):
+                wrapped = np.union1d(wrapped, centres[details["away"] > AWAY_FRACTION])
+            if wrapped.size:
+                fitted = _thin_part_normals(
+                    vertices,
+                    np.where(valid[:, None], fitted, normals),
+                    radius,
+                    wrapped,
+                    neighbours=neighbours,
+                    adjacency=adjacency,
+                    degree=NORMAL_DEGREE,
+                    iterations=NORMAL_ITERATIONS,
+                    settled=NORMAL_SETTLED,
+                    min_spread=NORMAL_MIN_SPREAD,
+                    widen=1.0,
+                    sampled=False,
+                    bend=SMOOTH_THIN_BEND,
+                )
     else:
         smooth = thin and widen == 1.0 and adjacency is not None  # (a smooth mesh's thin parts: below)
         fitted = _fit_jet_normals(
@@ -1527,11 +1563,14 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             failed=failed[j],
             fits=fits[j] if j < len(fits) else None,
             coarse=voxel,
+            thin=True,  # a thin part's fits made again over their own side, as estimate's (widen 1)
+            widen=1.0,
         )
         for j, radius in enumerate(radii)
     ]
     stages.start("compute face measures")
-    measures = np.stack([face_measures(vertices, faces, rung) for rung in normals])
+    facing = _facing_measures(vertices, faces)  # the balls holding a thin part's other side: _reaching
+    measures = np.stack([np.column_stack([face_measures(vertices, faces, rung), facing]) for rung in normals])
     kept = [_usable_faces(faces, degenerate, rung) for rung in normals]
     stages.start("sum over balls")
     if all(mask is None if kept[0] is None else mask is not None and np.array_equal(mask, kept[0]) for mask in kept):
@@ -1547,22 +1586,13 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     stages.start("retrieve curvatures")
     out = []
     for radius, rung, sums, rung_failed in zip(radii, normals, summed, failed):
+        sums, facing_sums = sums[:, :-FACING_COLUMNS], sums[:, -FACING_COLUMNS:]
         k_min, k_max, dir_min, dir_max = curvatures_from_measures(sums, rung)
         parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius}
-        out.append(
-            finish(
-                "icc",
-                parameters,
-                valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed),
-                rung,
-                k_min,
-                k_max,
-                dir_min,
-                dir_max,
-                defects,
-                radius=np.full(vertices.shape[0], radius),
-            )
-        )
+        rung_valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed)
+        reached = _reaching(facing_sums, sums[:, 0], rung, radius, k_min, k_max, rung_valid)
+        fields = (k_min, k_max, dir_min, dir_max, rung, rung_valid & ~reached)
+        out.append(_finished(parameters, fields, defects, np.full(vertices.shape[0], radius), reached))
     return out
 
 
@@ -1589,9 +1619,11 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
         adjacency=_adjacency(topology),
         areas=_vertex_areas(mesh),
         coarse=_coarse_fits(mesh, NORMAL_RADIUS_RATIO * base, defects.invalid_vertices, stages),
+        thin=True,  # a thin part's fits made again over their own side, as estimate's (widen 1)
+        widen=1.0,
     )
     stages.start("compute face measures")
-    measures = face_measures(vertices, faces, normals)
+    measures = np.column_stack([face_measures(vertices, faces, normals), _facing_measures(vertices, faces)])
     stages.start("sum over balls")
     area = 0.5 * float(np.linalg.norm(mesh.cross[~_dropped(mesh)], axis=1).sum())
     radii = scale_ladder(base, median_edge_length(vertices, topology.edges), area)
@@ -1599,19 +1631,14 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
         vertices, faces, radii, measures, usable=_usable_faces(faces, _dropped(mesh), normals)
     )
     stages.start("retrieve curvatures")
+    summed, facing_sums = summed[..., :-FACING_COLUMNS], summed[..., -FACING_COLUMNS:]
     rung = stable_scales(*principal_from_measures(summed), topology.neighbour_lists)
-    chosen = summed[rung, np.arange(vertices.shape[0])]
+    every = np.arange(vertices.shape[0])
+    chosen = summed[rung, every]
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(chosen, normals)
     parameters = {**parameters, "scale": "adaptive", "radii": tuple(float(r) for r in radii)}
-    return finish(
-        "icc",
-        parameters,
-        valid & np.isfinite(k_min),
-        normals,
-        k_min,
-        k_max,
-        dir_min,
-        dir_max,
-        defects,
-        radius=radii[rung],
-    )
+    valid = valid & np.isfinite(k_min)
+    # the rung chosen holding a thin part's other side (_reaching): undefined, not a smaller rung's value
+    reached = _reaching(facing_sums[rung, every], chosen[:, 0], normals, radii[rung], k_min, k_max, valid)
+    fields = (k_min, k_max, dir_min, dir_max, normals, valid & ~reached)
+    return _finished(parameters, fields, defects, radii[rung], reached)
