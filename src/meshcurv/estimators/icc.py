@@ -362,6 +362,7 @@ def fitted_normals(
         areas = areas / np.median(positive) if positive.size else None
     if dense and areas is not None:
         level = _coarse_level(vertices, start, radius, areas, neighbours, adjacency, edge=edge)
+    wrapped = None  # the fits refused for points facing away (a smooth mesh's thin parts: below)
     if level is not None:
         points, point_normals, allowed, lists, point_areas = level
         # the vertices measured only: the cubes of the samples start at their corner, which a vertex in no face
@@ -384,7 +385,6 @@ def fitted_normals(
     elif fits is not None:
         fitted = fits
         if thin and widen == 1.0 and adjacency is not None:  # the fits a first fit would refuse, as below
-            fitted = np.array(fits, copy=True)
             wrapped = np.flatnonzero(valid & ~finite_rows(fitted))
             centres = np.flatnonzero(valid & finite_rows(fitted))
             details: dict = {}
@@ -403,22 +403,6 @@ def fitted_normals(
             )
             with np.errstate(invalid="ignore"):
                 wrapped = np.union1d(wrapped, centres[details["away"] > AWAY_FRACTION])
-            if wrapped.size:
-                fitted = _thin_part_normals(
-                    vertices,
-                    np.where(valid[:, None], fitted, normals),
-                    radius,
-                    wrapped,
-                    neighbours=neighbours,
-                    adjacency=adjacency,
-                    degree=NORMAL_DEGREE,
-                    iterations=NORMAL_ITERATIONS,
-                    settled=NORMAL_SETTLED,
-                    min_spread=NORMAL_MIN_SPREAD,
-                    widen=1.0,
-                    sampled=False,
-                    bend=SMOOTH_THIN_BEND,
-                )
     else:
         smooth = thin and widen == 1.0 and adjacency is not None  # (a smooth mesh's thin parts: below)
         fitted = _fit_jet_normals(
@@ -434,7 +418,6 @@ def fitted_normals(
             min_spread=NORMAL_MIN_SPREAD,
             facing=start if smooth else None,
         )
-        wrapped = None
         if smooth:  # the fits refused for holding points facing away (or failed), made again without the check
             wrapped = np.flatnonzero(valid & ~finite_rows(fitted))
             if wrapped.size:
@@ -465,7 +448,8 @@ def fitted_normals(
                 areas if weighted else None,
                 counts=counts,
             )
-        if thin and adjacency is not None and (wrapped is None or wrapped.size):
+    if level is None and thin and adjacency is not None and (fits is None or wrapped is not None):
+        if wrapped is None or wrapped.size:
             fitted = _thin_part_normals(
                 vertices,
                 np.where(valid[:, None], fitted, normals),
