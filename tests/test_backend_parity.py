@@ -192,7 +192,9 @@ def test_flat_ellipsoid_default_radius_does_not_depend_on_the_backend():
     h = mean_edge_length(flat.vertices, MeshTopology.from_faces(flat.faces, flat.vertices.shape[0]).edges)
     radii = {}
     for backend in ("numba", "numpy"):
-        with use_backend(backend):
+        # its rim (from 0.9 of the radius) is thinner than the balls there: those vertices are undefined, with a
+        # warning (before, every vertex valid and 1,420 with H of the wrong sign; issue 29, T68/T69)
+        with use_backend(backend), pytest.warns(MeshQualityWarning, match="ball reaches round the surface"):
             result = meshcurv.principal_curvatures(flat.vertices, flat.faces, method="icc")
         radii[backend] = result.parameters["radius"]
         error = np.abs(result.mean - flat.mean) / np.abs(flat.mean)

@@ -6,11 +6,13 @@ whatever the chunk grid; the reader must give back the array written and the
 voxel size of the OME-Zarr metadata written by the test.
 """
 
+import warnings
+
 import numpy as np
 import pytest
 
 from meshcurv._lazy import LazyImage, check_lazy_labels, lazy_objects
-from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshFileError
+from meshcurv.errors import InvalidMeshError, InvalidOptionError, MeshFileError, MeshQualityWarning
 from meshcurv.io._images import read_image
 from meshcurv.volume import _objects
 
@@ -225,7 +227,11 @@ def test_lazy_labels_on_two_workers_are_the_serial_rows():
     read = LazyImage(image, chunks=(8, 16, 16))
     from meshcurv.batch import local_cluster
 
-    with local_cluster(workers=2, dashboard=False) as client:
+    with local_cluster(workers=2, dashboard=False) as client, warnings.catch_warnings():
+        # label 21, cut by two image faces and carved by label 7 (radius 3.16): 4 vertices on that interface, 1-2.5
+        # voxels from the faces, have balls holding its other side and are undefined; they read H of 0.06-0.20
+        # there before (truth -1 / 3.16 = -0.32, concave: the wrong sign; T69). Serial and parallel warn alike.
+        warnings.simplefilter("ignore", MeshQualityWarning)
         for smooth in (None, 1.0):  # the smoothed crops travel with their origin
             serial = label_curvatures(image, spacing=(1.0, 1.0, 1.0), smooth=smooth)
             parallel = label_curvatures(read, spacing=(1.0, 1.0, 1.0), client=client, smooth=smooth)

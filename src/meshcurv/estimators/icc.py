@@ -109,6 +109,22 @@ so the default radius and the curvatures do not depend on whether numba is
 installed (issue 29: a 3 x 3 x 0.15 ellipsoid had a default radius of 0.118
 with numba and 0.538 without).
 
+Where the part is thinner than the ball and its rim lies within it, the connected
+ball holds the other side, round the rim, on one side of the centre. A normal fit
+whose ball holds points facing away (by the vertex normals, in the fit's own walk)
+is made again without that check, and where the cubic over its own side hardly
+bends (:data:`SMOOTH_THIN_BEND`; a ball wraps round its own bend only where ``k r``
+reaches about ``sqrt(2)``) over its own side (:func:`meshcurv.jets._thin_part_normals`;
+on a voxel surface over wider balls, its terraces); a ball of the sums whose
+faces' area vectors face the centre's way far less than a ball of its own
+curvatures would (:data:`THIN_FACING`) holds both sides, and its vertex is
+undefined with the reason "ball reaches round the surface". (Issue 29: the clean
+ellipsoid (3, 3, 0.15) at 16 subdivisions, every vertex valid and H of the wrong
+sign over 0.8-0.95 of its radius, 1,048 vertices off by more than half of the
+largest ``|k|``; none now, 844 undefined at the rim; ``benchmarks/thin_band_T68.md``.)
+A coarse closed mesh whose balls wrap round its own bend (an icosahedron, a torus
+of 8 x 4 vertices) keeps its values: those balls are symmetric and their fits right.
+
 References
 ----------
 F. Cazals and M. Pouget (2005). Estimating differential quantities using
@@ -122,12 +138,16 @@ corrected curvature measures for polygonal surfaces. Computer Graphics Forum
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from .._geometry import face_areas, finite_rows, median_edge_length
 from .._backend import numba_kernels
 from .._tensors import tangent_basis
 from ..jets import (
+    THIN_BEND,
+    THIN_WIDEN,
     AWAY_FRACTION,
     NORMAL_MIN_SPREAD,
     SAMPLED_SPREAD,
@@ -168,6 +188,7 @@ from ..radius import (
 )
 from .._prepared import PreparedMesh
 from ..topology import MeshTopology
+from ..defects import REACH
 from ._support import Stages, failed_fits_undefined, finish
 
 #: Degree of the jets whose normals the measures interpolate.
@@ -223,6 +244,37 @@ HOLE_MIN_SHARE = 0.2
 #: 1,549 valid vertices read H of the wrong sign, at -0.33 to -0.85 here; no other below 0.82; at 0.7, 200 more
 #: vertices of a holed voxel torus undefined, none of them off).
 HOLE_FACING = 0.5
+#: A ball of the sums on a mesh (not a voxel surface at its default) holds the other side of a part thinner than it
+#: where its faces' area vectors, summed, have a component along the centre's normal (over its corrected area: its
+#: facing ``f``) below what a ball of its own curvatures would have by more than this: ``f < 1 - r^2 (k_1^2 +
+#: k_2^2) / 8 - THIN_FACING`` (a sphere's ball: ``1 - (r k)^2 / 4`` exactly). Its sums then hold both sides, and
+#: the vertex is undefined (reason :data:`meshcurv.defects.REACH`). Issue 29 (T68): the clean ellipsoid (3, 3, 0.15)
+#: at 16 subdivisions, balls of 0.18 at its rim 0.06 to 0.13 thick: 0.72-0.86 below (H of the wrong sign at valid
+#: vertices); the coarse closed meshes whose balls wrap round their own bend (an icosahedron, ``torus(3, 1, 8, 4)``,
+#: ``icosphere(2)``) within 0.03, the coarse ellipsoid (3, 2, 1) at 4 subdivisions (162 vertices) up to 0.46.
+THIN_FACING = 0.5
+#: ... but only where the ball's area vectors ``a`` cancel too, as the two sides of a thin part do: the length of
+#: their sum ``S`` over the corrected area lies more than this below the same ``1 - r^2 (k_1^2 + k_2^2) / 8`` ...
+THIN_CANCEL = 0.3
+#: ... and more than this of ``(n^T T n - n . S) / trace T`` (``T = sum a a^T / |a|`` the faces' sign-blind normal
+#: tensor: a face at cosine ``c`` to the centre's normal ``n`` adds ``(c^2 - c)`` times its area, 2 facing away, 0
+#: at right angles, at most 1/4 less facing ``n``'s way: ``g``, twice the share of the area facing away) says
+#: that area faces away from ``n``. A low facing alone comes from a fold of one surface as well: the 90-degree
+#: crease between a label's closing cap and its wall where the image border cuts it (T69: a hemisphere of radius 9
+#: voxels cut on its equator, 19 vertices 0.5-1.5 voxels from the cap, their normals 23-57 degrees off the sphere's)
+#: has ``f`` 0.11-0.41 for a ball of its curvatures' 0.88-0.93, but ``|S|`` only 0.17-0.26 below it (a fold's
+#: faces at right angles, a share ``w`` of the area: ``f = 1 - w``, ``|S| = sqrt((1 - w)^2 + w^2)``, 0.71 at
+#: ``w = 1/2``) and ``g`` 0.16-0.30 (0.38 at the vertex whose normal is 57 degrees off): each test alone leaves
+#: a margin of 0.03-0.05 at most (the ellipsoid (1, 1, 0.08): ``g`` from 0.385; ``|S|`` alone at 0.35 let valid
+#: vertices off by more than half of the largest ``|k|`` back, 288 -> 364), the two together none of the 19 and
+#: the same vertices off on ``benchmarks/thin_band_T68.py`` as the facing alone. The label path leaves those
+#: crease vertices out of its statistics anyway (:mod:`meshcurv.volume`).
+THIN_OPPOSITE = 0.25
+#: On a mesh other than a voxel surface at its default, a normal fit whose ball wraps round a part thinner than it
+#: is fitted again over its own side where the same-side cubic's largest ``|k| r`` is below this
+#: (:func:`meshcurv.jets._thin_part_normals`; a voxel surface's: :data:`meshcurv.jets.THIN_BEND`, its terraces'):
+#: a ball wraps round its own bend only where ``k r`` reaches about ``sqrt(2)``.
+SMOOTH_THIN_BEND = 1.0
 
 
 STAGES = (
@@ -251,6 +303,7 @@ def fitted_normals(
     unwrap: np.ndarray | None = None,
     counts: np.ndarray | None = None,
     thin: bool = False,
+    widen: float = THIN_WIDEN,
     coarse: bool = False,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
@@ -277,9 +330,13 @@ def fitted_normals(
     again over smaller balls where they do (:func:`_unwrapped_normals`: the vertices near holes); ``counts`` (V,)
     float, when given, is set in place to the number of points of their first fits (unchanged elsewhere).
 
-    ``thin``: a voxel surface; the fits on its thin flat parts (balls that wrap round a part thinner than them while
-    their jets hardly bend) are made again over wider balls of the points that face the centre's way
-    (:func:`meshcurv.jets._thin_part_normals`; not on the coarse level).
+    ``thin``: the fits on thin flat parts (balls that wrap round a part thinner than them while their jets hardly
+    bend) are made again over balls ``widen`` times wider of the points that face the centre's way
+    (:func:`meshcurv.jets._thin_part_normals`; not on the coarse level): a voxel surface's over wider balls
+    (:data:`meshcurv.jets.THIN_WIDEN`, its terraces; at samples of the centres), a smooth mesh's over the same balls
+    at every centre (1: the other side of a
+    thin rim tilted the fits of a clean ellipsoid (3, 3, 0.15) by 3.6-7 degrees over a band 0.8-0.95 of its radius,
+    and H took the wrong sign there; issue 29, T68).
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -306,6 +363,7 @@ def fitted_normals(
         areas = areas / np.median(positive) if positive.size else None
     if dense and areas is not None:
         level = _coarse_level(vertices, start, radius, areas, neighbours, adjacency, edge=edge)
+    wrapped = None  # the fits refused for points facing away (a smooth mesh's thin parts: below)
     if level is not None:
         points, point_normals, allowed, lists, point_areas = level
         # the vertices measured only: the cubes of the samples start at their corner, which a vertex in no face
@@ -327,7 +385,27 @@ def fitted_normals(
         )
     elif fits is not None:
         fitted = fits
+        if thin and widen == 1.0 and adjacency is not None:  # the fits a first fit would refuse, as below
+            wrapped = np.flatnonzero(valid & ~finite_rows(fitted))
+            centres = np.flatnonzero(valid & finite_rows(fitted))
+            details: dict = {}
+            _fit_jets(  # the share facing away alone (the walk and the check, no moments: _thin_part_normals)
+                vertices,
+                start,
+                radius if np.ndim(radius) == 0 else np.asarray(radius)[centres],
+                degree=1,
+                iterations=0,
+                centres=centres,
+                neighbours=neighbours,
+                adjacency=adjacency,
+                compact=True,
+                facing=start,
+                details=details,
+            )
+            with np.errstate(invalid="ignore"):
+                wrapped = np.union1d(wrapped, centres[details["away"] > AWAY_FRACTION])
     else:
+        smooth = thin and widen == 1.0 and adjacency is not None  # (a smooth mesh's thin parts: below)
         fitted = _fit_jet_normals(
             vertices,
             start,
@@ -339,7 +417,26 @@ def fitted_normals(
             settled=NORMAL_SETTLED,
             areas=areas if weighted else None,
             min_spread=NORMAL_MIN_SPREAD,
+            facing=start if smooth else None,
         )
+        if smooth:  # the fits refused for holding points facing away (or failed), made again without the check
+            wrapped = np.flatnonzero(valid & ~finite_rows(fitted))
+            if wrapped.size:
+                coefficients, frame, _ = _fit_jets(
+                    vertices,
+                    start,
+                    radius if np.ndim(radius) == 0 else np.asarray(radius)[wrapped],
+                    degree=NORMAL_DEGREE,
+                    iterations=NORMAL_ITERATIONS,
+                    centres=wrapped,
+                    neighbours=neighbours,
+                    adjacency=adjacency,
+                    settled=NORMAL_SETTLED,
+                    compact=True,
+                    areas=areas if weighted else None,
+                    min_spread=NORMAL_MIN_SPREAD,
+                )
+                fitted[wrapped] = jet_normals(coefficients, frame)
         if unwrap is not None and adjacency is not None:
             fitted = _unwrapped_normals(
                 vertices,
@@ -352,18 +449,22 @@ def fitted_normals(
                 areas if weighted else None,
                 counts=counts,
             )
-        if thin and adjacency is not None:
+    if level is None and thin and adjacency is not None and (fits is None or wrapped is not None):
+        if wrapped is None or wrapped.size:
             fitted = _thin_part_normals(
                 vertices,
                 np.where(valid[:, None], fitted, normals),
                 radius,
-                np.flatnonzero(valid),
+                np.flatnonzero(valid) if wrapped is None else wrapped,
                 neighbours=neighbours,
                 adjacency=adjacency,
                 degree=NORMAL_DEGREE,
                 iterations=NORMAL_ITERATIONS,
                 settled=NORMAL_SETTLED,
                 min_spread=NORMAL_MIN_SPREAD,
+                widen=widen,
+                sampled=widen != 1.0,
+                bend=THIN_BEND if widen != 1.0 else SMOOTH_THIN_BEND,
             )
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
@@ -406,7 +507,8 @@ def _unwrapped_normals(
     turns by up to 90 degrees between the vertices of a staircase) wraps around the surface, and a jet over the
     tangent plane describes no height function there. Where the surface around is whole such a ball is about
     symmetric and its normal comes out right (a coarse sphere, a cylinder under noise: smaller balls there are
-    only noisier, so only the vertices near holes are checked); with holes, cracks or faces detached beyond the
+    only noisier, so only the vertices near holes are checked here; the rim of a part thinner than the ball is
+    the exception, :func:`fitted_normals` ``thin``); with holes, cracks or faces detached beyond the
     weld the points left are lopsided and tilt the fit (issue 29: ``shapes.uv_sphere(12, 8)``, half of its faces
     detached by 0.065 edge lengths: fitted normals 13.5 degrees off the sphere's at the median, 2.5 intact, and H
     of 0.35-0.85 for 1 at 10 of 59 valid vertices; with the exact normals the same sums give 1 to 0.004). Those
@@ -980,6 +1082,7 @@ def _curvatures(
     cracked: bool = False,
     pieces: np.ndarray | None = None,
     edge: float,
+    reached: np.ndarray | None = None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -996,6 +1099,11 @@ def _curvatures(
     holes, the pieces whose fits scatter (:func:`_scattered_pieces`) or whose balls hold a small piece of a staircase
     (:func:`_stair_pieces`; ``pieces``: a voxel surface's soup's, :func:`_soup_pieces`) are undefined.
     ``edge``: the median length of every edge (:func:`_mesh_edge`: the coarse level's test and the scatter's ball).
+
+    The normal fits on thin flat parts are made again over their own side (:func:`fitted_normals` ``thin``).
+    ``reached`` (V,) bool, when given (not on a voxel surface at its default): set True, in place, at the vertices
+    whose ball of the sums holds the other side of a thin part (:data:`THIN_FACING`), left out of the ``valid``
+    returned.
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -1036,7 +1144,8 @@ def _curvatures(
             edge=edge,
             unwrap=near,
             counts=counts,
-            thin=coarse,
+            thin=True,
+            widen=THIN_WIDEN if coarse else 1.0,
             coarse=coarse or coarse_fits,
         )
 
@@ -1052,6 +1161,9 @@ def _curvatures(
         corners = vertices[faces]
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
+    facing_columns = reached is not None and boundary_faces is None and not coarse
+    if facing_columns:  # nine more columns: the faces' area vectors and normal tensors (THIN_FACING)
+        measures = np.column_stack([measures, _facing_measures(vertices, faces)])
     areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
     if areas_column:
         measures = np.column_stack([measures, face_areas(vertices, faces)])
@@ -1066,17 +1178,67 @@ def _curvatures(
     ball_areas = None
     if areas_column:
         summed, ball_areas = summed[:, :-1], summed[:, -1]
+    facing = None
+    if facing_columns:
+        summed, facing = summed[:, :-FACING_COLUMNS], summed[:, -FACING_COLUMNS:]
 
     start("retrieve curvatures")
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(summed, normals)
     valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, failed)
     if sparse is not None:
         valid &= ~sparse
+    if facing is not None and reached is not None:
+        reached |= _reaching(facing, summed[:, 0], normals, radius, k_min, k_max, valid)
+        valid &= ~reached
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
         if ball_areas is not None:
             valid &= ~_stair_pieces(summed[:, 0], ball_areas, radius, valid & np.isfinite(counts), pieces)
     return k_min, k_max, dir_min, dir_max, normals, valid, radius
+
+
+#: The columns of :func:`_facing_measures`.
+FACING_COLUMNS = 9
+
+
+def _facing_measures(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, :data:`FACING_COLUMNS`) each face's area vector ``a`` and its sign-blind normal tensor ``a a^T / |a|``
+    (xx, yy, zz, xy, xz, yz): summed over a ball, what :func:`_reaching` reads (a degenerate face adds 0)."""
+    corners = vertices[faces]
+    sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    size = np.linalg.norm(sides, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(size[:, None] > 0, sides / size[:, None], 0.0)
+    rows, columns = [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]
+    return np.column_stack([sides, size[:, None] * unit[:, rows] * unit[:, columns]])
+
+
+def _reaching(facing, area, normals, radius, k_min, k_max, valid) -> np.ndarray:
+    """(V,) bool: the ``valid`` vertices whose ball of the sums holds the other side of a thin part.
+
+    ``facing`` (V, :data:`FACING_COLUMNS`): the sums over each ball of :func:`_facing_measures` (``S`` the area
+    vectors', ``T`` the tensors'); ``area`` (V,) its corrected area; ``normals`` ``n``, ``radius`` (float or (V,)),
+    ``k_min``, ``k_max`` those of the vertex. Where the ball holds the other side, its facing ``f = n . S / area``
+    lies more than :data:`THIN_FACING` below a ball of its own curvatures' (``1 - r^2 (k_1^2 + k_2^2) / 8``),
+    its area vectors cancel (``|S| / area`` more than :data:`THIN_CANCEL` below the same) and a share of its area
+    faces away from ``n`` (:data:`THIN_OPPOSITE`); a fold of one surface tilts ``S`` off ``n`` (``f`` low) but
+    cancels little.
+    """
+    n = normals
+    tensor = facing[:, 3:]
+    squared = (
+        tensor[:, 0] * n[:, 0] ** 2
+        + tensor[:, 1] * n[:, 1] ** 2
+        + tensor[:, 2] * n[:, 2] ** 2
+        + 2.0 * (tensor[:, 3] * n[:, 0] * n[:, 1] + tensor[:, 4] * n[:, 0] * n[:, 2] + tensor[:, 5] * n[:, 1] * n[:, 2])
+    )
+    along = np.einsum("ij,ij->i", n, facing[:, :3])
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        bent = 1.0 - np.asarray(radius) ** 2 * (k_min**2 + k_max**2) / 8.0  # a ball of its own curvatures'
+        tilted = along / area < bent - THIN_FACING
+        cancelled = np.linalg.norm(facing[:, :3], axis=1) / area < bent - THIN_CANCEL
+        opposite = (squared - along) / (tensor[:, 0] + tensor[:, 1] + tensor[:, 2]) > THIN_OPPOSITE
+    return valid & tilted & cancelled & opposite
 
 
 #: Near holes (:func:`_near_holes`), a vertex is undefined where its points scatter by more than
@@ -1334,6 +1496,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         }
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     pieces = _soup_pieces(mesh, defects, valid)
+    reached = np.zeros(vertices.shape[0], dtype=bool)  # balls holding a thin part's other side (THIN_FACING)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor,
         # more where its own noise calls for more (a noisy patch)
         ratios = _local_scale_ratios(mesh)
@@ -1359,22 +1522,13 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 cracked=bool(mesh.n_cracked),
                 pieces=pieces,
                 coarse_fits=wide,
+                reached=reached,
             )
-            k_min, k_max, dir_min, dir_max, normals, valid, _ = _turned_back(computed, axes)
-            return finish(
-                "icc",
-                {**parameters, "scale": "local"},
-                valid,
-                normals,
-                k_min,
-                k_max,
-                dir_min,
-                dir_max,
-                defects,
-                radius=radii_v,
-            )
+            local = _turned_back(computed, axes)[:-1]
+            return _finished({**parameters, "scale": "local"}, local, defects, radii_v, reached)
     fields: tuple[np.ndarray, ...] | None = None
     for group_radius, members in groups:
+        group_reached = np.zeros_like(reached)
         wide = _coarse_fits(mesh, NORMAL_RADIUS_RATIO * group_radius, defects.invalid_vertices, stages)
         axes = _grid_axes(mesh, stages.voxel) if wide else None  # (the coarse level along the grid's axes)
         computed = _curvatures(
@@ -1393,6 +1547,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             cracked=bool(mesh.n_cracked),
             pieces=pieces,
             coarse_fits=wide,
+            reached=reached if members is None else group_reached,
         )
         computed = _turned_back(computed, axes)[:-1]
         if members is None:
@@ -1402,21 +1557,22 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             fields = tuple(np.array(field, copy=True) for field in computed)
         for field, values in zip(fields, computed):
             field[members] = values[members]
+        reached[members] = group_reached[members]
     if fields is None:
         raise RuntimeError("default_radii gave no group")
+    return _finished(parameters, fields, defects, _vertex_radii(groups, vertices.shape[0]), reached)
+
+
+def _finished(parameters: dict, fields: tuple, defects, radius: np.ndarray, reached: np.ndarray) -> tuple:
+    """:func:`finish`'s ``(result, problems)`` of ``fields`` (``k_min, k_max, dir_min, dir_max, normals, valid``)
+    with the reason :data:`meshcurv.defects.REACH` at the ``reached`` (V,) vertices (balls holding a thin part's
+    other side, :data:`THIN_FACING`; a defect's code still comes first)."""
     k_min, k_max, dir_min, dir_max, normals, valid = fields
-    return finish(
-        "icc",
-        parameters,
-        valid,
-        normals,
-        k_min,
-        k_max,
-        dir_min,
-        dir_max,
-        defects,
-        radius=_vertex_radii(groups, vertices.shape[0]),
-    )
+    result, problems = finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radius)
+    if not reached.any():
+        return result, problems
+    codes = np.where(reached & ~result.valid, REACH, 0).astype(np.int8)
+    return dataclasses.replace(result, invalid_reason=codes), problems
 
 
 def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tuple]:
@@ -1480,12 +1636,15 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             failed=failed[j],
             fits=_along(fits[j], axes) if j < len(fits) else None,
             coarse=voxel,
+            thin=True,  # a thin part's fits made again over their own side, as estimate's (widen 1)
+            widen=1.0,
         )
         for j, radius in enumerate(radii)
     ]
     normals = [rung if axes is None else rung @ axes for rung in normals]
     stages.start("compute face measures")
-    measures = np.stack([face_measures(vertices, faces, rung) for rung in normals])
+    facing = _facing_measures(vertices, faces)  # the balls holding a thin part's other side: _reaching
+    measures = np.stack([np.column_stack([face_measures(vertices, faces, rung), facing]) for rung in normals])
     kept = [_usable_faces(faces, degenerate, rung) for rung in normals]
     stages.start("sum over balls")
     if all(mask is None if kept[0] is None else mask is not None and np.array_equal(mask, kept[0]) for mask in kept):
@@ -1501,22 +1660,13 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     stages.start("retrieve curvatures")
     out = []
     for radius, rung, sums, rung_failed in zip(radii, normals, summed, failed):
+        sums, facing_sums = sums[:, :-FACING_COLUMNS], sums[:, -FACING_COLUMNS:]
         k_min, k_max, dir_min, dir_max = curvatures_from_measures(sums, rung)
         parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius}
-        out.append(
-            finish(
-                "icc",
-                parameters,
-                valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed),
-                rung,
-                k_min,
-                k_max,
-                dir_min,
-                dir_max,
-                defects,
-                radius=np.full(vertices.shape[0], radius),
-            )
-        )
+        rung_valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed)
+        reached = _reaching(facing_sums, sums[:, 0], rung, radius, k_min, k_max, rung_valid)
+        fields = (k_min, k_max, dir_min, dir_max, rung, rung_valid & ~reached)
+        out.append(_finished(parameters, fields, defects, np.full(vertices.shape[0], radius), reached))
     return out
 
 
@@ -1545,10 +1695,12 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
         adjacency=_adjacency(topology),
         areas=_vertex_areas(mesh),
         coarse=wide,
+        thin=True,  # a thin part's fits made again over their own side, as estimate's (widen 1)
+        widen=1.0,
     )
     normals = normals if axes is None else normals @ axes
     stages.start("compute face measures")
-    measures = face_measures(vertices, faces, normals)
+    measures = np.column_stack([face_measures(vertices, faces, normals), _facing_measures(vertices, faces)])
     stages.start("sum over balls")
     area = 0.5 * float(np.linalg.norm(mesh.cross[~_dropped(mesh)], axis=1).sum())
     radii = scale_ladder(base, median_edge_length(vertices, topology.edges), area)
@@ -1556,19 +1708,14 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
         vertices, faces, radii, measures, usable=_usable_faces(faces, _dropped(mesh), normals)
     )
     stages.start("retrieve curvatures")
+    summed, facing_sums = summed[..., :-FACING_COLUMNS], summed[..., -FACING_COLUMNS:]
     rung = stable_scales(*principal_from_measures(summed), topology.neighbour_lists)
-    chosen = summed[rung, np.arange(vertices.shape[0])]
+    every = np.arange(vertices.shape[0])
+    chosen = summed[rung, every]
     k_min, k_max, dir_min, dir_max = curvatures_from_measures(chosen, normals)
     parameters = {**parameters, "scale": "adaptive", "radii": tuple(float(r) for r in radii)}
-    return finish(
-        "icc",
-        parameters,
-        valid & np.isfinite(k_min),
-        normals,
-        k_min,
-        k_max,
-        dir_min,
-        dir_max,
-        defects,
-        radius=radii[rung],
-    )
+    valid = valid & np.isfinite(k_min)
+    # the rung chosen holding a thin part's other side (_reaching): undefined, not a smaller rung's value
+    reached = _reaching(facing_sums[rung, every], chosen[:, 0], normals, radii[rung], k_min, k_max, valid)
+    fields = (k_min, k_max, dir_min, dir_max, normals, valid & ~reached)
+    return _finished(parameters, fields, defects, radii[rung], reached)
