@@ -41,11 +41,15 @@ quick: $(STAMP)
 
 # the suite on a plain install without its extras (no matplotlib, pyvista, dask, scikit-image, ...),
 # numba then removed: what needs an extra is skipped, and the NumPy backend (the reference) runs
-test-minimal:
-	$(PYTHON) -m venv .venv-minimal
-	.venv-minimal/bin/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
-	.venv-minimal/bin/python -m pip uninstall --quiet --yes numba llvmlite
-	.venv-minimal/bin/python -m pytest -q -m "not slow"
+MINIMAL := .venv-minimal
+$(MINIMAL)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(MINIMAL)
+	$(MINIMAL)/bin/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
+	$(MINIMAL)/bin/python -m pip uninstall --quiet --yes numba llvmlite
+	@touch $@
+
+test-minimal: $(MINIMAL)/.installed
+	$(MINIMAL)/bin/python -m pytest -q -m "not slow"
 
 # the user guide (docs/guide) and the API reference (docs/_build/html/index.html); warnings are errors
 docs: $(STAMP)
