@@ -115,8 +115,10 @@ def _assert_one_side(vertices, faces, doubled, method, *, rows=None):
     n = vertices.shape[0]
     np.testing.assert_array_equal(both.valid[:n], one.valid)
     np.testing.assert_array_equal(both.invalid_reason[:n], one.invalid_reason)
+    # to round-off: the noise level is read over the faces in another order (the noisy soup reversed first:
+    # 0.0012419044344732962 against ...2719 with numpy 2.4.6), which moves 6 of its 2,160 k_max by 2.5e-12
     for name in ("k_min", "k_max"):
-        np.testing.assert_allclose(getattr(both, name)[:n], getattr(one, name), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(getattr(both, name)[:n], getattr(one, name), rtol=1e-9, atol=1e-12)
     return one, both
 
 
