@@ -74,7 +74,10 @@ tensor, the mean of the shape operator over the ball, mixes the part's sides (``
 off, valid; issue 29). A default ball whose vertex normals turn from its centre's by more than
 :data:`meshcurv.radius.BALL_TURN_CAP` with no crease in it is summed again over a smaller ball; its default stays
 where the smaller ball reproduces it, and a vertex with no smaller ball within the cap is NaN with ``valid=False``
-(reason :data:`meshcurv.defects.REACH`; :func:`_round_balls`).
+(reason :data:`meshcurv.defects.REACH`; :func:`_round_balls`). At the voxel default, whose shell of balls
+(:data:`VOXEL_SHELL`) reaches round a part thinner than a voxel or two (the rim of ``voxel_ellipsoid((8, 8, 2))``,
+read at half its curvature), the vertex normals of the staircase scatter too much for that test: a vertex whose outer
+ball's mean normal is short (:data:`VOXEL_REACH_MEAN_NORMAL`) is NaN with the same reason (:func:`_voxel_round_balls`).
 
 References
 ----------
@@ -177,7 +180,8 @@ VOXEL_SHELL = (0.7, 0.85, 1.0, 1.15, 1.3)
 #: shapes (valid vertices off by more than half the largest ``|k|``: 54 -> 0; 5 at 0.5 terraces, 4 at 0.65, 1 at
 #: 0.9); held out at 1 x 1 x 2.5, 1 x 1 x 3, 1 x 1.5 x 2.5 and M33's held-out shapes: 89 -> 0, the valid vertices' ``k`` off by more
 #: than half 595 -> 140 (``benchmarks/ncb_plateaus_M33.py --anisotropic``). Wider balls reach further round a
-#: part thinner than a voxel: ``voxel_ellipsoid((8, 8, 2))``'s rim (its radius of curvature half a voxel) 1 -> 24.
+#: part thinner than a voxel: ``voxel_ellipsoid((8, 8, 2))``'s rim (its radius of curvature half a voxel) 1 -> 24
+#: (made undefined, :data:`VOXEL_REACH_MEAN_NORMAL`).
 VOXEL_SHELL_TERRACES = 1.0
 
 #: At the voxel default a vertex whose outermost shell ball (:data:`VOXEL_SHELL`, :func:`_voxel_shell`) reaches round
