@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import time
 import warnings
+from unittest import mock
 
 import numpy as np
 
@@ -73,17 +74,12 @@ HELD_OUT = [
 def measure(mesh, threshold):
     """``(valid, lies, rim lies, CPU s)`` of ``normal_cycle_ball`` at its default with ``VOXEL_REACH_MEAN_NORMAL =
     threshold`` (None: the default)."""
-    saved = normal_cycle_ball.VOXEL_REACH_MEAN_NORMAL
-    if threshold is not None:
-        normal_cycle_ball.VOXEL_REACH_MEAN_NORMAL = threshold
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            start = time.process_time()
-            result = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method="normal_cycle_ball")
-            cpu = time.process_time() - start
-    finally:
-        normal_cycle_ball.VOXEL_REACH_MEAN_NORMAL = saved
+    value = normal_cycle_ball.VOXEL_REACH_MEAN_NORMAL if threshold is None else threshold
+    with mock.patch.object(normal_cycle_ball, "VOXEL_REACH_MEAN_NORMAL", value), warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the mesh's winding and the vertices refused, said in each call
+        start = time.process_time()
+        result = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method="normal_cycle_ball")
+        cpu = time.process_time() - start
     largest = float(np.nanmax(np.abs(np.concatenate([mesh.k_min, mesh.k_max]))))
     valid = result.valid
     errors = np.fmax(np.abs(result.k_min - mesh.k_min), np.abs(result.k_max - mesh.k_max))
