@@ -71,7 +71,7 @@ def test_no_valid_vertex_of_a_thin_rim_reads_half_its_curvature(name, backend):
     [
         lambda: shapes.voxel_sphere(10.0),
         lambda: shapes.voxel_torus(12.0, 4.0),
-        lambda: shapes.voxel_sphere(17.0, seed=5),
+        pytest.param(lambda: shapes.voxel_sphere(17.0, seed=5), marks=pytest.mark.slow),
     ],
     ids=["sphere 10", "torus 12 4", "sphere 17"],
 )
