@@ -22,6 +22,8 @@ import numpy as np
 import meshcurv
 from meshcurv import shapes
 
+from fuzz_api import _detach  # the fuzzer's detached faces (its draws)
+
 SETS = {  # (shape, share, gap in edges, seed)
     "tuned": [
         ("icosphere(40)", 1.0, 0.096, 0),
@@ -77,24 +79,12 @@ def base(name: str):
     return shapes.torus(major, minor, int(ring), int(tube))
 
 
-def detach(rng, vertices, faces, share, gap):
-    """The fuzzer's ``_detach`` (benchmarks/fuzz_api.py), and the clean corner of each row."""
-    edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
-    picked = rng.random(len(faces)) < share
-    corners = faces[picked].ravel()
-    directions = rng.normal(size=(corners.size, 3))
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    faces = faces.copy()
-    faces[picked] = len(vertices) + np.arange(corners.size).reshape(-1, 3)
-    soup = np.concatenate([vertices, vertices[corners] + directions * gap * edge])
-    return soup, faces, np.concatenate([np.arange(len(vertices)), corners])
-
-
 def run(name, share, gap, seed):
     """``(n, valid, off 0.5, off 0.35, worst, cpu)`` of one case."""
     mesh = base(name)
     vertices, faces = np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces)
-    soup, soup_faces, corner = detach(np.random.default_rng(seed), vertices, faces, share, gap)
+    soup, soup_faces = _detach(np.random.default_rng(seed), vertices, faces, share, gap)
+    corner = np.concatenate([np.arange(len(vertices)), faces[soup_faces != faces]])  # the clean corner of each row
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         start = time.process_time()

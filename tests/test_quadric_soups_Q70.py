@@ -21,33 +21,25 @@ from meshcurv import shapes
 from meshcurv._prepared import prepare_mesh
 
 from conftest import chosen_backend
+from test_normal_cycle_ball_holes import _detached
 
 
-def _detached(mesh, share: float, gap: float, seed: int):
+def _soup(mesh, share: float, gap: float, seed: int):
     """``(vertices, faces, corners)``: a ``share`` of the faces of ``mesh`` given corners of their own, each moved
     ``gap`` mean edge lengths in a random direction (the fuzzer's ``_detach``), and the clean corner of each row."""
-    vertices, faces = np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces)
-    rng = np.random.default_rng(seed)
-    edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
-    picked = rng.random(len(faces)) < share
-    corners = faces[picked].ravel()
-    directions = rng.normal(size=(corners.size, 3))
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    soup_faces = faces.copy()
-    soup_faces[picked] = len(vertices) + np.arange(corners.size).reshape(-1, 3)
-    soup = np.concatenate([vertices, vertices[corners] + directions * gap * edge])
-    return soup, soup_faces, np.concatenate([np.arange(len(vertices)), corners])
+    vertices, faces = _detached(mesh, share, gap, seed)
+    clean = np.asarray(mesh.faces)
+    return vertices, faces, np.concatenate([np.arange(len(mesh.vertices)), clean[faces != clean]])
 
 
 def _errors(mesh, share, gap, seed, backend="numba"):
     """``(valid, referenced, error)``: the valid rows, the rows in a face, and ``|H - H_exact|`` over the largest
     exact ``|k|`` at the valid rows."""
-    vertices, faces, corners = _detached(mesh, share, gap, seed)
+    vertices, faces, corners = _soup(mesh, share, gap, seed)
+    referenced = np.bincount(faces.ravel(), minlength=len(vertices)) > 0
     with chosen_backend(backend), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+        warnings.simplefilter("ignore")  # the weld's note
         result = meshcurv.principal_curvatures(vertices, faces, method="quadric")
-    referenced = np.zeros(len(vertices), dtype=bool)
-    referenced[faces] = True
     valid = result.valid & referenced
     largest = float(np.max(np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))))
     error = np.abs(result.mean - np.asarray(mesh.mean)[corners])[valid] / largest
@@ -101,7 +93,7 @@ def test_crack_gaps_are_the_copies_distances():
     soup = vertices[faces.ravel()]
     coincident = prepare_mesh(soup, np.arange(soup.shape[0]).reshape(-1, 3), orient="auto", weld=True)
     assert coincident.n_welded > 0 and coincident.crack_gaps is None
-    soup, soup_faces, corners = _detached(sphere, 0.5, 0.03, 4)
+    soup, soup_faces, corners = _soup(sphere, 0.5, 0.03, 4)
     mesh = prepare_mesh(soup, soup_faces, orient="auto", weld=True)
     assert mesh.n_cracked > 0
     edge = float(np.mean(np.linalg.norm(vertices[faces[:, 0]] - vertices[faces[:, 1]], axis=1)))
