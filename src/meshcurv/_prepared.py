@@ -123,6 +123,9 @@ class PreparedMesh:
     unwelded : bool
         Not welded (``weld=False``, or taken as given): its coincident boundary vertices are looked at for tangles
         (:func:`meshcurv.weld.tangled_vertices`); a welded mesh has none left.
+    crack_gaps : ndarray of shape (V,), float64, or None
+        On a mesh welded across cracks (``n_cracked``), each vertex's largest distance to a caller's vertex joined
+        into it (0 where none was): the width of the cracks it closed; None elsewhere.
     """
 
     vertices: np.ndarray
@@ -139,6 +142,7 @@ class PreparedMesh:
     n_cracked: int = 0
     known_median: float | None = None
     unwelded: bool = False
+    crack_gaps: np.ndarray | None = None
 
     @classmethod
     def as_given(cls, vertices: np.ndarray, topology: MeshTopology) -> PreparedMesh:
@@ -692,7 +696,19 @@ def prepare_mesh(vertices, faces=None, *, orient: str, weld: bool, stacklevel: i
         welded.n_cracked if welded is not None else 0,
         median,
         not weld,
+        crack_gaps=_joined_gaps(given[0], welded) if welded is not None and welded.n_cracked else None,
     )
+
+
+def _joined_gaps(points: np.ndarray, welding: Welding) -> np.ndarray:
+    """(W,) read-only: each vertex of ``welding`` (of the (V, 3) ``points``) at its largest distance from the given
+    vertices it joined (0 where it joined none: :attr:`PreparedMesh.crack_gaps`)."""
+    out = np.zeros(welding.vertices.shape[0])
+    rows = np.flatnonzero(welding.index >= 0)
+    distances = np.linalg.norm(points[rows] - welding.vertices[welding.index[rows]], axis=1)
+    moved = distances > 0
+    np.maximum.at(out, welding.index[rows[moved]], distances[moved])
+    return _read_only(out)
 
 
 def _face_spans(faces: np.ndarray, n_vertices: int, shift: int) -> np.ndarray:

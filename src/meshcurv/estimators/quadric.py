@@ -81,7 +81,9 @@ edge lengths, averaged over two rings), and
   width over ``sqrt(3)`` as their noise (:func:`_crack_sigmas`): on such a soup most points are in place and the
   level reads clean, while a ball of a few points by a crack follows the copies' offsets (fuzz 420/76: H off by
   up to 2.15 of the largest ``|k|``, valid). Not on other meshes: an irregular rim's vertices lie as close (the
-  irregular hemisphere at 2.5 edges: 1,343 -> 1,200 valid with them taken for cracks).
+  irregular hemisphere at 2.5 edges: 1,343 -> 1,200 valid with them taken for cracks). At the default radius the
+  vertices the weld joined across cracks wide for the curvature (:data:`WELDED_GAP`) are a crack's corners too,
+  and a ball of scatter over cracks is grown further (:data:`GROWN_REACH`).
 
 ``benchmarks/quadric_noise.md`` gives the errors before and after.
 
@@ -201,8 +203,19 @@ NOISE_SIGMA_FACTOR = 2.5
 SCATTER_SCALE = 2.0
 
 #: A ball of scatter is grown this much beyond the size at which its fit's spread (falling as ``r^-3``) would meet
-#: :data:`NOISE_REACH` (:func:`_scatter_check`).
+#: :data:`NOISE_REACH` (over cracks :data:`GROWN_REACH`; :func:`_scatter_check`).
 GROWTH_MARGIN = 1.1
+
+#: A ball of scatter over a soup's cracks at the default radius is grown until its fit's spread would be within this
+#: share of its curvature (:func:`_scatter_check`, step 4; with :data:`GROWTH_MARGIN`), below :data:`NOISE_REACH`,
+#: which the grown fit is then held to. The spread is honest (the quadrics over fine soups: their H off the truth by
+#: half a spread at the standard deviation), but the
+#: farthest of 10^5 balls lies 2.2-2.3 spreads out: balls grown to just within :data:`NOISE_REACH` (0.23 with the
+#: margin) read H 0.49 and 1.53 for 1, valid (issue 29, fuzz 400/78 and 690/72: ``icosphere(40)`` with every face
+#: detached by 0.096 and 0.059 edges, where the wider ball of step 3 read 0.89-1.05, spread 0.05-0.07). Off cracks
+#: (a noisy mesh) the balls stay as they were: the noisy saddle of ``accuracy.py --quick`` (0.3 h) read H 14 -> 19%
+#: off at the median with 0.15 everywhere. On a staircase :data:`STAIRCASE_PULL` does as much.
+GROWN_REACH = 0.15
 
 #: The growth of the residuals of structure over a ball :data:`SCATTER_SCALE` times wider, at the least
 #: (:func:`_scatter_check`): the noise left in residuals that grew by ``g`` is their share
@@ -234,8 +247,12 @@ DEPARTURE_SPREADS = 2.0
 #: fit follows the steps (:func:`_scatter_check`, step 5): one spread, as a jet departing from its quadric
 #: (:func:`_follow_quadrics`), since the steps are not independent noise. At :data:`DEPARTURE_SPREADS` the fits that
 #: departed by 1.7-2.0 spreads stayed, 11 of them off by more than half the largest ``|k|`` (up to 0.62) on fuzz
-#: 415/108; at 1 spread 5 grown balls' fits (up to 0.52), and 97% of the valid vertices take a grown ball.
-CRACK_DEPARTURE_SPREADS = 1.0
+#: 415/108; at 1 spread 5 grown balls' fits (up to 0.52), and 97% of the valid vertices take a grown ball. Half a
+#: spread (as on a staircase, :data:`STAIRCASE_DEPARTURE_SPREADS`): at one, a fit 1.06 spreads off stayed on
+#: ``icosphere(40)`` with every face detached by 0.059 edges (fuzz 690/72: H 1.39 for 1). With :data:`GROWN_REACH` and
+#: :data:`WELDED_GAP`, the tuned soups of ``benchmarks/quadric_soups_Q70.py`` went from 12 valid vertices off by more
+#: than half of ``|k|`` (517 by more than 0.35) to none, with 584 more valid.
+CRACK_DEPARTURE_SPREADS = 0.5
 
 
 #: A mesh (a group of components of one scale) whose median noise level (:func:`meshcurv.radius.local_noise`) exceeds
@@ -254,6 +271,20 @@ ROUGH_LEVEL = 0.02
 #: ball over a cylinder's or a saddle's rim: 100 -> 33% valid on the noisy coarse cylinder of ``accuracy.py
 #: --quick`` with every rim taken for a crack).
 CRACK_WIDTH = 0.5
+
+#: A vertex into which the weld joined the caller's vertices across cracks (``PreparedMesh.crack_gaps``: the
+#: largest distance of a copy joined into it) is a crack's corner (:func:`_welded_groups`) where that gap exceeds this
+#: share of ``h^2 k`` (``h`` its local edge length, ``k`` its group's median curvedness, :func:`_curvature_scales`):
+#: the welded point is one copy's, up to the gap off the surface, with no crack left to show it, and a fit over a
+#: ball of a few edges reads an offset ``delta`` as some ``delta / h^2`` of curvature beside the bend ``k`` it
+#: measures. On welded soups at the default the largest H error of the valid vertices grew as 2-3 times that ratio
+#: (``icosphere(24)`` with half or all of its faces detached by 0.002-0.016 edges: 0.07-0.95 of ``|k|``, 6,120 of
+#: 860,976 valid rows off by more than half: ``benchmarks/quadric_soups_Q70.py --set sweep``, none now; fuzz 730/1,
+#: ``icosphere(40)`` half detached by 0.031 edges, reads 0.6-1.4: H 0.03 and 1.69 for 1, valid). A weld narrow for
+#: the curvature stays on the jets: ``torus(3, 1, 32, 16)`` with 30% of its faces moved by 1e-3 edges
+#: (``tests/test_double_sided_welds_D24.py``) reads at most 0.003, and taking every welded vertex for a corner (Q69,
+#: reverted) left 272 of its 1,424 vertices valid, all right before (the largest H error 0.16 of ``|k|``).
+WELDED_GAP = 0.05
 
 
 #: On a staircase (a voxel surface at its default radius), the departure from the wider ball's quadric, in noise
@@ -408,6 +439,8 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
             unsure = _noise_reach((vertices, start, radii, referenced, facing), sigmas, curvatures, fields)
         else:  # the default radius: scatter told from structure by the residuals at two scales
             corners = _crack_corners(vertices, rim & referenced, mesh.scale_edge_means)
+            if mesh.n_cracked:  # the copies the weld joined across cracks wide for the curvature (_welded_groups)
+                corners |= _welded_groups(mesh, _curvature_scales(curvedness, scales, vertices, referenced))
             cracked = _cracked_balls(vertices, radii, corners)
             with np.errstate(invalid="ignore"):  # a noisy mesh: its group's median level above ROUGH_LEVEL
                 rough = _group_medians(levels, scales, np.isfinite(levels)) > ROUGH_LEVEL
@@ -929,9 +962,9 @@ def _scatter_check(
        the noise in them is the share ``sqrt((G^2 - g^2) / (G^2 - 1))`` (``G``: :data:`STRUCTURE_GROWTH`, the
        slowest growth of structure) of ``s``, and its spread within the reach passes (W20's check of the spread
        alone, against the noise fits' level, lost fandisk's creases: 80 -> 57% valid);
-    4. scatter takes the quadric over a ball grown until its spread (as ``r^-3``) is within the reach, at most
-       :data:`meshcurv.radius.JET_CURVATURE_CAP` over its curvedness, if it is; else it is NaN with
-       ``valid=False``;
+    4. scatter takes the quadric over a ball grown until its spread (as ``r^-3``) is within the reach (over cracks
+       within :data:`GROWN_REACH`), at most :data:`meshcurv.radius.JET_CURVATURE_CAP` over its curvedness, if it is
+       steady (its spread within the reach); else it is NaN with ``valid=False``;
     5. at the vertices whose ball holds a crack's corner (``cracked``, :func:`_cracked_balls`: a soup's detached
        faces), a quadric that departs from the wider ball's by more than :data:`CRACK_DEPARTURE_SPREADS` of its
        spreads follows the steps (the spread of independent noise underestimates their pull) whatever its residuals did:
@@ -1033,11 +1066,13 @@ def _scatter_check(
     rows, found, spreads, wide = rows[~structure], found[~structure], spreads[~structure], wide[~structure]
     if rows.size == 0:
         return unsure
-    # scatter: a ball grown until the spread (as r^-3) is within the reach, within the curvature's cap
+    # scatter: a ball grown until the spread (as r^-3) is within the reach, within the curvature's cap (over a
+    # soup's cracks within GROWN_REACH; on a staircase as for STAIRCASE_PULL times the spread)
     held = np.fmax(_curvedness(found, frames[rows], wide), floor[rows])
+    target = np.where(over_cracks[~structure] & (not staircase), GROWN_REACH, NOISE_REACH)
     with np.errstate(divide="ignore", invalid="ignore"):
         pull = STAIRCASE_PULL if staircase else 1.0
-        grown = wide * np.cbrt(pull * spreads / (NOISE_REACH * held)) * GROWTH_MARGIN
+        grown = wide * np.cbrt(pull * spreads / (target * held)) * GROWTH_MARGIN
         grown = np.fmin(np.fmax(grown, radii[rows]), JET_CURVATURE_CAP / held)
     again = np.isfinite(grown) & (np.abs(grown - wide) > 0.01 * wide)
     if again.any():
@@ -1143,6 +1178,19 @@ def _crack_gaps(vertices: np.ndarray, rim: np.ndarray, edge_lengths: np.ndarray)
 
     distances = cKDTree(vertices[ids]).query(vertices[ids], k=2)[0][:, 1]  # the nearest other rim vertex
     out[ids] = np.where(distances < CRACK_WIDTH * edge_lengths[ids], distances, np.nan)
+    return out
+
+
+def _welded_groups(mesh: PreparedMesh, curvatures: np.ndarray) -> np.ndarray:
+    """(V,) bool: the vertices into which the weld joined the caller's vertices across cracks wider than
+    :data:`WELDED_GAP` of ``h^2 k`` (``PreparedMesh.crack_gaps``; ``h`` the local edge length
+    ``mesh.scale_edge_means``, ``k`` the (V,) ``curvatures`` of :func:`_curvature_scales`): taken as a crack's
+    corners (:func:`_cracked_balls`). All False on a mesh not welded across cracks, and at a weld of coincident copies
+    (a seam: no gap)."""
+    out = np.zeros(mesh.vertices.shape[0], dtype=bool)
+    if mesh.crack_gaps is not None:
+        with np.errstate(invalid="ignore"):  # (NaN edge lengths: no corner)
+            out |= mesh.crack_gaps > WELDED_GAP * mesh.scale_edge_means**2 * curvatures
     return out
 
 
