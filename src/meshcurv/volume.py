@@ -220,7 +220,16 @@ from .result import CurvatureResult
 from .batch import _driver as driver
 from .statistics import COLUMNS as STATISTICS_COLUMNS
 from ._lazy import as_lazy, check_lazy_labels, is_lazy, lazy_objects
-from ._masks import check_smooth, check_threshold, labels_from_image, smoothed_crop, smoothed_surface
+from ._masks import (
+    canonical_pose,
+    check_smooth,
+    check_threshold,
+    labels_from_image,
+    posed,
+    posed_marching_cubes,
+    smoothed_crop,
+    smoothed_surface,
+)
 from .statistics import _face_average, _fold_note, _region_statistics
 
 __all__ = [
@@ -457,15 +466,20 @@ def _crop(image: np.ndarray, label: int, box) -> tuple[np.ndarray, np.ndarray, n
 
 
 def _surface(padded: np.ndarray, starts: np.ndarray, spacing: np.ndarray):
-    """Vertices (in voxels), outward faces, voxel count and centroid of one label's padded crop."""
+    """Vertices (in voxels), outward faces, voxel count and centroid of one label's padded crop.
+
+    The crop is cut in its :func:`meshcurv._masks.canonical_pose` and its
+    surface turned back: the same triangles in every mirror and permutation of
+    the image's axes.
+    """
     marching_cubes = _marching_cubes()
     mask = padded[1:-1, 1:-1, 1:-1]
     n_voxels = int(np.count_nonzero(mask))
     centroid = (np.array([np.mean(axis) for axis in np.nonzero(mask)]) + starts) * spacing
-    vertices, faces, _, _ = marching_cubes(padded.astype(np.float32), 0.5, method="lewiner", allow_degenerate=False)
+    pose = canonical_pose(padded, spacing)
     # in whole voxels first (exact), then to physical units: grid planes repeat bit for bit (meshcurv.lattice)
-    index = vertices.astype(np.float64) + (starts - 1)
-    faces = np.ascontiguousarray(faces[:, ::-1], dtype=np.int64)  # marching cubes winds a bright object inward
+    index, faces = posed_marching_cubes(posed(padded, pose).astype(np.float32), pose, marching_cubes)
+    index += starts - 1
     return index, faces, n_voxels, centroid
 
 
