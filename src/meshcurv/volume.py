@@ -8,7 +8,12 @@ scikit-image's marching cubes of the binary crop at level 0.5, placed in
 physical units (``index * spacing``, image axes 0, 1, 2, often called z, y,
 x) and wound outward (marching cubes winds the faces of a bright object
 inward: they are reversed, so that the outer surface of a cell and the wall of
-a cavity inside it both face away from the object). The curvatures are those
+a cavity inside it both face away from the object). Marching cubes is not
+equivariant (a mirrored cube's polygon is split by the other diagonal), so
+each crop is cut in the first of its 48 mirrors and axis permutations
+(:func:`meshcurv._masks.canonical_pose`) and its surface turned back: every
+mirror and permutation of the image's axes, the spacing permuted along, gets
+the same mesh moved rigidly, and the same row. The curvatures are those
 of :func:`meshcurv.principal_curvatures` with its default method (``icc``),
 whose default radius recognises the voxel grid of the mesh
 (``result.parameters["surface"] == "voxel"``: a radius of a few voxels that
