@@ -8,7 +8,12 @@ scikit-image's marching cubes of the binary crop at level 0.5, placed in
 physical units (``index * spacing``, image axes 0, 1, 2, often called z, y,
 x) and wound outward (marching cubes winds the faces of a bright object
 inward: they are reversed, so that the outer surface of a cell and the wall of
-a cavity inside it both face away from the object). The curvatures are those
+a cavity inside it both face away from the object). Marching cubes is not
+equivariant (a mirrored cube's polygon is split by the other diagonal), so
+each crop is cut in the first of its 48 mirrors and axis permutations
+(:func:`meshcurv._masks.canonical_pose`) and its surface turned back: every
+mirror and permutation of the image's axes, the spacing permuted along, gets
+the same mesh moved rigidly, and the same row. The curvatures are those
 of :func:`meshcurv.principal_curvatures` with its default method (``icc``),
 whose default radius recognises the voxel grid of the mesh
 (``result.parameters["surface"] == "voxel"``: a radius of a few voxels that
@@ -220,7 +225,16 @@ from .result import CurvatureResult
 from .batch import _driver as driver
 from .statistics import COLUMNS as STATISTICS_COLUMNS
 from ._lazy import as_lazy, check_lazy_labels, is_lazy, lazy_objects
-from ._masks import check_smooth, check_threshold, labels_from_image, smoothed_crop, smoothed_surface
+from ._masks import (
+    canonical_pose,
+    check_smooth,
+    check_threshold,
+    labels_from_image,
+    posed,
+    posed_marching_cubes,
+    smoothed_crop,
+    smoothed_surface,
+)
 from .statistics import _face_average, _fold_note, _region_statistics
 
 __all__ = [
@@ -457,15 +471,20 @@ def _crop(image: np.ndarray, label: int, box) -> tuple[np.ndarray, np.ndarray, n
 
 
 def _surface(padded: np.ndarray, starts: np.ndarray, spacing: np.ndarray):
-    """Vertices (in voxels), outward faces, voxel count and centroid of one label's padded crop."""
+    """Vertices (in voxels), outward faces, voxel count and centroid of one label's padded crop.
+
+    The crop is cut in its :func:`meshcurv._masks.canonical_pose` and its
+    surface turned back: the same triangles in every mirror and permutation of
+    the image's axes.
+    """
     marching_cubes = _marching_cubes()
     mask = padded[1:-1, 1:-1, 1:-1]
     n_voxels = int(np.count_nonzero(mask))
     centroid = (np.array([np.mean(axis) for axis in np.nonzero(mask)]) + starts) * spacing
-    vertices, faces, _, _ = marching_cubes(padded.astype(np.float32), 0.5, method="lewiner", allow_degenerate=False)
+    pose = canonical_pose(padded, spacing)
     # in whole voxels first (exact), then to physical units: grid planes repeat bit for bit (meshcurv.lattice)
-    index = vertices.astype(np.float64) + (starts - 1)
-    faces = np.ascontiguousarray(faces[:, ::-1], dtype=np.int64)  # marching cubes winds a bright object inward
+    index, faces = posed_marching_cubes(posed(padded, pose).astype(np.float32), pose, marching_cubes)
+    index += starts - 1
     return index, faces, n_voxels, centroid
 
 
