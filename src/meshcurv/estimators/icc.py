@@ -275,6 +275,12 @@ THIN_OPPOSITE = 0.25
 #: (:func:`meshcurv.jets._thin_part_normals`; a voxel surface's: :data:`meshcurv.jets.THIN_BEND`, its terraces'):
 #: a ball wraps round its own bend only where ``k r`` reaches about ``sqrt(2)``.
 SMOOTH_THIN_BEND = 1.0
+#: Where a normal fit's ball held points facing away (it reaches round a thin part, or round its own bend on a coarse
+#: mesh), the sums are read again over a ball :data:`THIN_WIDER` times wider, and the vertex is undefined (reason
+#: :data:`meshcurv.defects.REACH`) where H moves by more than this share of the largest ``|k|`` (:func:`_varying`) ...
+THIN_VARYING = 0.5
+#: ... (``sqrt(2)``: a bias growing as ``r^2`` adds as much again, so the step is the bias itself).
+THIN_WIDER = float(np.sqrt(2.0))
 
 
 STAGES = (
@@ -305,6 +311,7 @@ def fitted_normals(
     thin: bool = False,
     widen: float = THIN_WIDEN,
     coarse: bool = False,
+    reaching: np.ndarray | None = None,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -336,7 +343,9 @@ def fitted_normals(
     (:data:`meshcurv.jets.THIN_WIDEN`, its terraces; at samples of the centres), a smooth mesh's over the same balls
     at every centre (1: the other side of a
     thin rim tilted the fits of a clean ellipsoid (3, 3, 0.15) by 3.6-7 degrees over a band 0.8-0.95 of its radius,
-    and H took the wrong sign there; issue 29, T68).
+    and H took the wrong sign there; issue 29, T68). ``reaching`` (V,) bool, when given: set True, in place, at
+    the centres so checked whose ball held points facing away (or whose first fit failed): :func:`_varying` reads
+    their sums again over a wider ball.
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -449,6 +458,8 @@ def fitted_normals(
                 areas if weighted else None,
                 counts=counts,
             )
+    if reaching is not None and wrapped is not None:
+        reaching[wrapped] = True
     if level is None and thin and adjacency is not None and (fits is None or wrapped is not None):
         if wrapped is None or wrapped.size:
             fitted = _thin_part_normals(
@@ -1119,6 +1130,8 @@ def _curvatures(
     start("fit normals")
     failed = np.zeros(vertices.shape[0], dtype=bool)
     counts = None  # the points of the normal fits near holes, where cracks were welded (below)
+    facing_columns = reached is not None and boundary_faces is None and not coarse
+    wraps = np.zeros(vertices.shape[0], dtype=bool) if facing_columns else None  # (the fits reaching round: _varying)
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
@@ -1147,6 +1160,7 @@ def _curvatures(
             thin=True,
             widen=THIN_WIDEN if coarse else 1.0,
             coarse=coarse or coarse_fits,
+            reaching=wraps,
         )
 
         if boundary_faces is not None and adjacency is not None:
@@ -1161,7 +1175,6 @@ def _curvatures(
         corners = vertices[faces]
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
-    facing_columns = reached is not None and boundary_faces is None and not coarse
     if facing_columns:  # nine more columns: the faces' area vectors and normal tensors (THIN_FACING)
         measures = np.column_stack([measures, _facing_measures(vertices, faces)])
     areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
@@ -1189,6 +1202,8 @@ def _curvatures(
         valid &= ~sparse
     if facing is not None and reached is not None:
         reached |= _reaching(facing, summed[:, 0], normals, radius, k_min, k_max, valid)
+        if wraps is not None and wraps.any():
+            reached |= _varying(vertices, faces, measures, usable, radius, valid & wraps & ~reached, k_min, k_max)
         valid &= ~reached
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
@@ -1211,6 +1226,29 @@ def _facing_measures(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
         unit = np.where(size[:, None] > 0, sides / size[:, None], 0.0)
     rows, columns = [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]
     return np.column_stack([sides, size[:, None] * unit[:, rows] * unit[:, columns]])
+
+
+def _varying(vertices, faces, measures, usable, radius, centres, k_min, k_max) -> np.ndarray:
+    """(V,) bool: the ``centres`` (V,) bool whose H moves by more than :data:`THIN_VARYING` of their largest
+    ``|k|`` (``k_min``, ``k_max`` over the balls of ``radius``, a float or (V,)) when their ball is
+    :data:`THIN_WIDER` times wider (``measures`` (F, >= 3): the face measures, ``mu_0, mu_1, mu_2`` first;
+    ``usable``: :func:`_usable_faces`).
+
+    A ball's H is the mean of the surface's over it, the centre's plus a bias; where the bias grows as ``r^2`` the
+    wider ball's adds as much again, and the step between the two estimates it (a faster growth, more).
+    """
+    out = np.zeros(vertices.shape[0], dtype=bool)
+    ids = np.flatnonzero(centres)
+    if not ids.size:
+        return out
+    radii = THIN_WIDER * np.broadcast_to(np.asarray(radius, dtype=np.float64), (vertices.shape[0],))
+    values = np.ascontiguousarray(measures[:, :3])
+    wide = _ball_face_sums(vertices, faces, radii, values, usable=usable, connected=True, centres=ids)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        step = np.abs(wide[:, 1] / (2.0 * wide[:, 0]) - 0.5 * (k_min[ids] + k_max[ids]))
+        largest = np.maximum(np.abs(k_min[ids]), np.abs(k_max[ids]))
+        out[ids] = ~(step <= THIN_VARYING * largest)
+    return out
 
 
 def _reaching(facing, area, normals, radius, k_min, k_max, valid) -> np.ndarray:
@@ -1600,6 +1638,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     radii = [_check_radius(radius, mesh) if j in (0, last) else float(radius) for j, radius in enumerate(radii)]
     stages.start("fit normals")
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
+    wraps = np.zeros((len(radii), vertices.shape[0]), dtype=bool)  # the fits reaching round (_varying)
     # the fits of the radii not fitted on the coarse level (a voxel surface's wider than COARSE_EDGES median edges:
     # _coarse_fits; any other mesh's none), from one walk per vertex (the radii increase, and so does _dense: the
     # radii fitted so are the first ones)
@@ -1638,6 +1677,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             coarse=voxel,
             thin=True,  # a thin part's fits made again over their own side, as estimate's (widen 1)
             widen=1.0,
+            reaching=wraps[j],
         )
         for j, radius in enumerate(radii)
     ]
@@ -1659,12 +1699,16 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         )
     stages.start("retrieve curvatures")
     out = []
-    for radius, rung, sums, rung_failed in zip(radii, normals, summed, failed):
+    for radius, rung, sums, rung_failed, values, mask, wrapped in zip(
+        radii, normals, summed, failed, measures, kept, wraps
+    ):
         sums, facing_sums = sums[:, :-FACING_COLUMNS], sums[:, -FACING_COLUMNS:]
         k_min, k_max, dir_min, dir_max = curvatures_from_measures(sums, rung)
         parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius}
         rung_valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed)
         reached = _reaching(facing_sums, sums[:, 0], rung, radius, k_min, k_max, rung_valid)
+        if wrapped.any():  # as estimate's (_curvatures)
+            reached |= _varying(vertices, faces, values, mask, radius, rung_valid & wrapped & ~reached, k_min, k_max)
         fields = (k_min, k_max, dir_min, dir_max, rung, rung_valid & ~reached)
         out.append(_finished(parameters, fields, defects, np.full(vertices.shape[0], radius), reached))
     return out
@@ -1686,6 +1730,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     stages.start("fit normals")
     wide = _coarse_fits(mesh, NORMAL_RADIUS_RATIO * base, defects.invalid_vertices, stages)
     axes = _grid_axes(mesh, stages.voxel) if wide else None  # (the coarse level along the grid's axes)
+    wraps = np.zeros(vertices.shape[0], dtype=bool)  # the fits reaching round (_varying)
     normals = fitted_normals(
         _along(vertices, axes),
         _along(mesh.vertex_normals, axes),
@@ -1697,6 +1742,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
         coarse=wide,
         thin=True,  # a thin part's fits made again over their own side, as estimate's (widen 1)
         widen=1.0,
+        reaching=wraps,
     )
     normals = normals if axes is None else normals @ axes
     stages.start("compute face measures")
@@ -1704,9 +1750,8 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     stages.start("sum over balls")
     area = 0.5 * float(np.linalg.norm(mesh.cross[~_dropped(mesh)], axis=1).sum())
     radii = scale_ladder(base, median_edge_length(vertices, topology.edges), area)
-    summed = _ball_face_sums_nested(
-        vertices, faces, radii, measures, usable=_usable_faces(faces, _dropped(mesh), normals)
-    )
+    usable = _usable_faces(faces, _dropped(mesh), normals)
+    summed = _ball_face_sums_nested(vertices, faces, radii, measures, usable=usable)
     stages.start("retrieve curvatures")
     summed, facing_sums = summed[..., :-FACING_COLUMNS], summed[..., -FACING_COLUMNS:]
     rung = stable_scales(*principal_from_measures(summed), topology.neighbour_lists)
@@ -1717,5 +1762,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     valid = valid & np.isfinite(k_min)
     # the rung chosen holding a thin part's other side (_reaching): undefined, not a smaller rung's value
     reached = _reaching(facing_sums[rung, every], chosen[:, 0], normals, radii[rung], k_min, k_max, valid)
+    if wraps.any():  # the rung chosen read again over a wider ball (_varying)
+        reached |= _varying(vertices, faces, measures, usable, radii[rung], valid & wraps & ~reached, k_min, k_max)
     fields = (k_min, k_max, dir_min, dir_max, normals, valid & ~reached)
     return _finished(parameters, fields, defects, radii[rung], reached)
