@@ -344,8 +344,8 @@ def fitted_normals(
     at every centre (1: the other side of a
     thin rim tilted the fits of a clean ellipsoid (3, 3, 0.15) by 3.6-7 degrees over a band 0.8-0.95 of its radius,
     and H took the wrong sign there; issue 29, T68). ``reaching`` (V,) bool, when given: set True, in place, at
-    the centres so checked whose ball held points facing away (or whose first fit failed): :func:`_varying` reads
-    their sums again over a wider ball.
+    the centres whose fits were so made again (a ball reaching round a thin part): :func:`_varying` reads their
+    sums again over a wider ball.
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -458,13 +458,12 @@ def fitted_normals(
                 areas if weighted else None,
                 counts=counts,
             )
-    if reaching is not None and wrapped is not None:
-        reaching[wrapped] = True
     if level is None and thin and adjacency is not None and (fits is None or wrapped is not None):
         if wrapped is None or wrapped.size:
+            given = np.where(valid[:, None], fitted, normals)
             fitted = _thin_part_normals(
                 vertices,
-                np.where(valid[:, None], fitted, normals),
+                given,
                 radius,
                 np.flatnonzero(valid) if wrapped is None else wrapped,
                 neighbours=neighbours,
@@ -477,6 +476,8 @@ def fitted_normals(
                 sampled=widen != 1.0,
                 bend=THIN_BEND if widen != 1.0 else SMOOTH_THIN_BEND,
             )
+            if reaching is not None:  # the fits made again over their own side
+                reaching |= ~np.all((fitted == given) | (np.isnan(fitted) & np.isnan(given)), axis=1)
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     if failed is not None:
@@ -1203,7 +1204,7 @@ def _curvatures(
     if facing is not None and reached is not None:
         reached |= _reaching(facing, summed[:, 0], normals, radius, k_min, k_max, valid)
         if wraps is not None and wraps.any():
-            reached |= _varying(vertices, faces, measures, usable, radius, valid & wraps & ~reached, k_min, k_max)
+            reached |= _varying(vertices, faces, measures, usable, radius, valid & wraps & ~reached, k_min, k_max, normals)
         valid &= ~reached
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
@@ -1228,26 +1229,34 @@ def _facing_measures(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return np.column_stack([sides, size[:, None] * unit[:, rows] * unit[:, columns]])
 
 
-def _varying(vertices, faces, measures, usable, radius, centres, k_min, k_max) -> np.ndarray:
-    """(V,) bool: the ``centres`` (V,) bool whose H moves by more than :data:`THIN_VARYING` of their largest
-    ``|k|`` (``k_min``, ``k_max`` over the balls of ``radius``, a float or (V,)) when their ball is
-    :data:`THIN_WIDER` times wider (``measures`` (F, >= 3): the face measures, ``mu_0, mu_1, mu_2`` first;
-    ``usable``: :func:`_usable_faces`).
+def _varying(vertices, faces, measures, usable, radius, centres, k_min, k_max, normals) -> np.ndarray:
+    """(V,) bool: the ``centres`` (V,) bool whose ball :data:`THIN_WIDER` times wider than ``radius`` (a float or
+    (V,)) moves H by more than :data:`THIN_VARYING` of their largest ``|k|`` (``k_min``, ``k_max``, of the balls
+    of ``radius``) or holds the other side of a thin part (:func:`_reaching`, with those curvatures and
+    ``normals``). ``measures`` (F, >= 3): the face measures, ``mu_0, mu_1, mu_2`` first; ``usable``:
+    :func:`_usable_faces`.
 
-    A ball's H is the mean of the surface's over it, the centre's plus a bias; where the bias grows as ``r^2`` the
-    wider ball's adds as much again, and the step between the two estimates it (a faster growth, more).
+    A ball's H is the mean of the surface's over it: the centre's plus a bias. Where the bias grows as ``r^2`` the
+    wider ball adds as much again, and the step between the two is the bias itself (a faster growth: more). Near
+    the rim of a part thinner than the normal fits' balls the curvature grows fast towards the rim (on the
+    ellipsoid (3, 3, 0.15), ``k`` from 0.2 at 0.9 of its radius to 133 at the rim): a ball that stops short of the
+    rim (its facing as a ball of its own curvatures') still reads twice the centre's H there, with the exact
+    normals too; and a ball just short of reaching round the rim (its facing 0.4-0.5 below, :data:`THIN_FACING`)
+    reads it more than the wider ball does.
     """
     out = np.zeros(vertices.shape[0], dtype=bool)
     ids = np.flatnonzero(centres)
     if not ids.size:
         return out
     radii = THIN_WIDER * np.broadcast_to(np.asarray(radius, dtype=np.float64), (vertices.shape[0],))
-    values = np.ascontiguousarray(measures[:, :3])
+    values = np.column_stack([measures[:, :3], _facing_measures(vertices, faces)])
     wide = _ball_face_sums(vertices, faces, radii, values, usable=usable, connected=True, centres=ids)
+    k_min, k_max = k_min[ids], k_max[ids]
     with np.errstate(invalid="ignore", divide="ignore"):
-        step = np.abs(wide[:, 1] / (2.0 * wide[:, 0]) - 0.5 * (k_min[ids] + k_max[ids]))
-        largest = np.maximum(np.abs(k_min[ids]), np.abs(k_max[ids]))
-        out[ids] = ~(step <= THIN_VARYING * largest)
+        step = np.abs(wide[:, 1] / (2.0 * wide[:, 0]) - 0.5 * (k_min + k_max))
+        moved = ~(step <= THIN_VARYING * np.maximum(np.abs(k_min), np.abs(k_max)))
+    reaching = _reaching(wide[:, 3:], wide[:, 0], normals[ids], radii[ids], k_min, k_max, np.ones(ids.size, bool))
+    out[ids] = moved | reaching
     return out
 
 
@@ -1708,7 +1717,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         rung_valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed)
         reached = _reaching(facing_sums, sums[:, 0], rung, radius, k_min, k_max, rung_valid)
         if wrapped.any():  # as estimate's (_curvatures)
-            reached |= _varying(vertices, faces, values, mask, radius, rung_valid & wrapped & ~reached, k_min, k_max)
+            reached |= _varying(vertices, faces, values, mask, radius, rung_valid & wrapped & ~reached, k_min, k_max, rung)
         fields = (k_min, k_max, dir_min, dir_max, rung, rung_valid & ~reached)
         out.append(_finished(parameters, fields, defects, np.full(vertices.shape[0], radius), reached))
     return out
@@ -1763,6 +1772,6 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     # the rung chosen holding a thin part's other side (_reaching): undefined, not a smaller rung's value
     reached = _reaching(facing_sums[rung, every], chosen[:, 0], normals, radii[rung], k_min, k_max, valid)
     if wraps.any():  # the rung chosen read again over a wider ball (_varying)
-        reached |= _varying(vertices, faces, measures, usable, radii[rung], valid & wraps & ~reached, k_min, k_max)
+        reached |= _varying(vertices, faces, measures, usable, radii[rung], valid & wraps & ~reached, k_min, k_max, normals)
     fields = (k_min, k_max, dir_min, dir_max, normals, valid & ~reached)
     return _finished(parameters, fields, defects, radii[rung], reached)
