@@ -1217,7 +1217,9 @@ def _curvatures(
     if facing is not None and reached is not None:
         reached |= _reaching(facing, summed[:, 0], normals, radius, k_min, k_max, valid)
         if wraps is not None and wraps.any():
-            reached |= _varying(vertices, faces, measures, usable, radius, valid & wraps & ~reached, k_min, k_max, normals)
+            reached |= _varying(
+                vertices, faces, measures, usable, radius, valid & wraps & ~reached, k_min, k_max, normals
+            )
         valid &= ~reached
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
@@ -1730,7 +1732,9 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         rung_valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed)
         reached = _reaching(facing_sums, sums[:, 0], rung, radius, k_min, k_max, rung_valid)
         if wrapped.any():  # as estimate's (_curvatures)
-            reached |= _varying(vertices, faces, values, mask, radius, rung_valid & wrapped & ~reached, k_min, k_max, rung)
+            reached |= _varying(
+                vertices, faces, values, mask, radius, rung_valid & wrapped & ~reached, k_min, k_max, rung
+            )
         fields = (k_min, k_max, dir_min, dir_max, rung, rung_valid & ~reached)
         out.append(_finished(parameters, fields, defects, np.full(vertices.shape[0], radius), reached))
     return out
@@ -1785,6 +1789,8 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     # the rung chosen holding a thin part's other side (_reaching): undefined, not a smaller rung's value
     reached = _reaching(facing_sums[rung, every], chosen[:, 0], normals, radii[rung], k_min, k_max, valid)
     if wraps.any():  # the rung chosen read again over a wider ball (_varying)
-        reached |= _varying(vertices, faces, measures, usable, radii[rung], valid & wraps & ~reached, k_min, k_max, normals)
+        reached |= _varying(
+            vertices, faces, measures, usable, radii[rung], valid & wraps & ~reached, k_min, k_max, normals
+        )
     fields = (k_min, k_max, dir_min, dir_max, normals, valid & ~reached)
     return _finished(parameters, fields, defects, radii[rung], reached)
