@@ -122,6 +122,13 @@ undefined with the reason "ball reaches round the surface". (Issue 29: the clean
 ellipsoid (3, 3, 0.15) at 16 subdivisions, every vertex valid and H of the wrong
 sign over 0.8-0.95 of its radius, 1,048 vertices off by more than half of the
 largest ``|k|``; none now, 844 undefined at the rim; ``benchmarks/thin_band_T68.md``.)
+Where a fit was so made again, its vertex's sums are read again over a ball :data:`THIN_WIDER` times wider, and it
+is undefined for the same reason where that ball reaches round the part or moves H by more than
+:data:`THIN_VARYING` of its largest ``|k|`` (:func:`_varying`): towards the rim the curvature grows fast, and a ball
+that stops short of it reads up to twice the centre's H (given radii of 0.25 and 0.35 on that ellipsoid: 56 and 148
+valid vertices off, none now; ``benchmarks/thin_band_T68.py --radii``). A fit made again that turns further from the
+face normals than the first (:data:`THIN_FURTHER`: a tube thinner than the ball, whose own side reads flat) keeps the
+first.
 A coarse closed mesh whose balls wrap round its own bend (an icosahedron, a torus
 of 8 x 4 vertices) keeps its values: those balls are symmetric and their fits right.
 
