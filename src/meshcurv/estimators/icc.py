@@ -289,7 +289,8 @@ SMOOTH_THIN_BEND = 1.0
 #: face normals, and the median H error went 1.37% -> 4.45% (T68); kept: 1.37% again. On the thin ellipsoids the
 #: first fits lie 8-56 degrees off the face normals and the fits made again turn back towards them. With no margin
 #: the noisy and irregular coarse meshes of ``benchmarks/accuracy.py --quick``, whose first fits and face normals
-#: differ by their noise, moved by up to 3 points of p95 either way; at 5 and 10 degrees none moved (T70).
+#: differ by their noise, moved by up to 3 points of p95 either way; at 5 and 10 degrees none moved (T70). Not on a
+#: voxel surface (its wider fits, :data:`meshcurv.jets.THIN_WIDEN`): the face normals of a staircase are no guide.
 THIN_FURTHER = 10.0
 #: Where a normal fit was so made again (its ball reached round a thin part), the sums are read again over a ball
 #: :data:`THIN_WIDER` times wider (:func:`_varying`), and the vertex is undefined (reason
@@ -507,7 +508,7 @@ def fitted_normals(
                     np.arccos(np.clip(np.einsum("ij,ij->i", fitted, start), -1.0, 1.0))
                     - np.arccos(np.clip(np.einsum("ij,ij->i", given, start), -1.0, 1.0))
                 )
-                further = refitted & (turn > THIN_FURTHER)
+                further = refitted & (turn > THIN_FURTHER) & (widen == 1.0)  # (a staircase's face normals: kept)
             fitted[further] = given[further]
             refitted &= ~further
             if reaching is not None:  # the fits made again over their own side
