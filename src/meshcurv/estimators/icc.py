@@ -1130,6 +1130,7 @@ def _curvatures(
     pieces: np.ndarray | None = None,
     edge: float,
     reached: np.ndarray | None = None,
+    voxel=None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -1150,7 +1151,8 @@ def _curvatures(
     The normal fits on thin flat parts are made again over their own side (:func:`fitted_normals` ``thin``).
     ``reached`` (V,) bool, when given (not on a voxel surface at its default): set True, in place, at the vertices
     whose ball of the sums holds the other side of a thin part (:data:`THIN_FACING`), left out of the ``valid``
-    returned.
+    returned. ``voxel``: a callable telling whether the mesh is a voxel surface (read only where a thin part's fits
+    were made again: :func:`_varying` is not read on one).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -1238,7 +1240,7 @@ def _curvatures(
         valid &= ~sparse
     if facing is not None and reached is not None:
         reached |= _reaching(facing, summed[:, 0], normals, radius, k_min, k_max, valid)
-        if wraps is not None and wraps.any():
+        if wraps is not None and wraps.any() and not (voxel is not None and voxel()):
             reached |= _varying(
                 vertices, faces, measures, usable, radius, valid & wraps & ~reached, k_min, k_max, normals
             )
@@ -1264,6 +1266,21 @@ def _facing_measures(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
         unit = np.where(size[:, None] > 0, sides / size[:, None], 0.0)
     rows, columns = [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]
     return np.column_stack([sides, size[:, None] * unit[:, rows] * unit[:, columns]])
+
+
+def _voxel_reader(mesh: PreparedMesh, defects, stages: Stages):
+    """A callable: whether ``mesh`` is a voxel surface (:func:`meshcurv.radius._voxel_surface`, read once a call:
+    ``stages.voxel``). :func:`_varying` is not read on one: a label cut by the image border has a 90-degree crease
+    between its closing cap and its wall, whose normal fits are made again as a thin part's and whose wider balls
+    read the crease (``tests/test_volume_border.py``: 71-73 vertices of a cut hemisphere undefined)."""
+    found: list[bool] = []
+
+    def read() -> bool:
+        if not found:
+            found.append(bool(_voxel_surface(mesh, defects.invalid_vertices, reading=stages.voxel)))
+        return found[0]
+
+    return read
 
 
 def _varying(vertices, faces, measures, usable, radius, centres, k_min, k_max, normals) -> np.ndarray:
@@ -1580,6 +1597,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         }
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     pieces = _soup_pieces(mesh, defects, valid)
+    voxel = _voxel_reader(mesh, defects, stages)
     reached = np.zeros(vertices.shape[0], dtype=bool)  # balls holding a thin part's other side (THIN_FACING)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor,
         # more where its own noise calls for more (a noisy patch)
@@ -1607,6 +1625,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 pieces=pieces,
                 coarse_fits=wide,
                 reached=reached,
+                voxel=voxel,
             )
             local = _turned_back(computed, axes)[:-1]
             return _finished({**parameters, "scale": "local"}, local, defects, radii_v, reached)
@@ -1632,6 +1651,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             pieces=pieces,
             coarse_fits=wide,
             reached=reached if members is None else group_reached,
+            voxel=voxel,
         )
         computed = _turned_back(computed, axes)[:-1]
         if members is None:
@@ -1745,6 +1765,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         )
     stages.start("retrieve curvatures")
     out = []
+    voxel_reader = _voxel_reader(mesh, defects, stages)
     for radius, rung, sums, rung_failed, values, mask, wrapped in zip(
         radii, normals, summed, failed, measures, kept, wraps
     ):
@@ -1753,7 +1774,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius}
         rung_valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed)
         reached = _reaching(facing_sums, sums[:, 0], rung, radius, k_min, k_max, rung_valid)
-        if wrapped.any():  # as estimate's (_curvatures)
+        if wrapped.any() and not voxel_reader():  # as estimate's (_curvatures)
             reached |= _varying(
                 vertices, faces, values, mask, radius, rung_valid & wrapped & ~reached, k_min, k_max, rung
             )
@@ -1810,7 +1831,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     valid = valid & np.isfinite(k_min)
     # the rung chosen holding a thin part's other side (_reaching): undefined, not a smaller rung's value
     reached = _reaching(facing_sums[rung, every], chosen[:, 0], normals, radii[rung], k_min, k_max, valid)
-    if wraps.any():  # the rung chosen read again over a wider ball (_varying)
+    if wraps.any() and not _voxel_reader(mesh, defects, stages)():  # the rung chosen read over a wider ball (_varying)
         reached |= _varying(
             vertices, faces, measures, usable, radii[rung], valid & wraps & ~reached, k_min, k_max, normals
         )
