@@ -1105,8 +1105,12 @@ def _whole_ties(points, normals, centres, index, counts, radius, k):
         shared[:, :-1] &= chain[:, 1:]  # (a chain of one point: nothing to order)
         rows, cols = np.nonzero(inside & ~shared)
         if rows.size:
-            # (the mean offset of each ball's points, in their order of (squared distance, index))
-            mean = np.where(inside[..., None], step, 0.0).sum(axis=1) / np.maximum(found, 1)[:, None]
+            # (the ball's mean offset and its mean turn of the normals times the radius, in the order of (squared
+            # distance, index): a direction of the ball's own where its points are a symmetry of the lattice)
+            turn = normals[safe] - normals[centres][:, None, :]
+            turn = np.where(inside[..., None] & np.isfinite(turn), turn, 0.0).sum(axis=1)
+            offset = np.where(inside[..., None], step, 0.0).sum(axis=1)
+            mean = (offset + radius * turn) / np.maximum(found, 1)[:, None]
             turns = np.zeros(index.shape)
             turns[rows, cols] = _tie_turns(points, normals, index[rows, cols], centres[rows], mean[rows], radius)
             order = np.lexsort((np.where(inside, index, n), turns, np.cumsum(chain, axis=1)), axis=-1)
@@ -1141,9 +1145,9 @@ def _tie_keys(points, normals, members, centres) -> np.ndarray:
 
 def _tie_turns(points, normals, members, centres, mean, radius) -> np.ndarray:
     """(P,) the keys of :func:`meshcurv._kernels.pointcloud._tie_turn` of the points ``members`` (P,) in the balls of
-    ``centres`` (P,) whose mean offsets (of their points from the centre) are ``mean`` (P, 3), the same operations:
-    ``(u . g + w_0 n_c . (u x g)) / radius`` (:data:`TIE_WEIGHTS`) of the unit offset ``u`` from ``c`` to ``j`` (0
-    where they coincide) and ``g`` the mean offset; +inf where NaN.
+    ``centres`` (P,) whose balls' directions are ``mean`` (P, 3), the same operations: ``(u . g + w_0 n_c . (u x g)) /
+    radius`` (:data:`TIE_WEIGHTS`) of the unit offset ``u`` from ``c`` to ``j`` (0 where they coincide) and ``g``
+    the ball's mean offset plus ``radius`` times the mean turn of its normals from the centre's; +inf where NaN.
 
     Points at one distance whose :func:`_tie_keys` agree are a symmetry of the centre and the two normals: on a
     flat facet of a voxel staircase (every normal the same) every point of the facet at one distance, opposite

@@ -419,8 +419,8 @@ def _tie_key(points, normals, j, c):
 def _tie_turn(points, normals, j, c, gx, gy, gz, radius):
     """The place of point ``j`` among the points of the ball of ``c`` whose :func:`_tie_key` it shares (a symmetry
     of the centre and the normals: a flat facet's points at one distance): ``(u . g + w n_c . (u x g)) / radius`` of
-    the unit offset ``u`` from ``c`` to ``j`` and the ball's mean offset ``g``, which rigid motions keep; +inf where
-    it is NaN. The NumPy twin: :func:`meshcurv._pointcloud_estimators._tie_turns`."""
+    the unit offset ``u`` from ``c`` to ``j`` and ``g`` the ball's mean offset plus ``radius`` times its mean turn of
+    the normals, which rigid motions keep; +inf where it is NaN. The NumPy twin: :func:`meshcurv._pointcloud_estimators._tie_turns`."""
     dx, dy, dz = points[j, 0] - points[c, 0], points[j, 1] - points[c, 1], points[j, 2] - points[c, 2]
     length = np.sqrt(dx * dx + dy * dy + dz * dz)
     if length > 0.0:
@@ -459,14 +459,20 @@ def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, 
         out[row, a] = ids[a]
     for a in range(count, k):
         out[row, a] = n
-    gx = gy = gz = 0.0  # (the mean offset of the ball's points, in their order of (squared distance, index))
+    # the ball's mean offset and its mean turn of the normals times the radius, in the order of (squared distance,
+    # index): :func:`_tie_turn`'s direction of the ball
+    gx = gy = gz = hx = hy = hz = 0.0
     for a in range(count):
         q = ids[a]
         gx += points[q, 0] - points[c, 0]
         gy += points[q, 1] - points[c, 1]
         gz += points[q, 2] - points[c, 2]
+        tx, ty, tz = normals[q, 0] - normals[c, 0], normals[q, 1] - normals[c, 1], normals[q, 2] - normals[c, 2]
+        hx += tx if np.isfinite(tx) else 0.0
+        hy += ty if np.isfinite(ty) else 0.0
+        hz += tz if np.isfinite(tz) else 0.0
     if count > 0:
-        gx, gy, gz = gx / count, gy / count, gz / count
+        gx, gy, gz = (gx + radius * hx) / count, (gy + radius * hy) / count, (gz + radius * hz) / count
     start = 0
     for a in range(1, count + 1):
         if a == count or squared[a - 1] < squared[a] * (1.0 - tie):  # a run [start, a) ends
@@ -566,8 +572,9 @@ def _chunk_measured_balls(
         count = 0
         while count < held and sorted_squared[count] < inner:
             count += 1
+        limit = inner * (1.0 - tie)
         count = _whole_row(
-            points, normals, c, sorted_ids, sorted_squared, count, inner * (1.0 - tie), tie, least, index, row, n, radius
+            points, normals, c, sorted_ids, sorted_squared, count, limit, tie, least, index, row, n, radius
         )
         counts[row] = _own_row(normals, c, index, row, count, sheets, own, margin, n)
         if k_wide > 0:
