@@ -1123,16 +1123,23 @@ def _whole_ties(points, normals, centres, index, counts, radius, k):
     return np.ascontiguousarray(out), found
 
 
-def _tie_keys(points, normals, members, centres) -> np.ndarray:
-    """(P,) the keys of :func:`meshcurv._kernels.pointcloud._tie_key` of the points ``members`` (P,) in the balls of
-    ``centres`` (P,), the same operations: ``n_c . u + w_1 n_j . u + w_2 n_c . n_j + w_3 n_c . (u x n_j)``
-    (:data:`TIE_WEIGHTS`) of the unit offset ``u`` from ``c`` to ``j`` (0 where they coincide), +inf where NaN."""
+def _unit_offsets(points, members, centres) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The unit offsets (three (P,) components) from the points ``centres`` (P,) to ``members`` (P,) (0 where they
+    coincide): :func:`meshcurv._kernels.pointcloud._unit_offset`'s operations."""
     step = points[members] - points[centres]
     dx, dy, dz = step[:, 0], step[:, 1], step[:, 2]
     length = np.sqrt(dx * dx + dy * dy + dz * dz)
     with np.errstate(invalid="ignore", divide="ignore"):
         safe = np.where(length > 0.0, length, 1.0)
         ux, uy, uz = (np.where(length > 0.0, d / safe, 0.0) for d in (dx, dy, dz))
+    return ux, uy, uz
+
+
+def _tie_keys(points, normals, members, centres) -> np.ndarray:
+    """(P,) the keys of :func:`meshcurv._kernels.pointcloud._tie_key` of the points ``members`` (P,) in the balls of
+    ``centres`` (P,), the same operations: ``n_c . u + w_1 n_j . u + w_2 n_c . n_j + w_3 n_c . (u x n_j)``
+    (:data:`TIE_WEIGHTS`) of the unit offset ``u`` from ``c`` to ``j`` (0 where they coincide), +inf where NaN."""
+    ux, uy, uz = _unit_offsets(points, members, centres)
     a, b = normals[centres], normals[members]
     ax, ay, az, bx, by, bz = a[:, 0], a[:, 1], a[:, 2], b[:, 0], b[:, 1], b[:, 2]
     height = ax * ux + ay * uy + az * uz
@@ -1156,12 +1163,7 @@ def _tie_turns(points, normals, members, centres, mean, radius) -> np.ndarray:
     the ball's own that rigid motions, scaling and re-indexing move with it; it tells them apart unless the ball
     is symmetric about its centre's normal too.
     """
-    step = points[members] - points[centres]
-    dx, dy, dz = step[:, 0], step[:, 1], step[:, 2]
-    length = np.sqrt(dx * dx + dy * dy + dz * dz)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        safe = np.where(length > 0.0, length, 1.0)
-        ux, uy, uz = (np.where(length > 0.0, d / safe, 0.0) for d in (dx, dy, dz))
+    ux, uy, uz = _unit_offsets(points, members, centres)
     a = normals[centres]
     ax, ay, az, gx, gy, gz = a[:, 0], a[:, 1], a[:, 2], mean[:, 0], mean[:, 1], mean[:, 2]
     along = ux * gx + uy * gy + uz * gz

@@ -394,17 +394,22 @@ def _sort_ball(squared, ids, found, limit, sorted_squared, sorted_ids, starts):
 
 
 @nb.njit(inline="always", **_JIT)
+def _unit_offset(points, j, c):
+    """The unit offset from point ``c`` to point ``j`` (0 where they coincide)."""
+    dx, dy, dz = points[j, 0] - points[c, 0], points[j, 1] - points[c, 1], points[j, 2] - points[c, 2]
+    length = np.sqrt(dx * dx + dy * dy + dz * dz)
+    if length > 0.0:
+        return dx / length, dy / length, dz / length
+    return 0.0, 0.0, 0.0
+
+
+@nb.njit(inline="always", **_JIT)
 def _tie_key(points, normals, j, c):
     """The place of point ``j`` among the points of the ball of ``c`` at its distance: a sum of four cosines of
     the unit offset ``u`` from ``c`` to ``j`` and the two normals (``n_c . u``, ``n_j . u``, ``n_c . n_j`` and
     ``n_c . (u x n_j)``) with weights of no common ratio, which rigid motions keep (the last one tells mirror images
     apart); +inf where it is NaN. The NumPy twin: :func:`meshcurv._pointcloud_estimators._tie_keys`."""
-    dx, dy, dz = points[j, 0] - points[c, 0], points[j, 1] - points[c, 1], points[j, 2] - points[c, 2]
-    length = np.sqrt(dx * dx + dy * dy + dz * dz)
-    if length > 0.0:
-        ux, uy, uz = dx / length, dy / length, dz / length
-    else:
-        ux, uy, uz = 0.0, 0.0, 0.0
+    ux, uy, uz = _unit_offset(points, j, c)
     ax, ay, az = normals[c, 0], normals[c, 1], normals[c, 2]
     bx, by, bz = normals[j, 0], normals[j, 1], normals[j, 2]
     height = ax * ux + ay * uy + az * uz
@@ -421,12 +426,7 @@ def _tie_turn(points, normals, j, c, gx, gy, gz, radius):
     of the centre and the normals: a flat facet's points at one distance): ``(u . g + w n_c . (u x g)) / radius`` of
     the unit offset ``u`` from ``c`` to ``j`` and ``g`` the ball's mean offset plus ``radius`` times its mean turn of
     the normals, which rigid motions keep; +inf where it is NaN. The NumPy twin: :func:`meshcurv._pointcloud_estimators._tie_turns`."""
-    dx, dy, dz = points[j, 0] - points[c, 0], points[j, 1] - points[c, 1], points[j, 2] - points[c, 2]
-    length = np.sqrt(dx * dx + dy * dy + dz * dz)
-    if length > 0.0:
-        ux, uy, uz = dx / length, dy / length, dz / length
-    else:
-        ux, uy, uz = 0.0, 0.0, 0.0
+    ux, uy, uz = _unit_offset(points, j, c)
     ax, ay, az = normals[c, 0], normals[c, 1], normals[c, 2]
     along = ux * gx + uy * gy + uz * gz
     twist = ax * (uy * gz - uz * gy) + ay * (uz * gx - ux * gz) + az * (ux * gy - uy * gx)
@@ -599,62 +599,63 @@ def _chunk_measured_balls(
 @nb.njit(**_JIT)
 def _sort_tied(points, normals, c, out, row, start, end, tie, gx, gy, gz, radius):
     """Sort ``out[row, start:end]`` by :func:`_tie_key`, keys within ``tie`` of the one before (a chain) by
-    :func:`_tie_turn` (of the ball's mean offset ``g`` and ``radius``), those within ``tie`` of the one before by
+    :func:`_tie_turn` (of the ball's direction ``g`` and ``radius``), those within ``tie`` of the one before by
     index: insertion sorts (a few points). Points whose keys differ by round-off alone (a symmetry of the ball: the
     same geometry) keep one order on both backends."""
-    for a in range(start + 1, end):
-        q = out[row, a]
-        key = _tie_key(points, normals, q, c)
-        j = a
-        while j > start:
-            p = out[row, j - 1]
-            other = _tie_key(points, normals, p, c)
-            if not (other > key or (other == key and p > q)):
-                break
-            out[row, j] = p
-            j -= 1
-        out[row, j] = q
+    _sort_places(points, normals, c, out, row, start, end, gx, gy, gz, radius, False)
     first = start
-    before = _tie_key(points, normals, out[row, start], c)
-    for a in range(start + 1, end + 1):
-        key = _tie_key(points, normals, out[row, a], c) if a < end else np.inf
-        if a == end or key - before > tie:  # a chain [first, a) ends
-            if a - first > 1:
-                _sort_chain(points, normals, c, out, row, first, a, tie, gx, gy, gz, radius)
-            first = a
-        before = key
+    while first < end:
+        stop = _chain_end(points, normals, c, out, row, first, end, tie, gx, gy, gz, radius, False)
+        if stop - first > 1:
+            _sort_places(points, normals, c, out, row, first, stop, gx, gy, gz, radius, True)
+            inner = first
+            while inner < stop:
+                last = _chain_end(points, normals, c, out, row, inner, stop, tie, gx, gy, gz, radius, True)
+                for b in range(inner + 1, last):  # by index
+                    q = out[row, b]
+                    j = b
+                    while j > inner and out[row, j - 1] > q:
+                        out[row, j] = out[row, j - 1]
+                        j -= 1
+                    out[row, j] = q
+                inner = last
+        first = stop
+
+
+@nb.njit(inline="always", **_JIT)
+def _place(points, normals, j, c, gx, gy, gz, radius, turn):
+    """:func:`_tie_turn` of ``j`` (``turn``) or its :func:`_tie_key`."""
+    return _tie_turn(points, normals, j, c, gx, gy, gz, radius) if turn else _tie_key(points, normals, j, c)
 
 
 @nb.njit(**_JIT)
-def _sort_chain(points, normals, c, out, row, start, end, tie, gx, gy, gz, radius):
-    """Sort the chain ``out[row, start:end]`` of :func:`_sort_tied` by ``(`` :func:`_tie_turn` ``, index)``, then
-    each run of turns within ``tie`` of the one before by index."""
+def _sort_places(points, normals, c, out, row, start, end, gx, gy, gz, radius, turn):
+    """Sort ``out[row, start:end]`` by ``(`` :func:`_place` ``, index)``: an insertion sort."""
     for a in range(start + 1, end):
         q = out[row, a]
-        key = _tie_turn(points, normals, q, c, gx, gy, gz, radius)
+        key = _place(points, normals, q, c, gx, gy, gz, radius, turn)
         j = a
         while j > start:
             p = out[row, j - 1]
-            other = _tie_turn(points, normals, p, c, gx, gy, gz, radius)
+            other = _place(points, normals, p, c, gx, gy, gz, radius, turn)
             if not (other > key or (other == key and p > q)):
                 break
             out[row, j] = p
             j -= 1
         out[row, j] = q
-    first = start
-    before = _tie_turn(points, normals, out[row, start], c, gx, gy, gz, radius)
-    for a in range(start + 1, end + 1):
-        key = _tie_turn(points, normals, out[row, a], c, gx, gy, gz, radius) if a < end else np.inf
-        if a == end or key - before > tie:  # a run [first, a) ends
-            for b in range(first + 1, a):
-                q = out[row, b]
-                j = b
-                while j > first and out[row, j - 1] > q:
-                    out[row, j] = out[row, j - 1]
-                    j -= 1
-                out[row, j] = q
-            first = a
+
+
+@nb.njit(**_JIT)
+def _chain_end(points, normals, c, out, row, first, end, tie, gx, gy, gz, radius, turn):
+    """The end of the chain of ``out[row, first:end]`` (sorted by :func:`_place`) from ``first``: the first point
+    whose place is more than ``tie`` above the one before (``end`` when none)."""
+    before = _place(points, normals, out[row, first], c, gx, gy, gz, radius, turn)
+    for a in range(first + 1, end):
+        key = _place(points, normals, out[row, a], c, gx, gy, gz, radius, turn)
+        if key - before > tie:
+            return a
         before = key
+    return end
 
 
 @nb.njit(**_JIT)
