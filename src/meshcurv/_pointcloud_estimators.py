@@ -1111,6 +1111,8 @@ def _whole_ties(points, normals, centres, index, counts, radius, k):
             turn = np.where(inside[..., None] & np.isfinite(turn), turn, 0.0).sum(axis=1)
             offset = np.where(inside[..., None], step, 0.0).sum(axis=1)
             mean = (offset + radius * turn) / np.maximum(found, 1)[:, None]
+            # (a centre without a normal: its ties by index, as its keys)
+            mean[~(_dot(normals[centres], normals[centres]) > 0.0)] = 0.0
             turns = np.zeros(index.shape)
             turns[rows, cols] = _tie_turns(points, normals, index[rows, cols], centres[rows], mean[rows], radius)
             order = np.lexsort((np.where(inside, index, n), turns, np.cumsum(chain, axis=1)), axis=-1)

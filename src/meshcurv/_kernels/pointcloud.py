@@ -473,6 +473,8 @@ def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, 
         hz += tz if np.isfinite(tz) else 0.0
     if count > 0:
         gx, gy, gz = (gx + radius * hx) / count, (gy + radius * hy) / count, (gz + radius * hz) / count
+    if not normals[c, 0] * normals[c, 0] + normals[c, 1] * normals[c, 1] + normals[c, 2] * normals[c, 2] > 0.0:
+        gx = gy = gz = 0.0  # (a centre without a normal: its ties by index, as its keys)
     start = 0
     for a in range(1, count + 1):
         if a == count or squared[a - 1] < squared[a] * (1.0 - tie):  # a run [start, a) ends
