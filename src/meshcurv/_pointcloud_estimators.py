@@ -32,10 +32,13 @@ TRIANGLES = 32
 #: within this fraction of their lengths' product: its corrected area is round-off, and so is the sign that turns
 #: it. On a lattice (a mesh's vertices as a cloud) such triangles are common, and normals equal to round-off turned
 #: them apart on the two backends (``benchmarks/fuzz_api.md``, round 11). So does a flat triangle (three points of a
-#: lattice's line: the cross product of its edges within this fraction of their L1 lengths' product), whose area is
+#: lattice's line: the cross product of its edges within this fraction of their lengths' product), whose area is
 #: round-off once the cloud is turned, in a direction of its own: its measures of the normals' turning (mu_1, mu_2,
 #: not small) came with the sign of that round-off (a voxel sphere turned: 680 of 3,706 estimates 1e-3 of the
-#: largest |k| apart, up to 1.3e-2).
+#: largest |k| apart, up to 1.3e-2). Euclidean lengths, not L1 ones: the L1 lengths' ratio changes by up to 3
+#: times under a rotation, and triangles of a sine between 1e-9 and a few 1e-9 (a voxel line's points with near
+#: copies merged at their centroid, 1e-11 of the extent apart) were dropped in one pose and kept in the other,
+#: mu_1 up to 0.09 with the sign of that near-zero area (``fuzz_api.py --seed 771 --replay 19``: 25 points' validity).
 EDGE_ON = 1e-9
 
 #: Most points of a ball that ``corrected_measures`` draws its triangles from (the nearest ones).
@@ -913,10 +916,13 @@ def _triangle_sums(points, normals, index, counts, pattern):
     u2x, u2y, u2z = u2[..., 0], u2[..., 1], u2[..., 2]
     sx, sy, sz = u0x + u1x + u2x, u0y + u1y + u2y, u0z + u1z + u2z
     cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-    # a triangle edge-on to its corners' normals, or flat, adds nothing: its sign would be round-off (EDGE_ON)
-    area = np.abs(cx) + np.abs(cy) + np.abs(cz)
-    edge_on = np.abs(sx * cx + sy * cy + sz * cz) <= EDGE_ON * (np.abs(sx) + np.abs(sy) + np.abs(sz)) * area
-    edge_on |= area <= EDGE_ON * (np.abs(ax) + np.abs(ay) + np.abs(az)) * (np.abs(bx) + np.abs(by) + np.abs(bz))
+    # a triangle edge-on to its corners' normals, or flat, adds nothing: its sign would be round-off (EDGE_ON;
+    # Euclidean lengths, which no rotation changes)
+    tolerance = EDGE_ON * EDGE_ON
+    area = cx * cx + cy * cy + cz * cz
+    facing = sx * cx + sy * cy + sz * cz
+    edge_on = facing * facing <= tolerance * (sx * sx + sy * sy + sz * sz) * area
+    edge_on |= area <= tolerance * (ax * ax + ay * ay + az * az) * (bx * bx + by * by + bz * bz)
     mx, my, mz = sx / 3, sy / 3, sz / 3
     # turned so that its normal agrees with the mean of its corners' normals: (i, j, k) -> (i, k, j)
     flip = mx * cx + my * cy + mz * cz < 0
@@ -1089,26 +1095,53 @@ def _whole_ties(points, normals, centres, index, counts, radius, k):
         run = np.cumsum(starts, axis=1)
         order = np.lexsort((np.where(inside, index, n), keys, run), axis=-1)
         index, keys = np.take_along_axis(index, order, axis=1), np.take_along_axis(keys, order, axis=1)
-        # keys within SQUARED_TIE of the one before (chains: a symmetry of the ball, its keys round-off apart) by index
+        # keys within SQUARED_TIE of the one before (chains: a symmetry of the point and its normals, its keys
+        # round-off apart) by their offsets' place against the ball's mean offset (:func:`_tie_turns`), and those
+        # within SQUARED_TIE of the one before by index
         with np.errstate(invalid="ignore"):  # (inf - inf: NaN keys, one chain)
             chain = np.ones(index.shape, dtype=bool)
             chain[:, 1:] = starts[:, 1:] | (keys[:, 1:] - keys[:, :-1] > SQUARED_TIE)
+        shared = chain.copy()
+        shared[:, :-1] &= chain[:, 1:]  # (a chain of one point: nothing to order)
+        rows, cols = np.nonzero(inside & ~shared)
+        if rows.size:
+            # (the ball's mean offset and its mean turn of the normals times the radius, in the order of (squared
+            # distance, index): a direction of the ball's own where its points are a symmetry of the lattice)
+            turn = normals[safe] - normals[centres][:, None, :]
+            turn = np.where(inside[..., None] & np.isfinite(turn), turn, 0.0).sum(axis=1)
+            offset = np.where(inside[..., None], step, 0.0).sum(axis=1)
+            mean = (offset + radius * turn) / np.maximum(found, 1)[:, None]
+            # (a centre without a normal: its ties by index, as its keys)
+            mean[~(_dot(normals[centres], normals[centres]) > 0.0)] = 0.0
+            turns = np.zeros(index.shape)
+            turns[rows, cols] = _tie_turns(points, normals, index[rows, cols], centres[rows], mean[rows], radius)
+            order = np.lexsort((np.where(inside, index, n), turns, np.cumsum(chain, axis=1)), axis=-1)
+            index, turns = np.take_along_axis(index, order, axis=1), np.take_along_axis(turns, order, axis=1)
+            with np.errstate(invalid="ignore"):
+                chain[:, 1:] |= turns[:, 1:] - turns[:, :-1] > SQUARED_TIE
         order = np.lexsort((np.where(inside, index, n), np.cumsum(chain, axis=1)), axis=-1)
         index = np.take_along_axis(index, order, axis=1)
     out = np.where(inside, index, n)[:, :k]
     return np.ascontiguousarray(out), found
 
 
-def _tie_keys(points, normals, members, centres) -> np.ndarray:
-    """(P,) the keys of :func:`meshcurv._kernels.pointcloud._tie_key` of the points ``members`` (P,) in the balls of
-    ``centres`` (P,), the same operations: ``n_c . u + w_1 n_j . u + w_2 n_c . n_j + w_3 n_c . (u x n_j)``
-    (:data:`TIE_WEIGHTS`) of the unit offset ``u`` from ``c`` to ``j`` (0 where they coincide), +inf where NaN."""
+def _unit_offsets(points, members, centres) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The unit offsets (three (P,) components) from the points ``centres`` (P,) to ``members`` (P,) (0 where they
+    coincide): :func:`meshcurv._kernels.pointcloud._unit_offset`'s operations."""
     step = points[members] - points[centres]
     dx, dy, dz = step[:, 0], step[:, 1], step[:, 2]
     length = np.sqrt(dx * dx + dy * dy + dz * dz)
     with np.errstate(invalid="ignore", divide="ignore"):
         safe = np.where(length > 0.0, length, 1.0)
         ux, uy, uz = (np.where(length > 0.0, d / safe, 0.0) for d in (dx, dy, dz))
+    return ux, uy, uz
+
+
+def _tie_keys(points, normals, members, centres) -> np.ndarray:
+    """(P,) the keys of :func:`meshcurv._kernels.pointcloud._tie_key` of the points ``members`` (P,) in the balls of
+    ``centres`` (P,), the same operations: ``n_c . u + w_1 n_j . u + w_2 n_c . n_j + w_3 n_c . (u x n_j)``
+    (:data:`TIE_WEIGHTS`) of the unit offset ``u`` from ``c`` to ``j`` (0 where they coincide), +inf where NaN."""
+    ux, uy, uz = _unit_offsets(points, members, centres)
     a, b = normals[centres], normals[members]
     ax, ay, az, bx, by, bz = a[:, 0], a[:, 1], a[:, 2], b[:, 0], b[:, 1], b[:, 2]
     height = ax * ux + ay * uy + az * uz
@@ -1116,6 +1149,28 @@ def _tie_keys(points, normals, members, centres) -> np.ndarray:
     cosine = ax * bx + ay * by + az * bz
     twist = ax * (uy * bz - uz * by) + ay * (uz * bx - ux * bz) + az * (ux * by - uy * bx)
     key = height + TIE_WEIGHTS[0] * slope + TIE_WEIGHTS[1] * cosine + TIE_WEIGHTS[2] * twist
+    return np.where(np.isnan(key), np.inf, key)
+
+
+def _tie_turns(points, normals, members, centres, mean, radius) -> np.ndarray:
+    """(P,) the keys of :func:`meshcurv._kernels.pointcloud._tie_turn` of the points ``members`` (P,) in the balls of
+    ``centres`` (P,) whose balls' directions are ``mean`` (P, 3), the same operations: ``(u . g + w_0 n_c . (u x g)) /
+    radius`` (:data:`TIE_WEIGHTS`) of the unit offset ``u`` from ``c`` to ``j`` (0 where they coincide) and ``g``
+    the ball's mean offset plus ``radius`` times the mean turn of its normals from the centre's; +inf where NaN.
+
+    Points at one distance whose :func:`_tie_keys` agree are a symmetry of the centre and the two normals: on a
+    flat facet of a voxel staircase (every normal the same) every point of the facet at one distance, opposite
+    points among them. Their order was their index, which the pose chose (the Morton order): their triangles and
+    measures 0.04 of |k| apart (``fuzz_api.py --seed 771 --replay 19``). The ball's mean offset is a direction of
+    the ball's own that rigid motions, scaling and re-indexing move with it; it tells them apart unless the ball
+    is symmetric about its centre's normal too.
+    """
+    ux, uy, uz = _unit_offsets(points, members, centres)
+    a = normals[centres]
+    ax, ay, az, gx, gy, gz = a[:, 0], a[:, 1], a[:, 2], mean[:, 0], mean[:, 1], mean[:, 2]
+    along = ux * gx + uy * gy + uz * gz
+    twist = ax * (uy * gz - uz * gy) + ay * (uz * gx - ux * gz) + az * (ux * gy - uy * gx)
+    key = (along + TIE_WEIGHTS[0] * twist) / radius
     return np.where(np.isnan(key), np.inf, key)
 
 

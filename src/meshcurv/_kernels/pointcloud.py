@@ -19,20 +19,22 @@ from .neighborhoods import _ball_members
 @nb.njit(**_JIT)
 def _edge_on(points, normals, i, j, k, tolerance):
     """Whether the triangle ``(i, j, k)`` holds the mean of its corners' normals in its plane, within
-    ``tolerance`` of the product of their (L1) lengths, or is flat (the L1 length of the cross product of its two
+    ``tolerance`` of the product of their (Euclidean) lengths, or is flat (the length of the cross product of its two
     edges from ``i`` within ``tolerance`` of the product of theirs): its corrected area is round-off, and so is the
-    sign that turns it (:data:`meshcurv._pointcloud_estimators.EDGE_ON`)."""
+    sign that turns it (:data:`meshcurv._pointcloud_estimators.EDGE_ON`). Squared lengths, which no rotation
+    changes (L1 ones do, by up to 3 times): the operations of the NumPy path, in its order."""
     ax, ay, az = points[j, 0] - points[i, 0], points[j, 1] - points[i, 1], points[j, 2] - points[i, 2]
     bx, by, bz = points[k, 0] - points[i, 0], points[k, 1] - points[i, 1], points[k, 2] - points[i, 2]
     mx = normals[i, 0] + normals[j, 0] + normals[k, 0]
     my = normals[i, 1] + normals[j, 1] + normals[k, 1]
     mz = normals[i, 2] + normals[j, 2] + normals[k, 2]
     cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-    area = abs(cx) + abs(cy) + abs(cz)
-    if area <= tolerance * (abs(ax) + abs(ay) + abs(az)) * (abs(bx) + abs(by) + abs(bz)):
+    squared = tolerance * tolerance
+    area = cx * cx + cy * cy + cz * cz
+    if area <= squared * (ax * ax + ay * ay + az * az) * (bx * bx + by * by + bz * bz):
         return True
-    facing = abs(mx * cx + my * cy + mz * cz)
-    return facing <= tolerance * (abs(mx) + abs(my) + abs(mz)) * area
+    facing = mx * cx + my * cy + mz * cz
+    return facing * facing <= squared * (mx * mx + my * my + mz * mz) * area
 
 
 @nb.njit(**_JIT)
@@ -392,17 +394,22 @@ def _sort_ball(squared, ids, found, limit, sorted_squared, sorted_ids, starts):
 
 
 @nb.njit(inline="always", **_JIT)
+def _unit_offset(points, j, c):
+    """The unit offset from point ``c`` to point ``j`` (0 where they coincide)."""
+    dx, dy, dz = points[j, 0] - points[c, 0], points[j, 1] - points[c, 1], points[j, 2] - points[c, 2]
+    length = np.sqrt(dx * dx + dy * dy + dz * dz)
+    if length > 0.0:
+        return dx / length, dy / length, dz / length
+    return 0.0, 0.0, 0.0
+
+
+@nb.njit(inline="always", **_JIT)
 def _tie_key(points, normals, j, c):
     """The place of point ``j`` among the points of the ball of ``c`` at its distance: a sum of four cosines of
     the unit offset ``u`` from ``c`` to ``j`` and the two normals (``n_c . u``, ``n_j . u``, ``n_c . n_j`` and
     ``n_c . (u x n_j)``) with weights of no common ratio, which rigid motions keep (the last one tells mirror images
     apart); +inf where it is NaN. The NumPy twin: :func:`meshcurv._pointcloud_estimators._tie_keys`."""
-    dx, dy, dz = points[j, 0] - points[c, 0], points[j, 1] - points[c, 1], points[j, 2] - points[c, 2]
-    length = np.sqrt(dx * dx + dy * dy + dz * dz)
-    if length > 0.0:
-        ux, uy, uz = dx / length, dy / length, dz / length
-    else:
-        ux, uy, uz = 0.0, 0.0, 0.0
+    ux, uy, uz = _unit_offset(points, j, c)
     ax, ay, az = normals[c, 0], normals[c, 1], normals[c, 2]
     bx, by, bz = normals[j, 0], normals[j, 1], normals[j, 2]
     height = ax * ux + ay * uy + az * uz
@@ -413,8 +420,22 @@ def _tie_key(points, normals, j, c):
     return key if key == key else np.inf
 
 
+@nb.njit(inline="always", **_JIT)
+def _tie_turn(points, normals, j, c, gx, gy, gz, radius):
+    """The place of point ``j`` among the points of the ball of ``c`` whose :func:`_tie_key` it shares (a symmetry
+    of the centre and the normals: a flat facet's points at one distance): ``(u . g + w n_c . (u x g)) / radius`` of
+    the unit offset ``u`` from ``c`` to ``j`` and ``g`` the ball's mean offset plus ``radius`` times its mean turn of
+    the normals, which rigid motions keep; +inf where it is NaN. The NumPy twin: :func:`meshcurv._pointcloud_estimators._tie_turns`."""
+    ux, uy, uz = _unit_offset(points, j, c)
+    ax, ay, az = normals[c, 0], normals[c, 1], normals[c, 2]
+    along = ux * gx + uy * gy + uz * gz
+    twist = ax * (uy * gz - uz * gy) + ay * (uz * gx - ux * gz) + az * (ux * gy - uy * gx)
+    key = (along + 0.6180339887498949 * twist) / radius
+    return key if key == key else np.inf
+
+
 @nb.njit(**_JIT)
-def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, row, n):
+def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, row, n, radius):
     """Row ``row`` of ``out`` (M, k) from the ball of point ``c``: its ``count`` points ``ids`` (K,) in the order of
     ``(squared distance, index)`` and their ``squared`` distances, cut to the radius and to ``k`` points with the
     points tied in distance taken or dropped whole and ordered among themselves by the geometry; returns its count.
@@ -423,7 +444,8 @@ def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, 
     ``tie`` (of the squared distance: ``limit`` is the squared radius less the tie) go; a row holding more than
     ``k`` loses the points tied with its ``k + 1``-th (unless fewer than ``least`` would be left: then its first
     ``k``); each run of points tied with the one before is sorted by :func:`_tie_key` (keys within ``tie``: by
-    index, :func:`_sort_tied`). Padded with ``n``. ``ids`` and ``squared``: the search's buffers."""
+    index, :func:`_sort_tied`, which takes the ball's mean offset and ``radius``). Padded with ``n``. ``ids`` and
+    ``squared``: the search's buffers."""
     k = out.shape[1]
     while count > 0 and squared[count - 1] >= limit:
         count -= 1
@@ -437,11 +459,27 @@ def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, 
         out[row, a] = ids[a]
     for a in range(count, k):
         out[row, a] = n
+    # the ball's mean offset and its mean turn of the normals times the radius, in the order of (squared distance,
+    # index): :func:`_tie_turn`'s direction of the ball
+    gx = gy = gz = hx = hy = hz = 0.0
+    for a in range(count):
+        q = ids[a]
+        gx += points[q, 0] - points[c, 0]
+        gy += points[q, 1] - points[c, 1]
+        gz += points[q, 2] - points[c, 2]
+        tx, ty, tz = normals[q, 0] - normals[c, 0], normals[q, 1] - normals[c, 1], normals[q, 2] - normals[c, 2]
+        hx += tx if np.isfinite(tx) else 0.0
+        hy += ty if np.isfinite(ty) else 0.0
+        hz += tz if np.isfinite(tz) else 0.0
+    if count > 0:
+        gx, gy, gz = (gx + radius * hx) / count, (gy + radius * hy) / count, (gz + radius * hz) / count
+    if not normals[c, 0] * normals[c, 0] + normals[c, 1] * normals[c, 1] + normals[c, 2] * normals[c, 2] > 0.0:
+        gx = gy = gz = 0.0  # (a centre without a normal: its ties by index, as its keys)
     start = 0
     for a in range(1, count + 1):
         if a == count or squared[a - 1] < squared[a] * (1.0 - tie):  # a run [start, a) ends
             if a - start > 1:
-                _sort_tied(points, normals, c, out, row, start, a, tie)
+                _sort_tied(points, normals, c, out, row, start, a, tie, gx, gy, gz, radius)
             start = a
     return count
 
@@ -536,8 +574,9 @@ def _chunk_measured_balls(
         count = 0
         while count < held and sorted_squared[count] < inner:
             count += 1
+        limit = inner * (1.0 - tie)
         count = _whole_row(
-            points, normals, c, sorted_ids, sorted_squared, count, inner * (1.0 - tie), tie, least, index, row, n
+            points, normals, c, sorted_ids, sorted_squared, count, limit, tie, least, index, row, n, radius
         )
         counts[row] = _own_row(normals, c, index, row, count, sheets, own, margin, n)
         if k_wide > 0:
@@ -554,41 +593,71 @@ def _chunk_measured_balls(
                 wide_index,
                 row,
                 n,
+                wide,
             )
             wide_counts[row] = _own_row(normals, c, wide_index, row, count, sheets, own, margin, n)
 
 
 @nb.njit(**_JIT)
-def _sort_tied(points, normals, c, out, row, start, end, tie):
-    """Sort ``out[row, start:end]`` by :func:`_tie_key`, keys within ``tie`` of the one before (a chain) by index:
-    an insertion sort by ``(key, index)`` (a few points), then one by index over each chain. Points whose keys
-    differ by round-off alone (a symmetry of the ball: the same geometry) keep one order on both backends."""
+def _sort_tied(points, normals, c, out, row, start, end, tie, gx, gy, gz, radius):
+    """Sort ``out[row, start:end]`` by :func:`_tie_key`, keys within ``tie`` of the one before (a chain) by
+    :func:`_tie_turn` (of the ball's direction ``g`` and ``radius``), those within ``tie`` of the one before by
+    index: insertion sorts (a few points). Points whose keys differ by round-off alone (a symmetry of the ball: the
+    same geometry) keep one order on both backends."""
+    _sort_places(points, normals, c, out, row, start, end, gx, gy, gz, radius, False)
+    first = start
+    while first < end:
+        stop = _chain_end(points, normals, c, out, row, first, end, tie, gx, gy, gz, radius, False)
+        if stop - first > 1:
+            _sort_places(points, normals, c, out, row, first, stop, gx, gy, gz, radius, True)
+            inner = first
+            while inner < stop:
+                last = _chain_end(points, normals, c, out, row, inner, stop, tie, gx, gy, gz, radius, True)
+                for b in range(inner + 1, last):  # by index
+                    q = out[row, b]
+                    j = b
+                    while j > inner and out[row, j - 1] > q:
+                        out[row, j] = out[row, j - 1]
+                        j -= 1
+                    out[row, j] = q
+                inner = last
+        first = stop
+
+
+@nb.njit(inline="always", **_JIT)
+def _place(points, normals, j, c, gx, gy, gz, radius, turn):
+    """:func:`_tie_turn` of ``j`` (``turn``) or its :func:`_tie_key`."""
+    return _tie_turn(points, normals, j, c, gx, gy, gz, radius) if turn else _tie_key(points, normals, j, c)
+
+
+@nb.njit(**_JIT)
+def _sort_places(points, normals, c, out, row, start, end, gx, gy, gz, radius, turn):
+    """Sort ``out[row, start:end]`` by ``(`` :func:`_place` ``, index)``: an insertion sort."""
     for a in range(start + 1, end):
         q = out[row, a]
-        key = _tie_key(points, normals, q, c)
+        key = _place(points, normals, q, c, gx, gy, gz, radius, turn)
         j = a
         while j > start:
             p = out[row, j - 1]
-            other = _tie_key(points, normals, p, c)
+            other = _place(points, normals, p, c, gx, gy, gz, radius, turn)
             if not (other > key or (other == key and p > q)):
                 break
             out[row, j] = p
             j -= 1
         out[row, j] = q
-    first = start
-    before = _tie_key(points, normals, out[row, start], c)
-    for a in range(start + 1, end + 1):
-        key = _tie_key(points, normals, out[row, a], c) if a < end else np.inf
-        if a == end or key - before > tie:  # a chain [first, a) ends
-            for b in range(first + 1, a):
-                q = out[row, b]
-                j = b
-                while j > first and out[row, j - 1] > q:
-                    out[row, j] = out[row, j - 1]
-                    j -= 1
-                out[row, j] = q
-            first = a
+
+
+@nb.njit(**_JIT)
+def _chain_end(points, normals, c, out, row, first, end, tie, gx, gy, gz, radius, turn):
+    """The end of the chain of ``out[row, first:end]`` (sorted by :func:`_place`) from ``first``: the first point
+    whose place is more than ``tie`` above the one before (``end`` when none)."""
+    before = _place(points, normals, out[row, first], c, gx, gy, gz, radius, turn)
+    for a in range(first + 1, end):
+        key = _place(points, normals, out[row, a], c, gx, gy, gz, radius, turn)
+        if key - before > tie:
+            return a
         before = key
+    return end
 
 
 @nb.njit(**_JIT)
