@@ -18,6 +18,8 @@ from meshcurv._backend import use_backend
 from meshcurv.defects import REACH
 from meshcurv.errors import MeshQualityWarning
 
+pytest.importorskip("skimage")  # the voxel shapes: marching cubes (meshcurv[volume])
+
 BACKENDS = [pytest.param("numba", id="numba"), pytest.param("numpy", id="numpy")]
 
 #: ``voxel_ellipsoid((8, 8, 2), seed=2)`` (issue 29: 24 valid vertices of its rim with ``k_max`` 0.58-0.75 for
