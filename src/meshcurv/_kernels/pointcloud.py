@@ -421,6 +421,29 @@ def _tie_key(points, normals, j, c):
 
 
 @nb.njit(inline="always", **_JIT)
+def _ball_direction(points, normals, c, ids, count, radius):
+    """:func:`_tie_turn`'s direction of the ball of ``c`` (its ``count`` points ``ids``, in the order of (squared
+    distance, index)): its mean offset plus ``radius`` times its mean turn of the normals; 0 for a centre without a
+    normal (its ties by index, as its keys). The NumPy twin: in
+    :func:`meshcurv._pointcloud_estimators._whole_ties`."""
+    gx = gy = gz = hx = hy = hz = 0.0
+    for a in range(count):
+        q = ids[a]
+        gx += points[q, 0] - points[c, 0]
+        gy += points[q, 1] - points[c, 1]
+        gz += points[q, 2] - points[c, 2]
+        tx, ty, tz = normals[q, 0] - normals[c, 0], normals[q, 1] - normals[c, 1], normals[q, 2] - normals[c, 2]
+        hx += tx if np.isfinite(tx) else 0.0
+        hy += ty if np.isfinite(ty) else 0.0
+        hz += tz if np.isfinite(tz) else 0.0
+    if count > 0:
+        gx, gy, gz = (gx + radius * hx) / count, (gy + radius * hy) / count, (gz + radius * hz) / count
+    if not normals[c, 0] * normals[c, 0] + normals[c, 1] * normals[c, 1] + normals[c, 2] * normals[c, 2] > 0.0:
+        gx = gy = gz = 0.0
+    return gx, gy, gz
+
+
+@nb.njit(inline="always", **_JIT)
 def _tie_turn(points, normals, j, c, gx, gy, gz, radius):
     """The place of point ``j`` among the points of the ball of ``c`` whose :func:`_tie_key` it shares (a symmetry
     of the centre and the normals: a flat facet's points at one distance): ``(u . g + w n_c . (u x g)) / radius`` of
@@ -459,26 +482,15 @@ def _whole_row(points, normals, c, ids, squared, count, limit, tie, least, out, 
         out[row, a] = ids[a]
     for a in range(count, k):
         out[row, a] = n
-    # the ball's mean offset and its mean turn of the normals times the radius, in the order of (squared distance,
-    # index): :func:`_tie_turn`'s direction of the ball
-    gx = gy = gz = hx = hy = hz = 0.0
-    for a in range(count):
-        q = ids[a]
-        gx += points[q, 0] - points[c, 0]
-        gy += points[q, 1] - points[c, 1]
-        gz += points[q, 2] - points[c, 2]
-        tx, ty, tz = normals[q, 0] - normals[c, 0], normals[q, 1] - normals[c, 1], normals[q, 2] - normals[c, 2]
-        hx += tx if np.isfinite(tx) else 0.0
-        hy += ty if np.isfinite(ty) else 0.0
-        hz += tz if np.isfinite(tz) else 0.0
-    if count > 0:
-        gx, gy, gz = (gx + radius * hx) / count, (gy + radius * hy) / count, (gz + radius * hz) / count
-    if not normals[c, 0] * normals[c, 0] + normals[c, 1] * normals[c, 1] + normals[c, 2] * normals[c, 2] > 0.0:
-        gx = gy = gz = 0.0  # (a centre without a normal: its ties by index, as its keys)
     start = 0
+    found = False  # the ball's direction, read at its first run of tied points only (most balls have none)
+    gx = gy = gz = 0.0
     for a in range(1, count + 1):
         if a == count or squared[a - 1] < squared[a] * (1.0 - tie):  # a run [start, a) ends
             if a - start > 1:
+                if not found:
+                    gx, gy, gz = _ball_direction(points, normals, c, ids, count, radius)
+                    found = True
                 _sort_tied(points, normals, c, out, row, start, a, tie, gx, gy, gz, radius)
             start = a
     return count
