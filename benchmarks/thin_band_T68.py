@@ -8,9 +8,13 @@ default; the error of H over the largest exact ``|k|`` at each vertex, over the 
 their ball reaches round the surface. ``tuned`` marks the shapes the constants were chosen on (T68); the rest were
 not looked at before the constants were fixed.
 
+A second table (T70) runs the thin shapes at given radii (``radius=`` 0.12, 0.25, 0.35: 0.6, 1.4 and 2 default radii of
+the ellipsoid (3, 3, 0.15) s16), where balls that stop short of the rim read the curvature growing towards it; its
+``tuned`` marks the shapes the check of the wider ball (``meshcurv.estimators.icc.THIN_VARYING``) was chosen on.
+
 Run from the repository root (a source tree with ``PYTHONPATH=<tree>/src`` to compare two commits)::
 
-    python benchmarks/thin_band_T68.py [numba|numpy]
+    python benchmarks/thin_band_T68.py [numba|numpy] [--radii]
 """
 
 from __future__ import annotations
@@ -50,16 +54,37 @@ CASES = (
 )
 
 
-def main(backend: str) -> None:
+#: The thin shapes of the given radii's table (T70), with whether the wider ball's check was tuned on them.
+THIN_CASES = (
+    ("ellipsoid (3, 3, 0.15) s16", True, CASES[1][2]),
+    ("ellipsoid (3, 2, 0.1) s20", True, CASES[4][2]),
+    ("ellipsoid (3, 3, 0.05) s24", True, CASES[5][2]),
+    ("ellipsoid (3, 1.5, 0.2) s20", False, CASES[10][2]),
+    ("ellipsoid (4, 3, 0.12) s24", False, CASES[11][2]),
+    ("ellipsoid (1, 1, 0.08) s20", False, CASES[12][2]),
+    ("torus (2, 0.08) 128 x 8", False, CASES[13][2]),
+    ("torus (3, 0.1) 96 x 8", False, CASES[6][2]),
+)
+RADII = (0.12, 0.25, 0.35)
+
+
+def main(backend: str, radii: bool = False) -> None:
     print(f"meshcurv {meshcurv.__version__}, backend {backend}\n")
-    print("| shape | tuned | V | valid | off | wrong sign | REACH | H error median / p95 | CPU s |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for name, tuned, make in CASES:
+    given = " radius |" if radii else ""
+    print(f"| shape | tuned | V |{given} valid | off | wrong sign | REACH | H error median / p95 | CPU s |")
+    print(f"|---|---|---|{'---|' if radii else ''}---|---|---|---|---|---|")
+    rows = (
+        [(name, tuned, make, radius) for name, tuned, make in THIN_CASES for radius in RADII]
+        if radii
+        else [(name, tuned, make, None) for name, tuned, make in CASES]
+    )
+    for name, tuned, make, radius in rows:
         mesh = make()
         start = time.process_time()
         with use_backend(backend), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            result = meshcurv.principal_curvatures(mesh.vertices, mesh.faces)
+            given = {} if radius is None else {"radius": radius}
+            result = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, **given)
         cpu = time.process_time() - start
         largest = np.maximum(np.abs(mesh.k_min), np.abs(mesh.k_max))
         H = (result.k_min + result.k_max) / 2
@@ -74,11 +99,13 @@ def main(backend: str) -> None:
             else "-"
         )
         print(
-            f"| {name} | {'yes' if tuned else 'no'} | {valid.size} | {int(valid.sum())} | "
+            f"| {name} | {'yes' if tuned else 'no'} | {valid.size} |{'' if radius is None else f' {radius} |'} "
+            f"{int(valid.sum())} | "
             f"{int(np.sum(valid & (error > 0.5)))} | {int(wrong.sum())} | {reach} | {cells} | {cpu:.2f} |",
             flush=True,
         )
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "numba")
+    arguments = [argument for argument in sys.argv[1:] if argument != "--radii"]
+    main(arguments[0] if arguments else "numba", radii="--radii" in sys.argv[1:])

@@ -73,7 +73,7 @@ def test_thin_rim_never_valid_wrong_at_several_radii_nor_adaptive(backend):
     call does (T69): each radius equal to the single call, and at the default radius (0.18) and the adaptive scale
     no valid vertex off (before: the multi-scale radii all valid, 1,048 off at 0.18; the adaptive scale 744 off)."""
     mesh = shapes.ellipsoid((3.0, 3.0, 0.15), 16)
-    radii = [0.12, 0.18, 0.25]  # (at 0.12 and 0.25 the single call itself has 44-56 valid vertices off: left open)
+    radii = [0.12, 0.18, 0.25]  # (at 0.12 the single call itself has 48 valid vertices off: left open; T70)
     with chosen_backend(backend), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         several = meshcurv.multiscale_curvatures(mesh.vertices, mesh.faces, radii, method="icc")

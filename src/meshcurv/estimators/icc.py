@@ -122,6 +122,13 @@ undefined with the reason "ball reaches round the surface". (Issue 29: the clean
 ellipsoid (3, 3, 0.15) at 16 subdivisions, every vertex valid and H of the wrong
 sign over 0.8-0.95 of its radius, 1,048 vertices off by more than half of the
 largest ``|k|``; none now, 844 undefined at the rim; ``benchmarks/thin_band_T68.md``.)
+Where a fit was so made again, its vertex's sums are read again over a ball :data:`THIN_WIDER` times wider, and it
+is undefined for the same reason where that ball reaches round the part or moves H by more than
+:data:`THIN_VARYING` of its largest ``|k|`` (:func:`_varying`): towards the rim the curvature grows fast, and a ball
+that stops short of it reads up to twice the centre's H (given radii of 0.25 and 0.35 on that ellipsoid: 56 and 148
+valid vertices off, none now; ``benchmarks/thin_band_T68.py --radii``). A fit made again that turns further from the
+face normals than the first (:data:`THIN_FURTHER`: a tube thinner than the ball, whose own side reads flat) keeps the
+first.
 A coarse closed mesh whose balls wrap round its own bend (an icosahedron, a torus
 of 8 x 4 vertices) keeps its values: those balls are symmetric and their fits right.
 
@@ -275,6 +282,29 @@ THIN_OPPOSITE = 0.25
 #: (:func:`meshcurv.jets._thin_part_normals`; a voxel surface's: :data:`meshcurv.jets.THIN_BEND`, its terraces'):
 #: a ball wraps round its own bend only where ``k r`` reaches about ``sqrt(2)``.
 SMOOTH_THIN_BEND = 1.0
+#: A fit so made again is kept only where it turns no further from the mean of the face normals than the first fit,
+#: by more than this many degrees (:func:`fitted_normals`). The balls of a tube thinner than them
+#: (``torus(2, 0.08, 128, 8)`` at its default: normal fits over 0.87 round a tube of 0.08) hold a strip of their own
+#: side that a cubic reads as flat; its fits turned the normals 20-23 degrees off first fits within 1 degree of the
+#: face normals, and the median H error went 1.37% -> 4.45% (T68); kept: 1.37% again. On the thin ellipsoids the
+#: first fits lie 8-56 degrees off the face normals and the fits made again turn back towards them. With no margin
+#: the noisy and irregular coarse meshes of ``benchmarks/accuracy.py --quick``, whose first fits and face normals
+#: differ by their noise, moved by up to 3 points of p95 either way; at 5 and 10 degrees none moved (T70). Not on a
+#: voxel surface (its wider fits, :data:`meshcurv.jets.THIN_WIDEN`): the face normals of a staircase are no guide.
+THIN_FURTHER = 10.0
+#: Where a normal fit was so made again (its ball reached round a thin part), the sums are read again over a ball
+#: :data:`THIN_WIDER` times wider (:func:`_varying`), and the vertex is undefined (reason
+#: :data:`meshcurv.defects.REACH`) where that ball reaches round the part (:func:`_reaching`) or moves H by more
+#: than this share of the largest ``|k|``. Near the rim of a part thinner than the normal fits' balls the curvature
+#: grows fast (the ellipsoid (3, 3, 0.15): ``|k|`` 0.2 at 0.9 of its radius, 133 at the rim), and a ball stopping
+#: short of the rim reads up to twice the centre's H, with the exact normals too: at given radii of 0.25 and 0.35,
+#: 56 and 148 valid vertices off the exact H by more than half of the largest ``|k|``, none now (0.35 and 0.25 left
+#: the same vertices valid on the tuned ellipsoids). Gated on the fits made again: at every fit whose ball held
+#: points facing away, the coarse ellipsoid (3, 2, 1) s4, whose balls wrap round its own bend, lost 34 of its 162
+#: vertices (errors 0.06-0.45); none so.
+THIN_VARYING = 0.5
+#: ... (``sqrt(2)``: a bias growing as ``r^2`` adds as much again, so the step is the bias itself).
+THIN_WIDER = float(np.sqrt(2.0))
 
 
 STAGES = (
@@ -305,6 +335,7 @@ def fitted_normals(
     thin: bool = False,
     widen: float = THIN_WIDEN,
     coarse: bool = False,
+    reaching: np.ndarray | None = None,
 ) -> np.ndarray:
     """(V, 3) unit normals of weighted degree-:data:`NORMAL_DEGREE` jets over balls of ``radius``.
 
@@ -336,7 +367,9 @@ def fitted_normals(
     (:data:`meshcurv.jets.THIN_WIDEN`, its terraces; at samples of the centres), a smooth mesh's over the same balls
     at every centre (1: the other side of a
     thin rim tilted the fits of a clean ellipsoid (3, 3, 0.15) by 3.6-7 degrees over a band 0.8-0.95 of its radius,
-    and H took the wrong sign there; issue 29, T68).
+    and H took the wrong sign there; issue 29, T68). ``reaching`` (V,) bool, when given: set True, in place, at
+    the centres whose fits were so made again (a ball reaching round a thin part): :func:`_varying` reads their
+    sums again over a wider ball.
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
     weighs its area (a mesh whose sampling varies: a part sampled 100 times
@@ -451,9 +484,10 @@ def fitted_normals(
             )
     if level is None and thin and adjacency is not None and (fits is None or wrapped is not None):
         if wrapped is None or wrapped.size:
+            given = np.where(valid[:, None], fitted, normals)
             fitted = _thin_part_normals(
                 vertices,
-                np.where(valid[:, None], fitted, normals),
+                given,
                 radius,
                 np.flatnonzero(valid) if wrapped is None else wrapped,
                 neighbours=neighbours,
@@ -466,6 +500,19 @@ def fitted_normals(
                 sampled=widen != 1.0,
                 bend=THIN_BEND if widen != 1.0 else SMOOTH_THIN_BEND,
             )
+            # a fit made again that turns further from the mean of the face normals than the first (THIN_FURTHER)
+            # keeps the first: the other side tilts a first fit off them, the same side's strip of a thin tube not
+            refitted = ~np.all((fitted == given) | (np.isnan(fitted) & np.isnan(given)), axis=1)
+            with np.errstate(invalid="ignore"):
+                turn = np.degrees(
+                    np.arccos(np.clip(np.einsum("ij,ij->i", fitted, start), -1.0, 1.0))
+                    - np.arccos(np.clip(np.einsum("ij,ij->i", given, start), -1.0, 1.0))
+                )
+                further = refitted & (turn > THIN_FURTHER) & (widen == 1.0)  # (a staircase's face normals: kept)
+            fitted[further] = given[further]
+            refitted &= ~further
+            if reaching is not None:  # the fits made again over their own side
+                reaching |= refitted
     with np.errstate(invalid="ignore"):
         usable = valid & (np.einsum("ij,ij->i", fitted, start) > NORMAL_AGREEMENT)
     if failed is not None:
@@ -1083,6 +1130,7 @@ def _curvatures(
     pieces: np.ndarray | None = None,
     edge: float,
     reached: np.ndarray | None = None,
+    voxel=None,
 ):
     """``k_min, k_max, dir_min, dir_max, normals, valid, radius`` of the measures over balls of ``radius``.
 
@@ -1103,7 +1151,8 @@ def _curvatures(
     The normal fits on thin flat parts are made again over their own side (:func:`fitted_normals` ``thin``).
     ``reached`` (V,) bool, when given (not on a voxel surface at its default): set True, in place, at the vertices
     whose ball of the sums holds the other side of a thin part (:data:`THIN_FACING`), left out of the ``valid``
-    returned.
+    returned. ``voxel``: a callable telling whether the mesh is a voxel surface (read only where a thin part's fits
+    were made again: :func:`_varying` is not read on one).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -1119,6 +1168,8 @@ def _curvatures(
     start("fit normals")
     failed = np.zeros(vertices.shape[0], dtype=bool)
     counts = None  # the points of the normal fits near holes, where cracks were welded (below)
+    facing_columns = reached is not None and boundary_faces is None and not coarse
+    wraps = np.zeros(vertices.shape[0], dtype=bool) if facing_columns else None  # (the fits reaching round: _varying)
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
@@ -1147,6 +1198,7 @@ def _curvatures(
             thin=True,
             widen=THIN_WIDEN if coarse else 1.0,
             coarse=coarse or coarse_fits,
+            reaching=wraps,
         )
 
         if boundary_faces is not None and adjacency is not None:
@@ -1161,7 +1213,6 @@ def _curvatures(
         corners = vertices[faces]
         sides = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         measures = np.column_stack([measures, sides, boundary_faces.astype(np.float64)])
-    facing_columns = reached is not None and boundary_faces is None and not coarse
     if facing_columns:  # nine more columns: the faces' area vectors and normal tensors (THIN_FACING)
         measures = np.column_stack([measures, _facing_measures(vertices, faces)])
     areas_column = counts is not None and boundary_faces is None  # one more column: the faces' areas
@@ -1189,6 +1240,10 @@ def _curvatures(
         valid &= ~sparse
     if facing is not None and reached is not None:
         reached |= _reaching(facing, summed[:, 0], normals, radius, k_min, k_max, valid)
+        if wraps is not None and wraps.any() and not (voxel is not None and voxel()):
+            reached |= _varying(
+                vertices, faces, measures, usable, radius, valid & wraps & ~reached, k_min, k_max, normals
+            )
         valid &= ~reached
     if counts is not None:
         valid &= ~_scattered_pieces(vertices, faces, degenerate, normals, valid, counts, k_min, k_max, edge)
@@ -1211,6 +1266,52 @@ def _facing_measures(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
         unit = np.where(size[:, None] > 0, sides / size[:, None], 0.0)
     rows, columns = [0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]
     return np.column_stack([sides, size[:, None] * unit[:, rows] * unit[:, columns]])
+
+
+def _voxel_reader(mesh: PreparedMesh, defects, stages: Stages):
+    """A callable: whether ``mesh`` is a voxel surface (:func:`meshcurv.radius._voxel_surface`, read once a call:
+    ``stages.voxel``). :func:`_varying` is not read on one: a label cut by the image border has a 90-degree crease
+    between its closing cap and its wall, whose normal fits are made again as a thin part's and whose wider balls
+    read the crease (``tests/test_volume_border.py``: 71-73 vertices of a cut hemisphere undefined)."""
+    found: list[bool] = []
+
+    def read() -> bool:
+        if not found:
+            found.append(bool(_voxel_surface(mesh, defects.invalid_vertices, reading=stages.voxel)))
+        return found[0]
+
+    return read
+
+
+def _varying(vertices, faces, measures, usable, radius, centres, k_min, k_max, normals) -> np.ndarray:
+    """(V,) bool: the ``centres`` (V,) bool whose ball :data:`THIN_WIDER` times wider than ``radius`` (a float or
+    (V,)) moves H by more than :data:`THIN_VARYING` of their largest ``|k|`` (``k_min``, ``k_max``, of the balls
+    of ``radius``) or holds the other side of a thin part (:func:`_reaching`, with those curvatures and
+    ``normals``). ``measures`` (F, >= 3): the face measures, ``mu_0, mu_1, mu_2`` first; ``usable``:
+    :func:`_usable_faces`.
+
+    A ball's H is the mean of the surface's over it: the centre's plus a bias. Where the bias grows as ``r^2`` the
+    wider ball adds as much again, and the step between the two is the bias itself (a faster growth: more). Near
+    the rim of a part thinner than the normal fits' balls the curvature grows fast towards the rim (on the
+    ellipsoid (3, 3, 0.15), ``k`` from 0.2 at 0.9 of its radius to 133 at the rim): a ball that stops short of the
+    rim (its facing as a ball of its own curvatures') still reads twice the centre's H there, with the exact
+    normals too; and a ball just short of reaching round the rim (its facing 0.4-0.5 below, :data:`THIN_FACING`)
+    reads it more than the wider ball does.
+    """
+    out = np.zeros(vertices.shape[0], dtype=bool)
+    ids = np.flatnonzero(centres)
+    if not ids.size:
+        return out
+    radii = THIN_WIDER * np.broadcast_to(np.asarray(radius, dtype=np.float64), (vertices.shape[0],))
+    values = np.column_stack([measures[:, :3], _facing_measures(vertices, faces)])
+    wide = _ball_face_sums(vertices, faces, radii, values, usable=usable, connected=True, centres=ids)
+    k_min, k_max = k_min[ids], k_max[ids]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        step = np.abs(wide[:, 1] / (2.0 * wide[:, 0]) - 0.5 * (k_min + k_max))
+        moved = ~(step <= THIN_VARYING * np.maximum(np.abs(k_min), np.abs(k_max)))
+    reaching = _reaching(wide[:, 3:], wide[:, 0], normals[ids], radii[ids], k_min, k_max, np.ones(ids.size, bool))
+    out[ids] = moved | reaching
+    return out
 
 
 def _reaching(facing, area, normals, radius, k_min, k_max, valid) -> np.ndarray:
@@ -1496,6 +1597,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
         }
         return finish("icc", parameters, valid, normals, k_min, k_max, dir_min, dir_max, defects, radius=radii_v)
     pieces = _soup_pieces(mesh, defects, valid)
+    voxel = _voxel_reader(mesh, defects, stages)
     reached = np.zeros(vertices.shape[0], dtype=bool)  # balls holding a thin part's other side (THIN_FACING)
     if radius is None:  # the default: each vertex at its group's radius times its local sampling's factor,
         # more where its own noise calls for more (a noisy patch)
@@ -1523,6 +1625,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
                 pieces=pieces,
                 coarse_fits=wide,
                 reached=reached,
+                voxel=voxel,
             )
             local = _turned_back(computed, axes)[:-1]
             return _finished({**parameters, "scale": "local"}, local, defects, radii_v, reached)
@@ -1548,6 +1651,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages, adaptive: bool = Fal
             pieces=pieces,
             coarse_fits=wide,
             reached=reached if members is None else group_reached,
+            voxel=voxel,
         )
         computed = _turned_back(computed, axes)[:-1]
         if members is None:
@@ -1600,6 +1704,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     radii = [_check_radius(radius, mesh) if j in (0, last) else float(radius) for j, radius in enumerate(radii)]
     stages.start("fit normals")
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
+    wraps = np.zeros((len(radii), vertices.shape[0]), dtype=bool)  # the fits reaching round (_varying)
     # the fits of the radii not fitted on the coarse level (a voxel surface's wider than COARSE_EDGES median edges:
     # _coarse_fits; any other mesh's none), from one walk per vertex (the radii increase, and so does _dense: the
     # radii fitted so are the first ones)
@@ -1638,6 +1743,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
             coarse=voxel,
             thin=True,  # a thin part's fits made again over their own side, as estimate's (widen 1)
             widen=1.0,
+            reaching=wraps[j],
         )
         for j, radius in enumerate(radii)
     ]
@@ -1659,12 +1765,19 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         )
     stages.start("retrieve curvatures")
     out = []
-    for radius, rung, sums, rung_failed in zip(radii, normals, summed, failed):
+    voxel_reader = _voxel_reader(mesh, defects, stages)
+    for radius, rung, sums, rung_failed, values, mask, wrapped in zip(
+        radii, normals, summed, failed, measures, kept, wraps
+    ):
         sums, facing_sums = sums[:, :-FACING_COLUMNS], sums[:, -FACING_COLUMNS:]
         k_min, k_max, dir_min, dir_max = curvatures_from_measures(sums, rung)
         parameters = {"radius": radius, "normal_radius": NORMAL_RADIUS_RATIO * radius}
         rung_valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed)
         reached = _reaching(facing_sums, sums[:, 0], rung, radius, k_min, k_max, rung_valid)
+        if wrapped.any() and not voxel_reader():  # as estimate's (_curvatures)
+            reached |= _varying(
+                vertices, faces, values, mask, radius, rung_valid & wrapped & ~reached, k_min, k_max, rung
+            )
         fields = (k_min, k_max, dir_min, dir_max, rung, rung_valid & ~reached)
         out.append(_finished(parameters, fields, defects, np.full(vertices.shape[0], radius), reached))
     return out
@@ -1686,6 +1799,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     stages.start("fit normals")
     wide = _coarse_fits(mesh, NORMAL_RADIUS_RATIO * base, defects.invalid_vertices, stages)
     axes = _grid_axes(mesh, stages.voxel) if wide else None  # (the coarse level along the grid's axes)
+    wraps = np.zeros(vertices.shape[0], dtype=bool)  # the fits reaching round (_varying)
     normals = fitted_normals(
         _along(vertices, axes),
         _along(mesh.vertex_normals, axes),
@@ -1697,6 +1811,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
         coarse=wide,
         thin=True,  # a thin part's fits made again over their own side, as estimate's (widen 1)
         widen=1.0,
+        reaching=wraps,
     )
     normals = normals if axes is None else normals @ axes
     stages.start("compute face measures")
@@ -1704,9 +1819,8 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     stages.start("sum over balls")
     area = 0.5 * float(np.linalg.norm(mesh.cross[~_dropped(mesh)], axis=1).sum())
     radii = scale_ladder(base, median_edge_length(vertices, topology.edges), area)
-    summed = _ball_face_sums_nested(
-        vertices, faces, radii, measures, usable=_usable_faces(faces, _dropped(mesh), normals)
-    )
+    usable = _usable_faces(faces, _dropped(mesh), normals)
+    summed = _ball_face_sums_nested(vertices, faces, radii, measures, usable=usable)
     stages.start("retrieve curvatures")
     summed, facing_sums = summed[..., :-FACING_COLUMNS], summed[..., -FACING_COLUMNS:]
     rung = stable_scales(*principal_from_measures(summed), topology.neighbour_lists)
@@ -1717,5 +1831,9 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     valid = valid & np.isfinite(k_min)
     # the rung chosen holding a thin part's other side (_reaching): undefined, not a smaller rung's value
     reached = _reaching(facing_sums[rung, every], chosen[:, 0], normals, radii[rung], k_min, k_max, valid)
+    if wraps.any() and not _voxel_reader(mesh, defects, stages)():  # the rung chosen read over a wider ball (_varying)
+        reached |= _varying(
+            vertices, faces, measures, usable, radii[rung], valid & wraps & ~reached, k_min, k_max, normals
+        )
     fields = (k_min, k_max, dir_min, dir_max, normals, valid & ~reached)
     return _finished(parameters, fields, defects, radii[rung], reached)
