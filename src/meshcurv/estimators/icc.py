@@ -123,12 +123,11 @@ ellipsoid (3, 3, 0.15) at 16 subdivisions, every vertex valid and H of the wrong
 sign over 0.8-0.95 of its radius, 1,048 vertices off by more than half of the
 largest ``|k|``; none now, 844 undefined at the rim; ``benchmarks/thin_band_T68.md``.)
 Where a fit was so made again, its vertex's sums are read again over a ball :data:`THIN_WIDER` times wider, and it
-is undefined for the same reason where that ball reaches round the part or moves H by more than
-:data:`THIN_VARYING` of its largest ``|k|`` (:func:`_varying`): towards the rim the curvature grows fast, and a ball
-that stops short of it reads up to twice the centre's H (given radii of 0.25 and 0.35 on that ellipsoid: 56 and 148
-valid vertices off, none now; ``benchmarks/thin_band_T68.py --radii``). A fit made again that turns further from the
-face normals than the first (:data:`THIN_FURTHER`: a tube thinner than the ball, whose own side reads flat) keeps the
-first.
+is undefined for the same reason where that ball reaches round the part (:func:`_wider_reaching`): towards the rim
+the curvature grows fast, and a ball that stops short of it reads up to twice the centre's H (given radii of 0.25
+and 0.35 on that ellipsoid: 56 and 148 valid vertices off, none now; ``benchmarks/thin_band_T68.py --radii``). A fit
+made again that turns further from the face normals than a first fit the other side did not tilt
+(:data:`THIN_FURTHER`, :data:`THIN_FIRST`: a tube thinner than the ball, whose own side reads flat) keeps the first.
 A coarse closed mesh whose balls wrap round its own bend (an icosahedron, a torus
 of 8 x 4 vertices) keeps its values: those balls are symmetric and their fits right.
 
@@ -283,27 +282,36 @@ THIN_OPPOSITE = 0.25
 #: a ball wraps round its own bend only where ``k r`` reaches about ``sqrt(2)``.
 SMOOTH_THIN_BEND = 1.0
 #: A fit so made again is kept only where it turns no further from the mean of the face normals than the first fit,
-#: by more than this many degrees (:func:`fitted_normals`). The balls of a tube thinner than them
-#: (``torus(2, 0.08, 128, 8)`` at its default: normal fits over 0.87 round a tube of 0.08) hold a strip of their own
-#: side that a cubic reads as flat; its fits turned the normals 20-23 degrees off first fits within 1 degree of the
-#: face normals, and the median H error went 1.37% -> 4.45% (T68); kept: 1.37% again. On the thin ellipsoids the
-#: first fits lie 8-56 degrees off the face normals and the fits made again turn back towards them. With no margin
-#: the noisy and irregular coarse meshes of ``benchmarks/accuracy.py --quick``, whose first fits and face normals
-#: differ by their noise, moved by up to 3 points of p95 either way; at 5 and 10 degrees none moved (T70). Not on a
-#: voxel surface (its wider fits, :data:`meshcurv.jets.THIN_WIDEN`): the face normals of a staircase are no guide.
+#: by more than this many degrees, where the first lay within :data:`THIN_FIRST` of them (:func:`fitted_normals`).
+#: The balls of a tube thinner than them (``torus(2, 0.08, 128, 8)`` at its default: normal fits over 0.87 round a
+#: tube of 0.08) hold a strip of their own side that a cubic reads as flat; its fits turned the normals 20-23 degrees
+#: off first fits within 1 degree of the face normals, and the median H error went 1.37% -> 4.45% (T68); kept: 1.37%
+#: again. On the thin ellipsoids the first fits lie 8-56 degrees off the face normals and the fits made again turn
+#: back towards them. With no margin the noisy and irregular coarse meshes of ``benchmarks/accuracy.py --quick``,
+#: whose first fits and face normals differ by their noise, moved by up to 3 points of p95 either way; at 5 and 10
+#: degrees none moved (T70). Not on a voxel surface (its wider fits, :data:`meshcurv.jets.THIN_WIDEN`): the face
+#: normals of a staircase are no guide.
 THIN_FURTHER = 10.0
+#: ... A first fit further than this many degrees from the mean of the face normals was tilted (by the other side, a
+#: fold, a feature narrower than the ball): its fit made again is kept whichever way it turns, as before
+#: :data:`THIN_FURTHER`. The thin tube's first fits lie 0.2-1.0 degrees off. The real meshes' fits made again that
+#: turn more than 10 degrees further start further off: ``spot`` (``tests/data/matgeom``, the README's example) one,
+#: 7.2 degrees (at the tip of a horn, H 27-29: with its first fit, H no closer to the other estimators': at 12 of the
+#: 34 vertices its normal moves), fandisk 15, 1.97-38.9 degrees; kept as they were (T71).
+THIN_FIRST = 1.5
 #: Where a normal fit was so made again (its ball reached round a thin part), the sums are read again over a ball
-#: :data:`THIN_WIDER` times wider (:func:`_varying`), and the vertex is undefined (reason
-#: :data:`meshcurv.defects.REACH`) where that ball reaches round the part (:func:`_reaching`) or moves H by more
-#: than this share of the largest ``|k|``. Near the rim of a part thinner than the normal fits' balls the curvature
-#: grows fast (the ellipsoid (3, 3, 0.15): ``|k|`` 0.2 at 0.9 of its radius, 133 at the rim), and a ball stopping
-#: short of the rim reads up to twice the centre's H, with the exact normals too: at given radii of 0.25 and 0.35,
-#: 56 and 148 valid vertices off the exact H by more than half of the largest ``|k|``, none now (0.35 and 0.25 left
-#: the same vertices valid on the tuned ellipsoids). Gated on the fits made again: at every fit whose ball held
-#: points facing away, the coarse ellipsoid (3, 2, 1) s4, whose balls wrap round its own bend, lost 34 of its 162
-#: vertices (errors 0.06-0.45); none so.
-THIN_VARYING = 0.5
-#: ... (``sqrt(2)``: a bias growing as ``r^2`` adds as much again, so the step is the bias itself).
+#: this many times wider (:func:`_wider_reaching`), and the vertex is undefined (reason
+#: :data:`meshcurv.defects.REACH`) where that ball reaches round the part (:func:`_reaching`, with the curvatures
+#: of the ball of the sums). Near the rim of a part thinner than the normal fits' balls the curvature grows fast
+#: (the ellipsoid (3, 3, 0.15): ``|k|`` 0.2 at 0.9 of its radius, 133 at the rim), and a ball stopping short of the
+#: rim reads up to twice the centre's H, with the exact normals too: at given radii of 0.25 and 0.35, 56 and 148
+#: valid vertices off the exact H by more than half of the largest ``|k|``, none now; the ball ``sqrt(2)`` wider,
+#: which reaches round, tells them (a bias growing as ``r^2``: twice as much). Gated on the fits made again: at every
+#: fit whose ball held points facing away, the coarse ellipsoid (3, 2, 1) s4, whose balls wrap round its own bend,
+#: lost 34 of its 162 vertices (errors 0.06-0.45); none so. T70 also made undefined the vertices where the wider
+#: ball moved H by more than half of their largest ``|k|``: on the tuned ellipsoids no vertex so alone, but 498
+#: vertices of fandisk (flat faces beside its creases, where ``|k|`` is round-off: the two backends parted at 10 of
+#: them, fuzz 800/31) and one of ``spot`` (the README's example); dropped (T71).
 THIN_WIDER = float(np.sqrt(2.0))
 
 
@@ -368,7 +376,7 @@ def fitted_normals(
     at every centre (1: the other side of a
     thin rim tilted the fits of a clean ellipsoid (3, 3, 0.15) by 3.6-7 degrees over a band 0.8-0.95 of its radius,
     and H took the wrong sign there; issue 29, T68). ``reaching`` (V,) bool, when given: set True, in place, at
-    the centres whose fits were so made again (a ball reaching round a thin part): :func:`_varying` reads their
+    the centres whose fits were so made again (a ball reaching round a thin part): :func:`_wider_reaching` reads their
     sums again over a wider ball.
 
     ``areas`` (V,): the vertex areas. With ``weighted``, each point of a fit
@@ -500,15 +508,15 @@ def fitted_normals(
                 sampled=widen != 1.0,
                 bend=THIN_BEND if widen != 1.0 else SMOOTH_THIN_BEND,
             )
-            # a fit made again that turns further from the mean of the face normals than the first (THIN_FURTHER)
-            # keeps the first: the other side tilts a first fit off them, the same side's strip of a thin tube not
+            # a fit made again that turns further from the mean of the face normals than a first fit within
+            # THIN_FIRST of them (THIN_FURTHER) keeps the first: the other side tilts a first fit off them, the same
+            # side's strip of a thin tube not
             refitted = ~np.all((fitted == given) | (np.isnan(fitted) & np.isnan(given)), axis=1)
             with np.errstate(invalid="ignore"):
-                turn = np.degrees(
-                    np.arccos(np.clip(np.einsum("ij,ij->i", fitted, start), -1.0, 1.0))
-                    - np.arccos(np.clip(np.einsum("ij,ij->i", given, start), -1.0, 1.0))
-                )
-                further = refitted & (turn > THIN_FURTHER) & (widen == 1.0)  # (a staircase's face normals: kept)
+                first = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", given, start), -1.0, 1.0)))
+                turn = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", fitted, start), -1.0, 1.0))) - first
+                further = refitted & (turn > THIN_FURTHER) & (first < THIN_FIRST) & (widen == 1.0)  # (a staircase's
+                # face normals: no guide)
             fitted[further] = given[further]
             refitted &= ~further
             if reaching is not None:  # the fits made again over their own side
@@ -1152,7 +1160,7 @@ def _curvatures(
     ``reached`` (V,) bool, when given (not on a voxel surface at its default): set True, in place, at the vertices
     whose ball of the sums holds the other side of a thin part (:data:`THIN_FACING`), left out of the ``valid``
     returned. ``voxel``: a callable telling whether the mesh is a voxel surface (read only where a thin part's fits
-    were made again: :func:`_varying` is not read on one).
+    were made again: :func:`_wider_reaching` is not read on one).
 
     ``valid`` is not changed: the vertices whose ball has no corrected area
     are left out of the one returned. The balls of the normal fits and of the
@@ -1169,7 +1177,9 @@ def _curvatures(
     failed = np.zeros(vertices.shape[0], dtype=bool)
     counts = None  # the points of the normal fits near holes, where cracks were welded (below)
     facing_columns = reached is not None and boundary_faces is None and not coarse
-    wraps = np.zeros(vertices.shape[0], dtype=bool) if facing_columns else None  # (the fits reaching round: _varying)
+    wraps = (
+        np.zeros(vertices.shape[0], dtype=bool) if facing_columns else None
+    )  # (the fits reaching round: _wider_reaching)
     if np.all(np.asarray(radius) > 0):
         if normal_radius is None:
             normal_radius = NORMAL_RADIUS_RATIO * radius
@@ -1241,7 +1251,7 @@ def _curvatures(
     if facing is not None and reached is not None:
         reached |= _reaching(facing, summed[:, 0], normals, radius, k_min, k_max, valid)
         if wraps is not None and wraps.any() and not (voxel is not None and voxel()):
-            reached |= _varying(
+            reached |= _wider_reaching(
                 vertices, faces, measures, usable, radius, valid & wraps & ~reached, k_min, k_max, normals
             )
         valid &= ~reached
@@ -1270,7 +1280,7 @@ def _facing_measures(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 def _voxel_reader(mesh: PreparedMesh, defects, stages: Stages):
     """A callable: whether ``mesh`` is a voxel surface (:func:`meshcurv.radius._voxel_surface`, read once a call:
-    ``stages.voxel``). :func:`_varying` is not read on one: a label cut by the image border has a 90-degree crease
+    ``stages.voxel``). :func:`_wider_reaching` is not read on one: a label cut by the image border has a 90-degree crease
     between its closing cap and its wall, whose normal fits are made again as a thin part's and whose wider balls
     read the crease (``tests/test_volume_border.py``: 71-73 vertices of a cut hemisphere undefined)."""
     found: list[bool] = []
@@ -1283,34 +1293,28 @@ def _voxel_reader(mesh: PreparedMesh, defects, stages: Stages):
     return read
 
 
-def _varying(vertices, faces, measures, usable, radius, centres, k_min, k_max, normals) -> np.ndarray:
+def _wider_reaching(vertices, faces, measures, usable, radius, centres, k_min, k_max, normals) -> np.ndarray:
     """(V,) bool: the ``centres`` (V,) bool whose ball :data:`THIN_WIDER` times wider than ``radius`` (a float or
-    (V,)) moves H by more than :data:`THIN_VARYING` of their largest ``|k|`` (``k_min``, ``k_max``, of the balls
-    of ``radius``) or holds the other side of a thin part (:func:`_reaching`, with those curvatures and
-    ``normals``). ``measures`` (F, >= 3): the face measures, ``mu_0, mu_1, mu_2`` first; ``usable``:
+    (V,)) holds the other side of a thin part (:func:`_reaching`, with their ``k_min``, ``k_max`` of the balls of
+    ``radius`` and ``normals``). ``measures`` (F, >= 1): the face measures, ``mu_0`` first; ``usable``:
     :func:`_usable_faces`.
 
-    A ball's H is the mean of the surface's over it: the centre's plus a bias. Where the bias grows as ``r^2`` the
-    wider ball adds as much again, and the step between the two is the bias itself (a faster growth: more). Near
-    the rim of a part thinner than the normal fits' balls the curvature grows fast towards the rim (on the
-    ellipsoid (3, 3, 0.15), ``k`` from 0.2 at 0.9 of its radius to 133 at the rim): a ball that stops short of the
-    rim (its facing as a ball of its own curvatures') still reads twice the centre's H there, with the exact
-    normals too; and a ball just short of reaching round the rim (its facing 0.4-0.5 below, :data:`THIN_FACING`)
-    reads it more than the wider ball does.
+    A ball's H is the mean of the surface's over it: the centre's plus a bias. Near the rim of a part thinner than
+    the normal fits' balls the curvature grows fast towards the rim (on the ellipsoid (3, 3, 0.15), ``k`` from 0.2
+    at 0.9 of its radius to 133 at the rim): a ball that stops short of the rim (its facing as a ball of its own
+    curvatures') still reads twice the centre's H there, with the exact normals too, where the wider ball reaches
+    round it.
     """
     out = np.zeros(vertices.shape[0], dtype=bool)
     ids = np.flatnonzero(centres)
     if not ids.size:
         return out
     radii = THIN_WIDER * np.broadcast_to(np.asarray(radius, dtype=np.float64), (vertices.shape[0],))
-    values = np.column_stack([measures[:, :3], _facing_measures(vertices, faces)])
+    values = np.column_stack([measures[:, :1], _facing_measures(vertices, faces)])
     wide = _ball_face_sums(vertices, faces, radii, values, usable=usable, connected=True, centres=ids)
-    k_min, k_max = k_min[ids], k_max[ids]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        step = np.abs(wide[:, 1] / (2.0 * wide[:, 0]) - 0.5 * (k_min + k_max))
-        moved = ~(step <= THIN_VARYING * np.maximum(np.abs(k_min), np.abs(k_max)))
-    reaching = _reaching(wide[:, 3:], wide[:, 0], normals[ids], radii[ids], k_min, k_max, np.ones(ids.size, bool))
-    out[ids] = moved | reaching
+    out[ids] = _reaching(
+        wide[:, 1:], wide[:, 0], normals[ids], radii[ids], k_min[ids], k_max[ids], np.ones(ids.size, bool)
+    )
     return out
 
 
@@ -1704,7 +1708,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
     radii = [_check_radius(radius, mesh) if j in (0, last) else float(radius) for j, radius in enumerate(radii)]
     stages.start("fit normals")
     failed = np.zeros((len(radii), vertices.shape[0]), dtype=bool)
-    wraps = np.zeros((len(radii), vertices.shape[0]), dtype=bool)  # the fits reaching round (_varying)
+    wraps = np.zeros((len(radii), vertices.shape[0]), dtype=bool)  # the fits reaching round (_wider_reaching)
     # the fits of the radii not fitted on the coarse level (a voxel surface's wider than COARSE_EDGES median edges:
     # _coarse_fits; any other mesh's none), from one walk per vertex (the radii increase, and so does _dense: the
     # radii fitted so are the first ones)
@@ -1775,7 +1779,7 @@ def estimate_multiscale(mesh: PreparedMesh, *, radii, stages: Stages) -> list[tu
         rung_valid = valid & np.isfinite(k_min) & ~failed_fits_undefined(vertices, faces, radius, rung_failed)
         reached = _reaching(facing_sums, sums[:, 0], rung, radius, k_min, k_max, rung_valid)
         if wrapped.any() and not voxel_reader():  # as estimate's (_curvatures)
-            reached |= _varying(
+            reached |= _wider_reaching(
                 vertices, faces, values, mask, radius, rung_valid & wrapped & ~reached, k_min, k_max, rung
             )
         fields = (k_min, k_max, dir_min, dir_max, rung, rung_valid & ~reached)
@@ -1799,7 +1803,7 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     stages.start("fit normals")
     wide = _coarse_fits(mesh, NORMAL_RADIUS_RATIO * base, defects.invalid_vertices, stages)
     axes = _grid_axes(mesh, stages.voxel) if wide else None  # (the coarse level along the grid's axes)
-    wraps = np.zeros(vertices.shape[0], dtype=bool)  # the fits reaching round (_varying)
+    wraps = np.zeros(vertices.shape[0], dtype=bool)  # the fits reaching round (_wider_reaching)
     normals = fitted_normals(
         _along(vertices, axes),
         _along(mesh.vertex_normals, axes),
@@ -1831,8 +1835,10 @@ def _adaptive(mesh: PreparedMesh, base: float, parameters: dict, defects, valid,
     valid = valid & np.isfinite(k_min)
     # the rung chosen holding a thin part's other side (_reaching): undefined, not a smaller rung's value
     reached = _reaching(facing_sums[rung, every], chosen[:, 0], normals, radii[rung], k_min, k_max, valid)
-    if wraps.any() and not _voxel_reader(mesh, defects, stages)():  # the rung chosen read over a wider ball (_varying)
-        reached |= _varying(
+    if (
+        wraps.any() and not _voxel_reader(mesh, defects, stages)()
+    ):  # the rung chosen read over a wider ball (_wider_reaching)
+        reached |= _wider_reaching(
             vertices, faces, measures, usable, radii[rung], valid & wraps & ~reached, k_min, k_max, normals
         )
     fields = (k_min, k_max, dir_min, dir_max, normals, valid & ~reached)
