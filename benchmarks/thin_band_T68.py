@@ -10,7 +10,7 @@ not looked at before the constants were fixed.
 
 A second table (T70) runs the thin shapes at given radii (``radius=`` 0.12, 0.25, 0.35: 0.6, 1.4 and 2 default radii of
 the ellipsoid (3, 3, 0.15) s16), where balls that stop short of the rim read the curvature growing towards it; its
-``tuned`` marks the shapes the check of the wider ball (``meshcurv.estimators.icc.THIN_VARYING``) was chosen on.
+``tuned`` marks the shapes the check of the wider ball (``meshcurv.estimators.icc.THIN_WIDER``) was chosen on.
 
 Run from the repository root (a source tree with ``PYTHONPATH=<tree>/src`` to compare two commits)::
 

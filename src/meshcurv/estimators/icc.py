@@ -1280,9 +1280,9 @@ def _facing_measures(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 def _voxel_reader(mesh: PreparedMesh, defects, stages: Stages):
     """A callable: whether ``mesh`` is a voxel surface (:func:`meshcurv.radius._voxel_surface`, read once a call:
-    ``stages.voxel``). :func:`_wider_reaching` is not read on one: a label cut by the image border has a 90-degree crease
-    between its closing cap and its wall, whose normal fits are made again as a thin part's and whose wider balls
-    read the crease (``tests/test_volume_border.py``: 71-73 vertices of a cut hemisphere undefined)."""
+    ``stages.voxel``). :func:`_wider_reaching` is not read on one: a label cut by the image border has a 90-degree
+    crease between its closing cap and its wall, whose normal fits are made again as a thin part's and whose wider
+    balls read the crease (``tests/test_volume_border.py``: 71-73 vertices of a cut hemisphere undefined, T70)."""
     found: list[bool] = []
 
     def read() -> bool:
