@@ -603,7 +603,7 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, ed
     # argmax let the last bits of a scaled mesh choose one (issue 29, fuzz_labels seed 460 case 313: a slab's area
     # 0.05% and H 0.1% apart between the spacings x1 and x0.7), and a first axis of the tied ones would change with
     # a permutation of the axes (a transposed image): the tied set is its own side
-    facing = _side_normals(normals, np.where(inside, areas, 0.0), tails, indices)[members]
+    facing = _side_normals(normals, np.where(inside, areas, 0.0), adjacency)[members]
     magnitude = np.abs(facing)
     dominant = magnitude >= magnitude.max(axis=1, keepdims=True) - AXIS_TIE
     side = (dominant * (1 + (facing < 0)) * np.array([1, 3, 9])).sum(axis=1)
@@ -634,9 +634,9 @@ def _coarse_level(vertices, normals, radius, areas, neighbours, adjacency, *, ed
     return (np.concatenate([vertices, centroid]), np.concatenate([normals, group_normals]), allowed, lists, point_areas)
 
 
-def _side_normals(normals: np.ndarray, weights: np.ndarray, tails: np.ndarray, heads: np.ndarray) -> np.ndarray:
+def _side_normals(normals: np.ndarray, weights: np.ndarray, adjacency: tuple) -> np.ndarray:
     """(V, 3) the normals that :func:`_coarse_level` reads its groups' sides from: the normalised sum of the
-    ``weights``-weighted ``normals`` over :data:`SIDE_RINGS` rings of the edges ``tails -> heads`` (each vertex
+    ``weights``-weighted ``normals`` over :data:`SIDE_RINGS` rings of the edge lists ``adjacency`` (CSR; each vertex
     counted once per path, as :func:`_spread_normals`), ``normals`` where that sum is zero (or with 0 rings).
 
     A voxel surface's vertex normals jump between the staircase's treads and risers (axes and diagonals): their
@@ -646,14 +646,16 @@ def _side_normals(normals: np.ndarray, weights: np.ndarray, tails: np.ndarray, h
     points (the call -10% of CPU; ``benchmarks/dense_voxel.md``). The two sides of a part thinner than a cube
     keep their own groups (a slab one or two voxels thick under cubes of four: the same groups over two rings as
     over none)."""
+    from scipy import sparse
+
     if SIDE_RINGS == 0:
         return normals
+    indptr, indices = adjacency
     n = normals.shape[0]
+    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n))
     summed = normals * weights[:, None]
     for _ in range(SIDE_RINGS):
-        summed = summed + np.stack(
-            [np.bincount(tails, weights=summed[heads, k], minlength=n) for k in range(3)], axis=1
-        )
+        summed = summed + ring @ summed
     length = np.linalg.norm(summed, axis=1, keepdims=True)
     return np.divide(summed, length, out=np.array(normals, dtype=np.float64), where=length > 0)
 
