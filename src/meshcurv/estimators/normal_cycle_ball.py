@@ -79,6 +79,14 @@ where the smaller ball reproduces it, and a vertex with no smaller ball within t
 read at half its curvature), the vertex normals of the staircase scatter too much for that test: a vertex whose outer
 ball's mean normal is short (:data:`VOXEL_REACH_MEAN_NORMAL`) is NaN with the same reason (:func:`_voxel_round_balls`).
 
+Staircase readings. At the voxel default the tensor is read in the tangent plane of the shell's mean normal (the
+surface's normals summed over its balls, measured on the edges as the area is: :func:`_shell_normals`), not the
+vertex's own, which on a staircase is off the surface's by up to a radian, and it is divided by the surface's area in
+the balls, ``pi rho^2`` per ball (exact on a sphere), not the staircase's, which has up to 1.3 times more
+(:data:`VOXEL_AREA_INFLATION`, :func:`_voxel_surface_areas`). Without them, the poles of the coarse axis of
+``voxel_sphere(3)`` at 0.5 x 0.2 x 0.2 read ``k`` 0.14 and 0.44 for 1/3 (valid) and clean voxel spheres H 7-11% low
+(issue 29, N71; ``benchmarks/ncb_thin_rim_N70.py --readings``).
+
 References
 ----------
 D. Cohen-Steiner and J.-M. Morvan (2003). Restricted Delaunay triangulations and
