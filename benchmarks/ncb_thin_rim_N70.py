@@ -18,12 +18,20 @@ a pole flat, another cause) and the call's CPU seconds; then the totals of each 
 ``VOXEL_REACH_MEAN_NORMAL`` and the use of ``ROUND_CANDIDATE`` were chosen on the ``tuned`` shapes; the ``held out``
 ones were not looked at until then.
 
-Run: ``python benchmarks/ncb_thin_rim_N70.py`` (``--quick``: the first four shapes of each set).
+``--readings`` (N71): the default against the reading before N71 (``N70``: the tensor in the tangent plane of the
+vertex's own normal, over the staircase's area) in the same run on the same mesh: the vertices left lying by the
+staircase's normals and area (a pole of a coarse axis, the saddles of tori). N71's readings (the shell's mean normal,
+the surface's area, ``normal_cycle_ball._shell_normals`` and ``_voxel_surface_areas``, whose
+``VOXEL_AREA_INFLATION`` was chosen on the ``tuned`` shapes) are the default rows (``N71``).
+
+Run: ``python benchmarks/ncb_thin_rim_N70.py`` (``--quick``: the first four shapes of each set; ``--readings``: N70's
+reading against N71's).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import time
 import warnings
 from unittest import mock
@@ -71,11 +79,20 @@ HELD_OUT = [
 ]
 
 
-def measure(mesh, threshold):
+def _staircase_reading():
+    """The reading before N71: the vertex's own normal and the staircase's area (patches of ``normal_cycle_ball``)."""
+    stack = contextlib.ExitStack()
+    stack.enter_context(mock.patch.object(normal_cycle_ball, "_shell_normals", lambda sums, normals: normals))
+    stack.enter_context(mock.patch.object(normal_cycle_ball, "_voxel_surface_areas", lambda areas, *rest: areas))
+    return stack
+
+
+def measure(mesh, threshold, *, staircase=False):
     """``(valid, lies, rim lies, CPU s)`` of ``normal_cycle_ball`` at its default with ``VOXEL_REACH_MEAN_NORMAL =
-    threshold`` (None: the default)."""
+    threshold`` (None: the default); ``staircase``: with the reading before N71 (:func:`_staircase_reading`)."""
     value = normal_cycle_ball.VOXEL_REACH_MEAN_NORMAL if threshold is None else threshold
-    with mock.patch.object(normal_cycle_ball, "VOXEL_REACH_MEAN_NORMAL", value), warnings.catch_warnings():
+    reading = _staircase_reading() if staircase else contextlib.nullcontext()
+    with reading, mock.patch.object(normal_cycle_ball, "VOXEL_REACH_MEAN_NORMAL", value), warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the mesh's winding and the vertices refused, said in each call
         start = time.process_time()
         result = meshcurv.principal_curvatures(mesh.vertices, mesh.faces, method="normal_cycle_ball")
@@ -98,14 +115,21 @@ def measure(mesh, threshold):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the first four shapes of each set")
+    parser.add_argument("--readings", action="store_true", help="N70's reading (staircase normal, area) against N71's")
     options = parser.parse_args(argv)
+    # rows: (label, threshold, staircase reading)
+    rows = (
+        [("N70", None, True), ("N71", None, False)]
+        if options.readings
+        else [("none", -np.inf, False), ("mean", None, False)]
+    )
     print(f"{'shape':48s} {'set':8s} {'check':5s} {'V':>6s} {'valid':>6s} {'lies':>5s} {'rim':>5s} {'CPU s':>6s}")
     for kind, cases in (("tuned", TUNED), ("held out", HELD_OUT)):
-        totals = {"none": np.zeros(3, dtype=int), "mean": np.zeros(3, dtype=int)}
+        totals = {label: np.zeros(3, dtype=int) for label, _, _ in rows}
         for name, make in cases[:4] if options.quick else cases:
             mesh = make()
-            for label, threshold in (("none", -np.inf), ("mean", None)):  # paired: same mesh, same minute
-                valid, lies, rim, cpu = measure(mesh, threshold)
+            for label, threshold, staircase in rows:  # paired: same mesh, same minute
+                valid, lies, rim, cpu = measure(mesh, threshold, staircase=staircase)
                 totals[label] += (valid, lies, rim)
                 print(
                     f"{name:48s} {kind:8s} {label:5s} {len(mesh.vertices):6d} {valid:6d} {lies:5d} {rim:5d} {cpu:6.2f}",

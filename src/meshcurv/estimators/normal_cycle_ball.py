@@ -79,6 +79,14 @@ where the smaller ball reproduces it, and a vertex with no smaller ball within t
 read at half its curvature), the vertex normals of the staircase scatter too much for that test: a vertex whose outer
 ball's mean normal is short (:data:`VOXEL_REACH_MEAN_NORMAL`) is NaN with the same reason (:func:`_voxel_round_balls`).
 
+Staircase readings. At the voxel default the tensor is read in the tangent plane of the shell's mean normal (the
+surface's normals summed over its balls, measured on the edges as the area is: :func:`_shell_normals`), not the
+vertex's own, which on a staircase is off the surface's by up to a radian, and it is divided by the surface's area in
+the balls, ``pi rho^2`` per ball (exact on a sphere), not the staircase's, which has up to 1.3 times more
+(:data:`VOXEL_AREA_INFLATION`, :func:`_voxel_surface_areas`). Without them, the poles of the coarse axis of
+``voxel_sphere(3)`` at 0.5 x 0.2 x 0.2 read ``k`` 0.14 and 0.44 for 1/3 (valid) and clean voxel spheres H 7-11% low
+(issue 29, N71; ``benchmarks/ncb_thin_rim_N70.py --readings``).
+
 References
 ----------
 D. Cohen-Steiner and J.-M. Morvan (2003). Restricted Delaunay triangulations and
@@ -199,6 +207,46 @@ VOXEL_SHELL_TERRACES = 1.0
 #: vertex normals' turn over the same balls, the rule of :func:`_round_balls`, refused as many lies for 12% (tuned)
 #: and 16% (held out) of the valid vertices.
 VOXEL_REACH_MEAN_NORMAL = 0.5 * (1.0 + float(np.cos(BALL_TURN_CAP)))
+
+
+#: At the voxel default the area that divides a ball's curvature measure is the surface's, not the staircase's
+#: (:func:`_voxel_surface_areas`): the mesh's area in the ball over at most this many times ``pi rho^2``. A
+#: marching-cubes staircase has more area than the surface it samples (its terraces and risers: a flat staircase's mean
+#: normal is 0.85 long, N70), while the curvature measure, the flux of the slope across the ball's rim, is the
+#: surface's: ``voxel_sphere(17)`` read H 0.925 of the exact at the median (its balls held 1.06-1.11 times ``pi
+#: rho^2``), ``voxel_sphere(10)`` at 1 x 1 x 2 0.893 (1.04-1.22). A sphere holds exactly ``pi rho^2`` in a ball of
+#: radius ``rho`` centred on it, a smooth surface ``pi rho^2 (1 + O((rho k)^2))``. A ball holding less (a rim, a
+#: hole) keeps its own area; one holding more than this is a ball over more than its sheet (two parts within the
+#: ball), whose excess is not the staircase's: it is divided by this much only.
+VOXEL_AREA_INFLATION = 1.3
+
+
+def _voxel_surface_areas(areas: np.ndarray, groups: list, shells: list, n: int) -> np.ndarray:
+    """(V,) the ``areas`` of a voxel surface's shells of balls (:func:`_ball_sums`: the mesh's area in each ball,
+    added over the shell) read as the surface's: each divided by its ratio to the shell's ``sum pi (s r)^2``, clipped
+    to [1, :data:`VOXEL_AREA_INFLATION`]. ``groups``: ``(radius, members)``; ``shells``: the multiples of each group's
+    radius (:func:`_voxel_shell`)."""
+    disc = np.zeros(n)
+    for (group_radius, members), shell in zip(groups, shells):
+        rows = slice(None) if members is None else members
+        disc[rows] = np.pi * float(sum(s * s for s in shell)) * np.asarray(group_radius, dtype=np.float64) ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        inflation = np.clip(areas / disc, 1.0, VOXEL_AREA_INFLATION)
+    return np.where(np.isfinite(inflation), areas / inflation, areas)
+
+
+def _shell_normals(normal_sums: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(V, 3) the unit mean of the surface's normals over each vertex's shell of balls (``normal_sums``, (V, 3):
+    :func:`_ball_sums`), the vertex's own unit normal (``normals``) where that sum vanishes.
+
+    The tensor is read in the tangent plane of this normal at the voxel default: a staircase's vertex normals scatter
+    by up to a radian round the surface's (``voxel_sphere(3)`` at 0.5 x 0.2 x 0.2: a pole's vertex normals 0.6-1.2 rad
+    off its axis), and the tensor restricted to such a plane mixes its normal part into ``k_min`` and ``k_max``
+    (``k`` 0.14 and 0.44 for 1/3, valid; issue 29)."""
+    lengths = np.linalg.norm(normal_sums, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = normal_sums / lengths[:, None]
+    return np.where((lengths > 0)[:, None] & np.isfinite(unit).all(axis=1)[:, None], unit, normals)
 
 
 def _voxel_shell(radius: float, step: float) -> tuple[float, ...]:
@@ -541,8 +589,10 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         grid = stages.voxel.mesh_grid(mesh)
         step = float(np.max(grid.spacing)) if grid is not None else np.nan
         shells = [_voxel_shell(float(np.max(r)), step) for r, _ in groups]
-    measures, areas, spread_sums, holes, readings, summed = _ball_sums(
-        vertices, topology, groups, radii, terms, scattered, shells
+    # at the voxel default the shell's own normals too: a staircase's vertex normal is off by up to a radian
+    area_normals = np.where(kept_faces[:, None], cross / 2.0, 0.0) if stages.voxel_default else None
+    measures, areas, spread_sums, holes, readings, summed, normal_sums = _ball_sums(
+        vertices, topology, groups, radii, terms, scattered, shells, area_normals
     )
 
     stages.start("retrieve curvatures")
@@ -553,7 +603,12 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
     outer = [(max(shell) * np.asarray(r, dtype=np.float64), m) for (r, m), shell in zip(groups, shells)]  # its reach
     holed = _voxel_holed_balls(mesh, holes, outer, valid, stages.voxel) & valid
     valid &= ~holed
-    k_min, k_max, dir_min, dir_max = _principal(measures, areas, normals, valid)
+    read_areas = areas
+    # at the voxel default: the shell's mean normal and the surface's area, not the staircase's
+    if normal_sums is not None:
+        normals = _shell_normals(normal_sums, normals)
+        read_areas = _voxel_surface_areas(areas, groups, shells, vertices.shape[0])
+    k_min, k_max, dir_min, dir_max = _principal(measures, read_areas, normals, valid)
     reached = np.zeros_like(valid)
     if radius is None and not stages.voxel_default:  # a default ball that reaches round the surface: made smaller
         sums = (measures, areas, spread_sums)
@@ -563,7 +618,7 @@ def estimate(mesh: PreparedMesh, *, radius, stages: Stages):
         factors = np.ones_like(radii)
         for (_, members), shell in zip(groups, shells):
             factors[slice(None) if members is None else members] = max(shell)
-        faces = (np.where(kept_faces[:, None], cross / 2.0, 0.0), intact, lengths)
+        faces = (area_normals, intact, lengths)
         reached = _voxel_round_balls(mesh, factors * radii, valid, (k_min, k_max), faces)
         valid &= ~reached
     few, biased = np.zeros_like(valid), np.zeros_like(valid)
@@ -736,22 +791,33 @@ def _reach_note(count: int, *, voxel: bool = False) -> str:
     )
 
 
-def _ball_sums(vertices, topology, groups, radii, terms, scattered, shells=None):
-    """``(measures, areas, spread_sums, holes, readings, (edge_values, measured))`` of the balls of ``groups``
+def _ball_sums(vertices, topology, groups, radii, terms, scattered, shells=None, area_normals=None):
+    """``(measures, areas, spread_sums, holes, readings, (edge_values, measured), normal_sums)`` of the balls of ``groups``
     (``(radius, members)``; a radius may be one per vertex): the tensor's six columns, the area and the scatter's
     columns (:func:`_edge_spread_columns`, none without ``scattered``), each vertex's sums over its ball, with the
     edges of holes (:func:`hole_edges`, read within ``radii``, (V,)) taking neither curvature nor area; last, what
     was summed (:func:`_edge_values`: :func:`_round_balls` sums it again over smaller balls). ``terms``: ``(beta,
     unit, lengths, intact, usable)`` of the edges, ``intact`` their area densities with the holes'. ``shells``: per group,
-    the multiples of its radius whose balls' sums are added (:func:`_voxel_shell`; None: one ball each)."""
+    the multiples of its radius whose balls' sums are added (:func:`_voxel_shell`; None: one ball each).
+    ``area_normals``: (F, 3) each face's area times its unit normal (0 for the faces left out); with it, each ball's
+    sum of the normals over its area (``normal_sums``, (V, 3); else None), measured on the edges as the area is (the
+    holes' edges add none), in the same pass."""
     edge_values, measured, holes, readings = _edge_values(vertices, topology, radii, terms, scattered)
-    measures = np.zeros((vertices.shape[0], edge_values.shape[1]))
+    width = edge_values.shape[1]
+    values = edge_values
+    if area_normals is not None:
+        lengths = terms[2]
+        columns = [edge_area_densities(topology, area_normals[:, axis], lengths) for axis in range(3)]
+        values = np.column_stack([edge_values, np.where(holes[:, None], 0.0, np.column_stack(columns))])
+    measures = np.zeros((vertices.shape[0], values.shape[1]))
     for (group_radius, members), shell in zip(groups, shells or [(1.0,)] * len(groups)):
         rows = slice(None) if members is None else members
         for factor in shell:
             ball = group_radius if factor == 1.0 else factor * np.asarray(group_radius, dtype=np.float64)
-            measures[rows] += _ball_edge_sums(vertices, topology.edges, ball, edge_values, usable=measured)[rows]
-    return measures[:, :6], measures[:, 6], measures[:, 7:], holes, readings, (edge_values, measured)
+            measures[rows] += _ball_edge_sums(vertices, topology.edges, ball, values, usable=measured)[rows]
+    normal_sums = measures[:, width:] if area_normals is not None else None
+    sums = (measures[:, :6], measures[:, 6], measures[:, 7:width], holes, readings, (edge_values, measured))
+    return (*sums, normal_sums)
 
 
 def _edge_values(vertices, topology, radii, terms, scattered):
