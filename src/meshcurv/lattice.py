@@ -77,6 +77,14 @@ LATTICE_ABOVE_ROUND_OFF = 1000.0
 #: this share.
 LATTICE_SAME_STEP = 0.01
 
+#: A turned grid whose two axes have steps equal to this share may be the diagonals of the true one: the vertices of
+#: a cubic grid of ``h`` lie on the planes at right angles to ``(a + b) / sqrt(2)`` too, ``h / sqrt(2)`` apart, and
+#: the frame of the facets found them in one pose only (fuzz_api 811/48: a voxel ellipsoid read on steps 0.35, 0.5,
+#: 0.35 turned, 0.5 each along the axes; its staircase then read as stacked sheets, no point valid). The axes are the
+#: coarsest grid: the two bisectors are taken where they read one whose cell is this many times larger.
+LATTICE_DIAGONAL_STEP = 0.02
+LATTICE_DIAGONAL_CELL = 1.5
+
 #: A cloud none of whose coordinates repeats among this many of its points, evenly spaced, is on no lattice (the
 #: whole cloud is not read: a lattice of fewer than millions of planes along an axis repeats one there).
 LATTICE_PROBE = 4096
@@ -819,6 +827,7 @@ def read_lattice(
     turned = _lattice_in(rows @ frame.T, spacing)
     if not turned.steps.all():
         return lattice
+    frame, turned = _undiagonal(rows, frame, turned, spacing)
     # the axes to the planes' own precision (the frame's search is to a thousandth of a radian): along each, the
     # plane index of every coordinate near its plane is a linear function of the point, w . x + c, whose gradient w
     # is the axis over its step; least squares, then the nearest orthonormal axes. The points are taken from their
@@ -837,6 +846,26 @@ def read_lattice(
     # (the same grid, read to the planes' precision: not another one that round-off made)
     same = exact.steps.all() and np.allclose(exact.steps, turned.steps, rtol=LATTICE_SAME_STEP)
     return exact._replace(frame=refined) if same else turned._replace(frame=frame)
+
+
+def _undiagonal(rows, frame, turned, spacing):
+    """``(frame, lattice)``: the ``frame`` (3, 3) of the :class:`Lattice` ``turned`` of ``rows`` (M, 3), or the frame
+    of its axes where two of them are diagonals of a coarser grid (see :data:`LATTICE_DIAGONAL_STEP`)."""
+    for _ in range(3):  # (each turn halves the cell's count of planes: a frame of three diagonals takes two)
+        steps = turned.steps
+        better = None
+        for i, j in itertools.combinations(range(3), 2):
+            if abs(steps[i] - steps[j]) > LATTICE_DIAGONAL_STEP * max(steps[i], steps[j]):
+                continue
+            axes = frame.copy()
+            axes[i], axes[j] = (frame[i] + frame[j]) / np.sqrt(2.0), (frame[i] - frame[j]) / np.sqrt(2.0)
+            found = _lattice_in(rows @ axes.T, spacing)
+            if found.steps.all() and np.prod(found.steps) > LATTICE_DIAGONAL_CELL * np.prod(steps):
+                better = (axes, found) if better is None or np.prod(found.steps) > np.prod(better[1].steps) else better
+        if better is None:
+            break
+        frame, turned = better
+    return frame, turned
 
 
 def _lattice_in(points, spacing):
