@@ -75,7 +75,10 @@ def _grid_patch(n, function, jitter=0.0, seed=0, scale=1.0, offset=(0.0, 0.0, 0.
     vertices = np.column_stack([x.ravel(), y.ravel(), function(x, y).ravel()]) + np.asarray(offset)
     corner = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel()
     faces = np.vstack(
-        [np.column_stack([corner, corner + n + 1, corner + n + 2]), np.column_stack([corner, corner + n + 2, corner + 1])]
+        [
+            np.column_stack([corner, corner + n + 1, corner + n + 2]),
+            np.column_stack([corner, corner + n + 2, corner + 1]),
+        ]
     )
     return vertices, faces
 
@@ -289,12 +292,18 @@ def compare(a, b) -> dict:
     """The figures of one case: ``a`` compiled, ``b`` NumPy."""
     if str(a["error"]) or str(b["error"]):
         same = str(a["error"]) == str(b["error"])
-        return {"valid": 0 if same else -1, "rel": 0.0 if same else np.inf, "field": f"error {a['error']} | {b['error']}"}
+        return {
+            "valid": 0 if same else -1,
+            "rel": 0.0 if same else np.inf,
+            "field": f"error {a['error']} | {b['error']}",
+        }
     valid_a, valid_b = a["valid"], b["valid"]
     differ = int((valid_a != valid_b).sum())
-    reasons = int((a["invalid_reason"] != b["invalid_reason"]).sum()) if a["invalid_reason"].shape == b[
-        "invalid_reason"
-    ].shape else -1
+    reasons = (
+        int((a["invalid_reason"] != b["invalid_reason"]).sum())
+        if a["invalid_reason"].shape == b["invalid_reason"].shape
+        else -1
+    )
     both = valid_a & valid_b
     scale = float(np.abs(np.concatenate([a["k_min"][valid_a], a["k_max"][valid_a]])).max(initial=0.0)) or 1.0
     worst, field, where = 0.0, "", -1
