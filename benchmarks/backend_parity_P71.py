@@ -379,7 +379,29 @@ def main(argv=None) -> int:
         print(f"  {case}: valid differ {row['valid']}, max rel {row['rel']:.2e} ({row['field']})")
     total = {backend: sum(row.get("seconds", (0, 0))[i] for _, row in rows) for i, backend in enumerate(folders)}
     print(f"\nseconds: numba {total['numba']:.1f}, numpy {total['numpy']:.1f}; results in {root}")
+    _dtype_table(folders["numba"], [case for case, *_ in cases(args.part, args.only)])
     return 0
+
+
+def _dtype_table(folder: Path, names: list) -> None:
+    """float32 against float64 vertices on the compiled backend, at the default radius: the cases whose valid
+    masks differ or whose values part by more than 1e-4 of max |k| (float32's rounding of the vertices is some
+    6e-8 of their size: a larger difference is a decision that the rounding flips)."""
+    print("\nfloat32 against float64 vertices (compiled backend, default radius): valid differ, max rel")
+    parted = 0
+    for name in names:
+        if not name.endswith("|default|f32"):
+            continue
+        other = name[: -len("f32")] + "f64"
+        with (
+            np.load(folder / (other.replace("|", "__") + ".npz")) as a,
+            np.load(folder / (name.replace("|", "__") + ".npz")) as b,
+        ):
+            row = compare(dict(a), dict(b))
+        if row["valid"] or row["rel"] > 1e-4:
+            parted += 1
+            print(f"  {name[: -len('|default|f32')]}: valid differ {row['valid']}, max rel {row['rel']:.1e}")
+    print(f"  {parted} case(s)")
 
 
 if __name__ == "__main__":

@@ -58,14 +58,11 @@ def _grid(n: int, step: float, height=None):
 
 def _cracked(mesh):
     """``mesh`` with the faces beyond x = 0 given their own copies of their vertices: a crack across it."""
-    vertices, faces = mesh.vertices, mesh.faces
-    side = vertices[faces][:, :, 0].mean(axis=1) > 0
-    copied = np.unique(faces[side])
-    index = np.arange(vertices.shape[0])
-    index[copied] = vertices.shape[0] + np.arange(copied.size)
-    faces = faces.copy()
-    faces[side] = index[faces[side]]
-    return np.vstack([vertices, vertices[copied]]), faces
+    beyond = mesh.vertices[mesh.faces].mean(axis=1)[:, 0] > 0
+    used, inverse = np.unique(mesh.faces[beyond], return_inverse=True)
+    faces = mesh.faces.copy()
+    faces[beyond] = mesh.vertices.shape[0] + inverse.reshape(-1, 3)
+    return np.vstack([mesh.vertices, mesh.vertices[used]]), faces
 
 
 def _mixed_winding(mesh, seed: int):
