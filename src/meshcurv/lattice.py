@@ -59,9 +59,10 @@ _ON_GRID = 1e-6
 #: (an STL file, a float32 array) hold every grid coordinate ``origin + i * spacing`` rounded by up to this times its
 #: size: still repeated bit for bit, but, where ``spacing`` is no float32 value (0.8, 1.4), no longer evenly spaced
 #: within :data:`_ON_GRID` (at 10 voxels from 0, some 1e-6 of a voxel). The exact reading is made again on such
-#: vertices with this round-off (:func:`_exact_voxel_grid`) where it found no grid at float64's: a small voxel object
-#: (under some 8 voxels along an axis: too few planes for the periodic reading) was read as a smooth mesh, its
-#: staircase as curvature (``meyer``: every vertex valid, the median H error 100%; float64: refused).
+#: vertices with this round-off (:func:`_exact_voxel_grid`), kept where float64's found no grid or a finer one: a
+#: small voxel object (under some 8 voxels along an axis: too few planes for the periodic reading) was read as a
+#: smooth mesh, its staircase as curvature (``meyer``: every vertex valid, the median H error 100%; float64:
+#: refused), or at half its voxel size.
 FLOAT32_ROUND_OFF = 2.0**-24
 
 
@@ -687,11 +688,16 @@ VOXEL_ROUNDING = 1e-11
 
 
 def _exact_voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
-    """:func:`voxel_grid` on the coordinates that repeat bit for bit; on vertices that went through float32, where
-    none is found at float64's round-off, again at float32's (:data:`FLOAT32_ROUND_OFF`)."""
+    """:func:`voxel_grid` on the coordinates that repeat bit for bit; on vertices that went through float32, also at
+    float32's round-off (:data:`FLOAT32_ROUND_OFF`), that reading kept where float64's found none or a finer grid
+    (the half voxels' of a binary mask's isosurface, where the rounding left too few coordinates on the voxels' own
+    planes to choose them: a voxel torus in 0.9 x 1 x 1.3 voxels, read at half its voxel size)."""
     grid = _exact_voxel_grid_at(vertices, 0.0)
-    if grid is None and _float32_values(vertices):
-        grid = _exact_voxel_grid_at(vertices, FLOAT32_ROUND_OFF)
+    if _float32_values(vertices):
+        rounded = _exact_voxel_grid_at(vertices, FLOAT32_ROUND_OFF)
+        coarser = grid is None or (rounded is not None and np.prod(rounded.spacing) > 1.5 * np.prod(grid.spacing))
+        if rounded is not None and coarser:
+            grid = rounded
     return grid
 
 
