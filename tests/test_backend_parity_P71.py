@@ -194,6 +194,7 @@ def test_backends_agree_on_a_flat_grid_cloud_at_tie_radii(method, steps):
 @pytest.mark.parametrize("method", ["icc", "quadric", "normal_cycle_ball"])
 def test_backends_agree_on_a_voxel_sphere_at_lattice_radii(method, voxels):
     # marching cubes' vertices on the half-voxel lattice: radii of 1, sqrt 2 and 2 voxels pass through rows of them
+    pytest.importorskip("skimage")  # (the voxel shapes' marching cubes)
     sphere = shapes.voxel_sphere(5.0, seed=13)
     compiled, reference = _both(
         lambda: meshcurv.principal_curvatures(sphere.vertices, sphere.faces, method=method, radius=voxels)
@@ -259,6 +260,7 @@ def test_float32_vertices_of_a_small_voxel_surface_are_read_on_its_grid(voxel, b
     # radius 2.91 against 1.74 on the ellipsoid, normal_cycle_ball valid at 304 vertices of the torus against 6. Now
     # as the float64 vertices: the same reasons, the same radius, normal_cycle_ball's curvatures to the float32
     # rounding's effect (measured: 5e-7 of |k|max at most)
+    pytest.importorskip("skimage")  # (the voxel shapes' marching cubes)
     mesh = voxel()
     for method in ("meyer", "icc", "normal_cycle_ball"):
         results = []
