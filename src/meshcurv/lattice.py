@@ -55,6 +55,16 @@ _ORIGIN_CANDIDATES = 64
 #: Grid coordinates within this fraction of the spacing of a plane of the lattice lie on it.
 _ON_GRID = 1e-6
 
+#: The relative round-off of a float32 coordinate (half a unit in its last place). Vertices that went through float32
+#: (an STL file, a float32 array) hold every grid coordinate ``origin + i * spacing`` rounded by up to this times its
+#: size: still repeated bit for bit, but, where ``spacing`` is no float32 value (0.8, 1.4), no longer evenly spaced
+#: within :data:`_ON_GRID` (at 10 voxels from 0, some 1e-6 of a voxel). The exact reading is made again on such
+#: vertices with this round-off (:func:`_exact_voxel_grid`), kept where float64's found no grid or a finer one: a
+#: small voxel object (under some 8 voxels along an axis: too few planes for the periodic reading) was read as a
+#: smooth mesh, its staircase as curvature (``meyer``: every vertex valid, the median H error 100%; float64:
+#: refused), or at half its voxel size.
+FLOAT32_ROUND_OFF = 2.0**-24
+
 
 #: A cloud lies on a lattice along an axis when at least this share of its points share their coordinate along it
 #: with another point, on at least :data:`LATTICE_PLANES` planes whole multiples of the smallest distance between
@@ -341,14 +351,17 @@ def _plane_lattice(planes: np.ndarray, candidates: np.ndarray, share: float):
     return spacing, float(candidates[np.argmax(held)])
 
 
-def _axis_lattice(values: np.ndarray):
+def _axis_lattice(values: np.ndarray, round_off: float = 0.0):
     """``(spacing, origin, on_grid)`` of one coordinate axis, or None when its repeated values form no lattice.
 
     The lattice of every repeated value (a binary mask's isosurface: the grid
     planes and the middles between them), or else that of the busiest ones:
     the interpolated coordinates of a smoothed mask's isosurface repeat too, a
     few times each (a symmetric solid, float32 coordinates), where a plane of
-    the grid holds every vertex on the grid edges that lie in it.
+    the grid holds every vertex on the grid edges that lie in it. ``round_off``
+    (relative, :data:`FLOAT32_ROUND_OFF`): the values were rounded by up to that
+    much; the lattice is then fitted to its planes (least squares) and a value
+    within that round-off (four times, of the largest |value|) of it lies on it.
     """
     planes, counts = np.unique(values, return_counts=True)
     repeated = counts >= _PLANE_MULTIPLICITY
@@ -361,12 +374,22 @@ def _axis_lattice(values: np.ndarray):
     if found is None:
         return None
     spacing, origin = found
+    tolerance = 0.0
+    if round_off:
+        # the planes' rounding pulls a spacing read from their gaps off by some 1e-7, a drift of 1e-6 of a voxel
+        # across ten planes: the lattice fitted to every plane on it instead
+        index, off = _nearest_planes(planes, spacing, origin)
+        on_lattice = np.abs(off) <= 1e3 * _ON_GRID * spacing
+        if np.ptp(index[on_lattice]) > 0:
+            fitted, intercept = np.polyfit(index[on_lattice], planes[on_lattice], 1)
+            spacing, origin = float(fitted), float(intercept)
+        tolerance = 4.0 * round_off * float(np.abs(values).max()) / spacing
     with np.errstate(over="ignore", invalid="ignore"):
         steps = (values - origin) / spacing
     if not np.isfinite(steps).all() or np.abs(steps).max() > 2.0**52:
         return None  # a coordinate billions of voxels away (a spike): not a voxel image
     whole = np.round(steps)
-    on_grid = np.abs(steps - whole) <= _ON_GRID * max(1.0, np.abs(steps).max() * 1e-9)
+    on_grid = np.abs(steps - whole) <= max(_ON_GRID * max(1.0, np.abs(steps).max() * 1e-9), tolerance)
     return spacing, origin, on_grid, whole.astype(np.int64) % 2
 
 
@@ -673,10 +696,30 @@ VOXEL_ROUNDING = 1e-11
 
 
 def _exact_voxel_grid(vertices: np.ndarray) -> VoxelGrid | None:
-    """:func:`voxel_grid` on the coordinates that repeat bit for bit."""
+    """:func:`voxel_grid` on the coordinates that repeat bit for bit; on vertices that went through float32, also at
+    float32's round-off (:data:`FLOAT32_ROUND_OFF`), that reading kept where float64's found none or a finer grid
+    (the half voxels' of a binary mask's isosurface, where the rounding left too few coordinates on the voxels' own
+    planes to choose them: a voxel torus in 0.9 x 1 x 1.3 voxels, read at half its voxel size)."""
+    grid = _exact_voxel_grid_at(vertices, 0.0)
+    if _float32_values(vertices):
+        rounded = _exact_voxel_grid_at(vertices, FLOAT32_ROUND_OFF)
+        coarser = grid is None or (rounded is not None and np.prod(rounded.spacing) > 1.5 * np.prod(grid.spacing))
+        if rounded is not None and coarser:
+            grid = rounded
+    return grid
+
+
+def _float32_values(vertices: np.ndarray) -> bool:
+    """Whether every coordinate of ``vertices`` is a float32 value (exactly: they went through float32)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return bool(np.array_equal(vertices, vertices.astype(np.float32)))
+
+
+def _exact_voxel_grid_at(vertices: np.ndarray, round_off: float) -> VoxelGrid | None:
+    """:func:`_exact_voxel_grid` at one relative ``round_off`` of the coordinates (0: float64's)."""
     found = []
     for k in range(3):  # an axis without a lattice settles it: the others are not sorted (most meshes)
-        axis = _axis_lattice(vertices[:, k])
+        axis = _axis_lattice(vertices[:, k], round_off)
         if axis is None:
             return None
         found.append(axis)
