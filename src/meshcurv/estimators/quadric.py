@@ -1279,15 +1279,16 @@ def _curvedness(coefficients: np.ndarray, normals: np.ndarray, radii: np.ndarray
 
 def _fitted_curvedness(fields: tuple, groups: list, vertices: np.ndarray, referenced: np.ndarray) -> np.ndarray:
     """(V,) the median curvedness ``sqrt((k_min^2 + k_max^2) / 2)`` of the fits in ``fields = (six, fitted,
-    coefficients)`` over each group of components (``groups``), at least ``2 / d`` (``d``: the extent of the
-    referenced vertices, :func:`_extent`, as :func:`_curvature_scales`)."""
+    coefficients)`` over each group of components (``groups``), at least ``2 / d`` (``d``: the diagonal of the
+    bounding box of the referenced vertices, as :func:`_curvature_scales`)."""
     six, fitted, coefficients = fields
     usable = np.isfinite(coefficients).all(axis=1) & referenced
     own = np.full(vertices.shape[0], np.nan)
     if usable.any():
         k_min, k_max = principal_from_shape_operator(six[usable], fitted[usable])[:2]
         own[usable] = np.sqrt((k_min * k_min + k_max * k_max) / 2)
-    diagonal = _extent(vertices[referenced])
+    points = vertices[referenced]
+    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if points.size else 0.0
     return np.fmax(_group_medians(own, groups, np.isfinite(own)), 2.0 / diagonal if diagonal > 0 else np.inf)
 
 
@@ -1307,26 +1308,13 @@ def _noise_sigmas(levels: np.ndarray, groups: list, edge_lengths: np.ndarray) ->
 
 def _curvature_scales(curvedness: np.ndarray, groups: list, vertices: np.ndarray, referenced) -> np.ndarray:
     """(V,) the curvature that a vertex's estimate is held to: the median curvedness of its group (``groups``;
-    :func:`meshcurv.radius.local_noise`), at least ``2 / d`` (``d``: the extent of the referenced vertices,
-    :func:`_extent`: a sphere's curvedness is ``3.5 / d``; a noisy plane is held to the curvature of its
+    :func:`meshcurv.radius.local_noise`), at least ``2 / d`` (``d``: the diagonal of the bounding box of the
+    referenced vertices: a sphere's curvedness is ``2.4 / d``; a noisy plane is held to the curvature of its
     extent)."""
-    diagonal = _extent(vertices[referenced])
+    points = vertices[referenced]
+    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if points.size else 0.0
     floor = 2.0 / diagonal if diagonal > 0 else np.inf
     return np.fmax(_group_medians(curvedness, groups, np.isfinite(curvedness) & referenced), floor)
-
-
-def _extent(points: np.ndarray) -> float:
-    """The extent of ``points`` (N, 3), 0 for none: ``2 sqrt(3 mean |x - mean x|^2)``, which no rigid motion changes
-    (the diagonal of the points' bounding box for a sphere, ``2 sqrt(3) R``, and for a square, ``sqrt(2)`` its side).
-
-    The diagonal of the bounding box in the axes, used until Q71, turned with the mesh: ``1.73`` for a unit cube in
-    its axes, ``2.7`` turned, so that the floor ``2 / d`` of the curvature a noisy ball is held to
-    (:func:`_curvature_scales`) moved by 60% and the validity of 288 of the 2,402 vertices of a cube of 20 x 20 cells
-    a face at a given radius of 2.5 edges changed with its pose."""
-    if points.size == 0:
-        return 0.0
-    offsets = points - points.mean(axis=0)
-    return float(2.0 * np.sqrt(3.0 * np.mean(np.einsum("ij,ij->i", offsets, offsets))))
 
 
 def _noise_reach(reach: tuple, sigmas: np.ndarray, curvatures: np.ndarray, fields: tuple) -> np.ndarray:
