@@ -111,6 +111,7 @@ from ..jets import (
     MIN_POINTS,
     MIN_SPREAD,
     PIVOT_FLOOR,
+    _binomials,
     _exponents,
     _fit_chunk,
     _fit_jets,
@@ -190,6 +191,14 @@ NOISE_REACH = 0.3
 #: A jet whose spread under the noise of its ball exceeds this share of the surface's curvature gives way to a
 #: quadric over the same ball (:func:`_noise_reach`).
 JET_NOISE_REACH = 0.1
+
+#: The smallest spread of a ball's points (:data:`meshcurv.jets.MIN_SPREAD`: ``1 / (sum(w) trace(G^-1))`` in the basis
+#: that no turn of the tangent frame changes) for which :func:`_noise_spreads` gives a fit's spread under the noise of
+#: its ball (below it: inf, the jet takes a quadric where that one's spread is within :data:`NOISE_REACH`, else NaN):
+#: the jets' own floor, below which no jet of that degree is fitted (a jet of degree 4 over such a ball is one of
+#: degree 3 or 2). Read on the normal matrix in the monomials' basis, the test (the smallest eigenvalue over the
+#: largest above 1e-12) changed with the pose (issue 29, fuzz 804/313).
+NOISE_MIN_SPREAD = MIN_SPREAD
 
 #: The noise's standard deviation per unit of noise level (:func:`meshcurv.radius.local_noise`: a mean distance
 #: to degree-2 fits over about 13 points, which absorb part of it): on the spheres, tori and ellipsoids with
@@ -813,12 +822,22 @@ def _noise_spreads(ball: tuple, rows: np.ndarray, radii: np.ndarray, sigmas: np.
     weighted normal matrix, ``M = sum_j w_j^2 (sigma_j / r)^2 b_j b_j^T``), and the shape operator
     ``[[2 c20, c11], [c11, 2 c02]] / r`` by ``sqrt(4 var c20 + 2 var c11 + 4 var c02) / r`` (the root of its
     expected squared Frobenius norm, which no turn of the tangent frame changes), in units of curvature; inf
-    where the normal matrix is singular (fewer points than terms, or points along a curve)."""
+    where the ball's points are not spread for a fit of ``degree`` (:data:`NOISE_MIN_SPREAD`: fewer points than
+    terms, points along a curve), a measure that no rigid motion, scaling or turn of the frame changes either;
+    0 where no point of the ball (of positive weight) has noise.
+
+    The matrices are solved in the basis ``sqrt(C(i + k, i)) u^i v^k`` of :data:`meshcurv.jets.MIN_SPREAD`, on which
+    a turn of the frame acts by an orthogonal matrix: their eigenvalues are those of every pose. (The smallest
+    eigenvalue of ``G`` in the monomials over its largest, the test until Q71, changed with the frame: 2.4e-12 and
+    9.1e-13 for the ball of 15 points of fandisk's vertex 5002 at a radius of 0.198 in two poses, against a floor of
+    1e-12: a spread of 0 in one pose, inf in the other, a jet kept in one and a quadric taken in the other, k_max
+    0.0726 and 0.0714; issue 29, fuzz 804/313.)"""
     vertices, normals, referenced = ball
     ids = np.flatnonzero(referenced)
     exponents = _exponents(degree)
     second = [int(np.flatnonzero((exponents == pair).all(axis=1))[0]) for pair in ((2, 0), (1, 1), (0, 2))]
-    factor = np.array([4.0, 2.0, 4.0])
+    bombieri = np.sqrt(_binomials(degree))  # the basis b_B = S b: G_B = S G S, coefficients c = S c_B
+    factor = np.array([4.0, 2.0, 4.0]) * bombieri[second] ** 2
     t1, t2 = tangent_basis(normals[rows])
     out = np.full(rows.size, np.inf)
     centres = vertices[rows]
@@ -828,16 +847,23 @@ def _noise_spreads(ball: tuple, rows: np.ndarray, radii: np.ndarray, sigmas: np.
         weights = np.clip(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0, None) ** 2
         size = chunk.stop - chunk.start
         frame = (t1[chunk], t2[chunk], normals[rows][chunk])
-        gram = _fit_chunk(offsets, local, size, frame, weights, degree)[0]
-        noise = _fit_chunk(offsets, local, size, frame, (weights * sigmas[ids[j]] / radii[i]) ** 2, degree)[0]
+        scaled = bombieri[:, None] * bombieri[None, :]
+        gram = _fit_chunk(offsets, local, size, frame, weights, degree)[0] * scaled
+        noise = _fit_chunk(offsets, local, size, frame, (weights * sigmas[ids[j]] / radii[i]) ** 2, degree)[0] * scaled
         values, vectors = np.linalg.eigh(gram)
-        solid = values[:, 0] > PIVOT_FLOOR * np.maximum(values[:, -1], 1e-300)
+        with np.errstate(divide="ignore", invalid="ignore"):  # (a singular G: not spread)
+            spread = 1.0 / (gram[:, 0, 0] * (1.0 / values).sum(axis=1))
+        solid = (values[:, 0] > 0) & (spread >= NOISE_MIN_SPREAD)
         inverse = np.where(solid[:, None], 1.0 / np.where(values > 0, values, 1.0), 0.0)
-        # the rows of G^-1 = Q diag(1 / l) Q^T for the second-order terms
+        # the rows of G_B^-1 = Q diag(1 / l) Q^T for the second-order terms
         rows_inverse = np.einsum("nkm,nm,nlm->nkl", vectors[:, second, :], inverse, vectors)
         covariance = np.einsum("nkl,nlm,nkm->nk", rows_inverse, noise, rows_inverse)
         spread = np.sqrt(np.clip(covariance, 0.0, None) @ factor) / radii[chunk]
-        out[chunk] = np.where(solid, spread, np.inf)
+        # a ball none of whose weighted points is noisy: the noise moves nothing, however its points are spread
+        # (its jet as on a clean mesh; the spread test alone turned such balls to quadrics wherever another
+        # vertex of the mesh had noise: test_dirty's torus with a fin, 58 of 668 vertices far from the fin)
+        quiet = np.bincount(local, weights=((weights > 0) & (sigmas[ids[j]] > 0)).astype(float), minlength=size) == 0
+        out[chunk] = np.where(quiet, 0.0, np.where(solid, spread, np.inf))
     return out
 
 
