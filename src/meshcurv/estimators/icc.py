@@ -701,13 +701,9 @@ def _side_normals(normals: np.ndarray, weights: np.ndarray, adjacency: tuple) ->
     points (the call -10% of CPU; ``benchmarks/dense_voxel.md``). The two sides of a part thinner than a cube
     keep their own groups (a slab one or two voxels thick under cubes of four: the same groups over two rings as
     over none)."""
-    from scipy import sparse
-
     if SIDE_RINGS == 0:
         return normals
-    indptr, indices = adjacency
-    n = normals.shape[0]
-    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n))
+    ring = _ring_matrix(adjacency)
     summed = normals * weights[:, None]
     for _ in range(SIDE_RINGS):
         summed = summed + ring @ summed
@@ -1022,11 +1018,8 @@ def _pilot_centres(vertices: np.ndarray, topology: MeshTopology, valid: np.ndarr
 def _spread_normals(neighbour_lists: tuple, centres: np.ndarray, fitted: np.ndarray, fallback, rings: int):
     """(V, 3) unit normals: ``fitted`` at ``centres``; elsewhere the normalised sum of those one ring away, else
     of those two rings away (each counted once per path), ... up to ``rings``; ``fallback`` (V, 3) where none is."""
-    from scipy import sparse
-
-    indptr, indices = neighbour_lists
-    n = indptr.size - 1
-    ring = sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n))
+    ring = _ring_matrix(neighbour_lists)
+    n = ring.shape[0]
     normals = np.array(fallback, dtype=np.float64, copy=True)
     summed = np.zeros((n, 3))
     summed[centres] = fitted
@@ -1040,6 +1033,16 @@ def _spread_normals(neighbour_lists: tuple, centres: np.ndarray, fitted: np.ndar
         normals[fresh] = summed[fresh] / length[fresh, None]
         done |= fresh
     return normals
+
+
+def _ring_matrix(neighbour_lists: tuple):
+    """The (V, V) sparse matrix (CSR, ones) of the neighbour lists ``(indptr, indices)``: ``ring @ x`` sums ``x``
+    over each vertex's ring (:func:`_spread_normals`, :func:`_side_normals`)."""
+    from scipy import sparse
+
+    indptr, indices = neighbour_lists
+    n = indptr.size - 1
+    return sparse.csr_matrix((np.ones(indices.size), indices, indptr), shape=(n, n))
 
 
 def _vertex_areas(mesh: PreparedMesh) -> np.ndarray:
