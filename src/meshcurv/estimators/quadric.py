@@ -838,6 +838,7 @@ def _noise_spreads(ball: tuple, rows: np.ndarray, radii: np.ndarray, sigmas: np.
     second = [int(np.flatnonzero((exponents == pair).all(axis=1))[0]) for pair in ((2, 0), (1, 1), (0, 2))]
     bombieri = np.sqrt(_binomials(degree))  # the basis b_B = S b: G_B = S G S, coefficients c = S c_B
     factor = np.array([4.0, 2.0, 4.0]) * bombieri[second] ** 2
+    scaled = bombieri[:, None] * bombieri[None, :]
     t1, t2 = tangent_basis(normals[rows])
     out = np.full(rows.size, np.inf)
     centres = vertices[rows]
@@ -847,7 +848,6 @@ def _noise_spreads(ball: tuple, rows: np.ndarray, radii: np.ndarray, sigmas: np.
         weights = np.clip(1.0 - np.einsum("ij,ij->i", offsets, offsets), 0.0, None) ** 2
         size = chunk.stop - chunk.start
         frame = (t1[chunk], t2[chunk], normals[rows][chunk])
-        scaled = bombieri[:, None] * bombieri[None, :]
         gram = _fit_chunk(offsets, local, size, frame, weights, degree)[0] * scaled
         noise = _fit_chunk(offsets, local, size, frame, (weights * sigmas[ids[j]] / radii[i]) ** 2, degree)[0] * scaled
         values, vectors = np.linalg.eigh(gram)
